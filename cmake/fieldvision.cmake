@@ -1,0 +1,25 @@
+# Helpers: one library per module folder, tests beside the code.
+#
+# fv_module(NAME name SRCS a.cc b.cc DEPS fv_util ...)
+#   builds library fv_<name> from SRCS and, when tests are on, the test program
+#   <name>_test from every *_test.cc in the folder (linked to the library and GTest).
+function(fv_module)
+  cmake_parse_arguments(M "" "NAME" "SRCS;DEPS;TEST_DEPS" ${ARGN})
+  set(lib fv_${M_NAME})
+  add_library(${lib} STATIC ${M_SRCS})
+  target_include_directories(${lib} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(${lib} PUBLIC ${M_DEPS})
+  target_compile_options(${lib} PRIVATE -Wall -Wextra -Wno-unused-parameter)
+  if(FV_BUILD_TESTS)
+    file(GLOB tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_test.cc)
+    if(tests)
+      add_executable(${M_NAME}_test ${tests})
+      target_link_libraries(${M_NAME}_test PRIVATE ${lib} ${M_TEST_DEPS} fv_testing GTest::gtest
+                            GTest::gtest_main)
+      gtest_discover_tests(${M_NAME}_test
+        WORKING_DIRECTORY ${CMAKE_BINARY_DIR}
+        PROPERTIES ENVIRONMENT "FV_TEST_TMP=${CMAKE_BINARY_DIR}/test-tmp"
+        DISCOVERY_TIMEOUT 60)
+    endif()
+  endif()
+endfunction()

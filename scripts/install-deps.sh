@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian packages fieldvision needs, only those missing. Idempotent; uses sudo
+# only when not root. Set FV_SKIP_INSTALL=1 to skip (e.g. on a machine managed otherwise).
+set -euo pipefail
+[ "${FV_SKIP_INSTALL:-0}" = 1 ] && exit 0
+PKGS=(
+  build-essential cmake ninja-build pkg-config
+  libopencv-dev libopencv-contrib-dev
+  libeigen3-dev libceres-dev
+  nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+missing=()
+for p in "${PKGS[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

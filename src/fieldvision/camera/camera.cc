@@ -1,0 +1,136 @@
+#include "fieldvision/camera/camera.h"
+
+#include <cmath>
+
+#include <ceres/jet.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+bool ValidDistortionSize(size_t n) {
+  return n == 0 || n == 4 || n == 5 || n == 8 || n == 12 || n == 14;
+}
+
+}  // namespace
+
+Camera Camera::FromFov(int width, int height, double hfov_deg) {
+  Camera c;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = 0.5 * width / std::tan(0.5 * hfov_deg * M_PI / 180.0);
+  c.cx = 0.5 * (width - 1);
+  c.cy = 0.5 * (height - 1);
+  return c;
+}
+
+void Camera::Check(const std::string& context) const {
+  FV_REQUIRE(width > 0 && height > 0, "{}: image size must be positive (got {}x{})", context,
+             width, height);
+  for (const auto& [name, v] : {std::pair{"fx", fx}, {"fy", fy}, {"cx", cx}, {"cy", cy}}) {
+    FV_REQUIRE(std::isfinite(v), "{}: camera_matrix {} is not finite", context, name);
+  }
+  FV_REQUIRE(fx > 0 && fy > 0, "{}: camera_matrix focal length must be > 0 (fx={}, fy={})",
+             context, fx, fy);
+  FV_REQUIRE(ValidDistortionSize(distortion.size()),
+             "{}: distortion_coefficients has {} values; OpenCV takes 4, 5, 8, 12 or 14", context,
+             distortion.size());
+  for (double d : distortion) {
+    FV_REQUIRE(std::isfinite(d), "{}: distortion_coefficients contains a non-finite value",
+               context);
+  }
+  if (has_pose) {
+    FV_REQUIRE(cam_from_world.rotation.allFinite() && cam_from_world.translation.allFinite(),
+               "{}: rvec/tvec contain a non-finite value", context);
+  }
+}
+
+std::array<double, kNumIntrinsics> Camera::IntrinsicsBlock() const {
+  std::array<double, kNumIntrinsics> b{};
+  b[0] = fx;
+  b[1] = fy;
+  b[2] = cx;
+  b[3] = cy;
+  for (size_t i = 0; i < distortion.size() && i < kNumDistortion; ++i) b[4 + i] = distortion[i];
+  return b;
+}
+
+void Camera::SetIntrinsicsBlock(const std::array<double, kNumIntrinsics>& b, int num_distortion) {
+  FV_REQUIRE(ValidDistortionSize(num_distortion), "num_distortion {} is not an OpenCV size",
+             num_distortion);
+  fx = b[0];
+  fy = b[1];
+  cx = b[2];
+  cy = b[3];
+  distortion.assign(b.begin() + 4, b.begin() + 4 + num_distortion);
+}
+
+Eigen::Vector3d Camera::CentreInWorld() const {
+  return -cam_from_world.rotation.transpose() * cam_from_world.translation;
+}
+
+std::optional<Eigen::Vector2d> Camera::ProjectFromCamera(const Eigen::Vector3d& p_cam) const {
+  const auto intr = IntrinsicsBlock();
+  Eigen::Vector2d uv;
+  if (!ProjectCameraPoint(intr.data(), p_cam.data(), uv.data())) return std::nullopt;
+  return uv;
+}
+
+std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& p_world) const {
+  return ProjectFromCamera(cam_from_world * p_world);
+}
+
+std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) const {
+  const auto intr = IntrinsicsBlock();
+  const double* d = intr.data() + 4;
+  const Eigen::Vector2d target((uv.x() - cx) / fx, (uv.y() - cy) / fy);
+  bool any = false;
+  for (int i = 0; i < kNumDistortion; ++i) any = any || d[i] != 0.0;
+  if (!any) return target;
+  // Newton's method on distort(x) = target with exact Jacobians from dual numbers.
+  using Jet = ceres::Jet<double, 2>;
+  std::array<Jet, kNumDistortion> dj;
+  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(d[i]);
+  Eigen::Vector2d x = target;
+  for (int iter = 0; iter < 50; ++iter) {
+    Jet xd, yd;
+    DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
+    const Eigen::Vector2d r(xd.a - target.x(), yd.a - target.y());
+    if (r.norm() < 1e-14) return x;
+    Eigen::Matrix2d j;
+    j << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
+    const double det = j.determinant();
+    if (!std::isfinite(det) || std::abs(det) < 1e-12) return std::nullopt;
+    Eigen::Vector2d step = j.inverse() * r;
+    // Damp large steps so the iteration stays in the region where the model is monotonic.
+    const double max_step = 0.5 * (1.0 + x.norm());
+    if (step.norm() > max_step) step *= max_step / step.norm();
+    x -= step;
+    if (!x.allFinite()) return std::nullopt;
+  }
+  Jet xd, yd;
+  DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
+  const double err_px = std::hypot((xd.a - target.x()) * fx, (yd.a - target.y()) * fy);
+  if (err_px < 1e-6) return x;
+  return std::nullopt;
+}
+
+std::optional<Ray3d> Camera::RayFromPixel(const Eigen::Vector2d& uv) const {
+  const auto xn = Undistort(uv);
+  if (!xn) return std::nullopt;
+  const Eigen::Vector3d dir_cam = Eigen::Vector3d(xn->x(), xn->y(), 1.0).normalized();
+  return Ray3d{CentreInWorld(), cam_from_world.rotation.transpose() * dir_cam};
+}
+
+double Camera::PixelFootprintM(const Eigen::Vector3d& p_world) const {
+  const double depth = (cam_from_world * p_world).z();
+  return std::abs(depth) / std::sqrt(fx * fy);
+}
+
+bool Camera::InImage(const Eigen::Vector2d& uv, double margin_px) const {
+  return uv.x() >= -0.5 + margin_px && uv.y() >= -0.5 + margin_px &&
+         uv.x() < width - 0.5 - margin_px && uv.y() < height - 0.5 - margin_px;
+}
+
+}  // namespace fv

@@ -1,0 +1,229 @@
+#include "fieldvision/camera/camera.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+// A camera 20 m from the field centre with plausible distortion of `n` coefficients.
+Camera RandomCamera(Rng& rng, int n) {
+  Camera cam = Camera::FromFov(1280, 960, rng.Uniform(50, 90));
+  cam.cx += rng.Uniform(-20, 20);
+  cam.cy += rng.Uniform(-20, 20);
+  cam.fy *= rng.Uniform(0.98, 1.02);
+  const double full[kNumDistortion] = {rng.Uniform(-0.3, 0.1),   rng.Uniform(-0.05, 0.05),
+                                       rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-3, 1e-3),
+                                       rng.Uniform(-0.01, 0.01), rng.Uniform(-0.05, 0.05),
+                                       rng.Uniform(-0.01, 0.01), rng.Uniform(-0.01, 0.01),
+                                       rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-4, 1e-4),
+                                       rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-4, 1e-4),
+                                       rng.Uniform(-0.02, 0.02), rng.Uniform(-0.02, 0.02)};
+  cam.distortion.assign(full, full + n);
+  const Eigen::Vector3d eye(rng.Uniform(-15, 15), rng.Uniform(-12, -8), rng.Uniform(3, 8));
+  cam.cam_from_world = Rigid3d::LookAt(eye, Eigen::Vector3d(rng.Uniform(-3, 3), 0, 0));
+  cam.has_pose = true;
+  return cam;
+}
+
+Eigen::Vector3d RandomPointInView(Rng& rng, const Camera& cam) {
+  // A point on the ray through a random pixel inside the central 90 % of the image.
+  while (true) {
+    const Eigen::Vector2d uv(rng.Uniform(0.05, 0.95) * cam.width,
+                             rng.Uniform(0.05, 0.95) * cam.height);
+    const auto ray = cam.RayFromPixel(uv);
+    if (ray) return ray->At(rng.Uniform(2, 40));
+  }
+}
+
+class CameraModel : public ::testing::TestWithParam<int> {};
+
+TEST_P(CameraModel, AgreesWithOpenCvProjectPoints) {
+  const uint64_t seed = testing::TestSeed(100 + GetParam());
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Camera cam = RandomCamera(rng, GetParam());
+    std::vector<cv::Point3d> pts;
+    for (int i = 0; i < 50; ++i) {
+      const Eigen::Vector3d p(rng.Uniform(-9, 9), rng.Uniform(-6, 6), rng.Uniform(0, 3));
+      if ((cam.cam_from_world * p).z() > 0.5) pts.emplace_back(p.x(), p.y(), p.z());
+    }
+    const cv::Mat k = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+    const Eigen::Vector3d r = cam.cam_from_world.Rvec();
+    const Eigen::Vector3d& t = cam.cam_from_world.translation;
+    std::vector<cv::Point2d> uv_cv;
+    cv::projectPoints(pts, cv::Vec3d(r.x(), r.y(), r.z()), cv::Vec3d(t.x(), t.y(), t.z()), k,
+                      cam.distortion, uv_cv);
+    for (size_t i = 0; i < pts.size(); ++i) {
+      // Far outside the image the high-order terms blow up; compare where pixels exist.
+      if (!cam.InImage({uv_cv[i].x, uv_cv[i].y}, -0.5 * cam.width)) continue;
+      const auto uv = cam.Project({pts[i].x, pts[i].y, pts[i].z});
+      ASSERT_TRUE(uv);
+      EXPECT_NEAR(uv->x(), uv_cv[i].x, 1e-9);
+      EXPECT_NEAR(uv->y(), uv_cv[i].y, 1e-9);
+    }
+  }
+}
+
+TEST_P(CameraModel, ProjectUnprojectRoundTrip) {
+  const uint64_t seed = testing::TestSeed(200 + GetParam());
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Camera cam = RandomCamera(rng, GetParam());
+    for (int i = 0; i < 50; ++i) {
+      const Eigen::Vector3d p = RandomPointInView(rng, cam);
+      const auto uv = cam.Project(p);
+      ASSERT_TRUE(uv);
+      const auto ray = cam.RayFromPixel(*uv);
+      ASSERT_TRUE(ray);
+      // Distance from the point to the ray, and re-projection of the ray's point.
+      const Eigen::Vector3d v = p - ray->origin;
+      EXPECT_LT((v - v.dot(ray->direction) * ray->direction).norm(), 1e-9);
+      const auto uv2 = cam.Project(ray->At(v.norm()));
+      ASSERT_TRUE(uv2);
+      EXPECT_LT((*uv2 - *uv).norm(), 1e-9);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllDistortionSizes, CameraModel, ::testing::Values(0, 4, 5, 8, 12, 14));
+
+TEST(Camera, BehindAndFootprint) {
+  Camera cam = Camera::FromFov(1000, 800, 90);
+  cam.has_pose = true;  // identity pose: looking along +z
+  EXPECT_FALSE(cam.Project({0, 0, -1}));
+  EXPECT_TRUE(cam.Project({0, 0, 1}));
+  EXPECT_NEAR(cam.PixelFootprintM({0, 0, 10}), 10.0 / 500.0, 1e-12);
+  EXPECT_TRUE(cam.InImage({-0.4, 0}));
+  EXPECT_FALSE(cam.InImage({999.6, 0}));
+}
+
+TEST(CameraIo, YamlRoundTrip) {
+  Rng rng(testing::TestSeed(3));
+  Camera cam = RandomCamera(rng, 8);
+  cam.name = "cam1";
+  cam.rms_px = 0.25;
+  cam.notes["board"] = "chessboard 9x6";
+  const std::string path = testing::TempDir() + "/cam.yaml";
+  WriteCameraYaml(cam, path);
+  const Camera back = ReadCameraYaml(path);
+  EXPECT_EQ(back.name, "cam1");
+  EXPECT_EQ(back.width, 1280);
+  EXPECT_DOUBLE_EQ(back.fx, cam.fx);
+  EXPECT_EQ(back.distortion, cam.distortion);
+  ASSERT_TRUE(back.has_pose);
+  EXPECT_LT((back.cam_from_world.translation - cam.cam_from_world.translation).norm(), 1e-12);
+  EXPECT_LT(RotationAngleBetween(back.cam_from_world.rotation, cam.cam_from_world.rotation), 1e-12);
+  ASSERT_TRUE(back.rms_px);
+  EXPECT_DOUBLE_EQ(*back.rms_px, 0.25);
+  EXPECT_EQ(back.notes.at("board"), "chessboard 9x6");
+  // And it is readable by cv::FileStorage with the contract's keys.
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  cv::Mat k, rvec;
+  fs["camera_matrix"] >> k;
+  fs["rvec"] >> rvec;
+  EXPECT_EQ(k.rows, 3);
+  EXPECT_EQ(rvec.total(), 3u);
+}
+
+TEST(CameraIo, ReadsOpenCvSampleCalibration) {
+  const std::string data = testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "../shared/data not present";
+  const Camera cam = ReadCameraYaml(data + "/opencv-chessboard/left_intrinsics.yml");
+  EXPECT_EQ(cam.width, 640);
+  EXPECT_NEAR(cam.fx, 535.9, 0.1);
+  EXPECT_EQ(cam.distortion.size(), 5u);
+  EXPECT_FALSE(cam.has_pose);
+}
+
+struct BadFile {
+  const char* what;
+  const char* text;
+  const char* expect;  // a word the message must contain
+};
+
+class CameraIoBad : public ::testing::TestWithParam<BadFile> {};
+
+TEST_P(CameraIoBad, OneLineErrorNamingFileAndKey) {
+  const std::string path = testing::TempDir() + "/bad.yaml";
+  std::ofstream(path) << GetParam().text;
+  try {
+    ReadCameraYaml(path);
+    FAIL() << "no error for " << GetParam().what;
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(GetParam().expect), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+#define FV_HDR "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+#define FV_K "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
+#define FV_D "distortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 5\n  dt: d\n  data: [0, 0, 0, 0, 0]\n"
+
+std::string BadFileName(const ::testing::TestParamInfo<BadFile>& info) {
+  std::string s = info.param.what;
+  for (char& c : s) {
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  }
+  return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CameraIoBad,
+    ::testing::Values(
+        BadFile{"missing width", "%YAML:1.0\n---\nimage_height: 480\n" FV_K FV_D, "image_width"},
+        BadFile{"missing matrix", FV_HDR FV_D, "camera_matrix"},
+        BadFile{"missing distortion", FV_HDR FV_K, "distortion_coefficients"},
+        BadFile{"2x2 matrix",
+                FV_HDR "camera_matrix: !!opencv-matrix\n  rows: 2\n  cols: 2\n  dt: d\n  data: [1, "
+                       "0, 0, 1]\n" FV_D,
+                "3x3"},
+        BadFile{"NaN focal",
+                FV_HDR "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: "
+                       "[.nan, 0, 320, 0, 500, 240, 0, 0, 1]\n" FV_D,
+                "NaN"},
+        BadFile{"negative focal",
+                FV_HDR "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: "
+                       "[-500, 0, 320, 0, 500, 240, 0, 0, 1]\n" FV_D,
+                "focal"},
+        BadFile{"6 distortion values",
+                FV_HDR FV_K "distortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 6\n  "
+                            "dt: d\n  data: [0, 0, 0, 0, 0, 0]\n",
+                "distortion_coefficients"},
+        BadFile{"inf in tvec",
+                FV_HDR FV_K FV_D "rvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: d\n  data: "
+                                 "[0, 0, 0]\ntvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: "
+                                 "d\n  data: [0, .inf, 0]\n",
+                "tvec"},
+        BadFile{"rvec without tvec",
+                FV_HDR FV_K FV_D "rvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: d\n  data: "
+                                 "[0, 0, 0]\n",
+                "tvec"},
+        BadFile{"zero width", "%YAML:1.0\n---\nimage_width: 0\nimage_height: 480\n" FV_K FV_D,
+                "image_width"},
+        BadFile{"not yaml", "this is { not yaml", "bad.yaml"},
+        BadFile{"empty", "", "bad.yaml"}),
+    BadFileName);
+
+TEST(CameraIo, MissingFile) {
+  try {
+    ReadCameraYaml("/nonexistent/cam.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/cam.yaml"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace fv

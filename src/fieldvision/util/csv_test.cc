@@ -1,0 +1,56 @@
+#include "fieldvision/util/csv.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+TEST(Csv, RoundTrip) {
+  const std::string path = testing::TempDir() + "/a.csv";
+  {
+    CsvWriter w(path, {"frame", "x_m", "name"}, 3);
+    w << 0 << 1.23456 << "a";
+    w.EndRow();
+    w << 1 << -2.0 << "b";
+    w.EndRow();
+    w.Close();
+  }
+  CsvTable t = CsvTable::Read(path);
+  ASSERT_EQ(t.rows(), 2u);
+  EXPECT_EQ(t.GetInt(1, "frame"), 1);
+  EXPECT_DOUBLE_EQ(t.GetDouble(0, "x_m"), 1.235);
+  EXPECT_EQ(t.Get(1, "name"), "b");
+}
+
+TEST(Csv, ErrorsNameTheInput) {
+  EXPECT_THROW(CsvTable::Read("/nonexistent/x.csv"), Error);
+  try {
+    CsvTable::Parse("a,b\n1,2\n3\n", "f.csv");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("f.csv:3"), std::string::npos) << e.what();
+  }
+  CsvTable t = CsvTable::Parse("a,b\n1,x\n", "g.csv");
+  try {
+    t.GetDouble(0, "b");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("g.csv:2"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(t.Require({"a", "c"}), Error);
+  EXPECT_THROW(CsvTable::Parse("", "empty.csv"), Error);
+}
+
+TEST(Csv, WriterRejectsRaggedRows) {
+  CsvWriter w(testing::TempDir() + "/b.csv", {"a", "b"});
+  w << 1;
+  EXPECT_THROW(w.EndRow(), Error);
+}
+
+}  // namespace
+}  // namespace fv

@@ -1,0 +1,33 @@
+// Progress of a long job on stderr: items done, rate and time left. On a terminal it redraws one
+// line; otherwise it prints a line every ~10 % so logs stay short.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace fv {
+
+class Progress {
+ public:
+  // total <= 0 means unknown. `unit` names the items ("frames").
+  Progress(std::string label, long long total, std::string unit = "frames", bool enabled = true);
+  ~Progress();
+  void Update(long long done);
+  void Finish();
+  double ElapsedSeconds() const;
+
+ private:
+  void Print(bool final_line);
+  std::string label_;
+  std::string unit_;
+  long long total_;
+  long long done_ = 0;
+  bool enabled_;
+  bool tty_;
+  bool finished_ = false;
+  int last_decile_ = -1;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_print_;
+};
+
+}  // namespace fv

@@ -1,0 +1,67 @@
+#include "fieldvision/util/strings.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdlib>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+
+std::vector<std::string> Split(std::string_view s, char sep) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (true) {
+    const size_t pos = s.find(sep, start);
+    if (pos == std::string_view::npos) {
+      out.emplace_back(s.substr(start));
+      return out;
+    }
+    out.emplace_back(s.substr(start, pos - start));
+    start = pos + 1;
+  }
+}
+
+std::string Trim(std::string_view s) {
+  size_t b = 0;
+  size_t e = s.size();
+  while (b < e && std::isspace(static_cast<unsigned char>(s[b]))) ++b;
+  while (e > b && std::isspace(static_cast<unsigned char>(s[e - 1]))) --e;
+  return std::string(s.substr(b, e - b));
+}
+
+bool StartsWith(std::string_view s, std::string_view prefix) {
+  return s.substr(0, prefix.size()) == prefix;
+}
+
+bool EndsWith(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+std::string ToLower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+double ParseDouble(std::string_view s, std::string_view context) {
+  const std::string t = Trim(s);
+  FV_REQUIRE(!t.empty(), "{}: empty value where a number is expected", context);
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  FV_REQUIRE(end == t.c_str() + t.size(), "{}: '{}' is not a number", context, t);
+  return v;
+}
+
+long long ParseInt(std::string_view s, std::string_view context) {
+  const std::string t = Trim(s);
+  long long v = 0;
+  const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  FV_REQUIRE(ec == std::errc() && ptr == t.data() + t.size() && !t.empty(),
+             "{}: '{}' is not an integer", context, t);
+  return v;
+}
+
+}  // namespace fv

@@ -1,0 +1,22 @@
+// Test helpers: a seed per test (FV_TEST_SEED overrides it) that is printed on failure, a fresh
+// temporary folder per test, and the path of the shared real data.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace fv::testing {
+
+// The test's seed: FV_TEST_SEED if set, else `fallback`. Add FV_SEED_TRACE(seed) after it.
+uint64_t TestSeed(uint64_t fallback = 1);
+// An empty folder for this test's files (under $FV_TEST_TMP or /tmp).
+std::string TempDir();
+// ../shared/data next to the source tree; empty string if absent.
+std::string SharedDataDir();
+
+}  // namespace fv::testing
+
+#define FV_SEED_TRACE(seed) \
+  SCOPED_TRACE(::testing::Message() << "seed=" << (seed) << " (rerun with FV_TEST_SEED=" << (seed) << ")")
