@@ -1,11 +1,16 @@
 # Helpers: one library per module folder, tests beside the code.
 #
-# fv_module(NAME name SRCS a.cc b.cc DEPS fv_util ...)
-#   builds library fv_<name> from SRCS and, when tests are on, the test program
-#   <name>_test from every *_test.cc in the folder (linked to the library and GTest).
+# fv_module(NAME name DEPS fv_util ... [TEST_DEPS ...] [SRCS a.cc ...])
+#   builds library fv_<name> from SRCS (default: every *.cc in the folder that is not a
+#   *_test.cc) and, when tests are on, the test program <name>_test from every *_test.cc in the
+#   folder (linked to the library, TEST_DEPS and GTest).
 function(fv_module)
   cmake_parse_arguments(M "" "NAME" "SRCS;DEPS;TEST_DEPS" ${ARGN})
   set(lib fv_${M_NAME})
+  if(NOT M_SRCS)
+    file(GLOB M_SRCS CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cc)
+    list(FILTER M_SRCS EXCLUDE REGEX "_test\\.cc$")
+  endif()
   add_library(${lib} STATIC ${M_SRCS})
   target_include_directories(${lib} PUBLIC ${PROJECT_SOURCE_DIR}/src)
   target_link_libraries(${lib} PUBLIC ${M_DEPS})
