@@ -1,0 +1,54 @@
+#include "fieldvision/app/command.h"
+
+#include <algorithm>
+#include <iostream>
+#include <vector>
+
+namespace fv::app {
+namespace {
+
+struct Entry {
+  int order;
+  std::string name;
+  CommandSetup setup;
+};
+
+std::vector<Entry>& Registry() {
+  static std::vector<Entry> entries;
+  return entries;
+}
+
+}  // namespace
+
+CommandRegistration::CommandRegistration(int order, const std::string& name, CommandSetup setup) {
+  Registry().push_back({order, name, std::move(setup)});
+}
+
+void SetUpAllCommands(CLI::App& app, int& exit_code) {
+  auto entries = Registry();
+  std::sort(entries.begin(), entries.end(),
+            [](const Entry& a, const Entry& b) { return a.order < b.order; });
+  for (const auto& e : entries) e.setup(app, exit_code);
+}
+
+CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string& description) {
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    if (sub->get_name() == name) return sub;
+  }
+  CLI::App* group = app.add_subcommand(name, description);
+  group->require_subcommand(1);
+  return group;
+}
+
+void AddPlannedCommand(CLI::App& parent, const std::string& name, const std::string& summary,
+                       const std::string& plan, int& exit_code) {
+  CLI::App* cmd = parent.add_subcommand(name, summary + " (not built yet)");
+  cmd->footer(plan);
+  cmd->allow_extras();
+  cmd->callback([&exit_code, name, plan] {
+    std::cerr << "fieldvision: '" << name << "' is not built yet: " << plan << "\n";
+    exit_code = 2;
+  });
+}
+
+}  // namespace fv::app

@@ -1,0 +1,37 @@
+// Subcommand registration for the fieldvision program: each cmd_<name>.cc defines a function
+// that adds its CLI11 subcommand and registers it with FV_REGISTER_COMMAND. The subcommand only
+// parses options and calls a library function that tests call directly.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace fv::app {
+
+// Adds a subcommand to `app`; the callback it sets returns through `exit_code`.
+using CommandSetup = std::function<void(CLI::App& app, int& exit_code)>;
+
+struct CommandRegistration {
+  // `order` sorts the subcommands in --help.
+  CommandRegistration(int order, const std::string& name, CommandSetup setup);
+};
+
+void SetUpAllCommands(CLI::App& app, int& exit_code);
+
+// A command group (e.g. "calibrate", "eval") shared by several cmd_*.cc files: returns the
+// existing subcommand or adds it.
+CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string& description);
+
+// For subcommands of later work: prints what it will do and exits with code 2.
+void AddPlannedCommand(CLI::App& parent, const std::string& name, const std::string& summary,
+                       const std::string& plan, int& exit_code);
+
+}  // namespace fv::app
+
+#define FV_CONCAT_INNER(a, b) a##b
+#define FV_CONCAT(a, b) FV_CONCAT_INNER(a, b)
+#define FV_REGISTER_COMMAND(order, name, setup)                                       \
+  static const ::fv::app::CommandRegistration FV_CONCAT(fv_command_, __LINE__)( \
+      order, name, setup)
