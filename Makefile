@@ -18,6 +18,7 @@ configure: deps $(BUILD)/build.ninja
 
 build: configure
 	cmake --build $(BUILD) -j $(JOBS)
+	@if [ -f scripts/fetch-models.sh ]; then bash scripts/fetch-models.sh $(BUILD); fi
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
