@@ -35,9 +35,10 @@ void ShowField(const FieldShowOptions& o) {
   std::cout << fmt::format("{}: {}\n", f.name, f.description);
   std::cout << fmt::format("playing area {:.2f} x {:.2f} m, lines {:.3f} m, surround {:.1f} m\n",
                            f.length_m, f.width_m, f.line_width_m, f.surround_m);
-  std::cout << fmt::format("{} keypoints (x, y, z in metres; origin at the centre, x along the "
-                           "length, z up):\n",
-                           f.keypoints.size());
+  std::cout << fmt::format(
+      "{} keypoints (x, y, z in metres; origin at the centre, x along the "
+      "length, z up):\n",
+      f.keypoints.size());
   for (const auto& k : f.keypoints) {
     std::cout << fmt::format("  {:<40s} {:9.3f} {:9.3f} {:7.3f}\n", k.name, k.position_m.x(),
                              k.position_m.y(), k.position_m.z());

@@ -32,6 +32,5 @@ void AddPlannedCommand(CLI::App& parent, const std::string& name, const std::str
 
 #define FV_CONCAT_INNER(a, b) a##b
 #define FV_CONCAT(a, b) FV_CONCAT_INNER(a, b)
-#define FV_REGISTER_COMMAND(order, name, setup)                                       \
-  static const ::fv::app::CommandRegistration FV_CONCAT(fv_command_, __LINE__)( \
-      order, name, setup)
+#define FV_REGISTER_COMMAND(order, name, setup) \
+  static const ::fv::app::CommandRegistration FV_CONCAT(fv_command_, __LINE__)(order, name, setup)

@@ -2,9 +2,9 @@
 #include <exception>
 #include <iostream>
 
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
-#include <spdlog/spdlog.h>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/util/error.h"

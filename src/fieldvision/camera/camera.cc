@@ -26,13 +26,13 @@ Camera Camera::FromFov(int width, int height, double hfov_deg) {
 }
 
 void Camera::Check(const std::string& context) const {
-  FV_REQUIRE(width > 0 && height > 0, "{}: image size must be positive (got {}x{})", context,
-             width, height);
+  FV_REQUIRE(width > 0 && height > 0, "{}: image size must be positive (got {}x{})", context, width,
+             height);
   for (const auto& [name, v] : {std::pair{"fx", fx}, {"fy", fy}, {"cx", cx}, {"cy", cy}}) {
     FV_REQUIRE(std::isfinite(v), "{}: camera_matrix {} is not finite", context, name);
   }
-  FV_REQUIRE(fx > 0 && fy > 0, "{}: camera_matrix focal length must be > 0 (fx={}, fy={})",
-             context, fx, fy);
+  FV_REQUIRE(fx > 0 && fy > 0, "{}: camera_matrix focal length must be > 0 (fx={}, fy={})", context,
+             fx, fy);
   FV_REQUIRE(ValidDistortionSize(distortion.size()),
              "{}: distortion_coefficients has {} values; OpenCV takes 4, 5, 8, 12 or 14", context,
              distortion.size());

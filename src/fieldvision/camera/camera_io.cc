@@ -62,8 +62,8 @@ Camera ReadCameraYaml(const std::string& path) {
 
   FV_REQUIRE(!fs["camera_matrix"].empty(), "camera file '{}': missing key 'camera_matrix'", path);
   const cv::Mat k = ReadMatrix(fs["camera_matrix"], path, "camera_matrix");
-  FV_REQUIRE(k.rows == 3 && k.cols == 3, "camera file '{}': key 'camera_matrix' must be 3x3 (got {}x{})",
-             path, k.rows, k.cols);
+  FV_REQUIRE(k.rows == 3 && k.cols == 3,
+             "camera file '{}': key 'camera_matrix' must be 3x3 (got {}x{})", path, k.rows, k.cols);
   cam.fx = k.at<double>(0, 0);
   cam.fy = k.at<double>(1, 1);
   cam.cx = k.at<double>(0, 2);
@@ -127,8 +127,8 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
     FV_REQUIRE(fs.isOpened(), "cannot write camera file '{}'", path);
     if (!camera.name.empty()) fs << "name" << camera.name;
     fs << "image_width" << camera.width << "image_height" << camera.height;
-    const cv::Mat k = (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy,
-                       0, 0, 1);
+    const cv::Mat k =
+        (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
     fs << "camera_matrix" << k;
     std::vector<double> d = camera.distortion;
     if (d.empty()) d.assign(5, 0.0);
@@ -143,7 +143,8 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
     }
     if (camera.rms_px) fs << "rms_px" << *camera.rms_px;
     if (!camera.notes.empty()) {
-      fs << "notes" << "{";
+      fs << "notes"
+         << "{";
       for (const auto& [key, value] : camera.notes) fs << key << value;
       fs << "}";
     }

@@ -19,13 +19,12 @@ Camera RandomCamera(Rng& rng, int n) {
   cam.cx += rng.Uniform(-20, 20);
   cam.cy += rng.Uniform(-20, 20);
   cam.fy *= rng.Uniform(0.98, 1.02);
-  const double full[kNumDistortion] = {rng.Uniform(-0.3, 0.1),   rng.Uniform(-0.05, 0.05),
-                                       rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-3, 1e-3),
-                                       rng.Uniform(-0.01, 0.01), rng.Uniform(-0.05, 0.05),
-                                       rng.Uniform(-0.01, 0.01), rng.Uniform(-0.01, 0.01),
-                                       rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-4, 1e-4),
-                                       rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-4, 1e-4),
-                                       rng.Uniform(-0.02, 0.02), rng.Uniform(-0.02, 0.02)};
+  const double full[kNumDistortion] = {
+      rng.Uniform(-0.3, 0.1),   rng.Uniform(-0.05, 0.05), rng.Uniform(-1e-3, 1e-3),
+      rng.Uniform(-1e-3, 1e-3), rng.Uniform(-0.01, 0.01), rng.Uniform(-0.05, 0.05),
+      rng.Uniform(-0.01, 0.01), rng.Uniform(-0.01, 0.01), rng.Uniform(-1e-3, 1e-3),
+      rng.Uniform(-1e-4, 1e-4), rng.Uniform(-1e-3, 1e-3), rng.Uniform(-1e-4, 1e-4),
+      rng.Uniform(-0.02, 0.02), rng.Uniform(-0.02, 0.02)};
   cam.distortion.assign(full, full + n);
   const Eigen::Vector3d eye(rng.Uniform(-15, 15), rng.Uniform(-12, -8), rng.Uniform(3, 8));
   cam.cam_from_world = Rigid3d::LookAt(eye, Eigen::Vector3d(rng.Uniform(-3, 3), 0, 0));
@@ -168,8 +167,12 @@ TEST_P(CameraIoBad, OneLineErrorNamingFileAndKey) {
 }
 
 #define FV_HDR "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
-#define FV_K "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
-#define FV_D "distortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 5\n  dt: d\n  data: [0, 0, 0, 0, 0]\n"
+#define FV_K                                                                                      \
+  "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: [500, 0, 320, 0, 500, " \
+  "240, 0, 0, 1]\n"
+#define FV_D                                                                                       \
+  "distortion_coefficients: !!opencv-matrix\n  rows: 1\n  cols: 5\n  dt: d\n  data: [0, 0, 0, 0, " \
+  "0]\n"
 
 std::string BadFileName(const ::testing::TestParamInfo<BadFile>& info) {
   std::string s = info.param.what;
@@ -212,8 +215,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "tvec"},
         BadFile{"zero width", "%YAML:1.0\n---\nimage_width: 0\nimage_height: 480\n" FV_K FV_D,
                 "image_width"},
-        BadFile{"not yaml", "this is { not yaml", "bad.yaml"},
-        BadFile{"empty", "", "bad.yaml"}),
+        BadFile{"not yaml", "this is { not yaml", "bad.yaml"}, BadFile{"empty", "", "bad.yaml"}),
     BadFileName);
 
 TEST(CameraIo, MissingFile) {

@@ -21,8 +21,8 @@ void DistortNormalized(const T* d, const T& x, const T& y, T* xd, T* yd) {
   const T r2 = x * x + y * y;
   const T r4 = r2 * r2;
   const T r6 = r4 * r2;
-  const T radial = (T(1) + d[0] * r2 + d[1] * r4 + d[4] * r6) /
-                   (T(1) + d[5] * r2 + d[6] * r4 + d[7] * r6);
+  const T radial =
+      (T(1) + d[0] * r2 + d[1] * r4 + d[4] * r6) / (T(1) + d[5] * r2 + d[6] * r4 + d[7] * r6);
   const T a1 = T(2) * x * y;
   const T a2 = r2 + T(2) * x * x;
   const T a3 = r2 + T(2) * y * y;
@@ -40,8 +40,10 @@ void DistortNormalized(const T* d, const T& x, const T& y, T* xd, T* yd) {
     const T r10 = T(0), r11 = cx, r12 = sx;
     const T r20 = sy, r21 = -cy * sx, r22 = cy * cx;
     // Tilt = [r22 0 -r02; 0 r22 -r12; 0 0 1] * R
-    const T t0 = (r22 * r00 - r02 * r20) * u + (r22 * r01 - r02 * r21) * v + (r22 * r02 - r02 * r22);
-    const T t1 = (r22 * r10 - r12 * r20) * u + (r22 * r11 - r12 * r21) * v + (r22 * r12 - r12 * r22);
+    const T t0 =
+        (r22 * r00 - r02 * r20) * u + (r22 * r01 - r02 * r21) * v + (r22 * r02 - r02 * r22);
+    const T t1 =
+        (r22 * r10 - r12 * r20) * u + (r22 * r11 - r12 * r21) * v + (r22 * r12 - r12 * r22);
     const T t2 = r20 * u + r21 * v + r22;
     u = t0 / t2;
     v = t1 / t2;
@@ -65,8 +67,7 @@ bool ProjectCameraPoint(const T* intrinsics, const T* p_cam, T* uv) {
 
 // World point -> pixel through the pose (rvec = angle-axis of R, x_cam = R x_world + t).
 template <typename T>
-bool ProjectWorldPoint(const T* intrinsics, const T* rvec, const T* tvec, const T* p_world,
-                       T* uv) {
+bool ProjectWorldPoint(const T* intrinsics, const T* rvec, const T* tvec, const T* p_world, T* uv) {
   T p_cam[3];
   ceres::AngleAxisRotatePoint(rvec, p_world, p_cam);
   p_cam[0] += tvec[0];

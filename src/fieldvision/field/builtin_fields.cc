@@ -37,11 +37,11 @@ class Builder {
 
 struct SoccerSpec {
   double length, width, line;
-  double penalty_depth, penalty_width;  // outer edge to outer edge
-  double goal_area_depth, goal_area_width;  // 0: none
+  double penalty_depth, penalty_width;                             // outer edge to outer edge
+  double goal_area_depth, goal_area_width;                         // 0: none
   double centre_radius, corner_radius, penalty_mark, second_mark;  // 0: none
   double goal_width, goal_height, spot_diameter;
-  bool futsal_area;  // quarter circles around the posts joined by a straight line
+  bool futsal_area;           // quarter circles around the posts joined by a straight line
   double penalty_arc_radius;  // 0: none
 };
 
@@ -277,18 +277,18 @@ std::vector<std::string> BuiltinFieldNames() {
 
 FieldModel BuiltinField(const std::string& name) {
   if (name == "fifa") {
-    SoccerSpec s{105.0, 68.0, 0.12, 16.5, 40.32, 5.5, 18.32, 9.15, 1.0, 11.0, 0.0,
-                 7.32,  2.44, 0.22, false, 9.15};
+    SoccerSpec s{105.0, 68.0, 0.12, 16.5, 40.32, 5.5,  18.32, 9.15,
+                 1.0,   11.0, 0.0,  7.32, 2.44,  0.22, false, 9.15};
     return Soccer(name, "FIFA football pitch, 105 x 68 m (Laws of the Game, law 1)", s, 5.0);
   }
   if (name == "robocup-msl") {
-    SoccerSpec s{18.0, 12.0, 0.125, 2.25, 6.5, 0.75, 3.5, 2.0, 0.75, 3.0, 0.0,
-                 2.0,  1.0,  0.15,  false, 0.0};
+    SoccerSpec s{18.0, 12.0, 0.125, 2.25, 6.5, 0.75, 3.5,   2.0,
+                 0.75, 3.0,  0.0,   2.0,  1.0, 0.15, false, 0.0};
     return Soccer(name, "RoboCup Middle Size League field, 18 x 12 m, 0.125 m lines", s, 1.5);
   }
   if (name == "futsal") {
-    SoccerSpec s{40.0, 20.0, 0.08, 6.0, 0.0, 0.0, 0.0, 3.0, 0.25, 6.0, 10.0,
-                 3.0,  2.0,  0.12, true, 0.0};
+    SoccerSpec s{40.0, 20.0, 0.08, 6.0, 0.0, 0.0,  0.0,  3.0,
+                 0.25, 6.0,  10.0, 3.0, 2.0, 0.12, true, 0.0};
     return Soccer(name, "Futsal pitch, 40 x 20 m (Futsal Laws of the Game)", s, 2.0);
   }
   if (name == "basketball-fiba") return Basketball();

@@ -59,8 +59,7 @@ void FieldModel::Check() const {
   }
   for (const auto& g : goals) {
     FV_REQUIRE(g.y_max_m > g.y_min_m && g.height_m > 0 && (g.side == -1 || g.side == 1),
-               "{}: goal '{}' needs y_max_m > y_min_m, height_m > 0 and side -1 or 1", ctx,
-               g.name);
+               "{}: goal '{}' needs y_max_m > y_min_m, height_m > 0 and side -1 or 1", ctx, g.name);
   }
 }
 

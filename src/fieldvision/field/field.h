@@ -62,7 +62,7 @@ struct FieldModel {
   double length_m = 0.0;  // rule-book dimensions of the playing area
   double width_m = 0.0;
   double line_width_m = 0.1;
-  double surround_m = 2.0;     // run-off area around the playing area (walls stand beyond it)
+  double surround_m = 2.0;        // run-off area around the playing area (walls stand beyond it)
   std::string surface = "grass";  // "grass" or "court": a hint for rendering
   std::vector<FieldSegment> segments;
   std::vector<FieldArc> arcs;

@@ -40,22 +40,21 @@ void DrawFieldLines(cv::Mat& image, const FieldModel& field, const TopView& view
              cv::LINE_AA, kShift);
   }
   for (const auto& a : field.arcs) {
-    const int n = std::max(8, static_cast<int>((a.end_rad - a.start_rad) * a.radius_m *
-                                               view.px_per_m / 2));
+    const int n =
+        std::max(8, static_cast<int>((a.end_rad - a.start_rad) * a.radius_m * view.px_per_m / 2));
     std::vector<cv::Point> pts;
     for (int i = 0; i <= n; ++i) {
       const double t = a.start_rad + (a.end_rad - a.start_rad) * i / n;
-      pts.push_back(Fixed(
-          view.ToPixel(a.centre + a.radius_m * Eigen::Vector2d(std::cos(t), std::sin(t)))));
+      pts.push_back(
+          Fixed(view.ToPixel(a.centre + a.radius_m * Eigen::Vector2d(std::cos(t), std::sin(t)))));
     }
     cv::polylines(image, pts, false, colour, thick(a.width_m), cv::LINE_AA, kShift);
   }
   for (const auto& g : field.goals) {
     const double x_back = g.line_x_m + g.side * g.depth_m;
-    std::vector<cv::Point> pts = {Fixed(view.ToPixel({g.line_x_m, g.y_min_m})),
-                                  Fixed(view.ToPixel({x_back, g.y_min_m})),
-                                  Fixed(view.ToPixel({x_back, g.y_max_m})),
-                                  Fixed(view.ToPixel({g.line_x_m, g.y_max_m}))};
+    std::vector<cv::Point> pts = {
+        Fixed(view.ToPixel({g.line_x_m, g.y_min_m})), Fixed(view.ToPixel({x_back, g.y_min_m})),
+        Fixed(view.ToPixel({x_back, g.y_max_m})), Fixed(view.ToPixel({g.line_x_m, g.y_max_m}))};
     cv::polylines(image, pts, false, colour, std::max(1, thick(g.post_width_m) / 2), cv::LINE_AA,
                   kShift);
   }

@@ -64,8 +64,8 @@ json FieldToJson(const FieldModel& f) {
   j["surface"] = f.surface;
   j["segments"] = json::array();
   for (const auto& s : f.segments) {
-    j["segments"].push_back({{"name", s.name}, {"a", Vec(s.a)}, {"b", Vec(s.b)},
-                             {"width_m", s.width_m}});
+    j["segments"].push_back(
+        {{"name", s.name}, {"a", Vec(s.a)}, {"b", Vec(s.b)}, {"width_m", s.width_m}});
   }
   j["arcs"] = json::array();
   for (const auto& a : f.arcs) {
@@ -93,7 +93,8 @@ json FieldToJson(const FieldModel& f) {
   }
   j["hoops"] = json::array();
   for (const auto& h : f.hoops) {
-    j["hoops"].push_back({{"name", h.name}, {"centre_m", Vec(h.centre_m)}, {"radius_m", h.radius_m}});
+    j["hoops"].push_back(
+        {{"name", h.name}, {"centre_m", Vec(h.centre_m)}, {"radius_m", h.radius_m}});
   }
   return j;
 }

@@ -114,7 +114,7 @@ TEST(Fields, TennisRuleBookDimensions) {
 
 TEST(Fields, DistancesToLines) {
   const FieldModel f = BuiltinField("robocup-msl");
-  EXPECT_NEAR(f.DistanceToLineCentres({0, 0.5}), 0.0, 1e-12);  // on the halfway line
+  EXPECT_NEAR(f.DistanceToLineCentres({0, 0.5}), 0.0, 1e-12);      // on the halfway line
   EXPECT_NEAR(f.DistanceToLineCentres({1.0, 0.0}), 0.9375, 1e-9);  // between line and circle
   EXPECT_LT(f.DistanceToPaint({0.05, 3.0}), 0.0);
   const auto samples = f.SampleLines(0.1);

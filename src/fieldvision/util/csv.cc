@@ -79,8 +79,7 @@ long long CsvTable::GetInt(size_t row, const std::string& column) const {
   return ParseInt(Get(row, column), fmt::format("{} column '{}'", Where(row), column));
 }
 
-CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header,
-                     int precision)
+CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header, int precision)
     : path_(path), out_(path), columns_(header.size()), precision_(precision) {
   FV_REQUIRE(out_.good(), "cannot write CSV file '{}'", path);
   for (size_t i = 0; i < header.size(); ++i) out_ << (i ? "," : "") << header[i];

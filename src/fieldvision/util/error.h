@@ -20,11 +20,11 @@ template <typename... Args>
 }
 
 // Throws fv::Error with the formatted message when `cond` is false.
-#define FV_REQUIRE(cond, ...)     \
-  do {                            \
-    if (!(cond)) {                \
-      ::fv::Throw(__VA_ARGS__);   \
-    }                             \
+#define FV_REQUIRE(cond, ...)   \
+  do {                          \
+    if (!(cond)) {              \
+      ::fv::Throw(__VA_ARGS__); \
+    }                           \
   } while (0)
 
 // Checks for Options::Check(): throw naming the field when the value is out of range.

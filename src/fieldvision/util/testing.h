@@ -18,5 +18,6 @@ std::string SharedDataDir();
 
 }  // namespace fv::testing
 
-#define FV_SEED_TRACE(seed) \
-  SCOPED_TRACE(::testing::Message() << "seed=" << (seed) << " (rerun with FV_TEST_SEED=" << (seed) << ")")
+#define FV_SEED_TRACE(seed)         \
+  SCOPED_TRACE(::testing::Message() \
+               << "seed=" << (seed) << " (rerun with FV_TEST_SEED=" << (seed) << ")")
