@@ -1,0 +1,150 @@
+// Triangulation of the ball centre from 1..N calibrated cameras. Two-ray closest point (the
+// seeds' midpoint method); N-view linear triangulation (DLT on undistorted normalized points,
+// Hartley & Zisserman, "Multiple View Geometry", 2nd ed., sec. 12.2) refined by Ceres on the
+// reprojection error weighted by each detection's sigma_px, with the covariance (J^T J)^-1 of the
+// point (H&Z sec. 5.2); a robust mode that scores every two-view hypothesis over all candidate
+// blobs and keeps the largest set of cameras that agree within a few pixels (exhaustive RANSAC,
+// Fischler & Bolles 1981); a single camera with the ball on the ground (centre at z = radius).
+// Written here because OpenCV's triangulatePoints is two-view, unweighted and has no robust mode.
+// A ball of radius r projects to an ellipse whose centre is not the image of the sphere's centre:
+// with ball_radius_m > 0 the model predicts the outline's centre, (X Z, Y Z) / (Z^2 - r^2) in
+// normalized coordinates (exact for the tangent cone), so detectors report the blob's centre.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fieldvision/camera/camera.h"
+#include "fieldvision/geometry/rigid.h"
+
+namespace fv {
+
+// One ball candidate seen by one camera (what a detector reports), in that camera's pixels.
+struct BallObservation {
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;  // 0 when unknown
+  double sigma_px = 1.0;   // 1-sigma uncertainty of the centre
+  double score = 1.0;      // detector confidence, higher is better
+};
+
+// ---- Two rays -----------------------------------------------------------------------------
+
+enum class RayPairStatus { kOk, kParallel, kBehind };
+
+struct RayPairResult {
+  RayPairStatus status = RayPairStatus::kParallel;
+  Eigen::Vector3d midpoint = Eigen::Vector3d::Zero();  // halfway between the closest points
+  double gap_m = 0.0;                                  // distance between the two rays there
+  double s_a = 0.0, s_b = 0.0;                         // ray parameters of the closest points
+  double angle_deg = 0.0;                              // angle between the directions
+  bool ok() const { return status == RayPairStatus::kOk; }
+};
+
+// The closest point of two rays (directions need not be unit length). Rays closer to parallel
+// than `min_angle_deg` give kParallel; a closest point behind either origin gives kBehind (the
+// midpoint is still filled in). Never throws for geometry; throws fv::Error for NaN input.
+RayPairResult ClosestPointOfRays(const Ray3d& a, const Ray3d& b, double min_angle_deg = 0.01);
+
+// ---- N views --------------------------------------------------------------------------------
+
+struct TriangulationOptions {
+  // Ball radius in metres for the outline-centre model above; 0 treats the ball as a point.
+  double ball_radius_m = 0.0;
+  // Nonlinear refinement of the linear estimate (Ceres, Levenberg-Marquardt).
+  bool refine = true;
+  int max_iterations = 25;
+  // A view is consistent when its reprojection error is below
+  // max(inlier_threshold_px, inlier_sigmas * sigma_px).
+  double inlier_threshold_px = 4.0;
+  double inlier_sigmas = 3.0;
+  // Points nearer than this in front of a camera (or behind it) are rejected.
+  double min_depth_m = 0.1;
+  // Two-view hypotheses whose rays meet at less than this angle are degenerate.
+  double min_angle_deg = 2.0;
+  // Robust mode: the best `max_candidates_per_camera` blobs (by score) of each camera are tried.
+  int max_candidates_per_camera = 6;
+  // Reject points below the ground by more than this (metres); negative disables the check.
+  double max_below_ground_m = 0.05;
+  // When the detector reports radius_px: a view whose radius differs from the radius predicted
+  // from the depth by more than this factor (either way) is inconsistent; 0 disables.
+  double max_radius_ratio = 0.0;
+  // Robust mode: with only one camera seeing anything, place the ball on the ground.
+  bool single_camera_ground = false;
+
+  void Check() const;  // throws fv::Error naming the bad field
+};
+
+enum class TriangulationStatus {
+  kOk,               // a 3D point (or a ground point when `on_ground`)
+  kTooFewViews,      // fewer than 2 views (and no ground mode)
+  kDegenerate,       // rays (nearly) parallel or the linear system is singular
+  kBehindCamera,     // the point lies behind (or too close to) a camera
+  kNoConsistentSet,  // robust mode: no two cameras agree
+};
+
+const char* ToString(TriangulationStatus status);
+
+struct ViewResidual {
+  int camera = -1;     // index into the camera list
+  int candidate = -1;  // index into that camera's candidates (robust mode), else 0
+  Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // predicted - observed
+  double err_px = 0.0;                                    // |residual_px|
+};
+
+struct TriangulationResult {
+  TriangulationStatus status = TriangulationStatus::kTooFewViews;
+  Eigen::Vector3d point_world = Eigen::Vector3d::Zero();
+  // Covariance of point_world in m^2 from the weighted Jacobian, (J^T J)^-1; for a ground
+  // point the z row and column are zero.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  bool on_ground = false;  // single camera, centre assumed at z = ball radius: a 2D position
+  std::vector<ViewResidual> views;  // the views used, in camera order
+  double rms_px = 0.0;              // RMS of err_px over `views`
+  int iterations = 0;               // Ceres iterations of the final refinement
+  int hypotheses = 0;               // robust mode: two-view hypotheses scored
+  bool ok() const { return status == TriangulationStatus::kOk; }
+  int num_views() const { return static_cast<int>(views.size()); }
+};
+
+// A view used by TriangulatePoint: which camera saw the ball where.
+struct View {
+  int camera = 0;  // index into the camera list
+  BallObservation observation;
+};
+
+// Linear triangulation only (weighted DLT on undistorted normalized points). nullopt when fewer
+// than two views, a pixel cannot be undistorted or the solution is at infinity.
+std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<Camera>& cameras,
+                                                 const std::vector<View>& views);
+
+// All views together: DLT, refinement, residuals and covariance. No outlier rejection (see
+// TriangulateRobust). Throws fv::Error for a camera index out of range, a camera without a pose
+// or a non-finite observation.
+TriangulationResult TriangulatePoint(const std::vector<Camera>& cameras,
+                                     const std::vector<View>& views,
+                                     const TriangulationOptions& options = {});
+
+// Robust mode: candidates[c] are camera c's blobs (any number, possibly none). Scores every
+// two-view hypothesis, keeps the one with the most consistent cameras (then the smallest
+// weighted error), refines it on those views and returns it. Throws fv::Error when
+// candidates.size() != cameras.size().
+TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
+                                      const std::vector<std::vector<BallObservation>>& candidates,
+                                      const TriangulationOptions& options = {});
+
+// One camera, the ball resting on the ground (centre at z = options.ball_radius_m): intersects
+// the ray with that plane and refines x, y. Status kBehindCamera when the ray does not reach the
+// plane in front of the camera.
+TriangulationResult LocateOnGround(const Camera& camera, int camera_index,
+                                   const BallObservation& observation,
+                                   const TriangulationOptions& options = {});
+
+// The model's prediction of where `camera` sees the ball centred at `point_world` (the outline's
+// centre when radius_m > 0); nullopt when the point is not in front of the camera.
+std::optional<Eigen::Vector2d> PredictBallCentre(const Camera& camera,
+                                                 const Eigen::Vector3d& point_world,
+                                                 double radius_m);
+
+}  // namespace fv
