@@ -1,0 +1,68 @@
+// Frame sources behind one interface: a video file OpenCV reads, an image sequence (a printf
+// pattern such as dir/%05d.png, a glob such as dir/*.jpg, or a folder of images, in name order),
+// or a live camera ("camera:0"). Frames are numbered from 0 and carry a time in seconds (the
+// container's timestamps for files, frame / fps for images, a steady clock for live cameras).
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/camera/camera.h"
+
+namespace fv {
+
+struct VideoSourceOptions {
+  // Frame rate assumed for image sequences (and for files whose container has none).
+  double fps = 30.0;
+  void Check() const;
+};
+
+struct Frame {
+  int index = -1;
+  double time_s = 0.0;
+  cv::Mat bgr;
+};
+
+class VideoSource {
+ public:
+  // Opens `spec`; throws fv::Error naming it when it cannot be opened or holds no frame.
+  static std::unique_ptr<VideoSource> Open(const std::string& spec,
+                                           const VideoSourceOptions& options = {});
+  virtual ~VideoSource() = default;
+
+  const std::string& spec() const { return spec_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  double fps() const { return fps_; }
+  // Frames announced by the container or found on disk; -1 when unknown (live camera).
+  int frame_count() const { return frame_count_; }
+  bool live() const { return live_; }
+
+  // Reads the next frame into `frame`; false at the end. A frame that cannot be decoded in an
+  // image sequence, or a frame of another size, throws fv::Error naming the source and frame.
+  virtual bool Read(Frame& frame) = 0;
+  // Frames read so far.
+  int frames_read() const { return next_index_; }
+
+  // Throws fv::Error naming both files when the frames are not the camera's image size.
+  void CheckMatchesCamera(const Camera& camera, const std::string& camera_name) const;
+
+ protected:
+  std::string spec_;
+  int width_ = 0;
+  int height_ = 0;
+  double fps_ = 0.0;
+  int frame_count_ = -1;
+  bool live_ = false;
+  int next_index_ = 0;
+};
+
+// The image files an image-sequence spec names, in order (empty if it is not one).
+std::vector<std::string> ListImageSequence(const std::string& spec);
+
+}  // namespace fv

@@ -1,0 +1,100 @@
+#include "fieldvision/io/video_source.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+cv::Mat NumberedFrame(int i, int w = 64, int h = 48) {
+  cv::Mat m(h, w, CV_8UC3, cv::Scalar(10 * i, 255 - 10 * i, 100));
+  return m;
+}
+
+TEST(VideoSource, ImagePatternGlobAndFolderInOrder) {
+  const std::string dir = testing::TempDir();
+  for (int i = 0; i < 5; ++i) cv::imwrite(fmt::format("{}/{:05d}.png", dir, i), NumberedFrame(i));
+  for (const std::string spec : {dir + "/%05d.png", dir + "/*.png", dir}) {
+    SCOPED_TRACE(spec);
+    auto src = VideoSource::Open(spec, {.fps = 25.0});
+    EXPECT_EQ(src->frame_count(), 5);
+    EXPECT_EQ(src->width(), 64);
+    Frame f;
+    int n = 0;
+    while (src->Read(f)) {
+      EXPECT_EQ(f.index, n);
+      EXPECT_DOUBLE_EQ(f.time_s, n / 25.0);
+      EXPECT_EQ(f.bgr.at<cv::Vec3b>(0, 0)[0], 10 * n);
+      ++n;
+    }
+    EXPECT_EQ(n, 5);
+  }
+}
+
+TEST(VideoSource, MjpgFileFramesAndTimes) {
+  const std::string path = testing::TempDir() + "/v.avi";
+  {
+    cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 50.0, cv::Size(64, 48));
+    ASSERT_TRUE(w.isOpened());
+    for (int i = 0; i < 7; ++i) w.write(NumberedFrame(i));
+  }
+  auto src = VideoSource::Open(path);
+  EXPECT_EQ(src->frame_count(), 7);
+  EXPECT_NEAR(src->fps(), 50.0, 1e-6);
+  Frame f;
+  int n = 0;
+  while (src->Read(f)) {
+    EXPECT_EQ(f.index, n);
+    EXPECT_NEAR(f.time_s, n / 50.0, 1e-3);
+    ++n;
+  }
+  EXPECT_EQ(n, 7);
+}
+
+TEST(VideoSource, BadInputsNameTheInput) {
+  const std::string dir = testing::TempDir();
+  auto expect_error = [](const std::string& spec, const std::string& word) {
+    try {
+      VideoSource::Open(spec);
+      ADD_FAILURE() << "no error for " << spec;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what();
+    }
+  };
+  expect_error(dir + "/missing.avi", "missing.avi");
+  std::ofstream(dir + "/corrupt.avi") << "this is not a video at all";
+  expect_error(dir + "/corrupt.avi", "corrupt.avi");
+  expect_error(dir + "/none_%05d.png", "none_%05d.png");
+  // A sequence whose later frame is unreadable fails at that frame, naming it.
+  cv::imwrite(dir + "/s_00000.png", NumberedFrame(0));
+  std::ofstream(dir + "/s_00001.png") << "broken";
+  auto src = VideoSource::Open(dir + "/s_%05d.png");
+  Frame f;
+  EXPECT_TRUE(src->Read(f));
+  EXPECT_THROW(src->Read(f), Error);
+}
+
+TEST(VideoSource, CameraSizeMismatch) {
+  const std::string dir = testing::TempDir();
+  cv::imwrite(dir + "/00000.png", NumberedFrame(0));
+  auto src = VideoSource::Open(dir + "/%05d.png");
+  Camera cam = Camera::FromFov(640, 480, 60);
+  try {
+    src->CheckMatchesCamera(cam, "cam.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cam.yaml"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("640x480"), std::string::npos);
+  }
+  cam = Camera::FromFov(64, 48, 60);
+  EXPECT_NO_THROW(src->CheckMatchesCamera(cam, "cam.yaml"));
+}
+
+}  // namespace
+}  // namespace fv
