@@ -73,6 +73,11 @@ double Depth(const Camera& cam, const Eigen::Vector3d& p_world) {
   return (cam.cam_from_world * p_world).z();
 }
 
+// Radius for the outline-centre model (0: observations are projections of the centre).
+double ModelRadius(const TriangulationOptions& o) {
+  return o.outline_centre ? o.ball_radius_m : 0.0;
+}
+
 double Threshold(const TriangulationOptions& o, double sigma_px) {
   return std::max(o.inlier_threshold_px, o.inlier_sigmas * sigma_px);
 }
@@ -105,13 +110,13 @@ void Refine(const std::vector<Camera>& cameras, const std::vector<View>& views,
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<ReprojectionCost<true>, 2, 2>(
               new ReprojectionCost<true>(blocks.back(), v.observation.centre_px,
-                                         v.observation.sigma_px, o.ball_radius_m, x[2])),
+                                         v.observation.sigma_px, ModelRadius(o), x[2])),
           nullptr, x);
     } else {
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<ReprojectionCost<false>, 2, 3>(
               new ReprojectionCost<false>(blocks.back(), v.observation.centre_px,
-                                          v.observation.sigma_px, o.ball_radius_m, 0.0)),
+                                          v.observation.sigma_px, ModelRadius(o), 0.0)),
           nullptr, x);
     }
   }
@@ -160,7 +165,7 @@ void Refine(const std::vector<Camera>& cameras, const std::vector<View>& views,
     if (evaluated && weighted.size() >= 2 * (i + 1)) {
       vr.residual_px =
           Eigen::Vector2d(weighted[2 * i], weighted[2 * i + 1]) * v.observation.sigma_px;
-    } else if (auto uv = PredictBallCentre(cameras[v.camera], *p, o.ball_radius_m)) {
+    } else if (auto uv = PredictBallCentre(cameras[v.camera], *p, ModelRadius(o))) {
       vr.residual_px = *uv - v.observation.centre_px;
     } else {
       vr.residual_px = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
@@ -426,7 +431,7 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
   auto view_error = [&](int c, int k, const Eigen::Vector3d& p) -> double {
     const BallObservation& obs = candidates[c][k];
     if (!(Depth(cameras[c], p) > o.min_depth_m)) return -1;
-    const auto uv = PredictBallCentre(cameras[c], p, o.ball_radius_m);
+    const auto uv = PredictBallCentre(cameras[c], p, ModelRadius(o));
     if (!uv) return -1;
     const double err = (*uv - obs.centre_px).norm();
     if (err > Threshold(o, obs.sigma_px)) return -1;

@@ -7,8 +7,8 @@
 // Fischler & Bolles 1981); a single camera with the ball on the ground (centre at z = radius).
 // Written here because OpenCV's triangulatePoints is two-view, unweighted and has no robust mode.
 // A ball of radius r projects to an ellipse whose centre is not the image of the sphere's centre:
-// with ball_radius_m > 0 the model predicts the outline's centre, (X Z, Y Z) / (Z^2 - r^2) in
-// normalized coordinates (exact for the tangent cone), so detectors report the blob's centre.
+// with outline_centre the model predicts the outline's centre, (X Z, Y Z) / (Z^2 - r^2) in
+// normalized coordinates (exact for the tangent cone), for detectors that report blob centres.
 #pragma once
 
 #include <optional>
@@ -50,8 +50,12 @@ RayPairResult ClosestPointOfRays(const Ray3d& a, const Ray3d& b, double min_angl
 // ---- N views --------------------------------------------------------------------------------
 
 struct TriangulationOptions {
-  // Ball radius in metres for the outline-centre model above; 0 treats the ball as a point.
-  double ball_radius_m = 0.0;
+  // Ball radius in metres: the ground height of single-camera positions, the size check and the
+  // outline-centre model.
+  double ball_radius_m = 0.11;
+  // Observations are centres of the ball's outline (a blob's centre) rather than projections of
+  // the sphere's centre (what a tangent-cone fit such as detect/ball_fit.h reports).
+  bool outline_centre = false;
   // Nonlinear refinement of the linear estimate (Ceres, Levenberg-Marquardt).
   bool refine = true;
   int max_iterations = 25;

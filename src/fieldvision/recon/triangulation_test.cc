@@ -121,7 +121,7 @@ TEST(Triangulation, RefinedPointAndCovarianceMatchTheNoise) {
   Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
-  opt.ball_radius_m = 0.11;
+  opt.outline_centre = true;
   // Normalized squared errors e^T C^-1 e follow chi-square(3): mean 3.
   double sum_chi2 = 0, sum_err = 0;
   const int trials = 200;
@@ -244,7 +244,7 @@ TEST(Triangulation, OneCameraOnlyNeedsTheGroundAssumption) {
   TriangulationOptions opt;
   opt.ball_radius_m = 0.11;
   const Eigen::Vector3d p(rng.Uniform(-6, 6), rng.Uniform(-4, 4), opt.ball_radius_m);
-  const BallObservation obs = Observe(cams[2], p, opt.ball_radius_m, 0, nullptr);
+  const BallObservation obs = Observe(cams[2], p, 0.0, 0, nullptr);
   EXPECT_EQ(TriangulatePoint(cams, {{2, obs}}, opt).status, TriangulationStatus::kTooFewViews);
   std::vector<std::vector<BallObservation>> cand(4);
   cand[2] = {obs};
@@ -271,7 +271,7 @@ TEST(Triangulation, FalseBlobInOneCameraNeverMovesTheBall) {
   Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
-  opt.ball_radius_m = 0.11;
+  opt.outline_centre = true;
   for (int trial = 0; trial < 40; ++trial) {
     const Eigen::Vector3d p = RandomBall(rng);
     std::vector<std::vector<BallObservation>> cand(4);
