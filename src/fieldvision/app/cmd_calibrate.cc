@@ -1,16 +1,311 @@
-// `fieldvision calibrate`: planned; replaced by its implementation.
+// `fieldvision calibrate intrinsics|extrinsics|refine|check|rig`: parse options, call the
+// calibration library (src/fieldvision/calib), print the numbers and write the camera files.
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/calib/check.h"
+#include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/calib/intrinsics.h"
+#include "fieldvision/calib/lines.h"
+#include "fieldvision/calib/rig.h"
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
 
+using namespace fv::calib;
+
+cv::Mat ReadImage(const std::string& path) {
+  FV_REQUIRE(std::filesystem::is_regular_file(path), "image '{}' does not exist", path);
+  cv::Mat image;
+  try {
+    image = cv::imread(path, cv::IMREAD_COLOR);
+  } catch (const cv::Exception&) {
+    image.release();
+  }
+  FV_REQUIRE(!image.empty(), "image '{}' cannot be read (corrupt or not an image)", path);
+  return image;
+}
+
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, image);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", path);
+}
+
+void Warn(const std::string& message) { std::cerr << "warning: " << message << "\n"; }
+
+// ---- intrinsics
+struct IntrinsicsCli {
+  std::string images, board = "chessboard", out, name;
+  int cols = 0, rows = 0;
+  double square_m = 0.0, marker_m = 0.0;
+  std::string dictionary = "DICT_4X4_50";
+  IntrinsicsOptions o;
+  bool quiet = false;
+};
+
+void RunIntrinsics(IntrinsicsCli& c) {
+  c.o.board.type = ParseBoardType(c.board);
+  c.o.board.cols = c.cols;
+  c.o.board.rows = c.rows;
+  c.o.board.square_m = c.square_m;
+  c.o.board.marker_m = c.marker_m;
+  c.o.board.dictionary = c.dictionary;
+  c.o.camera_name = c.name;
+  c.o.progress = !c.quiet;
+  const IntrinsicsResult r = CalibrateIntrinsics(c.images, c.o);
+  std::cout << fmt::format("{:<48s} {:>7s} {:>8s}  {}\n", "view", "corners", "rms_px", "status");
+  for (const auto& v : r.views) {
+    const std::string status = !v.board_found ? "no board"
+                               : v.used       ? "used"
+                                              : "dropped: " + v.dropped_because;
+    std::cout << fmt::format("{:<48s} {:>7d} {:>8.3f}  {}\n", v.name, v.num_corners, v.rms_px,
+                             status);
+  }
+  std::cout << "coverage: " << r.coverage.Describe() << "\n";
+  std::cout << r.Summary() << "\n";
+  for (const auto& w : r.warnings) Warn(w);
+  WriteCameraYaml(r.camera, c.out);
+  std::cout << fmt::format("RMS reprojection error: {:.3f} px\nwrote {}\n", r.rms_px, c.out);
+}
+
+// ---- extrinsics
+struct ExtrinsicsCli {
+  std::string camera, points, field, out, table;
+  ExtrinsicsOptions o;
+};
+
+void PrintPointTable(const std::vector<PointResidual>& pts) {
+  std::cout << fmt::format("{:<28s} {:>8s} {:>8s} {:>8s} {:>8s} {:>7s} {:>8s} {:>8s}  {}\n",
+                           "point", "u", "v", "x_m", "y_m", "z_m", "err_px", "err_mm", "");
+  for (const auto& p : pts) {
+    std::cout << fmt::format(
+        "{:<28s} {:>8.1f} {:>8.1f} {:>8.3f} {:>8.3f} {:>7.3f} {:>8.2f} {:>8s}  "
+        "{}\n",
+        p.name, p.uv_px.x(), p.uv_px.y(), p.p_world.x(), p.p_world.y(), p.p_world.z(), p.err_px,
+        p.err_mm ? fmt::format("{:.0f}", *p.err_mm) : std::string("-"), p.inlier ? "" : "outlier");
+  }
+}
+
+void RunExtrinsics(const ExtrinsicsCli& c) {
+  const Camera cam = ReadCameraYaml(c.camera);
+  std::unique_ptr<FieldModel> field;
+  if (!c.field.empty()) field = std::make_unique<FieldModel>(LoadField(c.field));
+  const auto pts = ReadPointsCsv(c.points, field.get());
+  const ExtrinsicsResult r = EstimatePose(cam, pts, c.o);
+  PrintPointTable(r.points);
+  std::cout << r.Summary() << "\n";
+  std::cout << fmt::format(
+      "reprojection error: {:.2f} px rms\ncamera position: {:.3f} {:.3f} "
+      "{:.3f} m\n",
+      r.rms_px, r.camera_position_m.x(), r.camera_position_m.y(), r.camera_position_m.z());
+  if (r.num_inliers < static_cast<int>(pts.size())) {
+    Warn(fmt::format("{} points did not fit and were left out (marked 'outlier')",
+                     pts.size() - r.num_inliers));
+  }
+  Camera out = r.camera;
+  out.rms_px = r.rms_px;
+  out.notes["extrinsics_points"] = c.points;
+  out.notes["extrinsics_rms_px"] = fmt::format("{:.3f}", r.rms_px);
+  if (!c.table.empty()) WritePointErrorTable(c.table, r.points);
+  WriteCameraYaml(out, c.out);
+  std::cout << "wrote " << c.out << "\n";
+}
+
+// ---- refine
+struct RefineCli {
+  std::string camera, image, field, out, overlay;
+  RefineOptions o;
+};
+
+void RunRefine(const RefineCli& c) {
+  const Camera cam = ReadCameraYaml(c.camera);
+  const cv::Mat image = ReadImage(c.image);
+  CheckImageSize(image, cam, c.image, c.camera);
+  const FieldModel field = LoadField(c.field);
+  const RefineResult r = RefineWithLines(cam, image, field, c.o);
+  std::cout << fmt::format("before: {}\nafter:  {}\n", r.before.Summary(), r.after.Summary());
+  std::cout << r.Summary() << "\n";
+  std::cout << fmt::format(
+      "line error: mean {:.1f} mm, p95 {:.1f} mm (before: mean {:.1f} mm, "
+      "p95 {:.1f} mm)\n",
+      r.after.mean_mm, r.after.p95_mm, r.before.mean_mm, r.before.p95_mm);
+  if (!r.accepted) Warn("pose not refined: " + r.status + "; the camera file keeps the input pose");
+  Camera out = r.camera;
+  if (r.accepted) {
+    out.notes["refined_with_lines"] = c.image;
+    out.notes["line_error_mean_mm"] = fmt::format("{:.1f}", r.after.mean_mm);
+    out.notes["line_error_p95_mm"] = fmt::format("{:.1f}", r.after.p95_mm);
+  }
+  WriteCameraYaml(out, c.out);
+  std::cout << "wrote " << c.out << "\n";
+  if (!c.overlay.empty()) {
+    CheckOptions co;
+    co.detect = c.o.detect;
+    WriteImage(c.overlay, CheckCalibration(out, image, field, {}, co).overlay);
+    std::cout << "wrote " << c.overlay << "\n";
+  }
+}
+
+// ---- check
+struct CheckCli {
+  std::string camera, image, field, out, points, table;
+  CheckOptions o;
+};
+
+void RunCheck(const CheckCli& c) {
+  const Camera cam = ReadCameraYaml(c.camera);
+  const cv::Mat image = ReadImage(c.image);
+  CheckImageSize(image, cam, c.image, c.camera);
+  const FieldModel field = LoadField(c.field);
+  std::vector<PointCorrespondence> pts;
+  if (!c.points.empty()) pts = ReadPointsCsv(c.points, &field);
+  const CheckResult r = CheckCalibration(cam, image, field, pts, c.o);
+  if (!r.points.empty()) PrintPointTable(r.points);
+  std::cout << r.Summary() << "\n";
+  std::cout << fmt::format("line error: mean {:.1f} mm, p95 {:.1f} mm\n", r.lines.mean_mm,
+                           r.lines.p95_mm);
+  WriteImage(c.out, r.overlay);
+  std::cout << "wrote " << c.out << "\n";
+  if (!c.table.empty()) {
+    FV_REQUIRE(!r.points.empty(), "--table needs --points");
+    WritePointErrorTable(c.table, r.points);
+    std::cout << "wrote " << c.table << "\n";
+  }
+}
+
+// ---- rig
+struct RigCli {
+  std::vector<std::string> cameras, points;
+  std::string field, out_dir;
+  RigOptions o;
+};
+
+void RunRig(const RigCli& c) {
+  FV_REQUIRE(c.cameras.size() == c.points.size(),
+             "{} --camera but {} --points; give one points file per camera", c.cameras.size(),
+             c.points.size());
+  std::unique_ptr<FieldModel> field;
+  if (!c.field.empty()) field = std::make_unique<FieldModel>(LoadField(c.field));
+  std::vector<Camera> cams;
+  std::vector<std::vector<RigObservation>> obs;
+  for (size_t i = 0; i < c.cameras.size(); ++i) {
+    cams.push_back(ReadCameraYaml(c.cameras[i]));
+    if (cams.back().name.empty()) {
+      cams.back().name = std::filesystem::path(c.cameras[i]).stem().string();
+    }
+    obs.push_back(ReadRigObservations(c.points[i], field.get()));
+  }
+  const RigResult r = RefineRig(cams, obs, c.o);
+  std::cout << r.Summary() << "\n";
+  std::filesystem::create_directories(c.out_dir);
+  for (size_t i = 0; i < r.cameras.size(); ++i) {
+    const std::string path =
+        (std::filesystem::path(c.out_dir) / std::filesystem::path(c.cameras[i]).filename())
+            .string();
+    Camera out = r.cameras[i];
+    out.notes["rig_rms_px"] = fmt::format("{:.3f}", r.reports[i].rms_after_px);
+    WriteCameraYaml(out, path);
+    std::cout << "wrote " << path << "\n";
+  }
+}
+
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(app, "calibrate", "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
-  AddPlannedCommand(*group, "intrinsics", "Intrinsics from chessboard/ChArUco images", "see the calibration issue", exit_code);
-  AddPlannedCommand(*group, "extrinsics", "Pose from known field points", "see the calibration issue", exit_code);
-  AddPlannedCommand(*group, "refine", "Refine the pose against the painted field lines", "see the calibration issue", exit_code);
-  AddPlannedCommand(*group, "check", "Draw the field over a frame and report the line error", "see the calibration issue", exit_code);
-  AddPlannedCommand(*group, "rig", "Refine several cameras' poses jointly", "see the calibration issue", exit_code);
+  CLI::App* group = CommandGroup(
+      app, "calibrate",
+      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
+
+  auto ic = std::make_shared<IntrinsicsCli>();
+  CLI::App* in = group->add_subcommand(
+      "intrinsics", "Intrinsics from chessboard or ChArUco views (a folder, a glob or a video)");
+  in->add_option("--images", ic->images, "Folder, glob pattern ('dir/*.jpg') or video")->required();
+  in->add_option("--board", ic->board, "chessboard or charuco")->capture_default_str();
+  in->add_option("--cols", ic->cols, "Chessboard: inner corners per row; ChArUco: squares per row")
+      ->required();
+  in->add_option("--rows", ic->rows,
+                 "Chessboard: inner corners per column; ChArUco: squares per column")
+      ->required();
+  in->add_option("--square", ic->square_m, "Square side in metres")->required();
+  in->add_option("--marker", ic->marker_m, "ChArUco marker side in metres (default 0.7 x square)");
+  in->add_option("--dictionary", ic->dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+  in->add_option("--model", ic->o.num_distortion,
+                 "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
+      ->capture_default_str();
+  in->add_flag("--fix-aspect", ic->o.fix_aspect_ratio, "Keep fx = fy");
+  in->add_flag("--zero-tangent", ic->o.zero_tangent, "No tangential distortion");
+  in->add_flag("--fix-principal-point", ic->o.fix_principal_point,
+               "Principal point at the image centre");
+  in->add_option("--outlier-factor", ic->o.outlier_factor,
+                 "Drop views with RMS above this x the median (and above --outlier-min-px)")
+      ->capture_default_str();
+  in->add_option("--outlier-min-px", ic->o.outlier_min_px, "See --outlier-factor")
+      ->capture_default_str();
+  in->add_option("--max-frames", ic->o.source.max_video_frames, "Frames sampled from a video")
+      ->capture_default_str();
+  in->add_option("--name", ic->name, "Camera name written to the file");
+  in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
+  in->add_flag("--quiet", ic->quiet, "No progress");
+  in->callback([ic] { RunIntrinsics(*ic); });
+
+  auto ec = std::make_shared<ExtrinsicsCli>();
+  CLI::App* ex = group->add_subcommand(
+      "extrinsics", "Camera pose from clicked points of known position (RANSAC PnP + refinement)");
+  ex->add_option("--camera", ec->camera, "Camera file with intrinsics")->required();
+  ex->add_option("--points", ec->points, "CSV with u,v,x,y,z (metres) or u,v,name")->required();
+  ex->add_option("--field", ec->field, "Field for named points (built-in name or JSON)");
+  ex->add_option("--out", ec->out, "Camera file to write")->required();
+  ex->add_option("--threshold", ec->o.ransac_threshold_px, "RANSAC inlier threshold in pixels")
+      ->capture_default_str();
+  ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
+  ex->callback([ec] { RunExtrinsics(*ec); });
+
+  auto rc = std::make_shared<RefineCli>();
+  CLI::App* re =
+      group->add_subcommand("refine", "Refine the pose against the painted field lines in a frame");
+  re->add_option("--camera", rc->camera, "Camera file with a pose")->required();
+  re->add_option("--image", rc->image, "Frame of this camera")->required();
+  re->add_option("--field", rc->field, "Field (built-in name or JSON)")->required();
+  re->add_option("--out", rc->out, "Camera file to write")->required();
+  re->add_option("--lut-resolution", rc->o.lut_resolution_m,
+                 "Cell of the distance lookup table in metres")
+      ->capture_default_str();
+  re->add_option("--overlay", rc->overlay, "Also write the check image of the refined pose");
+  re->callback([rc] { RunRefine(*rc); });
+
+  auto cc = std::make_shared<CheckCli>();
+  CLI::App* ch = group->add_subcommand(
+      "check", "Draw the field model over a frame and print the line error in mm");
+  ch->add_option("--camera", cc->camera, "Camera file with a pose")->required();
+  ch->add_option("--image", cc->image, "Frame of this camera")->required();
+  ch->add_option("--field", cc->field, "Field (built-in name or JSON)")->required();
+  ch->add_option("--out", cc->out, "Image to write (.png, .jpg)")->required();
+  ch->add_option("--points", cc->points, "Known points (u,v,name or u,v,x,y,z) to tabulate");
+  ch->add_option("--table", cc->table, "Write the known points' error table (CSV)");
+  ch->callback([cc] { RunCheck(*cc); });
+
+  auto gc = std::make_shared<RigCli>();
+  CLI::App* rg = group->add_subcommand(
+      "rig", "Refine several cameras' poses jointly from shared observations (bundle adjustment)");
+  rg->add_option("--camera", gc->cameras, "Camera file (repeat, one per camera)")->required();
+  rg->add_option("--points", gc->points,
+                 "Observations per camera: CSV u,v,name[,x,y,z] (repeat, in camera order)")
+      ->required();
+  rg->add_option("--field", gc->field, "Field whose keypoint names have known positions");
+  rg->add_option("--out-dir", gc->out_dir, "Folder for the refined camera files")->required();
+  rg->callback([gc] { RunRig(*gc); });
+  (void)exit_code;
 }
 
 FV_REGISTER_COMMAND(20, "calibrate", Setup);

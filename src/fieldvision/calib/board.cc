@@ -1,0 +1,279 @@
+#include "fieldvision/calib/board.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include <fmt/format.h>
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::calib {
+namespace {
+
+const std::map<std::string, int>& DictionaryNames() {
+  static const std::map<std::string, int> names = {
+      {"DICT_4X4_50", cv::aruco::DICT_4X4_50},
+      {"DICT_4X4_100", cv::aruco::DICT_4X4_100},
+      {"DICT_4X4_250", cv::aruco::DICT_4X4_250},
+      {"DICT_4X4_1000", cv::aruco::DICT_4X4_1000},
+      {"DICT_5X5_50", cv::aruco::DICT_5X5_50},
+      {"DICT_5X5_100", cv::aruco::DICT_5X5_100},
+      {"DICT_5X5_250", cv::aruco::DICT_5X5_250},
+      {"DICT_5X5_1000", cv::aruco::DICT_5X5_1000},
+      {"DICT_6X6_50", cv::aruco::DICT_6X6_50},
+      {"DICT_6X6_100", cv::aruco::DICT_6X6_100},
+      {"DICT_6X6_250", cv::aruco::DICT_6X6_250},
+      {"DICT_6X6_1000", cv::aruco::DICT_6X6_1000},
+      {"DICT_7X7_50", cv::aruco::DICT_7X7_50},
+      {"DICT_7X7_100", cv::aruco::DICT_7X7_100},
+      {"DICT_7X7_250", cv::aruco::DICT_7X7_250},
+      {"DICT_7X7_1000", cv::aruco::DICT_7X7_1000},
+      {"DICT_ARUCO_ORIGINAL", cv::aruco::DICT_ARUCO_ORIGINAL}};
+  return names;
+}
+
+bool IsImageFile(const std::filesystem::path& p) {
+  const std::string ext = ToLower(p.extension().string());
+  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp" || ext == ".tif" ||
+         ext == ".tiff" || ext == ".pgm" || ext == ".ppm";
+}
+
+cv::Mat ToGrey(const cv::Mat& image) {
+  if (image.channels() == 1) return image;
+  cv::Mat grey;
+  cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+// The smallest distance between neighbouring chessboard corners, in pixels.
+double SmallestSquarePx(const std::vector<cv::Point2f>& corners, int cols, int rows) {
+  double best = 1e9;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const cv::Point2f& p = corners[r * cols + c];
+      if (c + 1 < cols) best = std::min(best, cv::norm(p - corners[r * cols + c + 1]));
+      if (r + 1 < rows) best = std::min(best, cv::norm(p - corners[(r + 1) * cols + c]));
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+BoardType ParseBoardType(const std::string& name) {
+  const std::string n = ToLower(name);
+  if (n == "chessboard") return BoardType::kChessboard;
+  if (n == "charuco") return BoardType::kCharuco;
+  Throw("board '{}' is not known; use chessboard or charuco", name);
+}
+
+void BoardSpec::Check() const {
+  const int min_size = type == BoardType::kChessboard ? 2 : 3;
+  FV_REQUIRE(cols >= min_size && rows >= min_size, "board cols and rows must be >= {} (got {}x{})",
+             min_size, cols, rows);
+  FV_REQUIRE(std::isfinite(square_m) && square_m > 0, "board square must be > 0 m (got {})",
+             square_m);
+  if (type == BoardType::kCharuco) {
+    FV_REQUIRE(std::isfinite(marker_m) && marker_m >= 0 && marker_m < square_m,
+               "board marker size must be in [0, square) (got {} m, square {} m)", marker_m,
+               square_m);
+    FV_REQUIRE(DictionaryNames().count(dictionary) > 0,
+               "board dictionary '{}' is not an OpenCV ArUco dictionary (e.g. DICT_4X4_50)",
+               dictionary);
+  }
+}
+
+std::string BoardSpec::Describe() const {
+  if (type == BoardType::kChessboard) {
+    return fmt::format("chessboard {}x{} inner corners, {:.1f} mm squares", cols, rows,
+                       square_m * 1000);
+  }
+  return fmt::format("charuco {}x{} squares, {:.1f} mm squares, {:.1f} mm markers, {}", cols, rows,
+                     square_m * 1000, (marker_m > 0 ? marker_m : 0.7 * square_m) * 1000,
+                     dictionary);
+}
+
+std::vector<cv::Point3f> BoardSpec::CornerPositions() const {
+  const int nc = type == BoardType::kChessboard ? cols : cols - 1;
+  const int nr = type == BoardType::kChessboard ? rows : rows - 1;
+  std::vector<cv::Point3f> pts;
+  pts.reserve(nc * nr);
+  for (int r = 0; r < nr; ++r) {
+    for (int c = 0; c < nc; ++c) {
+      // ChArUco corner (c, r) sits at ((c + 1) * square, (r + 1) * square) in OpenCV's layout.
+      const int off = type == BoardType::kChessboard ? 0 : 1;
+      pts.emplace_back(static_cast<float>((c + off) * square_m),
+                       static_cast<float>((r + off) * square_m), 0.0f);
+    }
+  }
+  return pts;
+}
+
+void DetectOptions::Check() const {
+  FV_REQUIRE(subpix_half_window_px >= 1 && subpix_half_window_px <= 50,
+             "subpix_half_window_px must be in [1, 50] (got {})", subpix_half_window_px);
+  FV_REQUIRE(search_max_width_px == 0 || search_max_width_px >= 160,
+             "search_max_width_px must be 0 or >= 160 (got {})", search_max_width_px);
+  CheckInRange(subpix_square_fraction, 0.0, 1.0, "subpix_square_fraction");
+  FV_REQUIRE(min_charuco_corners >= 4, "min_charuco_corners must be >= 4 (got {})",
+             min_charuco_corners);
+}
+
+BoardView DetectBoard(const cv::Mat& image, const BoardSpec& board, const DetectOptions& options,
+                      const std::string& name) {
+  board.Check();
+  options.Check();
+  FV_REQUIRE(!image.empty(), "image '{}' is empty", name);
+  BoardView view;
+  view.name = name;
+  view.image_size = image.size();
+  const cv::Mat grey = ToGrey(image);
+  if (board.type == BoardType::kChessboard) {
+    const cv::Size pattern(board.cols, board.rows);
+    std::vector<cv::Point2f> corners;
+    const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE;
+    double scale = 1.0;
+    bool found = false;
+    if (options.search_max_width_px > 0 && grey.cols > options.search_max_width_px) {
+      scale = static_cast<double>(options.search_max_width_px) / grey.cols;
+      cv::Mat small;
+      cv::resize(grey, small, cv::Size(), scale, scale, cv::INTER_AREA);
+      found = cv::findChessboardCorners(small, pattern, corners, flags);
+      if (found) {
+        for (auto& c : corners) c = (c + cv::Point2f(0.5f, 0.5f)) / scale - cv::Point2f(0.5f, 0.5f);
+      }
+    }
+    if (!found) {
+      scale = 1.0;
+      found = cv::findChessboardCorners(grey, pattern, corners, flags);
+    }
+    if (!found) return view;
+    const double square_px = SmallestSquarePx(corners, board.cols, board.rows);
+    int half = options.subpix_half_window_px;
+    if (options.subpix_square_fraction > 0) {
+      half =
+          std::max(1, std::min(half, static_cast<int>(options.subpix_square_fraction * square_px)));
+    }
+    cv::cornerSubPix(grey, corners, cv::Size(half, half), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.01));
+    const auto all = board.CornerPositions();
+    view.image_points = corners;
+    view.object_points = all;
+    view.corner_ids.resize(all.size());
+    for (size_t i = 0; i < all.size(); ++i) view.corner_ids[i] = static_cast<int>(i);
+    return view;
+  }
+  // ChArUco: markers, then the chessboard corners between them (interpolated by a local
+  // homography and refined to sub-pixel by OpenCV).
+  const auto dict = cv::aruco::getPredefinedDictionary(DictionaryNames().at(board.dictionary));
+  const float marker =
+      static_cast<float>(board.marker_m > 0 ? board.marker_m : 0.7 * board.square_m);
+  const auto charuco = cv::aruco::CharucoBoard::create(
+      board.cols, board.rows, static_cast<float>(board.square_m), marker, dict);
+  std::vector<std::vector<cv::Point2f>> marker_corners;
+  std::vector<int> marker_ids;
+  cv::aruco::detectMarkers(grey, dict, marker_corners, marker_ids);
+  if (marker_ids.empty()) return view;
+  std::vector<cv::Point2f> corners;
+  std::vector<int> ids;
+  cv::aruco::interpolateCornersCharuco(marker_corners, marker_ids, grey, charuco, corners, ids);
+  if (static_cast<int>(ids.size()) < options.min_charuco_corners) return view;
+  view.image_points = corners;
+  view.corner_ids = ids;
+  for (int id : ids) view.object_points.push_back(charuco->chessboardCorners[id]);
+  return view;
+}
+
+void ImageSourceOptions::Check() const {
+  FV_REQUIRE(max_video_frames >= 1, "max_video_frames must be >= 1 (got {})", max_video_frames);
+}
+
+ImageSource::ImageSource(const std::string& spec, const ImageSourceOptions& options) : spec_(spec) {
+  options.Check();
+  namespace fs = std::filesystem;
+  FV_REQUIRE(!spec.empty(), "images: no folder, pattern or video given");
+  if (spec.find_first_of("*?[") != std::string::npos) {
+    std::vector<cv::String> found;
+    try {
+      cv::glob(spec, found, false);
+    } catch (const cv::Exception&) {
+      found.clear();
+    }
+    for (const auto& f : found) {
+      if (IsImageFile(f)) names_.push_back(f);
+    }
+    std::sort(names_.begin(), names_.end());
+    FV_REQUIRE(!names_.empty(), "images '{}': the pattern matches no image file", spec);
+    return;
+  }
+  FV_REQUIRE(fs::exists(spec), "images '{}': no such file or folder", spec);
+  if (fs::is_directory(spec)) {
+    for (const auto& e : fs::directory_iterator(spec)) {
+      if (e.is_regular_file() && IsImageFile(e.path())) names_.push_back(e.path().string());
+    }
+    std::sort(names_.begin(), names_.end());
+    FV_REQUIRE(!names_.empty(), "images '{}': the folder has no image files", spec);
+    return;
+  }
+  if (IsImageFile(spec)) {
+    names_.push_back(spec);
+    return;
+  }
+  cv::VideoCapture cap;
+  try {
+    cap.open(spec);
+  } catch (const cv::Exception&) {
+  }
+  FV_REQUIRE(cap.isOpened(), "images '{}': not an image, folder, pattern or readable video", spec);
+  long long count = static_cast<long long>(cap.get(cv::CAP_PROP_FRAME_COUNT));
+  if (count <= 0) {
+    // Some containers do not say; count by reading.
+    cv::Mat f;
+    count = 0;
+    while (cap.read(f)) ++count;
+  }
+  FV_REQUIRE(count > 0, "images '{}': the video has no readable frames", spec);
+  video_ = true;
+  const int n = static_cast<int>(std::min<long long>(count, options.max_video_frames));
+  for (int i = 0; i < n; ++i) {
+    const int frame = static_cast<int>((count * (2LL * i + 1)) / (2LL * n));
+    frames_.push_back(frame);
+    names_.push_back(fmt::format("{}#{}", spec, frame));
+  }
+}
+
+cv::Mat ImageSource::Read(int i) const {
+  FV_REQUIRE(i >= 0 && i < size(), "images '{}': index {} out of range", spec_, i);
+  cv::Mat image;
+  if (!video_) {
+    try {
+      image = cv::imread(names_[i], cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+      image.release();
+    }
+    FV_REQUIRE(!image.empty(), "image '{}' cannot be read (missing or corrupt)", names_[i]);
+    if (image.depth() != CV_8U) {
+      cv::Mat converted;
+      image.convertTo(converted, CV_8U, image.depth() == CV_16U ? 1.0 / 256 : 1.0);
+      image = converted;
+    }
+    return image;
+  }
+  cv::VideoCapture cap(spec_);
+  FV_REQUIRE(cap.isOpened(), "video '{}' cannot be opened", spec_);
+  cap.set(cv::CAP_PROP_POS_FRAMES, frames_[i]);
+  cap.read(image);
+  FV_REQUIRE(!image.empty(), "video '{}': frame {} cannot be read (corrupt video?)", spec_,
+             frames_[i]);
+  return image;
+}
+
+}  // namespace fv::calib

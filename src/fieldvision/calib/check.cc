@@ -1,0 +1,166 @@
+#include "fieldvision/calib/check.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::calib {
+namespace {
+
+void DrawPolyline3d(cv::Mat& image, const Camera& camera, const std::vector<Eigen::Vector3d>& pts,
+                    const cv::Scalar& colour, int thickness) {
+  std::optional<Eigen::Vector2d> prev;
+  const double big = 4.0 * std::max(camera.width, camera.height);
+  for (const auto& p : pts) {
+    std::optional<Eigen::Vector2d> uv = camera.Project(p);
+    // Far outside the image the distortion polynomial folds back; do not draw there.
+    if (uv && !camera.InImage(*uv, -0.5 * big)) uv.reset();
+    if (uv && prev) {
+      cv::line(image, cv::Point2d(prev->x(), prev->y()), cv::Point2d(uv->x(), uv->y()), colour,
+               thickness, cv::LINE_AA);
+    }
+    prev = uv;
+  }
+}
+
+}  // namespace
+
+void CheckOptions::Check() const {
+  detect.Check();
+  CheckPositive(gate_m, "gate_m");
+  FV_REQUIRE(thickness_px >= 1 && thickness_px <= 20, "thickness_px must be in [1, 20] (got {})",
+             thickness_px);
+  CheckInRange(sample_step_m, 0.001, 5.0, "sample_step_m");
+}
+
+std::string CheckResult::Summary() const {
+  std::string s = lines.Summary();
+  if (!points.empty()) {
+    double sum_px = 0, sum_mm = 0;
+    int n_mm = 0;
+    for (const auto& p : points) {
+      sum_px += p.err_px;
+      if (p.err_mm) {
+        sum_mm += *p.err_mm;
+        ++n_mm;
+      }
+    }
+    s += fmt::format("; {} known points: mean {:.2f} px, {:.0f} mm", points.size(),
+                     sum_px / points.size(), n_mm ? sum_mm / n_mm : 0.0);
+  }
+  return s;
+}
+
+void DrawFieldOverlay(cv::Mat& image, const Camera& camera, const FieldModel& field,
+                      const cv::Scalar& colour, int thickness_px, double step_m) {
+  for (const auto& s : field.segments) {
+    const int n = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / step_m)));
+    std::vector<Eigen::Vector3d> pts;
+    for (int i = 0; i <= n; ++i) {
+      const Eigen::Vector2d p = s.a + (s.b - s.a) * (static_cast<double>(i) / n);
+      pts.emplace_back(p.x(), p.y(), 0.0);
+    }
+    DrawPolyline3d(image, camera, pts, colour, thickness_px);
+  }
+  for (const auto& a : field.arcs) {
+    const double len = a.radius_m * (a.end_rad - a.start_rad);
+    const int n = std::max(2, static_cast<int>(std::ceil(len / step_m)));
+    std::vector<Eigen::Vector3d> pts;
+    for (int i = 0; i <= n; ++i) {
+      const double t = a.start_rad + (a.end_rad - a.start_rad) * i / n;
+      pts.emplace_back(a.centre.x() + a.radius_m * std::cos(t),
+                       a.centre.y() + a.radius_m * std::sin(t), 0.0);
+    }
+    DrawPolyline3d(image, camera, pts, colour, thickness_px);
+  }
+  for (const auto& g : field.goals) {
+    for (double y : {g.y_min_m, g.y_max_m}) {
+      DrawPolyline3d(
+          image, camera,
+          {Eigen::Vector3d(g.line_x_m, y, 0), Eigen::Vector3d(g.line_x_m, y, g.height_m)}, colour,
+          thickness_px);
+    }
+    DrawPolyline3d(image, camera,
+                   {Eigen::Vector3d(g.line_x_m, g.y_min_m, g.height_m),
+                    Eigen::Vector3d(g.line_x_m, g.y_max_m, g.height_m)},
+                   colour, thickness_px);
+  }
+  for (const auto& k : field.keypoints) {
+    const auto uv = camera.Project(k.position_m);
+    if (uv && camera.InImage(*uv)) {
+      cv::circle(image, cv::Point2d(uv->x(), uv->y()), 3 + thickness_px, colour, 1, cv::LINE_AA);
+    }
+  }
+}
+
+CheckResult CheckCalibration(const Camera& camera, const cv::Mat& image_bgr,
+                             const FieldModel& field,
+                             const std::vector<PointCorrespondence>& known_points,
+                             const CheckOptions& options) {
+  options.Check();
+  camera.Check("camera");
+  FV_REQUIRE(camera.has_pose, "camera '{}' has no pose; run `calibrate extrinsics` first",
+             camera.name);
+  CheckImageSize(image_bgr, camera, "frame", camera.name);
+  CheckResult result;
+  if (image_bgr.channels() == 1) {
+    cv::cvtColor(image_bgr, result.overlay, cv::COLOR_GRAY2BGR);
+  } else {
+    result.overlay = image_bgr.clone();
+  }
+  const auto pixels = DetectLinePixels(result.overlay, camera, field, options.detect);
+  result.lines = LineError(camera, pixels, field, options.gate_m);
+  DrawFieldOverlay(result.overlay, camera, field, options.model_colour, options.thickness_px,
+                   options.sample_step_m);
+  if (options.draw_line_pixels) {
+    // Green within 5 cm of the model, yellow within the gate, red beyond.
+    for (const auto& uv : pixels) {
+      const auto ray = camera.RayFromPixel(uv);
+      const auto g = ray ? IntersectHorizontalPlane(*ray, 0.0) : std::nullopt;
+      if (!g) continue;
+      const double d = field.DistanceToLineCentres(g->head<2>());
+      const cv::Scalar c = d < 0.05             ? cv::Scalar(0, 255, 0)
+                           : d < options.gate_m ? cv::Scalar(0, 255, 255)
+                                                : cv::Scalar(0, 0, 255);
+      cv::circle(result.overlay, cv::Point2d(uv.x(), uv.y()), 1, c, -1);
+    }
+  }
+  if (!known_points.empty()) {
+    result.points = PointResiduals(camera, known_points);
+    for (const auto& p : result.points) {
+      cv::circle(result.overlay, cv::Point2d(p.uv_px.x(), p.uv_px.y()), 6, cv::Scalar(0, 255, 255),
+                 2, cv::LINE_AA);
+      if (p.projected_px.allFinite()) {
+        cv::line(result.overlay, cv::Point2d(p.uv_px.x(), p.uv_px.y()),
+                 cv::Point2d(p.projected_px.x(), p.projected_px.y()), cv::Scalar(0, 0, 255), 2,
+                 cv::LINE_AA);
+      }
+    }
+  }
+  const std::string text = fmt::format("line error mean {:.0f} mm, p95 {:.0f} mm",
+                                       result.lines.mean_mm, result.lines.p95_mm);
+  cv::putText(result.overlay, text, cv::Point(12, 32), cv::FONT_HERSHEY_SIMPLEX, 0.9,
+              cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
+  cv::putText(result.overlay, text, cv::Point(12, 32), cv::FONT_HERSHEY_SIMPLEX, 0.9,
+              cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+  return result;
+}
+
+void WritePointErrorTable(const std::string& path, const std::vector<PointResidual>& points) {
+  CsvWriter w(
+      path,
+      {"name", "u", "v", "x_m", "y_m", "z_m", "u_proj", "v_proj", "err_px", "err_mm", "inlier"}, 4);
+  for (const auto& p : points) {
+    w << p.name << p.uv_px.x() << p.uv_px.y() << p.p_world.x() << p.p_world.y() << p.p_world.z()
+      << p.projected_px.x() << p.projected_px.y() << p.err_px
+      << (p.err_mm ? *p.err_mm : std::nan("")) << (p.inlier ? 1 : 0);
+    w.EndRow();
+  }
+  w.Close();
+}
+
+}  // namespace fv::calib

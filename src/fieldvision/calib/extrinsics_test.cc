@@ -1,0 +1,199 @@
+#include "fieldvision/calib/extrinsics.h"
+
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::calib {
+namespace {
+
+// A camera about 20 m from the field centre of the RoboCup MSL field, looking at it.
+Camera TwentyMetreCamera() {
+  Camera cam = Camera::FromFov(1280, 960, 60.0);
+  cam.distortion = {-0.05, 0.02, 0.0, 0.0, 0.0};
+  cam.has_pose = true;
+  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15.0, -12.0, 7.0), Eigen::Vector3d::Zero());
+  return cam;
+}
+
+// The field's ground keypoints that the camera sees, 8 of them spread over the list.
+std::vector<PointCorrespondence> ClickKeypoints(const Camera& cam, const FieldModel& field,
+                                                int count, double noise_px, Rng& rng) {
+  std::vector<const FieldKeypoint*> seen;
+  for (const auto& k : field.keypoints) {
+    const auto uv = cam.Project(k.position_m);
+    if (k.position_m.z() == 0.0 && uv && cam.InImage(*uv, 10)) seen.push_back(&k);
+  }
+  // Farthest-point order in the image, from the first seen point: what a user told to click
+  // points spread over the image does.
+  std::vector<PointCorrespondence> pts;
+  std::vector<bool> taken(seen.size(), false);
+  for (int i = 0; i < count && i < static_cast<int>(seen.size()); ++i) {
+    size_t pick = 0;
+    double best = -1;
+    for (size_t j = 0; j < seen.size(); ++j) {
+      if (taken[j]) continue;
+      double nearest = 1e18;
+      for (const auto& p : pts) {
+        nearest = std::min(
+            nearest, (*cam.Project(seen[j]->position_m) - *cam.Project(p.p_world)).squaredNorm());
+      }
+      if (nearest > best) {
+        best = nearest;
+        pick = j;
+      }
+    }
+    taken[pick] = true;
+    const FieldKeypoint* k = seen[pick];
+    PointCorrespondence p;
+    p.name = k->name;
+    p.p_world = k->position_m;
+    p.uv_px = *cam.Project(k->position_m) +
+              Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px));
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+TEST(Extrinsics, EightKeypointsWithOnePixelNoiseWithin5cmAt20m) {
+  // 40 independent clicks of 8 keypoints with 1 px noise: the camera position error is a
+  // random variable (the estimate is maximum likelihood; its spread is the geometry's), so we
+  // check its median and 90th percentile.
+  const uint64_t seed = fv::testing::TestSeed(3);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const FieldModel field = BuiltinField("robocup-msl");
+  const Camera truth = TwentyMetreCamera();
+  ASSERT_NEAR(truth.CentreInWorld().norm(), 20.4, 0.1);
+  Camera intrinsics = truth;
+  intrinsics.has_pose = false;
+  std::vector<double> errs_m;
+  for (int trial = 0; trial < 40; ++trial) {
+    const auto pts = ClickKeypoints(truth, field, 8, 1.0, rng);
+    ASSERT_EQ(pts.size(), 8u);
+    const ExtrinsicsResult r = EstimatePose(intrinsics, pts);
+    errs_m.push_back((r.camera_position_m - truth.CentreInWorld()).norm());
+    EXPECT_EQ(r.num_inliers, 8) << r.Summary();
+    EXPECT_GT(r.rms_px, 0.1);  // the noise is there: a zero residual would be suspicious
+    EXPECT_LT(r.rms_px, 2.5);
+    for (const auto& p : r.points) {
+      ASSERT_TRUE(p.err_mm.has_value());
+      EXPECT_LT(*p.err_mm, 400.0) << p.name;  // grazing rays: a pixel spans decimetres
+    }
+  }
+  std::sort(errs_m.begin(), errs_m.end());
+  EXPECT_LT(errs_m[20], 0.05);
+  EXPECT_LT(errs_m[36], 0.08);
+  std::cout << "camera position error over 40 clicks: median " << 1000 * errs_m[20]
+            << " mm, 90th percentile " << 1000 * errs_m[36] << " mm\n";
+}
+
+TEST(Extrinsics, GrossOutlierIsRejected) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const FieldModel field = BuiltinField("robocup-msl");
+  const Camera truth = TwentyMetreCamera();
+  auto pts = ClickKeypoints(truth, field, 10, 0.5, rng);
+  pts[3].uv_px += Eigen::Vector2d(60, -45);  // a point clicked at the wrong place
+  Camera intrinsics = truth;
+  intrinsics.has_pose = false;
+  const ExtrinsicsResult r = EstimatePose(intrinsics, pts);
+  EXPECT_FALSE(r.points[3].inlier);
+  EXPECT_EQ(r.num_inliers, 9);
+  EXPECT_LT((r.camera_position_m - truth.CentreInWorld()).norm(), 0.1) << r.Summary();
+}
+
+TEST(Extrinsics, FewerThanFourPointsIsAnError) {
+  const Camera cam = TwentyMetreCamera();
+  std::vector<PointCorrespondence> pts(3);
+  for (int i = 0; i < 3; ++i) {
+    pts[i].p_world = Eigen::Vector3d(i, i * i, 0);
+    pts[i].uv_px = *cam.Project(pts[i].p_world);
+  }
+  try {
+    EstimatePose(cam, pts);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("only 3 points"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Extrinsics, CollinearPointsAreAnError) {
+  const Camera cam = TwentyMetreCamera();
+  std::vector<PointCorrespondence> pts;
+  for (int i = 0; i < 6; ++i) {
+    PointCorrespondence p;
+    p.p_world = Eigen::Vector3d(-5 + 2 * i, 3, 0);
+    p.uv_px = *cam.Project(p.p_world);
+    pts.push_back(p);
+  }
+  try {
+    EstimatePose(cam, pts);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("one line"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Extrinsics, ReadsNamedAndNumericPointFiles) {
+  const FieldModel field = BuiltinField("robocup-msl");
+  const std::string dir = fv::testing::TempDir();
+  {
+    std::ofstream f(dir + "/named.csv");
+    f << "u,v,name\n100,200,centre_spot\n300.5,400,corner_left_bottom\n";
+  }
+  const auto named = ReadPointsCsv(dir + "/named.csv", &field);
+  ASSERT_EQ(named.size(), 2u);
+  EXPECT_EQ(named[1].p_world, field.FindKeypoint("corner_left_bottom")->position_m);
+  EXPECT_DOUBLE_EQ(named[1].uv_px.x(), 300.5);
+  {
+    std::ofstream f(dir + "/xyz.csv");
+    f << "u,v,x,y,z\n1,2,3,4,5\n";
+  }
+  const auto xyz = ReadPointsCsv(dir + "/xyz.csv", nullptr);
+  ASSERT_EQ(xyz.size(), 1u);
+  EXPECT_EQ(xyz[0].p_world, Eigen::Vector3d(3, 4, 5));
+}
+
+TEST(Extrinsics, UnknownKeypointNameIsAnErrorNamingIt) {
+  const FieldModel field = BuiltinField("robocup-msl");
+  const std::string path = fv::testing::TempDir() + "/bad.csv";
+  {
+    std::ofstream f(path);
+    f << "u,v,name\n100,200,centre_spot\n300,400,centre_sport\n";
+  }
+  try {
+    ReadPointsCsv(path, &field);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("centre_sport"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("bad.csv:3"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+TEST(Extrinsics, MissingColumnsAndNaNAreErrors) {
+  const std::string dir = fv::testing::TempDir();
+  {
+    std::ofstream f(dir + "/cols.csv");
+    f << "u,v,x\n1,2,3\n";
+  }
+  EXPECT_THROW(ReadPointsCsv(dir + "/cols.csv", nullptr), Error);
+  {
+    std::ofstream f(dir + "/nan.csv");
+    f << "u,v,x,y,z\n1,2,nan,4,5\n";
+  }
+  EXPECT_THROW(ReadPointsCsv(dir + "/nan.csv", nullptr), Error);
+  EXPECT_THROW(ReadPointsCsv(dir + "/missing.csv", nullptr), Error);
+}
+
+}  // namespace
+}  // namespace fv::calib

@@ -1,0 +1,306 @@
+#include "fieldvision/calib/intrinsics.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+
+namespace fv::calib {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+int CalibFlags(const IntrinsicsOptions& o) {
+  int flags = 0;
+  switch (o.num_distortion) {
+    case 4:
+      flags |= cv::CALIB_FIX_K3;
+      break;
+    case 5:
+      break;
+    case 8:
+      flags |= cv::CALIB_RATIONAL_MODEL;
+      break;
+    case 12:
+      flags |= cv::CALIB_RATIONAL_MODEL | cv::CALIB_THIN_PRISM_MODEL;
+      break;
+    case 14:
+      flags |= cv::CALIB_RATIONAL_MODEL | cv::CALIB_THIN_PRISM_MODEL | cv::CALIB_TILTED_MODEL;
+      break;
+  }
+  if (o.fix_aspect_ratio) flags |= cv::CALIB_FIX_ASPECT_RATIO;
+  if (o.zero_tangent) flags |= cv::CALIB_ZERO_TANGENT_DIST;
+  if (o.fix_principal_point) flags |= cv::CALIB_FIX_PRINCIPAL_POINT;
+  return flags;
+}
+
+std::string Today() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+}  // namespace
+
+void IntrinsicsOptions::Check() const {
+  board.Check();
+  detect.Check();
+  source.Check();
+  FV_REQUIRE(num_distortion == 4 || num_distortion == 5 || num_distortion == 8 ||
+                 num_distortion == 12 || num_distortion == 14,
+             "num_distortion must be 4, 5, 8, 12 or 14 (got {})", num_distortion);
+  CheckPositive(outlier_factor, "outlier_factor");
+  CheckNonNegative(outlier_min_px, "outlier_min_px");
+  CheckInRange(max_drop_fraction, 0.0, 0.9, "max_drop_fraction");
+  FV_REQUIRE(min_views >= 1, "min_views must be >= 1 (got {})", min_views);
+  FV_REQUIRE(coverage_grid >= 1 && coverage_grid <= 32, "coverage_grid must be in [1, 32] (got {})",
+             coverage_grid);
+}
+
+std::string CoverageReport::Describe() const {
+  std::string s = fmt::format(
+      "corners reach {:.0f}% of {}x{} image cells, {:.0f}% of the half "
+      "diagonal; board tilt range {:.0f} deg",
+      100 * cell_fraction, grid, grid, 100 * radius_fraction, tilt_range_deg);
+  for (int r = 0; r < grid; ++r) {
+    s += "\n  ";
+    for (int c = 0; c < grid; ++c) s += fmt::format("{:5d}", corners_per_cell[r * grid + c]);
+  }
+  return s;
+}
+
+std::string IntrinsicsResult::Summary() const {
+  std::string s = fmt::format(
+      "rms {:.3f} px over {} of {} views ({} images, {} fits); fx {:.2f} fy {:.2f} cx {:.2f} cy "
+      "{:.2f} px (std {:.2f} {:.2f} {:.2f} {:.2f}); distortion [",
+      rms_px, num_used, num_found, num_images, fits, camera.fx, camera.fy, camera.cx, camera.cy,
+      std_fx_px, std_fy_px, std_cx_px, std_cy_px);
+  for (size_t i = 0; i < camera.distortion.size(); ++i) {
+    s += fmt::format("{}{:.5g}", i ? ", " : "", camera.distortion[i]);
+  }
+  return s + "]";
+}
+
+IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
+                                    const IntrinsicsOptions& options) {
+  options.Check();
+  IntrinsicsResult result;
+  result.num_images = static_cast<int>(views.size());
+  std::vector<int> found;
+  cv::Size size;
+  for (size_t i = 0; i < views.size(); ++i) {
+    ViewReport rep;
+    rep.name = views[i].name;
+    rep.board_found = !views[i].image_points.empty();
+    rep.num_corners = static_cast<int>(views[i].image_points.size());
+    FV_REQUIRE(views[i].image_points.size() == views[i].object_points.size(),
+               "view '{}': {} image points but {} board points", views[i].name,
+               views[i].image_points.size(), views[i].object_points.size());
+    if (rep.board_found) {
+      FV_REQUIRE(rep.num_corners >= 4, "view '{}': {} corners; a view needs at least 4",
+                 views[i].name, rep.num_corners);
+      if (found.empty()) size = views[i].image_size;
+      FV_REQUIRE(views[i].image_size == size,
+                 "image '{}' is {}x{} but the first view with the board is {}x{}", views[i].name,
+                 views[i].image_size.width, views[i].image_size.height, size.width, size.height);
+      found.push_back(static_cast<int>(i));
+    }
+    result.views.push_back(rep);
+  }
+  result.num_found = static_cast<int>(found.size());
+  FV_REQUIRE(!found.empty(), "no {} found in any of the {} images", options.board.Describe(),
+             views.size());
+  FV_REQUIRE(result.num_found >= options.min_views,
+             "the {} was found in only {} of {} images; at least {} views are needed",
+             options.board.Describe(), result.num_found, views.size(), options.min_views);
+
+  const int flags = CalibFlags(options);
+  const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * result.num_found));
+  std::vector<int> used = found;
+  cv::Mat k, d, std_intr, std_extr, per_view;
+  std::vector<cv::Mat> rvecs, tvecs;
+  double rms = 0;
+  while (true) {
+    std::vector<std::vector<cv::Point3f>> obj;
+    std::vector<std::vector<cv::Point2f>> img;
+    for (int i : used) {
+      obj.push_back(views[i].object_points);
+      img.push_back(views[i].image_points);
+    }
+    k = cv::Mat::eye(3, 3, CV_64F);
+    d = cv::Mat::zeros(1, 14, CV_64F);
+    rvecs.clear();
+    tvecs.clear();
+    try {
+      rms = cv::calibrateCamera(
+          obj, img, size, k, d, rvecs, tvecs, std_intr, std_extr, per_view, flags,
+          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+    } catch (const cv::Exception& e) {
+      Throw("calibration failed on {} views of the {} (degenerate views?): {}", used.size(),
+            options.board.Describe(), e.err);
+    }
+    ++result.fits;
+    FV_REQUIRE(std::isfinite(rms), "calibration diverged on {} views", used.size());
+    std::vector<double> errs(per_view.begin<double>(), per_view.end<double>());
+    const double threshold =
+        std::max(options.outlier_factor * Median(errs), options.outlier_min_px);
+    // Drop the worst view above the threshold, one at a time, while the budget allows.
+    int worst = -1;
+    for (size_t j = 0; j < errs.size(); ++j) {
+      if (errs[j] > threshold && (worst < 0 || errs[j] > errs[worst])) worst = static_cast<int>(j);
+    }
+    const int dropped = result.num_found - static_cast<int>(used.size());
+    if (worst < 0 || dropped >= max_drop || static_cast<int>(used.size()) - 1 < options.min_views) {
+      for (size_t j = 0; j < used.size(); ++j) {
+        result.views[used[j]].used = true;
+        result.views[used[j]].rms_px = errs[j];
+      }
+      break;
+    }
+    auto& rep = result.views[used[worst]];
+    rep.rms_px = errs[worst];
+    rep.dropped_because = fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})",
+                                      errs[worst], threshold, options.outlier_factor, Median(errs));
+    used.erase(used.begin() + worst);
+  }
+  result.num_used = static_cast<int>(used.size());
+  result.rms_px = rms;
+
+  Camera& cam = result.camera;
+  cam.name = options.camera_name;
+  cam.width = size.width;
+  cam.height = size.height;
+  cam.fx = k.at<double>(0, 0);
+  cam.fy = k.at<double>(1, 1);
+  cam.cx = k.at<double>(0, 2);
+  cam.cy = k.at<double>(1, 2);
+  cam.distortion.assign(options.num_distortion, 0.0);
+  for (int i = 0; i < options.num_distortion && i < static_cast<int>(d.total()); ++i) {
+    cam.distortion[i] = d.at<double>(i);
+  }
+  cam.rms_px = rms;
+  cam.Check("calibrated camera");
+  if (std_intr.total() >= 4) {
+    result.std_fx_px = std_intr.at<double>(0);
+    result.std_fy_px = std_intr.at<double>(1);
+    result.std_cx_px = std_intr.at<double>(2);
+    result.std_cy_px = std_intr.at<double>(3);
+    if (options.fix_aspect_ratio) result.std_fx_px = result.std_fy_px * cam.fx / cam.fy;
+  }
+
+  // Coverage of the image by the corners of the used views, and the spread of board tilts.
+  CoverageReport& cov = result.coverage;
+  cov.grid = options.coverage_grid;
+  cov.corners_per_cell.assign(cov.grid * cov.grid, 0);
+  const double half_diag = 0.5 * std::hypot(size.width, size.height);
+  std::vector<cv::Vec3d> normals;
+  for (size_t j = 0; j < used.size(); ++j) {
+    for (const auto& p : views[used[j]].image_points) {
+      const int c = std::clamp(static_cast<int>(p.x * cov.grid / size.width), 0, cov.grid - 1);
+      const int r = std::clamp(static_cast<int>(p.y * cov.grid / size.height), 0, cov.grid - 1);
+      ++cov.corners_per_cell[r * cov.grid + c];
+      cov.radius_fraction = std::max(
+          cov.radius_fraction,
+          std::hypot(p.x - 0.5 * (size.width - 1), p.y - 0.5 * (size.height - 1)) / half_diag);
+    }
+    cv::Mat r;
+    cv::Rodrigues(rvecs[j], r);
+    normals.emplace_back(r.at<double>(0, 2), r.at<double>(1, 2), r.at<double>(2, 2));
+  }
+  cov.cell_fraction =
+      static_cast<double>(std::count_if(cov.corners_per_cell.begin(), cov.corners_per_cell.end(),
+                                        [](int n) { return n > 0; })) /
+      cov.corners_per_cell.size();
+  for (size_t a = 0; a < normals.size(); ++a) {
+    for (size_t b = a + 1; b < normals.size(); ++b) {
+      const double c = std::clamp(std::abs(normals[a].dot(normals[b])), 0.0, 1.0);
+      cov.tilt_range_deg = std::max(cov.tilt_range_deg, std::acos(c) * 180.0 / M_PI);
+    }
+  }
+
+  // Warnings when the views do not pin the model down.
+  auto& w = result.warnings;
+  if (result.num_used < 8) {
+    w.push_back(fmt::format("only {} views: use 10 or more, spread over the image and tilted",
+                            result.num_used));
+  }
+  if (cov.cell_fraction < 0.6) {
+    w.push_back(
+        fmt::format("corners cover only {:.0f}% of the image cells: distortion outside "
+                    "them is extrapolated; show the board near the edges and corners",
+                    100 * cov.cell_fraction));
+  }
+  if (options.num_distortion >= 5 && cov.radius_fraction < 0.75) {
+    w.push_back(
+        fmt::format("corners reach only {:.0f}% of the half diagonal: the higher radial "
+                    "terms are not constrained",
+                    100 * cov.radius_fraction));
+  }
+  if (cov.tilt_range_deg < 15.0) {
+    w.push_back(
+        fmt::format("board orientations differ by only {:.0f} deg: the focal length is "
+                    "poorly constrained; tilt the board by 20-45 deg",
+                    cov.tilt_range_deg));
+  }
+  if (result.std_fx_px > 0.01 * cam.fx || result.std_fy_px > 0.01 * cam.fy) {
+    w.push_back(fmt::format("focal length uncertain: std {:.1f} px ({:.1f}%)", result.std_fx_px,
+                            100 * result.std_fx_px / cam.fx));
+  }
+  if (result.std_cx_px > 0.02 * size.width || result.std_cy_px > 0.02 * size.height) {
+    w.push_back(fmt::format("principal point uncertain: std {:.1f}, {:.1f} px", result.std_cx_px,
+                            result.std_cy_px));
+  }
+  const int dropped = result.num_found - result.num_used;
+  if (dropped > 0 && dropped >= max_drop) {
+    w.push_back(fmt::format("{} views were dropped as outliers (the most allowed)", dropped));
+  }
+
+  std::string used_names, dropped_names;
+  for (const auto& v : result.views) {
+    if (v.used) used_names += (used_names.empty() ? "" : " ") + v.name;
+    if (!v.dropped_because.empty()) dropped_names += (dropped_names.empty() ? "" : " ") + v.name;
+  }
+  cam.notes["board"] = options.board.Describe();
+  cam.notes["views"] = used_names;
+  if (!dropped_names.empty()) cam.notes["dropped_views"] = dropped_names;
+  cam.notes["num_views"] = std::to_string(result.num_used);
+  cam.notes["distortion_model"] = std::to_string(options.num_distortion) + " coefficients";
+  cam.notes["date"] = Today();
+  return result;
+}
+
+IntrinsicsResult CalibrateIntrinsics(const std::string& images, const IntrinsicsOptions& options) {
+  options.Check();
+  const ImageSource source(images, options.source);
+  std::vector<BoardView> views;
+  Progress progress("detecting corners", source.size(), "images", options.progress);
+  cv::Size first_size;
+  for (int i = 0; i < source.size(); ++i) {
+    const cv::Mat image = source.Read(i);
+    if (i == 0) first_size = image.size();
+    FV_REQUIRE(image.size() == first_size, "image '{}' is {}x{} but '{}' is {}x{}", source.name(i),
+               image.cols, image.rows, source.name(0), first_size.width, first_size.height);
+    views.push_back(DetectBoard(image, options.board, options.detect, source.name(i)));
+    progress.Update(i + 1);
+  }
+  progress.Finish();
+  const bool any = std::any_of(views.begin(), views.end(),
+                               [](const BoardView& v) { return !v.image_points.empty(); });
+  FV_REQUIRE(any, "images '{}': no {} found in any of the {} images (check --cols/--rows)", images,
+             options.board.Describe(), views.size());
+  return CalibrateFromViews(views, options);
+}
+
+}  // namespace fv::calib

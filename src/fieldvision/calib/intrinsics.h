@@ -1,0 +1,83 @@
+// Intrinsic calibration from board views: Zhang's method as implemented by OpenCV's
+// cv::calibrateCamera (Z. Zhang, "A flexible new technique for camera calibration", PAMI 2000),
+// with the chosen distortion model, per-view reprojection errors, outlier views dropped (and
+// named) before a final fit, a coverage report of the image area the corners reached, and
+// warnings when the views do not constrain the model (few views, poor coverage, little tilt,
+// large parameter standard deviations).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fieldvision/calib/board.h"
+#include "fieldvision/camera/camera.h"
+
+namespace fv::calib {
+
+struct IntrinsicsOptions {
+  BoardSpec board;
+  DetectOptions detect;
+  ImageSourceOptions source;
+  // Distortion coefficients to estimate: 4 (k1 k2 p1 p2), 5 (+k3, OpenCV's default), 8 (rational
+  // k4..k6), 12 (+ thin prism s1..s4) or 14 (+ tilted sensor tauX tauY).
+  int num_distortion = 5;
+  bool fix_aspect_ratio = false;     // fx = fy (CALIB_FIX_ASPECT_RATIO)
+  bool zero_tangent = false;         // p1 = p2 = 0
+  bool fix_principal_point = false;  // principal point at the image centre
+  // A view is dropped when its RMS error exceeds both outlier_factor x the median view RMS and
+  // outlier_min_px; then the camera is fitted again without it (at most max_drop_fraction of
+  // the views are dropped).
+  double outlier_factor = 4.0;
+  double outlier_min_px = 1.5;
+  double max_drop_fraction = 0.3;
+  int min_views = 3;        // fewer usable views is an error
+  int coverage_grid = 4;    // coverage report: grid cells per side
+  bool progress = true;     // progress on stderr while detecting corners
+  std::string camera_name;  // written to the camera file
+
+  void Check() const;
+};
+
+struct ViewReport {
+  std::string name;
+  bool board_found = false;
+  int num_corners = 0;
+  double rms_px = 0.0;  // reprojection RMS of this view in the final fit (or when dropped)
+  bool used = false;
+  std::string dropped_because;  // empty when used or when the board was not found
+};
+
+struct CoverageReport {
+  int grid = 4;
+  std::vector<int> corners_per_cell;  // row-major grid x grid
+  double cell_fraction = 0.0;         // share of cells with at least one corner
+  double radius_fraction = 0.0;       // farthest corner from the centre / half diagonal
+  double tilt_range_deg = 0.0;        // spread of the board normals' angle to the optical axis
+  std::string Describe() const;       // a small text map of the grid
+};
+
+struct IntrinsicsResult {
+  Camera camera;        // intrinsics only (has_pose = false), rms_px and notes set
+  double rms_px = 0.0;  // OpenCV's RMS over all corners of the used views
+  int num_images = 0;
+  int num_found = 0;
+  int num_used = 0;
+  int fits = 0;  // calibrateCamera runs (1 + refits after dropping views)
+  std::vector<ViewReport> views;
+  CoverageReport coverage;
+  // Standard deviations of fx, fy, cx, cy in pixels (from OpenCV's covariance estimate).
+  double std_fx_px = 0, std_fy_px = 0, std_cx_px = 0, std_cy_px = 0;
+  std::vector<std::string> warnings;
+  std::string Summary() const;
+};
+
+// Detects the board in every image of `images` (see ImageSource) and calibrates. Throws
+// fv::Error naming the input when no image shows the board, images differ in size or fewer than
+// min_views views are usable.
+IntrinsicsResult CalibrateIntrinsics(const std::string& images, const IntrinsicsOptions& options);
+
+// The fit alone, on views already detected (all of one size); used by the above and the tests.
+IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
+                                    const IntrinsicsOptions& options);
+
+}  // namespace fv::calib

@@ -1,0 +1,167 @@
+#include "fieldvision/calib/lines.h"
+
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::calib {
+namespace {
+
+// One camera about 20 m from the centre of the RoboCup MSL field, the static scene (no robots).
+synth::SceneSpec TwentyMetreScene(uint64_t seed) {
+  synth::SceneSpec spec = synth::Preset("static", seed);
+  spec.cameras.resize(1);
+  synth::CameraSpec& c = spec.cameras[0];
+  c.width = 1280;
+  c.height = 960;
+  c.hfov_deg = 60.0;
+  c.distortion = {-0.05, 0.02, 0.0, 0.0, 0.0};
+  c.position_m = Eigen::Vector3d(-15.0, -12.0, 7.0);
+  c.look_at_m = Eigen::Vector3d::Zero();
+  spec.num_frames = 1;
+  spec.ball.placements.resize(1);
+  return spec;
+}
+
+std::vector<PointCorrespondence> ClickKeypoints(const Camera& cam, const FieldModel& field,
+                                                int count, double noise_px, Rng& rng) {
+  std::vector<const FieldKeypoint*> seen;
+  for (const auto& k : field.keypoints) {
+    const auto uv = cam.Project(k.position_m);
+    if (k.position_m.z() == 0.0 && uv && cam.InImage(*uv, 10)) seen.push_back(&k);
+  }
+  // Farthest-point order in the image, from the first seen point: what a user told to click
+  // points spread over the image does.
+  std::vector<PointCorrespondence> pts;
+  std::vector<bool> taken(seen.size(), false);
+  for (int i = 0; i < count && i < static_cast<int>(seen.size()); ++i) {
+    size_t pick = 0;
+    double best = -1;
+    for (size_t j = 0; j < seen.size(); ++j) {
+      if (taken[j]) continue;
+      double nearest = 1e18;
+      for (const auto& p : pts) {
+        nearest = std::min(
+            nearest, (*cam.Project(seen[j]->position_m) - *cam.Project(p.p_world)).squaredNorm());
+      }
+      if (nearest > best) {
+        best = nearest;
+        pick = j;
+      }
+    }
+    taken[pick] = true;
+    const FieldKeypoint* k = seen[pick];
+    PointCorrespondence p;
+    p.name = k->name;
+    p.p_world = k->position_m;
+    p.uv_px = *cam.Project(k->position_m) +
+              Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px));
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+TEST(LineDistanceMap, MatchesExactDistances) {
+  const uint64_t seed = fv::testing::TestSeed(11);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const FieldModel field = BuiltinField("robocup-msl");
+  const LineDistanceMap map(field, 0.01, 1.0);
+  for (int i = 0; i < 500; ++i) {
+    const Eigen::Vector2d p(rng.Uniform(-10, 10), rng.Uniform(-7, 7));
+    const double exact = std::min(1.0, field.DistanceToLineCentres(p));
+    // Bilinear interpolation of a V-shaped function: off by at most half a cell at the crease.
+    EXPECT_NEAR(map.Distance(p.x(), p.y()), exact, 0.006) << p.transpose();
+  }
+  EXPECT_DOUBLE_EQ(map.Distance(100, 0), 1.0);
+}
+
+TEST(Refine, SyntheticFrameBringsTheCameraWithin2cm) {
+  const uint64_t seed = fv::testing::TestSeed(7);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const synth::SceneRenderer scene(TwentyMetreScene(seed));
+  const Camera& truth = scene.cameras()[0];
+  const FieldModel& field = scene.field();
+  ASSERT_NEAR(truth.CentreInWorld().norm(), 20.4, 0.1);
+  const cv::Mat frame = scene.Render(0)[0];
+
+  // The clicked pose: 8 keypoints with 1 px noise.
+  Camera intrinsics = truth;
+  intrinsics.has_pose = false;
+  const ExtrinsicsResult clicked =
+      EstimatePose(intrinsics, ClickKeypoints(truth, field, 8, 1.0, rng));
+  const double clicked_err_m = (clicked.camera_position_m - truth.CentreInWorld()).norm();
+  EXPECT_LT(clicked_err_m, 0.15) << clicked.Summary();
+
+  const auto pixels = DetectLinePixels(frame, clicked.camera, field);
+  ASSERT_GT(pixels.size(), 1000u);
+  // The detected pixels lie on the lines under the true pose.
+  const LineErrorStats on_truth = LineError(truth, pixels, field);
+  EXPECT_GT(on_truth.num_inliers, 0.9 * on_truth.num_pixels) << on_truth.Summary();
+  EXPECT_LT(on_truth.median_mm, 10.0) << on_truth.Summary();
+  EXPECT_LT(on_truth.mean_mm, 20.0) << on_truth.Summary();
+
+  const RefineResult r = RefineWithLinePixels(clicked.camera, pixels, field);
+  ASSERT_TRUE(r.accepted) << r.Summary();
+  const double refined_err_m = (r.camera.CentreInWorld() - truth.CentreInWorld()).norm();
+  EXPECT_LT(refined_err_m, 0.02) << r.Summary() << " (clicked: " << clicked_err_m << " m)";
+  EXPECT_LE(r.after.mean_mm, r.before.mean_mm + 1e-9) << r.Summary();
+  EXPECT_LT(RotationAngleBetween(r.camera.cam_from_world.rotation, truth.cam_from_world.rotation) *
+                180 / M_PI,
+            0.05);
+  RecordProperty("clicked_err_mm", static_cast<int>(1000 * clicked_err_m));
+  RecordProperty("refined_err_mm", static_cast<int>(1000 * refined_err_m));
+  std::cout << "clicked pose " << 1000 * clicked_err_m << " mm off, refined "
+            << 1000 * refined_err_m << " mm off; " << r.Summary() << "\n";
+}
+
+TEST(Refine, StartFarOffIsNotMadeWorse) {
+  // A pose 1.5 m and a few degrees off: the refinement must either fix it or refuse.
+  const uint64_t seed = fv::testing::TestSeed(9);
+  FV_SEED_TRACE(seed);
+  const synth::SceneRenderer scene(TwentyMetreScene(seed));
+  const Camera& truth = scene.cameras()[0];
+  const cv::Mat frame = scene.Render(0)[0];
+  Camera start = truth;
+  start.cam_from_world =
+      Rigid3d::LookAt(Eigen::Vector3d(-14.0, -11.5, 7.5), Eigen::Vector3d(0.3, 0.2, 0.0));
+  const RefineResult r = RefineWithLines(start, frame, scene.field());
+  const double before = (start.CentreInWorld() - truth.CentreInWorld()).norm();
+  const double after = (r.camera.CentreInWorld() - truth.CentreInWorld()).norm();
+  EXPECT_LE(after, before + 1e-9) << r.Summary();
+}
+
+TEST(Refine, ImageOfAnotherSizeIsAnError) {
+  Camera cam = Camera::FromFov(1280, 960, 60);
+  cam.has_pose = true;
+  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  const cv::Mat small(480, 640, CV_8UC3, cv::Scalar(0, 120, 0));
+  try {
+    RefineWithLines(cam, small, BuiltinField("robocup-msl"));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("640x480"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("1280x960"), std::string::npos) << msg;
+  }
+}
+
+TEST(Refine, NoLinesIsAValueNotAnException) {
+  Camera cam = Camera::FromFov(640, 480, 60);
+  cam.has_pose = true;
+  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  const cv::Mat grass(480, 640, CV_8UC3, cv::Scalar(40, 130, 40));
+  const RefineResult r = RefineWithLines(cam, grass, BuiltinField("robocup-msl"));
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.status.find("line pixels"), std::string::npos) << r.status;
+}
+
+}  // namespace
+}  // namespace fv::calib
