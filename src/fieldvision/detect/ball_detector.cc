@@ -1,0 +1,324 @@
+#include "fieldvision/detect/ball_detector.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+// Share of pixels with the ball bit in the disc r < disc_r and in the ring
+// ring_r0 <= r < ring_r1 around c.
+void DiscShares(const cv::Mat& bgr, const ColourTable& table, uint8_t bit, const Vector2d& c,
+                double disc_r, double ring_r0, double ring_r1, double* disc, double* ring) {
+  int n_disc = 0, b_disc = 0, n_ring = 0, b_ring = 0;
+  const int x0 = std::max(0, static_cast<int>(std::floor(c.x() - ring_r1)));
+  const int x1 = std::min(bgr.cols - 1, static_cast<int>(std::ceil(c.x() + ring_r1)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(c.y() - ring_r1)));
+  const int y1 = std::min(bgr.rows - 1, static_cast<int>(std::ceil(c.y() + ring_r1)));
+  for (int y = y0; y <= y1; ++y) {
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    for (int x = x0; x <= x1; ++x) {
+      const double d2 = (x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y());
+      const uint8_t* p = row + 3 * x;
+      if (d2 < disc_r * disc_r) {
+        ++n_disc;
+        b_disc += (table.Classify(p[0], p[1], p[2]) & bit) != 0;
+      } else if (d2 >= ring_r0 * ring_r0 && d2 < ring_r1 * ring_r1) {
+        ++n_ring;
+        b_ring += (table.Classify(p[0], p[1], p[2]) & bit) != 0;
+      }
+    }
+  }
+  // Pixels outside the image count as not ball (the disc is then partly invisible).
+  const double disc_area = M_PI * disc_r * disc_r;
+  *disc = disc_area > 0 ? std::min(1.0, b_disc / disc_area) : 0.0;
+  (void)n_disc;
+  *ring = n_ring > 0 ? double(b_ring) / n_ring : 0.0;
+}
+
+// The [s_lo, s_hi] part of the ray with height in [z_lo, z_hi] and s >= s_min; false if empty.
+bool HeightInterval(const Ray3d& ray, double z_lo, double z_hi, double s_min, double s_max,
+                    double* s_lo, double* s_hi) {
+  double lo = s_min, hi = s_max;
+  const double z0 = ray.origin.z(), dz = ray.direction.z();
+  if (std::abs(dz) < 1e-12) {
+    if (z0 < z_lo || z0 > z_hi) return false;
+  } else {
+    double a = (z_lo - z0) / dz, b = (z_hi - z0) / dz;
+    if (a > b) std::swap(a, b);
+    lo = std::max(lo, a);
+    hi = std::min(hi, b);
+  }
+  *s_lo = lo;
+  *s_hi = hi;
+  return lo <= hi;
+}
+
+// Liang-Barsky: does the xy segment p0 -> p1 meet the rectangle |x| <= hx, |y| <= hy?
+bool SegmentMeetsRect(const Vector2d& p0, const Vector2d& p1, double hx, double hy) {
+  double t0 = 0, t1 = 1;
+  const Vector2d d = p1 - p0;
+  const double p[4] = {-d.x(), d.x(), -d.y(), d.y()};
+  const double q[4] = {p0.x() + hx, hx - p0.x(), p0.y() + hy, hy - p0.y()};
+  for (int i = 0; i < 4; ++i) {
+    if (std::abs(p[i]) < 1e-15) {
+      if (q[i] < 0) return false;
+    } else {
+      const double t = q[i] / p[i];
+      if (p[i] < 0) {
+        t0 = std::max(t0, t);
+      } else {
+        t1 = std::min(t1, t);
+      }
+    }
+  }
+  return t0 <= t1;
+}
+
+}  // namespace
+
+void BallDetectorOptions::Check() const {
+  CheckPositive(diameter_m, "diameter_m");
+  CheckFinite(diameter_m, "diameter_m");
+  FV_REQUIRE(!colour.empty(), "colour must name a preset or a colour file");
+  FV_REQUIRE(lut_bits >= 5 && lut_bits <= 8, "lut_bits must be 5..8 (got {})", lut_bits);
+  FV_REQUIRE(scan_step_px >= 1 && scan_step_px <= 16, "scan_step_px must be 1..16 (got {})",
+             scan_step_px);
+  FV_REQUIRE(min_samples >= 1, "min_samples must be >= 1 (got {})", min_samples);
+  CheckPositive(min_radius_px, "min_radius_px");
+  FV_REQUIRE(max_radius_px > min_radius_px, "max_radius_px must be > min_radius_px");
+  CheckInRange(min_fill_ratio, 0.0, 1.0, "min_fill_ratio");
+  FV_REQUIRE(max_aspect_ratio >= 1.0, "max_aspect_ratio must be >= 1 (got {})", max_aspect_ratio);
+  CheckInRange(min_inlier_fraction, 0.0, 1.0, "min_inlier_fraction");
+  CheckPositive(max_fit_rms_px, "max_fit_rms_px");
+  CheckInRange(min_visible_fraction, 0.0, 1.0, "min_visible_fraction");
+  CheckInRange(max_leak_fraction, 0.0, 1.0, "max_leak_fraction");
+  CheckInRange(size_tolerance, 0.0, 10.0, "size_tolerance");
+  CheckPositive(max_height_m, "max_height_m");
+  CheckNonNegative(min_distance_m, "min_distance_m");
+  CheckNonNegative(field_margin_m, "field_margin_m");
+  FV_REQUIRE(max_refine >= 1, "max_refine must be >= 1 (got {})", max_refine);
+  fit.Check();
+}
+
+int BallDetectionResult::accepted() const {
+  return static_cast<int>(std::count_if(candidates.begin(), candidates.end(),
+                                        [](const BallCandidate& c) { return c.accepted; }));
+}
+
+std::string BallDetectionResult::Summary() const {
+  return fmt::format("{} samples, {} runs, {} blobs, {} refined, {} candidates, {} accepted",
+                     samples, runs, blobs, refined, candidates.size(), accepted());
+}
+
+BallDetector::BallDetector(const BallDetectorOptions& options, const Camera* camera,
+                           const FieldModel* field)
+    : options_(options), camera_(camera), field_(field) {
+  options_.Check();
+  Init(LoadColourSpec(options_.colour));
+}
+
+BallDetector::BallDetector(const BallDetectorOptions& options, const ColourSpec& colour,
+                           const Camera* camera, const FieldModel* field)
+    : options_(options), camera_(camera), field_(field) {
+  options_.Check();
+  Init(colour);
+}
+
+void BallDetector::Init(const ColourSpec& colour) {
+  colour.Check("colour spec");
+  if (camera_ != nullptr) camera_->Check();
+  table_ = ColourTable::Shared(colour, options_.lut_bits);
+  ball_bit_ = table_->BallBit();
+  if (camera_ != nullptr && field_ != nullptr && camera_->has_pose && options_.use_field_mask) {
+    field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
+  }
+}
+
+bool BallDetector::ExpectedRadius(const Vector2d& uv, double* min_px, double* max_px) const {
+  if (camera_ == nullptr || !camera_->has_pose) return false;
+  const auto ray = camera_->RayFromPixel(uv);
+  if (!ray) return false;
+  const double r_m = 0.5 * options_.diameter_m;
+  double s_lo, s_hi;
+  if (!HeightInterval(*ray, r_m, options_.max_height_m, options_.min_distance_m, 1e6, &s_lo,
+                      &s_hi)) {
+    return false;
+  }
+  // Image radius of the ball at distance s along the ray: project a point r_m off the ray.
+  const Vector3d side = ray->direction.cross(Vector3d::UnitZ()).squaredNorm() > 1e-12
+                            ? ray->direction.cross(Vector3d::UnitZ()).normalized()
+                            : ray->direction.cross(Vector3d::UnitX()).normalized();
+  auto radius_at = [&](double s) {
+    const Vector3d p = ray->At(s);
+    const auto a = camera_->Project(p);
+    const auto b = camera_->Project(p + r_m * side);
+    if (!a || !b) return r_m / camera_->PixelFootprintM(p);
+    return (*a - *b).norm();
+  };
+  *max_px = radius_at(s_lo);
+  *min_px = s_hi >= 1e5 ? 0.0 : radius_at(s_hi);
+  return true;
+}
+
+std::vector<BallCandidate> BallDetector::Detect(const cv::Mat& bgr) const {
+  return DetectWithSummary(bgr).candidates;
+}
+
+BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
+  FV_REQUIRE(!bgr.empty(), "ball detector: the frame is empty");
+  FV_REQUIRE(bgr.type() == CV_8UC3, "ball detector: the frame must be 8-bit BGR (got type {})",
+             bgr.type());
+  if (camera_ != nullptr) {
+    FV_REQUIRE(bgr.cols == camera_->width && bgr.rows == camera_->height,
+               "frame is {}x{} but camera '{}' is {}x{}", bgr.cols, bgr.rows, camera_->name,
+               camera_->width, camera_->height);
+  }
+  const BallDetectorOptions& o = options_;
+  ScanOptions scan;
+  scan.step_px = o.scan_step_px;
+  scan.min_samples = o.min_samples;
+  const BlobScanResult blobs = ScanBlobs(bgr, *table_, ball_bit_, scan, field_mask_);
+  BallDetectionResult result;
+  result.blobs = static_cast<int>(blobs.blobs.size());
+  result.runs = blobs.runs;
+  result.samples = blobs.samples;
+  for (const Blob& blob : blobs.blobs) {
+    BallCandidate cand;
+    cand.centre_px = Vector2d(0.5 * (blob.x_min + blob.x_max), 0.5 * (blob.y_min + blob.y_max));
+    cand.radius_px = 0.25 * (blob.width_px() + blob.height_px());
+    cand.sigma_px = 0.5 * blob.step_px;
+    cand.score = 0.0;
+    auto reject = [&](std::string why) {
+      cand.accepted = false;
+      cand.reason = std::move(why);
+      result.candidates.push_back(cand);
+    };
+    const double rough_r = 0.5 * std::max(blob.width_px(), blob.height_px());
+    if (rough_r < 0.5 * o.min_radius_px || rough_r > 1.5 * o.max_radius_px) {
+      reject("blob size");
+      continue;
+    }
+    if (blob.aspect_ratio() > o.max_aspect_ratio) {
+      reject("blob aspect ratio");
+      continue;
+    }
+    if (blob.samples >= 6 && blob.fill_ratio() < o.min_fill_ratio) {
+      reject("blob fill ratio");
+      continue;
+    }
+    if (result.refined >= o.max_refine) {
+      reject("not refined (max_refine)");
+      continue;
+    }
+    ++result.refined;
+    const BallFit fit =
+        FitBall(bgr, *table_, ball_bit_, blob.centroid_px(), rough_r, camera_, o.fit);
+    if (!fit.ok) {
+      reject(fit.failure);
+      continue;
+    }
+    cand.centre_px = fit.centre_px;
+    cand.radius_px = fit.radius_px;
+    cand.sigma_px = fit.sigma_px;
+    cand.blurred = fit.blurred;
+    double visible, leak;
+    DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
+               fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
+    cand.visible_fraction = visible;
+    double size_factor = 1.0;
+    std::string why;
+    double exp_min = 0, exp_max = 0;
+    if (fit.radius_px < o.min_radius_px || fit.radius_px > o.max_radius_px) {
+      why = fmt::format("radius {:.1f} px outside {}..{}", fit.radius_px, o.min_radius_px,
+                        o.max_radius_px);
+    } else if (fit.inlier_fraction < o.min_inlier_fraction) {
+      why = fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
+    } else if (fit.rms_px > o.max_fit_rms_px) {
+      why = fmt::format("outline rms {:.2f} px", fit.rms_px);
+    } else if (visible < o.min_visible_fraction) {
+      why = fmt::format("disc only {:.0f} % ball-coloured", 100 * visible);
+    } else if (leak > o.max_leak_fraction) {
+      why = fmt::format("colour extends beyond the circle ({:.0f} %)", 100 * leak);
+    } else if (ExpectedRadius(fit.centre_px, &exp_min, &exp_max)) {
+      const double lo = exp_min * (1 - o.size_tolerance) - 0.5;
+      const double hi = exp_max * (1 + o.size_tolerance) + 0.5;
+      if (fit.radius_px < lo) {
+        why = fmt::format("too small for a ball here ({:.1f} < {:.1f} px)", fit.radius_px, lo);
+      } else if (fit.radius_px > hi) {
+        why = fmt::format("too large for a ball here ({:.1f} > {:.1f} px)", fit.radius_px, hi);
+      } else if (exp_min > 0) {
+        // Prefer sizes near the ball on the ground.
+        size_factor = std::exp(-0.5 * std::pow(std::log(fit.radius_px / exp_min) / 0.3, 2));
+        size_factor = 0.5 + 0.5 * size_factor;
+      }
+    }
+    cand.score = fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
+                 std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor;
+    cand.accepted = why.empty();
+    cand.reason = why;
+    result.candidates.push_back(cand);
+  }
+  std::stable_sort(result.candidates.begin(), result.candidates.end(),
+                   [](const BallCandidate& a, const BallCandidate& b) {
+                     if (a.accepted != b.accepted) return a.accepted;
+                     return a.score > b.score;
+                   });
+  // One ball, one candidate: a later accepted candidate on a better one is a duplicate.
+  for (size_t i = 0; i < result.candidates.size(); ++i) {
+    BallCandidate& c = result.candidates[i];
+    if (!c.accepted) continue;
+    for (size_t j = 0; j < i; ++j) {
+      const BallCandidate& b = result.candidates[j];
+      if (b.accepted && (b.centre_px - c.centre_px).norm() < std::max(b.radius_px, 2.0)) {
+        c.accepted = false;
+        c.reason = "duplicate";
+        break;
+      }
+    }
+  }
+  std::stable_sort(result.candidates.begin(), result.candidates.end(),
+                   [](const BallCandidate& a, const BallCandidate& b) {
+                     if (a.accepted != b.accepted) return a.accepted;
+                     return a.score > b.score;
+                   });
+  return result;
+}
+
+cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m,
+                  double max_height_m) {
+  const int cell = 4;
+  const int gw = (camera.width + cell - 1) / cell, gh = (camera.height + cell - 1) / cell;
+  cv::Mat coarse(gh, gw, CV_8U, cv::Scalar(0));
+  const double hx = 0.5 * field.length_m + margin_m, hy = 0.5 * field.width_m + margin_m;
+  for (int gy = 0; gy < gh; ++gy) {
+    for (int gx = 0; gx < gw; ++gx) {
+      const Vector2d uv(std::min(gx * cell + 0.5 * cell, camera.width - 1.0),
+                        std::min(gy * cell + 0.5 * cell, camera.height - 1.0));
+      const auto ray = camera.RayFromPixel(uv);
+      if (!ray) {
+        coarse.at<uint8_t>(gy, gx) = 255;  // unknown: do not hide anything
+        continue;
+      }
+      double s_lo, s_hi;
+      if (!HeightInterval(*ray, 0.0, max_height_m, 0.0, 1e4, &s_lo, &s_hi)) continue;
+      const Vector3d a = ray->At(s_lo), b = ray->At(s_hi);
+      if (SegmentMeetsRect(a.head<2>(), b.head<2>(), hx, hy)) coarse.at<uint8_t>(gy, gx) = 255;
+    }
+  }
+  // Grow by one cell so the coarse grid never cuts a ball at the border.
+  cv::dilate(coarse, coarse, cv::Mat(), cv::Point(-1, -1), 1);
+  cv::Mat mask;
+  cv::resize(coarse, mask, cv::Size(gw * cell, gh * cell), 0, 0, cv::INTER_NEAREST);
+  return mask(cv::Rect(0, 0, camera.width, camera.height)).clone();
+}
+
+}  // namespace fv

@@ -1,0 +1,111 @@
+// The ball detector of one camera: colour lookup table (colour.h) -> scanlines, runs and blobs
+// (blobs.h) -> shape and size filters -> sub-pixel centre from the outline (ball_fit.h). With a
+// calibrated camera it also checks the size a ball of the given diameter has at that place in
+// the image (on the ground and anywhere along the ray up to max_height_m) and, with a field,
+// ignores everything outside the field of play (the image of the prism over the field up to
+// max_height_m). Method after the RoboCup colour-segmentation pipelines (e.g. CMVision, Bruce et
+// al., IROS 2000; B-Human's ball perceptor).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "fieldvision/camera/camera.h"
+#include "fieldvision/detect/ball_fit.h"
+#include "fieldvision/detect/blobs.h"
+#include "fieldvision/detect/colour.h"
+#include "fieldvision/field/field.h"
+
+namespace fv {
+
+struct BallCandidate {
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  double sigma_px = 0.0;  // standard deviation of the centre, pixels (each axis)
+  double score = 0.0;     // 0..1, higher is more ball-like
+  bool accepted = false;  // passed every filter
+  // Extras for drawing and diagnosis.
+  double visible_fraction = 0.0;  // share of the fitted disc with the ball's colour
+  bool blurred = false;
+  std::string reason;  // why rejected ("" when accepted)
+};
+
+struct BallDetectorOptions {
+  double diameter_m = 0.22;       // ball diameter (size check with a calibrated camera)
+  std::string colour = "orange";  // preset name or colour file (LoadColourSpec)
+  int lut_bits = 8;               // bits per channel of the lookup table: 8 exact, 5..7 quantised
+  int scan_step_px = 2;           // scanline step (rows and columns)
+  int min_samples = 2;            // smallest blob, in scan samples
+  double min_radius_px = 2.5;     // ball radius limits in the image
+  double max_radius_px = 150.0;
+  double min_fill_ratio = 0.35;       // blob area / bounding box (pi/4 for a disc; lower: occluded)
+  double max_aspect_ratio = 3.0;      // blob bounding box long / short side
+  double min_inlier_fraction = 0.45;  // rays whose outline point lies on the fitted circle
+  double max_fit_rms_px = 0.8;        // RMS of those outline points
+  double min_visible_fraction = 0.35;  // ball-coloured share of the fitted disc
+  double max_leak_fraction = 0.35;     // ball-coloured share of a ring just outside it
+  double size_tolerance = 0.3;         // relative slack of the expected radius (calibrated camera)
+  double max_height_m = 8.0;           // highest ball centre considered (size check and field mask)
+  double min_distance_m = 0.5;         // nearest ball distance to the camera considered
+  bool use_field_mask = true;          // with camera pose and field: only the field of play
+  double field_margin_m = 1.0;         // around the field of play
+  int max_refine = 12;                 // largest blobs refined per frame
+  BallFitOptions fit;
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct BallDetectionResult {
+  std::vector<BallCandidate> candidates;  // best first
+  int blobs = 0;
+  int runs = 0;
+  long long samples = 0;
+  int refined = 0;
+  int accepted() const;
+  std::string Summary() const;
+};
+
+class BallDetector {
+ public:
+  // camera: null for an uncalibrated camera (no size check, no field mask, pixel-space fit);
+  // a camera without a pose gives the perspective fit but no size check or mask. field: null for
+  // no field mask. Both must outlive the detector. Throws fv::Error on bad options or colour.
+  BallDetector(const BallDetectorOptions& options, const Camera* camera, const FieldModel* field);
+  // Same, with an explicit colour spec (options.colour is ignored).
+  BallDetector(const BallDetectorOptions& options, const ColourSpec& colour, const Camera* camera,
+               const FieldModel* field);
+
+  // All candidates found in a BGR frame, best first; accepted ones passed every filter.
+  // Thread-safe (const). Throws fv::Error when the frame is empty, not BGR, or not the camera's
+  // size.
+  std::vector<BallCandidate> Detect(const cv::Mat& bgr) const;
+  BallDetectionResult DetectWithSummary(const cv::Mat& bgr) const;
+
+  const BallDetectorOptions& options() const { return options_; }
+  const ColourTable& table() const { return *table_; }
+  // The field-of-play mask (CV_8U, 255 inside) or empty when not used.
+  const cv::Mat& field_mask() const { return field_mask_; }
+  // Expected radius range [min, max] in pixels of the ball seen at `uv` (calibrated camera with
+  // pose), or false when unknown.
+  bool ExpectedRadius(const Eigen::Vector2d& uv, double* min_px, double* max_px) const;
+
+ private:
+  void Init(const ColourSpec& colour);
+  BallDetectorOptions options_;
+  const Camera* camera_;
+  const FieldModel* field_;
+  std::shared_ptr<const ColourTable> table_;
+  uint8_t ball_bit_ = 1;
+  cv::Mat field_mask_;
+};
+
+// The field-of-play mask of a camera: the image of the prism over the field (plus margin) from
+// the ground to max_height_m. Empty when a corner of the prism is behind the camera.
+cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m,
+                  double max_height_m);
+
+}  // namespace fv

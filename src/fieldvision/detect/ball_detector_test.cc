@@ -1,0 +1,80 @@
+#include "fieldvision/detect/ball_detector.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+int Accepted(const std::vector<BallCandidate>& c) {
+  return static_cast<int>(std::count_if(c.begin(), c.end(), [](auto& x) { return x.accepted; }));
+}
+
+TEST(BallDetector, FindsDrawnBallsAndRejectsATriangle) {
+  const uint64_t seed = fv::testing::TestSeed(21);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  EXPECT_EQ(Accepted(det.Detect(img)), 0);  // no ball: nothing accepted
+  // An orange cone seen from the side: a triangle.
+  const std::vector<cv::Point> tri = {{500, 400}, {540, 400}, {520, 340}};
+  cv::fillConvexPoly(img, tri, cv::Scalar(0, 80, 255), cv::LINE_AA);
+  const Eigen::Vector2d c(rng.Uniform(150, 300), rng.Uniform(150, 300));
+  const double r = rng.Uniform(5, 15);
+  detect_testing::PaintDisc(img, c, r);
+  const BallDetectionResult res = det.DetectWithSummary(img);
+  ASSERT_EQ(res.accepted(), 1) << res.Summary();
+  const BallCandidate& best = res.candidates.front();
+  EXPECT_TRUE(best.accepted);
+  EXPECT_LT((best.centre_px - c).norm(), 0.2);
+  EXPECT_NEAR(best.radius_px, r, 0.4);
+  EXPECT_GT(best.score, 0.5);
+  bool cone_seen = false;
+  for (const auto& cand : res.candidates) {
+    if ((cand.centre_px - Eigen::Vector2d(520, 380)).norm() < 25) {
+      cone_seen = true;
+      EXPECT_FALSE(cand.accepted);
+      EXPECT_FALSE(cand.reason.empty());
+    }
+  }
+  EXPECT_TRUE(cone_seen);
+}
+
+TEST(BallDetector, BadInputGivesErrors) {
+  BallDetectorOptions o;
+  o.scan_step_px = 0;
+  try {
+    o.Check();
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("scan_step_px"), std::string::npos);
+  }
+  o = BallDetectorOptions{};
+  o.max_radius_px = 1.0;
+  EXPECT_THROW(o.Check(), Error);
+  o = BallDetectorOptions{};
+  o.diameter_m = std::nan("");
+  EXPECT_THROW(o.Check(), Error);
+  o = BallDetectorOptions{};
+  o.colour = "not-a-colour";
+  EXPECT_THROW(BallDetector(o, nullptr, nullptr), Error);
+  const Camera cam = Camera::FromFov(320, 240, 60);
+  const BallDetector det(BallDetectorOptions{}, &cam, nullptr);
+  try {
+    det.Detect(cv::Mat(200, 300, CV_8UC3, cv::Scalar(0, 0, 0)));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("frame is 300x200 but camera"), std::string::npos);
+  }
+  EXPECT_THROW(det.Detect(cv::Mat()), Error);
+  EXPECT_THROW(det.Detect(cv::Mat(240, 320, CV_8U)), Error);
+}
+
+}  // namespace
+}  // namespace fv

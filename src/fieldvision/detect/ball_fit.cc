@@ -1,0 +1,612 @@
+#include "fieldvision/detect/ball_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+// Bilinear BGR sample; false outside the image.
+inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
+  if (!(x >= 0 && y >= 0 && x <= img.cols - 1 && y <= img.rows - 1)) return false;
+  const int x0 = std::min(static_cast<int>(x), img.cols - 2 >= 0 ? img.cols - 2 : 0);
+  const int y0 = std::min(static_cast<int>(y), img.rows - 2 >= 0 ? img.rows - 2 : 0);
+  const int x1 = std::min(x0 + 1, img.cols - 1), y1 = std::min(y0 + 1, img.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  const uint8_t* a = img.ptr<uint8_t>(y0) + 3 * x0;
+  const uint8_t* b = img.ptr<uint8_t>(y0) + 3 * x1;
+  const uint8_t* c = img.ptr<uint8_t>(y1) + 3 * x0;
+  const uint8_t* d = img.ptr<uint8_t>(y1) + 3 * x1;
+  for (int k = 0; k < 3; ++k) {
+    (*out)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
+  }
+  return true;
+}
+
+inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, double x, double y) {
+  const int xi = static_cast<int>(std::lround(x)), yi = static_cast<int>(std::lround(y));
+  if (xi < 0 || yi < 0 || xi >= img.cols || yi >= img.rows) return false;
+  const uint8_t* p = img.ptr<uint8_t>(yi) + 3 * xi;
+  return (table.Classify(p[0], p[1], p[2]) & bit) != 0;
+}
+
+struct Edges {
+  std::vector<Vector2d> points;
+  std::vector<double> ramp_px;  // width of a motion-blur ramp at each point (0: sharp edge)
+  int rays = 0;
+};
+
+// Rough outline: along each ray, where the colour class stops being the ball.
+Edges ClassEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
+                 double r0) {
+  Edges e;
+  e.rays = std::clamp(static_cast<int>(2 * M_PI * r0 / 1.5), 16, 96);
+  const double t_max = 1.6 * r0 + 3.0;
+  for (int k = 0; k < e.rays; ++k) {
+    const double th = 2 * M_PI * k / e.rays;
+    const Vector2d u(std::cos(th), std::sin(th));
+    bool seen = false;
+    int misses = 0;
+    double last_ball = 0;
+    for (double t = 0; t <= t_max; t += 0.5) {
+      const Vector2d p = c + t * u;
+      if (p.x() < 0 || p.y() < 0 || p.x() > img.cols - 1 || p.y() > img.rows - 1) {
+        seen = false;  // the outline leaves the image: no point on this ray
+        break;
+      }
+      if (IsBall(img, table, bit, p.x(), p.y())) {
+        seen = true;
+        misses = 0;
+        last_ball = t;
+      } else if (seen && ++misses >= 2) {
+        e.points.push_back(c + (last_ball + 0.25) * u);
+        break;
+      }
+    }
+  }
+  return e;
+}
+
+// Sub-pixel outline: along each ray from `c`, search around the reference radius ref(theta)
+// for the first strong colour step (largest gradient), then take the ray's own colours 1.5 px
+// inside and outside it and find where the profile crosses halfway between them (linear
+// interpolation of bilinear samples). Local references keep shading and a changing background
+// (a line just beyond the ball) from biasing the edge.
+Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
+                    const std::function<double(double)>& ref, double mean_radius,
+                    const BallFitOptions& o) {
+  constexpr double kStep = 0.25, kSide = 1.5;
+  Edges e;
+  e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), 24, 180);
+  std::vector<Vector3d> prof;
+  std::vector<double> grad;
+  for (int k = 0; k < e.rays; ++k) {
+    const double th = 2 * M_PI * (k + 0.5) / e.rays;
+    const Vector2d u(std::cos(th), std::sin(th));
+    const double r = ref(th);
+    const double half = std::max(2.0, 0.25 * r);
+    const double t_lo = std::max(r - half, 0.5 * r), t_hi = r + half;
+    const double t0 = std::min(0.35 * r, std::max(t_lo - kSide - kStep, 0.0));
+    const double t_end = r + std::max(half, 0.6 * r) + 2.0;
+    const int m = static_cast<int>((t_end - t0) / kStep) + 1;
+    prof.resize(m);
+    bool inside_image = true;
+    for (int i = 0; i < m && inside_image; ++i) {
+      const Vector2d p = c + (t0 + i * kStep) * u;
+      inside_image = Sample(img, p.x(), p.y(), &prof[i]);
+    }
+    if (!inside_image) continue;
+    // Gradient magnitude (central differences over 0.5 px) in the search window.
+    grad.assign(m, 0.0);
+    double g_max = 0;
+    for (int i = 1; i + 1 < m; ++i) {
+      const double t = t0 + i * kStep;
+      if (t < t_lo || t > t_hi) continue;
+      grad[i] = (prof[i + 1] - prof[i - 1]).norm();
+      g_max = std::max(g_max, grad[i]);
+    }
+    if (g_max < 0.1 * o.min_contrast) continue;
+    // The first local maximum above half the largest, going outwards.
+    int peak = -1;
+    for (int i = 2; i + 2 < m; ++i) {
+      if (grad[i] >= 0.5 * g_max && grad[i] >= grad[i - 1] && grad[i] >= grad[i + 1]) {
+        peak = i;
+        break;
+      }
+    }
+    if (peak < 0) continue;
+    int ia = std::max(0, peak - static_cast<int>(kSide / kStep));
+    int ib = std::min(m - 1, peak + static_cast<int>(kSide / kStep));
+    Vector3d a = 0.5 * (prof[ia] + prof[std::max(ia - 1, 0)]);
+    Vector3d b = 0.5 * (prof[ib] + prof[std::min(ib + 1, m - 1)]);
+    // A wide ramp (motion blur along this ray): the colours 3 px from the peak differ much more
+    // than those 1.5 px from it, so both local colours lie on the ramp; use the ray's ends
+    // instead (the halfway crossing of a swept disc is still its outline).
+    const int ka = std::max(0, peak - static_cast<int>(2 * kSide / kStep));
+    const int kb = std::min(m - 1, peak + static_cast<int>(2 * kSide / kStep));
+    bool ramp = false;
+    if ((prof[kb] - prof[ka]).squaredNorm() > 1.6 * 1.6 * (b - a).squaredNorm() &&
+        IsBall(img, table, bit, c.x() + t0 * u.x(), c.y() + t0 * u.y())) {
+      ramp = true;
+      ia = 0;
+      ib = m - 1;
+      a = prof[0];
+      b = prof[m - 1];
+    }
+    const Vector3d ab = b - a;
+    const double contrast2 = ab.squaredNorm();
+    if (contrast2 < o.min_contrast * o.min_contrast) continue;
+    const Vector2d pin = c + (t0 + ia * kStep) * u, pout = c + (t0 + ib * kStep) * u;
+    if (!IsBall(img, table, bit, pin.x(), pin.y())) continue;   // inside is not the ball
+    if (IsBall(img, table, bit, pout.x(), pout.y())) continue;  // outside is ball-coloured
+    double prev_p = (prof[ia] - a).dot(ab) / contrast2;
+    double t10 = -1, t90 = -1, te = -1;
+    for (int i = ia + 1; i <= ib; ++i) {
+      const double q = (prof[i] - a).dot(ab) / contrast2;
+      auto cross = [&](double level) {
+        return t0 + (i - 1 + (level - prev_p) / (q - prev_p)) * kStep;
+      };
+      if (t10 < 0 && prev_p < 0.1 && q >= 0.1) t10 = cross(0.1);
+      if (te < 0 && prev_p < 0.5 && q >= 0.5) te = cross(0.5);
+      if (te >= 0 && prev_p < 0.9 && q >= 0.9) {
+        t90 = cross(0.9);
+        break;
+      }
+      prev_p = q;
+    }
+    if (te < 0) continue;
+    e.points.push_back(c + te * u);
+    e.ramp_px.push_back(ramp && t10 >= 0 && t90 >= 0 ? (t90 - t10) / 0.8 : 0.0);
+  }
+  return e;
+}
+
+bool CircleFrom3(const Vector2d& a, const Vector2d& b, const Vector2d& c, Vector2d* centre,
+                 double* radius) {
+  const double d =
+      2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
+  if (std::abs(d) < 1e-9) return false;
+  const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
+  centre->x() = (a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d;
+  centre->y() = (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d;
+  *radius = (a - *centre).norm();
+  return std::isfinite(*radius);
+}
+
+// RANSAC on triples (deterministic sequence) then FitCircle.
+bool RansacCircle(const std::vector<Vector2d>& pts, double thr, int iterations, Vector2d* centre,
+                  double* radius, std::vector<char>* inlier) {
+  const int n = static_cast<int>(pts.size());
+  if (n < 3) return false;
+  uint64_t state = 0x9E3779B97F4A7C15ull ^ uint64_t(n);
+  auto next = [&](int m) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<int>((state >> 33) % uint64_t(m));
+  };
+  int best = -1;
+  Vector2d best_c = Vector2d::Zero();
+  double best_r = 0;
+  for (int it = 0; it < iterations; ++it) {
+    const int i = next(n), j = next(n), k = next(n);
+    if (i == j || j == k || i == k) continue;
+    Vector2d c;
+    double r;
+    if (!CircleFrom3(pts[i], pts[j], pts[k], &c, &r)) continue;
+    int count = 0;
+    for (const auto& p : pts) count += std::abs((p - c).norm() - r) < thr;
+    if (count > best) {
+      best = count;
+      best_c = c;
+      best_r = r;
+    }
+  }
+  if (best < 3) return false;
+  *centre = best_c;
+  *radius = best_r;
+  return FitCircle(pts, thr, centre, radius, inlier);
+}
+
+// Centre covariance of a circle through the inliers: sigma^2 (J^T J)^-1, J the Jacobian of the
+// distances to the circle with respect to (cx, cy, r).
+double CentreSigma(const std::vector<Vector2d>& pts, const std::vector<char>& inlier,
+                   const Vector2d& c, double rms) {
+  Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+  int n = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (!inlier[i]) continue;
+    const Vector2d d = pts[i] - c;
+    const double len = std::max(d.norm(), 1e-9);
+    const Vector3d j(-d.x() / len, -d.y() / len, -1.0);
+    jtj += j * j.transpose();
+    ++n;
+  }
+  const double s = std::max(rms * std::sqrt(double(n) / std::max(n - 3, 1)), 0.15);
+  Eigen::FullPivLU<Eigen::Matrix3d> lu(jtj);
+  if (n < 3 || !lu.isInvertible()) return 10.0;
+  const Eigen::Matrix3d cov = s * s * lu.inverse();
+  return std::sqrt(std::max(0.5 * (cov(0, 0) + cov(1, 1)), 0.0)) + 0.02;
+}
+
+// The cone of rays tangent to the sphere: unit rays v_i with v_i . w = 1.
+bool FitCone(const std::vector<Vector3d>& rays, const std::vector<char>& use, Vector3d* axis,
+             double* half_angle) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Vector3d atb = Vector3d::Zero();
+  int n = 0;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    if (!use[i]) continue;
+    ata += rays[i] * rays[i].transpose();
+    atb += rays[i];
+    ++n;
+  }
+  if (n < 3) return false;
+  const Vector3d w = ata.ldlt().solve(atb);
+  const double len = w.norm();
+  if (!std::isfinite(len) || len < 1.0) return false;  // cos(alpha) = 1 / |w| must be <= 1
+  *axis = w / len;
+  *half_angle = std::acos(1.0 / len);
+  return true;
+}
+
+double Rms(const std::vector<double>& res, const std::vector<char>& inlier, int* count) {
+  double s = 0;
+  int n = 0;
+  for (size_t i = 0; i < res.size(); ++i) {
+    if (inlier[i]) {
+      s += res[i] * res[i];
+      ++n;
+    }
+  }
+  *count = n;
+  return n > 0 ? std::sqrt(s / n) : 0.0;
+}
+
+// Distance of p from an ellipse (approximate: along the ray from its centre).
+double EllipseDistance(const cv::RotatedRect& e, const Vector2d& p) {
+  const double th = e.angle * M_PI / 180.0;
+  const Vector2d d = p - Vector2d(e.center.x, e.center.y);
+  const double x = std::cos(th) * d.x() + std::sin(th) * d.y();
+  const double y = -std::sin(th) * d.x() + std::cos(th) * d.y();
+  const double a = 0.5 * e.size.width, b = 0.5 * e.size.height;
+  const double rho = std::sqrt((x / a) * (x / a) + (y / b) * (y / b));
+  if (rho < 1e-9) return std::min(a, b);
+  return d.norm() * (1.0 - 1.0 / rho);
+}
+
+double EllipsePolarRadius(const cv::RotatedRect& e, double direction) {
+  const double th = direction - e.angle * M_PI / 180.0;
+  const double a = 0.5 * e.size.width, b = 0.5 * e.size.height;
+  const double c = std::cos(th), s = std::sin(th);
+  return 1.0 / std::sqrt((c / a) * (c / a) + (s / b) * (s / b));
+}
+
+// The image outline of the cone (axis, half-angle) as a polar function around the projection
+// of the axis: the search reference for outline points of a sphere seen in perspective.
+struct ConeOutline {
+  bool ok = false;
+  Vector2d centre = Vector2d::Zero();
+  double mean_radius = 0.0;
+  std::vector<double> radius_at;  // per degree
+
+  ConeOutline(const Camera& cam, const Vector3d& axis, double alpha) {
+    const auto c = cam.ProjectFromCamera(axis);
+    if (!c) return;
+    centre = *c;
+    const Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+    std::vector<std::pair<double, double>> polar;
+    for (int k = 0; k < 720; ++k) {
+      const double phi = 2 * M_PI * k / 720;
+      const Vector3d v =
+          std::cos(alpha) * axis + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
+      const auto p = cam.ProjectFromCamera(v);
+      if (!p) return;
+      const Vector2d d = *p - centre;
+      double th = std::atan2(d.y(), d.x());
+      if (th < 0) th += 2 * M_PI;
+      polar.push_back({th, d.norm()});
+    }
+    std::sort(polar.begin(), polar.end());
+    radius_at.assign(360, 0.0);
+    size_t j = 0;
+    for (int deg = 0; deg < 360; ++deg) {
+      const double th = deg * M_PI / 180.0;
+      while (j < polar.size() && polar[j].first < th) ++j;
+      const auto& hi = polar[j % polar.size()];
+      const auto& lo = polar[(j + polar.size() - 1) % polar.size()];
+      double span = hi.first - lo.first;
+      double off = th - lo.first;
+      if (span <= 0) span += 2 * M_PI;
+      if (off < 0) off += 2 * M_PI;
+      radius_at[deg] = lo.second + (hi.second - lo.second) * std::clamp(off / span, 0.0, 1.0);
+      mean_radius += radius_at[deg] / 360.0;
+    }
+    ok = mean_radius > 0.5;
+  }
+  double operator()(double th) const {
+    double deg = th * 180.0 / M_PI;
+    deg -= 360.0 * std::floor(deg / 360.0);
+    const int a = static_cast<int>(deg) % 360, b = (a + 1) % 360;
+    const double f = deg - std::floor(deg);
+    return (1 - f) * radius_at[a] + f * radius_at[b];
+  }
+};
+
+// Robust cone fit of outline pixels: initial inliers are `inl` (or those within thr of a given
+// cone), then three rounds of fit and re-selection. `res` receives pixel residuals.
+bool RobustCone(const std::vector<Vector2d>& pts, const Camera& cam, double thr,
+                const Vector3d* axis0, double alpha0, std::vector<char>* inl,
+                std::vector<double>* res, Vector3d* axis, double* alpha) {
+  const int n = static_cast<int>(pts.size());
+  std::vector<Vector3d> rays(n);
+  std::vector<char> ok(n, 1);
+  for (int i = 0; i < n; ++i) {
+    const auto xn = cam.Undistort(pts[i]);
+    if (!xn) {
+      ok[i] = 0;
+      rays[i] = Vector3d::UnitZ();
+      continue;
+    }
+    rays[i] = Vector3d(xn->x(), xn->y(), 1.0).normalized();
+  }
+  const double f = std::sqrt(cam.fx * cam.fy);
+  res->assign(n, 0.0);
+  inl->resize(n);
+  auto select = [&](const Vector3d& ax, double al) {
+    for (int i = 0; i < n; ++i) {
+      (*res)[i] = (std::acos(std::clamp(rays[i].dot(ax), -1.0, 1.0)) - al) * f;
+      (*inl)[i] = ok[i] && std::abs((*res)[i]) < thr;
+    }
+  };
+  if (axis0 != nullptr) {
+    select(*axis0, alpha0);
+  } else {
+    for (int i = 0; i < n; ++i) (*inl)[i] = (*inl)[i] && ok[i];
+  }
+  for (int round = 0; round < 3; ++round) {
+    if (!FitCone(rays, *inl, axis, alpha)) return false;
+    select(*axis, *alpha);
+  }
+  return std::count(inl->begin(), inl->end(), 1) >= 3;
+}
+
+}  // namespace
+
+void BallFitOptions::Check() const {
+  CheckNonNegative(min_contrast, "BallFitOptions.min_contrast");
+  CheckPositive(inlier_px, "BallFitOptions.inlier_px");
+  FV_REQUIRE(ransac_iterations >= 1, "BallFitOptions.ransac_iterations must be >= 1");
+  FV_REQUIRE(blur_min_aspect >= 1.0, "BallFitOptions.blur_min_aspect must be >= 1");
+}
+
+std::string BallFit::Summary() const {
+  if (!ok) return "no fit: " + failure;
+  return fmt::format(
+      "centre ({:.2f}, {:.2f}) px, radius {:.2f} px, sigma {:.3f} px, {}/{} rays "
+      "on the outline, rms {:.3f} px{}",
+      centre_px.x(), centre_px.y(), radius_px, sigma_px, inliers, rays, rms_px,
+      blurred ? fmt::format(", blurred {:.1f} px", blur_length_px) : "");
+}
+
+bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* centre, double* radius,
+               std::vector<char>* inlier) {
+  const int n = static_cast<int>(pts.size());
+  inlier->assign(n, 1);
+  if (n < 3) return false;
+  if (!(*radius > 0)) {
+    // Kasa's algebraic fit as the start.
+    Eigen::MatrixXd a(n, 3);
+    Eigen::VectorXd b(n);
+    for (int i = 0; i < n; ++i) {
+      a.row(i) << pts[i].x(), pts[i].y(), 1.0;
+      b(i) = -pts[i].squaredNorm();
+    }
+    const Vector3d s = a.colPivHouseholderQr().solve(b);
+    *centre = Vector2d(-0.5 * s(0), -0.5 * s(1));
+    *radius = std::sqrt(std::max(centre->squaredNorm() - s(2), 1e-9));
+  }
+  Vector2d c = *centre;
+  double r = *radius;
+  for (int round = 0; round < 4; ++round) {
+    int count = 0;
+    for (int i = 0; i < n; ++i) {
+      (*inlier)[i] = std::abs((pts[i] - c).norm() - r) < inlier_px;
+      count += (*inlier)[i];
+    }
+    if (count < 3) return false;
+    for (int it = 0; it < 6; ++it) {
+      Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+      Vector3d jtr = Vector3d::Zero();
+      for (int i = 0; i < n; ++i) {
+        if (!(*inlier)[i]) continue;
+        const Vector2d d = pts[i] - c;
+        const double len = std::max(d.norm(), 1e-9);
+        const Vector3d j(-d.x() / len, -d.y() / len, -1.0);
+        jtj += j * j.transpose();
+        jtr += j * (len - r);
+      }
+      const Vector3d step = -jtj.ldlt().solve(jtr);
+      if (!step.allFinite()) return false;
+      c += step.head<2>();
+      r += step(2);
+      if (step.norm() < 1e-6) break;
+    }
+  }
+  *centre = c;
+  *radius = r;
+  return std::isfinite(r) && r > 0;
+}
+
+BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                const Vector2d& rough_centre_px, double rough_radius_px, const Camera* camera,
+                const BallFitOptions& o) {
+  o.Check();
+  BallFit fit;
+  const double r0 = std::max(rough_radius_px, 1.0);
+  // 1. Rough outline from the colour classes, robust circle.
+  const Edges rough = ClassEdges(bgr, table, ball_bit, rough_centre_px, r0);
+  if (rough.points.size() < 5) {
+    fit.failure = "too few outline points";
+    return fit;
+  }
+  Vector2d c1;
+  double r1 = 0;
+  std::vector<char> in1;
+  if (!RansacCircle(rough.points, std::max(1.0, 0.08 * r0), o.ransac_iterations, &c1, &r1, &in1) ||
+      r1 > 3 * r0 + 3) {
+    fit.failure = "no circle in the rough outline";
+    return fit;
+  }
+  // 2. Sub-pixel outline twice (the second from the refined circle).
+  Edges edges;
+  std::vector<char> inl;
+  for (int pass = 0; pass < 2; ++pass) {
+    edges = SubpixelEdges(
+        bgr, table, ball_bit, c1, [r1](double) { return r1; }, r1, o);
+    Vector2d c2 = c1;
+    double r2 = r1;
+    if (!FitCircle(edges.points, o.inlier_px + 0.03 * r1 + (pass == 0 ? 0.5 : 0.0), &c2, &r2,
+                   &inl)) {
+      fit.failure = "too few sub-pixel outline points";
+      return fit;
+    }
+    c1 = c2;
+    r1 = r2;
+  }
+  const double thr = o.inlier_px + 0.03 * r1;
+  // 3. Final fit: the cone of the sphere with a camera (its predicted outline guides two more
+  // passes of outline points, so a sphere seen far off the axis, an ellipse, is searched where
+  // it is), else the circle.
+  Vector2d centre = c1;
+  double radius = r1;
+  std::vector<double> res;
+  if (camera != nullptr) {
+    Vector3d axis;
+    double alpha = 0;
+    bool have_cone = false;
+    for (int pass = 0; pass < 3; ++pass) {
+      if (have_cone) {
+        const ConeOutline outline(*camera, axis, alpha);
+        if (!outline.ok) break;
+        const Edges next = SubpixelEdges(
+            bgr, table, ball_bit, outline.centre, [&outline](double th) { return outline(th); },
+            outline.mean_radius, o);
+        if (next.points.size() < 5) break;
+        edges = next;
+        inl.assign(edges.points.size(), 1);
+      }
+      Vector3d new_axis;
+      double new_alpha;
+      if (!RobustCone(edges.points, *camera, thr, have_cone ? &axis : nullptr,
+                      have_cone ? alpha : 0.0, &inl, &res, &new_axis, &new_alpha)) {
+        break;
+      }
+      axis = new_axis;
+      alpha = new_alpha;
+      have_cone = true;
+    }
+    const auto uv = have_cone ? camera->ProjectFromCamera(axis) : std::nullopt;
+    if (uv) {
+      centre = *uv;
+      double s = 0;
+      int cnt = 0;
+      for (size_t i = 0; i < edges.points.size(); ++i) {
+        if (inl[i]) {
+          s += (edges.points[i] - centre).norm();
+          ++cnt;
+        }
+      }
+      radius = cnt > 0 ? s / cnt : r1;
+    } else {
+      FitCircle(edges.points, thr, &centre, &radius, &inl);
+    }
+  }
+  const int n = static_cast<int>(edges.points.size());
+  fit.rays = edges.rays;
+  fit.edges = n;
+  if (res.size() != edges.points.size()) {
+    res.resize(n);
+    for (int i = 0; i < n; ++i) res[i] = (edges.points[i] - centre).norm() - radius;
+  }
+  int count = 0;
+  double rms = Rms(res, inl, &count);
+  // 4. Motion blur: an elongated outline that an ellipse explains much better.
+  if (count < 0.8 * n && n >= 8) {
+    std::vector<cv::Point2f> cv_pts;
+    for (const auto& p : edges.points) cv_pts.emplace_back(float(p.x()), float(p.y()));
+    cv::RotatedRect e = cv::fitEllipseDirect(cv_pts);
+    for (int pass = 0; pass < 2 && e.size.width > 0 && e.size.height > 0; ++pass) {
+      const Vector2d ec(e.center.x, e.center.y);
+      const double mean_r = 0.25 * (e.size.width + e.size.height);
+      const Edges be = SubpixelEdges(
+          bgr, table, ball_bit, ec, [&e](double th) { return EllipsePolarRadius(e, th); }, mean_r,
+          o);
+      if (be.points.size() < 8) break;
+      cv_pts.clear();
+      for (const auto& p : be.points) cv_pts.emplace_back(float(p.x()), float(p.y()));
+      const cv::RotatedRect e2 = cv::fitEllipseDirect(cv_pts);
+      if (!(e2.size.width > 0 && e2.size.height > 0)) break;
+      int ecount = 0;
+      double es = 0;
+      for (const auto& p : be.points) {
+        const double d = EllipseDistance(e2, p);
+        if (std::abs(d) < thr) {
+          ++ecount;
+          es += d * d;
+        }
+      }
+      const double major = std::max(e2.size.width, e2.size.height);
+      const double minor = std::min(e2.size.width, e2.size.height);
+      e = e2;
+      if (pass == 1 && ecount >= 0.9 * be.points.size() && major / minor >= o.blur_min_aspect &&
+          double(ecount) / be.rays > double(count) / n) {
+        fit.blurred = true;
+        fit.blur_length_px = major - minor;
+        centre = Vector2d(e2.center.x, e2.center.y);
+        radius = 0.5 * minor;
+        rms = std::sqrt(es / ecount);
+        edges = be;
+        count = ecount;
+        fit.rays = be.rays;
+        fit.edges = static_cast<int>(be.points.size());
+        inl.assign(be.points.size(), 0);
+        for (size_t i = 0; i < be.points.size(); ++i) {
+          inl[i] = std::abs(EllipseDistance(e2, be.points[i])) < thr;
+        }
+      }
+    }
+  }
+  if (!fit.blurred && !edges.ramp_px.empty()) {
+    std::vector<double> ramps;
+    for (double w : edges.ramp_px) {
+      if (w > 3.0) ramps.push_back(w);
+    }
+    if (ramps.size() >= 0.15 * edges.ramp_px.size()) {
+      std::sort(ramps.begin(), ramps.end());
+      fit.blurred = true;
+      fit.blur_length_px = ramps[ramps.size() * 3 / 4];
+    }
+  }
+  fit.ok = true;
+  fit.centre_px = centre;
+  fit.radius_px = radius;
+  fit.rms_px = rms;
+  fit.inliers = count;
+  fit.inlier_fraction = fit.rays > 0 ? double(count) / fit.rays : 0.0;
+  fit.sigma_px = CentreSigma(edges.points, inl, centre, rms);
+  if (fit.blurred) fit.sigma_px = std::hypot(fit.sigma_px, 0.05 * fit.blur_length_px);
+  fit.edge_points = edges.points;
+  fit.edge_inlier = inl;
+  return fit;
+}
+
+}  // namespace fv

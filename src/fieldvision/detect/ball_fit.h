@@ -1,0 +1,67 @@
+// Sub-pixel centre of a ball blob from its outline, not its colour centroid (which shading,
+// highlights and occlusion bias): sub-pixel edge points along rays from a rough centre (the 0.5
+// crossing of each ray's profile between its own inside and outside colours, so the ball's
+// shading and a changing background do not bias it), then a robust fit that keeps only the free
+// part of the outline (occluders' edges are outliers). With a camera the fit is of the cone of
+// rays tangent to the sphere (unit rays v with v . w = 1, linear least squares, w = axis / cos
+// alpha), whose axis projects exactly to the sphere centre, so it is unbiased in perspective and
+// under distortion; without one it is a geometric circle fit (Gauss-Newton). A motion-blurred
+// ball (an elongated outline) gets an ellipse fit (cv::fitEllipseDirect) whose centre is the
+// mid-exposure position. The uncertainty is the centre's standard deviation from the residuals
+// and the Jacobian of the circle. Ray casting as in Hanek's contracting-curve papers and RoboCup
+// ball detectors (B-Human code release 2019, "ball perceptor").
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "fieldvision/camera/camera.h"
+#include "fieldvision/detect/colour.h"
+
+namespace fv {
+
+struct BallFitOptions {
+  double min_contrast = 20.0;     // BGR distance between a ray's inside and outside colours
+  double inlier_px = 0.6;         // outline points farther than this from the fit are outliers
+                                  // (plus 3 % of the radius)
+  int ransac_iterations = 60;     // for the first, rough outline
+  double blur_min_aspect = 1.15;  // an outline this elongated that fits an ellipse is blurred
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct BallFit {
+  bool ok = false;
+  std::string failure;  // why not ok
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  double sigma_px = 0.0;  // standard deviation of the centre (each axis)
+  double rms_px = 0.0;    // RMS distance of the inlier outline points from the fit
+  int rays = 0;
+  int edges = 0;                 // rays with an outline point
+  int inliers = 0;               // outline points on the fit
+  double inlier_fraction = 0.0;  // inliers / rays
+  bool blurred = false;
+  double blur_length_px = 0.0;               // major minus minor axis of the blurred outline
+  std::vector<Eigen::Vector2d> edge_points;  // for drawing
+  std::vector<char> edge_inlier;
+  std::string Summary() const;
+};
+
+// Refines a ball seen around `rough_centre_px` with radius about `rough_radius_px`. `ball_bit`
+// is the ball's class in `table`. `camera` may be null (pixel-space fit).
+BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                const Eigen::Vector2d& rough_centre_px, double rough_radius_px,
+                const Camera* camera, const BallFitOptions& options = {});
+
+// Robust geometric circle fit of points (used by FitBall; exposed for tests): the initial guess
+// is refined by Gauss-Newton with outliers (farther than inlier_px) dropped; `inlier` receives
+// the final inlier flags. Returns false when fewer than 3 inliers remain.
+bool FitCircle(const std::vector<Eigen::Vector2d>& points, double inlier_px,
+               Eigen::Vector2d* centre, double* radius, std::vector<char>* inlier);
+
+}  // namespace fv

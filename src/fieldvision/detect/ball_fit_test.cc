@@ -1,0 +1,144 @@
+#include "fieldvision/detect/ball_fit.h"
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 1e9 : v[v.size() / 2];
+}
+
+TEST(FitCircle, IgnoresOutliers) {
+  const uint64_t seed = fv::testing::TestSeed(2);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const Eigen::Vector2d c(rng.Uniform(10, 90), rng.Uniform(10, 90));
+  const double r = rng.Uniform(5, 30);
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < 60; ++i) {
+    const double th = rng.Uniform(0, 2 * M_PI);
+    const double rr = i % 3 == 0 ? r * rng.Uniform(0.3, 0.8) : r + rng.Normal(0, 0.05);
+    pts.push_back(c + rr * Eigen::Vector2d(std::cos(th), std::sin(th)));
+  }
+  // Start from a rough guess, as FitBall does.
+  Eigen::Vector2d centre = c + Eigen::Vector2d(0.4, -0.3);
+  double radius = r + 0.3;
+  std::vector<char> inlier;
+  ASSERT_TRUE(FitCircle(pts, 1.0, &centre, &radius, &inlier));
+  EXPECT_LT((centre - c).norm(), 0.05);
+  EXPECT_NEAR(radius, r, 0.05);
+  for (int i = 0; i < 60; ++i)
+    EXPECT_EQ(inlier[i] != 0, i % 3 != 0 || (pts[i] - c).norm() > r - 1.0);
+}
+
+// Shaded discs of 6..40 px diameter at random sub-pixel places on a noisy field.
+TEST(FitBall, SubpixelCentreOfShadedDiscs) {
+  const uint64_t seed = fv::testing::TestSeed(4);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  std::vector<double> err, radius_err;
+  for (int i = 0; i < 40; ++i) {
+    cv::Mat img = detect_testing::FieldImage(120, 120, rng);
+    const double r = rng.Uniform(3, 20);
+    const Eigen::Vector2d c(rng.Uniform(40, 80), rng.Uniform(40, 80));
+    detect_testing::PaintDisc(img, c, r);
+    const Eigen::Vector2d rough = c + Eigen::Vector2d(rng.Uniform(-1, 1), rng.Uniform(-1, 1));
+    const BallFit fit =
+        FitBall(img, table, table.BallBit(), rough, r * rng.Uniform(0.85, 1.15), nullptr);
+    ASSERT_TRUE(fit.ok) << fit.failure << " r=" << r;
+    err.push_back((fit.centre_px - c).norm());
+    radius_err.push_back(std::abs(fit.radius_px - r));
+    EXPECT_FALSE(fit.blurred) << fit.Summary();
+    EXPECT_GT(fit.inlier_fraction, 0.8) << fit.Summary();
+    EXPECT_GT(fit.sigma_px, 0.0);
+    EXPECT_LT(fit.sigma_px, 0.5);
+  }
+  EXPECT_LT(Median(err), 0.1);
+  EXPECT_LT(*std::max_element(err.begin(), err.end()), 0.4);
+  EXPECT_LT(Median(radius_err), 0.3);
+}
+
+TEST(FitBall, PartlyOccludedBallFitsTheFreeOutline) {
+  const uint64_t seed = fv::testing::TestSeed(8);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  std::vector<double> err;
+  for (int i = 0; i < 12; ++i) {
+    cv::Mat img = detect_testing::FieldImage(120, 120, rng);
+    const double r = rng.Uniform(6, 18);
+    const Eigen::Vector2d c(rng.Uniform(50, 70), rng.Uniform(50, 70));
+    detect_testing::PaintDisc(img, c, r);
+    // A dark robot covering about a third of the ball from the side.
+    const int edge = static_cast<int>(c.x() + r * rng.Uniform(0.2, 0.5));
+    cv::rectangle(img, cv::Rect(edge, 0, 120 - edge, 120), cv::Scalar(35, 35, 35), cv::FILLED);
+    // The blob's rough centre and radius are those of the visible part.
+    const BallFit fit =
+        FitBall(img, table, table.BallBit(), c + Eigen::Vector2d(-0.3 * r, 0), 0.8 * r, nullptr);
+    ASSERT_TRUE(fit.ok) << fit.failure;
+    err.push_back((fit.centre_px - c).norm());
+    EXPECT_LT(fit.inlier_fraction, 0.85) << fit.Summary();
+    EXPECT_GT(fit.sigma_px, 0.0);
+  }
+  EXPECT_LT(Median(err), 0.3);
+}
+
+TEST(FitBall, MotionBlurredBallGivesTheMidExposureCentre) {
+  const uint64_t seed = fv::testing::TestSeed(9);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  cv::Mat bg = detect_testing::FieldImage(160, 160, rng, 0.0);
+  const double r = 10;
+  const Eigen::Vector2d c(40.3, 119.6);  // clear of the painted lines
+  const double th = rng.Uniform(0, M_PI);
+  const Eigen::Vector2d dir(std::cos(th), std::sin(th));
+  const double length = 14;  // px travelled during the exposure
+  cv::Mat acc(bg.size(), CV_32FC3, cv::Scalar(0, 0, 0));
+  const int n = 15;
+  for (int k = 0; k < n; ++k) {
+    cv::Mat img = bg.clone();
+    detect_testing::PaintDisc(img, c + (k / double(n - 1) - 0.5) * length * dir, r);
+    cv::Mat f;
+    img.convertTo(f, CV_32FC3);
+    acc += f / n;
+  }
+  cv::Mat blurred;
+  acc.convertTo(blurred, CV_8UC3);
+  const BallFit fit = FitBall(blurred, table, table.BallBit(), c, r + 5, nullptr);
+  ASSERT_TRUE(fit.ok) << fit.failure;
+  EXPECT_TRUE(fit.blurred) << fit.Summary();
+  // Shading smeared along the motion biases the outline a little; the uncertainty says so.
+  const double err = (fit.centre_px - c).norm();
+  EXPECT_LT(err, 1.0) << fit.Summary();
+  EXPECT_LT(err, 2.5 * fit.sigma_px) << fit.Summary();
+  EXPECT_NEAR(fit.blur_length_px, length, 4.0);
+}
+
+// A sphere near the corner of a wide-angle view projects to an ellipse whose centre is not the
+// projection of the sphere centre; the cone fit with the camera removes that bias.
+TEST(FitBall, ConeFitIsUnbiasedInPerspective) {
+  const ColourTable table(PresetColourSpec("orange"));
+  const Camera cam = Camera::FromFov(640, 480, 110.0);
+  Rng rng(1);
+  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  const Eigen::Vector3d centre(1.2, 0.85, 1.0);  // 56 degrees off the axis
+  const Eigen::Vector2d uv = detect_testing::PaintSphere(img, cam, centre, 0.08);
+  const BallFit with_camera = FitBall(img, table, table.BallBit(), uv, 12, &cam);
+  const BallFit without = FitBall(img, table, table.BallBit(), uv, 12, nullptr);
+  ASSERT_TRUE(with_camera.ok && without.ok);
+  EXPECT_LT((with_camera.centre_px - uv).norm(), 0.1) << with_camera.Summary();
+  EXPECT_GT((without.centre_px - uv).norm(), 0.3) << without.Summary();
+}
+
+}  // namespace
+}  // namespace fv

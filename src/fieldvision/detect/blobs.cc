@@ -1,0 +1,179 @@
+#include "fieldvision/detect/blobs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+int Find(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+void Union(std::vector<int>& parent, int a, int b) {
+  a = Find(parent, a);
+  b = Find(parent, b);
+  if (a != b) parent[std::max(a, b)] = std::min(a, b);
+}
+
+// Classifies samples x = x_start, x_start + step, ... of one row into `cls`.
+template <int kStep>
+void ClassifyRow(const uint8_t* row, int n, int x_start, int step, const ColourTable& table,
+                 uint8_t* cls) {
+  const uint8_t* lut = table.data();
+  const int st = kStep > 0 ? kStep : step;
+  const uint8_t* p = row + 3 * x_start;
+  if (table.bits_per_channel() == 8) {
+    for (int i = 0; i < n; ++i, p += 3 * st) {
+      cls[i] = lut[uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16];
+    }
+  } else {
+    const int b = table.bits_per_channel();
+    const int s = 8 - b;
+    for (int i = 0; i < n; ++i, p += 3 * st) {
+      cls[i] = lut[uint32_t(p[0] >> s) | uint32_t(p[1] >> s) << b | uint32_t(p[2] >> s) << (2 * b)];
+    }
+  }
+}
+
+}  // namespace
+
+void ScanOptions::Check() const {
+  FV_REQUIRE(step_px >= 1 && step_px <= 16, "scan step_px must be 1..16 (got {})", step_px);
+  FV_REQUIRE(min_samples >= 1, "scan min_samples must be >= 1 (got {})", min_samples);
+}
+
+double Blob::aspect_ratio() const {
+  const double w = width_px(), h = height_px();
+  return std::max(w, h) / std::min(w, h);
+}
+
+double Blob::equivalent_radius_px() const { return std::sqrt(area_px() / M_PI); }
+
+std::string BlobScanResult::Summary() const {
+  return fmt::format("{} samples, {} runs, {} blobs", samples, runs, blobs.size());
+}
+
+BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t class_mask,
+                         const ScanOptions& options, const cv::Mat& mask) {
+  options.Check();
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "ScanBlobs: expected a BGR 8-bit image");
+  FV_REQUIRE(mask.empty() || (mask.type() == CV_8U && mask.size() == bgr.size()),
+             "ScanBlobs: mask must be CV_8U of the image size");
+  const int step = options.step_px;
+  const int offset = step / 2;
+  const int n = bgr.cols > offset ? (bgr.cols - offset + step - 1) / step : 0;
+  BlobScanResult result;
+  std::vector<uint8_t> cls(n + 8, 0);
+  std::vector<Run> runs;
+  runs.reserve(1024);
+  std::vector<int> parent;
+  parent.reserve(1024);
+  uint64_t mask8;
+  std::memset(&mask8, class_mask, sizeof(mask8));
+  int prev_begin = 0, prev_end = 0;
+  for (int y = offset; y < bgr.rows; y += step) {
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    switch (step) {
+      case 2:
+        ClassifyRow<2>(row, n, offset, step, table, cls.data());
+        break;
+      case 4:
+        ClassifyRow<4>(row, n, offset, step, table, cls.data());
+        break;
+      default:
+        ClassifyRow<0>(row, n, offset, step, table, cls.data());
+    }
+    if (!mask.empty()) {
+      const uint8_t* m = mask.ptr<uint8_t>(y);
+      for (int i = 0; i < n; ++i) cls[i] &= m[offset + i * step] ? 0xFF : 0;
+    }
+    result.samples += n;
+    // Run-length encoding: skip 8 samples at a time while none has the class.
+    const int cur_begin = static_cast<int>(runs.size());
+    int i = 0;
+    while (i < n) {
+      uint64_t word;
+      std::memcpy(&word, cls.data() + i, 8);
+      if ((word & mask8) == 0) {
+        i += 8;
+        continue;
+      }
+      if (!(cls[i] & class_mask)) {
+        ++i;
+        continue;
+      }
+      int j = i + 1;
+      while (j < n && (cls[j] & class_mask)) ++j;
+      runs.push_back({y, offset + i * step, offset + (j - 1) * step});
+      parent.push_back(static_cast<int>(parent.size()));
+      i = j;
+    }
+    const int cur_end = static_cast<int>(runs.size());
+    // Merge with the previous scanned row (both sorted by x): 8-connected on the sample grid.
+    if (prev_end > prev_begin && cur_end > cur_begin && runs[prev_begin].y == y - step) {
+      int a = prev_begin, b = cur_begin;
+      while (a < prev_end && b < cur_end) {
+        const Run& p = runs[a];
+        const Run& c = runs[b];
+        if (p.x0 <= c.x1 + step && c.x0 <= p.x1 + step) Union(parent, a, b);
+        if (p.x1 < c.x1) {
+          ++a;
+        } else {
+          ++b;
+        }
+      }
+    }
+    prev_begin = cur_begin;
+    prev_end = cur_end;
+  }
+  result.runs = static_cast<int>(runs.size());
+  // Blob statistics per root.
+  std::vector<int> blob_of(runs.size(), -1);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const int root = Find(parent, static_cast<int>(r));
+    if (blob_of[root] < 0) {
+      blob_of[root] = static_cast<int>(result.blobs.size());
+      Blob b;
+      b.x_min = runs[r].x0;
+      b.x_max = runs[r].x1;
+      b.y_min = b.y_max = runs[r].y;
+      b.step_px = step;
+      result.blobs.push_back(b);
+    }
+    Blob& b = result.blobs[blob_of[root]];
+    const Run& run = runs[r];
+    const double cnt = (run.x1 - run.x0) / step + 1;
+    const double k1 = cnt * (cnt - 1) / 2, k2 = (cnt - 1) * cnt * (2 * cnt - 1) / 6;
+    const double sx = cnt * run.x0 + step * k1;
+    const double sxx = cnt * double(run.x0) * run.x0 + 2.0 * run.x0 * step * k1 + step * step * k2;
+    b.x_min = std::min(b.x_min, run.x0);
+    b.x_max = std::max(b.x_max, run.x1);
+    b.y_min = std::min(b.y_min, run.y);
+    b.y_max = std::max(b.y_max, run.y);
+    b.samples += static_cast<int>(cnt);
+    b.runs += 1;
+    b.sum_x += sx;
+    b.sum_xx += sxx;
+    b.sum_y += cnt * run.y;
+    b.sum_yy += cnt * double(run.y) * run.y;
+    b.sum_xy += sx * run.y;
+  }
+  result.blobs.erase(std::remove_if(result.blobs.begin(), result.blobs.end(),
+                                    [&](const Blob& b) { return b.samples < options.min_samples; }),
+                     result.blobs.end());
+  std::sort(result.blobs.begin(), result.blobs.end(),
+            [](const Blob& a, const Blob& b) { return a.samples > b.samples; });
+  return result;
+}
+
+}  // namespace fv

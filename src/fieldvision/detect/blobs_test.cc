@@ -1,0 +1,122 @@
+#include "fieldvision/detect/blobs.h"
+
+#include <map>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+using detect_testing::kGrass;
+using detect_testing::kOrange;
+
+// Random orange and green pixels in clumps: a hard case for run merging.
+cv::Mat RandomClumps(Rng& rng, int w, int h) {
+  cv::Mat small(h / 3, w / 3, CV_8UC3);
+  for (int y = 0; y < small.rows; ++y) {
+    for (int x = 0; x < small.cols; ++x) {
+      small.at<cv::Vec3b>(y, x) = rng.Uniform() < 0.35 ? kOrange : kGrass;
+    }
+  }
+  cv::Mat img;
+  cv::resize(small, img, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
+  // Single stray pixels and diagonal touches.
+  for (int i = 0; i < 200; ++i)
+    img.at<cv::Vec3b>(rng.UniformInt(0, h - 1), rng.UniformInt(0, w - 1)) = kOrange;
+  return img;
+}
+
+TEST(ScanBlobs, StepOneEqualsOpenCvConnectedComponents) {
+  const uint64_t seed = fv::testing::TestSeed(11);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  const cv::Mat img = RandomClumps(rng, 150, 120);
+  ScanOptions o;
+  o.step_px = 1;
+  o.min_samples = 1;
+  const BlobScanResult r = ScanBlobs(img, table, table.BallBit(), o);
+  cv::Mat bin = table.ClassifyImage(img) & table.BallBit();
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(bin > 0, labels, stats, centroids, 8);
+  ASSERT_EQ(static_cast<int>(r.blobs.size()), n - 1);
+  std::multiset<std::tuple<int, int, int, int, int>> ours, theirs;
+  for (const Blob& b : r.blobs) ours.insert({b.samples, b.x_min, b.y_min, b.x_max, b.y_max});
+  for (int i = 1; i < n; ++i) {
+    const int* s = stats.ptr<int>(i);
+    theirs.insert({s[cv::CC_STAT_AREA], s[cv::CC_STAT_LEFT], s[cv::CC_STAT_TOP],
+                   s[cv::CC_STAT_LEFT] + s[cv::CC_STAT_WIDTH] - 1,
+                   s[cv::CC_STAT_TOP] + s[cv::CC_STAT_HEIGHT] - 1});
+  }
+  EXPECT_EQ(ours, theirs);
+  // Moments: the centroid of the largest blob equals OpenCV's.
+  const Blob& big = r.blobs.front();
+  bool found = false;
+  for (int i = 1; i < n; ++i) {
+    if (stats.at<int>(i, cv::CC_STAT_AREA) == big.samples &&
+        stats.at<int>(i, cv::CC_STAT_LEFT) == big.x_min &&
+        stats.at<int>(i, cv::CC_STAT_TOP) == big.y_min) {
+      EXPECT_NEAR(big.centroid_px().x(), centroids.at<double>(i, 0), 1e-9);
+      EXPECT_NEAR(big.centroid_px().y(), centroids.at<double>(i, 1), 1e-9);
+      found = true;
+    }
+  }
+  EXPECT_TRUE(found);
+}
+
+TEST(ScanBlobs, CoarseStepFindsEachDiscOnceWithItsSize) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  std::vector<std::pair<Eigen::Vector2d, double>> discs;
+  for (int i = 0; i < 6; ++i) {
+    const Eigen::Vector2d c(60 + 100 * i + rng.Uniform(0, 1), rng.Uniform(60, 420));
+    const double r = rng.Uniform(4, 30);
+    detect_testing::PaintDisc(img, c, r);
+    discs.push_back({c, r});
+  }
+  for (int step : {2, 4}) {
+    SCOPED_TRACE(step);
+    ScanOptions o;
+    o.step_px = step;
+    const BlobScanResult res = ScanBlobs(img, table, table.BallBit(), o);
+    ASSERT_EQ(res.blobs.size(), discs.size()) << res.Summary();
+    for (const auto& [c, r] : discs) {
+      int matches = 0;
+      for (const Blob& b : res.blobs) {
+        if ((b.centroid_px() - c).norm() < 0.3 * r + step) {
+          ++matches;
+          EXPECT_NEAR(b.equivalent_radius_px(), r, 0.15 * r + step);
+          EXPECT_NEAR(b.fill_ratio(), M_PI / 4, 0.25);
+          EXPECT_LT(b.aspect_ratio(), 1.5);
+        }
+      }
+      EXPECT_EQ(matches, 1) << "disc at " << c.transpose() << " r " << r;
+    }
+  }
+  // A mask hides what is outside it.
+  cv::Mat mask(img.size(), CV_8U, cv::Scalar(0));
+  mask(cv::Rect(0, 0, 320, 480)).setTo(255);
+  const BlobScanResult half = ScanBlobs(img, table, table.BallBit(), ScanOptions{}, mask);
+  for (const Blob& b : half.blobs) EXPECT_LT(b.x_max, 320);
+  EXPECT_LT(half.blobs.size(), discs.size());
+}
+
+TEST(ScanBlobs, OptionsAreChecked) {
+  ScanOptions o;
+  o.step_px = 0;
+  EXPECT_THROW(o.Check(), Error);
+  const ColourTable table(PresetColourSpec("orange"), 6);
+  EXPECT_THROW(ScanBlobs(cv::Mat(), table, 1, ScanOptions{}), Error);
+}
+
+}  // namespace
+}  // namespace fv

@@ -1,0 +1,338 @@
+#include "fieldvision/detect/colour.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+using nlohmann::json;
+
+ColourRange Hsv(double h0, double s0, double v0, double h1, double s1, double v1) {
+  return {ColourSpace::kHsv, {h0, s0, v0}, {h1, s1, v1}};
+}
+
+const std::map<std::string, std::vector<ColourRange>>& Presets() {
+  // Hue in degrees. Orange covers Lambert-shaded balls (dark side down to V 45) but not skin
+  // (low saturation) or red shirts (hue < 6).
+  static const std::map<std::string, std::vector<ColourRange>> presets = {
+      {"orange", {Hsv(6, 130, 45, 45, 255, 255)}}, {"yellow", {Hsv(45, 100, 80, 70, 255, 255)}},
+      {"white", {Hsv(0, 0, 170, 360, 45, 255)}},   {"pink", {Hsv(295, 60, 120, 345, 255, 255)}},
+      {"red", {Hsv(345, 120, 60, 6, 255, 255)}},   {"blue", {Hsv(190, 100, 50, 250, 255, 255)}},
+      {"green", {Hsv(70, 50, 30, 170, 255, 255)}}, {"black", {Hsv(0, 0, 0, 360, 255, 45)}},
+  };
+  return presets;
+}
+
+const char* SpaceName(ColourSpace s) { return s == ColourSpace::kHsv ? "hsv" : "yuv"; }
+
+// Per channel, which 8-bit values of the converted image are inside the range.
+struct CompiledRange {
+  ColourSpace space;
+  std::array<std::array<uint8_t, 256>, 3> in;
+};
+
+CompiledRange Compile(const ColourRange& r) {
+  CompiledRange c{r.space, {}};
+  for (int ch = 0; ch < 3; ++ch) {
+    for (int v = 0; v < 256; ++v) {
+      bool inside;
+      if (r.space == ColourSpace::kHsv && ch == 0) {
+        const double deg = v * 360.0 / 256.0;
+        inside = r.min[0] <= r.max[0] ? (deg >= r.min[0] && deg <= r.max[0])
+                                      : (deg >= r.min[0] || deg <= r.max[0]);
+      } else {
+        inside = v >= r.min[ch] && v <= r.max[ch];
+      }
+      c.in[ch][v] = inside ? 1 : 0;
+    }
+  }
+  return c;
+}
+
+std::array<double, 3> Array3(const json& j, const std::string& where) {
+  FV_REQUIRE(j.is_array() && j.size() == 3, "{} must be an array of 3 numbers", where);
+  std::array<double, 3> a;
+  for (int i = 0; i < 3; ++i) {
+    FV_REQUIRE(j[i].is_number(), "{}[{}] is not a number", where, i);
+    a[i] = j[i].get<double>();
+  }
+  return a;
+}
+
+}  // namespace
+
+void ColourSpec::Check(const std::string& context) const {
+  FV_REQUIRE(!classes.empty(), "{}: no colour classes", context);
+  FV_REQUIRE(classes.size() <= 8, "{}: {} classes; at most 8 fit the table", context,
+             classes.size());
+  std::set<std::string> names;
+  for (size_t i = 0; i < classes.size(); ++i) {
+    const ColourClass& c = classes[i];
+    FV_REQUIRE(!c.name.empty(), "{}: classes[{}] has no name", context, i);
+    FV_REQUIRE(names.insert(c.name).second, "{}: class '{}' appears twice", context, c.name);
+    FV_REQUIRE(!c.ranges.empty(), "{}: class '{}' has no ranges", context, c.name);
+    for (size_t k = 0; k < c.ranges.size(); ++k) {
+      const ColourRange& r = c.ranges[k];
+      for (int ch = 0; ch < 3; ++ch) {
+        FV_REQUIRE(std::isfinite(r.min[ch]) && std::isfinite(r.max[ch]),
+                   "{}: class '{}' ranges[{}] has a non-finite bound", context, c.name, k);
+        const double hi = (r.space == ColourSpace::kHsv && ch == 0) ? 360.0 : 255.0;
+        FV_REQUIRE(r.min[ch] >= 0 && r.max[ch] <= hi && r.max[ch] >= 0 && r.min[ch] <= hi,
+                   "{}: class '{}' ranges[{}] channel {} outside 0..{}", context, c.name, k, ch,
+                   hi);
+        if (!(r.space == ColourSpace::kHsv && ch == 0)) {
+          FV_REQUIRE(r.min[ch] <= r.max[ch], "{}: class '{}' ranges[{}] channel {} has min > max",
+                     context, c.name, k, ch);
+        }
+      }
+    }
+  }
+  FV_REQUIRE(Find(ball_class) >= 0, "{}: ball_class '{}' is not one of the classes", context,
+             ball_class);
+}
+
+int ColourSpec::Find(const std::string& name) const {
+  for (size_t i = 0; i < classes.size(); ++i) {
+    if (classes[i].name == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+std::vector<std::string> ColourPresetNames() {
+  return {"orange", "yellow", "white", "pink", "red", "blue", "green", "black"};
+}
+
+ColourClass ColourPreset(const std::string& name) {
+  const auto it = Presets().find(name);
+  if (it == Presets().end()) {
+    std::string names;
+    for (const auto& n : ColourPresetNames()) names += (names.empty() ? "" : ", ") + n;
+    Throw("unknown colour preset '{}' (presets: {})", name, names);
+  }
+  return {name, it->second};
+}
+
+ColourSpec PresetColourSpec(const std::string& ball_preset) {
+  ColourSpec spec;
+  ColourClass ball = ColourPreset(ball_preset);
+  ball.name = "ball";
+  spec.classes.push_back(ball);
+  if (ball_preset != "green") spec.classes.push_back({"field", ColourPreset("green").ranges});
+  if (ball_preset != "white") spec.classes.push_back({"line", ColourPreset("white").ranges});
+  spec.ball_class = "ball";
+  return spec;
+}
+
+json ColourSpecToJson(const ColourSpec& spec) {
+  json classes = json::array();
+  for (const auto& c : spec.classes) {
+    json ranges = json::array();
+    for (const auto& r : c.ranges) {
+      ranges.push_back({{"space", SpaceName(r.space)}, {"min", r.min}, {"max", r.max}});
+    }
+    classes.push_back({{"name", c.name}, {"ranges", ranges}});
+  }
+  return {{"format", "fieldvision colour classes"},
+          {"note",
+           "hsv: hue degrees 0..360 (min > max wraps through 0), saturation and value 0..255; "
+           "yuv: OpenCV BT.601 8-bit"},
+          {"ball_class", spec.ball_class},
+          {"classes", classes}};
+}
+
+ColourSpec ColourSpecFromJson(const json& j, const std::string& context) {
+  FV_REQUIRE(j.is_object(), "{}: expected a JSON object with 'classes'", context);
+  FV_REQUIRE(j.contains("classes") && j["classes"].is_array(), "{}: missing array 'classes'",
+             context);
+  ColourSpec spec;
+  for (size_t i = 0; i < j["classes"].size(); ++i) {
+    const json& jc = j["classes"][i];
+    const std::string where = fmt::format("{}: classes[{}]", context, i);
+    FV_REQUIRE(jc.is_object() && jc.contains("name") && jc["name"].is_string(),
+               "{} needs a string 'name'", where);
+    ColourClass c;
+    c.name = jc["name"].get<std::string>();
+    FV_REQUIRE(jc.contains("ranges") && jc["ranges"].is_array(), "{} needs an array 'ranges'",
+               where);
+    for (size_t k = 0; k < jc["ranges"].size(); ++k) {
+      const json& jr = jc["ranges"][k];
+      const std::string rwhere = fmt::format("{}.ranges[{}]", where, k);
+      FV_REQUIRE(jr.is_object(), "{} is not an object", rwhere);
+      ColourRange r;
+      const std::string space = jr.value("space", std::string("hsv"));
+      FV_REQUIRE(space == "hsv" || space == "yuv", "{}.space '{}' is not hsv or yuv", rwhere,
+                 space);
+      r.space = space == "hsv" ? ColourSpace::kHsv : ColourSpace::kYuv;
+      FV_REQUIRE(jr.contains("min") && jr.contains("max"), "{} needs 'min' and 'max'", rwhere);
+      r.min = Array3(jr["min"], rwhere + ".min");
+      r.max = Array3(jr["max"], rwhere + ".max");
+      c.ranges.push_back(r);
+    }
+    spec.classes.push_back(c);
+  }
+  if (j.contains("ball_class")) {
+    FV_REQUIRE(j["ball_class"].is_string(), "{}: 'ball_class' is not a string", context);
+    spec.ball_class = j["ball_class"].get<std::string>();
+  } else if (!spec.classes.empty()) {
+    spec.ball_class = spec.classes.front().name;
+  }
+  spec.Check(context);
+  return spec;
+}
+
+ColourSpec ReadColourSpec(const std::string& path) {
+  std::error_code ec;
+  FV_REQUIRE(std::filesystem::is_regular_file(path, ec), "colour file '{}' does not exist", path);
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "cannot read colour file '{}'", path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  FV_REQUIRE(text.find_first_not_of(" \t\r\n") != std::string::npos, "colour file '{}' is empty",
+             path);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::exception& e) {
+    Throw("colour file '{}' is not valid JSON: {}", path, e.what());
+  }
+  return ColourSpecFromJson(j, fmt::format("colour file '{}'", path));
+}
+
+void WriteColourSpec(const ColourSpec& spec, const std::string& path) {
+  spec.Check("colour spec to write");
+  std::ofstream out(path);
+  FV_REQUIRE(out.good(), "cannot write colour file '{}'", path);
+  out << ColourSpecToJson(spec).dump(2) << "\n";
+  out.close();
+  FV_REQUIRE(out.good(), "cannot write colour file '{}'", path);
+}
+
+ColourSpec LoadColourSpec(const std::string& preset_or_path) {
+  FV_REQUIRE(!preset_or_path.empty(), "--color is empty: give a preset name or a colour file");
+  std::error_code ec;
+  if (Presets().count(preset_or_path) && !std::filesystem::exists(preset_or_path, ec)) {
+    return PresetColourSpec(preset_or_path);
+  }
+  if (!std::filesystem::exists(preset_or_path, ec)) {
+    std::string names;
+    for (const auto& n : ColourPresetNames()) names += (names.empty() ? "" : ", ") + n;
+    Throw("colour '{}' is neither a preset ({}) nor an existing colour file", preset_or_path,
+          names);
+  }
+  return ReadColourSpec(preset_or_path);
+}
+
+std::array<double, 3> BgrToHsv(uint8_t b, uint8_t g, uint8_t r) {
+  cv::Mat px(1, 1, CV_8UC3, cv::Scalar(b, g, r)), hsv;
+  cv::cvtColor(px, hsv, cv::COLOR_BGR2HSV_FULL);
+  const cv::Vec3b v = hsv.at<cv::Vec3b>(0, 0);
+  return {v[0] * 360.0 / 256.0, double(v[1]), double(v[2])};
+}
+
+std::array<double, 3> BgrToYuv(uint8_t b, uint8_t g, uint8_t r) {
+  cv::Mat px(1, 1, CV_8UC3, cv::Scalar(b, g, r)), yuv;
+  cv::cvtColor(px, yuv, cv::COLOR_BGR2YUV);
+  const cv::Vec3b v = yuv.at<cv::Vec3b>(0, 0);
+  return {double(v[0]), double(v[1]), double(v[2])};
+}
+
+bool RangeContains(const ColourRange& range, const std::array<double, 3>& hsv,
+                   const std::array<double, 3>& yuv) {
+  const auto& p = range.space == ColourSpace::kHsv ? hsv : yuv;
+  for (int ch = 0; ch < 3; ++ch) {
+    if (range.space == ColourSpace::kHsv && ch == 0) {
+      const bool in = range.min[0] <= range.max[0] ? (p[0] >= range.min[0] && p[0] <= range.max[0])
+                                                   : (p[0] >= range.min[0] || p[0] <= range.max[0]);
+      if (!in) return false;
+    } else if (p[ch] < range.min[ch] || p[ch] > range.max[ch]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
+    : spec_(spec), bits_(bits_per_channel) {
+  spec_.Check();
+  FV_REQUIRE(bits_ >= 4 && bits_ <= 8, "lut_bits must be 4..8 (got {})", bits_);
+  const int n = 1 << bits_;
+  const int shift = 8 - bits_;
+  const int centre = shift > 0 ? 1 << (shift - 1) : 0;
+  table_.assign(size_t(1) << (3 * bits_), 0);
+  // Compiled ranges per class.
+  std::vector<std::pair<uint8_t, CompiledRange>> ranges;
+  bool need_hsv = false, need_yuv = false;
+  for (size_t k = 0; k < spec_.classes.size(); ++k) {
+    for (const auto& r : spec_.classes[k].ranges) {
+      ranges.push_back({uint8_t(1u << k), Compile(r)});
+      (r.space == ColourSpace::kHsv ? need_hsv : need_yuv) = true;
+    }
+  }
+  // One n x n image (b along columns, g along rows) per red level, converted by OpenCV.
+  cv::Mat bgr(n, n, CV_8UC3), hsv, yuv;
+  for (int ri = 0; ri < n; ++ri) {
+    for (int gi = 0; gi < n; ++gi) {
+      cv::Vec3b* row = bgr.ptr<cv::Vec3b>(gi);
+      for (int bi = 0; bi < n; ++bi) {
+        row[bi] = cv::Vec3b(uint8_t((bi << shift) + centre), uint8_t((gi << shift) + centre),
+                            uint8_t((ri << shift) + centre));
+      }
+    }
+    if (need_hsv) cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
+    if (need_yuv) cv::cvtColor(bgr, yuv, cv::COLOR_BGR2YUV);
+    uint8_t* out = table_.data() + size_t(ri) * n * n;
+    for (const auto& [bit, cr] : ranges) {
+      const cv::Mat& conv = cr.space == ColourSpace::kHsv ? hsv : yuv;
+      const uint8_t* p = conv.ptr<uint8_t>(0);  // continuous
+      const uint8_t* in0 = cr.in[0].data();
+      const uint8_t* in1 = cr.in[1].data();
+      const uint8_t* in2 = cr.in[2].data();
+      for (int i = 0; i < n * n; ++i) {
+        const uint8_t inside = in0[p[3 * i]] & in1[p[3 * i + 1]] & in2[p[3 * i + 2]];
+        out[i] |= uint8_t(bit * inside);
+      }
+    }
+  }
+}
+
+std::shared_ptr<const ColourTable> ColourTable::Shared(const ColourSpec& spec,
+                                                       int bits_per_channel) {
+  static std::mutex mutex;
+  static std::map<std::string, std::weak_ptr<const ColourTable>> cache;
+  const std::string key = std::to_string(bits_per_channel) + ColourSpecToJson(spec).dump();
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto existing = cache[key].lock()) return existing;
+  auto table = std::make_shared<const ColourTable>(spec, bits_per_channel);
+  cache[key] = table;
+  return table;
+}
+
+uint8_t ColourTable::ClassBit(const std::string& name) const {
+  const int i = spec_.Find(name);
+  FV_REQUIRE(i >= 0, "colour class '{}' is not in the colour spec", name);
+  return uint8_t(1u << i);
+}
+
+cv::Mat ColourTable::ClassifyImage(const cv::Mat& bgr) const {
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "ClassifyImage: expected a BGR 8-bit image");
+  cv::Mat out(bgr.size(), CV_8U);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* p = bgr.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < bgr.cols; ++x, p += 3) o[x] = Classify(p[0], p[1], p[2]);
+  }
+  return out;
+}
+
+}  // namespace fv

@@ -1,0 +1,102 @@
+// Colour classes for the ball path (RoboCup-style colour segmentation): each class is a union of
+// boxes in HSV (hue in degrees, wrapping when min > max) or YUV (OpenCV's BT.601 8-bit
+// conversion), compiled into a lookup table that maps a packed BGR value to a bit set of
+// classes: the exact 2^24-entry table (16 MiB) or a quantised one (2^(3b) entries for b bits per
+// channel, each cell takes the class of its centre). Presets (orange, yellow, white, pink, ...)
+// and JSON colour files (what `color learn` writes and `--color` reads). Written by hand because
+// this table is the product's fast path; OpenCV's cvtColor does the colour conversions once.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+namespace fv {
+
+enum class ColourSpace { kHsv, kYuv };
+
+// One box. HSV: min/max = (hue degrees 0..360, saturation 0..255, value 0..255); a hue range
+// with min > max wraps through 0 (reds). YUV: (Y, U, V) 0..255 as cv::COLOR_BGR2YUV.
+struct ColourRange {
+  ColourSpace space = ColourSpace::kHsv;
+  std::array<double, 3> min = {0, 0, 0};
+  std::array<double, 3> max = {360, 255, 255};
+};
+
+struct ColourClass {
+  std::string name;
+  std::vector<ColourRange> ranges;  // a pixel belongs to the class if it is in any range
+};
+
+// At most 8 classes (one bit each in the table); `ball_class` names the ball's.
+struct ColourSpec {
+  std::vector<ColourClass> classes;
+  std::string ball_class = "ball";
+  // Throws fv::Error naming `context` and the bad class or range.
+  void Check(const std::string& context = "colour spec") const;
+  // Index of a class; -1 if absent.
+  int Find(const std::string& name) const;
+};
+
+// Names of the presets: orange, yellow, white, pink, red, blue, green, black.
+std::vector<std::string> ColourPresetNames();
+// One preset class (named after the preset); throws listing the names when unknown.
+ColourClass ColourPreset(const std::string& name);
+// A spec whose ball class is the preset `ball_preset`, plus "field" (green) and "line" (white).
+ColourSpec PresetColourSpec(const std::string& ball_preset = "orange");
+
+nlohmann::json ColourSpecToJson(const ColourSpec& spec);
+// Throws fv::Error naming `context` and the bad key.
+ColourSpec ColourSpecFromJson(const nlohmann::json& j, const std::string& context);
+// Reads a colour file; an absent, empty or invalid file throws fv::Error naming it.
+ColourSpec ReadColourSpec(const std::string& path);
+void WriteColourSpec(const ColourSpec& spec, const std::string& path);
+// `--color SPEC`: a preset name (PresetColourSpec) or the path of a colour file.
+ColourSpec LoadColourSpec(const std::string& preset_or_path);
+
+// HSV (degrees, 0..255, 0..255) and YUV of one BGR pixel, as the table sees them.
+std::array<double, 3> BgrToHsv(uint8_t b, uint8_t g, uint8_t r);
+std::array<double, 3> BgrToYuv(uint8_t b, uint8_t g, uint8_t r);
+bool RangeContains(const ColourRange& range, const std::array<double, 3>& hsv,
+                   const std::array<double, 3>& yuv);
+
+// The compiled lookup table. bits_per_channel 8: exact 2^24 table; 5..7: quantised.
+class ColourTable {
+ public:
+  ColourTable(const ColourSpec& spec, int bits_per_channel = 8);
+  // Shared, cached tables: detectors built for several cameras with one spec share one table.
+  static std::shared_ptr<const ColourTable> Shared(const ColourSpec& spec,
+                                                   int bits_per_channel = 8);
+
+  const ColourSpec& spec() const { return spec_; }
+  int bits_per_channel() const { return bits_; }
+  // Bit of a class (1 << index); throws naming the class when absent.
+  uint8_t ClassBit(const std::string& name) const;
+  uint8_t BallBit() const { return ClassBit(spec_.ball_class); }
+
+  // Table index of a packed BGR value (b | g << 8 | r << 16).
+  uint32_t Index(uint32_t packed_bgr) const {
+    if (bits_ == 8) return packed_bgr;
+    const uint32_t s = 8 - bits_, m = (1u << bits_) - 1;
+    return ((packed_bgr >> s) & m) | (((packed_bgr >> (8 + s)) & m) << bits_) |
+           (((packed_bgr >> (16 + s)) & m) << (2 * bits_));
+  }
+  uint8_t Classify(uint8_t b, uint8_t g, uint8_t r) const {
+    return table_[Index(uint32_t(b) | uint32_t(g) << 8 | uint32_t(r) << 16)];
+  }
+  const uint8_t* data() const { return table_.data(); }
+  // Class bits of every pixel of a BGR image (CV_8U).
+  cv::Mat ClassifyImage(const cv::Mat& bgr) const;
+
+ private:
+  ColourSpec spec_;
+  int bits_;
+  std::vector<uint8_t> table_;
+};
+
+}  // namespace fv
