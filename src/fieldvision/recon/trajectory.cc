@@ -1,0 +1,952 @@
+#include "fieldvision/recon/trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <ceres/ceres.h>
+#include <fmt/format.h>
+#include <Eigen/Dense>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+constexpr double kMaxStepS = 0.002;  // RK4 step for the drag model
+
+// a = -g z - k |v| v
+template <typename T>
+void Accel(const T v[3], const T& k, double g, T a[3]) {
+  using std::sqrt;
+  const T speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + T(1e-12));
+  for (int i = 0; i < 3; ++i) a[i] = -k * speed * v[i];
+  a[2] -= T(g);
+}
+
+template <typename T>
+void Rk4Step(T p[3], T v[3], const T& k, double g, double h) {
+  T a1[3], a2[3], a3[3], a4[3], vt[3];
+  Accel(v, k, g, a1);
+  for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a1[i];
+  Accel(vt, k, g, a2);
+  T v2[3] = {vt[0], vt[1], vt[2]};
+  for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a2[i];
+  Accel(vt, k, g, a3);
+  T v3[3] = {vt[0], vt[1], vt[2]};
+  for (int i = 0; i < 3; ++i) vt[i] = v[i] + h * a3[i];
+  Accel(vt, k, g, a4);
+  for (int i = 0; i < 3; ++i) {
+    p[i] = p[i] + h / 6.0 * (v[i] + 2.0 * v2[i] + 2.0 * v3[i] + vt[i]);
+    v[i] = v[i] + h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i]);
+  }
+}
+
+// Propagates (p, v) by dt seconds (either sign).
+template <typename T>
+void Propagate(T p[3], T v[3], const T& k, double g, double dt) {
+  const int n = std::max(1, static_cast<int>(std::ceil(std::abs(dt) / kMaxStepS)));
+  const double h = dt / n;
+  for (int s = 0; s < n; ++s) Rk4Step(p, v, k, g, h);
+}
+
+// Residual of one sample against the model with parameters p0 (3), v0 (3), k (1) at t0.
+struct SampleResidual {
+  SampleResidual(const Eigen::Vector3d& x, double dt, double g, bool drag)
+      : x_(x), dt_(dt), g_(g), drag_(drag) {}
+  template <typename T>
+  bool operator()(const T* p0, const T* v0, const T* k, T* r) const {
+    T p[3] = {p0[0], p0[1], p0[2]};
+    T v[3] = {v0[0], v0[1], v0[2]};
+    if (drag_) {
+      Propagate(p, v, k[0], g_, dt_);
+    } else {
+      for (int i = 0; i < 3; ++i) p[i] = p0[i] + v0[i] * dt_;
+      p[2] -= T(0.5 * g_ * dt_ * dt_);
+    }
+    for (int i = 0; i < 3; ++i) r[i] = p[i] - x_[i];
+    return true;
+  }
+  Eigen::Vector3d x_;
+  double dt_, g_;
+  bool drag_;
+};
+
+// Least-squares line per axis through gravity-corrected positions q = p + (0, 0, g t^2 / 2)
+// (relative to t_ref): q(t) = a + b (t - t_ref). A ballistic arc without drag is a line in q.
+struct GravityLine {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+  double t_ref = 0.0, t_mean = 0.0, sxx = 0.0;
+  int n = 0;
+  double sse = 0.0;  // sum of squared 3D residuals
+  Eigen::Vector3d At(double t, double g) const {
+    Eigen::Vector3d q = a + b * (t - t_ref);
+    q.z() -= 0.5 * g * (t - t_ref) * (t - t_ref);
+    return q;
+  }
+  // Standard error factor (per unit noise) of the prediction at t and of the slope.
+  double PredictionSd(double t) const {
+    return std::sqrt(1.0 / n + (t - t_mean) * (t - t_mean) / std::max(sxx, 1e-12));
+  }
+  double SlopeSd() const { return 1.0 / std::sqrt(std::max(sxx, 1e-12)); }
+};
+
+GravityLine FitGravityLine(const std::vector<BallSample>& track, const std::vector<int>& idx,
+                           double g, double t_ref) {
+  GravityLine L;
+  L.t_ref = t_ref;
+  L.n = static_cast<int>(idx.size());
+  if (idx.empty()) return L;
+  auto q = [&](int i) {
+    const double dt = track[i].time_s - t_ref;
+    Eigen::Vector3d v = track[i].ball_in_world;
+    v.z() += 0.5 * g * dt * dt;
+    return v;
+  };
+  double tm = 0;
+  Eigen::Vector3d qm = Eigen::Vector3d::Zero();
+  for (int i : idx) {
+    tm += track[i].time_s;
+    qm += q(i);
+  }
+  tm /= L.n;
+  qm /= L.n;
+  double sxx = 0;
+  Eigen::Vector3d sxq = Eigen::Vector3d::Zero();
+  for (int i : idx) {
+    const double d = track[i].time_s - tm;
+    sxx += d * d;
+    sxq += d * (q(i) - qm);
+  }
+  L.t_mean = tm;
+  L.sxx = sxx;
+  L.b = sxx > 1e-12 ? Eigen::Vector3d(sxq / sxx) : Eigen::Vector3d::Zero();
+  L.a = qm + L.b * (t_ref - tm);
+  for (int i : idx) {
+    const Eigen::Vector3d r = q(i) - (L.a + L.b * (track[i].time_s - t_ref));
+    L.sse += r.squaredNorm();
+  }
+  return L;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+// Indices of up to `want` and at least `min_n` samples from `list` next to position `pos`
+// (inclusive), going backwards (dir = -1) or forwards (+1), not beyond list positions [lo, hi),
+// preferring those within window_s of the first.
+std::vector<int> Window(const std::vector<int>& list, const std::vector<BallSample>& track, int pos,
+                        int dir, int lo, int hi, double window_s, int min_n) {
+  std::vector<int> out;
+  if (pos < lo || pos >= hi) return out;
+  const double t0 = track[list[pos]].time_s;
+  for (int p = pos; p >= lo && p < hi; p += dir) {
+    const double dt = std::abs(track[list[p]].time_s - t0);
+    if (dt > window_s && static_cast<int>(out.size()) >= min_n) break;
+    if (dt > 3 * window_s) break;
+    out.push_back(list[p]);
+  }
+  if (dir < 0) std::reverse(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// BallisticModel
+
+void BallisticModel::StateAt(double time_s, Eigen::Vector3d* p_m, Eigen::Vector3d* v_mps) const {
+  const double dt = time_s - t0_s;
+  if (drag_per_m == 0.0) {
+    Eigen::Vector3d p = p0_m + v0_mps * dt;
+    p.z() -= 0.5 * gravity_mps2 * dt * dt;
+    Eigen::Vector3d v = v0_mps;
+    v.z() -= gravity_mps2 * dt;
+    if (p_m) *p_m = p;
+    if (v_mps) *v_mps = v;
+    return;
+  }
+  double p[3] = {p0_m.x(), p0_m.y(), p0_m.z()};
+  double v[3] = {v0_mps.x(), v0_mps.y(), v0_mps.z()};
+  Propagate(p, v, drag_per_m, gravity_mps2, dt);
+  if (p_m) *p_m = Eigen::Vector3d(p[0], p[1], p[2]);
+  if (v_mps) *v_mps = Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::Vector3d BallisticModel::PositionAt(double time_s) const {
+  Eigen::Vector3d p;
+  StateAt(time_s, &p, nullptr);
+  return p;
+}
+
+Eigen::Vector3d BallisticModel::VelocityAt(double time_s) const {
+  Eigen::Vector3d v;
+  StateAt(time_s, nullptr, &v);
+  return v;
+}
+
+std::optional<double> BallisticModel::CrossingTime(double z_m, double from_s, bool forward,
+                                                   double max_s) const {
+  // The height is unimodal in time (vz only decreases while positive and stays negative), so the
+  // ascending crossing lies before the apex and the descending one after it. Walks in small
+  // steps: first to the apex if from_s is on the other side of it, then away from the apex (or
+  // back towards it when already below z_m).
+  const double h = (forward ? 1.0 : -1.0) * (drag_per_m == 0.0 ? 0.005 : kMaxStepS);
+  Eigen::Vector3d p, v;
+  StateAt(from_s, &p, &v);
+  double t = from_s;
+  auto step = [&](double dt) {
+    if (drag_per_m == 0.0) {
+      p += v * dt;
+      p.z() -= 0.5 * gravity_mps2 * dt * dt;
+      v.z() -= gravity_mps2 * dt;
+    } else {
+      double pa[3] = {p.x(), p.y(), p.z()}, va[3] = {v.x(), v.y(), v.z()};
+      Rk4Step(pa, va, drag_per_m, gravity_mps2, dt);
+      p = {pa[0], pa[1], pa[2]};
+      v = {va[0], va[1], va[2]};
+    }
+    t += dt;
+  };
+  // Beyond the apex side: ascending side has vz > 0 (forward in time: descending, vz < 0).
+  auto before_apex = [&] { return forward ? v.z() > 0 : v.z() < 0; };
+  bool moved = false;
+  while (before_apex() && std::abs(t - from_s) < max_s) {
+    step(h);
+    moved = true;
+  }
+  const double dir = p.z() >= z_m ? 1.0 : -1.0;  // -1: walk back towards the apex
+  if (dir < 0 && moved) return std::nullopt;     // the apex is below z_m
+  while (std::abs(t - from_s) < max_s) {
+    const double z_prev = p.z(), t_prev = t;
+    step(dir * h);
+    if ((p.z() - z_m) * (z_prev - z_m) <= 0 && p.z() != z_prev) {
+      // Newton steps from the interpolated crossing.
+      double tc = t_prev + (z_m - z_prev) / (p.z() - z_prev) * (t - t_prev);
+      for (int it = 0; it < 4; ++it) {
+        Eigen::Vector3d pc, vc;
+        StateAt(tc, &pc, &vc);
+        if (std::abs(vc.z()) < 1e-9) break;
+        tc -= (pc.z() - z_m) / vc.z();
+      }
+      return tc;
+    }
+    if (dir < 0 && before_apex()) return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+DragMode ParseDragMode(const std::string& s, const std::string& context) {
+  if (s == "off") return DragMode::kOff;
+  if (s == "on") return DragMode::kOn;
+  if (s == "auto") return DragMode::kAuto;
+  Throw("{}: drag mode must be off, on or auto (got '{}')", context, s);
+}
+
+const char* DragModeName(DragMode m) {
+  switch (m) {
+    case DragMode::kOff:
+      return "off";
+    case DragMode::kOn:
+      return "on";
+    default:
+      return "auto";
+  }
+}
+
+const char* FlightEventName(FlightEvent e) {
+  switch (e) {
+    case FlightEvent::kBounce:
+      return "bounce";
+    case FlightEvent::kGround:
+      return "ground";
+    case FlightEvent::kHit:
+      return "hit";
+    case FlightEvent::kTrackStart:
+      return "track start";
+    default:
+      return "track end";
+  }
+}
+
+void TrajectoryOptions::Check() const {
+  CheckPositive(gravity_mps2, "gravity_mps2");
+  CheckPositive(ball_radius_m, "ball_radius_m");
+  CheckFinite(ground_z_m, "ground_z_m");
+  CheckNonNegative(noise_m, "noise_m");
+  CheckPositive(window_s, "window_s");
+  FV_REQUIRE(window_samples >= 3, "window_samples must be >= 3 (got {})", window_samples);
+  CheckNonNegative(min_velocity_change_mps, "min_velocity_change_mps");
+  CheckPositive(break_sigmas, "break_sigmas");
+  CheckPositive(outlier_sigmas, "outlier_sigmas");
+  CheckNonNegative(min_outlier_m, "min_outlier_m");
+  CheckNonNegative(ground_tolerance_m, "ground_tolerance_m");
+  CheckNonNegative(min_ground_s, "min_ground_s");
+  CheckPositive(max_gap_s, "max_gap_s");
+  FV_REQUIRE(min_flight_samples >= 3, "min_flight_samples must be >= 3 (got {})",
+             min_flight_samples);
+  CheckPositive(max_drag_per_m, "max_drag_per_m");
+  FV_REQUIRE(max_iterations >= 1, "max_iterations must be >= 1 (got {})", max_iterations);
+}
+
+double EstimateTrackNoise(const std::vector<BallSample>& track, double g) {
+  // Normalised second differences of q = p + (0, 0, g t^2 / 2): zero for a drag-free arc, noise
+  // with the sample's sigma otherwise; the median absolute value is robust to bounces and hits.
+  std::vector<double> e;
+  for (size_t i = 1; i + 1 < track.size(); ++i) {
+    const double h1 = track[i].time_s - track[i - 1].time_s;
+    const double h2 = track[i + 1].time_s - track[i].time_s;
+    if (h1 <= 0 || h2 <= 0) continue;
+    const double t0 = track[i].time_s;
+    auto q = [&](size_t j) {
+      Eigen::Vector3d v = track[j].ball_in_world;
+      const double dt = track[j].time_s - t0;
+      v.z() += 0.5 * g * dt * dt;
+      return v;
+    };
+    const Eigen::Vector3d d = (q(i + 1) - q(i)) / h2 - (q(i) - q(i - 1)) / h1;
+    const double w = std::sqrt(1 / (h2 * h2) + std::pow(1 / h1 + 1 / h2, 2) + 1 / (h1 * h1));
+    for (int a = 0; a < 3; ++a) e.push_back(std::abs(d[a]) / w);
+  }
+  if (e.empty()) return 0.01;
+  return std::max(1e-3, 1.4826 * Median(e));
+}
+
+BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
+                          const TrajectoryOptions& options, double noise_m) {
+  BallisticFit fit;
+  const int n = static_cast<int>(samples.size());
+  fit.inlier.assign(n, false);
+  if (n < 3) return fit;
+  const double g = options.gravity_mps2;
+  const double t_ref = samples[n / 2].time_s;
+  std::vector<int> all(n);
+  std::iota(all.begin(), all.end(), 0);
+  const GravityLine line = FitGravityLine(samples, all, g, t_ref);
+  double p0[3] = {line.a.x(), line.a.y(), line.a.z()};
+  double v0[3] = {line.b.x(), line.b.y(), line.b.z()};
+  double k[1] = {fit_drag ? 0.01 : 0.0};
+  const double huber = 3.0 * std::max(noise_m, 1e-3);
+  auto solve = [&](bool drag) {
+    ceres::Problem problem;
+    for (const auto& s : samples) {
+      auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 3, 3, 1>(
+          new SampleResidual(s.ball_in_world, s.time_s - t_ref, g, drag));
+      problem.AddResidualBlock(cost, new ceres::HuberLoss(huber), p0, v0, k);
+    }
+    if (drag) {
+      problem.SetParameterLowerBound(k, 0, 0.0);
+      problem.SetParameterUpperBound(k, 0, options.max_drag_per_m);
+    } else {
+      problem.SetParameterBlockConstant(k);
+    }
+    ceres::Solver::Options so;
+    so.max_num_iterations = options.max_iterations;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    fit.iterations += static_cast<int>(summary.iterations.size());
+    return summary.IsSolutionUsable();
+  };
+  bool ok = solve(false);
+  if (fit_drag && ok) ok = solve(true);
+  fit.model.t0_s = t_ref;
+  fit.model.p0_m = Eigen::Vector3d(p0[0], p0[1], p0[2]);
+  fit.model.v0_mps = Eigen::Vector3d(v0[0], v0[1], v0[2]);
+  fit.model.gravity_mps2 = g;
+  fit.model.drag_per_m = fit_drag ? k[0] : 0.0;
+  // Residuals: rmse over all samples given; inliers by a robust threshold.
+  std::vector<double> r(n);
+  double ss = 0;
+  if (fit.model.drag_per_m == 0.0) {
+    for (int i = 0; i < n; ++i)
+      r[i] = (fit.model.PositionAt(samples[i].time_s) - samples[i].ball_in_world).norm();
+  } else {
+    // Walk once through the samples (sorted by time) in both directions from t_ref.
+    Eigen::Vector3d p, v;
+    for (int dir : {1, -1}) {
+      fit.model.StateAt(t_ref, &p, &v);
+      double t = t_ref;
+      for (int i = n / 2; i >= 0 && i < n; i += dir) {
+        double pa[3] = {p.x(), p.y(), p.z()}, va[3] = {v.x(), v.y(), v.z()};
+        Propagate(pa, va, fit.model.drag_per_m, g, samples[i].time_s - t);
+        p = {pa[0], pa[1], pa[2]};
+        v = {va[0], va[1], va[2]};
+        t = samples[i].time_s;
+        r[i] = (p - samples[i].ball_in_world).norm();
+      }
+    }
+  }
+  for (double x : r) ss += x * x;
+  fit.rmse_m = std::sqrt(ss / n);
+  const double robust_sigma = 1.4826 * Median(r) / std::sqrt(3.0);
+  const double thr =
+      std::max(options.outlier_sigmas * std::max(noise_m, robust_sigma), options.min_outlier_m);
+  for (int i = 0; i < n; ++i) {
+    fit.inlier[i] = r[i] <= thr;
+    fit.inliers += fit.inlier[i];
+  }
+  fit.ok = ok && std::isfinite(fit.rmse_m);
+  return fit;
+}
+
+PlaneQuadraticFit FitPlaneQuadratic(const std::vector<BallSample>& samples,
+                                    const TrajectoryOptions& options) {
+  PlaneQuadraticFit f;
+  const int n = static_cast<int>(samples.size());
+  if (n < 3) {
+    f.failure = "fewer than 3 points";
+    return f;
+  }
+  const Eigen::Vector2d xy0 = samples.front().ball_in_world.head<2>();
+  Eigen::Vector2d d = samples.back().ball_in_world.head<2>() - xy0;
+  if (d.norm() < 0.05) {
+    f.failure = "vertical flight (no horizontal direction)";
+    return f;
+  }
+  d.normalize();
+  const Eigen::Vector2d nrm(-d.y(), d.x());
+  auto s_of = [&](const BallSample& b) { return (b.ball_in_world.head<2>() - xy0).dot(d); };
+  // The seed: the quadratic through the last three points.
+  Eigen::Matrix3d A3;
+  Eigen::Vector3d z3;
+  for (int j = 0; j < 3; ++j) {
+    const double s = s_of(samples[n - 3 + j]);
+    A3.row(j) << s * s, s, 1;
+    z3[j] = samples[n - 3 + j].ball_in_world.z();
+  }
+  Eigen::Vector3d c = A3.colPivHouseholderQr().solve(z3);
+  // Refined with all points (linear least squares).
+  Eigen::MatrixXd A(n, 3);
+  Eigen::VectorXd z(n), tt(n);
+  Eigen::MatrixXd B(n, 2);
+  for (int i = 0; i < n; ++i) {
+    const double s = s_of(samples[i]);
+    A.row(i) << s * s, s, 1;
+    z[i] = samples[i].ball_in_world.z();
+    B.row(i) << s, 1;
+    tt[i] = samples[i].time_s;
+  }
+  const Eigen::Vector3d c_ls = A.colPivHouseholderQr().solve(z);
+  if (c_ls.allFinite()) c = c_ls;
+  const Eigen::Vector2d ts = B.colPivHouseholderQr().solve(tt);  // t = ts0 s + ts1
+  // Lateral offset of the plane: mean of the perpendicular coordinate.
+  double off = 0;
+  for (const auto& b : samples) off += (b.ball_in_world.head<2>() - xy0).dot(nrm);
+  off /= n;
+  double ss = 0;
+  for (int i = 0; i < n; ++i) {
+    const double s = s_of(samples[i]);
+    const double perp = (samples[i].ball_in_world.head<2>() - xy0).dot(nrm) - off;
+    const double dz = z[i] - (c[0] * s * s + c[1] * s + c[2]);
+    ss += perp * perp + dz * dz;
+  }
+  f.rmse_m = std::sqrt(ss / n);
+  if (c[0] >= 0) {
+    f.failure = "curvature does not open downwards";
+    return f;
+  }
+  const double zr = options.ground_z_m + options.ball_radius_m;
+  const double disc = c[1] * c[1] - 4 * c[0] * (c[2] - zr);
+  if (disc < 0) {
+    f.failure = "arc never reaches the ground";
+    return f;
+  }
+  const double s1 = (-c[1] + std::sqrt(disc)) / (2 * c[0]);
+  const double s2 = (-c[1] - std::sqrt(disc)) / (2 * c[0]);
+  const double sa = -c[1] / (2 * c[0]);
+  auto point = [&](double s, double zz) {
+    const Eigen::Vector2d p = xy0 + s * d + off * nrm;
+    return Eigen::Vector3d(p.x(), p.y(), zz);
+  };
+  f.origin_m = point(std::min(s1, s2), zr);
+  f.landing_m = point(std::max(s1, s2), zr);
+  f.apex_m = point(sa, c[2] - c[1] * c[1] / (4 * c[0]));
+  f.t_origin_s = ts[0] * std::min(s1, s2) + ts[1];
+  f.t_landing_s = ts[0] * std::max(s1, s2) + ts[1];
+  f.gravity_mps2 = std::abs(ts[0]) > 1e-9 ? -2 * c[0] / (ts[0] * ts[0]) : 0.0;
+  f.ok = true;
+  return f;
+}
+
+std::string TrajectoryResult::Summary() const {
+  int outliers = static_cast<int>(std::count(outlier.begin(), outlier.end(), true));
+  int ground = static_cast<int>(std::count(on_ground.begin(), on_ground.end(), true));
+  int drag = 0;
+  for (const auto& f : flights) drag += f.drag_used;
+  return fmt::format(
+      "{} flights ({} with drag), {} bounces/hits, {} outliers, {} samples on the ground, "
+      "{} short hops, noise {:.1f} mm",
+      flights.size(), drag, breaks.size(), outliers, ground, short_hops, noise_m * 1e3);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Segmentation
+
+namespace {
+
+struct Segmenter {
+  const std::vector<BallSample>& track;
+  const TrajectoryOptions& o;
+  double sigma;
+
+  // Flags samples that both neighbouring local fits miss (two passes).
+  std::vector<bool> FindOutliers() const {
+    const int n = static_cast<int>(track.size());
+    std::vector<bool> out(n, false);
+    const double g = o.gravity_mps2;
+    for (int pass = 0; pass < 2; ++pass) {
+      std::vector<int> good;
+      for (int i = 0; i < n; ++i)
+        if (!out[i]) good.push_back(i);
+      std::vector<bool> next(n, false);
+      for (int i = 0; i < n; ++i) {
+        // Neighbours among the currently good samples, excluding i itself.
+        std::vector<int> list;
+        int pos = 0;  // position of i in list (the first of the right side)
+        for (int j : good) {
+          if (j == i) continue;
+          if (j < i) ++pos;
+          list.push_back(j);
+        }
+        const int m = static_cast<int>(list.size());
+        const auto left = Window(list, track, pos - 1, -1, 0, m, o.window_s, o.window_samples);
+        const auto right = Window(list, track, pos, +1, 0, m, o.window_s, o.window_samples);
+        int fits = 0, misses = 0;
+        for (const auto* w : {&left, &right}) {
+          if (static_cast<int>(w->size()) < o.window_samples) continue;
+          const double span_ok = std::abs(track[(*w)[w->size() / 2]].time_s - track[i].time_s);
+          if (span_ok > 3 * o.window_s) continue;
+          const GravityLine L = FitGravityLine(track, *w, g, track[i].time_s);
+          const double err = (L.At(track[i].time_s, g) - track[i].ball_in_world).norm();
+          const double thr = std::max(
+              o.min_outlier_m,
+              o.outlier_sigmas * sigma * std::sqrt(3.0) *
+                  std::sqrt(1 + L.PredictionSd(track[i].time_s) * L.PredictionSd(track[i].time_s)));
+          ++fits;
+          misses += err > thr;
+        }
+        next[i] = fits > 0 && misses == fits;
+      }
+      out = next;
+    }
+    return out;
+  }
+
+  // Samples in ground phases: within the tolerance of the resting height for min_ground_s.
+  std::vector<bool> FindGround(const std::vector<bool>& outlier) const {
+    const int n = static_cast<int>(track.size());
+    std::vector<bool> ground(n, false);
+    const double zr = o.ground_z_m + o.ball_radius_m;
+    const double tol = o.ground_tolerance_m + 3 * sigma;
+    int i = 0;
+    while (i < n) {
+      if (outlier[i] || track[i].ball_in_world.z() > zr + tol) {
+        ++i;
+        continue;
+      }
+      int j = i, last = i;
+      while (j < n && (outlier[j] || track[j].ball_in_world.z() <= zr + tol)) {
+        if (!outlier[j]) last = j;
+        if (j > i && track[j].time_s - track[j - 1].time_s > o.max_gap_s) break;
+        ++j;
+      }
+      if (track[last].time_s - track[i].time_s >= o.min_ground_s) {
+        for (int k = i; k <= last; ++k) ground[k] = !outlier[k];
+      }
+      i = std::max(j, i + 1);
+    }
+    return ground;
+  }
+
+  struct Candidate {
+    double ratio = 0.0;
+    int pos = -1;
+    double dv = 0.0;
+  };
+
+  // The velocity jump at the gap after list position k, windows limited to [lo, hi).
+  Candidate Score(const std::vector<int>& list, int k, int lo, int hi) const {
+    Candidate c;
+    const auto left = Window(list, track, k, -1, lo, hi, o.window_s, o.window_samples);
+    const auto right = Window(list, track, k + 1, +1, lo, hi, o.window_s, o.window_samples);
+    if (static_cast<int>(left.size()) < o.window_samples ||
+        static_cast<int>(right.size()) < o.window_samples)
+      return c;
+    const double g = o.gravity_mps2;
+    const double tc = 0.5 * (track[list[k]].time_s + track[list[k + 1]].time_s);
+    const GravityLine L = FitGravityLine(track, left, g, tc);
+    const GravityLine R = FitGravityLine(track, right, g, tc);
+    const double dv = (R.b - L.b).norm();
+    // Standard error of the jump (3D), plus a slack for unmodelled drag/spin (5 m/s^2 over
+    // the windows' half spans).
+    const double sd = sigma * std::sqrt(3.0) * std::hypot(L.SlopeSd(), R.SlopeSd());
+    const double span = track[right.back()].time_s - track[left.front()].time_s;
+    const double thr = std::max(o.min_velocity_change_mps, o.break_sigmas * sd + 5.0 * 0.5 * span);
+    c.ratio = dv / thr;
+    c.pos = k;
+    c.dv = dv;
+    return c;
+  }
+
+  // Sum of squared residuals of splitting list[a..b] after position k.
+  double SplitCost(const std::vector<int>& list, int a, int b, int k) const {
+    std::vector<int> l(list.begin() + a, list.begin() + k + 1);
+    std::vector<int> r(list.begin() + k + 1, list.begin() + b + 1);
+    if (l.size() < 2 || r.size() < 2) return std::numeric_limits<double>::infinity();
+    const double tc = track[list[k]].time_s;
+    return FitGravityLine(track, l, o.gravity_mps2, tc).sse +
+           FitGravityLine(track, r, o.gravity_mps2, tc).sse;
+  }
+
+  // Greedy: the largest jump above threshold becomes a break, until none is left.
+  std::vector<int> FindBreaks(const std::vector<int>& list, int lo, int hi) const {
+    std::vector<int> breaks;  // positions k: break between list[k] and list[k+1]
+    while (true) {
+      Candidate best;
+      for (int k = lo; k + 1 < hi; ++k) {
+        int a = lo, b = hi;
+        for (int br : breaks) {
+          if (br < k) a = std::max(a, br + 1);
+          if (br >= k + 1) b = std::min(b, br + 1);
+          if (br == k) a = hi;  // already a break
+        }
+        if (a >= b) continue;
+        const Candidate c = Score(list, k, a, b);
+        if (c.ratio > 1.0 && c.ratio > best.ratio) best = c;
+      }
+      if (best.pos < 0) break;
+      // Localise: the split of the neighbourhood with the least residual.
+      int a = std::max(lo, best.pos - 2 * o.window_samples);
+      int b = std::min(hi - 1, best.pos + 1 + 2 * o.window_samples);
+      for (int br : breaks) {
+        if (br < best.pos) a = std::max(a, br + 1);
+        if (br > best.pos) b = std::min(b, br);
+      }
+      int k_best = best.pos;
+      double c_best = SplitCost(list, a, b, best.pos);
+      for (int k = std::max(a + 1, best.pos - 2); k <= std::min(b - 2, best.pos + 2); ++k) {
+        if (std::find(breaks.begin(), breaks.end(), k) != breaks.end()) continue;
+        const double c = SplitCost(list, a, b, k);
+        if (c < c_best) {
+          c_best = c;
+          k_best = k;
+        }
+      }
+      breaks.push_back(k_best);
+      std::sort(breaks.begin(), breaks.end());
+    }
+    return breaks;
+  }
+};
+
+double ApexOf(const BallisticModel& m, double t0, double t1, double* t_apex) {
+  double best = -std::numeric_limits<double>::infinity();
+  const int steps = std::clamp(static_cast<int>((t1 - t0) / 0.002), 2, 2000);
+  Eigen::Vector3d p, v;
+  double t = t0;
+  m.StateAt(t0, &p, &v);
+  for (int s = 0; s <= steps; ++s) {
+    const double ts = t0 + (t1 - t0) * s / steps;
+    if (m.drag_per_m == 0.0) {
+      p = m.PositionAt(ts);
+    } else {
+      double pa[3] = {p.x(), p.y(), p.z()}, va[3] = {v.x(), v.y(), v.z()};
+      Propagate(pa, va, m.drag_per_m, m.gravity_mps2, ts - t);
+      p = {pa[0], pa[1], pa[2]};
+      v = {va[0], va[1], va[2]};
+      t = ts;
+    }
+    if (p.z() > best) {
+      best = p.z();
+      *t_apex = ts;
+    }
+  }
+  return best;
+}
+
+// The time where two arcs are closest, searched around [t_a, t_b].
+double MeetingTime(const BallisticModel& a, const BallisticModel& b, double t_a, double t_b) {
+  const double lo = t_a - 0.05, hi = t_b + 0.05;
+  double best_t = 0.5 * (t_a + t_b), best = std::numeric_limits<double>::infinity();
+  const int steps = std::clamp(static_cast<int>((hi - lo) / 0.0005), 4, 4000);
+  for (int s = 0; s <= steps; ++s) {
+    const double t = lo + (hi - lo) * s / steps;
+    const double d = (a.PositionAt(t) - b.PositionAt(t)).norm();
+    if (d < best) {
+      best = d;
+      best_t = t;
+    }
+  }
+  return best_t;
+}
+
+}  // namespace
+
+TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
+                                   const TrajectoryOptions& options) {
+  options.Check();
+  for (size_t i = 1; i < track.size(); ++i) {
+    FV_REQUIRE(track[i].time_s > track[i - 1].time_s,
+               "ball track: times must increase (sample {} at {} s follows {} s)", i,
+               track[i].time_s, track[i - 1].time_s);
+  }
+  TrajectoryResult res;
+  const int n = static_cast<int>(track.size());
+  res.outlier.assign(n, false);
+  res.on_ground.assign(n, false);
+  res.noise_m =
+      options.noise_m > 0 ? options.noise_m : EstimateTrackNoise(track, options.gravity_mps2);
+  if (n < 3) return res;
+  const Segmenter seg{track, options, res.noise_m};
+  res.outlier = seg.FindOutliers();
+  res.on_ground = seg.FindGround(res.outlier);
+
+  // Airborne inliers, cut into blocks at ground phases and long gaps.
+  std::vector<int> air;
+  for (int i = 0; i < n; ++i)
+    if (!res.outlier[i] && !res.on_ground[i]) air.push_back(i);
+  struct Piece {
+    int a, b;  // positions in `air`, inclusive
+    FlightEvent start, end;
+  };
+  std::vector<Piece> pieces;
+  const double zr = options.ground_z_m + options.ball_radius_m;
+  auto ground_in = [&](int i0, int i1) {  // any ground sample in [i0, i1)
+    for (int k = std::max(i0, 0); k < std::min(i1, n); ++k)
+      if (res.on_ground[k]) return true;
+    return false;
+  };
+  int block_start = 0;
+  const int m = static_cast<int>(air.size());
+  for (int p = 0; p < m; ++p) {
+    const bool last = p + 1 == m;
+    const int next = last ? n : air[p + 1];
+    const bool cut = last || ground_in(air[p] + 1, next) ||
+                     track[next].time_s - track[air[p]].time_s > options.max_gap_s;
+    if (!cut) continue;
+    const int prev = block_start == 0 ? 0 : air[block_start - 1] + 1;
+    const FlightEvent start_ev =
+        ground_in(prev, air[block_start]) ? FlightEvent::kGround : FlightEvent::kTrackStart;
+    const FlightEvent end_ev =
+        ground_in(air[p] + 1, next) ? FlightEvent::kGround : FlightEvent::kTrackEnd;
+    const std::vector<int> brk = seg.FindBreaks(air, block_start, p + 1);
+    int a = block_start;
+    FlightEvent ev = start_ev;
+    for (int br : brk) {
+      pieces.push_back({a, br, ev, FlightEvent::kHit});
+      a = br + 1;
+      ev = FlightEvent::kHit;  // bounce or hit: decided from the fitted arcs below
+    }
+    pieces.push_back({a, p, ev, end_ev});
+    block_start = p + 1;
+  }
+
+  // Fit the pieces.
+  std::vector<Flight> flights;
+  std::vector<int> piece_of_flight;
+  std::vector<std::pair<double, double>> limits;  // contact times lie within these
+  for (size_t pi = 0; pi < pieces.size(); ++pi) {
+    const Piece& pc = pieces[pi];
+    const int count = pc.b - pc.a + 1;
+    if (count < options.min_flight_samples) {
+      ++res.short_hops;
+      continue;
+    }
+    std::vector<BallSample> s;
+    Flight f;
+    for (int p = pc.a; p <= pc.b; ++p) {
+      s.push_back(track[air[p]]);
+      f.samples.push_back(air[p]);
+    }
+    f.start_event = pc.start;
+    f.end_event = pc.end;
+    f.no_drag = FitBallistic(s, false, options, res.noise_m);
+    // Leading and trailing samples the arc misses belong to a neighbouring hop too short to be
+    // split off by the local fits: drop them and fit again.
+    {
+      int lead = 0, trail = 0;
+      const int ns = static_cast<int>(s.size());
+      while (lead < ns && !f.no_drag.inlier[lead]) ++lead;
+      while (trail < ns - lead && !f.no_drag.inlier[ns - 1 - trail]) ++trail;
+      if ((lead > 0 || trail > 0) && ns - lead - trail >= options.min_flight_samples) {
+        s = std::vector<BallSample>(s.begin() + lead, s.end() - trail);
+        f.samples = std::vector<int>(f.samples.begin() + lead, f.samples.end() - trail);
+        f.no_drag = FitBallistic(s, false, options, res.noise_m);
+        if (lead > 0) f.start_event = FlightEvent::kGround;
+        if (trail > 0) f.end_event = FlightEvent::kGround;
+        ++res.short_hops;
+      }
+    }
+    // Samples of the neighbouring ground phase that lie on the arc (the approach to a contact
+    // within the ground tolerance) join it; the first one that does not bounds the contact time.
+    double lo = -std::numeric_limits<double>::infinity();
+    double hi = std::numeric_limits<double>::infinity();
+    {
+      const double thr =
+          std::max(options.outlier_sigmas * res.noise_m * std::sqrt(3.0), options.min_outlier_m);
+      auto consistent = [&](int k) {
+        return (f.no_drag.model.PositionAt(track[k].time_s) - track[k].ball_in_world).norm() <= thr;
+      };
+      bool added = false;
+      for (int k = f.samples.front() - 1; k >= 0; --k) {
+        if (res.outlier[k]) continue;
+        if (!res.on_ground[k] || !consistent(k)) {
+          lo = track[k].time_s;
+          break;
+        }
+        f.samples.insert(f.samples.begin(), k);
+        res.on_ground[k] = false;
+        added = true;
+      }
+      for (int k = f.samples.back() + 1; k < n; ++k) {
+        if (res.outlier[k]) continue;
+        if (!res.on_ground[k] || !consistent(k)) {
+          hi = track[k].time_s;
+          break;
+        }
+        f.samples.push_back(k);
+        res.on_ground[k] = false;
+        added = true;
+      }
+      if (added) {
+        s.clear();
+        for (int k : f.samples) s.push_back(track[k]);
+        f.no_drag = FitBallistic(s, false, options, res.noise_m);
+      }
+    }
+    f.t_first_seen_s = s.front().time_s;
+    f.t_last_seen_s = s.back().time_s;
+    const double span = f.t_last_seen_s - f.t_first_seen_s;
+    const bool try_drag = options.drag == DragMode::kOn ||
+                          (options.drag == DragMode::kAuto && count >= 8 && span >= 0.15);
+    if (try_drag) f.with_drag = FitBallistic(s, true, options, res.noise_m);
+    f.drag_used = f.with_drag.ok &&
+                  (options.drag == DragMode::kOn || f.with_drag.rmse_m < 0.9 * f.no_drag.rmse_m);
+    if (!f.no_drag.ok && !f.drag_used) {
+      ++res.short_hops;
+      continue;
+    }
+    f.rmse_m = f.drag_used ? f.with_drag.rmse_m : f.no_drag.rmse_m;
+    f.seed = FitPlaneQuadratic(s, options);
+    flights.push_back(std::move(f));
+    piece_of_flight.push_back(static_cast<int>(pi));
+    limits.emplace_back(lo, hi);
+  }
+
+  // Events between consecutive pieces that are both fitted: bounce or hit, with the contact time
+  // where the two arcs meet.
+  const double ground_tol = options.ground_tolerance_m + 3 * res.noise_m + 0.05;
+  for (size_t i = 0; i + 1 < flights.size(); ++i) {
+    Flight& A = flights[i];
+    Flight& B = flights[i + 1];
+    if (piece_of_flight[i + 1] != piece_of_flight[i] + 1) continue;
+    if (A.end_event != FlightEvent::kHit || B.start_event != FlightEvent::kHit) {
+      // One side was trimmed: the contact is not resolved between these two.
+      if (A.end_event == FlightEvent::kHit) A.end_event = FlightEvent::kGround;
+      if (B.start_event == FlightEvent::kHit) B.start_event = FlightEvent::kGround;
+      continue;
+    }
+    const double tm = MeetingTime(A.model(), B.model(), A.t_last_seen_s, B.t_first_seen_s);
+    const Eigen::Vector3d pa = A.model().PositionAt(tm);
+    const Eigen::Vector3d va = A.model().VelocityAt(tm);
+    const Eigen::Vector3d vb = B.model().VelocityAt(tm);
+    TrackBreak br;
+    br.time_s = tm;
+    br.ball_in_world = 0.5 * (pa + B.model().PositionAt(tm));
+    br.velocity_change_mps = (vb - va).norm();
+    br.kind = (br.ball_in_world.z() < zr + ground_tol && va.z() < 0 && vb.z() > 0)
+                  ? FlightEvent::kBounce
+                  : FlightEvent::kHit;
+    A.end_event = br.kind;
+    B.start_event = br.kind;
+    if (br.kind == FlightEvent::kHit) {
+      A.t_end_s = tm;
+      B.t_start_s = tm;
+    }
+    res.breaks.push_back(br);
+  }
+  // A break next to a hop too short to fit: the contact is not resolved; treat it as a ground
+  // contact (origin and landing from the arc's own crossing of the ground level).
+  for (size_t i = 0; i < flights.size(); ++i) {
+    const bool prev_fitted = i > 0 && piece_of_flight[i - 1] + 1 == piece_of_flight[i];
+    const bool next_fitted =
+        i + 1 < flights.size() && piece_of_flight[i + 1] == piece_of_flight[i] + 1;
+    if (flights[i].start_event == FlightEvent::kHit && !prev_fitted)
+      flights[i].start_event = FlightEvent::kGround;
+    if (flights[i].end_event == FlightEvent::kHit && !next_fitted)
+      flights[i].end_event = FlightEvent::kGround;
+  }
+
+  // Origins, landings, apex, v0.
+  for (size_t i = 0; i < flights.size(); ++i) {
+    Flight& f = flights[i];
+    f.index = static_cast<int>(i);
+    const BallisticModel& mdl = f.model();
+    if (f.start_event == FlightEvent::kHit) {
+      f.origin_m = mdl.PositionAt(f.t_start_s);
+    } else {
+      const auto t0 = mdl.CrossingTime(zr, f.t_first_seen_s, false, 10.0);
+      f.t_start_s = t0 ? *t0 : f.t_first_seen_s;
+      // Kicked while rolling or hopping low: the arc starts after the last sample off it.
+      if (f.start_event == FlightEvent::kGround)
+        f.t_start_s = std::max(f.t_start_s, limits[i].first);
+      f.origin_m = mdl.PositionAt(f.t_start_s);
+    }
+    const auto t1 = mdl.CrossingTime(zr, f.t_last_seen_s, true, 10.0);
+    f.t_landing_s = t1 ? *t1 : f.t_last_seen_s;
+    if (f.end_event == FlightEvent::kGround)
+      f.t_landing_s = std::min(f.t_landing_s, limits[i].second);
+    f.landing_m = mdl.PositionAt(f.t_landing_s);
+    if (f.end_event != FlightEvent::kHit) f.t_end_s = f.t_landing_s;
+    f.origin_extrapolated = f.start_event == FlightEvent::kTrackStart;
+    f.landing_extrapolated =
+        f.end_event == FlightEvent::kHit || f.end_event == FlightEvent::kTrackEnd;
+    f.v0_mps = mdl.VelocityAt(f.t_start_s);
+    f.speed_mps = f.v0_mps.norm();
+    f.apex_m = mdl.PositionAt(f.t_start_s);
+    ApexOf(mdl, f.t_start_s, f.t_end_s, &f.t_apex_s);
+    f.apex_m = mdl.PositionAt(f.t_apex_s);
+  }
+  // A bounce is one point on the ground: combine the landing of the arc before and the origin
+  // of the arc after, weighted by the inverse extrapolation variance of each (leverage of the
+  // contact time in each arc's gravity fit).
+  for (size_t i = 0; i + 1 < flights.size(); ++i) {
+    Flight& A = flights[i];
+    Flight& B = flights[i + 1];
+    if (A.end_event != FlightEvent::kBounce || B.start_event != FlightEvent::kBounce) continue;
+    const double tc = 0.5 * (A.t_landing_s + B.t_start_s);
+    const double la =
+        FitGravityLine(track, A.samples, options.gravity_mps2, tc).PredictionSd(A.t_landing_s);
+    const double lb =
+        FitGravityLine(track, B.samples, options.gravity_mps2, tc).PredictionSd(B.t_start_s);
+    const double wa = 1 / (la * la), wb = 1 / (lb * lb);
+    const Eigen::Vector3d c = (wa * A.landing_m + wb * B.origin_m) / (wa + wb);
+    const double t = (wa * A.t_landing_s + wb * B.t_start_s) / (wa + wb);
+    A.landing_m = B.origin_m = c;
+    A.t_landing_s = A.t_end_s = B.t_start_s = t;
+    B.v0_mps = B.model().VelocityAt(t);
+    B.speed_mps = B.v0_mps.norm();
+  }
+  for (Flight& f : flights) {
+    // Outliers inside the flight's span belong to it (for the pictures).
+    for (int k = 0; k < n; ++k) {
+      if (res.outlier[k] && track[k].time_s >= f.t_first_seen_s &&
+          track[k].time_s <= f.t_last_seen_s)
+        f.samples.push_back(k);
+    }
+    std::sort(f.samples.begin(), f.samples.end());
+  }
+  res.flights = std::move(flights);
+  return res;
+}
+
+}  // namespace fv

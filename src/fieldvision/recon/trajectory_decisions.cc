@@ -1,0 +1,225 @@
+#include "fieldvision/recon/trajectory_decisions.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv {
+namespace {
+
+// Signed distance of p to the rectangle |x| <= hx, |y| <= hy: > 0 inside.
+double InsideDistance(const Eigen::Vector2d& p, double hx, double hy) {
+  const double dx = std::abs(p.x()) - hx, dy = std::abs(p.y()) - hy;
+  if (dx <= 0 && dy <= 0) return -std::max(dx, dy);
+  return -std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
+}
+
+double R4(double v) { return std::round(v * 1e4) / 1e4; }
+
+}  // namespace
+
+void DecisionOptions::Check() const {
+  FV_REQUIRE(rule == "auto" || rule == "football" || rule == "tennis" || rule == "basketball",
+             "decision rule must be auto, football, tennis or basketball (got '{}')", rule);
+  CheckNonNegative(contact_patch_m, "contact_patch_m");
+  CheckInRange(time_step_s, 1e-5, 0.1, "time_step_s");
+}
+
+Eigen::Vector3d BallPathAt(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                           double time_s, int* flight) {
+  for (const auto& f : result.flights) {
+    if (time_s >= f.t_start_s && time_s <= f.t_end_s) {
+      if (flight) *flight = f.index;
+      return f.model().PositionAt(time_s);
+    }
+  }
+  if (flight) *flight = -1;
+  // Linear between the nearest non-outlier samples.
+  int before = -1, after = -1;
+  for (int i = 0; i < static_cast<int>(track.size()); ++i) {
+    if (result.outlier.size() == track.size() && result.outlier[i]) continue;
+    if (track[i].time_s <= time_s) before = i;
+    if (track[i].time_s >= time_s) {
+      after = i;
+      break;
+    }
+  }
+  if (before < 0) return after < 0 ? Eigen::Vector3d::Zero() : track[after].ball_in_world;
+  if (after < 0 || after == before) return track[before].ball_in_world;
+  const double f = (time_s - track[before].time_s) / (track[after].time_s - track[before].time_s);
+  return (1 - f) * track[before].ball_in_world + f * track[after].ball_in_world;
+}
+
+Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                        const FieldModel* field, const TrajectoryOptions& o,
+                        const DecisionOptions& d) {
+  d.Check();
+  Decisions out;
+  const double r = o.ball_radius_m;
+  for (const auto& f : result.flights) {
+    std::string what;
+    switch (f.start_event) {
+      case FlightEvent::kBounce:
+        what = "bounce";
+        break;
+      case FlightEvent::kHit:
+        what = "hit/kick in the air";
+        break;
+      case FlightEvent::kGround:
+        what = "kick/hit from the ground";
+        break;
+      default:
+        what = "flight already under way";
+    }
+    out.timeline.push_back(
+        {f.t_start_s, fmt::format("flight {}: {} at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, "
+                                  "apex {:.2f} m, flight time {:.2f} s",
+                                  f.index, what, f.origin_m.x(), f.origin_m.y(), f.origin_m.z(),
+                                  f.speed_mps, f.apex_m.z(), f.FlightTime())});
+    if (f.end_event == FlightEvent::kHit) {
+      out.timeline.push_back({f.t_end_s, fmt::format("flight {}: hit at ({:.2f}, {:.2f}, {:.2f}) m",
+                                                     f.index, f.model().PositionAt(f.t_end_s).x(),
+                                                     f.model().PositionAt(f.t_end_s).y(),
+                                                     f.model().PositionAt(f.t_end_s).z())});
+    }
+  }
+  if (field && field->length_m > 0) {
+    std::string rule = d.rule;
+    if (rule == "auto") {
+      const std::string n = ToLower(field->name);
+      rule = n.find("tennis") != std::string::npos       ? "tennis"
+             : n.find("basketball") != std::string::npos ? "basketball"
+                                                         : "football";
+    }
+    out.rule = rule;
+    for (const auto& name : d.lines) {
+      bool found = false;
+      for (const auto& s : field->segments) found |= s.name == name;
+      FV_REQUIRE(found, "field '{}' has no line named '{}' (see `fieldvision field show {}`)",
+                 field->name, name, field->name);
+    }
+    for (const auto& f : result.flights) {
+      LandingCall c;
+      c.flight = f.index;
+      c.time_s = f.t_landing_s;
+      c.point_m = f.landing_m.head<2>();
+      c.extrapolated = f.landing_extrapolated;
+      c.against = "playing area";
+      const double din = InsideDistance(c.point_m, 0.5 * field->length_m, 0.5 * field->width_m);
+      // football: any part of the ball's projection over the area or its lines; tennis: the
+      // contact patch touches the area (lines are in); basketball: the patch clear of the lines
+      // (the area's edge is the lines' inner edge).
+      c.margin_m = rule == "football" ? din + r
+                   : rule == "tennis" ? din + d.contact_patch_m
+                                      : din - d.contact_patch_m;
+      c.in = c.margin_m >= 0;
+      out.landings.push_back(c);
+      for (const auto& name : d.lines) {
+        double gap = 1e9;
+        for (const auto& s : field->segments) {
+          if (s.name != name) continue;
+          gap = std::min(gap, DistanceToSegment(c.point_m, s.a, s.b) - 0.5 * s.width_m);
+        }
+        LandingCall lc = c;
+        lc.against = name;
+        const double patch = rule == "football" ? r : d.contact_patch_m;
+        lc.margin_m = patch - gap;  // > 0: the ball touches the line
+        lc.in = lc.margin_m >= 0;
+        out.landings.push_back(lc);
+      }
+    }
+    for (const auto& c : out.landings) {
+      out.timeline.push_back(
+          {c.time_s,
+           fmt::format("flight {}: {}lands at ({:.2f}, {:.2f}) m: {} {} by {:.3f} m", c.flight,
+                       c.extrapolated ? "would have " : "", c.point_m.x(), c.point_m.y(),
+                       c.against == "playing area" ? (c.in ? "IN" : "OUT")
+                                                   : (c.in ? "TOUCHES" : "CLEAR OF"),
+                       c.against, std::abs(c.margin_m))});
+    }
+    // Scan the ball's path for goal-line crossings and made shots.
+    if (!track.empty() && (!field->goals.empty() || !field->hoops.empty())) {
+      const double t0 = track.front().time_s, t1 = track.back().time_s;
+      std::vector<bool> was_in(field->goals.size(), false);
+      Eigen::Vector3d prev = BallPathAt(track, result, t0);
+      for (double t = t0 + d.time_step_s; t <= t1; t += d.time_step_s) {
+        int fl = -1;
+        const Eigen::Vector3d p = BallPathAt(track, result, t, &fl);
+        for (size_t g = 0; g < field->goals.size(); ++g) {
+          const FieldGoal& goal = field->goals[g];
+          const bool beyond = goal.side * (p.x() - goal.line_x_m) > 0.5 * field->line_width_m + r;
+          const bool inside = beyond && p.y() >= goal.y_min_m && p.y() <= goal.y_max_m &&
+                              p.z() <= goal.height_m && p.z() >= -r;
+          if (inside && !was_in[g]) {
+            out.goals.push_back({fl, goal.name, t, p});
+            out.timeline.push_back(
+                {t, fmt::format("GOAL: the whole ball crossed the line of {} at ({:.2f}, {:.2f}, "
+                                "{:.2f}) m",
+                                goal.name, p.x(), p.y(), p.z())});
+          }
+          was_in[g] = inside;
+        }
+        for (const auto& h : field->hoops) {
+          const double hz = h.centre_m.z();
+          if (prev.z() > hz && p.z() <= hz) {
+            const double f = (prev.z() - hz) / (prev.z() - p.z());
+            const Eigen::Vector3d c = prev + f * (p - prev);
+            const double off = (c.head<2>() - h.centre_m.head<2>()).norm();
+            if (off < h.radius_m) {
+              out.shots.push_back({fl, h.name, t, off, off < h.radius_m - r});
+              out.timeline.push_back(
+                  {t, fmt::format("MADE SHOT through {} ({} {:.3f} m from the centre)", h.name,
+                                  off < h.radius_m - r ? "clean," : "touching the ring,", off)});
+            }
+          }
+        }
+        prev = p;
+      }
+    }
+  }
+  std::stable_sort(
+      out.timeline.begin(), out.timeline.end(),
+      [](const TimelineEvent& a, const TimelineEvent& b) { return a.time_s < b.time_s; });
+  return out;
+}
+
+nlohmann::json Decisions::ToJson() const {
+  nlohmann::json j;
+  j["rule"] = rule;
+  j["landings"] = nlohmann::json::array();
+  for (const auto& c : landings) {
+    j["landings"].push_back({{"flight", c.flight},
+                             {"time_s", R4(c.time_s)},
+                             {"point", {R4(c.point_m.x()), R4(c.point_m.y())}},
+                             {"extrapolated", c.extrapolated},
+                             {"against", c.against},
+                             {c.against == "playing area" ? "in" : "touches", c.in},
+                             {"margin_m", R4(c.margin_m)}});
+  }
+  j["goal_crossings"] = nlohmann::json::array();
+  for (const auto& g : goals) {
+    j["goal_crossings"].push_back(
+        {{"flight", g.flight},
+         {"goal", g.goal},
+         {"time_s", R4(g.time_s)},
+         {"ball", {R4(g.ball_in_world.x()), R4(g.ball_in_world.y()), R4(g.ball_in_world.z())}}});
+  }
+  j["made_shots"] = nlohmann::json::array();
+  for (const auto& s : shots) {
+    j["made_shots"].push_back({{"flight", s.flight},
+                               {"hoop", s.hoop},
+                               {"time_s", R4(s.time_s)},
+                               {"offset_m", R4(s.offset_m)},
+                               {"clean", s.clean}});
+  }
+  j["timeline"] = nlohmann::json::array();
+  for (const auto& e : timeline)
+    j["timeline"].push_back({{"time_s", R4(e.time_s)}, {"event", e.text}});
+  return j;
+}
+
+}  // namespace fv

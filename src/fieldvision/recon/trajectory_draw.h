@@ -1,0 +1,34 @@
+// Pictures of ball flights so a user can judge the fit: a side view per flight (height over the
+// horizontal distance along the flight, measured points, fitted arcs with and without drag, the
+// seed's quadratic, origin, landing, apex and the landing predicted from the first half), a
+// height-over-time view of the whole track with the breaks, and a top view on the field
+// (field_draw.h) with the landing calls.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "fieldvision/field/field.h"
+#include "fieldvision/recon/trajectory.h"
+#include "fieldvision/recon/trajectory_decisions.h"
+#include "fieldvision/recon/trajectory_predict.h"
+
+namespace fv {
+
+cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                       const Flight& flight, const TrajectoryOptions& options,
+                       const LandingPrediction* prediction, cv::Size size = {1100, 550});
+
+cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                        const TrajectoryOptions& options, cv::Size size = {1600, 600});
+
+// field may be null (a plain grid around the track).
+cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                       const FieldModel* field, const Decisions* decisions, int width_px = 1400);
+
+// Writes an image; throws fv::Error naming the path on failure.
+void WriteImage(const std::string& path, const cv::Mat& image);
+
+}  // namespace fv

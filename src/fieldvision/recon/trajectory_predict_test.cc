@@ -1,0 +1,95 @@
+#include "fieldvision/recon/trajectory_predict.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <Eigen/Dense>
+
+#include "fieldvision/recon/trajectory_sim.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+TEST(TrajectoryPredict, LandingFromTheFirstHalfWithin25cmAndInsideTheEllipse) {
+  const uint64_t seed = testing::TestSeed(21);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  int inside = 0, total = 0;
+  double worst = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    BallSimOptions o;
+    o.start_m = {rng.Uniform(-5, 5), rng.Uniform(-3, 3), 0.11};
+    const double speed = rng.Uniform(6, 14), elev = rng.Uniform(0.3, 1.0),
+                 head = rng.Uniform(-3, 3);
+    o.kicks = {
+        {0.1, Eigen::Vector3d(speed * std::cos(elev) * std::cos(head),
+                              speed * std::cos(elev) * std::sin(head), speed * std::sin(elev))}};
+    o.duration_s = 0.1 + 2 * speed * std::sin(elev) / 9.81 + 0.3;
+    const BallSimulation sim(o);
+    const auto track = sim.Sample(50.0, 0.005, 0.05, 0.0, 0.0, rng);
+    TrajectoryOptions to;
+    const TrajectoryResult r = AnalyzeTrajectory(track, to);
+    ASSERT_FALSE(r.flights.empty()) << r.Summary();
+    const FlightTruth& truth = sim.Flights().front();
+    const LandingPrediction p = PredictFlightLanding(track, r, r.flights.front(), 0.5, to);
+    ASSERT_TRUE(p.ok);
+    EXPECT_LT(p.t_cut_s, truth.t_start_s + 0.55 * (truth.t_end_s - truth.t_start_s));
+    const Eigen::Vector2d err = p.landing_m.head<2>() - truth.landing_m.head<2>();
+    worst = std::max(worst, err.norm());
+    EXPECT_LT(err.norm(), 0.25) << "trial " << trial;
+    EXPECT_NEAR(p.t_landing_s, truth.t_end_s, 0.05) << "trial " << trial;
+    // Mahalanobis distance inside the 95 % ellipse.
+    const double d2 = err.dot(p.cov_xy_m2.inverse() * err);
+    inside += d2 <= 5.991;
+    ++total;
+    EXPECT_GT(p.semi_major_m, 0.0);
+    EXPECT_GE(p.semi_major_m, p.semi_minor_m);
+  }
+  RecordProperty("worst_prediction_error_m", std::to_string(worst));
+  // 95 % ellipses: allow for chance, but most must hold the truth.
+  EXPECT_GE(inside, 15) << inside << " of " << total;
+}
+
+TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
+  const uint64_t seed = testing::TestSeed(23);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  BallSimOptions o;
+  o.start_m = {-6, 0, 0.11};
+  o.kicks = {{0.2, {9, 1, 7}}};
+  o.restitution = 0.6;
+  o.duration_s = 3.0;
+  const BallSimulation sim(o);
+  const double sigma = 0.02;
+  const auto track = sim.Sample(50.0, sigma, 0.05, 0.02, 0.6, rng);
+  TrajectoryOptions to;
+  const TrajectoryResult r = AnalyzeTrajectory(track, to);
+  const auto smooth = SmoothTrack(track, r, to, SmootherOptions());
+  ASSERT_EQ(smooth.size(), track.size());
+  double raw = 0, sm = 0;
+  int n = 0;
+  for (size_t i = 0; i < track.size(); ++i) {
+    if (r.outlier[i]) continue;
+    const Eigen::Vector3d t = sim.BallAt(track[i].time_s);
+    raw += (track[i].ball_in_world - t).squaredNorm();
+    sm += (smooth[i].ball_in_world - t).squaredNorm();
+    ++n;
+    EXPECT_EQ(smooth[i].frame, track[i].frame);
+  }
+  raw = std::sqrt(raw / n);
+  sm = std::sqrt(sm / n);
+  EXPECT_LT(sm, 0.6 * raw) << "raw " << raw << " smoothed " << sm;
+  // Outliers are replaced by the smoothed path.
+  for (size_t i = 0; i < track.size(); ++i)
+    if (r.outlier[i])
+      EXPECT_LT((smooth[i].ball_in_world - sim.BallAt(track[i].time_s)).norm(), 0.15);
+  SmootherOptions bad;
+  bad.accel_noise_mps2 = 0;
+  EXPECT_THROW(SmoothTrack(track, r, to, bad), Error);
+}
+
+}  // namespace
+}  // namespace fv

@@ -1,0 +1,44 @@
+// The `fieldvision trajectory` job: reads a ball track (BALL.csv or TT3D CSV), finds and fits the
+// flights (trajectory.h), predicts each landing from the first part of its flight, makes the
+// referee calls on a field (trajectory_decisions.h), writes FLIGHTS.json (CONTRACT.md), pictures,
+// a smoothed BALL.csv and a report, and prints the flights and a timeline.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "fieldvision/recon/trajectory.h"
+#include "fieldvision/recon/trajectory_decisions.h"
+#include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/recon/trajectory_predict.h"
+
+namespace fv {
+
+struct TrajectoryJob {
+  std::string in_path;           // BALL.csv or Timestamp,X,Y,Z
+  std::string out_path;          // FLIGHTS.json
+  double ball_diameter_m = 0.0;  // 0: 0.22 m (football), 0.04 m for the TT3D layout
+  TrajectoryOptions analysis;    // ball_radius_m is set from the diameter
+  std::string field;             // built-in name or JSON; empty: no calls
+  DecisionOptions decisions;
+  std::string images_dir;         // empty: no pictures
+  std::string smoothed_path;      // empty: no smoothed track
+  std::string report_path;        // empty: no report JSON
+  double predict_fraction = 0.5;  // of each flight's time used for the landing prediction
+  SmootherOptions smoother;
+  void Check() const;
+};
+
+struct TrajectoryJobResult {
+  BallTrackFile input;
+  TrajectoryOptions options;  // as used (radius)
+  TrajectoryResult result;
+  std::vector<LandingPrediction> predictions;  // per flight
+  Decisions decisions;
+  std::vector<std::string> images;  // written
+};
+
+TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log);
+
+}  // namespace fv
