@@ -1,0 +1,207 @@
+#include "fieldvision/plan/coverage_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/field/field_draw.h"
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+const cv::Vec3b kNoData(70, 70, 70);
+
+cv::Vec3b CountColour(int k) {
+  static const std::vector<cv::Vec3b> palette = {
+      {70, 70, 70},  {50, 50, 220}, {0, 150, 255}, {0, 230, 230},  {80, 220, 80},
+      {40, 150, 40}, {200, 200, 0}, {220, 120, 0}, {200, 60, 120}, {150, 40, 150}};
+  return palette[std::min<size_t>(k, palette.size() - 1)];
+}
+
+cv::Vec3b TurboColour(double t) {
+  static const cv::Mat lut = [] {
+    cv::Mat grey(1, 256, CV_8U);
+    for (int i = 0; i < 256; ++i) grey.at<uchar>(0, i) = static_cast<uchar>(i);
+    cv::Mat colour;
+    cv::applyColorMap(grey, colour, cv::COLORMAP_TURBO);
+    return colour;
+  }();
+  const int i = std::clamp(static_cast<int>(std::lround(t * 255)), 0, 255);
+  return lut.at<cv::Vec3b>(0, i);
+}
+
+const std::vector<cv::Scalar> kCameraColours = {{255, 255, 255}, {255, 0, 255}, {255, 255, 0},
+                                                {0, 255, 255},   {255, 128, 0}, {128, 0, 255},
+                                                {0, 128, 255},   {128, 255, 0}};
+
+void Text(cv::Mat& img, const std::string& s, cv::Point at, double scale, cv::Scalar colour) {
+  cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+  cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
+}
+
+// The image border of `cam` cast onto the plane z = height, as polylines (broken where the
+// border is above the horizon or very far away).
+std::vector<std::vector<cv::Point>> Footprint(const Camera& cam, double height, const TopView& view,
+                                              double max_range_m) {
+  std::vector<Eigen::Vector2d> border;
+  const int steps = 60;
+  const double w = cam.width - 0.5, h = cam.height - 0.5;
+  for (int s = 0; s < steps; ++s) border.emplace_back(-0.5 + (w + 0.5) * s / steps, -0.5);
+  for (int s = 0; s < steps; ++s) border.emplace_back(w, -0.5 + (h + 0.5) * s / steps);
+  for (int s = 0; s < steps; ++s) border.emplace_back(w - (w + 0.5) * s / steps, h);
+  for (int s = 0; s <= steps; ++s) border.emplace_back(-0.5, h - (h + 0.5) * s / steps);
+  std::vector<std::vector<cv::Point>> lines(1);
+  const Eigen::Vector3d centre = cam.CentreInWorld();
+  for (const auto& uv : border) {
+    const auto ray = cam.RayFromPixel(uv);
+    std::optional<Eigen::Vector3d> hit;
+    if (ray) hit = IntersectHorizontalPlane(*ray, height);
+    if (!hit || (*hit - centre).norm() > max_range_m) {
+      if (!lines.back().empty()) lines.emplace_back();
+      continue;
+    }
+    lines.back().push_back(view.ToPixel(hit->head<2>()));
+  }
+  return lines;
+}
+
+}  // namespace
+
+void CoverageMapOptions::Check() const {
+  FV_REQUIRE(width_px >= 200 && width_px <= 20000, "width_px must be in [200, 20000] (got {})",
+             width_px);
+  CheckInRange(alpha, 0, 1, "alpha");
+  CheckNonNegative(err_scale_m, "err_scale_m");
+}
+
+cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
+                        const std::vector<Camera>& cameras, const FieldModel& field,
+                        const CoverageOptions& coverage, const CoverageMapOptions& options) {
+  options.Check();
+  // Make room for cameras standing outside the drawn area.
+  double extra_m = 0.3;
+  for (const Camera& c : cameras) {
+    const Eigen::Vector3d p = c.CentreInWorld();
+    extra_m = std::max(extra_m, std::abs(p.x()) - field.HalfLengthWithSurround() + 0.8);
+    extra_m = std::max(extra_m, std::abs(p.y()) - field.HalfWidthWithSurround() + 0.8);
+  }
+  const TopView view = TopView::ForField(field, options.width_px, extra_m);
+  cv::Mat img = DrawField(field, view);
+  cv::Mat overlay = img.clone();
+
+  double err_scale = options.err_scale_m;
+  if (err_scale <= 0) err_scale = std::isfinite(layer.err_max_m) ? layer.err_max_m : 0.1;
+  auto colour_of = [&](size_t cell) -> cv::Vec3b {
+    switch (kind) {
+      case CoverageMapKind::kCount:
+        return CountColour(layer.count[cell]);
+      case CoverageMapKind::kAngle: {
+        const double a = layer.best_angle_deg[cell];
+        return std::isnan(a) ? kNoData : TurboColour(a / 180.0);
+      }
+      case CoverageMapKind::kError: {
+        const double e = layer.err_rms_m[cell];
+        return std::isnan(e) ? kNoData : TurboColour(e / err_scale);
+      }
+    }
+    return kNoData;
+  };
+  for (int j = 0; j < layer.ny; ++j) {
+    for (int i = 0; i < layer.nx; ++i) {
+      const Eigen::Vector3d c = layer.CellCentre(i, j);
+      const cv::Point2d a =
+          view.ToPixel({c.x() - 0.5 * layer.step_x_m, c.y() + 0.5 * layer.step_y_m});
+      const cv::Point2d b =
+          view.ToPixel({c.x() + 0.5 * layer.step_x_m, c.y() - 0.5 * layer.step_y_m});
+      const cv::Vec3b col = colour_of(static_cast<size_t>(j) * layer.nx + i);
+      cv::rectangle(overlay, cv::Point(std::lround(a.x), std::lround(a.y)),
+                    cv::Point(std::lround(b.x), std::lround(b.y)),
+                    cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
+    }
+  }
+  cv::addWeighted(overlay, options.alpha, img, 1 - options.alpha, 0, img);
+  DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255));
+
+  const double range_m =
+      3 * std::hypot(field.HalfLengthWithSurround(), field.HalfWidthWithSurround());
+  const double scale = options.width_px / 1400.0;
+  for (size_t k = 0; k < cameras.size(); ++k) {
+    const Camera& cam = cameras[k];
+    const cv::Scalar colour = kCameraColours[k % kCameraColours.size()];
+    if (options.footprints) {
+      for (const auto& line : Footprint(cam, layer.height_m, view, range_m)) {
+        if (line.size() > 1) cv::polylines(img, line, false, colour, 1, cv::LINE_AA);
+      }
+    }
+    const Eigen::Vector3d eye = cam.CentreInWorld();
+    const cv::Point2d p = view.ToPixel(eye.head<2>());
+    const Eigen::Vector3d axis = cam.cam_from_world.rotation.row(2).transpose();
+    Eigen::Vector3d aim = eye + 5.0 * axis;
+    if (axis.z() < -1e-6)
+      aim = eye + std::min(range_m, (layer.height_m - eye.z()) / axis.z()) * axis;
+    cv::arrowedLine(img, p, view.ToPixel(aim.head<2>()), colour, std::max(1, int(2 * scale)),
+                    cv::LINE_AA, 0, 0.03);
+    cv::circle(img, p, std::max(4, int(9 * scale)), cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
+    cv::circle(img, p, std::max(3, int(7 * scale)), colour, cv::FILLED, cv::LINE_AA);
+    Text(img, fmt::format("{} ({:.1f} m)", cam.name, eye.z()),
+         cv::Point(int(p.x + 10 * scale), int(p.y - 8 * scale)), 0.5 * scale, colour);
+  }
+
+  // Legend strip.
+  const int strip_h = std::max(50, int(70 * scale));
+  cv::Mat legend(strip_h, img.cols, CV_8UC3, cv::Scalar(30, 30, 30));
+  const int pad = int(15 * scale);
+  const double ts = 0.5 * scale;
+  std::string title;
+  if (kind == CoverageMapKind::kCount) {
+    title = fmt::format("cameras seeing the ball, z = {:.2f} m", layer.height_m);
+    const int n = static_cast<int>(layer.fraction_exactly.size());
+    const int box = int(60 * scale);
+    for (int k = 0; k < n; ++k) {
+      const cv::Vec3b c = CountColour(k);
+      const int x = pad + k * (box + pad) + int(img.cols * 0.45);
+      cv::rectangle(legend, cv::Rect(x, pad, box, strip_h - 2 * pad), cv::Scalar(c[0], c[1], c[2]),
+                    cv::FILLED);
+      Text(legend, fmt::format("{}: {:.0f}%", k, 100 * layer.fraction_exactly[k]),
+           cv::Point(x + 3, strip_h / 2 + 5), 0.4 * scale, cv::Scalar(255, 255, 255));
+    }
+  } else {
+    const bool angle = kind == CoverageMapKind::kAngle;
+    title = angle ? fmt::format("best pair angle (deg), good {:.0f}-{:.0f}, z = {:.2f} m",
+                                coverage.good_angle_min_deg, coverage.good_angle_max_deg,
+                                layer.height_m)
+                  : fmt::format("expected 3D error (mm, {:.2f} px noise), z = {:.2f} m",
+                                coverage.pixel_noise_px, layer.height_m);
+    const int x0 = int(img.cols * 0.45), x1 = img.cols - 3 * pad;
+    for (int x = x0; x < x1; ++x) {
+      const cv::Vec3b c = TurboColour(double(x - x0) / (x1 - x0));
+      cv::line(legend, cv::Point(x, pad), cv::Point(x, strip_h / 2), cv::Scalar(c[0], c[1], c[2]));
+    }
+    const double top = angle ? 180.0 : 1000 * err_scale;
+    std::vector<double> ticks;
+    if (angle) {
+      ticks = {0, coverage.good_angle_min_deg, 90, coverage.good_angle_max_deg, 180};
+    } else {
+      for (int t = 0; t <= 4; ++t) ticks.push_back(top * t / 4);
+    }
+    for (double t : ticks) {
+      const int x = x0 + int((x1 - x0) * t / top);
+      cv::line(legend, cv::Point(x, pad), cv::Point(x, strip_h / 2 + 4), cv::Scalar(255, 255, 255));
+      Text(legend, angle ? fmt::format("{:.0f}", t) : fmt::format("{:.0f}", t),
+           cv::Point(x - 8, strip_h - pad / 2), 0.4 * scale, cv::Scalar(255, 255, 255));
+    }
+    if (!angle) {
+      Text(legend, "grey: < 2 cameras", cv::Point(x1 - int(140 * scale), pad - 2), 0.35 * scale,
+           cv::Scalar(200, 200, 200));
+    }
+  }
+  Text(legend, title, cv::Point(pad, strip_h / 2 + 5), ts, cv::Scalar(255, 255, 255));
+  cv::Mat out;
+  cv::vconcat(img, legend, out);
+  return out;
+}
+
+}  // namespace fv

@@ -1,0 +1,191 @@
+#include "fieldvision/plan/plan_run.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+using nlohmann::json;
+
+json Finite(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json LayerJson(const CoverageLayer& L) {
+  return {
+      {"height_m", L.height_m},
+      {"grid", {{"nx", L.nx}, {"ny", L.ny}, {"step_x_m", L.step_x_m}, {"step_y_m", L.step_y_m}}},
+      {"fraction_exactly", L.fraction_exactly},
+      {"fraction_at_least_2", L.fraction_at_least_2},
+      {"fraction_good", L.fraction_good},
+      {"angle",
+       {{"median_deg", Finite(L.angle_median_deg)},
+        {"fraction_good_of_at_least_2", Finite(L.fraction_angle_good_of_2)}}},
+      {"error",
+       {{"median_m", Finite(L.err_median_m)},
+        {"p95_m", Finite(L.err_p95_m)},
+        {"max_m", Finite(L.err_max_m)},
+        {"max_axis_max_m", Finite(L.err_max_axis_max_m)}}},
+      {"score", L.score}};
+}
+
+void WriteImage(const std::string& path, const cv::Mat& img) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, img);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  FV_REQUIRE(ok, "cannot write image '{}'", path);
+}
+
+}  // namespace
+
+void PlanRunOptions::Check() const {
+  FV_REQUIRE(!out_dir.empty(), "plan: --out is required");
+  FV_REQUIRE(!field.empty(), "plan: --field is required");
+  if (!optimize) {
+    FV_REQUIRE(rig_path.empty() != camera_paths.empty(),
+               "plan: give either --rig RIG.json or --camera CAM.yaml (one or more)");
+  } else {
+    FV_REQUIRE(camera_paths.empty() || rig_path.empty(),
+               "plan: give at most one of --rig and --camera with --optimize");
+    search.Check();
+    FV_REQUIRE(image_width > 0 && image_height > 0, "plan: image size must be positive");
+    CheckInRange(hfov_deg, 1, 179, "hfov_deg");
+    CheckNonNegative(perimeter_offset_m, "perimeter_offset_m");
+    CheckPositive(mount_height_m, "mount_height_m");
+  }
+  coverage.Check();
+  map.Check();
+}
+
+PlanRunResult RunPlan(const PlanRunOptions& options) {
+  options.Check();
+  const FieldModel field = LoadField(options.field);
+  PlanRunResult result;
+  std::optional<Rig> given;
+  if (!options.rig_path.empty()) given = ReadRigJson(options.rig_path);
+  if (!options.camera_paths.empty()) given = RigFromCameraFiles(options.camera_paths);
+
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  FV_REQUIRE(fs::is_directory(options.out_dir), "cannot create output folder '{}'",
+             options.out_dir);
+  auto out = [&](const std::string& name) { return (fs::path(options.out_dir) / name).string(); };
+
+  std::string summary;
+  if (options.optimize) {
+    const std::vector<MountPlace> mounts =
+        options.mounts_path.empty()
+            ? PerimeterMounts(field, options.perimeter_offset_m, options.mount_height_m)
+            : ReadMountsJson(options.mounts_path);
+    const Camera model =
+        given ? given->cameras.front()
+              : Camera::FromFov(options.image_width, options.image_height, options.hfov_deg);
+    OptimizeResult opt = OptimizeRig(field, mounts, model, options.coverage, options.search);
+    summary += opt.Summary();
+    if (given) {
+      result.given_rig_search_score =
+          RigScore(given->cameras, field, options.coverage, options.search.grid_step_m);
+      summary += fmt::format("given rig '{}': score {:.4f} on the search grid\n", given->name,
+                             *result.given_rig_search_score);
+    }
+    result.rig = opt.rig;
+    result.optimized = std::move(opt);
+    WriteRigJson(result.rig, out("rig.json"));
+    result.files.push_back(out("rig.json"));
+  } else {
+    result.rig = *given;
+  }
+
+  result.coverage = EvaluateCoverage(result.rig.cameras, field, options.coverage);
+  if (options.optimize && given) {
+    CoverageOptions one_layer = options.coverage;
+    one_layer.height_above_m = 0;
+    result.given_rig_score = EvaluateCoverage(given->cameras, field, one_layer).score();
+  }
+  summary += fmt::format("rig '{}', {} cameras, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
+                         result.rig.cameras.size(), field.name, field.length_m, field.width_m);
+  summary += result.coverage.Summary();
+  if (result.given_rig_score) {
+    summary += fmt::format("score on this grid: optimized {:.4f}, given rig {:.4f}\n",
+                           result.coverage.score(), *result.given_rig_score);
+  }
+
+  // Maps.
+  const std::vector<std::pair<CoverageMapKind, std::string>> kinds = {
+      {CoverageMapKind::kCount, "coverage"},
+      {CoverageMapKind::kAngle, "angle"},
+      {CoverageMapKind::kError, "error"}};
+  for (size_t l = 0; l < result.coverage.layers.size(); ++l) {
+    CoverageMapOptions map = options.map;
+    // Both layers' error maps on the ground layer's scale so they compare.
+    if (map.err_scale_m <= 0 && std::isfinite(result.coverage.layers[0].err_max_m)) {
+      map.err_scale_m = result.coverage.layers[0].err_max_m;
+    }
+    for (const auto& [kind, name] : kinds) {
+      const std::string file = out(name + (l == 0 ? "" : "_above") + ".png");
+      WriteImage(file, DrawCoverageMap(result.coverage.layers[l], kind, result.rig.cameras, field,
+                                       options.coverage, map));
+      result.files.push_back(file);
+    }
+  }
+
+  // coverage.json
+  const CoverageOptions& co = options.coverage;
+  const CoverageLayer& ground = result.coverage.layers[0];
+  json j;
+  j["field"] = field.name;
+  j["rig"] = result.rig.name;
+  j["num_cameras"] = result.rig.cameras.size();
+  j["cameras"] = json::array();
+  for (const Camera& c : result.rig.cameras) {
+    const Eigen::Vector3d p = c.CentreInWorld();
+    j["cameras"].push_back({{"name", c.name}, {"position", {p.x(), p.y(), p.z()}}});
+  }
+  j["options"] = {{"grid_step_m", co.grid_step_m},
+                  {"include_surround", co.include_surround},
+                  {"ball_diameter_m", co.ball_diameter_m},
+                  {"height_above_m", co.height_above_m},
+                  {"min_ball_px", co.min_ball_px},
+                  {"margin_px", co.margin_px},
+                  {"pixel_noise_px", co.pixel_noise_px},
+                  {"good_angle_min_deg", co.good_angle_min_deg},
+                  {"good_angle_max_deg", co.good_angle_max_deg},
+                  {"error_weight_per_m", co.error_weight_per_m}};
+  // The ball-height layer at the top level: fraction_exactly[k] = share seen by exactly k.
+  const json g = LayerJson(ground);
+  for (auto it = g.begin(); it != g.end(); ++it) j[it.key()] = it.value();
+  j["layers"] = json::array();
+  for (const auto& L : result.coverage.layers) j["layers"].push_back(LayerJson(L));
+  if (result.optimized) {
+    j["optimize"] = {{"search_grid_step_m", options.search.grid_step_m},
+                     {"search_score", result.optimized->score},
+                     {"even_start_search_score", result.optimized->start_score},
+                     {"evaluations", result.optimized->evaluations},
+                     {"seconds", result.optimized->seconds},
+                     {"seed", options.search.seed}};
+    if (result.given_rig_score) {
+      j["optimize"]["given_rig_search_score"] = *result.given_rig_search_score;
+      j["optimize"]["given_rig_score"] = *result.given_rig_score;
+    }
+  }
+  {
+    std::ofstream f(out("coverage.json"));
+    FV_REQUIRE(f.good(), "cannot write '{}'", out("coverage.json"));
+    f << j.dump(2) << "\n";
+  }
+  result.files.push_back(out("coverage.json"));
+  summary += fmt::format("wrote {} files to {}\n", result.files.size(), options.out_dir);
+  result.summary = summary;
+  return result;
+}
+
+}  // namespace fv

@@ -1,0 +1,111 @@
+#include "fieldvision/plan/plan_run.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+using nlohmann::json;
+
+std::string WriteCornerRig(const std::string& dir) {
+  json cams = json::array();
+  for (const auto& [x, y] : {std::pair{-10.0, -7.0}, {10.0, -7.0}, {10.0, 7.0}, {-10.0, 7.0}}) {
+    cams.push_back({{"position", {x, y, 4.0}}, {"look_at", {0, 0, 0}}});
+  }
+  const json rig = {{"name", "corners"},
+                    {"defaults", {{"image_width", 1280}, {"image_height", 960}, {"hfov_deg", 80}}},
+                    {"cameras", cams}};
+  const std::string path = dir + "/rig.json";
+  std::ofstream(path) << rig.dump(2);
+  return path;
+}
+
+TEST(PlanRunTest, WritesCoverageJsonAndMaps) {
+  const std::string dir = fv::testing::TempDir();
+  PlanRunOptions o;
+  o.rig_path = WriteCornerRig(dir);
+  o.out_dir = dir + "/out";
+  o.coverage.grid_step_m = 0.5;
+  o.map.width_px = 400;
+  const PlanRunResult r = RunPlan(o);
+  ASSERT_EQ(r.coverage.layers.size(), 2u);
+  std::ifstream in(o.out_dir + "/coverage.json");
+  const json j = json::parse(in);
+  ASSERT_EQ(j["fraction_exactly"].size(), 5u);
+  double sum = 0;
+  for (size_t k = 0; k < 5; ++k) {
+    EXPECT_DOUBLE_EQ(j["fraction_exactly"][k].get<double>(),
+                     r.coverage.layers[0].fraction_exactly[k]);
+    sum += j["fraction_exactly"][k].get<double>();
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-12);
+  EXPECT_EQ(j["layers"].size(), 2u);
+  EXPECT_TRUE(j["error"]["max_m"].is_number());
+  for (const char* name :
+       {"coverage", "angle", "error", "coverage_above", "angle_above", "error_above"}) {
+    const cv::Mat img = cv::imread(o.out_dir + "/" + name + ".png");
+    EXPECT_EQ(img.cols, 400) << name;
+  }
+  EXPECT_NE(r.summary.find("share of the field"), std::string::npos);
+}
+
+TEST(PlanRunTest, OptimizeWritesARigThatReadsBack) {
+  const std::string dir = fv::testing::TempDir();
+  PlanRunOptions o;
+  o.optimize = true;
+  o.rig_path = WriteCornerRig(dir);  // scored for comparison
+  o.out_dir = dir + "/out";
+  o.coverage.grid_step_m = 1.0;
+  o.coverage.height_above_m = 0;
+  o.search.grid_step_m = 1.5;
+  o.search.iterations = 60;
+  o.search.restarts = 1;
+  o.map.width_px = 300;
+  const PlanRunResult r = RunPlan(o);
+  ASSERT_TRUE(r.optimized && r.given_rig_score && r.given_rig_search_score);
+  const Rig back = ReadRigJson(o.out_dir + "/rig.json");
+  ASSERT_EQ(back.cameras.size(), 4u);
+  CoverageOptions c = o.coverage;
+  EXPECT_NEAR(EvaluateCoverage(back.cameras, LoadField("robocup-msl"), c).score(),
+              r.coverage.score(), 1e-9);
+}
+
+TEST(PlanRunTest, BadInputGivesOneLineErrors) {
+  const std::string dir = fv::testing::TempDir();
+  auto error_of = [](const PlanRunOptions& o) -> std::string {
+    try {
+      RunPlan(o);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  PlanRunOptions o;
+  o.out_dir = dir + "/out";
+  o.rig_path = dir + "/nope.json";
+  std::string msg = error_of(o);
+  EXPECT_NE(msg.find("nope.json"), std::string::npos) << msg;
+  o.rig_path = WriteCornerRig(dir);
+  o.field = "rugby";
+  msg = error_of(o);
+  EXPECT_NE(msg.find("rugby"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  o.field = "robocup-msl";
+  o.rig_path.clear();
+  msg = error_of(o);
+  EXPECT_NE(msg.find("--rig"), std::string::npos) << msg;
+  o.rig_path = WriteCornerRig(dir);
+  o.coverage.pixel_noise_px = -1;
+  msg = error_of(o);
+  EXPECT_NE(msg.find("pixel_noise_px"), std::string::npos) << msg;
+}
+
+}  // namespace
+}  // namespace fv
