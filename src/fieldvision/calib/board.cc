@@ -151,7 +151,7 @@ BoardView DetectBoard(const cv::Mat& image, const BoardSpec& board, const Detect
         for (auto& c : corners) c = (c + cv::Point2f(0.5f, 0.5f)) / scale - cv::Point2f(0.5f, 0.5f);
       }
     }
-    if (!found) {
+    if (!found && (scale == 1.0 || options.full_resolution_retry)) {
       scale = 1.0;
       found = cv::findChessboardCorners(grey, pattern, corners, flags);
     }

@@ -46,6 +46,8 @@ struct DetectOptions {
   // Chessboards are searched in a copy downscaled to at most this many pixels wide (0: never),
   // then corners are refined in the full image; big frames are found much faster.
   int search_max_width_px = 1280;
+  // When the downscaled search fails, search the full image too (slower, finds small boards).
+  bool full_resolution_retry = true;
   // ChArUco: a view needs at least this many interpolated corners.
   int min_charuco_corners = 6;
 

@@ -1,0 +1,142 @@
+#include "fieldvision/calib/pose2sim.h"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include "fieldvision/util/error.h"
+
+namespace fv::calib {
+namespace {
+
+std::map<std::string, double> Attributes(const std::string& tag) {
+  std::map<std::string, double> out;
+  static const std::regex re(R"((\w+)=\"([-+0-9.eE]+)\")");
+  for (auto it = std::sregex_iterator(tag.begin(), tag.end(), re); it != std::sregex_iterator();
+       ++it) {
+    out[(*it)[1]] = std::stod((*it)[2]);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Camera> ReadQualisysCalibration(const std::string& path) {
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "Qualisys calibration '{}' cannot be read", path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  static const std::regex camera_re(
+      R"(<camera [^>]*serial=\"([^\"]*)\"[\s\S]*?<fov_video ([^>]*)/>[\s\S]*?<transform ([^>]*)/>\s*<intrinsic ([^>]*)/>)");
+  std::vector<Camera> cams;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), camera_re);
+       it != std::sregex_iterator(); ++it) {
+    const auto fov = Attributes((*it)[2]);
+    const auto t = Attributes((*it)[3]);
+    const auto k = Attributes((*it)[4]);
+    for (const char* key :
+         {"r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33", "x", "y", "z"}) {
+      FV_REQUIRE(t.count(key), "Qualisys calibration '{}': camera {} has no transform {}", path,
+                 (*it)[1].str(), key);
+    }
+    for (const char* key : {"focalLengthU", "focalLengthV", "centerPointU", "centerPointV"}) {
+      FV_REQUIRE(k.count(key), "Qualisys calibration '{}': camera {} has no intrinsic {}", path,
+                 (*it)[1].str(), key);
+    }
+    Camera c;
+    c.name = (*it)[1];
+    c.width = static_cast<int>(fov.at("right") - fov.at("left") + 1);
+    c.height = static_cast<int>(fov.at("bottom") - fov.at("top") + 1);
+    c.fx = k.at("focalLengthU") / 64.0;
+    c.fy = k.at("focalLengthV") / 64.0;
+    c.cx = k.at("centerPointU") / 64.0;
+    c.cy = k.at("centerPointV") / 64.0;
+    c.distortion = {k.count("radialDistortion1") ? k.at("radialDistortion1") : 0.0,
+                    k.count("radialDistortion2") ? k.at("radialDistortion2") : 0.0,
+                    k.count("tangentalDistortion1") ? k.at("tangentalDistortion1") : 0.0,
+                    k.count("tangentalDistortion2") ? k.at("tangentalDistortion2") : 0.0};
+    Eigen::Matrix3d r;
+    r << t.at("r11"), t.at("r12"), t.at("r13"), t.at("r21"), t.at("r22"), t.at("r23"), t.at("r31"),
+        t.at("r32"), t.at("r33");
+    const Eigen::Vector3d position_m(t.at("x") / 1000, t.at("y") / 1000, t.at("z") / 1000);
+    const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
+    c.has_pose = true;
+    c.cam_from_world.rotation = flip * r;
+    c.cam_from_world.translation = -c.cam_from_world.rotation * position_m;
+    c.Check("Qualisys calibration '" + path + "' camera " + c.name);
+    cams.push_back(c);
+  }
+  FV_REQUIRE(!cams.empty(), "Qualisys calibration '{}' has no cameras", path);
+  return cams;
+}
+
+std::string RigComparison::Summary() const {
+  std::string s = fmt::format(
+      "baselines differ by at most {:.0f} mm, relative rotations by at most {:.2f} deg; camera "
+      "centres after rigid alignment: rms {:.0f} mm",
+      max_baseline_diff_mm, max_rotation_diff_deg, rms_aligned_err_mm);
+  for (const auto& p : pairs) {
+    s += fmt::format(
+        "\n  cams {}-{}: baseline {:.0f} vs {:.0f} mm (diff {:+.0f} mm), relative "
+        "rotation differs by {:.2f} deg",
+        p.i + 1, p.j + 1, p.baseline_a_mm, p.baseline_b_mm, p.baseline_diff_mm,
+        p.relative_rotation_diff_deg);
+  }
+  for (size_t i = 0; i < aligned_centre_err_mm.size(); ++i) {
+    s += fmt::format("\n  cam {} centre off by {:.0f} mm after alignment", i + 1,
+                     aligned_centre_err_mm[i]);
+  }
+  return s;
+}
+
+RigComparison CompareRigs(const std::vector<Camera>& a, const std::vector<Camera>& b) {
+  FV_REQUIRE(a.size() == b.size() && a.size() >= 2,
+             "rig comparison needs two lists of the same cameras (got {} and {})", a.size(),
+             b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    FV_REQUIRE(a[i].has_pose && b[i].has_pose, "rig comparison: camera {} has no pose", i + 1);
+  }
+  RigComparison out;
+  for (size_t i = 0; i < a.size(); ++i) {
+    for (size_t j = i + 1; j < a.size(); ++j) {
+      RigComparison::Pair p;
+      p.i = static_cast<int>(i);
+      p.j = static_cast<int>(j);
+      p.baseline_a_mm = 1000 * (a[i].CentreInWorld() - a[j].CentreInWorld()).norm();
+      p.baseline_b_mm = 1000 * (b[i].CentreInWorld() - b[j].CentreInWorld()).norm();
+      p.baseline_diff_mm = p.baseline_a_mm - p.baseline_b_mm;
+      const Eigen::Matrix3d rel_a =
+          a[i].cam_from_world.rotation * a[j].cam_from_world.rotation.transpose();
+      const Eigen::Matrix3d rel_b =
+          b[i].cam_from_world.rotation * b[j].cam_from_world.rotation.transpose();
+      p.relative_rotation_diff_deg = RotationAngleBetween(rel_a, rel_b) * 180.0 / M_PI;
+      out.max_baseline_diff_mm = std::max(out.max_baseline_diff_mm, std::abs(p.baseline_diff_mm));
+      out.max_rotation_diff_deg = std::max(out.max_rotation_diff_deg, p.relative_rotation_diff_deg);
+      out.pairs.push_back(p);
+    }
+  }
+  Eigen::Matrix3Xd ca(3, a.size()), cb(3, b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    ca.col(i) = a[i].CentreInWorld();
+    cb.col(i) = b[i].CentreInWorld();
+  }
+  const Eigen::Matrix4d t = Eigen::umeyama(ca, cb, /*with_scaling=*/false);
+  double sq = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const Eigen::Vector3d p = t.topLeftCorner<3, 3>() * ca.col(i) + t.topRightCorner<3, 1>();
+    const double e = 1000 * (p - cb.col(i)).norm();
+    out.aligned_centre_err_mm.push_back(e);
+    sq += e * e;
+  }
+  out.rms_aligned_err_mm = std::sqrt(sq / a.size());
+  return out;
+}
+
+}  // namespace fv::calib

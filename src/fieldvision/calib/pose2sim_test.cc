@@ -1,0 +1,133 @@
+// Real multi-camera data: the Pose2Sim demo's four cameras, calibrated from their own chessboard
+// views and the hand-clicked scene points (testdata/README.md), compared with the Qualisys
+// reference.
+#include "fieldvision/calib/pose2sim.h"
+
+#include <iostream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/calib/intrinsics.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::calib {
+namespace {
+
+std::string TestData(const std::string& name) {
+  return std::string(FV_CALIB_TESTDATA_DIR) + "/" + name;
+}
+
+std::vector<PointCorrespondence> ScenePoints(const std::string& camera) {
+  const CsvTable t = CsvTable::Read(TestData("pose2sim_scene_points.csv"));
+  std::vector<PointCorrespondence> pts;
+  for (size_t r = 0; r < t.rows(); ++r) {
+    if (t.Get(r, "camera") != camera) continue;
+    pts.push_back({t.Get(r, "feature"),
+                   {t.GetDouble(r, "u"), t.GetDouble(r, "v")},
+                   {t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "z")}});
+  }
+  return pts;
+}
+
+TEST(Pose2Sim, QualisysReferenceProjectsTheScenePointsNearTheClicks) {
+  // Checks the reading of the reference and the identity of the clicked points: the reference's
+  // projections fall within a few tens of pixels of the clicks (its frame differs slightly).
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "no shared data";
+  const auto ref = ReadQualisysCalibration(data + "/pose2sim-4cam/calibration/Calib.qca.txt");
+  ASSERT_EQ(ref.size(), 4u);
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_EQ(ref[c].width, 1088);
+    EXPECT_EQ(ref[c].height, 1920);
+    for (const auto& p : ScenePoints(fmt::format("cam{:02d}", c + 1))) {
+      const auto uv = ref[c].Project(p.p_world);
+      ASSERT_TRUE(uv.has_value());
+      EXPECT_LT((*uv - p.uv_px).norm(), 50.0) << "cam" << c + 1 << " " << p.name;
+    }
+  }
+}
+
+TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "no shared data";
+  const std::string root = data + "/pose2sim-4cam/calibration";
+  const auto ref = ReadQualisysCalibration(root + "/Calib.qca.txt");
+  std::vector<Camera> ours, with_ref_intrinsics;
+  for (int c = 1; c <= 4; ++c) {
+    IntrinsicsOptions o;
+    o.board = {BoardType::kChessboard, 4, 7, 0.06};  // Config.toml: corners [4, 7], 60 mm
+    o.num_distortion = 4;                            // k1 k2 p1 p2, as the Qualisys model
+    o.progress = false;
+    o.detect.search_max_width_px = 640;  // the boards are large; this keeps the test quick
+    o.detect.full_resolution_retry = false;
+    const IntrinsicsResult in =
+        CalibrateIntrinsics(fmt::format("{}/intrinsics/int_cam{:02d}_img", root, c), o);
+    const Camera& q = ref[c - 1];
+    std::cout << fmt::format(
+        "cam{:02d} intrinsics: {}\n  Qualisys: fx {:.1f} fy {:.1f} cx {:.1f} "
+        "cy {:.1f}\n",
+        c, in.Summary(), q.fx, q.fy, q.cx, q.cy);
+    EXPECT_GE(in.num_used, 5);
+    EXPECT_LT(in.rms_px, 0.5);
+    EXPECT_NEAR(in.camera.fx, q.fx, 0.02 * q.fx);
+    EXPECT_NEAR(in.camera.fy, q.fy, 0.02 * q.fy);
+    EXPECT_NEAR(in.camera.cx, q.cx, 60.0);
+    EXPECT_NEAR(in.camera.cy, q.cy, 60.0);
+
+    const auto pts = ScenePoints(fmt::format("cam{:02d}", c));
+    ASSERT_GE(pts.size(), 6u);
+    ExtrinsicsOptions eo;
+    eo.ransac_threshold_px = 15.0;
+    const ExtrinsicsResult ex = EstimatePose(in.camera, pts, eo);
+    std::cout << fmt::format("  pose from {} scene points: {}\n", pts.size(), ex.Summary());
+    for (const auto& p : ex.points) {
+      std::cout << fmt::format(
+          "    {:<52s} err {:5.2f} px {:4.0f} mm (projected at {:.1f}, "
+          "{:.1f})\n",
+          p.name, p.err_px, p.err_mm.value_or(-1), p.projected_px.x(), p.projected_px.y());
+    }
+    EXPECT_EQ(ex.num_inliers, static_cast<int>(pts.size()));
+    EXPECT_LT(ex.rms_px, 8.0);
+    ours.push_back(ex.camera);
+    // The same clicks with the reference's intrinsics, to tell clicking from intrinsics.
+    Camera q_intrinsics = q;
+    q_intrinsics.has_pose = false;
+    with_ref_intrinsics.push_back(EstimatePose(q_intrinsics, pts, eo).camera);
+  }
+  const RigComparison clicks_only = CompareRigs(with_ref_intrinsics, ref);
+  std::cout << "clicked poses with the Qualisys intrinsics against Qualisys: "
+            << clicks_only.Summary() << "\n";
+  const RigComparison cmp = CompareRigs(ours, ref);
+  std::cout << "against Qualisys: " << cmp.Summary() << "\n";
+  // Loose bounds: 6-7 hand-clicked points 0.6 x 2 m seen from 3-5 m.
+  EXPECT_LT(cmp.max_baseline_diff_mm, 250.0);
+  EXPECT_LT(cmp.max_rotation_diff_deg, 4.0);
+  EXPECT_LT(cmp.rms_aligned_err_mm, 200.0);
+}
+
+TEST(Pose2Sim, CompareRigsIsFrameIndependent) {
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "no shared data";
+  const auto ref = ReadQualisysCalibration(data + "/pose2sim-4cam/calibration/Calib.qca.txt");
+  // The same rig in another world frame compares equal.
+  const Rigid3d world_from_other = {RotationFromRvec(Eigen::Vector3d(0.3, -0.2, 1.0)),
+                                    Eigen::Vector3d(5, -3, 1)};
+  auto moved = ref;
+  for (auto& c : moved) c.cam_from_world = c.cam_from_world * world_from_other;
+  const RigComparison same = CompareRigs(moved, ref);
+  EXPECT_LT(same.max_baseline_diff_mm, 1e-6);
+  EXPECT_LT(same.max_rotation_diff_deg, 1e-6);
+  EXPECT_LT(same.rms_aligned_err_mm, 1e-6);
+  // A camera turned by 1 degree shows up.
+  moved[2].cam_from_world.rotation =
+      RotationFromRvec(Eigen::Vector3d(0, M_PI / 180, 0)) * moved[2].cam_from_world.rotation;
+  EXPECT_NEAR(CompareRigs(moved, ref).max_rotation_diff_deg, 1.0, 1e-6);
+  EXPECT_THROW(ReadQualisysCalibration(data + "/pose2sim-4cam/Config.toml"), Error);
+}
+
+}  // namespace
+}  // namespace fv::calib
