@@ -101,10 +101,12 @@ void BallDetectorOptions::Check() const {
   CheckPositive(max_fit_rms_px, "max_fit_rms_px");
   CheckInRange(min_visible_fraction, 0.0, 1.0, "min_visible_fraction");
   CheckInRange(max_leak_fraction, 0.0, 1.0, "max_leak_fraction");
+  CheckInRange(max_outside_fraction, 0.0, 1.0, "max_outside_fraction");
   CheckInRange(size_tolerance, 0.0, 10.0, "size_tolerance");
   CheckPositive(max_height_m, "max_height_m");
   CheckNonNegative(min_distance_m, "min_distance_m");
   CheckNonNegative(field_margin_m, "field_margin_m");
+  FV_REQUIRE(max_dents >= 0, "max_dents must be >= 0 (got {})", max_dents);
   FV_REQUIRE(max_refine >= 1, "max_refine must be >= 1 (got {})", max_refine);
   fit.Check();
 }
@@ -230,6 +232,9 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
     cand.radius_px = fit.radius_px;
     cand.sigma_px = fit.sigma_px;
     cand.blurred = fit.blurred;
+    cand.inlier_fraction = fit.inlier_fraction;
+    cand.outside_fraction = fit.outside_fraction;
+    cand.dents = fit.dents;
     double visible, leak;
     DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
                fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
@@ -242,6 +247,11 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
                         o.max_radius_px);
     } else if (fit.inlier_fraction < o.min_inlier_fraction) {
       why = fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
+    } else if (fit.outside_fraction > o.max_outside_fraction) {
+      why = fmt::format("colour goes on beyond the circle on {:.0f} % of rays",
+                        100 * fit.outside_fraction);
+    } else if (fit.dents > o.max_dents && fit.inlier_fraction < 0.85) {
+      why = fmt::format("outline has {} dents: not a disc", fit.dents);
     } else if (fit.rms_px > o.max_fit_rms_px) {
       why = fmt::format("outline rms {:.2f} px", fit.rms_px);
     } else if (visible < o.min_visible_fraction) {

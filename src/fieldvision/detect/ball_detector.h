@@ -30,6 +30,9 @@ struct BallCandidate {
   bool accepted = false;  // passed every filter
   // Extras for drawing and diagnosis.
   double visible_fraction = 0.0;  // share of the fitted disc with the ball's colour
+  double inlier_fraction = 0.0;   // share of rays with an outline point on the fit
+  double outside_fraction = 0.0;  // share of rays where the colour goes on beyond the fit
+  int dents = 0;                  // arcs of the outline inside the fit
   bool blurred = false;
   std::string reason;  // why rejected ("" when accepted)
 };
@@ -46,8 +49,10 @@ struct BallDetectorOptions {
   double max_aspect_ratio = 3.0;      // blob bounding box long / short side
   double min_inlier_fraction = 0.45;  // rays whose outline point lies on the fitted circle
   double max_fit_rms_px = 0.8;        // RMS of those outline points
+  int max_dents = 2;  // arcs of the outline inside the circle (occluders), when < 85 % fit
   double min_visible_fraction = 0.35;  // ball-coloured share of the fitted disc
   double max_leak_fraction = 0.35;     // ball-coloured share of a ring just outside it
+  double max_outside_fraction = 0.1;   // rays where the colour goes on beyond the fitted circle
   double size_tolerance = 0.3;         // relative slack of the expected radius (calibrated camera)
   double max_height_m = 8.0;           // highest ball centre considered (size check and field mask)
   double min_distance_m = 0.5;         // nearest ball distance to the camera considered

@@ -43,6 +43,7 @@ inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, do
 struct Edges {
   std::vector<Vector2d> points;
   std::vector<double> ramp_px;  // width of a motion-blur ramp at each point (0: sharp edge)
+  int outside_ball = 0;         // rays whose outside is ball-coloured too
   int rays = 0;
 };
 
@@ -147,8 +148,11 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     const double contrast2 = ab.squaredNorm();
     if (contrast2 < o.min_contrast * o.min_contrast) continue;
     const Vector2d pin = c + (t0 + ia * kStep) * u, pout = c + (t0 + ib * kStep) * u;
-    if (!IsBall(img, table, bit, pin.x(), pin.y())) continue;   // inside is not the ball
-    if (IsBall(img, table, bit, pout.x(), pout.y())) continue;  // outside is ball-coloured
+    if (!IsBall(img, table, bit, pin.x(), pin.y())) continue;  // inside is not the ball
+    if (IsBall(img, table, bit, pout.x(), pout.y())) {         // outside is ball-coloured
+      ++e.outside_ball;
+      continue;
+    }
     double prev_p = (prof[ia] - a).dot(ab) / contrast2;
     double t10 = -1, t90 = -1, te = -1;
     for (int i = ia + 1; i <= ib; ++i) {
@@ -392,9 +396,9 @@ std::string BallFit::Summary() const {
   if (!ok) return "no fit: " + failure;
   return fmt::format(
       "centre ({:.2f}, {:.2f}) px, radius {:.2f} px, sigma {:.3f} px, {}/{} rays "
-      "on the outline, rms {:.3f} px{}",
+      "on the outline, rms {:.3f} px, {:.0f} % outside{}",
       centre_px.x(), centre_px.y(), radius_px, sigma_px, inliers, rays, rms_px,
-      blurred ? fmt::format(", blurred {:.1f} px", blur_length_px) : "");
+      100 * outside_fraction, blurred ? fmt::format(", blurred {:.1f} px", blur_length_px) : "");
 }
 
 bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* centre, double* radius,
@@ -594,6 +598,32 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
       std::sort(ramps.begin(), ramps.end());
       fit.blurred = true;
       fit.blur_length_px = ramps[ramps.size() * 3 / 4];
+    }
+  }
+  int outside = edges.outside_ball;
+  for (size_t i = 0; i < res.size() && i < inl.size(); ++i) outside += !inl[i] && res[i] > 0;
+  fit.outside_fraction = fit.rays > 0 ? double(outside) / fit.rays : 0.0;
+  // Arcs of the outline that lie inside the fit (dents): one or two for an occluder.
+  {
+    const int m = static_cast<int>(std::min(res.size(), inl.size()));
+    int first_break = -1;
+    for (int i = 0; i < m; ++i) {
+      if (!(!inl[i] && res[i] < 0)) {
+        first_break = i;
+        break;
+      }
+    }
+    if (first_break >= 0) {
+      int run = 0;
+      for (int j = 1; j <= m; ++j) {
+        const int i = (first_break + j) % m;
+        if (!inl[i] && res[i] < 0) {
+          ++run;
+        } else {
+          fit.dents += run >= 2;
+          run = 0;
+        }
+      }
     }
   }
   fit.ok = true;

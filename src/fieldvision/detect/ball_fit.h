@@ -45,6 +45,11 @@ struct BallFit {
   int edges = 0;                 // rays with an outline point
   int inliers = 0;               // outline points on the fit
   double inlier_fraction = 0.0;  // inliers / rays
+  // Rays where the colour goes on beyond the fit (outline outside it, or ball-coloured outside):
+  // high for shapes that are not discs (a cone's apex), low for occluded balls.
+  double outside_fraction = 0.0;
+  // Arcs (2+ rays) of the outline inside the fit: an occluder makes one or two, a polygon more.
+  int dents = 0;
   bool blurred = false;
   double blur_length_px = 0.0;               // major minus minor axis of the blurred outline
   std::vector<Eigen::Vector2d> edge_points;  // for drawing

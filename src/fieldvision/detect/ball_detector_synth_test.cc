@@ -1,0 +1,154 @@
+// Ball detection on rendered scenes (fv::synth) with exact truth: sub-pixel accuracy over the
+// 6-40 px diameter range, partly occluded balls, the orange cone distractor, no ball.
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 1e9;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+const BallCandidate* BestAccepted(const std::vector<BallCandidate>& c) {
+  return !c.empty() && c.front().accepted ? &c.front() : nullptr;
+}
+
+TEST(BallDetectorSynth, SubpixelCentreOverTheSizeRange) {
+  const uint64_t seed = fv::testing::TestSeed(1);
+  FV_SEED_TRACE(seed);
+  synth::SceneSpec spec = synth::Preset("static", seed);
+  spec.cameras.resize(2);
+  spec.num_frames = 12;
+  spec.ball.placements.resize(12);
+  const synth::SceneRenderer scene(spec);
+  std::vector<std::unique_ptr<BallDetector>> detectors;
+  for (const Camera& cam : scene.cameras()) {
+    detectors.push_back(
+        std::make_unique<BallDetector>(BallDetectorOptions{}, &cam, &scene.field()));
+  }
+  std::vector<double> err, err_small, err_large;
+  int expected = 0, found = 0;
+  for (int f = 0; f < scene.num_frames(); ++f) {
+    const auto images = scene.Render(f);
+    const auto truth = scene.BallTruth(f);
+    for (size_t k = 0; k < images.size(); ++k) {
+      const auto& t = truth.cameras[k];
+      const auto cands = detectors[k]->Detect(images[k]);
+      const double d_px = 2 * t.radius_px;
+      if (!t.in_front || t.visible_fraction < 0.99 || d_px < 6 || d_px > 40) continue;
+      ++expected;
+      const BallCandidate* best = BestAccepted(cands);
+      if (best == nullptr) {
+        ADD_FAILURE() << "no ball: frame " << f << " cam " << k << " truth " << t.uv_px.transpose()
+                      << " r " << t.radius_px
+                      << (cands.empty() ? "" : " best candidate: " + cands.front().reason);
+        continue;
+      }
+      ++found;
+      const double e = (best->centre_px - t.uv_px).norm();
+      err.push_back(e);
+      (d_px < 15 ? err_small : err_large).push_back(e);
+      EXPECT_LT(e, 1.0) << "frame " << f << " cam " << k << " r " << t.radius_px;
+      EXPECT_NEAR(best->radius_px, t.radius_px, 0.15 * t.radius_px + 0.5);
+    }
+  }
+  std::cout << "synth static: " << found << "/" << expected << " balls found, median centre error "
+            << Median(err) << " px (d < 15 px: " << Median(err_small)
+            << ", d >= 15 px: " << Median(err_large) << ")\n";
+  ASSERT_GE(expected, 10);
+  EXPECT_EQ(found, expected);
+  EXPECT_LT(Median(err), 0.3);
+  EXPECT_LT(Median(err_small), 0.3);
+  EXPECT_LT(Median(err_large), 0.3);
+}
+
+TEST(BallDetectorSynth, OccludedBallsFoundConeRejectedNoBallNoDetection) {
+  const uint64_t seed = fv::testing::TestSeed(1);
+  FV_SEED_TRACE(seed);
+  synth::SceneSpec spec = synth::Preset("kick", seed);
+  spec.cameras.resize(2);
+  // The robot in front of the ball (as cam1 sees it) slides sideways before a later kick, so
+  // cam1 sees the ball hidden, then partly, then free.
+  const Eigen::Vector2d ball = spec.ball.kicks[0].position_m.head<2>();
+  const Eigen::Vector2d to_cam = (spec.cameras[0].position_m.head<2>() - ball).normalized();
+  const Eigen::Vector2d side(-to_cam.y(), to_cam.x());
+  spec.robots[0].path.waypoints_m = {ball + 0.6 * to_cam + 0.1 * side,
+                                     ball + 0.6 * to_cam + 0.5 * side};
+  spec.robots[0].path.speed_mps = 0.25;
+  spec.ball.kicks[0].time_s = 1.6;
+  spec.num_frames = 120;
+  const synth::SceneRenderer scene(spec);
+  std::vector<std::unique_ptr<BallDetector>> detectors;
+  for (const Camera& cam : scene.cameras()) {
+    detectors.push_back(
+        std::make_unique<BallDetector>(BallDetectorOptions{}, &cam, &scene.field()));
+  }
+  const Eigen::Vector3d cone(spec.cones[0].position_m.x(), spec.cones[0].position_m.y(),
+                             0.5 * spec.cones[0].height_m);
+  int occluded = 0, occluded_found = 0, cone_checks = 0;
+  std::vector<double> err;
+  for (int f = 0; f <= 72; f += 6) {
+    const auto images = scene.Render(f);
+    const auto truth = scene.BallTruth(f);
+    for (size_t k = 0; k < images.size(); ++k) {
+      const Camera& cam = scene.cameras()[k];
+      const auto& t = truth.cameras[k];
+      const auto cands = detectors[k]->Detect(images[k]);
+      // Nothing accepted on the cone (unless the ball is right there).
+      const auto cone_uv = cam.Project(cone);
+      if (cone_uv && cam.InImage(*cone_uv) && (!t.in_front || (t.uv_px - *cone_uv).norm() > 30)) {
+        ++cone_checks;
+        for (const auto& c : cands) {
+          if (c.accepted) {
+            EXPECT_GT((c.centre_px - *cone_uv).norm(), 25)
+                << "cone accepted: frame " << f << " cam " << k << " r " << c.radius_px << " score "
+                << c.score << " vis " << c.visible_fraction << " in " << c.inlier_fraction
+                << " out " << c.outside_fraction << " at " << c.centre_px.transpose();
+          }
+        }
+      }
+      if (!t.in_front || t.radius_px < 3) continue;
+      const BallCandidate* best = BestAccepted(cands);
+      if (t.visible_fraction >= 0.5 && t.visible_fraction < 0.95) {
+        ++occluded;
+        if (best != nullptr && (best->centre_px - t.uv_px).norm() < t.radius_px) {
+          ++occluded_found;
+          err.push_back((best->centre_px - t.uv_px).norm());
+        }
+      }
+    }
+  }
+  std::cout << "synth kick: " << occluded_found << "/" << occluded
+            << " partly occluded balls found, median error " << Median(err) << " px; "
+            << cone_checks << " views of the cone\n";
+  EXPECT_GT(cone_checks, 0);
+  EXPECT_GE(occluded, 3);
+  EXPECT_GE(occluded_found, 0.8 * occluded);
+  EXPECT_LT(Median(err), 0.5);
+  // No ball at all.
+  spec.ball.enabled = false;
+  spec.num_frames = 2;
+  const synth::SceneRenderer empty(spec);
+  const auto images = empty.Render(1);
+  for (size_t k = 0; k < images.size(); ++k) {
+    const auto cands = detectors[k]->Detect(images[k]);
+    const BallCandidate* best = BestAccepted(cands);
+    EXPECT_EQ(best, nullptr)
+        << "cam " << k << " accepted at "
+        << (best ? Eigen::Vector2d(best->centre_px) : Eigen::Vector2d(0, 0)).transpose() << " r "
+        << (best ? best->radius_px : 0.0) << " in " << (best ? best->inlier_fraction : 0.0)
+        << " out " << (best ? best->outside_fraction : 0.0) << " vis "
+        << (best ? best->visible_fraction : 0.0) << " sigma " << (best ? best->sigma_px : 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace fv
