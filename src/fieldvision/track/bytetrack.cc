@@ -1,0 +1,371 @@
+#include "fieldvision/track/bytetrack.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/tracking.hpp>
+#include <opencv2/tracking/tracking_legacy.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "fieldvision/track/hungarian.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::track {
+
+void TrackerOptions::Check() const {
+  CheckInRange(high_score, 0.0, 1.0, "high_score");
+  CheckInRange(low_score, 0.0, 1.0, "low_score");
+  FV_REQUIRE(low_score <= high_score, "low_score ({}) must be <= high_score ({})", low_score,
+             high_score);
+  CheckInRange(new_track_score, 0.0, 1.0, "new_track_score");
+  CheckInRange(match_iou, 0.0, 1.0, "match_iou");
+  CheckInRange(low_match_iou, 0.0, 1.0, "low_match_iou");
+  CheckPositive(field_gate_m, "field_gate_m");
+  CheckInRange(field_weight, 0.0, 1.0, "field_weight");
+  CheckNonNegative(max_lost_frames, "max_lost_frames");
+  FV_REQUIRE(min_hits >= 1, "min_hits must be >= 1 (got {})", min_hits);
+  CheckInRange(reid_max_distance, 0.0, 1.0, "reid_max_distance");
+  CheckPositive(reid_speed_mps, "reid_speed_mps");
+  CheckPositive(reid_speed_px, "reid_speed_px");
+  CheckPositive(fps, "fps");
+  CheckInRange(foot_offset_m, 0.0, 1.0, "foot_offset_m");
+  FV_REQUIRE(sot == "none" || sot == "csrt" || sot == "kcf" || sot == "mosse",
+             "sot '{}' is not one of none, csrt, kcf, mosse", sot);
+}
+
+std::string TrackerStats::Summary() const {
+  return fmt::format("{} frames, {} tracks, {} re-found by appearance, {} + {} matches (high, low)",
+                     frames, tracks_started, refound, first_stage_matches, second_stage_matches);
+}
+
+std::optional<Eigen::Vector2d> FootOnGround(const Camera& camera, const cv::Rect2d& box,
+                                            double offset_m) {
+  const auto ray = camera.RayFromPixel({box.x + 0.5 * box.width, box.y + box.height});
+  if (!ray) return std::nullopt;
+  const auto p = IntersectHorizontalPlane(*ray, 0.0);
+  if (!p) return std::nullopt;
+  Eigen::Vector2d g = p->head<2>();
+  const Eigen::Vector2d away = g - camera.CentreInWorld().head<2>();
+  if (offset_m != 0.0 && away.norm() > 1e-6) g += offset_m * away.normalized();
+  return g;
+}
+
+cv::Mat TorsoHistogram(const cv::Mat& bgr, const cv::Rect2d& box) {
+  if (bgr.empty()) return {};
+  const cv::Rect2d torso(box.x + 0.25 * box.width, box.y + 0.2 * box.height, 0.5 * box.width,
+                         0.35 * box.height);
+  const cv::Rect r = cv::Rect(torso) & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (r.width < 2 || r.height < 2) return {};
+  cv::Mat hsv;
+  cv::cvtColor(bgr(r), hsv, cv::COLOR_BGR2HSV);
+  const int channels[] = {0, 1};
+  const int sizes[] = {16, 8};
+  const float h_range[] = {0, 180}, s_range[] = {0, 256};
+  const float* ranges[] = {h_range, s_range};
+  cv::Mat hist;
+  cv::calcHist(&hsv, 1, channels, cv::Mat(), hist, 2, sizes, ranges);
+  cv::normalize(hist, hist, 1.0, 0.0, cv::NORM_L1);
+  return hist;
+}
+
+namespace {
+
+enum class State { kNew, kTracked, kLost };
+
+// Kalman noise relative to the box height, as in ByteTrack.
+constexpr double kStdPos = 1.0 / 20, kStdVel = 1.0 / 160;
+
+cv::Mat Xyah(const cv::Rect2d& b) {
+  return (cv::Mat_<float>(4, 1) << b.x + 0.5 * b.width, b.y + 0.5 * b.height,
+          b.width / std::max(1e-6, b.height), b.height);
+}
+
+}  // namespace
+
+struct ByteTracker::Track {
+  int id = 0;  // 0 until confirmed
+  State state = State::kNew;
+  cv::KalmanFilter kf{8, 4, 0, CV_32F};
+  int hits = 0;
+  int lost_frames = 0;
+  bool matched = false;
+  double score = 0;
+  cv::Rect2d box;  // corrected (or predicted) box
+  std::optional<Eigen::Vector2d> field_m;
+  cv::Mat hist;
+  cv::Ptr<cv::Tracker> sot;
+  cv::Ptr<cv::legacy::Tracker> sot_legacy;
+  bool sot_box = false;  // this frame's box came from the SOT
+
+  void Init(const cv::Rect2d& b) {
+    cv::setIdentity(kf.transitionMatrix);
+    for (int i = 0; i < 4; ++i) kf.transitionMatrix.at<float>(i, i + 4) = 1.0f;
+    kf.measurementMatrix = cv::Mat::zeros(4, 8, CV_32F);
+    for (int i = 0; i < 4; ++i) kf.measurementMatrix.at<float>(i, i) = 1.0f;
+    kf.statePost = cv::Mat::zeros(8, 1, CV_32F);
+    Xyah(b).copyTo(kf.statePost.rowRange(0, 4));
+    const double h = b.height;
+    const double sd[8] = {2 * kStdPos * h,  2 * kStdPos * h,  1e-2, 2 * kStdPos * h,
+                          10 * kStdVel * h, 10 * kStdVel * h, 1e-5, 10 * kStdVel * h};
+    kf.errorCovPost = cv::Mat::zeros(8, 8, CV_32F);
+    for (int i = 0; i < 8; ++i) kf.errorCovPost.at<float>(i, i) = float(sd[i] * sd[i]);
+    box = b;
+  }
+  void Predict() {
+    if (state != State::kTracked) kf.statePost.at<float>(7) = 0;  // lost: no height change
+    const double h = std::max(1.0f, kf.statePost.at<float>(3));
+    const double sd[8] = {kStdPos * h, kStdPos * h, 1e-2, kStdPos * h,
+                          kStdVel * h, kStdVel * h, 1e-5, kStdVel * h};
+    kf.processNoiseCov = cv::Mat::zeros(8, 8, CV_32F);
+    for (int i = 0; i < 8; ++i) kf.processNoiseCov.at<float>(i, i) = float(sd[i] * sd[i]);
+    const cv::Mat s = kf.predict();
+    box = BoxOf(s);
+  }
+  void Correct(const cv::Rect2d& b) {
+    const double h = std::max(1.0f, kf.statePre.at<float>(3));
+    const double sd[4] = {kStdPos * h, kStdPos * h, 1e-1, kStdPos * h};
+    kf.measurementNoiseCov = cv::Mat::zeros(4, 4, CV_32F);
+    for (int i = 0; i < 4; ++i) kf.measurementNoiseCov.at<float>(i, i) = float(sd[i] * sd[i]);
+    box = BoxOf(kf.correct(Xyah(b)));
+  }
+  static cv::Rect2d BoxOf(const cv::Mat& s) {
+    const double h = s.at<float>(3), w = s.at<float>(2) * h;
+    return {s.at<float>(0) - 0.5 * w, s.at<float>(1) - 0.5 * h, w, h};
+  }
+  void ResetSot() {
+    sot.reset();
+    sot_legacy.reset();
+  }
+};
+
+ByteTracker::ByteTracker(const TrackerOptions& options, const Camera* camera) : o_(options) {
+  o_.Check();
+  if (camera != nullptr && camera->has_pose) camera_ = *camera;
+}
+
+ByteTracker::~ByteTracker() = default;
+
+std::vector<TrackState> ByteTracker::Update(const std::vector<Detection>& detections,
+                                            const cv::Mat& frame) {
+  ++frame_;
+  ++stats_.frames;
+  for (auto& t : tracks_) {
+    t->matched = false;
+    t->sot_box = false;
+    t->Predict();
+    if (camera_) t->field_m = FootOnGround(*camera_, t->box, o_.foot_offset_m);
+  }
+  std::vector<std::optional<Eigen::Vector2d>> det_field(detections.size());
+  if (camera_) {
+    for (size_t i = 0; i < detections.size(); ++i) {
+      det_field[i] = FootOnGround(*camera_, detections[i].box, o_.foot_offset_m);
+    }
+  }
+  std::vector<int> high, low;
+  for (int i = 0; i < int(detections.size()); ++i) {
+    if (detections[i].score >= o_.high_score) {
+      high.push_back(i);
+    } else if (detections[i].score >= o_.low_score) {
+      low.push_back(i);
+    }
+  }
+  std::vector<char> det_used(detections.size(), 0);
+
+  auto apply = [&](Track& t, int d) {
+    t.Correct(detections[d].box);
+    t.matched = true;
+    t.score = detections[d].score;
+    t.hits++;
+    t.lost_frames = 0;
+    t.ResetSot();
+    if (camera_) t.field_m = FootOnGround(*camera_, t.box, o_.foot_offset_m);
+    if (detections[d].score >= o_.high_score) {
+      cv::Mat h = TorsoHistogram(frame, detections[d].box);
+      if (!h.empty()) t.hist = t.hist.empty() ? h : 0.9 * t.hist + 0.1 * h;
+    }
+    det_used[d] = 1;
+  };
+
+  // Cost of a track-detection pair; >= 1e9 when not allowed.
+  auto pair_cost = [&](const Track& t, int d, double min_iou, bool use_field) {
+    const double iou = Iou(t.box, detections[d].box);
+    if (!use_field || !camera_ || !t.field_m || !det_field[d] || o_.field_weight <= 0) {
+      return iou >= min_iou ? 1.0 - iou : 1e9;
+    }
+    const double gate = o_.field_gate_m * (1 + std::min(t.lost_frames, 5));
+    const double dist = (*t.field_m - *det_field[d]).norm();
+    if (dist > gate || (iou < min_iou && dist > 0.5 * gate)) return 1e9;
+    return (1 - o_.field_weight) * (1 - iou) + o_.field_weight * dist / gate;
+  };
+
+  auto associate = [&](const std::vector<Track*>& ts, const std::vector<int>& ds, double min_iou,
+                       bool use_field) {
+    std::vector<std::vector<double>> cost(ts.size(), std::vector<double>(ds.size()));
+    for (size_t i = 0; i < ts.size(); ++i) {
+      for (size_t j = 0; j < ds.size(); ++j)
+        cost[i][j] = pair_cost(*ts[i], ds[j], min_iou, use_field);
+    }
+    const std::vector<int> a = SolveAssignment(cost);
+    int n = 0;
+    for (size_t i = 0; i < ts.size(); ++i) {
+      if (a[i] >= 0) {
+        apply(*ts[i], ds[a[i]]);
+        ++n;
+      }
+    }
+    return n;
+  };
+
+  // Stage 1: confirmed tracks (tracked and lost) with high-score detections.
+  std::vector<Track*> pool;
+  for (auto& t : tracks_) {
+    if (t->state != State::kNew) pool.push_back(t.get());
+  }
+  stats_.first_stage_matches += associate(pool, high, o_.match_iou, true);
+  // Stage 2: tracked tracks left with low-score detections (IoU only, as in ByteTrack).
+  std::vector<Track*> left;
+  for (Track* t : pool) {
+    if (!t->matched && t->state == State::kTracked) left.push_back(t);
+  }
+  stats_.second_stage_matches += associate(left, low, o_.low_match_iou, false);
+  // Unconfirmed tracks with the high-score detections left.
+  std::vector<Track*> fresh;
+  for (auto& t : tracks_) {
+    if (t->state == State::kNew) fresh.push_back(t.get());
+  }
+  std::vector<int> high_left;
+  for (int d : high) {
+    if (!det_used[d]) high_left.push_back(d);
+  }
+  associate(fresh, high_left, 0.3, true);
+
+  // Tracks not matched: single-target tracker or lost.
+  for (auto& t : tracks_) {
+    if (t->matched) {
+      if (t->state == State::kLost) t->state = State::kTracked;
+      if (t->state == State::kNew && (t->hits >= o_.min_hits)) {
+        t->state = State::kTracked;
+        t->id = next_id_++;
+        ++stats_.tracks_started;
+      }
+      continue;
+    }
+    if (t->state == State::kNew) {
+      t->lost_frames = 1 << 20;  // unconfirmed and missed: dropped below
+      continue;
+    }
+    bool carried = false;
+    if (o_.sot != "none" && t->state == State::kTracked && !frame.empty()) {
+      if (!t->sot && !t->sot_legacy && !previous_frame_.empty()) {
+        const cv::Rect init = cv::Rect(t->box) & cv::Rect(0, 0, frame.cols, frame.rows);
+        if (init.width > 4 && init.height > 4) {
+          if (o_.sot == "csrt") t->sot = cv::TrackerCSRT::create();
+          if (o_.sot == "kcf") t->sot = cv::TrackerKCF::create();
+          if (o_.sot == "mosse") t->sot_legacy = cv::legacy::TrackerMOSSE::create();
+          if (t->sot) t->sot->init(previous_frame_, init);
+          if (t->sot_legacy) t->sot_legacy->init(previous_frame_, cv::Rect2d(init));
+        }
+      }
+      if (t->sot) {
+        cv::Rect r;
+        if (t->sot->update(frame, r)) {
+          t->Correct(cv::Rect2d(r));
+          carried = true;
+        }
+      } else if (t->sot_legacy) {
+        cv::Rect2d r;
+        if (t->sot_legacy->update(frame, r)) {
+          t->Correct(r);
+          carried = true;
+        }
+      }
+      if (carried && camera_) t->field_m = FootOnGround(*camera_, t->box, o_.foot_offset_m);
+      if (!carried) t->ResetSot();
+    }
+    t->sot_box = carried;
+    t->lost_frames++;
+    if (!carried) t->state = State::kLost;
+  }
+
+  // Re-finding lost tracks by appearance, then new tracks.
+  std::vector<int> unmatched;
+  for (int d : high) {
+    if (!det_used[d] && detections[d].score >= o_.new_track_score) unmatched.push_back(d);
+  }
+  std::vector<Track*> lost;
+  for (auto& t : tracks_) {
+    if (t->state == State::kLost && !t->matched && !t->hist.empty() &&
+        t->lost_frames <= o_.max_lost_frames) {
+      lost.push_back(t.get());
+    }
+  }
+  if (!lost.empty() && !unmatched.empty() && !frame.empty()) {
+    std::vector<cv::Mat> hists(unmatched.size());
+    for (size_t j = 0; j < unmatched.size(); ++j) {
+      hists[j] = TorsoHistogram(frame, detections[unmatched[j]].box);
+    }
+    std::vector<std::vector<double>> cost(lost.size(), std::vector<double>(unmatched.size(), 1e9));
+    for (size_t i = 0; i < lost.size(); ++i) {
+      for (size_t j = 0; j < unmatched.size(); ++j) {
+        if (hists[j].empty()) continue;
+        const int d = unmatched[j];
+        bool in_reach;
+        if (camera_ && lost[i]->field_m && det_field[d]) {
+          const double reach = o_.reid_speed_mps * lost[i]->lost_frames / o_.fps + 1.0;
+          in_reach = (*lost[i]->field_m - *det_field[d]).norm() <= reach;
+        } else {
+          const cv::Point2d a(lost[i]->box.x + 0.5 * lost[i]->box.width,
+                              lost[i]->box.y + lost[i]->box.height);
+          const cv::Point2d b(detections[d].box.x + 0.5 * detections[d].box.width,
+                              detections[d].box.y + detections[d].box.height);
+          in_reach =
+              cv::norm(a - b) <= o_.reid_speed_px * lost[i]->lost_frames + detections[d].box.height;
+        }
+        if (!in_reach) continue;
+        const double dist = cv::compareHist(lost[i]->hist, hists[j], cv::HISTCMP_BHATTACHARYYA);
+        if (dist <= o_.reid_max_distance) cost[i][j] = dist;
+      }
+    }
+    const std::vector<int> a = SolveAssignment(cost);
+    for (size_t i = 0; i < lost.size(); ++i) {
+      if (a[i] < 0) continue;
+      Track& t = *lost[i];
+      t.Init(detections[unmatched[a[i]]].box);
+      apply(t, unmatched[a[i]]);
+      t.state = State::kTracked;
+      ++stats_.refound;
+    }
+  }
+  for (int d : unmatched) {
+    if (det_used[d]) continue;
+    auto t = std::make_unique<Track>();
+    t->Init(detections[d].box);
+    t->score = detections[d].score;
+    t->hits = 1;
+    t->matched = true;
+    if (camera_) t->field_m = FootOnGround(*camera_, t->box, o_.foot_offset_m);
+    t->hist = TorsoHistogram(frame, detections[d].box);
+    if (frame_ == 1 || o_.min_hits <= 1) {
+      t->state = State::kTracked;
+      t->id = next_id_++;
+      ++stats_.tracks_started;
+    }
+    tracks_.push_back(std::move(t));
+  }
+  std::erase_if(tracks_, [&](const std::unique_ptr<Track>& t) {
+    return t->lost_frames > o_.max_lost_frames;
+  });
+
+  std::vector<TrackState> out;
+  for (auto& t : tracks_) {
+    if (t->state != State::kTracked || t->id == 0) continue;
+    if (!t->matched && !t->sot_box) continue;
+    out.push_back({t->id, t->box, t->matched ? t->score : 0.0, t->field_m, !t->matched});
+  }
+  if (o_.sot != "none" && !frame.empty()) previous_frame_ = frame.clone();
+  return out;
+}
+
+}  // namespace fv::track

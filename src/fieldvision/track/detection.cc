@@ -1,0 +1,377 @@
+#include "fieldvision/track/detection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/objdetect.hpp>
+#include <opencv2/video/background_segm.hpp>
+
+#include "fieldvision/geometry/rigid.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::track {
+namespace fs = std::filesystem;
+
+void DetectorOptions::Check() const {
+  FV_REQUIRE(kind == "nanodet" || kind == "hog" || kind == "motion" || kind == "onnx",
+             "detector kind '{}' is not one of nanodet, hog, motion, onnx", kind);
+  FV_REQUIRE(input_width >= 64 && input_width % 32 == 0,
+             "input_width must be a multiple of 32 and >= 64 (got {})", input_width);
+  FV_REQUIRE(input_height == 0 || (input_height >= 64 && input_height % 32 == 0),
+             "input_height must be 0 or a multiple of 32 and >= 64 (got {})", input_height);
+  CheckInRange(score_threshold, 0.0, 1.0, "score_threshold");
+  CheckInRange(nms_iou, 0.0, 1.0, "nms_iou");
+  CheckNonNegative(threads, "threads");
+  CheckInRange(hog_upscale, 0.25, 4.0, "hog_upscale");
+  CheckFinite(hog_hit_threshold, "hog_hit_threshold");
+  CheckPositive(motion_history, "motion_history");
+  CheckPositive(motion_var_threshold, "motion_var_threshold");
+  CheckInRange(motion_min_fill, 0.0, 1.0, "motion_min_fill");
+  CheckPositive(person_height_m, "person_height_m");
+  CheckPositive(person_width_m, "person_width_m");
+  CheckNonNegative(onnx_person_class, "onnx_person_class");
+  FV_REQUIRE(kind != "onnx" || !model_path.empty(),
+             "detector 'onnx' needs a model file (--onnx MODEL.onnx)");
+}
+
+double Iou(const cv::Rect2d& a, const cv::Rect2d& b) {
+  const double inter = (a & b).area();
+  const double uni = a.area() + b.area() - inter;
+  return uni > 0 ? inter / uni : 0.0;
+}
+
+std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_threshold,
+                           double score_threshold) {
+  std::vector<cv::Rect2d> boxes;
+  std::vector<float> scores;
+  for (const auto& d : detections) {
+    boxes.push_back(d.box);
+    scores.push_back(static_cast<float>(d.score));
+  }
+  std::vector<int> keep;
+  cv::dnn::NMSBoxes(boxes, scores, static_cast<float>(score_threshold),
+                    static_cast<float>(iou_threshold), keep);
+  std::vector<Detection> out;
+  for (int i : keep) out.push_back(detections[i]);
+  std::sort(out.begin(), out.end(),
+            [](const Detection& a, const Detection& b) { return a.score > b.score; });
+  return out;
+}
+
+std::string FindModel(const std::string& file) {
+  std::vector<fs::path> dirs;
+  if (const char* env = std::getenv("FV_MODELS_DIR")) dirs.emplace_back(env);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back(exe.parent_path().parent_path() / "models");
+  dirs.push_back(fs::current_path(ec) / "models");
+  dirs.push_back(fs::current_path(ec) / "build" / "models");
+  std::string looked;
+  for (const auto& d : dirs) {
+    const fs::path p = d / file;
+    if (fs::exists(p, ec)) return p.string();
+    looked += (looked.empty() ? "" : ", ") + d.string();
+  }
+  Throw(
+      "model '{}' not found (looked in {}); run `make build`, which fetches and converts it "
+      "(scripts/fetch-models.sh BUILD_DIR)",
+      file, looked);
+}
+
+namespace {
+
+cv::dnn::Net LoadOnnx(const std::string& path) {
+  FV_REQUIRE(fs::exists(path),
+             "model '{}' not found; run `make build` to fetch and convert the detector", path);
+  cv::dnn::Net net;
+  try {
+    net = cv::dnn::readNetFromONNX(path);
+  } catch (const cv::Exception& e) {
+    Throw(
+        "model '{}' is corrupt or not an ONNX model OpenCV can read; run `make build` to fetch "
+        "and convert it again",
+        path);
+  }
+  FV_REQUIRE(!net.empty(), "model '{}' has no layers; run `make build` to fetch it again", path);
+  net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+  net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+  return net;
+}
+
+// Keeps detections whose foot point passes the filter, then NMS.
+std::vector<Detection> Finish(std::vector<Detection> dets, const DetectorOptions& o,
+                              const FootFilter& filter) {
+  if (filter) {
+    std::erase_if(dets, [&](const Detection& d) {
+      return !filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height});
+    });
+  }
+  return Nms(dets, o.nms_iou, o.score_threshold);
+}
+
+class NanoDetDetector : public PersonDetector {
+ public:
+  NanoDetDetector(const DetectorOptions& o, FootFilter filter) : o_(o), filter_(std::move(filter)) {
+    path_ = o.model_path.empty() ? FindModel("nanodet.onnx") : o.model_path;
+    net_ = LoadOnnx(path_);
+    // A forward pass on a blank image checks that the model has NanoDet's outputs.
+    try {
+      RunNet(cv::Mat(o.input_width, o.input_width, CV_8UC3, cv::Scalar::all(0)));
+    } catch (const cv::Exception& e) {
+      Throw(
+          "model '{}' does not run as NanoDet (outputs cls8..dis32 expected); run `make build` "
+          "to convert it again",
+          path_);
+    }
+  }
+  std::string name() const override { return "nanodet"; }
+
+  std::vector<Detection> Detect(const cv::Mat& bgr) override {
+    FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "nanodet: expected a BGR frame");
+    const int net_w = o_.input_width;
+    const int net_h =
+        o_.input_height > 0
+            ? o_.input_height
+            : std::max(
+                  32,
+                  static_cast<int>(std::lround(net_w * double(bgr.rows) / bgr.cols / 32.0)) * 32);
+    cv::Mat resized;
+    cv::resize(bgr, resized, cv::Size(net_w, net_h), 0, 0, cv::INTER_LINEAR);
+    const std::vector<cv::Mat> outs = RunNet(resized);
+    std::vector<Detection> dets = DecodeNanoDet(outs, net_w, net_h, o_.score_threshold);
+    const double sx = double(bgr.cols) / net_w, sy = double(bgr.rows) / net_h;
+    for (auto& d : dets) {
+      d.box = cv::Rect2d(d.box.x * sx, d.box.y * sy, d.box.width * sx, d.box.height * sy);
+    }
+    return Finish(std::move(dets), o_, filter_);
+  }
+
+ private:
+  std::vector<cv::Mat> RunNet(const cv::Mat& resized) {
+    cv::Mat f;
+    resized.convertTo(f, CV_32FC3);
+    cv::subtract(f, cv::Scalar(103.53, 116.28, 123.675), f);
+    cv::multiply(f, cv::Scalar(1 / 57.375, 1 / 57.12, 1 / 58.395), f);
+    net_.setInput(cv::dnn::blobFromImage(f));
+    std::vector<cv::Mat> outs;
+    net_.forward(outs, std::vector<cv::String>{"cls8", "cls16", "cls32", "dis8", "dis16", "dis32"});
+    return outs;
+  }
+
+  DetectorOptions o_;
+  FootFilter filter_;
+  std::string path_;
+  cv::dnn::Net net_;
+};
+
+class HogDetector : public PersonDetector {
+ public:
+  HogDetector(const DetectorOptions& o, FootFilter filter) : o_(o), filter_(std::move(filter)) {
+    hog_.setSVMDetector(cv::HOGDescriptor::getDefaultPeopleDetector());
+  }
+  std::string name() const override { return "hog"; }
+  std::vector<Detection> Detect(const cv::Mat& bgr) override {
+    FV_REQUIRE(!bgr.empty(), "hog: empty frame");
+    cv::Mat img;
+    cv::resize(bgr, img, cv::Size(), o_.hog_upscale, o_.hog_upscale, cv::INTER_LINEAR);
+    std::vector<cv::Rect> rects;
+    std::vector<double> weights;
+    hog_.detectMultiScale(img, rects, weights, o_.hog_hit_threshold, cv::Size(8, 8), cv::Size(),
+                          1.05, 0.0, false);
+    std::vector<Detection> dets;
+    const double s = 1.0 / o_.hog_upscale;
+    for (size_t i = 0; i < rects.size(); ++i) {
+      // The 64 x 128 window holds a person of about 32 x 100 pixels: shrink to the person.
+      const cv::Rect2d r(rects[i].x * s, rects[i].y * s, rects[i].width * s, rects[i].height * s);
+      const cv::Rect2d person(r.x + 0.22 * r.width, r.y + 0.08 * r.height, 0.56 * r.width,
+                              0.84 * r.height);
+      dets.push_back({person, 1.0 / (1.0 + std::exp(-2.0 * weights[i]))});
+    }
+    return Finish(std::move(dets), o_, filter_);
+  }
+
+ private:
+  DetectorOptions o_;
+  FootFilter filter_;
+  cv::HOGDescriptor hog_;
+};
+
+class MotionDetector : public PersonDetector {
+ public:
+  MotionDetector(const DetectorOptions& o, const Camera* camera, FootFilter filter)
+      : o_(o), filter_(std::move(filter)) {
+    if (camera != nullptr && camera->has_pose) camera_ = *camera;
+    mog_ = cv::createBackgroundSubtractorMOG2(o.motion_history, o.motion_var_threshold, true);
+  }
+  std::string name() const override { return "motion"; }
+
+  // Expected person box size (w, h) in pixels with the foot at `foot`; nullopt without a camera.
+  std::optional<cv::Size2d> Expected(const cv::Point2d& foot) const {
+    if (!camera_) return std::nullopt;
+    const auto ray = camera_->RayFromPixel({foot.x, foot.y});
+    if (!ray) return std::nullopt;
+    const auto ground = IntersectHorizontalPlane(*ray, 0.0);
+    if (!ground) return std::nullopt;
+    const auto head = camera_->Project(*ground + Eigen::Vector3d(0, 0, o_.person_height_m));
+    if (!head) return std::nullopt;
+    const double h = std::abs(foot.y - head->y());
+    return cv::Size2d(h * o_.person_width_m / o_.person_height_m, h);
+  }
+
+  std::vector<Detection> Detect(const cv::Mat& bgr) override {
+    FV_REQUIRE(!bgr.empty(), "motion: empty frame");
+    cv::Mat fg;
+    mog_->apply(bgr, fg);
+    cv::threshold(fg, fg, 200, 255, cv::THRESH_BINARY);  // drop shadows (127)
+    cv::morphologyEx(fg, fg, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(3, 3)));
+    cv::morphologyEx(fg, fg, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 9)));
+    cv::Mat labels, stats, centroids;
+    const int n = cv::connectedComponentsWithStats(fg, labels, stats, centroids, 8, CV_32S);
+    std::vector<Detection> dets;
+    for (int i = 1; i < n; ++i) {
+      const cv::Rect blob(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
+                          stats.at<int>(i, cv::CC_STAT_WIDTH),
+                          stats.at<int>(i, cv::CC_STAT_HEIGHT));
+      const double area = stats.at<int>(i, cv::CC_STAT_AREA);
+      if (area < 30) continue;
+      const cv::Point2d foot(blob.x + 0.5 * blob.width, blob.y + blob.height);
+      const auto expected = Expected(foot);
+      const double exp_w = expected ? expected->width : 0.4 * blob.height;
+      const double exp_h = expected ? expected->height : blob.height;
+      if (exp_h < 8) continue;
+      if (blob.height < 0.4 * exp_h) continue;  // too short to be a person
+      // Split blobs wider than one person into side-by-side people.
+      const int parts = std::max(1, static_cast<int>(std::lround(blob.width / (1.2 * exp_w))));
+      const double part_w = double(blob.width) / parts;
+      for (int k = 0; k < parts; ++k) {
+        const cv::Rect part(static_cast<int>(blob.x + k * part_w), blob.y,
+                            std::max(1, static_cast<int>(part_w)), blob.height);
+        cv::Mat mask = (labels(part) == i);
+        const double fill = cv::countNonZero(mask);
+        const double expected_area = exp_w * std::min<double>(exp_h, blob.height);
+        if (fill < o_.motion_min_fill * expected_area) continue;
+        // Tighten the part to its own pixels.
+        const cv::Rect tight = cv::boundingRect(mask) + part.tl();
+        const double score = std::clamp(fill / std::max(1.0, exp_w * exp_h), 0.0, 1.0);
+        dets.push_back({cv::Rect2d(tight), 0.3 + 0.7 * score});
+      }
+    }
+    return Finish(std::move(dets), o_, filter_);
+  }
+
+ private:
+  DetectorOptions o_;
+  FootFilter filter_;
+  std::optional<Camera> camera_;
+  cv::Ptr<cv::BackgroundSubtractorMOG2> mog_;
+};
+
+// A YOLO-style model (YOLOv5/v8 exports): one output of rows (cx, cy, w, h, obj, classes...) or,
+// for v8, (cx, cy, w, h, classes...) transposed; square input of input_width.
+class OnnxYoloDetector : public PersonDetector {
+ public:
+  OnnxYoloDetector(const DetectorOptions& o, FootFilter filter)
+      : o_(o), filter_(std::move(filter)), net_(LoadOnnx(o.model_path)) {}
+  std::string name() const override { return "onnx"; }
+  std::vector<Detection> Detect(const cv::Mat& bgr) override {
+    const int s = o_.input_width;
+    net_.setInput(cv::dnn::blobFromImage(bgr, 1.0 / 255, cv::Size(s, s), cv::Scalar(), true));
+    cv::Mat out;
+    try {
+      out = net_.forward();
+    } catch (const cv::Exception& e) {
+      Throw("model '{}' failed to run on a {}x{} input: {}", o_.model_path, s, s,
+            e.err.substr(0, 120));
+    }
+    FV_REQUIRE(out.dims == 3, "model '{}': expected a 1 x N x K output", o_.model_path);
+    cv::Mat rows(out.size[1], out.size[2], CV_32F, out.ptr<float>());
+    bool v8 = false;
+    if (rows.rows < rows.cols) {  // 1 x (4 + C) x N (YOLOv8): transpose
+      rows = rows.t();
+      v8 = true;
+    }
+    const int first_class = v8 ? 4 : 5;
+    FV_REQUIRE(rows.cols > first_class + o_.onnx_person_class,
+               "model '{}': {} columns per row, too few for class {}", o_.model_path, rows.cols,
+               o_.onnx_person_class);
+    const double sx = double(bgr.cols) / s, sy = double(bgr.rows) / s;
+    std::vector<Detection> dets;
+    for (int r = 0; r < rows.rows; ++r) {
+      const float* p = rows.ptr<float>(r);
+      const double score = (v8 ? 1.0 : p[4]) * p[first_class + o_.onnx_person_class];
+      if (score < o_.score_threshold) continue;
+      dets.push_back(
+          {cv::Rect2d((p[0] - 0.5 * p[2]) * sx, (p[1] - 0.5 * p[3]) * sy, p[2] * sx, p[3] * sy),
+           score});
+    }
+    return Finish(std::move(dets), o_, filter_);
+  }
+
+ private:
+  DetectorOptions o_;
+  FootFilter filter_;
+  cv::dnn::Net net_;
+};
+
+}  // namespace
+
+std::vector<Detection> DecodeNanoDet(const std::vector<cv::Mat>& outputs, int net_width,
+                                     int net_height, double score_threshold) {
+  FV_REQUIRE(outputs.size() == 6, "NanoDet: expected 6 outputs, got {}", outputs.size());
+  constexpr int kStrides[3] = {8, 16, 32};
+  constexpr int kBins = 11;
+  constexpr int kPerson = 0;
+  std::vector<Detection> dets;
+  for (int level = 0; level < 3; ++level) {
+    const int s = kStrides[level];
+    const int fw = (net_width + s - 1) / s, fh = (net_height + s - 1) / s;
+    const cv::Mat& cls = outputs[level];
+    const cv::Mat& dis = outputs[3 + level];
+    FV_REQUIRE(cls.total() == size_t(fw) * fh * 80 && dis.total() == size_t(fw) * fh * 44,
+               "NanoDet: output sizes do not match a {}x{} input", net_width, net_height);
+    const float* c = cls.ptr<float>();
+    const float* d = dis.ptr<float>();
+    for (int idx = 0; idx < fw * fh; ++idx) {
+      const float score = c[idx * 80 + kPerson];
+      if (score < score_threshold) continue;
+      const double cx = (idx % fw + 0.5) * s, cy = (idx / fw + 0.5) * s;
+      double side[4];
+      for (int k = 0; k < 4; ++k) {
+        const float* bins = d + idx * 44 + k * kBins;
+        const float mx = *std::max_element(bins, bins + kBins);
+        double sum = 0, mean = 0;
+        for (int b = 0; b < kBins; ++b) {
+          const double e = std::exp(double(bins[b]) - mx);
+          sum += e;
+          mean += e * b;
+        }
+        side[k] = mean / sum * s;
+      }
+      const double x0 = std::max(0.0, cx - side[0]), y0 = std::max(0.0, cy - side[1]);
+      const double x1 = std::min<double>(net_width, cx + side[2]);
+      const double y1 = std::min<double>(net_height, cy + side[3]);
+      if (x1 <= x0 || y1 <= y0) continue;
+      dets.push_back({cv::Rect2d(x0, y0, x1 - x0, y1 - y0), score});
+    }
+  }
+  return dets;
+}
+
+std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options, const Camera* camera,
+                                             FootFilter filter) {
+  options.Check();
+  if (options.threads > 0) cv::setNumThreads(options.threads);
+  if (options.kind == "nanodet") return std::make_unique<NanoDetDetector>(options, filter);
+  if (options.kind == "hog") return std::make_unique<HogDetector>(options, filter);
+  if (options.kind == "motion") return std::make_unique<MotionDetector>(options, camera, filter);
+  return std::make_unique<OnnxYoloDetector>(options, filter);
+}
+
+}  // namespace fv::track

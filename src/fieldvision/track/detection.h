@@ -1,0 +1,94 @@
+// Person detectors behind one interface, chosen by DetectorOptions::kind:
+//  - "nanodet": the pretrained NanoDet-m (RangiLyu 2020, Apache-2.0; COCO "person" class), an ONNX
+//    model converted at set-up by scripts/nanodet_to_onnx.py and run with OpenCV's dnn; decoding of
+//    its GFL head (Li et al. 2020: per-stride class scores and 4 x 11-bin distance distributions
+//    at strides 8/16/32, box = centre -/+ stride * E[bin]);
+//  - "hog": OpenCV's HOG + linear SVM people detector (Dalal & Triggs 2005);
+//  - "motion": background subtraction for a fixed camera (cv::BackgroundSubtractorMOG2, Zivkovic
+//    2004), foreground blobs split and filtered by the expected image size of a person standing at
+//    the blob's foot point (from the calibration);
+//  - "onnx": a user's YOLO-style ONNX model (rows of cx, cy, w, h, objectness, class scores).
+// Every detector applies non-maximum suppression (cv::dnn::NMSBoxes) and keeps only people whose
+// foot point is on the ground inside an optional area (the field plus a margin).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "fieldvision/camera/camera.h"
+
+namespace fv::track {
+
+struct Detection {
+  cv::Rect2d box;  // image pixels
+  double score = 0.0;
+};
+
+struct DetectorOptions {
+  std::string kind = "nanodet";  // nanodet | hog | motion | onnx
+  // Model file (nanodet: default FindModel("nanodet.onnx"); onnx: required).
+  std::string model_path;
+  // Network input width in pixels (multiple of 32); the height follows the frame's aspect ratio.
+  // 416 is NanoDet's training size; smaller is faster and misses small people.
+  int input_width = 416;
+  int input_height = 0;          // 0: from the frame's aspect ratio (rounded to a multiple of 32)
+  double score_threshold = 0.2;  // lowest score reported (ByteTrack uses the low ones too)
+  double nms_iou = 0.5;          // IoU above which the weaker of two boxes is dropped
+  int threads = 0;               // OpenCV threads (cv::setNumThreads); 0 leaves the default
+  // HOG: the frame is scaled by this before detection (the window is 64 x 128 pixels, so people
+  // smaller than about 100 pixels need upscaling).
+  double hog_upscale = 1.6;
+  double hog_hit_threshold = 0.0;  // SVM margin
+  // Motion: MOG2 history and variance threshold; a blob must cover at least this share of the
+  // expected person box; person height and width in metres for the expected box.
+  int motion_history = 200;
+  double motion_var_threshold = 16.0;
+  double motion_min_fill = 0.25;
+  double person_height_m = 1.75;
+  double person_width_m = 0.6;
+  // onnx: the class index of "person" in the user's model.
+  int onnx_person_class = 0;
+
+  void Check() const;
+};
+
+class PersonDetector {
+ public:
+  virtual ~PersonDetector() = default;
+  // Boxes of people in a BGR frame, after NMS, sorted by decreasing score.
+  virtual std::vector<Detection> Detect(const cv::Mat& bgr) = 0;
+  virtual std::string name() const = 0;
+};
+
+// Accepts a detection whose foot point (bottom centre) is in the area of interest.
+using FootFilter = std::function<bool(const cv::Point2d& foot_px)>;
+
+// The detector chosen by options.kind. `camera` (calibrated, may be null) gives the motion
+// detector the expected person size; `filter` (may be empty) drops detections outside the area.
+// Throws fv::Error for bad options or a missing/corrupt model (saying how to get it).
+std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options,
+                                             const Camera* camera = nullptr,
+                                             FootFilter filter = {});
+
+// Greedy NMS over boxes sorted by score (cv::dnn::NMSBoxes).
+std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_threshold,
+                           double score_threshold = 0.0);
+double Iou(const cv::Rect2d& a, const cv::Rect2d& b);
+
+// Where the set-up put the models: $FV_MODELS_DIR, <program dir>/../models, ./models,
+// ./build/models. Returns the first existing path of `file`, or throws fv::Error saying to run
+// `make build` (which runs scripts/fetch-models.sh).
+std::string FindModel(const std::string& file);
+
+// NanoDet's decoder, exposed for tests: the six outputs (cls8, cls16, cls32: 1 x N x 80;
+// dis8, dis16, dis32: 1 x N x 44) of a net_width x net_height input -> person boxes in network
+// pixels with score >= score_threshold (before NMS).
+std::vector<Detection> DecodeNanoDet(const std::vector<cv::Mat>& outputs, int net_width,
+                                     int net_height, double score_threshold);
+
+}  // namespace fv::track

@@ -1,0 +1,311 @@
+#include "fieldvision/track/players.h"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+
+namespace fv::track {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// Reads frames in its own thread into a small queue (decoding overlaps detection).
+class FrameReader {
+ public:
+  FrameReader(const std::string& path, int max_frames) : max_frames_(max_frames) {
+    cv::VideoCapture cap;
+    try {
+      cap.open(path);
+    } catch (const cv::Exception&) {
+    }
+    FV_REQUIRE(cap.isOpened(),
+               "cannot open video '{}' (missing file or a format OpenCV cannot "
+               "read)",
+               path);
+    fps_ = cap.get(cv::CAP_PROP_FPS);
+    total_ = static_cast<int>(cap.get(cv::CAP_PROP_FRAME_COUNT));
+    cv::Mat first;
+    bool ok = false;
+    try {
+      ok = cap.read(first);
+    } catch (const cv::Exception&) {
+    }
+    FV_REQUIRE(ok && !first.empty(), "video '{}' has no readable frame (corrupt?)", path);
+    size_ = first.size();
+    queue_.push_back(first);
+    thread_ = std::thread([this, cap = std::move(cap)]() mutable { Run(cap); });
+  }
+  ~FrameReader() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    if (thread_.joinable()) thread_.join();
+  }
+  // Next frame, or false at the end.
+  bool Next(cv::Mat& frame) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [&] { return !queue_.empty() || done_; });
+    if (queue_.empty()) return false;
+    frame = queue_.front();
+    queue_.pop_front();
+    cv_.notify_all();
+    return true;
+  }
+  double fps() const { return fps_; }
+  int total() const { return total_; }
+  cv::Size size() const { return size_; }
+  double read_seconds() const { return read_s_; }
+
+ private:
+  void Run(cv::VideoCapture& cap) {
+    int n = 1;
+    while (true) {
+      if (max_frames_ > 0 && n >= max_frames_) break;
+      cv::Mat f;
+      const auto t0 = Clock::now();
+      bool ok = false;
+      try {
+        ok = cap.read(f);
+      } catch (const cv::Exception&) {
+      }
+      read_s_ += Seconds(t0, Clock::now());
+      if (!ok || f.empty()) break;
+      ++n;
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [&] { return queue_.size() < 8 || stop_; });
+      if (stop_) break;
+      queue_.push_back(std::move(f));
+      cv_.notify_all();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+    cv_.notify_all();
+  }
+
+  int max_frames_;
+  double fps_ = 0;
+  int total_ = 0;
+  cv::Size size_;
+  double read_s_ = 0;
+  std::deque<cv::Mat> queue_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool done_ = false, stop_ = false;
+  std::thread thread_;
+};
+
+}  // namespace
+
+void PlayersOptions::Check() const {
+  detector.Check();
+  tracker.Check();
+  CheckNonNegative(field_margin_m, "field_margin_m");
+  CheckNonNegative(max_frames, "max_frames");
+  CheckNonNegative(interpolate_max_gap, "interpolate_max_gap");
+  CheckNonNegative(min_track_frames, "min_track_frames");
+  CheckNonNegative(fps, "fps");
+}
+
+std::string PlayersResult::Summary() const {
+  const double f = std::max(1, frames);
+  return fmt::format(
+      "{} frames, {} detections ({}), {} tracks, {} rows ({} interpolated, {} off the ground); "
+      "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
+      "{:.1f}, map {:.1f}); tracker: {}",
+      frames, detections, detector, tracks, rows.size(), interpolated, off_ground, times.total_s,
+      frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f, 1000 * times.detect_s / f,
+      1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary());
+}
+
+void CheckCameraMatchesVideo(const Camera& camera, int width, int height,
+                             const std::string& video) {
+  FV_REQUIRE(camera.width == width && camera.height == height,
+             "camera '{}' is for {}x{} images but video '{}' is {}x{}: use the camera file made "
+             "for this video",
+             camera.name.empty() ? "(unnamed)" : camera.name, camera.width, camera.height, video,
+             width, height);
+}
+
+int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const Camera* camera,
+                    double foot_offset_m) {
+  if (max_gap <= 0) return 0;
+  std::map<int, std::vector<TrackRow>> by_id;
+  for (const auto& r : rows) by_id[r.id].push_back(r);
+  int added = 0;
+  std::vector<TrackRow> extra;
+  for (auto& [id, rs] : by_id) {
+    std::sort(rs.begin(), rs.end(),
+              [](const TrackRow& a, const TrackRow& b) { return a.frame < b.frame; });
+    for (size_t i = 1; i < rs.size(); ++i) {
+      const int gap = rs[i].frame - rs[i - 1].frame;
+      if (gap <= 1 || gap - 1 > max_gap) continue;
+      for (int f = rs[i - 1].frame + 1; f < rs[i].frame; ++f) {
+        const double t = double(f - rs[i - 1].frame) / gap;
+        TrackRow r;
+        r.frame = f;
+        r.id = id;
+        const cv::Rect2d& a = rs[i - 1].box;
+        const cv::Rect2d& b = rs[i].box;
+        r.box = cv::Rect2d(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y),
+                           a.width + t * (b.width - a.width), a.height + t * (b.height - a.height));
+        r.conf = 0.0;
+        if (camera != nullptr && camera->has_pose) {
+          if (const auto g = FootOnGround(*camera, r.box, foot_offset_m)) {
+            r.x_m = g->x();
+            r.y_m = g->y();
+          }
+        }
+        extra.push_back(r);
+        ++added;
+      }
+    }
+  }
+  rows.insert(rows.end(), extra.begin(), extra.end());
+  std::sort(rows.begin(), rows.end(), [](const TrackRow& a, const TrackRow& b) {
+    return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
+  });
+  return added;
+}
+
+PlayersResult RunPlayers(const std::string& video, const Camera* camera, const FieldModel* field,
+                         const PlayersOptions& options) {
+  options.Check();
+  const auto t_start = Clock::now();
+  const bool calibrated = camera != nullptr && camera->has_pose;
+  FootFilter filter;
+  if (calibrated) {
+    const Camera cam = *camera;
+    std::optional<FieldModel> f;
+    if (field != nullptr) f = *field;
+    const double margin = options.field_margin_m;
+    filter = [cam, f, margin](const cv::Point2d& foot) {
+      const auto ray = cam.RayFromPixel({foot.x, foot.y});
+      if (!ray) return false;
+      const auto g = IntersectHorizontalPlane(*ray, 0.0);
+      if (!g) return false;
+      if (!f) return true;
+      return std::abs(g->x()) <= 0.5 * f->length_m + margin &&
+             std::abs(g->y()) <= 0.5 * f->width_m + margin;
+    };
+  }
+  // Open the video first: a bad video is reported before the model is loaded.
+  FrameReader reader(video, options.max_frames);
+  if (camera != nullptr) {
+    CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
+  }
+  std::unique_ptr<PersonDetector> detector =
+      MakeDetector(options.detector, calibrated ? camera : nullptr, filter);
+  PlayersResult result;
+  result.detector = detector->name();
+  result.fps = options.fps > 0 ? options.fps : (reader.fps() > 0 ? reader.fps() : 25.0);
+  TrackerOptions topt = options.tracker;
+  topt.fps = result.fps;
+  ByteTracker tracker(topt, calibrated ? camera : nullptr);
+  long long total = reader.total();
+  if (options.max_frames > 0 && (total <= 0 || total > options.max_frames)) {
+    total = options.max_frames;
+  }
+  Progress progress("players", total, "frames", options.progress);
+  std::map<int, std::vector<cv::Vec3f>> torso_colours;
+  cv::Mat frame;
+  int index = 0;
+  while (reader.Next(frame)) {
+    const auto t0 = Clock::now();
+    const std::vector<Detection> dets = detector->Detect(frame);
+    const auto t1 = Clock::now();
+    const std::vector<TrackState> states = tracker.Update(dets, frame);
+    const auto t2 = Clock::now();
+    result.detections += static_cast<int>(dets.size());
+    for (const auto& s : states) {
+      TrackRow r;
+      r.frame = index;
+      r.id = s.id;
+      r.box = s.box;
+      r.conf = s.score;
+      if (calibrated) {
+        if (s.field_m) {
+          r.x_m = s.field_m->x();
+          r.y_m = s.field_m->y();
+        } else {
+          result.off_ground++;
+        }
+      }
+      result.rows.push_back(r);
+      if (options.teams && !s.predicted) {
+        const cv::Rect torso =
+            cv::Rect(cv::Rect2d(s.box.x + 0.3 * s.box.width, s.box.y + 0.2 * s.box.height,
+                                0.4 * s.box.width, 0.3 * s.box.height)) &
+            cv::Rect(0, 0, frame.cols, frame.rows);
+        if (torso.area() > 4) {
+          cv::Mat lab;
+          cv::cvtColor(frame(torso), lab, cv::COLOR_BGR2Lab);
+          const cv::Scalar m = cv::mean(lab);
+          torso_colours[s.id].push_back(cv::Vec3f(m[0] * 0.3, m[1], m[2]));  // chroma first
+        }
+      }
+    }
+    result.times.detect_s += std::chrono::duration<double>(t1 - t0).count();
+    result.times.track_s += std::chrono::duration<double>(t2 - t1).count();
+    ++index;
+    progress.Update(index);
+  }
+  progress.Finish();
+  result.frames = index;
+  FV_REQUIRE(index > 0, "video '{}' has no readable frame", video);
+  const auto t_map = Clock::now();
+  // Short tracks are usually false detections.
+  if (options.min_track_frames > 0) {
+    std::map<int, int> count;
+    for (const auto& r : result.rows) count[r.id]++;
+    std::erase_if(result.rows,
+                  [&](const TrackRow& r) { return count[r.id] < options.min_track_frames; });
+  }
+  result.interpolated =
+      InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
+                      options.tracker.foot_offset_m);
+  std::set<int> ids;
+  for (const auto& r : result.rows) ids.insert(r.id);
+  result.tracks = static_cast<int>(ids.size());
+  if (options.teams) {
+    std::vector<int> team_ids;
+    cv::Mat samples;
+    for (const auto& [id, cs] : torso_colours) {
+      if (!ids.count(id) || cs.empty()) continue;
+      cv::Vec3f mean(0, 0, 0);
+      for (const auto& c : cs) mean += c;
+      mean /= static_cast<float>(cs.size());
+      samples.push_back(cv::Mat(1, 3, CV_32F, &mean[0]).clone());
+      team_ids.push_back(id);
+    }
+    if (samples.rows >= 2) {
+      cv::Mat labels, centres;
+      cv::kmeans(samples, 2, labels,
+                 cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3), 5,
+                 cv::KMEANS_PP_CENTERS, centres);
+      for (size_t i = 0; i < team_ids.size(); ++i) result.team_of[team_ids[i]] = labels.at<int>(i);
+    }
+  }
+  result.times.map_s = Seconds(t_map, Clock::now());
+  result.times.read_s = reader.read_seconds();
+  result.tracker = tracker.stats();
+  result.times.total_s = Seconds(t_start, Clock::now());
+  return result;
+}
+
+}  // namespace fv::track

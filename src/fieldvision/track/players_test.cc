@@ -1,0 +1,153 @@
+#include "fieldvision/track/players.h"
+
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+#if __has_include("fieldvision/synth/synth.h")
+#include "fieldvision/synth/synth.h"
+#define FV_HAVE_SYNTH 1
+#endif
+
+namespace fv::track {
+namespace {
+
+std::string WriteNoiseVideo(const std::string& path, int w, int h, int frames, uint64_t seed) {
+  cv::VideoWriter vw(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, cv::Size(w, h));
+  EXPECT_TRUE(vw.isOpened());
+  cv::RNG rng(seed);
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat f(h, w, CV_8UC3);
+    rng.fill(f, cv::RNG::UNIFORM, 0, 255);
+    vw.write(f);
+  }
+  return path;
+}
+
+TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
+  const uint64_t seed = fv::testing::TestSeed(2);
+  FV_SEED_TRACE(seed);
+  const std::string dir = fv::testing::TempDir();
+  PlayersOptions o;
+  o.progress = false;
+  o.detector.kind = "motion";
+  const Camera cam = Camera::FromFov(640, 480, 60);
+  // A video that cannot be opened.
+  try {
+    RunPlayers(dir + "/missing.avi", &cam, nullptr, o);
+    FAIL() << "no error";
+  } catch (const fv::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.avi"), std::string::npos) << e.what();
+  }
+  // A file that is not a video.
+  {
+    std::ofstream f(dir + "/junk.avi");
+    f << "not a video at all";
+  }
+  EXPECT_THROW(RunPlayers(dir + "/junk.avi", &cam, nullptr, o), fv::Error);
+  // A camera file made for another resolution.
+  const std::string video = WriteNoiseVideo(dir + "/small.avi", 320, 240, 3, seed);
+  try {
+    RunPlayers(video, &cam, nullptr, o);
+    FAIL() << "no error";
+  } catch (const fv::Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("640x480"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("320x240"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+  // A missing detector model says how to get it.
+  const Camera small = Camera::FromFov(320, 240, 60);
+  o.detector.kind = "nanodet";
+  o.detector.model_path = dir + "/nanodet.onnx";
+  try {
+    RunPlayers(video, &small, nullptr, o);
+    FAIL() << "no error";
+  } catch (const fv::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("make build"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Players, InterpolationFillsShortGapsOnly) {
+  std::vector<TrackRow> rows = {{0, 1, cv::Rect2d(0, 0, 10, 20), 1, {}, {}},
+                                {4, 1, cv::Rect2d(8, 0, 10, 20), 1, {}, {}},
+                                {20, 1, cv::Rect2d(40, 0, 10, 20), 1, {}, {}}};
+  const int added = InterpolateGaps(rows, 5, nullptr);
+  EXPECT_EQ(added, 3);
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_EQ(rows[2].frame, 2);
+  EXPECT_NEAR(rows[2].box.x, 4.0, 1e-9);
+}
+
+#ifdef FV_HAVE_SYNTH
+// The synthetic players scene (people of two teams crossing, running and walking): positions on
+// the field within 0.3 m of the truth and one id per person through the crossings.
+TEST(Players, SynthScenePositionsAndStableIds) {
+  const uint64_t seed = fv::testing::TestSeed(1);
+  FV_SEED_TRACE(seed);
+  synth::SceneSpec spec = synth::Preset("players", seed);
+  spec.num_frames = 50;
+  synth::ResizeCameras(spec, 640, 480);
+  const std::string dir = fv::testing::TempDir();
+  synth::WriteScene(spec, dir, false);
+  synth::SceneRenderer scene(spec);
+  const Camera cam = scene.cameras()[0];
+  const FieldModel field = scene.field();
+  PlayersOptions o;
+  o.progress = false;
+  o.detector.input_width = 416;
+  const PlayersResult r = RunPlayers(dir + "/" + cam.name + ".avi", &cam, &field, o);
+  ASSERT_GT(r.rows.size(), 0u) << r.Summary();
+  WriteTracksCsv(r.rows, dir + "/tracks.csv");
+  // Match each row to the truth person whose box overlaps most.
+  std::vector<double> errors;
+  std::map<int, std::set<int>> ids_of_person;
+  int matched = 0;
+  for (const auto& row : r.rows) {
+    const auto truth = scene.PlayerTruth(row.frame);
+    double best = 0.3;
+    const synth::PersonTruth* who = nullptr;
+    for (const auto& t : truth) {
+      const auto& c = t.cameras[0];
+      if (!c.in_image || c.visible_fraction < 0.5) continue;
+      const double iou = Iou(row.box, cv::Rect2d(c.bb_left, c.bb_top, c.bb_width, c.bb_height));
+      if (iou > best) {
+        best = iou;
+        who = &t;
+      }
+    }
+    if (who == nullptr || !row.x_m) continue;
+    ++matched;
+    errors.push_back(std::hypot(*row.x_m - who->x_m, *row.y_m - who->y_m));
+    ids_of_person[who->id].insert(row.id);
+    if (std::getenv("FV_DEBUG_PLAYERS")) {
+      std::cerr << row.frame << " id " << row.id << " person " << who->id << " err "
+                << errors.back() << " dx " << *row.x_m - who->x_m << " dy " << *row.y_m - who->y_m
+                << "\n";
+    }
+  }
+  ASSERT_GT(matched, static_cast<int>(r.rows.size() * 0.8)) << r.Summary();
+  std::sort(errors.begin(), errors.end());
+  const double median = errors[errors.size() / 2];
+  const double p90 = errors[errors.size() * 9 / 10];
+  EXPECT_LT(median, 0.3) << r.Summary();
+  EXPECT_LT(p90, 0.5) << r.Summary();
+  int switches = 0;
+  for (const auto& [person, ids] : ids_of_person) switches += static_cast<int>(ids.size()) - 1;
+  EXPECT_LE(switches, 1) << r.Summary();
+  EXPECT_GE(ids_of_person.size(), 6u) << r.Summary();
+}
+#endif
+
+}  // namespace
+}  // namespace fv::track
