@@ -1,0 +1,891 @@
+// SceneRenderer: pixel rays and backgrounds per camera, then per frame the boxes of moving objects.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+#include <ceres/jet.h>
+#include <fmt/format.h>
+
+#include "fieldvision/synth/ball_physics.h"
+#include "fieldvision/synth/figures.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+
+namespace fv::synth {
+
+struct SceneRenderer::CameraData {
+  Camera cam;
+  Eigen::Vector3d origin;
+  std::vector<Eigen::Vector3f> ray;  // unit world direction per pixel; NaN where undefined
+  cv::Mat bg;                        // CV_8UC3
+  cv::Mat depth;                     // CV_32F, metres along the ray
+  std::vector<uint8_t> ground;       // 1 where the background is the ground (takes shadows)
+  std::vector<float> vignette;       // brightness factor per pixel
+  double pixel_angle = 0.0;          // radians per pixel near the centre
+};
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+uint64_t SplitMix(uint64_t& x) {
+  uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+double Hash2(int x, int y, uint32_t salt = 0) {
+  uint32_t h = static_cast<uint32_t>(x) * 374761393u + static_cast<uint32_t>(y) * 668265263u +
+               salt * 2246822519u;
+  h = (h ^ (h >> 13)) * 1274126177u;
+  h ^= h >> 16;
+  return h / 4294967296.0;
+}
+
+double ValueNoise(double x, double y, uint32_t salt = 0) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+  double tx = x - fx, ty = y - fy;
+  tx = tx * tx * (3 - 2 * tx);
+  ty = ty * ty * (3 - 2 * ty);
+  const double a = Hash2(ix, iy, salt), b = Hash2(ix + 1, iy, salt);
+  const double c = Hash2(ix, iy + 1, salt), d = Hash2(ix + 1, iy + 1, salt);
+  return (a * (1 - tx) + b * tx) * (1 - ty) + (c * (1 - tx) + d * tx) * ty;
+}
+
+Vec3 Clamp255(const Vec3& c) { return c.cwiseMax(0.0).cwiseMin(255.0); }
+
+Camera MakeCamera(const CameraSpec& s, int index) {
+  Camera c;
+  if (s.fx > 0) {
+    c.width = s.width;
+    c.height = s.height;
+    c.fx = s.fx;
+    c.fy = s.fy;
+    c.cx = 0.5 * (s.width - 1);
+    c.cy = 0.5 * (s.height - 1);
+  } else {
+    c = Camera::FromFov(s.width, s.height, s.hfov_deg);
+  }
+  c.name = s.name;
+  c.distortion = s.distortion;
+  c.has_pose = true;
+  c.cam_from_world = s.has_rvec_tvec ? Rigid3d::FromRvecTvec(s.rvec, s.tvec)
+                                     : Rigid3d::LookAt(s.position_m, s.look_at_m);
+  c.notes["source"] = "fieldvision synth";
+  c.Check(fmt::format("cameras[{}]", index));
+  return c;
+}
+
+// The world ray of every pixel: exact undistortion seeded from a coarse grid, refined by Newton.
+std::vector<Eigen::Vector3f> PixelRays(const Camera& cam) {
+  const int w = cam.width, h = cam.height;
+  std::vector<Eigen::Vector3f> rays(static_cast<size_t>(w) * h);
+  const Eigen::Matrix3d world_from_cam = cam.cam_from_world.rotation.transpose();
+  bool distorted = false;
+  for (double d : cam.distortion) distorted = distorted || d != 0.0;
+  const auto intr = cam.IntrinsicsBlock();
+  const double* dist = intr.data() + 4;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto store = [&](int u, int v, double x, double y) {
+    const Eigen::Vector3d d = (world_from_cam * Eigen::Vector3d(x, y, 1.0)).normalized();
+    rays[static_cast<size_t>(v) * w + u] = d.cast<float>();
+  };
+  if (!distorted) {
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) store(u, v, (u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy);
+    }
+    return rays;
+  }
+  const int step = 16;
+  const int gw = (w - 1) / step + 2, gh = (h - 1) / step + 2;
+  std::vector<Eigen::Vector2d> grid(static_cast<size_t>(gw) * gh);
+  std::vector<uint8_t> grid_ok(grid.size());
+  for (int j = 0; j < gh; ++j) {
+    for (int i = 0; i < gw; ++i) {
+      const auto x = cam.Undistort(Eigen::Vector2d(i * step, j * step));
+      grid_ok[j * gw + i] = x.has_value();
+      if (x) grid[j * gw + i] = *x;
+    }
+  }
+  using Jet = ceres::Jet<double, 2>;
+  std::array<Jet, kNumDistortion> dj;
+  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(dist[i]);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const Eigen::Vector2d target((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy);
+      const int i = u / step, j = v / step;
+      const double a = (u - i * step) / static_cast<double>(step);
+      const double b = (v - j * step) / static_cast<double>(step);
+      const size_t k00 = j * gw + i, k10 = k00 + 1, k01 = k00 + gw, k11 = k01 + 1;
+      bool converged = false;
+      Eigen::Vector2d x;
+      if (grid_ok[k00] && grid_ok[k10] && grid_ok[k01] && grid_ok[k11]) {
+        x = (1 - b) * ((1 - a) * grid[k00] + a * grid[k10]) +
+            b * ((1 - a) * grid[k01] + a * grid[k11]);
+        for (int it = 0; it < 6; ++it) {
+          Jet xd, yd;
+          DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
+          const Eigen::Vector2d r(xd.a - target.x(), yd.a - target.y());
+          if (std::abs(r.x() * cam.fx) + std::abs(r.y() * cam.fy) < 1e-9) {
+            converged = true;
+            break;
+          }
+          Eigen::Matrix2d jm;
+          jm << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
+          const double det = jm.determinant();
+          if (!std::isfinite(det) || std::abs(det) < 1e-12) break;
+          x -= jm.inverse() * r;
+        }
+      }
+      if (!converged) {
+        const auto xo = cam.Undistort(Eigen::Vector2d(u, v));
+        if (!xo) {
+          rays[static_cast<size_t>(v) * w + u] = Eigen::Vector3f(nan, nan, nan);
+          continue;
+        }
+        x = *xo;
+      }
+      store(u, v, x.x(), x.y());
+    }
+  }
+  return rays;
+}
+
+// The static world seen by the background pass.
+struct StaticWorld {
+  const FieldModel* field = nullptr;
+  double hl = 0, hw = 0;  // half extents with the surround (walls stand there)
+  double wall_h = 2.6;
+  double stripe_w = 1.5;
+  bool grass = true;
+  Vec3 light;
+  // Coarse top-view map of the signed distance to paint (for skipping far pixels).
+  double map_res = 0.05;
+  int map_w = 0, map_h = 0;
+  std::vector<float> paint_map;
+  struct Bar {
+    Vec3 a, b;
+    double r;
+    Vec3 colour;
+  };
+  std::vector<Bar> bars;  // goal frames
+  std::vector<ConeSpec> cones;
+
+  double CoarsePaint(double x, double y) const {
+    const int i = static_cast<int>(std::lround((x + hl) / map_res));
+    const int j = static_cast<int>(std::lround((y + hw) / map_res));
+    if (i < 0 || j < 0 || i >= map_w || j >= map_h) return 1e3;
+    return paint_map[static_cast<size_t>(j) * map_w + i];
+  }
+
+  Vec3 Ground(double x, double y, double fp) const {
+    const FieldModel& f = *field;
+    const bool playing = std::abs(x) <= 0.5 * f.length_m && std::abs(y) <= 0.5 * f.width_m;
+    const double fine = std::clamp(1.0 - fp / 0.06, 0.0, 1.0);
+    Vec3 c;
+    if (grass) {
+      c = Vec3(48, 128, 58);
+      if (playing) {
+        const int band = static_cast<int>(std::floor((x + 0.5 * f.length_m) / stripe_w));
+        c *= (band % 2 == 0) ? 1.08 : 0.93;
+      } else {
+        c *= 0.9;
+      }
+      const double m = 1.0 + 0.10 * (ValueNoise(x / 0.9, y / 0.9, 1) - 0.5) +
+                       0.12 * fine * (ValueNoise(x / 0.05, y / 0.05, 2) - 0.5);
+      c *= m;
+    } else {
+      if (playing) {
+        const int plank = static_cast<int>(std::floor(y / 0.12));
+        const double pl =
+            0.92 + 0.16 * Hash2(plank, static_cast<int>(std::floor(x / 2.4 + 0.37 * plank)), 3);
+        c = Vec3(105, 155, 205) * pl;
+      } else {
+        c = Vec3(150, 105, 55);
+      }
+      c *= 1.0 + 0.06 * (ValueNoise(x / 0.7, y / 0.7, 4) - 0.5);
+    }
+    return c;
+  }
+
+  Vec3 Wall(double s, double z) const {
+    if (z < 0.9) {
+      static const Vec3 palette[6] = {Vec3(170, 60, 20),  Vec3(30, 30, 190), Vec3(235, 235, 235),
+                                      Vec3(20, 170, 230), Vec3(60, 60, 60),  Vec3(40, 140, 40)};
+      const int panel = static_cast<int>(std::floor(s / 4.0));
+      const Vec3 bgc = palette[static_cast<int>(Hash2(panel, 7, 5) * 6) % 6];
+      const double in = s - 4.0 * panel;
+      const bool text = z > 0.3 && z < 0.62 && in > 0.5 && in < 3.5 &&
+                        Hash2(static_cast<int>(std::floor(in / 0.22)), panel, 6) > 0.35;
+      if (z < 0.05) return Vec3(40, 40, 40);
+      return text ? Vec3(255, 255, 255) - 0.7 * bgc : bgc;
+    }
+    // Stands with spectators: rows every 0.45 m, a person-sized cell of random colour.
+    const int row = static_cast<int>(std::floor((z - 0.9) / 0.45));
+    const int col = static_cast<int>(std::floor(s / 0.5));
+    const double rz = (z - 0.9) - 0.45 * row;
+    if (rz < 0.08) return Vec3(95, 95, 100);
+    const double hsh = Hash2(col, row, 9);
+    if (hsh < 0.35) return Vec3(130, 130, 135);
+    const Vec3 shirt(255 * Hash2(col, row, 10), 255 * Hash2(col, row, 11),
+                     255 * Hash2(col, row, 12));
+    return rz > 0.32 ? Vec3(120, 150, 190) : 0.55 * shirt + Vec3(50, 50, 50);
+  }
+
+  Vec3 Sky(const Vec3& d) const {
+    const double e = std::clamp(d.z(), 0.0, 1.0);
+    return Vec3(225, 210, 195) * (1 - e) + Vec3(235, 190, 150) * e;
+  }
+
+  double Shade(const Vec3& n) const { return 0.55 + 0.5 * std::max(0.0, n.dot(light)); }
+};
+
+StaticWorld MakeStaticWorld(const FieldModel& f, const SceneSpec& spec) {
+  StaticWorld w;
+  w.field = &f;
+  w.hl = f.HalfLengthWithSurround();
+  w.hw = f.HalfWidthWithSurround();
+  w.grass = f.surface == "grass";
+  w.stripe_w = f.length_m / std::clamp(std::round(f.length_m / 1.5), 6.0, 24.0);
+  w.light = spec.lighting.light_dir.normalized();
+  w.map_w = static_cast<int>(std::ceil(2 * w.hl / w.map_res)) + 1;
+  w.map_h = static_cast<int>(std::ceil(2 * w.hw / w.map_res)) + 1;
+  w.paint_map.resize(static_cast<size_t>(w.map_w) * w.map_h);
+  for (int j = 0; j < w.map_h; ++j) {
+    for (int i = 0; i < w.map_w; ++i) {
+      w.paint_map[static_cast<size_t>(j) * w.map_w + i] = static_cast<float>(
+          f.DistanceToPaint(Eigen::Vector2d(i * w.map_res - w.hl, j * w.map_res - w.hw)));
+    }
+  }
+  const Vec3 white(240, 240, 240), grey(200, 200, 200);
+  for (const FieldGoal& g : f.goals) {
+    const double r = 0.5 * g.post_width_m;
+    const double x = g.line_x_m + g.side * r;
+    const double xb = g.line_x_m + g.side * (g.depth_m + r);
+    const double y0 = g.y_min_m - r, y1 = g.y_max_m + r, top = g.height_m + r;
+    w.bars.push_back({Vec3(x, y0, 0), Vec3(x, y0, top), r, white});
+    w.bars.push_back({Vec3(x, y1, 0), Vec3(x, y1, top), r, white});
+    w.bars.push_back({Vec3(x, y0, top), Vec3(x, y1, top), r, white});
+    const double rb = std::min(r, 0.025);
+    w.bars.push_back({Vec3(x, y0, top), Vec3(xb, y0, 0.3 * top), rb, grey});
+    w.bars.push_back({Vec3(x, y1, top), Vec3(xb, y1, 0.3 * top), rb, grey});
+    w.bars.push_back({Vec3(xb, y0, 0.3 * top), Vec3(xb, y0, 0), rb, grey});
+    w.bars.push_back({Vec3(xb, y1, 0.3 * top), Vec3(xb, y1, 0), rb, grey});
+    w.bars.push_back({Vec3(xb, y0, rb), Vec3(xb, y1, rb), rb, grey});
+    w.bars.push_back({Vec3(xb, y0, 0.3 * top), Vec3(xb, y1, 0.3 * top), rb, grey});
+  }
+  w.cones = spec.cones;
+  return w;
+}
+
+void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
+                      const SceneSpec& spec) {
+  const Camera& cam = cd.cam;
+  const int w = cam.width, h = cam.height;
+  const Vec3 o = cd.origin;
+  cd.bg.create(h, w, CV_8UC3);
+  cd.depth.create(h, w, CV_32F);
+  cd.ground.assign(static_cast<size_t>(w) * h, 0);
+  std::vector<float> paint(static_cast<size_t>(w) * h, 1e3f);
+  std::vector<Vec3> colour(static_cast<size_t>(w) * h);
+  const bool inside = std::abs(o.x()) < world.hl && std::abs(o.y()) < world.hw;
+  const double line_half = 0.5 * world.field->line_width_m;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      const Eigen::Vector3f df = cd.ray[i];
+      if (!df.allFinite()) {
+        colour[i] = Vec3(0, 0, 0);
+        cd.depth.at<float>(v, u) = std::numeric_limits<float>::infinity();
+        continue;
+      }
+      const Vec3 d = df.cast<double>();
+      double best = kInf;
+      Vec3 c = world.Sky(d);
+      int kind = 0;  // 0 sky, 1 ground, 2 wall/object
+      // Walls: one-sided, seen from inside.
+      if (inside) {
+        for (int axis = 0; axis < 2; ++axis) {
+          const double half = axis == 0 ? world.hl : world.hw;
+          const double dd = d[axis];
+          if (std::abs(dd) < 1e-12) continue;
+          const double plane = dd > 0 ? half : -half;
+          const double t = (plane - o[axis]) / dd;
+          if (t <= 0 || t >= best) continue;
+          const Vec3 p = o + t * d;
+          const double other = axis == 0 ? world.hw : world.hl;
+          if (p.z() < 0 || p.z() > world.wall_h || std::abs(p[1 - axis]) > other) continue;
+          best = t;
+          kind = 2;
+          const double s = p[1 - axis] + (axis == 0 ? 100.0 : 0.0) + (plane > 0 ? 50.0 : 0.0);
+          c = world.Wall(s, p.z()) * (axis == 0 ? 0.92 : 1.0);
+        }
+      }
+      if (d.z() < 0) {
+        const double t = -o.z() / d.z();
+        if (t > 0 && t < best) {
+          const Vec3 p = o + t * d;
+          best = t;
+          kind = 1;
+          if (std::abs(p.x()) <= world.hl && std::abs(p.y()) <= world.hw) {
+            const double fp = t * cd.pixel_angle / std::max(std::abs(d.z()), 0.05);
+            c = world.Ground(p.x(), p.y(), fp);
+            const double coarse = world.CoarsePaint(p.x(), p.y());
+            if (coarse < 0.05 + std::max(0.3, 4 * fp)) {
+              paint[i] = static_cast<float>(world.field->DistanceToPaint(p.head<2>()));
+            } else {
+              paint[i] = static_cast<float>(coarse);
+            }
+          } else {
+            c = Vec3(105, 110, 115);
+          }
+        }
+      }
+      for (const auto& bar : world.bars) {
+        const double t = IntersectCapsule(o, d, bar.a, bar.b, bar.r);
+        if (t > 0 && t < best) {
+          best = t;
+          kind = 2;
+          const Vec3 p = o + t * d;
+          const Vec3 ba = bar.b - bar.a;
+          const double s = std::clamp((p - bar.a).dot(ba) / ba.squaredNorm(), 0.0, 1.0);
+          c = bar.colour * world.Shade((p - (bar.a + s * ba)).normalized());
+        }
+      }
+      for (const auto& cone : world.cones) {
+        Vec3 n = Vec3::UnitZ();
+        const double t =
+            IntersectCone(o, d, cone.position_m, cone.base_radius_m, cone.height_m, &n);
+        if (t > 0 && t < best) {
+          best = t;
+          kind = 2;
+          c = cone.colour_bgr * world.Shade(n);
+        }
+      }
+      colour[i] = c;
+      cd.depth.at<float>(v, u) = static_cast<float>(best);
+      cd.ground[i] = kind == 1;
+    }
+  }
+  // Paint coverage: the overlap of the pixel with the line across it, in pixel units from the
+  // signed distance and its screen-space rate of change (largest one-sided difference).
+  const Vec3 paint_colour(232, 238, 238);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t i = static_cast<size_t>(v) * w + u;
+      if (!cd.ground[i] || paint[i] > 2.0f) continue;
+      const double d0 = paint[i];
+      auto rate = [&](int du, int dv) {
+        double g = 0;
+        for (int sgn = -1; sgn <= 1; sgn += 2) {
+          const int uu = u + sgn * du, vv = v + sgn * dv;
+          if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+          const size_t j = static_cast<size_t>(vv) * w + uu;
+          if (!cd.ground[j]) continue;
+          g = std::max(g, std::abs(paint[j] - d0));
+        }
+        return g;
+      };
+      const double gx = rate(1, 0), gy = rate(0, 1);
+      double g = std::sqrt(gx * gx + gy * gy);
+      if (g < 1e-6) g = 1e-6;
+      const double a = line_half / g;                 // half width in pixels
+      const double x = std::abs(d0 + line_half) / g;  // distance from the centreline in pixels
+      const double cov = std::clamp(std::min(x + 0.5, a) - std::max(x - 0.5, -a), 0.0, 1.0);
+      if (cov > 0) colour[i] = (1 - cov) * colour[i] + cov * paint_colour;
+    }
+  }
+  for (int v = 0; v < h; ++v) {
+    auto* row = cd.bg.ptr<cv::Vec3b>(v);
+    for (int u = 0; u < w; ++u) {
+      const Vec3 c = Clamp255(colour[static_cast<size_t>(v) * w + u]);
+      row[u] = cv::Vec3b(static_cast<uint8_t>(std::lround(c[0])),
+                         static_cast<uint8_t>(std::lround(c[1])),
+                         static_cast<uint8_t>(std::lround(c[2])));
+    }
+  }
+  cd.vignette.resize(static_cast<size_t>(w) * h);
+  const double rmax2 = cam.cx * cam.cx + cam.cy * cam.cy;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const double r2 = ((u - cam.cx) * (u - cam.cx) + (v - cam.cy) * (v - cam.cy)) / rmax2;
+      cd.vignette[static_cast<size_t>(v) * w + u] =
+          static_cast<float>(1.0 - spec.lighting.vignetting * r2);
+    }
+  }
+}
+
+// Image box (clipped) of a world box; empty when entirely behind the camera.
+cv::Rect ProjectBox(const Camera& cam, const Vec3& lo, const Vec3& hi, double margin_px = 2) {
+  double umin = kInf, vmin = kInf, umax = -kInf, vmax = -kInf;
+  int behind = 0;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+    const Vec3 pc = cam.cam_from_world * p;
+    if (pc.z() < 0.05) {
+      ++behind;
+      continue;
+    }
+    const auto uv = cam.ProjectFromCamera(pc);
+    const double lim = 3.0 * std::max(cam.width, cam.height);
+    if (!uv || !uv->allFinite() || std::abs(uv->x()) > lim || std::abs(uv->y()) > lim) {
+      ++behind;
+      continue;
+    }
+    umin = std::min(umin, uv->x());
+    umax = std::max(umax, uv->x());
+    vmin = std::min(vmin, uv->y());
+    vmax = std::max(vmax, uv->y());
+  }
+  if (behind == 8) return {};
+  if (behind > 0) return {0, 0, cam.width, cam.height};
+  const int x0 = std::max(0, static_cast<int>(std::floor(umin - margin_px)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(vmin - margin_px)));
+  const int x1 = std::min(cam.width, static_cast<int>(std::ceil(umax + margin_px)) + 1);
+  const int y1 = std::min(cam.height, static_cast<int>(std::ceil(vmax + margin_px)) + 1);
+  if (x1 <= x0 || y1 <= y0) return {};
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+// Projected centre and apparent radius of a sphere (from its silhouette circle).
+bool ProjectSphere(const Camera& cam, const Vec3& c, double r, Eigen::Vector2d* uv,
+                   double* radius_px) {
+  const Vec3 o = cam.CentreInWorld();
+  const Vec3 dv = c - o;
+  const double dist = dv.norm();
+  const auto p = cam.Project(c);
+  if (!p || dist <= r * 1.0001) return false;
+  *uv = *p;
+  const Vec3 n = dv / dist;
+  Vec3 e1 = n.cross(Vec3(0, 0, 1));
+  if (e1.norm() < 1e-6) e1 = n.cross(Vec3(1, 0, 0));
+  e1.normalize();
+  const Vec3 e2 = n.cross(e1);
+  const Vec3 centre = c - (r * r / dist) * n;
+  const double rho = r * std::sqrt(1.0 - (r * r) / (dist * dist));
+  double sum = 0;
+  int cnt = 0;
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * M_PI / 4;
+    const auto q = cam.Project(centre + rho * (std::cos(a) * e1 + std::sin(a) * e2));
+    if (q) {
+      sum += (*q - *p).norm();
+      ++cnt;
+    }
+  }
+  *radius_px = cnt > 0 ? sum / cnt : 0.0;
+  return cnt > 0;
+}
+
+}  // namespace
+
+SceneRenderer::SceneRenderer(const SceneSpec& spec) : spec_(spec) {
+  spec_.Check();
+  field_ = LoadField(spec_.field);
+  for (size_t i = 0; i < spec_.cameras.size(); ++i) {
+    cameras_.push_back(MakeCamera(spec_.cameras[i], static_cast<int>(i)));
+  }
+  if (spec_.ball.enabled) {
+    trajectory_ = std::make_unique<BallTrajectory>(spec_.ball, spec_.duration_s() + 1.0);
+  }
+  Rng rng(spec_.seed * 6364136223846793005ULL + 1442695040888963407ULL);
+  noise_table_.resize(65536);
+  for (auto& n : noise_table_) {
+    n = static_cast<int16_t>(
+        std::lround(std::clamp(rng.Normal(0, spec_.noise_sigma), -127.0, 127.0)));
+  }
+  const StaticWorld world = MakeStaticWorld(field_, spec_);
+  data_.resize(cameras_.size());
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i = next++; i < cameras_.size(); i = next++) {
+      auto cd = std::make_unique<CameraData>();
+      cd->cam = cameras_[i];
+      cd->origin = cd->cam.CentreInWorld();
+      cd->pixel_angle = 1.0 / std::sqrt(cd->cam.fx * cd->cam.fy);
+      cd->ray = PixelRays(cd->cam);
+      RenderBackground(world, *cd, spec_);
+      data_[i] = std::move(cd);
+    }
+  };
+  const size_t n_threads =
+      std::min<size_t>(cameras_.size(), std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> threads;
+  for (size_t t = 1; t < n_threads; ++t) threads.emplace_back(worker);
+  worker();
+  for (auto& t : threads) t.join();
+}
+
+SceneRenderer::~SceneRenderer() = default;
+
+Eigen::Vector3d SceneRenderer::BallAt(double time_s) const {
+  FV_REQUIRE(spec_.ball.enabled, "BallAt: the scene has no ball");
+  if (!spec_.ball.placements.empty()) {
+    const long frame = std::lround(std::floor(time_s * spec_.fps + 0.5));
+    const long idx = std::clamp<long>(frame / spec_.ball.hold_frames, 0,
+                                      static_cast<long>(spec_.ball.placements.size()) - 1);
+    return spec_.ball.placements[idx];
+  }
+  return trajectory_->PositionAt(time_s);
+}
+
+const std::vector<Flight>& SceneRenderer::Flights() const {
+  static const std::vector<Flight> kNone;
+  return trajectory_ ? trajectory_->flights() : kNone;
+}
+
+const cv::Mat& SceneRenderer::Background(int camera) const {
+  FV_REQUIRE(camera >= 0 && camera < static_cast<int>(data_.size()), "camera {} out of range",
+             camera);
+  return data_[camera]->bg;
+}
+
+const cv::Mat& SceneRenderer::BackgroundDepth(int camera) const {
+  FV_REQUIRE(camera >= 0 && camera < static_cast<int>(data_.size()), "camera {} out of range",
+             camera);
+  return data_[camera]->depth;
+}
+
+cv::Mat SceneRenderer::RenderCamera(int camera, int frame, CameraFrameStats* stats) const {
+  return RenderInternal(camera, frame, stats, true);
+}
+
+CameraFrameStats SceneRenderer::CameraTruth(int camera, int frame) const {
+  CameraFrameStats s;
+  RenderInternal(camera, frame, &s, false);
+  return s;
+}
+
+cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* stats,
+                                      bool want_image) const {
+  FV_REQUIRE(camera >= 0 && camera < static_cast<int>(data_.size()),
+             "camera index {} out of range (0..{})", camera, data_.size() - 1);
+  FV_REQUIRE(frame >= 0, "frame {} must be >= 0", frame);
+  const CameraData& cd = *data_[camera];
+  const Camera& cam = cd.cam;
+  const int w = cam.width, h = cam.height;
+  const Vec3 o = cd.origin;
+  const double t = FrameTime(frame);
+  const Vec3 light = spec_.lighting.light_dir.normalized();
+  cv::Mat img = cd.bg.clone();
+  cv::Mat depth = cd.depth.clone();
+  auto ray = [&](int u, int v) -> Vec3 {
+    return cd.ray[static_cast<size_t>(v) * w + u].cast<double>();
+  };
+
+  // Bodies: people, then robots.
+  std::vector<Body> bodies;
+  for (const auto& p : spec_.people) bodies.push_back(PersonBody(p, spec_.teams[p.team], t));
+  for (size_t i = 0; i < spec_.robots.size(); ++i) {
+    bodies.push_back(RobotBody(spec_.robots[i], static_cast<int>(i), t));
+  }
+  const bool has_ball = spec_.ball.enabled;
+  const double r_ball = spec_.ball.radius_m();
+  const Vec3 ball_mid = has_ball ? BallAt(t) : Vec3::Zero();
+
+  // Shadows on the ground (hard for bodies, soft-edged for the ball).
+  if (want_image && spec_.lighting.shadows) {
+    std::vector<uint8_t> shadowed;
+    auto shade_box = [&](const Vec3& lo, const Vec3& hi, auto&& occlusion) {
+      Vec3 slo = lo, shi = hi;
+      for (int k = 0; k < 8; ++k) {
+        const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
+                     (k & 4) ? hi.z() : lo.z());
+        const Vec3 g = p - (p.z() / light.z()) * light;
+        slo = slo.cwiseMin(g);
+        shi = shi.cwiseMax(g);
+      }
+      slo.z() = 0;
+      const cv::Rect box = ProjectBox(cam, slo, shi);
+      if (box.empty()) return;
+      if (shadowed.empty()) shadowed.assign(static_cast<size_t>(w) * h, 0);
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        auto* row = img.ptr<cv::Vec3b>(v);
+        const float* drow = depth.ptr<float>(v);
+        for (int u = box.x; u < box.x + box.width; ++u) {
+          const size_t i = static_cast<size_t>(v) * w + u;
+          if (!cd.ground[i] || shadowed[i]) continue;
+          const Vec3 p = o + static_cast<double>(drow[u]) * ray(u, v);
+          const double s = occlusion(Vec3(p.x(), p.y(), 1e-4));
+          if (s <= 0) continue;
+          const double f = 1.0 - 0.42 * s;
+          for (int ch = 0; ch < 3; ++ch) row[u][ch] = static_cast<uint8_t>(row[u][ch] * f);
+          if (s >= 1) shadowed[i] = 1;
+        }
+      }
+    };
+    for (const Body& b : bodies) {
+      shade_box(b.box_min, b.box_max,
+                [&](const Vec3& p) { return RayHitsBody(b, p, light) ? 1.0 : 0.0; });
+    }
+    if (has_ball && ball_mid.z() < 8.0) {
+      const Vec3 rr(r_ball, r_ball, r_ball);
+      shade_box(ball_mid - rr, ball_mid + rr, [&](const Vec3& p) {
+        const Vec3 q = ball_mid - p;
+        const double along = q.dot(light);
+        if (along <= 0) return 0.0;
+        const double dist = (q - along * light).norm();
+        return std::clamp((1.1 * r_ball - dist) / (0.3 * r_ball), 0.0, 1.0);
+      });
+    }
+  }
+
+  // Opaque bodies with a depth test; ids for the truth of visibility.
+  std::vector<uint16_t> id;
+  if (!bodies.empty()) id.assign(static_cast<size_t>(w) * h, 0);
+  std::vector<cv::Rect> boxes(bodies.size());
+  std::vector<long> hits_all(bodies.size(), 0);
+  std::vector<cv::Rect> hit_bbox(bodies.size());
+  for (size_t k = 0; k < bodies.size(); ++k) {
+    const Body& b = bodies[k];
+    boxes[k] = ProjectBox(cam, b.box_min, b.box_max);
+    const cv::Rect& box = boxes[k];
+    int bx0 = w, by0 = h, bx1 = -1, by1 = -1;
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      auto* row = img.ptr<cv::Vec3b>(v);
+      float* drow = depth.ptr<float>(v);
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        const Vec3 d = ray(u, v);
+        if (!d.allFinite()) continue;
+        const Hit hit = IntersectBody(b, o, d);
+        if (hit.t <= 0) continue;
+        ++hits_all[k];
+        bx0 = std::min(bx0, u);
+        by0 = std::min(by0, v);
+        bx1 = std::max(bx1, u);
+        by1 = std::max(by1, v);
+        if (hit.t >= drow[u]) continue;
+        drow[u] = static_cast<float>(hit.t);
+        id[static_cast<size_t>(v) * w + u] = static_cast<uint16_t>(k + 1);
+        if (want_image) {
+          const double shade = 0.5 + 0.6 * std::max(0.0, hit.normal.dot(light));
+          const Vec3 c = Clamp255(hit.colour * shade);
+          row[u] = cv::Vec3b(static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]),
+                             static_cast<uint8_t>(c[2]));
+        }
+      }
+    }
+    if (bx1 >= 0) hit_bbox[k] = cv::Rect(bx0, by0, bx1 - bx0 + 1, by1 - by0 + 1);
+  }
+  if (stats) {
+    stats->players.assign(spec_.people.size(), PlayerCameraTruth{});
+    for (size_t k = 0; k < spec_.people.size(); ++k) {
+      PlayerCameraTruth& pt = stats->players[k];
+      if (hits_all[k] == 0) continue;
+      long vis = 0;
+      const cv::Rect& box = boxes[k];
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        for (int u = box.x; u < box.x + box.width; ++u) {
+          vis += id[static_cast<size_t>(v) * w + u] == k + 1;
+        }
+      }
+      pt.in_image = true;
+      pt.bb_left = hit_bbox[k].x;
+      pt.bb_top = hit_bbox[k].y;
+      pt.bb_width = hit_bbox[k].width;
+      pt.bb_height = hit_bbox[k].height;
+      pt.visible_fraction = static_cast<double>(vis) / hits_all[k];
+    }
+  }
+
+  // The ball: anti-aliased, shaded, blurred over the exposure.
+  if (has_ball) {
+    BallCameraTruth bt;
+    Eigen::Vector2d uv_mid;
+    double rad_mid = 0;
+    const Vec3 c_cam = cam.cam_from_world * ball_mid;
+    bt.in_front = c_cam.z() > 0;
+    if (ProjectSphere(cam, ball_mid, r_ball, &uv_mid, &rad_mid)) {
+      bt.uv_px = uv_mid;
+      bt.radius_px = rad_mid;
+    } else if (const auto p = cam.Project(ball_mid)) {
+      bt.uv_px = *p;
+    }
+    // Coverage of one pixel by the ball at centre c: the distance from the centre to the ray
+    // minus the radius, over the pixel's size at that depth.
+    auto coverage = [&](const Vec3& c, const Vec3& d, double* t_hit, Vec3* normal) {
+      const Vec3 oc = c - o;
+      const double tc = oc.dot(d);
+      if (tc <= r_ball) return 0.0;
+      const Vec3 perp = oc - tc * d;
+      const double dist = perp.norm();
+      const double fp = tc * cd.pixel_angle;
+      const double cov = std::clamp(0.5 - (dist - r_ball) / fp, 0.0, 1.0);
+      if (cov <= 0) return 0.0;
+      const double th = dist < r_ball ? tc - std::sqrt(r_ball * r_ball - dist * dist) : tc;
+      *t_hit = th;
+      if (normal) *normal = (o + th * d - c).normalized();
+      return cov;
+    };
+    if (bt.in_front && rad_mid > 0) {
+      // Truth: visible share of the disc at mid-exposure.
+      const double m = rad_mid * 1.3 + 2;
+      const cv::Rect full(static_cast<int>(std::floor(uv_mid.x() - m)),
+                          static_cast<int>(std::floor(uv_mid.y() - m)),
+                          static_cast<int>(std::ceil(2 * m)) + 2,
+                          static_cast<int>(std::ceil(2 * m)) + 2);
+      const cv::Rect box = full & cv::Rect(0, 0, w, h);
+      double cov_all = 0, cov_vis = 0;
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        const float* drow = depth.ptr<float>(v);
+        for (int u = box.x; u < box.x + box.width; ++u) {
+          const Vec3 d = ray(u, v);
+          if (!d.allFinite()) continue;
+          double th;
+          const double cov = coverage(ball_mid, d, &th, nullptr);
+          if (cov <= 0) continue;
+          cov_all += cov;
+          if (th < drow[u]) cov_vis += cov;
+        }
+      }
+      const bool inside = box == full;
+      const double denom = inside ? cov_all : M_PI * rad_mid * rad_mid;
+      bt.visible_fraction = denom > 0 ? std::clamp(cov_vis / denom, 0.0, 1.0) : 0.0;
+    }
+    if (stats) stats->ball = bt;
+    if (want_image) {
+      // Sub-exposure samples: about one per half pixel of image motion.
+      const double e = spec_.exposure_s;
+      int K = 1;
+      if (e > 0) {
+        const auto p0 = cam.Project(BallAt(t - 0.5 * e));
+        const auto p1 = cam.Project(BallAt(t + 0.5 * e));
+        if (p0 && p1)
+          K = std::clamp(static_cast<int>(std::ceil((*p1 - *p0).norm() / 0.5)) + 1, 1, 48);
+      }
+      std::vector<Vec3> centres;
+      cv::Rect box;
+      for (int k = 0; k < K; ++k) {
+        const Vec3 c = K == 1 ? ball_mid : BallAt(t + e * ((k + 0.5) / K - 0.5));
+        Eigen::Vector2d uv;
+        double rad;
+        if (!ProjectSphere(cam, c, r_ball, &uv, &rad)) continue;
+        centres.push_back(c);
+        const double m = rad * 1.3 + 2;
+        const cv::Rect b(
+            static_cast<int>(std::floor(uv.x() - m)), static_cast<int>(std::floor(uv.y() - m)),
+            static_cast<int>(std::ceil(2 * m)) + 2, static_cast<int>(std::ceil(2 * m)) + 2);
+        box = box.empty() ? b : (box | b);
+      }
+      box &= cv::Rect(0, 0, w, h);
+      const Vec3 albedo = spec_.ball.colour_bgr;
+      const double inv_k = 1.0 / K;
+      for (int v = box.y; v < box.y + box.height; ++v) {
+        auto* row = img.ptr<cv::Vec3b>(v);
+        const float* drow = depth.ptr<float>(v);
+        for (int u = box.x; u < box.x + box.width; ++u) {
+          const Vec3 d = ray(u, v);
+          if (!d.allFinite()) continue;
+          const Vec3 pix(row[u][0], row[u][1], row[u][2]);
+          Vec3 acc = Vec3::Zero();
+          for (const Vec3& c : centres) {
+            double th;
+            Vec3 n = Vec3::UnitZ();
+            const double cov = coverage(c, d, &th, &n);
+            if (cov <= 0 || th >= drow[u]) continue;
+            const double ndl = n.dot(light);
+            const Vec3 refl = 2 * ndl * n - light;
+            const double spec = std::pow(std::max(0.0, -refl.dot(d)), 24.0);
+            const Vec3 col = albedo * (0.5 + 0.6 * std::max(0.0, ndl)) + Vec3::Constant(70 * spec);
+            acc += cov * (Clamp255(col) - pix);
+          }
+          if (acc.isZero()) continue;
+          const Vec3 c = Clamp255(pix + inv_k * acc);
+          row[u] = cv::Vec3b(static_cast<uint8_t>(std::lround(c[0])),
+                             static_cast<uint8_t>(std::lround(c[1])),
+                             static_cast<uint8_t>(std::lround(c[2])));
+        }
+      }
+    }
+  }
+  if (!want_image) return {};
+
+  // Lighting gain, vignetting and sensor noise (fresh per frame, seeded by scene, camera, frame).
+  const double gain =
+      1.0 + spec_.lighting.gain_amplitude * std::sin(2 * M_PI * t / spec_.lighting.period_s);
+  const bool noise = spec_.noise_sigma > 0;
+  for (int v = 0; v < h; ++v) {
+    uint8_t* row = img.ptr<uint8_t>(v);
+    const float* vig = cd.vignette.data() + static_cast<size_t>(v) * w;
+    uint64_t state = spec_.seed * 0x9E3779B97F4A7C15ULL ^ (static_cast<uint64_t>(camera) << 48) ^
+                     (static_cast<uint64_t>(frame) << 20) ^ static_cast<uint64_t>(v);
+    uint64_t bits = 0;
+    int left = 0;
+    for (int u = 0; u < w; ++u) {
+      const float f = static_cast<float>(gain) * vig[u];
+      for (int ch = 0; ch < 3; ++ch) {
+        float val = row[3 * u + ch] * f;
+        if (noise) {
+          if (left == 0) {
+            bits = SplitMix(state);
+            left = 4;
+          }
+          val += noise_table_[bits & 0xffff];
+          bits >>= 16;
+          --left;
+        }
+        row[3 * u + ch] = static_cast<uint8_t>(std::clamp(val + 0.5f, 0.0f, 255.0f));
+      }
+    }
+  }
+  return img;
+}
+
+std::vector<cv::Mat> SceneRenderer::Render(int frame) const {
+  std::vector<cv::Mat> out(cameras_.size());
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i = next++; i < cameras_.size(); i = next++) {
+      out[i] = RenderCamera(static_cast<int>(i), frame);
+    }
+  };
+  const size_t n_threads =
+      std::min<size_t>(cameras_.size(), std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> threads;
+  for (size_t k = 1; k < n_threads; ++k) threads.emplace_back(worker);
+  worker();
+  for (auto& th : threads) th.join();
+  return out;
+}
+
+BallTruthFrame SceneRenderer::BallTruth(int frame) const {
+  BallTruthFrame b;
+  b.frame = frame;
+  b.time_s = FrameTime(frame);
+  b.present = spec_.ball.enabled;
+  if (!b.present) return b;
+  b.centre_m = BallAt(b.time_s);
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    b.cameras.push_back(CameraTruth(static_cast<int>(i), frame).ball);
+    if (b.cameras.back().in_front && b.cameras.back().visible_fraction >= 0.3) ++b.n_cams;
+  }
+  return b;
+}
+
+std::vector<PersonTruth> SceneRenderer::PlayerTruth(int frame) const {
+  const double t = FrameTime(frame);
+  std::vector<PersonTruth> out;
+  for (const auto& p : spec_.people) {
+    PersonTruth pt;
+    pt.id = p.id;
+    pt.team = p.team;
+    const PathState s = PathAt(p.path, t);
+    pt.x_m = s.position_m.x();
+    pt.y_m = s.position_m.y();
+    out.push_back(pt);
+  }
+  if (out.empty()) return out;
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    const CameraFrameStats s = CameraTruth(static_cast<int>(i), frame);
+    for (size_t k = 0; k < out.size(); ++k) out[k].cameras.push_back(s.players[k]);
+  }
+  return out;
+}
+
+}  // namespace fv::synth

@@ -1,0 +1,748 @@
+// SceneSpec: validation, JSON round trip and the presets.
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+
+namespace fv::synth {
+namespace {
+
+using nlohmann::json;
+
+// ---- JSON helpers: every error names the key path.
+
+std::string Key(const std::string& ctx, const std::string& key) {
+  return ctx.empty() ? key : ctx + "." + key;
+}
+
+bool Has(const json& o, const char* key) { return o.is_object() && o.contains(key); }
+
+double Num(const json& o, const char* key, const std::string& ctx, double fallback) {
+  if (!Has(o, key)) return fallback;
+  FV_REQUIRE(o[key].is_number(), "{}: must be a number", Key(ctx, key));
+  const double v = o[key].get<double>();
+  FV_REQUIRE(std::isfinite(v), "{}: must be finite", Key(ctx, key));
+  return v;
+}
+
+int Int(const json& o, const char* key, const std::string& ctx, int fallback) {
+  if (!Has(o, key)) return fallback;
+  FV_REQUIRE(o[key].is_number_integer(), "{}: must be an integer", Key(ctx, key));
+  return o[key].get<int>();
+}
+
+bool Bool(const json& o, const char* key, const std::string& ctx, bool fallback) {
+  if (!Has(o, key)) return fallback;
+  FV_REQUIRE(o[key].is_boolean(), "{}: must be true or false", Key(ctx, key));
+  return o[key].get<bool>();
+}
+
+std::string Str(const json& o, const char* key, const std::string& ctx,
+                const std::string& fallback) {
+  if (!Has(o, key)) return fallback;
+  FV_REQUIRE(o[key].is_string(), "{}: must be a string", Key(ctx, key));
+  return o[key].get<std::string>();
+}
+
+template <int N>
+Eigen::Matrix<double, N, 1> VecOf(const json& a, const std::string& ctx) {
+  FV_REQUIRE(a.is_array() && a.size() == N, "{}: must be an array of {} numbers", ctx, N);
+  Eigen::Matrix<double, N, 1> v;
+  for (int i = 0; i < N; ++i) {
+    FV_REQUIRE(a[i].is_number(), "{}[{}]: must be a number", ctx, i);
+    v[i] = a[i].get<double>();
+    FV_REQUIRE(std::isfinite(v[i]), "{}[{}]: must be finite", ctx, i);
+  }
+  return v;
+}
+
+template <int N>
+Eigen::Matrix<double, N, 1> Vec(const json& o, const char* key, const std::string& ctx,
+                                const Eigen::Matrix<double, N, 1>& fallback) {
+  if (!Has(o, key)) return fallback;
+  return VecOf<N>(o[key], Key(ctx, key));
+}
+
+std::vector<double> Doubles(const json& o, const char* key, const std::string& ctx) {
+  std::vector<double> out;
+  if (!Has(o, key)) return out;
+  const std::string k = Key(ctx, key);
+  FV_REQUIRE(o[key].is_array(), "{}: must be an array of numbers", k);
+  for (size_t i = 0; i < o[key].size(); ++i) {
+    FV_REQUIRE(o[key][i].is_number(), "{}[{}]: must be a number", k, i);
+    out.push_back(o[key][i].get<double>());
+  }
+  return out;
+}
+
+const json& Arr(const json& o, const char* key, const std::string& ctx) {
+  static const json kEmpty = json::array();
+  if (!Has(o, key)) return kEmpty;
+  FV_REQUIRE(o[key].is_array(), "{}: must be an array", Key(ctx, key));
+  return o[key];
+}
+
+const json& Obj(const json& o, const char* key, const std::string& ctx) {
+  static const json kEmpty = json::object();
+  if (!Has(o, key)) return kEmpty;
+  FV_REQUIRE(o[key].is_object(), "{}: must be an object", Key(ctx, key));
+  return o[key];
+}
+
+// Rejects keys we do not know, so typos do not pass silently.
+void Known(const json& o, const std::string& ctx, std::initializer_list<const char*> keys) {
+  FV_REQUIRE(o.is_object(), "{}: must be an object", ctx.empty() ? "scene" : ctx);
+  std::set<std::string> known(keys.begin(), keys.end());
+  for (auto it = o.begin(); it != o.end(); ++it) {
+    FV_REQUIRE(known.count(it.key()) > 0, "{}: unknown key (known: {})", Key(ctx, it.key()),
+               fmt::join(keys, ", "));
+  }
+}
+
+json J(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (int i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+json PathToJson(const PathSpec& p) {
+  json j;
+  j["waypoints_m"] = json::array();
+  for (const auto& w : p.waypoints_m) j["waypoints_m"].push_back(J(w));
+  j["speed_mps"] = p.speed_mps;
+  if (!p.speeds_mps.empty()) j["speeds_mps"] = p.speeds_mps;
+  j["start_s"] = p.start_s;
+  return j;
+}
+
+PathSpec PathFromJson(const json& o, const std::string& ctx) {
+  Known(o, ctx, {"waypoints_m", "speed_mps", "speeds_mps", "start_s"});
+  PathSpec p;
+  const json& w = Arr(o, "waypoints_m", ctx);
+  for (size_t i = 0; i < w.size(); ++i) {
+    p.waypoints_m.push_back(VecOf<2>(w[i], fmt::format("{}.waypoints_m[{}]", ctx, i)));
+  }
+  p.speed_mps = Num(o, "speed_mps", ctx, p.speed_mps);
+  p.speeds_mps = Doubles(o, "speeds_mps", ctx);
+  p.start_s = Num(o, "start_s", ctx, p.start_s);
+  return p;
+}
+
+void CheckPath(const PathSpec& p, const std::string& ctx) {
+  FV_REQUIRE(!p.waypoints_m.empty(), "{}.waypoints_m: needs at least one point", ctx);
+  for (size_t i = 0; i < p.waypoints_m.size(); ++i) {
+    FV_REQUIRE(p.waypoints_m[i].allFinite(), "{}.waypoints_m[{}]: not finite", ctx, i);
+  }
+  FV_REQUIRE(std::isfinite(p.speed_mps) && p.speed_mps > 0, "{}.speed_mps: must be > 0", ctx);
+  FV_REQUIRE(p.speeds_mps.empty() || p.speeds_mps.size() + 1 == p.waypoints_m.size(),
+             "{}.speeds_mps: needs one speed per leg ({}), has {}", ctx, p.waypoints_m.size() - 1,
+             p.speeds_mps.size());
+  for (size_t i = 0; i < p.speeds_mps.size(); ++i) {
+    FV_REQUIRE(std::isfinite(p.speeds_mps[i]) && p.speeds_mps[i] > 0,
+               "{}.speeds_mps[{}]: must be > 0", ctx, i);
+  }
+  FV_REQUIRE(std::isfinite(p.start_s), "{}.start_s: not finite", ctx);
+}
+
+void CheckColour(const Eigen::Vector3d& c, const std::string& ctx) {
+  for (int i = 0; i < 3; ++i) {
+    FV_REQUIRE(std::isfinite(c[i]) && c[i] >= 0 && c[i] <= 255,
+               "{}: colour values must be in 0..255 (BGR)", ctx);
+  }
+}
+
+// A rig of 4 cameras at the corners of a field, outside the playing area, looking at it.
+std::vector<CameraSpec> CornerRig(const FieldModel& f, double height_m, int w, int h,
+                                  double hfov_deg) {
+  std::vector<CameraSpec> cams;
+  const double hx = 0.5 * f.length_m + 0.6 * f.surround_m;
+  const double hy = 0.5 * f.width_m + 0.6 * f.surround_m;
+  const int sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+  for (int i = 0; i < 4; ++i) {
+    CameraSpec c;
+    c.name = fmt::format("cam{}", i + 1);
+    c.width = w;
+    c.height = h;
+    c.hfov_deg = hfov_deg;
+    c.distortion = {-0.06, 0.02, 0.0, 0.0, 0.0};
+    c.position_m = Eigen::Vector3d(sx[i] * hx, sy[i] * hy, height_m);
+    // Look at a point a little towards the camera from the centre so the near corner is in view.
+    c.look_at_m = Eigen::Vector3d(sx[i] * 0.1 * f.length_m, sy[i] * 0.1 * f.width_m, 0.0);
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+SceneSpec StaticPreset(uint64_t seed) {
+  SceneSpec s;
+  s.seed = seed;
+  s.field = "robocup-msl";
+  const FieldModel f = BuiltinField(s.field);
+  s.cameras = CornerRig(f, 4.0, 1280, 960, 75.0);
+  s.fps = 30;
+  s.num_frames = 16;
+  Rng rng(seed * 7919 + 17);
+  const double r = s.ball.radius_m();
+  for (int i = 0; i < s.num_frames; ++i) {
+    Eigen::Vector3d p(rng.Uniform(-0.42, 0.42) * f.length_m, rng.Uniform(-0.42, 0.42) * f.width_m,
+                      r);
+    if (i % 3 != 0) p.z() = rng.Uniform(r, 3.0);
+    s.ball.placements.push_back(p);
+  }
+  s.ball.hold_frames = 1;
+  s.exposure_s = 0;
+  s.noise_sigma = 1.5;
+  s.format = "avi";
+  return s;
+}
+
+SceneSpec KickPreset(uint64_t seed) {
+  SceneSpec s;
+  s.seed = seed;
+  s.field = "robocup-msl";
+  const FieldModel f = BuiltinField(s.field);
+  s.cameras = CornerRig(f, 4.0, 1280, 960, 75.0);
+  s.fps = 60;
+  s.num_frames = 192;
+  Rng rng(seed * 104729 + 3);
+  const double r = s.ball.radius_m();
+  KickSpec k;
+  k.time_s = 0.25;
+  k.position_m = Eigen::Vector3d(-5.5 + rng.Uniform(-0.5, 0.5), -2.0 + rng.Uniform(-0.5, 0.5), r);
+  k.velocity_mps = Eigen::Vector3d(5.5 + rng.Uniform(-0.5, 0.5), 2.0 + rng.Uniform(-0.5, 0.5),
+                                   7.0 + rng.Uniform(-0.4, 0.4));
+  s.ball.kicks.push_back(k);
+  s.exposure_s = 1.0 / 250.0;
+  // A robot just in front of the ball's start as seen from cam1 (hides it before the kick), one
+  // near the first landing and one moving across the field.
+  const Eigen::Vector3d cam1 = s.cameras[0].position_m;
+  const Eigen::Vector2d to_cam = (cam1.head<2>() - k.position_m.head<2>()).normalized();
+  RobotSpec r1;
+  r1.path.waypoints_m = {k.position_m.head<2>() + 0.6 * to_cam};
+  RobotSpec r2;
+  r2.path.waypoints_m = {Eigen::Vector2d(2.5, 1.0), Eigen::Vector2d(3.5, -2.0)};
+  r2.path.speed_mps = 1.0;
+  RobotSpec r3;
+  r3.path.waypoints_m = {Eigen::Vector2d(-1.0, 4.0), Eigen::Vector2d(-3.0, 0.5)};
+  r3.path.speed_mps = 1.5;
+  r3.colour_bgr = Eigen::Vector3d(25, 25, 30);
+  s.robots = {r1, r2, r3};
+  ConeSpec cone;
+  cone.position_m = Eigen::Vector2d(1.0 + rng.Uniform(-1, 1), -3.5 + rng.Uniform(-0.5, 0.5));
+  s.cones = {cone};
+  s.lighting.gain_amplitude = 0.08;
+  s.lighting.period_s = 6.0;
+  s.noise_sigma = 2.0;
+  s.jpeg_quality = 90;
+  s.format = "avi";
+  return s;
+}
+
+SceneSpec PlayersPreset(uint64_t seed) {
+  SceneSpec s;
+  s.seed = seed;
+  s.field = "robocup-msl";
+  const FieldModel f = BuiltinField(s.field);
+  CameraSpec c;
+  c.name = "side";
+  c.width = 1280;
+  c.height = 960;
+  c.hfov_deg = 88;
+  c.distortion = {-0.08, 0.015, 0.0, 0.0, 0.0};
+  c.position_m = Eigen::Vector3d(0.0, -0.5 * f.width_m - 0.8 * f.surround_m, 6.0);
+  c.look_at_m = Eigen::Vector3d(0.0, 0.5, 0.0);
+  s.cameras = {c};
+  s.fps = 25;
+  s.num_frames = 250;
+  s.ball.enabled = false;
+  Rng rng(seed * 15485863 + 11);
+  const double hx = 0.45 * f.length_m, hy = 0.42 * f.width_m;
+  for (int i = 0; i < 8; ++i) {
+    PersonSpec p;
+    p.id = i + 1;
+    p.team = i % 2;
+    p.height_m = rng.Uniform(1.68, 1.92);
+    const double tone = rng.Uniform(0.55, 1.0);
+    p.skin_bgr = Eigen::Vector3d(110 + 60 * tone, 140 + 50 * tone, 175 + 60 * tone);
+    // Paths cross the field: each starts on one side and goes to the other, with random turns.
+    const double side = (i % 2 == 0) ? -1.0 : 1.0;
+    p.path.waypoints_m.push_back(
+        Eigen::Vector2d(side * rng.Uniform(0.3, 1.0) * hx, rng.Uniform(-hy, hy)));
+    const int n = 3 + rng.UniformInt(0, 2);
+    for (int k = 0; k < n; ++k) {
+      const double x = (k % 2 == 0 ? -side : side) * rng.Uniform(0.2, 1.0) * hx;
+      p.path.waypoints_m.push_back(Eigen::Vector2d(x, rng.Uniform(-hy, hy)));
+    }
+    for (int k = 0; k < n; ++k) {
+      p.path.speeds_mps.push_back(rng.Uniform() < 0.5 ? rng.Uniform(1.2, 1.7)
+                                                      : rng.Uniform(4.0, 6.0));
+    }
+    p.path.speed_mps = p.path.speeds_mps[0];
+    s.people.push_back(p);
+  }
+  s.lighting.gain_amplitude = 0.05;
+  s.lighting.period_s = 8;
+  s.noise_sigma = 2.0;
+  s.format = "avi";
+  return s;
+}
+
+}  // namespace
+
+void SceneSpec::Check() const {
+  FV_REQUIRE(!field.empty(), "field: must name a built-in field or a JSON file");
+  FV_REQUIRE(!cameras.empty(), "cameras: needs at least one camera");
+  std::set<std::string> names;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const CameraSpec& c = cameras[i];
+    const std::string ctx = fmt::format("cameras[{}]", i);
+    FV_REQUIRE(!c.name.empty(), "{}.name: must not be empty", ctx);
+    FV_REQUIRE(c.name.find_first_of("/\\ ") == std::string::npos,
+               "{}.name: '{}' must not contain '/', '\\' or spaces (it names files)", ctx, c.name);
+    FV_REQUIRE(names.insert(c.name).second, "{}.name: '{}' is used twice", ctx, c.name);
+    FV_REQUIRE(c.width > 0 && c.width <= 16384, "{}.width: must be in 1..16384", ctx);
+    FV_REQUIRE(c.height > 0 && c.height <= 16384, "{}.height: must be in 1..16384", ctx);
+    if (c.fx > 0 || c.fy > 0) {
+      FV_REQUIRE(std::isfinite(c.fx) && c.fx > 0, "{}.fx: must be > 0", ctx);
+      FV_REQUIRE(std::isfinite(c.fy) && c.fy > 0, "{}.fy: must be > 0", ctx);
+    } else {
+      FV_REQUIRE(std::isfinite(c.hfov_deg) && c.hfov_deg > 1 && c.hfov_deg < 179,
+                 "{}.hfov_deg: must be in (1, 179)", ctx);
+    }
+    const size_t nd = c.distortion.size();
+    FV_REQUIRE(nd == 0 || nd == 4 || nd == 5 || nd == 8 || nd == 12 || nd == 14,
+               "{}.distortion: has {} values; OpenCV takes 0, 4, 5, 8, 12 or 14", ctx, nd);
+    for (double d : c.distortion) {
+      FV_REQUIRE(std::isfinite(d), "{}.distortion: contains a non-finite value", ctx);
+    }
+    if (c.has_rvec_tvec) {
+      FV_REQUIRE(c.rvec.allFinite() && c.tvec.allFinite(), "{}.rvec/tvec: not finite", ctx);
+    } else {
+      FV_REQUIRE(c.position_m.allFinite(), "{}.position_m: not finite", ctx);
+      FV_REQUIRE(c.look_at_m.allFinite(), "{}.look_at_m: not finite", ctx);
+      const Eigen::Vector3d d = c.look_at_m - c.position_m;
+      FV_REQUIRE(d.norm() > 1e-6, "{}.look_at_m: equals position_m", ctx);
+      FV_REQUIRE(d.head<2>().norm() > 1e-6 * d.norm(),
+                 "{}.look_at_m: straight up or down from position_m (the image's up is "
+                 "undefined; give rvec/tvec)",
+                 ctx);
+    }
+  }
+  FV_REQUIRE(std::isfinite(fps) && fps > 0 && fps <= 10000, "fps: must be in (0, 10000]");
+  FV_REQUIRE(num_frames > 0 && num_frames <= 1000000, "num_frames: must be in 1..1000000");
+  FV_REQUIRE(std::isfinite(exposure_s) && exposure_s >= 0 && exposure_s <= 1.0 / fps + 1e-12,
+             "exposure_s: must be in [0, 1/fps]");
+  if (ball.enabled) {
+    FV_REQUIRE(std::isfinite(ball.diameter_m) && ball.diameter_m > 0 && ball.diameter_m < 5,
+               "ball.diameter_m: must be in (0, 5)");
+    CheckColour(ball.colour_bgr, "ball.colour_bgr");
+    FV_REQUIRE(ball.placements.empty() || ball.kicks.empty(),
+               "ball: give either placements or kicks, not both");
+    FV_REQUIRE(!ball.placements.empty() || !ball.kicks.empty(),
+               "ball: needs placements or kicks (or \"enabled\": false)");
+    for (size_t i = 0; i < ball.placements.size(); ++i) {
+      FV_REQUIRE(ball.placements[i].allFinite(), "ball.placements[{}]: not finite", i);
+    }
+    FV_REQUIRE(ball.hold_frames >= 1, "ball.hold_frames: must be >= 1");
+    for (size_t i = 0; i < ball.kicks.size(); ++i) {
+      const KickSpec& k = ball.kicks[i];
+      FV_REQUIRE(std::isfinite(k.time_s) && k.time_s >= 0, "ball.kicks[{}].time_s: must be >= 0",
+                 i);
+      FV_REQUIRE(k.position_m.allFinite(), "ball.kicks[{}].position_m: not finite", i);
+      FV_REQUIRE(k.position_m.z() >= ball.radius_m() - 1e-9,
+                 "ball.kicks[{}].position_m: z must be >= the ball radius {}", i, ball.radius_m());
+      FV_REQUIRE(k.velocity_mps.allFinite() && k.velocity_mps.norm() < 100,
+                 "ball.kicks[{}].velocity_mps: must be finite and below 100 m/s", i);
+    }
+    const BallPhysics& p = ball.physics;
+    FV_REQUIRE(std::isfinite(p.gravity_mps2) && p.gravity_mps2 > 0,
+               "ball.physics.gravity_mps2: must be > 0");
+    FV_REQUIRE(std::isfinite(p.drag_coefficient) && p.drag_coefficient >= 0,
+               "ball.physics.drag_coefficient: must be >= 0");
+    FV_REQUIRE(std::isfinite(p.air_density_kgm3) && p.air_density_kgm3 >= 0,
+               "ball.physics.air_density_kgm3: must be >= 0");
+    FV_REQUIRE(std::isfinite(p.mass_kg) && p.mass_kg > 0, "ball.physics.mass_kg: must be > 0");
+    FV_REQUIRE(std::isfinite(p.restitution) && p.restitution >= 0 && p.restitution < 1,
+               "ball.physics.restitution: must be in [0, 1)");
+    FV_REQUIRE(std::isfinite(p.bounce_friction) && p.bounce_friction >= 0 && p.bounce_friction <= 1,
+               "ball.physics.bounce_friction: must be in [0, 1]");
+    FV_REQUIRE(std::isfinite(p.rolling_resistance) && p.rolling_resistance >= 0,
+               "ball.physics.rolling_resistance: must be >= 0");
+    FV_REQUIRE(std::isfinite(p.min_bounce_speed_mps) && p.min_bounce_speed_mps > 0,
+               "ball.physics.min_bounce_speed_mps: must be > 0");
+    FV_REQUIRE(std::isfinite(p.time_step_s) && p.time_step_s >= 1e-5 && p.time_step_s <= 0.01,
+               "ball.physics.time_step_s: must be in [1e-5, 0.01]");
+  }
+  for (size_t i = 0; i < robots.size(); ++i) {
+    const std::string ctx = fmt::format("robots[{}]", i);
+    CheckPath(robots[i].path, ctx + ".path");
+    FV_REQUIRE(std::isfinite(robots[i].radius_m) && robots[i].radius_m > 0,
+               "{}.radius_m: must be > 0", ctx);
+    FV_REQUIRE(std::isfinite(robots[i].height_m) && robots[i].height_m > 0,
+               "{}.height_m: must be > 0", ctx);
+    CheckColour(robots[i].colour_bgr, ctx + ".colour_bgr");
+  }
+  std::set<int> ids;
+  for (size_t i = 0; i < people.size(); ++i) {
+    const std::string ctx = fmt::format("people[{}]", i);
+    FV_REQUIRE(ids.insert(people[i].id).second, "{}.id: {} is used twice", ctx, people[i].id);
+    FV_REQUIRE(people[i].team >= 0 && people[i].team < static_cast<int>(teams.size()),
+               "{}.team: must index teams (0..{})", ctx, static_cast<int>(teams.size()) - 1);
+    CheckPath(people[i].path, ctx + ".path");
+    FV_REQUIRE(
+        std::isfinite(people[i].height_m) && people[i].height_m > 0.5 && people[i].height_m < 2.5,
+        "{}.height_m: must be in (0.5, 2.5)", ctx);
+    CheckColour(people[i].skin_bgr, ctx + ".skin_bgr");
+  }
+  for (size_t i = 0; i < teams.size(); ++i) {
+    CheckColour(teams[i].shirt_bgr, fmt::format("teams[{}].shirt_bgr", i));
+    CheckColour(teams[i].shorts_bgr, fmt::format("teams[{}].shorts_bgr", i));
+  }
+  for (size_t i = 0; i < cones.size(); ++i) {
+    const std::string ctx = fmt::format("cones[{}]", i);
+    FV_REQUIRE(cones[i].position_m.allFinite(), "{}.position_m: not finite", ctx);
+    FV_REQUIRE(std::isfinite(cones[i].height_m) && cones[i].height_m > 0,
+               "{}.height_m: must be > 0", ctx);
+    FV_REQUIRE(std::isfinite(cones[i].base_radius_m) && cones[i].base_radius_m > 0,
+               "{}.base_radius_m: must be > 0", ctx);
+    CheckColour(cones[i].colour_bgr, ctx + ".colour_bgr");
+  }
+  FV_REQUIRE(lighting.light_dir.allFinite() && lighting.light_dir.z() > 0.05,
+             "lighting.light_dir: must point upwards (z > 0)");
+  FV_REQUIRE(std::isfinite(lighting.gain_amplitude) && lighting.gain_amplitude >= 0 &&
+                 lighting.gain_amplitude < 1,
+             "lighting.gain_amplitude: must be in [0, 1)");
+  FV_REQUIRE(std::isfinite(lighting.period_s) && lighting.period_s > 0,
+             "lighting.period_s: must be > 0");
+  FV_REQUIRE(
+      std::isfinite(lighting.vignetting) && lighting.vignetting >= 0 && lighting.vignetting < 1,
+      "lighting.vignetting: must be in [0, 1)");
+  FV_REQUIRE(std::isfinite(noise_sigma) && noise_sigma >= 0 && noise_sigma <= 50,
+             "noise_sigma: must be in [0, 50]");
+  FV_REQUIRE(jpeg_quality >= 1 && jpeg_quality <= 100, "jpeg_quality: must be in 1..100");
+  FV_REQUIRE(format == "avi" || format == "png" || format == "jpg",
+             "format: must be avi, png or jpg (got '{}')", format);
+}
+
+json SceneSpecToJson(const SceneSpec& s) {
+  json j;
+  j["field"] = s.field;
+  j["fps"] = s.fps;
+  j["num_frames"] = s.num_frames;
+  j["seed"] = s.seed;
+  j["exposure_s"] = s.exposure_s;
+  j["cameras"] = json::array();
+  for (const auto& c : s.cameras) {
+    json cj;
+    cj["name"] = c.name;
+    cj["width"] = c.width;
+    cj["height"] = c.height;
+    if (c.fx > 0) {
+      cj["fx"] = c.fx;
+      cj["fy"] = c.fy;
+    } else {
+      cj["hfov_deg"] = c.hfov_deg;
+    }
+    cj["distortion"] = c.distortion;
+    if (c.has_rvec_tvec) {
+      cj["rvec"] = J(c.rvec);
+      cj["tvec"] = J(c.tvec);
+    } else {
+      cj["position_m"] = J(c.position_m);
+      cj["look_at_m"] = J(c.look_at_m);
+    }
+    j["cameras"].push_back(cj);
+  }
+  json b;
+  b["enabled"] = s.ball.enabled;
+  b["diameter_m"] = s.ball.diameter_m;
+  b["colour_bgr"] = J(s.ball.colour_bgr);
+  b["placements"] = json::array();
+  for (const auto& p : s.ball.placements) b["placements"].push_back(J(p));
+  b["hold_frames"] = s.ball.hold_frames;
+  b["kicks"] = json::array();
+  for (const auto& k : s.ball.kicks) {
+    b["kicks"].push_back({{"time_s", k.time_s},
+                          {"position_m", J(k.position_m)},
+                          {"velocity_mps", J(k.velocity_mps)}});
+  }
+  const BallPhysics& p = s.ball.physics;
+  b["physics"] = {{"gravity_mps2", p.gravity_mps2},
+                  {"drag_coefficient", p.drag_coefficient},
+                  {"air_density_kgm3", p.air_density_kgm3},
+                  {"mass_kg", p.mass_kg},
+                  {"restitution", p.restitution},
+                  {"bounce_friction", p.bounce_friction},
+                  {"rolling_resistance", p.rolling_resistance},
+                  {"min_bounce_speed_mps", p.min_bounce_speed_mps},
+                  {"time_step_s", p.time_step_s}};
+  j["ball"] = b;
+  j["robots"] = json::array();
+  for (const auto& r : s.robots) {
+    j["robots"].push_back({{"path", PathToJson(r.path)},
+                           {"radius_m", r.radius_m},
+                           {"height_m", r.height_m},
+                           {"colour_bgr", J(r.colour_bgr)}});
+  }
+  j["people"] = json::array();
+  for (const auto& p : s.people) {
+    j["people"].push_back({{"id", p.id},
+                           {"team", p.team},
+                           {"path", PathToJson(p.path)},
+                           {"height_m", p.height_m},
+                           {"skin_bgr", J(p.skin_bgr)}});
+  }
+  j["teams"] = json::array();
+  for (const auto& t : s.teams) {
+    j["teams"].push_back(
+        {{"name", t.name}, {"shirt_bgr", J(t.shirt_bgr)}, {"shorts_bgr", J(t.shorts_bgr)}});
+  }
+  j["cones"] = json::array();
+  for (const auto& c : s.cones) {
+    j["cones"].push_back({{"position_m", J(c.position_m)},
+                          {"height_m", c.height_m},
+                          {"base_radius_m", c.base_radius_m},
+                          {"colour_bgr", J(c.colour_bgr)}});
+  }
+  j["lighting"] = {{"light_dir", J(s.lighting.light_dir)},
+                   {"gain_amplitude", s.lighting.gain_amplitude},
+                   {"period_s", s.lighting.period_s},
+                   {"vignetting", s.lighting.vignetting},
+                   {"shadows", s.lighting.shadows}};
+  j["noise_sigma"] = s.noise_sigma;
+  j["jpeg_quality"] = s.jpeg_quality;
+  j["format"] = s.format;
+  return j;
+}
+
+SceneSpec SceneSpecFromJson(const json& j, const std::string& context) {
+  try {
+    Known(j, "",
+          {"field", "fps", "num_frames", "duration_s", "seed", "exposure_s", "cameras", "ball",
+           "robots", "people", "teams", "cones", "lighting", "noise_sigma", "jpeg_quality",
+           "format"});
+    SceneSpec s;
+    s.field = Str(j, "field", "", s.field);
+    s.fps = Num(j, "fps", "", s.fps);
+    FV_REQUIRE(s.fps > 0, "fps: must be > 0");
+    if (Has(j, "num_frames")) {
+      s.num_frames = Int(j, "num_frames", "", s.num_frames);
+    } else if (Has(j, "duration_s")) {
+      const double d = Num(j, "duration_s", "", 1.0);
+      FV_REQUIRE(d > 0 && d < 1e5, "duration_s: must be in (0, 1e5)");
+      s.num_frames = std::max(1, static_cast<int>(std::lround(d * s.fps)));
+    }
+    if (Has(j, "seed")) {
+      FV_REQUIRE(j["seed"].is_number_unsigned() || j["seed"].is_number_integer(),
+                 "seed: must be a non-negative integer");
+      FV_REQUIRE(!j["seed"].is_number_integer() || j["seed"].get<int64_t>() >= 0,
+                 "seed: must be a non-negative integer");
+      s.seed = j["seed"].get<uint64_t>();
+    }
+    s.exposure_s = Num(j, "exposure_s", "", s.exposure_s);
+    const json& cams = Arr(j, "cameras", "");
+    s.cameras.clear();
+    for (size_t i = 0; i < cams.size(); ++i) {
+      const std::string ctx = fmt::format("cameras[{}]", i);
+      const json& c = cams[i];
+      Known(c, ctx,
+            {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion", "position_m",
+             "look_at_m", "rvec", "tvec"});
+      CameraSpec cs;
+      cs.name = Str(c, "name", ctx, fmt::format("cam{}", i + 1));
+      cs.width = Int(c, "width", ctx, cs.width);
+      cs.height = Int(c, "height", ctx, cs.height);
+      cs.hfov_deg = Num(c, "hfov_deg", ctx, cs.hfov_deg);
+      cs.fx = Num(c, "fx", ctx, 0.0);
+      cs.fy = Num(c, "fy", ctx, cs.fx);
+      cs.distortion = Doubles(c, "distortion", ctx);
+      if (Has(c, "rvec") || Has(c, "tvec")) {
+        FV_REQUIRE(Has(c, "rvec") && Has(c, "tvec"), "{}: give both rvec and tvec", ctx);
+        cs.has_rvec_tvec = true;
+        cs.rvec = Vec<3>(c, "rvec", ctx, cs.rvec);
+        cs.tvec = Vec<3>(c, "tvec", ctx, cs.tvec);
+      } else {
+        FV_REQUIRE(Has(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)", ctx);
+        FV_REQUIRE(Has(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
+        cs.position_m = Vec<3>(c, "position_m", ctx, cs.position_m);
+        cs.look_at_m = Vec<3>(c, "look_at_m", ctx, cs.look_at_m);
+      }
+      s.cameras.push_back(cs);
+    }
+    if (Has(j, "ball")) {
+      const json& b = Obj(j, "ball", "");
+      Known(
+          b, "ball",
+          {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "physics"});
+      s.ball.enabled = Bool(b, "enabled", "ball", true);
+      s.ball.diameter_m = Num(b, "diameter_m", "ball", s.ball.diameter_m);
+      s.ball.colour_bgr = Vec<3>(b, "colour_bgr", "ball", s.ball.colour_bgr);
+      const json& pl = Arr(b, "placements", "ball");
+      for (size_t i = 0; i < pl.size(); ++i) {
+        s.ball.placements.push_back(VecOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
+      }
+      s.ball.hold_frames = Int(b, "hold_frames", "ball", s.ball.hold_frames);
+      const json& ks = Arr(b, "kicks", "ball");
+      for (size_t i = 0; i < ks.size(); ++i) {
+        const std::string ctx = fmt::format("ball.kicks[{}]", i);
+        Known(ks[i], ctx, {"time_s", "position_m", "velocity_mps"});
+        KickSpec k;
+        k.time_s = Num(ks[i], "time_s", ctx, 0.0);
+        FV_REQUIRE(Has(ks[i], "position_m"), "{}.position_m: missing", ctx);
+        k.position_m = Vec<3>(ks[i], "position_m", ctx, k.position_m);
+        FV_REQUIRE(Has(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
+        k.velocity_mps = Vec<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
+        s.ball.kicks.push_back(k);
+      }
+      const json& ph = Obj(b, "physics", "ball");
+      const std::string pc = "ball.physics";
+      Known(ph, pc,
+            {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
+             "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
+      BallPhysics& p = s.ball.physics;
+      p.gravity_mps2 = Num(ph, "gravity_mps2", pc, p.gravity_mps2);
+      p.drag_coefficient = Num(ph, "drag_coefficient", pc, p.drag_coefficient);
+      p.air_density_kgm3 = Num(ph, "air_density_kgm3", pc, p.air_density_kgm3);
+      p.mass_kg = Num(ph, "mass_kg", pc, p.mass_kg);
+      p.restitution = Num(ph, "restitution", pc, p.restitution);
+      p.bounce_friction = Num(ph, "bounce_friction", pc, p.bounce_friction);
+      p.rolling_resistance = Num(ph, "rolling_resistance", pc, p.rolling_resistance);
+      p.min_bounce_speed_mps = Num(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
+      p.time_step_s = Num(ph, "time_step_s", pc, p.time_step_s);
+    } else {
+      s.ball.enabled = false;
+    }
+    const json& robots = Arr(j, "robots", "");
+    for (size_t i = 0; i < robots.size(); ++i) {
+      const std::string ctx = fmt::format("robots[{}]", i);
+      Known(robots[i], ctx, {"path", "position_m", "radius_m", "height_m", "colour_bgr"});
+      RobotSpec r;
+      if (Has(robots[i], "path")) r.path = PathFromJson(robots[i]["path"], ctx + ".path");
+      if (Has(robots[i], "position_m")) {
+        r.path.waypoints_m.insert(r.path.waypoints_m.begin(),
+                                  Vec<2>(robots[i], "position_m", ctx, Eigen::Vector2d::Zero()));
+      }
+      r.radius_m = Num(robots[i], "radius_m", ctx, r.radius_m);
+      r.height_m = Num(robots[i], "height_m", ctx, r.height_m);
+      r.colour_bgr = Vec<3>(robots[i], "colour_bgr", ctx, r.colour_bgr);
+      s.robots.push_back(r);
+    }
+    const json& people = Arr(j, "people", "");
+    for (size_t i = 0; i < people.size(); ++i) {
+      const std::string ctx = fmt::format("people[{}]", i);
+      Known(people[i], ctx, {"id", "team", "path", "height_m", "skin_bgr"});
+      PersonSpec p;
+      p.id = Int(people[i], "id", ctx, static_cast<int>(i) + 1);
+      p.team = Int(people[i], "team", ctx, 0);
+      FV_REQUIRE(Has(people[i], "path"), "{}.path: missing", ctx);
+      p.path = PathFromJson(people[i]["path"], ctx + ".path");
+      p.height_m = Num(people[i], "height_m", ctx, p.height_m);
+      p.skin_bgr = Vec<3>(people[i], "skin_bgr", ctx, p.skin_bgr);
+      s.people.push_back(p);
+    }
+    if (Has(j, "teams")) {
+      const json& teams = Arr(j, "teams", "");
+      s.teams.clear();
+      for (size_t i = 0; i < teams.size(); ++i) {
+        const std::string ctx = fmt::format("teams[{}]", i);
+        Known(teams[i], ctx, {"name", "shirt_bgr", "shorts_bgr"});
+        TeamSpec t;
+        t.name = Str(teams[i], "name", ctx, fmt::format("team{}", i));
+        t.shirt_bgr = Vec<3>(teams[i], "shirt_bgr", ctx, t.shirt_bgr);
+        t.shorts_bgr = Vec<3>(teams[i], "shorts_bgr", ctx, t.shorts_bgr);
+        s.teams.push_back(t);
+      }
+    }
+    const json& cones = Arr(j, "cones", "");
+    for (size_t i = 0; i < cones.size(); ++i) {
+      const std::string ctx = fmt::format("cones[{}]", i);
+      Known(cones[i], ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
+      ConeSpec c;
+      FV_REQUIRE(Has(cones[i], "position_m"), "{}.position_m: missing", ctx);
+      c.position_m = Vec<2>(cones[i], "position_m", ctx, c.position_m);
+      c.height_m = Num(cones[i], "height_m", ctx, c.height_m);
+      c.base_radius_m = Num(cones[i], "base_radius_m", ctx, c.base_radius_m);
+      c.colour_bgr = Vec<3>(cones[i], "colour_bgr", ctx, c.colour_bgr);
+      s.cones.push_back(c);
+    }
+    if (Has(j, "lighting")) {
+      const json& l = Obj(j, "lighting", "");
+      Known(l, "lighting", {"light_dir", "gain_amplitude", "period_s", "vignetting", "shadows"});
+      s.lighting.light_dir = Vec<3>(l, "light_dir", "lighting", s.lighting.light_dir);
+      s.lighting.gain_amplitude = Num(l, "gain_amplitude", "lighting", s.lighting.gain_amplitude);
+      s.lighting.period_s = Num(l, "period_s", "lighting", s.lighting.period_s);
+      s.lighting.vignetting = Num(l, "vignetting", "lighting", s.lighting.vignetting);
+      s.lighting.shadows = Bool(l, "shadows", "lighting", s.lighting.shadows);
+    }
+    s.noise_sigma = Num(j, "noise_sigma", "", s.noise_sigma);
+    s.jpeg_quality = Int(j, "jpeg_quality", "", s.jpeg_quality);
+    s.format = Str(j, "format", "", s.format);
+    s.Check();
+    return s;
+  } catch (const Error& e) {
+    throw Error(context.empty() ? std::string(e.what()) : context + ": " + e.what());
+  } catch (const json::exception& e) {
+    throw Error(fmt::format("{}: {}", context.empty() ? "scene" : context, e.what()));
+  }
+}
+
+SceneSpec ReadSceneSpec(const std::string& path) {
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "cannot open scene file '{}'", path);
+  json j;
+  try {
+    in >> j;
+  } catch (const json::exception& e) {
+    Throw("{}: not valid JSON ({})", path, e.what());
+  }
+  return SceneSpecFromJson(j, path);
+}
+
+std::vector<std::string> PresetNames() { return {"static", "kick", "players", "demo"}; }
+
+SceneSpec Preset(const std::string& name, uint64_t seed) {
+  SceneSpec s;
+  if (name == "static") {
+    s = StaticPreset(seed);
+  } else if (name == "kick" || name == "demo") {
+    s = KickPreset(seed);
+  } else if (name == "players") {
+    s = PlayersPreset(seed);
+  } else {
+    Throw("unknown preset '{}' (known: {})", name, fmt::join(PresetNames(), ", "));
+  }
+  s.Check();
+  return s;
+}
+
+void ResizeCameras(SceneSpec& spec, int width, int height) {
+  FV_REQUIRE(width > 0 && height > 0, "image size must be positive (got {}x{})", width, height);
+  for (auto& c : spec.cameras) {
+    if (c.fx > 0) {
+      c.fx *= static_cast<double>(width) / c.width;
+      c.fy *= static_cast<double>(height) / c.height;
+    }
+    c.width = width;
+    c.height = height;
+  }
+}
+
+json FlightsToJson(const std::vector<Flight>& flights) {
+  json a = json::array();
+  for (const auto& f : flights) {
+    a.push_back({{"t_start_s", f.t_start_s},
+                 {"t_end_s", f.t_end_s},
+                 {"origin", J(f.origin)},
+                 {"landing", J(f.landing)},
+                 {"apex", J(f.apex)},
+                 {"v0_mps", J(f.v0_mps)}});
+  }
+  return a;
+}
+
+}  // namespace fv::synth
