@@ -111,6 +111,15 @@ double RayAngleDeg(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& centr
 
 std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const Camera& camera,
                                                               const Eigen::Vector3d& p_world) {
+  if (!HasDistortion(camera)) {
+    // Pinhole: d(uv)/d(p_cam) = [fx / Z, 0, -fx X / Z^2; 0, fy / Z, -fy Y / Z^2], times R.
+    const Eigen::Vector3d q = camera.cam_from_world * p_world;
+    if (!(q.z() > 0)) return std::nullopt;
+    Eigen::Matrix<double, 2, 3> d;
+    d << camera.fx / q.z(), 0, -camera.fx * q.x() / (q.z() * q.z()), 0, camera.fy / q.z(),
+        -camera.fy * q.y() / (q.z() * q.z());
+    return d * camera.cam_from_world.rotation;
+  }
   using Jet = ceres::Jet<double, 3>;
   const auto intr = camera.IntrinsicsBlock();
   std::array<Jet, kNumIntrinsics> intr_jet;
@@ -131,9 +140,12 @@ std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const Camera& came
   return j;
 }
 
-std::optional<Eigen::Matrix3d> TriangulationCovariance(const std::vector<const Camera*>& cameras,
-                                                       const Eigen::Vector3d& p_world,
-                                                       double sigma_px) {
+namespace {
+
+// Eigen-decomposition of the information matrix sum_i J_i^T J_i / sigma^2 of the point; nullopt
+// when a camera cannot project it or the rays leave a direction unobserved.
+std::optional<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>> InformationEigen(
+    const std::vector<const Camera*>& cameras, const Eigen::Vector3d& p_world, double sigma_px) {
   if (cameras.size() < 2) return std::nullopt;
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
   for (const Camera* c : cameras) {
@@ -142,10 +154,22 @@ std::optional<Eigen::Matrix3d> TriangulationCovariance(const std::vector<const C
     info += j->transpose() * *j;
   }
   info /= sigma_px * sigma_px;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(info);
-  const Eigen::Vector3d ev = eig.eigenvalues();
-  if (!(ev.minCoeff() > 1e-10 * ev.maxCoeff())) return std::nullopt;
-  return eig.eigenvectors() * ev.cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(info);
+  const Eigen::Vector3d ev = eig.eigenvalues();  // increasing
+  if (!(ev(0) > 1e-10 * ev(2))) return std::nullopt;
+  return eig;
+}
+
+}  // namespace
+
+std::optional<Eigen::Matrix3d> TriangulationCovariance(const std::vector<const Camera*>& cameras,
+                                                       const Eigen::Vector3d& p_world,
+                                                       double sigma_px) {
+  const auto eig = InformationEigen(cameras, p_world, sigma_px);
+  if (!eig) return std::nullopt;
+  return eig->eigenvectors() * eig->eigenvalues().cwiseInverse().asDiagonal() *
+         eig->eigenvectors().transpose();
 }
 
 CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldModel& field,
@@ -213,10 +237,11 @@ CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldM
           }
         }
         layer.best_angle_deg[cell] = best;
-        if (const auto cov = TriangulationCovariance(seeing, p, options.pixel_noise_px)) {
-          layer.err_rms_m[cell] = std::sqrt(cov->trace());
-          layer.err_max_axis_m[cell] = std::sqrt(
-              Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(*cov).eigenvalues().maxCoeff());
+        if (const auto eig = InformationEigen(seeing, p, options.pixel_noise_px)) {
+          // Cov = V diag(1 / lambda) V^T: trace = sum 1 / lambda, largest axis 1 / lambda_min.
+          const Eigen::Vector3d ev = eig->eigenvalues();
+          layer.err_rms_m[cell] = std::sqrt(ev.cwiseInverse().sum());
+          layer.err_max_axis_m[cell] = std::sqrt(1.0 / ev(0));
         }
       }
       progress.Update(++rows_done);

@@ -146,8 +146,15 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
                     cv::LINE_AA, 0, 0.03);
     cv::circle(img, p, std::max(4, int(9 * scale)), cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
     cv::circle(img, p, std::max(3, int(7 * scale)), colour, cv::FILLED, cv::LINE_AA);
-    Text(img, fmt::format("{} ({:.1f} m)", cam.name, eye.z()),
-         cv::Point(int(p.x + 10 * scale), int(p.y - 8 * scale)), 0.5 * scale, colour);
+    // The label on the side of the marker that faces the image centre, so it stays inside.
+    const std::string label = fmt::format("{} ({:.1f} m)", cam.name, eye.z());
+    int baseline = 0;
+    const cv::Size text =
+        cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, 0.5 * scale, 1, &baseline);
+    const int tx =
+        p.x < 0.5 * img.cols ? int(p.x + 10 * scale) : int(p.x - 10 * scale) - text.width;
+    const int ty = p.y < 0.5 * img.rows ? int(p.y + 8 * scale) + text.height : int(p.y - 8 * scale);
+    Text(img, label, cv::Point(tx, ty), 0.5 * scale, colour);
   }
 
   // Legend strip.
