@@ -88,11 +88,11 @@ struct ExtrinsicsCli {
 };
 
 void PrintPointTable(const std::vector<PointResidual>& pts) {
-  std::cout << fmt::format("{:<28s} {:>8s} {:>8s} {:>8s} {:>8s} {:>7s} {:>8s} {:>8s}  {}\n",
+  std::cout << fmt::format("{:<36s} {:>8s} {:>8s} {:>8s} {:>8s} {:>7s} {:>8s} {:>8s}  {}\n",
                            "point", "u", "v", "x_m", "y_m", "z_m", "err_px", "err_mm", "");
   for (const auto& p : pts) {
     std::cout << fmt::format(
-        "{:<28s} {:>8.1f} {:>8.1f} {:>8.3f} {:>8.3f} {:>7.3f} {:>8.2f} {:>8s}  "
+        "{:<36s} {:>8.1f} {:>8.1f} {:>8.3f} {:>8.3f} {:>7.3f} {:>8.2f} {:>8s}  "
         "{}\n",
         p.name, p.uv_px.x(), p.uv_px.y(), p.p_world.x(), p.p_world.y(), p.p_world.z(), p.err_px,
         p.err_mm ? fmt::format("{:.0f}", *p.err_mm) : std::string("-"), p.inlier ? "" : "outlier");
@@ -251,6 +251,13 @@ void Setup(CLI::App& app, int& exit_code) {
                  "Drop views with RMS above this x the median (and above --outlier-min-px)")
       ->capture_default_str();
   in->add_option("--outlier-min-px", ic->o.outlier_min_px, "See --outlier-factor")
+      ->capture_default_str();
+  in->add_option("--subpix-window", ic->o.detect.subpix_half_window_px,
+                 "cornerSubPix half window in pixels")
+      ->capture_default_str();
+  in->add_option("--subpix-cap", ic->o.detect.subpix_square_fraction,
+                 "Cap the half window at this fraction of the smallest square (0: no cap, as "
+                 "OpenCV's calibration sample)")
       ->capture_default_str();
   in->add_option("--max-frames", ic->o.source.max_video_frames, "Frames sampled from a video")
       ->capture_default_str();

@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/util/error.h"
@@ -141,6 +142,38 @@ TEST(Board, ChArUcoPartialViewsCount) {
   EXPECT_GE(r.num_used, 8) << r.Summary();
   EXPECT_NEAR(r.camera.fx, 580, 8) << r.Summary();
   EXPECT_NEAR(r.camera.cx, 318, 10) << r.Summary();
+}
+
+TEST(Board, VideoIsSampledEvenly) {
+  const uint64_t seed = fv::testing::TestSeed(23);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const cv::Size size(640, 480);
+  const cv::Matx33d k(600, 0, 322, 0, 600, 236, 0, 0, 1);
+  BoardSpec b{BoardType::kChessboard, 7, 5, 0.03};
+  const std::string dir = fv::testing::TempDir();
+  WriteViews(b, k, size, 12, rng, dir, 0.45);
+  const std::string video = dir + "/board.avi";
+  {
+    cv::VideoWriter w(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, size, true);
+    ASSERT_TRUE(w.isOpened());
+    const ImageSource views(dir + "/view*.png");
+    for (int i = 0; i < views.size(); ++i) {
+      cv::Mat bgr;
+      cv::cvtColor(views.Read(i), bgr, cv::COLOR_GRAY2BGR);
+      for (int repeat = 0; repeat < 3; ++repeat) w.write(bgr);  // 36 frames
+    }
+  }
+  IntrinsicsOptions o;
+  o.board = b;
+  o.progress = false;
+  o.num_distortion = 4;
+  o.source.max_video_frames = 12;
+  const IntrinsicsResult r = CalibrateIntrinsics(video, o);
+  EXPECT_EQ(r.num_images, 12);
+  EXPECT_GE(r.num_used, 9) << r.Summary();
+  EXPECT_NEAR(r.camera.fx, 600, 8) << r.Summary();
+  EXPECT_NE(r.views[0].name.find("board.avi#"), std::string::npos) << r.views[0].name;
 }
 
 TEST(Board, NoBoardInAnyImageIsAnErrorNamingTheInput) {

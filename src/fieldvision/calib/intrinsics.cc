@@ -1,6 +1,7 @@
 #include "fieldvision/calib/intrinsics.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <ctime>

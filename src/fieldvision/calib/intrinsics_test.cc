@@ -2,6 +2,8 @@
 
 #include <filesystem>
 
+#include <fmt/format.h>
+
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -69,6 +71,118 @@ TEST(Intrinsics, DefaultsFitTheLeftViewsBetterThanTheReference) {
   EXPECT_NEAR(r.camera.fy, k.at<double>(1, 1), 0.01 * k.at<double>(1, 1));
   EXPECT_NEAR(r.camera.cx, k.at<double>(0, 2), 0.01 * k.at<double>(0, 2));
   EXPECT_NEAR(r.camera.cy, k.at<double>(1, 2), 0.01 * k.at<double>(1, 2));
+}
+
+// Board views made by projecting the board's corners through a known camera (with noise).
+std::vector<BoardView> ProjectedViews(const BoardSpec& b, const cv::Matx33d& k,
+                                      const std::vector<double>& d, int n, double noise_px,
+                                      double max_offset, Rng& rng) {
+  std::vector<BoardView> views;
+  const auto obj = b.CornerPositions();
+  std::vector<cv::Point3d> obj_d(obj.begin(), obj.end());
+  while (static_cast<int>(views.size()) < n) {
+    const cv::Vec3d rvec(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6), rng.Uniform(-0.3, 0.3));
+    const cv::Vec3d tvec(rng.Uniform(-max_offset, max_offset) - 0.1,
+                         rng.Uniform(-0.75 * max_offset, 0.75 * max_offset) - 0.07,
+                         rng.Uniform(0.5, 0.7));
+    std::vector<cv::Point2d> uv;
+    cv::projectPoints(obj_d, rvec, tvec, k, d, uv);
+    BoardView v;
+    v.name = fmt::format("view{:02d}", views.size());
+    v.image_size = cv::Size(640, 480);
+    bool inside = true;
+    for (const auto& p : uv) {
+      inside = inside && p.x > 0 && p.y > 0 && p.x < 639 && p.y < 479;
+      v.image_points.emplace_back(static_cast<float>(p.x + rng.Normal(0, noise_px)),
+                                  static_cast<float>(p.y + rng.Normal(0, noise_px)));
+    }
+    if (!inside) continue;
+    v.object_points = obj;
+    views.push_back(v);
+  }
+  return views;
+}
+
+TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
+  const uint64_t seed = fv::testing::TestSeed(51);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  IntrinsicsOptions o;
+  o.board = {BoardType::kChessboard, 9, 6, 0.025};
+  o.progress = false;
+  const cv::Matx33d k(540, 0, 330, 0, 540, 238, 0, 0, 1);
+  const std::vector<double> d = {-0.25, 0.08, 0.0, 0.0, 0.0};
+  auto views = ProjectedViews(o.board, k, d, 12, 0.1, 0.15, rng);
+  // View 5 was detected with its corners jittered by 3 px (a blurred frame, say).
+  for (auto& p : views[5].image_points) {
+    p += cv::Point2f(static_cast<float>(rng.Normal(0, 3)), static_cast<float>(rng.Normal(0, 3)));
+  }
+  const IntrinsicsResult r = CalibrateFromViews(views, o);
+  EXPECT_FALSE(r.views[5].used);
+  EXPECT_NE(r.views[5].dropped_because.find("median"), std::string::npos);
+  EXPECT_EQ(r.num_used, 11);
+  EXPECT_EQ(r.fits, 2);
+  EXPECT_EQ(r.camera.notes.at("dropped_views"), "view05");
+  EXPECT_LT(r.rms_px, 0.2);
+  EXPECT_NEAR(r.camera.fx, 540, 3);
+  EXPECT_NEAR(r.camera.distortion[0], -0.25, 0.02);
+}
+
+TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
+  const uint64_t seed = fv::testing::TestSeed(52);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  IntrinsicsOptions o;
+  o.board = {BoardType::kChessboard, 4, 3, 0.02};
+  o.progress = false;
+  const cv::Matx33d k(540, 0, 330, 0, 540, 238, 0, 0, 1);
+  // A small board always near the same spot, barely tilted: the model is not constrained.
+  std::vector<BoardView> views;
+  for (int i = 0; i < 5; ++i) {
+    BoardView v;
+    v.name = fmt::format("v{}", i);
+    v.image_size = cv::Size(640, 480);
+    const auto obj = o.board.CornerPositions();
+    std::vector<cv::Point3d> obj_d(obj.begin(), obj.end());
+    std::vector<cv::Point2d> uv;
+    cv::projectPoints(
+        obj_d,
+        cv::Vec3d(rng.Uniform(-0.04, 0.04), rng.Uniform(-0.04, 0.04), rng.Uniform(-0.2, 0.2)),
+        cv::Vec3d(-0.2, -0.15, 0.6), k, cv::noArray(), uv);
+    for (const auto& p : uv) {
+      v.image_points.emplace_back(static_cast<float>(p.x + rng.Normal(0, 0.1)),
+                                  static_cast<float>(p.y + rng.Normal(0, 0.1)));
+    }
+    v.object_points = obj;
+    views.push_back(v);
+  }
+  const IntrinsicsResult r = CalibrateFromViews(views, o);
+  std::string all;
+  for (const auto& w : r.warnings) all += w + "\n";
+  EXPECT_NE(all.find("only 5 views"), std::string::npos) << all;
+  EXPECT_NE(all.find("cover only"), std::string::npos) << all;
+  // The focal length is not pinned down: the board hardly tilts, which is either seen in the
+  // estimated tilts or in the focal length's standard deviation.
+  EXPECT_TRUE(all.find("board orientations differ") != std::string::npos ||
+              all.find("focal length uncertain") != std::string::npos)
+      << all << r.Summary() << " tilt range " << r.coverage.tilt_range_deg;
+  EXPECT_LT(r.coverage.cell_fraction, 0.3);
+}
+
+TEST(Intrinsics, TooFewViewsIsAnError) {
+  Rng rng(1);
+  IntrinsicsOptions o;
+  o.board = {BoardType::kChessboard, 9, 6, 0.025};
+  o.progress = false;
+  auto views = ProjectedViews(o.board, cv::Matx33d(540, 0, 330, 0, 540, 238, 0, 0, 1), {}, 2, 0.1,
+                              0.15, rng);
+  views.push_back({"empty", cv::Size(640, 480), {}, {}, {}});
+  try {
+    CalibrateFromViews(views, o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("only 2 of 3"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
