@@ -492,7 +492,7 @@ SceneRenderer::SceneRenderer(const SceneSpec& spec) : spec_(spec) {
     cameras_.push_back(MakeCamera(spec_.cameras[i], static_cast<int>(i)));
   }
   if (spec_.ball.enabled) {
-    trajectory_ = std::make_unique<BallTrajectory>(spec_.ball, spec_.duration_s() + 1.0);
+    trajectory_ = std::make_unique<BallTrajectory>(spec_.ball, spec_.duration_s());
   }
   Rng rng(spec_.seed * 6364136223846793005ULL + 1442695040888963407ULL);
   noise_table_.resize(65536);

@@ -160,8 +160,8 @@ void CheckColour(const Eigen::Vector3d& c, const std::string& ctx) {
 std::vector<CameraSpec> CornerRig(const FieldModel& f, double height_m, int w, int h,
                                   double hfov_deg) {
   std::vector<CameraSpec> cams;
-  const double hx = 0.5 * f.length_m + 0.6 * f.surround_m;
-  const double hy = 0.5 * f.width_m + 0.6 * f.surround_m;
+  const double hx = 0.5 * f.length_m + 0.9 * f.surround_m;
+  const double hy = 0.5 * f.width_m + 0.9 * f.surround_m;
   const int sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
   for (int i = 0; i < 4; ++i) {
     CameraSpec c;
@@ -172,7 +172,7 @@ std::vector<CameraSpec> CornerRig(const FieldModel& f, double height_m, int w, i
     c.distortion = {-0.06, 0.02, 0.0, 0.0, 0.0};
     c.position_m = Eigen::Vector3d(sx[i] * hx, sy[i] * hy, height_m);
     // Look at a point a little towards the camera from the centre so the near corner is in view.
-    c.look_at_m = Eigen::Vector3d(sx[i] * 0.1 * f.length_m, sy[i] * 0.1 * f.width_m, 0.0);
+    c.look_at_m = Eigen::Vector3d(sx[i] * 0.06 * f.length_m, sy[i] * 0.06 * f.width_m, 0.0);
     cams.push_back(c);
   }
   return cams;

@@ -60,7 +60,7 @@ struct BallPhysics {
   double restitution = 0.6;           // share of the vertical speed kept at a bounce
   double bounce_friction = 0.2;       // share of the horizontal speed lost at a bounce
   double rolling_resistance = 0.04;   // rolling deceleration in units of g
-  double min_bounce_speed_mps = 0.5;  // a bounce slower than this ends in rolling
+  double min_bounce_speed_mps = 1.0;  // a bounce slower than this ends in rolling
   double time_step_s = 0.001;         // RK4 step
 };
 

@@ -352,7 +352,7 @@ TEST(Writer, ReproducibleFilesWithContractHeaders) {
   FV_SEED_TRACE(seed);
   SceneSpec s = Preset("kick", seed);
   ResizeCameras(s, 160, 120);
-  s.num_frames = 6;
+  s.num_frames = 20;  // past the kick at 0.25 s
   s.people.push_back(PersonSpec{});
   s.people.back().path.waypoints_m = {Eigen::Vector2d(0, 0), Eigen::Vector2d(3, 1)};
   const std::string dir = fv::testing::TempDir();
@@ -366,7 +366,7 @@ TEST(Writer, ReproducibleFilesWithContractHeaders) {
   }
   EXPECT_EQ(CsvTable::Read(dir + "/a/truth.csv").header(),
             (std::vector<std::string>{"frame", "time_s", "x_m", "y_m", "z_m", "n_cams"}));
-  EXPECT_EQ(CsvTable::Read(dir + "/a/truth.csv").rows(), 6u);
+  EXPECT_EQ(CsvTable::Read(dir + "/a/truth.csv").rows(), 20u);
   EXPECT_EQ(
       CsvTable::Read(dir + "/a/truth_2d.csv").header(),
       (std::vector<std::string>{"frame", "cam", "u_px", "v_px", "radius_px", "visible_fraction"}));
@@ -396,7 +396,7 @@ TEST(Writer, ReproducibleFilesWithContractHeaders) {
     EXPECT_EQ(img.rows, 120);
     ++frames;
   }
-  EXPECT_EQ(frames, 6);
+  EXPECT_EQ(frames, 20);
   // The spec written reads back to the same scene.
   EXPECT_EQ(SceneSpecToJson(ReadSceneSpec(dir + "/a/scene.json")).dump(),
             SceneSpecToJson(s).dump());

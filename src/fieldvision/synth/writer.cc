@@ -4,6 +4,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -108,50 +110,70 @@ WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir, b
       video_files[c] = path(name + "/%05d." + spec.format);
     }
   }
+  // Work items are (frame, camera) in frame-major order, rendered by a pool of threads; each
+  // camera's frames are written in order as soon as they are ready.
+  struct CameraOut {
+    std::mutex mutex;
+    cv::VideoWriter writer;
+    std::map<int, cv::Mat> pending;
+    int next_write = 0;
+  };
+  std::vector<std::unique_ptr<CameraOut>> outs;
+  for (int c = 0; c < nc; ++c) {
+    outs.push_back(std::make_unique<CameraOut>());
+    if (spec.format != "avi") continue;
+    const Camera& cam = scene.cameras()[c];
+    cv::VideoWriter& writer = outs.back()->writer;
+    writer.open(video_files[c], cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                spec.fps, cv::Size(cam.width, cam.height), true);
+    FV_REQUIRE(writer.isOpened(), "cannot open video '{}' for writing", video_files[c]);
+    writer.set(cv::VIDEOWRITER_PROP_QUALITY, spec.jpeg_quality);
+  }
+  const std::vector<int> params =
+      spec.format == "jpg" ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, spec.jpeg_quality}
+                           : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};
+  const long long total = static_cast<long long>(nc) * nf;
   std::atomic<long long> done{0};
-  std::atomic<int> next{0};
+  std::atomic<long long> next{0};
   std::mutex error_mutex;
   std::string error;
   auto worker = [&] {
-    for (int c = next++; c < nc; c = next++) {
+    for (long long i = next++; i < total; i = next++) {
+      const int f = static_cast<int>(i / nc), c = static_cast<int>(i % nc);
       try {
-        const Camera& cam = scene.cameras()[c];
-        cv::VideoWriter writer;
-        if (spec.format == "avi") {
-          writer.open(video_files[c], cv::CAP_OPENCV_MJPEG,
-                      cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), spec.fps,
-                      cv::Size(cam.width, cam.height), true);
-          FV_REQUIRE(writer.isOpened(), "cannot open video '{}' for writing", video_files[c]);
-          writer.set(cv::VIDEOWRITER_PROP_QUALITY, spec.jpeg_quality);
-        }
-        const std::vector<int> params =
-            spec.format == "jpg" ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, spec.jpeg_quality}
-                                 : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};
-        for (int f = 0; f < nf; ++f) {
-          cv::Mat img = scene.RenderCamera(c, f, &stats[c][f]);
-          if (f == 0) first[c] = img.clone();
+        cv::Mat img = scene.RenderCamera(c, f, &stats[c][f]);
+        if (f == 0) first[c] = img.clone();
+        CameraOut& out = *outs[c];
+        std::lock_guard<std::mutex> lock(out.mutex);
+        out.pending.emplace(f, std::move(img));
+        while (!out.pending.empty() && out.pending.begin()->first == out.next_write) {
           if (spec.format == "avi") {
-            writer.write(img);
+            out.writer.write(out.pending.begin()->second);
           } else {
-            const std::string p = fmt::format("{}/{}/{:05d}.{}", out_dir, cam.name, f, spec.format);
-            FV_REQUIRE(cv::imwrite(p, img, params), "cannot write image '{}'", p);
+            const std::string p = fmt::format("{}/{}/{:05d}.{}", out_dir, scene.cameras()[c].name,
+                                              out.next_write, spec.format);
+            FV_REQUIRE(cv::imwrite(p, out.pending.begin()->second, params),
+                       "cannot write image '{}'", p);
           }
+          out.pending.erase(out.pending.begin());
+          ++out.next_write;
           ++done;
         }
       } catch (const std::exception& e) {
         std::lock_guard<std::mutex> lock(error_mutex);
         if (error.empty()) error = e.what();
-        next = nc;
+        next = total;
       }
     }
   };
   {
     Progress prog("synth: rendering", static_cast<long long>(nc) * nf, "frames", progress);
-    const int n_threads = std::min<int>(nc, std::max(1u, std::thread::hardware_concurrency()));
+    const int n_threads = static_cast<int>(
+        std::min<long long>(total, std::max(1u, std::thread::hardware_concurrency())));
     std::vector<std::thread> threads;
     for (int k = 0; k < n_threads; ++k) threads.emplace_back(worker);
     while (true) {
-      bool all_done = done.load() >= static_cast<long long>(nc) * nf;
+      bool all_done = done.load() >= total;
       {
         std::lock_guard<std::mutex> lock(error_mutex);
         all_done = all_done || !error.empty();
@@ -161,6 +183,7 @@ WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir, b
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     for (auto& t : threads) t.join();
+    for (auto& o : outs) o->writer.release();
     prog.Update(done.load());
     prog.Finish();
   }
