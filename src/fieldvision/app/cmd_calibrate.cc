@@ -210,6 +210,9 @@ void RunRig(const RigCli& c) {
   }
   const RigResult r = RefineRig(cams, obs, c.o);
   std::cout << r.Summary() << "\n";
+  for (const auto& [name, p] : r.free_points) {
+    std::cout << fmt::format("  point {}: ({:.3f}, {:.3f}, {:.3f}) m\n", name, p.x(), p.y(), p.z());
+  }
   std::filesystem::create_directories(c.out_dir);
   for (size_t i = 0; i < r.cameras.size(); ++i) {
     const std::string path =
