@@ -1,12 +1,63 @@
-// `fieldvision trajectory`: planned; replaced by its implementation.
+// `fieldvision trajectory`: split a ball track into flights, fit them, predict landings, make
+// line/goal/basket calls, write FLIGHTS.json, pictures and a smoothed track (trajectory_run.h).
+#include <iostream>
+#include <memory>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/recon/trajectory_run.h"
 
 namespace fv::app {
 namespace {
 
+struct TrajectoryCliOptions {
+  TrajectoryJob job;
+  std::string drag = "auto";
+};
+
 void Setup(CLI::App& app, int& exit_code) {
-  AddPlannedCommand(app, "trajectory", "Split a ball track into flights and fit them",
-                    "writes FLIGHTS.json with origin, landing, apex, v0 (ball flights issue)", exit_code);
+  auto o = std::make_shared<TrajectoryCliOptions>();
+  TrajectoryJob& j = o->job;
+  CLI::App* c = app.add_subcommand(
+      "trajectory", "Split a ball track into flights and fit them (origin, landing, apex, v0)");
+  c->add_option("--in", j.in_path,
+                "BALL.csv (frame,time_s,x_m,y_m,z_m,n_cams,err_px) or a Timestamp,X,Y,Z CSV")
+      ->required();
+  c->add_option("--out", j.out_path, "FLIGHTS.json to write")->required();
+  c->add_option("--ball-diameter", j.ball_diameter_m,
+                "Ball diameter in metres (default 0.22; 0.04 for a Timestamp,X,Y,Z file)")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--gravity", j.analysis.gravity_mps2, "Gravity in m/s^2 (default 9.81)")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--ground-z", j.analysis.ground_z_m,
+                "Height of the bounce surface in metres (default 0)");
+  c->add_option("--drag", o->drag,
+                "Quadratic air drag: auto (used when it lowers the residual by > 10 %), on, off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
+  c->add_option("--noise", j.analysis.noise_m,
+                "Position noise (1 sigma, metres); default: estimated from the track")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--accel-slack", j.accel_slack_mps2,
+                "Unmodelled acceleration (drag, spin) allowed before a velocity change counts as "
+                "a bounce or hit, m/s^2 (default 10; 25 for a Timestamp,X,Y,Z file)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--field", j.field,
+                "Field (built-in name or JSON) for in/out, goal and basket calls");
+  c->add_option("--rule", j.decisions.rule, "In/out rule: auto, football, tennis, basketball")
+      ->check(CLI::IsMember({"auto", "football", "tennis", "basketball"}));
+  c->add_option("--line", j.decisions.lines,
+                "A named field line to judge each landing against (repeatable)");
+  c->add_option("--images", j.images_dir,
+                "Folder for pictures: track height over time, top view, side view per flight");
+  c->add_option("--smoothed", j.smoothed_path, "Write the Kalman/RTS-smoothed track (BALL.csv)");
+  c->add_option("--report", j.report_path, "Write a report JSON (flights, calls, timeline)");
+  c->add_option("--predict-fraction", j.predict_fraction,
+                "Part of each flight used to predict its landing (default 0.5)")
+      ->check(CLI::Range(0.05, 1.0));
+  c->callback([o, &exit_code] {
+    o->job.analysis.drag = ParseDragMode(o->drag, "--drag");
+    RunTrajectory(o->job, std::cout);
+    exit_code = 0;
+  });
 }
 
 FV_REGISTER_COMMAND(50, "trajectory", Setup);

@@ -285,6 +285,7 @@ void TrajectoryOptions::Check() const {
   FV_REQUIRE(window_samples >= 3, "window_samples must be >= 3 (got {})", window_samples);
   CheckNonNegative(min_velocity_change_mps, "min_velocity_change_mps");
   CheckPositive(break_sigmas, "break_sigmas");
+  CheckNonNegative(unmodelled_accel_mps2, "unmodelled_accel_mps2");
   CheckPositive(outlier_sigmas, "outlier_sigmas");
   CheckNonNegative(min_outlier_m, "min_outlier_m");
   CheckNonNegative(ground_tolerance_m, "ground_tolerance_m");
@@ -590,7 +591,8 @@ struct Segmenter {
     // the windows' half spans).
     const double sd = sigma * std::sqrt(3.0) * std::hypot(L.SlopeSd(), R.SlopeSd());
     const double span = track[right.back()].time_s - track[left.front()].time_s;
-    const double thr = std::max(o.min_velocity_change_mps, o.break_sigmas * sd + 5.0 * 0.5 * span);
+    const double thr = std::max(o.min_velocity_change_mps,
+                                o.break_sigmas * sd + o.unmodelled_accel_mps2 * 0.5 * span);
     c.ratio = dv / thr;
     c.pos = k;
     c.dv = dv;
@@ -777,12 +779,13 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
       const int ns = static_cast<int>(s.size());
       while (lead < ns && !f.no_drag.inlier[lead]) ++lead;
       while (trail < ns - lead && !f.no_drag.inlier[ns - 1 - trail]) ++trail;
+      // Only a few samples (a hop); a long run of misses is model error (spin), kept.
+      if (lead > 3) lead = 0;
+      if (trail > 3) trail = 0;
       if ((lead > 0 || trail > 0) && ns - lead - trail >= options.min_flight_samples) {
         s = std::vector<BallSample>(s.begin() + lead, s.end() - trail);
         f.samples = std::vector<int>(f.samples.begin() + lead, f.samples.end() - trail);
         f.no_drag = FitBallistic(s, false, options, res.noise_m);
-        if (lead > 0) f.start_event = FlightEvent::kGround;
-        if (trail > 0) f.end_event = FlightEvent::kGround;
         ++res.short_hops;
       }
     }

@@ -80,8 +80,10 @@ struct TrajectoryOptions {
   int window_samples = 3;           // fewest samples on each side of a break
   double min_velocity_change_mps = 1.0;  // smaller velocity jumps are never breaks
   double break_sigmas = 6.0;             // a break needs a jump this many standard errors large
-  double outlier_sigmas = 5.0;           // a sample this far from both local fits is an outlier
-  double min_outlier_m = 0.03;           // and at least this far
+  // plus this unmodelled acceleration (drag, spin) times half the span of the two local fits
+  double unmodelled_accel_mps2 = 10.0;
+  double outlier_sigmas = 5.0;       // a sample this far from both local fits is an outlier
+  double min_outlier_m = 0.03;       // and at least this far
   double ground_tolerance_m = 0.03;  // centre within radius + this (+3 noise) counts as on ground
   double min_ground_s = 0.1;         // a ground phase (rolling, at rest) lasts at least this
   double max_gap_s = 0.5;            // longer gaps without samples end a flight

@@ -14,6 +14,7 @@ void TrajectoryJob::Check() const {
   FV_REQUIRE(!in_path.empty(), "trajectory: --in is required");
   FV_REQUIRE(!out_path.empty(), "trajectory: --out is required");
   CheckNonNegative(ball_diameter_m, "ball_diameter_m");
+  CheckNonNegative(accel_slack_mps2, "accel_slack_mps2");
   CheckInRange(predict_fraction, 0.05, 1.0, "predict_fraction");
   decisions.Check();
   smoother.Check();
@@ -21,6 +22,13 @@ void TrajectoryJob::Check() const {
 
 TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   job.Check();
+  for (const std::string* p : {&job.out_path, &job.report_path, &job.smoothed_path}) {
+    const auto parent = std::filesystem::path(*p).parent_path();
+    if (p->empty() || parent.empty()) continue;
+    std::error_code ec;
+    std::filesystem::create_directories(parent, ec);
+    FV_REQUIRE(!ec, "cannot create folder '{}' for '{}': {}", parent.string(), *p, ec.message());
+  }
   TrajectoryJobResult out;
   out.input = ReadBallTrack(job.in_path);
   const auto& track = out.input.samples;
@@ -37,6 +45,8 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
                        out.input.layout == "tt3d" ? "table tennis, TT3D layout" : "football");
   }
   out.options.ball_radius_m = 0.5 * diameter;
+  out.options.unmodelled_accel_mps2 =
+      job.accel_slack_mps2 > 0 ? job.accel_slack_mps2 : (out.input.layout == "tt3d" ? 25.0 : 10.0);
   out.options.Check();
   FieldModel field;
   const bool has_field = !job.field.empty();

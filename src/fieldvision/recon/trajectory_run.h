@@ -20,7 +20,10 @@ struct TrajectoryJob {
   std::string out_path;          // FLIGHTS.json
   double ball_diameter_m = 0.0;  // 0: 0.22 m (football), 0.04 m for the TT3D layout
   TrajectoryOptions analysis;    // ball_radius_m is set from the diameter
-  std::string field;             // built-in name or JSON; empty: no calls
+  // Unmodelled acceleration allowed at breaks; 0: 10 m/s^2 (football), 25 for the TT3D layout
+  // (a 2.7 g ball with strong drag and spin).
+  double accel_slack_mps2 = 0.0;
+  std::string field;  // built-in name or JSON; empty: no calls
   DecisionOptions decisions;
   std::string images_dir;         // empty: no pictures
   std::string smoothed_path;      // empty: no smoothed track
