@@ -272,6 +272,59 @@ Hit IntersectBody(const Body& body, const Eigen::Vector3d& ro, const Eigen::Vect
   return hit;
 }
 
+int NumPrimitives(const Body& body) {
+  return static_cast<int>(body.capsules.size() + body.cylinders.size());
+}
+
+void PrimitiveBounds(const Body& body, int index, Eigen::Vector3d* lo, Eigen::Vector3d* hi) {
+  const int nc = static_cast<int>(body.capsules.size());
+  if (index < nc) {
+    const Capsule& c = body.capsules[index];
+    const Eigen::Vector3d r = Eigen::Vector3d::Constant(c.radius_m);
+    *lo = c.a.cwiseMin(c.b) - r;
+    *hi = c.a.cwiseMax(c.b) + r;
+  } else {
+    const Cylinder& c = body.cylinders[index - nc];
+    *lo = Eigen::Vector3d(c.centre_m.x() - c.radius_m, c.centre_m.y() - c.radius_m, 0);
+    *hi = Eigen::Vector3d(c.centre_m.x() + c.radius_m, c.centre_m.y() + c.radius_m, c.height_m);
+  }
+}
+
+double IntersectPrimitive(const Body& body, int index, const Eigen::Vector3d& ro,
+                          const Eigen::Vector3d& rd) {
+  const int nc = static_cast<int>(body.capsules.size());
+  if (index < nc) {
+    const Capsule& c = body.capsules[index];
+    return IntersectCapsule(ro, rd, c.a, c.b, c.radius_m);
+  }
+  return CylinderHit(body.cylinders[index - nc], ro, rd, nullptr, nullptr);
+}
+
+Hit ShadePrimitive(const Body& body, int index, const Eigen::Vector3d& ro,
+                   const Eigen::Vector3d& rd, double t) {
+  Hit hit;
+  hit.t = t;
+  const int nc = static_cast<int>(body.capsules.size());
+  if (index < nc) {
+    const Capsule& c = body.capsules[index];
+    const Eigen::Vector3d p = ro + t * rd;
+    const Eigen::Vector3d ba = c.b - c.a;
+    const double baba = ba.squaredNorm();
+    const double h = baba > 0 ? std::clamp((p - c.a).dot(ba) / baba, 0.0, 1.0) : 0.0;
+    hit.normal = (p - (c.a + h * ba)).normalized();
+    hit.colour = h < c.split ? c.colour_a : c.colour_b;
+    if (c.hair && hit.normal.z() > 0.3) hit.colour = Eigen::Vector3d(30, 40, 55);
+    return hit;
+  }
+  const Cylinder& cy = body.cylinders[index - nc];
+  bool top = false;
+  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  CylinderHit(cy, ro, rd, &n, &top);
+  hit.normal = n;
+  hit.colour = top ? cy.top_bgr : cy.side_bgr;
+  return hit;
+}
+
 bool RayHitsBody(const Body& body, const Eigen::Vector3d& ro, const Eigen::Vector3d& rd) {
   for (const Capsule& c : body.capsules) {
     if (IntersectCapsule(ro, rd, c.a, c.b, c.radius_m) > 1e-6) return true;

@@ -63,6 +63,15 @@ Hit IntersectBody(const Body& body, const Eigen::Vector3d& origin, const Eigen::
                   double t_min = 1e-6);
 // Whether the ray hits the body at all (for shadows).
 bool RayHitsBody(const Body& body, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir);
+// Primitive by primitive (capsules first, then cylinders), for renderers that rasterise each
+// primitive only inside its own image box.
+int NumPrimitives(const Body& body);
+void PrimitiveBounds(const Body& body, int index, Eigen::Vector3d* lo, Eigen::Vector3d* hi);
+double IntersectPrimitive(const Body& body, int index, const Eigen::Vector3d& origin,
+                          const Eigen::Vector3d& dir);
+// Normal and colour where the ray meets primitive `index` at distance t.
+Hit ShadePrimitive(const Body& body, int index, const Eigen::Vector3d& origin,
+                   const Eigen::Vector3d& dir, double t);
 // Capsule and cone intersections (t along the ray, < 0 when missed).
 double IntersectCapsule(const Eigen::Vector3d& ro, const Eigen::Vector3d& rd,
                         const Eigen::Vector3d& pa, const Eigen::Vector3d& pb, double radius);

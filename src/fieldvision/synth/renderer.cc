@@ -621,8 +621,31 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
       }
     };
     for (const Body& b : bodies) {
-      shade_box(b.box_min, b.box_max,
-                [&](const Vec3& p) { return RayHitsBody(b, p, light) ? 1.0 : 0.0; });
+      // Ground boxes of each primitive's shadow, to test only the primitives that can shade.
+      const int np = NumPrimitives(b);
+      std::vector<Eigen::Vector4d> sb(np);
+      for (int q = 0; q < np; ++q) {
+        Vec3 lo, hi;
+        PrimitiveBounds(b, q, &lo, &hi);
+        Eigen::Vector4d box(kInf, kInf, -kInf, -kInf);
+        for (int k = 0; k < 8; ++k) {
+          const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
+                       (k & 4) ? hi.z() : lo.z());
+          const Vec3 g = p - (p.z() / light.z()) * light;
+          box = Eigen::Vector4d(std::min(box[0], g.x()), std::min(box[1], g.y()),
+                                std::max(box[2], g.x()), std::max(box[3], g.y()));
+        }
+        sb[q] = box;
+      }
+      shade_box(b.box_min, b.box_max, [&](const Vec3& p) {
+        for (int q = 0; q < np; ++q) {
+          if (p.x() < sb[q][0] || p.y() < sb[q][1] || p.x() > sb[q][2] || p.y() > sb[q][3]) {
+            continue;
+          }
+          if (IntersectPrimitive(b, q, p, light) > 1e-6) return 1.0;
+        }
+        return 0.0;
+      });
     }
     if (has_ball && ball_mid.z() < 8.0) {
       const Vec3 rr(r_ball, r_ball, r_ball);
@@ -647,23 +670,45 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
     boxes[k] = ProjectBox(cam, b.box_min, b.box_max);
     const cv::Rect& box = boxes[k];
     int bx0 = w, by0 = h, bx1 = -1, by1 = -1;
+    if (box.empty()) continue;
+    // Rasterise primitive by primitive inside its own box: nearest distance and primitive.
+    std::vector<float> best_t(static_cast<size_t>(box.area()),
+                              std::numeric_limits<float>::infinity());
+    std::vector<int16_t> best_p(static_cast<size_t>(box.area()), -1);
+    const int np = NumPrimitives(b);
+    for (int q = 0; q < np; ++q) {
+      Vec3 lo, hi;
+      PrimitiveBounds(b, q, &lo, &hi);
+      const cv::Rect pbox = ProjectBox(cam, lo, hi) & box;
+      for (int v = pbox.y; v < pbox.y + pbox.height; ++v) {
+        for (int u = pbox.x; u < pbox.x + pbox.width; ++u) {
+          const Vec3 d = ray(u, v);
+          if (!d.allFinite()) continue;
+          const double tq = IntersectPrimitive(b, q, o, d);
+          const size_t j = static_cast<size_t>(v - box.y) * box.width + (u - box.x);
+          if (tq > 1e-6 && tq < best_t[j]) {
+            best_t[j] = static_cast<float>(tq);
+            best_p[j] = static_cast<int16_t>(q);
+          }
+        }
+      }
+    }
     for (int v = box.y; v < box.y + box.height; ++v) {
       auto* row = img.ptr<cv::Vec3b>(v);
       float* drow = depth.ptr<float>(v);
       for (int u = box.x; u < box.x + box.width; ++u) {
-        const Vec3 d = ray(u, v);
-        if (!d.allFinite()) continue;
-        const Hit hit = IntersectBody(b, o, d);
-        if (hit.t <= 0) continue;
+        const size_t j = static_cast<size_t>(v - box.y) * box.width + (u - box.x);
+        if (best_p[j] < 0) continue;
         ++hits_all[k];
         bx0 = std::min(bx0, u);
         by0 = std::min(by0, v);
         bx1 = std::max(bx1, u);
         by1 = std::max(by1, v);
-        if (hit.t >= drow[u]) continue;
-        drow[u] = static_cast<float>(hit.t);
+        if (best_t[j] >= drow[u]) continue;
+        drow[u] = best_t[j];
         id[static_cast<size_t>(v) * w + u] = static_cast<uint16_t>(k + 1);
         if (want_image) {
+          const Hit hit = ShadePrimitive(b, best_p[j], o, ray(u, v), best_t[j]);
           const double shade = 0.5 + 0.6 * std::max(0.0, hit.normal.dot(light));
           const Vec3 c = Clamp255(hit.colour * shade);
           row[u] = cv::Vec3b(static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]),
