@@ -52,7 +52,7 @@ void DrawGrid(cv::Mat& img, const Axes& a, const std::string& xlabel, const std:
   cv::rectangle(img, a.box, kDark, 1);
   cv::putText(img, xlabel, cv::Point(a.box.x + a.box.width / 2 - 60, a.box.br().y + 38),
               cv::FONT_HERSHEY_SIMPLEX, 0.5, kBlack, 1, cv::LINE_AA);
-  cv::putText(img, ylabel, cv::Point(5, a.box.y - 10), cv::FONT_HERSHEY_SIMPLEX, 0.5, kBlack, 1,
+  cv::putText(img, ylabel, cv::Point(5, a.box.y - 8), cv::FONT_HERSHEY_SIMPLEX, 0.5, kBlack, 1,
               cv::LINE_AA);
 }
 
@@ -98,7 +98,7 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
   if (pred && pred->ok) grow(pred->landing_m);
   const double ms = 0.05 * (smax - smin) + 0.05, mz = 0.1 * (zmax - zmin) + 0.05;
   Axes a{smin - ms, smax + ms, zmin - mz, zmax + mz,
-         cv::Rect(70, 60, size.width - 100, size.height - 120)};
+         cv::Rect(70, 80, size.width - 100, size.height - 140)};
   DrawGrid(img, a, "horizontal distance along the flight from the origin (m)", "height z (m)");
   cv::line(img, a.P(a.x0, o.ground_z_m), a.P(a.x1, o.ground_z_m), kDark, 2);
   auto curve = [&](const BallisticModel& m, double ta, double tb, const cv::Scalar& c, int th) {

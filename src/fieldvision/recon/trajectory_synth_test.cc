@@ -3,6 +3,7 @@
 #if __has_include("fieldvision/synth/ball_physics.h")
 
 #include <cmath>
+#include <iostream>
 
 #include <gtest/gtest.h>
 
