@@ -135,8 +135,8 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
     for (const auto& c : out.landings) {
       out.timeline.push_back(
           {c.time_s,
-           fmt::format("flight {}: {}lands at ({:.2f}, {:.2f}) m: {} {} by {:.3f} m", c.flight,
-                       c.extrapolated ? "would have " : "", c.point_m.x(), c.point_m.y(),
+           fmt::format("flight {}: {} at ({:.2f}, {:.2f}) m: {} {} by {:.3f} m", c.flight,
+                       c.extrapolated ? "would land" : "lands", c.point_m.x(), c.point_m.y(),
                        c.against == "playing area" ? (c.in ? "IN" : "OUT")
                                                    : (c.in ? "TOUCHES" : "CLEAR OF"),
                        c.against, std::abs(c.margin_m))});
