@@ -183,6 +183,10 @@ std::vector<MountPlace> ReadMountsJson(const std::string& path) {
     j = json::parse(in);
   } catch (const json::parse_error& e) {
     Throw("mounts file '{}' is not valid JSON (byte {})", path, e.byte);
+  } catch (const json::exception& e) {
+    // e.g. a number too large for a double; drop nlohmann's "[json.exception...] " prefix.
+    const std::string what = e.what();
+    Throw("mounts file '{}' is not valid JSON: {}", path, what.substr(what.find("] ") + 2));
   }
   return MountsFromJson(j, "mounts file '" + path + "'");
 }

@@ -230,6 +230,10 @@ Rig ReadRigJson(const std::string& path) {
     j = json::parse(in);
   } catch (const json::parse_error& e) {
     Throw("rig file '{}' is not valid JSON (byte {})", path, e.byte);
+  } catch (const json::exception& e) {
+    // e.g. a number too large for a double; drop nlohmann's "[json.exception...] " prefix.
+    const std::string what = e.what();
+    Throw("rig file '{}' is not valid JSON: {}", path, what.substr(what.find("] ") + 2));
   }
   const std::string base = std::filesystem::path(path).parent_path().string();
   Rig rig = RigFromJson(j, "rig file '" + path + "'", base);

@@ -116,6 +116,10 @@ TEST(RigTest, BadInputGivesOneLineErrors) {
   std::ofstream(dir + "/broken.json") << "{\"cameras\": [ {\"position\": [1, 2,, 3]} ]}";
   ExpectOneLineNaming(ErrorOf([&] { ReadRigJson(dir + "/broken.json"); }),
                       {"broken.json", "not valid JSON"});
+  std::ofstream(dir + "/huge.json")
+      << "{\"cameras\": [{\"position\": [1, 1e999, 3], \"look_at\": [0, 0, 0]}]}";
+  ExpectOneLineNaming(ErrorOf([&] { ReadRigJson(dir + "/huge.json"); }),
+                      {"huge.json", "not valid JSON", "1e999"});
   const json defaults = {{"image_width", 640}, {"image_height", 480}, {"hfov_deg", 60}};
   // Zero cameras.
   ExpectOneLineNaming(ErrorOf([&] {
