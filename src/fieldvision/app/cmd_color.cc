@@ -1,12 +1,72 @@
-// `fieldvision color`: planned; replaced by its implementation.
+// `fieldvision color learn`: a colour class from pixels a user points at (colour_learn.h).
+#include <filesystem>
+#include <iostream>
+
+#include <opencv2/imgcodecs.hpp>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/detect/colour_learn.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
 
+struct ColorLearnArgs {
+  std::string video;
+  int frame = 0;
+  std::string points;
+  std::string roi;
+  std::string negatives;
+  std::string out;
+  std::string mask_out;
+  ColourLearnOptions learn;
+};
+
+void Learn(const ColorLearnArgs& a) {
+  ColourLearnOptions o = a.learn;
+  FV_REQUIRE(!a.points.empty() || !a.roi.empty(), "give --points u,v;u,v... or --roi x,y,w,h");
+  if (!a.points.empty()) o.points = ParsePoints(a.points, "--points");
+  if (!a.roi.empty()) o.roi = ParseRect(a.roi, "--roi");
+  if (!a.negatives.empty()) o.negative_points = ParsePoints(a.negatives, "--negative");
+  const cv::Mat frame = ReadVideoFrame(a.video, a.frame);
+  const ColourLearnResult r = LearnColour(frame, o);
+  WriteColourSpec(r.spec, a.out);
+  std::string mask_out = a.mask_out;
+  if (mask_out.empty()) {
+    std::filesystem::path p(a.out);
+    mask_out = (p.parent_path() / (p.stem().string() + "-mask.png")).string();
+  }
+  bool ok = false;
+  try {
+    ok = cv::imwrite(mask_out, r.overlay);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  FV_REQUIRE(ok, "cannot write mask image '{}'", mask_out);
+  std::cout << r.Summary() << "\nwrote " << a.out << " (use it with --color " << a.out << ") and "
+            << mask_out << " (what the class selects)\n";
+}
+
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(app, "color", "Colour classes for the ball");
-  AddPlannedCommand(*group, "learn", "Learn a colour class from pixels a user points at", "see the ball detection issue", exit_code);
+  auto a = std::make_shared<ColorLearnArgs>();
+  CLI::App* learn = group->add_subcommand(
+      "learn",
+      "Learn a colour class from pixels you point at; writes a colour file and an image "
+      "of what it selects");
+  learn->add_option("--video", a->video, "Video file or image pattern (or a single image)")
+      ->required();
+  learn->add_option("--frame", a->frame, "Frame number (from 0)")->capture_default_str();
+  learn->add_option("--points", a->points, "Pixels on the ball: \"u,v;u,v;...\"");
+  learn->add_option("--roi", a->roi, "Box around the ball: x,y,w,h");
+  learn->add_option("--negative", a->negatives,
+                    "Pixels that are not the class: \"u,v;u,v;...\" (default: the frame away "
+                    "from the ball)");
+  learn->add_option("--name", a->learn.class_name, "Class name")->capture_default_str();
+  learn->add_option("--out", a->out, "Colour file to write (JSON)")->required();
+  learn->add_option("--mask-out", a->mask_out, "Image of the selection (default: OUT-mask.png)");
+  learn->callback([a] { Learn(*a); });
+  (void)exit_code;
 }
 
 FV_REGISTER_COMMAND(30, "color", Setup);

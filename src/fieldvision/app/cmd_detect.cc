@@ -1,12 +1,47 @@
-// `fieldvision detect`: planned; replaced by its implementation.
+// `fieldvision detect`: ball candidates in every frame of one camera's video (detect_video.h).
+#include <iostream>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/detect/detect_video.h"
 
 namespace fv::app {
 namespace {
 
 void Setup(CLI::App& app, int& exit_code) {
-  AddPlannedCommand(app, "detect", "Find ball candidates in each frame of one camera",
-                    "colour lookup table, scanlines, run lengths, blobs, sub-pixel centre (ball detection issue)", exit_code);
+  auto o = std::make_shared<DetectVideoOptions>();
+  CLI::App* cmd =
+      app.add_subcommand("detect",
+                         "Find ball candidates in each frame of one camera (colour table, blobs, "
+                         "sub-pixel centre); write frame,u,v,radius_px,score,accepted,sigma_px");
+  cmd->add_option("--camera", o->camera,
+                  "Camera file (YAML); without it no size check or field mask");
+  cmd->add_option("--video", o->video, "Video file or image pattern (dir/%05d.png)")->required();
+  cmd->add_option("--out", o->out, "CSV of every candidate per frame")->required();
+  cmd->add_option("--color", o->detector.colour,
+                  "Colour preset (orange, yellow, white, pink, red, blue, green, black) or colour "
+                  "file from `color learn`")
+      ->capture_default_str();
+  cmd->add_option("--ball-diameter", o->detector.diameter_m, "Ball diameter in metres")
+      ->capture_default_str();
+  cmd->add_option("--field", o->field,
+                  "Field (built-in name or JSON): ignore everything outside the field of play "
+                  "(needs a camera with a pose)");
+  cmd->add_option(
+      "--draw", o->draw,
+      "Draw the candidates: an annotated video (.avi, .mp4, .mkv) or a folder of JPEGs");
+  cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
+      ->capture_default_str();
+  cmd->add_option("--min-radius", o->detector.min_radius_px, "Smallest ball radius in pixels")
+      ->capture_default_str();
+  cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
+      ->capture_default_str();
+  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
+  cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
+  cmd->callback([o] {
+    const DetectVideoResult r = DetectVideo(*o);
+    std::cout << r.Summary() << "\nwrote " << o->out << "\n";
+  });
+  (void)exit_code;
 }
 
 FV_REGISTER_COMMAND(35, "detect", Setup);

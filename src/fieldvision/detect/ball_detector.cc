@@ -102,6 +102,7 @@ void BallDetectorOptions::Check() const {
   CheckInRange(min_visible_fraction, 0.0, 1.0, "min_visible_fraction");
   CheckInRange(max_leak_fraction, 0.0, 1.0, "max_leak_fraction");
   CheckInRange(max_outside_fraction, 0.0, 1.0, "max_outside_fraction");
+  CheckInRange(max_outside_fraction_occluded, 0.0, 1.0, "max_outside_fraction_occluded");
   CheckInRange(size_tolerance, 0.0, 10.0, "size_tolerance");
   CheckPositive(max_height_m, "max_height_m");
   CheckNonNegative(min_distance_m, "min_distance_m");
@@ -249,6 +250,10 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
       why = fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
     } else if (fit.outside_fraction > o.max_outside_fraction) {
       why = fmt::format("colour goes on beyond the circle on {:.0f} % of rays",
+                        100 * fit.outside_fraction);
+    } else if (fit.inlier_fraction < 0.75 &&
+               fit.outside_fraction > o.max_outside_fraction_occluded) {
+      why = fmt::format("partial outline with colour beyond the circle on {:.0f} % of rays",
                         100 * fit.outside_fraction);
     } else if (fit.dents > o.max_dents && fit.inlier_fraction < 0.85) {
       why = fmt::format("outline has {} dents: not a disc", fit.dents);

@@ -52,13 +52,16 @@ struct BallDetectorOptions {
   int max_dents = 2;  // arcs of the outline inside the circle (occluders), when < 85 % fit
   double min_visible_fraction = 0.35;  // ball-coloured share of the fitted disc
   double max_leak_fraction = 0.35;     // ball-coloured share of a ring just outside it
-  double max_outside_fraction = 0.1;   // rays where the colour goes on beyond the fitted circle
-  double size_tolerance = 0.3;         // relative slack of the expected radius (calibrated camera)
-  double max_height_m = 8.0;           // highest ball centre considered (size check and field mask)
-  double min_distance_m = 0.5;         // nearest ball distance to the camera considered
-  bool use_field_mask = true;          // with camera pose and field: only the field of play
-  double field_margin_m = 1.0;         // around the field of play
-  int max_refine = 12;                 // largest blobs refined per frame
+  double max_outside_fraction = 0.15;
+  // A partly hidden ball (under 75 % of rays on the circle) must not spill beyond it at all.
+  double max_outside_fraction_occluded =
+      0.03;                     // rays where the colour goes on beyond the fitted circle
+  double size_tolerance = 0.3;  // relative slack of the expected radius (calibrated camera)
+  double max_height_m = 8.0;    // highest ball centre considered (size check and field mask)
+  double min_distance_m = 0.5;  // nearest ball distance to the camera considered
+  bool use_field_mask = true;   // with camera pose and field: only the field of play
+  double field_margin_m = 1.0;  // around the field of play
+  int max_refine = 12;          // largest blobs refined per frame
   BallFitOptions fit;
   // Throws fv::Error naming the bad field.
   void Check() const;

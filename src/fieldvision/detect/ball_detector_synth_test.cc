@@ -2,6 +2,8 @@
 // 6-40 px diameter range, partly occluded balls, the orange cone distractor, no ball.
 #include <algorithm>
 
+#if __has_include("fieldvision/synth/synth.h")
+
 #include <gtest/gtest.h>
 
 #include "fieldvision/detect/ball_detector.h"
@@ -152,3 +154,5 @@ TEST(BallDetectorSynth, OccludedBallsFoundConeRejectedNoBallNoDetection) {
 
 }  // namespace
 }  // namespace fv
+
+#endif  // synth module present

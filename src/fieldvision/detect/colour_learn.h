@@ -1,0 +1,58 @@
+// Learning a colour class from pixels a user points at (`fieldvision color learn`): positive
+// pixels (small neighbourhoods of clicked points, or the inscribed ellipse of a region around the
+// ball) give an HSV box from trimmed percentiles (hue as the shortest circular interval), widened
+// for shading; negative pixels (clicked, or by default the frame away from the positives) then
+// shrink the box greedily where that removes most negatives per positive lost. The result is a
+// colour file (class + field green + line white) and an overlay image of what the class selects.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "fieldvision/detect/colour.h"
+
+namespace fv {
+
+struct ColourLearnOptions {
+  std::vector<Eigen::Vector2d> points;           // positive pixels (u, v)
+  std::optional<cv::Rect> roi;                   // or a box around the ball
+  std::vector<Eigen::Vector2d> negative_points;  // pixels that are not the class
+  int point_radius_px = 2;                       // neighbourhood of each point
+  double trim = 0.02;           // share of positives trimmed at each end of each channel
+  double hue_margin_deg = 6.0;  // widening of the learned box
+  double saturation_margin = 25.0;
+  double value_margin = 40.0;
+  double min_recall = 0.9;  // shrinking stops before fewer positives than this remain
+  std::string class_name = "ball";
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct ColourLearnResult {
+  ColourSpec spec;  // the learned class (first, the ball class) + field + line
+  ColourRange range;
+  int positives = 0;
+  int negatives = 0;
+  double recall = 0.0;         // share of positives inside the learned range
+  double negative_rate = 0.0;  // share of negatives inside it
+  cv::Mat overlay;             // the frame, darkened where the class is absent
+  std::string Summary() const;
+};
+
+// Learns from one BGR frame. Throws fv::Error for points or a region outside the frame, or too
+// few positives.
+ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& options);
+
+// Reads frame `frame` of `video` (file or image pattern); throws naming the video when it cannot
+// be opened or is shorter.
+cv::Mat ReadVideoFrame(const std::string& video, int frame);
+
+// "u,v;u,v;..." -> points; "x,y,w,h" -> rectangle. Throw naming `what` on bad syntax.
+std::vector<Eigen::Vector2d> ParsePoints(const std::string& text, const std::string& what);
+cv::Rect ParseRect(const std::string& text, const std::string& what);
+
+}  // namespace fv

@@ -1,0 +1,132 @@
+#include "fieldvision/detect/detect_video.h"
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/io/video_source.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv {
+namespace {
+
+bool IsVideoPath(const std::string& path) {
+  const std::string p = ToLower(path);
+  return EndsWith(p, ".avi") || EndsWith(p, ".mp4") || EndsWith(p, ".mkv");
+}
+
+}  // namespace
+
+void DetectVideoOptions::Check() const {
+  FV_REQUIRE(!video.empty(), "--video is required");
+  FV_REQUIRE(!out.empty(), "--out is required");
+  FV_REQUIRE(max_frames == -1 || max_frames > 0, "max_frames must be -1 or > 0 (got {})",
+             max_frames);
+  detector.Check();
+}
+
+std::string DetectVideoResult::Summary() const {
+  return fmt::format("{} frames, {} candidates, ball accepted in {} frames, {:.1f} frames/s",
+                     frames, candidates, frames_with_ball, seconds > 0 ? frames / seconds : 0.0);
+}
+
+void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates) {
+  constexpr int kShift = 4;  // sub-pixel drawing
+  const auto pt = [](const Eigen::Vector2d& p) {
+    return cv::Point(cvRound(p.x() * (1 << kShift)), cvRound(p.y() * (1 << kShift)));
+  };
+  for (auto it = candidates.rbegin(); it != candidates.rend(); ++it) {
+    const BallCandidate& c = *it;
+    const int r = cvRound(std::max(c.radius_px, 1.0) * (1 << kShift));
+    if (c.accepted) {
+      const cv::Scalar green(0, 255, 0);
+      cv::circle(bgr, pt(c.centre_px), r, green, 1, cv::LINE_AA, kShift);
+      const Eigen::Vector2d dx(3, 0), dy(0, 3);
+      cv::line(bgr, pt(c.centre_px - dx), pt(c.centre_px + dx), green, 1, cv::LINE_AA, kShift);
+      cv::line(bgr, pt(c.centre_px - dy), pt(c.centre_px + dy), green, 1, cv::LINE_AA, kShift);
+      cv::putText(bgr, fmt::format("{:.2f}", c.score),
+                  cv::Point(cvRound(c.centre_px.x() + c.radius_px + 4), cvRound(c.centre_px.y())),
+                  cv::FONT_HERSHEY_SIMPLEX, 0.45, green, 1, cv::LINE_AA);
+    } else {
+      cv::circle(bgr, pt(c.centre_px), r, cv::Scalar(0, 0, 255), 1, cv::LINE_AA, kShift);
+    }
+  }
+}
+
+DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
+  o.Check();
+  std::optional<Camera> camera;
+  if (!o.camera.empty()) camera = ReadCameraYaml(o.camera);
+  std::optional<FieldModel> field;
+  if (!o.field.empty()) field = LoadField(o.field);
+  auto source = VideoSource::Open(o.video);
+  if (camera) source->CheckMatchesCamera(*camera, o.camera);
+  const BallDetector detector(o.detector, camera ? &*camera : nullptr, field ? &*field : nullptr);
+  CsvWriter csv(o.out, {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
+  cv::VideoWriter writer;
+  std::string draw_dir;
+  if (!o.draw.empty()) {
+    if (IsVideoPath(o.draw)) {
+      const int fourcc = EndsWith(ToLower(o.draw), ".avi")
+                             ? cv::VideoWriter::fourcc('M', 'J', 'P', 'G')
+                             : cv::VideoWriter::fourcc('m', 'p', '4', 'v');
+      const double fps = source->fps() > 0 ? source->fps() : 30.0;
+      writer.open(o.draw, fourcc, fps, cv::Size(source->width(), source->height()));
+      FV_REQUIRE(writer.isOpened(), "cannot write annotated video '{}'", o.draw);
+    } else {
+      std::error_code ec;
+      std::filesystem::create_directories(o.draw, ec);
+      FV_REQUIRE(std::filesystem::is_directory(o.draw), "cannot create folder '{}' for --draw",
+                 o.draw);
+      draw_dir = o.draw;
+    }
+  }
+  DetectVideoResult result;
+  const long long total = o.max_frames > 0 && source->frame_count() > 0
+                              ? std::min(o.max_frames, source->frame_count())
+                              : (o.max_frames > 0 ? o.max_frames : source->frame_count());
+  Progress progress("detect", total, "frames", o.progress);
+  const auto t0 = std::chrono::steady_clock::now();
+  Frame frame;
+  while ((o.max_frames < 0 || result.frames < o.max_frames) && source->Read(frame)) {
+    const auto cands = detector.Detect(frame.bgr);
+    bool any = false;
+    for (const auto& c : cands) {
+      csv << frame.index << c.centre_px.x() << c.centre_px.y() << c.radius_px << c.score
+          << (c.accepted ? 1 : 0) << c.sigma_px;
+      csv.EndRow();
+      any = any || c.accepted;
+    }
+    result.candidates += static_cast<long long>(cands.size());
+    result.frames_with_ball += any;
+    ++result.frames;
+    if (writer.isOpened() || !draw_dir.empty()) {
+      cv::Mat canvas = frame.bgr.clone();
+      DrawCandidates(canvas, cands);
+      if (writer.isOpened()) {
+        writer.write(canvas);
+      } else {
+        const std::string path = fmt::format("{}/{:05d}.jpg", draw_dir, frame.index);
+        FV_REQUIRE(cv::imwrite(path, canvas), "cannot write '{}'", path);
+      }
+    }
+    progress.Update(result.frames);
+  }
+  progress.Finish();
+  csv.Close();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  FV_REQUIRE(result.frames > 0, "video '{}' has no frames", o.video);
+  return result;
+}
+
+}  // namespace fv

@@ -1,0 +1,39 @@
+// `fieldvision detect`: runs the ball detector of one camera over a video (any file OpenCV reads
+// or an image sequence, via fv::VideoSource), writes every candidate per frame to a CSV file and
+// optionally draws them on the frames (an annotated video or a folder of images).
+#pragma once
+
+#include <string>
+
+#include "fieldvision/detect/ball_detector.h"
+
+namespace fv {
+
+struct DetectVideoOptions {
+  std::string camera;   // camera YAML; "" for an uncalibrated camera (no size check, no mask)
+  std::string video;    // file or image pattern (dir/%05d.png)
+  std::string out;      // CSV: frame,u,v,radius_px,score,accepted,sigma_px
+  std::string field;    // built-in field name or JSON for the field mask; "" for none
+  std::string draw;     // "" none; *.avi / *.mp4 / *.mkv an annotated video; else a folder of JPEGs
+  int max_frames = -1;  // -1: all
+  bool progress = true;
+  BallDetectorOptions detector;
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct DetectVideoResult {
+  int frames = 0;
+  long long candidates = 0;
+  int frames_with_ball = 0;  // frames with an accepted candidate
+  double seconds = 0.0;
+  std::string Summary() const;
+};
+
+DetectVideoResult DetectVideo(const DetectVideoOptions& options);
+
+// Draws candidates on a BGR frame: accepted in green (circle, centre cross, score), rejected in
+// red (thin circle).
+void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates);
+
+}  // namespace fv

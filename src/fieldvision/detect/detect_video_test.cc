@@ -1,0 +1,122 @@
+#include "fieldvision/detect/detect_video.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// An image sequence of a ball rolling across a drawn field, and its camera file.
+struct Clip {
+  std::string dir, pattern, camera;
+  std::vector<Eigen::Vector2d> centres;
+};
+
+Clip MakeClip(uint64_t seed, int frames) {
+  Rng rng(seed);
+  Clip clip;
+  clip.dir = fv::testing::TempDir();
+  std::filesystem::create_directories(clip.dir + "/frames");
+  clip.pattern = clip.dir + "/frames/%05d.png";
+  const double r = rng.Uniform(5, 12);
+  for (int f = 0; f < frames; ++f) {
+    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(60 + 40 * f + rng.Uniform(0, 1), 150 + rng.Uniform(0, 1));
+    detect_testing::PaintDisc(img, c, r);
+    clip.centres.push_back(c);
+    const std::string path = fmt::format("{}/frames/{:05d}.png", clip.dir, f);
+    if (!cv::imwrite(path, img)) ADD_FAILURE() << "cannot write " << path;
+  }
+  clip.camera = clip.dir + "/cam.yaml";
+  WriteCameraYaml(Camera::FromFov(320, 240, 60), clip.camera);
+  return clip;
+}
+
+TEST(DetectVideo, WritesEveryCandidateAndDrawsThem) {
+  const uint64_t seed = fv::testing::TestSeed(12);
+  FV_SEED_TRACE(seed);
+  Clip clip;
+  ASSERT_NO_FATAL_FAILURE(clip = MakeClip(seed, 5));
+  DetectVideoOptions o;
+  o.camera = clip.camera;
+  o.video = clip.pattern;
+  o.out = clip.dir + "/det.csv";
+  o.draw = clip.dir + "/drawn";
+  o.progress = false;
+  const DetectVideoResult r = DetectVideo(o);
+  EXPECT_EQ(r.frames, 5);
+  EXPECT_EQ(r.frames_with_ball, 5) << r.Summary();
+  const CsvTable t = CsvTable::Read(o.out);
+  t.Require({"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
+  int accepted = 0;
+  for (size_t i = 0; i < t.rows(); ++i) {
+    if (t.GetInt(i, "accepted") != 1) continue;
+    ++accepted;
+    const int f = static_cast<int>(t.GetInt(i, "frame"));
+    ASSERT_GE(f, 0);
+    ASSERT_LT(f, 5);
+    const Eigen::Vector2d uv(t.GetDouble(i, "u"), t.GetDouble(i, "v"));
+    EXPECT_LT((uv - clip.centres[f]).norm(), 0.3) << "frame " << f;
+    EXPECT_GT(t.GetDouble(i, "sigma_px"), 0.0);
+  }
+  EXPECT_EQ(accepted, 5);
+  for (int f = 0; f < 5; ++f) {
+    EXPECT_TRUE(std::filesystem::exists(fmt::format("{}/{:05d}.jpg", o.draw, f)));
+  }
+}
+
+TEST(DetectVideo, BadInputGivesOneLineErrorsNamingTheInput) {
+  Clip clip;
+  ASSERT_NO_FATAL_FAILURE(clip = MakeClip(3, 1));
+  DetectVideoOptions o;
+  o.video = clip.dir + "/missing.avi";
+  o.out = clip.dir + "/det.csv";
+  o.progress = false;
+  std::string e = ErrorOf([&] { DetectVideo(o); });
+  EXPECT_NE(e.find("missing.avi"), std::string::npos) << e;
+  EXPECT_EQ(e.find('\n'), std::string::npos);
+  // A corrupt video file.
+  const std::string corrupt = clip.dir + "/corrupt.avi";
+  std::ofstream(corrupt) << "this is not a video";
+  o.video = corrupt;
+  e = ErrorOf([&] { DetectVideo(o); });
+  EXPECT_NE(e.find("corrupt.avi"), std::string::npos) << e;
+  // Frames of another size than the camera file.
+  const std::string other = clip.dir + "/other.yaml";
+  WriteCameraYaml(Camera::FromFov(640, 480, 60), other);
+  o.video = clip.pattern;
+  o.camera = other;
+  e = ErrorOf([&] { DetectVideo(o); });
+  EXPECT_NE(e.find("other.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("640x480"), std::string::npos) << e;
+  // An empty colour file.
+  const std::string empty = clip.dir + "/empty.json";
+  std::ofstream(empty) << "";
+  o.camera = clip.camera;
+  o.detector.colour = empty;
+  e = ErrorOf([&] { DetectVideo(o); });
+  EXPECT_NE(e.find("empty.json' is empty"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace fv
