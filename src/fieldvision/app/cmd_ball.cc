@@ -1,12 +1,65 @@
-// `fieldvision ball`: planned; replaced by its implementation.
+// `fieldvision ball`: the ball in 3D from 2..N synchronised cameras (pipeline/ball_job.h).
+#include <iostream>
+#include <memory>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/pipeline/ball_job.h"
 
 namespace fv::app {
 namespace {
 
+struct BallCliOptions {
+  BallJobOptions job;
+  bool rows = false;
+};
+
+void RunBall(const BallCliOptions& o) {
+  const BallJobResult r = RunBallJob(o.job);
+  std::cout << r.summary.ToString() << "\n";
+  std::cout << "wrote " << o.job.out << " (" << r.rows_written << " rows)\n";
+  if (r.eval) std::cout << r.eval->Table(o.rows || r.eval->rows.size() <= 40) << "\n";
+}
+
 void Setup(CLI::App& app, int& exit_code) {
-  AddPlannedCommand(app, "ball", "Place the ball in 3D from 2..N synchronized cameras",
-                    "writes BALL.csv frame,time_s,x_m,y_m,z_m,n_cams,err_px (ball 3D issue)", exit_code);
+  auto o = std::make_shared<BallCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "ball", "Place the ball in 3D from 2..N synchronized cameras; writes BALL.csv");
+  cmd->add_option("--camera", o->job.cameras, "Camera file (repeat; pairs with --video in order)")
+      ->required();
+  cmd->add_option("--video", o->job.videos, "Video file or image pattern such as dir/%05d.jpg")
+      ->required();
+  cmd->add_option("--ball-diameter", o->job.ball_diameter_m, "Ball diameter in metres")
+      ->capture_default_str();
+  cmd->add_option("--color,--colour", o->job.colour, "Colour preset or colour file of the ball")
+      ->capture_default_str();
+  cmd->add_option("--out", o->job.out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")
+      ->required();
+  cmd->add_option("--truth", o->job.truth, "truth.csv: also print the error table");
+  cmd->add_flag("--rows", o->rows, "With --truth: print every frame's error, not only summary");
+  cmd->add_option("--field", o->job.field,
+                  "Field (built-in name or JSON): look for the ball only over it");
+  cmd->add_option("--sync", o->job.sync,
+                  "Pair frames by 'frame' index or by 'time' (the --timestamps CSVs, else the "
+                  "container's timestamps)")
+      ->capture_default_str();
+  cmd->add_option("--timestamps", o->job.timestamps,
+                  "CSV with frame,time_s per video (repeat, one per video); implies --sync time");
+  cmd->add_option("--tolerance", o->job.pipeline.sync.tolerance_s,
+                  "With --sync time: frames this close in seconds are combined")
+      ->capture_default_str();
+  cmd->add_flag("--live", o->job.live,
+                "Live input: keep the newest frames when fusion falls behind (drops frames)");
+  cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames");
+  cmd->add_option("--inlier-px", o->job.pipeline.triangulation.inlier_threshold_px,
+                  "A camera agrees when it sees the ball within this many pixels")
+      ->capture_default_str();
+  cmd->add_flag("--ground", o->job.pipeline.triangulation.single_camera_ground,
+                "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
+  cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
+  cmd->callback([o] {
+    if (!o->job.timestamps.empty()) o->job.sync = "time";
+    RunBall(*o);
+  });
 }
 
 FV_REGISTER_COMMAND(40, "ball", Setup);

@@ -1,13 +1,37 @@
-// `fieldvision eval`: planned; replaced by its implementation.
+// `fieldvision eval ball`: the error table of a ball track against ground truth
+// (recon/ball_eval.h), matched by frame.
+#include <iostream>
+#include <memory>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/recon/ball_eval.h"
 
 namespace fv::app {
 namespace {
 
+struct EvalBallCliOptions {
+  std::string truth;
+  std::string est;
+  bool rows = false;
+  BallEvalOptions eval;
+};
+
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
-  AddPlannedCommand(*group, "ball", "Error table of a ball track against truth", "see the ball 3D and players issues", exit_code);
-
+  auto o = std::make_shared<EvalBallCliOptions>();
+  CLI::App* cmd = group->add_subcommand("ball", "Error table of a ball track against truth");
+  cmd->add_option("--truth", o->truth, "Truth CSV: frame,x_m,y_m,z_m[,time_s,n_cams]")->required();
+  cmd->add_option("--est", o->est, "Estimate CSV (BALL.csv): frame,x_m,y_m,z_m[,...]")->required();
+  cmd->add_flag("--rows", o->rows, "Print every frame's error (default: when <= 40 frames)");
+  cmd->add_option("--min-cams", o->eval.min_truth_cams,
+                  "Truth frames seen by at least this many cameras count for the found rate")
+      ->capture_default_str();
+  cmd->add_option("--outlier", o->eval.outlier_m, "Estimates further off (metres) are false")
+      ->capture_default_str();
+  cmd->callback([o] {
+    const BallEvalResult r = EvaluateBallFiles(o->truth, o->est, o->eval);
+    std::cout << r.Table(o->rows || r.rows.size() <= 40) << "\n";
+  });
 }
 
 FV_REGISTER_COMMAND(80, "eval ball", Setup);

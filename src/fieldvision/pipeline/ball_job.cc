@@ -1,0 +1,119 @@
+#include "fieldvision/pipeline/ball_job.h"
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+
+namespace fv {
+
+const std::vector<std::string>& BallCsvHeader() {
+  static const std::vector<std::string> header = {"frame", "time_s", "x_m",   "y_m",
+                                                  "z_m",   "n_cams", "err_px"};
+  return header;
+}
+
+void BallJobOptions::Check() const {
+  FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --video pair");
+  FV_REQUIRE(cameras.size() == videos.size(), "ball: {} --camera but {} --video (they pair up)",
+             cameras.size(), videos.size());
+  FV_REQUIRE(timestamps.empty() || timestamps.size() == videos.size(),
+             "ball: {} --timestamps for {} videos (give one per video or none)", timestamps.size(),
+             videos.size());
+  FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
+             "ball: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
+  FV_REQUIRE(!out.empty(), "ball: --out is required");
+  FV_REQUIRE(sync == "frame" || sync == "time", "ball: --sync must be 'frame' or 'time' (got '{}')",
+             sync);
+  pipeline.Check();
+  eval.Check();
+}
+
+BallJobResult RunBallJob(const BallJobOptions& o) {
+  o.Check();
+  FV_REQUIRE(o.truth.empty() || std::filesystem::exists(o.truth), "truth file '{}' does not exist",
+             o.truth);
+  const int n = static_cast<int>(o.cameras.size());
+  std::vector<Camera> cameras;
+  for (int c = 0; c < n; ++c) {
+    cameras.push_back(ReadCameraYaml(o.cameras[c]));
+    FV_REQUIRE(cameras.back().has_pose,
+               "camera file '{}' has no pose (rvec, tvec): calibrate its "
+               "extrinsics first",
+               o.cameras[c]);
+    if (cameras.back().name.empty()) cameras.back().name = o.cameras[c];
+  }
+  std::optional<FieldModel> field;
+  if (!o.field.empty()) field = LoadField(o.field);
+  // Open every video (and check its size) before starting any thread.
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  for (int c = 0; c < n; ++c) {
+    FrameSourceOptions vo;
+    if (!o.timestamps.empty()) {
+      vo.time = TimeSource::kCsv;
+      vo.timestamps_csv = o.timestamps[c];
+    } else if (o.sync == "time") {
+      vo.time = TimeSource::kContainer;
+    }
+    auto src = std::make_unique<VideoFrameSource>(o.videos[c], vo);
+    const cv::Size size = src->FrameSize();
+    FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
+               "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
+               cameras[c].width, cameras[c].height, o.videos[c], size.width, size.height);
+    sources.push_back(std::move(src));
+  }
+  BallDetectorOptions dopt;
+  dopt.diameter_m = o.ball_diameter_m;
+  dopt.colour = o.colour;
+  std::vector<std::shared_ptr<BallDetector>> detectors;
+  std::vector<BallDetectFn> detect_fns;
+  for (int c = 0; c < n; ++c) {
+    auto det = std::make_shared<BallDetector>(dopt, &cameras[c], field ? &*field : nullptr);
+    detectors.push_back(det);
+    detect_fns.push_back([det](const cv::Mat& bgr) {
+      std::vector<BallObservation> out;
+      for (const BallCandidate& b : det->Detect(bgr)) {
+        if (!b.accepted) continue;
+        BallObservation obs;
+        obs.centre_px = b.centre_px;
+        obs.radius_px = b.radius_px;
+        obs.sigma_px = std::max(b.sigma_px, 0.05);
+        obs.score = b.score;
+        out.push_back(obs);
+      }
+      return out;
+    });
+  }
+  BallPipelineOptions popt = o.pipeline;
+  popt.sync.mode = o.sync == "time" ? SyncMode::kTimestamp : SyncMode::kFrameIndex;
+  popt.queue_policy = o.live ? QueuePolicy::kDropOldest : QueuePolicy::kBlock;
+  popt.triangulation.ball_radius_m = 0.5 * o.ball_diameter_m;
+
+  BallJobResult result;
+  // Write to a temporary name, rename at the end: a failed run leaves no half file.
+  const std::string tmp = o.out + ".part";
+  {
+    CsvWriter csv(tmp, BallCsvHeader(), 6);
+    result.summary = RunBallPipeline(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
+      if (!f.result.ok()) return;
+      const Eigen::Vector3d& p = f.result.point_world;
+      csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
+          << f.result.rms_px;
+      csv.EndRow();
+      ++result.rows_written;
+    });
+    csv.Close();
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, o.out, ec);
+  FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
+  if (!o.truth.empty()) result.eval = EvaluateBallFiles(o.truth, o.out, o.eval);
+  return result;
+}
+
+}  // namespace fv

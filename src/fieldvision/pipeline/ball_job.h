@@ -1,0 +1,44 @@
+// The `fieldvision ball` job as a library function: reads the camera files, opens the videos
+// (checking each frame size against its camera file), builds one detect/BallDetector per camera,
+// runs the ball pipeline, writes BALL.csv (frame,time_s,x_m,y_m,z_m,n_cams,err_px, one row per
+// frame with a position) and, given a truth file, evaluates it (recon/ball_eval.h).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fieldvision/pipeline/ball_pipeline.h"
+#include "fieldvision/recon/ball_eval.h"
+
+namespace fv {
+
+struct BallJobOptions {
+  std::vector<std::string> cameras;     // camera files, paired with `videos` in order
+  std::vector<std::string> videos;      // files OpenCV reads or patterns such as dir/%05d.jpg
+  std::vector<std::string> timestamps;  // optional: one frame,time_s CSV per video
+  double ball_diameter_m = 0.22;
+  std::string colour = "orange";  // colour preset or colour file (detect/colour.h)
+  std::string field;              // optional field (name or JSON): detect only over it
+  std::string out;                // BALL.csv
+  std::string truth;              // optional truth.csv for the error table
+  // "frame" pairs frames by index; "time" by timestamps (the CSVs, else the container's).
+  std::string sync = "frame";
+  bool live = false;  // keep the newest messages (drop the oldest) instead of blocking
+  BallPipelineOptions pipeline;
+  BallEvalOptions eval;
+  void Check() const;  // throws fv::Error naming the bad option
+};
+
+struct BallJobResult {
+  BallPipelineSummary summary;
+  std::optional<BallEvalResult> eval;  // when a truth file was given
+  long long rows_written = 0;
+};
+
+BallJobResult RunBallJob(const BallJobOptions& options);
+
+// BALL.csv's columns, as fixed by CONTRACT.md.
+const std::vector<std::string>& BallCsvHeader();
+
+}  // namespace fv

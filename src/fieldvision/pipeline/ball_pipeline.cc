@@ -1,0 +1,178 @@
+#include "fieldvision/pipeline/ball_pipeline.h"
+
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+
+namespace fv {
+
+void BallPipelineOptions::Check() const {
+  sync.Check();
+  FV_REQUIRE(queue_capacity >= 1 && queue_capacity <= 10000,
+             "BallPipelineOptions.queue_capacity must be in [1, 10000] (got {})", queue_capacity);
+  FV_REQUIRE(max_frames >= 0, "BallPipelineOptions.max_frames must be >= 0 (got {})", max_frames);
+  triangulation.Check();
+}
+
+std::string BallPipelineSummary::ToString() const {
+  std::string s = fmt::format(
+      "{} synchronised frames, {} with a ball position ({:.1f} %){}, mean reprojection error "
+      "{:.2f} px\n",
+      frames, frames_with_position, frames ? 100.0 * frames_with_position / frames : 0.0,
+      ground_positions
+          ? fmt::format(" of which {} single-camera ground positions", ground_positions)
+          : "",
+      mean_err_px);
+  s += "cameras used:";
+  for (int c = 0; c < num_cameras; ++c) {
+    s += fmt::format(" cam{} {} ({} candidates)", c, used_per_camera[c], candidates_per_camera[c]);
+    if (queue_drops[c] > 0) s += fmt::format(" [{} dropped by the queue]", queue_drops[c]);
+    s += c + 1 < num_cameras ? "," : "";
+  }
+  s += fmt::format("\n{:.2f} s, {:.1f} frames/s", seconds, fps);
+  for (const std::string& p : sync.Problems()) s += "\nsync: " + p;
+  return s;
+}
+
+BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
+                    const TriangulationOptions& options) {
+  BallFrame out;
+  out.frame = frame.frame;
+  out.time_s = frame.time_s;
+  std::vector<std::vector<BallObservation>> candidates(cameras.size());
+  for (size_t c = 0; c < cameras.size() && c < frame.cameras.size(); ++c) {
+    if (!frame.cameras[c]) continue;
+    ++out.cameras_present;
+    candidates[c] = frame.cameras[c]->candidates;
+    if (!candidates[c].empty()) ++out.cameras_with_blobs;
+  }
+  out.result = TriangulateRobust(cameras, candidates, options);
+  return out;
+}
+
+BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
+                                    std::vector<std::unique_ptr<FrameSource>>& sources,
+                                    const std::vector<BallDetectFn>& detectors,
+                                    const BallPipelineOptions& options,
+                                    const std::function<void(const BallFrame&)>& on_frame) {
+  options.Check();
+  const int n = static_cast<int>(cameras.size());
+  FV_REQUIRE(n >= 1, "ball pipeline: no cameras");
+  FV_REQUIRE(sources.size() == cameras.size() && detectors.size() == cameras.size(),
+             "ball pipeline: {} cameras but {} videos and {} detectors", n, sources.size(),
+             detectors.size());
+  for (int c = 0; c < n; ++c) {
+    FV_REQUIRE(sources[c] != nullptr && detectors[c] != nullptr,
+               "ball pipeline: camera {} has no video or detector", c);
+    const cv::Size size = sources[c]->FrameSize();
+    FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
+               "camera {} ('{}') is calibrated for {}x{} but video '{}' is {}x{}", c,
+               cameras[c].name, cameras[c].width, cameras[c].height, sources[c]->name(), size.width,
+               size.height);
+  }
+  BallPipelineSummary summary;
+  summary.num_cameras = n;
+  summary.used_per_camera.assign(n, 0);
+  summary.candidates_per_camera.assign(n, 0);
+  summary.queue_drops.assign(n, 0);
+
+  std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>> queues;
+  for (int c = 0; c < n; ++c) {
+    queues.push_back(std::make_unique<BoundedQueue<CameraMessage>>(options.queue_capacity,
+                                                                   options.queue_policy));
+  }
+  std::atomic<bool> stop{false};
+  std::mutex error_mutex;
+  std::exception_ptr error;
+  auto fail = [&](std::exception_ptr e) {
+    {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = e;
+    }
+    stop = true;
+    for (auto& q : queues) q->Close();
+  };
+  long long total = -1;
+  for (const auto& s : sources) total = std::max(total, s->FrameCount());
+  if (options.max_frames > 0) total = total > 0 ? std::min(total, options.max_frames) : -1;
+
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::thread> threads;
+  for (int c = 0; c < n; ++c) {
+    threads.emplace_back([&, c] {
+      try {
+        cv::Mat bgr;
+        CameraMessage m;
+        m.camera = c;
+        long long count = 0;
+        while (!stop && (options.max_frames == 0 || count < options.max_frames) &&
+               sources[c]->Read(&bgr, &m.frame, &m.time_s)) {
+          FV_REQUIRE(bgr.cols == cameras[c].width && bgr.rows == cameras[c].height,
+                     "video '{}' frame {} is {}x{}, camera {} is {}x{}", sources[c]->name(),
+                     m.frame, bgr.cols, bgr.rows, c, cameras[c].width, cameras[c].height);
+          m.candidates = detectors[c](bgr);
+          ++count;
+          if (!queues[c]->Push(m)) break;
+        }
+        queues[c]->Close();
+      } catch (...) {
+        fail(std::current_exception());
+      }
+    });
+  }
+
+  // The fusion stage, in this thread.
+  double sum_err = 0;
+  try {
+    FrameSynchronizer sync(n, options.sync);
+    Progress progress("ball", total, "frames", options.progress);
+    while (!stop) {
+      while (auto group = sync.Next()) {
+        for (int c = 0; c < n; ++c) {
+          if (group->cameras[c])
+            summary.candidates_per_camera[c] += group->cameras[c]->candidates.size();
+        }
+        const BallFrame f = FuseFrame(cameras, *group, options.triangulation);
+        ++summary.frames;
+        if (f.result.ok()) {
+          ++summary.frames_with_position;
+          if (f.result.on_ground) ++summary.ground_positions;
+          sum_err += f.result.rms_px;
+          for (const auto& v : f.result.views) ++summary.used_per_camera[v.camera];
+        }
+        on_frame(f);
+        progress.Update(summary.frames);
+      }
+      if (sync.Done()) break;
+      const int c = sync.Waiting();
+      if (c < 0) break;  // cannot happen: Next() decides when nobody is waiting
+      if (auto m = queues[c]->Pop()) {
+        sync.Add(std::move(*m));
+      } else if (!stop) {
+        sync.EndOfStream(c);
+      }
+    }
+    progress.Finish();
+    summary.sync = sync.report();
+  } catch (...) {
+    fail(std::current_exception());
+  }
+  stop = true;
+  for (auto& q : queues) q->Close();
+  for (auto& t : threads) t.join();
+  if (error) std::rethrow_exception(error);
+  for (int c = 0; c < n; ++c) summary.queue_drops[c] = queues[c]->dropped();
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.fps = summary.seconds > 0 ? summary.frames / summary.seconds : 0.0;
+  summary.mean_err_px = summary.frames_with_position ? sum_err / summary.frames_with_position : 0;
+  return summary;
+}
+
+}  // namespace fv

@@ -1,0 +1,222 @@
+#include "fieldvision/pipeline/ball_pipeline.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+constexpr double kRadius = 0.25;
+constexpr double kFps = 30.0;
+
+std::vector<Camera> SmallRig() {
+  std::vector<Camera> cams;
+  const Eigen::Vector3d eyes[3] = {{-6, -5, 3}, {6, -5, 3}, {0, 6, 3}};
+  for (int i = 0; i < 3; ++i) {
+    Camera c = Camera::FromFov(320, 240, 70);
+    c.name = "cam" + std::to_string(i);
+    c.cam_from_world = Rigid3d::LookAt(eyes[i], {0, 0, 0.5});
+    c.has_pose = true;
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+Eigen::Vector3d BallAt(double t) { return {2 * std::sin(t), 1.5 * std::cos(t), 0.5 + 0.3 * t}; }
+
+// An orange disc on green, centred on the projection of the ball centre, as MJPG video whose
+// frame f shows time (f + first) / fps.
+void WriteVideo(const Camera& cam, const std::string& path, int frames, int first) {
+  cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), kFps,
+                    cv::Size(cam.width, cam.height));
+  ASSERT_TRUE(w.isOpened());
+  for (int f = 0; f < frames; ++f) {
+    cv::Mat img(cam.height, cam.width, CV_8UC3, cv::Scalar(60, 130, 60));
+    const Eigen::Vector3d p = BallAt((f + first) / kFps);
+    const Eigen::Vector2d uv = *cam.Project(p);
+    const double r = kRadius * cam.fx / (cam.cam_from_world * p).z();
+    const int s = 16;  // 4 bits of sub-pixel precision
+    cv::circle(img, cv::Point(std::lround(uv.x() * s), std::lround(uv.y() * s)),
+               static_cast<int>(std::lround(r * s)), cv::Scalar(0, 110, 255), cv::FILLED,
+               cv::LINE_AA, 4);
+    w.write(img);
+  }
+}
+
+// A simple detector: orange pixels' centroid.
+std::vector<BallObservation> Centroid(const cv::Mat& bgr) {
+  cv::Mat mask;
+  cv::inRange(bgr, cv::Scalar(0, 60, 180), cv::Scalar(90, 170, 255), mask);
+  const cv::Moments m = cv::moments(mask, true);
+  if (m.m00 < 5) return {};
+  BallObservation o;
+  o.centre_px = {m.m10 / m.m00, m.m01 / m.m00};
+  o.radius_px = std::sqrt(m.m00 / M_PI);
+  o.sigma_px = 0.3;
+  return {o};
+}
+
+struct Scene {
+  std::vector<Camera> cams = SmallRig();
+  std::vector<std::string> videos;
+};
+
+Scene MakeScene(const std::string& dir, const std::vector<int>& lengths,
+                const std::vector<int>& firsts) {
+  Scene s;
+  for (int c = 0; c < 3; ++c) {
+    s.videos.push_back(dir + "/cam" + std::to_string(c) + ".avi");
+    WriteVideo(s.cams[c], s.videos[c], lengths[c], firsts[c]);
+  }
+  return s;
+}
+
+std::vector<std::unique_ptr<FrameSource>> Open(const Scene& s,
+                                               const std::vector<FrameSourceOptions>& vo) {
+  std::vector<std::unique_ptr<FrameSource>> src;
+  for (int c = 0; c < 3; ++c) src.push_back(std::make_unique<VideoFrameSource>(s.videos[c], vo[c]));
+  return src;
+}
+
+TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
+  const std::string dir = testing::TempDir();
+  const Scene s = MakeScene(dir, {30, 30, 24}, {0, 0, 0});
+  auto sources = Open(s, std::vector<FrameSourceOptions>(3));
+  BallPipelineOptions opt;
+  opt.progress = false;
+  std::vector<BallFrame> frames;
+  const auto summary = RunBallPipeline(s.cams, sources, {Centroid, Centroid, Centroid}, opt,
+                                       [&](const BallFrame& f) { frames.push_back(f); });
+  ASSERT_EQ(frames.size(), 30u);
+  EXPECT_EQ(summary.frames_with_position, 30);
+  for (const BallFrame& f : frames) {
+    ASSERT_TRUE(f.result.ok()) << f.frame;
+    EXPECT_EQ(f.result.num_views(), f.frame < 24 ? 3 : 2);
+    EXPECT_NEAR(f.time_s, f.frame / kFps, 1e-9);
+    EXPECT_LT((f.result.point_world - BallAt(f.time_s)).norm(), 0.03) << f.frame;
+    EXPECT_LT(f.result.rms_px, 1.0);
+  }
+  EXPECT_EQ(summary.used_per_camera[2], 24);
+  EXPECT_EQ(summary.sync.cameras[2].last_frame, 23);
+  EXPECT_NE(summary.ToString().find("camera 2: ended at frame 23"), std::string::npos);
+}
+
+TEST(BallPipeline, UnsynchronizedVideosPairedByTimestampCsv) {
+  const std::string dir = testing::TempDir();
+  // Camera 2 started 3 frames late: by index the frames would be paired wrongly.
+  const Scene s = MakeScene(dir, {30, 30, 27}, {0, 0, 3});
+  std::vector<FrameSourceOptions> vo(3);
+  for (int c = 0; c < 3; ++c) {
+    const std::string csv_path = dir + "/cam" + std::to_string(c) + "_times.csv";
+    CsvWriter csv(csv_path, {"frame", "time_s"}, 9);
+    for (int f = 0; f < 30; ++f) {
+      csv << f << (f + (c == 2 ? 3 : 0)) / kFps;
+      csv.EndRow();
+    }
+    csv.Close();
+    vo[c].time = TimeSource::kCsv;
+    vo[c].timestamps_csv = csv_path;
+  }
+  BallPipelineOptions opt;
+  opt.progress = false;
+  opt.sync.mode = SyncMode::kTimestamp;
+  opt.sync.tolerance_s = 0.3 / kFps;
+  auto sources = Open(s, vo);
+  std::vector<BallFrame> frames;
+  RunBallPipeline(s.cams, sources, {Centroid, Centroid, Centroid}, opt,
+                  [&](const BallFrame& f) { frames.push_back(f); });
+  ASSERT_EQ(frames.size(), 30u);
+  double sum_time = 0, sum_index = 0;
+  for (const BallFrame& f : frames) {
+    ASSERT_TRUE(f.result.ok()) << f.frame;
+    EXPECT_EQ(f.result.num_views(), f.frame < 3 ? 2 : 3);
+    const double err = (f.result.point_world - BallAt(f.time_s)).norm();
+    EXPECT_LT(err, 0.03) << f.frame;
+    sum_time += err;
+  }
+  // The same videos paired by index put camera 2 three frames off: much worse.
+  opt.sync.mode = SyncMode::kFrameIndex;
+  auto again = Open(s, std::vector<FrameSourceOptions>(3));
+  int n_index = 0;
+  RunBallPipeline(s.cams, again, {Centroid, Centroid, Centroid}, opt, [&](const BallFrame& f) {
+    if (!f.result.ok()) return;
+    sum_index += (f.result.point_world - BallAt(f.time_s)).norm();
+    ++n_index;
+  });
+  ASSERT_GT(n_index, 0);
+  EXPECT_GT(sum_index / n_index, 3 * sum_time / frames.size());
+}
+
+TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
+  const std::string dir = testing::TempDir();
+  const Scene s = MakeScene(dir, {3, 3, 3}, {0, 0, 0});
+  auto cams = s.cams;
+  cams[1] = Camera::FromFov(640, 480, 70);
+  cams[1].cam_from_world = s.cams[1].cam_from_world;
+  cams[1].has_pose = true;
+  auto sources = Open(s, std::vector<FrameSourceOptions>(3));
+  BallPipelineOptions opt;
+  opt.progress = false;
+  try {
+    RunBallPipeline(cams, sources, {Centroid, Centroid, Centroid}, opt, [](const BallFrame&) {});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("640x480"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("320x240"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("cam1.avi"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos);
+  }
+  // The same through the job, with camera files.
+  BallJobOptions job;
+  for (int c = 0; c < 3; ++c) {
+    job.cameras.push_back(dir + "/cam" + std::to_string(c) + ".yaml");
+    WriteCameraYaml(cams[c], job.cameras.back());
+  }
+  job.videos = s.videos;
+  job.out = dir + "/ball.csv";
+  job.pipeline.progress = false;
+  try {
+    RunBallJob(job);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("cam1.yaml"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("640x480"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("320x240"), std::string::npos) << msg;
+  }
+  EXPECT_FALSE(std::filesystem::exists(job.out));
+}
+
+TEST(BallPipeline, BadInputsAreOneLineErrors) {
+  const std::string dir = testing::TempDir();
+  EXPECT_THROW(VideoFrameSource(dir + "/missing.avi"), Error);
+  {
+    std::ofstream junk(dir + "/junk.avi");
+    junk << "this is not a video";
+  }
+  EXPECT_THROW(VideoFrameSource(dir + "/junk.avi"), Error);
+  BallJobOptions job;
+  job.cameras = {"a.yaml", "b.yaml"};
+  job.videos = {"a.avi"};
+  job.out = dir + "/x.csv";
+  EXPECT_THROW(job.Check(), Error);
+  job.videos = {"a.avi", "b.avi"};
+  job.ball_diameter_m = NAN;
+  EXPECT_THROW(job.Check(), Error);
+}
+
+}  // namespace
+}  // namespace fv
