@@ -30,6 +30,12 @@ std::string BallPipelineSummary::ToString() const {
           ? fmt::format(" of which {} single-camera ground positions", ground_positions)
           : "",
       mean_err_px);
+  if (frames > frames_with_position) {
+    s += fmt::format(
+        "no position: {} frames with candidates in fewer than 2 cameras, {} frames "
+        "whose candidates disagree\n",
+        frames_few_blobs, frames_inconsistent);
+  }
   s += "cameras used:";
   for (int c = 0; c < num_cameras; ++c) {
     s += fmt::format(" cam{} {} ({} candidates)", c, used_per_camera[c], candidates_per_camera[c]);
@@ -146,6 +152,10 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
           if (f.result.on_ground) ++summary.ground_positions;
           sum_err += f.result.rms_px;
           for (const auto& v : f.result.views) ++summary.used_per_camera[v.camera];
+        } else if (f.cameras_with_blobs < 2) {
+          ++summary.frames_few_blobs;
+        } else {
+          ++summary.frames_inconsistent;
         }
         on_frame(f);
         progress.Update(summary.frames);

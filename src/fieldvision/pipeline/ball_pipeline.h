@@ -46,6 +46,8 @@ struct BallPipelineSummary {
   long long frames = 0;                          // synchronised frames
   long long frames_with_position = 0;            // 3D (or ground) positions
   long long ground_positions = 0;                // single-camera ground positions among them
+  long long frames_few_blobs = 0;                // no position: fewer than 2 cameras had candidates
+  long long frames_inconsistent = 0;             // no position although >= 2 cameras had candidates
   double mean_err_px = 0.0;                      // mean of the positions' RMS reprojection errors
   std::vector<long long> used_per_camera;        // positions each camera contributed to
   std::vector<long long> candidates_per_camera;  // candidates each camera reported
