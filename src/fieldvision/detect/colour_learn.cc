@@ -1,6 +1,7 @@
 #include "fieldvision/detect/colour_learn.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -118,6 +119,35 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
                 360, 255, cv::FILLED);
     const cv::Rect grown(r.x - r.width / 4, r.y - r.height / 4, r.width * 3 / 2, r.height * 3 / 2);
     near_mask(grown & frame_rect).setTo(255);
+    // A loose box also holds background: keep the pixels closer to the box centre's colour
+    // than to the median colour of the ring around the box.
+    const cv::Point c(r.x + r.width / 2, r.y + r.height / 2);
+    const cv::Scalar centre = cv::mean(bgr(cv::Rect(c.x - 1, c.y - 1, 3, 3) & frame_rect));
+    std::array<std::vector<int>, 3> ring;
+    const cv::Rect outer = grown & frame_rect;
+    for (int y = outer.y; y < outer.y + outer.height; ++y) {
+      for (int x = outer.x; x < outer.x + outer.width; ++x) {
+        if (r.contains(cv::Point(x, y))) continue;
+        const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+        for (int k = 0; k < 3; ++k) ring[k].push_back(p[k]);
+      }
+    }
+    if (!ring[0].empty()) {
+      cv::Vec3d bg;
+      for (int k = 0; k < 3; ++k) bg[k] = Percentile(ring[k], 0.5);
+      for (int y = r.y; y < r.y + r.height; ++y) {
+        for (int x = r.x; x < r.x + r.width; ++x) {
+          if (!pos_mask.at<uint8_t>(y, x)) continue;
+          const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+          double dc = 0, db = 0;
+          for (int k = 0; k < 3; ++k) {
+            dc += (p[k] - centre[k]) * (p[k] - centre[k]);
+            db += (p[k] - bg[k]) * (p[k] - bg[k]);
+          }
+          if (db <= dc) pos_mask.at<uint8_t>(y, x) = 0;
+        }
+      }
+    }
   }
   for (const auto& p : o.negative_points) {
     FV_REQUIRE(p.x() >= 0 && p.y() >= 0 && p.x() < bgr.cols && p.y() < bgr.rows,
