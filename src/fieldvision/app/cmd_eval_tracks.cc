@@ -1,13 +1,66 @@
-// `fieldvision eval tracks`: planned; replaced by its implementation.
+// `fieldvision eval tracks`: MOTA, MOTP, IDF1, HOTA of TRACKS.csv against ground truth; and
+// `fieldvision eval import-pets`: PETS CVML annotations -> MOT CSV.
+#include <fstream>
+#include <iostream>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/track/mot.h"
+#include "fieldvision/track/pets.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::app {
 namespace {
 
+struct EvalTracksCli {
+  std::string gt, est, json;
+  track::MotOptions o;
+};
+
+std::vector<track::TrackRow> ReadGt(const std::string& path) {
+  if (EndsWith(ToLower(path), ".xml")) return track::ReadPetsCvml(path);
+  return track::ReadTracksCsv(path);
+}
+
+void RunEvalTracks(const EvalTracksCli& c) {
+  const auto gt = ReadGt(c.gt);
+  const auto est = track::ReadTracksCsv(c.est);
+  const track::MotMetrics m = track::EvaluateMot(gt, est, c.o);
+  std::cout << m.Summary() << "\n";
+  if (!c.json.empty()) {
+    std::ofstream out(c.json);
+    FV_REQUIRE(out.good(), "cannot write '{}'", c.json);
+    out << m.ToJson() << "\n";
+  }
+}
+
+struct ImportPetsCli {
+  std::string xml, out;
+};
+
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
-  AddPlannedCommand(*group, "tracks", "MOTA, MOTP, IDF1 of player tracks against ground truth",
-                    "see the players issue", exit_code);
+  auto c = std::make_shared<EvalTracksCli>();
+  CLI::App* cmd = group->add_subcommand(
+      "tracks", "MOTA, MOTP, IDF1 and HOTA of player tracks against ground truth (MOTChallenge)");
+  cmd->add_option("--gt", c->gt, "Ground truth: MOT CSV / TRACKS.csv, or a PETS CVML .xml")
+      ->required();
+  cmd->add_option("--est", c->est, "Estimated TRACKS.csv")->required();
+  cmd->add_option("--iou", c->o.iou_threshold, "IoU needed for a match (MOTChallenge: 0.5)");
+  cmd->add_option("--json", c->json, "Also write the metrics as JSON");
+  cmd->callback([c] { RunEvalTracks(*c); });
+
+  auto p = std::make_shared<ImportPetsCli>();
+  CLI::App* imp =
+      group->add_subcommand("import-pets", "Convert PETS 2009 CVML annotations to MOT CSV");
+  imp->add_option("--xml", p->xml, "PETS CVML annotation file (e.g. PETS2009-S2L1.xml)")
+      ->required();
+  imp->add_option("--out", p->out, "MOT CSV (TRACKS.csv layout)")->required();
+  imp->callback([p] {
+    const auto rows = track::ReadPetsCvml(p->xml);
+    track::WriteTracksCsv(rows, p->out);
+    std::cout << "wrote " << rows.size() << " boxes to " << p->out << "\n";
+  });
 }
 
 FV_REGISTER_COMMAND(81, "eval tracks", Setup);

@@ -1,12 +1,83 @@
-// `fieldvision players`: planned; replaced by its implementation.
+// `fieldvision players`: detect and track people in a video, positions on the field (TRACKS.csv).
+#include <iostream>
+
+#include <fmt/format.h>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/track/mot.h"
+#include "fieldvision/track/players.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
 
+struct PlayersCli {
+  std::string camera, video, out, field, onnx;
+  track::PlayersOptions o;
+};
+
+void RunPlayersCommand(const PlayersCli& c) {
+  const Camera camera = ReadCameraYaml(c.camera);
+  std::optional<FieldModel> field;
+  if (!c.field.empty()) field = LoadField(c.field);
+  track::PlayersOptions o = c.o;
+  if (!c.onnx.empty()) {
+    o.detector.kind = "onnx";
+    o.detector.model_path = c.onnx;
+  }
+  const track::PlayersResult r = track::RunPlayers(c.video, &camera, field ? &*field : nullptr, o);
+  track::WriteTracksCsv(r.rows, c.out);
+  if (!r.team_of.empty()) {
+    const std::string teams = c.out + ".teams.csv";
+    CsvWriter w(teams, {"id", "team"});
+    for (const auto& [id, team] : r.team_of) {
+      w << id << team;
+      w.EndRow();
+    }
+    w.Close();
+    std::cout << "wrote " << teams << "\n";
+  }
+  std::cout << r.Summary() << "\nwrote " << c.out << "\n";
+}
+
 void Setup(CLI::App& app, int& exit_code) {
-  AddPlannedCommand(app, "players", "Detect and track players, positions on the field",
-                    "writes TRACKS.csv in MOTChallenge layout plus x_m,y_m (players issue)", exit_code);
+  auto c = std::make_shared<PlayersCli>();
+  CLI::App* cmd = app.add_subcommand(
+      "players", "Detect and track people in a video; positions on the field (TRACKS.csv)");
+  cmd->add_option("--camera", c->camera, "Camera file (CAM.yaml) of the video")->required();
+  cmd->add_option("--video", c->video, "Video file or image pattern (dir/%05d.jpg)")->required();
+  cmd->add_option("--out", c->out,
+                  "TRACKS.csv: frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m")
+      ->required();
+  cmd->add_option("--field", c->field,
+                  "Field (built-in name or JSON): keep only people on it plus --margin");
+  cmd->add_option("--margin", c->o.field_margin_m, "Metres around the field still accepted");
+  cmd->add_option("--detector", c->o.detector.kind, "nanodet (default), hog, motion or onnx")
+      ->check(CLI::IsMember({"nanodet", "hog", "motion", "onnx"}));
+  cmd->add_option("--onnx", c->onnx, "A YOLO-style ONNX model of your own (sets --detector onnx)");
+  cmd->add_option("--model", c->o.detector.model_path,
+                  "NanoDet model (default: BUILD/models/nanodet.onnx from make build)");
+  cmd->add_option("--input-width", c->o.detector.input_width,
+                  "Network input width in pixels (multiple of 32; smaller is faster)");
+  cmd->add_option("--score", c->o.detector.score_threshold, "Lowest detection score kept");
+  cmd->add_option("--min-height", c->o.detector.min_height_px,
+                  "Ignore people shorter than this in pixels (far outside the area of interest)");
+  cmd->add_option("--threads", c->o.detector.threads, "OpenCV threads (0: all cores)");
+  cmd->add_option("--sot", c->o.tracker.sot,
+                  "Single-target tracker through missed detections: none, csrt, kcf, mosse")
+      ->check(CLI::IsMember({"none", "csrt", "kcf", "mosse"}));
+  cmd->add_option("--max-lost", c->o.tracker.max_lost_frames,
+                  "Frames a lost track is kept to be re-found");
+  cmd->add_option("--max-frames", c->o.max_frames, "Process at most this many frames (0: all)");
+  cmd->add_option("--interpolate", c->o.interpolate_max_gap,
+                  "Fill track gaps up to this many frames (0: off)");
+  cmd->add_flag("--teams", c->o.teams,
+                "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
+  cmd->add_flag("!--no-progress", c->o.progress, "No progress line");
+  cmd->callback([c] { RunPlayersCommand(*c); });
 }
 
 FV_REGISTER_COMMAND(70, "players", Setup);

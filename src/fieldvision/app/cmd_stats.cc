@@ -1,12 +1,59 @@
-// `fieldvision stats`: planned; replaced by its implementation.
+// `fieldvision stats`: statistics, heat maps, radar view and an HTML report from TRACKS.csv.
+#include <filesystem>
+#include <iostream>
+
 #include "fieldvision/app/command.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/stats/stats.h"
+#include "fieldvision/track/mot.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
 
+struct StatsCli {
+  std::string tracks, field, out, zones, teams;
+  stats::StatsOptions o;
+};
+
+void RunStats(const StatsCli& c) {
+  const FieldModel field = LoadField(c.field);
+  const auto rows = track::ReadTracksCsv(c.tracks);
+  stats::StatsOptions o = c.o;
+  if (!c.zones.empty()) o.zones = stats::ReadZones(c.zones);
+  std::string teams = c.teams;
+  if (teams.empty() && std::filesystem::exists(c.tracks + ".teams.csv")) {
+    teams = c.tracks + ".teams.csv";
+  }
+  if (!teams.empty()) {
+    const CsvTable t = CsvTable::Read(teams);
+    t.Require({"id", "team"});
+    for (size_t i = 0; i < t.rows(); ++i) {
+      o.team_of[static_cast<int>(t.GetInt(i, "id"))] = static_cast<int>(t.GetInt(i, "team"));
+    }
+  }
+  const stats::StatsResult r = stats::ComputeStats(rows, o);
+  const stats::ReportFiles f = stats::WriteStatsReport(r, field, o, c.out);
+  std::cout << r.Summary() << "\nwrote " << f.files.size() << " files to " << c.out << " (open "
+            << c.out << "/index.html)\n";
+}
+
 void Setup(CLI::App& app, int& exit_code) {
-  AddPlannedCommand(app, "stats", "Statistics for coaches from player tracks",
-                    "writes stats.json, heat maps and index.html (players issue)", exit_code);
+  auto c = std::make_shared<StatsCli>();
+  CLI::App* cmd = app.add_subcommand(
+      "stats", "Statistics for coaches from player tracks: stats.json, heat maps, index.html");
+  cmd->add_option("--tracks", c->tracks, "TRACKS.csv from `fieldvision players`")->required();
+  cmd->add_option("--field", c->field, "Field: built-in name or JSON file")->required();
+  cmd->add_option("--out", c->out, "Output folder")->required();
+  cmd->add_option("--fps", c->o.fps, "Frame rate of the tracked video")->check(CLI::PositiveNumber);
+  cmd->add_option("--zones", c->zones,
+                  "JSON zones for alerts: [{\"name\": \"box\", \"polygon\": [[x, y], ...]}]");
+  cmd->add_option("--teams", c->teams, "id,team CSV (default: TRACKS.csv.teams.csv if present)");
+  cmd->add_option("--smooth", c->o.smooth_window_s, "Smoothing window of positions in seconds");
+  cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s");
+  cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.avi");
+  cmd->callback([c] { RunStats(*c); });
 }
 
 FV_REGISTER_COMMAND(75, "stats", Setup);

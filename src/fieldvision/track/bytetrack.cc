@@ -156,7 +156,18 @@ std::vector<TrackState> ByteTracker::Update(const std::vector<Detection>& detect
     t->sot_box = false;
     t->Predict();
     if (camera_) t->field_m = FootOnGround(*camera_, t->box, o_.foot_offset_m);
+    // A lost track whose prediction left the image has left the scene: a person coming back
+    // later is a new track (as in the MOTChallenge annotations).
+    if (t->state == State::kLost && !frame.empty()) {
+      const cv::Point2d c(t->box.x + 0.5 * t->box.width, t->box.y + t->box.height);
+      if (c.x < 0 || c.y < 0 || c.x >= frame.cols || c.y >= frame.rows + 0.25 * t->box.height) {
+        t->lost_frames = o_.max_lost_frames + 1;
+      }
+    }
   }
+  std::erase_if(tracks_, [&](const std::unique_ptr<Track>& t) {
+    return t->lost_frames > o_.max_lost_frames;
+  });
   std::vector<std::optional<Eigen::Vector2d>> det_field(detections.size());
   if (camera_) {
     for (size_t i = 0; i < detections.size(); ++i) {
@@ -194,7 +205,9 @@ std::vector<TrackState> ByteTracker::Update(const std::vector<Detection>& detect
     if (!use_field || !camera_ || !t.field_m || !det_field[d] || o_.field_weight <= 0) {
       return iou >= min_iou ? 1.0 - iou : 1e9;
     }
-    const double gate = o_.field_gate_m * (1 + std::min(t.lost_frames, 5));
+    // The gate grows with the time lost by how far a person may have gone, up to 3 gates.
+    const double gate = std::min(3.0 * o_.field_gate_m,
+                                 o_.field_gate_m + o_.reid_speed_mps * t.lost_frames / o_.fps);
     const double dist = (*t.field_m - *det_field[d]).norm();
     if (dist > gate || (iou < min_iou && dist > 0.5 * gate)) return 1e9;
     return (1 - o_.field_weight) * (1 - iou) + o_.field_weight * dist / gate;

@@ -26,6 +26,7 @@ void DetectorOptions::Check() const {
              "input_height must be 0 or a multiple of 32 and >= 64 (got {})", input_height);
   CheckInRange(score_threshold, 0.0, 1.0, "score_threshold");
   CheckInRange(nms_iou, 0.0, 1.0, "nms_iou");
+  CheckNonNegative(min_height_px, "min_height_px");
   CheckNonNegative(threads, "threads");
   CheckInRange(hog_upscale, 0.25, 4.0, "hog_upscale");
   CheckFinite(hog_hit_threshold, "hog_hit_threshold");
@@ -106,6 +107,7 @@ cv::dnn::Net LoadOnnx(const std::string& path) {
 // Keeps detections whose foot point passes the filter, then NMS.
 std::vector<Detection> Finish(std::vector<Detection> dets, const DetectorOptions& o,
                               const FootFilter& filter) {
+  std::erase_if(dets, [&](const Detection& d) { return d.box.height < o.min_height_px; });
   if (filter) {
     std::erase_if(dets, [&](const Detection& d) {
       return !filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height});

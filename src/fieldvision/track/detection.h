@@ -39,7 +39,9 @@ struct DetectorOptions {
   int input_height = 0;          // 0: from the frame's aspect ratio (rounded to a multiple of 32)
   double score_threshold = 0.2;  // lowest score reported (ByteTrack uses the low ones too)
   double nms_iou = 0.5;          // IoU above which the weaker of two boxes is dropped
-  int threads = 0;               // OpenCV threads (cv::setNumThreads); 0 leaves the default
+  // Boxes shorter than this are dropped (far-away people outside the area of interest).
+  double min_height_px = 0.0;
+  int threads = 0;  // OpenCV threads (cv::setNumThreads); 0 leaves the default
   // HOG: the frame is scaled by this before detection (the window is 64 x 128 pixels, so people
   // smaller than about 100 pixels need upscaling).
   double hog_upscale = 1.6;

@@ -1,8 +1,8 @@
 #include "fieldvision/track/pets.h"
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -24,9 +24,19 @@ std::string ReadAll(const std::string& path, const std::string& what) {
 
 // Value of attribute `name` in an XML start tag `tag` ("" when absent).
 std::string Attr(const std::string& tag, const std::string& name) {
-  const std::regex re("\\b" + name + "\\s*=\\s*\"([^\"]*)\"");
-  std::smatch m;
-  return std::regex_search(tag, m, re) ? m[1].str() : std::string();
+  size_t pos = 0;
+  while ((pos = tag.find(name, pos)) != std::string::npos) {
+    const bool starts = pos > 0 && std::isspace(static_cast<unsigned char>(tag[pos - 1]));
+    size_t eq = pos + name.size();
+    while (eq < tag.size() && std::isspace(static_cast<unsigned char>(tag[eq]))) ++eq;
+    if (starts && eq < tag.size() && tag[eq] == '=') {
+      const size_t q = tag.find('"', eq);
+      const size_t e = q == std::string::npos ? q : tag.find('"', q + 1);
+      if (e != std::string::npos) return tag.substr(q + 1, e - q - 1);
+    }
+    pos += name.size();
+  }
+  return {};
 }
 
 double NumAttr(const std::string& tag, const std::string& name, const std::string& where) {

@@ -1,0 +1,227 @@
+#include "fieldvision/stats/stats.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "fieldvision/util/error.h"
+
+namespace fv::stats {
+
+void StatsOptions::Check() const {
+  CheckPositive(fps, "fps");
+  CheckPositive(smooth_window_s, "smooth_window_s");
+  CheckPositive(max_speed_mps, "max_speed_mps");
+  CheckPositive(sprint_speed_mps, "sprint_speed_mps");
+  CheckNonNegative(sprint_min_s, "sprint_min_s");
+  for (size_t i = 0; i < speed_bands_mps.size(); ++i) {
+    FV_REQUIRE(speed_bands_mps[i] > 0 && (i == 0 || speed_bands_mps[i] > speed_bands_mps[i - 1]),
+               "speed_bands_mps must be positive and increasing");
+  }
+  CheckNonNegative(min_track_s, "min_track_s");
+  for (const auto& z : zones) {
+    FV_REQUIRE(z.polygon_m.size() >= 3, "zone '{}' needs at least 3 vertices", z.name);
+  }
+  FV_REQUIRE(image_width_px >= 100, "image_width_px must be >= 100 (got {})", image_width_px);
+  CheckPositive(heat_sigma_m, "heat_sigma_m");
+  CheckNonNegative(max_player_heatmaps, "max_player_heatmaps");
+}
+
+std::string StatsResult::Summary() const {
+  double total = 0, top = 0;
+  int sprints = 0;
+  for (const auto& p : players) {
+    total += p.distance_m;
+    top = std::max(top, p.top_speed_mps);
+    sprints += p.sprints;
+  }
+  return fmt::format(
+      "{} players over {:.1f} s: {:.0f} m covered in all, top speed {:.2f} m/s, "
+      "{} sprints, {} zone entries",
+      players.size(), duration_s, total, top, sprints, events.size());
+}
+
+bool InPolygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& p) {
+  bool inside = false;
+  for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+    const auto& a = poly[i];
+    const auto& b = poly[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      inside = !inside;
+    }
+  }
+  return inside;
+}
+
+std::vector<Zone> ReadZones(const std::string& path) {
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "cannot open zones file '{}'", path);
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const std::exception& e) {
+    Throw("zones file '{}' is not valid JSON", path);
+  }
+  FV_REQUIRE(j.is_array(), "zones file '{}': expected an array of {{name, polygon}}", path);
+  std::vector<Zone> zones;
+  for (size_t i = 0; i < j.size(); ++i) {
+    Zone z;
+    FV_REQUIRE(j[i].contains("polygon") && j[i]["polygon"].is_array(),
+               "zones file '{}': zone {} has no polygon", path, i);
+    z.name = j[i].value("name", fmt::format("zone{}", i + 1));
+    for (const auto& v : j[i]["polygon"]) {
+      FV_REQUIRE(v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number(),
+                 "zones file '{}': zone '{}' has a vertex that is not [x, y]", path, z.name);
+      z.polygon_m.emplace_back(v[0].get<double>(), v[1].get<double>());
+    }
+    FV_REQUIRE(z.polygon_m.size() >= 3, "zones file '{}': zone '{}' needs 3 or more vertices", path,
+               z.name);
+    zones.push_back(z);
+  }
+  return zones;
+}
+
+SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
+                            const std::vector<Eigen::Vector2d>& p, const StatsOptions& o) {
+  SmoothTrack s;
+  s.id = id;
+  const size_t n = t.size();
+  s.time_s = t;
+  s.pos_m.resize(n);
+  s.speed_mps.assign(n, 0.0);
+  s.segment.assign(n, 0);
+  // Segments: split at gaps and at jumps no person makes.
+  const double max_gap_s = std::max(0.5, 3.0 / o.fps);
+  for (size_t i = 1; i < n; ++i) {
+    const double dt = t[i] - t[i - 1];
+    const bool brk = dt > max_gap_s || (p[i] - p[i - 1]).norm() > o.max_speed_mps * dt + 0.5;
+    s.segment[i] = s.segment[i - 1] + (brk ? 1 : 0);
+  }
+  const double half = 0.5 * o.smooth_window_s;
+  for (size_t i = 0; i < n; ++i) {
+    // Local quadratic fit (Savitzky-Golay) over the neighbours in the same segment.
+    size_t a = i, b = i;
+    while (a > 0 && s.segment[a - 1] == s.segment[i] && t[i] - t[a - 1] <= half) --a;
+    while (b + 1 < n && s.segment[b + 1] == s.segment[i] && t[b + 1] - t[i] <= half) ++b;
+    const int m = static_cast<int>(b - a + 1);
+    if (m < 3) {
+      s.pos_m[i] = p[i];
+      continue;
+    }
+    Eigen::MatrixXd A(m, 3);
+    Eigen::MatrixXd Y(m, 2);
+    for (int k = 0; k < m; ++k) {
+      const double dt = t[a + k] - t[i];
+      A.row(k) << 1.0, dt, dt * dt;
+      Y.row(k) = p[a + k].transpose();
+    }
+    const Eigen::MatrixXd coef = (A.transpose() * A).ldlt().solve(A.transpose() * Y);
+    s.pos_m[i] = coef.row(0).transpose();
+    s.speed_mps[i] = coef.row(1).norm();
+  }
+  return s;
+}
+
+StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& o) {
+  o.Check();
+  std::map<int, std::vector<const track::TrackRow*>> by_id;
+  for (const auto& r : rows) {
+    if (r.x_m && r.y_m) by_id[r.id].push_back(&r);
+  }
+  FV_REQUIRE(!by_id.empty(),
+             "the tracks have no field positions (x_m, y_m): run players with a calibrated camera");
+  StatsResult res;
+  double t_min = 1e300, t_max = -1e300;
+  const size_t bands = o.speed_bands_mps.size() + 1;
+  for (auto& [id, rs] : by_id) {
+    std::sort(rs.begin(), rs.end(), [](auto* a, auto* b) { return a->frame < b->frame; });
+    std::vector<double> t;
+    std::vector<Eigen::Vector2d> p;
+    for (const auto* r : rs) {
+      if (!t.empty() && r->frame / o.fps <= t.back()) continue;  // duplicate frame
+      t.push_back(r->frame / o.fps);
+      p.emplace_back(*r->x_m, *r->y_m);
+    }
+    if (t.empty() || t.back() - t.front() < o.min_track_s) continue;
+    SmoothTrack s = SmoothPositions(id, t, p, o);
+    PlayerStats ps;
+    ps.id = id;
+    const auto team = o.team_of.find(id);
+    ps.team = team == o.team_of.end() ? -1 : team->second;
+    ps.samples = static_cast<int>(t.size());
+    ps.first_s = t.front();
+    ps.last_s = t.back();
+    ps.band_time_s.assign(bands, 0.0);
+    for (const auto& z : o.zones) ps.zone_time_s[z.name] = 0.0;
+    double sprint_run = 0, speed_time = 0, speed_sum = 0;
+    std::map<std::string, std::optional<double>> inside_since;
+    std::map<int, std::pair<double, int>> per_second;  // second -> (sum, count)
+    for (size_t i = 0; i < t.size(); ++i) {
+      const bool joined = i + 1 < t.size() && s.segment[i + 1] == s.segment[i];
+      const double dt = joined ? t[i + 1] - t[i] : 0.0;
+      if (joined) ps.distance_m += (s.pos_m[i + 1] - s.pos_m[i]).norm();
+      const double v = std::min(s.speed_mps[i], o.max_speed_mps);
+      ps.top_speed_mps = std::max(ps.top_speed_mps, v);
+      speed_sum += v * dt;
+      speed_time += dt;
+      size_t band = 0;
+      while (band < o.speed_bands_mps.size() && v >= o.speed_bands_mps[band]) ++band;
+      ps.band_time_s[band] += dt;
+      if (v >= o.sprint_speed_mps && joined) {
+        sprint_run += dt;
+      } else {
+        if (sprint_run >= o.sprint_min_s) ps.sprints++;
+        sprint_run = 0;
+      }
+      auto& sec = per_second[static_cast<int>(std::floor(t[i]))];
+      sec.first += v;
+      sec.second++;
+      for (const auto& z : o.zones) {
+        const bool in = InPolygon(z.polygon_m, s.pos_m[i]);
+        if (in) ps.zone_time_s[z.name] += dt;
+        auto& since = inside_since[z.name];
+        if (in && !since) since = t[i];
+        if ((!in || i + 1 == t.size()) && since) {
+          res.events.push_back({z.name, id, *since, t[i]});
+          since.reset();
+        }
+      }
+    }
+    if (sprint_run >= o.sprint_min_s) ps.sprints++;
+    ps.mean_speed_mps = speed_time > 0 ? speed_sum / speed_time : 0.0;
+    for (const auto& [sec, sc] : per_second)
+      ps.speed_profile.emplace_back(sec, sc.first / sc.second);
+    t_min = std::min(t_min, t.front());
+    t_max = std::max(t_max, t.back());
+    res.players.push_back(ps);
+    res.tracks.push_back(std::move(s));
+  }
+  FV_REQUIRE(!res.players.empty(), "no track is longer than min_track_s = {} s", o.min_track_s);
+  res.duration_s = t_max - t_min;
+  std::sort(res.events.begin(), res.events.end(),
+            [](const ZoneEvent& a, const ZoneEvent& b) { return a.enter_s < b.enter_s; });
+  // Distances between players once per second (nearest sample within half a second).
+  for (int sec = static_cast<int>(std::ceil(t_min)); sec <= t_max; ++sec) {
+    std::vector<std::pair<int, Eigen::Vector2d>> at;
+    for (const auto& s : res.tracks) {
+      const auto it = std::lower_bound(s.time_s.begin(), s.time_s.end(), sec - 0.5);
+      if (it == s.time_s.end() || *it > sec + 0.5) continue;
+      at.emplace_back(s.id, s.pos_m[it - s.time_s.begin()]);
+    }
+    for (size_t i = 0; i < at.size(); ++i) {
+      for (size_t j = i + 1; j < at.size(); ++j) {
+        res.pair_distances.emplace_back(sec, at[i].first, at[j].first,
+                                        (at[i].second - at[j].second).norm());
+      }
+    }
+  }
+  return res;
+}
+
+}  // namespace fv::stats

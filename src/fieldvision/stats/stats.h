@@ -1,0 +1,103 @@
+// Statistics for coaches from player tracks (TRACKS.csv): per player distance covered, speed
+// profile, top speed, sprints, time per speed band and per named zone; zone alerts (who entered a
+// polygon and when); distances between players over time; heat maps per player and per team and
+// a radar (top) view as images, an annotated radar video, stats.json and an index.html report.
+// Positions are smoothed before differentiating (a centred Savitzky-Golay filter, quadratic, over
+// smooth_window_s; Savitzky & Golay 1964) because per-frame noise inflates distance and speed;
+// jumps faster than max_speed_mps are treated as track breaks.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fieldvision/field/field.h"
+#include "fieldvision/track/mot.h"
+
+namespace fv::stats {
+
+struct Zone {
+  std::string name;
+  std::vector<Eigen::Vector2d> polygon_m;  // field metres, 3 or more vertices
+};
+
+struct StatsOptions {
+  double fps = 25.0;              // frame rate of the tracked video (TRACKS.csv has frames)
+  double smooth_window_s = 1.0;   // smoothing window of positions
+  double max_speed_mps = 12.0;    // faster steps are track breaks (not running)
+  double sprint_speed_mps = 5.5;  // a sprint is at least this fast ...
+  double sprint_min_s = 1.0;      // ... for at least this long
+  std::vector<double> speed_bands_mps = {2.0, 4.0, 5.5, 7.0};  // band edges (walk, jog, run...)
+  double min_track_s = 1.0;                                    // ignore tracks shorter than this
+  std::vector<Zone> zones;       // named polygons for zone time and alerts
+  std::map<int, int> team_of;    // optional id -> team (from players --teams)
+  int image_width_px = 900;      // width of heat-map and radar images
+  double heat_sigma_m = 1.0;     // Gaussian kernel of the heat maps
+  bool write_video = true;       // radar.avi
+  int max_player_heatmaps = 40;  // heat maps per player for the longest tracks
+
+  void Check() const;
+};
+
+struct PlayerStats {
+  int id = 0;
+  int team = -1;
+  int samples = 0;
+  double first_s = 0, last_s = 0;
+  double distance_m = 0;
+  double top_speed_mps = 0, mean_speed_mps = 0;
+  int sprints = 0;
+  std::vector<double> band_time_s;  // one per speed band (bands + 1)
+  std::map<std::string, double> zone_time_s;
+  std::vector<std::pair<double, double>> speed_profile;  // (time_s, speed_mps), 1 per second
+};
+
+struct ZoneEvent {
+  std::string zone;
+  int id = 0;
+  double enter_s = 0, exit_s = 0;
+};
+
+// Smoothed track: time and position per frame with a position.
+struct SmoothTrack {
+  int id = 0;
+  std::vector<double> time_s;
+  std::vector<Eigen::Vector2d> pos_m;
+  std::vector<double> speed_mps;
+  std::vector<int> segment;  // pieces split at gaps and impossible jumps
+};
+
+struct StatsResult {
+  std::vector<PlayerStats> players;
+  std::vector<ZoneEvent> events;
+  std::vector<SmoothTrack> tracks;
+  // Distances between pairs of players, one sample per second: (time_s, id_a, id_b, metres).
+  std::vector<std::tuple<double, int, int, double>> pair_distances;
+  double duration_s = 0;
+  std::string Summary() const;
+};
+
+// Positions come from rows with x_m/y_m; throws fv::Error if there are none.
+StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& options);
+
+// Smooths one track's positions (exposed for tests).
+SmoothTrack SmoothPositions(int id, const std::vector<double>& time_s,
+                            const std::vector<Eigen::Vector2d>& pos_m, const StatsOptions& o);
+
+bool InPolygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p);
+
+// Reads zones from JSON: [{"name": "box", "polygon": [[x, y], ...]}, ...]. Throws naming the file.
+std::vector<Zone> ReadZones(const std::string& path);
+
+struct ReportFiles {
+  std::vector<std::string> files;
+};
+
+// Writes stats.json, heatmap_all.png, heatmap_team<k>.png, heatmap_player<id>.png, radar.png,
+// radar.avi, distances.csv and index.html into out_dir (created).
+ReportFiles WriteStatsReport(const StatsResult& result, const FieldModel& field,
+                             const StatsOptions& options, const std::string& out_dir);
+
+}  // namespace fv::stats

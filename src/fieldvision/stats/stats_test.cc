@@ -1,0 +1,137 @@
+#include "fieldvision/stats/stats.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/field/field_draw.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::stats {
+namespace {
+
+// A player walking 1.5 m/s along +x for 10 s, then sprinting 7 m/s for 3 s, then standing 3 s,
+// with Gaussian position noise; 25 frames/s.
+std::vector<track::TrackRow> Runner(Rng& rng, int id, double y, double noise_m, double* distance) {
+  std::vector<track::TrackRow> rows;
+  const double fps = 25;
+  double x = -20;
+  *distance = 0;
+  for (int f = 0; f < 16 * 25; ++f) {
+    const double t = f / fps;
+    const double v = t < 10 ? 1.5 : (t < 13 ? 7.0 : 0.0);
+    if (f > 0) {
+      x += v / fps;
+      *distance += v / fps;
+    }
+    track::TrackRow r;
+    r.frame = f;
+    r.id = id;
+    r.box = cv::Rect2d(0, 0, 10, 20);
+    r.x_m = x + rng.Normal(0, noise_m);
+    r.y_m = y + rng.Normal(0, noise_m);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
+  const uint64_t seed = fv::testing::TestSeed(21);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  double truth = 0;
+  const auto rows = Runner(rng, 4, 0.0, 0.05, &truth);
+  StatsOptions o;
+  o.fps = 25;
+  o.zones = {{"right", {{10, -5}, {40, -5}, {40, 5}, {10, 5}}}};
+  const StatsResult r = ComputeStats(rows, o);
+  ASSERT_EQ(r.players.size(), 1u);
+  const PlayerStats& p = r.players[0];
+  // Raw noisy positions would add about 400 * 0.05 * sqrt(pi)... metres; smoothed stays close.
+  double raw = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    raw += std::hypot(*rows[i].x_m - *rows[i - 1].x_m, *rows[i].y_m - *rows[i - 1].y_m);
+  }
+  EXPECT_GT(raw, truth * 1.3);
+  EXPECT_NEAR(p.distance_m, truth, 0.05 * truth) << "raw " << raw;
+  EXPECT_NEAR(p.top_speed_mps, 7.0, 0.7);
+  EXPECT_EQ(p.sprints, 1);
+  EXPECT_NEAR(p.mean_speed_mps, truth / 16.0, 0.3);
+  // x passes 10 m at t = 30 / 7 s into the sprint: 10 + (10 - (-20 + 15)) / 7.
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].id, 4);
+  EXPECT_NEAR(r.events[0].enter_s, 10.0 + 15.0 / 7.0, 0.2);
+  EXPECT_NEAR(p.zone_time_s.at("right"), 16.0 - r.events[0].enter_s, 0.2);
+  // Speed bands add up to the time tracked.
+  double bands = 0;
+  for (double b : p.band_time_s) bands += b;
+  EXPECT_NEAR(bands, p.last_s - p.first_s, 1e-6);
+}
+
+TEST(Stats, PairDistancesAndReport) {
+  const uint64_t seed = fv::testing::TestSeed(22);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  double d1 = 0, d2 = 0;
+  auto rows = Runner(rng, 1, -3.0, 0.02, &d1);
+  const auto other = Runner(rng, 2, 3.0, 0.02, &d2);
+  rows.insert(rows.end(), other.begin(), other.end());
+  StatsOptions o;
+  o.team_of = {{1, 0}, {2, 1}};
+  o.write_video = true;
+  const StatsResult r = ComputeStats(rows, o);
+  ASSERT_FALSE(r.pair_distances.empty());
+  for (const auto& [t, a, b, d] : r.pair_distances) EXPECT_NEAR(d, 6.0, 0.2) << "t " << t;
+  const std::string dir = fv::testing::TempDir() + "/report";
+  const FieldModel field = BuiltinField("futsal");
+  const ReportFiles files = WriteStatsReport(r, field, o, dir);
+  for (const char* f :
+       {"stats.json", "index.html", "heatmap_all.png", "heatmap_team0.png", "heatmap_team1.png",
+        "heatmap_player1.png", "radar.png", "radar.avi", "distances.csv"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
+  }
+  // The hottest place of player 1's map is where it stood longest: the end of its path.
+  const cv::Mat heat = cv::imread(dir + "/heatmap_player1.png");
+  ASSERT_FALSE(heat.empty());
+  const TopView view = TopView::ForField(field, o.image_width_px, 2.0);
+  const cv::Point2d end = view.ToPixel({*rows[16 * 25 - 1].x_m, -3.0});
+  const cv::Point2d start = view.ToPixel({-12.0, -3.0});  // walked through, off the lines
+  // JET maps the maximum to dark red: more red than blue at the end, green at the start.
+  const cv::Vec3b e = heat.at<cv::Vec3b>(cv::Point(end));
+  const cv::Vec3b s = heat.at<cv::Vec3b>(cv::Point(start));
+  EXPECT_GT(e[2], e[0] + 50) << e;
+  EXPECT_GT(s[1], s[2]) << s;  // a cooler (green) colour where it only walked through
+  std::ifstream html(dir + "/index.html");
+  const std::string text((std::istreambuf_iterator<char>(html)), {});
+  EXPECT_NE(text.find("heatmap_player2.png"), std::string::npos);
+  EXPECT_NE(text.find("radar.png"), std::string::npos);
+}
+
+TEST(Stats, BadInputs) {
+  StatsOptions o;
+  o.fps = 0;
+  EXPECT_THROW(o.Check(), fv::Error);
+  std::vector<track::TrackRow> no_positions = {{0, 1, cv::Rect2d(0, 0, 1, 1), 1, {}, {}}};
+  try {
+    ComputeStats(no_positions, StatsOptions{});
+    FAIL();
+  } catch (const fv::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("x_m"), std::string::npos);
+  }
+  const std::string dir = fv::testing::TempDir();
+  {
+    std::ofstream f(dir + "/zones.json");
+    f << "[{\"name\": \"a\", \"polygon\": [[0, 0], [1, 0]]}]";
+  }
+  EXPECT_THROW(ReadZones(dir + "/zones.json"), fv::Error);
+  EXPECT_THROW(ReadZones(dir + "/none.json"), fv::Error);
+  EXPECT_TRUE(InPolygon({{0, 0}, {2, 0}, {2, 2}, {0, 2}}, {1, 1}));
+  EXPECT_FALSE(InPolygon({{0, 0}, {2, 0}, {2, 2}, {0, 2}}, {3, 1}));
+}
+
+}  // namespace
+}  // namespace fv::stats
