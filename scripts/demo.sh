@@ -18,20 +18,26 @@ echo "cameras:  $SCENE/cam*.yaml    videos: $SCENE/cam*.avi (MJPG)"
 echo "truth:    $SCENE/truth.csv (ball centre per frame), $SCENE/truth_2d.csv (per camera),"
 echo "          $SCENE/flights.json (flights), $SCENE/scene.json (the scene, re-render with --scene)"
 
-# == 2. ball: find the ball in every video and triangulate it (added by the ball/recon work).
-#    e.g. "$FV" ball --camera "$SCENE/cam1.yaml" --video "$SCENE/cam1.avi" ... --out "$OUT/ball.csv"
-#    then "$FV" eval ball --truth "$SCENE/truth.csv" --in "$OUT/ball.csv"
+CAMS=()
+for y in "$SCENE"/cam*.yaml; do
+  CAMS+=(--camera "$y" --video "${y%.yaml}.avi")
+done
 
-# == 3. trajectory: fit flights to the 3D ball track (added by the flight-fitting work).
-#    e.g. "$FV" trajectory --in "$OUT/ball.csv" --out "$OUT/flights.json" (compare with
-#    "$SCENE/flights.json")
+echo
+echo "== 2. ball in 3D from ${#CAMS[@]} / 4 camera+video pairs: $FV ball ... --out $OUT/ball.csv"
+"$FV" ball "${CAMS[@]}" --field robocup-msl --out "$OUT/ball.csv" --truth "$SCENE/truth.csv"
 
-# == 4. plan: coverage of the demo rig (added by the camera-planning work).
-#    e.g. "$FV" plan --camera "$SCENE/cam1.yaml" ... --field robocup-msl --out "$OUT/plan"
+echo
+echo "== 3. flights of the ball: $FV trajectory --in $OUT/ball.csv --out $OUT/flights.json"
+"$FV" trajectory --in "$OUT/ball.csv" --out "$OUT/flights.json" --field robocup-msl \
+  --images "$OUT/flights" --smoothed "$OUT/ball_smoothed.csv"
+echo "truth flights for comparison: $SCENE/flights.json; pictures: $OUT/flights/"
 
-# == 5. players: track people in the players preset (added by the player-tracking work).
-#    e.g. "$FV" synth --preset players --out "$OUT/players-scene" and
-#    "$FV" players --camera "$OUT/players-scene/side.yaml" --video "$OUT/players-scene/side.avi" ...
+echo
+echo "== 4. coverage of the demo rig: $FV plan --camera ... --field robocup-msl --out $OUT/plan"
+PLAN_CAMS=()
+for y in "$SCENE"/cam*.yaml; do PLAN_CAMS+=(--camera "$y"); done
+"$FV" plan "${PLAN_CAMS[@]}" --field robocup-msl --out "$OUT/plan"
 
 echo
 echo "demo: done; everything is in $OUT/"
