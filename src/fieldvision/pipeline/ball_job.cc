@@ -42,6 +42,9 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::vector<Camera> cameras;
   for (int c = 0; c < n; ++c) {
     cameras.push_back(ReadCameraYaml(o.cameras[c]));
+    if (cameras.back().name.empty()) {
+      cameras.back().name = std::filesystem::path(o.cameras[c]).stem().string();
+    }
     FV_REQUIRE(cameras.back().has_pose,
                "camera file '{}' has no pose (rvec, tvec): calibrate its "
                "extrinsics first",

@@ -38,7 +38,9 @@ std::string BallPipelineSummary::ToString() const {
   }
   s += "cameras used:";
   for (int c = 0; c < num_cameras; ++c) {
-    s += fmt::format(" cam{} {} ({} candidates)", c, used_per_camera[c], candidates_per_camera[c]);
+    const std::string name =
+        c < static_cast<int>(camera_names.size()) ? camera_names[c] : fmt::format("camera {}", c);
+    s += fmt::format(" {} {} ({} candidates)", name, used_per_camera[c], candidates_per_camera[c]);
     if (queue_drops[c] > 0) s += fmt::format(" [{} dropped by the queue]", queue_drops[c]);
     s += c + 1 < num_cameras ? "," : "";
   }
@@ -85,6 +87,10 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
   }
   BallPipelineSummary summary;
   summary.num_cameras = n;
+  for (int c = 0; c < n; ++c) {
+    summary.camera_names.push_back(cameras[c].name.empty() ? fmt::format("camera {}", c)
+                                                           : cameras[c].name);
+  }
   summary.used_per_camera.assign(n, 0);
   summary.candidates_per_camera.assign(n, 0);
   summary.queue_drops.assign(n, 0);

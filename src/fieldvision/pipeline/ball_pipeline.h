@@ -43,6 +43,7 @@ struct BallFrame {
 
 struct BallPipelineSummary {
   int num_cameras = 0;
+  std::vector<std::string> camera_names;         // Camera::name, or "camera <index>" if unnamed
   long long frames = 0;                          // synchronised frames
   long long frames_with_position = 0;            // 3D (or ground) positions
   long long ground_positions = 0;                // single-camera ground positions among them
