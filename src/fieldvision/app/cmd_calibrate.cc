@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/calib/check.h"
 #include "fieldvision/calib/extrinsics.h"
 #include "fieldvision/calib/intrinsics.h"
@@ -32,16 +33,6 @@ cv::Mat ReadImage(const std::string& path) {
   }
   FV_REQUIRE(!image.empty(), "image '{}' cannot be read (corrupt or not an image)", path);
   return image;
-}
-
-void WriteImage(const std::string& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", path);
 }
 
 void Warn(const std::string& message) { std::cerr << "warning: " << message << "\n"; }

@@ -9,6 +9,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/field/field_json.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -54,13 +55,7 @@ void DrawFieldCommand(const FieldDrawOptions2& o) {
   d.keypoints = true;
   d.keypoint_names = o.names;
   const cv::Mat img = DrawField(f, view, d);
-  bool ok = false;
-  try {
-    ok = cv::imwrite(o.out, img);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", o.out);
+  WriteImage(o.out, img);
   std::cout << "wrote " << o.out << " (" << img.cols << "x" << img.rows << ")\n";
 }
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
 
 namespace fv {
@@ -32,16 +33,6 @@ json LayerJson(const CoverageLayer& L) {
         {"max_m", Finite(L.err_max_m)},
         {"max_axis_max_m", Finite(L.err_max_axis_max_m)}}},
       {"score", L.score}};
-}
-
-void WriteImage(const std::string& path, const cv::Mat& img) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, img);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  FV_REQUIRE(ok, "cannot write image '{}'", path);
 }
 
 }  // namespace

@@ -274,14 +274,4 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
   return img;
 }
 
-void WriteImage(const std::string& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, image);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", path);
-}
-
 }  // namespace fv

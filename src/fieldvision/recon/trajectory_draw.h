@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/field/field.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/trajectory_decisions.h"
 #include "fieldvision/recon/trajectory_predict.h"
@@ -27,8 +28,5 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
 // field may be null (a plain grid around the track).
 cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryResult& result,
                        const FieldModel* field, const Decisions* decisions, int width_px = 1400);
-
-// Writes an image; throws fv::Error naming the path on failure.
-void WriteImage(const std::string& path, const cv::Mat& image);
 
 }  // namespace fv

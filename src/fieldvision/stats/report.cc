@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/field/field_draw.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -29,12 +30,7 @@ cv::Scalar ColourOf(int id, int team) {
 }
 
 void Write(const std::string& path, const cv::Mat& img, ReportFiles& files) {
-  bool ok = false;
-  try {
-    ok = cv::imwrite(path, img);
-  } catch (const cv::Exception&) {
-  }
-  FV_REQUIRE(ok, "cannot write image '{}'", path);
+  WriteImage(path, img);
   files.files.push_back(path);
 }
 
