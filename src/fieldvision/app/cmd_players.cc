@@ -58,6 +58,11 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--detector", c->o.detector.kind, "nanodet (default), hog, motion or onnx")
       ->check(CLI::IsMember({"nanodet", "hog", "motion", "onnx"}));
   cmd->add_option("--onnx", c->onnx, "A YOLO-style ONNX model of your own (sets --detector onnx)");
+  cmd->add_option("--detections", c->o.detections_in,
+                  "Read detections (MOTChallenge det.txt: frame,-1,x,y,w,h,score; 1-based "
+                  "frames) instead of running a detector");
+  cmd->add_option("--save-detections", c->o.detections_out,
+                  "Also write the detections (after filtering) as det.txt for --detections");
   cmd->add_option("--model", c->o.detector.model_path,
                   "NanoDet model (default: BUILD/models/nanodet.onnx from make build)");
   cmd->add_option("--input-width", c->o.detector.input_width,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 #include <fmt/format.h>
 #include <opencv2/dnn.hpp>
@@ -13,6 +14,7 @@
 
 #include "fieldvision/geometry/rigid.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::track {
 namespace fs = std::filesystem;
@@ -64,6 +66,65 @@ std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_
   return out;
 }
 
+std::vector<Detection> FilterDetections(std::vector<Detection> dets, const DetectorOptions& o,
+                                        const FootFilter& filter) {
+  std::erase_if(dets, [&](const Detection& d) { return d.box.height < o.min_height_px; });
+  if (filter) {
+    std::erase_if(dets, [&](const Detection& d) {
+      return !filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height});
+    });
+  }
+  return Nms(dets, o.nms_iou, o.score_threshold);
+}
+
+void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& path) {
+  std::ofstream out(path);
+  FV_REQUIRE(out.good(), "cannot write detections file '{}'", path);
+  for (size_t f = 0; f < detections.frames.size(); ++f) {
+    for (const Detection& d : detections.frames[f]) {
+      // {} is the shortest text that reads back as the same double.
+      out << fmt::format("{},-1,{},{},{},{},{}\n", f + 1, d.box.x, d.box.y, d.box.width,
+                         d.box.height, d.score);
+    }
+  }
+  out.close();
+  FV_REQUIRE(!out.fail(), "cannot write detections file '{}'", path);
+}
+
+DetectionsFile ReadDetectionsCsv(const std::string& path) {
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "cannot open detections file '{}'", path);
+  DetectionsFile out;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string t = Trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    const std::vector<std::string> f = Split(t, ',');
+    const std::string where = fmt::format("detections file {}:{}", path, line_no);
+    FV_REQUIRE(f.size() >= 7,
+               "{}: expected at least 7 columns (frame,-1,bb_left,bb_top,bb_width,bb_height,"
+               "score), got {}",
+               where, f.size());
+    const long long frame = ParseInt(Trim(f[0]), where + " frame");
+    FV_REQUIRE(frame >= 1 && frame <= 10000000, "{}: frame {} (frames are 1-based)", where, frame);
+    Detection d;
+    d.box = cv::Rect2d(ParseDouble(Trim(f[2]), where + " bb_left"),
+                       ParseDouble(Trim(f[3]), where + " bb_top"),
+                       ParseDouble(Trim(f[4]), where + " bb_width"),
+                       ParseDouble(Trim(f[5]), where + " bb_height"));
+    FV_REQUIRE(std::isfinite(d.box.x) && std::isfinite(d.box.y) && d.box.width >= 0 &&
+                   d.box.height >= 0 && std::isfinite(d.box.width) && std::isfinite(d.box.height),
+               "{}: box must be finite with a non-negative size", where);
+    d.score = ParseDouble(Trim(f[6]), where + " score");
+    FV_REQUIRE(std::isfinite(d.score), "{}: score is not finite", where);
+    if (out.frames.size() < size_t(frame)) out.frames.resize(frame);
+    out.frames[frame - 1].push_back(d);
+  }
+  return out;
+}
+
 std::string FindModel(const std::string& file) {
   std::vector<fs::path> dirs;
   if (const char* env = std::getenv("FV_MODELS_DIR")) dirs.emplace_back(env);
@@ -104,16 +165,9 @@ cv::dnn::Net LoadOnnx(const std::string& path) {
   return net;
 }
 
-// Keeps detections whose foot point passes the filter, then NMS.
 std::vector<Detection> Finish(std::vector<Detection> dets, const DetectorOptions& o,
                               const FootFilter& filter) {
-  std::erase_if(dets, [&](const Detection& d) { return d.box.height < o.min_height_px; });
-  if (filter) {
-    std::erase_if(dets, [&](const Detection& d) {
-      return !filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height});
-    });
-  }
-  return Nms(dets, o.nms_iou, o.score_threshold);
+  return FilterDetections(std::move(dets), o, filter);
 }
 
 class NanoDetDetector : public PersonDetector {

@@ -77,6 +77,26 @@ std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options,
                                              const Camera* camera = nullptr,
                                              FootFilter filter = {});
 
+// The filtering every detector applies: drops boxes shorter than options.min_height_px and those
+// whose foot point fails `filter` (may be empty), then NMS (options.nms_iou) keeping scores >=
+// options.score_threshold, sorted by decreasing score. Idempotent: filtering twice changes nothing.
+std::vector<Detection> FilterDetections(std::vector<Detection> detections,
+                                        const DetectorOptions& options, const FootFilter& filter);
+
+// Detections of a whole video, MOTChallenge det.txt style: one row per box,
+// `frame,-1,bb_left,bb_top,bb_width,bb_height,score` with 1-based frames and no header (MOT's
+// det.txt files have 10 columns; the columns after the score are ignored). frames[i] holds the
+// boxes of video frame i (0-based).
+struct DetectionsFile {
+  std::vector<std::vector<Detection>> frames;
+};
+// Writes with full precision (reading gives back the same numbers). Throws fv::Error naming the
+// path when it cannot be written.
+void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& path);
+// Throws fv::Error naming the file and line for a malformed row (fewer than 7 columns, a number
+// that does not parse, a frame < 1, a negative box size, a score that is not finite).
+DetectionsFile ReadDetectionsCsv(const std::string& path);
+
 // Greedy NMS over boxes sorted by score (cv::dnn::NMSBoxes).
 std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_threshold,
                            double score_threshold = 0.0);

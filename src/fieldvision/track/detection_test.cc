@@ -54,6 +54,85 @@ TEST(NanoDetDecode, RecoversTheBoxOfAOneHotDistribution) {
   }
 }
 
+TEST(DetectionsFile, RoundTripsExactlyAndFilteringIsIdempotent) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  DetectionsFile in;
+  in.frames.resize(6);
+  for (int f = 0; f < 6; ++f) {
+    if (f == 2) continue;  // a frame without detections
+    for (int k = 0; k < 4; ++k) {
+      in.frames[f].push_back({cv::Rect2d(rng.Uniform(0, 600), rng.Uniform(0, 400),
+                                         rng.Uniform(5, 60), rng.Uniform(20, 150)),
+                              rng.Uniform(0.1, 1.0)});
+    }
+  }
+  const std::string path = fv::testing::TempDir() + "/det.txt";
+  WriteDetectionsCsv(in, path);
+  const DetectionsFile out = ReadDetectionsCsv(path);
+  ASSERT_EQ(out.frames.size(), in.frames.size());
+  for (size_t f = 0; f < in.frames.size(); ++f) {
+    ASSERT_EQ(out.frames[f].size(), in.frames[f].size());
+    for (size_t k = 0; k < in.frames[f].size(); ++k) {
+      EXPECT_EQ(out.frames[f][k].box, in.frames[f][k].box);
+      EXPECT_EQ(out.frames[f][k].score, in.frames[f][k].score);
+    }
+  }
+  DetectorOptions o;
+  o.min_height_px = 40;
+  const FootFilter left_half = [](const cv::Point2d& p) { return p.x < 320; };
+  for (const auto& dets : in.frames) {
+    const auto once = FilterDetections(dets, o, left_half);
+    const auto twice = FilterDetections(once, o, left_half);
+    ASSERT_EQ(once.size(), twice.size());
+    for (size_t k = 0; k < once.size(); ++k) EXPECT_EQ(once[k].box, twice[k].box);
+    for (const auto& d : once) {
+      EXPECT_GE(d.box.height, 40);
+      EXPECT_LT(d.box.x + 0.5 * d.box.width, 320);
+    }
+  }
+}
+
+TEST(DetectionsFile, MotChallengeColumnsReadAndBadRowsNameFileAndLine) {
+  const std::string dir = fv::testing::TempDir();
+  {
+    std::ofstream f(dir + "/mot.txt");
+    f << "1,-1,10,20,30,80,0.9,-1,-1,-1\n\n3,-1,11.5,21,30,81,0.4,-1,-1,-1\n";
+  }
+  const DetectionsFile d = ReadDetectionsCsv(dir + "/mot.txt");
+  ASSERT_EQ(d.frames.size(), 3u);
+  EXPECT_EQ(d.frames[0].size(), 1u);
+  EXPECT_TRUE(d.frames[1].empty());
+  ASSERT_EQ(d.frames[2].size(), 1u);
+  EXPECT_DOUBLE_EQ(d.frames[2][0].box.x, 11.5);
+  EXPECT_DOUBLE_EQ(d.frames[2][0].score, 0.4);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"1,-1,10,20,30,80\n", "7 columns"},
+      {"1,-1,10,20,30,80,0.5\n2,-1,10,x,30,80,0.5\n", "bb_top"},
+      {"0,-1,10,20,30,80,0.5\n", "1-based"},
+      {"1,-1,10,20,-30,80,0.5\n", "non-negative"},
+  };
+  for (size_t i = 0; i < bad.size(); ++i) {
+    const std::string path = dir + "/bad" + std::to_string(i) + ".txt";
+    {
+      std::ofstream f(path);
+      f << bad[i].first;
+    }
+    try {
+      ReadDetectionsCsv(path);
+      ADD_FAILURE() << "no error for " << bad[i].first;
+    } catch (const fv::Error& e) {
+      const std::string what = e.what();
+      const std::string line = i == 1 ? ":2" : ":1";
+      EXPECT_NE(what.find(path + line), std::string::npos) << what;
+      EXPECT_NE(what.find(bad[i].second), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+  EXPECT_THROW(ReadDetectionsCsv(dir + "/missing.txt"), fv::Error);
+}
+
 TEST(Nms, KeepsTheBestOfOverlappingBoxes) {
   const std::vector<Detection> d = {{cv::Rect2d(0, 0, 10, 20), 0.6},
                                     {cv::Rect2d(1, 1, 10, 20), 0.9},

@@ -110,6 +110,26 @@ class FrameReader {
   std::thread thread_;
 };
 
+// Detections read from a file (det.txt), frame by frame, filtered like a detector's.
+class FileDetector : public PersonDetector {
+ public:
+  FileDetector(const std::string& path, const DetectorOptions& o, FootFilter filter)
+      : file_(ReadDetectionsCsv(path)), o_(o), filter_(std::move(filter)), path_(path) {}
+  std::vector<Detection> Detect(const cv::Mat&) override {
+    const size_t f = next_++;
+    if (f >= file_.frames.size()) return {};
+    return FilterDetections(file_.frames[f], o_, filter_);
+  }
+  std::string name() const override { return "file " + path_; }
+
+ private:
+  DetectionsFile file_;
+  DetectorOptions o_;
+  FootFilter filter_;
+  std::string path_;
+  size_t next_ = 0;
+};
+
 }  // namespace
 
 void PlayersOptions::Check() const {
@@ -209,8 +229,14 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   if (camera != nullptr) {
     CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
   }
-  std::unique_ptr<PersonDetector> detector =
-      MakeDetector(options.detector, calibrated ? camera : nullptr, filter);
+  std::unique_ptr<PersonDetector> detector;
+  if (!options.detections_in.empty()) {
+    options.detector.Check();
+    detector = std::make_unique<FileDetector>(options.detections_in, options.detector, filter);
+  } else {
+    detector = MakeDetector(options.detector, calibrated ? camera : nullptr, filter);
+  }
+  DetectionsFile saved;
   PlayersResult result;
   result.detector = detector->name();
   result.fps = options.fps > 0 ? options.fps : (reader.fps() > 0 ? reader.fps() : 25.0);
@@ -232,6 +258,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     const std::vector<TrackState> states = tracker.Update(dets, frame);
     const auto t2 = Clock::now();
     result.detections += static_cast<int>(dets.size());
+    if (!options.detections_out.empty()) saved.frames.push_back(dets);
     for (const auto& s : states) {
       TrackRow r;
       r.frame = index;
@@ -268,6 +295,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   progress.Finish();
   result.frames = index;
   FV_REQUIRE(index > 0, "video '{}' has no readable frame", video);
+  if (!options.detections_out.empty()) WriteDetectionsCsv(saved, options.detections_out);
   const auto t_map = Clock::now();
   // Short tracks are usually false detections.
   if (options.min_track_frames > 0) {

@@ -29,6 +29,13 @@ struct PlayersOptions {
   bool teams = false;            // assign teams (k-means, k = 2, on torso colour)
   bool progress = true;          // fv::Progress on stderr
   double fps = 0;                // 0: from the video (falls back to 25)
+  // Read the detections from this file (MOTChallenge det.txt style, detection.h) instead of
+  // running the detector; the video is still read (the tracker's appearance model uses the
+  // frames). The same filtering (min height, field area, NMS, score threshold) is applied.
+  std::string detections_in;
+  // Write the detections of every frame (after filtering) to this file; reading it back with
+  // detections_in gives the same tracks.
+  std::string detections_out;
 
   void Check() const;
 };

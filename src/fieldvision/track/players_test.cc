@@ -106,8 +106,22 @@ TEST(Players, SynthScenePositionsAndStableIds) {
   PlayersOptions o;
   o.progress = false;
   o.detector.input_width = 416;
+  o.detections_out = dir + "/det.txt";
   const PlayersResult r = RunPlayers(dir + "/" + cam.name + ".avi", &cam, &field, o);
   ASSERT_GT(r.rows.size(), 0u) << r.Summary();
+  // The saved detections read back instead of the detector give the same tracks.
+  {
+    PlayersOptions again = o;
+    again.detections_out.clear();
+    again.detections_in = dir + "/det.txt";
+    const PlayersResult r2 = RunPlayers(dir + "/" + cam.name + ".avi", &cam, &field, again);
+    EXPECT_EQ(r2.detections, r.detections);
+    ASSERT_EQ(r2.rows.size(), r.rows.size());
+    for (size_t i = 0; i < r.rows.size(); ++i) {
+      EXPECT_EQ(r2.rows[i].id, r.rows[i].id);
+      EXPECT_EQ(r2.rows[i].box, r.rows[i].box);
+    }
+  }
   WriteTracksCsv(r.rows, dir + "/tracks.csv");
   // Match each row to the truth person whose box overlaps most.
   std::vector<double> errors;
