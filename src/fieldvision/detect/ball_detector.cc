@@ -109,6 +109,8 @@ void BallDetectorOptions::Check() const {
   CheckNonNegative(field_margin_m, "field_margin_m");
   FV_REQUIRE(max_dents >= 0, "max_dents must be >= 0 (got {})", max_dents);
   FV_REQUIRE(max_refine >= 1, "max_refine must be >= 1 (got {})", max_refine);
+  FV_REQUIRE(weak_min_inlier_fraction >= 0 && weak_min_inlier_fraction <= 1,
+             "weak_min_inlier_fraction must be in [0, 1] (got {})", weak_min_inlier_fraction);
   fit.Check();
 }
 
@@ -241,28 +243,12 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
                fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
     cand.visible_fraction = visible;
     double size_factor = 1.0;
-    std::string why;
+    std::string why;        // a hard failure: size
+    std::string shape_why;  // an outline check: the candidate may still be weak
     double exp_min = 0, exp_max = 0;
     if (fit.radius_px < o.min_radius_px || fit.radius_px > o.max_radius_px) {
       why = fmt::format("radius {:.1f} px outside {}..{}", fit.radius_px, o.min_radius_px,
                         o.max_radius_px);
-    } else if (fit.inlier_fraction < o.min_inlier_fraction) {
-      why = fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
-    } else if (fit.outside_fraction > o.max_outside_fraction) {
-      why = fmt::format("colour goes on beyond the circle on {:.0f} % of rays",
-                        100 * fit.outside_fraction);
-    } else if (fit.inlier_fraction < 0.75 &&
-               fit.outside_fraction > o.max_outside_fraction_occluded) {
-      why = fmt::format("partial outline with colour beyond the circle on {:.0f} % of rays",
-                        100 * fit.outside_fraction);
-    } else if (fit.dents > o.max_dents && fit.inlier_fraction < 0.85) {
-      why = fmt::format("outline has {} dents: not a disc", fit.dents);
-    } else if (fit.rms_px > o.max_fit_rms_px) {
-      why = fmt::format("outline rms {:.2f} px", fit.rms_px);
-    } else if (visible < o.min_visible_fraction) {
-      why = fmt::format("disc only {:.0f} % ball-coloured", 100 * visible);
-    } else if (leak > o.max_leak_fraction) {
-      why = fmt::format("colour extends beyond the circle ({:.0f} %)", 100 * leak);
     } else if (ExpectedRadius(fit.centre_px, &exp_min, &exp_max)) {
       const double lo = exp_min * (1 - o.size_tolerance) - 0.5;
       const double hi = exp_max * (1 + o.size_tolerance) + 0.5;
@@ -276,6 +262,29 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
         size_factor = 0.5 + 0.5 * size_factor;
       }
     }
+    if (fit.inlier_fraction < o.min_inlier_fraction) {
+      shape_why =
+          fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
+    } else if (fit.outside_fraction > o.max_outside_fraction) {
+      shape_why = fmt::format("colour goes on beyond the circle on {:.0f} % of rays",
+                              100 * fit.outside_fraction);
+    } else if (fit.inlier_fraction < 0.75 &&
+               fit.outside_fraction > o.max_outside_fraction_occluded) {
+      shape_why = fmt::format("partial outline with colour beyond the circle on {:.0f} % of rays",
+                              100 * fit.outside_fraction);
+    } else if (fit.dents > o.max_dents && fit.inlier_fraction < 0.85) {
+      shape_why = fmt::format("outline has {} dents: not a disc", fit.dents);
+    } else if (fit.rms_px > o.max_fit_rms_px) {
+      shape_why = fmt::format("outline rms {:.2f} px", fit.rms_px);
+    } else if (visible < o.min_visible_fraction) {
+      shape_why = fmt::format("disc only {:.0f} % ball-coloured", 100 * visible);
+    } else if (leak > o.max_leak_fraction) {
+      shape_why = fmt::format("colour extends beyond the circle ({:.0f} %)", 100 * leak);
+    }
+    cand.weak = why.empty() && !shape_why.empty() &&
+                fit.inlier_fraction >= o.weak_min_inlier_fraction &&
+                visible >= o.min_visible_fraction;
+    if (why.empty()) why = shape_why;
     cand.score = fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
                  std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor;
     cand.accepted = why.empty();

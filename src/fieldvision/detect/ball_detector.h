@@ -28,6 +28,11 @@ struct BallCandidate {
   double sigma_px = 0.0;  // standard deviation of the centre, pixels (each axis)
   double score = 0.0;     // 0..1, higher is more ball-like
   bool accepted = false;  // passed every filter
+  // Not accepted, but a fitted disc of a plausible size that failed only an outline check
+  // (colour beyond the circle, dents, fit RMS, leak): a ball in front of a same-coloured or
+  // dark background often looks like this. Multi-view fusion may use it to complete a position
+  // that an accepted candidate of another camera starts (recon/triangulation.h).
+  bool weak = false;
   // Extras for drawing and diagnosis.
   double visible_fraction = 0.0;  // share of the fitted disc with the ball's colour
   double inlier_fraction = 0.0;   // share of rays with an outline point on the fit
@@ -62,6 +67,8 @@ struct BallDetectorOptions {
   bool use_field_mask = true;   // with camera pose and field: only the field of play
   double field_margin_m = 1.0;  // around the field of play
   int max_refine = 12;          // largest blobs refined per frame
+  // Weak candidates (see BallCandidate::weak) need at least this share of rays on the circle.
+  double weak_min_inlier_fraction = 0.5;
   BallFitOptions fit;
   // Throws fv::Error naming the bad field.
   void Check() const;

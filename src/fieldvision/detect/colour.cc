@@ -25,7 +25,7 @@ const std::map<std::string, std::vector<ColourRange>>& Presets() {
   // Hue in degrees. Orange covers Lambert-shaded balls (dark side down to V 45) but not skin
   // (low saturation) or red shirts (hue < 6).
   static const std::map<std::string, std::vector<ColourRange>> presets = {
-      {"orange", {Hsv(6, 170, 45, 45, 255, 255)}}, {"yellow", {Hsv(45, 100, 80, 70, 255, 255)}},
+      {"orange", {Hsv(6, 170, 45, 38, 255, 255)}}, {"yellow", {Hsv(45, 100, 80, 70, 255, 255)}},
       {"white", {Hsv(0, 0, 170, 360, 45, 255)}},   {"pink", {Hsv(295, 60, 120, 345, 255, 255)}},
       {"red", {Hsv(345, 120, 60, 6, 255, 255)}},   {"blue", {Hsv(190, 100, 50, 250, 255, 255)}},
       {"green", {Hsv(70, 50, 30, 170, 255, 255)}}, {"black", {Hsv(0, 0, 0, 360, 255, 45)}},

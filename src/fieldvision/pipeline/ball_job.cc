@@ -79,10 +79,16 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
     auto det = std::make_shared<BallDetector>(dopt, &cameras[c], field ? &*field : nullptr);
     detectors.push_back(det);
     detect_fns.push_back([det](const cv::Mat& bgr) {
+      // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
+      // position that an accepted candidate of another camera starts).
+      constexpr int kMaxWeak = 3;
       std::vector<BallObservation> out;
+      int weak = 0;
       for (const BallCandidate& b : det->Detect(bgr)) {
-        if (!b.accepted) continue;
+        if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
+        weak += !b.accepted;
         BallObservation obs;
+        obs.weak = !b.accepted;
         obs.centre_px = b.centre_px;
         obs.radius_px = b.radius_px;
         obs.sigma_px = std::max(b.sigma_px, 0.05);

@@ -1,5 +1,6 @@
 #include "fieldvision/pipeline/ball_pipeline.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <exception>
@@ -30,6 +31,12 @@ std::string BallPipelineSummary::ToString() const {
           ? fmt::format(" of which {} single-camera ground positions", ground_positions)
           : "",
       mean_err_px);
+  if (weak_positions > 0) {
+    s += fmt::format(
+        "{} positions completed with weak candidates (failed a shape check in one "
+        "camera, consistent with the others)\n",
+        weak_positions);
+  }
   if (frames > frames_with_position) {
     s += fmt::format(
         "no position: {} frames with candidates in fewer than 2 cameras, {} frames "
@@ -49,8 +56,23 @@ std::string BallPipelineSummary::ToString() const {
   return s;
 }
 
+void BallPredictor::Add(long long frame, const Eigen::Vector3d& point_world) {
+  frame_[1] = frame_[0];
+  point_[1] = point_[0];
+  frame_[0] = frame;
+  point_[0] = point_world;
+  count_ = std::min(count_ + 1, 2);
+}
+
+std::optional<Eigen::Vector3d> BallPredictor::Predict(long long frame) const {
+  if (count_ == 0 || frame - frame_[0] > max_gap_ || frame < frame_[0]) return std::nullopt;
+  if (count_ < 2 || frame_[0] - frame_[1] > max_gap_ || frame_[0] <= frame_[1]) return point_[0];
+  const Eigen::Vector3d v = (point_[0] - point_[1]) / double(frame_[0] - frame_[1]);
+  return point_[0] + v * double(frame - frame_[0]);
+}
+
 BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
-                    const TriangulationOptions& options) {
+                    const TriangulationOptions& options, const Eigen::Vector3d* prior) {
   BallFrame out;
   out.frame = frame.frame;
   out.time_s = frame.time_s;
@@ -59,9 +81,12 @@ BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame
     if (!frame.cameras[c]) continue;
     ++out.cameras_present;
     candidates[c] = frame.cameras[c]->candidates;
-    if (!candidates[c].empty()) ++out.cameras_with_blobs;
+    if (std::any_of(candidates[c].begin(), candidates[c].end(),
+                    [](const BallObservation& o) { return !o.weak; })) {
+      ++out.cameras_with_blobs;
+    }
   }
-  out.result = TriangulateRobust(cameras, candidates, options);
+  out.result = TriangulateRobust(cameras, candidates, options, prior);
   return out;
 }
 
@@ -144,18 +169,25 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
   double sum_err = 0;
   try {
     FrameSynchronizer sync(n, options.sync);
+    BallPredictor predictor;
     Progress progress("ball", total, "frames", options.progress);
     while (!stop) {
       while (auto group = sync.Next()) {
         for (int c = 0; c < n; ++c) {
-          if (group->cameras[c])
-            summary.candidates_per_camera[c] += group->cameras[c]->candidates.size();
+          if (!group->cameras[c]) continue;
+          for (const BallObservation& o : group->cameras[c]->candidates) {
+            summary.candidates_per_camera[c] += !o.weak;
+          }
         }
-        const BallFrame f = FuseFrame(cameras, *group, options.triangulation);
+        const auto prior = predictor.Predict(group->frame);
+        const BallFrame f =
+            FuseFrame(cameras, *group, options.triangulation, prior ? &*prior : nullptr);
+        if (f.result.ok() && !f.result.on_ground) predictor.Add(f.frame, f.result.point_world);
         ++summary.frames;
         if (f.result.ok()) {
           ++summary.frames_with_position;
           if (f.result.on_ground) ++summary.ground_positions;
+          if (f.result.weak_views > 0) ++summary.weak_positions;
           sum_err += f.result.rms_px;
           for (const auto& v : f.result.views) ++summary.used_per_camera[v.camera];
         } else if (f.cameras_with_blobs < 2) {

@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,13 +44,14 @@ struct BallFrame {
 
 struct BallPipelineSummary {
   int num_cameras = 0;
-  std::vector<std::string> camera_names;         // Camera::name, or "camera <index>" if unnamed
-  long long frames = 0;                          // synchronised frames
-  long long frames_with_position = 0;            // 3D (or ground) positions
-  long long ground_positions = 0;                // single-camera ground positions among them
-  long long frames_few_blobs = 0;                // no position: fewer than 2 cameras had candidates
-  long long frames_inconsistent = 0;             // no position although >= 2 cameras had candidates
-  double mean_err_px = 0.0;                      // mean of the positions' RMS reprojection errors
+  std::vector<std::string> camera_names;  // Camera::name, or "camera <index>" if unnamed
+  long long frames = 0;                   // synchronised frames
+  long long frames_with_position = 0;     // 3D (or ground) positions
+  long long ground_positions = 0;         // single-camera ground positions among them
+  long long weak_positions = 0;       // positions completed with weak candidates (triangulation.h)
+  long long frames_few_blobs = 0;     // no position: fewer than 2 cameras had candidates
+  long long frames_inconsistent = 0;  // no position although >= 2 cameras had candidates
+  double mean_err_px = 0.0;           // mean of the positions' RMS reprojection errors
   std::vector<long long> used_per_camera;        // positions each camera contributed to
   std::vector<long long> candidates_per_camera;  // candidates each camera reported
   std::vector<size_t> queue_drops;               // messages dropped by the queues
@@ -71,6 +73,21 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
 
 // The fusion of one synchronised frame (what the fusion stage does per frame).
 BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
-                    const TriangulationOptions& options);
+                    const TriangulationOptions& options, const Eigen::Vector3d* prior = nullptr);
+
+// The ball's expected position from the last positions (constant velocity over the last two,
+// when they are at most max_gap frames apart and the newest is at most max_gap frames old).
+class BallPredictor {
+ public:
+  explicit BallPredictor(int max_gap = 5) : max_gap_(max_gap) {}
+  void Add(long long frame, const Eigen::Vector3d& point_world);
+  std::optional<Eigen::Vector3d> Predict(long long frame) const;
+
+ private:
+  int max_gap_;
+  int count_ = 0;
+  long long frame_[2] = {0, 0};  // [0] newest
+  Eigen::Vector3d point_[2];
+};
 
 }  // namespace fv

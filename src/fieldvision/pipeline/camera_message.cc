@@ -28,11 +28,13 @@ std::string CameraMessage::ToJsonLine() const {
   j["time_s"] = time_s;
   json c = json::array();
   for (const BallObservation& o : candidates) {
-    c.push_back({{"u", o.centre_px.x()},
-                 {"v", o.centre_px.y()},
-                 {"r", o.radius_px},
-                 {"sigma", o.sigma_px},
-                 {"score", o.score}});
+    json cj = {{"u", o.centre_px.x()},
+               {"v", o.centre_px.y()},
+               {"r", o.radius_px},
+               {"sigma", o.sigma_px},
+               {"score", o.score}};
+    if (o.weak) cj["weak"] = true;  // absent means false
+    c.push_back(std::move(cj));
   }
   j["candidates"] = std::move(c);
   return j.dump();
@@ -67,6 +69,10 @@ CameraMessage CameraMessage::FromJsonLine(const std::string& line, const std::st
     o.sigma_px = Number(c, "sigma", ctx);
     o.score = Number(c, "score", ctx);
     FV_REQUIRE(o.sigma_px > 0, "{}: 'sigma' must be > 0", ctx);
+    if (c.contains("weak")) {
+      FV_REQUIRE(c["weak"].is_boolean(), "{}: 'weak' is not true or false", ctx);
+      o.weak = c["weak"].get<bool>();
+    }
     m.candidates.push_back(o);
   }
   return m;

@@ -17,7 +17,7 @@ struct CameraMessage {
   std::vector<BallObservation> candidates;  // best first
 
   // {"camera":0,"frame":12,"time_s":0.2,"candidates":[{"u":..,"v":..,"r":..,"sigma":..,
-  // "score":..}]} on one line; doubles round-trip exactly.
+  // "score":..[,"weak":true]}]} on one line; doubles round-trip exactly.
   std::string ToJsonLine() const;
   // Throws fv::Error naming `context` and the bad key (missing, wrong type, not finite).
   static CameraMessage FromJsonLine(const std::string& line,

@@ -250,9 +250,16 @@ void TriangulationOptions::Check() const {
              "TriangulationOptions.max_candidates_per_camera must be in [1, 64] (got {})",
              max_candidates_per_camera);
   CheckFinite(max_below_ground_m, "TriangulationOptions.max_below_ground_m");
+  CheckPositive(prior_gate_m, "TriangulationOptions.prior_gate_m");
   FV_REQUIRE(max_radius_ratio == 0.0 || max_radius_ratio > 1.0,
              "TriangulationOptions.max_radius_ratio must be 0 (off) or > 1 (got {})",
              max_radius_ratio);
+  FV_REQUIRE(weak_max_radius_ratio == 0.0 || weak_max_radius_ratio > 1.0,
+             "TriangulationOptions.weak_max_radius_ratio must be 0 (off) or > 1 (got {})",
+             weak_max_radius_ratio);
+  FV_REQUIRE(min_views_all_weak == 0 || min_views_all_weak >= 2,
+             "TriangulationOptions.min_views_all_weak must be 0 (never) or >= 2 (got {})",
+             min_views_all_weak);
 }
 
 const char* ToString(TriangulationStatus status) {
@@ -387,13 +394,14 @@ TriangulationResult LocateOnGround(const Camera& camera, int camera_index,
   return result;
 }
 
-TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
-                                      const std::vector<std::vector<BallObservation>>& candidates,
-                                      const TriangulationOptions& o) {
-  o.Check();
-  FV_REQUIRE(candidates.size() == cameras.size(),
-             "TriangulateRobust: {} candidate lists for {} cameras", candidates.size(),
-             cameras.size());
+namespace {
+
+// The robust search. With require_strong, the final set must keep a candidate that is not weak
+// (or have min_views_all_weak views), and there is no single-camera ground mode.
+TriangulationResult RobustCore(const std::vector<Camera>& cameras,
+                               const std::vector<std::vector<BallObservation>>& candidates,
+                               const TriangulationOptions& o, bool require_strong,
+                               const Eigen::Vector3d* prior) {
   const int num_cams = static_cast<int>(cameras.size());
   // The best candidates of each camera, by score.
   std::vector<std::vector<int>> order(num_cams);
@@ -418,7 +426,7 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
   }
   TriangulationResult result;
   if (seen.size() < 2) {
-    if (seen.size() == 1 && o.single_camera_ground) {
+    if (seen.size() == 1 && o.single_camera_ground && !require_strong) {
       const int c = seen[0];
       result = LocateOnGround(cameras[c], c, candidates[c][order[c][0]], o);
       if (!result.views.empty()) result.views[0].candidate = order[c][0];
@@ -440,6 +448,12 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
       const double expected = o.ball_radius_m * std::sqrt(cam.fx * cam.fy) / Depth(cam, p);
       const double ratio = obs.radius_px / expected;
       if (ratio > o.max_radius_ratio || ratio < 1.0 / o.max_radius_ratio) return -1;
+    }
+    if (obs.weak && o.weak_max_radius_ratio > 0 && obs.radius_px > 0 && o.ball_radius_m > 0) {
+      const Camera& cam = cameras[c];
+      const double expected = o.ball_radius_m * std::sqrt(cam.fx * cam.fy) / Depth(cam, p);
+      const double ratio = obs.radius_px / expected;
+      if (ratio > o.weak_max_radius_ratio || ratio < 1.0 / o.weak_max_radius_ratio) return -1;
     }
     return err;
   };
@@ -466,6 +480,15 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
   auto count = [](const std::vector<int>& pick) {
     return static_cast<int>(std::count_if(pick.begin(), pick.end(), [](int k) { return k >= 0; }));
   };
+  // With require_strong: a set keeps a candidate that is not weak, or is all weak but seen by
+  // min_views_all_weak cameras near the prior.
+  auto weak_set_ok = [&](const std::vector<int>& pick, int n, const Eigen::Vector3d& p) {
+    for (int c = 0; c < num_cams; ++c) {
+      if (pick[c] >= 0 && !candidates[c][pick[c]].weak) return true;
+    }
+    return o.min_views_all_weak > 0 && n >= o.min_views_all_weak && prior != nullptr &&
+           (p - *prior).norm() <= o.prior_gate_m;
+  };
   std::vector<int> best_pick;
   int best_n = 0;
   double best_cost = 0, best_score = 0;
@@ -478,6 +501,10 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
         if (!rays[ca][ka]) continue;
         for (int kb : order[cb]) {
           if (!rays[cb][kb]) continue;
+          if (require_strong && o.min_views_all_weak == 0 && candidates[ca][ka].weak &&
+              candidates[cb][kb].weak) {
+            continue;
+          }
           const RayPairResult rp =
               ClosestPointOfRays(*rays[ca][ka], *rays[cb][kb], o.min_angle_deg);
           if (!rp.ok()) continue;
@@ -486,6 +513,7 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
           const double cost = gather(rp.midpoint, &pick);
           if (pick[ca] != ka || pick[cb] != kb) continue;  // the pair itself must agree
           const int n = count(pick);
+          if (require_strong && !weak_set_ok(pick, n, rp.midpoint)) continue;
           double score = 0;
           for (int c : seen) {
             if (pick[c] >= 0) score += candidates[c][pick[c]].score;
@@ -549,8 +577,53 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
     best_pick[worst->camera] = -1;
     result = solve(best_pick);
   }
+  if (result.ok()) {
+    for (const ViewResidual& v : result.views) {
+      result.weak_views += candidates[v.camera][v.candidate].weak;
+    }
+    std::vector<int> used(num_cams, -1);
+    for (const ViewResidual& v : result.views) used[v.camera] = v.candidate;
+    if (require_strong && !weak_set_ok(used, result.num_views(), result.point_world)) {
+      result.status = TriangulationStatus::kNoConsistentSet;
+    }
+  }
   result.hypotheses = hypotheses;
   return result;
+}
+
+}  // namespace
+
+TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
+                                      const std::vector<std::vector<BallObservation>>& candidates,
+                                      const TriangulationOptions& o, const Eigen::Vector3d* prior) {
+  o.Check();
+  FV_REQUIRE(candidates.size() == cameras.size(),
+             "TriangulateRobust: {} candidate lists for {} cameras", candidates.size(),
+             cameras.size());
+  FV_REQUIRE(prior == nullptr || prior->allFinite(), "TriangulateRobust: the prior is not finite");
+  bool any_weak = false;
+  for (const auto& list : candidates) {
+    for (const BallObservation& obs : list) any_weak = any_weak || obs.weak;
+  }
+  if (!any_weak) return RobustCore(cameras, candidates, o, false, nullptr);
+  // The candidates that are not weak first, alone: a weak one never moves what they give.
+  std::vector<std::vector<BallObservation>> strong(candidates.size());
+  std::vector<std::vector<int>> index(candidates.size());
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    for (size_t k = 0; k < candidates[c].size(); ++k) {
+      if (candidates[c][k].weak) continue;
+      strong[c].push_back(candidates[c][k]);
+      index[c].push_back(static_cast<int>(k));
+    }
+  }
+  TriangulationResult result = RobustCore(cameras, strong, o, false, nullptr);
+  for (ViewResidual& v : result.views) {
+    if (v.candidate >= 0) v.candidate = index[v.camera][v.candidate];
+  }
+  if ((result.ok() && !result.on_ground) || !o.use_weak) return result;
+  TriangulationResult with_weak = RobustCore(cameras, candidates, o, true, prior);
+  with_weak.hypotheses += result.hypotheses;
+  return with_weak.ok() ? with_weak : result;
 }
 
 }  // namespace fv

@@ -27,6 +27,10 @@ struct BallObservation {
   double radius_px = 0.0;  // 0 when unknown
   double sigma_px = 1.0;   // 1-sigma uncertainty of the centre
   double score = 1.0;      // detector confidence, higher is better
+  // A candidate that failed a single-view shape check (detect/ball_detector.h): the robust mode
+  // uses it only to complete a set that an accepted candidate of another camera starts, and only
+  // when the accepted candidates alone give no 3D position.
+  bool weak = false;
 };
 
 // ---- Two rays -----------------------------------------------------------------------------
@@ -76,6 +80,16 @@ struct TriangulationOptions {
   double max_radius_ratio = 0.0;
   // Robust mode: with only one camera seeing anything, place the ball on the ground.
   bool single_camera_ground = false;
+  // Robust mode: use weak candidates (BallObservation::weak) when the others give no position.
+  bool use_weak = true;
+  // A weak view whose radius differs from the one predicted from the depth by more than this
+  // factor (either way) is inconsistent (when the detector reports radius_px).
+  double weak_max_radius_ratio = 1.5;
+  // A set of weak views only is kept when at least this many cameras agree (0: never) and the
+  // point lies within prior_gate_m of the prior (the ball's predicted position; no prior, no
+  // such set): a static ball-like object (a cone) seen by every camera is consistent too.
+  int min_views_all_weak = 3;
+  double prior_gate_m = 1.0;
 
   void Check() const;  // throws fv::Error naming the bad field
 };
@@ -108,6 +122,7 @@ struct TriangulationResult {
   double rms_px = 0.0;              // RMS of err_px over `views`
   int iterations = 0;               // Ceres iterations of the final refinement
   int hypotheses = 0;               // robust mode: two-view hypotheses scored
+  int weak_views = 0;               // robust mode: views from weak candidates
   bool ok() const { return status == TriangulationStatus::kOk; }
   int num_views() const { return static_cast<int>(views.size()); }
 };
@@ -132,11 +147,15 @@ TriangulationResult TriangulatePoint(const std::vector<Camera>& cameras,
 
 // Robust mode: candidates[c] are camera c's blobs (any number, possibly none). Scores every
 // two-view hypothesis, keeps the one with the most consistent cameras (then the smallest
-// weighted error), refines it on those views and returns it. Throws fv::Error when
+// weighted error), refines it on those views and returns it. Weak candidates are tried only
+// when the others give no 3D position, in sets with at least one candidate that is not weak or
+// with at least min_views_all_weak cameras. Throws fv::Error when
 // candidates.size() != cameras.size().
+// `prior`: where the ball is expected (e.g. extrapolated from the last frames), or null.
 TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
                                       const std::vector<std::vector<BallObservation>>& candidates,
-                                      const TriangulationOptions& options = {});
+                                      const TriangulationOptions& options = {},
+                                      const Eigen::Vector3d* prior = nullptr);
 
 // One camera, the ball resting on the ground (centre at z = options.ball_radius_m): intersects
 // the ray with that plane and refines x, y. Status kBehindCamera when the ray does not reach the

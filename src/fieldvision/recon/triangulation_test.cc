@@ -326,5 +326,73 @@ TEST(Triangulation, BadInputThrowsNamingIt) {
   EXPECT_THROW(opt.Check(), Error);
 }
 
+// Weak candidates (a ball that failed a single-view shape check) complete a position that an
+// accepted candidate starts, never move one that accepted candidates give, and alone count only
+// when three or more cameras agree near the predicted position (a cone is consistent too).
+TEST(Triangulation, WeakCandidatesOnlyCompleteOrConfirm) {
+  const uint64_t seed = testing::TestSeed(21);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const auto cams = CornerCameras(&rng);
+  TriangulationOptions opt;
+  opt.ball_radius_m = 0.11;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d ball = RandomBall(rng), cone(rng.Uniform(-8, 8), rng.Uniform(-5, 5), 0.2);
+    if ((ball - cone).norm() < 2.0) continue;
+    auto weak = [&](int c, const Eigen::Vector3d& p) {
+      BallObservation o = Observe(cams[c], p, 0.0, 0.3, &rng);
+      o.sigma_px = 0.3;
+      o.weak = true;
+      o.score = 0.9;  // higher than the accepted ones: the score must not decide
+      return o;
+    };
+    auto strong = [&](int c) {
+      BallObservation o = Observe(cams[c], ball, 0.0, 0.3, &rng);
+      o.sigma_px = 0.3;
+      o.score = 0.5;
+      return o;
+    };
+    // Accepted candidates in two cameras, a consistent cone seen weakly by all four: the ball.
+    std::vector<std::vector<BallObservation>> cand(4);
+    for (int c = 0; c < 4; ++c) cand[c].push_back(weak(c, cone));
+    cand[0].push_back(strong(0));
+    cand[2].push_back(strong(2));
+    auto r = TriangulateRobust(cams, cand, opt);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_EQ(r.weak_views, 0);
+    EXPECT_LT((r.point_world - ball).norm(), 0.05);
+    // One accepted view of the ball plus a weak one in another camera: completed.
+    cand.assign(4, {});
+    cand[1] = {strong(1)};
+    cand[3] = {weak(3, ball), weak(3, cone)};
+    r = TriangulateRobust(cams, cand, opt);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_EQ(r.weak_views, 1);
+    EXPECT_EQ(r.num_views(), 2);
+    EXPECT_LT((r.point_world - ball).norm(), 0.05);
+    opt.use_weak = false;
+    EXPECT_FALSE(TriangulateRobust(cams, cand, opt).ok());
+    opt.use_weak = true;
+    // Weak views only: two are never enough; four need a prior near them.
+    cand.assign(4, {});
+    cand[0] = {weak(0, ball)};
+    cand[1] = {weak(1, ball)};
+    EXPECT_FALSE(TriangulateRobust(cams, cand, opt, &ball).ok());
+    for (int c = 0; c < 4; ++c) cand[c] = {weak(c, ball), weak(c, cone)};
+    EXPECT_FALSE(TriangulateRobust(cams, cand, opt).ok());  // no prior
+    const Eigen::Vector3d near_ball = ball + Eigen::Vector3d(0.3, -0.2, 0.1);
+    r = TriangulateRobust(cams, cand, opt, &near_ball);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_EQ(r.weak_views, 4);
+    EXPECT_LT((r.point_world - ball).norm(), 0.05);
+    const Eigen::Vector3d near_cone = cone + Eigen::Vector3d(0.2, 0.2, 0.0);
+    r = TriangulateRobust(cams, cand, opt, &near_cone);
+    ASSERT_TRUE(r.ok());
+    EXPECT_LT((r.point_world - cone).norm(), 0.05);  // what the prior asks for
+    const Eigen::Vector3d far(50, 50, 1);
+    EXPECT_FALSE(TriangulateRobust(cams, cand, opt, &far).ok());
+  }
+}
+
 }  // namespace
 }  // namespace fv
