@@ -79,6 +79,10 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-frames", c->o.max_frames, "Process at most this many frames (0: all)");
   cmd->add_option("--interpolate", c->o.interpolate_max_gap,
                   "Fill track gaps up to this many frames (0: off)");
+  cmd->add_option("--stitch-gap", c->o.stitch.max_gap_s,
+                  "Join tracklets of one person across gaps up to this many seconds (0: off)");
+  cmd->add_option("--stitch-appearance", c->o.stitch.max_appearance_distance,
+                  "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets");
   cmd->add_flag("--teams", c->o.teams,
                 "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
   cmd->add_flag("!--no-progress", c->o.progress, "No progress line");

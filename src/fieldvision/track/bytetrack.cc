@@ -30,6 +30,8 @@ void TrackerOptions::Check() const {
   CheckPositive(reid_speed_mps, "reid_speed_mps");
   CheckPositive(reid_speed_px, "reid_speed_px");
   CheckPositive(fps, "fps");
+  CheckInRange(appearance_weight, 0.0, 1.0, "appearance_weight");
+  CheckInRange(appearance_momentum, 0.0, 1.0, "appearance_momentum");
   CheckInRange(foot_offset_m, 0.0, 1.0, "foot_offset_m");
   FV_REQUIRE(sot == "none" || sot == "csrt" || sot == "kcf" || sot == "mosse",
              "sot '{}' is not one of none, csrt, kcf, mosse", sot);
@@ -183,6 +185,19 @@ std::vector<TrackState> ByteTracker::Update(const std::vector<Detection>& detect
     }
   }
   std::vector<char> det_used(detections.size(), 0);
+  // Torso histograms of the high-score detections (appearance cost), and whether another
+  // detection overlaps each (then its histogram mixes two people and does not update tracks).
+  std::vector<cv::Mat> det_hist(detections.size());
+  std::vector<char> det_clear(detections.size(), 1);
+  for (int i : high) {
+    if (!frame.empty()) det_hist[i] = TorsoHistogram(frame, detections[i].box);
+    for (int j = 0; j < int(detections.size()); ++j) {
+      if (j != i && detections[j].score >= o_.low_score &&
+          (detections[i].box & detections[j].box).area() > 0.1 * detections[i].box.area()) {
+        det_clear[i] = 0;
+      }
+    }
+  }
 
   auto apply = [&](Track& t, int d) {
     t.Correct(detections[d].box);
@@ -192,25 +207,36 @@ std::vector<TrackState> ByteTracker::Update(const std::vector<Detection>& detect
     t.lost_frames = 0;
     t.ResetSot();
     if (camera_) t.field_m = FootOnGround(*camera_, t.box, o_.foot_offset_m);
-    if (detections[d].score >= o_.high_score) {
-      cv::Mat h = TorsoHistogram(frame, detections[d].box);
-      if (!h.empty()) t.hist = t.hist.empty() ? h : 0.9 * t.hist + 0.1 * h;
+    if (!det_hist[d].empty() && (det_clear[d] || t.hist.empty())) {
+      const cv::Mat& h = det_hist[d];
+      t.hist = t.hist.empty() ? h.clone()
+                              : (1 - o_.appearance_momentum) * t.hist + o_.appearance_momentum * h;
     }
     det_used[d] = 1;
   };
 
   // Cost of a track-detection pair; >= 1e9 when not allowed.
-  auto pair_cost = [&](const Track& t, int d, double min_iou, bool use_field) {
+  // Field distance and appearance take part when `full` (the associations of high-score
+  // detections); the low-score stage uses IoU only, as in ByteTrack.
+  auto pair_cost = [&](const Track& t, int d, double min_iou, bool full) {
     const double iou = Iou(t.box, detections[d].box);
-    if (!use_field || !camera_ || !t.field_m || !det_field[d] || o_.field_weight <= 0) {
-      return iou >= min_iou ? 1.0 - iou : 1e9;
+    double motion;
+    if (!full || !camera_ || !t.field_m || !det_field[d] || o_.field_weight <= 0) {
+      if (iou < min_iou) return 1e9;
+      motion = 1.0 - iou;
+    } else {
+      // The gate grows with the time lost by how far a person may have gone, up to 3 gates.
+      const double gate = std::min(3.0 * o_.field_gate_m,
+                                   o_.field_gate_m + o_.reid_speed_mps * t.lost_frames / o_.fps);
+      const double dist = (*t.field_m - *det_field[d]).norm();
+      if (dist > gate || (iou < min_iou && dist > 0.5 * gate)) return 1e9;
+      motion = (1 - o_.field_weight) * (1 - iou) + o_.field_weight * dist / gate;
     }
-    // The gate grows with the time lost by how far a person may have gone, up to 3 gates.
-    const double gate = std::min(3.0 * o_.field_gate_m,
-                                 o_.field_gate_m + o_.reid_speed_mps * t.lost_frames / o_.fps);
-    const double dist = (*t.field_m - *det_field[d]).norm();
-    if (dist > gate || (iou < min_iou && dist > 0.5 * gate)) return 1e9;
-    return (1 - o_.field_weight) * (1 - iou) + o_.field_weight * dist / gate;
+    if (!full || o_.appearance_weight <= 0 || t.hist.empty() || det_hist[d].empty()) {
+      return motion;
+    }
+    const double app = cv::compareHist(t.hist, det_hist[d], cv::HISTCMP_BHATTACHARYYA);
+    return (1 - o_.appearance_weight) * motion + o_.appearance_weight * app;
   };
 
   auto associate = [&](const std::vector<Track*>& ts, const std::vector<int>& ds, double min_iou,

@@ -4,7 +4,10 @@
 // association of high-score detections with tracked and lost tracks, a second association of the
 // low-score detections with the tracks left, both solved with the Hungarian method
 // (hungarian.h). With a calibrated camera the cost mixes box IoU with the distance on the field
-// plane between the predicted and the detected foot points (gated in metres). Lost tracks are kept
+// plane between the predicted and the detected foot points (gated in metres); with frames, the
+// associations of high-score detections also weigh the torso-colour distance between the track's
+// running histogram and the detection's (appearance_weight, as DeepSORT/BoT-SORT do with
+// embeddings; people walking side by side keep their ids). Lost tracks are kept
 // for max_lost_frames and re-found by appearance (an HSV histogram of the torso, Bhattacharyya
 // distance) within a reach that grows with the time lost. Optionally an OpenCV single-target
 // tracker (CSRT, KCF, MOSSE) carries a track through frames where the detector misses it. The
@@ -38,6 +41,12 @@ struct TrackerOptions {
   double reid_speed_mps = 3.0;      // reach of re-finding: metres per second lost (field)
   double reid_speed_px = 12.0;      // same without a calibrated camera: pixels per frame
   double fps = 25.0;                // frame rate of the video (for reach in metres)
+  // First association: share of the torso-colour distance (Bhattacharyya, 0..1, between the
+  // track's running histogram and the detection's) in the cost (0: motion only). Needs frames.
+  double appearance_weight = 0.5;
+  // The track's histogram follows its detections with this weight per frame (exponential moving
+  // average), from confident detections that no other detection overlaps.
+  double appearance_momentum = 0.1;
   // The bottom edge of a box is the near edge of the feet: the person's ground position is this
   // far behind it, away from the camera (synthetic scenes: about 0.2 m).
   double foot_offset_m = 0.2;

@@ -4,6 +4,7 @@
 #include <set>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/error.h"
@@ -61,6 +62,45 @@ TEST(ByteTracker, KeepsIdsThroughCrossingsAndMisses) {
   EXPECT_EQ(m.id_switches, 0) << m.Summary();
   EXPECT_GT(m.idf1, 0.9) << m.Summary();
   EXPECT_GT(m.mota, 0.85) << m.Summary();
+}
+
+// Two people in different shirts walk side by side, so close that their boxes overlap and the
+// noisy detections alone often fit either; the torso colours keep each id on its person.
+TEST(ByteTracker, AppearanceKeepsIdsOfPeopleWalkingSideBySide) {
+  const uint64_t seed = fv::testing::TestSeed(12);
+  FV_SEED_TRACE(seed);
+  const cv::Scalar shirts[2] = {cv::Scalar(30, 30, 200), cv::Scalar(200, 60, 30)};
+  auto run = [&](double appearance_weight) {
+    Rng rng(seed);
+    TrackerOptions o;
+    o.appearance_weight = appearance_weight;
+    ByteTracker tracker(o, nullptr);
+    std::vector<TrackRow> gt, est;
+    for (int f = 0; f < 120; ++f) {
+      cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(90, 120, 90));
+      std::vector<Detection> dets;
+      for (int i = 0; i < 2; ++i) {
+        // They sway towards and away from each other while walking right.
+        const double x = 60 + 3.0 * f + (i == 0 ? 0 : 22) + 6 * std::sin(0.3 * f + 3 * i);
+        const cv::Rect2d box(x, 80, 30, 80);
+        gt.push_back({f, i + 1, box, 1.0, {}, {}});
+        cv::rectangle(frame, cv::Rect(box.x, box.y, 30, 45), shirts[i], cv::FILLED);
+        cv::rectangle(frame, cv::Rect(box.x, box.y + 45, 30, 35), cv::Scalar(40, 40, 40),
+                      cv::FILLED);
+        dets.push_back({cv::Rect2d(x + rng.Normal(0, 5), 80 + rng.Normal(0, 2), 30, 80),
+                        rng.Uniform(0.6, 0.9)});
+      }
+      for (const auto& s : tracker.Update(dets, frame)) {
+        est.push_back({f, s.id, s.box, s.score, {}, {}});
+      }
+    }
+    return EvaluateMot(gt, est, {0.3});
+  };
+  const MotMetrics with = run(0.5);
+  const MotMetrics without = run(0.0);
+  EXPECT_EQ(with.id_switches, 0) << with.Summary();
+  EXPECT_GT(with.idf1, 0.95) << with.Summary();
+  EXPECT_LE(with.id_switches, without.id_switches) << without.Summary();
 }
 
 TEST(ByteTracker, OptionsAreChecked) {

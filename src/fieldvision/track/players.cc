@@ -7,6 +7,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -132,9 +133,159 @@ class FileDetector : public PersonDetector {
 
 }  // namespace
 
+void StitchOptions::Check() const {
+  CheckNonNegative(max_gap_s, "stitch max_gap_s");
+  CheckNonNegative(reach_m, "stitch reach_m");
+  CheckNonNegative(speed_slack_mps, "stitch speed_slack_mps");
+  CheckNonNegative(max_speed_mps, "stitch max_speed_mps");
+  CheckPositive(velocity_window_s, "stitch velocity_window_s");
+  CheckInRange(max_appearance_distance, 0.0, 1.0, "stitch max_appearance_distance");
+  CheckNonNegative(border_px, "stitch border_px");
+  CheckInRange(full_height_ratio, 0.0, 1.0, "stitch full_height_ratio");
+  CheckPositive(person_height_m, "stitch person_height_m");
+}
+
+namespace {
+
+struct Tracklet {
+  int id = 0;
+  std::vector<const TrackRow*> rows;             // by frame
+  Eigen::Vector2d first, last, v_first, v_last;  // metres, metres per second
+  int first_frame = 0, last_frame = 0;           // frames of `first` and `last`
+  bool starts_at_border = false, ends_at_border = false;
+};
+
+}  // namespace
+
+int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppearance>& appearance,
+                    const StitchOptions& o, double fps, cv::Size image) {
+  o.Check();
+  if (o.max_gap_s <= 0 || rows.empty()) return 0;
+  fps = fps > 0 ? fps : 25.0;
+  std::map<int, Tracklet> tl;
+  for (const auto& r : rows) tl[r.id].rows.push_back(&r);
+  bool field = true;
+  for (const auto& r : rows) field = field && r.x_m && r.y_m;
+  double mean_h = 0;
+  for (const auto& r : rows) mean_h += r.box.height;
+  mean_h = std::max(1.0, mean_h / rows.size());
+  // Ground position in metres: the field position, else the foot pixel scaled by the box height.
+  auto pos = [&](const TrackRow& r) -> Eigen::Vector2d {
+    if (field) return {*r.x_m, *r.y_m};
+    const double s = o.person_height_m / std::max(1.0, r.box.height);
+    return {(r.box.x + 0.5 * r.box.width) * s, (r.box.y + r.box.height) * s};
+  };
+  auto at_border = [&](const cv::Rect2d& b) {
+    if (image.empty()) return false;
+    return b.x <= o.border_px || b.y <= o.border_px || b.x + b.width >= image.width - o.border_px ||
+           b.y + b.height >= image.height - o.border_px;
+  };
+  auto clamp_speed = [&](Eigen::Vector2d v) {
+    const double n = v.norm();
+    return n > o.max_speed_mps ? Eigen::Vector2d(v * (o.max_speed_mps / n)) : v;
+  };
+  const int window = std::max(1, static_cast<int>(std::lround(o.velocity_window_s * fps)));
+  for (auto& [id, t] : tl) {
+    t.id = id;
+    std::sort(t.rows.begin(), t.rows.end(),
+              [](const TrackRow* a, const TrackRow* b) { return a->frame < b->frame; });
+    const TrackRow& f = *t.rows.front();
+    const TrackRow& l = *t.rows.back();
+    // Ends: the rows within the velocity window of the first/last row; positions come from
+    // those whose box is not much shorter than the window's median (a shorter box is partly
+    // hidden and its foot point is wrong).
+    auto ends = [&](bool at_end) {
+      std::vector<const TrackRow*> w;
+      for (size_t k = 0; k < t.rows.size(); ++k) {
+        const TrackRow* r = at_end ? t.rows[t.rows.size() - 1 - k] : t.rows[k];
+        if (std::abs(r->frame - (at_end ? l.frame : f.frame)) > window) break;
+        w.push_back(r);  // from the end inwards
+      }
+      std::vector<double> hs;
+      for (const TrackRow* r : w) hs.push_back(r->box.height);
+      std::nth_element(hs.begin(), hs.begin() + hs.size() / 2, hs.end());
+      const double full = o.full_height_ratio * hs[hs.size() / 2];
+      std::vector<const TrackRow*> good;
+      for (const TrackRow* r : w) {
+        if (r->box.height >= full) good.push_back(r);
+      }
+      if (good.empty()) good = w;
+      const TrackRow* anchor = good.front();
+      const TrackRow* other = good.back();
+      Eigen::Vector2d v = Eigen::Vector2d::Zero();
+      if (anchor->frame != other->frame) {
+        v = clamp_speed((pos(*anchor) - pos(*other)) * fps / (anchor->frame - other->frame));
+      }
+      return std::make_pair(anchor, v);
+    };
+    const auto [fa, vf] = ends(false);
+    const auto [la, vl] = ends(true);
+    t.first = pos(*fa);
+    t.first_frame = fa->frame;
+    t.v_first = vf;
+    t.last = pos(*la);
+    t.last_frame = la->frame;
+    t.v_last = vl;
+    t.starts_at_border = at_border(f.box);
+    t.ends_at_border = at_border(l.box);
+  }
+  struct Link {
+    double cost;
+    int a, b;
+  };
+  std::vector<Link> links;
+  for (const auto& [ia, a] : tl) {
+    const int a_end = a.rows.back()->frame;
+    for (const auto& [ib, b] : tl) {
+      if (ia == ib) continue;
+      const int gap = b.rows.front()->frame - a_end;
+      if (gap <= 0 || gap > o.max_gap_s * fps) continue;
+      if (a.ends_at_border && b.starts_at_border) continue;
+      const double gap_s = (b.first_frame - a.last_frame) / fps;
+      const Eigen::Vector2d pa = a.last + 0.5 * gap_s * a.v_last;
+      const Eigen::Vector2d pb = b.first - 0.5 * gap_s * b.v_first;
+      const double limit = o.reach_m + o.speed_slack_mps * gap_s;
+      const double d = (pa - pb).norm();
+      if (d > limit) continue;
+      double app = 1.0;
+      const auto ha = appearance.find(ia), hb = appearance.find(ib);
+      if (ha != appearance.end() && hb != appearance.end() && ha->second.count > 0 &&
+          hb->second.count > 0) {
+        app = cv::compareHist(ha->second.sum / ha->second.count, hb->second.sum / hb->second.count,
+                              cv::HISTCMP_BHATTACHARYYA);
+      }
+      if (app > o.max_appearance_distance) continue;
+      const double cost =
+          d / std::max(1e-9, limit) + app / std::max(1e-9, o.max_appearance_distance);
+      links.push_back({cost, ia, ib});
+    }
+  }
+  std::sort(links.begin(), links.end(), [](const Link& x, const Link& y) {
+    return x.cost != y.cost ? x.cost < y.cost : std::tie(x.a, x.b) < std::tie(y.a, y.b);
+  });
+  std::set<int> has_next, has_prev;
+  std::map<int, int> prev_of;
+  int joins = 0;
+  for (const Link& l : links) {
+    if (has_next.count(l.a) || has_prev.count(l.b)) continue;
+    has_next.insert(l.a);
+    has_prev.insert(l.b);
+    prev_of[l.b] = l.a;
+    ++joins;
+  }
+  if (joins == 0) return 0;
+  auto root = [&](int id) {
+    while (prev_of.count(id)) id = prev_of[id];
+    return id;
+  };
+  for (auto& r : rows) r.id = root(r.id);
+  return joins;
+}
+
 void PlayersOptions::Check() const {
   detector.Check();
   tracker.Check();
+  stitch.Check();
   CheckNonNegative(field_margin_m, "field_margin_m");
   CheckNonNegative(max_frames, "max_frames");
   CheckNonNegative(interpolate_max_gap, "interpolate_max_gap");
@@ -145,12 +296,15 @@ void PlayersOptions::Check() const {
 std::string PlayersResult::Summary() const {
   const double f = std::max(1, frames);
   return fmt::format(
-      "{} frames, {} detections ({}), {} tracks, {} rows ({} interpolated, {} off the ground); "
+      "{} frames, {} detections ({}), {} tracks ({} tracklets joined), {} rows ({} interpolated, "
+      "{} "
+      "off the ground); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
       "{:.1f}, map {:.1f}); tracker: {}",
-      frames, detections, detector, tracks, rows.size(), interpolated, off_ground, times.total_s,
-      frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f, 1000 * times.detect_s / f,
-      1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary());
+      frames, detections, detector, tracks, stitched, rows.size(), interpolated, off_ground,
+      times.total_s, frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f,
+      1000 * times.detect_s / f, 1000 * times.track_s / f, 1000 * times.map_s / f,
+      tracker.Summary());
 }
 
 void CheckCameraMatchesVideo(const Camera& camera, int width, int height,
@@ -249,6 +403,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   }
   Progress progress("players", total, "frames", options.progress);
   std::map<int, std::vector<cv::Vec3f>> torso_colours;
+  std::map<int, TrackAppearance> appearance;
   cv::Mat frame;
   int index = 0;
   while (reader.Next(frame)) {
@@ -258,6 +413,22 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     const std::vector<TrackState> states = tracker.Update(dets, frame);
     const auto t2 = Clock::now();
     result.detections += static_cast<int>(dets.size());
+    // Appearance of each track for stitching: confident boxes that no other box overlaps.
+    if (options.stitch.max_gap_s > 0) {
+      for (const auto& s : states) {
+        if (s.predicted || s.score < options.tracker.high_score) continue;
+        bool clear = true;
+        for (const auto& o : states) {
+          if (o.id != s.id && (o.box & s.box).area() > 0.1 * s.box.area()) clear = false;
+        }
+        if (!clear) continue;
+        const cv::Mat h = TorsoHistogram(frame, s.box);
+        if (h.empty()) continue;
+        TrackAppearance& a = appearance[s.id];
+        a.sum = a.sum.empty() ? h.clone() : a.sum + h;
+        a.count++;
+      }
+    }
     if (!options.detections_out.empty()) saved.frames.push_back(dets);
     for (const auto& s : states) {
       TrackRow r;
@@ -304,6 +475,8 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     std::erase_if(result.rows,
                   [&](const TrackRow& r) { return count[r.id] < options.min_track_frames; });
   }
+  result.stitched =
+      StitchTracklets(result.rows, appearance, options.stitch, result.fps, reader.size());
   result.interpolated =
       InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
                       options.tracker.foot_offset_m);

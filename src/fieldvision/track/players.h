@@ -1,8 +1,10 @@
 // The players pipeline: frames (read in a separate thread) -> person detector (detection.h) ->
 // ByteTrack tracker (bytetrack.h) -> foot points mapped to the ground plane z = 0 through the
-// calibration -> TRACKS.csv rows; then short gaps of a track are filled by linear interpolation
-// (as ByteTrack does for MOTChallenge results) and, optionally, tracks are split into two teams by
-// k-means on their torso colours. Reports the time spent per stage.
+// calibration -> TRACKS.csv rows; then, offline, tracklets of one person broken by an occlusion are
+// joined (StitchTracklets: motion across the gap and torso colour), short gaps of a track are
+// filled by linear interpolation (as ByteTrack does for MOTChallenge results) and, optionally,
+// tracks are split into two teams by k-means on their torso colours. Reports the time spent per
+// stage.
 #pragma once
 
 #include <map>
@@ -18,6 +20,38 @@
 
 namespace fv::track {
 
+// The offline pass that joins tracklets of one person after the tracker: a tracklet A that ends
+// and a tracklet B that starts at most max_gap_s later are joined (B takes A's id) when B's start
+// is where A's motion leads across the gap (A extrapolated forward and B backward by half the gap
+// each, at their end/start velocities, meet within reach_m + speed_slack_mps * gap) and their
+// mean torso colours are alike (Bhattacharyya distance <= max_appearance_distance). Pairs are
+// joined greedily by increasing cost (sum of both distances relative to their limits), each
+// tracklet once on each side. A tracklet that ends at the image border and one that starts at the
+// border are not joined (the person left and someone came in; MOTChallenge gives a new id).
+// Positions are on the field when known, else in pixels scaled to metres by the box height
+// (person_height_m).
+struct StitchOptions {
+  double max_gap_s = 4.0;          // longest gap between tracklets joined (0: off)
+  double reach_m = 1.0;            // distance accepted at a gap of 0 (position noise)
+  double speed_slack_mps = 1.0;    // plus this much per second of gap (velocity error)
+  double max_speed_mps = 3.0;      // end/start velocities are clamped to this speed
+  double velocity_window_s = 1.0;  // velocity from the tracklet's last/first this many seconds
+  double max_appearance_distance = 0.3;  // torso histograms (0: same, 1: disjoint)
+  // Near its ends, a box shorter than this share of the median box height there is taken as
+  // partly hidden: its foot point is not used for the end positions and velocities.
+  double full_height_ratio = 0.85;
+  double border_px = 8;           // closer than this to the image edge counts as at the border
+  double person_height_m = 1.75;  // pixels -> metres without a calibrated camera
+
+  void Check() const;
+};
+
+// Mean appearance of one track: the sum of its torso histograms (TorsoHistogram) and how many.
+struct TrackAppearance {
+  cv::Mat sum;
+  int count = 0;
+};
+
 struct PlayersOptions {
   DetectorOptions detector;
   TrackerOptions tracker;
@@ -26,6 +60,7 @@ struct PlayersOptions {
   int max_frames = 0;            // 0: the whole video
   int interpolate_max_gap = 20;  // fill track gaps up to this many frames (0: off)
   int min_track_frames = 5;      // drop tracks seen in fewer frames (0: keep all)
+  StitchOptions stitch;          // offline joining of tracklets (before gap interpolation)
   bool teams = false;            // assign teams (k-means, k = 2, on torso colour)
   bool progress = true;          // fv::Progress on stderr
   double fps = 0;                // 0: from the video (falls back to 25)
@@ -52,6 +87,7 @@ struct PlayersResult {
   int detections = 0;    // after filtering and NMS, all frames
   int tracks = 0;        // ids in the output
   int interpolated = 0;  // rows added by gap filling
+  int stitched = 0;      // tracklets joined to an earlier one
   int off_ground = 0;    // rows whose foot point does not meet the ground
   TrackerStats tracker;
   StageTimes times;
@@ -66,6 +102,12 @@ void CheckCameraMatchesVideo(const Camera& camera, int width, int height, const 
 // uncalibrated (no pose): then no field positions. `field` (optional) limits detections.
 PlayersResult RunPlayers(const std::string& video, const Camera* camera, const FieldModel* field,
                          const PlayersOptions& options);
+
+// Joins tracklets in `rows` (StitchOptions); `appearance` by id (ids without one are joined on
+// motion alone only if options.max_appearance_distance >= 1); `image` is the frame size (for the
+// border rule; empty: no border rule). Returns the number of joins.
+int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppearance>& appearance,
+                    const StitchOptions& options, double fps, cv::Size image);
 
 // Linear interpolation of gaps (<= max_gap frames) inside each track; returns the rows added.
 int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const Camera* camera,

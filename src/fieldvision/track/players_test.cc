@@ -89,6 +89,53 @@ TEST(Players, InterpolationFillsShortGapsOnly) {
   EXPECT_NEAR(rows[2].box.x, 4.0, 1e-9);
 }
 
+// One person walking in a straight line, tracked as two tracklets with a gap of 10 frames, and
+// a second person in another colour: the tracklets are joined, the other person is not, and gap
+// interpolation then fills the gap exactly.
+TEST(Players, StitchJoinsTrackletsOfOnePersonAndInterpolationFillsTheGap) {
+  auto box_at = [](int f, double x0) { return cv::Rect2d(x0 + 2.0 * f, 200, 30, 80); };
+  std::vector<TrackRow> rows;
+  for (int f = 0; f < 80; ++f) {
+    if (f < 30) rows.push_back({f, 1, box_at(f, 100), 0.9, {}, {}});
+    if (f >= 40) rows.push_back({f, 2, box_at(f, 100), 0.9, {}, {}});
+    // Someone else starts right after the gap near the first person but looks different.
+    if (f >= 32) rows.push_back({f, 3, box_at(f, 150), 0.9, {}, {}});
+  }
+  auto hist = [](int bin) {
+    cv::Mat h = cv::Mat::zeros(16, 8, CV_32F);
+    h.at<float>(bin, 3) = 1.0f;
+    return h;
+  };
+  std::map<int, TrackAppearance> app = {
+      {1, {hist(2), 1}}, {2, {2 * hist(2), 2}}, {3, {hist(10), 1}}};
+  StitchOptions o;
+  const cv::Size image(640, 480);
+  std::vector<TrackRow> stitched = rows;
+  EXPECT_EQ(StitchTracklets(stitched, app, o, 25.0, image), 1);
+  std::set<int> ids;
+  for (const auto& r : stitched) ids.insert(r.id);
+  EXPECT_EQ(ids, (std::set<int>{1, 3}));
+  EXPECT_EQ(InterpolateGaps(stitched, 20, nullptr), 10);
+  for (const auto& r : stitched) {
+    if (r.id != 1) continue;
+    EXPECT_NEAR(r.box.x, box_at(r.frame, 100).x, 1e-9) << r.frame;
+    EXPECT_NEAR(r.box.y, 200, 1e-9);
+  }
+  // The same tracklets too far apart in time, or the first leaving at the image border and the
+  // second coming in there, are not joined.
+  std::vector<TrackRow> far = rows;
+  o.max_gap_s = 0.2;
+  EXPECT_EQ(StitchTracklets(far, app, o, 25.0, image), 0);
+  o = {};
+  std::vector<TrackRow> border;
+  for (int f = 0; f < 30; ++f) border.push_back({f, 1, cv::Rect2d(0, 200, 30, 80), 0.9, {}, {}});
+  for (int f = 40; f < 60; ++f) border.push_back({f, 2, cv::Rect2d(1, 200, 30, 80), 0.9, {}, {}});
+  EXPECT_EQ(StitchTracklets(border, app, o, 25.0, image), 0);
+  EXPECT_EQ(StitchTracklets(border, app, o, 25.0, cv::Size()), 1);
+  o.max_appearance_distance = 2.0;
+  EXPECT_THROW(o.Check(), fv::Error);
+}
+
 #ifdef FV_HAVE_SYNTH
 // The synthetic players scene (people of two teams crossing, running and walking): positions on
 // the field within 0.3 m of the truth and one id per person through the crossings.
