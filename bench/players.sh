@@ -2,7 +2,9 @@
 # Players on real data: the 795-frame PETS 2009 S2.L1 video (768x576) through detection,
 # tracking and field mapping, timed per stage, then MOTA/MOTP/IDF1/HOTA against the PETS
 # annotations. Usage: bench/players.sh [BUILD_DIR] [DETECTORS...]  (default: nanodet).
-# FV_BENCH_FRAMES=N limits the frames (e.g. for the slow hog detector).
+# FV_BENCH_FRAMES=N limits the frames (e.g. for the slow hog detector). The detections are saved
+# to BUILD/bench-players/det_DETECTOR.txt: `fieldvision players ... --detections` on them re-runs
+# the tracker alone in about a second.
 set -euo pipefail
 BUILD="${1:-build}"
 shift || true
@@ -26,7 +28,8 @@ for det in "${DETECTORS[@]}"; do
   # The PETS annotations cover the people in front of the background path (boxes of 52 px and
   # taller); --min-height 45 leaves out the smaller people walking beyond it.
   "$FV" players --camera "$OUT/pets.yaml" --video "$DATA/vtest.avi" --out "$OUT/tracks_$det.csv" \
-    --detector "$det" --max-frames "$FRAMES" --min-height 45 --no-progress
+    --detector "$det" --max-frames "$FRAMES" --min-height 45 --no-progress \
+    --save-detections "$OUT/det_$det.txt"
   end=$(date +%s%N)
   echo "wall time: $(( (end - start) / 1000000 )) ms"
   if [ "$FRAMES" = 0 ]; then
