@@ -5,7 +5,7 @@ set -euo pipefail
 [ "${FV_SKIP_INSTALL:-0}" = 1 ] && exit 0
 PKGS=(
   build-essential cmake ninja-build pkg-config
-  libopencv-dev libopencv-contrib-dev
+  libopencv-dev libopencv-contrib-dev libjpeg62-turbo-dev
   libeigen3-dev libceres-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev

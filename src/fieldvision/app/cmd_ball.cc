@@ -55,6 +55,13 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("--ground", o->job.pipeline.triangulation.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
+  cmd->add_flag("!--whole-frames", o->job.pipeline.track.enabled,
+                "Search every frame whole (no tracking window)");
+  cmd->add_option("--full-scan-every", o->job.pipeline.track.full_scan_every,
+                  "While tracking, search the whole frame at least every N frames")
+      ->capture_default_str();
+  cmd->add_flag("!--no-weak", o->job.pipeline.triangulation.use_weak,
+                "Never use candidates that failed a shape check to complete a position");
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o] {
     if (!o->job.timestamps.empty()) o->job.sync = "time";

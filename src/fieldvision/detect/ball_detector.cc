@@ -174,11 +174,12 @@ bool BallDetector::ExpectedRadius(const Vector2d& uv, double* min_px, double* ma
   return true;
 }
 
-std::vector<BallCandidate> BallDetector::Detect(const cv::Mat& bgr) const {
-  return DetectWithSummary(bgr).candidates;
+std::vector<BallCandidate> BallDetector::Detect(const cv::Mat& bgr, const cv::Rect& region) const {
+  return DetectWithSummary(bgr, region).candidates;
 }
 
-BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
+BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
+                                                    const cv::Rect& region) const {
   FV_REQUIRE(!bgr.empty(), "ball detector: the frame is empty");
   FV_REQUIRE(bgr.type() == CV_8UC3, "ball detector: the frame must be 8-bit BGR (got type {})",
              bgr.type());
@@ -191,12 +192,24 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr) const {
   ScanOptions scan;
   scan.step_px = o.scan_step_px;
   scan.min_samples = o.min_samples;
-  const BlobScanResult blobs = ScanBlobs(bgr, *table_, ball_bit_, scan, field_mask_);
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect roi = region.empty() ? image : region & image;
+  const BlobScanResult blobs = ScanBlobs(bgr, *table_, ball_bit_, scan, field_mask_, roi);
+  // The fit reads up to about two radii beyond a blob: blobs nearer than that to an edge of the
+  // region that is not the image's own edge cannot be fitted from the region's pixels.
+  auto fits_in_region = [&](const Blob& b) {
+    if (roi == image) return true;
+    const int m = static_cast<int>(std::ceil(std::max(b.width_px(), b.height_px()))) + 4;
+    return (roi.x == 0 || b.x_min - m >= roi.x) && (roi.y == 0 || b.y_min - m >= roi.y) &&
+           (roi.x + roi.width == bgr.cols || b.x_max + m < roi.x + roi.width) &&
+           (roi.y + roi.height == bgr.rows || b.y_max + m < roi.y + roi.height);
+  };
   BallDetectionResult result;
   result.blobs = static_cast<int>(blobs.blobs.size());
   result.runs = blobs.runs;
   result.samples = blobs.samples;
   for (const Blob& blob : blobs.blobs) {
+    if (!fits_in_region(blob)) continue;
     BallCandidate cand;
     cand.centre_px = Vector2d(0.5 * (blob.x_min + blob.x_max), 0.5 * (blob.y_min + blob.y_max));
     cand.radius_px = 0.25 * (blob.width_px() + blob.height_px());

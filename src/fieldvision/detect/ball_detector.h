@@ -96,9 +96,11 @@ class BallDetector {
 
   // All candidates found in a BGR frame, best first; accepted ones passed every filter.
   // Thread-safe (const). Throws fv::Error when the frame is empty, not BGR, or not the camera's
-  // size.
-  std::vector<BallCandidate> Detect(const cv::Mat& bgr) const;
-  BallDetectionResult DetectWithSummary(const cv::Mat& bgr) const;
+  // size. `region` (optional): search only there (a window around a tracked ball); pixels
+  // outside it are not read, and blobs too near its inner edges to be fitted are left out.
+  std::vector<BallCandidate> Detect(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
+  BallDetectionResult DetectWithSummary(const cv::Mat& bgr,
+                                        const cv::Rect& region = cv::Rect()) const;
 
   const BallDetectorOptions& options() const { return options_; }
   const ColourTable& table() const { return *table_; }

@@ -60,6 +60,18 @@ TEST(BallDetectorSynth, SubpixelCentreOverTheSizeRange) {
       (d_px < 15 ? err_small : err_large).push_back(e);
       EXPECT_LT(e, 1.0) << "frame " << f << " cam " << k << " r " << t.radius_px;
       EXPECT_NEAR(best->radius_px, t.radius_px, 0.15 * t.radius_px + 0.5);
+      // A window around the ball finds the same centre without reading beyond the window:
+      // everything outside it is painted ball-orange.
+      const int half = std::max(40, static_cast<int>(6 * t.radius_px));
+      const cv::Rect window = cv::Rect(static_cast<int>(t.uv_px.x()) - half,
+                                       static_cast<int>(t.uv_px.y()) - half, 2 * half, 2 * half) &
+                              cv::Rect(0, 0, images[k].cols, images[k].rows);
+      cv::Mat painted(images[k].size(), CV_8UC3, cv::Scalar(0, 110, 255));
+      images[k](window).copyTo(painted(window));
+      const auto in_window = detectors[k]->Detect(painted, window);
+      const BallCandidate* w = BestAccepted(in_window);
+      ASSERT_NE(w, nullptr) << "frame " << f << " cam " << k;
+      EXPECT_EQ(w->centre_px, best->centre_px) << "frame " << f << " cam " << k;
     }
   }
   std::cout << "synth static: " << found << "/" << expected << " balls found, median centre error "

@@ -64,14 +64,24 @@ std::string BlobScanResult::Summary() const {
 }
 
 BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t class_mask,
-                         const ScanOptions& options, const cv::Mat& mask) {
+                         const ScanOptions& options, const cv::Mat& mask, const cv::Rect& region) {
   options.Check();
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "ScanBlobs: expected a BGR 8-bit image");
   FV_REQUIRE(mask.empty() || (mask.type() == CV_8U && mask.size() == bgr.size()),
              "ScanBlobs: mask must be CV_8U of the image size");
+  const cv::Rect roi = region.empty() ? cv::Rect(0, 0, bgr.cols, bgr.rows)
+                                      : region & cv::Rect(0, 0, bgr.cols, bgr.rows);
   const int step = options.step_px;
   const int offset = step / 2;
-  const int n = bgr.cols > offset ? (bgr.cols - offset + step - 1) / step : 0;
+  // The sample grid is that of the whole image (offset + k * step), so a region finds exactly
+  // what the whole-image scan finds there.
+  auto first_at_or_after = [&](int v) { return v <= offset ? 0 : (v - offset + step - 1) / step; };
+  const int i0 = first_at_or_after(roi.x);
+  const int i_end = first_at_or_after(roi.x + roi.width);
+  const int n = std::max(0, i_end - i0);
+  const int xs = offset + i0 * step;
+  const int y0 = offset + first_at_or_after(roi.y) * step;
+  const int y_end = roi.y + roi.height;
   BlobScanResult result;
   std::vector<uint8_t> cls(n + 8, 0);
   std::vector<Run> runs;
@@ -81,21 +91,21 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
   uint64_t mask8;
   std::memset(&mask8, class_mask, sizeof(mask8));
   int prev_begin = 0, prev_end = 0;
-  for (int y = offset; y < bgr.rows; y += step) {
+  for (int y = y0; y < y_end; y += step) {
     const uint8_t* row = bgr.ptr<uint8_t>(y);
     switch (step) {
       case 2:
-        ClassifyRow<2>(row, n, offset, step, table, cls.data());
+        ClassifyRow<2>(row, n, xs, step, table, cls.data());
         break;
       case 4:
-        ClassifyRow<4>(row, n, offset, step, table, cls.data());
+        ClassifyRow<4>(row, n, xs, step, table, cls.data());
         break;
       default:
-        ClassifyRow<0>(row, n, offset, step, table, cls.data());
+        ClassifyRow<0>(row, n, xs, step, table, cls.data());
     }
     if (!mask.empty()) {
       const uint8_t* m = mask.ptr<uint8_t>(y);
-      for (int i = 0; i < n; ++i) cls[i] &= m[offset + i * step] ? 0xFF : 0;
+      for (int i = 0; i < n; ++i) cls[i] &= m[xs + i * step] ? 0xFF : 0;
     }
     result.samples += n;
     // Run-length encoding: skip 8 samples at a time while none has the class.
@@ -114,7 +124,7 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
       }
       int j = i + 1;
       while (j < n && (cls[j] & class_mask)) ++j;
-      runs.push_back({y, offset + i * step, offset + (j - 1) * step});
+      runs.push_back({y, xs + i * step, xs + (j - 1) * step});
       parent.push_back(static_cast<int>(parent.size()));
       i = j;
     }

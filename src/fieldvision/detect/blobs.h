@@ -61,8 +61,10 @@ struct BlobScanResult {
 };
 
 // Scans `bgr` (CV_8UC3) for samples whose class bits intersect `class_mask`. `mask` (optional,
-// CV_8U, same size): samples where it is 0 are ignored.
+// CV_8U, same size): samples where it is 0 are ignored. `region` (optional): only the samples
+// inside it (on the same grid as the whole image), in whole-image coordinates.
 BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t class_mask,
-                         const ScanOptions& options, const cv::Mat& mask = cv::Mat());
+                         const ScanOptions& options, const cv::Mat& mask = cv::Mat(),
+                         const cv::Rect& region = cv::Rect());
 
 }  // namespace fv

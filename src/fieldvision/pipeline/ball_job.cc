@@ -63,6 +63,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
     } else if (o.sync == "time") {
       vo.time = TimeSource::kContainer;
     }
+    vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
     auto src = std::make_unique<VideoFrameSource>(o.videos[c], vo);
     const cv::Size size = src->FrameSize();
     FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
@@ -74,17 +75,17 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
   std::vector<std::shared_ptr<BallDetector>> detectors;
-  std::vector<BallDetectFn> detect_fns;
+  std::vector<BallRegionDetectFn> detect_fns;
   for (int c = 0; c < n; ++c) {
     auto det = std::make_shared<BallDetector>(dopt, &cameras[c], field ? &*field : nullptr);
     detectors.push_back(det);
-    detect_fns.push_back([det](const cv::Mat& bgr) {
+    detect_fns.push_back([det](const cv::Mat& bgr, const cv::Rect& roi) {
       // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
       // position that an accepted candidate of another camera starts).
       constexpr int kMaxWeak = 3;
       std::vector<BallObservation> out;
       int weak = 0;
-      for (const BallCandidate& b : det->Detect(bgr)) {
+      for (const BallCandidate& b : det->Detect(bgr, roi)) {
         if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
         weak += !b.accepted;
         BallObservation obs;
@@ -108,14 +109,15 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   const std::string tmp = o.out + ".part";
   {
     CsvWriter csv(tmp, BallCsvHeader(), 6);
-    result.summary = RunBallPipeline(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
-      if (!f.result.ok()) return;
-      const Eigen::Vector3d& p = f.result.point_world;
-      csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
-          << f.result.rms_px;
-      csv.EndRow();
-      ++result.rows_written;
-    });
+    result.summary =
+        RunBallPipelineTracked(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
+          if (!f.result.ok()) return;
+          const Eigen::Vector3d& p = f.result.point_world;
+          csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
+              << f.result.rms_px;
+          csv.EndRow();
+          ++result.rows_written;
+        });
     csv.Close();
   }
   std::error_code ec;

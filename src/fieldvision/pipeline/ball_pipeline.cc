@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <exception>
 #include <mutex>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "fieldvision/pipeline/jpeg_region.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 
@@ -20,6 +22,7 @@ void BallPipelineOptions::Check() const {
              "BallPipelineOptions.queue_capacity must be in [1, 10000] (got {})", queue_capacity);
   FV_REQUIRE(max_frames >= 0, "BallPipelineOptions.max_frames must be >= 0 (got {})", max_frames);
   triangulation.Check();
+  track.Check();
 }
 
 std::string BallPipelineSummary::ToString() const {
@@ -52,6 +55,13 @@ std::string BallPipelineSummary::ToString() const {
     s += c + 1 < num_cameras ? "," : "";
   }
   s += fmt::format("\n{:.2f} s, {:.1f} frames/s", seconds, fps);
+  long long full = 0, window = 0;
+  for (long long f : full_scans) full += f;
+  for (long long w : window_scans) window += w;
+  if (window > 0) {
+    s += fmt::format(", {} camera frames searched in a window around the ball, {} whole", window,
+                     full);
+  }
   for (const std::string& p : sync.Problems()) s += "\nsync: " + p;
   return s;
 }
@@ -90,11 +100,88 @@ BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame
   return out;
 }
 
+void BallTrackOptions::Check() const {
+  FV_REQUIRE(full_scan_every >= 1, "BallTrackOptions.full_scan_every must be >= 1 (got {})",
+             full_scan_every);
+  FV_REQUIRE(std::isfinite(window_radii) && window_radii >= 2,
+             "BallTrackOptions.window_radii must be >= 2 (got {})", window_radii);
+  FV_REQUIRE(min_window_px >= 8, "BallTrackOptions.min_window_px must be >= 8 (got {})",
+             min_window_px);
+}
+
+namespace {
+
+// Where a camera stage looks next: the window around the ball's predicted image position.
+class ImageTrack {
+ public:
+  explicit ImageTrack(const BallTrackOptions& o) : o_(o) {}
+  // The window for the next frame, or an empty rectangle for the whole frame.
+  cv::Rect Window(const cv::Size& image) const {
+    if (!o_.enabled || !active_ || since_full_ + 1 >= o_.full_scan_every) return {};
+    const Eigen::Vector2d p = centre_ + velocity_;
+    const double half =
+        std::max<double>(o_.min_window_px, o_.window_radii * radius_ + velocity_.norm());
+    const int x0 = static_cast<int>(std::floor(p.x() - half));
+    const int y0 = static_cast<int>(std::floor(p.y() - half));
+    const int x1 = static_cast<int>(std::ceil(p.x() + half));
+    const int y1 = static_cast<int>(std::ceil(p.y() + half));
+    const cv::Rect r = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(cv::Point(0, 0), image);
+    return r.area() > 0 ? r : cv::Rect();
+  }
+  void Update(const std::vector<BallObservation>& obs, bool full) {
+    since_full_ = full ? 0 : since_full_ + 1;
+    const BallObservation* best = nullptr;
+    for (const BallObservation& b : obs) {
+      if (!b.weak && (best == nullptr || b.score > best->score)) best = &b;
+    }
+    if (best == nullptr) {
+      active_ = false;
+      return;
+    }
+    velocity_ = active_ ? Eigen::Vector2d(best->centre_px - centre_) : Eigen::Vector2d::Zero();
+    centre_ = best->centre_px;
+    radius_ = std::max(best->radius_px, 2.0);
+    active_ = true;
+  }
+
+ private:
+  BallTrackOptions o_;
+  bool active_ = false;
+  int since_full_ = 0;
+  Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
+  double radius_ = 0.0;
+};
+
+bool HasAccepted(const std::vector<BallObservation>& obs) {
+  return std::any_of(obs.begin(), obs.end(), [](const BallObservation& o) { return !o.weak; });
+}
+
+}  // namespace
+
 BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
                                     std::vector<std::unique_ptr<FrameSource>>& sources,
                                     const std::vector<BallDetectFn>& detectors,
                                     const BallPipelineOptions& options,
                                     const std::function<void(const BallFrame&)>& on_frame) {
+  std::vector<BallRegionDetectFn> region_fns;
+  for (const BallDetectFn& fn : detectors) {
+    if (!fn) {
+      region_fns.emplace_back();
+      continue;
+    }
+    region_fns.push_back([fn](const cv::Mat& bgr, const cv::Rect&) { return fn(bgr); });
+  }
+  BallPipelineOptions o = options;
+  o.track.enabled = false;  // these detectors search whole frames
+  return RunBallPipelineTracked(cameras, sources, region_fns, o, on_frame);
+}
+
+BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
+                                           std::vector<std::unique_ptr<FrameSource>>& sources,
+                                           const std::vector<BallRegionDetectFn>& detectors,
+                                           const BallPipelineOptions& options,
+                                           const std::function<void(const BallFrame&)>& on_frame) {
   options.Check();
   const int n = static_cast<int>(cameras.size());
   FV_REQUIRE(n >= 1, "ball pipeline: no cameras");
@@ -119,6 +206,8 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
   summary.used_per_camera.assign(n, 0);
   summary.candidates_per_camera.assign(n, 0);
   summary.queue_drops.assign(n, 0);
+  summary.full_scans.assign(n, 0);
+  summary.window_scans.assign(n, 0);
 
   std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>> queues;
   for (int c = 0; c < n; ++c) {
@@ -145,16 +234,45 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
   for (int c = 0; c < n; ++c) {
     threads.emplace_back([&, c] {
       try {
-        cv::Mat bgr;
+        SourceFrame in;
+        cv::Mat decoded;  // encoded frames are decoded here, in full or a window
+        JpegRegionDecoder decoder;
+        ImageTrack track(options.track);
+        const cv::Size size(cameras[c].width, cameras[c].height);
         CameraMessage m;
         m.camera = c;
         long long count = 0;
         while (!stop && (options.max_frames == 0 || count < options.max_frames) &&
-               sources[c]->Read(&bgr, &m.frame, &m.time_s)) {
-          FV_REQUIRE(bgr.cols == cameras[c].width && bgr.rows == cameras[c].height,
-                     "video '{}' frame {} is {}x{}, camera {} is {}x{}", sources[c]->name(),
-                     m.frame, bgr.cols, bgr.rows, c, cameras[c].width, cameras[c].height);
-          m.candidates = detectors[c](bgr);
+               sources[c]->ReadFrame(&in)) {
+          m.frame = in.frame;
+          m.time_s = in.time_s;
+          const bool encoded = !in.jpeg.empty();
+          auto image = [&](const cv::Rect& roi) -> const cv::Mat& {
+            if (!encoded) return in.bgr;
+            decoder.Decode(in.jpeg.data(), in.jpeg.size(), roi, &decoded,
+                           fmt::format("video '{}' frame {}", sources[c]->name(), in.frame));
+            return decoded;
+          };
+          const cv::Size got =
+              encoded ? JpegRegionDecoder::ReadSize(
+                            in.jpeg.data(), in.jpeg.size(),
+                            fmt::format("video '{}' frame {}", sources[c]->name(), in.frame))
+                      : in.bgr.size();
+          FV_REQUIRE(got == size, "video '{}' frame {} is {}x{}, camera {} is {}x{}",
+                     sources[c]->name(), m.frame, got.width, got.height, c, size.width,
+                     size.height);
+          const cv::Rect window = track.Window(size);
+          bool full = window.empty();
+          if (!full) {
+            m.candidates = detectors[c](image(window), window);
+            ++summary.window_scans[c];
+            full = !HasAccepted(m.candidates);
+          }
+          if (full) {
+            m.candidates = detectors[c](image(cv::Rect()), cv::Rect());
+            ++summary.full_scans[c];
+          }
+          track.Update(m.candidates, full);
           ++count;
           if (!queues[c]->Push(m)) break;
         }

@@ -22,12 +22,29 @@ namespace fv {
 // A camera stage's detector: the ball candidates of one BGR frame, best first. Called from that
 // camera's thread only.
 using BallDetectFn = std::function<std::vector<BallObservation>(const cv::Mat& bgr)>;
+// A detector that can search a region only (roi empty: the whole frame). Pixels of `bgr` outside
+// roi may be stale and must not be read. Weak candidates are never tracked.
+using BallRegionDetectFn =
+    std::function<std::vector<BallObservation>(const cv::Mat& bgr, const cv::Rect& roi)>;
+
+// Ball tracking in each camera stage: search a window around where the ball was last seen
+// (constant velocity in the image), decoding only that part of Motion-JPEG frames; the whole
+// frame when the window has no accepted candidate, when the ball was not seen in the previous
+// frame, and at least every full_scan_every frames (a second ball-like object, a wrong lock).
+struct BallTrackOptions {
+  bool enabled = true;
+  int full_scan_every = 10;
+  double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
+  int min_window_px = 40;     // half-size of the window at least
+  void Check() const;         // throws fv::Error naming the bad field
+};
 
 struct BallPipelineOptions {
   SyncOptions sync;
   int queue_capacity = 3;                          // messages per camera queue (the seed's 3)
   QueuePolicy queue_policy = QueuePolicy::kBlock;  // kDropOldest for live input
   TriangulationOptions triangulation;
+  BallTrackOptions track;    // used with BallRegionDetectFn detectors
   long long max_frames = 0;  // stop each camera after this many frames; 0: all
   bool progress = true;      // frames, fps and time left on stderr
   void Check() const;        // throws fv::Error naming the bad field
@@ -55,6 +72,8 @@ struct BallPipelineSummary {
   std::vector<long long> used_per_camera;        // positions each camera contributed to
   std::vector<long long> candidates_per_camera;  // candidates each camera reported
   std::vector<size_t> queue_drops;               // messages dropped by the queues
+  std::vector<long long> full_scans;             // frames searched whole, per camera
+  std::vector<long long> window_scans;           // frames searched in a window, per camera
   SyncReport sync;
   double seconds = 0.0;
   double fps = 0.0;              // synchronised frames per second of wall time
@@ -70,6 +89,13 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
                                     const std::vector<BallDetectFn>& detectors,
                                     const BallPipelineOptions& options,
                                     const std::function<void(const BallFrame&)>& on_frame);
+// The same with detectors that can search a window (options.track): each camera stage tracks
+// the ball and decodes encoded frames (SourceFrame::jpeg) only where it looks.
+BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
+                                           std::vector<std::unique_ptr<FrameSource>>& sources,
+                                           const std::vector<BallRegionDetectFn>& detectors,
+                                           const BallPipelineOptions& options,
+                                           const std::function<void(const BallFrame&)>& on_frame);
 
 // The fusion of one synchronised frame (what the fusion stage does per frame).
 BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,

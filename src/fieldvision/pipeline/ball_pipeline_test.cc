@@ -113,6 +113,54 @@ TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
   EXPECT_NE(summary.ToString().find("camera 2: ended at frame 23"), std::string::npos);
 }
 
+// Each camera stage tracks the ball: MJPG frames are decoded only in a window around it (and
+// whole every few frames or when the window has no ball); the positions are those of the
+// whole-frame run.
+TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
+  const std::string dir = testing::TempDir();
+  const Scene s = MakeScene(dir, {40, 40, 40}, {0, 0, 0});
+  BallPipelineOptions opt;
+  opt.progress = false;
+  std::vector<FrameSourceOptions> vo(3);
+  for (auto& v : vo) v.encoded = true;
+  auto whole_sources = Open(s, vo);  // decoded whole (track.enabled is off here)
+  std::vector<BallFrame> whole;
+  RunBallPipeline(s.cams, whole_sources, {Centroid, Centroid, Centroid}, opt,
+                  [&](const BallFrame& f) { whole.push_back(f); });
+  auto sources = Open(s, vo);
+  for (const auto& src : sources) {
+    EXPECT_TRUE(dynamic_cast<const VideoFrameSource&>(*src).encoded());
+  }
+  int calls_with_window = 0;
+  auto in_window = [&](const cv::Mat& bgr, const cv::Rect& roi) {
+    if (roi.empty()) return Centroid(bgr);
+    ++calls_with_window;
+    auto obs = Centroid(bgr(roi));
+    for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
+    return obs;
+  };
+  std::vector<BallFrame> tracked;
+  opt.track.full_scan_every = 8;
+  const auto summary =
+      RunBallPipelineTracked(s.cams, sources, {in_window, in_window, in_window}, opt,
+                             [&](const BallFrame& f) { tracked.push_back(f); });
+  ASSERT_EQ(tracked.size(), whole.size());
+  long long windows = 0, fulls = 0;
+  for (int c = 0; c < 3; ++c) {
+    windows += summary.window_scans[c];
+    fulls += summary.full_scans[c];
+  }
+  EXPECT_EQ(windows, calls_with_window);
+  EXPECT_GE(windows, 3 * 40 * 6 / 8);  // 7 of every 8 frames after the first
+  EXPECT_EQ(windows + fulls, 3 * 40 + 0);
+  for (size_t i = 0; i < tracked.size(); ++i) {
+    ASSERT_TRUE(tracked[i].result.ok()) << i;
+    ASSERT_TRUE(whole[i].result.ok()) << i;
+    EXPECT_LT((tracked[i].result.point_world - whole[i].result.point_world).norm(), 1e-9) << i;
+    EXPECT_LT((tracked[i].result.point_world - BallAt(tracked[i].time_s)).norm(), 0.03) << i;
+  }
+}
+
 TEST(BallPipeline, UnsynchronizedVideosPairedByTimestampCsv) {
   const std::string dir = testing::TempDir();
   // Camera 2 started 3 frames late: by index the frames would be paired wrongly.

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/util/csv.h"
@@ -44,9 +45,71 @@ VideoFrameSource::VideoFrameSource(const std::string& path, const FrameSourceOpt
       FV_REQUIRE(times_.emplace(f, ts).second, "{}: frame {} listed twice", t.Where(r), f);
     }
   }
+  // Motion JPEG through FFmpeg: the packets themselves are the JPEG frames.
+  const int fourcc = static_cast<int>(capture_.get(cv::CAP_PROP_FOURCC));
+  if (options.encoded && !pattern && fourcc == cv::VideoWriter::fourcc('M', 'J', 'P', 'G') &&
+      capture_.getBackendName() == "FFMPEG") {
+    encoded_ = capture_.set(cv::CAP_PROP_FORMAT, -1);
+  }
+  if (encoded_) {
+    has_pending_ = GrabFrame(&pending_frame_);
+    FV_REQUIRE(has_pending_, "video '{}' has no readable frame", path);
+    size_ = JpegRegionDecoder::ReadSize(pending_frame_.jpeg.data(), pending_frame_.jpeg.size(),
+                                        fmt::format("video '{}' frame 0", path));
+    return;
+  }
   has_pending_ = Grab(&pending_, &pending_time_s_);
   FV_REQUIRE(has_pending_, "video '{}' has no readable frame", path);
   size_ = pending_.size();
+}
+
+bool VideoFrameSource::GrabFrame(SourceFrame* out) {
+  cv::Mat packet;
+  bool ok = false;
+  try {
+    ok = capture_.read(packet);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok || packet.empty()) return false;
+  const auto* p = packet.ptr<uint8_t>();
+  out->jpeg.assign(p, p + packet.total() * packet.elemSize());
+  out->bgr = cv::Mat();
+  out->time_s = TimeOf(next_frame_);
+  return true;
+}
+
+bool VideoFrameSource::ReadFrame(SourceFrame* out) {
+  if (!encoded_) {
+    out->jpeg.clear();
+    return Read(&out->bgr, &out->frame, &out->time_s);
+  }
+  if (has_pending_) {
+    std::swap(*out, pending_frame_);
+    has_pending_ = false;
+  } else if (!GrabFrame(out)) {
+    return false;
+  }
+  out->frame = next_frame_++;
+  return true;
+}
+
+double VideoFrameSource::TimeOf(long long f) {
+  switch (options_.time) {
+    case TimeSource::kFrameRate:
+      return f / fps_;
+    case TimeSource::kContainer: {
+      const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+      return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
+    }
+    case TimeSource::kCsv: {
+      const auto it = times_.find(f);
+      FV_REQUIRE(it != times_.end(), "timestamps '{}' have no row for frame {} of video '{}'",
+                 options_.timestamps_csv, f, path_);
+      return it->second;
+    }
+  }
+  return f / fps_;
 }
 
 bool VideoFrameSource::Grab(cv::Mat* bgr, double* time_s) {
@@ -58,28 +121,20 @@ bool VideoFrameSource::Grab(cv::Mat* bgr, double* time_s) {
   }
   if (!ok || bgr->empty()) return false;
   if (bgr->channels() == 1) cv::cvtColor(*bgr, *bgr, cv::COLOR_GRAY2BGR);
-  const long long f = next_frame_;
-  switch (options_.time) {
-    case TimeSource::kFrameRate:
-      *time_s = f / fps_;
-      break;
-    case TimeSource::kContainer: {
-      const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
-      *time_s = std::isfinite(ms) ? ms / 1000.0 : f / fps_;
-      break;
-    }
-    case TimeSource::kCsv: {
-      const auto it = times_.find(f);
-      FV_REQUIRE(it != times_.end(), "timestamps '{}' have no row for frame {} of video '{}'",
-                 options_.timestamps_csv, f, path_);
-      *time_s = it->second;
-      break;
-    }
-  }
+  *time_s = TimeOf(next_frame_);
   return true;
 }
 
 bool VideoFrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
+  if (encoded_) {
+    SourceFrame f;
+    if (!ReadFrame(&f)) return false;
+    decoder_.Decode(f.jpeg.data(), f.jpeg.size(), cv::Rect(), bgr,
+                    fmt::format("video '{}' frame {}", path_, f.frame));
+    *frame = f.frame;
+    *time_s = f.time_s;
+    return true;
+  }
   if (has_pending_) {
     *bgr = pending_;
     *time_s = pending_time_s_;
