@@ -16,11 +16,25 @@ for y in "$SCENE"/*.yaml; do
   args+=(--camera "$y" --video "${y%.yaml}.avi")
 done
 frames=$(($(wc -l <"$SCENE/truth.csv") - 1))
-start=$(date +%s.%N)
-"$FV" ball "${args[@]}" --out "$SCENE/ball.csv" --no-progress >"$SCENE/ball.log"
-end=$(date +%s.%N)
-awk -v s="$start" -v e="$end" -v n="$frames" -v cams="${#args[@]}" 'BEGIN {
-  wall = e - s; video = n / 60.0;
-  printf "ball pipeline: %d cameras x %d frames (%.2f s of 60 fps video) in %.2f s wall = %.1f frames/s, %.2fx real time\n",
-         cams / 4, n, video, wall, n / wall, video / wall }'
-"$FV" eval ball --truth "$SCENE/truth.csv" --est "$SCENE/ball.csv" | tail -2
+# One run per mode: the default (each camera tracks the ball and decodes MJPG only around it)
+# and the baseline that searches and decodes every frame whole; ratios against the baseline.
+run() {  # mode-name extra-args...
+  local name="$1"
+  shift
+  local start end
+  start=$(date +%s.%N)
+  /usr/bin/time -f "%U %S" -o "$SCENE/time_$name.txt" \
+    "$FV" ball "${args[@]}" "$@" --out "$SCENE/ball_$name.csv" --no-progress >"$SCENE/ball_$name.log"
+  end=$(date +%s.%N)
+  awk -v s="$start" -v e="$end" -v n="$frames" -v cams="$((${#args[@]} / 4))" -v name="$name" \
+    -v cpu="$(awk '{print $1 + $2}' "$SCENE/time_$name.txt")" 'BEGIN {
+    wall = e - s; video = n / 60.0;
+    printf "ball pipeline (%s): %d cameras x %d frames (%.2f s of 60 fps video) in %.2f s wall, %.2f s CPU = %.1f frames/s, %.2fx real time\n",
+           name, cams, n, video, wall, cpu, n / wall, video / wall }'
+  awk -v s="$start" -v e="$end" 'BEGIN { print e - s }' >"$SCENE/wall_$name.txt"
+  "$FV" eval ball --truth "$SCENE/truth.csv" --est "$SCENE/ball_$name.csv" | tail -2
+}
+run whole --whole-frames
+run tracked
+awk -v w="$(cat "$SCENE/wall_whole.txt")" -v t="$(cat "$SCENE/wall_tracked.txt")" \
+  'BEGIN { printf "tracked vs whole frames: %.2fx faster (wall)\n", w / t }'
