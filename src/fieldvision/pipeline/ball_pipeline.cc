@@ -63,6 +63,12 @@ std::string BallPipelineSummary::ToString() const {
                      full);
   }
   for (const std::string& p : sync.Problems()) s += "\nsync: " + p;
+  for (int c = 0; c < num_cameras && c < static_cast<int>(bad_frames.size()); ++c) {
+    if (bad_frames[c] > 0) {
+      s += fmt::format("\n{}: {} frames could not be decoded (first: {})", camera_names[c],
+                       bad_frames[c], first_bad_frame[c]);
+    }
+  }
   return s;
 }
 
@@ -207,6 +213,8 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   summary.candidates_per_camera.assign(n, 0);
   summary.queue_drops.assign(n, 0);
   summary.full_scans.assign(n, 0);
+  summary.bad_frames.assign(n, 0);
+  summary.first_bad_frame.assign(n, "");
   summary.window_scans.assign(n, 0);
 
   std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>> queues;
@@ -253,24 +261,42 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
                            fmt::format("video '{}' frame {}", sources[c]->name(), in.frame));
             return decoded;
           };
-          const cv::Size got =
-              encoded ? JpegRegionDecoder::ReadSize(
-                            in.jpeg.data(), in.jpeg.size(),
-                            fmt::format("video '{}' frame {}", sources[c]->name(), in.frame))
-                      : in.bgr.size();
+          cv::Size got = in.bgr.size();
+          if (encoded) {
+            // A damaged frame is reported and sent without candidates; the video goes on.
+            try {
+              got = JpegRegionDecoder::ReadSize(
+                  in.jpeg.data(), in.jpeg.size(),
+                  fmt::format("video '{}' frame {}", sources[c]->name(), in.frame));
+            } catch (const Error& e) {
+              if (summary.bad_frames[c]++ == 0) summary.first_bad_frame[c] = e.what();
+              m.candidates.clear();
+              track.Update(m.candidates, true);
+              ++count;
+              if (!queues[c]->Push(m)) break;
+              continue;
+            }
+          }
           FV_REQUIRE(got == size, "video '{}' frame {} is {}x{}, camera {} is {}x{}",
                      sources[c]->name(), m.frame, got.width, got.height, c, size.width,
                      size.height);
           const cv::Rect window = track.Window(size);
           bool full = window.empty();
-          if (!full) {
-            m.candidates = detectors[c](image(window), window);
-            ++summary.window_scans[c];
-            full = !HasAccepted(m.candidates);
-          }
-          if (full) {
-            m.candidates = detectors[c](image(cv::Rect()), cv::Rect());
-            ++summary.full_scans[c];
+          try {
+            if (!full) {
+              m.candidates = detectors[c](image(window), window);
+              ++summary.window_scans[c];
+              full = !HasAccepted(m.candidates);
+            }
+            if (full) {
+              m.candidates = detectors[c](image(cv::Rect()), cv::Rect());
+              ++summary.full_scans[c];
+            }
+          } catch (const Error& e) {
+            if (!encoded) throw;
+            if (summary.bad_frames[c]++ == 0) summary.first_bad_frame[c] = e.what();
+            m.candidates.clear();
+            full = true;
           }
           track.Update(m.candidates, full);
           ++count;

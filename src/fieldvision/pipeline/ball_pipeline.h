@@ -74,6 +74,8 @@ struct BallPipelineSummary {
   std::vector<size_t> queue_drops;               // messages dropped by the queues
   std::vector<long long> full_scans;             // frames searched whole, per camera
   std::vector<long long> window_scans;           // frames searched in a window, per camera
+  std::vector<long long> bad_frames;             // encoded frames that could not be decoded
+  std::vector<std::string> first_bad_frame;      // the error of the first of them
   SyncReport sync;
   double seconds = 0.0;
   double fps = 0.0;              // synchronised frames per second of wall time

@@ -161,6 +161,49 @@ TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
   }
 }
 
+// A damaged frame in one MJPG video is reported and skipped; the other cameras carry on.
+TEST(BallPipeline, DamagedMjpgFrameIsReportedNotFatal) {
+  const std::string dir = testing::TempDir();
+  const Scene s = MakeScene(dir, {20, 20, 20}, {0, 0, 0});
+  {
+    // Overwrite the header of cam1's frame 5 (the 6th JPEG start in the file) with zeros.
+    std::fstream f(s.videos[1], std::ios::in | std::ios::out | std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    size_t pos = 0;
+    for (int k = 0; k <= 5; ++k) {
+      pos = bytes.find("\xFF\xD8\xFF", k == 0 ? 0 : pos + 3);
+      ASSERT_NE(pos, std::string::npos);
+    }
+    f.seekp(static_cast<std::streamoff>(pos + 2));
+    const std::string zeros(64, '\0');
+    f.write(zeros.data(), static_cast<std::streamsize>(zeros.size()));
+  }
+  std::vector<FrameSourceOptions> vo(3);
+  for (auto& v : vo) v.encoded = true;
+  auto sources = Open(s, vo);
+  auto in_window = [](const cv::Mat& bgr, const cv::Rect& roi) {
+    if (roi.empty()) return Centroid(bgr);
+    auto obs = Centroid(bgr(roi));
+    for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
+    return obs;
+  };
+  BallPipelineOptions opt;
+  opt.progress = false;
+  std::vector<BallFrame> frames;
+  const auto summary =
+      RunBallPipelineTracked(s.cams, sources, {in_window, in_window, in_window}, opt,
+                             [&](const BallFrame& f) { frames.push_back(f); });
+  ASSERT_EQ(frames.size(), 20u);
+  EXPECT_EQ(summary.bad_frames[1], 1);
+  EXPECT_NE(summary.first_bad_frame[1].find("cam1.avi' frame 5"), std::string::npos)
+      << summary.first_bad_frame[1];
+  EXPECT_NE(summary.ToString().find("1 frames could not be decoded"), std::string::npos);
+  for (const BallFrame& f : frames) {
+    ASSERT_TRUE(f.result.ok()) << f.frame;
+    EXPECT_EQ(f.result.num_views(), f.frame == 5 ? 2 : 3) << f.frame;
+  }
+}
+
 TEST(BallPipeline, UnsynchronizedVideosPairedByTimestampCsv) {
   const std::string dir = testing::TempDir();
   // Camera 2 started 3 frames late: by index the frames would be paired wrongly.
