@@ -88,6 +88,9 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
                     const BallFitOptions& o) {
   constexpr double kStep = 0.25, kSide = 1.5;
   Edges e;
+  // A degenerate reference (an ellipse or cone fit gone wild) gives no outline points.
+  const double max_r = std::max(img.cols, img.rows);
+  if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;
   e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), 24, 180);
   std::vector<Vector3d> prof;
   std::vector<double> grad;
@@ -95,6 +98,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     const double th = 2 * M_PI * (k + 0.5) / e.rays;
     const Vector2d u(std::cos(th), std::sin(th));
     const double r = ref(th);
+    if (!std::isfinite(r) || r <= 0 || r > max_r) continue;
     const double half = std::max(2.0, 0.25 * r);
     const double t_lo = std::max(r - half, 0.5 * r), t_hi = r + half;
     const double t0 = std::min(0.35 * r, std::max(t_lo - kSide - kStep, 0.0));

@@ -33,7 +33,7 @@ using BallRegionDetectFn =
 // frame, and at least every full_scan_every frames (a second ball-like object, a wrong lock).
 struct BallTrackOptions {
   bool enabled = true;
-  int full_scan_every = 10;
+  int full_scan_every = 20;
   double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
   int min_window_px = 40;     // half-size of the window at least
   void Check() const;         // throws fv::Error naming the bad field
