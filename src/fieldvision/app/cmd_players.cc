@@ -83,6 +83,11 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Join tracklets of one person across gaps up to this many seconds (0: off)");
   cmd->add_option("--stitch-appearance", c->o.stitch.max_appearance_distance,
                   "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets");
+  cmd->add_option("--smooth-accel", c->o.smooth.accel_sigma_mps2,
+                  "Field-position smoothing (Kalman + RTS): players' acceleration sigma in m/s^2 "
+                  "(smaller: smoother)")
+      ->capture_default_str();
+  cmd->add_flag("!--no-smooth", c->o.smooth.enabled, "Do not smooth the field positions");
   cmd->add_flag("--teams", c->o.teams,
                 "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
   cmd->add_flag("!--no-progress", c->o.progress, "No progress line");

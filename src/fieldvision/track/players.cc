@@ -286,6 +286,7 @@ void PlayersOptions::Check() const {
   detector.Check();
   tracker.Check();
   stitch.Check();
+  smooth.Check();
   CheckNonNegative(field_margin_m, "field_margin_m");
   CheckNonNegative(max_frames, "max_frames");
   CheckNonNegative(interpolate_max_gap, "interpolate_max_gap");
@@ -300,11 +301,11 @@ std::string PlayersResult::Summary() const {
       "{} "
       "off the ground); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
-      "{:.1f}, map {:.1f}); tracker: {}",
+      "{:.1f}, map {:.1f}); tracker: {}{}",
       frames, detections, detector, tracks, stitched, rows.size(), interpolated, off_ground,
       times.total_s, frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f,
       1000 * times.detect_s / f, 1000 * times.track_s / f, 1000 * times.map_s / f,
-      tracker.Summary());
+      tracker.Summary(), smoothing.tracks > 0 ? "; " + smoothing.Summary() : "");
 }
 
 void CheckCameraMatchesVideo(const Camera& camera, int width, int height,
@@ -480,6 +481,13 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   result.interpolated =
       InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
                       options.tracker.foot_offset_m);
+  if (calibrated) {
+    // Rows with a detection are measurements; carried and interpolated ones (conf 0) are not.
+    std::vector<bool> measured(result.rows.size());
+    for (size_t i = 0; i < result.rows.size(); ++i) measured[i] = result.rows[i].conf > 0;
+    result.smoothing =
+        SmoothGroundTracks(result.rows, measured, *camera, result.fps, options.smooth);
+  }
   std::set<int> ids;
   for (const auto& r : result.rows) ids.insert(r.id);
   result.tracks = static_cast<int>(ids.size());

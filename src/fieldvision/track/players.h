@@ -16,6 +16,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/track/bytetrack.h"
 #include "fieldvision/track/detection.h"
+#include "fieldvision/track/ground_smoother.h"
 #include "fieldvision/track/mot.h"
 
 namespace fv::track {
@@ -61,6 +62,7 @@ struct PlayersOptions {
   int interpolate_max_gap = 20;  // fill track gaps up to this many frames (0: off)
   int min_track_frames = 5;      // drop tracks seen in fewer frames (0: keep all)
   StitchOptions stitch;          // offline joining of tracklets (before gap interpolation)
+  GroundSmoothOptions smooth;    // offline smoothing of field positions (calibrated camera)
   bool teams = false;            // assign teams (k-means, k = 2, on torso colour)
   bool progress = true;          // fv::Progress on stderr
   double fps = 0;                // 0: from the video (falls back to 25)
@@ -89,6 +91,7 @@ struct PlayersResult {
   int interpolated = 0;  // rows added by gap filling
   int stitched = 0;      // tracklets joined to an earlier one
   int off_ground = 0;    // rows whose foot point does not meet the ground
+  GroundSmoothResult smoothing;
   TrackerStats tracker;
   StageTimes times;
   std::string detector;
