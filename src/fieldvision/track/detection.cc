@@ -32,6 +32,7 @@ void DetectorOptions::Check() const {
   CheckNonNegative(threads, "threads");
   CheckInRange(hog_upscale, 0.25, 4.0, "hog_upscale");
   CheckFinite(hog_hit_threshold, "hog_hit_threshold");
+  CheckFinite(hog_margin_at_half, "hog_margin_at_half");
   CheckPositive(motion_history, "motion_history");
   CheckPositive(motion_var_threshold, "motion_var_threshold");
   CheckInRange(motion_min_fill, 0.0, 1.0, "motion_min_fill");
@@ -246,7 +247,7 @@ class HogDetector : public PersonDetector {
       const cv::Rect2d r(rects[i].x * s, rects[i].y * s, rects[i].width * s, rects[i].height * s);
       const cv::Rect2d person(r.x + 0.22 * r.width, r.y + 0.08 * r.height, 0.56 * r.width,
                               0.84 * r.height);
-      dets.push_back({person, 1.0 / (1.0 + std::exp(-2.0 * weights[i]))});
+      dets.push_back({person, 1.0 / (1.0 + std::exp(-2.0 * (weights[i] - o_.hog_margin_at_half)))});
     }
     return Finish(std::move(dets), o_, filter_);
   }
