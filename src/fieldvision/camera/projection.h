@@ -36,9 +36,13 @@ void DistortNormalized(const T* d, const T& x, const T& y, T* xd, T* yd) {
     using std::sin;
     const T cx = cos(tau_x), sx = sin(tau_x), cy = cos(tau_y), sy = sin(tau_y);
     // R = [cy, sx*sy, -sy*cx; 0, cx, sx; sy, -cy*sx, cy*cx]
-    const T r00 = cy, r01 = sx * sy, r02 = -sy * cx;
-    const T r10 = T(0), r11 = cx, r12 = sx;
-    const T r20 = sy, r21 = -cy * sx, r22 = cy * cx;
+    const T& r00 = cy;
+    const T r01 = sx * sy, r02 = -sy * cx;
+    const T r10 = T(0);
+    const T& r11 = cx;
+    const T& r12 = sx;
+    const T& r20 = sy;
+    const T r21 = -cy * sx, r22 = cy * cx;
     // Tilt = [r22 0 -r02; 0 r22 -r12; 0 0 1] * R
     const T t0 =
         (r22 * r00 - r02 * r20) * u + (r22 * r01 - r02 * r21) * v + (r22 * r02 - r02 * r22);

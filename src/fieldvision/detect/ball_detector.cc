@@ -27,7 +27,7 @@ void DiscShares(const cv::Mat& bgr, const ColourTable& table, uint8_t bit, const
     const uint8_t* row = bgr.ptr<uint8_t>(y);
     for (int x = x0; x <= x1; ++x) {
       const double d2 = (x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y());
-      const uint8_t* p = row + 3 * x;
+      const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x);
       if (d2 < disc_r * disc_r) {
         ++n_disc;
         b_disc += (table.Classify(p[0], p[1], p[2]) & bit) != 0;

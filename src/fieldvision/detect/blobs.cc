@@ -31,15 +31,16 @@ void ClassifyRow(const uint8_t* row, int n, int x_start, int step, const ColourT
                  uint8_t* cls) {
   const uint8_t* lut = table.data();
   const int st = kStep > 0 ? kStep : step;
-  const uint8_t* p = row + 3 * x_start;
+  const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x_start);
+  const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(st);
   if (table.bits_per_channel() == 8) {
-    for (int i = 0; i < n; ++i, p += 3 * st) {
+    for (int i = 0; i < n; ++i, p += stride) {
       cls[i] = lut[uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16];
     }
   } else {
     const int b = table.bits_per_channel();
     const int s = 8 - b;
-    for (int i = 0; i < n; ++i, p += 3 * st) {
+    for (int i = 0; i < n; ++i, p += stride) {
       cls[i] = lut[uint32_t(p[0] >> s) | uint32_t(p[1] >> s) << b | uint32_t(p[2] >> s) << (2 * b)];
     }
   }
@@ -162,7 +163,7 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
     }
     Blob& b = result.blobs[blob_of[root]];
     const Run& run = runs[r];
-    const double cnt = (run.x1 - run.x0) / step + 1;
+    const double cnt = static_cast<double>((run.x1 - run.x0) / step + 1);  // samples
     const double k1 = cnt * (cnt - 1) / 2, k2 = (cnt - 1) * cnt * (2 * cnt - 1) / 6;
     const double sx = cnt * run.x0 + step * k1;
     const double sxx = cnt * double(run.x0) * run.x0 + 2.0 * run.x0 * step * k1 + step * step * k2;

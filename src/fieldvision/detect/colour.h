@@ -68,7 +68,7 @@ bool RangeContains(const ColourRange& range, const std::array<double, 3>& hsv,
 // The compiled lookup table. bits_per_channel 8: exact 2^24 table; 5..7: quantised.
 class ColourTable {
  public:
-  ColourTable(const ColourSpec& spec, int bits_per_channel = 8);
+  explicit ColourTable(const ColourSpec& spec, int bits_per_channel = 8);
   // Shared, cached tables: detectors built for several cameras with one spec share one table.
   static std::shared_ptr<const ColourTable> Shared(const ColourSpec& spec,
                                                    int bits_per_channel = 8);

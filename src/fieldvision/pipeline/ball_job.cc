@@ -13,9 +13,9 @@
 namespace fv {
 
 const std::vector<std::string>& BallCsvHeader() {
-  static const std::vector<std::string> header = {"frame", "time_s", "x_m",   "y_m",
-                                                  "z_m",   "n_cams", "err_px"};
-  return header;
+  static const std::vector<std::string> kHeader = {"frame", "time_s", "x_m",   "y_m",
+                                                   "z_m",   "n_cams", "err_px"};
+  return kHeader;
 }
 
 void BallJobOptions::Check() const {

@@ -218,6 +218,7 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   summary.window_scans.assign(n, 0);
 
   std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>> queues;
+  queues.reserve(n);
   for (int c = 0; c < n; ++c) {
     queues.push_back(std::make_unique<BoundedQueue<CameraMessage>>(options.queue_capacity,
                                                                    options.queue_policy));
@@ -225,7 +226,7 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   std::atomic<bool> stop{false};
   std::mutex error_mutex;
   std::exception_ptr error;
-  auto fail = [&](std::exception_ptr e) {
+  auto fail = [&](const std::exception_ptr& e) {
     {
       std::lock_guard<std::mutex> lock(error_mutex);
       if (!error) error = e;
@@ -239,6 +240,7 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
 
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::thread> threads;
+  threads.reserve(n);
   for (int c = 0; c < n; ++c) {
     threads.emplace_back([&, c] {
       try {

@@ -57,7 +57,7 @@ class VideoFrameSource : public FrameSource {
   // Opens `path` (a file OpenCV reads or a pattern such as dir/%05d.jpg) and reads its first
   // frame; throws fv::Error naming the file when it cannot be opened, is empty or the timestamps
   // cannot be read.
-  VideoFrameSource(const std::string& path, const FrameSourceOptions& options = {});
+  explicit VideoFrameSource(const std::string& path, const FrameSourceOptions& options = {});
   bool Read(cv::Mat* bgr, long long* frame, double* time_s) override;
   bool ReadFrame(SourceFrame* out) override;
   // True when frames are delivered encoded (options.encoded and a Motion-JPEG video).

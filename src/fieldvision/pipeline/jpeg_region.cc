@@ -78,7 +78,8 @@ bool RunJob(Job* job, ErrorManager* err) {
     y0 = static_cast<int>(cinfo.output_scanline);
   }
   while (static_cast<int>(cinfo.output_scanline) < y1) {
-    JSAMPROW row = bgr.ptr<uint8_t>(static_cast<int>(cinfo.output_scanline)) + 3 * x0;
+    JSAMPROW row =
+        bgr.ptr<uint8_t>(static_cast<int>(cinfo.output_scanline)) + 3 * static_cast<ptrdiff_t>(x0);
     if (jpeg_read_scanlines(&cinfo, &row, 1) != 1) break;
   }
   job->out_x = x0;
