@@ -19,7 +19,7 @@ namespace fv::calib {
 namespace {
 
 const std::map<std::string, int>& DictionaryNames() {
-  static const std::map<std::string, int> names = {
+  static const std::map<std::string, int> kNames = {
       {"DICT_4X4_50", cv::aruco::DICT_4X4_50},
       {"DICT_4X4_100", cv::aruco::DICT_4X4_100},
       {"DICT_4X4_250", cv::aruco::DICT_4X4_250},
@@ -37,7 +37,7 @@ const std::map<std::string, int>& DictionaryNames() {
       {"DICT_7X7_250", cv::aruco::DICT_7X7_250},
       {"DICT_7X7_1000", cv::aruco::DICT_7X7_1000},
       {"DICT_ARUCO_ORIGINAL", cv::aruco::DICT_ARUCO_ORIGINAL}};
-  return names;
+  return kNames;
 }
 
 bool IsImageFile(const std::filesystem::path& p) {

@@ -207,8 +207,9 @@ std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr, const Ca
   if (static_cast<int>(pixels.size()) > options.max_pixels) {
     std::vector<Eigen::Vector2d> kept;
     const double stride = static_cast<double>(pixels.size()) / options.max_pixels;
-    for (int i = 0; i < options.max_pixels; ++i)
+    for (int i = 0; i < options.max_pixels; ++i) {
       kept.push_back(pixels[static_cast<size_t>(i * stride)]);
+    }
     pixels.swap(kept);
   }
   return pixels;

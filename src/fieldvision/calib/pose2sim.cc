@@ -17,8 +17,8 @@ namespace {
 
 std::map<std::string, double> Attributes(const std::string& tag) {
   std::map<std::string, double> out;
-  static const std::regex re(R"((\w+)=\"([-+0-9.eE]+)\")");
-  for (auto it = std::sregex_iterator(tag.begin(), tag.end(), re); it != std::sregex_iterator();
+  static const std::regex kAttr(R"((\w+)=\"([-+0-9.eE]+)\")");
+  for (auto it = std::sregex_iterator(tag.begin(), tag.end(), kAttr); it != std::sregex_iterator();
        ++it) {
     out[(*it)[1]] = std::stod((*it)[2]);
   }
@@ -33,10 +33,10 @@ std::vector<Camera> ReadQualisysCalibration(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string text = ss.str();
-  static const std::regex camera_re(
+  static const std::regex kCamera(
       R"(<camera [^>]*serial=\"([^\"]*)\"[\s\S]*?<fov_video ([^>]*)/>[\s\S]*?<transform ([^>]*)/>\s*<intrinsic ([^>]*)/>)");
   std::vector<Camera> cams;
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), camera_re);
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), kCamera);
        it != std::sregex_iterator(); ++it) {
     const auto fov = Attributes((*it)[2]);
     const auto t = Attributes((*it)[3]);

@@ -24,13 +24,13 @@ ColourRange Hsv(double h0, double s0, double v0, double h1, double s1, double v1
 const std::map<std::string, std::vector<ColourRange>>& Presets() {
   // Hue in degrees. Orange covers Lambert-shaded balls (dark side down to V 45) but not skin
   // (low saturation) or red shirts (hue < 6).
-  static const std::map<std::string, std::vector<ColourRange>> presets = {
+  static const std::map<std::string, std::vector<ColourRange>> kPresets = {
       {"orange", {Hsv(6, 170, 45, 38, 255, 255)}}, {"yellow", {Hsv(45, 100, 80, 70, 255, 255)}},
       {"white", {Hsv(0, 0, 170, 360, 45, 255)}},   {"pink", {Hsv(295, 60, 120, 345, 255, 255)}},
       {"red", {Hsv(345, 120, 60, 6, 255, 255)}},   {"blue", {Hsv(190, 100, 50, 250, 255, 255)}},
       {"green", {Hsv(70, 50, 30, 170, 255, 255)}}, {"black", {Hsv(0, 0, 0, 360, 255, 45)}},
   };
-  return presets;
+  return kPresets;
 }
 
 const char* SpaceName(ColourSpace s) { return s == ColourSpace::kHsv ? "hsv" : "yuv"; }

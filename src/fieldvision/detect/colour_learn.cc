@@ -238,8 +238,9 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
   result.recall = recall;
   result.negative_rate = neg_rate;
   result.spec.classes.push_back({o.class_name, {r}});
-  if (o.class_name != "field")
+  if (o.class_name != "field") {
     result.spec.classes.push_back({"field", ColourPreset("green").ranges});
+  }
   if (o.class_name != "line") result.spec.classes.push_back({"line", ColourPreset("white").ranges});
   result.spec.ball_class = o.class_name;
   result.spec.Check("learned colour");

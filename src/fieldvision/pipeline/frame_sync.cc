@@ -29,8 +29,9 @@ std::vector<std::string> SyncReport::Problems() const {
     std::vector<std::string> parts;
     if (c.received == 0) parts.push_back("no frames");
     if (c.gaps > 0) parts.push_back(fmt::format("{} frames missing (dropped)", c.gaps));
-    if (c.duplicates > 0)
+    if (c.duplicates > 0) {
       parts.push_back(fmt::format("{} duplicated frames ignored", c.duplicates));
+    }
     if (c.out_of_order > 0) {
       parts.push_back(fmt::format("{} out-of-order frames ignored", c.out_of_order));
     }

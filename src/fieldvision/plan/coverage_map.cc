@@ -15,14 +15,14 @@ namespace {
 const cv::Vec3b kNoData(70, 70, 70);
 
 cv::Vec3b CountColour(int k) {
-  static const std::vector<cv::Vec3b> palette = {
+  static const std::vector<cv::Vec3b> kPalette = {
       {70, 70, 70},  {50, 50, 220}, {0, 150, 255}, {0, 230, 230},  {80, 220, 80},
       {40, 150, 40}, {200, 200, 0}, {220, 120, 0}, {200, 60, 120}, {150, 40, 150}};
-  return palette[std::min<size_t>(k, palette.size() - 1)];
+  return kPalette[std::min<size_t>(k, kPalette.size() - 1)];
 }
 
 cv::Vec3b TurboColour(double t) {
-  static const cv::Mat lut = [] {
+  static const cv::Mat kLut = [] {
     cv::Mat grey(1, 256, CV_8U);
     for (int i = 0; i < 256; ++i) grey.at<uchar>(0, i) = static_cast<uchar>(i);
     cv::Mat colour;
@@ -30,7 +30,7 @@ cv::Vec3b TurboColour(double t) {
     return colour;
   }();
   const int i = std::clamp(static_cast<int>(std::lround(t * 255)), 0, 255);
-  return lut.at<cv::Vec3b>(0, i);
+  return kLut.at<cv::Vec3b>(0, i);
 }
 
 const std::vector<cv::Scalar> kCameraColours = {{255, 255, 255}, {255, 0, 255}, {255, 255, 0},
@@ -140,8 +140,9 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
     const cv::Point2d p = view.ToPixel(eye.head<2>());
     const Eigen::Vector3d axis = cam.cam_from_world.rotation.row(2).transpose();
     Eigen::Vector3d aim = eye + 5.0 * axis;
-    if (axis.z() < -1e-6)
+    if (axis.z() < -1e-6) {
       aim = eye + std::min(range_m, (layer.height_m - eye.z()) / axis.z()) * axis;
+    }
     cv::arrowedLine(img, p, view.ToPixel(aim.head<2>()), colour, std::max(1, int(2 * scale)),
                     cv::LINE_AA, 0, 0.03);
     cv::circle(img, p, std::max(4, int(9 * scale)), cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);

@@ -368,8 +368,9 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
   std::vector<double> r(n);
   double ss = 0;
   if (fit.model.drag_per_m == 0.0) {
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < n; ++i) {
       r[i] = (fit.model.PositionAt(samples[i].time_s) - samples[i].ball_in_world).norm();
+    }
   } else {
     // Walk once through the samples (sorted by time) in both directions from t_ref.
     Eigen::Vector3d p, v;
@@ -506,8 +507,9 @@ struct Segmenter {
     const double g = o.gravity_mps2;
     for (int pass = 0; pass < 2; ++pass) {
       std::vector<int> good;
-      for (int i = 0; i < n; ++i)
+      for (int i = 0; i < n; ++i) {
         if (!out[i]) good.push_back(i);
+      }
       std::vector<bool> next(n, false);
       for (int i = 0; i < n; ++i) {
         // Neighbours among the currently good samples, excluding i itself.
@@ -580,8 +582,9 @@ struct Segmenter {
     const auto left = Window(list, track, k, -1, lo, hi, o.window_s, o.window_samples);
     const auto right = Window(list, track, k + 1, +1, lo, hi, o.window_s, o.window_samples);
     if (static_cast<int>(left.size()) < o.window_samples ||
-        static_cast<int>(right.size()) < o.window_samples)
+        static_cast<int>(right.size()) < o.window_samples) {
       return c;
+    }
     const double g = o.gravity_mps2;
     const double tc = 0.5 * (track[list[k]].time_s + track[list[k + 1]].time_s);
     const GravityLine L = FitGravityLine(track, left, g, tc);
@@ -714,8 +717,9 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
 
   // Airborne inliers, cut into blocks at ground phases and long gaps.
   std::vector<int> air;
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
     if (!res.outlier[i] && !res.on_ground[i]) air.push_back(i);
+  }
   struct Piece {
     int a, b;  // positions in `air`, inclusive
     FlightEvent start, end;
@@ -723,8 +727,9 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
   std::vector<Piece> pieces;
   const double zr = options.ground_z_m + options.ball_radius_m;
   auto ground_in = [&](int i0, int i1) {  // any ground sample in [i0, i1)
-    for (int k = std::max(i0, 0); k < std::min(i1, n); ++k)
+    for (int k = std::max(i0, 0); k < std::min(i1, n); ++k) {
       if (res.on_ground[k]) return true;
+    }
     return false;
   };
   int block_start = 0;
@@ -883,10 +888,12 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     const bool prev_fitted = i > 0 && piece_of_flight[i - 1] + 1 == piece_of_flight[i];
     const bool next_fitted =
         i + 1 < flights.size() && piece_of_flight[i + 1] == piece_of_flight[i] + 1;
-    if (flights[i].start_event == FlightEvent::kHit && !prev_fitted)
+    if (flights[i].start_event == FlightEvent::kHit && !prev_fitted) {
       flights[i].start_event = FlightEvent::kGround;
-    if (flights[i].end_event == FlightEvent::kHit && !next_fitted)
+    }
+    if (flights[i].end_event == FlightEvent::kHit && !next_fitted) {
       flights[i].end_event = FlightEvent::kGround;
+    }
   }
 
   // Origins, landings, apex, v0.
@@ -900,14 +907,16 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
       const auto t0 = mdl.CrossingTime(zr, f.t_first_seen_s, false, 10.0);
       f.t_start_s = t0 ? *t0 : f.t_first_seen_s;
       // Kicked while rolling or hopping low: the arc starts after the last sample off it.
-      if (f.start_event == FlightEvent::kGround)
+      if (f.start_event == FlightEvent::kGround) {
         f.t_start_s = std::max(f.t_start_s, limits[i].first);
+      }
       f.origin_m = mdl.PositionAt(f.t_start_s);
     }
     const auto t1 = mdl.CrossingTime(zr, f.t_last_seen_s, true, 10.0);
     f.t_landing_s = t1 ? *t1 : f.t_last_seen_s;
-    if (f.end_event == FlightEvent::kGround)
+    if (f.end_event == FlightEvent::kGround) {
       f.t_landing_s = std::min(f.t_landing_s, limits[i].second);
+    }
     f.landing_m = mdl.PositionAt(f.t_landing_s);
     if (f.end_event != FlightEvent::kHit) f.t_end_s = f.t_landing_s;
     f.origin_extrapolated = f.start_event == FlightEvent::kTrackStart;
@@ -943,8 +952,9 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     // Outliers inside the flight's span belong to it (for the pictures).
     for (int k = 0; k < n; ++k) {
       if (res.outlier[k] && track[k].time_s >= f.t_first_seen_s &&
-          track[k].time_s <= f.t_last_seen_s)
+          track[k].time_s <= f.t_last_seen_s) {
         f.samples.push_back(k);
+      }
     }
     std::sort(f.samples.begin(), f.samples.end());
   }

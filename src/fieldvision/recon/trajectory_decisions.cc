@@ -217,8 +217,9 @@ nlohmann::json Decisions::ToJson() const {
                                {"clean", s.clean}});
   }
   j["timeline"] = nlohmann::json::array();
-  for (const auto& e : timeline)
+  for (const auto& e : timeline) {
     j["timeline"].push_back({{"time_s", R4(e.time_s)}, {"event", e.text}});
+  }
   return j;
 }
 

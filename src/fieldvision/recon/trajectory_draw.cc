@@ -30,8 +30,9 @@ struct Axes {
 double NiceStep(double range) {
   const double raw = range / 8;
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
     if (m * p >= raw) return m * p;
+  }
   return 10 * p;
 }
 
@@ -67,9 +68,9 @@ void Cross(cv::Mat& img, cv::Point2d p, const cv::Scalar& c, int r = 5) {
 }
 
 cv::Scalar FlightColour(int i) {
-  static const cv::Scalar c[] = {kBlue, kOrange, kPurple, cv::Scalar(30, 130, 30),
-                                 cv::Scalar(160, 120, 0)};
-  return c[i % 5];
+  static const cv::Scalar kColours[] = {kBlue, kOrange, kPurple, cv::Scalar(30, 130, 30),
+                                        cv::Scalar(160, 120, 0)};
+  return kColours[i % 5];
 }
 
 }  // namespace
@@ -132,10 +133,11 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
   curve(f.model(), t0, t1, kBlue, 2);
   for (int i : f.samples) {
     const auto& p = track[i].ball_in_world;
-    if (result.outlier[i])
+    if (result.outlier[i]) {
       Cross(img, a.P(s_of(p), p.z()), kRed);
-    else
+    } else {
       cv::circle(img, a.P(s_of(p), p.z()), 3, kGreen, cv::FILLED, cv::LINE_AA);
+    }
   }
   cv::circle(img, a.P(s_of(f.origin_m), f.origin_m.z()), 7, kBlack,
              f.origin_extrapolated ? 1 : cv::FILLED, cv::LINE_AA);
@@ -156,9 +158,10 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
            f.t_end_s, f.FlightTime(), f.speed_mps, f.apex_m.z()),
        {10, 22}, kBlack, 0.55);
   std::string fits = fmt::format("rmse: gravity {:.1f} mm", f.no_drag.rmse_m * 1e3);
-  if (f.with_drag.ok)
+  if (f.with_drag.ok) {
     fits += fmt::format(", drag {:.1f} mm (k {:.3f}/m)", f.with_drag.rmse_m * 1e3,
                         f.with_drag.model.drag_per_m);
+  }
   if (f.seed.ok) fits += fmt::format(", seed quadratic {:.1f} mm", f.seed.rmse_m * 1e3);
   fits += f.drag_used ? "  [blue: drag model]" : "  [blue: gravity model]";
   Text(img, fits, {10, 44}, kDark);
@@ -202,10 +205,11 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
   }
   for (size_t i = 0; i < track.size(); ++i) {
     const cv::Point2d p = a.P(track[i].time_s, track[i].ball_in_world.z());
-    if (result.outlier[i])
+    if (result.outlier[i]) {
       Cross(img, p, kRed, 4);
-    else
+    } else {
       cv::circle(img, p, 2, result.on_ground[i] ? kGrey : kGreen, cv::FILLED, cv::LINE_AA);
+    }
   }
   Text(img, result.Summary(), {10, 22}, kBlack, 0.5);
   Text(img,
@@ -239,18 +243,21 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
     view.size = cv::Size(width_px, std::max(50, static_cast<int>((y1 - y0) * view.px_per_m)));
     img = cv::Mat(view.size, CV_8UC3, cv::Scalar(70, 70, 70));
     const double step = NiceStep(x1 - x0);
-    for (double x = std::ceil(x0 / step) * step; x <= x1; x += step)
+    for (double x = std::ceil(x0 / step) * step; x <= x1; x += step) {
       cv::line(img, view.ToPixel({x, y0}), view.ToPixel({x, y1}), cv::Scalar(95, 95, 95), 1);
-    for (double y = std::ceil(y0 / step) * step; y <= y1; y += step)
+    }
+    for (double y = std::ceil(y0 / step) * step; y <= y1; y += step) {
       cv::line(img, view.ToPixel({x0, y}), view.ToPixel({x1, y}), cv::Scalar(95, 95, 95), 1);
+    }
     Text(img, fmt::format("grid {:g} m", step), {10, view.size.height - 10}, kWhite, 0.5);
   }
   for (size_t i = 0; i < track.size(); ++i) {
     const cv::Point2d p = view.ToPixel(track[i].ball_in_world.head<2>());
-    if (result.outlier[i])
+    if (result.outlier[i]) {
       Cross(img, p, kRed, 3);
-    else
+    } else {
       cv::circle(img, p, 2, cv::Scalar(220, 220, 220), cv::FILLED, cv::LINE_AA);
+    }
   }
   for (const auto& f : result.flights) {
     std::vector<cv::Point> pts;

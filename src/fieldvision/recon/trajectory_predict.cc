@@ -45,8 +45,9 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, bool fi
   const int np = fit_drag ? 7 : 6;
   // Jacobian of the residuals (numerical), inliers only.
   std::vector<int> used;
-  for (size_t i = 0; i < samples.size(); ++i)
+  for (size_t i = 0; i < samples.size(); ++i) {
     if (fit.inlier[i]) used.push_back(static_cast<int>(i));
+  }
   if (static_cast<int>(used.size()) < 4) return pr;
   Eigen::MatrixXd J(3 * used.size(), np);
   Eigen::Matrix<double, 3, Eigen::Dynamic> JL(3, np);
@@ -116,8 +117,9 @@ std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
   for (const auto& f : result.flights) {
     const int id = static_cast<int>(gravity.size());
     gravity.push_back(true);
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < n; ++i) {
       if (track[i].time_s >= f.t_first_seen_s && track[i].time_s <= f.t_last_seen_s) seg[i] = id;
+    }
   }
   for (int i = 0; i < n; ++i) {
     if (seg[i] >= 0) continue;

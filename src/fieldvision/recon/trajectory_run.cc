@@ -33,10 +33,12 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   out.input = ReadBallTrack(job.in_path);
   const auto& track = out.input.samples;
   const size_t max_listed = 10;
-  for (size_t i = 0; i < out.input.skipped.size() && i < max_listed; ++i)
+  for (size_t i = 0; i < out.input.skipped.size() && i < max_listed; ++i) {
     log << "skipped: " << out.input.skipped[i] << "\n";
-  if (out.input.skipped.size() > max_listed)
+  }
+  if (out.input.skipped.size() > max_listed) {
     log << fmt::format("skipped: ... and {} more rows\n", out.input.skipped.size() - max_listed);
+  }
   out.options = job.analysis;
   double diameter = job.ball_diameter_m;
   if (diameter <= 0) {
@@ -56,8 +58,9 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   const TrajectoryResult& r = out.result;
   log << fmt::format("{}: {} samples, {:.2f} s; {}\n", job.in_path, track.size(),
                      track.empty() ? 0.0 : track.back().time_s - track.front().time_s, r.Summary());
-  for (const auto& f : r.flights)
+  for (const auto& f : r.flights) {
     out.predictions.push_back(PredictFlightLanding(track, r, f, job.predict_fraction, out.options));
+  }
   out.decisions = MakeDecisions(track, r, has_field ? &field : nullptr, out.options, job.decisions);
 
   // FLIGHTS.json: the contract's array, each flight with its prediction and calls.
@@ -82,14 +85,17 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
     flights[i]["prediction"] = pj;
     nlohmann::json calls = nlohmann::json::array();
     const nlohmann::json dj = out.decisions.ToJson();
-    for (const auto& c : dj["landings"])
+    for (const auto& c : dj["landings"]) {
       if (c["flight"] == static_cast<int>(i)) calls.push_back(c);
+    }
     flights[i]["landing_calls"] = calls;
     nlohmann::json goals = nlohmann::json::array(), shots = nlohmann::json::array();
-    for (const auto& g : dj["goal_crossings"])
+    for (const auto& g : dj["goal_crossings"]) {
       if (g["flight"] == static_cast<int>(i)) goals.push_back(g);
-    for (const auto& s : dj["made_shots"])
+    }
+    for (const auto& s : dj["made_shots"]) {
       if (s["flight"] == static_cast<int>(i)) shots.push_back(s);
+    }
     flights[i]["goal_crossings"] = goals;
     flights[i]["made_shots"] = shots;
   }
@@ -151,8 +157,9 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
         f.with_drag.ok ? fmt::format("{:.1f}", f.with_drag.rmse_m * 1e3) : "-");
   }
   log << "timeline:\n";
-  for (const auto& e : out.decisions.timeline)
+  for (const auto& e : out.decisions.timeline) {
     log << fmt::format("  {:9.3f} s  {}\n", e.time_s, e.text);
+  }
   log << fmt::format("wrote {} ({} flights){}\n", job.out_path, r.flights.size(),
                      out.images.empty()
                          ? ""

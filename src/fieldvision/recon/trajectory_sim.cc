@@ -16,8 +16,9 @@ void BallSimOptions::Check() const {
   CheckInRange(tangential_factor, 0.0, 1.0, "tangential_factor");
   CheckNonNegative(min_bounce_mps, "min_bounce_mps");
   CheckNonNegative(rolling_decel_mps2, "rolling_decel_mps2");
-  for (size_t i = 1; i < kicks.size(); ++i)
+  for (size_t i = 1; i < kicks.size(); ++i) {
     FV_REQUIRE(kicks[i].time_s > kicks[i - 1].time_s, "kicks must be in time order (kick {})", i);
+  }
 }
 
 BallSimulation::BallSimulation(const BallSimOptions& o) : options_(o) {

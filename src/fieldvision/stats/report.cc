@@ -23,10 +23,10 @@ namespace {
 cv::Scalar ColourOf(int id, int team) {
   if (team == 0) return {40, 40, 220};
   if (team == 1) return {220, 120, 30};
-  static const cv::Scalar palette[] = {
+  static const cv::Scalar kPalette[] = {
       {230, 25, 75},  {60, 180, 75},  {255, 225, 25}, {0, 130, 200},  {245, 130, 48},
       {145, 30, 180}, {70, 240, 240}, {240, 50, 230}, {210, 245, 60}, {250, 190, 212}};
-  return palette[std::abs(id) % 10];
+  return kPalette[std::abs(id) % 10];
 }
 
 void Write(const std::string& path, const cv::Mat& img, ReportFiles& files) {
@@ -253,8 +253,9 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
          "radar.avi</a>. Distances between players each second: <a href=\"distances.csv\">"
          "distances.csv</a>.</p>\n";
     h << "<h2>Heat maps</h2>\n<div class=\"maps\"><img src=\"heatmap_all.png\">";
-    for (const auto& [team, ts] : by_team)
+    for (const auto& [team, ts] : by_team) {
       h << fmt::format("<img src=\"heatmap_team{}.png\">", team);
+    }
     h << "</div>\n<h3>Per player</h3>\n<div class=\"maps\">";
     for (int id : player_maps) h << fmt::format("<img src=\"heatmap_player{}.png\">", id);
     h << "</div>\n</body></html>\n";

@@ -195,8 +195,9 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
     }
     if (sprint_run >= o.sprint_min_s) ps.sprints++;
     ps.mean_speed_mps = speed_time > 0 ? speed_sum / speed_time : 0.0;
-    for (const auto& [sec, sc] : per_second)
+    for (const auto& [sec, sc] : per_second) {
       ps.speed_profile.emplace_back(sec, sc.first / sc.second);
+    }
     t_min = std::min(t_min, t.front());
     t_max = std::max(t_max, t.back());
     res.players.push_back(ps);

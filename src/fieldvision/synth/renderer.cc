@@ -216,10 +216,10 @@ struct StaticWorld {
 
   Vec3 Wall(double s, double z) const {
     if (z < 0.9) {
-      static const Vec3 palette[6] = {Vec3(170, 60, 20),  Vec3(30, 30, 190), Vec3(235, 235, 235),
-                                      Vec3(20, 170, 230), Vec3(60, 60, 60),  Vec3(40, 140, 40)};
+      static const Vec3 kPalette[6] = {Vec3(170, 60, 20),  Vec3(30, 30, 190), Vec3(235, 235, 235),
+                                       Vec3(20, 170, 230), Vec3(60, 60, 60),  Vec3(40, 140, 40)};
       const int panel = static_cast<int>(std::floor(s / 4.0));
-      const Vec3 bgc = palette[static_cast<int>(Hash2(panel, 7, 5) * 6) % 6];
+      const Vec3 bgc = kPalette[static_cast<int>(Hash2(panel, 7, 5) * 6) % 6];
       const double in = s - 4.0 * panel;
       const bool text = z > 0.3 && z < 0.62 && in > 0.5 && in < 3.5 &&
                         Hash2(static_cast<int>(std::floor(in / 0.22)), panel, 6) > 0.35;
@@ -801,8 +801,9 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
       if (e > 0) {
         const auto p0 = cam.Project(BallAt(t - 0.5 * e));
         const auto p1 = cam.Project(BallAt(t + 0.5 * e));
-        if (p0 && p1)
+        if (p0 && p1) {
           K = std::clamp(static_cast<int>(std::ceil((*p1 - *p0).norm() / 0.5)) + 1, 1, 48);
+        }
       }
       std::vector<Vec3> centres;
       cv::Rect box;

@@ -243,8 +243,9 @@ std::vector<TrackState> ByteTracker::Update(const std::vector<Detection>& detect
                        bool use_field) {
     std::vector<std::vector<double>> cost(ts.size(), std::vector<double>(ds.size()));
     for (size_t i = 0; i < ts.size(); ++i) {
-      for (size_t j = 0; j < ds.size(); ++j)
+      for (size_t j = 0; j < ds.size(); ++j) {
         cost[i][j] = pair_cost(*ts[i], ds[j], min_iou, use_field);
+      }
     }
     const std::vector<int> a = SolveAssignment(cost);
     int n = 0;
