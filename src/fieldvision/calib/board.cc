@@ -105,7 +105,7 @@ std::vector<cv::Point3f> BoardSpec::CornerPositions() const {
   const int nc = type == BoardType::kChessboard ? cols : cols - 1;
   const int nr = type == BoardType::kChessboard ? rows : rows - 1;
   std::vector<cv::Point3f> pts;
-  pts.reserve(nc * nr);
+  pts.reserve(static_cast<size_t>(nc) * nr);
   for (int r = 0; r < nr; ++r) {
     for (int c = 0; c < nc; ++c) {
       // ChArUco corner (c, r) sits at ((c + 1) * square, (r + 1) * square) in OpenCV's layout.

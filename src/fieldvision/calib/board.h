@@ -78,7 +78,7 @@ class ImageSource {
   // A folder (every .jpg/.jpeg/.png/.bmp/.tif/.tiff in it, sorted), a glob pattern
   // ("dir/left*.jpg"), one image, or a video. Throws fv::Error naming `spec` when nothing
   // matches or the file cannot be opened.
-  ImageSource(const std::string& spec, const ImageSourceOptions& options = {});
+  explicit ImageSource(const std::string& spec, const ImageSourceOptions& options = {});
   int size() const { return static_cast<int>(names_.size()); }
   const std::string& spec() const { return spec_; }
   const std::string& name(int i) const { return names_[i]; }

@@ -23,7 +23,7 @@ double SpreadOffLine(const std::vector<Eigen::Matrix<double, N, 1>>& pts) {
   Eigen::MatrixXd a(pts.size(), N);
   for (size_t i = 0; i < pts.size(); ++i) a.row(i) = (pts[i] - mean).transpose();
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a);
-  const auto s = svd.singularValues();
+  const auto& s = svd.singularValues();
   double off = 0;
   for (int i = 1; i < s.size(); ++i) off += s(i) * s(i);
   return std::sqrt(off / pts.size());

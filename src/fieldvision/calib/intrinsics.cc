@@ -204,7 +204,7 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   // Coverage of the image by the corners of the used views, and the spread of board tilts.
   CoverageReport& cov = result.coverage;
   cov.grid = options.coverage_grid;
-  cov.corners_per_cell.assign(cov.grid * cov.grid, 0);
+  cov.corners_per_cell.assign(static_cast<size_t>(cov.grid) * cov.grid, 0);
   const double half_diag = 0.5 * std::hypot(size.width, size.height);
   std::vector<cv::Vec3d> normals;
   for (size_t j = 0; j < used.size(); ++j) {

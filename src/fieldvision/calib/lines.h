@@ -44,8 +44,8 @@ class LineDistanceMap {
  public:
   // Cells of `resolution_m` over the field and its surround (coarser if that would exceed
   // max_cells); distances beyond max_distance_m are clamped.
-  LineDistanceMap(const FieldModel& field, double resolution_m = 0.01, double max_distance_m = 1.0,
-                  int max_cells = 8'000'000);
+  explicit LineDistanceMap(const FieldModel& field, double resolution_m = 0.01,
+                           double max_distance_m = 1.0, int max_cells = 8'000'000);
   double resolution_m() const { return resolution_m_; }
   double max_distance_m() const { return max_distance_m_; }
   // Bilinear lookup; max_distance_m outside the grid.

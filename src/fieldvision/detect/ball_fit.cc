@@ -23,10 +23,10 @@ inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
   const int y0 = std::min(static_cast<int>(y), img.rows - 2 >= 0 ? img.rows - 2 : 0);
   const int x1 = std::min(x0 + 1, img.cols - 1), y1 = std::min(y0 + 1, img.rows - 1);
   const double fx = x - x0, fy = y - y0;
-  const uint8_t* a = img.ptr<uint8_t>(y0) + 3 * x0;
-  const uint8_t* b = img.ptr<uint8_t>(y0) + 3 * x1;
-  const uint8_t* c = img.ptr<uint8_t>(y1) + 3 * x0;
-  const uint8_t* d = img.ptr<uint8_t>(y1) + 3 * x1;
+  const uint8_t* a = img.ptr<uint8_t>(y0) + 3 * static_cast<ptrdiff_t>(x0);
+  const uint8_t* b = img.ptr<uint8_t>(y0) + 3 * static_cast<ptrdiff_t>(x1);
+  const uint8_t* c = img.ptr<uint8_t>(y1) + 3 * static_cast<ptrdiff_t>(x0);
+  const uint8_t* d = img.ptr<uint8_t>(y1) + 3 * static_cast<ptrdiff_t>(x1);
   for (int k = 0; k < 3; ++k) {
     (*out)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
   }
@@ -36,7 +36,7 @@ inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
 inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, double x, double y) {
   const int xi = static_cast<int>(std::lround(x)), yi = static_cast<int>(std::lround(y));
   if (xi < 0 || yi < 0 || xi >= img.cols || yi >= img.rows) return false;
-  const uint8_t* p = img.ptr<uint8_t>(yi) + 3 * xi;
+  const uint8_t* p = img.ptr<uint8_t>(yi) + 3 * static_cast<ptrdiff_t>(xi);
   return (table.Classify(p[0], p[1], p[2]) & bit) != 0;
 }
 

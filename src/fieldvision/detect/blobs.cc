@@ -163,7 +163,8 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
     }
     Blob& b = result.blobs[blob_of[root]];
     const Run& run = runs[r];
-    const double cnt = static_cast<double>((run.x1 - run.x0) / step + 1);  // samples
+    const int samples = (run.x1 - run.x0) / step + 1;
+    const double cnt = samples;
     const double k1 = cnt * (cnt - 1) / 2, k2 = (cnt - 1) * cnt * (2 * cnt - 1) / 6;
     const double sx = cnt * run.x0 + step * k1;
     const double sxx = cnt * double(run.x0) * run.x0 + 2.0 * run.x0 * step * k1 + step * step * k2;

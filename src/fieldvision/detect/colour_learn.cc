@@ -34,7 +34,7 @@ double Share(const ColourRange& r, const std::vector<Hsv8>& px) {
 
 double Percentile(std::vector<int> v, double q) {
   std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
+  const size_t i = std::min(v.size() - 1, static_cast<size_t>(std::lround(q * (v.size() - 1))));
   return v[i];
 }
 
@@ -128,7 +128,7 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
     for (int y = outer.y; y < outer.y + outer.height; ++y) {
       for (int x = outer.x; x < outer.x + outer.width; ++x) {
         if (r.contains(cv::Point(x, y))) continue;
-        const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+        const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
         for (int k = 0; k < 3; ++k) ring[k].push_back(p[k]);
       }
     }
@@ -138,7 +138,7 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
       for (int y = r.y; y < r.y + r.height; ++y) {
         for (int x = r.x; x < r.x + r.width; ++x) {
           if (!pos_mask.at<uint8_t>(y, x)) continue;
-          const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+          const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
           double dc = 0, db = 0;
           for (int k = 0; k < 3; ++k) {
             dc += (p[k] - centre[k]) * (p[k] - centre[k]);

@@ -37,7 +37,8 @@ const std::vector<cv::Scalar> kCameraColours = {{255, 255, 255}, {255, 0, 255}, 
                                                 {0, 255, 255},   {255, 128, 0}, {128, 0, 255},
                                                 {0, 128, 255},   {128, 255, 0}};
 
-void Text(cv::Mat& img, const std::string& s, cv::Point at, double scale, cv::Scalar colour) {
+void Text(cv::Mat& img, const std::string& s, cv::Point at, double scale,
+          const cv::Scalar& colour) {
   cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
   cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
 }
@@ -130,7 +131,7 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
   const double scale = options.width_px / 1400.0;
   for (size_t k = 0; k < cameras.size(); ++k) {
     const Camera& cam = cameras[k];
-    const cv::Scalar colour = kCameraColours[k % kCameraColours.size()];
+    const cv::Scalar& colour = kCameraColours[k % kCameraColours.size()];
     if (options.footprints) {
       for (const auto& line : Footprint(cam, layer.height_m, view, range_m)) {
         if (line.size() > 1) cv::polylines(img, line, false, colour, 1, cv::LINE_AA);
@@ -198,8 +199,8 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
     for (double t : ticks) {
       const int x = x0 + int((x1 - x0) * t / top);
       cv::line(legend, cv::Point(x, pad), cv::Point(x, strip_h / 2 + 4), cv::Scalar(255, 255, 255));
-      Text(legend, angle ? fmt::format("{:.0f}", t) : fmt::format("{:.0f}", t),
-           cv::Point(x - 8, strip_h - pad / 2), 0.4 * scale, cv::Scalar(255, 255, 255));
+      Text(legend, fmt::format("{:.0f}", t), cv::Point(x - 8, strip_h - pad / 2), 0.4 * scale,
+           cv::Scalar(255, 255, 255));
     }
     if (!angle) {
       Text(legend, "grey: < 2 cameras", cv::Point(x1 - int(140 * scale), pad - 2), 0.35 * scale,

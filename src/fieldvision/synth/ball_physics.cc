@@ -31,11 +31,14 @@ class Dynamics {
   State Step(const State& s, double h, bool rolling) const {
     const Eigen::Vector3d k1v = Accel(s.v, rolling), k1p = s.v;
     const Eigen::Vector3d v2 = s.v + 0.5 * h * k1v;
-    const Eigen::Vector3d k2v = Accel(v2, rolling), k2p = v2;
+    const Eigen::Vector3d k2v = Accel(v2, rolling);
+    const Eigen::Vector3d& k2p = v2;
     const Eigen::Vector3d v3 = s.v + 0.5 * h * k2v;
-    const Eigen::Vector3d k3v = Accel(v3, rolling), k3p = v3;
+    const Eigen::Vector3d k3v = Accel(v3, rolling);
+    const Eigen::Vector3d& k3p = v3;
     const Eigen::Vector3d v4 = s.v + h * k3v;
-    const Eigen::Vector3d k4v = Accel(v4, rolling), k4p = v4;
+    const Eigen::Vector3d k4v = Accel(v4, rolling);
+    const Eigen::Vector3d& k4p = v4;
     return {s.p + h / 6.0 * (k1p + 2 * k2p + 2 * k3p + k4p),
             s.v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)};
   }

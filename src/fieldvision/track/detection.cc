@@ -425,10 +425,12 @@ std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options, con
                                              FootFilter filter) {
   options.Check();
   if (options.threads > 0) cv::setNumThreads(options.threads);
-  if (options.kind == "nanodet") return std::make_unique<NanoDetDetector>(options, filter);
-  if (options.kind == "hog") return std::make_unique<HogDetector>(options, filter);
-  if (options.kind == "motion") return std::make_unique<MotionDetector>(options, camera, filter);
-  return std::make_unique<OnnxYoloDetector>(options, filter);
+  if (options.kind == "nanodet")
+    return std::make_unique<NanoDetDetector>(options, std::move(filter));
+  if (options.kind == "hog") return std::make_unique<HogDetector>(options, std::move(filter));
+  if (options.kind == "motion")
+    return std::make_unique<MotionDetector>(options, camera, std::move(filter));
+  return std::make_unique<OnnxYoloDetector>(options, std::move(filter));
 }
 
 }  // namespace fv::track

@@ -180,7 +180,7 @@ int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppear
     return b.x <= o.border_px || b.y <= o.border_px || b.x + b.width >= image.width - o.border_px ||
            b.y + b.height >= image.height - o.border_px;
   };
-  auto clamp_speed = [&](Eigen::Vector2d v) {
+  auto clamp_speed = [&](const Eigen::Vector2d& v) {
     const double n = v.norm();
     return n > o.max_speed_mps ? Eigen::Vector2d(v * (o.max_speed_mps / n)) : v;
   };
