@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -158,6 +160,66 @@ TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
     ASSERT_TRUE(whole[i].result.ok()) << i;
     EXPECT_LT((tracked[i].result.point_world - whole[i].result.point_world).norm(), 1e-9) << i;
     EXPECT_LT((tracked[i].result.point_world - BallAt(tracked[i].time_s)).norm(), 0.03) << i;
+  }
+}
+
+// A pattern of JPEG files (dir/%05d.jpg, from index 1) is read as encoded frames too: the same
+// pixels as OpenCV's reader, and the tracked pipeline finds the ball in every frame.
+TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
+  const std::string dir = testing::TempDir();
+  const Scene s = MakeScene(dir, {24, 24, 24}, {0, 0, 0});
+  std::vector<std::string> patterns;
+  for (int c = 0; c < 3; ++c) {
+    const std::string folder = dir + "/seq" + std::to_string(c);
+    std::filesystem::create_directories(folder);
+    cv::VideoCapture cap(s.videos[c]);
+    cv::Mat frame;
+    for (int f = 1; cap.read(frame); ++f) {
+      ASSERT_TRUE(cv::imwrite(fmt::format("{}/{:05d}.jpg", folder, f), frame));
+    }
+    patterns.push_back(folder + "/%05d.jpg");
+  }
+  FrameSourceOptions enc;
+  enc.encoded = true;
+  enc.fps = kFps;  // image files have no frame rate
+  {
+    VideoFrameSource src(patterns[0], enc);
+    EXPECT_TRUE(src.encoded());
+    EXPECT_EQ(src.FrameCount(), 24);
+    VideoFrameSource plain(patterns[0]);
+    EXPECT_FALSE(plain.encoded());
+    cv::Mat a;
+    long long fa;
+    double ta;
+    for (int f = 0; f < 24; ++f) {
+      ASSERT_TRUE(src.Read(&a, &fa, &ta));
+      EXPECT_EQ(fa, f);
+      EXPECT_DOUBLE_EQ(ta, f / kFps);
+      // The pixels of OpenCV's JPEG reader (libjpeg-turbo, the same settings).
+      const cv::Mat b = cv::imread(fmt::format("{}/seq0/{:05d}.jpg", dir, f + 1));
+      EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << "frame " << f;
+    }
+    EXPECT_FALSE(src.Read(&a, &fa, &ta));
+  }
+  std::vector<std::unique_ptr<FrameSource>> sources;
+  for (const auto& p : patterns) sources.push_back(std::make_unique<VideoFrameSource>(p, enc));
+  auto in_window = [](const cv::Mat& bgr, const cv::Rect& roi) {
+    if (roi.empty()) return Centroid(bgr);
+    auto obs = Centroid(bgr(roi));
+    for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
+    return obs;
+  };
+  BallPipelineOptions opt;
+  opt.progress = false;
+  std::vector<BallFrame> frames;
+  const auto summary =
+      RunBallPipelineTracked(s.cams, sources, {in_window, in_window, in_window}, opt,
+                             [&](const BallFrame& f) { frames.push_back(f); });
+  ASSERT_EQ(frames.size(), 24u);
+  EXPECT_GT(summary.window_scans[0], 12);
+  for (const BallFrame& f : frames) {
+    ASSERT_TRUE(f.result.ok()) << f.frame;
+    EXPECT_LT((f.result.point_world - BallAt(f.time_s)).norm(), 0.03) << f.frame;
   }
 }
 

@@ -1,7 +1,12 @@
 #include "fieldvision/pipeline/frame_source.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -10,6 +15,28 @@
 #include "fieldvision/util/error.h"
 
 namespace fv {
+namespace {
+
+// The file of frame `index` of a printf pattern with one integer field (dir/%05d.jpg), or ""
+// when the pattern has another form.
+std::string PatternFile(const std::string& pattern, long long index) {
+  static const std::regex kOneIntField(R"(^([^%]*)%(0?)([0-9]{0,3})d([^%]*)$)");
+  std::smatch m;
+  if (!std::regex_match(pattern, m, kOneIntField)) return "";
+  const size_t width = m[3].length() > 0 ? std::stoul(m[3].str()) : 0;
+  std::string number = std::to_string(index);
+  if (number.size() < width) number.insert(0, width - number.size(), m[2].length() ? '0' : ' ');
+  return m[1].str() + number + m[4].str();
+}
+
+bool HasJpegExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".jpg" || ext == ".jpeg";
+}
+
+}  // namespace
 
 void FrameSourceOptions::Check() const {
   FV_REQUIRE(std::isfinite(fps) && fps >= 0, "FrameSourceOptions.fps must be >= 0 (got {})", fps);
@@ -51,6 +78,24 @@ VideoFrameSource::VideoFrameSource(const std::string& path, const FrameSourceOpt
       capture_.getBackendName() == "FFMPEG") {
     encoded_ = capture_.set(cv::CAP_PROP_FORMAT, -1);
   }
+  // A pattern of JPEG files: the files themselves are the frames (OpenCV's image reader starts
+  // at the first of indices 0..1000 that exists; so does this).
+  if (options.encoded && pattern && HasJpegExtension(path) && !PatternFile(path, 0).empty()) {
+    for (long long i = 0; i <= 1000; ++i) {
+      if (std::filesystem::exists(PatternFile(path, i))) {
+        first_file_ = i;
+        break;
+      }
+    }
+    if (first_file_ >= 0) {
+      encoded_ = true;
+      jpeg_files_ = true;
+      long long n = 0;
+      while (std::filesystem::exists(PatternFile(path, first_file_ + n))) ++n;
+      frame_count_ = n;
+      capture_.release();
+    }
+  }
   if (encoded_) {
     has_pending_ = GrabFrame(&pending_frame_);
     FV_REQUIRE(has_pending_, "video '{}' has no readable frame", path);
@@ -64,6 +109,16 @@ VideoFrameSource::VideoFrameSource(const std::string& path, const FrameSourceOpt
 }
 
 bool VideoFrameSource::GrabFrame(SourceFrame* out) {
+  if (jpeg_files_) {
+    const std::string file = PatternFile(path_, first_file_ + next_frame_);
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return false;  // the end of the sequence
+    out->jpeg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    FV_REQUIRE(!in.bad(), "cannot read '{}'", file);
+    out->bgr = cv::Mat();
+    out->time_s = TimeOf(next_frame_);
+    return true;
+  }
   cv::Mat packet;
   bool ok = false;
   try {
@@ -99,6 +154,7 @@ double VideoFrameSource::TimeOf(long long f) {
     case TimeSource::kFrameRate:
       return f / fps_;
     case TimeSource::kContainer: {
+      if (jpeg_files_) return f / fps_;  // image files carry no capture times
       const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
       return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
     }

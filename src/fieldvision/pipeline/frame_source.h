@@ -46,8 +46,9 @@ struct FrameSourceOptions {
   TimeSource time = TimeSource::kFrameRate;
   std::string timestamps_csv;  // kCsv: a file with columns frame,time_s
   double fps = 0.0;            // kFrameRate: 0 takes the container's rate (30 if it has none)
-  // Motion-JPEG video: ReadFrame delivers the encoded frames (SourceFrame::jpeg) so that a
-  // camera stage can decode only where the ball is; other videos are decoded as usual.
+  // Motion-JPEG video or a pattern of JPEG files (dir/%05d.jpg): ReadFrame delivers the encoded
+  // frames (SourceFrame::jpeg) so that a camera stage can decode only where the ball is; other
+  // videos are decoded as usual.
   bool encoded = false;
   void Check() const;  // throws fv::Error naming the bad field
 };
@@ -76,6 +77,8 @@ class VideoFrameSource : public FrameSource {
   cv::VideoCapture capture_;
   std::map<long long, double> times_;  // kCsv
   bool encoded_ = false;
+  bool jpeg_files_ = false;    // encoded: a pattern of JPEG files (else MJPG packets)
+  long long first_file_ = -1;  // index of the first file of the pattern
   JpegRegionDecoder decoder_;  // Read() of an encoded stream
   SourceFrame pending_frame_;  // encoded: the first frame, read when opening
   cv::Mat pending_;            // the first frame, read when opening
