@@ -257,49 +257,52 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
           m.frame = in.frame;
           m.time_s = in.time_s;
           const bool encoded = !in.jpeg.empty();
-          auto image = [&](const cv::Rect& roi) -> const cv::Mat& {
-            if (!encoded) return in.bgr;
-            decoder.Decode(in.jpeg.data(), in.jpeg.size(), roi, &decoded,
-                           fmt::format("video '{}' frame {}", sources[c]->name(), in.frame));
-            return decoded;
+          // The frame's pixels in `roi` (empty: all); null for a damaged encoded frame, which is
+          // reported and sent without candidates while the video goes on.
+          auto check_size = [&](const cv::Size& got) {
+            FV_REQUIRE(got == size, "video '{}' frame {} is {}x{}, camera {} is {}x{}",
+                       sources[c]->name(), m.frame, got.width, got.height, c, size.width,
+                       size.height);
           };
-          cv::Size got = in.bgr.size();
-          if (encoded) {
-            // A damaged frame is reported and sent without candidates; the video goes on.
+          auto image = [&](const cv::Rect& roi) -> const cv::Mat* {
+            if (!encoded) return &in.bgr;
+            const std::string what =
+                fmt::format("video '{}' frame {}", sources[c]->name(), in.frame);
             try {
-              got = JpegRegionDecoder::ReadSize(
-                  in.jpeg.data(), in.jpeg.size(),
-                  fmt::format("video '{}' frame {}", sources[c]->name(), in.frame));
+              decoder.Decode(in.jpeg.data(), in.jpeg.size(), roi, &decoded, what);
             } catch (const Error& e) {
+              // A readable header of another size is the wrong video, not a damaged frame.
+              cv::Size got = size;
+              try {
+                got = JpegRegionDecoder::ReadSize(in.jpeg.data(), in.jpeg.size(), what);
+              } catch (const Error&) {
+              }
+              check_size(got);
               if (summary.bad_frames[c]++ == 0) summary.first_bad_frame[c] = e.what();
-              m.candidates.clear();
-              track.Update(m.candidates, true);
-              ++count;
-              if (!queues[c]->Push(m)) break;
-              continue;
+              return nullptr;
             }
-          }
-          FV_REQUIRE(got == size, "video '{}' frame {} is {}x{}, camera {} is {}x{}",
-                     sources[c]->name(), m.frame, got.width, got.height, c, size.width,
-                     size.height);
+            return &decoded;
+          };
           const cv::Rect window = track.Window(size);
           bool full = window.empty();
-          try {
+          const cv::Mat* frame = image(window);
+          m.candidates.clear();
+          if (frame != nullptr) {
+            check_size(frame->size());
             if (!full) {
-              m.candidates = detectors[c](image(window), window);
+              m.candidates = detectors[c](*frame, window);
               ++summary.window_scans[c];
               full = !HasAccepted(m.candidates);
             }
-            if (full) {
-              m.candidates = detectors[c](image(cv::Rect()), cv::Rect());
+            if (full && !window.empty()) frame = image(cv::Rect());
+            if (frame == nullptr) {
+              m.candidates.clear();
+            } else if (full) {
+              m.candidates = detectors[c](*frame, cv::Rect());
               ++summary.full_scans[c];
             }
-          } catch (const Error& e) {
-            if (!encoded) throw;
-            if (summary.bad_frames[c]++ == 0) summary.first_bad_frame[c] = e.what();
-            m.candidates.clear();
-            full = true;
           }
+          full = full || frame == nullptr;
           track.Update(m.candidates, full);
           ++count;
           if (!queues[c]->Push(m)) break;
