@@ -443,18 +443,17 @@ TriangulationResult RobustCore(const std::vector<Camera>& cameras,
     if (!uv) return -1;
     const double err = (*uv - obs.centre_px).norm();
     if (err > Threshold(o, obs.sigma_px)) return -1;
-    if (o.max_radius_ratio > 0 && obs.radius_px > 0 && o.ball_radius_m > 0) {
+    // The reported radius against the one the depth predicts, within max_ratio either way
+    // (0: no check).
+    auto radius_ok = [&](double max_ratio) {
+      if (max_ratio <= 0 || obs.radius_px <= 0 || o.ball_radius_m <= 0) return true;
       const Camera& cam = cameras[c];
       const double expected = o.ball_radius_m * std::sqrt(cam.fx * cam.fy) / Depth(cam, p);
       const double ratio = obs.radius_px / expected;
-      if (ratio > o.max_radius_ratio || ratio < 1.0 / o.max_radius_ratio) return -1;
-    }
-    if (obs.weak && o.weak_max_radius_ratio > 0 && obs.radius_px > 0 && o.ball_radius_m > 0) {
-      const Camera& cam = cameras[c];
-      const double expected = o.ball_radius_m * std::sqrt(cam.fx * cam.fy) / Depth(cam, p);
-      const double ratio = obs.radius_px / expected;
-      if (ratio > o.weak_max_radius_ratio || ratio < 1.0 / o.weak_max_radius_ratio) return -1;
-    }
+      return ratio <= max_ratio && ratio >= 1.0 / max_ratio;
+    };
+    if (!radius_ok(o.max_radius_ratio)) return -1;
+    if (obs.weak && !radius_ok(o.weak_max_radius_ratio)) return -1;
     return err;
   };
   // For a point: the best consistent candidate of every camera and the weighted squared error.
