@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "fieldvision/geometry/rigid.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::track {
@@ -18,10 +19,10 @@ using Vec4 = Eigen::Vector4d;
 // The ground point under pixel (u, v), or false.
 bool Ground(const Camera& camera, double u, double v, Eigen::Vector2d* g) {
   const auto ray = camera.RayFromPixel({u, v});
-  if (!ray || !(ray->direction.z() < -1e-9)) return false;
-  const double s = -ray->origin.z() / ray->direction.z();
-  if (!(s > 0)) return false;
-  *g = (ray->origin + s * ray->direction).head<2>();
+  if (!ray) return false;
+  const auto p = IntersectHorizontalPlane(*ray, 0.0);
+  if (!p) return false;
+  *g = p->head<2>();
   return true;
 }
 
