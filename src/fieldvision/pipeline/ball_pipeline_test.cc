@@ -70,6 +70,14 @@ std::vector<BallObservation> Centroid(const cv::Mat& bgr) {
   return {o};
 }
 
+// The same, searching only `roi` when one is given (whole-frame pixels).
+std::vector<BallObservation> CentroidInWindow(const cv::Mat& bgr, const cv::Rect& roi) {
+  if (roi.empty()) return Centroid(bgr);
+  auto obs = Centroid(bgr(roi));
+  for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
+  return obs;
+}
+
 struct Scene {
   std::vector<Camera> cams = SmallRig();
   std::vector<std::string> videos;
@@ -135,11 +143,8 @@ TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
   }
   int calls_with_window = 0;
   auto in_window = [&](const cv::Mat& bgr, const cv::Rect& roi) {
-    if (roi.empty()) return Centroid(bgr);
-    ++calls_with_window;
-    auto obs = Centroid(bgr(roi));
-    for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
-    return obs;
+    calls_with_window += !roi.empty();
+    return CentroidInWindow(bgr, roi);
   };
   std::vector<BallFrame> tracked;
   opt.track.full_scan_every = 8;
@@ -203,18 +208,12 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
   }
   std::vector<std::unique_ptr<FrameSource>> sources;
   for (const auto& p : patterns) sources.push_back(std::make_unique<VideoFrameSource>(p, enc));
-  auto in_window = [](const cv::Mat& bgr, const cv::Rect& roi) {
-    if (roi.empty()) return Centroid(bgr);
-    auto obs = Centroid(bgr(roi));
-    for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
-    return obs;
-  };
   BallPipelineOptions opt;
   opt.progress = false;
   std::vector<BallFrame> frames;
-  const auto summary =
-      RunBallPipelineTracked(s.cams, sources, {in_window, in_window, in_window}, opt,
-                             [&](const BallFrame& f) { frames.push_back(f); });
+  const auto summary = RunBallPipelineTracked(
+      s.cams, sources, {CentroidInWindow, CentroidInWindow, CentroidInWindow}, opt,
+      [&](const BallFrame& f) { frames.push_back(f); });
   ASSERT_EQ(frames.size(), 24u);
   EXPECT_GT(summary.window_scans[0], 12);
   for (const BallFrame& f : frames) {
@@ -243,18 +242,12 @@ TEST(BallPipeline, DamagedMjpgFrameIsReportedNotFatal) {
   std::vector<FrameSourceOptions> vo(3);
   for (auto& v : vo) v.encoded = true;
   auto sources = Open(s, vo);
-  auto in_window = [](const cv::Mat& bgr, const cv::Rect& roi) {
-    if (roi.empty()) return Centroid(bgr);
-    auto obs = Centroid(bgr(roi));
-    for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
-    return obs;
-  };
   BallPipelineOptions opt;
   opt.progress = false;
   std::vector<BallFrame> frames;
-  const auto summary =
-      RunBallPipelineTracked(s.cams, sources, {in_window, in_window, in_window}, opt,
-                             [&](const BallFrame& f) { frames.push_back(f); });
+  const auto summary = RunBallPipelineTracked(
+      s.cams, sources, {CentroidInWindow, CentroidInWindow, CentroidInWindow}, opt,
+      [&](const BallFrame& f) { frames.push_back(f); });
   ASSERT_EQ(frames.size(), 20u);
   EXPECT_EQ(summary.bad_frames[1], 1);
   EXPECT_NE(summary.first_bad_frame[1].find("cam1.avi' frame 5"), std::string::npos)
