@@ -72,6 +72,15 @@ std::string BallPipelineSummary::ToString() const {
   return s;
 }
 
+namespace {
+
+// At least one candidate that is not weak.
+bool HasAccepted(const std::vector<BallObservation>& obs) {
+  return std::any_of(obs.begin(), obs.end(), [](const BallObservation& o) { return !o.weak; });
+}
+
+}  // namespace
+
 void BallPredictor::Add(long long frame, const Eigen::Vector3d& point_world) {
   frame_[1] = frame_[0];
   point_[1] = point_[0];
@@ -97,10 +106,7 @@ BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame
     if (!frame.cameras[c]) continue;
     ++out.cameras_present;
     candidates[c] = frame.cameras[c]->candidates;
-    if (std::any_of(candidates[c].begin(), candidates[c].end(),
-                    [](const BallObservation& o) { return !o.weak; })) {
-      ++out.cameras_with_blobs;
-    }
+    if (HasAccepted(candidates[c])) ++out.cameras_with_blobs;
   }
   out.result = TriangulateRobust(cameras, candidates, options, prior);
   return out;
@@ -158,10 +164,6 @@ class ImageTrack {
   Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
   double radius_ = 0.0;
 };
-
-bool HasAccepted(const std::vector<BallObservation>& obs) {
-  return std::any_of(obs.begin(), obs.end(), [](const BallObservation& o) { return !o.weak; });
-}
 
 }  // namespace
 
