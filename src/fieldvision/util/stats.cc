@@ -1,0 +1,47 @@
+#include "fieldvision/util/stats.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fv {
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  q = std::clamp(q, 0.0, 1.0);
+  const double pos = q * static_cast<double>(values.size() - 1);
+  const auto lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(lo + 1, values.size() - 1);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(lo), values.end());
+  const double v_lo = values[lo];
+  if (hi == lo) return v_lo;
+  const double v_hi =
+      *std::min_element(values.begin() + static_cast<std::ptrdiff_t>(lo) + 1, values.end());
+  return v_lo + (pos - static_cast<double>(lo)) * (v_hi - v_lo);
+}
+
+double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
+
+double Mean(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  double s = 0.0;
+  for (double v : values) s += v;
+  return s / static_cast<double>(values.size());
+}
+
+double Rms(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  double s = 0.0;
+  for (double v : values) s += v * v;
+  return std::sqrt(s / static_cast<double>(values.size()));
+}
+
+double RobustSigma(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  const double m = Median(values);
+  std::vector<double> dev;
+  dev.reserve(values.size());
+  for (double v : values) dev.push_back(std::abs(v - m));
+  return 1.4826 * Median(std::move(dev));
+}
+
+}  // namespace fv

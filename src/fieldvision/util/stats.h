@@ -1,0 +1,18 @@
+// Summary statistics used across modules (error tables, robust thresholds): percentiles with
+// linear interpolation between closest ranks (numpy's default), median, mean, RMS and the
+// median absolute deviation scaled to a normal sigma (Hampel 1974).
+#pragma once
+
+#include <vector>
+
+namespace fv {
+
+// q in [0, 1]; 0 for an empty sample. Non-finite values must be removed by the caller.
+double Percentile(std::vector<double> values, double q);
+double Median(std::vector<double> values);
+double Mean(const std::vector<double>& values);
+double Rms(const std::vector<double>& values);
+// 1.4826 * median |x - median|: a normal sigma that ignores up to half the sample as outliers.
+double RobustSigma(const std::vector<double>& values);
+
+}  // namespace fv
