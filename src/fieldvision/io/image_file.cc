@@ -6,6 +6,17 @@
 
 namespace fv {
 
+cv::Mat ReadImage(const std::string& path) {
+  cv::Mat image;
+  try {
+    image = cv::imread(path, cv::IMREAD_COLOR);
+  } catch (const cv::Exception&) {
+    image.release();
+  }
+  FV_REQUIRE(!image.empty(), "cannot read image '{}' (missing, unreadable or not an image)", path);
+  return image;
+}
+
 void WriteImage(const std::string& path, const cv::Mat& image) {
   bool ok = false;
   try {

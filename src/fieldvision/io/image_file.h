@@ -1,5 +1,5 @@
-// Writing result images (maps, overlays, pictures): cv::imwrite with a one-line fv::Error that
-// names the path when the folder or the extension is wrong.
+// Reading and writing single images (frames, maps, overlays, pictures): cv::imread/imwrite with a
+// one-line fv::Error that names the path.
 #pragma once
 
 #include <string>
@@ -7,6 +7,9 @@
 #include <opencv2/core.hpp>
 
 namespace fv {
+
+// An 8-bit BGR image; throws fv::Error naming `path` when it is missing or does not decode.
+cv::Mat ReadImage(const std::string& path);
 
 // Throws fv::Error naming `path` when the image cannot be written.
 void WriteImage(const std::string& path, const cv::Mat& image);
