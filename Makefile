@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test demo bench format tidy clean
+.PHONY: all deps configure build test demo bench format tidy clean studio
 
 all: build
 
@@ -19,12 +19,17 @@ configure: deps $(BUILD)/build.ninja
 build: configure
 	cmake --build $(BUILD) -j $(JOBS)
 	@if [ -f scripts/fetch-models.sh ]; then bash scripts/fetch-models.sh $(BUILD); fi
+	@bash studio/build.sh
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 600
 
 demo: build
 	bash scripts/demo.sh $(BUILD)
+
+# The studio web app over the current folder (http://127.0.0.1:8470/; Ctrl-C stops).
+studio: build
+	$(BUILD)/bin/fieldvision studio
 
 bench: build
 	bash scripts/bench.sh $(BUILD)

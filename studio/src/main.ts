@@ -1,0 +1,44 @@
+// The studio's pages, one per hash (#calibrate, #colour, #view3d, #players), and the live status
+// line fed by the server's Server-Sent Events (/api/events).
+import './style.css';
+import { url } from './api';
+import { calibratePage } from './calibrate';
+import { colourPage } from './colour';
+import { view3dPage } from './view3d';
+import { playersPage } from './players';
+
+const pages: Record<string, (root: HTMLElement) => Promise<void>> = {
+  calibrate: calibratePage,
+  colour: colourPage,
+  view3d: view3dPage,
+  players: playersPage,
+};
+
+async function route(): Promise<void> {
+  const name = location.hash.slice(1) || 'calibrate';
+  const root = document.getElementById('page')!;
+  for (const a of document.querySelectorAll<HTMLAnchorElement>('#nav a')) {
+    a.classList.toggle('active', a.hash === `#${name}`);
+  }
+  const page = pages[name] ?? calibratePage;
+  root.dataset.page = name;
+  root.dataset.ready = '';
+  try {
+    await page(root);
+  } catch (e) {
+    root.textContent = `cannot open the page: ${(e as Error).message}`;
+  }
+  root.dataset.ready = '1';
+}
+
+const live = document.getElementById('live')!;
+const events = new EventSource(url('/api/events'));
+events.addEventListener('hello', () => (live.textContent = 'live'));
+events.addEventListener('saved', (e) => {
+  const d = JSON.parse((e as MessageEvent).data);
+  live.textContent = `saved ${d.path}`;
+});
+events.onerror = () => (live.textContent = 'server not reachable');
+
+window.addEventListener('hashchange', () => void route());
+void route();
