@@ -11,6 +11,7 @@ PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-onnx python3-numpy darknet
   libcpp-httplib-dev chromium
+  libzmq3-dev cppzmq-dev python3-zmq
 )
 missing=()
 for p in "${PKGS[@]}"; do
@@ -20,7 +21,9 @@ for p in "${PKGS[@]}"; do
 done
 # npm fetches the pretrained detector (scripts/fetch-models.sh); any npm on PATH will do. darknet
 # ships the sample photo person.jpg that the detector test uses. npm also builds the studio's front
-# end (studio/); chromium runs its browser tests (never a downloaded browser).
+# end (studio/); chromium runs its browser tests (never a downloaded browser). ZeroMQ joins camera
+# nodes and the fusion node (python3-zmq runs the README's example client). Optional, found when
+# installed: libaravis-dev (GigE / USB3 Vision cameras, `aravis:` sources).
 command -v npm >/dev/null 2>&1 || missing+=(npm)
 [ ${#missing[@]} -eq 0 ] && exit 0
 SUDO=""
