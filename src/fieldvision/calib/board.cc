@@ -75,12 +75,25 @@ BoardType ParseBoardType(const std::string& name) {
   Throw("board '{}' is not known; use chessboard or charuco", name);
 }
 
+int DictionaryId(const std::string& name) {
+  const auto it = DictionaryNames().find(name);
+  FV_REQUIRE(it != DictionaryNames().end(),
+             "board dictionary '{}' is not an OpenCV ArUco dictionary (e.g. DICT_4X4_50)", name);
+  return it->second;
+}
+
 void BoardSpec::Check() const {
   const int min_size = type == BoardType::kChessboard ? 2 : 3;
   FV_REQUIRE(cols >= min_size && rows >= min_size, "board cols and rows must be >= {} (got {}x{})",
              min_size, cols, rows);
   FV_REQUIRE(std::isfinite(square_m) && square_m > 0, "board square must be > 0 m (got {})",
              square_m);
+  FV_REQUIRE(square_m <= 1.0,
+             "board square {} m is over 1 m: sizes are in metres ({} mm is --square {})", square_m,
+             square_m, square_m / 1000);
+  FV_REQUIRE(marker_m <= 1.0,
+             "board marker {} m is over 1 m: sizes are in metres ({} mm is --marker {})", marker_m,
+             marker_m, marker_m / 1000);
   if (type == BoardType::kCharuco) {
     FV_REQUIRE(std::isfinite(marker_m) && marker_m >= 0 && marker_m < square_m,
                "board marker size must be in [0, square) (got {} m, square {} m)", marker_m,

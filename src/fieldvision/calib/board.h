@@ -37,6 +37,10 @@ struct BoardSpec {
 // Parses "chessboard" or "charuco"; throws naming the value otherwise.
 BoardType ParseBoardType(const std::string& name);
 
+// OpenCV's id of an ArUco dictionary name (cv::aruco::PREDEFINED_DICTIONARY_NAME); throws naming
+// the value otherwise.
+int DictionaryId(const std::string& name);
+
 struct DetectOptions {
   // cornerSubPix half window in pixels (cv::cornerSubPix's winSize; OpenCV's calibration sample
   // uses 11), capped at subpix_square_fraction x the smallest square seen so that the window does

@@ -1,0 +1,874 @@
+#include "fieldvision/calib/multi.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/calib/intrinsics.h"
+#include "fieldvision/camera/projection.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::calib {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+// The last run of digits in a file's stem, or in a video frame's "#N"; -1 when there is none.
+long long LastNumber(const std::string& name) {
+  const size_t hash = name.rfind('#');
+  const std::string s = hash != std::string::npos ? name.substr(hash + 1)
+                                                  : std::filesystem::path(name).stem().string();
+  size_t end = s.size();
+  while (end > 0 && !std::isdigit(static_cast<unsigned char>(s[end - 1]))) --end;
+  if (end == 0) return -1;
+  size_t begin = end;
+  while (begin > 0 && std::isdigit(static_cast<unsigned char>(s[begin - 1]))) --begin;
+  if (end - begin > 15) return -1;
+  return std::stoll(s.substr(begin, end - begin));
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Board corner (board frame, metres) -> pixel of camera c through the board's pose in the
+// reference frame (ref_from_board) and the camera's (cam_from_ref).
+struct BoardCornerCost {
+  BoardCornerCost(const cv::Point2f& uv, const cv::Point3f& p)
+      : u(uv.x), v(uv.y), x(p.x), y(p.y), z(p.z) {}
+  template <typename T>
+  bool operator()(const T* intrinsics, const T* cam_r, const T* cam_t, const T* board_r,
+                  const T* board_t, T* residual) const {
+    const T p[3] = {T(x), T(y), T(z)};
+    T p_ref[3];
+    ceres::AngleAxisRotatePoint(board_r, p, p_ref);
+    for (int k = 0; k < 3; ++k) p_ref[k] += board_t[k];
+    T uv[2];
+    if (!ProjectWorldPoint(intrinsics, cam_r, cam_t, p_ref, uv)) return false;
+    residual[0] = uv[0] - T(u);
+    residual[1] = uv[1] - T(v);
+    return true;
+  }
+  double u, v, x, y, z;
+};
+
+struct ViewPose {
+  bool ok = false;
+  Rigid3d cam_from_board;
+  double rms_px = 0.0;
+};
+
+std::vector<cv::Point2f> ProjectBoard(const Camera& cam, const Rigid3d& cam_from_board,
+                                      const std::vector<cv::Point3f>& pts, bool* all_in_front) {
+  std::vector<cv::Point2f> out;
+  out.reserve(pts.size());
+  *all_in_front = true;
+  for (const auto& p : pts) {
+    const auto uv = cam.ProjectFromCamera(cam_from_board * Eigen::Vector3d(p.x, p.y, p.z));
+    if (!uv) {
+      *all_in_front = false;
+      out.emplace_back(-1e6f, -1e6f);
+    } else {
+      out.emplace_back(static_cast<float>(uv->x()), static_cast<float>(uv->y()));
+    }
+  }
+  return out;
+}
+
+double RmsBetween(const std::vector<cv::Point2f>& a, const std::vector<cv::Point2f>& b) {
+  double sq = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const double dx = a[i].x - b[i].x, dy = a[i].y - b[i].y;
+    sq += dx * dx + dy * dy;
+  }
+  return a.empty() ? 0.0 : std::sqrt(sq / a.size());
+}
+
+// Board pose in one view with known intrinsics: IPPE (planar), then Levenberg-Marquardt.
+ViewPose BoardPose(const Camera& cam, const BoardView& view) {
+  ViewPose out;
+  if (view.image_points.size() < 4) return out;
+  const cv::Mat k = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+  const cv::Mat d = cam.distortion.empty() ? cv::Mat::zeros(1, 5, CV_64F)
+                                           : cv::Mat(cam.distortion, true).reshape(1, 1);
+  cv::Mat rvec, tvec;
+  try {
+    if (!cv::solvePnP(view.object_points, view.image_points, k, d, rvec, tvec, false,
+                      cv::SOLVEPNP_IPPE)) {
+      return out;
+    }
+    cv::solvePnP(view.object_points, view.image_points, k, d, rvec, tvec, true,
+                 cv::SOLVEPNP_ITERATIVE);
+  } catch (const cv::Exception&) {
+    return out;
+  }
+  out.cam_from_board =
+      Rigid3d::FromRvecTvec({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)},
+                            {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)});
+  bool in_front = true;
+  const auto proj = ProjectBoard(cam, out.cam_from_board, view.object_points, &in_front);
+  if (!in_front) return out;
+  out.rms_px = RmsBetween(proj, view.image_points);
+  out.ok = std::isfinite(out.rms_px);
+  return out;
+}
+
+}  // namespace
+
+CameraViews ParseCameraViews(const std::string& arg) {
+  const size_t eq = arg.find('=');
+  FV_REQUIRE(eq != std::string::npos && eq > 0 && eq + 1 < arg.size(),
+             "--views '{}': give NAME=GLOB_OR_DIR_OR_VIDEO (e.g. left='data/left*.jpg')", arg);
+  CameraViews v{arg.substr(0, eq), arg.substr(eq + 1)};
+  FV_REQUIRE(v.name.find_first_of("/\\ ") == std::string::npos,
+             "--views '{}': the camera name '{}' must not contain '/', '\\' or spaces (it names "
+             "the file NAME.yaml)",
+             arg, v.name);
+  return v;
+}
+
+Pairing ParsePairing(const std::string& name) {
+  const std::string n = ToLower(name);
+  if (n == "auto") return Pairing::kAuto;
+  if (n == "order") return Pairing::kOrder;
+  if (n == "frame" || n == "frame-number") return Pairing::kFrameNumber;
+  Throw("pairing '{}' is not known; use auto, order or frame", name);
+}
+
+void MultiOptions::Check() const {
+  board.Check();
+  detect.Check();
+  source.Check();
+  FV_REQUIRE(num_distortion == 4 || num_distortion == 5 || num_distortion == 8 ||
+                 num_distortion == 12 || num_distortion == 14,
+             "num_distortion must be 4, 5, 8, 12 or 14 (got {})", num_distortion);
+  CheckPositive(loss_px, "loss_px");
+  CheckPositive(outlier_factor, "outlier_factor");
+  CheckNonNegative(outlier_min_px, "outlier_min_px");
+  CheckInRange(max_drop_fraction, 0.0, 0.9, "max_drop_fraction");
+  FV_REQUIRE(min_shared_views >= 1, "min_shared_views must be >= 1 (got {})", min_shared_views);
+  FV_REQUIRE(min_views >= 2, "min_views must be >= 2 (got {})", min_views);
+  FV_REQUIRE(max_iterations >= 1, "max_iterations must be >= 1 (got {})", max_iterations);
+  for (const auto& [name, cam] : known_intrinsics) cam.Check("known intrinsics of " + name);
+}
+
+std::string MultiResult::Summary() const {
+  std::string s = fmt::format(
+      "{} cameras, {} moments with the board ({}), rms {:.3f} px over the used corners; {} "
+      "adjustments, {} iterations, cost {:.4g} -> {:.4g}",
+      cameras.size(), num_frames, pairing, rms_px, num_adjustments, iterations, initial_cost,
+      final_cost);
+  for (const auto& c : camera_reports) {
+    const Camera* cam = nullptr;
+    for (const auto& k : cameras) {
+      if (k.name == c.name) cam = &k;
+    }
+    s += fmt::format(
+        "\n  camera {}: {} of {} views used ({} images), rms {:.3f} px (alone {:.3f} px)", c.name,
+        c.num_used, c.num_found, c.num_images, c.rms_px, c.own_rms_px);
+    if (cam) {
+      s += fmt::format("; fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}", cam->fx, cam->fy, cam->cx,
+                       cam->cy);
+    }
+    if (c.tree_parent >= 0) {
+      s += fmt::format("; chained from {} ({} shared views)", camera_reports[c.tree_parent].name,
+                       c.tree_shared_views);
+    } else {
+      s += "; reference frame";
+    }
+  }
+  for (const auto& p : pairs) {
+    s += fmt::format("\n  pair {}-{}: rotation {:.3f} deg, baseline {:.2f} mm, {} shared views",
+                     camera_reports[p.i].name, camera_reports[p.j].name, p.rotation_deg,
+                     1000 * p.baseline_m, p.shared_views);
+  }
+  for (const auto& v : views) {
+    if (!v.used) {
+      s += fmt::format("\n  dropped view {} of {}: {}", v.name, camera_reports[v.camera].name,
+                       v.dropped_because);
+    }
+  }
+  return s;
+}
+
+CameraDetections DetectCameraViews(const CameraViews& camera, const MultiOptions& options) {
+  options.Check();
+  const ImageSource source(camera.source, options.source);
+  CameraDetections out;
+  out.name = camera.name;
+  out.source = camera.source;
+  Progress progress(fmt::format("camera {}: detecting corners", camera.name), source.size(),
+                    "images", options.progress);
+  cv::Size first_size;
+  for (int i = 0; i < source.size(); ++i) {
+    const cv::Mat image = source.Read(i);
+    if (i == 0) first_size = image.size();
+    FV_REQUIRE(image.size() == first_size, "camera '{}': image '{}' is {}x{} but '{}' is {}x{}",
+               camera.name, source.name(i), image.cols, image.rows, source.name(0),
+               first_size.width, first_size.height);
+    out.views.push_back(DetectBoard(image, options.board, options.detect, source.name(i)));
+    out.frame_numbers.push_back(LastNumber(source.name(i)));
+    progress.Update(i + 1);
+  }
+  progress.Finish();
+  return out;
+}
+
+std::vector<MultiFrame> PairViews(const std::vector<CameraDetections>& cameras, Pairing pairing,
+                                  std::string* how) {
+  FV_REQUIRE(cameras.size() >= 2, "a rig needs at least 2 cameras (got {}); give --views twice",
+             cameras.size());
+  const size_t n = cameras.size();
+  // Frame numbers usable when every view has one and they are unique per camera.
+  auto numbered = [&](size_t c, std::string* why) {
+    std::set<long long> seen;
+    for (size_t i = 0; i < cameras[c].views.size(); ++i) {
+      const long long f = cameras[c].frame_numbers[i];
+      if (f < 0) {
+        if (why) *why = fmt::format("image '{}' has no number", cameras[c].views[i].name);
+        return false;
+      }
+      if (!seen.insert(f).second) {
+        if (why) *why = fmt::format("two images are numbered {}", f);
+        return false;
+      }
+    }
+    return true;
+  };
+  auto by_frame = [&]() {
+    std::map<long long, MultiFrame> frames;
+    for (size_t c = 0; c < n; ++c) {
+      for (size_t i = 0; i < cameras[c].views.size(); ++i) {
+        const long long f = cameras[c].frame_numbers[i];
+        MultiFrame& m = frames[f];
+        if (m.views.empty()) {
+          m.key = fmt::format("frame {}", f);
+          m.views.resize(n);
+        }
+        m.views[c] = cameras[c].views[i];
+      }
+    }
+    std::vector<MultiFrame> out;
+    for (auto& [f, m] : frames) out.push_back(std::move(m));
+    return out;
+  };
+  auto by_order = [&]() {
+    for (size_t c = 1; c < n; ++c) {
+      FV_REQUIRE(cameras[c].views.size() == cameras[0].views.size(),
+                 "views cannot be paired: camera '{}' has {} images but camera '{}' has {}; name "
+                 "the images with frame numbers (left07.jpg, right07.jpg) or give each camera the "
+                 "same moments",
+                 cameras[c].name, cameras[c].views.size(), cameras[0].name,
+                 cameras[0].views.size());
+    }
+    std::vector<MultiFrame> out(cameras[0].views.size());
+    for (size_t i = 0; i < out.size(); ++i) {
+      out[i].key = fmt::format("#{}", i + 1);
+      out[i].views.resize(n);
+      for (size_t c = 0; c < n; ++c) out[i].views[c] = cameras[c].views[i];
+    }
+    return out;
+  };
+  auto shared_moments = [&](const std::vector<MultiFrame>& frames) {
+    int count = 0;
+    for (const auto& f : frames) {
+      int cams = 0;
+      for (const auto& v : f.views) cams += v.name.empty() ? 0 : 1;
+      count += cams >= 2 ? 1 : 0;
+    }
+    return count;
+  };
+  if (pairing == Pairing::kFrameNumber) {
+    for (size_t c = 0; c < n; ++c) {
+      std::string why;
+      FV_REQUIRE(numbered(c, &why),
+                 "views of camera '{}' cannot be paired by frame number: {}; use --pairing order",
+                 cameras[c].name, why);
+    }
+    auto frames = by_frame();
+    FV_REQUIRE(shared_moments(frames) > 0,
+               "views cannot be paired: no frame number occurs in two cameras (camera '{}' numbers "
+               "{}..); use --pairing order",
+               cameras[0].name, cameras[0].frame_numbers.empty() ? 0 : cameras[0].frame_numbers[0]);
+    if (how) *how = "paired by frame number";
+    return frames;
+  }
+  if (pairing == Pairing::kAuto) {
+    bool all = true;
+    for (size_t c = 0; c < n; ++c) all = all && numbered(c, nullptr);
+    if (all) {
+      auto frames = by_frame();
+      if (shared_moments(frames) > 0) {
+        if (how) *how = "paired by frame number";
+        return frames;
+      }
+    }
+  }
+  if (how) *how = "paired by sorted order";
+  return by_order();
+}
+
+MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
+                                     const std::vector<MultiFrame>& frames,
+                                     const MultiOptions& options, const std::string& pairing) {
+  options.Check();
+  const int nc = static_cast<int>(names.size());
+  FV_REQUIRE(nc >= 2, "a rig needs at least 2 cameras (got {})", nc);
+  {
+    std::set<std::string> unique(names.begin(), names.end());
+    FV_REQUIRE(static_cast<int>(unique.size()) == nc,
+               "two cameras have the same name; give each --views a different NAME");
+  }
+  const int nf = static_cast<int>(frames.size());
+  for (const auto& f : frames) {
+    FV_REQUIRE(static_cast<int>(f.views.size()) == nc, "moment {} has {} views for {} cameras",
+               f.key, f.views.size(), nc);
+  }
+  MultiResult result;
+  result.pairing = pairing.empty() ? "paired by moment" : pairing;
+
+  // ---- Intrinsics per camera.
+  std::vector<Camera> cams(nc);
+  result.camera_reports.resize(nc);
+  for (int c = 0; c < nc; ++c) {
+    auto& rep = result.camera_reports[c];
+    rep.name = names[c];
+    std::vector<BoardView> found;
+    for (const auto& f : frames) {
+      if (f.views[c].name.empty()) continue;
+      ++rep.num_images;
+      if (!f.views[c].image_points.empty()) found.push_back(f.views[c]);
+    }
+    rep.num_found = static_cast<int>(found.size());
+    FV_REQUIRE(!found.empty(),
+               "camera '{}': no {} found in any of its {} images (check --cols/--rows{})", names[c],
+               options.board.Describe(), rep.num_images,
+               options.board.type == BoardType::kCharuco ? ", --dictionary and --marker" : "");
+    const auto known = options.known_intrinsics.find(names[c]);
+    if (known != options.known_intrinsics.end()) {
+      cams[c] = known->second;
+      FV_REQUIRE(cams[c].width == found[0].image_size.width &&
+                     cams[c].height == found[0].image_size.height,
+                 "camera '{}': the known intrinsics are for {}x{} images but its images are {}x{}",
+                 names[c], cams[c].width, cams[c].height, found[0].image_size.width,
+                 found[0].image_size.height);
+      cams[c].has_pose = false;
+      cams[c].rms_px.reset();
+      cams[c].notes.clear();
+      continue;
+    }
+    FV_REQUIRE(rep.num_found >= options.min_views,
+               "camera '{}': the {} was found in only {} of its {} images; its intrinsics need at "
+               "least {} views (add views, or give its intrinsics with --intrinsics {}=CAM.yaml)",
+               names[c], options.board.Describe(), rep.num_found, rep.num_images, options.min_views,
+               names[c]);
+    IntrinsicsOptions io;
+    io.board = options.board;
+    io.detect = options.detect;
+    io.num_distortion = options.num_distortion;
+    io.min_views = options.min_views;
+    io.progress = false;
+    io.camera_name = names[c];
+    try {
+      const IntrinsicsResult ir = CalibrateFromViews(found, io);
+      cams[c] = ir.camera;
+      rep.own_rms_px = ir.rms_px;
+    } catch (const Error& e) {
+      Throw("camera '{}': {}", names[c], e.what());
+    }
+    cams[c].notes.clear();
+  }
+
+  // ---- Board pose in every view.
+  std::vector<std::vector<ViewPose>> pose(nc, std::vector<ViewPose>(nf));
+  for (int c = 0; c < nc; ++c) {
+    for (int f = 0; f < nf; ++f) {
+      const BoardView& v = frames[f].views[c];
+      if (!v.image_points.empty()) pose[c][f] = BoardPose(cams[c], v);
+    }
+  }
+
+  // ---- Relative pose of each linked pair: the shared view whose relative pose best transfers
+  // the board from camera a to camera b in all shared views.
+  struct Edge {
+    int shared = 0;
+    Rigid3d b_from_a;
+  };
+  auto relative = [&](int a, int b) {
+    Edge e;
+    std::vector<int> shared;
+    for (int f = 0; f < nf; ++f) {
+      if (pose[a][f].ok && pose[b][f].ok) shared.push_back(f);
+    }
+    e.shared = static_cast<int>(shared.size());
+    double best = 1e300;
+    for (int f : shared) {
+      const Rigid3d cand = pose[b][f].cam_from_board * pose[a][f].cam_from_board.Inverse();
+      double score = 0;
+      for (int g : shared) {
+        bool in_front = true;
+        const auto proj = ProjectBoard(cams[b], cand * pose[a][g].cam_from_board,
+                                       frames[g].views[b].object_points, &in_front);
+        score +=
+            in_front ? std::min(RmsBetween(proj, frames[g].views[b].image_points), 50.0) : 50.0;
+      }
+      if (score < best) {
+        best = score;
+        e.b_from_a = cand;
+      }
+    }
+    return e;
+  };
+  std::vector<std::vector<Edge>> edges(nc, std::vector<Edge>(nc));
+  for (int a = 0; a < nc; ++a) {
+    for (int b = 0; b < nc; ++b) {
+      if (a != b) edges[a][b] = relative(a, b);
+    }
+  }
+  // Maximum spanning tree (Prim) from the first camera.
+  std::vector<bool> in_tree(nc, false);
+  std::vector<Rigid3d> cam_from_ref(nc);
+  in_tree[0] = true;
+  for (int added = 1; added < nc; ++added) {
+    int best_a = -1, best_b = -1, best_shared = 0;
+    for (int a = 0; a < nc; ++a) {
+      if (!in_tree[a]) continue;
+      for (int b = 0; b < nc; ++b) {
+        if (in_tree[b] || edges[a][b].shared < options.min_shared_views) continue;
+        if (edges[a][b].shared > best_shared) {
+          best_shared = edges[a][b].shared;
+          best_a = a;
+          best_b = b;
+        }
+      }
+    }
+    if (best_b < 0) {
+      for (int b = 0; b < nc; ++b) {
+        if (in_tree[b]) continue;
+        std::string counts;
+        for (int a = 0; a < nc; ++a) {
+          if (a != b)
+            counts +=
+                fmt::format("{}{} {}", counts.empty() ? "" : ", ", names[a], edges[a][b].shared);
+        }
+        Throw(
+            "camera '{}' never sees the board together with the rest of the rig (views shared "
+            "with: {}; {} needed): add moments where '{}' and another camera both see the whole "
+            "board, or check that the views pair up (--pairing)",
+            names[b], counts, options.min_shared_views, names[b]);
+      }
+    }
+    in_tree[best_b] = true;
+    cam_from_ref[best_b] = edges[best_a][best_b].b_from_a * cam_from_ref[best_a];
+    result.camera_reports[best_b].tree_parent = best_a;
+    result.camera_reports[best_b].tree_shared_views = best_shared;
+  }
+
+  // ---- Parameters: intrinsics, camera poses (the first fixed), board poses.
+  std::vector<std::array<double, kNumIntrinsics>> intr(nc);
+  std::vector<Eigen::Vector3d> cam_r(nc), cam_t(nc);
+  for (int c = 0; c < nc; ++c) {
+    intr[c] = cams[c].IntrinsicsBlock();
+    cam_r[c] = cam_from_ref[c].Rvec();
+    cam_t[c] = cam_from_ref[c].translation;
+  }
+  std::vector<Eigen::Vector3d> board_r(nf), board_t(nf);
+  std::vector<bool> board_ok(nf, false);
+  for (int f = 0; f < nf; ++f) {
+    int best = -1;
+    for (int c = 0; c < nc; ++c) {
+      if (pose[c][f].ok && (best < 0 || pose[c][f].rms_px < pose[best][f].rms_px)) best = c;
+    }
+    if (best < 0) continue;
+    const Rigid3d ref_from_board = cam_from_ref[best].Inverse() * pose[best][f].cam_from_board;
+    board_r[f] = ref_from_board.Rvec();
+    board_t[f] = ref_from_board.translation;
+    board_ok[f] = true;
+  }
+  // Views in the adjustment: every view with a board pose start.
+  std::vector<std::vector<bool>> used(nc, std::vector<bool>(nf, false));
+  int total_views = 0;
+  for (int c = 0; c < nc; ++c) {
+    for (int f = 0; f < nf; ++f) {
+      used[c][f] = board_ok[f] && !frames[f].views[c].image_points.empty();
+      total_views += used[c][f] ? 1 : 0;
+    }
+  }
+  std::vector<std::vector<std::string>> dropped_because(nc, std::vector<std::string>(nf));
+
+  auto view_errors = [&](int c, int f) {
+    const BoardView& v = frames[f].views[c];
+    std::vector<float> err(v.image_points.size(), 1e6f);
+    for (size_t k = 0; k < v.image_points.size(); ++k) {
+      BoardCornerCost cost(v.image_points[k], v.object_points[k]);
+      double res[2];
+      if (cost(intr[c].data(), cam_r[c].data(), cam_t[c].data(), board_r[f].data(),
+               board_t[f].data(), res)) {
+        err[k] = static_cast<float>(std::hypot(res[0], res[1]));
+      }
+    }
+    return err;
+  };
+  auto view_rms = [&](const std::vector<float>& err) {
+    double sq = 0;
+    for (float e : err) sq += static_cast<double>(e) * e;
+    return err.empty() ? 0.0 : std::sqrt(sq / err.size());
+  };
+
+  const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * total_views));
+  int dropped_total = 0;
+  for (int round = 0; round < 4; ++round) {
+    ceres::Problem problem;
+    std::vector<bool> frame_in(nf, false);
+    for (int c = 0; c < nc; ++c) {
+      for (int f = 0; f < nf; ++f) {
+        if (!used[c][f]) continue;
+        frame_in[f] = true;
+        const BoardView& v = frames[f].views[c];
+        for (size_t k = 0; k < v.image_points.size(); ++k) {
+          problem.AddResidualBlock(
+              new ceres::AutoDiffCostFunction<BoardCornerCost, 2, kNumIntrinsics, 3, 3, 3, 3>(
+                  new BoardCornerCost(v.image_points[k], v.object_points[k])),
+              new ceres::HuberLoss(options.loss_px), intr[c].data(), cam_r[c].data(),
+              cam_t[c].data(), board_r[f].data(), board_t[f].data());
+        }
+      }
+    }
+    for (int c = 0; c < nc; ++c) {
+      if (!problem.HasParameterBlock(intr[c].data())) continue;
+      const bool fixed = !options.refine_intrinsics || options.known_intrinsics.count(names[c]);
+      const int nd = fixed ? 0 : static_cast<int>(cams[c].distortion.size());
+      if (fixed) {
+        problem.SetParameterBlockConstant(intr[c].data());
+      } else if (nd < kNumDistortion) {
+        std::vector<int> constant;
+        for (int i = 4 + nd; i < kNumIntrinsics; ++i) constant.push_back(i);
+        problem.SetManifold(intr[c].data(), new ceres::SubsetManifold(kNumIntrinsics, constant));
+      }
+    }
+    if (problem.HasParameterBlock(cam_r[0].data())) {
+      problem.SetParameterBlockConstant(cam_r[0].data());
+      problem.SetParameterBlockConstant(cam_t[0].data());
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_SCHUR;
+    so.max_num_iterations = options.max_iterations;
+    so.num_threads = 1;
+    so.logging_type = ceres::SILENT;
+    so.function_tolerance = 1e-10;
+    so.parameter_tolerance = 1e-10;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    FV_REQUIRE(summary.IsSolutionUsable(), "the rig's bundle adjustment failed: {}",
+               summary.message);
+    ++result.num_adjustments;
+    result.iterations += static_cast<int>(summary.iterations.size());
+    if (round == 0) result.initial_cost = summary.initial_cost;
+    result.final_cost = summary.final_cost;
+
+    // Outlier views: the worst above the threshold, keeping every camera calibrated and linked.
+    std::vector<double> rms_all;
+    std::vector<std::tuple<double, int, int>> candidates;
+    for (int c = 0; c < nc; ++c) {
+      for (int f = 0; f < nf; ++f) {
+        if (!used[c][f]) continue;
+        const double r = view_rms(view_errors(c, f));
+        rms_all.push_back(r);
+        candidates.emplace_back(r, c, f);
+      }
+    }
+    const double med = Median(rms_all);
+    const double threshold = std::max(options.outlier_factor * med, options.outlier_min_px);
+    std::sort(candidates.rbegin(), candidates.rend());
+    int dropped_now = 0;
+    for (const auto& [r, c, f] : candidates) {
+      if (r <= threshold || dropped_total >= max_drop) break;
+      int views_left = 0, shared_left = 0;
+      for (int g = 0; g < nf; ++g) {
+        if (!used[c][g] || g == f) continue;
+        ++views_left;
+        for (int o = 0; o < nc; ++o) {
+          if (o != c && used[o][g]) {
+            ++shared_left;
+            break;
+          }
+        }
+      }
+      if (views_left < options.min_views || shared_left < 1) continue;
+      used[c][f] = false;
+      dropped_because[c][f] = fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})",
+                                          r, threshold, options.outlier_factor, med);
+      ++dropped_total;
+      ++dropped_now;
+    }
+    if (dropped_now == 0) break;
+  }
+
+  // ---- Results.
+  result.cameras.resize(nc);
+  double sq_all = 0;
+  long long n_all = 0;
+  for (int c = 0; c < nc; ++c) {
+    Camera& cam = result.cameras[c];
+    cam = cams[c];
+    cam.name = names[c];
+    cam.SetIntrinsicsBlock(intr[c], static_cast<int>(cams[c].distortion.size()));
+    cam.has_pose = true;
+    cam.cam_from_world = Rigid3d::FromRvecTvec(cam_r[c], cam_t[c]);
+    if (c == 0) cam.cam_from_world = Rigid3d();
+    double sq = 0;
+    long long n = 0;
+    auto& rep = result.camera_reports[c];
+    for (int f = 0; f < nf; ++f) {
+      const BoardView& v = frames[f].views[c];
+      if (v.image_points.empty()) continue;
+      MultiViewReport vr;
+      vr.camera = c;
+      vr.frame = f;
+      vr.name = v.name;
+      vr.image_points = v.image_points;
+      vr.object_points = v.object_points;
+      vr.corner_ids = v.corner_ids;
+      vr.used = used[c][f];
+      if (board_ok[f]) {
+        vr.err_px = view_errors(c, f);
+        vr.rms_px = view_rms(vr.err_px);
+      } else {
+        vr.err_px.assign(v.image_points.size(), 0.0f);
+        vr.dropped_because = "no board pose (the board could not be placed in this view)";
+      }
+      if (!dropped_because[c][f].empty()) vr.dropped_because = dropped_because[c][f];
+      if (vr.used) {
+        ++rep.num_used;
+        for (float e : vr.err_px) {
+          sq += static_cast<double>(e) * e;
+          ++n;
+        }
+      }
+      result.views.push_back(std::move(vr));
+    }
+    rep.rms_px = n ? std::sqrt(sq / n) : 0.0;
+    sq_all += sq;
+    n_all += n;
+    cam.rms_px = rep.rms_px;
+    cam.notes["board"] = options.board.Describe();
+    cam.notes["rig_reference"] = names[0];
+    cam.notes["rig_pose"] = "x_cam = R x_ref + t, ref = camera " + names[0];
+    cam.notes["num_views"] = std::to_string(rep.num_used);
+  }
+  result.rms_px = n_all ? std::sqrt(sq_all / n_all) : 0.0;
+  for (int f = 0; f < nf; ++f) {
+    for (int c = 0; c < nc; ++c) {
+      if (used[c][f]) {
+        ++result.num_frames;
+        break;
+      }
+    }
+  }
+  for (int i = 0; i < nc; ++i) {
+    for (int j = i + 1; j < nc; ++j) {
+      MultiPairReport p;
+      p.i = i;
+      p.j = j;
+      for (int f = 0; f < nf; ++f) p.shared_views += used[i][f] && used[j][f] ? 1 : 0;
+      const Camera& a = result.cameras[i];
+      const Camera& b = result.cameras[j];
+      p.rotation_deg =
+          RotationAngleBetween(b.cam_from_world.rotation * a.cam_from_world.rotation.transpose(),
+                               Eigen::Matrix3d::Identity()) *
+          kRadToDeg;
+      p.baseline_m = (a.CentreInWorld() - b.CentreInWorld()).norm();
+      result.pairs.push_back(p);
+    }
+  }
+  for (int c = 0; c < nc; ++c) {
+    const auto& rep = result.camera_reports[c];
+    if (rep.num_used < 8) {
+      result.warnings.push_back(fmt::format(
+          "camera '{}': only {} views; 10 or more spread over its image pin its intrinsics down",
+          rep.name, rep.num_used));
+    }
+    if (rep.rms_px > 1.0) {
+      result.warnings.push_back(fmt::format(
+          "camera '{}': rms {:.2f} px is high (blur, a bent board or unsynchronized views?)",
+          rep.name, rep.rms_px));
+    }
+  }
+  if (dropped_total > 0 && dropped_total >= max_drop) {
+    result.warnings.push_back(
+        fmt::format("{} views were dropped as outliers (the most allowed)", dropped_total));
+  }
+  return result;
+}
+
+MultiResult CalibrateMulti(const std::vector<CameraViews>& cameras, const MultiOptions& options) {
+  options.Check();
+  FV_REQUIRE(cameras.size() >= 2, "a rig needs at least 2 cameras (got {}); give --views twice",
+             cameras.size());
+  std::vector<CameraDetections> detections;
+  std::vector<std::string> names;
+  for (const auto& c : cameras) {
+    FV_REQUIRE(std::find(names.begin(), names.end(), c.name) == names.end(),
+               "camera name '{}' is given twice; give each --views a different NAME", c.name);
+    names.push_back(c.name);
+    detections.push_back(DetectCameraViews(c, options));
+    const bool any = std::any_of(detections.back().views.begin(), detections.back().views.end(),
+                                 [](const BoardView& v) { return !v.image_points.empty(); });
+    FV_REQUIRE(any,
+               "camera '{}': no {} found in any of the {} images of '{}' (check --cols/--rows{})",
+               c.name, options.board.Describe(), detections.back().views.size(), c.source,
+               options.board.type == BoardType::kCharuco ? ", --dictionary and --marker" : "");
+  }
+  std::string how;
+  const auto frames = PairViews(detections, options.pairing, &how);
+  return CalibrateMultiFromFrames(names, frames, options, how);
+}
+
+cv::Mat MultiCoveragePicture(const MultiResult& result, int camera) {
+  FV_REQUIRE(camera >= 0 && camera < static_cast<int>(result.cameras.size()),
+             "coverage picture: camera {} out of range", camera);
+  const Camera& cam = result.cameras[camera];
+  const auto& rep = result.camera_reports[camera];
+  const double scale = std::min(1.0, 960.0 / cam.width);
+  const int w = static_cast<int>(std::lround(cam.width * scale));
+  const int h = static_cast<int>(std::lround(cam.height * scale));
+  const int left = 64, top = 56, right = 190, bottom = 48;
+  cv::Mat img(h + top + bottom, w + left + right, CV_8UC3, cv::Scalar(255, 255, 255));
+  const cv::Rect area(left, top, w, h);
+  img(area).setTo(cv::Scalar(48, 48, 48));
+  const auto font = cv::FONT_HERSHEY_SIMPLEX;
+  const cv::Scalar black(0, 0, 0);
+  auto to_px = [&](const cv::Point2f& p) {
+    return cv::Point(left + static_cast<int>(std::lround((p.x + 0.5) * scale - 0.5)),
+                     top + static_cast<int>(std::lround((p.y + 0.5) * scale - 0.5)));
+  };
+  // Grid of 4x4 cells with the number of used corners in each.
+  const int grid = 4;
+  std::vector<int> counts(grid * grid, 0);
+  double max_err = 0.0;
+  for (const auto& v : result.views) {
+    if (v.camera != camera || !v.used) continue;
+    for (size_t k = 0; k < v.image_points.size(); ++k) {
+      const auto& p = v.image_points[k];
+      const int gc = std::clamp(static_cast<int>(p.x * grid / cam.width), 0, grid - 1);
+      const int gr = std::clamp(static_cast<int>(p.y * grid / cam.height), 0, grid - 1);
+      ++counts[gr * grid + gc];
+      max_err = std::max(max_err, static_cast<double>(v.err_px[k]));
+    }
+  }
+  // Colour scale: 0 .. the larger of 1 px and 3 x the camera's RMS, capped at the worst corner.
+  const double scale_px = std::max(0.5, std::min(max_err, std::max(1.0, 3.0 * rep.rms_px)));
+  auto colour = [&](double e) {
+    cv::Mat v(1, 1, CV_8U, cv::Scalar(std::clamp(e / scale_px, 0.0, 1.0) * 255));
+    cv::Mat c;
+    cv::applyColorMap(v, c, cv::COLORMAP_TURBO);
+    const cv::Vec3b b = c.at<cv::Vec3b>(0, 0);
+    return cv::Scalar(b[0], b[1], b[2]);
+  };
+  for (const auto& v : result.views) {
+    if (v.camera != camera || v.used) continue;
+    for (const auto& p : v.image_points) {
+      const cv::Point q = to_px(p);
+      cv::line(img, q + cv::Point(-3, -3), q + cv::Point(3, 3), cv::Scalar(150, 150, 150), 1);
+      cv::line(img, q + cv::Point(-3, 3), q + cv::Point(3, -3), cv::Scalar(150, 150, 150), 1);
+    }
+  }
+  for (const auto& v : result.views) {
+    if (v.camera != camera || !v.used) continue;
+    for (size_t k = 0; k < v.image_points.size(); ++k) {
+      cv::circle(img, to_px(v.image_points[k]), 2, colour(v.err_px[k]), cv::FILLED, cv::LINE_AA);
+    }
+  }
+  for (int g = 1; g < grid; ++g) {
+    const int x = left + g * w / grid, y = top + g * h / grid;
+    cv::line(img, {x, top}, {x, top + h}, cv::Scalar(110, 110, 110), 1);
+    cv::line(img, {left, y}, {left + w, y}, cv::Scalar(110, 110, 110), 1);
+  }
+  for (int r = 0; r < grid; ++r) {
+    for (int c = 0; c < grid; ++c) {
+      const std::string s = std::to_string(counts[r * grid + c]);
+      const cv::Point at(left + c * w / grid + 4, top + r * h / grid + 16);
+      cv::putText(img, s, at, font, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+      cv::putText(img, s, at, font, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+    }
+  }
+  cv::rectangle(img, area, black, 1);
+  // Axes: ticks in image pixels.
+  const int span = std::max(cam.width, cam.height);
+  const int step = span > 3000 ? 1000 : span > 1500 ? 500 : span > 600 ? 200 : 100;
+  for (int u = 0; u <= cam.width; u += step) {
+    const int x = left + static_cast<int>(std::lround(u * scale));
+    cv::line(img, {x, top + h}, {x, top + h + 5}, black, 1);
+    cv::putText(img, std::to_string(u), {x - 10, top + h + 20}, font, 0.4, black, 1, cv::LINE_AA);
+  }
+  for (int v = 0; v <= cam.height; v += step) {
+    const int y = top + static_cast<int>(std::lround(v * scale));
+    cv::line(img, {left - 5, y}, {left, y}, black, 1);
+    cv::putText(img, std::to_string(v), {left - 44, y + 4}, font, 0.4, black, 1, cv::LINE_AA);
+  }
+  cv::putText(img, "u (px)", {left + w / 2 - 20, top + h + 40}, font, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(img, "v (px)", {4, top - 8}, font, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(img,
+              fmt::format("camera {}: {} of {} views used, rms {:.3f} px ({}x{} px)", rep.name,
+                          rep.num_used, rep.num_found, rep.rms_px, cam.width, cam.height),
+              {left, 20}, font, 0.5, black, 1, cv::LINE_AA);
+  cv::putText(img, "dots: board corners coloured by reprojection error; numbers: corners per cell",
+              {left, 40}, font, 0.4, black, 1, cv::LINE_AA);
+  // Legend: colour bar.
+  const int bx = left + w + 30, by = top + 10, bh = std::max(100, h - 80);
+  for (int y = 0; y < bh; ++y) {
+    const double e = scale_px * (1.0 - static_cast<double>(y) / (bh - 1));
+    cv::line(img, {bx, by + y}, {bx + 18, by + y}, colour(e), 1);
+  }
+  cv::rectangle(img, cv::Rect(bx, by, 19, bh), black, 1);
+  cv::putText(img, fmt::format("{:.2f} px", scale_px), {bx + 24, by + 8}, font, 0.4, black, 1,
+              cv::LINE_AA);
+  cv::putText(img, fmt::format("{:.2f} px", scale_px / 2), {bx + 24, by + bh / 2 + 4}, font, 0.4,
+              black, 1, cv::LINE_AA);
+  cv::putText(img, "0 px", {bx + 24, by + bh}, font, 0.4, black, 1, cv::LINE_AA);
+  cv::putText(img, "error", {bx - 4, by + bh + 20}, font, 0.4, black, 1, cv::LINE_AA);
+  const cv::Point xq(bx + 6, by + bh + 38);
+  cv::line(img, xq + cv::Point(-3, -3), xq + cv::Point(3, 3), cv::Scalar(150, 150, 150), 1);
+  cv::line(img, xq + cv::Point(-3, 3), xq + cv::Point(3, -3), cv::Scalar(150, 150, 150), 1);
+  cv::putText(img, "dropped view", {bx + 14, by + bh + 42}, font, 0.4, black, 1, cv::LINE_AA);
+  return img;
+}
+
+void WriteMultiCorners(const std::string& path, const MultiResult& result) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    FV_REQUIRE(out.good(), "corners file '{}' cannot be written", path);
+    out << "camera,moment,image,corner_id,u_px,v_px,x_m,y_m,err_px,used\n";
+    for (const auto& v : result.views) {
+      for (size_t k = 0; k < v.image_points.size(); ++k) {
+        out << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.6f},{:.6f},{:.4f},{}\n",
+                           result.camera_reports[v.camera].name, v.frame, v.name,
+                           k < v.corner_ids.size() ? v.corner_ids[k] : static_cast<int>(k),
+                           v.image_points[k].x, v.image_points[k].y, v.object_points[k].x,
+                           v.object_points[k].y, v.err_px[k], v.used ? 1 : 0);
+      }
+    }
+    FV_REQUIRE(out.good(), "corners file '{}' cannot be written", path);
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  FV_REQUIRE(!ec, "corners file '{}' cannot be written: {}", path, ec.message());
+}
+
+}  // namespace fv::calib

@@ -1,0 +1,397 @@
+#include "fieldvision/calib/multi.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/calib/board_render.h"
+#include "fieldvision/calib/pose2sim.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::calib {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A rig of `n` cameras on an arc of radius `radius_m` around the origin, looking at it.
+std::vector<Camera> ArcRig(int n, double radius_m, double arc_deg, int width, int height,
+                           double hfov_deg, Rng& rng) {
+  std::vector<Camera> cams;
+  for (int i = 0; i < n; ++i) {
+    Camera c = Camera::FromFov(width, height, hfov_deg);
+    c.name = fmt::format("cam{}", i + 1);
+    c.cx += rng.Uniform(-8, 8);
+    c.cy += rng.Uniform(-8, 8);
+    c.fy = c.fx * rng.Uniform(0.998, 1.002);
+    c.distortion = {rng.Uniform(-0.15, 0.05), rng.Uniform(-0.02, 0.05), 0, 0, 0};
+    const double a = (n == 1 ? 0.0 : (i / (n - 1.0) - 0.5) * arc_deg) * kDeg;
+    const Eigen::Vector3d eye(radius_m * std::sin(a), -radius_m * std::cos(a),
+                              rng.Uniform(0.0, 0.4));
+    c.has_pose = true;
+    c.cam_from_world = Rigid3d::LookAt(eye, Eigen::Vector3d(0, 0, rng.Uniform(-0.05, 0.05)));
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+// A board pose near the origin, facing the -y side (where the cameras are), tilted at random.
+Rigid3d RandomBoardPose(const BoardSpec& b, Rng& rng, double spread_m, double tilt_deg) {
+  // Board frame: x right, y down in the board, z into the board. Facing -y: board z = +y.
+  Eigen::Matrix3d face;
+  face.col(0) = Eigen::Vector3d(1, 0, 0);
+  face.col(1) = Eigen::Vector3d(0, 0, -1);
+  face.col(2) = Eigen::Vector3d(0, 1, 0);
+  const Eigen::Vector3d tilt(rng.Uniform(-tilt_deg, tilt_deg) * kDeg,
+                             rng.Uniform(-tilt_deg, tilt_deg) * kDeg,
+                             rng.Uniform(-0.5 * tilt_deg, 0.5 * tilt_deg) * kDeg);
+  Rigid3d world_from_board;
+  world_from_board.rotation = face * RotationFromRvec(tilt);
+  const auto corners = b.CornerPositions();
+  const Eigen::Vector3d centre_board(0.5 * corners.back().x, 0.5 * corners.back().y, 0);
+  const Eigen::Vector3d centre(rng.Uniform(-spread_m, spread_m), rng.Uniform(-spread_m, spread_m),
+                               rng.Uniform(-spread_m, spread_m));
+  world_from_board.translation = centre - world_from_board.rotation * centre_board;
+  return world_from_board;
+}
+
+// The view of the board by `cam`: every corner in the image (chessboards need all), the board
+// facing the camera; image_points empty otherwise.
+BoardView ProjectView(const Camera& cam, const BoardSpec& b, const Rigid3d& world_from_board,
+                      double noise_px, Rng& rng, const std::string& name) {
+  BoardView v;
+  v.name = name;
+  v.image_size = cv::Size(cam.width, cam.height);
+  const Rigid3d cam_from_board = cam.cam_from_world * world_from_board;
+  const Eigen::Vector3d normal_cam = cam_from_board.rotation.col(2);
+  const Eigen::Vector3d to_board = cam_from_board.translation.normalized();
+  if (normal_cam.dot(to_board) < 0.3) return v;  // seen too edge-on or from behind
+  const auto corners = b.CornerPositions();
+  std::vector<cv::Point2f> img;
+  for (const auto& p : corners) {
+    const auto uv = cam.ProjectFromCamera(cam_from_board * Eigen::Vector3d(p.x, p.y, p.z));
+    if (!uv || !cam.InImage(*uv, 10)) return v;
+    img.emplace_back(static_cast<float>(uv->x() + rng.Normal(0, noise_px)),
+                     static_cast<float>(uv->y() + rng.Normal(0, noise_px)));
+  }
+  v.image_points = img;
+  v.object_points = corners;
+  for (size_t i = 0; i < corners.size(); ++i) v.corner_ids.push_back(static_cast<int>(i));
+  return v;
+}
+
+std::vector<std::string> Names(const std::vector<Camera>& cams) {
+  std::vector<std::string> n;
+  for (const auto& c : cams) n.push_back(c.name);
+  return n;
+}
+
+TEST(Multi, FourCameraRigWithinTwentiethOfADegreeAndTwoPerMille) {
+  const uint64_t seed = fv::testing::TestSeed(61);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const auto truth = ArcRig(4, 1.6, 100, 1280, 720, 60, rng);
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 9, 7, 0.07};
+  o.progress = false;
+  std::vector<MultiFrame> frames;
+  for (int f = 0; f < 40; ++f) {
+    const Rigid3d world_from_board = RandomBoardPose(o.board, rng, 0.3, 40);
+    MultiFrame m;
+    m.key = fmt::format("frame {}", f);
+    for (const auto& c : truth) {
+      // 0.12 px per axis: what cornerSubPix measures on our rendered boards (the rendered stereo
+      // test below: 0.165 px RMS in 2D).
+      m.views.push_back(
+          ProjectView(c, o.board, world_from_board, 0.12, rng, c.name + fmt::format("_{}", f)));
+    }
+    frames.push_back(m);
+  }
+  // One broken view (a bad detection): corners scattered by 6 px.
+  std::string broken;
+  for (auto& m : frames) {
+    BoardView& v = m.views[2];
+    if (v.image_points.empty()) continue;
+    for (auto& p : v.image_points) p += cv::Point2f(rng.Normal(0, 6), rng.Normal(0, 6));
+    broken = v.name;
+    break;
+  }
+  ASSERT_FALSE(broken.empty());
+  const MultiResult r = CalibrateMultiFromFrames(Names(truth), frames, o);
+  ASSERT_EQ(r.cameras.size(), 4u);
+  // Relative poses against the truth (frame-independent: first camera's frame vs world).
+  const RigComparison cmp = CompareRigs(r.cameras, truth);
+  EXPECT_LT(cmp.max_rotation_diff_deg, 0.05) << cmp.Summary() << "\n" << r.Summary();
+  for (const auto& p : cmp.pairs) {
+    EXPECT_LT(std::abs(p.baseline_diff_mm) / p.baseline_b_mm, 0.002) << cmp.Summary();
+  }
+  for (size_t c = 0; c < truth.size(); ++c) {
+    EXPECT_NEAR(r.cameras[c].fx, truth[c].fx, 0.005 * truth[c].fx) << r.Summary();
+    EXPECT_NEAR(r.cameras[c].cx, truth[c].cx, 3.0) << r.Summary();
+    EXPECT_NEAR(r.cameras[c].distortion[0], truth[c].distortion[0], 0.01) << r.Summary();
+    EXPECT_LT(r.camera_reports[c].rms_px, 0.3) << r.Summary();
+  }
+  EXPECT_TRUE(r.cameras[0].cam_from_world.translation.isZero());
+  bool dropped = false;
+  for (const auto& v : r.views) {
+    if (v.name == broken) dropped = !v.used && !v.dropped_because.empty();
+  }
+  EXPECT_TRUE(dropped) << broken << "\n" << r.Summary();
+  EXPECT_NE(r.Summary().find(broken), std::string::npos);
+  EXPECT_EQ(r.pairs.size(), 6u);
+
+  // Coverage picture and corner table.
+  const cv::Mat pic = MultiCoveragePicture(r, 1);
+  EXPECT_GT(pic.cols, 960);
+  EXPECT_EQ(pic.type(), CV_8UC3);
+  const std::string corners = fv::testing::TempDir() + "/corners.csv";
+  WriteMultiCorners(corners, r);
+  std::ifstream in(corners);
+  std::string line;
+  int rows = 0;
+  while (std::getline(in, line)) ++rows;
+  size_t expected = 1;
+  for (const auto& v : r.views) expected += v.image_points.size();
+  EXPECT_EQ(static_cast<size_t>(rows), expected);
+}
+
+// Rendered pictures through folders, paired by frame number (a right image missing, a moment
+// where the right camera does not see the board).
+TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
+  const uint64_t seed = fv::testing::TestSeed(62);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  Camera left = Camera::FromFov(640, 480, 60);
+  left.name = "left";
+  left.has_pose = true;
+  Camera right = left;
+  right.name = "right";
+  right.cam_from_world.rotation = RotationFromRvec(Eigen::Vector3d(0.01, -0.05, 0.005));
+  right.cam_from_world.translation = Eigen::Vector3d(-0.1, 0.002, 0.004);
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 9, 6, 0.025};
+  o.progress = false;
+  o.num_distortion = 4;
+  const BoardPicture picture = DrawBoard(o.board);
+  const std::string dir = fv::testing::TempDir();
+  std::filesystem::create_directories(dir + "/l");
+  std::filesystem::create_directories(dir + "/r");
+  for (int f = 1; f <= 16; ++f) {
+    const Eigen::Vector3d tilt(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6),
+                               rng.Uniform(-0.3, 0.3));
+    Rigid3d board;
+    board.rotation = RotationFromRvec(tilt);
+    board.translation = Eigen::Vector3d(-0.1 + rng.Uniform(-0.06, 0.06),
+                                        -0.06 + rng.Uniform(-0.05, 0.05), rng.Uniform(0.45, 0.6));
+    if (f == 5) board.translation.x() += 0.35;  // right camera cannot see all of it
+    cv::imwrite(fmt::format("{}/l/left{:02d}.png", dir, f),
+                RenderBoardView(picture, left, left.cam_from_world * board));
+    if (f != 9) {
+      cv::imwrite(fmt::format("{}/r/right{:02d}.png", dir, f),
+                  RenderBoardView(picture, right, right.cam_from_world * board));
+    }
+  }
+  const MultiResult r = CalibrateMulti({{"left", dir + "/l"}, {"right", dir + "/r/right*.png"}}, o);
+  EXPECT_EQ(r.pairing, "paired by frame number");
+  // The relative rotation is as good as the principal points that 15 views give (about 1 px,
+  // 0.1-0.2 deg); with the true intrinsics it is within 0.05 deg.
+  const RigComparison cmp = CompareRigs(r.cameras, {left, right});
+  EXPECT_LT(cmp.max_rotation_diff_deg, 0.3) << cmp.Summary() << "\n" << r.Summary();
+  EXPECT_LT(std::abs(cmp.pairs[0].baseline_diff_mm), 1.0) << cmp.Summary();
+  MultiOptions known = o;
+  known.known_intrinsics["left"] = left;
+  known.known_intrinsics["right"] = right;
+  const MultiResult rk =
+      CalibrateMulti({{"left", dir + "/l"}, {"right", dir + "/r/right*.png"}}, known);
+  const RigComparison cmp_known = CompareRigs(rk.cameras, {left, right});
+  EXPECT_LT(cmp_known.max_rotation_diff_deg, 0.05) << cmp_known.Summary() << "\n" << rk.Summary();
+  EXPECT_LT(std::abs(cmp_known.pairs[0].baseline_diff_mm), 0.5) << cmp_known.Summary();
+  EXPECT_DOUBLE_EQ(rk.cameras[1].cx, right.cx);
+  EXPECT_LT(r.rms_px, 0.3) << r.Summary();
+  EXPECT_EQ(r.camera_reports[1].num_images, 15) << r.Summary();
+  EXPECT_LT(r.pairs[0].shared_views, r.camera_reports[0].num_used) << r.Summary();
+}
+
+TEST(Multi, ChArUcoPartialViewsAndAWrongDictionary) {
+  const uint64_t seed = fv::testing::TestSeed(63);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  Camera a = Camera::FromFov(640, 480, 65);
+  a.name = "a";
+  a.has_pose = true;
+  Camera b = a;
+  b.name = "b";
+  b.cam_from_world.rotation = RotationFromRvec(Eigen::Vector3d(0.0, -0.25, 0.0));
+  b.cam_from_world.translation = Eigen::Vector3d(-0.2, 0.0, 0.03);
+  MultiOptions o;
+  o.board = {BoardType::kCharuco, 7, 5, 0.04, 0.03, "DICT_4X4_50"};
+  o.progress = false;
+  o.num_distortion = 4;
+  const BoardPicture picture = DrawBoard(o.board);
+  const std::string dir = fv::testing::TempDir();
+  std::filesystem::create_directories(dir + "/a");
+  std::filesystem::create_directories(dir + "/b");
+  for (int f = 0; f < 14; ++f) {
+    Rigid3d board;
+    board.rotation = RotationFromRvec(
+        Eigen::Vector3d(rng.Uniform(-0.5, 0.5), rng.Uniform(-0.7, 0.3), rng.Uniform(-0.3, 0.3)));
+    // Some views cut by an image edge: partial boards.
+    board.translation = Eigen::Vector3d(-0.08 + rng.Uniform(-0.12, 0.12),
+                                        -0.08 + rng.Uniform(-0.08, 0.08), rng.Uniform(0.55, 0.7));
+    cv::imwrite(fmt::format("{}/a/{:03d}.png", dir, f),
+                RenderBoardView(picture, a, a.cam_from_world * board));
+    cv::imwrite(fmt::format("{}/b/{:03d}.png", dir, f),
+                RenderBoardView(picture, b, b.cam_from_world * board));
+  }
+  const MultiResult r = CalibrateMulti({{"a", dir + "/a"}, {"b", dir + "/b"}}, o);
+  int partial = 0;
+  for (const auto& v : r.views) partial += v.image_points.size() < 24 ? 1 : 0;
+  EXPECT_GT(partial, 0) << "no partial view in this draw";
+  // 14 views, many partial: intrinsics-limited as above.
+  const RigComparison cmp = CompareRigs(r.cameras, {a, b});
+  EXPECT_LT(cmp.max_rotation_diff_deg, 0.5) << cmp.Summary() << "\n" << r.Summary();
+  EXPECT_LT(std::abs(cmp.pairs[0].baseline_diff_mm), 4.0) << cmp.Summary();
+
+  MultiOptions wrong = o;
+  wrong.board.dictionary = "DICT_6X6_250";
+  try {
+    CalibrateMulti({{"a", dir + "/a"}, {"b", dir + "/b"}}, wrong);
+    ADD_FAILURE() << "a wrong dictionary was accepted";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("camera 'a'"), std::string::npos) << m;
+    EXPECT_NE(m.find("--dictionary"), std::string::npos) << m;
+  }
+}
+
+TEST(Multi, UnpairableViewsAndUnlinkedCamerasAreErrorsNamingTheCamera) {
+  CameraDetections a, b;
+  a.name = "a";
+  b.name = "b";
+  for (int i = 0; i < 3; ++i) {
+    BoardView v;
+    v.name = fmt::format("a_shot{}", i);
+    a.views.push_back(v);
+    a.frame_numbers.push_back(-1);
+  }
+  b.views = a.views;
+  b.frame_numbers = a.frame_numbers;
+  b.views.pop_back();
+  b.frame_numbers.pop_back();
+  try {
+    PairViews({a, b}, Pairing::kAuto);
+    ADD_FAILURE() << "unequal counts without numbers were paired";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'b'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(PairViews({a, b}, Pairing::kFrameNumber), Error);
+
+  // Camera c never sees the board together with a or b.
+  const uint64_t seed = fv::testing::TestSeed(64);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const auto rig = ArcRig(3, 2.5, 60, 1280, 720, 60, rng);
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 8, 6, 0.06};
+  std::vector<MultiFrame> frames;
+  for (int f = 0; f < 12; ++f) {
+    const Rigid3d board = RandomBoardPose(o.board, rng, 0.3, 25);
+    MultiFrame m;
+    m.key = std::to_string(f);
+    for (int c = 0; c < 3; ++c) {
+      const bool shown = (c == 2) == (f % 2 == 0);
+      m.views.push_back(shown ? ProjectView(rig[c], o.board, board, 0.1, rng, "v")
+                              : BoardView{"v", {1280, 720}, {}, {}, {}});
+    }
+    frames.push_back(m);
+  }
+  try {
+    CalibrateMultiFromFrames(Names(rig), frames, o);
+    ADD_FAILURE() << "an unlinked camera was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'cam3' never sees the board together"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(ParseCameraViews("left"), Error);
+  EXPECT_THROW(ParseCameraViews("a/b=x"), Error);
+  EXPECT_EQ(ParseCameraViews("left=d/*.jpg").source, "d/*.jpg");
+}
+
+// OpenCV's stereo sample (9x6, 25 mm): the rig against OpenCV's stereoCalibrate on the same
+// detections, run here as the baseline.
+TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "no shared data";
+  const std::string dir = data + "/opencv-chessboard";
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 9, 6, 0.025};
+  o.progress = false;
+  const MultiResult r =
+      CalibrateMulti({{"left", dir + "/left*.jpg"}, {"right", dir + "/right*.jpg"}}, o);
+  ASSERT_EQ(r.pairs.size(), 1u);
+
+  // The baseline: the same corners, each camera's calibrateCamera, then stereoCalibrate.
+  std::map<int, std::vector<cv::Point2f>> img[2];
+  std::map<int, std::vector<cv::Point3f>> obj;
+  for (const auto& v : r.views) {
+    img[v.camera][v.frame] = v.image_points;
+    obj[v.frame] = v.object_points;
+  }
+  std::vector<std::vector<cv::Point3f>> o_all[2], o_both;
+  std::vector<std::vector<cv::Point2f>> i_all[2], i_l, i_r;
+  for (int c = 0; c < 2; ++c) {
+    for (const auto& [f, pts] : img[c]) {
+      o_all[c].push_back(obj[f]);
+      i_all[c].push_back(pts);
+    }
+  }
+  for (const auto& [f, pts] : img[0]) {
+    if (!img[1].count(f)) continue;
+    o_both.push_back(obj[f]);
+    i_l.push_back(pts);
+    i_r.push_back(img[1][f]);
+  }
+  const cv::Size size(640, 480);
+  cv::Mat k[2], d[2];
+  for (int c = 0; c < 2; ++c) {
+    std::vector<cv::Mat> rv, tv;
+    cv::calibrateCamera(o_all[c], i_all[c], size, k[c], d[c], rv, tv);
+  }
+  cv::Mat rot, t, e, fm;
+  const double stereo_rms = cv::stereoCalibrate(o_both, i_l, i_r, k[0], d[0], k[1], d[1], size, rot,
+                                                t, e, fm, cv::CALIB_USE_INTRINSIC_GUESS);
+  Eigen::Matrix3d rot_e;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) rot_e(i, j) = rot.at<double>(i, j);
+  }
+  const Eigen::Vector3d t_e(t.at<double>(0), t.at<double>(1), t.at<double>(2));
+  const double ref_rot_deg = RotationAngleBetween(rot_e, Eigen::Matrix3d::Identity()) / kDeg;
+  const double ref_baseline_mm = 1000 * t_e.norm();
+  const Rigid3d& ours = r.cameras[1].cam_from_world;
+  const double rot_diff_deg = RotationAngleBetween(ours.rotation, rot_e) / kDeg;
+  const double baseline_mm = 1000 * r.pairs[0].baseline_m;
+  std::cout << fmt::format(
+      "multi: rotation {:.3f} deg, baseline {:.2f} mm, rms {:.3f} px; stereoCalibrate: rotation "
+      "{:.3f} deg, baseline {:.2f} mm, rms {:.3f} px; rotations differ by {:.3f} deg, baselines "
+      "by {:.2f} %\n",
+      r.pairs[0].rotation_deg, baseline_mm, r.rms_px, ref_rot_deg, ref_baseline_mm, stereo_rms,
+      rot_diff_deg, 100 * (baseline_mm - ref_baseline_mm) / ref_baseline_mm);
+  EXPECT_LT(rot_diff_deg, 0.1) << r.Summary();
+  EXPECT_LT(std::abs(baseline_mm - ref_baseline_mm) / ref_baseline_mm, 0.01) << r.Summary();
+  EXPECT_LT(r.rms_px, 0.5) << r.Summary();
+  // OpenCV's reference stereo intrinsics (intrinsics.yml): the same focal length within 1 %.
+  cv::FileStorage fs(dir + "/intrinsics.yml", cv::FileStorage::READ);
+  cv::Mat m1;
+  fs["M1"] >> m1;
+  ASSERT_FALSE(m1.empty());
+  EXPECT_NEAR(r.cameras[0].fx, m1.at<double>(0, 0), 0.01 * m1.at<double>(0, 0)) << r.Summary();
+}
+
+}  // namespace
+}  // namespace fv::calib
