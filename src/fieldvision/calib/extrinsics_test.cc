@@ -6,12 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/calib/calib_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
 namespace {
+
+using test_util::ClickKeypoints;
 
 // A camera about 20 m from the field centre of the RoboCup MSL field, looking at it.
 Camera TwentyMetreCamera() {
@@ -20,45 +23,6 @@ Camera TwentyMetreCamera() {
   cam.has_pose = true;
   cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15.0, -12.0, 7.0), Eigen::Vector3d::Zero());
   return cam;
-}
-
-// The field's ground keypoints that the camera sees, 8 of them spread over the list.
-std::vector<PointCorrespondence> ClickKeypoints(const Camera& cam, const FieldModel& field,
-                                                int count, double noise_px, Rng& rng) {
-  std::vector<const FieldKeypoint*> seen;
-  for (const auto& k : field.keypoints) {
-    const auto uv = cam.Project(k.position_m);
-    if (k.position_m.z() == 0.0 && uv && cam.InImage(*uv, 10)) seen.push_back(&k);
-  }
-  // Farthest-point order in the image, from the first seen point: what a user told to click
-  // points spread over the image does.
-  std::vector<PointCorrespondence> pts;
-  std::vector<bool> taken(seen.size(), false);
-  for (int i = 0; i < count && i < static_cast<int>(seen.size()); ++i) {
-    size_t pick = 0;
-    double best = -1;
-    for (size_t j = 0; j < seen.size(); ++j) {
-      if (taken[j]) continue;
-      double nearest = 1e18;
-      for (const auto& p : pts) {
-        nearest = std::min(
-            nearest, (*cam.Project(seen[j]->position_m) - *cam.Project(p.p_world)).squaredNorm());
-      }
-      if (nearest > best) {
-        best = nearest;
-        pick = j;
-      }
-    }
-    taken[pick] = true;
-    const FieldKeypoint* k = seen[pick];
-    PointCorrespondence p;
-    p.name = k->name;
-    p.p_world = k->position_m;
-    p.uv_px = *cam.Project(k->position_m) +
-              Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px));
-    pts.push_back(p);
-  }
-  return pts;
 }
 
 TEST(Extrinsics, EightKeypointsWithOnePixelNoiseWithin5cmAt20m) {

@@ -1,0 +1,74 @@
+// Helpers shared by the calibration tests (header only, not part of the library): clicks of a
+// field's keypoints as a user would make them, and cameras of the synthetic presets.
+#pragma once
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/random.h"
+
+namespace fv::calib::test_util {
+
+// The field's ground keypoints that the camera sees, 8 of them spread over the list.
+inline std::vector<PointCorrespondence> ClickKeypoints(const Camera& cam, const FieldModel& field,
+                                                       int count, double noise_px, Rng& rng) {
+  std::vector<const FieldKeypoint*> seen;
+  for (const auto& k : field.keypoints) {
+    const auto uv = cam.Project(k.position_m);
+    if (k.position_m.z() == 0.0 && uv && cam.InImage(*uv, 10)) seen.push_back(&k);
+  }
+  // Farthest-point order in the image, from the first seen point: what a user told to click
+  // points spread over the image does.
+  std::vector<PointCorrespondence> pts;
+  std::vector<bool> taken(seen.size(), false);
+  for (int i = 0; i < count && i < static_cast<int>(seen.size()); ++i) {
+    size_t pick = 0;
+    double best = -1;
+    for (size_t j = 0; j < seen.size(); ++j) {
+      if (taken[j]) continue;
+      double nearest = 1e18;
+      for (const auto& p : pts) {
+        nearest = std::min(
+            nearest, (*cam.Project(seen[j]->position_m) - *cam.Project(p.p_world)).squaredNorm());
+      }
+      if (nearest > best) {
+        best = nearest;
+        pick = j;
+      }
+    }
+    taken[pick] = true;
+    const FieldKeypoint* k = seen[pick];
+    PointCorrespondence p;
+    p.name = k->name;
+    p.p_world = k->position_m;
+    p.uv_px = *cam.Project(k->position_m) +
+              Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px));
+    pts.push_back(p);
+  }
+  return pts;
+}
+
+// The cameras of a synth preset (position, look-at and field of view as the renderer builds
+// them), without rendering anything.
+inline std::vector<Camera> PresetCameras(const std::string& preset, uint64_t seed) {
+  const synth::SceneSpec spec = synth::Preset(preset, seed);
+  std::vector<Camera> cams;
+  for (const auto& s : spec.cameras) {
+    Camera c = Camera::FromFov(s.width, s.height, s.hfov_deg);
+    if (s.fx > 0) c.fx = s.fx;
+    if (s.fy > 0) c.fy = s.fy;
+    c.distortion = s.distortion;
+    c.name = s.name;
+    c.has_pose = true;
+    c.cam_from_world = s.has_rvec_tvec ? Rigid3d::FromRvecTvec(s.rvec, s.tvec)
+                                       : Rigid3d::LookAt(s.position_m, s.look_at_m);
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+}  // namespace fv::calib::test_util
