@@ -1,0 +1,120 @@
+#include "fieldvision/calib/import.h"
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "fieldvision/calib/pose2sim.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::calib {
+namespace {
+
+TEST(Import, AniposeTomlWithCommentsAndMillimetres) {
+  const std::string path = fv::testing::TempDir() + "/calibration.toml";
+  std::ofstream(path) << R"([cam_0]  # the left one
+name = "A"
+size = [ 1280.0, 720.0,]
+matrix = [ [ 1000.5, 0.0, 640.25,],
+  [ 0.0, 1001.0, 360.0,],
+  [ 0.0, 0.0, 1.0,],]
+distortions = [ -0.1, 0.02, 0.0, 0.0, 0.0,]
+rotation = [ 0.0, 0.0, 0.0,]
+translation = [ 0.0, 0.0, 0.0,]
+
+[cam_1]
+name = 'B'
+size = [ 1280.0, 720.0,]
+matrix = [ [ 990.0, 0.0, 641.0,], [ 0.0, 990.0, 361.0,], [ 0.0, 0.0, 1.0,],]
+distortions = [ -0.05, 0.01, 0.001, 0.0,]
+rotation = [ 0.0, -0.3, 0.0,]
+translation = [ -500.0, 0.0, 50.0,]
+fisheye = false
+
+[metadata]
+adjusted = true
+error = 0.42
+)";
+  const auto cams = ReadCalibrationToml(path, 0.001);
+  ASSERT_EQ(cams.size(), 2u);
+  EXPECT_EQ(cams[0].name, "A");
+  EXPECT_EQ(cams[1].name, "B");
+  EXPECT_EQ(cams[0].width, 1280);
+  EXPECT_DOUBLE_EQ(cams[0].fx, 1000.5);
+  EXPECT_DOUBLE_EQ(cams[0].cx, 640.25);
+  EXPECT_DOUBLE_EQ(cams[1].distortion[2], 0.001);
+  EXPECT_NEAR(cams[1].cam_from_world.translation.x(), -0.5, 1e-12);
+  EXPECT_NEAR(cams[1].CentreInWorld().norm(), std::hypot(0.5, 0.05), 1e-9);
+
+  // Round trip through our writer (metres).
+  const std::string out = fv::testing::TempDir() + "/out.toml";
+  WriteCalibrationToml(cams, out);
+  const auto back = ReadCalibrationToml(out);
+  ASSERT_EQ(back.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(back[i].name, cams[i].name);
+    EXPECT_NEAR(back[i].fy, cams[i].fy, 1e-9);
+    EXPECT_LT((back[i].cam_from_world.translation - cams[i].cam_from_world.translation).norm(),
+              1e-12);
+    EXPECT_LT(
+        RotationAngleBetween(back[i].cam_from_world.rotation, cams[i].cam_from_world.rotation),
+        1e-12);
+  }
+}
+
+TEST(Import, BadTomlNamesFileAndKey) {
+  const std::string path = fv::testing::TempDir() + "/bad.toml";
+  std::ofstream(path) << "[cam_1]\nname = \"x\"\nmatrix = [[1, 0, 2], [0, 1]]\nsize = [10, 10]\n";
+  try {
+    ReadCalibrationToml(path);
+    ADD_FAILURE() << "a 3x2 matrix was accepted";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("bad.toml"), std::string::npos) << m;
+    EXPECT_NE(m.find("matrix"), std::string::npos) << m;
+  }
+  std::ofstream(path) << "[cam_1]\nmatrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]\n";
+  EXPECT_THROW(ReadCalibrationToml(path), Error);  // not closed
+  EXPECT_THROW(ReadCalibrationToml(path + ".missing"), Error);
+  int w = 0, h = 0;
+  ParseImageSize("1920x1080", "size", &w, &h);
+  EXPECT_EQ(w, 1920);
+  EXPECT_EQ(h, 1080);
+  EXPECT_THROW(ParseImageSize("1920", "size", &w, &h), Error);
+  EXPECT_THROW(ParseImageSize("1920x1080x3", "size", &w, &h), Error);
+}
+
+TEST(Import, OpenCvStereoFiles) {
+  const std::string dir = fv::testing::TempDir();
+  {
+    cv::FileStorage fs(dir + "/extrinsics.yml", cv::FileStorage::WRITE);
+    const cv::Mat r = (cv::Mat_<double>(3, 3) << 1, 0, 0, 0, 0.99995, -0.01, 0, 0.01, 0.99995);
+    const cv::Mat t = (cv::Mat_<double>(3, 1) << -3.3, 0.04, -0.01);  // squares
+    fs << "R" << r << "T" << t;
+  }
+  std::vector<std::string> files = {dir + "/extrinsics.yml"};
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) {
+    cv::FileStorage fs(dir + "/intrinsics.yml", cv::FileStorage::WRITE);
+    const cv::Mat m = (cv::Mat_<double>(3, 3) << 534.8, 0, 335.7, 0, 534.8, 240.7, 0, 0, 1);
+    const cv::Mat d = (cv::Mat_<double>(1, 5) << 0.1, -0.2, 0, 0, 0);
+    fs << "M1" << m << "D1" << d << "M2" << m << "D2" << d;
+    files.insert(files.begin(), dir + "/intrinsics.yml");
+  } else {
+    files.insert(files.begin(), data + "/opencv-chessboard/intrinsics.yml");
+  }
+  const auto cams = ReadOpenCvStereo(files, 640, 480, 0.025);
+  ASSERT_EQ(cams.size(), 2u);
+  EXPECT_NEAR(cams[0].fx, 534.8, 0.1);
+  EXPECT_EQ(cams[1].width, 640);
+  EXPECT_TRUE(cams[0].cam_from_world.translation.isZero());
+  EXPECT_NEAR(cams[1].CentreInWorld().norm(), 0.025 * std::sqrt(3.3 * 3.3 + 0.04 * 0.04 + 1e-4),
+              1e-9);
+  EXPECT_THROW(ReadOpenCvStereo({dir + "/extrinsics.yml"}, 640, 480), Error);  // no M1
+  EXPECT_THROW(ReadOpenCvStereo(files, 0, 480), Error);
+}
+
+}  // namespace
+}  // namespace fv::calib
