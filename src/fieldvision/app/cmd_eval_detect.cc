@@ -1,0 +1,51 @@
+// `fieldvision eval detect`: the ball detector's recall, precision and centre error on labelled
+// frames (detect/detect_eval.h).
+#include <iostream>
+#include <memory>
+
+#include "fieldvision/app/command.h"
+#include "fieldvision/detect/detect_eval.h"
+
+namespace fv::app {
+namespace {
+
+void Setup(CLI::App& app, int& exit_code) {
+  CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
+  auto o = std::make_shared<DetectEvalOptions>();
+  CLI::App* cmd = group->add_subcommand(
+      "detect",
+      "Recall, precision and centre error of the ball detector on labelled frames (best accepted "
+      "candidate per image; a hit when its centre is inside a box grown by --grow)");
+  cmd->add_option("--video", o->video,
+                  "Images (a folder, searched recursively; a glob; dir/%05d.jpg) or a video file")
+      ->required();
+  cmd->add_option("--labels", o->labels,
+                  "Folder of YOLO txt files (class cx cy w h, normalised; default: beside the "
+                  "images) or a CSV with image|frame,x,y,w,h in pixels");
+  cmd->add_option("--class", o->class_id, "YOLO class of the ball")->capture_default_str();
+  cmd->add_option("--camera", o->camera, "Camera file (size checks)");
+  cmd->add_option("--color", o->detector.colour, "Colour preset or colour file")
+      ->capture_default_str();
+  cmd->add_option("--min-radius", o->detector.min_radius_px, "Smallest ball radius in pixels")
+      ->capture_default_str();
+  cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
+      ->capture_default_str();
+  cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")
+      ->capture_default_str();
+  cmd->add_option("--list", o->list_misses, "Misses and false detections to list")
+      ->capture_default_str();
+  cmd->add_option("--out", o->out, "CSV with one row per image");
+  cmd->add_option("--candidates", o->candidates_out,
+                  "CSV with every candidate and its measurements (for diagnosis)");
+  cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
+  cmd->callback([o] {
+    const DetectEvalResult r = EvaluateDetector(*o);
+    std::cout << r.Summary(o->list_misses) << "\n";
+  });
+  (void)exit_code;
+}
+
+FV_REGISTER_COMMAND(82, "eval detect", Setup);
+
+}  // namespace
+}  // namespace fv::app

@@ -1,0 +1,352 @@
+#include "fieldvision/detect/detect_eval.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/io/image_file.h"
+#include "fieldvision/io/video_source.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+#include "fieldvision/util/stats.h"
+
+namespace fv {
+namespace fs = std::filesystem;
+
+namespace {
+
+bool IsImagePath(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp" || ext == ".tif" ||
+         ext == ".tiff" || ext == ".webp" || ext == ".ppm" || ext == ".pgm";
+}
+
+// Images of a folder and its subfolders, in path order.
+std::vector<std::string> ImagesUnder(const std::string& dir) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file() && IsImagePath(e.path())) files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string ReplaceCommas(std::string s) {
+  std::replace(s.begin(), s.end(), ',', ';');
+  return s;
+}
+
+cv::Rect2d Grow(const cv::Rect2d& r, double grow) {
+  return {r.x - grow * r.width, r.y - grow * r.height, r.width * (1 + 2 * grow),
+          r.height * (1 + 2 * grow)};
+}
+
+bool Inside(const cv::Rect2d& r, double u, double v) {
+  return u >= r.x && u <= r.x + r.width && v >= r.y && v <= r.y + r.height;
+}
+
+// CSV labels: image (file name, path or stem) or frame, and x,y,w,h in pixels.
+std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items,
+                                         const std::string& path) {
+  const CsvTable t = CsvTable::Read(path);
+  t.Require({"x", "y", "w", "h"});
+  FV_REQUIRE(t.Has("image") || t.Has("frame"), "{}: needs a column 'image' or 'frame'", path);
+  std::map<std::string, std::vector<cv::Rect2d>> by_key;
+  for (size_t r = 0; r < t.rows(); ++r) {
+    const cv::Rect2d box(t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "w"),
+                         t.GetDouble(r, "h"));
+    FV_REQUIRE(std::isfinite(box.x) && std::isfinite(box.y) && box.width > 0 && box.height > 0,
+               "{}: a box needs finite x, y and positive w, h", t.Where(r));
+    const std::string key = t.Has("image") ? t.Get(r, "image") : t.Get(r, "frame");
+    by_key[key].push_back(box);
+  }
+  std::vector<LabelledImage> out = items;
+  for (auto& item : out) {
+    item.has_label_file = true;
+    std::vector<std::string> keys;
+    if (item.frame >= 0) {
+      keys = {std::to_string(item.frame)};
+    } else {
+      const fs::path p(item.image);
+      keys = {item.image, p.filename().string(), p.stem().string()};
+    }
+    for (const auto& k : keys) {
+      const auto it = by_key.find(k);
+      if (it != by_key.end()) {
+        item.boxes = it->second;
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<cv::Rect2d> ReadYoloFile(const std::string& path, int class_id, int width, int height) {
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "cannot read label file '{}'", path);
+  std::vector<cv::Rect2d> boxes;
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::istringstream ss(line);
+    double cls = 0, cx = 0, cy = 0, w = 0, h = 0;
+    ss >> cls >> cx >> cy >> w >> h;
+    std::string rest;
+    const bool ok = !ss.fail() && !(ss >> rest) && cls == std::floor(cls) && cls >= 0 &&
+                    std::isfinite(cx) && std::isfinite(cy) && w > 0 && h > 0 && w <= 1.5 &&
+                    h <= 1.5;
+    FV_REQUIRE(ok, "{}:{}: expected 'class cx cy w h' (YOLO, normalised to the image), got '{}'",
+               path, line_no, line);
+    if (static_cast<int>(cls) != class_id) continue;
+    boxes.emplace_back((cx - 0.5 * w) * width, (cy - 0.5 * h) * height, w * width, h * height);
+  }
+  return boxes;
+}
+
+std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images,
+                                          const std::string& image_root, const std::string& labels,
+                                          int class_id) {
+  std::vector<LabelledImage> out;
+  out.reserve(images.size());
+  for (const auto& image : images) {
+    LabelledImage item;
+    item.image = image;
+    const fs::path p(image);
+    std::vector<fs::path> tries;
+    if (labels.empty()) {
+      tries.push_back(p.parent_path() / (p.stem().string() + ".txt"));
+    } else {
+      if (!image_root.empty()) {
+        std::error_code ec;
+        const fs::path rel = fs::relative(p, image_root, ec);
+        if (!ec && !rel.empty() && *rel.begin() != "..") {
+          tries.push_back(fs::path(labels) / rel.parent_path() / (rel.stem().string() + ".txt"));
+        }
+      }
+      tries.push_back(fs::path(labels) / (p.stem().string() + ".txt"));
+    }
+    for (const auto& t : tries) {
+      if (fs::is_regular_file(t)) {
+        item.has_label_file = true;
+        const cv::Mat im = ReadImage(image);  // the size normalises the boxes
+        item.boxes = ReadYoloFile(t.string(), class_id, im.cols, im.rows);
+        break;
+      }
+    }
+    out.push_back(std::move(item));
+  }
+  return out;
+}
+
+void DetectEvalOptions::Check() const {
+  FV_REQUIRE(!video.empty(), "eval detect: --video is required");
+  FV_REQUIRE(class_id >= 0, "--class must be >= 0 (got {})", class_id);
+  CheckInRange(grow, 0.0, 5.0, "grow");
+  FV_REQUIRE(list_misses >= 0, "list_misses must be >= 0");
+  detector.Check();
+}
+
+DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
+                           const std::vector<cv::Rect2d>& boxes, double grow) {
+  DetectEvalImage r;
+  r.boxes = static_cast<int>(boxes.size());
+  auto on_ball = [&](const BallCandidate& c, const cv::Rect2d** which) {
+    for (const auto& b : boxes) {
+      if (Inside(Grow(b, grow), c.centre_px.x(), c.centre_px.y())) {
+        if (which != nullptr) *which = &b;
+        return true;
+      }
+    }
+    return false;
+  };
+  for (const auto& c : candidates) {
+    if (!on_ball(c, nullptr)) continue;
+    r.candidate_on_ball = true;
+    if (r.reason.empty() && !c.accepted) r.reason = c.reason;
+  }
+  // Candidates come best first; the first accepted one is the image's detection.
+  const auto best = std::find_if(candidates.begin(), candidates.end(),
+                                 [](const BallCandidate& c) { return c.accepted; });
+  if (best == candidates.end()) {
+    if (r.reason.empty()) r.reason = r.boxes > 0 ? "no candidate on the ball" : "";
+    return r;
+  }
+  r.detected = true;
+  r.u = best->centre_px.x();
+  r.v = best->centre_px.y();
+  r.radius_px = best->radius_px;
+  r.score = best->score;
+  const cv::Rect2d* box = nullptr;
+  r.hit = on_ball(*best, &box);
+  if (r.hit) {
+    r.reason.clear();
+    const double cx = box->x + 0.5 * box->width, cy = box->y + 0.5 * box->height;
+    r.centre_err_px = std::hypot(r.u - cx, r.v - cy);
+    r.centre_err_rel = r.centre_err_px / (0.25 * (box->width + box->height));
+  } else if (r.boxes > 0) {
+    r.reason = fmt::format("best candidate off the ball at ({:.0f}, {:.0f})", r.u, r.v) +
+               (r.reason.empty() ? "" : "; on the ball: " + r.reason);
+  }
+  return r;
+}
+
+std::string DetectEvalResult::Summary(int list) const {
+  std::vector<double> err_px, err_rel;
+  for (const auto& im : images) {
+    if (!im.hit) continue;
+    err_px.push_back(im.centre_err_px);
+    err_rel.push_back(im.centre_err_rel);
+  }
+  std::string s = fmt::format(
+      "{} images, {} with a ball, {} with a detection: recall {:.3f} ({}/{}), precision {:.3f} "
+      "({}/{}), {} false detections",
+      images.size(), with_ball, detected, recall(), hits, with_ball, precision(), hits, detected,
+      false_detections);
+  if (!err_px.empty()) {
+    s += fmt::format(
+        "\ncentre error vs. box centre: median {:.2f} px, p90 {:.2f} px ({:.2f} / {:.2f} of the "
+        "box half size)",
+        Median(err_px), Percentile(err_px, 0.9), Median(err_rel), Percentile(err_rel, 0.9));
+  }
+  int on_ball = 0;
+  for (const auto& im : images) on_ball += im.boxes > 0 && im.candidate_on_ball;
+  s += fmt::format("\na candidate (accepted or not) lies on the ball in {}/{} images", on_ball,
+                   with_ball);
+  if (no_label_file > 0) {
+    s += fmt::format("\n{} images have no label file (taken as images without a ball)",
+                     no_label_file);
+  }
+  s += fmt::format("\n{:.1f} s ({:.1f} ms per image)", seconds,
+                   images.empty() ? 0.0 : 1e3 * seconds / images.size());
+  int listed = 0;
+  for (const auto& im : images) {
+    if (listed >= list) break;
+    if (im.hit || (im.boxes == 0 && !im.detected)) continue;
+    s += fmt::format("\n  {}: {}", im.image,
+                     im.boxes == 0 ? fmt::format("false detection at ({:.0f}, {:.0f}) r {:.1f}",
+                                                 im.u, im.v, im.radius_px)
+                                   : "miss: " + im.reason);
+    ++listed;
+  }
+  return s;
+}
+
+DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
+  o.Check();
+  std::vector<LabelledImage> items;
+  std::string root;
+  const bool is_dir = fs::is_directory(o.video);
+  std::vector<std::string> files = is_dir ? ImagesUnder(o.video) : ListImageSequence(o.video);
+  std::unique_ptr<VideoSource> video;
+  if (is_dir) root = o.video;
+  if (files.empty()) {
+    FV_REQUIRE(!is_dir, "eval detect: folder '{}' holds no image", o.video);
+    video = VideoSource::Open(o.video);  // throws naming the video
+    FV_REQUIRE(!o.labels.empty() && fs::path(o.labels).extension() == ".csv",
+               "eval detect: a video needs --labels LABELS.csv with columns frame,x,y,w,h");
+    for (int i = 0; i < std::max(0, video->frame_count()); ++i) {
+      LabelledImage item;
+      item.image = fmt::format("{}#{}", o.video, i);
+      item.frame = i;
+      items.push_back(item);
+    }
+  } else {
+    if (root.empty()) root = fs::path(files.front()).parent_path().string();
+    for (const auto& f : files) items.push_back(LabelledImage{f, -1, {}, false});
+  }
+  if (!o.labels.empty() && fs::is_regular_file(o.labels)) {
+    items = ReadCsvLabels(items, o.labels);
+  } else if (video == nullptr) {
+    FV_REQUIRE(o.labels.empty() || fs::is_directory(o.labels),
+               "eval detect: labels '{}' is neither a folder of YOLO files nor a CSV file",
+               o.labels);
+    items = ReadYoloLabels(files, root, o.labels, o.class_id);
+  } else {
+    Throw("eval detect: labels '{}' not found", o.labels);
+  }
+  std::unique_ptr<Camera> camera;
+  if (!o.camera.empty()) camera = std::make_unique<Camera>(ReadCameraYaml(o.camera));
+  const BallDetector detector(o.detector, camera.get(), nullptr);
+
+  DetectEvalResult result;
+  std::unique_ptr<CsvWriter> cand_csv;
+  if (!o.candidates_out.empty()) {
+    cand_csv = std::make_unique<CsvWriter>(
+        o.candidates_out + ".part",
+        std::vector<std::string>{"image", "u", "v", "radius_px", "score", "accepted", "weak",
+                                 "on_ball", "visible", "inliers", "outside", "dents", "reason"},
+        4);
+  }
+  Progress progress("eval detect", static_cast<long long>(items.size()), "images", o.progress);
+  Frame frame;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const LabelledImage& item = items[i];
+    cv::Mat bgr;
+    if (video != nullptr) {
+      if (!video->Read(frame)) {
+        items.resize(i);
+        break;
+      }
+      bgr = frame.bgr;
+    } else {
+      bgr = ReadImage(item.image);
+    }
+    const auto candidates = detector.Detect(bgr);
+    DetectEvalImage r = ScoreImage(candidates, item.boxes, o.grow);
+    if (cand_csv != nullptr) {
+      for (const auto& c : candidates) {
+        const bool on_ball = std::any_of(item.boxes.begin(), item.boxes.end(), [&](const auto& b) {
+          return Inside(Grow(b, o.grow), c.centre_px.x(), c.centre_px.y());
+        });
+        *cand_csv << item.image << c.centre_px.x() << c.centre_px.y() << c.radius_px << c.score
+                  << int(c.accepted) << int(c.weak) << int(on_ball) << c.visible_fraction
+                  << c.inlier_fraction << c.outside_fraction << c.dents << ReplaceCommas(c.reason);
+        cand_csv->EndRow();
+      }
+    }
+    r.image = item.image;
+    result.with_ball += r.boxes > 0;
+    result.detected += r.detected;
+    result.hits += r.hit;
+    result.false_detections += r.detected && !r.hit;
+    result.no_label_file += !item.has_label_file;
+    result.images.push_back(std::move(r));
+    progress.Update(static_cast<long long>(i + 1));
+  }
+  progress.Finish();
+  result.seconds = progress.ElapsedSeconds();
+  if (cand_csv != nullptr) {
+    cand_csv->Close();
+    fs::rename(o.candidates_out + ".part", o.candidates_out);
+  }
+  if (!o.out.empty()) {
+    const std::string tmp = o.out + ".part";
+    {
+      CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
+                        "centre_err_px", "candidate_on_ball", "reason"});
+      for (const auto& im : result.images) {
+        w << im.image << im.boxes << int(im.detected) << int(im.hit) << im.u << im.v << im.radius_px
+          << im.score << im.centre_err_px << int(im.candidate_on_ball) << ReplaceCommas(im.reason);
+        w.EndRow();
+      }
+      w.Close();
+    }
+    fs::rename(tmp, o.out);
+  }
+  return result;
+}
+
+}  // namespace fv

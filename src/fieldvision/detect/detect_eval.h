@@ -1,0 +1,82 @@
+// Checking the ball detector on a user's labelled frames (`fieldvision eval detect`): images (a
+// folder, searched recursively, a glob or a pattern) or a video, with boxes as YOLO txt files
+// (one per image, `class cx cy w h` normalised; an image without a file has no ball) or a CSV
+// (`image|frame,x,y,w,h` in pixels). Per image the best accepted candidate counts as a hit when
+// its centre lies inside a labelled box grown by `grow` (25 % by default, each side); recall over
+// images with a ball, precision over images with a detection (the score of the shared RoboCup
+// photo sets, shared/data/robocup-ball-photos/README).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "fieldvision/detect/ball_detector.h"
+
+namespace fv {
+
+struct LabelledImage {
+  std::string image;              // file path, or the video plus frame for a video
+  int frame = -1;                 // frame index in a video; -1 for image files
+  std::vector<cv::Rect2d> boxes;  // ball boxes in pixels (the chosen class only)
+  bool has_label_file = false;    // YOLO: false when no label file was found (no ball)
+};
+
+// Reads the labels of `images` from `labels` (a folder of YOLO txt files or a CSV). YOLO files
+// are looked up as LABELS/<path relative to image_root with .txt> and then LABELS/<stem>.txt.
+// Throws fv::Error naming file and line for a row that does not parse.
+std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images,
+                                          const std::string& image_root, const std::string& labels,
+                                          int class_id);
+// One YOLO txt file: boxes of class `class_id` in pixels for an image of width x height.
+std::vector<cv::Rect2d> ReadYoloFile(const std::string& path, int class_id, int width, int height);
+
+struct DetectEvalOptions {
+  std::string video;           // folder (recursive), glob, image pattern or video file
+  std::string labels;          // YOLO folder or CSV; "" = YOLO files beside the images
+  int class_id = 0;            // YOLO class of the ball
+  std::string camera;          // optional camera file (size checks); frames must then match it
+  double grow = 0.25;          // box growth for a hit (each side, share of the box size)
+  int list_misses = 30;        // misses and false detections listed in the summary
+  std::string out;             // optional CSV, one row per image
+  std::string candidates_out;  // optional CSV, one row per candidate with its measurements
+  bool progress = true;
+  BallDetectorOptions detector;
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct DetectEvalImage {
+  std::string image;
+  int boxes = 0;
+  bool detected = false;  // an accepted candidate
+  bool hit = false;
+  double u = 0, v = 0, radius_px = 0, score = 0;
+  double centre_err_px = -1;       // hit: distance to the box centre
+  double centre_err_rel = -1;      // ... divided by the box's half size
+  bool candidate_on_ball = false;  // any candidate (accepted or not) inside a grown box
+  std::string reason;              // for a miss: the best rejected candidate on the ball's reason
+};
+
+struct DetectEvalResult {
+  std::vector<DetectEvalImage> images;
+  int with_ball = 0;
+  int detected = 0;  // images with an accepted candidate
+  int hits = 0;
+  int false_detections = 0;
+  int no_label_file = 0;
+  double seconds = 0.0;
+  double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
+  double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }
+  // Recall, precision, centre errors and the first `list` misses and false detections.
+  std::string Summary(int list = 30) const;
+};
+
+// Scores one image's candidates against its boxes (best accepted candidate first).
+DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
+                           const std::vector<cv::Rect2d>& boxes, double grow);
+
+DetectEvalResult EvaluateDetector(const DetectEvalOptions& options);
+
+}  // namespace fv

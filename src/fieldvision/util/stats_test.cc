@@ -1,0 +1,36 @@
+#include "fieldvision/util/stats.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+TEST(Stats, PercentileInterpolatesLikeNumpy) {
+  const std::vector<double> v = {4, 1, 3, 2, 5};
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 1.0), 5.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.5), 3.0);
+  EXPECT_DOUBLE_EQ(Percentile(v, 0.9), 4.6);  // numpy.percentile([1..5], 90)
+  EXPECT_DOUBLE_EQ(Percentile({}, 0.5), 0.0);
+  EXPECT_DOUBLE_EQ(Median({1, 2, 3, 10}), 2.5);
+}
+
+TEST(Stats, MeanRmsRobustSigma) {
+  EXPECT_DOUBLE_EQ(Mean({1, 2, 3}), 2.0);
+  EXPECT_DOUBLE_EQ(Rms({3, 4}), std::sqrt(12.5));
+  const uint64_t seed = testing::TestSeed(7);
+  FV_SEED_TRACE(seed);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal(10.0, 2.0);
+  std::vector<double> v;
+  for (int i = 0; i < 20000; ++i) v.push_back(normal(rng));
+  for (int i = 0; i < 1000; ++i) v.push_back(1e6);  // 5 % gross outliers
+  EXPECT_NEAR(RobustSigma(v), 2.0, 0.3);            // outliers inflate it only a little
+}
+
+}  // namespace
+}  // namespace fv
