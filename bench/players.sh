@@ -35,7 +35,8 @@ for det in "${DETECTORS[@]}"; do
   if [ "$FRAMES" = 0 ]; then
     GT="$OUT/gt.csv"
   else
-    awk -F, -v n="$FRAMES" 'NR == 1 || $1 < n' "$OUT/gt.csv" > "$OUT/gt_$FRAMES.csv"
+    # Frames are numbered from 1 in both files (MOTChallenge).
+    awk -F, -v n="$FRAMES" 'NR == 1 || $1 <= n' "$OUT/gt.csv" > "$OUT/gt_$FRAMES.csv"
     GT="$OUT/gt_$FRAMES.csv"
   fi
   "$FV" eval tracks --gt "$GT" --est "$OUT/tracks_$det.csv" --json "$OUT/metrics_$det.json"

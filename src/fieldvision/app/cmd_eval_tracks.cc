@@ -26,7 +26,7 @@ void RunEvalTracks(const EvalTracksCli& c) {
   const auto gt = ReadGt(c.gt);
   const auto est = track::ReadTracksCsv(c.est);
   const track::MotMetrics m = track::EvaluateMot(gt, est, c.o);
-  std::cout << m.Summary() << "\n";
+  std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
   if (!c.json.empty()) {
     std::ofstream out(c.json);
     FV_REQUIRE(out.good(), "cannot write '{}'", c.json);
@@ -43,10 +43,21 @@ void Setup(CLI::App& app, int& exit_code) {
   auto c = std::make_shared<EvalTracksCli>();
   CLI::App* cmd = group->add_subcommand(
       "tracks", "MOTA, MOTP, IDF1 and HOTA of player tracks against ground truth (MOTChallenge)");
-  cmd->add_option("--gt", c->gt, "Ground truth: MOT CSV / TRACKS.csv, or a PETS CVML .xml")
+  cmd->add_option("--gt", c->gt,
+                  "Ground truth: MOT gt.txt (MOT17 rules applied), TRACKS.csv, or a PETS CVML .xml "
+                  "(frames numbered from 1)")
       ->required();
-  cmd->add_option("--est", c->est, "Estimated TRACKS.csv")->required();
+  cmd->add_option("--est", c->est, "Estimated TRACKS.csv or MOTChallenge results file")->required();
   cmd->add_option("--iou", c->o.iou_threshold, "IoU needed for a match (MOTChallenge: 0.5)");
+  cmd->add_option("--frame-offset", c->o.frame_offset,
+                  "Add this to the estimate's frame numbers (e.g. 1 for a 0-based file against "
+                  "MOT ground truth); the output warns when another offset fits far better");
+  cmd->add_flag("!--no-mot17-rules", c->o.mot17_rules,
+                "Score every ground-truth row (default, for MOT16/17/20 ground truth with classes: "
+                "drop conf-0 and non-pedestrian rows and estimates on distractors, as TrackEval)");
+  cmd->add_flag("!--all-frames", c->o.clip_to_gt_frames,
+                "Also count estimated rows in frames outside the ground truth's first..last frame "
+                "(default: left out)");
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
   cmd->callback([c] { RunEvalTracks(*c); });
 

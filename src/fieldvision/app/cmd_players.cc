@@ -1,5 +1,6 @@
 // `fieldvision players`: detect and track people in a video, positions on the field (TRACKS.csv).
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -7,6 +8,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/overlay.h"
 #include "fieldvision/track/players.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -15,21 +17,26 @@ namespace fv::app {
 namespace {
 
 struct PlayersCli {
-  std::string camera, video, out, field, onnx;
+  std::string camera, video, out, field, onnx, draw, mot_out;
   track::PlayersOptions o;
 };
 
 void RunPlayersCommand(const PlayersCli& c) {
-  const Camera camera = ReadCameraYaml(c.camera);
+  std::optional<Camera> camera;
+  if (!c.camera.empty()) camera = ReadCameraYaml(c.camera);
   std::optional<FieldModel> field;
   if (!c.field.empty()) field = LoadField(c.field);
+  FV_REQUIRE(!field || (camera && camera->has_pose),
+             "--field needs --camera with a pose (the field area is found through it)");
   track::PlayersOptions o = c.o;
   if (!c.onnx.empty()) {
     o.detector.kind = "onnx";
     o.detector.model_path = c.onnx;
   }
-  const track::PlayersResult r = track::RunPlayers(c.video, &camera, field ? &*field : nullptr, o);
+  const track::PlayersResult r =
+      track::RunPlayers(c.video, camera ? &*camera : nullptr, field ? &*field : nullptr, o);
   track::WriteTracksCsv(r.rows, c.out);
+  if (!c.mot_out.empty()) track::WriteMotChallenge(r.rows, c.mot_out);
   if (!r.team_of.empty()) {
     const std::string teams = c.out + ".teams.csv";
     CsvWriter w(teams, {"id", "team"});
@@ -40,17 +47,42 @@ void RunPlayersCommand(const PlayersCli& c) {
     w.Close();
     std::cout << "wrote " << teams << "\n";
   }
-  std::cout << r.Summary() << "\nwrote " << c.out << "\n";
+  std::cout << r.Summary() << "\nwrote " << c.out << (c.mot_out.empty() ? "" : " and " + c.mot_out)
+            << "\n";
+  if (r.rows.empty()) {
+    std::cerr << "fieldvision: warning: no tracks"
+              << (r.dropped_tracks > 0
+                      ? fmt::format(" ({} dropped as shorter than {} frames: lower "
+                                    "--min-track-frames)",
+                                    r.dropped_tracks, r.min_track_frames)
+                      : "")
+              << "\n";
+  }
+  if (r.time.time_s.empty()) {
+    std::cerr << "fieldvision: warning: time_s left empty: " << r.time.source << "\n";
+  }
+  if (!c.draw.empty()) {
+    // Field lines need a posed camera; without a field file the camera's own field is unknown.
+    const track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
+                                      field ? &*field : nullptr);
+    const track::DrawVideoResult d =
+        track::DrawTracksVideo(c.video, c.draw, overlay, c.o.fps, c.o.max_frames);
+    std::cout << d.Summary() << "\n";
+  }
 }
 
 void Setup(CLI::App& app, int& exit_code) {
   auto c = std::make_shared<PlayersCli>();
   CLI::App* cmd = app.add_subcommand(
       "players", "Detect and track people in a video; positions on the field (TRACKS.csv)");
-  cmd->add_option("--camera", c->camera, "Camera file (CAM.yaml) of the video")->required();
+  cmd->add_option("--camera", c->camera,
+                  "Camera file (CAM.yaml) of the video; without one (or without a pose) only boxes "
+                  "are tracked and x_m,y_m stay empty");
   cmd->add_option("--video", c->video, "Video file or image pattern (dir/%05d.jpg)")->required();
-  cmd->add_option("--out", c->out,
-                  "TRACKS.csv: frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m")
+  cmd->add_option(
+         "--out", c->out,
+         "TRACKS.csv: frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s (frames "
+         "from 1 as MOTChallenge; time from the video's timestamps, else its frame rate)")
       ->required();
   cmd->add_option("--field", c->field,
                   "Field (built-in name or JSON): keep only people on it plus --margin");
@@ -77,6 +109,21 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-lost", c->o.tracker.max_lost_frames,
                   "Frames a lost track is kept to be re-found");
   cmd->add_option("--max-frames", c->o.max_frames, "Process at most this many frames (0: all)");
+  cmd->add_option("--fps", c->o.fps,
+                  "Override the video's time: frame i at i / FPS seconds (default: the video's "
+                  "timestamps, else its frame rate)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--min-track-frames", c->o.min_track_frames,
+                  "Drop tracks seen in fewer frames (0: keep all; on a clip shorter than twice "
+                  "this, half the clip); the summary says how many were dropped")
+      ->capture_default_str();
+  cmd->add_option("--draw", c->draw,
+                  "Also write the video with boxes, ids, team colours, trails and (with a posed "
+                  "camera and --field) the field lines: H.264 .mp4, or MJPG .avi where OpenCV has "
+                  "no H.264 encoder");
+  cmd->add_option("--mot-out", c->mot_out,
+                  "Also write the tracks as a MOTChallenge results file (no header, "
+                  "frame,id,left,top,w,h,conf,-1,-1,-1) for TrackEval / py-motmetrics");
   cmd->add_option("--interpolate", c->o.interpolate_max_gap,
                   "Fill track gaps up to this many frames (0: off)");
   cmd->add_option("--stitch-gap", c->o.stitch.max_gap_s,

@@ -22,8 +22,9 @@ namespace fs = std::filesystem;
 void DetectorOptions::Check() const {
   FV_REQUIRE(kind == "nanodet" || kind == "hog" || kind == "motion" || kind == "onnx",
              "detector kind '{}' is not one of nanodet, hog, motion, onnx", kind);
-  FV_REQUIRE(input_width >= 64 && input_width % 32 == 0,
-             "input_width must be a multiple of 32 and >= 64 (got {})", input_width);
+  FV_REQUIRE(input_width == 0 || (input_width >= 64 && input_width % 32 == 0),
+             "input_width must be 0 (from the frame) or a multiple of 32 and >= 64 (got {})",
+             input_width);
   FV_REQUIRE(input_height == 0 || (input_height >= 64 && input_height % 32 == 0),
              "input_height must be 0 or a multiple of 32 and >= 64 (got {})", input_height);
   CheckInRange(score_threshold, 0.0, 1.0, "score_threshold");
@@ -41,6 +42,12 @@ void DetectorOptions::Check() const {
   CheckNonNegative(onnx_person_class, "onnx_person_class");
   FV_REQUIRE(kind != "onnx" || !model_path.empty(),
              "detector 'onnx' needs a model file (--onnx MODEL.onnx)");
+}
+
+int NetInputWidth(int input_width, int frame_width) {
+  if (input_width > 0) return input_width;
+  const int half = static_cast<int>(std::lround(0.5 * frame_width / 32.0)) * 32;
+  return std::clamp(half, 416, 960);
 }
 
 double Iou(const cv::Rect2d& a, const cv::Rect2d& b) {
@@ -178,7 +185,8 @@ class NanoDetDetector : public PersonDetector {
     net_ = LoadOnnx(path_);
     // A forward pass on a blank image checks that the model has NanoDet's outputs.
     try {
-      RunNet(cv::Mat(o.input_width, o.input_width, CV_8UC3, cv::Scalar::all(0)));
+      const int w = o.input_width > 0 ? o.input_width : 416;
+      RunNet(cv::Mat(w, w, CV_8UC3, cv::Scalar::all(0)));
     } catch (const cv::Exception& e) {
       Throw(
           "model '{}' does not run as NanoDet (outputs cls8..dis32 expected); run `make build` "
@@ -190,7 +198,7 @@ class NanoDetDetector : public PersonDetector {
 
   std::vector<Detection> Detect(const cv::Mat& bgr) override {
     FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "nanodet: expected a BGR frame");
-    const int net_w = o_.input_width;
+    const int net_w = NetInputWidth(o_.input_width, bgr.cols);
     const int net_h =
         o_.input_height > 0
             ? o_.input_height
@@ -338,7 +346,7 @@ class OnnxYoloDetector : public PersonDetector {
       : o_(o), filter_(std::move(filter)), net_(LoadOnnx(o.model_path)) {}
   std::string name() const override { return "onnx"; }
   std::vector<Detection> Detect(const cv::Mat& bgr) override {
-    const int s = o_.input_width;
+    const int s = o_.input_width > 0 ? o_.input_width : 640;  // YOLO models' usual size
     net_.setInput(cv::dnn::blobFromImage(bgr, 1.0 / 255, cv::Size(s, s), cv::Scalar(), true));
     cv::Mat out;
     try {

@@ -34,8 +34,9 @@ struct DetectorOptions {
   // Model file (nanodet: default FindModel("nanodet.onnx"); onnx: required).
   std::string model_path;
   // Network input width in pixels (multiple of 32); the height follows the frame's aspect ratio.
-  // 416 is NanoDet's training size; smaller is faster and misses small people.
-  int input_width = 416;
+  // 0: from the frame (NetInputWidth: half its width, 416..960). 416 is NanoDet's training size;
+  // smaller is faster and misses small people.
+  int input_width = 0;
   int input_height = 0;          // 0: from the frame's aspect ratio (rounded to a multiple of 32)
   double score_threshold = 0.2;  // lowest score reported (ByteTrack uses the low ones too)
   double nms_iou = 0.5;          // IoU above which the weaker of two boxes is dropped
@@ -100,6 +101,11 @@ void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& pat
 // Throws fv::Error naming the file and line for a malformed row (fewer than 7 columns, a number
 // that does not parse, a frame < 1, a negative box size, a score that is not finite).
 DetectionsFile ReadDetectionsCsv(const std::string& path);
+
+// The network input width for a frame `frame_width` pixels wide: `input_width` when > 0, else
+// half the frame's width rounded to a multiple of 32 and clamped to 416..960 (768x576 PETS: 416,
+// 1280x960: 640, 1920x1080: 960), so people 40-120 px tall in HD frames stay large enough.
+int NetInputWidth(int input_width, int frame_width);
 
 // Greedy NMS over boxes sorted by score (cv::dnn::NMSBoxes).
 std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_threshold,

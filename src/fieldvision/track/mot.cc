@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -16,20 +18,62 @@
 
 namespace fv::track {
 
-void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) {
-  CsvWriter w(
-      path, {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "x_m", "y_m"}, 4);
-  for (const auto& r : rows) {
-    w << r.frame << r.id << r.box.x << r.box.y << r.box.width << r.box.height << r.conf;
-    if (r.x_m && r.y_m) {
-      w << *r.x_m << *r.y_m;
-    } else {
-      w << ""
-        << "";
-    }
-    w.EndRow();
+namespace {
+
+// Writes through `path`.tmp renamed to `path` at the end.
+template <typename WriteFn>
+void WriteReplacing(const std::string& path, WriteFn write) {
+  const std::string tmp = path + ".tmp";
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
   }
-  w.Close();
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  FV_REQUIRE(!ec, "cannot write '{}' ({})", path, ec.message());
+}
+
+}  // namespace
+
+void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) {
+  WriteReplacing(path, [&](const std::string& tmp) {
+    CsvWriter w(tmp,
+                {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "x_m", "y_m",
+                 "time_s"},
+                4);
+    for (const auto& r : rows) {
+      w << r.frame << r.id << r.box.x << r.box.y << r.box.width << r.box.height << r.conf;
+      if (r.x_m && r.y_m) {
+        w << *r.x_m << *r.y_m;
+      } else {
+        w << ""
+          << "";
+      }
+      if (r.time_s) {
+        w << *r.time_s;
+      } else {
+        w << "";
+      }
+      w.EndRow();
+    }
+    w.Close();
+  });
+}
+
+void WriteMotChallenge(const std::vector<TrackRow>& rows, const std::string& path) {
+  WriteReplacing(path, [&](const std::string& tmp) {
+    std::ofstream out(tmp);
+    FV_REQUIRE(out.good(), "cannot write MOTChallenge file '{}'", path);
+    for (const auto& r : rows) {
+      out << fmt::format("{},{},{:.2f},{:.2f},{:.2f},{:.2f},{:.4f},-1,-1,-1\n", r.frame, r.id,
+                         r.box.x, r.box.y, r.box.width, r.box.height, r.conf);
+    }
+    out.close();
+    FV_REQUIRE(!out.fail(), "cannot write MOTChallenge file '{}'", path);
+  });
 }
 
 std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
@@ -38,39 +82,78 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
   std::vector<TrackRow> rows;
   std::string line;
   int line_no = 0;
+  // Column of each field; without a header, MOTChallenge's order.
+  std::map<std::string, int> col = {{"frame", 0},  {"id", 1},       {"bb_left", 2},
+                                    {"bb_top", 3}, {"bb_width", 4}, {"bb_height", 5},
+                                    {"conf", 6}};
+  bool header = false;
   while (std::getline(in, line)) {
     ++line_no;
     const std::string t = Trim(line);
     if (t.empty()) continue;
-    if (line_no == 1 && !t.empty() && !std::isdigit(static_cast<unsigned char>(t[0])) &&
-        t[0] != '-') {
+    if (line_no == 1 && !std::isdigit(static_cast<unsigned char>(t[0])) && t[0] != '-') {
       FV_REQUIRE(StartsWith(t, "frame,id,bb_left"),
                  "{}: header must start with frame,id,bb_left,bb_top,bb_width,bb_height", path);
+      const std::vector<std::string> names = Split(t, ',');
+      col.clear();
+      for (size_t i = 0; i < names.size(); ++i) col[Trim(names[i])] = static_cast<int>(i);
+      for (const char* need : {"bb_top", "bb_width", "bb_height"}) {
+        FV_REQUIRE(col.count(need), "{}: header has no column '{}'", path, need);
+      }
+      header = true;
       continue;
     }
     const std::vector<std::string> f = Split(t, ',');
     FV_REQUIRE(f.size() >= 6, "{}:{}: expected at least 6 columns, got {}", path, line_no,
                f.size());
     const std::string where = fmt::format("{}:{}", path, line_no);
+    auto field = [&](const char* name) -> std::string {
+      const auto it = col.find(name);
+      if (it == col.end() || it->second >= static_cast<int>(f.size())) return {};
+      return Trim(f[it->second]);
+    };
+    auto number = [&](const char* name) { return ParseDouble(field(name), where + " " + name); };
     TrackRow r;
-    r.frame = static_cast<int>(ParseInt(Trim(f[0]), where + " frame"));
-    r.id = static_cast<int>(ParseInt(Trim(f[1]), where + " id"));
-    r.box = cv::Rect2d(ParseDouble(Trim(f[2]), where + " bb_left"),
-                       ParseDouble(Trim(f[3]), where + " bb_top"),
-                       ParseDouble(Trim(f[4]), where + " bb_width"),
-                       ParseDouble(Trim(f[5]), where + " bb_height"));
+    r.frame = static_cast<int>(ParseInt(field("frame"), where + " frame"));
+    r.id = static_cast<int>(ParseInt(field("id"), where + " id"));
+    r.box =
+        cv::Rect2d(number("bb_left"), number("bb_top"), number("bb_width"), number("bb_height"));
     FV_REQUIRE(r.box.width >= 0 && r.box.height >= 0, "{}: negative box size", where);
-    if (f.size() > 6 && !Trim(f[6]).empty()) r.conf = ParseDouble(Trim(f[6]), where + " conf");
-    if (f.size() > 8 && !Trim(f[7]).empty() && !Trim(f[8]).empty()) {
-      r.x_m = ParseDouble(Trim(f[7]), where + " x_m");
-      r.y_m = ParseDouble(Trim(f[8]), where + " y_m");
+    if (!field("conf").empty()) r.conf = number("conf");
+    if (header) {
+      if (!field("x_m").empty() && !field("y_m").empty()) {
+        r.x_m = number("x_m");
+        r.y_m = number("y_m");
+      }
+      if (!field("time_s").empty()) r.time_s = number("time_s");
+    } else if (f.size() == 9) {
+      // MOT16/17/20 ground truth: class and visibility.
+      r.mot_class = static_cast<int>(ParseDouble(Trim(f[7]), where + " class"));
+      r.visibility = ParseDouble(Trim(f[8]), where + " visibility");
     }
     rows.push_back(r);
   }
   return rows;
 }
 
-void MotOptions::Check() const { CheckInRange(iou_threshold, 1e-6, 1.0, "iou_threshold"); }
+void MotOptions::Check() const {
+  CheckInRange(iou_threshold, 1e-6, 1.0, "iou_threshold");
+  FV_REQUIRE(std::abs(frame_offset) <= 1000000, "frame_offset {} is out of range", frame_offset);
+}
+
+std::string MotPreprocessing::Summary() const {
+  std::string s = fmt::format(
+      "left out: {} ground-truth boxes (conf 0 or not a pedestrian), {} estimated boxes on "
+      "distractors, {} estimated boxes outside the ground truth's frames",
+      gt_ignored, est_on_distractors, est_outside_gt_frames);
+  if (best_offset != 0 && iou_at_best > 1.02 * iou_at_zero) {
+    s += fmt::format(
+        "; WARNING: the frames look shifted: the boxes overlap better (summed IoU {:.0f} against "
+        "{:.0f}) with the estimate's frames moved by {:+d} (--frame-offset {})",
+        iou_at_best, iou_at_zero, best_offset, best_offset);
+  }
+  return s;
+}
 
 std::string MotMetrics::Summary() const {
   return fmt::format(
@@ -103,7 +186,11 @@ std::string MotMetrics::ToJson() const {
                       {"est_ids", est_ids},
                       {"gt_boxes", gt_boxes},
                       {"est_boxes", est_boxes},
-                      {"frames", frames}};
+                      {"frames", frames},
+                      {"gt_ignored", preprocessing.gt_ignored},
+                      {"est_on_distractors", preprocessing.est_on_distractors},
+                      {"est_outside_gt_frames", preprocessing.est_outside_gt_frames},
+                      {"best_frame_offset", preprocessing.best_offset}};
   return j.dump(2);
 }
 
@@ -113,11 +200,104 @@ struct FrameData {
   std::vector<const TrackRow*> gt, est;
 };
 
+// One-to-one matching of boxes at IoU >= thr maximising the IoU sum (Hungarian): pairs (i, j).
+std::vector<std::pair<int, int>> MatchBoxes(const std::vector<const TrackRow*>& a,
+                                            const std::vector<const TrackRow*>& b, double thr) {
+  std::vector<std::pair<int, int>> out;
+  if (a.empty() || b.empty()) return out;
+  std::vector<std::vector<double>> cost(a.size(), std::vector<double>(b.size()));
+  for (size_t i = 0; i < a.size(); ++i) {
+    for (size_t j = 0; j < b.size(); ++j) {
+      const double v = Iou(a[i]->box, b[j]->box);
+      cost[i][j] = v >= thr - 1e-12 ? 1.0 - v : 1e9;
+    }
+  }
+  const std::vector<int> m = SolveAssignment(cost);
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (m[i] >= 0 && cost[i][m[i]] < 1e8) out.emplace_back(static_cast<int>(i), m[i]);
+  }
+  return out;
+}
+
+std::map<int, std::vector<const TrackRow*>> ByFrame(const std::vector<TrackRow>& rows,
+                                                    int offset = 0) {
+  std::map<int, std::vector<const TrackRow*>> out;
+  for (const auto& r : rows) out[r.frame + offset].push_back(&r);
+  return out;
+}
+
+// MOT17 rules, frame alignment check and clipping (MotOptions): the rows that are scored.
+void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,
+                const MotOptions& o, std::vector<TrackRow>& gt, std::vector<TrackRow>& est,
+                MotPreprocessing& p) {
+  est = est_in;
+  for (auto& r : est) r.frame += o.frame_offset;
+  // Frame alignment: summed IoU of the matches (IoU >= 0.5) for offsets -2..2 (on the ground
+  // truth as given); slow walkers overlap themselves a frame later, so the IoU, not the count.
+  const auto gt_frames = ByFrame(gt_in);
+  for (int off = -2; off <= 2; ++off) {
+    double sum = 0;
+    for (const auto& [f, es] : ByFrame(est, off)) {
+      const auto g = gt_frames.find(f);
+      if (g == gt_frames.end()) continue;
+      for (const auto& [i, j] : MatchBoxes(g->second, es, 0.5)) {
+        sum += Iou(g->second[i]->box, es[j]->box);
+      }
+    }
+    if (off == 0) p.iou_at_zero = sum;
+    if (sum > p.iou_at_best || (sum == p.iou_at_best && off == 0)) {
+      p.iou_at_best = sum;
+      p.best_offset = off;
+    }
+  }
+  bool has_classes = false;
+  for (const auto& r : gt_in) has_classes = has_classes || r.mot_class >= 0;
+  if (o.mot17_rules && has_classes) {
+    // TrackEval: estimated boxes matched to a distractor class are removed.
+    static const std::set<int> kDistractors = {2, 7, 8, 12};
+    std::set<const TrackRow*> drop;
+    const auto est_frames = ByFrame(est);
+    for (const auto& [f, gs] : gt_frames) {
+      const auto e = est_frames.find(f);
+      if (e == est_frames.end()) continue;
+      for (const auto& [i, j] : MatchBoxes(gs, e->second, 0.5)) {
+        if (kDistractors.count(gs[i]->mot_class)) drop.insert(e->second[j]);
+      }
+    }
+    std::vector<TrackRow> kept;
+    for (const auto& [f, es] : est_frames) {
+      for (const TrackRow* r : es) {
+        if (!drop.count(r)) kept.push_back(*r);
+      }
+    }
+    p.est_on_distractors = static_cast<int>(drop.size());
+    est = std::move(kept);
+    for (const auto& r : gt_in) {
+      if (r.conf != 0 && r.mot_class == 1) {
+        gt.push_back(r);
+      } else {
+        p.gt_ignored++;
+      }
+    }
+  } else {
+    gt = gt_in;
+  }
+  if (o.clip_to_gt_frames && !gt_frames.empty()) {
+    const int first = gt_frames.begin()->first, last = gt_frames.rbegin()->first;
+    const size_t before = est.size();
+    std::erase_if(est, [&](const TrackRow& r) { return r.frame < first || r.frame > last; });
+    p.est_outside_gt_frames = static_cast<int>(before - est.size());
+  }
+}
+
 }  // namespace
 
-MotMetrics EvaluateMot(const std::vector<TrackRow>& gt, const std::vector<TrackRow>& est,
+MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,
                        const MotOptions& options) {
   options.Check();
+  std::vector<TrackRow> gt, est;
+  MotPreprocessing pre;
+  Preprocess(gt_in, est_in, options, gt, est, pre);
   std::map<int, FrameData> frames;
   std::map<int, int> gt_index, est_index;  // id -> dense index
   for (const auto& r : gt) {
@@ -129,6 +309,7 @@ MotMetrics EvaluateMot(const std::vector<TrackRow>& gt, const std::vector<TrackR
     est_index.emplace(r.id, static_cast<int>(est_index.size()));
   }
   MotMetrics m;
+  m.preprocessing = pre;
   m.frames = static_cast<int>(frames.size());
   m.gt_boxes = static_cast<int>(gt.size());
   m.est_boxes = static_cast<int>(est.size());

@@ -103,5 +103,101 @@ TEST(Mot, CsvRoundTripAndBadFile) {
   }
 }
 
+// TRACKS.csv keeps time_s; a file without it (older TRACKS.csv) still reads.
+TEST(Mot, TimeRoundTripAndMotChallengeOutput) {
+  const std::string dir = fv::testing::TempDir();
+  std::vector<TrackRow> rows = {{1, 2, cv::Rect2d(1, 2, 30, 60), 0.75, 1.0, 2.0, 0.0},
+                                {2, 2, cv::Rect2d(2, 3, 30, 60), 0.5, {}, {}, 0.1}};
+  WriteTracksCsv(rows, dir + "/t.csv");
+  const auto back = ReadTracksCsv(dir + "/t.csv");
+  ASSERT_EQ(back.size(), 2u);
+  ASSERT_TRUE(back[1].time_s.has_value());
+  EXPECT_NEAR(*back[1].time_s, 0.1, 1e-9);
+  EXPECT_FALSE(back[1].x_m.has_value());
+  {
+    std::ofstream old(dir + "/old.csv");
+    old << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m\n1,4,1,2,3,4,0.9,5,6\n";
+  }
+  const auto o = ReadTracksCsv(dir + "/old.csv");
+  ASSERT_EQ(o.size(), 1u);
+  EXPECT_FALSE(o[0].time_s.has_value());
+  EXPECT_NEAR(*o[0].y_m, 6.0, 1e-12);
+  // The MOTChallenge file has no header and ten columns; it reads back as the same boxes.
+  WriteMotChallenge(rows, dir + "/mot.txt");
+  std::ifstream in(dir + "/mot.txt");
+  std::string first;
+  std::getline(in, first);
+  EXPECT_EQ(first, "1,2,1.00,2.00,30.00,60.00,0.7500,-1,-1,-1");
+  const auto mot = ReadTracksCsv(dir + "/mot.txt");
+  ASSERT_EQ(mot.size(), 2u);
+  EXPECT_EQ(mot[1].frame, 2);
+  EXPECT_FALSE(mot[1].x_m.has_value());
+}
+
+// MOT17 ground truth (9 columns: conf 0 = ignore, class, visibility) scored as TrackEval does:
+// a static person (class 7) matched by the tracker is neither a hit nor a false positive, a car
+// (class 3) and a zero-marked pedestrian are not misses.
+TEST(Mot, Mot17RulesIgnoreDistractorsAndZeroMarkedRows) {
+  const std::string dir = fv::testing::TempDir();
+  {
+    std::ofstream gt(dir + "/gt.txt");
+    for (int f = 1; f <= 10; ++f) {
+      gt << f << ",1,100,100,40,100,1,1,1\n";    // pedestrian
+      gt << f << ",2,300,100,40,100,1,7,0.8\n";  // static person (distractor)
+      gt << f << ",3,500,100,80,60,0,3,1\n";     // car, zero-marked
+      gt << f << ",4,700,100,40,100,0,1,0.1\n";  // pedestrian marked 0 (ignore)
+    }
+  }
+  const auto gt = ReadTracksCsv(dir + "/gt.txt");
+  ASSERT_EQ(gt.size(), 40u);
+  EXPECT_EQ(gt[1].mot_class, 7);
+  EXPECT_NEAR(gt[1].visibility, 0.8, 1e-12);
+  std::vector<TrackRow> est;
+  for (int f = 1; f <= 10; ++f) {
+    est.push_back({f, 11, cv::Rect2d(101, 100, 40, 100), 0.9, {}, {}});  // the pedestrian
+    est.push_back({f, 12, cv::Rect2d(300, 102, 40, 100), 0.9, {}, {}});  // the static person
+  }
+  const MotMetrics m = EvaluateMot(gt, est);
+  EXPECT_EQ(m.preprocessing.gt_ignored, 30);
+  EXPECT_EQ(m.preprocessing.est_on_distractors, 10);
+  EXPECT_EQ(m.tp, 10);
+  EXPECT_EQ(m.fp, 0);
+  EXPECT_EQ(m.fn, 0);
+  EXPECT_DOUBLE_EQ(m.mota, 1.0);
+  // Without the rules every row counts.
+  MotOptions all;
+  all.mot17_rules = false;
+  const MotMetrics raw = EvaluateMot(gt, est, all);
+  EXPECT_EQ(raw.fn, 20);
+  EXPECT_LT(raw.mota, 0.6);
+}
+
+// An estimate numbered from 0 against 1-based ground truth: the shift is reported, and
+// --frame-offset 1 scores it fully; estimated rows beyond the ground truth's frames are left out.
+TEST(Mot, FrameAlignment) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  auto gt = Walkers(rng, 4, 30);
+  for (auto& r : gt) r.frame += 1;  // 1..30
+  std::vector<TrackRow> est;
+  for (auto r : gt) {
+    r.frame -= 1;  // 0..29
+    est.push_back(r);
+  }
+  est.push_back({40, 9, cv::Rect2d(0, 0, 30, 80), 0.9, {}, {}});  // beyond the ground truth
+  const MotMetrics shifted = EvaluateMot(gt, est);
+  EXPECT_EQ(shifted.preprocessing.best_offset, 1);
+  EXPECT_NE(shifted.preprocessing.Summary().find("--frame-offset 1"), std::string::npos)
+      << shifted.preprocessing.Summary();
+  MotOptions o;
+  o.frame_offset = 1;
+  const MotMetrics fixed = EvaluateMot(gt, est, o);
+  EXPECT_DOUBLE_EQ(fixed.mota, 1.0);
+  EXPECT_EQ(fixed.preprocessing.best_offset, 0);
+  EXPECT_EQ(fixed.preprocessing.est_outside_gt_frames, 1);
+  EXPECT_EQ(fixed.preprocessing.Summary().find("WARNING"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace fv::track

@@ -69,7 +69,7 @@ std::vector<TrackRow> ReadPetsCvml(const std::string& path) {
       const double xc = NumAttr(tag, "xc", where), yc = NumAttr(tag, "yc", where);
       const double w = NumAttr(tag, "w", where), h = NumAttr(tag, "h", where);
       TrackRow r;
-      r.frame = frame;
+      r.frame = frame + 1;  // CVML numbers frames from 0, MOTChallenge from 1
       r.id = id;
       r.box = cv::Rect2d(xc - 0.5 * w, yc - 0.5 * h, w, h);
       rows.push_back(r);

@@ -16,7 +16,8 @@
 
 namespace fv::track {
 
-// Every <object> box of every <frame> (conf 1, no field position). Throws naming the file.
+// Every <object> box of every <frame> (conf 1, no field position) as MOT rows: frames numbered
+// from 1 (CVML's frame 0 is MOT frame 1, the video's first frame). Throws naming the file.
 std::vector<TrackRow> ReadPetsCvml(const std::string& path);
 
 struct TsaiParameters {

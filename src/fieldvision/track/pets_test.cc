@@ -48,14 +48,15 @@ TEST(Pets, AnnotationsImportAndFeetLieOnAPlausibleGround) {
     frames.insert(r.frame);
     ids.insert(r.id);
   }
-  EXPECT_EQ(*frames.begin(), 0);
-  EXPECT_EQ(*frames.rbegin(), 794);
+  EXPECT_EQ(*frames.begin(), 1);  // MOTChallenge numbering: CVML frames 0..794
+  EXPECT_EQ(*frames.rbegin(), 795);
   EXPECT_GE(ids.size(), 15u);
   EXPECT_GT(rows.size(), 4000u);
-  // Frame 0, object 15: xc 274.4912 yc 262.9999 w 32.9129 h 88.7021 (first lines of the file).
+  // CVML frame 0 (MOT frame 1), object 15: xc 274.4912 yc 262.9999 w 32.9129 h 88.7021 (first lines
+  // of the file).
   bool found = false;
   for (const auto& r : rows) {
-    if (r.frame == 0 && r.id == 15) {
+    if (r.frame == 1 && r.id == 15) {
       found = true;
       EXPECT_NEAR(r.box.x + 0.5 * r.box.width, 274.4912, 1e-3);
       EXPECT_NEAR(r.box.height, 88.7021, 1e-3);

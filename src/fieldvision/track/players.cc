@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -48,6 +49,7 @@ class FrameReader {
     FV_REQUIRE(ok && !first.empty(), "video '{}' has no readable frame (corrupt?)", path);
     size_ = first.size();
     queue_.push_back(first);
+    times_ms_.push_back(cap.get(cv::CAP_PROP_POS_MSEC));
     thread_ = std::thread([this, cap = std::move(cap)]() mutable { Run(cap); });
   }
   ~FrameReader() {
@@ -58,13 +60,16 @@ class FrameReader {
     cv_.notify_all();
     if (thread_.joinable()) thread_.join();
   }
-  // Next frame, or false at the end.
-  bool Next(cv::Mat& frame) {
+  // Next frame and its container timestamp (CAP_PROP_POS_MSEC; 0 or NaN when the backend has
+  // none), or false at the end.
+  bool Next(cv::Mat& frame, double& time_ms) {
     std::unique_lock<std::mutex> lock(mutex_);
     cv_.wait(lock, [&] { return !queue_.empty() || done_; });
     if (queue_.empty()) return false;
     frame = queue_.front();
     queue_.pop_front();
+    time_ms = times_ms_.front();
+    times_ms_.pop_front();
     cv_.notify_all();
     return true;
   }
@@ -85,6 +90,7 @@ class FrameReader {
         ok = cap.read(f);
       } catch (const cv::Exception&) {
       }
+      const double ms = ok ? cap.get(cv::CAP_PROP_POS_MSEC) : 0.0;
       read_s_ += Seconds(t0, Clock::now());
       if (!ok || f.empty()) break;
       ++n;
@@ -92,6 +98,7 @@ class FrameReader {
       cv_.wait(lock, [&] { return queue_.size() < 8 || stop_; });
       if (stop_) break;
       queue_.push_back(std::move(f));
+      times_ms_.push_back(ms);
       cv_.notify_all();
     }
     std::lock_guard<std::mutex> lock(mutex_);
@@ -105,6 +112,7 @@ class FrameReader {
   cv::Size size_;
   double read_s_ = 0;
   std::deque<cv::Mat> queue_;
+  std::deque<double> times_ms_;
   std::mutex mutex_;
   std::condition_variable cv_;
   bool done_ = false, stop_ = false;
@@ -131,7 +139,47 @@ class FileDetector : public PersonDetector {
   size_t next_ = 0;
 };
 
+bool ValidFps(double fps) { return std::isfinite(fps) && fps > 0 && fps < 10000; }
+
 }  // namespace
+
+FrameTimes TimesOfFrames(const std::vector<double>& container_ms, double container_fps,
+                         double fps_override) {
+  FrameTimes t;
+  const size_t n = container_ms.size();
+  if (n == 0) return t;
+  auto by_rate = [&](double fps, const std::string& source) {
+    t.fps = fps;
+    t.source = source;
+    t.time_s.resize(n);
+    for (size_t i = 0; i < n; ++i) t.time_s[i] = i / fps;
+    return t;
+  };
+  if (ValidFps(fps_override)) return by_rate(fps_override, fmt::format("--fps {:g}", fps_override));
+  // Container timestamps: used when finite and strictly increasing (a backend without them
+  // reports 0 for every frame).
+  bool increasing = n >= 2;
+  for (size_t i = 0; i < n && increasing; ++i) {
+    increasing = std::isfinite(container_ms[i]) && container_ms[i] >= 0 &&
+                 (i == 0 || container_ms[i] > container_ms[i - 1]);
+  }
+  if (increasing) {
+    std::vector<double> steps;
+    for (size_t i = 1; i < n; ++i) steps.push_back(container_ms[i] - container_ms[i - 1]);
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    t.fps = 1000.0 / steps[steps.size() / 2];
+    t.source = fmt::format("the video's timestamps (median {:.2f} frames/s)", t.fps);
+    t.time_s.resize(n);
+    for (size_t i = 0; i < n; ++i) t.time_s[i] = container_ms[i] / 1000.0;
+    return t;
+  }
+  if (ValidFps(container_fps)) {
+    return by_rate(container_fps,
+                   fmt::format("the video's frame rate ({:g} frames/s)", container_fps));
+  }
+  t.source = "none (the video gives neither timestamps nor a frame rate: give --fps)";
+  return t;
+}
 
 void StitchOptions::Check() const {
   CheckNonNegative(max_gap_s, "stitch max_gap_s");
@@ -297,15 +345,19 @@ void PlayersOptions::Check() const {
 std::string PlayersResult::Summary() const {
   const double f = std::max(1, frames);
   return fmt::format(
-      "{} frames, {} detections ({}), {} tracks ({} tracklets joined), {} rows ({} interpolated, "
-      "{} "
-      "off the ground); "
+      "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
+      "({} interpolated, {} off the ground); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
       "{:.1f}, map {:.1f}); tracker: {}{}",
-      frames, detections, detector, tracks, stitched, rows.size(), interpolated, off_ground,
-      times.total_s, frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f,
-      1000 * times.detect_s / f, 1000 * times.track_s / f, 1000 * times.map_s / f,
-      tracker.Summary(), smoothing.tracks > 0 ? "; " + smoothing.Summary() : "");
+      frames, time.source, detections, detector, tracks, stitched,
+      dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
+                                       "--min-track-frames",
+                                       dropped_tracks, min_track_frames)
+                         : "",
+      rows.size(), interpolated, off_ground, times.total_s, frames / std::max(1e-9, times.total_s),
+      1000 * times.read_s / f, 1000 * times.detect_s / f, 1000 * times.track_s / f,
+      1000 * times.map_s / f, tracker.Summary(),
+      smoothing.tracks > 0 ? "; " + smoothing.Summary() : "");
 }
 
 void CheckCameraMatchesVideo(const Camera& camera, int width, int height,
@@ -394,7 +446,9 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   DetectionsFile saved;
   PlayersResult result;
   result.detector = detector->name();
-  result.fps = options.fps > 0 ? options.fps : (reader.fps() > 0 ? reader.fps() : 25.0);
+  // The tracker's and stitcher's rate (frame steps to seconds); the rows' times come from
+  // TimesOfFrames after the pass.
+  result.fps = options.fps > 0 ? options.fps : (ValidFps(reader.fps()) ? reader.fps() : 25.0);
   TrackerOptions topt = options.tracker;
   topt.fps = result.fps;
   ByteTracker tracker(topt, calibrated ? camera : nullptr);
@@ -407,7 +461,10 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   std::map<int, TrackAppearance> appearance;
   cv::Mat frame;
   int index = 0;
-  while (reader.Next(frame)) {
+  double time_ms = 0;
+  std::vector<double> times_ms;
+  while (reader.Next(frame, time_ms)) {
+    times_ms.push_back(time_ms);
     const auto t0 = Clock::now();
     const std::vector<Detection> dets = detector->Detect(frame);
     const auto t1 = Clock::now();
@@ -433,7 +490,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     if (!options.detections_out.empty()) saved.frames.push_back(dets);
     for (const auto& s : states) {
       TrackRow r;
-      r.frame = index;
+      r.frame = index + 1;  // MOTChallenge numbering
       r.id = s.id;
       r.box = s.box;
       r.conf = s.score;
@@ -469,12 +526,16 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   FV_REQUIRE(index > 0, "video '{}' has no readable frame", video);
   if (!options.detections_out.empty()) WriteDetectionsCsv(saved, options.detections_out);
   const auto t_map = Clock::now();
-  // Short tracks are usually false detections.
+  // Short tracks are usually false detections; on a short clip the minimum is half the clip.
+  result.min_track_frames = std::min(options.min_track_frames, std::max(1, (index + 1) / 2));
   if (options.min_track_frames > 0) {
     std::map<int, int> count;
     for (const auto& r : result.rows) count[r.id]++;
+    for (const auto& [id, n] : count) {
+      if (n < result.min_track_frames) result.dropped_tracks++;
+    }
     std::erase_if(result.rows,
-                  [&](const TrackRow& r) { return count[r.id] < options.min_track_frames; });
+                  [&](const TrackRow& r) { return count[r.id] < result.min_track_frames; });
   }
   result.stitched =
       StitchTracklets(result.rows, appearance, options.stitch, result.fps, reader.size());
@@ -509,6 +570,10 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
                  cv::KMEANS_PP_CENTERS, centres);
       for (size_t i = 0; i < team_ids.size(); ++i) result.team_of[team_ids[i]] = labels.at<int>(i);
     }
+  }
+  result.time = TimesOfFrames(times_ms, reader.fps(), options.fps);
+  if (!result.time.time_s.empty()) {
+    for (auto& r : result.rows) r.time_s = result.time.time_s[r.frame - 1];
   }
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();

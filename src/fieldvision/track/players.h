@@ -60,12 +60,17 @@ struct PlayersOptions {
   double field_margin_m = 3.0;
   int max_frames = 0;            // 0: the whole video
   int interpolate_max_gap = 20;  // fill track gaps up to this many frames (0: off)
-  int min_track_frames = 5;      // drop tracks seen in fewer frames (0: keep all)
-  StitchOptions stitch;          // offline joining of tracklets (before gap interpolation)
-  GroundSmoothOptions smooth;    // offline smoothing of field positions (calibrated camera)
-  bool teams = false;            // assign teams (k-means, k = 2, on torso colour)
-  bool progress = true;          // fv::Progress on stderr
-  double fps = 0;                // 0: from the video (falls back to 25)
+  // Drop tracks seen in fewer frames (mostly false detections; 0: keep all). On a clip shorter
+  // than twice this, the minimum is half the clip's frames (a 3-frame clip keeps 2-frame tracks).
+  // The summary says how many were dropped.
+  int min_track_frames = 5;
+  StitchOptions stitch;        // offline joining of tracklets (before gap interpolation)
+  GroundSmoothOptions smooth;  // offline smoothing of field positions (calibrated camera)
+  bool teams = false;          // assign teams (k-means, k = 2, on torso colour)
+  bool progress = true;        // fv::Progress on stderr
+  // Overrides the video's time: frame i (0-based) is at i / fps seconds. 0: the video's
+  // timestamps, else its frame rate (TimesOfFrames).
+  double fps = 0;
   // Read the detections from this file (MOTChallenge det.txt style, detection.h) instead of
   // running the detector; the video is still read (the tracker's appearance model uses the
   // frames). The same filtering (min height, field area, NMS, score threshold) is applied.
@@ -77,6 +82,19 @@ struct PlayersOptions {
   void Check() const;
 };
 
+// The time of each frame of a video (CONTRACT.md: from the video, never assumed).
+struct FrameTimes {
+  std::vector<double> time_s;  // per frame (0-based); empty when the video gives no time
+  double fps = 0;              // the rate used (median of the timestamps' steps); 0: none
+  std::string source;          // where the time came from, for messages
+};
+
+// Frame times from, in order: `fps_override` (> 0: frame i at i / fps), the container's
+// timestamps (CAP_PROP_POS_MSEC per frame, used when finite and strictly increasing), the
+// container's frame rate; else none.
+FrameTimes TimesOfFrames(const std::vector<double>& container_ms, double container_fps,
+                         double fps_override);
+
 struct StageTimes {
   double read_s = 0, detect_s = 0, track_s = 0, map_s = 0, total_s = 0;
 };
@@ -85,12 +103,15 @@ struct PlayersResult {
   std::vector<TrackRow> rows;
   std::map<int, int> team_of;  // id -> 0/1 when teams were asked for
   int frames = 0;
-  double fps = 0;        // video frame rate used
-  int detections = 0;    // after filtering and NMS, all frames
-  int tracks = 0;        // ids in the output
-  int interpolated = 0;  // rows added by gap filling
-  int stitched = 0;      // tracklets joined to an earlier one
-  int off_ground = 0;    // rows whose foot point does not meet the ground
+  double fps = 0;            // frame rate used by the tracker (25 when the video gives none)
+  FrameTimes time;           // the rows' time_s (TrackRow::time_s) and where it came from
+  int min_track_frames = 0;  // the minimum track length applied (PlayersOptions)
+  int dropped_tracks = 0;    // tracks shorter than that, dropped
+  int detections = 0;        // after filtering and NMS, all frames
+  int tracks = 0;            // ids in the output
+  int interpolated = 0;      // rows added by gap filling
+  int stitched = 0;          // tracklets joined to an earlier one
+  int off_ground = 0;        // rows whose foot point does not meet the ground
   GroundSmoothResult smoothing;
   TrackerStats tracker;
   StageTimes times;

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/track/overlay.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -136,7 +137,83 @@ TEST(Players, StitchJoinsTrackletsOfOnePersonAndInterpolationFillsTheGap) {
   EXPECT_THROW(o.Check(), fv::Error);
 }
 
+TEST(Players, FrameTimesFromOverrideTimestampsRateOrNone) {
+  // Timestamps of a variable-rate video win over the container's nominal rate.
+  const FrameTimes ts = TimesOfFrames({0, 100, 210, 300}, 25, 0);
+  ASSERT_EQ(ts.time_s.size(), 4u);
+  EXPECT_DOUBLE_EQ(ts.time_s[2], 0.21);
+  EXPECT_NEAR(ts.fps, 10.0, 1e-9);
+  EXPECT_NE(ts.source.find("timestamps"), std::string::npos) << ts.source;
+  // A backend without timestamps (all 0): the container's rate.
+  const FrameTimes rate = TimesOfFrames({0, 0, 0}, 12.5, 0);
+  ASSERT_EQ(rate.time_s.size(), 3u);
+  EXPECT_DOUBLE_EQ(rate.time_s[2], 0.16);
+  EXPECT_NE(rate.source.find("12.5"), std::string::npos) << rate.source;
+  // --fps overrides both.
+  const FrameTimes forced = TimesOfFrames({0, 100, 210}, 25, 50);
+  EXPECT_DOUBLE_EQ(forced.time_s[1], 0.02);
+  // Neither timestamps nor a rate: no time, and the message says what to do.
+  const FrameTimes none = TimesOfFrames({0, 0}, 0, 0);
+  EXPECT_TRUE(none.time_s.empty());
+  EXPECT_NE(none.source.find("--fps"), std::string::npos);
+}
+
 #ifdef FV_HAVE_SYNTH
+// A 3-frame clip at 10 frames/s (not 25): tracks with 1-based frames and the video's time, boxes
+// without a camera, and the overlay video with one frame per input frame.
+TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
+  const uint64_t seed = fv::testing::TestSeed(3);
+  FV_SEED_TRACE(seed);
+  synth::SceneSpec spec = synth::Preset("players", seed);
+  spec.num_frames = 3;
+  spec.fps = 10;
+  synth::ResizeCameras(spec, 640, 480);
+  const std::string dir = fv::testing::TempDir();
+  synth::WriteScene(spec, dir, false);
+  synth::SceneRenderer scene(spec);
+  const Camera cam = scene.cameras()[0];
+  const FieldModel field = scene.field();
+  const std::string video = dir + "/" + cam.name + ".avi";
+  PlayersOptions o;
+  o.progress = false;
+  const PlayersResult r = RunPlayers(video, &cam, &field, o);
+  ASSERT_FALSE(r.rows.empty()) << r.Summary();
+  EXPECT_EQ(r.frames, 3);
+  EXPECT_LE(r.min_track_frames, 2);
+  EXPECT_NEAR(r.time.fps, 10.0, 1e-6) << r.time.source;
+  std::set<int> frames;
+  for (const auto& row : r.rows) {
+    frames.insert(row.frame);
+    ASSERT_TRUE(row.time_s.has_value());
+    EXPECT_NEAR(*row.time_s, (row.frame - 1) / 10.0, 1e-6);
+    EXPECT_TRUE(row.x_m.has_value());
+  }
+  EXPECT_GE(*frames.begin(), 1);
+  EXPECT_LE(*frames.rbegin(), 3);
+  // Without a camera: the same boxes, no field positions.
+  const PlayersResult boxes = RunPlayers(video, nullptr, nullptr, o);
+  ASSERT_FALSE(boxes.rows.empty()) << boxes.Summary();
+  for (const auto& row : boxes.rows) EXPECT_FALSE(row.x_m.has_value());
+  // The overlay: one output frame per input frame, boxes drawn where the tracks are.
+  const TrackOverlay overlay(r.rows, {}, {}, &cam, &field);
+  const DrawVideoResult d = DrawTracksVideo(video, dir + "/overlay.mp4", overlay);
+  EXPECT_EQ(d.frames, 3) << d.Summary();
+  cv::VideoCapture back(d.path);
+  ASSERT_TRUE(back.isOpened()) << d.Summary();
+  cv::Mat f, first;
+  int n = 0;
+  while (back.read(f)) {
+    if (n == 0) first = f.clone();
+    ++n;
+  }
+  EXPECT_EQ(n, 3) << d.Summary();
+  ASSERT_FALSE(first.empty());
+  cv::VideoCapture in(video);
+  cv::Mat raw;
+  ASSERT_TRUE(in.read(raw));
+  EXPECT_GT(cv::norm(first, raw, cv::NORM_L1) / raw.total(), 1.0);  // something was drawn
+}
+
 // The synthetic players scene (people of two teams crossing, running and walking): positions on
 // the field within 0.3 m of the truth and one id per person through the crossings.
 TEST(Players, SynthScenePositionsAndStableIds) {
@@ -181,7 +258,7 @@ TEST(Players, SynthScenePositionsAndStableIds) {
   int matched = 0, switches = 0, reentries = 0;
   std::map<int, int> last_in_image;
   for (const auto& [frame, rows] : rows_of_frame) {
-    const auto truth = scene.PlayerTruth(static_cast<int>(frame));
+    const auto truth = scene.PlayerTruth(static_cast<int>(frame) - 1);  // TRACKS.csv: 1-based
     struct Pair {
       double iou;
       const TrackRow* row;
@@ -215,7 +292,7 @@ TEST(Players, SynthScenePositionsAndStableIds) {
         // Out of the image since the last match: a re-entry, else a switch.
         bool left = false;
         for (int f = last_frame_seen[p.who->id] + 1; f < frame && !left; ++f) {
-          const auto tf = scene.PlayerTruth(f);
+          const auto tf = scene.PlayerTruth(f - 1);
           for (const auto& t : tf) left = left || (t.id == p.who->id && !t.cameras[0].in_image);
         }
         (left ? reentries : switches) += 1;

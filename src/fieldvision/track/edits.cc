@@ -1,0 +1,315 @@
+#include "fieldvision/track/edits.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::track {
+namespace {
+
+using json = nlohmann::json;
+
+int LineOfByte(const std::string& text, size_t byte) {
+  byte = std::min(byte, text.size());
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + byte, '\n'));
+}
+
+// Lines where the elements of the top-level array start (skipping strings and nesting).
+std::vector<int> TopLevelElementLines(const std::string& text) {
+  std::vector<int> lines;
+  int depth = 0, line = 1;
+  bool in_string = false, escaped = false, expect_element = false;
+  for (char c : text) {
+    if (c == '\n') ++line;
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+      continue;
+    }
+    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (expect_element && depth == 1 && c != ']') {
+      lines.push_back(line);
+      expect_element = false;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      ++depth;
+      if (depth == 1 && c == '[') expect_element = true;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    } else if (c == ',' && depth == 1) {
+      expect_element = true;
+    }
+  }
+  return lines;
+}
+
+int IdFrom(const json& v, const std::string& where) {
+  if (v.is_number_integer()) return v.get<int>();
+  if (v.is_string()) return static_cast<int>(ParseInt(Trim(v.get<std::string>()), where + " id"));
+  Throw("{}: expected an id (a whole number), got {}", where, v.dump());
+}
+
+std::vector<int> IdList(const json& v, const std::string& where) {
+  FV_REQUIRE(v.is_array(), "{}: expected a list of ids such as [3, 17]", where);
+  std::vector<int> ids;
+  for (const auto& e : v) ids.push_back(IdFrom(e, where));
+  return ids;
+}
+
+}  // namespace
+
+TrackEdits ParseTrackEdits(const std::string& text, const std::string& path) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    Throw("{}:{}: not valid JSON ({})", path, LineOfByte(text, e.byte > 0 ? e.byte - 1 : 0),
+          e.what());
+  }
+  FV_REQUIRE(j.is_array(),
+             "{}:1: expected an array of edits such as [{{\"merge\": [3, 17]}}, {{\"team\": "
+             "{{\"3\": 0}}}}]",
+             path);
+  const std::vector<int> lines = TopLevelElementLines(text);
+  TrackEdits out;
+  out.path = path;
+  for (size_t i = 0; i < j.size(); ++i) {
+    TrackEdit e;
+    e.line = i < lines.size() ? lines[i] : 1;
+    const std::string where = fmt::format("{}:{}", path, e.line);
+    const json& v = j[i];
+    FV_REQUIRE(v.is_object() && v.size() == 1,
+               "{}: each edit is an object with one of merge, rename, name, team, drop", where);
+    const std::string op = v.begin().key();
+    const json& arg = v.begin().value();
+    if (op == "merge" || op == "drop") {
+      e.kind = op == "merge" ? TrackEdit::Kind::kMerge : TrackEdit::Kind::kDrop;
+      e.ids = IdList(arg, where + ": " + op);
+      FV_REQUIRE(op != "merge" || e.ids.size() >= 2, "{}: merge needs two or more ids", where);
+      FV_REQUIRE(!e.ids.empty(), "{}: {} needs one or more ids", where, op);
+    } else if (op == "rename" || op == "team") {
+      e.kind = op == "rename" ? TrackEdit::Kind::kRename : TrackEdit::Kind::kTeam;
+      FV_REQUIRE(arg.is_object() && !arg.empty(), "{}: {} expects {{\"id\": {}, ...}}", where, op,
+                 op == "rename" ? "new id" : "team");
+      for (const auto& [k, val] : arg.items()) {
+        FV_REQUIRE(val.is_number_integer(), "{}: {}: the value for id {} must be a whole number",
+                   where, op, k);
+        e.to[IdFrom(json(k), where + ": " + op)] = val.get<int>();
+      }
+    } else if (op == "name") {
+      e.kind = TrackEdit::Kind::kName;
+      FV_REQUIRE(arg.is_object() && !arg.empty(), "{}: name expects {{\"id\": \"name\", ...}}",
+                 where);
+      for (const auto& [k, val] : arg.items()) {
+        FV_REQUIRE(val.is_string(), "{}: name: the name of id {} must be a string", where, k);
+        const std::string n = val.get<std::string>();
+        FV_REQUIRE(n.find_first_of(",\n\r\"") == std::string::npos,
+                   "{}: name: '{}' must not contain commas, quotes or line breaks", where, n);
+        e.names[IdFrom(json(k), where + ": name")] = n;
+      }
+    } else {
+      Throw("{}: unknown edit '{}' (known: merge, rename, name, team, drop)", where, op);
+    }
+    out.edits.push_back(std::move(e));
+  }
+  return out;
+}
+
+TrackEdits ReadTrackEdits(const std::string& path) {
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "cannot open edits file '{}'", path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseTrackEdits(ss.str(), path);
+}
+
+Roster ReadRoster(const std::string& path) {
+  const CsvTable t = CsvTable::Read(path);
+  t.Require({"id", "team"});
+  Roster r;
+  for (size_t i = 0; i < t.rows(); ++i) {
+    const int id = static_cast<int>(t.GetInt(i, "id"));
+    const int team = static_cast<int>(t.GetInt(i, "team"));
+    if (team >= 0) r.team_of[id] = team;
+    if (t.Has("name") && !Trim(t.Get(i, "name")).empty()) r.name_of[id] = Trim(t.Get(i, "name"));
+  }
+  return r;
+}
+
+void WriteRoster(const Roster& roster, const std::string& path) {
+  std::set<int> ids;
+  for (const auto& [id, t] : roster.team_of) ids.insert(id);
+  for (const auto& [id, n] : roster.name_of) ids.insert(id);
+  const std::string tmp = path + ".tmp";
+  {
+    CsvWriter w(tmp, {"id", "team", "name"});
+    for (int id : ids) {
+      const auto t = roster.team_of.find(id);
+      const auto n = roster.name_of.find(id);
+      w << id << (t == roster.team_of.end() ? -1 : t->second)
+        << (n == roster.name_of.end() ? std::string() : n->second);
+      w.EndRow();
+    }
+    w.Close();
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  FV_REQUIRE(!ec, "cannot write roster '{}' ({})", path, ec.message());
+}
+
+std::string RosterPathFor(const std::string& tracks_path) { return tracks_path + ".teams.csv"; }
+
+std::string EditResult::Summary() const {
+  return fmt::format(
+      "{} ids -> {}: {} merged ({} frames with both: the surer box kept), {} renamed, {} named, "
+      "{} given a team, {} dropped ({} rows)",
+      ids_before, ids_after, merged, overlapping_rows, renamed, named, teamed, dropped_ids,
+      dropped_rows);
+}
+
+EditResult ApplyTrackEdits(std::vector<TrackRow> rows, Roster roster, const TrackEdits& edits) {
+  EditResult res;
+  std::set<int> ids;
+  for (const auto& r : rows) ids.insert(r.id);
+  res.ids_before = static_cast<int>(ids.size());
+  auto require_known = [&](int id, const TrackEdit& e, const char* op) {
+    FV_REQUIRE(ids.count(id), "{}:{}: {}: id {} is not in the tracks{}", edits.path, e.line, op, id,
+               ids.empty() ? std::string()
+                           : fmt::format(" (ids {}..{}, {} in all)", *ids.begin(), *ids.rbegin(),
+                                         ids.size()));
+  };
+  // Moves roster entries from one id to another (the target's own entries win).
+  auto move_roster = [&](int from, int to) {
+    if (roster.team_of.count(from) && !roster.team_of.count(to)) {
+      roster.team_of[to] = roster.team_of[from];
+    }
+    if (roster.name_of.count(from) && !roster.name_of.count(to)) {
+      roster.name_of[to] = roster.name_of[from];
+    }
+    roster.team_of.erase(from);
+    roster.name_of.erase(from);
+  };
+  for (const TrackEdit& e : edits.edits) {
+    switch (e.kind) {
+      case TrackEdit::Kind::kMerge: {
+        const int keep = e.ids.front();
+        std::set<int> from;
+        for (int id : e.ids) {
+          require_known(id, e, "merge");
+          if (id != keep) from.insert(id);
+        }
+        for (auto& r : rows) {
+          if (from.count(r.id)) r.id = keep;
+        }
+        // One row per frame: where both were present, keep the more confident box.
+        std::stable_sort(rows.begin(), rows.end(), [](const TrackRow& a, const TrackRow& b) {
+          return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
+        });
+        std::vector<TrackRow> out;
+        out.reserve(rows.size());
+        for (const auto& r : rows) {
+          if (!out.empty() && out.back().frame == r.frame && out.back().id == r.id) {
+            ++res.overlapping_rows;
+            if (r.conf > out.back().conf) out.back() = r;
+            continue;
+          }
+          out.push_back(r);
+        }
+        rows = std::move(out);
+        for (int id : from) {
+          move_roster(id, keep);
+          ids.erase(id);
+        }
+        res.merged += static_cast<int>(from.size());
+        break;
+      }
+      case TrackEdit::Kind::kRename: {
+        for (const auto& [from, to] : e.to) require_known(from, e, "rename");
+        std::set<int> after = ids;
+        for (const auto& [from, to] : e.to) after.erase(from);
+        for (const auto& [from, to] : e.to) {
+          FV_REQUIRE(!after.count(to),
+                     "{}:{}: rename: id {} is already in use (merge {} into it instead)",
+                     edits.path, e.line, to, from);
+          after.insert(to);
+        }
+        for (auto& r : rows) {
+          const auto it = e.to.find(r.id);
+          if (it != e.to.end()) r.id = it->second;
+        }
+        Roster moved;
+        for (const auto& [id, t] : roster.team_of) {
+          const auto it = e.to.find(id);
+          moved.team_of[it == e.to.end() ? id : it->second] = t;
+        }
+        for (const auto& [id, n] : roster.name_of) {
+          const auto it = e.to.find(id);
+          moved.name_of[it == e.to.end() ? id : it->second] = n;
+        }
+        roster = std::move(moved);
+        ids = std::move(after);
+        res.renamed += static_cast<int>(e.to.size());
+        break;
+      }
+      case TrackEdit::Kind::kName:
+        for (const auto& [id, n] : e.names) {
+          require_known(id, e, "name");
+          roster.name_of[id] = n;
+        }
+        res.named += static_cast<int>(e.names.size());
+        break;
+      case TrackEdit::Kind::kTeam:
+        for (const auto& [id, team] : e.to) {
+          require_known(id, e, "team");
+          FV_REQUIRE(team >= -1 && team <= 99, "{}:{}: team: {} for id {} is not -1..99",
+                     edits.path, e.line, team, id);
+          if (team < 0) {
+            roster.team_of.erase(id);
+          } else {
+            roster.team_of[id] = team;
+          }
+        }
+        res.teamed += static_cast<int>(e.to.size());
+        break;
+      case TrackEdit::Kind::kDrop: {
+        const std::set<int> drop(e.ids.begin(), e.ids.end());
+        for (int id : drop) require_known(id, e, "drop");
+        const size_t before = rows.size();
+        std::erase_if(rows, [&](const TrackRow& r) { return drop.count(r.id) > 0; });
+        res.dropped_rows += static_cast<int>(before - rows.size());
+        for (int id : drop) {
+          ids.erase(id);
+          roster.team_of.erase(id);
+          roster.name_of.erase(id);
+        }
+        res.dropped_ids += static_cast<int>(drop.size());
+        break;
+      }
+    }
+  }
+  std::stable_sort(rows.begin(), rows.end(), [](const TrackRow& a, const TrackRow& b) {
+    return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
+  });
+  res.ids_after = static_cast<int>(ids.size());
+  res.rows = std::move(rows);
+  res.roster = std::move(roster);
+  return res;
+}
+
+}  // namespace fv::track

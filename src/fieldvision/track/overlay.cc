@@ -1,0 +1,242 @@
+#include "fieldvision/track/overlay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/calib/check.h"
+#include "fieldvision/io/video_source.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::track {
+namespace fs = std::filesystem;
+
+void OverlayOptions::Check() const {
+  CheckNonNegative(trail_frames, "overlay trail_frames");
+  FV_REQUIRE(thickness_px >= 1 && thickness_px <= 20, "overlay thickness_px must be 1..20 (got {})",
+             thickness_px);
+}
+
+cv::Scalar TrackColour(int id, int team) {
+  static const cv::Scalar kTeams[] = {
+      {40, 40, 230}, {230, 120, 30}, {40, 220, 240}, {240, 240, 240}};
+  if (team >= 0 && team < 4) return kTeams[team];
+  static const cv::Scalar kPalette[] = {
+      {75, 25, 230},  {75, 180, 60},  {25, 225, 255}, {200, 130, 0},  {48, 130, 245},
+      {180, 30, 145}, {240, 240, 70}, {230, 50, 240}, {60, 245, 210}, {212, 190, 250}};
+  return kPalette[std::abs(id) % 10];
+}
+
+TrackOverlay::TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int> team_of,
+                           std::map<int, std::string> name_of, const Camera* camera,
+                           const FieldModel* field, const OverlayOptions& options)
+    : team_of_(std::move(team_of)), name_of_(std::move(name_of)), o_(options) {
+  o_.Check();
+  for (const auto& r : rows) by_frame_[r.frame].push_back(r);
+  if (camera != nullptr && camera->has_pose && field != nullptr && o_.field_lines) {
+    camera_ = std::make_unique<Camera>(*camera);
+    field_ = std::make_unique<FieldModel>(*field);
+  }
+}
+
+void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "overlay: expected a BGR frame");
+  if (camera_) {
+    // The field lines, drawn half-transparent so the players stay visible.
+    cv::Mat lines = bgr.clone();
+    calib::DrawFieldOverlay(lines, *camera_, *field_, o_.field_colour, 1, 0.1);
+    cv::addWeighted(lines, 0.6, bgr, 0.4, 0.0, bgr);
+  }
+  const double scale = std::max(0.4, bgr.rows / 1000.0);
+  // Trails: foot points of the last trail_frames frames, per id.
+  if (o_.trail_frames > 0) {
+    std::map<int, std::vector<cv::Point>> trail;
+    for (auto it = by_frame_.lower_bound(frame - o_.trail_frames);
+         it != by_frame_.end() && it->first <= frame; ++it) {
+      for (const auto& r : it->second) {
+        trail[r.id].emplace_back(cvRound(r.box.x + 0.5 * r.box.width),
+                                 cvRound(r.box.y + r.box.height));
+      }
+    }
+    for (const auto& [id, pts] : trail) {
+      const auto t = team_of_.find(id);
+      const cv::Scalar c = TrackColour(id, t == team_of_.end() ? -1 : t->second);
+      for (size_t i = 1; i < pts.size(); ++i) {
+        cv::line(bgr, pts[i - 1], pts[i], c, o_.thickness_px, cv::LINE_AA);
+      }
+    }
+  }
+  const auto rows = by_frame_.find(frame);
+  std::optional<double> time_s;
+  if (rows != by_frame_.end()) {
+    for (const auto& r : rows->second) {
+      const auto t = team_of_.find(r.id);
+      const cv::Scalar c = TrackColour(r.id, t == team_of_.end() ? -1 : t->second);
+      // Boxes carried without a detection (conf 0: interpolated or predicted) are dashed.
+      const cv::Rect box(r.box);
+      if (r.conf > 0) {
+        cv::rectangle(bgr, box, c, o_.thickness_px, cv::LINE_AA);
+      } else {
+        for (int x = box.x; x < box.x + box.width; x += 8) {
+          cv::line(bgr, {x, box.y}, {std::min(x + 4, box.x + box.width), box.y}, c, 1);
+          cv::line(bgr, {x, box.y + box.height},
+                   {std::min(x + 4, box.x + box.width), box.y + box.height}, c, 1);
+        }
+        for (int y = box.y; y < box.y + box.height; y += 8) {
+          cv::line(bgr, {box.x, y}, {box.x, std::min(y + 4, box.y + box.height)}, c, 1);
+          cv::line(bgr, {box.x + box.width, y},
+                   {box.x + box.width, std::min(y + 4, box.y + box.height)}, c, 1);
+        }
+      }
+      const auto n = name_of_.find(r.id);
+      const std::string label =
+          n != name_of_.end() && !n->second.empty() ? n->second : std::to_string(r.id);
+      int base = 0;
+      const cv::Size ts = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, 0.5 * scale, 1, &base);
+      const cv::Point org(box.x, std::max(ts.height + 2, box.y - 3));
+      cv::rectangle(bgr, org + cv::Point(-1, base), org + cv::Point(ts.width + 1, -ts.height - 2),
+                    c, cv::FILLED);
+      const double lum = 0.114 * c[0] + 0.587 * c[1] + 0.299 * c[2];
+      cv::putText(bgr, label, org, cv::FONT_HERSHEY_SIMPLEX, 0.5 * scale,
+                  lum > 140 ? cv::Scalar(0, 0, 0) : cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+      if (r.time_s) time_s = r.time_s;
+    }
+  }
+  if (o_.time_label) {
+    const std::string text = time_s ? fmt::format("frame {}  t = {:.2f} s", frame, *time_s)
+                                    : fmt::format("frame {}", frame);
+    const cv::Point org(8, static_cast<int>(24 * scale));
+    cv::putText(bgr, text, org, cv::FONT_HERSHEY_SIMPLEX, 0.6 * scale, {0, 0, 0}, 3, cv::LINE_AA);
+    cv::putText(bgr, text, org, cv::FONT_HERSHEY_SIMPLEX, 0.6 * scale, {255, 255, 255}, 1,
+                cv::LINE_AA);
+  }
+}
+
+namespace {
+
+// Opens a writer with OpenCV's log quiet (a missing encoder is an expected outcome here).
+bool TryOpen(cv::VideoWriter& w, const std::string& path, int fourcc, double fps, cv::Size size) {
+  const auto level = cv::utils::logging::getLogLevel();
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  bool ok = false;
+  try {
+    ok = w.open(path, cv::CAP_FFMPEG, fourcc, fps, size) && w.isOpened();
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  cv::utils::logging::setLogLevel(level);
+  return ok;
+}
+
+// `dir/name.ext` -> `dir/.name.tmp.ext` (the container is chosen by the extension).
+std::string TempPathFor(const std::string& path) {
+  const fs::path p(path);
+  return (p.parent_path() / ("." + p.stem().string() + ".tmp" + p.extension().string())).string();
+}
+
+}  // namespace
+
+bool H264Available() {
+  static const bool available = [] {
+    const fs::path p = fs::temp_directory_path() / fmt::format("fv_h264_probe_{}.mp4", ::getpid());
+    cv::VideoWriter w;
+    bool ok = TryOpen(w, p.string(), cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 10, {64, 64});
+    if (ok) {
+      w.write(cv::Mat(64, 64, CV_8UC3, cv::Scalar(0, 0, 0)));
+      w.release();
+      std::error_code ec;
+      ok = fs::file_size(p, ec) > 0 && !ec;
+    }
+    std::error_code ec;
+    fs::remove(p, ec);
+    return ok;
+  }();
+  return available;
+}
+
+PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size)
+    : size_(size) {
+  FV_REQUIRE(fps > 0 && std::isfinite(fps), "video '{}': frame rate must be positive (got {})",
+             path, fps);
+  FV_REQUIRE(size.width > 0 && size.height > 0, "video '{}': empty frame size", path);
+  path_ = path;
+  const bool mp4 = EndsWith(ToLower(path), ".mp4");
+  if (mp4 && H264Available()) {
+    tmp_ = TempPathFor(path_);
+    if (TryOpen(writer_, tmp_, cv::VideoWriter::fourcc('a', 'v', 'c', '1'), fps, size)) {
+      codec_ = "H.264";
+      return;
+    }
+  }
+  if (mp4) {
+    path_ = fs::path(path).replace_extension(".avi").string();
+    note_ = fmt::format(
+        "OpenCV's FFmpeg has no H.264 encoder here: wrote Motion-JPEG to '{}' instead (browsers do "
+        "not play it; VLC or ffplay do)",
+        path_);
+  }
+  tmp_ = TempPathFor(path_);
+  FV_REQUIRE(TryOpen(writer_, tmp_, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, size),
+             "cannot write video '{}' (folder missing or not writable?)", path_);
+  codec_ = "MJPG";
+}
+
+PlayableVideoWriter::~PlayableVideoWriter() {
+  if (!closed_) {
+    writer_.release();
+    std::error_code ec;
+    fs::remove(tmp_, ec);
+  }
+}
+
+void PlayableVideoWriter::Write(const cv::Mat& bgr) {
+  FV_REQUIRE(bgr.size() == size_ && bgr.type() == CV_8UC3,
+             "video '{}': frame {} is {}x{}, the video {}x{}", path_, frames_, bgr.cols, bgr.rows,
+             size_.width, size_.height);
+  writer_.write(bgr);
+  ++frames_;
+}
+
+void PlayableVideoWriter::Close() {
+  if (closed_) return;
+  writer_.release();
+  closed_ = true;
+  std::error_code ec;
+  fs::rename(tmp_, path_, ec);
+  FV_REQUIRE(!ec, "cannot write video '{}' ({})", path_, ec.message());
+}
+
+std::string DrawVideoResult::Summary() const {
+  return fmt::format("wrote {} ({} frames, {}){}", path, frames, codec,
+                     note.empty() ? "" : "; " + note);
+}
+
+DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out,
+                                const TrackOverlay& overlay, double fps, int max_frames) {
+  auto source = VideoSource::Open(video);
+  const double rate = fps > 0 ? fps : source->fps();
+  PlayableVideoWriter writer(out, rate, {source->width(), source->height()});
+  Frame f;
+  while ((max_frames <= 0 || source->frames_read() < max_frames) && source->Read(f)) {
+    cv::Mat img = f.bgr.clone();
+    overlay.Draw(img, f.index + 1);
+    writer.Write(img);
+  }
+  writer.Close();
+  DrawVideoResult r;
+  r.frames = writer.frames();
+  r.path = writer.path();
+  r.codec = writer.codec();
+  r.note = writer.note();
+  return r;
+}
+
+}  // namespace fv::track

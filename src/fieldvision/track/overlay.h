@@ -1,0 +1,94 @@
+// Tracks drawn on the video a coach looks at: per frame, each person's box in the team's colour
+// (else a colour per id), the id or roster name, a short trail of foot points and, with a posed
+// camera, the field's lines projected into the image (calib::DrawFieldOverlay); and a video
+// writer for what browsers play: H.264 in MP4 through OpenCV's FFmpeg backend ('avc1'), or
+// Motion-JPEG in AVI where that encoder is missing. `players --draw` uses both; other commands
+// (ball) can draw their own marks on the same frames before writing.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/camera/camera.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/track/mot.h"
+
+namespace fv::track {
+
+struct OverlayOptions {
+  int trail_frames = 25;    // foot points of this many past frames form the trail (0: none)
+  int thickness_px = 2;     // boxes and trails
+  bool field_lines = true;  // project the field's lines (needs a posed camera and a field)
+  cv::Scalar field_colour = cv::Scalar(255, 255, 255);  // BGR
+  bool time_label = true;                               // "frame N, t = S s" in the corner
+  void Check() const;
+};
+
+// BGR colour of a track: team 0 red, team 1 blue, team 2 yellow, team 3 white; no team (-1): a
+// fixed palette by id.
+cv::Scalar TrackColour(int id, int team);
+
+class TrackOverlay {
+ public:
+  // `rows` as in TRACKS.csv (1-based frames); `team_of` and `name_of` by id (may be empty);
+  // `camera` (may be null or without pose) and `field` (may be null) for the field lines.
+  TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int> team_of,
+               std::map<int, std::string> name_of, const Camera* camera, const FieldModel* field,
+               const OverlayOptions& options = {});
+  // Draws TRACKS.csv frame `frame` (1-based) onto `bgr`.
+  void Draw(cv::Mat& bgr, int frame) const;
+
+ private:
+  std::map<int, std::vector<TrackRow>> by_frame_;
+  std::map<int, int> team_of_;
+  std::map<int, std::string> name_of_;
+  std::unique_ptr<Camera> camera_;
+  std::unique_ptr<FieldModel> field_;
+  cv::Mat field_layer_, field_mask_;  // projected lines, drawn once
+  OverlayOptions o_;
+};
+
+// A video being written: H.264 in MP4 when `path` ends in .mp4 and OpenCV's FFmpeg has the
+// encoder, else Motion-JPEG in AVI (the path's extension becomes .avi). Frames go to a temporary
+// file renamed to `path` by Close() (a failed run leaves an existing file as it was).
+class PlayableVideoWriter {
+ public:
+  // Throws fv::Error naming the path when no writer opens.
+  PlayableVideoWriter(const std::string& path, double fps, cv::Size size);
+  ~PlayableVideoWriter();
+  void Write(const cv::Mat& bgr);
+  void Close();
+  const std::string& path() const { return path_; }    // the file written (extension may change)
+  const std::string& codec() const { return codec_; }  // "H.264" or "MJPG"
+  const std::string& note() const { return note_; }    // why MJPG, when it is
+  int frames() const { return frames_; }
+
+ private:
+  cv::VideoWriter writer_;
+  std::string path_, tmp_, codec_, note_;
+  cv::Size size_;
+  int frames_ = 0;
+  bool closed_ = false;
+};
+
+// Whether OpenCV's FFmpeg backend can write H.264 MP4 here (tried once on a tiny file).
+bool H264Available();
+
+struct DrawVideoResult {
+  int frames = 0;
+  std::string path, codec, note;
+  std::string Summary() const;
+};
+
+// Reads `video` (any file or image pattern fv::VideoSource opens) and writes each frame with the
+// overlay drawn (one output frame per input frame, at the video's rate; `fps` > 0 overrides),
+// up to `max_frames` (0: all).
+DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out,
+                                const TrackOverlay& overlay, double fps = 0, int max_frames = 0);
+
+}  // namespace fv::track
