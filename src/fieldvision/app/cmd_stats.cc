@@ -5,8 +5,8 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/stats/stats.h"
+#include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
-#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -23,20 +23,19 @@ void RunStats(const StatsCli& c) {
   stats::StatsOptions o = c.o;
   if (!c.zones.empty()) o.zones = stats::ReadZones(c.zones);
   std::string teams = c.teams;
-  if (teams.empty() && std::filesystem::exists(c.tracks + ".teams.csv")) {
-    teams = c.tracks + ".teams.csv";
+  if (teams.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
+    teams = track::RosterPathFor(c.tracks);
   }
   if (!teams.empty()) {
-    const CsvTable t = CsvTable::Read(teams);
-    t.Require({"id", "team"});
-    for (size_t i = 0; i < t.rows(); ++i) {
-      o.team_of[static_cast<int>(t.GetInt(i, "id"))] = static_cast<int>(t.GetInt(i, "team"));
-    }
+    const track::Roster roster = track::ReadRoster(teams);
+    o.team_of = roster.team_of;
+    o.name_of = roster.name_of;
   }
   const stats::StatsResult r = stats::ComputeStats(rows, o);
   const stats::ReportFiles f = stats::WriteStatsReport(r, field, o, c.out);
   std::cout << r.Summary() << "\nwrote " << f.files.size() << " files to " << c.out << " (open "
             << c.out << "/index.html)\n";
+  for (const auto& n : f.notes) std::cout << "note: " << n << "\n";
 }
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -46,13 +45,18 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--tracks", c->tracks, "TRACKS.csv from `fieldvision players`")->required();
   cmd->add_option("--field", c->field, "Field: built-in name or JSON file")->required();
   cmd->add_option("--out", c->out, "Output folder")->required();
-  cmd->add_option("--fps", c->o.fps, "Frame rate of the tracked video")->check(CLI::PositiveNumber);
+  cmd->add_option("--fps", c->o.fps,
+                  "Override the time in TRACKS.csv (time_s, the video's own): frame f at "
+                  "(f - 1) / FPS seconds")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--zones", c->zones,
                   "JSON zones for alerts: [{\"name\": \"box\", \"polygon\": [[x, y], ...]}]");
-  cmd->add_option("--teams", c->teams, "id,team CSV (default: TRACKS.csv.teams.csv if present)");
+  cmd->add_option("--teams", c->teams,
+                  "id,team[,name] CSV (default: TRACKS.csv.teams.csv if present, as players "
+                  "--teams and tracks edit write it; team -1: none)");
   cmd->add_option("--smooth", c->o.smooth_window_s, "Smoothing window of positions in seconds");
   cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s");
-  cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.avi");
+  cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.mp4");
   cmd->callback([c] { RunStats(*c); });
 }
 

@@ -13,6 +13,7 @@
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/stats/stats.h"
+#include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
@@ -20,46 +21,84 @@ namespace fv::stats {
 namespace fs = std::filesystem;
 namespace {
 
-cv::Scalar ColourOf(int id, int team) {
-  if (team == 0) return {40, 40, 220};
-  if (team == 1) return {220, 120, 30};
-  static const cv::Scalar kPalette[] = {
-      {230, 25, 75},  {60, 180, 75},  {255, 225, 25}, {0, 130, 200},  {245, 130, 48},
-      {145, 30, 180}, {70, 240, 240}, {240, 50, 230}, {210, 245, 60}, {250, 190, 212}};
-  return kPalette[std::abs(id) % 10];
-}
-
 void Write(const std::string& path, const cv::Mat& img, ReportFiles& files) {
   WriteImage(path, img);
   files.files.push_back(path);
 }
 
-// Heat map of positions over the field drawing.
-cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const FieldModel& field,
-                const TopView& view, const StatsOptions& o, const std::string& title) {
+// Zones drawn on a top view: outline and name.
+void DrawZones(cv::Mat& img, const std::vector<Zone>& zones, const TopView& view) {
+  for (const auto& z : zones) {
+    std::vector<cv::Point> pts;
+    for (const auto& v : z.polygon_m) pts.push_back(view.ToPixel(v));
+    cv::polylines(img, pts, true, {0, 255, 255}, 2, cv::LINE_AA);
+    cv::Point c(0, 0);
+    for (const auto& p : pts) c += p;
+    c = cv::Point(c.x / static_cast<int>(pts.size()), c.y / static_cast<int>(pts.size()));
+    cv::putText(img, z.name, c, cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0}, 3, cv::LINE_AA);
+    cv::putText(img, z.name, c, cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 255, 255}, 1, cv::LINE_AA);
+  }
+}
+
+// Time spent per square metre (seconds): each sample weighs the time to the next one (at most
+// 0.5 s), spread by a Gaussian of heat_sigma_m.
+cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const TopView& view,
+                    const StatsOptions& o) {
   cv::Mat acc = cv::Mat::zeros(view.size, CV_32F);
   for (const auto* s : tracks) {
-    for (size_t i = 0; i < s->pos_m.size(); ++i) {
+    const size_t n = s->pos_m.size();
+    for (size_t i = 0; i < n; ++i) {
+      double dt = 0;
+      if (i + 1 < n) {
+        dt = s->time_s[i + 1] - s->time_s[i];
+      } else if (n > 1) {
+        dt = s->time_s[i] - s->time_s[i - 1];
+      }
+      dt = std::min(dt, 0.5);
       const cv::Point2d px = view.ToPixel(s->pos_m[i]);
       const int x = static_cast<int>(px.x), y = static_cast<int>(px.y);
-      if (x >= 0 && y >= 0 && x < acc.cols && y < acc.rows) acc.at<float>(y, x) += 1.0f;
+      if (x >= 0 && y >= 0 && x < acc.cols && y < acc.rows) {
+        acc.at<float>(y, x) += static_cast<float>(dt);
+      }
     }
   }
   const double sigma = std::max(1.0, o.heat_sigma_m * view.px_per_m);
   cv::GaussianBlur(acc, acc, cv::Size(), sigma);
+  return acc * (view.px_per_m * view.px_per_m);  // seconds per pixel -> per square metre
+}
+
+// The top of the colour scale: the 99th percentile of the cells with time (one person standing
+// still in one spot does not take the whole range).
+double ScaleMax(const cv::Mat& density) {
+  std::vector<float> v;
   double mx = 0;
-  cv::minMaxLoc(acc, nullptr, &mx);
+  cv::minMaxLoc(density, nullptr, &mx);
+  for (int y = 0; y < density.rows; ++y) {
+    for (int x = 0; x < density.cols; ++x) {
+      const float d = density.at<float>(y, x);
+      if (d > 0.01 * mx) v.push_back(d);
+    }
+  }
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() * 99 / 100, v.end());
+  return std::max<double>(v[v.size() * 99 / 100], 1e-6);
+}
+
+// Heat map of time spent over the field drawing, with its colour scale (seconds per square
+// metre) on the right and the zones drawn.
+cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const FieldModel& field,
+                const TopView& view, const StatsOptions& o, const std::string& title) {
+  const cv::Mat density = TimeDensity(tracks, view, o);
+  const double vmax = ScaleMax(density);
   cv::Mat img = DrawField(field, view);
-  if (mx > 0) {
+  if (vmax > 0) {
     cv::Mat norm8, colour;
-    acc.convertTo(norm8, CV_8U, 255.0 / mx);
+    density.convertTo(norm8, CV_8U, 255.0 / vmax);  // saturates above vmax
     cv::applyColorMap(norm8, colour, cv::COLORMAP_JET);
-    cv::Mat alpha;
-    acc.convertTo(alpha, CV_32F, 1.0 / mx);
-    cv::sqrt(alpha, alpha);
     for (int y = 0; y < img.rows; ++y) {
       for (int x = 0; x < img.cols; ++x) {
-        const float a = std::min(0.85f, alpha.at<float>(y, x));
+        const float a =
+            std::min(0.85f, std::sqrt(std::min(1.0f, density.at<float>(y, x) / float(vmax))));
         cv::Vec3b& d = img.at<cv::Vec3b>(y, x);
         const cv::Vec3b c = colour.at<cv::Vec3b>(y, x);
         for (int k = 0; k < 3; ++k) d[k] = cv::saturate_cast<uchar>((1 - a) * d[k] + a * c[k]);
@@ -67,16 +106,47 @@ cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const FieldModel&
     }
     DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255), 1);
   }
+  DrawZones(img, o.zones, view);
   cv::putText(img, title, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7, {255, 255, 255}, 2);
-  return img;
+  // Colour scale: a bar with ticks at 0, 1/2 and the top (>= top: the few busiest cells).
+  const int panel_w = 110, bar_w = 22, top = 52, bottom = img.rows - 20;
+  cv::Mat out(img.rows, img.cols + panel_w, CV_8UC3, cv::Scalar(255, 255, 255));
+  img.copyTo(out(cv::Rect(0, 0, img.cols, img.rows)));
+  const int x0 = img.cols + 12;
+  cv::putText(out, "time spent", {x0 - 4, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1,
+              cv::LINE_AA);
+  cv::putText(out, "s per m^2", {x0 - 4, 32}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1,
+              cv::LINE_AA);
+  for (int y = top; y <= bottom; ++y) {
+    const double f = double(bottom - y) / std::max(1, bottom - top);
+    cv::Mat v(1, 1, CV_8U, cv::Scalar(cv::saturate_cast<uchar>(255 * f)));
+    cv::Mat c;
+    cv::applyColorMap(v, c, cv::COLORMAP_JET);
+    cv::line(out, {x0, y}, {x0 + bar_w, y}, cv::Scalar(c.at<cv::Vec3b>(0, 0)), 1);
+  }
+  cv::rectangle(out, {x0, top}, {x0 + bar_w, bottom}, {0, 0, 0}, 1);
+  for (int k = 0; k <= 2; ++k) {
+    const int y = bottom - k * (bottom - top) / 2;
+    cv::line(out, {x0 + bar_w, y}, {x0 + bar_w + 5, y}, {0, 0, 0}, 1);
+    const std::string label = fmt::format("{}{:.2g}", k == 2 ? ">=" : "", vmax * k / 2.0);
+    cv::putText(out, label, {x0 + bar_w + 8, y + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {0, 0, 0}, 1,
+                cv::LINE_AA);
+  }
+  return out;
 }
 
-// The radar (top) view at time t: trails of the last seconds and current positions with ids.
+// A player's label: the roster name, else the id.
+std::string LabelOf(int id, const std::map<int, std::string>& name_of) {
+  const auto n = name_of.find(id);
+  return n != name_of.end() ? n->second : std::to_string(id);
+}
+
+// The radar (top) view at time t: trails of the last seconds and current positions with labels.
 void DrawRadar(cv::Mat& img, const StatsResult& r, const TopView& view, double t, double trail_s,
-               const std::map<int, int>& team) {
+               const StatsOptions& o) {
   for (const auto& s : r.tracks) {
-    const auto tm = team.find(s.id);
-    const cv::Scalar c = ColourOf(s.id, tm == team.end() ? -1 : tm->second);
+    const auto tm = o.team_of.find(s.id);
+    const cv::Scalar c = track::TrackColour(s.id, tm == o.team_of.end() ? -1 : tm->second);
     std::optional<cv::Point2d> last;
     size_t last_i = 0;
     for (size_t i = 0; i < s.time_s.size(); ++i) {
@@ -90,11 +160,92 @@ void DrawRadar(cv::Mat& img, const StatsResult& r, const TopView& view, double t
     if (last && t - s.time_s[last_i] < 0.5) {
       cv::circle(img, *last, 7, c, cv::FILLED, cv::LINE_AA);
       cv::circle(img, *last, 7, {0, 0, 0}, 1, cv::LINE_AA);
-      cv::putText(img, std::to_string(s.id), *last + cv::Point2d(8, -8), cv::FONT_HERSHEY_SIMPLEX,
-                  0.5, {255, 255, 255}, 1, cv::LINE_AA);
+      cv::putText(img, LabelOf(s.id, o.name_of), *last + cv::Point2d(8, -8),
+                  cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
     }
   }
 }
+
+// Speed over time of one player as an inline SVG chart (axes in s and m/s, sprint threshold
+// dashed), on a time axis shared by all players.
+std::string SpeedChartSvg(const PlayerStats& p, double t0, double t1, double vmax, double sprint) {
+  const double w = 460, h = 130, left = 40, right = 10, top = 10, bottom = 28;
+  const double span = std::max(1e-6, t1 - t0);
+  auto X = [&](double t) { return left + (t - t0) / span * (w - left - right); };
+  auto Y = [&](double v) { return top + (1 - std::min(v, vmax) / vmax) * (h - top - bottom); };
+  std::string svg = fmt::format(
+      "<svg width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" font-size=\"10\">"
+      "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"#f8f8f8\" stroke=\"#999\"/>",
+      w, h, w, h, left, top, w - left - right, h - top - bottom);
+  for (int k = 0; k <= 4; ++k) {  // speed ticks
+    const double v = vmax * k / 4;
+    svg += fmt::format(
+        "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#ddd\"/>"
+        "<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:.3g}</text>",
+        left, Y(v), w - right, Y(v), left - 3, Y(v) + 3, v);
+  }
+  for (int k = 0; k <= 5; ++k) {  // time ticks
+    const double t = t0 + span * k / 5;
+    svg += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{:.0f}</text>", X(t),
+                       h - bottom + 12, t);
+  }
+  svg += fmt::format(
+      "<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">time (s)</text>"
+      "<text x=\"10\" y=\"{:.1f}\" transform=\"rotate(-90 10 {:.1f})\" "
+      "text-anchor=\"middle\">m/s</text>",
+      left + 0.5 * (w - left - right), h - 3, top + 0.5 * (h - top - bottom),
+      top + 0.5 * (h - top - bottom));
+  if (sprint < vmax) {
+    svg += fmt::format(
+        "<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" stroke=\"#c00\" "
+        "stroke-dasharray=\"4 3\"><title>sprint threshold {:g} m/s</title></line>",
+        left, Y(sprint), w - right, Y(sprint), sprint);
+  }
+  std::string pts;
+  for (const auto& [t, v] : p.speed_profile) pts += fmt::format("{:.1f},{:.1f} ", X(t + 0.5), Y(v));
+  svg += fmt::format(
+      "<polyline fill=\"none\" stroke=\"#1060c0\" stroke-width=\"1.5\" points=\"{}\"/>", pts);
+  return svg + "</svg>";
+}
+
+std::string Html(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<') {
+      out += "&lt;";
+    } else if (c == '>') {
+      out += "&gt;";
+    } else if (c == '&') {
+      out += "&amp;";
+    } else if (c == '"') {
+      out += "&quot;";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// Sorting of tables by a click on a header (numbers as numbers), for the report.
+constexpr const char* kSortScript = R"(<script>
+document.querySelectorAll('table.sortable th').forEach(function (th, col) {
+  th.style.cursor = 'pointer';
+  th.title = 'sort';
+  th.addEventListener('click', function () {
+    var table = th.closest('table'), rows = Array.from(table.querySelectorAll('tr')).slice(1);
+    var asc = th.dataset.asc !== '1';
+    th.dataset.asc = asc ? '1' : '0';
+    rows.sort(function (a, b) {
+      var x = a.children[col].textContent, y = b.children[col].textContent;
+      var nx = parseFloat(x), ny = parseFloat(y);
+      var c = (!isNaN(nx) && !isNaN(ny)) ? nx - ny : x.localeCompare(y);
+      return asc ? c : -c;
+    });
+    rows.forEach(function (r) { table.appendChild(r); });
+  });
+});
+</script>
+)";
 
 }  // namespace
 
@@ -130,11 +281,11 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
   std::vector<int> player_maps;
   for (const auto* s : longest) {
     Write(fmt::format("{}/heatmap_player{}.png", out_dir, s->id),
-          HeatMap({s}, field, view, o, fmt::format("player {}", s->id)), files);
+          HeatMap({s}, field, view, o, "player " + LabelOf(s->id, o.name_of)), files);
     player_maps.push_back(s->id);
   }
   std::sort(player_maps.begin(), player_maps.end());
-  // Radar: whole trajectories; and the video (5 frames per second of play).
+  // Radar: whole trajectories; and the video (10 frames per second of play).
   double t0 = 1e300, t1 = -1e300;
   for (const auto& s : r.tracks) {
     t0 = std::min(t0, s.time_s.front());
@@ -142,25 +293,33 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
   }
   {
     cv::Mat img = DrawField(field, view);
-    DrawRadar(img, r, view, t1, t1 - t0 + 1, o.team_of);
+    DrawZones(img, o.zones, view);
+    DrawRadar(img, r, view, t1, t1 - t0 + 1, o);
     cv::putText(img, "radar: all trajectories", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
                 {255, 255, 255}, 2);
     Write(out_dir + "/radar.png", img, files);
   }
+  std::string radar_video;
   if (o.write_video) {
-    const std::string path = out_dir + "/radar.avi";
-    const cv::Mat base = DrawField(field, view);
-    cv::VideoWriter vw(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0, base.size());
-    FV_REQUIRE(vw.isOpened(), "cannot write video '{}'", path);
-    for (double t = t0; t <= t1; t += 0.1) {
-      cv::Mat img = base.clone();
-      DrawRadar(img, r, view, t, 3.0, o.team_of);
-      cv::putText(img, fmt::format("t = {:.1f} s", t), {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
-                  {255, 255, 255}, 2);
-      vw.write(img);
+    if (track::H264Available()) {
+      const std::string path = out_dir + "/radar.mp4";
+      cv::Mat base = DrawField(field, view);
+      DrawZones(base, o.zones, view);
+      track::PlayableVideoWriter vw(path, 10.0, base.size());
+      for (double t = t0; t <= t1; t += 0.1) {
+        cv::Mat img = base.clone();
+        DrawRadar(img, r, view, t, 3.0, o);
+        cv::putText(img, fmt::format("t = {:.1f} s", t), {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
+                    {255, 255, 255}, 2);
+        vw.Write(img);
+      }
+      vw.Close();
+      files.files.push_back(path);
+      radar_video = "radar.mp4";
+    } else {
+      files.notes.push_back(
+          "radar video skipped: OpenCV's FFmpeg has no H.264 encoder here (a video browsers play)");
     }
-    vw.release();
-    files.files.push_back(path);
   }
   // Distances between players.
   {
@@ -173,15 +332,55 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
     w.Close();
     files.files.push_back(path);
   }
+  // The players' table as CSV (and the speed profiles, one row per player and second).
+  std::vector<std::string> band_names;
+  for (size_t b = 0; b <= o.speed_bands_mps.size(); ++b) {
+    const std::string lo = b == 0 ? "0" : fmt::format("{:g}", o.speed_bands_mps[b - 1]);
+    const std::string hi =
+        b < o.speed_bands_mps.size() ? fmt::format("{:g}", o.speed_bands_mps[b]) : "up";
+    band_names.push_back(lo + "-" + hi);
+  }
+  {
+    const std::string path = out_dir + "/players.csv";
+    std::vector<std::string> header = {"id",     "name",       "team",          "from_s",
+                                       "to_s",   "distance_m", "top_speed_mps", "mean_speed_mps",
+                                       "sprints"};
+    for (const auto& b : band_names) header.push_back("time_" + b + "_mps_s");
+    for (const auto& z : o.zones) header.push_back("time_in_" + z.name + "_s");
+    CsvWriter w(path, header, 2);
+    for (const auto& p : r.players) {
+      w << p.id << p.name << p.team << p.first_s << p.last_s << p.distance_m << p.top_speed_mps
+        << p.mean_speed_mps << p.sprints;
+      for (double bt : p.band_time_s) w << bt;
+      for (const auto& z : o.zones) w << p.zone_time_s.at(z.name);
+      w.EndRow();
+    }
+    w.Close();
+    files.files.push_back(path);
+  }
+  {
+    const std::string path = out_dir + "/speed_profiles.csv";
+    CsvWriter w(path, {"id", "time_s", "speed_mps"}, 2);
+    for (const auto& p : r.players) {
+      for (const auto& [t, v] : p.speed_profile) {
+        w << p.id << t << v;
+        w.EndRow();
+      }
+    }
+    w.Close();
+    files.files.push_back(path);
+  }
   // stats.json
   nlohmann::json j;
   j["duration_s"] = r.duration_s;
-  j["fps"] = o.fps;
+  j["fps"] = r.fps;
+  j["time_source"] = r.time_source;
   j["summary"] = r.Summary();
   j["speed_bands_mps"] = o.speed_bands_mps;
   j["players"] = nlohmann::json::array();
   for (const auto& p : r.players) {
     nlohmann::json pj = {{"id", p.id},
+                         {"name", p.name},
                          {"team", p.team},
                          {"first_s", p.first_s},
                          {"last_s", p.last_s},
@@ -202,6 +401,7 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
         {{"zone", e.zone}, {"id", e.id}, {"enter_s", e.enter_s}, {"exit_s", e.exit_s}});
   }
   j["files"] = files.files;
+  j["notes"] = files.notes;
   {
     const std::string path = out_dir + "/stats.json";
     std::ofstream out(path);
@@ -209,56 +409,78 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
     out << j.dump(2) << "\n";
     files.files.push_back(path);
   }
-  // index.html
+  // index.html: one folder that stands alone (images, CSVs and the video beside it).
   {
     const std::string path = out_dir + "/index.html";
     std::ofstream h(path);
     FV_REQUIRE(h.good(), "cannot write '{}'", path);
     h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>fieldvision stats</title>"
          "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-         "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}img{max-width:100%}"
-         ".maps img{width:300px;margin:4px}</style></head><body>\n";
-    h << "<h1>Player statistics</h1>\n<p>" << r.Summary() << "</p>\n";
-    h << "<h2>Players</h2>\n<table><tr><th>id</th><th>team</th><th>from s</th><th>to s</th>"
-         "<th>distance m</th><th>top speed m/s</th><th>mean speed m/s</th><th>sprints</th>";
-    for (size_t b = 0; b <= o.speed_bands_mps.size(); ++b) {
-      const std::string lo = b == 0 ? "0" : fmt::format("{:g}", o.speed_bands_mps[b - 1]);
-      const std::string hi =
-          b < o.speed_bands_mps.size() ? fmt::format("{:g}", o.speed_bands_mps[b]) : "+";
-      h << "<th>" << lo << "-" << hi << " m/s (s)</th>";
-    }
-    for (const auto& z : o.zones) h << "<th>in " << z.name << " (s)</th>";
+         "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}th{background:#eee}"
+         "img,video{max-width:100%}.maps img{width:340px;margin:4px}"
+         ".charts div{display:inline-block;margin:4px 12px 4px 0}</style></head><body>\n";
+    h << "<h1>Player statistics</h1>\n<p>" << Html(r.Summary()) << "</p>\n";
+    for (const auto& n : files.notes) h << "<p><em>" << Html(n) << "</em></p>\n";
+    h << "<h2>Players</h2>\n<p>Click a column header to sort. Download: <a href=\"players.csv\">"
+         "players.csv</a>, <a href=\"speed_profiles.csv\">speed_profiles.csv</a> (speed per "
+         "player and second), <a href=\"distances.csv\">distances.csv</a> (distances between "
+         "players each second), <a href=\"stats.json\">stats.json</a>.</p>\n";
+    h << "<table class=\"sortable\"><tr><th>id</th><th>name</th><th>team</th><th>from s</th>"
+         "<th>to s</th><th>distance m</th><th>top speed m/s</th><th>mean speed m/s</th>"
+         "<th>sprints</th>";
+    for (const auto& b : band_names) h << "<th>" << b << " m/s (s)</th>";
+    for (const auto& z : o.zones) h << "<th>in " << Html(z.name) << " (s)</th>";
     h << "</tr>\n";
     for (const auto& p : r.players) {
       h << fmt::format(
-          "<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.2f}"
-          "</td><td>{:.2f}</td><td>{}</td>",
-          p.id, p.team >= 0 ? std::to_string(p.team) : "-", p.first_s, p.last_s, p.distance_m,
-          p.top_speed_mps, p.mean_speed_mps, p.sprints);
+          "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>"
+          "<td>{:.2f}</td><td>{:.2f}</td><td>{}</td>",
+          p.id, Html(p.name), p.team >= 0 ? std::to_string(p.team) : "-", p.first_s, p.last_s,
+          p.distance_m, p.top_speed_mps, p.mean_speed_mps, p.sprints);
       for (double bt : p.band_time_s) h << fmt::format("<td>{:.1f}</td>", bt);
       for (const auto& z : o.zones) h << fmt::format("<td>{:.1f}</td>", p.zone_time_s.at(z.name));
       h << "</tr>\n";
     }
     h << "</table>\n";
+    // Speed over time: one chart per player, same axes for all.
+    double vmax = o.sprint_speed_mps;
+    for (const auto& p : r.players) {
+      for (const auto& [t, v] : p.speed_profile) vmax = std::max(vmax, v);
+    }
+    vmax = std::ceil(vmax + 0.5);
+    h << "<h2>Speed over time</h2>\n<p>Mean speed per second (m/s); the dashed red line is the "
+         "sprint threshold ("
+      << fmt::format("{:g}", o.sprint_speed_mps) << " m/s).</p>\n<div class=\"charts\">";
+    for (const auto& p : r.players) {
+      h << "<div><b>"
+        << Html(p.name.empty() ? "player " + std::to_string(p.id)
+                               : p.name + " (" + std::to_string(p.id) + ")")
+        << "</b><br>" << SpeedChartSvg(p, t0, t1, vmax, o.sprint_speed_mps) << "</div>";
+    }
+    h << "</div>\n";
     if (!o.zones.empty()) {
-      h << "<h2>Zone alerts</h2>\n<table><tr><th>zone</th><th>id</th><th>entered s</th>"
-           "<th>left s</th></tr>\n";
+      h << "<h2>Zone alerts</h2>\n<table class=\"sortable\"><tr><th>zone</th><th>id</th>"
+           "<th>entered s</th><th>left s</th></tr>\n";
       for (const auto& e : r.events) {
-        h << fmt::format("<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td></tr>\n", e.zone,
-                         e.id, e.enter_s, e.exit_s);
+        h << fmt::format("<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td></tr>\n",
+                         Html(e.zone), e.id, e.enter_s, e.exit_s);
       }
       h << "</table>\n";
     }
-    h << "<h2>Radar view</h2>\n<p><img src=\"radar.png\"></p><p>Video: <a href=\"radar.avi\">"
-         "radar.avi</a>. Distances between players each second: <a href=\"distances.csv\">"
-         "distances.csv</a>.</p>\n";
-    h << "<h2>Heat maps</h2>\n<div class=\"maps\"><img src=\"heatmap_all.png\">";
+    h << "<h2>Radar view</h2>\n<p><img src=\"radar.png\"></p>\n";
+    if (!radar_video.empty()) {
+      h << "<p><video src=\"" << radar_video << "\" controls muted playsinline width=\""
+        << view.size.width << "\"></video></p>\n";
+    }
+    h << "<h2>Heat maps</h2>\n<p>Time spent per square metre of field (seconds; the scale's top "
+         "is the 99th percentile of the cells, busier cells share its colour). Zones in "
+         "yellow.</p>\n<div class=\"maps\"><img src=\"heatmap_all.png\">";
     for (const auto& [team, ts] : by_team) {
       h << fmt::format("<img src=\"heatmap_team{}.png\">", team);
     }
     h << "</div>\n<h3>Per player</h3>\n<div class=\"maps\">";
     for (int id : player_maps) h << fmt::format("<img src=\"heatmap_player{}.png\">", id);
-    h << "</div>\n</body></html>\n";
+    h << "</div>\n" << kSortScript << "</body></html>\n";
     files.files.push_back(path);
   }
   return files;

@@ -14,7 +14,7 @@
 namespace fv::stats {
 
 void StatsOptions::Check() const {
-  CheckPositive(fps, "fps");
+  CheckNonNegative(fps, "fps");
   CheckPositive(smooth_window_s, "smooth_window_s");
   CheckPositive(max_speed_mps, "max_speed_mps");
   CheckPositive(sprint_speed_mps, "sprint_speed_mps");
@@ -41,9 +41,9 @@ std::string StatsResult::Summary() const {
     sprints += p.sprints;
   }
   return fmt::format(
-      "{} players over {:.1f} s: {:.0f} m covered in all, top speed {:.2f} m/s, "
-      "{} sprints, {} zone entries",
-      players.size(), duration_s, total, top, sprints, events.size());
+      "{} players over {:.1f} s (time from {}, {:.2f} frames/s): {:.0f} m covered in all, top "
+      "speed {:.2f} m/s, {} sprints, {} zone entries",
+      players.size(), duration_s, time_source, fps, total, top, sprints, events.size());
 }
 
 bool InPolygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& p) {
@@ -97,7 +97,7 @@ SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
   s.speed_mps.assign(n, 0.0);
   s.segment.assign(n, 0);
   // Segments: split at gaps and at jumps no person makes.
-  const double max_gap_s = std::max(0.5, 3.0 / o.fps);
+  const double max_gap_s = o.fps > 0 ? std::max(0.5, 3.0 / o.fps) : 0.5;
   for (size_t i = 1; i < n; ++i) {
     const double dt = t[i] - t[i - 1];
     const bool brk = dt > max_gap_s || (p[i] - p[i - 1]).norm() > o.max_speed_mps * dt + 0.5;
@@ -128,8 +128,17 @@ SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
   return s;
 }
 
-StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& o) {
-  o.Check();
+namespace {
+
+// Time of a row: (frame - 1) / fps when fps > 0, else its time_s.
+double TimeOf(const track::TrackRow& r, double fps) {
+  return fps > 0 ? (r.frame - 1) / fps : *r.time_s;
+}
+
+}  // namespace
+
+StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& options) {
+  options.Check();
   std::map<int, std::vector<const track::TrackRow*>> by_id;
   for (const auto& r : rows) {
     if (r.x_m && r.y_m) by_id[r.id].push_back(&r);
@@ -137,6 +146,33 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
   FV_REQUIRE(!by_id.empty(),
              "the tracks have no field positions (x_m, y_m): run players with a calibrated camera");
   StatsResult res;
+  StatsOptions o = options;
+  if (options.fps > 0) {
+    res.time_source = fmt::format("--fps {:g}", options.fps);
+    res.fps = options.fps;
+  } else {
+    // The rate of the rows' own times: the median step between consecutive frames.
+    std::map<int, double> time_of_frame;
+    for (const auto& r : rows) {
+      FV_REQUIRE(r.time_s.has_value(),
+                 "the tracks have no time_s (frame {}): re-run players (it writes the video's "
+                 "time) or give --fps",
+                 r.frame);
+      time_of_frame[r.frame] = *r.time_s;
+    }
+    std::vector<double> steps;
+    for (auto it = time_of_frame.begin(); std::next(it) != time_of_frame.end(); ++it) {
+      const auto next = std::next(it);
+      FV_REQUIRE(next->second > it->second,
+                 "the tracks' time_s does not increase from frame {} to frame {}", it->first,
+                 next->first);
+      steps.push_back((next->second - it->second) / (next->first - it->first));
+    }
+    std::sort(steps.begin(), steps.end());
+    res.fps = steps.empty() ? 0.0 : 1.0 / steps[steps.size() / 2];
+    res.time_source = "TRACKS.csv time_s";
+    o.fps = res.fps > 0 ? res.fps : 25.0;  // only for the gap rule of SmoothPositions
+  }
   double t_min = 1e300, t_max = -1e300;
   const size_t bands = o.speed_bands_mps.size() + 1;
   for (auto& [id, rs] : by_id) {
@@ -144,8 +180,9 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
     std::vector<double> t;
     std::vector<Eigen::Vector2d> p;
     for (const auto* r : rs) {
-      if (!t.empty() && r->frame / o.fps <= t.back()) continue;  // duplicate frame
-      t.push_back(r->frame / o.fps);
+      const double time = TimeOf(*r, options.fps);
+      if (!t.empty() && time <= t.back()) continue;  // duplicate frame
+      t.push_back(time);
       p.emplace_back(*r->x_m, *r->y_m);
     }
     if (t.empty() || t.back() - t.front() < o.min_track_s) continue;
@@ -154,6 +191,8 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
     ps.id = id;
     const auto team = o.team_of.find(id);
     ps.team = team == o.team_of.end() ? -1 : team->second;
+    const auto name = o.name_of.find(id);
+    if (name != o.name_of.end()) ps.name = name->second;
     ps.samples = static_cast<int>(t.size());
     ps.first_s = t.front();
     ps.last_s = t.back();

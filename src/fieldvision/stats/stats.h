@@ -24,19 +24,22 @@ struct Zone {
 };
 
 struct StatsOptions {
-  double fps = 25.0;              // frame rate of the tracked video (TRACKS.csv has frames)
+  // Time of the rows: 0 takes TRACKS.csv's time_s (the video's own time, written by players);
+  // > 0 overrides it: frame f (1-based) at (f - 1) / fps seconds.
+  double fps = 0.0;
   double smooth_window_s = 1.0;   // smoothing window of positions
   double max_speed_mps = 12.0;    // faster steps are track breaks (not running)
   double sprint_speed_mps = 5.5;  // a sprint is at least this fast ...
   double sprint_min_s = 1.0;      // ... for at least this long
   std::vector<double> speed_bands_mps = {2.0, 4.0, 5.5, 7.0};  // band edges (walk, jog, run...)
   double min_track_s = 1.0;                                    // ignore tracks shorter than this
-  std::vector<Zone> zones;       // named polygons for zone time and alerts
-  std::map<int, int> team_of;    // optional id -> team (from players --teams)
-  int image_width_px = 900;      // width of heat-map and radar images
-  double heat_sigma_m = 1.0;     // Gaussian kernel of the heat maps
-  bool write_video = true;       // radar.avi
-  int max_player_heatmaps = 40;  // heat maps per player for the longest tracks
+  std::vector<Zone> zones;             // named polygons for zone time and alerts
+  std::map<int, int> team_of;          // optional id -> team (from players --teams)
+  std::map<int, std::string> name_of;  // optional id -> roster name (from tracks edit)
+  int image_width_px = 900;            // width of heat-map and radar images
+  double heat_sigma_m = 1.0;           // Gaussian kernel of the heat maps
+  bool write_video = true;             // radar.mp4 (H.264)
+  int max_player_heatmaps = 40;        // heat maps per player for the longest tracks
 
   void Check() const;
 };
@@ -44,6 +47,7 @@ struct StatsOptions {
 struct PlayerStats {
   int id = 0;
   int team = -1;
+  std::string name;  // roster name, empty when none
   int samples = 0;
   double first_s = 0, last_s = 0;
   double distance_m = 0;
@@ -76,10 +80,13 @@ struct StatsResult {
   // Distances between pairs of players, one sample per second: (time_s, id_a, id_b, metres).
   std::vector<std::tuple<double, int, int, double>> pair_distances;
   double duration_s = 0;
+  double fps = 0;           // the frame rate of the rows' time (median step)
+  std::string time_source;  // where the time came from ("TRACKS.csv time_s" or "--fps N")
   std::string Summary() const;
 };
 
-// Positions come from rows with x_m/y_m; throws fv::Error if there are none.
+// Positions come from rows with x_m/y_m, times from time_s (or options.fps); throws fv::Error if
+// there are no positions, or no time_s and no options.fps.
 StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& options);
 
 // Smooths one track's positions (exposed for tests).
@@ -93,10 +100,14 @@ std::vector<Zone> ReadZones(const std::string& path);
 
 struct ReportFiles {
   std::vector<std::string> files;
+  std::vector<std::string> notes;  // what was skipped and why (e.g. no H.264 encoder)
 };
 
-// Writes stats.json, heatmap_all.png, heatmap_team<k>.png, heatmap_player<id>.png, radar.png,
-// radar.avi, distances.csv and index.html into out_dir (created).
+// Writes into out_dir (created): stats.json; heat maps of time spent (heatmap_all.png,
+// heatmap_team<k>.png, heatmap_player<id>.png) with a colour scale in seconds per square metre
+// and the zones drawn; radar.png and radar.mp4 (H.264, skipped with a note where OpenCV has no
+// encoder); players.csv, speed_profiles.csv, distances.csv; index.html with sortable tables,
+// speed-over-time charts per player (inline SVG) and links to every file.
 ReportFiles WriteStatsReport(const StatsResult& result, const FieldModel& field,
                              const StatsOptions& options, const std::string& out_dir);
 

@@ -7,6 +7,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/field/field_draw.h"
+#include "fieldvision/track/overlay.h"
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -29,7 +31,8 @@ std::vector<track::TrackRow> Runner(Rng& rng, int id, double y, double noise_m, 
       *distance += v / fps;
     }
     track::TrackRow r;
-    r.frame = f;
+    r.frame = f + 1;  // MOTChallenge numbering
+    r.time_s = t;
     r.id = id;
     r.box = cv::Rect2d(0, 0, 10, 20);
     r.x_m = x + rng.Normal(0, noise_m);
@@ -46,7 +49,6 @@ TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
   double truth = 0;
   const auto rows = Runner(rng, 4, 0.0, 0.05, &truth);
   StatsOptions o;
-  o.fps = 25;
   o.zones = {{"right", {{10, -5}, {40, -5}, {40, 5}, {10, 5}}}};
   const StatsResult r = ComputeStats(rows, o);
   ASSERT_EQ(r.players.size(), 1u);
@@ -91,29 +93,83 @@ TEST(Stats, PairDistancesAndReport) {
   const ReportFiles files = WriteStatsReport(r, field, o, dir);
   for (const char* f :
        {"stats.json", "index.html", "heatmap_all.png", "heatmap_team0.png", "heatmap_team1.png",
-        "heatmap_player1.png", "radar.png", "radar.avi", "distances.csv"}) {
+        "heatmap_player1.png", "radar.png", "distances.csv", "players.csv", "speed_profiles.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
   }
+  // The radar video browsers play, where OpenCV can write H.264; else a note says why not.
+  if (track::H264Available()) {
+    EXPECT_TRUE(std::filesystem::exists(dir + "/radar.mp4"));
+  } else {
+    EXPECT_EQ(files.notes.size(), 1u);
+  }
+  // players.csv has one row per player with the table's numbers.
+  const CsvTable players = CsvTable::Read(dir + "/players.csv");
+  ASSERT_EQ(players.rows(), 2u);
+  EXPECT_NEAR(players.GetDouble(0, "distance_m"), r.players[0].distance_m, 0.01);
   // The hottest place of player 1's map is where it stood longest: the end of its path.
   const cv::Mat heat = cv::imread(dir + "/heatmap_player1.png");
   ASSERT_FALSE(heat.empty());
   const TopView view = TopView::ForField(field, o.image_width_px, 2.0);
   const cv::Point2d end = view.ToPixel({*rows[16 * 25 - 1].x_m, -3.0});
   const cv::Point2d start = view.ToPixel({-12.0, -3.0});  // walked through, off the lines
-  // JET maps the maximum to dark red: more red than blue at the end, green at the start.
+  // JET maps the top of the scale to dark red: more red than blue at the end, less red where it
+  // only walked through.
   const cv::Vec3b e = heat.at<cv::Vec3b>(cv::Point(end));
   const cv::Vec3b s = heat.at<cv::Vec3b>(cv::Point(start));
   EXPECT_GT(e[2], e[0] + 50) << e;
-  EXPECT_GT(s[1], s[2]) << s;  // a cooler (green) colour where it only walked through
+  EXPECT_GT(int(e[2]) - int(e[1]), int(s[2]) - int(s[1])) << e << s;
+  // The colour scale is drawn to the right of the field.
+  EXPECT_GT(heat.cols, view.size.width + 50);
   std::ifstream html(dir + "/index.html");
   const std::string text((std::istreambuf_iterator<char>(html)), {});
   EXPECT_NE(text.find("heatmap_player2.png"), std::string::npos);
   EXPECT_NE(text.find("radar.png"), std::string::npos);
+  EXPECT_NE(text.find("<svg"), std::string::npos);  // speed over time
+  EXPECT_NE(text.find("players.csv"), std::string::npos);
+}
+
+// The time comes from TRACKS.csv's time_s (here 10 frames/s, the rate of the video), --fps
+// overrides it, and tracks without time_s and without --fps are an error that says what to do.
+TEST(Stats, TimeFromTracksAndRateOverride) {
+  const uint64_t seed = fv::testing::TestSeed(23);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  std::vector<track::TrackRow> rows;
+  const double v = 1.5, fps = 10;  // walking 1.5 m/s filmed at 10 frames/s
+  for (int f = 0; f < 100; ++f) {
+    track::TrackRow r;
+    r.frame = f + 1;
+    r.id = 3;
+    r.time_s = f / fps;
+    r.x_m = v * f / fps + rng.Normal(0, 0.03);
+    r.y_m = rng.Normal(0, 0.03);
+    rows.push_back(r);
+  }
+  const StatsResult r = ComputeStats(rows, StatsOptions{});
+  EXPECT_NEAR(r.fps, fps, 1e-6);
+  EXPECT_NE(r.Summary().find("10.00 frames/s"), std::string::npos) << r.Summary();
+  ASSERT_EQ(r.players.size(), 1u);
+  EXPECT_NEAR(r.players[0].top_speed_mps, v, 0.3);
+  EXPECT_NEAR(r.duration_s, 9.9, 1e-6);
+  // --fps 25 would make the same frames 2.5 times faster.
+  StatsOptions o;
+  o.fps = 25;
+  const StatsResult fast = ComputeStats(rows, o);
+  EXPECT_NEAR(fast.players[0].top_speed_mps, v * 2.5, 0.6);
+  EXPECT_NE(fast.Summary().find("--fps 25"), std::string::npos) << fast.Summary();
+  for (auto& row : rows) row.time_s.reset();
+  try {
+    ComputeStats(rows, StatsOptions{});
+    FAIL() << "no error";
+  } catch (const fv::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--fps"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(ComputeStats(rows, o));
 }
 
 TEST(Stats, BadInputs) {
   StatsOptions o;
-  o.fps = 0;
+  o.fps = -1;
   EXPECT_THROW(o.Check(), fv::Error);
   std::vector<track::TrackRow> no_positions = {{0, 1, cv::Rect2d(0, 0, 1, 1), 1, {}, {}}};
   try {
