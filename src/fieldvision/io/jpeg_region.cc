@@ -1,4 +1,4 @@
-#include "fieldvision/pipeline/jpeg_region.h"
+#include "fieldvision/io/jpeg_region.h"
 
 #include <algorithm>
 #include <csetjmp>

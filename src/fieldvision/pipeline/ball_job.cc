@@ -34,23 +34,44 @@ void BallJobOptions::Check() const {
   eval.Check();
 }
 
+Camera ReadRigCamera(const std::string& path) {
+  Camera camera = ReadCameraYaml(path);
+  if (camera.name.empty()) camera.name = std::filesystem::path(path).stem().string();
+  if (camera.name.empty()) camera.name = path;
+  FV_REQUIRE(camera.has_pose,
+             "camera file '{}' has no pose (rvec, tvec): calibrate its extrinsics first", path);
+  return camera;
+}
+
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector) {
+  return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
+    // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
+    // position that an accepted candidate of another camera starts).
+    constexpr int kMaxWeak = 3;
+    std::vector<BallObservation> out;
+    int weak = 0;
+    for (const BallCandidate& b : det->Detect(bgr, roi)) {
+      if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
+      weak += !b.accepted;
+      BallObservation obs;
+      obs.weak = !b.accepted;
+      obs.centre_px = b.centre_px;
+      obs.radius_px = b.radius_px;
+      obs.sigma_px = std::max(b.sigma_px, 0.05);
+      obs.score = b.score;
+      out.push_back(obs);
+    }
+    return out;
+  };
+}
+
 BallJobResult RunBallJob(const BallJobOptions& o) {
   o.Check();
   FV_REQUIRE(o.truth.empty() || std::filesystem::exists(o.truth), "truth file '{}' does not exist",
              o.truth);
   const int n = static_cast<int>(o.cameras.size());
   std::vector<Camera> cameras;
-  for (int c = 0; c < n; ++c) {
-    cameras.push_back(ReadCameraYaml(o.cameras[c]));
-    if (cameras.back().name.empty()) {
-      cameras.back().name = std::filesystem::path(o.cameras[c]).stem().string();
-    }
-    FV_REQUIRE(cameras.back().has_pose,
-               "camera file '{}' has no pose (rvec, tvec): calibrate its "
-               "extrinsics first",
-               o.cameras[c]);
-    if (cameras.back().name.empty()) cameras.back().name = o.cameras[c];
-  }
+  for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
   std::optional<FieldModel> field;
   if (!o.field.empty()) field = LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
@@ -64,7 +85,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
       vo.time = TimeSource::kContainer;
     }
     vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
-    auto src = std::make_unique<VideoFrameSource>(o.videos[c], vo);
+    auto src = OpenFrameSource(o.videos[c], vo);
     const cv::Size size = src->FrameSize();
     FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
                "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
@@ -79,25 +100,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   for (int c = 0; c < n; ++c) {
     auto det = std::make_shared<BallDetector>(dopt, &cameras[c], field ? &*field : nullptr);
     detectors.push_back(det);
-    detect_fns.push_back([det](const cv::Mat& bgr, const cv::Rect& roi) {
-      // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
-      // position that an accepted candidate of another camera starts).
-      constexpr int kMaxWeak = 3;
-      std::vector<BallObservation> out;
-      int weak = 0;
-      for (const BallCandidate& b : det->Detect(bgr, roi)) {
-        if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
-        weak += !b.accepted;
-        BallObservation obs;
-        obs.weak = !b.accepted;
-        obs.centre_px = b.centre_px;
-        obs.radius_px = b.radius_px;
-        obs.sigma_px = std::max(b.sigma_px, 0.05);
-        obs.score = b.score;
-        out.push_back(obs);
-      }
-      return out;
-    });
+    detect_fns.push_back(BallDetectFnFor(det));
   }
   BallPipelineOptions popt = o.pipeline;
   popt.sync.mode = o.sync == "time" ? SyncMode::kTimestamp : SyncMode::kFrameIndex;

@@ -4,10 +4,12 @@
 // frame with a position) and, given a truth file, evaluates it (recon/ball_eval.h).
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
 #include "fieldvision/recon/ball_eval.h"
 
@@ -37,6 +39,14 @@ struct BallJobResult {
 };
 
 BallJobResult RunBallJob(const BallJobOptions& options);
+
+// A rig camera from its file: the pose is required; `name` defaults to the file's stem.
+Camera ReadRigCamera(const std::string& path);
+
+// A camera stage's detector from a ball detector: its accepted candidates, then the best few weak
+// ones (fusion uses those only to complete a position that an accepted candidate of another
+// camera starts).
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector);
 
 // BALL.csv's columns, as fixed by CONTRACT.md.
 const std::vector<std::string>& BallCsvHeader();

@@ -10,7 +10,6 @@
 
 #include <fmt/format.h>
 
-#include "fieldvision/pipeline/jpeg_region.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 
@@ -72,101 +71,6 @@ std::string BallPipelineSummary::ToString() const {
   return s;
 }
 
-namespace {
-
-// At least one candidate that is not weak.
-bool HasAccepted(const std::vector<BallObservation>& obs) {
-  return std::any_of(obs.begin(), obs.end(), [](const BallObservation& o) { return !o.weak; });
-}
-
-}  // namespace
-
-void BallPredictor::Add(long long frame, const Eigen::Vector3d& point_world) {
-  frame_[1] = frame_[0];
-  point_[1] = point_[0];
-  frame_[0] = frame;
-  point_[0] = point_world;
-  count_ = std::min(count_ + 1, 2);
-}
-
-std::optional<Eigen::Vector3d> BallPredictor::Predict(long long frame) const {
-  if (count_ == 0 || frame - frame_[0] > max_gap_ || frame < frame_[0]) return std::nullopt;
-  if (count_ < 2 || frame_[0] - frame_[1] > max_gap_ || frame_[0] <= frame_[1]) return point_[0];
-  const Eigen::Vector3d v = (point_[0] - point_[1]) / double(frame_[0] - frame_[1]);
-  return point_[0] + v * double(frame - frame_[0]);
-}
-
-BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
-                    const TriangulationOptions& options, const Eigen::Vector3d* prior) {
-  BallFrame out;
-  out.frame = frame.frame;
-  out.time_s = frame.time_s;
-  std::vector<std::vector<BallObservation>> candidates(cameras.size());
-  for (size_t c = 0; c < cameras.size() && c < frame.cameras.size(); ++c) {
-    if (!frame.cameras[c]) continue;
-    ++out.cameras_present;
-    candidates[c] = frame.cameras[c]->candidates;
-    if (HasAccepted(candidates[c])) ++out.cameras_with_blobs;
-  }
-  out.result = TriangulateRobust(cameras, candidates, options, prior);
-  return out;
-}
-
-void BallTrackOptions::Check() const {
-  FV_REQUIRE(full_scan_every >= 1, "BallTrackOptions.full_scan_every must be >= 1 (got {})",
-             full_scan_every);
-  FV_REQUIRE(std::isfinite(window_radii) && window_radii >= 2,
-             "BallTrackOptions.window_radii must be >= 2 (got {})", window_radii);
-  FV_REQUIRE(min_window_px >= 8, "BallTrackOptions.min_window_px must be >= 8 (got {})",
-             min_window_px);
-}
-
-namespace {
-
-// Where a camera stage looks next: the window around the ball's predicted image position.
-class ImageTrack {
- public:
-  explicit ImageTrack(const BallTrackOptions& o) : o_(o) {}
-  // The window for the next frame, or an empty rectangle for the whole frame.
-  cv::Rect Window(const cv::Size& image) const {
-    if (!o_.enabled || !active_ || since_full_ + 1 >= o_.full_scan_every) return {};
-    const Eigen::Vector2d p = centre_ + velocity_;
-    const double half =
-        std::max<double>(o_.min_window_px, o_.window_radii * radius_ + velocity_.norm());
-    const int x0 = static_cast<int>(std::floor(p.x() - half));
-    const int y0 = static_cast<int>(std::floor(p.y() - half));
-    const int x1 = static_cast<int>(std::ceil(p.x() + half));
-    const int y1 = static_cast<int>(std::ceil(p.y() + half));
-    const cv::Rect r = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(cv::Point(0, 0), image);
-    return r.area() > 0 ? r : cv::Rect();
-  }
-  void Update(const std::vector<BallObservation>& obs, bool full) {
-    since_full_ = full ? 0 : since_full_ + 1;
-    const BallObservation* best = nullptr;
-    for (const BallObservation& b : obs) {
-      if (!b.weak && (best == nullptr || b.score > best->score)) best = &b;
-    }
-    if (best == nullptr) {
-      active_ = false;
-      return;
-    }
-    velocity_ = active_ ? Eigen::Vector2d(best->centre_px - centre_) : Eigen::Vector2d::Zero();
-    centre_ = best->centre_px;
-    radius_ = std::max(best->radius_px, 2.0);
-    active_ = true;
-  }
-
- private:
-  BallTrackOptions o_;
-  bool active_ = false;
-  int since_full_ = 0;
-  Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
-  double radius_ = 0.0;
-};
-
-}  // namespace
-
 BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
                                     std::vector<std::unique_ptr<FrameSource>>& sources,
                                     const std::vector<BallDetectFn>& detectors,
@@ -225,6 +129,11 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
     queues.push_back(std::make_unique<BoundedQueue<CameraMessage>>(options.queue_capacity,
                                                                    options.queue_policy));
   }
+  std::vector<CameraStage> stages;
+  stages.reserve(n);
+  for (int c = 0; c < n; ++c) {
+    stages.emplace_back(c, cameras[c], detectors[c], options.track, sources[c]->name());
+  }
   std::atomic<bool> stop{false};
   std::mutex error_mutex;
   std::exception_ptr error;
@@ -236,6 +145,7 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
     stop = true;
     for (auto& q : queues) q->Close();
   };
+  auto stopping = [&] { return stop || StopRequested(options.control); };
   long long total = -1;
   for (const auto& s : sources) total = std::max(total, s->FrameCount());
   if (options.max_frames > 0) total = total > 0 ? std::min(total, options.max_frames) : -1;
@@ -247,67 +157,11 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
     threads.emplace_back([&, c] {
       try {
         SourceFrame in;
-        cv::Mat decoded;  // encoded frames are decoded here, in full or a window
-        JpegRegionDecoder decoder;
-        ImageTrack track(options.track);
-        const cv::Size size(cameras[c].width, cameras[c].height);
-        CameraMessage m;
-        m.camera = c;
         long long count = 0;
-        while (!stop && (options.max_frames == 0 || count < options.max_frames) &&
+        while (!stopping() && (options.max_frames == 0 || count < options.max_frames) &&
                sources[c]->ReadFrame(&in)) {
-          m.frame = in.frame;
-          m.time_s = in.time_s;
-          const bool encoded = !in.jpeg.empty();
-          // The frame's pixels in `roi` (empty: all); null for a damaged encoded frame, which is
-          // reported and sent without candidates while the video goes on.
-          auto check_size = [&](const cv::Size& got) {
-            FV_REQUIRE(got == size, "video '{}' frame {} is {}x{}, camera {} is {}x{}",
-                       sources[c]->name(), m.frame, got.width, got.height, c, size.width,
-                       size.height);
-          };
-          auto image = [&](const cv::Rect& roi) -> const cv::Mat* {
-            if (!encoded) return &in.bgr;
-            const std::string what =
-                fmt::format("video '{}' frame {}", sources[c]->name(), in.frame);
-            try {
-              decoder.Decode(in.jpeg.data(), in.jpeg.size(), roi, &decoded, what);
-            } catch (const Error& e) {
-              // A readable header of another size is the wrong video, not a damaged frame.
-              cv::Size got = size;
-              try {
-                got = JpegRegionDecoder::ReadSize(in.jpeg.data(), in.jpeg.size(), what);
-              } catch (const Error&) {
-              }
-              check_size(got);
-              if (summary.bad_frames[c]++ == 0) summary.first_bad_frame[c] = e.what();
-              return nullptr;
-            }
-            return &decoded;
-          };
-          const cv::Rect window = track.Window(size);
-          bool full = window.empty();
-          const cv::Mat* frame = image(window);
-          m.candidates.clear();
-          if (frame != nullptr) {
-            check_size(frame->size());
-            if (!full) {
-              m.candidates = detectors[c](*frame, window);
-              ++summary.window_scans[c];
-              full = !HasAccepted(m.candidates);
-            }
-            if (full && !window.empty()) frame = image(cv::Rect());
-            if (frame == nullptr) {
-              m.candidates.clear();
-            } else if (full) {
-              m.candidates = detectors[c](*frame, cv::Rect());
-              ++summary.full_scans[c];
-            }
-          }
-          full = full || frame == nullptr;
-          track.Update(m.candidates, full);
           ++count;
-          if (!queues[c]->Push(m)) break;
+          if (!queues[c]->Push(stages[c].Process(in))) break;
         }
         queues[c]->Close();
       } catch (...) {
@@ -317,49 +171,39 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   }
 
   // The fusion stage, in this thread.
-  double sum_err = 0;
   try {
     FrameSynchronizer sync(n, options.sync);
-    BallPredictor predictor;
+    FusionStage fusion(cameras, options.triangulation);
     Progress progress("ball", total, "frames", options.progress);
-    while (!stop) {
+    while (!stopping()) {
       while (auto group = sync.Next()) {
-        for (int c = 0; c < n; ++c) {
-          if (!group->cameras[c]) continue;
-          for (const BallObservation& o : group->cameras[c]->candidates) {
-            summary.candidates_per_camera[c] += !o.weak;
-          }
+        on_frame(fusion.Fuse(*group));
+        progress.Update(fusion.stats().frames);
+        if (options.control != nullptr) {
+          options.control->Report({"ball", fusion.stats().frames, total, "frames", ""});
         }
-        const auto prior = predictor.Predict(group->frame);
-        const BallFrame f =
-            FuseFrame(cameras, *group, options.triangulation, prior ? &*prior : nullptr);
-        if (f.result.ok() && !f.result.on_ground) predictor.Add(f.frame, f.result.point_world);
-        ++summary.frames;
-        if (f.result.ok()) {
-          ++summary.frames_with_position;
-          if (f.result.on_ground) ++summary.ground_positions;
-          if (f.result.weak_views > 0) ++summary.weak_positions;
-          sum_err += f.result.rms_px;
-          for (const auto& v : f.result.views) ++summary.used_per_camera[v.camera];
-        } else if (f.cameras_with_blobs < 2) {
-          ++summary.frames_few_blobs;
-        } else {
-          ++summary.frames_inconsistent;
-        }
-        on_frame(f);
-        progress.Update(summary.frames);
       }
       if (sync.Done()) break;
       const int c = sync.Waiting();
       if (c < 0) break;  // cannot happen: Next() decides when nobody is waiting
       if (auto m = queues[c]->Pop()) {
         sync.Add(std::move(*m));
-      } else if (!stop) {
+      } else if (!stopping()) {
         sync.EndOfStream(c);
       }
     }
     progress.Finish();
     summary.sync = sync.report();
+    const FusionStats& f = fusion.stats();
+    summary.frames = f.frames;
+    summary.frames_with_position = f.frames_with_position;
+    summary.ground_positions = f.ground_positions;
+    summary.weak_positions = f.weak_positions;
+    summary.frames_few_blobs = f.frames_few_blobs;
+    summary.frames_inconsistent = f.frames_inconsistent;
+    summary.used_per_camera = f.used_per_camera;
+    summary.candidates_per_camera = f.candidates_per_camera;
+    summary.mean_err_px = f.frames_with_position ? f.sum_err_px / f.frames_with_position : 0;
   } catch (...) {
     fail(std::current_exception());
   }
@@ -367,10 +211,16 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   for (auto& q : queues) q->Close();
   for (auto& t : threads) t.join();
   if (error) std::rethrow_exception(error);
-  for (int c = 0; c < n; ++c) summary.queue_drops[c] = queues[c]->dropped();
+  for (int c = 0; c < n; ++c) {
+    summary.queue_drops[c] = queues[c]->dropped();
+    const CameraStageStats& st = stages[c].stats();
+    summary.full_scans[c] = st.full_scans;
+    summary.window_scans[c] = st.window_scans;
+    summary.bad_frames[c] = st.bad_frames;
+    summary.first_bad_frame[c] = st.first_bad_frame;
+  }
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.fps = summary.seconds > 0 ? summary.frames / summary.seconds : 0.0;
-  summary.mean_err_px = summary.frames_with_position ? sum_err / summary.frames_with_position : 0;
   return summary;
 }
 

@@ -1,7 +1,8 @@
-// The multi-camera ball pipeline: one thread per camera (read a frame, detect ball candidates,
-// send a CameraMessage) and one fusion stage (synchronise, triangulate robustly), joined through
-// bounded queues, as in the seed's one-process-per-camera server. Offline files block when a
-// queue is full so no frame is lost; live input keeps the newest messages (QueuePolicy).
+// The multi-camera ball pipeline in one process: one thread per camera running a CameraStage
+// (read a frame, detect ball candidates, send a CameraMessage) and a FusionStage (synchronise,
+// triangulate robustly) in the calling thread, joined through bounded queues. Across processes
+// the same stages are joined by ZeroMQ instead (net/node.h, net/fuse.h). Offline files block
+// when a queue is full so no frame is lost; live input keeps the newest messages (QueuePolicy).
 // Drops, duplicates and streams of different lengths are reported by the synchroniser.
 #pragma once
 
@@ -12,51 +13,26 @@
 #include <vector>
 
 #include "fieldvision/camera/camera.h"
+#include "fieldvision/io/frame_source.h"
 #include "fieldvision/pipeline/bounded_queue.h"
-#include "fieldvision/pipeline/frame_source.h"
+#include "fieldvision/pipeline/camera_stage.h"
 #include "fieldvision/pipeline/frame_sync.h"
+#include "fieldvision/pipeline/fusion_stage.h"
+#include "fieldvision/pipeline/job.h"
 #include "fieldvision/recon/triangulation.h"
 
 namespace fv {
-
-// A camera stage's detector: the ball candidates of one BGR frame, best first. Called from that
-// camera's thread only.
-using BallDetectFn = std::function<std::vector<BallObservation>(const cv::Mat& bgr)>;
-// A detector that can search a region only (roi empty: the whole frame). Pixels of `bgr` outside
-// roi may be stale and must not be read. Weak candidates are never tracked.
-using BallRegionDetectFn =
-    std::function<std::vector<BallObservation>(const cv::Mat& bgr, const cv::Rect& roi)>;
-
-// Ball tracking in each camera stage: search a window around where the ball was last seen
-// (constant velocity in the image), decoding only that part of Motion-JPEG frames; the whole
-// frame when the window has no accepted candidate, when the ball was not seen in the previous
-// frame, and at least every full_scan_every frames (a second ball-like object, a wrong lock).
-struct BallTrackOptions {
-  bool enabled = true;
-  int full_scan_every = 20;
-  double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
-  int min_window_px = 40;     // half-size of the window at least
-  void Check() const;         // throws fv::Error naming the bad field
-};
 
 struct BallPipelineOptions {
   SyncOptions sync;
   int queue_capacity = 3;                          // messages per camera queue (the seed's 3)
   QueuePolicy queue_policy = QueuePolicy::kBlock;  // kDropOldest for live input
   TriangulationOptions triangulation;
-  BallTrackOptions track;    // used with BallRegionDetectFn detectors
-  long long max_frames = 0;  // stop each camera after this many frames; 0: all
-  bool progress = true;      // frames, fps and time left on stderr
-  void Check() const;        // throws fv::Error naming the bad field
-};
-
-// The fused result of one synchronised frame.
-struct BallFrame {
-  long long frame = 0;
-  double time_s = 0.0;
-  int cameras_present = 0;     // cameras with a message for this frame
-  int cameras_with_blobs = 0;  // of those, cameras with at least one candidate
-  TriangulationResult result;
+  BallTrackOptions track;         // used with BallRegionDetectFn detectors
+  long long max_frames = 0;       // stop each camera after this many frames; 0: all
+  bool progress = true;           // frames, fps and time left on stderr
+  JobControl* control = nullptr;  // optional: progress callback and stop check (not owned)
+  void Check() const;             // throws fv::Error naming the bad field
 };
 
 struct BallPipelineSummary {
@@ -98,24 +74,5 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
                                            const std::vector<BallRegionDetectFn>& detectors,
                                            const BallPipelineOptions& options,
                                            const std::function<void(const BallFrame&)>& on_frame);
-
-// The fusion of one synchronised frame (what the fusion stage does per frame).
-BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
-                    const TriangulationOptions& options, const Eigen::Vector3d* prior = nullptr);
-
-// The ball's expected position from the last positions (constant velocity over the last two,
-// when they are at most max_gap frames apart and the newest is at most max_gap frames old).
-class BallPredictor {
- public:
-  explicit BallPredictor(int max_gap = 5) : max_gap_(max_gap) {}
-  void Add(long long frame, const Eigen::Vector3d& point_world);
-  std::optional<Eigen::Vector3d> Predict(long long frame) const;
-
- private:
-  int max_gap_;
-  int count_ = 0;
-  long long frame_[2] = {0, 0};  // [0] newest
-  Eigen::Vector3d point_[2];
-};
 
 }  // namespace fv

@@ -96,7 +96,7 @@ Scene MakeScene(const std::string& dir, const std::vector<int>& lengths,
 std::vector<std::unique_ptr<FrameSource>> Open(const Scene& s,
                                                const std::vector<FrameSourceOptions>& vo) {
   std::vector<std::unique_ptr<FrameSource>> src;
-  for (int c = 0; c < 3; ++c) src.push_back(std::make_unique<VideoFrameSource>(s.videos[c], vo[c]));
+  for (int c = 0; c < 3; ++c) src.push_back(OpenFrameSource(s.videos[c], vo[c]));
   return src;
 }
 
@@ -139,7 +139,7 @@ TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
                   [&](const BallFrame& f) { whole.push_back(f); });
   auto sources = Open(s, vo);
   for (const auto& src : sources) {
-    EXPECT_TRUE(dynamic_cast<const VideoFrameSource&>(*src).encoded());
+    EXPECT_TRUE(src->encoded());
   }
   int calls_with_window = 0;
   auto in_window = [&](const cv::Mat& bgr, const cv::Rect& roi) {
@@ -188,10 +188,12 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
   enc.encoded = true;
   enc.fps = kFps;  // image files have no frame rate
   {
-    VideoFrameSource src(patterns[0], enc);
+    auto src_ptr = OpenFrameSource(patterns[0], enc);
+    FrameSource& src = *src_ptr;
     EXPECT_TRUE(src.encoded());
     EXPECT_EQ(src.FrameCount(), 24);
-    VideoFrameSource plain(patterns[0]);
+    auto plain_ptr = OpenFrameSource(patterns[0]);
+    FrameSource& plain = *plain_ptr;
     EXPECT_FALSE(plain.encoded());
     cv::Mat a;
     long long fa;
@@ -207,7 +209,7 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
     EXPECT_FALSE(src.Read(&a, &fa, &ta));
   }
   std::vector<std::unique_ptr<FrameSource>> sources;
-  for (const auto& p : patterns) sources.push_back(std::make_unique<VideoFrameSource>(p, enc));
+  for (const auto& p : patterns) sources.push_back(OpenFrameSource(p, enc));
   BallPipelineOptions opt;
   opt.progress = false;
   std::vector<BallFrame> frames;
@@ -348,12 +350,12 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
 
 TEST(BallPipeline, BadInputsAreOneLineErrors) {
   const std::string dir = testing::TempDir();
-  EXPECT_THROW(VideoFrameSource(dir + "/missing.avi"), Error);
+  EXPECT_THROW(OpenFrameSource(dir + "/missing.avi"), Error);
   {
     std::ofstream junk(dir + "/junk.avi");
     junk << "this is not a video";
   }
-  EXPECT_THROW(VideoFrameSource(dir + "/junk.avi"), Error);
+  EXPECT_THROW(OpenFrameSource(dir + "/junk.avi"), Error);
   BallJobOptions job;
   job.cameras = {"a.yaml", "b.yaml"};
   job.videos = {"a.avi"};

@@ -21,11 +21,7 @@ double Number(const json& j, const char* key, const std::string& context) {
 
 }  // namespace
 
-std::string CameraMessage::ToJsonLine() const {
-  json j;
-  j["camera"] = camera;
-  j["frame"] = frame;
-  j["time_s"] = time_s;
+json CandidatesToJson(const std::vector<BallObservation>& candidates) {
   json c = json::array();
   for (const BallObservation& o : candidates) {
     json cj = {{"u", o.centre_px.x()},
@@ -36,7 +32,37 @@ std::string CameraMessage::ToJsonLine() const {
     if (o.weak) cj["weak"] = true;  // absent means false
     c.push_back(std::move(cj));
   }
-  j["candidates"] = std::move(c);
+  return c;
+}
+
+std::vector<BallObservation> CandidatesFromJson(const json& j, const std::string& context) {
+  FV_REQUIRE(j.is_array(), "{}: 'candidates' is not an array", context);
+  std::vector<BallObservation> out;
+  for (size_t i = 0; i < j.size(); ++i) {
+    const json& c = j[i];
+    const std::string ctx = context + ": candidates[" + std::to_string(i) + "]";
+    FV_REQUIRE(c.is_object(), "{} is not an object", ctx);
+    BallObservation o;
+    o.centre_px = {Number(c, "u", ctx), Number(c, "v", ctx)};
+    o.radius_px = Number(c, "r", ctx);
+    o.sigma_px = Number(c, "sigma", ctx);
+    o.score = Number(c, "score", ctx);
+    FV_REQUIRE(o.sigma_px > 0, "{}: 'sigma' must be > 0", ctx);
+    if (c.contains("weak")) {
+      FV_REQUIRE(c["weak"].is_boolean(), "{}: 'weak' is not true or false", ctx);
+      o.weak = c["weak"].get<bool>();
+    }
+    out.push_back(o);
+  }
+  return out;
+}
+
+std::string CameraMessage::ToJsonLine() const {
+  json j;
+  j["camera"] = camera;
+  j["frame"] = frame;
+  j["time_s"] = time_s;
+  j["candidates"] = CandidatesToJson(candidates);
   return j.dump();
 }
 
@@ -57,24 +83,8 @@ CameraMessage CameraMessage::FromJsonLine(const std::string& line, const std::st
   m.frame = j["frame"].get<long long>();
   FV_REQUIRE(m.camera >= 0 && m.frame >= 0, "{}: 'camera' and 'frame' must be >= 0", context);
   m.time_s = Number(j, "time_s", context);
-  FV_REQUIRE(j.contains("candidates") && j["candidates"].is_array(),
-             "{}: 'candidates' missing or not an array", context);
-  for (size_t i = 0; i < j["candidates"].size(); ++i) {
-    const json& c = j["candidates"][i];
-    const std::string ctx = context + ": candidates[" + std::to_string(i) + "]";
-    FV_REQUIRE(c.is_object(), "{} is not an object", ctx);
-    BallObservation o;
-    o.centre_px = {Number(c, "u", ctx), Number(c, "v", ctx)};
-    o.radius_px = Number(c, "r", ctx);
-    o.sigma_px = Number(c, "sigma", ctx);
-    o.score = Number(c, "score", ctx);
-    FV_REQUIRE(o.sigma_px > 0, "{}: 'sigma' must be > 0", ctx);
-    if (c.contains("weak")) {
-      FV_REQUIRE(c["weak"].is_boolean(), "{}: 'weak' is not true or false", ctx);
-      o.weak = c["weak"].get<bool>();
-    }
-    m.candidates.push_back(o);
-  }
+  FV_REQUIRE(j.contains("candidates"), "{}: 'candidates' missing or not an array", context);
+  m.candidates = CandidatesFromJson(j["candidates"], context);
   return m;
 }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "fieldvision/recon/triangulation.h"
 
 namespace fv {
@@ -23,5 +25,11 @@ struct CameraMessage {
   static CameraMessage FromJsonLine(const std::string& line,
                                     const std::string& context = "message");
 };
+
+// The candidates as a JSON array ([{"u":..,"v":..,"r":..,"sigma":..,"score":..[,"weak":true]}])
+// and back; the reader throws fv::Error naming `context` and the bad key.
+nlohmann::json CandidatesToJson(const std::vector<BallObservation>& candidates);
+std::vector<BallObservation> CandidatesFromJson(const nlohmann::json& j,
+                                                const std::string& context);
 
 }  // namespace fv

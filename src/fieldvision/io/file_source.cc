@@ -1,0 +1,213 @@
+// Frame-source backend: video files OpenCV reads and printf image patterns (dir/%05d.jpg), with
+// times from the frame rate, the container or a frame,time_s CSV. Motion-JPEG packets (through
+// FFmpeg) and JPEG files can be delivered encoded (the ball pipeline's window-decoding path).
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <regex>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/io/source_backends.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::io_backend {
+namespace {
+
+// The file of frame `index` of a printf pattern with one integer field (dir/%05d.jpg), or ""
+// when the pattern has another form.
+std::string PatternFile(const std::string& pattern, long long index) {
+  static const std::regex kOneIntField(R"(^([^%]*)%(0?)([0-9]{0,3})d([^%]*)$)");
+  std::smatch m;
+  if (!std::regex_match(pattern, m, kOneIntField)) return "";
+  const size_t width = m[3].length() > 0 ? std::stoul(m[3].str()) : 0;
+  std::string number = std::to_string(index);
+  if (number.size() < width) number.insert(0, width - number.size(), m[2].length() ? '0' : ' ');
+  return m[1].str() + number + m[4].str();
+}
+
+bool HasJpegExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext == ".jpg" || ext == ".jpeg";
+}
+
+class FileSource : public FrameSource {
+ public:
+  FileSource(const std::string& path, const FrameSourceOptions& options);
+  bool ReadFrame(SourceFrame* out) override;
+  bool encoded() const override { return encoded_; }
+  long long FrameCount() const override { return frame_count_; }
+  cv::Size FrameSize() const override { return size_; }
+  std::string name() const override { return path_; }
+  double fps() const override { return fps_; }
+
+ private:
+  bool Grab(SourceFrame* out);         // decoded
+  bool GrabEncoded(SourceFrame* out);  // encoded
+  double TimeOf(long long frame);
+  std::string path_;
+  FrameSourceOptions options_;
+  TimeOrigin origin_ = TimeOrigin::kFrameRate;
+  cv::VideoCapture capture_;
+  std::map<long long, double> times_;  // kCsv
+  bool encoded_ = false;
+  bool jpeg_files_ = false;    // encoded: a pattern of JPEG files (else MJPG packets)
+  long long first_file_ = -1;  // index of the first file of the pattern
+  SourceFrame pending_;        // the first frame, read when opening
+  bool has_pending_ = false;
+  long long next_frame_ = 0;
+  long long frame_count_ = -1;
+  double fps_ = 30.0;
+  cv::Size size_;
+};
+
+FileSource::FileSource(const std::string& path, const FrameSourceOptions& options)
+    : path_(path), options_(options) {
+  const bool pattern = path.find('%') != std::string::npos;
+  FV_REQUIRE(pattern || std::filesystem::exists(path), "video '{}' does not exist", path);
+  FV_REQUIRE(pattern || !std::filesystem::is_directory(path),
+             "video '{}' is a folder (give an image pattern such as '{}/%05d.jpg')", path, path);
+  bool opened = false;
+  try {
+    opened = capture_.open(path, cv::CAP_ANY);
+  } catch (const cv::Exception&) {
+    opened = false;
+  }
+  FV_REQUIRE(opened && capture_.isOpened(), "cannot open video '{}' (not a video OpenCV reads?)",
+             path);
+  const double container_fps = capture_.get(cv::CAP_PROP_FPS);
+  fps_ = options.fps > 0 ? options.fps
+                         : (std::isfinite(container_fps) && container_fps > 0 ? container_fps : 30);
+  const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+  if (std::isfinite(count) && count > 0) frame_count_ = static_cast<long long>(count);
+  origin_ = options.time == TimeSource::kCsv         ? TimeOrigin::kCsv
+            : options.time == TimeSource::kContainer ? TimeOrigin::kContainer
+                                                     : TimeOrigin::kFrameRate;
+  if (options.time == TimeSource::kCsv) {
+    const CsvTable t = CsvTable::Read(options.timestamps_csv);
+    t.Require({"frame", "time_s"});
+    for (size_t r = 0; r < t.rows(); ++r) {
+      const long long f = t.GetInt(r, "frame");
+      const double ts = t.GetDouble(r, "time_s");
+      FV_REQUIRE(std::isfinite(ts), "{}: time_s is not finite", t.Where(r));
+      FV_REQUIRE(times_.emplace(f, ts).second, "{}: frame {} listed twice", t.Where(r), f);
+    }
+  }
+  // Motion JPEG through FFmpeg: the packets themselves are the JPEG frames.
+  const int fourcc = static_cast<int>(capture_.get(cv::CAP_PROP_FOURCC));
+  if (options.encoded && !pattern && fourcc == cv::VideoWriter::fourcc('M', 'J', 'P', 'G') &&
+      capture_.getBackendName() == "FFMPEG") {
+    encoded_ = capture_.set(cv::CAP_PROP_FORMAT, -1);
+  }
+  // A pattern of JPEG files: the files themselves are the frames (OpenCV's image reader starts
+  // at the first of indices 0..1000 that exists; so does this).
+  if (options.encoded && pattern && HasJpegExtension(path) && !PatternFile(path, 0).empty()) {
+    for (long long i = 0; i <= 1000; ++i) {
+      if (std::filesystem::exists(PatternFile(path, i))) {
+        first_file_ = i;
+        break;
+      }
+    }
+    if (first_file_ >= 0) {
+      encoded_ = true;
+      jpeg_files_ = true;
+      long long n = 0;
+      while (std::filesystem::exists(PatternFile(path, first_file_ + n))) ++n;
+      frame_count_ = n;
+      capture_.release();
+      if (origin_ == TimeOrigin::kContainer) origin_ = TimeOrigin::kFrameRate;  // no times
+    }
+  }
+  has_pending_ = encoded_ ? GrabEncoded(&pending_) : Grab(&pending_);
+  FV_REQUIRE(has_pending_, "video '{}' has no readable frame", path);
+  size_ = encoded_ ? JpegRegionDecoder::ReadSize(pending_.jpeg.data(), pending_.jpeg.size(),
+                                                 fmt::format("video '{}' frame 0", path))
+                   : pending_.bgr.size();
+}
+
+bool FileSource::GrabEncoded(SourceFrame* out) {
+  out->bgr = cv::Mat();
+  if (jpeg_files_) {
+    const std::string file = PatternFile(path_, first_file_ + next_frame_);
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return false;  // the end of the sequence
+    out->jpeg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    FV_REQUIRE(!in.bad(), "cannot read '{}'", file);
+  } else {
+    cv::Mat packet;
+    bool ok = false;
+    try {
+      ok = capture_.read(packet);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    if (!ok || packet.empty()) return false;
+    const auto* p = packet.ptr<uint8_t>();
+    out->jpeg.assign(p, p + packet.total() * packet.elemSize());
+  }
+  out->time_s = TimeOf(next_frame_);
+  return true;
+}
+
+bool FileSource::Grab(SourceFrame* out) {
+  out->jpeg.clear();
+  bool ok = false;
+  try {
+    ok = capture_.read(out->bgr);
+  } catch (const cv::Exception&) {
+    ok = false;  // a corrupt frame ends the stream; the pipeline reports where
+  }
+  if (!ok || out->bgr.empty()) return false;
+  if (out->bgr.channels() == 1) cv::cvtColor(out->bgr, out->bgr, cv::COLOR_GRAY2BGR);
+  out->time_s = TimeOf(next_frame_);
+  return true;
+}
+
+bool FileSource::ReadFrame(SourceFrame* out) {
+  if (has_pending_) {
+    std::swap(*out, pending_);
+    pending_ = SourceFrame();
+    has_pending_ = false;
+  } else if (!(encoded_ ? GrabEncoded(out) : Grab(out))) {
+    return false;
+  }
+  out->frame = next_frame_++;
+  out->origin = origin_;
+  return true;
+}
+
+double FileSource::TimeOf(long long f) {
+  switch (options_.time) {
+    case TimeSource::kFrameRate:
+      return f / fps_;
+    case TimeSource::kContainer: {
+      if (jpeg_files_) return f / fps_;  // image files carry no capture times
+      const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+      return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
+    }
+    case TimeSource::kCsv: {
+      const auto it = times_.find(f);
+      FV_REQUIRE(it != times_.end(), "timestamps '{}' have no row for frame {} of video '{}'",
+                 options_.timestamps_csv, f, path_);
+      return it->second;
+    }
+  }
+  return f / fps_;
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenFile(const std::string& path, const FrameSourceOptions& options) {
+  return std::make_unique<FileSource>(path, options);
+}
+
+}  // namespace fv::io_backend

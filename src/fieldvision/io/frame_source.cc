@@ -1,0 +1,109 @@
+#include "fieldvision/io/frame_source.h"
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+
+#include <fmt/format.h>
+
+#include "fieldvision/io/source_backends.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv {
+
+const char* ToString(TimeOrigin origin) {
+  switch (origin) {
+    case TimeOrigin::kFrameRate:
+      return "frame-rate";
+    case TimeOrigin::kContainer:
+      return "container";
+    case TimeOrigin::kCsv:
+      return "csv";
+    case TimeOrigin::kDevice:
+      return "device";
+    case TimeOrigin::kPlayback:
+      return "playback";
+    case TimeOrigin::kArrival:
+      return "arrival";
+  }
+  return "unknown";
+}
+
+void FrameSourceOptions::Check() const {
+  FV_REQUIRE(std::isfinite(fps) && fps >= 0, "FrameSourceOptions.fps must be >= 0 (got {})", fps);
+  FV_REQUIRE(time != TimeSource::kCsv || !timestamps_csv.empty(),
+             "FrameSourceOptions.timestamps_csv is needed for CSV timestamps");
+  FV_REQUIRE(std::isfinite(start_at_s) && start_at_s >= 0,
+             "FrameSourceOptions.start_at_s must be >= 0 (got {})", start_at_s);
+  FV_REQUIRE(live_buffer_frames >= 1 && live_buffer_frames <= 100000,
+             "FrameSourceOptions.live_buffer_frames must be in [1, 100000] (got {})",
+             live_buffer_frames);
+  FV_REQUIRE(width >= 0 && height >= 0, "FrameSourceOptions.width/height must be >= 0");
+  FV_REQUIRE(std::isfinite(exposure_us) && exposure_us >= 0,
+             "FrameSourceOptions.exposure_us must be >= 0 (got {})", exposure_us);
+}
+
+bool FrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
+  SourceFrame f;
+  if (!ReadFrame(&f)) return false;
+  if (!f.jpeg.empty()) {
+    decoder_.Decode(f.jpeg.data(), f.jpeg.size(), cv::Rect(), bgr,
+                    fmt::format("video '{}' frame {}", name(), f.frame));
+  } else {
+    *bgr = f.bgr;
+  }
+  *frame = f.frame;
+  *time_s = f.time_s;
+  return true;
+}
+
+double SystemClockNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::vector<std::string> FrameSourceBackends() {
+  std::vector<std::string> out = {"file", "v4l2"};
+  if (io_backend::HaveGStreamer()) out.push_back("gstreamer");
+  if (io_backend::HaveAravis()) out.push_back("aravis");
+  out.push_back("synth");
+  return out;
+}
+
+namespace io_backend {
+
+double SystemFromMonotonic(double monotonic_s) {
+  timespec mono{};
+  clock_gettime(CLOCK_MONOTONIC, &mono);
+  const double now_mono = mono.tv_sec + 1e-9 * mono.tv_nsec;
+  return SystemClockNow() - (now_mono - monotonic_s);
+}
+
+}  // namespace io_backend
+
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
+                                             const FrameSourceOptions& options) {
+  options.Check();
+  FV_REQUIRE(!spec.empty(), "empty video name");
+  if (StartsWith(spec, "v4l2:") || StartsWith(spec, "camera:")) {
+    return io_backend::OpenV4l2(spec, options);
+  }
+  if (StartsWith(spec, "gst:") || StartsWith(spec, "rtsp://") || StartsWith(spec, "rtsps://")) {
+    return io_backend::OpenGStreamer(spec, options);
+  }
+  if (StartsWith(spec, "aravis:")) return io_backend::OpenAravis(spec, options);
+  if (StartsWith(spec, "synth:")) return io_backend::OpenSynth(spec, options);
+  // Anything else with a scheme is a mistake, not a file name.
+  const size_t colon = spec.find("://");
+  if (colon != std::string::npos) {
+    Throw(
+        "video '{}': unknown source scheme '{}' (known: a file, an image pattern, v4l2:, "
+        "camera:, gst:, rtsp://, aravis:, synth:)",
+        spec, spec.substr(0, colon));
+  }
+  auto file = io_backend::OpenFile(spec, options);
+  if (options.realtime) return io_backend::Paced(std::move(file), options);
+  return file;
+}
+
+}  // namespace fv

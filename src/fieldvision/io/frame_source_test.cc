@@ -1,0 +1,204 @@
+// The frame-source backends: files (plain, encoded, played in real time), synth scenes played
+// live, GStreamer, V4L2 (the kernel's vivid test driver) and Aravis' simulated camera where
+// this machine has them; unknown schemes.
+#include "fieldvision/io/frame_source.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+std::string WriteMjpg(const std::string& dir, int frames, double fps) {
+  const std::string path = dir + "/v.avi";
+  cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, cv::Size(64, 48));
+  for (int i = 0; i < frames; ++i) w.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(10 * i, 80, 200)));
+  return path;
+}
+
+TEST(FrameSource, FileEncodedAndDecodedAgree) {
+  const std::string video = WriteMjpg(testing::TempDir(), 5, 25);
+  FrameSourceOptions enc;
+  enc.encoded = true;
+  auto a = OpenFrameSource(video, enc);
+  auto b = OpenFrameSource(video);
+  EXPECT_TRUE(a->encoded());
+  EXPECT_FALSE(b->encoded());
+  EXPECT_FALSE(a->live());
+  EXPECT_EQ(a->FrameSize(), cv::Size(64, 48));
+  cv::Mat ma;
+  SourceFrame fb;
+  long long fa = 0;
+  double ta = 0;
+  int n = 0;
+  while (a->Read(&ma, &fa, &ta)) {
+    ASSERT_TRUE(b->ReadFrame(&fb));
+    EXPECT_EQ(fa, n);
+    EXPECT_EQ(fb.frame, n);
+    EXPECT_DOUBLE_EQ(ta, n / 25.0);
+    EXPECT_EQ(fb.origin, TimeOrigin::kFrameRate);
+    // libjpeg-turbo and FFmpeg's MJPEG decoder round their inverse DCTs differently.
+    EXPECT_LE(cv::norm(ma, fb.bgr, cv::NORM_INF), 3);
+    ++n;
+  }
+  EXPECT_EQ(n, 5);
+}
+
+TEST(FrameSource, RealtimeFileIsStampedOnTheSystemClockAndSkipsWhatIsGone) {
+  const std::string video = WriteMjpg(testing::TempDir(), 4, 50);
+  FrameSourceOptions o;
+  o.realtime = true;
+  o.start_at_s = SystemClockNow();
+  auto src = OpenFrameSource(video, o);
+  EXPECT_TRUE(src->live());
+  SourceFrame f;
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_TRUE(src->ReadFrame(&f));
+    EXPECT_EQ(f.origin, TimeOrigin::kPlayback);
+    EXPECT_DOUBLE_EQ(f.time_s, o.start_at_s + k / 50.0);
+  }
+  EXPECT_FALSE(src->ReadFrame(&f));
+  // Started long ago with one frame of buffer: every frame is gone, and counted.
+  o.start_at_s = SystemClockNow() - 100;
+  o.live_buffer_frames = 1;
+  auto late = OpenFrameSource(video, o);
+  EXPECT_FALSE(late->ReadFrame(&f));
+  EXPECT_EQ(late->dropped(), 4);
+}
+
+TEST(FrameSource, SynthSceneIsPlayedLive) {
+  FrameSourceOptions o;
+  o.encoded = true;
+  auto src = OpenFrameSource("synth:kick?camera=1&width=160&height=120&frames=3", o);
+  EXPECT_TRUE(src->live());
+  EXPECT_TRUE(src->encoded());
+  EXPECT_EQ(src->FrameSize(), cv::Size(160, 120));
+  EXPECT_EQ(src->FrameCount(), 3);
+  cv::Mat bgr;
+  long long frame = 0;
+  double t = 0, last = 0;
+  int n = 0;
+  while (src->Read(&bgr, &frame, &t)) {
+    EXPECT_EQ(bgr.size(), cv::Size(160, 120));
+    if (n > 0) EXPECT_NEAR(t - last, 1.0 / 60, 1e-6);  // Unix seconds: 0.24 us resolution
+    last = t;
+    ++n;
+  }
+  EXPECT_EQ(n, 3);
+  EXPECT_THROW(OpenFrameSource("synth:kick?camera=nobody"), Error);
+  EXPECT_THROW(OpenFrameSource("synth:kick?colour=red"), Error);
+  EXPECT_THROW(OpenFrameSource("synth:no-such-preset"), Error);
+}
+
+TEST(FrameSource, UnknownSchemesAndMissingDevicesAreOneLineErrors) {
+  for (const std::string spec :
+       {"ftp://host/video.avi", "v4l2:/dev/video-none", "camera:x", "/no/such/file.avi"}) {
+    SCOPED_TRACE(spec);
+    try {
+      OpenFrameSource(spec);
+      ADD_FAILURE() << "opened";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find('\n'), std::string::npos);
+      EXPECT_NE(what.find(spec.substr(0, 6)), std::string::npos) << what;
+    }
+  }
+}
+
+TEST(FrameSource, GStreamerPipeline) {
+  const auto backends = FrameSourceBackends();
+  if (std::find(backends.begin(), backends.end(), "gstreamer") == backends.end()) {
+    GTEST_SKIP() << "this OpenCV has no GStreamer backend";
+  }
+  std::unique_ptr<FrameSource> src;
+  try {
+    src = OpenFrameSource(
+        "gst:videotestsrc num-buffers=3 ! video/x-raw,width=64,height=48,framerate=30/1");
+  } catch (const Error& e) {
+    GTEST_SKIP() << "GStreamer's videotestsrc is not usable here (gstreamer1.0-plugins-base "
+                    "installed?): "
+                 << e.what();
+  }
+  EXPECT_EQ(src->FrameSize(), cv::Size(64, 48));
+  SourceFrame f;
+  int n = 0;
+  while (src->ReadFrame(&f)) {
+    EXPECT_TRUE(f.origin == TimeOrigin::kContainer || f.origin == TimeOrigin::kArrival);
+    ++n;
+  }
+  EXPECT_EQ(n, 3);
+}
+
+// The device of the kernel's vivid test driver, or "" (it must be loaded: `modprobe vivid`).
+std::string VividDevice(std::string* why) {
+  const std::filesystem::path sys = "/sys/class/video4linux";
+  if (!std::filesystem::exists(sys)) {
+    *why =
+        "no V4L2 devices on this machine (/sys/class/video4linux absent; `modprobe vivid` "
+        "needs a kernel with the vivid module and the right to load it)";
+    return "";
+  }
+  for (const auto& e : std::filesystem::directory_iterator(sys)) {
+    std::ifstream in(e.path() / "name");
+    std::string name;
+    std::getline(in, name);
+    if (name.find("vivid") != std::string::npos && name.find("vid-cap") != std::string::npos) {
+      return "/dev/" + e.path().filename().string();
+    }
+  }
+  *why = "no vivid capture device loaded (`sudo modprobe vivid`)";
+  return "";
+}
+
+TEST(FrameSource, V4l2WithTheVividDriver) {
+  std::string why;
+  const std::string device = VividDevice(&why);
+  if (device.empty()) GTEST_SKIP() << why;
+  FrameSourceOptions o;
+  o.width = 640;
+  o.height = 360;
+  auto src = OpenFrameSource("v4l2:" + device, o);
+  EXPECT_TRUE(src->live());
+  SourceFrame f;
+  double last = 0;
+  for (int k = 0; k < 5; ++k) {
+    ASSERT_TRUE(src->ReadFrame(&f));
+    EXPECT_FALSE(f.bgr.empty());
+    EXPECT_TRUE(f.origin == TimeOrigin::kDevice || f.origin == TimeOrigin::kArrival);
+    EXPECT_NEAR(f.time_s, SystemClockNow(), 1.0);
+    if (k > 0) EXPECT_GT(f.time_s, last);
+    last = f.time_s;
+  }
+}
+
+TEST(FrameSource, AravisSimulatedCamera) {
+  const auto backends = FrameSourceBackends();
+  if (std::find(backends.begin(), backends.end(), "aravis") == backends.end()) {
+    GTEST_SKIP() << "built without Aravis (libaravis-dev not found)";
+  }
+  FrameSourceOptions o;
+  o.width = 64;
+  o.height = 48;
+  o.fps = 100;
+  o.exposure_us = 2000;
+  auto src = OpenFrameSource("aravis:Fake_1", o);
+  EXPECT_EQ(src->FrameSize(), cv::Size(64, 48));
+  SourceFrame f;
+  double last = 0;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(src->ReadFrame(&f));
+    EXPECT_EQ(f.bgr.size(), cv::Size(64, 48));
+    if (k > 0) EXPECT_GT(f.time_s, last);
+    last = f.time_s;
+  }
+}
+
+}  // namespace
+}  // namespace fv

@@ -1,0 +1,109 @@
+// Frame-source backend: V4L2 cameras ("v4l2:/dev/videoN"; "camera:N" is /dev/videoN) through
+// OpenCV's V4L2 backend. Times are the kernel's buffer timestamps (CLOCK_MONOTONIC at capture)
+// moved to the system clock (TimeOrigin::kDevice), else the arrival time.
+#include <cmath>
+#include <filesystem>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "fieldvision/io/source_backends.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::io_backend {
+namespace {
+
+class V4l2Source : public FrameSource {
+ public:
+  V4l2Source(const std::string& spec, const std::string& device, const FrameSourceOptions& o)
+      : spec_(spec) {
+    FV_REQUIRE(std::filesystem::exists(device), "camera '{}': device '{}' does not exist", spec,
+               device);
+    bool opened = false;
+    try {
+      opened = capture_.open(device, cv::CAP_V4L2);
+    } catch (const cv::Exception&) {
+      opened = false;
+    }
+    FV_REQUIRE(opened && capture_.isOpened(), "camera '{}': cannot open '{}' as a V4L2 camera",
+               spec, device);
+    if (o.width > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, o.width);
+    if (o.height > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, o.height);
+    if (o.fps > 0) capture_.set(cv::CAP_PROP_FPS, o.fps);
+    if (o.exposure_us > 0) {
+      capture_.set(cv::CAP_PROP_AUTO_EXPOSURE, 1);                 // V4L2 manual mode
+      capture_.set(cv::CAP_PROP_EXPOSURE, o.exposure_us / 100.0);  // units of 100 us
+    }
+    fps_ = capture_.get(cv::CAP_PROP_FPS);
+    if (!(std::isfinite(fps_) && fps_ > 0)) fps_ = o.fps > 0 ? o.fps : 30.0;
+    FV_REQUIRE(Grab(&pending_), "camera '{}' delivers no frame", spec);
+    size_ = pending_.bgr.size();
+    has_pending_ = true;
+  }
+
+  bool ReadFrame(SourceFrame* out) override {
+    if (has_pending_) {
+      std::swap(*out, pending_);
+      has_pending_ = false;
+    } else if (!Grab(out)) {
+      Throw("camera '{}' stopped delivering frames (disconnected?)", spec_);
+    }
+    out->frame = next_++;
+    return true;
+  }
+  cv::Size FrameSize() const override { return size_; }
+  std::string name() const override { return spec_; }
+  double fps() const override { return fps_; }
+  bool live() const override { return true; }
+
+ private:
+  bool Grab(SourceFrame* out) {
+    bool ok = false;
+    try {
+      ok = capture_.read(out->bgr);
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    const double arrival_s = SystemClockNow();
+    if (!ok || out->bgr.empty()) return false;
+    if (out->bgr.channels() == 1) cv::cvtColor(out->bgr, out->bgr, cv::COLOR_GRAY2BGR);
+    out->jpeg.clear();
+    // OpenCV's V4L2 backend reports the buffer's timestamp (ms on CLOCK_MONOTONIC).
+    const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+    const double device_s = std::isfinite(ms) && ms > 0 ? SystemFromMonotonic(ms / 1000.0) : 0;
+    if (device_s > 0 && std::abs(device_s - arrival_s) < 1.0) {
+      out->time_s = device_s;
+      out->origin = TimeOrigin::kDevice;
+    } else {
+      out->time_s = arrival_s;
+      out->origin = TimeOrigin::kArrival;
+    }
+    return true;
+  }
+
+  std::string spec_;
+  cv::VideoCapture capture_;
+  SourceFrame pending_;
+  bool has_pending_ = false;
+  long long next_ = 0;
+  double fps_ = 30.0;
+  cv::Size size_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenV4l2(const std::string& spec, const FrameSourceOptions& options) {
+  std::string device;
+  if (StartsWith(spec, "camera:")) {
+    const long long n = ParseInt(spec.substr(7), "camera number in '" + spec + "'");
+    FV_REQUIRE(n >= 0, "camera '{}': the number must be >= 0", spec);
+    device = "/dev/video" + std::to_string(n);
+  } else {
+    device = spec.substr(5);
+    FV_REQUIRE(!device.empty(), "camera '{}': give a device, e.g. v4l2:/dev/video0", spec);
+  }
+  return std::make_unique<V4l2Source>(spec, device, options);
+}
+
+}  // namespace fv::io_backend

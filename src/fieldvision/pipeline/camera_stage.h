@@ -1,0 +1,77 @@
+// The camera stage of the ball pipeline: one camera's frames in, timestamped ball candidates out
+// (CameraMessage). It tracks the ball in the image and searches a window around where it is
+// expected (constant velocity in the image), decoding encoded frames (SourceFrame::jpeg) only
+// there; the whole frame when the window has no accepted candidate, when the ball was not seen in
+// the previous frame and at least every full_scan_every frames. The same stage serves the
+// in-process pipeline (ball_pipeline.h) and the camera node (net/node.h).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fieldvision/camera/camera.h"
+#include "fieldvision/io/frame_source.h"
+#include "fieldvision/io/jpeg_region.h"
+#include "fieldvision/pipeline/camera_message.h"
+#include "fieldvision/recon/triangulation.h"
+
+namespace fv {
+
+// A camera stage's detector: the ball candidates of one BGR frame, best first. Called from that
+// camera's thread only.
+using BallDetectFn = std::function<std::vector<BallObservation>(const cv::Mat& bgr)>;
+// A detector that can search a region only (roi empty: the whole frame). Pixels of `bgr` outside
+// roi may be stale and must not be read. Weak candidates are never tracked.
+using BallRegionDetectFn =
+    std::function<std::vector<BallObservation>(const cv::Mat& bgr, const cv::Rect& roi)>;
+
+// Ball tracking in each camera stage (see above).
+struct BallTrackOptions {
+  bool enabled = true;
+  int full_scan_every = 20;
+  double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
+  int min_window_px = 40;     // half-size of the window at least
+  void Check() const;         // throws fv::Error naming the bad field
+};
+
+struct CameraStageStats {
+  long long frames = 0;
+  long long candidates = 0;    // accepted candidates reported
+  long long full_scans = 0;    // frames searched whole
+  long long window_scans = 0;  // frames searched in a window
+  long long bad_frames = 0;    // encoded frames that could not be decoded
+  std::string first_bad_frame;
+};
+
+// At least one candidate that is not weak.
+bool HasAccepted(const std::vector<BallObservation>& obs);
+
+class CameraStage {
+ public:
+  // `camera_index` goes into the messages; `source_name` into errors. Throws fv::Error when the
+  // detector is empty or the options are bad.
+  CameraStage(int camera_index, const Camera& camera, BallRegionDetectFn detector,
+              const BallTrackOptions& track, std::string source_name);
+  ~CameraStage();
+  CameraStage(CameraStage&&) noexcept;
+  // The candidates of one frame. A damaged encoded frame is counted (stats) and gives a message
+  // without candidates; a frame of another size than the camera's throws fv::Error.
+  CameraMessage Process(const SourceFrame& frame);
+  const CameraStageStats& stats() const { return stats_; }
+
+ private:
+  class Track;
+  const cv::Mat* Image(const SourceFrame& in, const cv::Rect& roi);
+  void CheckSize(const cv::Size& got, long long frame) const;
+  int camera_index_;
+  cv::Size size_;
+  BallRegionDetectFn detector_;
+  std::string source_name_;
+  std::unique_ptr<Track> track_;
+  JpegRegionDecoder decoder_;
+  cv::Mat decoded_;
+  CameraStageStats stats_;
+};
+
+}  // namespace fv

@@ -1,0 +1,72 @@
+// The fusion stage of the ball pipeline: a synchronised multi-camera frame (frame_sync.h) in, a
+// robustly triangulated ball position out (recon/triangulation.h), with the last positions as
+// the prior of the next frame (BallPredictor) and per-camera counts for the summary. The same
+// stage serves the in-process pipeline (ball_pipeline.h) and the fusion node (net/fuse.h).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fieldvision/camera/camera.h"
+#include "fieldvision/pipeline/frame_sync.h"
+#include "fieldvision/recon/triangulation.h"
+
+namespace fv {
+
+// The fused result of one synchronised frame.
+struct BallFrame {
+  long long frame = 0;
+  double time_s = 0.0;
+  int cameras_present = 0;     // cameras with a message for this frame
+  int cameras_with_blobs = 0;  // of those, cameras with at least one candidate
+  TriangulationResult result;
+};
+
+// The fusion of one synchronised frame (what the fusion stage does per frame).
+BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
+                    const TriangulationOptions& options, const Eigen::Vector3d* prior = nullptr);
+
+// The ball's expected position from the last positions (constant velocity over the last two,
+// when they are at most max_gap frames apart and the newest is at most max_gap frames old).
+class BallPredictor {
+ public:
+  explicit BallPredictor(int max_gap = 5) : max_gap_(max_gap) {}
+  void Add(long long frame, const Eigen::Vector3d& point_world);
+  std::optional<Eigen::Vector3d> Predict(long long frame) const;
+
+ private:
+  int max_gap_;
+  int count_ = 0;
+  long long frame_[2] = {0, 0};  // [0] newest
+  Eigen::Vector3d point_[2];
+};
+
+struct FusionStats {
+  long long frames = 0;                          // synchronised frames
+  long long frames_with_position = 0;            // 3D (or ground) positions
+  long long ground_positions = 0;                // single-camera ground positions among them
+  long long weak_positions = 0;                  // positions completed with weak candidates
+  long long frames_few_blobs = 0;                // no position: fewer than 2 cameras had candidates
+  long long frames_inconsistent = 0;             // no position although >= 2 cameras had candidates
+  double sum_err_px = 0.0;                       // sum of the positions' RMS reprojection errors
+  std::vector<long long> used_per_camera;        // positions each camera contributed to
+  std::vector<long long> candidates_per_camera;  // accepted candidates each camera reported
+};
+
+class FusionStage {
+ public:
+  // Throws fv::Error when there is no camera or the options are bad.
+  FusionStage(std::vector<Camera> cameras, const TriangulationOptions& options);
+  BallFrame Fuse(const SyncedFrame& frame);
+  const FusionStats& stats() const { return stats_; }
+  const std::vector<Camera>& cameras() const { return cameras_; }
+
+ private:
+  std::vector<Camera> cameras_;
+  TriangulationOptions options_;
+  BallPredictor predictor_;
+  FusionStats stats_;
+};
+
+}  // namespace fv

@@ -1,0 +1,161 @@
+#include "fieldvision/pipeline/live_sync.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+
+void LiveSyncOptions::Check() const {
+  FV_REQUIRE(std::isfinite(tolerance_s) && tolerance_s > 0,
+             "LiveSyncOptions.tolerance_s must be > 0 (got {})", tolerance_s);
+  FV_REQUIRE(std::isfinite(max_wait_s) && max_wait_s > 0,
+             "LiveSyncOptions.max_wait_s must be > 0 (got {})", max_wait_s);
+  FV_REQUIRE(max_buffered >= 1, "LiveSyncOptions.max_buffered must be >= 1");
+}
+
+LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& options)
+    : n_(num_cameras),
+      options_(options),
+      buffers_(num_cameras),
+      stats_(num_cameras),
+      last_frame_(num_cameras, -1),
+      last_time_(num_cameras, -std::numeric_limits<double>::infinity()),
+      last_arrival_(num_cameras, -std::numeric_limits<double>::infinity()) {
+  FV_REQUIRE(num_cameras >= 1, "LiveSynchronizer: needs at least one camera");
+  options.Check();
+}
+
+bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
+  FV_REQUIRE(m.camera >= 0 && m.camera < n_, "live sync: message for camera {} of {}", m.camera,
+             n_);
+  const int c = m.camera;
+  LiveCameraStats& s = stats_[c];
+  s.active = true;
+  last_arrival_[c] = arrival_s;
+  if (!std::isfinite(m.time_s)) {
+    ++s.out_of_order;
+    return false;
+  }
+  if (last_frame_[c] >= 0) {
+    if (m.frame == last_frame_[c] || std::abs(m.time_s - last_time_[c]) < 1e-9) {
+      ++s.duplicates;
+      return false;
+    }
+    if (m.frame < last_frame_[c] || m.time_s < last_time_[c]) {
+      ++s.out_of_order;
+      return false;
+    }
+    s.gaps += m.frame - last_frame_[c] - 1;
+  }
+  last_frame_[c] = m.frame;
+  last_time_[c] = m.time_s;
+  if (any_group_ && m.time_s <= decided_until_s_) {
+    ++s.late;
+    return false;
+  }
+  ++s.received;
+  if (buffers_[c].size() >= options_.max_buffered) {
+    buffers_[c].pop_front();
+    ++s.overflow;
+  }
+  buffers_[c].push_back({std::move(m), arrival_s});
+  return true;
+}
+
+void LiveSynchronizer::Admit(int camera, double arrival_s) {
+  FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  stats_[camera].active = true;
+  last_arrival_[camera] = std::max(last_arrival_[camera], arrival_s);
+}
+
+void LiveSynchronizer::Restart(int camera) {
+  FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  ++stats_[camera].restarts;
+  last_frame_[camera] = -1;
+  last_time_[camera] = -std::numeric_limits<double>::infinity();
+}
+
+void LiveSynchronizer::EndOfStream(int camera) {
+  FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  stats_[camera].active = false;
+}
+
+bool LiveSynchronizer::Empty() const {
+  return std::all_of(buffers_.begin(), buffers_.end(), [](const auto& b) { return b.empty(); });
+}
+
+std::optional<SyncedFrame> LiveSynchronizer::Next(double now_s, bool flush) {
+  double t = std::numeric_limits<double>::infinity();
+  for (const auto& b : buffers_) {
+    if (!b.empty()) t = std::min(t, b.front().message.time_s);
+  }
+  if (!std::isfinite(t)) return std::nullopt;
+  const double until = t + options_.tolerance_s;
+  // The group's members and its first arrival.
+  double first_arrival = std::numeric_limits<double>::infinity();
+  bool ready = true;
+  for (int c = 0; c < n_; ++c) {
+    const auto& b = buffers_[c];
+    if (!b.empty() && b.front().message.time_s <= until) {
+      first_arrival = std::min(first_arrival, b.front().arrival_s);
+      continue;
+    }
+    if (!b.empty()) continue;  // it has sent something later: not in this group
+    // Nothing from camera c: wait for it only when it is active and not silent for long.
+    if (stats_[c].active && now_s - last_arrival_[c] < options_.max_wait_s) ready = false;
+  }
+  if (!ready && !flush && now_s - first_arrival < options_.max_wait_s) return std::nullopt;
+  SyncedFrame out;
+  out.cameras.resize(n_);
+  double sum_t = 0;
+  int k = 0;
+  for (int c = 0; c < n_; ++c) {
+    auto& b = buffers_[c];
+    if (b.empty() || b.front().message.time_s > until) continue;
+    sum_t += b.front().message.time_s;
+    if (k == 0) out.frame = b.front().message.frame;
+    ++k;
+    out.cameras[c] = std::move(b.front().message);
+    b.pop_front();
+  }
+  out.time_s = sum_t / k;
+  any_group_ = true;
+  decided_until_s_ = std::max(decided_until_s_, until);
+  ++groups_;
+  if (k == n_) ++complete_groups_;
+  for (int c = 0; c < n_; ++c) {
+    if (out.cameras[c]) ++(k > 1 ? stats_[c].paired : stats_[c].unpaired);
+  }
+  return out;
+}
+
+std::vector<std::string> LiveSynchronizer::Problems(const std::vector<std::string>& names) const {
+  std::vector<std::string> out;
+  for (int c = 0; c < n_; ++c) {
+    const LiveCameraStats& s = stats_[c];
+    std::vector<std::string> parts;
+    if (s.received == 0) parts.push_back("no frames");
+    if (s.gaps > 0) parts.push_back(fmt::format("{} frames missing (dropped)", s.gaps));
+    if (s.late > 0) parts.push_back(fmt::format("{} late frames dropped", s.late));
+    if (s.duplicates > 0) parts.push_back(fmt::format("{} duplicates dropped", s.duplicates));
+    if (s.out_of_order > 0) {
+      parts.push_back(fmt::format("{} out-of-order frames dropped", s.out_of_order));
+    }
+    if (s.overflow > 0) parts.push_back(fmt::format("{} dropped (buffer full)", s.overflow));
+    if (s.unpaired > 0) parts.push_back(fmt::format("{} frames without a partner", s.unpaired));
+    if (s.restarts > 0) parts.push_back(fmt::format("restarted {} times", s.restarts));
+    if (parts.empty()) continue;
+    std::string line =
+        (c < static_cast<int>(names.size()) ? names[c] : fmt::format("camera {}", c)) + ": ";
+    for (size_t i = 0; i < parts.size(); ++i) line += (i ? ", " : "") + parts[i];
+    out.push_back(line);
+  }
+  return out;
+}
+
+}  // namespace fv

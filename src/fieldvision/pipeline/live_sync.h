@@ -1,0 +1,81 @@
+// Synchronisation of live camera streams by capture time: groups the camera stages' messages
+// (times on one common clock) into multi-camera frames, each message with those of the other
+// cameras within `tolerance_s` of the group's earliest. A group is decided as soon as every
+// active camera has sent something later, or when its first message has waited `max_wait_s`
+// (a slow or dead camera never stalls the others: it is left out and its message, if it comes,
+// is late). Cameras that sent nothing for max_wait_s are not waited for. Late, duplicate and
+// out-of-order messages are dropped and counted, never paired wrongly; gaps in frame numbers
+// count as dropped frames. A restarted camera (a new session) starts a fresh stream. A
+// single-threaded state machine; the fusion node feeds it. (frame_sync.h is the offline one:
+// it waits for every stream, as files never stall.)
+#pragma once
+
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fieldvision/pipeline/camera_message.h"
+#include "fieldvision/pipeline/frame_sync.h"
+
+namespace fv {
+
+struct LiveSyncOptions {
+  double tolerance_s = 0.008;  // half a frame at 60 fps
+  double max_wait_s = 0.1;     // longest wait for a camera's message of a group
+  size_t max_buffered = 1000;  // messages held per camera (the oldest dropped beyond)
+  void Check() const;          // throws fv::Error naming the bad field
+};
+
+struct LiveCameraStats {
+  long long received = 0;      // messages accepted
+  long long paired = 0;        // in a group with another camera
+  long long unpaired = 0;      // in a group alone
+  long long gaps = 0;          // frame numbers skipped (dropped upstream)
+  long long duplicates = 0;    // the same frame again: dropped
+  long long out_of_order = 0;  // earlier than the previous message: dropped
+  long long late = 0;          // its group was already decided: dropped
+  long long overflow = 0;      // dropped because the buffer was full
+  long long restarts = 0;      // new sessions after the first
+  bool active = false;
+};
+
+class LiveSynchronizer {
+ public:
+  LiveSynchronizer(int num_cameras, const LiveSyncOptions& options);
+  // Adds camera `m.camera`'s message, which arrived at `arrival_s` (any steady clock in
+  // seconds, the same for Next). Returns false when it was dropped (counted).
+  bool Add(CameraMessage m, double arrival_s);
+  // The camera is connected (e.g. it answered a clock ping at `arrival_s`): wait for its frames.
+  void Admit(int camera, double arrival_s);
+  // The camera restarted (a new session): its stream starts afresh.
+  void Restart(int camera);
+  // The camera's stream ended: it is no longer waited for.
+  void EndOfStream(int camera);
+  // The next group that can be decided at `now_s`; with `flush`, any group at all.
+  std::optional<SyncedFrame> Next(double now_s, bool flush = false);
+  bool Empty() const;
+  const std::vector<LiveCameraStats>& stats() const { return stats_; }
+  long long groups() const { return groups_; }
+  long long complete_groups() const { return complete_groups_; }
+  // One line per camera with a problem (empty when everything paired cleanly).
+  std::vector<std::string> Problems(const std::vector<std::string>& names) const;
+
+ private:
+  struct Held {
+    CameraMessage message;
+    double arrival_s;
+  };
+  int n_;
+  LiveSyncOptions options_;
+  std::vector<std::deque<Held>> buffers_;
+  std::vector<LiveCameraStats> stats_;
+  std::vector<long long> last_frame_;
+  std::vector<double> last_time_;
+  std::vector<double> last_arrival_;
+  bool any_group_ = false;
+  double decided_until_s_ = 0;  // messages at or before this time are late
+  long long groups_ = 0, complete_groups_ = 0;
+};
+
+}  // namespace fv

@@ -1,0 +1,81 @@
+// Live synchronisation: pairing by capture time, a dead camera never stalls the others, late,
+// duplicate and out-of-order messages are dropped and counted, a restarted camera re-admitted.
+#include "fieldvision/pipeline/live_sync.h"
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+CameraMessage Msg(int camera, long long frame, double time_s) {
+  CameraMessage m;
+  m.camera = camera;
+  m.frame = frame;
+  m.time_s = time_s;
+  return m;
+}
+
+TEST(LiveSync, PairsByTimeWithJitterAndOffsetsInFrameNumbers) {
+  const uint64_t seed = testing::TestSeed(2);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  LiveSyncOptions o;
+  o.tolerance_s = 0.008;
+  LiveSynchronizer sync(3, o);
+  // Camera c numbers its frames from 10 c; capture jitter up to 2 ms.
+  std::vector<SyncedFrame> groups;
+  for (int k = 0; k < 50; ++k) {
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_TRUE(sync.Add(Msg(c, 10 * c + k, 100 + k / 60.0 + rng.Uniform(-0.002, 0.002)), k));
+    }
+    while (auto g = sync.Next(k)) groups.push_back(*g);
+  }
+  while (auto g = sync.Next(100, true)) groups.push_back(*g);
+  ASSERT_EQ(groups.size(), 50u);
+  for (size_t k = 0; k < groups.size(); ++k) {
+    ASSERT_EQ(groups[k].present(), 3);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(groups[k].cameras[c]->frame, 10 * c + (long long)k);
+  }
+  EXPECT_EQ(sync.complete_groups(), 50);
+}
+
+TEST(LiveSync, ADeadCameraDoesNotStallTheOthersAndItsLateFramesAreDropped) {
+  LiveSyncOptions o;
+  o.max_wait_s = 0.1;
+  LiveSynchronizer sync(2, o);
+  ASSERT_TRUE(sync.Add(Msg(0, 0, 10.0), 1.0));
+  ASSERT_TRUE(sync.Add(Msg(1, 0, 10.0), 1.0));
+  ASSERT_TRUE(sync.Next(1.0));  // both: decided at once
+  // Camera 1 goes quiet: camera 0's frame waits at most max_wait_s.
+  ASSERT_TRUE(sync.Add(Msg(0, 1, 10.1), 1.02));
+  EXPECT_FALSE(sync.Next(1.05));
+  const auto g = sync.Next(1.13);
+  ASSERT_TRUE(g);
+  EXPECT_EQ(g->present(), 1);
+  // Camera 1's frame of that moment arrives now: late, dropped, counted.
+  EXPECT_FALSE(sync.Add(Msg(1, 1, 10.1), 1.2));
+  EXPECT_EQ(sync.stats()[1].late, 1);
+  // A silent camera is not waited for at all.
+  ASSERT_TRUE(sync.Add(Msg(0, 2, 10.2), 1.5));
+  EXPECT_TRUE(sync.Next(1.5));
+  // Duplicates and out-of-order frames.
+  EXPECT_FALSE(sync.Add(Msg(0, 2, 10.2), 1.6));
+  EXPECT_FALSE(sync.Add(Msg(0, 1, 10.15), 1.6));
+  EXPECT_EQ(sync.stats()[0].duplicates, 1);
+  EXPECT_EQ(sync.stats()[0].out_of_order, 1);
+  // A restarted camera numbers from 0 again and is paired again.
+  sync.Restart(1);
+  ASSERT_TRUE(sync.Add(Msg(1, 0, 10.3), 2.0));
+  ASSERT_TRUE(sync.Add(Msg(0, 3, 10.3), 2.0));
+  const auto again = sync.Next(2.0);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->present(), 2);
+  EXPECT_EQ(sync.stats()[1].restarts, 1);
+  EXPECT_FALSE(sync.Problems({"a", "b"}).empty());
+}
+
+}  // namespace
+}  // namespace fv
