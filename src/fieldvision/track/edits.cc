@@ -18,6 +18,9 @@ namespace {
 
 using json = nlohmann::json;
 
+// Frames in which ids merged into one may both be tracked (a hand-over between two tracklets).
+constexpr int kMaxMergeOverlapFrames = 10;
+
 int LineOfByte(const std::string& text, size_t byte) {
   byte = std::min(byte, text.size());
   return 1 + static_cast<int>(std::count(text.begin(), text.begin() + byte, '\n'));
@@ -223,14 +226,21 @@ EditResult ApplyTrackEdits(std::vector<TrackRow> rows, Roster roster, const Trac
         });
         std::vector<TrackRow> out;
         out.reserve(rows.size());
+        int overlap = 0, first_overlap = 0;
         for (const auto& r : rows) {
           if (!out.empty() && out.back().frame == r.frame && out.back().id == r.id) {
-            ++res.overlapping_rows;
+            if (overlap++ == 0) first_overlap = r.frame;
             if (r.conf > out.back().conf) out.back() = r;
             continue;
           }
           out.push_back(r);
         }
+        // Two ids seen together for long are two people, not one tracked in pieces.
+        FV_REQUIRE(overlap <= kMaxMergeOverlapFrames,
+                   "{}:{}: merge: the ids are tracked at the same time in {} frames (from frame "
+                   "{}): two people, not one (at most {} frames may overlap)",
+                   edits.path, e.line, overlap, first_overlap, kMaxMergeOverlapFrames);
+        res.overlapping_rows += overlap;
         rows = std::move(out);
         for (int id : from) {
           move_roster(id, keep);

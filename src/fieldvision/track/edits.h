@@ -2,7 +2,9 @@
 // `stats` (`fieldvision tracks edit`), and the roster file beside TRACKS.csv (TRACKS.csv.teams.csv:
 // id,team,name) that carries teams and names. The edits file is an array applied in order, each
 // element one operation on the ids as they are at that point:
-//   {"merge": [3, 17, 22]}           ids 17 and 22 become 3 (one person tracked in pieces)
+//   {"merge": [3, 17, 22]}           ids 17 and 22 become 3 (one person tracked in pieces; where
+//                                    two were tracked in the same frame, the surer box is kept;
+//                                    more than 10 such frames is an error: two people)
 //   {"rename": {"3": 10}}            id 3 becomes 10 (a shirt number); 10 must be free
 //   {"name": {"10": "Anna"}}         roster names
 //   {"team": {"10": 0, "11": 1}}     teams (0, 1, ...; -1: none)
@@ -63,7 +65,8 @@ struct EditResult {
 };
 
 // Applies the edits in order. Throws fv::Error naming the file and line for an id that is not in
-// the tracks (at that point), a rename onto an id in use, or a merge of fewer than two ids.
+// the tracks (at that point), a rename onto an id in use, or a merge of ids tracked together in
+// more than 10 frames.
 EditResult ApplyTrackEdits(std::vector<TrackRow> rows, Roster roster, const TrackEdits& edits);
 
 }  // namespace fv::track

@@ -96,6 +96,14 @@ TEST(TrackEdits, ErrorsNameFileAndLine) {
   const std::string used = ErrorOf(
       [&] { ApplyTrackEdits(rows, {}, ParseTrackEdits("[{\"rename\": {\"1\": 2}}]", "e")); });
   EXPECT_NE(used.find("e:1: rename: id 2 is already in use"), std::string::npos) << used;
+  const std::string together = ErrorOf([&] {
+    ApplyTrackEdits(Rows({{1, {1, 30}}, {2, {5, 30}}}), {},
+                    ParseTrackEdits("[\n{\"merge\": [1, 2]}]", "e"));
+  });
+  EXPECT_NE(together.find("e:2: merge: the ids are tracked at the same time in 26 frames (from "
+                          "frame 5)"),
+            std::string::npos)
+      << together;
   const std::string json =
       ErrorOf([&] { ParseTrackEdits("[\n{\"merge\": [1, 2]},\n{\"drop\": [2}\n]", "e"); });
   EXPECT_NE(json.find("e:3: not valid JSON"), std::string::npos) << json;
