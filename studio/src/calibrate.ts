@@ -134,7 +134,7 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
       ctx.lineTo(c.u + 0.5, c.v + 0.5 + r);
       ctx.stroke();
       ctx.fillStyle = '#f33';
-      ctx.fillText(`${i + 1} ${c.name}`, c.u + r, c.v - r);
+      ctx.fillText(String(i + 1), c.u + r, c.v - r);
     });
     drawLoupe();
   }
@@ -143,11 +143,20 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
     const ctx = loupe.getContext('2d')!;
     ctx.fillStyle = '#222';
     ctx.fillRect(0, 0, loupe.width, loupe.height);
-    if (!pointer) return;
+    if (!pointer || !img) return;
     const zoom = 6;
     const half = loupe.width / zoom / 2;
+    const [x0, y0] = [pointer[0] + 0.5 - half, pointer[1] + 0.5 - half];
     ctx.imageSmoothingEnabled = false;
-    ctx.drawImage(image, pointer[0] + 0.5 - half, pointer[1] + 0.5 - half, 2 * half, 2 * half, 0, 0, loupe.width, loupe.height);
+    ctx.drawImage(img, x0, y0, 2 * half, 2 * half, 0, 0, loupe.width, loupe.height);
+    // Clicked points (red) and reprojected keypoints (cyan) near the pointer.
+    const mark = (u: number, v: number, colour: string) => {
+      const [x, y] = [(u + 0.5 - x0) * zoom, (v + 0.5 - y0) * zoom];
+      ctx.strokeStyle = colour;
+      ctx.strokeRect(x - 4, y - 4, 8, 8);
+    };
+    for (const c of clicks) mark(c.u, c.v, '#f33');
+    for (const p of pose?.points ?? []) mark(p.projected[0], p.projected[1], '#0ff');
     ctx.strokeStyle = '#0f0';
     ctx.beginPath();
     ctx.moveTo(loupe.width / 2, 0);

@@ -2,16 +2,13 @@
 // line fed by the server's Server-Sent Events (/api/events).
 import './style.css';
 import { url } from './api';
-import { calibratePage } from './calibrate';
-import { colourPage } from './colour';
-import { view3dPage } from './view3d';
-import { playersPage } from './players';
 
+// Each page is its own chunk, loaded when opened (three.js and uPlot only for the 3D view).
 const pages: Record<string, (root: HTMLElement) => Promise<void>> = {
-  calibrate: calibratePage,
-  colour: colourPage,
-  view3d: view3dPage,
-  players: playersPage,
+  calibrate: async (root) => (await import('./calibrate')).calibratePage(root),
+  colour: async (root) => (await import('./colour')).colourPage(root),
+  view3d: async (root) => (await import('./view3d')).view3dPage(root),
+  players: async (root) => (await import('./players')).playersPage(root),
 };
 
 async function route(): Promise<void> {
@@ -20,7 +17,7 @@ async function route(): Promise<void> {
   for (const a of document.querySelectorAll<HTMLAnchorElement>('#nav a')) {
     a.classList.toggle('active', a.hash === `#${name}`);
   }
-  const page = pages[name] ?? calibratePage;
+  const page = pages[name] ?? pages.calibrate;
   root.dataset.page = name;
   root.dataset.ready = '';
   try {

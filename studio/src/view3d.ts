@@ -128,7 +128,7 @@ export async function view3dPage(root: HTMLElement): Promise<void> {
     const geo = new THREE.BufferGeometry();
     geo.setAttribute('position', new THREE.BufferAttribute(pos, 3));
     geo.setAttribute('color', new THREE.BufferAttribute(col, 3));
-    return new THREE.Points(geo, new THREE.PointsMaterial({ size: 0.12, vertexColors: true }));
+    return new THREE.Points(geo, new THREE.PointsMaterial({ size: 0.2, vertexColors: true }));
   }
 
   function setTime(i: number) {

@@ -1,0 +1,30 @@
+// `fieldvision studio`: serves the local web app (web/studio_server.h) over the current folder.
+#include <iostream>
+#include <memory>
+
+#include "fieldvision/app/command.h"
+#include "fieldvision/web/studio_server.h"
+
+namespace fv::app {
+namespace {
+
+void Setup(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<web::StudioOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "studio",
+      "Serve the studio web app (calibrate by clicking, ball colour, 3D view, tactical board) "
+      "over the current folder; reads and writes only inside it");
+  cmd->add_option("--host", o->host,
+                  "Address to bind; any other than loopback requires the printed token")
+      ->capture_default_str();
+  cmd->add_option("--port", o->port, "Port (0: any free one)")->capture_default_str();
+  cmd->add_option("--token", o->token, "Token for a non-loopback --host (default: random)");
+  cmd->add_option("--assets", o->assets,
+                  "Folder of the built front end (default: studio/dist of the source tree)");
+  cmd->callback([o, &exit_code] { exit_code = web::RunStudio(*o, std::cout); });
+}
+
+FV_REGISTER_COMMAND(95, "studio", Setup);
+
+}  // namespace
+}  // namespace fv::app

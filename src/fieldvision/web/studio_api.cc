@@ -1,0 +1,550 @@
+#include "fieldvision/web/studio_api.h"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/colour.h"
+#include "fieldvision/detect/colour_learn.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/field/field_json.h"
+#include "fieldvision/io/video_source.h"
+#include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/util/csv.h"
+
+namespace fv::web {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+std::string OneLine(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return s;
+}
+
+ApiResponse Json(const json& j, int status = 200) { return {status, "application/json", j.dump()}; }
+
+ApiResponse ErrorResponse(int status, const std::string& message) {
+  return Json({{"error", OneLine(message)}}, status);
+}
+
+double Round(double v, double step = 1e-4) { return std::round(v / step) * step; }
+
+json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// ---- request helpers
+
+const std::string& Param(const ApiRequest& r, const std::string& name) {
+  auto it = r.params.find(name);
+  if (it == r.params.end() || it->second.empty()) {
+    throw HttpError(400, "missing query parameter '" + name + "'");
+  }
+  return it->second;
+}
+
+json Body(const ApiRequest& r) {
+  if (r.body.empty()) throw HttpError(400, "request body is empty (expected JSON)");
+  try {
+    json j = json::parse(r.body);
+    if (!j.is_object()) throw HttpError(400, "request body is not a JSON object");
+    return j;
+  } catch (const json::parse_error& e) {
+    throw HttpError(400, "malformed JSON: " + std::string(e.what()));
+  }
+}
+
+template <typename T>
+T Get(const json& body, const std::string& key) {
+  if (!body.contains(key)) throw HttpError(400, "missing key '" + key + "'");
+  try {
+    return body.at(key).get<T>();
+  } catch (const json::exception&) {
+    throw HttpError(400, "key '" + key + "' has the wrong type");
+  }
+}
+
+template <typename T>
+T GetOr(const json& body, const std::string& key, const T& fallback) {
+  if (!body.contains(key) || body.at(key).is_null()) return fallback;
+  return Get<T>(body, key);
+}
+
+int ParseInt(const std::string& text, const std::string& what) {
+  try {
+    size_t used = 0;
+    const int v = std::stoi(text, &used);
+    if (used == text.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw HttpError(400, what + " '" + text + "' is not an integer");
+}
+
+// ---- library adapters
+
+FieldModel LoadFieldIn(const Workspace& ws, const std::string& name_or_path) {
+  for (const auto& n : BuiltinFieldNames()) {
+    if (n == name_or_path) return BuiltinField(n);
+  }
+  if (name_or_path.size() < 5 || name_or_path.substr(name_or_path.size() - 5) != ".json") {
+    std::string names;
+    for (const auto& n : BuiltinFieldNames()) names += (names.empty() ? "" : ", ") + n;
+    throw HttpError(
+        404, "unknown field '" + name_or_path + "' (built in: " + names + ", or a .json file)");
+  }
+  return LoadField(ws.Resolve(name_or_path).string());
+}
+
+json CameraToJson(const Camera& c) {
+  json j = {{"name", c.name},
+            {"width", c.width},
+            {"height", c.height},
+            {"fx", c.fx},
+            {"fy", c.fy},
+            {"cx", c.cx},
+            {"cy", c.cy},
+            {"distortion", c.distortion},
+            {"has_pose", c.has_pose}};
+  if (c.rms_px) j["rms_px"] = *c.rms_px;
+  if (c.has_pose) {
+    j["rvec"] = Vec(c.cam_from_world.Rvec());
+    j["tvec"] = Vec(c.cam_from_world.translation);
+    j["position_m"] = Vec(c.CentreInWorld());
+    const Eigen::Matrix3d& r = c.cam_from_world.rotation;
+    j["cam_from_world_rotation"] = {r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1),
+                                    r(1, 2), r(2, 0), r(2, 1), r(2, 2)};
+  }
+  return j;
+}
+
+// Field lines and keypoints as the camera sees them: polylines in pixels (split where a point is
+// behind the camera or far outside the image).
+json ProjectField(const Camera& cam, const FieldModel& field) {
+  json lines = json::array();
+  const double margin = 0.5 * std::max(cam.width, cam.height);
+  auto add_polyline = [&](const std::function<Eigen::Vector2d(double)>& at, double length_m) {
+    const int n = std::max(2, int(std::ceil(length_m / 0.2)) + 1);
+    json poly = json::array();
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector2d p = at(double(i) / (n - 1));
+      const auto uv = cam.Project(Eigen::Vector3d(p.x(), p.y(), 0.0));
+      if (uv && cam.InImage(*uv, -margin)) {
+        poly.push_back({Round(uv->x(), 0.01), Round(uv->y(), 0.01)});
+      } else {
+        if (poly.size() >= 2) lines.push_back(poly);
+        poly = json::array();
+      }
+    }
+    if (poly.size() >= 2) lines.push_back(poly);
+  };
+  for (const auto& s : field.segments) {
+    add_polyline([&](double t) { return Eigen::Vector2d(s.a + t * (s.b - s.a)); },
+                 (s.b - s.a).norm());
+  }
+  for (const auto& a : field.arcs) {
+    add_polyline(
+        [&](double t) {
+          const double ang = a.start_rad + t * (a.end_rad - a.start_rad);
+          return Eigen::Vector2d(a.centre +
+                                 a.radius_m * Eigen::Vector2d(std::cos(ang), std::sin(ang)));
+        },
+        a.radius_m * (a.end_rad - a.start_rad));
+  }
+  json keypoints = json::array();
+  for (const auto& k : field.keypoints) {
+    const auto uv = cam.Project(k.position_m);
+    if (uv && cam.InImage(*uv)) {
+      keypoints.push_back(
+          {{"name", k.name}, {"u", Round(uv->x(), 1e-3)}, {"v", Round(uv->y(), 1e-3)}});
+    }
+  }
+  return {{"lines_px", lines}, {"keypoints_px", keypoints}};
+}
+
+std::vector<calib::PointCorrespondence> ParseClicks(const json& body, const FieldModel& field) {
+  if (!body.contains("points") || !body["points"].is_array()) {
+    throw HttpError(400, "missing key 'points' (an array of {name, u, v})");
+  }
+  std::vector<calib::PointCorrespondence> points;
+  int i = 0;
+  for (const auto& p : body["points"]) {
+    const std::string where = "points[" + std::to_string(i++) + "]";
+    if (!p.is_object() || !p.contains("u") || !p.contains("v") || !p["u"].is_number() ||
+        !p["v"].is_number()) {
+      throw HttpError(400, where + " needs numbers u and v");
+    }
+    calib::PointCorrespondence c;
+    c.uv_px = {p["u"].get<double>(), p["v"].get<double>()};
+    if (p.contains("name") && p["name"].is_string()) {
+      c.name = p["name"].get<std::string>();
+      const FieldKeypoint* k = field.FindKeypoint(c.name);
+      if (!k) throw HttpError(400, where + ": '" + c.name + "' is not a keypoint of " + field.name);
+      c.p_world = k->position_m;
+    } else if (p.contains("x") && p.contains("y")) {
+      c.name = where;
+      c.p_world = {p["x"].get<double>(), p["y"].get<double>(), p.value("z", 0.0)};
+    } else {
+      throw HttpError(400, where + " needs a keypoint name or x, y (metres)");
+    }
+    points.push_back(c);
+  }
+  return points;
+}
+
+json PoseToJson(const calib::ExtrinsicsResult& r, const FieldModel& field) {
+  json points = json::array();
+  for (const auto& p : r.points) {
+    json j = {{"name", p.name},
+              {"u", p.uv_px.x()},
+              {"v", p.uv_px.y()},
+              {"projected", {Round(p.projected_px.x(), 1e-3), Round(p.projected_px.y(), 1e-3)}},
+              {"err_px", Round(p.err_px)},
+              {"inlier", p.inlier}};
+    j["err_mm"] = p.err_mm ? json(Round(*p.err_mm, 0.01)) : json(nullptr);
+    points.push_back(j);
+  }
+  json j = {{"camera", CameraToJson(r.camera)},
+            {"points", points},
+            {"num_inliers", r.num_inliers},
+            {"rms_px", Round(r.rms_px)},
+            {"max_err_px", Round(r.max_err_px)},
+            {"mean_err_mm", Round(r.mean_err_mm, 0.01)},
+            {"max_err_mm", Round(r.max_err_mm, 0.01)},
+            {"camera_position_m", Vec(r.camera_position_m)},
+            {"summary", OneLine(r.Summary())}};
+  j.update(ProjectField(r.camera, field));
+  return j;
+}
+
+ColourRange RangeFromJson(const json& j) {
+  if (!j.is_object() || !j.contains("min") || !j.contains("max")) {
+    throw HttpError(400, "'range' needs min and max ([h, s, v])");
+  }
+  ColourRange r;
+  try {
+    r.min = j["min"].get<std::array<double, 3>>();
+    r.max = j["max"].get<std::array<double, 3>>();
+  } catch (const json::exception&) {
+    throw HttpError(400, "'range' min and max must be three numbers each");
+  }
+  if (j.value("space", "hsv") == "yuv") r.space = ColourSpace::kYuv;
+  return r;
+}
+
+json RangeToJson(const ColourRange& r) {
+  return {{"space", r.space == ColourSpace::kHsv ? "hsv" : "yuv"},
+          {"min", {Round(r.min[0], 0.01), Round(r.min[1], 0.01), Round(r.min[2], 0.01)}},
+          {"max", {Round(r.max[0], 0.01), Round(r.max[1], 0.01), Round(r.max[2], 0.01)}}};
+}
+
+// A preset's field and line classes with the ball class replaced by `range`.
+ColourSpec SpecWithBallRange(const ColourRange& range) {
+  ColourSpec spec = PresetColourSpec("orange");
+  const int ball = spec.Find(spec.ball_class);
+  spec.classes[ball].ranges = {range};
+  spec.Check("studio colour");
+  return spec;
+}
+
+std::vector<Eigen::Vector2d> ParseUvList(const json& body, const std::string& key) {
+  std::vector<Eigen::Vector2d> out;
+  if (!body.contains(key)) return out;
+  if (!body[key].is_array()) throw HttpError(400, "'" + key + "' must be an array of [u, v]");
+  for (const auto& p : body[key]) {
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
+      throw HttpError(400, "'" + key + "' must be an array of [u, v]");
+    }
+    out.emplace_back(p[0].get<double>(), p[1].get<double>());
+  }
+  return out;
+}
+
+std::string EncodePng(const cv::Mat& image) {
+  std::vector<uchar> buf;
+  cv::imencode(".png", image, buf, {cv::IMWRITE_PNG_COMPRESSION, 1});
+  return std::string(buf.begin(), buf.end());
+}
+
+// Writes text to a temporary name beside `path`, then renames it (a failure loses nothing).
+void WriteTextFile(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp);
+    FV_REQUIRE(out.good(), "cannot write '{}'", path.string());
+    out << text;
+    FV_REQUIRE(out.good(), "error while writing '{}'", path.string());
+  }
+  fs::rename(tmp, path);
+}
+
+// ---- endpoints
+
+using Handler = std::function<ApiResponse(const Workspace&, EventHub*, const ApiRequest&)>;
+
+struct Route {
+  Endpoint endpoint;
+  Handler handler;
+};
+
+void Saved(EventHub* events, const Workspace& ws, const fs::path& path, const std::string& what) {
+  if (events) events->Publish("saved", {{"path", ws.Relative(path)}, {"what", what}});
+}
+
+const std::vector<Route>& Routes() {
+  static const std::vector<Route> routes = {
+      {{"GET", "/api/endpoints", "this list"},
+       [](const Workspace&, EventHub*, const ApiRequest&) {
+         json j = json::array();
+         for (const auto& e : StudioApi::Endpoints()) {
+           j.push_back({{"method", e.method}, {"path", e.path}, {"summary", e.summary}});
+         }
+         return Json(j);
+       }},
+      {{"GET", "/api/info", "working folder, built-in fields and colour presets"},
+       [](const Workspace& ws, EventHub*, const ApiRequest&) {
+         return Json({{"root", ws.root().string()},
+                      {"fields", BuiltinFieldNames()},
+                      {"colour_presets", ColourPresetNames()}});
+       }},
+      {{"GET", "/api/files", "files of the working folder: [{path, size, kind}]"},
+       [](const Workspace& ws, EventHub*, const ApiRequest&) { return Json(ws.ListFiles()); }},
+      {{"GET", "/api/field", "?name=NAME_OR_JSON: the field model (field show --json)"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         return Json(FieldToJson(LoadFieldIn(ws, Param(r, "name"))));
+       }},
+      {{"GET", "/api/video", "?path=V: width, height, frames, fps"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const fs::path p = ws.Resolve(Param(r, "path"));
+         auto source = VideoSource::Open(p.string());
+         return Json({{"path", ws.Relative(p)},
+                      {"width", source->width()},
+                      {"height", source->height()},
+                      {"frames", source->frame_count()},
+                      {"fps", source->fps()}});
+       }},
+      {{"GET", "/api/frame", "?path=V&frame=N: frame N of a video or image pattern (PNG)"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const fs::path p = ws.Resolve(Param(r, "path"));
+         const int frame = r.params.count("frame") ? ParseInt(r.params.at("frame"), "frame") : 0;
+         if (frame < 0) throw HttpError(400, "frame must be >= 0");
+         const cv::Mat bgr = ReadVideoFrame(p.string(), frame);
+         return ApiResponse{200, "image/png", EncodePng(bgr)};
+       }},
+      {{"GET", "/api/camera", "?path=CAM.yaml: the camera (intrinsics, pose, position)"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         return Json(CameraToJson(ReadCameraYaml(ws.Resolve(Param(r, "path")).string())));
+       }},
+      {{"POST", "/api/calibrate/project",
+        "{camera, field}: the field's lines and keypoints in the camera's image"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const json body = Body(r);
+         const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         if (!cam.has_pose) throw HttpError(422, "camera file has no pose (rvec, tvec)");
+         return Json(ProjectField(cam, LoadFieldIn(ws, Get<std::string>(body, "field"))));
+       }},
+      {{"POST", "/api/calibrate/pose",
+        "{camera, field, points: [{name, u, v}]}: pose, residuals (px, mm), reprojected lines"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const json body = Body(r);
+         const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
+         const auto points = ParseClicks(body, field);
+         return Json(PoseToJson(calib::EstimatePose(cam, points), field));
+       }},
+      {{"POST", "/api/calibrate/save",
+        "{camera, field, points, out[, points_out]}: estimate the pose and write the camera file"},
+       [](const Workspace& ws, EventHub* events, const ApiRequest& r) {
+         const json body = Body(r);
+         const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
+         const auto points = ParseClicks(body, field);
+         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         fs::path points_out;
+         if (body.contains("points_out")) {
+           points_out = ws.ResolveOutput(Get<std::string>(body, "points_out"));
+         }
+         const calib::ExtrinsicsResult result = calib::EstimatePose(cam, points);
+         WriteCameraYaml(result.camera, out.string());
+         json j = PoseToJson(result, field);
+         j["wrote"] = {ws.Relative(out)};
+         if (!points_out.empty()) {
+           std::ostringstream csv;
+           csv.precision(10);
+           csv << "u,v,name\n";
+           for (const auto& p : points)
+             csv << p.uv_px.x() << ',' << p.uv_px.y() << ',' << p.name << '\n';
+           WriteTextFile(points_out, csv.str());
+           j["wrote"].push_back(ws.Relative(points_out));
+         }
+         Saved(events, ws, out, "camera");
+         return Json(j);
+       }},
+      {{"POST", "/api/colour/learn",
+        "{video, frame, points: [[u, v]], roi: [x, y, w, h], negative_points}: HSV box"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const json body = Body(r);
+         const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
+         ColourLearnOptions o;
+         o.points = ParseUvList(body, "points");
+         o.negative_points = ParseUvList(body, "negative_points");
+         if (body.contains("roi")) {
+           const auto roi = Get<std::array<int, 4>>(body, "roi");
+           o.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
+         }
+         if (o.points.empty() && !o.roi) throw HttpError(400, "give 'points' or 'roi'");
+         const cv::Mat bgr = ReadVideoFrame(video.string(), GetOr<int>(body, "frame", 0));
+         const ColourLearnResult res = LearnColour(bgr, o);
+         return Json({{"range", RangeToJson(res.range)},
+                      {"positives", res.positives},
+                      {"negatives", res.negatives},
+                      {"recall", Round(res.recall)},
+                      {"negative_rate", Round(res.negative_rate, 1e-6)},
+                      {"summary", OneLine(res.Summary())}});
+       }},
+      {{"POST", "/api/colour/save",
+        "{range: {min, max}, out}: write a colour file (ball class + field + line)"},
+       [](const Workspace& ws, EventHub* events, const ApiRequest& r) {
+         const json body = Body(r);
+         const ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
+         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         WriteColourSpec(spec, out.string());
+         Saved(events, ws, out, "colour");
+         return Json({{"wrote", {ws.Relative(out)}}, {"spec", ColourSpecToJson(spec)}});
+       }},
+      {{"POST", "/api/colour/detect",
+        "{video, frames: [N], colour: FILE_OR_PRESET | range, camera?}: ball candidates"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const json body = Body(r);
+         const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
+         ColourSpec spec;
+         if (body.contains("range")) {
+           spec = SpecWithBallRange(RangeFromJson(body["range"]));
+         } else {
+           const std::string c = GetOr<std::string>(body, "colour", "orange");
+           bool preset = false;
+           for (const auto& n : ColourPresetNames()) preset = preset || n == c;
+           spec = preset ? PresetColourSpec(c) : ReadColourSpec(ws.Resolve(c).string());
+         }
+         std::optional<Camera> cam;
+         if (body.contains("camera")) {
+           cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         }
+         std::vector<int> frames = GetOr<std::vector<int>>(body, "frames", {0});
+         if (frames.empty() || frames.size() > 50) {
+           throw HttpError(400, "'frames' must list 1 to 50 frame numbers");
+         }
+         BallDetector detector(BallDetectorOptions{}, spec, cam ? &*cam : nullptr, nullptr);
+         json out = json::array();
+         for (int f : frames) {
+           if (f < 0) throw HttpError(400, "frame numbers must be >= 0");
+           const cv::Mat bgr = ReadVideoFrame(video.string(), f);
+           json cands = json::array();
+           for (const auto& c : detector.Detect(bgr)) {
+             cands.push_back({{"u", Round(c.centre_px.x(), 1e-3)},
+                              {"v", Round(c.centre_px.y(), 1e-3)},
+                              {"radius_px", Round(c.radius_px, 1e-3)},
+                              {"score", Round(c.score)},
+                              {"accepted", c.accepted},
+                              {"reason", c.reason}});
+           }
+           out.push_back({{"frame", f}, {"candidates", cands}});
+         }
+         return Json({{"frames", out}});
+       }},
+      {{"GET", "/api/ball", "?path=BALL.csv: the ball track (time, position, cameras, error)"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const BallTrackFile track = ReadBallTrack(ws.Resolve(Param(r, "path")).string());
+         json samples = json::array();
+         for (const auto& s : track.samples) {
+           samples.push_back({s.frame, s.time_s, Round(s.ball_in_world.x()),
+                              Round(s.ball_in_world.y()), Round(s.ball_in_world.z()), s.n_cams,
+                              Round(s.err_px)});
+         }
+         return Json({{"columns", {"frame", "time_s", "x_m", "y_m", "z_m", "n_cams", "err_px"}},
+                      {"samples", samples},
+                      {"skipped", track.skipped.size()}});
+       }},
+      {{"GET", "/api/tracks", "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s)"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const CsvTable t = CsvTable::Read(ws.Resolve(Param(r, "path")).string());
+         t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
+         json rows = json::array();
+         auto num = [&](size_t i, const char* col) -> json {
+           if (!t.Has(col) || t.Get(i, col).empty()) return nullptr;
+           return t.GetDouble(i, col);
+         };
+         for (size_t i = 0; i < t.rows(); ++i) {
+           rows.push_back({t.GetInt(i, "frame"), t.GetInt(i, "id"), num(i, "bb_left"),
+                           num(i, "bb_top"), num(i, "bb_width"), num(i, "bb_height"), num(i, "x_m"),
+                           num(i, "y_m"), num(i, "time_s")});
+         }
+         return Json({{"columns",
+                       {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "x_m", "y_m",
+                        "time_s"}},
+                      {"rows", rows}});
+       }},
+      {{"GET", "/api/json", "?path=F.json: a JSON file of the folder (FLIGHTS.json, ...)"},
+       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+         const fs::path p = ws.Resolve(Param(r, "path"));
+         std::ifstream in(p);
+         if (!in) throw HttpError(404, "cannot read '" + Param(r, "path") + "'");
+         try {
+           return Json(json::parse(in));
+         } catch (const json::parse_error&) {
+           throw HttpError(422, "'" + Param(r, "path") + "' is not valid JSON");
+         }
+       }},
+  };
+  return routes;
+}
+
+}  // namespace
+
+StudioApi::StudioApi(const Workspace& workspace, EventHub* events)
+    : workspace_(workspace), events_(events) {}
+
+const std::vector<Endpoint>& StudioApi::Endpoints() {
+  static const std::vector<Endpoint> endpoints = [] {
+    std::vector<Endpoint> e;
+    for (const auto& r : Routes()) e.push_back(r.endpoint);
+    e.push_back({"GET", "/api/events", "Server-Sent Events: saved files"});
+    return e;
+  }();
+  return endpoints;
+}
+
+ApiResponse StudioApi::Handle(const ApiRequest& request) const {
+  bool path_known = false;
+  for (const auto& route : Routes()) {
+    if (route.endpoint.path != request.path) continue;
+    path_known = true;
+    if (route.endpoint.method != request.method) continue;
+    try {
+      return route.handler(workspace_, events_, request);
+    } catch (const HttpError& e) {
+      return ErrorResponse(e.status(), e.what());
+    } catch (const fv::Error& e) {
+      // Library errors name the input (bad file content, too few points, ...).
+      return ErrorResponse(422, e.what());
+    } catch (const json::exception& e) {
+      return ErrorResponse(400, std::string("bad request: ") + e.what());
+    } catch (const cv::Exception& e) {
+      return ErrorResponse(422, std::string("OpenCV: ") + e.err);
+    } catch (const std::exception& e) {
+      return ErrorResponse(500, std::string("internal error: ") + e.what());
+    }
+  }
+  if (path_known) return ErrorResponse(405, request.method + " is not allowed on " + request.path);
+  return ErrorResponse(404, "unknown endpoint " + request.path);
+}
+
+}  // namespace fv::web

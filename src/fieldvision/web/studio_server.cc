@@ -1,0 +1,218 @@
+#include "fieldvision/web/studio_server.h"
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <ostream>
+#include <random>
+#include <thread>
+
+#include <fmt/format.h>
+#include <httplib.h>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/web/studio_api.h"
+
+#ifndef FV_STUDIO_DIST
+#define FV_STUDIO_DIST "studio/dist"
+#endif
+
+namespace fv::web {
+
+namespace fs = std::filesystem;
+
+void StudioOptions::Check() const {
+  FV_REQUIRE(!host.empty(), "studio: --host is empty");
+  FV_REQUIRE(port >= 0 && port <= 65535, "studio: --port must be 0..65535 (got {})", port);
+  FV_REQUIRE(token.find_first_of(" \r\n&?#") == std::string::npos,
+             "studio: --token must not contain spaces or URL separators");
+}
+
+bool IsLoopback(const std::string& host) {
+  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+namespace {
+
+std::string RandomToken() {
+  std::random_device rd;
+  std::string t;
+  for (int i = 0; i < 4; ++i) t += fmt::format("{:08x}", rd());
+  return t;
+}
+
+std::string NotBuiltPage(const std::string& assets) {
+  return fmt::format(
+      R"(<!doctype html><html><head><meta charset="utf-8"><title>fieldvision studio</title></head>
+<body style="font-family:sans-serif;max-width:50em;margin:3em auto">
+<h1>fieldvision studio: the front end is not built</h1>
+<p id="not-built">Missing: <code>{}/index.html</code>. The studio's pages are TypeScript built with
+Vite, which needs Node.js and npm (installed by <code>scripts/install-deps.sh</code>). Build them
+with <code>make build</code> (or <code>bash studio/build.sh</code>), then reload this page.</p>
+<p>The JSON API works without them: <a href="/api/endpoints">/api/endpoints</a>.</p>
+</body></html>)",
+      assets);
+}
+
+}  // namespace
+
+struct StudioServer::Impl {
+  StudioOptions options;
+  std::unique_ptr<Workspace> workspace;
+  std::unique_ptr<StudioApi> api;
+  EventHub events;
+  httplib::Server server;
+  std::thread thread;
+  std::atomic<bool> loop_ended{false};
+  int port = -1;
+  bool token_required = false;
+  bool assets_built = false;
+
+  bool Authorized(const httplib::Request& req) const {
+    if (!token_required) return true;
+    if (req.get_header_value("X-Studio-Token") == options.token) return true;
+    return req.has_param("token") && req.get_param_value("token") == options.token;
+  }
+};
+
+StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_unique<Impl>()) {
+  options.Check();
+  Impl& m = *impl_;
+  m.options = options;
+  m.workspace = std::make_unique<Workspace>(options.root.empty() ? fs::current_path()
+                                                                 : fs::path(options.root));
+  m.api = std::make_unique<StudioApi>(*m.workspace, &m.events);
+  if (m.options.assets.empty()) m.options.assets = FV_STUDIO_DIST;
+  m.assets_built = fs::is_regular_file(fs::path(m.options.assets) / "index.html");
+  m.token_required = !IsLoopback(options.host);
+  if (m.token_required && m.options.token.empty()) m.options.token = RandomToken();
+
+  httplib::Server& s = m.server;
+  s.new_task_queue = [] { return new httplib::ThreadPool(16); };
+  s.set_payload_max_length(32 << 20);
+  s.set_read_timeout(10);
+  // SO_REUSEADDR only: httplib's default SO_REUSEPORT would let a second studio share the port.
+  s.set_socket_options([](int sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
+  auto send = [](httplib::Response& res, const ApiResponse& r) {
+    res.status = r.status;
+    res.set_content(r.body, r.content_type);
+    res.set_header("Cache-Control", "no-store");
+  };
+  auto unauthorized = [send](httplib::Response& res) {
+    send(res,
+         {401, "application/json",
+          R"j({"error":"missing or wrong studio token (X-Studio-Token header or ?token=)"})j"});
+  };
+  // Event stream first: the generic /api handler below would take it otherwise.
+  s.Get("/api/events", [this, unauthorized](const httplib::Request& req, httplib::Response& res) {
+    Impl& m = *impl_;
+    if (!m.Authorized(req)) return unauthorized(res);
+    auto cursor = std::make_shared<uint64_t>(m.events.Last());
+    auto first = std::make_shared<bool>(true);
+    res.set_header("Cache-Control", "no-store");
+    res.set_chunked_content_provider(
+        "text/event-stream", [this, cursor, first](size_t, httplib::DataSink& sink) {
+          std::string out;
+          if (*first) {
+            *first = false;
+            out = "retry: 2000\nevent: hello\ndata: {}\n\n";
+          } else if (!impl_->events.Wait(*cursor, out, std::chrono::seconds(10))) {
+            sink.done();
+            return false;
+          }
+          if (out.empty()) out = ": keep-alive\n\n";
+          return sink.write(out.data(), out.size());
+        });
+  });
+  auto api = [this, send, unauthorized](const httplib::Request& req, httplib::Response& res) {
+    Impl& m = *impl_;
+    if (!m.Authorized(req)) return unauthorized(res);
+    ApiRequest r{req.method, req.path, {}, req.body};
+    for (const auto& [k, v] : req.params) r.params[k] = v;
+    send(res, m.api->Handle(r));
+  };
+  s.Get(R"(/api/.*)", api);
+  s.Post(R"(/api/.*)", api);
+  if (m.assets_built) {
+    s.set_mount_point("/", m.options.assets);
+  } else {
+    s.Get("/", [this](const httplib::Request&, httplib::Response& res) {
+      res.set_content(NotBuiltPage(impl_->options.assets), "text/html");
+    });
+  }
+}
+
+StudioServer::~StudioServer() { Stop(); }
+
+int StudioServer::Start() {
+  Impl& m = *impl_;
+  FV_REQUIRE(m.port < 0, "studio: server already started");
+  if (m.options.port == 0) {
+    m.port = m.server.bind_to_any_port(m.options.host);
+  } else {
+    m.port = m.server.bind_to_port(m.options.host, m.options.port) ? m.options.port : -1;
+  }
+  FV_REQUIRE(m.port > 0, "studio: cannot listen on {}:{} (address in use or not this machine's)",
+             m.options.host, m.options.port);
+  m.thread = std::thread([this] {
+    impl_->server.listen_after_bind();
+    impl_->loop_ended = true;
+  });
+  // httplib's stop() does nothing before the loop runs: wait for it, so Stop() always ends it.
+  while (!m.server.is_running() && !m.loop_ended) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return m.port;
+}
+
+void StudioServer::Stop() {
+  Impl& m = *impl_;
+  m.events.Close();
+  if (m.thread.joinable()) {
+    m.server.stop();
+    m.thread.join();
+  }
+}
+
+int StudioServer::port() const { return impl_->port; }
+bool StudioServer::token_required() const { return impl_->token_required; }
+const std::string& StudioServer::token() const { return impl_->options.token; }
+bool StudioServer::assets_built() const { return impl_->assets_built; }
+const std::string& StudioServer::assets_dir() const { return impl_->options.assets; }
+EventHub& StudioServer::events() { return impl_->events; }
+
+std::string StudioServer::Url() const {
+  const std::string& h = impl_->options.host;
+  const std::string host = h.find(':') != std::string::npos ? "[" + h + "]" : h;
+  std::string url = fmt::format("http://{}:{}/", host, impl_->port);
+  if (impl_->token_required) url += "?token=" + impl_->options.token;
+  return url;
+}
+
+int RunStudio(const StudioOptions& options, std::ostream& out) {
+  // Block the stop signals in every thread (the server's inherit the mask) and wait for them.
+  sigset_t stop;
+  sigemptyset(&stop);
+  sigaddset(&stop, SIGINT);
+  sigaddset(&stop, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop, nullptr);
+  StudioServer server(options);
+  server.Start();
+  out << "fieldvision studio: working folder " << fs::current_path().string() << "\n";
+  if (!server.assets_built()) {
+    out << "fieldvision studio: the front end is not built (" << server.assets_dir()
+        << "/index.html missing): run `make build` with Node.js and npm installed; the page says "
+           "so too\n";
+  }
+  out << "fieldvision studio: open " << server.Url() << "  (Ctrl-C stops)" << std::endl;
+  int sig = 0;
+  sigwait(&stop, &sig);
+  out << "fieldvision studio: stopping" << std::endl;
+  server.Stop();
+  return 0;
+}
+
+}  // namespace fv::web

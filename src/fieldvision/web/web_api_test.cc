@@ -1,0 +1,385 @@
+// The studio's HTTP API end to end: a server on a free loopback port over a folder holding a small
+// synthetic scene, called with cpp-httplib's client. Every endpoint, and bad requests (unknown
+// file, path outside the folder, malformed JSON, wrong method, missing token) get 4xx with a
+// one-line message.
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+// glibc's resolv.h (through httplib.h) defines _res, a parameter name in Eigen's headers.
+#undef _res
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/colour.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+#include "fieldvision/web/studio_api.h"
+#include "fieldvision/web/studio_server.h"
+
+namespace fv::web {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+class StudioApiTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(fv::testing::TempDir()) / "work";
+    fs::create_directories(dir_ / "scene");
+    synth::SceneSpec spec = synth::Preset("static", seed_);
+    synth::ResizeCameras(spec, 640, 480);
+    spec.num_frames = 2;
+    spec.cameras.resize(2);
+    synth::WriteScene(spec, (dir_ / "scene").string());
+    StartServer({});
+  }
+
+  void StartServer(StudioOptions o) {
+    server_.reset();
+    o.root = dir_.string();
+    o.port = 0;
+    if (o.assets.empty()) o.assets = (dir_.parent_path() / "no-assets").string();
+    server_ = std::make_unique<StudioServer>(o);
+    port_ = server_->Start();
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
+    client_->set_read_timeout(30);
+  }
+
+  struct Reply {
+    int status = 0;
+    std::string body;
+    json j() const { return json::parse(body); }
+  };
+  Reply Get(const std::string& path, const httplib::Headers& headers = {}) {
+    auto r = client_->Get(path.c_str(), headers);
+    if (!r) return {-1, ""};
+    return {r->status, r->body};
+  }
+  Reply Post(const std::string& path, const std::string& body) {
+    auto r = client_->Post(path.c_str(), body, "application/json");
+    if (!r) return {-1, ""};
+    return {r->status, r->body};
+  }
+  Reply Post(const std::string& path, const json& body) { return Post(path, body.dump()); }
+
+  // A 4xx reply whose body is {"error": one line}.
+  static void ExpectError(const Reply& r, int status, const std::string& words) {
+    EXPECT_EQ(r.status, status) << r.body;
+    json j;
+    ASSERT_NO_THROW(j = json::parse(r.body)) << r.body;
+    ASSERT_TRUE(j.contains("error")) << r.body;
+    const std::string e = j["error"];
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    EXPECT_NE(e.find(words), std::string::npos) << e;
+  }
+
+  // The truth camera's projections of the field keypoints it sees.
+  json TruthKeypoints() {
+    const Reply r = Post("/api/calibrate/project",
+                         json{{"camera", "scene/cam1.yaml"}, {"field", "robocup-msl"}});
+    EXPECT_EQ(r.status, 200) << r.body;
+    return r.j()["keypoints_px"];
+  }
+
+  // The ball's truth in cam1 at frame 0 (truth_2d.csv).
+  Eigen::Vector3d BallTruth() {
+    const CsvTable t = CsvTable::Read((dir_ / "scene/truth_2d.csv").string());
+    for (size_t i = 0; i < t.rows(); ++i) {
+      if (t.GetInt(i, "frame") == 0 && t.Get(i, "cam") == "cam1") {
+        return {t.GetDouble(i, "u_px"), t.GetDouble(i, "v_px"), t.GetDouble(i, "radius_px")};
+      }
+    }
+    ADD_FAILURE() << "no ball truth for cam1";
+    return Eigen::Vector3d::Zero();
+  }
+
+  uint64_t seed_ = fv::testing::TestSeed(1);
+  fs::path dir_;
+  std::unique_ptr<StudioServer> server_;
+  std::unique_ptr<httplib::Client> client_;
+  int port_ = 0;
+};
+
+TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
+  FV_SEED_TRACE(seed_);
+  const Reply info = Get("/api/info");
+  ASSERT_EQ(info.status, 200);
+  EXPECT_EQ(info.j()["root"], fs::canonical(dir_).string());
+  EXPECT_NE(info.body.find("robocup-msl"), std::string::npos);
+  const Reply endpoints = Get("/api/endpoints");
+  ASSERT_EQ(endpoints.status, 200);
+  EXPECT_EQ(endpoints.j().size(), StudioApi::Endpoints().size());
+  const Reply files = Get("/api/files");
+  ASSERT_EQ(files.status, 200);
+  std::map<std::string, std::string> kinds;
+  for (const auto& f : files.j()) kinds[f["path"]] = f["kind"];
+  EXPECT_EQ(kinds["scene/cam1.yaml"], "camera");
+  EXPECT_EQ(kinds["scene/cam1.avi"], "video");
+  EXPECT_EQ(kinds["scene/truth.csv"], "csv");
+  ExpectError(Get("/api/nothing"), 404, "unknown endpoint");
+  ExpectError(Post("/api/info", json::object()), 405, "not allowed");
+}
+
+TEST_F(StudioApiTest, FieldVideoFrameAndCamera) {
+  FV_SEED_TRACE(seed_);
+  const Reply field = Get("/api/field?name=robocup-msl");
+  ASSERT_EQ(field.status, 200);
+  EXPECT_DOUBLE_EQ(field.j()["length_m"].get<double>(), 18.0);
+  ExpectError(Get("/api/field?name=rugby"), 404, "unknown field");
+  ExpectError(Get("/api/field"), 400, "missing query parameter 'name'");
+
+  const Reply video = Get("/api/video?path=scene/cam1.avi");
+  ASSERT_EQ(video.status, 200) << video.body;
+  EXPECT_EQ(video.j()["width"], 640);
+  EXPECT_EQ(video.j()["frames"], 2);
+
+  auto frame = client_->Get("/api/frame?path=scene/cam1.avi&frame=1");
+  ASSERT_TRUE(frame);
+  ASSERT_EQ(frame->status, 200);
+  EXPECT_EQ(frame->get_header_value("Content-Type"), "image/png");
+  const std::vector<uchar> png(frame->body.begin(), frame->body.end());
+  const cv::Mat image = cv::imdecode(png, cv::IMREAD_COLOR);
+  EXPECT_EQ(image.cols, 640);
+  EXPECT_EQ(image.rows, 480);
+  ExpectError(Get("/api/frame?path=scene/cam1.avi&frame=5"), 422, "frame 5 does not exist");
+  ExpectError(Get("/api/frame?path=scene/cam1.avi&frame=x"), 400, "not an integer");
+  ExpectError(Get("/api/frame?path=scene/none.avi"), 404, "does not exist");
+
+  const Reply cam = Get("/api/camera?path=scene/cam1.yaml");
+  ASSERT_EQ(cam.status, 200);
+  const Camera truth = ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
+  EXPECT_TRUE(cam.j()["has_pose"].get<bool>());
+  EXPECT_NEAR(cam.j()["position_m"][0].get<double>(), truth.CentreInWorld().x(), 1e-9);
+  ExpectError(Get("/api/camera?path=scene/truth.csv"), 422, "truth.csv");
+}
+
+TEST_F(StudioApiTest, PathsOutsideTheFolderAreRefused) {
+  FV_SEED_TRACE(seed_);
+  std::ofstream(dir_.parent_path() / "secret.yaml") << "x: 1\n";
+  ExpectError(Get("/api/camera?path=../secret.yaml"), 403, "outside the studio folder");
+  ExpectError(Get("/api/camera?path=" + (dir_.parent_path() / "secret.yaml").string()), 403,
+              "outside");
+  ExpectError(Get("/api/json?path=/etc/hostname"), 403, "outside");
+  ExpectError(Get("/api/frame?path=../../x/%2505d.png"), 403, "outside");
+  fs::create_directory_symlink(dir_.parent_path(), dir_ / "link");
+  ExpectError(Get("/api/camera?path=link/secret.yaml"), 403, "outside");
+  // Writing outside: refused, nothing written.
+  const json keypoints = TruthKeypoints();
+  json points = json::array();
+  for (const auto& k : keypoints) points.push_back(k);
+  ExpectError(Post("/api/calibrate/save", json{{"camera", "scene/cam1.yaml"},
+                                               {"field", "robocup-msl"},
+                                               {"points", points},
+                                               {"out", "../escaped.yaml"}}),
+              403, "outside");
+  EXPECT_FALSE(fs::exists(dir_.parent_path() / "escaped.yaml"));
+  ExpectError(
+      Post("/api/colour/save", json{{"range", {{"min", {0, 0, 0}}, {"max", {30, 255, 255}}}},
+                                    {"out", "/tmp/fv-studio-escaped.json"}}),
+      403, "outside");
+  EXPECT_FALSE(fs::exists("/tmp/fv-studio-escaped.json"));
+  ExpectError(
+      Post("/api/colour/save", json{{"range", {{"min", {0, 0, 0}}, {"max", {30, 255, 255}}}},
+                                    {"out", "nofolder/c.json"}}),
+      404, "does not exist");
+}
+
+TEST_F(StudioApiTest, MalformedRequests) {
+  FV_SEED_TRACE(seed_);
+  ExpectError(Post("/api/calibrate/pose", std::string("{not json")), 400, "malformed JSON");
+  ExpectError(Post("/api/calibrate/pose", std::string("")), 400, "empty");
+  ExpectError(Post("/api/calibrate/pose", std::string("[1, 2]")), 400, "not a JSON object");
+  ExpectError(Post("/api/calibrate/pose", json{{"camera", 3}}), 400, "wrong type");
+  ExpectError(
+      Post("/api/calibrate/pose", json{{"camera", "scene/cam1.yaml"}, {"field", "robocup-msl"}}),
+      400, "points");
+  ExpectError(
+      Post("/api/calibrate/pose", json{{"camera", "scene/cam1.yaml"},
+                                       {"field", "robocup-msl"},
+                                       {"points", {{{"name", "nowhere"}, {"u", 1}, {"v", 2}}}}}),
+      400, "not a keypoint");
+  ExpectError(Post("/api/colour/learn", json{{"video", "scene/cam1.avi"}}), 400, "points");
+  ExpectError(
+      Post("/api/colour/detect", json{{"video", "scene/cam1.avi"}, {"frames", json::array()}}), 400,
+      "frames");
+  ExpectError(Post("/api/colour/save", json{{"range", {{"min", {0, 0}}}}, {"out", "c.json"}}), 400,
+              "range");
+}
+
+TEST_F(StudioApiTest, PoseFromClickedKeypoints) {
+  FV_SEED_TRACE(seed_);
+  const json keypoints = TruthKeypoints();
+  ASSERT_GE(keypoints.size(), 6u);
+  json points = json::array();
+  for (size_t i = 0; i < 3; ++i) points.push_back(keypoints[i]);
+  json body = {{"camera", "scene/cam1.yaml"}, {"field", "robocup-msl"}, {"points", points}};
+  ExpectError(Post("/api/calibrate/pose", body), 422, "");  // too few points: the library says
+  for (size_t i = 3; i < keypoints.size(); ++i) points.push_back(keypoints[i]);
+  body["points"] = points;
+  const Reply pose = Post("/api/calibrate/pose", body);
+  ASSERT_EQ(pose.status, 200) << pose.body;
+  const Camera truth = ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
+  const json j = pose.j();
+  const Eigen::Vector3d position(j["camera_position_m"][0], j["camera_position_m"][1],
+                                 j["camera_position_m"][2]);
+  EXPECT_LT((position - truth.CentreInWorld()).norm(), 0.005);
+  EXPECT_LT(j["rms_px"].get<double>(), 0.01);
+  EXPECT_EQ(j["points"].size(), points.size());
+  EXPECT_FALSE(j["lines_px"].empty());
+
+  body["out"] = "scene/cam1_studio.yaml";
+  body["points_out"] = "scene/cam1_points.csv";
+  const Reply saved = Post("/api/calibrate/save", body);
+  ASSERT_EQ(saved.status, 200) << saved.body;
+  const Camera written = ReadCameraYaml((dir_ / "scene/cam1_studio.yaml").string());
+  EXPECT_LT((written.CentreInWorld() - truth.CentreInWorld()).norm(), 0.005);
+  EXPECT_EQ(CsvTable::Read((dir_ / "scene/cam1_points.csv").string()).rows(), points.size());
+}
+
+TEST_F(StudioApiTest, BallColourLearnSaveDetect) {
+  FV_SEED_TRACE(seed_);
+  const Eigen::Vector3d ball = BallTruth();
+  ASSERT_GT(ball.z(), 2.5) << "ball too small in the test scene";
+  const double r = 0.5 * ball.z();
+  json points = {{ball.x(), ball.y()},
+                 {ball.x() + r, ball.y()},
+                 {ball.x() - r, ball.y()},
+                 {ball.x(), ball.y() + r},
+                 {ball.x(), ball.y() - r}};
+  const Reply learned = Post("/api/colour/learn",
+                             json{{"video", "scene/cam1.avi"}, {"frame", 0}, {"points", points}});
+  ASSERT_EQ(learned.status, 200) << learned.body;
+  EXPECT_GT(learned.j()["recall"].get<double>(), 0.8);
+  const json range = learned.j()["range"];
+
+  const Reply saved = Post("/api/colour/save", json{{"range", range}, {"out", "ball.json"}});
+  ASSERT_EQ(saved.status, 200) << saved.body;
+  EXPECT_NO_THROW(ReadColourSpec((dir_ / "ball.json").string()));
+
+  const Reply det = Post("/api/colour/detect", json{{"video", "scene/cam1.avi"},
+                                                    {"frames", {0, 1}},
+                                                    {"colour", "ball.json"},
+                                                    {"camera", "scene/cam1.yaml"}});
+  ASSERT_EQ(det.status, 200) << det.body;
+  const json f0 = det.j()["frames"][0];
+  ASSERT_FALSE(f0["candidates"].empty()) << det.body;
+  const json best = f0["candidates"][0];
+  EXPECT_TRUE(best["accepted"].get<bool>()) << best.dump();
+  EXPECT_LT(std::hypot(best["u"].get<double>() - ball.x(), best["v"].get<double>() - ball.y()),
+            1.5);
+  ExpectError(
+      Post("/api/colour/detect", json{{"video", "scene/cam1.avi"}, {"colour", "missing.json"}}),
+      404, "missing.json");
+}
+
+TEST_F(StudioApiTest, BallTracksFlightsAndPlayers) {
+  FV_SEED_TRACE(seed_);
+  std::ofstream(dir_ / "BALL.csv") << "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n"
+                                      "0,0,1,2,0.11,2,0.5\n1,0.02,1.1,2,0.3,3,0.4\n";
+  const Reply ball = Get("/api/ball?path=BALL.csv");
+  ASSERT_EQ(ball.status, 200) << ball.body;
+  ASSERT_EQ(ball.j()["samples"].size(), 2u);
+  EXPECT_DOUBLE_EQ(ball.j()["samples"][1][2].get<double>(), 1.1);
+  ExpectError(Get("/api/ball?path=scene/cam1.yaml"), 422, "cam1.yaml");
+
+  const Reply flights = Get("/api/json?path=scene/flights.json");
+  ASSERT_EQ(flights.status, 200) << flights.body;
+  std::ofstream(dir_ / "bad.json") << "{oops";
+  ExpectError(Get("/api/json?path=bad.json"), 422, "not valid JSON");
+
+  std::ofstream(dir_ / "TRACKS.csv")
+      << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n"
+         "1,7,10,20,30,60,0.9,1.5,-2,0\n2,7,11,20,30,60,0.9,,,0.04\n";
+  const Reply tracks = Get("/api/tracks?path=TRACKS.csv");
+  ASSERT_EQ(tracks.status, 200) << tracks.body;
+  const json rows = tracks.j()["rows"];
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0][1], 7);
+  EXPECT_DOUBLE_EQ(rows[0][6].get<double>(), 1.5);
+  EXPECT_TRUE(rows[1][6].is_null());
+  ExpectError(Get("/api/tracks?path=scene/truth.csv"), 422, "truth.csv");
+}
+
+TEST_F(StudioApiTest, EventsStreamTellsOfSavedFiles) {
+  FV_SEED_TRACE(seed_);
+  std::string received;
+  std::atomic<bool> hello{false}, saw_saved{false};
+  httplib::Client stream("127.0.0.1", port_);
+  stream.set_read_timeout(20);
+  std::thread reader([&] {
+    stream.Get("/api/events", [&](const char* data, size_t n) {
+      received.append(data, n);
+      if (received.find("event: hello") != std::string::npos) hello = true;
+      if (received.find("event: saved") != std::string::npos) {
+        saw_saved = true;
+        return false;
+      }
+      return true;
+    });
+  });
+  // Save once the stream has said hello (events before it are not sent to it).
+  for (int i = 0; i < 1000 && !hello; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_TRUE(hello) << "no hello on the event stream";
+  const Reply saved =
+      Post("/api/colour/save",
+           json{{"range", {{"min", {0, 50, 50}}, {"max", {30, 255, 255}}}}, {"out", "c.json"}});
+  ASSERT_EQ(saved.status, 200) << saved.body;
+  reader.join();
+  EXPECT_TRUE(saw_saved);
+  EXPECT_NE(received.find("event: hello"), std::string::npos) << received;
+  EXPECT_NE(received.find("\"path\":\"c.json\""), std::string::npos) << received;
+}
+
+TEST_F(StudioApiTest, TokenRequiredOffLoopback) {
+  FV_SEED_TRACE(seed_);
+  EXPECT_TRUE(IsLoopback("127.0.0.1"));
+  EXPECT_TRUE(IsLoopback("localhost"));
+  EXPECT_FALSE(IsLoopback("0.0.0.0"));
+  EXPECT_FALSE(server_->token_required());
+  StudioOptions o;
+  o.host = "0.0.0.0";
+  o.token = "abc123";
+  StartServer(o);
+  ASSERT_TRUE(server_->token_required());
+  EXPECT_NE(server_->Url().find("?token=abc123"), std::string::npos);
+  ExpectError(Get("/api/info"), 401, "token");
+  ExpectError(Get("/api/events"), 401, "token");
+  ExpectError(Get("/api/info?token=wrong"), 401, "token");
+  EXPECT_EQ(Get("/api/info?token=abc123").status, 200);
+  EXPECT_EQ(Get("/api/info", {{"X-Studio-Token", "abc123"}}).status, 200);
+  o.token = "bad token";
+  EXPECT_THROW(StudioServer{o}, fv::Error);
+}
+
+TEST_F(StudioApiTest, PageSaysWhenTheFrontEndIsNotBuilt) {
+  FV_SEED_TRACE(seed_);
+  const Reply missing = Get("/");
+  ASSERT_EQ(missing.status, 200);
+  EXPECT_NE(missing.body.find("not built"), std::string::npos);
+  const fs::path assets = dir_.parent_path() / "assets";
+  fs::create_directories(assets);
+  std::ofstream(assets / "index.html") << "<html>studio page</html>";
+  StudioOptions o;
+  o.assets = assets.string();
+  StartServer(o);
+  EXPECT_TRUE(server_->assets_built());
+  const Reply page = Get("/");
+  ASSERT_EQ(page.status, 200);
+  EXPECT_NE(page.body.find("studio page"), std::string::npos);
+  StudioOptions taken;
+  taken.port = port_;
+  taken.root = dir_.string();
+  StudioServer second(taken);
+  EXPECT_THROW(second.Start(), fv::Error);
+}
+
+}  // namespace
+}  // namespace fv::web

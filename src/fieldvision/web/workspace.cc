@@ -1,0 +1,128 @@
+#include "fieldvision/web/workspace.h"
+
+#include <algorithm>
+#include <map>
+#include <regex>
+#include <system_error>
+
+namespace fv::web {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool Inside(const fs::path& root, const fs::path& p) {
+  const fs::path rel = p.lexically_relative(root);
+  if (rel.empty()) return false;
+  if (rel == ".") return true;
+  return *rel.begin() != "..";
+}
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+}  // namespace
+
+std::string FileKind(const fs::path& path) {
+  const std::string ext = Lower(path.extension().string());
+  if (ext == ".avi" || ext == ".mp4" || ext == ".mkv" || ext == ".mov" || ext == ".webm") {
+    return "video";
+  }
+  if (path.string().find('%') != std::string::npos) return "images";
+  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp") return "image";
+  if (ext == ".yaml" || ext == ".yml") return "camera";
+  if (ext == ".csv" || ext == ".txt") return "csv";
+  if (ext == ".json") return "json";
+  return "other";
+}
+
+Workspace::Workspace(const fs::path& root) {
+  std::error_code ec;
+  root_ = fs::canonical(root, ec);
+  FV_REQUIRE(!ec && fs::is_directory(root_), "studio folder '{}' is not a folder", root.string());
+}
+
+fs::path Workspace::Resolve(const std::string& path, bool must_exist) const {
+  if (path.empty()) throw HttpError(400, "no path given");
+  if (path.find('\0') != std::string::npos || path.find('\n') != std::string::npos) {
+    throw HttpError(400, "path has control characters");
+  }
+  fs::path p(path);
+  if (p.is_relative()) p = root_ / p;
+  std::error_code ec;
+  fs::path c = fs::weakly_canonical(p, ec);
+  if (ec) throw HttpError(400, "path '" + path + "' cannot be resolved");
+  if (!Inside(root_, c)) throw HttpError(403, "path '" + path + "' is outside the studio folder");
+  const bool pattern = c.filename().string().find('%') != std::string::npos;
+  if (must_exist) {
+    if (pattern) {
+      if (!fs::is_directory(c.parent_path())) {
+        throw HttpError(404, "folder of '" + path + "' does not exist");
+      }
+    } else if (!fs::exists(c)) {
+      throw HttpError(404, "file '" + path + "' does not exist");
+    }
+  }
+  return c;
+}
+
+fs::path Workspace::ResolveOutput(const std::string& path) const {
+  fs::path c = Resolve(path, false);
+  if (c == root_) throw HttpError(400, "output path '" + path + "' is the studio folder");
+  if (!fs::is_directory(c.parent_path())) {
+    throw HttpError(404, "folder of output '" + path + "' does not exist");
+  }
+  if (fs::is_directory(c)) throw HttpError(400, "output '" + path + "' is a folder");
+  return c;
+}
+
+std::string Workspace::Relative(const fs::path& absolute) const {
+  return absolute.lexically_relative(root_).generic_string();
+}
+
+nlohmann::json Workspace::ListFiles(size_t max_files) const {
+  nlohmann::json files = nlohmann::json::array();
+  // Folders whose files are numbered images: listed as one pattern.
+  static const std::regex kNumbered(R"(^(\d+)\.(png|jpg|jpeg|bmp)$)", std::regex::icase);
+  std::map<fs::path, std::pair<std::string, size_t>> sequences;  // folder -> (pattern, count)
+  std::vector<fs::path> paths;
+  std::error_code ec;
+  fs::recursive_directory_iterator it(root_, fs::directory_options::skip_permission_denied, ec);
+  for (; !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    const fs::path& p = it->path();
+    const std::string name = p.filename().string();
+    if (it->is_directory(ec)) {
+      if (name.empty() || name[0] == '.' || name == "node_modules" || name.rfind("build", 0) == 0) {
+        it.disable_recursion_pending();
+      }
+      continue;
+    }
+    if (!it->is_regular_file(ec)) continue;
+    std::smatch m;
+    if (std::regex_match(name, m, kNumbered)) {
+      auto& s = sequences[p.parent_path()];
+      if (s.first.empty()) {
+        s.first = "%0" + std::to_string(m[1].length()) + "d." + m[2].str();
+      }
+      ++s.second;
+      continue;
+    }
+    paths.push_back(p);
+    if (paths.size() >= max_files) break;
+  }
+  std::sort(paths.begin(), paths.end());
+  for (const auto& [folder, s] : sequences) {
+    if (s.second < 2) continue;
+    files.push_back({{"path", Relative(folder / s.first)}, {"size", s.second}, {"kind", "images"}});
+  }
+  for (const auto& p : paths) {
+    std::error_code size_ec;
+    const auto size = fs::file_size(p, size_ec);
+    files.push_back({{"path", Relative(p)}, {"size", size_ec ? 0 : size}, {"kind", FileKind(p)}});
+  }
+  return files;
+}
+
+}  // namespace fv::web

@@ -1,0 +1,193 @@
+// Browser tests of the studio: playwright-core drives Debian's chromium (never a downloaded
+// browser) against `fieldvision studio` serving a synthetic scene (tests/run.sh sets it up).
+//   calibrate: click the field keypoints at their true pixels -> saved pose within 2 cm of truth
+//   ball colour: click on the ball -> saved colour file; the detector (API and CLI) finds the ball
+//   3D view: a ball result renders (canvas not blank, every camera listed); 10,000-point benchmark
+//   players: the tactical board plays
+// Usage: node browser.mjs URL OUT_DIR FIELDVISION
+import { chromium } from 'playwright-core';
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+
+const [url, out, fv] = process.argv.slice(2);
+const work = path.join(out, 'work');
+const failures = [];
+function check(ok, what) {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  if (!ok) failures.push(what);
+}
+async function api(p, body) {
+  const res = await fetch(new URL(p, url), body ? { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(body) } : {});
+  if (!res.ok) throw new Error(`${p}: ${res.status} ${await res.text()}`);
+  return res.json();
+}
+function readCsv(file) {
+  const [head, ...rows] = fs.readFileSync(file, 'utf8').trim().split('\n');
+  const cols = head.split(',');
+  return rows.map((r) => Object.fromEntries(r.split(',').map((v, i) => [cols[i], v])));
+}
+
+const userDir = fs.mkdtempSync(path.join(os.tmpdir(), 'fv-studio-chromium-'));
+const context = await chromium.launchPersistentContext(userDir, {
+  executablePath: process.env.FV_CHROMIUM || '/usr/bin/chromium',
+  headless: true,
+  viewport: { width: 1400, height: 1000 },
+  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking', '--disable-component-update',
+    '--disable-sync', '--no-first-run'],
+});
+const page = context.pages()[0] ?? (await context.newPage());
+const consoleErrors = [];
+page.on('pageerror', (e) => consoleErrors.push(String(e)));
+page.on('console', (m) => m.type() === 'error' && !/Failed to load resource/.test(m.text()) && consoleErrors.push(m.text()));
+// Replies with 4xx/5xx that the pages did not ask for on purpose.
+// (A pose request with too few or collinear points is answered 422 and shown on the page.)
+page.on('response', (r) => r.status() >= 400 && !(r.status() === 422 && r.url().includes('/api/calibrate/pose')) &&
+  consoleErrors.push(`${r.status()} ${r.url()}`));
+page.setDefaultTimeout(20000);
+
+// Clicks image pixel (u, v) (OpenCV convention) on a canvas showing the image scaled.
+async function clickPixel(canvas, u, v) {
+  const box = await canvas.boundingBox();
+  const size = await canvas.evaluate((c) => [c.width, c.height]);
+  const x = box.x + ((u + 0.5) * box.width) / size[0];
+  const y = box.y + ((v + 0.5) * box.height) / size[1];
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  await page.mouse.up();
+}
+
+try {
+  // ---- first load of the app (the browser itself warmed up on a blank page first)
+  await page.goto('about:blank');
+  const t0 = Date.now();
+  await page.goto(url + '#calibrate', { waitUntil: 'load' });
+  const loadMs = await page.evaluate(() => performance.getEntriesByType('navigation')[0].loadEventEnd);
+  await page.waitForSelector('#page[data-ready="1"]');
+  console.log(`first page load: ${loadMs.toFixed(0)} ms to the load event (navigation timing), page ready after ${Date.now() - t0} ms`);
+  const resources = await page.evaluate(() => performance.getEntriesByType('resource').map((e) => `${e.name.replace(/^.*\//, '')} ${e.startTime.toFixed(0)}+${e.duration.toFixed(0)} ms`));
+  console.log(`  resources: ${resources.join(', ')}`);
+  check(loadMs < 1000, `first page load under 1 s on loopback (${loadMs.toFixed(0)} ms)`);
+
+  // ---- calibrate
+  await page.selectOption('#cal-video', 'scene/cam1.avi');
+  await page.selectOption('#cal-camera', 'scene/cam1.yaml');
+  await page.fill('#cal-out', 'scene/cam1_studio.yaml');
+  await page.click('#cal-load');
+  await page.waitForSelector('#cal-image[data-ready="1"]');
+  const truthCam = await api('/api/camera?path=scene/cam1.yaml');
+  const projected = await api('/api/calibrate/project', { camera: 'scene/cam1.yaml', field: 'robocup-msl' });
+  const canvas = page.locator('#cal-image');
+  const kps = projected.keypoints_px.filter((k) => k.u > 5 && k.v > 5 && k.u < truthCam.width - 5 && k.v < truthCam.height - 5);
+  check(kps.length >= 6, `cam1 sees ${kps.length} field keypoints`);
+  for (const k of kps) {
+    await page.click(`[data-keypoint="${k.name}"]`);
+    await clickPixel(canvas, k.u, k.v);
+  }
+  await page.waitForFunction((n) => document.querySelectorAll('#cal-points tr').length === n + 1, kps.length);
+  await page.click('#cal-save');
+  await page.waitForFunction(() => /wrote/.test(document.querySelector('#cal-status').textContent));
+  await page.screenshot({ path: path.join(out, 'calibrate.png') });
+  const saved = await api('/api/camera?path=scene/cam1_studio.yaml');
+  const d = Math.hypot(...saved.position_m.map((v, i) => v - truthCam.position_m[i]));
+  console.log(`calibrate: ${kps.length} keypoints clicked; camera position error ${(100 * d).toFixed(2)} cm (${(await page.textContent('#cal-rms'))})`);
+  check(d < 0.02, `pose from clicks within 2 cm of the truth (${(100 * d).toFixed(2)} cm)`);
+
+  // ---- ball colour
+  await page.goto(url + '#colour');
+  await page.waitForSelector('#page[data-ready="1"]');
+  await page.selectOption('#col-video', 'scene/cam1.avi');
+  const truth2d = readCsv(path.join(work, 'scene/truth_2d.csv')).filter((r) => r.cam === 'cam1');
+  const f0 = truth2d.find((r) => Number(r.visible_fraction) > 0.9 && Number(r.radius_px) > 4);
+  check(!!f0, 'the ball is visible in a frame of cam1');
+  await page.fill('#col-frame', f0.frame);
+  await page.click('#col-load');
+  await page.waitForSelector('#col-image[data-ready="1"]');
+  const [bu, bv, br] = [Number(f0.u_px), Number(f0.v_px), Number(f0.radius_px)];
+  const colourCanvas = page.locator('#col-image');
+  for (const [du, dv] of [[0, 0], [0.5, 0], [-0.5, 0], [0, 0.5], [0, -0.5]]) {
+    await clickPixel(colourCanvas, bu + du * br, bv + dv * br);
+    await page.waitForFunction(() => /learned/.test(document.querySelector('#col-status').textContent));
+  }
+  const selected = Number(await page.getAttribute('#col-count', 'data-selected'));
+  check(selected > 0 && selected < 20 * Math.PI * br * br, `selected pixels shown (${selected} px; ball disc ${(Math.PI * br * br).toFixed(0)} px)`);
+  await page.fill('#col-out', 'ball_colour.json');
+  await page.click('#col-save');
+  await page.waitForFunction(() => /wrote/.test(document.querySelector('#col-status').textContent));
+  const frames = truth2d.filter((r) => Number(r.visible_fraction) > 0.9 && Number(r.radius_px) > 3).filter((_, i) => i % 8 === 0).slice(0, 4);
+  await page.fill('#col-detect-frames', frames.map((r) => r.frame).join(','));
+  await page.click('#col-detect');
+  await page.waitForSelector('#col-detect-result tr[data-frame]');
+  await page.screenshot({ path: path.join(out, 'colour.png') });
+  for (const r of frames) {
+    const best = await page.getAttribute(`#col-detect-result tr[data-frame="${r.frame}"]`, 'data-best');
+    const e = best ? Math.hypot(JSON.parse(best)[0] - r.u_px, JSON.parse(best)[1] - r.v_px) : Infinity;
+    check(e < 2, `studio detect with the saved colour finds the ball in frame ${r.frame} (${e.toFixed(2)} px off)`);
+  }
+  // The saved file works with the command-line detector too.
+  execFileSync(fv, ['detect', '--camera', 'scene/cam1.yaml', '--video', 'scene/cam1.avi', '--color', 'ball_colour.json',
+    '--out', 'det.csv', '--no-progress'], { cwd: work, stdio: 'pipe' });
+  const det = readCsv(path.join(work, 'det.csv')).filter((r) => r.accepted === '1' || r.accepted === 'true');
+  const hits = truth2d.filter((t) => Number(t.visible_fraction) > 0.9 && Number(t.radius_px) > 3)
+    .filter((t) => det.some((r) => r.frame === t.frame && Math.hypot(r.u - t.u_px, r.v - t.v_px) < 2));
+  const visible = truth2d.filter((t) => Number(t.visible_fraction) > 0.9 && Number(t.radius_px) > 3).length;
+  check(hits.length >= 0.9 * visible, `fieldvision detect --color ball_colour.json finds the ball in ${hits.length}/${visible} frames`);
+
+  // ---- 3D view
+  await page.goto(url + '#view3d');
+  await page.waitForSelector('#page[data-ready="1"]');
+  await page.selectOption('#v3-ball', 'ball.csv');
+  await page.selectOption('#v3-flights', 'flights.json');
+  await page.click('#v3-load');
+  await page.waitForSelector('#v3-canvas[data-ready="1"]');
+  const files = await api('/api/files');
+  const nCams = files.filter((f) => f.kind === 'camera').length;
+  const listed = await page.locator('#v3-cameras li').count();
+  check(listed === nCams, `3D view lists ${listed} cameras (${nCams} camera files)`);
+  const stats = await page.evaluate(() => {
+    const c = document.querySelector('#v3-canvas');
+    const t = document.createElement('canvas');
+    t.width = c.width;
+    t.height = c.height;
+    const ctx = t.getContext('2d');
+    ctx.drawImage(c, 0, 0);
+    const d = ctx.getImageData(0, 0, t.width, t.height).data;
+    const colours = new Set();
+    let changed = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+      if (Math.abs(d[i] - 0x1d) + Math.abs(d[i + 1] - 0x26) + Math.abs(d[i + 2] - 0x30) > 30) ++changed;
+    }
+    return { colours: colours.size, changed: changed / (d.length / 4) };
+  });
+  check(stats.changed > 0.05 && stats.colours > 20, `3D canvas rendered (${(100 * stats.changed).toFixed(1)} % of pixels off the background, ${stats.colours} colours)`);
+  await page.locator('#v3-time').fill('20');
+  await page.screenshot({ path: path.join(out, 'view3d.png') });
+  await page.click('#v3-bench');
+  await page.waitForSelector('#v3-status[data-fps]', { timeout: 30000 });
+  console.log(`3D benchmark: ${await page.getAttribute('#v3-status', 'data-fps')} frames/s with a 10,000-point track (headless chromium, software GL)`);
+
+  // ---- players
+  await page.goto(url + '#players');
+  await page.waitForSelector('#page[data-ready="1"]');
+  await page.selectOption('#pl-tracks', 'TRACKS.csv');
+  await page.click('#pl-load');
+  await page.waitForSelector('#pl-board[data-frame]');
+  const firstFrame = await page.getAttribute('#pl-board', 'data-frame');
+  await page.click('#pl-play');
+  await page.waitForFunction((f) => document.querySelector('#pl-board').dataset.frame !== f, firstFrame);
+  await page.click('#pl-play');
+  await page.screenshot({ path: path.join(out, 'players.png') });
+  check(true, `tactical board plays (frame ${firstFrame} -> ${await page.getAttribute('#pl-board', 'data-frame')})`);
+  check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
+} catch (e) {
+  failures.push(String(e));
+  console.log(`FAIL ${e}`);
+  await page.screenshot({ path: path.join(out, 'failure.png') }).catch(() => {});
+} finally {
+  await context.close();
+  fs.rmSync(userDir, { recursive: true, force: true });
+}
+console.log(failures.length ? `${failures.length} failure(s); screenshots in ${out}` : `all passed; screenshots in ${out}`);
+process.exit(failures.length ? 1 : 0);
