@@ -12,6 +12,7 @@ namespace {
 struct TrajectoryCliOptions {
   TrajectoryJob job;
   std::string drag = "auto";
+  std::string spin = "auto";
 };
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -20,9 +21,13 @@ void Setup(CLI::App& app, int& exit_code) {
   CLI::App* c = app.add_subcommand(
       "trajectory", "Split a ball track into flights and fit them (origin, landing, apex, v0)");
   c->add_option("--in", j.in_path,
-                "BALL.csv (frame,time_s,x_m,y_m,z_m,n_cams,err_px) or a Timestamp,X,Y,Z CSV")
+                "BALL.csv (frame,time_s,x_m,y_m,z_m,n_cams,err_px) or a Timestamp,X,Y,Z CSV; a "
+                "folder or a quoted glob ('dir/*.csv') runs every file (batch mode)")
       ->required();
-  c->add_option("--out", j.out_path, "FLIGHTS.json to write")->required();
+  c->add_option("--out", j.out_path,
+                "FLIGHTS.json to write (batch mode: a folder for NAME.json per track and "
+                "summary.csv)")
+      ->required();
   c->add_option("--ball-diameter", j.ball_diameter_m,
                 "Ball diameter in metres (default 0.22; 0.04 for a Timestamp,X,Y,Z file)")
       ->check(CLI::PositiveNumber);
@@ -33,6 +38,13 @@ void Setup(CLI::App& app, int& exit_code) {
   c->add_option("--drag", o->drag,
                 "Quadratic air drag: auto (used when it lowers the residual by > 10 %), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  c->add_option("--spin", o->spin,
+                "Spin (Magnus lift with drag): auto (used when it lowers the BIC by > 10), on, off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
+  c->add_option("--ball-mass", j.ball_mass_kg,
+                "Ball mass in kg, for the spin in rev/s (default 0.43; 0.0027 for a "
+                "Timestamp,X,Y,Z file)")
+      ->check(CLI::PositiveNumber);
   c->add_option("--noise", j.analysis.noise_m,
                 "Position noise (1 sigma, metres); default: estimated from the track")
       ->check(CLI::NonNegativeNumber);
@@ -55,7 +67,13 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.05, 1.0));
   c->callback([o, &exit_code] {
     o->job.analysis.drag = ParseDragMode(o->drag, "--drag");
-    RunTrajectory(o->job, std::cout);
+    o->job.analysis.spin = ParseDragMode(o->spin, "--spin");
+    const auto files = ExpandTrackInputs(o->job.in_path);
+    if (files.empty()) {
+      RunTrajectory(o->job, std::cout);
+    } else {
+      RunTrajectoryBatch(o->job, files, std::cout);
+    }
     exit_code = 0;
   });
 }

@@ -269,10 +269,44 @@ FieldModel Tennis() {
   return f;
 }
 
+// ITTF table (Handbook, law 2.1): playing surface 2.74 x 1.525 m, 2 cm white edge lines, a 3 mm
+// centre line for doubles, the net 15.25 cm high over the middle, its posts 15.25 cm outside the
+// side lines. The "ground" is the table surface (z = 0), as in the TT3D recordings.
+FieldModel TableTennis() {
+  FieldModel f;
+  f.name = "table-tennis";
+  f.description =
+      "ITTF table-tennis table, 2.74 x 1.525 m playing surface (z = 0 on the table), net 15.25 cm";
+  f.length_m = 2.74;
+  f.width_m = 1.525;
+  f.line_width_m = 0.02;
+  f.surround_m = 1.5;
+  f.surface = "court";
+  Builder b(&f);
+  const double xe = 1.37 - 0.01, ye = 0.7625 - 0.01;  // centrelines of the 2 cm edge lines
+  for (int t : {-1, 1}) {
+    const std::string tn = YName(t);
+    b.Seg("side_line_" + tn, -1.37, t * ye, 1.37, t * ye);
+    b.Kp("net_post_" + tn, 0, t * (0.7625 + 0.1525), 0.1525);
+    b.Kp("net_" + tn, 0, t * 0.7625, 0);
+    b.Kp("net_top_" + tn, 0, t * 0.7625, 0.1525);
+  }
+  b.Kp("net_top_centre", 0, 0, 0.1525);
+  b.Seg("centre_line", -1.37, 0, 1.37, 0, 0.003);
+  for (int side : {-1, 1}) {
+    const std::string sn = SideName(side);
+    b.Seg("end_line_" + sn, side * xe, -0.7625, side * xe, 0.7625);
+    b.Kp("centre_line_end_" + sn, side * 1.37, 0);
+    for (int t : {-1, 1}) b.Kp("corner_" + sn + "_" + YName(t), side * 1.37, t * 0.7625);
+  }
+  f.Check();
+  return f;
+}
+
 }  // namespace
 
 std::vector<std::string> BuiltinFieldNames() {
-  return {"robocup-msl", "fifa", "futsal", "basketball-fiba", "tennis"};
+  return {"robocup-msl", "fifa", "futsal", "basketball-fiba", "tennis", "table-tennis"};
 }
 
 FieldModel BuiltinField(const std::string& name) {
@@ -293,6 +327,7 @@ FieldModel BuiltinField(const std::string& name) {
   }
   if (name == "basketball-fiba") return Basketball();
   if (name == "tennis") return Tennis();
+  if (name == "table-tennis") return TableTennis();
   std::string list;
   for (const auto& n : BuiltinFieldNames()) list += (list.empty() ? "" : ", ") + n;
   Throw("unknown field '{}': give a JSON file or one of {}", name, list);

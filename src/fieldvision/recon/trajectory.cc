@@ -9,58 +9,36 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/util/error.h"
 
 namespace fv {
 namespace {
 
-constexpr double kMaxStepS = 0.002;  // RK4 step for the drag model
+// The model's Magnus vector s = c_M w.
+Eigen::Vector3d MagnusVector(const BallisticModel& m) { return m.magnus_per_rad * m.spin_radps; }
 
-// a = -g z - k |v| v
-template <typename T>
-void Accel(const T v[3], const T& k, double g, T a[3]) {
-  using std::sqrt;
-  const T speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + T(1e-12));
-  for (int i = 0; i < 3; ++i) a[i] = -k * speed * v[i];
-  a[2] -= T(g);
+// One RK4 step of a model's state (any model).
+void StepModel(const BallisticModel& m, Eigen::Vector3d* p, Eigen::Vector3d* v, double dt) {
+  const Eigen::Vector3d sv = MagnusVector(m);
+  double pa[3] = {p->x(), p->y(), p->z()}, va[3] = {v->x(), v->y(), v->z()};
+  const double sa[3] = {sv.x(), sv.y(), sv.z()};
+  PropagateFlight(pa, va, m.drag_per_m, sa, m.gravity_mps2, dt);
+  *p = {pa[0], pa[1], pa[2]};
+  *v = {va[0], va[1], va[2]};
 }
 
-template <typename T>
-void Rk4Step(T p[3], T v[3], const T& k, double g, double h) {
-  T a1[3], a2[3], a3[3], a4[3], vt[3];
-  Accel(v, k, g, a1);
-  for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a1[i];
-  Accel(vt, k, g, a2);
-  T v2[3] = {vt[0], vt[1], vt[2]};
-  for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a2[i];
-  Accel(vt, k, g, a3);
-  T v3[3] = {vt[0], vt[1], vt[2]};
-  for (int i = 0; i < 3; ++i) vt[i] = v[i] + h * a3[i];
-  Accel(vt, k, g, a4);
-  for (int i = 0; i < 3; ++i) {
-    p[i] = p[i] + h / 6.0 * (v[i] + 2.0 * v2[i] + 2.0 * v3[i] + vt[i]);
-    v[i] = v[i] + h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i]);
-  }
-}
-
-// Propagates (p, v) by dt seconds (either sign).
-template <typename T>
-void Propagate(T p[3], T v[3], const T& k, double g, double dt) {
-  const int n = std::max(1, static_cast<int>(std::ceil(std::abs(dt) / kMaxStepS)));
-  const double h = dt / n;
-  for (int s = 0; s < n; ++s) Rk4Step(p, v, k, g, h);
-}
-
-// Residual of one sample against the model with parameters p0 (3), v0 (3), k (1) at t0.
+// Residual of one sample against the model with parameters p0 (3), v0 (3), k (1) and the Magnus
+// vector s (3) at t0.
 struct SampleResidual {
-  SampleResidual(const Eigen::Vector3d& x, double dt, double g, bool drag)
-      : x_(x), dt_(dt), g_(g), drag_(drag) {}
+  SampleResidual(const Eigen::Vector3d& x, double dt, double g, bool integrate)
+      : x_(x), dt_(dt), g_(g), integrate_(integrate) {}
   template <typename T>
-  bool operator()(const T* p0, const T* v0, const T* k, T* r) const {
+  bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
     T p[3] = {p0[0], p0[1], p0[2]};
     T v[3] = {v0[0], v0[1], v0[2]};
-    if (drag_) {
-      Propagate(p, v, k[0], g_, dt_);
+    if (integrate_) {
+      PropagateFlight(p, v, k[0], sm, g_, dt_);
     } else {
       for (int i = 0; i < 3; ++i) p[i] = p0[i] + v0[i] * dt_;
       p[2] -= T(0.5 * g_ * dt_ * dt_);
@@ -70,7 +48,25 @@ struct SampleResidual {
   }
   Eigen::Vector3d x_;
   double dt_, g_;
-  bool drag_;
+  bool integrate_;
+};
+
+// Zero-mean prior on the Magnus vector, r = W s with W = w_perp (I - d d^T) + w_along d d^T for
+// the flight direction d: weak across the flight, tighter along it (that spin makes almost no
+// force, so only the prior holds it).
+struct SpinPrior {
+  SpinPrior(const Eigen::Vector3d& dir, double w_perp, double w_along) {
+    W_ = w_perp * (Eigen::Matrix3d::Identity() - dir * dir.transpose()) +
+         w_along * dir * dir.transpose();
+  }
+  template <typename T>
+  bool operator()(const T* sm, T* r) const {
+    for (int i = 0; i < 3; ++i) {
+      r[i] = T(W_(i, 0)) * sm[0] + T(W_(i, 1)) * sm[1] + T(W_(i, 2)) * sm[2];
+    }
+    return true;
+  }
+  Eigen::Matrix3d W_;
 };
 
 // Least-squares line per axis through gravity-corrected positions q = p + (0, 0, g t^2 / 2)
@@ -162,7 +158,7 @@ std::vector<int> Window(const std::vector<int>& list, const std::vector<BallSamp
 
 void BallisticModel::StateAt(double time_s, Eigen::Vector3d* p_m, Eigen::Vector3d* v_mps) const {
   const double dt = time_s - t0_s;
-  if (drag_per_m == 0.0) {
+  if (Parabola()) {
     Eigen::Vector3d p = p0_m + v0_mps * dt;
     p.z() -= 0.5 * gravity_mps2 * dt * dt;
     Eigen::Vector3d v = v0_mps;
@@ -171,12 +167,13 @@ void BallisticModel::StateAt(double time_s, Eigen::Vector3d* p_m, Eigen::Vector3
     if (v_mps) *v_mps = v;
     return;
   }
-  double p[3] = {p0_m.x(), p0_m.y(), p0_m.z()};
-  double v[3] = {v0_mps.x(), v0_mps.y(), v0_mps.z()};
-  Propagate(p, v, drag_per_m, gravity_mps2, dt);
-  if (p_m) *p_m = Eigen::Vector3d(p[0], p[1], p[2]);
-  if (v_mps) *v_mps = Eigen::Vector3d(v[0], v[1], v[2]);
+  Eigen::Vector3d p = p0_m, v = v0_mps;
+  StepModel(*this, &p, &v, dt);
+  if (p_m) *p_m = p;
+  if (v_mps) *v_mps = v;
 }
+
+double BallisticModel::SpinRevPerS() const { return spin_radps.norm() / (2 * M_PI); }
 
 Eigen::Vector3d BallisticModel::PositionAt(double time_s) const {
   Eigen::Vector3d p;
@@ -196,20 +193,17 @@ std::optional<double> BallisticModel::CrossingTime(double z_m, double from_s, bo
   // ascending crossing lies before the apex and the descending one after it. Walks in small
   // steps: first to the apex if from_s is on the other side of it, then away from the apex (or
   // back towards it when already below z_m).
-  const double h = (forward ? 1.0 : -1.0) * (drag_per_m == 0.0 ? 0.005 : kMaxStepS);
+  const double h = (forward ? 1.0 : -1.0) * (Parabola() ? 0.005 : kMaxStepS);
   Eigen::Vector3d p, v;
   StateAt(from_s, &p, &v);
   double t = from_s;
   auto step = [&](double dt) {
-    if (drag_per_m == 0.0) {
+    if (Parabola()) {
       p += v * dt;
       p.z() -= 0.5 * gravity_mps2 * dt * dt;
       v.z() -= gravity_mps2 * dt;
     } else {
-      double pa[3] = {p.x(), p.y(), p.z()}, va[3] = {v.x(), v.y(), v.z()};
-      Rk4Step(pa, va, drag_per_m, gravity_mps2, dt);
-      p = {pa[0], pa[1], pa[2]};
-      v = {va[0], va[1], va[2]};
+      StepModel(*this, &p, &v, dt);
     }
     t += dt;
   };
@@ -261,6 +255,21 @@ const char* DragModeName(DragMode m) {
   }
 }
 
+const char* FlightModelName(FlightModel m) {
+  switch (m) {
+    case FlightModel::kGravity:
+      return "gravity";
+    case FlightModel::kDrag:
+      return "drag";
+    default:
+      return "spin";
+  }
+}
+
+double TrajectoryOptions::MagnusPerRad() const {
+  return lift_slope * air_density_kgpm3 * M_PI * std::pow(ball_radius_m, 3) / (2 * ball_mass_kg);
+}
+
 const char* FlightEventName(FlightEvent e) {
   switch (e) {
     case FlightEvent::kBounce:
@@ -295,6 +304,15 @@ void TrajectoryOptions::Check() const {
              min_flight_samples);
   CheckPositive(max_drag_per_m, "max_drag_per_m");
   FV_REQUIRE(max_iterations >= 1, "max_iterations must be >= 1 (got {})", max_iterations);
+  FV_REQUIRE(spin_min_samples >= 10, "spin_min_samples must be >= 10 (got {})", spin_min_samples);
+  CheckNonNegative(spin_min_span_s, "spin_min_span_s");
+  CheckNonNegative(spin_min_bic_gain, "spin_min_bic_gain");
+  CheckPositive(ball_mass_kg, "ball_mass_kg");
+  CheckPositive(air_density_kgpm3, "air_density_kgpm3");
+  CheckPositive(lift_slope, "lift_slope");
+  CheckPositive(spin_prior_revps, "spin_prior_revps");
+  CheckPositive(spin_along_prior_revps, "spin_along_prior_revps");
+  bounce.Check();
 }
 
 double EstimateTrackNoise(const std::vector<BallSample>& track, double g) {
@@ -322,31 +340,68 @@ double EstimateTrackNoise(const std::vector<BallSample>& track, double g) {
 
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
                           const TrajectoryOptions& options, double noise_m) {
+  return FitBallistic(samples, fit_drag ? FlightModel::kDrag : FlightModel::kGravity, options,
+                      noise_m);
+}
+
+BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel kind,
+                          const TrajectoryOptions& options, double noise_m,
+                          const BallisticModel* start) {
   BallisticFit fit;
   const int n = static_cast<int>(samples.size());
   fit.inlier.assign(n, false);
+  fit.parameters = kind == FlightModel::kGravity ? 6 : kind == FlightModel::kDrag ? 7 : 10;
   if (n < 3) return fit;
   const double g = options.gravity_mps2;
   const double t_ref = samples[n / 2].time_s;
-  std::vector<int> all(n);
-  std::iota(all.begin(), all.end(), 0);
-  const GravityLine line = FitGravityLine(samples, all, g, t_ref);
-  double p0[3] = {line.a.x(), line.a.y(), line.a.z()};
-  double v0[3] = {line.b.x(), line.b.y(), line.b.z()};
-  double k[1] = {fit_drag ? 0.01 : 0.0};
+  const double c_m = options.MagnusPerRad();
+  double p0[3], v0[3];
+  double k[1] = {kind != FlightModel::kGravity ? 0.01 : 0.0};
+  double sm[3] = {0, 0, 0};
+  bool warm = false;
+  if (start != nullptr) {
+    Eigen::Vector3d p, v;
+    start->StateAt(t_ref, &p, &v);
+    for (int i = 0; i < 3; ++i) p0[i] = p[i], v0[i] = v[i];
+    if (kind != FlightModel::kGravity)
+      k[0] = std::clamp(start->drag_per_m, 0.0, options.max_drag_per_m);
+    if (kind == FlightModel::kSpin) {
+      const Eigen::Vector3d s0 = MagnusVector(*start);
+      for (int i = 0; i < 3; ++i) sm[i] = s0[i];
+    }
+    warm = true;
+  } else {
+    std::vector<int> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    const GravityLine line = FitGravityLine(samples, all, g, t_ref);
+    for (int i = 0; i < 3; ++i) p0[i] = line.a[i], v0[i] = line.b[i];
+  }
   const double huber = 3.0 * std::max(noise_m, 1e-3);
-  auto solve = [&](bool drag) {
+  auto solve = [&](FlightModel m) {
     ceres::Problem problem;
     for (const auto& s : samples) {
-      auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 3, 3, 1>(
-          new SampleResidual(s.ball_in_world, s.time_s - t_ref, g, drag));
-      problem.AddResidualBlock(cost, new ceres::HuberLoss(huber), p0, v0, k);
+      auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 3, 3, 1, 3>(
+          new SampleResidual(s.ball_in_world, s.time_s - t_ref, g, m != FlightModel::kGravity));
+      problem.AddResidualBlock(cost, new ceres::HuberLoss(huber), p0, v0, k, sm);
     }
-    if (drag) {
+    if (m != FlightModel::kGravity) {
       problem.SetParameterLowerBound(k, 0, 0.0);
       problem.SetParameterUpperBound(k, 0, options.max_drag_per_m);
     } else {
       problem.SetParameterBlockConstant(k);
+    }
+    if (m == FlightModel::kSpin) {
+      // The prior costs as much as one sample off by the noise when each component is at
+      // spin_prior_revps.
+      const double unit = std::max(noise_m, 1e-3) / (c_m * 2 * M_PI);
+      Eigen::Vector3d dir(v0[0], v0[1], v0[2]);
+      dir = dir.norm() > 1e-6 ? Eigen::Vector3d(dir.normalized()) : Eigen::Vector3d::UnitX();
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<SpinPrior, 3, 3>(new SpinPrior(
+              dir, unit / options.spin_prior_revps, unit / options.spin_along_prior_revps)),
+          nullptr, sm);
+    } else {
+      problem.SetParameterBlockConstant(sm);
     }
     ceres::Solver::Options so;
     so.max_num_iterations = options.max_iterations;
@@ -357,17 +412,26 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
     fit.iterations += static_cast<int>(summary.iterations.size());
     return summary.IsSolutionUsable();
   };
-  bool ok = solve(false);
-  if (fit_drag && ok) ok = solve(true);
+  // Cold starts go up the hierarchy (gravity, drag, spin), each from the one before.
+  bool ok = true;
+  if (!warm || kind == FlightModel::kGravity) ok = solve(FlightModel::kGravity);
+  if (ok && kind != FlightModel::kGravity && !(warm && kind == FlightModel::kSpin)) {
+    ok = solve(FlightModel::kDrag);
+  }
+  if (ok && kind == FlightModel::kSpin) ok = solve(FlightModel::kSpin);
   fit.model.t0_s = t_ref;
   fit.model.p0_m = Eigen::Vector3d(p0[0], p0[1], p0[2]);
   fit.model.v0_mps = Eigen::Vector3d(v0[0], v0[1], v0[2]);
   fit.model.gravity_mps2 = g;
-  fit.model.drag_per_m = fit_drag ? k[0] : 0.0;
+  fit.model.drag_per_m = kind != FlightModel::kGravity ? k[0] : 0.0;
+  if (kind == FlightModel::kSpin && c_m > 0) {
+    fit.model.magnus_per_rad = c_m;
+    fit.model.spin_radps = Eigen::Vector3d(sm[0], sm[1], sm[2]) / c_m;
+  }
   // Residuals: rmse over all samples given; inliers by a robust threshold.
   std::vector<double> r(n);
   double ss = 0;
-  if (fit.model.drag_per_m == 0.0) {
+  if (fit.model.Parabola()) {
     for (int i = 0; i < n; ++i) {
       r[i] = (fit.model.PositionAt(samples[i].time_s) - samples[i].ball_in_world).norm();
     }
@@ -378,10 +442,7 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
       fit.model.StateAt(t_ref, &p, &v);
       double t = t_ref;
       for (int i = n / 2; i >= 0 && i < n; i += dir) {
-        double pa[3] = {p.x(), p.y(), p.z()}, va[3] = {v.x(), v.y(), v.z()};
-        Propagate(pa, va, fit.model.drag_per_m, g, samples[i].time_s - t);
-        p = {pa[0], pa[1], pa[2]};
-        v = {va[0], va[1], va[2]};
+        StepModel(fit.model, &p, &v, samples[i].time_s - t);
         t = samples[i].time_s;
         r[i] = (p - samples[i].ball_in_world).norm();
       }
@@ -396,8 +457,65 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
     fit.inlier[i] = r[i] <= thr;
     fit.inliers += fit.inlier[i];
   }
+  const double cap = std::max(options.outlier_sigmas * std::max(noise_m, 1e-4) * std::sqrt(3.0),
+                              options.min_outlier_m);
+  for (double x : r) fit.capped_sse_m2 += std::min(x * x, cap * cap);
+  const double nobs = 3.0 * n;
+  fit.bic =
+      nobs * std::log(std::max(fit.capped_sse_m2, 1e-18) / nobs) + fit.parameters * std::log(nobs);
   fit.ok = ok && std::isfinite(fit.rmse_m);
   return fit;
+}
+
+Eigen::Vector3d ConstantAccelerationFit::PositionAt(double time_s) const {
+  const double dt = time_s - t0_s;
+  return p0_m + v0_mps * dt + 0.5 * accel_mps2 * dt * dt;
+}
+
+std::optional<double> ConstantAccelerationFit::DescendingCrossing(double z_m, double from_s) const {
+  // z(t) = z_m: 0.5 a dt^2 + v dt + (p - z_m) = 0, the later root after from_s.
+  const double a = 0.5 * accel_mps2.z(), b = v0_mps.z(), c = p0_m.z() - z_m;
+  std::vector<double> roots;
+  if (std::abs(a) < 1e-12) {
+    if (std::abs(b) > 1e-12) roots.push_back(-c / b);
+  } else {
+    const double disc = b * b - 4 * a * c;
+    if (disc < 0) return std::nullopt;
+    roots.push_back((-b - std::sqrt(disc)) / (2 * a));
+    roots.push_back((-b + std::sqrt(disc)) / (2 * a));
+  }
+  std::optional<double> best;
+  for (double dt : roots) {
+    const double t = t0_s + dt;
+    const double vz = b + 2 * a * dt;
+    if (t >= from_s && vz < 0 && (!best || t < *best)) best = t;
+  }
+  return best;
+}
+
+ConstantAccelerationFit FitConstantAcceleration(const std::vector<BallSample>& samples) {
+  ConstantAccelerationFit f;
+  const int n = static_cast<int>(samples.size());
+  if (n < 4) return f;
+  f.t0_s = samples[n / 2].time_s;
+  Eigen::MatrixXd A(n, 3);
+  Eigen::MatrixXd B(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double dt = samples[i].time_s - f.t0_s;
+    A.row(i) << 1, dt, 0.5 * dt * dt;
+    B.row(i) = samples[i].ball_in_world.transpose();
+  }
+  const Eigen::MatrixXd X = A.colPivHouseholderQr().solve(B);  // 3 x 3: rows p0, v0, a
+  if (!X.allFinite()) return f;
+  f.p0_m = X.row(0).transpose();
+  f.v0_mps = X.row(1).transpose();
+  f.accel_mps2 = X.row(2).transpose();
+  double ss = 0;
+  for (int i = 0; i < n; ++i)
+    ss += (f.PositionAt(samples[i].time_s) - samples[i].ball_in_world).squaredNorm();
+  f.rmse_m = std::sqrt(ss / n);
+  f.ok = true;
+  return f;
 }
 
 PlaneQuadraticFit FitPlaneQuadratic(const std::vector<BallSample>& samples,
@@ -479,15 +597,56 @@ PlaneQuadraticFit FitPlaneQuadratic(const std::vector<BallSample>& samples,
   return f;
 }
 
+void BounceModel::Check() const {
+  CheckInRange(restitution, 0.0, 1.5, "restitution");
+  CheckNonNegative(friction, "friction");
+  CheckPositive(inertia_factor, "inertia_factor");
+}
+
+void BounceModel::Apply(double r, Eigen::Vector3d* v, Eigen::Vector3d* w) const {
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  const double vn = v->z();
+  if (vn >= 0) return;
+  // Contact point velocity (tangential): u = v_t + w x (-r z).
+  const Eigen::Vector3d vt(v->x(), v->y(), 0.0);
+  const Eigen::Vector3d u = vt + w->cross(-r * z);
+  // A tangential impulse J (per unit mass) changes u by J (1 + 1 / inertia_factor).
+  const double gain = 1.0 + 1.0 / inertia_factor;
+  const double normal = (1.0 + restitution) * -vn;  // normal impulse per unit mass
+  Eigen::Vector3d J = Eigen::Vector3d::Zero();
+  const double un = u.norm();
+  if (un > 1e-9) J = -u / un * std::min(friction * normal, un / gain);
+  *v = vt + J;
+  v->z() = -restitution * vn;
+  // dw = (-r z) x J / (inertia_factor r^2)
+  *w += (-r * z).cross(J) / (inertia_factor * r * r);
+}
+
+BounceFit FitBounce(const Eigen::Vector3d& vb, const Eigen::Vector3d& wb, const Eigen::Vector3d& va,
+                    double r, double inertia_factor) {
+  BounceFit f;
+  f.spin_before_radps = wb;
+  if (vb.z() >= -0.1 || va.z() <= 0) return f;
+  f.restitution = -va.z() / vb.z();
+  // Friction: the tangential impulse seen, over the normal impulse (sliding); when the contact
+  // point ended rolling, this is a lower bound and the model's result is the same.
+  const Eigen::Vector3d J(va.x() - vb.x(), va.y() - vb.y(), 0.0);
+  const double normal = va.z() - vb.z();
+  f.friction = J.norm() / normal;
+  f.spin_after_radps = wb + (-r * Eigen::Vector3d::UnitZ()).cross(J) / (inertia_factor * r * r);
+  f.ok = std::isfinite(f.restitution) && std::isfinite(f.friction);
+  return f;
+}
+
 std::string TrajectoryResult::Summary() const {
   int outliers = static_cast<int>(std::count(outlier.begin(), outlier.end(), true));
   int ground = static_cast<int>(std::count(on_ground.begin(), on_ground.end(), true));
-  int drag = 0;
-  for (const auto& f : flights) drag += f.drag_used;
+  int drag = 0, spin = 0;
+  for (const auto& f : flights) drag += f.drag_used && !f.spin_used, spin += f.spin_used;
   return fmt::format(
-      "{} flights ({} with drag), {} bounces/hits, {} outliers, {} samples on the ground, "
-      "{} short hops, noise {:.1f} mm",
-      flights.size(), drag, breaks.size(), outliers, ground, short_hops, noise_m * 1e3);
+      "{} flights ({} with drag, {} with spin), {} bounces/hits, {} outliers, {} samples on the "
+      "ground, {} short hops, noise {:.1f} mm",
+      flights.size(), drag, spin, breaks.size(), outliers, ground, short_hops, noise_m * 1e3);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -524,20 +683,37 @@ struct Segmenter {
         const auto left = Window(list, track, pos - 1, -1, 0, m, o.window_s, o.window_samples);
         const auto right = Window(list, track, pos, +1, 0, m, o.window_s, o.window_samples);
         int fits = 0, misses = 0;
+        auto misses_line = [&](const GravityLine& L, int k) {
+          const double err = (L.At(track[k].time_s, g) - track[k].ball_in_world).norm();
+          const double sd = L.PredictionSd(track[k].time_s);
+          const double thr = std::max(
+              o.min_outlier_m, o.outlier_sigmas * sigma * std::sqrt(3.0) * std::sqrt(1 + sd * sd));
+          return err > thr;
+        };
+        std::optional<GravityLine> missed;  // the fit of the side that missed
+        bool missed_left = false;
         for (const auto* w : {&left, &right}) {
           if (static_cast<int>(w->size()) < o.window_samples) continue;
           const double span_ok = std::abs(track[(*w)[w->size() / 2]].time_s - track[i].time_s);
           if (span_ok > 3 * o.window_s) continue;
           const GravityLine L = FitGravityLine(track, *w, g, track[i].time_s);
-          const double err = (L.At(track[i].time_s, g) - track[i].ball_in_world).norm();
-          const double thr = std::max(
-              o.min_outlier_m,
-              o.outlier_sigmas * sigma * std::sqrt(3.0) *
-                  std::sqrt(1 + L.PredictionSd(track[i].time_s) * L.PredictionSd(track[i].time_s)));
           ++fits;
-          misses += err > thr;
+          if (misses_line(L, i)) {
+            ++misses;
+            missed = L;
+            missed_left = w == &left;
+          }
         }
-        next[i] = fits > 0 && misses == fits;
+        if (fits == 2) {
+          next[i] = misses == 2;
+        } else if (fits == 1 && misses == 1) {
+          // One side only (near a track end or a break): a jump there is either a glitch or the
+          // start of a new arc. An outlier only when the next sample on the other side returns
+          // to the arc (an isolated jump); without such a sample nothing says which.
+          const int other =
+              missed_left ? (pos < m ? list[pos] : -1) : (pos > 0 ? list[pos - 1] : -1);
+          next[i] = other >= 0 && !misses_line(*missed, other);
+        }
       }
       out = next;
     }
@@ -562,7 +738,12 @@ struct Segmenter {
         if (j > i && track[j].time_s - track[j - 1].time_s > o.max_gap_s) break;
         ++j;
       }
-      if (track[last].time_s - track[i].time_s >= o.min_ground_s) {
+      // A run at a track end may have lasted longer than seen: a few samples suffice there.
+      const bool at_end = i == 0 || j >= n;
+      int count = 0;
+      for (int k = i; k <= last; ++k) count += !outlier[k];
+      if (track[last].time_s - track[i].time_s >= o.min_ground_s ||
+          (at_end && count >= o.window_samples)) {
         for (int k = i; k <= last; ++k) ground[k] = !outlier[k];
       }
       i = std::max(j, i + 1);
@@ -661,13 +842,10 @@ double ApexOf(const BallisticModel& m, double t0, double t1, double* t_apex) {
   m.StateAt(t0, &p, &v);
   for (int s = 0; s <= steps; ++s) {
     const double ts = t0 + (t1 - t0) * s / steps;
-    if (m.drag_per_m == 0.0) {
+    if (m.Parabola()) {
       p = m.PositionAt(ts);
     } else {
-      double pa[3] = {p.x(), p.y(), p.z()}, va[3] = {v.x(), v.y(), v.z()};
-      Propagate(pa, va, m.drag_per_m, m.gravity_mps2, ts - t);
-      p = {pa[0], pa[1], pa[2]};
-      v = {va[0], va[1], va[2]};
+      StepModel(m, &p, &v, ts - t);
       t = ts;
     }
     if (p.z() > best) {
@@ -839,11 +1017,26 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     if (try_drag) f.with_drag = FitBallistic(s, true, options, res.noise_m);
     f.drag_used = f.with_drag.ok &&
                   (options.drag == DragMode::kOn || f.with_drag.rmse_m < 0.9 * f.no_drag.rmse_m);
-    if (!f.no_drag.ok && !f.drag_used) {
+    const bool try_spin =
+        options.spin == SpinMode::kOn ||
+        (options.spin == SpinMode::kAuto &&
+         static_cast<int>(s.size()) >= options.spin_min_samples && span >= options.spin_min_span_s);
+    if (try_spin) {
+      const BallisticFit& base = f.drag_used ? f.with_drag : f.no_drag;
+      if (base.ok)
+        f.with_spin = FitBallistic(s, FlightModel::kSpin, options, res.noise_m, &base.model);
+      if (!f.with_spin.ok) f.with_spin = FitBallistic(s, FlightModel::kSpin, options, res.noise_m);
+      f.spin_used = f.with_spin.ok && (options.spin == SpinMode::kOn || !base.ok ||
+                                       f.with_spin.bic < base.bic - options.spin_min_bic_gain);
+    }
+    if (!f.no_drag.ok && !f.drag_used && !f.spin_used) {
       ++res.short_hops;
       continue;
     }
-    f.rmse_m = f.drag_used ? f.with_drag.rmse_m : f.no_drag.rmse_m;
+    f.rmse_m = f.spin_used   ? f.with_spin.rmse_m
+               : f.drag_used ? f.with_drag.rmse_m
+                             : f.no_drag.rmse_m;
+    f.free_accel = FitConstantAcceleration(s);
     f.seed = FitPlaneQuadratic(s, options);
     flights.push_back(std::move(f));
     piece_of_flight.push_back(static_cast<int>(pi));
@@ -874,6 +1067,9 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     br.kind = (br.ball_in_world.z() < zr + ground_tol && va.z() < 0 && vb.z() > 0)
                   ? FlightEvent::kBounce
                   : FlightEvent::kHit;
+    if (br.kind == FlightEvent::kBounce) {
+      br.bounce = FitBounce(va, A.model().spin_radps, vb, options.ball_radius_m);
+    }
     A.end_event = br.kind;
     B.start_event = br.kind;
     if (br.kind == FlightEvent::kHit) {

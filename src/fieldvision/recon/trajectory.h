@@ -1,9 +1,11 @@
 // Ball flights from a 3D ball track: splits the track into airborne arcs at ground contacts,
 // kicks and hits (velocity jumps that gravity cannot explain, found by comparing gravity-only fits
 // of the samples before and after each gap), and fits each arc with a point-mass model under known
-// gravity and optional quadratic air drag, a = g - k |v| v (Ceres, Huber loss; drag model as in
-// R. Cross, "Physics of Baseball & Softball", 2011, ch. 6). Also fits the seed's plane quadratic
-// (three last points, then least squares) for comparison.
+// gravity, optional quadratic air drag and optional Magnus lift from a constant spin,
+// a = g - k |v| v + c_M w x v (Ceres, Huber loss; drag and Magnus models as in R. Cross, "Physics
+// of Baseball & Softball", 2011, ch. 6-7). The spin model is kept when it lowers the Bayesian
+// information criterion (Schwarz 1978) by a clear margin. Also fits a free constant-acceleration
+// model and the seed's plane quadratic (three last points, then least squares) for comparison.
 #pragma once
 
 #include <optional>
@@ -24,13 +26,21 @@ struct BallSample {
 };
 
 // Point-mass flight: position p0 and velocity v0 at t0_s, gravity along -z, acceleration
-// g - k |v| v with k = drag_per_m (0: a parabola).
+// g - k |v| v + c_M w x v with k = drag_per_m, w = spin_radps (constant) and c_M = magnus_per_rad
+// (both 0: a parabola).
 struct BallisticModel {
   double t0_s = 0.0;
   Eigen::Vector3d p0_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d v0_mps = Eigen::Vector3d::Zero();
   double gravity_mps2 = 9.81;
   double drag_per_m = 0.0;
+  Eigen::Vector3d spin_radps = Eigen::Vector3d::Zero();  // angular velocity (right hand), rad/s
+  double magnus_per_rad = 0.0;  // c_M: Magnus acceleration per (rad/s x m/s)
+
+  bool Parabola() const { return drag_per_m == 0.0 && !HasSpin(); }
+  bool HasSpin() const { return magnus_per_rad != 0.0 && !spin_radps.isZero(); }
+  // The spin in revolutions per second (its norm) and its unit axis (right hand).
+  double SpinRevPerS() const;
 
   Eigen::Vector3d PositionAt(double time_s) const;
   Eigen::Vector3d VelocityAt(double time_s) const;
@@ -49,6 +59,25 @@ struct BallisticFit {
   int inliers = 0;
   int iterations = 0;        // Ceres iterations
   std::vector<bool> inlier;  // per sample given to the fit
+  int parameters = 0;        // free parameters (6 gravity, 7 drag, 10 spin)
+  // Sum of squared residuals with each sample's residual capped at the outlier threshold of the
+  // track's noise (the same cap for every model of a flight), and the Bayesian information
+  // criterion from it over the 3 n coordinates: 3n ln(sse / 3n) + parameters ln(3n).
+  double capped_sse_m2 = 0.0;
+  double bic = 0.0;
+};
+
+// Free constant-acceleration fit p(t) = p0 + v0 t + a t^2 / 2 (9 parameters, linear least
+// squares): the reference a physical model should come close to over a short arc.
+struct ConstantAccelerationFit {
+  bool ok = false;
+  double t0_s = 0.0;
+  Eigen::Vector3d p0_m = Eigen::Vector3d::Zero(), v0_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_mps2 = Eigen::Vector3d::Zero();
+  double rmse_m = 0.0;
+  Eigen::Vector3d PositionAt(double time_s) const;
+  // The first time after from_s where the height descends through z_m; nullopt if none.
+  std::optional<double> DescendingCrossing(double z_m, double from_s) const;
 };
 
 // The seed's method: a quadratic z(s) in the vertical plane of the flight (s: horizontal distance),
@@ -69,6 +98,24 @@ enum class DragMode { kOff, kOn, kAuto };
 // "off", "on", "auto"; throws naming `context` otherwise.
 DragMode ParseDragMode(const std::string& s, const std::string& context);
 const char* DragModeName(DragMode m);
+using SpinMode = DragMode;  // off, on, auto as for drag
+
+// The models a flight is fitted with, each containing the one before.
+enum class FlightModel { kGravity, kDrag, kSpin };
+const char* FlightModelName(FlightModel m);
+
+// A bounce on a horizontal surface (R. Cross, Am. J. Phys. 70(5), 2002; the sliding/rolling
+// model of Nakashima et al., 2010): the normal velocity reverses with restitution e; a friction
+// impulse (coefficient mu, times the normal impulse) opposes the contact point's velocity
+// v_t + w x (-r z) and stops at rolling. Hollow ball (table tennis) I = 2/3 m r^2; solid 2/5.
+struct BounceModel {
+  double restitution = 0.9;
+  double friction = 0.25;
+  double inertia_factor = 2.0 / 3.0;  // I / (m r^2)
+  void Check() const;
+  // Velocity and spin after the bounce of a ball of radius_m.
+  void Apply(double radius_m, Eigen::Vector3d* v_mps, Eigen::Vector3d* spin_radps) const;
+};
 
 struct TrajectoryOptions {
   double gravity_mps2 = 9.81;       // along -z
@@ -90,6 +137,26 @@ struct TrajectoryOptions {
   int min_flight_samples = 4;        // shorter arcs are reported as unfitted hops
   double max_drag_per_m = 2.0;       // upper bound of k
   int max_iterations = 50;
+  // Spin (Magnus lift). auto: fitted on flights with >= spin_min_samples samples over
+  // >= spin_min_span_s, kept when its BIC is lower than the drag (or gravity) model's by
+  // spin_min_bic_gain (10: "very strong" evidence, Kass & Raftery 1995).
+  SpinMode spin = SpinMode::kAuto;
+  int spin_min_samples = 12;
+  double spin_min_span_s = 0.12;
+  double spin_min_bic_gain = 10.0;
+  // Magnus coefficient c_M = lift_slope rho pi r^3 / (2 m): the lift coefficient taken as
+  // C_L = lift_slope * S with the spin parameter S = r |w| / |v| (Cross 2011, ch. 7; about 1 for
+  // smooth balls at S < 0.4). Only c_M w is measured: the spin in rev/s scales with 1 / lift_slope.
+  double ball_mass_kg = 0.43;  // size-5 football; 0.0027 for a table-tennis ball
+  double air_density_kgpm3 = 1.2;
+  double lift_slope = 1.0;
+  // Zero-mean prior on the spin (1 sigma, rev/s; it weighs as much as one sample off by the
+  // noise): weak across the flight; tighter along it, where spin makes almost no force (a
+  // rifle spin is told from sidespin only by the slow turn of the velocity) and is rare.
+  double spin_prior_revps = 300.0;
+  double spin_along_prior_revps = 5.0;
+  double MagnusPerRad() const;
+  BounceModel bounce;  // for predicting the flight after a bounce
 
   void Check() const;
 };
@@ -117,11 +184,32 @@ struct Flight {
   double speed_mps = 0.0;                            // |v0|
   double rmse_m = 0.0;                               // of the chosen model
   bool drag_used = false;
-  BallisticFit no_drag, with_drag;  // with_drag.ok is false when it was not fitted
+  bool spin_used = false;              // the chosen model is with_spin (drag and Magnus)
+  BallisticFit no_drag, with_drag;     // with_drag.ok is false when it was not fitted
+  BallisticFit with_spin;              // ok is false when it was not fitted
+  ConstantAccelerationFit free_accel;  // for comparison
   PlaneQuadraticFit seed;
-  const BallisticModel& model() const { return drag_used ? with_drag.model : no_drag.model; }
+  FlightModel model_kind() const {
+    return spin_used ? FlightModel::kSpin : drag_used ? FlightModel::kDrag : FlightModel::kGravity;
+  }
+  const BallisticModel& model() const {
+    return spin_used ? with_spin.model : drag_used ? with_drag.model : no_drag.model;
+  }
   double FlightTime() const { return t_end_s - t_start_s; }
 };
+
+// Restitution and friction measured at one bounce from the velocities (and spins) on both sides;
+// ok is false when the ball does not approach the surface or the tangential change says nothing.
+struct BounceFit {
+  bool ok = false;
+  double restitution = 0.0;
+  double friction = 0.0;  // NaN-free: 0 when no sliding was seen
+  Eigen::Vector3d spin_before_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d spin_after_radps = Eigen::Vector3d::Zero();
+};
+BounceFit FitBounce(const Eigen::Vector3d& v_before_mps, const Eigen::Vector3d& spin_before_radps,
+                    const Eigen::Vector3d& v_after_mps, double radius_m,
+                    double inertia_factor = 2.0 / 3.0);
 
 // A velocity jump between two arcs (for the timeline and the pictures).
 struct TrackBreak {
@@ -129,6 +217,7 @@ struct TrackBreak {
   Eigen::Vector3d ball_in_world = Eigen::Vector3d::Zero();
   double velocity_change_mps = 0.0;
   FlightEvent kind = FlightEvent::kHit;
+  BounceFit bounce;  // kBounce with both arcs fitted: what the bounce did
 };
 
 struct TrajectoryResult {
@@ -148,6 +237,11 @@ double EstimateTrackNoise(const std::vector<BallSample>& track, double gravity_m
 // 3 sigma; samples farther than max(outlier_sigmas sigma, min_outlier_m) are outliers.
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
                           const TrajectoryOptions& options, double noise_m);
+// The same for any model; kSpin starts from `start` when given (e.g. the drag fit).
+BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel kind,
+                          const TrajectoryOptions& options, double noise_m,
+                          const BallisticModel* start = nullptr);
+ConstantAccelerationFit FitConstantAcceleration(const std::vector<BallSample>& samples);
 PlaneQuadraticFit FitPlaneQuadratic(const std::vector<BallSample>& samples,
                                     const TrajectoryOptions& options);
 

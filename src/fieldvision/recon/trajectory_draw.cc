@@ -112,8 +112,12 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
     cv::polylines(img, pts, false, c, th, cv::LINE_AA);
   };
   // Other model thin, chosen model thick, seed quadratic orange.
-  if (f.drag_used && f.no_drag.ok) curve(f.no_drag.model, t0, t1, kGrey, 1);
-  if (!f.drag_used && f.with_drag.ok) curve(f.with_drag.model, t0, t1, kGrey, 1);
+  if (f.model_kind() != FlightModel::kGravity && f.no_drag.ok) {
+    curve(f.no_drag.model, t0, t1, kGrey, 1);
+  }
+  if (f.model_kind() != FlightModel::kDrag && f.with_drag.ok) {
+    curve(f.with_drag.model, t0, t1, kGrey, 1);
+  }
   if (f.seed.ok) {
     std::vector<cv::Point> pts;
     for (int k = 0; k <= 100; ++k) {
@@ -162,12 +166,22 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
     fits += fmt::format(", drag {:.1f} mm (k {:.3f}/m)", f.with_drag.rmse_m * 1e3,
                         f.with_drag.model.drag_per_m);
   }
+  if (f.with_spin.ok) fits += fmt::format(", spin {:.1f} mm", f.with_spin.rmse_m * 1e3);
+  if (f.free_accel.ok) fits += fmt::format(", free accel. {:.1f} mm", f.free_accel.rmse_m * 1e3);
   if (f.seed.ok) fits += fmt::format(", seed quadratic {:.1f} mm", f.seed.rmse_m * 1e3);
-  fits += f.drag_used ? "  [blue: drag model]" : "  [blue: gravity model]";
+  fits += fmt::format("  [blue: {} model]", FlightModelName(f.model_kind()));
+  if (f.spin_used) {
+    const Eigen::Vector3d w = f.model().spin_radps.normalized();
+    Text(img,
+         fmt::format("spin {:.0f} rev/s about ({:.2f}, {:.2f}, {:.2f}) (Magnus, lift slope as "
+                     "configured), drag k {:.3f}/m",
+                     f.model().SpinRevPerS(), w.x(), w.y(), w.z(), f.model().drag_per_m),
+         {10, 66}, kDark);
+  }
   Text(img, fits, {10, 44}, kDark);
   Text(img,
-       "green: samples, red x: outliers, blue: fit, grey: other model, orange: seed, "
-       "purple: landing predicted from the first half",
+       "green: samples, red x: outliers, blue: fit, grey: other models, orange: seed, purple: "
+       "landing predicted from the first half; origin/landing hollow: extrapolated (not seen)",
        {10, size.height - 8}, kDark, 0.42);
   return img;
 }
@@ -219,22 +233,60 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
   return img;
 }
 
+FieldModel RotateFieldQuarter(const FieldModel& f) {
+  FieldModel r = f;
+  auto rot = [](const Eigen::Vector2d& p) { return Eigen::Vector2d(-p.y(), p.x()); };
+  std::swap(r.length_m, r.width_m);
+  for (auto& sgm : r.segments) sgm.a = rot(sgm.a), sgm.b = rot(sgm.b);
+  for (auto& a : r.arcs) {
+    a.centre = rot(a.centre);
+    a.start_rad += M_PI / 2;
+    a.end_rad += M_PI / 2;
+  }
+  for (auto& k : r.keypoints) {
+    const Eigen::Vector2d q = rot(k.position_m.head<2>());
+    k.position_m.x() = q.x();
+    k.position_m.y() = q.y();
+  }
+  r.goals.clear();  // goals are defined on lines x = const
+  for (auto& h : r.hoops) {
+    const Eigen::Vector2d q = rot(h.centre_m.head<2>());
+    h.centre_m.x() = q.x();
+    h.centre_m.y() = q.y();
+  }
+  return r;
+}
+
 cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryResult& result,
                        const FieldModel* field, const Decisions* decisions, int width_px) {
   TopView view;
   cv::Mat img;
+  double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
+  auto grow = [&](const Eigen::Vector3d& p) {
+    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x());
+    y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
+  };
+  for (const auto& s : track) grow(s.ball_in_world);
+  for (const auto& f : result.flights) grow(f.landing_m), grow(f.origin_m);
+  if (track.empty()) x0 = y0 = -1, x1 = y1 = 1;
   if (field && field->length_m > 0) {
-    view = TopView::ForField(*field, width_px);
-    img = DrawField(*field, view);
+    // The field plus whatever of the track lies beyond its surround.
+    const double ex =
+        std::max({0.0, x1 - field->HalfLengthWithSurround(), -x0 - field->HalfLengthWithSurround(),
+                  y1 - field->HalfWidthWithSurround(), -y0 - field->HalfWidthWithSurround()});
+    view = TopView::ForField(*field, width_px, std::min(ex + 0.2, 50.0));
+    FieldDrawOptions fo;
+    fo.keypoints = false;
+    img = DrawField(*field, view, fo);
+    // A table-tennis net across the middle (x = 0).
+    for (const auto& k : field->keypoints) {
+      if (k.name == "net_post_top") {
+        const cv::Point2d a = view.ToPixel(k.position_m.head<2>());
+        const cv::Point2d b = view.ToPixel(-k.position_m.head<2>());
+        cv::line(img, a, b, cv::Scalar(30, 30, 30), 3, cv::LINE_AA);
+      }
+    }
   } else {
-    double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
-    auto grow = [&](const Eigen::Vector3d& p) {
-      x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x());
-      y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
-    };
-    for (const auto& s : track) grow(s.ball_in_world);
-    for (const auto& f : result.flights) grow(f.landing_m), grow(f.origin_m);
-    if (track.empty()) x0 = y0 = -1, x1 = y1 = 1;
     const double m = 0.1 * std::max(x1 - x0, y1 - y0) + 0.2;
     x0 -= m, x1 += m, y0 -= m, y1 += m;
     view.px_per_m = width_px / (x1 - x0);
@@ -249,7 +301,6 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
     for (double y = std::ceil(y0 / step) * step; y <= y1; y += step) {
       cv::line(img, view.ToPixel({x0, y}), view.ToPixel({x1, y}), cv::Scalar(95, 95, 95), 1);
     }
-    Text(img, fmt::format("grid {:g} m", step), {10, view.size.height - 10}, kWhite, 0.5);
   }
   for (size_t i = 0; i < track.size(); ++i) {
     const cv::Point2d p = view.ToPixel(track[i].ball_in_world.head<2>());
@@ -260,14 +311,25 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
     }
   }
   for (const auto& f : result.flights) {
-    std::vector<cv::Point> pts;
+    // Seen part solid, extrapolated parts thin.
+    auto arc = [&](double ta, double tb, int thickness) {
+      if (tb <= ta) return;
+      std::vector<cv::Point> pts;
+      for (int k = 0; k <= 60; ++k) {
+        const double t = ta + (tb - ta) * k / 60.0;
+        pts.push_back(view.ToPixel(f.model().PositionAt(t).head<2>()));
+      }
+      cv::polylines(img, pts, false, FlightColour(f.index), thickness, cv::LINE_AA);
+    };
     const double tb = std::max(f.t_end_s, f.t_landing_s);
-    for (int k = 0; k <= 100; ++k) {
-      const double t = f.t_start_s + (tb - f.t_start_s) * k / 100.0;
-      pts.push_back(view.ToPixel(f.model().PositionAt(t).head<2>()));
-    }
-    cv::polylines(img, pts, false, FlightColour(f.index), 2, cv::LINE_AA);
-    cv::circle(img, view.ToPixel(f.origin_m.head<2>()), 5, kBlack, 2, cv::LINE_AA);
+    arc(f.t_start_s, f.t_first_seen_s, 1);
+    arc(std::max(f.t_start_s, f.t_first_seen_s), std::min(tb, f.t_last_seen_s), 2);
+    arc(f.t_last_seen_s, tb, 1);
+    // Origin and landing: filled when seen, hollow when extrapolated.
+    cv::circle(img, view.ToPixel(f.origin_m.head<2>()), 5, kBlack,
+               f.origin_extrapolated ? 1 : cv::FILLED, cv::LINE_AA);
+    cv::circle(img, view.ToPixel(f.landing_m.head<2>()), 5, FlightColour(f.index),
+               f.landing_extrapolated ? 1 : cv::FILLED, cv::LINE_AA);
     Text(img, std::to_string(f.index), view.ToPixel(f.origin_m.head<2>()) + cv::Point2d(6, -6),
          kWhite);
   }
@@ -278,7 +340,36 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
                  c.extrapolated ? 1 : 2, cv::LINE_AA);
     }
   }
-  return img;
+  // Axes: a white frame with tick labels in metres, a scale bar and a legend.
+  const int ml = 60, mr = 20, mt = 30, mb = 70;
+  cv::Mat out(img.rows + mt + mb, img.cols + ml + mr, CV_8UC3, kWhite);
+  img.copyTo(out(cv::Rect(ml, mt, img.cols, img.rows)));
+  const Eigen::Vector2d lo = view.ToField({0.0, static_cast<double>(img.rows)});
+  const Eigen::Vector2d hi = view.ToField({static_cast<double>(img.cols), 0.0});
+  const double step = NiceStep(std::max(hi.x() - lo.x(), hi.y() - lo.y()));
+  for (double x = std::ceil(lo.x() / step) * step; x <= hi.x(); x += step) {
+    const double px = ml + view.ToPixel({x, 0}).x;
+    cv::line(out, {static_cast<int>(px), mt + img.rows}, {static_cast<int>(px), mt + img.rows + 5},
+             kDark, 1);
+    Text(out, fmt::format("{:g}", std::round(x / step) * step),
+         {static_cast<int>(px) - 10, mt + img.rows + 20}, kDark, 0.45);
+  }
+  for (double y = std::ceil(lo.y() / step) * step; y <= hi.y(); y += step) {
+    const double py = mt + view.ToPixel({0, y}).y;
+    cv::line(out, {ml - 5, static_cast<int>(py)}, {ml, static_cast<int>(py)}, kDark, 1);
+    Text(out, fmt::format("{:g}", std::round(y / step) * step), {5, static_cast<int>(py) + 5},
+         kDark, 0.45);
+  }
+  Text(out, "x (m)", {ml + img.cols / 2 - 20, mt + img.rows + 38}, kBlack);
+  Text(out, "y (m)", {5, mt - 10}, kBlack);
+  const int bar = static_cast<int>(step * view.px_per_m);
+  cv::line(out, {out.cols - mr - bar, mt - 12}, {out.cols - mr, mt - 12}, kBlack, 3);
+  Text(out, fmt::format("{:g} m", step), {out.cols - mr - bar - 60, mt - 6}, kBlack, 0.45);
+  Text(out,
+       "top view. thick: seen part of a flight, thin: extrapolated; circles filled: seen, hollow: "
+       "extrapolated (black origin, coloured landing); red x: outliers",
+       {5, out.rows - 10}, kDark, 0.42);
+  return out;
 }
 
 }  // namespace fv

@@ -25,8 +25,12 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
 cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryResult& result,
                         const TrajectoryOptions& options, cv::Size size = {1600, 600});
 
-// field may be null (a plain grid around the track).
+// field may be null (a plain grid around the track). Axes in metres, scale bar, legend; the
+// extrapolated parts of flights thin and their origins and landings hollow.
 cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryResult& result,
                        const FieldModel* field, const Decisions* decisions, int width_px = 1400);
+
+// The field turned a quarter turn (x -> y): for tracks recorded with the length along y (TT3D).
+FieldModel RotateFieldQuarter(const FieldModel& field);
 
 }  // namespace fv

@@ -91,13 +91,26 @@ double Round(double v, int decimals = 4) {
   return std::round(v * f) / f;
 }
 
+nlohmann::json SpinJson(const BallisticModel& m) {
+  const double n = m.spin_radps.norm();
+  const Eigen::Vector3d axis = n > 0 ? Eigen::Vector3d(m.spin_radps / n) : Eigen::Vector3d::Zero();
+  return {{"rev_per_s", Round(m.SpinRevPerS(), 2)},
+          {"axis", Vec3Json(axis, 3)},
+          {"spin_radps", Vec3Json(m.spin_radps, 2)},
+          {"magnus_per_rad", Round(m.magnus_per_rad, 7)}};
+}
+
 nlohmann::json FitJson(const BallisticFit& b) {
   if (!b.ok) return nullptr;
-  return {{"rmse_m", Round(b.rmse_m, 5)},
-          {"inliers", b.inliers},
-          {"samples", b.inlier.size()},
-          {"iterations", b.iterations},
-          {"drag_per_m", Round(b.model.drag_per_m, 5)}};
+  nlohmann::json j = {{"rmse_m", Round(b.rmse_m, 5)},
+                      {"inliers", b.inliers},
+                      {"samples", b.inlier.size()},
+                      {"iterations", b.iterations},
+                      {"parameters", b.parameters},
+                      {"bic", Round(b.bic, 2)},
+                      {"drag_per_m", Round(b.model.drag_per_m, 5)}};
+  if (b.model.HasSpin()) j["spin"] = SpinJson(b.model);
+  return j;
 }
 
 }  // namespace
@@ -122,10 +135,16 @@ nlohmann::json FlightToJson(const Flight& f) {
   j["t_last_seen_s"] = Round(f.t_last_seen_s);
   j["speed_mps"] = Round(f.speed_mps, 3);
   j["flight_time_s"] = Round(f.FlightTime());
-  j["model"] = f.drag_used ? "drag" : "gravity";
+  j["model"] = FlightModelName(f.model_kind());
   j["drag_per_m"] = Round(f.model().drag_per_m, 5);
+  j["spin"] = f.spin_used ? SpinJson(f.model()) : nlohmann::json(nullptr);
   j["fit_no_drag"] = FitJson(f.no_drag);
   j["fit_drag"] = FitJson(f.with_drag);
+  j["fit_spin"] = FitJson(f.with_spin);
+  if (f.free_accel.ok) {
+    j["fit_free_acceleration"] = {{"rmse_m", Round(f.free_accel.rmse_m, 5)},
+                                  {"accel_mps2", Vec3Json(f.free_accel.accel_mps2, 3)}};
+  }
   nlohmann::json seed;
   seed["method"] = "plane quadratic from the last 3 points, refined by least squares";
   seed["ok"] = f.seed.ok;

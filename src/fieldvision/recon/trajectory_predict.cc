@@ -1,5 +1,6 @@
 #include "fieldvision/recon/trajectory_predict.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -9,13 +10,18 @@
 namespace fv {
 namespace {
 
-using Vec7 = Eigen::Matrix<double, 7, 1>;
+using Vec10 = Eigen::Matrix<double, 10, 1>;
 
-BallisticModel WithParams(const BallisticModel& m, const Vec7& th) {
+// Parameters: p0 (3), v0 (3), k, the Magnus vector c_M w (3).
+BallisticModel WithParams(const BallisticModel& m, const Vec10& th, double c_m) {
   BallisticModel r = m;
   r.p0_m = th.head<3>();
   r.v0_mps = th.segment<3>(3);
   r.drag_per_m = th[6];
+  if (c_m > 0) {
+    r.magnus_per_rad = c_m;
+    r.spin_radps = th.tail<3>() / c_m;
+  }
   return r;
 }
 
@@ -23,12 +29,20 @@ BallisticModel WithParams(const BallisticModel& m, const Vec7& th) {
 
 LandingPrediction PredictLanding(const std::vector<BallSample>& samples, bool fit_drag,
                                  const TrajectoryOptions& options, double noise_m) {
+  return PredictLanding(samples, fit_drag ? FlightModel::kDrag : FlightModel::kGravity, options,
+                        noise_m);
+}
+
+LandingPrediction PredictLanding(const std::vector<BallSample>& samples, FlightModel kind,
+                                 const TrajectoryOptions& options, double noise_m) {
   LandingPrediction pr;
   pr.samples_used = static_cast<int>(samples.size());
   if (samples.size() < 4) return pr;
   pr.t_cut_s = samples.back().time_s;
-  const BallisticFit fit = FitBallistic(samples, fit_drag, options, noise_m);
+  pr.model = kind;
+  const BallisticFit fit = FitBallistic(samples, kind, options, noise_m);
   if (!fit.ok) return pr;
+  pr.fit_rmse_m = fit.rmse_m;
   const double zr = options.ground_z_m + options.ball_radius_m;
   const BallisticModel& m = fit.model;
   auto landing = [&](const BallisticModel& mm, Eigen::Vector3d* out) {
@@ -40,9 +54,10 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, bool fi
   };
   Eigen::Vector3d L0;
   if (!landing(m, &L0)) return pr;
-  Vec7 th;
-  th << m.p0_m, m.v0_mps, m.drag_per_m;
-  const int np = fit_drag ? 7 : 6;
+  Vec10 th;
+  const double c_m = kind == FlightModel::kSpin ? options.MagnusPerRad() : 0.0;
+  th << m.p0_m, m.v0_mps, m.drag_per_m, c_m * m.spin_radps;
+  const int np = kind == FlightModel::kGravity ? 6 : kind == FlightModel::kDrag ? 7 : 10;
   // Jacobian of the residuals (numerical), inliers only.
   std::vector<int> used;
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -52,11 +67,11 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, bool fi
   Eigen::MatrixXd J(3 * used.size(), np);
   Eigen::Matrix<double, 3, Eigen::Dynamic> JL(3, np);
   for (int p = 0; p < np; ++p) {
-    const double h = p == 6 ? 1e-5 : 1e-6;
-    Vec7 a = th, b = th;
+    const double h = p >= 6 ? 1e-5 : 1e-6;
+    Vec10 a = th, b = th;
     a[p] += h;
     b[p] -= h;
-    const BallisticModel ma = WithParams(m, a), mb = WithParams(m, b);
+    const BallisticModel ma = WithParams(m, a, c_m), mb = WithParams(m, b, c_m);
     for (size_t k = 0; k < used.size(); ++k) {
       const double t = samples[used[k]].time_s;
       J.block<3, 1>(3 * k, p) = (ma.PositionAt(t) - mb.PositionAt(t)) / (2 * h);
@@ -82,18 +97,26 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, bool fi
   return pr;
 }
 
+FlightModel PredictionModel(const Flight& flight, const std::vector<BallSample>& /*samples*/,
+                            const TrajectoryOptions& /*options*/, double /*noise_m*/) {
+  return flight.model_kind();
+}
+
 LandingPrediction PredictFlightLanding(const std::vector<BallSample>& track,
                                        const TrajectoryResult& result, const Flight& flight,
                                        double fraction, const TrajectoryOptions& options) {
   CheckInRange(fraction, 0.05, 1.0, "fraction");
-  const double t_cut = flight.t_start_s + fraction * (flight.t_end_s - flight.t_start_s);
+  // From the first sample seen (an extrapolated origin may lie far before it).
+  const double t0 = std::max(flight.t_start_s, flight.t_first_seen_s);
+  const double t_cut = t0 + fraction * (flight.t_end_s - t0);
   std::vector<BallSample> s;
   for (size_t k = 0; k < flight.samples.size(); ++k) {
     const int i = flight.samples[k];
     if (track[i].time_s > t_cut) break;
     if (!result.outlier[i]) s.push_back(track[i]);
   }
-  return PredictLanding(s, flight.drag_used, options, result.noise_m);
+  return PredictLanding(s, PredictionModel(flight, s, options, result.noise_m), options,
+                        result.noise_m);
 }
 
 void SmootherOptions::Check() const {

@@ -16,6 +16,8 @@ namespace fv {
 
 struct LandingPrediction {
   bool ok = false;
+  FlightModel model = FlightModel::kGravity;  // fitted to the samples used
+  double fit_rmse_m = 0.0;
   int samples_used = 0;
   double t_cut_s = 0.0;  // samples up to this time were used
   Eigen::Vector3d landing_m = Eigen::Vector3d::Zero();
@@ -30,6 +32,12 @@ struct LandingPrediction {
 // ground. noise_m: the position noise (1 sigma per axis).
 LandingPrediction PredictLanding(const std::vector<BallSample>& samples, bool fit_drag,
                                  const TrajectoryOptions& options, double noise_m);
+LandingPrediction PredictLanding(const std::vector<BallSample>& samples, FlightModel kind,
+                                 const TrajectoryOptions& options, double noise_m);
+
+// The model used to predict a flight's landing from its first samples: the flight's chosen model.
+FlightModel PredictionModel(const Flight& flight, const std::vector<BallSample>& samples,
+                            const TrajectoryOptions& options, double noise_m);
 
 // Prediction from the samples of `flight` seen before t_start + fraction * flight time.
 LandingPrediction PredictFlightLanding(const std::vector<BallSample>& track,

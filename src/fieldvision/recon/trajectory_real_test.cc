@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/recon/trajectory.h"
+#include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/util/testing.h"
 
@@ -20,7 +21,42 @@ TrajectoryOptions TableTennis() {
   o.ground_z_m = 0.0;              // the table surface
   o.unmodelled_accel_mps2 = 25.0;  // drag and spin of a 2.7 g ball (as the CLI for TT3D files)
   o.drag = DragMode::kOn;          // fit both models on every flight
+  o.ball_mass_kg = 0.0027;
   return o;
+}
+
+std::vector<std::string> Tt3dFiles() {
+  std::vector<std::string> files;
+  const std::string dir = testing::SharedDataDir();
+  if (dir.empty()) return files;
+  const std::string gt = dir + "/tt3d-trajectories/3D_gt";
+  if (!std::filesystem::exists(gt)) return files;
+  for (const auto& e : std::filesystem::directory_iterator(gt)) {
+    if (e.path().extension() == ".csv") files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// The measures on every TT3D file: one bounce each, the pre-bounce residual of the
+// chosen model near the free constant-acceleration fit, and the landing predicted from the first
+// half of the flight against the bounce measured from the full track.
+TEST(TrajectoryReal, Tt3dSpinModelResidualAndLandingFromTheFirstHalf) {
+  const auto files = Tt3dFiles();
+  if (files.empty()) GTEST_SKIP() << "no ../shared/data/tt3d-trajectories";
+  TrajectoryOptions o = TableTennis();
+  o.drag = DragMode::kAuto;
+  std::vector<BounceTrackScore> scores;
+  // Every third file keeps the test fast; bench_trajectory scores all of them.
+  for (size_t i = 0; i < files.size(); i += 3) {
+    scores.push_back(ScoreBounceTrack(files[i], ReadBallTrack(files[i]).samples, o));
+  }
+  const BounceTrackSummary sum = Summarize(scores);
+  std::cout << sum.Table();
+  EXPECT_EQ(sum.one_bounce, static_cast<int>(scores.size()));
+  EXPECT_LE(sum.median_rmse_chosen_m, 0.006);
+  EXPECT_LE(sum.median_pred_chosen_m, 0.10);
+  EXPECT_LT(sum.median_pred_chosen_m, sum.median_pred_drag_m);
 }
 
 TEST(TrajectoryReal, Tt3dBounceOnTheTableIsFoundAndFitted) {
@@ -65,9 +101,11 @@ TEST(TrajectoryReal, Tt3dAllFilesResiduals) {
   std::sort(files.begin(), files.end());
   int flights = 0, bounces = 0, hits = 0, with_bounce = 0;
   std::vector<double> nd, wd;
+  TrajectoryOptions o = TableTennis();
+  o.spin = SpinMode::kOff;  // gravity against drag (the spin model: the test above)
   for (const auto& p : files) {
     const BallTrackFile file = ReadBallTrack(p);
-    const TrajectoryResult r = AnalyzeTrajectory(file.samples, TableTennis());
+    const TrajectoryResult r = AnalyzeTrajectory(file.samples, o);
     bool b = false;
     for (const auto& br : r.breaks) {
       bounces += br.kind == FlightEvent::kBounce;

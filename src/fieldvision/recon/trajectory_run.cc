@@ -1,11 +1,15 @@
 #include "fieldvision/recon/trajectory_run.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
 #include "fieldvision/recon/trajectory_draw.h"
+#include "fieldvision/recon/trajectory_eval.h"
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
 namespace fv {
@@ -14,10 +18,42 @@ void TrajectoryJob::Check() const {
   FV_REQUIRE(!in_path.empty(), "trajectory: --in is required");
   FV_REQUIRE(!out_path.empty(), "trajectory: --out is required");
   CheckNonNegative(ball_diameter_m, "ball_diameter_m");
+  CheckNonNegative(ball_mass_kg, "ball_mass_kg");
   CheckNonNegative(accel_slack_mps2, "accel_slack_mps2");
   CheckInRange(predict_fraction, 0.05, 1.0, "predict_fraction");
   decisions.Check();
   smoother.Check();
+}
+
+std::string FlightTable(const TrajectoryResult& r) {
+  std::string s = fmt::format(
+      "{:>3} {:>14} {:>8} {:>8} {:>23} {:>23} {:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>20}\n", "#",
+      "events", "t0_s", "t1_s", "origin_m", "landing_m", "apex_m", "v0_mps", "model", "grav_mm",
+      "drag_mm", "spin_mm", "spin rev/s (axis)");
+  auto mm = [](const BallisticFit& b) {
+    return b.ok ? fmt::format("{:.1f}", b.rmse_m * 1e3) : std::string("-");
+  };
+  for (const auto& f : r.flights) {
+    std::string spin = "-";
+    if (f.spin_used) {
+      const Eigen::Vector3d w = f.model().spin_radps.normalized();
+      spin = fmt::format("{:.0f} ({:.2f},{:.2f},{:.2f})", f.model().SpinRevPerS(), w.x(), w.y(),
+                         w.z());
+    }
+    s += fmt::format(
+        "{:>3} {:>14} {:8.3f} {:8.3f} {:>23} {:>23} {:7.2f} {:7.2f} {:>7} {:>8} {:>8} {:>8} "
+        "{:>20}\n",
+        f.index, fmt::format("{}>{}", FlightEventName(f.start_event), FlightEventName(f.end_event)),
+        f.t_start_s, f.t_end_s,
+        fmt::format("({:.2f},{:.2f},{:.2f}){}", f.origin_m.x(), f.origin_m.y(), f.origin_m.z(),
+                    f.origin_extrapolated ? "*" : " "),
+        fmt::format("({:.2f},{:.2f},{:.2f}){}", f.landing_m.x(), f.landing_m.y(), f.landing_m.z(),
+                    f.landing_extrapolated ? "*" : " "),
+        f.apex_m.z(), f.speed_mps, FlightModelName(f.model_kind()), mm(f.no_drag), mm(f.with_drag),
+        mm(f.with_spin), spin);
+  }
+  s += "* extrapolated: the model's value beyond the samples seen (not measured)\n";
+  return s;
 }
 
 TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
@@ -47,12 +83,19 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
                        out.input.layout == "tt3d" ? "table tennis, TT3D layout" : "football");
   }
   out.options.ball_radius_m = 0.5 * diameter;
+  out.options.ball_mass_kg =
+      job.ball_mass_kg > 0 ? job.ball_mass_kg : (out.input.layout == "tt3d" ? 0.0027 : 0.43);
   out.options.unmodelled_accel_mps2 =
       job.accel_slack_mps2 > 0 ? job.accel_slack_mps2 : (out.input.layout == "tt3d" ? 25.0 : 10.0);
   out.options.Check();
   FieldModel field;
   const bool has_field = !job.field.empty();
   if (has_field) field = LoadField(job.field);
+  if (has_field && out.input.layout == "tt3d") {
+    // TT3D files have the table's length along y: the field is turned to match.
+    field = RotateFieldQuarter(field);
+    log << "field turned a quarter (TT3D layout: the table's length along y)\n";
+  }
 
   out.result = AnalyzeTrajectory(track, out.options);
   const TrajectoryResult& r = out.result;
@@ -142,20 +185,7 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
     }
   }
   // The flights and the timeline.
-  log << fmt::format("{:>3} {:>14} {:>8} {:>8} {:>22} {:>22} {:>7} {:>7} {:>8} {:>8}\n", "#",
-                     "events", "t0_s", "t1_s", "origin_m", "landing_m", "apex_m", "v0_mps",
-                     "rmse_mm", "drag_mm");
-  for (const auto& f : r.flights) {
-    log << fmt::format(
-        "{:>3} {:>14} {:8.3f} {:8.3f} {:>22} {:>22} {:7.2f} {:7.2f} {:8.1f} {:>8}\n", f.index,
-        fmt::format("{}>{}", FlightEventName(f.start_event), FlightEventName(f.end_event)),
-        f.t_start_s, f.t_end_s,
-        fmt::format("({:.2f},{:.2f},{:.2f})", f.origin_m.x(), f.origin_m.y(), f.origin_m.z()),
-        fmt::format("({:.2f},{:.2f},{:.2f}){}", f.landing_m.x(), f.landing_m.y(), f.landing_m.z(),
-                    f.landing_extrapolated ? "*" : ""),
-        f.apex_m.z(), f.speed_mps, f.no_drag.rmse_m * 1e3,
-        f.with_drag.ok ? fmt::format("{:.1f}", f.with_drag.rmse_m * 1e3) : "-");
-  }
+  log << FlightTable(r);
   log << "timeline:\n";
   for (const auto& e : out.decisions.timeline) {
     log << fmt::format("  {:9.3f} s  {}\n", e.time_s, e.text);
@@ -165,6 +195,115 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
                          ? ""
                          : fmt::format(", {} images in {}", out.images.size(), job.images_dir));
   return out;
+}
+
+namespace {
+
+// fnmatch-like: '*' any run, '?' one character.
+bool Match(const char* pat, const char* str) {
+  if (*pat == '\0') return *str == '\0';
+  if (*pat == '*') return Match(pat + 1, str) || (*str != '\0' && Match(pat, str + 1));
+  if (*str == '\0') return false;
+  return (*pat == '?' || *pat == *str) && Match(pat + 1, str + 1);
+}
+
+}  // namespace
+
+std::vector<std::string> ExpandTrackInputs(const std::string& in) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> out;
+  const bool glob = in.find_first_of("*?") != std::string::npos;
+  if (!glob && !fs::is_directory(in)) return out;
+  const fs::path dir = glob ? fs::path(in).parent_path() : fs::path(in);
+  const std::string pattern = glob ? fs::path(in).filename().string() : "*.csv";
+  FV_REQUIRE(fs::is_directory(dir.empty() ? fs::path(".") : dir),
+             "trajectory: no folder '{}' for '{}'", dir.string(), in);
+  for (const auto& e : fs::directory_iterator(dir.empty() ? fs::path(".") : dir)) {
+    if (!e.is_regular_file()) continue;
+    const std::string name = e.path().filename().string();
+    if (Match(pattern.c_str(), name.c_str())) out.push_back(e.path().string());
+  }
+  std::sort(out.begin(), out.end());
+  FV_REQUIRE(!out.empty(), "trajectory: '{}' matches no track file", in);
+  return out;
+}
+
+TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
+                                         const std::vector<std::string>& files, std::ostream& log) {
+  namespace fs = std::filesystem;
+  FV_REQUIRE(!job.out_path.empty(), "trajectory: --out is required (a folder in batch mode)");
+  std::error_code ec;
+  fs::create_directories(job.out_path, ec);
+  FV_REQUIRE(!ec && fs::is_directory(job.out_path),
+             "trajectory: cannot create the output folder '{}' (batch mode writes one JSON per "
+             "track there)",
+             job.out_path);
+  TrajectoryBatchResult res;
+  res.files = files;
+  res.summary_csv = (fs::path(job.out_path) / "summary.csv").string();
+  const std::string tmp = res.summary_csv + ".part";
+  std::vector<BounceTrackScore> scores;
+  {
+    CsvWriter csv(tmp, {"file",           "flight",
+                        "start_event",    "end_event",
+                        "t_start_s",      "t_end_s",
+                        "origin_x_m",     "origin_y_m",
+                        "origin_z_m",     "origin_extrapolated",
+                        "landing_x_m",    "landing_y_m",
+                        "landing_z_m",    "landing_extrapolated",
+                        "apex_z_m",       "speed_mps",
+                        "model",          "rmse_m",
+                        "rmse_gravity_m", "rmse_drag_m",
+                        "rmse_spin_m",    "rmse_free_accel_m",
+                        "spin_revps",     "spin_axis_x",
+                        "spin_axis_y",    "spin_axis_z"},
+                  5);
+    for (const auto& file : files) {
+      const std::string stem = fs::path(file).stem().string();
+      TrajectoryJob j = job;
+      j.in_path = file;
+      j.out_path = (fs::path(job.out_path) / (stem + ".json")).string();
+      if (!job.images_dir.empty()) j.images_dir = (fs::path(job.images_dir) / stem).string();
+      if (!job.report_path.empty()) j.report_path.clear();
+      if (!job.smoothed_path.empty()) {
+        j.smoothed_path = (fs::path(job.out_path) / (stem + "_smoothed.csv")).string();
+      }
+      std::ostringstream quiet;
+      TrajectoryJobResult r;
+      try {
+        r = RunTrajectory(j, quiet);
+      } catch (const Error& e) {
+        res.failed.push_back(fmt::format("{}: {}", file, e.what()));
+        log << "failed: " << res.failed.back() << "\n";
+        continue;
+      }
+      auto rm = [](const BallisticFit& b) { return b.ok ? b.rmse_m : -1.0; };
+      for (const auto& f : r.result.flights) {
+        const Eigen::Vector3d w = f.spin_used ? Eigen::Vector3d(f.model().spin_radps.normalized())
+                                              : Eigen::Vector3d::Zero();
+        csv << fs::path(file).filename().string() << f.index << FlightEventName(f.start_event)
+            << FlightEventName(f.end_event) << f.t_start_s << f.t_end_s << f.origin_m.x()
+            << f.origin_m.y() << f.origin_m.z() << (f.origin_extrapolated ? 1 : 0)
+            << f.landing_m.x() << f.landing_m.y() << f.landing_m.z()
+            << (f.landing_extrapolated ? 1 : 0) << f.apex_m.z() << f.speed_mps
+            << FlightModelName(f.model_kind()) << f.rmse_m << rm(f.no_drag) << rm(f.with_drag)
+            << rm(f.with_spin) << (f.free_accel.ok ? f.free_accel.rmse_m : -1.0)
+            << (f.spin_used ? f.model().SpinRevPerS() : 0.0) << w.x() << w.y() << w.z();
+        csv.EndRow();
+      }
+      log << fmt::format("{}: {}\n", file, r.result.Summary());
+      bool bounce = false;
+      for (const auto& b : r.result.breaks) bounce |= b.kind == FlightEvent::kBounce;
+      if (bounce) scores.push_back(ScoreBounceTrack(file, r.input.samples, r.options));
+    }
+    csv.Close();
+  }
+  fs::rename(tmp, res.summary_csv, ec);
+  FV_REQUIRE(!ec, "cannot write '{}': {}", res.summary_csv, ec.message());
+  if (!scores.empty()) log << Summarize(scores).Table();
+  log << fmt::format("wrote {} ({} tracks, {} failed; -1: not fitted)\n", res.summary_csv,
+                     files.size() - res.failed.size(), res.failed.size());
+  return res;
 }
 
 }  // namespace fv

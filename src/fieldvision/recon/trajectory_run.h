@@ -19,6 +19,7 @@ struct TrajectoryJob {
   std::string in_path;           // BALL.csv or Timestamp,X,Y,Z
   std::string out_path;          // FLIGHTS.json
   double ball_diameter_m = 0.0;  // 0: 0.22 m (football), 0.04 m for the TT3D layout
+  double ball_mass_kg = 0.0;     // 0: 0.43 kg (football), 0.0027 kg for the TT3D layout
   TrajectoryOptions analysis;    // ball_radius_m is set from the diameter
   // Unmodelled acceleration allowed at breaks; 0: 10 m/s^2 (football), 25 for the TT3D layout
   // (a 2.7 g ball with strong drag and spin).
@@ -43,5 +44,24 @@ struct TrajectoryJobResult {
 };
 
 TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log);
+
+// The flights as a console table; extrapolated origins and landings are marked with '*'.
+std::string FlightTable(const TrajectoryResult& result);
+
+// The track files named by a folder (its *.csv files) or a glob pattern (`dir/*.csv`), sorted;
+// empty when `in` names a single file. Throws fv::Error when a folder or pattern matches nothing.
+std::vector<std::string> ExpandTrackInputs(const std::string& in);
+
+// Batch mode: the job for every file (job.out_path is a folder: NAME.json per track, pictures in
+// images_dir/NAME/), then one summary table, summary.csv in that folder, one row per flight (file,
+// events, times, origin and landing with their extrapolated flags, model, residuals, spin) and,
+// for tracks with a bounce, the pre-bounce scores of trajectory_eval.h printed to `log`.
+struct TrajectoryBatchResult {
+  std::vector<std::string> files;
+  std::vector<std::string> failed;  // "file: error"
+  std::string summary_csv;
+};
+TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
+                                         const std::vector<std::string>& files, std::ostream& log);
 
 }  // namespace fv

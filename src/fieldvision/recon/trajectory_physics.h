@@ -1,0 +1,51 @@
+// The flight model's equations of motion, templated on the scalar so that Ceres can
+// differentiate them: a = -g z - k |v| v + s x v (gravity, quadratic drag, Magnus lift with the
+// Magnus vector s = c_M w), integrated with classical fourth-order Runge-Kutta in steps of at
+// most kMaxStepS (trajectory.h explains the model).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+namespace fv {
+
+constexpr double kMaxStepS = 0.002;  // RK4 step
+
+// a = -g z - k |v| v + s x v, with s = c_M w (the Magnus vector, 1/s).
+template <typename T>
+void FlightAccel(const T v[3], const T& k, const T s[3], double g, T a[3]) {
+  using std::sqrt;
+  const T speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + T(1e-12));
+  a[0] = -k * speed * v[0] + (s[1] * v[2] - s[2] * v[1]);
+  a[1] = -k * speed * v[1] + (s[2] * v[0] - s[0] * v[2]);
+  a[2] = -k * speed * v[2] + (s[0] * v[1] - s[1] * v[0]);
+  a[2] -= T(g);
+}
+
+template <typename T>
+void FlightRk4Step(T p[3], T v[3], const T& k, const T s[3], double g, double h) {
+  T a1[3], a2[3], a3[3], a4[3], vt[3];
+  FlightAccel(v, k, s, g, a1);
+  for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a1[i];
+  FlightAccel(vt, k, s, g, a2);
+  T v2[3] = {vt[0], vt[1], vt[2]};
+  for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a2[i];
+  FlightAccel(vt, k, s, g, a3);
+  T v3[3] = {vt[0], vt[1], vt[2]};
+  for (int i = 0; i < 3; ++i) vt[i] = v[i] + h * a3[i];
+  FlightAccel(vt, k, s, g, a4);
+  for (int i = 0; i < 3; ++i) {
+    p[i] = p[i] + h / 6.0 * (v[i] + 2.0 * v2[i] + 2.0 * v3[i] + vt[i]);
+    v[i] = v[i] + h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i]);
+  }
+}
+
+// Propagates (p, v) by dt seconds (either sign).
+template <typename T>
+void PropagateFlight(T p[3], T v[3], const T& k, const T s[3], double g, double dt) {
+  const int n = std::max(1, static_cast<int>(std::ceil(std::abs(dt) / kMaxStepS)));
+  const double h = dt / n;
+  for (int i = 0; i < n; ++i) FlightRk4Step(p, v, k, s, g, h);
+}
+
+}  // namespace fv
