@@ -74,12 +74,13 @@ std::string FocalResult::Summary() const {
   const Eigen::Vector3d& c = camera_position_m;
   std::string s = fmt::format(
       "focal {:.1f} px (std {:.1f} px, {:.1f}%), horizontal field of view {:.2f} deg (std {:.2f}); "
-      "k1 {:.4f} (std {:.4f}); camera at ({:.3f}, {:.3f}, {:.3f}) m (std {:.3f} {:.3f} {:.3f} m); "
+      "{}; camera at ({:.3f}, {:.3f}, {:.3f}) m (std {:.3f} {:.3f} {:.3f} m); "
       "{} of {} points inliers, rms {:.2f} px (noise estimate {:.2f} px)",
       camera.fx, std_focal_px, 100 * std_focal_px / camera.fx, hfov_deg, std_hfov_deg,
-      camera.distortion.empty() ? 0.0 : camera.distortion[0], std_k1, c.x(), c.y(), c.z(),
-      std_position_m.x(), std_position_m.y(), std_position_m.z(), num_inliers, points.size(),
-      rms_px, residual_sigma_px);
+      std_k1 > 0 ? fmt::format("k1 {:.4f} (std {:.4f})", camera.distortion[0], std_k1)
+                 : std::string("k1 not estimated"),
+      c.x(), c.y(), c.z(), std_position_m.x(), std_position_m.y(), std_position_m.z(), num_inliers,
+      points.size(), rms_px, residual_sigma_px);
   return s;
 }
 
@@ -146,11 +147,6 @@ FocalResult EstimateFocalAndPose(int width, int height,
     ceres::Solve(so, problem, &summary);
     return summary;
   };
-  std::vector<bool> use(n, true);
-  {
-    ceres::Problem robust_problem;
-    solve(use, true, &robust_problem);
-  }
   auto errors = [&]() {
     const Camera c = CameraFromParams(width, height, x);
     std::vector<double> e(n);
@@ -160,6 +156,14 @@ FocalResult EstimateFocalAndPose(int width, int height,
     }
     return e;
   };
+  // Points behind the start camera cannot be evaluated (gross outliers): left out at once.
+  std::vector<bool> use(n);
+  {
+    const auto e0 = errors();
+    for (int k = 0; k < n; ++k) use[k] = e0[k] < 1e9;
+    ceres::Problem robust_problem;
+    solve(use, true, &robust_problem);
+  }
   auto e = errors();
   int n_in = 0;
   for (int k = 0; k < n; ++k) {

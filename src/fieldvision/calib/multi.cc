@@ -317,6 +317,19 @@ std::vector<MultiFrame> PairViews(const std::vector<CameraDetections>& cameras, 
         if (how) *how = "paired by frame number";
         return frames;
       }
+      for (size_t c = 1; c < n; ++c) {
+        FV_REQUIRE(
+            cameras[c].views.size() == cameras[0].views.size(),
+            "views cannot be paired: no frame number occurs in two cameras (camera '{}' "
+            "numbers {}..{}, camera '{}' {}..{}) and their image counts differ; give the "
+            "images of one moment the same number",
+            cameras[0].name,
+            *std::min_element(cameras[0].frame_numbers.begin(), cameras[0].frame_numbers.end()),
+            *std::max_element(cameras[0].frame_numbers.begin(), cameras[0].frame_numbers.end()),
+            cameras[c].name,
+            *std::min_element(cameras[c].frame_numbers.begin(), cameras[c].frame_numbers.end()),
+            *std::max_element(cameras[c].frame_numbers.begin(), cameras[c].frame_numbers.end()));
+      }
     }
   }
   if (how) *how = "paired by sorted order";
@@ -747,7 +760,7 @@ cv::Mat MultiCoveragePicture(const MultiResult& result, int camera) {
   const double scale = std::min(1.0, 960.0 / cam.width);
   const int w = static_cast<int>(std::lround(cam.width * scale));
   const int h = static_cast<int>(std::lround(cam.height * scale));
-  const int left = 64, top = 56, right = 190, bottom = 48;
+  const int left = 100, top = 56, right = 190, bottom = 48;
   cv::Mat img(h + top + bottom, w + left + right, CV_8UC3, cv::Scalar(255, 255, 255));
   const cv::Rect area(left, top, w, h);
   img(area).setTo(cv::Scalar(48, 48, 48));
@@ -822,7 +835,7 @@ cv::Mat MultiCoveragePicture(const MultiResult& result, int camera) {
     cv::putText(img, std::to_string(v), {left - 44, y + 4}, font, 0.4, black, 1, cv::LINE_AA);
   }
   cv::putText(img, "u (px)", {left + w / 2 - 20, top + h + 40}, font, 0.45, black, 1, cv::LINE_AA);
-  cv::putText(img, "v (px)", {4, top - 8}, font, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(img, "v (px)", {4, top + h / 2 + 4}, font, 0.45, black, 1, cv::LINE_AA);
   cv::putText(img,
               fmt::format("camera {}: {} of {} views used, rms {:.3f} px ({}x{} px)", rep.name,
                           rep.num_used, rep.num_found, rep.rms_px, cam.width, cam.height),

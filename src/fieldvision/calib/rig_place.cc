@@ -310,6 +310,10 @@ RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
   double best_cost = 1e300;
   Rigid3d best;
   for (const auto& [name, s] : starts) {
+    // A start that puts a point behind its camera cannot be evaluated (Ceres would stop and
+    // log); such starts are wrong anyway.
+    const auto e0 = errors(s);
+    if (std::any_of(e0.begin(), e0.end(), [](double v) { return v >= 1e9; })) continue;
     double cost = 1e300;
     const Rigid3d r = refine(s, all, &result.iterations, &cost);
     // Robust comparison: the number of points within the outlier gate, then the cost.
@@ -323,6 +327,10 @@ RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
       result.start = name;
     }
   }
+  FV_REQUIRE(result.start.size() > 0,
+             "the {} points cannot place the rig: every start puts some point behind its camera "
+             "(check the names and each camera's points file)",
+             obs.size());
   // Leave out points far off, refit once.
   auto e = errors(best);
   std::vector<bool> inlier(obs.size());
