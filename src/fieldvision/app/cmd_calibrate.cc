@@ -1,5 +1,9 @@
 // `fieldvision calibrate intrinsics|extrinsics|refine|check|rig`: parse options, call the
 // calibration library (src/fieldvision/calib), print the numbers and write the camera files.
+// `extrinsics` also places a whole rig (--rig DIR, calib/rig_place.h), calibrates a camera without
+// intrinsics from the field alone (--image-size, calib/focal.h) or fits the ground homography
+// (--homography-only); `refine --rig DIR` carries the rig with the refined camera.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -8,14 +12,17 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/app/command.h"
-#include "fieldvision/io/image_file.h"
 #include "fieldvision/calib/check.h"
 #include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/calib/focal.h"
+#include "fieldvision/calib/import.h"
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/calib/lines.h"
 #include "fieldvision/calib/rig.h"
+#include "fieldvision/calib/rig_place.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -36,6 +43,51 @@ cv::Mat ReadImage(const std::string& path) {
 }
 
 void Warn(const std::string& message) { std::cerr << "warning: " << message << "\n"; }
+
+// A rig folder (`calibrate multi --out DIR`): every camera file in it, by file name; each camera
+// named by its `name` or the file's stem.
+std::vector<Camera> ReadRigFolder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  FV_REQUIRE(fs::is_directory(dir), "rig '{}' is not a folder (give the folder of calibrate multi)",
+             dir);
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string ext = e.path().extension().string();
+    if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml"))
+      files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<Camera> rig;
+  for (const auto& f : files) {
+    Camera c = ReadCameraYaml(f);
+    if (c.name.empty()) c.name = fs::path(f).stem().string();
+    FV_REQUIRE(c.has_pose, "rig '{}': camera file '{}' has no pose (rvec/tvec)", dir, f);
+    rig.push_back(c);
+  }
+  FV_REQUIRE(!rig.empty(), "rig '{}' has no camera files (*.yaml)", dir);
+  return rig;
+}
+
+// The rig camera named by `which`: a camera name or the path/stem of one of its files.
+int FindRigCamera(const std::vector<Camera>& rig, const std::string& which,
+                  const std::string& dir) {
+  const std::string stem = std::filesystem::path(which).stem().string();
+  for (size_t i = 0; i < rig.size(); ++i) {
+    if (rig[i].name == which || rig[i].name == stem) return static_cast<int>(i);
+  }
+  std::string names;
+  for (const auto& c : rig) names += (names.empty() ? "" : ", ") + c.name;
+  Throw("rig '{}' has no camera '{}' (its cameras: {})", dir, which, names);
+}
+
+void WriteRig(const std::vector<Camera>& cams, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  for (const auto& c : cams) {
+    const std::string path = (std::filesystem::path(dir) / (c.name + ".yaml")).string();
+    WriteCameraYaml(c, path);
+    std::cout << "wrote " << path << "\n";
+  }
+}
 
 // ---- intrinsics
 struct IntrinsicsCli {
@@ -74,7 +126,9 @@ void RunIntrinsics(IntrinsicsCli& c) {
 
 // ---- extrinsics
 struct ExtrinsicsCli {
-  std::string camera, points, field, out, table;
+  std::string camera, field, out, table, rig, image_size;
+  std::vector<std::string> points;
+  bool k1 = false, homography_only = false;
   ExtrinsicsOptions o;
 };
 
@@ -90,11 +144,106 @@ void PrintPointTable(const std::vector<PointResidual>& pts) {
   }
 }
 
+void PlaceRigOnField(const ExtrinsicsCli& c, const FieldModel* field) {
+  const std::vector<Camera> rig = ReadRigFolder(c.rig);
+  std::vector<std::vector<PointCorrespondence>> pts(rig.size());
+  for (const auto& arg : c.points) {
+    const size_t eq = arg.find('=');
+    int k;
+    std::string file;
+    if (eq == std::string::npos) {
+      FV_REQUIRE(!c.camera.empty(),
+                 "--points '{}': with --rig give NAME=POINTS.csv (NAME a camera of the rig) or "
+                 "--camera NAME",
+                 arg);
+      k = FindRigCamera(rig, c.camera, c.rig);
+      file = arg;
+    } else {
+      k = FindRigCamera(rig, arg.substr(0, eq), c.rig);
+      file = arg.substr(eq + 1);
+    }
+    const auto p = ReadPointsCsv(file, field);
+    pts[k].insert(pts[k].end(), p.begin(), p.end());
+  }
+  RigPlacementOptions ro;
+  ro.pnp = c.o;
+  const RigPlacementResult r = PlaceRig(rig, pts, ro);
+  for (size_t i = 0; i < rig.size(); ++i) {
+    if (r.points[i].empty()) continue;
+    std::cout << "camera " << rig[i].name << ":\n";
+    PrintPointTable(r.points[i]);
+  }
+  std::cout << r.Summary() << "\n";
+  std::cout << fmt::format("reprojection error: {:.2f} px rms\n", r.rms_px_all);
+  if (r.num_inliers < r.num_points) {
+    Warn(fmt::format("{} points did not fit and were left out (marked 'outlier')",
+                     r.num_points - r.num_inliers));
+  }
+  std::vector<Camera> out = r.cameras;
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i].notes["placed_with_rig"] = c.rig;
+    out[i].notes["rig_placement_rms_px"] = fmt::format("{:.3f}", r.rms_px_all);
+  }
+  WriteRig(out, c.out);
+}
+
+void RunFocal(const ExtrinsicsCli& c, const FieldModel* field) {
+  int w = 0, h = 0;
+  ParseImageSize(c.image_size, "--image-size", &w, &h);
+  const auto pts = ReadPointsCsv(c.points.front(), field);
+  if (c.homography_only) {
+    const HomographyResult r = EstimateGroundHomography(w, h, pts, c.o.ransac_threshold_px);
+    PrintPointTable(r.points);
+    std::cout << r.Summary() << "\n";
+    WriteHomographyYaml(r, c.out);
+    std::cout << "wrote " << c.out << "\n";
+    return;
+  }
+  FocalOptions fo;
+  fo.pnp = c.o;
+  fo.estimate_k1 = c.k1;
+  const FocalResult r = EstimateFocalAndPose(w, h, pts, fo);
+  PrintPointTable(r.points);
+  std::cout << r.Summary() << "\n";
+  std::cout << fmt::format(
+      "focal length: {:.1f} px +- {:.1f} px (1 sigma), horizontal field of view {:.2f} deg\n"
+      "reprojection error: {:.2f} px rms\ncamera position: {:.3f} {:.3f} {:.3f} m (+- {:.3f} "
+      "{:.3f} {:.3f} m)\n",
+      r.camera.fx, r.std_focal_px, r.hfov_deg, r.rms_px, r.camera_position_m.x(),
+      r.camera_position_m.y(), r.camera_position_m.z(), r.std_position_m.x(), r.std_position_m.y(),
+      r.std_position_m.z());
+  for (const auto& w2 : r.warnings) Warn(w2);
+  Camera out = r.camera;
+  out.rms_px = r.rms_px;
+  out.notes["extrinsics_points"] = c.points.front();
+  out.notes["focal_std_px"] = fmt::format("{:.2f}", r.std_focal_px);
+  if (!c.table.empty()) WritePointErrorTable(c.table, r.points);
+  WriteCameraYaml(out, c.out);
+  std::cout << "wrote " << c.out << "\n";
+}
+
 void RunExtrinsics(const ExtrinsicsCli& c) {
-  const Camera cam = ReadCameraYaml(c.camera);
   std::unique_ptr<FieldModel> field;
   if (!c.field.empty()) field = std::make_unique<FieldModel>(LoadField(c.field));
-  const auto pts = ReadPointsCsv(c.points, field.get());
+  if (!c.rig.empty()) {
+    FV_REQUIRE(c.image_size.empty() && !c.homography_only,
+               "--rig places calibrated cameras; it does not go with --image-size or "
+               "--homography-only");
+    PlaceRigOnField(c, field.get());
+    return;
+  }
+  FV_REQUIRE(c.points.size() == 1,
+             "give one --points file (several only with --rig DIR, as NAME=POINTS.csv)");
+  FV_REQUIRE(!c.camera.empty() || !c.image_size.empty(),
+             "give --camera CAM.yaml (with intrinsics), or --image-size WxH to estimate the focal "
+             "length from the points too");
+  if (c.camera.empty()) {
+    RunFocal(c, field.get());
+    return;
+  }
+  FV_REQUIRE(!c.homography_only, "--homography-only goes with --image-size, not --camera");
+  const Camera cam = ReadCameraYaml(c.camera);
+  const auto pts = ReadPointsCsv(c.points.front(), field.get());
   const ExtrinsicsResult r = EstimatePose(cam, pts, c.o);
   PrintPointTable(r.points);
   std::cout << r.Summary() << "\n";
@@ -108,7 +257,7 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
   }
   Camera out = r.camera;
   out.rms_px = r.rms_px;
-  out.notes["extrinsics_points"] = c.points;
+  out.notes["extrinsics_points"] = c.points.front();
   out.notes["extrinsics_rms_px"] = fmt::format("{:.3f}", r.rms_px);
   if (!c.table.empty()) WritePointErrorTable(c.table, r.points);
   WriteCameraYaml(out, c.out);
@@ -117,17 +266,26 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
 
 // ---- refine
 struct RefineCli {
-  std::string camera, image, field, out, overlay;
+  std::string camera, image, field, out, overlay, rig;
   RefineOptions o;
 };
 
 void RunRefine(const RefineCli& c) {
-  const Camera cam = ReadCameraYaml(c.camera);
+  std::vector<Camera> rig;
+  int k = -1;
+  Camera cam;
+  if (!c.rig.empty()) {
+    rig = ReadRigFolder(c.rig);
+    k = FindRigCamera(rig, c.camera, c.rig);
+    cam = rig[k];
+  } else {
+    cam = ReadCameraYaml(c.camera);
+  }
   const cv::Mat image = ReadImage(c.image);
   CheckImageSize(image, cam, c.image, c.camera);
   const FieldModel field = LoadField(c.field);
   const RefineResult r = RefineWithLines(cam, image, field, c.o);
-  std::cout << fmt::format("before: {}\nafter:  {}\n", r.before.Summary(), r.after.Summary());
+  // One report: the library's summary, then the contract's line error.
   std::cout << r.Summary() << "\n";
   std::cout << fmt::format(
       "line error: mean {:.1f} mm, p95 {:.1f} mm (before: mean {:.1f} mm, "
@@ -139,6 +297,22 @@ void RunRefine(const RefineCli& c) {
     out.notes["refined_with_lines"] = c.image;
     out.notes["line_error_mean_mm"] = fmt::format("{:.1f}", r.after.mean_mm);
     out.notes["line_error_p95_mm"] = fmt::format("{:.1f}", r.after.p95_mm);
+  }
+  if (!rig.empty()) {
+    // The rig follows the refined camera rigidly.
+    std::vector<Camera> moved = CarryRig(rig, k, out.cam_from_world);
+    moved[k] = out;
+    std::cout << fmt::format(
+        "the rig's {} cameras follow {} (moved {:.1f} mm, turned {:.3f} deg)\n", rig.size(),
+        cam.name, 1000 * r.moved_m, r.rotated_deg);
+    WriteRig(moved, c.out);
+    if (!c.overlay.empty()) {
+      CheckOptions co;
+      co.detect = c.o.detect;
+      WriteImage(c.overlay, CheckCalibration(out, image, field, {}, co).overlay);
+      std::cout << "wrote " << c.overlay << "\n";
+    }
+    return;
   }
   WriteCameraYaml(out, c.out);
   std::cout << "wrote " << c.out << "\n";
@@ -201,6 +375,12 @@ void RunRig(const RigCli& c) {
   }
   const RigResult r = RefineRig(cams, obs, c.o);
   std::cout << r.Summary() << "\n";
+  if (r.free_points.empty()) {
+    std::cout << "note: every point has a known position, so no point ties the cameras together: "
+                 "each camera's pose was refined against its own points only (as `calibrate "
+                 "extrinsics` would); name points seen by several cameras without x,y,z to "
+                 "adjust the rig jointly\n";
+  }
   for (const auto& [name, p] : r.free_points) {
     std::cout << fmt::format("  point {}: ({:.3f}, {:.3f}, {:.3f}) m\n", name, p.x(), p.y(), p.z());
   }
@@ -263,10 +443,27 @@ void Setup(CLI::App& app, int& exit_code) {
   auto ec = std::make_shared<ExtrinsicsCli>();
   CLI::App* ex = group->add_subcommand(
       "extrinsics", "Camera pose from clicked points of known position (RANSAC PnP + refinement)");
-  ex->add_option("--camera", ec->camera, "Camera file with intrinsics")->required();
-  ex->add_option("--points", ec->points, "CSV with u,v,x,y,z (metres) or u,v,name")->required();
+  ex->add_option("--camera", ec->camera,
+                 "Camera file with intrinsics (with --rig: the rig camera the --points belong to)");
+  ex->add_option("--points", ec->points,
+                 "CSV with u,v,x,y,z (metres) or u,v,name; with --rig NAME=POINTS.csv, repeated "
+                 "for the rig's cameras")
+      ->required();
   ex->add_option("--field", ec->field, "Field for named points (built-in name or JSON)");
-  ex->add_option("--out", ec->out, "Camera file to write")->required();
+  ex->add_option("--out", ec->out,
+                 "Camera file to write (with --rig: a folder for every camera; with "
+                 "--homography-only: the homography file)")
+      ->required();
+  ex->add_option("--rig", ec->rig,
+                 "Folder of a calibrated rig (calibrate multi --out): place the whole rig from "
+                 "points seen by any of its cameras, keeping their relative poses");
+  ex->add_option("--image-size", ec->image_size,
+                 "WxH: a camera without intrinsics (a phone); the focal length (principal point "
+                 "at the centre) is estimated with the pose from 6 or more points, with its "
+                 "uncertainty");
+  ex->add_flag("--k1", ec->k1, "With --image-size: also estimate the radial distortion k1");
+  ex->add_flag("--homography-only", ec->homography_only,
+               "With --image-size and ground points (z = 0): fit only the image-ground homography");
   ex->add_option("--threshold", ec->o.ransac_threshold_px, "RANSAC inlier threshold in pixels")
       ->capture_default_str();
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
@@ -275,7 +472,12 @@ void Setup(CLI::App& app, int& exit_code) {
   auto rc = std::make_shared<RefineCli>();
   CLI::App* re =
       group->add_subcommand("refine", "Refine the pose against the painted field lines in a frame");
-  re->add_option("--camera", rc->camera, "Camera file with a pose")->required();
+  re->add_option("--camera", rc->camera,
+                 "Camera file with a pose (with --rig: the name of the rig camera of --image)")
+      ->required();
+  re->add_option("--rig", rc->rig,
+                 "Folder of a rig placed on the field: refine --camera and move every camera of "
+                 "the rig with it (--out is then a folder)");
   re->add_option("--image", rc->image, "Frame of this camera")->required();
   re->add_option("--field", rc->field, "Field (built-in name or JSON)")->required();
   re->add_option("--out", rc->out, "Camera file to write")->required();

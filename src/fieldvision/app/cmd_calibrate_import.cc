@@ -1,34 +1,171 @@
-// `fieldvision calibrate import --tsai FILE.xml --out CAM.yaml`: a Tsai calibration (PETS 2009)
-// as the camera file of CONTRACT.md.
+// `fieldvision calibrate import` / `calibrate export`: calibrations made elsewhere as the camera
+// files of CONTRACT.md (Tsai XML as PETS, Qualisys .qca.txt, Pose2Sim/anipose calibration.toml,
+// OpenCV stereo YAML/XML), and camera files back to calibration.toml.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <regex>
+#include <sstream>
+
+#include <fmt/format.h>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/calib/import.h"
+#include "fieldvision/calib/pose2sim.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/track/pets.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
 
 struct ImportCli {
-  std::string tsai, out, name;
+  std::string tsai, qualisys, toml, out, name, image_size, units = "m";
+  std::vector<std::string> opencv_stereo;
 };
+
+struct ExportCli {
+  std::vector<std::string> cameras;
+  std::string rig, toml;
+};
+
+// The name attribute of a Tsai file's <Camera name="..."> ("" when absent).
+std::string TsaiCameraName(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  static const std::regex kName(R"(<Camera[^>]*\sname\s*=\s*\"([^\"]*)\")");
+  std::smatch m;
+  return std::regex_search(text, m, kName) ? m[1].str() : std::string();
+}
+
+double MetresPerUnit(const std::string& units) {
+  if (units == "m") return 1.0;
+  if (units == "mm") return 0.001;
+  if (units == "cm") return 0.01;
+  Throw("--units '{}' is not known; use m, cm or mm", units);
+}
+
+void WriteCameras(const std::vector<Camera>& cams, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  for (size_t i = 0; i < cams.size(); ++i) {
+    const std::string name = cams[i].name.empty() ? fmt::format("cam{}", i + 1) : cams[i].name;
+    const std::string path = (std::filesystem::path(dir) / (name + ".yaml")).string();
+    WriteCameraYaml(cams[i], path);
+    const Eigen::Vector3d c = cams[i].has_pose ? cams[i].CentreInWorld() : Eigen::Vector3d::Zero();
+    std::cout << fmt::format(
+        "{}: {}x{}, fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}{}\nwrote {}\n", name, cams[i].width,
+        cams[i].height, cams[i].fx, cams[i].fy, cams[i].cx, cams[i].cy,
+        cams[i].has_pose ? fmt::format(", centre ({:.3f}, {:.3f}, {:.3f}) m", c.x(), c.y(), c.z())
+                         : std::string(", no pose"),
+        path);
+  }
+}
+
+void RunImport(const ImportCli& c) {
+  const int sources =
+      !c.tsai.empty() + !c.qualisys.empty() + !c.toml.empty() + !c.opencv_stereo.empty();
+  FV_REQUIRE(sources == 1, "give one of --tsai, --qualisys, --toml or --opencv-stereo (got {})",
+             sources);
+  if (!c.tsai.empty()) {
+    const track::TsaiParameters p = track::ReadTsaiXml(c.tsai);
+    std::string name = c.name;
+    if (name.empty()) name = TsaiCameraName(c.tsai);
+    if (name.empty()) name = std::filesystem::path(c.tsai).stem().string();
+    const track::TsaiConversion conv = track::CameraFromTsai(p, name);
+    WriteCameraYaml(conv.camera, c.out);
+    std::cout << conv.Summary() << "\ncamera " << name << "\nwrote " << c.out << "\n";
+    return;
+  }
+  std::vector<Camera> cams;
+  if (!c.qualisys.empty()) {
+    cams = calib::ReadQualisysCalibration(c.qualisys);
+  } else if (!c.toml.empty()) {
+    cams = calib::ReadCalibrationToml(c.toml, MetresPerUnit(c.units));
+  } else {
+    int w = 0, h = 0;
+    FV_REQUIRE(!c.image_size.empty(),
+               "--opencv-stereo: the files do not hold the image size; give --image-size WxH");
+    calib::ParseImageSize(c.image_size, "--image-size", &w, &h);
+    cams = calib::ReadOpenCvStereo(c.opencv_stereo, w, h, MetresPerUnit(c.units));
+  }
+  if (!c.name.empty()) {
+    FV_REQUIRE(cams.size() == 1, "--name applies to a single camera; the file has {}", cams.size());
+    cams[0].name = c.name;
+  }
+  for (size_t i = 0; i + 1 < cams.size(); ++i) {
+    if (!cams[i].has_pose || !cams[i + 1].has_pose) continue;
+    const double baseline = (cams[i].CentreInWorld() - cams[i + 1].CentreInWorld()).norm();
+    if (baseline > 100) {
+      std::cerr << fmt::format(
+          "warning: cameras {} and {} are {:.0f} m apart: were the translations in mm? (--units "
+          "mm)\n",
+          cams[i].name, cams[i + 1].name, baseline);
+      break;
+    }
+  }
+  WriteCameras(cams, c.out);
+}
+
+void RunExport(const ExportCli& c) {
+  std::vector<std::string> files = c.cameras;
+  if (!c.rig.empty()) {
+    FV_REQUIRE(std::filesystem::is_directory(c.rig), "rig '{}' is not a folder", c.rig);
+    for (const auto& e : std::filesystem::directory_iterator(c.rig)) {
+      const std::string ext = e.path().extension().string();
+      if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml")) {
+        files.push_back(e.path().string());
+      }
+    }
+    std::sort(files.begin(), files.end());
+  }
+  FV_REQUIRE(!files.empty(), "give --camera CAM.yaml (repeat) or --rig DIR");
+  std::vector<Camera> cams;
+  for (const auto& f : files) {
+    cams.push_back(ReadCameraYaml(f));
+    if (cams.back().name.empty()) cams.back().name = std::filesystem::path(f).stem().string();
+  }
+  calib::WriteCalibrationToml(cams, c.toml);
+  std::cout << "wrote " << c.toml << " (" << cams.size() << " cameras)\n";
+}
 
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(
       app, "calibrate",
       "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
   auto c = std::make_shared<ImportCli>();
-  CLI::App* cmd =
-      group->add_subcommand("import", "Import a calibration made elsewhere (Tsai XML, as PETS)");
-  cmd->add_option("--tsai", c->tsai, "Tsai camera file (e.g. PETS View_001.xml)")->required();
-  cmd->add_option("--out", c->out, "Camera file to write (CAM.yaml)")->required();
-  cmd->add_option("--name", c->name, "Camera name (default: the Tsai file's name attribute)");
-  cmd->callback([c] {
-    const track::TsaiParameters p = track::ReadTsaiXml(c->tsai);
-    const track::TsaiConversion conv = track::CameraFromTsai(p, c->name.empty() ? "tsai" : c->name);
-    WriteCameraYaml(conv.camera, c->out);
-    std::cout << conv.Summary() << "\nwrote " << c->out << "\n";
-  });
+  CLI::App* cmd = group->add_subcommand(
+      "import",
+      "Import a calibration made elsewhere (Tsai XML, Qualisys, Pose2Sim/anipose TOML, OpenCV "
+      "stereo)");
+  cmd->add_option("--tsai", c->tsai, "Tsai camera file (e.g. PETS View_001.xml)");
+  cmd->add_option("--qualisys", c->qualisys, "Qualisys calibration export (Calib.qca.txt)");
+  cmd->add_option("--toml", c->toml, "Pose2Sim Calib.toml or anipose calibration.toml");
+  cmd->add_option("--opencv-stereo", c->opencv_stereo,
+                  "OpenCV stereo file(s) with M1 D1 M2 D2 [R T] (intrinsics.yml, extrinsics.yml; "
+                  "repeat)");
+  cmd->add_option("--image-size", c->image_size, "WxH, for --opencv-stereo");
+  cmd->add_option("--units", c->units,
+                  "Unit of the file's translations: m (Pose2Sim), mm or cm (anipose and OpenCV "
+                  "use the board's unit)")
+      ->capture_default_str();
+  cmd->add_option("--out", c->out,
+                  "Camera file to write (--tsai) or folder for NAME.yaml per camera (others)")
+      ->required();
+  cmd->add_option("--name", c->name,
+                  "Camera name (default: the file's camera name, e.g. the Tsai name attribute)");
+  cmd->callback([c] { RunImport(*c); });
+
+  auto e = std::make_shared<ExportCli>();
+  CLI::App* ex = group->add_subcommand(
+      "export", "Write camera files as a Pose2Sim / anipose calibration.toml (metres)");
+  ex->add_option("--camera", e->cameras, "Camera file with a pose (repeat)");
+  ex->add_option("--rig", e->rig, "Folder of camera files (e.g. calibrate multi --out)");
+  ex->add_option("--toml", e->toml, "calibration.toml to write")->required();
+  ex->callback([e] { RunExport(*e); });
+  (void)exit_code;
 }
 
 FV_REGISTER_COMMAND(21, "calibrate import", Setup);

@@ -1,0 +1,161 @@
+// `fieldvision calibrate multi`: intrinsics and relative poses of 2..N cameras from synchronized
+// views of one board (calib/multi.h); writes DIR/NAME.yaml per camera (pose in the first camera's
+// frame), DIR/NAME_coverage.png, DIR/corners.csv and DIR/calibration.toml (Pose2Sim/anipose).
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+
+#include "fieldvision/app/command.h"
+#include "fieldvision/calib/import.h"
+#include "fieldvision/calib/multi.h"
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/io/image_file.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::app {
+namespace {
+
+using namespace fv::calib;
+
+struct MultiCli {
+  std::string board = "chessboard", out, pairing = "auto";
+  int cols = 0, rows = 0;
+  double square_m = 0.0, marker_m = 0.0;
+  std::string dictionary = "DICT_4X4_50";
+  std::vector<std::string> views, intrinsics;
+  bool fix_intrinsics = false, quiet = false, no_pictures = false;
+  MultiOptions o;
+};
+
+void RunMulti(MultiCli& c) {
+  c.o.board.type = ParseBoardType(c.board);
+  c.o.board.cols = c.cols;
+  c.o.board.rows = c.rows;
+  c.o.board.square_m = c.square_m;
+  c.o.board.marker_m = c.marker_m;
+  c.o.board.dictionary = c.dictionary;
+  c.o.pairing = ParsePairing(c.pairing);
+  c.o.progress = !c.quiet;
+  c.o.refine_intrinsics = !c.fix_intrinsics;
+  std::vector<CameraViews> cams;
+  for (const auto& v : c.views) cams.push_back(ParseCameraViews(v));
+  for (const auto& k : c.intrinsics) {
+    const CameraViews kv = ParseCameraViews(k);  // NAME=CAM.yaml
+    const bool known = std::any_of(cams.begin(), cams.end(),
+                                   [&](const CameraViews& v) { return v.name == kv.name; });
+    FV_REQUIRE(known, "--intrinsics '{}': no --views names camera '{}'", k, kv.name);
+    c.o.known_intrinsics[kv.name] = ReadCameraYaml(kv.source);
+  }
+  c.o.Check();
+  const MultiResult r = CalibrateMulti(cams, c.o);
+
+  std::cout << fmt::format("{:<12s} {:>6s} {:>6s} {:>6s} {:>9s} {:>9s} {:>9s} {:>9s} {:>9s}  {}\n",
+                           "camera", "images", "found", "used", "rms_px", "fx", "fy", "cx", "cy",
+                           "chained from");
+  for (size_t i = 0; i < r.cameras.size(); ++i) {
+    const auto& rep = r.camera_reports[i];
+    const Camera& cam = r.cameras[i];
+    std::cout << fmt::format(
+        "{:<12s} {:>6d} {:>6d} {:>6d} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}  {}\n", rep.name,
+        rep.num_images, rep.num_found, rep.num_used, rep.rms_px, cam.fx, cam.fy, cam.cx, cam.cy,
+        rep.tree_parent < 0
+            ? std::string("(reference)")
+            : fmt::format("{} ({} shared views)", r.camera_reports[rep.tree_parent].name,
+                          rep.tree_shared_views));
+  }
+  std::cout << fmt::format("\n{:<24s} {:>12s} {:>12s} {:>7s}\n", "pair", "rotation_deg",
+                           "baseline_mm", "shared");
+  for (const auto& p : r.pairs) {
+    std::cout << fmt::format("{:<24s} {:>12.3f} {:>12.2f} {:>7d}\n",
+                             r.camera_reports[p.i].name + " - " + r.camera_reports[p.j].name,
+                             p.rotation_deg, 1000 * p.baseline_m, p.shared_views);
+  }
+  bool any_dropped = false;
+  for (const auto& v : r.views) {
+    if (v.used) continue;
+    if (!any_dropped) std::cout << "\ndropped views:\n";
+    any_dropped = true;
+    std::cout << fmt::format("  {} ({}): {}\n", v.name, r.camera_reports[v.camera].name,
+                             v.dropped_because);
+  }
+  std::cout << fmt::format(
+      "\n{} moments with the board ({}); rms {:.3f} px over all used corners; bundle adjustment "
+      "cost {:.4g} -> {:.4g} in {} iterations\n",
+      r.num_frames, r.pairing, r.rms_px, r.initial_cost, r.final_cost, r.iterations);
+  for (const auto& w : r.warnings) std::cerr << "warning: " << w << "\n";
+
+  namespace fs = std::filesystem;
+  fs::create_directories(c.out);
+  for (size_t i = 0; i < r.cameras.size(); ++i) {
+    const std::string path = (fs::path(c.out) / (r.cameras[i].name + ".yaml")).string();
+    WriteCameraYaml(r.cameras[i], path);
+    std::cout << "wrote " << path << "\n";
+    if (!c.no_pictures) {
+      const std::string pic = (fs::path(c.out) / (r.cameras[i].name + "_coverage.png")).string();
+      WriteImage(pic, MultiCoveragePicture(r, static_cast<int>(i)));
+      std::cout << "wrote " << pic << "\n";
+    }
+  }
+  const std::string corners = (fs::path(c.out) / "corners.csv").string();
+  WriteMultiCorners(corners, r);
+  const std::string toml = (fs::path(c.out) / "calibration.toml").string();
+  WriteCalibrationToml(r.cameras, toml);
+  std::cout << "wrote " << corners << "\nwrote " << toml << "\n";
+}
+
+void Setup(CLI::App& app, int& exit_code) {
+  CLI::App* group = CommandGroup(
+      app, "calibrate",
+      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
+  auto c = std::make_shared<MultiCli>();
+  CLI::App* cmd = group->add_subcommand(
+      "multi",
+      "Intrinsics and relative poses of 2..N cameras from synchronized views of one board");
+  cmd->add_option("--board", c->board, "chessboard or charuco")->capture_default_str();
+  cmd->add_option("--cols", c->cols, "Chessboard: inner corners per row; ChArUco: squares per row")
+      ->required();
+  cmd->add_option("--rows", c->rows,
+                  "Chessboard: inner corners per column; ChArUco: squares per column")
+      ->required();
+  cmd->add_option("--square", c->square_m, "Square side in metres (25 mm: 0.025)")->required();
+  cmd->add_option("--marker", c->marker_m, "ChArUco marker side in metres (default 0.7 x square)");
+  cmd->add_option("--dictionary", c->dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+  cmd->add_option("--views", c->views,
+                  "NAME=GLOB_OR_DIR_OR_VIDEO, one per camera (repeat); the first is the reference")
+      ->required();
+  cmd->add_option("--pairing", c->pairing,
+                  "auto (frame number when every file name has one, else sorted order), order or "
+                  "frame")
+      ->capture_default_str();
+  cmd->add_option("--intrinsics", c->intrinsics,
+                  "NAME=CAM.yaml: known intrinsics of a camera, kept fixed (repeat)");
+  cmd->add_flag("--fix-intrinsics", c->fix_intrinsics,
+                "Keep every camera's own intrinsics fixed in the joint adjustment");
+  cmd->add_option("--model", c->o.num_distortion,
+                  "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
+      ->capture_default_str();
+  cmd->add_option("--loss-px", c->o.loss_px, "Huber scale of the bundle adjustment in pixels")
+      ->capture_default_str();
+  cmd->add_option("--outlier-factor", c->o.outlier_factor,
+                  "Drop views with RMS above this x the median (and above --outlier-min-px)")
+      ->capture_default_str();
+  cmd->add_option("--outlier-min-px", c->o.outlier_min_px, "See --outlier-factor")
+      ->capture_default_str();
+  cmd->add_option("--min-shared", c->o.min_shared_views,
+                  "Views two cameras must share to be linked")
+      ->capture_default_str();
+  cmd->add_option("--max-frames", c->o.source.max_video_frames, "Frames sampled from a video")
+      ->capture_default_str();
+  cmd->add_option("--out", c->out, "Folder for NAME.yaml per camera and the pictures")->required();
+  cmd->add_flag("--no-pictures", c->no_pictures, "Do not write the coverage pictures");
+  cmd->add_flag("--quiet", c->quiet, "No progress");
+  cmd->callback([c] { RunMulti(*c); });
+  (void)exit_code;
+}
+
+FV_REGISTER_COMMAND(22, "calibrate multi", Setup);
+
+}  // namespace
+}  // namespace fv::app
