@@ -44,6 +44,7 @@ class FileSource : public FrameSource {
  public:
   FileSource(const std::string& path, const FrameSourceOptions& options);
   bool ReadFrame(SourceFrame* out) override;
+  bool SkipFrame() override;
   bool encoded() const override { return encoded_; }
   long long FrameCount() const override { return frame_count_; }
   cv::Size FrameSize() const override { return size_; }
@@ -182,6 +183,26 @@ bool FileSource::ReadFrame(SourceFrame* out) {
   }
   out->frame = next_frame_++;
   out->origin = origin_;
+  return true;
+}
+
+bool FileSource::SkipFrame() {
+  if (has_pending_) {
+    pending_ = SourceFrame();
+    has_pending_ = false;
+  } else if (encoded_) {
+    SourceFrame f;
+    if (!GrabEncoded(&f)) return false;
+  } else {
+    bool ok = false;
+    try {
+      ok = capture_.grab();  // no decoding
+    } catch (const cv::Exception&) {
+      ok = false;
+    }
+    if (!ok) return false;
+  }
+  ++next_frame_;
   return true;
 }
 

@@ -44,6 +44,11 @@ void FrameSourceOptions::Check() const {
              "FrameSourceOptions.exposure_us must be >= 0 (got {})", exposure_us);
 }
 
+bool FrameSource::SkipFrame() {
+  SourceFrame f;
+  return ReadFrame(&f);
+}
+
 bool FrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
   SourceFrame f;
   if (!ReadFrame(&f)) return false;

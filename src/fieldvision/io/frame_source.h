@@ -56,7 +56,7 @@ struct FrameSourceOptions {
   // frames (SourceFrame::jpeg) so that a camera stage can decode only where the ball is.
   bool encoded = false;
   // Files: delivered at their own frame rate from start_at_s (Unix seconds on the system clock;
-  // 0: when opened), stamped with each frame's scheduled capture time. Synth scenes always are.
+  // 0: the first read), stamped with each frame's scheduled capture time. Synth scenes always are.
   bool realtime = false;
   double start_at_s = 0.0;
   int live_buffer_frames = 4;  // frames a live source holds for a slow reader (oldest dropped)
@@ -74,6 +74,8 @@ class FrameSource {
   // The next frame, encoded when the source keeps it so (options.encoded); false at the end of
   // the stream. Throws fv::Error naming the source when it fails (a camera that disappears).
   virtual bool ReadFrame(SourceFrame* out) = 0;
+  // Skips the next frame without decoding it where the source can; false at the end.
+  virtual bool SkipFrame();
   // The next frame decoded to BGR, its number and capture time; false at the end.
   bool Read(cv::Mat* bgr, long long* frame, double* time_s);
   // Frames in the stream, or -1 when unknown (live).

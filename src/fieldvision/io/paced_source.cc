@@ -1,5 +1,6 @@
 // Frame-source backend: a finite source (a file, a rendered scene) delivered as a live camera
-// would deliver it. Frame k is captured at start + k / fps on the system clock and stamped so
+// would deliver it. Frame k is captured at start + k / fps on the system clock (start: the given
+// Unix time, else the first read) and stamped so
 // (TimeOrigin::kPlayback); a reader that asks early waits for it, a reader more than
 // live_buffer_frames behind finds the oldest frames gone (skipped and counted), as with a
 // camera's driver buffers.
@@ -17,18 +18,19 @@ class PacedSource : public FrameSource {
  public:
   PacedSource(std::unique_ptr<FrameSource> source, const FrameSourceOptions& options)
       : source_(std::move(source)),
-        start_s_(options.start_at_s > 0 ? options.start_at_s : SystemClockNow()),
+        start_s_(options.start_at_s),
         buffer_(options.live_buffer_frames) {
     FV_REQUIRE(source_->fps() > 0, "video '{}': no frame rate to play it at", source_->name());
   }
 
   bool ReadFrame(SourceFrame* out) override {
+    if (start_s_ <= 0) start_s_ = SystemClockNow();  // no start given: the first read starts it
     const double period_s = 1.0 / source_->fps();
     // The newest frame captured by now; older than newest - buffer + 1 is gone.
     const double now = SystemClockNow();
     const long long newest = static_cast<long long>(std::floor((now - start_s_) / period_s));
     while (next_ < newest - buffer_ + 1) {
-      if (!source_->ReadFrame(out)) return false;
+      if (!source_->SkipFrame()) return false;
       ++next_;
       ++dropped_;
     }

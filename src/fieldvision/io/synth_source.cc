@@ -2,9 +2,13 @@
 // &seed=N&width=W&height=H&frames=N" (the parameters of `fieldvision synth`; camera: a name or an
 // index, default the first). Frames are rendered on demand (synth/synth.h), JPEG-compressed at
 // the scene's quality when encoded frames are asked for, and delivered at the scene's frame rate
-// as a camera would (paced_source.cc), so a camera node can be tested without a camera.
+// as a camera would, so camera nodes can be tested without cameras.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <map>
+#include <thread>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -17,18 +21,37 @@
 namespace fv::io_backend {
 namespace {
 
-class SynthSceneSource : public FrameSource {
+// Live: frame k is captured at start + k / fps (given start_at_s: frames 0..N-1, then the end)
+// or, without a start, on the world's clock: at Unix time t every synth camera of the scene sees
+// scene frame floor(t fps) mod N (the scene loops), so nodes started at different moments agree.
+class SynthLiveSource : public FrameSource {
  public:
-  SynthSceneSource(const std::string& spec, const synth::SceneSpec& scene, int camera, bool encoded)
-      : spec_(spec), encoded_(encoded) {
+  SynthLiveSource(const std::string& spec, const synth::SceneSpec& scene, int camera,
+                  const FrameSourceOptions& o)
+      : spec_(spec), encoded_(o.encoded), start_s_(o.start_at_s), buffer_(o.live_buffer_frames) {
     synth::SceneSpec one = scene;
     one.cameras = {scene.cameras[camera]};
     renderer_ = std::make_unique<synth::SceneRenderer>(one);
     quality_ = scene.jpeg_quality;
   }
   bool ReadFrame(SourceFrame* out) override {
-    if (next_ >= renderer_->num_frames()) return false;
-    const cv::Mat bgr = renderer_->RenderCamera(0, static_cast<int>(next_));
+    const double fps = renderer_->fps();
+    const long long n = renderer_->num_frames();
+    const double now = SystemClockNow();
+    // The newest frame captured by now, in this source's numbering of capture instants.
+    const long long newest = static_cast<long long>(std::floor((now - start_s_) * fps));
+    if (next_ < 0) next_ = start_s_ > 0 ? 0 : std::max(0LL, newest);  // looping: join now
+    long long oldest = newest - buffer_ + 1;  // older frames are gone
+    if (start_s_ > 0) oldest = std::min(oldest, n);
+    if (next_ < oldest) {
+      dropped_ += oldest - next_;
+      next_ = oldest;
+    }
+    if (start_s_ > 0 && next_ >= n) return false;
+    if (first_ < 0) first_ = next_;
+    const double capture_s = start_s_ + next_ / fps;
+    const int scene_frame = static_cast<int>(next_ % n);
+    const cv::Mat bgr = renderer_->RenderCamera(0, scene_frame);
     out->bgr = cv::Mat();
     out->jpeg.clear();
     if (encoded_) {
@@ -36,27 +59,35 @@ class SynthSceneSource : public FrameSource {
     } else {
       out->bgr = bgr;
     }
-    out->frame = next_;
-    out->time_s = renderer_->FrameTime(static_cast<int>(next_));
-    out->origin = TimeOrigin::kFrameRate;
+    const double wait_s = capture_s - SystemClockNow();
+    if (wait_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
+    out->frame = next_ - first_;
+    out->time_s = capture_s;
+    out->origin = TimeOrigin::kPlayback;
     ++next_;
     return true;
   }
-  long long FrameCount() const override { return renderer_->num_frames(); }
+  long long FrameCount() const override { return start_s_ > 0 ? renderer_->num_frames() : -1; }
   cv::Size FrameSize() const override {
     const Camera& c = renderer_->cameras()[0];
     return {c.width, c.height};
   }
   std::string name() const override { return spec_; }
   double fps() const override { return renderer_->fps(); }
+  bool live() const override { return true; }
   bool encoded() const override { return encoded_; }
+  long long dropped() const override { return dropped_; }
 
  private:
   std::string spec_;
   bool encoded_;
+  double start_s_;  // 0: the world's clock (see above)
+  long long buffer_;
   int quality_ = 90;
   std::unique_ptr<synth::SceneRenderer> renderer_;
-  long long next_ = 0;
+  long long next_ = -1;   // capture instant of the next frame
+  long long first_ = -1;  // of the first frame delivered
+  long long dropped_ = 0;
 };
 
 }  // namespace
@@ -128,8 +159,7 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
     FV_REQUIRE(camera >= 0 && camera < static_cast<int>(scene.cameras.size()),
                "video '{}': the scene has no camera '{}'", spec, camera_key);
   }
-  auto source = std::make_unique<SynthSceneSource>(spec, scene, camera, options.encoded);
-  return Paced(std::move(source), options);
+  return std::make_unique<SynthLiveSource>(spec, scene, camera, options);
 }
 
 }  // namespace fv::io_backend
