@@ -1,0 +1,68 @@
+// `fieldvision node`: a camera node; finds the ball in one camera's frames and sends timestamped
+// detections to the fusion node (net/node.h).
+#include <csignal>
+#include <iostream>
+#include <memory>
+
+#include "fieldvision/app/command.h"
+#include "fieldvision/net/node.h"
+
+namespace fv::app {
+namespace {
+
+JobControl* g_node_control = nullptr;
+
+void Setup(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<net::NodeOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "node", "Camera node: find the ball in one camera and send detections to `fuse`");
+  cmd->add_option("--camera", o->camera, "Camera file (its name, else its stem, names it)")
+      ->required();
+  cmd->add_option("--video", o->video,
+                  "Video file, image pattern, v4l2:/dev/videoN, rtsp://..., gst:PIPELINE, "
+                  "aravis:[ID] or synth:PRESET?camera=NAME")
+      ->required();
+  cmd->add_option("--connect", o->connect, "The fusion node, tcp://HOST:PORT")->required();
+  cmd->add_flag("--realtime", o->realtime,
+                "Play a file at its own frame rate, as a live camera would deliver it");
+  cmd->add_option("--start-at", o->start_at_s,
+                  "With --realtime: Unix time (s) of frame 0, as for cameras triggered together");
+  cmd->add_option("--live-buffer", o->live_buffer_frames,
+                  "Frames a live source holds for a slow node (the oldest are dropped)")
+      ->capture_default_str();
+  cmd->add_option("--ball-diameter", o->ball_diameter_m, "Ball diameter in metres")
+      ->capture_default_str();
+  cmd->add_option("--color,--colour", o->colour, "Colour preset or colour file of the ball")
+      ->capture_default_str();
+  cmd->add_option("--field", o->field, "Field (name or JSON): look for the ball only over it");
+  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
+  cmd->add_flag("!--whole-frames", o->track.enabled,
+                "Search every frame whole (no tracking window)");
+  cmd->add_option("--connect-wait", o->connect_wait_s,
+                  "Seconds to wait for the fusion node's first clock reply before starting")
+      ->capture_default_str();
+  cmd->add_option("--clock-offset", o->clock_offset_s,
+                  "Testing: add this many seconds to this node's clock (a machine whose clock "
+                  "is off)");
+  cmd->add_flag("!--no-detect", o->detect,
+                "Send frames without looking for the ball (a latency baseline)");
+  cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
+  cmd->callback([o, &exit_code] {
+    JobControl control;
+    g_node_control = &control;
+    auto on_signal = [](int) {
+      if (g_node_control != nullptr) g_node_control->Stop();
+    };
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    o->control = &control;
+    const net::NodeSummary s = net::RunNode(*o);
+    g_node_control = nullptr;
+    std::cout << s.ToString() << "\n";
+  });
+}
+
+FV_REGISTER_COMMAND(45, "node", Setup);
+
+}  // namespace
+}  // namespace fv::app

@@ -1,0 +1,291 @@
+#include "fieldvision/net/fuse.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+#include <zmq.hpp>
+
+#include "fieldvision/io/frame_source.h"
+#include "fieldvision/net/messages.h"
+#include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::net {
+
+void FuseOptions::Check() const {
+  FV_REQUIRE(StartsWith(listen, "tcp://") || StartsWith(listen, "ipc://"),
+             "fuse: --listen must be tcp://HOST:PORT (got '{}')", listen);
+  FV_REQUIRE(publish.empty() || StartsWith(publish, "tcp://") || StartsWith(publish, "ipc://"),
+             "fuse: --publish must be tcp://HOST:PORT (got '{}')", publish);
+  FV_REQUIRE(!cameras.empty(), "fuse: give at least one --camera");
+  FV_REQUIRE(!out.empty(), "fuse: --out is required");
+  FV_REQUIRE(std::isfinite(idle_exit_s) && idle_exit_s >= 0, "fuse: --idle-exit must be >= 0");
+  FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
+             "fuse: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
+  sync.Check();
+  triangulation.Check();
+}
+
+double Percentile(std::vector<double> v, double p) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const double rank = std::ceil(p / 100.0 * static_cast<double>(v.size()));
+  const size_t i = static_cast<size_t>(std::clamp(rank, 1.0, static_cast<double>(v.size()))) - 1;
+  return v[i];
+}
+
+std::string FuseSummary::ToString() const {
+  std::string s = fmt::format(
+      "{} frames fused, {} with a ball position ({:.1f} %), mean reprojection error {:.2f} px",
+      fusion.frames, fusion.frames_with_position,
+      fusion.frames ? 100.0 * fusion.frames_with_position / fusion.frames : 0.0,
+      fusion.frames_with_position ? fusion.sum_err_px / fusion.frames_with_position : 0.0);
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    const FuseCameraReport& r = cameras[c];
+    s += fmt::format("\n{}: {} frames, {} positions", r.name, r.frames,
+                     c < fusion.used_per_camera.size() ? fusion.used_per_camera[c] : 0);
+    if (r.has_offset) s += fmt::format(", clock offset {:+.4f} s", r.offset_s);
+    if (r.sessions > 1) s += fmt::format(", {} sessions (restarted)", r.sessions);
+  }
+  for (const std::string& p : sync_problems) s += "\nsync: " + p;
+  const long long refused =
+      malformed + oversized + wrong_version + unknown_camera + unsynced + clock_mismatch;
+  if (refused > 0) {
+    s += fmt::format(
+        "\nmessages dropped: {} malformed, {} oversized, {} of another schema version, {} from "
+        "unknown cameras, {} before a clock estimate, {} on another clock",
+        malformed, oversized, wrong_version, unknown_camera, unsynced, clock_mismatch);
+  }
+  if (!latency_s.empty()) {
+    s += fmt::format("\nlatency capture -> position: p50 {:.1f} ms, p95 {:.1f} ms ({} positions)",
+                     1e3 * Percentile(latency_s, 50), 1e3 * Percentile(latency_s, 95),
+                     latency_s.size());
+  }
+  s += fmt::format("\n{} messages in {:.2f} s", messages, seconds);
+  if (published > 0) s += fmt::format(", {} positions published", published);
+  return s;
+}
+
+namespace {
+
+double SteadyNow() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+FuseSummary RunFuse(const FuseOptions& o) {
+  o.Check();
+  std::vector<Camera> cameras;
+  std::map<std::string, int> index;
+  for (const std::string& path : o.cameras) {
+    cameras.push_back(ReadRigCamera(path));
+    FV_REQUIRE(index.emplace(cameras.back().name, static_cast<int>(cameras.size()) - 1).second,
+               "fuse: two cameras are named '{}' (set `name` in the camera files)",
+               cameras.back().name);
+  }
+  const int n = static_cast<int>(cameras.size());
+  TriangulationOptions topt = o.triangulation;
+  topt.ball_radius_m = 0.5 * o.ball_diameter_m;
+  FusionStage fusion(cameras, topt);
+  LiveSynchronizer sync(n, o.sync);
+
+  FuseSummary summary;
+  summary.cameras.resize(n);
+  std::vector<std::string> names;
+  for (int c = 0; c < n; ++c) {
+    summary.cameras[c].name = cameras[c].name;
+    names.push_back(cameras[c].name);
+  }
+  std::vector<std::string> sessions(n);
+  std::set<std::string> warned_unknown;
+  std::string clock_kind;  // "system" or "media", from the first frame
+
+  zmq::context_t ctx(1);
+  zmq::socket_t router(ctx, zmq::socket_type::router);
+  router.set(zmq::sockopt::linger, 0);
+  router.set(zmq::sockopt::rcvhwm, 10000);
+  // Far larger messages are cut off by ZeroMQ (the peer is disconnected, then reconnects).
+  router.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(16 * kMaxMessageBytes));
+  try {
+    router.bind(o.listen);
+  } catch (const zmq::error_t& e) {
+    Throw("fuse: cannot listen on '{}': {}", o.listen, e.what());
+  }
+  zmq::socket_t pub;
+  if (!o.publish.empty()) {
+    pub = zmq::socket_t(ctx, zmq::socket_type::pub);
+    pub.set(zmq::sockopt::linger, 0);
+    pub.set(zmq::sockopt::sndhwm, 1000);
+    try {
+      pub.bind(o.publish);
+    } catch (const zmq::error_t& e) {
+      Throw("fuse: cannot publish on '{}': {}", o.publish, e.what());
+    }
+  }
+
+  const std::string tmp = o.out + ".part";
+  CsvWriter csv(tmp, BallCsvHeader(), 6);
+  auto emit = [&](const SyncedFrame& group) {
+    const BallFrame f = fusion.Fuse(group);
+    ++summary.groups;
+    if (!f.result.ok()) return;
+    const Eigen::Vector3d& p = f.result.point_world;
+    csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
+        << f.result.rms_px;
+    csv.EndRow();
+    ++summary.rows_written;
+    BallMessage b{f.frame,         f.time_s, p.x(), p.y(), p.z(), f.result.num_views(),
+                  f.result.rms_px, 0.0};
+    if (clock_kind == "system") {
+      b.latency_s = SystemClockNow() - f.time_s;
+      summary.latency_s.push_back(b.latency_s);
+    }
+    if (pub) {
+      const std::string topic = "ball";
+      pub.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+      if (pub.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary.published;
+    }
+  };
+
+  const auto start = std::chrono::steady_clock::now();
+  double last_message = SteadyNow();
+  double last_report = 0;
+  std::vector<zmq::pollitem_t> items = {{router.handle(), 0, ZMQ_POLLIN, 0}};
+  while (!StopRequested(o.control)) {
+    zmq::poll(items, std::chrono::milliseconds(2));
+    zmq::message_t identity, payload;
+    while (router.recv(identity, zmq::recv_flags::dontwait)) {
+      const double t1 = SystemClockNow();
+      const double arrival = SteadyNow();
+      last_message = arrival;
+      if (!identity.more() || !router.recv(payload, zmq::recv_flags::dontwait)) {
+        ++summary.malformed;
+        continue;
+      }
+      while (payload.more()) {  // extra parts: not our protocol
+        zmq::message_t extra;
+        if (!router.recv(extra, zmq::recv_flags::dontwait)) break;
+        payload.rebuild(extra.data(), extra.size());
+        ++summary.malformed;
+      }
+      ++summary.messages;
+      Message m;
+      try {
+        m = Decode(payload.data(), payload.size());
+      } catch (const MessageError& e) {
+        switch (e.reason()) {
+          case MessageError::Reason::kOversized:
+            ++summary.oversized;
+            break;
+          case MessageError::Reason::kVersion:
+            ++summary.wrong_version;
+            break;
+          case MessageError::Reason::kMalformed:
+            ++summary.malformed;
+            break;
+        }
+        continue;
+      }
+      // Every message but a pong or a ball names its camera and session.
+      std::string camera, session;
+      if (const auto* ping = std::get_if<PingMessage>(&m)) {
+        PongMessage pong{ping->t0_s, t1, 0};
+        pong.t2_s = SystemClockNow();
+        router.send(identity, zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+        router.send(zmq::buffer(Encode(pong)), zmq::send_flags::dontwait);
+        camera = ping->camera, session = ping->session;
+      } else if (const auto* f = std::get_if<FrameMessage>(&m)) {
+        camera = f->camera, session = f->session;
+      } else if (const auto* h = std::get_if<HelloMessage>(&m)) {
+        camera = h->camera, session = h->session;
+      } else if (const auto* b = std::get_if<ByeMessage>(&m)) {
+        camera = b->camera, session = b->session;
+      } else {
+        ++summary.malformed;  // a pong or a ball message sent to us
+        continue;
+      }
+      const auto it = index.find(camera);
+      if (it == index.end()) {
+        ++summary.unknown_camera;
+        if (warned_unknown.insert(camera).second && warned_unknown.size() <= 10) {
+          std::cerr << fmt::format("fuse: warning: messages from unknown camera '{}' ignored\n",
+                                   camera);
+        }
+        continue;
+      }
+      const int c = it->second;
+      if (sessions[c] != session) {
+        if (!sessions[c].empty()) sync.Restart(c);
+        sessions[c] = session;
+        ++summary.cameras[c].sessions;
+      }
+      if (std::holds_alternative<PingMessage>(m) || std::holds_alternative<HelloMessage>(m)) {
+        sync.Admit(c, arrival);  // connected: its frames are waited for
+        continue;
+      }
+      if (std::holds_alternative<ByeMessage>(m)) {
+        sync.EndOfStream(c);
+        continue;
+      }
+      const auto* f = std::get_if<FrameMessage>(&m);
+      FuseCameraReport& r = summary.cameras[c];
+      ++r.frames;
+      if (clock_kind.empty()) clock_kind = f->clock;
+      if (f->clock != clock_kind) {
+        ++summary.clock_mismatch;
+        continue;
+      }
+      CameraMessage cm;
+      cm.camera = c;
+      cm.frame = f->frame;
+      cm.time_s = f->time_s;
+      if (f->clock == "system") {
+        if (!f->has_offset) {
+          ++summary.unsynced;
+          continue;
+        }
+        cm.time_s += f->offset_s;
+        r.has_offset = true;
+        r.offset_s = f->offset_s;
+      }
+      cm.candidates = f->candidates;
+      sync.Add(std::move(cm), arrival);
+    }
+    const double now = SteadyNow();
+    while (auto group = sync.Next(now)) emit(*group);
+    if (o.idle_exit_s > 0 && now - last_message > o.idle_exit_s) break;
+    if (now - last_report > 0.5) {
+      last_report = now;
+      if (o.control != nullptr) {
+        o.control->Report({"fuse", fusion.stats().frames, -1, "frames", ""});
+      }
+      if (o.progress) {
+        std::cerr << fmt::format("\rfuse: {} frames, {} positions", fusion.stats().frames,
+                                 summary.rows_written)
+                  << std::flush;
+      }
+    }
+  }
+  if (o.progress) std::cerr << "\n";
+  while (auto group = sync.Next(SteadyNow(), /*flush=*/true)) emit(*group);
+  csv.Close();
+  std::error_code ec;
+  std::filesystem::rename(tmp, o.out, ec);
+  FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
+  summary.fusion = fusion.stats();
+  summary.sync = sync.stats();
+  summary.sync_problems = sync.Problems(names);
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace fv::net

@@ -1,0 +1,65 @@
+// The fusion node (`fieldvision fuse`): receives the camera nodes' detections on a ZeroMQ ROUTER
+// socket, answers their clock pings (clock_sync.h), places each frame on its own clock (the
+// node's capture time plus the node's offset estimate), pairs the cameras by capture time
+// (pipeline/live_sync.h), triangulates through the fusion stage (pipeline/fusion_stage.h), writes
+// BALL.csv as `ball` does and publishes each position on a PUB socket (messages.h). Malformed,
+// oversized and wrong-version messages, unknown cameras and frames without a clock estimate are
+// dropped and counted; a node that restarts (a new session) is re-admitted; nodes reconnect
+// by themselves when the fusion node restarts.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fieldvision/pipeline/fusion_stage.h"
+#include "fieldvision/pipeline/job.h"
+#include "fieldvision/pipeline/live_sync.h"
+
+namespace fv::net {
+
+struct FuseOptions {
+  std::string listen;                // tcp://HOST:PORT (127.0.0.1 unless told otherwise)
+  std::vector<std::string> cameras;  // camera files; nodes are matched by camera name
+  std::string out;                   // BALL.csv
+  std::string publish;               // optional PUB endpoint for positions, tcp://HOST:PORT
+  double idle_exit_s = 0;            // exit after this many seconds without messages; 0: never
+  double ball_diameter_m = 0.22;
+  LiveSyncOptions sync;
+  TriangulationOptions triangulation;
+  bool progress = true;
+  JobControl* control = nullptr;  // optional: progress callback and stop check (e.g. Ctrl-C)
+  void Check() const;             // throws fv::Error naming the bad option
+};
+
+struct FuseCameraReport {
+  std::string name;
+  long long frames = 0;  // frame messages received
+  long long sessions = 0;
+  bool has_offset = false;
+  double offset_s = 0;  // the node's last clock estimate (fuse - node)
+};
+
+struct FuseSummary {
+  std::vector<FuseCameraReport> cameras;
+  long long messages = 0;
+  long long malformed = 0, oversized = 0, wrong_version = 0;
+  long long unknown_camera = 0;  // messages naming no camera of the rig
+  long long unsynced = 0;        // live frames sent before the node had a clock estimate
+  long long clock_mismatch = 0;  // media-time frames among system-clock ones or vice versa
+  std::vector<LiveCameraStats> sync;
+  std::vector<std::string> sync_problems;
+  long long groups = 0;
+  FusionStats fusion;
+  long long rows_written = 0;
+  long long published = 0;
+  std::vector<double> latency_s;  // capture -> position, per position (system clocks only)
+  double seconds = 0;
+  std::string ToString() const;
+};
+
+FuseSummary RunFuse(const FuseOptions& options);
+
+// The p-th percentile (0..100) of `values` (nearest rank); NaN when empty.
+double Percentile(std::vector<double> values, double p);
+
+}  // namespace fv::net

@@ -1,0 +1,159 @@
+#include "fieldvision/net/messages.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldvision/pipeline/camera_message.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::net {
+namespace {
+
+using nlohmann::json;
+
+double Num(const json& j, const char* key) {
+  FV_REQUIRE(j.contains(key) && j[key].is_number(), "message: '{}' missing or not a number", key);
+  const double v = j[key].get<double>();
+  FV_REQUIRE(std::isfinite(v), "message: '{}' is not finite", key);
+  return v;
+}
+
+long long Int(const json& j, const char* key) {
+  FV_REQUIRE(j.contains(key) && j[key].is_number_integer(),
+             "message: '{}' missing or not an integer", key);
+  return j[key].get<long long>();
+}
+
+std::string Str(const json& j, const char* key, size_t max_len = 256) {
+  FV_REQUIRE(j.contains(key) && j[key].is_string(), "message: '{}' missing or not a string", key);
+  std::string s = j[key].get<std::string>();
+  FV_REQUIRE(s.size() <= max_len, "message: '{}' longer than {} characters", key, max_len);
+  return s;
+}
+
+std::string Clock(const json& j) {
+  std::string c = Str(j, "clock");
+  FV_REQUIRE(c == "system" || c == "media", "message: 'clock' must be system or media");
+  return c;
+}
+
+struct Encoder {
+  json operator()(const HelloMessage& m) const {
+    return {{"type", "hello"},    {"camera", m.camera}, {"session", m.session}, {"width", m.width},
+            {"height", m.height}, {"fps", m.fps},       {"source", m.source},   {"clock", m.clock}};
+  }
+  json operator()(const FrameMessage& m) const {
+    json j = {{"type", "frame"},      {"camera", m.camera},
+              {"session", m.session}, {"frame", m.frame},
+              {"time_s", m.time_s},   {"origin", m.origin},
+              {"clock", m.clock},     {"candidates", CandidatesToJson(m.candidates)}};
+    if (m.has_offset) j["offset_s"] = m.offset_s;
+    return j;
+  }
+  json operator()(const PingMessage& m) const {
+    return {{"type", "ping"}, {"camera", m.camera}, {"session", m.session}, {"t0_s", m.t0_s}};
+  }
+  json operator()(const PongMessage& m) const {
+    return {{"type", "pong"}, {"t0_s", m.t0_s}, {"t1_s", m.t1_s}, {"t2_s", m.t2_s}};
+  }
+  json operator()(const ByeMessage& m) const {
+    return {{"type", "bye"}, {"camera", m.camera}, {"session", m.session}, {"frames", m.frames}};
+  }
+  json operator()(const BallMessage& m) const {
+    return {{"type", "ball"},     {"frame", m.frame},   {"time_s", m.time_s},
+            {"x_m", m.x_m},       {"y_m", m.y_m},       {"z_m", m.z_m},
+            {"n_cams", m.n_cams}, {"err_px", m.err_px}, {"latency_s", m.latency_s}};
+  }
+};
+
+}  // namespace
+
+std::string Encode(const Message& message) {
+  json j = std::visit(Encoder{}, message);
+  j["v"] = kSchemaVersion;
+  return j.dump();
+}
+
+namespace {
+
+Message DecodeChecked(const void* data, size_t size) {
+  const char* p = static_cast<const char*>(data);
+  json j = json::parse(p, p + size, nullptr, /*allow_exceptions=*/false);
+  FV_REQUIRE(!j.is_discarded() && j.is_object(), "message: not a JSON object");
+  FV_REQUIRE(j.contains("v") && j["v"].is_number_integer(), "message: no schema version 'v'");
+  const long long v = j["v"].get<long long>();
+  if (v != kSchemaVersion) {
+    throw MessageError(
+        MessageError::Reason::kVersion,
+        fmt::format("message: schema version {} (this program speaks {})", v, kSchemaVersion));
+  }
+  const std::string type = Str(j, "type");
+  if (type == "frame") {
+    FrameMessage m;
+    m.camera = Str(j, "camera");
+    m.session = Str(j, "session");
+    m.frame = Int(j, "frame");
+    FV_REQUIRE(m.frame >= 0, "message: 'frame' must be >= 0");
+    m.time_s = Num(j, "time_s");
+    m.origin = Str(j, "origin");
+    m.clock = Clock(j);
+    if (j.contains("offset_s")) {
+      m.offset_s = Num(j, "offset_s");
+      m.has_offset = true;
+    }
+    FV_REQUIRE(j.contains("candidates"), "message: 'candidates' missing");
+    FV_REQUIRE(j["candidates"].size() <= 1000, "message: more than 1000 candidates");
+    m.candidates = CandidatesFromJson(j["candidates"], "message");
+    return m;
+  }
+  if (type == "ping") {
+    return PingMessage{Str(j, "camera"), Str(j, "session"), Num(j, "t0_s")};
+  }
+  if (type == "pong") return PongMessage{Num(j, "t0_s"), Num(j, "t1_s"), Num(j, "t2_s")};
+  if (type == "hello") {
+    HelloMessage m;
+    m.camera = Str(j, "camera");
+    m.session = Str(j, "session");
+    m.width = static_cast<int>(Int(j, "width"));
+    m.height = static_cast<int>(Int(j, "height"));
+    m.fps = Num(j, "fps");
+    m.source = Str(j, "source", 4096);
+    m.clock = Clock(j);
+    return m;
+  }
+  if (type == "bye") return ByeMessage{Str(j, "camera"), Str(j, "session"), Int(j, "frames")};
+  if (type == "ball") {
+    BallMessage m;
+    m.frame = Int(j, "frame");
+    m.time_s = Num(j, "time_s");
+    m.x_m = Num(j, "x_m");
+    m.y_m = Num(j, "y_m");
+    m.z_m = Num(j, "z_m");
+    m.n_cams = static_cast<int>(Int(j, "n_cams"));
+    m.err_px = Num(j, "err_px");
+    m.latency_s = Num(j, "latency_s");
+    return m;
+  }
+  Throw("message: unknown type '{}'", type);
+}
+
+}  // namespace
+
+Message Decode(const void* data, size_t size) {
+  if (size > kMaxMessageBytes) {
+    throw MessageError(
+        MessageError::Reason::kOversized,
+        fmt::format("message: {} bytes, more than the limit {}", size, kMaxMessageBytes));
+  }
+  try {
+    return DecodeChecked(data, size);
+  } catch (const MessageError&) {
+    throw;
+  } catch (const std::exception& e) {  // fv::Error, or nlohmann's for a bad value type
+    throw MessageError(MessageError::Reason::kMalformed, e.what());
+  }
+}
+
+}  // namespace fv::net

@@ -1,0 +1,99 @@
+// The messages between camera nodes and the fusion node, and the fusion node's published ball
+// positions: JSON objects, one per ZeroMQ message, each with the schema version "v" and a
+// "type". JSON rather than protobuf: the messages are small (a few candidates), nlohmann/json is
+// already a dependency (no code generation step), every language reads them without a schema
+// file (the README's Python client is a dozen lines), and the offline CameraMessage is JSON too;
+// our detections are not ssl-vision's frames, so its clients gain nothing from its protobuf.
+//
+// node -> fuse (DEALER -> ROUTER):
+//   {"v":1,"type":"hello","camera":"cam1","session":"5f..","width":1280,"height":960,"fps":60,
+//    "source":"v4l2:/dev/video0","clock":"system"}
+//   {"v":1,"type":"frame","camera":"cam1","session":"5f..","frame":12,"time_s":1764612345.2,
+//    "origin":"device","clock":"system","offset_s":0.0123,"candidates":[{"u":..,"v":..,"r":..,
+//    "sigma":..,"score":..[,"weak":true]}]}
+//   {"v":1,"type":"ping","camera":"cam1","session":"5f..","t0_s":..}
+//   {"v":1,"type":"bye","camera":"cam1","session":"5f..","frames":120}
+// fuse -> node: {"v":1,"type":"pong","t0_s":..,"t1_s":..,"t2_s":..}
+// fuse PUB, topic "ball": {"v":1,"type":"ball","frame":12,"time_s":..,"x_m":..,"y_m":..,
+//   "z_m":..,"n_cams":3,"err_px":0.41,"latency_s":0.012}
+// "clock" says what time_s is measured on: "system" (the node's system clock, Unix seconds; the
+// fusion node adds offset_s, the node's estimate of fuse clock - node clock) or "media" (a
+// file's own time from 0, the same for every camera of a recording).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "fieldvision/recon/triangulation.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::net {
+
+constexpr int kSchemaVersion = 1;
+constexpr size_t kMaxMessageBytes = 64 * 1024;  // larger messages are dropped and counted
+
+struct HelloMessage {
+  std::string camera, session;
+  int width = 0, height = 0;
+  double fps = 0;
+  std::string source;
+  std::string clock = "system";
+};
+
+struct FrameMessage {
+  std::string camera, session;
+  long long frame = 0;
+  double time_s = 0;
+  std::string origin;  // TimeOrigin as text
+  std::string clock = "system";
+  double offset_s = 0;      // fuse clock - node clock (clock "system")
+  bool has_offset = false;  // false until the node has a clock estimate
+  std::vector<BallObservation> candidates;
+};
+
+struct PingMessage {
+  std::string camera, session;
+  double t0_s = 0;  // node clock when sent
+};
+
+struct PongMessage {
+  double t0_s = 0, t1_s = 0, t2_s = 0;  // the ping's t0; fuse clock at receipt and at reply
+};
+
+struct ByeMessage {
+  std::string camera, session;
+  long long frames = 0;
+};
+
+struct BallMessage {
+  long long frame = 0;
+  double time_s = 0;
+  double x_m = 0, y_m = 0, z_m = 0;
+  int n_cams = 0;
+  double err_px = 0;
+  double latency_s = 0;  // fuse clock at publication - capture time (system clocks only)
+};
+
+using Message =
+    std::variant<HelloMessage, FrameMessage, PingMessage, PongMessage, ByeMessage, BallMessage>;
+
+// Why a message was refused (Decode throws MessageError).
+class MessageError : public Error {
+ public:
+  enum class Reason { kOversized, kMalformed, kVersion };
+  MessageError(Reason reason, const std::string& what) : Error(what), reason_(reason) {}
+  Reason reason() const { return reason_; }
+
+ private:
+  Reason reason_;
+};
+
+std::string Encode(const Message& message);
+// Throws MessageError (one line) for oversized data (kOversized), another schema version
+// (kVersion), data that is not a JSON object, an unknown type or a missing or bad field
+// (kMalformed).
+Message Decode(const void* data, size_t size);
+
+}  // namespace fv::net

@@ -1,0 +1,93 @@
+// Messages (round trip, refusals by reason) and the NTP-style clock estimate.
+#include <gtest/gtest.h>
+
+#include "fieldvision/net/clock_sync.h"
+#include "fieldvision/net/messages.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::net {
+namespace {
+
+MessageError::Reason ReasonOf(const std::string& bytes) {
+  try {
+    Decode(bytes.data(), bytes.size());
+  } catch (const MessageError& e) {
+    return e.reason();
+  }
+  ADD_FAILURE() << "accepted: " << bytes;
+  return MessageError::Reason::kMalformed;
+}
+
+TEST(Messages, FrameRoundTripsExactly) {
+  FrameMessage f;
+  f.camera = "cam2";
+  f.session = "abc";
+  f.frame = 17;
+  f.time_s = 1764612345.123456789;
+  f.origin = "device";
+  f.has_offset = true;
+  f.offset_s = -0.0801234567;
+  BallObservation o;
+  o.centre_px = {100.25, 33.125};
+  o.radius_px = 4.5;
+  o.sigma_px = 0.3;
+  o.score = 0.9;
+  f.candidates = {o, o};
+  f.candidates[1].weak = true;
+  const std::string bytes = Encode(f);
+  const Message m = Decode(bytes.data(), bytes.size());
+  const auto* back = std::get_if<FrameMessage>(&m);
+  ASSERT_NE(back, nullptr);
+  EXPECT_EQ(back->camera, "cam2");
+  EXPECT_EQ(back->frame, 17);
+  EXPECT_EQ(back->time_s, f.time_s);
+  EXPECT_EQ(back->offset_s, f.offset_s);
+  EXPECT_TRUE(back->has_offset);
+  ASSERT_EQ(back->candidates.size(), 2u);
+  EXPECT_EQ(back->candidates[0].centre_px, o.centre_px);
+  EXPECT_TRUE(back->candidates[1].weak);
+}
+
+TEST(Messages, RefusalsSayWhy) {
+  using R = MessageError::Reason;
+  EXPECT_EQ(ReasonOf(std::string(kMaxMessageBytes + 1, '{')), R::kOversized);
+  EXPECT_EQ(ReasonOf(R"({"v":2,"type":"ping","camera":"a","session":"b","t0_s":1})"), R::kVersion);
+  EXPECT_EQ(ReasonOf(R"({"type":"ping"})"), R::kMalformed);
+  EXPECT_EQ(ReasonOf("[1,2]"), R::kMalformed);
+  EXPECT_EQ(ReasonOf(R"({"v":1,"type":"teleport"})"), R::kMalformed);
+  EXPECT_EQ(ReasonOf(R"({"v":1,"type":"ping","camera":"a","session":"b","t0_s":"x"})"),
+            R::kMalformed);
+  EXPECT_EQ(ReasonOf(R"({"v":1,"type":"frame","camera":"a","session":"b","frame":1,)"
+                     R"("time_s":1,"origin":"device","clock":"system","candidates":[{"u":1}]})"),
+            R::kMalformed);
+}
+
+TEST(ClockSync, ShortestRoundTripGivesTheOffset) {
+  const uint64_t seed = testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const double true_offset = 0.0803;  // fuse - node
+  ClockSync sync(16);
+  EXPECT_FALSE(sync.Estimate());
+  double node_t = 1000.0;
+  for (int i = 0; i < 16; ++i) {
+    // Asymmetric queueing delays up to 20 ms each way; one exchange is nearly free of them.
+    const double up = i == 9 ? 1e-4 : rng.Uniform(0.0, 0.02);
+    const double down = i == 9 ? 1e-4 : rng.Uniform(0.0, 0.02);
+    const double t0 = node_t;
+    const double t1 = t0 + up + true_offset;
+    const double t2 = t1 + 1e-4;
+    const double t3 = t2 - true_offset + down;
+    EXPECT_TRUE(sync.Add(t0, t1, t2, t3));
+    node_t += 0.5;
+  }
+  EXPECT_FALSE(sync.Add(10, 11, 10.5, 12));  // replied before it was received
+  const auto e = sync.Estimate();
+  ASSERT_TRUE(e);
+  EXPECT_NEAR(e->offset_s, true_offset, 1e-4);
+  EXPECT_NEAR(e->round_trip_s, 2e-4, 1e-9);
+}
+
+}  // namespace
+}  // namespace fv::net

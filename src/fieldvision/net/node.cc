@@ -1,0 +1,281 @@
+#include "fieldvision/net/node.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <thread>
+
+#include <fmt/format.h>
+#include <zmq.hpp>
+
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/field/field.h"
+#include "fieldvision/io/frame_source.h"
+#include "fieldvision/net/clock_sync.h"
+#include "fieldvision/net/messages.h"
+#include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::net {
+
+void NodeOptions::Check() const {
+  FV_REQUIRE(!camera.empty(), "node: --camera is required");
+  FV_REQUIRE(!video.empty(), "node: --video is required");
+  FV_REQUIRE(StartsWith(connect, "tcp://") || StartsWith(connect, "ipc://"),
+             "node: --connect must be tcp://HOST:PORT (got '{}')", connect);
+  FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
+             "node: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
+  FV_REQUIRE(std::isfinite(start_at_s) && start_at_s >= 0, "node: --start-at must be >= 0");
+  FV_REQUIRE(live_buffer_frames >= 1, "node: --live-buffer must be >= 1");
+  FV_REQUIRE(max_frames >= 0, "node: --max-frames must be >= 0");
+  FV_REQUIRE(std::isfinite(connect_wait_s) && connect_wait_s >= 0,
+             "node: --connect-wait must be >= 0");
+  FV_REQUIRE(std::isfinite(ping_interval_s) && ping_interval_s > 0,
+             "node: ping interval must be > 0");
+  FV_REQUIRE(std::isfinite(clock_offset_s) && std::abs(clock_offset_s) < 1e6,
+             "node: --clock-offset must be finite");
+  track.Check();
+}
+
+std::string NodeSummary::ToString() const {
+  std::string s = fmt::format(
+      "node {}: {} frames ({} times), {} sent, {} not sent (fusion node unreachable or slow), "
+      "{} skipped by the source (node slower than the camera)",
+      camera, frames, source_origin.empty() ? "no" : source_origin, sent, send_dropped, source_dropped);
+  if (has_offset) {
+    s += fmt::format(
+        "\nclock: fusion node - this node = {:+.4f} s (round trip {:.2f} ms, {} samples)", offset_s,
+        1e3 * round_trip_s, clock_samples);
+  } else {
+    s += "\nclock: no reply from the fusion node";
+  }
+  if (stage.window_scans > 0) {
+    s += fmt::format("\n{} frames searched in a window around the ball, {} whole",
+                     stage.window_scans, stage.full_scans);
+  }
+  if (stage.bad_frames > 0) {
+    s += fmt::format("\n{} frames could not be decoded (first: {})", stage.bad_frames,
+                     stage.first_bad_frame);
+  }
+  if (bad_replies > 0) s += fmt::format("\n{} bad replies ignored", bad_replies);
+  s += fmt::format("\n{:.2f} s", seconds);
+  return s;
+}
+
+namespace {
+
+std::string NewSession() {
+  std::random_device rd;
+  return fmt::format("{:08x}{:08x}", rd(), rd());
+}
+
+// The socket side of a node, in its own thread: forwards what the main thread sends over an
+// inproc pair, pings the fusion node and keeps the clock estimate.
+class NodeLink {
+ public:
+  NodeLink(zmq::context_t& ctx, const NodeOptions& o, std::string camera, std::string session)
+      : ctx_(ctx), o_(o), camera_(std::move(camera)), session_(std::move(session)) {
+    // Bind the pair before the thread connects to it (inproc needs the bind first).
+    to_link_ = zmq::socket_t(ctx_, zmq::socket_type::pair);
+    to_link_.set(zmq::sockopt::sndhwm, 64);
+    to_link_.set(zmq::sockopt::linger, 0);
+    to_link_.bind("inproc://node-link");
+    thread_ = std::thread([this] { Run(); });
+  }
+  ~NodeLink() { Finish(); }
+
+  // From the main thread: a message for the fusion node; false when dropped (link busy).
+  bool Send(const std::string& bytes) {
+    return to_link_.send(zmq::buffer(bytes), zmq::send_flags::dontwait).has_value();
+  }
+  // Sends the bye message, stops the thread (waiting at most ~1 s for the bye to leave).
+  void Finish() {
+    if (!thread_.joinable()) return;
+    const std::string end = "end";
+    to_link_.send(zmq::buffer(end), zmq::send_flags::none);
+    thread_.join();
+    to_link_.close();
+  }
+  double Now() const { return SystemClockNow() + o_.clock_offset_s; }
+  bool has_offset() const { return has_offset_; }
+  double offset_s() const { return offset_s_; }
+  std::atomic<long long> send_dropped{0};
+  std::atomic<long long> bad_replies{0};
+  std::atomic<int> samples{0};
+  std::atomic<double> round_trip_s{0};
+  std::atomic<long long> frames_for_bye{0};  // set by the main thread before Finish
+
+ private:
+  void Run() {
+    zmq::socket_t from_main(ctx_, zmq::socket_type::pair);
+    from_main.connect("inproc://node-link");
+    zmq::socket_t dealer(ctx_, zmq::socket_type::dealer);
+    dealer.set(zmq::sockopt::linger, 1000);
+    dealer.set(zmq::sockopt::sndhwm, 256);
+    dealer.set(zmq::sockopt::immediate, 1);  // no queue for a fusion node that is not there
+    dealer.set(zmq::sockopt::reconnect_ivl, 100);
+    dealer.set(zmq::sockopt::reconnect_ivl_max, 1000);
+    dealer.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(kMaxMessageBytes));
+    dealer.connect(o_.connect);
+    ClockSync clock;
+    int pings = 0;
+    double next_ping = Now();
+    bool hello_sent = false;
+    std::vector<zmq::pollitem_t> items = {{from_main.handle(), 0, ZMQ_POLLIN, 0},
+                                          {dealer.handle(), 0, ZMQ_POLLIN, 0}};
+    for (;;) {
+      const double wait_s = std::max(0.0, next_ping - Now());
+      zmq::poll(items, std::chrono::milliseconds(static_cast<int>(std::ceil(wait_s * 1000))));
+      if (items[1].revents & ZMQ_POLLIN) {
+        zmq::message_t reply;
+        while (dealer.recv(reply, zmq::recv_flags::dontwait)) {
+          const double t3 = Now();
+          try {
+            const Message m = Decode(reply.data(), reply.size());
+            if (const auto* pong = std::get_if<PongMessage>(&m)) {
+              if (clock.Add(pong->t0_s, pong->t1_s, pong->t2_s, t3)) {
+                const ClockSample e = *clock.Estimate();
+                offset_s_ = e.offset_s;
+                round_trip_s = e.round_trip_s;
+                samples = clock.samples();
+                has_offset_ = true;
+              }
+            }
+          } catch (const Error&) {
+            ++bad_replies;
+          }
+        }
+      }
+      if (items[0].revents & ZMQ_POLLIN) {
+        zmq::message_t msg;
+        bool end = false;
+        while (from_main.recv(msg, zmq::recv_flags::dontwait)) {
+          if (msg.to_string_view() == "end") {
+            end = true;
+            break;
+          }
+          if (!dealer.send(msg, zmq::send_flags::dontwait)) ++send_dropped;
+        }
+        if (end) {
+          ByeMessage bye{camera_, session_, frames_for_bye};
+          dealer.send(zmq::buffer(Encode(bye)), zmq::send_flags::dontwait);
+          return;
+        }
+      }
+      if (Now() >= next_ping) {
+        if (!hello_sent) {
+          HelloMessage h{camera_, session_, 0, 0, 0, o_.video, "system"};
+          hello_sent = dealer.send(zmq::buffer(Encode(h)), zmq::send_flags::dontwait).has_value();
+        }
+        PingMessage p{camera_, session_, Now()};
+        dealer.send(zmq::buffer(Encode(p)), zmq::send_flags::dontwait);
+        ++pings;
+        // A burst of 8 pings 20 ms apart first (a quick estimate), then the steady rate.
+        next_ping = Now() + (pings < 8 ? 0.02 : o_.ping_interval_s);
+      }
+    }
+  }
+
+  zmq::context_t& ctx_;
+  const NodeOptions& o_;
+  std::string camera_, session_;
+  zmq::socket_t to_link_;
+  std::thread thread_;
+  std::atomic<bool> has_offset_{false};
+  std::atomic<double> offset_s_{0};
+};
+
+}  // namespace
+
+NodeSummary RunNode(const NodeOptions& o) {
+  o.Check();
+  const Camera camera = ReadRigCamera(o.camera);
+  std::optional<FieldModel> field;
+  if (!o.field.empty()) field = LoadField(o.field);
+  FrameSourceOptions so;
+  so.encoded = true;  // MJPG / JPEG: decoded only around the tracked ball
+  so.realtime = o.realtime;
+  so.start_at_s = o.start_at_s;
+  so.live_buffer_frames = o.live_buffer_frames;
+  auto source = OpenFrameSource(o.video, so);
+  const cv::Size size = source->FrameSize();
+  FV_REQUIRE(size.width == camera.width && size.height == camera.height,
+             "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,
+             camera.height, o.video, size.width, size.height);
+  BallDetectorOptions dopt;
+  dopt.diameter_m = o.ball_diameter_m;
+  dopt.colour = o.colour;
+  auto detector = std::make_shared<BallDetector>(dopt, &camera, field ? &*field : nullptr);
+  CameraStage stage(0, camera, BallDetectFnFor(detector), o.track, o.video);
+
+  NodeSummary summary;
+  summary.camera = camera.name;
+  const auto start = std::chrono::steady_clock::now();
+  zmq::context_t ctx(1);
+  const std::string session = NewSession();
+  {
+    NodeLink link(ctx, o, camera.name, session);
+    // Wait for the first clock reply so that the first frames can be placed in time.
+    const auto wait_until =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(o.connect_wait_s);
+    while (!link.has_offset() && std::chrono::steady_clock::now() < wait_until &&
+           !StopRequested(o.control)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    const bool system_clock = source->live();
+    Progress progress("node " + camera.name, o.max_frames > 0 ? o.max_frames : source->FrameCount(),
+                      "frames", o.progress);
+    SourceFrame in;
+    FrameMessage m;
+    m.camera = camera.name;
+    m.session = session;
+    m.clock = system_clock ? "system" : "media";
+    while (!StopRequested(o.control) && (o.max_frames == 0 || summary.frames < o.max_frames) &&
+           source->ReadFrame(&in)) {
+      CameraMessage cm;
+      if (o.detect) {
+        cm = stage.Process(in);
+      } else {
+        cm.frame = in.frame;
+        cm.time_s = in.time_s;
+      }
+      ++summary.frames;
+      summary.source_origin = ToString(in.origin);
+      m.frame = cm.frame;
+      // Live times are on this machine's system clock, which the node's clock offset shifts.
+      m.time_s = system_clock ? cm.time_s + o.clock_offset_s : cm.time_s;
+      m.origin = ToString(in.origin);
+      m.has_offset = link.has_offset();
+      m.offset_s = link.offset_s();
+      m.candidates = std::move(cm.candidates);
+      if (link.Send(Encode(m))) {
+        ++summary.sent;
+      } else {
+        ++summary.send_dropped;
+      }
+      progress.Update(summary.frames);
+      if (o.control != nullptr) {
+        o.control->Report({"node", summary.frames, source->FrameCount(), "frames", ""});
+      }
+    }
+    progress.Finish();
+    link.frames_for_bye = summary.frames;
+    link.Finish();
+    summary.send_dropped += link.send_dropped;
+    summary.sent -= link.send_dropped;
+    summary.bad_replies = link.bad_replies;
+    summary.has_offset = link.has_offset();
+    summary.offset_s = link.offset_s();
+    summary.round_trip_s = link.round_trip_s;
+    summary.clock_samples = link.samples;
+  }
+  summary.source_dropped = source->dropped();
+  summary.stage = stage.stats();
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace fv::net

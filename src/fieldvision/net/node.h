@@ -1,0 +1,58 @@
+// The camera node (`fieldvision node`): one camera's frames (any frame source, io/frame_source.h)
+// through the camera stage (pipeline/camera_stage.h) to the fusion node over ZeroMQ (a DEALER
+// socket connecting to the fusion node's ROUTER; it reconnects by itself when the fusion node
+// restarts). An I/O thread owns the socket: it forwards the frame messages, sends a clock ping
+// every ping_interval_s (a burst at the start) and turns the replies into the clock offset
+// (clock_sync.h) that every frame message carries. Frames the socket cannot take at once (the
+// fusion node unreachable or slower) are dropped and counted, never queued without bound.
+#pragma once
+
+#include <string>
+
+#include "fieldvision/pipeline/camera_stage.h"
+#include "fieldvision/pipeline/job.h"
+
+namespace fv::net {
+
+struct NodeOptions {
+  std::string camera;          // camera file (its `name`, else its stem, names the camera)
+  std::string video;           // a frame source spec (io/frame_source.h)
+  std::string connect;         // the fusion node, tcp://HOST:PORT
+  bool realtime = false;       // play a file at its frame rate (live sources always are)
+  double start_at_s = 0;       // with realtime: Unix time of frame 0 (0: now)
+  int live_buffer_frames = 4;  // frames a live source holds for a slow node
+  double ball_diameter_m = 0.22;
+  std::string colour = "orange";
+  std::string field;  // optional: look for the ball only over this field
+  BallTrackOptions track;
+  long long max_frames = 0;   // 0: all
+  bool detect = true;         // false: send frames without candidates (a latency baseline)
+  double connect_wait_s = 5;  // wait this long for the fusion node's first clock reply
+  double ping_interval_s = 0.5;
+  // Added to this node's clock: simulates a machine whose clock is off (tests, benchmarks).
+  double clock_offset_s = 0;
+  bool progress = true;
+  JobControl* control = nullptr;  // optional: progress callback and stop check
+  void Check() const;             // throws fv::Error naming the bad option
+};
+
+struct NodeSummary {
+  std::string camera;
+  std::string source_origin;     // where frame times come from (TimeOrigin)
+  long long frames = 0;          // frames read and processed
+  long long sent = 0;            // frame messages handed to the socket
+  long long send_dropped = 0;    // frame messages the socket could not take
+  long long source_dropped = 0;  // frames the live source skipped (node too slow)
+  int clock_samples = 0;
+  bool has_offset = false;
+  double offset_s = 0;        // fuse clock - node clock
+  double round_trip_s = 0;    // of the sample used
+  long long bad_replies = 0;  // replies that were not valid messages
+  CameraStageStats stage;
+  double seconds = 0;
+  std::string ToString() const;
+};
+
+NodeSummary RunNode(const NodeOptions& options);
+
+}  // namespace fv::net

@@ -1,0 +1,181 @@
+// Camera nodes and the fusion node on loopback: a synth kick scene played live by one node per
+// camera gives the same positions as the offline `ball` job, also with one node's clock 80 ms
+// off; bad messages are counted while the fusion node keeps running.
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <zmq.hpp>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/io/frame_source.h"
+#include "fieldvision/net/fuse.h"
+#include "fieldvision/net/messages.h"
+#include "fieldvision/net/node.h"
+#include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv::net {
+namespace {
+
+struct Row {
+  double x, y, z;
+  int n_cams;
+};
+
+std::map<long long, Row> ReadBall(const std::string& path) {
+  const CsvTable t = CsvTable::Read(path);
+  std::map<long long, Row> rows;
+  for (size_t r = 0; r < t.rows(); ++r) {
+    rows[t.GetInt(r, "frame")] = {t.GetDouble(r, "x_m"), t.GetDouble(r, "y_m"),
+                                  t.GetDouble(r, "z_m"), static_cast<int>(t.GetInt(r, "n_cams"))};
+  }
+  return rows;
+}
+
+// A free loopback TCP endpoint.
+std::string FreeEndpoint(zmq::context_t& ctx) {
+  zmq::socket_t s(ctx, zmq::socket_type::router);
+  s.bind("tcp://127.0.0.1:*");
+  return s.get(zmq::sockopt::last_endpoint);
+}
+
+struct Scene {
+  std::string dir;
+  std::vector<std::string> cameras, videos;
+};
+
+Scene WriteKick(uint64_t seed) {
+  synth::SceneSpec spec = synth::Preset("kick", seed);
+  synth::ResizeCameras(spec, 640, 480);
+  spec.num_frames = 30;  // the kick is at 0.25 s: rest, kick and flight
+  Scene s;
+  s.dir = testing::TempDir() + "/kick";
+  synth::WriteScene(spec, s.dir);
+  for (const auto& c : spec.cameras) {
+    s.cameras.push_back(s.dir + "/" + c.name + ".yaml");
+    s.videos.push_back(s.dir + "/" + c.name + ".avi");
+  }
+  return s;
+}
+
+TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
+  const uint64_t seed = testing::TestSeed(3);
+  FV_SEED_TRACE(seed);
+  const Scene scene = WriteKick(seed);
+  BallJobOptions job;
+  job.cameras = scene.cameras;
+  job.videos = scene.videos;
+  job.out = scene.dir + "/offline.csv";
+  job.pipeline.progress = false;
+  RunBallJob(job);
+  const auto offline = ReadBall(job.out);
+  ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
+
+  zmq::context_t ctx;
+  FuseOptions fo;
+  fo.listen = FreeEndpoint(ctx);
+  fo.cameras = scene.cameras;
+  fo.out = scene.dir + "/live.csv";
+  fo.idle_exit_s = 0.5;
+  fo.sync.max_wait_s = 3.0;  // a loaded test machine may run a node late; wait for it
+  fo.progress = false;
+  FuseSummary fused;
+  std::thread fuse([&] { fused = RunFuse(fo); });
+
+  const double offset_s = 0.080;  // node 1's clock is 80 ms ahead
+  const double start_at = SystemClockNow() + 1.0;  // every node connected by then
+  std::vector<NodeSummary> nodes(scene.cameras.size());
+  std::vector<std::thread> threads;
+  for (size_t c = 0; c < scene.cameras.size(); ++c) {
+    threads.emplace_back([&, c] {
+      NodeOptions no;
+      no.camera = scene.cameras[c];
+      no.video = scene.videos[c];
+      no.connect = fo.listen;
+      no.realtime = true;
+      no.start_at_s = start_at;
+      no.live_buffer_frames = 1000;  // a late node is late, never skips frames
+      no.clock_offset_s = c == 1 ? offset_s : 0.0;
+      no.progress = false;
+      nodes[c] = RunNode(no);
+    });
+  }
+  for (auto& t : threads) t.join();
+  fuse.join();
+
+  for (size_t c = 0; c < nodes.size(); ++c) {
+    SCOPED_TRACE(nodes[c].ToString());
+    EXPECT_EQ(nodes[c].frames, 30);
+    EXPECT_EQ(nodes[c].sent, 30);
+    ASSERT_TRUE(nodes[c].has_offset);
+    // fuse clock - node clock: -80 ms for the node that is ahead; off by more than the pairing
+    // tolerance (8 ms), frames would pair wrongly.
+    EXPECT_NEAR(nodes[c].offset_s, c == 1 ? -offset_s : 0.0, 0.008);
+  }
+  SCOPED_TRACE(fused.ToString());
+  EXPECT_EQ(fused.groups, 30);
+  const auto live = ReadBall(fo.out);
+  ASSERT_EQ(live.size(), offline.size());
+  for (const auto& [frame, a] : offline) {
+    ASSERT_TRUE(live.count(frame)) << "frame " << frame;
+    const Row& b = live.at(frame);
+    EXPECT_NEAR(a.x, b.x, 5e-4) << "frame " << frame;
+    EXPECT_NEAR(a.y, b.y, 5e-4) << "frame " << frame;
+    EXPECT_NEAR(a.z, b.z, 5e-4) << "frame " << frame;
+    EXPECT_EQ(a.n_cams, b.n_cams) << "frame " << frame;
+  }
+}
+
+TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
+  const std::string dir = testing::TempDir();
+  Camera cam = Camera::FromFov(64, 48, 60);
+  cam.name = "cam1";
+  cam.has_pose = true;
+  cam.cam_from_world = Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
+  WriteCameraYaml(cam, dir + "/cam1.yaml");
+  zmq::context_t ctx;
+  FuseOptions fo;
+  fo.listen = FreeEndpoint(ctx);
+  fo.cameras = {dir + "/cam1.yaml"};
+  fo.out = dir + "/ball.csv";
+  fo.idle_exit_s = 0.5;
+  fo.progress = false;
+  FuseSummary fused;
+  std::thread fuse([&] { fused = RunFuse(fo); });
+  zmq::socket_t s(ctx, zmq::socket_type::dealer);
+  s.set(zmq::sockopt::linger, 2000);
+  s.connect(fo.listen);
+  auto send = [&](const std::string& bytes) { s.send(zmq::buffer(bytes), zmq::send_flags::none); };
+  send("not json");
+  send(R"({"v":99,"type":"frame"})");
+  send(std::string(kMaxMessageBytes + 10, ' '));
+  send(R"({"v":1,"type":"frame","camera":"cam1"})");  // fields missing
+  FrameMessage f;
+  f.camera = "nobody";
+  f.session = "s";
+  f.clock = "media";
+  send(Encode(f));  // an unknown camera
+  f.camera = "cam1";
+  f.clock = "system";
+  send(Encode(f));  // a live frame without a clock estimate
+  PingMessage ping{"cam1", "s", SystemClockNow()};
+  send(Encode(ping));
+  zmq::message_t reply;
+  ASSERT_TRUE(s.recv(reply));  // the fusion node still answers
+  EXPECT_TRUE(std::holds_alternative<PongMessage>(Decode(reply.data(), reply.size())));
+  fuse.join();
+  EXPECT_EQ(fused.malformed, 2);
+  EXPECT_EQ(fused.wrong_version, 1);
+  EXPECT_EQ(fused.oversized, 1);
+  EXPECT_EQ(fused.unknown_camera, 1);
+  EXPECT_EQ(fused.unsynced, 1);
+  EXPECT_TRUE(std::filesystem::exists(fo.out));
+}
+
+}  // namespace
+}  // namespace fv::net
