@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 
@@ -571,7 +572,15 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
       for (size_t i = 0; i < team_ids.size(); ++i) result.team_of[team_ids[i]] = labels.at<int>(i);
     }
   }
-  result.time = TimesOfFrames(times_ms, reader.fps(), options.fps);
+  // An image sequence has no time of its own (OpenCV reports 25 frames/s for any pattern).
+  if (!ListImageSequence(video).empty()) {
+    result.time = TimesOfFrames(std::vector<double>(times_ms.size(), 0.0), 0.0, options.fps);
+    if (result.time.time_s.empty()) {
+      result.time.source = "none (an image sequence has no frame rate: give --fps)";
+    }
+  } else {
+    result.time = TimesOfFrames(times_ms, reader.fps(), options.fps);
+  }
   if (!result.time.time_s.empty()) {
     for (auto& r : result.rows) r.time_s = result.time.time_s[r.frame - 1];
   }

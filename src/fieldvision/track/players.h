@@ -123,7 +123,9 @@ struct PlayersResult {
 void CheckCameraMatchesVideo(const Camera& camera, int width, int height, const std::string& video);
 
 // Runs the pipeline on a video (any file OpenCV reads or an image pattern). `camera` may be
-// uncalibrated (no pose): then no field positions. `field` (optional) limits detections.
+// null or uncalibrated (no pose): then boxes only, no field positions. `field` (optional) limits
+// detections. Rows number frames from 1 and carry the frame's time (TimesOfFrames; an image
+// sequence has a time only with options.fps).
 PlayersResult RunPlayers(const std::string& video, const Camera* camera, const FieldModel* field,
                          const PlayersOptions& options);
 

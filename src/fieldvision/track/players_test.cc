@@ -7,7 +7,9 @@
 
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/track/overlay.h"
@@ -156,6 +158,30 @@ TEST(Players, FrameTimesFromOverrideTimestampsRateOrNone) {
   const FrameTimes none = TimesOfFrames({0, 0}, 0, 0);
   EXPECT_TRUE(none.time_s.empty());
   EXPECT_NE(none.source.find("--fps"), std::string::npos);
+}
+
+// An image sequence has no time of its own: none without --fps (OpenCV would say 25 frames/s).
+TEST(Players, ImageSequenceHasNoTimeWithoutFps) {
+  const uint64_t seed = fv::testing::TestSeed(4);
+  FV_SEED_TRACE(seed);
+  const std::string dir = fv::testing::TempDir();
+  cv::RNG rng(seed);
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat f(120, 160, CV_8UC3);
+    rng.fill(f, cv::RNG::UNIFORM, 0, 255);
+    cv::imwrite(fmt::format("{}/{:05d}.png", dir, i), f);
+  }
+  PlayersOptions o;
+  o.progress = false;
+  o.detector.kind = "motion";
+  const PlayersResult none = RunPlayers(dir + "/%05d.png", nullptr, nullptr, o);
+  EXPECT_EQ(none.frames, 3);
+  EXPECT_TRUE(none.time.time_s.empty());
+  EXPECT_NE(none.time.source.find("--fps"), std::string::npos) << none.time.source;
+  o.fps = 8;
+  const PlayersResult given = RunPlayers(dir + "/%05d.png", nullptr, nullptr, o);
+  ASSERT_EQ(given.time.time_s.size(), 3u);
+  EXPECT_DOUBLE_EQ(given.time.time_s[2], 0.25);
 }
 
 #ifdef FV_HAVE_SYNTH
