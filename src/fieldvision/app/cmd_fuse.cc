@@ -18,7 +18,7 @@ void Setup(CLI::App& app, int& exit_code) {
       "fuse", "Fusion node: pair the camera nodes' detections, place the ball in 3D; BALL.csv");
   cmd->add_option("--listen", o->listen,
                   "Where nodes connect, tcp://HOST:PORT (use 127.0.0.1 unless other machines "
-                  "must reach it)")
+                  "must reach it; PORT * takes a free port)")
       ->required();
   cmd->add_option("--camera", o->cameras, "Camera file (repeat); nodes are matched by name")
       ->required();
@@ -26,7 +26,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--publish", o->publish,
                   "Publish each position on a ZeroMQ PUB socket, tcp://HOST:PORT (topic 'ball')");
   cmd->add_option("--idle-exit", o->idle_exit_s,
-                  "Exit after this many seconds without messages (0: run until Ctrl-C)")
+                  "Exit after this many seconds without messages, counted once the first has come "
+                  "(0: run until Ctrl-C)")
       ->capture_default_str();
   cmd->add_option("--tolerance", o->sync.tolerance_s,
                   "Frames this close in capture time (s) are paired")
@@ -53,6 +54,9 @@ void Setup(CLI::App& app, int& exit_code) {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     o->control = &control;
+    o->on_listening = [](const std::string& endpoint) {
+      std::cout << "fuse: listening on " << endpoint << std::endl;
+    };
     const net::FuseSummary s = net::RunFuse(*o);
     g_fuse_control = nullptr;
     std::cout << s.ToString() << "\n";

@@ -120,6 +120,7 @@ FuseSummary RunFuse(const FuseOptions& o) {
   } catch (const zmq::error_t& e) {
     Throw("fuse: cannot listen on '{}': {}", o.listen, e.what());
   }
+  if (o.on_listening) o.on_listening(router.get(zmq::sockopt::last_endpoint));
   zmq::socket_t pub;
   if (!o.publish.empty()) {
     pub = zmq::socket_t(ctx, zmq::socket_type::pub);
@@ -262,7 +263,7 @@ FuseSummary RunFuse(const FuseOptions& o) {
     }
     const double now = SteadyNow();
     while (auto group = sync.Next(now)) emit(*group);
-    if (o.idle_exit_s > 0 && now - last_message > o.idle_exit_s) break;
+    if (o.idle_exit_s > 0 && summary.messages > 0 && now - last_message > o.idle_exit_s) break;
     if (now - last_report > 0.5) {
       last_report = now;
       if (o.control != nullptr) {

@@ -8,6 +8,7 @@
 // by themselves when the fusion node restarts.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,17 +19,20 @@
 namespace fv::net {
 
 struct FuseOptions {
-  std::string listen;                // tcp://HOST:PORT (127.0.0.1 unless told otherwise)
+  std::string listen;  // tcp://HOST:PORT (127.0.0.1 unless told otherwise; PORT * : any free)
   std::vector<std::string> cameras;  // camera files; nodes are matched by camera name
   std::string out;                   // BALL.csv
   std::string publish;               // optional PUB endpoint for positions, tcp://HOST:PORT
-  double idle_exit_s = 0;            // exit after this many seconds without messages; 0: never
+  double idle_exit_s =
+      0;  // exit after this many seconds without messages (after the first); 0: never
   double ball_diameter_m = 0.22;
   LiveSyncOptions sync;
   TriangulationOptions triangulation;
   bool progress = true;
   JobControl* control = nullptr;  // optional: progress callback and stop check (e.g. Ctrl-C)
-  void Check() const;             // throws fv::Error naming the bad option
+  // Optional: called once listening, with the address bound (the port chosen for PORT *).
+  std::function<void(const std::string& endpoint)> on_listening;
+  void Check() const;  // throws fv::Error naming the bad option
 };
 
 struct FuseCameraReport {

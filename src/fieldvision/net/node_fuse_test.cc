@@ -3,6 +3,7 @@
 // off; bad messages are counted while the fusion node keeps running.
 #include <chrono>
 #include <filesystem>
+#include <future>
 #include <map>
 #include <thread>
 
@@ -15,6 +16,7 @@
 #include "fieldvision/net/messages.h"
 #include "fieldvision/net/node.h"
 #include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/pipeline/job.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/testing.h"
@@ -37,11 +39,19 @@ std::map<long long, Row> ReadBall(const std::string& path) {
   return rows;
 }
 
-// A free loopback TCP endpoint.
-std::string FreeEndpoint(zmq::context_t& ctx) {
-  zmq::socket_t s(ctx, zmq::socket_type::router);
-  s.bind("tcp://127.0.0.1:*");
-  return s.get(zmq::sockopt::last_endpoint);
+// Starts RunFuse(o) in `thread` on a free loopback port; returns the address it listens on.
+std::string StartFuse(FuseOptions& o, FuseSummary* summary, std::thread* thread) {
+  std::promise<std::string> bound;
+  auto endpoint = bound.get_future();
+  o.on_listening = [&bound](const std::string& e) { bound.set_value(e); };
+  *thread = std::thread([o, summary] {
+    try {
+      *summary = RunFuse(o);
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << e.what();
+    }
+  });
+  return endpoint.get();
 }
 
 struct Scene {
@@ -76,18 +86,18 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   const auto offline = ReadBall(job.out);
   ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
 
-  zmq::context_t ctx;
   FuseOptions fo;
-  fo.listen = FreeEndpoint(ctx);
+  fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = scene.cameras;
   fo.out = scene.dir + "/live.csv";
   fo.idle_exit_s = 0.5;
   fo.sync.max_wait_s = 3.0;  // a loaded test machine may run a node late; wait for it
   fo.progress = false;
   FuseSummary fused;
-  std::thread fuse([&] { fused = RunFuse(fo); });
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
 
-  const double offset_s = 0.080;  // node 1's clock is 80 ms ahead
+  const double offset_s = 0.080;                   // node 1's clock is 80 ms ahead
   const double start_at = SystemClockNow() + 1.0;  // every node connected by then
   std::vector<NodeSummary> nodes(scene.cameras.size());
   std::vector<std::thread> threads;
@@ -96,7 +106,7 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
       NodeOptions no;
       no.camera = scene.cameras[c];
       no.video = scene.videos[c];
-      no.connect = fo.listen;
+      no.connect = endpoint;
       no.realtime = true;
       no.start_at_s = start_at;
       no.live_buffer_frames = 1000;  // a late node is late, never skips frames
@@ -138,18 +148,19 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   cam.has_pose = true;
   cam.cam_from_world = Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
   WriteCameraYaml(cam, dir + "/cam1.yaml");
-  zmq::context_t ctx;
   FuseOptions fo;
-  fo.listen = FreeEndpoint(ctx);
+  fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = {dir + "/cam1.yaml"};
   fo.out = dir + "/ball.csv";
   fo.idle_exit_s = 0.5;
   fo.progress = false;
   FuseSummary fused;
-  std::thread fuse([&] { fused = RunFuse(fo); });
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
+  zmq::context_t ctx;
   zmq::socket_t s(ctx, zmq::socket_type::dealer);
   s.set(zmq::sockopt::linger, 2000);
-  s.connect(fo.listen);
+  s.connect(endpoint);
   auto send = [&](const std::string& bytes) { s.send(zmq::buffer(bytes), zmq::send_flags::none); };
   send("not json");
   send(R"({"v":99,"type":"frame"})");
@@ -175,6 +186,86 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   EXPECT_EQ(fused.unknown_camera, 1);
   EXPECT_EQ(fused.unsynced, 1);
   EXPECT_TRUE(std::filesystem::exists(fo.out));
+}
+
+// Synth cameras on the world's clock: node 2 is stopped and started again (a new session) and
+// is re-admitted; the fusion node is then restarted on the same address and the running node
+// reconnects to it by itself.
+TEST(NodeFuse, RestartedNodeIsReadmittedAndNodesReconnectToARestartedFuse) {
+  const std::string dir = testing::TempDir();
+  synth::SceneSpec spec = synth::Preset("kick", 1);
+  synth::ResizeCameras(spec, 320, 240);
+  std::vector<std::string> cams;
+  for (const auto& c : spec.cameras) {
+    synth::SceneRenderer one([&] {
+      synth::SceneSpec s = spec;
+      s.cameras = {c};
+      s.num_frames = 1;
+      return s;
+    }());
+    Camera cam = one.cameras()[0];
+    cam.name = c.name;
+    WriteCameraYaml(cam, dir + "/" + c.name + ".yaml");
+    cams.push_back(dir + "/" + c.name + ".yaml");
+  }
+  const std::string src = "synth:kick?width=320&height=240&camera=";
+  FuseOptions fo;
+  fo.listen = "tcp://127.0.0.1:*";
+  fo.cameras = {cams[0], cams[1]};
+  fo.out = dir + "/ball1.csv";
+  fo.progress = false;
+  JobControl fuse_control;
+  fo.control = &fuse_control;
+  FuseSummary first;
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &first, &fuse);
+  fo.listen = endpoint;  // the restarted fusion node takes the same address
+  auto node_options = [&](int c, long long frames) {
+    NodeOptions no;
+    no.camera = cams[c];
+    no.video = src + spec.cameras[c].name;
+    no.connect = endpoint;
+    no.max_frames = frames;
+    no.progress = false;
+    return no;
+  };
+  JobControl node0_control;
+  NodeSummary steady;
+  NodeOptions steady_options = node_options(0, 0);  // runs until stopped
+  steady_options.control = &node0_control;
+  std::thread node0([&] { steady = RunNode(steady_options); });
+  // Node 2: 10 frames, stopped, then 10 more as a new session.
+  const NodeSummary a = RunNode(node_options(1, 10));
+  const NodeSummary b = RunNode(node_options(1, 10));
+  fuse_control.Stop();
+  fuse.join();
+  // A new fusion node on the same address: node 0 (still running) reconnects to it; both stop
+  // once it has fused a few frames (or after 20 s, a failure).
+  fo.out = dir + "/ball2.csv";
+  JobControl fuse2_control([&](const JobProgress& p) {
+    if (p.done >= 3) fuse2_control.Stop();
+  });
+  fo.control = &fuse2_control;
+  FuseSummary second;
+  std::thread fuse2;
+  StartFuse(fo, &second, &fuse2);
+  for (int i = 0; i < 200 && !fuse2_control.StopRequested(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  fuse2_control.Stop();
+  fuse2.join();
+  node0_control.Stop();
+  node0.join();
+  SCOPED_TRACE(first.ToString());
+  SCOPED_TRACE(second.ToString());
+  EXPECT_EQ(a.frames, 10);
+  EXPECT_EQ(b.frames, 10);
+  EXPECT_EQ(first.cameras[1].sessions, 2);
+  EXPECT_EQ(first.sync[1].restarts, 1);
+  EXPECT_EQ(first.cameras[1].frames, a.sent + b.sent);
+  EXPECT_GT(first.sync[1].paired, a.sent);  // paired again after the restart
+  EXPECT_GT(second.cameras[0].frames, 0);   // the running node found the new fusion node
+  EXPECT_GT(steady.frames, 0);
 }
 
 }  // namespace
