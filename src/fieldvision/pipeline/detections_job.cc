@@ -1,0 +1,393 @@
+#include "fieldvision/pipeline/detections_job.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include <ceres/ceres.h>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/camera/projection.h"
+#include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/pipeline/ball_pipeline.h"
+#include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/recon/trajectory_physics.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+
+namespace fv {
+
+void DetectionsJobOptions::Check() const {
+  FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --detections pair");
+  FV_REQUIRE(cameras.size() == detections.size(),
+             "ball: {} --camera but {} --detections (they pair up)", cameras.size(),
+             detections.size());
+  FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
+             "ball: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
+  FV_REQUIRE(std::isfinite(sigma_px) && sigma_px > 0, "ball: --det-sigma must be > 0 (got {})",
+             sigma_px);
+  FV_REQUIRE(std::isfinite(tolerance_s) && tolerance_s > 0,
+             "ball: --tolerance must be > 0 (got {})", tolerance_s);
+  FV_REQUIRE(!out.empty(), "ball: --out is required");
+  triangulation.Check();
+  eval.Check();
+}
+
+std::vector<CameraMessage> ParseDetections(const CsvTable& t, int camera, double sigma_px) {
+  t.Require({"frame", "time_s", "u", "v"});
+  const bool has_r = t.Has("radius_px"), has_score = t.Has("score");
+  std::vector<CameraMessage> out;
+  for (size_t r = 0; r < t.rows(); ++r) {
+    const long long frame = t.GetInt(r, "frame");
+    const double time_s = t.GetDouble(r, "time_s");
+    FV_REQUIRE(std::isfinite(time_s), "{}: time_s is not finite", t.Where(r));
+    if (out.empty() || out.back().frame != frame) {
+      if (!out.empty()) {
+        FV_REQUIRE(frame > out.back().frame && time_s > out.back().time_s,
+                   "{}: frame {} at {} s does not follow frame {} at {} s (frames and times must "
+                   "increase; rows of one frame together)",
+                   t.Where(r), frame, time_s, out.back().frame, out.back().time_s);
+      }
+      CameraMessage m;
+      m.camera = camera;
+      m.frame = frame;
+      m.time_s = time_s;
+      out.push_back(m);
+    } else {
+      FV_REQUIRE(time_s == out.back().time_s, "{}: frame {} has two times ({} and {} s)",
+                 t.Where(r), frame, out.back().time_s, time_s);
+    }
+    // Empty u and v: a frame without a detection.
+    if (t.Get(r, "u").empty() && t.Get(r, "v").empty()) continue;
+    BallObservation o;
+    o.centre_px = {t.GetDouble(r, "u"), t.GetDouble(r, "v")};
+    FV_REQUIRE(o.centre_px.allFinite(), "{}: u, v are not finite", t.Where(r));
+    o.sigma_px = sigma_px;
+    if (has_r && !t.Get(r, "radius_px").empty()) {
+      o.radius_px = t.GetDouble(r, "radius_px");
+      FV_REQUIRE(std::isfinite(o.radius_px) && o.radius_px >= 0,
+                 "{}: radius_px must be a number >= 0", t.Where(r));
+    }
+    if (has_score && !t.Get(r, "score").empty()) {
+      o.score = t.GetDouble(r, "score");
+      FV_REQUIRE(std::isfinite(o.score), "{}: score is not finite", t.Where(r));
+    }
+    out.back().candidates.push_back(o);
+  }
+  FV_REQUIRE(!out.empty(), "detections '{}': no rows", t.name());
+  for (auto& m : out) {
+    std::stable_sort(
+        m.candidates.begin(), m.candidates.end(),
+        [](const BallObservation& a, const BallObservation& b) { return a.score > b.score; });
+  }
+  return out;
+}
+
+std::vector<CameraMessage> ReadDetectionsCsv(const std::string& path, int camera, double sigma_px) {
+  FV_REQUIRE(std::filesystem::exists(path), "detections file '{}' does not exist", path);
+  return ParseDetections(CsvTable::Read(path), camera, sigma_px);
+}
+
+namespace {
+
+// One detection against the flight model: parameters p0 (3), v0 (3), drag k (1), Magnus vector
+// s = c_M w (3) at the flight's reference time; residual in units of the detection's sigma.
+struct DetectionResidual {
+  DetectionResidual(const Camera& cam, const Eigen::Vector2d& uv, double dt, double g,
+                    double sigma_px, bool integrate)
+      : uv_(uv), dt_(dt), g_(g), sigma_(sigma_px), integrate_(integrate) {
+    const auto block = cam.IntrinsicsBlock();
+    std::copy(block.begin(), block.end(), intrinsics_);
+    const Eigen::Vector3d r = cam.cam_from_world.Rvec();
+    for (int i = 0; i < 3; ++i) rvec_[i] = r[i], tvec_[i] = cam.cam_from_world.translation[i];
+  }
+  template <typename T>
+  bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
+    T p[3] = {p0[0], p0[1], p0[2]};
+    T v[3] = {v0[0], v0[1], v0[2]};
+    if (integrate_) {
+      PropagateFlight(p, v, k[0], sm, g_, dt_);
+    } else {
+      for (int i = 0; i < 3; ++i) p[i] = p0[i] + v0[i] * dt_;
+      p[2] -= T(0.5 * g_ * dt_ * dt_);
+    }
+    T intr[kNumIntrinsics], rv[3], tv[3], uv[2];
+    for (int i = 0; i < kNumIntrinsics; ++i) intr[i] = T(intrinsics_[i]);
+    for (int i = 0; i < 3; ++i) rv[i] = T(rvec_[i]), tv[i] = T(tvec_[i]);
+    if (!ProjectWorldPoint(intr, rv, tv, p, uv)) return false;
+    r[0] = (uv[0] - uv_.x()) / sigma_;
+    r[1] = (uv[1] - uv_.y()) / sigma_;
+    return true;
+  }
+  double intrinsics_[kNumIntrinsics];
+  double rvec_[3], tvec_[3];
+  Eigen::Vector2d uv_;
+  double dt_, g_, sigma_;
+  bool integrate_;
+};
+
+// Zero-mean spin prior (as trajectory.h): weak across the flight direction d, tight along it.
+struct SpinPriorResidual {
+  SpinPriorResidual(const Eigen::Vector3d& d, double w_perp, double w_along)
+      : W_(w_perp * (Eigen::Matrix3d::Identity() - d * d.transpose()) +
+           w_along * d * d.transpose()) {}
+  template <typename T>
+  bool operator()(const T* sm, T* r) const {
+    for (int i = 0; i < 3; ++i) {
+      r[i] = T(W_(i, 0)) * sm[0] + T(W_(i, 1)) * sm[1] + T(W_(i, 2)) * sm[2];
+    }
+    return true;
+  }
+  Eigen::Matrix3d W_;
+};
+
+struct Bundled {
+  bool ok = false;
+  FlightModel kind = FlightModel::kGravity;
+  BallisticModel model;
+  double rms_px = 0.0;
+  int observations = 0;
+};
+
+// The flight's model refitted on the detections of every camera between its first and last
+// seen samples (the candidate nearest the model's prediction, within a gate).
+Bundled BundleFlight(const std::vector<Camera>& cameras,
+                     const std::vector<std::vector<CameraMessage>>& messages, const Flight& f,
+                     const TrajectoryOptions& to, double sigma_px, double margin_s) {
+  Bundled out;
+  const BallisticModel start = f.model();
+  const FlightModel kind = f.model_kind();  // of the fit to the per-frame points
+  const double t_ref = start.t0_s;
+  struct Obs {
+    int cam;
+    Eigen::Vector2d uv;
+    double time_s;
+  };
+  std::vector<Obs> obs;
+  const double gate_px = 5 * sigma_px + 10.0;
+  for (size_t c = 0; c < messages.size(); ++c) {
+    for (const auto& m : messages[c]) {
+      if (m.time_s < f.t_first_seen_s - margin_s || m.time_s > f.t_last_seen_s + margin_s) continue;
+      const auto pred = cameras[c].Project(start.PositionAt(m.time_s));
+      if (!pred) continue;
+      const BallObservation* best = nullptr;
+      double best_d = gate_px;
+      for (const auto& o : m.candidates) {
+        const double d = (o.centre_px - *pred).norm();
+        if (d < best_d) best_d = d, best = &o;
+      }
+      if (best) obs.push_back({static_cast<int>(c), best->centre_px, m.time_s});
+    }
+  }
+  if (static_cast<int>(obs.size()) * 2 < 6 + 4) return out;
+  double p0[3] = {start.p0_m.x(), start.p0_m.y(), start.p0_m.z()};
+  double v0[3] = {start.v0_mps.x(), start.v0_mps.y(), start.v0_mps.z()};
+  double k[1] = {kind == FlightModel::kGravity ? 0.0 : start.drag_per_m};
+  const double c_m = to.MagnusPerRad();
+  const Eigen::Vector3d s0 = start.magnus_per_rad * start.spin_radps;
+  double sm[3] = {s0.x(), s0.y(), s0.z()};
+  // Each model in turn from the one before (gravity, drag, spin); the more complex one is kept
+  // when its BIC over the 2 n reprojection residuals (in sigmas) is lower by spin_min_bic_gain.
+  auto solve = [&](FlightModel m, double* cost) {
+    const bool integrate = m != FlightModel::kGravity;
+    ceres::Problem problem;
+    for (const auto& o : obs) {
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<DetectionResidual, 2, 3, 3, 1, 3>(new DetectionResidual(
+              cameras[o.cam], o.uv, o.time_s - t_ref, to.gravity_mps2, sigma_px, integrate)),
+          new ceres::HuberLoss(2.0), p0, v0, k, sm);
+    }
+    if (m == FlightModel::kGravity) {
+      problem.SetParameterBlockConstant(k);
+    } else {
+      problem.SetParameterLowerBound(k, 0, 0.0);
+      problem.SetParameterUpperBound(k, 0, to.max_drag_per_m);
+    }
+    if (m == FlightModel::kSpin) {
+      const double unit = 1.0 / (c_m * 2 * M_PI);
+      const Eigen::Vector3d d = Eigen::Vector3d(v0[0], v0[1], v0[2]).normalized();
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<SpinPriorResidual, 3, 3>(new SpinPriorResidual(
+              d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
+          nullptr, sm);
+    } else {
+      problem.SetParameterBlockConstant(sm);
+    }
+    ceres::Solver::Options so;
+    so.max_num_iterations = 50;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    *cost = summary.final_cost;
+    return summary.IsSolutionUsable();
+  };
+  const double nres = 2.0 * obs.size();
+  struct State {
+    double p0[3], v0[3], k, sm[3];
+    double bic;
+    FlightModel kind;
+  };
+  std::optional<State> best;
+  for (FlightModel m : {FlightModel::kGravity, FlightModel::kDrag, FlightModel::kSpin}) {
+    const int params = m == FlightModel::kGravity ? 6 : m == FlightModel::kDrag ? 7 : 10;
+    if (nres < params + 4) break;
+    if (m != FlightModel::kSpin) sm[0] = sm[1] = sm[2] = 0.0;
+    if (m == FlightModel::kGravity) k[0] = 0.0;
+    double cost = 0;
+    if (!solve(m, &cost)) break;
+    const double bic = nres * std::log(std::max(2 * cost, 1e-12) / nres) + params * std::log(nres);
+    if (!best || bic < best->bic - (m == FlightModel::kGravity ? 0.0 : to.spin_min_bic_gain)) {
+      best =
+          State{{p0[0], p0[1], p0[2]}, {v0[0], v0[1], v0[2]}, k[0], {sm[0], sm[1], sm[2]}, bic, m};
+    }
+  }
+  if (!best) return out;
+  out.model = start;
+  out.model.p0_m = {best->p0[0], best->p0[1], best->p0[2]};
+  out.model.v0_mps = {best->v0[0], best->v0[1], best->v0[2]};
+  out.model.drag_per_m = best->kind == FlightModel::kGravity ? 0.0 : best->k;
+  out.model.magnus_per_rad = best->kind == FlightModel::kSpin ? c_m : 0.0;
+  out.model.spin_radps =
+      best->kind == FlightModel::kSpin
+          ? Eigen::Vector3d(Eigen::Vector3d(best->sm[0], best->sm[1], best->sm[2]) / c_m)
+          : Eigen::Vector3d::Zero();
+  out.kind = best->kind;
+  double ss = 0;
+  for (const auto& o : obs) {
+    const auto uv = cameras[o.cam].Project(out.model.PositionAt(o.time_s));
+    if (uv) ss += (*uv - o.uv).squaredNorm();
+  }
+  out.observations = static_cast<int>(obs.size());
+  out.rms_px = std::sqrt(ss / obs.size());
+  out.ok = out.model.p0_m.allFinite() && out.model.v0_mps.allFinite();
+  return out;
+}
+
+}  // namespace
+
+std::string DetectionsJobResult::Summary() const {
+  std::string s = fmt::format("{} detections, {} moments paired by time, {} 3D positions",
+                              candidates, frames, positions);
+  if (bundled_flights > 0) {
+    s += fmt::format("; {} flights refined on the 2D detections ({} rows, {:.2f} px RMS)",
+                     bundled_flights, bundled_rows, bundle_rms_px);
+  }
+  for (const auto& p : sync.Problems()) s += "\n  " + p;
+  if (trajectory) s += "\n" + trajectory->Summary();
+  return s;
+}
+
+DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
+  o.Check();
+  FV_REQUIRE(o.truth.empty() || std::filesystem::exists(o.truth), "truth file '{}' does not exist",
+             o.truth);
+  const int n = static_cast<int>(o.cameras.size());
+  std::vector<Camera> cameras;
+  for (int c = 0; c < n; ++c) {
+    cameras.push_back(ReadCameraYaml(o.cameras[c]));
+    FV_REQUIRE(cameras.back().has_pose,
+               "camera file '{}' has no pose (rvec, tvec): calibrate its extrinsics first",
+               o.cameras[c]);
+    if (cameras.back().name.empty()) {
+      cameras.back().name = std::filesystem::path(o.cameras[c]).stem().string();
+    }
+  }
+  DetectionsJobResult res;
+  SyncOptions so;
+  so.mode = SyncMode::kTimestamp;
+  so.tolerance_s = o.tolerance_s;
+  FrameSynchronizer sync(n, so);
+  std::vector<std::vector<CameraMessage>> messages(n);
+  for (int c = 0; c < n; ++c) {
+    messages[c] = ReadDetectionsCsv(o.detections[c], c, o.sigma_px);
+    for (const auto& m : messages[c]) {
+      res.candidates += static_cast<long long>(m.candidates.size());
+      sync.Add(m);
+    }
+    sync.EndOfStream(c);
+  }
+  TriangulationOptions topt = o.triangulation;
+  topt.ball_radius_m = 0.5 * o.ball_diameter_m;
+  BallPredictor predictor;
+  while (auto f = sync.Next()) {
+    ++res.frames;
+    const auto prior = predictor.Predict(f->frame);
+    const BallFrame b = FuseFrame(cameras, *f, topt, prior ? &*prior : nullptr);
+    if (!b.result.ok()) continue;
+    const Eigen::Vector3d& p = b.result.point_world;
+    if (!b.result.on_ground) predictor.Add(b.frame, p);
+    BallSample s;
+    s.frame = b.frame;
+    s.time_s = b.time_s;
+    s.ball_in_world = p;
+    s.n_cams = b.result.num_views();
+    s.err_px = b.result.rms_px;
+    if (res.per_frame.empty() || s.time_s > res.per_frame.back().time_s) res.per_frame.push_back(s);
+  }
+  res.sync = sync.report();
+  res.track = res.per_frame;
+  // Flights, then the bundle.
+  TrajectoryOptions to;
+  to.ball_radius_m = topt.ball_radius_m;
+  to.ball_mass_kg =
+      o.ball_mass_kg > 0 ? o.ball_mass_kg : (o.ball_diameter_m < 0.05 ? 0.0027 : 0.43);
+  if (!o.flights.empty() || o.bundle) res.trajectory = AnalyzeTrajectory(res.per_frame, to);
+  if (o.bundle && res.trajectory) {
+    double ss = 0;
+    long long nobs = 0;
+    // Half the median frame interval around each flight's seen span.
+    std::vector<double> dts;
+    for (size_t i = 1; i < res.per_frame.size(); ++i) {
+      dts.push_back(res.per_frame[i].time_s - res.per_frame[i - 1].time_s);
+    }
+    std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+    const double margin = dts.empty() ? 0.0 : 0.5 * dts[dts.size() / 2];
+    for (const Flight& f : res.trajectory->flights) {
+      const Bundled b = BundleFlight(cameras, messages, f, to, o.sigma_px, margin);
+      if (!b.ok) continue;
+      ++res.bundled_flights;
+      ss += b.rms_px * b.rms_px * b.observations;
+      nobs += b.observations;
+      for (auto& s : res.track) {
+        if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
+        s.ball_in_world = b.model.PositionAt(s.time_s);
+        s.err_px = b.rms_px;
+        ++res.bundled_rows;
+      }
+    }
+    if (nobs > 0) res.bundle_rms_px = std::sqrt(ss / nobs);
+  }
+  res.positions = static_cast<long long>(res.track.size());
+  const std::string tmp = o.out + ".part";
+  {
+    CsvWriter csv(tmp, BallCsvHeader(), 6);
+    for (const auto& s : res.track) {
+      csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y()
+          << s.ball_in_world.z() << s.n_cams << s.err_px;
+      csv.EndRow();
+    }
+    csv.Close();
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, o.out, ec);
+  FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
+  if (!o.truth.empty()) res.eval = EvaluateBallFiles(o.truth, o.out, o.eval);
+  if (!o.flights.empty()) {
+    const std::string ftmp = o.flights + ".part";
+    {
+      std::ofstream f(ftmp);
+      FV_REQUIRE(f.good(), "cannot write '{}'", o.flights);
+      f << FlightsToJson(*res.trajectory).dump(2) << "\n";
+      FV_REQUIRE(f.good(), "cannot write '{}'", o.flights);
+    }
+    std::filesystem::rename(ftmp, o.flights, ec);
+    FV_REQUIRE(!ec, "cannot write '{}': {}", o.flights, ec.message());
+  }
+  return res;
+}
+
+}  // namespace fv

@@ -1,0 +1,164 @@
+// `ball --detections`: DET.csv files of three simulated cameras (25 Hz, 2 px noise, false
+// candidates) triangulated and fitted; bad files are one-line errors naming the file.
+#include "fieldvision/pipeline/detections_job.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/stats.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+std::vector<Camera> TableRig() {
+  std::vector<Camera> cams;
+  const Eigen::Vector3d eyes[] = {{-3.5, -2.5, 2.0}, {3.5, -2.5, 2.2}, {0.5, 3.5, 2.5}};
+  for (int c = 0; c < 3; ++c) {
+    Camera cam = Camera::FromFov(1280, 720, 60);
+    cam.name = fmt::format("cam{}", c);
+    cam.has_pose = true;
+    cam.cam_from_world = Rigid3d::LookAt(eyes[c], Eigen::Vector3d(0, 0, 0.3));
+    cams.push_back(cam);
+  }
+  return cams;
+}
+
+// A stroke along the table (x) with drag and topspin, bouncing once on the table (bounce model
+// of trajectory.h), sampled at 25 Hz from 10 s.
+std::vector<std::pair<double, Eigen::Vector3d>> Flight(Rng& rng) {
+  BallisticModel m;
+  m.t0_s = 10.0;
+  m.p0_m = {-1.8, rng.Uniform(-0.3, 0.3), rng.Uniform(0.3, 0.4)};
+  m.v0_mps = {rng.Uniform(5, 6), rng.Uniform(-0.3, 0.3), rng.Uniform(1.0, 1.5)};
+  m.drag_per_m = 0.14;
+  m.magnus_per_rad = 0.0056;
+  m.spin_radps = {0, 2 * M_PI * 40, 0};  // topspin for a flight along +x
+  const double tb = *m.CrossingTime(0.02, m.t0_s, true);
+  BallisticModel after = m;
+  after.t0_s = tb;
+  m.StateAt(tb, &after.p0_m, &after.v0_mps);
+  BounceModel().Apply(0.02, &after.v0_mps, &after.spin_radps);
+  std::vector<std::pair<double, Eigen::Vector3d>> out;
+  for (int i = 0; i < 200; ++i) {
+    const double t = 10.0 + 0.013 + i / 25.0;  // frames not aligned with the bounce
+    const Eigen::Vector3d p = t < tb ? m.PositionAt(t) : after.PositionAt(t);
+    if (p.x() > 2.5 || p.z() < 0.0) break;
+    out.emplace_back(t, p);
+  }
+  return out;
+}
+
+void WriteFile(const std::string& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+}
+
+// The check: 3 cameras, 25 Hz, 2 px noise, spinning flights with a bounce. Per flight the
+// job runs on DET.csv files; over all flights the 3D error median of the bundle must be <= 10 mm
+// and below the per-frame triangulation's, and the bounce found in >= 90 % of the flights.
+TEST(DetectionsJob, ThreeCamerasAt25HzWithFalseCandidates) {
+  const uint64_t seed0 = testing::TestSeed(51);
+  const auto cams = TableRig();
+  const std::string base = testing::TempDir();
+  std::vector<double> per_frame, bundled;
+  int flights = 0, bounce_found = 0;
+  for (uint64_t k = 0; k < 10; ++k) {
+    const uint64_t seed = seed0 + k;
+    FV_SEED_TRACE(seed);
+    Rng rng(seed);
+    const std::string dir = base + fmt::format("/f{}", k);
+    std::filesystem::create_directories(dir);
+    const auto flight = Flight(rng);
+    ASSERT_GE(flight.size(), 8u);
+    DetectionsJobOptions o;
+    o.ball_diameter_m = 0.04;
+    o.out = dir + "/ball.csv";
+    o.flights = dir + "/flights.json";
+    for (int c = 0; c < 3; ++c) {
+      const std::string cam_path = fmt::format("{}/cam{}.yaml", dir, c);
+      WriteCameraYaml(cams[c], cam_path);
+      std::string det = "frame,time_s,u,v,score\n";
+      for (size_t i = 0; i < flight.size(); ++i) {
+        const auto uv = cams[c].Project(flight[i].second);
+        ASSERT_TRUE(uv.has_value());
+        det += fmt::format("{},{:.6f},{:.3f},{:.3f},0.9\n", i, flight[i].first,
+                           uv->x() + rng.Normal(0, 2), uv->y() + rng.Normal(0, 2));
+        // A false candidate (a shoe, a light) in one camera every third frame, scored higher.
+        if (static_cast<int>(i % 3) == c) {
+          det += fmt::format("{},{:.6f},{:.3f},{:.3f},0.95\n", i, flight[i].first,
+                             rng.Uniform(0, 1280), rng.Uniform(0, 720));
+        }
+      }
+      WriteFile(fmt::format("{}/cam{}.csv", dir, c), det);
+      o.cameras.push_back(cam_path);
+      o.detections.push_back(fmt::format("{}/cam{}.csv", dir, c));
+    }
+    const DetectionsJobResult r = RunDetectionsJob(o);
+    SCOPED_TRACE(r.Summary());
+    EXPECT_EQ(r.frames, static_cast<long long>(flight.size()));
+    EXPECT_EQ(r.positions, static_cast<long long>(flight.size()));
+    for (const auto& s : r.per_frame) {
+      per_frame.push_back((s.ball_in_world - flight[s.frame].second).norm());
+    }
+    for (const auto& s : r.track) {
+      bundled.push_back((s.ball_in_world - flight[s.frame].second).norm());
+    }
+    ASSERT_TRUE(r.trajectory.has_value());
+    int bounces = 0;
+    for (const auto& b : r.trajectory->breaks) bounces += b.kind == FlightEvent::kBounce;
+    ++flights;
+    bounce_found += bounces == 1;
+    EXPECT_TRUE(std::filesystem::exists(o.flights));
+  }
+  std::cout << fmt::format(
+      "detections: {} flights at 25 Hz, 2 px: 3D error median per frame {:.1f} mm, bundle {:.1f} "
+      "mm (p95 {:.1f} / {:.1f} mm); bounce found in {} of {}\n",
+      flights, Median(per_frame) * 1e3, Median(bundled) * 1e3, Percentile(per_frame, 0.95) * 1e3,
+      Percentile(bundled, 0.95) * 1e3, bounce_found, flights);
+  EXPECT_LE(Median(bundled), 0.010);
+  EXPECT_LT(Median(bundled), Median(per_frame));
+  EXPECT_LT(Percentile(bundled, 0.95), 0.03);
+  EXPECT_GE(bounce_found, 9);
+}
+
+TEST(DetectionsJob, BadFilesAreOneLineErrorsNamingTheFile) {
+  auto parse = [](const std::string& text) {
+    return ParseDetections(CsvTable::Parse(text, "det.csv"), 0, 2.0);
+  };
+  auto message = [&](const std::string& text) {
+    try {
+      parse(text);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string missing = message("frame,time_s,u\n0,0.0,10\n");
+  EXPECT_NE(missing.find("det.csv"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("v"), std::string::npos) << missing;
+  EXPECT_EQ(missing.find('\n'), std::string::npos) << missing;
+  const std::string back = message("frame,time_s,u,v\n0,0.08,10,10\n1,0.04,11,11\n");
+  EXPECT_NE(back.find("det.csv:3"), std::string::npos) << back;
+  EXPECT_EQ(back.find('\n'), std::string::npos) << back;
+  const std::string two_times = message("frame,time_s,u,v\n0,0.0,10,10\n0,0.01,11,11\n");
+  EXPECT_NE(two_times.find("two times"), std::string::npos) << two_times;
+  // Several rows of a frame are candidates, best score first; empty u,v: no detection.
+  const auto msgs = parse("frame,time_s,u,v,score\n0,0.0,10,10,0.2\n0,0.0,20,20,0.7\n1,0.04,,,\n");
+  ASSERT_EQ(msgs.size(), 2u);
+  ASSERT_EQ(msgs[0].candidates.size(), 2u);
+  EXPECT_EQ(msgs[0].candidates[0].centre_px.x(), 20);
+  EXPECT_TRUE(msgs[1].candidates.empty());
+}
+
+}  // namespace
+}  // namespace fv
