@@ -4,6 +4,8 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/pipeline/detections_job.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -11,7 +13,24 @@ namespace {
 struct BallCliOptions {
   BallJobOptions job;
   bool rows = false;
+  DetectionsJobOptions det;  // with --detections instead of --video
 };
+
+void RunDetections(BallCliOptions& o) {
+  DetectionsJobOptions& d = o.det;
+  d.cameras = o.job.cameras;
+  d.ball_diameter_m = o.job.ball_diameter_m;
+  d.out = o.job.out;
+  d.truth = o.job.truth;
+  d.tolerance_s = o.job.pipeline.sync.tolerance_s;
+  d.triangulation = o.job.pipeline.triangulation;
+  d.eval = o.job.eval;
+  const DetectionsJobResult r = RunDetectionsJob(d);
+  std::cout << r.Summary() << "\n";
+  std::cout << "wrote " << d.out << " (" << r.positions << " rows)"
+            << (d.flights.empty() ? "" : ", " + d.flights) << "\n";
+  if (r.eval) std::cout << r.eval->Table(o.rows || r.eval->rows.size() <= 40) << "\n";
+}
 
 void RunBall(const BallCliOptions& o) {
   const BallJobResult r = RunBallJob(o.job);
@@ -26,8 +45,15 @@ void Setup(CLI::App& app, int& exit_code) {
       "ball", "Place the ball in 3D from 2..N synchronized cameras; writes BALL.csv");
   cmd->add_option("--camera", o->job.cameras, "Camera file (repeat; pairs with --video in order)")
       ->required();
-  cmd->add_option("--video", o->job.videos, "Video file or image pattern such as dir/%05d.jpg")
-      ->required();
+  cmd->add_option("--video", o->job.videos, "Video file or image pattern such as dir/%05d.jpg");
+  cmd->add_option("--detections", o->det.detections,
+                  "Instead of --video: 2D detections made elsewhere, DET.csv with frame,time_s,u,v "
+                  "[,radius_px,score] (repeat; pairs with --camera in order; paired by time)");
+  cmd->add_option("--det-sigma", o->det.sigma_px,
+                  "With --detections: 1-sigma of a detection's centre in pixels")
+      ->capture_default_str();
+  cmd->add_option("--flights", o->det.flights,
+                  "With --detections: also fit the flights and write FLIGHTS.json");
   cmd->add_option("--ball-diameter", o->job.ball_diameter_m, "Ball diameter in metres")
       ->capture_default_str();
   cmd->add_option("--color,--colour", o->job.colour, "Colour preset or colour file of the ball")
@@ -64,6 +90,11 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Never use candidates that failed a shape check to complete a position");
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o] {
+    if (!o->det.detections.empty()) {
+      FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
+      RunDetections(*o);
+      return;
+    }
     if (!o->job.timestamps.empty()) o->job.sync = "time";
     RunBall(*o);
   });
