@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include <fmt/format.h>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -31,10 +32,15 @@ class FrameReader {
  public:
   FrameReader(const std::string& path, int max_frames) : max_frames_(max_frames) {
     cv::VideoCapture cap;
+    // OpenCV's backends log their failures to stderr; the one-line error below says it.
+    const auto log_level = cv::utils::logging::getLogLevel();
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
     try {
-      cap.open(path);
+      // FFmpeg for files (GStreamer prints to stderr on a file it cannot read), else a pattern.
+      cap.open(path, path.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
     } catch (const cv::Exception&) {
     }
+    cv::utils::logging::setLogLevel(log_level);
     FV_REQUIRE(cap.isOpened(),
                "cannot open video '{}' (missing file or a format OpenCV cannot "
                "read)",
@@ -433,7 +439,14 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     };
   }
   // Open the video first: a bad video is reported before the model is loaded.
-  FrameReader reader(video, options.max_frames);
+  // An image sequence is read up to its last file (reading past it makes OpenCV warn).
+  const size_t sequence_files = ListImageSequence(video).size();
+  int frame_limit = options.max_frames;
+  if (sequence_files > 0) {
+    const int n = static_cast<int>(sequence_files);
+    frame_limit = frame_limit > 0 ? std::min(frame_limit, n) : n;
+  }
+  FrameReader reader(video, frame_limit);
   if (camera != nullptr) {
     CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
   }
@@ -573,7 +586,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     }
   }
   // An image sequence has no time of its own (OpenCV reports 25 frames/s for any pattern).
-  if (!ListImageSequence(video).empty()) {
+  if (sequence_files > 0) {
     result.time = TimesOfFrames(std::vector<double>(times_ms.size(), 0.0), 0.0, options.fps);
     if (result.time.time_s.empty()) {
       result.time.source = "none (an image sequence has no frame rate: give --fps)";
