@@ -71,6 +71,14 @@ void RunMulti(MultiCli& c) {
     std::cout << fmt::format("{:<24s} {:>12.3f} {:>12.2f} {:>7d}\n",
                              r.camera_reports[p.i].name + " - " + r.camera_reports[p.j].name,
                              p.rotation_deg, 1000 * p.baseline_m, p.shared_views);
+    if (p.has_opencv) {
+      std::cout << fmt::format(
+          "{:<24s} {:>12.3f} {:>12.2f}          (OpenCV stereoCalibrate, rms {:.3f} px: "
+          "rotations differ by {:.3f} deg, baselines by {:+.2f} %)\n",
+          "", p.opencv_rotation_deg, 1000 * p.opencv_baseline_m, p.opencv_rms_px,
+          p.opencv_rotation_diff_deg,
+          100 * (p.baseline_m - p.opencv_baseline_m) / p.opencv_baseline_m);
+    }
   }
   bool any_dropped = false;
   for (const auto& v : r.views) {
@@ -150,6 +158,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--out", c->out, "Folder for NAME.yaml per camera and the pictures")->required();
   cmd->add_flag("--no-pictures", c->no_pictures, "Do not write the coverage pictures");
+  cmd->add_flag("--compare-opencv", c->o.compare_opencv,
+                "Also run OpenCV's stereoCalibrate on every camera pair and print the differences");
   cmd->add_flag("--quiet", c->quiet, "No progress");
   cmd->callback([c] { RunMulti(*c); });
   (void)exit_code;

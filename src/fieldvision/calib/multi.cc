@@ -196,6 +196,14 @@ std::string MultiResult::Summary() const {
     s += fmt::format("\n  pair {}-{}: rotation {:.3f} deg, baseline {:.2f} mm, {} shared views",
                      camera_reports[p.i].name, camera_reports[p.j].name, p.rotation_deg,
                      1000 * p.baseline_m, p.shared_views);
+    if (p.has_opencv) {
+      s += fmt::format(
+          "; OpenCV stereoCalibrate: rotation {:.3f} deg, baseline {:.2f} mm (rms {:.3f} px), "
+          "rotations differ by {:.3f} deg, baselines by {:+.2f} %",
+          p.opencv_rotation_deg, 1000 * p.opencv_baseline_m, p.opencv_rms_px,
+          p.opencv_rotation_diff_deg,
+          100 * (p.baseline_m - p.opencv_baseline_m) / p.opencv_baseline_m);
+    }
   }
   for (const auto& v : views) {
     if (!v.used) {
@@ -706,6 +714,61 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
                                Eigen::Matrix3d::Identity()) *
           kRadToDeg;
       p.baseline_m = (a.CentreInWorld() - b.CentreInWorld()).norm();
+      if (options.compare_opencv && p.shared_views >= 3) {
+        // The same corners of the views both cameras use (a corner seen by both).
+        std::vector<std::vector<cv::Point3f>> obj;
+        std::vector<std::vector<cv::Point2f>> img_i, img_j;
+        for (int f = 0; f < nf; ++f) {
+          if (!(used[i][f] && used[j][f])) continue;
+          const BoardView& vi = frames[f].views[i];
+          const BoardView& vj = frames[f].views[j];
+          std::map<int, size_t> in_j;
+          for (size_t k = 0; k < vj.corner_ids.size(); ++k) in_j[vj.corner_ids[k]] = k;
+          std::vector<cv::Point3f> o;
+          std::vector<cv::Point2f> pi, pj;
+          for (size_t k = 0; k < vi.corner_ids.size(); ++k) {
+            const auto it = in_j.find(vi.corner_ids[k]);
+            if (it == in_j.end()) continue;
+            o.push_back(vi.object_points[k]);
+            pi.push_back(vi.image_points[k]);
+            pj.push_back(vj.image_points[it->second]);
+          }
+          if (o.size() < 6) continue;
+          obj.push_back(o);
+          img_i.push_back(pi);
+          img_j.push_back(pj);
+        }
+        auto k_of = [](const Camera& c) {
+          return cv::Mat(cv::Matx33d(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1));
+        };
+        auto d_of = [](const Camera& c) {
+          return c.distortion.empty() ? cv::Mat(cv::Mat::zeros(1, 5, CV_64F))
+                                      : cv::Mat(c.distortion, true).reshape(1, 1);
+        };
+        cv::Mat rot, t, e, fm;
+        try {
+          cv::Mat ki = k_of(cams[i]), kj = k_of(cams[j]), di = d_of(cams[i]), dj = d_of(cams[j]);
+          if (obj.size() >= 3) {
+            p.opencv_rms_px = cv::stereoCalibrate(obj, img_i, img_j, ki, di, kj, dj,
+                                                  cv::Size(cams[i].width, cams[i].height), rot, t,
+                                                  e, fm, cv::CALIB_USE_INTRINSIC_GUESS);
+            Eigen::Matrix3d r;
+            for (int u = 0; u < 3; ++u) {
+              for (int v = 0; v < 3; ++v) r(u, v) = rot.at<double>(u, v);
+            }
+            p.has_opencv = true;
+            p.opencv_rotation_deg =
+                RotationAngleBetween(r, Eigen::Matrix3d::Identity()) * kRadToDeg;
+            p.opencv_baseline_m = cv::norm(t);
+            p.opencv_rotation_diff_deg =
+                RotationAngleBetween(
+                    r, b.cam_from_world.rotation * a.cam_from_world.rotation.transpose()) *
+                kRadToDeg;
+          }
+        } catch (const cv::Exception&) {
+          p.has_opencv = false;
+        }
+      }
       result.pairs.push_back(p);
     }
   }

@@ -49,10 +49,11 @@ struct MultiOptions {
   double outlier_factor = 4.0;
   double outlier_min_px = 1.5;
   double max_drop_fraction = 0.3;
-  int min_shared_views = 2;  // moments two cameras must share to link them in the spanning tree
-  int min_views = 3;         // views with the board per camera (for its intrinsics)
-  int max_iterations = 200;  // of each bundle adjustment
-  bool progress = true;      // progress on stderr while detecting
+  int min_shared_views = 2;     // moments two cameras must share to link them in the spanning tree
+  int min_views = 3;            // views with the board per camera (for its intrinsics)
+  int max_iterations = 200;     // of each bundle adjustment
+  bool compare_opencv = false;  // also run cv::stereoCalibrate on every pair (MultiPairReport)
+  bool progress = true;         // progress on stderr while detecting
   void Check() const;
 };
 
@@ -105,6 +106,11 @@ struct MultiPairReport {
   int shared_views = 0;
   double rotation_deg = 0.0;  // angle of R_j R_i^T
   double baseline_m = 0.0;    // distance of the camera centres
+  // With MultiOptions::compare_opencv: OpenCV's stereoCalibrate on the pair's shared used views
+  // (each camera's intrinsics from calibrateCamera as the start), the baseline of the check.
+  bool has_opencv = false;
+  double opencv_rotation_deg = 0.0, opencv_baseline_m = 0.0, opencv_rms_px = 0.0;
+  double opencv_rotation_diff_deg = 0.0;  // angle between our relative rotation and OpenCV's
 };
 
 struct MultiResult {

@@ -409,9 +409,11 @@ TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
   MultiOptions o;
   o.board = {BoardType::kChessboard, 9, 6, 0.025};
   o.progress = false;
+  o.compare_opencv = true;
   const MultiResult r =
       CalibrateMulti({{"left", dir + "/left*.jpg"}, {"right", dir + "/right*.jpg"}}, o);
   ASSERT_EQ(r.pairs.size(), 1u);
+  ASSERT_TRUE(r.pairs[0].has_opencv) << r.Summary();
 
   // The baseline: the same corners, each camera's calibrateCamera, then stereoCalibrate.
   std::map<int, std::vector<cv::Point2f>> img[2];
@@ -460,6 +462,9 @@ TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
       r.pairs[0].rotation_deg, baseline_mm, r.rms_px, ref_rot_deg, ref_baseline_mm, stereo_rms,
       rot_diff_deg, 100 * (baseline_mm - ref_baseline_mm) / ref_baseline_mm);
   EXPECT_LT(rot_diff_deg, 0.1) << r.Summary();
+  // The library's own comparison agrees with this one.
+  EXPECT_NEAR(r.pairs[0].opencv_rotation_diff_deg, rot_diff_deg, 0.02) << r.Summary();
+  EXPECT_NEAR(1000 * r.pairs[0].opencv_baseline_m, ref_baseline_mm, 0.2) << r.Summary();
   EXPECT_LT(std::abs(baseline_mm - ref_baseline_mm) / ref_baseline_mm, 0.01) << r.Summary();
   EXPECT_LT(r.rms_px, 0.5) << r.Summary();
   // OpenCV's reference stereo intrinsics (intrinsics.yml): the same focal length within 1 %.
