@@ -75,11 +75,25 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
       default:
         what = "flight already under way";
     }
-    out.timeline.push_back(
-        {f.t_start_s, fmt::format("flight {}: {} at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, "
-                                  "apex {:.2f} m, flight time {:.2f} s",
-                                  f.index, what, f.origin_m.x(), f.origin_m.y(), f.origin_m.z(),
-                                  f.speed_mps, f.apex_m.z(), f.FlightTime())});
+    if (f.origin_extrapolated) {
+      // Not seen: say where the flight was first seen, and that the origin is the model's.
+      const Eigen::Vector3d p = f.model().PositionAt(f.t_first_seen_s);
+      out.timeline.push_back(
+          {f.t_first_seen_s,
+           fmt::format("flight {}: {}, first seen at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, apex "
+                       "{:.2f} m; origin not seen (extrapolated {:.2f} s back to ({:.2f}, {:.2f}, "
+                       "{:.2f}) m)",
+                       f.index, what, p.x(), p.y(), p.z(),
+                       f.model().VelocityAt(f.t_first_seen_s).norm(), f.apex_m.z(),
+                       f.t_first_seen_s - f.t_start_s, f.origin_m.x(), f.origin_m.y(),
+                       f.origin_m.z())});
+    } else {
+      out.timeline.push_back(
+          {f.t_start_s, fmt::format("flight {}: {} at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, "
+                                    "apex {:.2f} m, flight time {:.2f} s",
+                                    f.index, what, f.origin_m.x(), f.origin_m.y(), f.origin_m.z(),
+                                    f.speed_mps, f.apex_m.z(), f.FlightTime())});
+    }
     if (f.end_event == FlightEvent::kHit) {
       out.timeline.push_back({f.t_end_s, fmt::format("flight {}: hit at ({:.2f}, {:.2f}, {:.2f}) m",
                                                      f.index, f.model().PositionAt(f.t_end_s).x(),

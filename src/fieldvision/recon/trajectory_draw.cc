@@ -27,6 +27,12 @@ struct Axes {
   }
 };
 
+// A tick value without the "-0" of a rounded negative zero.
+double Tick(double v, double step) {
+  const double r = std::round(v / step) * step;
+  return r == 0.0 ? 0.0 : r;
+}
+
 double NiceStep(double range) {
   const double raw = range / 8;
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
@@ -40,15 +46,13 @@ void DrawGrid(cv::Mat& img, const Axes& a, const std::string& xlabel, const std:
   const double sx = NiceStep(a.x1 - a.x0), sy = NiceStep(a.y1 - a.y0);
   for (double x = std::ceil(a.x0 / sx) * sx; x <= a.x1; x += sx) {
     cv::line(img, a.P(x, a.y0), a.P(x, a.y1), cv::Scalar(225, 225, 225), 1);
-    cv::putText(img, fmt::format("{:g}", std::round(x / sx) * sx),
-                a.P(x, a.y0) + cv::Point2d(-10, 18), cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1,
-                cv::LINE_AA);
+    cv::putText(img, fmt::format("{:g}", Tick(x, sx)), a.P(x, a.y0) + cv::Point2d(-10, 18),
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1, cv::LINE_AA);
   }
   for (double y = std::ceil(a.y0 / sy) * sy; y <= a.y1; y += sy) {
     cv::line(img, a.P(a.x0, y), a.P(a.x1, y), cv::Scalar(225, 225, 225), 1);
-    cv::putText(img, fmt::format("{:g}", std::round(y / sy) * sy),
-                a.P(a.x0, y) + cv::Point2d(-48, 5), cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1,
-                cv::LINE_AA);
+    cv::putText(img, fmt::format("{:g}", Tick(y, sy)), a.P(a.x0, y) + cv::Point2d(-48, 5),
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1, cv::LINE_AA);
   }
   cv::rectangle(img, a.box, kDark, 1);
   cv::putText(img, xlabel, cv::Point(a.box.x + a.box.width / 2 - 60, a.box.br().y + 38),
@@ -99,10 +103,11 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
   if (pred && pred->ok) grow(pred->landing_m);
   const double ms = 0.05 * (smax - smin) + 0.05, mz = 0.1 * (zmax - zmin) + 0.05;
   Axes a{smin - ms, smax + ms, zmin - mz, zmax + mz,
-         cv::Rect(70, 80, size.width - 100, size.height - 140)};
+         cv::Rect(70, 100, size.width - 100, size.height - 190)};
   DrawGrid(img, a, "horizontal distance along the flight from the origin (m)", "height z (m)");
   cv::line(img, a.P(a.x0, o.ground_z_m), a.P(a.x1, o.ground_z_m), kDark, 2);
   auto curve = [&](const BallisticModel& m, double ta, double tb, const cv::Scalar& c, int th) {
+    if (tb <= ta) return;
     std::vector<cv::Point> pts;
     const int steps = 200;
     for (int k = 0; k <= steps; ++k) {
@@ -134,7 +139,10 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
     }
     cv::polylines(img, pts, false, kOrange, 1, cv::LINE_AA);
   }
-  curve(f.model(), t0, t1, kBlue, 2);
+  // The chosen model: thick over the seen samples, thin where it is extrapolated.
+  curve(f.model(), t0, f.t_first_seen_s, kBlue, 1);
+  curve(f.model(), f.t_first_seen_s, f.t_last_seen_s, kBlue, 2);
+  curve(f.model(), f.t_last_seen_s, t1, kBlue, 1);
   for (int i : f.samples) {
     const auto& p = track[i].ball_in_world;
     if (result.outlier[i]) {
@@ -180,8 +188,12 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
   }
   Text(img, fits, {10, 44}, kDark);
   Text(img,
-       "green: samples, red x: outliers, blue: fit, grey: other models, orange: seed, purple: "
-       "landing predicted from the first half; origin/landing hollow: extrapolated (not seen)",
+       "green: samples, red x: outliers, blue: fit (thin: extrapolated beyond the samples), grey: "
+       "other models, orange: seed quadratic,",
+       {10, size.height - 26}, kDark, 0.42);
+  Text(img,
+       "purple: landing predicted from the first half (bar: 95 % semi-axis); origin/landing "
+       "circles hollow: extrapolated, filled: seen",
        {10, size.height - 8}, kDark, 0.42);
   return img;
 }
@@ -351,14 +363,13 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
     const double px = ml + view.ToPixel({x, 0}).x;
     cv::line(out, {static_cast<int>(px), mt + img.rows}, {static_cast<int>(px), mt + img.rows + 5},
              kDark, 1);
-    Text(out, fmt::format("{:g}", std::round(x / step) * step),
-         {static_cast<int>(px) - 10, mt + img.rows + 20}, kDark, 0.45);
+    Text(out, fmt::format("{:g}", Tick(x, step)), {static_cast<int>(px) - 10, mt + img.rows + 20},
+         kDark, 0.45);
   }
   for (double y = std::ceil(lo.y() / step) * step; y <= hi.y(); y += step) {
     const double py = mt + view.ToPixel({0, y}).y;
     cv::line(out, {ml - 5, static_cast<int>(py)}, {ml, static_cast<int>(py)}, kDark, 1);
-    Text(out, fmt::format("{:g}", std::round(y / step) * step), {5, static_cast<int>(py) + 5},
-         kDark, 0.45);
+    Text(out, fmt::format("{:g}", Tick(y, step)), {5, static_cast<int>(py) + 5}, kDark, 0.45);
   }
   Text(out, "x (m)", {ml + img.cols / 2 - 20, mt + img.rows + 38}, kBlack);
   Text(out, "y (m)", {5, mt - 10}, kBlack);

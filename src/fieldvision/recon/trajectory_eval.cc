@@ -39,9 +39,14 @@ BounceTrackScore ScoreBounceTrack(const std::string& path, const std::vector<Bal
   const TrajectoryResult r = AnalyzeTrajectory(track, options);
   s.flights = static_cast<int>(r.flights.size());
   for (bool o : r.outlier) s.outliers += o;
+  s.restitution = s.friction = kNaN;
   for (const auto& b : r.breaks) {
     s.bounces += b.kind == FlightEvent::kBounce;
     s.hits += b.kind == FlightEvent::kHit;
+    if (b.kind == FlightEvent::kBounce && b.bounce.ok && !std::isfinite(s.restitution)) {
+      s.restitution = b.bounce.restitution;
+      s.friction = b.bounce.friction;
+    }
   }
   const Flight* pre = nullptr;
   const Flight* post = nullptr;
@@ -134,6 +139,8 @@ BounceTrackSummary Summarize(std::vector<BounceTrackScore> tracks) {
   out.median_pred_spin_m = MedianFinite(out.tracks, &S::pred_spin_m);
   out.median_pred_free_m = MedianFinite(out.tracks, &S::pred_free_m);
   out.median_after_bounce_rmse_m = MedianFinite(out.tracks, &S::after_bounce_rmse_m);
+  out.median_restitution = MedianFinite(out.tracks, &S::restitution);
+  out.median_friction = MedianFinite(out.tracks, &S::friction);
   for (const auto& t : out.tracks) {
     out.one_bounce += t.bounces == 1;
     out.spin_chosen += t.scored && t.model == "spin";
@@ -169,11 +176,12 @@ std::string BounceTrackSummary::Table() const {
       "median over {} tracks ({} with exactly one bounce, spin chosen on {}): pre-bounce rmse "
       "chosen {} mm, gravity {} mm, drag {} mm, spin {} mm, free constant acceleration {} mm; "
       "landing from the first half: chosen {} cm, drag {} cm, spin {} cm, free {} cm; after the "
-      "bounce (first 0.1 s, predicted) {} mm\n",
+      "bounce (first 0.1 s, predicted with the default bounce model) {} mm; bounces measured: "
+      "restitution {:.2f}, friction {:.2f} (medians)\n",
       tracks.size(), one_bounce, spin_chosen, mm(median_rmse_chosen_m), mm(median_rmse_gravity_m),
       mm(median_rmse_drag_m), mm(median_rmse_spin_m), mm(median_rmse_free_m),
       cm(median_pred_chosen_m), cm(median_pred_drag_m), cm(median_pred_spin_m),
-      cm(median_pred_free_m), mm(median_after_bounce_rmse_m));
+      cm(median_pred_free_m), mm(median_after_bounce_rmse_m), median_restitution, median_friction);
   return s;
 }
 

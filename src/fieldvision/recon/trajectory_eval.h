@@ -26,6 +26,8 @@ struct BounceTrackScore {
   // The flight after the bounce predicted from the whole flight before it through the bounce
   // model (trajectory.h, BounceOptions): RMS position error over its first 0.1 s (NaN if none).
   double after_bounce_rmse_m = 0;
+  // The bounce measured from the fitted arcs on both sides (trajectory.h, BounceFit; NaN if not).
+  double restitution = 0, friction = 0;
 };
 
 struct BounceTrackSummary {
@@ -36,6 +38,7 @@ struct BounceTrackSummary {
   double median_pred_chosen_m = 0, median_pred_drag_m = 0, median_pred_spin_m = 0,
          median_pred_free_m = 0;
   double median_after_bounce_rmse_m = 0;
+  double median_restitution = 0, median_friction = 0;
   int one_bounce = 0;         // tracks with exactly one bounce
   int spin_chosen = 0;        // pre-bounce flights where the spin model was chosen
   std::string Table() const;  // one row per track and the medians
