@@ -1,11 +1,16 @@
 // `fieldvision tracks edit`: fix identities in TRACKS.csv by hand (merge, rename, name, team,
-// drop) from a small JSON file, before `stats` (track/edits.h).
+// drop) from a small JSON file, before `stats` (track/edits.h); `tracks draw`: see the result on
+// the video (track/overlay.h).
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/field/field.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/overlay.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -33,6 +38,31 @@ void RunTracksEdit(const TracksEditCli& c) {
   std::cout << "\n";
 }
 
+struct TracksDrawCli {
+  std::string tracks, video, out, camera, field, roster_in;
+  double fps = 0;
+  int max_frames = 0;
+};
+
+// The video with the (edited) tracks drawn: names from the roster, team colours.
+void RunTracksDraw(const TracksDrawCli& c) {
+  const auto rows = track::ReadTracksCsv(c.tracks);
+  std::string roster_in = c.roster_in;
+  if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
+    roster_in = track::RosterPathFor(c.tracks);
+  }
+  const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
+  std::optional<Camera> camera;
+  if (!c.camera.empty()) camera = ReadCameraYaml(c.camera);
+  std::optional<FieldModel> field;
+  if (!c.field.empty()) field = LoadField(c.field);
+  const track::TrackOverlay overlay(rows, roster.team_of, roster.name_of,
+                                    camera ? &*camera : nullptr, field ? &*field : nullptr);
+  const track::DrawVideoResult d =
+      track::DrawTracksVideo(c.video, c.out, overlay, c.fps, c.max_frames);
+  std::cout << d.Summary() << "\n";
+}
+
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(app, "tracks", "Fix player tracks by hand");
   auto c = std::make_shared<TracksEditCli>();
@@ -52,6 +82,23 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--roster", c->roster_in,
                   "id,team[,name] CSV to start from (default: TRACKS.csv.teams.csv if present)");
   cmd->callback([c] { RunTracksEdit(*c); });
+
+  auto d = std::make_shared<TracksDrawCli>();
+  CLI::App* draw = group->add_subcommand(
+      "draw",
+      "Draw TRACKS.csv on its video (boxes, ids or roster names, team colours, trails, field "
+      "lines with a posed camera and --field): H.264 .mp4, or MJPG .avi without the encoder");
+  draw->add_option("--tracks", d->tracks, "TRACKS.csv (e.g. after tracks edit)")->required();
+  draw->add_option("--video", d->video, "The video the tracks come from")->required();
+  draw->add_option("--out", d->out, "Output video (.mp4)")->required();
+  draw->add_option("--camera", d->camera, "Camera file with a pose (for the field lines)");
+  draw->add_option("--field", d->field, "Field (built-in name or JSON) whose lines are drawn");
+  draw->add_option("--roster", d->roster_in,
+                   "id,team[,name] CSV (default: TRACKS.csv.teams.csv if present)");
+  draw->add_option("--fps", d->fps, "Frame rate of the output (default: the video's)")
+      ->check(CLI::PositiveNumber);
+  draw->add_option("--max-frames", d->max_frames, "Draw at most this many frames (0: all)");
+  draw->callback([d] { RunTracksDraw(*d); });
 }
 
 FV_REGISTER_COMMAND(72, "tracks edit", Setup);
