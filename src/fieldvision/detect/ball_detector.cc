@@ -83,7 +83,78 @@ bool SegmentMeetsRect(const Vector2d& p0, const Vector2d& p1, double hx, double 
   return t0 <= t1;
 }
 
+// The first outline check the sub-pixel fit fails ("" when it passes them all).
+std::string OutlineProblem(const BallFit& fit, double visible, double leak,
+                           const BallDetectorOptions& o) {
+  if (fit.inlier_fraction < o.min_inlier_fraction) {
+    return fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
+  }
+  if (fit.outside_fraction > o.max_outside_fraction) {
+    return fmt::format("colour goes on beyond the circle on {:.0f} % of rays",
+                       100 * fit.outside_fraction);
+  }
+  if (fit.inlier_fraction < 0.75 && fit.outside_fraction > o.max_outside_fraction_occluded) {
+    return fmt::format("partial outline with colour beyond the circle on {:.0f} % of rays",
+                       100 * fit.outside_fraction);
+  }
+  if (fit.dents > o.max_dents && fit.inlier_fraction < 0.85) {
+    return fmt::format("outline has {} dents: not a disc", fit.dents);
+  }
+  if (fit.rms_px > o.max_fit_rms_px) return fmt::format("outline rms {:.2f} px", fit.rms_px);
+  if (visible < o.min_visible_fraction) {
+    return fmt::format("disc only {:.0f} % ball-coloured", 100 * visible);
+  }
+  if (leak > o.max_leak_fraction) {
+    return fmt::format("colour extends beyond the circle ({:.0f} %)", 100 * leak);
+  }
+  return "";
+}
+
+// The first region check the candidate fails ("" when it passes them all).
+std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o) {
+  if (r.arc_cover < o.min_arc_cover) {
+    return fmt::format("region outline not round ({:.0f} % of the circle)", 100 * r.arc_cover);
+  }
+  if (r.outside > o.max_region_outside) {
+    return fmt::format("region outline sticks out of its circle ({:.0f} %)", 100 * r.outside);
+  }
+  if (r.fill < o.min_region_fill) {
+    return fmt::format("region fills only {:.0f} % of its circle", 100 * r.fill);
+  }
+  if (r.spill > o.max_region_spill) {
+    return fmt::format("region spills beyond its circle ({:.0f} %)", 100 * r.spill);
+  }
+  if (r.leak > o.max_ring_leak) {
+    return fmt::format("ball colour around the circle ({:.0f} % of a ring)", 100 * r.leak);
+  }
+  if (r.contrast < o.min_contrast) {
+    return fmt::format("too little contrast with the surroundings (Delta E {:.0f})", r.contrast);
+  }
+  return "";
+}
+
 }  // namespace
+
+std::string BallDetector::SizeProblem(const Vector2d& centre, double radius,
+                                      double* size_factor) const {
+  const BallDetectorOptions& o = options_;
+  *size_factor = 1.0;
+  if (radius < o.min_radius_px || radius > o.max_radius_px) {
+    return fmt::format("radius {:.1f} px outside {}..{}", radius, o.min_radius_px, o.max_radius_px);
+  }
+  double exp_min = 0, exp_max = 0;
+  if (!ExpectedRadius(centre, &exp_min, &exp_max)) return "";
+  const double lo = exp_min * (1 - o.size_tolerance) - 0.5;
+  const double hi = exp_max * (1 + o.size_tolerance) + 0.5;
+  if (radius < lo) return fmt::format("too small for a ball here ({:.1f} < {:.1f} px)", radius, lo);
+  if (radius > hi) return fmt::format("too large for a ball here ({:.1f} > {:.1f} px)", radius, hi);
+  if (exp_min > 0) {
+    // Prefer sizes near the ball on the ground.
+    const double f = std::exp(-0.5 * std::pow(std::log(radius / exp_min) / 0.3, 2));
+    *size_factor = 0.5 + 0.5 * f;
+  }
+  return "";
+}
 
 void BallDetectorOptions::Check() const {
   CheckPositive(diameter_m, "diameter_m");
@@ -111,6 +182,15 @@ void BallDetectorOptions::Check() const {
   FV_REQUIRE(max_refine >= 1, "max_refine must be >= 1 (got {})", max_refine);
   FV_REQUIRE(weak_min_inlier_fraction >= 0 && weak_min_inlier_fraction <= 1,
              "weak_min_inlier_fraction must be in [0, 1] (got {})", weak_min_inlier_fraction);
+  CheckInRange(min_arc_cover, 0.0, 1.0, "min_arc_cover");
+  CheckInRange(min_region_fill, 0.0, 1.0, "min_region_fill");
+  CheckNonNegative(max_region_spill, "max_region_spill");
+  CheckInRange(max_ring_leak, 0.0, 1.0, "max_ring_leak");
+  CheckNonNegative(min_contrast, "min_contrast");
+  CheckInRange(max_region_outside, 0.0, 1.0, "max_region_outside");
+  CheckInRange(grow_hue_deg, 0.0, 60.0, "grow_hue_deg");
+  CheckInRange(grow_factor, 0.0, 1.0, "grow_factor");
+  region.Check();
   fit.Check();
 }
 
@@ -143,6 +223,10 @@ void BallDetector::Init(const ColourSpec& colour) {
   if (camera_ != nullptr) camera_->Check();
   table_ = ColourTable::Shared(colour, options_.lut_bits);
   ball_bit_ = table_->BallBit();
+  if (options_.use_region) {
+    grow_table_ = ColourTable::Shared(
+        WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor), options_.lut_bits);
+  }
   if (camera_ != nullptr && field_ != nullptr && camera_->has_pose && options_.use_field_mask) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
   }
@@ -208,100 +292,157 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   result.blobs = static_cast<int>(blobs.blobs.size());
   result.runs = blobs.runs;
   result.samples = blobs.samples;
-  for (const Blob& blob : blobs.blobs) {
+  // Disc-like blobs first (a printed or partly hidden ball may be a few of them), then larger.
+  std::vector<const Blob*> order;
+  order.reserve(blobs.blobs.size());
+  for (const Blob& b : blobs.blobs) order.push_back(&b);
+  std::stable_sort(order.begin(), order.end(), [&](const Blob* a, const Blob* b) {
+    const bool da = a->aspect_ratio() <= o.max_aspect_ratio;
+    const bool db = b->aspect_ratio() <= o.max_aspect_ratio;
+    return da > db;
+  });
+  std::vector<Vector2d> region_centres;
+  std::vector<double> region_radii;
+  for (const Blob* blob_ptr : order) {
+    const Blob& blob = *blob_ptr;
     if (!fits_in_region(blob)) continue;
     BallCandidate cand;
     cand.centre_px = Vector2d(0.5 * (blob.x_min + blob.x_max), 0.5 * (blob.y_min + blob.y_max));
     cand.radius_px = 0.25 * (blob.width_px() + blob.height_px());
     cand.sigma_px = 0.5 * blob.step_px;
-    cand.score = 0.0;
     auto reject = [&](std::string why) {
       cand.accepted = false;
       cand.reason = std::move(why);
       result.candidates.push_back(cand);
     };
     const double rough_r = 0.5 * std::max(blob.width_px(), blob.height_px());
-    if (rough_r < 0.5 * o.min_radius_px || rough_r > 1.5 * o.max_radius_px) {
+    if (rough_r > 1.5 * o.max_radius_px) {
       reject("blob size");
-      continue;
-    }
-    if (blob.aspect_ratio() > o.max_aspect_ratio) {
-      reject("blob aspect ratio");
-      continue;
-    }
-    if (blob.samples >= 6 && blob.fill_ratio() < o.min_fill_ratio) {
-      reject("blob fill ratio");
       continue;
     }
     if (result.refined >= o.max_refine) {
       reject("not refined (max_refine)");
       continue;
     }
-    ++result.refined;
-    const BallFit fit =
-        FitBall(bgr, *table_, ball_bit_, blob.centroid_px(), rough_r, camera_, o.fit);
-    if (!fit.ok) {
-      reject(fit.failure);
-      continue;
-    }
-    cand.centre_px = fit.centre_px;
-    cand.radius_px = fit.radius_px;
-    cand.sigma_px = fit.sigma_px;
-    cand.blurred = fit.blurred;
-    cand.inlier_fraction = fit.inlier_fraction;
-    cand.outside_fraction = fit.outside_fraction;
-    cand.dents = fit.dents;
-    double visible, leak;
-    DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
-               fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
-    cand.visible_fraction = visible;
-    double size_factor = 1.0;
-    std::string why;        // a hard failure: size
-    std::string shape_why;  // an outline check: the candidate may still be weak
-    double exp_min = 0, exp_max = 0;
-    if (fit.radius_px < o.min_radius_px || fit.radius_px > o.max_radius_px) {
-      why = fmt::format("radius {:.1f} px outside {}..{}", fit.radius_px, o.min_radius_px,
-                        o.max_radius_px);
-    } else if (ExpectedRadius(fit.centre_px, &exp_min, &exp_max)) {
-      const double lo = exp_min * (1 - o.size_tolerance) - 0.5;
-      const double hi = exp_max * (1 + o.size_tolerance) + 0.5;
-      if (fit.radius_px < lo) {
-        why = fmt::format("too small for a ball here ({:.1f} < {:.1f} px)", fit.radius_px, lo);
-      } else if (fit.radius_px > hi) {
-        why = fmt::format("too large for a ball here ({:.1f} > {:.1f} px)", fit.radius_px, hi);
-      } else if (exp_min > 0) {
-        // Prefer sizes near the ball on the ground.
-        size_factor = std::exp(-0.5 * std::pow(std::log(fit.radius_px / exp_min) / 0.3, 2));
-        size_factor = 0.5 + 0.5 * size_factor;
+    // 1. The region check: the blob with its neighbouring fragments, holes filled.
+    BallRegion region;
+    if (o.use_region) {
+      const int half = blob.step_px / 2 + 1;
+      const cv::Rect seed(blob.x_min - half, blob.y_min - half,
+                          blob.x_max - blob.x_min + 2 * half + 1,
+                          blob.y_max - blob.y_min + 2 * half + 1);
+      region = AnalyseBallRegion(bgr, *table_, ball_bit_, seed, roi, o.region, grow_table_.get());
+      if (region.ok) {
+        // A fragment of a region already measured.
+        bool duplicate = false;
+        for (size_t i = 0; i < region_centres.size() && !duplicate; ++i) {
+          duplicate =
+              (region_centres[i] - region.centre_px).norm() < std::max(0.5 * region_radii[i], 1.0);
+        }
+        if (duplicate) continue;
+        region_centres.push_back(region.centre_px);
+        region_radii.push_back(region.radius_px);
+        cand.region_ok = true;
+        cand.arc_cover = region.arc_cover;
+        cand.fill = region.fill;
+        cand.spill = region.spill;
+        cand.leak = region.leak;
+        cand.contrast = region.contrast;
+        cand.region_outside = region.outside;
+        cand.centre_px = region.centre_px;
+        cand.radius_px = region.radius_px;
+        cand.sigma_px = region.sigma_px;
       }
     }
-    if (fit.inlier_fraction < o.min_inlier_fraction) {
-      shape_why =
-          fmt::format("outline not round ({:.0f} % on the circle)", 100 * fit.inlier_fraction);
-    } else if (fit.outside_fraction > o.max_outside_fraction) {
-      shape_why = fmt::format("colour goes on beyond the circle on {:.0f} % of rays",
-                              100 * fit.outside_fraction);
-    } else if (fit.inlier_fraction < 0.75 &&
-               fit.outside_fraction > o.max_outside_fraction_occluded) {
-      shape_why = fmt::format("partial outline with colour beyond the circle on {:.0f} % of rays",
-                              100 * fit.outside_fraction);
-    } else if (fit.dents > o.max_dents && fit.inlier_fraction < 0.85) {
-      shape_why = fmt::format("outline has {} dents: not a disc", fit.dents);
-    } else if (fit.rms_px > o.max_fit_rms_px) {
-      shape_why = fmt::format("outline rms {:.2f} px", fit.rms_px);
-    } else if (visible < o.min_visible_fraction) {
-      shape_why = fmt::format("disc only {:.0f} % ball-coloured", 100 * visible);
-    } else if (leak > o.max_leak_fraction) {
-      shape_why = fmt::format("colour extends beyond the circle ({:.0f} %)", 100 * leak);
+    if (!region.ok) {
+      if (blob.aspect_ratio() > o.max_aspect_ratio) {
+        reject("blob aspect ratio");
+        continue;
+      }
+      if (blob.samples >= 6 && blob.fill_ratio() < o.min_fill_ratio) {
+        reject("blob fill ratio");
+        continue;
+      }
     }
-    cand.weak = why.empty() && !shape_why.empty() &&
-                fit.inlier_fraction >= o.weak_min_inlier_fraction &&
-                visible >= o.min_visible_fraction;
-    if (why.empty()) why = shape_why;
-    cand.score = fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
-                 std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor;
-    cand.accepted = why.empty();
-    cand.reason = why;
+    ++result.refined;
+    // 2. The sub-pixel outline fit, seeded by the region when there is one.
+    const Vector2d seed_c = region.ok ? region.centre_px : blob.centroid_px();
+    const double seed_r = region.ok ? region.radius_px : rough_r;
+    const BallFit fit = seed_r >= 0.5 * o.min_radius_px
+                            ? FitBall(bgr, *table_, ball_bit_, seed_c, seed_r, camera_, o.fit)
+                            : BallFit{};
+    std::string fit_why;  // why the precise path fails
+    double visible = 0.0, leak = 1.0;
+    if (!fit.ok) {
+      fit_why = fit.failure.empty() ? "too small to fit" : fit.failure;
+    } else {
+      DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
+                 fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
+      fit_why = OutlineProblem(fit, visible, leak, o);
+    }
+    // 3. Size: the radius limits and, with a posed camera, the ball's size at that place.
+    const double radius = fit.ok && fit_why.empty() ? fit.radius_px : cand.radius_px;
+    const Vector2d centre = fit.ok && fit_why.empty() ? fit.centre_px : cand.centre_px;
+    double size_factor = 1.0;
+    const std::string size_why = SizeProblem(centre, radius, &size_factor);
+    const bool stands_out = !region.ok || region.contrast >= o.min_contrast;
+    const bool precise_ok = fit.ok && fit_why.empty() && size_why.empty() && stands_out;
+    std::string region_why;
+    if (!o.use_region) {
+      region_why = "region check off";
+    } else if (!region.ok) {
+      region_why = region.failure;
+    } else {
+      region_why = RegionProblem(region, o);
+      if (region_why.empty()) region_why = size_why;
+    }
+    const bool region_accept = region_why.empty();
+    if (fit.ok) {
+      cand.blurred = fit.blurred;
+      cand.inlier_fraction = fit.inlier_fraction;
+      cand.outside_fraction = fit.outside_fraction;
+      cand.dents = fit.dents;
+      cand.visible_fraction = visible;
+    }
+    const double region_score =
+        region.ok
+            ? region.arc_cover * std::min(1.0, region.fill / 0.9) * (1.0 - region.spill) *
+                  (1.0 - region.leak) * (region.radius_px / (region.radius_px + 1.0)) * size_factor
+            : 0.0;
+    if (precise_ok) {
+      cand.centre_px = fit.centre_px;
+      cand.radius_px = fit.radius_px;
+      cand.sigma_px = fit.sigma_px;
+      cand.precise = true;
+      cand.score =
+          std::max(region_score, fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
+                                     std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor);
+      cand.accepted = true;
+    } else if (region_accept) {
+      // The outline fit refines the region's centre when the two agree.
+      if (fit.ok && (fit.centre_px - region.centre_px).norm() < 0.25 * region.radius_px &&
+          std::abs(fit.radius_px - region.radius_px) < 0.25 * region.radius_px &&
+          fit.inlier_fraction >= o.weak_min_inlier_fraction) {
+        cand.centre_px = fit.centre_px;
+        cand.radius_px = fit.radius_px;
+        cand.sigma_px = std::max(fit.sigma_px, region.sigma_px * 0.5);
+        cand.precise = true;
+      }
+      cand.score = region_score;
+      cand.accepted = true;
+    } else {
+      cand.accepted = false;
+      cand.reason = !size_why.empty() ? size_why : (region.ok ? region_why : fit_why);
+      cand.score = std::max(region_score, 0.0);
+      cand.weak = fit.ok && size_why.empty() && !fit_why.empty() &&
+                  fit.inlier_fraction >= o.weak_min_inlier_fraction &&
+                  visible >= o.min_visible_fraction;
+      if (cand.weak) {
+        cand.centre_px = fit.centre_px;
+        cand.radius_px = fit.radius_px;
+        cand.sigma_px = fit.sigma_px;
+      }
+    }
     result.candidates.push_back(cand);
   }
   std::stable_sort(result.candidates.begin(), result.candidates.end(),

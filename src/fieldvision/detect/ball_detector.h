@@ -16,6 +16,7 @@
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/detect/ball_fit.h"
+#include "fieldvision/detect/ball_region.h"
 #include "fieldvision/detect/blobs.h"
 #include "fieldvision/detect/colour.h"
 #include "fieldvision/field/field.h"
@@ -39,7 +40,17 @@ struct BallCandidate {
   double outside_fraction = 0.0;  // share of rays where the colour goes on beyond the fit
   int dents = 0;                  // arcs of the outline inside the fit
   bool blurred = false;
-  std::string reason;  // why rejected ("" when accepted)
+  // The region check (ball_region.h): the blob taken whole, holes filled, a circle on its convex
+  // outline.
+  bool region_ok = false;
+  double arc_cover = 0.0;       // share of the circle's angle with outline on it
+  double fill = 0.0;            // share of the disc in the region
+  double spill = 0.0;           // region beyond the circle, as a share of the disc
+  double leak = 0.0;            // ball colour in a ring around the circle
+  double contrast = 0.0;        // CIELAB distance between the disc's and the ring's colours
+  double region_outside = 0.0;  // convex outline beyond the region's circle
+  bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
+  std::string reason;           // why rejected ("" when accepted)
 };
 
 struct BallDetectorOptions {
@@ -48,7 +59,7 @@ struct BallDetectorOptions {
   int lut_bits = 8;               // bits per channel of the lookup table: 8 exact, 5..7 quantised
   int scan_step_px = 2;           // scanline step (rows and columns)
   int min_samples = 2;            // smallest blob, in scan samples
-  double min_radius_px = 2.5;     // ball radius limits in the image
+  double min_radius_px = 2.0;     // ball radius limits in the image
   double max_radius_px = 150.0;
   double min_fill_ratio = 0.35;       // blob area / bounding box (pi/4 for a disc; lower: occluded)
   double max_aspect_ratio = 3.0;      // blob bounding box long / short side
@@ -66,7 +77,26 @@ struct BallDetectorOptions {
   double min_distance_m = 0.5;  // nearest ball distance to the camera considered
   bool use_field_mask = true;   // with camera pose and field: only the field of play
   double field_margin_m = 1.0;  // around the field of play
-  int max_refine = 12;          // largest blobs refined per frame
+  int max_refine = 24;          // blobs refined per frame (disc-like ones first, then largest)
+  // The region check (real balls: print, highlights, shading, occlusion, small and blurred):
+  // accepted when the circle on the region's convex outline is covered on this share of its
+  // angle, the disc is filled this much, little spills beyond it and little ball colour lies
+  // around it.
+  bool use_region = true;
+  double min_arc_cover = 0.5;
+  double min_region_fill = 0.6;
+  double max_region_spill = 0.25;
+  double max_ring_leak = 0.3;
+  double max_region_outside = 0.1;  // convex outline points beyond the circle (corners, apexes)
+  // A ball stands out from its surroundings: CIELAB Delta E between the disc's and a ring's
+  // median colours (ball_region.h), required of every accepted candidate with a region.
+  double min_contrast = 30.0;
+  BallRegionOptions region;
+  // The region grows through the ball class widened by this hue (degrees) and with saturation
+  // and value minima times grow_factor (colour.h: WidenedBallSpec); grow_factor 1 and
+  // grow_hue_deg 0 keep the class as it is.
+  double grow_hue_deg = 4.0;
+  double grow_factor = 0.6;
   // Weak candidates (see BallCandidate::weak) need at least this share of rays on the circle.
   double weak_min_inlier_fraction = 0.5;
   BallFitOptions fit;
@@ -112,10 +142,14 @@ class BallDetector {
 
  private:
   void Init(const ColourSpec& colour);
+  // "" when `radius` fits the radius limits and the ball's size at `centre` (posed camera);
+  // else why not. `size_factor` (0.5..1) prefers the size of a ball on the ground there.
+  std::string SizeProblem(const Eigen::Vector2d& centre, double radius, double* size_factor) const;
   BallDetectorOptions options_;
   const Camera* camera_;
   const FieldModel* field_;
   std::shared_ptr<const ColourTable> table_;
+  std::shared_ptr<const ColourTable> grow_table_;  // the widened ball class (region growing)
   uint8_t ball_bit_ = 1;
   cv::Mat field_mask_;
 };

@@ -191,39 +191,6 @@ bool CircleFrom3(const Vector2d& a, const Vector2d& b, const Vector2d& c, Vector
   return std::isfinite(*radius);
 }
 
-// RANSAC on triples (deterministic sequence) then FitCircle.
-bool RansacCircle(const std::vector<Vector2d>& pts, double thr, int iterations, Vector2d* centre,
-                  double* radius, std::vector<char>* inlier) {
-  const int n = static_cast<int>(pts.size());
-  if (n < 3) return false;
-  uint64_t state = 0x9E3779B97F4A7C15ull ^ uint64_t(n);
-  auto next = [&](int m) {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<int>((state >> 33) % uint64_t(m));
-  };
-  int best = -1;
-  Vector2d best_c = Vector2d::Zero();
-  double best_r = 0;
-  for (int it = 0; it < iterations; ++it) {
-    const int i = next(n), j = next(n), k = next(n);
-    if (i == j || j == k || i == k) continue;
-    Vector2d c;
-    double r;
-    if (!CircleFrom3(pts[i], pts[j], pts[k], &c, &r)) continue;
-    int count = 0;
-    for (const auto& p : pts) count += std::abs((p - c).norm() - r) < thr;
-    if (count > best) {
-      best = count;
-      best_c = c;
-      best_r = r;
-    }
-  }
-  if (best < 3) return false;
-  *centre = best_c;
-  *radius = best_r;
-  return FitCircle(pts, thr, centre, radius, inlier);
-}
-
 // Centre covariance of a circle through the inliers: sigma^2 (J^T J)^-1, J the Jacobian of the
 // distances to the circle with respect to (cx, cy, r).
 double CentreSigma(const std::vector<Vector2d>& pts, const std::vector<char>& inlier,
@@ -452,6 +419,38 @@ bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* cen
   *centre = c;
   *radius = r;
   return std::isfinite(r) && r > 0;
+}
+
+bool RansacCircle(const std::vector<Vector2d>& pts, double thr, int iterations, Vector2d* centre,
+                  double* radius, std::vector<char>* inlier) {
+  const int n = static_cast<int>(pts.size());
+  if (n < 3) return false;
+  uint64_t state = 0x9E3779B97F4A7C15ull ^ uint64_t(n);
+  auto next = [&](int m) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<int>((state >> 33) % uint64_t(m));
+  };
+  int best = -1;
+  Vector2d best_c = Vector2d::Zero();
+  double best_r = 0;
+  for (int it = 0; it < iterations; ++it) {
+    const int i = next(n), j = next(n), k = next(n);
+    if (i == j || j == k || i == k) continue;
+    Vector2d c;
+    double r;
+    if (!CircleFrom3(pts[i], pts[j], pts[k], &c, &r)) continue;
+    int count = 0;
+    for (const auto& p : pts) count += std::abs((p - c).norm() - r) < thr;
+    if (count > best) {
+      best = count;
+      best_c = c;
+      best_r = r;
+    }
+  }
+  if (best < 3) return false;
+  *centre = best_c;
+  *radius = best_r;
+  return FitCircle(pts, thr, centre, radius, inlier);
 }
 
 BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,

@@ -50,6 +50,12 @@ ColourClass ColourPreset(const std::string& name);
 // A spec whose ball class is the preset `ball_preset`, plus "field" (green) and "line" (white).
 ColourSpec PresetColourSpec(const std::string& ball_preset = "orange");
 
+// The ball class widened for the shaded, pale and blurred parts of a ball that touch its core
+// colour (region growing with hysteresis, as Canny's two thresholds): HSV hue +-hue_deg,
+// saturation and value minima times `factor`; YUV chroma +-2 * hue_deg, Y minimum times
+// `factor`. The result has the one class `ball_class`.
+ColourSpec WidenedBallSpec(const ColourSpec& spec, double hue_deg = 10.0, double factor = 0.6);
+
 nlohmann::json ColourSpecToJson(const ColourSpec& spec);
 // Throws fv::Error naming `context` and the bad key.
 ColourSpec ColourSpecFromJson(const nlohmann::json& j, const std::string& context);

@@ -286,8 +286,10 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   if (!o.candidates_out.empty()) {
     cand_csv = std::make_unique<CsvWriter>(
         o.candidates_out + ".part",
-        std::vector<std::string>{"image", "u", "v", "radius_px", "score", "accepted", "weak",
-                                 "on_ball", "visible", "inliers", "outside", "dents", "reason"},
+        std::vector<std::string>{
+            "image",   "u",       "v",       "radius_px", "score",     "accepted", "weak",
+            "on_ball", "visible", "inliers", "outside",   "dents",     "region",   "arc",
+            "fill",    "spill",   "leak",    "contrast",  "outside_r", "precise",  "reason"},
         4);
   }
   Progress progress("eval detect", static_cast<long long>(items.size()), "images", o.progress);
@@ -313,7 +315,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
         });
         *cand_csv << item.image << c.centre_px.x() << c.centre_px.y() << c.radius_px << c.score
                   << int(c.accepted) << int(c.weak) << int(on_ball) << c.visible_fraction
-                  << c.inlier_fraction << c.outside_fraction << c.dents << ReplaceCommas(c.reason);
+                  << c.inlier_fraction << c.outside_fraction << c.dents << int(c.region_ok)
+                  << c.arc_cover << c.fill << c.spill << c.leak << c.contrast << c.region_outside
+                  << int(c.precise) << ReplaceCommas(c.reason);
         cand_csv->EndRow();
       }
     }

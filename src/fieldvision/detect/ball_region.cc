@@ -1,0 +1,261 @@
+#include "fieldvision/detect/ball_region.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/detect/ball_fit.h"
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+using Eigen::Vector2d;
+
+cv::Rect Grow(const cv::Rect& r, int g) {
+  return {r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g};
+}
+
+// Ball-class pixels of `window` (CV_8U, 255 = ball).
+cv::Mat ClassMask(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
+                  const cv::Rect& window) {
+  cv::Mat mask(window.size(), CV_8U);
+  for (int y = 0; y < window.height; ++y) {
+    const uint8_t* p = bgr.ptr<uint8_t>(window.y + y) + 3 * static_cast<ptrdiff_t>(window.x);
+    uint8_t* m = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < window.width; ++x, p += 3) {
+      m[x] = (table.Classify(p[0], p[1], p[2]) & bit) != 0 ? 255 : 0;
+    }
+  }
+  return mask;
+}
+
+// The components of `labels` near the seed, gathered twice (fragments of a printed ball).
+cv::Mat GatherComponents(const cv::Mat& labels, const cv::Mat& stats, const cv::Rect& seed,
+                         double gather_fraction, cv::Rect* bounds) {
+  const int n = stats.rows;
+  std::vector<char> chosen(n, 0);
+  cv::Rect reach = seed;
+  cv::Rect box;
+  for (int round = 0; round < 2; ++round) {
+    const double r = 0.5 * std::max(reach.width, reach.height);
+    const cv::Rect grown = Grow(reach, static_cast<int>(std::ceil(gather_fraction * r)) + 2);
+    for (int i = 1; i < n; ++i) {
+      const cv::Rect b(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
+                       stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT));
+      // The first round takes what touches the seed itself, the second what is near it.
+      const cv::Rect& target = round == 0 ? seed : grown;
+      if (!chosen[i] && (b & target).area() > 0) {
+        chosen[i] = 1;
+        box = box.area() > 0 ? (box | b) : b;
+      }
+    }
+    if (box.area() == 0) break;
+    reach = box;
+  }
+  *bounds = box;
+  cv::Mat region(labels.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    uint8_t* m = region.ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) m[x] = chosen[l[x]] ? 255 : 0;
+  }
+  return region;
+}
+
+double MedianOf(std::vector<float>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
+
+void BallRegionOptions::Check() const {
+  CheckInRange(gather_fraction, 0.0, 3.0, "BallRegionOptions.gather_fraction");
+  CheckInRange(close_fraction, 0.0, 1.0, "BallRegionOptions.close_fraction");
+  CheckPositive(hull_tolerance_px, "BallRegionOptions.hull_tolerance_px");
+  CheckPositive(inlier_px, "BallRegionOptions.inlier_px");
+  FV_REQUIRE(ring_inner >= 1.0 && ring_outer > ring_inner,
+             "BallRegionOptions: need 1 <= ring_inner < ring_outer (got {}, {})", ring_inner,
+             ring_outer);
+}
+
+std::string BallRegion::Summary() const {
+  if (!ok) return "no region: " + failure;
+  return fmt::format(
+      "centre ({:.2f}, {:.2f}) px, radius {:.2f} px, arc {:.0f} %, fill {:.0f} %, spill {:.0f} %, "
+      "leak {:.0f} %, purity {:.0f} %, contrast {:.0f}, solidity {:.2f}, {}/{} outline points, "
+      "rms {:.2f} px",
+      centre_px.x(), centre_px.y(), radius_px, 100 * arc_cover, 100 * fill, 100 * spill, 100 * leak,
+      100 * purity, contrast, solidity, inliers, outline_points, rms_px);
+}
+
+BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                             const cv::Rect& seed_box, const cv::Rect& limit,
+                             const BallRegionOptions& o, const ColourTable* grow_table) {
+  BallRegion out;
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect lim = limit.empty() ? image : (limit & image);
+  const double r0 = 0.5 * std::max(seed_box.width, seed_box.height);
+  const cv::Rect window = Grow(seed_box, static_cast<int>(std::ceil(2.5 * r0)) + 6) & lim;
+  const cv::Rect seed = (seed_box & window) - window.tl();
+  if (seed.area() == 0) {
+    out.failure = "seed outside the searched region";
+    return out;
+  }
+  const cv::Mat raw = ClassMask(bgr, table, ball_bit, window);
+  const cv::Mat grow =
+      grow_table == nullptr ? raw : ClassMask(bgr, *grow_table, grow_table->BallBit(), window);
+  cv::Mat labels, stats, centroids;
+  cv::connectedComponentsWithStats(grow, labels, stats, centroids, 8, CV_32S);
+  cv::Rect bounds;
+  cv::Mat region = GatherComponents(labels, stats, seed, o.gather_fraction, &bounds);
+  if (bounds.area() == 0) {
+    out.failure = "no ball-coloured pixels at the blob";
+    return out;
+  }
+  const double r_region = 0.5 * std::max(bounds.width, bounds.height);
+  const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
+  if (k >= 1) {
+    cv::morphologyEx(region, region, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
+  }
+  // The largest outer contour, filled: holes (print, highlight) belong to the ball.
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  if (contours.empty()) {
+    out.failure = "no outline";
+    return out;
+  }
+  const auto largest =
+      std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
+        return cv::contourArea(a) + a.size() < cv::contourArea(b) + b.size();
+      });
+  const std::vector<cv::Point>& contour = *largest;
+  cv::Mat filled(region.size(), CV_8U, cv::Scalar(0));
+  cv::drawContours(filled, contours, static_cast<int>(largest - contours.begin()), 255, cv::FILLED);
+  std::vector<cv::Point> hull;
+  cv::convexHull(contour, hull);
+  const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
+  const double area = cv::countNonZero(filled);
+  out.area_px = area;
+  out.solidity = std::min(1.0, area / hull_area);
+  // Convex outline points, not on the window's or the image's border (a clipped outline).
+  const double r_est = std::sqrt(hull_area / M_PI);
+  std::vector<Vector2d> pts;
+  for (const auto& p : contour) {
+    const int gx = p.x + window.x, gy = p.y + window.y;
+    const bool at_border =
+        gx <= lim.x || gy <= lim.y || gx >= lim.x + lim.width - 1 || gy >= lim.y + lim.height - 1;
+    if (at_border) continue;
+    const double d = cv::pointPolygonTest(hull, cv::Point2f(p.x, p.y), true);
+    if (std::abs(d) <= o.hull_tolerance_px + 0.03 * r_est) pts.emplace_back(gx, gy);
+  }
+  out.outline_points = static_cast<int>(pts.size());
+  if (pts.size() < 5) {
+    out.failure = "too few convex outline points";
+    return out;
+  }
+  Vector2d c;
+  double r = 0;
+  std::vector<char> inl;
+  const double thr = o.inlier_px + 0.06 * r_est;
+  if (!RansacCircle(pts, thr, 64, &c, &r, &inl) || !(r > 0.5) || r > 2.5 * r_est + 3) {
+    out.failure = "no circle in the outline";
+    return out;
+  }
+  // Contour points are the centres of the region's border pixels: the edge lies half a pixel out.
+  r += 0.5;
+  double ss = 0;
+  int n_in = 0;
+  const int bins = std::clamp(static_cast<int>(std::lround(M_PI * r)), 8, 36);
+  std::vector<char> bin_hit(bins, 0), bin_known(bins, 0);
+  int n_out = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (!inl[i]) {
+      n_out += (pts[i] - c).norm() + 0.5 > r + thr;
+      continue;
+    }
+    const Vector2d d = pts[i] - c;
+    const double e = d.norm() + 0.5 - r;
+    ss += e * e;
+    ++n_in;
+    double th = std::atan2(d.y(), d.x());
+    if (th < 0) th += 2 * M_PI;
+    bin_hit[std::min(bins - 1, static_cast<int>(th / (2 * M_PI) * bins))] = 1;
+  }
+  int known = 0, hit = 0;
+  for (int b = 0; b < bins; ++b) {
+    const double th = 2 * M_PI * (b + 0.5) / bins;
+    const double x = c.x() + r * std::cos(th), y = c.y() + r * std::sin(th);
+    const bool visible = x >= lim.x + 1 && y >= lim.y + 1 && x <= lim.x + lim.width - 2 &&
+                         y <= lim.y + lim.height - 2;
+    known += visible || bin_hit[b];
+    hit += bin_hit[b];
+  }
+  if (known < bins / 2) {
+    out.failure = "most of the outline is outside the image";
+    return out;
+  }
+  out.inliers = n_in;
+  out.outside = double(n_out) / pts.size();
+  out.rms_px = n_in > 0 ? std::sqrt(ss / n_in) : 0.0;
+  out.arc_cover = double(hit) / known;
+  out.centre_px = c;
+  out.radius_px = r;
+  out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(n_in, 1)) + 0.05;
+  // Fill, spill, leak, purity and contrast over the window.
+  cv::Mat lab;
+  cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
+  std::array<std::vector<float>, 3> disc_lab, ring_lab;
+  const double r_core = 0.8 * r;
+  const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
+  long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, pure = 0;
+  for (int y = 0; y < window.height; ++y) {
+    const uint8_t* f = filled.ptr<uint8_t>(y);
+    const uint8_t* m = raw.ptr<uint8_t>(y);
+    const double dy = window.y + y - c.y();
+    for (int x = 0; x < window.width; ++x) {
+      const double dx = window.x + x - c.x();
+      const double d = std::sqrt(dx * dx + dy * dy);
+      if (d < r) {
+        ++disc;
+        disc_in += f[x] != 0;
+      } else if (d > r_spill) {
+        spill += f[x] != 0;
+      }
+      if (d >= ri && d < ro) {
+        ++ring;
+        ring_ball += m[x] != 0;
+        const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+        for (int ch = 0; ch < 3; ++ch) ring_lab[ch].push_back(l[ch]);
+      } else if (d < r_core) {
+        const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+        for (int ch = 0; ch < 3; ++ch) disc_lab[ch].push_back(l[ch]);
+      }
+      pure += f[x] != 0 && m[x] != 0;
+    }
+  }
+  out.fill = disc > 0 ? double(disc_in) / disc : 0.0;
+  out.spill = spill / (M_PI * r * r);
+  out.leak = ring > 0 ? double(ring_ball) / ring : 0.0;
+  out.purity = area > 0 ? pure / area : 0.0;
+  if (!disc_lab[0].empty() && !ring_lab[0].empty()) {
+    double d2 = 0;
+    for (int ch = 0; ch < 3; ++ch) {
+      // OpenCV's 8-bit Lab: L * 255 / 100, a + 128, b + 128.
+      const double scale = ch == 0 ? 100.0 / 255.0 : 1.0;
+      const double dv = scale * (MedianOf(disc_lab[ch]) - MedianOf(ring_lab[ch]));
+      d2 += dv * dv;
+    }
+    out.contrast = std::sqrt(d2);
+  }
+  out.ok = true;
+  return out;
+}
+
+}  // namespace fv

@@ -1,0 +1,65 @@
+// The region check of a ball candidate: what a real ball looks like once its colour blob is
+// taken whole. Around a blob, the ball-coloured pixels (full resolution) that touch it are
+// gathered, gaps from a print, seams or a highlight are closed and holes filled; the convex part
+// of the region's outline gets a robust circle (RANSAC + geometric fit), so an occluder's edge or
+// the image border does not pull it. The measurements say how disc-like the region is: the share
+// of the circle's angle with outline on it, the share of the disc that is filled, what spills
+// beyond it and how much ball colour lies in a ring around it (a part of a larger object).
+// After RoboCup region-based ball perceptors (e.g. B-Human 2019, Nao-Team HTWK) and the
+// hole-filling of ssl-vision's blob stage.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "fieldvision/detect/colour.h"
+
+namespace fv {
+
+struct BallRegionOptions {
+  double gather_fraction = 0.5;  // other blobs within this share of the radius (+2 px) join
+  double close_fraction = 0.2;   // closing radius as a share of the radius (print, seams), <= 4 px
+  double hull_tolerance_px = 1.0;  // outline points this near the convex hull are "convex"
+  double inlier_px = 0.8;          // circle inliers: within this plus 6 % of the radius
+  double ring_inner = 1.35;        // leak ring, in radii
+  double ring_outer = 1.9;
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct BallRegion {
+  bool ok = false;
+  std::string failure;  // why not ok
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  double sigma_px = 0.0;   // standard deviation of the centre (each axis), from the residuals
+  double rms_px = 0.0;     // RMS distance of the inlier outline points from the circle
+  double area_px = 0.0;    // the closed, filled region
+  double arc_cover = 0.0;  // share of angle bins around the circle with an inlier point
+  double fill = 0.0;       // share of the disc (its part inside the image) in the region
+  double spill = 0.0;      // region area beyond 1.25 r + 1 px, as a share of the disc area
+  double leak = 0.0;       // ball-coloured share of the ring ring_inner..ring_outer radii
+  // Share of the convex outline points farther out than the circle (beyond the inlier band): a
+  // corner or an apex (a cone, a robot's part) sticks out; an occluder's edge lies inside.
+  double outside = 0.0;
+  double purity = 0.0;  // ball-coloured share of the region before closing and filling
+  // CIELAB distance (Delta E 1976) between the median colours of the disc (inner 80 %) and of
+  // the leak ring: a ball stands out from what is around it, a patch of a wall does not.
+  double contrast = 0.0;
+  double solidity = 0.0;   // region area / convex hull area
+  int outline_points = 0;  // convex outline points used by the circle fit
+  int inliers = 0;
+  std::string Summary() const;
+};
+
+// Analyses the blob whose bounds (full-resolution pixels) are `seed_box`; only pixels inside
+// `limit` are read (the whole image when empty). `table`'s ball class is the core colour (leak,
+// purity); `grow_table` (null: the same) the widened class the region grows through.
+BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                             const cv::Rect& seed_box, const cv::Rect& limit,
+                             const BallRegionOptions& options = {},
+                             const ColourTable* grow_table = nullptr);
+
+}  // namespace fv
