@@ -55,13 +55,16 @@ std::string Today() {
 
 }  // namespace
 
+void CheckDistortionModel(int n) {
+  FV_REQUIRE(n == 4 || n == 5 || n == 8 || n == 12 || n == 14,
+             "num_distortion must be 4, 5, 8, 12 or 14 (got {})", n);
+}
+
 void IntrinsicsOptions::Check() const {
   board.Check();
   detect.Check();
   source.Check();
-  FV_REQUIRE(num_distortion == 4 || num_distortion == 5 || num_distortion == 8 ||
-                 num_distortion == 12 || num_distortion == 14,
-             "num_distortion must be 4, 5, 8, 12 or 14 (got {})", num_distortion);
+  CheckDistortionModel(num_distortion);
   CheckPositive(outlier_factor, "outlier_factor");
   CheckNonNegative(outlier_min_px, "outlier_min_px");
   CheckInRange(max_drop_fraction, 0.0, 0.9, "max_drop_fraction");

@@ -14,6 +14,9 @@
 
 namespace fv::calib {
 
+// Throws fv::Error unless n is an OpenCV distortion model size: 4, 5, 8, 12 or 14.
+void CheckDistortionModel(int n);
+
 struct IntrinsicsOptions {
   BoardSpec board;
   DetectOptions detect;

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/calib/calib_testing.h"
 #include "fieldvision/calib/extrinsics.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
@@ -27,44 +28,6 @@ synth::SceneSpec TwentyMetreScene(uint64_t seed) {
   spec.num_frames = 1;
   spec.ball.placements.resize(1);
   return spec;
-}
-
-std::vector<PointCorrespondence> ClickKeypoints(const Camera& cam, const FieldModel& field,
-                                                int count, double noise_px, Rng& rng) {
-  std::vector<const FieldKeypoint*> seen;
-  for (const auto& k : field.keypoints) {
-    const auto uv = cam.Project(k.position_m);
-    if (k.position_m.z() == 0.0 && uv && cam.InImage(*uv, 10)) seen.push_back(&k);
-  }
-  // Farthest-point order in the image, from the first seen point: what a user told to click
-  // points spread over the image does.
-  std::vector<PointCorrespondence> pts;
-  std::vector<bool> taken(seen.size(), false);
-  for (int i = 0; i < count && i < static_cast<int>(seen.size()); ++i) {
-    size_t pick = 0;
-    double best = -1;
-    for (size_t j = 0; j < seen.size(); ++j) {
-      if (taken[j]) continue;
-      double nearest = 1e18;
-      for (const auto& p : pts) {
-        nearest = std::min(
-            nearest, (*cam.Project(seen[j]->position_m) - *cam.Project(p.p_world)).squaredNorm());
-      }
-      if (nearest > best) {
-        best = nearest;
-        pick = j;
-      }
-    }
-    taken[pick] = true;
-    const FieldKeypoint* k = seen[pick];
-    PointCorrespondence p;
-    p.name = k->name;
-    p.p_world = k->position_m;
-    p.uv_px = *cam.Project(k->position_m) +
-              Eigen::Vector2d(rng.Normal(0, noise_px), rng.Normal(0, noise_px));
-    pts.push_back(p);
-  }
-  return pts;
 }
 
 TEST(LineDistanceMap, MatchesExactDistances) {
@@ -96,7 +59,7 @@ TEST(Refine, SyntheticFrameBringsTheCameraWithin2cm) {
   Camera intrinsics = truth;
   intrinsics.has_pose = false;
   const ExtrinsicsResult clicked =
-      EstimatePose(intrinsics, ClickKeypoints(truth, field, 8, 1.0, rng));
+      EstimatePose(intrinsics, test_util::ClickKeypoints(truth, field, 8, 1.0, rng));
   const double clicked_err_m = (clicked.camera_position_m - truth.CentreInWorld()).norm();
   EXPECT_LT(clicked_err_m, 0.15) << clicked.Summary();
 

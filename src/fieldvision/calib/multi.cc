@@ -154,9 +154,7 @@ void MultiOptions::Check() const {
   board.Check();
   detect.Check();
   source.Check();
-  FV_REQUIRE(num_distortion == 4 || num_distortion == 5 || num_distortion == 8 ||
-                 num_distortion == 12 || num_distortion == 14,
-             "num_distortion must be 4, 5, 8, 12 or 14 (got {})", num_distortion);
+  CheckDistortionModel(num_distortion);
   CheckPositive(loss_px, "loss_px");
   CheckPositive(outlier_factor, "outlier_factor");
   CheckNonNegative(outlier_min_px, "outlier_min_px");

@@ -93,6 +93,27 @@ std::vector<std::string> Names(const std::vector<Camera>& cams) {
   return n;
 }
 
+// Two 640x480 cameras: "left" at the origin, "right" at (right_from_left rvec, t).
+std::pair<Camera, Camera> StereoPair(const Eigen::Vector3d& rvec, const Eigen::Vector3d& t) {
+  Camera left = Camera::FromFov(640, 480, 60);
+  left.name = "left";
+  left.has_pose = true;
+  Camera right = left;
+  right.name = "right";
+  right.cam_from_world.rotation = RotationFromRvec(rvec);
+  right.cam_from_world.translation = t;
+  return {left, right};
+}
+
+// Options for rendered boards (no distortion in the pictures: k1 k2 p1 p2 fitted).
+MultiOptions RenderedOptions(const BoardSpec& board) {
+  MultiOptions o;
+  o.board = board;
+  o.progress = false;
+  o.num_distortion = 4;
+  return o;
+}
+
 TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   const uint64_t seed = fv::testing::TestSeed(61);
   FV_SEED_TRACE(seed);
@@ -185,17 +206,9 @@ TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
   const uint64_t seed = fv::testing::TestSeed(62);
   FV_SEED_TRACE(seed);
   Rng rng(seed);
-  Camera left = Camera::FromFov(640, 480, 60);
-  left.name = "left";
-  left.has_pose = true;
-  Camera right = left;
-  right.name = "right";
-  right.cam_from_world.rotation = RotationFromRvec(Eigen::Vector3d(0.01, -0.05, 0.005));
-  right.cam_from_world.translation = Eigen::Vector3d(-0.1, 0.002, 0.004);
-  MultiOptions o;
-  o.board = {BoardType::kChessboard, 9, 6, 0.025};
-  o.progress = false;
-  o.num_distortion = 4;
+  const auto [left, right] =
+      StereoPair(Eigen::Vector3d(0.01, -0.05, 0.005), Eigen::Vector3d(-0.1, 0.002, 0.004));
+  MultiOptions o = RenderedOptions({BoardType::kChessboard, 9, 6, 0.025});
   const BoardPicture picture = DrawBoard(o.board);
   const std::string dir = fv::testing::TempDir();
   std::filesystem::create_directories(dir + "/l");
@@ -241,17 +254,9 @@ TEST(Multi, SynchronizedVideos) {
   const uint64_t seed = fv::testing::TestSeed(65);
   FV_SEED_TRACE(seed);
   Rng rng(seed);
-  Camera left = Camera::FromFov(640, 480, 60);
-  left.name = "left";
-  left.has_pose = true;
-  Camera right = left;
-  right.name = "right";
-  right.cam_from_world.rotation = RotationFromRvec(Eigen::Vector3d(0.0, -0.08, 0.0));
-  right.cam_from_world.translation = Eigen::Vector3d(-0.12, 0.0, 0.0);
-  MultiOptions o;
-  o.board = {BoardType::kChessboard, 7, 5, 0.03};
-  o.progress = false;
-  o.num_distortion = 4;
+  const auto [left, right] =
+      StereoPair(Eigen::Vector3d(0.0, -0.08, 0.0), Eigen::Vector3d(-0.12, 0, 0));
+  MultiOptions o = RenderedOptions({BoardType::kChessboard, 7, 5, 0.03});
   o.source.max_video_frames = 12;
   const BoardPicture picture = DrawBoard(o.board);
   const std::string dir = fv::testing::TempDir();
@@ -299,10 +304,7 @@ TEST(Multi, ChArUcoPartialViewsAndAWrongDictionary) {
   b.name = "b";
   b.cam_from_world.rotation = RotationFromRvec(Eigen::Vector3d(0.0, -0.25, 0.0));
   b.cam_from_world.translation = Eigen::Vector3d(-0.2, 0.0, 0.03);
-  MultiOptions o;
-  o.board = {BoardType::kCharuco, 7, 5, 0.04, 0.03, "DICT_4X4_50"};
-  o.progress = false;
-  o.num_distortion = 4;
+  MultiOptions o = RenderedOptions({BoardType::kCharuco, 7, 5, 0.04, 0.03, "DICT_4X4_50"});
   const BoardPicture picture = DrawBoard(o.board);
   const std::string dir = fv::testing::TempDir();
   std::filesystem::create_directories(dir + "/a");
