@@ -29,9 +29,10 @@ cv::Scalar TrackColour(int id, int team) {
   static const cv::Scalar kTeams[] = {
       {40, 40, 230}, {230, 120, 30}, {40, 220, 240}, {240, 240, 240}};
   if (team >= 0 && team < 4) return kTeams[team];
+  // Without a team: colours far from the team colours (no red, blue, yellow or white).
   static const cv::Scalar kPalette[] = {
-      {75, 25, 230},  {75, 180, 60},  {25, 225, 255}, {200, 130, 0},  {48, 130, 245},
-      {180, 30, 145}, {240, 240, 70}, {230, 50, 240}, {60, 245, 210}, {212, 190, 250}};
+      {75, 180, 60}, {180, 30, 145}, {240, 240, 70},  {230, 50, 240}, {48, 130, 245},
+      {0, 128, 128}, {40, 90, 140},  {150, 150, 150}, {60, 245, 210}, {128, 0, 128}};
   return kPalette[std::abs(id) % 10];
 }
 

@@ -30,7 +30,7 @@ struct OverlayOptions {
 };
 
 // BGR colour of a track: team 0 red, team 1 blue, team 2 yellow, team 3 white; no team (-1): a
-// fixed palette by id.
+// fixed palette by id without those colours.
 cv::Scalar TrackColour(int id, int team);
 
 class TrackOverlay {
