@@ -1,4 +1,4 @@
-// The studio's pages, one per hash (#calibrate, #colour, #view3d, #players), and the live status
+// The studio's pages, one per hash (#calibrate, #colour, #view3d, #players, #zones, #jobs), and the live status
 // line fed by the server's Server-Sent Events (/api/events).
 import './style.css';
 import { url } from './api';
@@ -9,6 +9,8 @@ const pages: Record<string, (root: HTMLElement) => Promise<void>> = {
   colour: async (root) => (await import('./colour')).colourPage(root),
   view3d: async (root) => (await import('./view3d')).view3dPage(root),
   players: async (root) => (await import('./players')).playersPage(root),
+  zones: async (root) => (await import('./zones')).zonesPage(root),
+  jobs: async (root) => (await import('./jobs')).jobsPage(root),
 };
 
 async function route(): Promise<void> {
@@ -31,9 +33,16 @@ async function route(): Promise<void> {
 const live = document.getElementById('live')!;
 const events = new EventSource(url('/api/events'));
 events.addEventListener('hello', () => (live.textContent = 'live'));
-events.addEventListener('saved', (e) => {
-  const d = JSON.parse((e as MessageEvent).data);
-  live.textContent = `saved ${d.path}`;
+// Pages listen for the server's events as 'studio-event' on the window ({type, data}).
+const relay = (type: string) => (e: Event) => {
+  const data = JSON.parse((e as MessageEvent).data);
+  window.dispatchEvent(new CustomEvent('studio-event', { detail: { type, data } }));
+  return data;
+};
+events.addEventListener('saved', (e) => (live.textContent = `saved ${relay('saved')(e).path}`));
+events.addEventListener('job', (e) => {
+  const d = relay('job')(e);
+  live.textContent = `job ${d.id} ${d.command}: ${d.state}`;
 });
 events.onerror = () => (live.textContent = 'server not reachable');
 

@@ -3,7 +3,9 @@
 //   calibrate: click the field keypoints at their true pixels -> saved pose within 2 cm of truth
 //   ball colour: click on the ball -> saved colour file; the detector (API and CLI) finds the ball
 //   3D view: a ball result renders (canvas not blank, every camera listed); 10,000-point benchmark
-//   players: the tactical board plays
+//   zones: a polygon clicked on the field map is saved
+//   jobs: a job runs to the end, another is cancelled (states from the server's events)
+//   players: the tactical board plays with the zones and a speed chart
 // Usage: node browser.mjs URL OUT_DIR FIELDVISION
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
@@ -88,7 +90,7 @@ try {
   await page.waitForFunction((n) => document.querySelectorAll('#cal-points tr').length === n + 1, kps.length);
   await page.click('#cal-save');
   await page.waitForFunction(() => /wrote/.test(document.querySelector('#cal-status').textContent));
-  await page.screenshot({ path: path.join(out, 'calibrate.png') });
+  await page.screenshot({ path: path.join(out, 'calibrate.jpg'), quality: 70 });
   const saved = await api('/api/camera?path=scene/cam1_studio.yaml');
   const d = Math.hypot(...saved.position_m.map((v, i) => v - truthCam.position_m[i]));
   console.log(`calibrate: ${kps.length} keypoints clicked; camera position error ${(100 * d).toFixed(2)} cm (${(await page.textContent('#cal-rms'))})`);
@@ -119,7 +121,7 @@ try {
   await page.fill('#col-detect-frames', frames.map((r) => r.frame).join(','));
   await page.click('#col-detect');
   await page.waitForSelector('#col-detect-result tr[data-frame]');
-  await page.screenshot({ path: path.join(out, 'colour.png') });
+  await page.screenshot({ path: path.join(out, 'colour.jpg'), quality: 70 });
   for (const r of frames) {
     const best = await page.getAttribute(`#col-detect-result tr[data-frame="${r.frame}"]`, 'data-best');
     const e = best ? Math.hypot(JSON.parse(best)[0] - r.u_px, JSON.parse(best)[1] - r.v_px) : Infinity;
@@ -163,28 +165,69 @@ try {
   });
   check(stats.changed > 0.05 && stats.colours > 20, `3D canvas rendered (${(100 * stats.changed).toFixed(1)} % of pixels off the background, ${stats.colours} colours)`);
   await page.locator('#v3-time').fill('20');
-  await page.screenshot({ path: path.join(out, 'view3d.png') });
+  await page.screenshot({ path: path.join(out, 'view3d.jpg'), quality: 70 });
   await page.click('#v3-bench');
   await page.waitForSelector('#v3-status[data-fps]', { timeout: 30000 });
   console.log(`3D benchmark: ${await page.getAttribute('#v3-status', 'data-fps')} frames/s with a 10,000-point track (headless chromium, software GL)`);
+
+  // ---- zones: a box drawn by clicking four corners on the field map
+  await page.goto(url + '#zones');
+  await page.waitForSelector('#zn-map[data-ready="1"]');
+  const fieldModel = await api('/api/field?name=robocup-msl');
+  const mapBox = await page.locator('#zn-map').boundingBox();
+  const hl = fieldModel.length_m / 2 + fieldModel.surround_m;
+  const hw = fieldModel.width_m / 2 + fieldModel.surround_m;
+  const mapScale = Math.min(900 / (2 * hl), 600 / (2 * hw));
+  const corners = [[-9, -3], [-6, -3], [-6, 3], [-9, 3]];
+  for (const [x, y] of corners) {
+    await page.mouse.click(mapBox.x + ((450 + x * mapScale) * mapBox.width) / 900, mapBox.y + ((300 - y * mapScale) * mapBox.height) / 600);
+  }
+  await page.fill('#zn-name', 'left box');
+  await page.click('#zn-close');
+  await page.click('#zn-save');
+  await page.waitForFunction(() => /wrote/.test(document.querySelector('#zn-status').textContent));
+  await page.screenshot({ path: path.join(out, 'zones.jpg'), quality: 70 });
+  const savedZones = await api('/api/zones?path=zones.json');
+  const zoneErr = Math.max(...savedZones[0].polygon.map(([x, y], i) => Math.hypot(x - corners[i][0], y - corners[i][1])));
+  check(savedZones.length === 1 && savedZones[0].name === 'left box' && zoneErr < 0.1,
+    `zone drawn on the map saved (corners within ${zoneErr.toFixed(3)} m)`);
+
+  // ---- jobs: one runs to the end, one is cancelled; their states arrive as server events
+  await page.goto(url + '#jobs');
+  await page.waitForSelector('#page[data-ready="1"]');
+  await page.selectOption('#jb-command', 'trajectory');
+  await page.fill('#jb-args', '--in ball.csv --out flights_job.json');
+  await page.click('#jb-start');
+  await page.waitForSelector('#jb-list tr[data-state="done"]', { timeout: 30000 });
+  check(fs.existsSync(path.join(work, 'flights_job.json')), 'a trajectory job ran to the end (flights_job.json written)');
+  await page.selectOption('#jb-command', 'synth');
+  await page.fill('#jb-args', '--preset kick --frames 100000 --out long_scene');
+  await page.click('#jb-start');
+  await page.waitForSelector('#jb-list tr[data-state="running"] [data-cancel]');
+  await page.click('#jb-list tr[data-state="running"] [data-cancel]');
+  await page.waitForSelector('#jb-list tr[data-state="cancelled"]', { timeout: 30000 });
+  await page.screenshot({ path: path.join(out, 'jobs.jpg'), quality: 70 });
+  check(true, 'a running synth job was cancelled from the page');
 
   // ---- players
   await page.goto(url + '#players');
   await page.waitForSelector('#page[data-ready="1"]');
   await page.selectOption('#pl-tracks', 'TRACKS.csv');
+  await page.selectOption('#pl-zones', 'zones.json');
   await page.click('#pl-load');
   await page.waitForSelector('#pl-board[data-frame]');
   const firstFrame = await page.getAttribute('#pl-board', 'data-frame');
   await page.click('#pl-play');
   await page.waitForFunction((f) => document.querySelector('#pl-board').dataset.frame !== f, firstFrame);
   await page.click('#pl-play');
-  await page.screenshot({ path: path.join(out, 'players.png') });
+  await page.screenshot({ path: path.join(out, 'players.jpg'), quality: 70 });
+  check(await page.locator('#pl-chart .uplot').count() === 1, 'speed chart drawn');
   check(true, `tactical board plays (frame ${firstFrame} -> ${await page.getAttribute('#pl-board', 'data-frame')})`);
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
 } catch (e) {
   failures.push(String(e));
   console.log(`FAIL ${e}`);
-  await page.screenshot({ path: path.join(out, 'failure.png') }).catch(() => {});
+  await page.screenshot({ path: path.join(out, 'failure.jpg'), quality: 70 }).catch(() => {});
 } finally {
   await context.close();
   fs.rmSync(userDir, { recursive: true, force: true });

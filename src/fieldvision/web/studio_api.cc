@@ -16,6 +16,7 @@
 #include "fieldvision/field/field_json.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/stats/stats.h"
 #include "fieldvision/util/csv.h"
 
 namespace fv::web {
@@ -288,7 +289,8 @@ void WriteTextFile(const fs::path& path, const std::string& text) {
 
 // ---- endpoints
 
-using Handler = std::function<ApiResponse(const Workspace&, EventHub*, const ApiRequest&)>;
+using Handler =
+    std::function<ApiResponse(const Workspace&, EventHub*, JobRunner*, const ApiRequest&)>;
 
 struct Route {
   Endpoint endpoint;
@@ -302,7 +304,7 @@ void Saved(EventHub* events, const Workspace& ws, const fs::path& path, const st
 const std::vector<Route>& Routes() {
   static const std::vector<Route> routes = {
       {{"GET", "/api/endpoints", "this list"},
-       [](const Workspace&, EventHub*, const ApiRequest&) {
+       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest&) {
          json j = json::array();
          for (const auto& e : StudioApi::Endpoints()) {
            j.push_back({{"method", e.method}, {"path", e.path}, {"summary", e.summary}});
@@ -310,19 +312,21 @@ const std::vector<Route>& Routes() {
          return Json(j);
        }},
       {{"GET", "/api/info", "working folder, built-in fields and colour presets"},
-       [](const Workspace& ws, EventHub*, const ApiRequest&) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest&) {
          return Json({{"root", ws.root().string()},
                       {"fields", BuiltinFieldNames()},
                       {"colour_presets", ColourPresetNames()}});
        }},
       {{"GET", "/api/files", "files of the working folder: [{path, size, kind}]"},
-       [](const Workspace& ws, EventHub*, const ApiRequest&) { return Json(ws.ListFiles()); }},
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest&) {
+         return Json(ws.ListFiles());
+       }},
       {{"GET", "/api/field", "?name=NAME_OR_JSON: the field model (field show --json)"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          return Json(FieldToJson(LoadFieldIn(ws, Param(r, "name"))));
        }},
       {{"GET", "/api/video", "?path=V: width, height, frames, fps"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
          auto source = VideoSource::Open(p.string());
          return Json({{"path", ws.Relative(p)},
@@ -332,7 +336,7 @@ const std::vector<Route>& Routes() {
                       {"fps", source->fps()}});
        }},
       {{"GET", "/api/frame", "?path=V&frame=N: frame N of a video or image pattern (PNG)"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
          const int frame = r.params.count("frame") ? ParseInt(r.params.at("frame"), "frame") : 0;
          if (frame < 0) throw HttpError(400, "frame must be >= 0");
@@ -340,12 +344,12 @@ const std::vector<Route>& Routes() {
          return ApiResponse{200, "image/png", EncodePng(bgr)};
        }},
       {{"GET", "/api/camera", "?path=CAM.yaml: the camera (intrinsics, pose, position)"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          return Json(CameraToJson(ReadCameraYaml(ws.Resolve(Param(r, "path")).string())));
        }},
       {{"POST", "/api/calibrate/project",
         "{camera, field}: the field's lines and keypoints in the camera's image"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const json body = Body(r);
          const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          if (!cam.has_pose) throw HttpError(422, "camera file has no pose (rvec, tvec)");
@@ -353,7 +357,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/calibrate/pose",
         "{camera, field, points: [{name, u, v}]}: pose, residuals (px, mm), reprojected lines"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const json body = Body(r);
          const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
@@ -362,7 +366,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/calibrate/save",
         "{camera, field, points, out[, points_out]}: estimate the pose and write the camera file"},
-       [](const Workspace& ws, EventHub* events, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub* events, JobRunner* jobs, const ApiRequest& r) {
          const json body = Body(r);
          const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
@@ -390,7 +394,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/colour/learn",
         "{video, frame, points: [[u, v]], roi: [x, y, w, h], negative_points}: HSV box"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
          ColourLearnOptions o;
@@ -412,7 +416,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/colour/save",
         "{range: {min, max}, out}: write a colour file (ball class + field + line)"},
-       [](const Workspace& ws, EventHub* events, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub* events, JobRunner* jobs, const ApiRequest& r) {
          const json body = Body(r);
          const ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
          const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
@@ -422,7 +426,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/colour/detect",
         "{video, frames: [N], colour: FILE_OR_PRESET | range, camera?}: ball candidates"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
          ColourSpec spec;
@@ -461,7 +465,7 @@ const std::vector<Route>& Routes() {
          return Json({{"frames", out}});
        }},
       {{"GET", "/api/ball", "?path=BALL.csv: the ball track (time, position, cameras, error)"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const BallTrackFile track = ReadBallTrack(ws.Resolve(Param(r, "path")).string());
          json samples = json::array();
          for (const auto& s : track.samples) {
@@ -474,7 +478,7 @@ const std::vector<Route>& Routes() {
                       {"skipped", track.skipped.size()}});
        }},
       {{"GET", "/api/tracks", "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s)"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const CsvTable t = CsvTable::Read(ws.Resolve(Param(r, "path")).string());
          t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
          json rows = json::array();
@@ -492,8 +496,61 @@ const std::vector<Route>& Routes() {
                         "time_s"}},
                       {"rows", rows}});
        }},
+      {{"GET", "/api/zones", "?path=zones.json: named polygons on the field (stats --zones)"},
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+         json zones = json::array();
+         for (const auto& z : stats::ReadZones(ws.Resolve(Param(r, "path")).string())) {
+           json polygon = json::array();
+           for (const auto& p : z.polygon_m) polygon.push_back({p.x(), p.y()});
+           zones.push_back({{"name", z.name}, {"polygon", polygon}});
+         }
+         return Json(zones);
+       }},
+      {{"POST", "/api/zones/save", "{zones: [{name, polygon: [[x, y], ...]}], out}: zones file"},
+       [](const Workspace& ws, EventHub* events, JobRunner* jobs, const ApiRequest& r) {
+         const json body = Body(r);
+         const json zones = Get<json>(body, "zones");
+         if (!zones.is_array()) throw HttpError(400, "'zones' must be an array");
+         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         // Checked by the reader that `stats --zones` uses, on a temporary copy.
+         const fs::path tmp = out.string() + ".check";
+         WriteTextFile(tmp, zones.dump(1) + "\n");
+         try {
+           stats::ReadZones(tmp.string());
+         } catch (const fv::Error& e) {
+           fs::remove(tmp);
+           std::string m = e.what();
+           const auto at = m.find(tmp.string());
+           if (at != std::string::npos) m.replace(at, tmp.string().size(), "request");
+           throw HttpError(400, m);
+         }
+         fs::rename(tmp, out);
+         Saved(events, ws, out, "zones");
+         return Json({{"wrote", {ws.Relative(out)}}, {"zones", zones.size()}});
+       }},
+      {{"GET", "/api/jobs", "the jobs, newest first (state, progress line, output)"},
+       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest&) {
+         if (!jobs) throw HttpError(404, "this server runs no jobs");
+         return Json(jobs->List());
+       }},
+      {{"POST", "/api/jobs",
+        "{command: ball|trajectory|players|stats|plan|detect|synth, args: [...]}: start a job"},
+       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+         if (!jobs) throw HttpError(404, "this server runs no jobs");
+         const json body = Body(r);
+         const int id = jobs->Start(Get<std::string>(body, "command"),
+                                    GetOr<std::vector<std::string>>(body, "args", {}));
+         return Json(jobs->Get(id));
+       }},
+      {{"POST", "/api/jobs/cancel", "{id}: end a running job"},
+       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+         if (!jobs) throw HttpError(404, "this server runs no jobs");
+         const int id = Get<int>(Body(r), "id");
+         const bool cancelled = jobs->Cancel(id);
+         return Json({{"id", id}, {"cancelled", cancelled}});
+       }},
       {{"GET", "/api/json", "?path=F.json: a JSON file of the folder (FLIGHTS.json, ...)"},
-       [](const Workspace& ws, EventHub*, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
          std::ifstream in(p);
          if (!in) throw HttpError(404, "cannot read '" + Param(r, "path") + "'");
@@ -509,14 +566,14 @@ const std::vector<Route>& Routes() {
 
 }  // namespace
 
-StudioApi::StudioApi(const Workspace& workspace, EventHub* events)
-    : workspace_(workspace), events_(events) {}
+StudioApi::StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jobs)
+    : workspace_(workspace), events_(events), jobs_(jobs) {}
 
 const std::vector<Endpoint>& StudioApi::Endpoints() {
   static const std::vector<Endpoint> endpoints = [] {
     std::vector<Endpoint> e;
     for (const auto& r : Routes()) e.push_back(r.endpoint);
-    e.push_back({"GET", "/api/events", "Server-Sent Events: saved files"});
+    e.push_back({"GET", "/api/events", "Server-Sent Events: saved files, job progress"});
     return e;
   }();
   return endpoints;
@@ -529,7 +586,7 @@ ApiResponse StudioApi::Handle(const ApiRequest& request) const {
     path_known = true;
     if (route.endpoint.method != request.method) continue;
     try {
-      return route.handler(workspace_, events_, request);
+      return route.handler(workspace_, events_, jobs_, request);
     } catch (const HttpError& e) {
       return ErrorResponse(e.status(), e.what());
     } catch (const fv::Error& e) {

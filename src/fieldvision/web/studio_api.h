@@ -1,8 +1,8 @@
 // The studio's JSON API over the fieldvision library: files of the working folder, fields,
 // video frames, camera files, pose from clicked keypoints (calib/extrinsics.h), ball colour
-// learning and detection (detect/colour_learn.h, ball_detector.h), ball tracks, flights and
-// player tracks. Every path is resolved inside the working folder (workspace.h); bad requests
-// get a 4xx status and a one-line message ({"error": "..."}).
+// learning and detection (detect/colour_learn.h, ball_detector.h), ball tracks, flights, player
+// tracks, zones and jobs (jobs.h). Every path is resolved inside the working folder (workspace.h);
+// bad requests get a 4xx status and a one-line message ({"error": "..."}).
 #pragma once
 
 #include <map>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fieldvision/web/events.h"
+#include "fieldvision/web/jobs.h"
 #include "fieldvision/web/workspace.h"
 
 namespace fv::web {
@@ -34,8 +35,9 @@ struct Endpoint {
 
 class StudioApi {
  public:
-  // `events` (optional) receives "saved" events; it must outlive the API.
-  StudioApi(const Workspace& workspace, EventHub* events);
+  // `events` (optional) receives "saved" events; `jobs` (optional) runs jobs; both must outlive
+  // the API.
+  StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jobs = nullptr);
 
   // Answers a request; never throws: 4xx/5xx responses carry {"error": one line}.
   ApiResponse Handle(const ApiRequest& request) const;
@@ -45,6 +47,7 @@ class StudioApi {
  private:
   Workspace workspace_;
   EventHub* events_;
+  JobRunner* jobs_;
 };
 
 }  // namespace fv::web

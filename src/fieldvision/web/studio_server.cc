@@ -59,8 +59,9 @@ with <code>make build</code> (or <code>bash studio/build.sh</code>), then reload
 struct StudioServer::Impl {
   StudioOptions options;
   std::unique_ptr<Workspace> workspace;
-  std::unique_ptr<StudioApi> api;
   EventHub events;
+  std::unique_ptr<JobRunner> jobs;
+  std::unique_ptr<StudioApi> api;
   httplib::Server server;
   std::thread thread;
   std::atomic<bool> loop_ended{false};
@@ -81,7 +82,10 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   m.options = options;
   m.workspace = std::make_unique<Workspace>(options.root.empty() ? fs::current_path()
                                                                  : fs::path(options.root));
-  m.api = std::make_unique<StudioApi>(*m.workspace, &m.events);
+  std::string program = options.program;
+  if (program.empty()) program = fs::read_symlink("/proc/self/exe").string();
+  m.jobs = std::make_unique<JobRunner>(program, *m.workspace, &m.events);
+  m.api = std::make_unique<StudioApi>(*m.workspace, &m.events, m.jobs.get());
   if (m.options.assets.empty()) m.options.assets = FV_STUDIO_DIST;
   m.assets_built = fs::is_regular_file(fs::path(m.options.assets) / "index.html");
   m.token_required = !IsLoopback(options.host);

@@ -19,6 +19,7 @@ struct StudioOptions {
   std::string root;                // working folder; empty: the current folder
   std::string assets;              // built front end (index.html); empty: studio/dist
   std::string token;               // for a non-loopback host; empty: a random one
+  std::string program;             // the fieldvision executable jobs run; empty: this program
   // Throws fv::Error naming the bad field.
   void Check() const;
 };

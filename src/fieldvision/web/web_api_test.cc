@@ -44,6 +44,9 @@ class StudioApiTest : public ::testing::Test {
   void StartServer(StudioOptions o) {
     server_.reset();
     o.root = dir_.string();
+#ifdef FV_PROGRAM
+    o.program = FV_PROGRAM;
+#endif
     o.port = 0;
     if (o.assets.empty()) o.assets = (dir_.parent_path() / "no-assets").string();
     server_ = std::make_unique<StudioServer>(o);
@@ -305,6 +308,80 @@ TEST_F(StudioApiTest, BallTracksFlightsAndPlayers) {
   EXPECT_DOUBLE_EQ(rows[0][6].get<double>(), 1.5);
   EXPECT_TRUE(rows[1][6].is_null());
   ExpectError(Get("/api/tracks?path=scene/truth.csv"), 422, "truth.csv");
+}
+
+TEST_F(StudioApiTest, ZonesSaveAndRead) {
+  FV_SEED_TRACE(seed_);
+  const json zones = {{{"name", "box"}, {"polygon", {{-9, -2}, {-7, -2}, {-7, 2}, {-9, 2}}}}};
+  const Reply saved = Post("/api/zones/save", json{{"zones", zones}, {"out", "zones.json"}});
+  ASSERT_EQ(saved.status, 200) << saved.body;
+  const Reply read = Get("/api/zones?path=zones.json");
+  ASSERT_EQ(read.status, 200) << read.body;
+  EXPECT_EQ(read.j(), zones);
+  const json bad = {{{"name", "line"}, {"polygon", {{0, 0}, {1, 1}}}}};
+  ExpectError(Post("/api/zones/save", json{{"zones", bad}, {"out", "zones.json"}}), 400,
+              "3 or more vertices");
+  EXPECT_EQ(Get("/api/zones?path=zones.json").j(), zones);  // the old file is kept
+  EXPECT_FALSE(fs::exists(dir_ / "zones.json.check"));
+  ExpectError(Get("/api/zones?path=scene/truth.csv"), 422, "not valid JSON");
+}
+
+// Polls a job until it is no longer running (at most `seconds`).
+json WaitForJob(httplib::Client& client, int id, double seconds) {
+  json j;
+  for (int i = 0; i < seconds * 20; ++i) {
+    auto r = client.Get("/api/jobs");
+    if (!r) break;
+    for (const auto& job : json::parse(r->body)) {
+      if (job["id"] == id) j = job;
+    }
+    if (j.is_object() && j["state"] != "running") return j;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return j;
+}
+
+TEST_F(StudioApiTest, JobsRunAndCancel) {
+  FV_SEED_TRACE(seed_);
+#ifndef FV_PROGRAM
+  GTEST_SKIP() << "the fieldvision program is not built";
+#else
+  const Reply started =
+      Post("/api/jobs", json{{"command", "synth"},
+                             {"args",
+                              {"--preset", "static", "--frames", "2", "--width", "160", "--height",
+                               "120", "--seed", std::to_string(seed_), "--out", "jobs/a"}}});
+  ASSERT_EQ(started.status, 200) << started.body;
+  const json done = WaitForJob(*client_, started.j()["id"], 120);
+  ASSERT_TRUE(done.is_object());
+  EXPECT_EQ(done["state"], "done") << done.dump();
+  EXPECT_EQ(done["exit_code"], 0);
+  EXPECT_TRUE(fs::exists(dir_ / "jobs/a/cam1.avi"));
+
+  const Reply long_job = Post(
+      "/api/jobs", json{{"command", "synth"},
+                        {"args", {"--preset", "kick", "--frames", "100000", "--out", "jobs/b"}}});
+  ASSERT_EQ(long_job.status, 200) << long_job.body;
+  const int id = long_job.j()["id"];
+  const Reply cancel = Post("/api/jobs/cancel", json{{"id", id}});
+  ASSERT_EQ(cancel.status, 200) << cancel.body;
+  EXPECT_TRUE(cancel.j()["cancelled"].get<bool>());
+  const json cancelled = WaitForJob(*client_, id, 60);
+  EXPECT_EQ(cancelled["state"], "cancelled") << cancelled.dump();
+  EXPECT_EQ(Post("/api/jobs/cancel", json{{"id", id}}).j()["cancelled"], false);
+
+  ExpectError(Post("/api/jobs", json{{"command", "rm"}, {"args", {"-rf", "x"}}}), 400,
+              "not one of");
+  ExpectError(Post("/api/jobs", json{{"command", "synth"}, {"args", {"--out", "../x"}}}), 403,
+              "outside");
+  ExpectError(Post("/api/jobs", json{{"command", "trajectory"}, {"args", {"--in", "none.csv"}}}),
+              404, "does not exist");
+  ExpectError(Post("/api/jobs", json{{"command", "synth"}, {"args", {"--preset", "/etc/passwd"}}}),
+              400, "looks like a path");
+  ExpectError(Post("/api/jobs", json{{"command", "synth"}, {"args", {"--out=/tmp/x"}}}), 400,
+              "not an option name");
+  ExpectError(Post("/api/jobs/cancel", json{{"id", 999}}), 404, "no job 999");
+#endif
 }
 
 TEST_F(StudioApiTest, EventsStreamTellsOfSavedFiles) {
