@@ -65,7 +65,7 @@ std::string FuseSummary::ToString() const {
         malformed, oversized, wrong_version, unknown_camera, unsynced, clock_mismatch);
   }
   if (!latency_s.empty()) {
-    s += fmt::format("\nlatency capture -> position: p50 {:.1f} ms, p95 {:.1f} ms ({} positions)",
+    s += fmt::format("\nlatency capture -> fused: p50 {:.1f} ms, p95 {:.1f} ms ({} frames)",
                      1e3 * Percentile(latency_s, 50), 1e3 * Percentile(latency_s, 95),
                      latency_s.size());
   }
@@ -138,18 +138,17 @@ FuseSummary RunFuse(const FuseOptions& o) {
   auto emit = [&](const SyncedFrame& group) {
     const BallFrame f = fusion.Fuse(group);
     ++summary.groups;
+    // Capture to decision, for every frame fused (with a position or not).
+    const double latency_s = clock_kind == "system" ? SystemClockNow() - group.time_s : 0.0;
+    if (clock_kind == "system") summary.latency_s.push_back(latency_s);
     if (!f.result.ok()) return;
     const Eigen::Vector3d& p = f.result.point_world;
     csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
         << f.result.rms_px;
     csv.EndRow();
     ++summary.rows_written;
-    BallMessage b{f.frame,         f.time_s, p.x(), p.y(), p.z(), f.result.num_views(),
-                  f.result.rms_px, 0.0};
-    if (clock_kind == "system") {
-      b.latency_s = SystemClockNow() - f.time_s;
-      summary.latency_s.push_back(b.latency_s);
-    }
+    const BallMessage b{f.frame,         f.time_s, p.x(), p.y(), p.z(), f.result.num_views(),
+                        f.result.rms_px, latency_s};
     if (pub) {
       const std::string topic = "ball";
       pub.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);

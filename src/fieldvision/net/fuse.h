@@ -56,7 +56,7 @@ struct FuseSummary {
   FusionStats fusion;
   long long rows_written = 0;
   long long published = 0;
-  std::vector<double> latency_s;  // capture -> position, per position (system clocks only)
+  std::vector<double> latency_s;  // capture -> fused, per frame fused (system clocks only)
   double seconds = 0;
   std::string ToString() const;
 };
