@@ -44,7 +44,8 @@ std::string NodeSummary::ToString() const {
   std::string s = fmt::format(
       "node {}: {} frames ({} times), {} sent, {} not sent (fusion node unreachable or slow), "
       "{} skipped by the source (node slower than the camera)",
-      camera, frames, source_origin.empty() ? "no" : source_origin, sent, send_dropped, source_dropped);
+      camera, frames, source_origin.empty() ? "no" : source_origin, sent, send_dropped,
+      source_dropped);
   if (has_offset) {
     s += fmt::format(
         "\nclock: fusion node - this node = {:+.4f} s (round trip {:.2f} ms, {} samples)", offset_s,
