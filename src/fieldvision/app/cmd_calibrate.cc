@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/app/cmd_calibrate_board.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/check.h"
 #include "fieldvision/calib/extrinsics.h"
@@ -91,21 +92,14 @@ void WriteRig(const std::vector<Camera>& cams, const std::string& dir) {
 
 // ---- intrinsics
 struct IntrinsicsCli {
-  std::string images, board = "chessboard", out, name;
-  int cols = 0, rows = 0;
-  double square_m = 0.0, marker_m = 0.0;
-  std::string dictionary = "DICT_4X4_50";
+  std::string images, out, name;
+  BoardCli board;
   IntrinsicsOptions o;
   bool quiet = false;
 };
 
 void RunIntrinsics(IntrinsicsCli& c) {
-  c.o.board.type = ParseBoardType(c.board);
-  c.o.board.cols = c.cols;
-  c.o.board.rows = c.rows;
-  c.o.board.square_m = c.square_m;
-  c.o.board.marker_m = c.marker_m;
-  c.o.board.dictionary = c.dictionary;
+  c.o.board = c.board.Spec();
   c.o.camera_name = c.name;
   c.o.progress = !c.quiet;
   const IntrinsicsResult r = CalibrateIntrinsics(c.images, c.o);
@@ -405,15 +399,7 @@ void Setup(CLI::App& app, int& exit_code) {
   CLI::App* in = group->add_subcommand(
       "intrinsics", "Intrinsics from chessboard or ChArUco views (a folder, a glob or a video)");
   in->add_option("--images", ic->images, "Folder, glob pattern ('dir/*.jpg') or video")->required();
-  in->add_option("--board", ic->board, "chessboard or charuco")->capture_default_str();
-  in->add_option("--cols", ic->cols, "Chessboard: inner corners per row; ChArUco: squares per row")
-      ->required();
-  in->add_option("--rows", ic->rows,
-                 "Chessboard: inner corners per column; ChArUco: squares per column")
-      ->required();
-  in->add_option("--square", ic->square_m, "Square side in metres")->required();
-  in->add_option("--marker", ic->marker_m, "ChArUco marker side in metres (default 0.7 x square)");
-  in->add_option("--dictionary", ic->dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+  AddBoardOptions(in, ic->board);
   in->add_option("--model", ic->o.num_distortion,
                  "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
       ->capture_default_str();

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/app/cmd_calibrate_board.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/import.h"
 #include "fieldvision/calib/multi.h"
@@ -20,22 +21,15 @@ namespace {
 using namespace fv::calib;
 
 struct MultiCli {
-  std::string board = "chessboard", out, pairing = "auto";
-  int cols = 0, rows = 0;
-  double square_m = 0.0, marker_m = 0.0;
-  std::string dictionary = "DICT_4X4_50";
+  std::string out, pairing = "auto";
+  BoardCli board;
   std::vector<std::string> views, intrinsics;
   bool fix_intrinsics = false, quiet = false, no_pictures = false;
   MultiOptions o;
 };
 
 void RunMulti(MultiCli& c) {
-  c.o.board.type = ParseBoardType(c.board);
-  c.o.board.cols = c.cols;
-  c.o.board.rows = c.rows;
-  c.o.board.square_m = c.square_m;
-  c.o.board.marker_m = c.marker_m;
-  c.o.board.dictionary = c.dictionary;
+  c.o.board = c.board.Spec();
   c.o.pairing = ParsePairing(c.pairing);
   c.o.progress = !c.quiet;
   c.o.refine_intrinsics = !c.fix_intrinsics;
@@ -121,15 +115,7 @@ void Setup(CLI::App& app, int& exit_code) {
   CLI::App* cmd = group->add_subcommand(
       "multi",
       "Intrinsics and relative poses of 2..N cameras from synchronized views of one board");
-  cmd->add_option("--board", c->board, "chessboard or charuco")->capture_default_str();
-  cmd->add_option("--cols", c->cols, "Chessboard: inner corners per row; ChArUco: squares per row")
-      ->required();
-  cmd->add_option("--rows", c->rows,
-                  "Chessboard: inner corners per column; ChArUco: squares per column")
-      ->required();
-  cmd->add_option("--square", c->square_m, "Square side in metres (25 mm: 0.025)")->required();
-  cmd->add_option("--marker", c->marker_m, "ChArUco marker side in metres (default 0.7 x square)");
-  cmd->add_option("--dictionary", c->dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+  AddBoardOptions(cmd, c->board);
   cmd->add_option("--views", c->views,
                   "NAME=GLOB_OR_DIR_OR_VIDEO, one per camera (repeat); the first is the reference")
       ->required();

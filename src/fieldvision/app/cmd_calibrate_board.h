@@ -1,0 +1,43 @@
+// The board options shared by `calibrate intrinsics` and `calibrate multi` (--board, --cols,
+// --rows, --square, --marker, --dictionary) and their calib::BoardSpec.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "fieldvision/calib/board.h"
+
+namespace fv::app {
+
+struct BoardCli {
+  std::string board = "chessboard";
+  int cols = 0, rows = 0;
+  double square_m = 0.0, marker_m = 0.0;
+  std::string dictionary = "DICT_4X4_50";
+
+  calib::BoardSpec Spec() const {
+    calib::BoardSpec b;
+    b.type = calib::ParseBoardType(board);
+    b.cols = cols;
+    b.rows = rows;
+    b.square_m = square_m;
+    b.marker_m = marker_m;
+    b.dictionary = dictionary;
+    return b;
+  }
+};
+
+inline void AddBoardOptions(CLI::App* cmd, BoardCli& b) {
+  cmd->add_option("--board", b.board, "chessboard or charuco")->capture_default_str();
+  cmd->add_option("--cols", b.cols, "Chessboard: inner corners per row; ChArUco: squares per row")
+      ->required();
+  cmd->add_option("--rows", b.rows,
+                  "Chessboard: inner corners per column; ChArUco: squares per column")
+      ->required();
+  cmd->add_option("--square", b.square_m, "Square side in metres (25 mm: 0.025)")->required();
+  cmd->add_option("--marker", b.marker_m, "ChArUco marker side in metres (default 0.7 x square)");
+  cmd->add_option("--dictionary", b.dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+}
+
+}  // namespace fv::app
