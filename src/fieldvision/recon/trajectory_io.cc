@@ -165,9 +165,32 @@ nlohmann::json FlightToJson(const Flight& f) {
   return j;
 }
 
-nlohmann::json FlightsToJson(const TrajectoryResult& result) {
+nlohmann::json FlightsToJson(const TrajectoryResult& result, const TrajectoryOptions* options) {
   nlohmann::json a = nlohmann::json::array();
-  for (const auto& f : result.flights) a.push_back(FlightToJson(f));
+  for (const auto& f : result.flights) {
+    nlohmann::json j = FlightToJson(f);
+    if (f.end_event == FlightEvent::kBounce) {
+      // What the bounce did (both arcs fitted) and what the bounce model predicts from this arc.
+      for (const auto& b : result.breaks) {
+        if (b.kind != FlightEvent::kBounce || std::abs(b.time_s - f.t_end_s) > 0.05) continue;
+        if (!b.bounce.ok) break;
+        j["bounce_measured"] = {{"restitution", Round(b.bounce.restitution, 3)},
+                                {"friction", Round(b.bounce.friction, 3)},
+                                {"spin_before_radps", Vec3Json(b.bounce.spin_before_radps, 2)},
+                                {"spin_after_radps", Vec3Json(b.bounce.spin_after_radps, 2)}};
+        break;
+      }
+    }
+    if (options != nullptr && !f.landing_extrapolated) {
+      Eigen::Vector3d v = f.model().VelocityAt(f.t_landing_s), w = f.model().spin_radps;
+      options->bounce.Apply(options->ball_radius_m, &v, &w);
+      j["bounce_predicted"] = {{"restitution", options->bounce.restitution},
+                               {"friction", options->bounce.friction},
+                               {"v_after_mps", Vec3Json(v, 3)},
+                               {"spin_after_radps", Vec3Json(w, 2)}};
+    }
+    a.push_back(j);
+  }
   return a;
 }
 

@@ -30,6 +30,10 @@ nlohmann::json Vec3Json(const Eigen::Vector3d& v, int decimals = 4);
 // The contract's flight fields plus events, seen span, speed, flight time, both fits and the
 // seed's method.
 nlohmann::json FlightToJson(const Flight& f);
-nlohmann::json FlightsToJson(const TrajectoryResult& result);
+// With options: per flight that lands, the velocity and spin after the bounce that the bounce
+// model (options->bounce) predicts; per bounce seen on both sides, the measured restitution,
+// friction and spin change.
+nlohmann::json FlightsToJson(const TrajectoryResult& result,
+                             const TrajectoryOptions* options = nullptr);
 
 }  // namespace fv

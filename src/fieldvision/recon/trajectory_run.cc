@@ -107,7 +107,7 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   out.decisions = MakeDecisions(track, r, has_field ? &field : nullptr, out.options, job.decisions);
 
   // FLIGHTS.json: the contract's array, each flight with its prediction and calls.
-  nlohmann::json flights = FlightsToJson(r);
+  nlohmann::json flights = FlightsToJson(r, &out.options);
   for (size_t i = 0; i < r.flights.size(); ++i) {
     const auto& p = out.predictions[i];
     nlohmann::json pj;
