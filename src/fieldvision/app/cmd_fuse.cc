@@ -26,8 +26,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--publish", o->publish,
                   "Publish each position on a ZeroMQ PUB socket, tcp://HOST:PORT (topic 'ball')");
   cmd->add_option("--idle-exit", o->idle_exit_s,
-                  "Exit after this many seconds without messages, counted once the first has come "
-                  "(0: run until Ctrl-C)")
+                  "Exit after this many seconds without messages, counted once the first has come; "
+                  "running nodes ping every 0.5 s (0: run until Ctrl-C)")
       ->capture_default_str();
   cmd->add_option("--tolerance", o->sync.tolerance_s,
                   "Frames this close in capture time (s) are paired")

@@ -90,7 +90,7 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = scene.cameras;
   fo.out = scene.dir + "/live.csv";
-  fo.idle_exit_s = 0.5;
+  fo.idle_exit_s = 1.5;  // longer than the nodes' ping interval (0.5 s)
   fo.sync.max_wait_s = 3.0;  // a loaded test machine may run a node late; wait for it
   fo.progress = false;
   FuseSummary fused;
