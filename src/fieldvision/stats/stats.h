@@ -31,6 +31,8 @@ struct StatsOptions {
   double max_speed_mps = 12.0;    // faster steps are track breaks (not running)
   double sprint_speed_mps = 5.5;  // a sprint is at least this fast ...
   double sprint_min_s = 1.0;      // ... for at least this long
+  // Top speed: the largest mean speed over this long (position noise inflates single samples).
+  double top_speed_window_s = 1.0;
   std::vector<double> speed_bands_mps = {2.0, 4.0, 5.5, 7.0};  // band edges (walk, jog, run...)
   double min_track_s = 1.0;                                    // ignore tracks shorter than this
   std::vector<Zone> zones;             // named polygons for zone time and alerts
