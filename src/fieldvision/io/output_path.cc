@@ -1,0 +1,88 @@
+#include "fieldvision/io/output_path.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <system_error>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Same file: by inode when both exist, else by normalised absolute path.
+bool SameFile(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) {
+    const bool same = fs::equivalent(a, b, ec);
+    if (!ec) return same;
+  }
+  const fs::path ca = fs::weakly_canonical(a, ec);
+  if (ec) return false;
+  const fs::path cb = fs::weakly_canonical(b, ec);
+  if (ec) return false;
+  return ca == cb;
+}
+
+}  // namespace
+
+void CheckOutputPath(const std::string& out, const std::vector<std::string>& inputs,
+                     std::string_view what) {
+  if (out.empty()) return;
+  for (const std::string& in : inputs) {
+    if (in.empty()) continue;
+    FV_REQUIRE(!SameFile(out, in), "{} '{}' is the input '{}': choose another output", what, out,
+               in);
+  }
+}
+
+std::string ResolveOutputPath(const std::string& out, std::string_view what) {
+  FV_REQUIRE(!out.empty(), "{}: empty output path", what);
+  std::error_code ec;
+  fs::path target = out;
+  if (fs::is_symlink(fs::symlink_status(target, ec))) {
+    // Write through the link: replace its final target, keep the link.
+    target = fs::weakly_canonical(target, ec);
+    FV_REQUIRE(!ec, "{} '{}': cannot follow the link: {}", what, out, ec.message());
+  }
+  const fs::file_status st = fs::status(target, ec);
+  if (fs::exists(st)) {
+    FV_REQUIRE(fs::is_regular_file(st), "{} '{}' exists and is not a regular file", what, out);
+  }
+  return target.string();
+}
+
+AtomicOutput::AtomicOutput(const std::string& out, std::string_view what)
+    : out_(out), target_(ResolveOutputPath(out, what)) {
+  // Beside the target (same file system: rename is atomic), unique per process, keeping the
+  // extension that writers such as cv::VideoWriter and cv::imwrite choose the format by.
+  const fs::path t = target_;
+  temp_ = (t.parent_path() / (t.stem().string() + "." + std::to_string(::getpid()) + ".part" +
+                              t.extension().string()))
+              .string();
+}
+
+AtomicOutput::~AtomicOutput() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove(temp_, ec);
+}
+
+void AtomicOutput::Commit() {
+  std::error_code ec;
+  FV_REQUIRE(fs::exists(temp_, ec), "cannot write '{}': nothing was written", out_);
+  fs::rename(temp_, target_, ec);
+  FV_REQUIRE(!ec, "cannot write '{}': {}", out_, ec.message());
+  committed_ = true;
+}
+
+void AtomicWrite(const std::string& out, const std::function<void(const std::string&)>& write,
+                 std::string_view what) {
+  AtomicOutput file(out, what);
+  write(file.temp_path());
+  file.Commit();
+}
+
+}  // namespace fv

@@ -1,0 +1,67 @@
+// Output policy for every writer: refuse an output that is one of the inputs (same file by inode,
+// after following symlinks), write through a symlink to its target, refuse devices and folders,
+// and write to a temporary file beside the target that is renamed only on success.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+namespace fv {
+
+// Throws fv::Error (one line, naming `what` and both paths) when `out` is the same file as one of
+// `inputs` (compared with std::filesystem::equivalent, so symlinks and hard links count; also by
+// weakly_canonical path for files that do not exist yet). Empty paths are skipped.
+void CheckOutputPath(const std::string& out, const std::vector<std::string>& inputs,
+                     std::string_view what = "--out");
+
+// One list of paths from any mix of strings and vectors of strings (for CheckOutputPath).
+template <typename... Paths>
+std::vector<std::string> PathList(const Paths&... paths) {
+  std::vector<std::string> list;
+  auto add = [&list](const auto& p) {
+    if constexpr (std::is_convertible_v<decltype(p), std::string>) {
+      list.push_back(p);
+    } else {
+      list.insert(list.end(), p.begin(), p.end());
+    }
+  };
+  (add(paths), ...);
+  return list;
+}
+
+// The regular file a write to `out` should replace: `out` itself, or the final target of a
+// symlink. Throws fv::Error when `out` exists and is not a regular file (device, folder, fifo).
+std::string ResolveOutputPath(const std::string& out, std::string_view what = "--out");
+
+// A temporary file beside the (resolved) output; Commit() renames it over the output, the
+// destructor removes it when Commit() was not reached (a failed run leaves the output as it was).
+class AtomicOutput {
+ public:
+  explicit AtomicOutput(const std::string& out, std::string_view what = "--out");
+  ~AtomicOutput();
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+  // Where to write.
+  const std::string& temp_path() const { return temp_; }
+  // The file that Commit() replaces (the symlink's target when `out` is a symlink).
+  const std::string& target_path() const { return target_; }
+  // Renames the temporary file over the target; throws fv::Error naming the output on failure.
+  void Commit();
+
+ private:
+  std::string out_;
+  std::string target_;
+  std::string temp_;
+  bool committed_ = false;
+};
+
+// Calls `write(temp_path)` and renames the result over `out` when it returns; on an exception the
+// temporary file is removed and the exception passes on.
+void AtomicWrite(const std::string& out, const std::function<void(const std::string&)>& write,
+                 std::string_view what = "--out");
+
+}  // namespace fv

@@ -1,0 +1,98 @@
+#include "fieldvision/io/output_path.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+namespace fs = std::filesystem;
+
+void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int CountFiles(const std::string& dir) {
+  int n = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++n;
+  return n;
+}
+
+TEST(CheckOutputPath, RefusesTheSameFileByNameLinkAndHardLink) {
+  const std::string dir = testing::TempDir();
+  const std::string in = dir + "/in.csv";
+  WriteText(in, "a\n");
+  EXPECT_THROW(CheckOutputPath(in, {in}), Error);
+  EXPECT_THROW(CheckOutputPath(dir + "/./in.csv", {"", in}), Error);
+  fs::create_symlink(in, dir + "/link.csv");
+  EXPECT_THROW(CheckOutputPath(dir + "/link.csv", {in}), Error);
+  fs::create_hard_link(in, dir + "/hard.csv");
+  EXPECT_THROW(CheckOutputPath(dir + "/hard.csv", {in}), Error);
+  try {
+    CheckOutputPath(in, {in}, "--truth");
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.find('\n'), std::string::npos);
+    EXPECT_NE(msg.find("--truth"), std::string::npos);
+    EXPECT_NE(msg.find(in), std::string::npos);
+  }
+  // Other files, and outputs that do not exist yet, pass.
+  EXPECT_NO_THROW(CheckOutputPath(dir + "/out.csv", {in, dir + "/other.csv"}));
+  EXPECT_NO_THROW(CheckOutputPath("", {in}));
+  const std::vector<std::string> videos = {dir + "/a.avi", in};
+  EXPECT_THROW(CheckOutputPath(in, PathList(std::string(), videos, dir + "/b.csv")), Error);
+  EXPECT_EQ(ReadText(in), "a\n");
+}
+
+TEST(AtomicWrite, ReplacesOnlyOnSuccessAndLeavesNoTemporary) {
+  const std::string dir = testing::TempDir();
+  const std::string out = dir + "/out.csv";
+  WriteText(out, "old\n");
+  EXPECT_THROW(AtomicWrite(out,
+                           [](const std::string& tmp) {
+                             WriteText(tmp, "half");
+                             Throw("failed half way");
+                           }),
+               Error);
+  EXPECT_EQ(ReadText(out), "old\n");
+  EXPECT_EQ(CountFiles(dir), 1);
+  AtomicWrite(out, [](const std::string& tmp) {
+    EXPECT_EQ(fs::path(tmp).extension(), ".csv");  // writers pick formats by extension
+    WriteText(tmp, "new\n");
+  });
+  EXPECT_EQ(ReadText(out), "new\n");
+  EXPECT_EQ(CountFiles(dir), 1);
+  // A writer that wrote nothing does not destroy the output.
+  EXPECT_THROW(AtomicWrite(out, [](const std::string&) {}), Error);
+  EXPECT_EQ(ReadText(out), "new\n");
+}
+
+TEST(AtomicWrite, WritesThroughASymlinkAndRefusesDevicesAndFolders) {
+  const std::string dir = testing::TempDir();
+  const std::string target = dir + "/target.csv";
+  const std::string link = dir + "/link.csv";
+  WriteText(target, "old\n");
+  fs::create_symlink(target, link);
+  AtomicWrite(link, [](const std::string& tmp) { WriteText(tmp, "new\n"); });
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_EQ(ReadText(target), "new\n");
+  EXPECT_THROW(ResolveOutputPath("/dev/null"), Error);
+  EXPECT_THROW(ResolveOutputPath(dir), Error);
+  EXPECT_THROW(ResolveOutputPath(""), Error);
+  EXPECT_EQ(ResolveOutputPath(dir + "/new.csv"), dir + "/new.csv");
+}
+
+}  // namespace
+}  // namespace fv
