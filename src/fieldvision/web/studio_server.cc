@@ -41,6 +41,13 @@ std::string RandomToken() {
   return t;
 }
 
+// "host:port", "[::1]:port" or "host" -> the host name.
+std::string HostName(const std::string& host_header) {
+  if (host_header.empty()) return "localhost";
+  if (host_header[0] == '[') return host_header.substr(1, host_header.find(']') - 1);
+  return host_header.substr(0, host_header.find(':'));
+}
+
 std::string NotBuiltPage(const std::string& assets) {
   return fmt::format(
       R"(<!doctype html><html><head><meta charset="utf-8"><title>fieldvision studio</title></head>
@@ -134,6 +141,17 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   auto api = [this, send, unauthorized](const httplib::Request& req, httplib::Response& res) {
     Impl& m = *impl_;
     if (!m.Authorized(req)) return unauthorized(res);
+    // Without a token, only pages served from a loopback name may call (DNS rebinding), and a
+    // POST must be JSON, which a page of another origin cannot send without asking (CORS).
+    if (!m.token_required && !IsLoopback(HostName(req.get_header_value("Host")))) {
+      return send(res, {403, "application/json",
+                        R"j({"error":"requests must name a loopback host (Host header)"})j"});
+    }
+    if (req.method == "POST" &&
+        req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
+      return send(res, {415, "application/json",
+                        R"j({"error":"POST bodies must be sent as application/json"})j"});
+    }
     ApiRequest r{req.method, req.path, {}, req.body};
     for (const auto& [k, v] : req.params) r.params[k] = v;
     send(res, m.api->Handle(r));

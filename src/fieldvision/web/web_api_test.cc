@@ -197,6 +197,16 @@ TEST_F(StudioApiTest, PathsOutsideTheFolderAreRefused) {
 TEST_F(StudioApiTest, MalformedRequests) {
   FV_SEED_TRACE(seed_);
   ExpectError(Post("/api/calibrate/pose", std::string("{not json")), 400, "malformed JSON");
+  // Another origin's page: a plain-text POST (no CORS preflight), or a rebound host name.
+  auto text =
+      client_->Post("/api/colour/save", R"({"range":{"min":[0,0,0],"max":[9,9,9]},"out":"x.json"})",
+                    "text/plain");
+  ASSERT_TRUE(text);
+  ExpectError({text->status, text->body}, 415, "application/json");
+  EXPECT_FALSE(fs::exists(dir_ / "x.json"));
+  ExpectError(Get("/api/info", {{"Host", "evil.example:8470"}}), 403, "loopback host");
+  EXPECT_EQ(Get("/api/info", {{"Host", "localhost:8470"}}).status, 200);
+  EXPECT_EQ(Get("/api/info", {{"Host", "[::1]:8470"}}).status, 200);
   ExpectError(Post("/api/calibrate/pose", std::string("")), 400, "empty");
   ExpectError(Post("/api/calibrate/pose", std::string("[1, 2]")), 400, "not a JSON object");
   ExpectError(Post("/api/calibrate/pose", json{{"camera", 3}}), 400, "wrong type");
