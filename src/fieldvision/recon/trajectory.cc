@@ -299,6 +299,7 @@ void TrajectoryOptions::Check() const {
   CheckNonNegative(min_outlier_m, "min_outlier_m");
   CheckNonNegative(ground_tolerance_m, "ground_tolerance_m");
   CheckNonNegative(min_ground_s, "min_ground_s");
+  CheckPositive(max_resting_vz_mps, "max_resting_vz_mps");
   CheckPositive(max_gap_s, "max_gap_s");
   FV_REQUIRE(min_flight_samples >= 3, "min_flight_samples must be >= 3 (got {})",
              min_flight_samples);
@@ -738,10 +739,16 @@ struct Segmenter {
         if (j > i && track[j].time_s - track[j - 1].time_s > o.max_gap_s) break;
         ++j;
       }
-      // A run at a track end may have lasted longer than seen: a few samples suffice there.
-      const bool at_end = i == 0 || j >= n;
+      // A run at a track end may have lasted longer than seen: a few samples suffice there, when
+      // they are not moving up or down (a ball arriving at or leaving the ground is not).
       int count = 0;
       for (int k = i; k <= last; ++k) count += !outlier[k];
+      const double dt_run = track[last].time_s - track[i].time_s;
+      const bool level =
+          dt_run > 0 &&
+          std::abs(track[last].ball_in_world.z() - track[i].ball_in_world.z()) / dt_run <
+              o.max_resting_vz_mps;
+      const bool at_end = (i == 0 || j >= n) && level;
       if (track[last].time_s - track[i].time_s >= o.min_ground_s ||
           (at_end && count >= o.window_samples)) {
         for (int k = i; k <= last; ++k) ground[k] = !outlier[k];

@@ -133,9 +133,11 @@ struct TrajectoryOptions {
   double min_outlier_m = 0.03;       // and at least this far
   double ground_tolerance_m = 0.03;  // centre within radius + this (+3 noise) counts as on ground
   double min_ground_s = 0.1;         // a ground phase (rolling, at rest) lasts at least this
-  double max_gap_s = 0.5;            // longer gaps without samples end a flight
-  int min_flight_samples = 4;        // shorter arcs are reported as unfitted hops
-  double max_drag_per_m = 2.0;       // upper bound of k
+  // (or, at a track end, is window_samples samples moving up or down slower than this)
+  double max_resting_vz_mps = 0.3;
+  double max_gap_s = 0.5;       // longer gaps without samples end a flight
+  int min_flight_samples = 4;   // shorter arcs are reported as unfitted hops
+  double max_drag_per_m = 2.0;  // upper bound of k
   int max_iterations = 50;
   // Spin (Magnus lift). auto: fitted on flights with >= spin_min_samples samples over
   // >= spin_min_span_s, kept when its BIC is lower than the drag (or gravity) model's by

@@ -150,6 +150,10 @@ TEST(TrajectorySpin, GlitchIsAnOutlierNotAHit) {
       int outliers = 0;
       for (bool b : r.outlier) outliers += b;
       EXPECT_EQ(outliers, run);
+      // The descent to the table at the track's end is flight, not a ball at rest.
+      int ground = 0;
+      for (bool b : r.on_ground) ground += b;
+      EXPECT_EQ(ground, 0);
     }
   }
 }
