@@ -149,7 +149,8 @@ TEST(Stats, TimeFromTracksAndRateOverride) {
   EXPECT_NEAR(r.fps, fps, 1e-6);
   EXPECT_NE(r.Summary().find("10.00 frames/s"), std::string::npos) << r.Summary();
   ASSERT_EQ(r.players.size(), 1u);
-  EXPECT_NEAR(r.players[0].top_speed_mps, v, 0.3);
+  // The top speed is a 1-s mean: 3 cm of position noise does not inflate it much.
+  EXPECT_NEAR(r.players[0].top_speed_mps, v, 0.15);
   EXPECT_NEAR(r.duration_s, 9.9, 1e-6);
   // --fps 25 would make the same frames 2.5 times faster.
   StatsOptions o;
