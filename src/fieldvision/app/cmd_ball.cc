@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/util/error.h"
@@ -90,6 +91,10 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Never use candidates that failed a shape check to complete a position");
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o] {
+    const auto inputs = PathList(o->job.cameras, o->job.videos, o->job.timestamps, o->job.truth,
+                                 o->job.field, o->job.colour, o->det.detections);
+    CheckOutputPath(o->job.out, inputs);
+    CheckOutputPath(o->det.flights, PathList(inputs, o->job.out), "--flights");
     if (!o->det.detections.empty()) {
       FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
       RunDetections(*o);

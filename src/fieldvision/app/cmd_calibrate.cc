@@ -24,6 +24,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -424,7 +425,10 @@ void Setup(CLI::App& app, int& exit_code) {
   in->add_option("--name", ic->name, "Camera name written to the file");
   in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
   in->add_flag("--quiet", ic->quiet, "No progress");
-  in->callback([ic] { RunIntrinsics(*ic); });
+  in->callback([ic] {
+    CheckOutputPath(ic->out, {ic->images});
+    RunIntrinsics(*ic);
+  });
 
   auto ec = std::make_shared<ExtrinsicsCli>();
   CLI::App* ex = group->add_subcommand(
@@ -453,7 +457,11 @@ void Setup(CLI::App& app, int& exit_code) {
   ex->add_option("--threshold", ec->o.ransac_threshold_px, "RANSAC inlier threshold in pixels")
       ->capture_default_str();
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
-  ex->callback([ec] { RunExtrinsics(*ec); });
+  ex->callback([ec] {
+    CheckOutputPath(ec->out, PathList(ec->points, ec->field));  // --out may be --camera
+    CheckOutputPath(ec->table, PathList(ec->points, ec->field, ec->camera, ec->out), "--table");
+    RunExtrinsics(*ec);
+  });
 
   auto rc = std::make_shared<RefineCli>();
   CLI::App* re =
@@ -471,7 +479,11 @@ void Setup(CLI::App& app, int& exit_code) {
                  "Cell of the distance lookup table in metres")
       ->capture_default_str();
   re->add_option("--overlay", rc->overlay, "Also write the check image of the refined pose");
-  re->callback([rc] { RunRefine(*rc); });
+  re->callback([rc] {
+    CheckOutputPath(rc->out, {rc->image, rc->field});  // --out may be --camera
+    CheckOutputPath(rc->overlay, {rc->image, rc->field, rc->camera, rc->out}, "--overlay");
+    RunRefine(*rc);
+  });
 
   auto cc = std::make_shared<CheckCli>();
   CLI::App* ch = group->add_subcommand(
@@ -482,7 +494,11 @@ void Setup(CLI::App& app, int& exit_code) {
   ch->add_option("--out", cc->out, "Image to write (.png, .jpg)")->required();
   ch->add_option("--points", cc->points, "Known points (u,v,name or u,v,x,y,z) to tabulate");
   ch->add_option("--table", cc->table, "Write the known points' error table (CSV)");
-  ch->callback([cc] { RunCheck(*cc); });
+  ch->callback([cc] {
+    CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
+    CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out}, "--table");
+    RunCheck(*cc);
+  });
 
   auto gc = std::make_shared<RigCli>();
   CLI::App* rg = group->add_subcommand(

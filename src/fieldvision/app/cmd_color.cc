@@ -6,6 +6,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/detect/colour_learn.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -65,7 +66,11 @@ void Setup(CLI::App& app, int& exit_code) {
   learn->add_option("--name", a->learn.class_name, "Class name")->capture_default_str();
   learn->add_option("--out", a->out, "Colour file to write (JSON)")->required();
   learn->add_option("--mask-out", a->mask_out, "Image of the selection (default: OUT-mask.png)");
-  learn->callback([a] { Learn(*a); });
+  learn->callback([a] {
+    CheckOutputPath(a->out, {a->video});
+    CheckOutputPath(a->mask_out, {a->video, a->out}, "--mask-out");
+    Learn(*a);
+  });
   (void)exit_code;
 }
 

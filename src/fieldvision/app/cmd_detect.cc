@@ -3,6 +3,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/detect/detect_video.h"
+#include "fieldvision/io/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -38,6 +39,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
+    CheckOutputPath(o->out, PathList(o->video, o->camera, o->field, o->detector.colour));
+    CheckOutputPath(o->draw, PathList(o->video, o->camera, o->field, o->out), "--draw");
     const DetectVideoResult r = DetectVideo(*o);
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
   });

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/util/error.h"
@@ -68,6 +69,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   imp->add_option("--out", p->out, "MOT CSV (TRACKS.csv layout)")->required();
   imp->callback([p] {
+    CheckOutputPath(p->out, {p->xml});
     const auto rows = track::ReadPetsCvml(p->xml);
     track::WriteTracksCsv(rows, p->out);
     std::cout << "wrote " << rows.size() << " boxes to " << p->out << "\n";

@@ -7,6 +7,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/track/players.h"
@@ -138,7 +139,16 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("--teams", c->o.teams,
                 "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
   cmd->add_flag("!--no-progress", c->o.progress, "No progress line");
-  cmd->callback([c] { RunPlayersCommand(*c); });
+  cmd->callback([c] {
+    const auto inputs = PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
+    CheckOutputPath(c->out, inputs);
+    for (const auto& [out, what] : {std::pair{c->mot_out, "--mot-out"},
+                                    {c->draw, "--draw"},
+                                    {c->o.detections_out, "--save-detections"}}) {
+      CheckOutputPath(out, PathList(inputs, c->out), what);
+    }
+    RunPlayersCommand(*c);
+  });
 }
 
 FV_REGISTER_COMMAND(70, "players", Setup);

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/recon/trajectory_run.h"
 
 namespace fv::app {
@@ -69,6 +70,11 @@ void Setup(CLI::App& app, int& exit_code) {
     o->job.analysis.drag = ParseDragMode(o->drag, "--drag");
     o->job.analysis.spin = ParseDragMode(o->spin, "--spin");
     const auto files = ExpandTrackInputs(o->job.in_path);
+    for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
+                                    {o->job.smoothed_path, "--smoothed"},
+                                    {o->job.report_path, "--report"}}) {
+      CheckOutputPath(out, PathList(o->job.in_path, files, o->job.field), what);
+    }
     if (files.empty()) {
       RunTrajectory(o->job, std::cout);
     } else {
