@@ -1,9 +1,11 @@
 // `fieldvision stats`: statistics, heat maps, radar view and an HTML report from TRACKS.csv.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/field/field.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
@@ -32,6 +34,16 @@ void RunStats(const StatsCli& c) {
     o.name_of = roster.name_of;
   }
   const stats::StatsResult r = stats::ComputeStats(rows, o);
+  // The radar video has 10 frames per second of play: refuse spans longer than any match (6 h).
+  double t0 = 1e300, t1 = -1e300;
+  for (const auto& s : r.tracks) {
+    if (s.time_s.empty()) continue;
+    t0 = std::min(t0, s.time_s.front());
+    t1 = std::max(t1, s.time_s.back());
+  }
+  FV_REQUIRE(t1 - t0 <= 6 * 3600.0,
+             "stats: '{}' spans {:.0f} s of play (over 6 h): check its frame numbers and time_s",
+             c.tracks, t1 - t0);
   const stats::ReportFiles f = stats::WriteStatsReport(r, field, o, c.out);
   std::cout << r.Summary() << "\nwrote " << f.files.size() << " files to " << c.out << " (open "
             << c.out << "/index.html)\n";
@@ -57,7 +69,15 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--smooth", c->o.smooth_window_s, "Smoothing window of positions in seconds");
   cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s");
   cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.mp4");
-  cmd->callback([c] { RunStats(*c); });
+  cmd->callback([c] {
+    const auto inputs = PathList(c->tracks, c->field, c->zones, c->teams);
+    CheckOutputPath(c->out, inputs);
+    for (const char* name : {"distances.csv", "players.csv", "speed_profiles.csv", "stats.json",
+                             "index.html", "radar.png", "radar.mp4", "heatmap_all.png"}) {
+      CheckOutputPath(c->out + "/" + name, inputs);
+    }
+    RunStats(*c);
+  });
 }
 
 FV_REGISTER_COMMAND(75, "stats", Setup);

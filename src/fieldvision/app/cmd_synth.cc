@@ -1,4 +1,5 @@
 // `fieldvision synth`: render a synthetic scene (preset or scene JSON) with exact ground truth.
+#include <cstdint>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -30,6 +31,10 @@ void RunSynth(const SynthOptions& o) {
   if (o.seed) spec.seed = *o.seed;
   if (o.frames) spec.num_frames = *o.frames;
   FV_REQUIRE(o.width.has_value() == o.height.has_value(), "synth: give both --width and --height");
+  // Memory: about 80 bytes per pixel while rendering; 16 Mpx (8K UHD) keeps it near 1.3 GB.
+  FV_REQUIRE(!o.width || int64_t{*o.width} * *o.height <= 4096 * 4096,
+             "synth: --width x --height ({} x {}) is over 16.8 megapixels", o.width.value_or(0),
+             o.height.value_or(0));
   if (o.width) synth::ResizeCameras(spec, *o.width, *o.height);
   if (!o.format.empty()) spec.format = o.format;
   spec.Check();
@@ -49,9 +54,10 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", o->out, "Output folder (created)")->required();
   cmd->add_option("--seed", o->seed, "Random seed (placements, paths, noise)");
   cmd->add_option("--frames", o->frames, "Number of frames")->check(CLI::Range(1, 1000000));
-  cmd->add_option("--width", o->width, "Image width of every camera")->check(CLI::Range(16, 16384));
-  cmd->add_option("--height", o->height, "Image height of every camera")
-      ->check(CLI::Range(16, 16384));
+  cmd->add_option("--width", o->width, "Image width of every camera (at most 8192)")
+      ->check(CLI::Range(16, 8192));
+  cmd->add_option("--height", o->height, "Image height of every camera (at most 8192)")
+      ->check(CLI::Range(16, 8192));
   cmd->add_option("--format", o->format, "avi (MJPG) | png | jpg (image sequences)")
       ->check(CLI::IsMember({"avi", "png", "jpg"}));
   cmd->add_flag("--quiet", o->quiet, "No progress line");

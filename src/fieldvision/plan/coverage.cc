@@ -80,6 +80,18 @@ void CoverageOptions::Check() const {
   CheckNonNegative(error_weight_per_m, "error_weight_per_m");
 }
 
+void CheckCoverageGrid(const FieldModel& field, const CoverageOptions& options) {
+  const double half_x =
+      options.include_surround ? field.HalfLengthWithSurround() : 0.5 * field.length_m;
+  const double half_y =
+      options.include_surround ? field.HalfWidthWithSurround() : 0.5 * field.width_m;
+  constexpr double kMaxCells = 4e6;  // a 2 km x 2 km area at 1 m, a football pitch at 6 cm
+  FV_REQUIRE((2 * half_x / options.grid_step_m) * (2 * half_y / options.grid_step_m) <= kMaxCells,
+             "coverage: grid step {} m gives more than {:.0f} cells on field '{}' ({:.0f} x {:.0f} "
+             "m): use a larger step",
+             options.grid_step_m, kMaxCells, field.name, 2 * half_x, 2 * half_y);
+}
+
 bool SeesPoint(const Camera& camera, const Eigen::Vector3d& p_world,
                const CoverageOptions& options) {
   const Eigen::Vector3d p_cam = camera.cam_from_world * p_world;
@@ -192,6 +204,7 @@ CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldM
   std::vector<double> heights = {0.5 * options.ball_diameter_m};
   if (options.height_above_m > 0) heights.push_back(heights[0] + options.height_above_m);
 
+  CheckCoverageGrid(field, options);
   const int nx = std::max(1, static_cast<int>(std::lround(2 * half_x / options.grid_step_m)));
   const int ny = std::max(1, static_cast<int>(std::lround(2 * half_y / options.grid_step_m)));
   std::vector<Eigen::Vector3d> centres;

@@ -88,6 +88,9 @@ std::optional<Eigen::Matrix3d> TriangulationCovariance(const std::vector<const C
                                                        const Eigen::Vector3d& p_world,
                                                        double sigma_px);
 
+// Throws fv::Error (naming the step and the field) when the grid would have over 4 million cells.
+void CheckCoverageGrid(const FieldModel& field, const CoverageOptions& options);
+
 CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldModel& field,
                                 const CoverageOptions& options);
 

@@ -59,6 +59,12 @@ void PlanRunOptions::Check() const {
 PlanRunResult RunPlan(const PlanRunOptions& options) {
   options.Check();
   const FieldModel field = LoadField(options.field);
+  CheckCoverageGrid(field, options.coverage);
+  if (options.optimize) {
+    CoverageOptions search_grid = options.coverage;
+    search_grid.grid_step_m = options.search.grid_step_m;
+    CheckCoverageGrid(field, search_grid);
+  }
   PlanRunResult result;
   std::optional<Rig> given;
   if (!options.rig_path.empty()) given = ReadRigJson(options.rig_path);

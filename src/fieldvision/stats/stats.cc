@@ -14,7 +14,8 @@
 namespace fv::stats {
 
 void StatsOptions::Check() const {
-  CheckNonNegative(fps, "fps");
+  FV_REQUIRE(fps == 0 || (std::isfinite(fps) && fps >= 1e-3 && fps <= 1e4),
+             "fps must be 0 (from time_s) or in 0.001..10000 (got {})", fps);
   CheckPositive(smooth_window_s, "smooth_window_s");
   CheckPositive(max_speed_mps, "max_speed_mps");
   CheckPositive(sprint_speed_mps, "sprint_speed_mps");

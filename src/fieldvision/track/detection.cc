@@ -22,11 +22,13 @@ namespace fs = std::filesystem;
 void DetectorOptions::Check() const {
   FV_REQUIRE(kind == "nanodet" || kind == "hog" || kind == "motion" || kind == "onnx",
              "detector kind '{}' is not one of nanodet, hog, motion, onnx", kind);
-  FV_REQUIRE(input_width == 0 || (input_width >= 64 && input_width % 32 == 0),
-             "input_width must be 0 (from the frame) or a multiple of 32 and >= 64 (got {})",
-             input_width);
-  FV_REQUIRE(input_height == 0 || (input_height >= 64 && input_height % 32 == 0),
-             "input_height must be 0 or a multiple of 32 and >= 64 (got {})", input_height);
+  FV_REQUIRE(
+      input_width == 0 || (input_width >= 64 && input_width <= 4096 && input_width % 32 == 0),
+      "input_width must be 0 (from the frame) or a multiple of 32 in 64..4096 (got {})",
+      input_width);
+  FV_REQUIRE(
+      input_height == 0 || (input_height >= 64 && input_height <= 4096 && input_height % 32 == 0),
+      "input_height must be 0 or a multiple of 32 in 64..4096 (got {})", input_height);
   CheckInRange(score_threshold, 0.0, 1.0, "score_threshold");
   CheckInRange(nms_iou, 0.0, 1.0, "nms_iou");
   CheckNonNegative(min_height_px, "min_height_px");
