@@ -23,7 +23,8 @@ check() {  # check NAME EXPECTED_EXIT(0|nonzero) CMD...
 }
 for c in synth ball trajectory plan players stats detect "calibrate intrinsics" \
          "calibrate extrinsics" "calibrate refine" "field show" "field draw" "eval ball" \
-         "color learn" "calibrate check" "calibrate rig" "eval tracks"; do
+         "color learn" "calibrate check" "calibrate rig" "eval tracks" "eval detect" \
+         "eval import-pets" "calibrate multi" node fuse studio tracks; do
   check "$c --help" 0 $FV $c --help
 done
 check "field show" 0 $FV field show robocup-msl
@@ -39,4 +40,52 @@ check "extrinsics: missing camera" nonzero $FV calibrate extrinsics --camera "$T
   --points "$TMP/none.csv" --out "$TMP/c.yaml"
 printf 'frame,time_s,x_m,y_m,z_m\n0,0,1,2,nan\n' > "$TMP/nan.csv"
 check "eval ball: NaN truth" nonzero $FV eval ball --truth "$TMP/nan.csv" --est "$TMP/nan.csv"
+# An output that is one of the inputs (by name or through a link) is refused; the input stays.
+printf 'not a video\n' > "$TMP/v.avi"
+ln -s v.avi "$TMP/link.avi"
+printf 'frame,x_m,y_m,z_m\n0,1,2,0.11\n' > "$TMP/t.csv"
+printf '<dataset></dataset>\n' > "$TMP/p.xml"
+same_file() {  # same_file NAME INPUT CMD...: non-zero exit, one line, INPUT unchanged
+  local name="$1" input="$2"
+  shift 2
+  cp "$input" "$TMP/before"
+  check "$name" nonzero "$@"
+  grep -q "is the input" "$TMP/err" || { echo "FAIL $name: not the same-file error"; fail=1; }
+  cmp -s "$input" "$TMP/before" || { echo "FAIL $name: input changed"; fail=1; }
+}
+same_file "detect: --out is --video" "$TMP/v.avi" $FV detect --video "$TMP/v.avi" --out "$TMP/v.avi"
+same_file "detect: --out links to --video" "$TMP/v.avi" $FV detect --video "$TMP/v.avi" \
+  --out "$TMP/link.avi"
+same_file "ball: --out is --truth" "$TMP/t.csv" $FV ball --camera "$TMP/c1.yaml" \
+  --video "$TMP/v.avi" --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --truth "$TMP/t.csv" \
+  --out "$TMP/t.csv"
+same_file "players: --out is --video" "$TMP/v.avi" $FV players --video "$TMP/v.avi" \
+  --out "$TMP/v.avi"
+same_file "trajectory: --out is --in" "$TMP/t.csv" $FV trajectory --in "$TMP/t.csv" \
+  --out "$TMP/t.csv"
+same_file "stats: --out holds --tracks" "$TMP/t.csv" $FV stats --tracks "$TMP/t.csv" \
+  --field fifa --out "$TMP/t.csv"
+same_file "import-pets: --out is --xml" "$TMP/p.xml" $FV eval import-pets --xml "$TMP/p.xml" \
+  --out "$TMP/p.xml"
+same_file "color learn: --out is --video" "$TMP/v.avi" $FV color learn --video "$TMP/v.avi" \
+  --roi 1,1,2,2 --out "$TMP/v.avi"
+# Sizes that would exhaust memory or never finish are refused before anything is allocated.
+check "synth: 16384 px wide" nonzero $FV synth --preset static --width 16384 --height 16384 \
+  --out "$TMP/synth"
+check "synth: over 16 Mpx" nonzero $FV synth --preset static --width 8192 --height 8192 \
+  --out "$TMP/synth"
+check "players: --input-width 32000" nonzero $FV players --video "$TMP/v.avi" \
+  --input-width 32000 --out "$TMP/tracks.csv"
+grep -q input_width "$TMP/err" || { echo "FAIL players: error does not name input_width"; fail=1; }
+check "plan: --step 1e-4" nonzero $FV plan --field fifa --optimize --step 1e-4 --out "$TMP/plan"
+grep -q "grid step" "$TMP/err" || { echo "FAIL plan: error does not name the step"; fail=1; }
+printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n' > "$TMP/tracks.csv"
+for f in 1 2 3; do echo "$f,1,0,0,10,20,1,$f,0," >> "$TMP/tracks.csv"; done
+echo "2000000000,1,0,0,10,20,1,5,0," >> "$TMP/tracks.csv"
+check "stats: --fps 1e-300" nonzero $FV stats --tracks "$TMP/tracks.csv" --field fifa \
+  --fps 1e-300 --out "$TMP/stats"
+check "stats: frame 2e9" nonzero $FV stats --tracks "$TMP/tracks.csv" --field fifa --fps 25 \
+  --out "$TMP/stats"
+grep -q "tracks.csv" "$TMP/err" || { echo "FAIL stats: error does not name the file"; fail=1; }
+check "option error" nonzero $FV synth --frames 0 --out "$TMP/synth"
 exit $fail

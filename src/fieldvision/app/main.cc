@@ -1,10 +1,13 @@
 // fieldvision: turn ordinary cameras around a sports field into a measuring instrument.
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 
+#include <glog/logging.h>
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/util/error.h"
@@ -17,6 +20,17 @@ std::string FirstLine(const std::string& s) {
   return line;
 }
 
+// Library log spam never reaches the user (one line per error): OpenCV, FFmpeg (read by OpenCV
+// when its first capture opens), GStreamer and Ceres' glog are quiet unless --verbose.
+void QuietLibraries(bool verbose) {
+  cv::utils::logging::setLogLevel(verbose ? cv::utils::logging::LOG_LEVEL_INFO
+                                          : cv::utils::logging::LOG_LEVEL_SILENT);
+  // A user's own settings stand unless --verbose.
+  setenv("OPENCV_FFMPEG_LOGLEVEL", verbose ? "32" : "-8", verbose);  // AV_LOG_INFO / AV_LOG_QUIET
+  setenv("GST_DEBUG", verbose ? "2" : "0", verbose);
+  FLAGS_minloglevel = verbose ? google::GLOG_INFO : google::GLOG_FATAL;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -25,15 +39,23 @@ int main(int argc, char** argv) {
       "its flight, plan camera rigs and track players."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "fieldvision 0.1.0");
+  QuietLibraries(false);
   app.add_flag_callback(
-      "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "Print debug messages");
+      "-v,--verbose",
+      [] {
+        spdlog::set_level(spdlog::level::debug);
+        QuietLibraries(true);
+      },
+      "Print debug messages");
   int exit_code = 0;
   fv::app::SetUpAllCommands(app, exit_code);
   spdlog::set_pattern("%^%l%$: %v");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "fieldvision: error: " << FirstLine(e.what()) << "\n";  // one line
+    return e.get_exit_code();
   } catch (const fv::Error& e) {
     std::cerr << "fieldvision: error: " << FirstLine(e.what()) << "\n";
     return 1;
