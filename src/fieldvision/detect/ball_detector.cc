@@ -110,13 +110,18 @@ std::string OutlineProblem(const BallFit& fit, double visible, double leak,
   return "";
 }
 
-// The first region check the candidate fails ("" when it passes them all).
-std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o) {
+// The first region check the candidate fails ("" when it passes them all); with
+// `shape_only` the colour checks (leak, contrast) are left out.
+std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o,
+                          bool shape_only = false) {
   if (r.arc_cover < o.min_arc_cover) {
     return fmt::format("region outline not round ({:.0f} % of the circle)", 100 * r.arc_cover);
   }
   if (r.outside > o.max_region_outside) {
     return fmt::format("region outline sticks out of its circle ({:.0f} %)", 100 * r.outside);
+  }
+  if (r.extent > o.max_region_extent) {
+    return fmt::format("region has corners ({:.2f} radii out)", r.extent);
   }
   if (r.fill < o.min_region_fill) {
     return fmt::format("region fills only {:.0f} % of its circle", 100 * r.fill);
@@ -124,6 +129,7 @@ std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o) {
   if (r.spill > o.max_region_spill) {
     return fmt::format("region spills beyond its circle ({:.0f} %)", 100 * r.spill);
   }
+  if (shape_only) return "";
   if (r.leak > o.max_ring_leak) {
     return fmt::format("ball colour around the circle ({:.0f} % of a ring)", 100 * r.leak);
   }
@@ -188,6 +194,8 @@ void BallDetectorOptions::Check() const {
   CheckInRange(max_ring_leak, 0.0, 1.0, "max_ring_leak");
   CheckNonNegative(min_contrast, "min_contrast");
   CheckInRange(max_region_outside, 0.0, 1.0, "max_region_outside");
+  FV_REQUIRE(max_region_extent >= 1.0, "max_region_extent must be >= 1 (got {})",
+             max_region_extent);
   CheckInRange(grow_hue_deg, 0.0, 60.0, "grow_hue_deg");
   CheckInRange(grow_factor, 0.0, 1.0, "grow_factor");
   region.Check();
@@ -349,6 +357,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
         cand.leak = region.leak;
         cand.contrast = region.contrast;
         cand.region_outside = region.outside;
+        cand.region_extent = region.extent;
         cand.centre_px = region.centre_px;
         cand.radius_px = region.radius_px;
         cand.sigma_px = region.sigma_px;
@@ -368,9 +377,13 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     // 2. The sub-pixel outline fit, seeded by the region when there is one.
     const Vector2d seed_c = region.ok ? region.centre_px : blob.centroid_px();
     const double seed_r = region.ok ? region.radius_px : rough_r;
-    const BallFit fit = seed_r >= 0.5 * o.min_radius_px
-                            ? FitBall(bgr, *table_, ball_bit_, seed_c, seed_r, camera_, o.fit)
-                            : BallFit{};
+    BallFit fit = seed_r >= 0.5 * o.min_radius_px
+                      ? FitBall(bgr, *table_, ball_bit_, seed_c, seed_r, camera_, o.fit)
+                      : BallFit{};
+    if (region.ok && !fit.ok && rough_r >= 0.5 * o.min_radius_px) {
+      // A region that took in a neighbour seeds badly: the blob itself may still fit.
+      fit = FitBall(bgr, *table_, ball_bit_, blob.centroid_px(), rough_r, camera_, o.fit);
+    }
     std::string fit_why;  // why the precise path fails
     double visible = 0.0, leak = 1.0;
     if (!fit.ok) {
@@ -385,8 +398,10 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     const Vector2d centre = fit.ok && fit_why.empty() ? fit.centre_px : cand.centre_px;
     double size_factor = 1.0;
     const std::string size_why = SizeProblem(centre, radius, &size_factor);
-    const bool stands_out = !region.ok || region.contrast >= o.min_contrast;
-    const bool precise_ok = fit.ok && fit_why.empty() && size_why.empty() && stands_out;
+    // Where the region was measured, the outline fit alone does not decide: both must agree.
+    const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
+                               RegionProblem(region, o, /*shape_only=*/true).empty();
+    const bool precise_ok = fit.ok && fit_why.empty() && size_why.empty() && region_agrees;
     std::string region_why;
     if (!o.use_region) {
       region_why = "region check off";

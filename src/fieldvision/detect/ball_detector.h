@@ -49,6 +49,7 @@ struct BallCandidate {
   double leak = 0.0;            // ball colour in a ring around the circle
   double contrast = 0.0;        // CIELAB distance between the disc's and the ring's colours
   double region_outside = 0.0;  // convex outline beyond the region's circle
+  double region_extent = 0.0;   // the convex outline's far reach, in radii
   bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
   std::string reason;           // why rejected ("" when accepted)
 };
@@ -84,13 +85,18 @@ struct BallDetectorOptions {
   // around it.
   bool use_region = true;
   double min_arc_cover = 0.5;
-  double min_region_fill = 0.6;
+  double min_region_fill = 0.5;
   double max_region_spill = 0.25;
   double max_ring_leak = 0.3;
   double max_region_outside = 0.1;  // convex outline points beyond the circle (corners, apexes)
+  // The convex outline's far reach from the centre, in radii (1.41: a square's corners).
+  double max_region_extent = 1.25;
   // A ball stands out from its surroundings: CIELAB Delta E between the disc's and a ring's
   // median colours (ball_region.h), required of every accepted candidate with a region.
-  double min_contrast = 30.0;
+  double min_contrast = 35.0;
+  // Whether a failed region shape check also rejects a candidate whose sub-pixel outline fit
+  // passed all its own checks.
+  bool region_vetoes_fit = false;
   BallRegionOptions region;
   // The region grows through the ball class widened by this hue (degrees) and with saturation
   // and value minima times grow_factor (colour.h: WidenedBallSpec); grow_factor 1 and

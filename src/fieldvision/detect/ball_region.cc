@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -72,11 +73,57 @@ double MedianOf(std::vector<float>& v) {
   return *mid;
 }
 
+// RANSAC for the circle of a partly hidden disc: an occluder's edge lies inside the true circle,
+// nothing of the disc lies outside it, so points beyond the inlier band count against a
+// hypothesis (score = inliers - outside). Deterministic draws; FitCircle refines the winner.
+bool OuterCircle(const std::vector<Vector2d>& pts, double thr, int iterations, Vector2d* centre,
+                 double* radius, std::vector<char>* inlier) {
+  const int n = static_cast<int>(pts.size());
+  if (n < 3) return false;
+  uint64_t state = 0x2545F4914F6CDD1Dull ^ static_cast<uint64_t>(n);
+  auto next = [&](int m) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<int>((state >> 33) % static_cast<uint64_t>(m));
+  };
+  int best = -n;
+  Vector2d best_c = Vector2d::Zero();
+  double best_r = 0;
+  for (int it = 0; it < iterations; ++it) {
+    const int i = next(n), j = next(n), k = next(n);
+    if (i == j || j == k || i == k) continue;
+    // Circle through three points.
+    const Vector2d &a = pts[i], &b = pts[j], &c = pts[k];
+    const double d =
+        2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
+    if (std::abs(d) < 1e-9) continue;
+    const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
+    const Vector2d cc((a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d,
+                      (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d);
+    const double r = (a - cc).norm();
+    if (!std::isfinite(r)) continue;
+    int score = 0;
+    for (const auto& p : pts) {
+      const double e = (p - cc).norm() - r;
+      score += std::abs(e) < thr ? 1 : (e > 0 ? -1 : 0);
+    }
+    if (score > best) {
+      best = score;
+      best_c = cc;
+      best_r = r;
+    }
+  }
+  if (best < 3) return false;
+  *centre = best_c;
+  *radius = best_r;
+  return FitCircle(pts, thr, centre, radius, inlier);
+}
+
 }  // namespace
 
 void BallRegionOptions::Check() const {
   CheckInRange(gather_fraction, 0.0, 3.0, "BallRegionOptions.gather_fraction");
   CheckInRange(close_fraction, 0.0, 1.0, "BallRegionOptions.close_fraction");
+  CheckInRange(grow_fraction, 0.0, 2.0, "BallRegionOptions.grow_fraction");
   CheckPositive(hull_tolerance_px, "BallRegionOptions.hull_tolerance_px");
   CheckPositive(inlier_px, "BallRegionOptions.inlier_px");
   FV_REQUIRE(ring_inner >= 1.0 && ring_outer > ring_inner,
@@ -111,7 +158,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   const cv::Mat grow =
       grow_table == nullptr ? raw : ClassMask(bgr, *grow_table, grow_table->BallBit(), window);
   cv::Mat labels, stats, centroids;
-  cv::connectedComponentsWithStats(grow, labels, stats, centroids, 8, CV_32S);
+  cv::connectedComponentsWithStats(raw, labels, stats, centroids, 8, CV_32S);
   cv::Rect bounds;
   cv::Mat region = GatherComponents(labels, stats, seed, o.gather_fraction, &bounds);
   if (bounds.area() == 0) {
@@ -119,6 +166,16 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     return out;
   }
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
+  if (grow_table != nullptr) {
+    // Hysteresis with a reach: widened-class pixels join only near the core (a shaded rim, a
+    // pale cap), so a neighbour of a similar colour is not taken in.
+    const int reach = std::max(1, static_cast<int>(std::lround(o.grow_fraction * r_region)));
+    cv::Mat near;
+    cv::dilate(
+        region, near,
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
+    cv::bitwise_or(region, grow & near, region);
+  }
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
   if (k >= 1) {
     cv::morphologyEx(region, region, cv::MORPH_CLOSE,
@@ -164,7 +221,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   double r = 0;
   std::vector<char> inl;
   const double thr = o.inlier_px + 0.06 * r_est;
-  if (!RansacCircle(pts, thr, 64, &c, &r, &inl) || !(r > 0.5) || r > 2.5 * r_est + 3) {
+  if (!OuterCircle(pts, thr, 96, &c, &r, &inl) || !(r > 0.5) || r > 2.5 * r_est + 3) {
     out.failure = "no circle in the outline";
     return out;
   }
@@ -203,6 +260,14 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   }
   out.inliers = n_in;
   out.outside = double(n_out) / pts.size();
+  {
+    std::vector<double> rel;
+    rel.reserve(pts.size());
+    for (const auto& p : pts) rel.push_back(((p - c).norm() + 0.5) / r);
+    // The second largest: one stray pixel does not count, a corner's few do.
+    std::nth_element(rel.begin(), rel.begin() + 1, rel.end(), std::greater<>());
+    out.extent = rel.size() >= 2 ? rel[1] : rel[0];
+  }
   out.rms_px = n_in > 0 ? std::sqrt(ss / n_in) : 0.0;
   out.arc_cover = double(hit) / known;
   out.centre_px = c;
@@ -231,8 +296,10 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
       if (d >= ri && d < ro) {
         ++ring;
         ring_ball += m[x] != 0;
-        const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
-        for (int ch = 0; ch < 3; ++ch) ring_lab[ch].push_back(l[ch]);
+        if (m[x] == 0) {  // what is around the ball, not more of its colour (that is leak)
+          const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+          for (int ch = 0; ch < 3; ++ch) ring_lab[ch].push_back(l[ch]);
+        }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
         for (int ch = 0; ch < 3; ++ch) disc_lab[ch].push_back(l[ch]);

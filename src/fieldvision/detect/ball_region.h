@@ -20,6 +20,7 @@ namespace fv {
 
 struct BallRegionOptions {
   double gather_fraction = 0.5;  // other blobs within this share of the radius (+2 px) join
+  double grow_fraction = 0.3;    // widened-class pixels join within this share of the radius
   double close_fraction = 0.2;   // closing radius as a share of the radius (print, seams), <= 4 px
   double hull_tolerance_px = 1.0;  // outline points this near the convex hull are "convex"
   double inlier_px = 0.8;          // circle inliers: within this plus 6 % of the radius
@@ -44,9 +45,13 @@ struct BallRegion {
   // Share of the convex outline points farther out than the circle (beyond the inlier band): a
   // corner or an apex (a cone, a robot's part) sticks out; an occluder's edge lies inside.
   double outside = 0.0;
+  // The convex outline's second largest distance from the centre, in radii: about 1 for a disc,
+  // 1.41 for a square's corners, more for a triangle's apex.
+  double extent = 0.0;
   double purity = 0.0;  // ball-coloured share of the region before closing and filling
   // CIELAB distance (Delta E 1976) between the median colours of the disc (inner 80 %) and of
-  // the leak ring: a ball stands out from what is around it, a patch of a wall does not.
+  // the leak ring's pixels outside the ball class: a ball stands out from what is around it, a
+  // patch of a wall does not.
   double contrast = 0.0;
   double solidity = 0.0;   // region area / convex hull area
   int outline_points = 0;  // convex outline points used by the circle fit

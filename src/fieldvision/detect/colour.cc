@@ -23,12 +23,12 @@ ColourRange Hsv(double h0, double s0, double v0, double h1, double s1, double v1
 
 const std::map<std::string, std::vector<ColourRange>>& Presets() {
   // Hue in degrees. Orange covers Lambert-shaded balls (dark side down to V 45) but not skin
-  // (low saturation), red shirts (hue < 3) or amber (hue > 32). Yellow adds, for bright light, a
-  // paler box (a yellow ball overexposed or in white light turns cream) but stops short of
-  // olive (hue > 68). Both measured on the real photo sets in shared/data/robocup-ball-photos
-  // (share of ball pixels against background pixels, per box).
+  // (low saturation) or red shirts (hue < 6). Yellow adds, for bright light, a paler box (a
+  // yellow ball overexposed or in white light turns cream) and stops short of olive (hue > 68);
+  // measured on the MSL photos in shared/data/robocup-ball-photos (share of ball pixels against
+  // background pixels, per box).
   static const std::map<std::string, std::vector<ColourRange>> kPresets = {
-      {"orange", {Hsv(3, 130, 45, 32, 255, 255)}},
+      {"orange", {Hsv(6, 170, 45, 38, 255, 255)}},
       {"yellow", {Hsv(40, 100, 80, 68, 255, 255), Hsv(30, 48, 176, 62, 255, 255)}},
       {"white", {Hsv(0, 0, 170, 360, 45, 255)}},
       {"pink", {Hsv(295, 60, 120, 345, 255, 255)}},

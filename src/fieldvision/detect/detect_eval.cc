@@ -286,10 +286,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   if (!o.candidates_out.empty()) {
     cand_csv = std::make_unique<CsvWriter>(
         o.candidates_out + ".part",
-        std::vector<std::string>{
-            "image",   "u",       "v",       "radius_px", "score",     "accepted", "weak",
-            "on_ball", "visible", "inliers", "outside",   "dents",     "region",   "arc",
-            "fill",    "spill",   "leak",    "contrast",  "outside_r", "precise",  "reason"},
+        std::vector<std::string>{"image",    "u",     "v",        "radius_px", "score",
+                                 "accepted", "weak",  "on_ball",  "visible",   "inliers",
+                                 "outside",  "dents", "region",   "arc",       "fill",
+                                 "spill",    "leak",  "contrast", "outside_r", "extent",
+                                 "precise",  "reason"},
         4);
   }
   Progress progress("eval detect", static_cast<long long>(items.size()), "images", o.progress);
@@ -317,7 +318,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
                   << int(c.accepted) << int(c.weak) << int(on_ball) << c.visible_fraction
                   << c.inlier_fraction << c.outside_fraction << c.dents << int(c.region_ok)
                   << c.arc_cover << c.fill << c.spill << c.leak << c.contrast << c.region_outside
-                  << int(c.precise) << ReplaceCommas(c.reason);
+                  << c.region_extent << int(c.precise) << ReplaceCommas(c.reason);
         cand_csv->EndRow();
       }
     }

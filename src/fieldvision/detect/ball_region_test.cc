@@ -1,0 +1,170 @@
+// Real-ball appearances drawn by hand (a strong sun's shaded side, a print, a specular
+// highlight, an occluder, a small ball, a ball cut by the image edge, JPEG noise) must be
+// accepted with a good centre; shapes that are not balls (a cone's triangle, a box, a patch of a
+// wall with the ball's hue) must not.
+#include "fieldvision/detect/ball_region.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+using Eigen::Vector2d;
+
+const BallCandidate* Best(const std::vector<BallCandidate>& c) {
+  return !c.empty() && c.front().accepted ? &c.front() : nullptr;
+}
+
+std::string Describe(const BallCandidate& c) {
+  std::ostringstream s;
+  s << "centre (" << c.centre_px.transpose() << ") r " << c.radius_px << " arc " << c.arc_cover
+    << " fill " << c.fill << " outside " << c.region_outside << " leak " << c.leak << " contrast "
+    << c.contrast << " extent " << c.region_extent << " precise " << c.precise << " score "
+    << c.score;
+  return s.str();
+}
+
+enum class Look { kShaded, kPrinted, kHighlight, kOccluded, kJpeg };
+
+// Paints one ball of the given look at a random place and size; returns its centre and radius.
+void PaintBall(cv::Mat& img, Look look, Rng& rng, Vector2d* c, double* r) {
+  *r = rng.Uniform(6, 30);
+  *c = Vector2d(rng.Uniform(60, img.cols - 60), rng.Uniform(60, img.rows - 60));
+  // A low sun: the far side at 30 % brightness.
+  detect_testing::PaintDisc(img, *c, *r, detect_testing::kOrange,
+                            look == Look::kShaded ? 0.7 : 0.35);
+  if (look == Look::kPrinted) {
+    // Dark print patches inside the outline (a logo, panel seams).
+    for (int k = 0; k < 3; ++k) {
+      const double a = rng.Uniform(0, 2 * M_PI), d = rng.Uniform(0, 0.55) * *r;
+      cv::ellipse(img, cv::Point(int(c->x() + d * std::cos(a)), int(c->y() + d * std::sin(a))),
+                  cv::Size(int(0.18 * *r) + 1, int(0.1 * *r) + 1), rng.Uniform(0, 180), 0, 360,
+                  cv::Scalar(30, 30, 40), cv::FILLED);
+    }
+  } else if (look == Look::kHighlight) {
+    cv::circle(img, cv::Point(int(c->x() - 0.35 * *r), int(c->y() - 0.35 * *r)), int(0.25 * *r) + 1,
+               cv::Scalar(245, 250, 255), cv::FILLED, cv::LINE_AA);
+  } else if (look == Look::kOccluded) {
+    // A robot's dark side covers up to 40 % of the ball's width.
+    const int x0 = int(c->x() + 0.2 * *r);
+    cv::rectangle(img, cv::Rect(x0, int(c->y() - 2 * *r), int(2 * *r), int(4 * *r)),
+                  cv::Scalar(25, 25, 25), cv::FILLED);
+  } else if (look == Look::kJpeg) {
+    std::vector<uchar> buf;
+    cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, 60});
+    img = cv::imdecode(buf, cv::IMREAD_COLOR);
+  }
+}
+
+TEST(BallRegion, RealBallLooksAreAccepted) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  const std::vector<std::pair<Look, const char*>> looks = {{Look::kShaded, "shaded"},
+                                                           {Look::kPrinted, "printed"},
+                                                           {Look::kHighlight, "highlight"},
+                                                           {Look::kOccluded, "occluded"},
+                                                           {Look::kJpeg, "jpeg"}};
+  for (const auto& [look, name] : looks) {
+    for (int trial = 0; trial < 6; ++trial) {
+      cv::Mat img = detect_testing::FieldImage(480, 360, rng);
+      Vector2d c;
+      double r;
+      PaintBall(img, look, rng, &c, &r);
+      const auto cands = det.Detect(img);
+      const BallCandidate* best = Best(cands);
+      ASSERT_NE(best, nullptr) << name << " ball r " << r << " not accepted: "
+                               << (cands.empty() ? "no candidate" : cands.front().reason);
+      // The occluded ball's centre comes from 60 % of its outline.
+      const double tol = look == Look::kOccluded ? 0.12 * r + 0.5 : 0.08 * r + 0.5;
+      EXPECT_LT((best->centre_px - c).norm(), tol) << name << " r " << r;
+      EXPECT_NEAR(best->radius_px, r, 0.2 * r + 0.5) << name;
+    }
+  }
+}
+
+TEST(BallRegion, SmallAndEdgeBalls) {
+  const uint64_t seed = fv::testing::TestSeed(6);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  for (int trial = 0; trial < 5; ++trial) {
+    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    const Vector2d c(rng.Uniform(40, 280), rng.Uniform(40, 200));
+    const double r = rng.Uniform(3.0, 4.5);
+    detect_testing::PaintDisc(img, c, r);
+    const auto cands = det.Detect(img);
+    const BallCandidate* best = Best(cands);
+    ASSERT_NE(best, nullptr) << "small ball r " << r;
+    EXPECT_LT((best->centre_px - c).norm(), 0.6) << "r " << r << ": " << Describe(*best);
+  }
+  // A ball a third of which lies beyond the bottom edge (a fisheye robot camera's handler).
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    const double r = rng.Uniform(15, 30);
+    const Vector2d c(rng.Uniform(60, 260), 239 - 0.35 * r);
+    detect_testing::PaintDisc(img, c, r);
+    const auto cands = det.Detect(img);
+    const BallCandidate* best = Best(cands);
+    ASSERT_NE(best, nullptr) << "edge ball r " << r << ": "
+                             << (cands.empty() ? "no candidate" : cands.front().reason);
+    EXPECT_LT((best->centre_px - c).norm(), 0.1 * r + 0.5) << "r " << r;
+  }
+}
+
+TEST(BallRegion, ShapesThatAreNotBallsAreRejected) {
+  const uint64_t seed = fv::testing::TestSeed(7);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  const cv::Scalar orange(0, 110, 255);
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat img = detect_testing::FieldImage(480, 360, rng);
+    const int x = rng.UniformInt(60, 380), y = rng.UniformInt(60, 260);
+    const int s = rng.UniformInt(20, 40);  // smaller boxes blur into discs
+    switch (trial) {
+      case 0: {  // a cone from the side
+        const std::vector<cv::Point> tri = {{x - s / 2, y + s}, {x + s / 2, y + s}, {x, y - s}};
+        cv::fillConvexPoly(img, tri, orange, cv::LINE_AA);
+        break;
+      }
+      case 1:  // a box
+        cv::rectangle(img, cv::Rect(x, y, s, s), orange, cv::FILLED);
+        break;
+      case 2:  // a bar
+        cv::rectangle(img, cv::Rect(x, y, 3 * s, s / 3 + 2), orange, cv::FILLED);
+        break;
+      default: {  // a disc painted on a wall of nearly its own colour: no contrast
+        img(cv::Rect(x - 50, y - 50, 110, 110)).setTo(cv::Scalar(20, 95, 225));
+        detect_testing::PaintDisc(img, Vector2d(x, y), 0.4 * s, detect_testing::kOrange, 0.0);
+        break;
+      }
+    }
+    const auto cands = det.Detect(img);
+    EXPECT_EQ(Best(cands), nullptr)
+        << "shape " << trial << " accepted: " << Describe(cands.front());
+  }
+}
+
+TEST(BallRegion, OptionsAreChecked) {
+  BallRegionOptions o;
+  o.ring_outer = 1.0;
+  EXPECT_THROW(o.Check(), Error);
+  BallDetectorOptions d;
+  d.min_contrast = -1;
+  EXPECT_THROW(d.Check(), Error);
+}
+
+}  // namespace
+}  // namespace fv
