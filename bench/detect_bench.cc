@@ -140,12 +140,14 @@ BENCHMARK(BM_LutScanBlobs)
     ->Args({2, 5})
     ->Unit(benchmark::kMicrosecond);
 
-// The whole detector: blobs, filters, sub-pixel refinement and checks (calibrated camera).
+// The whole detector: blobs, filters, region check, sub-pixel refinement (calibrated camera);
+// region:0 leaves the region stage out (its cost is the difference).
 void BM_BallDetector(benchmark::State& state) {
   const BenchFrame& f = TestFrame();
   BaselineSeconds();
   fv::BallDetectorOptions o;
   o.scan_step_px = static_cast<int>(state.range(0));
+  o.use_region = state.range(1) != 0;
   const fv::BallDetector det(o, &f.camera, nullptr);
   int accepted = 0;
   double total = 0;
@@ -158,7 +160,12 @@ void BM_BallDetector(benchmark::State& state) {
   SetCounters(state, total);
   state.counters["accepted"] = accepted;
 }
-BENCHMARK(BM_BallDetector)->ArgName("step")->Arg(2)->Arg(4)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_BallDetector)
+    ->ArgNames({"step", "region"})
+    ->Args({2, 1})
+    ->Args({2, 0})
+    ->Args({4, 1})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
