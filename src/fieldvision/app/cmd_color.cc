@@ -20,6 +20,7 @@ struct ColorLearnArgs {
   std::string negatives;
   std::string out;
   std::string mask_out;
+  bool force = false;
   ColourLearnOptions learn;
 };
 
@@ -31,7 +32,7 @@ void Learn(const ColorLearnArgs& a) {
   if (!a.negatives.empty()) o.negative_points = ParsePoints(a.negatives, "--negative");
   const cv::Mat frame = ReadVideoFrame(a.video, a.frame);
   const ColourLearnResult r = LearnColour(frame, o);
-  WriteColourSpec(r.spec, a.out);
+  if (!r.bad || a.force) WriteColourSpec(r.spec, a.out);
   std::string mask_out = a.mask_out;
   if (mask_out.empty()) {
     std::filesystem::path p(a.out);
@@ -44,6 +45,10 @@ void Learn(const ColorLearnArgs& a) {
     ok = false;
   }
   FV_REQUIRE(ok, "cannot write mask image '{}'", mask_out);
+  FV_REQUIRE(!r.bad || a.force,
+             "colour class selects {:.1f} % of the background: {} not written (see {}; point at "
+             "the ball more tightly, add --negative, or --force to write it anyway)",
+             100 * r.negative_rate, a.out, mask_out);
   std::cout << r.Summary() << "\nwrote " << a.out << " (use it with --color " << a.out << ") and "
             << mask_out << " (what the class selects)\n";
 }
@@ -64,6 +69,11 @@ void Setup(CLI::App& app, int& exit_code) {
                     "Pixels that are not the class: \"u,v;u,v;...\" (default: the frame away "
                     "from the ball)");
   learn->add_option("--name", a->learn.class_name, "Class name")->capture_default_str();
+  learn
+      ->add_option("--max-background", a->learn.max_background_share,
+                   "Largest share of the background the class may select before it is bad")
+      ->capture_default_str();
+  learn->add_flag("--force", a->force, "Write the colour file even when the class is bad");
   learn->add_option("--out", a->out, "Colour file to write (JSON)")->required();
   learn->add_option("--mask-out", a->mask_out, "Image of the selection (default: OUT-mask.png)");
   learn->callback([a] {

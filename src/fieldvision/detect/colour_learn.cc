@@ -48,15 +48,20 @@ void ColourLearnOptions::Check() const {
   CheckInRange(saturation_margin, 0.0, 255.0, "saturation_margin");
   CheckInRange(value_margin, 0.0, 255.0, "value_margin");
   CheckInRange(min_recall, 0.0, 1.0, "min_recall");
+  CheckInRange(max_background_share, 0.0, 1.0, "max_background_share");
   FV_REQUIRE(!class_name.empty(), "class_name is empty");
 }
 
 std::string ColourLearnResult::Summary() const {
   return fmt::format(
-      "class '{}': hue {:.0f}..{:.0f} deg, saturation {:.0f}..{:.0f}, value {:.0f}..{:.0f}; "
-      "{} positive pixels ({:.1f} % inside), {} negative pixels ({:.2f} % inside)",
-      spec.ball_class, range.min[0], range.max[0], range.min[1], range.max[1], range.min[2],
-      range.max[2], positives, 100 * recall, negatives, 100 * negative_rate);
+             "class '{}': hue {:.0f}..{:.0f} deg, saturation {:.0f}..{:.0f}, value {:.0f}..{:.0f}; "
+             "{} positive pixels ({:.1f} % inside), {} negative pixels ({:.2f} % inside)",
+             spec.ball_class, range.min[0], range.max[0], range.min[1], range.max[1], range.min[2],
+             range.max[2], positives, 100 * recall, negatives, 100 * negative_rate) +
+         (bad ? fmt::format("\nBAD CLASS: it selects {:.1f} % of the background (more than the "
+                            "allowed share): point at the ball more tightly or add --negative",
+                            100 * negative_rate)
+              : "");
 }
 
 std::vector<Eigen::Vector2d> ParsePoints(const std::string& text, const std::string& what) {
@@ -237,6 +242,7 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
   result.negatives = static_cast<int>(neg.size());
   result.recall = recall;
   result.negative_rate = neg_rate;
+  result.bad = neg_rate > o.max_background_share;
   result.spec.classes.push_back({o.class_name, {r}});
   if (o.class_name != "field") {
     result.spec.classes.push_back({"field", ColourPreset("green").ranges});

@@ -27,6 +27,9 @@ struct ColourLearnOptions {
   double saturation_margin = 25.0;
   double value_margin = 40.0;
   double min_recall = 0.9;  // shrinking stops before fewer positives than this remain
+  // A class that still selects more than this share of the negative (background) pixels is
+  // reported as bad (ColourLearnResult::bad); `color learn` then does not write it.
+  double max_background_share = 0.02;
   std::string class_name = "ball";
   // Throws fv::Error naming the bad field.
   void Check() const;
@@ -39,6 +42,7 @@ struct ColourLearnResult {
   int negatives = 0;
   double recall = 0.0;         // share of positives inside the learned range
   double negative_rate = 0.0;  // share of negatives inside it
+  bool bad = false;            // negative_rate > max_background_share: not a usable class
   cv::Mat overlay;             // the frame, darkened where the class is absent
   std::string Summary() const;
 };

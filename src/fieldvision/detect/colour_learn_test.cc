@@ -56,6 +56,27 @@ TEST(LearnColour, PinkBallFromARegionAndFromPoints) {
   }
 }
 
+TEST(LearnColour, AClassThatSelectsTheBackgroundIsBad) {
+  const uint64_t seed = fv::testing::TestSeed(18);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+  // A yellow ball on a wall of nearly its colour: whatever box is learned selects the wall too.
+  img(cv::Rect(0, 0, 320, 140)).setTo(cv::Scalar(40, 200, 215));
+  const Eigen::Vector2d c(160, 70);
+  detect_testing::PaintDisc(img, c, 12, cv::Vec3b(30, 210, 230), 0.0);
+  ColourLearnOptions o;
+  o.roi = cv::Rect(140, 50, 40, 40);
+  const ColourLearnResult res = LearnColour(img, o);
+  EXPECT_TRUE(res.bad) << res.Summary();
+  EXPECT_NE(res.Summary().find("BAD CLASS"), std::string::npos);
+  // The clean pink ball of the test above is not.
+  cv::Mat clean = detect_testing::FieldImage(320, 240, rng);
+  detect_testing::PaintDisc(clean, c, 14, cv::Vec3b(180, 105, 255));
+  o.roi = cv::Rect(140, 50, 40, 40);
+  EXPECT_FALSE(LearnColour(clean, o).bad);
+}
+
 TEST(LearnColour, BadInputIsNamed) {
   cv::Mat img(100, 100, CV_8UC3, cv::Scalar(50, 140, 60));
   ColourLearnOptions o;
