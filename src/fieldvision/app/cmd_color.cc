@@ -2,10 +2,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "fieldvision/app/command.h"
 #include "fieldvision/detect/colour_learn.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 
@@ -38,13 +37,7 @@ void Learn(const ColorLearnArgs& a) {
     std::filesystem::path p(a.out);
     mask_out = (p.parent_path() / (p.stem().string() + "-mask.png")).string();
   }
-  bool ok = false;
-  try {
-    ok = cv::imwrite(mask_out, r.overlay);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  FV_REQUIRE(ok, "cannot write mask image '{}'", mask_out);
+  WriteImage(mask_out, r.overlay);
   FV_REQUIRE(!r.bad || a.force,
              "colour class selects {:.1f} % of the background: {} not written (see {}; point at "
              "the ball more tightly, add --negative, or --force to write it anyway)",

@@ -448,7 +448,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     } else {
       cand.accepted = false;
       cand.reason = !size_why.empty() ? size_why : (region.ok ? region_why : fit_why);
-      cand.score = std::max(region_score, 0.0);
+      cand.score = region_score;
       cand.weak = fit.ok && size_why.empty() && !fit_why.empty() &&
                   fit.inlier_fraction >= o.weak_min_inlier_fraction &&
                   visible >= o.min_visible_fraction;

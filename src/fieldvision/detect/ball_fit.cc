@@ -179,18 +179,6 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   return e;
 }
 
-bool CircleFrom3(const Vector2d& a, const Vector2d& b, const Vector2d& c, Vector2d* centre,
-                 double* radius) {
-  const double d =
-      2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
-  if (std::abs(d) < 1e-9) return false;
-  const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
-  centre->x() = (a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d;
-  centre->y() = (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d;
-  *radius = (a - *centre).norm();
-  return std::isfinite(*radius);
-}
-
 // Centre covariance of a circle through the inliers: sigma^2 (J^T J)^-1, J the Jacobian of the
 // distances to the circle with respect to (cx, cy, r).
 double CentreSigma(const std::vector<Vector2d>& pts, const std::vector<char>& inlier,
@@ -370,6 +358,18 @@ std::string BallFit::Summary() const {
       "on the outline, rms {:.3f} px, {:.0f} % outside{}",
       centre_px.x(), centre_px.y(), radius_px, sigma_px, inliers, rays, rms_px,
       100 * outside_fraction, blurred ? fmt::format(", blurred {:.1f} px", blur_length_px) : "");
+}
+
+bool CircleFrom3(const Vector2d& a, const Vector2d& b, const Vector2d& c, Vector2d* centre,
+                 double* radius) {
+  const double d =
+      2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
+  if (std::abs(d) < 1e-9) return false;
+  const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
+  centre->x() = (a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d;
+  centre->y() = (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d;
+  *radius = (a - *centre).norm();
+  return std::isfinite(*radius);
 }
 
 bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* centre, double* radius,

@@ -69,6 +69,10 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
 bool FitCircle(const std::vector<Eigen::Vector2d>& points, double inlier_px,
                Eigen::Vector2d* centre, double* radius, std::vector<char>* inlier);
 
+// The circle through three points; false when they are (nearly) collinear.
+bool CircleFrom3(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                 Eigen::Vector2d* centre, double* radius);
+
 // RANSAC on point triples (a fixed, deterministic sequence of `iterations` draws) with inlier
 // threshold `thr`, then FitCircle on the best triple's inliers. False with fewer than 3 inliers.
 bool RansacCircle(const std::vector<Eigen::Vector2d>& pts, double thr, int iterations,

@@ -10,6 +10,7 @@
 
 #include "fieldvision/detect/ball_fit.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv {
 namespace {
@@ -67,12 +68,6 @@ cv::Mat GatherComponents(const cv::Mat& labels, const cv::Mat& stats, const cv::
   return region;
 }
 
-double MedianOf(std::vector<float>& v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 // RANSAC for the circle of a partly hidden disc: an occluder's edge lies inside the true circle,
 // nothing of the disc lies outside it, so points beyond the inlier band count against a
 // hypothesis (score = inliers - outside). Deterministic draws; FitCircle refines the winner.
@@ -91,16 +86,9 @@ bool OuterCircle(const std::vector<Vector2d>& pts, double thr, int iterations, V
   for (int it = 0; it < iterations; ++it) {
     const int i = next(n), j = next(n), k = next(n);
     if (i == j || j == k || i == k) continue;
-    // Circle through three points.
-    const Vector2d &a = pts[i], &b = pts[j], &c = pts[k];
-    const double d =
-        2 * (a.x() * (b.y() - c.y()) + b.x() * (c.y() - a.y()) + c.x() * (a.y() - b.y()));
-    if (std::abs(d) < 1e-9) continue;
-    const double a2 = a.squaredNorm(), b2 = b.squaredNorm(), c2 = c.squaredNorm();
-    const Vector2d cc((a2 * (b.y() - c.y()) + b2 * (c.y() - a.y()) + c2 * (a.y() - b.y())) / d,
-                      (a2 * (c.x() - b.x()) + b2 * (a.x() - c.x()) + c2 * (b.x() - a.x())) / d);
-    const double r = (a - cc).norm();
-    if (!std::isfinite(r)) continue;
+    Vector2d cc;
+    double r = 0;
+    if (!CircleFrom3(pts[i], pts[j], pts[k], &cc, &r)) continue;
     int score = 0;
     for (const auto& p : pts) {
       const double e = (p - cc).norm() - r;
@@ -276,7 +264,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   // Fill, spill, leak, purity and contrast over the window.
   cv::Mat lab;
   cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
-  std::array<std::vector<float>, 3> disc_lab, ring_lab;
+  std::array<std::vector<double>, 3> disc_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
   long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, pure = 0;
@@ -316,7 +304,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     for (int ch = 0; ch < 3; ++ch) {
       // OpenCV's 8-bit Lab: L * 255 / 100, a + 128, b + 128.
       const double scale = ch == 0 ? 100.0 / 255.0 : 1.0;
-      const double dv = scale * (MedianOf(disc_lab[ch]) - MedianOf(ring_lab[ch]));
+      const double dv = scale * (Median(disc_lab[ch]) - Median(ring_lab[ch]));
       d2 += dv * dv;
     }
     out.contrast = std::sqrt(d2);

@@ -12,6 +12,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/io/image_file.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -23,18 +24,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool IsImagePath(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".webp" || ext == ".ppm" || ext == ".pgm";
-}
-
 // Images of a folder and its subfolders, in path order.
 std::vector<std::string> ImagesUnder(const std::string& dir) {
   std::vector<std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (e.is_regular_file() && IsImagePath(e.path())) files.push_back(e.path().string());
+    if (e.is_regular_file() && IsImageFile(e.path().string())) files.push_back(e.path().string());
   }
   std::sort(files.begin(), files.end());
   return files;
@@ -52,6 +46,15 @@ cv::Rect2d Grow(const cv::Rect2d& r, double grow) {
 
 bool Inside(const cv::Rect2d& r, double u, double v) {
   return u >= r.x && u <= r.x + r.width && v >= r.y && v <= r.y + r.height;
+}
+
+// The first box, grown by `grow`, that holds (u, v); null when none does.
+const cv::Rect2d* BoxHolding(const std::vector<cv::Rect2d>& boxes, double grow, double u,
+                             double v) {
+  for (const auto& b : boxes) {
+    if (Inside(Grow(b, grow), u, v)) return &b;
+  }
+  return nullptr;
 }
 
 // CSV labels: image (file name, path or stem) or frame, and x,y,w,h in pixels.
@@ -163,17 +166,11 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
                            const std::vector<cv::Rect2d>& boxes, double grow) {
   DetectEvalImage r;
   r.boxes = static_cast<int>(boxes.size());
-  auto on_ball = [&](const BallCandidate& c, const cv::Rect2d** which) {
-    for (const auto& b : boxes) {
-      if (Inside(Grow(b, grow), c.centre_px.x(), c.centre_px.y())) {
-        if (which != nullptr) *which = &b;
-        return true;
-      }
-    }
-    return false;
+  auto box_of = [&](const BallCandidate& c) {
+    return BoxHolding(boxes, grow, c.centre_px.x(), c.centre_px.y());
   };
   for (const auto& c : candidates) {
-    if (!on_ball(c, nullptr)) continue;
+    if (box_of(c) == nullptr) continue;
     r.candidate_on_ball = true;
     if (r.reason.empty() && !c.accepted) r.reason = c.reason;
   }
@@ -189,8 +186,8 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
   r.v = best->centre_px.y();
   r.radius_px = best->radius_px;
   r.score = best->score;
-  const cv::Rect2d* box = nullptr;
-  r.hit = on_ball(*best, &box);
+  const cv::Rect2d* box = box_of(*best);
+  r.hit = box != nullptr;
   if (r.hit) {
     r.reason.clear();
     const double cx = box->x + 0.5 * box->width, cy = box->y + 0.5 * box->height;
@@ -282,10 +279,12 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   const BallDetector detector(o.detector, camera.get(), nullptr);
 
   DetectEvalResult result;
+  std::unique_ptr<AtomicOutput> cand_file;
   std::unique_ptr<CsvWriter> cand_csv;
   if (!o.candidates_out.empty()) {
+    cand_file = std::make_unique<AtomicOutput>(o.candidates_out, "--candidates");
     cand_csv = std::make_unique<CsvWriter>(
-        o.candidates_out + ".part",
+        cand_file->temp_path(),
         std::vector<std::string>{"image",    "u",     "v",        "radius_px", "score",
                                  "accepted", "weak",  "on_ball",  "visible",   "inliers",
                                  "outside",  "dents", "region",   "arc",       "fill",
@@ -311,9 +310,8 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     DetectEvalImage r = ScoreImage(candidates, item.boxes, o.grow);
     if (cand_csv != nullptr) {
       for (const auto& c : candidates) {
-        const bool on_ball = std::any_of(item.boxes.begin(), item.boxes.end(), [&](const auto& b) {
-          return Inside(Grow(b, o.grow), c.centre_px.x(), c.centre_px.y());
-        });
+        const bool on_ball =
+            BoxHolding(item.boxes, o.grow, c.centre_px.x(), c.centre_px.y()) != nullptr;
         *cand_csv << item.image << c.centre_px.x() << c.centre_px.y() << c.radius_px << c.score
                   << int(c.accepted) << int(c.weak) << int(on_ball) << c.visible_fraction
                   << c.inlier_fraction << c.outside_fraction << c.dents << int(c.region_ok)
@@ -335,11 +333,10 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   result.seconds = progress.ElapsedSeconds();
   if (cand_csv != nullptr) {
     cand_csv->Close();
-    fs::rename(o.candidates_out + ".part", o.candidates_out);
+    cand_file->Commit();
   }
   if (!o.out.empty()) {
-    const std::string tmp = o.out + ".part";
-    {
+    AtomicWrite(o.out, [&](const std::string& tmp) {
       CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
                         "centre_err_px", "candidate_on_ball", "reason"});
       for (const auto& im : result.images) {
@@ -348,8 +345,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
         w.EndRow();
       }
       w.Close();
-    }
-    fs::rename(tmp, o.out);
+    });
   }
   return result;
 }

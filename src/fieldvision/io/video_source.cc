@@ -16,12 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool IsImageFile(const fs::path& p) {
-  const std::string ext = ToLower(p.extension().string());
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".pgm" || ext == ".ppm";
-}
-
 // Glob with '*' and '?' in the file name part only.
 std::vector<std::string> Glob(const std::string& spec) {
   const fs::path p(spec);
@@ -158,6 +152,12 @@ class CaptureSource : public VideoSource {
 
 void VideoSourceOptions::Check() const { CheckPositive(fps, "VideoSourceOptions.fps"); }
 
+bool IsImageFile(const std::string& path) {
+  const std::string ext = ToLower(fs::path(path).extension().string());
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
+         ext == ".tiff" || ext == ".pgm" || ext == ".ppm" || ext == ".webp";
+}
+
 std::vector<std::string> ListImageSequence(const std::string& spec) {
   std::vector<std::string> files;
   if (spec.find('%') != std::string::npos) {
@@ -182,7 +182,7 @@ std::vector<std::string> ListImageSequence(const std::string& spec) {
   }
   if (fs::is_directory(spec)) {
     for (const auto& e : fs::directory_iterator(spec)) {
-      if (e.is_regular_file() && IsImageFile(e.path())) files.push_back(e.path().string());
+      if (e.is_regular_file() && IsImageFile(e.path().string())) files.push_back(e.path().string());
     }
     std::sort(files.begin(), files.end());
   }

@@ -64,5 +64,7 @@ class VideoSource {
 
 // The image files an image-sequence spec names, in order (empty if it is not one).
 std::vector<std::string> ListImageSequence(const std::string& spec);
+// Whether a path names an image file OpenCV reads, by its extension (case-insensitive).
+bool IsImageFile(const std::string& path);
 
 }  // namespace fv
