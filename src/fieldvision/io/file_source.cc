@@ -15,6 +15,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/io/source_backends.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
@@ -77,13 +78,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
   FV_REQUIRE(pattern || std::filesystem::exists(path), "video '{}' does not exist", path);
   FV_REQUIRE(pattern || !std::filesystem::is_directory(path),
              "video '{}' is a folder (give an image pattern such as '{}/%05d.jpg')", path, path);
-  bool opened = false;
-  try {
-    opened = capture_.open(path, cv::CAP_ANY);
-  } catch (const cv::Exception&) {
-    opened = false;
-  }
-  FV_REQUIRE(opened && capture_.isOpened(), "cannot open video '{}' (not a video OpenCV reads?)",
+  FV_REQUIRE(OpenVideoFile(capture_, path), "cannot open video '{}' (not a video OpenCV reads?)",
              path);
   const double container_fps = capture_.get(cv::CAP_PROP_FPS);
   fps_ = options.fps > 0 ? options.fps

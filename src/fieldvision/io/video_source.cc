@@ -91,13 +91,8 @@ class CaptureSource : public VideoSource {
     } else {
       FV_REQUIRE(fs::exists(spec), "video '{}' does not exist", spec);
       FV_REQUIRE(fs::is_regular_file(spec), "video '{}' is not a file", spec);
-      try {
-        cap_.open(spec, cv::CAP_ANY);
-      } catch (const cv::Exception&) {
-        Throw("video '{}' cannot be opened (not a video OpenCV can decode?)", spec);
-      }
-      FV_REQUIRE(cap_.isOpened(), "video '{}' cannot be opened (not a video OpenCV can decode?)",
-                 spec);
+      FV_REQUIRE(OpenVideoFile(cap_, spec),
+                 "video '{}' cannot be opened (not a video OpenCV can decode?)", spec);
       frame_count_ = static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_COUNT));
       if (frame_count_ <= 0) frame_count_ = -1;
     }
@@ -151,6 +146,15 @@ class CaptureSource : public VideoSource {
 }  // namespace
 
 void VideoSourceOptions::Check() const { CheckPositive(fps, "VideoSourceOptions.fps"); }
+
+bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path) {
+  const int api = path.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG;
+  try {
+    return capture.open(path, api) && capture.isOpened();
+  } catch (const cv::Exception&) {
+    return false;
+  }
+}
 
 bool IsImageFile(const std::string& path) {
   const std::string ext = ToLower(fs::path(path).extension().string());

@@ -64,6 +64,10 @@ class VideoSource {
 
 // The image files an image-sequence spec names, in order (empty if it is not one).
 std::vector<std::string> ListImageSequence(const std::string& spec);
+// Opens a video file, or a printf image pattern (dir/%05d.jpg), with FFmpeg or OpenCV's image
+// reader, never GStreamer, whose failure on a file that is not a video prints pages of GLib
+// warnings. False when it cannot be opened.
+bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path);
 // Whether a path names an image file OpenCV reads, by its extension (case-insensitive).
 bool IsImageFile(const std::string& path);
 
