@@ -61,7 +61,7 @@ class SynthLiveSource : public FrameSource {
     }
     const double wait_s = capture_s - SystemClockNow();
     if (wait_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait_s));
-    out->frame = next_ - first_;
+    out->frame = start_s_ > 0 ? next_ : next_ - first_;  // from a given start: the scene's frame
     out->time_s = capture_s;
     out->origin = TimeOrigin::kPlayback;
     ++next_;

@@ -237,6 +237,9 @@ TEST(NodeFuse, RestartedNodeIsReadmittedAndNodesReconnectToARestartedFuse) {
   // Node 2: 10 frames, stopped, then 10 more as a new session.
   const NodeSummary a = RunNode(node_options(1, 10));
   const NodeSummary b = RunNode(node_options(1, 10));
+  // Node 2's last frames may still be on their way (its socket lingers up to 1 s): on a loaded
+  // machine the fusion node is stopped only once they have had time to arrive.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   fuse_control.Stop();
   fuse.join();
   // A new fusion node on the same address: node 0 (still running) reconnects to it; both stop
