@@ -12,15 +12,10 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::calib {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 int CalibFlags(const IntrinsicsOptions& o) {
   int flags = 0;
@@ -159,7 +154,7 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
     FV_REQUIRE(std::isfinite(rms), "calibration diverged on {} views", used.size());
     std::vector<double> errs(per_view.begin<double>(), per_view.end<double>());
     const double threshold =
-        std::max(options.outlier_factor * Median(errs), options.outlier_min_px);
+        std::max(options.outlier_factor * NearestRankPercentile(errs, 0.5), options.outlier_min_px);
     // Drop the worst view above the threshold, one at a time, while the budget allows.
     int worst = -1;
     for (size_t j = 0; j < errs.size(); ++j) {
@@ -175,8 +170,9 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
     }
     auto& rep = result.views[used[worst]];
     rep.rms_px = errs[worst];
-    rep.dropped_because = fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})",
-                                      errs[worst], threshold, options.outlier_factor, Median(errs));
+    rep.dropped_because =
+        fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})", errs[worst],
+                    threshold, options.outlier_factor, NearestRankPercentile(errs, 0.5));
     used.erase(used.begin() + worst);
   }
   result.num_used = static_cast<int>(used.size());

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::calib {
 namespace {
@@ -147,14 +148,6 @@ struct LinePixelCost {
   const LineDistanceMap* map_;
   const ceres::BiCubicInterpolator<ceres::Grid2D<float, 1>>* interp_;
 };
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const size_t k =
-      std::min(v.size() - 1, static_cast<size_t>(std::floor(q * (v.size() - 1) + 0.5)));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
-}
 
 }  // namespace
 
@@ -312,8 +305,8 @@ LineErrorStats LineError(const Camera& camera, const std::vector<Eigen::Vector2d
     double sum = 0;
     for (double v : mm) sum += v;
     s.mean_mm = sum / mm.size();
-    s.median_mm = Percentile(mm, 0.5);
-    s.p95_mm = Percentile(mm, 0.95);
+    s.median_mm = NearestRankPercentile(mm, 0.5);
+    s.p95_mm = NearestRankPercentile(mm, 0.95);
   }
   return s;
 }

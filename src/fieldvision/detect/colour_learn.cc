@@ -9,6 +9,7 @@
 
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv {
@@ -30,12 +31,6 @@ double Share(const ColourRange& r, const std::vector<Hsv8>& px) {
   size_t n = 0;
   for (const auto& p : px) n += Inside(r, p);
   return double(n) / px.size();
-}
-
-double Percentile(std::vector<int> v, double q) {
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(std::lround(q * (v.size() - 1))));
-  return v[i];
 }
 
 }  // namespace
@@ -139,7 +134,7 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
     }
     if (!ring[0].empty()) {
       cv::Vec3d bg;
-      for (int k = 0; k < 3; ++k) bg[k] = Percentile(ring[k], 0.5);
+      for (int k = 0; k < 3; ++k) bg[k] = NearestRankPercentile(ring[k], 0.5);
       for (int y = r.y; y < r.y + r.height; ++y) {
         for (int x = r.x; x < r.x + r.width; ++x) {
           if (!pos_mask.at<uint8_t>(y, x)) continue;
@@ -208,9 +203,9 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
     r.min[0] = std::fmod(h_lo + 360.0, 360.0);
     r.max[0] = std::fmod(h_hi + 360.0, 360.0);
   }
-  r.min[1] = std::max(0.0, Percentile(s, o.trim) - o.saturation_margin);
+  r.min[1] = std::max(0.0, NearestRankPercentile(s, o.trim) - o.saturation_margin);
   r.max[1] = 255;
-  r.min[2] = std::max(0.0, Percentile(v, o.trim) - o.value_margin);
+  r.min[2] = std::max(0.0, NearestRankPercentile(v, o.trim) - o.value_margin);
   r.max[2] = 255;
   // Shrink against the negatives: move one bound a step at a time.
   double recall = Share(r, pos), neg_rate = Share(r, neg);

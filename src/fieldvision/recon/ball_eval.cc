@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv {
 namespace {
@@ -31,16 +32,6 @@ std::map<long long, Entry> ReadTrack(const CsvTable& t) {
     FV_REQUIRE(out.emplace(frame, e).second, "{}: frame {} is listed twice", t.Where(r), frame);
   }
   return out;
-}
-
-double Percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  // Linear interpolation between closest ranks (numpy's default).
-  const double pos = q * (v.size() - 1);
-  const size_t lo = static_cast<size_t>(std::floor(pos));
-  const size_t hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
 }
 
 }  // namespace

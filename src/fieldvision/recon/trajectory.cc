@@ -11,6 +11,7 @@
 
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv {
 namespace {
@@ -124,13 +125,6 @@ GravityLine FitGravityLine(const std::vector<BallSample>& track, const std::vect
     L.sse += r.squaredNorm();
   }
   return L;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
 }
 
 // Indices of up to `want` and at least `min_n` samples from `list` next to position `pos`
@@ -336,7 +330,7 @@ double EstimateTrackNoise(const std::vector<BallSample>& track, double g) {
     for (int a = 0; a < 3; ++a) e.push_back(std::abs(d[a]) / w);
   }
   if (e.empty()) return 0.01;
-  return std::max(1e-3, 1.4826 * Median(e));
+  return std::max(1e-3, kMadToSigma * NearestRankPercentile(e, 0.5));
 }
 
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
@@ -451,7 +445,7 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
   }
   for (double x : r) ss += x * x;
   fit.rmse_m = std::sqrt(ss / n);
-  const double robust_sigma = 1.4826 * Median(r) / std::sqrt(3.0);
+  const double robust_sigma = kMadToSigma * NearestRankPercentile(r, 0.5) / std::sqrt(3.0);
   const double thr =
       std::max(options.outlier_sigmas * std::max(noise_m, robust_sigma), options.min_outlier_m);
   for (int i = 0; i < n; ++i) {
@@ -671,18 +665,16 @@ struct Segmenter {
         if (!out[i]) good.push_back(i);
       }
       std::vector<bool> next(n, false);
+      const int m = static_cast<int>(good.size());
       for (int i = 0; i < n; ++i) {
-        // Neighbours among the currently good samples, excluding i itself.
-        std::vector<int> list;
-        int pos = 0;  // position of i in list (the first of the right side)
-        for (int j : good) {
-          if (j == i) continue;
-          if (j < i) ++pos;
-          list.push_back(j);
-        }
-        const int m = static_cast<int>(list.size());
-        const auto left = Window(list, track, pos - 1, -1, 0, m, o.window_s, o.window_samples);
-        const auto right = Window(list, track, pos, +1, 0, m, o.window_s, o.window_samples);
+        // Neighbours among the currently good samples, excluding i itself: the windows walk
+        // `good` away from i (positions below lo_pos on the left, from hi_pos on the right).
+        const int lo_pos =
+            static_cast<int>(std::lower_bound(good.begin(), good.end(), i) - good.begin());
+        const int hi_pos =
+            static_cast<int>(std::upper_bound(good.begin(), good.end(), i) - good.begin());
+        const auto left = Window(good, track, lo_pos - 1, -1, 0, m, o.window_s, o.window_samples);
+        const auto right = Window(good, track, hi_pos, +1, 0, m, o.window_s, o.window_samples);
         int fits = 0, misses = 0;
         auto misses_line = [&](const GravityLine& L, int k) {
           const double err = (L.At(track[k].time_s, g) - track[k].ball_in_world).norm();
@@ -712,7 +704,7 @@ struct Segmenter {
           // start of a new arc. An outlier only when the next sample on the other side returns
           // to the arc (an isolated jump); without such a sample nothing says which.
           const int other =
-              missed_left ? (pos < m ? list[pos] : -1) : (pos > 0 ? list[pos - 1] : -1);
+              missed_left ? (hi_pos < m ? good[hi_pos] : -1) : (lo_pos > 0 ? good[lo_pos - 1] : -1);
           next[i] = other >= 0 && !misses_line(*missed, other);
         }
       }

@@ -21,6 +21,19 @@ double Percentile(std::vector<double> values, double q) {
 
 double Median(std::vector<double> values) { return Percentile(std::move(values), 0.5); }
 
+double NearestRankPercentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  q = std::clamp(q, 0.0, 1.0);
+  const size_t k =
+      std::min(values.size() - 1, static_cast<size_t>(std::floor(q * (values.size() - 1) + 0.5)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+double NearestRankPercentile(const std::vector<int>& values, double q) {
+  return NearestRankPercentile(std::vector<double>(values.begin(), values.end()), q);
+}
+
 double Mean(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   double s = 0.0;
@@ -41,7 +54,7 @@ double RobustSigma(const std::vector<double>& values) {
   std::vector<double> dev;
   dev.reserve(values.size());
   for (double v : values) dev.push_back(std::abs(v - m));
-  return 1.4826 * Median(std::move(dev));
+  return kMadToSigma * Median(std::move(dev));
 }
 
 }  // namespace fv

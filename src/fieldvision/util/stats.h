@@ -1,6 +1,6 @@
 // Summary statistics used across modules (error tables, robust thresholds): percentiles with
-// linear interpolation between closest ranks (numpy's default), median, mean, RMS and the
-// median absolute deviation scaled to a normal sigma (Hampel 1974).
+// linear interpolation between closest ranks (numpy's default) or the nearest rank, median, mean,
+// RMS and the median absolute deviation scaled to a normal sigma (Hampel 1974).
 #pragma once
 
 #include <vector>
@@ -10,8 +10,14 @@ namespace fv {
 // q in [0, 1]; 0 for an empty sample. Non-finite values must be removed by the caller.
 double Percentile(std::vector<double> values, double q);
 double Median(std::vector<double> values);
+// The sample at rank round(q (n - 1)) (no interpolation: always one of the values); for q = 0.5
+// and an even n the upper of the two middle values. 0 for an empty sample.
+double NearestRankPercentile(std::vector<double> values, double q);
+double NearestRankPercentile(const std::vector<int>& values, double q);
 double Mean(const std::vector<double>& values);
 double Rms(const std::vector<double>& values);
+// Ratio of a normal distribution's sigma to its median absolute deviation.
+inline constexpr double kMadToSigma = 1.4826;
 // 1.4826 * median |x - median|: a normal sigma that ignores up to half the sample as outliers.
 double RobustSigma(const std::vector<double>& values);
 

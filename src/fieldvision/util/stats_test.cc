@@ -19,6 +19,21 @@ TEST(Stats, PercentileInterpolatesLikeNumpy) {
   EXPECT_DOUBLE_EQ(Median({1, 2, 3, 10}), 2.5);
 }
 
+TEST(Stats, NearestRankPercentileIsASample) {
+  const std::vector<double> v = {4, 1, 3, 2, 5, 6};
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.5), 4.0);  // upper middle for an even n
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(std::vector<double>{4, 1, 3, 2, 5}, 0.5), 3.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 1.0), 6.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.95), 6.0);  // rank 4.75 -> 5
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(std::vector<double>{4, 1, 3, 2, 5}, 0.125),
+                   2.0);  // rank 0.5 -> 1
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(std::vector<double>{4, 1, 3, 2, 5}, 0.375),
+                   3.0);  // rank 1.5 -> 2
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(std::vector<int>{7, 9, 8}, 0.5), 8.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(std::vector<double>{}, 0.5), 0.0);
+}
+
 TEST(Stats, MeanRmsRobustSigma) {
   EXPECT_DOUBLE_EQ(Mean({1, 2, 3}), 2.0);
   EXPECT_DOUBLE_EQ(Rms({3, 4}), std::sqrt(12.5));
