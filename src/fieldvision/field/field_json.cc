@@ -4,51 +4,22 @@
 #include <fstream>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 
 namespace fv {
 namespace {
 
 using nlohmann::json;
 
-json Vec(const Eigen::VectorXd& v) {
-  json a = json::array();
-  for (int i = 0; i < v.size(); ++i) a.push_back(v[i]);
-  return a;
-}
-
-template <int N>
-Eigen::Matrix<double, N, 1> ReadVec(const json& j, const std::string& ctx) {
-  FV_REQUIRE(j.is_array() && j.size() == N, "{}: expected an array of {} numbers", ctx, N);
-  Eigen::Matrix<double, N, 1> v;
-  for (int i = 0; i < N; ++i) {
-    FV_REQUIRE(j[i].is_number(), "{}: element {} is not a number", ctx, i);
-    v[i] = j[i].get<double>();
-  }
-  return v;
-}
-
+// A number under `key`; without it `fallback`, or an error when `required`.
 double Num(const json& obj, const char* key, const std::string& ctx, double fallback = NAN,
            bool required = true) {
-  if (!obj.contains(key)) {
-    FV_REQUIRE(!required, "{}: missing key '{}'", ctx, key);
-    return fallback;
-  }
-  FV_REQUIRE(obj[key].is_number(), "{}: key '{}' must be a number", ctx, key);
-  return obj[key].get<double>();
+  return required ? JsonNumber(obj, key, ctx) : JsonNumber(obj, key, ctx, fallback);
 }
 
 std::string Str(const json& obj, const char* key, const std::string& ctx,
                 const std::string& fallback = "") {
-  if (!obj.contains(key)) return fallback;
-  FV_REQUIRE(obj[key].is_string(), "{}: key '{}' must be a string", ctx, key);
-  return obj[key].get<std::string>();
-}
-
-const json& Array(const json& obj, const char* key, const std::string& ctx) {
-  static const json kEmpty = json::array();
-  if (!obj.contains(key)) return kEmpty;
-  FV_REQUIRE(obj[key].is_array(), "{}: key '{}' must be an array", ctx, key);
-  return obj[key];
+  return JsonString(obj, key, ctx, fallback);
 }
 
 }  // namespace
@@ -64,13 +35,15 @@ json FieldToJson(const FieldModel& f) {
   j["surface"] = f.surface;
   j["segments"] = json::array();
   for (const auto& s : f.segments) {
-    j["segments"].push_back(
-        {{"name", s.name}, {"a", Vec(s.a)}, {"b", Vec(s.b)}, {"width_m", s.width_m}});
+    j["segments"].push_back({{"name", s.name},
+                             {"a", JsonFromVector(s.a)},
+                             {"b", JsonFromVector(s.b)},
+                             {"width_m", s.width_m}});
   }
   j["arcs"] = json::array();
   for (const auto& a : f.arcs) {
     j["arcs"].push_back({{"name", a.name},
-                         {"centre", Vec(a.centre)},
+                         {"centre", JsonFromVector(a.centre)},
                          {"radius_m", a.radius_m},
                          {"start_rad", a.start_rad},
                          {"end_rad", a.end_rad},
@@ -78,7 +51,7 @@ json FieldToJson(const FieldModel& f) {
   }
   j["keypoints"] = json::array();
   for (const auto& k : f.keypoints) {
-    j["keypoints"].push_back({{"name", k.name}, {"position_m", Vec(k.position_m)}});
+    j["keypoints"].push_back({{"name", k.name}, {"position_m", JsonFromVector(k.position_m)}});
   }
   j["goals"] = json::array();
   for (const auto& g : f.goals) {
@@ -94,7 +67,7 @@ json FieldToJson(const FieldModel& f) {
   j["hoops"] = json::array();
   for (const auto& h : f.hoops) {
     j["hoops"].push_back(
-        {{"name", h.name}, {"centre_m", Vec(h.centre_m)}, {"radius_m", h.radius_m}});
+        {{"name", h.name}, {"centre_m", JsonFromVector(h.centre_m)}, {"radius_m", h.radius_m}});
   }
   return j;
 }
@@ -109,31 +82,28 @@ FieldModel FieldFromJson(const json& j, const std::string& ctx) {
   f.line_width_m = Num(j, "line_width_m", ctx, 0.1, false);
   f.surround_m = Num(j, "surround_m", ctx, 2.0, false);
   f.surface = Str(j, "surface", ctx, "grass");
-  for (size_t i = 0; i < Array(j, "segments", ctx).size(); ++i) {
+  for (size_t i = 0; i < JsonArray(j, "segments", ctx).size(); ++i) {
     const json& s = j["segments"][i];
     const std::string c = fmt::format("{}: segments[{}]", ctx, i);
     FV_REQUIRE(s.is_object(), "{}: must be an object", c);
-    f.segments.push_back({Str(s, "name", c), ReadVec<2>(s.value("a", json()), c + ".a"),
-                          ReadVec<2>(s.value("b", json()), c + ".b"),
+    f.segments.push_back({Str(s, "name", c), JsonVector<2>(s, "a", c), JsonVector<2>(s, "b", c),
                           Num(s, "width_m", c, f.line_width_m, false)});
   }
-  for (size_t i = 0; i < Array(j, "arcs", ctx).size(); ++i) {
+  for (size_t i = 0; i < JsonArray(j, "arcs", ctx).size(); ++i) {
     const json& a = j["arcs"][i];
     const std::string c = fmt::format("{}: arcs[{}]", ctx, i);
     FV_REQUIRE(a.is_object(), "{}: must be an object", c);
-    f.arcs.push_back({Str(a, "name", c), ReadVec<2>(a.value("centre", json()), c + ".centre"),
-                      Num(a, "radius_m", c), Num(a, "start_rad", c, 0.0, false),
-                      Num(a, "end_rad", c, 2 * M_PI, false),
+    f.arcs.push_back({Str(a, "name", c), JsonVector<2>(a, "centre", c), Num(a, "radius_m", c),
+                      Num(a, "start_rad", c, 0.0, false), Num(a, "end_rad", c, 2 * M_PI, false),
                       Num(a, "width_m", c, f.line_width_m, false)});
   }
-  for (size_t i = 0; i < Array(j, "keypoints", ctx).size(); ++i) {
+  for (size_t i = 0; i < JsonArray(j, "keypoints", ctx).size(); ++i) {
     const json& k = j["keypoints"][i];
     const std::string c = fmt::format("{}: keypoints[{}]", ctx, i);
     FV_REQUIRE(k.is_object(), "{}: must be an object", c);
-    f.keypoints.push_back(
-        {Str(k, "name", c), ReadVec<3>(k.value("position_m", json()), c + ".position_m")});
+    f.keypoints.push_back({Str(k, "name", c), JsonVector<3>(k, "position_m", c)});
   }
-  for (size_t i = 0; i < Array(j, "goals", ctx).size(); ++i) {
+  for (size_t i = 0; i < JsonArray(j, "goals", ctx).size(); ++i) {
     const json& g = j["goals"][i];
     const std::string c = fmt::format("{}: goals[{}]", ctx, i);
     FieldGoal goal;
@@ -147,11 +117,11 @@ FieldModel FieldFromJson(const json& j, const std::string& ctx) {
     goal.depth_m = Num(g, "depth_m", c, 0.5, false);
     f.goals.push_back(goal);
   }
-  for (size_t i = 0; i < Array(j, "hoops", ctx).size(); ++i) {
+  for (size_t i = 0; i < JsonArray(j, "hoops", ctx).size(); ++i) {
     const json& h = j["hoops"][i];
     const std::string c = fmt::format("{}: hoops[{}]", ctx, i);
-    f.hoops.push_back({Str(h, "name", c), ReadVec<3>(h.value("centre_m", json()), c + ".centre_m"),
-                       Num(h, "radius_m", c, 0.225, false)});
+    f.hoops.push_back(
+        {Str(h, "name", c), JsonVector<3>(h, "centre_m", c), Num(h, "radius_m", c, 0.225, false)});
   }
   try {
     f.Check();

@@ -7,6 +7,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 
 namespace fv {
 namespace {
@@ -22,39 +23,10 @@ const std::set<std::string> kCameraKeys = {"name",         "position", "look_at"
                                            "image_height", "hfov_deg", "focal_px", "fx",
                                            "fy",           "cx",       "cy",       "distortion"};
 
-double Number(const json& obj, const std::string& key, const std::string& ctx) {
-  FV_REQUIRE(obj.contains(key), "{}: missing key '{}'", ctx, key);
-  FV_REQUIRE(obj[key].is_number(), "{}: key '{}' must be a number", ctx, key);
-  const double v = obj[key].get<double>();
-  FV_REQUIRE(std::isfinite(v), "{}: key '{}' is not finite", ctx, key);
-  return v;
-}
-
 int PositiveInt(const json& obj, const std::string& key, const std::string& ctx) {
-  FV_REQUIRE(obj.contains(key), "{}: missing key '{}'", ctx, key);
-  FV_REQUIRE(obj[key].is_number_integer(), "{}: key '{}' must be an integer", ctx, key);
-  const long long v = obj[key].get<long long>();
+  const int v = JsonInt(obj, key, ctx);
   FV_REQUIRE(v > 0 && v < 1000000, "{}: key '{}' must be a positive size (got {})", ctx, key, v);
-  return static_cast<int>(v);
-}
-
-std::vector<double> Numbers(const json& obj, const std::string& key, const std::string& ctx) {
-  const json& a = obj[key];
-  FV_REQUIRE(a.is_array(), "{}: key '{}' must be an array of numbers", ctx, key);
-  std::vector<double> v;
-  for (size_t i = 0; i < a.size(); ++i) {
-    FV_REQUIRE(a[i].is_number(), "{}: key '{}' element {} is not a number", ctx, key, i);
-    v.push_back(a[i].get<double>());
-    FV_REQUIRE(std::isfinite(v.back()), "{}: key '{}' element {} is not finite", ctx, key, i);
-  }
   return v;
-}
-
-Eigen::Vector3d Vector3(const json& obj, const std::string& key, const std::string& ctx) {
-  FV_REQUIRE(obj.contains(key), "{}: missing key '{}'", ctx, key);
-  const std::vector<double> v = Numbers(obj, key, ctx);
-  FV_REQUIRE(v.size() == 3, "{}: key '{}' must have 3 numbers (got {})", ctx, key, v.size());
-  return {v[0], v[1], v[2]};
 }
 
 // Camera keys: `defaults` filled in where the camera lacks them; a camera's own orientation or
@@ -91,29 +63,26 @@ Camera CameraFromJson(const json& j, const std::string& ctx) {
   for (const auto& k : {"hfov_deg", "focal_px", "fx"}) num_focal += j.contains(k) ? 1 : 0;
   FV_REQUIRE(num_focal == 1, "{}: give exactly one of 'hfov_deg', 'focal_px' or 'fx' + 'fy'", ctx);
   if (j.contains("hfov_deg")) {
-    const double hfov = Number(j, "hfov_deg", ctx);
+    const double hfov = JsonNumber(j, "hfov_deg", ctx);
     FV_REQUIRE(hfov > 0 && hfov < 180, "{}: key 'hfov_deg' must be in (0, 180) (got {})", ctx,
                hfov);
     cam = Camera::FromFov(width, height, hfov);
   } else {
     cam = Camera::FromFov(width, height, 90.0);
     if (j.contains("focal_px")) {
-      cam.fx = cam.fy = Number(j, "focal_px", ctx);
+      cam.fx = cam.fy = JsonNumber(j, "focal_px", ctx);
     } else {
-      cam.fx = Number(j, "fx", ctx);
-      cam.fy = Number(j, "fy", ctx);
+      cam.fx = JsonNumber(j, "fx", ctx);
+      cam.fy = JsonNumber(j, "fy", ctx);
     }
     FV_REQUIRE(cam.fx > 0 && cam.fy > 0, "{}: focal length must be > 0", ctx);
   }
-  if (j.contains("cx")) cam.cx = Number(j, "cx", ctx);
-  if (j.contains("cy")) cam.cy = Number(j, "cy", ctx);
-  if (j.contains("distortion")) cam.distortion = Numbers(j, "distortion", ctx);
-  if (j.contains("name")) {
-    FV_REQUIRE(j["name"].is_string(), "{}: key 'name' must be a string", ctx);
-    cam.name = j["name"].get<std::string>();
-  }
-  const Eigen::Vector3d eye = Vector3(j, "position", ctx);
-  const double roll_deg = j.contains("roll_deg") ? Number(j, "roll_deg", ctx) : 0.0;
+  if (j.contains("cx")) cam.cx = JsonNumber(j, "cx", ctx);
+  if (j.contains("cy")) cam.cy = JsonNumber(j, "cy", ctx);
+  if (j.contains("distortion")) cam.distortion = JsonNumbers(j, "distortion", ctx);
+  cam.name = JsonString(j, "name", ctx, cam.name);
+  const Eigen::Vector3d eye = JsonVector<3>(j, "position", ctx);
+  const double roll_deg = j.contains("roll_deg") ? JsonNumber(j, "roll_deg", ctx) : 0.0;
   int num_orient = 0;
   for (const auto& k : {"look_at", "yaw_deg", "rvec"}) num_orient += j.contains(k) ? 1 : 0;
   FV_REQUIRE(num_orient == 1,
@@ -121,17 +90,17 @@ Camera CameraFromJson(const json& j, const std::string& ctx) {
   Eigen::Vector3d target;
   if (j.contains("rvec")) {
     FV_REQUIRE(!j.contains("roll_deg"), "{}: 'roll_deg' cannot be combined with 'rvec'", ctx);
-    const Eigen::Vector3d rvec = Vector3(j, "rvec", ctx);
+    const Eigen::Vector3d rvec = JsonVector<3>(j, "rvec", ctx);
     const Eigen::Matrix3d rot = RotationFromRvec(rvec);
     cam.cam_from_world = Rigid3d{rot, -rot * eye};
     cam.has_pose = true;
   } else {
     if (j.contains("look_at")) {
-      target = Vector3(j, "look_at", ctx);
+      target = JsonVector<3>(j, "look_at", ctx);
       FV_REQUIRE((target - eye).norm() > 1e-6, "{}: 'look_at' equals 'position'", ctx);
     } else {
-      const double yaw = Number(j, "yaw_deg", ctx) * kDeg;
-      const double pitch = Number(j, "pitch_deg", ctx) * kDeg;
+      const double yaw = JsonNumber(j, "yaw_deg", ctx) * kDeg;
+      const double pitch = JsonNumber(j, "pitch_deg", ctx) * kDeg;
       target = eye + Eigen::Vector3d(std::cos(pitch) * std::cos(yaw),
                                      std::cos(pitch) * std::sin(yaw), -std::sin(pitch));
     }
@@ -142,8 +111,6 @@ Camera CameraFromJson(const json& j, const std::string& ctx) {
   cam.Check(ctx);
   return cam;
 }
-
-json Vec3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 
 }  // namespace
 
@@ -185,10 +152,7 @@ Rig RigFromJson(const json& j, const std::string& context, const std::string& ba
                context, it.key());
   }
   Rig rig;
-  if (j.contains("name")) {
-    FV_REQUIRE(j["name"].is_string(), "{}: key 'name' must be a string", context);
-    rig.name = j["name"].get<std::string>();
-  }
+  rig.name = JsonString(j, "name", context, rig.name);
   json defaults = json::object();
   if (j.contains("defaults")) {
     FV_REQUIRE(j["defaults"].is_object(), "{}: key 'defaults' must be an object", context);
@@ -249,15 +213,15 @@ json RigToJson(const Rig& rig) {
     json cj;
     cj["name"] = c.name;
     const Eigen::Vector3d eye = c.CentreInWorld();
-    cj["position"] = Vec3(eye);
+    cj["position"] = JsonFromVector(eye);
     const Eigen::Vector3d axis = c.cam_from_world.rotation.row(2).transpose();
     const Rigid3d look = Rigid3d::LookAt(eye, eye + axis);
     if (RotationAngleBetween(look.rotation, c.cam_from_world.rotation) < 1e-9) {
       Eigen::Vector3d target = eye + 10.0 * axis;
       if (axis.z() < -1e-6) target = eye + (-eye.z() / axis.z()) * axis;  // aim point on z = 0
-      cj["look_at"] = Vec3(target);
+      cj["look_at"] = JsonFromVector(target);
     } else {
-      cj["rvec"] = Vec3(c.cam_from_world.Rvec());
+      cj["rvec"] = JsonFromVector(c.cam_from_world.Rvec());
     }
     cj["image_width"] = c.width;
     cj["image_height"] = c.height;

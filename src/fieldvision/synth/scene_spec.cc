@@ -7,6 +7,7 @@
 
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/random.h"
 
 namespace fv::synth {
@@ -14,106 +15,10 @@ namespace {
 
 using nlohmann::json;
 
-// ---- JSON helpers: every error names the key path.
-
-std::string Key(const std::string& ctx, const std::string& key) {
-  return ctx.empty() ? key : ctx + "." + key;
-}
-
-bool Has(const json& o, const char* key) { return o.is_object() && o.contains(key); }
-
-double Num(const json& o, const char* key, const std::string& ctx, double fallback) {
-  if (!Has(o, key)) return fallback;
-  FV_REQUIRE(o[key].is_number(), "{}: must be a number", Key(ctx, key));
-  const double v = o[key].get<double>();
-  FV_REQUIRE(std::isfinite(v), "{}: must be finite", Key(ctx, key));
-  return v;
-}
-
-int Int(const json& o, const char* key, const std::string& ctx, int fallback) {
-  if (!Has(o, key)) return fallback;
-  FV_REQUIRE(o[key].is_number_integer(), "{}: must be an integer", Key(ctx, key));
-  return o[key].get<int>();
-}
-
-bool Bool(const json& o, const char* key, const std::string& ctx, bool fallback) {
-  if (!Has(o, key)) return fallback;
-  FV_REQUIRE(o[key].is_boolean(), "{}: must be true or false", Key(ctx, key));
-  return o[key].get<bool>();
-}
-
-std::string Str(const json& o, const char* key, const std::string& ctx,
-                const std::string& fallback) {
-  if (!Has(o, key)) return fallback;
-  FV_REQUIRE(o[key].is_string(), "{}: must be a string", Key(ctx, key));
-  return o[key].get<std::string>();
-}
-
-template <int N>
-Eigen::Matrix<double, N, 1> VecOf(const json& a, const std::string& ctx) {
-  FV_REQUIRE(a.is_array() && a.size() == N, "{}: must be an array of {} numbers", ctx, N);
-  Eigen::Matrix<double, N, 1> v;
-  for (int i = 0; i < N; ++i) {
-    FV_REQUIRE(a[i].is_number(), "{}[{}]: must be a number", ctx, i);
-    v[i] = a[i].get<double>();
-    FV_REQUIRE(std::isfinite(v[i]), "{}[{}]: must be finite", ctx, i);
-  }
-  return v;
-}
-
-template <int N>
-Eigen::Matrix<double, N, 1> Vec(const json& o, const char* key, const std::string& ctx,
-                                const Eigen::Matrix<double, N, 1>& fallback) {
-  if (!Has(o, key)) return fallback;
-  return VecOf<N>(o[key], Key(ctx, key));
-}
-
-std::vector<double> Doubles(const json& o, const char* key, const std::string& ctx) {
-  std::vector<double> out;
-  if (!Has(o, key)) return out;
-  const std::string k = Key(ctx, key);
-  FV_REQUIRE(o[key].is_array(), "{}: must be an array of numbers", k);
-  for (size_t i = 0; i < o[key].size(); ++i) {
-    FV_REQUIRE(o[key][i].is_number(), "{}[{}]: must be a number", k, i);
-    out.push_back(o[key][i].get<double>());
-  }
-  return out;
-}
-
-const json& Arr(const json& o, const char* key, const std::string& ctx) {
-  static const json kEmpty = json::array();
-  if (!Has(o, key)) return kEmpty;
-  FV_REQUIRE(o[key].is_array(), "{}: must be an array", Key(ctx, key));
-  return o[key];
-}
-
-const json& Obj(const json& o, const char* key, const std::string& ctx) {
-  static const json kEmpty = json::object();
-  if (!Has(o, key)) return kEmpty;
-  FV_REQUIRE(o[key].is_object(), "{}: must be an object", Key(ctx, key));
-  return o[key];
-}
-
-// Rejects keys we do not know, so typos do not pass silently.
-void Known(const json& o, const std::string& ctx, std::initializer_list<const char*> keys) {
-  FV_REQUIRE(o.is_object(), "{}: must be an object", ctx.empty() ? "scene" : ctx);
-  std::set<std::string> known(keys.begin(), keys.end());
-  for (auto it = o.begin(); it != o.end(); ++it) {
-    FV_REQUIRE(known.count(it.key()) > 0, "{}: unknown key (known: {})", Key(ctx, it.key()),
-               fmt::join(keys, ", "));
-  }
-}
-
-json J(const Eigen::VectorXd& v) {
-  json a = json::array();
-  for (int i = 0; i < v.size(); ++i) a.push_back(v[i]);
-  return a;
-}
-
 json PathToJson(const PathSpec& p) {
   json j;
   j["waypoints_m"] = json::array();
-  for (const auto& w : p.waypoints_m) j["waypoints_m"].push_back(J(w));
+  for (const auto& w : p.waypoints_m) j["waypoints_m"].push_back(JsonFromVector(w));
   j["speed_mps"] = p.speed_mps;
   if (!p.speeds_mps.empty()) j["speeds_mps"] = p.speeds_mps;
   j["start_s"] = p.start_s;
@@ -121,15 +26,15 @@ json PathToJson(const PathSpec& p) {
 }
 
 PathSpec PathFromJson(const json& o, const std::string& ctx) {
-  Known(o, ctx, {"waypoints_m", "speed_mps", "speeds_mps", "start_s"});
+  JsonKnownKeys(o, ctx, {"waypoints_m", "speed_mps", "speeds_mps", "start_s"});
   PathSpec p;
-  const json& w = Arr(o, "waypoints_m", ctx);
+  const json& w = JsonArray(o, "waypoints_m", ctx);
   for (size_t i = 0; i < w.size(); ++i) {
-    p.waypoints_m.push_back(VecOf<2>(w[i], fmt::format("{}.waypoints_m[{}]", ctx, i)));
+    p.waypoints_m.push_back(JsonVectorOf<2>(w[i], fmt::format("{}.waypoints_m[{}]", ctx, i)));
   }
-  p.speed_mps = Num(o, "speed_mps", ctx, p.speed_mps);
-  p.speeds_mps = Doubles(o, "speeds_mps", ctx);
-  p.start_s = Num(o, "start_s", ctx, p.start_s);
+  p.speed_mps = JsonNumber(o, "speed_mps", ctx, p.speed_mps);
+  p.speeds_mps = JsonNumbers(o, "speeds_mps", ctx, false);
+  p.start_s = JsonNumber(o, "start_s", ctx, p.start_s);
   return p;
 }
 
@@ -450,26 +355,26 @@ json SceneSpecToJson(const SceneSpec& s) {
     }
     cj["distortion"] = c.distortion;
     if (c.has_rvec_tvec) {
-      cj["rvec"] = J(c.rvec);
-      cj["tvec"] = J(c.tvec);
+      cj["rvec"] = JsonFromVector(c.rvec);
+      cj["tvec"] = JsonFromVector(c.tvec);
     } else {
-      cj["position_m"] = J(c.position_m);
-      cj["look_at_m"] = J(c.look_at_m);
+      cj["position_m"] = JsonFromVector(c.position_m);
+      cj["look_at_m"] = JsonFromVector(c.look_at_m);
     }
     j["cameras"].push_back(cj);
   }
   json b;
   b["enabled"] = s.ball.enabled;
   b["diameter_m"] = s.ball.diameter_m;
-  b["colour_bgr"] = J(s.ball.colour_bgr);
+  b["colour_bgr"] = JsonFromVector(s.ball.colour_bgr);
   b["placements"] = json::array();
-  for (const auto& p : s.ball.placements) b["placements"].push_back(J(p));
+  for (const auto& p : s.ball.placements) b["placements"].push_back(JsonFromVector(p));
   b["hold_frames"] = s.ball.hold_frames;
   b["kicks"] = json::array();
   for (const auto& k : s.ball.kicks) {
     b["kicks"].push_back({{"time_s", k.time_s},
-                          {"position_m", J(k.position_m)},
-                          {"velocity_mps", J(k.velocity_mps)}});
+                          {"position_m", JsonFromVector(k.position_m)},
+                          {"velocity_mps", JsonFromVector(k.velocity_mps)}});
   }
   const BallPhysics& p = s.ball.physics;
   b["physics"] = {{"gravity_mps2", p.gravity_mps2},
@@ -487,7 +392,7 @@ json SceneSpecToJson(const SceneSpec& s) {
     j["robots"].push_back({{"path", PathToJson(r.path)},
                            {"radius_m", r.radius_m},
                            {"height_m", r.height_m},
-                           {"colour_bgr", J(r.colour_bgr)}});
+                           {"colour_bgr", JsonFromVector(r.colour_bgr)}});
   }
   j["people"] = json::array();
   for (const auto& p : s.people) {
@@ -495,21 +400,22 @@ json SceneSpecToJson(const SceneSpec& s) {
                            {"team", p.team},
                            {"path", PathToJson(p.path)},
                            {"height_m", p.height_m},
-                           {"skin_bgr", J(p.skin_bgr)}});
+                           {"skin_bgr", JsonFromVector(p.skin_bgr)}});
   }
   j["teams"] = json::array();
   for (const auto& t : s.teams) {
-    j["teams"].push_back(
-        {{"name", t.name}, {"shirt_bgr", J(t.shirt_bgr)}, {"shorts_bgr", J(t.shorts_bgr)}});
+    j["teams"].push_back({{"name", t.name},
+                          {"shirt_bgr", JsonFromVector(t.shirt_bgr)},
+                          {"shorts_bgr", JsonFromVector(t.shorts_bgr)}});
   }
   j["cones"] = json::array();
   for (const auto& c : s.cones) {
-    j["cones"].push_back({{"position_m", J(c.position_m)},
+    j["cones"].push_back({{"position_m", JsonFromVector(c.position_m)},
                           {"height_m", c.height_m},
                           {"base_radius_m", c.base_radius_m},
-                          {"colour_bgr", J(c.colour_bgr)}});
+                          {"colour_bgr", JsonFromVector(c.colour_bgr)}});
   }
-  j["lighting"] = {{"light_dir", J(s.lighting.light_dir)},
+  j["lighting"] = {{"light_dir", JsonFromVector(s.lighting.light_dir)},
                    {"gain_amplitude", s.lighting.gain_amplitude},
                    {"period_s", s.lighting.period_s},
                    {"vignetting", s.lighting.vignetting},
@@ -522,166 +428,170 @@ json SceneSpecToJson(const SceneSpec& s) {
 
 SceneSpec SceneSpecFromJson(const json& j, const std::string& context) {
   try {
-    Known(j, "",
-          {"field", "fps", "num_frames", "duration_s", "seed", "exposure_s", "cameras", "ball",
-           "robots", "people", "teams", "cones", "lighting", "noise_sigma", "jpeg_quality",
-           "format"});
+    JsonKnownKeys(j, "",
+                  {"field", "fps", "num_frames", "duration_s", "seed", "exposure_s", "cameras",
+                   "ball", "robots", "people", "teams", "cones", "lighting", "noise_sigma",
+                   "jpeg_quality", "format"});
     SceneSpec s;
-    s.field = Str(j, "field", "", s.field);
-    s.fps = Num(j, "fps", "", s.fps);
+    s.field = JsonString(j, "field", "", s.field);
+    s.fps = JsonNumber(j, "fps", "", s.fps);
     FV_REQUIRE(s.fps > 0, "fps: must be > 0");
-    if (Has(j, "num_frames")) {
-      s.num_frames = Int(j, "num_frames", "", s.num_frames);
-    } else if (Has(j, "duration_s")) {
-      const double d = Num(j, "duration_s", "", 1.0);
+    if (JsonHas(j, "num_frames")) {
+      s.num_frames = JsonInt(j, "num_frames", "", s.num_frames);
+    } else if (JsonHas(j, "duration_s")) {
+      const double d = JsonNumber(j, "duration_s", "", 1.0);
       FV_REQUIRE(d > 0 && d < 1e5, "duration_s: must be in (0, 1e5)");
       s.num_frames = std::max(1, static_cast<int>(std::lround(d * s.fps)));
     }
-    if (Has(j, "seed")) {
+    if (JsonHas(j, "seed")) {
       FV_REQUIRE(j["seed"].is_number_unsigned() || j["seed"].is_number_integer(),
                  "seed: must be a non-negative integer");
       FV_REQUIRE(!j["seed"].is_number_integer() || j["seed"].get<int64_t>() >= 0,
                  "seed: must be a non-negative integer");
       s.seed = j["seed"].get<uint64_t>();
     }
-    s.exposure_s = Num(j, "exposure_s", "", s.exposure_s);
-    const json& cams = Arr(j, "cameras", "");
+    s.exposure_s = JsonNumber(j, "exposure_s", "", s.exposure_s);
+    const json& cams = JsonArray(j, "cameras", "");
     s.cameras.clear();
     for (size_t i = 0; i < cams.size(); ++i) {
       const std::string ctx = fmt::format("cameras[{}]", i);
       const json& c = cams[i];
-      Known(c, ctx,
-            {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion", "position_m",
-             "look_at_m", "rvec", "tvec"});
+      JsonKnownKeys(c, ctx,
+                    {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion", "position_m",
+                     "look_at_m", "rvec", "tvec"});
       CameraSpec cs;
-      cs.name = Str(c, "name", ctx, fmt::format("cam{}", i + 1));
-      cs.width = Int(c, "width", ctx, cs.width);
-      cs.height = Int(c, "height", ctx, cs.height);
-      cs.hfov_deg = Num(c, "hfov_deg", ctx, cs.hfov_deg);
-      cs.fx = Num(c, "fx", ctx, 0.0);
-      cs.fy = Num(c, "fy", ctx, cs.fx);
-      cs.distortion = Doubles(c, "distortion", ctx);
-      if (Has(c, "rvec") || Has(c, "tvec")) {
-        FV_REQUIRE(Has(c, "rvec") && Has(c, "tvec"), "{}: give both rvec and tvec", ctx);
+      cs.name = JsonString(c, "name", ctx, fmt::format("cam{}", i + 1));
+      cs.width = JsonInt(c, "width", ctx, cs.width);
+      cs.height = JsonInt(c, "height", ctx, cs.height);
+      cs.hfov_deg = JsonNumber(c, "hfov_deg", ctx, cs.hfov_deg);
+      cs.fx = JsonNumber(c, "fx", ctx, 0.0);
+      cs.fy = JsonNumber(c, "fy", ctx, cs.fx);
+      cs.distortion = JsonNumbers(c, "distortion", ctx, false);
+      if (JsonHas(c, "rvec") || JsonHas(c, "tvec")) {
+        FV_REQUIRE(JsonHas(c, "rvec") && JsonHas(c, "tvec"), "{}: give both rvec and tvec", ctx);
         cs.has_rvec_tvec = true;
-        cs.rvec = Vec<3>(c, "rvec", ctx, cs.rvec);
-        cs.tvec = Vec<3>(c, "tvec", ctx, cs.tvec);
+        cs.rvec = JsonVector<3>(c, "rvec", ctx, cs.rvec);
+        cs.tvec = JsonVector<3>(c, "tvec", ctx, cs.tvec);
       } else {
-        FV_REQUIRE(Has(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)", ctx);
-        FV_REQUIRE(Has(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
-        cs.position_m = Vec<3>(c, "position_m", ctx, cs.position_m);
-        cs.look_at_m = Vec<3>(c, "look_at_m", ctx, cs.look_at_m);
+        FV_REQUIRE(JsonHas(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)", ctx);
+        FV_REQUIRE(JsonHas(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
+        cs.position_m = JsonVector<3>(c, "position_m", ctx, cs.position_m);
+        cs.look_at_m = JsonVector<3>(c, "look_at_m", ctx, cs.look_at_m);
       }
       s.cameras.push_back(cs);
     }
-    if (Has(j, "ball")) {
-      const json& b = Obj(j, "ball", "");
-      Known(
+    if (JsonHas(j, "ball")) {
+      const json& b = JsonObject(j, "ball", "");
+      JsonKnownKeys(
           b, "ball",
           {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "physics"});
-      s.ball.enabled = Bool(b, "enabled", "ball", true);
-      s.ball.diameter_m = Num(b, "diameter_m", "ball", s.ball.diameter_m);
-      s.ball.colour_bgr = Vec<3>(b, "colour_bgr", "ball", s.ball.colour_bgr);
-      const json& pl = Arr(b, "placements", "ball");
+      s.ball.enabled = JsonBool(b, "enabled", "ball", true);
+      s.ball.diameter_m = JsonNumber(b, "diameter_m", "ball", s.ball.diameter_m);
+      s.ball.colour_bgr = JsonVector<3>(b, "colour_bgr", "ball", s.ball.colour_bgr);
+      const json& pl = JsonArray(b, "placements", "ball");
       for (size_t i = 0; i < pl.size(); ++i) {
-        s.ball.placements.push_back(VecOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
+        s.ball.placements.push_back(JsonVectorOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
       }
-      s.ball.hold_frames = Int(b, "hold_frames", "ball", s.ball.hold_frames);
-      const json& ks = Arr(b, "kicks", "ball");
+      s.ball.hold_frames = JsonInt(b, "hold_frames", "ball", s.ball.hold_frames);
+      const json& ks = JsonArray(b, "kicks", "ball");
       for (size_t i = 0; i < ks.size(); ++i) {
         const std::string ctx = fmt::format("ball.kicks[{}]", i);
-        Known(ks[i], ctx, {"time_s", "position_m", "velocity_mps"});
+        JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps"});
         KickSpec k;
-        k.time_s = Num(ks[i], "time_s", ctx, 0.0);
-        FV_REQUIRE(Has(ks[i], "position_m"), "{}.position_m: missing", ctx);
-        k.position_m = Vec<3>(ks[i], "position_m", ctx, k.position_m);
-        FV_REQUIRE(Has(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
-        k.velocity_mps = Vec<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
+        k.time_s = JsonNumber(ks[i], "time_s", ctx, 0.0);
+        FV_REQUIRE(JsonHas(ks[i], "position_m"), "{}.position_m: missing", ctx);
+        k.position_m = JsonVector<3>(ks[i], "position_m", ctx, k.position_m);
+        FV_REQUIRE(JsonHas(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
+        k.velocity_mps = JsonVector<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
         s.ball.kicks.push_back(k);
       }
-      const json& ph = Obj(b, "physics", "ball");
+      const json& ph = JsonObject(b, "physics", "ball");
       const std::string pc = "ball.physics";
-      Known(ph, pc,
-            {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
-             "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
+      JsonKnownKeys(
+          ph, pc,
+          {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
+           "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
       BallPhysics& p = s.ball.physics;
-      p.gravity_mps2 = Num(ph, "gravity_mps2", pc, p.gravity_mps2);
-      p.drag_coefficient = Num(ph, "drag_coefficient", pc, p.drag_coefficient);
-      p.air_density_kgm3 = Num(ph, "air_density_kgm3", pc, p.air_density_kgm3);
-      p.mass_kg = Num(ph, "mass_kg", pc, p.mass_kg);
-      p.restitution = Num(ph, "restitution", pc, p.restitution);
-      p.bounce_friction = Num(ph, "bounce_friction", pc, p.bounce_friction);
-      p.rolling_resistance = Num(ph, "rolling_resistance", pc, p.rolling_resistance);
-      p.min_bounce_speed_mps = Num(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
-      p.time_step_s = Num(ph, "time_step_s", pc, p.time_step_s);
+      p.gravity_mps2 = JsonNumber(ph, "gravity_mps2", pc, p.gravity_mps2);
+      p.drag_coefficient = JsonNumber(ph, "drag_coefficient", pc, p.drag_coefficient);
+      p.air_density_kgm3 = JsonNumber(ph, "air_density_kgm3", pc, p.air_density_kgm3);
+      p.mass_kg = JsonNumber(ph, "mass_kg", pc, p.mass_kg);
+      p.restitution = JsonNumber(ph, "restitution", pc, p.restitution);
+      p.bounce_friction = JsonNumber(ph, "bounce_friction", pc, p.bounce_friction);
+      p.rolling_resistance = JsonNumber(ph, "rolling_resistance", pc, p.rolling_resistance);
+      p.min_bounce_speed_mps = JsonNumber(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
+      p.time_step_s = JsonNumber(ph, "time_step_s", pc, p.time_step_s);
     } else {
       s.ball.enabled = false;
     }
-    const json& robots = Arr(j, "robots", "");
+    const json& robots = JsonArray(j, "robots", "");
     for (size_t i = 0; i < robots.size(); ++i) {
       const std::string ctx = fmt::format("robots[{}]", i);
-      Known(robots[i], ctx, {"path", "position_m", "radius_m", "height_m", "colour_bgr"});
+      JsonKnownKeys(robots[i], ctx, {"path", "position_m", "radius_m", "height_m", "colour_bgr"});
       RobotSpec r;
-      if (Has(robots[i], "path")) r.path = PathFromJson(robots[i]["path"], ctx + ".path");
-      if (Has(robots[i], "position_m")) {
-        r.path.waypoints_m.insert(r.path.waypoints_m.begin(),
-                                  Vec<2>(robots[i], "position_m", ctx, Eigen::Vector2d::Zero()));
+      if (JsonHas(robots[i], "path")) r.path = PathFromJson(robots[i]["path"], ctx + ".path");
+      if (JsonHas(robots[i], "position_m")) {
+        r.path.waypoints_m.insert(
+            r.path.waypoints_m.begin(),
+            JsonVector<2>(robots[i], "position_m", ctx, Eigen::Vector2d::Zero()));
       }
-      r.radius_m = Num(robots[i], "radius_m", ctx, r.radius_m);
-      r.height_m = Num(robots[i], "height_m", ctx, r.height_m);
-      r.colour_bgr = Vec<3>(robots[i], "colour_bgr", ctx, r.colour_bgr);
+      r.radius_m = JsonNumber(robots[i], "radius_m", ctx, r.radius_m);
+      r.height_m = JsonNumber(robots[i], "height_m", ctx, r.height_m);
+      r.colour_bgr = JsonVector<3>(robots[i], "colour_bgr", ctx, r.colour_bgr);
       s.robots.push_back(r);
     }
-    const json& people = Arr(j, "people", "");
+    const json& people = JsonArray(j, "people", "");
     for (size_t i = 0; i < people.size(); ++i) {
       const std::string ctx = fmt::format("people[{}]", i);
-      Known(people[i], ctx, {"id", "team", "path", "height_m", "skin_bgr"});
+      JsonKnownKeys(people[i], ctx, {"id", "team", "path", "height_m", "skin_bgr"});
       PersonSpec p;
-      p.id = Int(people[i], "id", ctx, static_cast<int>(i) + 1);
-      p.team = Int(people[i], "team", ctx, 0);
-      FV_REQUIRE(Has(people[i], "path"), "{}.path: missing", ctx);
+      p.id = JsonInt(people[i], "id", ctx, static_cast<int>(i) + 1);
+      p.team = JsonInt(people[i], "team", ctx, 0);
+      FV_REQUIRE(JsonHas(people[i], "path"), "{}.path: missing", ctx);
       p.path = PathFromJson(people[i]["path"], ctx + ".path");
-      p.height_m = Num(people[i], "height_m", ctx, p.height_m);
-      p.skin_bgr = Vec<3>(people[i], "skin_bgr", ctx, p.skin_bgr);
+      p.height_m = JsonNumber(people[i], "height_m", ctx, p.height_m);
+      p.skin_bgr = JsonVector<3>(people[i], "skin_bgr", ctx, p.skin_bgr);
       s.people.push_back(p);
     }
-    if (Has(j, "teams")) {
-      const json& teams = Arr(j, "teams", "");
+    if (JsonHas(j, "teams")) {
+      const json& teams = JsonArray(j, "teams", "");
       s.teams.clear();
       for (size_t i = 0; i < teams.size(); ++i) {
         const std::string ctx = fmt::format("teams[{}]", i);
-        Known(teams[i], ctx, {"name", "shirt_bgr", "shorts_bgr"});
+        JsonKnownKeys(teams[i], ctx, {"name", "shirt_bgr", "shorts_bgr"});
         TeamSpec t;
-        t.name = Str(teams[i], "name", ctx, fmt::format("team{}", i));
-        t.shirt_bgr = Vec<3>(teams[i], "shirt_bgr", ctx, t.shirt_bgr);
-        t.shorts_bgr = Vec<3>(teams[i], "shorts_bgr", ctx, t.shorts_bgr);
+        t.name = JsonString(teams[i], "name", ctx, fmt::format("team{}", i));
+        t.shirt_bgr = JsonVector<3>(teams[i], "shirt_bgr", ctx, t.shirt_bgr);
+        t.shorts_bgr = JsonVector<3>(teams[i], "shorts_bgr", ctx, t.shorts_bgr);
         s.teams.push_back(t);
       }
     }
-    const json& cones = Arr(j, "cones", "");
+    const json& cones = JsonArray(j, "cones", "");
     for (size_t i = 0; i < cones.size(); ++i) {
       const std::string ctx = fmt::format("cones[{}]", i);
-      Known(cones[i], ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
+      JsonKnownKeys(cones[i], ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
       ConeSpec c;
-      FV_REQUIRE(Has(cones[i], "position_m"), "{}.position_m: missing", ctx);
-      c.position_m = Vec<2>(cones[i], "position_m", ctx, c.position_m);
-      c.height_m = Num(cones[i], "height_m", ctx, c.height_m);
-      c.base_radius_m = Num(cones[i], "base_radius_m", ctx, c.base_radius_m);
-      c.colour_bgr = Vec<3>(cones[i], "colour_bgr", ctx, c.colour_bgr);
+      FV_REQUIRE(JsonHas(cones[i], "position_m"), "{}.position_m: missing", ctx);
+      c.position_m = JsonVector<2>(cones[i], "position_m", ctx, c.position_m);
+      c.height_m = JsonNumber(cones[i], "height_m", ctx, c.height_m);
+      c.base_radius_m = JsonNumber(cones[i], "base_radius_m", ctx, c.base_radius_m);
+      c.colour_bgr = JsonVector<3>(cones[i], "colour_bgr", ctx, c.colour_bgr);
       s.cones.push_back(c);
     }
-    if (Has(j, "lighting")) {
-      const json& l = Obj(j, "lighting", "");
-      Known(l, "lighting", {"light_dir", "gain_amplitude", "period_s", "vignetting", "shadows"});
-      s.lighting.light_dir = Vec<3>(l, "light_dir", "lighting", s.lighting.light_dir);
-      s.lighting.gain_amplitude = Num(l, "gain_amplitude", "lighting", s.lighting.gain_amplitude);
-      s.lighting.period_s = Num(l, "period_s", "lighting", s.lighting.period_s);
-      s.lighting.vignetting = Num(l, "vignetting", "lighting", s.lighting.vignetting);
-      s.lighting.shadows = Bool(l, "shadows", "lighting", s.lighting.shadows);
+    if (JsonHas(j, "lighting")) {
+      const json& l = JsonObject(j, "lighting", "");
+      JsonKnownKeys(l, "lighting",
+                    {"light_dir", "gain_amplitude", "period_s", "vignetting", "shadows"});
+      s.lighting.light_dir = JsonVector<3>(l, "light_dir", "lighting", s.lighting.light_dir);
+      s.lighting.gain_amplitude =
+          JsonNumber(l, "gain_amplitude", "lighting", s.lighting.gain_amplitude);
+      s.lighting.period_s = JsonNumber(l, "period_s", "lighting", s.lighting.period_s);
+      s.lighting.vignetting = JsonNumber(l, "vignetting", "lighting", s.lighting.vignetting);
+      s.lighting.shadows = JsonBool(l, "shadows", "lighting", s.lighting.shadows);
     }
-    s.noise_sigma = Num(j, "noise_sigma", "", s.noise_sigma);
-    s.jpeg_quality = Int(j, "jpeg_quality", "", s.jpeg_quality);
-    s.format = Str(j, "format", "", s.format);
+    s.noise_sigma = JsonNumber(j, "noise_sigma", "", s.noise_sigma);
+    s.jpeg_quality = JsonInt(j, "jpeg_quality", "", s.jpeg_quality);
+    s.format = JsonString(j, "format", "", s.format);
     s.Check();
     return s;
   } catch (const Error& e) {
@@ -737,10 +647,10 @@ json FlightsToJson(const std::vector<Flight>& flights) {
   for (const auto& f : flights) {
     a.push_back({{"t_start_s", f.t_start_s},
                  {"t_end_s", f.t_end_s},
-                 {"origin", J(f.origin)},
-                 {"landing", J(f.landing)},
-                 {"apex", J(f.apex)},
-                 {"v0_mps", J(f.v0_mps)}});
+                 {"origin", JsonFromVector(f.origin)},
+                 {"landing", JsonFromVector(f.landing)},
+                 {"apex", JsonFromVector(f.apex)},
+                 {"v0_mps", JsonFromVector(f.v0_mps)}});
   }
   return a;
 }

@@ -1,0 +1,140 @@
+#include "fieldvision/util/json.h"
+
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+using nlohmann::json;
+
+// "ctx: key 'key'" (or "key 'key'" without a context).
+std::string Named(const std::string& key, const std::string& ctx) {
+  return ctx.empty() ? fmt::format("key '{}'", key) : fmt::format("{}: key '{}'", ctx, key);
+}
+
+// The value under `key`, or nullptr when missing (and a fallback is allowed).
+const json* Member(const json& obj, const std::string& key, const std::string& ctx,
+                   bool has_fallback) {
+  if (JsonHas(obj, key)) return &obj[key];
+  if (!has_fallback) ThrowMissingJsonKey(key, ctx);
+  return nullptr;
+}
+
+}  // namespace
+
+std::string JsonPath(const std::string& ctx, const std::string& key) {
+  return ctx.empty() ? key : ctx + "." + key;
+}
+
+bool JsonHas(const json& obj, const std::string& key) {
+  return obj.is_object() && obj.contains(key);
+}
+
+void ThrowMissingJsonKey(const std::string& key, const std::string& ctx) {
+  if (ctx.empty()) Throw("missing key '{}'", key);
+  Throw("{}: missing key '{}'", ctx, key);
+}
+
+double JsonNumber(const json& obj, const std::string& key, const std::string& ctx,
+                  std::optional<double> fallback) {
+  const json* v = Member(obj, key, ctx, fallback.has_value());
+  if (!v) return *fallback;
+  FV_REQUIRE(v->is_number(), "{} must be a number", Named(key, ctx));
+  const double x = v->get<double>();
+  FV_REQUIRE(std::isfinite(x), "{} is not finite", Named(key, ctx));
+  return x;
+}
+
+int JsonInt(const json& obj, const std::string& key, const std::string& ctx,
+            std::optional<int> fallback) {
+  const json* v = Member(obj, key, ctx, fallback.has_value());
+  if (!v) return *fallback;
+  FV_REQUIRE(v->is_number_integer(), "{} must be an integer", Named(key, ctx));
+  FV_REQUIRE(v->is_number_unsigned() ? v->get<uint64_t>() <= std::numeric_limits<int>::max()
+                                     : v->get<int64_t>() >= std::numeric_limits<int>::min() &&
+                                           v->get<int64_t>() <= std::numeric_limits<int>::max(),
+             "{} is out of range", Named(key, ctx));
+  return static_cast<int>(v->get<int64_t>());
+}
+
+bool JsonBool(const json& obj, const std::string& key, const std::string& ctx,
+              std::optional<bool> fallback) {
+  const json* v = Member(obj, key, ctx, fallback.has_value());
+  if (!v) return *fallback;
+  FV_REQUIRE(v->is_boolean(), "{} must be true or false", Named(key, ctx));
+  return v->get<bool>();
+}
+
+std::string JsonString(const json& obj, const std::string& key, const std::string& ctx,
+                       std::optional<std::string> fallback) {
+  const json* v = Member(obj, key, ctx, fallback.has_value());
+  if (!v) return *fallback;
+  FV_REQUIRE(v->is_string(), "{} must be a string", Named(key, ctx));
+  return v->get<std::string>();
+}
+
+std::vector<double> JsonNumbers(const json& obj, const std::string& key, const std::string& ctx,
+                                bool required) {
+  const json* a = Member(obj, key, ctx, !required);
+  std::vector<double> out;
+  if (!a) return out;
+  const std::string name = Named(key, ctx);
+  FV_REQUIRE(a->is_array(), "{} must be an array of numbers", name);
+  for (size_t i = 0; i < a->size(); ++i) {
+    FV_REQUIRE((*a)[i].is_number(), "{} element {} is not a number", name, i);
+    out.push_back((*a)[i].get<double>());
+    FV_REQUIRE(std::isfinite(out.back()), "{} element {} is not finite", name, i);
+  }
+  return out;
+}
+
+std::vector<double> JsonFixedNumbers(const json& value, int n, const std::string& what) {
+  FV_REQUIRE(value.is_array() && value.size() == static_cast<size_t>(n),
+             "{} must be an array of {} numbers", what, n);
+  std::vector<double> out;
+  for (int i = 0; i < n; ++i) {
+    FV_REQUIRE(value[i].is_number(), "{} element {} is not a number", what, i);
+    out.push_back(value[i].get<double>());
+    FV_REQUIRE(std::isfinite(out.back()), "{} element {} is not finite", what, i);
+  }
+  return out;
+}
+
+const json& JsonArray(const json& obj, const std::string& key, const std::string& ctx) {
+  static const json kEmpty = json::array();
+  if (!JsonHas(obj, key)) return kEmpty;
+  FV_REQUIRE(obj[key].is_array(), "{} must be an array", Named(key, ctx));
+  return obj[key];
+}
+
+const json& JsonObject(const json& obj, const std::string& key, const std::string& ctx) {
+  static const json kEmpty = json::object();
+  if (!JsonHas(obj, key)) return kEmpty;
+  FV_REQUIRE(obj[key].is_object(), "{} must be an object", Named(key, ctx));
+  return obj[key];
+}
+
+void JsonKnownKeys(const json& obj, const std::string& ctx,
+                   std::initializer_list<const char*> known) {
+  FV_REQUIRE(obj.is_object(), "{} must be an object", ctx.empty() ? "the document" : ctx);
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    bool ok = false;
+    for (const char* k : known) ok = ok || it.key() == k;
+    if (ok) continue;
+    if (ctx.empty()) Throw("unknown key '{}' (known: {})", it.key(), fmt::join(known, ", "));
+    Throw("{}: unknown key '{}' (known: {})", ctx, it.key(), fmt::join(known, ", "));
+  }
+}
+
+json JsonFromVector(const Eigen::VectorXd& v) {
+  json a = json::array();
+  for (int i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+}  // namespace fv
