@@ -20,6 +20,7 @@
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/calib/lines.h"
 #include "fieldvision/calib/rig.h"
+#include "fieldvision/calib/rig_lines.h"
 #include "fieldvision/calib/rig_place.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
@@ -82,6 +83,65 @@ int FindRigCamera(const std::vector<Camera>& rig, const std::string& which,
   Throw("rig '{}' has no camera '{}' (its cameras: {})", dir, which, names);
 }
 
+// Frames of a rig's cameras from --image NAME=FRAME (or FRAME for the --camera NAME); empty for
+// cameras without a frame; names[i] the file of camera i's frame.
+std::vector<cv::Mat> ReadRigFrames(const std::vector<Camera>& rig,
+                                   const std::vector<std::string>& images,
+                                   const std::string& camera, const std::string& dir,
+                                   std::vector<std::string>* names) {
+  std::vector<cv::Mat> frames(rig.size());
+  names->assign(rig.size(), "");
+  for (const auto& arg : images) {
+    const size_t eq = arg.find('=');
+    int k;
+    std::string file;
+    if (eq == std::string::npos) {
+      FV_REQUIRE(!camera.empty(),
+                 "--image '{}': with --rig give NAME=FRAME (NAME a camera of the rig) or --camera "
+                 "NAME",
+                 arg);
+      k = FindRigCamera(rig, camera, dir);
+      file = arg;
+    } else {
+      k = FindRigCamera(rig, arg.substr(0, eq), dir);
+      file = arg.substr(eq + 1);
+    }
+    FV_REQUIRE(frames[k].empty(), "--image: two frames for rig camera '{}' ('{}' and '{}')",
+               rig[k].name, (*names)[k], file);
+    frames[k] = ReadImage(file);
+    CheckImageSize(frames[k], rig[k], file, rig[k].name);
+    (*names)[k] = file;
+  }
+  return frames;
+}
+
+// Prints a rig refinement's report and notes it in the camera files.
+std::vector<Camera> ReportRigRefinement(const RigRefineResult& r,
+                                        const std::vector<cv::Mat>& frames,
+                                        const std::vector<std::string>& names) {
+  std::cout << r.Summary() << "\n";
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (frames[i].empty()) continue;
+    std::cout << fmt::format(
+        "line error {}: mean {:.1f} mm, p95 {:.1f} mm (before: mean {:.1f} mm, p95 {:.1f} mm)\n",
+        r.cameras[i].name, r.after[i].mean_mm, r.after[i].p95_mm, r.before[i].mean_mm,
+        r.before[i].p95_mm);
+  }
+  if (!r.accepted) Warn("rig not refined: " + r.status + "; the camera files keep the input poses");
+  std::vector<Camera> out = r.cameras;
+  if (!r.accepted) return out;
+  const auto num_frames =
+      std::count_if(frames.begin(), frames.end(), [](const cv::Mat& m) { return !m.empty(); });
+  for (size_t i = 0; i < out.size(); ++i) {
+    out[i].notes["refined_with_rig_lines"] = fmt::format("{} frames", num_frames);
+    if (frames[i].empty()) continue;
+    out[i].notes["refined_with_lines"] = names[i];
+    out[i].notes["line_error_mean_mm"] = fmt::format("{:.1f}", r.after[i].mean_mm);
+    out[i].notes["line_error_p95_mm"] = fmt::format("{:.1f}", r.after[i].p95_mm);
+  }
+  return out;
+}
+
 void WriteRig(const std::vector<Camera>& cams, const std::string& dir) {
   std::filesystem::create_directories(dir);
   for (const auto& c : cams) {
@@ -122,7 +182,7 @@ void RunIntrinsics(IntrinsicsCli& c) {
 // ---- extrinsics
 struct ExtrinsicsCli {
   std::string camera, field, out, table, rig, image_size;
-  std::vector<std::string> points;
+  std::vector<std::string> points, images;
   bool k1 = false, homography_only = false;
   ExtrinsicsOptions o;
 };
@@ -179,6 +239,14 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const FieldModel* field) {
     out[i].notes["placed_with_rig"] = c.rig;
     out[i].notes["rig_placement_rms_px"] = fmt::format("{:.3f}", r.rms_px_all);
   }
+  if (!c.images.empty()) {
+    // Then the lines in the given frames: a few clicks place the rig within centimetres, the
+    // lines seen by its cameras within millimetres.
+    FV_REQUIRE(field != nullptr, "--image with --rig refines against the lines: give --field");
+    std::vector<std::string> names;
+    const std::vector<cv::Mat> frames = ReadRigFrames(out, c.images, c.camera, c.rig, &names);
+    out = ReportRigRefinement(RefineRigWithLines(out, frames, *field), frames, names);
+  }
   WriteRig(out, c.out);
 }
 
@@ -227,6 +295,7 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
     PlaceRigOnField(c, field.get());
     return;
   }
+  FV_REQUIRE(c.images.empty(), "--image goes with --rig (use calibrate refine for one camera)");
   FV_REQUIRE(c.points.size() == 1,
              "give one --points file (several only with --rig DIR, as NAME=POINTS.csv)");
   FV_REQUIRE(!c.camera.empty() || !c.image_size.empty(),
@@ -261,23 +330,51 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
 
 // ---- refine
 struct RefineCli {
-  std::string camera, image, field, out, overlay, rig;
+  std::string camera, field, out, overlay, rig;
+  std::vector<std::string> images;
   RefineOptions o;
 };
 
-void RunRefine(const RefineCli& c) {
-  std::vector<Camera> rig;
-  int k = -1;
-  Camera cam;
-  if (!c.rig.empty()) {
-    rig = ReadRigFolder(c.rig);
-    k = FindRigCamera(rig, c.camera, c.rig);
-    cam = rig[k];
-  } else {
-    cam = ReadCameraYaml(c.camera);
+void WriteOverlay(const std::string& path, const Camera& cam, const cv::Mat& image,
+                  const FieldModel& field, const RefineOptions& o) {
+  CheckOptions co;
+  co.detect = o.detect;
+  WriteImage(path, CheckCalibration(cam, image, field, {}, co).overlay);
+  std::cout << "wrote " << path << "\n";
+}
+
+// A rig on the field refined with the lines in frames of any of its cameras: one rigid
+// correction for the whole rig (calib/rig_lines.h).
+void RunRefineRig(const RefineCli& c) {
+  const std::vector<Camera> rig = ReadRigFolder(c.rig);
+  std::vector<std::string> names;
+  const std::vector<cv::Mat> frames = ReadRigFrames(rig, c.images, c.camera, c.rig, &names);
+  const FieldModel field = LoadField(c.field);
+  const RigRefineResult r = RefineRigWithLines(rig, frames, field, c.o);
+  const std::vector<Camera> out = ReportRigRefinement(r, frames, names);
+  WriteRig(out, c.out);
+  if (!c.overlay.empty()) {
+    // The overlay of the first camera with a frame.
+    for (size_t i = 0; i < rig.size(); ++i) {
+      if (frames[i].empty()) continue;
+      WriteOverlay(c.overlay, out[i], frames[i], field, c.o);
+      break;
+    }
   }
-  const cv::Mat image = ReadImage(c.image);
-  CheckImageSize(image, cam, c.image, c.camera);
+}
+
+void RunRefine(const RefineCli& c) {
+  if (!c.rig.empty()) {
+    RunRefineRig(c);
+    return;
+  }
+  FV_REQUIRE(!c.camera.empty(), "give --camera CAM.yaml (or --rig DIR with --image NAME=FRAME)");
+  FV_REQUIRE(c.images.size() == 1,
+             "give one --image for --camera (several only with --rig DIR, as NAME=FRAME)");
+  const Camera cam = ReadCameraYaml(c.camera);
+  const std::string& image_path = c.images.front();
+  const cv::Mat image = ReadImage(image_path);
+  CheckImageSize(image, cam, image_path, c.camera);
   const FieldModel field = LoadField(c.field);
   const RefineResult r = RefineWithLines(cam, image, field, c.o);
   // One report: the library's summary, then the contract's line error.
@@ -289,34 +386,13 @@ void RunRefine(const RefineCli& c) {
   if (!r.accepted) Warn("pose not refined: " + r.status + "; the camera file keeps the input pose");
   Camera out = r.camera;
   if (r.accepted) {
-    out.notes["refined_with_lines"] = c.image;
+    out.notes["refined_with_lines"] = image_path;
     out.notes["line_error_mean_mm"] = fmt::format("{:.1f}", r.after.mean_mm);
     out.notes["line_error_p95_mm"] = fmt::format("{:.1f}", r.after.p95_mm);
   }
-  if (!rig.empty()) {
-    // The rig follows the refined camera rigidly.
-    std::vector<Camera> moved = CarryRig(rig, k, out.cam_from_world);
-    moved[k] = out;
-    std::cout << fmt::format(
-        "the rig's {} cameras follow {} (moved {:.1f} mm, turned {:.3f} deg)\n", rig.size(),
-        cam.name, 1000 * r.moved_m, r.rotated_deg);
-    WriteRig(moved, c.out);
-    if (!c.overlay.empty()) {
-      CheckOptions co;
-      co.detect = c.o.detect;
-      WriteImage(c.overlay, CheckCalibration(out, image, field, {}, co).overlay);
-      std::cout << "wrote " << c.overlay << "\n";
-    }
-    return;
-  }
   WriteCameraYaml(out, c.out);
   std::cout << "wrote " << c.out << "\n";
-  if (!c.overlay.empty()) {
-    CheckOptions co;
-    co.detect = c.o.detect;
-    WriteImage(c.overlay, CheckCalibration(out, image, field, {}, co).overlay);
-    std::cout << "wrote " << c.overlay << "\n";
-  }
+  if (!c.overlay.empty()) WriteOverlay(c.overlay, out, image, field, c.o);
 }
 
 // ---- check
@@ -451,6 +527,10 @@ void Setup(CLI::App& app, int& exit_code) {
                  "WxH: a camera without intrinsics (a phone); the focal length (principal point "
                  "at the centre) is estimated with the pose from 6 or more points, with its "
                  "uncertainty");
+  ex->add_option("--image", ec->images,
+                 "With --rig: NAME=FRAME (repeated) of the rig's cameras; after the points place "
+                 "the rig, it is refined against the painted lines in these frames (--field "
+                 "needed)");
   ex->add_flag("--k1", ec->k1, "With --image-size: also estimate the radial distortion k1");
   ex->add_flag("--homography-only", ec->homography_only,
                "With --image-size and ground points (z = 0): fit only the image-ground homography");
@@ -458,7 +538,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
   ex->callback([ec] {
-    CheckOutputPath(ec->out, PathList(ec->points, ec->field));  // --out may be --camera
+    CheckOutputPath(ec->out, PathList(ec->points, ec->field, ec->images));  // may be --camera
     CheckOutputPath(ec->table, PathList(ec->points, ec->field, ec->camera, ec->out), "--table");
     RunExtrinsics(*ec);
   });
@@ -467,21 +547,29 @@ void Setup(CLI::App& app, int& exit_code) {
   CLI::App* re =
       group->add_subcommand("refine", "Refine the pose against the painted field lines in a frame");
   re->add_option("--camera", rc->camera,
-                 "Camera file with a pose (with --rig: the name of the rig camera of --image)")
-      ->required();
+                 "Camera file with a pose (with --rig: the rig camera of a plain --image)");
   re->add_option("--rig", rc->rig,
-                 "Folder of a rig placed on the field: refine --camera and move every camera of "
-                 "the rig with it (--out is then a folder)");
-  re->add_option("--image", rc->image, "Frame of this camera")->required();
+                 "Folder of a rig placed on the field: refine the whole rig (one rigid move, "
+                 "relative poses kept) against the lines in the frames of any of its cameras "
+                 "(--image NAME=FRAME, repeated); --out is then a folder");
+  re->add_option("--image", rc->images,
+                 "Frame of this camera (with --rig: NAME=FRAME, repeated for the rig's cameras)")
+      ->required();
   re->add_option("--field", rc->field, "Field (built-in name or JSON)")->required();
-  re->add_option("--out", rc->out, "Camera file to write")->required();
+  re->add_option("--out", rc->out, "Camera file to write (with --rig: a folder)")->required();
   re->add_option("--lut-resolution", rc->o.lut_resolution_m,
                  "Cell of the distance lookup table in metres")
       ->capture_default_str();
-  re->add_option("--overlay", rc->overlay, "Also write the check image of the refined pose");
+  re->add_option("--overlay", rc->overlay,
+                 "Also write the check image of the refined pose (with --rig: of the first "
+                 "camera with a frame)");
   re->callback([rc] {
-    CheckOutputPath(rc->out, {rc->image, rc->field});  // --out may be --camera
-    CheckOutputPath(rc->overlay, {rc->image, rc->field, rc->camera, rc->out}, "--overlay");
+    std::vector<std::string> inputs = {rc->field};
+    for (const auto& i : rc->images) inputs.push_back(i.substr(i.find('=') + 1));
+    CheckOutputPath(rc->out, inputs);  // --out may be --camera
+    inputs.push_back(rc->camera);
+    inputs.push_back(rc->out);
+    CheckOutputPath(rc->overlay, inputs, "--overlay");
     RunRefine(*rc);
   });
 

@@ -71,4 +71,21 @@ inline std::vector<Camera> PresetCameras(const std::string& preset, uint64_t see
   return cams;
 }
 
+// The rig as `calibrate multi` gives it: poses in the first camera's frame.
+inline std::vector<Camera> InRigFrame(const std::vector<Camera>& world) {
+  std::vector<Camera> rig = world;
+  const Rigid3d world_from_ref = world[0].cam_from_world.Inverse();
+  for (auto& c : rig) c.cam_from_world = c.cam_from_world * world_from_ref;
+  return rig;
+}
+
+// The largest camera centre difference between two placements of one rig.
+inline double WorstCentreErrorM(const std::vector<Camera>& a, const std::vector<Camera>& b) {
+  double worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    worst = std::max(worst, (a[i].CentreInWorld() - b[i].CentreInWorld()).norm());
+  }
+  return worst;
+}
+
 }  // namespace fv::calib::test_util

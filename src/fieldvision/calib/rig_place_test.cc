@@ -13,13 +13,8 @@
 namespace fv::calib {
 namespace {
 
-// The rig as `calibrate multi` gives it: poses in the first camera's frame.
-std::vector<Camera> InRigFrame(const std::vector<Camera>& world) {
-  std::vector<Camera> rig = world;
-  const Rigid3d world_from_ref = world[0].cam_from_world.Inverse();
-  for (auto& c : rig) c.cam_from_world = c.cam_from_world * world_from_ref;
-  return rig;
-}
+using test_util::InRigFrame;
+using test_util::WorstCentreErrorM;
 
 // Sum of squared reprojection errors of the clicks through `cams`.
 double SquaredErrorPx2(const std::vector<Camera>& cams,
@@ -29,14 +24,6 @@ double SquaredErrorPx2(const std::vector<Camera>& cams,
     for (const auto& p : pts[i]) sq += (*cams[i].Project(p.p_world) - p.uv_px).squaredNorm();
   }
   return sq;
-}
-
-double WorstCentreErrorM(const std::vector<Camera>& a, const std::vector<Camera>& b) {
-  double worst = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    worst = std::max(worst, (a[i].CentreInWorld() - b[i].CentreInWorld()).norm());
-  }
-  return worst;
 }
 
 // The demo rig (4 cameras at the corners of the RoboCup field, 1280x960) placed from 6 keypoint
