@@ -1,4 +1,5 @@
-// The studio's pages, one per hash (#calibrate, #colour, #view3d, #players, #zones, #jobs), and the live status
+// The studio's pages, one per hash (#calibrate, #colour, #view3d, #players, #zones, #jobs; #bench3d
+// is the 3D view's benchmark), and the live status
 // line fed by the server's Server-Sent Events (/api/events).
 import './style.css';
 import { url } from './api';
@@ -8,6 +9,7 @@ const pages: Record<string, (root: HTMLElement) => Promise<void>> = {
   calibrate: async (root) => (await import('./calibrate')).calibratePage(root),
   colour: async (root) => (await import('./colour')).colourPage(root),
   view3d: async (root) => (await import('./view3d')).view3dPage(root),
+  bench3d: async (root) => (await import('./view3d')).view3dPage(root, { bench: true }),
   players: async (root) => (await import('./players')).playersPage(root),
   zones: async (root) => (await import('./zones')).zonesPage(root),
   jobs: async (root) => (await import('./jobs')).jobsPage(root),
@@ -44,6 +46,9 @@ events.addEventListener('job', (e) => {
   const d = relay('job')(e);
   live.textContent = `job ${d.id} ${d.command}: ${d.state}`;
 });
+// Positions from a fusion node (live mode) and the live feed's state go to the pages only.
+events.addEventListener('ball', (e) => relay('ball')(e));
+events.addEventListener('live', (e) => relay('live')(e));
 events.onerror = () => (live.textContent = 'server not reachable');
 
 window.addEventListener('hashchange', () => void route());

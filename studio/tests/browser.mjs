@@ -3,6 +3,7 @@
 //   calibrate: click the field keypoints at their true pixels -> saved pose within 2 cm of truth
 //   ball colour: click on the ball -> saved colour file; the detector (API and CLI) finds the ball
 //   3D view: a ball result renders (canvas not blank, every camera listed); 10,000-point benchmark
+//     (frames/s reported, not asserted)
 //   zones: a polygon clicked on the field map is saved
 //   jobs: a job runs to the end, another is cancelled (states from the server's events)
 //   players: the tactical board plays with the zones and a speed chart
@@ -166,9 +167,16 @@ try {
   check(stats.changed > 0.05 && stats.colours > 20, `3D canvas rendered (${(100 * stats.changed).toFixed(1)} % of pixels off the background, ${stats.colours} colours)`);
   await page.locator('#v3-time').fill('20');
   await page.screenshot({ path: path.join(out, 'view3d.jpg'), quality: 70 });
-  await page.click('#v3-bench');
-  await page.waitForSelector('#v3-status[data-fps]', { timeout: 30000 });
-  console.log(`3D benchmark: ${await page.getAttribute('#v3-status', 'data-fps')} frames/s with a 10,000-point track (headless chromium, software GL)`);
+  // The benchmark page: a 10,000-point track over the field and the cameras, turned for 3 s.
+  // Reported, not asserted: headless chromium renders with SwiftShader (software) on the CI's CPUs.
+  await page.goto(url + '#bench3d');
+  await page.waitForSelector('#v3-status[data-fps]', { timeout: 60000 });
+  const bench = JSON.parse(await page.getAttribute('#v3-status', 'data-bench'));
+  console.log(`3D benchmark: ${bench.points} points: ${bench.paced_fps} frames/s shown while turning; render + GPU finish ` +
+    `${bench.render_ms_median} ms per frame (p95 ${bench.render_ms_p95} ms, ${(1000 / bench.render_ms_median).toFixed(0)} frames/s possible); ` +
+    `${bench.renderer}${bench.antialias ? '' : ', no antialiasing'}`);
+  check(bench.paced_fps > 0 && bench.render_ms_median > 0, '3D benchmark measured');
+  await page.screenshot({ path: path.join(out, 'bench3d.jpg'), quality: 70 });
 
   // ---- zones: a box drawn by clicking four corners on the field map
   await page.goto(url + '#zones');

@@ -8,6 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/calib/extrinsics.h"
+#include "fieldvision/calib/intrinsics.h"
+#include "fieldvision/calib/lines.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/colour.h"
@@ -226,6 +228,76 @@ json PoseToJson(const calib::ExtrinsicsResult& r, const FieldModel& field) {
   return j;
 }
 
+json LineStatsToJson(const calib::LineErrorStats& s) {
+  return {{"num_pixels", s.num_pixels},        {"num_inliers", s.num_inliers},
+          {"mean_mm", Round(s.mean_mm, 0.01)}, {"median_mm", Round(s.median_mm, 0.01)},
+          {"p95_mm", Round(s.p95_mm, 0.01)},   {"summary", OneLine(s.Summary())}};
+}
+
+// An image set for intrinsics (folder, glob in the file name, one image or a video) inside the
+// working folder; every file it lists must be inside too (links followed).
+std::string ResolveImageSpec(const Workspace& ws, const std::string& spec) {
+  if (spec.find_first_of("*?[") == std::string::npos) return ws.Resolve(spec).string();
+  const fs::path p(spec);
+  const std::string dir = p.parent_path().string();
+  if (dir.find_first_of("*?[") != std::string::npos) {
+    throw HttpError(400, "images '" + spec + "': wildcards are allowed in the file name only");
+  }
+  return (ws.Resolve(dir.empty() ? "." : dir) / p.filename()).string();
+}
+
+// The file name relative to the working folder ("dir/left01.jpg", "video.avi#12").
+std::string RelativeName(const Workspace& ws, const std::string& name) {
+  const std::string root = ws.root().string() + "/";
+  return name.rfind(root, 0) == 0 ? name.substr(root.size()) : name;
+}
+
+calib::BoardSpec BoardFromJson(const json& j) {
+  if (!j.is_object())
+    throw HttpError(400, "'board' must be an object {type, cols, rows, square_m}");
+  calib::BoardSpec b;
+  b.type = calib::ParseBoardType(GetOr<std::string>(j, "type", "chessboard"));
+  b.cols = Get<int>(j, "cols");
+  b.rows = Get<int>(j, "rows");
+  b.square_m = Get<double>(j, "square_m");
+  b.marker_m = GetOr<double>(j, "marker_m", 0.0);
+  b.dictionary = GetOr<std::string>(j, "dictionary", b.dictionary);
+  try {
+    b.Check();
+  } catch (const fv::Error& e) {
+    throw HttpError(400, e.what());
+  }
+  return b;
+}
+
+json IntrinsicsToJson(const Workspace& ws, const calib::IntrinsicsResult& r) {
+  json views = json::array();
+  for (const auto& v : r.views) {
+    views.push_back({{"name", RelativeName(ws, v.name)},
+                     {"board_found", v.board_found},
+                     {"num_corners", v.num_corners},
+                     {"rms_px", Round(v.rms_px)},
+                     {"used", v.used},
+                     {"dropped_because", v.dropped_because}});
+  }
+  return {
+      {"camera", CameraToJson(r.camera)},
+      {"rms_px", Round(r.rms_px)},
+      {"num_images", r.num_images},
+      {"num_found", r.num_found},
+      {"num_used", r.num_used},
+      {"views", views},
+      {"std_px", {Round(r.std_fx_px), Round(r.std_fy_px), Round(r.std_cx_px), Round(r.std_cy_px)}},
+      {"coverage",
+       {{"grid", r.coverage.grid},
+        {"corners_per_cell", r.coverage.corners_per_cell},
+        {"cell_fraction", Round(r.coverage.cell_fraction)},
+        {"radius_fraction", Round(r.coverage.radius_fraction)},
+        {"tilt_range_deg", Round(r.coverage.tilt_range_deg, 0.01)}}},
+      {"warnings", r.warnings},
+      {"summary", OneLine(r.Summary())}};
+}
+
 ColourRange RangeFromJson(const json& j) {
   if (!j.is_object() || !j.contains("min") || !j.contains("max")) {
     throw HttpError(400, "'range' needs min and max ([h, s, v])");
@@ -289,8 +361,8 @@ void WriteTextFile(const fs::path& path, const std::string& text) {
 
 // ---- endpoints
 
-using Handler =
-    std::function<ApiResponse(const Workspace&, EventHub*, JobRunner*, const ApiRequest&)>;
+using Handler = std::function<ApiResponse(const Workspace&, EventHub*, JobRunner*, LiveFeed*,
+                                          const ApiRequest&)>;
 
 struct Route {
   Endpoint endpoint;
@@ -304,7 +376,7 @@ void Saved(EventHub* events, const Workspace& ws, const fs::path& path, const st
 const std::vector<Route>& Routes() {
   static const std::vector<Route> routes = {
       {{"GET", "/api/endpoints", "this list"},
-       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest&) {
+       [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          json j = json::array();
          for (const auto& e : StudioApi::Endpoints()) {
            j.push_back({{"method", e.method}, {"path", e.path}, {"summary", e.summary}});
@@ -312,21 +384,21 @@ const std::vector<Route>& Routes() {
          return Json(j);
        }},
       {{"GET", "/api/info", "working folder, built-in fields and colour presets"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest&) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          return Json({{"root", ws.root().string()},
                       {"fields", BuiltinFieldNames()},
                       {"colour_presets", ColourPresetNames()}});
        }},
       {{"GET", "/api/files", "files of the working folder: [{path, size, kind}]"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest&) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          return Json(ws.ListFiles());
        }},
       {{"GET", "/api/field", "?name=NAME_OR_JSON: the field model (field show --json)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          return Json(FieldToJson(LoadFieldIn(ws, Param(r, "name"))));
        }},
       {{"GET", "/api/video", "?path=V: width, height, frames, fps"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
          auto source = VideoSource::Open(p.string());
          return Json({{"path", ws.Relative(p)},
@@ -336,7 +408,7 @@ const std::vector<Route>& Routes() {
                       {"fps", source->fps()}});
        }},
       {{"GET", "/api/frame", "?path=V&frame=N: frame N of a video or image pattern (PNG)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
          const int frame = r.params.count("frame") ? ParseInt(r.params.at("frame"), "frame") : 0;
          if (frame < 0) throw HttpError(400, "frame must be >= 0");
@@ -344,12 +416,12 @@ const std::vector<Route>& Routes() {
          return ApiResponse{200, "image/png", EncodePng(bgr)};
        }},
       {{"GET", "/api/camera", "?path=CAM.yaml: the camera (intrinsics, pose, position)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          return Json(CameraToJson(ReadCameraYaml(ws.Resolve(Param(r, "path")).string())));
        }},
       {{"POST", "/api/calibrate/project",
         "{camera, field}: the field's lines and keypoints in the camera's image"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          if (!cam.has_pose) throw HttpError(422, "camera file has no pose (rvec, tvec)");
@@ -357,7 +429,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/calibrate/pose",
         "{camera, field, points: [{name, u, v}]}: pose, residuals (px, mm), reprojected lines"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
@@ -366,7 +438,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/calibrate/save",
         "{camera, field, points, out[, points_out]}: estimate the pose and write the camera file"},
-       [](const Workspace& ws, EventHub* events, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
@@ -392,9 +464,118 @@ const std::vector<Route>& Routes() {
          Saved(events, ws, out, "camera");
          return Json(j);
        }},
+      {{"POST", "/api/calibrate/refine",
+        "{camera, field, video, frame[, points][, out]}: the pose (from the points, else the "
+        "camera file's) refined against the painted lines of the frame; line errors before and "
+        "after, the line pixels; writes the refined camera when out is given and it is accepted"},
+       [](const Workspace& ws, EventHub* events, JobRunner*, LiveFeed*, const ApiRequest& r) {
+         const json body = Body(r);
+         const std::string camera_path = Get<std::string>(body, "camera");
+         Camera cam = ReadCameraYaml(ws.Resolve(camera_path).string());
+         const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
+         const std::string video_path = Get<std::string>(body, "video");
+         const fs::path video = ws.Resolve(video_path);
+         fs::path out;
+         if (body.contains("out")) out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         if (body.contains("points"))
+           cam = calib::EstimatePose(cam, ParseClicks(body, field)).camera;
+         if (!cam.has_pose) {
+           throw HttpError(422,
+                           "no pose to refine: click 4 or more keypoints (or give a camera "
+                           "file with a pose)");
+         }
+         const int frame = GetOr<int>(body, "frame", 0);
+         if (frame < 0) throw HttpError(400, "frame must be >= 0");
+         const cv::Mat bgr = ReadVideoFrame(video.string(), frame);
+         calib::CheckImageSize(bgr, cam, video_path, camera_path);
+         const calib::RefineOptions options;
+         const auto pixels = calib::DetectLinePixels(bgr, cam, field, options.detect);
+         const calib::RefineResult res = calib::RefineWithLinePixels(cam, pixels, field, options);
+         json line_pixels = json::array();
+         const size_t step = std::max<size_t>(1, pixels.size() / 3000);
+         for (size_t i = 0; i < pixels.size(); i += step) {
+           line_pixels.push_back({Round(pixels[i].x(), 0.1), Round(pixels[i].y(), 0.1)});
+         }
+         json j = {{"accepted", res.accepted},
+                   {"status", res.status},
+                   {"before", LineStatsToJson(res.before)},
+                   {"after", LineStatsToJson(res.after)},
+                   {"num_line_pixels", res.num_line_pixels},
+                   {"iterations", res.iterations},
+                   {"moved_m", Round(res.moved_m, 1e-5)},
+                   {"rotated_deg", Round(res.rotated_deg, 1e-5)},
+                   {"camera", CameraToJson(res.camera)},
+                   {"camera_position_m", Vec(res.camera.CentreInWorld())},
+                   {"line_pixels", line_pixels},
+                   {"summary", OneLine(res.Summary())},
+                   {"wrote", json::array()}};
+         j.update(ProjectField(res.camera, field));
+         if (!out.empty() && res.accepted) {
+           WriteCameraYaml(res.camera, out.string());
+           j["wrote"].push_back(ws.Relative(out));
+           Saved(events, ws, out, "camera");
+         }
+         return Json(j);
+       }},
+      {{"POST", "/api/calibrate/intrinsics",
+        "{images: FOLDER|GLOB|IMAGE|VIDEO, board: {type, cols, rows, square_m[, marker_m, "
+        "dictionary]}[, num_distortion, fix_aspect_ratio, zero_tangent, name, out]}: intrinsics "
+        "from board images with per-view errors; writes the camera file when out is given"},
+       [](const Workspace& ws, EventHub* events, JobRunner*, LiveFeed*, const ApiRequest& r) {
+         const json body = Body(r);
+         calib::IntrinsicsOptions o;
+         o.board = BoardFromJson(Get<json>(body, "board"));
+         o.num_distortion = GetOr<int>(body, "num_distortion", o.num_distortion);
+         o.fix_aspect_ratio = GetOr<bool>(body, "fix_aspect_ratio", false);
+         o.zero_tangent = GetOr<bool>(body, "zero_tangent", false);
+         o.camera_name = GetOr<std::string>(body, "name", "");
+         o.progress = false;
+         try {
+           o.Check();
+         } catch (const fv::Error& e) {
+           throw HttpError(400, e.what());
+         }
+         const std::string spec = ResolveImageSpec(ws, Get<std::string>(body, "images"));
+         // Every listed file must be inside the folder (a link may point elsewhere).
+         const calib::ImageSource source(spec, o.source);
+         if (source.size() > 200) throw HttpError(400, "more than 200 images: choose fewer");
+         for (int i = 0; i < source.size(); ++i) {
+           if (source.name(i).find('#') == std::string::npos) ws.Resolve(source.name(i));
+         }
+         fs::path out;
+         if (body.contains("out")) out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         const calib::IntrinsicsResult res = calib::CalibrateIntrinsics(spec, o);
+         json j = IntrinsicsToJson(ws, res);
+         j["wrote"] = json::array();
+         if (!out.empty()) {
+           WriteCameraYaml(res.camera, out.string());
+           j["wrote"].push_back(ws.Relative(out));
+           Saved(events, ws, out, "camera");
+         }
+         return Json(j);
+       }},
+      {{"POST", "/api/live/start",
+        "{endpoint: tcp://HOST:PORT}: subscribe to a fusion node's positions (fuse --publish); "
+        "they arrive as 'ball' events on /api/events"},
+       [](const Workspace&, EventHub*, JobRunner*, LiveFeed* live, const ApiRequest& r) {
+         if (!live) throw HttpError(404, "this server has no live feed");
+         live->Start(Get<std::string>(Body(r), "endpoint"));
+         return Json(live->Status());
+       }},
+      {{"POST", "/api/live/stop", "{}: end the subscription"},
+       [](const Workspace&, EventHub*, JobRunner*, LiveFeed* live, const ApiRequest&) {
+         if (!live) throw HttpError(404, "this server has no live feed");
+         live->Stop();
+         return Json(live->Status());
+       }},
+      {{"GET", "/api/live", "the live feed: state, endpoint, positions received, last position"},
+       [](const Workspace&, EventHub*, JobRunner*, LiveFeed* live, const ApiRequest&) {
+         if (!live) throw HttpError(404, "this server has no live feed");
+         return Json(live->Status());
+       }},
       {{"POST", "/api/colour/learn",
         "{video, frame, points: [[u, v]], roi: [x, y, w, h], negative_points}: HSV box"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
          ColourLearnOptions o;
@@ -416,7 +597,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/colour/save",
         "{range: {min, max}, out}: write a colour file (ball class + field + line)"},
-       [](const Workspace& ws, EventHub* events, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
          const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
@@ -426,7 +607,7 @@ const std::vector<Route>& Routes() {
        }},
       {{"POST", "/api/colour/detect",
         "{video, frames: [N], colour: FILE_OR_PRESET | range, camera?}: ball candidates"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
          ColourSpec spec;
@@ -465,7 +646,7 @@ const std::vector<Route>& Routes() {
          return Json({{"frames", out}});
        }},
       {{"GET", "/api/ball", "?path=BALL.csv: the ball track (time, position, cameras, error)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const BallTrackFile track = ReadBallTrack(ws.Resolve(Param(r, "path")).string());
          json samples = json::array();
          for (const auto& s : track.samples) {
@@ -478,7 +659,7 @@ const std::vector<Route>& Routes() {
                       {"skipped", track.skipped.size()}});
        }},
       {{"GET", "/api/tracks", "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const CsvTable t = CsvTable::Read(ws.Resolve(Param(r, "path")).string());
          t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
          json rows = json::array();
@@ -497,7 +678,7 @@ const std::vector<Route>& Routes() {
                       {"rows", rows}});
        }},
       {{"GET", "/api/zones", "?path=zones.json: named polygons on the field (stats --zones)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          json zones = json::array();
          for (const auto& z : stats::ReadZones(ws.Resolve(Param(r, "path")).string())) {
            json polygon = json::array();
@@ -507,7 +688,7 @@ const std::vector<Route>& Routes() {
          return Json(zones);
        }},
       {{"POST", "/api/zones/save", "{zones: [{name, polygon: [[x, y], ...]}], out}: zones file"},
-       [](const Workspace& ws, EventHub* events, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const json zones = Get<json>(body, "zones");
          if (!zones.is_array()) throw HttpError(400, "'zones' must be an array");
@@ -529,13 +710,13 @@ const std::vector<Route>& Routes() {
          return Json({{"wrote", {ws.Relative(out)}}, {"zones", zones.size()}});
        }},
       {{"GET", "/api/jobs", "the jobs, newest first (state, progress line, output)"},
-       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest&) {
+       [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          if (!jobs) throw HttpError(404, "this server runs no jobs");
          return Json(jobs->List());
        }},
       {{"POST", "/api/jobs",
         "{command: ball|trajectory|players|stats|plan|detect|synth, args: [...]}: start a job"},
-       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          if (!jobs) throw HttpError(404, "this server runs no jobs");
          const json body = Body(r);
          const int id = jobs->Start(Get<std::string>(body, "command"),
@@ -543,14 +724,14 @@ const std::vector<Route>& Routes() {
          return Json(jobs->Get(id));
        }},
       {{"POST", "/api/jobs/cancel", "{id}: end a running job"},
-       [](const Workspace&, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          if (!jobs) throw HttpError(404, "this server runs no jobs");
          const int id = Get<int>(Body(r), "id");
          const bool cancelled = jobs->Cancel(id);
          return Json({{"id", id}, {"cancelled", cancelled}});
        }},
       {{"GET", "/api/json", "?path=F.json: a JSON file of the folder (FLIGHTS.json, ...)"},
-       [](const Workspace& ws, EventHub*, JobRunner* jobs, const ApiRequest& r) {
+       [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
          std::ifstream in(p);
          if (!in) throw HttpError(404, "cannot read '" + Param(r, "path") + "'");
@@ -566,14 +747,15 @@ const std::vector<Route>& Routes() {
 
 }  // namespace
 
-StudioApi::StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jobs)
-    : workspace_(workspace), events_(events), jobs_(jobs) {}
+StudioApi::StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jobs, LiveFeed* live)
+    : workspace_(workspace), events_(events), jobs_(jobs), live_(live) {}
 
 const std::vector<Endpoint>& StudioApi::Endpoints() {
   static const std::vector<Endpoint> endpoints = [] {
     std::vector<Endpoint> e;
     for (const auto& r : Routes()) e.push_back(r.endpoint);
-    e.push_back({"GET", "/api/events", "Server-Sent Events: saved files, job progress"});
+    e.push_back(
+        {"GET", "/api/events", "Server-Sent Events: saved files, job progress, live positions"});
     return e;
   }();
   return endpoints;
@@ -586,7 +768,7 @@ ApiResponse StudioApi::Handle(const ApiRequest& request) const {
     path_known = true;
     if (route.endpoint.method != request.method) continue;
     try {
-      return route.handler(workspace_, events_, jobs_, request);
+      return route.handler(workspace_, events_, jobs_, live_, request);
     } catch (const HttpError& e) {
       return ErrorResponse(e.status(), e.what());
     } catch (const fv::Error& e) {

@@ -1,8 +1,10 @@
 // The studio's JSON API over the fieldvision library: files of the working folder, fields,
-// video frames, camera files, pose from clicked keypoints (calib/extrinsics.h), ball colour
+// video frames, camera files, pose from clicked keypoints (calib/extrinsics.h) refined against
+// the painted lines (calib/lines.h), intrinsics from board images (calib/intrinsics.h), ball colour
 // learning and detection (detect/colour_learn.h, ball_detector.h), ball tracks, flights, player
-// tracks, zones and jobs (jobs.h). Every path is resolved inside the working folder (workspace.h);
-// bad requests get a 4xx status and a one-line message ({"error": "..."}).
+// tracks, zones, jobs (jobs.h) and the live feed from a fusion node (live_feed.h). Every path is
+// resolved inside the working folder (workspace.h); bad requests get a 4xx status and a one-line
+// message ({"error": "..."}).
 #pragma once
 
 #include <map>
@@ -11,6 +13,7 @@
 
 #include "fieldvision/web/events.h"
 #include "fieldvision/web/jobs.h"
+#include "fieldvision/web/live_feed.h"
 #include "fieldvision/web/workspace.h"
 
 namespace fv::web {
@@ -35,9 +38,10 @@ struct Endpoint {
 
 class StudioApi {
  public:
-  // `events` (optional) receives "saved" events; `jobs` (optional) runs jobs; both must outlive
-  // the API.
-  StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jobs = nullptr);
+  // `events` (optional) receives "saved" events; `jobs` (optional) runs jobs; `live` (optional)
+  // subscribes to a fusion node; all must outlive the API.
+  StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jobs = nullptr,
+            LiveFeed* live = nullptr);
 
   // Answers a request; never throws: 4xx/5xx responses carry {"error": one line}.
   ApiResponse Handle(const ApiRequest& request) const;
@@ -48,6 +52,7 @@ class StudioApi {
   Workspace workspace_;
   EventHub* events_;
   JobRunner* jobs_;
+  LiveFeed* live_;
 };
 
 }  // namespace fv::web

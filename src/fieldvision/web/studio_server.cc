@@ -67,6 +67,7 @@ struct StudioServer::Impl {
   StudioOptions options;
   std::unique_ptr<Workspace> workspace;
   EventHub events;
+  std::unique_ptr<LiveFeed> live;
   std::unique_ptr<JobRunner> jobs;
   std::unique_ptr<StudioApi> api;
   httplib::Server server;
@@ -92,7 +93,8 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   std::string program = options.program;
   if (program.empty()) program = fs::read_symlink("/proc/self/exe").string();
   m.jobs = std::make_unique<JobRunner>(program, *m.workspace, &m.events);
-  m.api = std::make_unique<StudioApi>(*m.workspace, &m.events, m.jobs.get());
+  m.live = std::make_unique<LiveFeed>(&m.events);
+  m.api = std::make_unique<StudioApi>(*m.workspace, &m.events, m.jobs.get(), m.live.get());
   if (m.options.assets.empty()) m.options.assets = FV_STUDIO_DIST;
   m.assets_built = fs::is_regular_file(fs::path(m.options.assets) / "index.html");
   m.token_required = !IsLoopback(options.host);
@@ -192,6 +194,7 @@ int StudioServer::Start() {
 
 void StudioServer::Stop() {
   Impl& m = *impl_;
+  m.live->Stop();
   m.events.Close();
   if (m.thread.joinable()) {
     m.server.stop();

@@ -2,10 +2,16 @@
 // synthetic scene, called with cpp-httplib's client. Every endpoint, and bad requests (unknown
 // file, path outside the folder, malformed JSON, wrong method, missing token) get 4xx with a
 // one-line message.
+#include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <thread>
 
+#include <zmq.hpp>
+
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
 // glibc's resolv.h (through httplib.h) defines _res, a parameter name in Eigen's headers.
@@ -13,11 +19,14 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/calib/board_render.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/colour.h"
+#include "fieldvision/net/messages.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 #include "fieldvision/web/studio_api.h"
 #include "fieldvision/web/studio_server.h"
@@ -254,6 +263,229 @@ TEST_F(StudioApiTest, PoseFromClickedKeypoints) {
   const Camera written = ReadCameraYaml((dir_ / "scene/cam1_studio.yaml").string());
   EXPECT_LT((written.CentreInWorld() - truth.CentreInWorld()).norm(), 0.005);
   EXPECT_EQ(CsvTable::Read((dir_ / "scene/cam1_points.csv").string()).rows(), points.size());
+}
+
+TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
+  FV_SEED_TRACE(seed_);
+  // cam1 moved 12 cm and turned 0.4 degrees off the truth: the lines of its frame pull it back.
+  const Camera truth = ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
+  Camera off = truth;
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(0.4 * M_PI / 180, Eigen::Vector3d(1, 2, 0.5).normalized()).matrix();
+  off.cam_from_world.rotation = turn * truth.cam_from_world.rotation;
+  off.cam_from_world.translation = turn * truth.cam_from_world.translation;
+  off.cam_from_world.translation +=
+      off.cam_from_world.rotation * Eigen::Vector3d(0.08, -0.06, 0.06);
+  WriteCameraYaml(off, (dir_ / "scene/cam1_off.yaml").string());
+  const double before_m = (off.CentreInWorld() - truth.CentreInWorld()).norm();
+
+  json body = {{"camera", "scene/cam1_off.yaml"},
+               {"field", "robocup-msl"},
+               {"video", "scene/cam1.avi"},
+               {"frame", 0},
+               {"out", "scene/cam1_refined.yaml"}};
+  const Reply r = Post("/api/calibrate/refine", body);
+  ASSERT_EQ(r.status, 200) << r.body;
+  const json j = r.j();
+  EXPECT_TRUE(j["accepted"].get<bool>()) << j["summary"];
+  EXPECT_GT(j["num_line_pixels"].get<int>(), 100);
+  EXPECT_FALSE(j["line_pixels"].empty());
+  EXPECT_FALSE(j["lines_px"].empty());
+  EXPECT_LT(j["after"]["mean_mm"].get<double>(), 0.5 * j["before"]["mean_mm"].get<double>())
+      << j["summary"];
+  const Camera refined = ReadCameraYaml((dir_ / "scene/cam1_refined.yaml").string());
+  const double after_m = (refined.CentreInWorld() - truth.CentreInWorld()).norm();
+  EXPECT_LT(after_m, 0.3 * before_m) << "before " << before_m << " m, after " << after_m << " m";
+  EXPECT_EQ(j["wrote"][0], "scene/cam1_refined.yaml");
+
+  // Starting from clicked points instead of the file's pose (cam1's intrinsics file has one too).
+  json points = json::array();
+  for (const auto& k : TruthKeypoints()) points.push_back(k);
+  body["camera"] = "scene/cam1_off.yaml";
+  body["points"] = points;
+  body.erase("out");
+  const Reply from_clicks = Post("/api/calibrate/refine", body);
+  ASSERT_EQ(from_clicks.status, 200) << from_clicks.body;
+  EXPECT_TRUE(from_clicks.j()["wrote"].empty());
+
+  // Bad requests.
+  Camera no_pose = truth;
+  no_pose.has_pose = false;
+  WriteCameraYaml(no_pose, (dir_ / "scene/cam1_intrinsics.yaml").string());
+  body = {{"camera", "scene/cam1_intrinsics.yaml"},
+          {"field", "robocup-msl"},
+          {"video", "scene/cam1.avi"}};
+  ExpectError(Post("/api/calibrate/refine", body), 422, "no pose to refine");
+  body["camera"] = "scene/cam1.yaml";
+  body["video"] = "scene/nothing.avi";
+  ExpectError(Post("/api/calibrate/refine", body), 404, "nothing.avi");
+  body["video"] = "scene/cam1.avi";
+  body["out"] = "../escape.yaml";
+  ExpectError(Post("/api/calibrate/refine", body), 403, "");
+  EXPECT_FALSE(fs::exists(dir_.parent_path() / "escape.yaml"));
+  Camera small = truth;
+  small.width = 320;
+  small.height = 240;
+  WriteCameraYaml(small, (dir_ / "scene/small.yaml").string());
+  body = {{"camera", "scene/small.yaml"}, {"field", "robocup-msl"}, {"video", "scene/cam1.avi"}};
+  ExpectError(Post("/api/calibrate/refine", body), 422, "");
+}
+
+TEST_F(StudioApiTest, IntrinsicsFromBoardImagesWithPerViewErrors) {
+  FV_SEED_TRACE(seed_);
+  // Eight views of a 9x6 chessboard (25 mm) seen by a 640x480 camera, fx = fy = 600.
+  Camera cam;
+  cam.width = 640;
+  cam.height = 480;
+  cam.fx = cam.fy = 600;
+  cam.cx = 322;
+  cam.cy = 238;
+  cam.distortion = {0, 0, 0, 0, 0};
+  calib::BoardSpec board;
+  const calib::BoardPicture picture = calib::DrawBoard(board, 3000);
+  fs::create_directories(dir_ / "boards");
+  Rng rng(seed_);
+  const Eigen::Vector3d centre((board.cols - 1) * board.square_m / 2,
+                               (board.rows - 1) * board.square_m / 2, 0);
+  for (int i = 0; i < 8; ++i) {
+    const double ax = rng.Uniform(-0.5, 0.5), ay = rng.Uniform(-0.5, 0.5);
+    Rigid3d cam_from_board;
+    cam_from_board.rotation = (Eigen::AngleAxisd(ax, Eigen::Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(ay, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(rng.Uniform(-0.3, 0.3), Eigen::Vector3d::UnitZ()))
+                                  .matrix();
+    const Eigen::Vector3d at(rng.Uniform(-0.06, 0.06), rng.Uniform(-0.04, 0.04),
+                             rng.Uniform(0.38, 0.5));
+    cam_from_board.translation = at - cam_from_board.rotation * centre;
+    cv::imwrite((dir_ / "boards" / fmt::format("view{:02d}.png", i)).string(),
+                calib::RenderBoardView(picture, cam, cam_from_board));
+  }
+  const json chessboard = {{"type", "chessboard"}, {"cols", 9}, {"rows", 6}, {"square_m", 0.025}};
+  json body = {{"images", "boards/*.png"},
+               {"board", chessboard},
+               {"num_distortion", 4},
+               {"name", "studio_cam"},
+               {"out", "boards/cam.yaml"}};
+  const Reply r = Post("/api/calibrate/intrinsics", body);
+  ASSERT_EQ(r.status, 200) << r.body;
+  const json j = r.j();
+  EXPECT_NEAR(j["camera"]["fx"].get<double>(), 600, 6) << j["summary"];
+  EXPECT_NEAR(j["camera"]["fy"].get<double>(), 600, 6);
+  EXPECT_NEAR(j["camera"]["cx"].get<double>(), 322, 6);
+  EXPECT_NEAR(j["camera"]["cy"].get<double>(), 238, 6);
+  ASSERT_EQ(j["views"].size(), 8u);
+  for (const auto& v : j["views"]) {
+    EXPECT_TRUE(v["board_found"].get<bool>()) << v["name"];
+    EXPECT_EQ(v["num_corners"], 54);
+    EXPECT_LT(v["rms_px"].get<double>(), 0.5) << v["name"];
+    EXPECT_EQ(v["name"].get<std::string>().rfind("boards/view", 0), 0u) << v["name"];
+  }
+  EXPECT_EQ(j["num_used"], 8);
+  EXPECT_EQ(j["wrote"][0], "boards/cam.yaml");
+  const Camera written = ReadCameraYaml((dir_ / "boards/cam.yaml").string());
+  EXPECT_NEAR(written.fx, j["camera"]["fx"].get<double>(), 1e-3);
+  EXPECT_EQ(written.name, "studio_cam");
+
+  // Bad requests: images outside, wildcards in a folder name, a bad board, no board found.
+  body.erase("out");
+  body["images"] = "../*.png";
+  ExpectError(Post("/api/calibrate/intrinsics", body), 403, "");
+  body["images"] = "b*/view00.png";
+  ExpectError(Post("/api/calibrate/intrinsics", body), 400, "wildcards");
+  body["images"] = "boards/*.png";
+  body["board"]["cols"] = 1;
+  ExpectError(Post("/api/calibrate/intrinsics", body), 400, "");
+  body["board"] = {{"type", "chessboard"}, {"cols", 7}, {"rows", 5}, {"square_m", 0.025}};
+  ExpectError(Post("/api/calibrate/intrinsics", body), 422, "");
+  body["board"] = "chessboard";
+  ExpectError(Post("/api/calibrate/intrinsics", body), 400, "board");
+}
+
+TEST_F(StudioApiTest, LivePositionsFromAFusionNodeArriveAsEvents) {
+  // A PUB socket as `fuse --publish` binds it, sending ball messages (net/messages.h).
+  zmq::context_t ctx(1);
+  zmq::socket_t pub(ctx, zmq::socket_type::pub);
+  pub.set(zmq::sockopt::linger, 0);
+  pub.bind("tcp://127.0.0.1:*");
+  const std::string endpoint = pub.get(zmq::sockopt::last_endpoint);
+
+  ExpectError(Post("/api/live/start", json{{"endpoint", "ipc:///etc/passwd"}}), 400, "tcp://");
+  ExpectError(Post("/api/live/start", json{{"endpoint", "tcp://127.0.0.1"}}), 400, "tcp://");
+  ExpectError(Post("/api/live/start", json::object()), 400, "endpoint");
+  EXPECT_EQ(Get("/api/live").j()["state"], "idle");
+
+  // The event stream, read on a thread of its own.
+  std::mutex mutex;
+  std::string stream;
+  std::atomic<bool> done{false};
+  httplib::Client events("127.0.0.1", port_);
+  events.set_read_timeout(20);
+  std::thread reader([&] {
+    events.Get("/api/events", [&](const char* data, size_t n) {
+      std::lock_guard<std::mutex> lock(mutex);
+      stream.append(data, n);
+      return !done && stream.find("\"frame\":7") == std::string::npos;
+    });
+  });
+  for (int i = 0; i < 200; ++i) {  // the stream is open once its hello has come
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (stream.find("event: hello") != std::string::npos) break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  const Reply start = Post("/api/live/start", json{{"endpoint", endpoint}});
+  ASSERT_EQ(start.status, 200) << start.body;
+  EXPECT_EQ(start.j()["state"], "running");
+
+  // ZeroMQ subscriptions take a moment to reach the publisher: publish until seen.
+  int received = 0;
+  for (int i = 0; i < 400 && received < 3; ++i) {
+    net::BallMessage b;
+    b.frame = i;
+    b.time_s = i / 30.0;
+    b.x_m = 1.5;
+    b.y_m = -2.0;
+    b.z_m = 0.25 + 0.01 * i;
+    b.n_cams = 3;
+    b.err_px = 0.4;
+    pub.send(zmq::buffer(std::string("ball")), zmq::send_flags::sndmore);
+    pub.send(zmq::buffer(net::Encode(b)));
+    if (i == 2) {  // a malformed message is counted and skipped
+      pub.send(zmq::buffer(std::string("ball")), zmq::send_flags::sndmore);
+      pub.send(zmq::buffer(std::string("{not json")));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    received = Get("/api/live").j()["received"].get<int>();
+  }
+  ASSERT_GE(received, 3);
+  const json status = Get("/api/live").j();
+  EXPECT_EQ(status["endpoint"], endpoint);
+  EXPECT_DOUBLE_EQ(status["last"]["x_m"].get<double>(), 1.5);
+  EXPECT_EQ(status["last"]["n_cams"], 3);
+
+  // Keep publishing until the stream has frame 7 (or give up after 20 s).
+  for (int i = 0; i < 400; ++i) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (stream.find("\"frame\":7") != std::string::npos) break;
+    }
+    net::BallMessage b;
+    b.frame = 7;
+    b.x_m = 1.5;
+    pub.send(zmq::buffer(std::string("ball")), zmq::send_flags::sndmore);
+    pub.send(zmq::buffer(net::Encode(b)));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  const Reply stop = Post("/api/live/stop", json::object());
+  ASSERT_EQ(stop.status, 200) << stop.body;
+  EXPECT_EQ(stop.j()["state"], "idle");
+  done = true;
+  reader.join();
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_NE(stream.find("event: live"), std::string::npos) << stream;
+  EXPECT_NE(stream.find("event: ball"), std::string::npos) << stream;
+  EXPECT_NE(stream.find("\"frame\":7"), std::string::npos) << stream;
 }
 
 TEST_F(StudioApiTest, BallColourLearnSaveDetect) {
