@@ -5,7 +5,9 @@
 # time from the frames' capture to the position (p50, p95). Baseline in the same run: the same
 # nodes sending frames without looking for the ball (--no-detect), i.e. the cost of pacing,
 # ZeroMQ, clock correction, pairing and triangulation alone. Also prints the frames the nodes
-# could not keep up with (skipped by the source) and the accuracy against the scene's truth.
+# could not keep up with (skipped by the source), where the latency goes (the nodes' source
+# buffer, their work per frame, transport, pairing), the machine's load and the accuracy against
+# the scene's truth.
 # Usage: bench/ball_pipeline_live.sh [BUILD_DIR] [WIDTHxHEIGHT]   (default 1280x960; the scene is
 # cached in BUILD_DIR/bench-data)
 set -euo pipefail
@@ -29,7 +31,7 @@ run() {  # name extra-node-args...
     --idle-exit 2 --no-progress >"$SCENE/fuse_$name.log" 2>&1 &
   local fuse_pid=$!
   local start_at
-  start_at=$(awk -v t="$(date +%s.%N)" 'BEGIN { printf "%.3f", t + 8 }')  # every node started by then
+  start_at=$(awk -v t="$(date +%s.%N)" 'BEGIN { printf "%.3f", t + 12 }')  # every node started by then
   local pids=()
   for y in "${cams[@]}"; do
     "$FV" node --camera "$y" --video "${y%.yaml}.avi" --connect "tcp://127.0.0.1:$port" \
@@ -43,10 +45,14 @@ run() {  # name extra-node-args...
   skipped=$(cat "$SCENE"/node_"${name}"_*.log | grep -o '[0-9]* skipped by the source' |
             awk '{ s += $1 } END { print s + 0 }')
   echo "live pipeline ($name): ${#cams[@]} nodes x 60 fps $SIZE -> fuse: latency capture -> fused frame $lat; $skipped frames skipped by slow nodes"
+  tr '\r' '\n' <"$SCENE/fuse_$name.log" | grep 'where it goes' || true
+  cat "$SCENE"/node_"${name}"_*.log | tr '\r' '\n' | grep -o 'work per frame.*' | sed 's/^/  node /' || true
   echo "$lat" | awk '{ print $2, $5 }' >"$SCENE/latency_$name.txt"
 }
+echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
 run transport --no-detect
 run detect
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 "$FV" eval ball --truth "$SCENE/truth.csv" --est "$SCENE/live_detect.csv" | tail -2
 awk 'NR == FNR { b50 = $1; b95 = $2; next } { printf "detection adds: p50 %.1f ms, p95 %.1f ms (%.2fx, %.2fx the transport-only baseline)\n", $1 - b50, $2 - b95, $1 / b50, $2 / b95 }' \
   "$SCENE/latency_transport.txt" "$SCENE/latency_detect.txt"

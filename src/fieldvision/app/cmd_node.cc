@@ -28,7 +28,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--start-at", o->start_at_s,
                   "With --realtime: Unix time (s) of frame 0, as for cameras triggered together");
   cmd->add_option("--live-buffer", o->live_buffer_frames,
-                  "Frames a live source holds for a slow node (the oldest are dropped)")
+                  "Frames a live source holds for a slow node (the oldest are dropped; 1: only the "
+                  "newest, the lowest latency)")
       ->capture_default_str();
   cmd->add_option("--ball-diameter", o->ball_diameter_m, "Ball diameter in metres")
       ->capture_default_str();

@@ -68,6 +68,23 @@ std::string FuseSummary::ToString() const {
     s += fmt::format("\nlatency capture -> fused: p50 {:.1f} ms, p95 {:.1f} ms ({} frames)",
                      1e3 * Percentile(latency_s, 50), 1e3 * Percentile(latency_s, 95),
                      latency_s.size());
+    // Each part: the slowest camera of the frame (p50 / p95 over frames).
+    std::vector<double> queued, process, arrival, pairing;
+    for (const LatencyParts& p : latency_parts) {
+      if (p.queued_s >= 0) queued.push_back(p.queued_s);
+      if (p.process_s >= 0) process.push_back(p.process_s);
+      arrival.push_back(p.arrival_s);
+      pairing.push_back(p.pairing_s);
+    }
+    const auto pp = [](const std::vector<double>& v) {
+      return v.empty()
+                 ? std::string("n/a")
+                 : fmt::format("{:.1f}/{:.1f}", 1e3 * Percentile(v, 50), 1e3 * Percentile(v, 95));
+    };
+    s += fmt::format(
+        "\n  where it goes (ms, p50/p95, slowest camera of each frame): waiting in the nodes' "
+        "source {}, the nodes' work {}, capture -> last message here {}, pairing and fusion {}",
+        pp(queued), pp(process), pp(arrival), pp(pairing));
   }
   s += fmt::format("\n{} messages in {:.2f} s", messages, seconds);
   if (published > 0) s += fmt::format(", {} positions published", published);
@@ -133,14 +150,37 @@ FuseSummary RunFuse(const FuseOptions& o) {
     }
   }
 
+  // Where each frame's latency goes (system clocks only): per camera and frame, the node's
+  // queue and work times and the message's arrival on this clock, until its group is decided.
+  struct Timing {
+    double queued_s = -1, process_s = -1, arrival_s = 0;
+  };
+  std::vector<std::map<long long, Timing>> timings(n);
   const std::string tmp = o.out + ".part";
   CsvWriter csv(tmp, BallCsvHeader(), 6);
   auto emit = [&](const SyncedFrame& group) {
     const BallFrame f = fusion.Fuse(group);
     ++summary.groups;
     // Capture to decision, for every frame fused (with a position or not).
-    const double latency_s = clock_kind == "system" ? SystemClockNow() - group.time_s : 0.0;
-    if (clock_kind == "system") summary.latency_s.push_back(latency_s);
+    const double decided_s = SystemClockNow();
+    const double latency_s = clock_kind == "system" ? decided_s - group.time_s : 0.0;
+    if (clock_kind == "system") {
+      summary.latency_s.push_back(latency_s);
+      FuseSummary::LatencyParts parts;
+      for (int c = 0; c < n; ++c) {
+        if (!group.cameras[c]) continue;
+        auto& t = timings[c];
+        const auto it = t.find(group.cameras[c]->frame);
+        if (it == t.end()) continue;
+        const Timing& m = it->second;
+        parts.queued_s = std::max(parts.queued_s, m.queued_s);
+        parts.process_s = std::max(parts.process_s, m.process_s);
+        parts.arrival_s = std::max(parts.arrival_s, m.arrival_s - group.cameras[c]->time_s);
+        t.erase(t.begin(), std::next(it));
+      }
+      parts.pairing_s = latency_s - parts.arrival_s;
+      summary.latency_parts.push_back(parts);
+    }
     if (!f.result.ok()) return;
     const Eigen::Vector3d& p = f.result.point_world;
     csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
@@ -205,6 +245,8 @@ FuseSummary RunFuse(const FuseOptions& o) {
         camera = ping->camera, session = ping->session;
       } else if (const auto* f = std::get_if<FrameMessage>(&m)) {
         camera = f->camera, session = f->session;
+      } else if (const auto* k = std::get_if<SkipMessage>(&m)) {
+        camera = k->camera, session = k->session;
       } else if (const auto* h = std::get_if<HelloMessage>(&m)) {
         camera = h->camera, session = h->session;
       } else if (const auto* b = std::get_if<ByeMessage>(&m)) {
@@ -236,6 +278,12 @@ FuseSummary RunFuse(const FuseOptions& o) {
         sync.EndOfStream(c);
         continue;
       }
+      if (const auto* k = std::get_if<SkipMessage>(&m)) {
+        if (k->clock != clock_kind && !clock_kind.empty()) continue;
+        if (k->clock == "system" && !k->has_offset) continue;
+        sync.SkipUntil(c, k->time_s + (k->clock == "system" ? k->offset_s : 0.0), arrival);
+        continue;
+      }
       const auto* f = std::get_if<FrameMessage>(&m);
       FuseCameraReport& r = summary.cameras[c];
       ++r.frames;
@@ -258,6 +306,11 @@ FuseSummary RunFuse(const FuseOptions& o) {
         r.offset_s = f->offset_s;
       }
       cm.candidates = f->candidates;
+      if (f->clock == "system") {
+        auto& t = timings[c];
+        if (t.size() >= 1000) t.erase(t.begin());  // frames that never make a group
+        t[cm.frame] = {f->queued_s, f->process_s, t1};
+      }
       sync.Add(std::move(cm), arrival);
     }
     const double now = SteadyNow();

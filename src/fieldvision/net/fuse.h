@@ -57,6 +57,13 @@ struct FuseSummary {
   long long rows_written = 0;
   long long published = 0;
   std::vector<double> latency_s;  // capture -> fused, per frame fused (system clocks only)
+  // Where the latency of each of those frames went (the slowest camera of the frame; < 0: the
+  // nodes did not say): capture -> the node had the frame, the node's work, capture -> the last
+  // message here, and the rest (waiting for pairing, triangulation).
+  struct LatencyParts {
+    double queued_s = -1, process_s = -1, arrival_s = 0, pairing_s = 0;
+  };
+  std::vector<LatencyParts> latency_parts;
   double seconds = 0;
   std::string ToString() const;
 };

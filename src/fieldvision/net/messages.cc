@@ -50,6 +50,15 @@ struct Encoder {
               {"time_s", m.time_s},   {"origin", m.origin},
               {"clock", m.clock},     {"candidates", CandidatesToJson(m.candidates)}};
     if (m.has_offset) j["offset_s"] = m.offset_s;
+    if (m.queued_s >= 0) j["queued_s"] = m.queued_s;
+    if (m.process_s >= 0) j["process_s"] = m.process_s;
+    return j;
+  }
+  json operator()(const SkipMessage& m) const {
+    json j = {{"type", "skip"},      {"camera", m.camera}, {"session", m.session},
+              {"frame", m.frame},    {"time_s", m.time_s}, {"clock", m.clock},
+              {"skipped", m.skipped}};
+    if (m.has_offset) j["offset_s"] = m.offset_s;
     return j;
   }
   json operator()(const PingMessage& m) const {
@@ -103,9 +112,30 @@ Message DecodeChecked(const void* data, size_t size) {
       m.offset_s = Num(j, "offset_s");
       m.has_offset = true;
     }
+    for (auto [key, value] : {std::pair{"queued_s", &m.queued_s}, {"process_s", &m.process_s}}) {
+      if (!j.contains(key)) continue;
+      *value = Num(j, key);
+      FV_REQUIRE(*value >= 0 && *value < 3600, "message: '{}' must be in [0, 3600) s", key);
+    }
     FV_REQUIRE(j.contains("candidates"), "message: 'candidates' missing");
     FV_REQUIRE(j["candidates"].size() <= 1000, "message: more than 1000 candidates");
     m.candidates = CandidatesFromJson(j["candidates"], "message");
+    return m;
+  }
+  if (type == "skip") {
+    SkipMessage m;
+    m.camera = Str(j, "camera");
+    m.session = Str(j, "session");
+    m.frame = Int(j, "frame");
+    FV_REQUIRE(m.frame >= 0, "message: 'frame' must be >= 0");
+    m.time_s = Num(j, "time_s");
+    m.clock = Clock(j);
+    m.skipped = Int(j, "skipped");
+    FV_REQUIRE(m.skipped >= 0, "message: 'skipped' must be >= 0");
+    if (j.contains("offset_s")) {
+      m.offset_s = Num(j, "offset_s");
+      m.has_offset = true;
+    }
     return m;
   }
   if (type == "ping") {

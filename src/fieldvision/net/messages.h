@@ -10,7 +10,10 @@
 //    "source":"v4l2:/dev/video0","clock":"system"}
 //   {"v":1,"type":"frame","camera":"cam1","session":"5f..","frame":12,"time_s":1764612345.2,
 //    "origin":"device","clock":"system","offset_s":0.0123,"candidates":[{"u":..,"v":..,"r":..,
-//    "sigma":..,"score":..[,"weak":true]}]}
+//    "sigma":..,"score":..[,"weak":true]}],"queued_s":0.001,"process_s":0.004}
+//    (queued_s, process_s optional: capture -> the node has the frame, the node's work on it)
+//   {"v":1,"type":"skip","camera":"cam1","session":"5f..","frame":15,"time_s":..,"clock":"system",
+//    "offset_s":..,"skipped":2}  (the source skipped 2 frames; frame 15 is being worked on)
 //   {"v":1,"type":"ping","camera":"cam1","session":"5f..","t0_s":..}
 //   {"v":1,"type":"bye","camera":"cam1","session":"5f..","frames":120}
 // fuse -> node: {"v":1,"type":"pong","t0_s":..,"t1_s":..,"t2_s":..}
@@ -51,6 +54,22 @@ struct FrameMessage {
   double offset_s = 0;      // fuse clock - node clock (clock "system")
   bool has_offset = false;  // false until the node has a clock estimate
   std::vector<BallObservation> candidates;
+  // Optional (< 0: not sent): seconds from capture until the node had the frame (the source's
+  // buffer) and the node's work on it (decoding and detection); the fusion node reports them.
+  double queued_s = -1, process_s = -1;
+};
+
+// Sent when the node's source skipped frames (the node was slower than the camera), before it
+// works on the frame that follows them: nothing captured before time_s will come from this
+// camera, so the fusion node need not wait for it for those frames.
+struct SkipMessage {
+  std::string camera, session;
+  long long frame = 0;  // the frame the node works on now
+  double time_s = 0;    // its capture time, on the clock named by `clock`
+  std::string clock = "system";
+  double offset_s = 0;
+  bool has_offset = false;
+  long long skipped = 0;  // frames skipped just before it
 };
 
 struct PingMessage {
@@ -76,8 +95,8 @@ struct BallMessage {
   double latency_s = 0;  // fuse clock at publication - capture time (system clocks only)
 };
 
-using Message =
-    std::variant<HelloMessage, FrameMessage, PingMessage, PongMessage, ByeMessage, BallMessage>;
+using Message = std::variant<HelloMessage, FrameMessage, SkipMessage, PingMessage, PongMessage,
+                             ByeMessage, BallMessage>;
 
 // Why a message was refused (Decode throws MessageError).
 class MessageError : public Error {

@@ -47,6 +47,30 @@ TEST(Messages, FrameRoundTripsExactly) {
   ASSERT_EQ(back->candidates.size(), 2u);
   EXPECT_EQ(back->candidates[0].centre_px, o.centre_px);
   EXPECT_TRUE(back->candidates[1].weak);
+  EXPECT_LT(back->queued_s, 0);  // not sent
+  f.queued_s = 0.0125;
+  f.process_s = 0.003;
+  const std::string timed = Encode(f);
+  const Message m2 = Decode(timed.data(), timed.size());
+  EXPECT_EQ(std::get<FrameMessage>(m2).queued_s, 0.0125);
+  EXPECT_EQ(std::get<FrameMessage>(m2).process_s, 0.003);
+}
+
+TEST(Messages, SkipRoundTripsAndBadTimingsAreRefused) {
+  SkipMessage k{"cam1", "s1", 15, 1764612345.5, "system", 0.25, true, 2};
+  const std::string bytes = Encode(k);
+  const Message m = Decode(bytes.data(), bytes.size());
+  const auto* back = std::get_if<SkipMessage>(&m);
+  ASSERT_NE(back, nullptr);
+  EXPECT_EQ(back->frame, 15);
+  EXPECT_EQ(back->time_s, k.time_s);
+  EXPECT_EQ(back->skipped, 2);
+  EXPECT_TRUE(back->has_offset);
+  EXPECT_EQ(back->offset_s, 0.25);
+  const std::string negative =
+      R"({"v":1,"type":"frame","camera":"c","session":"s","frame":1,"time_s":1,"origin":"device",)"
+      R"("clock":"system","candidates":[],"process_s":-1})";
+  EXPECT_THROW(Decode(negative.data(), negative.size()), MessageError);
 }
 
 TEST(Messages, RefusalsSayWhy) {

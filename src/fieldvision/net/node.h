@@ -15,12 +15,14 @@
 namespace fv::net {
 
 struct NodeOptions {
-  std::string camera;          // camera file (its `name`, else its stem, names the camera)
-  std::string video;           // a frame source spec (io/frame_source.h)
-  std::string connect;         // the fusion node, tcp://HOST:PORT
-  bool realtime = false;       // play a file at its frame rate (live sources always are)
-  double start_at_s = 0;       // with realtime: Unix time of frame 0 (0: now)
-  int live_buffer_frames = 4;  // frames a live source holds for a slow node
+  std::string camera;     // camera file (its `name`, else its stem, names the camera)
+  std::string video;      // a frame source spec (io/frame_source.h)
+  std::string connect;    // the fusion node, tcp://HOST:PORT
+  bool realtime = false;  // play a file at its frame rate (live sources always are)
+  double start_at_s = 0;  // with realtime: Unix time of frame 0 (0: now)
+  // Frames a live source holds for a slow node: 1 keeps only the newest (the lowest latency:
+  // a node that falls behind skips to the newest frame instead of working through old ones).
+  int live_buffer_frames = 1;
   double ball_diameter_m = 0.22;
   std::string colour = "orange";
   std::string field;  // optional: look for the ball only over this field
@@ -49,6 +51,7 @@ struct NodeSummary {
   double round_trip_s = 0;    // of the sample used
   long long bad_replies = 0;  // replies that were not valid messages
   CameraStageStats stage;
+  double process_p50_s = 0, process_p95_s = 0, process_max_s = 0;  // work per frame
   double seconds = 0;
   std::string ToString() const;
 };

@@ -25,7 +25,8 @@ LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& optio
       stats_(num_cameras),
       last_frame_(num_cameras, -1),
       last_time_(num_cameras, -std::numeric_limits<double>::infinity()),
-      last_arrival_(num_cameras, -std::numeric_limits<double>::infinity()) {
+      last_arrival_(num_cameras, -std::numeric_limits<double>::infinity()),
+      skip_until_s_(num_cameras, -std::numeric_limits<double>::infinity()) {
   FV_REQUIRE(num_cameras >= 1, "LiveSynchronizer: needs at least one camera");
   options.Check();
 }
@@ -73,8 +74,17 @@ void LiveSynchronizer::Admit(int camera, double arrival_s) {
   last_arrival_[camera] = std::max(last_arrival_[camera], arrival_s);
 }
 
+void LiveSynchronizer::SkipUntil(int camera, double time_s, double arrival_s) {
+  FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  if (!std::isfinite(time_s)) return;
+  skip_until_s_[camera] = std::max(skip_until_s_[camera], time_s);
+  stats_[camera].active = true;
+  last_arrival_[camera] = std::max(last_arrival_[camera], arrival_s);
+}
+
 void LiveSynchronizer::Restart(int camera) {
   FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  skip_until_s_[camera] = -std::numeric_limits<double>::infinity();
   ++stats_[camera].restarts;
   last_frame_[camera] = -1;
   last_time_[camera] = -std::numeric_limits<double>::infinity();
@@ -105,7 +115,8 @@ std::optional<SyncedFrame> LiveSynchronizer::Next(double now_s, bool flush) {
       first_arrival = std::min(first_arrival, b.front().arrival_s);
       continue;
     }
-    if (!b.empty()) continue;  // it has sent something later: not in this group
+    if (!b.empty()) continue;                // it has sent something later: not in this group
+    if (skip_until_s_[c] > until) continue;  // it skipped this group's frames
     // Nothing from camera c: wait for it only when it is active and not silent for long.
     if (stats_[c].active && now_s - last_arrival_[c] < options_.max_wait_s) ready = false;
   }

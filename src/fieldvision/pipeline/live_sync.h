@@ -3,7 +3,8 @@
 // cameras within `tolerance_s` of the group's earliest. A group is decided as soon as every
 // active camera has sent something later, or when its first message has waited `max_wait_s`
 // (a slow or dead camera never stalls the others: it is left out and its message, if it comes,
-// is late). Cameras that sent nothing for max_wait_s are not waited for. Late, duplicate and
+// is late). Cameras that sent nothing for max_wait_s are not waited for, nor cameras that said
+// they skipped the frames (SkipUntil). Late, duplicate and
 // out-of-order messages are dropped and counted, never paired wrongly; gaps in frame numbers
 // count as dropped frames. A restarted camera (a new session) starts a fresh stream. A
 // single-threaded state machine; the fusion node feeds it. (frame_sync.h is the offline one:
@@ -48,6 +49,9 @@ class LiveSynchronizer {
   bool Add(CameraMessage m, double arrival_s);
   // The camera is connected (e.g. it answered a clock ping at `arrival_s`): wait for its frames.
   void Admit(int camera, double arrival_s);
+  // Nothing captured before `time_s` will come from the camera (its source skipped frames): the
+  // groups before it do not wait for it.
+  void SkipUntil(int camera, double time_s, double arrival_s);
   // The camera restarted (a new session): its stream starts afresh.
   void Restart(int camera);
   // The camera's stream ended: it is no longer waited for.
@@ -73,6 +77,7 @@ class LiveSynchronizer {
   std::vector<long long> last_frame_;
   std::vector<double> last_time_;
   std::vector<double> last_arrival_;
+  std::vector<double> skip_until_s_;  // SkipUntil
   bool any_group_ = false;
   double decided_until_s_ = 0;  // messages at or before this time are late
   long long groups_ = 0, complete_groups_ = 0;

@@ -77,5 +77,36 @@ TEST(LiveSync, ADeadCameraDoesNotStallTheOthersAndItsLateFramesAreDropped) {
   EXPECT_FALSE(sync.Problems({"a", "b"}).empty());
 }
 
+// A camera whose source skipped frames says so (SkipUntil): the others' frames before it are
+// paired at once instead of waiting for that camera; frames after it still wait.
+TEST(LiveSync, SkippedFramesAreNotWaitedFor) {
+  LiveSyncOptions o;
+  o.max_wait_s = 10;  // far longer than the test: only SkipUntil can release a group
+  LiveSynchronizer sync(2, o);
+  const double dt = 1 / 60.0;
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_TRUE(sync.Add(Msg(0, k, 100 + k * dt), 1.0));
+    ASSERT_TRUE(sync.Add(Msg(1, k, 100 + k * dt), 1.0));
+  }
+  ASSERT_TRUE(sync.Next(1.0));
+  ASSERT_TRUE(sync.Next(1.0));
+  // Camera 0 sends frames 2..4; camera 1 skipped 2 and 3 and is working on 4.
+  for (int k = 2; k < 5; ++k) ASSERT_TRUE(sync.Add(Msg(0, k, 100 + k * dt), 1.0));
+  EXPECT_FALSE(sync.Next(1.0));  // waits for camera 1's frame 2
+  sync.SkipUntil(1, 100 + 4 * dt, 1.0);
+  for (int k = 2; k < 4; ++k) {
+    const auto g = sync.Next(1.0);
+    ASSERT_TRUE(g) << "frame " << k;
+    EXPECT_EQ(g->frame, k);
+    EXPECT_EQ(g->present(), 1);
+  }
+  EXPECT_FALSE(sync.Next(1.0));  // frame 4 waits for camera 1
+  ASSERT_TRUE(sync.Add(Msg(1, 4, 100 + 4 * dt), 1.0));
+  const auto g = sync.Next(1.0);
+  ASSERT_TRUE(g);
+  EXPECT_EQ(g->present(), 2);
+  EXPECT_EQ(sync.stats()[1].late, 0);
+}
+
 }  // namespace
 }  // namespace fv
