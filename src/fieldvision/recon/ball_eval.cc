@@ -6,30 +6,24 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
 namespace fv {
 namespace {
 
-struct Entry {
-  double time_s = 0;
-  Eigen::Vector3d p;
-  int n_cams = -1;
-};
-
-std::map<long long, Entry> ReadTrack(const CsvTable& t) {
+// A truth or estimate file by frame (BALL.csv columns; frame and x_m, y_m, z_m required); n_cams
+// is -1 when the file has no such column.
+std::map<long long, BallSample> ReadTrack(const CsvTable& t) {
   t.Require({"frame", "x_m", "y_m", "z_m"});
-  std::map<long long, Entry> out;
+  std::map<long long, BallSample> out;
   for (size_t r = 0; r < t.rows(); ++r) {
-    Entry e;
-    const long long frame = t.GetInt(r, "frame");
-    FV_REQUIRE(frame >= 0, "{}: frame must be >= 0", t.Where(r));
-    e.p = {t.GetDouble(r, "x_m"), t.GetDouble(r, "y_m"), t.GetDouble(r, "z_m")};
-    FV_REQUIRE(e.p.allFinite(), "{}: x_m, y_m, z_m must be finite numbers", t.Where(r));
-    if (t.Has("time_s")) e.time_s = t.GetDouble(r, "time_s");
-    if (t.Has("n_cams")) e.n_cams = static_cast<int>(t.GetInt(r, "n_cams"));
-    FV_REQUIRE(out.emplace(frame, e).second, "{}: frame {} is listed twice", t.Where(r), frame);
+    BallSample s = ReadBallCsvRow(t, r);
+    FV_REQUIRE(s.frame >= 0, "{}: frame must be >= 0", t.Where(r));
+    FV_REQUIRE(s.ball_in_world.allFinite(), "{}: x_m, y_m, z_m must be finite numbers", t.Where(r));
+    if (!t.Has("n_cams")) s.n_cams = -1;
+    FV_REQUIRE(out.emplace(s.frame, s).second, "{}: frame {} is listed twice", t.Where(r), s.frame);
   }
   return out;
 }
@@ -61,8 +55,8 @@ BallEvalResult EvaluateBall(const CsvTable& truth_table, const CsvTable& est_tab
     BallErrorRow row;
     row.frame = frame;
     row.time_s = t.time_s;
-    row.truth_m = t.p;
-    row.est_m = it->second.p;
+    row.truth_m = t.ball_in_world;
+    row.est_m = it->second.ball_in_world;
     row.truth_n_cams = t.n_cams;
     row.est_n_cams = it->second.n_cams;
     row.err_mm = 1000.0 * (row.est_m - row.truth_m).norm();

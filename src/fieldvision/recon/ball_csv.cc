@@ -1,0 +1,99 @@
+#include "fieldvision/recon/ball_csv.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+
+const std::vector<std::string>& BallCsvColumns() {
+  static const std::vector<std::string> kColumns = {"frame", "time_s", "x_m",   "y_m",
+                                                    "z_m",   "n_cams", "err_px"};
+  return kColumns;
+}
+
+BallSample ReadBallCsvRow(const CsvTable& t, size_t r) {
+  BallSample s;
+  if (t.Has("time_s")) s.time_s = t.GetDouble(r, "time_s");
+  s.ball_in_world = {t.GetDouble(r, "x_m"), t.GetDouble(r, "y_m"), t.GetDouble(r, "z_m")};
+  if (t.Has("frame")) s.frame = t.GetInt(r, "frame");
+  if (t.Has("n_cams")) s.n_cams = static_cast<int>(t.GetInt(r, "n_cams"));
+  if (t.Has("err_px")) s.err_px = t.GetDouble(r, "err_px");
+  return s;
+}
+
+namespace {
+
+BallSample ReadTt3dRow(const CsvTable& t, size_t r) {
+  BallSample s;
+  s.time_s = t.GetDouble(r, "Timestamp");
+  s.ball_in_world = {t.GetDouble(r, "X"), t.GetDouble(r, "Y"), t.GetDouble(r, "Z")};
+  return s;
+}
+
+}  // namespace
+
+BallTrackFile ParseBallTrack(const CsvTable& t) {
+  BallTrackFile out;
+  if (t.Has("time_s") || t.Has("x_m") || t.Has("frame")) {
+    t.Require({"time_s", "x_m", "y_m", "z_m"});
+    out.layout = "ball";
+  } else if (t.Has("Timestamp")) {
+    t.Require({"Timestamp", "X", "Y", "Z"});
+    out.layout = "tt3d";
+  } else {
+    Throw(
+        "ball track '{}': unknown columns (expected frame,time_s,x_m,y_m,z_m,n_cams,err_px "
+        "or Timestamp,X,Y,Z)",
+        t.name());
+  }
+  int out_of_order = 0;
+  for (size_t r = 0; r < t.rows(); ++r) {
+    BallSample s;
+    try {
+      s = out.layout == "ball" ? ReadBallCsvRow(t, r) : ReadTt3dRow(t, r);
+    } catch (const Error& e) {
+      out.skipped.push_back(fmt::format("{}; row skipped", e.what()));
+      continue;
+    }
+    if (!std::isfinite(s.time_s) || !s.ball_in_world.allFinite()) {
+      out.skipped.push_back(
+          fmt::format("{}: NaN or infinite time or position; row skipped", t.Where(r)));
+      continue;
+    }
+    if (!out.samples.empty() && s.time_s <= out.samples.back().time_s) {
+      const bool dup = s.time_s == out.samples.back().time_s;
+      out_of_order += !dup;
+      out.skipped.push_back(fmt::format("{}: time {} s {} the previous row's {} s; row skipped",
+                                        t.Where(r), s.time_s, dup ? "repeats" : "is before",
+                                        out.samples.back().time_s));
+      continue;
+    }
+    out.samples.push_back(s);
+  }
+  FV_REQUIRE(!out.samples.empty(), "ball track '{}': no valid rows ({} skipped)", t.name(),
+             out.skipped.size());
+  FV_REQUIRE(out_of_order <= static_cast<int>(out.samples.size()),
+             "ball track '{}': times are not increasing ({} rows out of order); sort the file "
+             "by time",
+             t.name(), out_of_order);
+  return out;
+}
+
+BallTrackFile ReadBallTrack(const std::string& path) {
+  return ParseBallTrack(CsvTable::Read(path));
+}
+
+void WriteBallTrack(const std::string& path, const std::vector<BallSample>& samples) {
+  CsvWriter w(path, BallCsvColumns());
+  for (const auto& s : samples) {
+    w << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y() << s.ball_in_world.z()
+      << s.n_cams << s.err_px;
+    w.EndRow();
+  }
+  w.Close();
+}
+
+}  // namespace fv

@@ -1,0 +1,36 @@
+// BALL.csv, the ball track file of CONTRACT.md (`frame,time_s,x_m,y_m,z_m,n_cams,err_px`; truth
+// files use the same columns), and the TT3D layout (`Timestamp,X,Y,Z`): the one reader and
+// writer that every ball-track user in recon goes through.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "fieldvision/recon/trajectory.h"
+#include "fieldvision/util/csv.h"
+
+namespace fv {
+
+// frame,time_s,x_m,y_m,z_m,n_cams,err_px
+const std::vector<std::string>& BallCsvColumns();
+
+// Row r of a BALL.csv table: x_m, y_m, z_m and, where the table has the column, frame, time_s,
+// n_cams and err_px (BallSample's defaults otherwise). Throws fv::Error naming the file and line
+// for a cell that is not a number; finiteness is the caller's to check.
+BallSample ReadBallCsvRow(const CsvTable& table, size_t r);
+
+struct BallTrackFile {
+  std::vector<BallSample> samples;   // strictly increasing times
+  std::string layout;                // "ball" (BALL.csv) or "tt3d" (Timestamp,X,Y,Z)
+  std::vector<std::string> skipped;  // one "file:line: reason" per skipped row
+};
+
+// A ball track for fitting flights: throws fv::Error naming the file when columns are missing, no
+// row is valid or most rows are out of time order; skips (and names) single bad rows (not
+// numbers, NaN, times not increasing, duplicates).
+BallTrackFile ParseBallTrack(const CsvTable& table);
+BallTrackFile ReadBallTrack(const std::string& path);
+// Writes BALL.csv (BallCsvColumns()).
+void WriteBallTrack(const std::string& path, const std::vector<BallSample>& samples);
+
+}  // namespace fv
