@@ -1,14 +1,9 @@
-// Triangulation of the ball centre from 1..N calibrated cameras. Two-ray closest point (the
-// seeds' midpoint method); N-view linear triangulation (DLT on undistorted normalized points,
-// Hartley & Zisserman, "Multiple View Geometry", 2nd ed., sec. 12.2) refined by Ceres on the
-// reprojection error weighted by each detection's sigma_px, with the covariance (J^T J)^-1 of the
-// point (H&Z sec. 5.2); a robust mode that scores every two-view hypothesis over all candidate
-// blobs and keeps the largest set of cameras that agree within a few pixels (exhaustive RANSAC,
-// Fischler & Bolles 1981); a single camera with the ball on the ground (centre at z = radius).
-// Written here because OpenCV's triangulatePoints is two-view, unweighted and has no robust mode.
-// A ball of radius r projects to an ellipse whose centre is not the image of the sphere's centre:
-// with outline_centre the model predicts the outline's centre, (X Z, Y Z) / (Z^2 - r^2) in
-// normalized coordinates (exact for the tangent cone), for detectors that report blob centres.
+// Triangulation of the ball centre from 1..N calibrated cameras, one method a file
+// (triangulation_*.cc): two rays (closest point), N views linear (DLT, Hartley & Zisserman 2nd ed.
+// sec. 12.2) and refined (Ceres, covariance H&Z sec. 5.2), a robust search over the candidates
+// (exhaustive RANSAC, Fischler & Bolles 1981) and one camera with the ball on the ground. With
+// outline_centre the model predicts a blob's centre: (X Z, Y Z) / (Z^2 - r^2) in normalized
+// coordinates (exact for the tangent cone).
 #pragma once
 
 #include <optional>

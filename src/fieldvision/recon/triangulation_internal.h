@@ -1,0 +1,71 @@
+// Shared by the triangulation methods (triangulation_*.cc), not part of the public interface:
+// the templated ball-centre projection and the checks and helpers they all use.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <ceres/rotation.h>
+
+#include "fieldvision/camera/projection.h"
+#include "fieldvision/recon/triangulation.h"
+
+namespace fv::triangulation_detail {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+// The camera's parameters as plain arrays for the templated projection.
+struct CameraBlock {
+  std::array<double, kNumIntrinsics> intrinsics;
+  std::array<double, 3> rvec;
+  std::array<double, 3> tvec;
+  explicit CameraBlock(const Camera& cam) : intrinsics(cam.IntrinsicsBlock()) {
+    const Eigen::Vector3d r = cam.cam_from_world.Rvec();
+    const Eigen::Vector3d& t = cam.cam_from_world.translation;
+    rvec = {r.x(), r.y(), r.z()};
+    tvec = {t.x(), t.y(), t.z()};
+  }
+};
+
+// World point -> predicted blob centre in pixels (see the header for the outline model).
+template <typename T>
+bool PredictCentre(const CameraBlock& cam, double radius_m, const T* p_world, T* uv) {
+  T intr[kNumIntrinsics];
+  for (int i = 0; i < kNumIntrinsics; ++i) intr[i] = T(cam.intrinsics[i]);
+  const T rvec[3] = {T(cam.rvec[0]), T(cam.rvec[1]), T(cam.rvec[2])};
+  const T tvec[3] = {T(cam.tvec[0]), T(cam.tvec[1]), T(cam.tvec[2])};
+  if (radius_m <= 0.0) return ProjectWorldPoint(intr, rvec, tvec, p_world, uv);
+  T p_cam[3];
+  ceres::AngleAxisRotatePoint(rvec, p_world, p_cam);
+  for (int i = 0; i < 3; ++i) p_cam[i] += tvec[i];
+  if (!(p_cam[2] > T(radius_m))) return false;
+  // Scaling the normalized point by Z^2 / (Z^2 - r^2) moves it to the outline's centre.
+  const T q[3] = {p_cam[0] * p_cam[2], p_cam[1] * p_cam[2],
+                  p_cam[2] * p_cam[2] - T(radius_m * radius_m)};
+  return ProjectCameraPoint(intr, q, uv);
+}
+
+double Depth(const Camera& cam, const Eigen::Vector3d& p_world);
+// Radius for the outline-centre model (0: observations are projections of the centre).
+double ModelRadius(const TriangulationOptions& o);
+// The reprojection error below which a view is consistent.
+double Threshold(const TriangulationOptions& o, double sigma_px);
+void CheckObservation(const BallObservation& obs, const std::string& what);
+void CheckCamera(const std::vector<Camera>& cameras, int index);
+bool InFrontOfAll(const std::vector<Camera>& cameras, const std::vector<View>& views,
+                  const Eigen::Vector3d& p, double min_depth_m);
+
+// Refines `p` (3 values, or x, y when `ground`) on the views; fills residuals, rms, covariance.
+void Refine(const std::vector<Camera>& cameras, const std::vector<View>& views,
+            const std::vector<int>& candidate_index, bool ground, const TriangulationOptions& o,
+            Eigen::Vector3d* p, TriangulationResult* result);
+
+// All views together (triangulation_refine.cc): degeneracy check, DLT, refinement; the
+// candidate index of each view is reported in the residuals.
+TriangulationResult TriangulateViews(const std::vector<Camera>& cameras,
+                                     const std::vector<View>& views,
+                                     const std::vector<int>& candidate_index,
+                                     const TriangulationOptions& o);
+
+}  // namespace fv::triangulation_detail
