@@ -29,9 +29,16 @@ void RunEvalTracks(const EvalTracksCli& c) {
   const track::MotMetrics m = track::EvaluateMot(gt, est, c.o);
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
   if (!c.json.empty()) {
-    std::ofstream out(c.json);
-    FV_REQUIRE(out.good(), "cannot write '{}'", c.json);
-    out << m.ToJson() << "\n";
+    AtomicWrite(
+        c.json,
+        [&](const std::string& tmp) {
+          std::ofstream out(tmp);
+          FV_REQUIRE(out.good(), "cannot write '{}'", c.json);
+          out << m.ToJson() << "\n";
+          out.close();
+          FV_REQUIRE(!out.fail(), "cannot write '{}'", c.json);
+        },
+        "--json");
   }
 }
 
@@ -60,7 +67,10 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Also count estimated rows in frames outside the ground truth's first..last frame "
                 "(default: left out)");
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
-  cmd->callback([c] { RunEvalTracks(*c); });
+  cmd->callback([c] {
+    CheckOutputPath(c->json, {c->gt, c->est}, "--json");
+    RunEvalTracks(*c);
+  });
 
   auto p = std::make_shared<ImportPetsCli>();
   CLI::App* imp =

@@ -77,6 +77,9 @@ void WriteMotChallenge(const std::vector<TrackRow>& rows, const std::string& pat
 }
 
 std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
+  // Ranges of the numbers read (NaN fails them too).
+  constexpr double kMaxPixel = 1e6;
+  constexpr double kMaxFieldM = 1e4;
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "cannot open tracks file '{}'", path);
   std::vector<TrackRow> rows;
@@ -118,14 +121,26 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
     r.id = static_cast<int>(ParseInt(field("id"), where + " id"));
     r.box =
         cv::Rect2d(number("bb_left"), number("bb_top"), number("bb_width"), number("bb_height"));
+    FV_REQUIRE(std::abs(r.box.x) <= kMaxPixel && std::abs(r.box.y) <= kMaxPixel &&
+                   r.box.width <= kMaxPixel && r.box.height <= kMaxPixel,
+               "{}: box {},{},{},{} is not a box in an image (finite, within +-{:.0f} px)", where,
+               r.box.x, r.box.y, r.box.width, r.box.height, kMaxPixel);
     FV_REQUIRE(r.box.width >= 0 && r.box.height >= 0, "{}: negative box size", where);
     if (!field("conf").empty()) r.conf = number("conf");
+    FV_REQUIRE(std::isfinite(r.conf), "{}: conf is not a finite number", where);
     if (header) {
       if (!field("x_m").empty() && !field("y_m").empty()) {
         r.x_m = number("x_m");
         r.y_m = number("y_m");
+        FV_REQUIRE(std::abs(*r.x_m) <= kMaxFieldM && std::abs(*r.y_m) <= kMaxFieldM,
+                   "{}: field position {}, {} m is not finite or beyond +-{:.0f} m (leave x_m,y_m "
+                   "empty when unknown)",
+                   where, *r.x_m, *r.y_m, kMaxFieldM);
       }
-      if (!field("time_s").empty()) r.time_s = number("time_s");
+      if (!field("time_s").empty()) {
+        r.time_s = number("time_s");
+        FV_REQUIRE(std::isfinite(*r.time_s), "{}: time_s is not a finite number", where);
+      }
     } else if (f.size() == 9) {
       // MOT16/17/20 ground truth: class and visibility.
       r.mot_class = static_cast<int>(ParseDouble(Trim(f[7]), where + " class"));
@@ -292,9 +307,27 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
 
 }  // namespace
 
+namespace {
+
+// MOTChallenge allows one box per id and frame; a second would be counted twice.
+void CheckOneBoxPerIdAndFrame(const std::vector<TrackRow>& rows, const std::string& what) {
+  std::map<std::pair<int, int>, size_t> seen;  // (frame, id) -> row
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto [it, fresh] = seen.emplace(std::pair{rows[i].frame, rows[i].id}, i);
+    FV_REQUIRE(fresh,
+               "{}: id {} has two boxes in frame {} (rows {} and {}); every id may have one box "
+               "per frame",
+               what, rows[i].id, rows[i].frame, it->second + 1, i + 1);
+  }
+}
+
+}  // namespace
+
 MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,
                        const MotOptions& options) {
   options.Check();
+  CheckOneBoxPerIdAndFrame(gt_in, "ground truth");
+  CheckOneBoxPerIdAndFrame(est_in, "estimate");
   std::vector<TrackRow> gt, est;
   MotPreprocessing pre;
   Preprocess(gt_in, est_in, options, gt, est, pre);
@@ -316,6 +349,11 @@ MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<Tra
   m.gt_ids = static_cast<int>(gt_index.size());
   m.est_ids = static_cast<int>(est_index.size());
   const int ng = m.gt_ids, ne = m.est_ids;
+  // The id-pair table below holds ng x ne counts.
+  FV_REQUIRE(static_cast<double>(ng) * ne <= 5e7,
+             "eval tracks: {} ground-truth ids x {} estimated ids is too many id pairs to score "
+             "(at most 5e7)",
+             ng, ne);
   const double thr = options.iou_threshold;
 
   // CLEAR MOT and the per-id-pair counts for IDF1, and HOTA's similarity sums.

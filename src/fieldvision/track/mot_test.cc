@@ -103,6 +103,44 @@ TEST(Mot, CsvRoundTripAndBadFile) {
   }
 }
 
+TEST(Mot, NumbersOutOfRangeNameTheLine) {
+  const std::string dir = fv::testing::TempDir();
+  const std::string header = "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n";
+  for (const std::string row :
+       {"1,1,0,0,10,20,1,nan,0,", "1,1,0,0,10,20,1,1e300,0,", "1,1,0,0,10,20,1,0,inf,",
+        "1,1,nan,0,10,20,1,,,", "1,1,0,0,1e300,20,1,,,", "1,1,0,0,10,20,nan,,,",
+        "1,1,0,0,10,20,1,,,nan"}) {
+    SCOPED_TRACE(row);
+    std::ofstream(dir + "/r.csv", std::ios::trunc) << header << "1,1,0,0,10,20,1,,,\n" << row;
+    try {
+      ReadTracksCsv(dir + "/r.csv");
+      ADD_FAILURE() << "no error";
+    } catch (const fv::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("r.csv:3"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(Mot, TwoBoxesOfOneIdInAFrameAreRefused) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const auto gt = Walkers(rng, 2, 10);
+  auto est = gt;
+  est.push_back(gt[3]);  // frame 3 of id 1 twice: IDF1 was 1.1
+  for (const bool in_est : {true, false}) {
+    try {
+      in_est ? EvaluateMot(gt, est) : EvaluateMot(est, gt);
+      ADD_FAILURE() << "no error";
+    } catch (const fv::Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(in_est ? "estimate" : "ground truth"), std::string::npos) << what;
+      EXPECT_NE(what.find("id 1 has two boxes in frame 3 (rows 4 and 21)"), std::string::npos)
+          << what;
+    }
+  }
+}
+
 // TRACKS.csv keeps time_s; a file without it (older TRACKS.csv) still reads.
 TEST(Mot, TimeRoundTripAndMotChallengeOutput) {
   const std::string dir = fv::testing::TempDir();
