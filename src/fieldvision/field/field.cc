@@ -38,6 +38,16 @@ void FieldModel::Check() const {
   CheckPositive(width_m, (ctx + " width_m").c_str());
   CheckPositive(line_width_m, (ctx + " line_width_m").c_str());
   CheckNonNegative(surround_m, (ctx + " surround_m").c_str());
+  // Sizes a sports ground can have (maps, grids and heat maps are sized from them).
+  constexpr double kMaxSideM = 1000.0, kMaxAspect = 20.0;
+  FV_REQUIRE(length_m <= kMaxSideM && width_m <= kMaxSideM && surround_m <= kMaxSideM &&
+                 line_width_m <= std::min(length_m, width_m),
+             "{}: {} x {} m with {} m lines and a {} m surround is not a field (sides and "
+             "surround at most {:.0f} m, lines narrower than the field)",
+             ctx, length_m, width_m, line_width_m, surround_m, kMaxSideM);
+  FV_REQUIRE(std::max(length_m, width_m) <= kMaxAspect * std::min(length_m, width_m),
+             "{}: {} x {} m: one side is more than {:.0f} times the other", ctx, length_m, width_m,
+             kMaxAspect);
   for (const auto& s : segments) {
     FV_REQUIRE(s.a.allFinite() && s.b.allFinite() && std::isfinite(s.width_m) && s.width_m > 0,
                "{}: line '{}' has a non-finite end or a bad width", ctx, s.name);

@@ -25,7 +25,11 @@ TopView TopView::ForField(const FieldModel& field, int width_px, double extra_ma
   v.px_per_m = width_px / (2 * hx);
   v.x_min_m = -hx;
   v.y_max_m = hy;
-  v.size = cv::Size(width_px, static_cast<int>(std::lround(2 * hy * v.px_per_m)));
+  const double height_px = 2 * hy * v.px_per_m;
+  FV_REQUIRE(height_px >= 1 && width_px * height_px <= 300e6,
+             "a top view of field '{}' {} px wide would be {:.0f} px high (at most 300 Mpx in all)",
+             field.name, width_px, height_px);
+  v.size = cv::Size(width_px, static_cast<int>(std::lround(height_px)));
   return v;
 }
 

@@ -143,6 +143,22 @@ TEST(Fields, BadNamesAndFiles) {
             {"name": "a", "position_m": [1,0,0]}]})";
   EXPECT_THROW(LoadField(dir + "/dup.json"), Error);
   EXPECT_THROW(LoadField(dir + "/missing.json"), Error);
+  // Sizes no sports ground has (maps and grids are sized from them) are refused, named.
+  for (const std::string size :
+       {R"("length_m": 1e308, "width_m": 1e308)", R"("length_m": 1001, "width_m": 500)",
+        R"("length_m": 1, "width_m": 1000)",
+        R"("length_m": 100, "width_m": 50, "surround_m": 1e9)"}) {
+    SCOPED_TRACE(size);
+    std::ofstream(dir + "/huge.json", std::ios::trunc) << "{\"name\": \"huge\", " << size << "}";
+    try {
+      LoadField(dir + "/huge.json");
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("huge"), std::string::npos) << e.what();
+    }
+  }
+  std::ofstream(dir + "/polo.json", std::ios::trunc) << R"({"length_m": 275, "width_m": 146})";
+  EXPECT_NO_THROW(LoadField(dir + "/polo.json"));
 }
 
 TEST(FieldDraw, TopViewMapsCornersAndDrawsLines) {
