@@ -5,6 +5,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/recon/ball_eval.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -30,6 +31,11 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->callback([o] {
     const BallEvalResult r = EvaluateBallFiles(o->truth, o->est, o->eval);
+    // Nothing matched: no error to report (a mean of 0 mm would read as perfect).
+    FV_REQUIRE(!r.rows.empty(),
+               "eval ball: no frame of '{}' ({} rows) is a frame of '{}' ({} rows): nothing to "
+               "compare (are both numbered from the same first frame?)",
+               o->est, r.estimates, o->truth, r.truth_frames);
     std::cout << r.Table(o->rows || r.rows.size() <= 40) << "\n";
   });
 }

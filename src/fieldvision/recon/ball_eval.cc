@@ -101,6 +101,10 @@ std::string BallEvalResult::Table(bool per_row) const {
       "({:.2f} %); {} estimates without truth\n",
       rows.size(), truth_frames, visible_found, visible_frames, options.min_truth_cams,
       100.0 * found_fraction(), estimates_without_truth);
+  if (rows.empty()) {
+    s += "error mm: none (no estimate has a truth frame to compare with)";
+    return s;
+  }
   s += fmt::format(
       "error mm: mean {:.2f}, median {:.2f}, p95 {:.2f}, max {:.2f}; {} estimates "
       "more than {} m off",

@@ -64,5 +64,15 @@ TEST(BallEval, BadFilesNameTheLine) {
   EXPECT_THROW(EvaluateBallFiles("/nonexistent/truth.csv", "/nonexistent/b.csv"), Error);
 }
 
+TEST(BallEval, NothingMatchedReportsNoError) {
+  const BallEvalResult r =
+      EvaluateBall(CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n1,1,2,3\n", "truth.csv"),
+                   CsvTable::Parse("frame,x_m,y_m,z_m\n5,1,2,3\n", "ball.csv"));
+  EXPECT_TRUE(r.rows.empty());
+  const std::string table = r.Table(false);
+  EXPECT_EQ(table.find("mean"), std::string::npos) << table;
+  EXPECT_NE(table.find("error mm: none"), std::string::npos) << table;
+}
+
 }  // namespace
 }  // namespace fv
