@@ -1,6 +1,10 @@
 // Calibrate: open a frame of a camera's video, pick a field keypoint (list or field map), click
 // it in the image (zoom loupe follows the pointer); with 4+ points the server estimates the pose
 // (calib/extrinsics.h) and the page shows residuals in px and mm and the field lines reprojected.
+// "Refine with lines" moves that pose so that the frame's painted lines fall on the field model's
+// (calib/lines.h): line pixels found (green), line error before and after; saving then writes the
+// refined pose. "Intrinsics from board images" calibrates a camera from chessboard or ChArUco
+// views (calib/intrinsics.h) with each view's error and the views dropped.
 import * as api from './api';
 import { el, fileSelect, optionsSelect, labelled, status, FieldMap } from './ui';
 
@@ -22,6 +26,42 @@ interface PoseResult {
   wrote?: string[];
 }
 
+interface LineStats {
+  num_pixels: number;
+  num_inliers: number;
+  mean_mm: number;
+  median_mm: number;
+  p95_mm: number;
+}
+
+interface RefineResult {
+  accepted: boolean;
+  status: string;
+  before: LineStats;
+  after: LineStats;
+  num_line_pixels: number;
+  moved_m: number;
+  rotated_deg: number;
+  camera_position_m: number[];
+  line_pixels: number[][];
+  lines_px: number[][][];
+  summary: string;
+  wrote: string[];
+}
+
+interface IntrinsicsResult {
+  camera: api.CameraJson & { distortion: number[] };
+  rms_px: number;
+  num_images: number;
+  num_found: number;
+  num_used: number;
+  views: { name: string; board_found: boolean; num_corners: number; rms_px: number; used: boolean; dropped_because: string }[];
+  std_px: number[];
+  warnings: string[];
+  summary: string;
+  wrote: string[];
+}
+
 export async function calibratePage(root: HTMLElement): Promise<void> {
   const [list, info] = await Promise.all([api.files(), api.info()]);
   const video = fileSelect('cal-video', list, ['video', 'images']);
@@ -32,6 +72,8 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
   const out = el('input', { id: 'cal-out', value: '' });
   const save = el('button', { id: 'cal-save', text: 'Save camera file' });
   const undo = el('button', { id: 'cal-undo', text: 'Remove last point' });
+  const refine = el('button', { id: 'cal-refine', text: 'Refine with lines' });
+  const refineResult = el('div', { id: 'cal-refine-result' });
   const msg = el('div', { id: 'cal-status', class: 'status' });
   const image = el('canvas', { id: 'cal-image', class: 'frame' });
   const loupe = el('canvas', { id: 'cal-loupe', width: '180', height: '180' });
@@ -49,9 +91,10 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
     el('section', { class: 'controls' }, labelled('Video', video), labelled('Frame', frame),
       labelled('Camera (intrinsics)', camera), labelled('Field', field), load),
     el('div', { class: 'workspace' },
-      el('div', { class: 'main-view' }, image, msg, result, table),
+      el('div', { class: 'main-view' }, image, msg, result, refineResult, table),
       el('div', { class: 'side' }, el('h3', { text: 'Keypoint to click' }), map, keypointList,
-        el('h3', { text: 'Loupe (6x)' }), loupe, el('p', {}, labelled('Save as', out)), save, undo)),
+        el('h3', { text: 'Loupe (6x)' }), loupe, el('p', {}, refine, ' ', undo), el('p', {}, labelled('Save as', out)), save)),
+    intrinsicsSection(list),
   );
 
   let img: HTMLImageElement | null = null;
@@ -60,6 +103,7 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
   let clicks: Click[] = [];
   let selected = '';
   let pose: PoseResult | null = null;
+  let refined: RefineResult | null = null;
   let pointer: [number, number] | null = null;
   let requestId = 0;
 
@@ -119,6 +163,17 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
         ctx.arc(p.projected[0] + 0.5, p.projected[1] + 0.5, 4 * lw, 0, 2 * Math.PI);
         ctx.moveTo(p.u + 0.5, p.v + 0.5);
         ctx.lineTo(p.projected[0] + 0.5, p.projected[1] + 0.5);
+        ctx.stroke();
+      }
+    }
+    if (refined) {
+      ctx.fillStyle = 'rgba(0, 255, 80, 0.8)';
+      for (const [u, v] of refined.line_pixels) ctx.fillRect(u, v, lw, lw);
+      ctx.strokeStyle = 'rgba(255, 120, 0, 0.95)';
+      ctx.lineWidth = lw;
+      for (const line of refined.lines_px) {
+        ctx.beginPath();
+        line.forEach(([u, v], i) => (i ? ctx.lineTo(u + 0.5, v + 0.5) : ctx.moveTo(u + 0.5, v + 0.5)));
         ctx.stroke();
       }
     }
@@ -190,8 +245,29 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
     );
   }
 
+  function showRefined() {
+    if (!refined) {
+      refineResult.replaceChildren();
+      return;
+    }
+    const r = refined;
+    const p = r.camera_position_m.map((v) => v.toFixed(3)).join(', ');
+    refineResult.replaceChildren(
+      el('div', {
+        id: 'cal-refine-summary', 'data-accepted': r.accepted ? '1' : '0', 'data-before-mm': String(r.before.mean_mm), 'data-after-mm': String(r.after.mean_mm),
+        'data-position': JSON.stringify(r.camera_position_m),
+        text: r.accepted
+          ? `refined against ${r.num_line_pixels} line pixels: line error mean ${r.before.mean_mm.toFixed(1)} → ${r.after.mean_mm.toFixed(1)} mm, median ${r.before.median_mm.toFixed(1)} → ${r.after.median_mm.toFixed(1)} mm, p95 ${r.before.p95_mm.toFixed(1)} → ${r.after.p95_mm.toFixed(1)} mm; camera moved ${(1000 * r.moved_m).toFixed(0)} mm, turned ${r.rotated_deg.toFixed(2)}°, now at (${p}) m`
+          : `not refined: ${r.status} (line error mean ${r.before.mean_mm.toFixed(1)} mm over ${r.num_line_pixels} line pixels)`,
+      }),
+      el('div', { class: 'hint', text: 'green: line pixels found in the frame; orange: the field lines at the refined pose. Saving writes the refined pose.' }),
+    );
+  }
+
   async function solve() {
     const id = ++requestId;
+    refined = null;
+    showRefined();
     if (clicks.length < 4) {
       pose = null;
       showPose();
@@ -240,6 +316,23 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
     }
     if (best) selectKeypoint(best);
   });
+  const refineBody = () => ({
+    camera: camera.value, field: field.value, video: video.value, frame: Number(frame.value),
+    ...(clicks.length >= 4 ? { points: clicks } : {}),
+  });
+  refine.onclick = async () => {
+    if (!img) return;
+    try {
+      status(msg, 'refining against the painted lines…');
+      const r = await api.post<RefineResult>('/api/calibrate/refine', refineBody());
+      refined = r;
+      showRefined();
+      draw();
+      status(msg, r.accepted ? 'pose refined against the lines' : `not refined: ${r.status}`, !r.accepted);
+    } catch (e) {
+      status(msg, (e as Error).message, true);
+    }
+  };
   undo.onclick = () => {
     clicks.pop();
     nextKeypoint();
@@ -264,6 +357,8 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
       );
       clicks = [];
       pose = null;
+      refined = null;
+      showRefined();
       nextKeypoint();
       draw();
       await solve();
@@ -274,6 +369,14 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
   };
   save.onclick = async () => {
     try {
+      if (refined?.accepted) {
+        const r = await api.post<RefineResult>('/api/calibrate/refine', { ...refineBody(), out: out.value });
+        refined = r;
+        showRefined();
+        draw();
+        status(msg, r.wrote.length ? `wrote ${r.wrote.join(', ')} (refined against the lines)` : `not written: ${r.status}`, !r.wrote.length);
+        return;
+      }
       const r = await api.post<PoseResult>('/api/calibrate/save', {
         camera: camera.value, field: field.value, points: clicks, out: out.value,
         points_out: out.value.replace(/(\.ya?ml)?$/i, '_points.csv'),
@@ -286,4 +389,68 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
       status(msg, (e as Error).message, true);
     }
   };
+}
+
+// Intrinsics from board images: a folder, a pattern (dir/left*.jpg) or a video of the folder.
+function intrinsicsSection(list: api.FileEntry[]): HTMLElement {
+  const folders = [...new Set(list.filter((f) => f.kind === 'image').map((f) => f.path.replace(/[^/]*$/, '')))];
+  const images = el('input', { id: 'int-images', size: '28', value: folders.length ? `${folders[0]}*.${list.find((f) => f.kind === 'image')!.path.split('.').pop()}` : '' });
+  const type = optionsSelect('int-board', ['chessboard', 'charuco'], 'chessboard');
+  const cols = el('input', { id: 'int-cols', type: 'number', value: '9', min: '2', style: 'width:4em' });
+  const rows = el('input', { id: 'int-rows', type: 'number', value: '6', min: '2', style: 'width:4em' });
+  const square = el('input', { id: 'int-square', type: 'number', value: '25', min: '0.1', step: '0.1', style: 'width:5em' });
+  const dist = optionsSelect('int-distortion', ['4', '5', '8'], '5');
+  const out = el('input', { id: 'int-out', value: 'intrinsics.yaml' });
+  const run = el('button', { id: 'int-run', text: 'Calibrate intrinsics' });
+  const msg = el('div', { id: 'int-status', class: 'status' });
+  const table = el('table', { id: 'int-views' });
+  const chart = el('canvas', { id: 'int-chart', width: '600', height: '140' });
+  run.onclick = async () => {
+    try {
+      status(msg, 'finding the board in every image and calibrating…');
+      table.replaceChildren();
+      const r = await api.post<IntrinsicsResult>('/api/calibrate/intrinsics', {
+        images: images.value, num_distortion: Number(dist.value), out: out.value || undefined,
+        board: { type: type.value, cols: Number(cols.value), rows: Number(rows.value), square_m: Number(square.value) / 1000 },
+      });
+      const c = r.camera;
+      status(msg, `fx ${c.fx.toFixed(1)} fy ${c.fy.toFixed(1)} cx ${c.cx.toFixed(1)} cy ${c.cy.toFixed(1)} px (± ${r.std_px.map((v) => v.toFixed(1)).join(', ')}), ` +
+        `RMS ${r.rms_px.toFixed(3)} px over ${r.num_used} of ${r.num_images} views (${r.num_found} with the board)` +
+        `${r.warnings.length ? '; ' + r.warnings.join('; ') : ''}${r.wrote.length ? '; wrote ' + r.wrote.join(', ') : ''}`);
+      msg.dataset.fx = String(c.fx);
+      table.replaceChildren(
+        el('tr', {}, ...['view', 'board', 'corners', 'error px', ''].map((h) => el('th', { text: h }))),
+        ...r.views.map((v) => el('tr', { class: v.used ? '' : 'outlier', 'data-view': v.name, 'data-rms': String(v.rms_px) },
+          el('td', { text: v.name }), el('td', { text: v.board_found ? 'found' : 'not found' }), el('td', { text: String(v.num_corners) }),
+          el('td', { text: v.board_found ? v.rms_px.toFixed(3) : '–' }), el('td', { text: v.used ? '' : v.dropped_because || 'not used' }))),
+      );
+      // Per-view errors as bars (dropped views in magenta), the overall RMS as a line.
+      const ctx = chart.getContext('2d')!;
+      ctx.fillStyle = '#111';
+      ctx.fillRect(0, 0, chart.width, chart.height);
+      const found = r.views.filter((v) => v.board_found);
+      const top = Math.max(r.rms_px * 2, ...found.map((v) => v.rms_px)) || 1;
+      const w = chart.width / Math.max(1, found.length);
+      found.forEach((v, i) => {
+        const h = ((chart.height - 20) * v.rms_px) / top;
+        ctx.fillStyle = v.used ? '#4af' : '#f4f';
+        ctx.fillRect(i * w + 2, chart.height - h, w - 4, h);
+      });
+      const y = chart.height - ((chart.height - 20) * r.rms_px) / top;
+      ctx.strokeStyle = '#fc0';
+      ctx.beginPath();
+      ctx.moveTo(0, y);
+      ctx.lineTo(chart.width, y);
+      ctx.stroke();
+      ctx.fillStyle = '#fc0';
+      ctx.font = '11px sans-serif';
+      ctx.fillText(`RMS ${r.rms_px.toFixed(3)} px (scale: 0–${top.toFixed(2)} px)`, 4, 12);
+    } catch (e) {
+      status(msg, (e as Error).message, true);
+    }
+  };
+  return el('section', { id: 'int-section' }, el('h3', { text: 'Intrinsics from board images' }),
+    el('div', { class: 'controls' }, labelled('Images (folder, dir/*.jpg or video)', images), labelled('Board', type), labelled('Inner corners per row', cols),
+      labelled('per column', rows), labelled('Square (mm)', square), labelled('Distortion terms', dist), labelled('Save as', out), run),
+    msg, chart, table);
 }

@@ -1,15 +1,28 @@
 // Players: the tactical board played back from TRACKS.csv (field positions x_m, y_m per frame):
-// a top view with ids, 2 s trails and the zones of a zones file, play/pause, a time slider and
-// each player's speed over time (uPlot).
+// a top view with ids, teams (a `team` column, when the file has one), 2 s trails and the zones
+// of a zones file; beside it the video the tracks came from (TRACKS frame N is video frame N-1,
+// MOTChallenge numbering) with each player's box; play/pause and a time slider drive both.
+// Below: a heat map of the time spent per 1 m cell (one player or all) with its colour scale in
+// seconds, each player's speed over time (uPlot) and a table of distance and top speed.
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import * as api from './api';
-import { el, fileSelect, optionsSelect, labelled, status, FieldMap } from './ui';
+import { el, fileSelect, optionsSelect, labelled, status, FieldMap, rampColour } from './ui';
 import { drawZones, Zone } from './zones';
 
 interface Tracks {
-  rows: (number | null)[][]; // frame, id, bb_left, bb_top, bb_width, bb_height, x_m, y_m, time_s
+  rows: (number | null)[][]; // frame, id, bb_left, bb_top, bb_width, bb_height, x_m, y_m, time_s, team
 }
+
+interface Player {
+  id: number;
+  x: number;
+  y: number;
+  box: number[] | null; // left, top, width, height (px)
+  team: number | null;
+}
+
+const teamColours = ['#f44', '#48f', '#fd3', '#3d6'];
 
 export async function playersPage(root: HTMLElement): Promise<void> {
   const [list, info] = await Promise.all([api.files(), api.info()]);
@@ -18,27 +31,90 @@ export async function playersPage(root: HTMLElement): Promise<void> {
   if (guess) tracks.value = guess.path;
   const field = optionsSelect('pl-field', info.fields, 'robocup-msl');
   const zonesFile = fileSelect('pl-zones', list, ['json'], true);
+  const video = fileSelect('pl-video-file', list, ['video', 'images'], true);
   const chart = el('div', { id: 'pl-chart' });
   const load = el('button', { id: 'pl-load', text: 'Show' });
   const play = el('button', { id: 'pl-play', text: '▶ Play' });
   const time = el('input', { id: 'pl-time', type: 'range', min: '0', max: '0', value: '0' });
   const timeLabel = el('span', { id: 'pl-time-label' });
   const board = el('canvas', { id: 'pl-board', width: '900', height: '600' });
+  const videoCanvas = el('canvas', { id: 'pl-video', width: '640', height: '480' });
+  const heatWho = el('select', { id: 'pl-heat-id' });
+  const heat = el('canvas', { id: 'pl-heat', width: '900', height: '600' });
+  const legend = el('canvas', { id: 'pl-heat-legend', width: '900', height: '46' });
+  const table = el('table', { id: 'pl-table' });
   const msg = el('div', { id: 'pl-status', class: 'status' });
   root.replaceChildren(
-    el('section', { class: 'controls' }, labelled('Tracks', tracks), labelled('Field', field), labelled('Zones', zonesFile), load, play),
-    el('div', { class: 'main-view' }, board, el('div', {}, labelled('Time', el('span', {}, time, timeLabel))), chart, msg),
+    el('section', { class: 'controls' }, labelled('Tracks', tracks), labelled('Field', field), labelled('Zones', zonesFile),
+      labelled('Video (side by side)', video), load, play),
+    el('div', { class: 'side-by-side' },
+      el('div', { class: 'half' }, board),
+      el('div', { class: 'half' }, videoCanvas)),
+    el('div', {}, labelled('Time', el('span', {}, time, timeLabel))), msg,
+    el('h3', { text: 'Speed (m/s)' }), chart,
+    el('div', { class: 'side-by-side' },
+      el('div', { class: 'half' }, el('h3', { text: 'Heat map: time spent per 1 m cell' }), labelled('Player', heatWho), heat, legend),
+      el('div', { class: 'half' }, el('h3', { text: 'Distance and top speed' }), table)),
   );
 
   let fmap: FieldMap | null = null;
   let frames: number[] = [];
-  let byFrame = new Map<number, { id: number; x: number; y: number }[]>();
+  let byFrame = new Map<number, Player[]>();
   let times = new Map<number, number>();
   let timer = 0;
   let zones: Zone[] = [];
   let plot: uPlot | null = null;
+  let model: api.FieldModel | null = null;
 
-  const colourOf = (id: number) => `hsl(${(id * 67) % 360}, 80%, 60%)`;
+  const colourOf = (p: { id: number; team?: number | null }) =>
+    p.team !== null && p.team !== undefined ? teamColours[p.team % teamColours.length] : `hsl(${(p.id * 67) % 360}, 80%, 60%)`;
+
+  // ---- the video beside the board: one frame request at a time, the latest wanted next.
+  let frameImage: HTMLImageElement | null = null;
+  let shownFrame = -1;
+  let wanted = -1;
+  let loading = false;
+  function drawVideo() {
+    const ctx = videoCanvas.getContext('2d')!;
+    if (!frameImage) {
+      ctx.fillStyle = '#000';
+      ctx.fillRect(0, 0, videoCanvas.width, videoCanvas.height);
+      return;
+    }
+    ctx.drawImage(frameImage, 0, 0);
+    const lw = Math.max(1, videoCanvas.width / 640);
+    ctx.lineWidth = 2 * lw;
+    ctx.font = `bold ${Math.round(12 * lw)}px sans-serif`;
+    for (const p of byFrame.get(shownFrame + 1) ?? []) {
+      if (!p.box) continue;
+      ctx.strokeStyle = colourOf(p);
+      ctx.strokeRect(p.box[0], p.box[1], p.box[2], p.box[3]);
+      ctx.fillStyle = colourOf(p);
+      ctx.fillText(String(p.id), p.box[0], p.box[1] - 3);
+    }
+  }
+  async function fetchFrame() {
+    if (loading || wanted < 0 || wanted === shownFrame || !video.value) return;
+    loading = true;
+    const f = wanted;
+    try {
+      const img = await api.loadFrame(video.value, f);
+      if (videoCanvas.width !== img.naturalWidth || videoCanvas.height !== img.naturalHeight) {
+        videoCanvas.width = img.naturalWidth;
+        videoCanvas.height = img.naturalHeight;
+      }
+      frameImage = img;
+      shownFrame = f;
+      videoCanvas.dataset.frame = String(f);
+      drawVideo();
+    } catch (e) {
+      status(msg, `video: ${(e as Error).message}`, true);
+      wanted = -1;
+    } finally {
+      loading = false;
+    }
+    void fetchFrame();
+  }
 
   function draw(i: number) {
     if (!fmap) return;
@@ -50,7 +126,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     for (let j = Math.max(0, i - 1); j >= 0 && t - (times.get(frames[j]) ?? 0) <= 2; --j) {
       for (const p of byFrame.get(frames[j]) ?? []) {
         const [x, y] = fmap.toCanvas(p.x, p.y);
-        ctx.fillStyle = colourOf(p.id);
+        ctx.fillStyle = colourOf(p);
         ctx.globalAlpha = 0.35;
         ctx.fillRect(x - 1.5, y - 1.5, 3, 3);
       }
@@ -60,7 +136,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     const now = byFrame.get(f) ?? [];
     for (const p of now) {
       const [x, y] = fmap.toCanvas(p.x, p.y);
-      ctx.fillStyle = colourOf(p.id);
+      ctx.fillStyle = colourOf(p);
       ctx.beginPath();
       ctx.arc(x, y, 8, 0, 2 * Math.PI);
       ctx.fill();
@@ -70,62 +146,152 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     timeLabel.textContent = ` t = ${t.toFixed(2)} s, frame ${f}, ${now.length} players`;
     board.dataset.frame = String(f);
     plot?.setCursor({ left: plot.valToPos(t, 'x'), top: 10 });
+    if (video.value) {
+      wanted = f - 1;
+      void fetchFrame();
+    }
+  }
+
+  // Player positions by id: [time index, player] in time order.
+  function byPlayer(): Map<number, [number, Player][]> {
+    const m = new Map<number, [number, Player][]>();
+    frames.forEach((f, i) => {
+      for (const p of byFrame.get(f) ?? []) {
+        if (!m.has(p.id)) m.set(p.id, []);
+        m.get(p.id)!.push([i, p]);
+      }
+    });
+    return m;
   }
 
   // Speed of each player (m/s) between frames, averaged over 5 steps; the 12 longest tracks.
-  function speedChart() {
+  function speedChart(players: Map<number, [number, Player][]>) {
     plot?.destroy();
     plot = null;
     const t = frames.map((f) => times.get(f) ?? 0);
-    const byId = new Map<number, Map<number, { x: number; y: number }>>();
-    frames.forEach((f, i) => {
-      for (const p of byFrame.get(f) ?? []) {
-        if (!byId.has(p.id)) byId.set(p.id, new Map());
-        byId.get(p.id)!.set(i, p);
-      }
-    });
-    const ids = [...byId.keys()].sort((a, b) => byId.get(b)!.size - byId.get(a)!.size).slice(0, 12).sort((a, b) => a - b);
+    const ids = [...players.keys()].sort((a, b) => players.get(b)!.length - players.get(a)!.length).slice(0, 12).sort((a, b) => a - b);
+    const rows: HTMLElement[] = [];
     const series: (number | null)[][] = ids.map((id) => {
-      const track = byId.get(id)!;
+      const track = new Map(players.get(id)!);
       const raw = t.map((_, i) => {
         const a = track.get(i - 1);
         const b = track.get(i);
         return a && b && t[i] > t[i - 1] ? Math.hypot(b.x - a.x, b.y - a.y) / (t[i] - t[i - 1]) : null;
       });
-      return raw.map((_, i) => {
+      const smooth = raw.map((_, i) => {
         const w = raw.slice(Math.max(0, i - 2), i + 3).filter((v): v is number => v !== null);
         return raw[i] === null || !w.length ? null : w.reduce((a, b) => a + b, 0) / w.length;
       });
+      let distance = 0;
+      for (let i = 1; i < t.length; ++i) {
+        const a = track.get(i - 1);
+        const b = track.get(i);
+        if (a && b) distance += Math.hypot(b.x - a.x, b.y - a.y);
+      }
+      const top = Math.max(0, ...smooth.filter((v): v is number => v !== null));
+      const team = players.get(id)![0][1].team;
+      rows.push(el('tr', { 'data-id': String(id) }, el('td', { style: `color:${colourOf({ id, team })}`, text: `id ${id}` }),
+        el('td', { text: team === null ? '–' : String(team) }), el('td', { text: distance.toFixed(1) }), el('td', { text: top.toFixed(2) })));
+      return smooth;
     });
+    table.replaceChildren(el('tr', {}, ...['player', 'team', 'distance (m)', 'top speed (m/s, 5-frame mean)'].map((h) => el('th', { text: h }))), ...rows);
     if (!t.length) return;
     plot = new uPlot({
-      width: board.clientWidth || 900, height: 190,
-      series: [{ label: 't (s)' }, ...ids.map((id) => ({ label: `id ${id}`, stroke: colourOf(id), width: 1.2, points: { show: false } }))],
+      width: chart.clientWidth || 900, height: 190,
+      series: [{ label: 't (s)' }, ...ids.map((id) => ({ label: `id ${id}`, stroke: `hsl(${(id * 67) % 360}, 80%, 60%)`, width: 1.2, points: { show: false } }))],
       axes: [{ label: 'time (s)', stroke: '#ccc' }, { label: 'speed (m/s)', stroke: '#ccc' }],
       scales: { x: { time: false } },
     }, [t, ...series] as uPlot.AlignedData, chart);
   }
 
+  // Heat map: seconds spent in each 1 m cell (each sample counts its frame's duration), drawn
+  // over the field with a colour scale from 0 to the busiest cell.
+  function drawHeat(players: Map<number, [number, Player][]>) {
+    if (!model) return;
+    const hm = new FieldMap(heat, model);
+    const ctx = hm.draw();
+    const cell = 1.0;
+    const hl = model.length_m / 2 + model.surround_m;
+    const hw = model.width_m / 2 + model.surround_m;
+    const nx = Math.ceil((2 * hl) / cell);
+    const ny = Math.ceil((2 * hw) / cell);
+    const grid = new Float64Array(nx * ny);
+    const t = frames.map((f) => times.get(f) ?? 0);
+    const steps = t.slice(1).map((v, i) => v - t[i]).filter((d) => d > 0).sort((a, b) => a - b);
+    const dt = steps.length ? steps[Math.floor(steps.length / 2)] : 0.04;
+    const who = heatWho.value;
+    for (const [id, samples] of players) {
+      if (who !== 'all' && String(id) !== who) continue;
+      for (const [, p] of samples) {
+        const ix = Math.floor((p.x + hl) / cell);
+        const iy = Math.floor((p.y + hw) / cell);
+        if (ix >= 0 && iy >= 0 && ix < nx && iy < ny) grid[iy * nx + ix] += dt;
+      }
+    }
+    const max = Math.max(...grid);
+    for (let iy = 0; iy < ny; ++iy) {
+      for (let ix = 0; ix < nx; ++ix) {
+        const v = grid[iy * nx + ix];
+        if (v <= 0) continue;
+        const [r, g, b] = rampColour(v / max);
+        ctx.fillStyle = `rgba(${Math.round(255 * r)}, ${Math.round(255 * g)}, ${Math.round(255 * b)}, 0.75)`;
+        const [x0, y0] = hm.toCanvas(-hl + ix * cell, -hw + (iy + 1) * cell);
+        ctx.fillRect(x0, y0, cell * hm.scale + 0.5, cell * hm.scale + 0.5);
+      }
+    }
+    heat.dataset.maxS = max.toFixed(3);
+    heat.dataset.totalS = grid.reduce((a, b) => a + b, 0).toFixed(3);
+    // The colour scale.
+    const lc = legend.getContext('2d')!;
+    lc.fillStyle = '#161b22';
+    lc.fillRect(0, 0, legend.width, legend.height);
+    const x0 = 40;
+    const w = legend.width - 80;
+    for (let i = 0; i < w; ++i) {
+      const [r, g, b] = rampColour(i / (w - 1));
+      lc.fillStyle = `rgb(${Math.round(255 * r)}, ${Math.round(255 * g)}, ${Math.round(255 * b)})`;
+      lc.fillRect(x0 + i, 6, 1, 14);
+    }
+    lc.fillStyle = '#ddd';
+    lc.font = '12px sans-serif';
+    for (let k = 0; k <= 4; ++k) {
+      const x = x0 + (k * (w - 1)) / 4;
+      lc.fillRect(x, 20, 1, 4);
+      const label = `${((k * max) / 4).toFixed(max < 4 ? 2 : 1)} s`;
+      lc.fillText(label, x - lc.measureText(label).width / 2, 38);
+    }
+    lc.fillText(`per ${cell} m cell`, legend.width - 72, 16);
+  }
+
   load.onclick = async () => {
     try {
       const [f, tr] = await Promise.all([api.get<api.FieldModel>('/api/field', { name: field.value }), api.get<Tracks>('/api/tracks', { path: tracks.value })]);
+      model = f;
       fmap = new FieldMap(board, f);
       byFrame = new Map();
       times = new Map();
       for (const r of tr.rows) {
-        const [frame, id, , , , , x, y, t] = r as number[];
+        const [frame, id, l, top, w, h, x, y, t, team] = r as (number | null)[];
         if (x === null || y === null) continue;
-        if (!byFrame.has(frame)) byFrame.set(frame, []);
-        byFrame.get(frame)!.push({ id, x, y });
-        times.set(frame, t ?? frame / 25);
+        if (!byFrame.has(frame!)) byFrame.set(frame!, []);
+        byFrame.get(frame!)!.push({ id: id!, x, y, box: l !== null && top !== null && w !== null && h !== null ? [l, top, w, h] : null, team: team ?? null });
+        times.set(frame!, t ?? frame! / 25);
       }
       frames = [...byFrame.keys()].sort((a, b) => a - b);
       zones = zonesFile.value ? await api.get<Zone[]>('/api/zones', { path: zonesFile.value }) : [];
-      speedChart();
+      const players = byPlayer();
+      heatWho.replaceChildren(el('option', { value: 'all', text: 'all players' }),
+        ...[...players.keys()].sort((a, b) => a - b).map((id) => el('option', { value: String(id), text: `id ${id}` })));
+      heatWho.onchange = () => drawHeat(players);
+      speedChart(players);
+      drawHeat(players);
+      frameImage = null;
+      shownFrame = -1;
+      drawVideo();
       time.max = String(Math.max(0, frames.length - 1));
       time.value = '0';
       draw(0);
-      status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
+      status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions, ${players.size} players` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
     } catch (e) {
       status(msg, (e as Error).message, true);
     }
@@ -140,6 +306,10 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     }
     play.textContent = '❚❚ Pause';
     timer = window.setInterval(() => {
+      if (!board.isConnected) {
+        clearInterval(timer);
+        return;
+      }
       const i = (Number(time.value) + 1) % Math.max(1, frames.length);
       time.value = String(i);
       draw(i);

@@ -264,8 +264,11 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
 
   async function loadCameras(): Promise<void> {
     const checked = [...cameraBoxes.querySelectorAll<HTMLInputElement>('input:checked')].map((b) => b.value);
-    const cs = await Promise.all(checked.map((p) => api.get<api.CameraJson>('/api/camera', { path: p }).then((c) => ({ ...c, path: p }))));
-    cams = cs.filter((c) => c.has_pose);
+    // A file that is not a camera is left out (and named) rather than failing the view.
+    const cs = await Promise.allSettled(checked.map((p) => api.get<api.CameraJson>('/api/camera', { path: p }).then((c) => ({ ...c, path: p }))));
+    cams = cs.flatMap((r) => (r.status === 'fulfilled' && r.value.has_pose ? [r.value] : []));
+    const unreadable = checked.filter((_, i) => cs[i].status === 'rejected');
+    if (unreadable.length) status(liveMsg, `not camera files: ${unreadable.join(', ')}`, true);
   }
 
   function rebuildStatic(f: api.FieldModel): void {

@@ -1,15 +1,19 @@
 // Browser tests of the studio: playwright-core drives Debian's chromium (never a downloaded
 // browser) against `fieldvision studio` serving a synthetic scene (tests/run.sh sets it up).
-//   calibrate: click the field keypoints at their true pixels -> saved pose within 2 cm of truth
+//   calibrate: click the field keypoints at their true pixels -> saved pose within 2 cm of truth;
+//     six clicks 3 px off, refined against the painted lines -> within 2 cm; intrinsics from
+//     OpenCV's chessboard samples -> fx within 1 % of OpenCV's, per-view errors listed
 //   ball colour: click on the ball -> saved colour file; the detector (API and CLI) finds the ball
 //   3D view: a ball result renders (canvas not blank, every camera listed); 10,000-point benchmark
 //     (frames/s reported, not asserted)
+//   live: positions of `fuse --publish` (four `node`s on the scene) reach the 3D view
 //   zones: a polygon clicked on the field map is saved
 //   jobs: a job runs to the end, another is cancelled (states from the server's events)
-//   players: the tactical board plays with the zones and a speed chart
+//   players: the tactical board plays with the zones, the video beside it, heat maps, speed chart
 // Usage: node browser.mjs URL OUT_DIR FIELDVISION
 import { chromium } from 'playwright-core';
-import { execFileSync } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
+import net from 'node:net';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -30,6 +34,25 @@ function readCsv(file) {
   const [head, ...rows] = fs.readFileSync(file, 'utf8').trim().split('\n');
   const cols = head.split(',');
   return rows.map((r) => Object.fromEntries(r.split(',').map((v, i) => [cols[i], v])));
+}
+
+// A free loopback port (bound, read, released).
+function freePort() {
+  return new Promise((resolve, reject) => {
+    const srv = net.createServer();
+    srv.on('error', reject);
+    srv.listen(0, '127.0.0.1', () => {
+      const { port } = srv.address();
+      srv.close(() => resolve(port));
+    });
+  });
+}
+const children = [];
+function start(args, log) {
+  const child = spawn(fv, args, { cwd: work, stdio: ['ignore', fs.openSync(path.join(out, log), 'w'), 'pipe'] });
+  child.stderr.on('data', (d) => fs.appendFileSync(path.join(out, log), d));
+  children.push(child);
+  return child;
 }
 
 const userDir = fs.mkdtempSync(path.join(os.tmpdir(), 'fv-studio-chromium-'));
@@ -97,6 +120,51 @@ try {
   console.log(`calibrate: ${kps.length} keypoints clicked; camera position error ${(100 * d).toFixed(2)} cm (${(await page.textContent('#cal-rms'))})`);
   check(d < 0.02, `pose from clicks within 2 cm of the truth (${(100 * d).toFixed(2)} cm)`);
 
+  // Six clicks off by 3 px: a pose some centimetres off, which the painted lines pull back.
+  await page.click('#cal-load');
+  await page.waitForFunction(() => document.querySelectorAll('#cal-points tr').length === 0);
+  const few = kps.slice(0, 6);
+  for (const [i, k] of few.entries()) {
+    await page.click(`[data-keypoint="${k.name}"]`);
+    await clickPixel(canvas, k.u + (i % 2 ? 3 : -3), k.v + (Math.floor(i / 2) % 2 ? 3 : -3));
+  }
+  await page.waitForFunction(() => document.querySelectorAll('#cal-points tr').length === 7);
+  const clickedAt = JSON.parse(await page.getAttribute('#cal-position', 'data-position'));
+  const dClicks = Math.hypot(...clickedAt.map((v, i) => v - truthCam.position_m[i]));
+  await page.click('#cal-refine');
+  await page.waitForSelector('#cal-refine-summary');
+  const refined = await page.evaluate(() => ({ ...document.querySelector('#cal-refine-summary').dataset }));
+  check(refined.accepted === '1' && Number(refined.afterMm) < Number(refined.beforeMm),
+    `refined against the painted lines: line error ${Number(refined.beforeMm).toFixed(1)} -> ${Number(refined.afterMm).toFixed(1)} mm`);
+  await page.fill('#cal-out', 'scene/cam1_refined.yaml');
+  await page.click('#cal-save');
+  await page.waitForFunction(() => /wrote .*refined/.test(document.querySelector('#cal-status').textContent));
+  await page.screenshot({ path: path.join(out, 'calibrate_refine.jpg'), quality: 70 });
+  const savedRefined = await api('/api/camera?path=scene/cam1_refined.yaml');
+  const dRefined = Math.hypot(...savedRefined.position_m.map((v, i) => v - truthCam.position_m[i]));
+  console.log(`refine: 6 clicks 3 px off put the camera ${(100 * dClicks).toFixed(1)} cm off; refined against the lines ${(100 * dRefined).toFixed(2)} cm`);
+  check(dRefined < 0.02 && dRefined < dClicks, `refined pose within 2 cm of the truth (${(100 * dRefined).toFixed(2)} cm; clicks alone ${(100 * dClicks).toFixed(1)} cm)`);
+
+  // Intrinsics from OpenCV's chessboard samples (when ../shared/data is there).
+  if (process.env.FV_BOARDS_REFERENCE && fs.existsSync(path.join(work, 'boards'))) {
+    // OpenCV's own calibration of these views (left_intrinsics.yml, camera_matrix data[0]).
+    const reference = Number(fs.readFileSync(process.env.FV_BOARDS_REFERENCE, 'utf8').match(/camera_matrix:[^[]*\[\s*([-0-9.e+]+)/)[1]);
+    await page.fill('#int-images', 'boards/left*.jpg');
+    await page.fill('#int-out', 'boards/left.yaml');
+    await page.click('#int-run');
+    await page.waitForFunction(() => /RMS|error|cannot/i.test(document.querySelector('#int-status').textContent), null, { timeout: 60000 });
+    const fx = Number(await page.getAttribute('#int-status', 'data-fx'));
+    const views = await page.locator('#int-views tr[data-view]').count();
+    const worst = Math.max(...(await page.$$eval('#int-views tr[data-view]', (rows) => rows.map((r) => Number(r.dataset.rms)))));
+    console.log(`intrinsics: ${await page.textContent('#int-status')}`);
+    await page.locator('#int-section').scrollIntoViewIfNeeded();
+    await page.screenshot({ path: path.join(out, 'calibrate_intrinsics.jpg'), quality: 70 });
+    check(Math.abs(fx - reference) < 0.01 * reference && views === 13 && worst < 1,
+      `intrinsics from 13 board images: fx ${fx.toFixed(1)} px (OpenCV ${reference.toFixed(1)}), ${views} views listed, worst view ${worst.toFixed(3)} px`);
+  } else {
+    console.log('intrinsics: skipped (no ../shared/data/opencv-chessboard)');
+  }
+
   // ---- ball colour
   await page.goto(url + '#colour');
   await page.waitForSelector('#page[data-ready="1"]');
@@ -145,9 +213,10 @@ try {
   await page.click('#v3-load');
   await page.waitForSelector('#v3-canvas[data-ready="1"]');
   const files = await api('/api/files');
-  const nCams = files.filter((f) => f.kind === 'camera').length;
+  const withPose = await Promise.all(files.filter((f) => f.kind === 'camera').map((f) => api(`/api/camera?path=${encodeURIComponent(f.path)}`)));
+  const nCams = withPose.filter((c) => c.has_pose).length;
   const listed = await page.locator('#v3-cameras li').count();
-  check(listed === nCams, `3D view lists ${listed} cameras (${nCams} camera files)`);
+  check(listed === nCams && nCams >= 4, `3D view lists ${listed} cameras (${nCams} camera files with a pose)`);
   const stats = await page.evaluate(() => {
     const c = document.querySelector('#v3-canvas');
     const t = document.createElement('canvas');
@@ -177,6 +246,31 @@ try {
     `${bench.renderer}${bench.antialias ? '' : ', no antialiasing'}`);
   check(bench.paced_fps > 0 && bench.render_ms_median > 0, '3D benchmark measured');
   await page.screenshot({ path: path.join(out, 'bench3d.jpg'), quality: 70 });
+
+  // ---- live: the 3D view subscribes (through the server) to a fusion node fed by four camera
+  // nodes playing the scene's videos; positions arrive as server events while they are fused.
+  await page.goto(url + '#view3d');
+  await page.waitForSelector('#v3-canvas[data-ready="1"]');
+  const [listenPort, publishPort] = [await freePort(), await freePort()];
+  await page.fill('#v3-live-endpoint', `tcp://127.0.0.1:${publishPort}`);
+  await page.click('#v3-live');
+  await page.waitForFunction(() => /waiting|running/.test(document.querySelector('#v3-live-status').textContent));
+  const cameraArgs = [1, 2, 3, 4].flatMap((c) => ['--camera', `scene/cam${c}.yaml`]);
+  const fuse = start(['fuse', '--listen', `tcp://127.0.0.1:${listenPort}`, ...cameraArgs, '--out', 'live_ball.csv',
+    '--publish', `tcp://127.0.0.1:${publishPort}`, '--idle-exit', '2', '--no-progress'], 'live_fuse.log');
+  const fuseEnded = new Promise((resolve) => fuse.on('exit', resolve));
+  for (const c of [1, 2, 3, 4]) {
+    start(['node', '--camera', `scene/cam${c}.yaml`, '--video', `scene/cam${c}.avi`, '--connect', `tcp://127.0.0.1:${listenPort}`, '--no-progress'], `live_node${c}.log`);
+  }
+  await Promise.race([fuseEnded, new Promise((r) => setTimeout(r, 60000))]);
+  const fused = fs.existsSync(path.join(work, 'live_ball.csv')) ? readCsv(path.join(work, 'live_ball.csv')).length : 0;
+  await page.waitForFunction(() => Number(document.querySelector('#v3-live-status').dataset.count || 0) > 0, null, { timeout: 10000 }).catch(() => {});
+  const shown = Number((await page.getAttribute('#v3-live-status', 'data-count')) || 0);
+  console.log(`live: the fusion node fused ${fused} positions; the 3D view received ${shown} (${await page.textContent('#v3-live-status')})`);
+  await page.screenshot({ path: path.join(out, 'view3d_live.jpg'), quality: 70 });
+  check(fused >= 20 && shown >= 0.8 * fused, `live positions from the fusion node shown in the 3D view (${shown} of ${fused})`);
+  await page.click('#v3-live');
+  await page.waitForFunction(() => /idle/.test(document.querySelector('#v3-live-status').textContent));
 
   // ---- zones: a box drawn by clicking four corners on the field map
   await page.goto(url + '#zones');
@@ -217,19 +311,48 @@ try {
   await page.screenshot({ path: path.join(out, 'jobs.jpg'), quality: 70 });
   check(true, 'a running synth job was cancelled from the page');
 
-  // ---- players
+  // ---- players: the board plays with the video beside it (boxes of the same frame), heat map
   await page.goto(url + '#players');
   await page.waitForSelector('#page[data-ready="1"]');
   await page.selectOption('#pl-tracks', 'TRACKS.csv');
   await page.selectOption('#pl-zones', 'zones.json');
+  await page.selectOption('#pl-video-file', 'players/side.avi');
   await page.click('#pl-load');
   await page.waitForSelector('#pl-board[data-frame]');
+  await page.waitForSelector('#pl-video[data-frame]');
   const firstFrame = await page.getAttribute('#pl-board', 'data-frame');
+  check(await page.getAttribute('#pl-video', 'data-frame') === String(Number(firstFrame) - 1),
+    `video beside the board shows frame ${await page.getAttribute('#pl-video', 'data-frame')} for TRACKS frame ${firstFrame}`);
   await page.click('#pl-play');
-  await page.waitForFunction((f) => document.querySelector('#pl-board').dataset.frame !== f, firstFrame);
+  await page.waitForFunction((f) => Number(document.querySelector('#pl-board').dataset.frame) >= Number(f) + 5, firstFrame);
   await page.click('#pl-play');
-  await page.screenshot({ path: path.join(out, 'players.jpg'), quality: 70 });
+  // Paused: the video catches up with the board.
+  await page.waitForFunction(() => Number(document.querySelector('#pl-video').dataset.frame) === Number(document.querySelector('#pl-board').dataset.frame) - 1);
+  const videoStats = await page.evaluate(() => {
+    const c = document.querySelector('#pl-video');
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let bright = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i] + d[i + 1] + d[i + 2] > 60) ++bright;
+    return bright / (d.length / 4);
+  });
+  check(videoStats > 0.2, `video frame drawn beside the board (${(100 * videoStats).toFixed(0)} % of pixels lit)`);
+  const players = readCsv(path.join(work, 'TRACKS.csv'));
+  const nFrames = new Set(players.map((r) => r.frame)).size;
+  const heatTotal = Number(await page.getAttribute('#pl-heat', 'data-total-s'));
+  const heatMax = Number(await page.getAttribute('#pl-heat', 'data-max-s'));
+  const nIds = new Set(players.map((r) => r.id)).size;
+  // Every sample counts one frame step (the scene's frames are evenly spaced).
+  const times = [...new Set(players.map((r) => Number(r.time_s)))].sort((a, b) => a - b);
+  const step = times[1] - times[0];
+  console.log(`players: heat map ${heatTotal.toFixed(2)} s in all (${players.length} samples x ${step.toFixed(3)} s), busiest cell ${heatMax.toFixed(2)} s`);
+  check(Math.abs(heatTotal - players.length * step) < 1e-3 * players.length && heatMax > 0 && heatMax <= nFrames * step + 1e-6,
+    `heat map holds every sample's time (${heatTotal.toFixed(2)} s for ${nIds} players)`);
+  await page.selectOption('#pl-heat-id', players[0].id);
+  const oneTotal = Number(await page.getAttribute('#pl-heat', 'data-total-s'));
+  check(oneTotal < heatTotal && oneTotal > 0, `heat map of one player (${oneTotal.toFixed(2)} s)`);
+  await page.screenshot({ path: path.join(out, 'players.jpg'), quality: 70, fullPage: true });
   check(await page.locator('#pl-chart .uplot').count() === 1, 'speed chart drawn');
+  check(await page.locator('#pl-table tr[data-id]').count() === Math.min(12, nIds), `distance and top speed of ${Math.min(12, nIds)} players listed`);
   check(true, `tactical board plays (frame ${firstFrame} -> ${await page.getAttribute('#pl-board', 'data-frame')})`);
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
 } catch (e) {
@@ -237,6 +360,7 @@ try {
   console.log(`FAIL ${e}`);
   await page.screenshot({ path: path.join(out, 'failure.jpg'), quality: 70 }).catch(() => {});
 } finally {
+  for (const c of children) if (c.exitCode === null) c.kill();
   await context.close();
   fs.rmSync(userDir, { recursive: true, force: true });
 }

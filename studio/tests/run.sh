@@ -33,11 +33,23 @@ for c in 1 2 3 4; do args+=(--camera "$W/scene/cam$c.yaml" --video "$W/scene/cam
 "$FV" ball "${args[@]}" --out "$W/ball.csv" >"$OUT/ball.log" 2>&1
 "$FV" trajectory --in "$W/ball.csv" --out "$W/flights.json" >"$OUT/trajectory.log" 2>&1 || true
 [ -f "$W/flights.json" ] || echo "[]" >"$W/flights.json"
-# Player tracks for the tactical board (TRACKS.csv layout) from a players scene's truth.
-"$FV" synth --preset players --seed 1 --frames 30 --width 320 --height 240 --quiet --out "$OUT/players" >"$OUT/synth_players.log"
-awk -F, 'NR == 1 { print "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s"; next }
-         { printf "%d,%d,0,0,10,20,1,%s,%s,%s\n", $1 + 1, $3, $5, $6, $2 }' \
-  "$OUT/players/players.csv" >"$W/TRACKS.csv"
+# Player tracks for the tactical board (TRACKS.csv layout, 1-based frames, with the boxes in the
+# scene's side camera and the team) from a players scene's truth; its video is shown beside the board.
+"$FV" synth --preset players --seed 1 --frames 30 --width 320 --height 240 --quiet --out "$W/players" >"$OUT/synth_players.log"
+awk -F, 'FNR == 1 { next }
+         FILENAME ~ /_2d/ { box[$1 "," $3] = $4 "," $5 "," $6 "," $7; next }
+         { k = $1 "," $3; b = (k in box) ? box[k] : ",,,";
+           printf "%d,%d,%s,1,%s,%s,%s,%s\n", $1 + 1, $3, b, $5, $6, $2, $4 }' \
+  "$W/players/players_2d.csv" "$W/players/players.csv" |
+  { echo "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s,team"; cat; } >"$W/TRACKS.csv"
+
+# Real chessboard views for the intrinsics section (OpenCV's samples in ../shared/data), when there.
+BOARDS="$STUDIO/../../shared/data/opencv-chessboard"
+if [ -d "$BOARDS" ]; then
+  mkdir -p "$W/boards"
+  cp "$BOARDS"/left*.jpg "$W/boards/"
+  export FV_BOARDS_REFERENCE="$BOARDS/left_intrinsics.yml"
+fi
 
 cd "$W"
 "$FV" studio --port 0 >"$OUT/server.log" 2>&1 &

@@ -658,7 +658,9 @@ const std::vector<Route>& Routes() {
                       {"samples", samples},
                       {"skipped", track.skipped.size()}});
        }},
-      {{"GET", "/api/tracks", "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s)"},
+      {{"GET", "/api/tracks",
+        "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s, team when the "
+        "file has that column)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const CsvTable t = CsvTable::Read(ws.Resolve(Param(r, "path")).string());
          t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
@@ -670,11 +672,11 @@ const std::vector<Route>& Routes() {
          for (size_t i = 0; i < t.rows(); ++i) {
            rows.push_back({t.GetInt(i, "frame"), t.GetInt(i, "id"), num(i, "bb_left"),
                            num(i, "bb_top"), num(i, "bb_width"), num(i, "bb_height"), num(i, "x_m"),
-                           num(i, "y_m"), num(i, "time_s")});
+                           num(i, "y_m"), num(i, "time_s"), num(i, "team")});
          }
          return Json({{"columns",
                        {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "x_m", "y_m",
-                        "time_s"}},
+                        "time_s", "team"}},
                       {"rows", rows}});
        }},
       {{"GET", "/api/zones", "?path=zones.json: named polygons on the field (stats --zones)"},

@@ -549,6 +549,13 @@ TEST_F(StudioApiTest, BallTracksFlightsAndPlayers) {
   EXPECT_EQ(rows[0][1], 7);
   EXPECT_DOUBLE_EQ(rows[0][6].get<double>(), 1.5);
   EXPECT_TRUE(rows[1][6].is_null());
+  EXPECT_TRUE(rows[0][9].is_null());  // no team column
+  std::ofstream(dir_ / "TEAMS.csv")
+      << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s,team\n"
+         "1,7,10,20,30,60,0.9,1.5,-2,0,1\n";
+  const Reply teams = Get("/api/tracks?path=TEAMS.csv");
+  ASSERT_EQ(teams.status, 200) << teams.body;
+  EXPECT_EQ(teams.j()["rows"][0][9], 1);
   ExpectError(Get("/api/tracks?path=scene/truth.csv"), 422, "truth.csv");
 }
 
