@@ -1,11 +1,18 @@
 // `fieldvision trajectory`: split a ball track into flights, fit them, predict landings, make
 // line/goal/basket calls, write FLIGHTS.json, pictures and a smoothed track (trajectory_run.h).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
 #include <iostream>
 #include <memory>
+
+#include <fmt/format.h>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/recon/trajectory_run.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -55,10 +62,11 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   c->add_option("--field", j.field,
                 "Field (built-in name or JSON) for in/out, goal and basket calls");
-  c->add_option("--rule", j.decisions.rule, "In/out rule: auto, football, tennis, basketball")
-      ->check(CLI::IsMember({"auto", "football", "tennis", "basketball"}));
-  c->add_option("--line", j.decisions.lines,
-                "A named field line to judge each landing against (repeatable)");
+  CLI::Option* rule =
+      c->add_option("--rule", j.decisions.rule, "In/out rule: auto, football, tennis, basketball")
+          ->check(CLI::IsMember({"auto", "football", "tennis", "basketball"}));
+  CLI::Option* line = c->add_option(
+      "--line", j.decisions.lines, "A named field line to judge each landing against (repeatable)");
   c->add_option("--images", j.images_dir,
                 "Folder for pictures: track height over time, top view, side view per flight");
   c->add_option("--smoothed", j.smoothed_path, "Write the Kalman/RTS-smoothed track (BALL.csv)");
@@ -66,7 +74,12 @@ void Setup(CLI::App& app, int& exit_code) {
   c->add_option("--predict-fraction", j.predict_fraction,
                 "Part of each flight used to predict its landing (default 0.5)")
       ->check(CLI::Range(0.05, 1.0));
-  c->callback([o, &exit_code] {
+  c->callback([o, rule, line, &exit_code] {
+    for (const CLI::Option* opt : {rule, line}) {
+      FV_REQUIRE(opt->count() == 0 || !o->job.field.empty(),
+                 "trajectory: {} needs --field (the calls are made on a field's lines)",
+                 opt->get_name());
+    }
     o->job.analysis.drag = ParseDragMode(o->drag, "--drag");
     o->job.analysis.spin = ParseDragMode(o->spin, "--spin");
     const auto files = ExpandTrackInputs(o->job.in_path);
@@ -76,7 +89,21 @@ void Setup(CLI::App& app, int& exit_code) {
       CheckOutputPath(out, PathList(o->job.in_path, files, o->job.field), what);
     }
     if (files.empty()) {
+      // A progress line on a terminal while the arcs of a long track are fitted.
+      bool shown = false;
+      if (isatty(fileno(stderr))) {
+        auto last = std::chrono::steady_clock::now();
+        o->job.analysis.progress = [last, &shown](size_t done, size_t total) mutable {
+          const auto now = std::chrono::steady_clock::now();
+          if (now - last < std::chrono::milliseconds(500)) return;
+          last = now;
+          std::cerr << fmt::format("\rtrajectory: fitting arc {} of {} ", done + 1, total)
+                    << std::flush;
+          shown = true;
+        };
+      }
       RunTrajectory(o->job, std::cout);
+      if (shown) std::cerr << "\r\033[K" << std::flush;
     } else {
       RunTrajectoryBatch(o->job, files, std::cout);
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <set>
 
 #include <ceres/ceres.h>
 #include <fmt/format.h>
@@ -792,44 +793,65 @@ struct Segmenter {
            FitGravityLine(track, r, o.gravity_mps2, tc).sse;
   }
 
-  // Greedy: the largest jump above threshold becomes a break, until none is left.
+  // Greedy: the largest jump above threshold becomes a break, until none is left. Each gap's
+  // score is kept and only the gaps whose windows reach a new break are scored again, so a long
+  // block with many breaks costs O(n log n) instead of O(n x breaks^2) (the same breaks).
   std::vector<int> FindBreaks(const std::vector<int>& list, int lo, int hi) const {
-    std::vector<int> breaks;  // positions k: break between list[k] and list[k+1]
-    while (true) {
-      Candidate best;
-      for (int k = lo; k + 1 < hi; ++k) {
-        int a = lo, b = hi;
-        for (int br : breaks) {
-          if (br < k) a = std::max(a, br + 1);
-          if (br >= k + 1) b = std::min(b, br + 1);
-          if (br == k) a = hi;  // already a break
-        }
-        if (a >= b) continue;
-        const Candidate c = Score(list, k, a, b);
-        if (c.ratio > 1.0 && c.ratio > best.ratio) best = c;
+    std::set<int> breaks;  // positions k: break between list[k] and list[k+1]
+    // Windows of the gap after k stay within the breaks around it.
+    auto bounds = [&](int k, int* a, int* b) {
+      if (breaks.count(k)) return false;  // already a break
+      *a = lo;
+      *b = hi;
+      const auto it = breaks.lower_bound(k);  // the first break after k
+      if (it != breaks.end()) *b = std::min(*b, *it + 1);
+      if (it != breaks.begin()) *a = std::max(*a, *std::prev(it) + 1);
+      return *a < *b;
+    };
+    std::vector<double> queued(std::max(hi, 0), -1.0);  // ratio in `queue`, -1: none
+    std::set<std::pair<double, int>> queue;             // (-ratio, k): largest, then first
+    std::vector<Candidate> score(std::max(hi, 0));
+    auto rescore = [&](int k) {
+      if (queued[k] >= 0) queue.erase({-queued[k], k});
+      queued[k] = -1.0;
+      int a = 0, b = 0;
+      if (!bounds(k, &a, &b)) return;
+      score[k] = Score(list, k, a, b);
+      if (score[k].ratio > 1.0) {
+        queued[k] = score[k].ratio;
+        queue.insert({-queued[k], k});
       }
-      if (best.pos < 0) break;
+    };
+    for (int k = lo; k + 1 < hi; ++k) rescore(k);
+    const double reach_s = 4 * o.window_s;  // beyond any window (3 window_s), with a margin
+    while (!queue.empty()) {
+      const Candidate best = score[queue.begin()->second];
       // Localise: the split of the neighbourhood with the least residual.
       int a = std::max(lo, best.pos - 2 * o.window_samples);
       int b = std::min(hi - 1, best.pos + 1 + 2 * o.window_samples);
-      for (int br : breaks) {
-        if (br < best.pos) a = std::max(a, br + 1);
-        if (br > best.pos) b = std::min(b, br);
-      }
+      const auto it = breaks.lower_bound(best.pos);
+      if (it != breaks.end()) b = std::min(b, *it);
+      if (it != breaks.begin()) a = std::max(a, *std::prev(it) + 1);
       int k_best = best.pos;
       double c_best = SplitCost(list, a, b, best.pos);
       for (int k = std::max(a + 1, best.pos - 2); k <= std::min(b - 2, best.pos + 2); ++k) {
-        if (std::find(breaks.begin(), breaks.end(), k) != breaks.end()) continue;
+        if (breaks.count(k)) continue;
         const double c = SplitCost(list, a, b, k);
         if (c < c_best) {
           c_best = c;
           k_best = k;
         }
       }
-      breaks.push_back(k_best);
-      std::sort(breaks.begin(), breaks.end());
+      breaks.insert(k_best);
+      // The gaps whose windows could include the samples on either side of the new break.
+      const double t_lo = track[list[k_best]].time_s - reach_s;
+      const double t_hi = track[list[k_best + 1]].time_s + reach_s;
+      int k0 = k_best, k1 = k_best;
+      while (k0 > lo && track[list[k0]].time_s >= t_lo) --k0;
+      while (k1 + 2 < hi && track[list[k1 + 1]].time_s <= t_hi) ++k1;
+      for (int k = std::max(lo, k0 - 2); k <= std::min(hi - 2, k1 + 2); ++k) rescore(k);
     }
-    return breaks;
+    return std::vector<int>(breaks.begin(), breaks.end());
   }
 };
 
@@ -939,6 +961,7 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
   std::vector<int> piece_of_flight;
   std::vector<std::pair<double, double>> limits;  // contact times lie within these
   for (size_t pi = 0; pi < pieces.size(); ++pi) {
+    if (options.progress) options.progress(pi, pieces.size());
     const Piece& pc = pieces[pi];
     const int count = pc.b - pc.a + 1;
     if (count < options.min_flight_samples) {

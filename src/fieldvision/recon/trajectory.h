@@ -8,6 +8,7 @@
 // model and the seed's plane quadratic (three last points, then least squares) for comparison.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -159,6 +160,9 @@ struct TrajectoryOptions {
   double spin_along_prior_revps = 5.0;
   double MagnusPerRad() const;
   BounceModel bounce;  // for predicting the flight after a bounce
+  // Called with (arcs fitted, arcs in all) while the flights are fitted (a progress line for long
+  // tracks); empty: none.
+  std::function<void(size_t done, size_t total)> progress;
 
   void Check() const;
 };

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -53,6 +55,68 @@ Eigen::Vector3d BallPathAt(const std::vector<BallSample>& track, const Trajector
   const double f = (time_s - track[before].time_s) / (track[after].time_s - track[before].time_s);
   return (1 - f) * track[before].ball_in_world + f * track[after].ball_in_world;
 }
+
+namespace {
+
+// BallPathAt for times that only increase (the crossing scan): the same answer in amortised
+// O(log flights) per call instead of a pass over every flight and sample.
+class BallPathCursor {
+ public:
+  BallPathCursor(const std::vector<BallSample>& track, const TrajectoryResult& result)
+      : track_(track), result_(result) {
+    by_start_.resize(result.flights.size());
+    std::iota(by_start_.begin(), by_start_.end(), 0);
+    std::stable_sort(by_start_.begin(), by_start_.end(), [&](int a, int b) {
+      return result.flights[a].t_start_s < result.flights[b].t_start_s;
+    });
+  }
+
+  Eigen::Vector3d At(double time_s, int* flight) {
+    // The first flight (in the result's order) whose [t_start_s, t_end_s] holds the time: flights
+    // join `active_` when they start; one that has ended is dropped when it comes first.
+    const auto& flights = result_.flights;
+    while (next_start_ < by_start_.size() && flights[by_start_[next_start_]].t_start_s <= time_s) {
+      active_.insert(by_start_[next_start_++]);
+    }
+    while (!active_.empty() && flights[*active_.begin()].t_end_s < time_s) {
+      active_.erase(active_.begin());
+    }
+    if (!active_.empty()) {
+      const Flight& f = flights[*active_.begin()];
+      if (flight) *flight = f.index;
+      return f.model().PositionAt(time_s);
+    }
+    if (flight) *flight = -1;
+    // Linear between the nearest non-outlier samples (as BallPathAt).
+    const int n = static_cast<int>(track_.size());
+    auto outlier = [&](int i) {
+      return result_.outlier.size() == track_.size() && result_.outlier[i];
+    };
+    while (k_ < n && (outlier(k_) || track_[k_].time_s < time_s)) {
+      if (!outlier(k_)) last_before_ = k_;
+      ++k_;
+    }
+    int before = last_before_;
+    const int after = k_ < n ? k_ : -1;
+    if (after >= 0 && track_[after].time_s <= time_s) before = after;
+    if (before < 0) return after < 0 ? Eigen::Vector3d::Zero() : track_[after].ball_in_world;
+    if (after < 0 || after == before) return track_[before].ball_in_world;
+    const double f =
+        (time_s - track_[before].time_s) / (track_[after].time_s - track_[before].time_s);
+    return (1 - f) * track_[before].ball_in_world + f * track_[after].ball_in_world;
+  }
+
+ private:
+  const std::vector<BallSample>& track_;
+  const TrajectoryResult& result_;
+  std::vector<int> by_start_;
+  size_t next_start_ = 0;
+  std::set<int> active_;
+  int k_ = 0;             // the first non-outlier sample at or after the last time asked
+  int last_before_ = -1;  // the last non-outlier sample before it
+};
+
+}  // namespace
 
 Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryResult& result,
                         const FieldModel* field, const TrajectoryOptions& o,
@@ -159,10 +223,11 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
     if (!track.empty() && (!field->goals.empty() || !field->hoops.empty())) {
       const double t0 = track.front().time_s, t1 = track.back().time_s;
       std::vector<bool> was_in(field->goals.size(), false);
-      Eigen::Vector3d prev = BallPathAt(track, result, t0);
+      BallPathCursor path(track, result);
+      Eigen::Vector3d prev = path.At(t0, nullptr);
       for (double t = t0 + d.time_step_s; t <= t1; t += d.time_step_s) {
         int fl = -1;
-        const Eigen::Vector3d p = BallPathAt(track, result, t, &fl);
+        const Eigen::Vector3d p = path.At(t, &fl);
         for (size_t g = 0; g < field->goals.size(); ++g) {
           const FieldGoal& goal = field->goals[g];
           const bool beyond = goal.side * (p.x() - goal.line_x_m) > 0.5 * field->line_width_m + r;

@@ -137,12 +137,15 @@ std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
   // Segments: each flight's seen span (with gravity); the rest in runs without gravity.
   std::vector<int> seg(n, -1);
   std::vector<bool> gravity;
+  auto before_time = [](const BallSample& s, double t) { return s.time_s < t; };
+  auto after_time = [](double t, const BallSample& s) { return t < s.time_s; };
   for (const auto& f : result.flights) {
     const int id = static_cast<int>(gravity.size());
     gravity.push_back(true);
-    for (int i = 0; i < n; ++i) {
-      if (track[i].time_s >= f.t_first_seen_s && track[i].time_s <= f.t_last_seen_s) seg[i] = id;
-    }
+    // The samples within the seen span (times increase along the track).
+    const auto lo = std::lower_bound(track.begin(), track.end(), f.t_first_seen_s, before_time);
+    const auto hi = std::upper_bound(track.begin(), track.end(), f.t_last_seen_s, after_time);
+    for (auto it = lo; it < hi; ++it) seg[it - track.begin()] = id;
   }
   for (int i = 0; i < n; ++i) {
     if (seg[i] >= 0) continue;

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/recon/trajectory_draw.h"
 #include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/util/csv.h"
@@ -106,8 +107,21 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   }
   out.decisions = MakeDecisions(track, r, has_field ? &field : nullptr, out.options, job.decisions);
 
-  // FLIGHTS.json: the contract's array, each flight with its prediction and calls.
+  // FLIGHTS.json: the contract's array, each flight with its prediction and calls (the calls
+  // sorted into their flights in one pass).
   nlohmann::json flights = FlightsToJson(r, &out.options);
+  const nlohmann::json dj = out.decisions.ToJson();
+  auto by_flight = [&](const char* key) {
+    std::vector<nlohmann::json> per(r.flights.size(), nlohmann::json::array());
+    for (const auto& c : dj[key]) {
+      const int f = c["flight"].get<int>();
+      if (f >= 0 && f < static_cast<int>(per.size())) per[f].push_back(c);
+    }
+    return per;
+  };
+  const auto landing_calls = by_flight("landings");
+  const auto goal_crossings = by_flight("goal_crossings");
+  const auto made_shots = by_flight("made_shots");
   for (size_t i = 0; i < r.flights.size(); ++i) {
     const auto& p = out.predictions[i];
     nlohmann::json pj;
@@ -126,28 +140,32 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
           (p.landing_m.head<2>() - r.flights[i].landing_m.head<2>()).norm();
     }
     flights[i]["prediction"] = pj;
-    nlohmann::json calls = nlohmann::json::array();
-    const nlohmann::json dj = out.decisions.ToJson();
-    for (const auto& c : dj["landings"]) {
-      if (c["flight"] == static_cast<int>(i)) calls.push_back(c);
-    }
-    flights[i]["landing_calls"] = calls;
-    nlohmann::json goals = nlohmann::json::array(), shots = nlohmann::json::array();
-    for (const auto& g : dj["goal_crossings"]) {
-      if (g["flight"] == static_cast<int>(i)) goals.push_back(g);
-    }
-    for (const auto& s : dj["made_shots"]) {
-      if (s["flight"] == static_cast<int>(i)) shots.push_back(s);
-    }
-    flights[i]["goal_crossings"] = goals;
-    flights[i]["made_shots"] = shots;
+    flights[i]["landing_calls"] = landing_calls[i];
+    flights[i]["goal_crossings"] = goal_crossings[i];
+    flights[i]["made_shots"] = made_shots[i];
   }
-  {
-    std::ofstream f(job.out_path);
-    FV_REQUIRE(f.good(), "cannot write '{}'", job.out_path);
-    f << flights.dump(2) << "\n";
-    FV_REQUIRE(f.good(), "cannot write '{}'", job.out_path);
+  // Everything is computed and the pictures' folder made before the first output is replaced;
+  // each output is written to a temporary file beside it and renamed (io/output_path.h).
+  auto write_json = [](const std::string& path, const nlohmann::json& j, const char* what) {
+    AtomicWrite(
+        path,
+        [&](const std::string& tmp) {
+          std::ofstream f(tmp);
+          FV_REQUIRE(f.good(), "cannot write '{}'", path);
+          f << j.dump(2) << "\n";
+          f.close();
+          FV_REQUIRE(!f.fail(), "cannot write '{}'", path);
+        },
+        what);
+  };
+  if (!job.images_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(job.images_dir, ec);
+    FV_REQUIRE(!ec && std::filesystem::is_directory(job.images_dir),
+               "cannot create the folder '{}' for --images{}", job.images_dir,
+               ec ? ": " + ec.message() : std::string());
   }
+  write_json(job.out_path, flights, "--out");
   if (!job.report_path.empty()) {
     nlohmann::json rep;
     rep["input"] = job.in_path;
@@ -159,22 +177,22 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
     rep["noise_m"] = r.noise_m;
     rep["summary"] = r.Summary();
     rep["flights"] = flights;
-    rep["decisions"] = out.decisions.ToJson();
-    std::ofstream f(job.report_path);
-    FV_REQUIRE(f.good(), "cannot write '{}'", job.report_path);
-    f << rep.dump(2) << "\n";
+    rep["decisions"] = dj;
+    write_json(job.report_path, rep, "--report");
   }
   if (!job.smoothed_path.empty()) {
-    WriteBallTrack(job.smoothed_path, SmoothTrack(track, r, out.options, job.smoother));
+    const std::vector<BallSample> smoothed = SmoothTrack(track, r, out.options, job.smoother);
+    AtomicWrite(
+        job.smoothed_path, [&](const std::string& tmp) { WriteBallTrack(tmp, smoothed); },
+        "--smoothed");
   }
   if (!job.images_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(job.images_dir, ec);
-    FV_REQUIRE(!ec, "cannot create folder '{}': {}", job.images_dir, ec.message());
+    // Drawn one at a time (a long track has thousands of flights).
     auto write = [&](const std::string& name, const cv::Mat& img) {
-      const std::string p = (std::filesystem::path(job.images_dir) / name).string();
-      WriteImage(p, img);
-      out.images.push_back(p);
+      const std::string path = (std::filesystem::path(job.images_dir) / name).string();
+      AtomicWrite(
+          path, [&](const std::string& tmp) { WriteImage(tmp, img); }, "--images");
+      out.images.push_back(path);
     };
     write("track_height.png", DrawTrackHeight(track, r, out.options));
     write("flights_top.png",
@@ -241,22 +259,22 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
   TrajectoryBatchResult res;
   res.files = files;
   res.summary_csv = (fs::path(job.out_path) / "summary.csv").string();
-  const std::string tmp = res.summary_csv + ".part";
+  AtomicOutput summary(res.summary_csv, "summary.csv");
   std::vector<BounceTrackScore> scores;
   {
-    CsvWriter csv(tmp, {"file",           "flight",
-                        "start_event",    "end_event",
-                        "t_start_s",      "t_end_s",
-                        "origin_x_m",     "origin_y_m",
-                        "origin_z_m",     "origin_extrapolated",
-                        "landing_x_m",    "landing_y_m",
-                        "landing_z_m",    "landing_extrapolated",
-                        "apex_z_m",       "speed_mps",
-                        "model",          "rmse_m",
-                        "rmse_gravity_m", "rmse_drag_m",
-                        "rmse_spin_m",    "rmse_free_accel_m",
-                        "spin_revps",     "spin_axis_x",
-                        "spin_axis_y",    "spin_axis_z"},
+    CsvWriter csv(summary.temp_path(), {"file",           "flight",
+                                        "start_event",    "end_event",
+                                        "t_start_s",      "t_end_s",
+                                        "origin_x_m",     "origin_y_m",
+                                        "origin_z_m",     "origin_extrapolated",
+                                        "landing_x_m",    "landing_y_m",
+                                        "landing_z_m",    "landing_extrapolated",
+                                        "apex_z_m",       "speed_mps",
+                                        "model",          "rmse_m",
+                                        "rmse_gravity_m", "rmse_drag_m",
+                                        "rmse_spin_m",    "rmse_free_accel_m",
+                                        "spin_revps",     "spin_axis_x",
+                                        "spin_axis_y",    "spin_axis_z"},
                   5);
     for (const auto& file : files) {
       const std::string stem = fs::path(file).stem().string();
@@ -298,8 +316,7 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
     }
     csv.Close();
   }
-  fs::rename(tmp, res.summary_csv, ec);
-  FV_REQUIRE(!ec, "cannot write '{}': {}", res.summary_csv, ec.message());
+  summary.Commit();
   if (!scores.empty()) log << Summarize(scores).Table();
   log << fmt::format("wrote {} ({} tracks, {} failed; -1: not fitted)\n", res.summary_csv,
                      files.size() - res.failed.size(), res.failed.size());

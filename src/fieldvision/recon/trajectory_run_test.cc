@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -59,9 +60,67 @@ TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
   for (const auto& p : r.images) EXPECT_GT(std::filesystem::file_size(p), 1000u) << p;
   EXPECT_EQ(ReadBallTrack(job.smoothed_path).samples.size(), r.input.samples.size());
   EXPECT_TRUE(std::filesystem::exists(job.report_path));
+  // A run that fails leaves the outputs of the last one as they were, and no temporary files.
+  auto bytes = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  };
+  const std::string flights_before = bytes(job.out_path);
+  std::filesystem::remove_all(job.images_dir);
+  std::ofstream(job.images_dir) << "a file where the pictures' folder should be";
+  EXPECT_THROW(RunTrajectory(job, log), Error);
+  EXPECT_EQ(bytes(job.out_path), flights_before);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir + "/out"),
+                          std::filesystem::directory_iterator()),
+            3);
   // Bad input: one line naming the file.
   job.in_path = dir + "/missing.csv";
   EXPECT_THROW(RunTrajectory(job, log), Error);
+}
+
+// A ball that never rests (60 hops in one airborne block): every bounce is found. Finding the
+// breaks took O(samples x breaks^2) (a 40,000-row track of such hops did not finish).
+TEST(TrajectoryRun, LongBlockWithManyBounces) {
+  const uint64_t seed = testing::TestSeed(43);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  std::vector<BallSample> track;
+  const double g = 9.81, r = 0.11, fps = 60;
+  double t0 = 0, vz = 4.0;
+  Eigen::Vector3d p0(-20, 0, r), v(3, 0.5, vz);
+  int hops = 0;
+  for (int i = 0; hops < 60; ++i) {
+    const double t = i / fps;
+    double dt = t - t0;
+    if (dt > 2 * v.z() / g) {  // the bounce: a new hop from the contact point
+      p0 += v * (2 * v.z() / g);
+      p0.z() = r;
+      t0 += 2 * v.z() / g;
+      v = Eigen::Vector3d(rng.Uniform(-3, 3), rng.Uniform(-3, 3), rng.Uniform(3, 5));
+      dt = t - t0;
+      ++hops;
+    }
+    BallSample s;
+    s.frame = i;
+    s.time_s = t;
+    s.ball_in_world = p0 + v * dt + Eigen::Vector3d(0, 0, -0.5 * g * dt * dt);
+    for (int a = 0; a < 3; ++a) s.ball_in_world[a] += rng.Normal(0, 0.003);
+    s.n_cams = 3;
+    track.push_back(s);
+  }
+  TrajectoryOptions o;
+  o.drag = DragMode::kOff;
+  o.spin = SpinMode::kOff;
+  o.noise_m = 0.003;
+  size_t calls = 0;
+  o.progress = [&calls](size_t, size_t) { ++calls; };
+  const TrajectoryResult res = AnalyzeTrajectory(track, o);
+  int bounces = 0;
+  for (const auto& b : res.breaks) bounces += b.kind == FlightEvent::kBounce;
+  EXPECT_GE(bounces, 58) << res.Summary();
+  EXPECT_LE(static_cast<int>(res.breaks.size()), 61) << res.Summary();
+  EXPECT_GE(res.flights.size(), 59u) << res.Summary();
+  EXPECT_GE(calls, res.flights.size());
 }
 
 }  // namespace
