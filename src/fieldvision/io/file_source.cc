@@ -74,7 +74,9 @@ class FileSource : public FrameSource {
 
 FileSource::FileSource(const std::string& path, const FrameSourceOptions& options)
     : path_(path), options_(options) {
-  const bool pattern = path.find('%') != std::string::npos;
+  // A file that exists is a video even when its name has a '%' (100%.avi).
+  const bool pattern =
+      path.find('%') != std::string::npos && !std::filesystem::is_regular_file(path);
   FV_REQUIRE(pattern || std::filesystem::exists(path), "video '{}' does not exist", path);
   FV_REQUIRE(pattern || !std::filesystem::is_directory(path),
              "video '{}' is a folder (give an image pattern such as '{}/%05d.jpg')", path, path);
@@ -174,6 +176,7 @@ bool FileSource::ReadFrame(SourceFrame* out) {
     pending_ = SourceFrame();
     has_pending_ = false;
   } else if (!(encoded_ ? GrabEncoded(out) : Grab(out))) {
+    CheckEndOfStream(path_, next_frame_, frame_count_);
     return false;
   }
   out->frame = next_frame_++;
@@ -187,7 +190,10 @@ bool FileSource::SkipFrame() {
     has_pending_ = false;
   } else if (encoded_) {
     SourceFrame f;
-    if (!GrabEncoded(&f)) return false;
+    if (!GrabEncoded(&f)) {
+      CheckEndOfStream(path_, next_frame_, frame_count_);
+      return false;
+    }
   } else {
     bool ok = false;
     try {
@@ -195,7 +201,10 @@ bool FileSource::SkipFrame() {
     } catch (const cv::Exception&) {
       ok = false;
     }
-    if (!ok) return false;
+    if (!ok) {
+      CheckEndOfStream(path_, next_frame_, frame_count_);
+      return false;
+    }
   }
   ++next_frame_;
   return true;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -50,6 +51,41 @@ TEST(FrameSource, FileEncodedAndDecodedAgree) {
     ++n;
   }
   EXPECT_EQ(n, 5);
+}
+
+TEST(FrameSource, TruncatedFileFailsAtItsEndEncodedOrNot) {
+  const std::string video = testing::TempDir() + "/cut.avi";
+  {
+    // Noisy frames: JPEGs large against the container's header, so a cut lands in the frames.
+    cv::VideoWriter w(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25, cv::Size(320, 240));
+    cv::RNG rng(7);
+    for (int i = 0; i < 16; ++i) {
+      cv::Mat m(240, 320, CV_8UC3);
+      rng.fill(m, cv::RNG::UNIFORM, 0, 256);
+      w.write(m);
+    }
+  }
+  {
+    std::ifstream in(video, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    std::ofstream(video, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 2);
+  }
+  for (const bool encoded : {false, true}) {
+    SCOPED_TRACE(encoded ? "encoded" : "decoded");
+    FrameSourceOptions o;
+    o.encoded = encoded;
+    auto src = OpenFrameSource(video, o);
+    SourceFrame f;
+    int n = 0;
+    try {
+      while (src->ReadFrame(&f)) ++n;
+      ADD_FAILURE() << "ended after " << n << " frames without an error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("of the 16 frames"), std::string::npos) << e.what();
+    }
+    EXPECT_LT(n, 16);
+  }
 }
 
 TEST(FrameSource, RealtimeFileIsStampedOnTheSystemClockAndSkipsWhatIsGone) {

@@ -113,7 +113,16 @@ class CaptureSource : public VideoSource {
       has_pending_ = false;
     } else {
       cv::Mat m;
-      if (!cap_.read(m) || m.empty()) return false;
+      bool ok = false;
+      try {
+        ok = cap_.read(m) && !m.empty();
+      } catch (const cv::Exception&) {
+        ok = false;
+      }
+      if (!ok) {
+        CheckEndOfStream(spec_, next_index_, frame_count_);
+        return false;
+      }
       FV_REQUIRE(m.cols == width_ && m.rows == height_,
                  "video '{}': frame {} is {}x{}, the first frame {}x{}", spec_, next_index_, m.cols,
                  m.rows, width_, height_);
@@ -148,12 +157,24 @@ class CaptureSource : public VideoSource {
 void VideoSourceOptions::Check() const { CheckPositive(fps, "VideoSourceOptions.fps"); }
 
 bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path) {
-  const int api = path.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG;
+  // A file that exists is a video even when its name has a '%' (100%.avi).
+  const int api = path.find('%') != std::string::npos && !fs::is_regular_file(path)
+                      ? cv::CAP_IMAGES
+                      : cv::CAP_FFMPEG;
   try {
     return capture.open(path, api) && capture.isOpened();
   } catch (const cv::Exception&) {
     return false;
   }
+}
+
+void CheckEndOfStream(const std::string& path, long long frames_read, long long frames_announced) {
+  // Containers without a frame index give an estimate (duration x rate): a frame or two of slack.
+  const long long slack = std::max(1LL, frames_announced / 1000);
+  FV_REQUIRE(frames_announced <= 0 || frames_read + slack >= frames_announced,
+             "video '{}' ends after {} of the {} frames its header announces (truncated or "
+             "damaged from frame {})",
+             path, frames_read, frames_announced, frames_read);
 }
 
 bool IsImageFile(const std::string& path) {
@@ -198,6 +219,8 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
   options.Check();
   FV_REQUIRE(!spec.empty(), "empty video name");
   if (StartsWith(spec, "camera:")) return std::make_unique<CaptureSource>(spec, options.fps);
+  // A file that exists is a video even when its name has '%', '*' or '?' (100%.avi, a*b.avi).
+  if (fs::is_regular_file(spec)) return std::make_unique<CaptureSource>(spec, options.fps);
   const bool sequence = spec.find('%') != std::string::npos ||
                         spec.find('*') != std::string::npos ||
                         spec.find('?') != std::string::npos || fs::is_directory(spec);

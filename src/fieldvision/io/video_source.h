@@ -68,6 +68,9 @@ std::vector<std::string> ListImageSequence(const std::string& spec);
 // reader, never GStreamer, whose failure on a file that is not a video prints pages of GLib
 // warnings. False when it cannot be opened.
 bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path);
+// At the end of a video file: throws fv::Error naming it when fewer frames were read than its
+// header announces (a truncated or damaged stream; 0 or less: not announced, nothing checked).
+void CheckEndOfStream(const std::string& path, long long frames_read, long long frames_announced);
 // Whether a path names an image file OpenCV reads, by its extension (case-insensitive).
 bool IsImageFile(const std::string& path);
 

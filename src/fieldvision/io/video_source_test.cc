@@ -1,6 +1,7 @@
 #include "fieldvision/io/video_source.h"
 
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -55,6 +56,62 @@ TEST(VideoSource, MjpgFileFramesAndTimes) {
     ++n;
   }
   EXPECT_EQ(n, 7);
+}
+
+// A 16-frame MJPG video cut to `keep` of its bytes (the header still announces 16 frames).
+std::string WriteTruncatedMjpg(const std::string& path, double keep) {
+  {
+    // Noisy frames: JPEGs large against the container's header, so a cut lands in the frames.
+    cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(320, 240));
+    cv::RNG rng(7);
+    for (int i = 0; i < 16; ++i) {
+      cv::Mat m(240, 320, CV_8UC3);
+      rng.fill(m, cv::RNG::UNIFORM, 0, 256);
+      w.write(m);
+    }
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      << bytes.substr(0, static_cast<size_t>(keep * bytes.size()));
+  return path;
+}
+
+TEST(VideoSource, TruncatedVideoFailsAtItsEndNamingTheFrames) {
+  const std::string path = WriteTruncatedMjpg(testing::TempDir() + "/cut.avi", 0.5);
+  auto src = VideoSource::Open(path);
+  EXPECT_EQ(src->frame_count(), 16);
+  Frame f;
+  int n = 0;
+  try {
+    while (src->Read(f)) ++n;
+    ADD_FAILURE() << "the truncated video ended after " << n << " frames without an error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("cut.avi"), std::string::npos) << what;
+    EXPECT_NE(what.find(fmt::format("after {} of the 16 frames", n)), std::string::npos) << what;
+  }
+  EXPECT_LT(n, 16);
+}
+
+TEST(VideoSource, FileNamesWithPatternCharactersAreFiles) {
+  const std::string dir = testing::TempDir();
+  for (const std::string name : {"100%.avi", "a*b.avi", "c?.avi"}) {
+    SCOPED_TRACE(name);
+    const std::string path = dir + "/" + name;
+    {
+      cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(64, 48));
+      ASSERT_TRUE(w.isOpened());
+      for (int i = 0; i < 3; ++i) w.write(NumberedFrame(i));
+    }
+    auto src = VideoSource::Open(path);
+    EXPECT_EQ(src->frame_count(), 3);
+    Frame f;
+    int n = 0;
+    while (src->Read(f)) ++n;
+    EXPECT_EQ(n, 3);
+  }
 }
 
 TEST(VideoSource, BadInputsNameTheInput) {
