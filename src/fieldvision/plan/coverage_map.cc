@@ -72,7 +72,8 @@ std::vector<std::vector<cv::Point>> Footprint(const Camera& cam, double height, 
 }  // namespace
 
 void CoverageMapOptions::Check() const {
-  FV_REQUIRE(width_px >= 200 && width_px <= 20000, "width_px must be in [200, 20000] (got {})",
+  // Six maps of up to 8000 px (with a legend) stay under 2 GB in all.
+  FV_REQUIRE(width_px >= 200 && width_px <= 8000, "width_px must be in [200, 8000] (got {})",
              width_px);
   CheckInRange(alpha, 0, 1, "alpha");
   CheckNonNegative(err_scale_m, "err_scale_m");

@@ -23,7 +23,9 @@ Eigen::Vector3d ReadPoint(const json& j, const std::string& ctx) {
   for (int i = 0; i < 3; ++i) {
     FV_REQUIRE(j[i].is_number(), "{}: element {} is not a number", ctx, i);
     p[i] = j[i].get<double>();
-    FV_REQUIRE(std::isfinite(p[i]), "{}: element {} is not finite", ctx, i);
+    FV_REQUIRE(std::isfinite(p[i]) && std::abs(p[i]) <= 1e4,
+               "{}: element {} is not a coordinate within 10 km of the field centre (got {})", ctx,
+               i, p[i]);
   }
   return p;
 }
@@ -195,8 +197,9 @@ void OptimizeOptions::Check() const {
   FV_REQUIRE(num_cameras >= 1 && num_cameras <= 32, "num_cameras must be in [1, 32] (got {})",
              num_cameras);
   CheckPositive(grid_step_m, "grid_step_m");
-  FV_REQUIRE(iterations >= 0, "iterations must be >= 0 (got {})", iterations);
-  FV_REQUIRE(restarts >= 1, "restarts must be >= 1 (got {})", restarts);
+  FV_REQUIRE(iterations >= 0 && iterations <= 1000000, "iterations must be in [0, 1e6] (got {})",
+             iterations);
+  FV_REQUIRE(restarts >= 1 && restarts <= 100, "restarts must be in [1, 100] (got {})", restarts);
   CheckPositive(start_temperature, "start_temperature");
   CheckPositive(move_step_m, "move_step_m");
   CheckPositive(aim_step_m, "aim_step_m");

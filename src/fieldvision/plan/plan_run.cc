@@ -69,6 +69,18 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   std::optional<Rig> given;
   if (!options.rig_path.empty()) given = ReadRigJson(options.rig_path);
   if (!options.camera_paths.empty()) given = RigFromCameraFiles(options.camera_paths);
+  if (given) {
+    // A camera kilometres away sees nothing and would only stretch the maps.
+    constexpr double kMaxDistanceM = 1e4;
+    for (const Camera& c : given->cameras) {
+      const double d = c.CentreInWorld().norm();
+      FV_REQUIRE(d <= kMaxDistanceM,
+                 "plan: camera '{}' of '{}' stands {:.3g} m from the field centre (at most {:.0f} "
+                 "m)",
+                 c.name, options.rig_path.empty() ? "--camera" : options.rig_path, d,
+                 kMaxDistanceM);
+    }
+  }
 
   namespace fs = std::filesystem;
   std::error_code ec;

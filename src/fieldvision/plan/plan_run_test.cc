@@ -105,6 +105,21 @@ TEST(PlanRunTest, BadInputGivesOneLineErrors) {
   o.coverage.pixel_noise_px = -1;
   msg = error_of(o);
   EXPECT_NE(msg.find("pixel_noise_px"), std::string::npos) << msg;
+  o.coverage.pixel_noise_px = 1;
+  // A camera 1e300 m away (it saw nothing and the rig was planned without a word).
+  {
+    json rig = json::parse(std::ifstream(WriteCornerRig(dir)));
+    rig["cameras"][0]["position"] = {1e300, -7.0, 4.0};
+    std::ofstream(dir + "/far.json") << rig.dump();
+  }
+  o.rig_path = dir + "/far.json";
+  msg = error_of(o);
+  EXPECT_NE(msg.find("far.json"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("10 km"), std::string::npos) << msg;
+  o.rig_path = WriteCornerRig(dir);
+  o.map.width_px = 20000;  // six such maps took 2.6 GB
+  msg = error_of(o);
+  EXPECT_NE(msg.find("width_px"), std::string::npos) << msg;
 }
 
 }  // namespace

@@ -82,6 +82,10 @@ Camera CameraFromJson(const json& j, const std::string& ctx) {
   if (j.contains("distortion")) cam.distortion = JsonNumbers(j, "distortion", ctx);
   cam.name = JsonString(j, "name", ctx, cam.name);
   const Eigen::Vector3d eye = JsonVector<3>(j, "position", ctx);
+  // A position kilometres away is a typo (1e300 ended up at the origin of the pose arithmetic).
+  FV_REQUIRE(eye.lpNorm<Eigen::Infinity>() <= 1e4,
+             "{}: key 'position' must be within 10 km of the field centre (got {}, {}, {})", ctx,
+             eye.x(), eye.y(), eye.z());
   const double roll_deg = j.contains("roll_deg") ? JsonNumber(j, "roll_deg", ctx) : 0.0;
   int num_orient = 0;
   for (const auto& k : {"look_at", "yaw_deg", "rvec"}) num_orient += j.contains(k) ? 1 : 0;
