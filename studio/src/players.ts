@@ -246,7 +246,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     lc.fillStyle = '#161b22';
     lc.fillRect(0, 0, legend.width, legend.height);
     const x0 = 40;
-    const w = legend.width - 80;
+    const w = legend.width - 160;
     for (let i = 0; i < w; ++i) {
       const [r, g, b] = rampColour(i / (w - 1));
       lc.fillStyle = `rgb(${Math.round(255 * r)}, ${Math.round(255 * g)}, ${Math.round(255 * b)})`;
@@ -260,7 +260,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       const label = `${((k * max) / 4).toFixed(max < 4 ? 2 : 1)} s`;
       lc.fillText(label, x - lc.measureText(label).width / 2, 38);
     }
-    lc.fillText(`per ${cell} m cell`, legend.width - 72, 16);
+    lc.fillText(`seconds per ${cell} m cell`, x0 + w + 12, 18);
   }
 
   load.onclick = async () => {

@@ -374,7 +374,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     const gl = renderer.getContext();
     const pixel = new Uint8Array(4);
     const costs: number[] = [];
-    for (let i = 0; i < 45; ++i) {
+    for (let i = 0; i < 30; ++i) {
       const t0 = performance.now();
       turn();
       renderNow();
@@ -382,13 +382,13 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
       if (i >= 5) costs.push(performance.now() - t0);
       if (i % 10 === 9) await new Promise((r) => setTimeout(r, 0));
     }
-    // Frames shown: the view turns every animation frame for 3 s, rendered on demand.
+    // Frames shown: the view turns every animation frame for 2 s, rendered on demand.
     const first = renders;
     const start = performance.now();
     await new Promise<void>((done) => {
       const step = () => {
         turn();
-        if (performance.now() - start < 3000) requestAnimationFrame(step);
+        if (performance.now() - start < 2000) requestAnimationFrame(step);
         else done();
       };
       requestAnimationFrame(step);

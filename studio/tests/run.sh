@@ -23,6 +23,7 @@ fi
 [ -d "$STUDIO/node_modules/playwright-core" ] || { echo "FAIL: playwright-core is not installed (npm ci in studio/ failed)"; exit 1; }
 [ -f "$STUDIO/dist/index.html" ] || { echo "FAIL: the studio front end is not built (studio/build.sh)"; exit 1; }
 
+START=$(date +%s.%N)
 rm -rf "$OUT"
 mkdir -p "$OUT/work"
 W="$OUT/work"
@@ -51,6 +52,7 @@ if [ -d "$BOARDS" ]; then
   export FV_BOARDS_REFERENCE="$BOARDS/left_intrinsics.yml"
 fi
 
+echo "  (scenes and ball track made: $(awk "BEGIN { printf \"%.1f\", $(date +%s.%N) - $START }") s)"
 cd "$W"
 "$FV" studio --port 0 >"$OUT/server.log" 2>&1 &
 SERVER=$!
