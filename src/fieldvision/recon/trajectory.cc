@@ -893,44 +893,27 @@ double MeetingTime(const BallisticModel& a, const BallisticModel& b, double t_a,
   return best_t;
 }
 
-}  // namespace
+// A run of airborne samples between two events: positions a..b (inclusive) in the list of
+// airborne inliers.
+struct Piece {
+  int a, b;
+  FlightEvent start, end;
+};
 
-TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
-                                   const TrajectoryOptions& options) {
-  options.Check();
-  for (size_t i = 1; i < track.size(); ++i) {
-    FV_REQUIRE(track[i].time_s > track[i - 1].time_s,
-               "ball track: times must increase (sample {} at {} s follows {} s)", i,
-               track[i].time_s, track[i - 1].time_s);
-  }
-  TrajectoryResult res;
+// The airborne inliers (`air`, track indices) cut into blocks at ground phases and gaps longer
+// than max_gap_s, each block split at the breaks the segmenter finds (kHit until the fitted arcs
+// tell a bounce from a hit).
+std::vector<Piece> CutIntoPieces(const std::vector<BallSample>& track,
+                                 const std::vector<bool>& on_ground, const std::vector<int>& air,
+                                 const Segmenter& seg, const TrajectoryOptions& options) {
   const int n = static_cast<int>(track.size());
-  res.outlier.assign(n, false);
-  res.on_ground.assign(n, false);
-  res.noise_m =
-      options.noise_m > 0 ? options.noise_m : EstimateTrackNoise(track, options.gravity_mps2);
-  if (n < 3) return res;
-  const Segmenter seg{track, options, res.noise_m};
-  res.outlier = seg.FindOutliers();
-  res.on_ground = seg.FindGround(res.outlier);
-
-  // Airborne inliers, cut into blocks at ground phases and long gaps.
-  std::vector<int> air;
-  for (int i = 0; i < n; ++i) {
-    if (!res.outlier[i] && !res.on_ground[i]) air.push_back(i);
-  }
-  struct Piece {
-    int a, b;  // positions in `air`, inclusive
-    FlightEvent start, end;
-  };
-  std::vector<Piece> pieces;
-  const double zr = options.ground_z_m + options.ball_radius_m;
   auto ground_in = [&](int i0, int i1) {  // any ground sample in [i0, i1)
     for (int k = std::max(i0, 0); k < std::min(i1, n); ++k) {
-      if (res.on_ground[k]) return true;
+      if (on_ground[k]) return true;
     }
     return false;
   };
+  std::vector<Piece> pieces;
   int block_start = 0;
   const int m = static_cast<int>(air.size());
   for (int p = 0; p < m; ++p) {
@@ -950,130 +933,159 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     for (int br : brk) {
       pieces.push_back({a, br, ev, FlightEvent::kHit});
       a = br + 1;
-      ev = FlightEvent::kHit;  // bounce or hit: decided from the fitted arcs below
+      ev = FlightEvent::kHit;  // bounce or hit: decided from the fitted arcs
     }
     pieces.push_back({a, p, ev, end_ev});
     block_start = p + 1;
   }
+  return pieces;
+}
 
-  // Fit the pieces.
-  std::vector<Flight> flights;
-  std::vector<int> piece_of_flight;
-  std::vector<std::pair<double, double>> limits;  // contact times lie within these
-  for (size_t pi = 0; pi < pieces.size(); ++pi) {
-    if (options.progress) options.progress(pi, pieces.size());
-    const Piece& pc = pieces[pi];
-    const int count = pc.b - pc.a + 1;
-    if (count < options.min_flight_samples) {
-      ++res.short_hops;
-      continue;
+// Leading and trailing samples the arc misses belong to a neighbouring hop too short to be split
+// off by the local fits: drops them (at most 3 a side; a longer run of misses is model error such
+// as spin, kept) and fits again. True when it dropped any.
+bool TrimMissedEnds(const TrajectoryOptions& options, double noise_m, std::vector<BallSample>* s,
+                    Flight* f) {
+  int lead = 0, trail = 0;
+  const int ns = static_cast<int>(s->size());
+  while (lead < ns && !f->no_drag.inlier[lead]) ++lead;
+  while (trail < ns - lead && !f->no_drag.inlier[ns - 1 - trail]) ++trail;
+  if (lead > 3) lead = 0;
+  if (trail > 3) trail = 0;
+  if ((lead == 0 && trail == 0) || ns - lead - trail < options.min_flight_samples) return false;
+  *s = std::vector<BallSample>(s->begin() + lead, s->end() - trail);
+  f->samples = std::vector<int>(f->samples.begin() + lead, f->samples.end() - trail);
+  f->no_drag = FitBallistic(*s, false, options, noise_m);
+  return true;
+}
+
+// Samples of the neighbouring ground phases that lie on the arc (the approach to a contact within
+// the ground tolerance) join it and leave the ground phase; the first one that does not bounds
+// the contact time (*lo before the arc, *hi after it).
+void JoinGroundApproach(const std::vector<BallSample>& track, const std::vector<bool>& outlier,
+                        const TrajectoryOptions& options, double noise_m,
+                        std::vector<bool>* on_ground, std::vector<BallSample>* s, Flight* f,
+                        double* lo, double* hi) {
+  const int n = static_cast<int>(track.size());
+  *lo = -std::numeric_limits<double>::infinity();
+  *hi = std::numeric_limits<double>::infinity();
+  const double thr =
+      std::max(options.outlier_sigmas * noise_m * std::sqrt(3.0), options.min_outlier_m);
+  auto consistent = [&](int k) {
+    return (f->no_drag.model.PositionAt(track[k].time_s) - track[k].ball_in_world).norm() <= thr;
+  };
+  bool added = false;
+  for (int k = f->samples.front() - 1; k >= 0; --k) {
+    if (outlier[k]) continue;
+    if (!(*on_ground)[k] || !consistent(k)) {
+      *lo = track[k].time_s;
+      break;
     }
-    std::vector<BallSample> s;
-    Flight f;
-    for (int p = pc.a; p <= pc.b; ++p) {
-      s.push_back(track[air[p]]);
-      f.samples.push_back(air[p]);
-    }
-    f.start_event = pc.start;
-    f.end_event = pc.end;
-    f.no_drag = FitBallistic(s, false, options, res.noise_m);
-    // Leading and trailing samples the arc misses belong to a neighbouring hop too short to be
-    // split off by the local fits: drop them and fit again.
-    {
-      int lead = 0, trail = 0;
-      const int ns = static_cast<int>(s.size());
-      while (lead < ns && !f.no_drag.inlier[lead]) ++lead;
-      while (trail < ns - lead && !f.no_drag.inlier[ns - 1 - trail]) ++trail;
-      // Only a few samples (a hop); a long run of misses is model error (spin), kept.
-      if (lead > 3) lead = 0;
-      if (trail > 3) trail = 0;
-      if ((lead > 0 || trail > 0) && ns - lead - trail >= options.min_flight_samples) {
-        s = std::vector<BallSample>(s.begin() + lead, s.end() - trail);
-        f.samples = std::vector<int>(f.samples.begin() + lead, f.samples.end() - trail);
-        f.no_drag = FitBallistic(s, false, options, res.noise_m);
-        ++res.short_hops;
-      }
-    }
-    // Samples of the neighbouring ground phase that lie on the arc (the approach to a contact
-    // within the ground tolerance) join it; the first one that does not bounds the contact time.
-    double lo = -std::numeric_limits<double>::infinity();
-    double hi = std::numeric_limits<double>::infinity();
-    {
-      const double thr =
-          std::max(options.outlier_sigmas * res.noise_m * std::sqrt(3.0), options.min_outlier_m);
-      auto consistent = [&](int k) {
-        return (f.no_drag.model.PositionAt(track[k].time_s) - track[k].ball_in_world).norm() <= thr;
-      };
-      bool added = false;
-      for (int k = f.samples.front() - 1; k >= 0; --k) {
-        if (res.outlier[k]) continue;
-        if (!res.on_ground[k] || !consistent(k)) {
-          lo = track[k].time_s;
-          break;
-        }
-        f.samples.insert(f.samples.begin(), k);
-        res.on_ground[k] = false;
-        added = true;
-      }
-      for (int k = f.samples.back() + 1; k < n; ++k) {
-        if (res.outlier[k]) continue;
-        if (!res.on_ground[k] || !consistent(k)) {
-          hi = track[k].time_s;
-          break;
-        }
-        f.samples.push_back(k);
-        res.on_ground[k] = false;
-        added = true;
-      }
-      if (added) {
-        s.clear();
-        for (int k : f.samples) s.push_back(track[k]);
-        f.no_drag = FitBallistic(s, false, options, res.noise_m);
-      }
-    }
-    f.t_first_seen_s = s.front().time_s;
-    f.t_last_seen_s = s.back().time_s;
-    const double span = f.t_last_seen_s - f.t_first_seen_s;
-    const bool try_drag = options.drag == DragMode::kOn ||
-                          (options.drag == DragMode::kAuto && count >= 8 && span >= 0.15);
-    if (try_drag) f.with_drag = FitBallistic(s, true, options, res.noise_m);
-    f.drag_used = f.with_drag.ok &&
-                  (options.drag == DragMode::kOn || f.with_drag.rmse_m < 0.9 * f.no_drag.rmse_m);
-    const bool try_spin =
-        options.spin == SpinMode::kOn ||
-        (options.spin == SpinMode::kAuto &&
-         static_cast<int>(s.size()) >= options.spin_min_samples && span >= options.spin_min_span_s);
-    if (try_spin) {
-      const BallisticFit& base = f.drag_used ? f.with_drag : f.no_drag;
-      if (base.ok)
-        f.with_spin = FitBallistic(s, FlightModel::kSpin, options, res.noise_m, &base.model);
-      if (!f.with_spin.ok) f.with_spin = FitBallistic(s, FlightModel::kSpin, options, res.noise_m);
-      f.spin_used = f.with_spin.ok && (options.spin == SpinMode::kOn || !base.ok ||
-                                       f.with_spin.bic < base.bic - options.spin_min_bic_gain);
-    }
-    if (!f.no_drag.ok && !f.drag_used && !f.spin_used) {
-      ++res.short_hops;
-      continue;
-    }
-    f.rmse_m = f.spin_used   ? f.with_spin.rmse_m
-               : f.drag_used ? f.with_drag.rmse_m
-                             : f.no_drag.rmse_m;
-    f.free_accel = FitConstantAcceleration(s);
-    f.seed = FitPlaneQuadratic(s, options);
-    flights.push_back(std::move(f));
-    piece_of_flight.push_back(static_cast<int>(pi));
-    limits.emplace_back(lo, hi);
+    f->samples.insert(f->samples.begin(), k);
+    (*on_ground)[k] = false;
+    added = true;
   }
+  for (int k = f->samples.back() + 1; k < n; ++k) {
+    if (outlier[k]) continue;
+    if (!(*on_ground)[k] || !consistent(k)) {
+      *hi = track[k].time_s;
+      break;
+    }
+    f->samples.push_back(k);
+    (*on_ground)[k] = false;
+    added = true;
+  }
+  if (added) {
+    s->clear();
+    for (int k : f->samples) s->push_back(track[k]);
+    f->no_drag = FitBallistic(*s, false, options, noise_m);
+  }
+}
 
-  // Events between consecutive pieces that are both fitted: bounce or hit, with the contact time
-  // where the two arcs meet.
-  const double ground_tol = options.ground_tolerance_m + 3 * res.noise_m + 0.05;
-  for (size_t i = 0; i + 1 < flights.size(); ++i) {
-    Flight& A = flights[i];
-    Flight& B = flights[i + 1];
+// The drag and spin fits the options ask for, and which model the flight uses: drag when it
+// lowers the RMSE by 10 % (or is forced), spin when it lowers the BIC by spin_min_bic_gain.
+// `piece_samples` is the piece's size before trimming (the drag fit's sample rule). False when
+// no model fits (a short hop).
+bool ChooseModel(const std::vector<BallSample>& s, int piece_samples,
+                 const TrajectoryOptions& options, double noise_m, Flight* f) {
+  f->t_first_seen_s = s.front().time_s;
+  f->t_last_seen_s = s.back().time_s;
+  const double span = f->t_last_seen_s - f->t_first_seen_s;
+  const bool try_drag = options.drag == DragMode::kOn ||
+                        (options.drag == DragMode::kAuto && piece_samples >= 8 && span >= 0.15);
+  if (try_drag) f->with_drag = FitBallistic(s, true, options, noise_m);
+  f->drag_used = f->with_drag.ok &&
+                 (options.drag == DragMode::kOn || f->with_drag.rmse_m < 0.9 * f->no_drag.rmse_m);
+  const bool try_spin =
+      options.spin == SpinMode::kOn ||
+      (options.spin == SpinMode::kAuto && static_cast<int>(s.size()) >= options.spin_min_samples &&
+       span >= options.spin_min_span_s);
+  if (try_spin) {
+    const BallisticFit& base = f->drag_used ? f->with_drag : f->no_drag;
+    if (base.ok) f->with_spin = FitBallistic(s, FlightModel::kSpin, options, noise_m, &base.model);
+    if (!f->with_spin.ok) f->with_spin = FitBallistic(s, FlightModel::kSpin, options, noise_m);
+    f->spin_used = f->with_spin.ok && (options.spin == SpinMode::kOn || !base.ok ||
+                                       f->with_spin.bic < base.bic - options.spin_min_bic_gain);
+  }
+  if (!f->no_drag.ok && !f->drag_used && !f->spin_used) return false;
+  f->rmse_m = f->spin_used   ? f->with_spin.rmse_m
+              : f->drag_used ? f->with_drag.rmse_m
+                             : f->no_drag.rmse_m;
+  return true;
+}
+
+struct FittedPiece {
+  Flight flight;
+  double lo_s, hi_s;  // the contact times before and after lie within these
+};
+
+// One piece fitted as a flight; nullopt for a hop too short to fit (counted in *short_hops, as
+// are trimmed ends). Joined ground samples leave *on_ground.
+std::optional<FittedPiece> FitPiece(const std::vector<BallSample>& track,
+                                    const std::vector<int>& air, const Piece& pc,
+                                    const std::vector<bool>& outlier,
+                                    const TrajectoryOptions& options, double noise_m,
+                                    std::vector<bool>* on_ground, int* short_hops) {
+  const int count = pc.b - pc.a + 1;
+  if (count < options.min_flight_samples) {
+    ++*short_hops;
+    return std::nullopt;
+  }
+  std::vector<BallSample> s;
+  FittedPiece fp;
+  Flight& f = fp.flight;
+  for (int p = pc.a; p <= pc.b; ++p) {
+    s.push_back(track[air[p]]);
+    f.samples.push_back(air[p]);
+  }
+  f.start_event = pc.start;
+  f.end_event = pc.end;
+  f.no_drag = FitBallistic(s, false, options, noise_m);
+  if (TrimMissedEnds(options, noise_m, &s, &f)) ++*short_hops;
+  JoinGroundApproach(track, outlier, options, noise_m, on_ground, &s, &f, &fp.lo_s, &fp.hi_s);
+  if (!ChooseModel(s, count, options, noise_m, &f)) {
+    ++*short_hops;
+    return std::nullopt;
+  }
+  f.free_accel = FitConstantAcceleration(s);
+  f.seed = FitPlaneQuadratic(s, options);
+  return fp;
+}
+
+// Events between consecutive pieces that are both fitted: bounce (low, descending then rising)
+// or hit, with the contact time where the two arcs meet; a side that was trimmed leaves the
+// contact unresolved (ground). Then a break next to a hop too short to fit is a ground contact
+// too (origin and landing from the arc's own crossing of the ground level).
+void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOptions& options,
+                     double noise_m, std::vector<Flight>* flights,
+                     std::vector<TrackBreak>* breaks) {
+  const double zr = options.ground_z_m + options.ball_radius_m;
+  const double ground_tol = options.ground_tolerance_m + 3 * noise_m + 0.05;
+  for (size_t i = 0; i + 1 < flights->size(); ++i) {
+    Flight& A = (*flights)[i];
+    Flight& B = (*flights)[i + 1];
     if (piece_of_flight[i + 1] != piece_of_flight[i] + 1) continue;
     if (A.end_event != FlightEvent::kHit || B.start_event != FlightEvent::kHit) {
-      // One side was trimmed: the contact is not resolved between these two.
       if (A.end_event == FlightEvent::kHit) A.end_event = FlightEvent::kGround;
       if (B.start_event == FlightEvent::kHit) B.start_event = FlightEvent::kGround;
       continue;
@@ -1098,60 +1110,55 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
       A.t_end_s = tm;
       B.t_start_s = tm;
     }
-    res.breaks.push_back(br);
+    breaks->push_back(br);
   }
-  // A break next to a hop too short to fit: the contact is not resolved; treat it as a ground
-  // contact (origin and landing from the arc's own crossing of the ground level).
-  for (size_t i = 0; i < flights.size(); ++i) {
+  for (size_t i = 0; i < flights->size(); ++i) {
+    Flight& f = (*flights)[i];
     const bool prev_fitted = i > 0 && piece_of_flight[i - 1] + 1 == piece_of_flight[i];
     const bool next_fitted =
-        i + 1 < flights.size() && piece_of_flight[i + 1] == piece_of_flight[i] + 1;
-    if (flights[i].start_event == FlightEvent::kHit && !prev_fitted) {
-      flights[i].start_event = FlightEvent::kGround;
-    }
-    if (flights[i].end_event == FlightEvent::kHit && !next_fitted) {
-      flights[i].end_event = FlightEvent::kGround;
-    }
+        i + 1 < flights->size() && piece_of_flight[i + 1] == piece_of_flight[i] + 1;
+    if (f.start_event == FlightEvent::kHit && !prev_fitted) f.start_event = FlightEvent::kGround;
+    if (f.end_event == FlightEvent::kHit && !next_fitted) f.end_event = FlightEvent::kGround;
   }
+}
 
-  // Origins, landings, apex, v0.
-  for (size_t i = 0; i < flights.size(); ++i) {
-    Flight& f = flights[i];
-    f.index = static_cast<int>(i);
-    const BallisticModel& mdl = f.model();
-    if (f.start_event == FlightEvent::kHit) {
-      f.origin_m = mdl.PositionAt(f.t_start_s);
-    } else {
-      const auto t0 = mdl.CrossingTime(zr, f.t_first_seen_s, false, 10.0);
-      f.t_start_s = t0 ? *t0 : f.t_first_seen_s;
-      // Kicked while rolling or hopping low: the arc starts after the last sample off it.
-      if (f.start_event == FlightEvent::kGround) {
-        f.t_start_s = std::max(f.t_start_s, limits[i].first);
-      }
-      f.origin_m = mdl.PositionAt(f.t_start_s);
-    }
-    const auto t1 = mdl.CrossingTime(zr, f.t_last_seen_s, true, 10.0);
-    f.t_landing_s = t1 ? *t1 : f.t_last_seen_s;
-    if (f.end_event == FlightEvent::kGround) {
-      f.t_landing_s = std::min(f.t_landing_s, limits[i].second);
-    }
-    f.landing_m = mdl.PositionAt(f.t_landing_s);
-    if (f.end_event != FlightEvent::kHit) f.t_end_s = f.t_landing_s;
-    f.origin_extrapolated = f.start_event == FlightEvent::kTrackStart;
-    f.landing_extrapolated =
-        f.end_event == FlightEvent::kHit || f.end_event == FlightEvent::kTrackEnd;
-    f.v0_mps = mdl.VelocityAt(f.t_start_s);
-    f.speed_mps = f.v0_mps.norm();
-    f.apex_m = mdl.PositionAt(f.t_start_s);
-    ApexOf(mdl, f.t_start_s, f.t_end_s, &f.t_apex_s);
-    f.apex_m = mdl.PositionAt(f.t_apex_s);
+// Origin, landing, apex and launch velocity of a flight from its model and events; a ground
+// contact lies within the contact-time bounds [lo_s, hi_s] of its piece.
+void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, Flight* f) {
+  const double zr = options.ground_z_m + options.ball_radius_m;
+  const BallisticModel& mdl = f->model();
+  if (f->start_event == FlightEvent::kHit) {
+    f->origin_m = mdl.PositionAt(f->t_start_s);
+  } else {
+    const auto t0 = mdl.CrossingTime(zr, f->t_first_seen_s, false, 10.0);
+    f->t_start_s = t0 ? *t0 : f->t_first_seen_s;
+    // Kicked while rolling or hopping low: the arc starts after the last sample off it.
+    if (f->start_event == FlightEvent::kGround) f->t_start_s = std::max(f->t_start_s, lo_s);
+    f->origin_m = mdl.PositionAt(f->t_start_s);
   }
-  // A bounce is one point on the ground: combine the landing of the arc before and the origin
-  // of the arc after, weighted by the inverse extrapolation variance of each (leverage of the
-  // contact time in each arc's gravity fit).
-  for (size_t i = 0; i + 1 < flights.size(); ++i) {
-    Flight& A = flights[i];
-    Flight& B = flights[i + 1];
+  const auto t1 = mdl.CrossingTime(zr, f->t_last_seen_s, true, 10.0);
+  f->t_landing_s = t1 ? *t1 : f->t_last_seen_s;
+  if (f->end_event == FlightEvent::kGround) f->t_landing_s = std::min(f->t_landing_s, hi_s);
+  f->landing_m = mdl.PositionAt(f->t_landing_s);
+  if (f->end_event != FlightEvent::kHit) f->t_end_s = f->t_landing_s;
+  f->origin_extrapolated = f->start_event == FlightEvent::kTrackStart;
+  f->landing_extrapolated =
+      f->end_event == FlightEvent::kHit || f->end_event == FlightEvent::kTrackEnd;
+  f->v0_mps = mdl.VelocityAt(f->t_start_s);
+  f->speed_mps = f->v0_mps.norm();
+  f->apex_m = mdl.PositionAt(f->t_start_s);
+  ApexOf(mdl, f->t_start_s, f->t_end_s, &f->t_apex_s);
+  f->apex_m = mdl.PositionAt(f->t_apex_s);
+}
+
+// A bounce is one point on the ground: the landing of the arc before and the origin of the arc
+// after, weighted by the inverse extrapolation variance of each (leverage of the contact time in
+// each arc's gravity fit).
+void MergeBounces(const std::vector<BallSample>& track, const TrajectoryOptions& options,
+                  std::vector<Flight>* flights) {
+  for (size_t i = 0; i + 1 < flights->size(); ++i) {
+    Flight& A = (*flights)[i];
+    Flight& B = (*flights)[i + 1];
     if (A.end_event != FlightEvent::kBounce || B.start_event != FlightEvent::kBounce) continue;
     const double tc = 0.5 * (A.t_landing_s + B.t_start_s);
     const double la =
@@ -1166,16 +1173,64 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     B.v0_mps = B.model().VelocityAt(t);
     B.speed_mps = B.v0_mps.norm();
   }
-  for (Flight& f : flights) {
-    // Outliers inside the flight's span belong to it (for the pictures).
-    for (int k = 0; k < n; ++k) {
-      if (res.outlier[k] && track[k].time_s >= f.t_first_seen_s &&
-          track[k].time_s <= f.t_last_seen_s) {
-        f.samples.push_back(k);
-      }
+}
+
+// Outliers inside a flight's seen span belong to it (for the pictures).
+void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool>& outlier,
+                    Flight* f) {
+  for (size_t k = 0; k < track.size(); ++k) {
+    if (outlier[k] && track[k].time_s >= f->t_first_seen_s && track[k].time_s <= f->t_last_seen_s) {
+      f->samples.push_back(static_cast<int>(k));
     }
-    std::sort(f.samples.begin(), f.samples.end());
   }
+  std::sort(f->samples.begin(), f->samples.end());
+}
+
+}  // namespace
+
+TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
+                                   const TrajectoryOptions& options) {
+  options.Check();
+  for (size_t i = 1; i < track.size(); ++i) {
+    FV_REQUIRE(track[i].time_s > track[i - 1].time_s,
+               "ball track: times must increase (sample {} at {} s follows {} s)", i,
+               track[i].time_s, track[i - 1].time_s);
+  }
+  TrajectoryResult res;
+  const int n = static_cast<int>(track.size());
+  res.outlier.assign(n, false);
+  res.on_ground.assign(n, false);
+  res.noise_m =
+      options.noise_m > 0 ? options.noise_m : EstimateTrackNoise(track, options.gravity_mps2);
+  if (n < 3) return res;
+  const Segmenter seg{track, options, res.noise_m};
+  res.outlier = seg.FindOutliers();
+  res.on_ground = seg.FindGround(res.outlier);
+
+  std::vector<int> air;  // airborne inliers
+  for (int i = 0; i < n; ++i) {
+    if (!res.outlier[i] && !res.on_ground[i]) air.push_back(i);
+  }
+  const std::vector<Piece> pieces = CutIntoPieces(track, res.on_ground, air, seg, options);
+  std::vector<Flight> flights;
+  std::vector<int> piece_of_flight;
+  std::vector<std::pair<double, double>> limits;  // contact times lie within these
+  for (size_t pi = 0; pi < pieces.size(); ++pi) {
+    if (options.progress) options.progress(pi, pieces.size());
+    auto fp = FitPiece(track, air, pieces[pi], res.outlier, options, res.noise_m, &res.on_ground,
+                       &res.short_hops);
+    if (!fp) continue;
+    flights.push_back(std::move(fp->flight));
+    piece_of_flight.push_back(static_cast<int>(pi));
+    limits.emplace_back(fp->lo_s, fp->hi_s);
+  }
+  ResolveContacts(piece_of_flight, options, res.noise_m, &flights, &res.breaks);
+  for (size_t i = 0; i < flights.size(); ++i) {
+    flights[i].index = static_cast<int>(i);
+    PlaceEndpoints(options, limits[i].first, limits[i].second, &flights[i]);
+  }
+  MergeBounces(track, options, &flights);
+  for (Flight& f : flights) AttachOutliers(track, res.outlier, &f);
   res.flights = std::move(flights);
   return res;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,5 +68,56 @@ TriangulationResult TriangulateViews(const std::vector<Camera>& cameras,
                                      const std::vector<View>& views,
                                      const std::vector<int>& candidate_index,
                                      const TriangulationOptions& o);
+
+// ---- The robust search's stages (triangulation_robust.cc)
+
+// Per camera: the best max_candidates_per_camera candidates by score, their rays, and the cameras
+// with any candidate.
+struct RankedCandidates {
+  std::vector<std::vector<int>> order;                  // candidate indices, best first
+  std::vector<std::vector<std::optional<Ray3d>>> rays;  // by candidate index (ranked ones)
+  std::vector<int> seen;                                // cameras with candidates
+};
+RankedCandidates RankCandidates(const std::vector<Camera>& cameras,
+                                const std::vector<std::vector<BallObservation>>& candidates,
+                                const TriangulationOptions& o);
+// The reported radius against the one that the depth of p predicts, within max_ratio either way
+// (true when max_ratio is 0 or a radius is unknown).
+bool RadiusConsistent(const Camera& camera, const BallObservation& obs, const Eigen::Vector3d& p,
+                      double ball_radius_m, double max_ratio);
+// The candidate's reprojection error at p when it is consistent with p (in front, within the
+// threshold, radius checks), else -1.
+double ConsistentError(const Camera& camera, const BallObservation& obs, const Eigen::Vector3d& p,
+                       const TriangulationOptions& o);
+// For a point: the best consistent candidate of every camera (-1: none) in *pick, and the
+// sigma-weighted squared error of those.
+double GatherConsistent(const std::vector<Camera>& cameras,
+                        const std::vector<std::vector<BallObservation>>& candidates,
+                        const RankedCandidates& ranked, const TriangulationOptions& o,
+                        const Eigen::Vector3d& p, std::vector<int>* pick);
+int CountPicked(const std::vector<int>& pick);
+// A set keeps a candidate that is not weak, or is all weak but seen by min_views_all_weak
+// cameras within prior_gate_m of the prior.
+bool StrongEnough(const std::vector<std::vector<BallObservation>>& candidates,
+                  const std::vector<int>& pick, const Eigen::Vector3d& p,
+                  const TriangulationOptions& o, const Eigen::Vector3d* prior);
+struct BestHypothesis {
+  std::vector<int> pick;  // candidate per camera, -1: none
+  int n = 0;              // cameras in the set
+  double cost = 0, score = 0;
+  int hypotheses = 0;  // two-view hypotheses scored
+};
+// Every two-view hypothesis: the set with the most cameras, then the highest total score, then
+// the smallest error.
+BestHypothesis SearchHypotheses(const std::vector<Camera>& cameras,
+                                const std::vector<std::vector<BallObservation>>& candidates,
+                                const RankedCandidates& ranked, const TriangulationOptions& o,
+                                bool require_strong, const Eigen::Vector3d* prior);
+// Refines on the set, re-gathers once with the refined point, then drops the views the refined
+// point does not explain (kNoConsistentSet below two).
+TriangulationResult RefineConsistentSet(const std::vector<Camera>& cameras,
+                                        const std::vector<std::vector<BallObservation>>& candidates,
+                                        const RankedCandidates& ranked,
+                                        const TriangulationOptions& o, std::vector<int> pick);
 
 }  // namespace fv::triangulation_detail

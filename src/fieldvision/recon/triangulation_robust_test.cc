@@ -1,0 +1,122 @@
+// The robust search's stages one by one (triangulation_internal.h).
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/recon/triangulation.h"
+#include "fieldvision/recon/triangulation_internal.h"
+
+namespace fv {
+namespace {
+
+using namespace triangulation_detail;  // NOLINT: the stages under test
+
+// Three cameras 10 m from the field centre, 5 m high, looking at it.
+std::vector<Camera> RingCameras() {
+  std::vector<Camera> cams;
+  for (int i = 0; i < 3; ++i) {
+    const double a = 2 * M_PI * i / 3;
+    Camera c = Camera::FromFov(1280, 960, 70);
+    c.cam_from_world =
+        Rigid3d::LookAt(Eigen::Vector3d(10 * std::cos(a), 10 * std::sin(a), 5), {0, 0, 0});
+    c.has_pose = true;
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+BallObservation Seen(const Camera& cam, const Eigen::Vector3d& p, double score = 1.0) {
+  BallObservation o;
+  o.centre_px = *PredictBallCentre(cam, p, 0.0);
+  o.score = score;
+  return o;
+}
+
+BallObservation Elsewhere(double score) {
+  BallObservation o;
+  o.centre_px = {100, 120};
+  o.score = score;
+  return o;
+}
+
+TEST(RobustStages, RankKeepsTheBestScoredCandidatesOfCamerasThatSeeAny) {
+  const auto cams = RingCameras();
+  TriangulationOptions o;
+  o.max_candidates_per_camera = 2;
+  std::vector<std::vector<BallObservation>> cand = {
+      {Elsewhere(0.1), Elsewhere(0.9), Elsewhere(0.5)}, {}, {Elsewhere(0.3)}};
+  const RankedCandidates r = RankCandidates(cams, cand, o);
+  EXPECT_EQ(r.seen, (std::vector<int>{0, 2}));
+  EXPECT_EQ(r.order[0], (std::vector<int>{1, 2}));  // 0.9, 0.5; the 0.1 one dropped
+  EXPECT_TRUE(r.order[1].empty());
+  EXPECT_TRUE(r.rays[0][1].has_value());
+  EXPECT_FALSE(r.rays[0][0].has_value());  // not ranked: no ray cast
+}
+
+TEST(RobustStages, ConsistencyChecksThresholdDepthAndRadius) {
+  const auto cams = RingCameras();
+  TriangulationOptions o;
+  const Eigen::Vector3d p(1, -2, 0.5);
+  BallObservation obs = Seen(cams[0], p);
+  EXPECT_NEAR(ConsistentError(cams[0], obs, p, o), 0.0, 1e-9);
+  obs.centre_px.x() += 3.0;  // within max(4 px, 3 sigma)
+  EXPECT_NEAR(ConsistentError(cams[0], obs, p, o), 3.0, 1e-9);
+  obs.centre_px.x() += 2.0;  // 5 px: outside
+  EXPECT_EQ(ConsistentError(cams[0], obs, p, o), -1);
+  // Behind the camera.
+  EXPECT_EQ(ConsistentError(cams[0], Seen(cams[0], p), Eigen::Vector3d(30, 0, 8), o), -1);
+  // Radius: the depth predicts r = 0.11 * f / depth; twice that fails a 1.5 ratio.
+  BallObservation sized = Seen(cams[0], p);
+  const double depth = (cams[0].cam_from_world * p).z();
+  sized.radius_px = 2 * 0.11 * std::sqrt(cams[0].fx * cams[0].fy) / depth;
+  EXPECT_TRUE(RadiusConsistent(cams[0], sized, p, 0.11, 0.0));  // off
+  EXPECT_TRUE(RadiusConsistent(cams[0], sized, p, 0.11, 2.5));
+  EXPECT_FALSE(RadiusConsistent(cams[0], sized, p, 0.11, 1.5));
+  sized.weak = true;  // weak candidates also meet weak_max_radius_ratio (1.5)
+  EXPECT_EQ(ConsistentError(cams[0], sized, p, o), -1);
+}
+
+TEST(RobustStages, SearchFindsTheLargestAgreeingSetAndRefineKeepsIt) {
+  const auto cams = RingCameras();
+  TriangulationOptions o;
+  const Eigen::Vector3d p(0.5, 1.5, 1.2);
+  // Camera 1's best-scored blob is false.
+  std::vector<std::vector<BallObservation>> cand = {
+      {Seen(cams[0], p)}, {Elsewhere(5.0), Seen(cams[1], p)}, {Seen(cams[2], p)}};
+  const RankedCandidates ranked = RankCandidates(cams, cand, o);
+  std::vector<int> pick;
+  EXPECT_NEAR(GatherConsistent(cams, cand, ranked, o, p, &pick), 0.0, 1e-12);
+  EXPECT_EQ(pick, (std::vector<int>{0, 1, 0}));
+  EXPECT_EQ(CountPicked(pick), 3);
+  const BestHypothesis best = SearchHypotheses(cams, cand, ranked, o, false, nullptr);
+  EXPECT_EQ(best.n, 3);
+  EXPECT_EQ(best.pick, (std::vector<int>{0, 1, 0}));
+  EXPECT_GE(best.hypotheses, 3);
+  const TriangulationResult r = RefineConsistentSet(cams, cand, ranked, o, best.pick);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.num_views(), 3);
+  EXPECT_LT((r.point_world - p).norm(), 1e-6);
+  // A view 20 px off in a set of three is dropped after refinement.
+  std::vector<std::vector<BallObservation>> off = cand;
+  off[2][0].centre_px.x() += 20;
+  const TriangulationResult r2 = RefineConsistentSet(cams, off, ranked, o, {0, 1, 0});
+  ASSERT_TRUE(r2.ok());
+  EXPECT_EQ(r2.num_views(), 2);
+}
+
+TEST(RobustStages, WeakOnlySetsNeedEnoughCamerasNearThePrior) {
+  TriangulationOptions o;  // min_views_all_weak 3, prior_gate_m 1
+  BallObservation weak;
+  weak.weak = true;
+  const std::vector<std::vector<BallObservation>> cand = {{weak}, {weak}, {weak, Elsewhere(1)}};
+  const Eigen::Vector3d p(1, 1, 1), near(1.5, 1, 1), far(3, 1, 1);
+  EXPECT_TRUE(StrongEnough(cand, {-1, 0, 1}, p, o, nullptr));  // one that is not weak
+  EXPECT_FALSE(StrongEnough(cand, {0, 0, -1}, p, o, &near));   // two weak views
+  EXPECT_FALSE(StrongEnough(cand, {0, 0, 0}, p, o, nullptr));  // no prior
+  EXPECT_FALSE(StrongEnough(cand, {0, 0, 0}, p, o, &far));
+  EXPECT_TRUE(StrongEnough(cand, {0, 0, 0}, p, o, &near));
+}
+
+}  // namespace
+}  // namespace fv
