@@ -114,6 +114,8 @@ void BallRegionOptions::Check() const {
   CheckInRange(grow_fraction, 0.0, 2.0, "BallRegionOptions.grow_fraction");
   CheckPositive(hull_tolerance_px, "BallRegionOptions.hull_tolerance_px");
   CheckPositive(inlier_px, "BallRegionOptions.inlier_px");
+  CheckInRange(hidden_value, 0, 255, "BallRegionOptions.hidden_value");
+  CheckInRange(min_seen, 0.1, 1.0, "BallRegionOptions.min_seen");
   FV_REQUIRE(ring_inner >= 1.0 && ring_outer > ring_inner,
              "BallRegionOptions: need 1 <= ring_inner < ring_outer (got {}, {})", ring_inner,
              ring_outer);
@@ -233,17 +235,35 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     if (th < 0) th += 2 * M_PI;
     bin_hit[std::min(bins - 1, static_cast<int>(th / (2 * M_PI) * bins))] = 1;
   }
+  // An angle is seen unless the circle there is outside the image or hidden: every pixel just
+  // beyond it (1.1..1.3 r) dark.
+  const auto dark = [&](int x, int y) {
+    const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+    return std::max({p[0], p[1], p[2]}) < o.hidden_value;
+  };
   int known = 0, hit = 0;
   for (int b = 0; b < bins; ++b) {
     const double th = 2 * M_PI * (b + 0.5) / bins;
     const double x = c.x() + r * std::cos(th), y = c.y() + r * std::sin(th);
-    const bool visible = x >= lim.x + 1 && y >= lim.y + 1 && x <= lim.x + lim.width - 2 &&
-                         y <= lim.y + lim.height - 2;
+    bool visible = x >= lim.x + 1 && y >= lim.y + 1 && x <= lim.x + lim.width - 2 &&
+                   y <= lim.y + lim.height - 2;
+    if (visible && o.hidden_value > 0 && !bin_hit[b]) {
+      bool all_dark = true, any = false;
+      for (const double f : {1.1, 1.2, 1.3}) {
+        const int px = static_cast<int>(std::lround(c.x() + (f * r + 1) * std::cos(th)));
+        const int py = static_cast<int>(std::lround(c.y() + (f * r + 1) * std::sin(th)));
+        if (!lim.contains({px, py})) continue;
+        any = true;
+        all_dark = all_dark && dark(px, py);
+      }
+      visible = !(any && all_dark);
+    }
     known += visible || bin_hit[b];
     hit += bin_hit[b];
   }
-  if (known < bins / 2) {
-    out.failure = "most of the outline is outside the image";
+  out.seen = double(known) / bins;
+  if (out.seen < o.min_seen) {
+    out.failure = "most of the outline is outside the image or hidden";
     return out;
   }
   out.inliers = n_in;
@@ -276,8 +296,11 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
       const double dx = window.x + x - c.x();
       const double d = std::sqrt(dx * dx + dy * dy);
       if (d < r) {
-        ++disc;
-        disc_in += f[x] != 0;
+        // A dark pixel not in the region hides the ball there (see hidden_value).
+        if (f[x] != 0 || o.hidden_value <= 0 || !dark(window.x + x, window.y + y)) {
+          ++disc;
+          disc_in += f[x] != 0;
+        }
       } else if (d > r_spill) {
         spill += f[x] != 0;
       }

@@ -26,6 +26,12 @@ struct BallRegionOptions {
   double inlier_px = 0.8;          // circle inliers: within this plus 6 % of the radius
   double ring_inner = 1.35;        // leak ring, in radii
   double ring_outer = 1.9;
+  // Pixels darker than this (max of B, G, R) hide the ball rather than frame it: a black robot in
+  // front of it, a fisheye lens's dark border. The circle's angles with such pixels just outside
+  // it, and the disc's dark pixels, count neither for nor against the outline and the fill.
+  // 0 turns this off.
+  int hidden_value = 40;
+  double min_seen = 0.5;  // least share of the circle's angles seen (not outside, not hidden)
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -38,8 +44,9 @@ struct BallRegion {
   double sigma_px = 0.0;   // standard deviation of the centre (each axis), from the residuals
   double rms_px = 0.0;     // RMS distance of the inlier outline points from the circle
   double area_px = 0.0;    // the closed, filled region
-  double arc_cover = 0.0;  // share of angle bins around the circle with an inlier point
-  double fill = 0.0;       // share of the disc (its part inside the image) in the region
+  double arc_cover = 0.0;  // share of the seen angle bins around the circle with an inlier point
+  double fill = 0.0;       // share of the seen disc (inside the image, not hidden) in the region
+  double seen = 0.0;       // share of the circle's angle bins not outside the image or hidden
   double spill = 0.0;      // region area beyond 1.25 r + 1 px, as a share of the disc area
   double leak = 0.0;       // ball-coloured share of the ring ring_inner..ring_outer radii
   // Share of the convex outline points farther out than the circle (beyond the inlier band): a

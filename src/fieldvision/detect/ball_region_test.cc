@@ -123,6 +123,42 @@ TEST(BallRegion, SmallAndEdgeBalls) {
   }
 }
 
+// A ball under a low sun (its shaded side not in the colour class) held by a robot whose dark
+// arm hides a third of it: the hidden angles and disc pixels count neither for nor against the
+// outline and the fill; counted as missing (hidden_value 0), the same region looks like a
+// fragment.
+TEST(BallRegion, ShadedBallHeldByADarkRobot) {
+  const uint64_t seed = fv::testing::TestSeed(8);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  BallRegionOptions off;
+  off.hidden_value = 0;
+  for (int trial = 0; trial < 5; ++trial) {
+    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    const double r = rng.Uniform(12, 28);
+    const Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    detect_testing::PaintDisc(img, c, r, detect_testing::kOrange, 0.7);
+    const int arm = static_cast<int>(c.x() - 0.35 * r);  // the arm's edge, left of the centre
+    cv::rectangle(img, cv::Point(0, 0), cv::Point(arm, 239), cv::Scalar(20, 22, 24), cv::FILLED);
+    const cv::Rect seed_box(arm + 1, static_cast<int>(c.y() - r), static_cast<int>(c.x() + r) - arm,
+                            static_cast<int>(2 * r));
+    const BallRegion seen = AnalyseBallRegion(img, table, table.BallBit(), seed_box, {});
+    const BallRegion counted = AnalyseBallRegion(img, table, table.BallBit(), seed_box, {}, off);
+    ASSERT_TRUE(seen.ok) << seen.failure;
+    ASSERT_TRUE(counted.ok) << counted.failure;
+    SCOPED_TRACE("r " + std::to_string(r) + ": " + seen.Summary() + " / " + counted.Summary());
+    EXPECT_LT(seen.seen, 0.8);  // the arm hides about 40 % of the circle's angle
+    EXPECT_GT(seen.seen, 0.5);
+    EXPECT_EQ(counted.seen, 1.0);
+    EXPECT_GT(seen.arc_cover, counted.arc_cover + 0.15);
+    EXPECT_GT(seen.fill, counted.fill + 0.15);
+    EXPECT_GE(seen.arc_cover, 0.5);
+    EXPECT_GE(seen.fill, 0.8);
+    EXPECT_LT((seen.centre_px - c).norm(), 0.15 * r + 0.5);
+  }
+}
+
 TEST(BallRegion, ShapesThatAreNotBallsAreRejected) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
@@ -160,6 +196,9 @@ TEST(BallRegion, ShapesThatAreNotBallsAreRejected) {
 TEST(BallRegion, OptionsAreChecked) {
   BallRegionOptions o;
   o.ring_outer = 1.0;
+  EXPECT_THROW(o.Check(), Error);
+  o = BallRegionOptions{};
+  o.min_seen = 0.0;
   EXPECT_THROW(o.Check(), Error);
   BallDetectorOptions d;
   d.min_contrast = -1;
