@@ -130,6 +130,9 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--model", c->o.num_distortion,
                   "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
       ->capture_default_str();
+  cmd->add_flag("--zero-tangent", c->o.zero_tangent,
+                "No tangential distortion (p1 = p2 = 0): lenses without it get better principal "
+                "points and relative rotations");
   cmd->add_option("--loss-px", c->o.loss_px, "Huber scale of the bundle adjustment in pixels")
       ->capture_default_str();
   cmd->add_option("--outlier-factor", c->o.outlier_factor,

@@ -400,6 +400,7 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
     io.board = options.board;
     io.detect = options.detect;
     io.num_distortion = options.num_distortion;
+    io.zero_tangent = options.zero_tangent;
     io.min_views = options.min_views;
     io.progress = false;
     io.camera_name = names[c];
@@ -574,8 +575,9 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
       const int nd = fixed ? 0 : static_cast<int>(cams[c].distortion.size());
       if (fixed) {
         problem.SetParameterBlockConstant(intr[c].data());
-      } else if (nd < kNumDistortion) {
+      } else if (nd < kNumDistortion || options.zero_tangent) {
         std::vector<int> constant;
+        if (options.zero_tangent) constant = {4 + 2, 4 + 3};  // p1, p2 (OpenCV order)
         for (int i = 4 + nd; i < kNumIntrinsics; ++i) constant.push_back(i);
         problem.SetManifold(intr[c].data(), new ceres::SubsetManifold(kNumIntrinsics, constant));
       }
@@ -747,9 +749,11 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
         try {
           cv::Mat ki = k_of(cams[i]), kj = k_of(cams[j]), di = d_of(cams[i]), dj = d_of(cams[j]);
           if (obj.size() >= 3) {
-            p.opencv_rms_px = cv::stereoCalibrate(obj, img_i, img_j, ki, di, kj, dj,
-                                                  cv::Size(cams[i].width, cams[i].height), rot, t,
-                                                  e, fm, cv::CALIB_USE_INTRINSIC_GUESS);
+            p.opencv_rms_px =
+                cv::stereoCalibrate(obj, img_i, img_j, ki, di, kj, dj,
+                                    cv::Size(cams[i].width, cams[i].height), rot, t, e, fm,
+                                    cv::CALIB_USE_INTRINSIC_GUESS |
+                                        (options.zero_tangent ? cv::CALIB_ZERO_TANGENT_DIST : 0));
             Eigen::Matrix3d r;
             for (int u = 0; u < 3; ++u) {
               for (int v = 0; v < 3; ++v) r(u, v) = rot.at<double>(u, v);

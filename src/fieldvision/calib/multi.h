@@ -39,7 +39,11 @@ struct MultiOptions {
   DetectOptions detect;
   ImageSourceOptions source;
   Pairing pairing = Pairing::kAuto;
-  int num_distortion = 5;         // 4, 5, 8, 12 or 14 OpenCV coefficients per camera
+  int num_distortion = 5;  // 4, 5, 8, 12 or 14 OpenCV coefficients per camera
+  // p1 = p2 = 0: cameras without tangential distortion (most). Fitting p1 p2 when a lens has
+  // none costs principal-point accuracy (they trade off against it), and with it the relative
+  // rotations (1 px of principal point is about 1/f rad of rotation).
+  bool zero_tangent = false;
   bool refine_intrinsics = true;  // intrinsics free in the bundle adjustment
   // Cameras whose intrinsics are known (by name): kept fixed, not calibrated again.
   std::map<std::string, Camera> known_intrinsics;

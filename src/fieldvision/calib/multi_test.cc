@@ -122,7 +122,8 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   MultiOptions o;
   o.board = {BoardType::kChessboard, 9, 7, 0.07};
   o.progress = false;
-  o.num_distortion = 4;  // the truth's model: k1 k2 p1 p2
+  o.num_distortion = 4;
+  o.zero_tangent = true;  // the truth's model: k1 k2
   std::vector<MultiFrame> frames;
   for (int f = 0; f < 40; ++f) {
     const Rigid3d world_from_board = RandomBoardPose(o.board, rng, 0.3, 40);
@@ -159,9 +160,10 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
       "px\n",
       cmp.max_rotation_diff_deg, 100 * worst_baseline, r.rms_px);
   // The relative rotations are as good as the principal points (1 px is 0.05 deg at this
-  // focal length): 0.04-0.13 deg over seeds 1-5 with 40 moments; with the true intrinsics the
-  // adjustment itself is far within 0.05 deg (below).
-  EXPECT_LT(cmp.max_rotation_diff_deg, 0.15) << cmp.Summary() << "\n" << r.Summary();
+  // focal length). Fitting p1 p2 too, which these lenses do not have, leaves the principal points
+  // 0.3-1.3 px off and the rotations 0.03-0.13 deg (below); the true model k1 k2: within 0.03
+  // deg over seeds 1-5. With the true intrinsics: far within 0.05 deg (below).
+  EXPECT_LT(cmp.max_rotation_diff_deg, 0.05) << cmp.Summary() << "\n" << r.Summary();
   EXPECT_LT(worst_baseline, 0.002) << cmp.Summary();
   for (size_t c = 0; c < truth.size(); ++c) {
     EXPECT_NEAR(r.cameras[c].fx, truth[c].fx, 0.005 * truth[c].fx) << r.Summary();
@@ -184,6 +186,17 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   std::cout << fmt::format("with the true intrinsics: relative rotations within {:.4f} deg\n",
                            cmp_known.max_rotation_diff_deg);
   EXPECT_LT(cmp_known.max_rotation_diff_deg, 0.02) << cmp_known.Summary();
+  MultiOptions tangent = o;
+  tangent.zero_tangent = false;
+  const MultiResult rt = CalibrateMultiFromFrames(Names(truth), frames, tangent);
+  const RigComparison cmp_tangent = CompareRigs(rt.cameras, truth);
+  std::cout << fmt::format("fitting p1 p2 too: relative rotations within {:.4f} deg\n",
+                           cmp_tangent.max_rotation_diff_deg);
+  EXPECT_LT(cmp_tangent.max_rotation_diff_deg, 0.15) << cmp_tangent.Summary();
+  for (const auto& c : r.cameras) {
+    EXPECT_EQ(c.distortion[2], 0.0);
+    EXPECT_EQ(c.distortion[3], 0.0);
+  }
 
   // Coverage picture and corner table.
   const cv::Mat pic = MultiCoveragePicture(r, 1);
