@@ -38,6 +38,138 @@ PathSpec PathFromJson(const json& o, const std::string& ctx) {
   return p;
 }
 
+// ---- SceneSpecFromJson's parts, each naming its key path in errors.
+
+CameraSpec CameraSpecFromJson(const json& c, size_t i) {
+  const std::string ctx = fmt::format("cameras[{}]", i);
+  JsonKnownKeys(c, ctx,
+                {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion", "position_m",
+                 "look_at_m", "rvec", "tvec"});
+  CameraSpec cs;
+  cs.name = JsonString(c, "name", ctx, fmt::format("cam{}", i + 1));
+  cs.width = JsonInt(c, "width", ctx, cs.width);
+  cs.height = JsonInt(c, "height", ctx, cs.height);
+  cs.hfov_deg = JsonNumber(c, "hfov_deg", ctx, cs.hfov_deg);
+  cs.fx = JsonNumber(c, "fx", ctx, 0.0);
+  cs.fy = JsonNumber(c, "fy", ctx, cs.fx);
+  cs.distortion = JsonNumbers(c, "distortion", ctx, false);
+  if (JsonHas(c, "rvec") || JsonHas(c, "tvec")) {
+    FV_REQUIRE(JsonHas(c, "rvec") && JsonHas(c, "tvec"), "{}: give both rvec and tvec", ctx);
+    cs.has_rvec_tvec = true;
+    cs.rvec = JsonVector<3>(c, "rvec", ctx, cs.rvec);
+    cs.tvec = JsonVector<3>(c, "tvec", ctx, cs.tvec);
+  } else {
+    FV_REQUIRE(JsonHas(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)", ctx);
+    FV_REQUIRE(JsonHas(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
+    cs.position_m = JsonVector<3>(c, "position_m", ctx, cs.position_m);
+    cs.look_at_m = JsonVector<3>(c, "look_at_m", ctx, cs.look_at_m);
+  }
+  return cs;
+}
+
+BallSpec BallSpecFromJson(const json& b, BallSpec ball) {
+  JsonKnownKeys(
+      b, "ball",
+      {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "physics"});
+  ball.enabled = JsonBool(b, "enabled", "ball", true);
+  ball.diameter_m = JsonNumber(b, "diameter_m", "ball", ball.diameter_m);
+  ball.colour_bgr = JsonVector<3>(b, "colour_bgr", "ball", ball.colour_bgr);
+  const json& pl = JsonArray(b, "placements", "ball");
+  for (size_t i = 0; i < pl.size(); ++i) {
+    ball.placements.push_back(JsonVectorOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
+  }
+  ball.hold_frames = JsonInt(b, "hold_frames", "ball", ball.hold_frames);
+  const json& ks = JsonArray(b, "kicks", "ball");
+  for (size_t i = 0; i < ks.size(); ++i) {
+    const std::string ctx = fmt::format("ball.kicks[{}]", i);
+    JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps"});
+    KickSpec k;
+    k.time_s = JsonNumber(ks[i], "time_s", ctx, 0.0);
+    FV_REQUIRE(JsonHas(ks[i], "position_m"), "{}.position_m: missing", ctx);
+    k.position_m = JsonVector<3>(ks[i], "position_m", ctx, k.position_m);
+    FV_REQUIRE(JsonHas(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
+    k.velocity_mps = JsonVector<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
+    ball.kicks.push_back(k);
+  }
+  const json& ph = JsonObject(b, "physics", "ball");
+  const std::string pc = "ball.physics";
+  JsonKnownKeys(ph, pc,
+                {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
+                 "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
+  BallPhysics& p = ball.physics;
+  p.gravity_mps2 = JsonNumber(ph, "gravity_mps2", pc, p.gravity_mps2);
+  p.drag_coefficient = JsonNumber(ph, "drag_coefficient", pc, p.drag_coefficient);
+  p.air_density_kgm3 = JsonNumber(ph, "air_density_kgm3", pc, p.air_density_kgm3);
+  p.mass_kg = JsonNumber(ph, "mass_kg", pc, p.mass_kg);
+  p.restitution = JsonNumber(ph, "restitution", pc, p.restitution);
+  p.bounce_friction = JsonNumber(ph, "bounce_friction", pc, p.bounce_friction);
+  p.rolling_resistance = JsonNumber(ph, "rolling_resistance", pc, p.rolling_resistance);
+  p.min_bounce_speed_mps = JsonNumber(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
+  p.time_step_s = JsonNumber(ph, "time_step_s", pc, p.time_step_s);
+  return ball;
+}
+
+RobotSpec RobotSpecFromJson(const json& robot, size_t i) {
+  const std::string ctx = fmt::format("robots[{}]", i);
+  JsonKnownKeys(robot, ctx, {"path", "position_m", "radius_m", "height_m", "colour_bgr"});
+  RobotSpec r;
+  if (JsonHas(robot, "path")) r.path = PathFromJson(robot["path"], ctx + ".path");
+  if (JsonHas(robot, "position_m")) {
+    r.path.waypoints_m.insert(r.path.waypoints_m.begin(),
+                              JsonVector<2>(robot, "position_m", ctx, Eigen::Vector2d::Zero()));
+  }
+  r.radius_m = JsonNumber(robot, "radius_m", ctx, r.radius_m);
+  r.height_m = JsonNumber(robot, "height_m", ctx, r.height_m);
+  r.colour_bgr = JsonVector<3>(robot, "colour_bgr", ctx, r.colour_bgr);
+  return r;
+}
+
+PersonSpec PersonSpecFromJson(const json& person, size_t i) {
+  const std::string ctx = fmt::format("people[{}]", i);
+  JsonKnownKeys(person, ctx, {"id", "team", "path", "height_m", "skin_bgr"});
+  PersonSpec p;
+  p.id = JsonInt(person, "id", ctx, static_cast<int>(i) + 1);
+  p.team = JsonInt(person, "team", ctx, 0);
+  FV_REQUIRE(JsonHas(person, "path"), "{}.path: missing", ctx);
+  p.path = PathFromJson(person["path"], ctx + ".path");
+  p.height_m = JsonNumber(person, "height_m", ctx, p.height_m);
+  p.skin_bgr = JsonVector<3>(person, "skin_bgr", ctx, p.skin_bgr);
+  return p;
+}
+
+TeamSpec TeamSpecFromJson(const json& team, size_t i) {
+  const std::string ctx = fmt::format("teams[{}]", i);
+  JsonKnownKeys(team, ctx, {"name", "shirt_bgr", "shorts_bgr"});
+  TeamSpec t;
+  t.name = JsonString(team, "name", ctx, fmt::format("team{}", i));
+  t.shirt_bgr = JsonVector<3>(team, "shirt_bgr", ctx, t.shirt_bgr);
+  t.shorts_bgr = JsonVector<3>(team, "shorts_bgr", ctx, t.shorts_bgr);
+  return t;
+}
+
+ConeSpec ConeSpecFromJson(const json& cone, size_t i) {
+  const std::string ctx = fmt::format("cones[{}]", i);
+  JsonKnownKeys(cone, ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
+  ConeSpec c;
+  FV_REQUIRE(JsonHas(cone, "position_m"), "{}.position_m: missing", ctx);
+  c.position_m = JsonVector<2>(cone, "position_m", ctx, c.position_m);
+  c.height_m = JsonNumber(cone, "height_m", ctx, c.height_m);
+  c.base_radius_m = JsonNumber(cone, "base_radius_m", ctx, c.base_radius_m);
+  c.colour_bgr = JsonVector<3>(cone, "colour_bgr", ctx, c.colour_bgr);
+  return c;
+}
+
+LightingSpec LightingSpecFromJson(const json& l, LightingSpec lighting) {
+  JsonKnownKeys(l, "lighting",
+                {"light_dir", "gain_amplitude", "period_s", "vignetting", "shadows"});
+  lighting.light_dir = JsonVector<3>(l, "light_dir", "lighting", lighting.light_dir);
+  lighting.gain_amplitude = JsonNumber(l, "gain_amplitude", "lighting", lighting.gain_amplitude);
+  lighting.period_s = JsonNumber(l, "period_s", "lighting", lighting.period_s);
+  lighting.vignetting = JsonNumber(l, "vignetting", "lighting", lighting.vignetting);
+  lighting.shadows = JsonBool(l, "shadows", "lighting", lighting.shadows);
+  return lighting;
+}
+
 void CheckPath(const PathSpec& p, const std::string& ctx) {
   FV_REQUIRE(!p.waypoints_m.empty(), "{}.waypoints_m: needs at least one point", ctx);
   for (size_t i = 0; i < p.waypoints_m.size(); ++i) {
@@ -453,141 +585,25 @@ SceneSpec SceneSpecFromJson(const json& j, const std::string& context) {
     s.exposure_s = JsonNumber(j, "exposure_s", "", s.exposure_s);
     const json& cams = JsonArray(j, "cameras", "");
     s.cameras.clear();
-    for (size_t i = 0; i < cams.size(); ++i) {
-      const std::string ctx = fmt::format("cameras[{}]", i);
-      const json& c = cams[i];
-      JsonKnownKeys(c, ctx,
-                    {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion", "position_m",
-                     "look_at_m", "rvec", "tvec"});
-      CameraSpec cs;
-      cs.name = JsonString(c, "name", ctx, fmt::format("cam{}", i + 1));
-      cs.width = JsonInt(c, "width", ctx, cs.width);
-      cs.height = JsonInt(c, "height", ctx, cs.height);
-      cs.hfov_deg = JsonNumber(c, "hfov_deg", ctx, cs.hfov_deg);
-      cs.fx = JsonNumber(c, "fx", ctx, 0.0);
-      cs.fy = JsonNumber(c, "fy", ctx, cs.fx);
-      cs.distortion = JsonNumbers(c, "distortion", ctx, false);
-      if (JsonHas(c, "rvec") || JsonHas(c, "tvec")) {
-        FV_REQUIRE(JsonHas(c, "rvec") && JsonHas(c, "tvec"), "{}: give both rvec and tvec", ctx);
-        cs.has_rvec_tvec = true;
-        cs.rvec = JsonVector<3>(c, "rvec", ctx, cs.rvec);
-        cs.tvec = JsonVector<3>(c, "tvec", ctx, cs.tvec);
-      } else {
-        FV_REQUIRE(JsonHas(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)", ctx);
-        FV_REQUIRE(JsonHas(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
-        cs.position_m = JsonVector<3>(c, "position_m", ctx, cs.position_m);
-        cs.look_at_m = JsonVector<3>(c, "look_at_m", ctx, cs.look_at_m);
-      }
-      s.cameras.push_back(cs);
-    }
+    for (size_t i = 0; i < cams.size(); ++i) s.cameras.push_back(CameraSpecFromJson(cams[i], i));
     if (JsonHas(j, "ball")) {
-      const json& b = JsonObject(j, "ball", "");
-      JsonKnownKeys(
-          b, "ball",
-          {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "physics"});
-      s.ball.enabled = JsonBool(b, "enabled", "ball", true);
-      s.ball.diameter_m = JsonNumber(b, "diameter_m", "ball", s.ball.diameter_m);
-      s.ball.colour_bgr = JsonVector<3>(b, "colour_bgr", "ball", s.ball.colour_bgr);
-      const json& pl = JsonArray(b, "placements", "ball");
-      for (size_t i = 0; i < pl.size(); ++i) {
-        s.ball.placements.push_back(JsonVectorOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
-      }
-      s.ball.hold_frames = JsonInt(b, "hold_frames", "ball", s.ball.hold_frames);
-      const json& ks = JsonArray(b, "kicks", "ball");
-      for (size_t i = 0; i < ks.size(); ++i) {
-        const std::string ctx = fmt::format("ball.kicks[{}]", i);
-        JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps"});
-        KickSpec k;
-        k.time_s = JsonNumber(ks[i], "time_s", ctx, 0.0);
-        FV_REQUIRE(JsonHas(ks[i], "position_m"), "{}.position_m: missing", ctx);
-        k.position_m = JsonVector<3>(ks[i], "position_m", ctx, k.position_m);
-        FV_REQUIRE(JsonHas(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
-        k.velocity_mps = JsonVector<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
-        s.ball.kicks.push_back(k);
-      }
-      const json& ph = JsonObject(b, "physics", "ball");
-      const std::string pc = "ball.physics";
-      JsonKnownKeys(
-          ph, pc,
-          {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
-           "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
-      BallPhysics& p = s.ball.physics;
-      p.gravity_mps2 = JsonNumber(ph, "gravity_mps2", pc, p.gravity_mps2);
-      p.drag_coefficient = JsonNumber(ph, "drag_coefficient", pc, p.drag_coefficient);
-      p.air_density_kgm3 = JsonNumber(ph, "air_density_kgm3", pc, p.air_density_kgm3);
-      p.mass_kg = JsonNumber(ph, "mass_kg", pc, p.mass_kg);
-      p.restitution = JsonNumber(ph, "restitution", pc, p.restitution);
-      p.bounce_friction = JsonNumber(ph, "bounce_friction", pc, p.bounce_friction);
-      p.rolling_resistance = JsonNumber(ph, "rolling_resistance", pc, p.rolling_resistance);
-      p.min_bounce_speed_mps = JsonNumber(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
-      p.time_step_s = JsonNumber(ph, "time_step_s", pc, p.time_step_s);
+      s.ball = BallSpecFromJson(JsonObject(j, "ball", ""), s.ball);
     } else {
       s.ball.enabled = false;
     }
     const json& robots = JsonArray(j, "robots", "");
-    for (size_t i = 0; i < robots.size(); ++i) {
-      const std::string ctx = fmt::format("robots[{}]", i);
-      JsonKnownKeys(robots[i], ctx, {"path", "position_m", "radius_m", "height_m", "colour_bgr"});
-      RobotSpec r;
-      if (JsonHas(robots[i], "path")) r.path = PathFromJson(robots[i]["path"], ctx + ".path");
-      if (JsonHas(robots[i], "position_m")) {
-        r.path.waypoints_m.insert(
-            r.path.waypoints_m.begin(),
-            JsonVector<2>(robots[i], "position_m", ctx, Eigen::Vector2d::Zero()));
-      }
-      r.radius_m = JsonNumber(robots[i], "radius_m", ctx, r.radius_m);
-      r.height_m = JsonNumber(robots[i], "height_m", ctx, r.height_m);
-      r.colour_bgr = JsonVector<3>(robots[i], "colour_bgr", ctx, r.colour_bgr);
-      s.robots.push_back(r);
-    }
+    for (size_t i = 0; i < robots.size(); ++i) s.robots.push_back(RobotSpecFromJson(robots[i], i));
     const json& people = JsonArray(j, "people", "");
-    for (size_t i = 0; i < people.size(); ++i) {
-      const std::string ctx = fmt::format("people[{}]", i);
-      JsonKnownKeys(people[i], ctx, {"id", "team", "path", "height_m", "skin_bgr"});
-      PersonSpec p;
-      p.id = JsonInt(people[i], "id", ctx, static_cast<int>(i) + 1);
-      p.team = JsonInt(people[i], "team", ctx, 0);
-      FV_REQUIRE(JsonHas(people[i], "path"), "{}.path: missing", ctx);
-      p.path = PathFromJson(people[i]["path"], ctx + ".path");
-      p.height_m = JsonNumber(people[i], "height_m", ctx, p.height_m);
-      p.skin_bgr = JsonVector<3>(people[i], "skin_bgr", ctx, p.skin_bgr);
-      s.people.push_back(p);
-    }
+    for (size_t i = 0; i < people.size(); ++i) s.people.push_back(PersonSpecFromJson(people[i], i));
     if (JsonHas(j, "teams")) {
       const json& teams = JsonArray(j, "teams", "");
       s.teams.clear();
-      for (size_t i = 0; i < teams.size(); ++i) {
-        const std::string ctx = fmt::format("teams[{}]", i);
-        JsonKnownKeys(teams[i], ctx, {"name", "shirt_bgr", "shorts_bgr"});
-        TeamSpec t;
-        t.name = JsonString(teams[i], "name", ctx, fmt::format("team{}", i));
-        t.shirt_bgr = JsonVector<3>(teams[i], "shirt_bgr", ctx, t.shirt_bgr);
-        t.shorts_bgr = JsonVector<3>(teams[i], "shorts_bgr", ctx, t.shorts_bgr);
-        s.teams.push_back(t);
-      }
+      for (size_t i = 0; i < teams.size(); ++i) s.teams.push_back(TeamSpecFromJson(teams[i], i));
     }
     const json& cones = JsonArray(j, "cones", "");
-    for (size_t i = 0; i < cones.size(); ++i) {
-      const std::string ctx = fmt::format("cones[{}]", i);
-      JsonKnownKeys(cones[i], ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
-      ConeSpec c;
-      FV_REQUIRE(JsonHas(cones[i], "position_m"), "{}.position_m: missing", ctx);
-      c.position_m = JsonVector<2>(cones[i], "position_m", ctx, c.position_m);
-      c.height_m = JsonNumber(cones[i], "height_m", ctx, c.height_m);
-      c.base_radius_m = JsonNumber(cones[i], "base_radius_m", ctx, c.base_radius_m);
-      c.colour_bgr = JsonVector<3>(cones[i], "colour_bgr", ctx, c.colour_bgr);
-      s.cones.push_back(c);
-    }
+    for (size_t i = 0; i < cones.size(); ++i) s.cones.push_back(ConeSpecFromJson(cones[i], i));
     if (JsonHas(j, "lighting")) {
-      const json& l = JsonObject(j, "lighting", "");
-      JsonKnownKeys(l, "lighting",
-                    {"light_dir", "gain_amplitude", "period_s", "vignetting", "shadows"});
-      s.lighting.light_dir = JsonVector<3>(l, "light_dir", "lighting", s.lighting.light_dir);
-      s.lighting.gain_amplitude =
-          JsonNumber(l, "gain_amplitude", "lighting", s.lighting.gain_amplitude);
-      s.lighting.period_s = JsonNumber(l, "period_s", "lighting", s.lighting.period_s);
-      s.lighting.vignetting = JsonNumber(l, "vignetting", "lighting", s.lighting.vignetting);
-      s.lighting.shadows = JsonBool(l, "shadows", "lighting", s.lighting.shadows);
+      s.lighting = LightingSpecFromJson(JsonObject(j, "lighting", ""), s.lighting);
     }
     s.noise_sigma = JsonNumber(j, "noise_sigma", "", s.noise_sigma);
     s.jpeg_quality = JsonInt(j, "jpeg_quality", "", s.jpeg_quality);
