@@ -1,22 +1,9 @@
-// The synthetic world: N calibrated cameras (any pose, size, focal length and OpenCV distortion)
+// The synthetic world: N calibrated cameras (fv::Camera's model, so projections agree exactly)
 // looking at a field with a ball, robots, people and distractors, rendered by ray casting with
-// exact ground truth (ball centre, its projection and visibility per camera, ball flights, player
-// positions and boxes). Method: per camera the world ray of every pixel and the static background
-// (grass with mowing stripes, painted lines anti-aliased by the signed distance to paint over the
-// pixel's footprint, walls, goals, cones) are computed once; per frame only the image boxes of
-// moving objects are ray-cast analytically (sphere, cylinder, capsules) with a depth test, the
-// ball is Lambert-shaded, anti-aliased and motion-blurred by averaging sub-exposure positions;
-// then lighting gain, vignetting and Gaussian sensor noise are applied and MJPG compresses the
-// video. Ball flights integrate gravity and quadratic drag (RK4, 1 ms) with bounces (restitution,
-// friction) and rolling resistance. Written by hand because no library renders calibrated
-// multi-camera scenes with exact truth; it uses fv::Camera's model so projections agree exactly.
-//
-// Quick use:
-//   fv::synth::SceneSpec spec = fv::synth::Preset("kick", /*seed=*/1);
-//   fv::synth::SceneRenderer scene(spec);
-//   std::vector<cv::Mat> images = scene.Render(0);        // one BGR image per camera
-//   fv::synth::BallTruthFrame truth = scene.BallTruth(0);  // centre, uv, radius, visibility
-//   fv::synth::WriteScene(spec, "out/scene", /*progress=*/true);  // videos, YAMLs, CSVs
+// exact ground truth. Per camera the pixel rays and the static background are computed once; per
+// frame only the moving objects' image boxes are ray-cast (sphere, cylinder, capsules), the ball
+// Lambert-shaded and motion-blurred, then lighting, vignetting, noise and MJPG. Ball physics:
+// ball_physics.h. Use: DEVELOPERS.md, "The synthetic world".
 #pragma once
 
 #include <cstdint>
