@@ -23,8 +23,10 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--camera", o->cameras, "Camera file (repeat); nodes are matched by name")
       ->required();
   cmd->add_option("--out", o->out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")->required();
-  cmd->add_option("--publish", o->publish,
-                  "Publish each position on a ZeroMQ PUB socket, tcp://HOST:PORT (topic 'ball')");
+  cmd->add_option(
+      "--publish", o->publish,
+      "Publish each position on a ZeroMQ PUB socket, tcp://HOST:PORT (topic 'ball'), and "
+      "each flight as it closes (topic 'flight')");
   cmd->add_option("--idle-exit", o->idle_exit_s,
                   "Exit after this many seconds without messages, counted once the first has come; "
                   "running nodes ping every 0.5 s (0: run until Ctrl-C)")
@@ -44,6 +46,8 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Seen by one camera only: place the ball on the ground (n_cams 1)");
   cmd->add_flag("!--no-weak", o->triangulation.use_weak,
                 "Never use candidates that failed a shape check to complete a position");
+  cmd->add_flag("!--no-flights", o->flights,
+                "Do not analyse flights (published on topic `flight` as each one closes)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     JobControl control;

@@ -3,10 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <set>
+#include <thread>
+#include <utility>
 
 #include <fmt/format.h>
 #include <zmq.hpp>
@@ -31,6 +36,7 @@ void FuseOptions::Check() const {
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
              "fuse: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
   sync.Check();
+  flight_options.Check();
   triangulation.Check();
 }
 
@@ -88,10 +94,99 @@ std::string FuseSummary::ToString() const {
   }
   s += fmt::format("\n{} messages in {:.2f} s", messages, seconds);
   if (published > 0) s += fmt::format(", {} positions published", published);
+  if (!flights.empty()) {
+    s += fmt::format("\n{} flights ({} published)", flights.size(), flights_published);
+  }
   return s;
 }
 
 namespace {
+
+// The flight analysis, in its own thread so that it never delays a position: positions in,
+// closed flights out.
+class FlightWorker {
+ public:
+  explicit FlightWorker(const LiveFlightsOptions& options)
+      : flights_(options), thread_([this] { Run(); }) {}
+  ~FlightWorker() { Finish(); }
+  void Add(const BallSample& s) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (in_.size() < 100000) in_.push_back(s);
+    }
+    cv_.notify_one();
+  }
+  // Flights closed so far (taken).
+  std::vector<Flight> Take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::exchange(out_, {});
+  }
+  // Analyses what is left, ends the thread; then Take() has the rest.
+  void Finish() {
+    if (!thread_.joinable()) return;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    cv_.notify_one();
+    thread_.join();
+  }
+
+ private:
+  void Run() {
+    for (;;) {
+      std::deque<BallSample> batch;
+      bool done = false;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [&] { return done_ || !in_.empty(); });
+        batch.swap(in_);
+        done = done_;
+      }
+      std::vector<Flight> closed;
+      for (const BallSample& s : batch) {
+        for (Flight& f : flights_.Add(s)) closed.push_back(std::move(f));
+      }
+      if (done) {
+        for (Flight& f : flights_.Finish()) closed.push_back(std::move(f));
+      }
+      if (!closed.empty()) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (Flight& f : closed) out_.push_back(std::move(f));
+      }
+      if (done) return;
+    }
+  }
+  LiveFlights flights_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<BallSample> in_;
+  std::vector<Flight> out_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+FlightMessage ToMessage(const Flight& f, long long index) {
+  FlightMessage m;
+  m.index = index;
+  m.start = FlightEventName(f.start_event);
+  m.end = FlightEventName(f.end_event);
+  m.t_start_s = f.t_start_s;
+  m.t_end_s = f.t_end_s;
+  for (int i = 0; i < 3; ++i) {
+    m.origin_m[i] = f.origin_m[i];
+    m.landing_m[i] = f.landing_m[i];
+    m.apex_m[i] = f.apex_m[i];
+    m.v0_mps[i] = f.v0_mps[i];
+  }
+  m.t_landing_s = f.t_landing_s;
+  m.landing_extrapolated = f.landing_extrapolated;
+  m.speed_mps = f.speed_mps;
+  m.rmse_m = f.rmse_m;
+  m.model = FlightModelName(f.model_kind());
+  m.samples = static_cast<long long>(f.samples.size());
+  return m;
+}
 
 double SteadyNow() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -156,6 +251,12 @@ FuseSummary RunFuse(const FuseOptions& o) {
     double queued_s = -1, process_s = -1, arrival_s = 0;
   };
   std::vector<std::map<long long, Timing>> timings(n);
+  std::unique_ptr<FlightWorker> flight_worker;
+  if (o.flights) {
+    LiveFlightsOptions fopt = o.flight_options;
+    fopt.analysis.ball_radius_m = 0.5 * o.ball_diameter_m;
+    flight_worker = std::make_unique<FlightWorker>(fopt);
+  }
   const std::string tmp = o.out + ".part";
   CsvWriter csv(tmp, BallCsvHeader(), 6);
   auto emit = [&](const SyncedFrame& group) {
@@ -193,6 +294,26 @@ FuseSummary RunFuse(const FuseOptions& o) {
       const std::string topic = "ball";
       pub.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
       if (pub.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary.published;
+    }
+    if (flight_worker) {
+      BallSample sample;
+      sample.frame = f.frame;
+      sample.time_s = f.time_s;
+      sample.ball_in_world = p;
+      sample.n_cams = f.result.num_views();
+      sample.err_px = f.result.rms_px;
+      flight_worker->Add(sample);
+    }
+  };
+  auto publish_flights = [&] {
+    if (!flight_worker) return;
+    for (Flight& flight : flight_worker->Take()) {
+      const FlightMessage m = ToMessage(flight, static_cast<long long>(summary.flights.size()));
+      summary.flights.push_back(std::move(flight));
+      if (!pub) continue;
+      const std::string topic = "flight";
+      pub.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+      if (pub.send(zmq::buffer(Encode(m)), zmq::send_flags::dontwait)) ++summary.flights_published;
     }
   };
 
@@ -315,6 +436,7 @@ FuseSummary RunFuse(const FuseOptions& o) {
     }
     const double now = SteadyNow();
     while (auto group = sync.Next(now)) emit(*group);
+    publish_flights();
     if (o.idle_exit_s > 0 && summary.messages > 0 && now - last_message > o.idle_exit_s) break;
     if (now - last_report > 0.5) {
       last_report = now;
@@ -330,6 +452,10 @@ FuseSummary RunFuse(const FuseOptions& o) {
   }
   if (o.progress) std::cerr << "\n";
   while (auto group = sync.Next(SteadyNow(), /*flush=*/true)) emit(*group);
+  if (flight_worker) {
+    flight_worker->Finish();
+    publish_flights();
+  }
   csv.Close();
   std::error_code ec;
   std::filesystem::rename(tmp, o.out, ec);

@@ -2,10 +2,11 @@
 // socket, answers their clock pings (clock_sync.h), places each frame on its own clock (the
 // node's capture time plus the node's offset estimate), pairs the cameras by capture time
 // (pipeline/live_sync.h), triangulates through the fusion stage (pipeline/fusion_stage.h), writes
-// BALL.csv as `ball` does and publishes each position on a PUB socket (messages.h). Malformed,
-// oversized and wrong-version messages, unknown cameras and frames without a clock estimate are
-// dropped and counted; a node that restarts (a new session) is re-admitted; nodes reconnect
-// by themselves when the fusion node restarts.
+// BALL.csv as `ball` does and publishes each position on a PUB socket (messages.h), and each
+// flight once it has closed (pipeline/live_flights.h, in a worker thread off the positions' path).
+// Malformed, oversized and wrong-version messages, unknown cameras and frames without a clock
+// estimate are dropped and counted; a node that restarts (a new session) is re-admitted; nodes
+// reconnect by themselves when the fusion node restarts.
 #pragma once
 
 #include <functional>
@@ -14,6 +15,7 @@
 
 #include "fieldvision/pipeline/fusion_stage.h"
 #include "fieldvision/pipeline/job.h"
+#include "fieldvision/pipeline/live_flights.h"
 #include "fieldvision/pipeline/live_sync.h"
 
 namespace fv::net {
@@ -27,6 +29,10 @@ struct FuseOptions {
       0;  // exit after this many seconds without messages (after the first); 0: never
   double ball_diameter_m = 0.22;
   LiveSyncOptions sync;
+  // Flights as they close (a worker thread analyses the positions; published on topic
+  // "flight"); analysis.ball_radius_m is set from ball_diameter_m.
+  bool flights = true;
+  LiveFlightsOptions flight_options;
   TriangulationOptions triangulation;
   bool progress = true;
   JobControl* control = nullptr;  // optional: progress callback and stop check (e.g. Ctrl-C)
@@ -56,6 +62,8 @@ struct FuseSummary {
   FusionStats fusion;
   long long rows_written = 0;
   long long published = 0;
+  std::vector<Flight> flights;  // closed flights, in the order published
+  long long flights_published = 0;
   std::vector<double> latency_s;  // capture -> fused, per frame fused (system clocks only)
   // Where the latency of each of those frames went (the slowest camera of the frame; < 0: the
   // nodes did not say): capture -> the node had the frame, the node's work, capture -> the last

@@ -75,7 +75,36 @@ struct Encoder {
             {"x_m", m.x_m},       {"y_m", m.y_m},       {"z_m", m.z_m},
             {"n_cams", m.n_cams}, {"err_px", m.err_px}, {"latency_s", m.latency_s}};
   }
+  json operator()(const FlightMessage& m) const {
+    const auto v = [](const double* p) { return json::array({p[0], p[1], p[2]}); };
+    return {{"type", "flight"},
+            {"index", m.index},
+            {"start", m.start},
+            {"end", m.end},
+            {"t_start_s", m.t_start_s},
+            {"t_end_s", m.t_end_s},
+            {"origin_m", v(m.origin_m)},
+            {"landing_m", v(m.landing_m)},
+            {"t_landing_s", m.t_landing_s},
+            {"landing_extrapolated", m.landing_extrapolated},
+            {"apex_m", v(m.apex_m)},
+            {"v0_mps", v(m.v0_mps)},
+            {"speed_mps", m.speed_mps},
+            {"rmse_m", m.rmse_m},
+            {"model", m.model},
+            {"samples", m.samples}};
+  }
 };
+
+void Vec3(const json& j, const char* key, double* out) {
+  FV_REQUIRE(j.contains(key) && j[key].is_array() && j[key].size() == 3,
+             "message: '{}' missing or not 3 numbers", key);
+  for (int i = 0; i < 3; ++i) {
+    FV_REQUIRE(j[key][i].is_number(), "message: '{}' missing or not 3 numbers", key);
+    out[i] = j[key][i].get<double>();
+    FV_REQUIRE(std::isfinite(out[i]), "message: '{}' is not finite", key);
+  }
+}
 
 }  // namespace
 
@@ -164,6 +193,27 @@ Message DecodeChecked(const void* data, size_t size) {
     m.n_cams = static_cast<int>(Int(j, "n_cams"));
     m.err_px = Num(j, "err_px");
     m.latency_s = Num(j, "latency_s");
+    return m;
+  }
+  if (type == "flight") {
+    FlightMessage m;
+    m.index = Int(j, "index");
+    m.start = Str(j, "start");
+    m.end = Str(j, "end");
+    m.t_start_s = Num(j, "t_start_s");
+    m.t_end_s = Num(j, "t_end_s");
+    Vec3(j, "origin_m", m.origin_m);
+    Vec3(j, "landing_m", m.landing_m);
+    m.t_landing_s = Num(j, "t_landing_s");
+    FV_REQUIRE(j.contains("landing_extrapolated") && j["landing_extrapolated"].is_boolean(),
+               "message: 'landing_extrapolated' missing or not a boolean");
+    m.landing_extrapolated = j["landing_extrapolated"].get<bool>();
+    Vec3(j, "apex_m", m.apex_m);
+    Vec3(j, "v0_mps", m.v0_mps);
+    m.speed_mps = Num(j, "speed_mps");
+    m.rmse_m = Num(j, "rmse_m");
+    m.model = Str(j, "model");
+    m.samples = Int(j, "samples");
     return m;
   }
   Throw("message: unknown type '{}'", type);

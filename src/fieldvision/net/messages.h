@@ -19,6 +19,11 @@
 // fuse -> node: {"v":1,"type":"pong","t0_s":..,"t1_s":..,"t2_s":..}
 // fuse PUB, topic "ball": {"v":1,"type":"ball","frame":12,"time_s":..,"x_m":..,"y_m":..,
 //   "z_m":..,"n_cams":3,"err_px":0.41,"latency_s":0.012}
+// fuse PUB, topic "flight", each flight once it has closed (the next one has begun, or the track
+//   ended): {"v":1,"type":"flight","index":0,"start":"hit","end":"bounce","t_start_s":..,
+//   "t_end_s":..,"origin_m":[x,y,z],"landing_m":[x,y,z],"t_landing_s":..,
+//   "landing_extrapolated":false,"apex_m":[x,y,z],"v0_mps":[vx,vy,vz],"speed_mps":..,
+//   "rmse_m":..,"model":"drag","samples":54}  (times as the ball's time_s; metres, world frame)
 // "clock" says what time_s is measured on: "system" (the node's system clock, Unix seconds; the
 // fusion node adds offset_s, the node's estimate of fuse clock - node clock) or "media" (a
 // file's own time from 0, the same for every camera of a recording).
@@ -95,8 +100,25 @@ struct BallMessage {
   double latency_s = 0;  // fuse clock at publication - capture time (system clocks only)
 };
 
+// A flight (an airborne arc between two contacts) once it has closed (pipeline/live_flights.h).
+struct FlightMessage {
+  long long index = 0;     // from 0 in this fusion run
+  std::string start, end;  // what starts and ends it: bounce, ground, hit, track start, track end
+  double t_start_s = 0, t_end_s = 0;
+  double origin_m[3] = {0, 0, 0};   // ball centre at t_start_s
+  double landing_m[3] = {0, 0, 0};  // where it meets the ground (centre)
+  double t_landing_s = 0;
+  bool landing_extrapolated = false;  // not seen to land (hit, end of track)
+  double apex_m[3] = {0, 0, 0};
+  double v0_mps[3] = {0, 0, 0};
+  double speed_mps = 0;
+  double rmse_m = 0;
+  std::string model;  // gravity, drag or spin
+  long long samples = 0;
+};
+
 using Message = std::variant<HelloMessage, FrameMessage, SkipMessage, PingMessage, PongMessage,
-                             ByeMessage, BallMessage>;
+                             ByeMessage, BallMessage, FlightMessage>;
 
 // Why a message was refused (Decode throws MessageError).
 class MessageError : public Error {

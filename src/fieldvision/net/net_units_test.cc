@@ -56,6 +56,38 @@ TEST(Messages, FrameRoundTripsExactly) {
   EXPECT_EQ(std::get<FrameMessage>(m2).process_s, 0.003);
 }
 
+TEST(Messages, FlightRoundTripsExactly) {
+  FlightMessage f;
+  f.index = 3;
+  f.start = "hit";
+  f.end = "bounce";
+  f.t_start_s = 1.25;
+  f.t_end_s = 2.5;
+  f.origin_m[0] = -1.5;
+  f.landing_m[1] = 7.25;
+  f.apex_m[2] = 3.125;
+  f.v0_mps[0] = 12.5;
+  f.landing_extrapolated = true;
+  f.model = "drag";
+  f.samples = 75;
+  const std::string bytes = Encode(f);
+  const Message m = Decode(bytes.data(), bytes.size());
+  const auto* back = std::get_if<FlightMessage>(&m);
+  ASSERT_NE(back, nullptr);
+  EXPECT_EQ(back->index, 3);
+  EXPECT_EQ(back->end, "bounce");
+  EXPECT_EQ(back->origin_m[0], -1.5);
+  EXPECT_EQ(back->landing_m[1], 7.25);
+  EXPECT_EQ(back->apex_m[2], 3.125);
+  EXPECT_EQ(back->v0_mps[0], 12.5);
+  EXPECT_TRUE(back->landing_extrapolated);
+  EXPECT_EQ(back->model, "drag");
+  EXPECT_EQ(back->samples, 75);
+  std::string bad = bytes;
+  bad.replace(bad.find("\"origin_m\":["), 12, "\"origin_m\":[1,");  // four numbers
+  EXPECT_THROW(Decode(bad.data(), bad.size()), MessageError);
+}
+
 TEST(Messages, SkipRoundTripsAndBadTimingsAreRefused) {
   SkipMessage k{"cam1", "s1", 15, 1764612345.5, "system", 0.25, true, 2};
   const std::string bytes = Encode(k);

@@ -17,6 +17,7 @@
 #include "fieldvision/net/node.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/job.h"
+#include "fieldvision/recon/trajectory.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/testing.h"
@@ -139,6 +140,22 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
     EXPECT_NEAR(a.z, b.z, 5e-4) << "frame " << frame;
     EXPECT_EQ(a.n_cams, b.n_cams) << "frame " << frame;
   }
+  // The flights fuse closed on the way are those of the whole track's analysis (the kick).
+  std::vector<BallSample> track;
+  for (const auto& [frame, r] : live) {
+    BallSample b;
+    b.frame = frame;
+    b.time_s = frame / 60.0;
+    b.ball_in_world = {r.x, r.y, r.z};
+    track.push_back(b);
+  }
+  TrajectoryOptions topt = fo.flight_options.analysis;
+  topt.ball_radius_m = 0.5 * fo.ball_diameter_m;
+  const TrajectoryResult whole = AnalyzeTrajectory(track, topt);
+  ASSERT_FALSE(whole.flights.empty()) << whole.Summary();
+  ASSERT_EQ(fused.flights.size(), whole.flights.size()) << whole.Summary();
+  EXPECT_EQ(fused.flights_published, 0);  // no --publish
+  EXPECT_LT((fused.flights[0].origin_m - whole.flights[0].origin_m).norm(), 0.05);
 }
 
 TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {

@@ -1,0 +1,91 @@
+// Live flights: the kick scene's true track (5 mm noise) fed one position at a time gives the
+// flights the offline analysis of the whole track gives, each once, in time order; a gap ends
+// the track and closes its flights.
+#include "fieldvision/pipeline/live_flights.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/synth/ball_physics.h"
+#include "fieldvision/synth/synth.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+std::vector<BallSample> KickTrack(uint64_t seed, TrajectoryOptions* options) {
+  const synth::SceneSpec spec = synth::Preset("kick", seed);
+  const synth::BallTrajectory trajectory(spec.ball, spec.duration_s());
+  Rng rng(seed + 1000);
+  std::vector<BallSample> track;
+  for (int f = 0; f < spec.num_frames; ++f) {
+    BallSample s;
+    s.frame = f;
+    s.time_s = f / spec.fps;
+    s.ball_in_world =
+        trajectory.PositionAt(s.time_s) +
+        Eigen::Vector3d(rng.Normal(0, 0.005), rng.Normal(0, 0.005), rng.Normal(0, 0.005));
+    s.n_cams = 4;
+    track.push_back(s);
+  }
+  options->ball_radius_m = spec.ball.radius_m();
+  options->gravity_mps2 = spec.ball.physics.gravity_mps2;
+  return track;
+}
+
+TEST(LiveFlights, SameFlightsAsTheWholeTrackEachOnce) {
+  const uint64_t seed = testing::TestSeed(1);
+  FV_SEED_TRACE(seed);
+  LiveFlightsOptions o;
+  const std::vector<BallSample> track = KickTrack(seed, &o.analysis);
+  ASSERT_GT(track.size(), 60u);
+  const TrajectoryResult offline = AnalyzeTrajectory(track, o.analysis);
+  ASSERT_GE(offline.flights.size(), 2u) << offline.Summary();
+
+  LiveFlights live(o);
+  std::vector<Flight> flights;
+  size_t closed_before_end = 0;
+  for (const BallSample& s : track) {
+    for (Flight& f : live.Add(s)) flights.push_back(std::move(f));
+  }
+  closed_before_end = flights.size();
+  for (Flight& f : live.Finish()) flights.push_back(std::move(f));
+  // All but the last one or two (too few samples after them) close before the end.
+  EXPECT_GE(closed_before_end + 2, offline.flights.size()) << "flights closed only at the end";
+  EXPECT_GE(closed_before_end, 1u);
+  EXPECT_LT(live.analyses(), static_cast<long long>(track.size()));
+  ASSERT_EQ(flights.size(), offline.flights.size()) << offline.Summary();
+  for (size_t i = 0; i < flights.size(); ++i) {
+    SCOPED_TRACE(i);
+    if (i > 0) EXPECT_GE(flights[i].t_start_s, flights[i - 1].t_end_s - 0.01);
+    EXPECT_NEAR(flights[i].t_start_s, offline.flights[i].t_start_s, 0.01);
+    EXPECT_NEAR(flights[i].t_end_s, offline.flights[i].t_end_s, 0.01);
+    EXPECT_LT((flights[i].landing_m - offline.flights[i].landing_m).norm(), 0.03);
+  }
+}
+
+TEST(LiveFlights, AGapClosesTheTrackAndBadOptionsAreNamed) {
+  const uint64_t seed = testing::TestSeed(2);
+  FV_SEED_TRACE(seed);
+  LiveFlightsOptions o;
+  const std::vector<BallSample> track = KickTrack(seed, &o.analysis);
+  LiveFlights live(o);
+  size_t n = 0;
+  for (const BallSample& s : track) n += live.Add(s).size();
+  // The same track again a second later: the first one's open flights close with its first
+  // position.
+  BallSample later = track.front();
+  later.time_s = track.back().time_s + 1.0;
+  const std::vector<Flight> closed = live.Add(later);
+  EXPECT_FALSE(closed.empty());
+  for (const Flight& f : closed) EXPECT_LE(f.t_end_s, track.back().time_s + 0.2);
+  EXPECT_TRUE(live.Finish().empty());  // one position: no flight
+  o.track_gap_s = 0;
+  EXPECT_THROW(LiveFlights live2(o), Error);
+}
+
+}  // namespace
+}  // namespace fv
