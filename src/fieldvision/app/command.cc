@@ -1,7 +1,6 @@
 #include "fieldvision/app/command.h"
 
 #include <algorithm>
-#include <iostream>
 #include <vector>
 
 namespace fv::app {
@@ -38,17 +37,6 @@ CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string
   CLI::App* group = app.add_subcommand(name, description);
   group->require_subcommand(1);
   return group;
-}
-
-void AddPlannedCommand(CLI::App& parent, const std::string& name, const std::string& summary,
-                       const std::string& plan, int& exit_code) {
-  CLI::App* cmd = parent.add_subcommand(name, summary + " (not built yet)");
-  cmd->footer(plan);
-  cmd->allow_extras();
-  cmd->callback([&exit_code, name, plan] {
-    std::cerr << "fieldvision: '" << name << "' is not built yet: " << plan << "\n";
-    exit_code = 2;
-  });
 }
 
 }  // namespace fv::app

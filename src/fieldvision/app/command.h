@@ -24,10 +24,6 @@ void SetUpAllCommands(CLI::App& app, int& exit_code);
 // existing subcommand or adds it.
 CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string& description);
 
-// For subcommands of later work: prints what it will do and exits with code 2.
-void AddPlannedCommand(CLI::App& parent, const std::string& name, const std::string& summary,
-                       const std::string& plan, int& exit_code);
-
 }  // namespace fv::app
 
 #define FV_CONCAT_INNER(a, b) a##b
