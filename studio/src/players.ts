@@ -2,8 +2,10 @@
 // a top view with ids, teams (a `team` column, when the file has one), 2 s trails and the zones
 // of a zones file; beside it the video the tracks came from (TRACKS frame N is video frame N-1,
 // MOTChallenge numbering) with each player's box; play/pause and a time slider drive both.
-// Below: a heat map of the time spent per 1 m cell (one player or all) with its colour scale in
-// seconds, each player's speed over time (uPlot) and a table of distance and top speed.
+// Below: the zone alerts on a timeline (who was in which zone when), each player's speed over
+// time (uPlot), a heat map of the time spent per 1 m cell (one player or all) with its colour
+// scale in seconds, and a table of distance, top and mean speed, sprints and zone time, as
+// `fieldvision stats` computes them (/api/players/stats).
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import * as api from './api';
@@ -20,6 +22,12 @@ interface Player {
   y: number;
   box: number[] | null; // left, top, width, height (px)
   team: number | null;
+}
+
+interface PlayerStats {
+  players: { id: number; team: number; distance_m: number; top_speed_mps: number; mean_speed_mps: number; sprints: number; zone_time_s: Record<string, number> }[];
+  events: { zone: string; id: number; enter_s: number; exit_s: number }[];
+  summary: string;
 }
 
 const teamColours = ['#f44', '#48f', '#fd3', '#3d6'];
@@ -43,6 +51,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
   const heat = el('canvas', { id: 'pl-heat', width: '900', height: '600' });
   const legend = el('canvas', { id: 'pl-heat-legend', width: '900', height: '46' });
   const table = el('table', { id: 'pl-table' });
+  const alerts = el('canvas', { id: 'pl-alerts', width: '1400', height: '60' });
   const msg = el('div', { id: 'pl-status', class: 'status' });
   root.replaceChildren(
     el('section', { class: 'controls' }, labelled('Tracks', tracks), labelled('Field', field), labelled('Zones', zonesFile),
@@ -51,10 +60,11 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       el('div', { class: 'half' }, board),
       el('div', { class: 'half' }, videoCanvas)),
     el('div', {}, labelled('Time', el('span', {}, time, timeLabel))), msg,
+    el('h3', { text: 'Zone alerts' }), alerts,
     el('h3', { text: 'Speed (m/s)' }), chart,
     el('div', { class: 'side-by-side' },
       el('div', { class: 'half' }, el('h3', { text: 'Heat map: time spent per 1 m cell' }), labelled('Player', heatWho), heat, legend),
-      el('div', { class: 'half' }, el('h3', { text: 'Distance and top speed' }), table)),
+      el('div', { class: 'half' }, el('h3', { text: 'Per player (fieldvision stats)' }), table)),
   );
 
   let fmap: FieldMap | null = null;
@@ -65,6 +75,8 @@ export async function playersPage(root: HTMLElement): Promise<void> {
   let zones: Zone[] = [];
   let plot: uPlot | null = null;
   let model: api.FieldModel | null = null;
+  let playerStats: PlayerStats | null = null;
+  let teamOf = new Map<number, number>();
 
   const colourOf = (p: { id: number; team?: number | null }) =>
     p.team !== null && p.team !== undefined ? teamColours[p.team % teamColours.length] : `hsl(${(p.id * 67) % 360}, 80%, 60%)`;
@@ -146,6 +158,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     timeLabel.textContent = ` t = ${t.toFixed(2)} s, frame ${f}, ${now.length} players`;
     board.dataset.frame = String(f);
     plot?.setCursor({ left: plot.valToPos(t, 'x'), top: 10 });
+    drawAlerts(t);
     if (video.value) {
       wanted = f - 1;
       void fetchFrame();
@@ -170,7 +183,6 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     plot = null;
     const t = frames.map((f) => times.get(f) ?? 0);
     const ids = [...players.keys()].sort((a, b) => players.get(b)!.length - players.get(a)!.length).slice(0, 12).sort((a, b) => a - b);
-    const rows: HTMLElement[] = [];
     const series: (number | null)[][] = ids.map((id) => {
       const track = new Map(players.get(id)!);
       const raw = t.map((_, i) => {
@@ -182,19 +194,8 @@ export async function playersPage(root: HTMLElement): Promise<void> {
         const w = raw.slice(Math.max(0, i - 2), i + 3).filter((v): v is number => v !== null);
         return raw[i] === null || !w.length ? null : w.reduce((a, b) => a + b, 0) / w.length;
       });
-      let distance = 0;
-      for (let i = 1; i < t.length; ++i) {
-        const a = track.get(i - 1);
-        const b = track.get(i);
-        if (a && b) distance += Math.hypot(b.x - a.x, b.y - a.y);
-      }
-      const top = Math.max(0, ...smooth.filter((v): v is number => v !== null));
-      const team = players.get(id)![0][1].team;
-      rows.push(el('tr', { 'data-id': String(id) }, el('td', { style: `color:${colourOf({ id, team })}`, text: `id ${id}` }),
-        el('td', { text: team === null ? '–' : String(team) }), el('td', { text: distance.toFixed(1) }), el('td', { text: top.toFixed(2) })));
       return smooth;
     });
-    table.replaceChildren(el('tr', {}, ...['player', 'team', 'distance (m)', 'top speed (m/s, 5-frame mean)'].map((h) => el('th', { text: h }))), ...rows);
     if (!t.length) return;
     plot = new uPlot({
       width: chart.clientWidth || 900, height: 190,
@@ -202,6 +203,72 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       axes: [{ label: 'time (s)', stroke: '#ccc' }, { label: 'speed (m/s)', stroke: '#ccc' }],
       scales: { x: { time: false } },
     }, [t, ...series] as uPlot.AlignedData, chart);
+  }
+
+  function statsTable() {
+    const st = playerStats;
+    if (!st) {
+      table.replaceChildren();
+      return;
+    }
+    const zoneNames = zones.map((z) => z.name);
+    table.replaceChildren(
+      el('tr', {}, ...['player', 'team', 'distance (m)', 'top speed (m/s, 1 s)', 'mean (m/s)', 'sprints', ...zoneNames.map((z) => `in ${z} (s)`)].map((h) => el('th', { text: h }))),
+      ...st.players.map((p) => el('tr', { 'data-id': String(p.id), 'data-distance': String(p.distance_m) },
+        el('td', { style: `color:${colourOf({ id: p.id, team: p.team >= 0 ? p.team : teamOf.get(p.id) ?? null })}`, text: `id ${p.id}` }),
+        el('td', { text: p.team >= 0 ? String(p.team) : teamOf.has(p.id) ? String(teamOf.get(p.id)) : '–' }),
+        el('td', { text: p.distance_m.toFixed(1) }), el('td', { text: p.top_speed_mps.toFixed(2) }), el('td', { text: p.mean_speed_mps.toFixed(2) }),
+        el('td', { text: String(p.sprints) }), ...zoneNames.map((z) => el('td', { text: (p.zone_time_s[z] ?? 0).toFixed(1) })))),
+    );
+  }
+
+  // Zone alerts: a row per zone, a bar per stay of a player (its colour and id), the board's time.
+  function drawAlerts(now: number) {
+    const rowsH = 22;
+    const h = 24 + rowsH * Math.max(1, zones.length);
+    if (alerts.height !== h) alerts.height = h;
+    const ctx = alerts.getContext('2d')!;
+    ctx.fillStyle = '#111';
+    ctx.fillRect(0, 0, alerts.width, alerts.height);
+    const t = frames.map((f) => times.get(f) ?? 0);
+    const t0 = t.length ? t[0] : 0;
+    const t1 = t.length > 1 ? t[t.length - 1] : t0 + 1;
+    const left = 110;
+    const x = (s: number) => left + ((s - t0) / (t1 - t0 || 1)) * (alerts.width - left - 10);
+    ctx.font = '12px sans-serif';
+    if (!zones.length) {
+      ctx.fillStyle = '#999';
+      ctx.fillText('no zones file chosen', 8, 16);
+    }
+    const events = playerStats?.events ?? [];
+    zones.forEach((z, k) => {
+      const y = 4 + k * rowsH;
+      ctx.fillStyle = '#ccc';
+      ctx.fillText(z.name.slice(0, 14), 6, y + 14);
+      ctx.fillStyle = '#222';
+      ctx.fillRect(left, y, alerts.width - left - 10, rowsH - 4);
+      for (const e of events.filter((ev) => ev.zone === z.name)) {
+        ctx.fillStyle = colourOf({ id: e.id, team: teamOf.get(e.id) ?? null });
+        ctx.globalAlpha = 0.8;
+        ctx.fillRect(x(e.enter_s), y + 2, Math.max(2, x(e.exit_s) - x(e.enter_s)), rowsH - 8);
+        ctx.globalAlpha = 1;
+        ctx.fillStyle = '#000';
+        ctx.fillText(String(e.id), x(e.enter_s) + 2, y + 13);
+      }
+    });
+    // Time axis and the board's time.
+    ctx.fillStyle = '#aaa';
+    const y = alerts.height - 6;
+    for (let k = 0; k <= 5; ++k) {
+      const s = t0 + ((t1 - t0) * k) / 5;
+      ctx.fillText(`${s.toFixed(1)} s`, x(s) - 10, y);
+    }
+    ctx.strokeStyle = '#ff0';
+    ctx.beginPath();
+    ctx.moveTo(x(now), 0);
+    ctx.lineTo(x(now), alerts.height - 18);
+    ctx.stroke();
+    alerts.dataset.events = String(events.length);
   }
 
   // Heat map: seconds spent in each 1 m cell (each sample counts its frame's duration), drawn
@@ -278,7 +345,18 @@ export async function playersPage(root: HTMLElement): Promise<void> {
         times.set(frame!, t ?? frame! / 25);
       }
       frames = [...byFrame.keys()].sort((a, b) => a - b);
+      teamOf = new Map();
+      for (const ps of byFrame.values()) for (const p of ps) if (p.team !== null) teamOf.set(p.id, p.team);
       zones = zonesFile.value ? await api.get<Zone[]>('/api/zones', { path: zonesFile.value }) : [];
+      // The library's numbers (as `fieldvision stats`); the board plays without them.
+      let statsNote = '';
+      try {
+        playerStats = await api.post<PlayerStats>('/api/players/stats', { tracks: tracks.value, ...(zonesFile.value ? { zones: zonesFile.value } : {}) });
+      } catch (e) {
+        playerStats = null;
+        statsNote = `; no statistics: ${(e as Error).message}`;
+      }
+      statsTable();
       const players = byPlayer();
       heatWho.replaceChildren(el('option', { value: 'all', text: 'all players' }),
         ...[...players.keys()].sort((a, b) => a - b).map((id) => el('option', { value: String(id), text: `id ${id}` })));
@@ -291,7 +369,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       time.max = String(Math.max(0, frames.length - 1));
       time.value = '0';
       draw(0);
-      status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions, ${players.size} players` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
+      status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions, ${players.size} players${statsNote}` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
     } catch (e) {
       status(msg, (e as Error).message, true);
     }

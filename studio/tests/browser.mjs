@@ -9,7 +9,8 @@
 //   live: positions of `fuse --publish` (four `node`s on the scene) reach the 3D view
 //   zones: a polygon clicked on the field map is saved
 //   jobs: a job runs to the end, another is cancelled (states from the server's events)
-//   players: the tactical board plays with the zones, the video beside it, heat maps, speed chart
+//   players: the tactical board plays with the zones, the video beside it, heat maps, speed chart,
+//     zone alerts on a timeline and the stats table (as /api/players/stats)
 // Usage: node browser.mjs URL OUT_DIR FIELDVISION
 import { chromium } from 'playwright-core';
 import { execFileSync, spawn } from 'node:child_process';
@@ -327,10 +328,14 @@ try {
 
   lap('jobs');
   // ---- players: the board plays with the video beside it (boxes of the same frame), heat map
+  // A zone around the first player's start, so that the alert timeline has someone in it.
+  const firstRow = readCsv(path.join(work, 'TRACKS.csv'))[0];
+  const [zx, zy] = [Number(firstRow.x_m), Number(firstRow.y_m)];
+  await api('/api/zones/save', { out: 'zones_players.json', zones: [{ name: 'start', polygon: [[zx - 1, zy - 1], [zx + 1, zy - 1], [zx + 1, zy + 1], [zx - 1, zy + 1]] }] });
   await page.goto(url + '#players');
   await page.waitForSelector('#page[data-ready="1"]');
   await page.selectOption('#pl-tracks', 'TRACKS.csv');
-  await page.selectOption('#pl-zones', 'zones.json');
+  await page.selectOption('#pl-zones', 'zones_players.json');
   await page.selectOption('#pl-video-file', 'players/side.avi');
   await page.click('#pl-load');
   await page.waitForSelector('#pl-board[data-frame]');
@@ -367,7 +372,14 @@ try {
   check(oneTotal < heatTotal && oneTotal > 0, `heat map of one player (${oneTotal.toFixed(2)} s)`);
   await page.screenshot({ path: path.join(out, 'players.jpg'), quality: 70, fullPage: true });
   check(await page.locator('#pl-chart .uplot').count() === 1, 'speed chart drawn');
-  check(await page.locator('#pl-table tr[data-id]').count() === Math.min(12, nIds), `distance and top speed of ${Math.min(12, nIds)} players listed`);
+  const libStats = await api('/api/players/stats', { tracks: 'TRACKS.csv', zones: 'zones_players.json' });
+  const tableRows = await page.$$eval('#pl-table tr[data-id]', (rows) => rows.map((r) => [Number(r.dataset.id), Number(r.dataset.distance)]));
+  check(tableRows.length === libStats.players.length && libStats.players.length === nIds &&
+    tableRows.every(([id, d]) => libStats.players.some((p) => p.id === id && p.distance_m === d)),
+    `the table shows fieldvision stats' distance and speeds of ${tableRows.length} players`);
+  const alertCount = Number(await page.getAttribute('#pl-alerts', 'data-events'));
+  check(alertCount === libStats.events.length && alertCount >= 1 && libStats.events.some((e) => e.id === Number(firstRow.id) && e.zone === 'start'),
+    `zone alerts on the timeline (${alertCount}: ${libStats.events.map((e) => `id ${e.id} ${e.enter_s}-${e.exit_s} s`).join(', ')})`);
   check(true, `tactical board plays (frame ${firstFrame} -> ${await page.getAttribute('#pl-board', 'data-frame')})`);
   lap('players');
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);

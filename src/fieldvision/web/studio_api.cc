@@ -19,6 +19,7 @@
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/stats/stats.h"
+#include "fieldvision/track/mot.h"
 #include "fieldvision/util/csv.h"
 
 namespace fv::web {
@@ -678,6 +679,49 @@ const std::vector<Route>& Routes() {
                        {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "x_m", "y_m",
                         "time_s", "team"}},
                       {"rows", rows}});
+       }},
+      {{"POST", "/api/players/stats",
+        "{tracks[, zones]}: per player distance, top speed (1-s mean), sprints, zone time and the "
+        "zone alerts (who entered which zone, when), as `stats` computes them"},
+       [](const Workspace& ws, EventHub*, JobRunner*, LiveFeed*, const ApiRequest& r) {
+         const json body = Body(r);
+         const auto rows =
+             track::ReadTracksCsv(ws.Resolve(Get<std::string>(body, "tracks")).string());
+         stats::StatsOptions o;
+         o.write_video = false;
+         if (body.contains("zones") && !body["zones"].is_null()) {
+           o.zones = stats::ReadZones(ws.Resolve(Get<std::string>(body, "zones")).string());
+         }
+         const stats::StatsResult res = stats::ComputeStats(rows, o);
+         json players = json::array();
+         for (const auto& p : res.players) {
+           json profile = json::array();
+           for (const auto& [t, v] : p.speed_profile)
+             profile.push_back({Round(t, 1e-3), Round(v, 1e-3)});
+           players.push_back({{"id", p.id},
+                              {"team", p.team},
+                              {"samples", p.samples},
+                              {"first_s", Round(p.first_s, 1e-3)},
+                              {"last_s", Round(p.last_s, 1e-3)},
+                              {"distance_m", Round(p.distance_m, 1e-3)},
+                              {"top_speed_mps", Round(p.top_speed_mps, 1e-3)},
+                              {"mean_speed_mps", Round(p.mean_speed_mps, 1e-3)},
+                              {"sprints", p.sprints},
+                              {"zone_time_s", p.zone_time_s},
+                              {"speed_profile", profile}});
+         }
+         json events = json::array();
+         for (const auto& e : res.events) {
+           events.push_back({{"zone", e.zone},
+                             {"id", e.id},
+                             {"enter_s", Round(e.enter_s, 1e-3)},
+                             {"exit_s", Round(e.exit_s, 1e-3)}});
+         }
+         return Json({{"players", players},
+                      {"events", events},
+                      {"duration_s", Round(res.duration_s, 1e-3)},
+                      {"fps", Round(res.fps, 1e-3)},
+                      {"summary", OneLine(res.Summary())}});
        }},
       {{"GET", "/api/zones", "?path=zones.json: named polygons on the field (stats --zones)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {

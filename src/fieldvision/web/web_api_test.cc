@@ -559,6 +559,47 @@ TEST_F(StudioApiTest, BallTracksFlightsAndPlayers) {
   ExpectError(Get("/api/tracks?path=scene/truth.csv"), 422, "truth.csv");
 }
 
+TEST_F(StudioApiTest, PlayerStatsAndZoneAlerts) {
+  // Player 3 walks along x at 1.5 m/s for 4 s (25 frames/s), through a zone from x = 1 to 2 m;
+  // player 4 stands still outside it.
+  std::ofstream tracks(dir_ / "WALK.csv");
+  tracks << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n";
+  for (int f = 0; f <= 100; ++f) {
+    const double t = f / 25.0;
+    tracks << fmt::format("{},3,0,0,10,20,1,{:.4f},0.5,{:.4f}\n", f + 1, 1.5 * t - 2.0, t);
+    tracks << fmt::format("{},4,0,0,10,20,1,-5,-3,{:.4f}\n", f + 1, t);
+  }
+  tracks.close();
+  const json zones = {{{"name", "strip"}, {"polygon", {{1, -1}, {2, -1}, {2, 1}, {1, 1}}}}};
+  ASSERT_EQ(Post("/api/zones/save", json{{"zones", zones}, {"out", "strip.json"}}).status, 200);
+  const Reply r = Post("/api/players/stats", json{{"tracks", "WALK.csv"}, {"zones", "strip.json"}});
+  ASSERT_EQ(r.status, 200) << r.body;
+  const json j = r.j();
+  ASSERT_EQ(j["players"].size(), 2u) << r.body;
+  for (const auto& p : j["players"]) {
+    if (p["id"] == 3) {
+      EXPECT_NEAR(p["distance_m"].get<double>(), 6.0, 0.1);
+      EXPECT_NEAR(p["top_speed_mps"].get<double>(), 1.5, 0.05);
+      EXPECT_NEAR(p["zone_time_s"]["strip"].get<double>(), 1.0 / 1.5, 0.1);
+    } else {
+      EXPECT_LT(p["distance_m"].get<double>(), 0.01);
+    }
+  }
+  ASSERT_EQ(j["events"].size(), 1u) << r.body;
+  EXPECT_EQ(j["events"][0]["id"], 3);
+  EXPECT_EQ(j["events"][0]["zone"], "strip");
+  EXPECT_NEAR(j["events"][0]["enter_s"].get<double>(), 2.0, 0.05);  // x = 1 m at t = 2 s
+  EXPECT_NEAR(j["events"][0]["exit_s"].get<double>(), 2.0 + 1.0 / 1.5, 0.05);
+  // Without zones; a file that is not a tracks file; a zones file that is not one.
+  const Reply plain = Post("/api/players/stats", json{{"tracks", "WALK.csv"}});
+  ASSERT_EQ(plain.status, 200) << plain.body;
+  EXPECT_TRUE(plain.j()["events"].empty());
+  ExpectError(Post("/api/players/stats", json{{"tracks", "scene/cam1.yaml"}}), 422, "cam1.yaml");
+  ExpectError(Post("/api/players/stats", json{{"tracks", "WALK.csv"}, {"zones", "WALK.csv"}}), 422,
+              "WALK.csv");
+  ExpectError(Post("/api/players/stats", json{{"tracks", "../WALK.csv"}}), 403, "");
+}
+
 TEST_F(StudioApiTest, ZonesSaveAndRead) {
   FV_SEED_TRACE(seed_);
   const json zones = {{{"name", "box"}, {"polygon", {{-9, -2}, {-7, -2}, {-7, 2}, {-9, 2}}}}};
