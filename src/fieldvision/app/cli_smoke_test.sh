@@ -88,4 +88,30 @@ check "stats: frame 2e9" nonzero $FV stats --tracks "$TMP/tracks.csv" --field fi
   --out "$TMP/stats"
 grep -q "tracks.csv" "$TMP/err" || { echo "FAIL stats: error does not name the file"; fail=1; }
 check "option error" nonzero $FV synth --frames 0 --out "$TMP/synth"
+# Metrics refuse impossible inputs; options that cannot apply are errors (issue 18).
+printf 'frame,x_m,y_m,z_m\n0,1,2,0.11\n1,1,2,0.11\n' > "$TMP/truth.csv"
+printf 'frame,x_m,y_m,z_m\n5,1,2,0.11\n6,1,2,0.11\n' > "$TMP/est.csv"
+check "eval ball: nothing matched" nonzero $FV eval ball --truth "$TMP/truth.csv" --est "$TMP/est.csv"
+grep -q "nothing to compare" "$TMP/err" || { echo "FAIL eval ball: not the no-match error"; fail=1; }
+printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n' > "$TMP/gt.csv"
+for f in 1 2 3; do echo "$f,1,0,0,10,20,1,,," >> "$TMP/gt.csv"; done
+cp "$TMP/gt.csv" "$TMP/dup.csv" && echo "2,1,0,0,10,20,1,,," >> "$TMP/dup.csv"
+check "eval tracks: a duplicated row" nonzero $FV eval tracks --gt "$TMP/gt.csv" --est "$TMP/dup.csv"
+grep -q "two boxes in frame 2" "$TMP/err" || { echo "FAIL eval tracks: not the duplicate"; fail=1; }
+echo "4,2,0,0,10,20,1,nan,0," >> "$TMP/gt.csv"
+check "stats: NaN position" nonzero $FV stats --tracks "$TMP/gt.csv" --field fifa --out "$TMP/st"
+grep -q "gt.csv:5" "$TMP/err" || { echo "FAIL stats: NaN row not named"; fail=1; }
+check "trajectory: --line without --field" nonzero $FV trajectory --in "$TMP/truth.csv" \
+  --out "$TMP/f.json" --line touch_top
+check "players: --margin without --field" nonzero $FV players --video "$TMP/v.avi" \
+  --out "$TMP/tracks.csv" --margin 2
+check "detect: --field without a camera" nonzero $FV detect --video "$TMP/v.avi" --field fifa \
+  --out "$TMP/det.csv"
+grep -q "needs --camera" "$TMP/err" || { echo "FAIL detect: not the --field error"; fail=1; }
+printf '{"name": "huge", "length_m": 1e308, "width_m": 1e308}\n' > "$TMP/huge.json"
+check "field of 1e308 m" nonzero $FV field show "$TMP/huge.json"
+check "plan: --map-width 20000" nonzero $FV plan --field fifa --optimize --map-width 20000 \
+  --out "$TMP/plan"
+check "plan: --iterations 2e9" nonzero $FV plan --field fifa --optimize --iterations 2000000000 \
+  --out "$TMP/plan"
 exit $fail

@@ -264,6 +264,7 @@ void RunFocal(const ExtrinsicsCli& c, const FieldModel* field) {
   }
   FocalOptions fo;
   fo.pnp = c.o;
+  fo.outlier_px = c.o.ransac_threshold_px;  // --threshold: also the gate of the focal fit
   fo.estimate_k1 = c.k1;
   const FocalResult r = EstimateFocalAndPose(w, h, pts, fo);
   PrintPointTable(r.points);
@@ -410,6 +411,11 @@ void RunCheck(const CheckCli& c) {
   if (!c.points.empty()) pts = ReadPointsCsv(c.points, &field);
   const CheckResult r = CheckCalibration(cam, image, field, pts, c.o);
   if (!r.points.empty()) PrintPointTable(r.points);
+  // No line pixel near a line: there is no line error to report (0.0 mm would read as perfect).
+  FV_REQUIRE(r.lines.num_inliers > 0,
+             "calibrate check: camera '{}' sees no line of field '{}' in '{}' ({} line pixels, "
+             "none near a line): the pose or the field is wrong",
+             c.camera, field.name, c.image, r.lines.num_pixels);
   std::cout << r.Summary() << "\n";
   std::cout << fmt::format("line error: mean {:.1f} mm, p95 {:.1f} mm\n", r.lines.mean_mm,
                            r.lines.p95_mm);

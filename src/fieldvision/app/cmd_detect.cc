@@ -2,8 +2,10 @@
 #include <iostream>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -39,6 +41,9 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
+    // The field mask is the field seen through a posed camera; without one --field did nothing.
+    FV_REQUIRE(o->field.empty() || (!o->camera.empty() && ReadCameraYaml(o->camera).has_pose),
+               "detect: --field needs --camera with a pose (the field is found through it)");
     CheckOutputPath(o->out, PathList(o->video, o->camera, o->field, o->detector.colour));
     CheckOutputPath(o->draw, PathList(o->video, o->camera, o->field, o->out), "--draw");
     const DetectVideoResult r = DetectVideo(*o);

@@ -40,12 +40,17 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (!c.mot_out.empty()) track::WriteMotChallenge(r.rows, c.mot_out);
   if (!r.team_of.empty()) {
     const std::string teams = c.out + ".teams.csv";
-    CsvWriter w(teams, {"id", "team"});
-    for (const auto& [id, team] : r.team_of) {
-      w << id << team;
-      w.EndRow();
-    }
-    w.Close();
+    AtomicWrite(
+        teams,
+        [&](const std::string& tmp) {
+          CsvWriter w(tmp, {"id", "team"});
+          for (const auto& [id, team] : r.team_of) {
+            w << id << team;
+            w.EndRow();
+          }
+          w.Close();
+        },
+        "--teams");
     std::cout << "wrote " << teams << "\n";
   }
   std::cout << r.Summary() << "\nwrote " << c.out << (c.mot_out.empty() ? "" : " and " + c.mot_out)
@@ -87,7 +92,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   cmd->add_option("--field", c->field,
                   "Field (built-in name or JSON): keep only people on it plus --margin");
-  cmd->add_option("--margin", c->o.field_margin_m, "Metres around the field still accepted");
+  CLI::Option* margin =
+      cmd->add_option("--margin", c->o.field_margin_m, "Metres around the field still accepted");
   cmd->add_option("--detector", c->o.detector.kind, "nanodet (default), hog, motion or onnx")
       ->check(CLI::IsMember({"nanodet", "hog", "motion", "onnx"}));
   cmd->add_option("--onnx", c->onnx, "A YOLO-style ONNX model of your own (sets --detector onnx)");
@@ -139,7 +145,9 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("--teams", c->o.teams,
                 "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
   cmd->add_flag("!--no-progress", c->o.progress, "No progress line");
-  cmd->callback([c] {
+  cmd->callback([c, margin] {
+    FV_REQUIRE(margin->count() == 0 || !c->field.empty(),
+               "players: --margin needs --field (it widens the field area people are kept in)");
     const auto inputs = PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
     CheckOutputPath(c->out, inputs);
     for (const auto& [out, what] : {std::pair{c->mot_out, "--mot-out"},
