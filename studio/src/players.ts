@@ -313,7 +313,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     lc.fillStyle = '#161b22';
     lc.fillRect(0, 0, legend.width, legend.height);
     const x0 = 40;
-    const w = legend.width - 160;
+    const w = legend.width - 200;
     for (let i = 0; i < w; ++i) {
       const [r, g, b] = rampColour(i / (w - 1));
       lc.fillStyle = `rgb(${Math.round(255 * r)}, ${Math.round(255 * g)}, ${Math.round(255 * b)})`;
