@@ -329,6 +329,96 @@ SceneSpec PlayersPreset(uint64_t seed) {
   return s;
 }
 
+// ---- SceneSpec::Check's parts.
+
+// A camera's size, focal length, distortion and pose (its name is checked with the others').
+void CheckCameraSpec(const CameraSpec& c, const std::string& ctx) {
+  FV_REQUIRE(c.width > 0 && c.width <= 16384, "{}.width: must be in 1..16384", ctx);
+  FV_REQUIRE(c.height > 0 && c.height <= 16384, "{}.height: must be in 1..16384", ctx);
+  if (c.fx > 0 || c.fy > 0) {
+    FV_REQUIRE(std::isfinite(c.fx) && c.fx > 0, "{}.fx: must be > 0", ctx);
+    FV_REQUIRE(std::isfinite(c.fy) && c.fy > 0, "{}.fy: must be > 0", ctx);
+  } else {
+    FV_REQUIRE(std::isfinite(c.hfov_deg) && c.hfov_deg > 1 && c.hfov_deg < 179,
+               "{}.hfov_deg: must be in (1, 179)", ctx);
+  }
+  const size_t nd = c.distortion.size();
+  FV_REQUIRE(nd == 0 || nd == 4 || nd == 5 || nd == 8 || nd == 12 || nd == 14,
+             "{}.distortion: has {} values; OpenCV takes 0, 4, 5, 8, 12 or 14", ctx, nd);
+  for (double d : c.distortion) {
+    FV_REQUIRE(std::isfinite(d), "{}.distortion: contains a non-finite value", ctx);
+  }
+  if (c.has_rvec_tvec) {
+    FV_REQUIRE(c.rvec.allFinite() && c.tvec.allFinite(), "{}.rvec/tvec: not finite", ctx);
+  } else {
+    FV_REQUIRE(c.position_m.allFinite(), "{}.position_m: not finite", ctx);
+    FV_REQUIRE(c.look_at_m.allFinite(), "{}.look_at_m: not finite", ctx);
+    const Eigen::Vector3d d = c.look_at_m - c.position_m;
+    FV_REQUIRE(d.norm() > 1e-6, "{}.look_at_m: equals position_m", ctx);
+    FV_REQUIRE(d.head<2>().norm() > 1e-6 * d.norm(),
+               "{}.look_at_m: straight up or down from position_m (the image's up is "
+               "undefined; give rvec/tvec)",
+               ctx);
+  }
+}
+
+void CheckBallPhysics(const BallPhysics& p) {
+  FV_REQUIRE(std::isfinite(p.gravity_mps2) && p.gravity_mps2 > 0,
+             "ball.physics.gravity_mps2: must be > 0");
+  FV_REQUIRE(std::isfinite(p.drag_coefficient) && p.drag_coefficient >= 0,
+             "ball.physics.drag_coefficient: must be >= 0");
+  FV_REQUIRE(std::isfinite(p.air_density_kgm3) && p.air_density_kgm3 >= 0,
+             "ball.physics.air_density_kgm3: must be >= 0");
+  FV_REQUIRE(std::isfinite(p.mass_kg) && p.mass_kg > 0, "ball.physics.mass_kg: must be > 0");
+  FV_REQUIRE(std::isfinite(p.restitution) && p.restitution >= 0 && p.restitution < 1,
+             "ball.physics.restitution: must be in [0, 1)");
+  FV_REQUIRE(std::isfinite(p.bounce_friction) && p.bounce_friction >= 0 && p.bounce_friction <= 1,
+             "ball.physics.bounce_friction: must be in [0, 1]");
+  FV_REQUIRE(std::isfinite(p.rolling_resistance) && p.rolling_resistance >= 0,
+             "ball.physics.rolling_resistance: must be >= 0");
+  FV_REQUIRE(std::isfinite(p.min_bounce_speed_mps) && p.min_bounce_speed_mps > 0,
+             "ball.physics.min_bounce_speed_mps: must be > 0");
+  FV_REQUIRE(std::isfinite(p.time_step_s) && p.time_step_s >= 1e-5 && p.time_step_s <= 0.01,
+             "ball.physics.time_step_s: must be in [1e-5, 0.01]");
+}
+
+void CheckBallSpec(const BallSpec& ball) {
+  FV_REQUIRE(std::isfinite(ball.diameter_m) && ball.diameter_m > 0 && ball.diameter_m < 5,
+             "ball.diameter_m: must be in (0, 5)");
+  CheckColour(ball.colour_bgr, "ball.colour_bgr");
+  FV_REQUIRE(ball.placements.empty() || ball.kicks.empty(),
+             "ball: give either placements or kicks, not both");
+  FV_REQUIRE(!ball.placements.empty() || !ball.kicks.empty(),
+             "ball: needs placements or kicks (or \"enabled\": false)");
+  for (size_t i = 0; i < ball.placements.size(); ++i) {
+    FV_REQUIRE(ball.placements[i].allFinite(), "ball.placements[{}]: not finite", i);
+  }
+  FV_REQUIRE(ball.hold_frames >= 1, "ball.hold_frames: must be >= 1");
+  for (size_t i = 0; i < ball.kicks.size(); ++i) {
+    const KickSpec& k = ball.kicks[i];
+    FV_REQUIRE(std::isfinite(k.time_s) && k.time_s >= 0, "ball.kicks[{}].time_s: must be >= 0", i);
+    FV_REQUIRE(k.position_m.allFinite(), "ball.kicks[{}].position_m: not finite", i);
+    FV_REQUIRE(k.position_m.z() >= ball.radius_m() - 1e-9,
+               "ball.kicks[{}].position_m: z must be >= the ball radius {}", i, ball.radius_m());
+    FV_REQUIRE(k.velocity_mps.allFinite() && k.velocity_mps.norm() < 100,
+               "ball.kicks[{}].velocity_mps: must be finite and below 100 m/s", i);
+  }
+  CheckBallPhysics(ball.physics);
+}
+
+void CheckLighting(const LightingSpec& lighting) {
+  FV_REQUIRE(lighting.light_dir.allFinite() && lighting.light_dir.z() > 0.05,
+             "lighting.light_dir: must point upwards (z > 0)");
+  FV_REQUIRE(std::isfinite(lighting.gain_amplitude) && lighting.gain_amplitude >= 0 &&
+                 lighting.gain_amplitude < 1,
+             "lighting.gain_amplitude: must be in [0, 1)");
+  FV_REQUIRE(std::isfinite(lighting.period_s) && lighting.period_s > 0,
+             "lighting.period_s: must be > 0");
+  FV_REQUIRE(
+      std::isfinite(lighting.vignetting) && lighting.vignetting >= 0 && lighting.vignetting < 1,
+      "lighting.vignetting: must be in [0, 1)");
+}
+
 }  // namespace
 
 void SceneSpec::Check() const {
@@ -342,78 +432,14 @@ void SceneSpec::Check() const {
     FV_REQUIRE(c.name.find_first_of("/\\ ") == std::string::npos,
                "{}.name: '{}' must not contain '/', '\\' or spaces (it names files)", ctx, c.name);
     FV_REQUIRE(names.insert(c.name).second, "{}.name: '{}' is used twice", ctx, c.name);
-    FV_REQUIRE(c.width > 0 && c.width <= 16384, "{}.width: must be in 1..16384", ctx);
-    FV_REQUIRE(c.height > 0 && c.height <= 16384, "{}.height: must be in 1..16384", ctx);
-    if (c.fx > 0 || c.fy > 0) {
-      FV_REQUIRE(std::isfinite(c.fx) && c.fx > 0, "{}.fx: must be > 0", ctx);
-      FV_REQUIRE(std::isfinite(c.fy) && c.fy > 0, "{}.fy: must be > 0", ctx);
-    } else {
-      FV_REQUIRE(std::isfinite(c.hfov_deg) && c.hfov_deg > 1 && c.hfov_deg < 179,
-                 "{}.hfov_deg: must be in (1, 179)", ctx);
-    }
-    const size_t nd = c.distortion.size();
-    FV_REQUIRE(nd == 0 || nd == 4 || nd == 5 || nd == 8 || nd == 12 || nd == 14,
-               "{}.distortion: has {} values; OpenCV takes 0, 4, 5, 8, 12 or 14", ctx, nd);
-    for (double d : c.distortion) {
-      FV_REQUIRE(std::isfinite(d), "{}.distortion: contains a non-finite value", ctx);
-    }
-    if (c.has_rvec_tvec) {
-      FV_REQUIRE(c.rvec.allFinite() && c.tvec.allFinite(), "{}.rvec/tvec: not finite", ctx);
-    } else {
-      FV_REQUIRE(c.position_m.allFinite(), "{}.position_m: not finite", ctx);
-      FV_REQUIRE(c.look_at_m.allFinite(), "{}.look_at_m: not finite", ctx);
-      const Eigen::Vector3d d = c.look_at_m - c.position_m;
-      FV_REQUIRE(d.norm() > 1e-6, "{}.look_at_m: equals position_m", ctx);
-      FV_REQUIRE(d.head<2>().norm() > 1e-6 * d.norm(),
-                 "{}.look_at_m: straight up or down from position_m (the image's up is "
-                 "undefined; give rvec/tvec)",
-                 ctx);
-    }
+    CheckCameraSpec(c, ctx);
   }
   FV_REQUIRE(std::isfinite(fps) && fps > 0 && fps <= 10000, "fps: must be in (0, 10000]");
   FV_REQUIRE(num_frames > 0 && num_frames <= 1000000, "num_frames: must be in 1..1000000");
   FV_REQUIRE(std::isfinite(exposure_s) && exposure_s >= 0 && exposure_s <= 1.0 / fps + 1e-12,
              "exposure_s: must be in [0, 1/fps]");
   if (ball.enabled) {
-    FV_REQUIRE(std::isfinite(ball.diameter_m) && ball.diameter_m > 0 && ball.diameter_m < 5,
-               "ball.diameter_m: must be in (0, 5)");
-    CheckColour(ball.colour_bgr, "ball.colour_bgr");
-    FV_REQUIRE(ball.placements.empty() || ball.kicks.empty(),
-               "ball: give either placements or kicks, not both");
-    FV_REQUIRE(!ball.placements.empty() || !ball.kicks.empty(),
-               "ball: needs placements or kicks (or \"enabled\": false)");
-    for (size_t i = 0; i < ball.placements.size(); ++i) {
-      FV_REQUIRE(ball.placements[i].allFinite(), "ball.placements[{}]: not finite", i);
-    }
-    FV_REQUIRE(ball.hold_frames >= 1, "ball.hold_frames: must be >= 1");
-    for (size_t i = 0; i < ball.kicks.size(); ++i) {
-      const KickSpec& k = ball.kicks[i];
-      FV_REQUIRE(std::isfinite(k.time_s) && k.time_s >= 0, "ball.kicks[{}].time_s: must be >= 0",
-                 i);
-      FV_REQUIRE(k.position_m.allFinite(), "ball.kicks[{}].position_m: not finite", i);
-      FV_REQUIRE(k.position_m.z() >= ball.radius_m() - 1e-9,
-                 "ball.kicks[{}].position_m: z must be >= the ball radius {}", i, ball.radius_m());
-      FV_REQUIRE(k.velocity_mps.allFinite() && k.velocity_mps.norm() < 100,
-                 "ball.kicks[{}].velocity_mps: must be finite and below 100 m/s", i);
-    }
-    const BallPhysics& p = ball.physics;
-    FV_REQUIRE(std::isfinite(p.gravity_mps2) && p.gravity_mps2 > 0,
-               "ball.physics.gravity_mps2: must be > 0");
-    FV_REQUIRE(std::isfinite(p.drag_coefficient) && p.drag_coefficient >= 0,
-               "ball.physics.drag_coefficient: must be >= 0");
-    FV_REQUIRE(std::isfinite(p.air_density_kgm3) && p.air_density_kgm3 >= 0,
-               "ball.physics.air_density_kgm3: must be >= 0");
-    FV_REQUIRE(std::isfinite(p.mass_kg) && p.mass_kg > 0, "ball.physics.mass_kg: must be > 0");
-    FV_REQUIRE(std::isfinite(p.restitution) && p.restitution >= 0 && p.restitution < 1,
-               "ball.physics.restitution: must be in [0, 1)");
-    FV_REQUIRE(std::isfinite(p.bounce_friction) && p.bounce_friction >= 0 && p.bounce_friction <= 1,
-               "ball.physics.bounce_friction: must be in [0, 1]");
-    FV_REQUIRE(std::isfinite(p.rolling_resistance) && p.rolling_resistance >= 0,
-               "ball.physics.rolling_resistance: must be >= 0");
-    FV_REQUIRE(std::isfinite(p.min_bounce_speed_mps) && p.min_bounce_speed_mps > 0,
-               "ball.physics.min_bounce_speed_mps: must be > 0");
-    FV_REQUIRE(std::isfinite(p.time_step_s) && p.time_step_s >= 1e-5 && p.time_step_s <= 0.01,
-               "ball.physics.time_step_s: must be in [1e-5, 0.01]");
+    CheckBallSpec(ball);
   }
   for (size_t i = 0; i < robots.size(); ++i) {
     const std::string ctx = fmt::format("robots[{}]", i);
@@ -449,16 +475,7 @@ void SceneSpec::Check() const {
                "{}.base_radius_m: must be > 0", ctx);
     CheckColour(cones[i].colour_bgr, ctx + ".colour_bgr");
   }
-  FV_REQUIRE(lighting.light_dir.allFinite() && lighting.light_dir.z() > 0.05,
-             "lighting.light_dir: must point upwards (z > 0)");
-  FV_REQUIRE(std::isfinite(lighting.gain_amplitude) && lighting.gain_amplitude >= 0 &&
-                 lighting.gain_amplitude < 1,
-             "lighting.gain_amplitude: must be in [0, 1)");
-  FV_REQUIRE(std::isfinite(lighting.period_s) && lighting.period_s > 0,
-             "lighting.period_s: must be > 0");
-  FV_REQUIRE(
-      std::isfinite(lighting.vignetting) && lighting.vignetting >= 0 && lighting.vignetting < 1,
-      "lighting.vignetting: must be in [0, 1)");
+  CheckLighting(lighting);
   FV_REQUIRE(std::isfinite(noise_sigma) && noise_sigma >= 0 && noise_sigma <= 50,
              "noise_sigma: must be in [0, 50]");
   FV_REQUIRE(jpeg_quality >= 1 && jpeg_quality <= 100, "jpeg_quality: must be in 1..100");
