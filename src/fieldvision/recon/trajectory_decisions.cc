@@ -118,12 +118,11 @@ class BallPathCursor {
 
 }  // namespace
 
-Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryResult& result,
-                        const FieldModel* field, const TrajectoryOptions& o,
-                        const DecisionOptions& d) {
-  d.Check();
-  Decisions out;
-  const double r = o.ball_radius_m;
+namespace {
+
+// The timeline's line for each flight: how it started (where it was first seen when the origin
+// is extrapolated) and any hit that ends it.
+void AddFlightEvents(const TrajectoryResult& result, std::vector<TimelineEvent>* timeline) {
   for (const auto& f : result.flights) {
     std::string what;
     switch (f.start_event) {
@@ -142,7 +141,7 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
     if (f.origin_extrapolated) {
       // Not seen: say where the flight was first seen, and that the origin is the model's.
       const Eigen::Vector3d p = f.model().PositionAt(f.t_first_seen_s);
-      out.timeline.push_back(
+      timeline->push_back(
           {f.t_first_seen_s,
            fmt::format("flight {}: {}, first seen at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, apex "
                        "{:.2f} m; origin not seen (extrapolated {:.2f} s back to ({:.2f}, {:.2f}, "
@@ -152,27 +151,125 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
                        f.t_first_seen_s - f.t_start_s, f.origin_m.x(), f.origin_m.y(),
                        f.origin_m.z())});
     } else {
-      out.timeline.push_back(
+      timeline->push_back(
           {f.t_start_s, fmt::format("flight {}: {} at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, "
                                     "apex {:.2f} m, flight time {:.2f} s",
                                     f.index, what, f.origin_m.x(), f.origin_m.y(), f.origin_m.z(),
                                     f.speed_mps, f.apex_m.z(), f.FlightTime())});
     }
     if (f.end_event == FlightEvent::kHit) {
-      out.timeline.push_back({f.t_end_s, fmt::format("flight {}: hit at ({:.2f}, {:.2f}, {:.2f}) m",
-                                                     f.index, f.model().PositionAt(f.t_end_s).x(),
-                                                     f.model().PositionAt(f.t_end_s).y(),
-                                                     f.model().PositionAt(f.t_end_s).z())});
+      timeline->push_back({f.t_end_s, fmt::format("flight {}: hit at ({:.2f}, {:.2f}, {:.2f}) m",
+                                                  f.index, f.model().PositionAt(f.t_end_s).x(),
+                                                  f.model().PositionAt(f.t_end_s).y(),
+                                                  f.model().PositionAt(f.t_end_s).z())});
     }
   }
-  if (field && field->length_m > 0) {
-    std::string rule = d.rule;
-    if (rule == "auto") {
-      const std::string n = ToLower(field->name);
-      rule = n.find("tennis") != std::string::npos       ? "tennis"
-             : n.find("basketball") != std::string::npos ? "basketball"
-                                                         : "football";
+}
+
+// "auto": tennis or basketball when the field's name says so, else football.
+std::string ResolveRule(const std::string& rule, const FieldModel& field) {
+  if (rule != "auto") return rule;
+  const std::string n = ToLower(field.name);
+  return n.find("tennis") != std::string::npos       ? "tennis"
+         : n.find("basketball") != std::string::npos ? "basketball"
+                                                     : "football";
+}
+
+// In/out of each landing against the playing area under `rule`, and touches of each named line.
+std::vector<LandingCall> CallLandings(const TrajectoryResult& result, const FieldModel& field,
+                                      const std::string& rule, double r, const DecisionOptions& d) {
+  std::vector<LandingCall> landings;
+  for (const auto& f : result.flights) {
+    LandingCall c;
+    c.flight = f.index;
+    c.time_s = f.t_landing_s;
+    c.point_m = f.landing_m.head<2>();
+    c.extrapolated = f.landing_extrapolated;
+    c.against = "playing area";
+    const double din = InsideDistance(c.point_m, 0.5 * field.length_m, 0.5 * field.width_m);
+    // football: any part of the ball's projection over the area or its lines; tennis: the
+    // contact patch touches the area (lines are in); basketball: the patch clear of the lines
+    // (the area's edge is the lines' inner edge).
+    c.margin_m = rule == "football" ? din + r
+                 : rule == "tennis" ? din + d.contact_patch_m
+                                    : din - d.contact_patch_m;
+    c.in = c.margin_m >= 0;
+    landings.push_back(c);
+    for (const auto& name : d.lines) {
+      double gap = 1e9;
+      for (const auto& s : field.segments) {
+        if (s.name != name) continue;
+        gap = std::min(gap, DistanceToSegment(c.point_m, s.a, s.b) - 0.5 * s.width_m);
+      }
+      LandingCall lc = c;
+      lc.against = name;
+      const double patch = rule == "football" ? r : d.contact_patch_m;
+      lc.margin_m = patch - gap;  // > 0: the ball touches the line
+      lc.in = lc.margin_m >= 0;
+      landings.push_back(lc);
     }
+  }
+  return landings;
+}
+
+// Walks the ball's path in time steps: goal-line crossings (the whole ball beyond the line between
+// the posts and under the bar) and shots down through a hoop.
+void ScanGoalsAndShots(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                       const FieldModel& field, double r, const DecisionOptions& d,
+                       Decisions* out) {
+  // Scan the ball's path for goal-line crossings and made shots.
+  if (!track.empty() && (!field.goals.empty() || !field.hoops.empty())) {
+    const double t0 = track.front().time_s, t1 = track.back().time_s;
+    std::vector<bool> was_in(field.goals.size(), false);
+    BallPathCursor path(track, result);
+    Eigen::Vector3d prev = path.At(t0, nullptr);
+    for (double t = t0 + d.time_step_s; t <= t1; t += d.time_step_s) {
+      int fl = -1;
+      const Eigen::Vector3d p = path.At(t, &fl);
+      for (size_t g = 0; g < field.goals.size(); ++g) {
+        const FieldGoal& goal = field.goals[g];
+        const bool beyond = goal.side * (p.x() - goal.line_x_m) > 0.5 * field.line_width_m + r;
+        const bool inside = beyond && p.y() >= goal.y_min_m && p.y() <= goal.y_max_m &&
+                            p.z() <= goal.height_m && p.z() >= -r;
+        if (inside && !was_in[g]) {
+          out->goals.push_back({fl, goal.name, t, p});
+          out->timeline.push_back(
+              {t, fmt::format("GOAL: the whole ball crossed the line of {} at ({:.2f}, {:.2f}, "
+                              "{:.2f}) m",
+                              goal.name, p.x(), p.y(), p.z())});
+        }
+        was_in[g] = inside;
+      }
+      for (const auto& h : field.hoops) {
+        const double hz = h.centre_m.z();
+        if (prev.z() > hz && p.z() <= hz) {
+          const double f = (prev.z() - hz) / (prev.z() - p.z());
+          const Eigen::Vector3d c = prev + f * (p - prev);
+          const double off = (c.head<2>() - h.centre_m.head<2>()).norm();
+          if (off < h.radius_m) {
+            out->shots.push_back({fl, h.name, t, off, off < h.radius_m - r});
+            out->timeline.push_back(
+                {t, fmt::format("MADE SHOT through {} ({} {:.3f} m from the centre)", h.name,
+                                off < h.radius_m - r ? "clean," : "touching the ring,", off)});
+          }
+        }
+      }
+      prev = p;
+    }
+  }
+}
+
+}  // namespace
+
+Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                        const FieldModel* field, const TrajectoryOptions& o,
+                        const DecisionOptions& d) {
+  d.Check();
+  Decisions out;
+  const double r = o.ball_radius_m;
+  AddFlightEvents(result, &out.timeline);
+  if (field && field->length_m > 0) {
+    const std::string rule = ResolveRule(d.rule, *field);
     out.rule = rule;
     for (const auto& name : d.lines) {
       bool found = false;
@@ -180,36 +277,7 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
       FV_REQUIRE(found, "field '{}' has no line named '{}' (see `fieldvision field show {}`)",
                  field->name, name, field->name);
     }
-    for (const auto& f : result.flights) {
-      LandingCall c;
-      c.flight = f.index;
-      c.time_s = f.t_landing_s;
-      c.point_m = f.landing_m.head<2>();
-      c.extrapolated = f.landing_extrapolated;
-      c.against = "playing area";
-      const double din = InsideDistance(c.point_m, 0.5 * field->length_m, 0.5 * field->width_m);
-      // football: any part of the ball's projection over the area or its lines; tennis: the
-      // contact patch touches the area (lines are in); basketball: the patch clear of the lines
-      // (the area's edge is the lines' inner edge).
-      c.margin_m = rule == "football" ? din + r
-                   : rule == "tennis" ? din + d.contact_patch_m
-                                      : din - d.contact_patch_m;
-      c.in = c.margin_m >= 0;
-      out.landings.push_back(c);
-      for (const auto& name : d.lines) {
-        double gap = 1e9;
-        for (const auto& s : field->segments) {
-          if (s.name != name) continue;
-          gap = std::min(gap, DistanceToSegment(c.point_m, s.a, s.b) - 0.5 * s.width_m);
-        }
-        LandingCall lc = c;
-        lc.against = name;
-        const double patch = rule == "football" ? r : d.contact_patch_m;
-        lc.margin_m = patch - gap;  // > 0: the ball touches the line
-        lc.in = lc.margin_m >= 0;
-        out.landings.push_back(lc);
-      }
-    }
+    out.landings = CallLandings(result, *field, rule, r, d);
     for (const auto& c : out.landings) {
       out.timeline.push_back(
           {c.time_s,
@@ -219,46 +287,7 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
                                                    : (c.in ? "TOUCHES" : "CLEAR OF"),
                        c.against, std::abs(c.margin_m))});
     }
-    // Scan the ball's path for goal-line crossings and made shots.
-    if (!track.empty() && (!field->goals.empty() || !field->hoops.empty())) {
-      const double t0 = track.front().time_s, t1 = track.back().time_s;
-      std::vector<bool> was_in(field->goals.size(), false);
-      BallPathCursor path(track, result);
-      Eigen::Vector3d prev = path.At(t0, nullptr);
-      for (double t = t0 + d.time_step_s; t <= t1; t += d.time_step_s) {
-        int fl = -1;
-        const Eigen::Vector3d p = path.At(t, &fl);
-        for (size_t g = 0; g < field->goals.size(); ++g) {
-          const FieldGoal& goal = field->goals[g];
-          const bool beyond = goal.side * (p.x() - goal.line_x_m) > 0.5 * field->line_width_m + r;
-          const bool inside = beyond && p.y() >= goal.y_min_m && p.y() <= goal.y_max_m &&
-                              p.z() <= goal.height_m && p.z() >= -r;
-          if (inside && !was_in[g]) {
-            out.goals.push_back({fl, goal.name, t, p});
-            out.timeline.push_back(
-                {t, fmt::format("GOAL: the whole ball crossed the line of {} at ({:.2f}, {:.2f}, "
-                                "{:.2f}) m",
-                                goal.name, p.x(), p.y(), p.z())});
-          }
-          was_in[g] = inside;
-        }
-        for (const auto& h : field->hoops) {
-          const double hz = h.centre_m.z();
-          if (prev.z() > hz && p.z() <= hz) {
-            const double f = (prev.z() - hz) / (prev.z() - p.z());
-            const Eigen::Vector3d c = prev + f * (p - prev);
-            const double off = (c.head<2>() - h.centre_m.head<2>()).norm();
-            if (off < h.radius_m) {
-              out.shots.push_back({fl, h.name, t, off, off < h.radius_m - r});
-              out.timeline.push_back(
-                  {t, fmt::format("MADE SHOT through {} ({} {:.3f} m from the centre)", h.name,
-                                  off < h.radius_m - r ? "clean," : "touching the ring,", off)});
-            }
-          }
-        }
-        prev = p;
-      }
-    }
+    ScanGoalsAndShots(track, result, *field, r, d, &out);
   }
   std::stable_sort(
       out.timeline.begin(), out.timeline.end(),
