@@ -340,6 +340,53 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
                       noise_m);
 }
 
+namespace {
+
+// A fitted model's residuals over all samples given: rmse, inliers by a robust threshold
+// (outlier_sigmas times the larger of the noise and the residuals' MAD sigma), the capped sum of
+// squares and the Bayesian information criterion (Schwarz 1978) that compares the models.
+void ScoreFit(const std::vector<BallSample>& samples, double t_ref,
+              const TrajectoryOptions& options, double noise_m, BallisticFit* fit_out) {
+  BallisticFit& fit = *fit_out;
+  const int n = static_cast<int>(samples.size());
+  std::vector<double> r(n);
+  double ss = 0;
+  if (fit.model.Parabola()) {
+    for (int i = 0; i < n; ++i) {
+      r[i] = (fit.model.PositionAt(samples[i].time_s) - samples[i].ball_in_world).norm();
+    }
+  } else {
+    // Walk once through the samples (sorted by time) in both directions from t_ref.
+    Eigen::Vector3d p, v;
+    for (int dir : {1, -1}) {
+      fit.model.StateAt(t_ref, &p, &v);
+      double t = t_ref;
+      for (int i = n / 2; i >= 0 && i < n; i += dir) {
+        StepModel(fit.model, &p, &v, samples[i].time_s - t);
+        t = samples[i].time_s;
+        r[i] = (p - samples[i].ball_in_world).norm();
+      }
+    }
+  }
+  for (double x : r) ss += x * x;
+  fit.rmse_m = std::sqrt(ss / n);
+  const double robust_sigma = kMadToSigma * NearestRankPercentile(r, 0.5) / std::sqrt(3.0);
+  const double thr =
+      std::max(options.outlier_sigmas * std::max(noise_m, robust_sigma), options.min_outlier_m);
+  for (int i = 0; i < n; ++i) {
+    fit.inlier[i] = r[i] <= thr;
+    fit.inliers += fit.inlier[i];
+  }
+  const double cap = std::max(options.outlier_sigmas * std::max(noise_m, 1e-4) * std::sqrt(3.0),
+                              options.min_outlier_m);
+  for (double x : r) fit.capped_sse_m2 += std::min(x * x, cap * cap);
+  const double nobs = 3.0 * n;
+  fit.bic =
+      nobs * std::log(std::max(fit.capped_sse_m2, 1e-18) / nobs) + fit.parameters * std::log(nobs);
+}
+
+}  // namespace
+
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel kind,
                           const TrajectoryOptions& options, double noise_m,
                           const BallisticModel* start) {
@@ -424,41 +471,7 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
     fit.model.magnus_per_rad = c_m;
     fit.model.spin_radps = Eigen::Vector3d(sm[0], sm[1], sm[2]) / c_m;
   }
-  // Residuals: rmse over all samples given; inliers by a robust threshold.
-  std::vector<double> r(n);
-  double ss = 0;
-  if (fit.model.Parabola()) {
-    for (int i = 0; i < n; ++i) {
-      r[i] = (fit.model.PositionAt(samples[i].time_s) - samples[i].ball_in_world).norm();
-    }
-  } else {
-    // Walk once through the samples (sorted by time) in both directions from t_ref.
-    Eigen::Vector3d p, v;
-    for (int dir : {1, -1}) {
-      fit.model.StateAt(t_ref, &p, &v);
-      double t = t_ref;
-      for (int i = n / 2; i >= 0 && i < n; i += dir) {
-        StepModel(fit.model, &p, &v, samples[i].time_s - t);
-        t = samples[i].time_s;
-        r[i] = (p - samples[i].ball_in_world).norm();
-      }
-    }
-  }
-  for (double x : r) ss += x * x;
-  fit.rmse_m = std::sqrt(ss / n);
-  const double robust_sigma = kMadToSigma * NearestRankPercentile(r, 0.5) / std::sqrt(3.0);
-  const double thr =
-      std::max(options.outlier_sigmas * std::max(noise_m, robust_sigma), options.min_outlier_m);
-  for (int i = 0; i < n; ++i) {
-    fit.inlier[i] = r[i] <= thr;
-    fit.inliers += fit.inlier[i];
-  }
-  const double cap = std::max(options.outlier_sigmas * std::max(noise_m, 1e-4) * std::sqrt(3.0),
-                              options.min_outlier_m);
-  for (double x : r) fit.capped_sse_m2 += std::min(x * x, cap * cap);
-  const double nobs = 3.0 * n;
-  fit.bic =
-      nobs * std::log(std::max(fit.capped_sse_m2, 1e-18) / nobs) + fit.parameters * std::log(nobs);
+  ScoreFit(samples, t_ref, options, noise_m, &fit);
   fit.ok = ok && std::isfinite(fit.rmse_m);
   return fit;
 }
