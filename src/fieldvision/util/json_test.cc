@@ -3,23 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <functional>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/testing.h"
 
 namespace fv {
 namespace {
 
 using nlohmann::json;
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 void ExpectNames(const std::string& error, std::initializer_list<const char*> parts) {
   EXPECT_FALSE(error.empty());

@@ -1,8 +1,9 @@
 // Test helpers: a seed per test (FV_TEST_SEED overrides it) that is printed on failure, a fresh
-// temporary folder per test, and the path of the shared real data.
+// temporary folder per test, the path of the shared real data and the message of a thrown error.
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -15,6 +16,16 @@ uint64_t TestSeed(uint64_t fallback = 1);
 std::string TempDir();
 // ../shared/data next to the source tree; empty string if absent.
 std::string SharedDataDir();
+// What `f` throws (an fv::Error or other std::exception), or "" when it returns.
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace fv::testing
 
