@@ -472,6 +472,16 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     }
   };
 
+  // A feed the server already runs (`studio --live`, or another page): show it.
+  void api.get<{ state: string; endpoint: string }>('/api/live').then((st) => {
+    if (st.state !== 'running' || !canvas.isConnected) return;
+    liveOn = true;
+    liveEndpoint.value = st.endpoint;
+    liveButton.textContent = 'Stop live';
+    if (!liveTrack.parent) scene.add(liveTrack);
+    status(liveMsg, `live: waiting for positions from ${st.endpoint}`);
+  }).catch(() => {});
+
   time.addEventListener('input', () => setTime(Number(time.value)));
   load.onclick = () => void show();
   bench.onclick = async () => {

@@ -19,6 +19,9 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--port", o->port, "Port (0: any free one)")->capture_default_str();
   cmd->add_option("--token", o->token, "Token for a non-loopback --host (default: random)");
+  cmd->add_option("--live", o->live,
+                  "Subscribe the 3D view's live mode to a fusion node's positions from the start "
+                  "(its --publish address, tcp://HOST:PORT)");
   cmd->add_option("--assets", o->assets,
                   "Folder of the built front end (default: studio/dist of the source tree)");
   cmd->callback([o, &exit_code] { exit_code = web::RunStudio(*o, std::cout); });

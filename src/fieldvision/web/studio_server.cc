@@ -24,6 +24,9 @@ namespace fs = std::filesystem;
 void StudioOptions::Check() const {
   FV_REQUIRE(!host.empty(), "studio: --host is empty");
   FV_REQUIRE(port >= 0 && port <= 65535, "studio: --port must be 0..65535 (got {})", port);
+  FV_REQUIRE(live.empty() || live.rfind("tcp://", 0) == 0,
+             "studio: --live must be tcp://HOST:PORT (the fusion node's --publish), got '{}'",
+             live);
   FV_REQUIRE(token.find_first_of(" \r\n&?#") == std::string::npos,
              "studio: --token must not contain spaces or URL separators");
 }
@@ -174,6 +177,13 @@ StudioServer::~StudioServer() { Stop(); }
 int StudioServer::Start() {
   Impl& m = *impl_;
   FV_REQUIRE(m.port < 0, "studio: server already started");
+  if (!m.options.live.empty()) {
+    try {
+      m.live->Start(m.options.live);
+    } catch (const HttpError& e) {
+      Throw("studio: --live: {}", e.what());
+    }
+  }
   if (m.options.port == 0) {
     m.port = m.server.bind_to_any_port(m.options.host);
   } else {

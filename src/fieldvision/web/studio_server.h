@@ -20,6 +20,9 @@ struct StudioOptions {
   std::string assets;              // built front end (index.html); empty: studio/dist
   std::string token;               // for a non-loopback host; empty: a random one
   std::string program;             // the fieldvision executable jobs run; empty: this program
+  // A fusion node's PUB address (fuse --publish) the 3D view's live mode subscribes to from the
+  // start, tcp://HOST:PORT; empty: none until a page starts one.
+  std::string live;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };

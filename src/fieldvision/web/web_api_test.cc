@@ -488,6 +488,18 @@ TEST_F(StudioApiTest, LivePositionsFromAFusionNodeArriveAsEvents) {
   EXPECT_NE(stream.find("\"frame\":7"), std::string::npos) << stream;
 }
 
+TEST_F(StudioApiTest, LiveFeedFromTheStart) {
+  StudioOptions bad;
+  bad.live = "ipc:///tmp/x";
+  EXPECT_THROW(bad.Check(), fv::Error);
+  StudioOptions o;
+  o.live = "tcp://127.0.0.1:5999";  // nothing there yet: ZeroMQ connects when it comes
+  StartServer(o);
+  const json status = Get("/api/live").j();
+  EXPECT_EQ(status["state"], "running");
+  EXPECT_EQ(status["endpoint"], "tcp://127.0.0.1:5999");
+}
+
 TEST_F(StudioApiTest, BallColourLearnSaveDetect) {
   FV_SEED_TRACE(seed_);
   const Eigen::Vector3d ball = BallTruth();
