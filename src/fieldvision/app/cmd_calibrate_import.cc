@@ -131,6 +131,61 @@ void RunExport(const ExportCli& c) {
   std::cout << "wrote " << c.toml << " (" << cams.size() << " cameras)\n";
 }
 
+// ---- compare
+std::vector<Camera> ReadCameraFolder(const std::string& dir) {
+  FV_REQUIRE(std::filesystem::is_directory(dir), "rig '{}' is not a folder", dir);
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string ext = e.path().extension().string();
+    if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml"))
+      files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<Camera> cams;
+  for (const auto& f : files) {
+    cams.push_back(ReadCameraYaml(f));
+    if (cams.back().name.empty()) cams.back().name = std::filesystem::path(f).stem().string();
+  }
+  FV_REQUIRE(!cams.empty(), "rig '{}' has no camera files (*.yaml)", dir);
+  return cams;
+}
+
+struct CompareCli {
+  std::vector<std::string> rigs;
+};
+
+// Two calibrations of one rig compared without a common frame: per camera the intrinsics, per
+// pair the baseline and relative rotation, and the centres after the best rigid alignment.
+void RunCompare(const CompareCli& c) {
+  FV_REQUIRE(c.rigs.size() == 2, "give --rig twice: the two calibrations to compare");
+  const auto a_all = ReadCameraFolder(c.rigs[0]);
+  const auto b_all = ReadCameraFolder(c.rigs[1]);
+  std::vector<Camera> a, b;
+  for (const auto& ca : a_all) {
+    for (const auto& cb : b_all) {
+      if (cb.name != ca.name) continue;
+      FV_REQUIRE(ca.has_pose && cb.has_pose, "camera '{}' has no pose in both rigs", ca.name);
+      a.push_back(ca);
+      b.push_back(cb);
+    }
+  }
+  FV_REQUIRE(a.size() >= 2,
+             "rigs '{}' and '{}' share {} camera names; comparing needs 2 or more (cameras are "
+             "matched by their name or file name)",
+             c.rigs[0], c.rigs[1], a.size());
+  std::cout << fmt::format("{:<10s} {:>9s} {:>9s} {:>9s} {:>9s} {:>9s}\n", "camera", "fx_a", "fx_b",
+                           "dfx_%", "dcx_px", "dcy_px");
+  for (size_t i = 0; i < a.size(); ++i) {
+    std::cout << fmt::format("{:<10s} {:>9.1f} {:>9.1f} {:>+9.2f} {:>+9.1f} {:>+9.1f}\n", a[i].name,
+                             a[i].fx, b[i].fx, 100 * (a[i].fx - b[i].fx) / b[i].fx,
+                             a[i].cx - b[i].cx, a[i].cy - b[i].cy);
+  }
+  const calib::RigComparison r = calib::CompareRigs(a, b);
+  std::string names;
+  for (size_t i = 0; i < a.size(); ++i) names += fmt::format(" {}={}", i + 1, a[i].name);
+  std::cout << "cameras:" << names << "\n" << r.Summary() << "\n";
+}
+
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(
       app, "calibrate",
@@ -165,6 +220,16 @@ void Setup(CLI::App& app, int& exit_code) {
   ex->add_option("--rig", e->rig, "Folder of camera files (e.g. calibrate multi --out)");
   ex->add_option("--toml", e->toml, "calibration.toml to write")->required();
   ex->callback([e] { RunExport(*e); });
+
+  auto k = std::make_shared<CompareCli>();
+  CLI::App* cm = group->add_subcommand(
+      "compare",
+      "Compare two calibrations of one rig without a common frame (intrinsics, baselines, "
+      "relative rotations, centres after rigid alignment)");
+  cm->add_option("--rig", k->rigs,
+                 "Folder of camera files (give twice; cameras matched by name or file name)")
+      ->required();
+  cm->callback([k] { RunCompare(*k); });
   (void)exit_code;
 }
 

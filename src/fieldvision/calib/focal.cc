@@ -164,8 +164,43 @@ FocalResult EstimateFocalAndPose(int width, int height,
     ceres::Problem robust_problem;
     solve(use, true, &robust_problem);
   }
+  // With few points one bad click bends even the robust fit and pushes good points over the
+  // gate: while some point is over it, refit leaving out each point in turn and keep the fit
+  // with the most points within the gate; then every point within the gate of that fit is used.
   auto e = errors();
+  auto within = [&](const std::vector<double>& ev) {
+    int count = 0;
+    for (double v : ev) count += v <= options.outlier_px ? 1 : 0;
+    return count;
+  };
   int n_in = 0;
+  for (int k = 0; k < n; ++k) n_in += use[k] ? 1 : 0;
+  int best_in = within(e);
+  while (best_in < n_in && n_in > options.min_points) {
+    const std::array<double, 8> x_start = x;
+    std::array<double, 8> x_best = x;
+    int drop = -1;
+    for (int k = 0; k < n; ++k) {
+      if (!use[k]) continue;
+      std::vector<bool> u = use;
+      u[k] = false;
+      x = x_start;
+      ceres::Problem refit;
+      solve(u, true, &refit);
+      const int in = within(errors());
+      if (in > best_in) {
+        best_in = in;
+        x_best = x;
+        drop = k;
+      }
+    }
+    x = x_best;
+    if (drop < 0) break;
+    use[drop] = false;
+    --n_in;
+  }
+  e = errors();
+  n_in = 0;
   for (int k = 0; k < n; ++k) {
     use[k] = e[k] <= options.outlier_px;
     n_in += use[k] ? 1 : 0;
