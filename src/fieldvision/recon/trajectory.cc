@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "fieldvision/recon/trajectory_physics.h"
+#include "fieldvision/recon/trajectory_stages.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
@@ -1085,10 +1086,10 @@ std::optional<FittedPiece> FitPiece(const std::vector<BallSample>& track,
   return fp;
 }
 
-// Events between consecutive pieces that are both fitted: bounce (low, descending then rising)
-// or hit, with the contact time where the two arcs meet; a side that was trimmed leaves the
-// contact unresolved (ground). Then a break next to a hop too short to fit is a ground contact
-// too (origin and landing from the arc's own crossing of the ground level).
+}  // namespace
+
+namespace trajectory_detail {
+
 void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOptions& options,
                      double noise_m, std::vector<Flight>* flights,
                      std::vector<TrackBreak>* breaks) {
@@ -1135,8 +1136,6 @@ void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOp
   }
 }
 
-// Origin, landing, apex and launch velocity of a flight from its model and events; a ground
-// contact lies within the contact-time bounds [lo_s, hi_s] of its piece.
 void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, Flight* f) {
   const double zr = options.ground_z_m + options.ball_radius_m;
   const BallisticModel& mdl = f->model();
@@ -1164,9 +1163,6 @@ void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, 
   f->apex_m = mdl.PositionAt(f->t_apex_s);
 }
 
-// A bounce is one point on the ground: the landing of the arc before and the origin of the arc
-// after, weighted by the inverse extrapolation variance of each (leverage of the contact time in
-// each arc's gravity fit).
 void MergeBounces(const std::vector<BallSample>& track, const TrajectoryOptions& options,
                   std::vector<Flight>* flights) {
   for (size_t i = 0; i + 1 < flights->size(); ++i) {
@@ -1188,7 +1184,6 @@ void MergeBounces(const std::vector<BallSample>& track, const TrajectoryOptions&
   }
 }
 
-// Outliers inside a flight's seen span belong to it (for the pictures).
 void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool>& outlier,
                     Flight* f) {
   for (size_t k = 0; k < track.size(); ++k) {
@@ -1199,7 +1194,12 @@ void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool
   std::sort(f->samples.begin(), f->samples.end());
 }
 
-}  // namespace
+}  // namespace trajectory_detail
+
+using trajectory_detail::AttachOutliers;
+using trajectory_detail::MergeBounces;
+using trajectory_detail::PlaceEndpoints;
+using trajectory_detail::ResolveContacts;
 
 TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
                                    const TrajectoryOptions& options) {
