@@ -3,10 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 
 #include <fmt/format.h>
 
 #include "fieldvision/io/source_backends.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -63,6 +65,14 @@ bool FrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
   return true;
 }
 
+void CheckFrameSize(const FrameSource& source, const Camera& camera,
+                    const std::string& camera_file) {
+  const cv::Size size = source.FrameSize();
+  FV_REQUIRE(size.width == camera.width && size.height == camera.height,
+             "video '{}' is {}x{} but camera file '{}' is for {}x{} images", source.name(),
+             size.width, size.height, camera_file, camera.width, camera.height);
+}
+
 double SystemClockNow() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -106,7 +116,14 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
         "camera:, gst:, rtsp://, aravis:, synth:)",
         spec, spec.substr(0, colon));
   }
-  auto file = io_backend::OpenFile(spec, options);
+  // An image sequence: a glob, a folder or a printf pattern whose files are numbered from 0 or 1
+  // (a file that exists is a file, whatever its name). Other printf patterns: OpenCV's reader.
+  std::unique_ptr<FrameSource> file;
+  const bool list =
+      !std::filesystem::is_regular_file(spec) &&
+      (spec.find_first_of("*?") != std::string::npos || std::filesystem::is_directory(spec) ||
+       (spec.find('%') != std::string::npos && !ListImageSequence(spec).empty()));
+  file = list ? io_backend::OpenImageList(spec, options) : io_backend::OpenFile(spec, options);
   if (options.realtime) return io_backend::Paced(std::move(file), options);
   return file;
 }

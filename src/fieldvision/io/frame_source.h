@@ -1,5 +1,7 @@
 // Frame sources behind one interface, chosen by the spec's form, one backend per file:
-//   a video file or an image pattern (dir/%05d.jpg)  file_source.cc (timestamps from the frame
+//   dir/*.png, a folder of images (name order),     image_list_source.cc (frame rate or CSV;
+//   dir/%05d.jpg numbered from 0 or 1                JPEG files kept encoded on request)
+//   a video file (or another image pattern)          file_source.cc (timestamps from the frame
 //                                                    rate, the container or a CSV; Motion-JPEG
 //                                                    and JPEG files kept encoded on request)
 //   v4l2:/dev/videoN, camera:N                       v4l2_source.cc (kernel buffer timestamps)
@@ -21,6 +23,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "fieldvision/camera/camera.h"
 #include "fieldvision/io/jpeg_region.h"
 
 namespace fv {
@@ -98,6 +101,10 @@ class FrameSource {
 // backend is not built in, or the source cannot be opened or holds no frame.
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
                                              const FrameSourceOptions& options = {});
+
+// Throws fv::Error naming both when the source's frames are not the camera's image size.
+void CheckFrameSize(const FrameSource& source, const Camera& camera,
+                    const std::string& camera_file);
 
 // Seconds on the system clock (Unix time): the clock of live sources' time_s.
 double SystemClockNow();

@@ -11,6 +11,9 @@ namespace fv::io_backend {
 
 // A video file OpenCV reads or a printf image pattern (file_source.cc).
 std::unique_ptr<FrameSource> OpenFile(const std::string& path, const FrameSourceOptions& options);
+// A glob (dir/*.png) or a folder of images, in name order (image_list_source.cc).
+std::unique_ptr<FrameSource> OpenImageList(const std::string& spec,
+                                           const FrameSourceOptions& options);
 // `source` delivered at its frame rate from options.start_at_s (paced_source.cc).
 std::unique_ptr<FrameSource> Paced(std::unique_ptr<FrameSource> source,
                                    const FrameSourceOptions& options);

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/io/frame_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -44,112 +45,32 @@ std::vector<std::string> Glob(const std::string& spec) {
   return out;
 }
 
-class ImageSequenceSource : public VideoSource {
+// VideoSource's reading, done by a frame source (frame_source.h).
+class FrameSourceVideo : public VideoSource {
  public:
-  ImageSequenceSource(const std::string& spec, std::vector<std::string> files, double fps)
-      : files_(std::move(files)) {
+  FrameSourceVideo(const std::string& spec, std::unique_ptr<FrameSource> source)
+      : source_(std::move(source)) {
     spec_ = spec;
-    fps_ = fps;
-    frame_count_ = static_cast<int>(files_.size());
-    const cv::Mat first = cv::imread(files_.front(), cv::IMREAD_COLOR);
-    FV_REQUIRE(!first.empty(), "image sequence '{}': cannot read its first image '{}'", spec,
-               files_.front());
-    width_ = first.cols;
-    height_ = first.rows;
+    const cv::Size size = source_->FrameSize();
+    width_ = size.width;
+    height_ = size.height;
+    fps_ = source_->fps();
+    const long long n = source_->FrameCount();
+    frame_count_ = n > 0 ? static_cast<int>(n) : -1;
+    live_ = source_->live();
   }
-
   bool Read(Frame& frame) override {
-    if (next_index_ >= frame_count_) return false;
-    const std::string& file = files_[next_index_];
-    frame.bgr = cv::imread(file, cv::IMREAD_COLOR);
-    FV_REQUIRE(!frame.bgr.empty(), "image sequence '{}': frame {} ('{}') cannot be read", spec_,
-               next_index_, file);
+    long long index = 0;
+    if (!source_->Read(&frame.bgr, &index, &frame.time_s)) return false;
     FV_REQUIRE(frame.bgr.cols == width_ && frame.bgr.rows == height_,
-               "image sequence '{}': frame {} ('{}') is {}x{}, the first frame {}x{}", spec_,
-               next_index_, file, frame.bgr.cols, frame.bgr.rows, width_, height_);
-    frame.index = next_index_;
-    frame.time_s = next_index_ / fps_;
-    ++next_index_;
-    return true;
-  }
-
- private:
-  std::vector<std::string> files_;
-};
-
-class CaptureSource : public VideoSource {
- public:
-  CaptureSource(const std::string& spec, double fallback_fps) {
-    spec_ = spec;
-    if (StartsWith(spec, "camera:")) {
-      const int device =
-          static_cast<int>(ParseInt(spec.substr(7), "camera device in '" + spec + "'"));
-      live_ = true;
-      cap_.open(device);
-      FV_REQUIRE(cap_.isOpened(), "cannot open live camera {} ('{}')", device, spec);
-      start_ = std::chrono::steady_clock::now();
-    } else {
-      FV_REQUIRE(fs::exists(spec), "video '{}' does not exist", spec);
-      FV_REQUIRE(fs::is_regular_file(spec), "video '{}' is not a file", spec);
-      FV_REQUIRE(OpenVideoFile(cap_, spec),
-                 "video '{}' cannot be opened (not a video OpenCV can decode?)", spec);
-      frame_count_ = static_cast<int>(cap_.get(cv::CAP_PROP_FRAME_COUNT));
-      if (frame_count_ <= 0) frame_count_ = -1;
-    }
-    fps_ = cap_.get(cv::CAP_PROP_FPS);
-    if (!(fps_ > 0 && fps_ < 10000)) fps_ = fallback_fps;
-    // Decode the first frame now so a file with a valid header but no decodable frame fails here.
-    FV_REQUIRE(cap_.read(pending_) && !pending_.empty(), "video '{}' has no decodable frame", spec);
-    pending_time_s_ = TimeOfLastRead();
-    width_ = pending_.cols;
-    height_ = pending_.rows;
-    has_pending_ = true;
-  }
-
-  bool Read(Frame& frame) override {
-    if (has_pending_) {
-      frame.bgr = pending_;
-      frame.time_s = pending_time_s_;
-      has_pending_ = false;
-    } else {
-      cv::Mat m;
-      bool ok = false;
-      try {
-        ok = cap_.read(m) && !m.empty();
-      } catch (const cv::Exception&) {
-        ok = false;
-      }
-      if (!ok) {
-        CheckEndOfStream(spec_, next_index_, frame_count_);
-        return false;
-      }
-      FV_REQUIRE(m.cols == width_ && m.rows == height_,
-                 "video '{}': frame {} is {}x{}, the first frame {}x{}", spec_, next_index_, m.cols,
-                 m.rows, width_, height_);
-      frame.bgr = m;
-      frame.time_s = TimeOfLastRead();
-    }
+               "video '{}': frame {} is {}x{}, the first frame {}x{}", spec_, next_index_,
+               frame.bgr.cols, frame.bgr.rows, width_, height_);
     frame.index = next_index_++;
     return true;
   }
 
  private:
-  double TimeOfLastRead() {
-    if (live_) {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    }
-    const double ms = cap_.get(cv::CAP_PROP_POS_MSEC);
-    // Some backends report the position after the frame; frame / fps is the robust fallback.
-    const double by_index = next_index_ / fps_;
-    if (!(ms >= 0) || std::abs(ms / 1000.0 - by_index) > 2.0 / fps_) return by_index;
-    return ms / 1000.0;
-  }
-
-  cv::VideoCapture cap_;
-  cv::Mat pending_;
-  double pending_time_s_ = 0.0;
-  bool has_pending_ = false;
-  std::chrono::steady_clock::time_point start_;
+  std::unique_ptr<FrameSource> source_;
 };
 
 }  // namespace
@@ -218,18 +139,18 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
                                                const VideoSourceOptions& options) {
   options.Check();
   FV_REQUIRE(!spec.empty(), "empty video name");
-  if (StartsWith(spec, "camera:")) return std::make_unique<CaptureSource>(spec, options.fps);
-  // A file that exists is a video even when its name has '%', '*' or '?' (100%.avi, a*b.avi).
-  if (fs::is_regular_file(spec)) return std::make_unique<CaptureSource>(spec, options.fps);
-  const bool sequence = spec.find('%') != std::string::npos ||
-                        spec.find('*') != std::string::npos ||
-                        spec.find('?') != std::string::npos || fs::is_directory(spec);
+  // Image sequences at options.fps; video files at their container's rate and times.
+  const bool sequence = !fs::is_regular_file(spec) &&
+                        (spec.find_first_of("%*?") != std::string::npos || fs::is_directory(spec));
+  FrameSourceOptions so;
   if (sequence) {
-    std::vector<std::string> files = ListImageSequence(spec);
-    FV_REQUIRE(!files.empty(), "image sequence '{}' matches no image file", spec);
-    return std::make_unique<ImageSequenceSource>(spec, std::move(files), options.fps);
+    so.fps = options.fps;
+    FV_REQUIRE(!ListImageSequence(spec).empty(), "image sequence '{}' matches no image file", spec);
+  } else if (!StartsWith(spec, "camera:") && spec.find(':') == std::string::npos) {
+    FV_REQUIRE(fs::exists(spec), "video '{}' does not exist", spec);
+    so.time = TimeSource::kContainer;
   }
-  return std::make_unique<CaptureSource>(spec, options.fps);
+  return std::make_unique<FrameSourceVideo>(spec, OpenFrameSource(spec, so));
 }
 
 void VideoSource::CheckMatchesCamera(const Camera& camera, const std::string& camera_name) const {

@@ -1,7 +1,8 @@
-// Frame sources behind one interface: a video file OpenCV reads, an image sequence (a printf
-// pattern such as dir/%05d.png, a glob such as dir/*.jpg, or a folder of images, in name order),
-// or a live camera ("camera:0"). Frames are numbered from 0 and carry a time in seconds (the
-// container's timestamps for files, frame / fps for images, a steady clock for live cameras).
+// The frame-by-frame view of a frame source (io/frame_source.h, which does the reading) that the
+// detection, colour, overlay and studio code use: a video file (its container's times), an image
+// sequence (a printf pattern such as dir/%05d.png, a glob such as dir/*.jpg, or a folder of
+// images, in name order, at options.fps) or any live source ("camera:0", "v4l2:...", "synth:..."
+// with system-clock times). Frames are numbered from 0. Also the helpers the file backends share.
 #pragma once
 
 #include <chrono>

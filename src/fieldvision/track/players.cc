@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
@@ -27,37 +28,28 @@ double Seconds(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-// Reads frames in its own thread into a small queue (decoding overlaps detection).
+// Reads frames (io/frame_source.h) in its own thread into a small queue (decoding overlaps
+// detection). A read that fails (a truncated video) is rethrown by Next.
 class FrameReader {
  public:
-  FrameReader(const std::string& path, int max_frames) : max_frames_(max_frames) {
-    cv::VideoCapture cap;
-    // OpenCV's backends log their failures to stderr; the one-line error below says it.
+  FrameReader(const std::string& path, int max_frames, bool sequence) : max_frames_(max_frames) {
+    FrameSourceOptions so;
+    so.time = TimeSource::kContainer;
+    if (sequence) so.fps = 25.0;  // the rate OpenCV reported for image patterns; --fps overrides
+    // OpenCV's backends log their failures to stderr; the one-line error says it.
     const auto log_level = cv::utils::logging::getLogLevel();
     cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
     try {
-      // FFmpeg for files (GStreamer prints to stderr on a file it cannot read), else a pattern.
-      cap.open(path, path.find('%') != std::string::npos ? cv::CAP_IMAGES : cv::CAP_FFMPEG);
-    } catch (const cv::Exception&) {
+      source_ = OpenFrameSource(path, so);
+    } catch (...) {
+      cv::utils::logging::setLogLevel(log_level);
+      throw;
     }
     cv::utils::logging::setLogLevel(log_level);
-    FV_REQUIRE(cap.isOpened(),
-               "cannot open video '{}' (missing file or a format OpenCV cannot "
-               "read)",
-               path);
-    fps_ = cap.get(cv::CAP_PROP_FPS);
-    total_ = static_cast<int>(cap.get(cv::CAP_PROP_FRAME_COUNT));
-    cv::Mat first;
-    bool ok = false;
-    try {
-      ok = cap.read(first);
-    } catch (const cv::Exception&) {
-    }
-    FV_REQUIRE(ok && !first.empty(), "video '{}' has no readable frame (corrupt?)", path);
-    size_ = first.size();
-    queue_.push_back(first);
-    times_ms_.push_back(cap.get(cv::CAP_PROP_POS_MSEC));
-    thread_ = std::thread([this, cap = std::move(cap)]() mutable { Run(cap); });
+    fps_ = source_->fps();
+    total_ = static_cast<int>(std::max(0LL, source_->FrameCount()));
+    size_ = source_->FrameSize();
+    thread_ = std::thread([this] { Run(); });
   }
   ~FrameReader() {
     {
@@ -67,12 +59,15 @@ class FrameReader {
     cv_.notify_all();
     if (thread_.joinable()) thread_.join();
   }
-  // Next frame and its container timestamp (CAP_PROP_POS_MSEC; 0 or NaN when the backend has
-  // none), or false at the end.
+  // Next frame and its container timestamp in ms (or frame / fps when the container has none),
+  // or false at the end.
   bool Next(cv::Mat& frame, double& time_ms) {
     std::unique_lock<std::mutex> lock(mutex_);
     cv_.wait(lock, [&] { return !queue_.empty() || done_; });
-    if (queue_.empty()) return false;
+    if (queue_.empty()) {
+      if (!error_.empty()) Throw("{}", error_);
+      return false;
+    }
     frame = queue_.front();
     queue_.pop_front();
     time_ms = times_ms_.front();
@@ -86,18 +81,21 @@ class FrameReader {
   double read_seconds() const { return read_s_; }
 
  private:
-  void Run(cv::VideoCapture& cap) {
-    int n = 1;
+  void Run() {
+    int n = 0;
+    std::string error;
     while (true) {
       if (max_frames_ > 0 && n >= max_frames_) break;
       cv::Mat f;
+      long long index = 0;
+      double time_s = 0;
       const auto t0 = Clock::now();
       bool ok = false;
       try {
-        ok = cap.read(f);
-      } catch (const cv::Exception&) {
+        ok = source_->Read(&f, &index, &time_s);
+      } catch (const std::exception& e) {
+        error = e.what();
       }
-      const double ms = ok ? cap.get(cv::CAP_PROP_POS_MSEC) : 0.0;
       read_s_ += Seconds(t0, Clock::now());
       if (!ok || f.empty()) break;
       ++n;
@@ -105,14 +103,17 @@ class FrameReader {
       cv_.wait(lock, [&] { return queue_.size() < 8 || stop_; });
       if (stop_) break;
       queue_.push_back(std::move(f));
-      times_ms_.push_back(ms);
+      times_ms_.push_back(1000.0 * time_s);
       cv_.notify_all();
     }
     std::lock_guard<std::mutex> lock(mutex_);
+    error_ = error;
     done_ = true;
     cv_.notify_all();
   }
 
+  std::unique_ptr<FrameSource> source_;
+  std::string error_;
   int max_frames_;
   double fps_ = 0;
   int total_ = 0;
@@ -446,7 +447,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     const int n = static_cast<int>(sequence_files);
     frame_limit = frame_limit > 0 ? std::min(frame_limit, n) : n;
   }
-  FrameReader reader(video, frame_limit);
+  FrameReader reader(video, frame_limit, sequence_files > 0);
   if (camera != nullptr) {
     CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
   }

@@ -1,0 +1,110 @@
+// Frame-source backend: an image sequence given as a glob (dir/*.png) or a folder of images, in
+// name order (ListImageSequence, video_source.h); times from the frame rate (options.fps, else
+// 30) or a frame,time_s CSV. JPEG files are delivered encoded on request (the files' bytes).
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fieldvision/io/source_backends.h"
+#include "fieldvision/io/video_source.h"
+#include "fieldvision/util/csv.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
+
+namespace fv::io_backend {
+namespace {
+
+bool IsJpeg(const std::string& path) {
+  const std::string ext = ToLower(std::filesystem::path(path).extension().string());
+  return ext == ".jpg" || ext == ".jpeg";
+}
+
+class ImageListSource : public FrameSource {
+ public:
+  ImageListSource(const std::string& spec, std::vector<std::string> files,
+                  const FrameSourceOptions& o)
+      : spec_(spec), files_(std::move(files)), fps_(o.fps > 0 ? o.fps : 30.0) {
+    encoded_ = o.encoded;
+    for (const std::string& f : files_) encoded_ = encoded_ && IsJpeg(f);
+    if (o.time == TimeSource::kCsv) {
+      const CsvTable t = CsvTable::Read(o.timestamps_csv);
+      t.Require({"frame", "time_s"});
+      for (size_t r = 0; r < t.rows(); ++r) times_[t.GetInt(r, "frame")] = t.GetDouble(r, "time_s");
+      origin_ = TimeOrigin::kCsv;
+      csv_ = o.timestamps_csv;
+    }
+    const cv::Mat first = cv::imread(files_.front(), cv::IMREAD_COLOR);
+    FV_REQUIRE(!first.empty(), "image sequence '{}': cannot read its first image '{}'", spec,
+               files_.front());
+    size_ = first.size();
+  }
+  bool ReadFrame(SourceFrame* out) override {
+    if (next_ >= static_cast<long long>(files_.size())) return false;
+    const std::string& file = files_[next_];
+    out->bgr = cv::Mat();
+    out->jpeg.clear();
+    if (encoded_) {
+      std::ifstream in(file, std::ios::binary);
+      out->jpeg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      FV_REQUIRE(in.good() || in.eof(), "image sequence '{}': frame {} ('{}') cannot be read",
+                 spec_, next_, file);
+      FV_REQUIRE(!out->jpeg.empty(), "image sequence '{}': frame {} ('{}') is empty", spec_, next_,
+                 file);
+    } else {
+      out->bgr = cv::imread(file, cv::IMREAD_COLOR);
+      FV_REQUIRE(!out->bgr.empty(), "image sequence '{}': frame {} ('{}') cannot be read", spec_,
+                 next_, file);
+      FV_REQUIRE(out->bgr.size() == size_,
+                 "image sequence '{}': frame {} ('{}') is {}x{}, the first frame {}x{}", spec_,
+                 next_, file, out->bgr.cols, out->bgr.rows, size_.width, size_.height);
+    }
+    out->frame = next_;
+    out->origin = origin_;
+    if (origin_ == TimeOrigin::kCsv) {
+      const auto it = times_.find(next_);
+      FV_REQUIRE(it != times_.end(), "timestamps '{}' have no row for frame {} of '{}'", csv_,
+                 next_, spec_);
+      out->time_s = it->second;
+    } else {
+      out->time_s = next_ / fps_;
+    }
+    ++next_;
+    return true;
+  }
+  bool SkipFrame() override {
+    if (next_ >= static_cast<long long>(files_.size())) return false;
+    ++next_;
+    return true;
+  }
+  long long FrameCount() const override { return static_cast<long long>(files_.size()); }
+  cv::Size FrameSize() const override { return size_; }
+  std::string name() const override { return spec_; }
+  double fps() const override { return fps_; }
+  bool encoded() const override { return encoded_; }
+
+ private:
+  std::string spec_;
+  std::vector<std::string> files_;
+  double fps_;
+  bool encoded_ = false;
+  TimeOrigin origin_ = TimeOrigin::kFrameRate;
+  std::map<long long, double> times_;
+  std::string csv_;
+  cv::Size size_;
+  long long next_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> OpenImageList(const std::string& spec,
+                                           const FrameSourceOptions& options) {
+  std::vector<std::string> files = ListImageSequence(spec);
+  FV_REQUIRE(!files.empty(), "image sequence '{}' matches no image file", spec);
+  return std::make_unique<ImageListSource>(spec, std::move(files), options);
+}
+
+}  // namespace fv::io_backend
