@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/util/error.h"
@@ -51,6 +52,49 @@ TEST(FrameSource, FileEncodedAndDecodedAgree) {
     ++n;
   }
   EXPECT_EQ(n, 5);
+}
+
+// A glob and a folder of JPEG files: name order, encoded on request (the files' bytes) and
+// decoded alike, times from the given rate; a size check names the camera file.
+TEST(FrameSource, ImageGlobAndFolderEncodedOrNot) {
+  const std::string dir = testing::TempDir() + "/glob";
+  std::filesystem::create_directories(dir);
+  for (int i = 0; i < 4; ++i) {
+    cv::imwrite(fmt::format("{}/f{:02d}.jpg", dir, i),
+                cv::Mat(48, 64, CV_8UC3, cv::Scalar(40 * i, 100, 200 - 40 * i)));
+  }
+  for (const std::string spec : {dir + "/f*.jpg", dir}) {
+    for (const bool encoded : {false, true}) {
+      SCOPED_TRACE(spec + (encoded ? " encoded" : ""));
+      FrameSourceOptions o;
+      o.fps = 20;
+      o.encoded = encoded;
+      auto src = OpenFrameSource(spec, o);
+      EXPECT_EQ(src->FrameCount(), 4);
+      EXPECT_EQ(src->encoded(), encoded);
+      EXPECT_EQ(src->FrameSize(), cv::Size(64, 48));
+      cv::Mat bgr;
+      long long frame = -1;
+      double t = -1;
+      int n = 0;
+      while (src->Read(&bgr, &frame, &t)) {
+        EXPECT_EQ(frame, n);
+        EXPECT_DOUBLE_EQ(t, n / 20.0);
+        EXPECT_NEAR(bgr.at<cv::Vec3b>(10, 10)[0], 40 * n, 4);
+        ++n;
+      }
+      EXPECT_EQ(n, 4);
+      Camera cam = Camera::FromFov(640, 480, 60);
+      try {
+        CheckFrameSize(*src, cam, "cam.yaml");
+        ADD_FAILURE() << "no size error";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("cam.yaml"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("64x48"), std::string::npos) << e.what();
+      }
+    }
+  }
+  EXPECT_THROW(OpenFrameSource(dir + "/none*.png"), Error);
 }
 
 TEST(FrameSource, TruncatedFileFailsAtItsEndEncodedOrNot) {
