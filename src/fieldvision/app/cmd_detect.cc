@@ -38,6 +38,11 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
       ->capture_default_str();
+  cmd->add_option("--small-balls", o->detector.small.mode,
+                  "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "
+                  "camera, where the ball looks that small)")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {

@@ -200,6 +200,7 @@ void BallDetectorOptions::Check() const {
   CheckInRange(grow_factor, 0.0, 1.0, "grow_factor");
   region.Check();
   fit.Check();
+  small.Check();
 }
 
 int BallDetectionResult::accepted() const {
@@ -238,6 +239,26 @@ void BallDetector::Init(const ColourSpec& colour) {
   if (camera_ != nullptr && field_ != nullptr && camera_->has_pose && options_.use_field_mask) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
   }
+  small_balls_ = SmallBallsPossible();
+}
+
+bool BallDetector::SmallBallsPossible() const {
+  const SmallBallOptions& o = options_.small;
+  if (o.mode != "auto") return o.mode == "on";
+  if (camera_ == nullptr || !camera_->has_pose) return false;
+  // Anywhere on a 32 x 24 grid (inside the field mask) where the ball may look that small.
+  for (int j = 0; j < 24; ++j) {
+    for (int i = 0; i < 32; ++i) {
+      const Vector2d uv((i + 0.5) * camera_->width / 32.0, (j + 0.5) * camera_->height / 24.0);
+      if (!field_mask_.empty() && field_mask_.at<uint8_t>(int(uv.y()), int(uv.x())) == 0) continue;
+      double lo = 0, hi = 0;
+      if (ExpectedRadius(uv, &lo, &hi) &&
+          lo * (1 - options_.size_tolerance) - 0.5 <= o.max_radius_px) {
+        return true;
+      }
+    }
+  }
+  return false;
 }
 
 bool BallDetector::ExpectedRadius(const Vector2d& uv, double* min_px, double* max_px) const {
@@ -460,6 +481,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     }
     result.candidates.push_back(cand);
   }
+  if (small_balls_ && result.accepted() == 0) AddSmallBalls(bgr, roi, &result);
   std::stable_sort(result.candidates.begin(), result.candidates.end(),
                    [](const BallCandidate& a, const BallCandidate& b) {
                      if (a.accepted != b.accepted) return a.accepted;
@@ -484,6 +506,31 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
                      return a.score > b.score;
                    });
   return result;
+}
+
+void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
+                                 BallDetectionResult* result) const {
+  const SmallBallOptions& o = options_.small;
+  for (const SmallBall& s : FindSmallBalls(bgr, *table_, ball_bit_, roi, field_mask_, o)) {
+    BallCandidate c;
+    c.centre_px = s.centre_px;
+    c.radius_px = s.radius_px;
+    c.sigma_px = 0.5;
+    c.small = true;
+    c.contrast = s.contrast;
+    // Below every candidate of the blob stages (0.5 at ten times the least contrast).
+    c.score = 0.5 * std::min(1.0, s.contrast / (10 * o.min_contrast));
+    double exp_min = 0, exp_max = 0;
+    if (!ExpectedRadius(s.centre_px, &exp_min, &exp_max)) {
+      c.accepted = o.mode == "on";
+      if (!c.accepted) c.reason = "a small spot, ball size unknown here (small balls: auto)";
+    } else if (exp_min * (1 - options_.size_tolerance) - 0.5 > o.max_radius_px) {
+      c.reason = fmt::format("a small spot where the ball looks larger ({:.1f} px)", exp_min);
+    } else {
+      c.accepted = true;
+    }
+    result->candidates.push_back(c);
+  }
 }
 
 cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m,

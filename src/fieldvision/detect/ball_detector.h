@@ -19,6 +19,7 @@
 #include "fieldvision/detect/ball_region.h"
 #include "fieldvision/detect/blobs.h"
 #include "fieldvision/detect/colour.h"
+#include "fieldvision/detect/small_ball.h"
 #include "fieldvision/field/field.h"
 
 namespace fv {
@@ -51,6 +52,7 @@ struct BallCandidate {
   double region_outside = 0.0;  // convex outline beyond the region's circle
   double region_extent = 0.0;   // the convex outline's far reach, in radii
   bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
+  bool small = false;           // found by the small-ball stage (small_ball.h)
   std::string reason;           // why rejected ("" when accepted)
 };
 
@@ -106,6 +108,8 @@ struct BallDetectorOptions {
   // Weak candidates (see BallCandidate::weak) need at least this share of rays on the circle.
   double weak_min_inlier_fraction = 0.5;
   BallFitOptions fit;
+  // Balls of a few pixels whose colour is mixed with the background (small_ball.h).
+  SmallBallOptions small;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -151,6 +155,12 @@ class BallDetector {
   // "" when `radius` fits the radius limits and the ball's size at `centre` (posed camera);
   // else why not. `size_factor` (0.5..1) prefers the size of a ball on the ground there.
   std::string SizeProblem(const Eigen::Vector2d& centre, double radius, double* size_factor) const;
+  // The small-ball stage's spots in `roi` as candidates (accepted unless the camera expects a
+  // larger ball there).
+  void AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi, BallDetectionResult* result) const;
+  // Whether the small-ball stage runs (options.small.mode; "auto": somewhere in the image a
+  // posed camera expects a ball that small).
+  bool SmallBallsPossible() const;
   BallDetectorOptions options_;
   const Camera* camera_;
   const FieldModel* field_;
@@ -158,6 +168,7 @@ class BallDetector {
   std::shared_ptr<const ColourTable> grow_table_;  // the widened ball class (region growing)
   uint8_t ball_bit_ = 1;
   cv::Mat field_mask_;
+  bool small_balls_ = false;
 };
 
 // The field-of-play mask of a camera: the image of the prism over the field (plus margin) from

@@ -1,0 +1,55 @@
+// Balls of a few pixels: in a small or blurred ball (and after a JPEG's chroma subsampling) no
+// pixel has the ball's colour, every pixel is a mix alpha * ball + (1 - alpha) * background. The
+// colour seen at a spot minus the local background, extended from the background by a factor
+// t >= 1 (alpha = 1 / t), must land in the ball's colour class; the spot must stand out of a
+// uniform background (its difference over the background's spread). Linear mixing model of
+// sub-pixel targets (spectral unmixing, Keshava & Mustard 2002) applied to a 3x3 spot against a
+// box ring 3..5 px away.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "fieldvision/detect/colour.h"
+
+namespace fv {
+
+struct SmallBallOptions {
+  // Looked for only when no other candidate is accepted, and then: "on" anywhere (footage known
+  // to show balls of a few pixels); "auto" only where a posed camera expects the ball at most
+  // max_radius_px (plus the size tolerance) large; "off" (default) never. Off by default because
+  // small spots of the ball's colour are common elsewhere: on the MSL photos "on" adds 33 false
+  // detections for 4 balls, and in the 640x480 kick scene "auto" took a cone's spot in frames
+  // whose ball the tracking window missed (63 positions 0.5 m off instead of 17).
+  std::string mode = "off";
+  // Background: the ring between boxes of these sides around the spot (pixels, odd).
+  int inner_box_px = 7;
+  int outer_box_px = 11;
+  // Extension factors t tried (alpha = 1 / t): 1 is a pure pixel, 3 a ball covering a third.
+  std::vector<double> extensions = {1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0, 4.0};
+  // Least contrast: |spot - background| / (background spread + noise_level), both BGR norms.
+  double min_contrast = 3.0;
+  double noise_level = 10.0;   // added to the background's spread (sensor and JPEG noise)
+  double max_radius_px = 4.0;  // larger balls are the blob stages' (and the expected size's)
+  int max_spots = 4;           // the strongest spots returned
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+struct SmallBall {
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();  // contrast-weighted, sub-pixel
+  double radius_px = 0.0;  // from the ball's share of the pixels around the spot
+  double contrast = 0.0;   // as min_contrast
+  double extension = 1.0;  // the smallest t that reached the ball's class
+};
+
+// Spots in `roi` of `bgr` (inside `mask` where it is not empty; CV_8U, 255 = searched) whose
+// unmixed colour is `table`'s class `bit`, strongest first.
+std::vector<SmallBall> FindSmallBalls(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
+                                      const cv::Rect& roi, const cv::Mat& mask,
+                                      const SmallBallOptions& options);
+
+}  // namespace fv

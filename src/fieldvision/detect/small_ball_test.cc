@@ -1,0 +1,116 @@
+// Balls of 1.5..2.8 px radius on grass, blurred and JPEG-compressed with 4:2:0 chroma (no pixel
+// keeps the ball's colour) are found with their centre and size; plain grass and a white line
+// give nothing; the detector takes them only where small balls are possible (mode).
+#include "fieldvision/detect/small_ball.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
+#include "fieldvision/util/testing.h"
+
+namespace fv {
+namespace {
+
+using Eigen::Vector2d;
+
+cv::Mat Jpeg(const cv::Mat& img, int quality) {
+  std::vector<uchar> buf;
+  cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, quality});
+  return cv::imdecode(buf, cv::IMREAD_COLOR);
+}
+
+TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
+  const uint64_t seed = fv::testing::TestSeed(11);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  const SmallBallOptions o;
+  BallDetectorOptions on;
+  on.small.mode = "on";
+  const BallDetector det(on, nullptr, nullptr);
+  int found = 0, small = 0, trials = 0;
+  std::string misses;
+  for (int trial = 0; trial < 12; ++trial) {
+    cv::Mat img = detect_testing::FieldImage(224, 224, rng);
+    const double r = rng.Uniform(1.6, 2.8);
+    const Vector2d c(rng.Uniform(20, 204), rng.Uniform(20, 204));
+    detect_testing::PaintDisc(img, c, r, detect_testing::kOrange, 0.3);
+    cv::GaussianBlur(img, img, {0, 0}, 0.7);
+    img = Jpeg(img, 75);
+    ++trials;
+    const auto cands = det.Detect(img);
+    if (cands.empty() || !cands.front().accepted) {
+      misses += " r " + std::to_string(r) + ": " + (cands.empty() ? "none" : cands.front().reason);
+      continue;
+    }
+    // Pixel centres are at integer coordinates: the disc painted at c is centred there.
+    const double err = (cands.front().centre_px - c).norm();
+    if (err > 1.0) {
+      misses += " r " + std::to_string(r) + ": " + std::to_string(err) + " px off;";
+      continue;
+    }
+    ++found;
+    small += cands.front().small;
+    EXPECT_NEAR(cands.front().radius_px, r, 0.5 * r + 0.3) << "r " << r;
+  }
+  EXPECT_GE(found, trials - 4) << misses;
+  EXPECT_GT(small, 0);  // the smallest ones only by the small-ball stage
+  // Grass with a white line: nothing of the ball's colour, however it is unmixed.
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat img = detect_testing::FieldImage(224, 224, rng);
+    cv::line(img, {0, 100 + 10 * trial}, {223, 120 + 10 * trial}, cv::Scalar(235, 235, 235), 3,
+             cv::LINE_AA);
+    img = Jpeg(img, 75);
+    EXPECT_TRUE(FindSmallBalls(img, table, table.BallBit(), {0, 0, 224, 224}, {}, o).empty());
+  }
+}
+
+TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
+  const uint64_t seed = fv::testing::TestSeed(12);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  cv::Mat img = detect_testing::FieldImage(224, 224, rng);
+  const Vector2d c(101.3, 80.6);
+  detect_testing::PaintDisc(img, c, 1.6, detect_testing::kOrange, 0.3);
+  img = Jpeg(img, 75);
+  BallDetectorOptions on;
+  on.small.mode = "on";
+  const auto with = BallDetector(on, nullptr, nullptr).Detect(img);
+  ASSERT_FALSE(with.empty());
+  ASSERT_TRUE(with.front().accepted) << with.front().reason;
+  EXPECT_TRUE(with.front().small);
+  EXPECT_LT((with.front().centre_px - c).norm(), 1.0);
+  // auto without a camera (the ball's size unknown) and the default (off): not taken.
+  BallDetectorOptions automatic;
+  automatic.small.mode = "auto";
+  for (const auto& cand : BallDetector(automatic, nullptr, nullptr).Detect(img)) {
+    EXPECT_FALSE(cand.accepted) << cand.reason;
+  }
+  for (const auto& cand : BallDetector(BallDetectorOptions{}, nullptr, nullptr).Detect(img)) {
+    EXPECT_FALSE(cand.accepted) << cand.reason;
+  }
+  BallDetectorOptions off;
+  off.small.mode = "off";
+  EXPECT_TRUE(BallDetector(off, nullptr, nullptr).Detect(img).empty());
+}
+
+TEST(SmallBall, OptionsAreChecked) {
+  SmallBallOptions o;
+  o.mode = "sometimes";
+  EXPECT_THROW(o.Check(), Error);
+  o = SmallBallOptions{};
+  o.inner_box_px = 6;
+  EXPECT_THROW(o.Check(), Error);
+  o = SmallBallOptions{};
+  o.extensions = {0.5};
+  EXPECT_THROW(o.Check(), Error);
+}
+
+}  // namespace
+}  // namespace fv
