@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -72,7 +73,10 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   auto source = VideoSource::Open(o.video);
   if (camera) source->CheckMatchesCamera(*camera, o.camera);
   const BallDetector detector(o.detector, camera ? &*camera : nullptr, field ? &*field : nullptr);
-  CsvWriter csv(o.out, {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
+  // Written beside --out and renamed over it at the end: a failed run leaves the old file.
+  AtomicOutput out_file(o.out);
+  CsvWriter csv(out_file.temp_path(),
+                {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
   cv::VideoWriter writer;
   std::string draw_dir;
   if (!o.draw.empty()) {
@@ -126,6 +130,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   csv.Close();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   FV_REQUIRE(result.frames > 0, "video '{}' has no frames", o.video);
+  out_file.Commit();
   return result;
 }
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/test_images.h"
@@ -116,6 +117,33 @@ TEST(DetectVideo, BadInputGivesOneLineErrorsNamingTheInput) {
   o.detector.colour = empty;
   e = ErrorOf([&] { DetectVideo(o); });
   EXPECT_NE(e.find("empty.json' is empty"), std::string::npos) << e;
+}
+
+// A run that fails half-way (a video cut short) leaves the existing output as it was.
+TEST(DetectVideo, AFailedRunKeepsTheOldOutput) {
+  const std::string dir = fv::testing::TempDir();
+  const std::string video = dir + "/cut.avi";
+  {
+    cv::VideoWriter w(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, {160, 120});
+    ASSERT_TRUE(w.isOpened());
+    for (int i = 0; i < 40; ++i) w.write(cv::Mat(120, 160, CV_8UC3, cv::Scalar(40, 120 + i, 50)));
+  }
+  std::filesystem::resize_file(video, std::filesystem::file_size(video) / 2);
+  const std::string out = dir + "/det.csv";
+  std::ofstream(out) << "kept\n";
+  DetectVideoOptions o;
+  o.video = video;
+  o.out = out;
+  o.progress = false;
+  const std::string e = ErrorOf([&] { DetectVideo(o); });
+  EXPECT_NE(e.find("cut.avi"), std::string::npos) << e;
+  std::ifstream in(out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "kept");
+  for (const auto& f : std::filesystem::directory_iterator(dir)) {
+    EXPECT_EQ(f.path().filename().string().find(".part"), std::string::npos) << f.path();
+  }
 }
 
 }  // namespace
