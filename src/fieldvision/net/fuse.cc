@@ -19,6 +19,7 @@
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -258,7 +259,7 @@ FuseSummary RunFuse(const FuseOptions& o) {
     flight_worker = std::make_unique<FlightWorker>(fopt);
   }
   const std::string tmp = o.out + ".part";
-  CsvWriter csv(tmp, BallCsvHeader(), 6);
+  CsvWriter csv(tmp, BallCsvColumns(), 6);
   auto emit = [&](const SyncedFrame& group) {
     const BallFrame f = fusion.Fuse(group);
     ++summary.groups;

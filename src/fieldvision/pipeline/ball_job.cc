@@ -7,16 +7,11 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/field/field.h"
+#include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
 namespace fv {
-
-const std::vector<std::string>& BallCsvHeader() {
-  static const std::vector<std::string> kHeader = {"frame", "time_s", "x_m",   "y_m",
-                                                   "z_m",   "n_cams", "err_px"};
-  return kHeader;
-}
 
 void BallJobOptions::Check() const {
   FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --video pair");
@@ -111,7 +106,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   // Write to a temporary name, rename at the end: a failed run leaves no half file.
   const std::string tmp = o.out + ".part";
   {
-    CsvWriter csv(tmp, BallCsvHeader(), 6);
+    CsvWriter csv(tmp, BallCsvColumns(), 6);
     result.summary =
         RunBallPipelineTracked(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
           if (!f.result.ok()) return;

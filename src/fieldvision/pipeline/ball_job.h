@@ -48,7 +48,4 @@ Camera ReadRigCamera(const std::string& path);
 // camera starts).
 BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector);
 
-// BALL.csv's columns, as fixed by CONTRACT.md.
-const std::vector<std::string>& BallCsvHeader();
-
 }  // namespace fv

@@ -13,6 +13,7 @@
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
+#include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/util/csv.h"
@@ -364,7 +365,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   res.positions = static_cast<long long>(res.track.size());
   const std::string tmp = o.out + ".part";
   {
-    CsvWriter csv(tmp, BallCsvHeader(), 6);
+    CsvWriter csv(tmp, BallCsvColumns(), 6);
     for (const auto& s : res.track) {
       csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y()
           << s.ball_in_world.z() << s.n_cams << s.err_px;
