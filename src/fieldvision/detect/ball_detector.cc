@@ -141,6 +141,10 @@ std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o,
 
 }  // namespace
 
+double BallDetector::SmallestPlausibleRadius(double expected_min_px) const {
+  return expected_min_px * (1 - options_.size_tolerance) - 0.5;
+}
+
 std::string BallDetector::SizeProblem(const Vector2d& centre, double radius,
                                       double* size_factor) const {
   const BallDetectorOptions& o = options_;
@@ -150,7 +154,7 @@ std::string BallDetector::SizeProblem(const Vector2d& centre, double radius,
   }
   double exp_min = 0, exp_max = 0;
   if (!ExpectedRadius(centre, &exp_min, &exp_max)) return "";
-  const double lo = exp_min * (1 - o.size_tolerance) - 0.5;
+  const double lo = SmallestPlausibleRadius(exp_min);
   const double hi = exp_max * (1 + o.size_tolerance) + 0.5;
   if (radius < lo) return fmt::format("too small for a ball here ({:.1f} < {:.1f} px)", radius, lo);
   if (radius > hi) return fmt::format("too large for a ball here ({:.1f} > {:.1f} px)", radius, hi);
@@ -252,8 +256,7 @@ bool BallDetector::SmallBallsPossible() const {
       const Vector2d uv((i + 0.5) * camera_->width / 32.0, (j + 0.5) * camera_->height / 24.0);
       if (!field_mask_.empty() && field_mask_.at<uint8_t>(int(uv.y()), int(uv.x())) == 0) continue;
       double lo = 0, hi = 0;
-      if (ExpectedRadius(uv, &lo, &hi) &&
-          lo * (1 - options_.size_tolerance) - 0.5 <= o.max_radius_px) {
+      if (ExpectedRadius(uv, &lo, &hi) && SmallestPlausibleRadius(lo) <= o.max_radius_px) {
         return true;
       }
     }
@@ -524,7 +527,7 @@ void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
     if (!ExpectedRadius(s.centre_px, &exp_min, &exp_max)) {
       c.accepted = o.mode == "on";
       if (!c.accepted) c.reason = "a small spot, ball size unknown here (small balls: auto)";
-    } else if (exp_min * (1 - options_.size_tolerance) - 0.5 > o.max_radius_px) {
+    } else if (SmallestPlausibleRadius(exp_min) > o.max_radius_px) {
       c.reason = fmt::format("a small spot where the ball looks larger ({:.1f} px)", exp_min);
     } else {
       c.accepted = true;

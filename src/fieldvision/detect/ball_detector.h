@@ -155,6 +155,9 @@ class BallDetector {
   // "" when `radius` fits the radius limits and the ball's size at `centre` (posed camera);
   // else why not. `size_factor` (0.5..1) prefers the size of a ball on the ground there.
   std::string SizeProblem(const Eigen::Vector2d& centre, double radius, double* size_factor) const;
+  // The smallest radius (pixels) the size check accepts where the ball is expected at least
+  // `expected_min_px` large (size_tolerance and half a pixel of slack).
+  double SmallestPlausibleRadius(double expected_min_px) const;
   // The small-ball stage's spots in `roi` as candidates (accepted unless the camera expects a
   // larger ball there).
   void AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi, BallDetectionResult* result) const;
