@@ -130,21 +130,6 @@ struct DetectionResidual {
   bool integrate_;
 };
 
-// Zero-mean spin prior (as trajectory.h): weak across the flight direction d, tight along it.
-struct SpinPriorResidual {
-  SpinPriorResidual(const Eigen::Vector3d& d, double w_perp, double w_along)
-      : W_(w_perp * (Eigen::Matrix3d::Identity() - d * d.transpose()) +
-           w_along * d * d.transpose()) {}
-  template <typename T>
-  bool operator()(const T* sm, T* r) const {
-    for (int i = 0; i < 3; ++i) {
-      r[i] = T(W_(i, 0)) * sm[0] + T(W_(i, 1)) * sm[1] + T(W_(i, 2)) * sm[2];
-    }
-    return true;
-  }
-  Eigen::Matrix3d W_;
-};
-
 struct Bundled {
   bool ok = false;
   FlightModel kind = FlightModel::kGravity;
@@ -211,8 +196,8 @@ Bundled BundleFlight(const std::vector<Camera>& cameras,
       const double unit = 1.0 / (c_m * 2 * M_PI);
       const Eigen::Vector3d d = Eigen::Vector3d(v0[0], v0[1], v0[2]).normalized();
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<SpinPriorResidual, 3, 3>(new SpinPriorResidual(
-              d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
+          new ceres::AutoDiffCostFunction<SpinPrior, 3, 3>(
+              new SpinPrior(d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
           nullptr, sm);
     } else {
       problem.SetParameterBlockConstant(sm);

@@ -54,24 +54,6 @@ struct SampleResidual {
   bool integrate_;
 };
 
-// Zero-mean prior on the Magnus vector, r = W s with W = w_perp (I - d d^T) + w_along d d^T for
-// the flight direction d: weak across the flight, tighter along it (that spin makes almost no
-// force, so only the prior holds it).
-struct SpinPrior {
-  SpinPrior(const Eigen::Vector3d& dir, double w_perp, double w_along) {
-    W_ = w_perp * (Eigen::Matrix3d::Identity() - dir * dir.transpose()) +
-         w_along * dir * dir.transpose();
-  }
-  template <typename T>
-  bool operator()(const T* sm, T* r) const {
-    for (int i = 0; i < 3; ++i) {
-      r[i] = T(W_(i, 0)) * sm[0] + T(W_(i, 1)) * sm[1] + T(W_(i, 2)) * sm[2];
-    }
-    return true;
-  }
-  Eigen::Matrix3d W_;
-};
-
 // Least-squares line per axis through gravity-corrected positions q = p + (0, 0, g t^2 / 2)
 // (relative to t_ref): q(t) = a + b (t - t_ref). A ballistic arc without drag is a line in q.
 struct GravityLine {

@@ -1,11 +1,14 @@
 // The flight model's equations of motion, templated on the scalar so that Ceres can
 // differentiate them: a = -g z - k |v| v + s x v (gravity, quadratic drag, Magnus lift with the
 // Magnus vector s = c_M w), integrated with classical fourth-order Runge-Kutta in steps of at
-// most kMaxStepS (trajectory.h explains the model).
+// most kMaxStepS (trajectory.h explains the model); and the zero-mean prior on the Magnus
+// vector that every spin fit uses.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+
+#include <Eigen/Core>
 
 namespace fv {
 
@@ -47,5 +50,23 @@ void PropagateFlight(T p[3], T v[3], const T& k, const T s[3], double g, double 
   const double h = dt / n;
   for (int i = 0; i < n; ++i) FlightRk4Step(p, v, k, s, g, h);
 }
+
+// Zero-mean prior on the Magnus vector, r = W s with W = w_perp (I - d d^T) + w_along d d^T for
+// the flight direction d: weak across the flight, tighter along it (that spin makes almost no
+// force, so only the prior holds it).
+struct SpinPrior {
+  SpinPrior(const Eigen::Vector3d& dir, double w_perp, double w_along) {
+    W_ = w_perp * (Eigen::Matrix3d::Identity() - dir * dir.transpose()) +
+         w_along * dir * dir.transpose();
+  }
+  template <typename T>
+  bool operator()(const T* sm, T* r) const {
+    for (int i = 0; i < 3; ++i) {
+      r[i] = T(W_(i, 0)) * sm[0] + T(W_(i, 1)) * sm[1] + T(W_(i, 2)) * sm[2];
+    }
+    return true;
+  }
+  Eigen::Matrix3d W_;
+};
 
 }  // namespace fv
