@@ -84,6 +84,11 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   let dragNow: [number, number] | null = null;
   let found: { u: number; v: number; radius_px: number; accepted: boolean }[] = [];
   let saved = '';
+  // Learn requests sent and answered: a click sends one; only the newest answer is applied (an
+  // older one arriving late would undo a later click), and #col-status's data-learned counts the
+  // answers so a caller can wait for all of them.
+  let learnSent = 0;
+  let learnAnswered = 0;
 
   const rangeFromSliders = (): Range => ({
     space: 'hsv',
@@ -150,15 +155,19 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   async function learn() {
     drawOverlay();
     if (!points.length && !roi) return;
+    const seq = ++learnSent;
     try {
       const r = await api.post<{ range: Range; recall: number; negative_rate: number; positives: number }>('/api/colour/learn', {
         video: video.value, frame: Number(frame.value), points, negative_points: negatives, ...(roi ? { roi } : {}),
       });
+      if (seq !== learnSent) return;
       range = r.range;
       setSliders(r.range);
       status(msg, `learned from ${r.positives} pixels: recall ${(100 * r.recall).toFixed(1)} %, ${(100 * r.negative_rate).toFixed(3)} % of other pixels selected`);
     } catch (e) {
-      status(msg, (e as Error).message, true);
+      if (seq === learnSent) status(msg, (e as Error).message, true);
+    } finally {
+      msg.dataset.learned = String(++learnAnswered);
     }
     drawOverlay();
   }

@@ -184,10 +184,14 @@ try {
   await page.waitForSelector('#col-image[data-ready="1"]');
   const [bu, bv, br] = [Number(f0.u_px), Number(f0.v_px), Number(f0.radius_px)];
   const colourCanvas = page.locator('#col-image');
+  let clicks = 0;
   for (const [du, dv] of [[0, 0], [0.5, 0], [-0.5, 0], [0, 0.5], [0, -0.5]]) {
     await clickPixel(colourCanvas, bu + du * br, bv + dv * br);
-    await page.waitForFunction(() => /learned/.test(document.querySelector('#col-status').textContent));
+    ++clicks;
+    // This click's answer, not an earlier one's (a late answer would overwrite what follows).
+    await page.waitForFunction((n) => Number(document.querySelector('#col-status').dataset.learned) >= n, clicks);
   }
+  check(/learned/.test(await page.textContent('#col-status')), 'colour learned from the clicks');
   const selected = Number(await page.getAttribute('#col-count', 'data-selected'));
   check(selected > 0 && selected < 20 * Math.PI * br * br, `selected pixels shown (${selected} px; ball disc ${(Math.PI * br * br).toFixed(0)} px)`);
   await page.fill('#col-out', 'ball_colour.json');
