@@ -21,10 +21,10 @@ namespace {
 using namespace fv::calib;
 
 struct MultiCli {
-  std::string out, pairing = "auto";
+  std::string out, pairing = "auto", tangential = "auto";
   BoardCli board;
   std::vector<std::string> views, intrinsics;
-  bool fix_intrinsics = false, quiet = false, no_pictures = false;
+  bool fix_intrinsics = false, zero_tangent = false, quiet = false, no_pictures = false;
   MultiOptions o;
 };
 
@@ -33,6 +33,7 @@ void RunMulti(MultiCli& c) {
   c.o.pairing = ParsePairing(c.pairing);
   c.o.progress = !c.quiet;
   c.o.refine_intrinsics = !c.fix_intrinsics;
+  c.o.tangential = c.zero_tangent ? TangentialModel::kZero : ParseTangentialModel(c.tangential);
   std::vector<CameraViews> cams;
   for (const auto& v : c.views) cams.push_back(ParseCameraViews(v));
   for (const auto& k : c.intrinsics) {
@@ -58,6 +59,10 @@ void RunMulti(MultiCli& c) {
             ? std::string("(reference)")
             : fmt::format("{} ({} shared views)", r.camera_reports[rep.tree_parent].name,
                           rep.tree_shared_views));
+  }
+  std::cout << "\ndistortion model:\n";
+  for (const auto& rep : r.camera_reports) {
+    std::cout << fmt::format("  {:<12s} {}\n", rep.name, rep.model);
   }
   std::cout << fmt::format("\n{:<24s} {:>12s} {:>12s} {:>7s}\n", "pair", "rotation_deg",
                            "baseline_mm", "shared");
@@ -130,9 +135,11 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--model", c->o.num_distortion,
                   "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
       ->capture_default_str();
-  cmd->add_flag("--zero-tangent", c->o.zero_tangent,
-                "No tangential distortion (p1 = p2 = 0): lenses without it get better principal "
-                "points and relative rotations");
+  cmd->add_option("--tangential", c->tangential,
+                  "Tangential distortion p1 p2: auto (per camera, kept only where it lowers the "
+                  "reprojection error by more than its 2 parameters cost: BIC), free or zero")
+      ->capture_default_str();
+  cmd->add_flag("--zero-tangent", c->zero_tangent, "The same as --tangential zero");
   cmd->add_option("--loss-px", c->o.loss_px, "Huber scale of the bundle adjustment in pixels")
       ->capture_default_str();
   cmd->add_option("--outlier-factor", c->o.outlier_factor,

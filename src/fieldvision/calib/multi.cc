@@ -19,6 +19,7 @@
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::calib {
@@ -38,12 +39,6 @@ long long LastNumber(const std::string& name) {
   while (begin > 0 && std::isdigit(static_cast<unsigned char>(s[begin - 1]))) --begin;
   if (end - begin > 15) return -1;
   return std::stoll(s.substr(begin, end - begin));
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // Board corner (board frame, metres) -> pixel of camera c through the board's pose in the
@@ -150,6 +145,14 @@ Pairing ParsePairing(const std::string& name) {
   Throw("pairing '{}' is not known; use auto, order or frame", name);
 }
 
+TangentialModel ParseTangentialModel(const std::string& name) {
+  const std::string n = ToLower(name);
+  if (n == "auto") return TangentialModel::kAuto;
+  if (n == "free") return TangentialModel::kFree;
+  if (n == "zero") return TangentialModel::kZero;
+  Throw("tangential model '{}' is not known; use auto, free or zero", name);
+}
+
 void MultiOptions::Check() const {
   board.Check();
   detect.Check();
@@ -183,6 +186,7 @@ std::string MultiResult::Summary() const {
       s += fmt::format("; fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}", cam->fx, cam->fy, cam->cx,
                        cam->cy);
     }
+    if (!c.model.empty()) s += "; distortion " + c.model;
     if (c.tree_parent >= 0) {
       s += fmt::format("; chained from {} ({} shared views)", camera_reports[c.tree_parent].name,
                        c.tree_shared_views);
@@ -342,30 +346,32 @@ std::vector<MultiFrame> PairViews(const std::vector<CameraDetections>& cameras, 
   return by_order();
 }
 
-MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
-                                     const std::vector<MultiFrame>& frames,
-                                     const MultiOptions& options, const std::string& pairing) {
-  options.Check();
+namespace {  // The stages of CalibrateMultiFromFrames.
+
+constexpr int kP1 = 4 + 2, kP2 = 4 + 3;  // p1 p2 in the intrinsics block (OpenCV order)
+
+void CheckFrames(const std::vector<std::string>& names, const std::vector<MultiFrame>& frames) {
   const int nc = static_cast<int>(names.size());
   FV_REQUIRE(nc >= 2, "a rig needs at least 2 cameras (got {})", nc);
-  {
-    std::set<std::string> unique(names.begin(), names.end());
-    FV_REQUIRE(static_cast<int>(unique.size()) == nc,
-               "two cameras have the same name; give each --views a different NAME");
-  }
-  const int nf = static_cast<int>(frames.size());
+  const std::set<std::string> unique(names.begin(), names.end());
+  FV_REQUIRE(static_cast<int>(unique.size()) == nc,
+             "two cameras have the same name; give each --views a different NAME");
   for (const auto& f : frames) {
     FV_REQUIRE(static_cast<int>(f.views.size()) == nc, "moment {} has {} views for {} cameras",
                f.key, f.views.size(), nc);
   }
-  MultiResult result;
-  result.pairing = pairing.empty() ? "paired by moment" : pairing;
+}
 
-  // ---- Intrinsics per camera.
+// Each camera's intrinsics: the known ones, or its own calibrateCamera fit of its views.
+std::vector<Camera> InitialIntrinsics(const std::vector<std::string>& names,
+                                      const std::vector<MultiFrame>& frames,
+                                      const MultiOptions& options,
+                                      std::vector<MultiCameraReport>* reports) {
+  const int nc = static_cast<int>(names.size());
   std::vector<Camera> cams(nc);
-  result.camera_reports.resize(nc);
+  reports->resize(nc);
   for (int c = 0; c < nc; ++c) {
-    auto& rep = result.camera_reports[c];
+    auto& rep = (*reports)[c];
     rep.name = names[c];
     std::vector<BoardView> found;
     for (const auto& f : frames) {
@@ -400,7 +406,7 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
     io.board = options.board;
     io.detect = options.detect;
     io.num_distortion = options.num_distortion;
-    io.zero_tangent = options.zero_tangent;
+    io.zero_tangent = options.tangential == TangentialModel::kZero;
     io.min_views = options.min_views;
     io.progress = false;
     io.camera_name = names[c];
@@ -413,62 +419,76 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
     }
     cams[c].notes.clear();
   }
+  return cams;
+}
 
-  // ---- Board pose in every view.
-  std::vector<std::vector<ViewPose>> pose(nc, std::vector<ViewPose>(nf));
-  for (int c = 0; c < nc; ++c) {
-    for (int f = 0; f < nf; ++f) {
+using PoseGrid = std::vector<std::vector<ViewPose>>;  // [camera][frame]
+
+PoseGrid BoardPoses(const std::vector<Camera>& cams, const std::vector<MultiFrame>& frames) {
+  PoseGrid pose(cams.size(), std::vector<ViewPose>(frames.size()));
+  for (size_t c = 0; c < cams.size(); ++c) {
+    for (size_t f = 0; f < frames.size(); ++f) {
       const BoardView& v = frames[f].views[c];
       if (!v.image_points.empty()) pose[c][f] = BoardPose(cams[c], v);
     }
   }
+  return pose;
+}
 
-  // ---- Relative pose of each linked pair: the shared view whose relative pose best transfers
-  // the board from camera a to camera b in all shared views.
-  struct Edge {
-    int shared = 0;
-    Rigid3d b_from_a;
-  };
-  auto relative = [&](int a, int b) {
-    Edge e;
-    std::vector<int> shared;
-    for (int f = 0; f < nf; ++f) {
-      if (pose[a][f].ok && pose[b][f].ok) shared.push_back(f);
+struct Edge {
+  int shared = 0;
+  Rigid3d b_from_a;
+};
+
+// The relative pose of cameras a and b: of the candidates their shared views give, the one that
+// best transfers the board from a to b in all shared views.
+Edge RelativePose(int a, int b, const std::vector<Camera>& cams,
+                  const std::vector<MultiFrame>& frames, const PoseGrid& pose) {
+  Edge e;
+  std::vector<int> shared;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (pose[a][f].ok && pose[b][f].ok) shared.push_back(static_cast<int>(f));
+  }
+  e.shared = static_cast<int>(shared.size());
+  double best = 1e300;
+  for (int f : shared) {
+    const Rigid3d cand = pose[b][f].cam_from_board * pose[a][f].cam_from_board.Inverse();
+    double score = 0;
+    for (int g : shared) {
+      bool in_front = true;
+      const auto proj = ProjectBoard(cams[b], cand * pose[a][g].cam_from_board,
+                                     frames[g].views[b].object_points, &in_front);
+      score += in_front ? std::min(RmsBetween(proj, frames[g].views[b].image_points), 50.0) : 50.0;
     }
-    e.shared = static_cast<int>(shared.size());
-    double best = 1e300;
-    for (int f : shared) {
-      const Rigid3d cand = pose[b][f].cam_from_board * pose[a][f].cam_from_board.Inverse();
-      double score = 0;
-      for (int g : shared) {
-        bool in_front = true;
-        const auto proj = ProjectBoard(cams[b], cand * pose[a][g].cam_from_board,
-                                       frames[g].views[b].object_points, &in_front);
-        score +=
-            in_front ? std::min(RmsBetween(proj, frames[g].views[b].image_points), 50.0) : 50.0;
-      }
-      if (score < best) {
-        best = score;
-        e.b_from_a = cand;
-      }
+    if (score < best) {
+      best = score;
+      e.b_from_a = cand;
     }
-    return e;
-  };
+  }
+  return e;
+}
+
+// Camera poses in the first camera's frame, chained through a maximum spanning tree (Prim) of
+// shared-view counts. Throws naming a camera that shares too few views with the others.
+std::vector<Rigid3d> ChainCameras(const std::vector<std::string>& names,
+                                  const std::vector<MultiFrame>& frames,
+                                  const std::vector<Camera>& cams, const PoseGrid& pose,
+                                  const MultiOptions& options,
+                                  std::vector<MultiCameraReport>* reports) {
+  const int nc = static_cast<int>(names.size());
   std::vector<std::vector<Edge>> edges(nc, std::vector<Edge>(nc));
   for (int a = 0; a < nc; ++a) {
     for (int b = 0; b < nc; ++b) {
-      if (a != b) edges[a][b] = relative(a, b);
+      if (a != b) edges[a][b] = RelativePose(a, b, cams, frames, pose);
     }
   }
-  // Maximum spanning tree (Prim) from the first camera.
   std::vector<bool> in_tree(nc, false);
   std::vector<Rigid3d> cam_from_ref(nc);
   in_tree[0] = true;
   for (int added = 1; added < nc; ++added) {
     int best_a = -1, best_b = -1, best_shared = 0;
     for (int a = 0; a < nc; ++a) {
-      if (!in_tree[a]) continue;
-      for (int b = 0; b < nc; ++b) {
+      for (int b = 0; in_tree[a] && b < nc; ++b) {
         if (in_tree[b] || edges[a][b].shared < options.min_shared_views) continue;
         if (edges[a][b].shared > best_shared) {
           best_shared = edges[a][b].shared;
@@ -477,38 +497,70 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
         }
       }
     }
-    if (best_b < 0) {
-      for (int b = 0; b < nc; ++b) {
-        if (in_tree[b]) continue;
-        std::string counts;
-        for (int a = 0; a < nc; ++a) {
-          if (a != b)
-            counts +=
-                fmt::format("{}{} {}", counts.empty() ? "" : ", ", names[a], edges[a][b].shared);
+    for (int b = 0; best_b < 0 && b < nc; ++b) {
+      if (in_tree[b]) continue;
+      std::string counts;
+      for (int a = 0; a < nc; ++a) {
+        if (a != b) {
+          counts +=
+              fmt::format("{}{} {}", counts.empty() ? "" : ", ", names[a], edges[a][b].shared);
         }
-        Throw(
-            "camera '{}' never sees the board together with the rest of the rig (views shared "
-            "with: {}; {} needed): add moments where '{}' and another camera both see the whole "
-            "board, or check that the views pair up (--pairing)",
-            names[b], counts, options.min_shared_views, names[b]);
       }
+      Throw(
+          "camera '{}' never sees the board together with the rest of the rig (views shared "
+          "with: {}; {} needed): add moments where '{}' and another camera both see the whole "
+          "board, or check that the views pair up (--pairing)",
+          names[b], counts, options.min_shared_views, names[b]);
     }
     in_tree[best_b] = true;
     cam_from_ref[best_b] = edges[best_a][best_b].b_from_a * cam_from_ref[best_a];
-    result.camera_reports[best_b].tree_parent = best_a;
-    result.camera_reports[best_b].tree_shared_views = best_shared;
+    (*reports)[best_b].tree_parent = best_a;
+    (*reports)[best_b].tree_shared_views = best_shared;
   }
+  return cam_from_ref;
+}
 
-  // ---- Parameters: intrinsics, camera poses (the first fixed), board poses.
-  std::vector<std::array<double, kNumIntrinsics>> intr(nc);
-  std::vector<Eigen::Vector3d> cam_r(nc), cam_t(nc);
-  for (int c = 0; c < nc; ++c) {
-    intr[c] = cams[c].IntrinsicsBlock();
-    cam_r[c] = cam_from_ref[c].Rvec();
-    cam_t[c] = cam_from_ref[c].translation;
+// The bundle adjustment's parameters and the views it uses.
+struct RigState {
+  std::vector<std::array<double, kNumIntrinsics>> intr;
+  std::vector<int> num_distortion;
+  std::vector<bool> fixed;                        // intrinsics kept constant
+  std::vector<bool> tangential;                   // p1 p2 free (else zero)
+  std::vector<Eigen::Vector3d> cam_r, cam_t;      // cam_from_ref
+  std::vector<Eigen::Vector3d> board_r, board_t;  // ref_from_board per moment
+  std::vector<bool> board_ok;
+  std::vector<std::vector<bool>> used;  // [camera][frame]
+  std::vector<std::vector<std::string>> dropped_because;
+  int nc() const { return static_cast<int>(intr.size()); }
+  int nf() const { return static_cast<int>(board_ok.size()); }
+  int NumUsedViews() const {
+    int n = 0;
+    for (const auto& row : used) n += static_cast<int>(std::count(row.begin(), row.end(), true));
+    return n;
   }
-  std::vector<Eigen::Vector3d> board_r(nf), board_t(nf);
-  std::vector<bool> board_ok(nf, false);
+};
+
+// The start of the adjustment: each board placed from the camera that sees it best.
+RigState StartState(const std::vector<std::string>& names, const std::vector<MultiFrame>& frames,
+                    const std::vector<Camera>& cams, const std::vector<Rigid3d>& cam_from_ref,
+                    const PoseGrid& pose, const MultiOptions& options) {
+  const int nc = static_cast<int>(cams.size()), nf = static_cast<int>(frames.size());
+  RigState s;
+  s.intr.resize(nc);
+  s.cam_r.resize(nc);
+  s.cam_t.resize(nc);
+  for (int c = 0; c < nc; ++c) {
+    s.intr[c] = cams[c].IntrinsicsBlock();
+    s.num_distortion.push_back(static_cast<int>(cams[c].distortion.size()));
+    s.fixed.push_back(!options.refine_intrinsics || options.known_intrinsics.count(names[c]) > 0);
+    s.tangential.push_back(s.fixed[c] || options.tangential == TangentialModel::kFree);
+    if (!s.tangential[c]) s.intr[c][kP1] = s.intr[c][kP2] = 0.0;
+    s.cam_r[c] = cam_from_ref[c].Rvec();
+    s.cam_t[c] = cam_from_ref[c].translation;
+  }
+  s.board_r.resize(nf);
+  s.board_t.resize(nf);
+  s.board_ok.assign(nf, false);
   for (int f = 0; f < nf; ++f) {
     int best = -1;
     for (int c = 0; c < nc; ++c) {
@@ -516,145 +568,249 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
     }
     if (best < 0) continue;
     const Rigid3d ref_from_board = cam_from_ref[best].Inverse() * pose[best][f].cam_from_board;
-    board_r[f] = ref_from_board.Rvec();
-    board_t[f] = ref_from_board.translation;
-    board_ok[f] = true;
+    s.board_r[f] = ref_from_board.Rvec();
+    s.board_t[f] = ref_from_board.translation;
+    s.board_ok[f] = true;
   }
-  // Views in the adjustment: every view with a board pose start.
-  std::vector<std::vector<bool>> used(nc, std::vector<bool>(nf, false));
-  int total_views = 0;
+  s.used.assign(nc, std::vector<bool>(nf, false));
+  s.dropped_because.assign(nc, std::vector<std::string>(nf));
   for (int c = 0; c < nc; ++c) {
     for (int f = 0; f < nf; ++f) {
-      used[c][f] = board_ok[f] && !frames[f].views[c].image_points.empty();
-      total_views += used[c][f] ? 1 : 0;
+      s.used[c][f] = s.board_ok[f] && !frames[f].views[c].image_points.empty();
     }
   }
-  std::vector<std::vector<std::string>> dropped_because(nc, std::vector<std::string>(nf));
+  return s;
+}
 
-  auto view_errors = [&](int c, int f) {
-    const BoardView& v = frames[f].views[c];
-    std::vector<float> err(v.image_points.size(), 1e6f);
-    for (size_t k = 0; k < v.image_points.size(); ++k) {
-      BoardCornerCost cost(v.image_points[k], v.object_points[k]);
-      double res[2];
-      if (cost(intr[c].data(), cam_r[c].data(), cam_t[c].data(), board_r[f].data(),
-               board_t[f].data(), res)) {
-        err[k] = static_cast<float>(std::hypot(res[0], res[1]));
+// Per-corner reprojection error of camera c's view of moment f.
+std::vector<float> ViewErrors(const RigState& s, const std::vector<MultiFrame>& frames, int c,
+                              int f) {
+  const BoardView& v = frames[f].views[c];
+  std::vector<float> err(v.image_points.size(), 1e6f);
+  for (size_t k = 0; k < v.image_points.size(); ++k) {
+    const BoardCornerCost cost(v.image_points[k], v.object_points[k]);
+    double res[2];
+    if (cost(s.intr[c].data(), s.cam_r[c].data(), s.cam_t[c].data(), s.board_r[f].data(),
+             s.board_t[f].data(), res)) {
+      err[k] = static_cast<float>(std::hypot(res[0], res[1]));
+    }
+  }
+  return err;
+}
+
+double RmsOf(const std::vector<float>& err) {
+  double sq = 0;
+  for (float e : err) sq += static_cast<double>(e) * e;
+  return err.empty() ? 0.0 : std::sqrt(sq / err.size());
+}
+
+// Sum of squared corner errors (px^2) over camera c's used views; *num_residuals: 2 per corner.
+double CameraSse(const RigState& s, const std::vector<MultiFrame>& frames, int c,
+                 long long* num_residuals) {
+  double sq = 0;
+  *num_residuals = 0;
+  for (int f = 0; f < s.nf(); ++f) {
+    if (!s.used[c][f]) continue;
+    for (float e : ViewErrors(s, frames, c, f)) sq += static_cast<double>(e) * e;
+    *num_residuals += 2 * static_cast<long long>(frames[f].views[c].image_points.size());
+  }
+  return sq;
+}
+
+// One Ceres solve of every used view (Huber loss), the first camera's pose fixed.
+void SolveRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOptions& options,
+              MultiResult* result) {
+  ceres::Problem problem;
+  for (int c = 0; c < s->nc(); ++c) {
+    for (int f = 0; f < s->nf(); ++f) {
+      if (!s->used[c][f]) continue;
+      const BoardView& v = frames[f].views[c];
+      for (size_t k = 0; k < v.image_points.size(); ++k) {
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<BoardCornerCost, 2, kNumIntrinsics, 3, 3, 3, 3>(
+                new BoardCornerCost(v.image_points[k], v.object_points[k])),
+            new ceres::HuberLoss(options.loss_px), s->intr[c].data(), s->cam_r[c].data(),
+            s->cam_t[c].data(), s->board_r[f].data(), s->board_t[f].data());
       }
     }
-    return err;
-  };
-  auto view_rms = [&](const std::vector<float>& err) {
-    double sq = 0;
-    for (float e : err) sq += static_cast<double>(e) * e;
-    return err.empty() ? 0.0 : std::sqrt(sq / err.size());
-  };
+  }
+  for (int c = 0; c < s->nc(); ++c) {
+    if (!problem.HasParameterBlock(s->intr[c].data())) continue;
+    if (s->fixed[c]) {
+      problem.SetParameterBlockConstant(s->intr[c].data());
+      continue;
+    }
+    std::vector<int> constant;
+    if (!s->tangential[c]) constant = {kP1, kP2};
+    for (int i = 4 + s->num_distortion[c]; i < kNumIntrinsics; ++i) constant.push_back(i);
+    if (!constant.empty()) {
+      problem.SetManifold(s->intr[c].data(), new ceres::SubsetManifold(kNumIntrinsics, constant));
+    }
+  }
+  if (problem.HasParameterBlock(s->cam_r[0].data())) {
+    problem.SetParameterBlockConstant(s->cam_r[0].data());
+    problem.SetParameterBlockConstant(s->cam_t[0].data());
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_SCHUR;
+  so.max_num_iterations = options.max_iterations;
+  so.num_threads = 1;
+  so.logging_type = ceres::SILENT;
+  so.function_tolerance = 1e-10;
+  so.parameter_tolerance = 1e-10;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  FV_REQUIRE(summary.IsSolutionUsable(), "the rig's bundle adjustment failed: {}", summary.message);
+  if (result->num_adjustments == 0) result->initial_cost = summary.initial_cost;
+  ++result->num_adjustments;
+  result->iterations += static_cast<int>(summary.iterations.size());
+  result->final_cost = summary.final_cost;
+}
 
-  const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * total_views));
-  int dropped_total = 0;
+// Drops the worst views above the threshold (outlier_factor x median view RMS, outlier_min_px),
+// keeping every camera calibrated and linked; at most max_drop in all. Returns how many now.
+int DropOutlierViews(RigState* s, const std::vector<MultiFrame>& frames,
+                     const MultiOptions& options, int max_drop, int* dropped_total) {
+  std::vector<double> rms_all;
+  std::vector<std::tuple<double, int, int>> candidates;
+  for (int c = 0; c < s->nc(); ++c) {
+    for (int f = 0; f < s->nf(); ++f) {
+      if (!s->used[c][f]) continue;
+      const double r = RmsOf(ViewErrors(*s, frames, c, f));
+      rms_all.push_back(r);
+      candidates.emplace_back(r, c, f);
+    }
+  }
+  const double med = Median(rms_all);
+  const double threshold = std::max(options.outlier_factor * med, options.outlier_min_px);
+  std::sort(candidates.rbegin(), candidates.rend());
+  int dropped_now = 0;
+  for (const auto& [r, c, f] : candidates) {
+    if (r <= threshold || *dropped_total >= max_drop) break;
+    int views_left = 0, shared_left = 0;
+    for (int g = 0; g < s->nf(); ++g) {
+      if (!s->used[c][g] || g == f) continue;
+      ++views_left;
+      for (int o = 0; o < s->nc(); ++o) {
+        if (o != c && s->used[o][g]) {
+          ++shared_left;
+          break;
+        }
+      }
+    }
+    if (views_left < options.min_views || shared_left < 1) continue;
+    s->used[c][f] = false;
+    s->dropped_because[c][f] =
+        fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})", r, threshold,
+                    options.outlier_factor, med);
+    ++*dropped_total;
+    ++dropped_now;
+  }
+  return dropped_now;
+}
+
+// Bundle adjustments alternating with outlier-view drops, at most 4 rounds.
+void AdjustRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOptions& options,
+               int max_drop, int* dropped_total, MultiResult* result) {
   for (int round = 0; round < 4; ++round) {
-    ceres::Problem problem;
-    std::vector<bool> frame_in(nf, false);
-    for (int c = 0; c < nc; ++c) {
-      for (int f = 0; f < nf; ++f) {
-        if (!used[c][f]) continue;
-        frame_in[f] = true;
-        const BoardView& v = frames[f].views[c];
-        for (size_t k = 0; k < v.image_points.size(); ++k) {
-          problem.AddResidualBlock(
-              new ceres::AutoDiffCostFunction<BoardCornerCost, 2, kNumIntrinsics, 3, 3, 3, 3>(
-                  new BoardCornerCost(v.image_points[k], v.object_points[k])),
-              new ceres::HuberLoss(options.loss_px), intr[c].data(), cam_r[c].data(),
-              cam_t[c].data(), board_r[f].data(), board_t[f].data());
-        }
-      }
-    }
-    for (int c = 0; c < nc; ++c) {
-      if (!problem.HasParameterBlock(intr[c].data())) continue;
-      const bool fixed = !options.refine_intrinsics || options.known_intrinsics.count(names[c]);
-      const int nd = fixed ? 0 : static_cast<int>(cams[c].distortion.size());
-      if (fixed) {
-        problem.SetParameterBlockConstant(intr[c].data());
-      } else if (nd < kNumDistortion || options.zero_tangent) {
-        std::vector<int> constant;
-        if (options.zero_tangent) constant = {4 + 2, 4 + 3};  // p1, p2 (OpenCV order)
-        for (int i = 4 + nd; i < kNumIntrinsics; ++i) constant.push_back(i);
-        problem.SetManifold(intr[c].data(), new ceres::SubsetManifold(kNumIntrinsics, constant));
-      }
-    }
-    if (problem.HasParameterBlock(cam_r[0].data())) {
-      problem.SetParameterBlockConstant(cam_r[0].data());
-      problem.SetParameterBlockConstant(cam_t[0].data());
-    }
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_SCHUR;
-    so.max_num_iterations = options.max_iterations;
-    so.num_threads = 1;
-    so.logging_type = ceres::SILENT;
-    so.function_tolerance = 1e-10;
-    so.parameter_tolerance = 1e-10;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    FV_REQUIRE(summary.IsSolutionUsable(), "the rig's bundle adjustment failed: {}",
-               summary.message);
-    ++result.num_adjustments;
-    result.iterations += static_cast<int>(summary.iterations.size());
-    if (round == 0) result.initial_cost = summary.initial_cost;
-    result.final_cost = summary.final_cost;
-
-    // Outlier views: the worst above the threshold, keeping every camera calibrated and linked.
-    std::vector<double> rms_all;
-    std::vector<std::tuple<double, int, int>> candidates;
-    for (int c = 0; c < nc; ++c) {
-      for (int f = 0; f < nf; ++f) {
-        if (!used[c][f]) continue;
-        const double r = view_rms(view_errors(c, f));
-        rms_all.push_back(r);
-        candidates.emplace_back(r, c, f);
-      }
-    }
-    const double med = Median(rms_all);
-    const double threshold = std::max(options.outlier_factor * med, options.outlier_min_px);
-    std::sort(candidates.rbegin(), candidates.rend());
-    int dropped_now = 0;
-    for (const auto& [r, c, f] : candidates) {
-      if (r <= threshold || dropped_total >= max_drop) break;
-      int views_left = 0, shared_left = 0;
-      for (int g = 0; g < nf; ++g) {
-        if (!used[c][g] || g == f) continue;
-        ++views_left;
-        for (int o = 0; o < nc; ++o) {
-          if (o != c && used[o][g]) {
-            ++shared_left;
-            break;
-          }
-        }
-      }
-      if (views_left < options.min_views || shared_left < 1) continue;
-      used[c][f] = false;
-      dropped_because[c][f] = fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})",
-                                          r, threshold, options.outlier_factor, med);
-      ++dropped_total;
-      ++dropped_now;
-    }
-    if (dropped_now == 0) break;
+    SolveRig(s, frames, options, result);
+    if (DropOutlierViews(s, frames, options, max_drop, dropped_total) == 0) break;
   }
+}
 
-  // ---- Results.
-  result.cameras.resize(nc);
+std::string ModelName(int num_distortion, bool tangential) {
+  static const char* kNames[] = {"k1", "k2", "p1", "p2", "k3", "k4",   "k5",
+                                 "k6", "s1", "s2", "s3", "s4", "tauX", "tauY"};
+  std::string s;
+  for (int i = 0; i < num_distortion; ++i) {
+    if (!tangential && (i == 2 || i == 3)) continue;
+    s += fmt::format("{}{}", s.empty() ? "" : " ", kNames[i]);
+  }
+  return s;
+}
+
+double RigSse(const RigState& s, const std::vector<MultiFrame>& frames, long long* num_residuals) {
+  double sse = 0;
+  *num_residuals = 0;
+  for (int c = 0; c < s.nc(); ++c) {
+    long long n = 0;
+    sse += CameraSse(s, frames, c, &n);
+    *num_residuals += n;
+  }
+  return sse;
+}
+
+// TangentialModel::kAuto, from the rig fitted without p1 p2 (*s): forward selection. Each camera
+// still without them is tried with them (the whole rig fitted again); the one that lowers the
+// rig's squared error most keeps them if TangentialPays, and the others are tried again given it.
+// One camera's lens error moves the shared board poses and so every camera's residuals: freeing
+// all cameras at once would credit the others with its gain.
+void ChooseTangential(RigState* s, const std::vector<MultiFrame>& frames,
+                      const MultiOptions& options, MultiResult* result) {
+  for (;;) {
+    long long n = 0, n_c = 0;
+    const double sse0 = RigSse(*s, frames, &n);
+    int best = -1;
+    double best_gain = 0;
+    RigState best_state;
+    for (int c = 0; c < s->nc(); ++c) {
+      if (s->fixed[c] || s->tangential[c]) continue;
+      RigState trial = *s;
+      trial.tangential[c] = true;
+      SolveRig(&trial, frames, options, result);
+      long long n1 = 0;
+      auto& rep = result->camera_reports[c];
+      TangentialPays(sse0, RigSse(trial, frames, &n1), n, &rep.tangential_bic);
+      rep.rms_without_tangential_px = std::sqrt(2 * CameraSse(*s, frames, c, &n_c) / n_c);
+      rep.rms_with_tangential_px = std::sqrt(2 * CameraSse(trial, frames, c, &n_c) / n_c);
+      if (rep.tangential_bic > best_gain) {
+        best = c;
+        best_gain = rep.tangential_bic;
+        best_state = std::move(trial);
+      }
+    }
+    if (best < 0) return;
+    *s = std::move(best_state);
+  }
+}
+
+// Per camera: the model kept and why.
+void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult* result) {
+  for (int c = 0; c < s.nc(); ++c) {
+    auto& rep = result->camera_reports[c];
+    rep.tangential = s.tangential[c];
+    const std::string name = ModelName(s.num_distortion[c], s.tangential[c]);
+    if (s.fixed[c]) {
+      rep.model = name + " (intrinsics fixed)";
+    } else if (options.tangential != TangentialModel::kAuto) {
+      rep.model = name + (s.tangential[c] ? " (--tangential free)" : " (--tangential zero)");
+    } else {
+      rep.model =
+          fmt::format("{} (p1 p2 {}: rms {:.4f} px without, {:.4f} px with, BIC gain {:.1f})", name,
+                      s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
+                      rep.rms_with_tangential_px, rep.tangential_bic);
+    }
+  }
+}
+
+// Cameras, views and per-camera RMS of the final state.
+void CollectCameras(const std::vector<std::string>& names, const std::vector<MultiFrame>& frames,
+                    const std::vector<Camera>& cams, const RigState& s, const MultiOptions& options,
+                    MultiResult* result) {
+  const int nc = s.nc(), nf = s.nf();
+  result->cameras.resize(nc);
   double sq_all = 0;
   long long n_all = 0;
   for (int c = 0; c < nc; ++c) {
-    Camera& cam = result.cameras[c];
+    Camera& cam = result->cameras[c];
     cam = cams[c];
     cam.name = names[c];
-    cam.SetIntrinsicsBlock(intr[c], static_cast<int>(cams[c].distortion.size()));
+    cam.SetIntrinsicsBlock(s.intr[c], s.num_distortion[c]);
     cam.has_pose = true;
-    cam.cam_from_world = Rigid3d::FromRvecTvec(cam_r[c], cam_t[c]);
-    if (c == 0) cam.cam_from_world = Rigid3d();
+    cam.cam_from_world = c == 0 ? Rigid3d() : Rigid3d::FromRvecTvec(s.cam_r[c], s.cam_t[c]);
     double sq = 0;
     long long n = 0;
-    auto& rep = result.camera_reports[c];
+    auto& rep = result->camera_reports[c];
     for (int f = 0; f < nf; ++f) {
       const BoardView& v = frames[f].views[c];
       if (v.image_points.empty()) continue;
@@ -665,15 +821,15 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
       vr.image_points = v.image_points;
       vr.object_points = v.object_points;
       vr.corner_ids = v.corner_ids;
-      vr.used = used[c][f];
-      if (board_ok[f]) {
-        vr.err_px = view_errors(c, f);
-        vr.rms_px = view_rms(vr.err_px);
+      vr.used = s.used[c][f];
+      if (s.board_ok[f]) {
+        vr.err_px = ViewErrors(s, frames, c, f);
+        vr.rms_px = RmsOf(vr.err_px);
       } else {
         vr.err_px.assign(v.image_points.size(), 0.0f);
         vr.dropped_because = "no board pose (the board could not be placed in this view)";
       }
-      if (!dropped_because[c][f].empty()) vr.dropped_because = dropped_because[c][f];
+      if (!s.dropped_because[c][f].empty()) vr.dropped_because = s.dropped_because[c][f];
       if (vr.used) {
         ++rep.num_used;
         for (float e : vr.err_px) {
@@ -681,116 +837,169 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
           ++n;
         }
       }
-      result.views.push_back(std::move(vr));
+      result->views.push_back(std::move(vr));
     }
     rep.rms_px = n ? std::sqrt(sq / n) : 0.0;
     sq_all += sq;
     n_all += n;
     cam.rms_px = rep.rms_px;
     cam.notes["board"] = options.board.Describe();
+    cam.notes["distortion_model"] = rep.model;
     cam.notes["rig_reference"] = names[0];
     cam.notes["rig_pose"] = "x_cam = R x_ref + t, ref = camera " + names[0];
     cam.notes["num_views"] = std::to_string(rep.num_used);
   }
-  result.rms_px = n_all ? std::sqrt(sq_all / n_all) : 0.0;
+  result->rms_px = n_all ? std::sqrt(sq_all / n_all) : 0.0;
   for (int f = 0; f < nf; ++f) {
     for (int c = 0; c < nc; ++c) {
-      if (used[c][f]) {
-        ++result.num_frames;
+      if (s.used[c][f]) {
+        ++result->num_frames;
         break;
       }
     }
   }
-  for (int i = 0; i < nc; ++i) {
-    for (int j = i + 1; j < nc; ++j) {
+}
+
+// OpenCV's stereoCalibrate on the corners both cameras see in their shared used views, each
+// camera's own calibrateCamera fit as the start, p1 p2 zero where neither camera kept them.
+void CompareWithOpenCv(const std::vector<MultiFrame>& frames, const std::vector<Camera>& cams,
+                       const RigState& s, const MultiResult& result, MultiPairReport* p) {
+  const int i = p->i, j = p->j;
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> img_i, img_j;
+  for (int f = 0; f < s.nf(); ++f) {
+    if (!(s.used[i][f] && s.used[j][f])) continue;
+    const BoardView& vi = frames[f].views[i];
+    const BoardView& vj = frames[f].views[j];
+    std::map<int, size_t> in_j;
+    for (size_t k = 0; k < vj.corner_ids.size(); ++k) in_j[vj.corner_ids[k]] = k;
+    std::vector<cv::Point3f> o;
+    std::vector<cv::Point2f> pi, pj;
+    for (size_t k = 0; k < vi.corner_ids.size(); ++k) {
+      const auto it = in_j.find(vi.corner_ids[k]);
+      if (it == in_j.end()) continue;
+      o.push_back(vi.object_points[k]);
+      pi.push_back(vi.image_points[k]);
+      pj.push_back(vj.image_points[it->second]);
+    }
+    if (o.size() < 6) continue;
+    obj.push_back(o);
+    img_i.push_back(pi);
+    img_j.push_back(pj);
+  }
+  if (obj.size() < 3) return;
+  const bool zero_tangent = !s.tangential[i] && !s.tangential[j];
+  auto k_of = [](const Camera& c) {
+    return cv::Mat(cv::Matx33d(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1));
+  };
+  auto d_of = [&](const Camera& c) {
+    cv::Mat d = c.distortion.empty() ? cv::Mat(cv::Mat::zeros(1, 5, CV_64F))
+                                     : cv::Mat(c.distortion, true).reshape(1, 1);
+    if (zero_tangent) d.at<double>(2) = d.at<double>(3) = 0.0;
+    return d;
+  };
+  cv::Mat rot, t, e, fm;
+  try {
+    cv::Mat ki = k_of(cams[i]), kj = k_of(cams[j]), di = d_of(cams[i]), dj = d_of(cams[j]);
+    p->opencv_rms_px = cv::stereoCalibrate(
+        obj, img_i, img_j, ki, di, kj, dj, cv::Size(cams[i].width, cams[i].height), rot, t, e, fm,
+        cv::CALIB_USE_INTRINSIC_GUESS | (zero_tangent ? cv::CALIB_ZERO_TANGENT_DIST : 0));
+  } catch (const cv::Exception&) {
+    return;
+  }
+  Eigen::Matrix3d r;
+  for (int u = 0; u < 3; ++u) {
+    for (int v = 0; v < 3; ++v) r(u, v) = rot.at<double>(u, v);
+  }
+  const Camera& a = result.cameras[i];
+  const Camera& b = result.cameras[j];
+  p->has_opencv = true;
+  p->opencv_rotation_deg = RotationAngleBetween(r, Eigen::Matrix3d::Identity()) * kRadToDeg;
+  p->opencv_baseline_m = cv::norm(t);
+  p->opencv_rotation_diff_deg =
+      RotationAngleBetween(r, b.cam_from_world.rotation * a.cam_from_world.rotation.transpose()) *
+      kRadToDeg;
+}
+
+// Rotation, baseline and shared views of every camera pair (and OpenCV's, when asked).
+void CollectPairs(const std::vector<MultiFrame>& frames, const std::vector<Camera>& cams,
+                  const RigState& s, const MultiOptions& options, MultiResult* result) {
+  for (int i = 0; i < s.nc(); ++i) {
+    for (int j = i + 1; j < s.nc(); ++j) {
       MultiPairReport p;
       p.i = i;
       p.j = j;
-      for (int f = 0; f < nf; ++f) p.shared_views += used[i][f] && used[j][f] ? 1 : 0;
-      const Camera& a = result.cameras[i];
-      const Camera& b = result.cameras[j];
+      for (int f = 0; f < s.nf(); ++f) p.shared_views += s.used[i][f] && s.used[j][f] ? 1 : 0;
+      const Camera& a = result->cameras[i];
+      const Camera& b = result->cameras[j];
       p.rotation_deg =
           RotationAngleBetween(b.cam_from_world.rotation * a.cam_from_world.rotation.transpose(),
                                Eigen::Matrix3d::Identity()) *
           kRadToDeg;
       p.baseline_m = (a.CentreInWorld() - b.CentreInWorld()).norm();
       if (options.compare_opencv && p.shared_views >= 3) {
-        // The same corners of the views both cameras use (a corner seen by both).
-        std::vector<std::vector<cv::Point3f>> obj;
-        std::vector<std::vector<cv::Point2f>> img_i, img_j;
-        for (int f = 0; f < nf; ++f) {
-          if (!(used[i][f] && used[j][f])) continue;
-          const BoardView& vi = frames[f].views[i];
-          const BoardView& vj = frames[f].views[j];
-          std::map<int, size_t> in_j;
-          for (size_t k = 0; k < vj.corner_ids.size(); ++k) in_j[vj.corner_ids[k]] = k;
-          std::vector<cv::Point3f> o;
-          std::vector<cv::Point2f> pi, pj;
-          for (size_t k = 0; k < vi.corner_ids.size(); ++k) {
-            const auto it = in_j.find(vi.corner_ids[k]);
-            if (it == in_j.end()) continue;
-            o.push_back(vi.object_points[k]);
-            pi.push_back(vi.image_points[k]);
-            pj.push_back(vj.image_points[it->second]);
-          }
-          if (o.size() < 6) continue;
-          obj.push_back(o);
-          img_i.push_back(pi);
-          img_j.push_back(pj);
-        }
-        auto k_of = [](const Camera& c) {
-          return cv::Mat(cv::Matx33d(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1));
-        };
-        auto d_of = [](const Camera& c) {
-          return c.distortion.empty() ? cv::Mat(cv::Mat::zeros(1, 5, CV_64F))
-                                      : cv::Mat(c.distortion, true).reshape(1, 1);
-        };
-        cv::Mat rot, t, e, fm;
-        try {
-          cv::Mat ki = k_of(cams[i]), kj = k_of(cams[j]), di = d_of(cams[i]), dj = d_of(cams[j]);
-          if (obj.size() >= 3) {
-            p.opencv_rms_px =
-                cv::stereoCalibrate(obj, img_i, img_j, ki, di, kj, dj,
-                                    cv::Size(cams[i].width, cams[i].height), rot, t, e, fm,
-                                    cv::CALIB_USE_INTRINSIC_GUESS |
-                                        (options.zero_tangent ? cv::CALIB_ZERO_TANGENT_DIST : 0));
-            Eigen::Matrix3d r;
-            for (int u = 0; u < 3; ++u) {
-              for (int v = 0; v < 3; ++v) r(u, v) = rot.at<double>(u, v);
-            }
-            p.has_opencv = true;
-            p.opencv_rotation_deg =
-                RotationAngleBetween(r, Eigen::Matrix3d::Identity()) * kRadToDeg;
-            p.opencv_baseline_m = cv::norm(t);
-            p.opencv_rotation_diff_deg =
-                RotationAngleBetween(
-                    r, b.cam_from_world.rotation * a.cam_from_world.rotation.transpose()) *
-                kRadToDeg;
-          }
-        } catch (const cv::Exception&) {
-          p.has_opencv = false;
-        }
+        CompareWithOpenCv(frames, cams, s, *result, &p);
       }
-      result.pairs.push_back(p);
+      result->pairs.push_back(p);
     }
   }
-  for (int c = 0; c < nc; ++c) {
-    const auto& rep = result.camera_reports[c];
+}
+
+void AddWarnings(int dropped_total, int max_drop, MultiResult* result) {
+  for (const auto& rep : result->camera_reports) {
     if (rep.num_used < 8) {
-      result.warnings.push_back(fmt::format(
+      result->warnings.push_back(fmt::format(
           "camera '{}': only {} views; 10 or more spread over its image pin its intrinsics down",
           rep.name, rep.num_used));
     }
     if (rep.rms_px > 1.0) {
-      result.warnings.push_back(fmt::format(
+      result->warnings.push_back(fmt::format(
           "camera '{}': rms {:.2f} px is high (blur, a bent board or unsynchronized views?)",
           rep.name, rep.rms_px));
     }
   }
   if (dropped_total > 0 && dropped_total >= max_drop) {
-    result.warnings.push_back(
+    result->warnings.push_back(
         fmt::format("{} views were dropped as outliers (the most allowed)", dropped_total));
   }
+}
+
+}  // namespace
+
+bool TangentialPays(double sse_without, double sse_with, long long num_residuals,
+                    double* bic_gain) {
+  double gain = -1e300;
+  if (num_residuals > 2 && sse_with > 0 && sse_without > 0) {
+    const double n = static_cast<double>(num_residuals);
+    gain = n * std::log(sse_without / sse_with) - 2.0 * std::log(n);
+  }
+  if (bic_gain) *bic_gain = gain;
+  return gain > 0;
+}
+
+MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
+                                     const std::vector<MultiFrame>& frames,
+                                     const MultiOptions& options, const std::string& pairing) {
+  options.Check();
+  CheckFrames(names, frames);
+  MultiResult result;
+  result.pairing = pairing.empty() ? "paired by moment" : pairing;
+  const std::vector<Camera> cams =
+      InitialIntrinsics(names, frames, options, &result.camera_reports);
+  const PoseGrid pose = BoardPoses(cams, frames);
+  const std::vector<Rigid3d> cam_from_ref =
+      ChainCameras(names, frames, cams, pose, options, &result.camera_reports);
+  RigState state = StartState(names, frames, cams, cam_from_ref, pose, options);
+  const int max_drop =
+      static_cast<int>(std::floor(options.max_drop_fraction * state.NumUsedViews()));
+  int dropped_total = 0;
+  AdjustRig(&state, frames, options, max_drop, &dropped_total, &result);
+  if (options.tangential == TangentialModel::kAuto)
+    ChooseTangential(&state, frames, options, &result);
+  DescribeModels(state, options, &result);
+  CollectCameras(names, frames, cams, state, options, &result);
+  CollectPairs(frames, cams, state, options, &result);
+  AddWarnings(dropped_total, max_drop, &result);
   return result;
 }
 

@@ -34,16 +34,28 @@ CameraViews ParseCameraViews(const std::string& arg);
 enum class Pairing { kAuto, kOrder, kFrameNumber };
 Pairing ParsePairing(const std::string& name);
 
+// Tangential distortion (p1 p2) in the rig's fit: chosen per camera, always fitted, or zero.
+enum class TangentialModel { kAuto, kFree, kZero };
+TangentialModel ParseTangentialModel(const std::string& name);
+
+// Whether fitting one camera's p1 p2 lowers the sum of squared corner residuals (px^2) enough for
+// 2 more parameters: the Bayesian information criterion, n ln(sse_without / sse_with) > 2 ln n,
+// n the number of residuals (2 per corner). Its value is returned in *bic_gain when given.
+bool TangentialPays(double sse_without, double sse_with, long long num_residuals,
+                    double* bic_gain = nullptr);
+
 struct MultiOptions {
   BoardSpec board;
   DetectOptions detect;
   ImageSourceOptions source;
   Pairing pairing = Pairing::kAuto;
   int num_distortion = 5;  // 4, 5, 8, 12 or 14 OpenCV coefficients per camera
-  // p1 = p2 = 0: cameras without tangential distortion (most). Fitting p1 p2 when a lens has
-  // none costs principal-point accuracy (they trade off against it), and with it the relative
-  // rotations (1 px of principal point is about 1/f rad of rotation).
-  bool zero_tangent = false;
+  // Tangential distortion p1 p2 per camera. Fitting them when a lens has none costs
+  // principal-point accuracy (they trade off against it), and with it the relative rotations
+  // (1 px of principal point is about 1/f rad of rotation). kAuto fits the rig without them, then
+  // frees them one camera at a time, the camera that lowers the rig's error most first, while
+  // they pay for their 2 parameters (TangentialPays on the whole rig's residuals).
+  TangentialModel tangential = TangentialModel::kAuto;
   bool refine_intrinsics = true;  // intrinsics free in the bundle adjustment
   // Cameras whose intrinsics are known (by name): kept fixed, not calibrated again.
   std::map<std::string, Camera> known_intrinsics;
@@ -103,6 +115,11 @@ struct MultiCameraReport {
   double rms_px = 0.0;      // joint fit, used views
   int tree_parent = -1;     // camera it was chained from (-1: the reference)
   int tree_shared_views = 0;
+  // The distortion model kept: "k1 k2 p1 p2 k3" and why ("fixed", "--tangential zero", or the
+  // camera's RMS without and with p1 p2 and the rig's BIC gain of the automatic choice).
+  bool tangential = false;
+  std::string model;
+  double rms_without_tangential_px = 0.0, rms_with_tangential_px = 0.0, tangential_bic = 0.0;
 };
 
 struct MultiPairReport {

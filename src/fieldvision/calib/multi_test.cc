@@ -123,7 +123,7 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   o.board = {BoardType::kChessboard, 9, 7, 0.07};
   o.progress = false;
   o.num_distortion = 4;
-  o.zero_tangent = true;  // the truth's model: k1 k2
+  // The default: p1 p2 kept only where they pay (the truth has none).
   std::vector<MultiFrame> frames;
   for (int f = 0; f < 40; ++f) {
     const Rigid3d world_from_board = RandomBoardPose(o.board, rng, 0.3, 40);
@@ -161,8 +161,14 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
       cmp.max_rotation_diff_deg, 100 * worst_baseline, r.rms_px);
   // The relative rotations are as good as the principal points (1 px is 0.05 deg at this
   // focal length). Fitting p1 p2 too, which these lenses do not have, leaves the principal points
-  // 0.3-1.3 px off and the rotations 0.03-0.13 deg (below); the true model k1 k2: within 0.03
-  // deg over seeds 1-5. With the true intrinsics: far within 0.05 deg (below).
+  // 0.3-1.3 px off and the rotations 0.03-0.13 deg (below); the automatic choice leaves them out
+  // (the true model k1 k2): within 0.04 deg over seeds 1-8. With the true intrinsics: far within
+  // 0.05 deg (below).
+  for (const auto& rep : r.camera_reports) {
+    EXPECT_FALSE(rep.tangential) << rep.name << ": " << rep.model;
+    EXPECT_LT(rep.tangential_bic, 0.0) << rep.name << ": " << rep.model;
+    EXPECT_NE(rep.model.find("left out"), std::string::npos) << rep.model;
+  }
   EXPECT_LT(cmp.max_rotation_diff_deg, 0.05) << cmp.Summary() << "\n" << r.Summary();
   EXPECT_LT(worst_baseline, 0.002) << cmp.Summary();
   for (size_t c = 0; c < truth.size(); ++c) {
@@ -187,12 +193,13 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
                            cmp_known.max_rotation_diff_deg);
   EXPECT_LT(cmp_known.max_rotation_diff_deg, 0.02) << cmp_known.Summary();
   MultiOptions tangent = o;
-  tangent.zero_tangent = false;
+  tangent.tangential = TangentialModel::kFree;
   const MultiResult rt = CalibrateMultiFromFrames(Names(truth), frames, tangent);
   const RigComparison cmp_tangent = CompareRigs(rt.cameras, truth);
   std::cout << fmt::format("fitting p1 p2 too: relative rotations within {:.4f} deg\n",
                            cmp_tangent.max_rotation_diff_deg);
   EXPECT_LT(cmp_tangent.max_rotation_diff_deg, 0.15) << cmp_tangent.Summary();
+  EXPECT_TRUE(rt.camera_reports[0].tangential);
   for (const auto& c : r.cameras) {
     EXPECT_EQ(c.distortion[2], 0.0);
     EXPECT_EQ(c.distortion[3], 0.0);
@@ -211,6 +218,57 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   size_t expected = 1;
   for (const auto& v : r.views) expected += v.image_points.size();
   EXPECT_EQ(static_cast<size_t>(rows), expected);
+}
+
+// A rig where one lens has tangential distortion: the automatic choice keeps p1 p2 for that camera
+// only, and the relative poses stay within 0.05 deg and 0.2 %.
+TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
+  const uint64_t seed = fv::testing::TestSeed(66);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  auto truth = ArcRig(3, 1.6, 80, 1280, 720, 60, rng);
+  truth[1].distortion[2] = 1.5e-3;  // p1, p2: a decentred lens (0.5-1.5 px at the edges)
+  truth[1].distortion[3] = -1.0e-3;
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 9, 7, 0.07};
+  o.progress = false;
+  o.num_distortion = 4;
+  std::vector<MultiFrame> frames;
+  for (int f = 0; f < 30; ++f) {
+    const Rigid3d world_from_board = RandomBoardPose(o.board, rng, 0.3, 40);
+    MultiFrame m;
+    m.key = fmt::format("frame {}", f);
+    for (const auto& c : truth) {
+      m.views.push_back(
+          ProjectView(c, o.board, world_from_board, 0.12, rng, c.name + fmt::format("_{}", f)));
+    }
+    frames.push_back(m);
+  }
+  const MultiResult r = CalibrateMultiFromFrames(Names(truth), frames, o);
+  EXPECT_FALSE(r.camera_reports[0].tangential) << r.Summary();
+  EXPECT_TRUE(r.camera_reports[1].tangential) << r.Summary();
+  EXPECT_FALSE(r.camera_reports[2].tangential) << r.Summary();
+  EXPECT_NEAR(r.cameras[1].distortion[2], 1.5e-3, 3e-4) << r.Summary();
+  EXPECT_EQ(r.cameras[0].distortion[2], 0.0);
+  EXPECT_NE(r.Summary().find("p1 p2 kept"), std::string::npos) << r.Summary();
+  const RigComparison cmp = CompareRigs(r.cameras, truth);
+  double worst_baseline = 0;
+  for (const auto& p : cmp.pairs) {
+    worst_baseline = std::max(worst_baseline, std::abs(p.baseline_diff_mm) / p.baseline_b_mm);
+  }
+  std::cout << fmt::format(
+      "rig with one decentred lens: relative rotations within {:.4f} deg, baselines within {:.4f} "
+      "%\n",
+      cmp.max_rotation_diff_deg, 100 * worst_baseline);
+  EXPECT_LT(cmp.max_rotation_diff_deg, 0.05) << cmp.Summary() << "\n" << r.Summary();
+  EXPECT_LT(worst_baseline, 0.002) << cmp.Summary();
+  // The statistic itself: 2 parameters must lower n ln(SSE) by more than 2 ln n.
+  double gain = 0;
+  EXPECT_FALSE(TangentialPays(100.0, 99.9, 10000, &gain));
+  EXPECT_LT(gain, 0.0);
+  EXPECT_TRUE(TangentialPays(100.0, 99.0, 10000, &gain));
+  EXPECT_NEAR(gain, 10000 * std::log(100.0 / 99.0) - 2 * std::log(10000.0), 1e-9);
+  EXPECT_FALSE(TangentialPays(0.0, 0.0, 10000));
 }
 
 // Rendered pictures through folders, paired by frame number (a right image missing, a moment
