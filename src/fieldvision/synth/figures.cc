@@ -119,7 +119,37 @@ Body PersonBody(const PersonSpec& person, const TeamSpec& team, double time_s) {
   return b;
 }
 
-Body RobotBody(const RobotSpec& robot, int index, double time_s) {
+namespace {
+
+// The handler's geometry: forward and lateral unit vectors, arm radius and the arms' height above
+// the ball centre and lateral offset (the arms touch the ball from above its sides).
+struct HandlerFrame {
+  Eigen::Vector3d forward, lateral;
+  double arm_radius_m = 0.035;
+  double arm_dz_m, arm_dy_m;
+};
+
+HandlerFrame MakeHandlerFrame(const RobotSpec& robot, double ball_radius_m) {
+  HandlerFrame h;
+  const double a = robot.heading_deg * M_PI / 180;
+  h.forward = Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+  h.lateral = Eigen::Vector3d(-std::sin(a), std::cos(a), 0);
+  h.arm_dz_m = 0.3 * ball_radius_m;
+  const double touch = ball_radius_m + h.arm_radius_m;
+  h.arm_dy_m = std::sqrt(touch * touch - h.arm_dz_m * h.arm_dz_m);
+  return h;
+}
+
+}  // namespace
+
+Eigen::Vector3d HeldBallCentre(const RobotSpec& robot, double ball_radius_m, double time_s) {
+  const PathState ps = PathAt(robot.path, time_s);
+  const HandlerFrame h = MakeHandlerFrame(robot, ball_radius_m);
+  return Eigen::Vector3d(ps.position_m.x(), ps.position_m.y(), ball_radius_m) +
+         (robot.radius_m + 0.7 * ball_radius_m) * h.forward;
+}
+
+Body RobotBody(const RobotSpec& robot, int index, double time_s, double ball_radius_m) {
   const PathState ps = PathAt(robot.path, time_s);
   Body b;
   b.id = -1 - index;
@@ -134,6 +164,22 @@ Body RobotBody(const RobotSpec& robot, int index, double time_s) {
   const Eigen::Vector3d r(robot.radius_m, robot.radius_m, 0);
   b.box_min = Eigen::Vector3d(c.centre_m.x(), c.centre_m.y(), 0) - r;
   b.box_max = Eigen::Vector3d(c.centre_m.x(), c.centre_m.y(), robot.height_m) + r;
+  if (robot.handler) {
+    const HandlerFrame h = MakeHandlerFrame(robot, ball_radius_m);
+    const Eigen::Vector3d ball = HeldBallCentre(robot, ball_radius_m, time_s);
+    const Eigen::Vector3d arm_bgr = 0.8 * robot.colour_bgr;
+    for (int side = -1; side <= 1; side += 2) {
+      const Eigen::Vector3d off =
+          side * h.arm_dy_m * h.lateral + h.arm_dz_m * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d a =
+          ball + off - (0.7 * ball_radius_m + 0.3 * robot.radius_m) * h.forward;
+      const Eigen::Vector3d e = ball + off + 0.35 * ball_radius_m * h.forward;
+      b.capsules.push_back({a, e, h.arm_radius_m, arm_bgr, arm_bgr, 1.0, false});
+      const Eigen::Vector3d rr = Eigen::Vector3d::Constant(h.arm_radius_m);
+      b.box_min = b.box_min.cwiseMin(a - rr).cwiseMin(e - rr);
+      b.box_max = b.box_max.cwiseMax(a + rr).cwiseMax(e + rr);
+    }
+  }
   return b;
 }
 

@@ -56,7 +56,10 @@ struct Hit {
 };
 
 Body PersonBody(const PersonSpec& person, const TeamSpec& team, double time_s);
-Body RobotBody(const RobotSpec& robot, int index, double time_s);
+// A robot; with a handler its two arms are sized for a ball of ball_radius_m.
+Body RobotBody(const RobotSpec& robot, int index, double time_s, double ball_radius_m = 0.11);
+// Where a robot's handler holds a ball of that radius (centre, world).
+Eigen::Vector3d HeldBallCentre(const RobotSpec& robot, double ball_radius_m, double time_s);
 
 // Nearest intersection of the ray (origin, unit direction) with a body (t > t_min).
 Hit IntersectBody(const Body& body, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,

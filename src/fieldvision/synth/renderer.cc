@@ -7,6 +7,7 @@
 #include <ceres/jet.h>
 #include <fmt/format.h>
 
+#include "fieldvision/geometry/rigid.h"
 #include "fieldvision/synth/ball_physics.h"
 #include "fieldvision/synth/figures.h"
 #include "fieldvision/synth/synth.h"
@@ -24,6 +25,12 @@ struct SceneRenderer::CameraData {
   std::vector<uint8_t> ground;       // 1 where the background is the ground (takes shadows)
   std::vector<float> vignette;       // brightness factor per pixel
   double pixel_angle = 0.0;          // radians per pixel near the centre
+};
+
+// One sub-exposure position of the ball: centre and turn (body to world).
+struct BallSample {
+  Eigen::Vector3d centre;
+  Eigen::Matrix3d orientation;
 };
 
 namespace {
@@ -59,6 +66,13 @@ double ValueNoise(double x, double y, uint32_t salt = 0) {
 }
 
 Vec3 Clamp255(const Vec3& c) { return c.cwiseMax(0.0).cwiseMin(255.0); }
+
+// Brightness factor of a surface at cos(angle to the light) ndl: the fixed shading (base + slope
+// max(0, ndl)) or, with an ambient share, ambient + (1 - ambient) max(0, ndl).
+double Lambert(const LightingSpec& l, double ndl, double base, double slope) {
+  const double lit = std::max(0.0, ndl);
+  return l.ambient >= 0 ? l.ambient + (1 - l.ambient) * lit : base + slope * lit;
+}
 
 Camera MakeCamera(const CameraSpec& s, int index) {
   Camera c;
@@ -165,6 +179,7 @@ struct StaticWorld {
   double stripe_w = 1.5;
   bool grass = true;
   Vec3 light;
+  const LightingSpec* lighting = nullptr;
   // Coarse top-view map of the signed distance to paint (for skipping far pixels).
   double map_res = 0.05;
   int map_w = 0, map_h = 0;
@@ -243,7 +258,7 @@ struct StaticWorld {
     return Vec3(225, 210, 195) * (1 - e) + Vec3(235, 190, 150) * e;
   }
 
-  double Shade(const Vec3& n) const { return 0.55 + 0.5 * std::max(0.0, n.dot(light)); }
+  double Shade(const Vec3& n) const { return Lambert(*lighting, n.dot(light), 0.55, 0.5); }
 };
 
 StaticWorld MakeStaticWorld(const FieldModel& f, const SceneSpec& spec) {
@@ -253,7 +268,8 @@ StaticWorld MakeStaticWorld(const FieldModel& f, const SceneSpec& spec) {
   w.hw = f.HalfWidthWithSurround();
   w.grass = f.surface == "grass";
   w.stripe_w = f.length_m / std::clamp(std::round(f.length_m / 1.5), 6.0, 24.0);
-  w.light = spec.lighting.light_dir.normalized();
+  w.light = spec.lighting.Direction();
+  w.lighting = &spec.lighting;
   w.map_w = static_cast<int>(std::ceil(2 * w.hl / w.map_res)) + 1;
   w.map_h = static_cast<int>(std::ceil(2 * w.hw / w.map_res)) + 1;
   w.paint_map.resize(static_cast<size_t>(w.map_w) * w.map_h);
@@ -526,6 +542,9 @@ SceneRenderer::~SceneRenderer() = default;
 
 Eigen::Vector3d SceneRenderer::BallAt(double time_s) const {
   FV_REQUIRE(spec_.ball.enabled, "BallAt: the scene has no ball");
+  if (spec_.ball.held_by >= 0) {
+    return HeldBallCentre(spec_.robots[spec_.ball.held_by], spec_.ball.radius_m(), time_s);
+  }
   if (!spec_.ball.placements.empty()) {
     const long frame = std::lround(std::floor(time_s * spec_.fps + 0.5));
     const long idx = std::clamp<long>(frame / spec_.ball.hold_frames, 0,
@@ -533,6 +552,53 @@ Eigen::Vector3d SceneRenderer::BallAt(double time_s) const {
     return spec_.ball.placements[idx];
   }
   return trajectory_->PositionAt(time_s);
+}
+
+Eigen::Matrix3d SceneRenderer::BallOrientation(double time_s) const {
+  const BallSpec& ball = spec_.ball;
+  Eigen::Matrix3d r = RotationFromRvec(ball.orientation_rvec);
+  if (!ball.placements.empty()) {
+    // A seeded turn per placement, so that each shows another side of the print.
+    const long frame = std::lround(std::floor(time_s * spec_.fps + 0.5));
+    const long idx = std::clamp<long>(frame / ball.hold_frames, 0,
+                                      static_cast<long>(ball.placements.size()) - 1);
+    uint64_t state = spec_.seed * 0xD1B54A32D192ED03ULL + static_cast<uint64_t>(idx);
+    const double z = 2.0 * (SplitMix(state) >> 11) * 0x1.0p-53 - 1.0;
+    const double az = 2 * M_PI * (SplitMix(state) >> 11) * 0x1.0p-53;
+    const double angle = M_PI * (SplitMix(state) >> 11) * 0x1.0p-53;
+    const double rho = std::sqrt(std::max(0.0, 1 - z * z));
+    return RotationFromRvec(angle * Vec3(rho * std::cos(az), rho * std::sin(az), z)) * r;
+  }
+  // Kicks: each spins the ball from its time until the next kick.
+  std::vector<KickSpec> kicks = ball.kicks;
+  std::stable_sort(kicks.begin(), kicks.end(),
+                   [](const KickSpec& a, const KickSpec& b) { return a.time_s < b.time_s; });
+  for (size_t k = 0; k < kicks.size() && kicks[k].time_s < time_s; ++k) {
+    const double end = k + 1 < kicks.size() ? std::min(time_s, kicks[k + 1].time_s) : time_s;
+    r = RotationFromRvec(kicks[k].spin_radps * (end - kicks[k].time_s)) * r;
+  }
+  return r;
+}
+
+std::vector<BallSample> SceneRenderer::BallSamples(int camera, double t) const {
+  const Camera& cam = cameras_[camera];
+  const bool patterned = spec_.ball.pattern != "none";
+  // Sub-exposure samples: about one per half pixel of image motion.
+  const double e = spec_.exposure_s;
+  int K = 1;
+  if (e > 0) {
+    const auto p0 = cam.Project(BallAt(t - 0.5 * e));
+    const auto p1 = cam.Project(BallAt(t + 0.5 * e));
+    if (p0 && p1) {
+      K = std::clamp(static_cast<int>(std::ceil((*p1 - *p0).norm() / 0.5)) + 1, 1, 48);
+    }
+  }
+  std::vector<BallSample> out;
+  for (int k = 0; k < K; ++k) {
+    const double tk = K == 1 ? t : t + e * ((k + 0.5) / K - 0.5);
+    out.push_back({BallAt(tk), patterned ? BallOrientation(tk) : Eigen::Matrix3d::Identity()});
+  }
+  return out;
 }
 
 const std::vector<Flight>& SceneRenderer::Flights() const {
@@ -562,113 +628,203 @@ CameraFrameStats SceneRenderer::CameraTruth(int camera, int frame) const {
   return s;
 }
 
-cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* stats,
-                                      bool want_image) const {
-  FV_REQUIRE(camera >= 0 && camera < static_cast<int>(data_.size()),
-             "camera index {} out of range (0..{})", camera, data_.size() - 1);
-  FV_REQUIRE(frame >= 0, "frame {} must be >= 0", frame);
-  const CameraData& cd = *data_[camera];
-  const Camera& cam = cd.cam;
-  const int w = cam.width, h = cam.height;
-  const Vec3 o = cd.origin;
-  const double t = FrameTime(frame);
-  const Vec3 light = spec_.lighting.light_dir.normalized();
-  cv::Mat img = cd.bg.clone();
-  cv::Mat depth = cd.depth.clone();
-  auto ray = [&](int u, int v) -> Vec3 {
-    return cd.ray[static_cast<size_t>(v) * w + u].cast<double>();
-  };
+namespace {
 
-  // Bodies: people, then robots.
-  std::vector<Body> bodies;
-  for (const auto& p : spec_.people) bodies.push_back(PersonBody(p, spec_.teams[p.team], t));
-  for (size_t i = 0; i < spec_.robots.size(); ++i) {
-    bodies.push_back(RobotBody(spec_.robots[i], static_cast<int>(i), t));
+// The 12 pentagons of a classic football (truncated icosahedron): per pentagon its centre and the
+// 5 outward edge normals in the gnomonic plane at the centre; inradius there (tangent units).
+struct Pentagons {
+  std::array<Vec3, 12> centre;
+  std::array<std::array<Vec3, 5>, 12> edge;
+  double inradius = 0;
+  double cos_reach = 0;  // points with x . centre below this are outside
+};
+
+const Pentagons& FootballPentagons() {
+  static const Pentagons p = [] {
+    Pentagons out;
+    const double phi = 0.5 * (1 + std::sqrt(5.0));
+    int k = 0;
+    for (int s1 = -1; s1 <= 1; s1 += 2) {
+      for (int s2 = -1; s2 <= 1; s2 += 2) {
+        out.centre[k++] = Vec3(0, s1, s2 * phi).normalized();
+        out.centre[k++] = Vec3(s1, s2 * phi, 0).normalized();
+        out.centre[k++] = Vec3(s2 * phi, 0, s1).normalized();
+      }
+    }
+    // Pentagon vertices point at the neighbouring icosahedron vertices; angular circumradius of
+    // the truncated icosahedron's pentagons: asin(0.8507 / 2.4782).
+    const double rho = std::asin(0.85065 / 2.47802);
+    out.inradius = std::tan(rho) * std::cos(M_PI / 5);
+    out.cos_reach = std::cos(rho) - 1e-3;
+    const double nb = 1.0 / std::sqrt(5.0);  // cos of the icosahedron's edge angle
+    for (int i = 0; i < 12; ++i) {
+      const Vec3& c = out.centre[i];
+      auto tangent = [&](const Vec3& n) { return (n / n.dot(c) - c).normalized(); };
+      std::vector<int> ns;
+      for (int j = 0; j < 12; ++j) {
+        if (j != i && std::abs(out.centre[j].dot(c) - nb) < 1e-6) ns.push_back(j);
+      }
+      int e = 0;
+      for (size_t a = 0; a < ns.size(); ++a) {
+        for (size_t b = a + 1; b < ns.size(); ++b) {
+          if (std::abs(out.centre[ns[a]].dot(out.centre[ns[b]]) - nb) > 1e-6) continue;
+          out.edge[i][e++ % 5] =
+              (tangent(out.centre[ns[a]]) + tangent(out.centre[ns[b]])).normalized();
+        }
+      }
+    }
+    return out;
+  }();
+  return p;
+}
+
+// Share of the pattern's print at a point x (unit vector in the ball's frame); px: a pixel's
+// angular size on the ball (radians), for a soft, anti-aliased edge.
+double PatternCover(const std::string& pattern, const Vec3& x, double px) {
+  double sd = 1.0;  // signed distance to the print (radians, negative inside)
+  if (pattern == "pentagons") {
+    const Pentagons& p = FootballPentagons();
+    for (int i = 0; i < 12; ++i) {
+      const double cd = x.dot(p.centre[i]);
+      if (cd < p.cos_reach - 0.1) continue;
+      const Vec3 q = x / cd - p.centre[i];
+      double d = -kInf;
+      for (const Vec3& m : p.edge[i]) d = std::max(d, q.dot(m) - p.inradius);
+      sd = std::min(sd, d);
+    }
+  } else if (pattern == "print") {
+    // Three wavy bands around tilted axes.
+    static const std::array<Vec3, 3> kAxes = {Vec3(0.2, 0.1, 1.0).normalized(),
+                                              Vec3(1.0, -0.3, 0.15).normalized(),
+                                              Vec3(-0.25, 1.0, 0.35).normalized()};
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& a = kAxes[k];
+      const Vec3 e1 = a.cross(k == 0 ? Vec3::UnitX() : Vec3::UnitZ()).normalized();
+      const Vec3 e2 = a.cross(e1);
+      const double lon = std::atan2(x.dot(e2), x.dot(e1));
+      const double lat = std::asin(std::clamp(x.dot(a), -1.0, 1.0));
+      sd = std::min(sd, std::abs(lat + 0.2 * std::sin(3 * lon + k)) - 0.085);
+    }
+  } else {
+    return 0.0;
   }
-  const bool has_ball = spec_.ball.enabled;
-  const double r_ball = spec_.ball.radius_m();
-  const Vec3 ball_mid = has_ball ? BallAt(t) : Vec3::Zero();
+  return std::clamp(0.5 - sd / std::max(px, 1e-6), 0.0, 1.0);
+}
 
-  // Shadows on the ground (hard for bodies, soft-edged for the ball).
-  if (want_image && spec_.lighting.shadows) {
-    std::vector<uint8_t> shadowed;
-    auto shade_box = [&](const Vec3& lo, const Vec3& hi, auto&& occlusion) {
-      Vec3 slo = lo, shi = hi;
+// One camera's frame while it is rendered: the image and depth so far and what the stages share.
+struct FrameCanvas {
+  const SceneRenderer::CameraData& cd;
+  const LightingSpec& lighting;
+  Vec3 light;
+  cv::Mat img, depth;
+  Vec3 Ray(int u, int v) const {
+    return cd.ray[static_cast<size_t>(v) * cd.cam.width + u].cast<double>();
+  }
+};
+
+// What DrawBodies found per body: image box, pixels hit (occluded or not), their bounding box, and
+// per pixel the visible body (index + 1).
+struct BodyRaster {
+  std::vector<uint16_t> id;
+  std::vector<cv::Rect> boxes;
+  std::vector<long> hits_all;
+  std::vector<cv::Rect> hit_bbox;
+};
+
+// Darkens the ground where bodies and the ball (soft-edged) block the light.
+void CastShadows(FrameCanvas& fc, const std::vector<Body>& bodies, bool has_ball,
+                 const Vec3& ball_mid, double r_ball) {
+  const auto& cd = fc.cd;
+  const int w = cd.cam.width, h = cd.cam.height;
+  const Vec3& light = fc.light;
+  const Vec3 o = cd.origin;
+  // Light lost in a full shadow: fixed, or all but the ambient share of the lit ground.
+  const double lost =
+      fc.lighting.ambient >= 0
+          ? 1.0 - fc.lighting.ambient /
+                      (fc.lighting.ambient + (1 - fc.lighting.ambient) * std::max(light.z(), 1e-3))
+          : 0.42;
+  std::vector<uint8_t> shadowed;
+  auto shade_box = [&](const Vec3& lo, const Vec3& hi, auto&& occlusion) {
+    Vec3 slo = lo, shi = hi;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+      const Vec3 g = p - (p.z() / light.z()) * light;
+      slo = slo.cwiseMin(g);
+      shi = shi.cwiseMax(g);
+    }
+    slo.z() = 0;
+    const cv::Rect box = ProjectBox(cd.cam, slo, shi);
+    if (box.empty()) return;
+    if (shadowed.empty()) shadowed.assign(static_cast<size_t>(w) * h, 0);
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      auto* row = fc.img.ptr<cv::Vec3b>(v);
+      const float* drow = fc.depth.ptr<float>(v);
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        const size_t i = static_cast<size_t>(v) * w + u;
+        if (!cd.ground[i] || shadowed[i]) continue;
+        const Vec3 p = o + static_cast<double>(drow[u]) * fc.Ray(u, v);
+        const double s = occlusion(Vec3(p.x(), p.y(), 1e-4));
+        if (s <= 0) continue;
+        const double f = 1.0 - lost * s;
+        for (int ch = 0; ch < 3; ++ch) row[u][ch] = static_cast<uint8_t>(row[u][ch] * f);
+        if (s >= 1) shadowed[i] = 1;
+      }
+    }
+  };
+  for (const Body& b : bodies) {
+    // Ground boxes of each primitive's shadow, to test only the primitives that can shade.
+    const int np = NumPrimitives(b);
+    std::vector<Eigen::Vector4d> sb(np);
+    for (int q = 0; q < np; ++q) {
+      Vec3 lo, hi;
+      PrimitiveBounds(b, q, &lo, &hi);
+      Eigen::Vector4d box(kInf, kInf, -kInf, -kInf);
       for (int k = 0; k < 8; ++k) {
         const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
                      (k & 4) ? hi.z() : lo.z());
         const Vec3 g = p - (p.z() / light.z()) * light;
-        slo = slo.cwiseMin(g);
-        shi = shi.cwiseMax(g);
+        box = Eigen::Vector4d(std::min(box[0], g.x()), std::min(box[1], g.y()),
+                              std::max(box[2], g.x()), std::max(box[3], g.y()));
       }
-      slo.z() = 0;
-      const cv::Rect box = ProjectBox(cam, slo, shi);
-      if (box.empty()) return;
-      if (shadowed.empty()) shadowed.assign(static_cast<size_t>(w) * h, 0);
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        auto* row = img.ptr<cv::Vec3b>(v);
-        const float* drow = depth.ptr<float>(v);
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const size_t i = static_cast<size_t>(v) * w + u;
-          if (!cd.ground[i] || shadowed[i]) continue;
-          const Vec3 p = o + static_cast<double>(drow[u]) * ray(u, v);
-          const double s = occlusion(Vec3(p.x(), p.y(), 1e-4));
-          if (s <= 0) continue;
-          const double f = 1.0 - 0.42 * s;
-          for (int ch = 0; ch < 3; ++ch) row[u][ch] = static_cast<uint8_t>(row[u][ch] * f);
-          if (s >= 1) shadowed[i] = 1;
-        }
-      }
-    };
-    for (const Body& b : bodies) {
-      // Ground boxes of each primitive's shadow, to test only the primitives that can shade.
-      const int np = NumPrimitives(b);
-      std::vector<Eigen::Vector4d> sb(np);
+      sb[q] = box;
+    }
+    shade_box(b.box_min, b.box_max, [&](const Vec3& p) {
       for (int q = 0; q < np; ++q) {
-        Vec3 lo, hi;
-        PrimitiveBounds(b, q, &lo, &hi);
-        Eigen::Vector4d box(kInf, kInf, -kInf, -kInf);
-        for (int k = 0; k < 8; ++k) {
-          const Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
-                       (k & 4) ? hi.z() : lo.z());
-          const Vec3 g = p - (p.z() / light.z()) * light;
-          box = Eigen::Vector4d(std::min(box[0], g.x()), std::min(box[1], g.y()),
-                                std::max(box[2], g.x()), std::max(box[3], g.y()));
+        if (p.x() < sb[q][0] || p.y() < sb[q][1] || p.x() > sb[q][2] || p.y() > sb[q][3]) {
+          continue;
         }
-        sb[q] = box;
+        if (IntersectPrimitive(b, q, p, light) > 1e-6) return 1.0;
       }
-      shade_box(b.box_min, b.box_max, [&](const Vec3& p) {
-        for (int q = 0; q < np; ++q) {
-          if (p.x() < sb[q][0] || p.y() < sb[q][1] || p.x() > sb[q][2] || p.y() > sb[q][3]) {
-            continue;
-          }
-          if (IntersectPrimitive(b, q, p, light) > 1e-6) return 1.0;
-        }
-        return 0.0;
-      });
-    }
-    if (has_ball && ball_mid.z() < 8.0) {
-      const Vec3 rr(r_ball, r_ball, r_ball);
-      shade_box(ball_mid - rr, ball_mid + rr, [&](const Vec3& p) {
-        const Vec3 q = ball_mid - p;
-        const double along = q.dot(light);
-        if (along <= 0) return 0.0;
-        const double dist = (q - along * light).norm();
-        return std::clamp((1.1 * r_ball - dist) / (0.3 * r_ball), 0.0, 1.0);
-      });
-    }
+      return 0.0;
+    });
   }
+  if (has_ball && ball_mid.z() < 8.0) {
+    const Vec3 rr(r_ball, r_ball, r_ball);
+    shade_box(ball_mid - rr, ball_mid + rr, [&](const Vec3& p) {
+      const Vec3 q = ball_mid - p;
+      const double along = q.dot(light);
+      if (along <= 0) return 0.0;
+      const double dist = (q - along * light).norm();
+      return std::clamp((1.1 * r_ball - dist) / (0.3 * r_ball), 0.0, 1.0);
+    });
+  }
+}
 
-  // Opaque bodies with a depth test; ids for the truth of visibility.
-  std::vector<uint16_t> id;
-  if (!bodies.empty()) id.assign(static_cast<size_t>(w) * h, 0);
-  std::vector<cv::Rect> boxes(bodies.size());
-  std::vector<long> hits_all(bodies.size(), 0);
-  std::vector<cv::Rect> hit_bbox(bodies.size());
+// Opaque bodies with a depth test (shaded when want_image), and the ids for the truth.
+BodyRaster DrawBodies(FrameCanvas& fc, const std::vector<Body>& bodies, bool want_image) {
+  const auto& cd = fc.cd;
+  const int w = cd.cam.width, h = cd.cam.height;
+  const Vec3 o = cd.origin;
+  BodyRaster r;
+  if (!bodies.empty()) r.id.assign(static_cast<size_t>(w) * h, 0);
+  r.boxes.resize(bodies.size());
+  r.hits_all.assign(bodies.size(), 0);
+  r.hit_bbox.resize(bodies.size());
   for (size_t k = 0; k < bodies.size(); ++k) {
     const Body& b = bodies[k];
-    boxes[k] = ProjectBox(cam, b.box_min, b.box_max);
-    const cv::Rect& box = boxes[k];
+    r.boxes[k] = ProjectBox(cd.cam, b.box_min, b.box_max);
+    const cv::Rect& box = r.boxes[k];
     int bx0 = w, by0 = h, bx1 = -1, by1 = -1;
     if (box.empty()) continue;
     // Rasterise primitive by primitive inside its own box: nearest distance and primitive.
@@ -679,10 +835,10 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
     for (int q = 0; q < np; ++q) {
       Vec3 lo, hi;
       PrimitiveBounds(b, q, &lo, &hi);
-      const cv::Rect pbox = ProjectBox(cam, lo, hi) & box;
+      const cv::Rect pbox = ProjectBox(cd.cam, lo, hi) & box;
       for (int v = pbox.y; v < pbox.y + pbox.height; ++v) {
         for (int u = pbox.x; u < pbox.x + pbox.width; ++u) {
-          const Vec3 d = ray(u, v);
+          const Vec3 d = fc.Ray(u, v);
           if (!d.allFinite()) continue;
           const double tq = IntersectPrimitive(b, q, o, d);
           const size_t j = static_cast<size_t>(v - box.y) * box.width + (u - box.x);
@@ -694,185 +850,203 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
       }
     }
     for (int v = box.y; v < box.y + box.height; ++v) {
-      auto* row = img.ptr<cv::Vec3b>(v);
-      float* drow = depth.ptr<float>(v);
+      auto* row = fc.img.ptr<cv::Vec3b>(v);
+      float* drow = fc.depth.ptr<float>(v);
       for (int u = box.x; u < box.x + box.width; ++u) {
         const size_t j = static_cast<size_t>(v - box.y) * box.width + (u - box.x);
         if (best_p[j] < 0) continue;
-        ++hits_all[k];
+        ++r.hits_all[k];
         bx0 = std::min(bx0, u);
         by0 = std::min(by0, v);
         bx1 = std::max(bx1, u);
         by1 = std::max(by1, v);
         if (best_t[j] >= drow[u]) continue;
         drow[u] = best_t[j];
-        id[static_cast<size_t>(v) * w + u] = static_cast<uint16_t>(k + 1);
+        r.id[static_cast<size_t>(v) * w + u] = static_cast<uint16_t>(k + 1);
         if (want_image) {
-          const Hit hit = ShadePrimitive(b, best_p[j], o, ray(u, v), best_t[j]);
-          const double shade = 0.5 + 0.6 * std::max(0.0, hit.normal.dot(light));
+          const Hit hit = ShadePrimitive(b, best_p[j], o, fc.Ray(u, v), best_t[j]);
+          const double shade = Lambert(fc.lighting, hit.normal.dot(fc.light), 0.5, 0.6);
           const Vec3 c = Clamp255(hit.colour * shade);
           row[u] = cv::Vec3b(static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]),
                              static_cast<uint8_t>(c[2]));
         }
       }
     }
-    if (bx1 >= 0) hit_bbox[k] = cv::Rect(bx0, by0, bx1 - bx0 + 1, by1 - by0 + 1);
+    if (bx1 >= 0) r.hit_bbox[k] = cv::Rect(bx0, by0, bx1 - bx0 + 1, by1 - by0 + 1);
   }
-  if (stats) {
-    stats->players.assign(spec_.people.size(), PlayerCameraTruth{});
-    for (size_t k = 0; k < spec_.people.size(); ++k) {
-      PlayerCameraTruth& pt = stats->players[k];
-      if (hits_all[k] == 0) continue;
-      long vis = 0;
-      const cv::Rect& box = boxes[k];
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          vis += id[static_cast<size_t>(v) * w + u] == k + 1;
-        }
-      }
-      pt.in_image = true;
-      pt.bb_left = hit_bbox[k].x;
-      pt.bb_top = hit_bbox[k].y;
-      pt.bb_width = hit_bbox[k].width;
-      pt.bb_height = hit_bbox[k].height;
-      pt.visible_fraction = static_cast<double>(vis) / hits_all[k];
-    }
-  }
+  return r;
+}
 
-  // The ball: anti-aliased, shaded, blurred over the exposure.
-  if (has_ball) {
-    BallCameraTruth bt;
-    Eigen::Vector2d uv_mid;
-    double rad_mid = 0;
-    const Vec3 c_cam = cam.cam_from_world * ball_mid;
-    bt.in_front = c_cam.z() > 0;
-    if (ProjectSphere(cam, ball_mid, r_ball, &uv_mid, &rad_mid)) {
-      bt.uv_px = uv_mid;
-      bt.radius_px = rad_mid;
-    } else if (const auto p = cam.Project(ball_mid)) {
-      bt.uv_px = *p;
+// Per person: in the image, its bounding box and unoccluded share.
+std::vector<PlayerCameraTruth> PeopleTruth(const BodyRaster& r, size_t num_people, int w) {
+  std::vector<PlayerCameraTruth> out(num_people);
+  for (size_t k = 0; k < num_people; ++k) {
+    PlayerCameraTruth& pt = out[k];
+    if (r.hits_all[k] == 0) continue;
+    long vis = 0;
+    const cv::Rect& box = r.boxes[k];
+    for (int v = box.y; v < box.y + box.height; ++v) {
+      for (int u = box.x; u < box.x + box.width; ++u) {
+        vis += r.id[static_cast<size_t>(v) * w + u] == k + 1;
+      }
     }
-    // Coverage of one pixel by the ball at centre c: the distance from the centre to the ray
-    // minus the radius, over the pixel's size at that depth.
-    auto coverage = [&](const Vec3& c, const Vec3& d, double* t_hit, Vec3* normal) {
-      const Vec3 oc = c - o;
-      const double tc = oc.dot(d);
-      if (tc <= r_ball) return 0.0;
-      const Vec3 perp = oc - tc * d;
-      const double dist = perp.norm();
-      const double fp = tc * cd.pixel_angle;
-      const double cov = std::clamp(0.5 - (dist - r_ball) / fp, 0.0, 1.0);
-      if (cov <= 0) return 0.0;
-      const double th = dist < r_ball ? tc - std::sqrt(r_ball * r_ball - dist * dist) : tc;
-      *t_hit = th;
-      if (normal) *normal = (o + th * d - c).normalized();
-      return cov;
-    };
-    if (bt.in_front && rad_mid > 0) {
-      // Truth: visible share of the disc at mid-exposure.
-      const double m = rad_mid * 1.3 + 2;
-      const cv::Rect full(static_cast<int>(std::floor(uv_mid.x() - m)),
-                          static_cast<int>(std::floor(uv_mid.y() - m)),
-                          static_cast<int>(std::ceil(2 * m)) + 2,
-                          static_cast<int>(std::ceil(2 * m)) + 2);
-      const cv::Rect box = full & cv::Rect(0, 0, w, h);
-      double cov_all = 0, cov_vis = 0;
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        const float* drow = depth.ptr<float>(v);
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const Vec3 d = ray(u, v);
-          if (!d.allFinite()) continue;
-          double th;
-          const double cov = coverage(ball_mid, d, &th, nullptr);
-          if (cov <= 0) continue;
-          cov_all += cov;
-          if (th < drow[u]) cov_vis += cov;
-        }
-      }
-      const bool inside = box == full;
-      const double denom = inside ? cov_all : M_PI * rad_mid * rad_mid;
-      bt.visible_fraction = denom > 0 ? std::clamp(cov_vis / denom, 0.0, 1.0) : 0.0;
-    }
-    if (stats) stats->ball = bt;
-    if (want_image) {
-      // Sub-exposure samples: about one per half pixel of image motion.
-      const double e = spec_.exposure_s;
-      int K = 1;
-      if (e > 0) {
-        const auto p0 = cam.Project(BallAt(t - 0.5 * e));
-        const auto p1 = cam.Project(BallAt(t + 0.5 * e));
-        if (p0 && p1) {
-          K = std::clamp(static_cast<int>(std::ceil((*p1 - *p0).norm() / 0.5)) + 1, 1, 48);
-        }
-      }
-      std::vector<Vec3> centres;
-      cv::Rect box;
-      for (int k = 0; k < K; ++k) {
-        const Vec3 c = K == 1 ? ball_mid : BallAt(t + e * ((k + 0.5) / K - 0.5));
-        Eigen::Vector2d uv;
-        double rad;
-        if (!ProjectSphere(cam, c, r_ball, &uv, &rad)) continue;
-        centres.push_back(c);
-        const double m = rad * 1.3 + 2;
-        const cv::Rect b(
-            static_cast<int>(std::floor(uv.x() - m)), static_cast<int>(std::floor(uv.y() - m)),
-            static_cast<int>(std::ceil(2 * m)) + 2, static_cast<int>(std::ceil(2 * m)) + 2);
-        box = box.empty() ? b : (box | b);
-      }
-      box &= cv::Rect(0, 0, w, h);
-      const Vec3 albedo = spec_.ball.colour_bgr;
-      const double inv_k = 1.0 / K;
-      for (int v = box.y; v < box.y + box.height; ++v) {
-        auto* row = img.ptr<cv::Vec3b>(v);
-        const float* drow = depth.ptr<float>(v);
-        for (int u = box.x; u < box.x + box.width; ++u) {
-          const Vec3 d = ray(u, v);
-          if (!d.allFinite()) continue;
-          const Vec3 pix(row[u][0], row[u][1], row[u][2]);
-          Vec3 acc = Vec3::Zero();
-          for (const Vec3& c : centres) {
-            double th;
-            Vec3 n = Vec3::UnitZ();
-            const double cov = coverage(c, d, &th, &n);
-            if (cov <= 0 || th >= drow[u]) continue;
-            const double ndl = n.dot(light);
-            const Vec3 refl = 2 * ndl * n - light;
-            const double spec = std::pow(std::max(0.0, -refl.dot(d)), 24.0);
-            const Vec3 col = albedo * (0.5 + 0.6 * std::max(0.0, ndl)) + Vec3::Constant(70 * spec);
-            acc += cov * (Clamp255(col) - pix);
-          }
-          if (acc.isZero()) continue;
-          const Vec3 c = Clamp255(pix + inv_k * acc);
-          row[u] = cv::Vec3b(static_cast<uint8_t>(std::lround(c[0])),
-                             static_cast<uint8_t>(std::lround(c[1])),
-                             static_cast<uint8_t>(std::lround(c[2])));
-        }
-      }
+    pt.in_image = true;
+    pt.bb_left = r.hit_bbox[k].x;
+    pt.bb_top = r.hit_bbox[k].y;
+    pt.bb_width = r.hit_bbox[k].width;
+    pt.bb_height = r.hit_bbox[k].height;
+    pt.visible_fraction = static_cast<double>(vis) / r.hits_all[k];
+  }
+  return out;
+}
+
+// Coverage of one pixel's ray d by a ball of radius r at centre c: the distance from the centre
+// to the ray minus the radius, over the pixel's size at that depth; the hit distance and normal.
+double BallCoverage(const SceneRenderer::CameraData& cd, double r, const Vec3& c, const Vec3& d,
+                    double* t_hit, Vec3* normal) {
+  const Vec3 oc = c - cd.origin;
+  const double tc = oc.dot(d);
+  if (tc <= r) return 0.0;
+  const Vec3 perp = oc - tc * d;
+  const double dist = perp.norm();
+  const double fp = tc * cd.pixel_angle;
+  const double cov = std::clamp(0.5 - (dist - r) / fp, 0.0, 1.0);
+  if (cov <= 0) return 0.0;
+  const double th = dist < r ? tc - std::sqrt(r * r - dist * dist) : tc;
+  *t_hit = th;
+  if (normal) *normal = (cd.origin + th * d - c).normalized();
+  return cov;
+}
+
+// The ball's projection and the visible share of its disc at mid-exposure.
+BallCameraTruth BallVisibility(const FrameCanvas& fc, const Vec3& ball_mid, double r_ball) {
+  const auto& cd = fc.cd;
+  const Camera& cam = cd.cam;
+  BallCameraTruth bt;
+  Eigen::Vector2d uv_mid;
+  double rad_mid = 0;
+  bt.in_front = (cam.cam_from_world * ball_mid).z() > 0;
+  if (ProjectSphere(cam, ball_mid, r_ball, &uv_mid, &rad_mid)) {
+    bt.uv_px = uv_mid;
+    bt.radius_px = rad_mid;
+  } else if (const auto p = cam.Project(ball_mid)) {
+    bt.uv_px = *p;
+  }
+  if (!bt.in_front || rad_mid <= 0) return bt;
+  const double m = rad_mid * 1.3 + 2;
+  const cv::Rect full(
+      static_cast<int>(std::floor(uv_mid.x() - m)), static_cast<int>(std::floor(uv_mid.y() - m)),
+      static_cast<int>(std::ceil(2 * m)) + 2, static_cast<int>(std::ceil(2 * m)) + 2);
+  const cv::Rect box = full & cv::Rect(0, 0, cam.width, cam.height);
+  double cov_all = 0, cov_vis = 0;
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    const float* drow = fc.depth.ptr<float>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      const Vec3 d = fc.Ray(u, v);
+      if (!d.allFinite()) continue;
+      double th;
+      const double cov = BallCoverage(cd, r_ball, ball_mid, d, &th, nullptr);
+      if (cov <= 0) continue;
+      cov_all += cov;
+      if (th < drow[u]) cov_vis += cov;
     }
   }
-  if (!want_image) return {};
+  const bool inside = box == full;
+  const double denom = inside ? cov_all : M_PI * rad_mid * rad_mid;
+  bt.visible_fraction = denom > 0 ? std::clamp(cov_vis / denom, 0.0, 1.0) : 0.0;
+  return bt;
+}
 
-  // Lighting gain, vignetting and sensor noise (fresh per frame, seeded by scene, camera, frame).
-  const double gain =
-      1.0 + spec_.lighting.gain_amplitude * std::sin(2 * M_PI * t / spec_.lighting.period_s);
-  const bool noise = spec_.noise_sigma > 0;
+// The ball's colour at a point with normal n seen along d: albedo (with the print) shaded, plus
+// the highlight.
+Vec3 BallColour(const BallSpec& ball, const FrameCanvas& fc, const Eigen::Matrix3d& orientation,
+                const Vec3& n, const Vec3& d, double px) {
+  const Vec3& light = fc.light;
+  const double ndl = n.dot(light);
+  const Vec3 refl = 2 * ndl * n - light;
+  const bool new_model = fc.lighting.ambient >= 0;
+  const double spec =
+      new_model && ndl <= 0 ? 0.0 : std::pow(std::max(0.0, -refl.dot(d)), ball.shininess);
+  Vec3 albedo = ball.colour_bgr;
+  if (ball.pattern != "none") {
+    const double m = PatternCover(ball.pattern, orientation.transpose() * n, px);
+    albedo = (1 - m) * albedo + m * ball.pattern_bgr;
+  }
+  return albedo * Lambert(fc.lighting, ndl, 0.5, 0.6) + Vec3::Constant(ball.specular * spec);
+}
+
+// The ball anti-aliased, shaded and averaged over the sub-exposure samples (motion blur).
+void DrawBall(FrameCanvas& fc, const BallSpec& ball, const std::vector<BallSample>& samples) {
+  const auto& cd = fc.cd;
+  const Camera& cam = cd.cam;
+  const double r_ball = ball.radius_m();
+  cv::Rect box;
+  std::vector<BallSample> seen;
+  for (const BallSample& s : samples) {
+    Eigen::Vector2d uv;
+    double rad;
+    if (!ProjectSphere(cam, s.centre, r_ball, &uv, &rad)) continue;
+    seen.push_back(s);
+    const double m = rad * 1.3 + 2;
+    const cv::Rect b(
+        static_cast<int>(std::floor(uv.x() - m)), static_cast<int>(std::floor(uv.y() - m)),
+        static_cast<int>(std::ceil(2 * m)) + 2, static_cast<int>(std::ceil(2 * m)) + 2);
+    box = box.empty() ? b : (box | b);
+  }
+  box &= cv::Rect(0, 0, cam.width, cam.height);
+  const double inv_k = 1.0 / static_cast<double>(samples.size());
+  for (int v = box.y; v < box.y + box.height; ++v) {
+    auto* row = fc.img.ptr<cv::Vec3b>(v);
+    const float* drow = fc.depth.ptr<float>(v);
+    for (int u = box.x; u < box.x + box.width; ++u) {
+      const Vec3 d = fc.Ray(u, v);
+      if (!d.allFinite()) continue;
+      const Vec3 pix(row[u][0], row[u][1], row[u][2]);
+      Vec3 acc = Vec3::Zero();
+      for (const BallSample& s : seen) {
+        double th;
+        Vec3 n = Vec3::UnitZ();
+        const double cov = BallCoverage(cd, r_ball, s.centre, d, &th, &n);
+        if (cov <= 0 || th >= drow[u]) continue;
+        const double px = th * cd.pixel_angle / r_ball;
+        acc += cov * (Clamp255(BallColour(ball, fc, s.orientation, n, d, px)) - pix);
+      }
+      if (acc.isZero()) continue;
+      const Vec3 c = Clamp255(pix + inv_k * acc);
+      row[u] = cv::Vec3b(static_cast<uint8_t>(std::lround(c[0])),
+                         static_cast<uint8_t>(std::lround(c[1])),
+                         static_cast<uint8_t>(std::lround(c[2])));
+    }
+  }
+}
+
+// Exposure gain, white balance, vignetting and sensor noise (fresh per frame, seeded by scene,
+// camera and frame).
+void ApplyCameraResponse(cv::Mat& img, const SceneRenderer::CameraData& cd, const SceneSpec& spec,
+                         const std::vector<int16_t>& noise_table, int camera, int frame, double t) {
+  const int w = cd.cam.width, h = cd.cam.height;
+  const LightingSpec& l = spec.lighting;
+  const double gain = 1.0 + l.gain_amplitude * std::sin(2 * M_PI * t / l.period_s);
+  const double wb = l.white_balance_amplitude * std::sin(2 * M_PI * t / l.white_balance_period_s);
+  const float wbf[3] = {static_cast<float>(1 + wb), 1.0f, static_cast<float>(1 - wb)};
+  const bool noise = spec.noise_sigma > 0;
   for (int v = 0; v < h; ++v) {
     uint8_t* row = img.ptr<uint8_t>(v);
     const float* vig = cd.vignette.data() + static_cast<size_t>(v) * w;
-    uint64_t state = spec_.seed * 0x9E3779B97F4A7C15ULL ^ (static_cast<uint64_t>(camera) << 48) ^
+    uint64_t state = spec.seed * 0x9E3779B97F4A7C15ULL ^ (static_cast<uint64_t>(camera) << 48) ^
                      (static_cast<uint64_t>(frame) << 20) ^ static_cast<uint64_t>(v);
     uint64_t bits = 0;
     int left = 0;
     for (int u = 0; u < w; ++u) {
       const float f = static_cast<float>(gain) * vig[u];
       for (int ch = 0; ch < 3; ++ch) {
-        float val = row[3 * u + ch] * f;
+        float val = row[3 * u + ch] * (f * wbf[ch]);
         if (noise) {
           if (left == 0) {
             bits = SplitMix(state);
             left = 4;
           }
-          val += noise_table_[bits & 0xffff];
+          val += noise_table[bits & 0xffff];
           bits >>= 16;
           --left;
         }
@@ -880,7 +1054,39 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
       }
     }
   }
-  return img;
+}
+
+}  // namespace
+
+cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* stats,
+                                      bool want_image) const {
+  FV_REQUIRE(camera >= 0 && camera < static_cast<int>(data_.size()),
+             "camera index {} out of range (0..{})", camera, data_.size() - 1);
+  FV_REQUIRE(frame >= 0, "frame {} must be >= 0", frame);
+  const CameraData& cd = *data_[camera];
+  const double t = FrameTime(frame);
+  FrameCanvas fc{cd, spec_.lighting, spec_.lighting.Direction(), cd.bg.clone(), cd.depth.clone()};
+
+  // Bodies: people, then robots.
+  std::vector<Body> bodies;
+  for (const auto& p : spec_.people) bodies.push_back(PersonBody(p, spec_.teams[p.team], t));
+  for (size_t i = 0; i < spec_.robots.size(); ++i) {
+    bodies.push_back(RobotBody(spec_.robots[i], static_cast<int>(i), t, spec_.ball.radius_m()));
+  }
+  const bool has_ball = spec_.ball.enabled;
+  const double r_ball = spec_.ball.radius_m();
+  const Vec3 ball_mid = has_ball ? BallAt(t) : Vec3::Zero();
+
+  if (want_image && spec_.lighting.shadows) CastShadows(fc, bodies, has_ball, ball_mid, r_ball);
+  const BodyRaster raster = DrawBodies(fc, bodies, want_image);
+  if (stats) stats->players = PeopleTruth(raster, spec_.people.size(), cd.cam.width);
+  if (has_ball) {
+    if (stats) stats->ball = BallVisibility(fc, ball_mid, r_ball);
+    if (want_image) DrawBall(fc, spec_.ball, BallSamples(camera, t));
+  }
+  if (!want_image) return {};
+  ApplyCameraResponse(fc.img, cd, spec_, noise_table_, camera, frame, t);
+  return fc.img;
 }
 
 std::vector<cv::Mat> SceneRenderer::Render(int frame) const {

@@ -1,4 +1,5 @@
 // SceneSpec: validation, JSON round trip and the presets.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -70,7 +71,8 @@ CameraSpec CameraSpecFromJson(const json& c, size_t i) {
 BallSpec BallSpecFromJson(const json& b, BallSpec ball) {
   JsonKnownKeys(
       b, "ball",
-      {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "physics"});
+      {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "held_by",
+       "physics", "specular", "shininess", "pattern", "pattern_bgr", "orientation_rvec"});
   ball.enabled = JsonBool(b, "enabled", "ball", true);
   ball.diameter_m = JsonNumber(b, "diameter_m", "ball", ball.diameter_m);
   ball.colour_bgr = JsonVector<3>(b, "colour_bgr", "ball", ball.colour_bgr);
@@ -82,15 +84,22 @@ BallSpec BallSpecFromJson(const json& b, BallSpec ball) {
   const json& ks = JsonArray(b, "kicks", "ball");
   for (size_t i = 0; i < ks.size(); ++i) {
     const std::string ctx = fmt::format("ball.kicks[{}]", i);
-    JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps"});
+    JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps", "spin_radps"});
     KickSpec k;
     k.time_s = JsonNumber(ks[i], "time_s", ctx, 0.0);
     FV_REQUIRE(JsonHas(ks[i], "position_m"), "{}.position_m: missing", ctx);
     k.position_m = JsonVector<3>(ks[i], "position_m", ctx, k.position_m);
     FV_REQUIRE(JsonHas(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
     k.velocity_mps = JsonVector<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
+    k.spin_radps = JsonVector<3>(ks[i], "spin_radps", ctx, k.spin_radps);
     ball.kicks.push_back(k);
   }
+  ball.held_by = JsonInt(b, "held_by", "ball", ball.held_by);
+  ball.specular = JsonNumber(b, "specular", "ball", ball.specular);
+  ball.shininess = JsonNumber(b, "shininess", "ball", ball.shininess);
+  ball.pattern = JsonString(b, "pattern", "ball", ball.pattern);
+  ball.pattern_bgr = JsonVector<3>(b, "pattern_bgr", "ball", ball.pattern_bgr);
+  ball.orientation_rvec = JsonVector<3>(b, "orientation_rvec", "ball", ball.orientation_rvec);
   const json& ph = JsonObject(b, "physics", "ball");
   const std::string pc = "ball.physics";
   JsonKnownKeys(ph, pc,
@@ -111,7 +120,9 @@ BallSpec BallSpecFromJson(const json& b, BallSpec ball) {
 
 RobotSpec RobotSpecFromJson(const json& robot, size_t i) {
   const std::string ctx = fmt::format("robots[{}]", i);
-  JsonKnownKeys(robot, ctx, {"path", "position_m", "radius_m", "height_m", "colour_bgr"});
+  JsonKnownKeys(
+      robot, ctx,
+      {"path", "position_m", "radius_m", "height_m", "colour_bgr", "handler", "heading_deg"});
   RobotSpec r;
   if (JsonHas(robot, "path")) r.path = PathFromJson(robot["path"], ctx + ".path");
   if (JsonHas(robot, "position_m")) {
@@ -121,6 +132,8 @@ RobotSpec RobotSpecFromJson(const json& robot, size_t i) {
   r.radius_m = JsonNumber(robot, "radius_m", ctx, r.radius_m);
   r.height_m = JsonNumber(robot, "height_m", ctx, r.height_m);
   r.colour_bgr = JsonVector<3>(robot, "colour_bgr", ctx, r.colour_bgr);
+  r.handler = JsonBool(robot, "handler", ctx, r.handler);
+  r.heading_deg = JsonNumber(robot, "heading_deg", ctx, r.heading_deg);
   return r;
 }
 
@@ -160,9 +173,19 @@ ConeSpec ConeSpecFromJson(const json& cone, size_t i) {
 }
 
 LightingSpec LightingSpecFromJson(const json& l, LightingSpec lighting) {
-  JsonKnownKeys(l, "lighting",
-                {"light_dir", "gain_amplitude", "period_s", "vignetting", "shadows"});
-  lighting.light_dir = JsonVector<3>(l, "light_dir", "lighting", lighting.light_dir);
+  JsonKnownKeys(
+      l, "lighting",
+      {"light_dir", "sun_elevation_deg", "sun_azimuth_deg", "ambient", "gain_amplitude", "period_s",
+       "white_balance_amplitude", "white_balance_period_s", "vignetting", "shadows"});
+  const std::string lc = "lighting";
+  lighting.light_dir = JsonVector<3>(l, "light_dir", lc, lighting.light_dir);
+  lighting.sun_elevation_deg = JsonNumber(l, "sun_elevation_deg", lc, lighting.sun_elevation_deg);
+  lighting.sun_azimuth_deg = JsonNumber(l, "sun_azimuth_deg", lc, lighting.sun_azimuth_deg);
+  lighting.ambient = JsonNumber(l, "ambient", lc, lighting.ambient);
+  lighting.white_balance_amplitude =
+      JsonNumber(l, "white_balance_amplitude", lc, lighting.white_balance_amplitude);
+  lighting.white_balance_period_s =
+      JsonNumber(l, "white_balance_period_s", lc, lighting.white_balance_period_s);
   lighting.gain_amplitude = JsonNumber(l, "gain_amplitude", "lighting", lighting.gain_amplitude);
   lighting.period_s = JsonNumber(l, "period_s", "lighting", lighting.period_s);
   lighting.vignetting = JsonNumber(l, "vignetting", "lighting", lighting.vignetting);
@@ -329,6 +352,98 @@ SceneSpec PlayersPreset(uint64_t seed) {
   return s;
 }
 
+// Low sun and a printed yellow ball (RoboCup MSL style): the side away from the sun at 35 % of
+// the lit side, a strong highlight, exposure and white balance drifting.
+void ApplyLowSun(SceneSpec& s) {
+  s.lighting.sun_elevation_deg = 30.0;
+  s.lighting.sun_azimuth_deg = 35.0;
+  s.lighting.ambient = 0.35;
+  s.lighting.gain_amplitude = 0.06;
+  s.lighting.period_s = 5.0;
+  s.lighting.white_balance_amplitude = 0.04;
+  s.lighting.white_balance_period_s = 7.0;
+  s.ball.colour_bgr = Eigen::Vector3d(20, 215, 245);
+  s.ball.pattern = "print";
+  s.ball.pattern_bgr = Eigen::Vector3d(60, 35, 30);
+  s.ball.specular = 110.0;
+  s.ball.shininess = 40.0;
+}
+
+SceneSpec LowSunKickPreset(uint64_t seed) {
+  SceneSpec s = KickPreset(seed);
+  ApplyLowSun(s);
+  // Backspin of 8 turns per second about the horizontal axis across the flight.
+  for (KickSpec& k : s.ball.kicks) {
+    const Eigen::Vector3d v(k.velocity_mps.x(), k.velocity_mps.y(), 0.0);
+    if (v.norm() > 1e-9)
+      k.spin_radps = 2 * M_PI * 8.0 * v.normalized().cross(Eigen::Vector3d::UnitZ());
+  }
+  return s;
+}
+
+// Four corner cameras with equidistant-like fisheye lenses (130 deg across the width); the balls
+// are placed where cam1 sees them near its image border (within 12 % of the width of it).
+SceneSpec FisheyePreset(uint64_t seed) {
+  SceneSpec s = StaticPreset(seed);
+  const FieldModel f = BuiltinField(s.field);
+  for (CameraSpec& c : s.cameras) {
+    c.fx = c.fy = FisheyeFocalPx(c.width, 130.0);
+    c.distortion = FisheyeDistortion();
+  }
+  Camera cam1;
+  cam1.width = s.cameras[0].width;
+  cam1.height = s.cameras[0].height;
+  cam1.fx = cam1.fy = s.cameras[0].fx;
+  cam1.cx = 0.5 * (cam1.width - 1);
+  cam1.cy = 0.5 * (cam1.height - 1);
+  cam1.distortion = s.cameras[0].distortion;
+  cam1.has_pose = true;
+  cam1.cam_from_world = Rigid3d::LookAt(s.cameras[0].position_m, s.cameras[0].look_at_m);
+  Rng rng(seed * 2654435761ULL + 5);
+  const double r = s.ball.radius_m();
+  const double margin = 0.12 * cam1.width;
+  s.ball.placements.clear();
+  for (int tries = 0; tries < 200000 && static_cast<int>(s.ball.placements.size()) < s.num_frames;
+       ++tries) {
+    const Eigen::Vector3d p(rng.Uniform(-0.5, 0.5) * f.length_m, rng.Uniform(-0.5, 0.5) * f.width_m,
+                            rng.Uniform() < 0.5 ? r : rng.Uniform(r, 2.0));
+    const auto uv = cam1.Project(p);
+    if (!uv) continue;
+    const double border =
+        std::min({uv->x(), uv->y(), cam1.width - 1 - uv->x(), cam1.height - 1 - uv->y()});
+    const double radius_px = r / cam1.PixelFootprintM(p);
+    if (border < radius_px + 2 || border > margin) continue;
+    s.ball.placements.push_back(p);
+  }
+  FV_REQUIRE(static_cast<int>(s.ball.placements.size()) == s.num_frames,
+             "fisheye preset: found only {} ball placements near cam1's border",
+             s.ball.placements.size());
+  return s;
+}
+
+// Four corner cameras and a robot with a handler holding the ball, driving back and forth and
+// turning the handler (one placement per frame), a second robot near it.
+SceneSpec HeldPreset(uint64_t seed) {
+  SceneSpec s = StaticPreset(seed);
+  s.ball.placements.clear();
+  s.num_frames = 24;
+  s.fps = 30;
+  Rng rng(seed * 40503 + 9);
+  RobotSpec r1;
+  r1.handler = true;
+  r1.heading_deg = rng.Uniform(0.0, 360.0);
+  r1.path.waypoints_m = {Eigen::Vector2d(rng.Uniform(-4, 4), rng.Uniform(-3, 3))};
+  r1.path.waypoints_m.push_back(r1.path.waypoints_m[0] + Eigen::Vector2d(1.5, 1.0));
+  r1.path.speed_mps = 1.0;
+  RobotSpec r2;
+  r2.path.waypoints_m = {r1.path.waypoints_m[0] + Eigen::Vector2d(-1.2, 0.8)};
+  r2.colour_bgr = Eigen::Vector3d(25, 25, 30);
+  s.robots = {r1, r2};
+  s.ball.held_by = 0;
+  s.ball.hold_frames = 1;
+  return s;
+}
+
 // ---- SceneSpec::Check's parts.
 
 // A camera's size, focal length, distortion and pose (its name is checked with the others').
@@ -382,14 +497,29 @@ void CheckBallPhysics(const BallPhysics& p) {
              "ball.physics.time_step_s: must be in [1e-5, 0.01]");
 }
 
+// The ball's highlight and printed pattern.
+void CheckBallLook(const BallSpec& ball) {
+  FV_REQUIRE(std::isfinite(ball.specular) && ball.specular >= 0 && ball.specular <= 255,
+             "ball.specular: must be in [0, 255] (8-bit levels)");
+  FV_REQUIRE(std::isfinite(ball.shininess) && ball.shininess >= 1 && ball.shininess <= 10000,
+             "ball.shininess: must be in [1, 10000]");
+  const auto& names = BallPatternNames();
+  FV_REQUIRE(std::find(names.begin(), names.end(), ball.pattern) != names.end(),
+             "ball.pattern: '{}' is not one of {}", ball.pattern, fmt::join(names, ", "));
+  CheckColour(ball.pattern_bgr, "ball.pattern_bgr");
+  FV_REQUIRE(ball.orientation_rvec.allFinite(), "ball.orientation_rvec: not finite");
+}
+
 void CheckBallSpec(const BallSpec& ball) {
   FV_REQUIRE(std::isfinite(ball.diameter_m) && ball.diameter_m > 0 && ball.diameter_m < 5,
              "ball.diameter_m: must be in (0, 5)");
   CheckColour(ball.colour_bgr, "ball.colour_bgr");
   FV_REQUIRE(ball.placements.empty() || ball.kicks.empty(),
              "ball: give either placements or kicks, not both");
-  FV_REQUIRE(!ball.placements.empty() || !ball.kicks.empty(),
-             "ball: needs placements or kicks (or \"enabled\": false)");
+  FV_REQUIRE(ball.held_by < 0 || (ball.placements.empty() && ball.kicks.empty()),
+             "ball.held_by: a held ball takes no placements or kicks");
+  FV_REQUIRE(ball.held_by >= 0 || !ball.placements.empty() || !ball.kicks.empty(),
+             "ball: needs placements, kicks or held_by (or \"enabled\": false)");
   for (size_t i = 0; i < ball.placements.size(); ++i) {
     FV_REQUIRE(ball.placements[i].allFinite(), "ball.placements[{}]: not finite", i);
   }
@@ -402,13 +532,29 @@ void CheckBallSpec(const BallSpec& ball) {
                "ball.kicks[{}].position_m: z must be >= the ball radius {}", i, ball.radius_m());
     FV_REQUIRE(k.velocity_mps.allFinite() && k.velocity_mps.norm() < 100,
                "ball.kicks[{}].velocity_mps: must be finite and below 100 m/s", i);
+    FV_REQUIRE(k.spin_radps.allFinite() && k.spin_radps.norm() <= 1000,
+               "ball.kicks[{}].spin_radps: must be finite and at most 1000 rad/s", i);
   }
   CheckBallPhysics(ball.physics);
+  CheckBallLook(ball);
 }
 
 void CheckLighting(const LightingSpec& lighting) {
   FV_REQUIRE(lighting.light_dir.allFinite() && lighting.light_dir.z() > 0.05,
              "lighting.light_dir: must point upwards (z > 0)");
+  FV_REQUIRE(std::isfinite(lighting.sun_elevation_deg) && lighting.sun_elevation_deg >= 0 &&
+                 lighting.sun_elevation_deg <= 90,
+             "lighting.sun_elevation_deg: must be in [0, 90] (0: use light_dir)");
+  FV_REQUIRE(lighting.sun_elevation_deg == 0 || lighting.sun_elevation_deg >= 3,
+             "lighting.sun_elevation_deg: at least 3 deg (shadows would reach too far)");
+  FV_REQUIRE(std::isfinite(lighting.sun_azimuth_deg), "lighting.sun_azimuth_deg: not finite");
+  FV_REQUIRE(std::isfinite(lighting.ambient) && lighting.ambient <= 1,
+             "lighting.ambient: must be in [0, 1] (or negative for the fixed shading)");
+  FV_REQUIRE(std::isfinite(lighting.white_balance_amplitude) &&
+                 lighting.white_balance_amplitude >= 0 && lighting.white_balance_amplitude < 0.5,
+             "lighting.white_balance_amplitude: must be in [0, 0.5)");
+  FV_REQUIRE(std::isfinite(lighting.white_balance_period_s) && lighting.white_balance_period_s > 0,
+             "lighting.white_balance_period_s: must be > 0");
   FV_REQUIRE(std::isfinite(lighting.gain_amplitude) && lighting.gain_amplitude >= 0 &&
                  lighting.gain_amplitude < 1,
              "lighting.gain_amplitude: must be in [0, 1)");
@@ -449,6 +595,11 @@ void SceneSpec::Check() const {
     FV_REQUIRE(std::isfinite(robots[i].height_m) && robots[i].height_m > 0,
                "{}.height_m: must be > 0", ctx);
     CheckColour(robots[i].colour_bgr, ctx + ".colour_bgr");
+    FV_REQUIRE(std::isfinite(robots[i].heading_deg), "{}.heading_deg: not finite", ctx);
+  }
+  if (ball.enabled && ball.held_by >= 0) {
+    FV_REQUIRE(ball.held_by < static_cast<int>(robots.size()) && robots[ball.held_by].handler,
+               "ball.held_by: {} must index a robot with \"handler\": true", ball.held_by);
   }
   std::set<int> ids;
   for (size_t i = 0; i < people.size(); ++i) {
@@ -521,9 +672,23 @@ json SceneSpecToJson(const SceneSpec& s) {
   b["hold_frames"] = s.ball.hold_frames;
   b["kicks"] = json::array();
   for (const auto& k : s.ball.kicks) {
-    b["kicks"].push_back({{"time_s", k.time_s},
-                          {"position_m", JsonFromVector(k.position_m)},
-                          {"velocity_mps", JsonFromVector(k.velocity_mps)}});
+    json kj = {{"time_s", k.time_s},
+               {"position_m", JsonFromVector(k.position_m)},
+               {"velocity_mps", JsonFromVector(k.velocity_mps)}};
+    if (!k.spin_radps.isZero()) kj["spin_radps"] = JsonFromVector(k.spin_radps);
+    b["kicks"].push_back(kj);
+  }
+  // The appearance keys are written when they differ from the defaults (older scenes unchanged).
+  const BallSpec db;
+  if (s.ball.held_by >= 0) b["held_by"] = s.ball.held_by;
+  if (s.ball.specular != db.specular) b["specular"] = s.ball.specular;
+  if (s.ball.shininess != db.shininess) b["shininess"] = s.ball.shininess;
+  if (s.ball.pattern != db.pattern) {
+    b["pattern"] = s.ball.pattern;
+    b["pattern_bgr"] = JsonFromVector(s.ball.pattern_bgr);
+  }
+  if (!s.ball.orientation_rvec.isZero()) {
+    b["orientation_rvec"] = JsonFromVector(s.ball.orientation_rvec);
   }
   const BallPhysics& p = s.ball.physics;
   b["physics"] = {{"gravity_mps2", p.gravity_mps2},
@@ -538,10 +703,15 @@ json SceneSpecToJson(const SceneSpec& s) {
   j["ball"] = b;
   j["robots"] = json::array();
   for (const auto& r : s.robots) {
-    j["robots"].push_back({{"path", PathToJson(r.path)},
-                           {"radius_m", r.radius_m},
-                           {"height_m", r.height_m},
-                           {"colour_bgr", JsonFromVector(r.colour_bgr)}});
+    json rj = {{"path", PathToJson(r.path)},
+               {"radius_m", r.radius_m},
+               {"height_m", r.height_m},
+               {"colour_bgr", JsonFromVector(r.colour_bgr)}};
+    if (r.handler) {
+      rj["handler"] = true;
+      rj["heading_deg"] = r.heading_deg;
+    }
+    j["robots"].push_back(rj);
   }
   j["people"] = json::array();
   for (const auto& p : s.people) {
@@ -569,6 +739,16 @@ json SceneSpecToJson(const SceneSpec& s) {
                    {"period_s", s.lighting.period_s},
                    {"vignetting", s.lighting.vignetting},
                    {"shadows", s.lighting.shadows}};
+  if (s.lighting.sun_elevation_deg > 0) {
+    j["lighting"]["sun_elevation_deg"] = s.lighting.sun_elevation_deg;
+    j["lighting"]["sun_azimuth_deg"] = s.lighting.sun_azimuth_deg;
+  }
+  if (s.lighting.ambient >= 0) j["lighting"]["ambient"] = s.lighting.ambient;
+  if (s.lighting.white_balance_amplitude > 0) {
+    j["lighting"]["white_balance_amplitude"] = s.lighting.white_balance_amplitude;
+    j["lighting"]["white_balance_period_s"] = s.lighting.white_balance_period_s;
+  }
+
   j["noise_sigma"] = s.noise_sigma;
   j["jpeg_quality"] = s.jpeg_quality;
   j["format"] = s.format;
@@ -646,7 +826,29 @@ SceneSpec ReadSceneSpec(const std::string& path) {
   return SceneSpecFromJson(j, path);
 }
 
-std::vector<std::string> PresetNames() { return {"static", "kick", "players", "demo"}; }
+std::vector<std::string> PresetNames() {
+  return {"static", "kick", "players", "demo", "low-sun", "low-sun-kick", "fisheye", "held"};
+}
+
+std::vector<std::string> BallPatternNames() { return {"none", "print", "pentagons"}; }
+
+Eigen::Vector3d LightingSpec::Direction() const {
+  if (sun_elevation_deg <= 0) return light_dir.normalized();
+  const double e = sun_elevation_deg * M_PI / 180, a = sun_azimuth_deg * M_PI / 180;
+  return Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+}
+
+std::vector<double> FisheyeDistortion() {
+  // Least-squares fit of r (1 + k1 r^2 + k2 r^4 + k3 r^6) / (1 + k4 r^2 + k5 r^4 + k6 r^6) to
+  // atan(r) for 0..82 deg off axis (within 0.03 deg up to 80 deg; monotonic to 90 deg).
+  return {0.43968398, 0.022700659, 0.0, 0.0, 7.7899975e-05, 0.76687624, 0.093428723, 0.0013553043};
+}
+
+double FisheyeFocalPx(int width, double hfov_deg) {
+  FV_REQUIRE(width > 0 && hfov_deg > 1 && hfov_deg < 180,
+             "fisheye: width must be > 0 and hfov_deg in (1, 180) (got {}, {})", width, hfov_deg);
+  return 0.5 * width / (0.5 * hfov_deg * M_PI / 180);
+}
 
 SceneSpec Preset(const std::string& name, uint64_t seed) {
   SceneSpec s;
@@ -656,6 +858,15 @@ SceneSpec Preset(const std::string& name, uint64_t seed) {
     s = KickPreset(seed);
   } else if (name == "players") {
     s = PlayersPreset(seed);
+  } else if (name == "low-sun") {
+    s = StaticPreset(seed);
+    ApplyLowSun(s);
+  } else if (name == "low-sun-kick") {
+    s = LowSunKickPreset(seed);
+  } else if (name == "fisheye") {
+    s = FisheyePreset(seed);
+  } else if (name == "held") {
+    s = HeldPreset(seed);
   } else {
     Throw("unknown preset '{}' (known: {})", name, fmt::join(PresetNames(), ", "));
   }

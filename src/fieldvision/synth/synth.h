@@ -2,8 +2,9 @@
 // looking at a field with a ball, robots, people and distractors, rendered by ray casting with
 // exact ground truth. Per camera the pixel rays and the static background are computed once; per
 // frame only the moving objects' image boxes are ray-cast (sphere, cylinder, capsules), the ball
-// Lambert-shaded and motion-blurred, then lighting, vignetting, noise and MJPG. Ball physics:
-// ball_physics.h. Use: DEVELOPERS.md, "The synthetic world".
+// shaded (Lambert with an ambient share, Phong highlight, a printed pattern turning with its spin)
+// and motion-blurred, then exposure and white-balance drift, vignetting, noise and MJPG. Ball
+// physics: ball_physics.h. Use: DEVELOPERS.md, "The synthetic world".
 #pragma once
 
 #include <cstdint>
@@ -51,16 +52,22 @@ struct BallPhysics {
   double time_step_s = 0.001;         // RK4 step
 };
 
-// A kick: at time_s the ball is at position_m (centre) and gets velocity_mps.
+// A kick: at time_s the ball is at position_m (centre) and gets velocity_mps. spin_radps (world
+// axis times rad/s) turns the ball's printed pattern from the kick on (the flight ignores it).
 struct KickSpec {
   double time_s = 0.0;
   Eigen::Vector3d position_m = Eigen::Vector3d(0, 0, 0.11);
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d spin_radps = Eigen::Vector3d::Zero();
 };
 
 // The ball and its motion: either placements (each position held for hold_frames frames, no
 // motion) or kicks (ballistic flights from the first kick on; before it the ball rests at the
-// first kick's position). enabled = false: no ball.
+// first kick's position), or held_by >= 0: the ball sits in that robot's handler. enabled = false:
+// no ball. pattern: "none", "print" (wavy dark bands, like the RoboCup MSL ball's print) or
+// "pentagons" (the 12 pentagons of a classic football) in pattern_bgr; orientation_rvec turns it
+// (placements each get a further seeded turn). specular: highlight peak in 8-bit levels
+// (Phong, exponent shininess).
 struct BallSpec {
   bool enabled = true;
   double diameter_m = 0.22;
@@ -68,7 +75,13 @@ struct BallSpec {
   std::vector<Eigen::Vector3d> placements;
   int hold_frames = 1;
   std::vector<KickSpec> kicks;
+  int held_by = -1;  // robot index; -1: not held
   BallPhysics physics;
+  double specular = 70.0;
+  double shininess = 24.0;
+  std::string pattern = "none";
+  Eigen::Vector3d pattern_bgr = Eigen::Vector3d(25, 25, 25);
+  Eigen::Vector3d orientation_rvec = Eigen::Vector3d::Zero();
   double radius_m() const { return 0.5 * diameter_m; }
 };
 
@@ -81,12 +94,16 @@ struct PathSpec {
   double start_s = 0.0;
 };
 
-// A robot: a dark vertical cylinder with a lighter top.
+// A robot: a dark vertical cylinder with a lighter top. handler: two dark arms at ball height
+// reaching out towards heading_deg (degrees from +x towards +y) that hold a ball between them
+// (BallSpec::held_by), pressed against the robot's side.
 struct RobotSpec {
   PathSpec path;
   double radius_m = 0.25;
   double height_m = 0.8;
   Eigen::Vector3d colour_bgr = Eigen::Vector3d(35, 35, 35);
+  bool handler = false;
+  double heading_deg = 0.0;
 };
 
 // A person: an articulated figure (legs, arms, torso as capsules, head sphere) in the team's
@@ -113,13 +130,25 @@ struct ConeSpec {
   Eigen::Vector3d colour_bgr = Eigen::Vector3d(0, 80, 255);
 };
 
-// Light: direction towards the light, global gain 1 + gain_amplitude * sin(2 pi t / period_s).
+// Light: direction towards the light (or, when sun_elevation_deg > 0, the sun at that elevation
+// above the horizon and azimuth from +x towards +y). Objects are shaded 0.5 + 0.6 cos(angle to the
+// light) (ball, robots, people) or 0.55 + 0.5 cos (goals, cones); with ambient in [0, 1] instead
+// ambient + (1 - ambient) max(0, cos): the side away from the sun at `ambient` of the lit side.
+// Exposure drift: gain 1 + gain_amplitude sin(2 pi t / period_s); white balance drift: blue gain
+// 1 + w, red gain 1 - w with w = white_balance_amplitude sin(2 pi t / white_balance_period_s).
 struct LightingSpec {
   Eigen::Vector3d light_dir = Eigen::Vector3d(0.35, 0.25, 1.0);
+  double sun_elevation_deg = 0.0;  // 0: use light_dir
+  double sun_azimuth_deg = 0.0;
+  double ambient = -1.0;  // < 0: the fixed shading above
   double gain_amplitude = 0.0;
   double period_s = 10.0;
+  double white_balance_amplitude = 0.0;
+  double white_balance_period_s = 10.0;
   double vignetting = 0.15;  // brightness lost at the image corners
   bool shadows = true;
+  // Unit vector towards the light (from the sun angles or light_dir).
+  Eigen::Vector3d Direction() const;
 };
 
 struct SceneSpec {
@@ -151,10 +180,20 @@ nlohmann::json SceneSpecToJson(const SceneSpec& spec);
 SceneSpec SceneSpecFromJson(const nlohmann::json& j, const std::string& context);
 SceneSpec ReadSceneSpec(const std::string& path);
 
-// Names of the presets: static, kick, players, demo.
+// Names of the presets: static, kick, players, demo, low-sun (static with a low sun and a printed
+// yellow ball), low-sun-kick (kick with that light and a spinning printed ball), fisheye (strong
+// radial distortion, balls near the image edges), held (a ball held in a robot's handler).
 std::vector<std::string> PresetNames();
 // A preset scene (see PresetNames); random parts (placements, paths) follow `seed`.
 SceneSpec Preset(const std::string& name, uint64_t seed = 1);
+
+// Rational-model distortion (OpenCV's 8 coefficients, k1 k2 p1 p2 k3 k4 k5 k6) close to an
+// equidistant fisheye (r = f theta) up to about 80 deg off axis; the focal length that gives an
+// image width covering hfov_deg with it.
+std::vector<double> FisheyeDistortion();
+// Names of the ball patterns: none, print, pentagons.
+std::vector<std::string> BallPatternNames();
+double FisheyeFocalPx(int width, double hfov_deg);
 
 // The same scene with every camera resized to width x height (focal length and principal point
 // scaled, so the field of view is kept).
@@ -202,6 +241,7 @@ nlohmann::json FlightsToJson(const std::vector<Flight>& flights);
 
 struct CameraFrameStats;  // internal
 class BallTrajectory;     // ball_physics.h
+struct BallSample;        // internal
 
 // Renders a scene. Construction precomputes the pixel rays and backgrounds of all cameras (about
 // a second per 1280x960 camera); every method is const and thread-safe.
@@ -221,6 +261,8 @@ class SceneRenderer {
 
   // Exact ball centre at a time (the scene must have a ball).
   Eigen::Vector3d BallAt(double time_s) const;
+  // The ball's turn (body to world) at a time: orientation_rvec, placements' seeded turns, spin.
+  Eigen::Matrix3d BallOrientation(double time_s) const;
   BallTruthFrame BallTruth(int frame) const;
   // Every person of the scene (SceneSpec::people order).
   std::vector<PersonTruth> PlayerTruth(int frame) const;
@@ -241,6 +283,8 @@ class SceneRenderer {
 
  private:
   cv::Mat RenderInternal(int camera, int frame, CameraFrameStats* stats, bool want_image) const;
+  // The ball's centre and turn at sub-exposure times (about one per half pixel of motion).
+  std::vector<BallSample> BallSamples(int camera, double t) const;
   SceneSpec spec_;
   FieldModel field_;
   std::vector<Camera> cameras_;
