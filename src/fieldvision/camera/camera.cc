@@ -26,10 +26,18 @@ Camera Camera::FromFov(int width, int height, double hfov_deg) {
 }
 
 void Camera::Check(const std::string& context) const {
+  // Limits far beyond any real camera, so that sizes and products of them stay in range.
+  constexpr int kMaxSide = 65536;
+  constexpr double kMaxPixels = 1e7, kMaxMetres = 1e7, kMaxDistortion = 1e6;
   FV_REQUIRE(width > 0 && height > 0, "{}: image size must be positive (got {}x{})", context, width,
              height);
+  FV_REQUIRE(width <= kMaxSide && height <= kMaxSide,
+             "{}: image size {}x{} is over the limit of {} pixels a side", context, width, height,
+             kMaxSide);
   for (const auto& [name, v] : {std::pair{"fx", fx}, {"fy", fy}, {"cx", cx}, {"cy", cy}}) {
     FV_REQUIRE(std::isfinite(v), "{}: camera_matrix {} is not finite", context, name);
+    FV_REQUIRE(std::abs(v) <= kMaxPixels, "{}: camera_matrix {} = {} is out of range (|{}| <= {})",
+               context, name, v, name, kMaxPixels);
   }
   FV_REQUIRE(fx > 0 && fy > 0, "{}: camera_matrix focal length must be > 0 (fx={}, fy={})", context,
              fx, fy);
@@ -39,10 +47,14 @@ void Camera::Check(const std::string& context) const {
   for (double d : distortion) {
     FV_REQUIRE(std::isfinite(d), "{}: distortion_coefficients contains a non-finite value",
                context);
+    FV_REQUIRE(std::abs(d) <= kMaxDistortion, "{}: distortion_coefficients contains {} (|k| <= {})",
+               context, d, kMaxDistortion);
   }
   if (has_pose) {
     FV_REQUIRE(cam_from_world.rotation.allFinite() && cam_from_world.translation.allFinite(),
                "{}: rvec/tvec contain a non-finite value", context);
+    FV_REQUIRE(cam_from_world.translation.cwiseAbs().maxCoeff() <= kMaxMetres,
+               "{}: tvec is out of range (|t| <= {} m)", context, kMaxMetres);
   }
 }
 

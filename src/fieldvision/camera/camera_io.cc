@@ -45,17 +45,7 @@ Eigen::Vector3d ReadVector3(const cv::FileStorage& fs, const std::string& path, 
   return {m.at<double>(0), m.at<double>(1), m.at<double>(2)};
 }
 
-}  // namespace
-
-Camera ReadCameraYaml(const std::string& path) {
-  FV_REQUIRE(std::filesystem::is_regular_file(path), "camera file '{}' does not exist", path);
-  cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    Throw("camera file '{}' is not valid OpenCV YAML", path);
-  }
-  FV_REQUIRE(fs.isOpened(), "camera file '{}' cannot be read as OpenCV YAML", path);
+Camera ReadCameraYamlFrom(const cv::FileStorage& fs, const std::string& path) {
   Camera cam;
   cam.width = ReadPositiveInt(fs, path, "image_width");
   cam.height = ReadPositiveInt(fs, path, "image_height");
@@ -112,6 +102,22 @@ Camera ReadCameraYaml(const std::string& path) {
   }
   cam.Check("camera file '" + path + "'");
   return cam;
+}
+
+}  // namespace
+
+Camera ReadCameraYaml(const std::string& path) {
+  FV_REQUIRE(std::filesystem::is_regular_file(path), "camera file '{}' does not exist", path);
+  cv::FileStorage fs;
+  try {
+    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    FV_REQUIRE(fs.isOpened(), "camera file '{}' cannot be read as OpenCV YAML", path);
+    FV_REQUIRE(fs.root().isMap(), "camera file '{}' is not a map of keys", path);
+    return ReadCameraYamlFrom(fs, path);
+  } catch (const cv::Exception& e) {
+    // OpenCV's parser and FileNode accessors assert on malformed structure.
+    Throw("camera file '{}' is not valid OpenCV YAML", path);
+  }
 }
 
 void WriteCameraYaml(const Camera& camera, const std::string& path) {

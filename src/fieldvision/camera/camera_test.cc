@@ -215,7 +215,21 @@ INSTANTIATE_TEST_SUITE_P(
                 "tvec"},
         BadFile{"zero width", "%YAML:1.0\n---\nimage_width: 0\nimage_height: 480\n" FV_K FV_D,
                 "image_width"},
-        BadFile{"not yaml", "this is { not yaml", "bad.yaml"}, BadFile{"empty", "", "bad.yaml"}),
+        BadFile{"not yaml", "this is { not yaml", "bad.yaml"}, BadFile{"empty", "", "bad.yaml"},
+        // Found by fuzz/camera_yaml_fuzz: OpenCV asserted (cv::Exception) on a top-level list.
+        BadFile{"top level list", "%YAML:1.0\n- 1\n- 2\n", "bad.yaml"},
+        BadFile{"2e9 wide",
+                "%YAML:1.0\n---\nimage_width: 2000000000\nimage_height: 480\n" FV_K FV_D,
+                "image size"},
+        BadFile{"1e300 focal",
+                FV_HDR "camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: "
+                       "[1e300, 0, 320, 0, 500, 240, 0, 0, 1]\n" FV_D,
+                "fx"},
+        BadFile{"1e300 in tvec",
+                FV_HDR FV_K FV_D "rvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: d\n  data: "
+                                 "[0, 0, 0]\ntvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: "
+                                 "d\n  data: [0, 1e300, 0]\n",
+                "tvec"}),
     BadFileName);
 
 TEST(CameraIo, MissingFile) {
