@@ -26,7 +26,20 @@ std::vector<track::TrackRow> ReadGt(const std::string& path) {
 void RunEvalTracks(const EvalTracksCli& c) {
   const auto gt = ReadGt(c.gt);
   const auto est = track::ReadTracksCsv(c.est);
-  const track::MotMetrics m = track::EvaluateMot(gt, est, c.o);
+  // Nothing to score is an error, not a table of zeros.
+  FV_REQUIRE(!gt.empty(), "ground truth '{}' has no boxes", c.gt);
+  FV_REQUIRE(!est.empty(), "estimate '{}' has no boxes", c.est);
+  const track::MotMetrics m = [&] {
+    try {
+      return track::EvaluateMot(gt, est, c.o);
+    } catch (const Error& e) {
+      // EvaluateMot names its inputs "ground truth" and "estimate": add the file.
+      const std::string what = e.what();
+      if (StartsWith(what, "ground truth:")) Throw("{}: {}", c.gt, what);
+      if (StartsWith(what, "estimate:")) Throw("{}: {}", c.est, what);
+      throw;
+    }
+  }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
   if (!c.json.empty()) {
     AtomicWrite(

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/net/fuse.h"
 
 namespace fv::app {
@@ -50,6 +51,7 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Do not analyse flights (published on topic `flight` as each one closes)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
+    CheckOutputPath(o->out, o->cameras);
     JobControl control;
     g_fuse_control = &control;
     auto on_signal = [](int) {

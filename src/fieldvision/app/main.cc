@@ -54,6 +54,14 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // `fieldvision bogus`: CLI11 says only "A subcommand is required".
+    const std::string first = argc > 1 ? argv[1] : "";
+    if (!first.empty() && first[0] != '-' &&
+        app.get_subcommands([&](const CLI::App* s) { return s->check_name(first); }).empty()) {
+      std::cerr << "fieldvision: error: unknown subcommand '" << first
+                << "' (fieldvision --help lists them)\n";
+      return e.get_exit_code();
+    }
     std::cerr << "fieldvision: error: " << FirstLine(e.what()) << "\n";  // one line
     return e.get_exit_code();
   } catch (const fv::Error& e) {

@@ -1,6 +1,7 @@
 #include "fieldvision/net/fuse.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -17,6 +18,7 @@
 #include <zmq.hpp>
 
 #include "fieldvision/io/frame_source.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/recon/ball_csv.h"
@@ -258,8 +260,9 @@ FuseSummary RunFuse(const FuseOptions& o) {
     fopt.analysis.ball_radius_m = 0.5 * o.ball_diameter_m;
     flight_worker = std::make_unique<FlightWorker>(fopt);
   }
-  const std::string tmp = o.out + ".part";
-  CsvWriter csv(tmp, BallCsvColumns(), 6);
+  // Written beside --out and renamed at the end; a run that fails leaves no temporary file.
+  AtomicOutput out_file(o.out);
+  CsvWriter csv(out_file.temp_path(), BallCsvColumns(), 6);
   auto emit = [&](const SyncedFrame& group) {
     const BallFrame f = fusion.Fuse(group);
     ++summary.groups;
@@ -323,7 +326,12 @@ FuseSummary RunFuse(const FuseOptions& o) {
   double last_report = 0;
   std::vector<zmq::pollitem_t> items = {{router.handle(), 0, ZMQ_POLLIN, 0}};
   while (!StopRequested(o.control)) {
-    zmq::poll(items, std::chrono::milliseconds(2));
+    try {
+      zmq::poll(items, std::chrono::milliseconds(2));
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR) throw;
+      continue;  // a signal (Ctrl-C, SIGTERM): StopRequested decides
+    }
     zmq::message_t identity, payload;
     while (router.recv(identity, zmq::recv_flags::dontwait)) {
       const double t1 = SystemClockNow();
@@ -458,9 +466,7 @@ FuseSummary RunFuse(const FuseOptions& o) {
     publish_flights();
   }
   csv.Close();
-  std::error_code ec;
-  std::filesystem::rename(tmp, o.out, ec);
-  FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
+  out_file.Commit();
   summary.fusion = fusion.stats();
   summary.sync = sync.stats();
   summary.sync_problems = sync.Problems(names);
