@@ -53,7 +53,11 @@ void Setup(CLI::App& app, int& exit_code) {
       "synth",
       "Render a synthetic scene: N calibrated cameras, a ball (placed or kicked with bounces), "
       "robots, people, a cone; writes videos, camera YAMLs and exact truth");
-  cmd->add_option("--preset", o->preset, "static | kick | players | demo");
+  cmd->add_option("--preset", o->preset,
+                  "static | kick | players | demo | low-sun (static, sun 30 deg high, far side "
+                  "of the ball at 35 %, printed yellow ball, exposure and white-balance drift) | "
+                  "low-sun-kick (kick in that light, ball spinning) | fisheye (130 deg lenses, "
+                  "balls near cam1's border) | held (a ball in a robot's handler)");
   cmd->add_option("--scene", o->scene, "Scene JSON (see scene.json written by a preset)");
   cmd->add_option("--out", o->out, "Output folder (created)")->required();
   cmd->add_option("--seed", o->seed, "Random seed (placements, paths, noise)");

@@ -68,6 +68,195 @@ cv::Mat ContactSheet(const std::vector<cv::Mat>& images, const std::vector<std::
   return sheet;
 }
 
+namespace {
+
+// Output paths of a scene folder.
+struct SceneFolder {
+  std::string dir;
+  std::string Path(const std::string& name) const { return (fs::path(dir) / name).string(); }
+};
+
+// scene.json (the spec as given) and one camera file per camera.
+void WriteSpecAndCameras(const SceneSpec& spec, const SceneRenderer& scene,
+                         const SceneFolder& folder, WriteSceneResult& res) {
+  const std::string p = folder.Path("scene.json");
+  std::ofstream out(p);
+  FV_REQUIRE(out.good(), "cannot write '{}'", p);
+  out << SceneSpecToJson(spec).dump(2) << "\n";
+  FV_REQUIRE(out.good(), "cannot write '{}'", p);
+  res.files.push_back(p);
+  for (const Camera& cam : scene.cameras()) {
+    const std::string yaml = folder.Path(cam.name + ".yaml");
+    WriteCameraYaml(cam, yaml);
+    res.files.push_back(yaml);
+  }
+}
+
+// Per camera: the video file or image pattern, created folders and an open MJPG writer.
+struct CameraOut {
+  std::string file;
+  std::mutex mutex;
+  cv::VideoWriter writer;
+  std::map<int, cv::Mat> pending;
+  int next_write = 0;
+};
+
+std::vector<std::unique_ptr<CameraOut>> OpenOutputs(const SceneSpec& spec,
+                                                    const SceneRenderer& scene,
+                                                    const SceneFolder& folder) {
+  std::vector<std::unique_ptr<CameraOut>> outs;
+  for (const Camera& cam : scene.cameras()) {
+    outs.push_back(std::make_unique<CameraOut>());
+    CameraOut& out = *outs.back();
+    if (spec.format != "avi") {
+      std::error_code ec;
+      fs::create_directories(folder.Path(cam.name), ec);
+      FV_REQUIRE(!ec, "cannot create folder '{}'", folder.Path(cam.name));
+      out.file = folder.Path(cam.name + "/%05d." + spec.format);
+      continue;
+    }
+    out.file = folder.Path(cam.name + ".avi");
+    out.writer.open(out.file, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                    spec.fps, cv::Size(cam.width, cam.height), true);
+    FV_REQUIRE(out.writer.isOpened(), "cannot open video '{}' for writing", out.file);
+    out.writer.set(cv::VIDEOWRITER_PROP_QUALITY, spec.jpeg_quality);
+  }
+  return outs;
+}
+
+// Renders every (frame, camera) in frame-major order on a pool of threads; each camera's frames
+// are written in order as soon as they are ready. Fills stats[camera][frame] and first[camera].
+void RenderAndWrite(const SceneSpec& spec, const SceneRenderer& scene, const SceneFolder& folder,
+                    std::vector<std::unique_ptr<CameraOut>>& outs,
+                    std::vector<std::vector<CameraFrameStats>>& stats, std::vector<cv::Mat>& first,
+                    bool progress) {
+  const int nc = static_cast<int>(outs.size()), nf = spec.num_frames;
+  const std::vector<int> params =
+      spec.format == "jpg" ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, spec.jpeg_quality}
+                           : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};
+  const long long total = static_cast<long long>(nc) * nf;
+  std::atomic<long long> done{0};
+  std::atomic<long long> next{0};
+  std::mutex error_mutex;
+  std::string error;
+  auto write_ready = [&](CameraOut& out, int c) {
+    while (!out.pending.empty() && out.pending.begin()->first == out.next_write) {
+      if (spec.format == "avi") {
+        out.writer.write(out.pending.begin()->second);
+      } else {
+        const std::string p = fmt::format("{}/{}/{:05d}.{}", folder.dir, scene.cameras()[c].name,
+                                          out.next_write, spec.format);
+        FV_REQUIRE(cv::imwrite(p, out.pending.begin()->second, params), "cannot write image '{}'",
+                   p);
+      }
+      out.pending.erase(out.pending.begin());
+      ++out.next_write;
+      ++done;
+    }
+  };
+  auto worker = [&] {
+    for (long long i = next++; i < total; i = next++) {
+      const int f = static_cast<int>(i / nc), c = static_cast<int>(i % nc);
+      try {
+        cv::Mat img = scene.RenderCamera(c, f, &stats[c][f]);
+        if (f == 0) first[c] = img.clone();
+        CameraOut& out = *outs[c];
+        std::lock_guard<std::mutex> lock(out.mutex);
+        out.pending.emplace(f, std::move(img));
+        write_ready(out, c);
+      } catch (const std::exception& e) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (error.empty()) error = e.what();
+        next = total;
+      }
+    }
+  };
+  Progress prog("synth: rendering", total, "frames", progress);
+  const int n_threads = static_cast<int>(
+      std::min<long long>(total, std::max(1u, std::thread::hardware_concurrency())));
+  std::vector<std::thread> threads;
+  for (int k = 0; k < n_threads; ++k) threads.emplace_back(worker);
+  while (true) {
+    bool all_done = done.load() >= total;
+    {
+      std::lock_guard<std::mutex> lock(error_mutex);
+      all_done = all_done || !error.empty();
+    }
+    prog.Update(done.load());
+    if (all_done) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  for (auto& t : threads) t.join();
+  for (auto& o : outs) o->writer.release();
+  prog.Update(done.load());
+  prog.Finish();
+  FV_REQUIRE(error.empty(), "{}", error);
+}
+
+// truth.csv (centre, cameras that see it) and truth_2d.csv (per camera in front of the ball).
+void WriteBallTruth(const SceneSpec& spec, const SceneRenderer& scene, const SceneFolder& folder,
+                    const std::vector<std::vector<CameraFrameStats>>& stats,
+                    WriteSceneResult& res) {
+  const int nc = res.num_cameras, nf = spec.num_frames;
+  CsvWriter truth(folder.Path("truth.csv"), {"frame", "time_s", "x_m", "y_m", "z_m", "n_cams"}, 6);
+  CsvWriter truth2d(folder.Path("truth_2d.csv"),
+                    {"frame", "cam", "u_px", "v_px", "radius_px", "visible_fraction"}, 4);
+  if (spec.ball.enabled) {
+    for (int f = 0; f < nf; ++f) {
+      const Eigen::Vector3d c = scene.BallAt(scene.FrameTime(f));
+      int n_cams = 0;
+      for (int k = 0; k < nc; ++k) {
+        const BallCameraTruth& b = stats[k][f].ball;
+        if (b.in_front && b.visible_fraction >= 0.3) ++n_cams;
+        if (!b.in_front) continue;
+        truth2d << f << scene.cameras()[k].name << b.uv_px.x() << b.uv_px.y() << b.radius_px
+                << b.visible_fraction;
+        truth2d.EndRow();
+      }
+      if (n_cams >= 2) ++res.frames_with_ball_in_2plus_cams;
+      truth << f << scene.FrameTime(f) << c.x() << c.y() << c.z() << n_cams;
+      truth.EndRow();
+    }
+  }
+  truth.Close();
+  truth2d.Close();
+  res.files.push_back(folder.Path("truth.csv"));
+  res.files.push_back(folder.Path("truth_2d.csv"));
+}
+
+// players.csv (positions from the paths the renderer used) and players_2d.csv (image boxes).
+void WritePlayerTruth(const SceneSpec& spec, const SceneRenderer& scene, const SceneFolder& folder,
+                      const std::vector<std::vector<CameraFrameStats>>& stats,
+                      WriteSceneResult& res) {
+  const int nc = res.num_cameras, nf = spec.num_frames;
+  CsvWriter players(folder.Path("players.csv"), {"frame", "time_s", "id", "team", "x_m", "y_m"}, 4);
+  CsvWriter players2d(
+      folder.Path("players_2d.csv"),
+      {"frame", "cam", "id", "bb_left", "bb_top", "bb_width", "bb_height", "visible_fraction"}, 4);
+  for (int f = 0; f < nf; ++f) {
+    const double t = scene.FrameTime(f);
+    for (size_t i = 0; i < spec.people.size(); ++i) {
+      const PersonSpec& p = spec.people[i];
+      const Eigen::Vector2d xy = PathAt(p.path, t).position_m;
+      players << f << t << p.id << p.team << xy.x() << xy.y();
+      players.EndRow();
+      for (int k = 0; k < nc; ++k) {
+        const PlayerCameraTruth& pc = stats[k][f].players[i];
+        if (!pc.in_image) continue;
+        players2d << f << scene.cameras()[k].name << p.id << pc.bb_left << pc.bb_top << pc.bb_width
+                  << pc.bb_height << pc.visible_fraction;
+        players2d.EndRow();
+      }
+    }
+  }
+  players.Close();
+  players2d.Close();
+  res.files.push_back(folder.Path("players.csv"));
+  res.files.push_back(folder.Path("players_2d.csv"));
+}
+
+}  // namespace
+
 WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir, bool progress) {
   const auto t0 = std::chrono::steady_clock::now();
   spec.Check();
@@ -80,188 +269,33 @@ WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir, b
   res.num_cameras = static_cast<int>(spec.cameras.size());
   const SceneRenderer scene(spec);
   res.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  auto path = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
-
-  {
-    const std::string p = path("scene.json");
-    std::ofstream out(p);
-    FV_REQUIRE(out.good(), "cannot write '{}'", p);
-    out << SceneSpecToJson(spec).dump(2) << "\n";
-    FV_REQUIRE(out.good(), "cannot write '{}'", p);
-    res.files.push_back(p);
-  }
-  for (const Camera& cam : scene.cameras()) {
-    const std::string p = path(cam.name + ".yaml");
-    WriteCameraYaml(cam, p);
-    res.files.push_back(p);
-  }
+  const SceneFolder folder{out_dir};
+  WriteSpecAndCameras(spec, scene, folder, res);
 
   const int nc = res.num_cameras, nf = spec.num_frames;
   std::vector<std::vector<CameraFrameStats>> stats(nc, std::vector<CameraFrameStats>(nf));
   std::vector<cv::Mat> first(nc);
-  std::vector<std::string> video_files(nc);
-  for (int c = 0; c < nc; ++c) {
-    const std::string& name = scene.cameras()[c].name;
-    if (spec.format == "avi") {
-      video_files[c] = path(name + ".avi");
-    } else {
-      fs::create_directories(path(name), ec);
-      FV_REQUIRE(!ec, "cannot create folder '{}'", path(name));
-      video_files[c] = path(name + "/%05d." + spec.format);
-    }
-  }
-  // Work items are (frame, camera) in frame-major order, rendered by a pool of threads; each
-  // camera's frames are written in order as soon as they are ready.
-  struct CameraOut {
-    std::mutex mutex;
-    cv::VideoWriter writer;
-    std::map<int, cv::Mat> pending;
-    int next_write = 0;
-  };
-  std::vector<std::unique_ptr<CameraOut>> outs;
-  for (int c = 0; c < nc; ++c) {
-    outs.push_back(std::make_unique<CameraOut>());
-    if (spec.format != "avi") continue;
-    const Camera& cam = scene.cameras()[c];
-    cv::VideoWriter& writer = outs.back()->writer;
-    writer.open(video_files[c], cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
-                spec.fps, cv::Size(cam.width, cam.height), true);
-    FV_REQUIRE(writer.isOpened(), "cannot open video '{}' for writing", video_files[c]);
-    writer.set(cv::VIDEOWRITER_PROP_QUALITY, spec.jpeg_quality);
-  }
-  const std::vector<int> params =
-      spec.format == "jpg" ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, spec.jpeg_quality}
-                           : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};
-  const long long total = static_cast<long long>(nc) * nf;
-  std::atomic<long long> done{0};
-  std::atomic<long long> next{0};
-  std::mutex error_mutex;
-  std::string error;
-  auto worker = [&] {
-    for (long long i = next++; i < total; i = next++) {
-      const int f = static_cast<int>(i / nc), c = static_cast<int>(i % nc);
-      try {
-        cv::Mat img = scene.RenderCamera(c, f, &stats[c][f]);
-        if (f == 0) first[c] = img.clone();
-        CameraOut& out = *outs[c];
-        std::lock_guard<std::mutex> lock(out.mutex);
-        out.pending.emplace(f, std::move(img));
-        while (!out.pending.empty() && out.pending.begin()->first == out.next_write) {
-          if (spec.format == "avi") {
-            out.writer.write(out.pending.begin()->second);
-          } else {
-            const std::string p = fmt::format("{}/{}/{:05d}.{}", out_dir, scene.cameras()[c].name,
-                                              out.next_write, spec.format);
-            FV_REQUIRE(cv::imwrite(p, out.pending.begin()->second, params),
-                       "cannot write image '{}'", p);
-          }
-          out.pending.erase(out.pending.begin());
-          ++out.next_write;
-          ++done;
-        }
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (error.empty()) error = e.what();
-        next = total;
-      }
-    }
-  };
-  {
-    Progress prog("synth: rendering", static_cast<long long>(nc) * nf, "frames", progress);
-    const int n_threads = static_cast<int>(
-        std::min<long long>(total, std::max(1u, std::thread::hardware_concurrency())));
-    std::vector<std::thread> threads;
-    for (int k = 0; k < n_threads; ++k) threads.emplace_back(worker);
-    while (true) {
-      bool all_done = done.load() >= total;
-      {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        all_done = all_done || !error.empty();
-      }
-      prog.Update(done.load());
-      if (all_done) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    }
-    for (auto& t : threads) t.join();
-    for (auto& o : outs) o->writer.release();
-    prog.Update(done.load());
-    prog.Finish();
-  }
-  FV_REQUIRE(error.empty(), "{}", error);
-  for (int c = 0; c < nc; ++c) res.files.push_back(video_files[c]);
+  auto outs = OpenOutputs(spec, scene, folder);
+  RenderAndWrite(spec, scene, folder, outs, stats, first, progress);
+  for (const auto& o : outs) res.files.push_back(o->file);
 
-  // Ball truth.
+  WriteBallTruth(spec, scene, folder, stats, res);
   {
-    CsvWriter truth(path("truth.csv"), {"frame", "time_s", "x_m", "y_m", "z_m", "n_cams"}, 6);
-    CsvWriter truth2d(path("truth_2d.csv"),
-                      {"frame", "cam", "u_px", "v_px", "radius_px", "visible_fraction"}, 4);
-    if (spec.ball.enabled) {
-      for (int f = 0; f < nf; ++f) {
-        const Eigen::Vector3d c = scene.BallAt(scene.FrameTime(f));
-        int n_cams = 0;
-        for (int k = 0; k < nc; ++k) {
-          const BallCameraTruth& b = stats[k][f].ball;
-          if (b.in_front && b.visible_fraction >= 0.3) ++n_cams;
-          if (!b.in_front) continue;
-          truth2d << f << scene.cameras()[k].name << b.uv_px.x() << b.uv_px.y() << b.radius_px
-                  << b.visible_fraction;
-          truth2d.EndRow();
-        }
-        if (n_cams >= 2) ++res.frames_with_ball_in_2plus_cams;
-        truth << f << scene.FrameTime(f) << c.x() << c.y() << c.z() << n_cams;
-        truth.EndRow();
-      }
-    }
-    truth.Close();
-    truth2d.Close();
-    res.files.push_back(path("truth.csv"));
-    res.files.push_back(path("truth_2d.csv"));
-  }
-  {
-    const std::string p = path("flights.json");
+    const std::string p = folder.Path("flights.json");
     std::ofstream out(p);
     FV_REQUIRE(out.good(), "cannot write '{}'", p);
     out << FlightsToJson(scene.Flights()).dump(2) << "\n";
     res.files.push_back(p);
   }
-  if (!spec.people.empty()) {
-    CsvWriter players(path("players.csv"), {"frame", "time_s", "id", "team", "x_m", "y_m"}, 4);
-    CsvWriter players2d(
-        path("players_2d.csv"),
-        {"frame", "cam", "id", "bb_left", "bb_top", "bb_width", "bb_height", "visible_fraction"},
-        4);
-    // Positions from the paths the renderer used; boxes from the rendering.
-    for (int f = 0; f < nf; ++f) {
-      const double t = scene.FrameTime(f);
-      for (size_t i = 0; i < spec.people.size(); ++i) {
-        const PersonSpec& p = spec.people[i];
-        const Eigen::Vector2d xy = PathAt(p.path, t).position_m;
-        players << f << t << p.id << p.team << xy.x() << xy.y();
-        players.EndRow();
-        for (int k = 0; k < nc; ++k) {
-          const PlayerCameraTruth& pc = stats[k][f].players[i];
-          if (!pc.in_image) continue;
-          players2d << f << scene.cameras()[k].name << p.id << pc.bb_left << pc.bb_top
-                    << pc.bb_width << pc.bb_height << pc.visible_fraction;
-          players2d.EndRow();
-        }
-      }
-    }
-    players.Close();
-    players2d.Close();
-    res.files.push_back(path("players.csv"));
-    res.files.push_back(path("players_2d.csv"));
+  if (!spec.people.empty()) WritePlayerTruth(spec, scene, folder, stats, res);
+  std::vector<std::string> names;
+  for (const Camera& c : scene.cameras()) {
+    names.push_back(fmt::format("{}  {}x{}  frame 0", c.name, c.width, c.height));
   }
-  {
-    std::vector<std::string> names;
-    for (const Camera& c : scene.cameras()) {
-      names.push_back(fmt::format("{}  {}x{}  frame 0", c.name, c.width, c.height));
-    }
-    const cv::Mat sheet = ContactSheet(first, names, first.size() > 1 ? 640 : 960);
-    const std::string p = path("contact_sheet.png");
-    FV_REQUIRE(cv::imwrite(p, sheet), "cannot write '{}'", p);
-    res.files.push_back(p);
-  }
+  const cv::Mat sheet = ContactSheet(first, names, first.size() > 1 ? 640 : 960);
+  const std::string p = folder.Path("contact_sheet.png");
+  FV_REQUIRE(cv::imwrite(p, sheet), "cannot write '{}'", p);
+  res.files.push_back(p);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
