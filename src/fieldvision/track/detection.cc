@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -17,7 +15,6 @@
 #include "fieldvision/util/strings.h"
 
 namespace fv::track {
-namespace fs = std::filesystem;
 
 void DetectorOptions::Check() const {
   FV_REQUIRE(kind == "nanodet" || kind == "hog" || kind == "motion" || kind == "onnx",
@@ -135,45 +132,9 @@ DetectionsFile ReadDetectionsCsv(const std::string& path) {
   return out;
 }
 
-std::string FindModel(const std::string& file) {
-  std::vector<fs::path> dirs;
-  if (const char* env = std::getenv("FV_MODELS_DIR")) dirs.emplace_back(env);
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back(exe.parent_path().parent_path() / "models");
-  dirs.push_back(fs::current_path(ec) / "models");
-  dirs.push_back(fs::current_path(ec) / "build" / "models");
-  std::string looked;
-  for (const auto& d : dirs) {
-    const fs::path p = d / file;
-    if (fs::exists(p, ec)) return p.string();
-    looked += (looked.empty() ? "" : ", ") + d.string();
-  }
-  Throw(
-      "model '{}' not found (looked in {}); run `make build`, which fetches and converts it "
-      "(scripts/fetch-models.sh BUILD_DIR)",
-      file, looked);
-}
-
 namespace {
 
-cv::dnn::Net LoadOnnx(const std::string& path) {
-  FV_REQUIRE(fs::exists(path),
-             "model '{}' not found; run `make build` to fetch and convert the detector", path);
-  cv::dnn::Net net;
-  try {
-    net = cv::dnn::readNetFromONNX(path);
-  } catch (const cv::Exception& e) {
-    Throw(
-        "model '{}' is corrupt or not an ONNX model OpenCV can read; run `make build` to fetch "
-        "and convert it again",
-        path);
-  }
-  FV_REQUIRE(!net.empty(), "model '{}' has no layers; run `make build` to fetch it again", path);
-  net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
-  net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
-  return net;
-}
+using fv::dnn::LoadOnnx;
 
 std::vector<Detection> Finish(std::vector<Detection> dets, const DetectorOptions& o,
                               const FootFilter& filter) {
@@ -182,20 +143,8 @@ std::vector<Detection> Finish(std::vector<Detection> dets, const DetectorOptions
 
 class NanoDetDetector : public PersonDetector {
  public:
-  NanoDetDetector(const DetectorOptions& o, FootFilter filter) : o_(o), filter_(std::move(filter)) {
-    path_ = o.model_path.empty() ? FindModel("nanodet.onnx") : o.model_path;
-    net_ = LoadOnnx(path_);
-    // A forward pass on a blank image checks that the model has NanoDet's outputs.
-    try {
-      const int w = o.input_width > 0 ? o.input_width : 416;
-      RunNet(cv::Mat(w, w, CV_8UC3, cv::Scalar::all(0)));
-    } catch (const cv::Exception& e) {
-      Throw(
-          "model '{}' does not run as NanoDet (outputs cls8..dis32 expected); run `make build` "
-          "to convert it again",
-          path_);
-    }
-  }
+  NanoDetDetector(const DetectorOptions& o, FootFilter filter)
+      : o_(o), filter_(std::move(filter)), net_(o.model_path) {}
   std::string name() const override { return "nanodet"; }
 
   std::vector<Detection> Detect(const cv::Mat& bgr) override {
@@ -207,33 +156,18 @@ class NanoDetDetector : public PersonDetector {
             : std::max(
                   32,
                   static_cast<int>(std::lround(net_w * double(bgr.rows) / bgr.cols / 32.0)) * 32);
-    cv::Mat resized;
-    cv::resize(bgr, resized, cv::Size(net_w, net_h), 0, 0, cv::INTER_LINEAR);
-    const std::vector<cv::Mat> outs = RunNet(resized);
-    std::vector<Detection> dets = DecodeNanoDet(outs, net_w, net_h, o_.score_threshold);
-    const double sx = double(bgr.cols) / net_w, sy = double(bgr.rows) / net_h;
-    for (auto& d : dets) {
-      d.box = cv::Rect2d(d.box.x * sx, d.box.y * sy, d.box.width * sx, d.box.height * sy);
+    std::vector<Detection> dets;
+    for (const dnn::DnnBox& b :
+         net_.Detect(bgr, cv::Size(net_w, net_h), o_.score_threshold, {dnn::kCocoPerson})) {
+      dets.push_back({b.box, b.score});
     }
     return Finish(std::move(dets), o_, filter_);
   }
 
  private:
-  std::vector<cv::Mat> RunNet(const cv::Mat& resized) {
-    cv::Mat f;
-    resized.convertTo(f, CV_32FC3);
-    cv::subtract(f, cv::Scalar(103.53, 116.28, 123.675), f);
-    cv::multiply(f, cv::Scalar(1 / 57.375, 1 / 57.12, 1 / 58.395), f);
-    net_.setInput(cv::dnn::blobFromImage(f));
-    std::vector<cv::Mat> outs;
-    net_.forward(outs, std::vector<cv::String>{"cls8", "cls16", "cls32", "dis8", "dis16", "dis32"});
-    return outs;
-  }
-
   DetectorOptions o_;
   FootFilter filter_;
-  std::string path_;
-  cv::dnn::Net net_;
+  dnn::NanoDet net_;
 };
 
 class HogDetector : public PersonDetector {
@@ -391,42 +325,10 @@ class OnnxYoloDetector : public PersonDetector {
 
 std::vector<Detection> DecodeNanoDet(const std::vector<cv::Mat>& outputs, int net_width,
                                      int net_height, double score_threshold) {
-  FV_REQUIRE(outputs.size() == 6, "NanoDet: expected 6 outputs, got {}", outputs.size());
-  constexpr int kStrides[3] = {8, 16, 32};
-  constexpr int kBins = 11;
-  constexpr int kPerson = 0;
   std::vector<Detection> dets;
-  for (int level = 0; level < 3; ++level) {
-    const int s = kStrides[level];
-    const int fw = (net_width + s - 1) / s, fh = (net_height + s - 1) / s;
-    const cv::Mat& cls = outputs[level];
-    const cv::Mat& dis = outputs[3 + level];
-    FV_REQUIRE(cls.total() == size_t(fw) * fh * 80 && dis.total() == size_t(fw) * fh * 44,
-               "NanoDet: output sizes do not match a {}x{} input", net_width, net_height);
-    const float* c = cls.ptr<float>();
-    const float* d = dis.ptr<float>();
-    for (int idx = 0; idx < fw * fh; ++idx) {
-      const float score = c[idx * 80 + kPerson];
-      if (score < score_threshold) continue;
-      const double cx = (idx % fw + 0.5) * s, cy = (idx / fw + 0.5) * s;
-      double side[4];
-      for (int k = 0; k < 4; ++k) {
-        const float* bins = d + idx * 44 + k * kBins;
-        const float mx = *std::max_element(bins, bins + kBins);
-        double sum = 0, mean = 0;
-        for (int b = 0; b < kBins; ++b) {
-          const double e = std::exp(double(bins[b]) - mx);
-          sum += e;
-          mean += e * b;
-        }
-        side[k] = mean / sum * s;
-      }
-      const double x0 = std::max(0.0, cx - side[0]), y0 = std::max(0.0, cy - side[1]);
-      const double x1 = std::min<double>(net_width, cx + side[2]);
-      const double y1 = std::min<double>(net_height, cy + side[3]);
-      if (x1 <= x0 || y1 <= y0) continue;
-      dets.push_back({cv::Rect2d(x0, y0, x1 - x0, y1 - y0), score});
-    }
+  for (const dnn::DnnBox& b :
+       dnn::DecodeNanoDet(outputs, net_width, net_height, score_threshold, {dnn::kCocoPerson})) {
+    dets.push_back({b.box, b.score});
   }
   return dets;
 }

@@ -21,6 +21,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/camera/camera.h"
+#include "fieldvision/dnn/nanodet.h"
 
 namespace fv::track {
 
@@ -112,14 +113,12 @@ std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_
                            double score_threshold = 0.0);
 double Iou(const cv::Rect2d& a, const cv::Rect2d& b);
 
-// Where the set-up put the models: $FV_MODELS_DIR, <program dir>/../models, ./models,
-// ./build/models. Returns the first existing path of `file`, or throws fv::Error saying to run
-// `make build` (which runs scripts/fetch-models.sh).
-std::string FindModel(const std::string& file);
+// Where the set-up put the models (dnn/nanodet.h).
+using fv::dnn::FindModel;
 
-// NanoDet's decoder, exposed for tests: the six outputs (cls8, cls16, cls32: 1 x N x 80;
-// dis8, dis16, dis32: 1 x N x 44) of a net_width x net_height input -> person boxes in network
-// pixels with score >= score_threshold (before NMS).
+// NanoDet's decoder for the person class (dnn::DecodeNanoDet), exposed for tests: the six outputs
+// (cls8, cls16, cls32: 1 x N x 80; dis8, dis16, dis32: 1 x N x 44) of a net_width x net_height
+// input -> person boxes in network pixels with score >= score_threshold (before NMS).
 std::vector<Detection> DecodeNanoDet(const std::vector<cv::Mat>& outputs, int net_width,
                                      int net_height, double score_threshold);
 
