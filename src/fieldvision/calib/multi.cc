@@ -785,10 +785,11 @@ void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult*
     } else if (options.tangential != TangentialModel::kAuto) {
       rep.model = name + (s.tangential[c] ? " (--tangential free)" : " (--tangential zero)");
     } else {
-      rep.model =
-          fmt::format("{} (p1 p2 {}: rms {:.4f} px without, {:.4f} px with, BIC gain {:.1f})", name,
-                      s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
-                      rep.rms_with_tangential_px, rep.tangential_bic);
+      rep.model = fmt::format(
+          "{} (p1 p2 {}: its rms {:.4f} px without them, {:.4f} px with; the rig's BIC gain "
+          "{:.1f})",
+          name, s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
+          rep.rms_with_tangential_px, rep.tangential_bic);
     }
   }
 }
