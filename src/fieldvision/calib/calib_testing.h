@@ -88,4 +88,24 @@ inline double WorstCentreErrorM(const std::vector<Camera>& a, const std::vector<
   return worst;
 }
 
+// Where a placement puts the field: the distance between a point of the playing area (a 1 m
+// grid at heights 0 and 1 m) and where placement `a` puts it when truth `b` is right (the same
+// camera coordinates: x_a = A0^-1 B0 x). Returns the median; *max the largest.
+inline double FieldPositionErrorM(const std::vector<Camera>& a, const std::vector<Camera>& b,
+                                  const FieldModel& field, double* max) {
+  const Rigid3d a_from_b = a[0].cam_from_world.Inverse() * b[0].cam_from_world;
+  std::vector<double> err;
+  for (double x = -0.5 * field.length_m; x <= 0.5 * field.length_m + 1e-9; x += 1.0) {
+    for (double y = -0.5 * field.width_m; y <= 0.5 * field.width_m + 1e-9; y += 1.0) {
+      for (double z : {0.0, 1.0}) {
+        const Eigen::Vector3d p(x, y, z);
+        err.push_back((a_from_b * p - p).norm());
+      }
+    }
+  }
+  std::sort(err.begin(), err.end());
+  *max = err.back();
+  return err[err.size() / 2];
+}
+
 }  // namespace fv::calib::test_util

@@ -92,13 +92,14 @@ std::string IntrinsicsResult::Summary() const {
   return s + "]";
 }
 
-IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
-                                    const IntrinsicsOptions& options) {
-  options.Check();
-  IntrinsicsResult result;
-  result.num_images = static_cast<int>(views.size());
+namespace {  // The stages of CalibrateFromViews.
+
+// Reports every view and checks them; returns the views with the board, *size their image size.
+std::vector<int> CheckViews(const std::vector<BoardView>& views, const IntrinsicsOptions& options,
+                            IntrinsicsResult* out, cv::Size* size_out) {
+  IntrinsicsResult& result = *out;
   std::vector<int> found;
-  cv::Size size;
+  cv::Size& size = *size_out;
   for (size_t i = 0; i < views.size(); ++i) {
     ViewReport rep;
     rep.name = views[i].name;
@@ -125,12 +126,31 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
              "the {} was found in only {} of {} images; at least {} views are needed",
              options.board.Describe(), result.num_found, views.size(), options.min_views);
 
-  const int flags = CalibFlags(options);
-  const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * result.num_found));
-  std::vector<int> used = found;
-  cv::Mat k, d, std_intr, std_extr, per_view;
-  std::vector<cv::Mat> rvecs, tvecs;
+  return found;
+}
+
+// What calibrateCamera gives on the used views.
+struct CvFit {
+  std::vector<int> used;
+  cv::Mat k, d, std_intr;
+  std::vector<cv::Mat> rvecs;
   double rms = 0;
+};
+
+// calibrateCamera on the views with the board, dropping the worst view above the outlier
+// threshold and fitting again while the budget allows.
+CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector<int>& found,
+                          const cv::Size& size, const IntrinsicsOptions& options, int max_drop,
+                          IntrinsicsResult* out) {
+  IntrinsicsResult& result = *out;
+  const int flags = CalibFlags(options);
+  CvFit fit;
+  std::vector<int>& used = fit.used;
+  used = found;
+  cv::Mat &k = fit.k, &d = fit.d, &std_intr = fit.std_intr, std_extr, per_view;
+  std::vector<cv::Mat>& rvecs = fit.rvecs;
+  std::vector<cv::Mat> tvecs;
+  double& rms = fit.rms;
   while (true) {
     std::vector<std::vector<cv::Point3f>> obj;
     std::vector<std::vector<cv::Point2f>> img;
@@ -177,7 +197,14 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   }
   result.num_used = static_cast<int>(used.size());
   result.rms_px = rms;
+  return fit;
+}
 
+// The camera and the standard deviations of its intrinsics from the fit.
+void SetCamera(const CvFit& fit, const cv::Size& size, const IntrinsicsOptions& options,
+               IntrinsicsResult* out) {
+  IntrinsicsResult& result = *out;
+  const cv::Mat &k = fit.k, &d = fit.d, &std_intr = fit.std_intr;
   Camera& cam = result.camera;
   cam.name = options.camera_name;
   cam.width = size.width;
@@ -190,7 +217,7 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   for (int i = 0; i < options.num_distortion && i < static_cast<int>(d.total()); ++i) {
     cam.distortion[i] = d.at<double>(i);
   }
-  cam.rms_px = rms;
+  cam.rms_px = fit.rms;
   cam.Check("calibrated camera");
   if (std_intr.total() >= 4) {
     result.std_fx_px = std_intr.at<double>(0);
@@ -199,10 +226,14 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
     result.std_cy_px = std_intr.at<double>(3);
     if (options.fix_aspect_ratio) result.std_fx_px = result.std_fy_px * cam.fx / cam.fy;
   }
+}
 
-  // Coverage of the image by the corners of the used views, and the spread of board tilts.
-  CoverageReport& cov = result.coverage;
-  cov.grid = options.coverage_grid;
+// Coverage of the image by the corners of the used views, and the spread of board tilts.
+CoverageReport Coverage(const std::vector<BoardView>& views, const CvFit& fit, const cv::Size& size,
+                        int grid) {
+  const std::vector<int>& used = fit.used;
+  CoverageReport cov;
+  cov.grid = grid;
   cov.corners_per_cell.assign(static_cast<size_t>(cov.grid) * cov.grid, 0);
   const double half_diag = 0.5 * std::hypot(size.width, size.height);
   std::vector<cv::Vec3d> normals;
@@ -216,7 +247,7 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
           std::hypot(p.x - 0.5 * (size.width - 1), p.y - 0.5 * (size.height - 1)) / half_diag);
     }
     cv::Mat r;
-    cv::Rodrigues(rvecs[j], r);
+    cv::Rodrigues(fit.rvecs[j], r);
     normals.emplace_back(r.at<double>(0, 2), r.at<double>(1, 2), r.at<double>(2, 2));
   }
   cov.cell_fraction =
@@ -230,7 +261,15 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
     }
   }
 
-  // Warnings when the views do not pin the model down.
+  return cov;
+}
+
+// Warnings when the views do not pin the model down.
+void AddWarnings(const cv::Size& size, const IntrinsicsOptions& options, int max_drop,
+                 IntrinsicsResult* out) {
+  IntrinsicsResult& result = *out;
+  const Camera& cam = result.camera;
+  const CoverageReport& cov = result.coverage;
   auto& w = result.warnings;
   if (result.num_used < 8) {
     w.push_back(fmt::format("only {} views: use 10 or more, spread over the image and tilted",
@@ -266,7 +305,12 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   if (dropped > 0 && dropped >= max_drop) {
     w.push_back(fmt::format("{} views were dropped as outliers (the most allowed)", dropped));
   }
+}
 
+// The camera file's notes: board, views used and dropped, model, date.
+void AddNotes(const IntrinsicsOptions& options, IntrinsicsResult* out) {
+  IntrinsicsResult& result = *out;
+  Camera& cam = result.camera;
   std::string used_names, dropped_names;
   for (const auto& v : result.views) {
     if (v.used) used_names += (used_names.empty() ? "" : " ") + v.name;
@@ -278,6 +322,23 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   cam.notes["num_views"] = std::to_string(result.num_used);
   cam.notes["distortion_model"] = std::to_string(options.num_distortion) + " coefficients";
   cam.notes["date"] = Today();
+}
+
+}  // namespace
+
+IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
+                                    const IntrinsicsOptions& options) {
+  options.Check();
+  IntrinsicsResult result;
+  result.num_images = static_cast<int>(views.size());
+  cv::Size size;
+  const std::vector<int> found = CheckViews(views, options, &result, &size);
+  const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * result.num_found));
+  const CvFit fit = FitDroppingOutliers(views, found, size, options, max_drop, &result);
+  SetCamera(fit, size, options, &result);
+  result.coverage = Coverage(views, fit, size, options.coverage_grid);
+  AddWarnings(size, options, max_drop, &result);
+  AddNotes(options, &result);
   return result;
 }
 

@@ -36,7 +36,8 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
   const auto truth = test_util::PresetCameras("demo", 1);
   ASSERT_EQ(truth.size(), 4u);
   const auto rig = InRigFrame(truth);
-  std::vector<double> one_cam, spread;
+  std::vector<double> one_cam, spread, field_one, field_spread, field_max_one, field_max_spread;
+  double field_max = 0;
   for (int trial = 0; trial < 20; ++trial) {
     std::vector<std::vector<PointCorrespondence>> pts(4);
     pts[2] = test_util::ClickKeypoints(truth[2], field, 6, 1.0, rng);
@@ -46,6 +47,8 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
     // The optimum: the placement fits the clicks at least as well as the truth does.
     EXPECT_LE(SquaredErrorPx2(a.cameras, pts), SquaredErrorPx2(truth, pts) * (1 + 1e-6));
     one_cam.push_back(WorstCentreErrorM(a.cameras, truth));
+    field_one.push_back(test_util::FieldPositionErrorM(a.cameras, truth, field, &field_max));
+    field_max_one.push_back(field_max);
 
     std::vector<std::vector<PointCorrespondence>> spread_pts(4);
     for (int c : {0, 1, 3}) spread_pts[c] = test_util::ClickKeypoints(truth[c], field, 2, 1.0, rng);
@@ -54,15 +57,31 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
     EXPECT_LE(SquaredErrorPx2(b.cameras, spread_pts),
               SquaredErrorPx2(truth, spread_pts) * (1 + 1e-6));
     spread.push_back(WorstCentreErrorM(b.cameras, truth));
+    field_spread.push_back(test_util::FieldPositionErrorM(b.cameras, truth, field, &field_max));
+    field_max_spread.push_back(field_max);
   }
-  std::sort(one_cam.begin(), one_cam.end());
-  std::sort(spread.begin(), spread.end());
+  for (auto* v :
+       {&one_cam, &spread, &field_one, &field_spread, &field_max_one, &field_max_spread}) {
+    std::sort(v->begin(), v->end());
+  }
+  std::cout << "points of the field (1 m grid, heights 0 and 1 m) as the placed rig puts them, "
+               "over 20 placements: 6 clicks in one camera: median "
+            << 1000 * field_one[10] << " mm (worst point: median " << 1000 * field_max_one[10]
+            << " mm, max " << 1000 * field_max_one.back()
+            << " mm); 2 clicks in each of 3 cameras: median " << 1000 * field_spread[10]
+            << " mm (worst point: median " << 1000 * field_max_spread[10] << " mm, max "
+            << 1000 * field_max_spread.back() << " mm)\n";
   std::cout << "worst camera centre error over 20 placements: 6 clicks in one camera: median "
             << 1000 * one_cam[10] << " mm, max " << 1000 * one_cam.back()
             << " mm; 2 clicks in each of 3 cameras: median " << 1000 * spread[10] << " mm, max "
             << 1000 * spread.back() << " mm\n";
   // 1 px is about 2 cm on the ground at 20 m: six clicks place the rig within a few cm (the
   // optimum: checked above against the truth's own fit), not 1 cm.
+  // The field itself (where the rig puts the ball) is placed better than the camera centres, but
+  // still not within 1 cm from 6 clicks of 1 px (median 18 mm, 27 mm with the clicks spread over
+  // three cameras); the painted lines bring it to about a millimetre (rig_lines_test).
+  EXPECT_LT(field_one[10], 0.035);
+  EXPECT_LT(field_spread[10], 0.06);
   EXPECT_LT(one_cam[10], 0.06);
   EXPECT_LT(one_cam.back(), 0.15);
   EXPECT_LT(spread[10], 0.10);
