@@ -51,6 +51,10 @@ std::string ResolveOutputPath(const std::string& out, std::string_view what) {
   if (fs::exists(st)) {
     FV_REQUIRE(fs::is_regular_file(st), "{} '{}' exists and is not a regular file", what, out);
   }
+  // Writers would otherwise fail on the temporary name, which the user never gave.
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  FV_REQUIRE(fs::is_directory(folder, ec), "{} '{}': folder '{}' does not exist", what, out,
+             folder.string());
   return target.string();
 }
 

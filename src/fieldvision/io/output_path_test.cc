@@ -92,6 +92,9 @@ TEST(AtomicWrite, WritesThroughASymlinkAndRefusesDevicesAndFolders) {
   EXPECT_THROW(ResolveOutputPath(dir), Error);
   EXPECT_THROW(ResolveOutputPath(""), Error);
   EXPECT_EQ(ResolveOutputPath(dir + "/new.csv"), dir + "/new.csv");
+  // A missing folder is named with the output, not with the temporary file's name.
+  const std::string lost = dir + "/no/such/out.csv";
+  EXPECT_NE(testing::ErrorOf([&] { ResolveOutputPath(lost); }).find(lost), std::string::npos);
 }
 
 }  // namespace
