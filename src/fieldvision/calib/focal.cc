@@ -1,5 +1,6 @@
 #include "fieldvision/calib/focal.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -84,20 +85,14 @@ std::string FocalResult::Summary() const {
   return s;
 }
 
-FocalResult EstimateFocalAndPose(int width, int height,
-                                 const std::vector<PointCorrespondence>& points,
-                                 const FocalOptions& options) {
-  options.Check();
-  FV_REQUIRE(width > 0 && height > 0, "image size {}x{} is not valid (give --image-size WxH)",
-             width, height);
-  const int n = static_cast<int>(points.size());
-  FV_REQUIRE(n >= options.min_points,
-             "only {} points given; the focal length and the pose from one frame need at least {}",
-             n, options.min_points);
-  // Starts: PnP at a sweep of fields of view; the most inliers, then the smallest error.
+namespace {  // The stages of EstimateFocalAndPose.
+
+// Starts: PnP at a sweep of fields of view; the most inliers, then the smallest error.
+ExtrinsicsResult StartFromFovSweep(int width, int height,
+                                   const std::vector<PointCorrespondence>& points,
+                                   const FocalOptions& options) {
   bool have = false;
   ExtrinsicsResult best;
-  double best_hfov = 0;
   std::string last_error;
   for (int i = 0; i < options.hfov_steps; ++i) {
     const double hfov = options.min_hfov_deg * std::pow(options.max_hfov_deg / options.min_hfov_deg,
@@ -108,7 +103,6 @@ FocalResult EstimateFocalAndPose(int width, int height,
       if (!have || e.num_inliers > best.num_inliers ||
           (e.num_inliers == best.num_inliers && e.rms_px < best.rms_px)) {
         best = std::move(e);
-        best_hfov = hfov;
         have = true;
       }
     } catch (const Error& e) {
@@ -118,27 +112,25 @@ FocalResult EstimateFocalAndPose(int width, int height,
   }
   FV_REQUIRE(have, "no focal length between {:.0f} and {:.0f} deg of view fits the points: {}",
              options.min_hfov_deg, options.max_hfov_deg, last_error);
-  (void)best_hfov;
+  return best;
+}
 
+// The parameters x = f, k1, rvec, tvec and their fit to a subset of the points.
+struct FocalFit {
+  int width = 0, height = 0;
+  const std::vector<PointCorrespondence>& points;
+  const FocalOptions& options;
   std::array<double, 8> x{};
-  x[0] = best.camera.fx;
-  x[1] = 0.0;
-  const Eigen::Vector3d r0 = best.camera.cam_from_world.Rvec();
-  for (int k = 0; k < 3; ++k) {
-    x[2 + k] = r0[k];
-    x[5 + k] = best.camera.cam_from_world.translation[k];
-  }
-  const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
-  auto solve = [&](const std::vector<bool>& use, bool robust, ceres::Problem* problem) {
-    for (int k = 0; k < n; ++k) {
+
+  ceres::Solver::Summary Solve(const std::vector<bool>& use, bool robust, ceres::Problem* problem) {
+    const double cx = 0.5 * (width - 1), cy = 0.5 * (height - 1);
+    for (size_t k = 0; k < points.size(); ++k) {
       if (!use[k]) continue;
       problem->AddResidualBlock(new ceres::AutoDiffCostFunction<FocalPointCost, 2, 8>(
                                     new FocalPointCost(cx, cy, points[k].uv_px, points[k].p_world)),
                                 robust ? new ceres::HuberLoss(2.0) : nullptr, x.data());
     }
-    if (!options.estimate_k1) {
-      problem->SetManifold(x.data(), new ceres::SubsetManifold(8, {1}));
-    }
+    if (!options.estimate_k1) problem->SetManifold(x.data(), new ceres::SubsetManifold(8, {1}));
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::DENSE_QR;
     so.max_num_iterations = options.max_iterations;
@@ -146,71 +138,150 @@ FocalResult EstimateFocalAndPose(int width, int height,
     ceres::Solver::Summary summary;
     ceres::Solve(so, problem, &summary);
     return summary;
-  };
-  auto errors = [&]() {
+  }
+  std::vector<double> Errors() const {
     const Camera c = CameraFromParams(width, height, x);
-    std::vector<double> e(n);
-    for (int k = 0; k < n; ++k) {
+    std::vector<double> e(points.size());
+    for (size_t k = 0; k < points.size(); ++k) {
       const auto uv = c.Project(points[k].p_world);
       e[k] = uv ? (*uv - points[k].uv_px).norm() : 1e9;
     }
     return e;
-  };
-  // Points behind the start camera cannot be evaluated (gross outliers): left out at once.
-  std::vector<bool> use(n);
-  {
-    const auto e0 = errors();
-    for (int k = 0; k < n; ++k) use[k] = e0[k] < 1e9;
-    ceres::Problem robust_problem;
-    solve(use, true, &robust_problem);
   }
-  // With few points one bad click bends even the robust fit and pushes good points over the
-  // gate: while some point is over it, refit leaving out each point in turn and keep the fit
-  // with the most points within the gate; then every point within the gate of that fit is used.
-  auto e = errors();
-  auto within = [&](const std::vector<double>& ev) {
+  int Within(const std::vector<double>& e) const {
     int count = 0;
-    for (double v : ev) count += v <= options.outlier_px ? 1 : 0;
+    for (double v : e) count += v <= options.outlier_px ? 1 : 0;
     return count;
-  };
-  int n_in = 0;
-  for (int k = 0; k < n; ++k) n_in += use[k] ? 1 : 0;
-  int best_in = within(e);
-  while (best_in < n_in && n_in > options.min_points) {
-    const std::array<double, 8> x_start = x;
-    std::array<double, 8> x_best = x;
+  }
+};
+
+// The points to use (within the gate), after a robust fit. Points behind the start camera cannot
+// be evaluated (gross outliers): left out at once. With few points one bad click bends even the
+// robust fit and pushes good points over the gate: while some point is over it, refit leaving
+// out each point in turn and keep the fit with the most points within the gate; then every point
+// within the gate of that fit is used.
+std::vector<bool> LeaveOutBadClicks(FocalFit* fit) {
+  const int n = static_cast<int>(fit->points.size());
+  std::vector<bool> use(n);
+  const auto e0 = fit->Errors();
+  for (int k = 0; k < n; ++k) use[k] = e0[k] < 1e9;
+  ceres::Problem robust_problem;
+  fit->Solve(use, true, &robust_problem);
+  int n_in = static_cast<int>(std::count(use.begin(), use.end(), true));
+  int best_in = fit->Within(fit->Errors());
+  while (best_in < n_in && n_in > fit->options.min_points) {
+    const std::array<double, 8> x_start = fit->x;
+    std::array<double, 8> x_best = fit->x;
     int drop = -1;
     for (int k = 0; k < n; ++k) {
       if (!use[k]) continue;
       std::vector<bool> u = use;
       u[k] = false;
-      x = x_start;
+      fit->x = x_start;
       ceres::Problem refit;
-      solve(u, true, &refit);
-      const int in = within(errors());
+      fit->Solve(u, true, &refit);
+      const int in = fit->Within(fit->Errors());
       if (in > best_in) {
         best_in = in;
-        x_best = x;
+        x_best = fit->x;
         drop = k;
       }
     }
-    x = x_best;
+    fit->x = x_best;
     if (drop < 0) break;
     use[drop] = false;
     --n_in;
   }
-  e = errors();
-  n_in = 0;
-  for (int k = 0; k < n; ++k) {
-    use[k] = e[k] <= options.outlier_px;
-    n_in += use[k] ? 1 : 0;
+  const auto e = fit->Errors();
+  for (int k = 0; k < n; ++k) use[k] = e[k] <= fit->options.outlier_px;
+  return use;
+}
+
+// Standard deviations of the focal length, k1, field of view and camera centre: (J^T J)^-1
+// sigma^2 at the solution of `problem` (a fit without a robust loss).
+void SetUncertainty(const std::array<double, 8>& x, int width, int dof, ceres::Problem* problem,
+                    FocalResult* result) {
+  result->std_focal_px = result->std_k1 = result->std_hfov_deg = kNaN;
+  result->std_position_m.setConstant(kNaN);
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  ceres::Covariance covariance(co);
+  std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
+  if (dof <= 0 || !covariance.Compute(blocks, problem)) return;
+  Eigen::Matrix<double, 8, 8, Eigen::RowMajor> cov;
+  covariance.GetCovarianceBlock(x.data(), x.data(), cov.data());
+  cov *= result->residual_sigma_px * result->residual_sigma_px;
+  result->covariance_ok = true;
+  result->std_focal_px = std::sqrt(std::max(0.0, cov(0, 0)));
+  result->std_k1 = std::sqrt(std::max(0.0, cov(1, 1)));
+  result->std_hfov_deg =
+      (width / (x[0] * x[0] + 0.25 * width * width)) * result->std_focal_px * 180 / M_PI;
+  // Camera centre C = -R(r)^T t: numerical Jacobian in (r, t).
+  auto centre = [&](const Eigen::Matrix<double, 6, 1>& rt) {
+    const Eigen::Matrix3d r = RotationFromRvec(rt.head<3>());
+    return Eigen::Vector3d(-r.transpose() * rt.tail<3>());
+  };
+  Eigen::Matrix<double, 6, 1> rt;
+  for (int k = 0; k < 6; ++k) rt[k] = x[2 + k];
+  Eigen::Matrix<double, 3, 6> jac;
+  for (int k = 0; k < 6; ++k) {
+    const double h = 1e-6 * std::max(1.0, std::abs(rt[k]));
+    Eigen::Matrix<double, 6, 1> a = rt, b = rt;
+    a[k] += h;
+    b[k] -= h;
+    jac.col(k) = (centre(a) - centre(b)) / (2 * h);
   }
+  const Eigen::Matrix3d cov_c = jac * cov.block<6, 6>(2, 2) * jac.transpose();
+  for (int k = 0; k < 3; ++k) result->std_position_m[k] = std::sqrt(std::max(0.0, cov_c(k, k)));
+}
+
+void AddFocalWarnings(const FocalOptions& options, int n, FocalResult* result) {
+  const double f = result->camera.fx;
+  if (!result->covariance_ok) {
+    result->warnings.push_back(
+        "the focal length is not determined by these points (degenerate geometry: spread the "
+        "points over the image and in depth, or use --homography-only for a flat field)");
+  } else if (result->std_focal_px > options.max_focal_rel_std * f) {
+    result->warnings.push_back(fmt::format(
+        "the focal length is uncertain ({:.0f}% std): spread the points over the image and in "
+        "depth, add points, or use --homography-only for a flat field",
+        100 * result->std_focal_px / f));
+  }
+  if (result->num_inliers < n) {
+    result->warnings.push_back(fmt::format(
+        "{} points did not fit and were left out (marked 'outlier')", n - result->num_inliers));
+  }
+}
+
+}  // namespace
+
+FocalResult EstimateFocalAndPose(int width, int height,
+                                 const std::vector<PointCorrespondence>& points,
+                                 const FocalOptions& options) {
+  options.Check();
+  FV_REQUIRE(width > 0 && height > 0, "image size {}x{} is not valid (give --image-size WxH)",
+             width, height);
+  const int n = static_cast<int>(points.size());
+  FV_REQUIRE(n >= options.min_points,
+             "only {} points given; the focal length and the pose from one frame need at least {}",
+             n, options.min_points);
+  const ExtrinsicsResult start = StartFromFovSweep(width, height, points, options);
+  FocalFit fit{width, height, points, options};
+  fit.x[0] = start.camera.fx;
+  const Eigen::Vector3d r0 = start.camera.cam_from_world.Rvec();
+  for (int k = 0; k < 3; ++k) {
+    fit.x[2 + k] = r0[k];
+    fit.x[5 + k] = start.camera.cam_from_world.translation[k];
+  }
+  const std::vector<bool> use = LeaveOutBadClicks(&fit);
+  const int n_in = static_cast<int>(std::count(use.begin(), use.end(), true));
   FV_REQUIRE(n_in >= options.min_points,
              "only {} of the {} points fit one camera within {:.1f} px; check the clicks and names",
              n_in, n, options.outlier_px);
   // Final fit without a robust loss (the inliers), so the covariance is the textbook one.
   ceres::Problem problem;
-  const ceres::Solver::Summary summary = solve(use, false, &problem);
+  const ceres::Solver::Summary summary = fit.Solve(use, false, &problem);
+  const std::array<double, 8>& x = fit.x;
   FV_REQUIRE(summary.IsSolutionUsable() && x[0] > 0,
              "the focal length fit failed ({}); check the points", summary.message);
 
@@ -229,59 +300,10 @@ FocalResult EstimateFocalAndPose(int width, int height,
   }
   result.num_inliers = n_in;
   result.rms_px = std::sqrt(sq / n_in);
-  const int num_params = options.estimate_k1 ? 8 : 7;
-  const int dof = 2 * n_in - num_params;
+  const int dof = 2 * n_in - (options.estimate_k1 ? 8 : 7);
   result.residual_sigma_px = dof > 0 ? std::sqrt(sq / dof) : kNaN;
-
-  // Uncertainty: (J^T J)^-1 sigma^2 at the solution.
-  result.std_focal_px = result.std_k1 = result.std_hfov_deg = kNaN;
-  result.std_position_m.setConstant(kNaN);
-  ceres::Covariance::Options co;
-  co.algorithm_type = ceres::DENSE_SVD;
-  ceres::Covariance covariance(co);
-  std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
-  if (dof > 0 && covariance.Compute(blocks, &problem)) {
-    Eigen::Matrix<double, 8, 8, Eigen::RowMajor> cov;
-    covariance.GetCovarianceBlock(x.data(), x.data(), cov.data());
-    const double s2 = result.residual_sigma_px * result.residual_sigma_px;
-    cov *= s2;
-    result.covariance_ok = true;
-    result.std_focal_px = std::sqrt(std::max(0.0, cov(0, 0)));
-    result.std_k1 = std::sqrt(std::max(0.0, cov(1, 1)));
-    result.std_hfov_deg =
-        (width / (x[0] * x[0] + 0.25 * width * width)) * result.std_focal_px * 180 / M_PI;
-    // Camera centre C = -R(r)^T t: numerical Jacobian in (r, t).
-    auto centre = [&](const Eigen::Matrix<double, 6, 1>& rt) {
-      const Eigen::Matrix3d r = RotationFromRvec(rt.head<3>());
-      return Eigen::Vector3d(-r.transpose() * rt.tail<3>());
-    };
-    Eigen::Matrix<double, 6, 1> rt;
-    for (int k = 0; k < 6; ++k) rt[k] = x[2 + k];
-    Eigen::Matrix<double, 3, 6> jac;
-    for (int k = 0; k < 6; ++k) {
-      const double h = 1e-6 * std::max(1.0, std::abs(rt[k]));
-      Eigen::Matrix<double, 6, 1> a = rt, b = rt;
-      a[k] += h;
-      b[k] -= h;
-      jac.col(k) = (centre(a) - centre(b)) / (2 * h);
-    }
-    const Eigen::Matrix3d cov_c = jac * cov.block<6, 6>(2, 2) * jac.transpose();
-    for (int k = 0; k < 3; ++k) result.std_position_m[k] = std::sqrt(std::max(0.0, cov_c(k, k)));
-  }
-  if (!result.covariance_ok) {
-    result.warnings.push_back(
-        "the focal length is not determined by these points (degenerate geometry: spread the "
-        "points over the image and in depth, or use --homography-only for a flat field)");
-  } else if (result.std_focal_px > options.max_focal_rel_std * x[0]) {
-    result.warnings.push_back(fmt::format(
-        "the focal length is uncertain ({:.0f}% std): spread the points over the image and in "
-        "depth, add points, or use --homography-only for a flat field",
-        100 * result.std_focal_px / x[0]));
-  }
-  if (n_in < n) {
-    result.warnings.push_back(
-        fmt::format("{} points did not fit and were left out (marked 'outlier')", n - n_in));
-  }
+  SetUncertainty(x, width, dof, &problem, &result);
+  AddFocalWarnings(options, n, &result);
   return result;
 }
 
