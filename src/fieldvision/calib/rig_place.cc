@@ -229,10 +229,11 @@ std::vector<Camera> CarryRig(const std::vector<Camera>& rig, int k,
   return Placed(rig, ref_from_world);
 }
 
-RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
-                            const std::vector<std::vector<PointCorrespondence>>& points,
-                            const RigPlacementOptions& options) {
-  options.Check();
+namespace {  // The stages of PlaceRig.
+
+std::vector<Obs> CollectObservations(const std::vector<Camera>& rig,
+                                     const std::vector<std::vector<PointCorrespondence>>& points,
+                                     const RigPlacementOptions& options) {
   FV_REQUIRE(!rig.empty(), "the rig has no cameras");
   FV_REQUIRE(points.size() == rig.size(), "{} cameras but {} point lists", rig.size(),
              points.size());
@@ -251,37 +252,48 @@ RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
   FV_REQUIRE(static_cast<int>(obs.size()) >= options.min_points,
              "only {} points over the rig's cameras; placing the rig needs at least {}", obs.size(),
              options.min_points);
+  return obs;
+}
 
-  auto refine = [&](Rigid3d start, const std::vector<bool>& inlier, int* iterations, double* cost) {
-    Eigen::Vector3d r = start.Rvec(), t = start.translation;
-    ceres::Problem problem;
-    for (size_t k = 0; k < obs.size(); ++k) {
-      if (!inlier[k]) continue;
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RigPointCost, 2, 3, 3>(
-                                   new RigPointCost(rig[obs[k].camera], obs[k].uv, obs[k].p)),
-                               new ceres::HuberLoss(options.huber_px), r.data(), t.data());
-    }
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.max_num_iterations = options.max_iterations;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    if (iterations) *iterations += static_cast<int>(summary.iterations.size());
-    if (cost) *cost = summary.IsSolutionUsable() ? summary.final_cost : 1e300;
-    return Rigid3d::FromRvecTvec(r, t);
-  };
-  auto errors = [&](const Rigid3d& ref_from_world) {
-    const auto cams = Placed(rig, ref_from_world);
-    std::vector<double> e(obs.size());
-    for (size_t k = 0; k < obs.size(); ++k) {
-      const auto uv = cams[obs[k].camera].Project(obs[k].p);
-      e[k] = uv ? (*uv - obs[k].uv).norm() : 1e9;
-    }
-    return e;
-  };
+// The rig's placement (ref_from_world) fitted to the inlier observations from `start`.
+Rigid3d RefinePlacement(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
+                        const RigPlacementOptions& options, const Rigid3d& start,
+                        const std::vector<bool>& inlier, int* iterations, double* cost) {
+  Eigen::Vector3d r = start.Rvec(), t = start.translation;
+  ceres::Problem problem;
+  for (size_t k = 0; k < obs.size(); ++k) {
+    if (!inlier[k]) continue;
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RigPointCost, 2, 3, 3>(
+                                 new RigPointCost(rig[obs[k].camera], obs[k].uv, obs[k].p)),
+                             new ceres::HuberLoss(options.huber_px), r.data(), t.data());
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  if (iterations) *iterations += static_cast<int>(summary.iterations.size());
+  if (cost) *cost = summary.IsSolutionUsable() ? summary.final_cost : 1e300;
+  return Rigid3d::FromRvecTvec(r, t);
+}
 
-  // Starts.
+// Pixel error of every observation through the placed rig; 1e9 behind its camera.
+std::vector<double> PlacementErrors(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
+                                    const Rigid3d& ref_from_world) {
+  const auto cams = Placed(rig, ref_from_world);
+  std::vector<double> e(obs.size());
+  for (size_t k = 0; k < obs.size(); ++k) {
+    const auto uv = cams[obs[k].camera].Project(obs[k].p);
+    e[k] = uv ? (*uv - obs[k].uv).norm() : 1e9;
+  }
+  return e;
+}
+
+// Starts: PnP in each camera with 4 or more points, the linear and the sampled rig poses.
+std::vector<std::pair<std::string, Rigid3d>> PlacementStarts(
+    const std::vector<Camera>& rig, const std::vector<std::vector<PointCorrespondence>>& points,
+    const std::vector<Obs>& obs, const RigPlacementOptions& options) {
   std::vector<std::pair<std::string, Rigid3d>> starts;
   for (size_t i = 0; i < rig.size(); ++i) {
     if (static_cast<int>(points[i].size()) < 4) continue;
@@ -295,8 +307,9 @@ RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
     }
   }
   if (obs.size() >= 6) {
-    for (const auto& lin : LinearRigPose(rig, obs))
+    for (const auto& lin : LinearRigPose(rig, obs)) {
       starts.emplace_back("all cameras (linear)", lin);
+    }
   }
   for (const auto& sampled : SampledRigPoses(rig, obs, 4000, 6)) {
     starts.emplace_back("all cameras (sampled rotations)", sampled);
@@ -305,34 +318,82 @@ RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
              "the {} points cannot place the rig: give one camera 4 or more points, or 6 or more "
              "over several cameras, spread in two directions",
              obs.size());
-  RigPlacementResult result;
+  return starts;
+}
+
+// Every start refined; the most points within the outlier gate, then the lowest cost.
+Rigid3d BestPlacement(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
+                      const std::vector<std::pair<std::string, Rigid3d>>& starts,
+                      const RigPlacementOptions& options, RigPlacementResult* result) {
   const std::vector<bool> all(obs.size(), true);
-  double best_cost = 1e300;
+  double best_score = 1e300;
   Rigid3d best;
   for (const auto& [name, s] : starts) {
     // A start that puts a point behind its camera cannot be evaluated (Ceres would stop and
     // log); such starts are wrong anyway.
-    const auto e0 = errors(s);
+    const auto e0 = PlacementErrors(rig, obs, s);
     if (std::any_of(e0.begin(), e0.end(), [](double v) { return v >= 1e9; })) continue;
     double cost = 1e300;
-    const Rigid3d r = refine(s, all, &result.iterations, &cost);
-    // Robust comparison: the number of points within the outlier gate, then the cost.
-    const auto e = errors(r);
+    const Rigid3d r = RefinePlacement(rig, obs, options, s, all, &result->iterations, &cost);
     int in = 0;
-    for (double v : e) in += v <= options.outlier_px ? 1 : 0;
+    for (double v : PlacementErrors(rig, obs, r)) in += v <= options.outlier_px ? 1 : 0;
     const double score = cost - 1e6 * in;
-    if (score < best_cost) {
-      best_cost = score;
+    if (score < best_score) {
+      best_score = score;
       best = r;
-      result.start = name;
+      result->start = name;
     }
   }
-  FV_REQUIRE(result.start.size() > 0,
+  FV_REQUIRE(result->start.size() > 0,
              "the {} points cannot place the rig: every start puts some point behind its camera "
              "(check the names and each camera's points file)",
              obs.size());
+  return best;
+}
+
+// Cameras, per-point residuals and per-camera RMS of the placement.
+void SetPlacementResiduals(const std::vector<Camera>& rig,
+                           const std::vector<std::vector<PointCorrespondence>>& points,
+                           const std::vector<Obs>& obs, const RigPlacementOptions& options,
+                           RigPlacementResult* result) {
+  result->cameras = Placed(rig, result->ref_from_world);
+  result->points.resize(rig.size());
+  result->rms_px.assign(rig.size(), 0.0);
+  result->num_points = static_cast<int>(obs.size());
+  const auto e = PlacementErrors(rig, obs, result->ref_from_world);
+  double sq_all = 0;
+  for (size_t i = 0; i < rig.size(); ++i) {
+    if (points[i].empty()) continue;
+    result->points[i] = PointResiduals(result->cameras[i], points[i]);
+    double sq = 0;
+    int n = 0;
+    for (size_t k = 0; k < obs.size(); ++k) {
+      if (obs[k].camera != static_cast<int>(i)) continue;
+      auto& pr = result->points[i][obs[k].index];
+      pr.inlier = e[k] <= options.outlier_px;
+      if (!pr.inlier) continue;
+      sq += pr.err_px * pr.err_px;
+      ++n;
+    }
+    result->rms_px[i] = n ? std::sqrt(sq / n) : 0.0;
+    sq_all += sq;
+    result->num_inliers += n;
+  }
+  result->rms_px_all = result->num_inliers ? std::sqrt(sq_all / result->num_inliers) : 0.0;
+}
+
+}  // namespace
+
+RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
+                            const std::vector<std::vector<PointCorrespondence>>& points,
+                            const RigPlacementOptions& options) {
+  options.Check();
+  const std::vector<Obs> obs = CollectObservations(rig, points, options);
+  RigPlacementResult result;
+  Rigid3d best =
+      BestPlacement(rig, obs, PlacementStarts(rig, points, obs, options), options, &result);
   // Leave out points far off, refit once.
-  auto e = errors(best);
+  const auto e = PlacementErrors(rig, obs, best);
   std::vector<bool> inlier(obs.size());
   int n_in = 0;
   for (size_t k = 0; k < obs.size(); ++k) {
@@ -343,33 +404,11 @@ RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
              "no placement of the rig puts 3 of its {} points within {:.1f} px of their clicks "
              "(check the names and each camera's points file)",
              obs.size(), options.outlier_px);
-  if (n_in < static_cast<int>(obs.size())) best = refine(best, inlier, &result.iterations, nullptr);
-
-  result.ref_from_world = best;
-  result.cameras = Placed(rig, best);
-  result.points.resize(rig.size());
-  result.rms_px.assign(rig.size(), 0.0);
-  result.num_points = static_cast<int>(obs.size());
-  e = errors(best);
-  double sq_all = 0;
-  for (size_t i = 0; i < rig.size(); ++i) {
-    if (points[i].empty()) continue;
-    result.points[i] = PointResiduals(result.cameras[i], points[i]);
-    double sq = 0;
-    int n = 0;
-    for (size_t k = 0; k < obs.size(); ++k) {
-      if (obs[k].camera != static_cast<int>(i)) continue;
-      auto& pr = result.points[i][obs[k].index];
-      pr.inlier = e[k] <= options.outlier_px;
-      if (!pr.inlier) continue;
-      sq += pr.err_px * pr.err_px;
-      ++n;
-    }
-    result.rms_px[i] = n ? std::sqrt(sq / n) : 0.0;
-    sq_all += sq;
-    result.num_inliers += n;
+  if (n_in < static_cast<int>(obs.size())) {
+    best = RefinePlacement(rig, obs, options, best, inlier, &result.iterations, nullptr);
   }
-  result.rms_px_all = result.num_inliers ? std::sqrt(sq_all / result.num_inliers) : 0.0;
+  result.ref_from_world = best;
+  SetPlacementResiduals(rig, points, obs, options, &result);
   return result;
 }
 
