@@ -27,6 +27,8 @@
 
 namespace fv::track {
 
+struct FrameDetections;
+
 struct TrackerOptions {
   double high_score = 0.5;          // detections at or above take part in the first association
   double low_score = 0.2;           // detections in [low_score, high_score) in the second one
@@ -86,6 +88,18 @@ class ByteTracker {
   struct Track;
 
  private:
+  void PredictTracks(const cv::Mat& frame);
+  void Apply(Track& t, int d, const std::vector<Detection>& detections, FrameDetections& fd);
+  int Associate(const std::vector<Track*>& ts, const std::vector<int>& ds, double min_iou,
+                bool full, const std::vector<Detection>& detections, FrameDetections& fd);
+  void AssociateAll(const std::vector<Detection>& detections, FrameDetections& fd);
+  void ConfirmOrMiss(const cv::Mat& frame);
+  bool CarryBySot(Track& t, const cv::Mat& frame);
+  void RefindOrStart(const std::vector<Detection>& detections, FrameDetections& fd,
+                     const cv::Mat& frame);
+  void DropExpired();
+  std::vector<TrackState> Report() const;
+
   TrackerOptions o_;
   std::optional<Camera> camera_;
   std::vector<std::unique_ptr<Track>> tracks_;

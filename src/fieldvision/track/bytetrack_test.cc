@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/track/bytetrack_internal.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
@@ -116,6 +117,59 @@ TEST(ByteTracker, OptionsAreChecked) {
   } catch (const fv::Error& e) {
     EXPECT_NE(std::string(e.what()).find("sot"), std::string::npos);
   }
+}
+
+TEST(ByteTrackerStages, SortDetectionsSplitsByScoreAndMarksOverlaps) {
+  TrackerOptions o;  // high 0.5, low 0.2
+  const std::vector<Detection> dets = {{cv::Rect2d(0, 0, 20, 40), 0.9},
+                                       {cv::Rect2d(5, 0, 20, 40), 0.3},
+                                       {cv::Rect2d(100, 0, 20, 40), 0.1},
+                                       {cv::Rect2d(200, 0, 20, 40), 0.7}};
+  const FrameDetections fd = SortDetections(dets, cv::Mat(), o, nullptr);
+  EXPECT_EQ(fd.high, (std::vector<int>{0, 3}));
+  EXPECT_EQ(fd.low, (std::vector<int>{1}));
+  EXPECT_FALSE(fd.clear[0]);  // the low-score box 1 covers most of it
+  EXPECT_TRUE(fd.clear[3]);
+  EXPECT_FALSE(fd.field_m[0].has_value());  // no camera
+  EXPECT_TRUE(fd.hist[0].empty());          // no frame
+  EXPECT_EQ(fd.used, (std::vector<char>(4, 0)));
+}
+
+TEST(ByteTrackerStages, PairCostGatesByIouAndReachGrowsWhileLost) {
+  TrackerOptions o;
+  ByteTracker::Track t;
+  t.Init(cv::Rect2d(0, 0, 20, 40));
+  const std::vector<Detection> dets = {{cv::Rect2d(0, 0, 20, 40), 0.9},
+                                       {cv::Rect2d(2, 0, 20, 40), 0.9},
+                                       {cv::Rect2d(100, 0, 20, 40), 0.9}};
+  const FrameDetections fd = SortDetections(dets, cv::Mat(), o, nullptr);
+  EXPECT_NEAR(PairCost(t, dets, fd, 0, o.match_iou, true, o), 0.0, 1e-12);
+  EXPECT_NEAR(PairCost(t, dets, fd, 1, o.match_iou, false, o), 1.0 - Iou(t.box, dets[1].box),
+              1e-12);
+  EXPECT_GE(PairCost(t, dets, fd, 2, o.match_iou, true, o), 1e9);
+  // Re-finding in pixels: reid_speed_px per frame lost plus the box height.
+  t.lost_frames = 2;
+  const Detection near{cv::Rect2d(60, 0, 20, 40), 0.9}, far{cv::Rect2d(70, 0, 20, 40), 0.9};
+  EXPECT_TRUE(InReidReach(t, near, std::nullopt, o));  // 60 <= 2 * 12 + 40
+  EXPECT_FALSE(InReidReach(t, far, std::nullopt, o));
+  t.lost_frames = 3;
+  EXPECT_TRUE(InReidReach(t, far, std::nullopt, o));
+  // On the field: 3 m/s at 25 frames/s plus 1 m.
+  t.field_m = Eigen::Vector2d(0, 0);
+  EXPECT_TRUE(InReidReach(t, far, Eigen::Vector2d(1.3, 0), o));
+  EXPECT_FALSE(InReidReach(t, far, Eigen::Vector2d(1.4, 0), o));
+}
+
+TEST(ByteTrackerStages, LeftImageUsesTheFootPoint) {
+  ByteTracker::Track t;
+  t.Init(cv::Rect2d(100, 100, 20, 40));
+  EXPECT_FALSE(LeftImage(t, cv::Size(640, 480)));
+  t.Init(cv::Rect2d(630, 100, 20, 40));  // foot at x = 640
+  EXPECT_TRUE(LeftImage(t, cv::Size(640, 480)));
+  t.Init(cv::Rect2d(100, 445, 20, 40));  // foot 5 px below, within a quarter of the height
+  EXPECT_FALSE(LeftImage(t, cv::Size(640, 480)));
+  t.Init(cv::Rect2d(100, 455, 20, 40));
+  EXPECT_TRUE(LeftImage(t, cv::Size(640, 480)));
 }
 
 }  // namespace

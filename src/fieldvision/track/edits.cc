@@ -186,140 +186,181 @@ std::string EditResult::Summary() const {
       dropped_rows);
 }
 
-EditResult ApplyTrackEdits(std::vector<TrackRow> rows, Roster roster, const TrackEdits& edits) {
-  EditResult res;
-  std::set<int> ids;
-  for (const auto& r : rows) ids.insert(r.id);
-  res.ids_before = static_cast<int>(ids.size());
-  auto require_known = [&](int id, const TrackEdit& e, const char* op) {
-    FV_REQUIRE(ids.count(id), "{}:{}: {}: id {} is not in the tracks{}", edits.path, e.line, op, id,
-               ids.empty() ? std::string()
-                           : fmt::format(" (ids {}..{}, {} in all)", *ids.begin(), *ids.rbegin(),
-                                         ids.size()));
-  };
-  // Moves roster entries from one id to another (the target's own entries win).
-  auto move_roster = [&](int from, int to) {
-    if (roster.team_of.count(from) && !roster.team_of.count(to)) {
-      roster.team_of[to] = roster.team_of[from];
-    }
-    if (roster.name_of.count(from) && !roster.name_of.count(to)) {
-      roster.name_of[to] = roster.name_of[from];
-    }
-    roster.team_of.erase(from);
-    roster.name_of.erase(from);
-  };
-  for (const TrackEdit& e : edits.edits) {
+namespace {
+
+// The state of ApplyTrackEdits between edits: the rows, roster and ids as they are so far.
+class TrackEditor {
+ public:
+  TrackEditor(std::vector<TrackRow> rows, Roster roster, const std::string& path)
+      : rows_(std::move(rows)), roster_(std::move(roster)), path_(path) {
+    for (const auto& r : rows_) ids_.insert(r.id);
+    res_.ids_before = static_cast<int>(ids_.size());
+  }
+
+  void Apply(const TrackEdit& e) {
     switch (e.kind) {
-      case TrackEdit::Kind::kMerge: {
-        const int keep = e.ids.front();
-        std::set<int> from;
-        for (int id : e.ids) {
-          require_known(id, e, "merge");
-          if (id != keep) from.insert(id);
-        }
-        for (auto& r : rows) {
-          if (from.count(r.id)) r.id = keep;
-        }
-        // One row per frame: where both were present, keep the more confident box.
-        std::stable_sort(rows.begin(), rows.end(), [](const TrackRow& a, const TrackRow& b) {
-          return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
-        });
-        std::vector<TrackRow> out;
-        out.reserve(rows.size());
-        int overlap = 0, first_overlap = 0;
-        for (const auto& r : rows) {
-          if (!out.empty() && out.back().frame == r.frame && out.back().id == r.id) {
-            if (overlap++ == 0) first_overlap = r.frame;
-            if (r.conf > out.back().conf) out.back() = r;
-            continue;
-          }
-          out.push_back(r);
-        }
-        // Two ids seen together for long are two people, not one tracked in pieces.
-        FV_REQUIRE(overlap <= kMaxMergeOverlapFrames,
-                   "{}:{}: merge: the ids are tracked at the same time in {} frames (from frame "
-                   "{}): two people, not one (at most {} frames may overlap)",
-                   edits.path, e.line, overlap, first_overlap, kMaxMergeOverlapFrames);
-        res.overlapping_rows += overlap;
-        rows = std::move(out);
-        for (int id : from) {
-          move_roster(id, keep);
-          ids.erase(id);
-        }
-        res.merged += static_cast<int>(from.size());
+      case TrackEdit::Kind::kMerge:
+        Merge(e);
         break;
-      }
-      case TrackEdit::Kind::kRename: {
-        for (const auto& [from, to] : e.to) require_known(from, e, "rename");
-        std::set<int> after = ids;
-        for (const auto& [from, to] : e.to) after.erase(from);
-        for (const auto& [from, to] : e.to) {
-          FV_REQUIRE(!after.count(to),
-                     "{}:{}: rename: id {} is already in use (merge {} into it instead)",
-                     edits.path, e.line, to, from);
-          after.insert(to);
-        }
-        for (auto& r : rows) {
-          const auto it = e.to.find(r.id);
-          if (it != e.to.end()) r.id = it->second;
-        }
-        Roster moved;
-        for (const auto& [id, t] : roster.team_of) {
-          const auto it = e.to.find(id);
-          moved.team_of[it == e.to.end() ? id : it->second] = t;
-        }
-        for (const auto& [id, n] : roster.name_of) {
-          const auto it = e.to.find(id);
-          moved.name_of[it == e.to.end() ? id : it->second] = n;
-        }
-        roster = std::move(moved);
-        ids = std::move(after);
-        res.renamed += static_cast<int>(e.to.size());
+      case TrackEdit::Kind::kRename:
+        Rename(e);
         break;
-      }
       case TrackEdit::Kind::kName:
         for (const auto& [id, n] : e.names) {
-          require_known(id, e, "name");
-          roster.name_of[id] = n;
+          RequireKnown(id, e, "name");
+          roster_.name_of[id] = n;
         }
-        res.named += static_cast<int>(e.names.size());
+        res_.named += static_cast<int>(e.names.size());
         break;
       case TrackEdit::Kind::kTeam:
-        for (const auto& [id, team] : e.to) {
-          require_known(id, e, "team");
-          FV_REQUIRE(team >= -1 && team <= 99, "{}:{}: team: {} for id {} is not -1..99",
-                     edits.path, e.line, team, id);
-          if (team < 0) {
-            roster.team_of.erase(id);
-          } else {
-            roster.team_of[id] = team;
-          }
-        }
-        res.teamed += static_cast<int>(e.to.size());
+        Team(e);
         break;
-      case TrackEdit::Kind::kDrop: {
-        const std::set<int> drop(e.ids.begin(), e.ids.end());
-        for (int id : drop) require_known(id, e, "drop");
-        const size_t before = rows.size();
-        std::erase_if(rows, [&](const TrackRow& r) { return drop.count(r.id) > 0; });
-        res.dropped_rows += static_cast<int>(before - rows.size());
-        for (int id : drop) {
-          ids.erase(id);
-          roster.team_of.erase(id);
-          roster.name_of.erase(id);
-        }
-        res.dropped_ids += static_cast<int>(drop.size());
+      case TrackEdit::Kind::kDrop:
+        Drop(e);
         break;
-      }
     }
   }
-  std::stable_sort(rows.begin(), rows.end(), [](const TrackRow& a, const TrackRow& b) {
-    return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
-  });
-  res.ids_after = static_cast<int>(ids.size());
-  res.rows = std::move(rows);
-  res.roster = std::move(roster);
-  return res;
+
+  EditResult Finish() && {
+    SortRows();
+    res_.ids_after = static_cast<int>(ids_.size());
+    res_.rows = std::move(rows_);
+    res_.roster = std::move(roster_);
+    return std::move(res_);
+  }
+
+ private:
+  void RequireKnown(int id, const TrackEdit& e, const char* op) const {
+    FV_REQUIRE(ids_.count(id), "{}:{}: {}: id {} is not in the tracks{}", path_, e.line, op, id,
+               ids_.empty() ? std::string()
+                            : fmt::format(" (ids {}..{}, {} in all)", *ids_.begin(), *ids_.rbegin(),
+                                          ids_.size()));
+  }
+
+  void SortRows() {
+    std::stable_sort(rows_.begin(), rows_.end(), [](const TrackRow& a, const TrackRow& b) {
+      return a.frame != b.frame ? a.frame < b.frame : a.id < b.id;
+    });
+  }
+
+  // Moves roster entries from one id to another (the target's own entries win).
+  void MoveRoster(int from, int to) {
+    if (roster_.team_of.count(from) && !roster_.team_of.count(to)) {
+      roster_.team_of[to] = roster_.team_of[from];
+    }
+    if (roster_.name_of.count(from) && !roster_.name_of.count(to)) {
+      roster_.name_of[to] = roster_.name_of[from];
+    }
+    roster_.team_of.erase(from);
+    roster_.name_of.erase(from);
+  }
+
+  void Merge(const TrackEdit& e) {
+    const int keep = e.ids.front();
+    std::set<int> from;
+    for (int id : e.ids) {
+      RequireKnown(id, e, "merge");
+      if (id != keep) from.insert(id);
+    }
+    for (auto& r : rows_) {
+      if (from.count(r.id)) r.id = keep;
+    }
+    // One row per frame: where both were present, keep the more confident box.
+    SortRows();
+    std::vector<TrackRow> out;
+    out.reserve(rows_.size());
+    int overlap = 0, first_overlap = 0;
+    for (const auto& r : rows_) {
+      if (!out.empty() && out.back().frame == r.frame && out.back().id == r.id) {
+        if (overlap++ == 0) first_overlap = r.frame;
+        if (r.conf > out.back().conf) out.back() = r;
+        continue;
+      }
+      out.push_back(r);
+    }
+    // Two ids seen together for long are two people, not one tracked in pieces.
+    FV_REQUIRE(overlap <= kMaxMergeOverlapFrames,
+               "{}:{}: merge: the ids are tracked at the same time in {} frames (from frame "
+               "{}): two people, not one (at most {} frames may overlap)",
+               path_, e.line, overlap, first_overlap, kMaxMergeOverlapFrames);
+    res_.overlapping_rows += overlap;
+    rows_ = std::move(out);
+    for (int id : from) {
+      MoveRoster(id, keep);
+      ids_.erase(id);
+    }
+    res_.merged += static_cast<int>(from.size());
+  }
+
+  void Rename(const TrackEdit& e) {
+    for (const auto& [from, to] : e.to) RequireKnown(from, e, "rename");
+    std::set<int> after = ids_;
+    for (const auto& [from, to] : e.to) after.erase(from);
+    for (const auto& [from, to] : e.to) {
+      FV_REQUIRE(!after.count(to),
+                 "{}:{}: rename: id {} is already in use (merge {} into it instead)", path_, e.line,
+                 to, from);
+      after.insert(to);
+    }
+    for (auto& r : rows_) {
+      const auto it = e.to.find(r.id);
+      if (it != e.to.end()) r.id = it->second;
+    }
+    Roster moved;
+    for (const auto& [id, t] : roster_.team_of) {
+      const auto it = e.to.find(id);
+      moved.team_of[it == e.to.end() ? id : it->second] = t;
+    }
+    for (const auto& [id, n] : roster_.name_of) {
+      const auto it = e.to.find(id);
+      moved.name_of[it == e.to.end() ? id : it->second] = n;
+    }
+    roster_ = std::move(moved);
+    ids_ = std::move(after);
+    res_.renamed += static_cast<int>(e.to.size());
+  }
+
+  void Team(const TrackEdit& e) {
+    for (const auto& [id, team] : e.to) {
+      RequireKnown(id, e, "team");
+      FV_REQUIRE(team >= -1 && team <= 99, "{}:{}: team: {} for id {} is not -1..99", path_, e.line,
+                 team, id);
+      if (team < 0) {
+        roster_.team_of.erase(id);
+      } else {
+        roster_.team_of[id] = team;
+      }
+    }
+    res_.teamed += static_cast<int>(e.to.size());
+  }
+
+  void Drop(const TrackEdit& e) {
+    const std::set<int> drop(e.ids.begin(), e.ids.end());
+    for (int id : drop) RequireKnown(id, e, "drop");
+    const size_t before = rows_.size();
+    std::erase_if(rows_, [&](const TrackRow& r) { return drop.count(r.id) > 0; });
+    res_.dropped_rows += static_cast<int>(before - rows_.size());
+    for (int id : drop) {
+      ids_.erase(id);
+      roster_.team_of.erase(id);
+      roster_.name_of.erase(id);
+    }
+    res_.dropped_ids += static_cast<int>(drop.size());
+  }
+
+  std::vector<TrackRow> rows_;
+  Roster roster_;
+  const std::string& path_;
+  std::set<int> ids_;
+  EditResult res_;
+};
+
+}  // namespace
+
+EditResult ApplyTrackEdits(std::vector<TrackRow> rows, Roster roster, const TrackEdits& edits) {
+  TrackEditor editor(std::move(rows), std::move(roster), edits.path);
+  for (const TrackEdit& e : edits.edits) editor.Apply(e);
+  return std::move(editor).Finish();
 }
 
 }  // namespace fv::track

@@ -12,6 +12,7 @@
 
 #include "fieldvision/track/detection.h"
 #include "fieldvision/track/hungarian.h"
+#include "fieldvision/track/mot_internal.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -211,10 +212,6 @@ std::string MotMetrics::ToJson() const {
 
 namespace {
 
-struct FrameData {
-  std::vector<const TrackRow*> gt, est;
-};
-
 // One-to-one matching of boxes at IoU >= thr maximising the IoU sum (Hungarian): pairs (i, j).
 std::vector<std::pair<int, int>> MatchBoxes(const std::vector<const TrackRow*>& a,
                                             const std::vector<const TrackRow*>& b, double thr) {
@@ -323,55 +320,81 @@ void CheckOneBoxPerIdAndFrame(const std::vector<TrackRow>& rows, const std::stri
 
 }  // namespace
 
-MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,
-                       const MotOptions& options) {
-  options.Check();
-  CheckOneBoxPerIdAndFrame(gt_in, "ground truth");
-  CheckOneBoxPerIdAndFrame(est_in, "estimate");
-  std::vector<TrackRow> gt, est;
-  MotPreprocessing pre;
-  Preprocess(gt_in, est_in, options, gt, est, pre);
-  std::map<int, FrameData> frames;
-  std::map<int, int> gt_index, est_index;  // id -> dense index
+MotIndex IndexMotRows(const std::vector<TrackRow>& gt, const std::vector<TrackRow>& est) {
+  MotIndex index;
   for (const auto& r : gt) {
-    frames[r.frame].gt.push_back(&r);
-    gt_index.emplace(r.id, static_cast<int>(gt_index.size()));
+    index.frames[r.frame].gt.push_back(&r);
+    index.gt_index.emplace(r.id, static_cast<int>(index.gt_index.size()));
   }
   for (const auto& r : est) {
-    frames[r.frame].est.push_back(&r);
-    est_index.emplace(r.id, static_cast<int>(est_index.size()));
+    index.frames[r.frame].est.push_back(&r);
+    index.est_index.emplace(r.id, static_cast<int>(index.est_index.size()));
   }
-  MotMetrics m;
-  m.preprocessing = pre;
-  m.frames = static_cast<int>(frames.size());
-  m.gt_boxes = static_cast<int>(gt.size());
-  m.est_boxes = static_cast<int>(est.size());
-  m.gt_ids = static_cast<int>(gt_index.size());
-  m.est_ids = static_cast<int>(est_index.size());
-  const int ng = m.gt_ids, ne = m.est_ids;
-  // The id-pair table below holds ng x ne counts.
-  FV_REQUIRE(static_cast<double>(ng) * ne <= 5e7,
-             "eval tracks: {} ground-truth ids x {} estimated ids is too many id pairs to score "
-             "(at most 5e7)",
-             ng, ne);
-  const double thr = options.iou_threshold;
+  return index;
+}
 
-  // CLEAR MOT and the per-id-pair counts for IDF1, and HOTA's similarity sums.
+std::vector<std::vector<double>> FrameIou(const MotFrame& fd) {
+  const size_t G = fd.gt.size(), E = fd.est.size();
+  std::vector<std::vector<double>> iou(G, std::vector<double>(E));
+  for (size_t i = 0; i < G; ++i) {
+    for (size_t j = 0; j < E; ++j) iou[i][j] = Iou(fd.gt[i]->box, fd.est[j]->box);
+  }
+  return iou;
+}
+
+std::vector<int> MatchClearMot(const MotFrame& fd, const std::vector<std::vector<double>>& iou,
+                               const std::map<int, int>& last_match, double thr) {
+  const size_t G = fd.gt.size(), E = fd.est.size();
+  std::vector<int> match(G, -1);
+  std::vector<char> est_taken(E, 0);
+  for (size_t i = 0; i < G; ++i) {
+    const auto it = last_match.find(fd.gt[i]->id);
+    if (it == last_match.end()) continue;
+    for (size_t j = 0; j < E; ++j) {
+      if (!est_taken[j] && fd.est[j]->id == it->second && iou[i][j] >= thr) {
+        match[i] = static_cast<int>(j);
+        est_taken[j] = 1;
+      }
+    }
+  }
+  std::vector<int> rows_left, cols_left;
+  for (size_t i = 0; i < G; ++i) {
+    if (match[i] < 0) rows_left.push_back(static_cast<int>(i));
+  }
+  for (size_t j = 0; j < E; ++j) {
+    if (!est_taken[j]) cols_left.push_back(static_cast<int>(j));
+  }
+  std::vector<std::vector<double>> cost(rows_left.size(), std::vector<double>(cols_left.size()));
+  for (size_t a = 0; a < rows_left.size(); ++a) {
+    for (size_t b = 0; b < cols_left.size(); ++b) {
+      const double v = iou[rows_left[a]][cols_left[b]];
+      cost[a][b] = v >= thr ? 1.0 - v : 1e9;
+    }
+  }
+  const std::vector<int> assign = SolveAssignment(cost);
+  for (size_t a = 0; a < rows_left.size(); ++a) {
+    if (assign[a] >= 0) match[rows_left[a]] = cols_left[assign[a]];
+  }
+  return match;
+}
+
+MotIdCounts CountClearMot(const MotIndex& index, double thr, MotMetrics& m) {
+  const int ng = static_cast<int>(index.gt_index.size());
+  const int ne = static_cast<int>(index.est_index.size());
+  MotIdCounts c;
+  c.pair_frames.assign(ng, std::vector<int>(ne, 0));
+  c.potential.assign(ng, std::vector<double>(ne, 0.0));
+  c.gt_count.assign(ng, 0);
+  c.est_count.assign(ne, 0);
   std::map<int, int> last_match;          // gt id -> est id of its last match
   std::map<int, int> last_matched_frame;  // gt id -> frame index of its last match (fragments)
   std::map<int, int> gt_frames, gt_matched;
-  std::vector<std::vector<int>> pair_frames(ng, std::vector<int>(ne, 0));
-  std::vector<std::vector<double>> potential(ng, std::vector<double>(ne, 0.0));
-  std::vector<int> gt_count(ng, 0), est_count(ne, 0);
   double iou_sum = 0;
   int frame_idx = 0;
-  for (auto& [frame, fd] : frames) {
+  for (const auto& [frame, fd] : index.frames) {
     ++frame_idx;
     const size_t G = fd.gt.size(), E = fd.est.size();
-    std::vector<std::vector<double>> iou(G, std::vector<double>(E));
-    for (size_t i = 0; i < G; ++i) {
-      for (size_t j = 0; j < E; ++j) iou[i][j] = Iou(fd.gt[i]->box, fd.est[j]->box);
-    }
+    const std::vector<std::vector<double>> iou = FrameIou(fd);
     // HOTA: similarity normalised by row and column sums (TrackEval).
     std::vector<double> row_sum(G, 0), col_sum(E, 0);
     for (size_t i = 0; i < G; ++i) {
@@ -381,45 +404,15 @@ MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<Tra
       }
     }
     for (size_t i = 0; i < G; ++i) {
-      const int g = gt_index[fd.gt[i]->id];
-      gt_count[g]++;
+      const int g = index.gt_index.at(fd.gt[i]->id);
+      c.gt_count[g]++;
       for (size_t j = 0; j < E; ++j) {
         const double denom = row_sum[i] + col_sum[j] - iou[i][j];
-        if (denom > 0) potential[g][est_index[fd.est[j]->id]] += iou[i][j] / denom;
+        if (denom > 0) c.potential[g][index.est_index.at(fd.est[j]->id)] += iou[i][j] / denom;
       }
     }
-    for (size_t j = 0; j < E; ++j) est_count[est_index[fd.est[j]->id]]++;
-    // CLEAR MOT: keep last frame's valid pairs, Hungarian on the rest.
-    std::vector<int> match(G, -1);
-    std::vector<char> est_taken(E, 0);
-    for (size_t i = 0; i < G; ++i) {
-      const auto it = last_match.find(fd.gt[i]->id);
-      if (it == last_match.end()) continue;
-      for (size_t j = 0; j < E; ++j) {
-        if (!est_taken[j] && fd.est[j]->id == it->second && iou[i][j] >= thr) {
-          match[i] = static_cast<int>(j);
-          est_taken[j] = 1;
-        }
-      }
-    }
-    std::vector<int> rows_left, cols_left;
-    for (size_t i = 0; i < G; ++i) {
-      if (match[i] < 0) rows_left.push_back(static_cast<int>(i));
-    }
-    for (size_t j = 0; j < E; ++j) {
-      if (!est_taken[j]) cols_left.push_back(static_cast<int>(j));
-    }
-    std::vector<std::vector<double>> cost(rows_left.size(), std::vector<double>(cols_left.size()));
-    for (size_t a = 0; a < rows_left.size(); ++a) {
-      for (size_t b = 0; b < cols_left.size(); ++b) {
-        const double v = iou[rows_left[a]][cols_left[b]];
-        cost[a][b] = v >= thr ? 1.0 - v : 1e9;
-      }
-    }
-    const std::vector<int> assign = SolveAssignment(cost);
-    for (size_t a = 0; a < rows_left.size(); ++a) {
-      if (assign[a] >= 0) match[rows_left[a]] = cols_left[assign[a]];
-    }
+    for (size_t j = 0; j < E; ++j) c.est_count[index.est_index.at(fd.est[j]->id)]++;
+    const std::vector<int> match = MatchClearMot(fd, iou, last_match, thr);
     int tp = 0;
     for (size_t i = 0; i < G; ++i) {
       const int gid = fd.gt[i]->id;
@@ -442,7 +435,9 @@ MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<Tra
     // IDF1: frames where a gt id and an est id overlap enough (any pairing, per frame).
     for (size_t i = 0; i < G; ++i) {
       for (size_t j = 0; j < E; ++j) {
-        if (iou[i][j] >= thr) pair_frames[gt_index[fd.gt[i]->id]][est_index[fd.est[j]->id]]++;
+        if (iou[i][j] >= thr) {
+          c.pair_frames[index.gt_index.at(fd.gt[i]->id)][index.est_index.at(fd.est[j]->id)]++;
+        }
       }
     }
   }
@@ -455,79 +450,112 @@ MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<Tra
     if (cover >= 0.8) m.mostly_tracked++;
     if (cover <= 0.2) m.mostly_lost++;
   }
-  // IDF1: maximise the total matched frames over one-to-one id pairs.
-  if (ng > 0 && ne > 0) {
-    std::vector<std::vector<double>> cost(ng, std::vector<double>(ne));
-    for (int g = 0; g < ng; ++g) {
-      for (int e = 0; e < ne; ++e) cost[g][e] = pair_frames[g][e] > 0 ? -pair_frames[g][e] : 1e9;
+  return c;
+}
+
+void ScoreIdentity(const std::vector<std::vector<int>>& pair_frames, MotMetrics& m) {
+  const int ng = static_cast<int>(pair_frames.size());
+  const int ne = ng > 0 ? static_cast<int>(pair_frames[0].size()) : 0;
+  if (ng == 0 || ne == 0) return;
+  std::vector<std::vector<double>> cost(ng, std::vector<double>(ne));
+  for (int g = 0; g < ng; ++g) {
+    for (int e = 0; e < ne; ++e) cost[g][e] = pair_frames[g][e] > 0 ? -pair_frames[g][e] : 1e9;
+  }
+  const std::vector<int> a = SolveAssignment(cost);
+  double idtp = 0;
+  for (int g = 0; g < ng; ++g) {
+    if (a[g] >= 0) idtp += pair_frames[g][a[g]];
+  }
+  m.idf1 = 2 * idtp / (m.gt_boxes + m.est_boxes);
+  m.idp = idtp / m.est_boxes;
+  m.idr = idtp / m.gt_boxes;
+}
+
+void ScoreHota(const MotIndex& index, const MotIdCounts& c, MotMetrics& m) {
+  const int ng = static_cast<int>(c.gt_count.size()), ne = static_cast<int>(c.est_count.size());
+  if (ng == 0 || ne == 0) return;
+  // Per frame, match by global alignment x IoU; count per alpha.
+  std::vector<std::vector<double>> align(ng, std::vector<double>(ne, 0));
+  for (int g = 0; g < ng; ++g) {
+    for (int e = 0; e < ne; ++e) {
+      align[g][e] = c.potential[g][e] / (c.gt_count[g] + c.est_count[e] - c.potential[g][e]);
+    }
+  }
+  constexpr int kAlphas = 19;
+  std::vector<double> tp_a(kAlphas, 0);
+  std::vector<std::vector<std::vector<int>>> matches(
+      kAlphas, std::vector<std::vector<int>>(ng, std::vector<int>(ne, 0)));
+  for (const auto& [frame, fd] : index.frames) {
+    const size_t G = fd.gt.size(), E = fd.est.size();
+    if (G == 0 || E == 0) continue;
+    const std::vector<std::vector<double>> iou = FrameIou(fd);
+    std::vector<std::vector<double>> cost(G, std::vector<double>(E));
+    for (size_t i = 0; i < G; ++i) {
+      for (size_t j = 0; j < E; ++j) {
+        const double s =
+            align[index.gt_index.at(fd.gt[i]->id)][index.est_index.at(fd.est[j]->id)] * iou[i][j];
+        cost[i][j] = s > 0 ? -s : 1e9;
+      }
     }
     const std::vector<int> a = SolveAssignment(cost);
-    double idtp = 0;
-    for (int g = 0; g < ng; ++g) {
-      if (a[g] >= 0) idtp += pair_frames[g][a[g]];
+    for (size_t i = 0; i < G; ++i) {
+      if (a[i] < 0) continue;
+      for (int k = 0; k < kAlphas; ++k) {
+        const double alpha = 0.05 + 0.05 * k;
+        if (iou[i][a[i]] >= alpha - 1e-9) {
+          tp_a[k] += 1;
+          matches[k][index.gt_index.at(fd.gt[i]->id)][index.est_index.at(fd.est[a[i]]->id)]++;
+        }
+      }
     }
-    m.idf1 = 2 * idtp / (m.gt_boxes + m.est_boxes);
-    m.idp = idtp / m.est_boxes;
-    m.idr = idtp / m.gt_boxes;
   }
-  // HOTA (second pass): per frame, match by global alignment x IoU; count per alpha.
-  if (ng > 0 && ne > 0) {
-    std::vector<std::vector<double>> align(ng, std::vector<double>(ne, 0));
+  double hota = 0, deta = 0, assa = 0;
+  for (int k = 0; k < kAlphas; ++k) {
+    const double tp = tp_a[k];
+    const double fn = m.gt_boxes - tp, fp = m.est_boxes - tp;
+    const double det = tp / std::max(1.0, tp + fn + fp);
+    double ass = 0;
     for (int g = 0; g < ng; ++g) {
       for (int e = 0; e < ne; ++e) {
-        align[g][e] = potential[g][e] / (gt_count[g] + est_count[e] - potential[g][e]);
+        const int n = matches[k][g][e];
+        if (n == 0) continue;
+        ass += n * (double(n) / (c.gt_count[g] + c.est_count[e] - n));
       }
     }
-    constexpr int kAlphas = 19;
-    std::vector<double> tp_a(kAlphas, 0);
-    std::vector<std::vector<std::vector<int>>> matches(
-        kAlphas, std::vector<std::vector<int>>(ng, std::vector<int>(ne, 0)));
-    for (auto& [frame, fd] : frames) {
-      const size_t G = fd.gt.size(), E = fd.est.size();
-      if (G == 0 || E == 0) continue;
-      std::vector<std::vector<double>> cost(G, std::vector<double>(E));
-      std::vector<std::vector<double>> iou(G, std::vector<double>(E));
-      for (size_t i = 0; i < G; ++i) {
-        for (size_t j = 0; j < E; ++j) {
-          iou[i][j] = Iou(fd.gt[i]->box, fd.est[j]->box);
-          const double s = align[gt_index[fd.gt[i]->id]][est_index[fd.est[j]->id]] * iou[i][j];
-          cost[i][j] = s > 0 ? -s : 1e9;
-        }
-      }
-      const std::vector<int> a = SolveAssignment(cost);
-      for (size_t i = 0; i < G; ++i) {
-        if (a[i] < 0) continue;
-        for (int k = 0; k < kAlphas; ++k) {
-          const double alpha = 0.05 + 0.05 * k;
-          if (iou[i][a[i]] >= alpha - 1e-9) {
-            tp_a[k] += 1;
-            matches[k][gt_index[fd.gt[i]->id]][est_index[fd.est[a[i]]->id]]++;
-          }
-        }
-      }
-    }
-    double hota = 0, deta = 0, assa = 0;
-    for (int k = 0; k < kAlphas; ++k) {
-      const double tp = tp_a[k];
-      const double fn = m.gt_boxes - tp, fp = m.est_boxes - tp;
-      const double det = tp / std::max(1.0, tp + fn + fp);
-      double ass = 0;
-      for (int g = 0; g < ng; ++g) {
-        for (int e = 0; e < ne; ++e) {
-          const int c = matches[k][g][e];
-          if (c == 0) continue;
-          ass += c * (double(c) / (gt_count[g] + est_count[e] - c));
-        }
-      }
-      ass /= std::max(1.0, tp);
-      hota += std::sqrt(det * ass);
-      deta += det;
-      assa += ass;
-    }
-    m.hota = hota / kAlphas;
-    m.deta = deta / kAlphas;
-    m.assa = assa / kAlphas;
+    ass /= std::max(1.0, tp);
+    hota += std::sqrt(det * ass);
+    deta += det;
+    assa += ass;
   }
+  m.hota = hota / kAlphas;
+  m.deta = deta / kAlphas;
+  m.assa = assa / kAlphas;
+}
+
+MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,
+                       const MotOptions& options) {
+  options.Check();
+  CheckOneBoxPerIdAndFrame(gt_in, "ground truth");
+  CheckOneBoxPerIdAndFrame(est_in, "estimate");
+  std::vector<TrackRow> gt, est;
+  MotPreprocessing pre;
+  Preprocess(gt_in, est_in, options, gt, est, pre);
+  const MotIndex index = IndexMotRows(gt, est);
+  MotMetrics m;
+  m.preprocessing = pre;
+  m.frames = static_cast<int>(index.frames.size());
+  m.gt_boxes = static_cast<int>(gt.size());
+  m.est_boxes = static_cast<int>(est.size());
+  m.gt_ids = static_cast<int>(index.gt_index.size());
+  m.est_ids = static_cast<int>(index.est_index.size());
+  // The id-pair tables hold gt_ids x est_ids counts.
+  FV_REQUIRE(static_cast<double>(m.gt_ids) * m.est_ids <= 5e7,
+             "eval tracks: {} ground-truth ids x {} estimated ids is too many id pairs to score "
+             "(at most 5e7)",
+             m.gt_ids, m.est_ids);
+  const MotIdCounts counts = CountClearMot(index, options.iou_threshold, m);
+  ScoreIdentity(counts.pair_frames, m);
+  ScoreHota(index, counts, m);
   return m;
 }
 

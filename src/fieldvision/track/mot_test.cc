@@ -1,4 +1,5 @@
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/mot_internal.h"
 
 #include <fstream>
 
@@ -235,6 +236,31 @@ TEST(Mot, FrameAlignment) {
   EXPECT_EQ(fixed.preprocessing.best_offset, 0);
   EXPECT_EQ(fixed.preprocessing.est_outside_gt_frames, 1);
   EXPECT_EQ(fixed.preprocessing.Summary().find("WARNING"), std::string::npos);
+}
+
+TEST(MotStages, ClearMotKeepsLastFramesPairWhileItOverlaps) {
+  const std::vector<TrackRow> gt = {{1, 1, cv::Rect2d(0, 0, 20, 40)}};
+  const std::vector<TrackRow> est = {{1, 7, cv::Rect2d(6, 0, 20, 40)},
+                                     {1, 8, cv::Rect2d(1, 0, 20, 40)}};
+  const MotIndex index = IndexMotRows(gt, est);
+  const MotFrame& f = index.frames.at(1);
+  const auto iou = FrameIou(f);
+  ASSERT_GE(iou[0][0], 0.5);
+  EXPECT_GT(iou[0][1], iou[0][0]);
+  EXPECT_EQ(MatchClearMot(f, iou, {}, 0.5), (std::vector<int>{1}));        // the better overlap
+  EXPECT_EQ(MatchClearMot(f, iou, {{1, 7}}, 0.5), (std::vector<int>{0}));  // kept from last frame
+  EXPECT_EQ(MatchClearMot(f, iou, {}, 0.99), (std::vector<int>{-1}));
+}
+
+TEST(MotStages, IdentityScoresPairIdsOneToOne) {
+  MotMetrics m;
+  m.gt_boxes = 10;
+  m.est_boxes = 12;
+  // gt 0 overlaps est 0 in 5 frames and est 1 in 6; gt 1 only est 1 in 4: 5 + 4 beats 6.
+  ScoreIdentity({{5, 6}, {0, 4}}, m);
+  EXPECT_DOUBLE_EQ(m.idf1, 2.0 * 9 / 22);
+  EXPECT_DOUBLE_EQ(m.idp, 9.0 / 12);
+  EXPECT_DOUBLE_EQ(m.idr, 9.0 / 10);
 }
 
 }  // namespace

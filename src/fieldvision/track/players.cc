@@ -17,6 +17,7 @@
 
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"
+#include "fieldvision/track/players_internal.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 
@@ -201,30 +202,12 @@ void StitchOptions::Check() const {
   CheckPositive(person_height_m, "stitch person_height_m");
 }
 
-namespace {
-
-struct Tracklet {
-  int id = 0;
-  std::vector<const TrackRow*> rows;             // by frame
-  Eigen::Vector2d first, last, v_first, v_last;  // metres, metres per second
-  int first_frame = 0, last_frame = 0;           // frames of `first` and `last`
-  bool starts_at_border = false, ends_at_border = false;
-};
-
-}  // namespace
-
-int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppearance>& appearance,
-                    const StitchOptions& o, double fps, cv::Size image) {
-  o.Check();
-  if (o.max_gap_s <= 0 || rows.empty()) return 0;
-  fps = fps > 0 ? fps : 25.0;
+std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const StitchOptions& o,
+                                       double fps, cv::Size image) {
   std::map<int, Tracklet> tl;
   for (const auto& r : rows) tl[r.id].rows.push_back(&r);
   bool field = true;
   for (const auto& r : rows) field = field && r.x_m && r.y_m;
-  double mean_h = 0;
-  for (const auto& r : rows) mean_h += r.box.height;
-  mean_h = std::max(1.0, mean_h / rows.size());
   // Ground position in metres: the field position, else the foot pixel scaled by the box height.
   auto pos = [&](const TrackRow& r) -> Eigen::Vector2d {
     if (field) return {*r.x_m, *r.y_m};
@@ -285,11 +268,13 @@ int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppear
     t.starts_at_border = at_border(f.box);
     t.ends_at_border = at_border(l.box);
   }
-  struct Link {
-    double cost;
-    int a, b;
-  };
-  std::vector<Link> links;
+  return tl;
+}
+
+std::vector<TrackletLink> TrackletLinks(const std::map<int, Tracklet>& tl,
+                                        const std::map<int, TrackAppearance>& appearance,
+                                        const StitchOptions& o, double fps) {
+  std::vector<TrackletLink> links;
   for (const auto& [ia, a] : tl) {
     const int a_end = a.rows.back()->frame;
     for (const auto& [ib, b] : tl) {
@@ -316,13 +301,17 @@ int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppear
       links.push_back({cost, ia, ib});
     }
   }
-  std::sort(links.begin(), links.end(), [](const Link& x, const Link& y) {
+  std::sort(links.begin(), links.end(), [](const TrackletLink& x, const TrackletLink& y) {
     return x.cost != y.cost ? x.cost < y.cost : std::tie(x.a, x.b) < std::tie(y.a, y.b);
   });
+  return links;
+}
+
+int JoinTracklets(const std::vector<TrackletLink>& links, std::vector<TrackRow>& rows) {
   std::set<int> has_next, has_prev;
   std::map<int, int> prev_of;
   int joins = 0;
-  for (const Link& l : links) {
+  for (const TrackletLink& l : links) {
     if (has_next.count(l.a) || has_prev.count(l.b)) continue;
     has_next.insert(l.a);
     has_prev.insert(l.b);
@@ -336,6 +325,16 @@ int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppear
   };
   for (auto& r : rows) r.id = root(r.id);
   return joins;
+}
+
+int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppearance>& appearance,
+                    const StitchOptions& o, double fps, cv::Size image) {
+  o.Check();
+  if (o.max_gap_s <= 0 || rows.empty()) return 0;
+  fps = fps > 0 ? fps : 25.0;
+  const std::map<int, Tracklet> tl = BuildTracklets(rows, o, fps, image);
+  const std::vector<TrackletLink> links = TrackletLinks(tl, appearance, o, fps);
+  return JoinTracklets(links, rows);
 }
 
 void PlayersOptions::Check() const {
@@ -418,27 +417,169 @@ int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const Camera* came
   return added;
 }
 
+FootFilter FieldFootFilter(const Camera& camera, const FieldModel* field, double margin_m) {
+  const Camera cam = camera;
+  std::optional<FieldModel> f;
+  if (field != nullptr) f = *field;
+  const double margin = margin_m;
+  return [cam, f, margin](const cv::Point2d& foot) {
+    const auto ray = cam.RayFromPixel({foot.x, foot.y});
+    if (!ray) return false;
+    const auto g = IntersectHorizontalPlane(*ray, 0.0);
+    if (!g) return false;
+    if (!f) return true;
+    return std::abs(g->x()) <= 0.5 * f->length_m + margin &&
+           std::abs(g->y()) <= 0.5 * f->width_m + margin;
+  };
+}
+
+void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& frame,
+                        double high_score, std::map<int, TrackAppearance>& appearance) {
+  for (const auto& s : states) {
+    if (s.predicted || s.score < high_score) continue;
+    bool clear = true;
+    for (const auto& o : states) {
+      if (o.id != s.id && (o.box & s.box).area() > 0.1 * s.box.area()) clear = false;
+    }
+    if (!clear) continue;
+    const cv::Mat h = TorsoHistogram(frame, s.box);
+    if (h.empty()) continue;
+    TrackAppearance& a = appearance[s.id];
+    a.sum = a.sum.empty() ? h.clone() : a.sum + h;
+    a.count++;
+  }
+}
+
+std::optional<cv::Vec3f> TorsoColour(const cv::Mat& frame, const cv::Rect2d& box) {
+  const cv::Rect torso = cv::Rect(cv::Rect2d(box.x + 0.3 * box.width, box.y + 0.2 * box.height,
+                                             0.4 * box.width, 0.3 * box.height)) &
+                         cv::Rect(0, 0, frame.cols, frame.rows);
+  if (torso.area() <= 4) return std::nullopt;
+  cv::Mat lab;
+  cv::cvtColor(frame(torso), lab, cv::COLOR_BGR2Lab);
+  const cv::Scalar m = cv::mean(lab);
+  return cv::Vec3f(m[0] * 0.3, m[1], m[2]);  // chroma first
+}
+
+int DropShortTracks(std::vector<TrackRow>& rows, int min_frames) {
+  std::map<int, int> count;
+  for (const auto& r : rows) count[r.id]++;
+  int dropped = 0;
+  for (const auto& [id, n] : count) {
+    if (n < min_frames) dropped++;
+  }
+  std::erase_if(rows, [&](const TrackRow& r) { return count[r.id] < min_frames; });
+  return dropped;
+}
+
+std::map<int, int> AssignTeams(const std::map<int, std::vector<cv::Vec3f>>& torso_colours,
+                               const std::set<int>& ids) {
+  std::map<int, int> team_of;
+  std::vector<int> team_ids;
+  cv::Mat samples;
+  for (const auto& [id, cs] : torso_colours) {
+    if (!ids.count(id) || cs.empty()) continue;
+    cv::Vec3f mean(0, 0, 0);
+    for (const auto& c : cs) mean += c;
+    mean /= static_cast<float>(cs.size());
+    samples.push_back(cv::Mat(1, 3, CV_32F, &mean[0]).clone());
+    team_ids.push_back(id);
+  }
+  if (samples.rows >= 2) {
+    cv::Mat labels, centres;
+    cv::kmeans(samples, 2, labels,
+               cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3), 5,
+               cv::KMEANS_PP_CENTERS, centres);
+    for (size_t i = 0; i < team_ids.size(); ++i) team_of[team_ids[i]] = labels.at<int>(i);
+  }
+  return team_of;
+}
+
+namespace {
+
+// What the pass over the frames gathers besides the rows.
+struct PlayersPass {
+  std::map<int, std::vector<cv::Vec3f>> torso_colours;
+  std::map<int, TrackAppearance> appearance;
+  std::vector<double> times_ms;
+  DetectionsFile saved;
+};
+
+// One frame's tracks as rows (1-based frame `frame_number`), with their torso colours for teams.
+void RecordTracks(const std::vector<TrackState>& states, const cv::Mat& frame, int frame_number,
+                  bool calibrated, const PlayersOptions& options, PlayersResult& result,
+                  PlayersPass& pass) {
+  for (const auto& s : states) {
+    TrackRow r;
+    r.frame = frame_number;  // MOTChallenge numbering
+    r.id = s.id;
+    r.box = s.box;
+    r.conf = s.score;
+    if (calibrated) {
+      if (s.field_m) {
+        r.x_m = s.field_m->x();
+        r.y_m = s.field_m->y();
+      } else {
+        result.off_ground++;
+      }
+    }
+    result.rows.push_back(r);
+    if (options.teams && !s.predicted) {
+      if (const auto c = TorsoColour(frame, s.box)) pass.torso_colours[s.id].push_back(*c);
+    }
+  }
+}
+
+// After the pass: short tracks dropped, tracklets joined, gaps filled, ground tracks smoothed,
+// teams and the rows' times.
+void FinishTracks(const PlayersOptions& options, const Camera* camera, bool calibrated,
+                  cv::Size image, const PlayersPass& pass, bool sequence, double video_fps,
+                  PlayersResult& result) {
+  const int frames = result.frames;
+  // Short tracks are usually false detections; on a short clip the minimum is half the clip.
+  result.min_track_frames = std::min(options.min_track_frames, std::max(1, (frames + 1) / 2));
+  if (options.min_track_frames > 0) {
+    result.dropped_tracks = DropShortTracks(result.rows, result.min_track_frames);
+  }
+  result.stitched =
+      StitchTracklets(result.rows, pass.appearance, options.stitch, result.fps, image);
+  result.interpolated =
+      InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
+                      options.tracker.foot_offset_m);
+  if (calibrated) {
+    // Rows with a detection are measurements; carried and interpolated ones (conf 0) are not.
+    std::vector<bool> measured(result.rows.size());
+    for (size_t i = 0; i < result.rows.size(); ++i) measured[i] = result.rows[i].conf > 0;
+    result.smoothing =
+        SmoothGroundTracks(result.rows, measured, *camera, result.fps, options.smooth);
+  }
+  std::set<int> ids;
+  for (const auto& r : result.rows) ids.insert(r.id);
+  result.tracks = static_cast<int>(ids.size());
+  if (options.teams) result.team_of = AssignTeams(pass.torso_colours, ids);
+  // An image sequence has no time of its own (OpenCV reports 25 frames/s for any pattern).
+  if (sequence) {
+    result.time = TimesOfFrames(std::vector<double>(pass.times_ms.size(), 0.0), 0.0, options.fps);
+    if (result.time.time_s.empty()) {
+      result.time.source = "none (an image sequence has no frame rate: give --fps)";
+    }
+  } else {
+    result.time = TimesOfFrames(pass.times_ms, video_fps, options.fps);
+  }
+  if (!result.time.time_s.empty()) {
+    for (auto& r : result.rows) r.time_s = result.time.time_s[r.frame - 1];
+  }
+}
+
+}  // namespace
+
 PlayersResult RunPlayers(const std::string& video, const Camera* camera, const FieldModel* field,
                          const PlayersOptions& options) {
   options.Check();
   const auto t_start = Clock::now();
   const bool calibrated = camera != nullptr && camera->has_pose;
   FootFilter filter;
-  if (calibrated) {
-    const Camera cam = *camera;
-    std::optional<FieldModel> f;
-    if (field != nullptr) f = *field;
-    const double margin = options.field_margin_m;
-    filter = [cam, f, margin](const cv::Point2d& foot) {
-      const auto ray = cam.RayFromPixel({foot.x, foot.y});
-      if (!ray) return false;
-      const auto g = IntersectHorizontalPlane(*ray, 0.0);
-      if (!g) return false;
-      if (!f) return true;
-      return std::abs(g->x()) <= 0.5 * f->length_m + margin &&
-             std::abs(g->y()) <= 0.5 * f->width_m + margin;
-    };
-  }
+  if (calibrated) filter = FieldFootFilter(*camera, field, options.field_margin_m);
   // Open the video first: a bad video is reported before the model is loaded.
   // An image sequence is read up to its last file (reading past it makes OpenCV warn).
   const size_t sequence_files = ListImageSequence(video).size();
@@ -458,7 +599,6 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   } else {
     detector = MakeDetector(options.detector, calibrated ? camera : nullptr, filter);
   }
-  DetectionsFile saved;
   PlayersResult result;
   result.detector = detector->name();
   // The tracker's and stitcher's rate (frame steps to seconds); the rows' times come from
@@ -472,14 +612,12 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     total = options.max_frames;
   }
   Progress progress("players", total, "frames", options.progress);
-  std::map<int, std::vector<cv::Vec3f>> torso_colours;
-  std::map<int, TrackAppearance> appearance;
+  PlayersPass pass;
   cv::Mat frame;
   int index = 0;
   double time_ms = 0;
-  std::vector<double> times_ms;
   while (reader.Next(frame, time_ms)) {
-    times_ms.push_back(time_ms);
+    pass.times_ms.push_back(time_ms);
     const auto t0 = Clock::now();
     const std::vector<Detection> dets = detector->Detect(frame);
     const auto t1 = Clock::now();
@@ -488,49 +626,10 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
     result.detections += static_cast<int>(dets.size());
     // Appearance of each track for stitching: confident boxes that no other box overlaps.
     if (options.stitch.max_gap_s > 0) {
-      for (const auto& s : states) {
-        if (s.predicted || s.score < options.tracker.high_score) continue;
-        bool clear = true;
-        for (const auto& o : states) {
-          if (o.id != s.id && (o.box & s.box).area() > 0.1 * s.box.area()) clear = false;
-        }
-        if (!clear) continue;
-        const cv::Mat h = TorsoHistogram(frame, s.box);
-        if (h.empty()) continue;
-        TrackAppearance& a = appearance[s.id];
-        a.sum = a.sum.empty() ? h.clone() : a.sum + h;
-        a.count++;
-      }
+      AddTrackAppearance(states, frame, options.tracker.high_score, pass.appearance);
     }
-    if (!options.detections_out.empty()) saved.frames.push_back(dets);
-    for (const auto& s : states) {
-      TrackRow r;
-      r.frame = index + 1;  // MOTChallenge numbering
-      r.id = s.id;
-      r.box = s.box;
-      r.conf = s.score;
-      if (calibrated) {
-        if (s.field_m) {
-          r.x_m = s.field_m->x();
-          r.y_m = s.field_m->y();
-        } else {
-          result.off_ground++;
-        }
-      }
-      result.rows.push_back(r);
-      if (options.teams && !s.predicted) {
-        const cv::Rect torso =
-            cv::Rect(cv::Rect2d(s.box.x + 0.3 * s.box.width, s.box.y + 0.2 * s.box.height,
-                                0.4 * s.box.width, 0.3 * s.box.height)) &
-            cv::Rect(0, 0, frame.cols, frame.rows);
-        if (torso.area() > 4) {
-          cv::Mat lab;
-          cv::cvtColor(frame(torso), lab, cv::COLOR_BGR2Lab);
-          const cv::Scalar m = cv::mean(lab);
-          torso_colours[s.id].push_back(cv::Vec3f(m[0] * 0.3, m[1], m[2]));  // chroma first
-        }
-      }
-    }
+    if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);
+    RecordTracks(states, frame, index + 1, calibrated, options, result, pass);
     result.times.detect_s += std::chrono::duration<double>(t1 - t0).count();
     result.times.track_s += std::chrono::duration<double>(t2 - t1).count();
     ++index;
@@ -539,65 +638,10 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   progress.Finish();
   result.frames = index;
   FV_REQUIRE(index > 0, "video '{}' has no readable frame", video);
-  if (!options.detections_out.empty()) WriteDetectionsCsv(saved, options.detections_out);
+  if (!options.detections_out.empty()) WriteDetectionsCsv(pass.saved, options.detections_out);
   const auto t_map = Clock::now();
-  // Short tracks are usually false detections; on a short clip the minimum is half the clip.
-  result.min_track_frames = std::min(options.min_track_frames, std::max(1, (index + 1) / 2));
-  if (options.min_track_frames > 0) {
-    std::map<int, int> count;
-    for (const auto& r : result.rows) count[r.id]++;
-    for (const auto& [id, n] : count) {
-      if (n < result.min_track_frames) result.dropped_tracks++;
-    }
-    std::erase_if(result.rows,
-                  [&](const TrackRow& r) { return count[r.id] < result.min_track_frames; });
-  }
-  result.stitched =
-      StitchTracklets(result.rows, appearance, options.stitch, result.fps, reader.size());
-  result.interpolated =
-      InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
-                      options.tracker.foot_offset_m);
-  if (calibrated) {
-    // Rows with a detection are measurements; carried and interpolated ones (conf 0) are not.
-    std::vector<bool> measured(result.rows.size());
-    for (size_t i = 0; i < result.rows.size(); ++i) measured[i] = result.rows[i].conf > 0;
-    result.smoothing =
-        SmoothGroundTracks(result.rows, measured, *camera, result.fps, options.smooth);
-  }
-  std::set<int> ids;
-  for (const auto& r : result.rows) ids.insert(r.id);
-  result.tracks = static_cast<int>(ids.size());
-  if (options.teams) {
-    std::vector<int> team_ids;
-    cv::Mat samples;
-    for (const auto& [id, cs] : torso_colours) {
-      if (!ids.count(id) || cs.empty()) continue;
-      cv::Vec3f mean(0, 0, 0);
-      for (const auto& c : cs) mean += c;
-      mean /= static_cast<float>(cs.size());
-      samples.push_back(cv::Mat(1, 3, CV_32F, &mean[0]).clone());
-      team_ids.push_back(id);
-    }
-    if (samples.rows >= 2) {
-      cv::Mat labels, centres;
-      cv::kmeans(samples, 2, labels,
-                 cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-3), 5,
-                 cv::KMEANS_PP_CENTERS, centres);
-      for (size_t i = 0; i < team_ids.size(); ++i) result.team_of[team_ids[i]] = labels.at<int>(i);
-    }
-  }
-  // An image sequence has no time of its own (OpenCV reports 25 frames/s for any pattern).
-  if (sequence_files > 0) {
-    result.time = TimesOfFrames(std::vector<double>(times_ms.size(), 0.0), 0.0, options.fps);
-    if (result.time.time_s.empty()) {
-      result.time.source = "none (an image sequence has no frame rate: give --fps)";
-    }
-  } else {
-    result.time = TimesOfFrames(times_ms, reader.fps(), options.fps);
-  }
-  if (!result.time.time_s.empty()) {
-    for (auto& r : result.rows) r.time_s = result.time.time_s[r.frame - 1];
-  }
+  FinishTracks(options, camera, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
+               result);
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();
   result.tracker = tracker.stats();

@@ -13,6 +13,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/track/overlay.h"
+#include "fieldvision/track/players_internal.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -345,6 +346,75 @@ TEST(Players, SynthScenePositionsAndStableIds) {
   EXPECT_GE(people.size(), 6u) << r.Summary();
 }
 #endif
+
+// Rows of one walker with field positions: frames first..last at (x0 + v t, 0).
+std::vector<TrackRow> WalkerRows(int id, int first, int last, double x0, double v, double fps) {
+  std::vector<TrackRow> rows;
+  for (int f = first; f <= last; ++f) {
+    TrackRow r;
+    r.frame = f;
+    r.id = id;
+    r.box = cv::Rect2d(100 + f, 100, 20, 60);
+    r.x_m = x0 + v * (f - first) / fps;
+    r.y_m = 0.0;
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+TEST(PlayersStages, TrackletEndsLinksAndJoins) {
+  const double fps = 10;
+  StitchOptions o;
+  std::vector<TrackRow> rows = WalkerRows(1, 1, 20, 0.0, 1.0, fps);               // ends at x = 1.9
+  for (const auto& r : WalkerRows(2, 25, 40, 2.4, 1.0, fps)) rows.push_back(r);   // on its way
+  for (const auto& r : WalkerRows(3, 25, 40, -5.0, 1.0, fps)) rows.push_back(r);  // too far
+  const auto tl = BuildTracklets(rows, o, fps, cv::Size());
+  ASSERT_EQ(tl.size(), 3u);
+  EXPECT_NEAR(tl.at(1).last.x(), 1.9, 1e-9);
+  EXPECT_NEAR(tl.at(1).v_last.x(), 1.0, 1e-9);
+  EXPECT_EQ(tl.at(2).first_frame, 25);
+  EXPECT_TRUE(TrackletLinks(tl, {}, o, fps).empty());  // no torso colours: no join
+  std::map<int, TrackAppearance> look;
+  for (int id : {1, 2, 3}) look[id] = {cv::Mat(16, 8, CV_32F, cv::Scalar(1.0 / 128)), 1};
+  const auto links = TrackletLinks(tl, look, o, fps);
+  ASSERT_EQ(links.size(), 1u);
+  EXPECT_EQ(links[0].a, 1);
+  EXPECT_EQ(links[0].b, 2);
+  EXPECT_EQ(JoinTracklets(links, rows), 1);
+  std::set<int> ids;
+  for (const auto& r : rows) ids.insert(r.id);
+  EXPECT_EQ(ids, (std::set<int>{1, 3}));
+}
+
+TEST(PlayersStages, JoinTakesOneSuccessorEachAndFollowsChains) {
+  std::vector<TrackRow> rows(4);
+  for (int i = 0; i < 4; ++i) rows[i].id = i + 1;
+  // 1 -> 2 is cheapest, 1 -> 3 then loses 1 as predecessor; 2 -> 4 chains 4 to 1.
+  const std::vector<TrackletLink> links = {{0.1, 1, 2}, {0.2, 1, 3}, {0.3, 2, 4}};
+  EXPECT_EQ(JoinTracklets(links, rows), 2);
+  EXPECT_EQ(rows[0].id, 1);
+  EXPECT_EQ(rows[1].id, 1);
+  EXPECT_EQ(rows[2].id, 3);
+  EXPECT_EQ(rows[3].id, 1);
+}
+
+TEST(PlayersStages, DropShortTracksAndTeams) {
+  std::vector<TrackRow> rows = WalkerRows(1, 1, 3, 0, 0, 10);
+  for (const auto& r : WalkerRows(2, 1, 8, 0, 0, 10)) rows.push_back(r);
+  EXPECT_EQ(DropShortTracks(rows, 5), 1);
+  EXPECT_EQ(rows.size(), 8u);
+  const std::map<int, std::vector<cv::Vec3f>> colours = {
+      {1, {cv::Vec3f(30, 200, 120)}},
+      {2, {cv::Vec3f(31, 198, 121)}},
+      {3, {cv::Vec3f(30, 60, 180)}},
+      {4, {cv::Vec3f(29, 62, 178)}},
+      {5, {cv::Vec3f(0, 0, 0)}}};  // not among the ids kept
+  const auto teams = AssignTeams(colours, {1, 2, 3, 4});
+  ASSERT_EQ(teams.size(), 4u);
+  EXPECT_EQ(teams.at(1), teams.at(2));
+  EXPECT_EQ(teams.at(3), teams.at(4));
+  EXPECT_NE(teams.at(1), teams.at(3));
+}
 
 }  // namespace
 }  // namespace fv::track
