@@ -10,6 +10,7 @@
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/recon/trajectory_draw.h"
 #include "fieldvision/recon/trajectory_eval.h"
+#include "fieldvision/recon/trajectory_run_internal.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
@@ -57,8 +58,9 @@ std::string FlightTable(const TrajectoryResult& r) {
   return s;
 }
 
-TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
-  job.Check();
+namespace {
+
+void CreateParentFolders(const TrajectoryJob& job) {
   for (const std::string* p : {&job.out_path, &job.report_path, &job.smoothed_path}) {
     const auto parent = std::filesystem::path(*p).parent_path();
     if (p->empty() || parent.empty()) continue;
@@ -66,49 +68,68 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
     std::filesystem::create_directories(parent, ec);
     FV_REQUIRE(!ec, "cannot create folder '{}' for '{}': {}", parent.string(), *p, ec.message());
   }
-  TrajectoryJobResult out;
-  out.input = ReadBallTrack(job.in_path);
-  const auto& track = out.input.samples;
+}
+
+void LogSkipped(const BallTrackFile& input, std::ostream& log) {
   const size_t max_listed = 10;
-  for (size_t i = 0; i < out.input.skipped.size() && i < max_listed; ++i) {
-    log << "skipped: " << out.input.skipped[i] << "\n";
+  for (size_t i = 0; i < input.skipped.size() && i < max_listed; ++i) {
+    log << "skipped: " << input.skipped[i] << "\n";
   }
-  if (out.input.skipped.size() > max_listed) {
-    log << fmt::format("skipped: ... and {} more rows\n", out.input.skipped.size() - max_listed);
+  if (input.skipped.size() > max_listed) {
+    log << fmt::format("skipped: ... and {} more rows\n", input.skipped.size() - max_listed);
   }
-  out.options = job.analysis;
+}
+
+// Writes JSON through a temporary file beside `path`.
+void WriteJson(const std::string& path, const nlohmann::json& j, const char* what) {
+  AtomicWrite(
+      path,
+      [&](const std::string& tmp) {
+        std::ofstream f(tmp);
+        FV_REQUIRE(f.good(), "cannot write '{}'", path);
+        f << j.dump(2) << "\n";
+        f.close();
+        FV_REQUIRE(!f.fail(), "cannot write '{}'", path);
+      },
+      what);
+}
+
+// The flights and the timeline.
+void LogFlights(const TrajectoryJob& job, const TrajectoryJobResult& out, std::ostream& log) {
+  const TrajectoryResult& r = out.result;
+  log << FlightTable(r);
+  log << "timeline:\n";
+  for (const auto& e : out.decisions.timeline) {
+    log << fmt::format("  {:9.3f} s  {}\n", e.time_s, e.text);
+  }
+  log << fmt::format("wrote {} ({} flights){}\n", job.out_path, r.flights.size(),
+                     out.images.empty()
+                         ? ""
+                         : fmt::format(", {} images in {}", out.images.size(), job.images_dir));
+}
+
+}  // namespace
+
+TrajectoryOptions TrajectoryOptionsFor(const TrajectoryJob& job, const std::string& layout,
+                                       std::ostream& log) {
+  TrajectoryOptions o = job.analysis;
+  const bool tt3d = layout == "tt3d";
   double diameter = job.ball_diameter_m;
   if (diameter <= 0) {
-    diameter = out.input.layout == "tt3d" ? 0.04 : 0.22;
+    diameter = tt3d ? 0.04 : 0.22;
     log << fmt::format("ball diameter {:.3f} m ({}; --ball-diameter to change)\n", diameter,
-                       out.input.layout == "tt3d" ? "table tennis, TT3D layout" : "football");
+                       tt3d ? "table tennis, TT3D layout" : "football");
   }
-  out.options.ball_radius_m = 0.5 * diameter;
-  out.options.ball_mass_kg =
-      job.ball_mass_kg > 0 ? job.ball_mass_kg : (out.input.layout == "tt3d" ? 0.0027 : 0.43);
-  out.options.unmodelled_accel_mps2 =
-      job.accel_slack_mps2 > 0 ? job.accel_slack_mps2 : (out.input.layout == "tt3d" ? 25.0 : 10.0);
-  out.options.Check();
-  FieldModel field;
-  const bool has_field = !job.field.empty();
-  if (has_field) field = LoadField(job.field);
-  if (has_field && out.input.layout == "tt3d") {
-    // TT3D files have the table's length along y: the field is turned to match.
-    field = RotateFieldQuarter(field);
-    log << "field turned a quarter (TT3D layout: the table's length along y)\n";
-  }
+  o.ball_radius_m = 0.5 * diameter;
+  o.ball_mass_kg = job.ball_mass_kg > 0 ? job.ball_mass_kg : (tt3d ? 0.0027 : 0.43);
+  o.unmodelled_accel_mps2 = job.accel_slack_mps2 > 0 ? job.accel_slack_mps2 : (tt3d ? 25.0 : 10.0);
+  o.Check();
+  return o;
+}
 
-  out.result = AnalyzeTrajectory(track, out.options);
+nlohmann::json FlightsJson(const TrajectoryJobResult& out, double predict_fraction) {
   const TrajectoryResult& r = out.result;
-  log << fmt::format("{}: {} samples, {:.2f} s; {}\n", job.in_path, track.size(),
-                     track.empty() ? 0.0 : track.back().time_s - track.front().time_s, r.Summary());
-  for (const auto& f : r.flights) {
-    out.predictions.push_back(PredictFlightLanding(track, r, f, job.predict_fraction, out.options));
-  }
-  out.decisions = MakeDecisions(track, r, has_field ? &field : nullptr, out.options, job.decisions);
-
-  // FLIGHTS.json: the contract's array, each flight with its prediction and calls (the calls
-  // sorted into their flights in one pass).
+  // The calls sorted into their flights in one pass.
   nlohmann::json flights = FlightsToJson(r, &out.options);
   const nlohmann::json dj = out.decisions.ToJson();
   auto by_flight = [&](const char* key) {
@@ -125,7 +146,7 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   for (size_t i = 0; i < r.flights.size(); ++i) {
     const auto& p = out.predictions[i];
     nlohmann::json pj;
-    pj["fraction"] = job.predict_fraction;
+    pj["fraction"] = predict_fraction;
     pj["ok"] = p.ok;
     if (p.ok) {
       pj["samples_used"] = p.samples_used;
@@ -144,20 +165,15 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
     flights[i]["goal_crossings"] = goal_crossings[i];
     flights[i]["made_shots"] = made_shots[i];
   }
+  return flights;
+}
+
+void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flights,
+                            const FieldModel* field, TrajectoryJobResult& out) {
+  const auto& track = out.input.samples;
+  const TrajectoryResult& r = out.result;
   // Everything is computed and the pictures' folder made before the first output is replaced;
   // each output is written to a temporary file beside it and renamed (io/output_path.h).
-  auto write_json = [](const std::string& path, const nlohmann::json& j, const char* what) {
-    AtomicWrite(
-        path,
-        [&](const std::string& tmp) {
-          std::ofstream f(tmp);
-          FV_REQUIRE(f.good(), "cannot write '{}'", path);
-          f << j.dump(2) << "\n";
-          f.close();
-          FV_REQUIRE(!f.fail(), "cannot write '{}'", path);
-        },
-        what);
-  };
   if (!job.images_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(job.images_dir, ec);
@@ -165,7 +181,7 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
                "cannot create the folder '{}' for --images{}", job.images_dir,
                ec ? ": " + ec.message() : std::string());
   }
-  write_json(job.out_path, flights, "--out");
+  WriteJson(job.out_path, flights, "--out");
   if (!job.report_path.empty()) {
     nlohmann::json rep;
     rep["input"] = job.in_path;
@@ -177,8 +193,8 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
     rep["noise_m"] = r.noise_m;
     rep["summary"] = r.Summary();
     rep["flights"] = flights;
-    rep["decisions"] = dj;
-    write_json(job.report_path, rep, "--report");
+    rep["decisions"] = out.decisions.ToJson();
+    WriteJson(job.report_path, rep, "--report");
   }
   if (!job.smoothed_path.empty()) {
     const std::vector<BallSample> smoothed = SmoothTrack(track, r, out.options, job.smoother);
@@ -186,32 +202,49 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
         job.smoothed_path, [&](const std::string& tmp) { WriteBallTrack(tmp, smoothed); },
         "--smoothed");
   }
-  if (!job.images_dir.empty()) {
-    // Drawn one at a time (a long track has thousands of flights).
-    auto write = [&](const std::string& name, const cv::Mat& img) {
-      const std::string path = (std::filesystem::path(job.images_dir) / name).string();
-      AtomicWrite(
-          path, [&](const std::string& tmp) { WriteImage(tmp, img); }, "--images");
-      out.images.push_back(path);
-    };
-    write("track_height.png", DrawTrackHeight(track, r, out.options));
-    write("flights_top.png",
-          DrawFlightsTop(track, r, has_field ? &field : nullptr, &out.decisions));
-    for (size_t i = 0; i < r.flights.size(); ++i) {
-      write(fmt::format("flight_{:02d}_side.png", i),
-            DrawFlightSide(track, r, r.flights[i], out.options, &out.predictions[i]));
-    }
+  if (job.images_dir.empty()) return;
+  // Drawn one at a time (a long track has thousands of flights).
+  auto write = [&](const std::string& name, const cv::Mat& img) {
+    const std::string path = (std::filesystem::path(job.images_dir) / name).string();
+    AtomicWrite(
+        path, [&](const std::string& tmp) { WriteImage(tmp, img); }, "--images");
+    out.images.push_back(path);
+  };
+  write("track_height.png", DrawTrackHeight(track, r, out.options));
+  write("flights_top.png", DrawFlightsTop(track, r, field, &out.decisions));
+  for (size_t i = 0; i < r.flights.size(); ++i) {
+    write(fmt::format("flight_{:02d}_side.png", i),
+          DrawFlightSide(track, r, r.flights[i], out.options, &out.predictions[i]));
   }
-  // The flights and the timeline.
-  log << FlightTable(r);
-  log << "timeline:\n";
-  for (const auto& e : out.decisions.timeline) {
-    log << fmt::format("  {:9.3f} s  {}\n", e.time_s, e.text);
+}
+
+TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
+  job.Check();
+  CreateParentFolders(job);
+  TrajectoryJobResult out;
+  out.input = ReadBallTrack(job.in_path);
+  const auto& track = out.input.samples;
+  LogSkipped(out.input, log);
+  out.options = TrajectoryOptionsFor(job, out.input.layout, log);
+  FieldModel field;
+  const bool has_field = !job.field.empty();
+  if (has_field) field = LoadField(job.field);
+  if (has_field && out.input.layout == "tt3d") {
+    // TT3D files have the table's length along y: the field is turned to match.
+    field = RotateFieldQuarter(field);
+    log << "field turned a quarter (TT3D layout: the table's length along y)\n";
   }
-  log << fmt::format("wrote {} ({} flights){}\n", job.out_path, r.flights.size(),
-                     out.images.empty()
-                         ? ""
-                         : fmt::format(", {} images in {}", out.images.size(), job.images_dir));
+  out.result = AnalyzeTrajectory(track, out.options);
+  const TrajectoryResult& r = out.result;
+  log << fmt::format("{}: {} samples, {:.2f} s; {}\n", job.in_path, track.size(),
+                     track.empty() ? 0.0 : track.back().time_s - track.front().time_s, r.Summary());
+  for (const auto& f : r.flights) {
+    out.predictions.push_back(PredictFlightLanding(track, r, f, job.predict_fraction, out.options));
+  }
+  out.decisions = MakeDecisions(track, r, has_field ? &field : nullptr, out.options, job.decisions);
+  const nlohmann::json flights = FlightsJson(out, job.predict_fraction);
+  WriteTrajectoryOutputs(job, flights, has_field ? &field : nullptr, out);
+  LogFlights(job, out, log);
   return out;
 }
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/recon/trajectory_run_internal.h"
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
@@ -121,6 +122,29 @@ TEST(TrajectoryRun, LongBlockWithManyBounces) {
   EXPECT_LE(static_cast<int>(res.breaks.size()), 61) << res.Summary();
   EXPECT_GE(res.flights.size(), 59u) << res.Summary();
   EXPECT_GE(calls, res.flights.size());
+}
+
+TEST(TrajectoryRunStages, OptionsFollowTheLayoutUnlessGiven) {
+  TrajectoryJob job;
+  std::ostringstream log;
+  const TrajectoryOptions football = TrajectoryOptionsFor(job, "ball_csv", log);
+  EXPECT_DOUBLE_EQ(football.ball_radius_m, 0.11);
+  EXPECT_DOUBLE_EQ(football.ball_mass_kg, 0.43);
+  EXPECT_DOUBLE_EQ(football.unmodelled_accel_mps2, 10.0);
+  EXPECT_NE(log.str().find("football"), std::string::npos) << log.str();
+  const TrajectoryOptions tt = TrajectoryOptionsFor(job, "tt3d", log);
+  EXPECT_DOUBLE_EQ(tt.ball_radius_m, 0.02);
+  EXPECT_DOUBLE_EQ(tt.ball_mass_kg, 0.0027);
+  EXPECT_DOUBLE_EQ(tt.unmodelled_accel_mps2, 25.0);
+  job.ball_diameter_m = 0.3;
+  job.ball_mass_kg = 1.0;
+  job.accel_slack_mps2 = 5.0;
+  std::ostringstream quiet;
+  const TrajectoryOptions given = TrajectoryOptionsFor(job, "tt3d", quiet);
+  EXPECT_DOUBLE_EQ(given.ball_radius_m, 0.15);
+  EXPECT_DOUBLE_EQ(given.ball_mass_kg, 1.0);
+  EXPECT_DOUBLE_EQ(given.unmodelled_accel_mps2, 5.0);
+  EXPECT_TRUE(quiet.str().empty()) << quiet.str();
 }
 
 }  // namespace
