@@ -79,23 +79,23 @@ void CoverageMapOptions::Check() const {
   CheckNonNegative(err_scale_m, "err_scale_m");
 }
 
-cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
-                        const std::vector<Camera>& cameras, const FieldModel& field,
-                        const CoverageOptions& coverage, const CoverageMapOptions& options) {
-  options.Check();
-  // Make room for cameras standing outside the drawn area.
+namespace {
+
+// The top view with room for cameras standing outside the drawn area.
+TopView MapView(const std::vector<Camera>& cameras, const FieldModel& field, int width_px) {
   double extra_m = 0.3;
   for (const Camera& c : cameras) {
     const Eigen::Vector3d p = c.CentreInWorld();
     extra_m = std::max(extra_m, std::abs(p.x()) - field.HalfLengthWithSurround() + 0.8);
     extra_m = std::max(extra_m, std::abs(p.y()) - field.HalfWidthWithSurround() + 0.8);
   }
-  const TopView view = TopView::ForField(field, options.width_px, extra_m);
-  cv::Mat img = DrawField(field, view);
-  cv::Mat overlay = img.clone();
+  return TopView::ForField(field, width_px, extra_m);
+}
 
-  double err_scale = options.err_scale_m;
-  if (err_scale <= 0) err_scale = std::isfinite(layer.err_max_m) ? layer.err_max_m : 0.1;
+// The layer's cells in their colours, blended over the field with `alpha`.
+void PaintCells(cv::Mat& img, const CoverageLayer& layer, CoverageMapKind kind, const TopView& view,
+                double err_scale, double alpha) {
+  cv::Mat overlay = img.clone();
   auto colour_of = [&](size_t cell) -> cv::Vec3b {
     switch (kind) {
       case CoverageMapKind::kCount:
@@ -124,17 +124,17 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
                     cv::Scalar(col[0], col[1], col[2]), cv::FILLED);
     }
   }
-  cv::addWeighted(overlay, options.alpha, img, 1 - options.alpha, 0, img);
-  DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255));
+  cv::addWeighted(overlay, alpha, img, 1 - alpha, 0, img);
+}
 
-  const double range_m =
-      3 * std::hypot(field.HalfLengthWithSurround(), field.HalfWidthWithSurround());
-  const double scale = options.width_px / 1400.0;
+// Each camera's footprint, position, aim and label.
+void DrawCameras(cv::Mat& img, const std::vector<Camera>& cameras, double height_m,
+                 const TopView& view, double range_m, double scale, bool footprints) {
   for (size_t k = 0; k < cameras.size(); ++k) {
     const Camera& cam = cameras[k];
     const cv::Scalar& colour = kCameraColours[k % kCameraColours.size()];
-    if (options.footprints) {
-      for (const auto& line : Footprint(cam, layer.height_m, view, range_m)) {
+    if (footprints) {
+      for (const auto& line : Footprint(cam, height_m, view, range_m)) {
         if (line.size() > 1) cv::polylines(img, line, false, colour, 1, cv::LINE_AA);
       }
     }
@@ -142,9 +142,7 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
     const cv::Point2d p = view.ToPixel(eye.head<2>());
     const Eigen::Vector3d axis = cam.cam_from_world.rotation.row(2).transpose();
     Eigen::Vector3d aim = eye + 5.0 * axis;
-    if (axis.z() < -1e-6) {
-      aim = eye + std::min(range_m, (layer.height_m - eye.z()) / axis.z()) * axis;
-    }
+    if (axis.z() < -1e-6) aim = eye + std::min(range_m, (height_m - eye.z()) / axis.z()) * axis;
     cv::arrowedLine(img, p, view.ToPixel(aim.head<2>()), colour, std::max(1, int(2 * scale)),
                     cv::LINE_AA, 0, 0.03);
     cv::circle(img, p, std::max(4, int(9 * scale)), cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
@@ -159,10 +157,13 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
     const int ty = p.y < 0.5 * img.rows ? int(p.y + 8 * scale) + text.height : int(p.y - 8 * scale);
     Text(img, label, cv::Point(tx, ty), 0.5 * scale, colour);
   }
+}
 
-  // Legend strip.
+// The legend strip below the map: count boxes, or the colour scale with ticks.
+cv::Mat Legend(const CoverageLayer& layer, CoverageMapKind kind, const CoverageOptions& coverage,
+               double err_scale, int cols, double scale) {
   const int strip_h = std::max(50, int(70 * scale));
-  cv::Mat legend(strip_h, img.cols, CV_8UC3, cv::Scalar(30, 30, 30));
+  cv::Mat legend(strip_h, cols, CV_8UC3, cv::Scalar(30, 30, 30));
   const int pad = int(15 * scale);
   const double ts = 0.5 * scale;
   std::string title;
@@ -172,7 +173,7 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
     const int box = int(60 * scale);
     for (int k = 0; k < n; ++k) {
       const cv::Vec3b c = CountColour(k);
-      const int x = pad + k * (box + pad) + int(img.cols * 0.45);
+      const int x = pad + k * (box + pad) + int(cols * 0.45);
       cv::rectangle(legend, cv::Rect(x, pad, box, strip_h - 2 * pad), cv::Scalar(c[0], c[1], c[2]),
                     cv::FILLED);
       Text(legend, fmt::format("{}: {:.0f}%", k, 100 * layer.fraction_exactly[k]),
@@ -185,7 +186,7 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
                                 layer.height_m)
                   : fmt::format("expected 3D error (mm, {:.2f} px noise), z = {:.2f} m",
                                 coverage.pixel_noise_px, layer.height_m);
-    const int x0 = int(img.cols * 0.45), x1 = img.cols - 3 * pad;
+    const int x0 = int(cols * 0.45), x1 = cols - 3 * pad;
     for (int x = x0; x < x1; ++x) {
       const cv::Vec3b c = TurboColour(double(x - x0) / (x1 - x0));
       cv::line(legend, cv::Point(x, pad), cv::Point(x, strip_h / 2), cv::Scalar(c[0], c[1], c[2]));
@@ -209,8 +210,27 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
     }
   }
   Text(legend, title, cv::Point(pad, strip_h / 2 + 5), ts, cv::Scalar(255, 255, 255));
+  return legend;
+}
+
+}  // namespace
+
+cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
+                        const std::vector<Camera>& cameras, const FieldModel& field,
+                        const CoverageOptions& coverage, const CoverageMapOptions& options) {
+  options.Check();
+  const TopView view = MapView(cameras, field, options.width_px);
+  cv::Mat img = DrawField(field, view);
+  double err_scale = options.err_scale_m;
+  if (err_scale <= 0) err_scale = std::isfinite(layer.err_max_m) ? layer.err_max_m : 0.1;
+  PaintCells(img, layer, kind, view, err_scale, options.alpha);
+  DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255));
+  const double range_m =
+      3 * std::hypot(field.HalfLengthWithSurround(), field.HalfWidthWithSurround());
+  const double scale = options.width_px / 1400.0;
+  DrawCameras(img, cameras, layer.height_m, view, range_m, scale, options.footprints);
   cv::Mat out;
-  cv::vconcat(img, legend, out);
+  cv::vconcat(img, Legend(layer, kind, coverage, err_scale, img.cols, scale), out);
   return out;
 }
 

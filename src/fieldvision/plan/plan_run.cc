@@ -56,79 +56,60 @@ void PlanRunOptions::Check() const {
   map.Check();
 }
 
-PlanRunResult RunPlan(const PlanRunOptions& options) {
-  options.Check();
-  const FieldModel field = LoadField(options.field);
-  CheckCoverageGrid(field, options.coverage);
-  if (options.optimize) {
-    CoverageOptions search_grid = options.coverage;
-    search_grid.grid_step_m = options.search.grid_step_m;
-    CheckCoverageGrid(field, search_grid);
-  }
-  PlanRunResult result;
+namespace {
+
+// The rig given by --rig or --camera, if any; a camera kilometres away is refused.
+std::optional<Rig> LoadGivenRig(const PlanRunOptions& options) {
   std::optional<Rig> given;
   if (!options.rig_path.empty()) given = ReadRigJson(options.rig_path);
   if (!options.camera_paths.empty()) given = RigFromCameraFiles(options.camera_paths);
-  if (given) {
-    // A camera kilometres away sees nothing and would only stretch the maps.
-    constexpr double kMaxDistanceM = 1e4;
-    for (const Camera& c : given->cameras) {
-      const double d = c.CentreInWorld().norm();
-      FV_REQUIRE(d <= kMaxDistanceM,
-                 "plan: camera '{}' of '{}' stands {:.3g} m from the field centre (at most {:.0f} "
-                 "m)",
-                 c.name, options.rig_path.empty() ? "--camera" : options.rig_path, d,
-                 kMaxDistanceM);
-    }
+  if (!given) return given;
+  // A camera kilometres away sees nothing and would only stretch the maps.
+  constexpr double kMaxDistanceM = 1e4;
+  for (const Camera& c : given->cameras) {
+    const double d = c.CentreInWorld().norm();
+    FV_REQUIRE(d <= kMaxDistanceM,
+               "plan: camera '{}' of '{}' stands {:.3g} m from the field centre (at most {:.0f} "
+               "m)",
+               c.name, options.rig_path.empty() ? "--camera" : options.rig_path, d, kMaxDistanceM);
   }
+  return given;
+}
 
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(options.out_dir, ec);
-  FV_REQUIRE(fs::is_directory(options.out_dir), "cannot create output folder '{}'",
-             options.out_dir);
-  auto out = [&](const std::string& name) { return (fs::path(options.out_dir) / name).string(); };
+std::string OutPath(const PlanRunOptions& options, const std::string& name) {
+  return (std::filesystem::path(options.out_dir) / name).string();
+}
 
+// --optimize: searches a rig over the mounting places, scores a given rig the same way and
+// writes rig.json; returns the summary lines.
+std::string OptimizeStage(const PlanRunOptions& options, const FieldModel& field,
+                          const std::optional<Rig>& given, PlanRunResult& result) {
   std::string summary;
-  if (options.optimize) {
-    const std::vector<MountPlace> mounts =
-        options.mounts_path.empty()
-            ? PerimeterMounts(field, options.perimeter_offset_m, options.mount_height_m)
-            : ReadMountsJson(options.mounts_path);
-    const Camera model =
-        given ? given->cameras.front()
-              : Camera::FromFov(options.image_width, options.image_height, options.hfov_deg);
-    OptimizeResult opt = OptimizeRig(field, mounts, model, options.coverage, options.search);
-    summary += opt.Summary();
-    if (given) {
-      result.given_rig_search_score =
-          RigScore(given->cameras, field, options.coverage, options.search.grid_step_m);
-      summary += fmt::format("given rig '{}': score {:.4f} on the search grid\n", given->name,
-                             *result.given_rig_search_score);
-    }
-    result.rig = opt.rig;
-    result.optimized = std::move(opt);
-    WriteRigJson(result.rig, out("rig.json"));
-    result.files.push_back(out("rig.json"));
-  } else {
-    result.rig = *given;
+  const std::vector<MountPlace> mounts =
+      options.mounts_path.empty()
+          ? PerimeterMounts(field, options.perimeter_offset_m, options.mount_height_m)
+          : ReadMountsJson(options.mounts_path);
+  const Camera model =
+      given ? given->cameras.front()
+            : Camera::FromFov(options.image_width, options.image_height, options.hfov_deg);
+  OptimizeResult opt = OptimizeRig(field, mounts, model, options.coverage, options.search);
+  summary += opt.Summary();
+  if (given) {
+    result.given_rig_search_score =
+        RigScore(given->cameras, field, options.coverage, options.search.grid_step_m);
+    summary += fmt::format("given rig '{}': score {:.4f} on the search grid\n", given->name,
+                           *result.given_rig_search_score);
   }
+  result.rig = opt.rig;
+  result.optimized = std::move(opt);
+  WriteRigJson(result.rig, OutPath(options, "rig.json"));
+  result.files.push_back(OutPath(options, "rig.json"));
+  return summary;
+}
 
-  result.coverage = EvaluateCoverage(result.rig.cameras, field, options.coverage);
-  if (options.optimize && given) {
-    CoverageOptions one_layer = options.coverage;
-    one_layer.height_above_m = 0;
-    result.given_rig_score = EvaluateCoverage(given->cameras, field, one_layer).score();
-  }
-  summary += fmt::format("rig '{}', {} cameras, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
-                         result.rig.cameras.size(), field.name, field.length_m, field.width_m);
-  summary += result.coverage.Summary();
-  if (result.given_rig_score) {
-    summary += fmt::format("score on this grid: optimized {:.4f}, given rig {:.4f}\n",
-                           result.coverage.score(), *result.given_rig_score);
-  }
-
-  // Maps.
+// The count, angle and error maps of every layer.
+void WriteCoverageMaps(const PlanRunOptions& options, const FieldModel& field,
+                       PlanRunResult& result) {
   const std::vector<std::pair<CoverageMapKind, std::string>> kinds = {
       {CoverageMapKind::kCount, "coverage"},
       {CoverageMapKind::kAngle, "angle"},
@@ -140,14 +121,18 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
       map.err_scale_m = result.coverage.layers[0].err_max_m;
     }
     for (const auto& [kind, name] : kinds) {
-      const std::string file = out(name + (l == 0 ? "" : "_above") + ".png");
+      const std::string file = OutPath(options, name + (l == 0 ? "" : "_above") + ".png");
       WriteImage(file, DrawCoverageMap(result.coverage.layers[l], kind, result.rig.cameras, field,
                                        options.coverage, map));
       result.files.push_back(file);
     }
   }
+}
 
-  // coverage.json
+}  // namespace
+
+json CoverageJson(const PlanRunResult& result, const FieldModel& field,
+                  const PlanRunOptions& options) {
   const CoverageOptions& co = options.coverage;
   const CoverageLayer& ground = result.coverage.layers[0];
   json j;
@@ -186,12 +171,51 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
       j["optimize"]["given_rig_score"] = *result.given_rig_score;
     }
   }
-  {
-    std::ofstream f(out("coverage.json"));
-    FV_REQUIRE(f.good(), "cannot write '{}'", out("coverage.json"));
-    f << j.dump(2) << "\n";
+  return j;
+}
+
+PlanRunResult RunPlan(const PlanRunOptions& options) {
+  options.Check();
+  const FieldModel field = LoadField(options.field);
+  CheckCoverageGrid(field, options.coverage);
+  if (options.optimize) {
+    CoverageOptions search_grid = options.coverage;
+    search_grid.grid_step_m = options.search.grid_step_m;
+    CheckCoverageGrid(field, search_grid);
   }
-  result.files.push_back(out("coverage.json"));
+  PlanRunResult result;
+  const std::optional<Rig> given = LoadGivenRig(options);
+  std::error_code ec;
+  std::filesystem::create_directories(options.out_dir, ec);
+  FV_REQUIRE(std::filesystem::is_directory(options.out_dir), "cannot create output folder '{}'",
+             options.out_dir);
+  std::string summary;
+  if (options.optimize) {
+    summary += OptimizeStage(options, field, given, result);
+  } else {
+    result.rig = *given;
+  }
+  result.coverage = EvaluateCoverage(result.rig.cameras, field, options.coverage);
+  if (options.optimize && given) {
+    CoverageOptions one_layer = options.coverage;
+    one_layer.height_above_m = 0;
+    result.given_rig_score = EvaluateCoverage(given->cameras, field, one_layer).score();
+  }
+  summary += fmt::format("rig '{}', {} cameras, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
+                         result.rig.cameras.size(), field.name, field.length_m, field.width_m);
+  summary += result.coverage.Summary();
+  if (result.given_rig_score) {
+    summary += fmt::format("score on this grid: optimized {:.4f}, given rig {:.4f}\n",
+                           result.coverage.score(), *result.given_rig_score);
+  }
+  WriteCoverageMaps(options, field, result);
+  const std::string json_path = OutPath(options, "coverage.json");
+  {
+    std::ofstream f(json_path);
+    FV_REQUIRE(f.good(), "cannot write '{}'", json_path);
+    f << CoverageJson(result, field, options).dump(2) << "\n";
+  }
+  result.files.push_back(json_path);
   summary += fmt::format("wrote {} files to {}\n", result.files.size(), options.out_dir);
   result.summary = summary;
   return result;

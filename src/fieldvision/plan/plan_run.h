@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "fieldvision/plan/coverage.h"
 #include "fieldvision/plan/coverage_map.h"
 #include "fieldvision/plan/optimize.h"
@@ -49,5 +51,10 @@ struct PlanRunResult {
 };
 
 PlanRunResult RunPlan(const PlanRunOptions& options);
+
+// coverage.json: the rig, the options, the ball-height layer's figures at the top level, every
+// layer and, after a search, its scores.
+nlohmann::json CoverageJson(const PlanRunResult& result, const FieldModel& field,
+                            const PlanRunOptions& options);
 
 }  // namespace fv
