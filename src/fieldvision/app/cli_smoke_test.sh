@@ -24,7 +24,8 @@ check() {  # check NAME EXPECTED_EXIT(0|nonzero) CMD...
 for c in synth ball trajectory plan players stats detect "calibrate intrinsics" \
          "calibrate extrinsics" "calibrate refine" "field show" "field draw" "eval ball" \
          "color learn" "calibrate check" "calibrate rig" "eval tracks" "eval detect" \
-         "eval import-pets" "calibrate multi" node fuse studio tracks; do
+         "eval import-pets" "calibrate multi" "calibrate import" "calibrate export" \
+         "calibrate compare" node fuse studio tracks; do
   check "$c --help" 0 $FV $c --help
 done
 check "field show" 0 $FV field show robocup-msl
@@ -114,4 +115,8 @@ check "plan: --map-width 20000" nonzero $FV plan --field fifa --optimize --map-w
   --out "$TMP/plan"
 check "plan: --iterations 2e9" nonzero $FV plan --field fifa --optimize --iterations 2000000000 \
   --out "$TMP/plan"
+check "calibrate intrinsics: --out in a missing folder" nonzero $FV calibrate intrinsics \
+  --images "$TMP" --cols 9 --rows 6 --square 0.025 --out "$TMP/missing/x.yaml"
+grep -q "does not exist; create it" "$TMP/err" || { echo "FAIL intrinsics: not the folder error"; fail=1; }
+check "calibrate compare: one --rig" nonzero $FV calibrate compare --rig "$TMP"
 exit $fail

@@ -473,11 +473,8 @@ void RunRig(const RigCli& c) {
   }
 }
 
-void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(
-      app, "calibrate",
-      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
-
+// calibrate intrinsics
+void SetupIntrinsics(CLI::App* group) {
   auto ic = std::make_shared<IntrinsicsCli>();
   CLI::App* in = group->add_subcommand(
       "intrinsics", "Intrinsics from chessboard or ChArUco views (a folder, a glob or a video)");
@@ -509,9 +506,13 @@ void Setup(CLI::App& app, int& exit_code) {
   in->add_flag("--quiet", ic->quiet, "No progress");
   in->callback([ic] {
     CheckOutputPath(ic->out, {ic->images});
+    CheckOutputFolder(ic->out);
     RunIntrinsics(*ic);
   });
+}
 
+// calibrate extrinsics (a camera, a rig, or a phone with --image-size)
+void SetupExtrinsics(CLI::App* group) {
   auto ec = std::make_shared<ExtrinsicsCli>();
   CLI::App* ex = group->add_subcommand(
       "extrinsics", "Camera pose from clicked points of known position (RANSAC PnP + refinement)");
@@ -546,9 +547,14 @@ void Setup(CLI::App& app, int& exit_code) {
   ex->callback([ec] {
     CheckOutputPath(ec->out, PathList(ec->points, ec->field, ec->images));  // may be --camera
     CheckOutputPath(ec->table, PathList(ec->points, ec->field, ec->camera, ec->out), "--table");
+    if (ec->rig.empty()) CheckOutputFolder(ec->out);
+    CheckOutputFolder(ec->table, "--table");
     RunExtrinsics(*ec);
   });
+}
 
+// calibrate refine (a camera or a rig)
+void SetupRefine(CLI::App* group) {
   auto rc = std::make_shared<RefineCli>();
   CLI::App* re =
       group->add_subcommand("refine", "Refine the pose against the painted field lines in a frame");
@@ -576,9 +582,14 @@ void Setup(CLI::App& app, int& exit_code) {
     inputs.push_back(rc->camera);
     inputs.push_back(rc->out);
     CheckOutputPath(rc->overlay, inputs, "--overlay");
+    if (rc->rig.empty()) CheckOutputFolder(rc->out);
+    CheckOutputFolder(rc->overlay, "--overlay");
     RunRefine(*rc);
   });
+}
 
+// calibrate check
+void SetupCheck(CLI::App* group) {
   auto cc = std::make_shared<CheckCli>();
   CLI::App* ch = group->add_subcommand(
       "check", "Draw the field model over a frame and print the line error in mm");
@@ -591,9 +602,14 @@ void Setup(CLI::App& app, int& exit_code) {
   ch->callback([cc] {
     CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
     CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out}, "--table");
+    CheckOutputFolder(cc->out);
+    CheckOutputFolder(cc->table, "--table");
     RunCheck(*cc);
   });
+}
 
+// calibrate rig
+void SetupRig(CLI::App* group) {
   auto gc = std::make_shared<RigCli>();
   CLI::App* rg = group->add_subcommand(
       "rig", "Refine several cameras' poses jointly from shared observations (bundle adjustment)");
@@ -604,6 +620,17 @@ void Setup(CLI::App& app, int& exit_code) {
   rg->add_option("--field", gc->field, "Field whose keypoint names have known positions");
   rg->add_option("--out-dir", gc->out_dir, "Folder for the refined camera files")->required();
   rg->callback([gc] { RunRig(*gc); });
+}
+
+void Setup(CLI::App& app, int& exit_code) {
+  CLI::App* group = CommandGroup(
+      app, "calibrate",
+      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
+  SetupIntrinsics(group);
+  SetupExtrinsics(group);
+  SetupRefine(group);
+  SetupCheck(group);
+  SetupRig(group);
   (void)exit_code;
 }
 

@@ -1,12 +1,16 @@
 // The board options shared by `calibrate intrinsics` and `calibrate multi` (--board, --cols,
-// --rows, --square, --marker, --dictionary) and their calib::BoardSpec.
+// --rows, --square, --marker, --dictionary) and their calib::BoardSpec; the calibrate commands'
+// check that an output file's folder exists before any work.
 #pragma once
 
+#include <filesystem>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 
 #include "fieldvision/calib/board.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 
@@ -38,6 +42,16 @@ inline void AddBoardOptions(CLI::App* cmd, BoardCli& b) {
   cmd->add_option("--square", b.square_m, "Square side in metres (25 mm: 0.025)")->required();
   cmd->add_option("--marker", b.marker_m, "ChArUco marker side in metres (default 0.7 x square)");
   cmd->add_option("--dictionary", b.dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+}
+
+// Throws (one line naming the option, the path and the fix) when the folder of output file `out`
+// does not exist; an empty `out` (option not given) passes.
+inline void CheckOutputFolder(const std::string& out, std::string_view what = "--out") {
+  if (out.empty()) return;
+  const std::filesystem::path folder = std::filesystem::path(out).parent_path();
+  FV_REQUIRE(folder.empty() || std::filesystem::is_directory(folder),
+             "{} '{}': the folder '{}' does not exist; create it (mkdir -p {}) or write elsewhere",
+             what, out, folder.string(), folder.string());
 }
 
 }  // namespace fv::app
