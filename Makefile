@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test demo bench format tidy clean studio
+.PHONY: all deps configure build test demo bench format tidy clean studio sweep fuzz sanitize
 
 all: build
 
@@ -39,6 +39,30 @@ format:
 
 tidy: configure
 	find src -name '*.cc' ! -name '*_test.cc' | xargs clang-tidy -p $(BUILD) --quiet
+
+# Issue 18's checks. `make sweep`: every bad-input case of scripts/sweep_bad_inputs.sh (CTest runs
+# its --quick subset). `make fuzz`: the libFuzzer harnesses (clang, ASan + UBSan) FUZZ_SECONDS each,
+# two at a time. `make sanitize`: the unit tests built with clang's ASan + UBSan (the same build as
+# the fuzzers) and run with scripts/sanitize.supp naming the third-party leaks.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 600
+SAN_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 \
+	LSAN_OPTIONS=suppressions=$(CURDIR)/scripts/sanitize.supp:print_suppressions=1 \
+	UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+
+sweep: build
+	bash scripts/sweep_bad_inputs.sh $(BUILD)/bin/fieldvision $(BUILD)/sweep
+
+$(FUZZ_BUILD)/build.ninja:
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DFV_FUZZ=ON -DFV_BUILD_BENCH=OFF
+
+fuzz: deps $(FUZZ_BUILD)/build.ninja
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzzers
+	bash fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) 2
+
+sanitize: deps $(FUZZ_BUILD)/build.ninja
+	cmake --build $(FUZZ_BUILD) -j $(JOBS)
+	cd $(FUZZ_BUILD) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) --timeout 1800 -E studio_browser
 
 clean:
 	rm -rf $(BUILD)
