@@ -300,18 +300,13 @@ StaticWorld MakeStaticWorld(const FieldModel& f, const SceneSpec& spec) {
   return w;
 }
 
-void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
-                      const SceneSpec& spec) {
-  const Camera& cam = cd.cam;
-  const int w = cam.width, h = cam.height;
+// The static world along every pixel's ray: colour, depth, ground flag and (on the ground) the
+// signed distance to the nearest paint.
+void CastBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
+                    std::vector<float>& paint, std::vector<Vec3>& colour) {
+  const int w = cd.cam.width, h = cd.cam.height;
   const Vec3 o = cd.origin;
-  cd.bg.create(h, w, CV_8UC3);
-  cd.depth.create(h, w, CV_32F);
-  cd.ground.assign(static_cast<size_t>(w) * h, 0);
-  std::vector<float> paint(static_cast<size_t>(w) * h, 1e3f);
-  std::vector<Vec3> colour(static_cast<size_t>(w) * h);
   const bool inside = std::abs(o.x()) < world.hl && std::abs(o.y()) < world.hw;
-  const double line_half = 0.5 * world.field->line_width_m;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const size_t i = static_cast<size_t>(v) * w + u;
@@ -389,6 +384,13 @@ void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
       cd.ground[i] = kind == 1;
     }
   }
+}
+
+// Painted lines blended into the ground colours.
+void PaintLines(const StaticWorld& world, const SceneRenderer::CameraData& cd,
+                const std::vector<float>& paint, std::vector<Vec3>& colour) {
+  const int w = cd.cam.width, h = cd.cam.height;
+  const double line_half = 0.5 * world.field->line_width_m;
   // Paint coverage: the overlap of the pixel with the line across it, in pixel units from the
   // signed distance and its screen-space rate of change (largest one-sided difference).
   const Vec3 paint_colour(232, 238, 238);
@@ -417,6 +419,19 @@ void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
       if (cov > 0) colour[i] = (1 - cov) * colour[i] + cov * paint_colour;
     }
   }
+}
+
+void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
+                      const SceneSpec& spec) {
+  const Camera& cam = cd.cam;
+  const int w = cam.width, h = cam.height;
+  cd.bg.create(h, w, CV_8UC3);
+  cd.depth.create(h, w, CV_32F);
+  cd.ground.assign(static_cast<size_t>(w) * h, 0);
+  std::vector<float> paint(static_cast<size_t>(w) * h, 1e3f);
+  std::vector<Vec3> colour(static_cast<size_t>(w) * h);
+  CastBackground(world, cd, paint, colour);
+  PaintLines(world, cd, paint, colour);
   for (int v = 0; v < h; ++v) {
     auto* row = cd.bg.ptr<cv::Vec3b>(v);
     for (int u = 0; u < w; ++u) {

@@ -634,44 +634,42 @@ void SceneSpec::Check() const {
              "format: must be avi, png or jpg (got '{}')", format);
 }
 
-json SceneSpecToJson(const SceneSpec& s) {
-  json j;
-  j["field"] = s.field;
-  j["fps"] = s.fps;
-  j["num_frames"] = s.num_frames;
-  j["seed"] = s.seed;
-  j["exposure_s"] = s.exposure_s;
-  j["cameras"] = json::array();
-  for (const auto& c : s.cameras) {
-    json cj;
-    cj["name"] = c.name;
-    cj["width"] = c.width;
-    cj["height"] = c.height;
-    if (c.fx > 0) {
-      cj["fx"] = c.fx;
-      cj["fy"] = c.fy;
-    } else {
-      cj["hfov_deg"] = c.hfov_deg;
-    }
-    cj["distortion"] = c.distortion;
-    if (c.has_rvec_tvec) {
-      cj["rvec"] = JsonFromVector(c.rvec);
-      cj["tvec"] = JsonFromVector(c.tvec);
-    } else {
-      cj["position_m"] = JsonFromVector(c.position_m);
-      cj["look_at_m"] = JsonFromVector(c.look_at_m);
-    }
-    j["cameras"].push_back(cj);
+namespace {
+
+// One camera of scene JSON.
+json CameraSpecToJson(const CameraSpec& c) {
+  json cj;
+  cj["name"] = c.name;
+  cj["width"] = c.width;
+  cj["height"] = c.height;
+  if (c.fx > 0) {
+    cj["fx"] = c.fx;
+    cj["fy"] = c.fy;
+  } else {
+    cj["hfov_deg"] = c.hfov_deg;
   }
+  cj["distortion"] = c.distortion;
+  if (c.has_rvec_tvec) {
+    cj["rvec"] = JsonFromVector(c.rvec);
+    cj["tvec"] = JsonFromVector(c.tvec);
+  } else {
+    cj["position_m"] = JsonFromVector(c.position_m);
+    cj["look_at_m"] = JsonFromVector(c.look_at_m);
+  }
+  return cj;
+}
+
+// The ball of scene JSON (appearance keys only when not the defaults).
+json BallSpecToJson(const BallSpec& ball) {
   json b;
-  b["enabled"] = s.ball.enabled;
-  b["diameter_m"] = s.ball.diameter_m;
-  b["colour_bgr"] = JsonFromVector(s.ball.colour_bgr);
+  b["enabled"] = ball.enabled;
+  b["diameter_m"] = ball.diameter_m;
+  b["colour_bgr"] = JsonFromVector(ball.colour_bgr);
   b["placements"] = json::array();
-  for (const auto& p : s.ball.placements) b["placements"].push_back(JsonFromVector(p));
-  b["hold_frames"] = s.ball.hold_frames;
+  for (const auto& p : ball.placements) b["placements"].push_back(JsonFromVector(p));
+  b["hold_frames"] = ball.hold_frames;
   b["kicks"] = json::array();
-  for (const auto& k : s.ball.kicks) {
+  for (const auto& k : ball.kicks) {
     json kj = {{"time_s", k.time_s},
                {"position_m", JsonFromVector(k.position_m)},
                {"velocity_mps", JsonFromVector(k.velocity_mps)}};
@@ -680,17 +678,17 @@ json SceneSpecToJson(const SceneSpec& s) {
   }
   // The appearance keys are written when they differ from the defaults (older scenes unchanged).
   const BallSpec db;
-  if (s.ball.held_by >= 0) b["held_by"] = s.ball.held_by;
-  if (s.ball.specular != db.specular) b["specular"] = s.ball.specular;
-  if (s.ball.shininess != db.shininess) b["shininess"] = s.ball.shininess;
-  if (s.ball.pattern != db.pattern) {
-    b["pattern"] = s.ball.pattern;
-    b["pattern_bgr"] = JsonFromVector(s.ball.pattern_bgr);
+  if (ball.held_by >= 0) b["held_by"] = ball.held_by;
+  if (ball.specular != db.specular) b["specular"] = ball.specular;
+  if (ball.shininess != db.shininess) b["shininess"] = ball.shininess;
+  if (ball.pattern != db.pattern) {
+    b["pattern"] = ball.pattern;
+    b["pattern_bgr"] = JsonFromVector(ball.pattern_bgr);
   }
-  if (!s.ball.orientation_rvec.isZero()) {
-    b["orientation_rvec"] = JsonFromVector(s.ball.orientation_rvec);
+  if (!ball.orientation_rvec.isZero()) {
+    b["orientation_rvec"] = JsonFromVector(ball.orientation_rvec);
   }
-  const BallPhysics& p = s.ball.physics;
+  const BallPhysics& p = ball.physics;
   b["physics"] = {{"gravity_mps2", p.gravity_mps2},
                   {"drag_coefficient", p.drag_coefficient},
                   {"air_density_kgm3", p.air_density_kgm3},
@@ -700,7 +698,21 @@ json SceneSpecToJson(const SceneSpec& s) {
                   {"rolling_resistance", p.rolling_resistance},
                   {"min_bounce_speed_mps", p.min_bounce_speed_mps},
                   {"time_step_s", p.time_step_s}};
-  j["ball"] = b;
+  return b;
+}
+
+}  // namespace
+
+json SceneSpecToJson(const SceneSpec& s) {
+  json j;
+  j["field"] = s.field;
+  j["fps"] = s.fps;
+  j["num_frames"] = s.num_frames;
+  j["seed"] = s.seed;
+  j["exposure_s"] = s.exposure_s;
+  j["cameras"] = json::array();
+  for (const auto& c : s.cameras) j["cameras"].push_back(CameraSpecToJson(c));
+  j["ball"] = BallSpecToJson(s.ball);
   j["robots"] = json::array();
   for (const auto& r : s.robots) {
     json rj = {{"path", PathToJson(r.path)},
