@@ -8,6 +8,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
@@ -27,6 +28,10 @@ void RunTracksEdit(const TracksEditCli& c) {
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     roster_in = track::RosterPathFor(c.tracks);
   }
+  // Neither the tracks nor the teams file beside them may overwrite an input.
+  const std::vector<std::string> inputs = {c.tracks, c.edits, roster_in};
+  CheckOutputPath(c.out, inputs);
+  CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);
@@ -51,6 +56,7 @@ void RunTracksDraw(const TracksDrawCli& c) {
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     roster_in = track::RosterPathFor(c.tracks);
   }
+  CheckOutputPath(c.out, {c.tracks, c.video, c.camera, c.field, roster_in});
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   std::optional<Camera> camera;
   if (!c.camera.empty()) camera = ReadCameraYaml(c.camera);
