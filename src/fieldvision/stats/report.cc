@@ -247,17 +247,37 @@ document.querySelectorAll('table.sortable th').forEach(function (th, col) {
 </script>
 )";
 
-}  // namespace
+// What the report's parts share.
+struct ReportParts {
+  const StatsResult& r;
+  const StatsOptions& o;
+  std::string out_dir;
+  TopView view;
+  double t0 = 1e300, t1 = -1e300;  // first and last time of all tracks
+  std::vector<std::string> band_names;
+  std::vector<int> teams;        // with a heat map
+  std::vector<int> player_maps;  // ids with a heat map, sorted
+  std::string radar_video;       // file name, empty when not written
+};
 
-ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, const StatsOptions& o,
-                             const std::string& out_dir) {
-  o.Check();
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  FV_REQUIRE(!ec && fs::is_directory(out_dir), "cannot create output folder '{}'", out_dir);
-  ReportFiles files;
-  // Heat maps: every player and the extent of all positions beyond the field.
-  const TopView view = TopView::ForField(field, o.image_width_px, 2.0);
+// Speed band names: "0-2", "2-4", ..., "7-up".
+std::vector<std::string> BandNames(const StatsOptions& o) {
+  std::vector<std::string> band_names;
+  for (size_t b = 0; b <= o.speed_bands_mps.size(); ++b) {
+    const std::string lo = b == 0 ? "0" : fmt::format("{:g}", o.speed_bands_mps[b - 1]);
+    const std::string hi =
+        b < o.speed_bands_mps.size() ? fmt::format("{:g}", o.speed_bands_mps[b]) : "up";
+    band_names.push_back(lo + "-" + hi);
+  }
+  return band_names;
+}
+
+// Heat maps: all players, each team and the longest tracks.
+void WriteHeatMaps(const FieldModel& field, ReportParts& rp, ReportFiles& files) {
+  const StatsResult& r = rp.r;
+  const StatsOptions& o = rp.o;
+  const std::string& out_dir = rp.out_dir;
+  const TopView& view = rp.view;
   std::vector<const SmoothTrack*> all;
   std::map<int, std::vector<const SmoothTrack*>> by_team;
   std::map<int, const PlayerStats*> player_of;
@@ -271,6 +291,7 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
   for (const auto& [team, ts] : by_team) {
     Write(fmt::format("{}/heatmap_team{}.png", out_dir, team),
           HeatMap(ts, field, view, o, fmt::format("team {}", team)), files);
+    rp.teams.push_back(team);
   }
   std::vector<const SmoothTrack*> longest = all;
   std::sort(longest.begin(), longest.end(),
@@ -278,49 +299,54 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
   if (static_cast<int>(longest.size()) > o.max_player_heatmaps) {
     longest.resize(o.max_player_heatmaps);
   }
-  std::vector<int> player_maps;
   for (const auto* s : longest) {
     Write(fmt::format("{}/heatmap_player{}.png", out_dir, s->id),
           HeatMap({s}, field, view, o, "player " + LabelOf(s->id, o.name_of)), files);
-    player_maps.push_back(s->id);
+    rp.player_maps.push_back(s->id);
   }
-  std::sort(player_maps.begin(), player_maps.end());
-  // Radar: whole trajectories; and the video (10 frames per second of play).
-  double t0 = 1e300, t1 = -1e300;
-  for (const auto& s : r.tracks) {
-    t0 = std::min(t0, s.time_s.front());
-    t1 = std::max(t1, s.time_s.back());
-  }
+  std::sort(rp.player_maps.begin(), rp.player_maps.end());
+}
+
+// Radar: whole trajectories; and the video (10 frames per second of play).
+void WriteRadar(const FieldModel& field, ReportParts& rp, ReportFiles& files) {
+  const StatsResult& r = rp.r;
+  const StatsOptions& o = rp.o;
+  const TopView& view = rp.view;
   {
     cv::Mat img = DrawField(field, view);
     DrawZones(img, o.zones, view);
-    DrawRadar(img, r, view, t1, t1 - t0 + 1, o);
+    DrawRadar(img, r, view, rp.t1, rp.t1 - rp.t0 + 1, o);
     cv::putText(img, "radar: all trajectories", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
                 {255, 255, 255}, 2);
-    Write(out_dir + "/radar.png", img, files);
+    Write(rp.out_dir + "/radar.png", img, files);
   }
-  std::string radar_video;
-  if (o.write_video) {
-    if (track::H264Available()) {
-      const std::string path = out_dir + "/radar.mp4";
-      cv::Mat base = DrawField(field, view);
-      DrawZones(base, o.zones, view);
-      track::PlayableVideoWriter vw(path, 10.0, base.size());
-      for (double t = t0; t <= t1; t += 0.1) {
-        cv::Mat img = base.clone();
-        DrawRadar(img, r, view, t, 3.0, o);
-        cv::putText(img, fmt::format("t = {:.1f} s", t), {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
-                    {255, 255, 255}, 2);
-        vw.Write(img);
-      }
-      vw.Close();
-      files.files.push_back(path);
-      radar_video = "radar.mp4";
-    } else {
-      files.notes.push_back(
-          "radar video skipped: OpenCV's FFmpeg has no H.264 encoder here (a video browsers play)");
-    }
+  if (!o.write_video) return;
+  if (!track::H264Available()) {
+    files.notes.push_back(
+        "radar video skipped: OpenCV's FFmpeg has no H.264 encoder here (a video browsers play)");
+    return;
   }
+  const std::string path = rp.out_dir + "/radar.mp4";
+  cv::Mat base = DrawField(field, view);
+  DrawZones(base, o.zones, view);
+  track::PlayableVideoWriter vw(path, 10.0, base.size());
+  for (double t = rp.t0; t <= rp.t1; t += 0.1) {
+    cv::Mat img = base.clone();
+    DrawRadar(img, r, view, t, 3.0, o);
+    cv::putText(img, fmt::format("t = {:.1f} s", t), {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
+                {255, 255, 255}, 2);
+    vw.Write(img);
+  }
+  vw.Close();
+  files.files.push_back(path);
+  rp.radar_video = "radar.mp4";
+}
+
+// distances.csv, players.csv and speed_profiles.csv.
+void WriteTables(const ReportParts& rp, ReportFiles& files) {
+  const StatsResult& r = rp.r;
+  const StatsOptions& o = rp.o;
+  const std::string& out_dir = rp.out_dir;
   // Distances between players.
   {
     const std::string path = out_dir + "/distances.csv";
@@ -333,19 +359,12 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
     files.files.push_back(path);
   }
   // The players' table as CSV (and the speed profiles, one row per player and second).
-  std::vector<std::string> band_names;
-  for (size_t b = 0; b <= o.speed_bands_mps.size(); ++b) {
-    const std::string lo = b == 0 ? "0" : fmt::format("{:g}", o.speed_bands_mps[b - 1]);
-    const std::string hi =
-        b < o.speed_bands_mps.size() ? fmt::format("{:g}", o.speed_bands_mps[b]) : "up";
-    band_names.push_back(lo + "-" + hi);
-  }
   {
     const std::string path = out_dir + "/players.csv";
     std::vector<std::string> header = {"id",     "name",       "team",          "from_s",
                                        "to_s",   "distance_m", "top_speed_mps", "mean_speed_mps",
                                        "sprints"};
-    for (const auto& b : band_names) header.push_back("time_" + b + "_mps_s");
+    for (const auto& b : rp.band_names) header.push_back("time_" + b + "_mps_s");
     for (const auto& z : o.zones) header.push_back("time_in_" + z.name + "_s");
     CsvWriter w(path, header, 2);
     for (const auto& p : r.players) {
@@ -370,7 +389,9 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
     w.Close();
     files.files.push_back(path);
   }
-  // stats.json
+}
+
+nlohmann::json StatsJson(const StatsResult& r, const StatsOptions& o, const ReportFiles& files) {
   nlohmann::json j;
   j["duration_s"] = r.duration_s;
   j["fps"] = r.fps;
@@ -402,87 +423,111 @@ ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, cons
   }
   j["files"] = files.files;
   j["notes"] = files.notes;
+  return j;
+}
+
+// index.html: one folder that stands alone (images, CSVs and the video beside it).
+void WriteIndexHtml(const std::string& path, const ReportParts& rp, const ReportFiles& files) {
+  const StatsResult& r = rp.r;
+  const StatsOptions& o = rp.o;
+  std::ofstream h(path);
+  FV_REQUIRE(h.good(), "cannot write '{}'", path);
+  h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>fieldvision stats</title>"
+       "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
+       "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}th{background:#eee}"
+       "img,video{max-width:100%}.maps img{width:340px;margin:4px}"
+       ".charts div{display:inline-block;margin:4px 12px 4px 0}</style></head><body>\n";
+  h << "<h1>Player statistics</h1>\n<p>" << Html(r.Summary()) << "</p>\n";
+  for (const auto& n : files.notes) h << "<p><em>" << Html(n) << "</em></p>\n";
+  h << "<h2>Players</h2>\n<p>Click a column header to sort. Download: <a href=\"players.csv\">"
+       "players.csv</a>, <a href=\"speed_profiles.csv\">speed_profiles.csv</a> (speed per "
+       "player and second), <a href=\"distances.csv\">distances.csv</a> (distances between "
+       "players each second), <a href=\"stats.json\">stats.json</a>.</p>\n";
+  h << "<table class=\"sortable\"><tr><th>id</th><th>name</th><th>team</th><th>from s</th>"
+       "<th>to s</th><th>distance m</th><th>top speed m/s</th><th>mean speed m/s</th>"
+       "<th>sprints</th>";
+  for (const auto& b : rp.band_names) h << "<th>" << b << " m/s (s)</th>";
+  for (const auto& z : o.zones) h << "<th>in " << Html(z.name) << " (s)</th>";
+  h << "</tr>\n";
+  for (const auto& p : r.players) {
+    h << fmt::format(
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>"
+        "<td>{:.2f}</td><td>{:.2f}</td><td>{}</td>",
+        p.id, Html(p.name), p.team >= 0 ? std::to_string(p.team) : "-", p.first_s, p.last_s,
+        p.distance_m, p.top_speed_mps, p.mean_speed_mps, p.sprints);
+    for (double bt : p.band_time_s) h << fmt::format("<td>{:.1f}</td>", bt);
+    for (const auto& z : o.zones) h << fmt::format("<td>{:.1f}</td>", p.zone_time_s.at(z.name));
+    h << "</tr>\n";
+  }
+  h << "</table>\n";
+  // Speed over time: one chart per player, same axes for all.
+  double vmax = o.sprint_speed_mps;
+  for (const auto& p : r.players) {
+    for (const auto& [t, v] : p.speed_profile) vmax = std::max(vmax, v);
+  }
+  vmax = std::ceil(vmax + 0.5);
+  h << "<h2>Speed over time</h2>\n<p>Mean speed per second (m/s); the dashed red line is the "
+       "sprint threshold ("
+    << fmt::format("{:g}", o.sprint_speed_mps) << " m/s).</p>\n<div class=\"charts\">";
+  for (const auto& p : r.players) {
+    h << "<div><b>"
+      << Html(p.name.empty() ? "player " + std::to_string(p.id)
+                             : p.name + " (" + std::to_string(p.id) + ")")
+      << "</b><br>" << SpeedChartSvg(p, rp.t0, rp.t1, vmax, o.sprint_speed_mps) << "</div>";
+  }
+  h << "</div>\n";
+  if (!o.zones.empty()) {
+    h << "<h2>Zone alerts</h2>\n<table class=\"sortable\"><tr><th>zone</th><th>id</th>"
+         "<th>entered s</th><th>left s</th></tr>\n";
+    for (const auto& e : r.events) {
+      h << fmt::format("<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td></tr>\n",
+                       Html(e.zone), e.id, e.enter_s, e.exit_s);
+    }
+    h << "</table>\n";
+  }
+  h << "<h2>Radar view</h2>\n<p><img src=\"radar.png\"></p>\n";
+  if (!rp.radar_video.empty()) {
+    h << "<p><video src=\"" << rp.radar_video << "\" controls muted playsinline width=\""
+      << rp.view.size.width << "\"></video></p>\n";
+  }
+  h << "<h2>Heat maps</h2>\n<p>Time spent per square metre of field (seconds; the scale's top "
+       "is the 99th percentile of the cells, busier cells share its colour). Zones in "
+       "yellow.</p>\n<div class=\"maps\"><img src=\"heatmap_all.png\">";
+  for (int team : rp.teams) h << fmt::format("<img src=\"heatmap_team{}.png\">", team);
+  h << "</div>\n<h3>Per player</h3>\n<div class=\"maps\">";
+  for (int id : rp.player_maps) h << fmt::format("<img src=\"heatmap_player{}.png\">", id);
+  h << "</div>\n" << kSortScript << "</body></html>\n";
+}
+
+}  // namespace
+
+ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, const StatsOptions& o,
+                             const std::string& out_dir) {
+  o.Check();
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  FV_REQUIRE(!ec && fs::is_directory(out_dir), "cannot create output folder '{}'", out_dir);
+  ReportFiles files;
+  // Heat maps: every player and the extent of all positions beyond the field.
+  ReportParts rp{r, o, out_dir, TopView::ForField(field, o.image_width_px, 2.0)};
+  WriteHeatMaps(field, rp, files);
+  for (const auto& s : r.tracks) {
+    rp.t0 = std::min(rp.t0, s.time_s.front());
+    rp.t1 = std::max(rp.t1, s.time_s.back());
+  }
+  WriteRadar(field, rp, files);
+  rp.band_names = BandNames(o);
+  WriteTables(rp, files);
   {
+    const nlohmann::json j = StatsJson(r, o, files);
     const std::string path = out_dir + "/stats.json";
     std::ofstream out(path);
     FV_REQUIRE(out.good(), "cannot write '{}'", path);
     out << j.dump(2) << "\n";
     files.files.push_back(path);
   }
-  // index.html: one folder that stands alone (images, CSVs and the video beside it).
-  {
-    const std::string path = out_dir + "/index.html";
-    std::ofstream h(path);
-    FV_REQUIRE(h.good(), "cannot write '{}'", path);
-    h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>fieldvision stats</title>"
-         "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-         "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}th{background:#eee}"
-         "img,video{max-width:100%}.maps img{width:340px;margin:4px}"
-         ".charts div{display:inline-block;margin:4px 12px 4px 0}</style></head><body>\n";
-    h << "<h1>Player statistics</h1>\n<p>" << Html(r.Summary()) << "</p>\n";
-    for (const auto& n : files.notes) h << "<p><em>" << Html(n) << "</em></p>\n";
-    h << "<h2>Players</h2>\n<p>Click a column header to sort. Download: <a href=\"players.csv\">"
-         "players.csv</a>, <a href=\"speed_profiles.csv\">speed_profiles.csv</a> (speed per "
-         "player and second), <a href=\"distances.csv\">distances.csv</a> (distances between "
-         "players each second), <a href=\"stats.json\">stats.json</a>.</p>\n";
-    h << "<table class=\"sortable\"><tr><th>id</th><th>name</th><th>team</th><th>from s</th>"
-         "<th>to s</th><th>distance m</th><th>top speed m/s</th><th>mean speed m/s</th>"
-         "<th>sprints</th>";
-    for (const auto& b : band_names) h << "<th>" << b << " m/s (s)</th>";
-    for (const auto& z : o.zones) h << "<th>in " << Html(z.name) << " (s)</th>";
-    h << "</tr>\n";
-    for (const auto& p : r.players) {
-      h << fmt::format(
-          "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>"
-          "<td>{:.2f}</td><td>{:.2f}</td><td>{}</td>",
-          p.id, Html(p.name), p.team >= 0 ? std::to_string(p.team) : "-", p.first_s, p.last_s,
-          p.distance_m, p.top_speed_mps, p.mean_speed_mps, p.sprints);
-      for (double bt : p.band_time_s) h << fmt::format("<td>{:.1f}</td>", bt);
-      for (const auto& z : o.zones) h << fmt::format("<td>{:.1f}</td>", p.zone_time_s.at(z.name));
-      h << "</tr>\n";
-    }
-    h << "</table>\n";
-    // Speed over time: one chart per player, same axes for all.
-    double vmax = o.sprint_speed_mps;
-    for (const auto& p : r.players) {
-      for (const auto& [t, v] : p.speed_profile) vmax = std::max(vmax, v);
-    }
-    vmax = std::ceil(vmax + 0.5);
-    h << "<h2>Speed over time</h2>\n<p>Mean speed per second (m/s); the dashed red line is the "
-         "sprint threshold ("
-      << fmt::format("{:g}", o.sprint_speed_mps) << " m/s).</p>\n<div class=\"charts\">";
-    for (const auto& p : r.players) {
-      h << "<div><b>"
-        << Html(p.name.empty() ? "player " + std::to_string(p.id)
-                               : p.name + " (" + std::to_string(p.id) + ")")
-        << "</b><br>" << SpeedChartSvg(p, t0, t1, vmax, o.sprint_speed_mps) << "</div>";
-    }
-    h << "</div>\n";
-    if (!o.zones.empty()) {
-      h << "<h2>Zone alerts</h2>\n<table class=\"sortable\"><tr><th>zone</th><th>id</th>"
-           "<th>entered s</th><th>left s</th></tr>\n";
-      for (const auto& e : r.events) {
-        h << fmt::format("<tr><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td></tr>\n",
-                         Html(e.zone), e.id, e.enter_s, e.exit_s);
-      }
-      h << "</table>\n";
-    }
-    h << "<h2>Radar view</h2>\n<p><img src=\"radar.png\"></p>\n";
-    if (!radar_video.empty()) {
-      h << "<p><video src=\"" << radar_video << "\" controls muted playsinline width=\""
-        << view.size.width << "\"></video></p>\n";
-    }
-    h << "<h2>Heat maps</h2>\n<p>Time spent per square metre of field (seconds; the scale's top "
-         "is the 99th percentile of the cells, busier cells share its colour). Zones in "
-         "yellow.</p>\n<div class=\"maps\"><img src=\"heatmap_all.png\">";
-    for (const auto& [team, ts] : by_team) {
-      h << fmt::format("<img src=\"heatmap_team{}.png\">", team);
-    }
-    h << "</div>\n<h3>Per player</h3>\n<div class=\"maps\">";
-    for (int id : player_maps) h << fmt::format("<img src=\"heatmap_player{}.png\">", id);
-    h << "</div>\n" << kSortScript << "</body></html>\n";
-    files.files.push_back(path);
-  }
+  WriteIndexHtml(out_dir + "/index.html", rp, files);
+  files.files.push_back(out_dir + "/index.html");
   return files;
 }
 

@@ -163,6 +163,102 @@ double TopSpeed(const SmoothTrack& s, const StatsOptions& o) {
 
 }  // namespace
 
+double FrameRateOfRows(const std::vector<track::TrackRow>& rows) {
+  std::map<int, double> time_of_frame;
+  for (const auto& r : rows) {
+    FV_REQUIRE(r.time_s.has_value(),
+               "the tracks have no time_s (frame {}): re-run players (it writes the video's "
+               "time) or give --fps",
+               r.frame);
+    time_of_frame[r.frame] = *r.time_s;
+  }
+  std::vector<double> steps;
+  for (auto it = time_of_frame.begin(); std::next(it) != time_of_frame.end(); ++it) {
+    const auto next = std::next(it);
+    FV_REQUIRE(next->second > it->second,
+               "the tracks' time_s does not increase from frame {} to frame {}", it->first,
+               next->first);
+    steps.push_back((next->second - it->second) / (next->first - it->first));
+  }
+  std::sort(steps.begin(), steps.end());
+  return steps.empty() ? 0.0 : 1.0 / steps[steps.size() / 2];
+}
+
+PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
+                          std::vector<ZoneEvent>& events) {
+  const std::vector<double>& t = s.time_s;
+  PlayerStats ps;
+  ps.id = s.id;
+  const auto team = o.team_of.find(s.id);
+  ps.team = team == o.team_of.end() ? -1 : team->second;
+  const auto name = o.name_of.find(s.id);
+  if (name != o.name_of.end()) ps.name = name->second;
+  ps.samples = static_cast<int>(t.size());
+  ps.first_s = t.front();
+  ps.last_s = t.back();
+  ps.band_time_s.assign(o.speed_bands_mps.size() + 1, 0.0);
+  for (const auto& z : o.zones) ps.zone_time_s[z.name] = 0.0;
+  ps.top_speed_mps = TopSpeed(s, o);
+  double sprint_run = 0, speed_time = 0, speed_sum = 0;
+  std::map<std::string, std::optional<double>> inside_since;
+  std::map<int, std::pair<double, int>> per_second;  // second -> (sum, count)
+  for (size_t i = 0; i < t.size(); ++i) {
+    const bool joined = i + 1 < t.size() && s.segment[i + 1] == s.segment[i];
+    const double dt = joined ? t[i + 1] - t[i] : 0.0;
+    if (joined) ps.distance_m += (s.pos_m[i + 1] - s.pos_m[i]).norm();
+    const double v = std::min(s.speed_mps[i], o.max_speed_mps);
+    speed_sum += v * dt;
+    speed_time += dt;
+    size_t band = 0;
+    while (band < o.speed_bands_mps.size() && v >= o.speed_bands_mps[band]) ++band;
+    ps.band_time_s[band] += dt;
+    if (v >= o.sprint_speed_mps && joined) {
+      sprint_run += dt;
+    } else {
+      if (sprint_run >= o.sprint_min_s) ps.sprints++;
+      sprint_run = 0;
+    }
+    auto& sec = per_second[static_cast<int>(std::floor(t[i]))];
+    sec.first += v;
+    sec.second++;
+    for (const auto& z : o.zones) {
+      const bool in = InPolygon(z.polygon_m, s.pos_m[i]);
+      if (in) ps.zone_time_s[z.name] += dt;
+      auto& since = inside_since[z.name];
+      if (in && !since) since = t[i];
+      if ((!in || i + 1 == t.size()) && since) {
+        events.push_back({z.name, s.id, *since, t[i]});
+        since.reset();
+      }
+    }
+  }
+  if (sprint_run >= o.sprint_min_s) ps.sprints++;
+  ps.mean_speed_mps = speed_time > 0 ? speed_sum / speed_time : 0.0;
+  for (const auto& [sec, sc] : per_second) {
+    ps.speed_profile.emplace_back(sec, sc.first / sc.second);
+  }
+  return ps;
+}
+
+std::vector<std::tuple<double, int, int, double>> PairDistancesPerSecond(
+    const std::vector<SmoothTrack>& tracks, double t_min, double t_max) {
+  std::vector<std::tuple<double, int, int, double>> out;
+  for (int sec = static_cast<int>(std::ceil(t_min)); sec <= t_max; ++sec) {
+    std::vector<std::pair<int, Eigen::Vector2d>> at;
+    for (const auto& s : tracks) {
+      const auto it = std::lower_bound(s.time_s.begin(), s.time_s.end(), sec - 0.5);
+      if (it == s.time_s.end() || *it > sec + 0.5) continue;
+      at.emplace_back(s.id, s.pos_m[it - s.time_s.begin()]);
+    }
+    for (size_t i = 0; i < at.size(); ++i) {
+      for (size_t j = i + 1; j < at.size(); ++j) {
+        out.emplace_back(sec, at[i].first, at[j].first, (at[i].second - at[j].second).norm());
+      }
+    }
+  }
+  return out;
+}
+
 StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& options) {
   options.Check();
   std::map<int, std::vector<const track::TrackRow*>> by_id;
@@ -178,29 +274,11 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
     res.fps = options.fps;
   } else {
     // The rate of the rows' own times: the median step between consecutive frames.
-    std::map<int, double> time_of_frame;
-    for (const auto& r : rows) {
-      FV_REQUIRE(r.time_s.has_value(),
-                 "the tracks have no time_s (frame {}): re-run players (it writes the video's "
-                 "time) or give --fps",
-                 r.frame);
-      time_of_frame[r.frame] = *r.time_s;
-    }
-    std::vector<double> steps;
-    for (auto it = time_of_frame.begin(); std::next(it) != time_of_frame.end(); ++it) {
-      const auto next = std::next(it);
-      FV_REQUIRE(next->second > it->second,
-                 "the tracks' time_s does not increase from frame {} to frame {}", it->first,
-                 next->first);
-      steps.push_back((next->second - it->second) / (next->first - it->first));
-    }
-    std::sort(steps.begin(), steps.end());
-    res.fps = steps.empty() ? 0.0 : 1.0 / steps[steps.size() / 2];
+    res.fps = FrameRateOfRows(rows);
     res.time_source = "TRACKS.csv time_s";
     o.fps = res.fps > 0 ? res.fps : 25.0;  // only for the gap rule of SmoothPositions
   }
   double t_min = 1e300, t_max = -1e300;
-  const size_t bands = o.speed_bands_mps.size() + 1;
   for (auto& [id, rs] : by_id) {
     std::sort(rs.begin(), rs.end(), [](auto* a, auto* b) { return a->frame < b->frame; });
     std::vector<double> t;
@@ -213,59 +291,9 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
     }
     if (t.empty() || t.back() - t.front() < o.min_track_s) continue;
     SmoothTrack s = SmoothPositions(id, t, p, o);
-    PlayerStats ps;
-    ps.id = id;
-    const auto team = o.team_of.find(id);
-    ps.team = team == o.team_of.end() ? -1 : team->second;
-    const auto name = o.name_of.find(id);
-    if (name != o.name_of.end()) ps.name = name->second;
-    ps.samples = static_cast<int>(t.size());
-    ps.first_s = t.front();
-    ps.last_s = t.back();
-    ps.band_time_s.assign(bands, 0.0);
-    for (const auto& z : o.zones) ps.zone_time_s[z.name] = 0.0;
-    double sprint_run = 0, speed_time = 0, speed_sum = 0;
-    std::map<std::string, std::optional<double>> inside_since;
-    std::map<int, std::pair<double, int>> per_second;  // second -> (sum, count)
-    for (size_t i = 0; i < t.size(); ++i) {
-      const bool joined = i + 1 < t.size() && s.segment[i + 1] == s.segment[i];
-      const double dt = joined ? t[i + 1] - t[i] : 0.0;
-      if (joined) ps.distance_m += (s.pos_m[i + 1] - s.pos_m[i]).norm();
-      const double v = std::min(s.speed_mps[i], o.max_speed_mps);
-      speed_sum += v * dt;
-      speed_time += dt;
-      size_t band = 0;
-      while (band < o.speed_bands_mps.size() && v >= o.speed_bands_mps[band]) ++band;
-      ps.band_time_s[band] += dt;
-      if (v >= o.sprint_speed_mps && joined) {
-        sprint_run += dt;
-      } else {
-        if (sprint_run >= o.sprint_min_s) ps.sprints++;
-        ps.top_speed_mps = TopSpeed(s, o);
-        sprint_run = 0;
-      }
-      auto& sec = per_second[static_cast<int>(std::floor(t[i]))];
-      sec.first += v;
-      sec.second++;
-      for (const auto& z : o.zones) {
-        const bool in = InPolygon(z.polygon_m, s.pos_m[i]);
-        if (in) ps.zone_time_s[z.name] += dt;
-        auto& since = inside_since[z.name];
-        if (in && !since) since = t[i];
-        if ((!in || i + 1 == t.size()) && since) {
-          res.events.push_back({z.name, id, *since, t[i]});
-          since.reset();
-        }
-      }
-    }
-    if (sprint_run >= o.sprint_min_s) ps.sprints++;
-    ps.mean_speed_mps = speed_time > 0 ? speed_sum / speed_time : 0.0;
-    for (const auto& [sec, sc] : per_second) {
-      ps.speed_profile.emplace_back(sec, sc.first / sc.second);
-    }
+    res.players.push_back(PlayerStatsOf(s, o, res.events));
     t_min = std::min(t_min, t.front());
     t_max = std::max(t_max, t.back());
-    res.players.push_back(ps);
     res.tracks.push_back(std::move(s));
   }
   FV_REQUIRE(!res.players.empty(), "no track is longer than min_track_s = {} s", o.min_track_s);
@@ -273,20 +301,7 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
   std::sort(res.events.begin(), res.events.end(),
             [](const ZoneEvent& a, const ZoneEvent& b) { return a.enter_s < b.enter_s; });
   // Distances between players once per second (nearest sample within half a second).
-  for (int sec = static_cast<int>(std::ceil(t_min)); sec <= t_max; ++sec) {
-    std::vector<std::pair<int, Eigen::Vector2d>> at;
-    for (const auto& s : res.tracks) {
-      const auto it = std::lower_bound(s.time_s.begin(), s.time_s.end(), sec - 0.5);
-      if (it == s.time_s.end() || *it > sec + 0.5) continue;
-      at.emplace_back(s.id, s.pos_m[it - s.time_s.begin()]);
-    }
-    for (size_t i = 0; i < at.size(); ++i) {
-      for (size_t j = i + 1; j < at.size(); ++j) {
-        res.pair_distances.emplace_back(sec, at[i].first, at[j].first,
-                                        (at[i].second - at[j].second).norm());
-      }
-    }
-  }
+  res.pair_distances = PairDistancesPerSecond(res.tracks, t_min, t_max);
   return res;
 }
 

@@ -91,6 +91,18 @@ struct StatsResult {
 // there are no positions, or no time_s and no options.fps.
 StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& options);
 
+// The stages of ComputeStats. The frame rate of the rows' time_s: the median step between
+// consecutive frames (0 with one frame); throws naming the frame without time or going back.
+double FrameRateOfRows(const std::vector<track::TrackRow>& rows);
+// One player's distance, speeds, speed bands, sprints, zone times and per-second profile from a
+// smoothed track; zone visits are added to `events`.
+PlayerStats PlayerStatsOf(const SmoothTrack& track, const StatsOptions& o,
+                          std::vector<ZoneEvent>& events);
+// Distances between every two players at each whole second in [t_min, t_max] (each player's
+// first sample within half a second of it).
+std::vector<std::tuple<double, int, int, double>> PairDistancesPerSecond(
+    const std::vector<SmoothTrack>& tracks, double t_min, double t_max);
+
 // Smooths one track's positions (exposed for tests).
 SmoothTrack SmoothPositions(int id, const std::vector<double>& time_s,
                             const std::vector<Eigen::Vector2d>& pos_m, const StatsOptions& o);

@@ -190,5 +190,60 @@ TEST(Stats, BadInputs) {
   EXPECT_FALSE(InPolygon({{0, 0}, {2, 0}, {2, 2}, {0, 2}}, {3, 1}));
 }
 
+// A hand-made smoothed track: 1 m/s for 4 s, then 6 m/s for 2 s (one segment), 10 samples/s.
+SmoothTrack StepTrack(int id) {
+  SmoothTrack s;
+  s.id = id;
+  double x = 0;
+  for (int k = 0; k <= 60; ++k) {
+    const double t = k / 10.0;
+    const double v = t < 4 ? 1.0 : 6.0;
+    s.time_s.push_back(t);
+    s.pos_m.emplace_back(x, 0.0);
+    s.speed_mps.push_back(v);
+    s.segment.push_back(0);
+    x += v / 10.0;
+  }
+  return s;
+}
+
+TEST(StatsStages, PlayerStatsOfAKnownTrack) {
+  StatsOptions o;
+  o.team_of[3] = 1;
+  o.zones = {{"right", {{3.5, -1}, {20, -1}, {20, 1}, {3.5, 1}}}};
+  std::vector<ZoneEvent> events;
+  const PlayerStats ps = PlayerStatsOf(StepTrack(3), o, events);
+  EXPECT_EQ(ps.team, 1);
+  EXPECT_EQ(ps.samples, 61);
+  EXPECT_NEAR(ps.distance_m, 4.0 + 12.0, 1e-9);
+  EXPECT_EQ(ps.sprints, 1);  // 6 m/s for 2 s
+  EXPECT_NEAR(ps.top_speed_mps, 6.0, 1e-9);
+  EXPECT_NEAR(ps.mean_speed_mps, 16.0 / 6.0, 1e-9);
+  EXPECT_NEAR(ps.band_time_s[0], 4.0, 1e-9);  // below 2 m/s
+  EXPECT_NEAR(ps.band_time_s[3], 2.0, 1e-9);  // 5.5..7 m/s
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_NEAR(events[0].enter_s, 3.5, 1e-9);  // x = 3.5 at t = 3.5 s
+  EXPECT_NEAR(events[0].exit_s, 6.0, 1e-9);
+  EXPECT_EQ(ps.speed_profile.size(), 7u);
+}
+
+TEST(StatsStages, FrameRateAndPairDistances) {
+  std::vector<track::TrackRow> rows(4);
+  for (int i = 0; i < 4; ++i) {
+    rows[i].frame = 1 + 2 * i;  // every other frame, 0.2 s apart: 10 frames/s
+    rows[i].time_s = 0.2 * i;
+  }
+  EXPECT_NEAR(FrameRateOfRows(rows), 10.0, 1e-9);
+  rows[2].time_s = 0.1;
+  EXPECT_THROW(FrameRateOfRows(rows), fv::Error);
+  SmoothTrack b = StepTrack(4);
+  for (auto& p : b.pos_m) p.y() = 3.0;
+  const auto d = PairDistancesPerSecond({StepTrack(3), b}, 0.0, 6.0);
+  ASSERT_EQ(d.size(), 7u);
+  EXPECT_EQ(std::get<1>(d[2]), 3);
+  EXPECT_EQ(std::get<2>(d[2]), 4);
+  EXPECT_NEAR(std::get<3>(d[2]), 3.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace fv::stats
