@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -38,12 +39,6 @@ const std::map<std::string, int>& DictionaryNames() {
       {"DICT_7X7_1000", cv::aruco::DICT_7X7_1000},
       {"DICT_ARUCO_ORIGINAL", cv::aruco::DICT_ARUCO_ORIGINAL}};
   return kNames;
-}
-
-bool IsImageFile(const std::filesystem::path& p) {
-  const std::string ext = ToLower(p.extension().string());
-  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".pgm" || ext == ".ppm";
 }
 
 cv::Mat ToGrey(const cv::Mat& image) {
@@ -230,7 +225,8 @@ ImageSource::ImageSource(const std::string& spec, const ImageSourceOptions& opti
   FV_REQUIRE(fs::exists(spec), "images '{}': no such file or folder", spec);
   if (fs::is_directory(spec)) {
     for (const auto& e : fs::directory_iterator(spec)) {
-      if (e.is_regular_file() && IsImageFile(e.path())) names_.push_back(e.path().string());
+      const std::string path = e.path().string();
+      if (e.is_regular_file() && IsImageFile(path)) names_.push_back(path);
     }
     std::sort(names_.begin(), names_.end());
     FV_REQUIRE(!names_.empty(), "images '{}': the folder has no image files", spec);
