@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/detector_options.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/detections_job.h"
@@ -59,6 +60,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--color,--colour", o->job.colour, "Colour preset or colour file of the ball")
       ->capture_default_str();
+  AddDetectorOptions(cmd, o->job.dnn);
   cmd->add_option("--out", o->job.out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")
       ->required();
   cmd->add_option("--truth", o->job.truth, "truth.csv: also print the error table");

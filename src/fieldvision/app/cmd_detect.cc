@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/detector_options.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/output_path.h"
@@ -43,6 +44,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "camera, where the ball looks that small)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
+  AddDetectorOptions(cmd, o->dnn);
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {

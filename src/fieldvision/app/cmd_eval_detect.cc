@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/detector_options.h"
 #include "fieldvision/detect/detect_eval.h"
 
 namespace fv::app {
@@ -35,6 +36,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "camera, where the ball looks that small)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
+  AddDetectorOptions(cmd, o->dnn);
   cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")
       ->capture_default_str();
   cmd->add_option("--list", o->list_misses, "Misses and false detections to list")

@@ -160,6 +160,7 @@ void DetectEvalOptions::Check() const {
   CheckInRange(grow, 0.0, 5.0, "grow");
   FV_REQUIRE(list_misses >= 0, "list_misses must be >= 0");
   detector.Check();
+  dnn.Check();
 }
 
 DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
@@ -276,7 +277,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   }
   std::unique_ptr<Camera> camera;
   if (!o.camera.empty()) camera = std::make_unique<Camera>(ReadCameraYaml(o.camera));
-  const BallDetector detector(o.detector, camera.get(), nullptr);
+  const AnyBallDetector detector(o.detector, o.dnn, camera.get(), nullptr);
 
   DetectEvalResult result;
   std::unique_ptr<AtomicOutput> cand_file;

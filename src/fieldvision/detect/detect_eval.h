@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/dnn_ball.h"
 
 namespace fv {
 
@@ -43,6 +44,7 @@ struct DetectEvalOptions {
   std::string candidates_out;  // optional CSV, one row per candidate with its measurements
   bool progress = true;
   BallDetectorOptions detector;
+  DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
   // Throws fv::Error naming the bad field.
   void Check() const;
 };

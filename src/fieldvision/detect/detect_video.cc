@@ -34,6 +34,7 @@ void DetectVideoOptions::Check() const {
   FV_REQUIRE(max_frames == -1 || max_frames > 0, "max_frames must be -1 or > 0 (got {})",
              max_frames);
   detector.Check();
+  dnn.Check();
 }
 
 std::string DetectVideoResult::Summary() const {
@@ -72,7 +73,8 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   if (!o.field.empty()) field = LoadField(o.field);
   auto source = VideoSource::Open(o.video);
   if (camera) source->CheckMatchesCamera(*camera, o.camera);
-  const BallDetector detector(o.detector, camera ? &*camera : nullptr, field ? &*field : nullptr);
+  const AnyBallDetector detector(o.detector, o.dnn, camera ? &*camera : nullptr,
+                                 field ? &*field : nullptr);
   // Written beside --out and renamed over it at the end: a failed run leaves the old file.
   AtomicOutput out_file(o.out);
   CsvWriter csv(out_file.temp_path(),

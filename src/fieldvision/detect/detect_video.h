@@ -6,6 +6,7 @@
 #include <string>
 
 #include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/dnn_ball.h"
 
 namespace fv {
 
@@ -18,6 +19,7 @@ struct DetectVideoOptions {
   int max_frames = -1;  // -1: all
   bool progress = true;
   BallDetectorOptions detector;
+  DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
   // Throws fv::Error naming the bad field.
   void Check() const;
 };

@@ -25,6 +25,7 @@ void BallJobOptions::Check() const {
   FV_REQUIRE(!out.empty(), "ball: --out is required");
   FV_REQUIRE(sync == "frame" || sync == "time", "ball: --sync must be 'frame' or 'time' (got '{}')",
              sync);
+  dnn.Check();
   pipeline.Check();
   eval.Check();
 }
@@ -38,25 +39,39 @@ Camera ReadRigCamera(const std::string& path) {
   return camera;
 }
 
+namespace {
+
+// Accepted candidates, then the best few weak ones (fusion uses those only to complete a
+// position that an accepted candidate of another camera starts).
+std::vector<BallObservation> Observations(const std::vector<BallCandidate>& candidates) {
+  constexpr int kMaxWeak = 3;
+  std::vector<BallObservation> out;
+  int weak = 0;
+  for (const BallCandidate& b : candidates) {
+    if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
+    weak += !b.accepted;
+    BallObservation obs;
+    obs.weak = !b.accepted;
+    obs.centre_px = b.centre_px;
+    obs.radius_px = b.radius_px;
+    obs.sigma_px = std::max(b.sigma_px, 0.05);
+    obs.score = b.score;
+    out.push_back(obs);
+  }
+  return out;
+}
+
+}  // namespace
+
 BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector) {
   return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
-    // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
-    // position that an accepted candidate of another camera starts).
-    constexpr int kMaxWeak = 3;
-    std::vector<BallObservation> out;
-    int weak = 0;
-    for (const BallCandidate& b : det->Detect(bgr, roi)) {
-      if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
-      weak += !b.accepted;
-      BallObservation obs;
-      obs.weak = !b.accepted;
-      obs.centre_px = b.centre_px;
-      obs.radius_px = b.radius_px;
-      obs.sigma_px = std::max(b.sigma_px, 0.05);
-      obs.score = b.score;
-      out.push_back(obs);
-    }
-    return out;
+    return Observations(det->Detect(bgr, roi));
+  };
+}
+
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<AnyBallDetector> detector) {
+  return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
+    return Observations(det->Detect(bgr, roi));
   };
 }
 
@@ -90,12 +105,10 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   BallDetectorOptions dopt;
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
-  std::vector<std::shared_ptr<BallDetector>> detectors;
   std::vector<BallRegionDetectFn> detect_fns;
   for (int c = 0; c < n; ++c) {
-    auto det = std::make_shared<BallDetector>(dopt, &cameras[c], field ? &*field : nullptr);
-    detectors.push_back(det);
-    detect_fns.push_back(BallDetectFnFor(det));
+    detect_fns.push_back(BallDetectFnFor(
+        std::make_shared<AnyBallDetector>(dopt, o.dnn, &cameras[c], field ? &*field : nullptr)));
   }
   BallPipelineOptions popt = o.pipeline;
   popt.sync.mode = o.sync == "time" ? SyncMode::kTimestamp : SyncMode::kFrameIndex;

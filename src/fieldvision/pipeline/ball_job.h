@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/dnn_ball.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
 #include "fieldvision/recon/ball_eval.h"
 
@@ -21,6 +22,7 @@ struct BallJobOptions {
   std::vector<std::string> timestamps;  // optional: one frame,time_s CSV per video
   double ball_diameter_m = 0.22;
   std::string colour = "orange";  // colour preset or colour file (detect/colour.h)
+  DnnBallOptions dnn;             // --detector colour|dnn|both (detect/dnn_ball.h)
   std::string field;              // optional field (name or JSON): detect only over it
   std::string out;                // BALL.csv
   std::string truth;              // optional truth.csv for the error table
@@ -47,5 +49,7 @@ Camera ReadRigCamera(const std::string& path);
 // ones (fusion uses those only to complete a position that an accepted candidate of another
 // camera starts).
 BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector);
+// The same for the detector chosen by --detector (colour, dnn or both).
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<AnyBallDetector> detector);
 
 }  // namespace fv

@@ -1,0 +1,38 @@
+// The `--detector colour|dnn|both` option group (detect/dnn_ball.h), shared by `detect`,
+// `eval detect` and `ball`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "fieldvision/detect/dnn_ball.h"
+
+namespace fv::app {
+
+inline void AddDetectorOptions(CLI::App* cmd, DnnBallOptions& o) {
+  cmd->add_option("--detector", o.detector,
+                  "Ball detector: colour (colour table and shape checks), dnn (the shipped "
+                  "NanoDet model's COCO 'sports ball' class: any ball, slower), or both (the "
+                  "network confirms colour candidates and completes them)")
+      ->check(CLI::IsMember({"colour", "dnn", "both"}))
+      ->capture_default_str();
+  cmd->add_option("--dnn-width", o.input_width,
+                  "With dnn/both: network input width for the whole-frame search (multiple of "
+                  "32; 0: the frame's width, at least 416)")
+      ->capture_default_str();
+  cmd->add_option("--dnn-accept", o.accept_score,
+                  "With dnn: a network ball is accepted from this score")
+      ->capture_default_str();
+  cmd->add_option("--dnn-confirm", o.confirm_score,
+                  "With both: a colour candidate is confirmed (accepted) from this network score "
+                  "(in a crop around it or the whole frame)")
+      ->capture_default_str();
+  cmd->add_option("--dnn-complete", o.complete_score,
+                  "With both: a network ball where colour found nothing is accepted from this "
+                  "score (1: never)")
+      ->capture_default_str();
+  cmd->add_flag("!--dnn-keep", o.demote_unconfirmed,
+                "With both: keep colour-accepted candidates the network does not confirm "
+                "(default: rejected)");
+}
+
+}  // namespace fv::app

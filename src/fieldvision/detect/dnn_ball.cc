@@ -1,0 +1,246 @@
+#include "fieldvision/detect/dnn_ball.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/util/error.h"
+
+namespace fv {
+namespace {
+
+constexpr double kPadGrey = 114.0;  // fill beyond the image in a crop (the usual letterbox grey)
+
+int RoundUp32(double v) { return std::max(32, static_cast<int>(std::ceil(v / 32.0)) * 32); }
+
+// Whether a network box (centre, half size) confirms a candidate: holds its centre, similar size.
+bool Confirms(const Eigen::Vector2d& centre, double radius, const cv::Rect2d& box,
+              double size_ratio) {
+  const double half = 0.25 * (box.width + box.height);
+  return centre.x() >= box.x && centre.x() <= box.x + box.width && centre.y() >= box.y &&
+         centre.y() <= box.y + box.height && half <= size_ratio * radius &&
+         half * size_ratio >= radius;
+}
+
+// The candidate's crop side in pixels.
+int CropSide(const BallCandidate& c, const DnnBallOptions& o) {
+  return std::max(o.min_crop_px, static_cast<int>(std::lround(2.0 * o.crop_radii * c.radius_px)));
+}
+
+}  // namespace
+
+void DnnBallOptions::Check() const {
+  FV_REQUIRE(detector == "colour" || detector == "dnn" || detector == "both",
+             "--detector must be colour, dnn or both (got '{}')", detector);
+  FV_REQUIRE(
+      input_width == 0 || (input_width >= 64 && input_width <= 4096 && input_width % 32 == 0),
+      "dnn input_width must be 0 (from the frame) or a multiple of 32 in 64..4096 (got {})",
+      input_width);
+  FV_REQUIRE(min_input_width >= 64 && min_input_width <= 4096 && min_input_width % 32 == 0,
+             "dnn min_input_width must be a multiple of 32 in 64..4096 (got {})", min_input_width);
+  CheckInRange(score_threshold, 0.0, 1.0, "dnn score_threshold");
+  CheckInRange(accept_score, 0.0, 1.0, "dnn accept_score");
+  CheckInRange(complete_score, 0.0, 1.0, "dnn complete_score");
+  CheckInRange(confirm_score, 0.0, 1.0, "dnn confirm_score");
+  CheckInRange(nms_iou, 0.0, 1.0, "dnn nms_iou");
+  CheckInRange(crop_radii, 1.0, 20.0, "dnn crop_radii");
+  FV_REQUIRE(min_crop_px >= 8, "dnn min_crop_px must be >= 8 (got {})", min_crop_px);
+  FV_REQUIRE(crop_px >= 64 && crop_px <= 1024 && crop_px % 32 == 0,
+             "dnn crop_px must be a multiple of 32 in 64..1024 (got {})", crop_px);
+  FV_REQUIRE(max_crops >= 0 && max_crops <= 100, "dnn max_crops must be in 0..100 (got {})",
+             max_crops);
+  CheckInRange(box_size_ratio, 1.0, 10.0, "dnn box_size_ratio");
+}
+
+BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score) {
+  BallCandidate c;
+  c.centre_px = {box.box.x + 0.5 * box.box.width, box.box.y + 0.5 * box.box.height};
+  c.radius_px = 0.25 * (box.box.width + box.box.height);
+  c.sigma_px = std::max(0.1 * c.radius_px, 0.3);
+  c.score = box.score;
+  c.accepted = box.score >= accept_score;
+  c.reason = c.accepted ? "" : "network score below the accept score";
+  return c;
+}
+
+std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
+                                  const std::vector<BallCandidate>& dnn, const DnnBallOptions& o) {
+  std::vector<double> out(colour.size(), 0.0);
+  for (size_t i = 0; i < colour.size(); ++i) {
+    for (const BallCandidate& d : dnn) {
+      const cv::Rect2d box(d.centre_px.x() - d.radius_px, d.centre_px.y() - d.radius_px,
+                           2 * d.radius_px, 2 * d.radius_px);
+      if (Confirms(colour[i].centre_px, colour[i].radius_px, box, o.box_size_ratio)) {
+        out[i] = std::max(out[i], d.score);
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate>& colour,
+                                                 const std::vector<double>& confirm,
+                                                 const std::vector<BallCandidate>& dnn,
+                                                 const DnnBallOptions& o) {
+  FV_REQUIRE(confirm.size() == colour.size(), "CombineBallCandidates: {} scores for {} candidates",
+             confirm.size(), colour.size());
+  // Tiers: 0 confirmed, 1 colour-accepted unconfirmed, 2 completing network ball, 3 the rest.
+  struct Ranked {
+    BallCandidate c;
+    int tier;
+    double key;
+  };
+  std::vector<Ranked> ranked;
+  for (size_t i = 0; i < colour.size(); ++i) {
+    BallCandidate c = colour[i];
+    if (confirm[i] >= o.confirm_score) {
+      c.accepted = true;
+      c.reason.clear();
+      ranked.push_back({c, 0, confirm[i]});
+    } else if (c.accepted && !o.demote_unconfirmed) {
+      ranked.push_back({c, 1, c.score});
+    } else {
+      if (c.accepted) {
+        c.accepted = false;
+        c.reason = "not confirmed by the network";
+      }
+      ranked.push_back({c, 3, c.score});
+    }
+  }
+  for (const BallCandidate& d : dnn) {
+    // A network ball that holds a colour candidate's centre adds nothing new (the crop check
+    // judged that candidate).
+    const bool covered = std::any_of(colour.begin(), colour.end(), [&](const BallCandidate& c) {
+      return (c.centre_px - d.centre_px).norm() <= std::max(d.radius_px, c.radius_px);
+    });
+    if (covered) continue;
+    BallCandidate c = d;
+    c.accepted = d.score >= o.complete_score;
+    c.reason = c.accepted ? "" : "network score below the complete score";
+    ranked.push_back({c, c.accepted ? 2 : 3, c.score});
+  }
+  std::stable_sort(ranked.begin(), ranked.end(), [](const Ranked& a, const Ranked& b) {
+    return a.tier != b.tier ? a.tier < b.tier : a.key > b.key;
+  });
+  std::vector<BallCandidate> out;
+  out.reserve(ranked.size());
+  for (auto& r : ranked) out.push_back(std::move(r.c));
+  return out;
+}
+
+DnnBallDetector::DnnBallDetector(const DnnBallOptions& options) : options_(options) {
+  options_.Check();
+  net_ = std::make_unique<dnn::NanoDet>(options_.model_path);
+}
+
+std::vector<BallCandidate> DnnBallDetector::Detect(const cv::Mat& bgr, const cv::Rect& roi) const {
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "dnn ball detector: expected a BGR frame");
+  const cv::Rect full(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect r = roi.empty() ? full : (roi & full);
+  if (r.width < 8 || r.height < 8) return {};
+  const cv::Mat view = bgr(r);
+  const int net_w = options_.input_width > 0
+                        ? options_.input_width
+                        : std::max(options_.min_input_width, RoundUp32(view.cols));
+  const int net_h = RoundUp32(net_w * double(view.rows) / view.cols);
+  std::vector<dnn::DnnBox> boxes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const double threshold = options_.detector == "both"
+                                 ? std::min(options_.score_threshold, options_.confirm_score)
+                                 : options_.score_threshold;
+    boxes = net_->Detect(view, cv::Size(net_w, net_h), threshold, {dnn::kCocoSportsBall});
+  }
+  std::vector<BallCandidate> out;
+  for (const dnn::DnnBox& b : dnn::NmsBoxes(boxes, options_.nms_iou)) {
+    BallCandidate c = CandidateFromBox(b, options_.accept_score);
+    c.centre_px += Eigen::Vector2d(r.x, r.y);
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::vector<double> DnnBallDetector::CropScores(const cv::Mat& bgr,
+                                                const std::vector<BallCandidate>& candidates,
+                                                const cv::Rect& roi) const {
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "dnn ball detector: expected a BGR frame");
+  const DnnBallOptions& o = options_;
+  const cv::Rect full(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect area = roi.empty() ? full : (roi & full);
+  std::vector<double> scores(candidates.size(), 0.0);
+  // Accepted first, then weak, then the rest, each in the detector's order.
+  std::vector<size_t> order(candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const auto rank = [](const BallCandidate& c) { return c.accepted ? 0 : (c.weak ? 1 : 2); };
+    return rank(candidates[a]) < rank(candidates[b]);
+  });
+  int crops = 0;
+  for (size_t i : order) {
+    if (crops >= o.max_crops) break;
+    const BallCandidate& c = candidates[i];
+    if (!(c.radius_px > 0) || !c.centre_px.allFinite()) continue;
+    const int side = CropSide(c, o);
+    const cv::Rect crop(static_cast<int>(std::lround(c.centre_px.x() - 0.5 * side)),
+                        static_cast<int>(std::lround(c.centre_px.y() - 0.5 * side)), side, side);
+    const cv::Rect inside = crop & area;
+    if (inside.empty()) continue;
+    // The crop square, grey where it leaves the searched area (nothing outside it is read).
+    cv::Mat square(side, side, CV_8UC3, cv::Scalar::all(kPadGrey));
+    bgr(inside).copyTo(square(inside - crop.tl()));
+    ++crops;
+    std::vector<dnn::DnnBox> boxes;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      boxes = net_->Detect(square, cv::Size(o.crop_px, o.crop_px),
+                           std::min(o.score_threshold, o.confirm_score), {dnn::kCocoSportsBall});
+    }
+    const Eigen::Vector2d centre = c.centre_px - Eigen::Vector2d(crop.x, crop.y);
+    for (const dnn::DnnBox& b : boxes) {
+      if (Confirms(centre, c.radius_px, b.box, o.box_size_ratio)) {
+        scores[i] = std::max(scores[i], b.score);
+      }
+    }
+  }
+  return scores;
+}
+
+AnyBallDetector::AnyBallDetector(const BallDetectorOptions& colour, const DnnBallOptions& dnn,
+                                 const Camera* camera, const FieldModel* field)
+    : dnn_options_(dnn) {
+  dnn_options_.Check();
+  colour_ = std::make_unique<BallDetector>(colour, camera, field);
+  if (dnn_options_.uses_dnn()) dnn_ = std::make_unique<DnnBallDetector>(dnn_options_);
+}
+
+std::vector<BallCandidate> AnyBallDetector::FilterDnn(std::vector<BallCandidate> cands) const {
+  const BallDetectorOptions& o = colour_->options();
+  const cv::Mat& mask = colour_->field_mask();
+  std::erase_if(cands, [&](const BallCandidate& c) {
+    if (c.radius_px < o.min_radius_px || c.radius_px > o.max_radius_px) return true;
+    if (mask.empty()) return false;
+    const int u = static_cast<int>(std::lround(c.centre_px.x()));
+    const int v = static_cast<int>(std::lround(c.centre_px.y()));
+    return u < 0 || v < 0 || u >= mask.cols || v >= mask.rows || mask.at<uint8_t>(v, u) == 0;
+  });
+  return cands;
+}
+
+std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
+                                                   const cv::Rect& region) const {
+  if (dnn_ == nullptr) return colour_->Detect(bgr, region);
+  if (!dnn_options_.uses_colour()) return FilterDnn(dnn_->Detect(bgr, region));
+  const std::vector<BallCandidate> colour = colour_->Detect(bgr, region);
+  std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
+  std::vector<BallCandidate> whole;
+  if (dnn_options_.whole_frame) {
+    whole = FilterDnn(dnn_->Detect(bgr, region));
+    const std::vector<double> held = HoldingScores(colour, whole, dnn_options_);
+    for (size_t i = 0; i < confirm.size(); ++i) confirm[i] = std::max(confirm[i], held[i]);
+  }
+  return CombineBallCandidates(colour, confirm, whole, dnn_options_);
+}
+
+}  // namespace fv

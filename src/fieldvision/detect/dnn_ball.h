@@ -1,0 +1,119 @@
+// Any ball, not only a coloured one: ball candidates from the pretrained NanoDet's COCO "sports
+// ball" class (dnn/nanodet.h; no ball-specific weights), and their combination with the colour
+// detector (ball_detector.h) chosen by `--detector colour|dnn|both`. "dnn" runs the network on
+// the whole frame (or the search window); "both" confirms colour candidates with the network:
+// each is checked in a crop around it (crop_radii of its radius, resized to crop_px, so small
+// balls get the network's pixels) and against the whole-frame network balls that hold it. A
+// confirmed candidate is accepted (promoted when colour rejected it); an accepted one the network
+// does not confirm is rejected (demote_unconfirmed, the default) or kept; a whole-frame network
+// ball that no colour candidate lies in completes them. Low network scores suffice here because
+// colour proposes the places (on the MSL photos a crop score >= 0.1 held 54 of 148 candidates on
+// balls and 8 of 2244 elsewhere). Propose with a cheap cue, confirm with a CNN, as in R-CNN
+// (Girshick et al., CVPR 2014).
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/dnn/nanodet.h"
+
+namespace fv {
+
+struct DnnBallOptions {
+  std::string detector = "colour";  // colour | dnn | both (--detector)
+  std::string model_path;           // "" = dnn::FindModel("nanodet.onnx")
+  // Whole-frame (or window) search: the network's input width, a multiple of 32; 0 = the frame's
+  // width rounded up to a multiple of 32, at least min_input_width (small frames are upscaled:
+  // NanoDet's finest stride is 8 px).
+  int input_width = 0;
+  int min_input_width = 416;
+  double score_threshold = 0.25;  // lowest sports-ball score kept as a candidate ("dnn")
+  double accept_score = 0.3;      // a network ball is accepted from this score ("dnn")
+  // "both": also search the whole frame; its balls confirm colour candidates they hold and, from
+  // complete_score, complete them where colour found nothing.
+  bool whole_frame = true;
+  double complete_score = 0.5;
+  double nms_iou = 0.3;
+  // "both": colour candidates checked in a square crop of crop_radii x their radius (at least
+  // min_crop_px), resized to crop_px; at most max_crops of them, accepted and weak ones first.
+  double crop_radii = 4.0;
+  int min_crop_px = 24;
+  int crop_px = 128;
+  int max_crops = 6;
+  // A sports-ball box (crop or whole frame) that holds the candidate's centre and has a half size
+  // within [1 / box_size_ratio, box_size_ratio] of its radius confirms it from this score.
+  double confirm_score = 0.1;
+  double box_size_ratio = 2.5;
+  bool demote_unconfirmed = true;
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+  bool uses_colour() const { return detector != "dnn"; }
+  bool uses_dnn() const { return detector != "colour"; }
+};
+
+// A network ball as a candidate: centre of the box, radius the mean of its half sides, score the
+// network's, accepted from `accept_score`, sigma a tenth of the radius (a box is coarse).
+BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score);
+
+// The best score of the network balls `dnn` that confirm each colour candidate (hold its centre,
+// half size within box_size_ratio of its radius); 0 where none does.
+std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
+                                  const std::vector<BallCandidate>& dnn,
+                                  const DnnBallOptions& options);
+
+// The "both" stage, without the network (tested on its own): `colour` (best first) with each
+// one's network score `confirm` (crop or whole frame, 0 when not checked; same length), and the
+// whole-frame network balls `dnn` (candidates, best first). Returns the candidates best first:
+// confirmed ones (accepted, by network score), then colour-accepted unconfirmed ones (rejected with
+// demote_unconfirmed), then completing network balls from complete_score, then the rest.
+std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate>& colour,
+                                                 const std::vector<double>& confirm,
+                                                 const std::vector<BallCandidate>& dnn,
+                                                 const DnnBallOptions& options);
+
+// The network part: NanoDet loaded once. Detect and CropScores lock a mutex (one network).
+class DnnBallDetector {
+ public:
+  // Throws fv::Error for bad options or a missing or corrupt model (saying how to get it).
+  explicit DnnBallDetector(const DnnBallOptions& options);
+  // Network balls in `roi` of `bgr` (the whole frame when empty; nothing outside it is read)
+  // from score_threshold ("both": from confirm_score when lower), after NMS, best first, in the
+  // frame's pixels.
+  std::vector<BallCandidate> Detect(const cv::Mat& bgr, const cv::Rect& roi = cv::Rect()) const;
+  // The crop score of each candidate (0 for those beyond max_crops, see DnnBallOptions); crops
+  // stay inside `roi` (the whole frame when empty).
+  std::vector<double> CropScores(const cv::Mat& bgr, const std::vector<BallCandidate>& candidates,
+                                 const cv::Rect& roi = cv::Rect()) const;
+  const DnnBallOptions& options() const { return options_; }
+
+ private:
+  DnnBallOptions options_;
+  mutable std::mutex mutex_;
+  mutable std::unique_ptr<dnn::NanoDet> net_;
+};
+
+// The detector chosen by options.detector: the colour detector, the network, or both combined.
+// In "dnn" mode the colour detector's radius limits and field mask still filter network balls.
+class AnyBallDetector {
+ public:
+  // Throws fv::Error for bad options, colour or model.
+  AnyBallDetector(const BallDetectorOptions& colour, const DnnBallOptions& dnn,
+                  const Camera* camera, const FieldModel* field);
+  // Candidates best first (BallDetector::Detect's contract: `region` empty = whole frame;
+  // nothing outside it is read).
+  std::vector<BallCandidate> Detect(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
+  const BallDetector& colour() const { return *colour_; }
+
+ private:
+  std::vector<BallCandidate> FilterDnn(std::vector<BallCandidate> candidates) const;
+  DnnBallOptions dnn_options_;
+  std::unique_ptr<BallDetector> colour_;
+  std::unique_ptr<DnnBallDetector> dnn_;
+};
+
+}  // namespace fv
