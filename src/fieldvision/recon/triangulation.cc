@@ -43,6 +43,10 @@ bool InFrontOfAll(const std::vector<Camera>& cameras, const std::vector<View>& v
   return true;
 }
 
+bool BelowRest(const Eigen::Vector3d& p, const TriangulationOptions& o, double sigma_z_m) {
+  return o.max_below_rest_m >= 0 && p.z() < o.ball_radius_m - o.max_below_rest_m - 3 * sigma_z_m;
+}
+
 }  // namespace fv::triangulation_detail
 
 namespace fv {
@@ -61,7 +65,7 @@ void TriangulationOptions::Check() const {
   FV_REQUIRE(max_candidates_per_camera >= 1 && max_candidates_per_camera <= 64,
              "TriangulationOptions.max_candidates_per_camera must be in [1, 64] (got {})",
              max_candidates_per_camera);
-  CheckFinite(max_below_ground_m, "TriangulationOptions.max_below_ground_m");
+  CheckFinite(max_below_rest_m, "TriangulationOptions.max_below_rest_m");
   CheckPositive(prior_gate_m, "TriangulationOptions.prior_gate_m");
   FV_REQUIRE(max_radius_ratio == 0.0 || max_radius_ratio > 1.0,
              "TriangulationOptions.max_radius_ratio must be 0 (off) or > 1 (got {})",

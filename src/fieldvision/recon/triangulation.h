@@ -68,8 +68,11 @@ struct TriangulationOptions {
   double min_angle_deg = 2.0;
   // Robust mode: the best `max_candidates_per_camera` blobs (by score) of each camera are tried.
   int max_candidates_per_camera = 6;
-  // Reject points below the ground by more than this (metres); negative disables the check.
-  double max_below_ground_m = 0.05;
+  // Reject points whose centre lies lower than a ball resting on the ground (ball_radius_m above
+  // it) by more than this (metres) plus three standard deviations of the point's height: a low
+  // orange object (a cone, a marker) is no ball, whatever the cameras agree on. Negative
+  // disables the check.
+  double max_below_rest_m = 0.02;
   // When the detector reports radius_px: a view whose radius differs from the radius predicted
   // from the depth by more than this factor (either way) is inconsistent; 0 disables.
   double max_radius_ratio = 0.0;

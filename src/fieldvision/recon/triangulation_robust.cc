@@ -123,7 +123,7 @@ BestHypothesis SearchHypotheses(const std::vector<Camera>& cameras,
           const RayPairResult rp =
               ClosestPointOfRays(*ranked.rays[ca][ka], *ranked.rays[cb][kb], o.min_angle_deg);
           if (!rp.ok()) continue;
-          if (o.max_below_ground_m >= 0 && rp.midpoint.z() < -o.max_below_ground_m) continue;
+          if (BelowRest(rp.midpoint, o)) continue;
           ++best.hypotheses;
           const double cost = GatherConsistent(cameras, candidates, ranked, o, rp.midpoint, &pick);
           if (pick[ca] != ka || pick[cb] != kb) continue;  // the pair itself must agree
@@ -201,6 +201,7 @@ TriangulationResult RefineConsistentSet(const std::vector<Camera>& cameras,
 namespace fv {
 namespace {
 
+using triangulation_detail::BelowRest;
 using triangulation_detail::BestHypothesis;
 using triangulation_detail::RankCandidates;
 using triangulation_detail::RankedCandidates;
@@ -227,15 +228,22 @@ TriangulationResult RobustCore(const std::vector<Camera>& cameras,
     result.status = TriangulationStatus::kTooFewViews;
     return result;
   }
-  const BestHypothesis best =
-      SearchHypotheses(cameras, candidates, ranked, o, require_strong, prior);
-  if (best.n < 2) {
-    result.status = TriangulationStatus::kNoConsistentSet;
-    result.hypotheses = best.hypotheses;
-    return result;
-  }
-  result = RefineConsistentSet(cameras, candidates, ranked, o, best.pick);
-  if (result.ok()) {
+  // A set whose refined point lies below a resting ball (a low orange object that the cameras
+  // agree on) is dropped and the search runs again without its candidates, a few times at most.
+  constexpr int kMaxSearches = 3;
+  RankedCandidates search = ranked;
+  int hypotheses = 0;
+  for (int attempt = 0; attempt < kMaxSearches; ++attempt) {
+    const BestHypothesis best =
+        SearchHypotheses(cameras, candidates, search, o, require_strong, prior);
+    hypotheses += best.hypotheses;
+    if (best.n < 2) {
+      result = TriangulationResult();
+      result.status = TriangulationStatus::kNoConsistentSet;
+      break;
+    }
+    result = RefineConsistentSet(cameras, candidates, search, o, best.pick);
+    if (!result.ok()) break;
     std::vector<int> used(cameras.size(), -1);
     for (const ViewResidual& v : result.views) {
       result.weak_views += candidates[v.camera][v.candidate].weak;
@@ -243,9 +251,18 @@ TriangulationResult RobustCore(const std::vector<Camera>& cameras,
     }
     if (require_strong && !StrongEnough(candidates, used, result.point_world, o, prior)) {
       result.status = TriangulationStatus::kNoConsistentSet;
+      break;
+    }
+    const double sigma_z_m = std::sqrt(std::max(result.covariance(2, 2), 0.0));
+    if (!BelowRest(result.point_world, o, sigma_z_m)) break;
+    result.status = TriangulationStatus::kNoConsistentSet;
+    for (size_t c = 0; c < used.size(); ++c) {
+      if (used[c] < 0) continue;
+      std::vector<int>& order = search.order[c];
+      order.erase(std::remove(order.begin(), order.end(), used[c]), order.end());
     }
   }
-  result.hypotheses = best.hypotheses;
+  result.hypotheses = hypotheses;
   return result;
 }
 

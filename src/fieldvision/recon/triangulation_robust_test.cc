@@ -118,5 +118,40 @@ TEST(RobustStages, WeakOnlySetsNeedEnoughCamerasNearThePrior) {
   EXPECT_TRUE(StrongEnough(cand, {0, 0, 0}, p, o, &near));
 }
 
+TEST(RobustStages, BelowRestAllowsForTheHeightUncertainty) {
+  TriangulationOptions o;  // ball_radius_m 0.11, max_below_rest_m 0.02
+  EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.11), o));
+  EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.095), o));
+  EXPECT_TRUE(BelowRest(Eigen::Vector3d(0, 0, 0.08), o));
+  EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.08), o, 0.005));  // within 3 sigma
+  o.max_below_rest_m = -1;                                         // off
+  EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, -1), o));
+}
+
+// A low orange object (a marker disc, a cone's base) that every camera sees and scores higher
+// than the ball is no ball: the search drops it and finds the ball that fewer cameras see.
+TEST(RobustTriangulation, ALowObjectSeenByEveryCameraGivesWayToTheBall) {
+  const auto cams = RingCameras();
+  TriangulationOptions o;
+  const Eigen::Vector3d marker(2.0, -1.0, 0.03), ball(-1.0, 1.5, 0.11);
+  auto seen = [&](int c, const Eigen::Vector3d& p, double score) {
+    BallObservation obs = Seen(cams[c], p, score);
+    obs.sigma_px = 0.2;
+    return obs;
+  };
+  std::vector<std::vector<BallObservation>> cand = {{seen(0, marker, 0.9), seen(0, ball, 0.6)},
+                                                    {seen(1, marker, 0.9), seen(1, ball, 0.6)},
+                                                    {seen(2, marker, 0.9)}};
+  const TriangulationResult r = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(r.ok()) << ToString(r.status);
+  EXPECT_EQ(r.num_views(), 2);
+  EXPECT_LT((r.point_world - ball).norm(), 1e-3);
+  // With the check off the marker wins (three cameras).
+  o.max_below_rest_m = -1;
+  const TriangulationResult off = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(off.ok());
+  EXPECT_LT((off.point_world - marker).norm(), 1e-3);
+}
+
 }  // namespace
 }  // namespace fv
