@@ -422,6 +422,13 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     const Vector2d centre = fit.ok && fit_why.empty() ? fit.centre_px : cand.centre_px;
     double size_factor = 1.0;
     const std::string size_why = SizeProblem(centre, radius, &size_factor);
+    // The region path checks the region's own size (a small ball's outline fit may hug its
+    // saturated core and measure it too small while the region holds the whole ball).
+    double region_size_factor = size_factor;
+    const std::string region_size_why =
+        region.ok && radius != region.radius_px
+            ? SizeProblem(region.centre_px, region.radius_px, &region_size_factor)
+            : size_why;
     // Where the region was measured, the outline fit alone does not decide: both must agree.
     const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
                                RegionProblem(region, o, /*shape_only=*/true).empty();
@@ -433,7 +440,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
       region_why = region.failure;
     } else {
       region_why = RegionProblem(region, o);
-      if (region_why.empty()) region_why = size_why;
+      if (region_why.empty()) region_why = region_size_why;
     }
     const bool region_accept = region_why.empty();
     if (fit.ok) {
@@ -443,11 +450,11 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
       cand.dents = fit.dents;
       cand.visible_fraction = visible;
     }
-    const double region_score =
-        region.ok
-            ? region.arc_cover * std::min(1.0, region.fill / 0.9) * (1.0 - region.spill) *
-                  (1.0 - region.leak) * (region.radius_px / (region.radius_px + 1.0)) * size_factor
-            : 0.0;
+    const double region_score = region.ok ? region.arc_cover * std::min(1.0, region.fill / 0.9) *
+                                                (1.0 - region.spill) * (1.0 - region.leak) *
+                                                (region.radius_px / (region.radius_px + 1.0)) *
+                                                region_size_factor
+                                          : 0.0;
     if (precise_ok) {
       cand.centre_px = fit.centre_px;
       cand.radius_px = fit.radius_px;
