@@ -264,10 +264,11 @@ const char* FlightEventName(FlightEvent e) {
 }
 
 void TrajectoryOptions::Check() const {
-  CheckPositive(gravity_mps2, "gravity_mps2");
-  CheckPositive(ball_radius_m, "ball_radius_m");
-  CheckFinite(ground_z_m, "ground_z_m");
-  CheckNonNegative(noise_m, "noise_m");
+  // Upper limits far beyond any sport (and any planet's surface), so that products stay finite.
+  CheckInRange(gravity_mps2, 1e-6, 1000.0, "gravity_mps2");
+  CheckInRange(ball_radius_m, 1e-6, 1.0, "ball_radius_m");
+  CheckInRange(ground_z_m, -1e4, 1e4, "ground_z_m");
+  CheckInRange(noise_m, 0.0, 100.0, "noise_m");
   CheckPositive(window_s, "window_s");
   FV_REQUIRE(window_samples >= 3, "window_samples must be >= 3 (got {})", window_samples);
   CheckNonNegative(min_velocity_change_mps, "min_velocity_change_mps");

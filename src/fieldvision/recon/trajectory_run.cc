@@ -19,9 +19,9 @@ namespace fv {
 void TrajectoryJob::Check() const {
   FV_REQUIRE(!in_path.empty(), "trajectory: --in is required");
   FV_REQUIRE(!out_path.empty(), "trajectory: --out is required");
-  CheckNonNegative(ball_diameter_m, "ball_diameter_m");
-  CheckNonNegative(ball_mass_kg, "ball_mass_kg");
-  CheckNonNegative(accel_slack_mps2, "accel_slack_mps2");
+  CheckInRange(ball_diameter_m, 0.0, 2.0, "ball_diameter_m");  // 0: the default
+  CheckInRange(ball_mass_kg, 0.0, 100.0, "ball_mass_kg");
+  CheckInRange(accel_slack_mps2, 0.0, 1000.0, "accel_slack_mps2");
   CheckInRange(predict_fraction, 0.05, 1.0, "predict_fraction");
   decisions.Check();
   smoother.Check();
