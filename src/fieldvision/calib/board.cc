@@ -200,6 +200,41 @@ BoardView DetectBoard(const cv::Mat& image, const BoardSpec& board, const Detect
   return view;
 }
 
+std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board) {
+  if (board.type != BoardType::kCharuco) {
+    return "(check --cols and --rows: inner corners, one fewer than the squares)";
+  }
+  const cv::Mat grey = ToGrey(image);
+  // The dictionary that finds the most markers; of dictionaries that find as many (the smaller
+  // ones are the first markers of the larger ones), the smallest.
+  std::string best;
+  size_t best_count = 0;
+  int best_size = 0;
+  for (const auto& [name, id] : DictionaryNames()) {
+    const auto dict = cv::aruco::getPredefinedDictionary(id);
+    std::vector<std::vector<cv::Point2f>> corners;
+    std::vector<int> ids;
+    cv::aruco::detectMarkers(grey, dict, corners, ids);
+    const int size = dict->bytesList.rows;
+    if (ids.size() > best_count || (ids.size() == best_count && size < best_size)) {
+      best = name;
+      best_count = ids.size();
+      best_size = size;
+    }
+  }
+  if (best_count < 3) {
+    return "(no ArUco markers seen in its first image: check the board, --dictionary and "
+           "--marker)";
+  }
+  const auto family = best.substr(0, best.rfind('_') + 1);
+  if (board.dictionary.rfind(family, 0) == 0 && family != "DICT_") {
+    return fmt::format("(its markers are {}'s as given: check --cols/--rows and --marker)",
+                       board.dictionary);
+  }
+  return fmt::format("(its first image shows {} markers of {}, not {}: give --dictionary {})",
+                     best_count, best, board.dictionary, best);
+}
+
 void ImageSourceOptions::Check() const {
   FV_REQUIRE(max_video_frames >= 1, "max_video_frames must be >= 1 (got {})", max_video_frames);
 }

@@ -71,6 +71,11 @@ struct BoardView {
 BoardView DetectBoard(const cv::Mat& image, const BoardSpec& board, const DetectOptions& options,
                       const std::string& name);
 
+// What to check when the board is found in none of a camera's images: for ChArUco, the predefined
+// dictionary whose markers `image` shows most ("give --dictionary D" when it is not the board's),
+// else the options that describe the board. One clause, "(...)".
+std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board);
+
 // Image sources for calibration.
 struct ImageSourceOptions {
   int max_video_frames = 60;  // a video is sampled evenly to at most this many frames

@@ -359,8 +359,9 @@ IntrinsicsResult CalibrateIntrinsics(const std::string& images, const Intrinsics
   progress.Finish();
   const bool any = std::any_of(views.begin(), views.end(),
                                [](const BoardView& v) { return !v.image_points.empty(); });
-  FV_REQUIRE(any, "images '{}': no {} found in any of the {} images (check --cols/--rows)", images,
-             options.board.Describe(), views.size());
+  FV_REQUIRE(any, "images '{}': no {} found in any of the {} images {}", images,
+             options.board.Describe(), views.size(),
+             BoardNotFoundHint(source.Read(0), options.board));
   return CalibrateFromViews(views, options);
 }
 

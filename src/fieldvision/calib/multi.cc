@@ -1017,10 +1017,9 @@ MultiResult CalibrateMulti(const std::vector<CameraViews>& cameras, const MultiO
     detections.push_back(DetectCameraViews(c, options));
     const bool any = std::any_of(detections.back().views.begin(), detections.back().views.end(),
                                  [](const BoardView& v) { return !v.image_points.empty(); });
-    FV_REQUIRE(any,
-               "camera '{}': no {} found in any of the {} images of '{}' (check --cols/--rows{})",
-               c.name, options.board.Describe(), detections.back().views.size(), c.source,
-               options.board.type == BoardType::kCharuco ? ", --dictionary and --marker" : "");
+    FV_REQUIRE(any, "camera '{}': no {} found in any of the {} images of '{}' {}", c.name,
+               options.board.Describe(), detections.back().views.size(), c.source,
+               BoardNotFoundHint(ImageSource(c.source, options.source).Read(0), options.board));
   }
   std::string how;
   const auto frames = PairViews(detections, options.pairing, &how);
