@@ -8,9 +8,11 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "fieldvision/calib/calib_testing.h"
 #include "fieldvision/calib/extrinsics.h"
 #include "fieldvision/calib/focal.h"
 #include "fieldvision/calib/intrinsics.h"
+#include "fieldvision/calib/rig_place.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
@@ -104,6 +106,32 @@ TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {
             << clicks_only.Summary() << "\n";
   const RigComparison cmp = CompareRigs(ours, ref);
   std::cout << "against Qualisys: " << cmp.Summary() << "\n";
+  // What limits the comparison: the Qualisys rig itself (its intrinsics and relative poses kept),
+  // placed on all the clicks by the best rigid move, fits them at 11.5 px rms (7-17 px per
+  // camera), our cameras fitted one by one at 3.8 px: the scene points' coordinates (Config.toml)
+  // and the Qualisys calibration disagree by about 3 cm at 3-5 m, more than the clicks' 2-3 px.
+  // Rigs 3 deg apart both fit these points within that disagreement.
+  std::vector<std::vector<PointCorrespondence>> all_points;
+  double sq_ours = 0;
+  int n_ours = 0;
+  for (int c = 1; c <= 4; ++c) {
+    all_points.push_back(ScenePoints(fmt::format("cam{:02d}", c)));
+    for (const auto& p : PointResiduals(ours[c - 1], all_points.back())) {
+      sq_ours += p.err_px * p.err_px;
+      ++n_ours;
+    }
+  }
+  RigPlacementOptions po;
+  po.outlier_px = 50.0;
+  const RigPlacementResult placed = PlaceRig(test_util::InRigFrame(ref), all_points, po);
+  const double rms_ours = std::sqrt(sq_ours / n_ours);
+  std::cout << fmt::format(
+      "the clicks: our cameras fitted one by one rms {:.2f} px; the Qualisys rig placed on them "
+      "by one rigid move rms {:.2f} px (per camera {:.2f} {:.2f} {:.2f} {:.2f})\n",
+      rms_ours, placed.rms_px_all, placed.rms_px[0], placed.rms_px[1], placed.rms_px[2],
+      placed.rms_px[3]);
+  EXPECT_EQ(placed.num_inliers, n_ours) << placed.Summary();
+  EXPECT_LT(rms_ours, placed.rms_px_all) << placed.Summary();
   // Loose bounds: 6-7 hand-clicked points 0.6 x 2 m seen from 3-5 m.
   EXPECT_LT(cmp.max_baseline_diff_mm, 250.0);
   EXPECT_LT(cmp.max_rotation_diff_deg, 4.0);
