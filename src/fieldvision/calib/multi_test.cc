@@ -114,29 +114,50 @@ MultiOptions RenderedOptions(const BoardSpec& board) {
   return o;
 }
 
+// Options for projected corners of a 9x7 chessboard of 70 mm squares (k1 k2 p1 p2 fitted).
+MultiOptions ProjectedOptions() {
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 9, 7, 0.07};
+  o.progress = false;
+  o.num_distortion = 4;
+  return o;
+}
+
+// `count` moments of the board near the origin seen by the `truth` cameras, 0.12 px of noise per
+// axis: what cornerSubPix measures on our rendered boards (the rendered stereo test below: 0.165
+// px RMS in 2D).
+std::vector<MultiFrame> ProjectedMoments(const std::vector<Camera>& truth, const BoardSpec& board,
+                                         int count, Rng& rng) {
+  std::vector<MultiFrame> frames;
+  for (int f = 0; f < count; ++f) {
+    const Rigid3d world_from_board = RandomBoardPose(board, rng, 0.3, 40);
+    MultiFrame m;
+    m.key = fmt::format("frame {}", f);
+    for (const auto& c : truth) {
+      m.views.push_back(
+          ProjectView(c, board, world_from_board, 0.12, rng, c.name + fmt::format("_{}", f)));
+    }
+    frames.push_back(m);
+  }
+  return frames;
+}
+
+// The largest baseline difference as a fraction of the baseline.
+double WorstBaselineFraction(const RigComparison& cmp) {
+  double worst = 0;
+  for (const auto& p : cmp.pairs) {
+    worst = std::max(worst, std::abs(p.baseline_diff_mm) / p.baseline_b_mm);
+  }
+  return worst;
+}
+
 TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   const uint64_t seed = fv::testing::TestSeed(61);
   FV_SEED_TRACE(seed);
   Rng rng(seed);
   const auto truth = ArcRig(4, 1.6, 100, 1280, 720, 60, rng);
-  MultiOptions o;
-  o.board = {BoardType::kChessboard, 9, 7, 0.07};
-  o.progress = false;
-  o.num_distortion = 4;
-  // The default: p1 p2 kept only where they pay (the truth has none).
-  std::vector<MultiFrame> frames;
-  for (int f = 0; f < 40; ++f) {
-    const Rigid3d world_from_board = RandomBoardPose(o.board, rng, 0.3, 40);
-    MultiFrame m;
-    m.key = fmt::format("frame {}", f);
-    for (const auto& c : truth) {
-      // 0.12 px per axis: what cornerSubPix measures on our rendered boards (the rendered stereo
-      // test below: 0.165 px RMS in 2D).
-      m.views.push_back(
-          ProjectView(c, o.board, world_from_board, 0.12, rng, c.name + fmt::format("_{}", f)));
-    }
-    frames.push_back(m);
-  }
+  const MultiOptions o = ProjectedOptions();  // p1 p2 kept only where they pay (the truth: none)
+  auto frames = ProjectedMoments(truth, o.board, 40, rng);
   // One broken view (a bad detection): corners scattered by 6 px.
   std::string broken;
   for (auto& m : frames) {
@@ -151,10 +172,7 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   ASSERT_EQ(r.cameras.size(), 4u);
   // Relative poses against the truth (frame-independent: first camera's frame vs world).
   const RigComparison cmp = CompareRigs(r.cameras, truth);
-  double worst_baseline = 0;
-  for (const auto& p : cmp.pairs) {
-    worst_baseline = std::max(worst_baseline, std::abs(p.baseline_diff_mm) / p.baseline_b_mm);
-  }
+  const double worst_baseline = WorstBaselineFraction(cmp);
   std::cout << fmt::format(
       "4-camera rig: relative rotations within {:.4f} deg, baselines within {:.4f} %, rms {:.3f} "
       "px\n",
@@ -230,21 +248,8 @@ TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
   auto truth = ArcRig(3, 1.6, 80, 1280, 720, 60, rng);
   truth[1].distortion[2] = 1.5e-3;  // p1, p2: a decentred lens (0.5-1.5 px at the edges)
   truth[1].distortion[3] = -1.0e-3;
-  MultiOptions o;
-  o.board = {BoardType::kChessboard, 9, 7, 0.07};
-  o.progress = false;
-  o.num_distortion = 4;
-  std::vector<MultiFrame> frames;
-  for (int f = 0; f < 30; ++f) {
-    const Rigid3d world_from_board = RandomBoardPose(o.board, rng, 0.3, 40);
-    MultiFrame m;
-    m.key = fmt::format("frame {}", f);
-    for (const auto& c : truth) {
-      m.views.push_back(
-          ProjectView(c, o.board, world_from_board, 0.12, rng, c.name + fmt::format("_{}", f)));
-    }
-    frames.push_back(m);
-  }
+  const MultiOptions o = ProjectedOptions();
+  const auto frames = ProjectedMoments(truth, o.board, 30, rng);
   const MultiResult r = CalibrateMultiFromFrames(Names(truth), frames, o);
   EXPECT_FALSE(r.camera_reports[0].tangential) << r.Summary();
   EXPECT_TRUE(r.camera_reports[1].tangential) << r.Summary();
@@ -253,10 +258,7 @@ TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
   EXPECT_EQ(r.cameras[0].distortion[2], 0.0);
   EXPECT_NE(r.Summary().find("p1 p2 kept"), std::string::npos) << r.Summary();
   const RigComparison cmp = CompareRigs(r.cameras, truth);
-  double worst_baseline = 0;
-  for (const auto& p : cmp.pairs) {
-    worst_baseline = std::max(worst_baseline, std::abs(p.baseline_diff_mm) / p.baseline_b_mm);
-  }
+  const double worst_baseline = WorstBaselineFraction(cmp);
   std::cout << fmt::format(
       "rig with one decentred lens: relative rotations within {:.4f} deg, baselines within {:.4f} "
       "%\n",
