@@ -421,8 +421,8 @@ SceneSpec FisheyePreset(uint64_t seed) {
   return s;
 }
 
-// Four corner cameras and a robot with a handler holding the ball, driving back and forth and
-// turning the handler (one placement per frame), a second robot near it.
+// Four corner cameras and a robot with a handler holding the ball, driving back and forth (the
+// handler towards a seeded heading), a second robot standing near it.
 SceneSpec HeldPreset(uint64_t seed) {
   SceneSpec s = StaticPreset(seed);
   s.ball.placements.clear();
