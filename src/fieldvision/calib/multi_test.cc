@@ -563,6 +563,9 @@ TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
       "by {:.2f} %\n",
       r.pairs[0].rotation_deg, baseline_mm, r.rms_px, ref_rot_deg, ref_baseline_mm, stereo_rms,
       rot_diff_deg, 100 * (baseline_mm - ref_baseline_mm) / ref_baseline_mm);
+  // The automatic choice keeps p1 p2 for both cameras; leave-one-moment-out over the 13 moments
+  // agrees: the held-out left board moved into the right camera through the rig is 0.415 px rms
+  // with p1 p2 (0.417 px with the automatic choice per fold), 0.428 px without.
   // OpenCV's stereo_calib sample on the same corners (its flags: one focal length, fx = fy, k1 k2
   // only, no p1 p2; intrinsics.yml here is its output).
   cv::Mat ks[2], ds[2], rot_s, t_s;
