@@ -50,6 +50,10 @@ TEST(Focal, EightKeypointsGiveTheFocalLengthWithAnHonestUncertainty) {
     EXPECT_EQ(r.num_inliers, 8);
     EXPECT_NEAR(r.camera.cx, 959.5, 1e-9);
   }
+  const auto f_within_2pct =
+      std::count_if(f_err.begin(), f_err.end(), [](double e) { return e <= 0.02; });
+  const auto c_within_10cm =
+      std::count_if(c_err.begin(), c_err.end(), [](double e) { return e <= 0.10; });
   std::sort(f_err.begin(), f_err.end());
   std::sort(c_err.begin(), c_err.end());
   std::sort(f_std.begin(), f_std.end());
@@ -58,7 +62,13 @@ TEST(Focal, EightKeypointsGiveTheFocalLengthWithAnHonestUncertainty) {
             << 100 * f_std[trials / 2] << " %; position error median " << 1000 * c_err[trials / 2]
             << " mm, max " << 1000 * c_err.back() << " mm; truth within 2 sigma: focal "
             << f_within_2sigma << "/" << trials << ", x " << c_within_2sigma << "/" << trials
-            << "\n";
+            << "; focal within 2 %: " << f_within_2pct << "/" << trials
+            << ", position within 10 cm: " << c_within_10cm << "/" << trials << "\n";
+  // Over seeds 81 and 1-6 (168 draws): focal within 0.9 % in every draw; position median 33-60
+  // mm, within 10 cm in 145 (18-23 of 24 per seed), the worst 11-17 cm: the focal length and the
+  // distance trade off along the line of sight (std about 0.3 %, 6 cm at 20 m, as reported).
+  EXPECT_EQ(f_within_2pct, trials);
+  EXPECT_GE(c_within_10cm, trials * 2 / 3);
   EXPECT_LT(f_err[trials / 2], 0.02);
   EXPECT_LT(c_err[trials / 2], 0.10);
   EXPECT_GE(f_within_2sigma, trials * 3 / 4);
