@@ -418,6 +418,7 @@ TEST(Multi, ChArUcoPartialViewsAndAWrongDictionary) {
   } catch (const Error& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("camera 'a'"), std::string::npos) << m;
+    std::cout << "a wrong dictionary: " << m << "\n";
     EXPECT_NE(m.find("give --dictionary DICT_4X4_50"), std::string::npos) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
   }
