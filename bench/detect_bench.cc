@@ -2,9 +2,11 @@
 // module is built, else a drawn field with a ball): colour classification + blobs with the
 // lookup table and scanlines (steps 1, 2, 4; exact and quantised tables), the full detector
 // (with sub-pixel refinement), and the same job done with OpenCV (cvtColor to HSV + inRange +
-// connectedComponentsWithStats on the full frame) as the baseline. Every benchmark reports
-// frames/s and `x_opencv`, its speed-up over the baseline measured in the same process, both
-// from the thread's CPU time (robust on a loaded machine). One thread (cv::setNumThreads(1)).
+// connectedComponentsWithStats on the full frame) as the baseline. The DNN path (--detector dnn
+// and both, detect/dnn_ball.h) also reports `x_colour`, its speed over the colour detector's. Every
+// benchmark reports frames/s and `x_opencv`, its speed-up over the baseline measured in the same
+// process, both from the thread's CPU time (robust on a loaded machine). One thread
+// (cv::setNumThreads(1)).
 #include <algorithm>
 #include <ctime>
 #include <vector>
@@ -16,7 +18,9 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/blobs.h"
 #include "fieldvision/detect/colour.h"
+#include "fieldvision/detect/dnn_ball.h"
 #include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/error.h"
 #if __has_include("fieldvision/synth/synth.h")
 #include "fieldvision/synth/synth.h"
 #define FV_BENCH_HAVE_SYNTH 1
@@ -166,6 +170,63 @@ BENCHMARK(BM_BallDetector)
     ->Args({2, 0})
     ->Args({4, 1})
     ->Unit(benchmark::kMicrosecond);
+
+// Seconds per frame of the colour detector (step 2, region stage on; median of 9 runs), once.
+double ColourSeconds() {
+  static const double seconds = [] {
+    const BenchFrame& f = TestFrame();
+    const fv::BallDetector det(fv::BallDetectorOptions(), &f.camera, nullptr);
+    std::vector<double> t;
+    for (int i = 0; i < 9; ++i) {
+      const double t0 = CpuSeconds();
+      benchmark::DoNotOptimize(det.Detect(f.bgr).size());
+      t.push_back(CpuSeconds() - t0);
+    }
+    std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+    return t[t.size() / 2];
+  }();
+  return seconds;
+}
+
+// The DNN path on the same frame (one thread). Args: mode (1 dnn, 2 both), whole_frame (both:
+// also the whole-frame search; dnn always searches the whole frame, at the frame's width).
+void BM_DnnBallDetector(benchmark::State& state) {
+  const BenchFrame& f = TestFrame();
+  BaselineSeconds();
+  fv::DnnBallOptions o;
+  o.detector = state.range(0) == 1 ? "dnn" : "both";
+  o.whole_frame = state.range(1) != 0;
+  std::unique_ptr<fv::AnyBallDetector> det;
+  try {
+    det = std::make_unique<fv::AnyBallDetector>(fv::BallDetectorOptions(), o, &f.camera, nullptr);
+  } catch (const fv::Error& e) {
+    state.SkipWithError(e.what());  // the model is made by `make build`
+    return;
+  }
+  const double colour_s = ColourSeconds();
+  int accepted = 0;
+  double total = 0;
+  for (auto _ : state) {
+    const double t0 = CpuSeconds();
+    const auto cands = det->Detect(f.bgr);
+    total += CpuSeconds() - t0;
+    accepted = static_cast<int>(
+        std::count_if(cands.begin(), cands.end(), [](const auto& c) { return c.accepted; }));
+  }
+  SetCounters(state, total);
+  const double per_frame = total / std::max<int64_t>(state.iterations(), 1);
+  state.counters["ms"] = 1e3 * per_frame;
+  state.counters["x_colour"] = colour_s / per_frame;
+  state.counters["colour_ms"] = 1e3 * colour_s;
+  state.counters["accepted"] = accepted;
+}
+BENCHMARK(BM_DnnBallDetector)
+    ->ArgNames({"mode", "whole"})
+    ->Args({1, 1})
+    ->Args({2, 1})
+    ->Args({2, 0})
+    ->Iterations(5)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

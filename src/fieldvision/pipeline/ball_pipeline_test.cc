@@ -364,6 +364,9 @@ TEST(BallPipeline, BadInputsAreOneLineErrors) {
   job.videos = {"a.avi", "b.avi"};
   job.ball_diameter_m = NAN;
   EXPECT_THROW(job.Check(), Error);
+  job.ball_diameter_m = 0.22;
+  job.dnn.detector = "yolo";
+  EXPECT_NE(testing::ErrorOf([&] { job.Check(); }).find("--detector"), std::string::npos);
 }
 
 }  // namespace
