@@ -10,7 +10,7 @@ namespace fv::app {
 namespace {
 
 void Setup(CLI::App& app, int& exit_code) {
-  auto o = std::make_shared<PlanRunOptions>();
+  auto o = std::make_shared<plan::PlanRunOptions>();
   auto good = std::make_shared<std::vector<double>>();
   CLI::App* cmd = app.add_subcommand(
       "plan",
@@ -75,7 +75,7 @@ void Setup(CLI::App& app, int& exit_code) {
       o->coverage.good_angle_max_deg = (*good)[1];
     }
     o->search.progress = o->coverage.progress;
-    const PlanRunResult r = RunPlan(*o);
+    const plan::PlanRunResult r = plan::RunPlan(*o);
     std::cout << r.summary;
     exit_code = 0;
   });

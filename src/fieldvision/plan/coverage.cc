@@ -12,7 +12,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
@@ -296,4 +296,4 @@ std::string CoverageResult::Summary() const {
   return s;
 }
 
-}  // namespace fv
+}  // namespace fv::plan

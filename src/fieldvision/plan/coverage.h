@@ -16,7 +16,7 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/field/field.h"
 
-namespace fv {
+namespace fv::plan {
 
 struct CoverageOptions {
   double grid_step_m = 0.1;        // grid cell size (cells are equal, centred in the area)
@@ -94,4 +94,4 @@ void CheckCoverageGrid(const FieldModel& field, const CoverageOptions& options);
 CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldModel& field,
                                 const CoverageOptions& options);
 
-}  // namespace fv
+}  // namespace fv::plan

@@ -9,7 +9,7 @@
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 const cv::Vec3b kNoData(70, 70, 70);
@@ -234,4 +234,4 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::plan

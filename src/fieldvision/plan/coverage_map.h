@@ -12,7 +12,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/plan/coverage.h"
 
-namespace fv {
+namespace fv::plan {
 
 enum class CoverageMapKind { kCount, kAngle, kError };
 
@@ -30,4 +30,4 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
                         const std::vector<Camera>& cameras, const FieldModel& field,
                         const CoverageOptions& coverage, const CoverageMapOptions& options = {});
 
-}  // namespace fv
+}  // namespace fv::plan

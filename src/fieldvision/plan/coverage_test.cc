@@ -7,12 +7,12 @@
 #include <Eigen/Dense>
 
 #include "fieldvision/field/field.h"
-#include "fieldvision/plan/rig.h"
+#include "fieldvision/plan/rig_json.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 // A camera looking straight down from `height_m` above the plane z = plane_z whose image covers
@@ -281,4 +281,4 @@ TEST(CoverageTest, OptionsCheckNamesTheField) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::plan

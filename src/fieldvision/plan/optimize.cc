@@ -12,7 +12,7 @@
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/random.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 using nlohmann::json;
@@ -288,4 +288,4 @@ std::string OptimizeResult::Summary() const {
   return s;
 }
 
-}  // namespace fv
+}  // namespace fv::plan

@@ -17,9 +17,9 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/plan/coverage.h"
-#include "fieldvision/plan/rig.h"
+#include "fieldvision/plan/rig_json.h"
 
-namespace fv {
+namespace fv::plan {
 
 // A mounting place: the segment a -> b (a point when a == b), heights in the z coordinates.
 struct MountPlace {
@@ -69,4 +69,4 @@ OptimizeResult OptimizeRig(const FieldModel& field, const std::vector<MountPlace
 double RigScore(const std::vector<Camera>& cameras, const FieldModel& field,
                 const CoverageOptions& coverage, double grid_step_m);
 
-}  // namespace fv
+}  // namespace fv::plan

@@ -7,7 +7,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 // The seed's reference rig: 4 cameras 1 m outside the corners of the 18 x 12 m field, 4 m high,
@@ -98,4 +98,4 @@ TEST(OptimizeTest, PointMountsAndBadOptions) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::plan

@@ -10,7 +10,7 @@
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 using nlohmann::json;
@@ -221,4 +221,4 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::plan

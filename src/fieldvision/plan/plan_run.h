@@ -14,9 +14,9 @@
 #include "fieldvision/plan/coverage.h"
 #include "fieldvision/plan/coverage_map.h"
 #include "fieldvision/plan/optimize.h"
-#include "fieldvision/plan/rig.h"
+#include "fieldvision/plan/rig_json.h"
 
-namespace fv {
+namespace fv::plan {
 
 struct PlanRunOptions {
   std::string rig_path;                   // a rig JSON file, or
@@ -57,4 +57,4 @@ PlanRunResult RunPlan(const PlanRunOptions& options);
 nlohmann::json CoverageJson(const PlanRunResult& result, const FieldModel& field,
                             const PlanRunOptions& options);
 
-}  // namespace fv
+}  // namespace fv::plan

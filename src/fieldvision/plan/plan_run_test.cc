@@ -9,7 +9,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 using nlohmann::json;
@@ -123,4 +123,4 @@ TEST(PlanRunTest, BadInputGivesOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::plan

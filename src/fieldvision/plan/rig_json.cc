@@ -1,4 +1,4 @@
-#include "fieldvision/plan/rig.h"
+#include "fieldvision/plan/rig_json.h"
 
 #include <cmath>
 #include <filesystem>
@@ -9,7 +9,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 using nlohmann::json;
@@ -266,4 +266,4 @@ Rig RigFromCameraFiles(const std::vector<std::string>& paths) {
   return rig;
 }
 
-}  // namespace fv
+}  // namespace fv::plan

@@ -18,7 +18,7 @@
 
 #include "fieldvision/camera/camera.h"
 
-namespace fv {
+namespace fv::plan {
 
 struct Rig {
   std::string name;
@@ -43,4 +43,4 @@ void WriteRigJson(const Rig& rig, const std::string& path);
 // A rig from camera YAML files (each must have a pose).
 Rig RigFromCameraFiles(const std::vector<std::string>& paths);
 
-}  // namespace fv
+}  // namespace fv::plan

@@ -1,4 +1,4 @@
-#include "fieldvision/plan/rig.h"
+#include "fieldvision/plan/rig_json.h"
 
 #include <cmath>
 #include <filesystem>
@@ -11,7 +11,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::plan {
 namespace {
 
 using nlohmann::json;
@@ -176,4 +176,4 @@ TEST(RigTest, BadInputGivesOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::plan
