@@ -10,6 +10,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 #include <utility>
@@ -24,6 +25,7 @@
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::net {
@@ -41,14 +43,6 @@ void FuseOptions::Check() const {
   sync.Check();
   flight_options.Check();
   triangulation.Check();
-}
-
-double Percentile(std::vector<double> v, double p) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const double rank = std::ceil(p / 100.0 * static_cast<double>(v.size()));
-  const size_t i = static_cast<size_t>(std::clamp(rank, 1.0, static_cast<double>(v.size()))) - 1;
-  return v[i];
 }
 
 std::string FuseSummary::ToString() const {
@@ -75,8 +69,8 @@ std::string FuseSummary::ToString() const {
   }
   if (!latency_s.empty()) {
     s += fmt::format("\nlatency capture -> fused: p50 {:.1f} ms, p95 {:.1f} ms ({} frames)",
-                     1e3 * Percentile(latency_s, 50), 1e3 * Percentile(latency_s, 95),
-                     latency_s.size());
+                     1e3 * NearestRankPercentile(latency_s, 0.5),
+                     1e3 * NearestRankPercentile(latency_s, 0.95), latency_s.size());
     // Each part: the slowest camera of the frame (p50 / p95 over frames).
     std::vector<double> queued, process, arrival, pairing;
     for (const LatencyParts& p : latency_parts) {
@@ -86,9 +80,9 @@ std::string FuseSummary::ToString() const {
       pairing.push_back(p.pairing_s);
     }
     const auto pp = [](const std::vector<double>& v) {
-      return v.empty()
-                 ? std::string("n/a")
-                 : fmt::format("{:.1f}/{:.1f}", 1e3 * Percentile(v, 50), 1e3 * Percentile(v, 95));
+      return v.empty() ? std::string("n/a")
+                       : fmt::format("{:.1f}/{:.1f}", 1e3 * NearestRankPercentile(v, 0.5),
+                                     1e3 * NearestRankPercentile(v, 0.95));
     };
     s += fmt::format(
         "\n  where it goes (ms, p50/p95, slowest camera of each frame): waiting in the nodes' "
@@ -197,135 +191,292 @@ double SteadyNow() {
 
 }  // namespace
 
-FuseSummary RunFuse(const FuseOptions& o) {
-  o.Check();
-  std::vector<Camera> cameras;
-  std::map<std::string, int> index;
+std::optional<std::pair<std::string, std::string>> SenderOf(const Message& m) {
+  if (const auto* ping = std::get_if<PingMessage>(&m)) return {{ping->camera, ping->session}};
+  if (const auto* f = std::get_if<FrameMessage>(&m)) return {{f->camera, f->session}};
+  if (const auto* k = std::get_if<SkipMessage>(&m)) return {{k->camera, k->session}};
+  if (const auto* h = std::get_if<HelloMessage>(&m)) return {{h->camera, h->session}};
+  if (const auto* b = std::get_if<ByeMessage>(&m)) return {{b->camera, b->session}};
+  return std::nullopt;  // a pong or a ball message
+}
+
+namespace {
+
+// Where each frame's latency goes (system clocks only): the node's queue and work times and the
+// message's arrival on this clock, kept per camera and frame until its group is decided.
+struct FrameTiming {
+  double queued_s = -1, process_s = -1, arrival_s = 0;
+};
+
+// The fusion server of RunFuse: its sockets, the synchronizer, fusion and outputs.
+class FuseServer {
+ public:
+  explicit FuseServer(const FuseOptions& o);
+  // Receives, pairs and fuses until stopped or idle; then flushes and closes the outputs.
+  FuseSummary Run();
+
+ private:
+  void Bind();
+  // One message from a node (`t1`: its arrival on the system clock, `arrival`: steady clock).
+  void Receive(zmq::message_t& identity, const zmq::message_t& payload, double t1, double arrival);
+  // One camera frame message of camera c.
+  void AddFrame(int c, const FrameMessage& f, double t1, double arrival);
+  void Emit(const SyncedFrame& group);
+  FuseSummary::LatencyParts LatencyPartsOf(const SyncedFrame& group, double latency_s);
+  void PublishFlights();
+  void ReportProgress(double now);
+
+  const FuseOptions& o_;
+  std::vector<Camera> cameras_;
+  std::map<std::string, int> index_;
+  int n_ = 0;
+  std::unique_ptr<FusionStage> fusion_;
+  std::unique_ptr<LiveSynchronizer> sync_;
+  FuseSummary summary_;
+  std::vector<std::string> names_;
+  std::vector<std::string> sessions_;
+  std::set<std::string> warned_unknown_;
+  std::string clock_kind_;  // "system" or "media", from the first frame
+  zmq::context_t ctx_{1};
+  zmq::socket_t router_;
+  zmq::socket_t pub_;
+  std::vector<std::map<long long, FrameTiming>> timings_;
+  std::unique_ptr<FlightWorker> flight_worker_;
+  CsvWriter* csv_ = nullptr;  // BALL.csv, while Run runs
+  double last_report_ = 0;
+};
+
+FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
   for (const std::string& path : o.cameras) {
-    cameras.push_back(ReadRigCamera(path));
-    FV_REQUIRE(index.emplace(cameras.back().name, static_cast<int>(cameras.size()) - 1).second,
+    cameras_.push_back(ReadRigCamera(path));
+    FV_REQUIRE(index_.emplace(cameras_.back().name, static_cast<int>(cameras_.size()) - 1).second,
                "fuse: two cameras are named '{}' (set `name` in the camera files)",
-               cameras.back().name);
+               cameras_.back().name);
   }
-  const int n = static_cast<int>(cameras.size());
+  n_ = static_cast<int>(cameras_.size());
   TriangulationOptions topt = o.triangulation;
   topt.ball_radius_m = 0.5 * o.ball_diameter_m;
-  FusionStage fusion(cameras, topt);
-  LiveSynchronizer sync(n, o.sync);
-
-  FuseSummary summary;
-  summary.cameras.resize(n);
-  std::vector<std::string> names;
-  for (int c = 0; c < n; ++c) {
-    summary.cameras[c].name = cameras[c].name;
-    names.push_back(cameras[c].name);
+  fusion_ = std::make_unique<FusionStage>(cameras_, topt);
+  sync_ = std::make_unique<LiveSynchronizer>(n_, o.sync);
+  summary_.cameras.resize(n_);
+  for (int c = 0; c < n_; ++c) {
+    summary_.cameras[c].name = cameras_[c].name;
+    names_.push_back(cameras_[c].name);
   }
-  std::vector<std::string> sessions(n);
-  std::set<std::string> warned_unknown;
-  std::string clock_kind;  // "system" or "media", from the first frame
+  sessions_.resize(n_);
+  timings_.resize(n_);
+}
 
-  zmq::context_t ctx(1);
-  zmq::socket_t router(ctx, zmq::socket_type::router);
-  router.set(zmq::sockopt::linger, 0);
-  router.set(zmq::sockopt::rcvhwm, 10000);
+void FuseServer::Bind() {
+  router_ = zmq::socket_t(ctx_, zmq::socket_type::router);
+  router_.set(zmq::sockopt::linger, 0);
+  router_.set(zmq::sockopt::rcvhwm, 10000);
   // Far larger messages are cut off by ZeroMQ (the peer is disconnected, then reconnects).
-  router.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(16 * kMaxMessageBytes));
+  router_.set(zmq::sockopt::maxmsgsize, static_cast<int64_t>(16 * kMaxMessageBytes));
   try {
-    router.bind(o.listen);
+    router_.bind(o_.listen);
   } catch (const zmq::error_t& e) {
-    Throw("fuse: cannot listen on '{}': {}", o.listen, e.what());
+    Throw("fuse: cannot listen on '{}': {}", o_.listen, e.what());
   }
-  if (o.on_listening) o.on_listening(router.get(zmq::sockopt::last_endpoint));
-  zmq::socket_t pub;
-  if (!o.publish.empty()) {
-    pub = zmq::socket_t(ctx, zmq::socket_type::pub);
-    pub.set(zmq::sockopt::linger, 0);
-    pub.set(zmq::sockopt::sndhwm, 1000);
-    try {
-      pub.bind(o.publish);
-    } catch (const zmq::error_t& e) {
-      Throw("fuse: cannot publish on '{}': {}", o.publish, e.what());
+  if (o_.on_listening) o_.on_listening(router_.get(zmq::sockopt::last_endpoint));
+  if (o_.publish.empty()) return;
+  pub_ = zmq::socket_t(ctx_, zmq::socket_type::pub);
+  pub_.set(zmq::sockopt::linger, 0);
+  pub_.set(zmq::sockopt::sndhwm, 1000);
+  try {
+    pub_.bind(o_.publish);
+  } catch (const zmq::error_t& e) {
+    Throw("fuse: cannot publish on '{}': {}", o_.publish, e.what());
+  }
+}
+
+FuseSummary::LatencyParts FuseServer::LatencyPartsOf(const SyncedFrame& group, double latency_s) {
+  FuseSummary::LatencyParts parts;
+  for (int c = 0; c < n_; ++c) {
+    if (!group.cameras[c]) continue;
+    auto& t = timings_[c];
+    const auto it = t.find(group.cameras[c]->frame);
+    if (it == t.end()) continue;
+    const FrameTiming& m = it->second;
+    parts.queued_s = std::max(parts.queued_s, m.queued_s);
+    parts.process_s = std::max(parts.process_s, m.process_s);
+    parts.arrival_s = std::max(parts.arrival_s, m.arrival_s - group.cameras[c]->time_s);
+    t.erase(t.begin(), std::next(it));
+  }
+  parts.pairing_s = latency_s - parts.arrival_s;
+  return parts;
+}
+
+void FuseServer::Emit(const SyncedFrame& group) {
+  const BallFrame f = fusion_->Fuse(group);
+  ++summary_.groups;
+  // Capture to decision, for every frame fused (with a position or not).
+  const double decided_s = SystemClockNow();
+  const double latency_s = clock_kind_ == "system" ? decided_s - group.time_s : 0.0;
+  if (clock_kind_ == "system") {
+    summary_.latency_s.push_back(latency_s);
+    summary_.latency_parts.push_back(LatencyPartsOf(group, latency_s));
+  }
+  if (!f.result.ok()) return;
+  const Eigen::Vector3d& p = f.result.point_world;
+  *csv_ << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
+        << f.result.rms_px;
+  csv_->EndRow();
+  ++summary_.rows_written;
+  const BallMessage b{f.frame,         f.time_s, p.x(), p.y(), p.z(), f.result.num_views(),
+                      f.result.rms_px, latency_s};
+  if (pub_) {
+    const std::string topic = "ball";
+    pub_.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+    if (pub_.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary_.published;
+  }
+  if (flight_worker_) {
+    BallSample sample;
+    sample.frame = f.frame;
+    sample.time_s = f.time_s;
+    sample.ball_in_world = p;
+    sample.n_cams = f.result.num_views();
+    sample.err_px = f.result.rms_px;
+    flight_worker_->Add(sample);
+  }
+}
+
+void FuseServer::PublishFlights() {
+  if (!flight_worker_) return;
+  for (Flight& flight : flight_worker_->Take()) {
+    const FlightMessage m = ToMessage(flight, static_cast<long long>(summary_.flights.size()));
+    summary_.flights.push_back(std::move(flight));
+    if (!pub_) continue;
+    const std::string topic = "flight";
+    pub_.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+    if (pub_.send(zmq::buffer(Encode(m)), zmq::send_flags::dontwait)) {
+      ++summary_.flights_published;
     }
   }
+}
 
-  // Where each frame's latency goes (system clocks only): per camera and frame, the node's
-  // queue and work times and the message's arrival on this clock, until its group is decided.
-  struct Timing {
-    double queued_s = -1, process_s = -1, arrival_s = 0;
-  };
-  std::vector<std::map<long long, Timing>> timings(n);
-  std::unique_ptr<FlightWorker> flight_worker;
-  if (o.flights) {
-    LiveFlightsOptions fopt = o.flight_options;
-    fopt.analysis.ball_radius_m = 0.5 * o.ball_diameter_m;
-    flight_worker = std::make_unique<FlightWorker>(fopt);
+void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload, double t1,
+                         double arrival) {
+  ++summary_.messages;
+  Message m;
+  try {
+    m = Decode(payload.data(), payload.size());
+  } catch (const MessageError& e) {
+    switch (e.reason()) {
+      case MessageError::Reason::kOversized:
+        ++summary_.oversized;
+        break;
+      case MessageError::Reason::kVersion:
+        ++summary_.wrong_version;
+        break;
+      case MessageError::Reason::kMalformed:
+        ++summary_.malformed;
+        break;
+    }
+    return;
+  }
+  // Every message but a pong or a ball names its camera and session.
+  const auto sender = SenderOf(m);
+  if (!sender) {
+    ++summary_.malformed;  // a pong or a ball message sent to us
+    return;
+  }
+  if (const auto* ping = std::get_if<PingMessage>(&m)) {
+    PongMessage pong{ping->t0_s, t1, 0};
+    pong.t2_s = SystemClockNow();
+    router_.send(identity, zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+    router_.send(zmq::buffer(Encode(pong)), zmq::send_flags::dontwait);
+  }
+  const auto& [camera, session] = *sender;
+  const auto it = index_.find(camera);
+  if (it == index_.end()) {
+    ++summary_.unknown_camera;
+    if (warned_unknown_.insert(camera).second && warned_unknown_.size() <= 10) {
+      std::cerr << fmt::format("fuse: warning: messages from unknown camera '{}' ignored\n",
+                               camera);
+    }
+    return;
+  }
+  const int c = it->second;
+  if (sessions_[c] != session) {
+    if (!sessions_[c].empty()) sync_->Restart(c);
+    sessions_[c] = session;
+    ++summary_.cameras[c].sessions;
+  }
+  if (std::holds_alternative<PingMessage>(m) || std::holds_alternative<HelloMessage>(m)) {
+    sync_->Admit(c, arrival);  // connected: its frames are waited for
+    return;
+  }
+  if (std::holds_alternative<ByeMessage>(m)) {
+    sync_->EndOfStream(c);
+    return;
+  }
+  if (const auto* k = std::get_if<SkipMessage>(&m)) {
+    if (k->clock != clock_kind_ && !clock_kind_.empty()) return;
+    if (k->clock == "system" && !k->has_offset) return;
+    sync_->SkipUntil(c, k->time_s + (k->clock == "system" ? k->offset_s : 0.0), arrival);
+    return;
+  }
+  AddFrame(c, std::get<FrameMessage>(m), t1, arrival);
+}
+
+void FuseServer::AddFrame(int c, const FrameMessage& f, double t1, double arrival) {
+  FuseCameraReport& r = summary_.cameras[c];
+  ++r.frames;
+  if (clock_kind_.empty()) clock_kind_ = f.clock;
+  if (f.clock != clock_kind_) {
+    ++summary_.clock_mismatch;
+    return;
+  }
+  CameraMessage cm;
+  cm.camera = c;
+  cm.frame = f.frame;
+  cm.time_s = f.time_s;
+  if (f.clock == "system") {
+    if (!f.has_offset) {
+      ++summary_.unsynced;
+      return;
+    }
+    cm.time_s += f.offset_s;
+    r.has_offset = true;
+    r.offset_s = f.offset_s;
+  }
+  cm.candidates = f.candidates;
+  if (f.clock == "system") {
+    auto& t = timings_[c];
+    if (t.size() >= 1000) t.erase(t.begin());  // frames that never make a group
+    t[cm.frame] = {f.queued_s, f.process_s, t1};
+  }
+  sync_->Add(std::move(cm), arrival);
+}
+
+void FuseServer::ReportProgress(double now) {
+  if (now - last_report_ <= 0.5) return;
+  last_report_ = now;
+  if (o_.control != nullptr)
+    o_.control->Report({"fuse", fusion_->stats().frames, -1, "frames", ""});
+  if (o_.progress) {
+    std::cerr << fmt::format("\rfuse: {} frames, {} positions", fusion_->stats().frames,
+                             summary_.rows_written)
+              << std::flush;
+  }
+}
+
+FuseSummary FuseServer::Run() {
+  Bind();
+  if (o_.flights) {
+    LiveFlightsOptions fopt = o_.flight_options;
+    fopt.analysis.ball_radius_m = 0.5 * o_.ball_diameter_m;
+    flight_worker_ = std::make_unique<FlightWorker>(fopt);
   }
   // Written beside --out and renamed at the end; a run that fails leaves no temporary file.
-  AtomicOutput out_file(o.out);
+  AtomicOutput out_file(o_.out);
   CsvWriter csv(out_file.temp_path(), BallCsvColumns(), 6);
-  auto emit = [&](const SyncedFrame& group) {
-    const BallFrame f = fusion.Fuse(group);
-    ++summary.groups;
-    // Capture to decision, for every frame fused (with a position or not).
-    const double decided_s = SystemClockNow();
-    const double latency_s = clock_kind == "system" ? decided_s - group.time_s : 0.0;
-    if (clock_kind == "system") {
-      summary.latency_s.push_back(latency_s);
-      FuseSummary::LatencyParts parts;
-      for (int c = 0; c < n; ++c) {
-        if (!group.cameras[c]) continue;
-        auto& t = timings[c];
-        const auto it = t.find(group.cameras[c]->frame);
-        if (it == t.end()) continue;
-        const Timing& m = it->second;
-        parts.queued_s = std::max(parts.queued_s, m.queued_s);
-        parts.process_s = std::max(parts.process_s, m.process_s);
-        parts.arrival_s = std::max(parts.arrival_s, m.arrival_s - group.cameras[c]->time_s);
-        t.erase(t.begin(), std::next(it));
-      }
-      parts.pairing_s = latency_s - parts.arrival_s;
-      summary.latency_parts.push_back(parts);
-    }
-    if (!f.result.ok()) return;
-    const Eigen::Vector3d& p = f.result.point_world;
-    csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
-        << f.result.rms_px;
-    csv.EndRow();
-    ++summary.rows_written;
-    const BallMessage b{f.frame,         f.time_s, p.x(), p.y(), p.z(), f.result.num_views(),
-                        f.result.rms_px, latency_s};
-    if (pub) {
-      const std::string topic = "ball";
-      pub.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
-      if (pub.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary.published;
-    }
-    if (flight_worker) {
-      BallSample sample;
-      sample.frame = f.frame;
-      sample.time_s = f.time_s;
-      sample.ball_in_world = p;
-      sample.n_cams = f.result.num_views();
-      sample.err_px = f.result.rms_px;
-      flight_worker->Add(sample);
-    }
-  };
-  auto publish_flights = [&] {
-    if (!flight_worker) return;
-    for (Flight& flight : flight_worker->Take()) {
-      const FlightMessage m = ToMessage(flight, static_cast<long long>(summary.flights.size()));
-      summary.flights.push_back(std::move(flight));
-      if (!pub) continue;
-      const std::string topic = "flight";
-      pub.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
-      if (pub.send(zmq::buffer(Encode(m)), zmq::send_flags::dontwait)) ++summary.flights_published;
-    }
-  };
-
+  csv_ = &csv;
   const auto start = std::chrono::steady_clock::now();
   double last_message = SteadyNow();
-  double last_report = 0;
-  std::vector<zmq::pollitem_t> items = {{router.handle(), 0, ZMQ_POLLIN, 0}};
-  while (!StopRequested(o.control)) {
+  std::vector<zmq::pollitem_t> items = {{router_.handle(), 0, ZMQ_POLLIN, 0}};
+  while (!StopRequested(o_.control)) {
     try {
       zmq::poll(items, std::chrono::milliseconds(2));
     } catch (const zmq::error_t& e) {
@@ -333,145 +484,51 @@ FuseSummary RunFuse(const FuseOptions& o) {
       continue;  // a signal (Ctrl-C, SIGTERM): StopRequested decides
     }
     zmq::message_t identity, payload;
-    while (router.recv(identity, zmq::recv_flags::dontwait)) {
+    while (router_.recv(identity, zmq::recv_flags::dontwait)) {
       const double t1 = SystemClockNow();
       const double arrival = SteadyNow();
       last_message = arrival;
-      if (!identity.more() || !router.recv(payload, zmq::recv_flags::dontwait)) {
-        ++summary.malformed;
+      if (!identity.more() || !router_.recv(payload, zmq::recv_flags::dontwait)) {
+        ++summary_.malformed;
         continue;
       }
       while (payload.more()) {  // extra parts: not our protocol
         zmq::message_t extra;
-        if (!router.recv(extra, zmq::recv_flags::dontwait)) break;
+        if (!router_.recv(extra, zmq::recv_flags::dontwait)) break;
         payload.rebuild(extra.data(), extra.size());
-        ++summary.malformed;
+        ++summary_.malformed;
       }
-      ++summary.messages;
-      Message m;
-      try {
-        m = Decode(payload.data(), payload.size());
-      } catch (const MessageError& e) {
-        switch (e.reason()) {
-          case MessageError::Reason::kOversized:
-            ++summary.oversized;
-            break;
-          case MessageError::Reason::kVersion:
-            ++summary.wrong_version;
-            break;
-          case MessageError::Reason::kMalformed:
-            ++summary.malformed;
-            break;
-        }
-        continue;
-      }
-      // Every message but a pong or a ball names its camera and session.
-      std::string camera, session;
-      if (const auto* ping = std::get_if<PingMessage>(&m)) {
-        PongMessage pong{ping->t0_s, t1, 0};
-        pong.t2_s = SystemClockNow();
-        router.send(identity, zmq::send_flags::sndmore | zmq::send_flags::dontwait);
-        router.send(zmq::buffer(Encode(pong)), zmq::send_flags::dontwait);
-        camera = ping->camera, session = ping->session;
-      } else if (const auto* f = std::get_if<FrameMessage>(&m)) {
-        camera = f->camera, session = f->session;
-      } else if (const auto* k = std::get_if<SkipMessage>(&m)) {
-        camera = k->camera, session = k->session;
-      } else if (const auto* h = std::get_if<HelloMessage>(&m)) {
-        camera = h->camera, session = h->session;
-      } else if (const auto* b = std::get_if<ByeMessage>(&m)) {
-        camera = b->camera, session = b->session;
-      } else {
-        ++summary.malformed;  // a pong or a ball message sent to us
-        continue;
-      }
-      const auto it = index.find(camera);
-      if (it == index.end()) {
-        ++summary.unknown_camera;
-        if (warned_unknown.insert(camera).second && warned_unknown.size() <= 10) {
-          std::cerr << fmt::format("fuse: warning: messages from unknown camera '{}' ignored\n",
-                                   camera);
-        }
-        continue;
-      }
-      const int c = it->second;
-      if (sessions[c] != session) {
-        if (!sessions[c].empty()) sync.Restart(c);
-        sessions[c] = session;
-        ++summary.cameras[c].sessions;
-      }
-      if (std::holds_alternative<PingMessage>(m) || std::holds_alternative<HelloMessage>(m)) {
-        sync.Admit(c, arrival);  // connected: its frames are waited for
-        continue;
-      }
-      if (std::holds_alternative<ByeMessage>(m)) {
-        sync.EndOfStream(c);
-        continue;
-      }
-      if (const auto* k = std::get_if<SkipMessage>(&m)) {
-        if (k->clock != clock_kind && !clock_kind.empty()) continue;
-        if (k->clock == "system" && !k->has_offset) continue;
-        sync.SkipUntil(c, k->time_s + (k->clock == "system" ? k->offset_s : 0.0), arrival);
-        continue;
-      }
-      const auto* f = std::get_if<FrameMessage>(&m);
-      FuseCameraReport& r = summary.cameras[c];
-      ++r.frames;
-      if (clock_kind.empty()) clock_kind = f->clock;
-      if (f->clock != clock_kind) {
-        ++summary.clock_mismatch;
-        continue;
-      }
-      CameraMessage cm;
-      cm.camera = c;
-      cm.frame = f->frame;
-      cm.time_s = f->time_s;
-      if (f->clock == "system") {
-        if (!f->has_offset) {
-          ++summary.unsynced;
-          continue;
-        }
-        cm.time_s += f->offset_s;
-        r.has_offset = true;
-        r.offset_s = f->offset_s;
-      }
-      cm.candidates = f->candidates;
-      if (f->clock == "system") {
-        auto& t = timings[c];
-        if (t.size() >= 1000) t.erase(t.begin());  // frames that never make a group
-        t[cm.frame] = {f->queued_s, f->process_s, t1};
-      }
-      sync.Add(std::move(cm), arrival);
+      Receive(identity, payload, t1, arrival);
     }
     const double now = SteadyNow();
-    while (auto group = sync.Next(now)) emit(*group);
-    publish_flights();
-    if (o.idle_exit_s > 0 && summary.messages > 0 && now - last_message > o.idle_exit_s) break;
-    if (now - last_report > 0.5) {
-      last_report = now;
-      if (o.control != nullptr) {
-        o.control->Report({"fuse", fusion.stats().frames, -1, "frames", ""});
-      }
-      if (o.progress) {
-        std::cerr << fmt::format("\rfuse: {} frames, {} positions", fusion.stats().frames,
-                                 summary.rows_written)
-                  << std::flush;
-      }
-    }
+    while (auto group = sync_->Next(now)) Emit(*group);
+    PublishFlights();
+    if (o_.idle_exit_s > 0 && summary_.messages > 0 && now - last_message > o_.idle_exit_s) break;
+    ReportProgress(now);
   }
-  if (o.progress) std::cerr << "\n";
-  while (auto group = sync.Next(SteadyNow(), /*flush=*/true)) emit(*group);
-  if (flight_worker) {
-    flight_worker->Finish();
-    publish_flights();
+  if (o_.progress) std::cerr << "\n";
+  while (auto group = sync_->Next(SteadyNow(), /*flush=*/true)) Emit(*group);
+  if (flight_worker_) {
+    flight_worker_->Finish();
+    PublishFlights();
   }
   csv.Close();
+  csv_ = nullptr;
   out_file.Commit();
-  summary.fusion = fusion.stats();
-  summary.sync = sync.stats();
-  summary.sync_problems = sync.Problems(names);
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return summary;
+  summary_.fusion = fusion_->stats();
+  summary_.sync = sync_->stats();
+  summary_.sync_problems = sync_->Problems(names_);
+  summary_.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::move(summary_);
+}
+
+}  // namespace
+
+FuseSummary RunFuse(const FuseOptions& o) {
+  o.Check();
+  FuseServer server(o);
+  return server.Run();
 }
 
 }  // namespace fv::net

@@ -1,18 +1,16 @@
-// The fusion node (`fieldvision fuse`): receives the camera nodes' detections on a ZeroMQ ROUTER
-// socket, answers their clock pings (clock_sync.h), places each frame on its own clock (the
-// node's capture time plus the node's offset estimate), pairs the cameras by capture time
-// (pipeline/live_sync.h), triangulates through the fusion stage (pipeline/fusion_stage.h), writes
-// BALL.csv as `ball` does and publishes each position on a PUB socket (messages.h), and each
-// flight once it has closed (pipeline/live_flights.h, in a worker thread off the positions' path).
-// Malformed, oversized and wrong-version messages, unknown cameras and frames without a clock
-// estimate are dropped and counted; a node that restarts (a new session) is re-admitted; nodes
-// reconnect by themselves when the fusion node restarts.
+// The fusion node (`fieldvision fuse`): receives camera nodes' detections (messages.h) on a ZeroMQ
+// ROUTER socket, answers clock pings (clock_sync.h), pairs frames by capture time
+// (pipeline/live_sync.h), triangulates them (pipeline/fusion_stage.h), writes BALL.csv and
+// publishes positions and closed flights; bad messages and unknown cameras are counted and dropped.
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "fieldvision/net/messages.h"
 #include "fieldvision/pipeline/fusion_stage.h"
 #include "fieldvision/pipeline/job.h"
 #include "fieldvision/pipeline/live_flights.h"
@@ -78,7 +76,8 @@ struct FuseSummary {
 
 FuseSummary RunFuse(const FuseOptions& options);
 
-// The p-th percentile (0..100) of `values` (nearest rank); NaN when empty.
-double Percentile(std::vector<double> values, double p);
+// The camera and session a node's message names; nullopt for a pong or a ball message (sent by
+// fuse, never to it).
+std::optional<std::pair<std::string, std::string>> SenderOf(const Message& m);
 
 }  // namespace fv::net

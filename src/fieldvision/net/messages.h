@@ -1,9 +1,6 @@
 // The messages between camera nodes and the fusion node, and the fusion node's published ball
-// positions: JSON objects, one per ZeroMQ message, each with the schema version "v" and a
-// "type". JSON rather than protobuf: the messages are small (a few candidates), nlohmann/json is
-// already a dependency (no code generation step), every language reads them without a schema
-// file (the README's Python client is a dozen lines), and the offline CameraMessage is JSON too;
-// our detections are not ssl-vision's frames, so its clients gain nothing from its protobuf.
+// positions and flights: JSON objects, one per ZeroMQ message, with the schema version "v" and a
+// "type".
 //
 // node -> fuse (DEALER -> ROUTER):
 //   {"v":1,"type":"hello","camera":"cam1","session":"5f..","width":1280,"height":960,"fps":60,

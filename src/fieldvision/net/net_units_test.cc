@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/net/clock_sync.h"
+#include "fieldvision/net/fuse.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -143,6 +144,19 @@ TEST(ClockSync, ShortestRoundTripGivesTheOffset) {
   ASSERT_TRUE(e);
   EXPECT_NEAR(e->offset_s, true_offset, 1e-4);
   EXPECT_NEAR(e->round_trip_s, 2e-4, 1e-9);
+}
+
+TEST(FuseStages, SenderOfNamesCameraAndSessionOfNodeMessages) {
+  FrameMessage f;
+  f.camera = "left";
+  f.session = "s1";
+  EXPECT_EQ(SenderOf(f), (std::pair<std::string, std::string>{"left", "s1"}));
+  ByeMessage b;
+  b.camera = "right";
+  b.session = "s2";
+  EXPECT_EQ(SenderOf(b), (std::pair<std::string, std::string>{"right", "s2"}));
+  EXPECT_FALSE(SenderOf(PongMessage{}).has_value());
+  EXPECT_FALSE(SenderOf(BallMessage{}).has_value());
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::net {
@@ -197,6 +198,55 @@ class NodeLink {
   std::atomic<double> offset_s_{0};
 };
 
+// A blank grass-coloured frame with discs of the preset ball colours, so that candidates go
+// through every stage of the detector; JPEG-encoded for an encoded source.
+SourceFrame WarmUpFrame(cv::Size size, bool encoded) {
+  SourceFrame blank;
+  blank.bgr = cv::Mat(size, CV_8UC3, cv::Scalar(90, 120, 90));
+  const cv::Scalar colours[] = {{0, 110, 255}, {0, 230, 255}, {255, 255, 255}, {180, 105, 255},
+                                {0, 0, 230},   {230, 60, 0},  {0, 200, 0},     {10, 10, 10}};
+  const int r = std::max(4, std::min(size.width, size.height) / 30);
+  for (int i = 0; i < 8; ++i) {
+    const cv::Point centre((2 * i + 1) * size.width / 16, size.height / 2);
+    cv::circle(blank.bgr, centre, r, colours[i], cv::FILLED, cv::LINE_AA);
+  }
+  if (encoded) {
+    cv::imencode(".jpg", blank.bgr, blank.jpeg);
+    blank.bgr = cv::Mat();
+  }
+  return blank;
+}
+
+// Waits for the first clock reply (at most connect_wait_s) so that the first frames can be
+// placed in time.
+void WaitForClock(const NodeLink& link, const NodeOptions& o) {
+  const auto wait_until =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(o.connect_wait_s);
+  while (!link.has_offset() && std::chrono::steady_clock::now() < wait_until &&
+         !StopRequested(o.control)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+// The median, 95th percentile and largest work time per frame.
+void SetProcessTimes(const std::vector<double>& process_s, NodeSummary& summary) {
+  if (process_s.empty()) return;
+  summary.process_p50_s = NearestRankPercentile(process_s, 0.5);
+  summary.process_p95_s = NearestRankPercentile(process_s, 0.95);
+  summary.process_max_s = *std::max_element(process_s.begin(), process_s.end());
+}
+
+// The link's counts and clock after it finished.
+void AddLinkSummary(const NodeLink& link, NodeSummary& summary) {
+  summary.send_dropped += link.send_dropped;
+  summary.sent -= link.send_dropped;
+  summary.bad_replies = link.bad_replies;
+  summary.has_offset = link.has_offset();
+  summary.offset_s = link.offset_s();
+  summary.round_trip_s = link.round_trip_s;
+  summary.clock_samples = link.samples;
+}
+
 }  // namespace
 
 NodeSummary RunNode(const NodeOptions& o) {
@@ -223,21 +273,7 @@ NodeSummary RunNode(const NodeOptions& o) {
     // The first detection pays for lazy set-up (OpenCV, the decoder, page faults: ~1 s on a
     // loaded machine); pay it on a blank frame before the stream starts, not on its first frames.
     CameraStage warm(0, camera, BallDetectFnFor(detector), o.track, "warm-up frame");
-    SourceFrame blank;
-    blank.bgr = cv::Mat(size, CV_8UC3, cv::Scalar(90, 120, 90));
-    // Discs of the preset colours, so that candidates go through every stage of the detector.
-    const cv::Scalar colours[] = {{0, 110, 255}, {0, 230, 255}, {255, 255, 255}, {180, 105, 255},
-                                  {0, 0, 230},   {230, 60, 0},  {0, 200, 0},     {10, 10, 10}};
-    const int r = std::max(4, std::min(size.width, size.height) / 30);
-    for (int i = 0; i < 8; ++i) {
-      const cv::Point centre((2 * i + 1) * size.width / 16, size.height / 2);
-      cv::circle(blank.bgr, centre, r, colours[i], cv::FILLED, cv::LINE_AA);
-    }
-    if (source->encoded()) {
-      cv::imencode(".jpg", blank.bgr, blank.jpeg);
-      blank.bgr = cv::Mat();
-    }
-    warm.Process(blank);
+    warm.Process(WarmUpFrame(size, source->encoded()));
   }
 
   NodeSummary summary;
@@ -247,13 +283,7 @@ NodeSummary RunNode(const NodeOptions& o) {
   const std::string session = NewSession();
   {
     NodeLink link(ctx, o, camera.name, session);
-    // Wait for the first clock reply so that the first frames can be placed in time.
-    const auto wait_until =
-        std::chrono::steady_clock::now() + std::chrono::duration<double>(o.connect_wait_s);
-    while (!link.has_offset() && std::chrono::steady_clock::now() < wait_until &&
-           !StopRequested(o.control)) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    WaitForClock(link, o);
     const bool system_clock = source->live();
     Progress progress("node " + camera.name, o.max_frames > 0 ? o.max_frames : source->FrameCount(),
                       "frames", o.progress);
@@ -306,24 +336,10 @@ NodeSummary RunNode(const NodeOptions& o) {
       }
     }
     progress.Finish();
-    if (!process_s.empty()) {
-      std::sort(process_s.begin(), process_s.end());
-      const auto at = [&](double q) {
-        return process_s[std::min(process_s.size() - 1, static_cast<size_t>(q * process_s.size()))];
-      };
-      summary.process_p50_s = at(0.5);
-      summary.process_p95_s = at(0.95);
-      summary.process_max_s = process_s.back();
-    }
+    SetProcessTimes(process_s, summary);
     link.frames_for_bye = summary.frames;
     link.Finish();
-    summary.send_dropped += link.send_dropped;
-    summary.sent -= link.send_dropped;
-    summary.bad_replies = link.bad_replies;
-    summary.has_offset = link.has_offset();
-    summary.offset_s = link.offset_s();
-    summary.round_trip_s = link.round_trip_s;
-    summary.clock_samples = link.samples;
+    AddLinkSummary(link, summary);
   }
   summary.source_dropped = source->dropped();
   summary.stage = stage.stats();
