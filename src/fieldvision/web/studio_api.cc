@@ -374,8 +374,9 @@ void Saved(EventHub* events, const Workspace& ws, const fs::path& path, const st
   if (events) events->Publish("saved", {{"path", ws.Relative(path)}, {"what", what}});
 }
 
-const std::vector<Route>& Routes() {
-  static const std::vector<Route> routes = {
+// Endpoints of the working folder: files, fields, videos, frames, cameras.
+std::vector<Route> FolderRoutes() {
+  return {
       {{"GET", "/api/endpoints", "this list"},
        [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          json j = json::array();
@@ -420,6 +421,12 @@ const std::vector<Route>& Routes() {
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          return Json(CameraToJson(ReadCameraYaml(ws.Resolve(Param(r, "path")).string())));
        }},
+  };
+}
+
+// Endpoints of calibration by hand: projection, pose, saving, line refinement.
+std::vector<Route> CalibrationRoutes() {
+  return {
       {{"POST", "/api/calibrate/project",
         "{camera, field}: the field's lines and keypoints in the camera's image"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
@@ -518,6 +525,12 @@ const std::vector<Route>& Routes() {
          }
          return Json(j);
        }},
+  };
+}
+
+// Endpoints of intrinsics from boards and the live feed.
+std::vector<Route> IntrinsicsAndLiveRoutes() {
+  return {
       {{"POST", "/api/calibrate/intrinsics",
         "{images: FOLDER|GLOB|IMAGE|VIDEO, board: {type, cols, rows, square_m[, marker_m, "
         "dictionary]}[, num_distortion, fix_aspect_ratio, zero_tangent, name, out]}: intrinsics "
@@ -574,6 +587,12 @@ const std::vector<Route>& Routes() {
          if (!live) throw HttpError(404, "this server has no live feed");
          return Json(live->Status());
        }},
+  };
+}
+
+// Endpoints of ball colour: learning, saving, detection on a frame.
+std::vector<Route> ColourRoutes() {
+  return {
       {{"POST", "/api/colour/learn",
         "{video, frame, points: [[u, v]], roi: [x, y, w, h], negative_points}: HSV box"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
@@ -646,6 +665,12 @@ const std::vector<Route>& Routes() {
          }
          return Json({{"frames", out}});
        }},
+  };
+}
+
+// Endpoints of ball and player tracks, player statistics, zones.
+std::vector<Route> TrackRoutes() {
+  return {
       {{"GET", "/api/ball", "?path=BALL.csv: the ball track (time, position, cameras, error)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const BallTrackFile track = ReadBallTrack(ws.Resolve(Param(r, "path")).string());
@@ -755,6 +780,12 @@ const std::vector<Route>& Routes() {
          Saved(events, ws, out, "zones");
          return Json({{"wrote", {ws.Relative(out)}}, {"zones", zones.size()}});
        }},
+  };
+}
+
+// Endpoints of jobs and JSON files.
+std::vector<Route> JobRoutes() {
+  return {
       {{"GET", "/api/jobs", "the jobs, newest first (state, progress line, output)"},
        [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          if (!jobs) throw HttpError(404, "this server runs no jobs");
@@ -788,6 +819,17 @@ const std::vector<Route>& Routes() {
          }
        }},
   };
+}
+
+const std::vector<Route>& Routes() {
+  static const std::vector<Route> routes = [] {
+    std::vector<Route> all;
+    for (auto group : {FolderRoutes, CalibrationRoutes, IntrinsicsAndLiveRoutes, ColourRoutes,
+                       TrackRoutes, JobRoutes}) {
+      for (Route& r : group()) all.push_back(std::move(r));
+    }
+    return all;
+  }();
   return routes;
 }
 
