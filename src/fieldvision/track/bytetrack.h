@@ -1,17 +1,8 @@
-// Multi-object tracking by detection, ByteTrack-style (Zhang et al., "ByteTrack: Multi-Object
-// Tracking by Associating Every Detection Box", ECCV 2022): a constant-velocity Kalman filter per
-// track on (centre x, centre y, aspect, height) (cv::KalmanFilter, as in SORT), a first
-// association of high-score detections with tracked and lost tracks, a second association of the
-// low-score detections with the tracks left, both solved with the Hungarian method
-// (hungarian.h). With a calibrated camera the cost mixes box IoU with the distance on the field
-// plane between the predicted and the detected foot points (gated in metres); with frames, the
-// associations of high-score detections also weigh the torso-colour distance between the track's
-// running histogram and the detection's (appearance_weight, as DeepSORT/BoT-SORT do with
-// embeddings; people walking side by side keep their ids). Lost tracks are kept
-// for max_lost_frames and re-found by appearance (an HSV histogram of the torso, Bhattacharyya
-// distance) within a reach that grows with the time lost. Optionally an OpenCV single-target
-// tracker (CSRT, KCF, MOSSE) carries a track through frames where the detector misses it. The
-// association is hand-written because OpenCV has no multi-object association.
+// Multi-object tracking by detection, ByteTrack (Zhang et al., ECCV 2022): a constant-velocity
+// Kalman filter per box, high-score then low-score detections matched by the Hungarian method on
+// IoU, with a calibrated camera also the foot points' distance on the field, and torso-colour
+// appearance (as DeepSORT) for matching and re-finding lost tracks; optional OpenCV single-target
+// trackers (CSRT, KCF, MOSSE) through missed detections.
 #pragma once
 
 #include <memory>
