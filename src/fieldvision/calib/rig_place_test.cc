@@ -26,6 +26,52 @@ double SquaredErrorPx2(const std::vector<Camera>& cams,
   return sq;
 }
 
+// The Cramer-Rao bound of a placement from clicks of `sigma_px` noise: the covariance of the 6
+// parameters of a rigid move of the world, sigma^2 (J^T J)^-1 with J the clicks' Jacobian,
+// carried to the points of the playing area (1 m grid, heights 0 and 1 m); the median of their
+// standard deviations (the bound on FieldPositionErrorM's spread).
+double FieldErrorBoundM(const std::vector<Camera>& truth,
+                        const std::vector<std::vector<PointCorrespondence>>& pts,
+                        const FieldModel& field, double sigma_px) {
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  auto moved = [](const Vec6& d) { return Rigid3d::FromRvecTvec(d.head<3>(), d.tail<3>()); };
+  auto step = [](int k, double h) {
+    Vec6 d = Vec6::Zero();
+    d[k] = h;
+    return d;
+  };
+  Eigen::Matrix<double, 6, 6> info = Eigen::Matrix<double, 6, 6>::Zero();
+  for (size_t c = 0; c < truth.size(); ++c) {
+    for (const auto& p : pts[c]) {
+      Eigen::Matrix<double, 2, 6> j;
+      for (int k = 0; k < 6; ++k) {
+        Camera ca = truth[c], cb = truth[c];
+        ca.cam_from_world = truth[c].cam_from_world * moved(step(k, 1e-6));
+        cb.cam_from_world = truth[c].cam_from_world * moved(step(k, -1e-6));
+        j.col(k) = (*ca.Project(p.p_world) - *cb.Project(p.p_world)) / 2e-6;
+      }
+      info += j.transpose() * j;
+    }
+  }
+  const Eigen::Matrix<double, 6, 6> cov = sigma_px * sigma_px * info.inverse();
+  std::vector<double> std_m;
+  for (double x = -0.5 * field.length_m; x <= 0.5 * field.length_m + 1e-9; x += 1.0) {
+    for (double y = -0.5 * field.width_m; y <= 0.5 * field.width_m + 1e-9; y += 1.0) {
+      for (double z : {0.0, 1.0}) {
+        const Eigen::Vector3d q(x, y, z);
+        Eigen::Matrix<double, 3, 6> jq;
+        for (int k = 0; k < 6; ++k) {
+          jq.col(k) =
+              (moved(step(k, 1e-6)).Inverse() * q - moved(step(k, -1e-6)).Inverse() * q) / 2e-6;
+        }
+        std_m.push_back(std::sqrt((jq * cov * jq.transpose()).trace()));
+      }
+    }
+  }
+  std::sort(std_m.begin(), std_m.end());
+  return std_m[std_m.size() / 2];
+}
+
 // The demo rig (4 cameras at the corners of the RoboCup field, 1280x960) placed from 6 keypoint
 // clicks with 1 px noise, all in one camera or 2 in each of three cameras.
 TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
@@ -37,6 +83,7 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
   ASSERT_EQ(truth.size(), 4u);
   const auto rig = InRigFrame(truth);
   std::vector<double> one_cam, spread, field_one, field_spread, field_max_one, field_max_spread;
+  std::vector<double> bound_one;
   double field_max = 0;
   for (int trial = 0; trial < 20; ++trial) {
     std::vector<std::vector<PointCorrespondence>> pts(4);
@@ -48,6 +95,7 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
     EXPECT_LE(SquaredErrorPx2(a.cameras, pts), SquaredErrorPx2(truth, pts) * (1 + 1e-6));
     one_cam.push_back(WorstCentreErrorM(a.cameras, truth));
     field_one.push_back(test_util::FieldPositionErrorM(a.cameras, truth, field, &field_max));
+    bound_one.push_back(FieldErrorBoundM(truth, pts, field, 1.0));
     field_max_one.push_back(field_max);
 
     std::vector<std::vector<PointCorrespondence>> spread_pts(4);
@@ -60,8 +108,8 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
     field_spread.push_back(test_util::FieldPositionErrorM(b.cameras, truth, field, &field_max));
     field_max_spread.push_back(field_max);
   }
-  for (auto* v :
-       {&one_cam, &spread, &field_one, &field_spread, &field_max_one, &field_max_spread}) {
+  for (auto* v : {&one_cam, &spread, &field_one, &field_spread, &field_max_one, &field_max_spread,
+                  &bound_one}) {
     std::sort(v->begin(), v->end());
   }
   std::cout << "points of the field (1 m grid, heights 0 and 1 m) as the placed rig puts them, "
@@ -70,7 +118,8 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
             << " mm, max " << 1000 * field_max_one.back()
             << " mm); 2 clicks in each of 3 cameras: median " << 1000 * field_spread[10]
             << " mm (worst point: median " << 1000 * field_max_spread[10] << " mm, max "
-            << 1000 * field_max_spread.back() << " mm)\n";
+            << 1000 * field_max_spread.back() << " mm); the Cramer-Rao bound of 6 clicks in one "
+            << "camera: median point std " << 1000 * bound_one[10] << " mm\n";
   std::cout << "worst camera centre error over 20 placements: 6 clicks in one camera: median "
             << 1000 * one_cam[10] << " mm, max " << 1000 * one_cam.back()
             << " mm; 2 clicks in each of 3 cameras: median " << 1000 * spread[10] << " mm, max "
@@ -78,9 +127,12 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
   // 1 px is about 2 cm on the ground at 20 m: six clicks place the rig within a few cm (the
   // optimum: checked above against the truth's own fit), not 1 cm.
   // The field itself (where the rig puts the ball) is placed better than the camera centres, but
-  // still not within 1 cm from 6 clicks of 1 px (median 18 mm, 27 mm with the clicks spread over
-  // three cameras); the painted lines bring it to about a millimetre (rig_lines_test).
+  // not within 1 cm from 6 clicks of 1 px (median 18-21 mm over seeds 1-6, 27 mm with the clicks
+  // spread over three cameras): no estimate can, the Cramer-Rao bound of these clicks is 20 mm
+  // (median point std). The painted lines bring it to about a millimetre (rig_lines_test).
   EXPECT_LT(field_one[10], 0.035);
+  // An efficient estimate: the field error is the bound's (a median distance vs a 3D std).
+  EXPECT_LT(field_one[10], 1.5 * bound_one[10]);
   EXPECT_LT(field_spread[10], 0.06);
   EXPECT_LT(one_cam[10], 0.06);
   EXPECT_LT(one_cam.back(), 0.15);
