@@ -30,6 +30,9 @@ inline void AddDetectorOptions(CLI::App* cmd, DnnBallOptions& o) {
                   "With both: a network ball where colour found nothing is accepted from this "
                   "score (1: never)")
       ->capture_default_str();
+  cmd->add_flag("!--dnn-crops-only", o.whole_frame,
+                "With both: check colour candidates in crops only, no whole-frame search (about "
+                "12x faster; nothing completes colour)");
   cmd->add_flag("!--dnn-keep", o.demote_unconfirmed,
                 "With both: keep colour-accepted candidates the network does not confirm "
                 "(default: rejected)");
