@@ -4,7 +4,8 @@
 // view (IPPE PnP), relative poses of camera pairs from their shared views (the candidate that
 // best transfers the board between the two, in pixels), chained from the first camera through a
 // maximum spanning tree of shared-view counts, then one Ceres bundle adjustment of every camera's
-// intrinsics and pose and every board pose (Huber loss), outlier views dropped and named. The
+// intrinsics and pose and every board pose (Huber loss), outlier views dropped and named, p1 p2
+// kept per camera only where they pay (forward selection by BIC, Schwarz 1978). The
 // method of multi-camera toolboxes such as MC-Calib (Rameau et al., "MC-Calib: a generic and
 // robust calibration toolbox for multi-camera systems", CVIU 2022) and anipose.
 #pragma once
