@@ -11,6 +11,12 @@ namespace fv {
 namespace {
 
 cv::Mat ReadMatrix(const cv::FileNode& node, const std::string& path, const char* key) {
+  // OpenCV allocates rows x cols before reading the data: a camera's matrices are small.
+  FV_REQUIRE(node.isMap() && node["rows"].isInt() && node["cols"].isInt(),
+             "camera file '{}': key '{}' is not a matrix (rows, cols, dt, data)", path, key);
+  const int rows = static_cast<int>(node["rows"]), cols = static_cast<int>(node["cols"]);
+  FV_REQUIRE(rows >= 1 && cols >= 1 && rows <= 16 && cols <= 16,
+             "camera file '{}': key '{}' has {}x{} values (at most 16x16)", path, key, rows, cols);
   cv::Mat m;
   try {
     node >> m;

@@ -216,7 +216,16 @@ INSTANTIATE_TEST_SUITE_P(
         BadFile{"zero width", "%YAML:1.0\n---\nimage_width: 0\nimage_height: 480\n" FV_K FV_D,
                 "image_width"},
         BadFile{"not yaml", "this is { not yaml", "bad.yaml"}, BadFile{"empty", "", "bad.yaml"},
-        // Found by fuzz/camera_yaml_fuzz: OpenCV asserted (cv::Exception) on a top-level list.
+        // Found by fuzz/camera_yaml_fuzz: OpenCV asserted (cv::Exception) on a top-level list,
+        // and allocated rows x cols (80 GB) before reading a matrix's data.
+        BadFile{"matrix rows not a number",
+                FV_HDR FV_K "distortion_coefficients: !!opencv-matrix\n  rows: q\n  cols: 5\n  "
+                            "dt: d\n  data: [0, 0, 0, 0, 0]\n",
+                "distortion_coefficients"},
+        BadFile{"huge matrix",
+                FV_HDR FV_K "distortion_coefficients: !!opencv-matrix\n  rows: 100000\n  cols: "
+                            "100000\n  dt: d\n  data: [0, 0, 0, 0, 0]\n",
+                "distortion_coefficients"},
         BadFile{"top level list", "%YAML:1.0\n- 1\n- 2\n", "bad.yaml"},
         BadFile{"2e9 wide",
                 "%YAML:1.0\n---\nimage_width: 2000000000\nimage_height: 480\n" FV_K FV_D,
