@@ -116,6 +116,24 @@ std::string Encode(const Message& message) {
 
 namespace {
 
+// The camera, session, frame and time of a frame or skip message, in that order.
+template <typename M>
+void ReadFrameStamp(const json& j, M& m) {
+  m.camera = Str(j, "camera");
+  m.session = Str(j, "session");
+  m.frame = Int(j, "frame");
+  FV_REQUIRE(m.frame >= 0, "message: 'frame' must be >= 0");
+  m.time_s = Num(j, "time_s");
+}
+
+// The optional clock offset of a frame or skip message.
+template <typename M>
+void ReadOffset(const json& j, M& m) {
+  if (!j.contains("offset_s")) return;
+  m.offset_s = Num(j, "offset_s");
+  m.has_offset = true;
+}
+
 Message DecodeChecked(const void* data, size_t size) {
   const char* p = static_cast<const char*>(data);
   json j = json::parse(p, p + size, nullptr, /*allow_exceptions=*/false);
@@ -130,17 +148,10 @@ Message DecodeChecked(const void* data, size_t size) {
   const std::string type = Str(j, "type");
   if (type == "frame") {
     FrameMessage m;
-    m.camera = Str(j, "camera");
-    m.session = Str(j, "session");
-    m.frame = Int(j, "frame");
-    FV_REQUIRE(m.frame >= 0, "message: 'frame' must be >= 0");
-    m.time_s = Num(j, "time_s");
+    ReadFrameStamp(j, m);
     m.origin = Str(j, "origin");
     m.clock = Clock(j);
-    if (j.contains("offset_s")) {
-      m.offset_s = Num(j, "offset_s");
-      m.has_offset = true;
-    }
+    ReadOffset(j, m);
     for (auto [key, value] : {std::pair{"queued_s", &m.queued_s}, {"process_s", &m.process_s}}) {
       if (!j.contains(key)) continue;
       *value = Num(j, key);
@@ -153,18 +164,11 @@ Message DecodeChecked(const void* data, size_t size) {
   }
   if (type == "skip") {
     SkipMessage m;
-    m.camera = Str(j, "camera");
-    m.session = Str(j, "session");
-    m.frame = Int(j, "frame");
-    FV_REQUIRE(m.frame >= 0, "message: 'frame' must be >= 0");
-    m.time_s = Num(j, "time_s");
+    ReadFrameStamp(j, m);
     m.clock = Clock(j);
     m.skipped = Int(j, "skipped");
     FV_REQUIRE(m.skipped >= 0, "message: 'skipped' must be >= 0");
-    if (j.contains("offset_s")) {
-      m.offset_s = Num(j, "offset_s");
-      m.has_offset = true;
-    }
+    ReadOffset(j, m);
     return m;
   }
   if (type == "ping") {
