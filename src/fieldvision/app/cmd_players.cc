@@ -155,6 +155,13 @@ void Setup(CLI::App& app, int& exit_code) {
                                     {c->o.detections_out, "--save-detections"}}) {
       CheckOutputPath(out, PathList(inputs, c->out), what);
     }
+    // A device, a folder or a missing folder as an output is refused before the run.
+    for (const auto& [out, what] : {std::pair{c->out, "--out"},
+                                    {c->mot_out, "--mot-out"},
+                                    {c->draw, "--draw"},
+                                    {c->o.detections_out, "--save-detections"}}) {
+      if (!out.empty()) ResolveOutputPath(out, what);
+    }
     RunPlayersCommand(*c);
   });
 }

@@ -10,6 +10,7 @@
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::app {
 namespace {
@@ -76,7 +77,13 @@ void Setup(CLI::App& app, int& exit_code) {
                              "index.html", "radar.png", "radar.mp4", "heatmap_all.png"}) {
       CheckOutputPath(c->out + "/" + name, inputs);
     }
-    RunStats(*c);
+    try {
+      RunStats(*c);
+    } catch (const Error& e) {
+      // The statistics' checks of the rows say "the tracks ...": name the file.
+      if (!StartsWith(e.what(), "the tracks")) throw;
+      Throw("{}: {}", c->tracks, e.what());
+    }
   });
 }
 
