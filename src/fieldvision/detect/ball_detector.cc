@@ -455,6 +455,11 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
                                                 (region.radius_px / (region.radius_px + 1.0)) *
                                                 region_size_factor
                                           : 0.0;
+    // Balls stand out: the score grows with the contrast up to twice the least one.
+    const double contrast_factor =
+        region.ok && o.min_contrast > 0
+            ? std::clamp(region.contrast / (2 * o.min_contrast), 0.25, 1.0)
+            : 1.0;
     if (precise_ok) {
       cand.centre_px = fit.centre_px;
       cand.radius_px = fit.radius_px;
@@ -463,6 +468,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
       cand.score =
           std::max(region_score, fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
                                      std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor);
+      cand.score *= contrast_factor;
       cand.accepted = true;
     } else if (region_accept) {
       // The outline fit refines the region's centre when the two agree.
@@ -474,7 +480,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
         cand.sigma_px = std::max(fit.sigma_px, region.sigma_px * 0.5);
         cand.precise = true;
       }
-      cand.score = region_score;
+      cand.score = region_score * contrast_factor;
       cand.accepted = true;
     } else {
       cand.accepted = false;

@@ -94,7 +94,8 @@ struct BallDetectorOptions {
   // The convex outline's far reach from the centre, in radii (1.41: a square's corners).
   double max_region_extent = 1.25;
   // A ball stands out from its surroundings: CIELAB Delta E between the disc's and a ring's
-  // median colours (ball_region.h), required of every accepted candidate with a region.
+  // median colours (ball_region.h), required of every accepted candidate with a region; a
+  // candidate's score grows with its contrast up to twice this.
   double min_contrast = 35.0;
   // Whether a failed region shape check also rejects a candidate whose sub-pixel outline fit
   // passed all its own checks.
