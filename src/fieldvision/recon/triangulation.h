@@ -72,7 +72,7 @@ struct TriangulationOptions {
   // it) by more than this (metres) plus three standard deviations of the point's height: a low
   // orange object (a cone, a marker) is no ball, whatever the cameras agree on. Negative
   // disables the check.
-  double max_below_rest_m = 0.02;
+  double max_below_rest_m = 0.015;
   // When the detector reports radius_px: a view whose radius differs from the radius predicted
   // from the depth by more than this factor (either way) is inconsistent; 0 disables.
   double max_radius_ratio = 0.0;

@@ -119,9 +119,9 @@ TEST(RobustStages, WeakOnlySetsNeedEnoughCamerasNearThePrior) {
 }
 
 TEST(RobustStages, BelowRestAllowsForTheHeightUncertainty) {
-  TriangulationOptions o;  // ball_radius_m 0.11, max_below_rest_m 0.02
+  TriangulationOptions o;  // ball_radius_m 0.11, max_below_rest_m 0.015
   EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.11), o));
-  EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.095), o));
+  EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.096), o));
   EXPECT_TRUE(BelowRest(Eigen::Vector3d(0, 0, 0.08), o));
   EXPECT_FALSE(BelowRest(Eigen::Vector3d(0, 0, 0.08), o, 0.005));  // within 3 sigma
   o.max_below_rest_m = -1;                                         // off
