@@ -76,11 +76,17 @@ std::vector<Zone> ReadZones(const std::string& path) {
     Zone z;
     FV_REQUIRE(j[i].contains("polygon") && j[i]["polygon"].is_array(),
                "zones file '{}': zone {} has no polygon", path, i);
+    FV_REQUIRE(!j[i].contains("name") || j[i]["name"].is_string(),
+               "zones file '{}': zone {}'s name is not a string", path, i);
     z.name = j[i].value("name", fmt::format("zone{}", i + 1));
     for (const auto& v : j[i]["polygon"]) {
       FV_REQUIRE(v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number(),
                  "zones file '{}': zone '{}' has a vertex that is not [x, y]", path, z.name);
       z.polygon_m.emplace_back(v[0].get<double>(), v[1].get<double>());
+      // Field coordinates: metres from the centre; 10 km is beyond any field.
+      FV_REQUIRE(z.polygon_m.back().allFinite() && z.polygon_m.back().cwiseAbs().maxCoeff() <= 1e4,
+                 "zones file '{}': zone '{}' has a vertex out of range ({}, {})", path, z.name,
+                 z.polygon_m.back().x(), z.polygon_m.back().y());
     }
     FV_REQUIRE(z.polygon_m.size() >= 3, "zones file '{}': zone '{}' needs 3 or more vertices", path,
                z.name);

@@ -245,5 +245,14 @@ TEST(StatsStages, FrameRateAndPairDistances) {
   EXPECT_NEAR(std::get<3>(d[2]), 3.0, 1e-9);
 }
 
+TEST(Zones, HugeVerticesAndNonStringNamesAreOneLineErrors) {
+  const std::string path = fv::testing::TempDir() + "/zones.json";
+  std::ofstream(path) << R"([{"name": "box", "polygon": [[0, 0], [1e300, 0], [5, 3]]}])";
+  EXPECT_NE(fv::testing::ErrorOf([&] { ReadZones(path); }).find(path), std::string::npos);
+  std::ofstream(path) << R"([{"name": 5, "polygon": [[0, 0], [1, 0], [5, 3]]}])";
+  const std::string e = fv::testing::ErrorOf([&] { ReadZones(path); });
+  EXPECT_NE(e.find(path), std::string::npos) << e;
+}
+
 }  // namespace
 }  // namespace fv::stats
