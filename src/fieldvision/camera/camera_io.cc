@@ -120,8 +120,13 @@ Camera ReadCameraYaml(const std::string& path) {
     FV_REQUIRE(fs.isOpened(), "camera file '{}' cannot be read as OpenCV YAML", path);
     FV_REQUIRE(fs.root().isMap(), "camera file '{}' is not a map of keys", path);
     return ReadCameraYamlFrom(fs, path);
-  } catch (const cv::Exception& e) {
-    // OpenCV's parser and FileNode accessors assert on malformed structure.
+  } catch (const Error&) {
+    throw;
+  } catch (const cv::Exception&) {
+    // OpenCV's parser and FileNode accessors assert on malformed structure,
+    Throw("camera file '{}' is not valid OpenCV YAML", path);
+  } catch (const std::exception&) {
+    // or throw std::length_error (a key of length -1 in "   : 5").
     Throw("camera file '{}' is not valid OpenCV YAML", path);
   }
 }
