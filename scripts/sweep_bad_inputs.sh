@@ -8,20 +8,22 @@
 #   - leaves every input and existing output unchanged and no new file behind (hashes before and
 #     after over the whole working folder),
 #   - stays under 2 GB of memory (maximum RSS from /usr/bin/time).
-# Usage: sweep_bad_inputs.sh FIELDVISION WORKDIR [--quick] [--only REGEX] [--list]
+# Usage: sweep_bad_inputs.sh FIELDVISION WORKDIR [--quick] [--only REGEX] [--shard I/N] [--list]
 #   --quick  one or two cases per input kind and command (CTest, a few seconds)
 #   --only   cases whose name matches REGEX
+#   --shard  every N-th case from the I-th (0-based), to run N sweeps side by side
 # Prints one line per failed case (and with -v every case) and a summary; exit 1 if any failed.
 set -u
 FV="$(realpath "$1")"
 W="$2"
 shift 2
-QUICK=0 ONLY="" LIST=0 VERBOSE=0
+QUICK=0 ONLY="" LIST=0 VERBOSE=0 SHARD_I=0 SHARD_N=1 index=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) QUICK=1 ;;
     --only) ONLY="$2"; shift ;;
     --list) LIST=1 ;;
+    --shard) SHARD_I="${2%/*}"; SHARD_N="${2#*/}"; shift ;;
     -v) VERBOSE=1 ;;
     *) echo "sweep: unknown option $1" >&2; exit 2 ;;
   esac
@@ -57,20 +59,21 @@ for c in cam1 cam2; do
     >"$F/det_$c.csv"
 done
 printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n' >"$F/TRACKS.csv"
-for f in 1 2 3 4 5 6; do
-  printf '%d,1,%d,50,20,60,0.9,%d.5,1.0,%.3f\n' $f $((10 + f)) $f "$(echo "($f-1)/25" | bc -l)"
-  printf '%d,2,%d,60,20,60,0.8,-%d.0,2.0,%.3f\n' $f $((100 + f)) $f "$(echo "($f-1)/25" | bc -l)"
-done >>"$F/TRACKS.csv"
+# Two players, 60 frames at 25 fps (stats needs tracks of a second or more).
+awk 'BEGIN { for (f = 1; f <= 60; f++) {
+  printf "%d,1,%d,50,20,60,0.9,%.2f,1.0,%.2f\n", f, 10 + f, 0.1 * f, (f - 1) / 25
+  printf "%d,2,%d,60,20,60,0.8,%.2f,2.0,%.2f\n", f, 100 + f, -0.1 * f, (f - 1) / 25 } }' \
+  >>"$F/TRACKS.csv"
 printf '1,-1,10,50,20,60,0.9\n2,-1,11,50,20,60,0.9\n' >"$F/det.txt"
 printf '[{"name": "box", "polygon": [[0, 0], [5, 0], [5, 3]]}]\n' >"$F/zones.json"
-printf '[{"merge": [1, 2]}]\n' >"$F/edits.json"
+printf '[{"rename": {"1": 10}}]\n' >"$F/edits.json"
 printf 'id,team,name\n1,A,Ann\n2,B,Bob\n' >"$F/roster.csv"
 "$FV" field show robocup-msl --json >"$F/field.json" 2>/dev/null
 printf '{"name": "r", "defaults": {"image_width": 640, "image_height": 480, "hfov_deg": 70}, "cameras": [{"name": "c1", "position": [0, -8, 4], "look_at": [0, 0, 0]}, {"name": "c2", "position": [6, -8, 4], "look_at": [0, 0, 0]}]}\n' >"$F/rig.json"
 printf '{"mounts": [{"point": [0, -8, 4]}, {"line": [[-6, -8, 4], [6, -8, 4]]}]}\n' >"$F/mounts.json"
 # Field points of cam1: u,v,x,y,z from the field's keypoints projected by the synth camera are not
 # at hand; named points on the field (u,v,name) with made-up pixels serve as a readable file.
-printf 'u,v,name\n10,20,center\n100,20,corner_nw\n10,200,corner_sw\n200,200,corner_ne\n' \
+printf 'u,v,name\n160,120,centre_spot\n160,20,halfway_top\n160,220,halfway_bottom\n10,220,corner_left_bottom\n' \
   >"$F/points.csv"
 printf '<?xml version="1.0"?>\n<dataset name="x">\n<frame number="0"><objectlist><object id="1"><box h="60" w="20" xc="20" yc="80"/></object></objectlist></frame>\n</dataset>\n' >"$F/pets.xml"
 printf '{"name": "ball", "classes": []}\n' >"$F/colour_bad_shape.json"
@@ -78,6 +81,10 @@ printf '{"name": "ball", "classes": []}\n' >"$F/colour_bad_shape.json"
 # ---- existing outputs: each must be unchanged after a failed run
 for e in csv json png yaml avi mp4 txt; do printf 'existing output\n' >"$O/old.$e"; done
 mkdir -p "$O/olddir" && printf 'existing output\n' >"$O/olddir/keep.txt"
+# A device of the sweep's own as an output (never a system one: a writer that renames over its
+# output would replace /dev/null for the whole machine); a FIFO where mknod is not allowed.
+mknod "$O/device" c 1 3 2>/dev/null || mkfifo "$O/device"
+DEV="$O/device"
 # Links to every good input, for outputs given as a link to an input.
 for f in "$F"/* "$FRAME"; do [ -f "$f" ] && ln -sf "$f" "$O/link_$(basename "$f")"; done
 
@@ -121,16 +128,16 @@ printf '{"image_width": 320}\n' >"$B/json_camera.yaml"
 ballcsv() {  # ballcsv NAME LINE_TO_APPEND_OR_REPLACE_3
   { head -3 "$F/truth.csv"; printf '%b\n' "$2"; tail -n +5 "$F/truth.csv"; } >"$B/$1.csv"
 }
-ballcsv nan_x '3,0.05,nan,1,0.11,3'
-ballcsv inf_z '3,0.05,1,1,inf,3'
-ballcsv huge_y '3,0.05,1,1e300,0.11,3'
-ballcsv huge_frame '2000000000,0.05,1,1,0.11,3'
-ballcsv neg_frame '-5,0.05,1,1,0.11,3'
-ballcsv nan_time '3,nan,1,1,0.11,3'
-ballcsv huge_time '3,1e300,1,1,0.11,3'
-ballcsv text_cell '3,0.05,one,1,0.11,3'
-ballcsv ragged '3,0.05,1'
-ballcsv dup_frame '2,0.0333,1,1,0.11,3'
+ballcsv nan_x '2,0.0333,nan,1,0.11,3'
+ballcsv inf_z '2,0.0333,1,1,inf,3'
+ballcsv huge_y '2,0.0333,1,1e300,0.11,3'
+ballcsv huge_frame '2000000000,0.0333,1,1,0.11,3'
+ballcsv neg_frame '-5,0.0333,1,1,0.11,3'
+ballcsv nan_time '2,nan,1,1,0.11,3'
+ballcsv huge_time '2,1e300,1,1,0.11,3'
+ballcsv text_cell '2,0.0333,one,1,0.11,3'
+ballcsv ragged '2,0.0333,1'
+ballcsv dup_frame '1,0.0167,1,1,0.11,3'
 head -1 "$F/truth.csv" >"$B/header_only.csv"
 printf 'a,b,c\n1,2,3\n' >"$B/wrong_columns.csv"
 # Detections CSV (frame,time_s,u,v,radius_px,score).
@@ -171,7 +178,7 @@ sed -e 's/"width": *[0-9]*/"width": 100000/' "$F/scene.json" >"$B/scene_width.js
 printf '<dataset><frame number="nan"></frame></dataset>\n' >"$B/pets_nan.xml"
 printf '<dataset><frame number="2000000000"><objectlist><object id="1"><box h="60" w="20" xc="20" yc="80"/></object></objectlist></frame></dataset>\n' >"$B/pets_huge.xml"
 printf 'u,v,name\n10,20,nowhere\n' >"$B/points_unknown.csv"
-printf 'u,v,name\nnan,20,center\n100,20,corner_nw\n10,200,corner_sw\n200,200,corner_ne\n' >"$B/points_nan.csv"
+printf 'u,v,name\nnan,120,centre_spot\n160,20,halfway_top\n160,220,halfway_bottom\n10,220,corner_left_bottom\n' >"$B/points_nan.csv"
 ln -s "$B/does_not_exist.csv" "$B/dangling.csv"
 ln -s "$B/does_not_exist.yaml" "$B/dangling.yaml"
 
@@ -212,6 +219,8 @@ c() {
   [ "${1:-}" = -- ] && shift
   [ -n "$ONLY" ] && ! [[ "$name" =~ $ONLY ]] && return
   [ $QUICK = 1 ] && ! [[ "$name" =~ $QUICK_CASES ]] && return
+  index=$((index + 1))
+  [ $(((index - 1) % SHARD_N)) = "$SHARD_I" ] || return
   if [ $LIST = 1 ]; then echo "$name"; nlisted=$((nlisted + 1)); return; fi
   total=$((total + 1))
   local why=""
@@ -274,8 +283,8 @@ JSON_BAD="not_json nan_token deep array empty binary truncated folder missing"
 FIELD_BAD="$JSON_BAD field_huge field_neg field_type"
 # --quick: these cases only (one or two per input kind, each from an issue 18 finding).
 QUICK_CASES='^(detect --camera nan_focal|detect --video truncated|detect out=same|ball --truth=out'
-QUICK_CASES+='|ball --camera huge_width|ball --detections det_huge_frame|trajectory --in huge_frame'
-QUICK_CASES+='|trajectory out=link|trajectory --gravity=nan|eval ball --est nan_x'
+QUICK_CASES+='|ball --camera huge_width|ball --detections det_huge_frame'
+QUICK_CASES+='|trajectory out=link|trajectory --gravity=nan|trajectory --in binary|eval ball --est nan_x'
 QUICK_CASES+='|eval tracks --gt tracks_dup|stats --tracks tracks_nan_x|stats --zones zones_huge'
 QUICK_CASES+='|stats --fps 1e-300|field show field_huge|plan --step tiny|plan --rig rig_huge'
 QUICK_CASES+='|synth 16384x16384|players --input-width huge|calibrate check --table=image'
@@ -313,7 +322,7 @@ sweep_out() {
       same) p="$input" ;;
       link) p="$O/link_$(basename "$input")" ;;
       folder) p="$O/olddir" ;;
-      device) p="/dev/full" ;;
+      device) p="$DEV" ;;
       nofolder) p="$O/no/such/folder/out.${input##*.}" ;;
     esac
     args=()
@@ -347,7 +356,7 @@ for o in --ball-diameter --min-radius --max-radius; do
 done
 sweep_opt detect --step "$INTS 0" detect --video "$F/cam1.avi" --out "$OUTCSV" --no-progress
 sweep_opt detect --max-frames "$INTS" detect --video "$F/cam1.avi" --out "$OUTCSV" --no-progress
-sweep_opt detect --draw "$O/olddir /dev/full $F/cam1.avi" detect --video "$F/cam1.avi" --out "$O/new.csv" --no-progress
+sweep_opt detect --draw "$O/olddir $DEV $F/cam1.avi" detect --video "$F/cam1.avi" --out "$O/new.csv" --no-progress
 # ball
 BALL2=(ball --camera "$F/cam1.yaml" --video "$F/cam1.avi" --camera "$F/cam2.yaml" --video "$F/cam2.avi" --no-progress)
 sweep_file "ball --camera" yaml "$CAM_BAD" ball --camera @ --video "$F/cam1.avi" --camera "$F/cam2.yaml" --video "$F/cam2.avi" --out "$OUTCSV" --no-progress
@@ -368,7 +377,8 @@ for o in --ball-diameter --det-sigma --tolerance --inlier-px; do sweep_opt ball 
 sweep_opt ball --max-frames "$INTS" "${BALL2[@]}" --out "$OUTCSV"
 sweep_opt ball --full-scan-every "$INTS 0" "${BALL2[@]}" --out "$OUTCSV"
 # trajectory
-sweep_file "trajectory --in" csv "$CSV_BAD" trajectory --in @ --out "$O/old.json"
+# (trajectory skips a bad row with a warning naming file:line, by design: whole-file cases only)
+sweep_file "trajectory --in" csv "header_only wrong_columns empty binary folder dangling missing" trajectory --in @ --out "$O/old.json"
 sweep_file "trajectory --field" json "$FIELD_BAD" trajectory --in "$F/BALL.csv" --field @ --out "$O/old.json"
 sweep_out "trajectory" "$F/BALL.csv" trajectory --in "$F/BALL.csv" --out @
 c "trajectory --smoothed=in" "BALL.csv" -- trajectory --in "$F/BALL.csv" --out "$O/new.json" --smoothed "$F/BALL.csv"
@@ -379,12 +389,12 @@ c "trajectory --line unknown" "nosuchline" -- trajectory --in "$F/BALL.csv" --ou
 for o in --ball-diameter --gravity --ball-mass; do sweep_opt trajectory $o "$POS" trajectory --in "$F/BALL.csv" --out "$O/new.json"; done
 for o in --ground-z --noise --accel-slack --predict-fraction; do sweep_opt trajectory $o "nan inf 1e300 -1e300 abc" trajectory --in "$F/BALL.csv" --out "$O/new.json"; done
 # plan
-sweep_file "plan --rig" json "$JSON_BAD rig_huge rig_width rig_hfov rig_empty" plan --rig @ --out "$O/plan" --no-progress
-sweep_file "plan --camera" yaml "$CAM_BAD" plan --camera @ --camera "$F/cam2.yaml" --out "$O/plan" --no-progress
+sweep_file "plan --rig" json "$JSON_BAD rig_huge rig_width rig_empty" plan --rig @ --out "$O/plan" --no-progress
+sweep_file "plan --camera" yaml "${CAM_BAD/wrong_size/}" plan --camera @ --camera "$F/cam2.yaml" --out "$O/plan" --no-progress
 sweep_file "plan --field" json "$FIELD_BAD" plan --rig "$F/rig.json" --field @ --out "$O/plan" --no-progress
 sweep_file "plan --mounts" json "$JSON_BAD mounts_type" plan --optimize --field robocup-msl --mounts @ --out "$O/plan" --no-progress
 c "plan --out=file" "old.csv" -- plan --rig "$F/rig.json" --out "$O/old.csv" --no-progress
-c "plan --out=device" "/dev/full" -- plan --rig "$F/rig.json" --out /dev/full --no-progress
+c "plan --out=device" "$DEV" -- plan --rig "$F/rig.json" --out "$DEV" --no-progress
 c "plan no rig" "rig" -- plan --out "$O/plan" --no-progress
 for o in --step --ball-diameter --min-ball-px --noise-px --hfov --search-step; do sweep_opt plan $o "$POS" plan --rig "$F/rig.json" --out "$O/plan" --no-progress; done
 for o in --height-above --margin-px --error-weight --perimeter-offset --mount-height; do sweep_opt plan $o "nan inf 1e300 abc" plan --rig "$F/rig.json" --out "$O/plan" --no-progress; done
@@ -405,7 +415,7 @@ c "players --save-detections=video" "cam1.avi" -- "${PL[@]}" --out "$O/new.csv" 
 c "players --margin without field" "margin" -- "${PL[@]}" --out "$O/new.csv" --margin 2
 for o in --score --min-height --stitch-gap --stitch-appearance --smooth-accel --fps; do sweep_opt players $o "nan inf 1e300 -1 abc" "${PL[@]}" --out "$O/new.csv"; done
 for o in --input-width --threads --max-lost --max-frames --interpolate --min-track-frames; do sweep_opt players $o "$INTS" "${PL[@]}" --out "$O/new.csv"; done
-c "players --input-width huge" "input-width" -- players --video "$F/cam1.avi" --input-width 32000 --out "$O/new.csv" --no-progress
+c "players --input-width huge" "opt:input-width" -- players --video "$F/cam1.avi" --input-width 32000 --out "$O/new.csv" --no-progress
 # stats
 ST=(stats --tracks "$F/TRACKS.csv" --field robocup-msl --no-video)
 sweep_file "stats --tracks" csv "$TRACKS_BAD" stats --tracks @ --field robocup-msl --out "$O/stats" --no-video
@@ -413,7 +423,7 @@ sweep_file "stats --field" json "$FIELD_BAD" stats --tracks "$F/TRACKS.csv" --fi
 sweep_file "stats --zones" json "$JSON_BAD zones_huge zones_short" "${ST[@]}" --zones @ --out "$O/stats"
 sweep_file "stats --teams" csv "wrong_columns empty binary folder missing" "${ST[@]}" --teams @ --out "$O/stats"
 c "stats --out=file" "old.csv" -- "${ST[@]}" --out "$O/old.csv"
-c "stats --out=device" "/dev/full" -- "${ST[@]}" --out /dev/full
+c "stats --out=device" "$DEV" -- "${ST[@]}" --out "$DEV"
 c "stats radar frame 2e9" "frame" -- stats --tracks "$B/tracks_huge_frame.csv" --field robocup-msl --out "$O/stats"
 for o in --fps --smooth --sprint-speed; do sweep_opt stats $o "$POS" "${ST[@]}" --out "$O/stats"; done
 c "stats --fps 1e-300" "fps" -- "${ST[@]}" --fps 1e-300 --out "$O/stats"
@@ -434,11 +444,11 @@ sweep_out "calibrate intrinsics" "$F/cam1.avi" calibrate intrinsics --images "$F
 for o in --square --marker --outlier-factor --subpix-cap; do sweep_opt "calibrate intrinsics" $o "nan inf 1e300 -1 abc" calibrate intrinsics --images "$F/frames" --cols 9 --rows 6 --square 0.025 --out "$O/new.yaml" --quiet; done
 for o in --cols --rows --model --subpix-window --max-frames; do sweep_opt "calibrate intrinsics" $o "$INTS 0" calibrate intrinsics --images "$F/frames" --cols 9 --rows 6 --square 0.025 --out "$O/new.yaml" --quiet; done
 EX=(calibrate extrinsics --field robocup-msl)
-sweep_file "calibrate extrinsics --camera" yaml "$CAM_BAD" "${EX[@]}" --camera @ --points "$F/points.csv" --out "$O/old.yaml"
+sweep_file "calibrate extrinsics --camera" yaml "${CAM_BAD/wrong_size/}" "${EX[@]}" --camera @ --points "$F/points.csv" --out "$O/old.yaml"
 sweep_file "calibrate extrinsics --points" csv "$CSV_BAD points_unknown points_nan" "${EX[@]}" --camera "$F/cam1.yaml" --points @ --out "$O/old.yaml"
 sweep_file "calibrate extrinsics --field" json "$FIELD_BAD" calibrate extrinsics --camera "$F/cam1.yaml" --points "$F/points.csv" --field @ --out "$O/old.yaml"
 sweep_out "calibrate extrinsics" "$F/points.csv" "${EX[@]}" --camera "$F/cam1.yaml" --points "$F/points.csv" --out @
-c "calibrate extrinsics --image-size bad" "image-size" -- "${EX[@]}" --image-size 0x-5 --points "$F/points.csv" --out "$O/new.yaml"
+c "calibrate extrinsics --image-size bad" "opt:image-size" -- "${EX[@]}" --image-size 0x-5 --points "$F/points.csv" --out "$O/new.yaml"
 sweep_opt "calibrate extrinsics" --threshold "$POS" "${EX[@]}" --camera "$F/cam1.yaml" --points "$F/points.csv" --out "$O/new.yaml"
 RF=(calibrate refine --field robocup-msl)
 sweep_file "calibrate refine --camera" yaml "$CAM_BAD" "${RF[@]}" --camera @ --image "$FRAME" --out "$O/old.yaml"
@@ -453,7 +463,7 @@ sweep_file "calibrate check --image" png "empty binary truncated folder missing"
 sweep_file "calibrate check --points" csv "$CSV_BAD points_unknown points_nan" "${CK[@]}" --camera "$F/cam1.yaml" --image "$FRAME" --points @ --out "$O/new.png"
 sweep_out "calibrate check" "$FRAME" "${CK[@]}" --camera "$F/cam1.yaml" --image "$FRAME" --out @
 c "calibrate check --table=image" "$(basename "$FRAME")" -- "${CK[@]}" --camera "$F/cam1.yaml" --image "$FRAME" --points "$F/points.csv" --table "$FRAME" --out "$O/new.png"
-sweep_file "calibrate rig --camera" yaml "$CAM_BAD" calibrate rig --field robocup-msl --camera @ --camera "$F/cam2.yaml" --points "$F/points.csv" --points "$F/points.csv" --out-dir "$O/rig"
+sweep_file "calibrate rig --camera" yaml "${CAM_BAD/wrong_size/}" calibrate rig --field robocup-msl --camera @ --camera "$F/cam2.yaml" --points "$F/points.csv" --points "$F/points.csv" --out-dir "$O/rig"
 sweep_file "calibrate rig --points" csv "$CSV_BAD points_unknown points_nan" calibrate rig --field robocup-msl --camera "$F/cam1.yaml" --camera "$F/cam2.yaml" --points @ --points "$F/points.csv" --out-dir "$O/rig"
 c "calibrate rig --out-dir=file" "old.csv" -- calibrate rig --field robocup-msl --camera "$F/cam1.yaml" --camera "$F/cam2.yaml" --points "$F/points.csv" --points "$F/points.csv" --out-dir "$O/old.csv"
 c "calibrate rig cameras/points mismatch" "points" -- calibrate rig --field robocup-msl --camera "$F/cam1.yaml" --camera "$F/cam2.yaml" --points "$F/points.csv" --out-dir "$O/rig"
@@ -506,9 +516,9 @@ c "field unknown" "rugby" -- field show rugby
 # synth
 sweep_file "synth --scene" json "$JSON_BAD scene_hfov scene_width" synth --scene @ --out "$O/synth" --quiet
 c "synth --out=file" "old.csv" -- synth --preset static --frames 2 --width 64 --height 48 --out "$O/old.csv" --quiet
-c "synth --out=device" "/dev/full" -- synth --preset static --frames 2 --width 64 --height 48 --out /dev/full --quiet
+c "synth --out=device" "$DEV" -- synth --preset static --frames 2 --width 64 --height 48 --out "$DEV" --quiet
 c "synth --preset bogus" "preset" -- synth --preset bogus --out "$O/synth" --quiet
-c "synth 16384x16384" "width" quick -- synth --preset static --frames 1 --width 16384 --height 16384 --out "$O/synth" --quiet
+c "synth 16384x16384" "width" -- synth --preset static --frames 1 --width 16384 --height 16384 --out "$O/synth" --quiet
 for o in --frames --width --height; do sweep_opt synth $o "$INTS 0" synth --preset static --frames 2 --width 64 --height 48 --out "$O/synth" --quiet; done
 # node / fuse (network: bad addresses and files fail before any connection)
 NODE=(node --video "$F/cam1.avi" --connect-wait 0.2 --no-progress)
@@ -520,7 +530,7 @@ done
 for o in --ball-diameter --connect-wait --start-at --clock-offset; do sweep_opt node $o "nan inf 1e300 abc" "${NODE[@]}" --camera "$F/cam1.yaml" --connect tcp://127.0.0.1:1; done
 sweep_opt node --live-buffer "$INTS 0" "${NODE[@]}" --camera "$F/cam1.yaml" --connect tcp://127.0.0.1:1
 FUSE=(fuse --listen tcp://127.0.0.1:0 --idle-exit 0.5 --no-progress)
-sweep_file "fuse --camera" yaml "$CAM_BAD" "${FUSE[@]}" --camera @ --camera "$F/cam2.yaml" --out "$OUTCSV"
+sweep_file "fuse --camera" yaml "${CAM_BAD/wrong_size/}" "${FUSE[@]}" --camera @ --camera "$F/cam2.yaml" --out "$OUTCSV"
 sweep_out "fuse" "$F/cam1.yaml" "${FUSE[@]}" --camera "$F/cam1.yaml" --camera "$F/cam2.yaml" --out @
 for v in "" "nonsense" "tcp://" "tcp://host:99999" "udp://127.0.0.1:5"; do
   c "fuse --listen=$v" "listen" -- fuse --listen "$v" --camera "$F/cam1.yaml" --camera "$F/cam2.yaml" --out "$O/new.csv" --no-progress --idle-exit 0.5
