@@ -294,6 +294,60 @@ std::vector<BallCandidate> BallDetector::Detect(const cv::Mat& bgr, const cv::Re
   return DetectWithSummary(bgr, region).candidates;
 }
 
+namespace {
+
+// Disc-like blobs first (a printed or partly hidden ball may be a few of them), then larger.
+std::vector<const Blob*> DiscLikeFirst(const BlobScanResult& blobs, double max_aspect_ratio) {
+  std::vector<const Blob*> order;
+  order.reserve(blobs.blobs.size());
+  for (const Blob& b : blobs.blobs) order.push_back(&b);
+  std::stable_sort(order.begin(), order.end(), [&](const Blob* a, const Blob* b) {
+    return (a->aspect_ratio() <= max_aspect_ratio) > (b->aspect_ratio() <= max_aspect_ratio);
+  });
+  return order;
+}
+
+// The fit reads up to about two radii beyond a blob: blobs nearer than that to an edge of the
+// region that is not the image's own edge cannot be fitted from the region's pixels.
+bool FitsInRegion(const Blob& b, const cv::Rect& roi, const cv::Size& image) {
+  if (roi == cv::Rect(0, 0, image.width, image.height)) return true;
+  const int m = static_cast<int>(std::ceil(std::max(b.width_px(), b.height_px()))) + 4;
+  return (roi.x == 0 || b.x_min - m >= roi.x) && (roi.y == 0 || b.y_min - m >= roi.y) &&
+         (roi.x + roi.width == image.width || b.x_max + m < roi.x + roi.width) &&
+         (roi.y + roi.height == image.height || b.y_max + m < roi.y + roi.height);
+}
+
+// Best first; one ball, one candidate: a later accepted candidate on a better one is a duplicate.
+void RankAndDropDuplicates(std::vector<BallCandidate>* candidates) {
+  auto better = [](const BallCandidate& a, const BallCandidate& b) {
+    if (a.accepted != b.accepted) return a.accepted;
+    return a.score > b.score;
+  };
+  std::stable_sort(candidates->begin(), candidates->end(), better);
+  for (size_t i = 0; i < candidates->size(); ++i) {
+    BallCandidate& c = (*candidates)[i];
+    if (!c.accepted) continue;
+    for (size_t j = 0; j < i; ++j) {
+      const BallCandidate& b = (*candidates)[j];
+      if (b.accepted && (b.centre_px - c.centre_px).norm() < std::max(b.radius_px, 2.0)) {
+        c.accepted = false;
+        c.reason = "duplicate";
+        break;
+      }
+    }
+  }
+  std::stable_sort(candidates->begin(), candidates->end(), better);
+}
+
+}  // namespace
+
+bool BallDetector::MeasuredRegions::Holds(const BallRegion& region) const {
+  for (size_t i = 0; i < centres.size(); ++i) {
+    if ((centres[i] - region.centre_px).norm() < std::max(0.5 * radii[i], 1.0)) return true;
+  }
+  return false;
+}
+
 BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
                                                     const cv::Rect& region) const {
   FV_REQUIRE(!bgr.empty(), "ball detector: the frame is empty");
@@ -311,217 +365,174 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   const cv::Rect image(0, 0, bgr.cols, bgr.rows);
   const cv::Rect roi = region.empty() ? image : region & image;
   const BlobScanResult blobs = ScanBlobs(bgr, *table_, ball_bit_, scan, field_mask_, roi);
-  // The fit reads up to about two radii beyond a blob: blobs nearer than that to an edge of the
-  // region that is not the image's own edge cannot be fitted from the region's pixels.
-  auto fits_in_region = [&](const Blob& b) {
-    if (roi == image) return true;
-    const int m = static_cast<int>(std::ceil(std::max(b.width_px(), b.height_px()))) + 4;
-    return (roi.x == 0 || b.x_min - m >= roi.x) && (roi.y == 0 || b.y_min - m >= roi.y) &&
-           (roi.x + roi.width == bgr.cols || b.x_max + m < roi.x + roi.width) &&
-           (roi.y + roi.height == bgr.rows || b.y_max + m < roi.y + roi.height);
-  };
   BallDetectionResult result;
   result.blobs = static_cast<int>(blobs.blobs.size());
   result.runs = blobs.runs;
   result.samples = blobs.samples;
-  // Disc-like blobs first (a printed or partly hidden ball may be a few of them), then larger.
-  std::vector<const Blob*> order;
-  order.reserve(blobs.blobs.size());
-  for (const Blob& b : blobs.blobs) order.push_back(&b);
-  std::stable_sort(order.begin(), order.end(), [&](const Blob* a, const Blob* b) {
-    const bool da = a->aspect_ratio() <= o.max_aspect_ratio;
-    const bool db = b->aspect_ratio() <= o.max_aspect_ratio;
-    return da > db;
-  });
-  std::vector<Vector2d> region_centres;
-  std::vector<double> region_radii;
-  for (const Blob* blob_ptr : order) {
-    const Blob& blob = *blob_ptr;
-    if (!fits_in_region(blob)) continue;
-    BallCandidate cand;
-    cand.centre_px = Vector2d(0.5 * (blob.x_min + blob.x_max), 0.5 * (blob.y_min + blob.y_max));
-    cand.radius_px = 0.25 * (blob.width_px() + blob.height_px());
-    cand.sigma_px = 0.5 * blob.step_px;
-    auto reject = [&](std::string why) {
-      cand.accepted = false;
-      cand.reason = std::move(why);
-      result.candidates.push_back(cand);
-    };
-    const double rough_r = 0.5 * std::max(blob.width_px(), blob.height_px());
-    if (rough_r > 1.5 * o.max_radius_px) {
-      reject("blob size");
-      continue;
+  MeasuredRegions measured;
+  for (const Blob* blob : DiscLikeFirst(blobs, o.max_aspect_ratio)) {
+    if (!FitsInRegion(*blob, roi, bgr.size())) continue;
+    std::optional<BallCandidate> cand = EvaluateBlob(bgr, *blob, roi, &measured, &result.refined);
+    if (cand) result.candidates.push_back(std::move(*cand));
+  }
+  if (small_balls_ && result.accepted() == 0) AddSmallBalls(bgr, roi, &result);
+  RankAndDropDuplicates(&result.candidates);
+  return result;
+}
+
+std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, const Blob& blob,
+                                                        const cv::Rect& roi,
+                                                        MeasuredRegions* measured,
+                                                        int* refined) const {
+  const BallDetectorOptions& o = options_;
+  BallCandidate cand;
+  cand.centre_px = Vector2d(0.5 * (blob.x_min + blob.x_max), 0.5 * (blob.y_min + blob.y_max));
+  cand.radius_px = 0.25 * (blob.width_px() + blob.height_px());
+  cand.sigma_px = 0.5 * blob.step_px;
+  auto reject = [&](std::string why) {
+    cand.accepted = false;
+    cand.reason = std::move(why);
+    return cand;
+  };
+  const double rough_r = 0.5 * std::max(blob.width_px(), blob.height_px());
+  if (rough_r > 1.5 * o.max_radius_px) return reject("blob size");
+  if (*refined >= o.max_refine) return reject("not refined (max_refine)");
+  // 1. The region check: the blob with its neighbouring fragments, holes filled.
+  BallRegion region;
+  if (o.use_region) {
+    const int half = blob.step_px / 2 + 1;
+    const cv::Rect seed(blob.x_min - half, blob.y_min - half,
+                        blob.x_max - blob.x_min + 2 * half + 1,
+                        blob.y_max - blob.y_min + 2 * half + 1);
+    region = AnalyseBallRegion(bgr, *table_, ball_bit_, seed, roi, o.region, grow_table_.get());
+    if (region.ok) {
+      if (measured->Holds(region)) return std::nullopt;  // a fragment of a region measured
+      measured->centres.push_back(region.centre_px);
+      measured->radii.push_back(region.radius_px);
+      cand.region_ok = true;
+      cand.arc_cover = region.arc_cover;
+      cand.fill = region.fill;
+      cand.spill = region.spill;
+      cand.leak = region.leak;
+      cand.contrast = region.contrast;
+      cand.region_outside = region.outside;
+      cand.region_extent = region.extent;
+      cand.centre_px = region.centre_px;
+      cand.radius_px = region.radius_px;
+      cand.sigma_px = region.sigma_px;
     }
-    if (result.refined >= o.max_refine) {
-      reject("not refined (max_refine)");
-      continue;
+  }
+  if (!region.ok) {
+    if (blob.aspect_ratio() > o.max_aspect_ratio) return reject("blob aspect ratio");
+    if (blob.samples >= 6 && blob.fill_ratio() < o.min_fill_ratio) {
+      return reject("blob fill ratio");
     }
-    // 1. The region check: the blob with its neighbouring fragments, holes filled.
-    BallRegion region;
-    if (o.use_region) {
-      const int half = blob.step_px / 2 + 1;
-      const cv::Rect seed(blob.x_min - half, blob.y_min - half,
-                          blob.x_max - blob.x_min + 2 * half + 1,
-                          blob.y_max - blob.y_min + 2 * half + 1);
-      region = AnalyseBallRegion(bgr, *table_, ball_bit_, seed, roi, o.region, grow_table_.get());
-      if (region.ok) {
-        // A fragment of a region already measured.
-        bool duplicate = false;
-        for (size_t i = 0; i < region_centres.size() && !duplicate; ++i) {
-          duplicate =
-              (region_centres[i] - region.centre_px).norm() < std::max(0.5 * region_radii[i], 1.0);
-        }
-        if (duplicate) continue;
-        region_centres.push_back(region.centre_px);
-        region_radii.push_back(region.radius_px);
-        cand.region_ok = true;
-        cand.arc_cover = region.arc_cover;
-        cand.fill = region.fill;
-        cand.spill = region.spill;
-        cand.leak = region.leak;
-        cand.contrast = region.contrast;
-        cand.region_outside = region.outside;
-        cand.region_extent = region.extent;
-        cand.centre_px = region.centre_px;
-        cand.radius_px = region.radius_px;
-        cand.sigma_px = region.sigma_px;
-      }
+  }
+  ++*refined;
+  // 2. The sub-pixel outline fit, seeded by the region when there is one.
+  const Vector2d seed_c = region.ok ? region.centre_px : blob.centroid_px();
+  const double seed_r = region.ok ? region.radius_px : rough_r;
+  BallFit fit = seed_r >= 0.5 * o.min_radius_px
+                    ? FitBall(bgr, *table_, ball_bit_, seed_c, seed_r, camera_, o.fit)
+                    : BallFit{};
+  if (region.ok && !fit.ok && rough_r >= 0.5 * o.min_radius_px) {
+    // A region that took in a neighbour seeds badly: the blob itself may still fit.
+    fit = FitBall(bgr, *table_, ball_bit_, blob.centroid_px(), rough_r, camera_, o.fit);
+  }
+  std::string fit_why;  // why the precise path fails
+  double visible = 0.0, leak = 1.0;
+  if (!fit.ok) {
+    fit_why = fit.failure.empty() ? "too small to fit" : fit.failure;
+  } else {
+    DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
+               fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
+    fit_why = OutlineProblem(fit, visible, leak, o);
+  }
+  Decide(region, fit, fit_why, visible, leak, &cand);
+  return cand;
+}
+
+void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const std::string& fit_why,
+                          double visible, double leak, BallCandidate* out) const {
+  const BallDetectorOptions& o = options_;
+  BallCandidate& cand = *out;
+  // 3. Size: the radius limits and, with a posed camera, the ball's size at that place.
+  const double radius = fit.ok && fit_why.empty() ? fit.radius_px : cand.radius_px;
+  const Vector2d centre = fit.ok && fit_why.empty() ? fit.centre_px : cand.centre_px;
+  double size_factor = 1.0;
+  const std::string size_why = SizeProblem(centre, radius, &size_factor);
+  // The region path checks the region's own size (a small ball's outline fit may hug its
+  // saturated core and measure it too small while the region holds the whole ball).
+  double region_size_factor = size_factor;
+  const std::string region_size_why =
+      region.ok && radius != region.radius_px
+          ? SizeProblem(region.centre_px, region.radius_px, &region_size_factor)
+          : size_why;
+  // Where the region was measured, the outline fit alone does not decide: both must agree.
+  const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
+                             RegionProblem(region, o, /*shape_only=*/true).empty();
+  const bool precise_ok = fit.ok && fit_why.empty() && size_why.empty() && region_agrees;
+  std::string region_why;
+  if (!o.use_region) {
+    region_why = "region check off";
+  } else if (!region.ok) {
+    region_why = region.failure;
+  } else {
+    region_why = RegionProblem(region, o);
+    if (region_why.empty()) region_why = region_size_why;
+  }
+  const bool region_accept = region_why.empty();
+  if (fit.ok) {
+    cand.blurred = fit.blurred;
+    cand.inlier_fraction = fit.inlier_fraction;
+    cand.outside_fraction = fit.outside_fraction;
+    cand.dents = fit.dents;
+    cand.visible_fraction = visible;
+  }
+  const double region_score = region.ok ? region.arc_cover * std::min(1.0, region.fill / 0.9) *
+                                              (1.0 - region.spill) * (1.0 - region.leak) *
+                                              (region.radius_px / (region.radius_px + 1.0)) *
+                                              region_size_factor
+                                        : 0.0;
+  // Balls stand out: the score grows with the contrast up to twice the least one.
+  const double contrast_factor = region.ok && o.min_contrast > 0
+                                     ? std::clamp(region.contrast / (2 * o.min_contrast), 0.25, 1.0)
+                                     : 1.0;
+  if (precise_ok) {
+    cand.centre_px = fit.centre_px;
+    cand.radius_px = fit.radius_px;
+    cand.sigma_px = fit.sigma_px;
+    cand.precise = true;
+    cand.score =
+        std::max(region_score, fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
+                                   std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor);
+    cand.score *= contrast_factor;
+    cand.accepted = true;
+  } else if (region_accept) {
+    // The outline fit refines the region's centre when the two agree.
+    if (fit.ok && (fit.centre_px - region.centre_px).norm() < 0.25 * region.radius_px &&
+        std::abs(fit.radius_px - region.radius_px) < 0.25 * region.radius_px &&
+        fit.inlier_fraction >= o.weak_min_inlier_fraction) {
+      cand.centre_px = fit.centre_px;
+      cand.radius_px = fit.radius_px;
+      cand.sigma_px = std::max(fit.sigma_px, region.sigma_px * 0.5);
+      cand.precise = true;
     }
-    if (!region.ok) {
-      if (blob.aspect_ratio() > o.max_aspect_ratio) {
-        reject("blob aspect ratio");
-        continue;
-      }
-      if (blob.samples >= 6 && blob.fill_ratio() < o.min_fill_ratio) {
-        reject("blob fill ratio");
-        continue;
-      }
-    }
-    ++result.refined;
-    // 2. The sub-pixel outline fit, seeded by the region when there is one.
-    const Vector2d seed_c = region.ok ? region.centre_px : blob.centroid_px();
-    const double seed_r = region.ok ? region.radius_px : rough_r;
-    BallFit fit = seed_r >= 0.5 * o.min_radius_px
-                      ? FitBall(bgr, *table_, ball_bit_, seed_c, seed_r, camera_, o.fit)
-                      : BallFit{};
-    if (region.ok && !fit.ok && rough_r >= 0.5 * o.min_radius_px) {
-      // A region that took in a neighbour seeds badly: the blob itself may still fit.
-      fit = FitBall(bgr, *table_, ball_bit_, blob.centroid_px(), rough_r, camera_, o.fit);
-    }
-    std::string fit_why;  // why the precise path fails
-    double visible = 0.0, leak = 1.0;
-    if (!fit.ok) {
-      fit_why = fit.failure.empty() ? "too small to fit" : fit.failure;
-    } else {
-      DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
-                 fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
-      fit_why = OutlineProblem(fit, visible, leak, o);
-    }
-    // 3. Size: the radius limits and, with a posed camera, the ball's size at that place.
-    const double radius = fit.ok && fit_why.empty() ? fit.radius_px : cand.radius_px;
-    const Vector2d centre = fit.ok && fit_why.empty() ? fit.centre_px : cand.centre_px;
-    double size_factor = 1.0;
-    const std::string size_why = SizeProblem(centre, radius, &size_factor);
-    // The region path checks the region's own size (a small ball's outline fit may hug its
-    // saturated core and measure it too small while the region holds the whole ball).
-    double region_size_factor = size_factor;
-    const std::string region_size_why =
-        region.ok && radius != region.radius_px
-            ? SizeProblem(region.centre_px, region.radius_px, &region_size_factor)
-            : size_why;
-    // Where the region was measured, the outline fit alone does not decide: both must agree.
-    const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
-                               RegionProblem(region, o, /*shape_only=*/true).empty();
-    const bool precise_ok = fit.ok && fit_why.empty() && size_why.empty() && region_agrees;
-    std::string region_why;
-    if (!o.use_region) {
-      region_why = "region check off";
-    } else if (!region.ok) {
-      region_why = region.failure;
-    } else {
-      region_why = RegionProblem(region, o);
-      if (region_why.empty()) region_why = region_size_why;
-    }
-    const bool region_accept = region_why.empty();
-    if (fit.ok) {
-      cand.blurred = fit.blurred;
-      cand.inlier_fraction = fit.inlier_fraction;
-      cand.outside_fraction = fit.outside_fraction;
-      cand.dents = fit.dents;
-      cand.visible_fraction = visible;
-    }
-    const double region_score = region.ok ? region.arc_cover * std::min(1.0, region.fill / 0.9) *
-                                                (1.0 - region.spill) * (1.0 - region.leak) *
-                                                (region.radius_px / (region.radius_px + 1.0)) *
-                                                region_size_factor
-                                          : 0.0;
-    // Balls stand out: the score grows with the contrast up to twice the least one.
-    const double contrast_factor =
-        region.ok && o.min_contrast > 0
-            ? std::clamp(region.contrast / (2 * o.min_contrast), 0.25, 1.0)
-            : 1.0;
-    if (precise_ok) {
+    cand.score = region_score * contrast_factor;
+    cand.accepted = true;
+  } else {
+    cand.accepted = false;
+    cand.reason = !size_why.empty() ? size_why : (region.ok ? region_why : fit_why);
+    cand.score = region_score;
+    cand.weak = fit.ok && size_why.empty() && !fit_why.empty() &&
+                fit.inlier_fraction >= o.weak_min_inlier_fraction &&
+                visible >= o.min_visible_fraction;
+    if (cand.weak) {
       cand.centre_px = fit.centre_px;
       cand.radius_px = fit.radius_px;
       cand.sigma_px = fit.sigma_px;
-      cand.precise = true;
-      cand.score =
-          std::max(region_score, fit.inlier_fraction * std::min(1.0, visible / 0.9) * (1.0 - leak) *
-                                     std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor);
-      cand.score *= contrast_factor;
-      cand.accepted = true;
-    } else if (region_accept) {
-      // The outline fit refines the region's centre when the two agree.
-      if (fit.ok && (fit.centre_px - region.centre_px).norm() < 0.25 * region.radius_px &&
-          std::abs(fit.radius_px - region.radius_px) < 0.25 * region.radius_px &&
-          fit.inlier_fraction >= o.weak_min_inlier_fraction) {
-        cand.centre_px = fit.centre_px;
-        cand.radius_px = fit.radius_px;
-        cand.sigma_px = std::max(fit.sigma_px, region.sigma_px * 0.5);
-        cand.precise = true;
-      }
-      cand.score = region_score * contrast_factor;
-      cand.accepted = true;
-    } else {
-      cand.accepted = false;
-      cand.reason = !size_why.empty() ? size_why : (region.ok ? region_why : fit_why);
-      cand.score = region_score;
-      cand.weak = fit.ok && size_why.empty() && !fit_why.empty() &&
-                  fit.inlier_fraction >= o.weak_min_inlier_fraction &&
-                  visible >= o.min_visible_fraction;
-      if (cand.weak) {
-        cand.centre_px = fit.centre_px;
-        cand.radius_px = fit.radius_px;
-        cand.sigma_px = fit.sigma_px;
-      }
-    }
-    result.candidates.push_back(cand);
-  }
-  if (small_balls_ && result.accepted() == 0) AddSmallBalls(bgr, roi, &result);
-  std::stable_sort(result.candidates.begin(), result.candidates.end(),
-                   [](const BallCandidate& a, const BallCandidate& b) {
-                     if (a.accepted != b.accepted) return a.accepted;
-                     return a.score > b.score;
-                   });
-  // One ball, one candidate: a later accepted candidate on a better one is a duplicate.
-  for (size_t i = 0; i < result.candidates.size(); ++i) {
-    BallCandidate& c = result.candidates[i];
-    if (!c.accepted) continue;
-    for (size_t j = 0; j < i; ++j) {
-      const BallCandidate& b = result.candidates[j];
-      if (b.accepted && (b.centre_px - c.centre_px).norm() < std::max(b.radius_px, 2.0)) {
-        c.accepted = false;
-        c.reason = "duplicate";
-        break;
-      }
     }
   }
-  std::stable_sort(result.candidates.begin(), result.candidates.end(),
-                   [](const BallCandidate& a, const BallCandidate& b) {
-                     if (a.accepted != b.accepted) return a.accepted;
-                     return a.score > b.score;
-                   });
-  return result;
 }
 
 void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,

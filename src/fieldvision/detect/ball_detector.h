@@ -8,6 +8,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -165,6 +166,22 @@ class BallDetector {
   // Whether the small-ball stage runs (options.small.mode; "auto": somewhere in the image a
   // posed camera expects a ball that small).
   bool SmallBallsPossible() const;
+  // Centres and radii of the regions measured so far in a frame (a blob inside one is a
+  // fragment of it).
+  struct MeasuredRegions {
+    std::vector<Eigen::Vector2d> centres;
+    std::vector<double> radii;
+    bool Holds(const BallRegion& region) const;
+  };
+  // One blob through the region stage, the outline fit and Decide: its candidate, or nullopt for
+  // a fragment of a region already measured. Counts refined blobs in `refined` (max_refine).
+  std::optional<BallCandidate> EvaluateBlob(const cv::Mat& bgr, const Blob& blob,
+                                            const cv::Rect& roi, MeasuredRegions* measured,
+                                            int* refined) const;
+  // Accepts `cand` by the outline fit (precise) or the region checks, with the size check and
+  // the score, or rejects it with the reason.
+  void Decide(const BallRegion& region, const BallFit& fit, const std::string& fit_why,
+              double visible, double leak, BallCandidate* cand) const;
   BallDetectorOptions options_;
   const Camera* camera_;
   const FieldModel* field_;
