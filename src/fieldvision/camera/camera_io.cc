@@ -1,5 +1,7 @@
 #include "fieldvision/camera/camera_io.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 
@@ -103,7 +105,17 @@ Camera ReadCameraYamlFrom(const cv::FileStorage& fs, const std::string& path) {
   const cv::FileNode notes = fs["notes"];
   if (notes.isMap()) {
     for (const auto& n : notes) {
-      if (n.isString()) cam.notes[n.name()] = static_cast<std::string>(n);
+      if (!n.isString()) continue;
+      // Only names that OpenCV can write back (WriteCameraYaml) are kept as notes.
+      const std::string key = n.name();
+      const bool valid =
+          !key.empty() && (std::isalpha(static_cast<unsigned char>(key[0])) || key[0] == '_') &&
+          std::all_of(key.begin(), key.end(), [](char ch) {
+            return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+          });
+      FV_REQUIRE(valid, "camera file '{}': notes key '{}' is not a name (letters, digits, _ or -)",
+                 path, key);
+      cam.notes[key] = static_cast<std::string>(n);
     }
   }
   cam.Check("camera file '" + path + "'");
