@@ -32,6 +32,7 @@ void RunTracksEdit(const TracksEditCli& c) {
   const std::vector<std::string> inputs = {c.tracks, c.edits, roster_in};
   CheckOutputPath(c.out, inputs);
   CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
+  ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);
@@ -57,6 +58,7 @@ void RunTracksDraw(const TracksDrawCli& c) {
     roster_in = track::RosterPathFor(c.tracks);
   }
   CheckOutputPath(c.out, {c.tracks, c.video, c.camera, c.field, roster_in});
+  ResolveOutputPath(c.out);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   std::optional<Camera> camera;
   if (!c.camera.empty()) camera = ReadCameraYaml(c.camera);
