@@ -154,7 +154,8 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
       Throw("cannot write camera file '{}'", path);
     }
     FV_REQUIRE(fs.isOpened(), "cannot write camera file '{}'", path);
-    if (!camera.name.empty()) fs << "name" << camera.name;
+    // cv::write, not <<: << takes strings that start with [ ] { } for structure marks.
+    if (!camera.name.empty()) cv::write(fs, "name", camera.name);
     fs << "image_width" << camera.width << "image_height" << camera.height;
     const cv::Mat k =
         (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
@@ -174,7 +175,7 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
     if (!camera.notes.empty()) {
       fs << "notes"
          << "{";
-      for (const auto& [key, value] : camera.notes) fs << key << value;
+      for (const auto& [key, value] : camera.notes) cv::write(fs, key, value);
       fs << "}";
     }
     fs.release();
