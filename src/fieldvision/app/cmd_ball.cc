@@ -77,7 +77,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "With --sync time: frames this close in seconds are combined")
       ->capture_default_str();
   cmd->add_flag("--live", o->job.live,
-                "Live input: keep the newest frames when fusion falls behind (drops frames)");
+                "Live: play the videos at their frame rate (as cameras deliver) and keep the "
+                "newest frames when fusion falls behind (drops frames)");
   cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames");
   cmd->add_option("--inlier-px", o->job.pipeline.triangulation.inlier_threshold_px,
                   "A camera agrees when it sees the ball within this many pixels")

@@ -1,5 +1,6 @@
 #include "fieldvision/pipeline/ball_job.h"
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -86,8 +87,15 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   if (!o.field.empty()) field = LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
   std::vector<std::unique_ptr<FrameSource>> sources;
+  // --live on files: a file is not live; each is played at its own frame rate from one common
+  // start (as cameras would deliver it), so frames drop only when fusion is slower than that.
+  const double live_start_s =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() +
+      0.5;
   for (int c = 0; c < n; ++c) {
     FrameSourceOptions vo;
+    vo.realtime = o.live;
+    vo.start_at_s = o.live ? live_start_s : 0.0;
     if (!o.timestamps.empty()) {
       vo.time = TimeSource::kCsv;
       vo.timestamps_csv = o.timestamps[c];
