@@ -40,6 +40,14 @@ check "plan: missing rig" nonzero $FV plan --rig "$TMP/none.json" --out "$TMP/pl
 check "extrinsics: missing camera" nonzero $FV calibrate extrinsics --camera "$TMP/none.yaml" \
   --points "$TMP/none.csv" --out "$TMP/c.yaml"
 printf 'frame,time_s,x_m,y_m,z_m\n0,0,1,2,nan\n' > "$TMP/nan.csv"
+check "ball: --det-sigma without --detections" nonzero $FV ball --camera "$TMP/c1.yaml" \
+  --video "$TMP/v.avi" --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" \
+  --det-sigma 3
+check "ball: --out a device" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out /dev/null
+[ -c /dev/null ] || { echo "FAIL ball: /dev/null replaced"; fail=1; }
+check "detect: --ball-diameter 1e300" nonzero $FV detect --video "$TMP/v.avi" --out "$TMP/d.csv" \
+  --ball-diameter 1e300
 check "eval ball: NaN truth" nonzero $FV eval ball --truth "$TMP/nan.csv" --est "$TMP/nan.csv"
 # An output that is one of the inputs (by name or through a link) is refused; the input stays.
 printf 'not a video\n' > "$TMP/v.avi"

@@ -93,11 +93,16 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-weak", o->job.pipeline.triangulation.use_weak,
                 "Never use candidates that failed a shape check to complete a position");
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
-  cmd->callback([o] {
+  cmd->callback([o, cmd] {
+    FV_REQUIRE(!o->det.detections.empty() ||
+                   (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
+               "ball: --det-sigma and --flights apply only with --detections");
     const auto inputs = PathList(o->job.cameras, o->job.videos, o->job.timestamps, o->job.truth,
                                  o->job.field, o->job.colour, o->det.detections);
     CheckOutputPath(o->job.out, inputs);
     CheckOutputPath(o->det.flights, PathList(inputs, o->job.out), "--flights");
+    o->job.out = ResolveOutputPath(o->job.out);  // refuses a device or a folder
+    if (!o->det.flights.empty()) o->det.flights = ResolveOutputPath(o->det.flights, "--flights");
     if (!o->det.detections.empty()) {
       FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
       RunDetections(*o);

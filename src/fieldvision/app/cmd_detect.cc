@@ -26,6 +26,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "file from `color learn`")
       ->capture_default_str();
   cmd->add_option("--ball-diameter", o->detector.diameter_m, "Ball diameter in metres")
+      ->check(CLI::Range(0.01, 2.0))
       ->capture_default_str();
   cmd->add_option("--field", o->field,
                   "Field (built-in name or JSON): ignore everything outside the field of play "
@@ -36,8 +37,10 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
       ->capture_default_str();
   cmd->add_option("--min-radius", o->detector.min_radius_px, "Smallest ball radius in pixels")
+      ->check(CLI::Range(0.1, 10000.0))
       ->capture_default_str();
   cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
+      ->check(CLI::Range(0.1, 10000.0))
       ->capture_default_str();
   cmd->add_option("--small-balls", o->detector.small.mode,
                   "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "

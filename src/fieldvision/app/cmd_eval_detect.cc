@@ -28,8 +28,10 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--color", o->detector.colour, "Colour preset or colour file")
       ->capture_default_str();
   cmd->add_option("--min-radius", o->detector.min_radius_px, "Smallest ball radius in pixels")
+      ->check(CLI::Range(0.1, 10000.0))
       ->capture_default_str();
   cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
+      ->check(CLI::Range(0.1, 10000.0))
       ->capture_default_str();
   cmd->add_option("--small-balls", o->detector.small.mode,
                   "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "

@@ -175,7 +175,9 @@ void BallDetectorOptions::Check() const {
              scan_step_px);
   FV_REQUIRE(min_samples >= 1, "min_samples must be >= 1 (got {})", min_samples);
   CheckPositive(min_radius_px, "min_radius_px");
-  FV_REQUIRE(max_radius_px > min_radius_px, "max_radius_px must be > min_radius_px");
+  FV_REQUIRE(std::isfinite(max_radius_px) && max_radius_px > min_radius_px,
+             "max_radius_px must be finite and > min_radius_px (got {})", max_radius_px);
+  FV_REQUIRE(diameter_m < 2.0, "diameter_m must be below 2 m (got {})", diameter_m);
   CheckInRange(min_fill_ratio, 0.0, 1.0, "min_fill_ratio");
   FV_REQUIRE(max_aspect_ratio >= 1.0, "max_aspect_ratio must be >= 1 (got {})", max_aspect_ratio);
   CheckInRange(min_inlier_fraction, 0.0, 1.0, "min_inlier_fraction");

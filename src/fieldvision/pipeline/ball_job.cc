@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/ball_detector.h"
@@ -80,6 +81,13 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   o.Check();
   FV_REQUIRE(o.truth.empty() || std::filesystem::exists(o.truth), "truth file '{}' does not exist",
              o.truth);
+  // A bad truth file fails before anything is written (read as both truth and estimate, it is
+  // checked for columns and values).
+  std::optional<CsvTable> truth;
+  if (!o.truth.empty()) {
+    truth = CsvTable::Read(o.truth);
+    EvaluateBall(*truth, *truth, o.eval);
+  }
   const int n = static_cast<int>(o.cameras.size());
   std::vector<Camera> cameras;
   for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
@@ -142,7 +150,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::error_code ec;
   std::filesystem::rename(tmp, o.out, ec);
   FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
-  if (!o.truth.empty()) result.eval = EvaluateBallFiles(o.truth, o.out, o.eval);
+  if (truth) result.eval = EvaluateBall(*truth, CsvTable::Read(o.out), o.eval);
   return result;
 }
 
