@@ -203,7 +203,9 @@ std::vector<Camera> ReadCalibrationToml(const std::string& path, double metres_p
   CheckPositive(metres_per_unit, "metres_per_unit");
   const auto sections = ParseToml(path);
   std::vector<Camera> cams;
-  for (const auto& [section, table] : sections) {
+  for (const auto& entry : sections) {
+    const auto& section = entry.first;
+    const auto& table = entry.second;  // a plain reference: lambdas below capture it
     if (!table.count("matrix")) continue;
     const std::string where = fmt::format("calibration file '{}' [{}]", path, section);
     auto get = [&](const char* key) -> const TomlValue& {
