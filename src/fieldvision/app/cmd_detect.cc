@@ -36,17 +36,7 @@ void Setup(CLI::App& app, int& exit_code) {
       "Draw the candidates: an annotated video (.avi, .mp4, .mkv) or a folder of JPEGs");
   cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
       ->capture_default_str();
-  cmd->add_option("--min-radius", o->detector.min_radius_px, "Smallest ball radius in pixels")
-      ->check(CLI::Range(0.1, 10000.0))
-      ->capture_default_str();
-  cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
-      ->check(CLI::Range(0.1, 10000.0))
-      ->capture_default_str();
-  cmd->add_option("--small-balls", o->detector.small.mode,
-                  "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "
-                  "camera, where the ball looks that small)")
-      ->check(CLI::IsMember({"auto", "on", "off"}))
-      ->capture_default_str();
+  AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn);
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");

@@ -27,17 +27,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--camera", o->camera, "Camera file (size checks)");
   cmd->add_option("--color", o->detector.colour, "Colour preset or colour file")
       ->capture_default_str();
-  cmd->add_option("--min-radius", o->detector.min_radius_px, "Smallest ball radius in pixels")
-      ->check(CLI::Range(0.1, 10000.0))
-      ->capture_default_str();
-  cmd->add_option("--max-radius", o->detector.max_radius_px, "Largest ball radius in pixels")
-      ->check(CLI::Range(0.1, 10000.0))
-      ->capture_default_str();
-  cmd->add_option("--small-balls", o->detector.small.mode,
-                  "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "
-                  "camera, where the ball looks that small)")
-      ->check(CLI::IsMember({"auto", "on", "off"}))
-      ->capture_default_str();
+  AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn);
   cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")
       ->capture_default_str();
