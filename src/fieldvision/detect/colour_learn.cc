@@ -26,11 +26,9 @@ bool Inside(const ColourRange& r, const Hsv8& p) {
   return hue && p[1] >= r.min[1] && p[1] <= r.max[1] && p[2] >= r.min[2] && p[2] <= r.max[2];
 }
 
-double Share(const ColourRange& r, const std::vector<Hsv8>& px) {
-  if (px.empty()) return 0.0;
-  size_t n = 0;
-  for (const auto& p : px) n += Inside(r, p);
-  return double(n) / px.size();
+// The box around a region that holds its ring of background: 1.5 times its size.
+cv::Rect AroundRoi(const cv::Rect& r) {
+  return cv::Rect(r.x - r.width / 4, r.y - r.height / 4, r.width * 3 / 2, r.height * 3 / 2);
 }
 
 }  // namespace
@@ -93,86 +91,90 @@ cv::Mat ReadVideoFrame(const std::string& video, int frame_index) {
         frame_index);
 }
 
-ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
-  o.Check();
-  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "colour learn: the frame is not 8-bit BGR");
+ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& o) {
   const cv::Rect frame_rect(0, 0, bgr.cols, bgr.rows);
-  cv::Mat hsv;
-  cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
-  cv::Mat pos_mask(bgr.size(), CV_8U, cv::Scalar(0));
-  cv::Mat neg_mask(bgr.size(), CV_8U, cv::Scalar(0));
-  cv::Mat near_mask(bgr.size(), CV_8U, cv::Scalar(0));  // kept out of the default negatives
+  ColourLearnMasks m;
+  m.positive = cv::Mat(bgr.size(), CV_8U, cv::Scalar(0));
+  m.negative = cv::Mat(bgr.size(), CV_8U, cv::Scalar(0));
+  m.near = cv::Mat(bgr.size(), CV_8U, cv::Scalar(0));
   for (const auto& p : o.points) {
     FV_REQUIRE(p.x() >= 0 && p.y() >= 0 && p.x() < bgr.cols && p.y() < bgr.rows,
                "point ({}, {}) is outside the {}x{} frame", p.x(), p.y(), bgr.cols, bgr.rows);
     const cv::Point c(cvRound(p.x()), cvRound(p.y()));
-    cv::circle(pos_mask, c, o.point_radius_px, 255, cv::FILLED);
-    cv::circle(near_mask, c, 40, 255, cv::FILLED);
+    cv::circle(m.positive, c, o.point_radius_px, 255, cv::FILLED);
+    cv::circle(m.near, c, 40, 255, cv::FILLED);
   }
   if (o.roi) {
     const cv::Rect r = *o.roi;
     FV_REQUIRE((r & frame_rect) == r, "region {},{},{},{} is not inside the {}x{} frame", r.x, r.y,
                r.width, r.height, bgr.cols, bgr.rows);
     // The ball's interior: the inscribed ellipse shrunk by 20 %.
-    cv::ellipse(pos_mask, cv::Point(r.x + r.width / 2, r.y + r.height / 2),
+    cv::ellipse(m.positive, cv::Point(r.x + r.width / 2, r.y + r.height / 2),
                 cv::Size(std::max(1, int(0.4 * r.width)), std::max(1, int(0.4 * r.height))), 0, 0,
                 360, 255, cv::FILLED);
-    const cv::Rect grown(r.x - r.width / 4, r.y - r.height / 4, r.width * 3 / 2, r.height * 3 / 2);
-    near_mask(grown & frame_rect).setTo(255);
-    // A loose box also holds background: keep the pixels closer to the box centre's colour
-    // than to the median colour of the ring around the box.
-    const cv::Point c(r.x + r.width / 2, r.y + r.height / 2);
-    const cv::Scalar centre = cv::mean(bgr(cv::Rect(c.x - 1, c.y - 1, 3, 3) & frame_rect));
-    std::array<std::vector<int>, 3> ring;
-    const cv::Rect outer = grown & frame_rect;
-    for (int y = outer.y; y < outer.y + outer.height; ++y) {
-      for (int x = outer.x; x < outer.x + outer.width; ++x) {
-        if (r.contains(cv::Point(x, y))) continue;
-        const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
-        for (int k = 0; k < 3; ++k) ring[k].push_back(p[k]);
-      }
-    }
-    if (!ring[0].empty()) {
-      cv::Vec3d bg;
-      for (int k = 0; k < 3; ++k) bg[k] = NearestRankPercentile(ring[k], 0.5);
-      for (int y = r.y; y < r.y + r.height; ++y) {
-        for (int x = r.x; x < r.x + r.width; ++x) {
-          if (!pos_mask.at<uint8_t>(y, x)) continue;
-          const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
-          double dc = 0, db = 0;
-          for (int k = 0; k < 3; ++k) {
-            dc += (p[k] - centre[k]) * (p[k] - centre[k]);
-            db += (p[k] - bg[k]) * (p[k] - bg[k]);
-          }
-          if (db <= dc) pos_mask.at<uint8_t>(y, x) = 0;
-        }
-      }
-    }
+    m.near(AroundRoi(r) & frame_rect).setTo(255);
+    DropBackgroundLikePixels(bgr, r, m.positive);
   }
   for (const auto& p : o.negative_points) {
     FV_REQUIRE(p.x() >= 0 && p.y() >= 0 && p.x() < bgr.cols && p.y() < bgr.rows,
                "negative point ({}, {}) is outside the {}x{} frame", p.x(), p.y(), bgr.cols,
                bgr.rows);
-    cv::circle(neg_mask, cv::Point(cvRound(p.x()), cvRound(p.y())), o.point_radius_px, 255,
+    cv::circle(m.negative, cv::Point(cvRound(p.x()), cvRound(p.y())), o.point_radius_px, 255,
                cv::FILLED);
   }
-  std::vector<Hsv8> pos, neg;
-  for (int y = 0; y < bgr.rows; ++y) {
-    for (int x = 0; x < bgr.cols; ++x) {
-      if (pos_mask.at<uint8_t>(y, x)) {
-        pos.push_back(hsv.at<Hsv8>(y, x));
-      } else if (neg_mask.at<uint8_t>(y, x) ||
-                 (!near_mask.at<uint8_t>(y, x) && (x % 3 == 0) && (y % 3 == 0))) {
-        neg.push_back(hsv.at<Hsv8>(y, x));  // clicked, or the frame away from the ball
+  return m;
+}
+
+void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& positive) {
+  const cv::Rect frame_rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect& r = roi;
+  const cv::Point c(r.x + r.width / 2, r.y + r.height / 2);
+  const cv::Scalar centre = cv::mean(bgr(cv::Rect(c.x - 1, c.y - 1, 3, 3) & frame_rect));
+  std::array<std::vector<int>, 3> ring;
+  const cv::Rect outer = AroundRoi(r) & frame_rect;
+  for (int y = outer.y; y < outer.y + outer.height; ++y) {
+    for (int x = outer.x; x < outer.x + outer.width; ++x) {
+      if (r.contains(cv::Point(x, y))) continue;
+      const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
+      for (int k = 0; k < 3; ++k) ring[k].push_back(p[k]);
+    }
+  }
+  if (ring[0].empty()) return;
+  cv::Vec3d bg;
+  for (int k = 0; k < 3; ++k) bg[k] = NearestRankPercentile(ring[k], 0.5);
+  for (int y = r.y; y < r.y + r.height; ++y) {
+    for (int x = r.x; x < r.x + r.width; ++x) {
+      if (!positive.at<uint8_t>(y, x)) continue;
+      const cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
+      double dc = 0, db = 0;
+      for (int k = 0; k < 3; ++k) {
+        dc += (p[k] - centre[k]) * (p[k] - centre[k]);
+        db += (p[k] - bg[k]) * (p[k] - bg[k]);
+      }
+      if (db <= dc) positive.at<uint8_t>(y, x) = 0;
+    }
+  }
+}
+
+ColourLearnPixels GatherLearnPixels(const cv::Mat& hsv, const ColourLearnMasks& m) {
+  ColourLearnPixels px;
+  for (int y = 0; y < hsv.rows; ++y) {
+    for (int x = 0; x < hsv.cols; ++x) {
+      if (m.positive.at<uint8_t>(y, x)) {
+        px.positive.push_back(hsv.at<Hsv8>(y, x));
+      } else if (m.negative.at<uint8_t>(y, x) ||
+                 (!m.near.at<uint8_t>(y, x) && (x % 3 == 0) && (y % 3 == 0))) {
+        px.negative.push_back(hsv.at<Hsv8>(y, x));  // clicked, or the frame away from the ball
       }
     }
   }
-  FV_REQUIRE(pos.size() >= 5, "only {} positive pixels; give more points or a larger region",
-             pos.size());
-  // Hue: the shortest circular interval holding all but the trimmed share.
+  return px;
+}
+
+std::pair<int, int> ShortestHueInterval(const std::vector<cv::Vec3b>& hsv, double trim) {
   std::vector<int> hist(256, 0);
-  for (const auto& p : pos) ++hist[p[0]];
-  const int need = static_cast<int>(std::ceil((1.0 - 2 * o.trim) * pos.size()));
+  for (const auto& p : hsv) ++hist[p[0]];
+  const int need = static_cast<int>(std::ceil((1.0 - 2 * trim) * hsv.size()));
   int best_start = 0, best_len = 256;
   for (int start = 0; start < 256; ++start) {
     int sum = 0;
@@ -187,8 +189,14 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
       }
     }
   }
+  return {best_start, best_len};
+}
+
+ColourRange InitialColourRange(const std::vector<cv::Vec3b>& positive,
+                               const ColourLearnOptions& o) {
+  const auto [best_start, best_len] = ShortestHueInterval(positive, o.trim);
   std::vector<int> s, v;
-  for (const auto& p : pos) {
+  for (const auto& p : positive) {
     s.push_back(p[1]);
     v.push_back(p[2]);
   }
@@ -207,8 +215,13 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
   r.max[1] = 255;
   r.min[2] = std::max(0.0, NearestRankPercentile(v, o.trim) - o.value_margin);
   r.max[2] = 255;
-  // Shrink against the negatives: move one bound a step at a time.
-  double recall = Share(r, pos), neg_rate = Share(r, neg);
+  return r;
+}
+
+ColourRange ShrinkAgainstNegatives(ColourRange r, const ColourLearnPixels& px, double min_recall) {
+  const auto& pos = px.positive;
+  const auto& neg = px.negative;
+  double recall = ColourRangeShare(r, pos), neg_rate = ColourRangeShare(r, neg);
   for (int iter = 0; iter < 200 && neg_rate > 0.001; ++iter) {
     ColourRange best = r;
     double best_gain = 0;
@@ -218,9 +231,9 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
       if (move == 1) t.min[2] = std::min(t.min[2] + 5, 250.0);
       if (move == 2) t.min[0] = std::fmod(t.min[0] + 1.40625, 360.0);
       if (move == 3) t.max[0] = std::fmod(t.max[0] - 1.40625 + 360.0, 360.0);
-      const double rec = Share(t, pos);
-      if (rec < o.min_recall) continue;
-      const double gain = (neg_rate - Share(t, neg)) - 0.2 * (recall - rec);
+      const double rec = ColourRangeShare(t, pos);
+      if (rec < min_recall) continue;
+      const double gain = (neg_rate - ColourRangeShare(t, neg)) - 0.2 * (recall - rec);
       if (gain > best_gain) {
         best_gain = gain;
         best = t;
@@ -228,31 +241,59 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
     }
     if (best_gain <= 0) break;
     r = best;
-    recall = Share(r, pos);
-    neg_rate = Share(r, neg);
+    recall = ColourRangeShare(r, pos);
+    neg_rate = ColourRangeShare(r, neg);
   }
-  ColourLearnResult result;
-  result.range = r;
-  result.positives = static_cast<int>(pos.size());
-  result.negatives = static_cast<int>(neg.size());
-  result.recall = recall;
-  result.negative_rate = neg_rate;
-  result.bad = neg_rate > o.max_background_share;
-  result.spec.classes.push_back({o.class_name, {r}});
-  if (o.class_name != "field") {
-    result.spec.classes.push_back({"field", ColourPreset("green").ranges});
-  }
-  if (o.class_name != "line") result.spec.classes.push_back({"line", ColourPreset("white").ranges});
-  result.spec.ball_class = o.class_name;
-  result.spec.Check("learned colour");
-  // Overlay: the class at full brightness, everything else dimmed; the positives outlined.
-  const ColourTable table(result.spec, 8);
+  return r;
+}
+
+double ColourRangeShare(const ColourRange& r, const std::vector<cv::Vec3b>& hsv) {
+  if (hsv.empty()) return 0.0;
+  size_t n = 0;
+  for (const auto& p : hsv) n += Inside(r, p);
+  return double(n) / hsv.size();
+}
+
+ColourSpec LearnedColourSpec(const ColourRange& r, const std::string& class_name) {
+  ColourSpec spec;
+  spec.classes.push_back({class_name, {r}});
+  if (class_name != "field") spec.classes.push_back({"field", ColourPreset("green").ranges});
+  if (class_name != "line") spec.classes.push_back({"line", ColourPreset("white").ranges});
+  spec.ball_class = class_name;
+  spec.Check("learned colour");
+  return spec;
+}
+
+cv::Mat LearnOverlay(const cv::Mat& bgr, const ColourSpec& spec, const cv::Mat& positive) {
+  // The class at full brightness, everything else dimmed; the positives outlined.
+  const ColourTable table(spec, 8);
   const cv::Mat cls = table.ClassifyImage(bgr) & table.BallBit();
-  result.overlay = bgr * 0.25;
-  bgr.copyTo(result.overlay, cls);
+  cv::Mat overlay = bgr * 0.25;
+  bgr.copyTo(overlay, cls);
   std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(pos_mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
-  cv::drawContours(result.overlay, contours, -1, cv::Scalar(255, 0, 255), 1, cv::LINE_AA);
+  cv::findContours(positive, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  cv::drawContours(overlay, contours, -1, cv::Scalar(255, 0, 255), 1, cv::LINE_AA);
+  return overlay;
+}
+
+ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
+  o.Check();
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "colour learn: the frame is not 8-bit BGR");
+  cv::Mat hsv;
+  cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
+  const ColourLearnMasks masks = MarkLearnPixels(bgr, o);
+  const ColourLearnPixels px = GatherLearnPixels(hsv, masks);
+  FV_REQUIRE(px.positive.size() >= 5,
+             "only {} positive pixels; give more points or a larger region", px.positive.size());
+  ColourLearnResult result;
+  result.range = ShrinkAgainstNegatives(InitialColourRange(px.positive, o), px, o.min_recall);
+  result.positives = static_cast<int>(px.positive.size());
+  result.negatives = static_cast<int>(px.negative.size());
+  result.recall = ColourRangeShare(result.range, px.positive);
+  result.negative_rate = ColourRangeShare(result.range, px.negative);
+  result.bad = result.negative_rate > o.max_background_share;
+  result.spec = LearnedColourSpec(result.range, o.class_name);
+  result.overlay = LearnOverlay(bgr, result.spec, masks.positive);
   return result;
 }
 

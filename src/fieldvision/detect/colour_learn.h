@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -50,6 +51,39 @@ struct ColourLearnResult {
 // Learns from one BGR frame. Throws fv::Error for points or a region outside the frame, or too
 // few positives.
 ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& options);
+
+// The stages of LearnColour, in order; each callable alone.
+struct ColourLearnMasks {
+  cv::Mat positive;  // CV_8U, 255 at the class's pixels
+  cv::Mat negative;  // CV_8U, 255 around the negative points
+  cv::Mat near;      // CV_8U, 255 near the positives: kept out of the default negatives
+};
+// Draws the points and the region into masks; throws fv::Error for any outside the frame.
+ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& options);
+// Clears the `positive` pixels inside `roi` that are closer to the median colour of the ring
+// around it than to the colour at its centre (a loose box also holds background).
+void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& positive);
+struct ColourLearnPixels {
+  std::vector<cv::Vec3b> positive;  // HSV_FULL (hue 0..255 for 0..360 degrees)
+  std::vector<cv::Vec3b> negative;  // clicked, or every third pixel away from the positives
+};
+ColourLearnPixels GatherLearnPixels(const cv::Mat& hsv_full, const ColourLearnMasks& masks);
+// The shortest circular interval of 8-bit hues holding all but the share `trim` at each end:
+// {first hue, length}, the first hue the lowest of equally short ones.
+std::pair<int, int> ShortestHueInterval(const std::vector<cv::Vec3b>& hsv_full, double trim);
+// The hue interval and the trimmed low saturation and value, widened by the margins.
+ColourRange InitialColourRange(const std::vector<cv::Vec3b>& positive,
+                               const ColourLearnOptions& options);
+// Greedy shrinking: one bound a step at a time where it removes most negatives per positive
+// lost, while the recall stays at least `min_recall`.
+ColourRange ShrinkAgainstNegatives(ColourRange range, const ColourLearnPixels& pixels,
+                                   double min_recall);
+// Share of the HSV_FULL pixels inside `range` (as the colour table sees it); 0 for none.
+double ColourRangeShare(const ColourRange& range, const std::vector<cv::Vec3b>& hsv_full);
+// The class, then field green and line white unless the class is one of them.
+ColourSpec LearnedColourSpec(const ColourRange& range, const std::string& class_name);
+// The frame dimmed except where the class is, the positives outlined.
+cv::Mat LearnOverlay(const cv::Mat& bgr, const ColourSpec& spec, const cv::Mat& positive);
 
 // Reads frame `frame` of `video` (file or image pattern); throws naming the video when it cannot
 // be opened or is shorter.

@@ -1,6 +1,7 @@
 #include "fieldvision/detect/colour_learn.h"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/test_images.h"
@@ -75,6 +76,85 @@ TEST(LearnColour, AClassThatSelectsTheBackgroundIsBad) {
   detect_testing::PaintDisc(clean, c, 14, cv::Vec3b(180, 105, 255));
   o.roi = cv::Rect(140, 50, 40, 40);
   EXPECT_FALSE(LearnColour(clean, o).bad);
+}
+
+TEST(LearnColourStages, HueIntervalIsCircularAndTrimmed) {
+  // Hues 250..255 and 0..5 (red on both sides of zero) and one outlier at 128.
+  std::vector<cv::Vec3b> px;
+  for (int h = 250; h < 256; ++h) px.emplace_back(h, 200, 200);
+  for (int h = 0; h <= 5; ++h) px.emplace_back(h, 200, 200);
+  const auto [start, len] = ShortestHueInterval(px, 0.0);
+  EXPECT_EQ(start, 250);
+  EXPECT_EQ(len, 12);
+  px.emplace_back(128, 200, 200);
+  const auto [start_all, len_all] = ShortestHueInterval(px, 0.0);
+  EXPECT_EQ(start_all, 128);  // without trimming the outlier is held: 128..5
+  EXPECT_EQ(len_all, 134);
+  // Trimming 1 of 13 at each end drops the outlier: the interval wraps through zero.
+  const auto [start_t, len_t] = ShortestHueInterval(px, 0.05);
+  EXPECT_EQ(start_t, 250);
+  EXPECT_EQ(len_t, 12);
+  // The range in degrees wraps too (min > max) and holds every trimmed-in pixel.
+  ColourLearnOptions o;
+  o.trim = 0.05;
+  o.hue_margin_deg = 0;
+  o.saturation_margin = 10;
+  o.value_margin = 10;
+  const ColourRange r = InitialColourRange(px, o);
+  EXPECT_GT(r.min[0], r.max[0]);
+  EXPECT_NEAR(r.min[0], 250 * 360.0 / 256, 1e-9);
+  EXPECT_NEAR(r.max[0], 5 * 360.0 / 256, 1e-9);
+  EXPECT_DOUBLE_EQ(r.min[1], 190);
+  EXPECT_DOUBLE_EQ(r.min[2], 190);
+  EXPECT_NEAR(ColourRangeShare(r, px), 12.0 / 13, 1e-12);
+  // Margins that cover the circle give the full hue range.
+  o.hue_margin_deg = 100;
+  const ColourRange wide = InitialColourRange(
+      std::vector<cv::Vec3b>{{0, 200, 200}, {128, 200, 200}, {200, 200, 200}}, o);
+  EXPECT_EQ(wide.min[0], 0);
+  EXPECT_EQ(wide.max[0], 360);
+}
+
+TEST(LearnColourStages, ShrinkingRemovesNegativesAndKeepsRecall) {
+  // Positives: saturation 80..179; negatives: saturation 40..79, same hue and value.
+  ColourLearnPixels px;
+  for (int s = 80; s < 180; ++s) px.positive.emplace_back(20, s, 200);
+  for (int s = 40; s < 80; ++s) px.negative.emplace_back(20, s, 200);
+  ColourRange r;
+  r.min = {0, 40, 0};
+  ASSERT_DOUBLE_EQ(ColourRangeShare(r, px.negative), 1.0);
+  const ColourRange shrunk = ShrinkAgainstNegatives(r, px, 0.9);
+  EXPECT_DOUBLE_EQ(ColourRangeShare(shrunk, px.negative), 0.0);
+  EXPECT_DOUBLE_EQ(ColourRangeShare(shrunk, px.positive), 1.0);
+  EXPECT_DOUBLE_EQ(shrunk.min[1], 80);  // stops once no negative is left
+  // Negatives that share the positives' colours: shrinking goes on into the positives only
+  // down to the recall limit (90 of 100 kept).
+  ColourLearnPixels mixed = px;
+  mixed.negative.insert(mixed.negative.end(), px.positive.begin(), px.positive.end());
+  const ColourRange kept = ShrinkAgainstNegatives(r, mixed, 0.9);
+  EXPECT_DOUBLE_EQ(kept.min[1], 90);
+  EXPECT_DOUBLE_EQ(ColourRangeShare(kept, mixed.positive), 0.9);
+}
+
+TEST(LearnColourStages, LooseRegionDropsItsBackground) {
+  // A 40x40 box: its left half ball pink, its right half and the ring around it green.
+  cv::Mat img(100, 100, CV_8UC3, cv::Scalar(50, 140, 60));
+  img(cv::Rect(30, 30, 22, 40)).setTo(cv::Scalar(180, 105, 255));
+  ColourLearnOptions o;
+  o.roi = cv::Rect(30, 30, 40, 40);
+  ColourLearnMasks m = MarkLearnPixels(img, o);
+  // The centre (50, 50) is pink: the green right part of the ellipse is dropped.
+  EXPECT_EQ(m.positive.at<uint8_t>(50, 40), 255);
+  EXPECT_EQ(m.positive.at<uint8_t>(50, 60), 0);
+  EXPECT_EQ(m.near.at<uint8_t>(25, 25), 255);  // inside the 1.5x box
+  EXPECT_EQ(m.near.at<uint8_t>(10, 10), 0);
+  cv::Mat hsv;
+  cv::cvtColor(img, hsv, cv::COLOR_BGR2HSV_FULL);
+  const ColourLearnPixels px = GatherLearnPixels(hsv, m);
+  EXPECT_EQ(px.positive.size(), size_t(cv::countNonZero(m.positive)));
+  for (const auto& p : px.positive) EXPECT_GT(p[0], 180);  // all pink (hue ~330 deg), no green
+  // Default negatives: every third pixel in x and y outside the 1.5x box (20..79).
+  EXPECT_EQ(px.negative.size(), 34u * 34u - 20u * 20u);
 }
 
 TEST(LearnColour, BadInputIsNamed) {
