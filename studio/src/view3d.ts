@@ -2,10 +2,11 @@
 // time, flights (FLIGHTS.json: origin, apex, landing), the rays from the cameras to the ball at
 // the time of the slider, and the ball's height over time (uPlot). Live mode: the server
 // subscribes to a fusion node's positions (`fuse --publish`) and forwards them as 'ball' events.
-// Drawing is cheap and on demand: a track is one BufferGeometry drawn as points and a line, the
-// markers one Points object, the rays one preallocated buffer; a frame is rendered only when the
-// view, the time or the data changed (at most once per animation frame). Antialiasing is off on
-// software renderers (SwiftShader, llvmpipe), where it costs ~10x the frame time.
+// Drawing is cheap and on demand: a track is one set of buffers drawn as points and as the line
+// segments the markers do not cover, the markers one Points object, the rays one preallocated
+// buffer; a frame is rendered only when the view, the time or the data changed (at most once per
+// animation frame). On software renderers (SwiftShader, llvmpipe) antialiasing is off (~10x the
+// frame time) and at most 0.3 Mpx are drawn, scaled up by the page.
 // The benchmark (#bench3d, or the button) renders a 10,000-point track while turning the view and
 // reports the displayed frame rate and the render cost per frame, synchronised with the GPU.
 import * as THREE from 'three';
@@ -39,11 +40,13 @@ interface Flight {
 
 export interface BenchResult {
   points: number;
+  segments: number; // line segments drawn (those longer than a marker)
   paced_fps: number; // frames shown per second while turning (requestAnimationFrame, vsync-bound)
   render_ms_median: number; // render + GPU finish per frame
   render_ms_p95: number;
   renderer: string;
   antialias: boolean;
+  canvas: string;
 }
 
 // The WebGL renderer's name (unmasked when the browser tells it) and whether it is software.
@@ -99,11 +102,14 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
 
   const gpu = probeRenderer();
   const antialias = !gpu.software;
-  const renderer = new THREE.WebGLRenderer({ canvas, antialias, preserveDrawingBuffer: true });
+  // No preserveDrawingBuffer: it costs a copy of the canvas every frame.
+  const renderer = new THREE.WebGLRenderer({ canvas, antialias });
   const width = canvas.parentElement!.clientWidth || 900;
   const height = Math.round(width * 0.55);
+  // Software GL fills pixels on the CPU: at most maxSoftwarePixels drawn, scaled up by the page.
+  const maxSoftwarePixels = 300000;
+  renderer.setPixelRatio(gpu.software ? Math.min(1, Math.sqrt(maxSoftwarePixels / (width * height))) : Math.min(2, window.devicePixelRatio || 1));
   renderer.setSize(width, height);
-  renderer.setPixelRatio(gpu.software ? 1 : Math.min(2, window.devicePixelRatio || 1));
   canvas.dataset.renderer = gpu.name;
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0x1d2630);
@@ -124,6 +130,9 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     if (!pending) pending = requestAnimationFrame(renderNow);
   };
   controls.addEventListener('change', requestRender);
+  // Without preserveDrawingBuffer the canvas reads back blank once shown: a 'render-now' event
+  // draws at once, so that a reader in the same task (tests, a capture) gets the picture.
+  canvas.addEventListener('render-now', renderNow);
 
   let dynamic = new THREE.Group();
   let samples: number[][] = [];
@@ -213,7 +222,11 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     return new THREE.LineSegments(geo, new THREE.LineBasicMaterial({ vertexColors: true }));
   }
 
-  // A track: one geometry (positions, time colours) drawn as points and as a line.
+  // A track: one set of positions and time colours drawn as points (every sample) and as line
+  // segments between consecutive samples. A segment shorter than a marker's width lies under the
+  // markers at its ends (same colour) and is left out: dense tracks (a ball rolling or at rest,
+  // 100 Hz samples) draw few segments; software GL pays ~0.5 us per primitive.
+  const markerSize = 0.12; // PointsMaterial size; a marker spans markerSize * tan(fov / 2) metres
   function trackObject(s: number[][]): THREE.Group {
     const pos = new Float32Array(3 * s.length);
     const col = new Float32Array(3 * s.length);
@@ -226,11 +239,24 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
       col.set(rampColour((row[1] - t0) / span), 3 * i);
     });
     const geo = new THREE.BufferGeometry();
-    geo.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    geo.setAttribute('color', new THREE.BufferAttribute(col, 3));
+    const position = new THREE.BufferAttribute(pos, 3);
+    const colour = new THREE.BufferAttribute(col, 3);
+    geo.setAttribute('position', position);
+    geo.setAttribute('color', colour);
+    const covered = markerSize * Math.tan(THREE.MathUtils.degToRad(view.fov / 2));
+    const pairs: number[] = [];
+    for (let i = 1; i < s.length; ++i) {
+      const d = Math.hypot(pos[3 * i] - pos[3 * i - 3], pos[3 * i + 1] - pos[3 * i - 2], pos[3 * i + 2] - pos[3 * i - 1]);
+      if (d > covered) pairs.push(i - 1, i);
+    }
+    const lineGeo = new THREE.BufferGeometry();
+    lineGeo.setAttribute('position', position);
+    lineGeo.setAttribute('color', colour);
+    lineGeo.setIndex(pairs);
     const g = new THREE.Group();
-    g.add(new THREE.Points(geo, new THREE.PointsMaterial({ size: 0.12, vertexColors: true })));
-    g.add(new THREE.Line(geo, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.5 })));
+    g.add(new THREE.Points(geo, new THREE.PointsMaterial({ size: markerSize, vertexColors: true })));
+    g.add(new THREE.LineSegments(lineGeo, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.5 })));
+    g.userData.segments = pairs.length / 2;
     return g;
   }
 
@@ -273,6 +299,11 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
 
   function rebuildStatic(f: api.FieldModel): void {
     scene.remove(dynamic);
+    dynamic.traverse((o) => {
+      const m = o as THREE.Mesh;
+      m.geometry?.dispose();
+      (m.material as THREE.Material | undefined)?.dispose();
+    });
     dynamic = new THREE.Group();
     dynamic.add(fieldGroup(f));
     cameraList.replaceChildren();
@@ -343,28 +374,32 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   }
 
   // ---- benchmark: a 10,000-point track over the field (and the cameras shown); it stays shown
-  // until the next benchmark or Show.
+  // until the next benchmark or Show. The page's ?points=N sets the track's length and
+  // ?scene=empty leaves the field and cameras out (the baseline: what drawing nothing reaches).
+  const benchQuery = new URLSearchParams(location.search);
+  const benchPoints = Math.max(0, Math.min(1e6, Number(benchQuery.get('points') ?? 10000) || 0));
+  const benchEmpty = benchQuery.get('scene') === 'empty';
   let benchTrack: THREE.Group | null = null;
   function dropBenchTrack() {
     if (!benchTrack) return;
     scene.remove(benchTrack);
-    (benchTrack.children[0] as THREE.Points).geometry.dispose();
+    for (const c of benchTrack.children) (c as THREE.Points).geometry.dispose();
     benchTrack = null;
   }
   async function runBench(): Promise<BenchResult> {
-    const n = 10000;
+    const n = benchPoints;
     const s: number[][] = [];
     for (let i = 0; i < n; ++i) {
       const t = i / 100;
       s.push([i, t, 8 * Math.cos(t / 7), 5 * Math.sin(t / 5), Math.abs(3 * Math.sin(t)), 2, 0.5]);
     }
-    if (!dynamic.children.length) {
+    if (!dynamic.children.length && !benchEmpty) {
       await loadCameras();
       rebuildStatic(await api.get<api.FieldModel>('/api/field', { name: field.value }));
     }
     dropBenchTrack();
     const track = trackObject(s);
-    scene.add(track);
+    if (n) scene.add(track);
     const axis = new THREE.Vector3(0, 0, 1);
     const turn = () => {
       view.position.applyAxisAngle(axis, 0.01);
@@ -397,11 +432,13 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     benchTrack = track;
     return {
       points: n,
+      segments: n ? track.userData.segments : 0,
       paced_fps: Number(paced.toFixed(1)),
       render_ms_median: Number(quantile(costs, 0.5).toFixed(2)),
       render_ms_p95: Number(quantile(costs, 0.95).toFixed(2)),
       renderer: gpu.name,
       antialias,
+      canvas: `${canvas.width}x${canvas.height}`,
     };
   }
 
@@ -487,7 +524,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   bench.onclick = async () => {
     status(msg, 'benchmark running…');
     const r = await runBench();
-    status(msg, `benchmark: ${r.points} points, ${r.paced_fps} frames/s shown while turning; render ${r.render_ms_median} ms per frame (p95 ${r.render_ms_p95} ms) → ${(1000 / r.render_ms_median).toFixed(0)} frames/s possible; ${r.renderer}${r.antialias ? '' : ', no antialiasing'}`);
+    status(msg, `benchmark: ${r.points} points (${r.segments} line segments longer than a marker), ${r.paced_fps} frames/s shown while turning; render ${r.render_ms_median} ms per frame (p95 ${r.render_ms_p95} ms) → ${(1000 / r.render_ms_median).toFixed(0)} frames/s possible; canvas ${r.canvas}; ${r.renderer}${r.antialias ? '' : ', no antialiasing'}`);
     msg.dataset.fps = String(r.paced_fps);
     msg.dataset.bench = JSON.stringify(r);
   };

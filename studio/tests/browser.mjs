@@ -231,6 +231,7 @@ try {
   check(listed === nCams && nCams >= 4, `3D view lists ${listed} cameras (${nCams} camera files with a pose)`);
   const stats = await page.evaluate(() => {
     const c = document.querySelector('#v3-canvas');
+    c.dispatchEvent(new Event('render-now'));
     const t = document.createElement('canvas');
     t.width = c.width;
     t.height = c.height;
@@ -259,6 +260,12 @@ try {
     `${bench.renderer}${bench.antialias ? '' : ', no antialiasing'}`);
   check(bench.paced_fps > 0 && bench.render_ms_median > 0, '3D benchmark measured');
   await page.screenshot({ path: path.join(out, 'bench3d.jpg'), quality: 70 });
+  // The same turn with nothing drawn: what headless chromium itself shows on this machine.
+  await page.goto(new URL('?scene=empty&points=0#bench3d', url).toString());
+  await page.waitForSelector('#v3-status[data-fps]', { timeout: 60000 });
+  const empty = JSON.parse(await page.getAttribute('#v3-status', 'data-bench'));
+  console.log(`3D benchmark baseline, empty scene: ${empty.paced_fps} frames/s shown, render ${empty.render_ms_median} ms; ` +
+    `the 10,000-point track reaches ${(100 * bench.paced_fps / empty.paced_fps).toFixed(0)} % of it`);
 
   lap('3D benchmark');
   // ---- live: the 3D view subscribes (through the server) to a fusion node fed by four camera
