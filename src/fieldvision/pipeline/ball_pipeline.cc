@@ -89,12 +89,9 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
   return RunBallPipelineTracked(cameras, sources, region_fns, o, on_frame);
 }
 
-BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
-                                           std::vector<std::unique_ptr<FrameSource>>& sources,
-                                           const std::vector<BallRegionDetectFn>& detectors,
-                                           const BallPipelineOptions& options,
-                                           const std::function<void(const BallFrame&)>& on_frame) {
-  options.Check();
+void CheckBallPipelineInputs(const std::vector<Camera>& cameras,
+                             const std::vector<std::unique_ptr<FrameSource>>& sources,
+                             const std::vector<BallRegionDetectFn>& detectors) {
   const int n = static_cast<int>(cameras.size());
   FV_REQUIRE(n >= 1, "ball pipeline: no cameras");
   FV_REQUIRE(sources.size() == cameras.size() && detectors.size() == cameras.size(),
@@ -109,6 +106,10 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
                cameras[c].name, cameras[c].width, cameras[c].height, sources[c]->name(), size.width,
                size.height);
   }
+}
+
+BallPipelineSummary EmptyBallPipelineSummary(const std::vector<Camera>& cameras) {
+  const int n = static_cast<int>(cameras.size());
   BallPipelineSummary summary;
   summary.num_cameras = n;
   for (int c = 0; c < n; ++c) {
@@ -122,33 +123,125 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   summary.bad_frames.assign(n, 0);
   summary.first_bad_frame.assign(n, "");
   summary.window_scans.assign(n, 0);
+  return summary;
+}
 
-  std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>> queues;
+long long ExpectedPipelineFrames(const std::vector<long long>& frame_counts, long long max_frames) {
+  long long total = -1;
+  for (long long count : frame_counts) total = std::max(total, count);
+  if (max_frames > 0) total = total > 0 ? std::min(total, max_frames) : -1;
+  return total;
+}
+
+void ReadCameraStream(FrameSource& source, CameraStage& stage, BoundedQueue<CameraMessage>& queue,
+                      long long max_frames, const std::function<bool()>& stopping) {
+  SourceFrame in;
+  long long count = 0;
+  while (!stopping() && (max_frames == 0 || count < max_frames) && source.ReadFrame(&in)) {
+    ++count;
+    if (!queue.Push(stage.Process(in))) break;
+  }
+  queue.Close();
+}
+
+void FuseCameraQueues(const std::vector<Camera>& cameras, const CameraQueues& queues,
+                      const BallPipelineOptions& options, long long total,
+                      const std::function<bool()>& stopping,
+                      const std::function<void(const BallFrame&)>& on_frame,
+                      BallPipelineSummary* summary) {
+  FrameSynchronizer sync(static_cast<int>(cameras.size()), options.sync);
+  FusionStage fusion(cameras, options.triangulation);
+  Progress progress("ball", total, "frames", options.progress);
+  while (!stopping()) {
+    while (auto group = sync.Next()) {
+      on_frame(fusion.Fuse(*group));
+      progress.Update(fusion.stats().frames);
+      if (options.control != nullptr) {
+        options.control->Report({"ball", fusion.stats().frames, total, "frames", ""});
+      }
+    }
+    if (sync.Done()) break;
+    const int c = sync.Waiting();
+    if (c < 0) break;  // cannot happen: Next() decides when nobody is waiting
+    if (auto m = queues[c]->Pop()) {
+      sync.Add(std::move(*m));
+    } else if (!stopping()) {
+      sync.EndOfStream(c);
+    }
+  }
+  progress.Finish();
+  summary->sync = sync.report();
+  AddFusionStats(fusion.stats(), summary);
+}
+
+void AddFusionStats(const FusionStats& f, BallPipelineSummary* summary) {
+  summary->frames = f.frames;
+  summary->frames_with_position = f.frames_with_position;
+  summary->ground_positions = f.ground_positions;
+  summary->weak_positions = f.weak_positions;
+  summary->frames_few_blobs = f.frames_few_blobs;
+  summary->frames_inconsistent = f.frames_inconsistent;
+  summary->used_per_camera = f.used_per_camera;
+  summary->candidates_per_camera = f.candidates_per_camera;
+  summary->mean_err_px = f.frames_with_position ? f.sum_err_px / f.frames_with_position : 0;
+}
+
+namespace {
+
+// The first error of any stage; stopping closes every queue so that no stage waits.
+class StageErrors {
+ public:
+  StageErrors(const CameraQueues& queues, const JobControl* control)
+      : queues_(queues), control_(control) {}
+  void Fail(const std::exception_ptr& e) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!error_) error_ = e;
+    }
+    StopAll();
+  }
+  void StopAll() {
+    stop_ = true;
+    for (auto& q : queues_) q->Close();
+  }
+  bool Stopping() const { return stop_ || StopRequested(control_); }
+  void RethrowFirst() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  const CameraQueues& queues_;
+  const JobControl* control_;
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::exception_ptr error_;
+};
+
+}  // namespace
+
+BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
+                                           std::vector<std::unique_ptr<FrameSource>>& sources,
+                                           const std::vector<BallRegionDetectFn>& detectors,
+                                           const BallPipelineOptions& options,
+                                           const std::function<void(const BallFrame&)>& on_frame) {
+  options.Check();
+  CheckBallPipelineInputs(cameras, sources, detectors);
+  const int n = static_cast<int>(cameras.size());
+  BallPipelineSummary summary = EmptyBallPipelineSummary(cameras);
+  CameraQueues queues;
+  std::vector<CameraStage> stages;
+  std::vector<long long> frame_counts;
   queues.reserve(n);
+  stages.reserve(n);
   for (int c = 0; c < n; ++c) {
     queues.push_back(std::make_unique<BoundedQueue<CameraMessage>>(options.queue_capacity,
                                                                    options.queue_policy));
-  }
-  std::vector<CameraStage> stages;
-  stages.reserve(n);
-  for (int c = 0; c < n; ++c) {
     stages.emplace_back(c, cameras[c], detectors[c], options.track, sources[c]->name());
+    frame_counts.push_back(sources[c]->FrameCount());
   }
-  std::atomic<bool> stop{false};
-  std::mutex error_mutex;
-  std::exception_ptr error;
-  auto fail = [&](const std::exception_ptr& e) {
-    {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = e;
-    }
-    stop = true;
-    for (auto& q : queues) q->Close();
-  };
-  auto stopping = [&] { return stop || StopRequested(options.control); };
-  long long total = -1;
-  for (const auto& s : sources) total = std::max(total, s->FrameCount());
-  if (options.max_frames > 0) total = total > 0 ? std::min(total, options.max_frames) : -1;
+  StageErrors errors(queues, options.control);
+  const std::function<bool()> stopping = [&errors] { return errors.Stopping(); };
+  const long long total = ExpectedPipelineFrames(frame_counts, options.max_frames);
 
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::thread> threads;
@@ -156,61 +249,20 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   for (int c = 0; c < n; ++c) {
     threads.emplace_back([&, c] {
       try {
-        SourceFrame in;
-        long long count = 0;
-        while (!stopping() && (options.max_frames == 0 || count < options.max_frames) &&
-               sources[c]->ReadFrame(&in)) {
-          ++count;
-          if (!queues[c]->Push(stages[c].Process(in))) break;
-        }
-        queues[c]->Close();
+        ReadCameraStream(*sources[c], stages[c], *queues[c], options.max_frames, stopping);
       } catch (...) {
-        fail(std::current_exception());
+        errors.Fail(std::current_exception());
       }
     });
   }
-
-  // The fusion stage, in this thread.
-  try {
-    FrameSynchronizer sync(n, options.sync);
-    FusionStage fusion(cameras, options.triangulation);
-    Progress progress("ball", total, "frames", options.progress);
-    while (!stopping()) {
-      while (auto group = sync.Next()) {
-        on_frame(fusion.Fuse(*group));
-        progress.Update(fusion.stats().frames);
-        if (options.control != nullptr) {
-          options.control->Report({"ball", fusion.stats().frames, total, "frames", ""});
-        }
-      }
-      if (sync.Done()) break;
-      const int c = sync.Waiting();
-      if (c < 0) break;  // cannot happen: Next() decides when nobody is waiting
-      if (auto m = queues[c]->Pop()) {
-        sync.Add(std::move(*m));
-      } else if (!stopping()) {
-        sync.EndOfStream(c);
-      }
-    }
-    progress.Finish();
-    summary.sync = sync.report();
-    const FusionStats& f = fusion.stats();
-    summary.frames = f.frames;
-    summary.frames_with_position = f.frames_with_position;
-    summary.ground_positions = f.ground_positions;
-    summary.weak_positions = f.weak_positions;
-    summary.frames_few_blobs = f.frames_few_blobs;
-    summary.frames_inconsistent = f.frames_inconsistent;
-    summary.used_per_camera = f.used_per_camera;
-    summary.candidates_per_camera = f.candidates_per_camera;
-    summary.mean_err_px = f.frames_with_position ? f.sum_err_px / f.frames_with_position : 0;
+  try {  // the fusion stage, in this thread
+    FuseCameraQueues(cameras, queues, options, total, stopping, on_frame, &summary);
   } catch (...) {
-    fail(std::current_exception());
+    errors.Fail(std::current_exception());
   }
-  stop = true;
-  for (auto& q : queues) q->Close();
+  errors.StopAll();
   for (auto& t : threads) t.join();
-  if (error) std::rethrow_exception(error);
+  errors.RethrowFirst();
   for (int c = 0; c < n; ++c) {
     summary.queue_drops[c] = queues[c]->dropped();
     const CameraStageStats& st = stages[c].stats();

@@ -75,4 +75,30 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
                                            const BallPipelineOptions& options,
                                            const std::function<void(const BallFrame&)>& on_frame);
 
+// The stages of RunBallPipelineTracked, in order; each callable alone.
+// Throws fv::Error for lists of different sizes, a missing video or detector, or a video whose
+// frame size is not its camera's.
+void CheckBallPipelineInputs(const std::vector<Camera>& cameras,
+                             const std::vector<std::unique_ptr<FrameSource>>& sources,
+                             const std::vector<BallRegionDetectFn>& detectors);
+// The camera names ("camera <index>" where unnamed) and zeroed per-camera counts.
+BallPipelineSummary EmptyBallPipelineSummary(const std::vector<Camera>& cameras);
+// The frames the progress line expects: the longest stream (FrameSource::FrameCount), at most
+// `max_frames` when > 0; -1 when unknown.
+long long ExpectedPipelineFrames(const std::vector<long long>& frame_counts, long long max_frames);
+// A camera thread: reads `source` through `stage` into `queue` until the end of the stream,
+// `max_frames` (> 0) frames, `stopping()` or a closed queue; then closes the queue.
+void ReadCameraStream(FrameSource& source, CameraStage& stage, BoundedQueue<CameraMessage>& queue,
+                      long long max_frames, const std::function<bool()>& stopping);
+using CameraQueues = std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>>;
+// The fusion stage: synchronises the queues' messages, fuses each frame and calls `on_frame`,
+// until every stream ended or `stopping()`; sets the summary's sync report and fusion counts.
+void FuseCameraQueues(const std::vector<Camera>& cameras, const CameraQueues& queues,
+                      const BallPipelineOptions& options, long long total,
+                      const std::function<bool()>& stopping,
+                      const std::function<void(const BallFrame&)>& on_frame,
+                      BallPipelineSummary* summary);
+// Copies the fusion counts into the summary (mean error: the sum over the positions).
+void AddFusionStats(const FusionStats& stats, BallPipelineSummary* summary);
+
 }  // namespace fv

@@ -348,6 +348,54 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(job.out));
 }
 
+// The pipeline's stages one by one, in one thread: each camera's stream read into its queue
+// (stopping at max_frames), then fused; the counts as the whole pipeline gives them.
+TEST(BallPipelineStages, ReadThenFuseInOneThread) {
+  EXPECT_EQ(ExpectedPipelineFrames({30, 30, 24}, 0), 30);
+  EXPECT_EQ(ExpectedPipelineFrames({30, -1}, 0), 30);
+  EXPECT_EQ(ExpectedPipelineFrames({-1, -1}, 0), -1);
+  EXPECT_EQ(ExpectedPipelineFrames({30, 24}, 10), 10);
+  EXPECT_EQ(ExpectedPipelineFrames({5}, 10), 5);
+  EXPECT_EQ(ExpectedPipelineFrames({-1}, 10), -1);
+
+  const std::string dir = testing::TempDir();
+  Scene s = MakeScene(dir, {20, 20, 12}, {0, 0, 0});
+  s.cams[1].name.clear();
+  auto sources = Open(s, std::vector<FrameSourceOptions>(3));
+  const std::vector<BallRegionDetectFn> detectors(3, CentroidInWindow);
+  CheckBallPipelineInputs(s.cams, sources, detectors);
+  EXPECT_THROW(CheckBallPipelineInputs(s.cams, sources, {CentroidInWindow}), Error);
+  BallPipelineSummary summary = EmptyBallPipelineSummary(s.cams);
+  EXPECT_EQ(summary.camera_names, (std::vector<std::string>{"cam0", "camera 1", "cam2"}));
+  ASSERT_EQ(summary.window_scans.size(), 3u);
+
+  BallPipelineOptions opt;
+  opt.progress = false;
+  CameraQueues queues;
+  const std::function<bool()> never = [] { return false; };
+  for (int c = 0; c < 3; ++c) {
+    queues.push_back(std::make_unique<BoundedQueue<CameraMessage>>(100, QueuePolicy::kBlock));
+    CameraStage stage(c, s.cams[c], detectors[c], opt.track, sources[c]->name());
+    ReadCameraStream(*sources[c], stage, *queues[c], 15, never);
+    EXPECT_EQ(stage.stats().frames, c < 2 ? 15 : 12);
+  }
+  std::vector<BallFrame> frames;
+  FuseCameraQueues(
+      s.cams, queues, opt, 15, never, [&](const BallFrame& f) { frames.push_back(f); }, &summary);
+  ASSERT_EQ(frames.size(), 15u);
+  EXPECT_EQ(summary.frames, 15);
+  EXPECT_EQ(summary.frames_with_position, 15);
+  EXPECT_EQ(summary.used_per_camera, (std::vector<long long>{15, 15, 12}));
+  EXPECT_EQ(summary.sync.cameras[2].last_frame, 11);
+  double sum_err = 0;
+  for (const BallFrame& f : frames) {
+    ASSERT_TRUE(f.result.ok()) << f.frame;
+    EXPECT_LT((f.result.point_world - BallAt(f.time_s)).norm(), 0.03) << f.frame;
+    sum_err += f.result.rms_px;
+  }
+  EXPECT_NEAR(summary.mean_err_px, sum_err / 15, 1e-9);
+}
+
 TEST(BallPipeline, BadInputsAreOneLineErrors) {
   const std::string dir = testing::TempDir();
   EXPECT_THROW(OpenFrameSource(dir + "/missing.avi"), Error);
