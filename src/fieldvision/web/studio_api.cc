@@ -3,7 +3,9 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <regex>
 #include <sstream>
+#include <string_view>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -360,6 +362,70 @@ void WriteTextFile(const fs::path& path, const std::string& text) {
   fs::rename(tmp, path);
 }
 
+// Bytes of base64 text (RFC 4648, padding optional, a data: URL's prefix skipped); throws
+// HttpError 400 naming `what` on anything else.
+std::string DecodeBase64(std::string_view text, const std::string& what) {
+  if (text.rfind("data:", 0) == 0) {
+    const size_t comma = text.find(',');
+    if (comma == std::string_view::npos)
+      throw HttpError(400, what + " is a data: URL without data");
+    text.remove_prefix(comma + 1);
+  }
+  std::string out;
+  out.reserve(text.size() / 4 * 3 + 3);
+  uint32_t acc = 0;
+  int bits = 0;
+  int pad = 0;
+  for (const char c : text) {
+    int v = -1;
+    if (c >= 'A' && c <= 'Z') v = c - 'A';
+    if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
+    if (c >= '0' && c <= '9') v = c - '0' + 52;
+    if (c == '+') v = 62;
+    if (c == '/') v = 63;
+    if (c == '=') {
+      ++pad;
+      continue;
+    }
+    if (v < 0 || pad > 0) throw HttpError(400, what + " is not base64 text");
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<char>((acc >> bits) & 0xff));
+    }
+  }
+  if (bits >= 6 || pad > 2) throw HttpError(400, what + " is not base64 text");
+  return out;
+}
+
+// A PNG image sent as base64 (a canvas's toDataURL()), decoded: refuses anything else.
+cv::Mat DecodePngImage(const std::string& base64, const std::string& what) {
+  const std::string bytes = DecodeBase64(base64, what);
+  static const std::string kSignature = "\x89PNG\r\n\x1a\n";
+  if (bytes.compare(0, kSignature.size(), kSignature) != 0) {
+    throw HttpError(400, what + " is not a PNG image");
+  }
+  const std::vector<uchar> buf(bytes.begin(), bytes.end());
+  cv::Mat image = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
+  if (image.empty()) throw HttpError(400, what + " is not a readable PNG image");
+  return image;
+}
+
+// A folder to write into, named by a request: inside the working folder, not the folder itself,
+// its parent existing; it may exist (as a folder) or not.
+fs::path ResolveOutputFolder(const Workspace& ws, const std::string& path) {
+  const fs::path c = ws.Resolve(path, false);
+  if (c == ws.root()) throw HttpError(400, "output folder '" + path + "' is the studio folder");
+  if (!fs::is_directory(c.parent_path())) {
+    throw HttpError(404, "folder of output '" + path + "' does not exist");
+  }
+  if (fs::exists(c) && !fs::is_directory(c)) {
+    throw HttpError(400, "output '" + path + "' is a file, not a folder");
+  }
+  return c;
+}
+
 // ---- endpoints
 
 using Handler = std::function<ApiResponse(const Workspace&, EventHub*, JobRunner*, LiveFeed*,
@@ -669,6 +735,83 @@ std::vector<Route> ColourRoutes() {
 }
 
 // Endpoints of ball and player tracks, player statistics, zones.
+// The player tracks and zones a statistics request names ({tracks[, zones]}), into `o`.
+std::vector<track::TrackRow> ReadStatsInput(const Workspace& ws, const json& body,
+                                            stats::StatsOptions& o) {
+  auto rows = track::ReadTracksCsv(ws.Resolve(Get<std::string>(body, "tracks")).string());
+  o.write_video = false;
+  if (body.contains("zones") && !body["zones"].is_null()) {
+    o.zones = stats::ReadZones(ws.Resolve(Get<std::string>(body, "zones")).string());
+  }
+  return rows;
+}
+
+// POST /api/players/export. Everything is checked before anything is written; the files are
+// written into a new folder beside OUT and then renamed into OUT, so that a link already in OUT
+// is replaced, never written through.
+ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiRequest& r) {
+  const json body = Body(r);
+  const fs::path out = ResolveOutputFolder(ws, Get<std::string>(body, "out"));
+  const FieldModel field = LoadFieldIn(ws, GetOr<std::string>(body, "field", "robocup-msl"));
+  std::vector<std::pair<std::string, cv::Mat>> images;
+  const json sent = GetOr<json>(body, "images", json::object());
+  if (!sent.is_object() || sent.size() > 8) {
+    throw HttpError(400, "'images' must be an object of at most 8 {name: PNG base64}");
+  }
+  static const std::regex kName("[A-Za-z0-9_-]{1,40}");
+  for (const auto& [name, data] : sent.items()) {
+    if (!std::regex_match(name, kName)) {
+      throw HttpError(400, "image name '" + name + "' is not 1-40 letters, digits, _ or -");
+    }
+    if (!data.is_string()) throw HttpError(400, "image '" + name + "' is not a string");
+    images.emplace_back("page_" + name + ".png",
+                        DecodePngImage(data.get<std::string>(), "image '" + name + "'"));
+  }
+  stats::StatsOptions o;
+  const auto rows = ReadStatsInput(ws, body, o);
+  const stats::StatsResult res = stats::ComputeStats(rows, o);
+
+  const fs::path tmp = out.parent_path() / ("." + out.filename().string() + ".export-tmp");
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  FV_REQUIRE(fs::create_directory(tmp, ec), "cannot create '{}'", ws.Relative(tmp));
+  json wrote = json::array();
+  stats::ReportFiles files;
+  try {
+    files = stats::WriteStatsReport(res, field, o, tmp.string());
+    CsvWriter alerts((tmp / "zone_alerts.csv").string(), {"zone", "id", "enter_s", "exit_s"}, 3);
+    for (const auto& e : res.events) {
+      alerts << e.zone << e.id << e.enter_s << e.exit_s;
+      alerts.EndRow();
+    }
+    alerts.Close();
+    for (const auto& [name, image] : images) {
+      const std::string png = EncodePng(image);
+      std::ofstream f(tmp / name, std::ios::binary);
+      f.write(png.data(), static_cast<std::streamsize>(png.size()));
+      FV_REQUIRE(f.good(), "cannot write '{}'", name);
+    }
+    fs::create_directory(out);
+    std::vector<fs::path> made;
+    for (const auto& e : fs::directory_iterator(tmp)) made.push_back(e.path());
+    std::sort(made.begin(), made.end());
+    for (const auto& p : made) {
+      const fs::path target = out / p.filename();
+      if (fs::is_directory(fs::symlink_status(target))) {
+        throw HttpError(409, "'" + ws.Relative(target) + "' is a folder; not replaced");
+      }
+      fs::rename(p, target);
+      wrote.push_back(ws.Relative(target));
+    }
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  fs::remove_all(tmp, ec);
+  Saved(events, ws, out, "players export");
+  return Json({{"wrote", wrote}, {"notes", files.notes}, {"summary", OneLine(res.Summary())}});
+}
+
 std::vector<Route> TrackRoutes() {
   return {
       {{"GET", "/api/ball", "?path=BALL.csv: the ball track (time, position, cameras, error)"},
@@ -710,13 +853,8 @@ std::vector<Route> TrackRoutes() {
         "zone alerts (who entered which zone, when), as `stats` computes them"},
        [](const Workspace& ws, EventHub*, JobRunner*, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
-         const auto rows =
-             track::ReadTracksCsv(ws.Resolve(Get<std::string>(body, "tracks")).string());
          stats::StatsOptions o;
-         o.write_video = false;
-         if (body.contains("zones") && !body["zones"].is_null()) {
-           o.zones = stats::ReadZones(ws.Resolve(Get<std::string>(body, "zones")).string());
-         }
+         const auto rows = ReadStatsInput(ws, body, o);
          const stats::StatsResult res = stats::ComputeStats(rows, o);
          json players = json::array();
          for (const auto& p : res.players) {
@@ -747,6 +885,14 @@ std::vector<Route> TrackRoutes() {
                       {"duration_s", Round(res.duration_s, 1e-3)},
                       {"fps", Round(res.fps, 1e-3)},
                       {"summary", OneLine(res.Summary())}});
+       }},
+      {{"POST", "/api/players/export",
+        "{tracks[, zones, field, images: {name: PNG base64}], out: FOLDER}: the Players page's "
+        "export: `stats` report (players.csv, speed_profiles.csv, distances.csv, heat maps with "
+        "scales, radar.png, stats.json, index.html), zone_alerts.csv, the page's images as "
+        "page_NAME.png"},
+       [](const Workspace& ws, EventHub* events, JobRunner*, LiveFeed*, const ApiRequest& r) {
+         return ExportPlayers(ws, events, r);
        }},
       {{"GET", "/api/zones", "?path=zones.json: named polygons on the field (stats --zones)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {

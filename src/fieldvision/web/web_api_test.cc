@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <zmq.hpp>
@@ -610,6 +611,110 @@ TEST_F(StudioApiTest, PlayerStatsAndZoneAlerts) {
   ExpectError(Post("/api/players/stats", json{{"tracks", "WALK.csv"}, {"zones", "WALK.csv"}}), 422,
               "WALK.csv");
   ExpectError(Post("/api/players/stats", json{{"tracks", "../WALK.csv"}}), 403, "");
+}
+
+std::string Base64(const std::string& bytes) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, bytes.size() - i);
+    uint32_t v = 0;
+    for (size_t k = 0; k < 3; ++k) v = (v << 8) | (k < n ? static_cast<uint8_t>(bytes[i + k]) : 0);
+    for (size_t k = 0; k < 4; ++k) out += k <= n ? kAlphabet[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+TEST_F(StudioApiTest, PlayersExport) {
+  // Player 3 walks through the zone "strip" at 1.5 m/s; player 4 stands still.
+  std::ofstream tracks(dir_ / "WALK.csv");
+  tracks << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n";
+  for (int f = 0; f <= 100; ++f) {
+    const double t = f / 25.0;
+    tracks << fmt::format("{},3,0,0,10,20,1,{:.4f},0.5,{:.4f}\n", f + 1, 1.5 * t - 2.0, t);
+    tracks << fmt::format("{},4,0,0,10,20,1,-5,-3,{:.4f}\n", f + 1, t);
+  }
+  tracks.close();
+  const json zones = {{{"name", "strip"}, {"polygon", {{1, -1}, {2, -1}, {2, 1}, {1, 1}}}}};
+  ASSERT_EQ(Post("/api/zones/save", json{{"zones", zones}, {"out", "strip.json"}}).status, 200);
+  // The page's heat map as a canvas sends it (a data: URL).
+  cv::Mat heat(30, 50, CV_8UC4, cv::Scalar(10, 200, 30, 255));
+  std::vector<uchar> png;
+  cv::imencode(".png", heat, png);
+  const std::string heat_url =
+      "data:image/png;base64," + Base64(std::string(png.begin(), png.end()));
+  json request = {{"tracks", "WALK.csv"},
+                  {"zones", "strip.json"},
+                  {"field", "robocup-msl"},
+                  {"images", {{"heatmap", heat_url}}},
+                  {"out", "exports/walk"}};
+  ExpectError(Post("/api/players/export", request), 404, "does not exist");  // no exports/
+  fs::create_directory(dir_ / "exports");
+  // A link already in the folder is replaced, not written through.
+  fs::create_directory(dir_ / "exports/walk");
+  std::ofstream(dir_.parent_path() / "victim.csv") << "untouched\n";
+  fs::create_symlink(dir_.parent_path() / "victim.csv", dir_ / "exports/walk/players.csv");
+  const Reply r = Post("/api/players/export", request);
+  ASSERT_EQ(r.status, 200) << r.body;
+  std::set<std::string> wrote;
+  const json reply = r.j();
+  for (const auto& w : reply["wrote"]) wrote.insert(w.get<std::string>());
+  for (const char* f :
+       {"players.csv", "speed_profiles.csv", "distances.csv", "zone_alerts.csv", "heatmap_all.png",
+        "radar.png", "stats.json", "index.html", "page_heatmap.png"}) {
+    EXPECT_TRUE(wrote.count(std::string("exports/walk/") + f)) << f << ": " << r.body;
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir_ / "exports/walk" / f))) << f;
+  }
+  {
+    std::ifstream victim(dir_.parent_path() / "victim.csv");
+    std::string line;
+    std::getline(victim, line);
+    EXPECT_EQ(line, "untouched");
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "exports/.walk.export-tmp"));
+  // The statistics are the library's (as /api/players/stats), the alerts one row per stay.
+  const CsvTable players = CsvTable::Read((dir_ / "exports/walk/players.csv").string());
+  ASSERT_EQ(players.rows(), 2u);
+  for (size_t i = 0; i < players.rows(); ++i) {
+    if (players.GetInt(i, "id") == 3) {
+      EXPECT_NEAR(players.GetDouble(i, "distance_m"), 6.0, 0.1);
+      EXPECT_NEAR(players.GetDouble(i, "time_in_strip_s"), 1.0 / 1.5, 0.1);
+    }
+  }
+  const CsvTable alerts = CsvTable::Read((dir_ / "exports/walk/zone_alerts.csv").string());
+  ASSERT_EQ(alerts.rows(), 1u);
+  EXPECT_EQ(alerts.Get(0, "zone"), "strip");
+  EXPECT_EQ(alerts.GetInt(0, "id"), 3);
+  EXPECT_NEAR(alerts.GetDouble(0, "enter_s"), 2.0, 0.05);
+  const cv::Mat page = cv::imread((dir_ / "exports/walk/page_heatmap.png").string(), -1);
+  ASSERT_FALSE(page.empty());
+  EXPECT_EQ(page.size(), heat.size());
+  EXPECT_EQ(cv::norm(page, heat, cv::NORM_INF), 0.0);
+  EXPECT_FALSE(cv::imread((dir_ / "exports/walk/heatmap_all.png").string()).empty());
+
+  // Bad requests: 4xx, one line, nothing written.
+  auto with = [&](const char* key, const json& value) {
+    json b = request;
+    b[key] = value;
+    return b;
+  };
+  ExpectError(Post("/api/players/export", with("out", "../escaped")), 403, "outside");
+  EXPECT_FALSE(fs::exists(dir_.parent_path() / "escaped"));
+  ExpectError(Post("/api/players/export", with("out", "WALK.csv")), 400, "not a folder");
+  ExpectError(Post("/api/players/export", with("out", ".")), 400, "studio folder");
+  ExpectError(Post("/api/players/export", with("tracks", "NONE.csv")), 404, "NONE.csv");
+  ExpectError(Post("/api/players/export", with("field", "nowhere")), 404, "unknown field");
+  for (const auto& [images, words] : std::vector<std::pair<json, std::string>>{
+           {{{"heatmap", "not*base64"}}, "base64"},
+           {{{"heatmap", Base64("GIF89a not a png")}}, "not a PNG"},
+           {{{"../x", heat_url}}, "image name"},
+           {{{"heatmap", 3}}, "not a string"},
+           {json::array(), "'images'"}}) {
+    request["out"] = "exports/bad";
+    ExpectError(Post("/api/players/export", with("images", images)), 400, words);
+    EXPECT_FALSE(fs::exists(dir_ / "exports/bad")) << words;
+  }
+  ExpectError(Post("/api/players/export", std::string("{\"out\": ")), 400, "malformed JSON");
 }
 
 TEST_F(StudioApiTest, ZonesSaveAndRead) {
