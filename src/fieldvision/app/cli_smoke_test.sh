@@ -127,4 +127,72 @@ check "calibrate intrinsics: --out in a missing folder" nonzero $FV calibrate in
   --images "$TMP" --cols 9 --rows 6 --square 0.025 --out "$TMP/missing/x.yaml"
 grep -q "does not exist; create it" "$TMP/err" || { echo "FAIL intrinsics: not the folder error"; fail=1; }
 check "calibrate compare: one --rig" nonzero $FV calibrate compare --rig "$TMP"
+# Issue 18's leftovers: outputs, option ranges, numbers in files, library noise.
+"$FV" synth --preset kick --frames 1 --width 320 --height 240 --format png --out "$TMP/sc" \
+  --quiet >/dev/null 2>&1 || { echo "FAIL synth of the fixture"; fail=1; }
+mknod "$TMP/dev" c 1 3 2>/dev/null || mkfifo "$TMP/dev"
+printf 'u,v,name\n160,120,centre_spot\n160,20,halfway_top\n160,220,halfway_bottom\n10,220,corner_left_bottom\n' \
+  >"$TMP/pts.csv"
+printf '<dataset><frame number="0"><objectlist><object id="1"><box h="60" w="20" xc="20" yc="80"/></object></objectlist></frame></dataset>\n' \
+  >"$TMP/pets.xml"
+device_out() {  # device_out NAME CMD...: refused, and the device is still one
+  local name="$1"
+  shift
+  check "$name" nonzero "$@"
+  [ -c "$TMP/dev" ] || [ -p "$TMP/dev" ] || { echo "FAIL $name: the device was replaced"; fail=1; }
+  grep -q "not a regular file" "$TMP/err" || { echo "FAIL $name: not the device error"; fail=1; }
+}
+device_out "calibrate extrinsics: --out a device" $FV calibrate extrinsics --field robocup-msl \
+  --camera "$TMP/sc/cam1.yaml" --points "$TMP/pts.csv" --out "$TMP/dev"
+device_out "calibrate refine: --out a device" $FV calibrate refine --field robocup-msl \
+  --camera "$TMP/sc/cam1.yaml" --image "$TMP/sc/cam1/00000.png" --out "$TMP/dev"
+device_out "calibrate intrinsics: --out a device (before the board search)" $FV calibrate \
+  intrinsics --images "$TMP/sc/cam1" --cols 9 --rows 6 --square 0.025 --out "$TMP/dev" --quiet
+device_out "eval import-pets: --out a device" $FV eval import-pets --xml "$TMP/pets.xml" \
+  --out "$TMP/dev"
+check "calibrate intrinsics: --outlier-factor 1e300 (before the board search)" nonzero $FV \
+  calibrate intrinsics --images "$TMP/sc/cam1" --cols 9 --rows 6 --square 0.025 \
+  --outlier-factor 1e300 --out "$TMP/i.yaml" --quiet
+grep -q -- "--outlier-factor" "$TMP/err" || { echo "FAIL intrinsics: option not named"; fail=1; }
+head -c 2000 "$TMP/sc/cam1/00000.png" >"$TMP/cut.png"
+check "calibrate check: a damaged PNG (no libpng line)" nonzero $FV calibrate check \
+  --field robocup-msl --camera "$TMP/sc/cam1.yaml" --image "$TMP/cut.png" --out "$TMP/chk.png"
+: >"$TMP/nodet.txt"
+check "players: --detections empty" nonzero $FV players --video "$TMP/sc/cam1/%05d.png" \
+  --detections "$TMP/nodet.txt" --out "$TMP/pl.csv" --no-progress
+printf '{"cameras": [{"name": "c1", "position": [0, -8, 4], "look_at": [0, 0, 0], "image_width": 640, "image_height": 480, "hfov_deg": 70}]}\n' \
+  >"$TMP/rig.json"
+check "plan: --error-weight 1e300" nonzero $FV plan --rig "$TMP/rig.json" --error-weight 1e300 \
+  --out "$TMP/pl" --no-progress
+grep -q -- "--error-weight" "$TMP/err" || { echo "FAIL plan: option not named"; fail=1; }
+check "plan: --hfov without --optimize" nonzero $FV plan --rig "$TMP/rig.json" --hfov 50 \
+  --out "$TMP/pl" --no-progress
+printf 'frame,x_m,y_m,z_m\n0,1,2,0.11\n1,1,1e300,0.11\n' >"$TMP/huge.csv"
+check "eval ball: 1e300 in a file" nonzero $FV eval ball --truth "$TMP/truth.csv" \
+  --est "$TMP/huge.csv"
+grep -q "huge.csv:3" "$TMP/err" || { echo "FAIL eval ball: file and line not named"; fail=1; }
+printf 'frame,x_m,y_m,z_m\n0,1,2,0.11\n2000000000,1,2,0.11\n' >"$TMP/far.csv"
+check "eval ball: frame 2e9 in a file" nonzero $FV eval ball --truth "$TMP/far.csv" \
+  --est "$TMP/truth.csv"
+grep -q "far.csv:3" "$TMP/err" || { echo "FAIL eval ball: file and line not named"; fail=1; }
+cp "$TMP/tracks.csv" "$TMP/far_tracks.csv"
+head -4 "$TMP/tracks.csv" >"$TMP/gt3.csv"
+check "eval tracks: frame 2e9 in a file" nonzero $FV eval tracks --gt "$TMP/gt3.csv" \
+  --est "$TMP/far_tracks.csv"
+grep -q "far_tracks.csv:5" "$TMP/err" || { echo "FAIL eval tracks: line not named"; fail=1; }
+head -4 "$TMP/tracks.csv" >"$TMP/dup_tracks.csv" && sed -n 3p "$TMP/tracks.csv" >>"$TMP/dup_tracks.csv"
+check "stats: a duplicated row" nonzero $FV stats --tracks "$TMP/dup_tracks.csv" --field fifa \
+  --out "$TMP/st2" --no-video
+grep -q "two rows in frame 2" "$TMP/err" || { echo "FAIL stats: not the duplicate"; fail=1; }
+check "stats: --smooth 1e300" nonzero $FV stats --tracks "$TMP/gt3.csv" --field fifa \
+  --smooth 1e300 --out "$TMP/st3" --no-video
+grep -q -- "--smooth" "$TMP/err" || { echo "FAIL stats: option not named"; fail=1; }
+check "fuse: --tolerance 1e300 (hung)" nonzero timeout 20 $FV fuse --listen tcp://127.0.0.1:0 \
+  --camera "$TMP/sc/cam1.yaml" --camera "$TMP/sc/cam2.yaml" --out "$TMP/f.csv" --tolerance 1e300 \
+  --no-progress
+check "studio: --assets a missing folder" nonzero timeout 20 $FV studio --assets "$TMP/none" \
+  --port 0
+check "node: --start-at 1e300" nonzero $FV node --camera "$TMP/sc/cam1.yaml" \
+  --video "$TMP/sc/cam1/%05d.png" --connect tcp://127.0.0.1:1 --connect-wait 0.2 \
+  --start-at 1e300 --no-progress
 exit $fail

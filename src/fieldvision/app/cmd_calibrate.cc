@@ -3,7 +3,11 @@
 // `extrinsics` also places a whole rig (--rig DIR, calib/rig_place.h), calibrates a camera without
 // intrinsics from the field alone (--image-size, calib/focal.h) or fits the ground homography
 // (--homography-only); `refine --rig DIR` carries the rig with the refined camera.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -33,10 +37,36 @@ namespace {
 
 using namespace fv::calib;
 
+// Sends this process's stderr to /dev/null while it lives: libpng's default error handler, which
+// OpenCV's PNG decoder keeps, prints "libpng error: ..." before imread returns an empty image,
+// and the error has one line, ours. Only around single-threaded reads.
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    std::fflush(stderr);
+    if (saved_ < 0) return;
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
 cv::Mat ReadImage(const std::string& path) {
   FV_REQUIRE(std::filesystem::is_regular_file(path), "image '{}' does not exist", path);
   cv::Mat image;
   try {
+    const QuietStderr quiet;
     image = cv::imread(path, cv::IMREAD_COLOR);
   } catch (const cv::Exception&) {
     image.release();
@@ -482,6 +512,7 @@ void SetupIntrinsics(CLI::App* group) {
   AddBoardOptions(in, ic->board);
   in->add_option("--model", ic->o.num_distortion,
                  "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
+      ->check(CLI::IsMember({4, 5, 8, 12, 14}))
       ->capture_default_str();
   in->add_flag("--fix-aspect", ic->o.fix_aspect_ratio, "Keep fx = fy");
   in->add_flag("--zero-tangent", ic->o.zero_tangent, "No tangential distortion");
@@ -489,24 +520,29 @@ void SetupIntrinsics(CLI::App* group) {
                "Principal point at the image centre");
   in->add_option("--outlier-factor", ic->o.outlier_factor,
                  "Drop views with RMS above this x the median (and above --outlier-min-px)")
+      ->check(FiniteRange(1, 1000))
       ->capture_default_str();
   in->add_option("--outlier-min-px", ic->o.outlier_min_px, "See --outlier-factor")
+      ->check(FiniteRange(0, 1000))
       ->capture_default_str();
   in->add_option("--subpix-window", ic->o.detect.subpix_half_window_px,
                  "cornerSubPix half window in pixels")
+      ->check(FiniteRange(1, 50))
       ->capture_default_str();
   in->add_option("--subpix-cap", ic->o.detect.subpix_square_fraction,
                  "Cap the half window at this fraction of the smallest square (0: no cap, as "
                  "OpenCV's calibration sample)")
+      ->check(FiniteRange(0, 1))
       ->capture_default_str();
   in->add_option("--max-frames", ic->o.source.max_video_frames, "Frames sampled from a video")
+      ->check(FiniteRange(1, 100000))
       ->capture_default_str();
   in->add_option("--name", ic->name, "Camera name written to the file");
   in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
   in->add_flag("--quiet", ic->quiet, "No progress");
   in->callback([ic] {
     CheckOutputPath(ic->out, {ic->images});
-    CheckOutputFolder(ic->out);
+    CheckOutputFile(ic->out);
     RunIntrinsics(*ic);
   });
 }
@@ -542,13 +578,14 @@ void SetupExtrinsics(CLI::App* group) {
   ex->add_flag("--homography-only", ec->homography_only,
                "With --image-size and ground points (z = 0): fit only the image-ground homography");
   ex->add_option("--threshold", ec->o.ransac_threshold_px, "RANSAC inlier threshold in pixels")
+      ->check(FiniteRange(0.01, 1000))
       ->capture_default_str();
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
   ex->callback([ec] {
     CheckOutputPath(ec->out, PathList(ec->points, ec->field, ec->images));  // may be --camera
     CheckOutputPath(ec->table, PathList(ec->points, ec->field, ec->camera, ec->out), "--table");
-    if (ec->rig.empty()) CheckOutputFolder(ec->out);
-    CheckOutputFolder(ec->table, "--table");
+    if (ec->rig.empty()) CheckOutputFile(ec->out);
+    CheckOutputFile(ec->table, "--table");
     RunExtrinsics(*ec);
   });
 }
@@ -571,6 +608,7 @@ void SetupRefine(CLI::App* group) {
   re->add_option("--out", rc->out, "Camera file to write (with --rig: a folder)")->required();
   re->add_option("--lut-resolution", rc->o.lut_resolution_m,
                  "Cell of the distance lookup table in metres")
+      ->check(FiniteRange(1e-3, 1))
       ->capture_default_str();
   re->add_option("--overlay", rc->overlay,
                  "Also write the check image of the refined pose (with --rig: of the first "
@@ -582,8 +620,8 @@ void SetupRefine(CLI::App* group) {
     inputs.push_back(rc->camera);
     inputs.push_back(rc->out);
     CheckOutputPath(rc->overlay, inputs, "--overlay");
-    if (rc->rig.empty()) CheckOutputFolder(rc->out);
-    CheckOutputFolder(rc->overlay, "--overlay");
+    if (rc->rig.empty()) CheckOutputFile(rc->out);
+    CheckOutputFile(rc->overlay, "--overlay");
     RunRefine(*rc);
   });
 }
@@ -602,8 +640,8 @@ void SetupCheck(CLI::App* group) {
   ch->callback([cc] {
     CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
     CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out}, "--table");
-    CheckOutputFolder(cc->out);
-    CheckOutputFolder(cc->table, "--table");
+    CheckOutputFile(cc->out);
+    CheckOutputFile(cc->table, "--table");
     RunCheck(*cc);
   });
 }

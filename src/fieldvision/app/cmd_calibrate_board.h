@@ -1,6 +1,6 @@
 // The board options shared by `calibrate intrinsics` and `calibrate multi` (--board, --cols,
 // --rows, --square, --marker, --dictionary) and their calib::BoardSpec; the calibrate commands'
-// check that an output file's folder exists before any work.
+// checks of an output file (its folder exists, it is not a device or a folder) before any work.
 #pragma once
 
 #include <filesystem>
@@ -9,7 +9,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "fieldvision/app/command.h"
 #include "fieldvision/calib/board.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -35,12 +37,17 @@ struct BoardCli {
 inline void AddBoardOptions(CLI::App* cmd, BoardCli& b) {
   cmd->add_option("--board", b.board, "chessboard or charuco")->capture_default_str();
   cmd->add_option("--cols", b.cols, "Chessboard: inner corners per row; ChArUco: squares per row")
-      ->required();
+      ->required()
+      ->check(FiniteRange(2, 200));
   cmd->add_option("--rows", b.rows,
                   "Chessboard: inner corners per column; ChArUco: squares per column")
-      ->required();
-  cmd->add_option("--square", b.square_m, "Square side in metres (25 mm: 0.025)")->required();
-  cmd->add_option("--marker", b.marker_m, "ChArUco marker side in metres (default 0.7 x square)");
+      ->required()
+      ->check(FiniteRange(2, 200));
+  cmd->add_option("--square", b.square_m, "Square side in metres (25 mm: 0.025)")
+      ->required()
+      ->check(FiniteRange(1e-4, 1));
+  cmd->add_option("--marker", b.marker_m, "ChArUco marker side in metres (default 0.7 x square)")
+      ->check(FiniteRange(1e-4, 1));
   cmd->add_option("--dictionary", b.dictionary, "ChArUco ArUco dictionary")->capture_default_str();
 }
 
@@ -52,6 +59,14 @@ inline void CheckOutputFolder(const std::string& out, std::string_view what = "-
   FV_REQUIRE(folder.empty() || std::filesystem::is_directory(folder),
              "{} '{}': the folder '{}' does not exist; create it (mkdir -p {}) or write elsewhere",
              what, out, folder.string(), folder.string());
+}
+
+// CheckOutputFolder, then the shared output policy's refusal of a device or a folder as the
+// output file (io/output_path.h), before any work; an empty `out` passes.
+inline void CheckOutputFile(const std::string& out, std::string_view what = "--out") {
+  if (out.empty()) return;
+  CheckOutputFolder(out, what);
+  ResolveOutputPath(out, what);
 }
 
 }  // namespace fv::app

@@ -134,6 +134,7 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Keep every camera's own intrinsics fixed in the joint adjustment");
   cmd->add_option("--model", c->o.num_distortion,
                   "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
+      ->check(CLI::IsMember({4, 5, 8, 12, 14}))
       ->capture_default_str();
   cmd->add_option("--tangential", c->tangential,
                   "Tangential distortion p1 p2: auto (per camera, kept only where it lowers the "
@@ -141,16 +142,21 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("--zero-tangent", c->zero_tangent, "The same as --tangential zero");
   cmd->add_option("--loss-px", c->o.loss_px, "Huber scale of the bundle adjustment in pixels")
+      ->check(FiniteRange(0.01, 1000))
       ->capture_default_str();
   cmd->add_option("--outlier-factor", c->o.outlier_factor,
                   "Drop views with RMS above this x the median (and above --outlier-min-px)")
+      ->check(FiniteRange(1, 1000))
       ->capture_default_str();
   cmd->add_option("--outlier-min-px", c->o.outlier_min_px, "See --outlier-factor")
+      ->check(FiniteRange(0, 1000))
       ->capture_default_str();
   cmd->add_option("--min-shared", c->o.min_shared_views,
                   "Views two cameras must share to be linked")
+      ->check(FiniteRange(1, 100000))
       ->capture_default_str();
   cmd->add_option("--max-frames", c->o.source.max_video_frames, "Frames sampled from a video")
+      ->check(FiniteRange(1, 100000))
       ->capture_default_str();
   cmd->add_option("--out", c->out, "Folder for NAME.yaml per camera and the pictures")->required();
   cmd->add_flag("--no-pictures", c->no_pictures, "Do not write the coverage pictures");

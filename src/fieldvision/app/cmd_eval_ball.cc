@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/input_checks.h"
 #include "fieldvision/recon/ball_eval.h"
 #include "fieldvision/util/error.h"
 
@@ -26,11 +27,18 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("--rows", o->rows, "Print every frame's error (default: when <= 40 frames)");
   cmd->add_option("--min-cams", o->eval.min_truth_cams,
                   "Truth frames seen by at least this many cameras count for the found rate")
+      ->check(FiniteRange(0, 1000))
       ->capture_default_str();
   cmd->add_option("--outlier", o->eval.outlier_m, "Estimates further off (metres) are false")
+      ->check(FiniteRange(1e-6, 1e4))
       ->capture_default_str();
   cmd->callback([o] {
-    const BallEvalResult r = EvaluateBallFiles(o->truth, o->est, o->eval);
+    const CsvTable truth = CsvTable::Read(o->truth), est = CsvTable::Read(o->est);
+    for (const CsvTable* t : {&truth, &est}) {
+      t->Require({"frame", "x_m", "y_m", "z_m"});
+      CheckBallTrackRanges(*t);
+    }
+    const BallEvalResult r = EvaluateBall(truth, est, o->eval);
     // Nothing matched: no error to report (a mean of 0 mm would read as perfect).
     FV_REQUIRE(!r.rows.empty(),
                "eval ball: no frame of '{}' ({} rows) is a frame of '{}' ({} rows): nothing to "

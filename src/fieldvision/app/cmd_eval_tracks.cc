@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/input_checks.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/pets.h"
@@ -69,10 +70,12 @@ void Setup(CLI::App& app, int& exit_code) {
                   "(frames numbered from 1)")
       ->required();
   cmd->add_option("--est", c->est, "Estimated TRACKS.csv or MOTChallenge results file")->required();
-  cmd->add_option("--iou", c->o.iou_threshold, "IoU needed for a match (MOTChallenge: 0.5)");
+  cmd->add_option("--iou", c->o.iou_threshold, "IoU needed for a match (MOTChallenge: 0.5)")
+      ->check(FiniteRange(1e-6, 1));
   cmd->add_option("--frame-offset", c->o.frame_offset,
                   "Add this to the estimate's frame numbers (e.g. 1 for a 0-based file against "
-                  "MOT ground truth); the output warns when another offset fits far better");
+                  "MOT ground truth); the output warns when another offset fits far better")
+      ->check(FiniteRange(-1000000, 1000000));
   cmd->add_flag("!--no-mot17-rules", c->o.mot17_rules,
                 "Score every ground-truth row (default, for MOT16/17/20 ground truth with classes: "
                 "drop conf-0 and non-pedestrian rows and estimates on distractors, as TrackEval)");
@@ -82,6 +85,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
   cmd->callback([c] {
     CheckOutputPath(c->json, {c->gt, c->est}, "--json");
+    if (!c->json.empty()) ResolveOutputPath(c->json, "--json");
     RunEvalTracks(*c);
   });
 
@@ -93,6 +97,7 @@ void Setup(CLI::App& app, int& exit_code) {
   imp->add_option("--out", p->out, "MOT CSV (TRACKS.csv layout)")->required();
   imp->callback([p] {
     CheckOutputPath(p->out, {p->xml});
+    ResolveOutputPath(p->out);  // not a device, a folder or in a missing folder
     const auto rows = track::ReadPetsCvml(p->xml);
     track::WriteTracksCsv(rows, p->out);
     std::cout << "wrote " << rows.size() << " boxes to " << p->out << "\n";

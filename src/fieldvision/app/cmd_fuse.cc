@@ -31,17 +31,22 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--idle-exit", o->idle_exit_s,
                   "Exit after this many seconds without messages, counted once the first has come; "
                   "running nodes ping every 0.5 s (0: run until Ctrl-C)")
+      ->check(FiniteRange(0, 86400))
       ->capture_default_str();
   cmd->add_option("--tolerance", o->sync.tolerance_s,
                   "Frames this close in capture time (s) are paired")
+      ->check(FiniteRange(1e-6, 1))
       ->capture_default_str();
   cmd->add_option("--max-wait", o->sync.max_wait_s,
                   "Longest wait (s) for a slow camera before a frame is fused without it")
+      ->check(FiniteRange(0, 60))
       ->capture_default_str();
   cmd->add_option("--ball-diameter", o->ball_diameter_m, "Ball diameter in metres")
+      ->check(FiniteRange(0.01, 2))
       ->capture_default_str();
   cmd->add_option("--inlier-px", o->triangulation.inlier_threshold_px,
                   "A camera agrees when it sees the ball within this many pixels")
+      ->check(FiniteRange(0.01, 1000))
       ->capture_default_str();
   cmd->add_flag("--ground", o->triangulation.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (n_cams 1)");

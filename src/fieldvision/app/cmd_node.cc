@@ -23,28 +23,36 @@ void Setup(CLI::App& app, int& exit_code) {
                   "aravis:[ID] or synth:PRESET?camera=NAME")
       ->required();
   cmd->add_option("--connect", o->connect, "The fusion node, tcp://HOST:PORT")->required();
-  cmd->add_flag("--realtime", o->realtime,
-                "Play a file at its own frame rate, as a live camera would deliver it");
+  CLI::Option* realtime =
+      cmd->add_flag("--realtime", o->realtime,
+                    "Play a file at its own frame rate, as a live camera would deliver it");
   cmd->add_option("--start-at", o->start_at_s,
-                  "With --realtime: Unix time (s) of frame 0, as for cameras triggered together");
+                  "With --realtime: Unix time (s) of frame 0, as for cameras triggered together")
+      ->check(FiniteRange(0, 1e10))
+      ->needs(realtime);
   cmd->add_option("--live-buffer", o->live_buffer_frames,
                   "Frames a live source holds for a slow node (the oldest are dropped; 1: only the "
                   "newest, the lowest latency)")
+      ->check(FiniteRange(1, 1000))
       ->capture_default_str();
   cmd->add_option("--ball-diameter", o->ball_diameter_m, "Ball diameter in metres")
+      ->check(FiniteRange(0.01, 2))
       ->capture_default_str();
   cmd->add_option("--color,--colour", o->colour, "Colour preset or colour file of the ball")
       ->capture_default_str();
   cmd->add_option("--field", o->field, "Field (name or JSON): look for the ball only over it");
-  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames");
+  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames")
+      ->check(FiniteRange(0, 1e12));
   cmd->add_flag("!--whole-frames", o->track.enabled,
                 "Search every frame whole (no tracking window)");
   cmd->add_option("--connect-wait", o->connect_wait_s,
                   "Seconds to wait for the fusion node's first clock reply before starting")
+      ->check(FiniteRange(0, 3600))
       ->capture_default_str();
   cmd->add_option("--clock-offset", o->clock_offset_s,
                   "Testing: add this many seconds to this node's clock (a machine whose clock "
-                  "is off)");
+                  "is off)")
+      ->check(FiniteRange(-86400, 86400));
   cmd->add_flag("!--no-detect", o->detect,
                 "Send frames without looking for the ball (a latency baseline)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");

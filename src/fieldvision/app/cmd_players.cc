@@ -1,4 +1,5 @@
 // `fieldvision players`: detect and track people in a video, positions on the field (TRACKS.csv).
+#include <filesystem>
 #include <iostream>
 #include <optional>
 
@@ -93,7 +94,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--field", c->field,
                   "Field (built-in name or JSON): keep only people on it plus --margin");
   CLI::Option* margin =
-      cmd->add_option("--margin", c->o.field_margin_m, "Metres around the field still accepted");
+      cmd->add_option("--margin", c->o.field_margin_m, "Metres around the field still accepted")
+          ->check(FiniteRange(0, 100));
   cmd->add_option("--detector", c->o.detector.kind, "nanodet (default), hog, motion or onnx")
       ->check(CLI::IsMember({"nanodet", "hog", "motion", "onnx"}));
   cmd->add_option("--onnx", c->onnx, "A YOLO-style ONNX model of your own (sets --detector onnx)");
@@ -106,23 +108,29 @@ void Setup(CLI::App& app, int& exit_code) {
                   "NanoDet model (default: BUILD/models/nanodet.onnx from make build)");
   cmd->add_option("--input-width", c->o.detector.input_width,
                   "Network input width in pixels (multiple of 32; smaller is faster)");
-  cmd->add_option("--score", c->o.detector.score_threshold, "Lowest detection score kept");
+  cmd->add_option("--score", c->o.detector.score_threshold, "Lowest detection score kept")
+      ->check(FiniteRange(0, 1));
   cmd->add_option("--min-height", c->o.detector.min_height_px,
-                  "Ignore people shorter than this in pixels (far outside the area of interest)");
-  cmd->add_option("--threads", c->o.detector.threads, "OpenCV threads (0: all cores)");
+                  "Ignore people shorter than this in pixels (far outside the area of interest)")
+      ->check(FiniteRange(0, 100000));
+  cmd->add_option("--threads", c->o.detector.threads, "OpenCV threads (0: all cores)")
+      ->check(FiniteRange(0, 256));
   cmd->add_option("--sot", c->o.tracker.sot,
                   "Single-target tracker through missed detections: none, csrt, kcf, mosse")
       ->check(CLI::IsMember({"none", "csrt", "kcf", "mosse"}));
   cmd->add_option("--max-lost", c->o.tracker.max_lost_frames,
-                  "Frames a lost track is kept to be re-found");
-  cmd->add_option("--max-frames", c->o.max_frames, "Process at most this many frames (0: all)");
+                  "Frames a lost track is kept to be re-found")
+      ->check(FiniteRange(0, 100000));
+  cmd->add_option("--max-frames", c->o.max_frames, "Process at most this many frames (0: all)")
+      ->check(FiniteRange(0, 1e9));
   cmd->add_option("--fps", c->o.fps,
                   "Override the video's time: frame i at i / FPS seconds (default: the video's "
                   "timestamps, else its frame rate)")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.01, 10000));
   cmd->add_option("--min-track-frames", c->o.min_track_frames,
                   "Drop tracks seen in fewer frames (0: keep all; on a clip shorter than twice "
                   "this, half the clip); the summary says how many were dropped")
+      ->check(FiniteRange(0, 1000000))
       ->capture_default_str();
   cmd->add_option("--draw", c->draw,
                   "Also write the video with boxes, ids, team colours, trails and (with a posed "
@@ -132,14 +140,18 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Also write the tracks as a MOTChallenge results file (no header, "
                   "frame,id,left,top,w,h,conf,-1,-1,-1) for TrackEval / py-motmetrics");
   cmd->add_option("--interpolate", c->o.interpolate_max_gap,
-                  "Fill track gaps up to this many frames (0: off)");
+                  "Fill track gaps up to this many frames (0: off)")
+      ->check(FiniteRange(0, 100000));
   cmd->add_option("--stitch-gap", c->o.stitch.max_gap_s,
-                  "Join tracklets of one person across gaps up to this many seconds (0: off)");
+                  "Join tracklets of one person across gaps up to this many seconds (0: off)")
+      ->check(FiniteRange(0, 3600));
   cmd->add_option("--stitch-appearance", c->o.stitch.max_appearance_distance,
-                  "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets");
+                  "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets")
+      ->check(FiniteRange(0, 1));
   cmd->add_option("--smooth-accel", c->o.smooth.accel_sigma_mps2,
                   "Field-position smoothing (Kalman + RTS): players' acceleration sigma in m/s^2 "
                   "(smaller: smoother)")
+      ->check(FiniteRange(0.01, 1000))
       ->capture_default_str();
   cmd->add_flag("!--no-smooth", c->o.smooth.enabled, "Do not smooth the field positions");
   cmd->add_flag("--teams", c->o.teams,
@@ -148,6 +160,15 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->callback([c, margin] {
     FV_REQUIRE(margin->count() == 0 || !c->field.empty(),
                "players: --margin needs --field (it widens the field area people are kept in)");
+    // An empty detections file is a failed export, not a video without people: refuse it rather
+    // than write a TRACKS.csv without rows.
+    std::error_code ec;
+    FV_REQUIRE(c->o.detections_in.empty() ||
+                   !std::filesystem::is_regular_file(c->o.detections_in, ec) ||
+                   std::filesystem::file_size(c->o.detections_in, ec) > 0,
+               "players: --detections '{}' is empty (a det.txt has a row per detection: "
+               "frame,-1,x,y,w,h,score)",
+               c->o.detections_in);
     const auto inputs = PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
     CheckOutputPath(c->out, inputs);
     for (const auto& [out, what] : {std::pair{c->mot_out, "--mot-out"},

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/input_checks.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/stats/stats.h"
@@ -23,6 +24,7 @@ struct StatsCli {
 void RunStats(const StatsCli& c) {
   const FieldModel field = LoadField(c.field);
   const auto rows = track::ReadTracksCsv(c.tracks);
+  CheckOneRowPerPlayerFrame(rows, c.tracks);
   stats::StatsOptions o = c.o;
   if (!c.zones.empty()) o.zones = stats::ReadZones(c.zones);
   std::string teams = c.teams;
@@ -61,14 +63,16 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--fps", c->o.fps,
                   "Override the time in TRACKS.csv (time_s, the video's own): frame f at "
                   "(f - 1) / FPS seconds")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.01, 10000));
   cmd->add_option("--zones", c->zones,
                   "JSON zones for alerts: [{\"name\": \"box\", \"polygon\": [[x, y], ...]}]");
   cmd->add_option("--teams", c->teams,
                   "id,team[,name] CSV (default: TRACKS.csv.teams.csv if present, as players "
                   "--teams and tracks edit write it; team -1: none)");
-  cmd->add_option("--smooth", c->o.smooth_window_s, "Smoothing window of positions in seconds");
-  cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s");
+  cmd->add_option("--smooth", c->o.smooth_window_s, "Smoothing window of positions in seconds")
+      ->check(FiniteRange(0.01, 60));
+  cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s")
+      ->check(FiniteRange(0.1, 20));
   cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.mp4");
   cmd->callback([c] {
     const auto inputs = PathList(c->tracks, c->field, c->zones, c->teams);

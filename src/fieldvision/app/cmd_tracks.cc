@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/input_checks.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
@@ -21,9 +22,18 @@ struct TracksEditCli {
   std::string tracks, edits, out, roster_in;
 };
 
+// The rows of --tracks: at least one, no player twice in a frame.
+std::vector<track::TrackRow> ReadTracks(const std::string& path) {
+  auto rows = track::ReadTracksCsv(path);
+  FV_REQUIRE(!rows.empty(), "tracks file '{}' has no rows (empty, or not a TRACKS.csv)", path);
+  CheckOneRowPerPlayerFrame(rows, path);
+  return rows;
+}
+
 void RunTracksEdit(const TracksEditCli& c) {
-  const auto rows = track::ReadTracksCsv(c.tracks);
+  const auto rows = ReadTracks(c.tracks);
   const track::TrackEdits edits = track::ReadTrackEdits(c.edits);
+  FV_REQUIRE(!edits.edits.empty(), "edits file '{}' has no edits: nothing to do", c.edits);
   std::string roster_in = c.roster_in;
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     roster_in = track::RosterPathFor(c.tracks);
@@ -52,7 +62,7 @@ struct TracksDrawCli {
 
 // The video with the (edited) tracks drawn: names from the roster, team colours.
 void RunTracksDraw(const TracksDrawCli& c) {
-  const auto rows = track::ReadTracksCsv(c.tracks);
+  const auto rows = ReadTracks(c.tracks);
   std::string roster_in = c.roster_in;
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     roster_in = track::RosterPathFor(c.tracks);
@@ -104,8 +114,9 @@ void Setup(CLI::App& app, int& exit_code) {
   draw->add_option("--roster", d->roster_in,
                    "id,team[,name] CSV (default: TRACKS.csv.teams.csv if present)");
   draw->add_option("--fps", d->fps, "Frame rate of the output (default: the video's)")
-      ->check(CLI::PositiveNumber);
-  draw->add_option("--max-frames", d->max_frames, "Draw at most this many frames (0: all)");
+      ->check(FiniteRange(0.01, 10000));
+  draw->add_option("--max-frames", d->max_frames, "Draw at most this many frames (0: all)")
+      ->check(FiniteRange(0, 1e9));
   draw->callback([d] { RunTracksDraw(*d); });
 }
 

@@ -89,6 +89,12 @@ void Setup(CLI::App& app, int& exit_code) {
       CheckOutputPath(out, PathList(o->job.in_path, files, o->job.field), what);
     }
     if (files.empty()) {
+      // Output files, as every writer's: not a device or a folder, in a folder that exists.
+      for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
+                                      {o->job.smoothed_path, "--smoothed"},
+                                      {o->job.report_path, "--report"}}) {
+        if (!out.empty()) ResolveOutputPath(out, what);
+      }
       // A progress line on a terminal while the arcs of a long track are fitted.
       bool shown = false;
       if (isatty(fileno(stderr))) {

@@ -1,7 +1,10 @@
 #include "fieldvision/app/command.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
+
+#include <fmt/format.h>
 
 namespace fv::app {
 namespace {
@@ -37,6 +40,18 @@ CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string
   CLI::App* group = app.add_subcommand(name, description);
   group->require_subcommand(1);
   return group;
+}
+
+CLI::Validator FiniteRange(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& text) {
+        double v = 0;
+        if (!CLI::detail::lexical_cast(text, v) || !std::isfinite(v) || v < lo || v > hi) {
+          return fmt::format("value {} is not a number in [{}, {}]", text, lo, hi);
+        }
+        return std::string();
+      },
+      fmt::format("NUMBER in [{}, {}]", lo, hi));
 }
 
 }  // namespace fv::app

@@ -24,6 +24,10 @@ void SetUpAllCommands(CLI::App& app, int& exit_code);
 // existing subcommand or adds it.
 CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string& description);
 
+// An option check: a finite number in [lo, hi]. CLI::Range lets NaN through; CLI11 puts the
+// option's name before the message ("--step: value nan is not a number in [0.001, 100]").
+CLI::Validator FiniteRange(double lo, double hi);
+
 }  // namespace fv::app
 
 #define FV_CONCAT_INNER(a, b) a##b

@@ -81,6 +81,7 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
   // Ranges of the numbers read (NaN fails them too).
   constexpr double kMaxPixel = 1e6;
   constexpr double kMaxFieldM = 1e4;
+  constexpr long long kMaxFrame = 100000000;  // 46 days at 25 frames/s; 2e9 is a damaged file
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "cannot open tracks file '{}'", path);
   std::vector<TrackRow> rows;
@@ -118,7 +119,10 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
     };
     auto number = [&](const char* name) { return ParseDouble(field(name), where + " " + name); };
     TrackRow r;
-    r.frame = static_cast<int>(ParseInt(field("frame"), where + " frame"));
+    const long long frame = ParseInt(field("frame"), where + " frame");
+    FV_REQUIRE(frame >= 0 && frame <= kMaxFrame, "{}: frame {} is not in [0, {}]", where, frame,
+               kMaxFrame);
+    r.frame = static_cast<int>(frame);
     r.id = static_cast<int>(ParseInt(field("id"), where + " id"));
     r.box =
         cv::Rect2d(number("bb_left"), number("bb_top"), number("bb_width"), number("bb_height"));

@@ -45,6 +45,14 @@ double NumAttr(const std::string& tag, const std::string& name, const std::strin
   return ParseDouble(v, where + " " + name);
 }
 
+// A frame number or id: a whole number in [0, 1e8] (NaN, 1e300 and 2e9 are refused).
+int IndexAttr(const std::string& tag, const std::string& name, const std::string& where) {
+  const double v = NumAttr(tag, name, where);
+  FV_REQUIRE(v >= 0 && v <= 1e8 && v == std::floor(v),
+             "{}: {} '{}' is not a whole number in [0, 1e8]", where, name, Attr(tag, name));
+  return static_cast<int>(v);
+}
+
 }  // namespace
 
 std::vector<TrackRow> ReadPetsCvml(const std::string& path) {
@@ -61,13 +69,17 @@ std::vector<TrackRow> ReadPetsCvml(const std::string& path) {
     pos = end + 1;
     const std::string where = fmt::format("{} (frame {})", path, frame);
     if (StartsWith(tag, "<frame ")) {
-      frame = static_cast<int>(NumAttr(tag, "number", where));
+      frame = IndexAttr(tag, "number", where);
     } else if (StartsWith(tag, "<object ")) {
-      id = static_cast<int>(NumAttr(tag, "id", where));
+      id = IndexAttr(tag, "id", where);
     } else if (StartsWith(tag, "<box ")) {
       FV_REQUIRE(frame >= 0 && id >= 0, "{}: <box> outside a frame/object", where);
       const double xc = NumAttr(tag, "xc", where), yc = NumAttr(tag, "yc", where);
       const double w = NumAttr(tag, "w", where), h = NumAttr(tag, "h", where);
+      FV_REQUIRE(
+          std::abs(xc) <= 1e6 && std::abs(yc) <= 1e6 && w >= 0 && w <= 1e6 && h >= 0 && h <= 1e6,
+          "{}: box xc={} yc={} w={} h={} is not a box in an image (within +-1e6 px)", where, xc, yc,
+          w, h);
       TrackRow r;
       r.frame = frame + 1;  // CVML numbers frames from 0, MOTChallenge from 1
       r.id = id;
