@@ -5,7 +5,9 @@
 // Below: the zone alerts on a timeline (who was in which zone when), each player's speed over
 // time (uPlot), a heat map of the time spent per 1 m cell (one player or all) with its colour
 // scale in seconds, and a table of distance, top and mean speed, sprints and zone time, as
-// `fieldvision stats` computes them (/api/players/stats).
+// `fieldvision stats` computes them (/api/players/stats). Export writes what the page shows into
+// a folder of the working folder (/api/players/export): the stats report's tables and images and
+// the page's own heat map (with its scale), board, speed chart and alert timeline as PNG.
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 import * as api from './api';
@@ -53,6 +55,9 @@ export async function playersPage(root: HTMLElement): Promise<void> {
   const table = el('table', { id: 'pl-table' });
   const alerts = el('canvas', { id: 'pl-alerts', width: '1400', height: '60' });
   const msg = el('div', { id: 'pl-status', class: 'status' });
+  const exportOut = el('input', { id: 'pl-export-out', value: 'players_export', size: '22', title: 'a folder of the working folder (made when absent)' });
+  const exportButton = el('button', { id: 'pl-export', text: 'Export' });
+  const exportMsg = el('div', { id: 'pl-export-status', class: 'status' });
   root.replaceChildren(
     el('section', { class: 'controls' }, labelled('Tracks', tracks), labelled('Field', field), labelled('Zones', zonesFile),
       labelled('Video (side by side)', video), load, play),
@@ -65,6 +70,10 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     el('div', { class: 'side-by-side' },
       el('div', { class: 'half' }, el('h3', { text: 'Heat map: time spent per 1 m cell' }), labelled('Player', heatWho), heat, legend),
       el('div', { class: 'half' }, el('h3', { text: 'Per player (fieldvision stats)' }), table)),
+    el('h3', { text: 'Export' }),
+    el('section', { class: 'controls' }, labelled('Folder', exportOut), exportButton),
+    el('p', { class: 'hint', text: 'Writes the statistics (players.csv, speed_profiles.csv, distances.csv, zone_alerts.csv, stats.json, index.html), the heat maps with their scales and the radar view as `fieldvision stats` makes them, and this page\'s heat map (with its scale), board, speed chart and zone alerts as page_*.png.' }),
+    exportMsg,
   );
 
   let fmap: FieldMap | null = null;
@@ -372,6 +381,41 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions, ${players.size} players${statsNote}` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
     } catch (e) {
       status(msg, (e as Error).message, true);
+    }
+  };
+  // The heat map as shown (one player or all) with its colour scale and a title, as one image.
+  function heatImage(): HTMLCanvasElement {
+    const title = 28;
+    const c = el('canvas', { width: String(heat.width), height: String(title + heat.height + legend.height) });
+    const ctx = c.getContext('2d')!;
+    ctx.fillStyle = '#161b22';
+    ctx.fillRect(0, 0, c.width, c.height);
+    ctx.fillStyle = '#ddd';
+    ctx.font = '15px sans-serif';
+    const who = heatWho.value === 'all' ? 'all players' : `player ${heatWho.value}`;
+    ctx.fillText(`Time spent per 1 m cell: ${who}, ${tracks.value}`, 8, 19);
+    ctx.drawImage(heat, 0, title);
+    ctx.drawImage(legend, 0, title + heat.height);
+    return c;
+  }
+
+  exportButton.onclick = async () => {
+    if (!model || !frames.length) {
+      status(exportMsg, 'nothing to export: show a tracks file first', true);
+      return;
+    }
+    try {
+      status(exportMsg, 'exporting…');
+      const images: Record<string, string> = { heatmap: heatImage().toDataURL('image/png'), board: board.toDataURL('image/png'), zone_alerts: alerts.toDataURL('image/png') };
+      const speed = chart.querySelector('canvas');
+      if (speed) images.speed = speed.toDataURL('image/png');
+      const r = await api.post<{ wrote: string[]; notes: string[] }>('/api/players/export', {
+        tracks: tracks.value, field: field.value, out: exportOut.value, images, ...(zonesFile.value ? { zones: zonesFile.value } : {}),
+      });
+      exportMsg.dataset.wrote = JSON.stringify(r.wrote);
+      status(exportMsg, `wrote ${r.wrote.length} files: ${r.wrote.join(', ')}${r.notes.length ? ` (${r.notes.join('; ')})` : ''}`);
+    } catch (e) {
+      status(exportMsg, (e as Error).message, true);
     }
   };
   time.addEventListener('input', () => draw(Number(time.value)));

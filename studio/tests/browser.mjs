@@ -10,7 +10,7 @@
 //   zones: a polygon clicked on the field map is saved
 //   jobs: a job runs to the end, another is cancelled (states from the server's events)
 //   players: the tactical board plays with the zones, the video beside it, heat maps, speed chart,
-//     zone alerts on a timeline and the stats table (as /api/players/stats)
+//     zone alerts on a timeline and the stats table (as /api/players/stats); export (CSV, PNG)
 // Usage: node browser.mjs URL OUT_DIR FIELDVISION
 import { chromium } from 'playwright-core';
 import { execFileSync, spawn } from 'node:child_process';
@@ -392,6 +392,25 @@ try {
   check(alertCount === libStats.events.length && alertCount >= 1 && libStats.events.some((e) => e.id === Number(firstRow.id) && e.zone === 'start'),
     `zone alerts on the timeline (${alertCount}: ${libStats.events.map((e) => `id ${e.id} ${e.enter_s}-${e.exit_s} s`).join(', ')})`);
   check(true, `tactical board plays (frame ${firstFrame} -> ${await page.getAttribute('#pl-board', 'data-frame')})`);
+  // Export: the statistics as CSV (the table's numbers), the alerts, the heat map shown with its
+  // scale and title, written into a folder of the working folder.
+  await page.fill('#pl-export-out', 'players_export');
+  await page.click('#pl-export');
+  await page.waitForSelector('#pl-export-status[data-wrote]');
+  const exported = path.join(work, 'players_export');
+  const csvPlayers = readCsv(path.join(exported, 'players.csv'));
+  check(csvPlayers.length === tableRows.length && tableRows.every(([id, d]) => csvPlayers.some((p) => Number(p.id) === id && Math.abs(Number(p.distance_m) - d) < 0.01)),
+    `export: players.csv holds the table's ${csvPlayers.length} players and distances`);
+  check(readCsv(path.join(exported, 'zone_alerts.csv')).length === alertCount, `export: zone_alerts.csv holds the ${alertCount} alerts`);
+  const pngSize = (f) => {
+    const b = fs.readFileSync(path.join(exported, f));
+    return b.subarray(1, 4).toString() === 'PNG' ? [b.readUInt32BE(16), b.readUInt32BE(20)] : null;
+  };
+  const [heatW, heatH] = await page.$eval('#pl-heat', (c) => [c.width, c.height + document.querySelector('#pl-heat-legend').height]);
+  const pageHeat = pngSize('page_heatmap.png');
+  check(pageHeat && pageHeat[0] === heatW && pageHeat[1] > heatH, `export: the page's heat map with its scale (page_heatmap.png ${pageHeat})`);
+  check(['heatmap_all.png', 'page_board.png', 'page_speed.png', 'index.html', 'stats.json'].every((f) => fs.existsSync(path.join(exported, f))),
+    'export: stats heat maps, board, speed chart, report');
   lap('players');
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
 } catch (e) {
