@@ -41,6 +41,7 @@ interface Flight {
 export interface BenchResult {
   points: number;
   segments: number; // line segments drawn (those longer than a marker)
+  points_drawn: number; // markers drawn in the last frame (software GL: the nearest per pixel)
   paced_fps: number; // frames shown per second while turning (requestAnimationFrame, vsync-bound)
   render_ms_median: number; // render + GPU finish per frame
   render_ms_p95: number;
@@ -121,18 +122,27 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   // Render on demand: at most once per animation frame, only after a change.
   let renders = 0;
   let pending = 0;
-  const renderNow = () => {
+  // Tracks culled to the view before each frame (software GL, see trackObject).
+  const culled = new Set<(viewProjection: THREE.Matrix4, all: boolean) => void>();
+  const viewProjection = new THREE.Matrix4();
+  const renderNow = (all = false) => {
     pending = 0;
+    if (culled.size) {
+      view.updateMatrixWorld();
+      viewProjection.multiplyMatrices(view.projectionMatrix, view.matrixWorldInverse);
+      for (const cull of culled) cull(viewProjection, all);
+    }
     renderer.render(scene, view);
     ++renders;
   };
   const requestRender = () => {
-    if (!pending) pending = requestAnimationFrame(renderNow);
+    if (!pending) pending = requestAnimationFrame(() => renderNow());
   };
   controls.addEventListener('change', requestRender);
   // Without preserveDrawingBuffer the canvas reads back blank once shown: a 'render-now' event
-  // draws at once, so that a reader in the same task (tests, a capture) gets the picture.
-  canvas.addEventListener('render-now', renderNow);
+  // draws at once, so that a reader in the same task (tests, a capture) gets the picture
+  // (detail {all: true}: every marker, none culled; for comparison).
+  canvas.addEventListener('render-now', (e) => renderNow(Boolean((e as CustomEvent).detail?.all)));
 
   let dynamic = new THREE.Group();
   let samples: number[][] = [];
@@ -222,10 +232,22 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     return new THREE.LineSegments(geo, new THREE.LineBasicMaterial({ vertexColors: true }));
   }
 
+  // Pixel grids shared by the culled tracks (frame stamp, nearest depth, its sample), sized to
+  // the drawing buffer; allocated once.
+  const bufferSize = renderer.getDrawingBufferSize(new THREE.Vector2());
+  const gridW = Math.max(1, Math.round(bufferSize.x));
+  const gridH = Math.max(1, Math.round(bufferSize.y));
+  const gridStamp = new Uint32Array(gridW * gridH);
+  const gridDepth = new Float32Array(gridW * gridH);
+  const gridBest = new Int32Array(gridW * gridH);
+  let stamp = 0;
+
   // A track: one set of positions and time colours drawn as points (every sample) and as line
   // segments between consecutive samples. A segment shorter than a marker's width lies under the
   // markers at its ends (same colour) and is left out: dense tracks (a ball rolling or at rest,
-  // 100 Hz samples) draw few segments; software GL pays ~0.5 us per primitive.
+  // 100 Hz samples) draw few segments. Software GL pays ~0.5 us per primitive, so there each
+  // frame draws, of the markers whose centres fall in the same pixel, only the nearest (the
+  // later one on a tie): the others lie under it, shifted by less than a pixel.
   const markerSize = 0.12; // PointsMaterial size; a marker spans markerSize * tan(fov / 2) metres
   function trackObject(s: number[][]): THREE.Group {
     const pos = new Float32Array(3 * s.length);
@@ -254,7 +276,56 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     lineGeo.setAttribute('color', colour);
     lineGeo.setIndex(pairs);
     const g = new THREE.Group();
-    g.add(new THREE.Points(geo, new THREE.PointsMaterial({ size: markerSize, vertexColors: true })));
+    const points = new THREE.Points(geo, new THREE.PointsMaterial({ size: markerSize, vertexColors: true }));
+    g.add(points);
+    if (gpu.software && s.length) {
+      const n = s.length;
+      const index = new THREE.BufferAttribute(new Uint32Array(n), 1).setUsage(THREE.DynamicDrawUsage);
+      geo.setIndex(index);
+      const cellOf = new Int32Array(n);
+      const margin = 16; // px: markers centred this far off the canvas may still show an edge
+      const cull = (vp: THREE.Matrix4, all: boolean) => {
+        const e = vp.elements;
+        if (++stamp === 0xffffffff) {
+          gridStamp.fill(0);
+          stamp = 1;
+        }
+        for (let i = 0; i < n; ++i) {
+          const x = pos[3 * i];
+          const y = pos[3 * i + 1];
+          const z = pos[3 * i + 2];
+          const w = e[3] * x + e[7] * y + e[11] * z + e[15];
+          cellOf[i] = -1;
+          if (w <= view.near) continue;
+          const px = Math.floor(((e[0] * x + e[4] * y + e[8] * z + e[12]) / w + 1) * 0.5 * gridW);
+          const py = Math.floor(((e[1] * x + e[5] * y + e[9] * z + e[13]) / w + 1) * 0.5 * gridH);
+          if (px < 0 || py < 0 || px >= gridW || py >= gridH) {
+            if (px >= -margin && py >= -margin && px < gridW + margin && py < gridH + margin) cellOf[i] = -2;
+            continue;
+          }
+          const k = py * gridW + px;
+          cellOf[i] = k;
+          if (gridStamp[k] !== stamp || w <= gridDepth[k]) {
+            gridStamp[k] = stamp;
+            gridDepth[k] = w;
+            gridBest[k] = i;
+          }
+        }
+        const out = index.array as Uint32Array;
+        let kept = 0;
+        for (let i = 0; i < n; ++i) {
+          const k = cellOf[i];
+          if (all || k === -2 || (k >= 0 && gridBest[k] === i)) out[kept++] = i;
+        }
+        index.clearUpdateRanges();
+        index.addUpdateRange(0, kept);
+        index.needsUpdate = true;
+        geo.setDrawRange(0, kept);
+        g.userData.drawn = kept;
+      };
+      culled.add(cull);
+      g.userData.cull = cull;
+    }
     g.add(new THREE.LineSegments(lineGeo, new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.5 })));
     g.userData.segments = pairs.length / 2;
     return g;
@@ -300,6 +371,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   function rebuildStatic(f: api.FieldModel): void {
     scene.remove(dynamic);
     dynamic.traverse((o) => {
+      if (o.userData.cull) culled.delete(o.userData.cull);
       const m = o as THREE.Mesh;
       m.geometry?.dispose();
       (m.material as THREE.Material | undefined)?.dispose();
@@ -383,6 +455,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   function dropBenchTrack() {
     if (!benchTrack) return;
     scene.remove(benchTrack);
+    culled.delete(benchTrack.userData.cull);
     for (const c of benchTrack.children) (c as THREE.Points).geometry.dispose();
     benchTrack = null;
   }
@@ -433,6 +506,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
     return {
       points: n,
       segments: n ? track.userData.segments : 0,
+      points_drawn: n ? track.userData.drawn ?? n : 0,
       paced_fps: Number(paced.toFixed(1)),
       render_ms_median: Number(quantile(costs, 0.5).toFixed(2)),
       render_ms_p95: Number(quantile(costs, 0.95).toFixed(2)),
@@ -524,7 +598,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   bench.onclick = async () => {
     status(msg, 'benchmark running…');
     const r = await runBench();
-    status(msg, `benchmark: ${r.points} points (${r.segments} line segments longer than a marker), ${r.paced_fps} frames/s shown while turning; render ${r.render_ms_median} ms per frame (p95 ${r.render_ms_p95} ms) → ${(1000 / r.render_ms_median).toFixed(0)} frames/s possible; canvas ${r.canvas}; ${r.renderer}${r.antialias ? '' : ', no antialiasing'}`);
+    status(msg, `benchmark: ${r.points} points (${r.points_drawn} drawn in the last frame, the others under them; ${r.segments} line segments longer than a marker), ${r.paced_fps} frames/s shown while turning; render ${r.render_ms_median} ms per frame (p95 ${r.render_ms_p95} ms) → ${(1000 / r.render_ms_median).toFixed(0)} frames/s possible; canvas ${r.canvas}; ${r.renderer}${r.antialias ? '' : ', no antialiasing'}`);
     msg.dataset.fps = String(r.paced_fps);
     msg.dataset.bench = JSON.stringify(r);
   };

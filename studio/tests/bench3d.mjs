@@ -34,7 +34,7 @@ try {
       await page.waitForSelector('#v3-status[data-fps]', { timeout: 120000 });
       const b = JSON.parse(await page.getAttribute('#v3-status', 'data-bench'));
       console.log(`${name.padEnd(34)} ${String(b.paced_fps).padStart(5)} frames/s shown; render ${b.render_ms_median} ms ` +
-        `(p95 ${b.render_ms_p95}); canvas ${b.canvas ?? '?'}, ${b.segments ?? '?'} line segments; ${b.renderer.replace(/ \(0x[0-9A-F]+\)|ANGLE \(Google, |, SwiftShader driver\)/g, '')}`);
+        `(p95 ${b.render_ms_p95}); canvas ${b.canvas ?? '?'}, ${b.points_drawn ?? '?'} points and ${b.segments ?? '?'} line segments drawn; ${b.renderer.replace(/ \(0x[0-9A-F]+\)|ANGLE \(Google, |, SwiftShader driver\)/g, '')}`);
     }
   }
 } finally {

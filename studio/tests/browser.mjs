@@ -260,6 +260,29 @@ try {
     `${bench.renderer}${bench.antialias ? '' : ', no antialiasing'}`);
   check(bench.paced_fps > 0 && bench.render_ms_median > 0, '3D benchmark measured');
   await page.screenshot({ path: path.join(out, 'bench3d.jpg'), quality: 70 });
+  // Software GL draws only the nearest marker per pixel: the picture is that of every marker.
+  const culling = await page.evaluate(() => {
+    const c = document.querySelector('#v3-canvas');
+    const grab = (all) => {
+      c.dispatchEvent(new CustomEvent('render-now', { detail: { all } }));
+      const t = document.createElement('canvas');
+      t.width = c.width;
+      t.height = c.height;
+      const ctx = t.getContext('2d');
+      ctx.drawImage(c, 0, 0);
+      return ctx.getImageData(0, 0, t.width, t.height).data;
+    };
+    const every = grab(true);
+    const culled = grab(false);
+    let differ = 0;
+    for (let i = 0; i < every.length; i += 4) {
+      if (Math.abs(every[i] - culled[i]) + Math.abs(every[i + 1] - culled[i + 1]) + Math.abs(every[i + 2] - culled[i + 2]) > 30) ++differ;
+    }
+    return { differ, pixels: every.length / 4 };
+  });
+  console.log(`3D benchmark: ${bench.points_drawn} of ${bench.points} markers drawn (nearest per pixel); ${culling.differ} of ` +
+    `${culling.pixels} pixels differ from drawing every marker`);
+  check(culling.differ < 0.01 * culling.pixels, `culled markers leave the picture as it was (${(100 * culling.differ / culling.pixels).toFixed(2)} % of pixels differ)`);
   // The same turn with nothing drawn: what headless chromium itself shows on this machine.
   await page.goto(new URL('?scene=empty&points=0#bench3d', url).toString());
   await page.waitForSelector('#v3-status[data-fps]', { timeout: 60000 });
