@@ -3,15 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <mutex>
 
 #include <fmt/format.h>
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -235,6 +237,17 @@ std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board) {
                      best_count, best, board.dictionary, best);
 }
 
+// A video read forward frame by frame (a frame source has no seek).
+struct ImageSource::VideoReader {
+  void Open(const std::string& spec) {
+    source = OpenFrameSource(spec);
+    next_frame = 0;
+  }
+  std::mutex mutex;
+  std::unique_ptr<FrameSource> source;
+  long long next_frame = 0;  // the frame the next read gives
+};
+
 void ImageSourceOptions::Check() const {
   FV_REQUIRE(max_video_frames >= 1, "max_video_frames must be >= 1 (got {})", max_video_frames);
 }
@@ -271,21 +284,20 @@ ImageSource::ImageSource(const std::string& spec, const ImageSourceOptions& opti
     names_.push_back(spec);
     return;
   }
-  cv::VideoCapture cap;
+  video_ = std::make_shared<VideoReader>();
+  long long count = 0;
   try {
-    cap.open(spec);
-  } catch (const cv::Exception&) {
-  }
-  FV_REQUIRE(cap.isOpened(), "images '{}': not an image, folder, pattern or readable video", spec);
-  long long count = static_cast<long long>(cap.get(cv::CAP_PROP_FRAME_COUNT));
-  if (count <= 0) {
-    // Some containers do not say; count by reading.
-    cv::Mat f;
-    count = 0;
-    while (cap.read(f)) ++count;
+    video_->Open(spec);
+    count = video_->source->FrameCount();
+    if (count <= 0) {  // some containers do not say; count by reading
+      count = 0;
+      while (video_->source->SkipFrame()) ++count;
+      video_->Open(spec);
+    }
+  } catch (const Error&) {
+    Throw("images '{}': not an image, folder, pattern or readable video", spec);
   }
   FV_REQUIRE(count > 0, "images '{}': the video has no readable frames", spec);
-  video_ = true;
   const int n = static_cast<int>(std::min<long long>(count, options.max_video_frames));
   for (int i = 0; i < n; ++i) {
     const int frame = static_cast<int>((count * (2LL * i + 1)) / (2LL * n));
@@ -311,11 +323,18 @@ cv::Mat ImageSource::Read(int i) const {
     }
     return image;
   }
-  cv::VideoCapture cap(spec_);
-  FV_REQUIRE(cap.isOpened(), "video '{}' cannot be opened", spec_);
-  cap.set(cv::CAP_PROP_POS_FRAMES, frames_[i]);
-  cap.read(image);
-  FV_REQUIRE(!image.empty(), "video '{}': frame {} cannot be read (corrupt video?)", spec_,
+  std::lock_guard<std::mutex> lock(video_->mutex);
+  if (frames_[i] < video_->next_frame) video_->Open(spec_);
+  bool ok = true;
+  while (ok && video_->next_frame < frames_[i]) {
+    ok = video_->source->SkipFrame();
+    ++video_->next_frame;
+  }
+  long long frame = 0;
+  double time_s = 0;
+  ok = ok && video_->source->Read(&image, &frame, &time_s);
+  video_->next_frame = ok ? frames_[i] + 1 : std::numeric_limits<long long>::max();
+  FV_REQUIRE(ok && !image.empty(), "video '{}': frame {} cannot be read (corrupt video?)", spec_,
              frames_[i]);
   return image;
 }

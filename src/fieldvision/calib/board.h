@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -91,12 +92,14 @@ class ImageSource {
   int size() const { return static_cast<int>(names_.size()); }
   const std::string& spec() const { return spec_; }
   const std::string& name(int i) const { return names_[i]; }
-  // Reads image i (BGR or grey as stored); throws naming the file when it cannot be read.
+  // Reads image i (BGR or grey as stored); throws naming the file when it cannot be read. A
+  // video is read forward through io's frame source (reopened when i goes back).
   cv::Mat Read(int i) const;
 
  private:
+  struct VideoReader;
   std::string spec_;
-  bool video_ = false;
+  std::shared_ptr<VideoReader> video_;  // null for images
   std::vector<std::string> names_;
   std::vector<int> frames_;  // video frame numbers
 };
