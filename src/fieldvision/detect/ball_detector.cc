@@ -484,6 +484,8 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
     if (region_why.empty()) region_why = region_size_why;
   }
   const bool region_accept = region_why.empty();
+  cand.disc_shaped =
+      region.ok && region_size_why.empty() && RegionProblem(region, o, /*shape_only=*/true).empty();
   if (fit.ok) {
     cand.blurred = fit.blurred;
     cand.inlier_fraction = fit.inlier_fraction;

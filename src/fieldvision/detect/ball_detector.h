@@ -36,6 +36,9 @@ struct BallCandidate {
   // dark background often looks like this. Multi-view fusion may use it to complete a position
   // that an accepted candidate of another camera starts (recon/triangulation.h).
   bool weak = false;
+  // The region passed every shape check and the size check (a disc of a plausible size), whatever
+  // the colour checks (leak, contrast) said: worth a second opinion (dnn_ball.h).
+  bool disc_shaped = false;
   // Extras for drawing and diagnosis.
   double visible_fraction = 0.0;  // share of the fitted disc with the ball's colour
   double inlier_fraction = 0.0;   // share of rays with an outline point on the fit

@@ -170,11 +170,13 @@ std::vector<double> DnnBallDetector::CropScores(const cv::Mat& bgr,
   const cv::Rect full(0, 0, bgr.cols, bgr.rows);
   const cv::Rect area = roi.empty() ? full : (roi & full);
   std::vector<double> scores(candidates.size(), 0.0);
-  // Accepted first, then weak, then the rest, each in the detector's order.
+  // Accepted first, then weak or disc-shaped ones, then the rest, each in the detector's order.
   std::vector<size_t> order(candidates.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    const auto rank = [](const BallCandidate& c) { return c.accepted ? 0 : (c.weak ? 1 : 2); };
+    const auto rank = [](const BallCandidate& c) {
+      return c.accepted ? 0 : (c.weak || c.disc_shaped ? 1 : 2);
+    };
     return rank(candidates[a]) < rank(candidates[b]);
   });
   int crops = 0;
