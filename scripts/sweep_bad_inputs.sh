@@ -488,9 +488,8 @@ sweep_opt "color learn" --frame "$INTS 1000" "${CL[@]}" --roi 10,10,20,20 --out 
 sweep_opt "color learn" --max-background "nan inf 1e300 -1 abc" "${CL[@]}" --roi 10,10,20,20 --out "$O/new.json"
 c "color learn neither points nor roi" "" -- "${CL[@]}" --out "$O/new.json"
 # eval
-# (a frame number of 2e9 is a frame like any other here)
-sweep_file "eval ball --truth" csv "${CSV_BAD/huge_frame/}" eval ball --truth @ --est "$F/BALL.csv"
-sweep_file "eval ball --est" csv "${CSV_BAD/huge_frame/}" eval ball --truth "$F/truth.csv" --est @
+sweep_file "eval ball --truth" csv "$CSV_BAD" eval ball --truth @ --est "$F/BALL.csv"
+sweep_file "eval ball --est" csv "$CSV_BAD" eval ball --truth "$F/truth.csv" --est @
 sweep_opt "eval ball" --outlier "$POS" eval ball --truth "$F/truth.csv" --est "$F/BALL.csv"
 sweep_opt "eval ball" --min-cams "$INTS" eval ball --truth "$F/truth.csv" --est "$F/BALL.csv"
 sweep_file "eval tracks --gt" csv "$TRACKS_BAD" eval tracks --gt @ --est "$F/TRACKS.csv"
@@ -498,7 +497,8 @@ sweep_file "eval tracks --est" csv "$TRACKS_BAD" eval tracks --gt "$F/TRACKS.csv
 sweep_file "eval tracks --gt xml" xml "pets_nan pets_huge empty binary" eval tracks --gt @ --est "$F/TRACKS.csv"
 sweep_out "eval tracks" "$F/TRACKS.csv" eval tracks --gt "$F/TRACKS.csv" --est "$F/TRACKS.csv" --json @
 sweep_opt "eval tracks" --iou "nan inf 1e300 -1 2 abc" eval tracks --gt "$F/TRACKS.csv" --est "$F/TRACKS.csv"
-sweep_opt "eval tracks" --frame-offset "$INTS" eval tracks --gt "$F/TRACKS.csv" --est "$F/TRACKS.csv"
+# (a negative offset is one: an estimate numbered from 1 against truth from 0)
+sweep_opt "eval tracks" --frame-offset "nan 1e300 99999999999999999999 abc" eval tracks --gt "$F/TRACKS.csv" --est "$F/TRACKS.csv"
 sweep_file "eval detect --video" avi "$VIDEO_BAD" eval detect --video @ --no-progress
 sweep_file "eval detect --camera" yaml "$CAM_BAD" eval detect --video "$F/frames" --camera @ --no-progress
 sweep_file "eval detect --labels" csv "empty binary missing" eval detect --video "$F/frames" --labels @ --no-progress

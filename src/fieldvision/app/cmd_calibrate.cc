@@ -480,7 +480,18 @@ void RunRig(const RigCli& c) {
     }
     obs.push_back(ReadRigObservations(c.points[i], field.get()));
   }
-  const RigResult r = RefineRig(cams, obs, c.o);
+  const RigResult r = [&] {
+    try {
+      return RefineRig(cams, obs, c.o);
+    } catch (const Error& e) {
+      // "CAM has N observations; ...": name that camera's points file.
+      const std::string what = e.what();
+      for (size_t i = 0; i < cams.size(); ++i) {
+        if (what.rfind(cams[i].name + " has ", 0) == 0) Throw("{}: {}", c.points[i], what);
+      }
+      throw;
+    }
+  }();
   std::cout << r.Summary() << "\n";
   if (r.free_points.empty()) {
     std::cout << "note: every point has a known position, so no point ties the cameras together: "

@@ -10,6 +10,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
@@ -71,7 +72,14 @@ void RunTracksDraw(const TracksDrawCli& c) {
   ResolveOutputPath(c.out);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   std::optional<Camera> camera;
-  if (!c.camera.empty()) camera = ReadCameraYaml(c.camera);
+  if (!c.camera.empty()) {
+    camera = ReadCameraYaml(c.camera);
+    // Field lines drawn with a camera of another size would be wrong everywhere.
+    const auto video = VideoSource::Open(c.video);
+    FV_REQUIRE(video->width() == camera->width && video->height() == camera->height,
+               "camera file '{}' is for {}x{} images but video '{}' is {}x{}", c.camera,
+               camera->width, camera->height, c.video, video->width(), video->height());
+  }
   std::optional<FieldModel> field;
   if (!c.field.empty()) field = LoadField(c.field);
   const track::TrackOverlay overlay(rows, roster.team_of, roster.name_of,
