@@ -46,6 +46,38 @@ TEST(BallDetector, FindsDrawnBallsAndRejectsATriangle) {
   EXPECT_TRUE(cone_seen);
 }
 
+// A disc that fails only the colour contrast is disc-shaped (worth a network's look); a cone is
+// not.
+TEST(BallDetector, LowContrastDiscIsDiscShapedAConeIsNot) {
+  const uint64_t seed = fv::testing::TestSeed(23);
+  FV_SEED_TRACE(seed);
+  Rng rng(seed);
+  BallDetectorOptions o;
+  o.min_contrast = 300;     // above any CIELAB distance: every region fails the contrast check
+  o.max_fit_rms_px = 1e-6;  // and no outline fit passes: the region path decides
+  const BallDetector det(o, nullptr, nullptr);
+  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  const std::vector<cv::Point> tri = {{500, 400}, {540, 400}, {520, 340}};
+  cv::fillConvexPoly(img, tri, cv::Scalar(0, 80, 255), cv::LINE_AA);
+  const Eigen::Vector2d c(rng.Uniform(150, 300), rng.Uniform(150, 300));
+  detect_testing::PaintDisc(img, c, rng.Uniform(6, 15));
+  const BallDetectionResult res = det.DetectWithSummary(img);
+  EXPECT_EQ(res.accepted(), 0) << res.Summary();
+  int discs = 0, cones = 0;
+  for (const BallCandidate& cand : res.candidates) {
+    if ((cand.centre_px - c).norm() < 2) {
+      ++discs;
+      EXPECT_TRUE(cand.disc_shaped);
+      EXPECT_NE(cand.reason.find("contrast"), std::string::npos) << cand.reason;
+    } else if ((cand.centre_px - Eigen::Vector2d(520, 380)).norm() < 25) {
+      ++cones;
+      EXPECT_FALSE(cand.disc_shaped) << cand.reason;
+    }
+  }
+  EXPECT_EQ(discs, 1);
+  EXPECT_GE(cones, 1);
+}
+
 TEST(BallDetector, BadInputGivesErrors) {
   BallDetectorOptions o;
   o.scan_step_px = 0;
