@@ -643,8 +643,9 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
          return Json(live->Status());
        }},
       {{"POST", "/api/live/stop", "{}: end the subscription"},
-       [](const Workspace&, EventHub*, JobRunner*, LiveFeed* live, const ApiRequest&) {
+       [](const Workspace&, EventHub*, JobRunner*, LiveFeed* live, const ApiRequest& r) {
          if (!live) throw HttpError(404, "this server has no live feed");
+         if (!r.body.empty()) Body(r);  // a malformed body is refused like everywhere else
          live->Stop();
          return Json(live->Status());
        }},

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include <zmq.hpp>
 
@@ -202,6 +203,40 @@ TEST_F(StudioApiTest, PathsOutsideTheFolderAreRefused) {
       Post("/api/colour/save", json{{"range", {{"min", {0, 0, 0}}, {"max", {30, 255, 255}}}},
                                     {"out", "nofolder/c.json"}}),
       404, "does not exist");
+}
+
+// Each endpoint that reads a file: no path (400), a missing file (404), a path outside (403);
+// each POST endpoint: malformed JSON (400). One line each.
+TEST_F(StudioApiTest, EveryEndpointRefusesBadFilesAndMalformedJson) {
+  FV_SEED_TRACE(seed_);
+  for (const std::string get : {"/api/video?", "/api/frame?frame=0&", "/api/camera?", "/api/ball?",
+                                "/api/tracks?", "/api/zones?", "/api/json?"}) {
+    SCOPED_TRACE(get);
+    ExpectError(Get(get), 400, "missing query parameter 'path'");
+    ExpectError(Get(get + "path=missing.csv"), 404, "missing.csv");
+    ExpectError(Get(get + "path=../x.csv"), 403, "outside");
+  }
+  const json uv = json::array({json::array({10, 10})});
+  for (const auto& [path, key, body] : std::vector<std::tuple<std::string, std::string, json>>{
+           {"/api/calibrate/project", "camera", {{"field", "robocup-msl"}}},
+           {"/api/calibrate/pose", "camera", {{"field", "robocup-msl"}, {"points", json::array()}}},
+           {"/api/colour/learn", "video", {{"frame", 0}, {"points", uv}}},
+           {"/api/colour/detect", "video", {{"frames", {0}}}},
+           {"/api/players/stats", "tracks", json::object()},
+           {"/api/players/export", "tracks", {{"out", "export"}}}}) {
+    SCOPED_TRACE(path);
+    json missing = body;
+    missing[key] = "missing.file";
+    ExpectError(Post(path, missing), 404, "missing.file");
+    json outside = body;
+    outside[key] = "../x.file";
+    ExpectError(Post(path, outside), 403, "outside");
+  }
+  for (const auto& e : StudioApi::Endpoints()) {
+    if (e.method != "POST") continue;
+    SCOPED_TRACE(e.path);
+    ExpectError(Post(e.path, std::string("{\"out\": ")), 400, "malformed JSON");
+  }
 }
 
 TEST_F(StudioApiTest, MalformedRequests) {
