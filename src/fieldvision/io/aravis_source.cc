@@ -4,6 +4,7 @@
 // to the camera. Times are the camera's timestamps anchored to the system clock at the first
 // frame (TimeOrigin::kDevice), else the host's time of arrival. Compiled only when
 // libaravis-dev was found (FV_HAVE_ARAVIS).
+#include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -39,10 +40,10 @@ void Check(GError* error, const std::string& spec, const char* what) {
   Throw("camera '{}': {} failed: {}", spec, what, message);
 }
 
-class AravisSource : public FrameSource {
+class AravisSource : public LiveSource {
  public:
   AravisSource(const std::string& spec, const std::string& id, const FrameSourceOptions& o)
-      : spec_(spec) {
+      : LiveSource(spec, "camera", false) {
     if (StartsWith(id, "Fake")) arv_enable_interface("Fake");
     GError* error = nullptr;
     camera_ = arv_camera_new(id.empty() ? nullptr : id.c_str(), &error);
@@ -80,9 +81,7 @@ class AravisSource : public FrameSource {
     }
     arv_camera_start_acquisition(camera_, &error);
     Check(error, spec, "starting the acquisition");
-    FV_REQUIRE(Grab(&pending_), "camera '{}' delivers no frame", spec);
-    size_ = pending_.bgr.size();
-    has_pending_ = true;
+    ReadFirstFrame();
   }
 
   ~AravisSource() override {
@@ -91,25 +90,11 @@ class AravisSource : public FrameSource {
     if (camera_ != nullptr) g_object_unref(camera_);
   }
 
-  bool ReadFrame(SourceFrame* out) override {
-    if (has_pending_) {
-      std::swap(*out, pending_);
-      has_pending_ = false;
-    } else if (!Grab(out)) {
-      Throw("camera '{}' stopped delivering frames (disconnected?)", spec_);
-    }
-    out->frame = next_++;
-    return true;
-  }
-  cv::Size FrameSize() const override { return size_; }
-  std::string name() const override { return spec_; }
-  double fps() const override { return fps_; }
-  bool live() const override { return true; }
   long long dropped() const override { return dropped_; }
 
  private:
   // The next complete buffer as BGR (incomplete buffers are counted as dropped).
-  bool Grab(SourceFrame* out) {
+  bool Grab(SourceFrame* out) override {
     for (int tries = 0; tries < 100; ++tries) {
       ArvBuffer* buffer = arv_stream_timeout_pop_buffer(stream_, 2000000);  // 2 s
       if (buffer == nullptr) return false;
@@ -146,7 +131,7 @@ class AravisSource : public FrameSource {
     auto* p = const_cast<void*>(data);
     const auto need = [&](size_t channels) {
       FV_REQUIRE(bytes >= static_cast<size_t>(w) * h * channels,
-                 "camera '{}': buffer of {} bytes for a {}x{} image", spec_, bytes, w, h);
+                 "camera '{}': buffer of {} bytes for a {}x{} image", spec(), bytes, w, h);
     };
     switch (format) {
       case ARV_PIXEL_FORMAT_MONO_8:
@@ -181,20 +166,14 @@ class AravisSource : public FrameSource {
         Throw(
             "camera '{}': pixel format 0x{:08x} is not supported (use Mono8, Bayer*8, RGB8 or "
             "BGR8)",
-            spec_, static_cast<unsigned>(format));
+            spec(), static_cast<unsigned>(format));
     }
   }
 
-  std::string spec_;
   ArvCamera* camera_ = nullptr;
   ArvStream* stream_ = nullptr;
-  SourceFrame pending_;
-  bool has_pending_ = false;
-  long long next_ = 0;
   long long dropped_ = 0;
-  double fps_ = 30.0;
   double anchor_s_ = 0;
-  cv::Size size_;
 };
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <filesystem>
 
-#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -14,20 +14,14 @@
 namespace fv::io_backend {
 namespace {
 
-class V4l2Source : public FrameSource {
+class V4l2Source : public LiveSource {
  public:
   V4l2Source(const std::string& spec, const std::string& device, const FrameSourceOptions& o)
-      : spec_(spec) {
+      : LiveSource(spec, "camera", false) {
     FV_REQUIRE(std::filesystem::exists(device), "camera '{}': device '{}' does not exist", spec,
                device);
-    bool opened = false;
-    try {
-      opened = capture_.open(device, cv::CAP_V4L2);
-    } catch (const cv::Exception&) {
-      opened = false;
-    }
-    FV_REQUIRE(opened && capture_.isOpened(), "camera '{}': cannot open '{}' as a V4L2 camera",
-               spec, device);
+    FV_REQUIRE(OpenCapture(capture_, device, cv::CAP_V4L2),
+               "camera '{}': cannot open '{}' as a V4L2 camera", spec, device);
     if (o.width > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, o.width);
     if (o.height > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, o.height);
     if (o.fps > 0) capture_.set(cv::CAP_PROP_FPS, o.fps);
@@ -37,40 +31,14 @@ class V4l2Source : public FrameSource {
     }
     fps_ = capture_.get(cv::CAP_PROP_FPS);
     if (!(std::isfinite(fps_) && fps_ > 0)) fps_ = o.fps > 0 ? o.fps : 30.0;
-    FV_REQUIRE(Grab(&pending_), "camera '{}' delivers no frame", spec);
-    size_ = pending_.bgr.size();
-    has_pending_ = true;
+    ReadFirstFrame();
   }
-
-  bool ReadFrame(SourceFrame* out) override {
-    if (has_pending_) {
-      std::swap(*out, pending_);
-      has_pending_ = false;
-    } else if (!Grab(out)) {
-      Throw("camera '{}' stopped delivering frames (disconnected?)", spec_);
-    }
-    out->frame = next_++;
-    return true;
-  }
-  cv::Size FrameSize() const override { return size_; }
-  std::string name() const override { return spec_; }
-  double fps() const override { return fps_; }
-  bool live() const override { return true; }
 
  private:
-  bool Grab(SourceFrame* out) {
-    bool ok = false;
-    try {
-      ok = capture_.read(out->bgr);
-    } catch (const cv::Exception&) {
-      ok = false;
-    }
-    const double arrival_s = SystemClockNow();
-    if (!ok || out->bgr.empty()) return false;
-    if (out->bgr.channels() == 1) cv::cvtColor(out->bgr, out->bgr, cv::COLOR_GRAY2BGR);
-    out->jpeg.clear();
+  bool Grab(SourceFrame* out) override {
     // OpenCV's V4L2 backend reports the buffer's timestamp (ms on CLOCK_MONOTONIC).
-    const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+    double arrival_s = 0, ms = 0;
+    if (!ReadCapture(capture_, out, &arrival_s, &ms)) return false;
     const double device_s = std::isfinite(ms) && ms > 0 ? SystemFromMonotonic(ms / 1000.0) : 0;
     if (device_s > 0 && std::abs(device_s - arrival_s) < 1.0) {
       out->time_s = device_s;
@@ -82,13 +50,7 @@ class V4l2Source : public FrameSource {
     return true;
   }
 
-  std::string spec_;
   cv::VideoCapture capture_;
-  SourceFrame pending_;
-  bool has_pending_ = false;
-  long long next_ = 0;
-  double fps_ = 30.0;
-  cv::Size size_;
 };
 
 }  // namespace

@@ -77,18 +77,6 @@ class FrameSourceVideo : public VideoSource {
 
 void VideoSourceOptions::Check() const { CheckPositive(fps, "VideoSourceOptions.fps"); }
 
-bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path) {
-  // A file that exists is a video even when its name has a '%' (100%.avi).
-  const int api = path.find('%') != std::string::npos && !fs::is_regular_file(path)
-                      ? cv::CAP_IMAGES
-                      : cv::CAP_FFMPEG;
-  try {
-    return capture.open(path, api) && capture.isOpened();
-  } catch (const cv::Exception&) {
-    return false;
-  }
-}
-
 void CheckEndOfStream(const std::string& path, long long frames_read, long long frames_announced) {
   // Containers without a frame index give an estimate (duration x rate): a frame or two of slack.
   const long long slack = std::max(1LL, frames_announced / 1000);

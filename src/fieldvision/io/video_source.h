@@ -65,10 +65,6 @@ class VideoSource {
 
 // The image files an image-sequence spec names, in order (empty if it is not one).
 std::vector<std::string> ListImageSequence(const std::string& spec);
-// Opens a video file, or a printf image pattern (dir/%05d.jpg), with FFmpeg or OpenCV's image
-// reader, never GStreamer, whose failure on a file that is not a video prints pages of GLib
-// warnings. False when it cannot be opened.
-bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path);
 // At the end of a video file: throws fv::Error naming it when fewer frames were read than its
 // header announces (a truncated or damaged stream; 0 or less: not announced, nothing checked).
 void CheckEndOfStream(const std::string& path, long long frames_read, long long frames_announced);
