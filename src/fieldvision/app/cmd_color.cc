@@ -1,6 +1,7 @@
 // `fieldvision color learn`: a colour class from pixels a user points at (colour_learn.h).
 #include <filesystem>
 #include <iostream>
+#include <utility>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/detect/colour_learn.h"
@@ -23,6 +24,13 @@ struct ColorLearnArgs {
   ColourLearnOptions learn;
 };
 
+// --mask-out, else OUT-mask.png beside --out.
+std::string MaskPath(const ColorLearnArgs& a) {
+  if (!a.mask_out.empty()) return a.mask_out;
+  const std::filesystem::path p(a.out);
+  return (p.parent_path() / (p.stem().string() + "-mask.png")).string();
+}
+
 void Learn(const ColorLearnArgs& a) {
   ColourLearnOptions o = a.learn;
   FV_REQUIRE(!a.points.empty() || !a.roi.empty(), "give --points u,v;u,v... or --roi x,y,w,h");
@@ -30,13 +38,21 @@ void Learn(const ColorLearnArgs& a) {
   if (!a.roi.empty()) o.roi = ParseRect(a.roi, "--roi");
   if (!a.negatives.empty()) o.negative_points = ParsePoints(a.negatives, "--negative");
   const cv::Mat frame = ReadVideoFrame(a.video, a.frame);
+  // Pixels outside the frame: name the option they came from.
+  const cv::Rect inside(0, 0, frame.cols, frame.rows);
+  FV_REQUIRE(!o.roi || (o.roi->area() > 0 && (*o.roi & inside) == *o.roi),
+             "--roi {} is not inside the {}x{} frame", a.roi, frame.cols, frame.rows);
+  for (const auto& [list, what] :
+       {std::pair{&o.points, "--points"}, {&o.negative_points, "--negative"}}) {
+    for (const Eigen::Vector2d& p : *list) {
+      FV_REQUIRE(p.x() >= 0 && p.y() >= 0 && p.x() < frame.cols && p.y() < frame.rows,
+                 "{}: pixel ({}, {}) is not inside the {}x{} frame", what, p.x(), p.y(), frame.cols,
+                 frame.rows);
+    }
+  }
   const ColourLearnResult r = LearnColour(frame, o);
   if (!r.bad || a.force) WriteColourSpec(r.spec, a.out);
-  std::string mask_out = a.mask_out;
-  if (mask_out.empty()) {
-    std::filesystem::path p(a.out);
-    mask_out = (p.parent_path() / (p.stem().string() + "-mask.png")).string();
-  }
+  const std::string mask_out = MaskPath(a);
   WriteImage(mask_out, r.overlay);
   FV_REQUIRE(!r.bad || a.force,
              "colour class selects {:.1f} % of the background: {} not written (see {}; point at "
@@ -55,7 +71,9 @@ void Setup(CLI::App& app, int& exit_code) {
       "of what it selects");
   learn->add_option("--video", a->video, "Video file or image pattern (or a single image)")
       ->required();
-  learn->add_option("--frame", a->frame, "Frame number (from 0)")->capture_default_str();
+  learn->add_option("--frame", a->frame, "Frame number (from 0)")
+      ->check(FiniteRange(0, 1e9))
+      ->capture_default_str();
   learn->add_option("--points", a->points, "Pixels on the ball: \"u,v;u,v;...\"");
   learn->add_option("--roi", a->roi, "Box around the ball: x,y,w,h");
   learn->add_option("--negative", a->negatives,
@@ -65,13 +83,17 @@ void Setup(CLI::App& app, int& exit_code) {
   learn
       ->add_option("--max-background", a->learn.max_background_share,
                    "Largest share of the background the class may select before it is bad")
+      ->check(FiniteRange(0, 1))
       ->capture_default_str();
   learn->add_flag("--force", a->force, "Write the colour file even when the class is bad");
   learn->add_option("--out", a->out, "Colour file to write (JSON)")->required();
   learn->add_option("--mask-out", a->mask_out, "Image of the selection (default: OUT-mask.png)");
   learn->callback([a] {
     CheckOutputPath(a->out, {a->video});
-    CheckOutputPath(a->mask_out, {a->video, a->out}, "--mask-out");
+    CheckOutputPath(MaskPath(*a), {a->video, a->out}, "--mask-out");
+    // A device, a folder or a missing folder as an output is refused before any work.
+    ResolveOutputPath(a->out);
+    ResolveOutputPath(MaskPath(*a), "--mask-out");
     Learn(*a);
   });
   (void)exit_code;

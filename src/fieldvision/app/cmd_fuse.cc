@@ -20,14 +20,16 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--listen", o->listen,
                   "Where nodes connect, tcp://HOST:PORT (use 127.0.0.1 unless other machines "
                   "must reach it; PORT * takes a free port)")
+      ->check(Endpoint(true))
       ->required();
   cmd->add_option("--camera", o->cameras, "Camera file (repeat); nodes are matched by name")
       ->required();
   cmd->add_option("--out", o->out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")->required();
   cmd->add_option(
-      "--publish", o->publish,
-      "Publish each position on a ZeroMQ PUB socket, tcp://HOST:PORT (topic 'ball'), and "
-      "each flight as it closes (topic 'flight')");
+         "--publish", o->publish,
+         "Publish each position on a ZeroMQ PUB socket, tcp://HOST:PORT (topic 'ball'), and "
+         "each flight as it closes (topic 'flight')")
+      ->check(Endpoint(true));
   cmd->add_option("--idle-exit", o->idle_exit_s,
                   "Exit after this many seconds without messages, counted once the first has come; "
                   "running nodes ping every 0.5 s (0: run until Ctrl-C)")

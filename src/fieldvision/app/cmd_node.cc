@@ -6,6 +6,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/net/node.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -22,7 +23,9 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Video file, image pattern, v4l2:/dev/videoN, rtsp://..., gst:PIPELINE, "
                   "aravis:[ID] or synth:PRESET?camera=NAME")
       ->required();
-  cmd->add_option("--connect", o->connect, "The fusion node, tcp://HOST:PORT")->required();
+  cmd->add_option("--connect", o->connect, "The fusion node, tcp://HOST:PORT")
+      ->check(Endpoint(false))
+      ->required();
   CLI::Option* realtime =
       cmd->add_flag("--realtime", o->realtime,
                     "Play a file at its own frame rate, as a live camera would deliver it");
@@ -68,6 +71,11 @@ void Setup(CLI::App& app, int& exit_code) {
     const net::NodeSummary s = net::RunNode(*o);
     g_node_control = nullptr;
     std::cout << s.ToString() << "\n";
+    // A node whose fusion node never answered has done nothing: say so in the exit code.
+    FV_REQUIRE(s.frames == 0 || s.sent > 0 || s.has_offset,
+               "node: the fusion node at '{}' never answered; none of the {} frames was sent (is "
+               "`fieldvision fuse --listen` running there?)",
+               o->connect, s.frames);
   });
 }
 

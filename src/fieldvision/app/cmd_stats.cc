@@ -26,7 +26,11 @@ void RunStats(const StatsCli& c) {
   const auto rows = track::ReadTracksCsv(c.tracks);
   CheckOneRowPerPlayerFrame(rows, c.tracks);
   stats::StatsOptions o = c.o;
-  if (!c.zones.empty()) o.zones = stats::ReadZones(c.zones);
+  if (!c.zones.empty()) {
+    o.zones = stats::ReadZones(c.zones);
+    FV_REQUIRE(!o.zones.empty(), "zones file '{}' has no zones (a JSON array of named polygons)",
+               c.zones);
+  }
   std::string teams = c.teams;
   if (teams.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     teams = track::RosterPathFor(c.tracks);

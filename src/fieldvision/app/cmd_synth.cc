@@ -1,5 +1,6 @@
 // `fieldvision synth`: render a synthetic scene (preset or scene JSON) with exact ground truth.
 #include <cstdint>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -26,6 +27,8 @@ struct SynthOptions {
 
 void RunSynth(const SynthOptions& o) {
   FV_REQUIRE(o.preset.empty() != o.scene.empty(), "synth: give exactly one of --preset or --scene");
+  FV_REQUIRE(o.scene.empty() || !std::filesystem::is_directory(o.scene),
+             "synth: --scene '{}' is a folder, not a scene JSON file", o.scene);
   synth::SceneSpec spec =
       o.scene.empty() ? synth::Preset(o.preset, o.seed.value_or(1)) : synth::ReadSceneSpec(o.scene);
   if (o.seed) spec.seed = *o.seed;
