@@ -131,32 +131,19 @@ std::string BallRegion::Summary() const {
       100 * purity, contrast, solidity, inliers, outline_points, rms_px);
 }
 
-BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
-                             const cv::Rect& seed_box, const cv::Rect& limit,
-                             const BallRegionOptions& o, const ColourTable* grow_table) {
-  BallRegion out;
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect lim = limit.empty() ? image : (limit & image);
-  const double r0 = 0.5 * std::max(seed_box.width, seed_box.height);
-  const cv::Rect window = Grow(seed_box, static_cast<int>(std::ceil(2.5 * r0)) + 6) & lim;
-  const cv::Rect seed = (seed_box & window) - window.tl();
-  if (seed.area() == 0) {
-    out.failure = "seed outside the searched region";
-    return out;
-  }
-  const cv::Mat raw = ClassMask(bgr, table, ball_bit, window);
-  const cv::Mat grow =
-      grow_table == nullptr ? raw : ClassMask(bgr, *grow_table, grow_table->BallBit(), window);
+namespace {
+
+// The gathered region grown through the widened class near its core and closed (print, seams);
+// empty when no ball-coloured pixel touches the seed.
+cv::Mat GrowAndCloseRegion(const cv::Mat& raw, const cv::Mat& grow, const cv::Rect& seed,
+                           const BallRegionOptions& o) {
   cv::Mat labels, stats, centroids;
   cv::connectedComponentsWithStats(raw, labels, stats, centroids, 8, CV_32S);
   cv::Rect bounds;
   cv::Mat region = GatherComponents(labels, stats, seed, o.gather_fraction, &bounds);
-  if (bounds.area() == 0) {
-    out.failure = "no ball-coloured pixels at the blob";
-    return out;
-  }
+  if (bounds.area() == 0) return {};
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
-  if (grow_table != nullptr) {
+  if (grow.data != raw.data) {
     // Hysteresis with a reach: widened-class pixels join only near the core (a shaded rim, a
     // pale cap), so a neighbour of a similar colour is not taken in.
     const int reach = std::max(1, static_cast<int>(std::lround(o.grow_fraction * r_region)));
@@ -171,117 +158,124 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     cv::morphologyEx(region, region, cv::MORPH_CLOSE,
                      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
   }
-  // The largest outer contour, filled: holes (print, highlight) belong to the ball.
+  return region;
+}
+
+// The region's largest outer contour and the region it bounds, filled (holes from a print or a
+// highlight belong to the ball); false when there is no outline.
+bool LargestFilledOutline(const cv::Mat& region, std::vector<cv::Point>* contour, cv::Mat* filled) {
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-  if (contours.empty()) {
-    out.failure = "no outline";
-    return out;
-  }
+  if (contours.empty()) return false;
   const auto largest =
       std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
         return cv::contourArea(a) + a.size() < cv::contourArea(b) + b.size();
       });
-  const std::vector<cv::Point>& contour = *largest;
-  cv::Mat filled(region.size(), CV_8U, cv::Scalar(0));
-  cv::drawContours(filled, contours, static_cast<int>(largest - contours.begin()), 255, cv::FILLED);
-  std::vector<cv::Point> hull;
-  cv::convexHull(contour, hull);
-  const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
-  const double area = cv::countNonZero(filled);
-  out.area_px = area;
-  out.solidity = std::min(1.0, area / hull_area);
-  // Convex outline points, not on the window's or the image's border (a clipped outline).
-  const double r_est = std::sqrt(hull_area / M_PI);
+  *filled = cv::Mat(region.size(), CV_8U, cv::Scalar(0));
+  cv::drawContours(*filled, contours, static_cast<int>(largest - contours.begin()), 255,
+                   cv::FILLED);
+  *contour = std::move(*largest);
+  return true;
+}
+
+// Points of `contour` (window coordinates) on its convex hull within `tolerance_px`, in image
+// coordinates, leaving out those on the border of `lim` (a clipped outline).
+std::vector<Vector2d> ConvexOutlinePoints(const std::vector<cv::Point>& contour,
+                                          const std::vector<cv::Point>& hull,
+                                          const cv::Point& window_tl, const cv::Rect& lim,
+                                          double tolerance_px) {
   std::vector<Vector2d> pts;
   for (const auto& p : contour) {
-    const int gx = p.x + window.x, gy = p.y + window.y;
+    const int gx = p.x + window_tl.x, gy = p.y + window_tl.y;
     const bool at_border =
         gx <= lim.x || gy <= lim.y || gx >= lim.x + lim.width - 1 || gy >= lim.y + lim.height - 1;
     if (at_border) continue;
     const double d = cv::pointPolygonTest(hull, cv::Point2f(p.x, p.y), true);
-    if (std::abs(d) <= o.hull_tolerance_px + 0.03 * r_est) pts.emplace_back(gx, gy);
+    if (std::abs(d) <= tolerance_px) pts.emplace_back(gx, gy);
   }
-  out.outline_points = static_cast<int>(pts.size());
-  if (pts.size() < 5) {
-    out.failure = "too few convex outline points";
-    return out;
-  }
-  Vector2d c;
-  double r = 0;
-  std::vector<char> inl;
-  const double thr = o.inlier_px + 0.06 * r_est;
-  if (!OuterCircle(pts, thr, 96, &c, &r, &inl) || !(r > 0.5) || r > 2.5 * r_est + 3) {
-    out.failure = "no circle in the outline";
-    return out;
-  }
-  // Contour points are the centres of the region's border pixels: the edge lies half a pixel out.
-  r += 0.5;
-  double ss = 0;
-  int n_in = 0;
-  const int bins = std::clamp(static_cast<int>(std::lround(M_PI * r)), 8, 36);
-  std::vector<char> bin_hit(bins, 0), bin_known(bins, 0);
-  int n_out = 0;
+  return pts;
+}
+
+// How the outline points sit on the circle (c, r): inlier residuals, points beyond the band and
+// which of `bins` angle bins hold an inlier.
+struct OutlineOnCircle {
+  double sum_sq = 0;
+  int inliers = 0;
+  int outside = 0;
+  std::vector<char> bin_hit;
+};
+
+OutlineOnCircle MeasureOutlineOnCircle(const std::vector<Vector2d>& pts,
+                                       const std::vector<char>& inl, const Vector2d& c, double r,
+                                       double thr, int bins) {
+  OutlineOnCircle m;
+  m.bin_hit.assign(bins, 0);
   for (size_t i = 0; i < pts.size(); ++i) {
     if (!inl[i]) {
-      n_out += (pts[i] - c).norm() + 0.5 > r + thr;
+      m.outside += (pts[i] - c).norm() + 0.5 > r + thr;
       continue;
     }
     const Vector2d d = pts[i] - c;
     const double e = d.norm() + 0.5 - r;
-    ss += e * e;
-    ++n_in;
+    m.sum_sq += e * e;
+    ++m.inliers;
     double th = std::atan2(d.y(), d.x());
     if (th < 0) th += 2 * M_PI;
-    bin_hit[std::min(bins - 1, static_cast<int>(th / (2 * M_PI) * bins))] = 1;
+    m.bin_hit[std::min(bins - 1, static_cast<int>(th / (2 * M_PI) * bins))] = 1;
   }
-  // An angle is seen unless the circle there is outside the image or hidden: every pixel just
-  // beyond it (1.1..1.3 r) dark.
-  const auto dark = [&](int x, int y) {
-    const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
-    return std::max({p[0], p[1], p[2]}) < o.hidden_value;
-  };
-  int known = 0, hit = 0;
+  return m;
+}
+
+// Whether the pixel is dark enough to hide the ball (BallRegionOptions::hidden_value).
+bool IsDark(const cv::Mat& bgr, int x, int y, int hidden_value) {
+  const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+  return std::max({p[0], p[1], p[2]}) < hidden_value;
+}
+
+// Angle bins of the circle that are seen (`known`: not outside `lim`, not hidden: every pixel
+// just beyond it, 1.1..1.3 r, dark) and those of them with outline (`hit`).
+void CountSeenBins(const cv::Mat& bgr, const Vector2d& c, double r,
+                   const std::vector<char>& bin_hit, const cv::Rect& lim, int hidden_value,
+                   int* known, int* hit) {
+  const int bins = static_cast<int>(bin_hit.size());
+  *known = 0;
+  *hit = 0;
   for (int b = 0; b < bins; ++b) {
     const double th = 2 * M_PI * (b + 0.5) / bins;
     const double x = c.x() + r * std::cos(th), y = c.y() + r * std::sin(th);
     bool visible = x >= lim.x + 1 && y >= lim.y + 1 && x <= lim.x + lim.width - 2 &&
                    y <= lim.y + lim.height - 2;
-    if (visible && o.hidden_value > 0 && !bin_hit[b]) {
+    if (visible && hidden_value > 0 && !bin_hit[b]) {
       bool all_dark = true, any = false;
       for (const double f : {1.1, 1.2, 1.3}) {
         const int px = static_cast<int>(std::lround(c.x() + (f * r + 1) * std::cos(th)));
         const int py = static_cast<int>(std::lround(c.y() + (f * r + 1) * std::sin(th)));
         if (!lim.contains({px, py})) continue;
         any = true;
-        all_dark = all_dark && dark(px, py);
+        all_dark = all_dark && IsDark(bgr, px, py, hidden_value);
       }
       visible = !(any && all_dark);
     }
-    known += visible || bin_hit[b];
-    hit += bin_hit[b];
+    *known += visible || bin_hit[b];
+    *hit += bin_hit[b];
   }
-  out.seen = double(known) / bins;
-  if (out.seen < o.min_seen) {
-    out.failure = "most of the outline is outside the image or hidden";
-    return out;
-  }
-  out.inliers = n_in;
-  out.outside = double(n_out) / pts.size();
-  {
-    std::vector<double> rel;
-    rel.reserve(pts.size());
-    for (const auto& p : pts) rel.push_back(((p - c).norm() + 0.5) / r);
-    // The second largest: one stray pixel does not count, a corner's few do.
-    std::nth_element(rel.begin(), rel.begin() + 1, rel.end(), std::greater<>());
-    out.extent = rel.size() >= 2 ? rel[1] : rel[0];
-  }
-  out.rms_px = n_in > 0 ? std::sqrt(ss / n_in) : 0.0;
-  out.arc_cover = double(hit) / known;
-  out.centre_px = c;
-  out.radius_px = r;
-  out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(n_in, 1)) + 0.05;
-  // Fill, spill, leak, purity and contrast over the window.
+}
+
+// The convex outline's second largest distance from the centre, in radii (one stray pixel does
+// not count, a corner's few do).
+double OutlineExtent(const std::vector<Vector2d>& pts, const Vector2d& c, double r) {
+  std::vector<double> rel;
+  rel.reserve(pts.size());
+  for (const auto& p : pts) rel.push_back(((p - c).norm() + 0.5) / r);
+  std::nth_element(rel.begin(), rel.begin() + 1, rel.end(), std::greater<>());
+  return rel.size() >= 2 ? rel[1] : rel[0];
+}
+
+// Fill, spill, leak, purity and contrast of the circle (c, r) over `window`: `filled` is the
+// closed, filled region, `raw` the ball class (window coordinates); `area` the region's area.
+void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& filled,
+                          const cv::Mat& raw, const Vector2d& c, double r, double area,
+                          const BallRegionOptions& o, BallRegion* out) {
   cv::Mat lab;
   cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
   std::array<std::vector<double>, 3> disc_lab, ring_lab;
@@ -297,7 +291,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
       const double d = std::sqrt(dx * dx + dy * dy);
       if (d < r) {
         // A dark pixel not in the region hides the ball there (see hidden_value).
-        if (f[x] != 0 || o.hidden_value <= 0 || !dark(window.x + x, window.y + y)) {
+        if (f[x] != 0 || o.hidden_value <= 0 ||
+            !IsDark(bgr, window.x + x, window.y + y, o.hidden_value)) {
           ++disc;
           disc_in += f[x] != 0;
         }
@@ -318,10 +313,10 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
       pure += f[x] != 0 && m[x] != 0;
     }
   }
-  out.fill = disc > 0 ? double(disc_in) / disc : 0.0;
-  out.spill = spill / (M_PI * r * r);
-  out.leak = ring > 0 ? double(ring_ball) / ring : 0.0;
-  out.purity = area > 0 ? pure / area : 0.0;
+  out->fill = disc > 0 ? double(disc_in) / disc : 0.0;
+  out->spill = spill / (M_PI * r * r);
+  out->leak = ring > 0 ? double(ring_ball) / ring : 0.0;
+  out->purity = area > 0 ? pure / area : 0.0;
   if (!disc_lab[0].empty() && !ring_lab[0].empty()) {
     double d2 = 0;
     for (int ch = 0; ch < 3; ++ch) {
@@ -330,8 +325,81 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
       const double dv = scale * (Median(disc_lab[ch]) - Median(ring_lab[ch]));
       d2 += dv * dv;
     }
-    out.contrast = std::sqrt(d2);
+    out->contrast = std::sqrt(d2);
   }
+}
+
+}  // namespace
+
+BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                             const cv::Rect& seed_box, const cv::Rect& limit,
+                             const BallRegionOptions& o, const ColourTable* grow_table) {
+  BallRegion out;
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect lim = limit.empty() ? image : (limit & image);
+  const double r0 = 0.5 * std::max(seed_box.width, seed_box.height);
+  const cv::Rect window = Grow(seed_box, static_cast<int>(std::ceil(2.5 * r0)) + 6) & lim;
+  const cv::Rect seed = (seed_box & window) - window.tl();
+  if (seed.area() == 0) {
+    out.failure = "seed outside the searched region";
+    return out;
+  }
+  const cv::Mat raw = ClassMask(bgr, table, ball_bit, window);
+  const cv::Mat grow =
+      grow_table == nullptr ? raw : ClassMask(bgr, *grow_table, grow_table->BallBit(), window);
+  const cv::Mat region = GrowAndCloseRegion(raw, grow, seed, o);
+  if (region.empty()) {
+    out.failure = "no ball-coloured pixels at the blob";
+    return out;
+  }
+  std::vector<cv::Point> contour;
+  cv::Mat filled;
+  if (!LargestFilledOutline(region, &contour, &filled)) {
+    out.failure = "no outline";
+    return out;
+  }
+  std::vector<cv::Point> hull;
+  cv::convexHull(contour, hull);
+  const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
+  const double area = cv::countNonZero(filled);
+  out.area_px = area;
+  out.solidity = std::min(1.0, area / hull_area);
+  const double r_est = std::sqrt(hull_area / M_PI);
+  const std::vector<Vector2d> pts =
+      ConvexOutlinePoints(contour, hull, window.tl(), lim, o.hull_tolerance_px + 0.03 * r_est);
+  out.outline_points = static_cast<int>(pts.size());
+  if (pts.size() < 5) {
+    out.failure = "too few convex outline points";
+    return out;
+  }
+  Vector2d c;
+  double r = 0;
+  std::vector<char> inl;
+  const double thr = o.inlier_px + 0.06 * r_est;
+  if (!OuterCircle(pts, thr, 96, &c, &r, &inl) || !(r > 0.5) || r > 2.5 * r_est + 3) {
+    out.failure = "no circle in the outline";
+    return out;
+  }
+  // Contour points are the centres of the region's border pixels: the edge lies half a pixel out.
+  r += 0.5;
+  const int bins = std::clamp(static_cast<int>(std::lround(M_PI * r)), 8, 36);
+  const OutlineOnCircle on = MeasureOutlineOnCircle(pts, inl, c, r, thr, bins);
+  int known = 0, hit = 0;
+  CountSeenBins(bgr, c, r, on.bin_hit, lim, o.hidden_value, &known, &hit);
+  out.seen = double(known) / bins;
+  if (out.seen < o.min_seen) {
+    out.failure = "most of the outline is outside the image or hidden";
+    return out;
+  }
+  out.inliers = on.inliers;
+  out.outside = double(on.outside) / pts.size();
+  out.extent = OutlineExtent(pts, c, r);
+  out.rms_px = on.inliers > 0 ? std::sqrt(on.sum_sq / on.inliers) : 0.0;
+  out.arc_cover = double(hit) / known;
+  out.centre_px = c;
+  out.radius_px = r;
+  out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(on.inliers, 1)) + 0.05;
+  MeasureRegionColours(bgr, window, filled, raw, c, r, area, o, &out);
   out.ok = true;
   return out;
 }
