@@ -183,7 +183,17 @@ void Setup(CLI::App& app, int& exit_code) {
                                     {c->o.detections_out, "--save-detections"}}) {
       if (!out.empty()) ResolveOutputPath(out, what);
     }
-    RunPlayersCommand(*c);
+    try {
+      RunPlayersCommand(*c);
+    } catch (const Error& e) {
+      // track::CheckCameraMatchesVideo names the camera by its name: add its file.
+      const std::string what = e.what();
+      if (!c->camera.empty() && what.rfind("camera '", 0) == 0 &&
+          what.find(" images but video ") != std::string::npos) {
+        Throw("{}: {}", c->camera, what);
+      }
+      throw;
+    }
   });
 }
 
