@@ -3,10 +3,12 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <string_view>
 
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/calib/extrinsics.h"
@@ -772,10 +774,16 @@ ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiReques
   const auto rows = ReadStatsInput(ws, body, o);
   const stats::StatsResult res = stats::ComputeStats(rows, o);
 
-  const fs::path tmp = out.parent_path() / ("." + out.filename().string() + ".export-tmp");
+  // A new folder (never one that was there before), removed at the end.
   std::error_code ec;
-  fs::remove_all(tmp, ec);
-  FV_REQUIRE(fs::create_directory(tmp, ec), "cannot create '{}'", ws.Relative(tmp));
+  fs::path tmp;
+  std::random_device random;
+  for (int attempt = 0; tmp.empty() && attempt < 100; ++attempt) {
+    const fs::path p =
+        out.parent_path() / fmt::format(".{}.export-{:08x}", out.filename().string(), random());
+    if (fs::create_directory(p, ec)) tmp = p;
+  }
+  FV_REQUIRE(!tmp.empty(), "cannot create a folder beside '{}'", ws.Relative(out));
   json wrote = json::array();
   stats::ReportFiles files;
   try {
