@@ -453,192 +453,226 @@ bool RansacCircle(const std::vector<Vector2d>& pts, double thr, int iterations, 
   return FitCircle(pts, thr, centre, radius, inlier);
 }
 
-BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
-                const Vector2d& rough_centre_px, double rough_radius_px, const Camera* camera,
-                const BallFitOptions& o) {
-  o.Check();
-  BallFit fit;
-  const double r0 = std::max(rough_radius_px, 1.0);
-  // 1. Rough outline from the colour classes, robust circle.
+namespace {
+
+// The outline fit in progress: the edge points, which are inliers, their residuals (filled by the
+// cone fit, else at the end) and the current circle.
+struct OutlineState {
+  Edges edges;
+  std::vector<char> inl;
+  std::vector<double> res;
+  Vector2d centre = Vector2d::Zero();
+  double radius = 0;
+};
+
+// 1. and 2.: the rough outline from the colour classes with a robust circle, then the sub-pixel
+// outline twice (the second from the refined circle). "" or why it failed.
+std::string SubpixelCircle(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                           const Vector2d& rough_centre_px, double r0, const BallFitOptions& o,
+                           OutlineState* s) {
   const Edges rough = ClassEdges(bgr, table, ball_bit, rough_centre_px, r0);
-  if (rough.points.size() < 5) {
-    fit.failure = "too few outline points";
-    return fit;
-  }
+  if (rough.points.size() < 5) return "too few outline points";
   Vector2d c1;
   double r1 = 0;
   std::vector<char> in1;
   if (!RansacCircle(rough.points, std::max(1.0, 0.08 * r0), o.ransac_iterations, &c1, &r1, &in1) ||
       r1 > 3 * r0 + 3) {
-    fit.failure = "no circle in the rough outline";
-    return fit;
+    return "no circle in the rough outline";
   }
-  // 2. Sub-pixel outline twice (the second from the refined circle).
-  Edges edges;
-  std::vector<char> inl;
   for (int pass = 0; pass < 2; ++pass) {
-    edges = SubpixelEdges(
+    s->edges = SubpixelEdges(
         bgr, table, ball_bit, c1, [r1](double) { return r1; }, r1, o);
     Vector2d c2 = c1;
     double r2 = r1;
-    if (!FitCircle(edges.points, o.inlier_px + 0.03 * r1 + (pass == 0 ? 0.5 : 0.0), &c2, &r2,
-                   &inl)) {
-      fit.failure = "too few sub-pixel outline points";
-      return fit;
+    if (!FitCircle(s->edges.points, o.inlier_px + 0.03 * r1 + (pass == 0 ? 0.5 : 0.0), &c2, &r2,
+                   &s->inl)) {
+      return "too few sub-pixel outline points";
     }
     c1 = c2;
     r1 = r2;
   }
-  const double thr = o.inlier_px + 0.03 * r1;
-  // 3. Final fit: the cone of the sphere with a camera (its predicted outline guides two more
-  // passes of outline points, so a sphere seen far off the axis, an ellipse, is searched where
-  // it is), else the circle.
-  Vector2d centre = c1;
-  double radius = r1;
-  std::vector<double> res;
-  if (camera != nullptr) {
-    Vector3d axis;
-    double alpha = 0;
-    bool have_cone = false;
-    for (int pass = 0; pass < 3; ++pass) {
-      if (have_cone) {
-        const ConeOutline outline(*camera, axis, alpha);
-        if (!outline.ok) break;
-        const Edges next = SubpixelEdges(
-            bgr, table, ball_bit, outline.centre, [&outline](double th) { return outline(th); },
-            outline.mean_radius, o);
-        if (next.points.size() < 5) break;
-        edges = next;
-        inl.assign(edges.points.size(), 1);
-      }
-      Vector3d new_axis;
-      double new_alpha;
-      if (!RobustCone(edges.points, *camera, thr, have_cone ? &axis : nullptr,
-                      have_cone ? alpha : 0.0, &inl, &res, &new_axis, &new_alpha)) {
-        break;
-      }
-      axis = new_axis;
-      alpha = new_alpha;
-      have_cone = true;
+  s->centre = c1;
+  s->radius = r1;
+  return "";
+}
+
+// 3. With a camera: the cone of the sphere (its predicted outline guides two more passes of
+// outline points, so a sphere seen far off the axis, an ellipse, is searched where it is); the
+// circle when no cone fits.
+void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                   const Camera& camera, double thr, const BallFitOptions& o, OutlineState* s) {
+  Vector3d axis;
+  double alpha = 0;
+  bool have_cone = false;
+  for (int pass = 0; pass < 3; ++pass) {
+    if (have_cone) {
+      const ConeOutline outline(camera, axis, alpha);
+      if (!outline.ok) break;
+      const Edges next = SubpixelEdges(
+          bgr, table, ball_bit, outline.centre, [&outline](double th) { return outline(th); },
+          outline.mean_radius, o);
+      if (next.points.size() < 5) break;
+      s->edges = next;
+      s->inl.assign(s->edges.points.size(), 1);
     }
-    const auto uv = have_cone ? camera->ProjectFromCamera(axis) : std::nullopt;
-    if (uv) {
-      centre = *uv;
-      double s = 0;
-      int cnt = 0;
-      for (size_t i = 0; i < edges.points.size(); ++i) {
-        if (inl[i]) {
-          s += (edges.points[i] - centre).norm();
-          ++cnt;
-        }
-      }
-      radius = cnt > 0 ? s / cnt : r1;
-    } else {
-      FitCircle(edges.points, thr, &centre, &radius, &inl);
+    Vector3d new_axis;
+    double new_alpha;
+    if (!RobustCone(s->edges.points, camera, thr, have_cone ? &axis : nullptr,
+                    have_cone ? alpha : 0.0, &s->inl, &s->res, &new_axis, &new_alpha)) {
+      break;
+    }
+    axis = new_axis;
+    alpha = new_alpha;
+    have_cone = true;
+  }
+  const auto uv = have_cone ? camera.ProjectFromCamera(axis) : std::nullopt;
+  if (!uv) {
+    FitCircle(s->edges.points, thr, &s->centre, &s->radius, &s->inl);
+    return;
+  }
+  s->centre = *uv;
+  double sum = 0;
+  int cnt = 0;
+  for (size_t i = 0; i < s->edges.points.size(); ++i) {
+    if (s->inl[i]) {
+      sum += (s->edges.points[i] - s->centre).norm();
+      ++cnt;
     }
   }
-  const int n = static_cast<int>(edges.points.size());
-  fit.rays = edges.rays;
+  if (cnt > 0) s->radius = sum / cnt;
+}
+
+// 4. Motion blur: an elongated outline that an ellipse explains much better than the circle
+// (`count` inliers, `rms`) replaces it; sets fit->blurred.
+void TryMotionBlurEllipse(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                          double thr, const BallFitOptions& o, OutlineState* s, int* count,
+                          double* rms, BallFit* fit) {
+  const int n = static_cast<int>(s->edges.points.size());
+  std::vector<cv::Point2f> cv_pts;
+  for (const auto& p : s->edges.points) cv_pts.emplace_back(float(p.x()), float(p.y()));
+  cv::RotatedRect e = cv::fitEllipseDirect(cv_pts);
+  for (int pass = 0; pass < 2 && e.size.width > 0 && e.size.height > 0; ++pass) {
+    const Vector2d ec(e.center.x, e.center.y);
+    const double mean_r = 0.25 * (e.size.width + e.size.height);
+    const Edges be = SubpixelEdges(
+        bgr, table, ball_bit, ec, [&e](double th) { return EllipsePolarRadius(e, th); }, mean_r, o);
+    if (be.points.size() < 8) break;
+    cv_pts.clear();
+    for (const auto& p : be.points) cv_pts.emplace_back(float(p.x()), float(p.y()));
+    const cv::RotatedRect e2 = cv::fitEllipseDirect(cv_pts);
+    if (!(e2.size.width > 0 && e2.size.height > 0)) break;
+    int ecount = 0;
+    double es = 0;
+    for (const auto& p : be.points) {
+      const double d = EllipseDistance(e2, p);
+      if (std::abs(d) < thr) {
+        ++ecount;
+        es += d * d;
+      }
+    }
+    const double major = std::max(e2.size.width, e2.size.height);
+    const double minor = std::min(e2.size.width, e2.size.height);
+    e = e2;
+    if (pass == 1 && ecount >= 0.9 * be.points.size() && major / minor >= o.blur_min_aspect &&
+        double(ecount) / be.rays > double(*count) / n) {
+      fit->blurred = true;
+      fit->blur_length_px = major - minor;
+      s->centre = Vector2d(e2.center.x, e2.center.y);
+      s->radius = 0.5 * minor;
+      *rms = std::sqrt(es / ecount);
+      s->edges = be;
+      *count = ecount;
+      fit->rays = be.rays;
+      fit->edges = static_cast<int>(be.points.size());
+      s->inl.assign(be.points.size(), 0);
+      for (size_t i = 0; i < be.points.size(); ++i) {
+        s->inl[i] = std::abs(EllipseDistance(e2, be.points[i])) < thr;
+      }
+    }
+  }
+}
+
+// A blur seen as wide edge ramps on at least 15 % of the outline (length: their 75th percentile).
+void BlurFromRamps(const Edges& edges, BallFit* fit) {
+  std::vector<double> ramps;
+  for (double w : edges.ramp_px) {
+    if (w > 3.0) ramps.push_back(w);
+  }
+  if (!edges.ramp_px.empty() && ramps.size() >= 0.15 * edges.ramp_px.size()) {
+    std::sort(ramps.begin(), ramps.end());
+    fit->blurred = true;
+    fit->blur_length_px = ramps[ramps.size() * 3 / 4];
+  }
+}
+
+// Arcs (two or more consecutive points) of the outline that lie inside the fit: one or two for
+// an occluder.
+int CountDents(const std::vector<double>& res, const std::vector<char>& inl) {
+  const int m = static_cast<int>(std::min(res.size(), inl.size()));
+  const auto dent = [&](int i) { return !inl[i] && res[i] < 0; };
+  int first_break = -1;
+  for (int i = 0; i < m; ++i) {
+    if (!dent(i)) {
+      first_break = i;
+      break;
+    }
+  }
+  if (first_break < 0) return 0;
+  int dents = 0, run = 0;
+  for (int j = 1; j <= m; ++j) {
+    const int i = (first_break + j) % m;
+    if (dent(i)) {
+      ++run;
+    } else {
+      dents += run >= 2;
+      run = 0;
+    }
+  }
+  return dents;
+}
+
+}  // namespace
+
+BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
+                const Vector2d& rough_centre_px, double rough_radius_px, const Camera* camera,
+                const BallFitOptions& o) {
+  o.Check();
+  BallFit fit;
+  OutlineState s;
+  fit.failure =
+      SubpixelCircle(bgr, table, ball_bit, rough_centre_px, std::max(rough_radius_px, 1.0), o, &s);
+  if (!fit.failure.empty()) return fit;
+  const double thr = o.inlier_px + 0.03 * s.radius;
+  if (camera != nullptr) FitSphereCone(bgr, table, ball_bit, *camera, thr, o, &s);
+  const int n = static_cast<int>(s.edges.points.size());
+  fit.rays = s.edges.rays;
   fit.edges = n;
-  if (res.size() != edges.points.size()) {
-    res.resize(n);
-    for (int i = 0; i < n; ++i) res[i] = (edges.points[i] - centre).norm() - radius;
+  if (s.res.size() != s.edges.points.size()) {
+    s.res.resize(n);
+    for (int i = 0; i < n; ++i) s.res[i] = (s.edges.points[i] - s.centre).norm() - s.radius;
   }
   int count = 0;
-  double rms = Rms(res, inl, &count);
-  // 4. Motion blur: an elongated outline that an ellipse explains much better.
+  double rms = Rms(s.res, s.inl, &count);
   if (count < 0.8 * n && n >= 8) {
-    std::vector<cv::Point2f> cv_pts;
-    for (const auto& p : edges.points) cv_pts.emplace_back(float(p.x()), float(p.y()));
-    cv::RotatedRect e = cv::fitEllipseDirect(cv_pts);
-    for (int pass = 0; pass < 2 && e.size.width > 0 && e.size.height > 0; ++pass) {
-      const Vector2d ec(e.center.x, e.center.y);
-      const double mean_r = 0.25 * (e.size.width + e.size.height);
-      const Edges be = SubpixelEdges(
-          bgr, table, ball_bit, ec, [&e](double th) { return EllipsePolarRadius(e, th); }, mean_r,
-          o);
-      if (be.points.size() < 8) break;
-      cv_pts.clear();
-      for (const auto& p : be.points) cv_pts.emplace_back(float(p.x()), float(p.y()));
-      const cv::RotatedRect e2 = cv::fitEllipseDirect(cv_pts);
-      if (!(e2.size.width > 0 && e2.size.height > 0)) break;
-      int ecount = 0;
-      double es = 0;
-      for (const auto& p : be.points) {
-        const double d = EllipseDistance(e2, p);
-        if (std::abs(d) < thr) {
-          ++ecount;
-          es += d * d;
-        }
-      }
-      const double major = std::max(e2.size.width, e2.size.height);
-      const double minor = std::min(e2.size.width, e2.size.height);
-      e = e2;
-      if (pass == 1 && ecount >= 0.9 * be.points.size() && major / minor >= o.blur_min_aspect &&
-          double(ecount) / be.rays > double(count) / n) {
-        fit.blurred = true;
-        fit.blur_length_px = major - minor;
-        centre = Vector2d(e2.center.x, e2.center.y);
-        radius = 0.5 * minor;
-        rms = std::sqrt(es / ecount);
-        edges = be;
-        count = ecount;
-        fit.rays = be.rays;
-        fit.edges = static_cast<int>(be.points.size());
-        inl.assign(be.points.size(), 0);
-        for (size_t i = 0; i < be.points.size(); ++i) {
-          inl[i] = std::abs(EllipseDistance(e2, be.points[i])) < thr;
-        }
-      }
-    }
+    TryMotionBlurEllipse(bgr, table, ball_bit, thr, o, &s, &count, &rms, &fit);
   }
-  if (!fit.blurred && !edges.ramp_px.empty()) {
-    std::vector<double> ramps;
-    for (double w : edges.ramp_px) {
-      if (w > 3.0) ramps.push_back(w);
-    }
-    if (ramps.size() >= 0.15 * edges.ramp_px.size()) {
-      std::sort(ramps.begin(), ramps.end());
-      fit.blurred = true;
-      fit.blur_length_px = ramps[ramps.size() * 3 / 4];
-    }
+  if (!fit.blurred) BlurFromRamps(s.edges, &fit);
+  int outside = s.edges.outside_ball;
+  for (size_t i = 0; i < s.res.size() && i < s.inl.size(); ++i) {
+    outside += !s.inl[i] && s.res[i] > 0;
   }
-  int outside = edges.outside_ball;
-  for (size_t i = 0; i < res.size() && i < inl.size(); ++i) outside += !inl[i] && res[i] > 0;
   fit.outside_fraction = fit.rays > 0 ? double(outside) / fit.rays : 0.0;
-  // Arcs of the outline that lie inside the fit (dents): one or two for an occluder.
-  {
-    const int m = static_cast<int>(std::min(res.size(), inl.size()));
-    int first_break = -1;
-    for (int i = 0; i < m; ++i) {
-      if (!(!inl[i] && res[i] < 0)) {
-        first_break = i;
-        break;
-      }
-    }
-    if (first_break >= 0) {
-      int run = 0;
-      for (int j = 1; j <= m; ++j) {
-        const int i = (first_break + j) % m;
-        if (!inl[i] && res[i] < 0) {
-          ++run;
-        } else {
-          fit.dents += run >= 2;
-          run = 0;
-        }
-      }
-    }
-  }
+  fit.dents = CountDents(s.res, s.inl);
   fit.ok = true;
-  fit.centre_px = centre;
-  fit.radius_px = radius;
+  fit.centre_px = s.centre;
+  fit.radius_px = s.radius;
   fit.rms_px = rms;
   fit.inliers = count;
   fit.inlier_fraction = fit.rays > 0 ? double(count) / fit.rays : 0.0;
-  fit.sigma_px = CentreSigma(edges.points, inl, centre, rms);
+  fit.sigma_px = CentreSigma(s.edges.points, s.inl, s.centre, rms);
   if (fit.blurred) fit.sigma_px = std::hypot(fit.sigma_px, 0.05 * fit.blur_length_px);
-  fit.edge_points = edges.points;
-  fit.edge_inlier = inl;
+  fit.edge_points = s.edges.points;
+  fit.edge_inlier = s.inl;
   return fit;
 }
 
