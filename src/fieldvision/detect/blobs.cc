@@ -64,6 +64,100 @@ std::string BlobScanResult::Summary() const {
   return fmt::format("{} samples, {} runs, {} blobs", samples, runs, blobs.size());
 }
 
+namespace {
+
+// Run-length encoding of one scanned row's classes `cls` (n samples at xs + i * step): runs of
+// `class_mask` appended to `runs`, each its own set in `parent`. Skips 8 samples at a time while
+// none has the class.
+void AppendRowRuns(const std::vector<uint8_t>& cls, int n, int xs, int step, int y,
+                   uint8_t class_mask, std::vector<Run>* runs, std::vector<int>* parent) {
+  uint64_t mask8;
+  std::memset(&mask8, class_mask, sizeof(mask8));
+  int i = 0;
+  while (i < n) {
+    uint64_t word;
+    std::memcpy(&word, cls.data() + i, 8);
+    if ((word & mask8) == 0) {
+      i += 8;
+      continue;
+    }
+    if (!(cls[i] & class_mask)) {
+      ++i;
+      continue;
+    }
+    int j = i + 1;
+    while (j < n && (cls[j] & class_mask)) ++j;
+    runs->push_back({y, xs + i * step, xs + (j - 1) * step});
+    parent->push_back(static_cast<int>(parent->size()));
+    i = j;
+  }
+}
+
+// Joins the runs [cur_begin, cur_end) of a row with those [prev_begin, prev_end) of the row
+// scanned before it (both sorted by x): 8-connected on the sample grid.
+void MergeWithPreviousRow(const std::vector<Run>& runs, int prev_begin, int prev_end, int cur_begin,
+                          int cur_end, int step, std::vector<int>* parent) {
+  if (prev_end <= prev_begin || cur_end <= cur_begin) return;
+  if (runs[prev_begin].y != runs[cur_begin].y - step) return;
+  int a = prev_begin, b = cur_begin;
+  while (a < prev_end && b < cur_end) {
+    const Run& p = runs[a];
+    const Run& c = runs[b];
+    if (p.x0 <= c.x1 + step && c.x0 <= p.x1 + step) Union(*parent, a, b);
+    if (p.x1 < c.x1) {
+      ++a;
+    } else {
+      ++b;
+    }
+  }
+}
+
+// One blob per set of runs, with its bounds, sample count and moments; blobs under
+// `min_samples` left out, the largest first.
+std::vector<Blob> BlobsFromRuns(const std::vector<Run>& runs, std::vector<int>& parent, int step,
+                                int min_samples) {
+  std::vector<Blob> blobs;
+  std::vector<int> blob_of(runs.size(), -1);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const int root = Find(parent, static_cast<int>(r));
+    if (blob_of[root] < 0) {
+      blob_of[root] = static_cast<int>(blobs.size());
+      Blob b;
+      b.x_min = runs[r].x0;
+      b.x_max = runs[r].x1;
+      b.y_min = b.y_max = runs[r].y;
+      b.step_px = step;
+      blobs.push_back(b);
+    }
+    Blob& b = blobs[blob_of[root]];
+    const Run& run = runs[r];
+    const int samples = (run.x1 - run.x0) / step + 1;
+    const double cnt = samples;
+    const double k1 = cnt * (cnt - 1) / 2, k2 = (cnt - 1) * cnt * (2 * cnt - 1) / 6;
+    const double sx = cnt * run.x0 + step * k1;
+    const double sxx = cnt * double(run.x0) * run.x0 + 2.0 * run.x0 * step * k1 + step * step * k2;
+    b.x_min = std::min(b.x_min, run.x0);
+    b.x_max = std::max(b.x_max, run.x1);
+    b.y_min = std::min(b.y_min, run.y);
+    b.y_max = std::max(b.y_max, run.y);
+    b.samples += static_cast<int>(cnt);
+    b.runs += 1;
+    b.sum_x += sx;
+    b.sum_xx += sxx;
+    b.sum_y += cnt * run.y;
+    b.sum_yy += cnt * double(run.y) * run.y;
+    b.sum_xy += sx * run.y;
+  }
+  blobs.erase(std::remove_if(blobs.begin(), blobs.end(),
+                             [&](const Blob& b) { return b.samples < min_samples; }),
+              blobs.end());
+  std::sort(blobs.begin(), blobs.end(),
+            [](const Blob& a, const Blob& b) { return a.samples > b.samples; });
+  return blobs;
+}
+
+}  // namespace
+
 BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t class_mask,
                          const ScanOptions& options, const cv::Mat& mask, const cv::Rect& region) {
   options.Check();
@@ -89,8 +183,6 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
   runs.reserve(1024);
   std::vector<int> parent;
   parent.reserve(1024);
-  uint64_t mask8;
-  std::memset(&mask8, class_mask, sizeof(mask8));
   int prev_begin = 0, prev_end = 0;
   for (int y = y0; y < y_end; y += step) {
     const uint8_t* row = bgr.ptr<uint8_t>(y);
@@ -109,82 +201,15 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
       for (int i = 0; i < n; ++i) cls[i] &= m[xs + i * step] ? 0xFF : 0;
     }
     result.samples += n;
-    // Run-length encoding: skip 8 samples at a time while none has the class.
     const int cur_begin = static_cast<int>(runs.size());
-    int i = 0;
-    while (i < n) {
-      uint64_t word;
-      std::memcpy(&word, cls.data() + i, 8);
-      if ((word & mask8) == 0) {
-        i += 8;
-        continue;
-      }
-      if (!(cls[i] & class_mask)) {
-        ++i;
-        continue;
-      }
-      int j = i + 1;
-      while (j < n && (cls[j] & class_mask)) ++j;
-      runs.push_back({y, xs + i * step, xs + (j - 1) * step});
-      parent.push_back(static_cast<int>(parent.size()));
-      i = j;
-    }
+    AppendRowRuns(cls, n, xs, step, y, class_mask, &runs, &parent);
     const int cur_end = static_cast<int>(runs.size());
-    // Merge with the previous scanned row (both sorted by x): 8-connected on the sample grid.
-    if (prev_end > prev_begin && cur_end > cur_begin && runs[prev_begin].y == y - step) {
-      int a = prev_begin, b = cur_begin;
-      while (a < prev_end && b < cur_end) {
-        const Run& p = runs[a];
-        const Run& c = runs[b];
-        if (p.x0 <= c.x1 + step && c.x0 <= p.x1 + step) Union(parent, a, b);
-        if (p.x1 < c.x1) {
-          ++a;
-        } else {
-          ++b;
-        }
-      }
-    }
+    MergeWithPreviousRow(runs, prev_begin, prev_end, cur_begin, cur_end, step, &parent);
     prev_begin = cur_begin;
     prev_end = cur_end;
   }
   result.runs = static_cast<int>(runs.size());
-  // Blob statistics per root.
-  std::vector<int> blob_of(runs.size(), -1);
-  for (size_t r = 0; r < runs.size(); ++r) {
-    const int root = Find(parent, static_cast<int>(r));
-    if (blob_of[root] < 0) {
-      blob_of[root] = static_cast<int>(result.blobs.size());
-      Blob b;
-      b.x_min = runs[r].x0;
-      b.x_max = runs[r].x1;
-      b.y_min = b.y_max = runs[r].y;
-      b.step_px = step;
-      result.blobs.push_back(b);
-    }
-    Blob& b = result.blobs[blob_of[root]];
-    const Run& run = runs[r];
-    const int samples = (run.x1 - run.x0) / step + 1;
-    const double cnt = samples;
-    const double k1 = cnt * (cnt - 1) / 2, k2 = (cnt - 1) * cnt * (2 * cnt - 1) / 6;
-    const double sx = cnt * run.x0 + step * k1;
-    const double sxx = cnt * double(run.x0) * run.x0 + 2.0 * run.x0 * step * k1 + step * step * k2;
-    b.x_min = std::min(b.x_min, run.x0);
-    b.x_max = std::max(b.x_max, run.x1);
-    b.y_min = std::min(b.y_min, run.y);
-    b.y_max = std::max(b.y_max, run.y);
-    b.samples += static_cast<int>(cnt);
-    b.runs += 1;
-    b.sum_x += sx;
-    b.sum_xx += sxx;
-    b.sum_y += cnt * run.y;
-    b.sum_yy += cnt * double(run.y) * run.y;
-    b.sum_xy += sx * run.y;
-  }
-  result.blobs.erase(std::remove_if(result.blobs.begin(), result.blobs.end(),
-                                    [&](const Blob& b) { return b.samples < options.min_samples; }),
-                     result.blobs.end());
-  std::sort(result.blobs.begin(), result.blobs.end(),
-            [](const Blob& a, const Blob& b) { return a.samples > b.samples; });
+  result.blobs = BlobsFromRuns(runs, parent, step, options.min_samples);
   return result;
 }
 
