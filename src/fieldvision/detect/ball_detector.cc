@@ -473,7 +473,10 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
   // Where the region was measured, the outline fit alone does not decide: both must agree.
   const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
                              RegionProblem(region, o, /*shape_only=*/true).empty();
-  const bool precise_ok = fit.ok && fit_why.empty() && size_why.empty() && region_agrees;
+  // A measured region must stand out from its surroundings on either path (min_contrast).
+  const bool stands_out = !region.ok || region.contrast >= o.min_contrast;
+  const bool precise_ok =
+      fit.ok && fit_why.empty() && size_why.empty() && region_agrees && stands_out;
   std::string region_why;
   if (!o.use_region) {
     region_why = "region check off";
