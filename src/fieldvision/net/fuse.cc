@@ -330,15 +330,7 @@ void FuseServer::Emit(const SyncedFrame& group) {
     pub_.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
     if (pub_.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary_.published;
   }
-  if (flight_worker_) {
-    BallSample sample;
-    sample.frame = f.frame;
-    sample.time_s = f.time_s;
-    sample.ball_in_world = p;
-    sample.n_cams = f.result.num_views();
-    sample.err_px = f.result.rms_px;
-    flight_worker_->Add(sample);
-  }
+  if (flight_worker_) flight_worker_->Add(BallSampleOf(f));
 }
 
 void FuseServer::PublishFlights() {

@@ -18,6 +18,7 @@
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv {
 
@@ -107,14 +108,8 @@ struct DetectionResidual {
   }
   template <typename T>
   bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
-    T p[3] = {p0[0], p0[1], p0[2]};
-    T v[3] = {v0[0], v0[1], v0[2]};
-    if (integrate_) {
-      PropagateFlight(p, v, k[0], sm, g_, dt_);
-    } else {
-      for (int i = 0; i < 3; ++i) p[i] = p0[i] + v0[i] * dt_;
-      p[2] -= T(0.5 * g_ * dt_ * dt_);
-    }
+    T p[3];
+    FlightPositionAt(p0, v0, k[0], sm, g_, dt_, integrate_, p);
     T intr[kNumIntrinsics], rv[3], tv[3], uv[2];
     for (int i = 0; i < kNumIntrinsics; ++i) intr[i] = T(intrinsics_[i]);
     for (int i = 0; i < 3; ++i) rv[i] = T(rvec_[i]), tv[i] = T(tvec_[i]);
@@ -306,12 +301,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     if (!b.result.ok()) continue;
     const Eigen::Vector3d& p = b.result.point_world;
     if (!b.result.on_ground) predictor.Add(b.frame, p);
-    BallSample s;
-    s.frame = b.frame;
-    s.time_s = b.time_s;
-    s.ball_in_world = p;
-    s.n_cams = b.result.num_views();
-    s.err_px = b.result.rms_px;
+    const BallSample s = BallSampleOf(b);
     if (res.per_frame.empty() || s.time_s > res.per_frame.back().time_s) res.per_frame.push_back(s);
   }
   res.sync = sync.report();
@@ -330,8 +320,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     for (size_t i = 1; i < res.per_frame.size(); ++i) {
       dts.push_back(res.per_frame[i].time_s - res.per_frame[i - 1].time_s);
     }
-    std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
-    const double margin = dts.empty() ? 0.0 : 0.5 * dts[dts.size() / 2];
+    const double margin = 0.5 * NearestRankPercentile(dts, 0.5);  // the upper middle; 0 if none
     for (const Flight& f : res.trajectory->flights) {
       const Bundled b = BundleFlight(cameras, messages, f, to, o.sigma_px, margin);
       if (!b.ok) continue;

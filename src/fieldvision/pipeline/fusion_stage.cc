@@ -22,6 +22,16 @@ std::optional<Eigen::Vector3d> BallPredictor::Predict(long long frame) const {
   return point_[0] + v * double(frame - frame_[0]);
 }
 
+BallSample BallSampleOf(const BallFrame& f) {
+  BallSample s;
+  s.frame = f.frame;
+  s.time_s = f.time_s;
+  s.ball_in_world = f.result.point_world;
+  s.n_cams = f.result.num_views();
+  s.err_px = f.result.rms_px;
+  return s;
+}
+
 BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
                     const TriangulationOptions& options, const Eigen::Vector3d* prior) {
   BallFrame out;

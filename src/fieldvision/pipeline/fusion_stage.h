@@ -10,6 +10,7 @@
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/pipeline/frame_sync.h"
+#include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/triangulation.h"
 
 namespace fv {
@@ -26,6 +27,9 @@ struct BallFrame {
 // The fusion of one synchronised frame (what the fusion stage does per frame).
 BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
                     const TriangulationOptions& options, const Eigen::Vector3d* prior = nullptr);
+
+// The trajectory sample of a frame with a position (its point, cameras and error).
+BallSample BallSampleOf(const BallFrame& frame);
 
 // The ball's expected position from the last positions (constant velocity over the last two,
 // when they are at most max_gap frames apart and the newest is at most max_gap frames old).

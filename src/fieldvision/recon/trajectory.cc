@@ -38,14 +38,8 @@ struct SampleResidual {
       : x_(x), dt_(dt), g_(g), integrate_(integrate) {}
   template <typename T>
   bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
-    T p[3] = {p0[0], p0[1], p0[2]};
-    T v[3] = {v0[0], v0[1], v0[2]};
-    if (integrate_) {
-      PropagateFlight(p, v, k[0], sm, g_, dt_);
-    } else {
-      for (int i = 0; i < 3; ++i) p[i] = p0[i] + v0[i] * dt_;
-      p[2] -= T(0.5 * g_ * dt_ * dt_);
-    }
+    T p[3];
+    FlightPositionAt(p0, v0, k[0], sm, g_, dt_, integrate_, p);
     for (int i = 0; i < 3; ++i) r[i] = p[i] - x_[i];
     return true;
   }

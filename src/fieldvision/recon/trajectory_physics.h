@@ -51,6 +51,21 @@ void PropagateFlight(T p[3], T v[3], const T& k, const T s[3], double g, double 
   for (int i = 0; i < n; ++i) FlightRk4Step(p, v, k, s, g, h);
 }
 
+// The position `dt` seconds after (p0, v0): integrated with drag k and Magnus vector s, or, with
+// `integrate` false, the drag-free parabola.
+template <typename T>
+void FlightPositionAt(const T p0[3], const T v0[3], const T& k, const T s[3], double g, double dt,
+                      bool integrate, T p[3]) {
+  if (integrate) {
+    T v[3] = {v0[0], v0[1], v0[2]};
+    for (int i = 0; i < 3; ++i) p[i] = p0[i];
+    PropagateFlight(p, v, k, s, g, dt);
+    return;
+  }
+  for (int i = 0; i < 3; ++i) p[i] = p0[i] + v0[i] * dt;
+  p[2] -= T(0.5 * g * dt * dt);
+}
+
 // Zero-mean prior on the Magnus vector, r = W s with W = w_perp (I - d d^T) + w_along d d^T for
 // the flight direction d: weak across the flight, tighter along it (that spin makes almost no
 // force, so only the prior holds it).
