@@ -302,9 +302,7 @@ LineErrorStats LineError(const Camera& camera, const std::vector<Eigen::Vector2d
   }
   s.num_inliers = static_cast<int>(mm.size());
   if (!mm.empty()) {
-    double sum = 0;
-    for (double v : mm) sum += v;
-    s.mean_mm = sum / mm.size();
+    s.mean_mm = Mean(mm);
     s.median_mm = NearestRankPercentile(mm, 0.5);
     s.p95_mm = NearestRankPercentile(mm, 0.95);
   }
@@ -328,6 +326,36 @@ std::string RefineResult::Summary() const {
       "iterations",
       accepted ? "refined" : "not refined (" + status + ")", num_line_pixels, before.Summary(),
       after.Summary(), moved_m * 1000, rotated_deg, iterations);
+}
+
+LossScaleSolve SolveOverLossScales(const std::function<void(ceres::Problem&, double)>& build,
+                                   const std::vector<double>& scales, int max_iterations,
+                                   Eigen::Vector3d* rvec, Eigen::Vector3d* tvec,
+                                   const Eigen::Vector3d& rvec_start,
+                                   const Eigen::Vector3d& tvec_start) {
+  LossScaleSolve out;
+  for (double scale : scales) {
+    ceres::Problem problem;
+    build(problem, scale);
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    so.max_num_iterations = max_iterations;
+    so.num_threads = 2;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    out.iterations += static_cast<int>(summary.iterations.size());
+  }
+  ceres::Problem problem;
+  build(problem, scales.back());
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), &out.final_cost, nullptr, nullptr, nullptr);
+  const Eigen::Vector3d r1 = *rvec, t1 = *tvec;
+  *rvec = rvec_start;
+  *tvec = tvec_start;
+  problem.Evaluate(ceres::Problem::EvaluateOptions(), &out.initial_cost, nullptr, nullptr, nullptr);
+  *rvec = r1;
+  *tvec = t1;
+  return out;
 }
 
 RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
@@ -364,31 +392,11 @@ RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen:
                                new ceres::CauchyLoss(scale), rvec.data(), tvec.data());
     }
   };
-  for (double scale : options.loss_scales_m) {
-    ceres::Problem problem;
-    build(problem, scale);
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-    so.max_num_iterations = options.max_iterations;
-    so.num_threads = 2;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    result.iterations += static_cast<int>(summary.iterations.size());
-  }
-  // Robust cost at the finest scale, before and after.
-  {
-    ceres::Problem problem;
-    build(problem, options.loss_scales_m.back());
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), &result.final_cost, nullptr, nullptr,
-                     nullptr);
-    const Eigen::Vector3d r1 = rvec, t1 = tvec;
-    rvec = rvec0;
-    tvec = tvec0;
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), &result.initial_cost, nullptr, nullptr,
-                     nullptr);
-    rvec = r1;
-    tvec = t1;
-  }
+  const LossScaleSolve solve = SolveOverLossScales(
+      build, options.loss_scales_m, options.max_iterations, &rvec, &tvec, rvec0, tvec0);
+  result.iterations = solve.iterations;
+  result.initial_cost = solve.initial_cost;
+  result.final_cost = solve.final_cost;
   Camera refined = camera;
   refined.cam_from_world = Rigid3d::FromRvecTvec(rvec, tvec);
   result.moved_m = (refined.CentreInWorld() - camera.CentreInWorld()).norm();

@@ -9,6 +9,7 @@
 // distance table. Written by hand: OpenCV has no model-to-image line registration.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,10 @@
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/field/field.h"
+
+namespace ceres {
+class Problem;
+}  // namespace ceres
 
 namespace fv::calib {
 
@@ -115,6 +120,20 @@ RefineResult RefineWithLines(const Camera& camera, const cv::Mat& image_bgr,
 // The same on line pixels already detected.
 RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
                                   const FieldModel& field, const RefineOptions& options = {});
+
+// The pose solve of both line refinements (RefineWithLinePixels, RefineRigWithLines): `build`
+// adds the residuals (on *rvec, *tvec) with a Cauchy loss of the given scale; the problem is
+// solved at each of `scales` in turn, then its robust cost at the last scale is evaluated at the
+// solution (final) and at the start pose (initial).
+struct LossScaleSolve {
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+};
+LossScaleSolve SolveOverLossScales(const std::function<void(ceres::Problem&, double)>& build,
+                                   const std::vector<double>& scales, int max_iterations,
+                                   Eigen::Vector3d* rvec, Eigen::Vector3d* tvec,
+                                   const Eigen::Vector3d& rvec_start,
+                                   const Eigen::Vector3d& tvec_start);
 
 // Checks that an image matches the camera's size; throws naming both.
 void CheckImageSize(const cv::Mat& image, const Camera& camera, const std::string& image_name,

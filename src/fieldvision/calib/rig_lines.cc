@@ -133,31 +133,12 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<Camera>& rig,
                                new ceres::CauchyLoss(scale), rvec.data(), tvec.data());
     }
   };
-  for (double scale : options.loss_scales_m) {
-    ceres::Problem problem;
-    build(problem, scale);
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-    so.max_num_iterations = options.max_iterations;
-    so.num_threads = 2;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    result.iterations += static_cast<int>(summary.iterations.size());
-  }
-  {
-    ceres::Problem problem;
-    build(problem, options.loss_scales_m.back());
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), &result.final_cost, nullptr, nullptr,
-                     nullptr);
-    const Eigen::Vector3d r1 = rvec, t1 = tvec;
-    rvec.setZero();
-    tvec.setZero();
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), &result.initial_cost, nullptr, nullptr,
-                     nullptr);
-    rvec = r1;
-    tvec = t1;
-  }
+  const LossScaleSolve solve =
+      SolveOverLossScales(build, options.loss_scales_m, options.max_iterations, &rvec, &tvec,
+                          Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  result.iterations = solve.iterations;
+  result.initial_cost = solve.initial_cost;
+  result.final_cost = solve.final_cost;
   if (!rvec.allFinite() || !tvec.allFinite()) {
     result.status = "the optimisation diverged";
     return result;

@@ -9,6 +9,7 @@
 
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 
 namespace fv::plan {
 namespace {
@@ -141,8 +142,7 @@ json CoverageJson(const PlanRunResult& result, const FieldModel& field,
   j["num_cameras"] = result.rig.cameras.size();
   j["cameras"] = json::array();
   for (const Camera& c : result.rig.cameras) {
-    const Eigen::Vector3d p = c.CentreInWorld();
-    j["cameras"].push_back({{"name", c.name}, {"position", {p.x(), p.y(), p.z()}}});
+    j["cameras"].push_back({{"name", c.name}, {"position", JsonFromVector(c.CentreInWorld())}});
   }
   j["options"] = {{"grid_step_m", co.grid_step_m},
                   {"include_surround", co.include_surround},

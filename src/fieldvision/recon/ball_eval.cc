@@ -68,9 +68,7 @@ BallEvalResult EvaluateBall(const CsvTable& truth_table, const CsvTable& est_tab
     if (!truth.count(frame)) ++r.estimates_without_truth;
   }
   if (!errs.empty()) {
-    double sum = 0;
-    for (double e : errs) sum += e;
-    r.mean_mm = sum / errs.size();
+    r.mean_mm = Mean(errs);
     r.median_mm = Percentile(errs, 0.5);
     r.p95_mm = Percentile(errs, 0.95);
     r.max_mm = *std::max_element(errs.begin(), errs.end());

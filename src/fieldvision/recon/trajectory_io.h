@@ -11,7 +11,6 @@
 
 namespace fv {
 
-nlohmann::json Vec3Json(const Eigen::Vector3d& v, int decimals = 4);
 // The contract's flight fields plus events, seen span, speed, flight time, both fits and the
 // seed's method.
 nlohmann::json FlightToJson(const Flight& f);

@@ -13,6 +13,7 @@
 #include "fieldvision/recon/trajectory_run_internal.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 
 namespace fv {
 
@@ -151,7 +152,7 @@ nlohmann::json FlightsJson(const TrajectoryJobResult& out, double predict_fracti
     if (p.ok) {
       pj["samples_used"] = p.samples_used;
       pj["t_cut_s"] = p.t_cut_s;
-      pj["landing"] = Vec3Json(p.landing_m);
+      pj["landing"] = JsonFromVector(p.landing_m, 4);
       pj["t_landing_s"] = p.t_landing_s;
       pj["sigma_t_s"] = p.sigma_t_s;
       pj["ellipse95"] = {{"semi_major_m", p.semi_major_m},

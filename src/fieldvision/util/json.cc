@@ -137,4 +137,15 @@ json JsonFromVector(const Eigen::VectorXd& v) {
   return a;
 }
 
+json JsonFromVector(const Eigen::VectorXd& v, int decimals) {
+  json a = json::array();
+  for (int i = 0; i < v.size(); ++i) a.push_back(JsonRound(v[i], decimals));
+  return a;
+}
+
+double JsonRound(double v, int decimals) {
+  const double f = std::pow(10.0, decimals);
+  return std::round(v * f) / f;
+}
+
 }  // namespace fv

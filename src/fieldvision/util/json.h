@@ -52,8 +52,12 @@ Eigen::Matrix<double, N, 1> JsonVector(
     const nlohmann::json& obj, const std::string& key, const std::string& ctx,
     std::optional<Eigen::Matrix<double, N, 1>> fallback = std::nullopt);
 
-// [x, y, ...]: a vector written as an array of numbers.
+// [x, y, ...]: a vector written as an array of numbers; with `decimals`, each rounded to that
+// many decimals (JsonRound).
 nlohmann::json JsonFromVector(const Eigen::VectorXd& v);
+nlohmann::json JsonFromVector(const Eigen::VectorXd& v, int decimals);
+// round(v 10^decimals) / 10^decimals: a number written with no more digits than it carries.
+double JsonRound(double v, int decimals);
 
 // ---- implementation of the template
 

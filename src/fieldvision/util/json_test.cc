@@ -72,6 +72,9 @@ TEST(Json, VectorWriterRoundTrips) {
   EXPECT_EQ(j.dump(), "[0.25,-1.0,300000000.0]");
   EXPECT_EQ(JsonVectorOf<3>(json::parse(j.dump()), "v"), v);
   EXPECT_EQ(JsonFromVector(Eigen::Vector2d(1, 2)).size(), 2u);
+  EXPECT_EQ(JsonFromVector(Eigen::Vector3d(0.123456, -2.5e-5, 7), 4).dump(), "[0.1235,-0.0,7.0]");
+  EXPECT_DOUBLE_EQ(JsonRound(1.23456, 2), 1.23);
+  EXPECT_DOUBLE_EQ(JsonRound(-1.235, 0), -1.0);
 }
 
 }  // namespace
