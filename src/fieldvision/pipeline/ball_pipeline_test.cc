@@ -100,6 +100,19 @@ std::vector<std::unique_ptr<FrameSource>> Open(const Scene& s,
   return src;
 }
 
+// The tracked pipeline with CentroidInWindow in every camera: the fused frames in order.
+std::vector<BallFrame> RunTracked(const Scene& s,
+                                  std::vector<std::unique_ptr<FrameSource>>& sources,
+                                  BallPipelineSummary* summary) {
+  BallPipelineOptions opt;
+  opt.progress = false;
+  std::vector<BallFrame> frames;
+  *summary = RunBallPipelineTracked(s.cams, sources,
+                                    {CentroidInWindow, CentroidInWindow, CentroidInWindow}, opt,
+                                    [&](const BallFrame& f) { frames.push_back(f); });
+  return frames;
+}
+
 TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
   const std::string dir = testing::TempDir();
   const Scene s = MakeScene(dir, {30, 30, 24}, {0, 0, 0});
@@ -210,12 +223,8 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
   }
   std::vector<std::unique_ptr<FrameSource>> sources;
   for (const auto& p : patterns) sources.push_back(OpenFrameSource(p, enc));
-  BallPipelineOptions opt;
-  opt.progress = false;
-  std::vector<BallFrame> frames;
-  const auto summary = RunBallPipelineTracked(
-      s.cams, sources, {CentroidInWindow, CentroidInWindow, CentroidInWindow}, opt,
-      [&](const BallFrame& f) { frames.push_back(f); });
+  BallPipelineSummary summary;
+  const std::vector<BallFrame> frames = RunTracked(s, sources, &summary);
   ASSERT_EQ(frames.size(), 24u);
   EXPECT_GT(summary.window_scans[0], 12);
   for (const BallFrame& f : frames) {
@@ -244,12 +253,8 @@ TEST(BallPipeline, DamagedMjpgFrameIsReportedNotFatal) {
   std::vector<FrameSourceOptions> vo(3);
   for (auto& v : vo) v.encoded = true;
   auto sources = Open(s, vo);
-  BallPipelineOptions opt;
-  opt.progress = false;
-  std::vector<BallFrame> frames;
-  const auto summary = RunBallPipelineTracked(
-      s.cams, sources, {CentroidInWindow, CentroidInWindow, CentroidInWindow}, opt,
-      [&](const BallFrame& f) { frames.push_back(f); });
+  BallPipelineSummary summary;
+  const std::vector<BallFrame> frames = RunTracked(s, sources, &summary);
   ASSERT_EQ(frames.size(), 20u);
   EXPECT_EQ(summary.bad_frames[1], 1);
   EXPECT_NE(summary.first_bad_frame[1].find("cam1.avi' frame 5"), std::string::npos)

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/pipeline/test_messages.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -11,13 +12,7 @@
 namespace fv {
 namespace {
 
-CameraMessage Msg(int camera, long long frame, double time_s) {
-  CameraMessage m;
-  m.camera = camera;
-  m.frame = frame;
-  m.time_s = time_s;
-  return m;
-}
+using pipeline_testing::Msg;
 
 // Feeds whole streams the way the fusion stage does (pull from the camera that is waited on).
 std::vector<SyncedFrame> Feed(FrameSynchronizer& sync,

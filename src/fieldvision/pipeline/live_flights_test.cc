@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/recon/test_tracks.h"
 #include "fieldvision/synth/ball_physics.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
@@ -20,17 +21,8 @@ std::vector<BallSample> KickTrack(uint64_t seed, TrajectoryOptions* options) {
   const synth::SceneSpec spec = synth::Preset("kick", seed);
   const synth::BallTrajectory trajectory(spec.ball, spec.duration_s());
   Rng rng(seed + 1000);
-  std::vector<BallSample> track;
-  for (int f = 0; f < spec.num_frames; ++f) {
-    BallSample s;
-    s.frame = f;
-    s.time_s = f / spec.fps;
-    s.ball_in_world =
-        trajectory.PositionAt(s.time_s) +
-        Eigen::Vector3d(rng.Normal(0, 0.005), rng.Normal(0, 0.005), rng.Normal(0, 0.005));
-    s.n_cams = 4;
-    track.push_back(s);
-  }
+  std::vector<BallSample> track =
+      recon_testing::NoisyTrack(trajectory, spec.num_frames, spec.fps, 0.005, rng, 4);
   options->ball_radius_m = spec.ball.radius_m();
   options->gravity_mps2 = spec.ball.physics.gravity_mps2;
   return track;

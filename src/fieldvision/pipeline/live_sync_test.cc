@@ -4,19 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/pipeline/test_messages.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv {
 namespace {
 
-CameraMessage Msg(int camera, long long frame, double time_s) {
-  CameraMessage m;
-  m.camera = camera;
-  m.frame = frame;
-  m.time_s = time_s;
-  return m;
-}
+using pipeline_testing::Msg;
 
 TEST(LiveSync, PairsByTimeWithJitterAndOffsetsInFrameNumbers) {
   const uint64_t seed = testing::TestSeed(2);

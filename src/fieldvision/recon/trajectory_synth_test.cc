@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/recon/test_tracks.h"
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/trajectory_predict.h"
 #include "fieldvision/synth/ball_physics.h"
@@ -27,16 +28,8 @@ TEST(TrajectorySynth, KickPresetFlightsFromTruthWith5mmNoise) {
     const synth::SceneSpec spec = synth::Preset("kick", seed);
     const synth::BallTrajectory traj(spec.ball, spec.duration_s());
     Rng rng(seed + 1000);
-    std::vector<BallSample> track;
-    for (int f = 0; f < spec.num_frames; ++f) {
-      BallSample s;
-      s.frame = f;
-      s.time_s = f / spec.fps;
-      s.ball_in_world =
-          traj.PositionAt(s.time_s) +
-          Eigen::Vector3d(rng.Normal(0, 0.005), rng.Normal(0, 0.005), rng.Normal(0, 0.005));
-      track.push_back(s);
-    }
+    const std::vector<BallSample> track =
+        recon_testing::NoisyTrack(traj, spec.num_frames, spec.fps, 0.005, rng);
     TrajectoryOptions o;
     o.ball_radius_m = spec.ball.radius_m();
     o.gravity_mps2 = spec.ball.physics.gravity_mps2;

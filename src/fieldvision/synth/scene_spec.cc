@@ -238,14 +238,20 @@ std::vector<CameraSpec> CornerRig(const FieldModel& f, double height_m, int w, i
   return cams;
 }
 
-SceneSpec StaticPreset(uint64_t seed) {
+// The presets' start: the MSL field seen by the 4-camera corner rig (1280x960, 75 deg, 4 m up).
+SceneSpec MslCornerScene(uint64_t seed, double fps, int num_frames) {
   SceneSpec s;
   s.seed = seed;
   s.field = "robocup-msl";
+  s.cameras = CornerRig(BuiltinField(s.field), 4.0, 1280, 960, 75.0);
+  s.fps = fps;
+  s.num_frames = num_frames;
+  return s;
+}
+
+SceneSpec StaticPreset(uint64_t seed) {
+  SceneSpec s = MslCornerScene(seed, 30, 16);
   const FieldModel f = BuiltinField(s.field);
-  s.cameras = CornerRig(f, 4.0, 1280, 960, 75.0);
-  s.fps = 30;
-  s.num_frames = 16;
   Rng rng(seed * 7919 + 17);
   const double r = s.ball.radius_m();
   for (int i = 0; i < s.num_frames; ++i) {
@@ -262,13 +268,7 @@ SceneSpec StaticPreset(uint64_t seed) {
 }
 
 SceneSpec KickPreset(uint64_t seed) {
-  SceneSpec s;
-  s.seed = seed;
-  s.field = "robocup-msl";
-  const FieldModel f = BuiltinField(s.field);
-  s.cameras = CornerRig(f, 4.0, 1280, 960, 75.0);
-  s.fps = 60;
-  s.num_frames = 192;
+  SceneSpec s = MslCornerScene(seed, 60, 192);
   Rng rng(seed * 104729 + 3);
   const double r = s.ball.radius_m();
   KickSpec k;
