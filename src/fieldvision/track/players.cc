@@ -224,8 +224,10 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
     return n > o.max_speed_mps ? Eigen::Vector2d(v * (o.max_speed_mps / n)) : v;
   };
   const int window = std::max(1, static_cast<int>(std::lround(o.velocity_window_s * fps)));
-  for (auto& [id, t] : tl) {
-    t.id = id;
+  for (auto& entry : tl) {
+    // Not a structured binding: clang 14 (make fuzz, make sanitize) cannot capture one.
+    Tracklet& t = entry.second;
+    t.id = entry.first;
     std::sort(t.rows.begin(), t.rows.end(),
               [](const TrackRow* a, const TrackRow* b) { return a->frame < b->frame; });
     const TrackRow& f = *t.rows.front();
