@@ -19,6 +19,7 @@
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/track/players_internal.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/progress.h"
 
 namespace fv::track {
@@ -175,8 +176,7 @@ FrameTimes TimesOfFrames(const std::vector<double>& container_ms, double contain
   if (increasing) {
     std::vector<double> steps;
     for (size_t i = 1; i < n; ++i) steps.push_back(container_ms[i] - container_ms[i - 1]);
-    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-    t.fps = 1000.0 / steps[steps.size() / 2];
+    t.fps = 1000.0 / NearestRankPercentile(steps, 0.5);
     t.source = fmt::format("the video's timestamps (median {:.2f} frames/s)", t.fps);
     t.time_s.resize(n);
     for (size_t i = 0; i < n; ++i) t.time_s[i] = container_ms[i] / 1000.0;
@@ -244,8 +244,7 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
       }
       std::vector<double> hs;
       for (const TrackRow* r : w) hs.push_back(r->box.height);
-      std::nth_element(hs.begin(), hs.begin() + hs.size() / 2, hs.end());
-      const double full = o.full_height_ratio * hs[hs.size() / 2];
+      const double full = o.full_height_ratio * NearestRankPercentile(hs, 0.5);
       std::vector<const TrackRow*> good;
       for (const TrackRow* r : w) {
         if (r->box.height >= full) good.push_back(r);
