@@ -38,10 +38,19 @@ void RunMulti(MultiCli& c) {
   for (const auto& v : c.views) cams.push_back(ParseCameraViews(v));
   for (const auto& k : c.intrinsics) {
     const CameraViews kv = ParseCameraViews(k);  // NAME=CAM.yaml
-    const bool known = std::any_of(cams.begin(), cams.end(),
+    const auto view = std::find_if(cams.begin(), cams.end(),
                                    [&](const CameraViews& v) { return v.name == kv.name; });
-    FV_REQUIRE(known, "--intrinsics '{}': no --views names camera '{}'", k, kv.name);
-    c.o.known_intrinsics[kv.name] = ReadCameraYaml(kv.source);
+    FV_REQUIRE(view != cams.end(), "--intrinsics '{}': no --views names camera '{}'", k, kv.name);
+    const Camera known = ReadCameraYaml(kv.source);
+    // A camera file of another image size is refused before the board search, not after it.
+    const ImageSource source(view->source, c.o.source);
+    const cv::Mat first = source.Read(0);
+    FV_REQUIRE(first.cols == known.width && first.rows == known.height,
+               "--intrinsics '{}': camera file '{}' is for {}x{} images but the views of '{}' "
+               "('{}') are {}x{}",
+               k, kv.source, known.width, known.height, kv.name, view->source, first.cols,
+               first.rows);
+    c.o.known_intrinsics[kv.name] = known;
   }
   c.o.Check();
   const MultiResult r = CalibrateMulti(cams, c.o);

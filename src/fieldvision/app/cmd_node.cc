@@ -73,8 +73,8 @@ void Setup(CLI::App& app, int& exit_code) {
     std::cout << s.ToString() << "\n";
     // A node whose fusion node never answered has done nothing: say so in the exit code.
     FV_REQUIRE(s.frames == 0 || s.sent > 0 || s.has_offset,
-               "node: the fusion node at '{}' never answered; none of the {} frames was sent (is "
-               "`fieldvision fuse --listen` running there?)",
+               "node: --connect '{}': the fusion node never answered; none of the {} frames was "
+               "sent (is `fieldvision fuse --listen` running there?)",
                o->connect, s.frames);
   });
 }
