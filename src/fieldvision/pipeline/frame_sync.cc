@@ -20,6 +20,19 @@ int SyncedFrame::present() const {
       std::count_if(cameras.begin(), cameras.end(), [](const auto& m) { return m.has_value(); }));
 }
 
+int SyncedFrame::SetFrameAndTime() {
+  double sum_t = 0;
+  int n = 0;
+  for (const auto& m : cameras) {
+    if (!m) continue;
+    sum_t += m->time_s;
+    if (n == 0) frame = m->frame;
+    ++n;
+  }
+  time_s = sum_t / n;
+  return n;
+}
+
 std::vector<std::string> SyncReport::Problems() const {
   std::vector<std::string> out;
   long long max_last = -1;
@@ -125,8 +138,6 @@ std::optional<SyncedFrame> FrameSynchronizer::Next() {
   if (!any) return std::nullopt;
   SyncedFrame out;
   out.cameras.resize(num_cameras_);
-  double sum_t = 0;
-  int n = 0;
   for (int c = 0; c < num_cameras_; ++c) {
     auto& b = buffers_[c];
     if (b.empty()) continue;
@@ -134,13 +145,10 @@ std::optional<SyncedFrame> FrameSynchronizer::Next() {
                           ? b.front().frame == k
                           : b.front().time_s - t <= options_.tolerance_s;
     if (!take) continue;
-    sum_t += b.front().time_s;
-    if (n == 0) out.frame = b.front().frame;
-    ++n;
     out.cameras[c] = std::move(b.front());
     b.pop_front();
   }
-  out.time_s = sum_t / n;
+  const int n = out.SetFrameAndTime();
   ++report_.groups;
   if (n == num_cameras_) ++report_.complete_groups;
   if (n == 1 && num_cameras_ > 1) {

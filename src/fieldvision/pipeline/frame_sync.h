@@ -32,6 +32,9 @@ struct SyncedFrame {
   double time_s = 0.0;  // mean capture time of the messages
   std::vector<std::optional<CameraMessage>> cameras;
   int present() const;
+  // Sets frame (the first present camera's) and time_s (the mean of the present cameras') from
+  // the messages; returns how many are present.
+  int SetFrameAndTime();
 };
 
 struct CameraSyncStats {

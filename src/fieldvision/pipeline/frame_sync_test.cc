@@ -34,6 +34,16 @@ std::vector<SyncedFrame> Feed(FrameSynchronizer& sync,
   return out;
 }
 
+TEST(SyncedFrame, FrameOfTheFirstPresentCameraAndMeanTime) {
+  SyncedFrame g;
+  g.cameras.resize(3);
+  g.cameras[1] = Msg(1, 7, 0.25);
+  g.cameras[2] = Msg(2, 9, 0.35);
+  EXPECT_EQ(g.SetFrameAndTime(), 2);
+  EXPECT_EQ(g.frame, 7);
+  EXPECT_DOUBLE_EQ(g.time_s, 0.3);
+}
+
 TEST(FrameSync, ByIndexWithDropsDuplicatesAndDifferentLengths) {
   std::vector<std::vector<CameraMessage>> s(3);
   for (int f = 0; f < 20; ++f) s[0].push_back(Msg(0, f, f / 60.0));

@@ -123,18 +123,13 @@ std::optional<SyncedFrame> LiveSynchronizer::Next(double now_s, bool flush) {
   if (!ready && !flush && now_s - first_arrival < options_.max_wait_s) return std::nullopt;
   SyncedFrame out;
   out.cameras.resize(n_);
-  double sum_t = 0;
-  int k = 0;
   for (int c = 0; c < n_; ++c) {
     auto& b = buffers_[c];
     if (b.empty() || b.front().message.time_s > until) continue;
-    sum_t += b.front().message.time_s;
-    if (k == 0) out.frame = b.front().message.frame;
-    ++k;
     out.cameras[c] = std::move(b.front().message);
     b.pop_front();
   }
-  out.time_s = sum_t / k;
+  const int k = out.SetFrameAndTime();
   any_group_ = true;
   decided_until_s_ = std::max(decided_until_s_, until);
   ++groups_;
