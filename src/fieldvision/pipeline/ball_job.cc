@@ -130,6 +130,13 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   popt.sync.mode = o.sync == "time" ? SyncMode::kTimestamp : SyncMode::kFrameIndex;
   popt.queue_policy = o.live ? QueuePolicy::kDropOldest : QueuePolicy::kBlock;
   popt.triangulation.ball_radius_m = 0.5 * o.ball_diameter_m;
+  if (field) {
+    // A position off the field (beyond the detector's margin) or above its highest ball is none.
+    const double hx = 0.5 * field->length_m + dopt.field_margin_m;
+    const double hy = 0.5 * field->width_m + dopt.field_margin_m;
+    popt.triangulation.allowed_region = Eigen::AlignedBox3d(
+        Eigen::Vector3d(-hx, -hy, -1e3), Eigen::Vector3d(hx, hy, dopt.max_height_m));
+  }
 
   BallJobResult result;
   // Write to a temporary name, rename at the end: a failed run leaves no half file.

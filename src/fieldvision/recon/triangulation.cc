@@ -47,6 +47,11 @@ bool BelowRest(const Eigen::Vector3d& p, const TriangulationOptions& o, double s
   return o.max_below_rest_m >= 0 && p.z() < o.ball_radius_m - o.max_below_rest_m - 3 * sigma_z_m;
 }
 
+bool NoBallThere(const Eigen::Vector3d& p, const TriangulationOptions& o, double sigma_z_m) {
+  return BelowRest(p, o, sigma_z_m) ||
+         (!o.allowed_region.isEmpty() && !o.allowed_region.contains(p));
+}
+
 }  // namespace fv::triangulation_detail
 
 namespace fv {
@@ -66,6 +71,10 @@ void TriangulationOptions::Check() const {
              "TriangulationOptions.max_candidates_per_camera must be in [1, 64] (got {})",
              max_candidates_per_camera);
   CheckFinite(max_below_rest_m, "TriangulationOptions.max_below_rest_m");
+  if (!allowed_region.isEmpty()) {
+    FV_REQUIRE(allowed_region.min().allFinite() && allowed_region.max().allFinite(),
+               "TriangulationOptions.allowed_region must be finite");
+  }
   CheckPositive(prior_gate_m, "TriangulationOptions.prior_gate_m");
   FV_REQUIRE(max_radius_ratio == 0.0 || max_radius_ratio > 1.0,
              "TriangulationOptions.max_radius_ratio must be 0 (off) or > 1 (got {})",

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/geometry/rigid.h"
@@ -73,6 +74,11 @@ struct TriangulationOptions {
   // orange object (a cone, a marker) is no ball, whatever the cameras agree on. Negative
   // disables the check.
   double max_below_rest_m = 0.015;
+  // Where a ball centre can be (world frame, metres): a point outside this box is no ball,
+  // whatever the cameras agree on (an advertising board behind the goal, a light above the
+  // field); its candidates are dropped as for max_below_rest_m. Empty (the default): anywhere.
+  // ball_job sets it to the field plus the detector's margin, up to its highest ball.
+  Eigen::AlignedBox3d allowed_region;
   // When the detector reports radius_px: a view whose radius differs from the radius predicted
   // from the depth by more than this factor (either way) is inconsistent; 0 disables.
   double max_radius_ratio = 0.0;

@@ -59,6 +59,8 @@ bool InFrontOfAll(const std::vector<Camera>& cameras, const std::vector<View>& v
 // True when the centre `p` lies lower than a resting ball's by more than max_below_rest_m plus
 // three times `sigma_z_m` (the standard deviation of its height).
 bool BelowRest(const Eigen::Vector3d& p, const TriangulationOptions& o, double sigma_z_m = 0.0);
+// BelowRest, or outside options.allowed_region: no ball centre can be at `p`.
+bool NoBallThere(const Eigen::Vector3d& p, const TriangulationOptions& o, double sigma_z_m = 0.0);
 
 // Refines `p` (3 values, or x, y when `ground`) on the views; fills residuals, rms, covariance.
 void Refine(const std::vector<Camera>& cameras, const std::vector<View>& views,

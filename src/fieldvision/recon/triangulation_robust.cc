@@ -123,7 +123,7 @@ BestHypothesis SearchHypotheses(const std::vector<Camera>& cameras,
           const RayPairResult rp =
               ClosestPointOfRays(*ranked.rays[ca][ka], *ranked.rays[cb][kb], o.min_angle_deg);
           if (!rp.ok()) continue;
-          if (BelowRest(rp.midpoint, o)) continue;
+          if (NoBallThere(rp.midpoint, o)) continue;
           ++best.hypotheses;
           const double cost = GatherConsistent(cameras, candidates, ranked, o, rp.midpoint, &pick);
           if (pick[ca] != ka || pick[cb] != kb) continue;  // the pair itself must agree
@@ -201,8 +201,8 @@ TriangulationResult RefineConsistentSet(const std::vector<Camera>& cameras,
 namespace fv {
 namespace {
 
-using triangulation_detail::BelowRest;
 using triangulation_detail::BestHypothesis;
+using triangulation_detail::NoBallThere;
 using triangulation_detail::RankCandidates;
 using triangulation_detail::RankedCandidates;
 using triangulation_detail::RefineConsistentSet;
@@ -229,7 +229,8 @@ TriangulationResult RobustCore(const std::vector<Camera>& cameras,
     return result;
   }
   // A set whose refined point lies below a resting ball (a low orange object that the cameras
-  // agree on) is dropped and the search runs again without its candidates, a few times at most.
+  // agree on) or outside the allowed region is dropped and the search runs again without its
+  // candidates, a few times at most.
   constexpr int kMaxSearches = 3;
   RankedCandidates search = ranked;
   int hypotheses = 0;
@@ -254,7 +255,7 @@ TriangulationResult RobustCore(const std::vector<Camera>& cameras,
       break;
     }
     const double sigma_z_m = std::sqrt(std::max(result.covariance(2, 2), 0.0));
-    if (!BelowRest(result.point_world, o, sigma_z_m)) break;
+    if (!NoBallThere(result.point_world, o, sigma_z_m)) break;
     result.status = TriangulationStatus::kNoConsistentSet;
     for (size_t c = 0; c < used.size(); ++c) {
       if (used[c] < 0) continue;

@@ -6,6 +6,7 @@
 
 #include "fieldvision/recon/triangulation.h"
 #include "fieldvision/recon/triangulation_internal.h"
+#include "fieldvision/util/error.h"
 
 namespace fv {
 namespace {
@@ -151,6 +152,33 @@ TEST(RobustTriangulation, ALowObjectSeenByEveryCameraGivesWayToTheBall) {
   const TriangulationResult off = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(off.ok());
   EXPECT_LT((off.point_world - marker).norm(), 1e-3);
+}
+
+// An advertising board behind the goal that every camera sees and scores higher than the ball:
+// with the field's box as the allowed region it gives way to the ball.
+TEST(RobustTriangulation, AnObjectOutsideTheAllowedRegionGivesWayToTheBall) {
+  const auto cams = RingCameras();
+  TriangulationOptions o;
+  const Eigen::Vector3d board(-6.5, 0.5, 0.4), ball(1.0, 1.5, 0.6);
+  auto seen = [&](int c, const Eigen::Vector3d& p, double score) {
+    BallObservation obs = Seen(cams[c], p, score);
+    obs.sigma_px = 0.2;
+    return obs;
+  };
+  std::vector<std::vector<BallObservation>> cand = {{seen(0, board, 0.9), seen(0, ball, 0.6)},
+                                                    {seen(1, board, 0.9), seen(1, ball, 0.6)},
+                                                    {seen(2, board, 0.9)}};
+  const TriangulationResult anywhere = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(anywhere.ok());
+  EXPECT_LT((anywhere.point_world - board).norm(), 1e-3);
+  o.allowed_region = Eigen::AlignedBox3d(Eigen::Vector3d(-5, -4, -1), Eigen::Vector3d(5, 4, 8));
+  const TriangulationResult r = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(r.ok()) << ToString(r.status);
+  EXPECT_LT((r.point_world - ball).norm(), 1e-3);
+  EXPECT_TRUE(NoBallThere(board, o));
+  EXPECT_FALSE(NoBallThere(ball, o));
+  o.allowed_region.max().x() = std::nan("");
+  EXPECT_THROW(o.Check(), Error);
 }
 
 }  // namespace
