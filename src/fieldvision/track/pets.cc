@@ -49,7 +49,7 @@ double NumAttr(const std::string& tag, const std::string& name, const std::strin
 int IndexAttr(const std::string& tag, const std::string& name, const std::string& where) {
   const double v = NumAttr(tag, name, where);
   FV_REQUIRE(v >= 0 && v <= 1e8 && v == std::floor(v),
-             "{}: {} '{}' is not a whole number in [0, 1e8]", where, name, Attr(tag, name));
+             "{}: {} {} is not a whole number in [0, 1e8]", where, name, v);
   return static_cast<int>(v);
 }
 

@@ -46,12 +46,26 @@ std::string ToLower(std::string_view s) {
   return out;
 }
 
+namespace {
+
+// A value as an error message shows it: one line (control characters as '?'), at most 40
+// characters, so that a damaged file's bytes never make the message several lines.
+std::string Shown(const std::string& t) {
+  std::string out = t.substr(0, 40);
+  for (char& c : out) {
+    if (std::iscntrl(static_cast<unsigned char>(c))) c = '?';
+  }
+  return t.size() > 40 ? out + "..." : out;
+}
+
+}  // namespace
+
 double ParseDouble(std::string_view s, std::string_view context) {
   const std::string t = Trim(s);
   FV_REQUIRE(!t.empty(), "{}: empty value where a number is expected", context);
   char* end = nullptr;
   const double v = std::strtod(t.c_str(), &end);
-  FV_REQUIRE(end == t.c_str() + t.size(), "{}: '{}' is not a number", context, t);
+  FV_REQUIRE(end == t.c_str() + t.size(), "{}: '{}' is not a number", context, Shown(t));
   return v;
 }
 
@@ -60,7 +74,7 @@ long long ParseInt(std::string_view s, std::string_view context) {
   long long v = 0;
   const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
   FV_REQUIRE(ec == std::errc() && ptr == t.data() + t.size() && !t.empty(),
-             "{}: '{}' is not an integer", context, t);
+             "{}: '{}' is not an integer", context, Shown(t));
   return v;
 }
 
