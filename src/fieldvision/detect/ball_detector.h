@@ -97,10 +97,11 @@ struct BallDetectorOptions {
   double max_region_outside = 0.1;  // convex outline points beyond the circle (corners, apexes)
   // The convex outline's far reach from the centre, in radii (1.41: a square's corners).
   double max_region_extent = 1.25;
-  // A ball stands out from its surroundings: CIELAB Delta E between the disc's and a ring's
-  // median colours (ball_region.h), required of every accepted candidate with a region; a
-  // candidate's score grows with its contrast up to twice this.
-  double min_contrast = 35.0;
+  // A ball stands out from its surroundings: CIELAB Delta E between the median colours of the
+  // disc's ball-class pixels and of a ring (ball_region.h), required of every accepted candidate
+  // with a region; a candidate's score grows with its contrast up to twice this. Chosen on the
+  // real SSL and MSL photos as a whole (35-45 tried: 40 keeps SSL's precision, MSL gains most).
+  double min_contrast = 40.0;
   // Whether a failed region shape check also rejects a candidate whose sub-pixel outline fit
   // passed all its own checks.
   bool region_vetoes_fit = false;

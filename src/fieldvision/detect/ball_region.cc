@@ -278,7 +278,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
                           const BallRegionOptions& o, BallRegion* out) {
   cv::Mat lab;
   cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
-  std::array<std::vector<double>, 3> disc_lab, ring_lab;
+  std::array<std::vector<double>, 3> disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
   long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, pure = 0;
@@ -308,7 +308,9 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
         }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
-        for (int ch = 0; ch < 3; ++ch) disc_lab[ch].push_back(l[ch]);
+        // The ball's own colour (not its print, shadow or a hidden part), else the whole core.
+        auto& dest = m[x] != 0 ? disc_lab : core_lab;
+        for (int ch = 0; ch < 3; ++ch) dest[ch].push_back(l[ch]);
       }
       pure += f[x] != 0 && m[x] != 0;
     }
@@ -317,6 +319,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   out->spill = spill / (M_PI * r * r);
   out->leak = ring > 0 ? double(ring_ball) / ring : 0.0;
   out->purity = area > 0 ? pure / area : 0.0;
+  if (disc_lab[0].empty()) disc_lab = std::move(core_lab);
   if (!disc_lab[0].empty() && !ring_lab[0].empty()) {
     double d2 = 0;
     for (int ch = 0; ch < 3; ++ch) {

@@ -56,9 +56,10 @@ struct BallRegion {
   // 1.41 for a square's corners, more for a triangle's apex.
   double extent = 0.0;
   double purity = 0.0;  // ball-coloured share of the region before closing and filling
-  // CIELAB distance (Delta E 1976) between the median colours of the disc (inner 80 %) and of
-  // the leak ring's pixels outside the ball class: a ball stands out from what is around it, a
-  // patch of a wall does not.
+  // CIELAB distance (Delta E 1976) between the median colours of the disc's ball-class pixels
+  // (inner 80 %; all of them when none is) and of the leak ring's pixels outside the ball class:
+  // a ball's colour stands out from what is around it, a patch of a wall does not. The print
+  // and the shaded side are left out (a yellow ball's shadow is olive, near the grass).
   double contrast = 0.0;
   double solidity = 0.0;   // region area / convex hull area
   int outline_points = 0;  // convex outline points used by the circle fit
