@@ -34,6 +34,13 @@ BallObservation Seen(const Camera& cam, const Eigen::Vector3d& p, double score =
   return o;
 }
 
+// Seen with a centre known to 0.2 px.
+BallObservation SeenSharp(const Camera& cam, const Eigen::Vector3d& p, double score) {
+  BallObservation o = Seen(cam, p, score);
+  o.sigma_px = 0.2;
+  return o;
+}
+
 BallObservation Elsewhere(double score) {
   BallObservation o;
   o.centre_px = {100, 120};
@@ -136,9 +143,7 @@ TEST(RobustTriangulation, ALowObjectSeenByEveryCameraGivesWayToTheBall) {
   TriangulationOptions o;
   const Eigen::Vector3d marker(2.0, -1.0, 0.03), ball(-1.0, 1.5, 0.11);
   auto seen = [&](int c, const Eigen::Vector3d& p, double score) {
-    BallObservation obs = Seen(cams[c], p, score);
-    obs.sigma_px = 0.2;
-    return obs;
+    return SeenSharp(cams[c], p, score);
   };
   std::vector<std::vector<BallObservation>> cand = {{seen(0, marker, 0.9), seen(0, ball, 0.6)},
                                                     {seen(1, marker, 0.9), seen(1, ball, 0.6)},
@@ -161,9 +166,7 @@ TEST(RobustTriangulation, AnObjectOutsideTheAllowedRegionGivesWayToTheBall) {
   TriangulationOptions o;
   const Eigen::Vector3d board(-6.5, 0.5, 0.4), ball(1.0, 1.5, 0.6);
   auto seen = [&](int c, const Eigen::Vector3d& p, double score) {
-    BallObservation obs = Seen(cams[c], p, score);
-    obs.sigma_px = 0.2;
-    return obs;
+    return SeenSharp(cams[c], p, score);
   };
   std::vector<std::vector<BallObservation>> cand = {{seen(0, board, 0.9), seen(0, ball, 0.6)},
                                                     {seen(1, board, 0.9), seen(1, ball, 0.6)},
