@@ -6,8 +6,9 @@ void EventHub::Publish(const std::string& type, const nlohmann::json& data) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ++last_;
-    events_.emplace_back(last_, "id: " + std::to_string(last_) + "\nevent: " + type +
-                                    "\ndata: " + data.dump() + "\n\n");
+    events_.emplace_back(
+        last_, "id: " + std::to_string(last_) + "\nevent: " + type + "\ndata: " +
+                   data.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n\n");
     while (events_.size() > kKeep) events_.pop_front();
   }
   changed_.notify_all();

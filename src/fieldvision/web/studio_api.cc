@@ -40,7 +40,10 @@ std::string OneLine(std::string s) {
   return s;
 }
 
-ApiResponse Json(const json& j, int status = 200) { return {status, "application/json", j.dump()}; }
+// Bytes that are not UTF-8 (from a request's keys or file names) are replaced, never thrown on.
+ApiResponse Json(const json& j, int status = 200) {
+  return {status, "application/json", j.dump(-1, ' ', false, json::error_handler_t::replace)};
+}
 
 ApiResponse ErrorResponse(int status, const std::string& message) {
   return Json({{"error", OneLine(message)}}, status);

@@ -253,6 +253,12 @@ TEST_F(StudioApiTest, MalformedRequests) {
   EXPECT_EQ(Get("/api/info", {{"Host", "localhost:8470"}}).status, 200);
   EXPECT_EQ(Get("/api/info", {{"Host", "[::1]:8470"}}).status, 200);
   ExpectError(Post("/api/calibrate/pose", std::string("")), 400, "empty");
+  // A key with bytes that are not UTF-8 is named in the error (replaced), never thrown on.
+  const Reply bad_utf8 = Post("/api/calibrate/pose",
+                              std::string("{\"camera\": \"cam.yaml\", \"points\xff\xff|\": 1}"));
+  EXPECT_GE(bad_utf8.status, 400);
+  EXPECT_LT(bad_utf8.status, 500);
+  EXPECT_NO_THROW(json::parse(bad_utf8.body)) << bad_utf8.body;
   ExpectError(Post("/api/calibrate/pose", std::string("[1, 2]")), 400, "not a JSON object");
   ExpectError(Post("/api/calibrate/pose", json{{"camera", 3}}), 400, "wrong type");
   ExpectError(
