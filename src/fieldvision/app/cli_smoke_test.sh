@@ -46,6 +46,18 @@ check "ball: --det-sigma without --detections" nonzero $FV ball --camera "$TMP/c
 check "ball: --out a device" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out /dev/null
 [ -c /dev/null ] || { echo "FAIL ball: /dev/null replaced"; fail=1; }
+check "ball: one camera" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --out "$TMP/b.csv"
+grep -q "one camera" "$TMP/err" || { echo "FAIL ball: one camera not named"; fail=1; }
+check "ball: a video twice" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --camera "$TMP/c2.yaml" --video "$TMP/v.avi" --out "$TMP/b.csv"
+check "ball: --tolerance 1e300" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --tolerance 1e300
+check "ball: --inlier-px nan" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --inlier-px nan
+check "detect: --ball-diameter nan" nonzero $FV detect --video "$TMP/v.avi" --out "$TMP/d.csv" \
+  --ball-diameter nan
+grep -q -- "--ball-diameter" "$TMP/err" || { echo "FAIL detect: nan diameter not named"; fail=1; }
 check "detect: --ball-diameter 1e300" nonzero $FV detect --video "$TMP/v.avi" --out "$TMP/d.csv" \
   --ball-diameter 1e300
 check "eval ball: NaN truth" nonzero $FV eval ball --truth "$TMP/nan.csv" --est "$TMP/nan.csv"

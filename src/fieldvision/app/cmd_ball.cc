@@ -57,6 +57,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--flights", o->det.flights,
                   "With --detections: also fit the flights and write FLIGHTS.json");
   cmd->add_option("--ball-diameter", o->job.ball_diameter_m, "Ball diameter in metres")
+      ->check(FiniteRange(0.01, 2.0))
       ->capture_default_str();
   cmd->add_option("--color,--colour", o->job.colour, "Colour preset or colour file of the ball")
       ->capture_default_str();
@@ -75,13 +76,16 @@ void Setup(CLI::App& app, int& exit_code) {
                   "CSV with frame,time_s per video (repeat, one per video); implies --sync time");
   cmd->add_option("--tolerance", o->job.pipeline.sync.tolerance_s,
                   "With --sync time: frames this close in seconds are combined")
+      ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
   cmd->add_flag("--live", o->job.live,
                 "Live: play the videos at their frame rate (as cameras deliver) and keep the "
                 "newest frames when fusion falls behind (drops frames)");
-  cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames");
+  cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames")
+      ->check(CLI::Range(0LL, 1000000000LL));
   cmd->add_option("--inlier-px", o->job.pipeline.triangulation.inlier_threshold_px,
                   "A camera agrees when it sees the ball within this many pixels")
+      ->check(FiniteRange(0.01, 1000.0))
       ->capture_default_str();
   cmd->add_flag("--ground", o->job.pipeline.triangulation.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");

@@ -26,7 +26,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "file from `color learn`")
       ->capture_default_str();
   cmd->add_option("--ball-diameter", o->detector.diameter_m, "Ball diameter in metres")
-      ->check(CLI::Range(0.01, 2.0))
+      ->check(FiniteRange(0.01, 2.0))
       ->capture_default_str();
   cmd->add_option("--field", o->field,
                   "Field (built-in name or JSON): ignore everything outside the field of play "

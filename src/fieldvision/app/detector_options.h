@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "fieldvision/app/command.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/dnn_ball.h"
 
@@ -12,10 +13,10 @@ namespace fv::app {
 // The colour detector's radius limits and small-ball stage (`detect`, `eval detect`).
 inline void AddBallSizeOptions(CLI::App* cmd, BallDetectorOptions& o) {
   cmd->add_option("--min-radius", o.min_radius_px, "Smallest ball radius in pixels")
-      ->check(CLI::Range(0.1, 10000.0))
+      ->check(FiniteRange(0.1, 10000.0))
       ->capture_default_str();
   cmd->add_option("--max-radius", o.max_radius_px, "Largest ball radius in pixels")
-      ->check(CLI::Range(0.1, 10000.0))
+      ->check(FiniteRange(0.1, 10000.0))
       ->capture_default_str();
   cmd->add_option("--small-balls", o.small.mode,
                   "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "

@@ -19,6 +19,14 @@ void BallJobOptions::Check() const {
   FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --video pair");
   FV_REQUIRE(cameras.size() == videos.size(), "ball: {} --camera but {} --video (they pair up)",
              cameras.size(), videos.size());
+  FV_REQUIRE(cameras.size() >= 2 || pipeline.triangulation.single_camera_ground,
+             "ball: one camera gives no 3D position: give 2 or more --camera/--video pairs (or "
+             "--ground for positions on the ground)");
+  for (size_t i = 0; i < videos.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      FV_REQUIRE(videos[i] != videos[j], "ball: video '{}' is given twice", videos[i]);
+    }
+  }
   FV_REQUIRE(timestamps.empty() || timestamps.size() == videos.size(),
              "ball: {} --timestamps for {} videos (give one per video or none)", timestamps.size(),
              videos.size());
