@@ -94,6 +94,8 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::optional<CsvTable> truth;
   if (!o.truth.empty()) {
     truth = CsvTable::Read(o.truth);
+    FV_REQUIRE(truth->rows() > 0, "truth file '{}' has a header but no rows", o.truth);
+    CheckBallTrackRanges(*truth);
     EvaluateBall(*truth, *truth, o.eval);
   }
   const int n = static_cast<int>(o.cameras.size());

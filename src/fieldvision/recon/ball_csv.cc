@@ -24,6 +24,26 @@ BallSample ReadBallCsvRow(const CsvTable& t, size_t r) {
   return s;
 }
 
+void CheckBallTrackRanges(const CsvTable& table) {
+  constexpr double kMaxFrame = 1e8, kMaxPositionM = 1e4, kMaxTimeS = 1e11;
+  for (size_t r = 0; r < table.rows(); ++r) {
+    const BallSample s = ReadBallCsvRow(table, r);
+    if (table.Has("frame")) {
+      FV_REQUIRE(s.frame >= 0 && s.frame <= kMaxFrame, "{}: frame {} is not in [0, {:.0f}]",
+                 table.Where(r), s.frame, kMaxFrame);
+    }
+    for (int k = 0; k < 3; ++k) {
+      FV_REQUIRE(std::abs(s.ball_in_world[k]) <= kMaxPositionM,
+                 "{}: {} = {} is not a finite position within +-{:.0f} m", table.Where(r),
+                 "xyz"[k] + std::string("_m"), s.ball_in_world[k], kMaxPositionM);
+    }
+    if (table.Has("time_s") && !table.Get(r, "time_s").empty()) {
+      FV_REQUIRE(std::abs(s.time_s) <= kMaxTimeS, "{}: time_s = {} is not a finite time",
+                 table.Where(r), s.time_s);
+    }
+  }
+}
+
 namespace {
 
 BallSample ReadTt3dRow(const CsvTable& t, size_t r) {

@@ -19,6 +19,11 @@ const std::vector<std::string>& BallCsvColumns();
 // for a cell that is not a number; finiteness is the caller's to check.
 BallSample ReadBallCsvRow(const CsvTable& table, size_t r);
 
+// Every row of a ball track table (BALL.csv, truth) in the ranges of a real recording: frame
+// numbers in [0, 1e8], positions within 10 km, times finite and within 1e11 s (Unix time fits).
+// Throws fv::Error naming file:line and the column.
+void CheckBallTrackRanges(const CsvTable& table);
+
 struct BallTrackFile {
   std::vector<BallSample> samples;   // strictly increasing times
   std::string layout;                // "ball" (BALL.csv) or "tt3d" (Timestamp,X,Y,Z)
