@@ -54,6 +54,11 @@ printf 'frame,time_s,x_m,y_m,z_m\n' > "$TMP/empty_truth.csv"
 check "ball: --truth header only" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --truth "$TMP/empty_truth.csv"
 grep -q "no rows" "$TMP/err" || { echo "FAIL ball: empty truth not named"; fail=1; }
+mkdir -p "$TMP/imgs" && $FV field draw fifa --out "$TMP/imgs/a.png" >/dev/null
+cp "$TMP/imgs/a.png" "$TMP/a_copy.png"
+check "eval detect: --out an image it reads" nonzero $FV eval detect --video "$TMP/imgs" \
+  --out "$TMP/imgs/a.png" --no-progress
+cmp -s "$TMP/imgs/a.png" "$TMP/a_copy.png" || { echo "FAIL eval detect: image overwritten"; fail=1; }
 check "ball: one camera" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --out "$TMP/b.csv"
 grep -q "one camera" "$TMP/err" || { echo "FAIL ball: one camera not named"; fail=1; }

@@ -275,6 +275,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   } else {
     Throw("eval detect: labels '{}' not found", o.labels);
   }
+  // No output may be one of the images, label files or the camera read (an image inside --video).
+  std::vector<std::string> inputs = {o.video, o.labels, o.camera};
+  for (const LabelledImage& item : items) inputs.push_back(item.image);
+  CheckOutputPath(o.out, inputs, "--out");
+  CheckOutputPath(o.candidates_out, inputs, "--candidates");
   std::unique_ptr<Camera> camera;
   if (!o.camera.empty()) camera = std::make_unique<Camera>(ReadCameraYaml(o.camera));
   const AnyBallDetector detector(o.detector, o.dnn, camera.get(), nullptr);
