@@ -208,11 +208,15 @@ std::string DetectEvalResult::Summary(int list) const {
     err_px.push_back(im.centre_err_px);
     err_rel.push_back(im.centre_err_rel);
   }
+  // A ratio of nothing is not a number: "n/a".
+  const auto ratio = [](double v, int den) {
+    return den > 0 ? fmt::format("{:.3f}", v) : std::string("n/a");
+  };
   std::string s = fmt::format(
-      "{} images, {} with a ball, {} with a detection: recall {:.3f} ({}/{}), precision {:.3f} "
-      "({}/{}), {} false detections",
-      images.size(), with_ball, detected, recall(), hits, with_ball, precision(), hits, detected,
-      false_detections);
+      "{} images, {} with a ball, {} with a detection: recall {} ({}/{}), precision {} ({}/{}), "
+      "{} false detections",
+      images.size(), with_ball, detected, ratio(recall(), with_ball), hits, with_ball,
+      ratio(precision(), detected), hits, detected, false_detections);
   if (!err_px.empty()) {
     s += fmt::format(
         "\ncentre error vs. box centre: median {:.2f} px, p90 {:.2f} px ({:.2f} / {:.2f} of the "
@@ -275,6 +279,12 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   } else {
     Throw("eval detect: labels '{}' not found", o.labels);
   }
+  // Nothing to score without a single label file (a wrong --labels folder, a forgotten export).
+  const bool any_label = std::any_of(items.begin(), items.end(),
+                                     [](const LabelledImage& it) { return it.has_label_file; });
+  FV_REQUIRE(any_label || items.empty(),
+             "eval detect: none of the {} images has a label file (labels: '{}'): nothing to score",
+             items.size(), o.labels.empty() ? "beside the images" : o.labels);
   // No output may be one of the images, label files or the camera read (an image inside --video).
   std::vector<std::string> inputs = {o.video, o.labels, o.camera};
   for (const LabelledImage& item : items) inputs.push_back(item.image);

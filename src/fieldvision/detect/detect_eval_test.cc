@@ -75,6 +75,28 @@ TEST(DetectEval, BadLabelNamesFileAndLine) {
   EXPECT_THROW(EvaluateDetector(o), Error);
 }
 
+// Nothing to score is said, not scored: no label file at all is an error, and a ratio of nothing
+// is "n/a" rather than 0.
+TEST(DetectEval, NothingToScoreIsNotAScore) {
+  const std::string dir = fv::testing::TempDir() + "/detect_eval_nolabels";
+  fs::create_directories(dir);
+  Rng rng(1);
+  cv::imwrite(dir + "/a.png", detect_testing::FieldImage(64, 48, rng));
+  DetectEvalOptions o;
+  o.video = dir;
+  o.progress = false;
+  try {
+    EvaluateDetector(o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("has a label file"), std::string::npos) << e.what();
+  }
+  WriteText(dir + "/a.txt", "");  // a label file without a ball
+  const DetectEvalResult r = EvaluateDetector(o);
+  EXPECT_EQ(r.with_ball, 0);
+  EXPECT_NE(r.Summary(0).find("recall n/a (0/0)"), std::string::npos) << r.Summary(0);
+}
+
 // The real RoboCup photos (shared/data/robocup-ball-photos): a floor under today's measured
 // recall and precision so that a change that loses real balls shows up here.
 TEST(DetectEval, RealRobocupPhotos) {
