@@ -114,6 +114,21 @@ class StudioApiTest : public ::testing::Test {
     return Eigen::Vector3d::Zero();
   }
 
+  // WALK.csv: player 3 walks along x at 1.5 m/s for 4 s (25 frames/s) from x = -2 m, through
+  // the zone "strip" (strip.json, x from 1 to 2 m); player 4 stands still outside it.
+  void WriteWalkAndStrip() {
+    std::ofstream tracks(dir_ / "WALK.csv");
+    tracks << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n";
+    for (int f = 0; f <= 100; ++f) {
+      const double t = f / 25.0;
+      tracks << fmt::format("{},3,0,0,10,20,1,{:.4f},0.5,{:.4f}\n", f + 1, 1.5 * t - 2.0, t);
+      tracks << fmt::format("{},4,0,0,10,20,1,-5,-3,{:.4f}\n", f + 1, t);
+    }
+    tracks.close();
+    const json zones = {{{"name", "strip"}, {"polygon", {{1, -1}, {2, -1}, {2, 1}, {1, 1}}}}};
+    ASSERT_EQ(Post("/api/zones/save", json{{"zones", zones}, {"out", "strip.json"}}).status, 200);
+  }
+
   uint64_t seed_ = fv::testing::TestSeed(1);
   fs::path dir_;
   std::unique_ptr<StudioServer> server_;
@@ -614,18 +629,7 @@ TEST_F(StudioApiTest, BallTracksFlightsAndPlayers) {
 }
 
 TEST_F(StudioApiTest, PlayerStatsAndZoneAlerts) {
-  // Player 3 walks along x at 1.5 m/s for 4 s (25 frames/s), through a zone from x = 1 to 2 m;
-  // player 4 stands still outside it.
-  std::ofstream tracks(dir_ / "WALK.csv");
-  tracks << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n";
-  for (int f = 0; f <= 100; ++f) {
-    const double t = f / 25.0;
-    tracks << fmt::format("{},3,0,0,10,20,1,{:.4f},0.5,{:.4f}\n", f + 1, 1.5 * t - 2.0, t);
-    tracks << fmt::format("{},4,0,0,10,20,1,-5,-3,{:.4f}\n", f + 1, t);
-  }
-  tracks.close();
-  const json zones = {{{"name", "strip"}, {"polygon", {{1, -1}, {2, -1}, {2, 1}, {1, 1}}}}};
-  ASSERT_EQ(Post("/api/zones/save", json{{"zones", zones}, {"out", "strip.json"}}).status, 200);
+  ASSERT_NO_FATAL_FAILURE(WriteWalkAndStrip());  // player 3 walks through "strip", 4 stands
   const Reply r = Post("/api/players/stats", json{{"tracks", "WALK.csv"}, {"zones", "strip.json"}});
   ASSERT_EQ(r.status, 200) << r.body;
   const json j = r.j();
@@ -667,17 +671,7 @@ std::string Base64(const std::string& bytes) {
 }
 
 TEST_F(StudioApiTest, PlayersExport) {
-  // Player 3 walks through the zone "strip" at 1.5 m/s; player 4 stands still.
-  std::ofstream tracks(dir_ / "WALK.csv");
-  tracks << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n";
-  for (int f = 0; f <= 100; ++f) {
-    const double t = f / 25.0;
-    tracks << fmt::format("{},3,0,0,10,20,1,{:.4f},0.5,{:.4f}\n", f + 1, 1.5 * t - 2.0, t);
-    tracks << fmt::format("{},4,0,0,10,20,1,-5,-3,{:.4f}\n", f + 1, t);
-  }
-  tracks.close();
-  const json zones = {{{"name", "strip"}, {"polygon", {{1, -1}, {2, -1}, {2, 1}, {1, 1}}}}};
-  ASSERT_EQ(Post("/api/zones/save", json{{"zones", zones}, {"out", "strip.json"}}).status, 200);
+  ASSERT_NO_FATAL_FAILURE(WriteWalkAndStrip());
   // The page's heat map as a canvas sends it (a data: URL).
   cv::Mat heat(30, 50, CV_8UC4, cv::Scalar(10, 200, 30, 255));
   std::vector<uchar> png;
