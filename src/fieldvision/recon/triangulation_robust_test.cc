@@ -142,12 +142,10 @@ TEST(RobustTriangulation, ALowObjectSeenByEveryCameraGivesWayToTheBall) {
   const auto cams = RingCameras();
   TriangulationOptions o;
   const Eigen::Vector3d marker(2.0, -1.0, 0.03), ball(-1.0, 1.5, 0.11);
-  auto seen = [&](int c, const Eigen::Vector3d& p, double score) {
-    return SeenSharp(cams[c], p, score);
-  };
-  std::vector<std::vector<BallObservation>> cand = {{seen(0, marker, 0.9), seen(0, ball, 0.6)},
-                                                    {seen(1, marker, 0.9), seen(1, ball, 0.6)},
-                                                    {seen(2, marker, 0.9)}};
+  std::vector<std::vector<BallObservation>> cand = {
+      {SeenSharp(cams[0], marker, 0.9), SeenSharp(cams[0], ball, 0.6)},
+      {SeenSharp(cams[1], marker, 0.9), SeenSharp(cams[1], ball, 0.6)},
+      {SeenSharp(cams[2], marker, 0.9)}};
   const TriangulationResult r = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(r.ok()) << ToString(r.status);
   EXPECT_EQ(r.num_views(), 2);
@@ -165,12 +163,10 @@ TEST(RobustTriangulation, AnObjectOutsideTheAllowedRegionGivesWayToTheBall) {
   const auto cams = RingCameras();
   TriangulationOptions o;
   const Eigen::Vector3d board(-6.5, 0.5, 0.4), ball(1.0, 1.5, 0.6);
-  auto seen = [&](int c, const Eigen::Vector3d& p, double score) {
-    return SeenSharp(cams[c], p, score);
-  };
-  std::vector<std::vector<BallObservation>> cand = {{seen(0, board, 0.9), seen(0, ball, 0.6)},
-                                                    {seen(1, board, 0.9), seen(1, ball, 0.6)},
-                                                    {seen(2, board, 0.9)}};
+  std::vector<std::vector<BallObservation>> cand = {
+      {SeenSharp(cams[0], board, 0.9), SeenSharp(cams[0], ball, 0.6)},
+      {SeenSharp(cams[1], board, 0.9), SeenSharp(cams[1], ball, 0.6)},
+      {SeenSharp(cams[2], board, 0.9)}};
   const TriangulationResult anywhere = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(anywhere.ok());
   EXPECT_LT((anywhere.point_world - board).norm(), 1e-3);
