@@ -3,25 +3,15 @@
 // this machine), the field and cameras alone, and the field with an N-point track. Prints, per
 // scene, the frames shown per second while the view turns and the render + GPU-finish cost.
 // Usage: node bench3d.mjs URL [POINTS=10000] [REPEATS=2]   (URL of a running `fieldvision studio`)
-import { chromium } from 'playwright-core';
-import fs from 'node:fs';
-import os from 'node:os';
-import path from 'node:path';
+import { launchChromium } from './chromium.mjs';
 
 const [url, points = '10000', repeats = '2'] = process.argv.slice(2);
 if (!url) {
   console.error('usage: node bench3d.mjs URL [POINTS] [REPEATS]');
   process.exit(2);
 }
-const userDir = fs.mkdtempSync(path.join(os.tmpdir(), 'fv-bench3d-chromium-'));
-const context = await chromium.launchPersistentContext(userDir, {
-  executablePath: process.env.FV_CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  viewport: { width: 1400, height: 1000 },
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking', '--disable-component-update',
-    '--disable-sync', '--no-first-run'],
-});
-const page = context.pages()[0] ?? (await context.newPage());
+const browser = await launchChromium('fv-bench3d-chromium-');
+const page = browser.page;
 const scenes = [['empty', 'scene=empty&points=0'], ['field + cameras', 'points=0'], [`field + cameras + ${points} points`, `points=${points}`]];
 try {
   for (let r = 0; r < Number(repeats); ++r) {
@@ -38,6 +28,5 @@ try {
     }
   }
 } finally {
-  await context.close();
-  fs.rmSync(userDir, { recursive: true, force: true });
+  await browser.close();
 }

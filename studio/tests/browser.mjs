@@ -12,11 +12,10 @@
 //   players: the tactical board plays with the zones, the video beside it, heat maps, speed chart,
 //     zone alerts on a timeline and the stats table (as /api/players/stats); export (CSV, PNG)
 // Usage: node browser.mjs URL OUT_DIR FIELDVISION
-import { chromium } from 'playwright-core';
+import { launchChromium } from './chromium.mjs';
 import { execFileSync, spawn } from 'node:child_process';
 import net from 'node:net';
 import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
 
 const [url, out, fv] = process.argv.slice(2);
@@ -61,15 +60,8 @@ function start(args, log) {
   return child;
 }
 
-const userDir = fs.mkdtempSync(path.join(os.tmpdir(), 'fv-studio-chromium-'));
-const context = await chromium.launchPersistentContext(userDir, {
-  executablePath: process.env.FV_CHROMIUM || '/usr/bin/chromium',
-  headless: true,
-  viewport: { width: 1400, height: 1000 },
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking', '--disable-component-update',
-    '--disable-sync', '--no-first-run'],
-});
-const page = context.pages()[0] ?? (await context.newPage());
+const browser = await launchChromium('fv-studio-chromium-');
+const page = browser.page;
 const consoleErrors = [];
 page.on('pageerror', (e) => consoleErrors.push(String(e)));
 page.on('console', (m) => m.type() === 'error' && !/Failed to load resource/.test(m.text()) && consoleErrors.push(m.text()));
@@ -442,8 +434,7 @@ try {
   await page.screenshot({ path: path.join(out, 'failure.jpg'), quality: 70 }).catch(() => {});
 } finally {
   for (const c of children) if (c.exitCode === null) c.kill();
-  await context.close();
-  fs.rmSync(userDir, { recursive: true, force: true });
+  await browser.close();
 }
 console.log(failures.length ? `${failures.length} failure(s); screenshots in ${out}` : `all passed; screenshots in ${out}`);
 process.exit(failures.length ? 1 : 0);
