@@ -43,7 +43,8 @@ tidy: configure
 # Issue 18's checks. `make sweep`: every bad-input case of scripts/sweep_bad_inputs.sh (CTest runs
 # its --quick subset). `make fuzz`: the libFuzzer harnesses (clang, ASan + UBSan) FUZZ_SECONDS each,
 # two at a time. `make sanitize`: the unit tests built with clang's ASan + UBSan (the same build as
-# the fuzzers) and run with scripts/sanitize.supp naming the third-party leaks.
+# the fuzzers, with the NanoDet model of scripts/fetch-models.sh in it) and run with
+# scripts/sanitize.supp naming the third-party leaks.
 FUZZ_BUILD ?= build-fuzz
 FUZZ_SECONDS ?= 600
 SAN_ENV = ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 \
@@ -62,6 +63,7 @@ fuzz: deps $(FUZZ_BUILD)/build.ninja
 
 sanitize: deps $(FUZZ_BUILD)/build.ninja
 	cmake --build $(FUZZ_BUILD) -j $(JOBS)
+	bash scripts/fetch-models.sh $(FUZZ_BUILD)
 	cd $(FUZZ_BUILD) && $(SAN_ENV) ctest --output-on-failure -j $(JOBS) --timeout 1800 -E studio_browser
 
 clean:

