@@ -50,6 +50,10 @@ rm -f "$F/contact_sheet.png"
 mkdir -p "$F/frames" && cp "$W"/png/cam1/*.png "$F/frames/" 2>/dev/null ||
   cp "$(find "$W/png" -name '*.png' | sort | head -1)" "$F/frames/00000.png"
 FRAME="$(find "$F/frames" -name '*.png' | sort | head -1)"
+# Ball labels for eval detect: a YOLO file per frame (folder of images) and a CSV (video).
+mkdir -p "$F/labels"
+for p in "$F"/frames/*.png; do printf '0 0.5 0.5 0.1 0.1\n' >"$F/labels/$(basename "$p" .png).txt"; done
+printf 'frame,x,y,w,h\n0,150,110,20,20\n1,150,110,20,20\n' >"$F/labels.csv"
 rm -rf "$W/png"
 cp "$F/truth.csv" "$F/BALL.csv"
 # Ball detections of cam1/cam2 from truth_2d (frame,time_s,u,v,radius_px,score).
@@ -138,6 +142,12 @@ ballcsv huge_time '2,1e300,1,1,0.11,3'
 ballcsv text_cell '2,0.0333,one,1,0.11,3'
 ballcsv ragged '2,0.0333,1'
 ballcsv dup_frame '1,0.0167,1,1,0.11,3'
+# Timestamps (frame,time_s): text, negative or non-increasing times, a negative frame.
+tscsv() { { printf 'frame,time_s\n0,0\n1,0.0167\n'; printf '%b\n' "$2"; printf '3,0.05\n4,0.0667\n5,0.0833\n'; } >"$B/$1.csv"; }
+tscsv ts_text '2,soon'
+tscsv ts_negative '2,-0.0333'
+tscsv ts_backwards '2,0.01'
+tscsv ts_neg_frame '-2,0.0333'
 head -1 "$F/truth.csv" >"$B/header_only.csv"
 printf 'a,b,c\n1,2,3\n' >"$B/wrong_columns.csv"
 # Detections CSV (frame,time_s,u,v,radius_px,score).
@@ -356,14 +366,15 @@ for o in --ball-diameter --min-radius --max-radius; do
 done
 sweep_opt detect --step "$INTS 0" detect --video "$F/cam1.avi" --out "$OUTCSV" --no-progress
 sweep_opt detect --max-frames "$INTS" detect --video "$F/cam1.avi" --out "$OUTCSV" --no-progress
-sweep_opt detect --draw "$O/olddir $DEV $F/cam1.avi" detect --video "$F/cam1.avi" --out "$O/new.csv" --no-progress
+# (a folder is a --draw output of its own: the annotated frames as JPEGs)
+sweep_opt detect --draw "$DEV $F/cam1.avi" detect --video "$F/cam1.avi" --out "$O/new.csv" --no-progress
 # ball
 BALL2=(ball --camera "$F/cam1.yaml" --video "$F/cam1.avi" --camera "$F/cam2.yaml" --video "$F/cam2.avi" --no-progress)
 sweep_file "ball --camera" yaml "$CAM_BAD" ball --camera @ --video "$F/cam1.avi" --camera "$F/cam2.yaml" --video "$F/cam2.avi" --out "$OUTCSV" --no-progress
 sweep_file "ball --video" avi "$VIDEO_BAD" ball --camera "$F/cam1.yaml" --video @ --camera "$F/cam2.yaml" --video "$F/cam2.avi" --out "$OUTCSV" --no-progress
 sweep_file "ball --truth" csv "$CSV_BAD" "${BALL2[@]}" --truth @ --out "$O/new.csv"
 sweep_file "ball --detections" csv "$CSV_BAD det_nan_u det_huge_frame det_inf_time" ball --camera "$F/cam1.yaml" --detections @ --camera "$F/cam2.yaml" --detections "$F/det_cam2.csv" --out "$OUTCSV" --no-progress
-sweep_file "ball --timestamps" csv "nan_time huge_time text_cell ragged header_only empty binary missing" "${BALL2[@]}" --timestamps @ --timestamps "$F/det_cam2.csv" --out "$OUTCSV"
+sweep_file "ball --timestamps" csv "nan_time huge_time ts_text ts_negative ts_backwards ts_neg_frame ragged header_only empty binary missing" "${BALL2[@]}" --timestamps @ --timestamps "$F/det_cam2.csv" --out "$OUTCSV"
 sweep_file "ball --field" json "$FIELD_BAD" "${BALL2[@]}" --field @ --out "$OUTCSV"
 sweep_out "ball" "$F/cam1.avi" "${BALL2[@]}" --out @
 c "ball --truth=out" "truth.csv" quick -- "${BALL2[@]}" --truth "$F/truth.csv" --out "$F/truth.csv"
@@ -499,12 +510,12 @@ sweep_out "eval tracks" "$F/TRACKS.csv" eval tracks --gt "$F/TRACKS.csv" --est "
 sweep_opt "eval tracks" --iou "nan inf 1e300 -1 2 abc" eval tracks --gt "$F/TRACKS.csv" --est "$F/TRACKS.csv"
 # (a negative offset is one: an estimate numbered from 1 against truth from 0)
 sweep_opt "eval tracks" --frame-offset "nan 1e300 99999999999999999999 abc" eval tracks --gt "$F/TRACKS.csv" --est "$F/TRACKS.csv"
-sweep_file "eval detect --video" avi "$VIDEO_BAD" eval detect --video @ --no-progress
-sweep_file "eval detect --camera" yaml "$CAM_BAD" eval detect --video "$F/frames" --camera @ --no-progress
+sweep_file "eval detect --video" avi "$VIDEO_BAD" eval detect --video @ --labels "$F/labels.csv" --no-progress
+sweep_file "eval detect --camera" yaml "$CAM_BAD" eval detect --video "$F/frames" --labels "$F/labels" --camera @ --no-progress
 sweep_file "eval detect --labels" csv "empty binary missing" eval detect --video "$F/frames" --labels @ --no-progress
-sweep_out "eval detect" "$FRAME" eval detect --video "$F/frames" --out @ --no-progress
-for o in --min-radius --max-radius --grow; do sweep_opt "eval detect" $o "nan inf 1e300 -1 abc" eval detect --video "$F/frames" --no-progress; done
-sweep_opt "eval detect" --class "$INTS" eval detect --video "$F/frames" --no-progress
+sweep_out "eval detect" "$FRAME" eval detect --video "$F/frames" --labels "$F/labels" --out @ --no-progress
+for o in --min-radius --max-radius --grow; do sweep_opt "eval detect" $o "nan inf 1e300 -1 abc" eval detect --video "$F/frames" --labels "$F/labels" --no-progress; done
+sweep_opt "eval detect" --class "$INTS" eval detect --video "$F/frames" --labels "$F/labels" --no-progress
 sweep_file "eval import-pets --xml" xml "empty binary pets_nan pets_huge folder missing" eval import-pets --xml @ --out "$OUTCSV"
 sweep_out "eval import-pets" "$F/pets.xml" eval import-pets --xml "$F/pets.xml" --out @
 # field
