@@ -37,7 +37,7 @@ double CpuSeconds() {
 
 struct BenchFrame {
   cv::Mat bgr;
-  fv::Camera camera;
+  fv::camera::Camera camera;
   bool synthetic = false;
 };
 
@@ -54,10 +54,10 @@ const BenchFrame& TestFrame() {
     f.camera = scene.cameras()[0];
     f.synthetic = true;
 #else
-    fv::Rng rng(1);
-    f.bgr = fv::detect_testing::FieldImage(1280, 960, rng);
-    fv::detect_testing::PaintDisc(f.bgr, Eigen::Vector2d(700.3, 500.6), 9.0);
-    f.camera = fv::Camera::FromFov(1280, 960, 75.0);
+    fv::util::Rng rng(1);
+    f.bgr = fv::detect::test_util::FieldImage(1280, 960, rng);
+    fv::detect::test_util::PaintDisc(f.bgr, Eigen::Vector2d(700.3, 500.6), 9.0);
+    f.camera = fv::camera::Camera::FromFov(1280, 960, 75.0);
 #endif
     return f;
   }();
@@ -68,7 +68,7 @@ const BenchFrame& TestFrame() {
 int OpenCvJob(const cv::Mat& bgr, cv::Mat& hsv, cv::Mat& mask, cv::Mat& labels, cv::Mat& stats,
               cv::Mat& centroids) {
   cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
-  const fv::ColourRange r = fv::ColourPreset("orange").ranges[0];
+  const fv::detect::ColourRange r = fv::detect::ColourPreset("orange").ranges[0];
   const auto h = [](double deg) { return deg * 256.0 / 360.0; };
   cv::inRange(hsv, cv::Scalar(h(r.min[0]), r.min[1], r.min[2]),
               cv::Scalar(h(r.max[0]), r.max[1], r.max[2]), mask);
@@ -119,14 +119,14 @@ void BM_LutScanBlobs(benchmark::State& state) {
   const BenchFrame& f = TestFrame();
   BaselineSeconds();
   const int bits = static_cast<int>(state.range(1));
-  const auto table = fv::ColourTable::Shared(fv::PresetColourSpec("orange"), bits);
-  fv::ScanOptions o;
+  const auto table = fv::detect::ColourTable::Shared(fv::detect::PresetColourSpec("orange"), bits);
+  fv::detect::ScanOptions o;
   o.step_px = static_cast<int>(state.range(0));
   size_t blobs = 0;
   double total = 0;
   for (auto _ : state) {
     const double t0 = CpuSeconds();
-    const fv::BlobScanResult r = fv::ScanBlobs(f.bgr, *table, table->BallBit(), o);
+    const fv::detect::BlobScanResult r = fv::detect::ScanBlobs(f.bgr, *table, table->BallBit(), o);
     total += CpuSeconds() - t0;
     blobs = r.blobs.size();
     benchmark::DoNotOptimize(blobs);
@@ -149,10 +149,10 @@ BENCHMARK(BM_LutScanBlobs)
 void BM_BallDetector(benchmark::State& state) {
   const BenchFrame& f = TestFrame();
   BaselineSeconds();
-  fv::BallDetectorOptions o;
+  fv::detect::BallDetectorOptions o;
   o.scan_step_px = static_cast<int>(state.range(0));
   o.use_region = state.range(1) != 0;
-  const fv::BallDetector det(o, &f.camera, nullptr);
+  const fv::detect::BallDetector det(o, &f.camera, nullptr);
   int accepted = 0;
   double total = 0;
   for (auto _ : state) {
@@ -175,7 +175,7 @@ BENCHMARK(BM_BallDetector)
 double ColourSeconds() {
   static const double seconds = [] {
     const BenchFrame& f = TestFrame();
-    const fv::BallDetector det(fv::BallDetectorOptions(), &f.camera, nullptr);
+    const fv::detect::BallDetector det(fv::detect::BallDetectorOptions(), &f.camera, nullptr);
     std::vector<double> t;
     for (int i = 0; i < 9; ++i) {
       const double t0 = CpuSeconds();
@@ -193,12 +193,13 @@ double ColourSeconds() {
 void BM_DnnBallDetector(benchmark::State& state) {
   const BenchFrame& f = TestFrame();
   BaselineSeconds();
-  fv::DnnBallOptions o;
+  fv::detect::DnnBallOptions o;
   o.detector = state.range(0) == 1 ? "dnn" : "both";
   o.whole_frame = state.range(1) != 0;
-  std::unique_ptr<fv::AnyBallDetector> det;
+  std::unique_ptr<fv::detect::AnyBallDetector> det;
   try {
-    det = std::make_unique<fv::AnyBallDetector>(fv::BallDetectorOptions(), o, &f.camera, nullptr);
+    det = std::make_unique<fv::detect::AnyBallDetector>(fv::detect::BallDetectorOptions(), o,
+                                                        &f.camera, nullptr);
   } catch (const fv::Error& e) {
     state.SkipWithError(e.what());  // the model is made by `make build`
     return;

@@ -32,8 +32,8 @@ double CpuSeconds() {
 }
 
 struct Clip {
-  fv::Camera camera;
-  std::vector<fv::SourceFrame> frames;  // JPEG, in order
+  fv::camera::Camera camera;
+  std::vector<fv::io::SourceFrame> frames;  // JPEG, in order
 };
 
 // Frames 10..69 of the kick scene (rest, the kick at 0.25 s, the flight), camera 1, 1280x960.
@@ -46,7 +46,7 @@ const Clip& KickClip() {
     Clip c;
     c.camera = scene.cameras()[0];
     for (int f = 10; f < 70; ++f) {
-      fv::SourceFrame s;
+      fv::io::SourceFrame s;
       cv::imencode(".jpg", scene.RenderCamera(0, f), s.jpeg,
                    {cv::IMWRITE_JPEG_QUALITY, spec.jpeg_quality});
       s.frame = f;
@@ -61,7 +61,7 @@ const Clip& KickClip() {
 double BaselineSeconds() {  // whole decode of one frame, median of 3 passes
   static const double seconds = [] {
     const Clip& c = KickClip();
-    fv::JpegRegionDecoder decoder;
+    fv::io::JpegRegionDecoder decoder;
     cv::Mat bgr;
     std::vector<double> t;
     for (int pass = 0; pass < 3; ++pass) {
@@ -86,7 +86,7 @@ void SetCounters(benchmark::State& state, double total_s) {
 
 void BM_DecodeWhole(benchmark::State& state) {
   const Clip& c = KickClip();
-  fv::JpegRegionDecoder decoder;
+  fv::io::JpegRegionDecoder decoder;
   cv::Mat bgr;
   size_t i = 0;
   double total = 0;
@@ -103,11 +103,11 @@ BENCHMARK(BM_DecodeWhole)->Unit(benchmark::kMillisecond);
 // state.range(0): 1 tracking window (the node's default), 0 every frame whole.
 void BM_NodeFrame(benchmark::State& state) {
   const Clip& c = KickClip();
-  fv::BallDetectorOptions dopt;
-  auto detector = std::make_shared<fv::BallDetector>(dopt, &c.camera, nullptr);
-  fv::BallTrackOptions track;
+  fv::detect::BallDetectorOptions dopt;
+  auto detector = std::make_shared<fv::detect::BallDetector>(dopt, &c.camera, nullptr);
+  fv::pipeline::BallTrackOptions track;
   track.enabled = state.range(0) != 0;
-  std::unique_ptr<fv::CameraStage> stage;
+  std::unique_ptr<fv::pipeline::CameraStage> stage;
   fv::net::FrameMessage m;
   m.camera = "cam1";
   m.session = "bench";
@@ -118,12 +118,12 @@ void BM_NodeFrame(benchmark::State& state) {
   for (auto _ : state) {
     if (i % c.frames.size() == 0) {  // each pass through the clip starts a fresh stage
       if (stage) full += stage->stats().full_scans, window += stage->stats().window_scans;
-      stage = std::make_unique<fv::CameraStage>(0, c.camera, fv::BallDetectFnFor(detector), track,
-                                                "bench");
+      stage = std::make_unique<fv::pipeline::CameraStage>(
+          0, c.camera, fv::pipeline::BallDetectFnFor(detector), track, "bench");
     }
     const auto& f = c.frames[i++ % c.frames.size()];
     const double t0 = CpuSeconds();
-    fv::CameraMessage cm = stage->Process(f);
+    fv::pipeline::CameraMessage cm = stage->Process(f);
     m.frame = cm.frame;
     m.time_s = cm.time_s;
     m.candidates = std::move(cm.candidates);

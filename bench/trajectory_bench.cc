@@ -16,8 +16,8 @@ namespace {
 
 const std::string kGt = std::string(FV_SHARED_DATA_DIR) + "/tt3d-trajectories/3D_gt";
 
-fv::TrajectoryOptions TableTennis() {
-  fv::TrajectoryOptions o;
+fv::recon::TrajectoryOptions TableTennis() {
+  fv::recon::TrajectoryOptions o;
   o.ball_radius_m = 0.02;
   o.ball_mass_kg = 0.0027;
   o.unmodelled_accel_mps2 = 25.0;
@@ -25,13 +25,13 @@ fv::TrajectoryOptions TableTennis() {
 }
 
 // The samples of 001.csv before its bounce.
-const std::vector<fv::BallSample>& Flight() {
+const std::vector<fv::recon::BallSample>& Flight() {
   static const auto samples = [] {
-    std::vector<fv::BallSample> s;
+    std::vector<fv::recon::BallSample> s;
     const std::string p = kGt + "/001.csv";
     if (!std::filesystem::exists(p)) return s;
-    const auto track = fv::ReadBallTrack(p).samples;
-    const auto r = fv::AnalyzeTrajectory(track, TableTennis());
+    const auto track = fv::recon::ReadBallTrack(p).samples;
+    const auto r = fv::recon::AnalyzeTrajectory(track, TableTennis());
     if (r.flights.empty()) return s;
     for (int k : r.flights[0].samples) {
       if (!r.outlier[k]) s.push_back(track[k]);
@@ -41,24 +41,24 @@ const std::vector<fv::BallSample>& Flight() {
   return samples;
 }
 
-void Fit(benchmark::State& state, fv::FlightModel kind) {
+void Fit(benchmark::State& state, fv::recon::FlightModel kind) {
   const auto& s = Flight();
   if (s.empty()) {
     state.SkipWithError("no ../shared/data/tt3d-trajectories");
     return;
   }
-  const double rmse_mm = fv::FitBallistic(s, kind, TableTennis(), 0.002).rmse_m * 1e3;
+  const double rmse_mm = fv::recon::FitBallistic(s, kind, TableTennis(), 0.002).rmse_m * 1e3;
   for (auto _ : state) {
-    fv::BallisticFit f = fv::FitBallistic(s, kind, TableTennis(), 0.002);
+    fv::recon::BallisticFit f = fv::recon::FitBallistic(s, kind, TableTennis(), 0.002);
     benchmark::DoNotOptimize(f.rmse_m);
   }
   state.counters["samples"] = static_cast<double>(s.size());
   state.counters["rmse_mm"] = rmse_mm;
 }
 
-void BM_FitGravity(benchmark::State& state) { Fit(state, fv::FlightModel::kGravity); }
-void BM_FitDrag(benchmark::State& state) { Fit(state, fv::FlightModel::kDrag); }
-void BM_FitSpin(benchmark::State& state) { Fit(state, fv::FlightModel::kSpin); }
+void BM_FitGravity(benchmark::State& state) { Fit(state, fv::recon::FlightModel::kGravity); }
+void BM_FitDrag(benchmark::State& state) { Fit(state, fv::recon::FlightModel::kDrag); }
+void BM_FitSpin(benchmark::State& state) { Fit(state, fv::recon::FlightModel::kSpin); }
 BENCHMARK(BM_FitGravity)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitDrag)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitSpin)->Unit(benchmark::kMillisecond);
@@ -72,11 +72,12 @@ int main(int argc, char** argv) {
       if (e.path().extension() == ".csv") files.push_back(e.path().string());
     }
     std::sort(files.begin(), files.end());
-    std::vector<fv::BounceTrackScore> scores;
+    std::vector<fv::recon::BounceTrackScore> scores;
     for (const auto& p : files) {
-      scores.push_back(fv::ScoreBounceTrack(p, fv::ReadBallTrack(p).samples, TableTennis()));
+      scores.push_back(
+          fv::recon::ScoreBounceTrack(p, fv::recon::ReadBallTrack(p).samples, TableTennis()));
     }
-    std::cout << fv::Summarize(scores).Table() << "\n";
+    std::cout << fv::recon::Summarize(scores).Table() << "\n";
   }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();

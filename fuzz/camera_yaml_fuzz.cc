@@ -10,7 +10,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path =
       fv::fuzz::WriteInput({reinterpret_cast<const char*>(data), size}, "camera.yaml");
   fv::fuzz::ExpectErrorOrValue([&] {
-    const fv::Camera camera = fv::ReadCameraYaml(path);
+    const fv::camera::Camera camera = fv::camera::ReadCameraYaml(path);
     try {
       camera.Check("fuzz");
     } catch (const fv::Error& e) {
@@ -19,8 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     (void)camera.RayFromPixel({camera.cx, camera.cy});
     const std::string again = (fv::fuzz::ScratchDir() / "again.yaml").string();
-    fv::WriteCameraYaml(camera, again);
-    const fv::Camera back = fv::ReadCameraYaml(again);
+    fv::camera::WriteCameraYaml(camera, again);
+    const fv::camera::Camera back = fv::camera::ReadCameraYaml(again);
     if (back.width != camera.width || back.height != camera.height || back.fx != camera.fx ||
         back.distortion.size() != camera.distortion.size()) {
       std::fprintf(stderr, "fuzz: camera file does not read back the same\n");

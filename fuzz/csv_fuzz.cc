@@ -14,12 +14,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fv::fuzz::ExpectErrorOrValue([&] {
     switch (data[0] % 5) {
       case 0: {
-        const auto table = fv::CsvTable::Parse(std::string(text), "BALL.csv");
-        (void)fv::ParseBallTrack(table);
+        const auto table = fv::util::CsvTable::Parse(std::string(text), "BALL.csv");
+        (void)fv::recon::ParseBallTrack(table);
         break;
       }
       case 1:
-        (void)fv::ReadBallTrack(fv::fuzz::WriteInput(text, "BALL.csv"));
+        (void)fv::recon::ReadBallTrack(fv::fuzz::WriteInput(text, "BALL.csv"));
         break;
       case 2:
         (void)fv::track::ReadTracksCsv(fv::fuzz::WriteInput(text, "TRACKS.csv"));

@@ -10,10 +10,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path =
       fv::fuzz::WriteInput({reinterpret_cast<const char*>(data), size}, "field.json");
   fv::fuzz::ExpectErrorOrValue([&] {
-    const fv::FieldModel field = fv::ReadFieldJson(path);
+    const fv::field::FieldModel field = fv::field::ReadFieldJson(path);
     field.Check();
-    const nlohmann::json once = fv::FieldToJson(field);
-    const nlohmann::json twice = fv::FieldToJson(fv::FieldFromJson(once, "again"));
+    const nlohmann::json once = fv::field::FieldToJson(field);
+    const nlohmann::json twice = fv::field::FieldToJson(fv::field::FieldFromJson(once, "again"));
     if (once != twice) {
       std::fprintf(stderr, "fuzz: field JSON does not read back the same\n");
       std::abort();

@@ -17,10 +17,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   });
   fv::fuzz::ExpectErrorOrValue([&] {
-    const auto message =
-        fv::CameraMessage::FromJsonLine({reinterpret_cast<const char*>(data), size}, "fuzz");
+    const auto message = fv::pipeline::CameraMessage::FromJsonLine(
+        {reinterpret_cast<const char*>(data), size}, "fuzz");
     const std::string once = message.ToJsonLine();
-    if (fv::CameraMessage::FromJsonLine(once, "again").ToJsonLine() != once) {
+    if (fv::pipeline::CameraMessage::FromJsonLine(once, "again").ToJsonLine() != once) {
       std::fprintf(stderr, "fuzz: camera message does not round-trip: %s\n", once.c_str());
       std::abort();
     }

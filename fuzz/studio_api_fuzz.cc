@@ -18,7 +18,8 @@ fs::path MakeWorkspace() {
   std::error_code ec;
   fs::remove_all(ws, ec);
   fs::create_directories(ws / "out");
-  fv::WriteCameraYaml(fv::Camera::FromFov(640, 480, 60), (ws / "cam.yaml").string());
+  fv::camera::WriteCameraYaml(fv::camera::Camera::FromFov(640, 480, 60),
+                              (ws / "cam.yaml").string());
   fv::fuzz::WriteInput("time_s,frame,x_m,y_m,z_m,cameras,err_px\n0,0,1,2,0.11,2,0.5\n",
                        "ws/BALL.csv");
   fv::fuzz::WriteInput("[{\"name\": \"box\", \"polygon\": [[0, 0], [1, 0], [1, 1]]}]",

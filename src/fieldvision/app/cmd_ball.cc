@@ -13,13 +13,13 @@ namespace fv::app {
 namespace {
 
 struct BallCliOptions {
-  BallJobOptions job;
+  pipeline::BallJobOptions job;
   bool rows = false;
-  DetectionsJobOptions det;  // with --detections instead of --video
+  pipeline::DetectionsJobOptions det;  // with --detections instead of --video
 };
 
 void RunDetections(BallCliOptions& o) {
-  DetectionsJobOptions& d = o.det;
+  pipeline::DetectionsJobOptions& d = o.det;
   d.cameras = o.job.cameras;
   d.ball_diameter_m = o.job.ball_diameter_m;
   d.out = o.job.out;
@@ -27,7 +27,7 @@ void RunDetections(BallCliOptions& o) {
   d.tolerance_s = o.job.pipeline.sync.tolerance_s;
   d.triangulation = o.job.pipeline.triangulation;
   d.eval = o.job.eval;
-  const DetectionsJobResult r = RunDetectionsJob(d);
+  const pipeline::DetectionsJobResult r = pipeline::RunDetectionsJob(d);
   std::cout << r.Summary() << "\n";
   std::cout << "wrote " << d.out << " (" << r.positions << " rows)"
             << (d.flights.empty() ? "" : ", " + d.flights) << "\n";
@@ -35,7 +35,7 @@ void RunDetections(BallCliOptions& o) {
 }
 
 void RunBall(const BallCliOptions& o) {
-  const BallJobResult r = RunBallJob(o.job);
+  const pipeline::BallJobResult r = pipeline::RunBallJob(o.job);
   std::cout << r.summary.ToString() << "\n";
   std::cout << "wrote " << o.job.out << " (" << r.rows_written << " rows)\n";
   if (r.eval) std::cout << r.eval->Table(o.rows || r.eval->rows.size() <= 40) << "\n";
@@ -101,12 +101,13 @@ void Setup(CLI::App& app, int& exit_code) {
     FV_REQUIRE(!o->det.detections.empty() ||
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");
-    const auto inputs = PathList(o->job.cameras, o->job.videos, o->job.timestamps, o->job.truth,
-                                 o->job.field, o->job.colour, o->det.detections);
-    CheckOutputPath(o->job.out, inputs);
-    CheckOutputPath(o->det.flights, PathList(inputs, o->job.out), "--flights");
-    o->job.out = ResolveOutputPath(o->job.out);  // refuses a device or a folder
-    if (!o->det.flights.empty()) o->det.flights = ResolveOutputPath(o->det.flights, "--flights");
+    const auto inputs = io::PathList(o->job.cameras, o->job.videos, o->job.timestamps, o->job.truth,
+                                     o->job.field, o->job.colour, o->det.detections);
+    io::CheckOutputPath(o->job.out, inputs);
+    io::CheckOutputPath(o->det.flights, io::PathList(inputs, o->job.out), "--flights");
+    o->job.out = io::ResolveOutputPath(o->job.out);  // refuses a device or a folder
+    if (!o->det.flights.empty())
+      o->det.flights = io::ResolveOutputPath(o->det.flights, "--flights");
     if (!o->det.detections.empty()) {
       FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
       RunDetections(*o);

@@ -79,7 +79,7 @@ void Warn(const std::string& message) { std::cerr << "warning: " << message << "
 
 // A rig folder (`calibrate multi --out DIR`): every camera file in it, by file name; each camera
 // named by its `name` or the file's stem.
-std::vector<Camera> ReadRigFolder(const std::string& dir) {
+std::vector<camera::Camera> ReadRigFolder(const std::string& dir) {
   namespace fs = std::filesystem;
   FV_REQUIRE(fs::is_directory(dir), "rig '{}' is not a folder (give the folder of calibrate multi)",
              dir);
@@ -90,9 +90,9 @@ std::vector<Camera> ReadRigFolder(const std::string& dir) {
       files.push_back(e.path().string());
   }
   std::sort(files.begin(), files.end());
-  std::vector<Camera> rig;
+  std::vector<camera::Camera> rig;
   for (const auto& f : files) {
-    Camera c = ReadCameraYaml(f);
+    camera::Camera c = camera::ReadCameraYaml(f);
     if (c.name.empty()) c.name = fs::path(f).stem().string();
     FV_REQUIRE(c.has_pose, "rig '{}': camera file '{}' has no pose (rvec/tvec)", dir, f);
     rig.push_back(c);
@@ -102,7 +102,7 @@ std::vector<Camera> ReadRigFolder(const std::string& dir) {
 }
 
 // The rig camera named by `which`: a camera name or the path/stem of one of its files.
-int FindRigCamera(const std::vector<Camera>& rig, const std::string& which,
+int FindRigCamera(const std::vector<camera::Camera>& rig, const std::string& which,
                   const std::string& dir) {
   const std::string stem = std::filesystem::path(which).stem().string();
   for (size_t i = 0; i < rig.size(); ++i) {
@@ -115,7 +115,7 @@ int FindRigCamera(const std::vector<Camera>& rig, const std::string& which,
 
 // Frames of a rig's cameras from --image NAME=FRAME (or FRAME for the --camera NAME); empty for
 // cameras without a frame; names[i] the file of camera i's frame.
-std::vector<cv::Mat> ReadRigFrames(const std::vector<Camera>& rig,
+std::vector<cv::Mat> ReadRigFrames(const std::vector<camera::Camera>& rig,
                                    const std::vector<std::string>& images,
                                    const std::string& camera, const std::string& dir,
                                    std::vector<std::string>* names) {
@@ -146,9 +146,9 @@ std::vector<cv::Mat> ReadRigFrames(const std::vector<Camera>& rig,
 }
 
 // Prints a rig refinement's report and notes it in the camera files.
-std::vector<Camera> ReportRigRefinement(const RigRefineResult& r,
-                                        const std::vector<cv::Mat>& frames,
-                                        const std::vector<std::string>& names) {
+std::vector<camera::Camera> ReportRigRefinement(const RigRefineResult& r,
+                                                const std::vector<cv::Mat>& frames,
+                                                const std::vector<std::string>& names) {
   std::cout << r.Summary() << "\n";
   for (size_t i = 0; i < frames.size(); ++i) {
     if (frames[i].empty()) continue;
@@ -158,7 +158,7 @@ std::vector<Camera> ReportRigRefinement(const RigRefineResult& r,
         r.before[i].p95_mm);
   }
   if (!r.accepted) Warn("rig not refined: " + r.status + "; the camera files keep the input poses");
-  std::vector<Camera> out = r.cameras;
+  std::vector<camera::Camera> out = r.cameras;
   if (!r.accepted) return out;
   const auto num_frames =
       std::count_if(frames.begin(), frames.end(), [](const cv::Mat& m) { return !m.empty(); });
@@ -172,11 +172,11 @@ std::vector<Camera> ReportRigRefinement(const RigRefineResult& r,
   return out;
 }
 
-void WriteRig(const std::vector<Camera>& cams, const std::string& dir) {
+void WriteRig(const std::vector<camera::Camera>& cams, const std::string& dir) {
   std::filesystem::create_directories(dir);
   for (const auto& c : cams) {
     const std::string path = (std::filesystem::path(dir) / (c.name + ".yaml")).string();
-    WriteCameraYaml(c, path);
+    camera::WriteCameraYaml(c, path);
     std::cout << "wrote " << path << "\n";
   }
 }
@@ -205,7 +205,7 @@ void RunIntrinsics(IntrinsicsCli& c) {
   std::cout << "coverage: " << r.coverage.Describe() << "\n";
   std::cout << r.Summary() << "\n";
   for (const auto& w : r.warnings) Warn(w);
-  WriteCameraYaml(r.camera, c.out);
+  camera::WriteCameraYaml(r.camera, c.out);
   std::cout << fmt::format("RMS reprojection error: {:.3f} px\nwrote {}\n", r.rms_px, c.out);
 }
 
@@ -229,8 +229,8 @@ void PrintPointTable(const std::vector<PointResidual>& pts) {
   }
 }
 
-void PlaceRigOnField(const ExtrinsicsCli& c, const FieldModel* field) {
-  const std::vector<Camera> rig = ReadRigFolder(c.rig);
+void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
+  const std::vector<camera::Camera> rig = ReadRigFolder(c.rig);
   std::vector<std::vector<PointCorrespondence>> pts(rig.size());
   for (const auto& arg : c.points) {
     const size_t eq = arg.find('=');
@@ -264,7 +264,7 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const FieldModel* field) {
     Warn(fmt::format("{} points did not fit and were left out (marked 'outlier')",
                      r.num_points - r.num_inliers));
   }
-  std::vector<Camera> out = r.cameras;
+  std::vector<camera::Camera> out = r.cameras;
   for (size_t i = 0; i < out.size(); ++i) {
     out[i].notes["placed_with_rig"] = c.rig;
     out[i].notes["rig_placement_rms_px"] = fmt::format("{:.3f}", r.rms_px_all);
@@ -280,7 +280,7 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const FieldModel* field) {
   WriteRig(out, c.out);
 }
 
-void RunFocal(const ExtrinsicsCli& c, const FieldModel* field) {
+void RunFocal(const ExtrinsicsCli& c, const field::FieldModel* field) {
   int w = 0, h = 0;
   ParseImageSize(c.image_size, "--image-size", &w, &h);
   const auto pts = ReadPointsCsv(c.points.front(), field);
@@ -307,18 +307,18 @@ void RunFocal(const ExtrinsicsCli& c, const FieldModel* field) {
       r.camera_position_m.y(), r.camera_position_m.z(), r.std_position_m.x(), r.std_position_m.y(),
       r.std_position_m.z());
   for (const auto& w2 : r.warnings) Warn(w2);
-  Camera out = r.camera;
+  camera::Camera out = r.camera;
   out.rms_px = r.rms_px;
   out.notes["extrinsics_points"] = c.points.front();
   out.notes["focal_std_px"] = fmt::format("{:.2f}", r.std_focal_px);
   if (!c.table.empty()) WritePointErrorTable(c.table, r.points);
-  WriteCameraYaml(out, c.out);
+  camera::WriteCameraYaml(out, c.out);
   std::cout << "wrote " << c.out << "\n";
 }
 
 void RunExtrinsics(const ExtrinsicsCli& c) {
-  std::unique_ptr<FieldModel> field;
-  if (!c.field.empty()) field = std::make_unique<FieldModel>(LoadField(c.field));
+  std::unique_ptr<field::FieldModel> field;
+  if (!c.field.empty()) field = std::make_unique<field::FieldModel>(field::LoadField(c.field));
   if (!c.rig.empty()) {
     FV_REQUIRE(c.image_size.empty() && !c.homography_only,
                "--rig places calibrated cameras; it does not go with --image-size or "
@@ -337,7 +337,7 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
     return;
   }
   FV_REQUIRE(!c.homography_only, "--homography-only goes with --image-size, not --camera");
-  const Camera cam = ReadCameraYaml(c.camera);
+  const camera::Camera cam = camera::ReadCameraYaml(c.camera);
   const auto pts = ReadPointsCsv(c.points.front(), field.get());
   const ExtrinsicsResult r = EstimatePose(cam, pts, c.o);
   PrintPointTable(r.points);
@@ -350,12 +350,12 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
     Warn(fmt::format("{} points did not fit and were left out (marked 'outlier')",
                      pts.size() - r.num_inliers));
   }
-  Camera out = r.camera;
+  camera::Camera out = r.camera;
   out.rms_px = r.rms_px;
   out.notes["extrinsics_points"] = c.points.front();
   out.notes["extrinsics_rms_px"] = fmt::format("{:.3f}", r.rms_px);
   if (!c.table.empty()) WritePointErrorTable(c.table, r.points);
-  WriteCameraYaml(out, c.out);
+  camera::WriteCameraYaml(out, c.out);
   std::cout << "wrote " << c.out << "\n";
 }
 
@@ -366,23 +366,23 @@ struct RefineCli {
   RefineOptions o;
 };
 
-void WriteOverlay(const std::string& path, const Camera& cam, const cv::Mat& image,
-                  const FieldModel& field, const RefineOptions& o) {
+void WriteOverlay(const std::string& path, const camera::Camera& cam, const cv::Mat& image,
+                  const field::FieldModel& field, const RefineOptions& o) {
   CheckOptions co;
   co.detect = o.detect;
-  WriteImage(path, CheckCalibration(cam, image, field, {}, co).overlay);
+  io::WriteImage(path, CheckCalibration(cam, image, field, {}, co).overlay);
   std::cout << "wrote " << path << "\n";
 }
 
 // A rig on the field refined with the lines in frames of any of its cameras: one rigid
 // correction for the whole rig (calib/rig_lines.h).
 void RunRefineRig(const RefineCli& c) {
-  const std::vector<Camera> rig = ReadRigFolder(c.rig);
+  const std::vector<camera::Camera> rig = ReadRigFolder(c.rig);
   std::vector<std::string> names;
   const std::vector<cv::Mat> frames = ReadRigFrames(rig, c.images, c.camera, c.rig, &names);
-  const FieldModel field = LoadField(c.field);
+  const field::FieldModel field = field::LoadField(c.field);
   const RigRefineResult r = RefineRigWithLines(rig, frames, field, c.o);
-  const std::vector<Camera> out = ReportRigRefinement(r, frames, names);
+  const std::vector<camera::Camera> out = ReportRigRefinement(r, frames, names);
   WriteRig(out, c.out);
   if (!c.overlay.empty()) {
     // The overlay of the first camera with a frame.
@@ -402,11 +402,11 @@ void RunRefine(const RefineCli& c) {
   FV_REQUIRE(!c.camera.empty(), "give --camera CAM.yaml (or --rig DIR with --image NAME=FRAME)");
   FV_REQUIRE(c.images.size() == 1,
              "give one --image for --camera (several only with --rig DIR, as NAME=FRAME)");
-  const Camera cam = ReadCameraYaml(c.camera);
+  const camera::Camera cam = camera::ReadCameraYaml(c.camera);
   const std::string& image_path = c.images.front();
   const cv::Mat image = ReadImage(image_path);
   CheckImageSize(image, cam, image_path, c.camera);
-  const FieldModel field = LoadField(c.field);
+  const field::FieldModel field = field::LoadField(c.field);
   const RefineResult r = RefineWithLines(cam, image, field, c.o);
   // One report: the library's summary, then the contract's line error.
   std::cout << r.Summary() << "\n";
@@ -415,13 +415,13 @@ void RunRefine(const RefineCli& c) {
       "p95 {:.1f} mm)\n",
       r.after.mean_mm, r.after.p95_mm, r.before.mean_mm, r.before.p95_mm);
   if (!r.accepted) Warn("pose not refined: " + r.status + "; the camera file keeps the input pose");
-  Camera out = r.camera;
+  camera::Camera out = r.camera;
   if (r.accepted) {
     out.notes["refined_with_lines"] = image_path;
     out.notes["line_error_mean_mm"] = fmt::format("{:.1f}", r.after.mean_mm);
     out.notes["line_error_p95_mm"] = fmt::format("{:.1f}", r.after.p95_mm);
   }
-  WriteCameraYaml(out, c.out);
+  camera::WriteCameraYaml(out, c.out);
   std::cout << "wrote " << c.out << "\n";
   if (!c.overlay.empty()) WriteOverlay(c.overlay, out, image, field, c.o);
 }
@@ -433,10 +433,10 @@ struct CheckCli {
 };
 
 void RunCheck(const CheckCli& c) {
-  const Camera cam = ReadCameraYaml(c.camera);
+  const camera::Camera cam = camera::ReadCameraYaml(c.camera);
   const cv::Mat image = ReadImage(c.image);
   CheckImageSize(image, cam, c.image, c.camera);
-  const FieldModel field = LoadField(c.field);
+  const field::FieldModel field = field::LoadField(c.field);
   std::vector<PointCorrespondence> pts;
   if (!c.points.empty()) pts = ReadPointsCsv(c.points, &field);
   const CheckResult r = CheckCalibration(cam, image, field, pts, c.o);
@@ -449,7 +449,7 @@ void RunCheck(const CheckCli& c) {
   std::cout << r.Summary() << "\n";
   std::cout << fmt::format("line error: mean {:.1f} mm, p95 {:.1f} mm\n", r.lines.mean_mm,
                            r.lines.p95_mm);
-  WriteImage(c.out, r.overlay);
+  io::WriteImage(c.out, r.overlay);
   std::cout << "wrote " << c.out << "\n";
   if (!c.table.empty()) {
     FV_REQUIRE(!r.points.empty(), "--table needs --points");
@@ -469,12 +469,12 @@ void RunRig(const RigCli& c) {
   FV_REQUIRE(c.cameras.size() == c.points.size(),
              "{} --camera but {} --points; give one points file per camera", c.cameras.size(),
              c.points.size());
-  std::unique_ptr<FieldModel> field;
-  if (!c.field.empty()) field = std::make_unique<FieldModel>(LoadField(c.field));
-  std::vector<Camera> cams;
+  std::unique_ptr<field::FieldModel> field;
+  if (!c.field.empty()) field = std::make_unique<field::FieldModel>(field::LoadField(c.field));
+  std::vector<camera::Camera> cams;
   std::vector<std::vector<RigObservation>> obs;
   for (size_t i = 0; i < c.cameras.size(); ++i) {
-    cams.push_back(ReadCameraYaml(c.cameras[i]));
+    cams.push_back(camera::ReadCameraYaml(c.cameras[i]));
     if (cams.back().name.empty()) {
       cams.back().name = std::filesystem::path(c.cameras[i]).stem().string();
     }
@@ -507,9 +507,9 @@ void RunRig(const RigCli& c) {
     const std::string path =
         (std::filesystem::path(c.out_dir) / std::filesystem::path(c.cameras[i]).filename())
             .string();
-    Camera out = r.cameras[i];
+    camera::Camera out = r.cameras[i];
     out.notes["rig_rms_px"] = fmt::format("{:.3f}", r.reports[i].rms_after_px);
-    WriteCameraYaml(out, path);
+    camera::WriteCameraYaml(out, path);
     std::cout << "wrote " << path << "\n";
   }
 }
@@ -552,7 +552,7 @@ void SetupIntrinsics(CLI::App* group) {
   in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
   in->add_flag("--quiet", ic->quiet, "No progress");
   in->callback([ic] {
-    CheckOutputPath(ic->out, {ic->images});
+    io::CheckOutputPath(ic->out, {ic->images});
     CheckOutputFile(ic->out);
     RunIntrinsics(*ic);
   });
@@ -593,8 +593,10 @@ void SetupExtrinsics(CLI::App* group) {
       ->capture_default_str();
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
   ex->callback([ec] {
-    CheckOutputPath(ec->out, PathList(ec->points, ec->field, ec->images));  // may be --camera
-    CheckOutputPath(ec->table, PathList(ec->points, ec->field, ec->camera, ec->out), "--table");
+    io::CheckOutputPath(ec->out,
+                        io::PathList(ec->points, ec->field, ec->images));  // may be --camera
+    io::CheckOutputPath(ec->table, io::PathList(ec->points, ec->field, ec->camera, ec->out),
+                        "--table");
     if (ec->rig.empty()) CheckOutputFile(ec->out);
     CheckOutputFile(ec->table, "--table");
     RunExtrinsics(*ec);
@@ -627,10 +629,10 @@ void SetupRefine(CLI::App* group) {
   re->callback([rc] {
     std::vector<std::string> inputs = {rc->field};
     for (const auto& i : rc->images) inputs.push_back(i.substr(i.find('=') + 1));
-    CheckOutputPath(rc->out, inputs);  // --out may be --camera
+    io::CheckOutputPath(rc->out, inputs);  // --out may be --camera
     inputs.push_back(rc->camera);
     inputs.push_back(rc->out);
-    CheckOutputPath(rc->overlay, inputs, "--overlay");
+    io::CheckOutputPath(rc->overlay, inputs, "--overlay");
     if (rc->rig.empty()) CheckOutputFile(rc->out);
     CheckOutputFile(rc->overlay, "--overlay");
     RunRefine(*rc);
@@ -649,8 +651,9 @@ void SetupCheck(CLI::App* group) {
   ch->add_option("--points", cc->points, "Known points (u,v,name or u,v,x,y,z) to tabulate");
   ch->add_option("--table", cc->table, "Write the known points' error table (CSV)");
   ch->callback([cc] {
-    CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
-    CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out}, "--table");
+    io::CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
+    io::CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out},
+                        "--table");
     CheckOutputFile(cc->out);
     CheckOutputFile(cc->table, "--table");
     RunCheck(*cc);

@@ -66,7 +66,7 @@ inline void CheckOutputFolder(const std::string& out, std::string_view what = "-
 inline void CheckOutputFile(const std::string& out, std::string_view what = "--out") {
   if (out.empty()) return;
   CheckOutputFolder(out, what);
-  ResolveOutputPath(out, what);
+  io::ResolveOutputPath(out, what);
 }
 
 }  // namespace fv::app

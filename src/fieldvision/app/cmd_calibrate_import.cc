@@ -48,12 +48,12 @@ double MetresPerUnit(const std::string& units) {
   Throw("--units '{}' is not known; use m, cm or mm", units);
 }
 
-void WriteCameras(const std::vector<Camera>& cams, const std::string& dir) {
+void WriteCameras(const std::vector<camera::Camera>& cams, const std::string& dir) {
   std::filesystem::create_directories(dir);
   for (size_t i = 0; i < cams.size(); ++i) {
     const std::string name = cams[i].name.empty() ? fmt::format("cam{}", i + 1) : cams[i].name;
     const std::string path = (std::filesystem::path(dir) / (name + ".yaml")).string();
-    WriteCameraYaml(cams[i], path);
+    camera::WriteCameraYaml(cams[i], path);
     const Eigen::Vector3d c = cams[i].has_pose ? cams[i].CentreInWorld() : Eigen::Vector3d::Zero();
     std::cout << fmt::format(
         "{}: {}x{}, fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}{}\nwrote {}\n", name, cams[i].width,
@@ -75,11 +75,11 @@ void RunImport(const ImportCli& c) {
     if (name.empty()) name = TsaiCameraName(c.tsai);
     if (name.empty()) name = std::filesystem::path(c.tsai).stem().string();
     const track::TsaiConversion conv = track::CameraFromTsai(p, name);
-    WriteCameraYaml(conv.camera, c.out);
+    camera::WriteCameraYaml(conv.camera, c.out);
     std::cout << conv.Summary() << "\ncamera " << name << "\nwrote " << c.out << "\n";
     return;
   }
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   if (!c.qualisys.empty()) {
     cams = calib::ReadQualisysCalibration(c.qualisys);
   } else if (!c.toml.empty()) {
@@ -122,9 +122,9 @@ void RunExport(const ExportCli& c) {
     std::sort(files.begin(), files.end());
   }
   FV_REQUIRE(!files.empty(), "give --camera CAM.yaml (repeat) or --rig DIR");
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   for (const auto& f : files) {
-    cams.push_back(ReadCameraYaml(f));
+    cams.push_back(camera::ReadCameraYaml(f));
     if (cams.back().name.empty()) cams.back().name = std::filesystem::path(f).stem().string();
   }
   calib::WriteCalibrationToml(cams, c.toml);
@@ -132,7 +132,7 @@ void RunExport(const ExportCli& c) {
 }
 
 // ---- compare
-std::vector<Camera> ReadCameraFolder(const std::string& dir) {
+std::vector<camera::Camera> ReadCameraFolder(const std::string& dir) {
   FV_REQUIRE(std::filesystem::is_directory(dir), "rig '{}' is not a folder", dir);
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(dir)) {
@@ -141,9 +141,9 @@ std::vector<Camera> ReadCameraFolder(const std::string& dir) {
       files.push_back(e.path().string());
   }
   std::sort(files.begin(), files.end());
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   for (const auto& f : files) {
-    cams.push_back(ReadCameraYaml(f));
+    cams.push_back(camera::ReadCameraYaml(f));
     if (cams.back().name.empty()) cams.back().name = std::filesystem::path(f).stem().string();
   }
   FV_REQUIRE(!cams.empty(), "rig '{}' has no camera files (*.yaml)", dir);
@@ -160,7 +160,7 @@ void RunCompare(const CompareCli& c) {
   FV_REQUIRE(c.rigs.size() == 2, "give --rig twice: the two calibrations to compare");
   const auto a_all = ReadCameraFolder(c.rigs[0]);
   const auto b_all = ReadCameraFolder(c.rigs[1]);
-  std::vector<Camera> a, b;
+  std::vector<camera::Camera> a, b;
   for (const auto& ca : a_all) {
     for (const auto& cb : b_all) {
       if (cb.name != ca.name) continue;

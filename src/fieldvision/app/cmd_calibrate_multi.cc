@@ -41,7 +41,7 @@ void RunMulti(MultiCli& c) {
     const auto view = std::find_if(cams.begin(), cams.end(),
                                    [&](const CameraViews& v) { return v.name == kv.name; });
     FV_REQUIRE(view != cams.end(), "--intrinsics '{}': no --views names camera '{}'", k, kv.name);
-    const Camera known = ReadCameraYaml(kv.source);
+    const camera::Camera known = camera::ReadCameraYaml(kv.source);
     // A camera file of another image size is refused before the board search, not after it.
     const ImageSource source(view->source, c.o.source);
     const cv::Mat first = source.Read(0);
@@ -60,7 +60,7 @@ void RunMulti(MultiCli& c) {
                            "chained from");
   for (size_t i = 0; i < r.cameras.size(); ++i) {
     const auto& rep = r.camera_reports[i];
-    const Camera& cam = r.cameras[i];
+    const camera::Camera& cam = r.cameras[i];
     std::cout << fmt::format(
         "{:<12s} {:>6d} {:>6d} {:>6d} {:>9.3f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}  {}\n", rep.name,
         rep.num_images, rep.num_found, rep.num_used, rep.rms_px, cam.fx, cam.fy, cam.cx, cam.cy,
@@ -106,11 +106,11 @@ void RunMulti(MultiCli& c) {
   fs::create_directories(c.out);
   for (size_t i = 0; i < r.cameras.size(); ++i) {
     const std::string path = (fs::path(c.out) / (r.cameras[i].name + ".yaml")).string();
-    WriteCameraYaml(r.cameras[i], path);
+    camera::WriteCameraYaml(r.cameras[i], path);
     std::cout << "wrote " << path << "\n";
     if (!c.no_pictures) {
       const std::string pic = (fs::path(c.out) / (r.cameras[i].name + "_coverage.png")).string();
-      WriteImage(pic, MultiCoveragePicture(r, static_cast<int>(i)));
+      io::WriteImage(pic, MultiCoveragePicture(r, static_cast<int>(i)));
       std::cout << "wrote " << pic << "\n";
     }
   }

@@ -21,7 +21,7 @@ struct ColorLearnArgs {
   std::string out;
   std::string mask_out;
   bool force = false;
-  ColourLearnOptions learn;
+  detect::ColourLearnOptions learn;
 };
 
 // --mask-out, else OUT-mask.png beside --out.
@@ -32,12 +32,12 @@ std::string MaskPath(const ColorLearnArgs& a) {
 }
 
 void Learn(const ColorLearnArgs& a) {
-  ColourLearnOptions o = a.learn;
+  detect::ColourLearnOptions o = a.learn;
   FV_REQUIRE(!a.points.empty() || !a.roi.empty(), "give --points u,v;u,v... or --roi x,y,w,h");
-  if (!a.points.empty()) o.points = ParsePoints(a.points, "--points");
-  if (!a.roi.empty()) o.roi = ParseRect(a.roi, "--roi");
-  if (!a.negatives.empty()) o.negative_points = ParsePoints(a.negatives, "--negative");
-  const cv::Mat frame = ReadVideoFrame(a.video, a.frame);
+  if (!a.points.empty()) o.points = detect::ParsePoints(a.points, "--points");
+  if (!a.roi.empty()) o.roi = detect::ParseRect(a.roi, "--roi");
+  if (!a.negatives.empty()) o.negative_points = detect::ParsePoints(a.negatives, "--negative");
+  const cv::Mat frame = detect::ReadVideoFrame(a.video, a.frame);
   // Pixels outside the frame: name the option they came from.
   const cv::Rect inside(0, 0, frame.cols, frame.rows);
   FV_REQUIRE(!o.roi || (o.roi->area() > 0 && (*o.roi & inside) == *o.roi),
@@ -50,10 +50,10 @@ void Learn(const ColorLearnArgs& a) {
                  frame.rows);
     }
   }
-  const ColourLearnResult r = LearnColour(frame, o);
-  if (!r.bad || a.force) WriteColourSpec(r.spec, a.out);
+  const detect::ColourLearnResult r = detect::LearnColour(frame, o);
+  if (!r.bad || a.force) detect::WriteColourSpec(r.spec, a.out);
   const std::string mask_out = MaskPath(a);
-  WriteImage(mask_out, r.overlay);
+  io::WriteImage(mask_out, r.overlay);
   FV_REQUIRE(!r.bad || a.force,
              "colour class selects {:.1f} % of the background: {} not written (see {}; point at "
              "the ball more tightly, add --negative, or --force to write it anyway)",
@@ -89,11 +89,11 @@ void Setup(CLI::App& app, int& exit_code) {
   learn->add_option("--out", a->out, "Colour file to write (JSON)")->required();
   learn->add_option("--mask-out", a->mask_out, "Image of the selection (default: OUT-mask.png)");
   learn->callback([a] {
-    CheckOutputPath(a->out, {a->video});
-    CheckOutputPath(MaskPath(*a), {a->video, a->out}, "--mask-out");
+    io::CheckOutputPath(a->out, {a->video});
+    io::CheckOutputPath(MaskPath(*a), {a->video, a->out}, "--mask-out");
     // A device, a folder or a missing folder as an output is refused before any work.
-    ResolveOutputPath(a->out);
-    ResolveOutputPath(MaskPath(*a), "--mask-out");
+    io::ResolveOutputPath(a->out);
+    io::ResolveOutputPath(MaskPath(*a), "--mask-out");
     Learn(*a);
   });
   (void)exit_code;

@@ -12,7 +12,7 @@ namespace fv::app {
 namespace {
 
 void Setup(CLI::App& app, int& exit_code) {
-  auto o = std::make_shared<DetectVideoOptions>();
+  auto o = std::make_shared<detect::DetectVideoOptions>();
   CLI::App* cmd =
       app.add_subcommand("detect",
                          "Find ball candidates in each frame of one camera (colour table, blobs, "
@@ -42,11 +42,12 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     // The field mask is the field seen through a posed camera; without one --field did nothing.
-    FV_REQUIRE(o->field.empty() || (!o->camera.empty() && ReadCameraYaml(o->camera).has_pose),
-               "detect: --field needs --camera with a pose (the field is found through it)");
-    CheckOutputPath(o->out, PathList(o->video, o->camera, o->field, o->detector.colour));
-    CheckOutputPath(o->draw, PathList(o->video, o->camera, o->field, o->out), "--draw");
-    const DetectVideoResult r = DetectVideo(*o);
+    FV_REQUIRE(
+        o->field.empty() || (!o->camera.empty() && camera::ReadCameraYaml(o->camera).has_pose),
+        "detect: --field needs --camera with a pose (the field is found through it)");
+    io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
+    io::CheckOutputPath(o->draw, io::PathList(o->video, o->camera, o->field, o->out), "--draw");
+    const detect::DetectVideoResult r = detect::DetectVideo(*o);
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
   });
   (void)exit_code;

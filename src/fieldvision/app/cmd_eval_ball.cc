@@ -15,7 +15,7 @@ struct EvalBallCliOptions {
   std::string truth;
   std::string est;
   bool rows = false;
-  BallEvalOptions eval;
+  recon::BallEvalOptions eval;
 };
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -33,12 +33,12 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(1e-6, 1e4))
       ->capture_default_str();
   cmd->callback([o] {
-    const CsvTable truth = CsvTable::Read(o->truth), est = CsvTable::Read(o->est);
-    for (const CsvTable* t : {&truth, &est}) {
+    const util::CsvTable truth = util::CsvTable::Read(o->truth), est = util::CsvTable::Read(o->est);
+    for (const util::CsvTable* t : {&truth, &est}) {
       t->Require({"frame", "x_m", "y_m", "z_m"});
-      CheckBallTrackRanges(*t);
+      recon::CheckBallTrackRanges(*t);
     }
-    const BallEvalResult r = EvaluateBall(truth, est, o->eval);
+    const recon::BallEvalResult r = recon::EvaluateBall(truth, est, o->eval);
     // Nothing matched: no error to report (a mean of 0 mm would read as perfect).
     FV_REQUIRE(!r.rows.empty(),
                "eval ball: no frame of '{}' ({} rows) is a frame of '{}' ({} rows): nothing to "

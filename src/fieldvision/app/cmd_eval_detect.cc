@@ -12,7 +12,7 @@ namespace {
 
 void Setup(CLI::App& app, int& exit_code) {
   CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
-  auto o = std::make_shared<DetectEvalOptions>();
+  auto o = std::make_shared<detect::DetectEvalOptions>();
   CLI::App* cmd = group->add_subcommand(
       "detect",
       "Recall, precision and centre error of the ball detector on labelled frames (best accepted "
@@ -38,7 +38,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "CSV with every candidate and its measurements (for diagnosis)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
-    const DetectEvalResult r = EvaluateDetector(*o);
+    const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
     std::cout << r.Summary(o->list_misses) << "\n";
   });
   (void)exit_code;

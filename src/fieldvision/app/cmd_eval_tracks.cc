@@ -20,7 +20,7 @@ struct EvalTracksCli {
 };
 
 std::vector<track::TrackRow> ReadGt(const std::string& path) {
-  if (EndsWith(ToLower(path), ".xml")) return track::ReadPetsCvml(path);
+  if (util::EndsWith(util::ToLower(path), ".xml")) return track::ReadPetsCvml(path);
   return track::ReadTracksCsv(path);
 }
 
@@ -36,14 +36,14 @@ void RunEvalTracks(const EvalTracksCli& c) {
     } catch (const Error& e) {
       // EvaluateMot names its inputs "ground truth" and "estimate": add the file.
       const std::string what = e.what();
-      if (StartsWith(what, "ground truth:")) Throw("{}: {}", c.gt, what);
-      if (StartsWith(what, "estimate:")) Throw("{}: {}", c.est, what);
+      if (util::StartsWith(what, "ground truth:")) Throw("{}: {}", c.gt, what);
+      if (util::StartsWith(what, "estimate:")) Throw("{}: {}", c.est, what);
       throw;
     }
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
   if (!c.json.empty()) {
-    AtomicWrite(
+    io::AtomicWrite(
         c.json,
         [&](const std::string& tmp) {
           std::ofstream out(tmp);
@@ -84,8 +84,8 @@ void Setup(CLI::App& app, int& exit_code) {
                 "(default: left out)");
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
   cmd->callback([c] {
-    CheckOutputPath(c->json, {c->gt, c->est}, "--json");
-    if (!c->json.empty()) ResolveOutputPath(c->json, "--json");
+    io::CheckOutputPath(c->json, {c->gt, c->est}, "--json");
+    if (!c->json.empty()) io::ResolveOutputPath(c->json, "--json");
     RunEvalTracks(*c);
   });
 
@@ -96,8 +96,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   imp->add_option("--out", p->out, "MOT CSV (TRACKS.csv layout)")->required();
   imp->callback([p] {
-    CheckOutputPath(p->out, {p->xml});
-    ResolveOutputPath(p->out);  // not a device, a folder or in a missing folder
+    io::CheckOutputPath(p->out, {p->xml});
+    io::ResolveOutputPath(p->out);  // not a device, a folder or in a missing folder
     const auto rows = track::ReadPetsCvml(p->xml);
     track::WriteTracksCsv(rows, p->out);
     std::cout << "wrote " << rows.size() << " boxes to " << p->out << "\n";

@@ -28,9 +28,9 @@ struct FieldDrawOptions2 {
 };
 
 void ShowField(const FieldShowOptions& o) {
-  const FieldModel f = LoadField(o.field);
+  const field::FieldModel f = field::LoadField(o.field);
   if (o.json) {
-    std::cout << FieldToJson(f).dump(2) << "\n";
+    std::cout << field::FieldToJson(f).dump(2) << "\n";
     return;
   }
   std::cout << fmt::format("{}: {}\n", f.name, f.description);
@@ -49,13 +49,13 @@ void ShowField(const FieldShowOptions& o) {
 }
 
 void DrawFieldCommand(const FieldDrawOptions2& o) {
-  const FieldModel f = LoadField(o.field);
-  const TopView view = TopView::ForField(f, o.width_px);
-  FieldDrawOptions d;
+  const field::FieldModel f = field::LoadField(o.field);
+  const field::TopView view = field::TopView::ForField(f, o.width_px);
+  field::FieldDrawOptions d;
   d.keypoints = true;
   d.keypoint_names = o.names;
-  const cv::Mat img = DrawField(f, view, d);
-  WriteImage(o.out, img);
+  const cv::Mat img = field::DrawField(f, view, d);
+  io::WriteImage(o.out, img);
   std::cout << "wrote " << o.out << " (" << img.cols << "x" << img.rows << ")\n";
 }
 

@@ -11,7 +11,7 @@
 namespace fv::app {
 namespace {
 
-JobControl* g_fuse_control = nullptr;
+pipeline::JobControl* g_fuse_control = nullptr;
 
 void Setup(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<net::FuseOptions>();
@@ -58,8 +58,8 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Do not analyse flights (published on topic `flight` as each one closes)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
-    CheckOutputPath(o->out, o->cameras);
-    JobControl control;
+    io::CheckOutputPath(o->out, o->cameras);
+    pipeline::JobControl control;
     g_fuse_control = &control;
     auto on_signal = [](int) {
       if (g_fuse_control != nullptr) g_fuse_control->Stop();

@@ -11,7 +11,7 @@
 namespace fv::app {
 namespace {
 
-JobControl* g_node_control = nullptr;
+pipeline::JobControl* g_node_control = nullptr;
 
 void Setup(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<net::NodeOptions>();
@@ -60,7 +60,7 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Send frames without looking for the ball (a latency baseline)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
-    JobControl control;
+    pipeline::JobControl control;
     g_node_control = &control;
     auto on_signal = [](int) {
       if (g_node_control != nullptr) g_node_control->Stop();

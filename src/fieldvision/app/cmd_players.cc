@@ -24,10 +24,10 @@ struct PlayersCli {
 };
 
 void RunPlayersCommand(const PlayersCli& c) {
-  std::optional<Camera> camera;
-  if (!c.camera.empty()) camera = ReadCameraYaml(c.camera);
-  std::optional<FieldModel> field;
-  if (!c.field.empty()) field = LoadField(c.field);
+  std::optional<camera::Camera> camera;
+  if (!c.camera.empty()) camera = camera::ReadCameraYaml(c.camera);
+  std::optional<field::FieldModel> field;
+  if (!c.field.empty()) field = field::LoadField(c.field);
   FV_REQUIRE(!field || (camera && camera->has_pose),
              "--field needs --camera with a pose (the field area is found through it)");
   track::PlayersOptions o = c.o;
@@ -41,10 +41,10 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (!c.mot_out.empty()) track::WriteMotChallenge(r.rows, c.mot_out);
   if (!r.team_of.empty()) {
     const std::string teams = c.out + ".teams.csv";
-    AtomicWrite(
+    io::AtomicWrite(
         teams,
         [&](const std::string& tmp) {
-          CsvWriter w(tmp, {"id", "team"});
+          util::CsvWriter w(tmp, {"id", "team"});
           for (const auto& [id, team] : r.team_of) {
             w << id << team;
             w.EndRow();
@@ -169,19 +169,19 @@ void Setup(CLI::App& app, int& exit_code) {
                "players: --detections '{}' is empty (a det.txt has a row per detection: "
                "frame,-1,x,y,w,h,score)",
                c->o.detections_in);
-    const auto inputs = PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
-    CheckOutputPath(c->out, inputs);
+    const auto inputs = io::PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
+    io::CheckOutputPath(c->out, inputs);
     for (const auto& [out, what] : {std::pair{c->mot_out, "--mot-out"},
                                     {c->draw, "--draw"},
                                     {c->o.detections_out, "--save-detections"}}) {
-      CheckOutputPath(out, PathList(inputs, c->out), what);
+      io::CheckOutputPath(out, io::PathList(inputs, c->out), what);
     }
     // A device, a folder or a missing folder as an output is refused before the run.
     for (const auto& [out, what] : {std::pair{c->out, "--out"},
                                     {c->mot_out, "--mot-out"},
                                     {c->draw, "--draw"},
                                     {c->o.detections_out, "--save-detections"}}) {
-      if (!out.empty()) ResolveOutputPath(out, what);
+      if (!out.empty()) io::ResolveOutputPath(out, what);
     }
     try {
       RunPlayersCommand(*c);

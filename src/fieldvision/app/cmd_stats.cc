@@ -22,7 +22,7 @@ struct StatsCli {
 };
 
 void RunStats(const StatsCli& c) {
-  const FieldModel field = LoadField(c.field);
+  const field::FieldModel field = field::LoadField(c.field);
   const auto rows = track::ReadTracksCsv(c.tracks);
   CheckOneRowPerPlayerFrame(rows, c.tracks);
   stats::StatsOptions o = c.o;
@@ -79,17 +79,17 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(0.1, 20));
   cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.mp4");
   cmd->callback([c] {
-    const auto inputs = PathList(c->tracks, c->field, c->zones, c->teams);
-    CheckOutputPath(c->out, inputs);
+    const auto inputs = io::PathList(c->tracks, c->field, c->zones, c->teams);
+    io::CheckOutputPath(c->out, inputs);
     for (const char* name : {"distances.csv", "players.csv", "speed_profiles.csv", "stats.json",
                              "index.html", "radar.png", "radar.mp4", "heatmap_all.png"}) {
-      CheckOutputPath(c->out + "/" + name, inputs);
+      io::CheckOutputPath(c->out + "/" + name, inputs);
     }
     try {
       RunStats(*c);
     } catch (const Error& e) {
       // The statistics' checks of the rows say "the tracks ...": name the file.
-      if (!StartsWith(e.what(), "the tracks")) throw;
+      if (!util::StartsWith(e.what(), "the tracks")) throw;
       Throw("{}: {}", c->tracks, e.what());
     }
   });

@@ -41,9 +41,9 @@ void RunTracksEdit(const TracksEditCli& c) {
   }
   // Neither the tracks nor the teams file beside them may overwrite an input.
   const std::vector<std::string> inputs = {c.tracks, c.edits, roster_in};
-  CheckOutputPath(c.out, inputs);
-  CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
-  ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
+  io::CheckOutputPath(c.out, inputs);
+  io::CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
+  io::ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);
@@ -68,20 +68,20 @@ void RunTracksDraw(const TracksDrawCli& c) {
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     roster_in = track::RosterPathFor(c.tracks);
   }
-  CheckOutputPath(c.out, {c.tracks, c.video, c.camera, c.field, roster_in});
-  ResolveOutputPath(c.out);
+  io::CheckOutputPath(c.out, {c.tracks, c.video, c.camera, c.field, roster_in});
+  io::ResolveOutputPath(c.out);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
-  std::optional<Camera> camera;
+  std::optional<camera::Camera> camera;
   if (!c.camera.empty()) {
-    camera = ReadCameraYaml(c.camera);
+    camera = camera::ReadCameraYaml(c.camera);
     // Field lines drawn with a camera of another size would be wrong everywhere.
-    const auto video = VideoSource::Open(c.video);
+    const auto video = io::VideoSource::Open(c.video);
     FV_REQUIRE(video->width() == camera->width && video->height() == camera->height,
                "camera file '{}' is for {}x{} images but video '{}' is {}x{}", c.camera,
                camera->width, camera->height, c.video, video->width(), video->height());
   }
-  std::optional<FieldModel> field;
-  if (!c.field.empty()) field = LoadField(c.field);
+  std::optional<field::FieldModel> field;
+  if (!c.field.empty()) field = field::LoadField(c.field);
   const track::TrackOverlay overlay(rows, roster.team_of, roster.name_of,
                                     camera ? &*camera : nullptr, field ? &*field : nullptr);
   const track::DrawVideoResult d =

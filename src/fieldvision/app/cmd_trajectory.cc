@@ -18,14 +18,14 @@ namespace fv::app {
 namespace {
 
 struct TrajectoryCliOptions {
-  TrajectoryJob job;
+  recon::TrajectoryJob job;
   std::string drag = "auto";
   std::string spin = "auto";
 };
 
 void Setup(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<TrajectoryCliOptions>();
-  TrajectoryJob& j = o->job;
+  recon::TrajectoryJob& j = o->job;
   CLI::App* c = app.add_subcommand(
       "trajectory", "Split a ball track into flights and fit them (origin, landing, apex, v0)");
   c->add_option("--in", j.in_path,
@@ -80,20 +80,20 @@ void Setup(CLI::App& app, int& exit_code) {
                  "trajectory: {} needs --field (the calls are made on a field's lines)",
                  opt->get_name());
     }
-    o->job.analysis.drag = ParseDragMode(o->drag, "--drag");
-    o->job.analysis.spin = ParseDragMode(o->spin, "--spin");
-    const auto files = ExpandTrackInputs(o->job.in_path);
+    o->job.analysis.drag = recon::ParseDragMode(o->drag, "--drag");
+    o->job.analysis.spin = recon::ParseDragMode(o->spin, "--spin");
+    const auto files = recon::ExpandTrackInputs(o->job.in_path);
     for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
                                     {o->job.smoothed_path, "--smoothed"},
                                     {o->job.report_path, "--report"}}) {
-      CheckOutputPath(out, PathList(o->job.in_path, files, o->job.field), what);
+      io::CheckOutputPath(out, io::PathList(o->job.in_path, files, o->job.field), what);
     }
     if (files.empty()) {
       // Output files, as every writer's: not a device or a folder, in a folder that exists.
       for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
                                       {o->job.smoothed_path, "--smoothed"},
                                       {o->job.report_path, "--report"}}) {
-        if (!out.empty()) ResolveOutputPath(out, what);
+        if (!out.empty()) io::ResolveOutputPath(out, what);
       }
       // A progress line on a terminal while the arcs of a long track are fitted.
       bool shown = false;
@@ -108,10 +108,10 @@ void Setup(CLI::App& app, int& exit_code) {
           shown = true;
         };
       }
-      RunTrajectory(o->job, std::cout);
+      recon::RunTrajectory(o->job, std::cout);
       if (shown) std::cerr << "\r\033[K" << std::flush;
     } else {
-      RunTrajectoryBatch(o->job, files, std::cout);
+      recon::RunTrajectoryBatch(o->job, files, std::cout);
     }
     exit_code = 0;
   });

@@ -11,7 +11,7 @@
 namespace fv::app {
 
 // The colour detector's radius limits and small-ball stage (`detect`, `eval detect`).
-inline void AddBallSizeOptions(CLI::App* cmd, BallDetectorOptions& o) {
+inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
   cmd->add_option("--min-radius", o.min_radius_px, "Smallest ball radius in pixels")
       ->check(FiniteRange(0.1, 10000.0))
       ->capture_default_str();
@@ -25,7 +25,7 @@ inline void AddBallSizeOptions(CLI::App* cmd, BallDetectorOptions& o) {
       ->capture_default_str();
 }
 
-inline void AddDetectorOptions(CLI::App* cmd, DnnBallOptions& o) {
+inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o) {
   cmd->add_option("--detector", o.detector,
                   "Ball detector: colour (colour table and shape checks), dnn (the shipped "
                   "NanoDet model's COCO 'sports ball' class: any ball, slower), or both (the "

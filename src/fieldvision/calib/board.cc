@@ -66,7 +66,7 @@ double SmallestSquarePx(const std::vector<cv::Point2f>& corners, int cols, int r
 }  // namespace
 
 BoardType ParseBoardType(const std::string& name) {
-  const std::string n = ToLower(name);
+  const std::string n = util::ToLower(name);
   if (n == "chessboard") return BoardType::kChessboard;
   if (n == "charuco") return BoardType::kCharuco;
   Throw("board '{}' is not known; use chessboard or charuco", name);
@@ -240,11 +240,11 @@ std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board) {
 // A video read forward frame by frame (a frame source has no seek).
 struct ImageSource::VideoReader {
   void Open(const std::string& spec) {
-    source = OpenFrameSource(spec);
+    source = io::OpenFrameSource(spec);
     next_frame = 0;
   }
   std::mutex mutex;
-  std::unique_ptr<FrameSource> source;
+  std::unique_ptr<io::FrameSource> source;
   long long next_frame = 0;  // the frame the next read gives
 };
 
@@ -264,7 +264,7 @@ ImageSource::ImageSource(const std::string& spec, const ImageSourceOptions& opti
       found.clear();
     }
     for (const auto& f : found) {
-      if (IsImageFile(f)) names_.push_back(f);
+      if (io::IsImageFile(f)) names_.push_back(f);
     }
     std::sort(names_.begin(), names_.end());
     FV_REQUIRE(!names_.empty(), "images '{}': the pattern matches no image file", spec);
@@ -274,13 +274,13 @@ ImageSource::ImageSource(const std::string& spec, const ImageSourceOptions& opti
   if (fs::is_directory(spec)) {
     for (const auto& e : fs::directory_iterator(spec)) {
       const std::string path = e.path().string();
-      if (e.is_regular_file() && IsImageFile(path)) names_.push_back(path);
+      if (e.is_regular_file() && io::IsImageFile(path)) names_.push_back(path);
     }
     std::sort(names_.begin(), names_.end());
     FV_REQUIRE(!names_.empty(), "images '{}': the folder has no image files", spec);
     return;
   }
-  if (IsImageFile(spec)) {
+  if (io::IsImageFile(spec)) {
     names_.push_back(spec);
     return;
   }

@@ -45,8 +45,8 @@ BoardPicture DrawBoard(const BoardSpec& b, double px_per_m) {
   return out;
 }
 
-cv::Mat RenderBoardView(const BoardPicture& picture, const Camera& camera,
-                        const Rigid3d& cam_from_board) {
+cv::Mat RenderBoardView(const BoardPicture& picture, const camera::Camera& camera,
+                        const geometry::Rigid3d& cam_from_board) {
   camera.Check("board view camera");
   const cv::Size size(camera.width, camera.height);
   const Eigen::Matrix3d& r = cam_from_board.rotation;

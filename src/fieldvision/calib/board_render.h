@@ -22,7 +22,7 @@ BoardPicture DrawBoard(const BoardSpec& board, double px_per_m = 4000.0);
 
 // The board seen by `camera` (size, intrinsics, distortion) with the board at cam_from_board
 // (board frame: CornerPositions(), z = 0); background grey 150, blur sigma 0.6 px.
-cv::Mat RenderBoardView(const BoardPicture& picture, const Camera& camera,
-                        const Rigid3d& cam_from_board);
+cv::Mat RenderBoardView(const BoardPicture& picture, const camera::Camera& camera,
+                        const geometry::Rigid3d& cam_from_board);
 
 }  // namespace fv::calib

@@ -68,7 +68,7 @@ cv::Mat RenderView(const cv::Mat& picture, const cv::Point2d& origin_m, const cv
 }
 
 // Views of the board from random tilts and positions; writes them into `dir`.
-void WriteViews(const BoardSpec& b, const cv::Matx33d& k, cv::Size size, int n, Rng& rng,
+void WriteViews(const BoardSpec& b, const cv::Matx33d& k, cv::Size size, int n, util::Rng& rng,
                 const std::string& dir, double distance_m) {
   cv::Point2d origin;
   const cv::Mat picture = BoardPicture(b, &origin);
@@ -86,7 +86,7 @@ void WriteViews(const BoardSpec& b, const cv::Matx33d& k, cv::Size size, int n, 
 TEST(Board, SyntheticChessboardViewsRecoverTheFocalLength) {
   const uint64_t seed = fv::testing::TestSeed(21);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const cv::Size size(640, 480);
   const cv::Matx33d k(600, 0, 322, 0, 600, 236, 0, 0, 1);
   IntrinsicsOptions o;
@@ -108,7 +108,7 @@ TEST(Board, SyntheticChessboardViewsRecoverTheFocalLength) {
 TEST(Board, ChArUcoPartialViewsCount) {
   const uint64_t seed = fv::testing::TestSeed(22);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const cv::Size size(640, 480);
   const cv::Matx33d k(580, 0, 318, 0, 580, 242, 0, 0, 1);
   BoardSpec b{BoardType::kCharuco, 7, 5, 0.04, 0.03, "DICT_4X4_50"};
@@ -147,7 +147,7 @@ TEST(Board, ChArUcoPartialViewsCount) {
 TEST(Board, VideoIsSampledEvenly) {
   const uint64_t seed = fv::testing::TestSeed(23);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const cv::Size size(640, 480);
   const cv::Matx33d k(600, 0, 322, 0, 600, 236, 0, 0, 1);
   BoardSpec b{BoardType::kChessboard, 7, 5, 0.03};

@@ -11,8 +11,9 @@
 namespace fv::calib {
 namespace {
 
-void DrawPolyline3d(cv::Mat& image, const Camera& camera, const std::vector<Eigen::Vector3d>& pts,
-                    const cv::Scalar& colour, int thickness) {
+void DrawPolyline3d(cv::Mat& image, const camera::Camera& camera,
+                    const std::vector<Eigen::Vector3d>& pts, const cv::Scalar& colour,
+                    int thickness) {
   std::optional<Eigen::Vector2d> prev;
   const double big = 4.0 * std::max(camera.width, camera.height);
   for (const auto& p : pts) {
@@ -55,7 +56,7 @@ std::string CheckResult::Summary() const {
   return s;
 }
 
-void DrawFieldOverlay(cv::Mat& image, const Camera& camera, const FieldModel& field,
+void DrawFieldOverlay(cv::Mat& image, const camera::Camera& camera, const field::FieldModel& field,
                       const cv::Scalar& colour, int thickness_px, double step_m) {
   for (const auto& s : field.segments) {
     const int n = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / step_m)));
@@ -97,8 +98,8 @@ void DrawFieldOverlay(cv::Mat& image, const Camera& camera, const FieldModel& fi
   }
 }
 
-CheckResult CheckCalibration(const Camera& camera, const cv::Mat& image_bgr,
-                             const FieldModel& field,
+CheckResult CheckCalibration(const camera::Camera& camera, const cv::Mat& image_bgr,
+                             const field::FieldModel& field,
                              const std::vector<PointCorrespondence>& known_points,
                              const CheckOptions& options) {
   options.Check();
@@ -120,7 +121,7 @@ CheckResult CheckCalibration(const Camera& camera, const cv::Mat& image_bgr,
     // Green within 5 cm of the model, yellow within the gate, red beyond.
     for (const auto& uv : pixels) {
       const auto ray = camera.RayFromPixel(uv);
-      const auto g = ray ? IntersectHorizontalPlane(*ray, 0.0) : std::nullopt;
+      const auto g = ray ? geometry::IntersectHorizontalPlane(*ray, 0.0) : std::nullopt;
       if (!g) continue;
       const double d = field.DistanceToLineCentres(g->head<2>());
       const cv::Scalar c = d < 0.05             ? cv::Scalar(0, 255, 0)
@@ -151,7 +152,7 @@ CheckResult CheckCalibration(const Camera& camera, const cv::Mat& image_bgr,
 }
 
 void WritePointErrorTable(const std::string& path, const std::vector<PointResidual>& points) {
-  CsvWriter w(
+  util::CsvWriter w(
       path,
       {"name", "u", "v", "x_m", "y_m", "z_m", "u_proj", "v_proj", "err_px", "err_mm", "inlier"}, 4);
   for (const auto& p : points) {

@@ -32,12 +32,12 @@ struct CheckResult {
 };
 
 // Projects the field's lines into `image` (BGR) through `camera` (with a pose).
-void DrawFieldOverlay(cv::Mat& image, const Camera& camera, const FieldModel& field,
+void DrawFieldOverlay(cv::Mat& image, const camera::Camera& camera, const field::FieldModel& field,
                       const cv::Scalar& colour, int thickness_px = 2, double step_m = 0.1);
 
 // Throws fv::Error when the camera has no pose or the frame's size differs from the camera's.
-CheckResult CheckCalibration(const Camera& camera, const cv::Mat& image_bgr,
-                             const FieldModel& field,
+CheckResult CheckCalibration(const camera::Camera& camera, const cv::Mat& image_bgr,
+                             const field::FieldModel& field,
                              const std::vector<PointCorrespondence>& known_points,
                              const CheckOptions& options = {});
 

@@ -17,7 +17,7 @@ TEST(Check, TruePoseHasSmallLineErrorAndAShiftedOneLarge) {
   spec.num_frames = 1;
   spec.ball.placements.resize(1);
   const synth::SceneRenderer scene(spec);
-  const Camera& truth = scene.cameras()[0];
+  const camera::Camera& truth = scene.cameras()[0];
   const cv::Mat frame = scene.Render(0)[0];
   std::vector<PointCorrespondence> known;
   for (const char* name : {"centre_spot", "corner_left_bottom", "penalty_mark_left"}) {
@@ -33,7 +33,7 @@ TEST(Check, TruePoseHasSmallLineErrorAndAShiftedOneLarge) {
   EXPECT_EQ(good.overlay.size(), frame.size());
   EXPECT_GT(cv::norm(good.overlay, frame, cv::NORM_L1), 0.0);  // something was drawn
 
-  Camera shifted = truth;
+  camera::Camera shifted = truth;
   const Eigen::Vector3d centre = truth.CentreInWorld() + Eigen::Vector3d(0.3, -0.2, 0.0);
   shifted.cam_from_world.translation = -shifted.cam_from_world.rotation * centre;
   const CheckResult bad = CheckCalibration(shifted, frame, scene.field(), known);
@@ -42,18 +42,19 @@ TEST(Check, TruePoseHasSmallLineErrorAndAShiftedOneLarge) {
 
   const std::string table = fv::testing::TempDir() + "/table.csv";
   WritePointErrorTable(table, bad.points);
-  const CsvTable t = CsvTable::Read(table);
+  const util::CsvTable t = util::CsvTable::Read(table);
   ASSERT_EQ(t.rows(), 3u);
   EXPECT_NEAR(t.GetDouble(0, "err_px"), bad.points[0].err_px, 1e-3);
 }
 
 TEST(Check, CameraWithoutPoseOrWrongSizeIsAnError) {
-  Camera cam = Camera::FromFov(640, 480, 60);
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
   const cv::Mat frame(480, 640, CV_8UC3, cv::Scalar(0, 100, 0));
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   EXPECT_THROW(CheckCalibration(cam, frame, field, {}), Error);
   cam.has_pose = true;
-  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  cam.cam_from_world =
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
   const cv::Mat other(360, 640, CV_8UC3, cv::Scalar(0, 100, 0));
   try {
     CheckCalibration(cam, other, field, {});

@@ -63,8 +63,9 @@ bool Better(const Candidate& a, const Candidate& b) {
 
 }  // namespace
 
-std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path, const FieldModel* field) {
-  const CsvTable t = CsvTable::Read(path);
+std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path,
+                                               const field::FieldModel* field) {
+  const util::CsvTable t = util::CsvTable::Read(path);
   std::vector<PointCorrespondence> pts;
   const bool xyz = t.Has("x") && t.Has("y") && t.Has("z");
   FV_REQUIRE(t.Has("u") && t.Has("v") && (xyz || t.Has("name")),
@@ -81,7 +82,7 @@ std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path, const Fi
     } else {
       FV_REQUIRE(field != nullptr, "{}: point '{}' is named but no field model was given (--field)",
                  t.Where(r), p.name);
-      const FieldKeypoint* k = field->FindKeypoint(p.name);
+      const field::FieldKeypoint* k = field->FindKeypoint(p.name);
       if (k == nullptr) {
         std::string known;
         for (size_t i = 0; i < field->keypoints.size() && i < 6; ++i) {
@@ -116,7 +117,7 @@ std::string ExtrinsicsResult::Summary() const {
       camera_position_m.x(), camera_position_m.y(), camera_position_m.z(), iterations);
 }
 
-std::vector<PointResidual> PointResiduals(const Camera& camera,
+std::vector<PointResidual> PointResiduals(const camera::Camera& camera,
                                           const std::vector<PointCorrespondence>& points) {
   FV_REQUIRE(camera.has_pose, "camera '{}' has no pose (rvec/tvec)", camera.name);
   std::vector<PointResidual> out;
@@ -134,7 +135,7 @@ std::vector<PointResidual> PointResiduals(const Camera& camera,
       r.err_px = std::numeric_limits<double>::infinity();
     }
     if (const auto ray = camera.RayFromPixel(p.uv_px)) {
-      if (const auto hit = IntersectHorizontalPlane(*ray, p.p_world.z())) {
+      if (const auto hit = geometry::IntersectHorizontalPlane(*ray, p.p_world.z())) {
         r.err_mm = 1000.0 * (hit->head<2>() - p.p_world.head<2>()).norm();
       }
     }
@@ -143,7 +144,7 @@ std::vector<PointResidual> PointResiduals(const Camera& camera,
   return out;
 }
 
-ExtrinsicsResult EstimatePose(const Camera& intrinsics,
+ExtrinsicsResult EstimatePose(const camera::Camera& intrinsics,
                               const std::vector<PointCorrespondence>& points,
                               const ExtrinsicsOptions& options) {
   options.Check();
@@ -239,7 +240,7 @@ ExtrinsicsResult EstimatePose(const Camera& intrinsics,
   }
   result.camera = intrinsics;
   result.camera.has_pose = true;
-  result.camera.cam_from_world = Rigid3d::FromRvecTvec(rvec, tvec);
+  result.camera.cam_from_world = geometry::Rigid3d::FromRvecTvec(rvec, tvec);
   result.camera_position_m = result.camera.CentreInWorld();
   result.points = PointResiduals(result.camera, points);
   double sq = 0, mm = 0;

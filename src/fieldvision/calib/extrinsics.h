@@ -27,7 +27,8 @@ struct PointCorrespondence {
 // Reads POINTS.csv: a header and columns u,v,x,y,z (metres) or u,v,name (a keypoint of
 // `field`). Throws fv::Error naming the file and line for a missing column, a bad number or an
 // unknown keypoint name (or names when no field is given).
-std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path, const FieldModel* field);
+std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path,
+                                               const field::FieldModel* field);
 
 struct ExtrinsicsOptions {
   double ransac_threshold_px = 8.0;  // inlier threshold of RANSAC
@@ -55,7 +56,7 @@ struct PointResidual {
 };
 
 struct ExtrinsicsResult {
-  Camera camera;  // the input intrinsics with the estimated pose
+  camera::Camera camera;  // the input intrinsics with the estimated pose
   std::vector<PointResidual> points;
   int num_inliers = 0;
   double rms_px = 0.0;       // over inliers
@@ -69,12 +70,12 @@ struct ExtrinsicsResult {
 
 // Throws fv::Error when there are fewer than min_points points, the world points are all on one
 // line, or no pose puts 4 points within the RANSAC threshold.
-ExtrinsicsResult EstimatePose(const Camera& intrinsics,
+ExtrinsicsResult EstimatePose(const camera::Camera& intrinsics,
                               const std::vector<PointCorrespondence>& points,
                               const ExtrinsicsOptions& options = {});
 
 // Residuals of `points` for a camera with a pose (used by EstimatePose and `calibrate check`).
-std::vector<PointResidual> PointResiduals(const Camera& camera,
+std::vector<PointResidual> PointResiduals(const camera::Camera& camera,
                                           const std::vector<PointCorrespondence>& points);
 
 }  // namespace fv::calib

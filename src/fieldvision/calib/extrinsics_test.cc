@@ -17,11 +17,12 @@ namespace {
 using test_util::ClickKeypoints;
 
 // A camera about 20 m from the field centre of the RoboCup MSL field, looking at it.
-Camera TwentyMetreCamera() {
-  Camera cam = Camera::FromFov(1280, 960, 60.0);
+camera::Camera TwentyMetreCamera() {
+  camera::Camera cam = camera::Camera::FromFov(1280, 960, 60.0);
   cam.distortion = {-0.05, 0.02, 0.0, 0.0, 0.0};
   cam.has_pose = true;
-  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15.0, -12.0, 7.0), Eigen::Vector3d::Zero());
+  cam.cam_from_world =
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(-15.0, -12.0, 7.0), Eigen::Vector3d::Zero());
   return cam;
 }
 
@@ -31,11 +32,11 @@ TEST(Extrinsics, EightKeypointsWithOnePixelNoiseWithin5cmAt20m) {
   // check its median and 90th percentile.
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
-  const Camera truth = TwentyMetreCamera();
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  const camera::Camera truth = TwentyMetreCamera();
   ASSERT_NEAR(truth.CentreInWorld().norm(), 20.4, 0.1);
-  Camera intrinsics = truth;
+  camera::Camera intrinsics = truth;
   intrinsics.has_pose = false;
   std::vector<double> errs_m;
   for (int trial = 0; trial < 40; ++trial) {
@@ -61,12 +62,12 @@ TEST(Extrinsics, EightKeypointsWithOnePixelNoiseWithin5cmAt20m) {
 TEST(Extrinsics, GrossOutlierIsRejected) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
-  const Camera truth = TwentyMetreCamera();
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  const camera::Camera truth = TwentyMetreCamera();
   auto pts = ClickKeypoints(truth, field, 10, 0.5, rng);
   pts[3].uv_px += Eigen::Vector2d(60, -45);  // a point clicked at the wrong place
-  Camera intrinsics = truth;
+  camera::Camera intrinsics = truth;
   intrinsics.has_pose = false;
   const ExtrinsicsResult r = EstimatePose(intrinsics, pts);
   EXPECT_FALSE(r.points[3].inlier);
@@ -75,7 +76,7 @@ TEST(Extrinsics, GrossOutlierIsRejected) {
 }
 
 TEST(Extrinsics, FewerThanFourPointsIsAnError) {
-  const Camera cam = TwentyMetreCamera();
+  const camera::Camera cam = TwentyMetreCamera();
   std::vector<PointCorrespondence> pts(3);
   for (int i = 0; i < 3; ++i) {
     pts[i].p_world = Eigen::Vector3d(i, i * i, 0);
@@ -90,7 +91,7 @@ TEST(Extrinsics, FewerThanFourPointsIsAnError) {
 }
 
 TEST(Extrinsics, CollinearPointsAreAnError) {
-  const Camera cam = TwentyMetreCamera();
+  const camera::Camera cam = TwentyMetreCamera();
   std::vector<PointCorrespondence> pts;
   for (int i = 0; i < 6; ++i) {
     PointCorrespondence p;
@@ -107,7 +108,7 @@ TEST(Extrinsics, CollinearPointsAreAnError) {
 }
 
 TEST(Extrinsics, ReadsNamedAndNumericPointFiles) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const std::string dir = fv::testing::TempDir();
   {
     std::ofstream f(dir + "/named.csv");
@@ -127,7 +128,7 @@ TEST(Extrinsics, ReadsNamedAndNumericPointFiles) {
 }
 
 TEST(Extrinsics, UnknownKeypointNameIsAnErrorNamingIt) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const std::string path = fv::testing::TempDir() + "/bad.csv";
   {
     std::ofstream f(path);

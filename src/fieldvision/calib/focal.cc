@@ -25,7 +25,7 @@ struct FocalPointCost {
       : cx(cx), cy(cy), uv(uv), p(p) {}
   template <typename T>
   bool operator()(const T* x, T* residual) const {
-    T intr[kNumIntrinsics];
+    T intr[camera::kNumIntrinsics];
     for (auto& v : intr) v = T(0);
     intr[0] = x[0];
     intr[1] = x[0];
@@ -34,7 +34,7 @@ struct FocalPointCost {
     intr[4] = x[1];
     const T pw[3] = {T(p.x()), T(p.y()), T(p.z())};
     T uvp[2];
-    if (!ProjectWorldPoint(intr, x + 2, x + 5, pw, uvp)) return false;
+    if (!camera::ProjectWorldPoint(intr, x + 2, x + 5, pw, uvp)) return false;
     residual[0] = uvp[0] - T(uv.x());
     residual[1] = uvp[1] - T(uv.y());
     return true;
@@ -44,8 +44,8 @@ struct FocalPointCost {
   Eigen::Vector3d p;
 };
 
-Camera CameraFromParams(int width, int height, const std::array<double, 8>& x) {
-  Camera c;
+camera::Camera CameraFromParams(int width, int height, const std::array<double, 8>& x) {
+  camera::Camera c;
   c.width = width;
   c.height = height;
   c.fx = c.fy = x[0];
@@ -53,7 +53,7 @@ Camera CameraFromParams(int width, int height, const std::array<double, 8>& x) {
   c.cy = 0.5 * (height - 1);
   c.distortion = {x[1], 0, 0, 0, 0};
   c.has_pose = true;
-  c.cam_from_world = Rigid3d::FromRvecTvec({x[2], x[3], x[4]}, {x[5], x[6], x[7]});
+  c.cam_from_world = geometry::Rigid3d::FromRvecTvec({x[2], x[3], x[4]}, {x[5], x[6], x[7]});
   return c;
 }
 
@@ -97,7 +97,7 @@ ExtrinsicsResult StartFromFovSweep(int width, int height,
   for (int i = 0; i < options.hfov_steps; ++i) {
     const double hfov = options.min_hfov_deg * std::pow(options.max_hfov_deg / options.min_hfov_deg,
                                                         i / (options.hfov_steps - 1.0));
-    Camera cam = Camera::FromFov(width, height, hfov);
+    camera::Camera cam = camera::Camera::FromFov(width, height, hfov);
     try {
       ExtrinsicsResult e = EstimatePose(cam, points, options.pnp);
       if (!have || e.num_inliers > best.num_inliers ||
@@ -140,7 +140,7 @@ struct FocalFit {
     return summary;
   }
   std::vector<double> Errors() const {
-    const Camera c = CameraFromParams(width, height, x);
+    const camera::Camera c = CameraFromParams(width, height, x);
     std::vector<double> e(points.size());
     for (size_t k = 0; k < points.size(); ++k) {
       const auto uv = c.Project(points[k].p_world);
@@ -218,7 +218,7 @@ void SetUncertainty(const std::array<double, 8>& x, int width, int dof, ceres::P
       (width / (x[0] * x[0] + 0.25 * width * width)) * result->std_focal_px * 180 / M_PI;
   // Camera centre C = -R(r)^T t: numerical Jacobian in (r, t).
   auto centre = [&](const Eigen::Matrix<double, 6, 1>& rt) {
-    const Eigen::Matrix3d r = RotationFromRvec(rt.head<3>());
+    const Eigen::Matrix3d r = geometry::RotationFromRvec(rt.head<3>());
     return Eigen::Vector3d(-r.transpose() * rt.tail<3>());
   };
   Eigen::Matrix<double, 6, 1> rt;

@@ -34,7 +34,7 @@ struct FocalOptions {
 };
 
 struct FocalResult {
-  Camera camera;  // fx = fy = f, principal point at the centre, distortion {k1, 0, 0, 0, 0}
+  camera::Camera camera;  // fx = fy = f, principal point at the centre, distortion {k1, 0, 0, 0, 0}
   std::vector<PointResidual> points;
   int num_inliers = 0;
   double rms_px = 0.0;

@@ -14,11 +14,12 @@ namespace fv::calib {
 namespace {
 
 // A 1920x1080 phone about 20 m from the centre of a futsal court, looking at it.
-Camera Phone(double hfov_deg, double k1 = 0.0) {
-  Camera cam = Camera::FromFov(1920, 1080, hfov_deg);
+camera::Camera Phone(double hfov_deg, double k1 = 0.0) {
+  camera::Camera cam = camera::Camera::FromFov(1920, 1080, hfov_deg);
   cam.distortion = {k1, 0, 0, 0, 0};
   cam.has_pose = true;
-  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-6.0, -18.0, 6.0), Eigen::Vector3d(2, 0, 0));
+  cam.cam_from_world =
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(-6.0, -18.0, 6.0), Eigen::Vector3d(2, 0, 0));
   return cam;
 }
 
@@ -28,9 +29,9 @@ Camera Phone(double hfov_deg, double k1 = 0.0) {
 TEST(Focal, EightKeypointsGiveTheFocalLengthWithAnHonestUncertainty) {
   const uint64_t seed = fv::testing::TestSeed(81);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("futsal");
-  const Camera truth = Phone(55);
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("futsal");
+  const camera::Camera truth = Phone(55);
   ASSERT_NEAR(truth.CentreInWorld().norm(), 19.9, 0.5);
   const int trials = 24;
   int f_within_2sigma = 0, c_within_2sigma = 0;
@@ -78,9 +79,9 @@ TEST(Focal, EightKeypointsGiveTheFocalLengthWithAnHonestUncertainty) {
 TEST(Focal, RadialDistortionToo) {
   const uint64_t seed = fv::testing::TestSeed(82);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("futsal");
-  const Camera truth = Phone(70, -0.12);
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("futsal");
+  const camera::Camera truth = Phone(70, -0.12);
   const auto pts = test_util::ClickKeypoints(truth, field, 16, 0.3, rng);
   FocalOptions o;
   o.estimate_k1 = true;
@@ -94,9 +95,9 @@ TEST(Focal, RadialDistortionToo) {
 TEST(Focal, GroundHomographyAndBadInputs) {
   const uint64_t seed = fv::testing::TestSeed(83);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("futsal");
-  const Camera truth = Phone(55);
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("futsal");
+  const camera::Camera truth = Phone(55);
   auto pts = test_util::ClickKeypoints(truth, field, 8, 0.5, rng);
   const HomographyResult h = EstimateGroundHomography(1920, 1080, pts);
   EXPECT_EQ(h.num_inliers, 8) << h.Summary();

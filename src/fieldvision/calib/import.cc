@@ -199,10 +199,10 @@ void ParseImageSize(const std::string& text, const std::string& what, int* width
   *height = h;
 }
 
-std::vector<Camera> ReadCalibrationToml(const std::string& path, double metres_per_unit) {
+std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double metres_per_unit) {
   CheckPositive(metres_per_unit, "metres_per_unit");
   const auto sections = ParseToml(path);
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   for (const auto& entry : sections) {
     const auto& section = entry.first;
     const auto& table = entry.second;  // a plain reference: lambdas below capture it
@@ -213,7 +213,7 @@ std::vector<Camera> ReadCalibrationToml(const std::string& path, double metres_p
       FV_REQUIRE(it != table.end(), "{}: key '{}' is missing", where, key);
       return it->second;
     };
-    Camera c;
+    camera::Camera c;
     c.name = section;
     if (table.count("name") && table.at("name").type == TomlValue::Type::kString) {
       c.name = table.at("name").text;
@@ -246,7 +246,7 @@ std::vector<Camera> ReadCalibrationToml(const std::string& path, double metres_p
       FV_REQUIRE(t.size() == 3, "{}: translation must have 3 numbers", where);
       c.has_pose = true;
       if (r.size() == 3) {
-        c.cam_from_world.rotation = RotationFromRvec({r[0], r[1], r[2]});
+        c.cam_from_world.rotation = geometry::RotationFromRvec({r[0], r[1], r[2]});
       } else {
         c.cam_from_world.rotation << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
       }
@@ -261,14 +261,14 @@ std::vector<Camera> ReadCalibrationToml(const std::string& path, double metres_p
   return cams;
 }
 
-void WriteCalibrationToml(const std::vector<Camera>& cameras, const std::string& path) {
+void WriteCalibrationToml(const std::vector<camera::Camera>& cameras, const std::string& path) {
   FV_REQUIRE(!cameras.empty(), "no cameras to write to '{}'", path);
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp);
     FV_REQUIRE(out.good(), "calibration file '{}' cannot be written", path);
     for (size_t i = 0; i < cameras.size(); ++i) {
-      const Camera& c = cameras[i];
+      const camera::Camera& c = cameras[i];
       FV_REQUIRE(c.has_pose, "camera '{}' has no pose; calibration.toml needs one", c.name);
       const std::string name = c.name.empty() ? fmt::format("cam_{}", i + 1) : c.name;
       std::vector<double> d = c.distortion;
@@ -295,8 +295,8 @@ void WriteCalibrationToml(const std::vector<Camera>& cameras, const std::string&
   FV_REQUIRE(!ec, "calibration file '{}' cannot be written: {}", path, ec.message());
 }
 
-std::vector<Camera> ReadOpenCvStereo(const std::vector<std::string>& paths, int width, int height,
-                                     double metres_per_unit) {
+std::vector<camera::Camera> ReadOpenCvStereo(const std::vector<std::string>& paths, int width,
+                                             int height, double metres_per_unit) {
   FV_REQUIRE(!paths.empty(), "no OpenCV stereo file given");
   FV_REQUIRE(width > 0 && height > 0, "OpenCV stereo files need the image size (--image-size)");
   CheckPositive(metres_per_unit, "metres_per_unit");
@@ -318,11 +318,11 @@ std::vector<Camera> ReadOpenCvStereo(const std::vector<std::string>& paths, int 
     if (!ri.empty()) r = ri;
     if (!ti.empty()) t = ti;
   }
-  std::vector<Camera> cams(2);
+  std::vector<camera::Camera> cams(2);
   for (int i = 0; i < 2; ++i) {
     FV_REQUIRE(!m[i].empty() && m[i].total() == 9, "OpenCV stereo files: no 3x3 M{} in {}", i + 1,
                paths.front());
-    Camera& c = cams[i];
+    camera::Camera& c = cams[i];
     c.name = i == 0 ? "left" : "right";
     c.width = width;
     c.height = height;
@@ -343,7 +343,7 @@ std::vector<Camera> ReadOpenCvStereo(const std::vector<std::string>& paths, int 
         for (int b = 0; b < 3; ++b) rot(a, b) = r.at<double>(a, b);
       }
     } else {
-      rot = RotationFromRvec({r.at<double>(0), r.at<double>(1), r.at<double>(2)});
+      rot = geometry::RotationFromRvec({r.at<double>(0), r.at<double>(1), r.at<double>(2)});
     }
     cams[0].has_pose = true;
     cams[1].has_pose = true;

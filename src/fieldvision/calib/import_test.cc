@@ -58,9 +58,9 @@ error = 0.42
     EXPECT_NEAR(back[i].fy, cams[i].fy, 1e-9);
     EXPECT_LT((back[i].cam_from_world.translation - cams[i].cam_from_world.translation).norm(),
               1e-12);
-    EXPECT_LT(
-        RotationAngleBetween(back[i].cam_from_world.rotation, cams[i].cam_from_world.rotation),
-        1e-12);
+    EXPECT_LT(geometry::RotationAngleBetween(back[i].cam_from_world.rotation,
+                                             cams[i].cam_from_world.rotation),
+              1e-12);
   }
 }
 

@@ -173,8 +173,8 @@ CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector
     ++result.fits;
     FV_REQUIRE(std::isfinite(rms), "calibration diverged on {} views", used.size());
     std::vector<double> errs(per_view.begin<double>(), per_view.end<double>());
-    const double threshold =
-        std::max(options.outlier_factor * NearestRankPercentile(errs, 0.5), options.outlier_min_px);
+    const double threshold = std::max(
+        options.outlier_factor * util::NearestRankPercentile(errs, 0.5), options.outlier_min_px);
     // Drop the worst view above the threshold, one at a time, while the budget allows.
     int worst = -1;
     for (size_t j = 0; j < errs.size(); ++j) {
@@ -192,7 +192,7 @@ CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector
     rep.rms_px = errs[worst];
     rep.dropped_because =
         fmt::format("view RMS {:.2f} px > {:.2f} px ({:.1f} x median {:.2f})", errs[worst],
-                    threshold, options.outlier_factor, NearestRankPercentile(errs, 0.5));
+                    threshold, options.outlier_factor, util::NearestRankPercentile(errs, 0.5));
     used.erase(used.begin() + worst);
   }
   result.num_used = static_cast<int>(used.size());
@@ -205,7 +205,7 @@ void SetCamera(const CvFit& fit, const cv::Size& size, const IntrinsicsOptions& 
                IntrinsicsResult* out) {
   IntrinsicsResult& result = *out;
   const cv::Mat &k = fit.k, &d = fit.d, &std_intr = fit.std_intr;
-  Camera& cam = result.camera;
+  camera::Camera& cam = result.camera;
   cam.name = options.camera_name;
   cam.width = size.width;
   cam.height = size.height;
@@ -268,7 +268,7 @@ CoverageReport Coverage(const std::vector<BoardView>& views, const CvFit& fit, c
 void AddWarnings(const cv::Size& size, const IntrinsicsOptions& options, int max_drop,
                  IntrinsicsResult* out) {
   IntrinsicsResult& result = *out;
-  const Camera& cam = result.camera;
+  const camera::Camera& cam = result.camera;
   const CoverageReport& cov = result.coverage;
   auto& w = result.warnings;
   if (result.num_used < 8) {
@@ -310,7 +310,7 @@ void AddWarnings(const cv::Size& size, const IntrinsicsOptions& options, int max
 // The camera file's notes: board, views used and dropped, model, date.
 void AddNotes(const IntrinsicsOptions& options, IntrinsicsResult* out) {
   IntrinsicsResult& result = *out;
-  Camera& cam = result.camera;
+  camera::Camera& cam = result.camera;
   std::string used_names, dropped_names;
   for (const auto& v : result.views) {
     if (v.used) used_names += (used_names.empty() ? "" : " ") + v.name;
@@ -346,7 +346,7 @@ IntrinsicsResult CalibrateIntrinsics(const std::string& images, const Intrinsics
   options.Check();
   const ImageSource source(images, options.source);
   std::vector<BoardView> views;
-  Progress progress("detecting corners", source.size(), "images", options.progress);
+  util::Progress progress("detecting corners", source.size(), "images", options.progress);
   cv::Size first_size;
   for (int i = 0; i < source.size(); ++i) {
     const cv::Mat image = source.Read(i);

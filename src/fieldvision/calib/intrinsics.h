@@ -60,8 +60,8 @@ struct CoverageReport {
 };
 
 struct IntrinsicsResult {
-  Camera camera;        // intrinsics only (has_pose = false), rms_px and notes set
-  double rms_px = 0.0;  // OpenCV's RMS over all corners of the used views
+  camera::Camera camera;  // intrinsics only (has_pose = false), rms_px and notes set
+  double rms_px = 0.0;    // OpenCV's RMS over all corners of the used views
   int num_images = 0;
   int num_found = 0;
   int num_used = 0;

@@ -76,7 +76,7 @@ TEST(Intrinsics, DefaultsFitTheLeftViewsBetterThanTheReference) {
 // Board views made by projecting the board's corners through a known camera (with noise).
 std::vector<BoardView> ProjectedViews(const BoardSpec& b, const cv::Matx33d& k,
                                       const std::vector<double>& d, int n, double noise_px,
-                                      double max_offset, Rng& rng) {
+                                      double max_offset, util::Rng& rng) {
   std::vector<BoardView> views;
   const auto obj = b.CornerPositions();
   std::vector<cv::Point3d> obj_d(obj.begin(), obj.end());
@@ -106,7 +106,7 @@ std::vector<BoardView> ProjectedViews(const BoardSpec& b, const cv::Matx33d& k,
 TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
   const uint64_t seed = fv::testing::TestSeed(51);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   IntrinsicsOptions o;
   o.board = {BoardType::kChessboard, 9, 6, 0.025};
   o.progress = false;
@@ -131,7 +131,7 @@ TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
 TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
   const uint64_t seed = fv::testing::TestSeed(52);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   IntrinsicsOptions o;
   o.board = {BoardType::kChessboard, 4, 3, 0.02};
   o.progress = false;
@@ -170,7 +170,7 @@ TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
 }
 
 TEST(Intrinsics, TooFewViewsIsAnError) {
-  Rng rng(1);
+  util::Rng rng(1);
   IntrinsicsOptions o;
   o.board = {BoardType::kChessboard, 9, 6, 0.025};
   o.progress = false;

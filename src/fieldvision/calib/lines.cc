@@ -17,19 +17,20 @@ namespace fv::calib {
 namespace {
 
 // Whether a ground point is on the field plus a margin.
-bool OnField(const FieldModel& field, const Eigen::Vector3d& p, double margin_m) {
+bool OnField(const field::FieldModel& field, const Eigen::Vector3d& p, double margin_m) {
   return std::abs(p.x()) <= 0.5 * field.length_m + field.surround_m + margin_m &&
          std::abs(p.y()) <= 0.5 * field.width_m + field.surround_m + margin_m;
 }
 
-std::optional<Eigen::Vector3d> GroundPoint(const Camera& camera, const Eigen::Vector2d& uv) {
+std::optional<Eigen::Vector3d> GroundPoint(const camera::Camera& camera,
+                                           const Eigen::Vector2d& uv) {
   const auto ray = camera.RayFromPixel(uv);
   if (!ray) return std::nullopt;
-  return IntersectHorizontalPlane(*ray, 0.0);
+  return geometry::IntersectHorizontalPlane(*ray, 0.0);
 }
 
 // Mask of pixels whose ground point is on the field (plus margin), from a coarse grid of rays.
-cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m) {
+cv::Mat FieldMask(const camera::Camera& camera, const field::FieldModel& field, double margin_m) {
   constexpr int kStep = 4;
   const int gw = (camera.width + kStep - 1) / kStep + 1;
   const int gh = (camera.height + kStep - 1) / kStep + 1;
@@ -48,7 +49,7 @@ cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m
 }
 
 // Image areas of the goals (convex hulls of their projected boxes), to be ignored.
-cv::Mat GoalMask(const Camera& camera, const FieldModel& field) {
+cv::Mat GoalMask(const camera::Camera& camera, const field::FieldModel& field) {
   cv::Mat mask(camera.height, camera.width, CV_8U, cv::Scalar(0));
   for (const auto& g : field.goals) {
     const double x0 = g.line_x_m - g.side * g.post_width_m;
@@ -76,7 +77,7 @@ cv::Mat GoalMask(const Camera& camera, const FieldModel& field) {
   return mask;
 }
 
-int AutoMaxWidthPx(const Camera& camera, const FieldModel& field) {
+int AutoMaxWidthPx(const camera::Camera& camera, const field::FieldModel& field) {
   double widest = 2.0;
   for (const auto& p : field.SampleLines(0.25)) {
     const Eigen::Vector3d pw(p.x(), p.y(), 0.0);
@@ -151,8 +152,8 @@ struct LinePixelCost {
 
 }  // namespace
 
-void CheckImageSize(const cv::Mat& image, const Camera& camera, const std::string& image_name,
-                    const std::string& camera_name) {
+void CheckImageSize(const cv::Mat& image, const camera::Camera& camera,
+                    const std::string& image_name, const std::string& camera_name) {
   FV_REQUIRE(!image.empty(), "image '{}' is empty or unreadable", image_name);
   FV_REQUIRE(image.cols == camera.width && image.rows == camera.height,
              "image '{}' is {}x{} but camera '{}' is {}x{}", image_name, image.cols, image.rows,
@@ -168,8 +169,9 @@ void LineDetectOptions::Check() const {
   FV_REQUIRE(max_pixels >= 100, "detect.max_pixels must be >= 100 (got {})", max_pixels);
 }
 
-std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr, const Camera& camera,
-                                              const FieldModel& field,
+std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr,
+                                              const camera::Camera& camera,
+                                              const field::FieldModel& field,
                                               const LineDetectOptions& options) {
   options.Check();
   CheckImageSize(image_bgr, camera, "frame", camera.name);
@@ -208,7 +210,7 @@ std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr, const Ca
   return pixels;
 }
 
-LineDistanceMap::LineDistanceMap(const FieldModel& field, double resolution_m,
+LineDistanceMap::LineDistanceMap(const field::FieldModel& field, double resolution_m,
                                  double max_distance_m, int max_cells)
     : resolution_m_(resolution_m), max_distance_m_(max_distance_m) {
   field.Check();
@@ -242,14 +244,15 @@ LineDistanceMap::LineDistanceMap(const FieldModel& field, double resolution_m,
   };
   std::vector<std::pair<Box, std::function<double(const Eigen::Vector2d&)>>> items;
   for (const auto& s : field.segments) {
-    items.emplace_back(box(std::min(s.a.x(), s.b.x()), std::max(s.a.x(), s.b.x()),
-                           std::min(s.a.y(), s.b.y()), std::max(s.a.y(), s.b.y())),
-                       [s](const Eigen::Vector2d& p) { return DistanceToSegment(p, s.a, s.b); });
+    items.emplace_back(
+        box(std::min(s.a.x(), s.b.x()), std::max(s.a.x(), s.b.x()), std::min(s.a.y(), s.b.y()),
+            std::max(s.a.y(), s.b.y())),
+        [s](const Eigen::Vector2d& p) { return field::DistanceToSegment(p, s.a, s.b); });
   }
   for (const auto& a : field.arcs) {
     items.emplace_back(box(a.centre.x() - a.radius_m, a.centre.x() + a.radius_m,
                            a.centre.y() - a.radius_m, a.centre.y() + a.radius_m),
-                       [a](const Eigen::Vector2d& p) { return DistanceToArc(p, a); });
+                       [a](const Eigen::Vector2d& p) { return field::DistanceToArc(p, a); });
   }
   cv::parallel_for_(cv::Range(0, rows_), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
@@ -287,8 +290,8 @@ std::string LineErrorStats::Summary() const {
       mean_mm, median_mm, p95_mm, num_inliers, num_pixels, gate_m * 1000);
 }
 
-LineErrorStats LineError(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
-                         const FieldModel& field, double gate_m) {
+LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
+                         const field::FieldModel& field, double gate_m) {
   CheckPositive(gate_m, "gate_m");
   LineErrorStats s;
   s.gate_m = gate_m;
@@ -302,9 +305,9 @@ LineErrorStats LineError(const Camera& camera, const std::vector<Eigen::Vector2d
   }
   s.num_inliers = static_cast<int>(mm.size());
   if (!mm.empty()) {
-    s.mean_mm = Mean(mm);
-    s.median_mm = NearestRankPercentile(mm, 0.5);
-    s.p95_mm = NearestRankPercentile(mm, 0.95);
+    s.mean_mm = util::Mean(mm);
+    s.median_mm = util::NearestRankPercentile(mm, 0.5);
+    s.p95_mm = util::NearestRankPercentile(mm, 0.95);
   }
   return s;
 }
@@ -358,8 +361,9 @@ LossScaleSolve SolveOverLossScales(const std::function<void(ceres::Problem&, dou
   return out;
 }
 
-RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
-                                  const FieldModel& field, const RefineOptions& options) {
+RefineResult RefineWithLinePixels(const camera::Camera& camera,
+                                  const std::vector<Eigen::Vector2d>& pixels,
+                                  const field::FieldModel& field, const RefineOptions& options) {
   options.Check();
   camera.Check("camera");
   FV_REQUIRE(camera.has_pose, "camera '{}' has no pose; run `calibrate extrinsics` first",
@@ -397,12 +401,12 @@ RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen:
   result.iterations = solve.iterations;
   result.initial_cost = solve.initial_cost;
   result.final_cost = solve.final_cost;
-  Camera refined = camera;
-  refined.cam_from_world = Rigid3d::FromRvecTvec(rvec, tvec);
+  camera::Camera refined = camera;
+  refined.cam_from_world = geometry::Rigid3d::FromRvecTvec(rvec, tvec);
   result.moved_m = (refined.CentreInWorld() - camera.CentreInWorld()).norm();
-  result.rotated_deg =
-      RotationAngleBetween(refined.cam_from_world.rotation, camera.cam_from_world.rotation) *
-      180.0 / M_PI;
+  result.rotated_deg = geometry::RotationAngleBetween(refined.cam_from_world.rotation,
+                                                      camera.cam_from_world.rotation) *
+                       180.0 / M_PI;
   if (!rvec.allFinite() || !tvec.allFinite()) {
     result.status = "the optimisation diverged";
   } else if (result.moved_m > options.max_move_m) {
@@ -420,8 +424,8 @@ RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen:
   return result;
 }
 
-RefineResult RefineWithLines(const Camera& camera, const cv::Mat& image_bgr,
-                             const FieldModel& field, const RefineOptions& options) {
+RefineResult RefineWithLines(const camera::Camera& camera, const cv::Mat& image_bgr,
+                             const field::FieldModel& field, const RefineOptions& options) {
   options.Check();
   CheckImageSize(image_bgr, camera, "frame", camera.name);
   const auto pixels = DetectLinePixels(image_bgr, camera, field, options.detect);

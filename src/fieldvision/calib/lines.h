@@ -40,8 +40,9 @@ struct LineDetectOptions {
 // Line pixels (centres of thin white cross-sections) of a BGR frame seen by `camera` (with a
 // pose), outside the image area of the field's goals. Throws fv::Error when the image size differs
 // from the camera's.
-std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr, const Camera& camera,
-                                              const FieldModel& field,
+std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr,
+                                              const camera::Camera& camera,
+                                              const field::FieldModel& field,
                                               const LineDetectOptions& options = {});
 
 // Distance (metres) from points of the ground to the nearest line centreline, on a grid.
@@ -49,7 +50,7 @@ class LineDistanceMap {
  public:
   // Cells of `resolution_m` over the field and its surround (coarser if that would exceed
   // max_cells); distances beyond max_distance_m are clamped.
-  explicit LineDistanceMap(const FieldModel& field, double resolution_m = 0.01,
+  explicit LineDistanceMap(const field::FieldModel& field, double resolution_m = 0.01,
                            double max_distance_m = 1.0, int max_cells = 8'000'000);
   double resolution_m() const { return resolution_m_; }
   double max_distance_m() const { return max_distance_m_; }
@@ -83,8 +84,8 @@ struct LineErrorStats {
 
 // Line error of a pose: distance of the line pixels' ground points to the nearest line
 // centreline (exact), over those within gate_m (the rest are other white things).
-LineErrorStats LineError(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
-                         const FieldModel& field, double gate_m = 0.5);
+LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
+                         const field::FieldModel& field, double gate_m = 0.5);
 
 struct RefineOptions {
   LineDetectOptions detect;
@@ -100,7 +101,7 @@ struct RefineOptions {
 };
 
 struct RefineResult {
-  Camera camera;  // refined (or the input when rejected)
+  camera::Camera camera;  // refined (or the input when rejected)
   bool accepted = false;
   std::string status;  // why not accepted
   LineErrorStats before, after;
@@ -115,11 +116,13 @@ struct RefineResult {
 // Refines camera.cam_from_world (intrinsics fixed) so that the frame's line pixels fall on the
 // field's lines. Throws fv::Error when the camera has no pose or the image is of another size
 // than the camera; too few line pixels is a result with accepted = false.
-RefineResult RefineWithLines(const Camera& camera, const cv::Mat& image_bgr,
-                             const FieldModel& field, const RefineOptions& options = {});
+RefineResult RefineWithLines(const camera::Camera& camera, const cv::Mat& image_bgr,
+                             const field::FieldModel& field, const RefineOptions& options = {});
 // The same on line pixels already detected.
-RefineResult RefineWithLinePixels(const Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
-                                  const FieldModel& field, const RefineOptions& options = {});
+RefineResult RefineWithLinePixels(const camera::Camera& camera,
+                                  const std::vector<Eigen::Vector2d>& pixels,
+                                  const field::FieldModel& field,
+                                  const RefineOptions& options = {});
 
 // The pose solve of both line refinements (RefineWithLinePixels, RefineRigWithLines): `build`
 // adds the residuals (on *rvec, *tvec) with a Cauchy loss of the given scale; the problem is
@@ -136,7 +139,7 @@ LossScaleSolve SolveOverLossScales(const std::function<void(ceres::Problem&, dou
                                    const Eigen::Vector3d& tvec_start);
 
 // Checks that an image matches the camera's size; throws naming both.
-void CheckImageSize(const cv::Mat& image, const Camera& camera, const std::string& image_name,
-                    const std::string& camera_name);
+void CheckImageSize(const cv::Mat& image, const camera::Camera& camera,
+                    const std::string& image_name, const std::string& camera_name);
 
 }  // namespace fv::calib

@@ -33,8 +33,8 @@ synth::SceneSpec TwentyMetreScene(uint64_t seed) {
 TEST(LineDistanceMap, MatchesExactDistances) {
   const uint64_t seed = fv::testing::TestSeed(11);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const LineDistanceMap map(field, 0.01, 1.0);
   for (int i = 0; i < 500; ++i) {
     const Eigen::Vector2d p(rng.Uniform(-10, 10), rng.Uniform(-7, 7));
@@ -48,15 +48,15 @@ TEST(LineDistanceMap, MatchesExactDistances) {
 TEST(Refine, SyntheticFrameBringsTheCameraWithin2cm) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const synth::SceneRenderer scene(TwentyMetreScene(seed));
-  const Camera& truth = scene.cameras()[0];
-  const FieldModel& field = scene.field();
+  const camera::Camera& truth = scene.cameras()[0];
+  const field::FieldModel& field = scene.field();
   ASSERT_NEAR(truth.CentreInWorld().norm(), 20.4, 0.1);
   const cv::Mat frame = scene.Render(0)[0];
 
   // The clicked pose: 8 keypoints with 1 px noise.
-  Camera intrinsics = truth;
+  camera::Camera intrinsics = truth;
   intrinsics.has_pose = false;
   const ExtrinsicsResult clicked =
       EstimatePose(intrinsics, test_util::ClickKeypoints(truth, field, 8, 1.0, rng));
@@ -76,7 +76,8 @@ TEST(Refine, SyntheticFrameBringsTheCameraWithin2cm) {
   const double refined_err_m = (r.camera.CentreInWorld() - truth.CentreInWorld()).norm();
   EXPECT_LT(refined_err_m, 0.02) << r.Summary() << " (clicked: " << clicked_err_m << " m)";
   EXPECT_LE(r.after.mean_mm, r.before.mean_mm + 1e-9) << r.Summary();
-  EXPECT_LT(RotationAngleBetween(r.camera.cam_from_world.rotation, truth.cam_from_world.rotation) *
+  EXPECT_LT(geometry::RotationAngleBetween(r.camera.cam_from_world.rotation,
+                                           truth.cam_from_world.rotation) *
                 180 / M_PI,
             0.05);
   RecordProperty("clicked_err_mm", static_cast<int>(1000 * clicked_err_m));
@@ -90,11 +91,11 @@ TEST(Refine, StartFarOffIsNotMadeWorse) {
   const uint64_t seed = fv::testing::TestSeed(9);
   FV_SEED_TRACE(seed);
   const synth::SceneRenderer scene(TwentyMetreScene(seed));
-  const Camera& truth = scene.cameras()[0];
+  const camera::Camera& truth = scene.cameras()[0];
   const cv::Mat frame = scene.Render(0)[0];
-  Camera start = truth;
+  camera::Camera start = truth;
   start.cam_from_world =
-      Rigid3d::LookAt(Eigen::Vector3d(-14.0, -11.5, 7.5), Eigen::Vector3d(0.3, 0.2, 0.0));
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(-14.0, -11.5, 7.5), Eigen::Vector3d(0.3, 0.2, 0.0));
   const RefineResult r = RefineWithLines(start, frame, scene.field());
   const double before = (start.CentreInWorld() - truth.CentreInWorld()).norm();
   const double after = (r.camera.CentreInWorld() - truth.CentreInWorld()).norm();
@@ -102,12 +103,13 @@ TEST(Refine, StartFarOffIsNotMadeWorse) {
 }
 
 TEST(Refine, ImageOfAnotherSizeIsAnError) {
-  Camera cam = Camera::FromFov(1280, 960, 60);
+  camera::Camera cam = camera::Camera::FromFov(1280, 960, 60);
   cam.has_pose = true;
-  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  cam.cam_from_world =
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
   const cv::Mat small(480, 640, CV_8UC3, cv::Scalar(0, 120, 0));
   try {
-    RefineWithLines(cam, small, BuiltinField("robocup-msl"));
+    RefineWithLines(cam, small, field::BuiltinField("robocup-msl"));
     FAIL() << "no error";
   } catch (const Error& e) {
     const std::string msg = e.what();
@@ -117,11 +119,12 @@ TEST(Refine, ImageOfAnotherSizeIsAnError) {
 }
 
 TEST(Refine, NoLinesIsAValueNotAnException) {
-  Camera cam = Camera::FromFov(640, 480, 60);
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
   cam.has_pose = true;
-  cam.cam_from_world = Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  cam.cam_from_world =
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
   const cv::Mat grass(480, 640, CV_8UC3, cv::Scalar(40, 130, 40));
-  const RefineResult r = RefineWithLines(cam, grass, BuiltinField("robocup-msl"));
+  const RefineResult r = RefineWithLines(cam, grass, field::BuiltinField("robocup-msl"));
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.status.find("line pixels"), std::string::npos) << r.status;
 }

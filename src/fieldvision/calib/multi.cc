@@ -54,7 +54,7 @@ struct BoardCornerCost {
     ceres::AngleAxisRotatePoint(board_r, p, p_ref);
     for (int k = 0; k < 3; ++k) p_ref[k] += board_t[k];
     T uv[2];
-    if (!ProjectWorldPoint(intrinsics, cam_r, cam_t, p_ref, uv)) return false;
+    if (!camera::ProjectWorldPoint(intrinsics, cam_r, cam_t, p_ref, uv)) return false;
     residual[0] = uv[0] - T(u);
     residual[1] = uv[1] - T(v);
     return true;
@@ -64,11 +64,12 @@ struct BoardCornerCost {
 
 struct ViewPose {
   bool ok = false;
-  Rigid3d cam_from_board;
+  geometry::Rigid3d cam_from_board;
   double rms_px = 0.0;
 };
 
-std::vector<cv::Point2f> ProjectBoard(const Camera& cam, const Rigid3d& cam_from_board,
+std::vector<cv::Point2f> ProjectBoard(const camera::Camera& cam,
+                                      const geometry::Rigid3d& cam_from_board,
                                       const std::vector<cv::Point3f>& pts, bool* all_in_front) {
   std::vector<cv::Point2f> out;
   out.reserve(pts.size());
@@ -95,7 +96,7 @@ double RmsBetween(const std::vector<cv::Point2f>& a, const std::vector<cv::Point
 }
 
 // Board pose in one view with known intrinsics: IPPE (planar), then Levenberg-Marquardt.
-ViewPose BoardPose(const Camera& cam, const BoardView& view) {
+ViewPose BoardPose(const camera::Camera& cam, const BoardView& view) {
   ViewPose out;
   if (view.image_points.size() < 4) return out;
   const cv::Mat k = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
@@ -113,8 +114,8 @@ ViewPose BoardPose(const Camera& cam, const BoardView& view) {
     return out;
   }
   out.cam_from_board =
-      Rigid3d::FromRvecTvec({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)},
-                            {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)});
+      geometry::Rigid3d::FromRvecTvec({rvec.at<double>(0), rvec.at<double>(1), rvec.at<double>(2)},
+                                      {tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2)});
   bool in_front = true;
   const auto proj = ProjectBoard(cam, out.cam_from_board, view.object_points, &in_front);
   if (!in_front) return out;
@@ -138,7 +139,7 @@ CameraViews ParseCameraViews(const std::string& arg) {
 }
 
 Pairing ParsePairing(const std::string& name) {
-  const std::string n = ToLower(name);
+  const std::string n = util::ToLower(name);
   if (n == "auto") return Pairing::kAuto;
   if (n == "order") return Pairing::kOrder;
   if (n == "frame" || n == "frame-number") return Pairing::kFrameNumber;
@@ -146,7 +147,7 @@ Pairing ParsePairing(const std::string& name) {
 }
 
 TangentialModel ParseTangentialModel(const std::string& name) {
-  const std::string n = ToLower(name);
+  const std::string n = util::ToLower(name);
   if (n == "auto") return TangentialModel::kAuto;
   if (n == "free") return TangentialModel::kFree;
   if (n == "zero") return TangentialModel::kZero;
@@ -175,7 +176,7 @@ std::string MultiResult::Summary() const {
       cameras.size(), num_frames, pairing, rms_px, num_adjustments, iterations, initial_cost,
       final_cost);
   for (const auto& c : camera_reports) {
-    const Camera* cam = nullptr;
+    const camera::Camera* cam = nullptr;
     for (const auto& k : cameras) {
       if (k.name == c.name) cam = &k;
     }
@@ -222,8 +223,8 @@ CameraDetections DetectCameraViews(const CameraViews& camera, const MultiOptions
   CameraDetections out;
   out.name = camera.name;
   out.source = camera.source;
-  Progress progress(fmt::format("camera {}: detecting corners", camera.name), source.size(),
-                    "images", options.progress);
+  util::Progress progress(fmt::format("camera {}: detecting corners", camera.name), source.size(),
+                          "images", options.progress);
   cv::Size first_size;
   for (int i = 0; i < source.size(); ++i) {
     const cv::Mat image = source.Read(i);
@@ -363,12 +364,12 @@ void CheckFrames(const std::vector<std::string>& names, const std::vector<MultiF
 }
 
 // Each camera's intrinsics: the known ones, or its own calibrateCamera fit of its views.
-std::vector<Camera> InitialIntrinsics(const std::vector<std::string>& names,
-                                      const std::vector<MultiFrame>& frames,
-                                      const MultiOptions& options,
-                                      std::vector<MultiCameraReport>* reports) {
+std::vector<camera::Camera> InitialIntrinsics(const std::vector<std::string>& names,
+                                              const std::vector<MultiFrame>& frames,
+                                              const MultiOptions& options,
+                                              std::vector<MultiCameraReport>* reports) {
   const int nc = static_cast<int>(names.size());
-  std::vector<Camera> cams(nc);
+  std::vector<camera::Camera> cams(nc);
   reports->resize(nc);
   for (int c = 0; c < nc; ++c) {
     auto& rep = (*reports)[c];
@@ -424,7 +425,8 @@ std::vector<Camera> InitialIntrinsics(const std::vector<std::string>& names,
 
 using PoseGrid = std::vector<std::vector<ViewPose>>;  // [camera][frame]
 
-PoseGrid BoardPoses(const std::vector<Camera>& cams, const std::vector<MultiFrame>& frames) {
+PoseGrid BoardPoses(const std::vector<camera::Camera>& cams,
+                    const std::vector<MultiFrame>& frames) {
   PoseGrid pose(cams.size(), std::vector<ViewPose>(frames.size()));
   for (size_t c = 0; c < cams.size(); ++c) {
     for (size_t f = 0; f < frames.size(); ++f) {
@@ -437,12 +439,12 @@ PoseGrid BoardPoses(const std::vector<Camera>& cams, const std::vector<MultiFram
 
 struct Edge {
   int shared = 0;
-  Rigid3d b_from_a;
+  geometry::Rigid3d b_from_a;
 };
 
 // The relative pose of cameras a and b: of the candidates their shared views give, the one that
 // best transfers the board from a to b in all shared views.
-Edge RelativePose(int a, int b, const std::vector<Camera>& cams,
+Edge RelativePose(int a, int b, const std::vector<camera::Camera>& cams,
                   const std::vector<MultiFrame>& frames, const PoseGrid& pose) {
   Edge e;
   std::vector<int> shared;
@@ -452,7 +454,7 @@ Edge RelativePose(int a, int b, const std::vector<Camera>& cams,
   e.shared = static_cast<int>(shared.size());
   double best = 1e300;
   for (int f : shared) {
-    const Rigid3d cand = pose[b][f].cam_from_board * pose[a][f].cam_from_board.Inverse();
+    const geometry::Rigid3d cand = pose[b][f].cam_from_board * pose[a][f].cam_from_board.Inverse();
     double score = 0;
     for (int g : shared) {
       bool in_front = true;
@@ -470,11 +472,11 @@ Edge RelativePose(int a, int b, const std::vector<Camera>& cams,
 
 // Camera poses in the first camera's frame, chained through a maximum spanning tree (Prim) of
 // shared-view counts. Throws naming a camera that shares too few views with the others.
-std::vector<Rigid3d> ChainCameras(const std::vector<std::string>& names,
-                                  const std::vector<MultiFrame>& frames,
-                                  const std::vector<Camera>& cams, const PoseGrid& pose,
-                                  const MultiOptions& options,
-                                  std::vector<MultiCameraReport>* reports) {
+std::vector<geometry::Rigid3d> ChainCameras(const std::vector<std::string>& names,
+                                            const std::vector<MultiFrame>& frames,
+                                            const std::vector<camera::Camera>& cams,
+                                            const PoseGrid& pose, const MultiOptions& options,
+                                            std::vector<MultiCameraReport>* reports) {
   const int nc = static_cast<int>(names.size());
   std::vector<std::vector<Edge>> edges(nc, std::vector<Edge>(nc));
   for (int a = 0; a < nc; ++a) {
@@ -483,7 +485,7 @@ std::vector<Rigid3d> ChainCameras(const std::vector<std::string>& names,
     }
   }
   std::vector<bool> in_tree(nc, false);
-  std::vector<Rigid3d> cam_from_ref(nc);
+  std::vector<geometry::Rigid3d> cam_from_ref(nc);
   in_tree[0] = true;
   for (int added = 1; added < nc; ++added) {
     int best_a = -1, best_b = -1, best_shared = 0;
@@ -522,7 +524,7 @@ std::vector<Rigid3d> ChainCameras(const std::vector<std::string>& names,
 
 // The bundle adjustment's parameters and the views it uses.
 struct RigState {
-  std::vector<std::array<double, kNumIntrinsics>> intr;
+  std::vector<std::array<double, camera::kNumIntrinsics>> intr;
   std::vector<int> num_distortion;
   std::vector<bool> fixed;                        // intrinsics kept constant
   std::vector<bool> tangential;                   // p1 p2 free (else zero)
@@ -542,8 +544,9 @@ struct RigState {
 
 // The start of the adjustment: each board placed from the camera that sees it best.
 RigState StartState(const std::vector<std::string>& names, const std::vector<MultiFrame>& frames,
-                    const std::vector<Camera>& cams, const std::vector<Rigid3d>& cam_from_ref,
-                    const PoseGrid& pose, const MultiOptions& options) {
+                    const std::vector<camera::Camera>& cams,
+                    const std::vector<geometry::Rigid3d>& cam_from_ref, const PoseGrid& pose,
+                    const MultiOptions& options) {
   const int nc = static_cast<int>(cams.size()), nf = static_cast<int>(frames.size());
   RigState s;
   s.intr.resize(nc);
@@ -567,7 +570,8 @@ RigState StartState(const std::vector<std::string>& names, const std::vector<Mul
       if (pose[c][f].ok && (best < 0 || pose[c][f].rms_px < pose[best][f].rms_px)) best = c;
     }
     if (best < 0) continue;
-    const Rigid3d ref_from_board = cam_from_ref[best].Inverse() * pose[best][f].cam_from_board;
+    const geometry::Rigid3d ref_from_board =
+        cam_from_ref[best].Inverse() * pose[best][f].cam_from_board;
     s.board_r[f] = ref_from_board.Rvec();
     s.board_t[f] = ref_from_board.translation;
     s.board_ok[f] = true;
@@ -627,7 +631,7 @@ void SolveRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOpt
       const BoardView& v = frames[f].views[c];
       for (size_t k = 0; k < v.image_points.size(); ++k) {
         problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<BoardCornerCost, 2, kNumIntrinsics, 3, 3, 3, 3>(
+            new ceres::AutoDiffCostFunction<BoardCornerCost, 2, camera::kNumIntrinsics, 3, 3, 3, 3>(
                 new BoardCornerCost(v.image_points[k], v.object_points[k])),
             new ceres::HuberLoss(options.loss_px), s->intr[c].data(), s->cam_r[c].data(),
             s->cam_t[c].data(), s->board_r[f].data(), s->board_t[f].data());
@@ -642,9 +646,10 @@ void SolveRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOpt
     }
     std::vector<int> constant;
     if (!s->tangential[c]) constant = {kP1, kP2};
-    for (int i = 4 + s->num_distortion[c]; i < kNumIntrinsics; ++i) constant.push_back(i);
+    for (int i = 4 + s->num_distortion[c]; i < camera::kNumIntrinsics; ++i) constant.push_back(i);
     if (!constant.empty()) {
-      problem.SetManifold(s->intr[c].data(), new ceres::SubsetManifold(kNumIntrinsics, constant));
+      problem.SetManifold(s->intr[c].data(),
+                          new ceres::SubsetManifold(camera::kNumIntrinsics, constant));
     }
   }
   if (problem.HasParameterBlock(s->cam_r[0].data())) {
@@ -681,7 +686,7 @@ int DropOutlierViews(RigState* s, const std::vector<MultiFrame>& frames,
       candidates.emplace_back(r, c, f);
     }
   }
-  const double med = Median(rms_all);
+  const double med = util::Median(rms_all);
   const double threshold = std::max(options.outlier_factor * med, options.outlier_min_px);
   std::sort(candidates.rbegin(), candidates.rend());
   int dropped_now = 0;
@@ -796,19 +801,20 @@ void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult*
 
 // Cameras, views and per-camera RMS of the final state.
 void CollectCameras(const std::vector<std::string>& names, const std::vector<MultiFrame>& frames,
-                    const std::vector<Camera>& cams, const RigState& s, const MultiOptions& options,
-                    MultiResult* result) {
+                    const std::vector<camera::Camera>& cams, const RigState& s,
+                    const MultiOptions& options, MultiResult* result) {
   const int nc = s.nc(), nf = s.nf();
   result->cameras.resize(nc);
   double sq_all = 0;
   long long n_all = 0;
   for (int c = 0; c < nc; ++c) {
-    Camera& cam = result->cameras[c];
+    camera::Camera& cam = result->cameras[c];
     cam = cams[c];
     cam.name = names[c];
     cam.SetIntrinsicsBlock(s.intr[c], s.num_distortion[c]);
     cam.has_pose = true;
-    cam.cam_from_world = c == 0 ? Rigid3d() : Rigid3d::FromRvecTvec(s.cam_r[c], s.cam_t[c]);
+    cam.cam_from_world =
+        c == 0 ? geometry::Rigid3d() : geometry::Rigid3d::FromRvecTvec(s.cam_r[c], s.cam_t[c]);
     double sq = 0;
     long long n = 0;
     auto& rep = result->camera_reports[c];
@@ -863,8 +869,9 @@ void CollectCameras(const std::vector<std::string>& names, const std::vector<Mul
 
 // OpenCV's stereoCalibrate on the corners both cameras see in their shared used views, each
 // camera's own calibrateCamera fit as the start, p1 p2 zero where neither camera kept them.
-void CompareWithOpenCv(const std::vector<MultiFrame>& frames, const std::vector<Camera>& cams,
-                       const RigState& s, const MultiResult& result, MultiPairReport* p) {
+void CompareWithOpenCv(const std::vector<MultiFrame>& frames,
+                       const std::vector<camera::Camera>& cams, const RigState& s,
+                       const MultiResult& result, MultiPairReport* p) {
   const int i = p->i, j = p->j;
   std::vector<std::vector<cv::Point3f>> obj;
   std::vector<std::vector<cv::Point2f>> img_i, img_j;
@@ -890,10 +897,10 @@ void CompareWithOpenCv(const std::vector<MultiFrame>& frames, const std::vector<
   }
   if (obj.size() < 3) return;
   const bool zero_tangent = !s.tangential[i] && !s.tangential[j];
-  auto k_of = [](const Camera& c) {
+  auto k_of = [](const camera::Camera& c) {
     return cv::Mat(cv::Matx33d(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1));
   };
-  auto d_of = [&](const Camera& c) {
+  auto d_of = [&](const camera::Camera& c) {
     cv::Mat d = c.distortion.empty() ? cv::Mat(cv::Mat::zeros(1, 5, CV_64F))
                                      : cv::Mat(c.distortion, true).reshape(1, 1);
     if (zero_tangent) d.at<double>(2) = d.at<double>(3) = 0.0;
@@ -912,18 +919,20 @@ void CompareWithOpenCv(const std::vector<MultiFrame>& frames, const std::vector<
   for (int u = 0; u < 3; ++u) {
     for (int v = 0; v < 3; ++v) r(u, v) = rot.at<double>(u, v);
   }
-  const Camera& a = result.cameras[i];
-  const Camera& b = result.cameras[j];
+  const camera::Camera& a = result.cameras[i];
+  const camera::Camera& b = result.cameras[j];
   p->has_opencv = true;
-  p->opencv_rotation_deg = RotationAngleBetween(r, Eigen::Matrix3d::Identity()) * kRadToDeg;
+  p->opencv_rotation_deg =
+      geometry::RotationAngleBetween(r, Eigen::Matrix3d::Identity()) * kRadToDeg;
   p->opencv_baseline_m = cv::norm(t);
   p->opencv_rotation_diff_deg =
-      RotationAngleBetween(r, b.cam_from_world.rotation * a.cam_from_world.rotation.transpose()) *
+      geometry::RotationAngleBetween(
+          r, b.cam_from_world.rotation * a.cam_from_world.rotation.transpose()) *
       kRadToDeg;
 }
 
 // Rotation, baseline and shared views of every camera pair (and OpenCV's, when asked).
-void CollectPairs(const std::vector<MultiFrame>& frames, const std::vector<Camera>& cams,
+void CollectPairs(const std::vector<MultiFrame>& frames, const std::vector<camera::Camera>& cams,
                   const RigState& s, const MultiOptions& options, MultiResult* result) {
   for (int i = 0; i < s.nc(); ++i) {
     for (int j = i + 1; j < s.nc(); ++j) {
@@ -931,12 +940,12 @@ void CollectPairs(const std::vector<MultiFrame>& frames, const std::vector<Camer
       p.i = i;
       p.j = j;
       for (int f = 0; f < s.nf(); ++f) p.shared_views += s.used[i][f] && s.used[j][f] ? 1 : 0;
-      const Camera& a = result->cameras[i];
-      const Camera& b = result->cameras[j];
-      p.rotation_deg =
-          RotationAngleBetween(b.cam_from_world.rotation * a.cam_from_world.rotation.transpose(),
-                               Eigen::Matrix3d::Identity()) *
-          kRadToDeg;
+      const camera::Camera& a = result->cameras[i];
+      const camera::Camera& b = result->cameras[j];
+      p.rotation_deg = geometry::RotationAngleBetween(
+                           b.cam_from_world.rotation * a.cam_from_world.rotation.transpose(),
+                           Eigen::Matrix3d::Identity()) *
+                       kRadToDeg;
       p.baseline_m = (a.CentreInWorld() - b.CentreInWorld()).norm();
       if (options.compare_opencv && p.shared_views >= 3) {
         CompareWithOpenCv(frames, cams, s, *result, &p);
@@ -985,10 +994,10 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
   CheckFrames(names, frames);
   MultiResult result;
   result.pairing = pairing.empty() ? "paired by moment" : pairing;
-  const std::vector<Camera> cams =
+  const std::vector<camera::Camera> cams =
       InitialIntrinsics(names, frames, options, &result.camera_reports);
   const PoseGrid pose = BoardPoses(cams, frames);
-  const std::vector<Rigid3d> cam_from_ref =
+  const std::vector<geometry::Rigid3d> cam_from_ref =
       ChainCameras(names, frames, cams, pose, options, &result.camera_reports);
   RigState state = StartState(names, frames, cams, cam_from_ref, pose, options);
   const int max_drop =
@@ -1029,7 +1038,7 @@ MultiResult CalibrateMulti(const std::vector<CameraViews>& cameras, const MultiO
 cv::Mat MultiCoveragePicture(const MultiResult& result, int camera) {
   FV_REQUIRE(camera >= 0 && camera < static_cast<int>(result.cameras.size()),
              "coverage picture: camera {} out of range", camera);
-  const Camera& cam = result.cameras[camera];
+  const camera::Camera& cam = result.cameras[camera];
   const auto& rep = result.camera_reports[camera];
   const double scale = std::min(1.0, 960.0 / cam.width);
   const int w = static_cast<int>(std::lround(cam.width * scale));

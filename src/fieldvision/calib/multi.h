@@ -59,7 +59,7 @@ struct MultiOptions {
   TangentialModel tangential = TangentialModel::kAuto;
   bool refine_intrinsics = true;  // intrinsics free in the bundle adjustment
   // Cameras whose intrinsics are known (by name): kept fixed, not calibrated again.
-  std::map<std::string, Camera> known_intrinsics;
+  std::map<std::string, camera::Camera> known_intrinsics;
   double loss_px = 1.0;  // Huber scale of the bundle adjustment
   // A view (one camera, one moment) is dropped when its RMS exceeds both outlier_factor x the
   // median view RMS and outlier_min_px, at most max_drop_fraction of the views.
@@ -137,7 +137,7 @@ struct MultiPairReport {
 
 struct MultiResult {
   // Intrinsics and pose in the first camera's frame (x_cam = R x_ref + t; first: identity).
-  std::vector<Camera> cameras;
+  std::vector<camera::Camera> cameras;
   std::vector<MultiCameraReport> camera_reports;
   std::vector<MultiPairReport> pairs;
   std::vector<MultiViewReport> views;  // every view with the board

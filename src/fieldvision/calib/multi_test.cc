@@ -22,11 +22,11 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 // A rig of `n` cameras on an arc of radius `radius_m` around the origin, looking at it.
-std::vector<Camera> ArcRig(int n, double radius_m, double arc_deg, int width, int height,
-                           double hfov_deg, Rng& rng) {
-  std::vector<Camera> cams;
+std::vector<camera::Camera> ArcRig(int n, double radius_m, double arc_deg, int width, int height,
+                                   double hfov_deg, util::Rng& rng) {
+  std::vector<camera::Camera> cams;
   for (int i = 0; i < n; ++i) {
-    Camera c = Camera::FromFov(width, height, hfov_deg);
+    camera::Camera c = camera::Camera::FromFov(width, height, hfov_deg);
     c.name = fmt::format("cam{}", i + 1);
     c.cx += rng.Uniform(-8, 8);
     c.cy += rng.Uniform(-8, 8);
@@ -36,14 +36,16 @@ std::vector<Camera> ArcRig(int n, double radius_m, double arc_deg, int width, in
     const Eigen::Vector3d eye(radius_m * std::sin(a), -radius_m * std::cos(a),
                               rng.Uniform(0.0, 0.4));
     c.has_pose = true;
-    c.cam_from_world = Rigid3d::LookAt(eye, Eigen::Vector3d(0, 0, rng.Uniform(-0.05, 0.05)));
+    c.cam_from_world =
+        geometry::Rigid3d::LookAt(eye, Eigen::Vector3d(0, 0, rng.Uniform(-0.05, 0.05)));
     cams.push_back(c);
   }
   return cams;
 }
 
 // A board pose near the origin, facing the -y side (where the cameras are), tilted at random.
-Rigid3d RandomBoardPose(const BoardSpec& b, Rng& rng, double spread_m, double tilt_deg) {
+geometry::Rigid3d RandomBoardPose(const BoardSpec& b, util::Rng& rng, double spread_m,
+                                  double tilt_deg) {
   // Board frame: x right, y down in the board, z into the board. Facing -y: board z = +y.
   Eigen::Matrix3d face;
   face.col(0) = Eigen::Vector3d(1, 0, 0);
@@ -52,8 +54,8 @@ Rigid3d RandomBoardPose(const BoardSpec& b, Rng& rng, double spread_m, double ti
   const Eigen::Vector3d tilt(rng.Uniform(-tilt_deg, tilt_deg) * kDeg,
                              rng.Uniform(-tilt_deg, tilt_deg) * kDeg,
                              rng.Uniform(-0.5 * tilt_deg, 0.5 * tilt_deg) * kDeg);
-  Rigid3d world_from_board;
-  world_from_board.rotation = face * RotationFromRvec(tilt);
+  geometry::Rigid3d world_from_board;
+  world_from_board.rotation = face * geometry::RotationFromRvec(tilt);
   const auto corners = b.CornerPositions();
   const Eigen::Vector3d centre_board(0.5 * corners.back().x, 0.5 * corners.back().y, 0);
   const Eigen::Vector3d centre(rng.Uniform(-spread_m, spread_m), rng.Uniform(-spread_m, spread_m),
@@ -64,12 +66,13 @@ Rigid3d RandomBoardPose(const BoardSpec& b, Rng& rng, double spread_m, double ti
 
 // The view of the board by `cam`: every corner in the image (chessboards need all), the board
 // facing the camera; image_points empty otherwise.
-BoardView ProjectView(const Camera& cam, const BoardSpec& b, const Rigid3d& world_from_board,
-                      double noise_px, Rng& rng, const std::string& name) {
+BoardView ProjectView(const camera::Camera& cam, const BoardSpec& b,
+                      const geometry::Rigid3d& world_from_board, double noise_px, util::Rng& rng,
+                      const std::string& name) {
   BoardView v;
   v.name = name;
   v.image_size = cv::Size(cam.width, cam.height);
-  const Rigid3d cam_from_board = cam.cam_from_world * world_from_board;
+  const geometry::Rigid3d cam_from_board = cam.cam_from_world * world_from_board;
   const Eigen::Vector3d normal_cam = cam_from_board.rotation.col(2);
   const Eigen::Vector3d to_board = cam_from_board.translation.normalized();
   if (normal_cam.dot(to_board) < 0.3) return v;  // seen too edge-on or from behind
@@ -87,20 +90,21 @@ BoardView ProjectView(const Camera& cam, const BoardSpec& b, const Rigid3d& worl
   return v;
 }
 
-std::vector<std::string> Names(const std::vector<Camera>& cams) {
+std::vector<std::string> Names(const std::vector<camera::Camera>& cams) {
   std::vector<std::string> n;
   for (const auto& c : cams) n.push_back(c.name);
   return n;
 }
 
 // Two 640x480 cameras: "left" at the origin, "right" at (right_from_left rvec, t).
-std::pair<Camera, Camera> StereoPair(const Eigen::Vector3d& rvec, const Eigen::Vector3d& t) {
-  Camera left = Camera::FromFov(640, 480, 60);
+std::pair<camera::Camera, camera::Camera> StereoPair(const Eigen::Vector3d& rvec,
+                                                     const Eigen::Vector3d& t) {
+  camera::Camera left = camera::Camera::FromFov(640, 480, 60);
   left.name = "left";
   left.has_pose = true;
-  Camera right = left;
+  camera::Camera right = left;
   right.name = "right";
-  right.cam_from_world.rotation = RotationFromRvec(rvec);
+  right.cam_from_world.rotation = geometry::RotationFromRvec(rvec);
   right.cam_from_world.translation = t;
   return {left, right};
 }
@@ -126,11 +130,11 @@ MultiOptions ProjectedOptions() {
 // `count` moments of the board near the origin seen by the `truth` cameras, 0.12 px of noise per
 // axis: what cornerSubPix measures on our rendered boards (the rendered stereo test below: 0.165
 // px RMS in 2D).
-std::vector<MultiFrame> ProjectedMoments(const std::vector<Camera>& truth, const BoardSpec& board,
-                                         int count, Rng& rng) {
+std::vector<MultiFrame> ProjectedMoments(const std::vector<camera::Camera>& truth,
+                                         const BoardSpec& board, int count, util::Rng& rng) {
   std::vector<MultiFrame> frames;
   for (int f = 0; f < count; ++f) {
-    const Rigid3d world_from_board = RandomBoardPose(board, rng, 0.3, 40);
+    const geometry::Rigid3d world_from_board = RandomBoardPose(board, rng, 0.3, 40);
     MultiFrame m;
     m.key = fmt::format("frame {}", f);
     for (const auto& c : truth) {
@@ -154,7 +158,7 @@ double WorstBaselineFraction(const RigComparison& cmp) {
 TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   const uint64_t seed = fv::testing::TestSeed(61);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto truth = ArcRig(4, 1.6, 100, 1280, 720, 60, rng);
   const MultiOptions o = ProjectedOptions();  // p1 p2 kept only where they pay (the truth: none)
   auto frames = ProjectedMoments(truth, o.board, 40, rng);
@@ -244,7 +248,7 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
 TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
   const uint64_t seed = fv::testing::TestSeed(66);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   auto truth = ArcRig(3, 1.6, 80, 1280, 720, 60, rng);
   truth[1].distortion[2] = 1.5e-3;  // p1, p2: a decentred lens (0.5-1.5 px at the edges)
   truth[1].distortion[3] = -1.0e-3;
@@ -279,7 +283,7 @@ TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
 TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
   const uint64_t seed = fv::testing::TestSeed(62);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto [left, right] =
       StereoPair(Eigen::Vector3d(0.01, -0.05, 0.005), Eigen::Vector3d(-0.1, 0.002, 0.004));
   MultiOptions o = RenderedOptions({BoardType::kChessboard, 9, 6, 0.025});
@@ -290,8 +294,8 @@ TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
   for (int f = 1; f <= 16; ++f) {
     const Eigen::Vector3d tilt(rng.Uniform(-0.6, 0.6), rng.Uniform(-0.6, 0.6),
                                rng.Uniform(-0.3, 0.3));
-    Rigid3d board;
-    board.rotation = RotationFromRvec(tilt);
+    geometry::Rigid3d board;
+    board.rotation = geometry::RotationFromRvec(tilt);
     board.translation = Eigen::Vector3d(-0.1 + rng.Uniform(-0.06, 0.06),
                                         -0.06 + rng.Uniform(-0.05, 0.05), rng.Uniform(0.45, 0.6));
     if (f == 5) board.translation.x() += 0.35;  // right camera cannot see all of it
@@ -327,7 +331,7 @@ TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
 TEST(Multi, SynchronizedVideos) {
   const uint64_t seed = fv::testing::TestSeed(65);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto [left, right] =
       StereoPair(Eigen::Vector3d(0.0, -0.08, 0.0), Eigen::Vector3d(-0.12, 0, 0));
   MultiOptions o = RenderedOptions({BoardType::kChessboard, 7, 5, 0.03});
@@ -341,8 +345,8 @@ TEST(Multi, SynchronizedVideos) {
                        cv::Size(640, 480), true);
     ASSERT_TRUE(wl.isOpened() && wr.isOpened());
     for (int f = 0; f < 12; ++f) {
-      Rigid3d board;
-      board.rotation = RotationFromRvec(
+      geometry::Rigid3d board;
+      board.rotation = geometry::RotationFromRvec(
           Eigen::Vector3d(rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5), rng.Uniform(-0.2, 0.2)));
       board.translation = Eigen::Vector3d(-0.04 + rng.Uniform(-0.04, 0.04),
                                           -0.06 + rng.Uniform(-0.04, 0.04), rng.Uniform(0.5, 0.6));
@@ -370,13 +374,13 @@ TEST(Multi, SynchronizedVideos) {
 TEST(Multi, ChArUcoPartialViewsAndAWrongDictionary) {
   const uint64_t seed = fv::testing::TestSeed(63);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  Camera a = Camera::FromFov(640, 480, 65);
+  util::Rng rng(seed);
+  camera::Camera a = camera::Camera::FromFov(640, 480, 65);
   a.name = "a";
   a.has_pose = true;
-  Camera b = a;
+  camera::Camera b = a;
   b.name = "b";
-  b.cam_from_world.rotation = RotationFromRvec(Eigen::Vector3d(0.0, -0.25, 0.0));
+  b.cam_from_world.rotation = geometry::RotationFromRvec(Eigen::Vector3d(0.0, -0.25, 0.0));
   b.cam_from_world.translation = Eigen::Vector3d(-0.2, 0.0, 0.03);
   MultiOptions o = RenderedOptions({BoardType::kCharuco, 7, 5, 0.04, 0.03, "DICT_4X4_50"});
   const BoardPicture picture = DrawBoard(o.board);
@@ -384,8 +388,8 @@ TEST(Multi, ChArUcoPartialViewsAndAWrongDictionary) {
   std::filesystem::create_directories(dir + "/a");
   std::filesystem::create_directories(dir + "/b");
   for (int f = 0; f < 14; ++f) {
-    Rigid3d board;
-    board.rotation = RotationFromRvec(
+    geometry::Rigid3d board;
+    board.rotation = geometry::RotationFromRvec(
         Eigen::Vector3d(rng.Uniform(-0.5, 0.5), rng.Uniform(-0.7, 0.3), rng.Uniform(-0.3, 0.3)));
     // Some views cut by an image edge: partial boards.
     board.translation = Eigen::Vector3d(-0.08 + rng.Uniform(-0.12, 0.12),
@@ -458,13 +462,13 @@ TEST(Multi, UnpairableViewsAndUnlinkedCamerasAreErrorsNamingTheCamera) {
   // Camera c never sees the board together with a or b.
   const uint64_t seed = fv::testing::TestSeed(64);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto rig = ArcRig(3, 2.5, 60, 1280, 720, 60, rng);
   MultiOptions o;
   o.board = {BoardType::kChessboard, 8, 6, 0.06};
   std::vector<MultiFrame> frames;
   for (int f = 0; f < 12; ++f) {
-    const Rigid3d board = RandomBoardPose(o.board, rng, 0.3, 25);
+    const geometry::Rigid3d board = RandomBoardPose(o.board, rng, 0.3, 25);
     MultiFrame m;
     m.key = std::to_string(f);
     for (int c = 0; c < 3; ++c) {
@@ -535,10 +539,11 @@ TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
     for (int j = 0; j < 3; ++j) rot_e(i, j) = rot.at<double>(i, j);
   }
   const Eigen::Vector3d t_e(t.at<double>(0), t.at<double>(1), t.at<double>(2));
-  const double ref_rot_deg = RotationAngleBetween(rot_e, Eigen::Matrix3d::Identity()) / kDeg;
+  const double ref_rot_deg =
+      geometry::RotationAngleBetween(rot_e, Eigen::Matrix3d::Identity()) / kDeg;
   const double ref_baseline_mm = 1000 * t_e.norm();
-  const Rigid3d& ours = r.cameras[1].cam_from_world;
-  const double rot_diff_deg = RotationAngleBetween(ours.rotation, rot_e) / kDeg;
+  const geometry::Rigid3d& ours = r.cameras[1].cam_from_world;
+  const double rot_diff_deg = geometry::RotationAngleBetween(ours.rotation, rot_e) / kDeg;
   const double baseline_mm = 1000 * r.pairs[0].baseline_m;
   std::cout << fmt::format(
       "multi: rotation {:.3f} deg, baseline {:.2f} mm, rms {:.3f} px; stereoCalibrate: rotation "
@@ -565,13 +570,14 @@ TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) rot_e(i, j) = rot_s.at<double>(i, j);
   }
-  const double sample_rot_deg = RotationAngleBetween(rot_e, Eigen::Matrix3d::Identity()) / kDeg;
+  const double sample_rot_deg =
+      geometry::RotationAngleBetween(rot_e, Eigen::Matrix3d::Identity()) / kDeg;
   const double sample_baseline_mm = 1000 * cv::norm(t_s);
   std::cout << fmt::format(
       "distortion models: {}; {}\nstereo_calib sample's flags: rotation {:.3f} deg, baseline "
       "{:.2f} mm, rms {:.3f} px; rotations differ by {:.3f} deg, baselines by {:.2f} %\n",
       r.camera_reports[0].model, r.camera_reports[1].model, sample_rot_deg, sample_baseline_mm,
-      sample_rms, RotationAngleBetween(ours.rotation, rot_e) / kDeg,
+      sample_rms, geometry::RotationAngleBetween(ours.rotation, rot_e) / kDeg,
       100 * (baseline_mm - sample_baseline_mm) / sample_baseline_mm);
   EXPECT_LT(rot_diff_deg, 0.1) << r.Summary();
   // The library's own comparison agrees with this one.

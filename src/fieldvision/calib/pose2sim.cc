@@ -27,7 +27,7 @@ std::map<std::string, double> Attributes(const std::string& tag) {
 
 }  // namespace
 
-std::vector<Camera> ReadQualisysCalibration(const std::string& path) {
+std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "Qualisys calibration '{}' cannot be read", path);
   std::stringstream ss;
@@ -35,7 +35,7 @@ std::vector<Camera> ReadQualisysCalibration(const std::string& path) {
   const std::string text = ss.str();
   static const std::regex kCamera(
       R"(<camera [^>]*serial=\"([^\"]*)\"[\s\S]*?<fov_video ([^>]*)/>[\s\S]*?<transform ([^>]*)/>\s*<intrinsic ([^>]*)/>)");
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   for (auto it = std::sregex_iterator(text.begin(), text.end(), kCamera);
        it != std::sregex_iterator(); ++it) {
     const auto fov = Attributes((*it)[2]);
@@ -50,7 +50,7 @@ std::vector<Camera> ReadQualisysCalibration(const std::string& path) {
       FV_REQUIRE(k.count(key), "Qualisys calibration '{}': camera {} has no intrinsic {}", path,
                  (*it)[1].str(), key);
     }
-    Camera c;
+    camera::Camera c;
     c.name = (*it)[1];
     c.width = static_cast<int>(fov.at("right") - fov.at("left") + 1);
     c.height = static_cast<int>(fov.at("bottom") - fov.at("top") + 1);
@@ -96,7 +96,8 @@ std::string RigComparison::Summary() const {
   return s;
 }
 
-RigComparison CompareRigs(const std::vector<Camera>& a, const std::vector<Camera>& b) {
+RigComparison CompareRigs(const std::vector<camera::Camera>& a,
+                          const std::vector<camera::Camera>& b) {
   FV_REQUIRE(a.size() == b.size() && a.size() >= 2,
              "rig comparison needs two lists of the same cameras (got {} and {})", a.size(),
              b.size());
@@ -116,7 +117,7 @@ RigComparison CompareRigs(const std::vector<Camera>& a, const std::vector<Camera
           a[i].cam_from_world.rotation * a[j].cam_from_world.rotation.transpose();
       const Eigen::Matrix3d rel_b =
           b[i].cam_from_world.rotation * b[j].cam_from_world.rotation.transpose();
-      p.relative_rotation_diff_deg = RotationAngleBetween(rel_a, rel_b) * 180.0 / M_PI;
+      p.relative_rotation_diff_deg = geometry::RotationAngleBetween(rel_a, rel_b) * 180.0 / M_PI;
       out.max_baseline_diff_mm = std::max(out.max_baseline_diff_mm, std::abs(p.baseline_diff_mm));
       out.max_rotation_diff_deg = std::max(out.max_rotation_diff_deg, p.relative_rotation_diff_deg);
       out.pairs.push_back(p);

@@ -1,9 +1,9 @@
 // Reading the Pose2Sim demo's reference calibration (a Qualisys .qca.txt export: per camera the
 // pose as camera position in mm and orientation, intrinsics in sensor units of 1/64 px) into
-// fv::Camera, and frame-independent comparisons of two calibrations of the same rig: distances
-// between camera centres and relative rotations between cameras, plus the residuals of the best
-// rigid alignment of the centres (Kabsch/Umeyama without scale). Used by the real-data tests and
-// `calibrate rig`-style reports.
+// fv::camera::Camera, and frame-independent comparisons of two calibrations of the same rig:
+// distances between camera centres and relative rotations between cameras, plus the residuals of
+// the best rigid alignment of the centres (Kabsch/Umeyama without scale). Used by the real-data
+// tests and `calibrate rig`-style reports.
 #pragma once
 
 #include <string>
@@ -17,7 +17,7 @@ namespace fv::calib {
 // Pose2Sim does (the transform's rows are Qualisys' camera axes, looking along -z with y up: x_cam
 // = Rx(pi) R (x - position)). Throws fv::Error naming the file when it cannot be read or has no
 // cameras.
-std::vector<Camera> ReadQualisysCalibration(const std::string& path);
+std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path);
 
 struct RigComparison {
   // Per pair (i < j): |C_i - C_j| of a minus that of b (mm), and the angle of
@@ -35,6 +35,7 @@ struct RigComparison {
 };
 
 // Both lists in the same camera order, all with poses; throws when sizes differ or < 2.
-RigComparison CompareRigs(const std::vector<Camera>& a, const std::vector<Camera>& b);
+RigComparison CompareRigs(const std::vector<camera::Camera>& a,
+                          const std::vector<camera::Camera>& b);
 
 }  // namespace fv::calib

@@ -25,7 +25,7 @@ std::string TestData(const std::string& name) {
 }
 
 std::vector<PointCorrespondence> ScenePoints(const std::string& camera) {
-  const CsvTable t = CsvTable::Read(TestData("pose2sim_scene_points.csv"));
+  const util::CsvTable t = util::CsvTable::Read(TestData("pose2sim_scene_points.csv"));
   std::vector<PointCorrespondence> pts;
   for (size_t r = 0; r < t.rows(); ++r) {
     if (t.Get(r, "camera") != camera) continue;
@@ -59,7 +59,7 @@ TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {
   if (data.empty()) GTEST_SKIP() << "no shared data";
   const std::string root = data + "/pose2sim-4cam/calibration";
   const auto ref = ReadQualisysCalibration(root + "/Calib.qca.txt");
-  std::vector<Camera> ours, with_ref_intrinsics;
+  std::vector<camera::Camera> ours, with_ref_intrinsics;
   for (int c = 1; c <= 4; ++c) {
     IntrinsicsOptions o;
     o.board = {BoardType::kChessboard, 4, 7, 0.06};  // Config.toml: corners [4, 7], 60 mm
@@ -69,7 +69,7 @@ TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {
     o.detect.full_resolution_retry = false;
     const IntrinsicsResult in =
         CalibrateIntrinsics(fmt::format("{}/intrinsics/int_cam{:02d}_img", root, c), o);
-    const Camera& q = ref[c - 1];
+    const camera::Camera& q = ref[c - 1];
     std::cout << fmt::format(
         "cam{:02d} intrinsics: {}\n  Qualisys: fx {:.1f} fy {:.1f} cx {:.1f} "
         "cy {:.1f}\n",
@@ -97,7 +97,7 @@ TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {
     EXPECT_LT(ex.rms_px, 8.0);
     ours.push_back(ex.camera);
     // The same clicks with the reference's intrinsics, to tell clicking from intrinsics.
-    Camera q_intrinsics = q;
+    camera::Camera q_intrinsics = q;
     q_intrinsics.has_pose = false;
     with_ref_intrinsics.push_back(EstimatePose(q_intrinsics, pts, eo).camera);
   }
@@ -150,7 +150,7 @@ TEST(Pose2Sim, FocalFromTheClickedPointsAloneIsHonest) {
     // Default gates (8 px): cam04's one bad click (15 px off) is left out, not two good ones.
     const FocalResult r = EstimateFocalAndPose(1088, 1920, pts);
     EXPECT_GE(r.num_inliers, static_cast<int>(pts.size()) - 1) << r.Summary();
-    const Camera& q = ref[c - 1];
+    const camera::Camera& q = ref[c - 1];
     std::cout << fmt::format(
         "cam{:02d} from {} clicks: {}\n  Qualisys fx {:.1f} px: off by {:+.1f} px\n", c, pts.size(),
         r.Summary(), q.fx, r.camera.fx - q.fx);
@@ -165,8 +165,8 @@ TEST(Pose2Sim, CompareRigsIsFrameIndependent) {
   if (data.empty()) GTEST_SKIP() << "no shared data";
   const auto ref = ReadQualisysCalibration(data + "/pose2sim-4cam/calibration/Calib.qca.txt");
   // The same rig in another world frame compares equal.
-  const Rigid3d world_from_other = {RotationFromRvec(Eigen::Vector3d(0.3, -0.2, 1.0)),
-                                    Eigen::Vector3d(5, -3, 1)};
+  const geometry::Rigid3d world_from_other = {
+      geometry::RotationFromRvec(Eigen::Vector3d(0.3, -0.2, 1.0)), Eigen::Vector3d(5, -3, 1)};
   auto moved = ref;
   for (auto& c : moved) c.cam_from_world = c.cam_from_world * world_from_other;
   const RigComparison same = CompareRigs(moved, ref);
@@ -174,8 +174,8 @@ TEST(Pose2Sim, CompareRigsIsFrameIndependent) {
   EXPECT_LT(same.max_rotation_diff_deg, 1e-6);
   EXPECT_LT(same.rms_aligned_err_mm, 1e-6);
   // A camera turned by 1 degree shows up.
-  moved[2].cam_from_world.rotation =
-      RotationFromRvec(Eigen::Vector3d(0, M_PI / 180, 0)) * moved[2].cam_from_world.rotation;
+  moved[2].cam_from_world.rotation = geometry::RotationFromRvec(Eigen::Vector3d(0, M_PI / 180, 0)) *
+                                     moved[2].cam_from_world.rotation;
   EXPECT_NEAR(CompareRigs(moved, ref).max_rotation_diff_deg, 1.0, 1e-6);
   EXPECT_THROW(ReadQualisysCalibration(data + "/pose2sim-4cam/Config.toml"), Error);
 }

@@ -15,7 +15,7 @@
 namespace fv::calib {
 namespace {
 
-double RmsPx(const Camera& cam, const std::vector<RigObservation>& obs,
+double RmsPx(const camera::Camera& cam, const std::vector<RigObservation>& obs,
              const std::map<std::string, Eigen::Vector3d>& points) {
   double sq = 0;
   int n = 0;
@@ -30,8 +30,9 @@ double RmsPx(const Camera& cam, const std::vector<RigObservation>& obs,
 
 }  // namespace
 
-std::vector<RigObservation> ReadRigObservations(const std::string& path, const FieldModel* field) {
-  const CsvTable t = CsvTable::Read(path);
+std::vector<RigObservation> ReadRigObservations(const std::string& path,
+                                                const field::FieldModel* field) {
+  const util::CsvTable t = util::CsvTable::Read(path);
   t.Require({"u", "v", "name"});
   const bool xyz = t.Has("x") && t.Has("y") && t.Has("z");
   std::vector<RigObservation> out;
@@ -45,7 +46,7 @@ std::vector<RigObservation> ReadRigObservations(const std::string& path, const F
       o.p_world = Eigen::Vector3d(t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "z"));
       FV_REQUIRE(o.p_world->allFinite(), "{}: x, y and z must be finite", t.Where(r));
     } else if (field != nullptr) {
-      if (const FieldKeypoint* k = field->FindKeypoint(o.name)) o.p_world = k->position_m;
+      if (const field::FieldKeypoint* k = field->FindKeypoint(o.name)) o.p_world = k->position_m;
     }
     out.push_back(o);
   }
@@ -74,7 +75,7 @@ std::string RigResult::Summary() const {
   return s;
 }
 
-RigResult RefineRig(const std::vector<Camera>& cameras,
+RigResult RefineRig(const std::vector<camera::Camera>& cameras,
                     const std::vector<std::vector<RigObservation>>& observations,
                     const RigOptions& options) {
   options.Check();
@@ -178,17 +179,17 @@ RigResult RefineRig(const std::vector<Camera>& cameras,
     result.free_points.emplace_back(name, p);
   }
   for (size_t i = 0; i < cameras.size(); ++i) {
-    Camera& c = result.cameras[i];
-    c.cam_from_world = Rigid3d::FromRvecTvec(rvecs[i], tvecs[i]);
+    camera::Camera& c = result.cameras[i];
+    c.cam_from_world = geometry::Rigid3d::FromRvecTvec(rvecs[i], tvecs[i]);
     RigCameraReport rep;
     rep.name = cam_name(i);
     rep.num_observations = static_cast<int>(observations[i].size());
     rep.rms_before_px = RmsPx(cameras[i], observations[i], points);
     rep.rms_after_px = RmsPx(c, observations[i], refined_points);
     rep.moved_mm = 1000.0 * (c.CentreInWorld() - cameras[i].CentreInWorld()).norm();
-    rep.rotated_deg =
-        RotationAngleBetween(c.cam_from_world.rotation, cameras[i].cam_from_world.rotation) *
-        180.0 / M_PI;
+    rep.rotated_deg = geometry::RotationAngleBetween(c.cam_from_world.rotation,
+                                                     cameras[i].cam_from_world.rotation) *
+                      180.0 / M_PI;
     result.reports.push_back(rep);
   }
   return result;

@@ -24,7 +24,8 @@ struct RigObservation {
 
 // Reads a camera's observations: columns u,v,name and optionally x,y,z. A name that is a
 // keypoint of `field` (may be null) gets its position; other names without x,y,z are free.
-std::vector<RigObservation> ReadRigObservations(const std::string& path, const FieldModel* field);
+std::vector<RigObservation> ReadRigObservations(const std::string& path,
+                                                const field::FieldModel* field);
 
 struct RigOptions {
   double huber_px = 3.0;  // robust loss scale
@@ -43,7 +44,7 @@ struct RigCameraReport {
 };
 
 struct RigResult {
-  std::vector<Camera> cameras;  // refined, in input order
+  std::vector<camera::Camera> cameras;  // refined, in input order
   std::vector<RigCameraReport> reports;
   std::vector<std::pair<std::string, Eigen::Vector3d>> free_points;  // refined positions
   int iterations = 0;
@@ -54,7 +55,7 @@ struct RigResult {
 // Cameras must have poses; observations[i] belongs to cameras[i]. Throws fv::Error naming the
 // camera or point when the input cannot define the rig (too few observations, a free point seen
 // by one camera only, too few known points).
-RigResult RefineRig(const std::vector<Camera>& cameras,
+RigResult RefineRig(const std::vector<camera::Camera>& cameras,
                     const std::vector<std::vector<RigObservation>>& observations,
                     const RigOptions& options = {});
 

@@ -52,11 +52,11 @@ struct RigLinePixelCost {
   const Interpolator* interp_;
 };
 
-Rigid3d CorrectionFrom(const Eigen::Vector3d& rvec, const Eigen::Vector3d& tvec,
-                       const Eigen::Vector2d& pivot) {
-  const Eigen::Matrix3d r = RotationFromRvec(rvec);
+geometry::Rigid3d CorrectionFrom(const Eigen::Vector3d& rvec, const Eigen::Vector3d& tvec,
+                                 const Eigen::Vector2d& pivot) {
+  const Eigen::Matrix3d r = geometry::RotationFromRvec(rvec);
   const Eigen::Vector3d o(pivot.x(), pivot.y(), 0.0);
-  return Rigid3d{r, o - r * o + tvec};
+  return geometry::Rigid3d{r, o - r * o + tvec};
 }
 
 }  // namespace
@@ -80,9 +80,10 @@ std::string RigRefineResult::Summary() const {
   return s;
 }
 
-RigRefineResult RefineRigWithLinePixels(const std::vector<Camera>& rig,
+RigRefineResult RefineRigWithLinePixels(const std::vector<camera::Camera>& rig,
                                         const std::vector<std::vector<Eigen::Vector2d>>& pixels,
-                                        const FieldModel& field, const RefineOptions& options) {
+                                        const field::FieldModel& field,
+                                        const RefineOptions& options) {
   options.Check();
   FV_REQUIRE(!rig.empty(), "the rig has no cameras");
   FV_REQUIRE(pixels.size() == rig.size(), "{} cameras but {} line pixel lists", rig.size(),
@@ -96,7 +97,7 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<Camera>& rig,
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;
   Eigen::Vector2d pivot = Eigen::Vector2d::Zero();
   for (size_t i = 0; i < rig.size(); ++i) {
-    const Camera& cam = rig[i];
+    const camera::Camera& cam = rig[i];
     cam.Check("rig camera '" + cam.name + "'");
     FV_REQUIRE(cam.has_pose, "rig camera '{}' has no pose; place the rig first", cam.name);
     result.num_line_pixels[i] = static_cast<int>(pixels[i].size());
@@ -144,7 +145,7 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<Camera>& rig,
     return result;
   }
   result.correction = CorrectionFrom(rvec, tvec, pivot);
-  std::vector<Camera> refined = rig;
+  std::vector<camera::Camera> refined = rig;
   for (size_t i = 0; i < rig.size(); ++i) {
     refined[i].cam_from_world = rig[i].cam_from_world * result.correction;
     result.moved_m =
@@ -170,9 +171,9 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<Camera>& rig,
   return result;
 }
 
-RigRefineResult RefineRigWithLines(const std::vector<Camera>& rig,
-                                   const std::vector<cv::Mat>& images, const FieldModel& field,
-                                   const RefineOptions& options) {
+RigRefineResult RefineRigWithLines(const std::vector<camera::Camera>& rig,
+                                   const std::vector<cv::Mat>& images,
+                                   const field::FieldModel& field, const RefineOptions& options) {
   options.Check();
   FV_REQUIRE(images.size() == rig.size(), "{} cameras but {} frames", rig.size(), images.size());
   std::vector<std::vector<Eigen::Vector2d>> pixels(rig.size());

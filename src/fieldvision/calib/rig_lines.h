@@ -19,13 +19,13 @@
 namespace fv::calib {
 
 struct RigRefineResult {
-  std::vector<Camera> cameras;  // refined rig (the input when not accepted)
+  std::vector<camera::Camera> cameras;  // refined rig (the input when not accepted)
   bool accepted = false;
   std::string status;  // why not accepted
   // Per camera (no pixels: zeros).
   std::vector<int> num_line_pixels;
   std::vector<LineErrorStats> before, after;
-  Rigid3d correction;  // new cam_from_world = old cam_from_world * correction
+  geometry::Rigid3d correction;  // new cam_from_world = old cam_from_world * correction
   int iterations = 0;
   double initial_cost = 0.0, final_cost = 0.0;
   double moved_m = 0.0;      // largest camera centre change
@@ -36,13 +36,15 @@ struct RigRefineResult {
 // rig: cameras with world poses (e.g. PlaceRig's); pixels[i]: camera i's line pixels (may be
 // empty). Throws fv::Error when a camera has no pose or the lists differ in size; too few line
 // pixels over all cameras is a result with accepted = false.
-RigRefineResult RefineRigWithLinePixels(const std::vector<Camera>& rig,
+RigRefineResult RefineRigWithLinePixels(const std::vector<camera::Camera>& rig,
                                         const std::vector<std::vector<Eigen::Vector2d>>& pixels,
-                                        const FieldModel& field, const RefineOptions& options = {});
+                                        const field::FieldModel& field,
+                                        const RefineOptions& options = {});
 
 // The same from frames: images[i] is camera i's frame (empty Mat: no frame for that camera).
-RigRefineResult RefineRigWithLines(const std::vector<Camera>& rig,
-                                   const std::vector<cv::Mat>& images, const FieldModel& field,
+RigRefineResult RefineRigWithLines(const std::vector<camera::Camera>& rig,
+                                   const std::vector<cv::Mat>& images,
+                                   const field::FieldModel& field,
                                    const RefineOptions& options = {});
 
 }  // namespace fv::calib

@@ -47,10 +47,10 @@ double Quantile(std::vector<double> v, double q) {
 TEST(RigLines, SixNoisyClicksThenTheLinesOfAllCamerasPlaceTheRigWithin1cm) {
   const uint64_t seed = fv::testing::TestSeed(81);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const std::vector<Camera>& truth = Scene().scene.cameras();
+  util::Rng rng(seed);
+  const std::vector<camera::Camera>& truth = Scene().scene.cameras();
   ASSERT_EQ(truth.size(), 4u);
-  const FieldModel& field = Scene().scene.field();
+  const field::FieldModel& field = Scene().scene.field();
   const std::vector<cv::Mat>& frames = Scene().frames;
   const auto rig = InRigFrame(truth);
   std::vector<double> clicked, refined, clicked_spread, refined_spread;
@@ -71,8 +71,9 @@ TEST(RigLines, SixNoisyClicksThenTheLinesOfAllCamerasPlaceTheRigWithin1cm) {
     }
     // The relative poses are kept.
     for (size_t i = 1; i < truth.size(); ++i) {
-      const Rigid3d before = placed.cameras[i].cam_from_world * placed.cameras[0].world_from_cam();
-      const Rigid3d after = r.cameras[i].cam_from_world * r.cameras[0].world_from_cam();
+      const geometry::Rigid3d before =
+          placed.cameras[i].cam_from_world * placed.cameras[0].world_from_cam();
+      const geometry::Rigid3d after = r.cameras[i].cam_from_world * r.cameras[0].world_from_cam();
       EXPECT_LT((before.translation - after.translation).norm(), 1e-9);
     }
 
@@ -105,14 +106,15 @@ TEST(RigLines, SixNoisyClicksThenTheLinesOfAllCamerasPlaceTheRigWithin1cm) {
 TEST(RigLines, CamerasWithoutFramesFollowAndBadInputsAreErrors) {
   const uint64_t seed = fv::testing::TestSeed(82);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const std::vector<Camera>& truth = Scene().scene.cameras();
-  const FieldModel& field = Scene().scene.field();
+  util::Rng rng(seed);
+  const std::vector<camera::Camera>& truth = Scene().scene.cameras();
+  const field::FieldModel& field = Scene().scene.field();
   const std::vector<cv::Mat>& frames = Scene().frames;
   // The rig a few cm and 0.1 deg off; only camera 1's frame.
-  const Rigid3d off{RotationFromRvec(Eigen::Vector3d(0, 0, 0.1 * M_PI / 180)),
-                    Eigen::Vector3d(rng.Uniform(0.03, 0.05), rng.Uniform(-0.05, -0.03), 0.0)};
-  std::vector<Camera> start = truth;
+  const geometry::Rigid3d off{
+      geometry::RotationFromRvec(Eigen::Vector3d(0, 0, 0.1 * M_PI / 180)),
+      Eigen::Vector3d(rng.Uniform(0.03, 0.05), rng.Uniform(-0.05, -0.03), 0.0)};
+  std::vector<camera::Camera> start = truth;
   for (auto& c : start) c.cam_from_world = c.cam_from_world * off;
   ASSERT_GT(WorstCentreErrorM(start, truth), 0.04);
   std::vector<cv::Mat> one(4);
@@ -136,7 +138,7 @@ TEST(RigLines, CamerasWithoutFramesFollowAndBadInputsAreErrors) {
   std::vector<cv::Mat> small(4);
   small[0] = cv::Mat(480, 640, CV_8UC3, cv::Scalar(0, 120, 0));
   EXPECT_THROW(RefineRigWithLines(start, small, field), Error);
-  std::vector<Camera> no_pose = start;
+  std::vector<camera::Camera> no_pose = start;
   no_pose[3].has_pose = false;
   EXPECT_THROW(RefineRigWithLines(no_pose, frames, field), Error);
 }

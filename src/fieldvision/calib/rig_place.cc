@@ -19,7 +19,7 @@ namespace {
 // A world point seen by camera i of the rig: p_ref = R p + t (ref_from_world), then the camera's
 // fixed pose in the rig and its intrinsics.
 struct RigPointCost {
-  RigPointCost(const Camera& cam, const Eigen::Vector2d& uv, const Eigen::Vector3d& p)
+  RigPointCost(const camera::Camera& cam, const Eigen::Vector2d& uv, const Eigen::Vector3d& p)
       : intr(cam.IntrinsicsBlock()),
         cam_r(cam.cam_from_world.Rvec()),
         cam_t(cam.cam_from_world.translation),
@@ -31,19 +31,19 @@ struct RigPointCost {
     T p_ref[3];
     ceres::AngleAxisRotatePoint(r, pw, p_ref);
     for (int k = 0; k < 3; ++k) p_ref[k] += t[k];
-    T in[kNumIntrinsics], cr[3], ct[3];
-    for (int k = 0; k < kNumIntrinsics; ++k) in[k] = T(intr[k]);
+    T in[camera::kNumIntrinsics], cr[3], ct[3];
+    for (int k = 0; k < camera::kNumIntrinsics; ++k) in[k] = T(intr[k]);
     for (int k = 0; k < 3; ++k) {
       cr[k] = T(cam_r[k]);
       ct[k] = T(cam_t[k]);
     }
     T px[2];
-    if (!ProjectWorldPoint(in, cr, ct, p_ref, px)) return false;
+    if (!camera::ProjectWorldPoint(in, cr, ct, p_ref, px)) return false;
     residual[0] = px[0] - T(uv.x());
     residual[1] = px[1] - T(uv.y());
     return true;
   }
-  std::array<double, kNumIntrinsics> intr;
+  std::array<double, camera::kNumIntrinsics> intr;
   Eigen::Vector3d cam_r, cam_t;
   Eigen::Vector2d uv;
   Eigen::Vector3d p;
@@ -58,7 +58,8 @@ struct Obs {
 
 // Linear generalized PnP: every observation's ray constraint (x p_z - p_x = 0, y p_z - p_y = 0 on
 // p_cam = A (R p + t) + b) stacked in the unknowns R, t and a homogeneous scale.
-std::vector<Rigid3d> LinearRigPose(const std::vector<Camera>& rig, const std::vector<Obs>& obs) {
+std::vector<geometry::Rigid3d> LinearRigPose(const std::vector<camera::Camera>& rig,
+                                             const std::vector<Obs>& obs) {
   bool planar = true;
   bool offset = false;
   for (const auto& o : obs) planar = planar && std::abs(o.p.z()) < 1e-9;
@@ -73,7 +74,7 @@ std::vector<Rigid3d> LinearRigPose(const std::vector<Camera>& rig, const std::ve
   }
   Eigen::MatrixXd a(2 * obs.size(), cols.size());
   for (size_t i = 0; i < obs.size(); ++i) {
-    const Camera& cam = rig[obs[i].camera];
+    const camera::Camera& cam = rig[obs[i].camera];
     const auto n = cam.Undistort(obs[i].uv);
     if (!n) return {};
     Eigen::Matrix<double, 3, 13> m = Eigen::Matrix<double, 3, 13>::Zero();
@@ -96,7 +97,7 @@ std::vector<Rigid3d> LinearRigPose(const std::vector<Camera>& rig, const std::ve
   // The smallest singular vectors: few points per camera leave spurious exact null vectors
   // (R = 0 with t at a camera centre; a rank-1 R with t = 0), so each of the last three is a
   // candidate and the caller keeps the one that fits best after refinement.
-  std::vector<Rigid3d> out;
+  std::vector<geometry::Rigid3d> out;
   const int nv = static_cast<int>(cols.size());
   for (int idx = nv - 1; idx >= std::max(0, nv - 3); --idx) {
     const Eigen::VectorXd v = svd.matrixV().col(idx);
@@ -124,21 +125,21 @@ std::vector<Rigid3d> LinearRigPose(const std::vector<Camera>& rig, const std::ve
       const Eigen::JacobiSVD<Eigen::Matrix3d> svd3(rs, Eigen::ComputeFullU | Eigen::ComputeFullV);
       const Eigen::Matrix3d rot = svd3.matrixU() * svd3.matrixV().transpose();
       if (rot.determinant() < 0 || !rot.allFinite()) continue;
-      out.push_back(Rigid3d{rot, sign * t});
+      out.push_back(geometry::Rigid3d{rot, sign * t});
     }
   }
   return out;
 }
 
 // Given the rotation of ref_from_world, the translation is linear in the ray constraints.
-std::optional<Eigen::Vector3d> TranslationFor(const std::vector<Camera>& rig,
+std::optional<Eigen::Vector3d> TranslationFor(const std::vector<camera::Camera>& rig,
                                               const std::vector<Obs>& obs,
                                               const std::vector<Eigen::Vector2d>& rays,
                                               const Eigen::Matrix3d& r) {
   Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
   Eigen::Vector3d atb = Eigen::Vector3d::Zero();
   for (size_t i = 0; i < obs.size(); ++i) {
-    const Rigid3d& c = rig[obs[i].camera].cam_from_world;
+    const geometry::Rigid3d& c = rig[obs[i].camera].cam_from_world;
     // c1 . (A (R p + t) + b) = 0, c2 . (...) = 0
     const Eigen::Vector3d q = c.rotation * (r * obs[i].p) + c.translation;
     const Eigen::RowVector3d c1(-1, 0, rays[i].x()), c2(0, -1, rays[i].y());
@@ -154,8 +155,8 @@ std::optional<Eigen::Vector3d> TranslationFor(const std::vector<Camera>& rig,
 
 // Starts from rotations spread over SO(3) (deterministic pseudo-random unit quaternions), each
 // with its best translation; the `keep` with the smallest truncated reprojection error.
-std::vector<Rigid3d> SampledRigPoses(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
-                                     int samples, int keep) {
+std::vector<geometry::Rigid3d> SampledRigPoses(const std::vector<camera::Camera>& rig,
+                                               const std::vector<Obs>& obs, int samples, int keep) {
   std::vector<Eigen::Vector2d> rays;
   for (const auto& o : obs) {
     const auto n = rig[o.camera].Undistort(o.uv);
@@ -164,7 +165,7 @@ std::vector<Rigid3d> SampledRigPoses(const std::vector<Camera>& rig, const std::
   }
   std::mt19937 rng(12345);
   std::normal_distribution<double> normal;
-  std::vector<std::pair<double, Rigid3d>> scored;
+  std::vector<std::pair<double, geometry::Rigid3d>> scored;
   for (int k = 0; k < samples; ++k) {
     Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
     q.normalize();
@@ -173,23 +174,24 @@ std::vector<Rigid3d> SampledRigPoses(const std::vector<Camera>& rig, const std::
     if (!t) continue;
     double score = 0;
     for (size_t i = 0; i < obs.size(); ++i) {
-      const Camera& cam = rig[obs[i].camera];
+      const camera::Camera& cam = rig[obs[i].camera];
       const auto uv = cam.ProjectFromCamera(cam.cam_from_world * (r * obs[i].p + *t));
       score += uv ? std::min((*uv - obs[i].uv).squaredNorm(), 2500.0) : 2500.0;
     }
-    scored.emplace_back(score, Rigid3d{r, *t});
+    scored.emplace_back(score, geometry::Rigid3d{r, *t});
   }
   std::sort(scored.begin(), scored.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<Rigid3d> out;
+  std::vector<geometry::Rigid3d> out;
   for (int k = 0; k < keep && k < static_cast<int>(scored.size()); ++k) {
     out.push_back(scored[k].second);
   }
   return out;
 }
 
-std::vector<Camera> Placed(const std::vector<Camera>& rig, const Rigid3d& ref_from_world) {
-  std::vector<Camera> out = rig;
+std::vector<camera::Camera> Placed(const std::vector<camera::Camera>& rig,
+                                   const geometry::Rigid3d& ref_from_world) {
+  std::vector<camera::Camera> out = rig;
   for (auto& c : out) c.cam_from_world = c.cam_from_world * ref_from_world;
   return out;
 }
@@ -219,19 +221,19 @@ std::string RigPlacementResult::Summary() const {
   return s;
 }
 
-std::vector<Camera> CarryRig(const std::vector<Camera>& rig, int k,
-                             const Rigid3d& cam_k_from_world) {
+std::vector<camera::Camera> CarryRig(const std::vector<camera::Camera>& rig, int k,
+                                     const geometry::Rigid3d& cam_k_from_world) {
   FV_REQUIRE(k >= 0 && k < static_cast<int>(rig.size()), "rig camera {} out of range", k);
   for (const auto& c : rig) {
     FV_REQUIRE(c.has_pose, "rig camera '{}' has no pose in the rig", c.name);
   }
-  const Rigid3d ref_from_world = rig[k].cam_from_world.Inverse() * cam_k_from_world;
+  const geometry::Rigid3d ref_from_world = rig[k].cam_from_world.Inverse() * cam_k_from_world;
   return Placed(rig, ref_from_world);
 }
 
 namespace {  // The stages of PlaceRig.
 
-std::vector<Obs> CollectObservations(const std::vector<Camera>& rig,
+std::vector<Obs> CollectObservations(const std::vector<camera::Camera>& rig,
                                      const std::vector<std::vector<PointCorrespondence>>& points,
                                      const RigPlacementOptions& options) {
   FV_REQUIRE(!rig.empty(), "the rig has no cameras");
@@ -256,9 +258,10 @@ std::vector<Obs> CollectObservations(const std::vector<Camera>& rig,
 }
 
 // The rig's placement (ref_from_world) fitted to the inlier observations from `start`.
-Rigid3d RefinePlacement(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
-                        const RigPlacementOptions& options, const Rigid3d& start,
-                        const std::vector<bool>& inlier, int* iterations, double* cost) {
+geometry::Rigid3d RefinePlacement(const std::vector<camera::Camera>& rig,
+                                  const std::vector<Obs>& obs, const RigPlacementOptions& options,
+                                  const geometry::Rigid3d& start, const std::vector<bool>& inlier,
+                                  int* iterations, double* cost) {
   Eigen::Vector3d r = start.Rvec(), t = start.translation;
   ceres::Problem problem;
   for (size_t k = 0; k < obs.size(); ++k) {
@@ -275,12 +278,13 @@ Rigid3d RefinePlacement(const std::vector<Camera>& rig, const std::vector<Obs>& 
   ceres::Solve(so, &problem, &summary);
   if (iterations) *iterations += static_cast<int>(summary.iterations.size());
   if (cost) *cost = summary.IsSolutionUsable() ? summary.final_cost : 1e300;
-  return Rigid3d::FromRvecTvec(r, t);
+  return geometry::Rigid3d::FromRvecTvec(r, t);
 }
 
 // Pixel error of every observation through the placed rig; 1e9 behind its camera.
-std::vector<double> PlacementErrors(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
-                                    const Rigid3d& ref_from_world) {
+std::vector<double> PlacementErrors(const std::vector<camera::Camera>& rig,
+                                    const std::vector<Obs>& obs,
+                                    const geometry::Rigid3d& ref_from_world) {
   const auto cams = Placed(rig, ref_from_world);
   std::vector<double> e(obs.size());
   for (size_t k = 0; k < obs.size(); ++k) {
@@ -291,14 +295,15 @@ std::vector<double> PlacementErrors(const std::vector<Camera>& rig, const std::v
 }
 
 // Starts: PnP in each camera with 4 or more points, the linear and the sampled rig poses.
-std::vector<std::pair<std::string, Rigid3d>> PlacementStarts(
-    const std::vector<Camera>& rig, const std::vector<std::vector<PointCorrespondence>>& points,
-    const std::vector<Obs>& obs, const RigPlacementOptions& options) {
-  std::vector<std::pair<std::string, Rigid3d>> starts;
+std::vector<std::pair<std::string, geometry::Rigid3d>> PlacementStarts(
+    const std::vector<camera::Camera>& rig,
+    const std::vector<std::vector<PointCorrespondence>>& points, const std::vector<Obs>& obs,
+    const RigPlacementOptions& options) {
+  std::vector<std::pair<std::string, geometry::Rigid3d>> starts;
   for (size_t i = 0; i < rig.size(); ++i) {
     if (static_cast<int>(points[i].size()) < 4) continue;
     try {
-      Camera intr = rig[i];
+      camera::Camera intr = rig[i];
       intr.has_pose = false;
       const ExtrinsicsResult e = EstimatePose(intr, points[i], options.pnp);
       starts.emplace_back("camera " + rig[i].name,
@@ -322,19 +327,21 @@ std::vector<std::pair<std::string, Rigid3d>> PlacementStarts(
 }
 
 // Every start refined; the most points within the outlier gate, then the lowest cost.
-Rigid3d BestPlacement(const std::vector<Camera>& rig, const std::vector<Obs>& obs,
-                      const std::vector<std::pair<std::string, Rigid3d>>& starts,
-                      const RigPlacementOptions& options, RigPlacementResult* result) {
+geometry::Rigid3d BestPlacement(
+    const std::vector<camera::Camera>& rig, const std::vector<Obs>& obs,
+    const std::vector<std::pair<std::string, geometry::Rigid3d>>& starts,
+    const RigPlacementOptions& options, RigPlacementResult* result) {
   const std::vector<bool> all(obs.size(), true);
   double best_score = 1e300;
-  Rigid3d best;
+  geometry::Rigid3d best;
   for (const auto& [name, s] : starts) {
     // A start that puts a point behind its camera cannot be evaluated (Ceres would stop and
     // log); such starts are wrong anyway.
     const auto e0 = PlacementErrors(rig, obs, s);
     if (std::any_of(e0.begin(), e0.end(), [](double v) { return v >= 1e9; })) continue;
     double cost = 1e300;
-    const Rigid3d r = RefinePlacement(rig, obs, options, s, all, &result->iterations, &cost);
+    const geometry::Rigid3d r =
+        RefinePlacement(rig, obs, options, s, all, &result->iterations, &cost);
     int in = 0;
     for (double v : PlacementErrors(rig, obs, r)) in += v <= options.outlier_px ? 1 : 0;
     const double score = cost - 1e6 * in;
@@ -352,7 +359,7 @@ Rigid3d BestPlacement(const std::vector<Camera>& rig, const std::vector<Obs>& ob
 }
 
 // Cameras, per-point residuals and per-camera RMS of the placement.
-void SetPlacementResiduals(const std::vector<Camera>& rig,
+void SetPlacementResiduals(const std::vector<camera::Camera>& rig,
                            const std::vector<std::vector<PointCorrespondence>>& points,
                            const std::vector<Obs>& obs, const RigPlacementOptions& options,
                            RigPlacementResult* result) {
@@ -384,13 +391,13 @@ void SetPlacementResiduals(const std::vector<Camera>& rig,
 
 }  // namespace
 
-RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
+RigPlacementResult PlaceRig(const std::vector<camera::Camera>& rig,
                             const std::vector<std::vector<PointCorrespondence>>& points,
                             const RigPlacementOptions& options) {
   options.Check();
   const std::vector<Obs> obs = CollectObservations(rig, points, options);
   RigPlacementResult result;
-  Rigid3d best =
+  geometry::Rigid3d best =
       BestPlacement(rig, obs, PlacementStarts(rig, points, obs, options), options, &result);
   // Leave out points far off, refit once.
   const auto e = PlacementErrors(rig, obs, best);

@@ -27,8 +27,8 @@ struct RigPlacementOptions {
 };
 
 struct RigPlacementResult {
-  std::vector<Camera> cameras;  // the rig with world poses (cam_from_world)
-  Rigid3d ref_from_world;       // the rig's frame in the world
+  std::vector<camera::Camera> cameras;  // the rig with world poses (cam_from_world)
+  geometry::Rigid3d ref_from_world;     // the rig's frame in the world
   // Per camera, the residuals of its points (empty for cameras without points).
   std::vector<std::vector<PointResidual>> points;
   std::vector<double> rms_px;  // per camera over its inliers (0 without points)
@@ -41,12 +41,12 @@ struct RigPlacementResult {
 
 // rig[i] has a pose in the rig's frame; points[i] are camera i's clicks (may be empty). Throws
 // fv::Error when the points cannot place the rig (too few, on one line, no start fits).
-RigPlacementResult PlaceRig(const std::vector<Camera>& rig,
+RigPlacementResult PlaceRig(const std::vector<camera::Camera>& rig,
                             const std::vector<std::vector<PointCorrespondence>>& points,
                             const RigPlacementOptions& options = {});
 
 // The rig moved so that camera k has the pose cam_k_from_world; the relative poses are kept.
-std::vector<Camera> CarryRig(const std::vector<Camera>& rig, int k,
-                             const Rigid3d& cam_k_from_world);
+std::vector<camera::Camera> CarryRig(const std::vector<camera::Camera>& rig, int k,
+                                     const geometry::Rigid3d& cam_k_from_world);
 
 }  // namespace fv::calib

@@ -17,7 +17,7 @@ using test_util::InRigFrame;
 using test_util::WorstCentreErrorM;
 
 // Sum of squared reprojection errors of the clicks through `cams`.
-double SquaredErrorPx2(const std::vector<Camera>& cams,
+double SquaredErrorPx2(const std::vector<camera::Camera>& cams,
                        const std::vector<std::vector<PointCorrespondence>>& pts) {
   double sq = 0;
   for (size_t i = 0; i < cams.size(); ++i) {
@@ -30,11 +30,13 @@ double SquaredErrorPx2(const std::vector<Camera>& cams,
 // parameters of a rigid move of the world, sigma^2 (J^T J)^-1 with J the clicks' Jacobian,
 // carried to the points of the playing area (1 m grid, heights 0 and 1 m); the median of their
 // standard deviations (the bound on FieldPositionErrorM's spread).
-double FieldErrorBoundM(const std::vector<Camera>& truth,
+double FieldErrorBoundM(const std::vector<camera::Camera>& truth,
                         const std::vector<std::vector<PointCorrespondence>>& pts,
-                        const FieldModel& field, double sigma_px) {
+                        const field::FieldModel& field, double sigma_px) {
   using Vec6 = Eigen::Matrix<double, 6, 1>;
-  auto moved = [](const Vec6& d) { return Rigid3d::FromRvecTvec(d.head<3>(), d.tail<3>()); };
+  auto moved = [](const Vec6& d) {
+    return geometry::Rigid3d::FromRvecTvec(d.head<3>(), d.tail<3>());
+  };
   auto step = [](int k, double h) {
     Vec6 d = Vec6::Zero();
     d[k] = h;
@@ -45,7 +47,7 @@ double FieldErrorBoundM(const std::vector<Camera>& truth,
     for (const auto& p : pts[c]) {
       Eigen::Matrix<double, 2, 6> j;
       for (int k = 0; k < 6; ++k) {
-        Camera ca = truth[c], cb = truth[c];
+        camera::Camera ca = truth[c], cb = truth[c];
         ca.cam_from_world = truth[c].cam_from_world * moved(step(k, 1e-6));
         cb.cam_from_world = truth[c].cam_from_world * moved(step(k, -1e-6));
         j.col(k) = (*ca.Project(p.p_world) - *cb.Project(p.p_world)) / 2e-6;
@@ -77,8 +79,8 @@ double FieldErrorBoundM(const std::vector<Camera>& truth,
 TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
   const uint64_t seed = fv::testing::TestSeed(71);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const auto truth = test_util::PresetCameras("demo", 1);
   ASSERT_EQ(truth.size(), 4u);
   const auto rig = InRigFrame(truth);
@@ -143,8 +145,8 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
 TEST(RigPlace, AGrossClickIsLeftOutAndCarryKeepsRelativePoses) {
   const uint64_t seed = fv::testing::TestSeed(72);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const auto truth = test_util::PresetCameras("demo", 1);
   const auto rig = InRigFrame(truth);
   std::vector<std::vector<PointCorrespondence>> pts(4);
@@ -156,15 +158,15 @@ TEST(RigPlace, AGrossClickIsLeftOutAndCarryKeepsRelativePoses) {
   EXPECT_LT(WorstCentreErrorM(r.cameras, truth), 0.1) << r.Summary();
 
   // Camera 3 moved: the others follow, relative poses unchanged.
-  Rigid3d moved = truth[3].cam_from_world;
+  geometry::Rigid3d moved = truth[3].cam_from_world;
   moved.translation += Eigen::Vector3d(0.3, -0.2, 0.1);
   const auto carried = CarryRig(truth, 3, moved);
   EXPECT_LT((carried[3].cam_from_world.translation - moved.translation).norm(), 1e-9);
   for (int i = 0; i < 4; ++i) {
-    const Rigid3d before = truth[i].cam_from_world * truth[0].cam_from_world.Inverse();
-    const Rigid3d after = carried[i].cam_from_world * carried[0].cam_from_world.Inverse();
+    const geometry::Rigid3d before = truth[i].cam_from_world * truth[0].cam_from_world.Inverse();
+    const geometry::Rigid3d after = carried[i].cam_from_world * carried[0].cam_from_world.Inverse();
     EXPECT_LT((before.translation - after.translation).norm(), 1e-9);
-    EXPECT_LT(RotationAngleBetween(before.rotation, after.rotation), 1e-9);
+    EXPECT_LT(geometry::RotationAngleBetween(before.rotation, after.rotation), 1e-9);
   }
 }
 
@@ -177,7 +179,7 @@ TEST(RigPlace, TooFewOrUnusablePointsAreErrors) {
   for (auto& p : pts[0]) p.uv_px = Eigen::Vector2d(100, 100);
   EXPECT_THROW(PlaceRig(rig, pts), Error);
   EXPECT_THROW(PlaceRig(rig, {}), Error);
-  std::vector<Camera> no_pose = rig;
+  std::vector<camera::Camera> no_pose = rig;
   no_pose[1].has_pose = false;
   EXPECT_THROW(PlaceRig(no_pose, std::vector<std::vector<PointCorrespondence>>(4)), Error);
 }

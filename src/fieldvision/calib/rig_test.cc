@@ -11,15 +11,15 @@
 namespace fv::calib {
 namespace {
 
-std::vector<Camera> ThreeCameras() {
+std::vector<camera::Camera> ThreeCameras() {
   const std::vector<Eigen::Vector3d> eyes = {{-15, -12, 7}, {14, -11, 6}, {0, 16, 8}};
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   for (size_t i = 0; i < eyes.size(); ++i) {
-    Camera c = Camera::FromFov(1280, 960, 65);
+    camera::Camera c = camera::Camera::FromFov(1280, 960, 65);
     c.name = "cam" + std::to_string(i + 1);
     c.distortion = {-0.04, 0.01, 0, 0, 0};
     c.has_pose = true;
-    c.cam_from_world = Rigid3d::LookAt(eyes[i], Eigen::Vector3d::Zero());
+    c.cam_from_world = geometry::Rigid3d::LookAt(eyes[i], Eigen::Vector3d::Zero());
     cams.push_back(c);
   }
   return cams;
@@ -28,8 +28,8 @@ std::vector<Camera> ThreeCameras() {
 TEST(Rig, JointRefinementMovesEveryCameraTowardsTheTruth) {
   const uint64_t seed = fv::testing::TestSeed(31);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const auto truth = ThreeCameras();
   // Shared free points (a ball held at several places, unknown position) and field keypoints.
   std::vector<Eigen::Vector3d> balls;
@@ -56,7 +56,7 @@ TEST(Rig, JointRefinementMovesEveryCameraTowardsTheTruth) {
   auto start = truth;
   for (auto& c : start) {
     const Eigen::Vector3d dr(rng.Normal(0, 0.003), rng.Normal(0, 0.003), rng.Normal(0, 0.003));
-    c.cam_from_world.rotation = RotationFromRvec(dr) * c.cam_from_world.rotation;
+    c.cam_from_world.rotation = geometry::RotationFromRvec(dr) * c.cam_from_world.rotation;
     const Eigen::Vector3d centre =
         c.CentreInWorld() +
         Eigen::Vector3d(rng.Normal(0, 0.1), rng.Normal(0, 0.1), rng.Normal(0, 0.1));
@@ -93,7 +93,7 @@ TEST(Rig, BadInputsAreErrorsNamingThem) {
                       Eigen::Vector3d(i, i * i, 0)});
   }
   obs[1].push_back({"lonely", {10, 10}, std::nullopt});
-  const std::vector<Camera> two(cams.begin(), cams.begin() + 2);
+  const std::vector<camera::Camera> two(cams.begin(), cams.begin() + 2);
   try {
     RefineRig(two, obs);
     FAIL() << "no error";
@@ -101,7 +101,7 @@ TEST(Rig, BadInputsAreErrorsNamingThem) {
     EXPECT_NE(std::string(e.what()).find("lonely"), std::string::npos) << e.what();
   }
   EXPECT_THROW(RefineRig(cams, obs), Error);  // 3 cameras, 2 lists
-  Camera no_pose = cams[0];
+  camera::Camera no_pose = cams[0];
   no_pose.has_pose = false;
   obs[1].pop_back();
   try {
@@ -113,7 +113,7 @@ TEST(Rig, BadInputsAreErrorsNamingThem) {
 }
 
 TEST(Rig, ReadsObservationFiles) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const std::string path = fv::testing::TempDir() + "/obs.csv";
   {
     std::ofstream f(path);

@@ -6,7 +6,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::camera {
 namespace {
 
 bool ValidDistortionSize(size_t n) {
@@ -128,11 +128,11 @@ std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) cons
   return std::nullopt;
 }
 
-std::optional<Ray3d> Camera::RayFromPixel(const Eigen::Vector2d& uv) const {
+std::optional<geometry::Ray3d> Camera::RayFromPixel(const Eigen::Vector2d& uv) const {
   const auto xn = Undistort(uv);
   if (!xn) return std::nullopt;
   const Eigen::Vector3d dir_cam = Eigen::Vector3d(xn->x(), xn->y(), 1.0).normalized();
-  return Ray3d{CentreInWorld(), cam_from_world.rotation.transpose() * dir_cam};
+  return geometry::Ray3d{CentreInWorld(), cam_from_world.rotation.transpose() * dir_cam};
 }
 
 double Camera::PixelFootprintM(const Eigen::Vector3d& p_world) const {
@@ -145,4 +145,4 @@ bool Camera::InImage(const Eigen::Vector2d& uv, double margin_px) const {
          uv.x() < width - 0.5 - margin_px && uv.y() < height - 0.5 - margin_px;
 }
 
-}  // namespace fv
+}  // namespace fv::camera

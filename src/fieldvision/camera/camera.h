@@ -13,7 +13,7 @@
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/geometry/rigid.h"
 
-namespace fv {
+namespace fv::camera {
 
 struct Camera {
   std::string name;
@@ -23,7 +23,7 @@ struct Camera {
   // 0, 4, 5, 8, 12 or 14 coefficients in OpenCV order.
   std::vector<double> distortion;
   bool has_pose = false;
-  Rigid3d cam_from_world;
+  geometry::Rigid3d cam_from_world;
   // Optional metadata written to and read from the camera file.
   std::optional<double> rms_px;
   std::map<std::string, std::string> notes;
@@ -39,7 +39,7 @@ struct Camera {
   void SetIntrinsicsBlock(const std::array<double, kNumIntrinsics>& block, int num_distortion);
 
   Eigen::Vector3d CentreInWorld() const;
-  Rigid3d world_from_cam() const { return cam_from_world.Inverse(); }
+  geometry::Rigid3d world_from_cam() const { return cam_from_world.Inverse(); }
 
   // World point -> pixel; nullopt when the point is behind the camera. Not clipped to the image.
   std::optional<Eigen::Vector2d> Project(const Eigen::Vector3d& p_world) const;
@@ -47,11 +47,11 @@ struct Camera {
   // Pixel -> normalized undistorted point (x/z, y/z); nullopt if the inversion does not converge.
   std::optional<Eigen::Vector2d> Undistort(const Eigen::Vector2d& uv) const;
   // Pixel -> unit ray in the world from the camera centre.
-  std::optional<Ray3d> RayFromPixel(const Eigen::Vector2d& uv) const;
+  std::optional<geometry::Ray3d> RayFromPixel(const Eigen::Vector2d& uv) const;
   // Metres on a plane facing the camera covered by one pixel at the depth of `p_world`.
   double PixelFootprintM(const Eigen::Vector3d& p_world) const;
   // Inside the image, OpenCV pixel centres: [-0.5, w - 0.5) x [-0.5, h - 0.5), shrunk by margin.
   bool InImage(const Eigen::Vector2d& uv, double margin_px = 0.0) const;
 };
 
-}  // namespace fv
+}  // namespace fv::camera

@@ -9,7 +9,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::camera {
 namespace {
 
 cv::Mat ReadMatrix(const cv::FileNode& node, const std::string& path, const char* key) {
@@ -95,8 +95,8 @@ Camera ReadCameraYamlFrom(const cv::FileStorage& fs, const std::string& path) {
              has_r ? "rvec" : "tvec", has_r ? "tvec" : "rvec");
   if (has_r) {
     cam.has_pose = true;
-    cam.cam_from_world =
-        Rigid3d::FromRvecTvec(ReadVector3(fs, path, "rvec"), ReadVector3(fs, path, "tvec"));
+    cam.cam_from_world = geometry::Rigid3d::FromRvecTvec(ReadVector3(fs, path, "rvec"),
+                                                         ReadVector3(fs, path, "tvec"));
   }
   if (fs["name"].isString()) cam.name = static_cast<std::string>(fs["name"]);
   if (fs["rms_px"].isReal() || fs["rms_px"].isInt()) {
@@ -185,4 +185,4 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
   FV_REQUIRE(!ec, "cannot write camera file '{}': {}", path, ec.message());
 }
 
-}  // namespace fv
+}  // namespace fv::camera

@@ -6,11 +6,11 @@
 
 #include "fieldvision/camera/camera.h"
 
-namespace fv {
+namespace fv::camera {
 
 // Reads and validates a camera file; every problem throws fv::Error naming the file and the key.
 Camera ReadCameraYaml(const std::string& path);
 // Writes the camera file (to a temporary name first, then renamed, so a failure loses nothing).
 void WriteCameraYaml(const Camera& camera, const std::string& path);
 
-}  // namespace fv
+}  // namespace fv::camera

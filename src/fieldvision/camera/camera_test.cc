@@ -10,11 +10,11 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::camera {
 namespace {
 
 // A camera 20 m from the field centre with plausible distortion of `n` coefficients.
-Camera RandomCamera(Rng& rng, int n) {
+Camera RandomCamera(util::Rng& rng, int n) {
   Camera cam = Camera::FromFov(1280, 960, rng.Uniform(50, 90));
   cam.cx += rng.Uniform(-20, 20);
   cam.cy += rng.Uniform(-20, 20);
@@ -27,12 +27,12 @@ Camera RandomCamera(Rng& rng, int n) {
       rng.Uniform(-0.02, 0.02), rng.Uniform(-0.02, 0.02)};
   cam.distortion.assign(full, full + n);
   const Eigen::Vector3d eye(rng.Uniform(-15, 15), rng.Uniform(-12, -8), rng.Uniform(3, 8));
-  cam.cam_from_world = Rigid3d::LookAt(eye, Eigen::Vector3d(rng.Uniform(-3, 3), 0, 0));
+  cam.cam_from_world = geometry::Rigid3d::LookAt(eye, Eigen::Vector3d(rng.Uniform(-3, 3), 0, 0));
   cam.has_pose = true;
   return cam;
 }
 
-Eigen::Vector3d RandomPointInView(Rng& rng, const Camera& cam) {
+Eigen::Vector3d RandomPointInView(util::Rng& rng, const Camera& cam) {
   // A point on the ray through a random pixel inside the central 90 % of the image.
   while (true) {
     const Eigen::Vector2d uv(rng.Uniform(0.05, 0.95) * cam.width,
@@ -47,7 +47,7 @@ class CameraModel : public ::testing::TestWithParam<int> {};
 TEST_P(CameraModel, AgreesWithOpenCvProjectPoints) {
   const uint64_t seed = testing::TestSeed(100 + GetParam());
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     const Camera cam = RandomCamera(rng, GetParam());
     std::vector<cv::Point3d> pts;
@@ -75,7 +75,7 @@ TEST_P(CameraModel, AgreesWithOpenCvProjectPoints) {
 TEST_P(CameraModel, ProjectUnprojectRoundTrip) {
   const uint64_t seed = testing::TestSeed(200 + GetParam());
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     const Camera cam = RandomCamera(rng, GetParam());
     for (int i = 0; i < 50; ++i) {
@@ -107,7 +107,7 @@ TEST(Camera, BehindAndFootprint) {
 }
 
 TEST(CameraIo, YamlRoundTrip) {
-  Rng rng(testing::TestSeed(3));
+  util::Rng rng(testing::TestSeed(3));
   Camera cam = RandomCamera(rng, 8);
   cam.name = "cam1";
   cam.rms_px = 0.25;
@@ -121,7 +121,9 @@ TEST(CameraIo, YamlRoundTrip) {
   EXPECT_EQ(back.distortion, cam.distortion);
   ASSERT_TRUE(back.has_pose);
   EXPECT_LT((back.cam_from_world.translation - cam.cam_from_world.translation).norm(), 1e-12);
-  EXPECT_LT(RotationAngleBetween(back.cam_from_world.rotation, cam.cam_from_world.rotation), 1e-12);
+  EXPECT_LT(
+      geometry::RotationAngleBetween(back.cam_from_world.rotation, cam.cam_from_world.rotation),
+      1e-12);
   ASSERT_TRUE(back.rms_px);
   EXPECT_DOUBLE_EQ(*back.rms_px, 0.25);
   EXPECT_EQ(back.notes.at("board"), "chessboard 9x6");
@@ -251,4 +253,4 @@ TEST(CameraIo, MissingFile) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::camera

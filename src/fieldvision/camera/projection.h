@@ -8,7 +8,7 @@
 
 #include <ceres/rotation.h>
 
-namespace fv {
+namespace fv::camera {
 
 constexpr int kNumDistortion = 14;
 // Intrinsic parameter block: fx, fy, cx, cy, then the 14 distortion coefficients in OpenCV order
@@ -80,4 +80,4 @@ bool ProjectWorldPoint(const T* intrinsics, const T* rvec, const T* tvec, const 
   return ProjectCameraPoint(intrinsics, p_cam, uv);
 }
 
-}  // namespace fv
+}  // namespace fv::camera

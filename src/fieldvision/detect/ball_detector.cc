@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 using Eigen::Vector2d;
@@ -45,8 +45,8 @@ void DiscShares(const cv::Mat& bgr, const ColourTable& table, uint8_t bit, const
 }
 
 // The [s_lo, s_hi] part of the ray with height in [z_lo, z_hi] and s >= s_min; false if empty.
-bool HeightInterval(const Ray3d& ray, double z_lo, double z_hi, double s_min, double s_max,
-                    double* s_lo, double* s_hi) {
+bool HeightInterval(const geometry::Ray3d& ray, double z_lo, double z_hi, double s_min,
+                    double s_max, double* s_lo, double* s_hi) {
   double lo = s_min, hi = s_max;
   const double z0 = ray.origin.z(), dz = ray.direction.z();
   if (std::abs(dz) < 1e-12) {
@@ -219,15 +219,15 @@ std::string BallDetectionResult::Summary() const {
                      samples, runs, blobs, refined, candidates.size(), accepted());
 }
 
-BallDetector::BallDetector(const BallDetectorOptions& options, const Camera* camera,
-                           const FieldModel* field)
+BallDetector::BallDetector(const BallDetectorOptions& options, const camera::Camera* camera,
+                           const field::FieldModel* field)
     : options_(options), camera_(camera), field_(field) {
   options_.Check();
   Init(LoadColourSpec(options_.colour));
 }
 
 BallDetector::BallDetector(const BallDetectorOptions& options, const ColourSpec& colour,
-                           const Camera* camera, const FieldModel* field)
+                           const camera::Camera* camera, const field::FieldModel* field)
     : options_(options), camera_(camera), field_(field) {
   options_.Check();
   Init(colour);
@@ -567,7 +567,7 @@ void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
   }
 }
 
-cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m,
+cv::Mat FieldMask(const camera::Camera& camera, const field::FieldModel& field, double margin_m,
                   double max_height_m) {
   const int cell = 4;
   const int gw = (camera.width + cell - 1) / cell, gh = (camera.height + cell - 1) / cell;
@@ -595,4 +595,4 @@ cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m
   return mask(cv::Rect(0, 0, camera.width, camera.height)).clone();
 }
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -23,7 +23,7 @@
 #include "fieldvision/detect/small_ball.h"
 #include "fieldvision/field/field.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct BallCandidate {
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
@@ -135,10 +135,11 @@ class BallDetector {
   // camera: null for an uncalibrated camera (no size check, no field mask, pixel-space fit);
   // a camera without a pose gives the perspective fit but no size check or mask. field: null for
   // no field mask. Both must outlive the detector. Throws fv::Error on bad options or colour.
-  BallDetector(const BallDetectorOptions& options, const Camera* camera, const FieldModel* field);
+  BallDetector(const BallDetectorOptions& options, const camera::Camera* camera,
+               const field::FieldModel* field);
   // Same, with an explicit colour spec (options.colour is ignored).
-  BallDetector(const BallDetectorOptions& options, const ColourSpec& colour, const Camera* camera,
-               const FieldModel* field);
+  BallDetector(const BallDetectorOptions& options, const ColourSpec& colour,
+               const camera::Camera* camera, const field::FieldModel* field);
 
   // All candidates found in a BGR frame, best first; accepted ones passed every filter.
   // Thread-safe (const). Throws fv::Error when the frame is empty, not BGR, or not the camera's
@@ -187,8 +188,8 @@ class BallDetector {
   void Decide(const BallRegion& region, const BallFit& fit, const std::string& fit_why,
               double visible, double leak, BallCandidate* cand) const;
   BallDetectorOptions options_;
-  const Camera* camera_;
-  const FieldModel* field_;
+  const camera::Camera* camera_;
+  const field::FieldModel* field_;
   std::shared_ptr<const ColourTable> table_;
   std::shared_ptr<const ColourTable> grow_table_;  // the widened ball class (region growing)
   uint8_t ball_bit_ = 1;
@@ -198,7 +199,7 @@ class BallDetector {
 
 // The field-of-play mask of a camera: the image of the prism over the field (plus margin) from
 // the ground to max_height_m. Empty when a corner of the prism is behind the camera.
-cv::Mat FieldMask(const Camera& camera, const FieldModel& field, double margin_m,
+cv::Mat FieldMask(const camera::Camera& camera, const field::FieldModel& field, double margin_m,
                   double max_height_m);
 
-}  // namespace fv
+}  // namespace fv::detect

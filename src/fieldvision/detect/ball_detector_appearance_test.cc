@@ -13,7 +13,7 @@
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 struct Score {
@@ -35,7 +35,7 @@ Score ScoreScene(const synth::SceneSpec& spec, const std::string& colour) {
   BallDetectorOptions options;
   options.colour = colour;
   std::vector<std::unique_ptr<BallDetector>> detectors;
-  for (const Camera& cam : scene.cameras()) {
+  for (const camera::Camera& cam : scene.cameras()) {
     detectors.push_back(std::make_unique<BallDetector>(options, &cam, &scene.field()));
   }
   Score s;
@@ -95,6 +95,6 @@ TEST(BallDetectorAppearance, BallHeldInAHandler) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect
 
 #endif  // __has_include("fieldvision/synth/synth.h")

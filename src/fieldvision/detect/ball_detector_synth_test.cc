@@ -10,7 +10,7 @@
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 double Median(std::vector<double> v) {
@@ -32,7 +32,7 @@ TEST(BallDetectorSynth, SubpixelCentreOverTheSizeRange) {
   spec.ball.placements.resize(12);
   const synth::SceneRenderer scene(spec);
   std::vector<std::unique_ptr<BallDetector>> detectors;
-  for (const Camera& cam : scene.cameras()) {
+  for (const camera::Camera& cam : scene.cameras()) {
     detectors.push_back(
         std::make_unique<BallDetector>(BallDetectorOptions{}, &cam, &scene.field()));
   }
@@ -101,7 +101,7 @@ TEST(BallDetectorSynth, OccludedBallsFoundConeRejectedNoBallNoDetection) {
   spec.num_frames = 120;
   const synth::SceneRenderer scene(spec);
   std::vector<std::unique_ptr<BallDetector>> detectors;
-  for (const Camera& cam : scene.cameras()) {
+  for (const camera::Camera& cam : scene.cameras()) {
     detectors.push_back(
         std::make_unique<BallDetector>(BallDetectorOptions{}, &cam, &scene.field()));
   }
@@ -113,7 +113,7 @@ TEST(BallDetectorSynth, OccludedBallsFoundConeRejectedNoBallNoDetection) {
     const auto images = scene.Render(f);
     const auto truth = scene.BallTruth(f);
     for (size_t k = 0; k < images.size(); ++k) {
-      const Camera& cam = scene.cameras()[k];
+      const camera::Camera& cam = scene.cameras()[k];
       const auto& t = truth.cameras[k];
       const auto cands = detectors[k]->Detect(images[k]);
       // Nothing accepted on the cone (unless the ball is right there).
@@ -165,6 +165,6 @@ TEST(BallDetectorSynth, OccludedBallsFoundConeRejectedNoBallNoDetection) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect
 
 #endif  // synth module present

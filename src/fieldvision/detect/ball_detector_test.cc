@@ -8,7 +8,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 int Accepted(const std::vector<BallCandidate>& c) {
@@ -18,16 +18,16 @@ int Accepted(const std::vector<BallCandidate>& c) {
 TEST(BallDetector, FindsDrawnBallsAndRejectsATriangle) {
   const uint64_t seed = fv::testing::TestSeed(21);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
-  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  cv::Mat img = test_util::FieldImage(640, 480, rng);
   EXPECT_EQ(Accepted(det.Detect(img)), 0);  // no ball: nothing accepted
   // An orange cone seen from the side: a triangle.
   const std::vector<cv::Point> tri = {{500, 400}, {540, 400}, {520, 340}};
   cv::fillConvexPoly(img, tri, cv::Scalar(0, 80, 255), cv::LINE_AA);
   const Eigen::Vector2d c(rng.Uniform(150, 300), rng.Uniform(150, 300));
   const double r = rng.Uniform(5, 15);
-  detect_testing::PaintDisc(img, c, r);
+  test_util::PaintDisc(img, c, r);
   const BallDetectionResult res = det.DetectWithSummary(img);
   ASSERT_EQ(res.accepted(), 1) << res.Summary();
   const BallCandidate& best = res.candidates.front();
@@ -51,16 +51,16 @@ TEST(BallDetector, FindsDrawnBallsAndRejectsATriangle) {
 TEST(BallDetector, LowContrastDiscIsDiscShapedAConeIsNot) {
   const uint64_t seed = fv::testing::TestSeed(23);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallDetectorOptions o;
   o.min_contrast = 300;     // above any CIELAB distance: every region fails the contrast check
   o.max_fit_rms_px = 1e-6;  // and no outline fit passes: the region path decides
   const BallDetector det(o, nullptr, nullptr);
-  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  cv::Mat img = test_util::FieldImage(640, 480, rng);
   const std::vector<cv::Point> tri = {{500, 400}, {540, 400}, {520, 340}};
   cv::fillConvexPoly(img, tri, cv::Scalar(0, 80, 255), cv::LINE_AA);
   const Eigen::Vector2d c(rng.Uniform(150, 300), rng.Uniform(150, 300));
-  detect_testing::PaintDisc(img, c, rng.Uniform(6, 15));
+  test_util::PaintDisc(img, c, rng.Uniform(6, 15));
   const BallDetectionResult res = det.DetectWithSummary(img);
   EXPECT_EQ(res.accepted(), 0) << res.Summary();
   int discs = 0, cones = 0;
@@ -96,7 +96,7 @@ TEST(BallDetector, BadInputGivesErrors) {
   o = BallDetectorOptions{};
   o.colour = "not-a-colour";
   EXPECT_THROW(BallDetector(o, nullptr, nullptr), Error);
-  const Camera cam = Camera::FromFov(320, 240, 60);
+  const camera::Camera cam = camera::Camera::FromFov(320, 240, 60);
   const BallDetector det(BallDetectorOptions{}, &cam, nullptr);
   try {
     det.Detect(cv::Mat(200, 300, CV_8UC3, cv::Scalar(0, 0, 0)));
@@ -109,4 +109,4 @@ TEST(BallDetector, BadInputGivesErrors) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

@@ -10,7 +10,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 using Eigen::Vector2d;
@@ -261,7 +261,7 @@ struct ConeOutline {
   double mean_radius = 0.0;
   std::vector<double> radius_at;  // per degree
 
-  ConeOutline(const Camera& cam, const Vector3d& axis, double alpha) {
+  ConeOutline(const camera::Camera& cam, const Vector3d& axis, double alpha) {
     const auto c = cam.ProjectFromCamera(axis);
     if (!c) return;
     centre = *c;
@@ -306,7 +306,7 @@ struct ConeOutline {
 
 // Robust cone fit of outline pixels: initial inliers are `inl` (or those within thr of a given
 // cone), then three rounds of fit and re-selection. `res` receives pixel residuals.
-bool RobustCone(const std::vector<Vector2d>& pts, const Camera& cam, double thr,
+bool RobustCone(const std::vector<Vector2d>& pts, const camera::Camera& cam, double thr,
                 const Vector3d* axis0, double alpha0, std::vector<char>* inl,
                 std::vector<double>* res, Vector3d* axis, double* alpha) {
   const int n = static_cast<int>(pts.size());
@@ -500,7 +500,8 @@ std::string SubpixelCircle(const cv::Mat& bgr, const ColourTable& table, uint8_t
 // outline points, so a sphere seen far off the axis, an ellipse, is searched where it is); the
 // circle when no cone fits.
 void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
-                   const Camera& camera, double thr, const BallFitOptions& o, OutlineState* s) {
+                   const camera::Camera& camera, double thr, const BallFitOptions& o,
+                   OutlineState* s) {
   Vector3d axis;
   double alpha = 0;
   bool have_cone = false;
@@ -634,8 +635,8 @@ int CountDents(const std::vector<double>& res, const std::vector<char>& inl) {
 }  // namespace
 
 BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
-                const Vector2d& rough_centre_px, double rough_radius_px, const Camera* camera,
-                const BallFitOptions& o) {
+                const Vector2d& rough_centre_px, double rough_radius_px,
+                const camera::Camera* camera, const BallFitOptions& o) {
   o.Check();
   BallFit fit;
   OutlineState s;
@@ -676,4 +677,4 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
   return fit;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -22,7 +22,7 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/detect/colour.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct BallFitOptions {
   double min_contrast = 20.0;     // BGR distance between a ray's inside and outside colours
@@ -61,7 +61,7 @@ struct BallFit {
 // is the ball's class in `table`. `camera` may be null (pixel-space fit).
 BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
                 const Eigen::Vector2d& rough_centre_px, double rough_radius_px,
-                const Camera* camera, const BallFitOptions& options = {});
+                const camera::Camera* camera, const BallFitOptions& options = {});
 
 // Robust geometric circle fit of points (used by FitBall; exposed for tests): the initial guess
 // is refined by Gauss-Newton with outliers (farther than inlier_px) dropped; `inlier` receives
@@ -78,4 +78,4 @@ bool CircleFrom3(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen
 bool RansacCircle(const std::vector<Eigen::Vector2d>& pts, double thr, int iterations,
                   Eigen::Vector2d* centre, double* radius, std::vector<char>* inlier);
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -8,7 +8,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 double Median(std::vector<double> v) {
@@ -19,7 +19,7 @@ double Median(std::vector<double> v) {
 TEST(FitCircle, IgnoresOutliers) {
   const uint64_t seed = fv::testing::TestSeed(2);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const Eigen::Vector2d c(rng.Uniform(10, 90), rng.Uniform(10, 90));
   const double r = rng.Uniform(5, 30);
   std::vector<Eigen::Vector2d> pts;
@@ -43,14 +43,14 @@ TEST(FitCircle, IgnoresOutliers) {
 TEST(FitBall, SubpixelCentreOfShadedDiscs) {
   const uint64_t seed = fv::testing::TestSeed(4);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
   std::vector<double> err, radius_err;
   for (int i = 0; i < 40; ++i) {
-    cv::Mat img = detect_testing::FieldImage(120, 120, rng);
+    cv::Mat img = test_util::FieldImage(120, 120, rng);
     const double r = rng.Uniform(3, 20);
     const Eigen::Vector2d c(rng.Uniform(40, 80), rng.Uniform(40, 80));
-    detect_testing::PaintDisc(img, c, r);
+    test_util::PaintDisc(img, c, r);
     const Eigen::Vector2d rough = c + Eigen::Vector2d(rng.Uniform(-1, 1), rng.Uniform(-1, 1));
     const BallFit fit =
         FitBall(img, table, table.BallBit(), rough, r * rng.Uniform(0.85, 1.15), nullptr);
@@ -70,14 +70,14 @@ TEST(FitBall, SubpixelCentreOfShadedDiscs) {
 TEST(FitBall, PartlyOccludedBallFitsTheFreeOutline) {
   const uint64_t seed = fv::testing::TestSeed(8);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
   std::vector<double> err;
   for (int i = 0; i < 12; ++i) {
-    cv::Mat img = detect_testing::FieldImage(120, 120, rng);
+    cv::Mat img = test_util::FieldImage(120, 120, rng);
     const double r = rng.Uniform(6, 18);
     const Eigen::Vector2d c(rng.Uniform(50, 70), rng.Uniform(50, 70));
-    detect_testing::PaintDisc(img, c, r);
+    test_util::PaintDisc(img, c, r);
     // A dark robot covering about a third of the ball from the side.
     const int edge = static_cast<int>(c.x() + r * rng.Uniform(0.2, 0.5));
     cv::rectangle(img, cv::Rect(edge, 0, 120 - edge, 120), cv::Scalar(35, 35, 35), cv::FILLED);
@@ -95,9 +95,9 @@ TEST(FitBall, PartlyOccludedBallFitsTheFreeOutline) {
 TEST(FitBall, MotionBlurredBallGivesTheMidExposureCentre) {
   const uint64_t seed = fv::testing::TestSeed(9);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
-  cv::Mat bg = detect_testing::FieldImage(160, 160, rng, 0.0);
+  cv::Mat bg = test_util::FieldImage(160, 160, rng, 0.0);
   const double r = 10;
   const Eigen::Vector2d c(40.3, 119.6);  // clear of the painted lines
   const double th = rng.Uniform(0, M_PI);
@@ -107,7 +107,7 @@ TEST(FitBall, MotionBlurredBallGivesTheMidExposureCentre) {
   const int n = 15;
   for (int k = 0; k < n; ++k) {
     cv::Mat img = bg.clone();
-    detect_testing::PaintDisc(img, c + (k / double(n - 1) - 0.5) * length * dir, r);
+    test_util::PaintDisc(img, c + (k / double(n - 1) - 0.5) * length * dir, r);
     cv::Mat f;
     img.convertTo(f, CV_32FC3);
     acc += f / n;
@@ -128,11 +128,11 @@ TEST(FitBall, MotionBlurredBallGivesTheMidExposureCentre) {
 // projection of the sphere centre; the cone fit with the camera removes that bias.
 TEST(FitBall, ConeFitIsUnbiasedInPerspective) {
   const ColourTable table(PresetColourSpec("orange"));
-  const Camera cam = Camera::FromFov(640, 480, 110.0);
-  Rng rng(1);
-  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  const camera::Camera cam = camera::Camera::FromFov(640, 480, 110.0);
+  util::Rng rng(1);
+  cv::Mat img = test_util::FieldImage(640, 480, rng);
   const Eigen::Vector3d centre(1.2, 0.85, 1.0);  // 56 degrees off the axis
-  const Eigen::Vector2d uv = detect_testing::PaintSphere(img, cam, centre, 0.08);
+  const Eigen::Vector2d uv = test_util::PaintSphere(img, cam, centre, 0.08);
   const BallFit with_camera = FitBall(img, table, table.BallBit(), uv, 12, &cam);
   const BallFit without = FitBall(img, table, table.BallBit(), uv, 12, nullptr);
   ASSERT_TRUE(with_camera.ok && without.ok);
@@ -141,4 +141,4 @@ TEST(FitBall, ConeFitIsUnbiasedInPerspective) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

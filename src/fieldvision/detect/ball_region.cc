@@ -12,7 +12,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 using Eigen::Vector2d;
@@ -325,7 +325,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
     for (int ch = 0; ch < 3; ++ch) {
       // OpenCV's 8-bit Lab: L * 255 / 100, a + 128, b + 128.
       const double scale = ch == 0 ? 100.0 / 255.0 : 1.0;
-      const double dv = scale * (Median(disc_lab[ch]) - Median(ring_lab[ch]));
+      const double dv = scale * (util::Median(disc_lab[ch]) - util::Median(ring_lab[ch]));
       d2 += dv * dv;
     }
     out->contrast = std::sqrt(d2);
@@ -407,4 +407,4 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -16,7 +16,7 @@
 
 #include "fieldvision/detect/colour.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct BallRegionOptions {
   double gather_fraction = 0.5;  // other blobs within this share of the radius (+2 px) join
@@ -75,4 +75,4 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
                              const BallRegionOptions& options = {},
                              const ColourTable* grow_table = nullptr);
 
-}  // namespace fv
+}  // namespace fv::detect

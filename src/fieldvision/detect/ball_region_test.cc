@@ -16,7 +16,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 using Eigen::Vector2d;
@@ -37,12 +37,11 @@ std::string Describe(const BallCandidate& c) {
 enum class Look { kShaded, kPrinted, kHighlight, kOccluded, kJpeg };
 
 // Paints one ball of the given look at a random place and size; returns its centre and radius.
-void PaintBall(cv::Mat& img, Look look, Rng& rng, Vector2d* c, double* r) {
+void PaintBall(cv::Mat& img, Look look, util::Rng& rng, Vector2d* c, double* r) {
   *r = rng.Uniform(6, 30);
   *c = Vector2d(rng.Uniform(60, img.cols - 60), rng.Uniform(60, img.rows - 60));
   // A low sun: the far side at 30 % brightness.
-  detect_testing::PaintDisc(img, *c, *r, detect_testing::kOrange,
-                            look == Look::kShaded ? 0.7 : 0.35);
+  test_util::PaintDisc(img, *c, *r, test_util::kOrange, look == Look::kShaded ? 0.7 : 0.35);
   if (look == Look::kPrinted) {
     // Dark print patches inside the outline (a logo, panel seams).
     for (int k = 0; k < 3; ++k) {
@@ -69,7 +68,7 @@ void PaintBall(cv::Mat& img, Look look, Rng& rng, Vector2d* c, double* r) {
 TEST(BallRegion, RealBallLooksAreAccepted) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
   const std::vector<std::pair<Look, const char*>> looks = {{Look::kShaded, "shaded"},
                                                            {Look::kPrinted, "printed"},
@@ -78,7 +77,7 @@ TEST(BallRegion, RealBallLooksAreAccepted) {
                                                            {Look::kJpeg, "jpeg"}};
   for (const auto& [look, name] : looks) {
     for (int trial = 0; trial < 6; ++trial) {
-      cv::Mat img = detect_testing::FieldImage(480, 360, rng);
+      cv::Mat img = test_util::FieldImage(480, 360, rng);
       Vector2d c;
       double r;
       PaintBall(img, look, rng, &c, &r);
@@ -97,13 +96,13 @@ TEST(BallRegion, RealBallLooksAreAccepted) {
 TEST(BallRegion, SmallAndEdgeBalls) {
   const uint64_t seed = fv::testing::TestSeed(6);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
   for (int trial = 0; trial < 5; ++trial) {
-    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
     const Vector2d c(rng.Uniform(40, 280), rng.Uniform(40, 200));
     const double r = rng.Uniform(3.0, 4.5);
-    detect_testing::PaintDisc(img, c, r);
+    test_util::PaintDisc(img, c, r);
     const auto cands = det.Detect(img);
     const BallCandidate* best = Best(cands);
     ASSERT_NE(best, nullptr) << "small ball r " << r;
@@ -111,10 +110,10 @@ TEST(BallRegion, SmallAndEdgeBalls) {
   }
   // A ball a third of which lies beyond the bottom edge (a fisheye robot camera's handler).
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
     const double r = rng.Uniform(15, 30);
     const Vector2d c(rng.Uniform(60, 260), 239 - 0.35 * r);
-    detect_testing::PaintDisc(img, c, r);
+    test_util::PaintDisc(img, c, r);
     const auto cands = det.Detect(img);
     const BallCandidate* best = Best(cands);
     ASSERT_NE(best, nullptr) << "edge ball r " << r << ": "
@@ -130,15 +129,15 @@ TEST(BallRegion, SmallAndEdgeBalls) {
 TEST(BallRegion, ShadedBallHeldByADarkRobot) {
   const uint64_t seed = fv::testing::TestSeed(8);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
   BallRegionOptions off;
   off.hidden_value = 0;
   for (int trial = 0; trial < 5; ++trial) {
-    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
     const double r = rng.Uniform(12, 28);
     const Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
-    detect_testing::PaintDisc(img, c, r, detect_testing::kOrange, 0.7);
+    test_util::PaintDisc(img, c, r, test_util::kOrange, 0.7);
     const int arm = static_cast<int>(c.x() - 0.35 * r);  // the arm's edge, left of the centre
     cv::rectangle(img, cv::Point(0, 0), cv::Point(arm, 239), cv::Scalar(20, 22, 24), cv::FILLED);
     const cv::Rect seed_box(arm + 1, static_cast<int>(c.y() - r), static_cast<int>(c.x() + r) - arm,
@@ -162,11 +161,11 @@ TEST(BallRegion, ShadedBallHeldByADarkRobot) {
 TEST(BallRegion, ShapesThatAreNotBallsAreRejected) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
   const cv::Scalar orange(0, 110, 255);
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat img = detect_testing::FieldImage(480, 360, rng);
+    cv::Mat img = test_util::FieldImage(480, 360, rng);
     const int x = rng.UniformInt(60, 380), y = rng.UniformInt(60, 260);
     const int s = rng.UniformInt(20, 40);  // smaller boxes blur into discs
     switch (trial) {
@@ -183,7 +182,7 @@ TEST(BallRegion, ShapesThatAreNotBallsAreRejected) {
         break;
       default: {  // a disc painted on a wall of nearly its own colour: no contrast
         img(cv::Rect(x - 50, y - 50, 110, 110)).setTo(cv::Scalar(20, 95, 225));
-        detect_testing::PaintDisc(img, Vector2d(x, y), 0.4 * s, detect_testing::kOrange, 0.0);
+        test_util::PaintDisc(img, Vector2d(x, y), 0.4 * s, test_util::kOrange, 0.0);
         break;
       }
     }
@@ -206,4 +205,4 @@ TEST(BallRegion, OptionsAreChecked) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

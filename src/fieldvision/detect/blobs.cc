@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 int Find(std::vector<int>& parent, int i) {
@@ -213,4 +213,4 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

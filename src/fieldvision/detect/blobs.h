@@ -16,7 +16,7 @@
 
 #include "fieldvision/detect/colour.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct ScanOptions {
   int step_px = 2;      // sample every step-th row and column (1 = every pixel)
@@ -67,4 +67,4 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
                          const ScanOptions& options, const cv::Mat& mask = cv::Mat(),
                          const cv::Rect& region = cv::Rect());
 
-}  // namespace fv
+}  // namespace fv::detect

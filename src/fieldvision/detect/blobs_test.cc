@@ -10,14 +10,14 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
-using detect_testing::kGrass;
-using detect_testing::kOrange;
+using test_util::kGrass;
+using test_util::kOrange;
 
 // Random orange and green pixels in clumps: a hard case for run merging.
-cv::Mat RandomClumps(Rng& rng, int w, int h) {
+cv::Mat RandomClumps(util::Rng& rng, int w, int h) {
   cv::Mat small(h / 3, w / 3, CV_8UC3);
   for (int y = 0; y < small.rows; ++y) {
     for (int x = 0; x < small.cols; ++x) {
@@ -35,7 +35,7 @@ cv::Mat RandomClumps(Rng& rng, int w, int h) {
 TEST(ScanBlobs, StepOneEqualsOpenCvConnectedComponents) {
   const uint64_t seed = fv::testing::TestSeed(11);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
   const cv::Mat img = RandomClumps(rng, 150, 120);
   ScanOptions o;
@@ -73,14 +73,14 @@ TEST(ScanBlobs, StepOneEqualsOpenCvConnectedComponents) {
 TEST(ScanBlobs, CoarseStepFindsEachDiscOnceWithItsSize) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
-  cv::Mat img = detect_testing::FieldImage(640, 480, rng);
+  cv::Mat img = test_util::FieldImage(640, 480, rng);
   std::vector<std::pair<Eigen::Vector2d, double>> discs;
   for (int i = 0; i < 6; ++i) {
     const Eigen::Vector2d c(60 + 100 * i + rng.Uniform(0, 1), rng.Uniform(60, 420));
     const double r = rng.Uniform(4, 30);
-    detect_testing::PaintDisc(img, c, r);
+    test_util::PaintDisc(img, c, r);
     discs.push_back({c, r});
   }
   for (int step : {2, 4}) {
@@ -119,4 +119,4 @@ TEST(ScanBlobs, OptionsAreChecked) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

@@ -12,7 +12,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 using nlohmann::json;
@@ -368,4 +368,4 @@ cv::Mat ColourTable::ClassifyImage(const cv::Mat& bgr) const {
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-namespace fv {
+namespace fv::detect {
 
 enum class ColourSpace { kHsv, kYuv };
 
@@ -105,4 +105,4 @@ class ColourTable {
   std::vector<uint8_t> table_;
 };
 
-}  // namespace fv
+}  // namespace fv::detect

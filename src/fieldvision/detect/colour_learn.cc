@@ -12,7 +12,7 @@
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 // HSV_FULL pixels (hue 0..255 for 0..360 degrees).
@@ -59,31 +59,33 @@ std::string ColourLearnResult::Summary() const {
 
 std::vector<Eigen::Vector2d> ParsePoints(const std::string& text, const std::string& what) {
   std::vector<Eigen::Vector2d> pts;
-  for (const std::string& item : Split(text, ';')) {
-    const std::string t = Trim(item);
+  for (const std::string& item : util::Split(text, ';')) {
+    const std::string t = util::Trim(item);
     if (t.empty()) continue;
-    const auto uv = Split(t, ',');
+    const auto uv = util::Split(t, ',');
     FV_REQUIRE(uv.size() == 2, "{}: '{}' is not u,v", what, t);
-    pts.emplace_back(ParseDouble(Trim(uv[0]), what), ParseDouble(Trim(uv[1]), what));
+    pts.emplace_back(util::ParseDouble(util::Trim(uv[0]), what),
+                     util::ParseDouble(util::Trim(uv[1]), what));
   }
   FV_REQUIRE(!pts.empty(), "{}: no points in '{}' (expected u,v;u,v...)", what, text);
   return pts;
 }
 
 cv::Rect ParseRect(const std::string& text, const std::string& what) {
-  const auto v = Split(text, ',');
+  const auto v = util::Split(text, ',');
   FV_REQUIRE(v.size() == 4, "{}: '{}' is not x,y,w,h", what, text);
-  cv::Rect r(
-      static_cast<int>(ParseInt(Trim(v[0]), what)), static_cast<int>(ParseInt(Trim(v[1]), what)),
-      static_cast<int>(ParseInt(Trim(v[2]), what)), static_cast<int>(ParseInt(Trim(v[3]), what)));
+  cv::Rect r(static_cast<int>(util::ParseInt(util::Trim(v[0]), what)),
+             static_cast<int>(util::ParseInt(util::Trim(v[1]), what)),
+             static_cast<int>(util::ParseInt(util::Trim(v[2]), what)),
+             static_cast<int>(util::ParseInt(util::Trim(v[3]), what)));
   FV_REQUIRE(r.width > 0 && r.height > 0, "{}: width and height must be > 0", what);
   return r;
 }
 
 cv::Mat ReadVideoFrame(const std::string& video, int frame_index) {
   FV_REQUIRE(frame_index >= 0, "--frame must be >= 0 (got {})", frame_index);
-  auto source = VideoSource::Open(video);
-  Frame frame;
+  auto source = io::VideoSource::Open(video);
+  io::Frame frame;
   while (source->Read(frame)) {
     if (frame.index == frame_index) return frame.bgr;
   }
@@ -141,7 +143,7 @@ void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& 
   }
   if (ring[0].empty()) return;
   cv::Vec3d bg;
-  for (int k = 0; k < 3; ++k) bg[k] = NearestRankPercentile(ring[k], 0.5);
+  for (int k = 0; k < 3; ++k) bg[k] = util::NearestRankPercentile(ring[k], 0.5);
   for (int y = r.y; y < r.y + r.height; ++y) {
     for (int x = r.x; x < r.x + r.width; ++x) {
       if (!positive.at<uint8_t>(y, x)) continue;
@@ -211,9 +213,9 @@ ColourRange InitialColourRange(const std::vector<cv::Vec3b>& positive,
     r.min[0] = std::fmod(h_lo + 360.0, 360.0);
     r.max[0] = std::fmod(h_hi + 360.0, 360.0);
   }
-  r.min[1] = std::max(0.0, NearestRankPercentile(s, o.trim) - o.saturation_margin);
+  r.min[1] = std::max(0.0, util::NearestRankPercentile(s, o.trim) - o.saturation_margin);
   r.max[1] = 255;
-  r.min[2] = std::max(0.0, NearestRankPercentile(v, o.trim) - o.value_margin);
+  r.min[2] = std::max(0.0, util::NearestRankPercentile(v, o.trim) - o.value_margin);
   r.max[2] = 255;
   return r;
 }
@@ -297,4 +299,4 @@ ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -16,7 +16,7 @@
 
 #include "fieldvision/detect/colour.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct ColourLearnOptions {
   std::vector<Eigen::Vector2d> points;           // positive pixels (u, v)
@@ -93,4 +93,4 @@ cv::Mat ReadVideoFrame(const std::string& video, int frame);
 std::vector<Eigen::Vector2d> ParsePoints(const std::string& text, const std::string& what);
 cv::Rect ParseRect(const std::string& text, const std::string& what);
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -9,7 +9,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 // Share of the pixels of `mask` (CV_8U) that the class selects.
@@ -21,12 +21,12 @@ double Selected(const ColourTable& t, const cv::Mat& bgr, const cv::Mat& mask) {
 TEST(LearnColour, PinkBallFromARegionAndFromPoints) {
   const uint64_t seed = fv::testing::TestSeed(17);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+  util::Rng rng(seed);
+  cv::Mat img = test_util::FieldImage(320, 240, rng);
   const cv::Vec3b pink(180, 105, 255);
   const Eigen::Vector2d c(rng.Uniform(100, 220), rng.Uniform(80, 160));
   const double r = 14;
-  detect_testing::PaintDisc(img, c, r, pink);
+  test_util::PaintDisc(img, c, r, pink);
   cv::Mat ball(img.size(), CV_8U, cv::Scalar(0));
   cv::circle(ball, cv::Point(cvRound(c.x()), cvRound(c.y())), int(r - 2), 255, cv::FILLED);
   cv::Mat rest(img.size(), CV_8U, cv::Scalar(255));
@@ -60,20 +60,20 @@ TEST(LearnColour, PinkBallFromARegionAndFromPoints) {
 TEST(LearnColour, AClassThatSelectsTheBackgroundIsBad) {
   const uint64_t seed = fv::testing::TestSeed(18);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+  util::Rng rng(seed);
+  cv::Mat img = test_util::FieldImage(320, 240, rng);
   // A yellow ball on a wall of nearly its colour: whatever box is learned selects the wall too.
   img(cv::Rect(0, 0, 320, 140)).setTo(cv::Scalar(40, 200, 215));
   const Eigen::Vector2d c(160, 70);
-  detect_testing::PaintDisc(img, c, 12, cv::Vec3b(30, 210, 230), 0.0);
+  test_util::PaintDisc(img, c, 12, cv::Vec3b(30, 210, 230), 0.0);
   ColourLearnOptions o;
   o.roi = cv::Rect(140, 50, 40, 40);
   const ColourLearnResult res = LearnColour(img, o);
   EXPECT_TRUE(res.bad) << res.Summary();
   EXPECT_NE(res.Summary().find("BAD CLASS"), std::string::npos);
   // The clean pink ball of the test above is not.
-  cv::Mat clean = detect_testing::FieldImage(320, 240, rng);
-  detect_testing::PaintDisc(clean, c, 14, cv::Vec3b(180, 105, 255));
+  cv::Mat clean = test_util::FieldImage(320, 240, rng);
+  test_util::PaintDisc(clean, c, 14, cv::Vec3b(180, 105, 255));
   o.roi = cv::Rect(140, 50, 40, 40);
   EXPECT_FALSE(LearnColour(clean, o).bad);
 }
@@ -177,4 +177,4 @@ TEST(LearnColour, BadInputIsNamed) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

@@ -10,7 +10,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 std::string WriteText(const std::string& name, const std::string& text) {
@@ -43,7 +43,7 @@ TEST(ColourTable, PresetSpecSeparatesBallGrassAndLines) {
 TEST(ColourTable, TableAgreesWithTheRangesForRandomColours) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   ColourSpec spec = PresetColourSpec("orange");
   spec.classes.push_back(ColourPreset("red"));  // wraps through hue 0
   spec.classes.push_back({"yuv", {{ColourSpace::kYuv, {50, 90, 140}, {220, 130, 255}}}});
@@ -67,7 +67,7 @@ TEST(ColourTable, TableAgreesWithTheRangesForRandomColours) {
 TEST(ColourTable, QuantisedTableMatchesTheExactTableAtCellCentres) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourSpec spec = PresetColourSpec("orange");
   const ColourTable exact(spec, 8), q6(spec, 6);
   int agree = 0;
@@ -116,4 +116,4 @@ TEST(ColourSpec, BadFilesGiveOneLineErrorsNamingTheFile) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

@@ -19,7 +19,7 @@
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
 
-namespace fv {
+namespace fv::detect {
 namespace fs = std::filesystem;
 
 namespace {
@@ -28,7 +28,8 @@ namespace {
 std::vector<std::string> ImagesUnder(const std::string& dir) {
   std::vector<std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (e.is_regular_file() && IsImageFile(e.path().string())) files.push_back(e.path().string());
+    if (e.is_regular_file() && io::IsImageFile(e.path().string()))
+      files.push_back(e.path().string());
   }
   std::sort(files.begin(), files.end());
   return files;
@@ -60,7 +61,7 @@ const cv::Rect2d* BoxHolding(const std::vector<cv::Rect2d>& boxes, double grow, 
 // CSV labels: image (file name, path or stem) or frame, and x,y,w,h in pixels.
 std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items,
                                          const std::string& path) {
-  const CsvTable t = CsvTable::Read(path);
+  const util::CsvTable t = util::CsvTable::Read(path);
   t.Require({"x", "y", "w", "h"});
   FV_REQUIRE(t.Has("image") || t.Has("frame"), "{}: needs a column 'image' or 'frame'", path);
   std::map<std::string, std::vector<cv::Rect2d>> by_key;
@@ -144,7 +145,7 @@ std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images
     for (const auto& t : tries) {
       if (fs::is_regular_file(t)) {
         item.has_label_file = true;
-        const cv::Mat im = ReadImage(image);  // the size normalises the boxes
+        const cv::Mat im = io::ReadImage(image);  // the size normalises the boxes
         item.boxes = ReadYoloFile(t.string(), class_id, im.cols, im.rows);
         break;
       }
@@ -221,7 +222,8 @@ std::string DetectEvalResult::Summary(int list) const {
     s += fmt::format(
         "\ncentre error vs. box centre: median {:.2f} px, p90 {:.2f} px ({:.2f} / {:.2f} of the "
         "box half size)",
-        Median(err_px), Percentile(err_px, 0.9), Median(err_rel), Percentile(err_rel, 0.9));
+        util::Median(err_px), util::Percentile(err_px, 0.9), util::Median(err_rel),
+        util::Percentile(err_rel, 0.9));
   }
   int on_ball = 0;
   for (const auto& im : images) on_ball += im.boxes > 0 && im.candidate_on_ball;
@@ -251,12 +253,12 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   std::vector<LabelledImage> items;
   std::string root;
   const bool is_dir = fs::is_directory(o.video);
-  std::vector<std::string> files = is_dir ? ImagesUnder(o.video) : ListImageSequence(o.video);
-  std::unique_ptr<VideoSource> video;
+  std::vector<std::string> files = is_dir ? ImagesUnder(o.video) : io::ListImageSequence(o.video);
+  std::unique_ptr<io::VideoSource> video;
   if (is_dir) root = o.video;
   if (files.empty()) {
     FV_REQUIRE(!is_dir, "eval detect: folder '{}' holds no image", o.video);
-    video = VideoSource::Open(o.video);  // throws naming the video
+    video = io::VideoSource::Open(o.video);  // throws naming the video
     FV_REQUIRE(!o.labels.empty() && fs::path(o.labels).extension() == ".csv",
                "eval detect: a video needs --labels LABELS.csv with columns frame,x,y,w,h");
     for (int i = 0; i < std::max(0, video->frame_count()); ++i) {
@@ -288,18 +290,19 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   // No output may be one of the images, label files or the camera read (an image inside --video).
   std::vector<std::string> inputs = {o.video, o.labels, o.camera};
   for (const LabelledImage& item : items) inputs.push_back(item.image);
-  CheckOutputPath(o.out, inputs, "--out");
-  CheckOutputPath(o.candidates_out, inputs, "--candidates");
-  std::unique_ptr<Camera> camera;
-  if (!o.camera.empty()) camera = std::make_unique<Camera>(ReadCameraYaml(o.camera));
+  io::CheckOutputPath(o.out, inputs, "--out");
+  io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
+  std::unique_ptr<camera::Camera> camera;
+  if (!o.camera.empty())
+    camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
   const AnyBallDetector detector(o.detector, o.dnn, camera.get(), nullptr);
 
   DetectEvalResult result;
-  std::unique_ptr<AtomicOutput> cand_file;
-  std::unique_ptr<CsvWriter> cand_csv;
+  std::unique_ptr<io::AtomicOutput> cand_file;
+  std::unique_ptr<util::CsvWriter> cand_csv;
   if (!o.candidates_out.empty()) {
-    cand_file = std::make_unique<AtomicOutput>(o.candidates_out, "--candidates");
-    cand_csv = std::make_unique<CsvWriter>(
+    cand_file = std::make_unique<io::AtomicOutput>(o.candidates_out, "--candidates");
+    cand_csv = std::make_unique<util::CsvWriter>(
         cand_file->temp_path(),
         std::vector<std::string>{"image",    "u",     "v",        "radius_px", "score",
                                  "accepted", "weak",  "on_ball",  "visible",   "inliers",
@@ -308,8 +311,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
                                  "precise",  "reason"},
         4);
   }
-  Progress progress("eval detect", static_cast<long long>(items.size()), "images", o.progress);
-  Frame frame;
+  util::Progress progress("eval detect", static_cast<long long>(items.size()), "images",
+                          o.progress);
+  io::Frame frame;
   for (size_t i = 0; i < items.size(); ++i) {
     const LabelledImage& item = items[i];
     cv::Mat bgr;
@@ -320,7 +324,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
       }
       bgr = frame.bgr;
     } else {
-      bgr = ReadImage(item.image);
+      bgr = io::ReadImage(item.image);
     }
     const auto candidates = detector.Detect(bgr);
     DetectEvalImage r = ScoreImage(candidates, item.boxes, o.grow);
@@ -352,9 +356,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     cand_file->Commit();
   }
   if (!o.out.empty()) {
-    AtomicWrite(o.out, [&](const std::string& tmp) {
-      CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
-                        "centre_err_px", "candidate_on_ball", "reason"});
+    io::AtomicWrite(o.out, [&](const std::string& tmp) {
+      util::CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
+                              "centre_err_px", "candidate_on_ball", "reason"});
       for (const auto& im : result.images) {
         w << im.image << im.boxes << int(im.detected) << int(im.hit) << im.u << im.v << im.radius_px
           << im.score << im.centre_err_px << int(im.candidate_on_ball) << ReplaceCommas(im.reason);
@@ -366,4 +370,4 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -15,7 +15,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/dnn_ball.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct LabelledImage {
   std::string image;              // file path, or the video plus frame for a video
@@ -81,4 +81,4 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
 
 DetectEvalResult EvaluateDetector(const DetectEvalOptions& options);
 
-}  // namespace fv
+}  // namespace fv::detect

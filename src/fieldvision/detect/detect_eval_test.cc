@@ -12,7 +12,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 namespace fs = std::filesystem;
@@ -22,18 +22,18 @@ void WriteText(const std::string& path, const std::string& text) { std::ofstream
 TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const std::string dir = fv::testing::TempDir() + "/detect_eval_yolo";
   fs::remove_all(dir);
   fs::create_directories(dir + "/labels");
   // Three images with a ball (labelled), one without (no label file).
   for (int i = 0; i < 4; ++i) {
-    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
     const std::string stem = "im" + std::to_string(i);
     if (i < 3) {
       const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
       const double r = rng.Uniform(6, 14);
-      detect_testing::PaintDisc(img, c, r);
+      test_util::PaintDisc(img, c, r);
       WriteText(dir + "/labels/" + stem + ".txt",
                 fmt::format("2 0.5 0.5 0.1 0.1\n0 {} {} {} {}\n", c.x() / 320, c.y() / 240,
                             2 * r / 320, 2 * r / 240));
@@ -80,8 +80,8 @@ TEST(DetectEval, BadLabelNamesFileAndLine) {
 TEST(DetectEval, NothingToScoreIsNotAScore) {
   const std::string dir = fv::testing::TempDir() + "/detect_eval_nolabels";
   fs::create_directories(dir);
-  Rng rng(1);
-  cv::imwrite(dir + "/a.png", detect_testing::FieldImage(64, 48, rng));
+  util::Rng rng(1);
+  cv::imwrite(dir + "/a.png", test_util::FieldImage(64, 48, rng));
   DetectEvalOptions o;
   o.video = dir;
   o.progress = false;
@@ -130,4 +130,4 @@ TEST(DetectEval, RealRobocupPhotos) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

@@ -18,12 +18,12 @@
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 bool IsVideoPath(const std::string& path) {
-  const std::string p = ToLower(path);
-  return EndsWith(p, ".avi") || EndsWith(p, ".mp4") || EndsWith(p, ".mkv");
+  const std::string p = util::ToLower(path);
+  return util::EndsWith(p, ".avi") || util::EndsWith(p, ".mp4") || util::EndsWith(p, ".mkv");
 }
 
 }  // namespace
@@ -67,23 +67,23 @@ void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates) 
 
 DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   o.Check();
-  std::optional<Camera> camera;
-  if (!o.camera.empty()) camera = ReadCameraYaml(o.camera);
-  std::optional<FieldModel> field;
-  if (!o.field.empty()) field = LoadField(o.field);
-  auto source = VideoSource::Open(o.video);
+  std::optional<camera::Camera> camera;
+  if (!o.camera.empty()) camera = camera::ReadCameraYaml(o.camera);
+  std::optional<field::FieldModel> field;
+  if (!o.field.empty()) field = field::LoadField(o.field);
+  auto source = io::VideoSource::Open(o.video);
   if (camera) source->CheckMatchesCamera(*camera, o.camera);
   const AnyBallDetector detector(o.detector, o.dnn, camera ? &*camera : nullptr,
                                  field ? &*field : nullptr);
   // Written beside --out and renamed over it at the end: a failed run leaves the old file.
-  AtomicOutput out_file(o.out);
-  CsvWriter csv(out_file.temp_path(),
-                {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
+  io::AtomicOutput out_file(o.out);
+  util::CsvWriter csv(out_file.temp_path(),
+                      {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
   cv::VideoWriter writer;
   std::string draw_dir;
   if (!o.draw.empty()) {
     if (IsVideoPath(o.draw)) {
-      const int fourcc = EndsWith(ToLower(o.draw), ".avi")
+      const int fourcc = util::EndsWith(util::ToLower(o.draw), ".avi")
                              ? cv::VideoWriter::fourcc('M', 'J', 'P', 'G')
                              : cv::VideoWriter::fourcc('m', 'p', '4', 'v');
       const double fps = source->fps() > 0 ? source->fps() : 30.0;
@@ -101,9 +101,9 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   const long long total = o.max_frames > 0 && source->frame_count() > 0
                               ? std::min(o.max_frames, source->frame_count())
                               : (o.max_frames > 0 ? o.max_frames : source->frame_count());
-  Progress progress("detect", total, "frames", o.progress);
+  util::Progress progress("detect", total, "frames", o.progress);
   const auto t0 = std::chrono::steady_clock::now();
-  Frame frame;
+  io::Frame frame;
   while ((o.max_frames < 0 || result.frames < o.max_frames) && source->Read(frame)) {
     const auto cands = detector.Detect(frame.bgr);
     bool any = false;
@@ -136,4 +136,4 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

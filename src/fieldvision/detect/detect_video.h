@@ -1,6 +1,6 @@
 // `fieldvision detect`: runs the ball detector of one camera over a video (any file OpenCV reads
-// or an image sequence, via fv::VideoSource), writes every candidate per frame to a CSV file and
-// optionally draws them on the frames (an annotated video or a folder of images).
+// or an image sequence, via fv::io::VideoSource), writes every candidate per frame to a CSV file
+// and optionally draws them on the frames (an annotated video or a folder of images).
 #pragma once
 
 #include <string>
@@ -8,7 +8,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/dnn_ball.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct DetectVideoOptions {
   std::string camera;   // camera YAML; "" for an uncalibrated camera (no size check, no mask)
@@ -38,4 +38,4 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& options);
 // red (thin circle).
 void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates);
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -15,7 +15,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 std::string ErrorOf(const std::function<void()>& f) {
@@ -34,22 +34,22 @@ struct Clip {
 };
 
 Clip MakeClip(uint64_t seed, int frames) {
-  Rng rng(seed);
+  util::Rng rng(seed);
   Clip clip;
   clip.dir = fv::testing::TempDir();
   std::filesystem::create_directories(clip.dir + "/frames");
   clip.pattern = clip.dir + "/frames/%05d.png";
   const double r = rng.Uniform(5, 12);
   for (int f = 0; f < frames; ++f) {
-    cv::Mat img = detect_testing::FieldImage(320, 240, rng);
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
     const Eigen::Vector2d c(60 + 40 * f + rng.Uniform(0, 1), 150 + rng.Uniform(0, 1));
-    detect_testing::PaintDisc(img, c, r);
+    test_util::PaintDisc(img, c, r);
     clip.centres.push_back(c);
     const std::string path = fmt::format("{}/frames/{:05d}.png", clip.dir, f);
     if (!cv::imwrite(path, img)) ADD_FAILURE() << "cannot write " << path;
   }
   clip.camera = clip.dir + "/cam.yaml";
-  WriteCameraYaml(Camera::FromFov(320, 240, 60), clip.camera);
+  camera::WriteCameraYaml(camera::Camera::FromFov(320, 240, 60), clip.camera);
   return clip;
 }
 
@@ -67,7 +67,7 @@ TEST(DetectVideo, WritesEveryCandidateAndDrawsThem) {
   const DetectVideoResult r = DetectVideo(o);
   EXPECT_EQ(r.frames, 5);
   EXPECT_EQ(r.frames_with_ball, 5) << r.Summary();
-  const CsvTable t = CsvTable::Read(o.out);
+  const util::CsvTable t = util::CsvTable::Read(o.out);
   t.Require({"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
   int accepted = 0;
   for (size_t i = 0; i < t.rows(); ++i) {
@@ -104,7 +104,7 @@ TEST(DetectVideo, BadInputGivesOneLineErrorsNamingTheInput) {
   EXPECT_NE(e.find("corrupt.avi"), std::string::npos) << e;
   // Frames of another size than the camera file.
   const std::string other = clip.dir + "/other.yaml";
-  WriteCameraYaml(Camera::FromFov(640, 480, 60), other);
+  camera::WriteCameraYaml(camera::Camera::FromFov(640, 480, 60), other);
   o.video = clip.pattern;
   o.camera = other;
   e = ErrorOf([&] { DetectVideo(o); });
@@ -147,4 +147,4 @@ TEST(DetectVideo, AFailedRunKeepsTheOldOutput) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 constexpr double kPadGrey = 114.0;  // fill beyond the image in a crop (the usual letterbox grey)
@@ -210,7 +210,7 @@ std::vector<double> DnnBallDetector::CropScores(const cv::Mat& bgr,
 }
 
 AnyBallDetector::AnyBallDetector(const BallDetectorOptions& colour, const DnnBallOptions& dnn,
-                                 const Camera* camera, const FieldModel* field)
+                                 const camera::Camera* camera, const field::FieldModel* field)
     : dnn_options_(dnn) {
   dnn_options_.Check();
   colour_ = std::make_unique<BallDetector>(colour, camera, field);
@@ -245,4 +245,4 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
   return CombineBallCandidates(colour, confirm, whole, dnn_options_);
 }
 
-}  // namespace fv
+}  // namespace fv::detect

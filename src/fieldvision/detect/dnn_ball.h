@@ -22,7 +22,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/dnn/nanodet.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct DnnBallOptions {
   std::string detector = "colour";  // colour | dnn | both (--detector)
@@ -103,7 +103,7 @@ class AnyBallDetector {
  public:
   // Throws fv::Error for bad options, colour or model.
   AnyBallDetector(const BallDetectorOptions& colour, const DnnBallOptions& dnn,
-                  const Camera* camera, const FieldModel* field);
+                  const camera::Camera* camera, const field::FieldModel* field);
   // Candidates best first (BallDetector::Detect's contract: `region` empty = whole frame;
   // nothing outside it is read).
   std::vector<BallCandidate> Detect(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
@@ -116,4 +116,4 @@ class AnyBallDetector {
   std::unique_ptr<DnnBallDetector> dnn_;
 };
 
-}  // namespace fv
+}  // namespace fv::detect

@@ -10,7 +10,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 BallCandidate Cand(double u, double v, double r, double score, bool accepted) {
@@ -50,7 +50,7 @@ TEST(CandidateFromBox, CentreAndMeanHalfSide) {
 TEST(CombineBallCandidates, ConfirmsKeepsOrDemotesAndCompletes) {
   const uint64_t seed = fv::testing::TestSeed(12);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 50; ++trial) {
     DnnBallOptions o;
     o.detector = "both";
@@ -176,4 +176,4 @@ TEST_F(DnnBallOnPhotos, NetworkFindsBallsAndConfirmsColour) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

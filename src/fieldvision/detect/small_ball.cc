@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::detect {
 
 void SmallBallOptions::Check() const {
   FV_REQUIRE(mode == "auto" || mode == "on" || mode == "off",
@@ -140,4 +140,4 @@ std::vector<SmallBall> FindSmallBalls(const cv::Mat& bgr, const ColourTable& tab
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::detect

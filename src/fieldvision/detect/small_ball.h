@@ -15,7 +15,7 @@
 
 #include "fieldvision/detect/colour.h"
 
-namespace fv {
+namespace fv::detect {
 
 struct SmallBallOptions {
   // Looked for only when no other candidate is accepted, and then: "on" anywhere (footage known
@@ -52,4 +52,4 @@ std::vector<SmallBall> FindSmallBalls(const cv::Mat& bgr, const ColourTable& tab
                                       const cv::Rect& roi, const cv::Mat& mask,
                                       const SmallBallOptions& options);
 
-}  // namespace fv
+}  // namespace fv::detect

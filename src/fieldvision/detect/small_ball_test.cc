@@ -14,7 +14,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::detect {
 namespace {
 
 using Eigen::Vector2d;
@@ -28,7 +28,7 @@ cv::Mat Jpeg(const cv::Mat& img, int quality) {
 TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
   const uint64_t seed = fv::testing::TestSeed(11);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
   const SmallBallOptions o;
   BallDetectorOptions on;
@@ -37,10 +37,10 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
   int found = 0, small = 0, trials = 0;
   std::string misses;
   for (int trial = 0; trial < 12; ++trial) {
-    cv::Mat img = detect_testing::FieldImage(224, 224, rng);
+    cv::Mat img = test_util::FieldImage(224, 224, rng);
     const double r = rng.Uniform(1.6, 2.8);
     const Vector2d c(rng.Uniform(20, 204), rng.Uniform(20, 204));
-    detect_testing::PaintDisc(img, c, r, detect_testing::kOrange, 0.3);
+    test_util::PaintDisc(img, c, r, test_util::kOrange, 0.3);
     cv::GaussianBlur(img, img, {0, 0}, 0.7);
     img = Jpeg(img, 75);
     ++trials;
@@ -63,7 +63,7 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
   EXPECT_GT(small, 0);  // the smallest ones only by the small-ball stage
   // Grass with a white line: nothing of the ball's colour, however it is unmixed.
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat img = detect_testing::FieldImage(224, 224, rng);
+    cv::Mat img = test_util::FieldImage(224, 224, rng);
     cv::line(img, {0, 100 + 10 * trial}, {223, 120 + 10 * trial}, cv::Scalar(235, 235, 235), 3,
              cv::LINE_AA);
     img = Jpeg(img, 75);
@@ -74,10 +74,10 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
 TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
   const uint64_t seed = fv::testing::TestSeed(12);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  cv::Mat img = detect_testing::FieldImage(224, 224, rng);
+  util::Rng rng(seed);
+  cv::Mat img = test_util::FieldImage(224, 224, rng);
   const Vector2d c(101.3, 80.6);
-  detect_testing::PaintDisc(img, c, 1.6, detect_testing::kOrange, 0.3);
+  test_util::PaintDisc(img, c, 1.6, test_util::kOrange, 0.3);
   img = Jpeg(img, 75);
   BallDetectorOptions on;
   on.small.mode = "on";
@@ -113,4 +113,4 @@ TEST(SmallBall, OptionsAreChecked) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::detect

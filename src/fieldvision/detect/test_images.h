@@ -13,13 +13,13 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/util/random.h"
 
-namespace fv::detect_testing {
+namespace fv::detect::test_util {
 
 inline const cv::Vec3b kGrass(50, 140, 60);
 inline const cv::Vec3b kOrange(0, 110, 255);
 
 // A grass-green image with mowing stripes, a few white lines and Gaussian noise.
-inline cv::Mat FieldImage(int width, int height, Rng& rng, double noise_sigma = 2.0) {
+inline cv::Mat FieldImage(int width, int height, util::Rng& rng, double noise_sigma = 2.0) {
   cv::Mat img(height, width, CV_8UC3, cv::Scalar(kGrass[0], kGrass[1], kGrass[2]));
   for (int x = 0; x < width; x += 160) {
     cv::rectangle(img, cv::Rect(x, 0, 80, height), cv::Scalar(45, 125, 55), cv::FILLED);
@@ -79,8 +79,9 @@ inline void PaintDisc(cv::Mat& img, const Eigen::Vector2d& c, double r, cv::Vec3
 // Ray-casts a sphere (centre in the camera frame, radius) through the camera by supersampling
 // (pinhole with the camera's distortion ignored: the camera must have none). Returns the
 // projection of the centre.
-inline Eigen::Vector2d PaintSphere(cv::Mat& img, const Camera& cam, const Eigen::Vector3d& centre,
-                                   double radius, cv::Vec3b colour = kOrange) {
+inline Eigen::Vector2d PaintSphere(cv::Mat& img, const camera::Camera& cam,
+                                   const Eigen::Vector3d& centre, double radius,
+                                   cv::Vec3b colour = kOrange) {
   const Eigen::Vector2d uv(cam.fx * centre.x() / centre.z() + cam.cx,
                            cam.fy * centre.y() / centre.z() + cam.cy);
   const double approx_r = cam.fx * radius / centre.norm() * 3.0 + 3;
@@ -112,4 +113,4 @@ inline Eigen::Vector2d PaintSphere(cv::Mat& img, const Camera& cam, const Eigen:
   return uv;
 }
 
-}  // namespace fv::detect_testing
+}  // namespace fv::detect::test_util

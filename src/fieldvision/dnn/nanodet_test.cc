@@ -40,7 +40,7 @@ std::vector<cv::Mat> FakeOutputs(int w, int h, const std::vector<Hot>& hot) {
 TEST(DecodeNanoDet, RecoversBoxesOfTheAskedClassesAtEveryStride) {
   const uint64_t seed = fv::testing::TestSeed(12);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const int w = 416, h = 320;
   for (int trial = 0; trial < 20; ++trial) {
     const int stride = std::array<int, 3>{8, 16, 32}[rng.UniformInt(0, 2)];

@@ -7,7 +7,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::field {
 namespace {
 
 const char* SideName(int s) { return s < 0 ? "left" : "right"; }
@@ -333,4 +333,4 @@ FieldModel BuiltinField(const std::string& name) {
   Throw("unknown field '{}': give a JSON file or one of {}", name, list);
 }
 
-}  // namespace fv
+}  // namespace fv::field

@@ -9,7 +9,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::field {
 
 double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
                          const Eigen::Vector2d& b) {
@@ -119,10 +119,11 @@ FieldModel LoadField(const std::string& name_or_path) {
   if (std::find(names.begin(), names.end(), name_or_path) != names.end()) {
     return BuiltinField(name_or_path);
   }
-  if (EndsWith(ToLower(name_or_path), ".json") || std::filesystem::exists(name_or_path)) {
+  if (util::EndsWith(util::ToLower(name_or_path), ".json") ||
+      std::filesystem::exists(name_or_path)) {
     return ReadFieldJson(name_or_path);
   }
   return BuiltinField(name_or_path);  // throws with the list of names
 }
 
-}  // namespace fv
+}  // namespace fv::field

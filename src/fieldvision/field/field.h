@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-namespace fv {
+namespace fv::field {
 
 // A straight painted line; a and b are the ends of its centreline.
 struct FieldSegment {
@@ -95,4 +95,4 @@ FieldModel BuiltinField(const std::string& name);
 // A built-in name or the path of a field JSON file.
 FieldModel LoadField(const std::string& name_or_path);
 
-}  // namespace fv
+}  // namespace fv::field

@@ -6,7 +6,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::field {
 namespace {
 
 constexpr int kShift = 4;  // sub-pixel bits for cv drawing
@@ -91,4 +91,4 @@ cv::Mat DrawField(const FieldModel& field, const TopView& view, const FieldDrawO
   return image;
 }
 
-}  // namespace fv
+}  // namespace fv::field

@@ -8,7 +8,7 @@
 
 #include "fieldvision/field/field.h"
 
-namespace fv {
+namespace fv::field {
 
 struct TopView {
   double px_per_m = 20.0;
@@ -41,4 +41,4 @@ void DrawFieldLines(cv::Mat& image, const FieldModel& field, const TopView& view
 cv::Mat DrawField(const FieldModel& field, const TopView& view,
                   const FieldDrawOptions& options = {});
 
-}  // namespace fv
+}  // namespace fv::field

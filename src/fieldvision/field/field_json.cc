@@ -6,7 +6,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
-namespace fv {
+namespace fv::field {
 namespace {
 
 using nlohmann::json;
@@ -14,12 +14,12 @@ using nlohmann::json;
 // A number under `key`; without it `fallback`, or an error when `required`.
 double Num(const json& obj, const char* key, const std::string& ctx, double fallback = NAN,
            bool required = true) {
-  return required ? JsonNumber(obj, key, ctx) : JsonNumber(obj, key, ctx, fallback);
+  return required ? util::JsonNumber(obj, key, ctx) : util::JsonNumber(obj, key, ctx, fallback);
 }
 
 std::string Str(const json& obj, const char* key, const std::string& ctx,
                 const std::string& fallback = "") {
-  return JsonString(obj, key, ctx, fallback);
+  return util::JsonString(obj, key, ctx, fallback);
 }
 
 }  // namespace
@@ -36,14 +36,14 @@ json FieldToJson(const FieldModel& f) {
   j["segments"] = json::array();
   for (const auto& s : f.segments) {
     j["segments"].push_back({{"name", s.name},
-                             {"a", JsonFromVector(s.a)},
-                             {"b", JsonFromVector(s.b)},
+                             {"a", util::JsonFromVector(s.a)},
+                             {"b", util::JsonFromVector(s.b)},
                              {"width_m", s.width_m}});
   }
   j["arcs"] = json::array();
   for (const auto& a : f.arcs) {
     j["arcs"].push_back({{"name", a.name},
-                         {"centre", JsonFromVector(a.centre)},
+                         {"centre", util::JsonFromVector(a.centre)},
                          {"radius_m", a.radius_m},
                          {"start_rad", a.start_rad},
                          {"end_rad", a.end_rad},
@@ -51,7 +51,8 @@ json FieldToJson(const FieldModel& f) {
   }
   j["keypoints"] = json::array();
   for (const auto& k : f.keypoints) {
-    j["keypoints"].push_back({{"name", k.name}, {"position_m", JsonFromVector(k.position_m)}});
+    j["keypoints"].push_back(
+        {{"name", k.name}, {"position_m", util::JsonFromVector(k.position_m)}});
   }
   j["goals"] = json::array();
   for (const auto& g : f.goals) {
@@ -66,8 +67,9 @@ json FieldToJson(const FieldModel& f) {
   }
   j["hoops"] = json::array();
   for (const auto& h : f.hoops) {
-    j["hoops"].push_back(
-        {{"name", h.name}, {"centre_m", JsonFromVector(h.centre_m)}, {"radius_m", h.radius_m}});
+    j["hoops"].push_back({{"name", h.name},
+                          {"centre_m", util::JsonFromVector(h.centre_m)},
+                          {"radius_m", h.radius_m}});
   }
   return j;
 }
@@ -82,28 +84,29 @@ FieldModel FieldFromJson(const json& j, const std::string& ctx) {
   f.line_width_m = Num(j, "line_width_m", ctx, 0.1, false);
   f.surround_m = Num(j, "surround_m", ctx, 2.0, false);
   f.surface = Str(j, "surface", ctx, "grass");
-  for (size_t i = 0; i < JsonArray(j, "segments", ctx).size(); ++i) {
+  for (size_t i = 0; i < util::JsonArray(j, "segments", ctx).size(); ++i) {
     const json& s = j["segments"][i];
     const std::string c = fmt::format("{}: segments[{}]", ctx, i);
     FV_REQUIRE(s.is_object(), "{}: must be an object", c);
-    f.segments.push_back({Str(s, "name", c), JsonVector<2>(s, "a", c), JsonVector<2>(s, "b", c),
+    f.segments.push_back({Str(s, "name", c), util::JsonVector<2>(s, "a", c),
+                          util::JsonVector<2>(s, "b", c),
                           Num(s, "width_m", c, f.line_width_m, false)});
   }
-  for (size_t i = 0; i < JsonArray(j, "arcs", ctx).size(); ++i) {
+  for (size_t i = 0; i < util::JsonArray(j, "arcs", ctx).size(); ++i) {
     const json& a = j["arcs"][i];
     const std::string c = fmt::format("{}: arcs[{}]", ctx, i);
     FV_REQUIRE(a.is_object(), "{}: must be an object", c);
-    f.arcs.push_back({Str(a, "name", c), JsonVector<2>(a, "centre", c), Num(a, "radius_m", c),
+    f.arcs.push_back({Str(a, "name", c), util::JsonVector<2>(a, "centre", c), Num(a, "radius_m", c),
                       Num(a, "start_rad", c, 0.0, false), Num(a, "end_rad", c, 2 * M_PI, false),
                       Num(a, "width_m", c, f.line_width_m, false)});
   }
-  for (size_t i = 0; i < JsonArray(j, "keypoints", ctx).size(); ++i) {
+  for (size_t i = 0; i < util::JsonArray(j, "keypoints", ctx).size(); ++i) {
     const json& k = j["keypoints"][i];
     const std::string c = fmt::format("{}: keypoints[{}]", ctx, i);
     FV_REQUIRE(k.is_object(), "{}: must be an object", c);
-    f.keypoints.push_back({Str(k, "name", c), JsonVector<3>(k, "position_m", c)});
+    f.keypoints.push_back({Str(k, "name", c), util::JsonVector<3>(k, "position_m", c)});
   }
-  for (size_t i = 0; i < JsonArray(j, "goals", ctx).size(); ++i) {
+  for (size_t i = 0; i < util::JsonArray(j, "goals", ctx).size(); ++i) {
     const json& g = j["goals"][i];
     const std::string c = fmt::format("{}: goals[{}]", ctx, i);
     FieldGoal goal;
@@ -117,11 +120,11 @@ FieldModel FieldFromJson(const json& j, const std::string& ctx) {
     goal.depth_m = Num(g, "depth_m", c, 0.5, false);
     f.goals.push_back(goal);
   }
-  for (size_t i = 0; i < JsonArray(j, "hoops", ctx).size(); ++i) {
+  for (size_t i = 0; i < util::JsonArray(j, "hoops", ctx).size(); ++i) {
     const json& h = j["hoops"][i];
     const std::string c = fmt::format("{}: hoops[{}]", ctx, i);
-    f.hoops.push_back(
-        {Str(h, "name", c), JsonVector<3>(h, "centre_m", c), Num(h, "radius_m", c, 0.225, false)});
+    f.hoops.push_back({Str(h, "name", c), util::JsonVector<3>(h, "centre_m", c),
+                       Num(h, "radius_m", c, 0.225, false)});
   }
   try {
     f.Check();
@@ -151,4 +154,4 @@ void WriteFieldJson(const FieldModel& field, const std::string& path) {
   FV_REQUIRE(out.good(), "error while writing field file '{}'", path);
 }
 
-}  // namespace fv
+}  // namespace fv::field

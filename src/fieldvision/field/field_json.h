@@ -7,7 +7,7 @@
 
 #include "fieldvision/field/field.h"
 
-namespace fv {
+namespace fv::field {
 
 nlohmann::json FieldToJson(const FieldModel& field);
 // Throws fv::Error naming `context` and the bad key.
@@ -15,4 +15,4 @@ FieldModel FieldFromJson(const nlohmann::json& j, const std::string& context);
 FieldModel ReadFieldJson(const std::string& path);
 void WriteFieldJson(const FieldModel& field, const std::string& path);
 
-}  // namespace fv
+}  // namespace fv::field

@@ -9,7 +9,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::field {
 namespace {
 
 Eigen::Vector3d Kp(const FieldModel& f, const std::string& name) {
@@ -180,4 +180,4 @@ TEST(FieldDraw, TopViewMapsCornersAndDrawsLines) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::field

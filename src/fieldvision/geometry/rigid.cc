@@ -4,7 +4,7 @@
 
 #include <ceres/rotation.h>
 
-namespace fv {
+namespace fv::geometry {
 
 Eigen::Matrix3d RotationFromRvec(const Eigen::Vector3d& rvec) {
   Eigen::Matrix3d r;
@@ -51,4 +51,4 @@ std::optional<Eigen::Vector3d> IntersectHorizontalPlane(const Ray3d& ray, double
   return ray.At(s);
 }
 
-}  // namespace fv
+}  // namespace fv::geometry

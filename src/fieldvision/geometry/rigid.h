@@ -7,7 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-namespace fv {
+namespace fv::geometry {
 
 struct Rigid3d {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
@@ -39,4 +39,4 @@ struct Ray3d {
 // Where the ray meets the horizontal plane z = height (only in front of the origin).
 std::optional<Eigen::Vector3d> IntersectHorizontalPlane(const Ray3d& ray, double height);
 
-}  // namespace fv
+}  // namespace fv::geometry

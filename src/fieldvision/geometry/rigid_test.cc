@@ -5,13 +5,13 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::geometry {
 namespace {
 
 TEST(Rigid3d, RvecRoundTripAndInverse) {
   const uint64_t seed = testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int i = 0; i < 100; ++i) {
     Eigen::Vector3d rvec(rng.Normal(), rng.Normal(), rng.Normal());
     if (rvec.norm() > 3.0) rvec *= 3.0 / rvec.norm();
@@ -46,4 +46,4 @@ TEST(Ray3d, HorizontalPlane) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::geometry

@@ -15,7 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #endif
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 
 #ifndef FV_HAVE_ARAVIS
 
@@ -44,7 +44,7 @@ class AravisSource : public LiveSource {
  public:
   AravisSource(const std::string& spec, const std::string& id, const FrameSourceOptions& o)
       : LiveSource(spec, "camera", false) {
-    if (StartsWith(id, "Fake")) arv_enable_interface("Fake");
+    if (util::StartsWith(id, "Fake")) arv_enable_interface("Fake");
     GError* error = nullptr;
     camera_ = arv_camera_new(id.empty() ? nullptr : id.c_str(), &error);
     Check(error, spec, "opening the camera");
@@ -187,4 +187,4 @@ std::unique_ptr<FrameSource> OpenAravis(const std::string& spec,
 
 #endif
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

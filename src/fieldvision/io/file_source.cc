@@ -20,7 +20,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 namespace {
 
 // The file of frame `index` of a printf pattern with one integer field (dir/%05d.jpg), or ""
@@ -92,7 +92,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
             : options.time == TimeSource::kContainer ? TimeOrigin::kContainer
                                                      : TimeOrigin::kFrameRate;
   if (options.time == TimeSource::kCsv) {
-    const CsvTable t = CsvTable::Read(options.timestamps_csv);
+    const util::CsvTable t = util::CsvTable::Read(options.timestamps_csv);
     t.Require({"frame", "time_s"});
     for (size_t r = 0; r < t.rows(); ++r) {
       const long long f = t.GetInt(r, "frame");
@@ -236,4 +236,4 @@ std::unique_ptr<FrameSource> OpenFile(const std::string& path, const FrameSource
   return std::make_unique<FileSource>(path, options);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

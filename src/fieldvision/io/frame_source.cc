@@ -12,7 +12,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::io {
 
 const char* ToString(TimeOrigin origin) {
   switch (origin) {
@@ -65,7 +65,7 @@ bool FrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
   return true;
 }
 
-void CheckFrameSize(const FrameSource& source, const Camera& camera,
+void CheckFrameSize(const FrameSource& source, const camera::Camera& camera,
                     const std::string& camera_file) {
   const cv::Size size = source.FrameSize();
   FV_REQUIRE(size.width == camera.width && size.height == camera.height,
@@ -79,13 +79,13 @@ double SystemClockNow() {
 
 std::vector<std::string> FrameSourceBackends() {
   std::vector<std::string> out = {"file", "v4l2"};
-  if (io_backend::HaveGStreamer()) out.push_back("gstreamer");
-  if (io_backend::HaveAravis()) out.push_back("aravis");
+  if (backend::HaveGStreamer()) out.push_back("gstreamer");
+  if (backend::HaveAravis()) out.push_back("aravis");
   out.push_back("synth");
   return out;
 }
 
-namespace io_backend {
+namespace backend {
 
 double SystemFromMonotonic(double monotonic_s) {
   timespec mono{};
@@ -94,20 +94,21 @@ double SystemFromMonotonic(double monotonic_s) {
   return SystemClockNow() - (now_mono - monotonic_s);
 }
 
-}  // namespace io_backend
+}  // namespace backend
 
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
                                              const FrameSourceOptions& options) {
   options.Check();
   FV_REQUIRE(!spec.empty(), "empty video name");
-  if (StartsWith(spec, "v4l2:") || StartsWith(spec, "camera:")) {
-    return io_backend::OpenV4l2(spec, options);
+  if (util::StartsWith(spec, "v4l2:") || util::StartsWith(spec, "camera:")) {
+    return backend::OpenV4l2(spec, options);
   }
-  if (StartsWith(spec, "gst:") || StartsWith(spec, "rtsp://") || StartsWith(spec, "rtsps://")) {
-    return io_backend::OpenGStreamer(spec, options);
+  if (util::StartsWith(spec, "gst:") || util::StartsWith(spec, "rtsp://") ||
+      util::StartsWith(spec, "rtsps://")) {
+    return backend::OpenGStreamer(spec, options);
   }
-  if (StartsWith(spec, "aravis:")) return io_backend::OpenAravis(spec, options);
-  if (StartsWith(spec, "synth:")) return io_backend::OpenSynth(spec, options);
+  if (util::StartsWith(spec, "aravis:")) return backend::OpenAravis(spec, options);
+  if (util::StartsWith(spec, "synth:")) return backend::OpenSynth(spec, options);
   // Anything else with a scheme is a mistake, not a file name.
   const size_t colon = spec.find("://");
   if (colon != std::string::npos) {
@@ -123,9 +124,9 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
       !std::filesystem::is_regular_file(spec) &&
       (spec.find_first_of("*?") != std::string::npos || std::filesystem::is_directory(spec) ||
        (spec.find('%') != std::string::npos && !ListImageSequence(spec).empty()));
-  file = list ? io_backend::OpenImageList(spec, options) : io_backend::OpenFile(spec, options);
-  if (options.realtime) return io_backend::Paced(std::move(file), options);
+  file = list ? backend::OpenImageList(spec, options) : backend::OpenFile(spec, options);
+  if (options.realtime) return backend::Paced(std::move(file), options);
   return file;
 }
 
-}  // namespace fv
+}  // namespace fv::io

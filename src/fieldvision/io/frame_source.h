@@ -26,7 +26,7 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/io/jpeg_region.h"
 
-namespace fv {
+namespace fv::io {
 
 // Where a frame's time_s comes from.
 enum class TimeOrigin {
@@ -103,7 +103,7 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
                                              const FrameSourceOptions& options = {});
 
 // Throws fv::Error naming both when the source's frames are not the camera's image size.
-void CheckFrameSize(const FrameSource& source, const Camera& camera,
+void CheckFrameSize(const FrameSource& source, const camera::Camera& camera,
                     const std::string& camera_file);
 
 // Seconds on the system clock (Unix time): the clock of live sources' time_s.
@@ -112,4 +112,4 @@ double SystemClockNow();
 // Names of the live backends compiled in ("v4l2", "gstreamer", "aravis", "synth").
 std::vector<std::string> FrameSourceBackends();
 
-}  // namespace fv
+}  // namespace fv::io

@@ -16,7 +16,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::io {
 namespace {
 
 std::string WriteMjpg(const std::string& dir, int frames, double fps) {
@@ -84,7 +84,7 @@ TEST(FrameSource, ImageGlobAndFolderEncodedOrNot) {
         ++n;
       }
       EXPECT_EQ(n, 4);
-      Camera cam = Camera::FromFov(640, 480, 60);
+      camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
       try {
         CheckFrameSize(*src, cam, "cam.yaml");
         ADD_FAILURE() << "no size error";
@@ -294,4 +294,4 @@ TEST(FrameSource, AravisSimulatedCamera) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::io

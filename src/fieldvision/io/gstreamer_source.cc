@@ -12,7 +12,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 namespace {
 
 class GStreamerSource : public LiveSource {
@@ -55,7 +55,7 @@ std::unique_ptr<FrameSource> OpenGStreamer(const std::string& spec,
                                            const FrameSourceOptions& options) {
   FV_REQUIRE(HaveGStreamer(), "stream '{}': this OpenCV has no GStreamer backend", spec);
   std::string pipeline;
-  if (StartsWith(spec, "gst:")) {
+  if (util::StartsWith(spec, "gst:")) {
     pipeline = spec.substr(4);
     FV_REQUIRE(!pipeline.empty(), "stream '{}': give a pipeline after 'gst:'", spec);
     if (pipeline.find("appsink") == std::string::npos) {
@@ -71,4 +71,4 @@ std::unique_ptr<FrameSource> OpenGStreamer(const std::string& spec,
   return std::make_unique<GStreamerSource>(spec, pipeline);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

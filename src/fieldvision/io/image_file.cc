@@ -4,7 +4,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::io {
 
 cv::Mat ReadImage(const std::string& path) {
   cv::Mat image;
@@ -27,4 +27,4 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
   FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", path);
 }
 
-}  // namespace fv
+}  // namespace fv::io

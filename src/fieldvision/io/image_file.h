@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace fv {
+namespace fv::io {
 
 // An 8-bit BGR image; throws fv::Error naming `path` when it is missing or does not decode.
 cv::Mat ReadImage(const std::string& path);
@@ -14,4 +14,4 @@ cv::Mat ReadImage(const std::string& path);
 // Throws fv::Error naming `path` when the image cannot be written.
 void WriteImage(const std::string& path, const cv::Mat& image);
 
-}  // namespace fv
+}  // namespace fv::io

@@ -15,11 +15,11 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 namespace {
 
 bool IsJpeg(const std::string& path) {
-  const std::string ext = ToLower(std::filesystem::path(path).extension().string());
+  const std::string ext = util::ToLower(std::filesystem::path(path).extension().string());
   return ext == ".jpg" || ext == ".jpeg";
 }
 
@@ -31,7 +31,7 @@ class ImageListSource : public FrameSource {
     encoded_ = o.encoded;
     for (const std::string& f : files_) encoded_ = encoded_ && IsJpeg(f);
     if (o.time == TimeSource::kCsv) {
-      const CsvTable t = CsvTable::Read(o.timestamps_csv);
+      const util::CsvTable t = util::CsvTable::Read(o.timestamps_csv);
       t.Require({"frame", "time_s"});
       for (size_t r = 0; r < t.rows(); ++r) times_[t.GetInt(r, "frame")] = t.GetDouble(r, "time_s");
       origin_ = TimeOrigin::kCsv;
@@ -107,4 +107,4 @@ std::unique_ptr<FrameSource> OpenImageList(const std::string& spec,
   return std::make_unique<ImageListSource>(spec, std::move(files), options);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

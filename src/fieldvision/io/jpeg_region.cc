@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::io {
 namespace {
 
 // libjpeg reports fatal errors through error_exit, which must not return: jump back to the
@@ -126,4 +126,4 @@ cv::Rect JpegRegionDecoder::Decode(const uint8_t* data, size_t size, const cv::R
   return {left, job.out_y, right - left, job.out_h};
 }
 
-}  // namespace fv
+}  // namespace fv::io

@@ -11,7 +11,7 @@
 
 #include <opencv2/core.hpp>
 
-namespace fv {
+namespace fv::io {
 
 class JpegRegionDecoder {
  public:
@@ -35,4 +35,4 @@ class JpegRegionDecoder {
   long long warnings_ = 0;
 };
 
-}  // namespace fv
+}  // namespace fv::io

@@ -10,11 +10,11 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::io {
 namespace {
 
 // A textured, noisy colour image (sharp edges, gradients) as JPEG bytes.
-std::vector<uint8_t> TestJpeg(Rng& rng, int w, int h, cv::Mat* image = nullptr) {
+std::vector<uint8_t> TestJpeg(util::Rng& rng, int w, int h, cv::Mat* image = nullptr) {
   cv::Mat img(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -33,7 +33,7 @@ std::vector<uint8_t> TestJpeg(Rng& rng, int w, int h, cv::Mat* image = nullptr) 
 TEST(JpegRegionDecoder, WholeImageAndRegionsMatchAFullDecode) {
   const uint64_t seed = testing::TestSeed(31);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const std::vector<uint8_t> jpeg = TestJpeg(rng, 333, 250);
   EXPECT_EQ(JpegRegionDecoder::ReadSize(jpeg.data(), jpeg.size(), "t.jpg"), cv::Size(333, 250));
   JpegRegionDecoder dec;
@@ -65,7 +65,7 @@ TEST(JpegRegionDecoder, WholeImageAndRegionsMatchAFullDecode) {
 TEST(JpegRegionDecoder, DamagedDataIsCountedOrAnErrorNamingTheInput) {
   const uint64_t seed = testing::TestSeed(32);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   std::vector<uint8_t> jpeg = TestJpeg(rng, 160, 120);
   JpegRegionDecoder dec;
   cv::Mat img;
@@ -92,4 +92,4 @@ TEST(JpegRegionDecoder, DamagedDataIsCountedOrAnErrorNamingTheInput) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::io

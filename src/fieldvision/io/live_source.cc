@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 
 LiveSource::LiveSource(std::string spec, std::string noun, bool may_end)
     : spec_(std::move(spec)), noun_(std::move(noun)), may_end_(may_end) {}
@@ -61,4 +61,4 @@ bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path) {
   return OpenCapture(capture, path, api);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

@@ -10,7 +10,7 @@
 
 #include "fieldvision/io/frame_source.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 
 class LiveSource : public FrameSource {
  public:
@@ -53,4 +53,4 @@ bool OpenCapture(cv::VideoCapture& capture, const std::string& target, int api);
 // end or on a read error.
 bool ReadCapture(cv::VideoCapture& capture, SourceFrame* out, double* arrival_s, double* pos_ms);
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

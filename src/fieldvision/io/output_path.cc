@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::io {
 namespace fs = std::filesystem;
 
 namespace {
@@ -89,4 +89,4 @@ void AtomicWrite(const std::string& out, const std::function<void(const std::str
   file.Commit();
 }
 
-}  // namespace fv
+}  // namespace fv::io

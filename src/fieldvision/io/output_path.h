@@ -9,7 +9,7 @@
 #include <type_traits>
 #include <vector>
 
-namespace fv {
+namespace fv::io {
 
 // Throws fv::Error (one line, naming `what` and both paths) when `out` is the same file as one of
 // `inputs` (compared with std::filesystem::equivalent, so symlinks and hard links count; also by
@@ -64,4 +64,4 @@ class AtomicOutput {
 void AtomicWrite(const std::string& out, const std::function<void(const std::string&)>& write,
                  std::string_view what = "--out");
 
-}  // namespace fv
+}  // namespace fv::io

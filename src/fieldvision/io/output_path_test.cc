@@ -11,7 +11,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::io {
 namespace {
 namespace fs = std::filesystem;
 
@@ -98,4 +98,4 @@ TEST(AtomicWrite, WritesThroughASymlinkAndRefusesDevicesAndFolders) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::io

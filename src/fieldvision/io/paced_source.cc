@@ -11,7 +11,7 @@
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/util/error.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 namespace {
 
 class PacedSource : public FrameSource {
@@ -66,4 +66,4 @@ std::unique_ptr<FrameSource> Paced(std::unique_ptr<FrameSource> source,
   return std::make_unique<PacedSource>(std::move(source), options);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

@@ -7,7 +7,7 @@
 
 #include "fieldvision/io/frame_source.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 
 // A video file OpenCV reads or a printf image pattern (file_source.cc).
 std::unique_ptr<FrameSource> OpenFile(const std::string& path, const FrameSourceOptions& options);
@@ -33,4 +33,4 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
 // Seconds on the system clock of a CLOCK_MONOTONIC time in seconds (V4L2 buffer timestamps).
 double SystemFromMonotonic(double monotonic_s);
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

@@ -18,7 +18,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 namespace {
 
 // Live: frame k is captured at start + k / fps (given start_at_s: frames 0..N-1, then the end)
@@ -41,7 +41,7 @@ class SynthLiveSource : public FrameSource {
     // The newest frame captured by now, in this source's numbering of capture instants.
     const long long newest = static_cast<long long>(std::floor((now - start_s_) * fps));
     if (next_ < 0) next_ = start_s_ > 0 ? 0 : std::max(0LL, newest);  // looping: join now
-    long long oldest = newest - buffer_ + 1;  // older frames are gone
+    long long oldest = newest - buffer_ + 1;                          // older frames are gone
     if (start_s_ > 0) oldest = std::min(oldest, n);
     if (next_ < oldest) {
       dropped_ += oldest - next_;
@@ -69,7 +69,7 @@ class SynthLiveSource : public FrameSource {
   }
   long long FrameCount() const override { return start_s_ > 0 ? renderer_->num_frames() : -1; }
   cv::Size FrameSize() const override {
-    const Camera& c = renderer_->cameras()[0];
+    const camera::Camera& c = renderer_->cameras()[0];
     return {c.width, c.height};
   }
   std::string name() const override { return spec_; }
@@ -99,7 +99,7 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
   FV_REQUIRE(!scene_name.empty(), "video '{}': give a preset or scene file after 'synth:'", spec);
   std::map<std::string, std::string> params;
   if (q != std::string::npos) {
-    for (const std::string& kv : Split(rest.substr(q + 1), '&')) {
+    for (const std::string& kv : util::Split(rest.substr(q + 1), '&')) {
       if (kv.empty()) continue;
       const size_t eq = kv.find('=');
       FV_REQUIRE(eq != std::string::npos, "video '{}': parameter '{}' has no value", spec, kv);
@@ -109,7 +109,7 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
   auto take_int = [&](const char* key, long long fallback) {
     const auto it = params.find(key);
     if (it == params.end()) return fallback;
-    const long long v = ParseInt(it->second, fmt::format("'{}' in video '{}'", key, spec));
+    const long long v = util::ParseInt(it->second, fmt::format("'{}' in video '{}'", key, spec));
     params.erase(it);
     return v;
   };
@@ -154,7 +154,7 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
     }
     if (camera < 0 && !camera_key.empty() &&
         camera_key.find_first_not_of("0123456789") == std::string::npos) {
-      camera = static_cast<int>(ParseInt(camera_key, "camera"));
+      camera = static_cast<int>(util::ParseInt(camera_key, "camera"));
     }
     FV_REQUIRE(camera >= 0 && camera < static_cast<int>(scene.cameras.size()),
                "video '{}': the scene has no camera '{}'", spec, camera_key);
@@ -162,4 +162,4 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
   return std::make_unique<SynthLiveSource>(spec, scene, camera, options);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

@@ -11,7 +11,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv::io_backend {
+namespace fv::io::backend {
 namespace {
 
 class V4l2Source : public LiveSource {
@@ -57,8 +57,8 @@ class V4l2Source : public LiveSource {
 
 std::unique_ptr<FrameSource> OpenV4l2(const std::string& spec, const FrameSourceOptions& options) {
   std::string device;
-  if (StartsWith(spec, "camera:")) {
-    const long long n = ParseInt(spec.substr(7), "camera number in '" + spec + "'");
+  if (util::StartsWith(spec, "camera:")) {
+    const long long n = util::ParseInt(spec.substr(7), "camera number in '" + spec + "'");
     FV_REQUIRE(n >= 0, "camera '{}': the number must be >= 0", spec);
     device = "/dev/video" + std::to_string(n);
   } else {
@@ -68,4 +68,4 @@ std::unique_ptr<FrameSource> OpenV4l2(const std::string& spec, const FrameSource
   return std::make_unique<V4l2Source>(spec, device, options);
 }
 
-}  // namespace fv::io_backend
+}  // namespace fv::io::backend

@@ -12,7 +12,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -87,7 +87,7 @@ void CheckEndOfStream(const std::string& path, long long frames_read, long long 
 }
 
 bool IsImageFile(const std::string& path) {
-  const std::string ext = ToLower(fs::path(path).extension().string());
+  const std::string ext = util::ToLower(fs::path(path).extension().string());
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
          ext == ".tiff" || ext == ".pgm" || ext == ".ppm" || ext == ".webp";
 }
@@ -134,17 +134,18 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
   if (sequence) {
     so.fps = options.fps;
     FV_REQUIRE(!ListImageSequence(spec).empty(), "image sequence '{}' matches no image file", spec);
-  } else if (!StartsWith(spec, "camera:") && spec.find(':') == std::string::npos) {
+  } else if (!util::StartsWith(spec, "camera:") && spec.find(':') == std::string::npos) {
     FV_REQUIRE(fs::exists(spec), "video '{}' does not exist", spec);
     so.time = TimeSource::kContainer;
   }
   return std::make_unique<FrameSourceVideo>(spec, OpenFrameSource(spec, so));
 }
 
-void VideoSource::CheckMatchesCamera(const Camera& camera, const std::string& camera_name) const {
+void VideoSource::CheckMatchesCamera(const camera::Camera& camera,
+                                     const std::string& camera_name) const {
   FV_REQUIRE(camera.width == width_ && camera.height == height_,
              "video '{}' is {}x{} but camera file '{}' is for {}x{} images", spec_, width_, height_,
              camera_name, camera.width, camera.height);
 }
 
-}  // namespace fv
+}  // namespace fv::io

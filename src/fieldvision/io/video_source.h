@@ -15,7 +15,7 @@
 
 #include "fieldvision/camera/camera.h"
 
-namespace fv {
+namespace fv::io {
 
 struct VideoSourceOptions {
   // Frame rate assumed for image sequences (and for files whose container has none).
@@ -51,7 +51,7 @@ class VideoSource {
   int frames_read() const { return next_index_; }
 
   // Throws fv::Error naming both files when the frames are not the camera's image size.
-  void CheckMatchesCamera(const Camera& camera, const std::string& camera_name) const;
+  void CheckMatchesCamera(const camera::Camera& camera, const std::string& camera_name) const;
 
  protected:
   std::string spec_;
@@ -71,4 +71,4 @@ void CheckEndOfStream(const std::string& path, long long frames_read, long long 
 // Whether a path names an image file OpenCV reads, by its extension (case-insensitive).
 bool IsImageFile(const std::string& path);
 
-}  // namespace fv
+}  // namespace fv::io

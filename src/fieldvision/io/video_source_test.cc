@@ -10,7 +10,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::io {
 namespace {
 
 cv::Mat NumberedFrame(int i, int w = 64, int h = 48) {
@@ -141,7 +141,7 @@ TEST(VideoSource, CameraSizeMismatch) {
   const std::string dir = testing::TempDir();
   cv::imwrite(dir + "/00000.png", NumberedFrame(0));
   auto src = VideoSource::Open(dir + "/%05d.png");
-  Camera cam = Camera::FromFov(640, 480, 60);
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
   try {
     src->CheckMatchesCamera(cam, "cam.yaml");
     FAIL();
@@ -149,9 +149,9 @@ TEST(VideoSource, CameraSizeMismatch) {
     EXPECT_NE(std::string(e.what()).find("cam.yaml"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("640x480"), std::string::npos);
   }
-  cam = Camera::FromFov(64, 48, 60);
+  cam = camera::Camera::FromFov(64, 48, 60);
   EXPECT_NO_THROW(src->CheckMatchesCamera(cam, "cam.yaml"));
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::io

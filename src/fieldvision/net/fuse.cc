@@ -31,10 +31,11 @@
 namespace fv::net {
 
 void FuseOptions::Check() const {
-  FV_REQUIRE(StartsWith(listen, "tcp://") || StartsWith(listen, "ipc://"),
+  FV_REQUIRE(util::StartsWith(listen, "tcp://") || util::StartsWith(listen, "ipc://"),
              "fuse: --listen must be tcp://HOST:PORT (got '{}')", listen);
-  FV_REQUIRE(publish.empty() || StartsWith(publish, "tcp://") || StartsWith(publish, "ipc://"),
-             "fuse: --publish must be tcp://HOST:PORT (got '{}')", publish);
+  FV_REQUIRE(
+      publish.empty() || util::StartsWith(publish, "tcp://") || util::StartsWith(publish, "ipc://"),
+      "fuse: --publish must be tcp://HOST:PORT (got '{}')", publish);
   FV_REQUIRE(!cameras.empty(), "fuse: give at least one --camera");
   FV_REQUIRE(!out.empty(), "fuse: --out is required");
   FV_REQUIRE(std::isfinite(idle_exit_s) && idle_exit_s >= 0, "fuse: --idle-exit must be >= 0");
@@ -69,8 +70,8 @@ std::string FuseSummary::ToString() const {
   }
   if (!latency_s.empty()) {
     s += fmt::format("\nlatency capture -> fused: p50 {:.1f} ms, p95 {:.1f} ms ({} frames)",
-                     1e3 * NearestRankPercentile(latency_s, 0.5),
-                     1e3 * NearestRankPercentile(latency_s, 0.95), latency_s.size());
+                     1e3 * util::NearestRankPercentile(latency_s, 0.5),
+                     1e3 * util::NearestRankPercentile(latency_s, 0.95), latency_s.size());
     // Each part: the slowest camera of the frame (p50 / p95 over frames).
     std::vector<double> queued, process, arrival, pairing;
     for (const LatencyParts& p : latency_parts) {
@@ -81,8 +82,8 @@ std::string FuseSummary::ToString() const {
     }
     const auto pp = [](const std::vector<double>& v) {
       return v.empty() ? std::string("n/a")
-                       : fmt::format("{:.1f}/{:.1f}", 1e3 * NearestRankPercentile(v, 0.5),
-                                     1e3 * NearestRankPercentile(v, 0.95));
+                       : fmt::format("{:.1f}/{:.1f}", 1e3 * util::NearestRankPercentile(v, 0.5),
+                                     1e3 * util::NearestRankPercentile(v, 0.95));
     };
     s += fmt::format(
         "\n  where it goes (ms, p50/p95, slowest camera of each frame): waiting in the nodes' "
@@ -103,10 +104,10 @@ namespace {
 // closed flights out.
 class FlightWorker {
  public:
-  explicit FlightWorker(const LiveFlightsOptions& options)
+  explicit FlightWorker(const pipeline::LiveFlightsOptions& options)
       : flights_(options), thread_([this] { Run(); }) {}
   ~FlightWorker() { Finish(); }
-  void Add(const BallSample& s) {
+  void Add(const recon::BallSample& s) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (in_.size() < 100000) in_.push_back(s);
@@ -114,7 +115,7 @@ class FlightWorker {
     cv_.notify_one();
   }
   // Flights closed so far (taken).
-  std::vector<Flight> Take() {
+  std::vector<recon::Flight> Take() {
     std::lock_guard<std::mutex> lock(mutex_);
     return std::exchange(out_, {});
   }
@@ -132,7 +133,7 @@ class FlightWorker {
  private:
   void Run() {
     for (;;) {
-      std::deque<BallSample> batch;
+      std::deque<recon::BallSample> batch;
       bool done = false;
       {
         std::unique_lock<std::mutex> lock(mutex_);
@@ -140,34 +141,34 @@ class FlightWorker {
         batch.swap(in_);
         done = done_;
       }
-      std::vector<Flight> closed;
-      for (const BallSample& s : batch) {
-        for (Flight& f : flights_.Add(s)) closed.push_back(std::move(f));
+      std::vector<recon::Flight> closed;
+      for (const recon::BallSample& s : batch) {
+        for (recon::Flight& f : flights_.Add(s)) closed.push_back(std::move(f));
       }
       if (done) {
-        for (Flight& f : flights_.Finish()) closed.push_back(std::move(f));
+        for (recon::Flight& f : flights_.Finish()) closed.push_back(std::move(f));
       }
       if (!closed.empty()) {
         std::lock_guard<std::mutex> lock(mutex_);
-        for (Flight& f : closed) out_.push_back(std::move(f));
+        for (recon::Flight& f : closed) out_.push_back(std::move(f));
       }
       if (done) return;
     }
   }
-  LiveFlights flights_;
+  pipeline::LiveFlights flights_;
   std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<BallSample> in_;
-  std::vector<Flight> out_;
+  std::deque<recon::BallSample> in_;
+  std::vector<recon::Flight> out_;
   bool done_ = false;
   std::thread thread_;
 };
 
-FlightMessage ToMessage(const Flight& f, long long index) {
+FlightMessage ToMessage(const recon::Flight& f, long long index) {
   FlightMessage m;
   m.index = index;
-  m.start = FlightEventName(f.start_event);
-  m.end = FlightEventName(f.end_event);
+  m.start = recon::FlightEventName(f.start_event);
+  m.end = recon::FlightEventName(f.end_event);
   m.t_start_s = f.t_start_s;
   m.t_end_s = f.t_end_s;
   for (int i = 0; i < 3; ++i) {
@@ -180,7 +181,7 @@ FlightMessage ToMessage(const Flight& f, long long index) {
   m.landing_extrapolated = f.landing_extrapolated;
   m.speed_mps = f.speed_mps;
   m.rmse_m = f.rmse_m;
-  m.model = FlightModelName(f.model_kind());
+  m.model = recon::FlightModelName(f.model_kind());
   m.samples = static_cast<long long>(f.samples.size());
   return m;
 }
@@ -221,17 +222,17 @@ class FuseServer {
   void Receive(zmq::message_t& identity, const zmq::message_t& payload, double t1, double arrival);
   // One camera frame message of camera c.
   void AddFrame(int c, const FrameMessage& f, double t1, double arrival);
-  void Emit(const SyncedFrame& group);
-  FuseSummary::LatencyParts LatencyPartsOf(const SyncedFrame& group, double latency_s);
+  void Emit(const pipeline::SyncedFrame& group);
+  FuseSummary::LatencyParts LatencyPartsOf(const pipeline::SyncedFrame& group, double latency_s);
   void PublishFlights();
   void ReportProgress(double now);
 
   const FuseOptions& o_;
-  std::vector<Camera> cameras_;
+  std::vector<camera::Camera> cameras_;
   std::map<std::string, int> index_;
   int n_ = 0;
-  std::unique_ptr<FusionStage> fusion_;
-  std::unique_ptr<LiveSynchronizer> sync_;
+  std::unique_ptr<pipeline::FusionStage> fusion_;
+  std::unique_ptr<pipeline::LiveSynchronizer> sync_;
   FuseSummary summary_;
   std::vector<std::string> names_;
   std::vector<std::string> sessions_;
@@ -242,22 +243,22 @@ class FuseServer {
   zmq::socket_t pub_;
   std::vector<std::map<long long, FrameTiming>> timings_;
   std::unique_ptr<FlightWorker> flight_worker_;
-  CsvWriter* csv_ = nullptr;  // BALL.csv, while Run runs
+  util::CsvWriter* csv_ = nullptr;  // BALL.csv, while Run runs
   double last_report_ = 0;
 };
 
 FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
   for (const std::string& path : o.cameras) {
-    cameras_.push_back(ReadRigCamera(path));
+    cameras_.push_back(pipeline::ReadRigCamera(path));
     FV_REQUIRE(index_.emplace(cameras_.back().name, static_cast<int>(cameras_.size()) - 1).second,
                "fuse: two cameras are named '{}' (set `name` in the camera files)",
                cameras_.back().name);
   }
   n_ = static_cast<int>(cameras_.size());
-  TriangulationOptions topt = o.triangulation;
+  recon::TriangulationOptions topt = o.triangulation;
   topt.ball_radius_m = 0.5 * o.ball_diameter_m;
-  fusion_ = std::make_unique<FusionStage>(cameras_, topt);
-  sync_ = std::make_unique<LiveSynchronizer>(n_, o.sync);
+  fusion_ = std::make_unique<pipeline::FusionStage>(cameras_, topt);
+  sync_ = std::make_unique<pipeline::LiveSynchronizer>(n_, o.sync);
   summary_.cameras.resize(n_);
   for (int c = 0; c < n_; ++c) {
     summary_.cameras[c].name = cameras_[c].name;
@@ -290,7 +291,8 @@ void FuseServer::Bind() {
   }
 }
 
-FuseSummary::LatencyParts FuseServer::LatencyPartsOf(const SyncedFrame& group, double latency_s) {
+FuseSummary::LatencyParts FuseServer::LatencyPartsOf(const pipeline::SyncedFrame& group,
+                                                     double latency_s) {
   FuseSummary::LatencyParts parts;
   for (int c = 0; c < n_; ++c) {
     if (!group.cameras[c]) continue;
@@ -307,11 +309,11 @@ FuseSummary::LatencyParts FuseServer::LatencyPartsOf(const SyncedFrame& group, d
   return parts;
 }
 
-void FuseServer::Emit(const SyncedFrame& group) {
-  const BallFrame f = fusion_->Fuse(group);
+void FuseServer::Emit(const pipeline::SyncedFrame& group) {
+  const pipeline::BallFrame f = fusion_->Fuse(group);
   ++summary_.groups;
   // Capture to decision, for every frame fused (with a position or not).
-  const double decided_s = SystemClockNow();
+  const double decided_s = io::SystemClockNow();
   const double latency_s = clock_kind_ == "system" ? decided_s - group.time_s : 0.0;
   if (clock_kind_ == "system") {
     summary_.latency_s.push_back(latency_s);
@@ -330,12 +332,12 @@ void FuseServer::Emit(const SyncedFrame& group) {
     pub_.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
     if (pub_.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary_.published;
   }
-  if (flight_worker_) flight_worker_->Add(BallSampleOf(f));
+  if (flight_worker_) flight_worker_->Add(pipeline::BallSampleOf(f));
 }
 
 void FuseServer::PublishFlights() {
   if (!flight_worker_) return;
-  for (Flight& flight : flight_worker_->Take()) {
+  for (recon::Flight& flight : flight_worker_->Take()) {
     const FlightMessage m = ToMessage(flight, static_cast<long long>(summary_.flights.size()));
     summary_.flights.push_back(std::move(flight));
     if (!pub_) continue;
@@ -375,7 +377,7 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
   }
   if (const auto* ping = std::get_if<PingMessage>(&m)) {
     PongMessage pong{ping->t0_s, t1, 0};
-    pong.t2_s = SystemClockNow();
+    pong.t2_s = io::SystemClockNow();
     router_.send(identity, zmq::send_flags::sndmore | zmq::send_flags::dontwait);
     router_.send(zmq::buffer(Encode(pong)), zmq::send_flags::dontwait);
   }
@@ -420,7 +422,7 @@ void FuseServer::AddFrame(int c, const FrameMessage& f, double t1, double arriva
     ++summary_.clock_mismatch;
     return;
   }
-  CameraMessage cm;
+  pipeline::CameraMessage cm;
   cm.camera = c;
   cm.frame = f.frame;
   cm.time_s = f.time_s;
@@ -457,13 +459,13 @@ void FuseServer::ReportProgress(double now) {
 FuseSummary FuseServer::Run() {
   Bind();
   if (o_.flights) {
-    LiveFlightsOptions fopt = o_.flight_options;
+    pipeline::LiveFlightsOptions fopt = o_.flight_options;
     fopt.analysis.ball_radius_m = 0.5 * o_.ball_diameter_m;
     flight_worker_ = std::make_unique<FlightWorker>(fopt);
   }
   // Written beside --out and renamed at the end; a run that fails leaves no temporary file.
-  AtomicOutput out_file(o_.out);
-  CsvWriter csv(out_file.temp_path(), BallCsvColumns(), 6);
+  io::AtomicOutput out_file(o_.out);
+  util::CsvWriter csv(out_file.temp_path(), recon::BallCsvColumns(), 6);
   csv_ = &csv;
   const auto start = std::chrono::steady_clock::now();
   double last_message = SteadyNow();
@@ -477,7 +479,7 @@ FuseSummary FuseServer::Run() {
     }
     zmq::message_t identity, payload;
     while (router_.recv(identity, zmq::recv_flags::dontwait)) {
-      const double t1 = SystemClockNow();
+      const double t1 = io::SystemClockNow();
       const double arrival = SteadyNow();
       last_message = arrival;
       if (!identity.more() || !router_.recv(payload, zmq::recv_flags::dontwait)) {

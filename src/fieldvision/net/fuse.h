@@ -26,14 +26,15 @@ struct FuseOptions {
   double idle_exit_s =
       0;  // exit after this many seconds without messages (after the first); 0: never
   double ball_diameter_m = 0.22;
-  LiveSyncOptions sync;
+  pipeline::LiveSyncOptions sync;
   // Flights as they close (a worker thread analyses the positions; published on topic
   // "flight"); analysis.ball_radius_m is set from ball_diameter_m.
   bool flights = true;
-  LiveFlightsOptions flight_options;
-  TriangulationOptions triangulation;
+  pipeline::LiveFlightsOptions flight_options;
+  recon::TriangulationOptions triangulation;
   bool progress = true;
-  JobControl* control = nullptr;  // optional: progress callback and stop check (e.g. Ctrl-C)
+  pipeline::JobControl* control =
+      nullptr;  // optional: progress callback and stop check (e.g. Ctrl-C)
   // Optional: called once listening, with the address bound (the port chosen for PORT *).
   std::function<void(const std::string& endpoint)> on_listening;
   void Check() const;  // throws fv::Error naming the bad option
@@ -54,13 +55,13 @@ struct FuseSummary {
   long long unknown_camera = 0;  // messages naming no camera of the rig
   long long unsynced = 0;        // live frames sent before the node had a clock estimate
   long long clock_mismatch = 0;  // media-time frames among system-clock ones or vice versa
-  std::vector<LiveCameraStats> sync;
+  std::vector<pipeline::LiveCameraStats> sync;
   std::vector<std::string> sync_problems;
   long long groups = 0;
-  FusionStats fusion;
+  pipeline::FusionStats fusion;
   long long rows_written = 0;
   long long published = 0;
-  std::vector<Flight> flights;  // closed flights, in the order published
+  std::vector<recon::Flight> flights;  // closed flights, in the order published
   long long flights_published = 0;
   std::vector<double> latency_s;  // capture -> fused, per frame fused (system clocks only)
   // Where the latency of each of those frames went (the slowest camera of the frame; < 0: the

@@ -48,7 +48,7 @@ struct Encoder {
     json j = {{"type", "frame"},      {"camera", m.camera},
               {"session", m.session}, {"frame", m.frame},
               {"time_s", m.time_s},   {"origin", m.origin},
-              {"clock", m.clock},     {"candidates", CandidatesToJson(m.candidates)}};
+              {"clock", m.clock},     {"candidates", pipeline::CandidatesToJson(m.candidates)}};
     if (m.has_offset) j["offset_s"] = m.offset_s;
     if (m.queued_s >= 0) j["queued_s"] = m.queued_s;
     if (m.process_s >= 0) j["process_s"] = m.process_s;
@@ -159,7 +159,7 @@ Message DecodeChecked(const void* data, size_t size) {
     }
     FV_REQUIRE(j.contains("candidates"), "message: 'candidates' missing");
     FV_REQUIRE(j["candidates"].size() <= 1000, "message: more than 1000 candidates");
-    m.candidates = CandidatesFromJson(j["candidates"], "message");
+    m.candidates = pipeline::CandidatesFromJson(j["candidates"], "message");
     return m;
   }
   if (type == "skip") {

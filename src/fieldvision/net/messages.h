@@ -55,7 +55,7 @@ struct FrameMessage {
   std::string clock = "system";
   double offset_s = 0;      // fuse clock - node clock (clock "system")
   bool has_offset = false;  // false until the node has a clock estimate
-  std::vector<BallObservation> candidates;
+  std::vector<recon::BallObservation> candidates;
   // Optional (< 0: not sent): seconds from capture until the node had the frame (the source's
   // buffer) and the node's work on it (decoding and detection); the fusion node reports them.
   double queued_s = -1, process_s = -1;

@@ -29,7 +29,7 @@ TEST(Messages, FrameRoundTripsExactly) {
   f.origin = "device";
   f.has_offset = true;
   f.offset_s = -0.0801234567;
-  BallObservation o;
+  recon::BallObservation o;
   o.centre_px = {100.25, 33.125};
   o.radius_px = 4.5;
   o.sigma_px = 0.3;
@@ -123,7 +123,7 @@ TEST(Messages, RefusalsSayWhy) {
 TEST(ClockSync, ShortestRoundTripGivesTheOffset) {
   const uint64_t seed = testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const double true_offset = 0.0803;  // fuse - node
   ClockSync sync(16);
   EXPECT_FALSE(sync.Estimate());

@@ -28,7 +28,7 @@ namespace fv::net {
 void NodeOptions::Check() const {
   FV_REQUIRE(!camera.empty(), "node: --camera is required");
   FV_REQUIRE(!video.empty(), "node: --video is required");
-  FV_REQUIRE(StartsWith(connect, "tcp://") || StartsWith(connect, "ipc://"),
+  FV_REQUIRE(util::StartsWith(connect, "tcp://") || util::StartsWith(connect, "ipc://"),
              "node: --connect must be tcp://HOST:PORT (got '{}')", connect);
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
              "node: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
@@ -109,7 +109,7 @@ class NodeLink {
     thread_.join();
     to_link_.close();
   }
-  double Now() const { return SystemClockNow() + o_.clock_offset_s; }
+  double Now() const { return io::SystemClockNow() + o_.clock_offset_s; }
   bool has_offset() const { return has_offset_; }
   double offset_s() const { return offset_s_; }
   std::atomic<long long> send_dropped{0};
@@ -200,8 +200,8 @@ class NodeLink {
 
 // A blank grass-coloured frame with discs of the preset ball colours, so that candidates go
 // through every stage of the detector; JPEG-encoded for an encoded source.
-SourceFrame WarmUpFrame(cv::Size size, bool encoded) {
-  SourceFrame blank;
+io::SourceFrame WarmUpFrame(cv::Size size, bool encoded) {
+  io::SourceFrame blank;
   blank.bgr = cv::Mat(size, CV_8UC3, cv::Scalar(90, 120, 90));
   const cv::Scalar colours[] = {{0, 110, 255}, {0, 230, 255}, {255, 255, 255}, {180, 105, 255},
                                 {0, 0, 230},   {230, 60, 0},  {0, 200, 0},     {10, 10, 10}};
@@ -231,8 +231,8 @@ void WaitForClock(const NodeLink& link, const NodeOptions& o) {
 // The median, 95th percentile and largest work time per frame.
 void SetProcessTimes(const std::vector<double>& process_s, NodeSummary& summary) {
   if (process_s.empty()) return;
-  summary.process_p50_s = NearestRankPercentile(process_s, 0.5);
-  summary.process_p95_s = NearestRankPercentile(process_s, 0.95);
+  summary.process_p50_s = util::NearestRankPercentile(process_s, 0.5);
+  summary.process_p95_s = util::NearestRankPercentile(process_s, 0.95);
   summary.process_max_s = *std::max_element(process_s.begin(), process_s.end());
 }
 
@@ -251,28 +251,29 @@ void AddLinkSummary(const NodeLink& link, NodeSummary& summary) {
 
 NodeSummary RunNode(const NodeOptions& o) {
   o.Check();
-  const Camera camera = ReadRigCamera(o.camera);
-  std::optional<FieldModel> field;
-  if (!o.field.empty()) field = LoadField(o.field);
-  FrameSourceOptions so;
+  const camera::Camera camera = pipeline::ReadRigCamera(o.camera);
+  std::optional<field::FieldModel> field;
+  if (!o.field.empty()) field = field::LoadField(o.field);
+  io::FrameSourceOptions so;
   so.encoded = true;  // MJPG / JPEG: decoded only around the tracked ball
   so.realtime = o.realtime;
   so.start_at_s = o.start_at_s;
   so.live_buffer_frames = o.live_buffer_frames;
-  auto source = OpenFrameSource(o.video, so);
+  auto source = io::OpenFrameSource(o.video, so);
   const cv::Size size = source->FrameSize();
   FV_REQUIRE(size.width == camera.width && size.height == camera.height,
              "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,
              camera.height, o.video, size.width, size.height);
-  BallDetectorOptions dopt;
+  detect::BallDetectorOptions dopt;
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
-  auto detector = std::make_shared<BallDetector>(dopt, &camera, field ? &*field : nullptr);
-  CameraStage stage(0, camera, BallDetectFnFor(detector), o.track, o.video);
+  auto detector = std::make_shared<detect::BallDetector>(dopt, &camera, field ? &*field : nullptr);
+  pipeline::CameraStage stage(0, camera, pipeline::BallDetectFnFor(detector), o.track, o.video);
   if (o.detect) {
     // The first detection pays for lazy set-up (OpenCV, the decoder, page faults: ~1 s on a
     // loaded machine); pay it on a blank frame before the stream starts, not on its first frames.
-    CameraStage warm(0, camera, BallDetectFnFor(detector), o.track, "warm-up frame");
+    pipeline::CameraStage warm(0, camera, pipeline::BallDetectFnFor(detector), o.track,
+                               "warm-up frame");
     warm.Process(WarmUpFrame(size, source->encoded()));
   }
 
@@ -285,9 +286,10 @@ NodeSummary RunNode(const NodeOptions& o) {
     NodeLink link(ctx, o, camera.name, session);
     WaitForClock(link, o);
     const bool system_clock = source->live();
-    Progress progress("node " + camera.name, o.max_frames > 0 ? o.max_frames : source->FrameCount(),
-                      "frames", o.progress);
-    SourceFrame in;
+    util::Progress progress("node " + camera.name,
+                            o.max_frames > 0 ? o.max_frames : source->FrameCount(), "frames",
+                            o.progress);
+    io::SourceFrame in;
     FrameMessage m;
     m.camera = camera.name;
     m.session = session;
@@ -296,7 +298,7 @@ NodeSummary RunNode(const NodeOptions& o) {
     long long last_dropped = 0;
     while (!StopRequested(o.control) && (o.max_frames == 0 || summary.frames < o.max_frames) &&
            source->ReadFrame(&in)) {
-      const double read_s = SystemClockNow();
+      const double read_s = io::SystemClockNow();
       if (const long long dropped = source->dropped(); dropped > last_dropped) {
         // Tell the fusion node now, before the work on this frame, that the skipped frames will
         // not come, so that it pairs the other cameras' frames without waiting for them.
@@ -306,14 +308,14 @@ NodeSummary RunNode(const NodeOptions& o) {
         link.Send(Encode(skip));
         last_dropped = dropped;
       }
-      CameraMessage cm;
+      pipeline::CameraMessage cm;
       if (o.detect) {
         cm = stage.Process(in);
       } else {
         cm.frame = in.frame;
         cm.time_s = in.time_s;
       }
-      m.process_s = std::max(0.0, SystemClockNow() - read_s);
+      m.process_s = std::max(0.0, io::SystemClockNow() - read_s);
       m.queued_s = system_clock ? std::clamp(read_s - in.time_s, 0.0, 3599.0) : -1.0;
       process_s.push_back(m.process_s);
       ++summary.frames;

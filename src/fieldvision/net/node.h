@@ -26,7 +26,7 @@ struct NodeOptions {
   double ball_diameter_m = 0.22;
   std::string colour = "orange";
   std::string field;  // optional: look for the ball only over this field
-  BallTrackOptions track;
+  pipeline::BallTrackOptions track;
   long long max_frames = 0;   // 0: all
   bool detect = true;         // false: send frames without candidates (a latency baseline)
   double connect_wait_s = 5;  // wait this long for the fusion node's first clock reply
@@ -34,8 +34,8 @@ struct NodeOptions {
   // Added to this node's clock: simulates a machine whose clock is off (tests, benchmarks).
   double clock_offset_s = 0;
   bool progress = true;
-  JobControl* control = nullptr;  // optional: progress callback and stop check
-  void Check() const;             // throws fv::Error naming the bad option
+  pipeline::JobControl* control = nullptr;  // optional: progress callback and stop check
+  void Check() const;                       // throws fv::Error naming the bad option
 };
 
 struct NodeSummary {
@@ -50,7 +50,7 @@ struct NodeSummary {
   double offset_s = 0;        // fuse clock - node clock
   double round_trip_s = 0;    // of the sample used
   long long bad_replies = 0;  // replies that were not valid messages
-  CameraStageStats stage;
+  pipeline::CameraStageStats stage;
   double process_p50_s = 0, process_p95_s = 0, process_max_s = 0;  // work per frame
   double seconds = 0;
   std::string ToString() const;

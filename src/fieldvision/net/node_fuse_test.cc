@@ -31,7 +31,7 @@ struct Row {
 };
 
 std::map<long long, Row> ReadBall(const std::string& path) {
-  const CsvTable t = CsvTable::Read(path);
+  const util::CsvTable t = util::CsvTable::Read(path);
   std::map<long long, Row> rows;
   for (size_t r = 0; r < t.rows(); ++r) {
     rows[t.GetInt(r, "frame")] = {t.GetDouble(r, "x_m"), t.GetDouble(r, "y_m"),
@@ -78,12 +78,12 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   const uint64_t seed = testing::TestSeed(3);
   FV_SEED_TRACE(seed);
   const Scene scene = WriteKick(seed);
-  BallJobOptions job;
+  pipeline::BallJobOptions job;
   job.cameras = scene.cameras;
   job.videos = scene.videos;
   job.out = scene.dir + "/offline.csv";
   job.pipeline.progress = false;
-  RunBallJob(job);
+  pipeline::RunBallJob(job);
   const auto offline = ReadBall(job.out);
   ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
 
@@ -98,8 +98,8 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
 
-  const double offset_s = 0.080;                   // node 1's clock is 80 ms ahead
-  const double start_at = SystemClockNow() + 1.0;  // every node connected by then
+  const double offset_s = 0.080;                       // node 1's clock is 80 ms ahead
+  const double start_at = io::SystemClockNow() + 1.0;  // every node connected by then
   std::vector<NodeSummary> nodes(scene.cameras.size());
   std::vector<std::thread> threads;
   for (size_t c = 0; c < scene.cameras.size(); ++c) {
@@ -141,17 +141,17 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
     EXPECT_EQ(a.n_cams, b.n_cams) << "frame " << frame;
   }
   // The flights fuse closed on the way are those of the whole track's analysis (the kick).
-  std::vector<BallSample> track;
+  std::vector<recon::BallSample> track;
   for (const auto& [frame, r] : live) {
-    BallSample b;
+    recon::BallSample b;
     b.frame = frame;
     b.time_s = frame / 60.0;
     b.ball_in_world = {r.x, r.y, r.z};
     track.push_back(b);
   }
-  TrajectoryOptions topt = fo.flight_options.analysis;
+  recon::TrajectoryOptions topt = fo.flight_options.analysis;
   topt.ball_radius_m = 0.5 * fo.ball_diameter_m;
-  const TrajectoryResult whole = AnalyzeTrajectory(track, topt);
+  const recon::TrajectoryResult whole = recon::AnalyzeTrajectory(track, topt);
   ASSERT_FALSE(whole.flights.empty()) << whole.Summary();
   ASSERT_EQ(fused.flights.size(), whole.flights.size()) << whole.Summary();
   EXPECT_EQ(fused.flights_published, 0);  // no --publish
@@ -160,11 +160,11 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
 
 TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   const std::string dir = testing::TempDir();
-  Camera cam = Camera::FromFov(64, 48, 60);
+  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
   cam.name = "cam1";
   cam.has_pose = true;
-  cam.cam_from_world = Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
-  WriteCameraYaml(cam, dir + "/cam1.yaml");
+  cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
+  camera::WriteCameraYaml(cam, dir + "/cam1.yaml");
   FuseOptions fo;
   fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = {dir + "/cam1.yaml"};
@@ -191,7 +191,7 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   f.camera = "cam1";
   f.clock = "system";
   send(Encode(f));  // a live frame without a clock estimate
-  PingMessage ping{"cam1", "s", SystemClockNow()};
+  PingMessage ping{"cam1", "s", io::SystemClockNow()};
   send(Encode(ping));
   zmq::message_t reply;
   ASSERT_TRUE(s.recv(reply));  // the fusion node still answers
@@ -220,9 +220,9 @@ TEST(NodeFuse, RestartedNodeIsReadmittedAndNodesReconnectToARestartedFuse) {
       s.num_frames = 1;
       return s;
     }());
-    Camera cam = one.cameras()[0];
+    camera::Camera cam = one.cameras()[0];
     cam.name = c.name;
-    WriteCameraYaml(cam, dir + "/" + c.name + ".yaml");
+    camera::WriteCameraYaml(cam, dir + "/" + c.name + ".yaml");
     cams.push_back(dir + "/" + c.name + ".yaml");
   }
   const std::string src = "synth:kick?width=160&height=120&camera=";
@@ -231,7 +231,7 @@ TEST(NodeFuse, RestartedNodeIsReadmittedAndNodesReconnectToARestartedFuse) {
   fo.cameras = {cams[0], cams[1]};
   fo.out = dir + "/ball1.csv";
   fo.progress = false;
-  JobControl fuse_control;
+  pipeline::JobControl fuse_control;
   fo.control = &fuse_control;
   FuseSummary first;
   std::thread fuse;
@@ -246,7 +246,7 @@ TEST(NodeFuse, RestartedNodeIsReadmittedAndNodesReconnectToARestartedFuse) {
     no.progress = false;
     return no;
   };
-  JobControl node0_control;
+  pipeline::JobControl node0_control;
   NodeSummary steady;
   NodeOptions steady_options = node_options(0, 0);  // runs until stopped
   steady_options.control = &node0_control;
@@ -262,7 +262,7 @@ TEST(NodeFuse, RestartedNodeIsReadmittedAndNodesReconnectToARestartedFuse) {
   // A new fusion node on the same address: node 0 (still running) reconnects to it; both stop
   // once it has fused a few frames (or after 20 s, a failure).
   fo.out = dir + "/ball2.csv";
-  JobControl fuse2_control([&](const JobProgress& p) {
+  pipeline::JobControl fuse2_control([&](const pipeline::JobProgress& p) {
     if (p.done >= 3) fuse2_control.Stop();
   });
   fo.control = &fuse2_control;

@@ -13,7 +13,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void BallJobOptions::Check() const {
   FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --video pair");
@@ -40,8 +40,8 @@ void BallJobOptions::Check() const {
   eval.Check();
 }
 
-Camera ReadRigCamera(const std::string& path) {
-  Camera camera = ReadCameraYaml(path);
+camera::Camera ReadRigCamera(const std::string& path) {
+  camera::Camera camera = camera::ReadCameraYaml(path);
   if (camera.name.empty()) camera.name = std::filesystem::path(path).stem().string();
   if (camera.name.empty()) camera.name = path;
   FV_REQUIRE(camera.has_pose,
@@ -53,14 +53,15 @@ namespace {
 
 // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
 // position that an accepted candidate of another camera starts).
-std::vector<BallObservation> Observations(const std::vector<BallCandidate>& candidates) {
+std::vector<recon::BallObservation> Observations(
+    const std::vector<detect::BallCandidate>& candidates) {
   constexpr int kMaxWeak = 3;
-  std::vector<BallObservation> out;
+  std::vector<recon::BallObservation> out;
   int weak = 0;
-  for (const BallCandidate& b : candidates) {
+  for (const detect::BallCandidate& b : candidates) {
     if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
     weak += !b.accepted;
-    BallObservation obs;
+    recon::BallObservation obs;
     obs.weak = !b.accepted;
     obs.centre_px = b.centre_px;
     obs.radius_px = b.radius_px;
@@ -73,13 +74,13 @@ std::vector<BallObservation> Observations(const std::vector<BallCandidate>& cand
 
 }  // namespace
 
-BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector) {
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::BallDetector> detector) {
   return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
     return Observations(det->Detect(bgr, roi));
   };
 }
 
-BallRegionDetectFn BallDetectFnFor(std::shared_ptr<AnyBallDetector> detector) {
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::AnyBallDetector> detector) {
   return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
     return Observations(det->Detect(bgr, roi));
   };
@@ -91,50 +92,50 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
              o.truth);
   // A bad truth file fails before anything is written (read as both truth and estimate, it is
   // checked for columns and values).
-  std::optional<CsvTable> truth;
+  std::optional<util::CsvTable> truth;
   if (!o.truth.empty()) {
-    truth = CsvTable::Read(o.truth);
+    truth = util::CsvTable::Read(o.truth);
     FV_REQUIRE(truth->rows() > 0, "truth file '{}' has a header but no rows", o.truth);
-    CheckBallTrackRanges(*truth);
-    EvaluateBall(*truth, *truth, o.eval);
+    recon::CheckBallTrackRanges(*truth);
+    recon::EvaluateBall(*truth, *truth, o.eval);
   }
   const int n = static_cast<int>(o.cameras.size());
-  std::vector<Camera> cameras;
+  std::vector<camera::Camera> cameras;
   for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
-  std::optional<FieldModel> field;
-  if (!o.field.empty()) field = LoadField(o.field);
+  std::optional<field::FieldModel> field;
+  if (!o.field.empty()) field = field::LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
-  std::vector<std::unique_ptr<FrameSource>> sources;
+  std::vector<std::unique_ptr<io::FrameSource>> sources;
   // --live on files: a file is not live; each is played at its own frame rate from one common
   // start (as cameras would deliver it), so frames drop only when fusion is slower than that.
   const double live_start_s =
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() +
       0.5;
   for (int c = 0; c < n; ++c) {
-    FrameSourceOptions vo;
+    io::FrameSourceOptions vo;
     vo.realtime = o.live;
     vo.start_at_s = o.live ? live_start_s : 0.0;
     if (!o.timestamps.empty()) {
-      vo.time = TimeSource::kCsv;
+      vo.time = io::TimeSource::kCsv;
       vo.timestamps_csv = o.timestamps[c];
     } else if (o.sync == "time") {
-      vo.time = TimeSource::kContainer;
+      vo.time = io::TimeSource::kContainer;
     }
     vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
-    auto src = OpenFrameSource(o.videos[c], vo);
+    auto src = io::OpenFrameSource(o.videos[c], vo);
     const cv::Size size = src->FrameSize();
     FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
                "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
                cameras[c].width, cameras[c].height, o.videos[c], size.width, size.height);
     sources.push_back(std::move(src));
   }
-  BallDetectorOptions dopt;
+  detect::BallDetectorOptions dopt;
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
   std::vector<BallRegionDetectFn> detect_fns;
   for (int c = 0; c < n; ++c) {
-    detect_fns.push_back(BallDetectFnFor(
-        std::make_shared<AnyBallDetector>(dopt, o.dnn, &cameras[c], field ? &*field : nullptr)));
+    detect_fns.push_back(BallDetectFnFor(std::make_shared<detect::AnyBallDetector>(
+        dopt, o.dnn, &cameras[c], field ? &*field : nullptr)));
   }
   BallPipelineOptions popt = o.pipeline;
   popt.sync.mode = o.sync == "time" ? SyncMode::kTimestamp : SyncMode::kFrameIndex;
@@ -152,7 +153,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   // Write to a temporary name, rename at the end: a failed run leaves no half file.
   const std::string tmp = o.out + ".part";
   {
-    CsvWriter csv(tmp, BallCsvColumns(), 6);
+    util::CsvWriter csv(tmp, recon::BallCsvColumns(), 6);
     result.summary =
         RunBallPipelineTracked(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
           if (!f.result.ok()) return;
@@ -167,8 +168,8 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::error_code ec;
   std::filesystem::rename(tmp, o.out, ec);
   FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
-  if (truth) result.eval = EvaluateBall(*truth, CsvTable::Read(o.out), o.eval);
+  if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -14,7 +14,7 @@
 #include "fieldvision/pipeline/ball_pipeline.h"
 #include "fieldvision/recon/ball_eval.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 struct BallJobOptions {
   std::vector<std::string> cameras;     // camera files, paired with `videos` in order
@@ -22,7 +22,7 @@ struct BallJobOptions {
   std::vector<std::string> timestamps;  // optional: one frame,time_s CSV per video
   double ball_diameter_m = 0.22;
   std::string colour = "orange";  // colour preset or colour file (detect/colour.h)
-  DnnBallOptions dnn;             // --detector colour|dnn|both (detect/dnn_ball.h)
+  detect::DnnBallOptions dnn;     // --detector colour|dnn|both (detect/dnn_ball.h)
   std::string field;              // optional field (name or JSON): detect only over it
   std::string out;                // BALL.csv
   std::string truth;              // optional truth.csv for the error table
@@ -30,26 +30,26 @@ struct BallJobOptions {
   std::string sync = "frame";
   bool live = false;  // keep the newest messages (drop the oldest) instead of blocking
   BallPipelineOptions pipeline;
-  BallEvalOptions eval;
+  recon::BallEvalOptions eval;
   void Check() const;  // throws fv::Error naming the bad option
 };
 
 struct BallJobResult {
   BallPipelineSummary summary;
-  std::optional<BallEvalResult> eval;  // when a truth file was given
+  std::optional<recon::BallEvalResult> eval;  // when a truth file was given
   long long rows_written = 0;
 };
 
 BallJobResult RunBallJob(const BallJobOptions& options);
 
 // A rig camera from its file: the pose is required; `name` defaults to the file's stem.
-Camera ReadRigCamera(const std::string& path);
+camera::Camera ReadRigCamera(const std::string& path);
 
 // A camera stage's detector from a ball detector: its accepted candidates, then the best few weak
 // ones (fusion uses those only to complete a position that an accepted candidate of another
 // camera starts).
-BallRegionDetectFn BallDetectFnFor(std::shared_ptr<BallDetector> detector);
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::BallDetector> detector);
 // The same for the detector chosen by --detector (colour, dnn or both).
-BallRegionDetectFn BallDetectFnFor(std::shared_ptr<AnyBallDetector> detector);
+BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::AnyBallDetector> detector);
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -13,7 +13,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void BallPipelineOptions::Check() const {
   sync.Check();
@@ -71,8 +71,8 @@ std::string BallPipelineSummary::ToString() const {
   return s;
 }
 
-BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
-                                    std::vector<std::unique_ptr<FrameSource>>& sources,
+BallPipelineSummary RunBallPipeline(const std::vector<camera::Camera>& cameras,
+                                    std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                     const std::vector<BallDetectFn>& detectors,
                                     const BallPipelineOptions& options,
                                     const std::function<void(const BallFrame&)>& on_frame) {
@@ -89,8 +89,8 @@ BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
   return RunBallPipelineTracked(cameras, sources, region_fns, o, on_frame);
 }
 
-void CheckBallPipelineInputs(const std::vector<Camera>& cameras,
-                             const std::vector<std::unique_ptr<FrameSource>>& sources,
+void CheckBallPipelineInputs(const std::vector<camera::Camera>& cameras,
+                             const std::vector<std::unique_ptr<io::FrameSource>>& sources,
                              const std::vector<BallRegionDetectFn>& detectors) {
   const int n = static_cast<int>(cameras.size());
   FV_REQUIRE(n >= 1, "ball pipeline: no cameras");
@@ -108,7 +108,7 @@ void CheckBallPipelineInputs(const std::vector<Camera>& cameras,
   }
 }
 
-BallPipelineSummary EmptyBallPipelineSummary(const std::vector<Camera>& cameras) {
+BallPipelineSummary EmptyBallPipelineSummary(const std::vector<camera::Camera>& cameras) {
   const int n = static_cast<int>(cameras.size());
   BallPipelineSummary summary;
   summary.num_cameras = n;
@@ -133,9 +133,10 @@ long long ExpectedPipelineFrames(const std::vector<long long>& frame_counts, lon
   return total;
 }
 
-void ReadCameraStream(FrameSource& source, CameraStage& stage, BoundedQueue<CameraMessage>& queue,
-                      long long max_frames, const std::function<bool()>& stopping) {
-  SourceFrame in;
+void ReadCameraStream(io::FrameSource& source, CameraStage& stage,
+                      BoundedQueue<CameraMessage>& queue, long long max_frames,
+                      const std::function<bool()>& stopping) {
+  io::SourceFrame in;
   long long count = 0;
   while (!stopping() && (max_frames == 0 || count < max_frames) && source.ReadFrame(&in)) {
     ++count;
@@ -144,14 +145,14 @@ void ReadCameraStream(FrameSource& source, CameraStage& stage, BoundedQueue<Came
   queue.Close();
 }
 
-void FuseCameraQueues(const std::vector<Camera>& cameras, const CameraQueues& queues,
+void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQueues& queues,
                       const BallPipelineOptions& options, long long total,
                       const std::function<bool()>& stopping,
                       const std::function<void(const BallFrame&)>& on_frame,
                       BallPipelineSummary* summary) {
   FrameSynchronizer sync(static_cast<int>(cameras.size()), options.sync);
   FusionStage fusion(cameras, options.triangulation);
-  Progress progress("ball", total, "frames", options.progress);
+  util::Progress progress("ball", total, "frames", options.progress);
   while (!stopping()) {
     while (auto group = sync.Next()) {
       on_frame(fusion.Fuse(*group));
@@ -219,8 +220,8 @@ class StageErrors {
 
 }  // namespace
 
-BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
-                                           std::vector<std::unique_ptr<FrameSource>>& sources,
+BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& cameras,
+                                           std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                            const std::vector<BallRegionDetectFn>& detectors,
                                            const BallPipelineOptions& options,
                                            const std::function<void(const BallFrame&)>& on_frame) {
@@ -276,4 +277,4 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
   return summary;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -21,13 +21,13 @@
 #include "fieldvision/pipeline/job.h"
 #include "fieldvision/recon/triangulation.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 struct BallPipelineOptions {
   SyncOptions sync;
   int queue_capacity = 3;                          // messages per camera queue (the seed's 3)
   QueuePolicy queue_policy = QueuePolicy::kBlock;  // kDropOldest for live input
-  TriangulationOptions triangulation;
+  recon::TriangulationOptions triangulation;
   BallTrackOptions track;         // used with BallRegionDetectFn detectors
   long long max_frames = 0;       // stop each camera after this many frames; 0: all
   bool progress = true;           // frames, fps and time left on stderr
@@ -62,15 +62,15 @@ struct BallPipelineSummary {
 // and calls `on_frame` in the calling thread for every synchronised frame, in order. Throws
 // fv::Error for mismatched list sizes, a frame size that differs from its camera file, or an
 // error in any stage (the other stages are stopped first).
-BallPipelineSummary RunBallPipeline(const std::vector<Camera>& cameras,
-                                    std::vector<std::unique_ptr<FrameSource>>& sources,
+BallPipelineSummary RunBallPipeline(const std::vector<camera::Camera>& cameras,
+                                    std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                     const std::vector<BallDetectFn>& detectors,
                                     const BallPipelineOptions& options,
                                     const std::function<void(const BallFrame&)>& on_frame);
 // The same with detectors that can search a window (options.track): each camera stage tracks
 // the ball and decodes encoded frames (SourceFrame::jpeg) only where it looks.
-BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
-                                           std::vector<std::unique_ptr<FrameSource>>& sources,
+BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& cameras,
+                                           std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                            const std::vector<BallRegionDetectFn>& detectors,
                                            const BallPipelineOptions& options,
                                            const std::function<void(const BallFrame&)>& on_frame);
@@ -78,22 +78,23 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<Camera>& cameras,
 // The stages of RunBallPipelineTracked, in order; each callable alone.
 // Throws fv::Error for lists of different sizes, a missing video or detector, or a video whose
 // frame size is not its camera's.
-void CheckBallPipelineInputs(const std::vector<Camera>& cameras,
-                             const std::vector<std::unique_ptr<FrameSource>>& sources,
+void CheckBallPipelineInputs(const std::vector<camera::Camera>& cameras,
+                             const std::vector<std::unique_ptr<io::FrameSource>>& sources,
                              const std::vector<BallRegionDetectFn>& detectors);
 // The camera names ("camera <index>" where unnamed) and zeroed per-camera counts.
-BallPipelineSummary EmptyBallPipelineSummary(const std::vector<Camera>& cameras);
+BallPipelineSummary EmptyBallPipelineSummary(const std::vector<camera::Camera>& cameras);
 // The frames the progress line expects: the longest stream (FrameSource::FrameCount), at most
 // `max_frames` when > 0; -1 when unknown.
 long long ExpectedPipelineFrames(const std::vector<long long>& frame_counts, long long max_frames);
 // A camera thread: reads `source` through `stage` into `queue` until the end of the stream,
 // `max_frames` (> 0) frames, `stopping()` or a closed queue; then closes the queue.
-void ReadCameraStream(FrameSource& source, CameraStage& stage, BoundedQueue<CameraMessage>& queue,
-                      long long max_frames, const std::function<bool()>& stopping);
+void ReadCameraStream(io::FrameSource& source, CameraStage& stage,
+                      BoundedQueue<CameraMessage>& queue, long long max_frames,
+                      const std::function<bool()>& stopping);
 using CameraQueues = std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>>;
 // The fusion stage: synchronises the queues' messages, fuses each frame and calls `on_frame`,
 // until every stream ended or `stopping()`; sets the summary's sync report and fusion counts.
-void FuseCameraQueues(const std::vector<Camera>& cameras, const CameraQueues& queues,
+void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQueues& queues,
                       const BallPipelineOptions& options, long long total,
                       const std::function<bool()>& stopping,
                       const std::function<void(const BallFrame&)>& on_frame,
@@ -101,4 +102,4 @@ void FuseCameraQueues(const std::vector<Camera>& cameras, const CameraQueues& qu
 // Copies the fusion counts into the summary (mean error: the sum over the positions).
 void AddFusionStats(const FusionStats& stats, BallPipelineSummary* summary);
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -17,19 +17,19 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
 constexpr double kRadius = 0.25;
 constexpr double kFps = 30.0;
 
-std::vector<Camera> SmallRig() {
-  std::vector<Camera> cams;
+std::vector<camera::Camera> SmallRig() {
+  std::vector<camera::Camera> cams;
   const Eigen::Vector3d eyes[3] = {{-6, -5, 3}, {6, -5, 3}, {0, 6, 3}};
   for (int i = 0; i < 3; ++i) {
-    Camera c = Camera::FromFov(320, 240, 70);
+    camera::Camera c = camera::Camera::FromFov(320, 240, 70);
     c.name = "cam" + std::to_string(i);
-    c.cam_from_world = Rigid3d::LookAt(eyes[i], {0, 0, 0.5});
+    c.cam_from_world = geometry::Rigid3d::LookAt(eyes[i], {0, 0, 0.5});
     c.has_pose = true;
     cams.push_back(c);
   }
@@ -40,7 +40,7 @@ Eigen::Vector3d BallAt(double t) { return {2 * std::sin(t), 1.5 * std::cos(t), 0
 
 // An orange disc on green, centred on the projection of the ball centre, as MJPG video whose
 // frame f shows time (f + first) / fps.
-void WriteVideo(const Camera& cam, const std::string& path, int frames, int first) {
+void WriteVideo(const camera::Camera& cam, const std::string& path, int frames, int first) {
   cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), kFps,
                     cv::Size(cam.width, cam.height));
   ASSERT_TRUE(w.isOpened());
@@ -58,12 +58,12 @@ void WriteVideo(const Camera& cam, const std::string& path, int frames, int firs
 }
 
 // A simple detector: orange pixels' centroid.
-std::vector<BallObservation> Centroid(const cv::Mat& bgr) {
+std::vector<recon::BallObservation> Centroid(const cv::Mat& bgr) {
   cv::Mat mask;
   cv::inRange(bgr, cv::Scalar(0, 60, 180), cv::Scalar(90, 170, 255), mask);
   const cv::Moments m = cv::moments(mask, true);
   if (m.m00 < 5) return {};
-  BallObservation o;
+  recon::BallObservation o;
   o.centre_px = {m.m10 / m.m00, m.m01 / m.m00};
   o.radius_px = std::sqrt(m.m00 / M_PI);
   o.sigma_px = 0.3;
@@ -71,7 +71,7 @@ std::vector<BallObservation> Centroid(const cv::Mat& bgr) {
 }
 
 // The same, searching only `roi` when one is given (whole-frame pixels).
-std::vector<BallObservation> CentroidInWindow(const cv::Mat& bgr, const cv::Rect& roi) {
+std::vector<recon::BallObservation> CentroidInWindow(const cv::Mat& bgr, const cv::Rect& roi) {
   if (roi.empty()) return Centroid(bgr);
   auto obs = Centroid(bgr(roi));
   for (auto& o : obs) o.centre_px += Eigen::Vector2d(roi.x, roi.y);
@@ -79,7 +79,7 @@ std::vector<BallObservation> CentroidInWindow(const cv::Mat& bgr, const cv::Rect
 }
 
 struct Scene {
-  std::vector<Camera> cams = SmallRig();
+  std::vector<camera::Camera> cams = SmallRig();
   std::vector<std::string> videos;
 };
 
@@ -93,16 +93,16 @@ Scene MakeScene(const std::string& dir, const std::vector<int>& lengths,
   return s;
 }
 
-std::vector<std::unique_ptr<FrameSource>> Open(const Scene& s,
-                                               const std::vector<FrameSourceOptions>& vo) {
-  std::vector<std::unique_ptr<FrameSource>> src;
-  for (int c = 0; c < 3; ++c) src.push_back(OpenFrameSource(s.videos[c], vo[c]));
+std::vector<std::unique_ptr<io::FrameSource>> Open(const Scene& s,
+                                                   const std::vector<io::FrameSourceOptions>& vo) {
+  std::vector<std::unique_ptr<io::FrameSource>> src;
+  for (int c = 0; c < 3; ++c) src.push_back(io::OpenFrameSource(s.videos[c], vo[c]));
   return src;
 }
 
 // The tracked pipeline with CentroidInWindow in every camera: the fused frames in order.
 std::vector<BallFrame> RunTracked(const Scene& s,
-                                  std::vector<std::unique_ptr<FrameSource>>& sources,
+                                  std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                   BallPipelineSummary* summary) {
   BallPipelineOptions opt;
   opt.progress = false;
@@ -116,7 +116,7 @@ std::vector<BallFrame> RunTracked(const Scene& s,
 TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
   const std::string dir = testing::TempDir();
   const Scene s = MakeScene(dir, {30, 30, 24}, {0, 0, 0});
-  auto sources = Open(s, std::vector<FrameSourceOptions>(3));
+  auto sources = Open(s, std::vector<io::FrameSourceOptions>(3));
   BallPipelineOptions opt;
   opt.progress = false;
   std::vector<BallFrame> frames;
@@ -144,7 +144,7 @@ TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
   const Scene s = MakeScene(dir, {40, 40, 40}, {0, 0, 0});
   BallPipelineOptions opt;
   opt.progress = false;
-  std::vector<FrameSourceOptions> vo(3);
+  std::vector<io::FrameSourceOptions> vo(3);
   for (auto& v : vo) v.encoded = true;
   auto whole_sources = Open(s, vo);  // decoded whole (track.enabled is off here)
   std::vector<BallFrame> whole;
@@ -197,16 +197,16 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
     }
     patterns.push_back(folder + "/%05d.jpg");
   }
-  FrameSourceOptions enc;
+  io::FrameSourceOptions enc;
   enc.encoded = true;
   enc.fps = kFps;  // image files have no frame rate
   {
-    auto src_ptr = OpenFrameSource(patterns[0], enc);
-    FrameSource& src = *src_ptr;
+    auto src_ptr = io::OpenFrameSource(patterns[0], enc);
+    io::FrameSource& src = *src_ptr;
     EXPECT_TRUE(src.encoded());
     EXPECT_EQ(src.FrameCount(), 24);
-    auto plain_ptr = OpenFrameSource(patterns[0]);
-    FrameSource& plain = *plain_ptr;
+    auto plain_ptr = io::OpenFrameSource(patterns[0]);
+    io::FrameSource& plain = *plain_ptr;
     EXPECT_FALSE(plain.encoded());
     cv::Mat a;
     long long fa;
@@ -221,8 +221,8 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
     }
     EXPECT_FALSE(src.Read(&a, &fa, &ta));
   }
-  std::vector<std::unique_ptr<FrameSource>> sources;
-  for (const auto& p : patterns) sources.push_back(OpenFrameSource(p, enc));
+  std::vector<std::unique_ptr<io::FrameSource>> sources;
+  for (const auto& p : patterns) sources.push_back(io::OpenFrameSource(p, enc));
   BallPipelineSummary summary;
   const std::vector<BallFrame> frames = RunTracked(s, sources, &summary);
   ASSERT_EQ(frames.size(), 24u);
@@ -250,7 +250,7 @@ TEST(BallPipeline, DamagedMjpgFrameIsReportedNotFatal) {
     const std::string zeros(64, '\0');
     f.write(zeros.data(), static_cast<std::streamsize>(zeros.size()));
   }
-  std::vector<FrameSourceOptions> vo(3);
+  std::vector<io::FrameSourceOptions> vo(3);
   for (auto& v : vo) v.encoded = true;
   auto sources = Open(s, vo);
   BallPipelineSummary summary;
@@ -270,16 +270,16 @@ TEST(BallPipeline, UnsynchronizedVideosPairedByTimestampCsv) {
   const std::string dir = testing::TempDir();
   // Camera 2 started 3 frames late: by index the frames would be paired wrongly.
   const Scene s = MakeScene(dir, {30, 30, 27}, {0, 0, 3});
-  std::vector<FrameSourceOptions> vo(3);
+  std::vector<io::FrameSourceOptions> vo(3);
   for (int c = 0; c < 3; ++c) {
     const std::string csv_path = dir + "/cam" + std::to_string(c) + "_times.csv";
-    CsvWriter csv(csv_path, {"frame", "time_s"}, 9);
+    util::CsvWriter csv(csv_path, {"frame", "time_s"}, 9);
     for (int f = 0; f < 30; ++f) {
       csv << f << (f + (c == 2 ? 3 : 0)) / kFps;
       csv.EndRow();
     }
     csv.Close();
-    vo[c].time = TimeSource::kCsv;
+    vo[c].time = io::TimeSource::kCsv;
     vo[c].timestamps_csv = csv_path;
   }
   BallPipelineOptions opt;
@@ -301,7 +301,7 @@ TEST(BallPipeline, UnsynchronizedVideosPairedByTimestampCsv) {
   }
   // The same videos paired by index put camera 2 three frames off: much worse.
   opt.sync.mode = SyncMode::kFrameIndex;
-  auto again = Open(s, std::vector<FrameSourceOptions>(3));
+  auto again = Open(s, std::vector<io::FrameSourceOptions>(3));
   int n_index = 0;
   RunBallPipeline(s.cams, again, {Centroid, Centroid, Centroid}, opt, [&](const BallFrame& f) {
     if (!f.result.ok()) return;
@@ -316,10 +316,10 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   const std::string dir = testing::TempDir();
   const Scene s = MakeScene(dir, {3, 3, 3}, {0, 0, 0});
   auto cams = s.cams;
-  cams[1] = Camera::FromFov(640, 480, 70);
+  cams[1] = camera::Camera::FromFov(640, 480, 70);
   cams[1].cam_from_world = s.cams[1].cam_from_world;
   cams[1].has_pose = true;
-  auto sources = Open(s, std::vector<FrameSourceOptions>(3));
+  auto sources = Open(s, std::vector<io::FrameSourceOptions>(3));
   BallPipelineOptions opt;
   opt.progress = false;
   try {
@@ -336,7 +336,7 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   BallJobOptions job;
   for (int c = 0; c < 3; ++c) {
     job.cameras.push_back(dir + "/cam" + std::to_string(c) + ".yaml");
-    WriteCameraYaml(cams[c], job.cameras.back());
+    camera::WriteCameraYaml(cams[c], job.cameras.back());
   }
   job.videos = s.videos;
   job.out = dir + "/ball.csv";
@@ -366,7 +366,7 @@ TEST(BallPipelineStages, ReadThenFuseInOneThread) {
   const std::string dir = testing::TempDir();
   Scene s = MakeScene(dir, {20, 20, 12}, {0, 0, 0});
   s.cams[1].name.clear();
-  auto sources = Open(s, std::vector<FrameSourceOptions>(3));
+  auto sources = Open(s, std::vector<io::FrameSourceOptions>(3));
   const std::vector<BallRegionDetectFn> detectors(3, CentroidInWindow);
   CheckBallPipelineInputs(s.cams, sources, detectors);
   EXPECT_THROW(CheckBallPipelineInputs(s.cams, sources, {CentroidInWindow}), Error);
@@ -403,12 +403,12 @@ TEST(BallPipelineStages, ReadThenFuseInOneThread) {
 
 TEST(BallPipeline, BadInputsAreOneLineErrors) {
   const std::string dir = testing::TempDir();
-  EXPECT_THROW(OpenFrameSource(dir + "/missing.avi"), Error);
+  EXPECT_THROW(io::OpenFrameSource(dir + "/missing.avi"), Error);
   {
     std::ofstream junk(dir + "/junk.avi");
     junk << "this is not a video";
   }
-  EXPECT_THROW(OpenFrameSource(dir + "/junk.avi"), Error);
+  EXPECT_THROW(io::OpenFrameSource(dir + "/junk.avi"), Error);
   BallJobOptions job;
   job.cameras = {"a.yaml", "b.yaml"};
   job.videos = {"a.avi"};
@@ -423,4 +423,4 @@ TEST(BallPipeline, BadInputsAreOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

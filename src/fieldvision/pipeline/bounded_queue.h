@@ -12,7 +12,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 enum class QueuePolicy { kBlock, kDropOldest };
 
@@ -90,4 +90,4 @@ class BoundedQueue {
   bool closed_ = false;
 };
 
-}  // namespace fv
+}  // namespace fv::pipeline

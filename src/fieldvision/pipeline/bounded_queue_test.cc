@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
 TEST(BoundedQueue, BlockingQueueLosesNothingAndKeepsOrder) {
@@ -52,4 +52,4 @@ TEST(BoundedQueue, CloseWakesABlockedProducerAndDrainsForTheConsumer) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -6,7 +6,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
 using nlohmann::json;
@@ -21,9 +21,9 @@ double Number(const json& j, const char* key, const std::string& context) {
 
 }  // namespace
 
-json CandidatesToJson(const std::vector<BallObservation>& candidates) {
+json CandidatesToJson(const std::vector<recon::BallObservation>& candidates) {
   json c = json::array();
-  for (const BallObservation& o : candidates) {
+  for (const recon::BallObservation& o : candidates) {
     json cj = {{"u", o.centre_px.x()},
                {"v", o.centre_px.y()},
                {"r", o.radius_px},
@@ -35,14 +35,14 @@ json CandidatesToJson(const std::vector<BallObservation>& candidates) {
   return c;
 }
 
-std::vector<BallObservation> CandidatesFromJson(const json& j, const std::string& context) {
+std::vector<recon::BallObservation> CandidatesFromJson(const json& j, const std::string& context) {
   FV_REQUIRE(j.is_array(), "{}: 'candidates' is not an array", context);
-  std::vector<BallObservation> out;
+  std::vector<recon::BallObservation> out;
   for (size_t i = 0; i < j.size(); ++i) {
     const json& c = j[i];
     const std::string ctx = context + ": candidates[" + std::to_string(i) + "]";
     FV_REQUIRE(c.is_object(), "{} is not an object", ctx);
-    BallObservation o;
+    recon::BallObservation o;
     o.centre_px = {Number(c, "u", ctx), Number(c, "v", ctx)};
     o.radius_px = Number(c, "r", ctx);
     o.sigma_px = Number(c, "sigma", ctx);
@@ -88,4 +88,4 @@ CameraMessage CameraMessage::FromJsonLine(const std::string& line, const std::st
   return m;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -10,13 +10,13 @@
 
 #include "fieldvision/recon/triangulation.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 struct CameraMessage {
-  int camera = 0;                           // index of the camera in the rig
-  long long frame = 0;                      // frame number in that camera's video, from 0
-  double time_s = 0.0;                      // capture time of the frame
-  std::vector<BallObservation> candidates;  // best first
+  int camera = 0;                                  // index of the camera in the rig
+  long long frame = 0;                             // frame number in that camera's video, from 0
+  double time_s = 0.0;                             // capture time of the frame
+  std::vector<recon::BallObservation> candidates;  // best first
 
   // {"camera":0,"frame":12,"time_s":0.2,"candidates":[{"u":..,"v":..,"r":..,"sigma":..,
   // "score":..[,"weak":true]}]} on one line; doubles round-trip exactly.
@@ -28,8 +28,8 @@ struct CameraMessage {
 
 // The candidates as a JSON array ([{"u":..,"v":..,"r":..,"sigma":..,"score":..[,"weak":true]}])
 // and back; the reader throws fv::Error naming `context` and the bad key.
-nlohmann::json CandidatesToJson(const std::vector<BallObservation>& candidates);
-std::vector<BallObservation> CandidatesFromJson(const nlohmann::json& j,
-                                                const std::string& context);
+nlohmann::json CandidatesToJson(const std::vector<recon::BallObservation>& candidates);
+std::vector<recon::BallObservation> CandidatesFromJson(const nlohmann::json& j,
+                                                       const std::string& context);
 
-}  // namespace fv
+}  // namespace fv::pipeline

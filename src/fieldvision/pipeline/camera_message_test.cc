@@ -6,20 +6,20 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
 TEST(CameraMessage, JsonLineRoundTripsExactly) {
   const uint64_t seed = testing::TestSeed(21);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     CameraMessage m;
     m.camera = rng.UniformInt(0, 7);
     m.frame = rng.UniformInt(0, 100000);
     m.time_s = rng.Uniform(0, 1000);
     for (int k = rng.UniformInt(0, 4); k > 0; --k) {
-      BallObservation o;
+      recon::BallObservation o;
       o.centre_px = {rng.Uniform(-10, 2000), rng.Uniform(-10, 2000)};
       o.radius_px = rng.Uniform(0, 50);
       o.sigma_px = rng.Uniform(0.01, 3);
@@ -70,4 +70,4 @@ TEST(CameraMessage, BadLinesNameTheProblem) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

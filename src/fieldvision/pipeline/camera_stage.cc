@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void BallTrackOptions::Check() const {
   FV_REQUIRE(full_scan_every >= 1, "BallTrackOptions.full_scan_every must be >= 1 (got {})",
@@ -18,8 +18,9 @@ void BallTrackOptions::Check() const {
              min_window_px);
 }
 
-bool HasAccepted(const std::vector<BallObservation>& obs) {
-  return std::any_of(obs.begin(), obs.end(), [](const BallObservation& o) { return !o.weak; });
+bool HasAccepted(const std::vector<recon::BallObservation>& obs) {
+  return std::any_of(obs.begin(), obs.end(),
+                     [](const recon::BallObservation& o) { return !o.weak; });
 }
 
 // Where a camera stage looks next: the window around the ball's predicted image position.
@@ -39,10 +40,10 @@ class CameraStage::Track {
     const cv::Rect r = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(cv::Point(0, 0), image);
     return r.area() > 0 ? r : cv::Rect();
   }
-  void Update(const std::vector<BallObservation>& obs, bool full) {
+  void Update(const std::vector<recon::BallObservation>& obs, bool full) {
     since_full_ = full ? 0 : since_full_ + 1;
-    const BallObservation* best = nullptr;
-    for (const BallObservation& b : obs) {
+    const recon::BallObservation* best = nullptr;
+    for (const recon::BallObservation& b : obs) {
       if (!b.weak && (best == nullptr || b.score > best->score)) best = &b;
     }
     if (best == nullptr) {
@@ -64,8 +65,9 @@ class CameraStage::Track {
   double radius_ = 0.0;
 };
 
-CameraStage::CameraStage(int camera_index, const Camera& camera, BallRegionDetectFn detector,
-                         const BallTrackOptions& track, std::string source_name)
+CameraStage::CameraStage(int camera_index, const camera::Camera& camera,
+                         BallRegionDetectFn detector, const BallTrackOptions& track,
+                         std::string source_name)
     : camera_index_(camera_index),
       size_(camera.width, camera.height),
       detector_(std::move(detector)),
@@ -84,7 +86,7 @@ void CameraStage::CheckSize(const cv::Size& got, long long frame) const {
 }
 
 // The frame's pixels in `roi` (empty: all); null for a damaged encoded frame, which is counted.
-const cv::Mat* CameraStage::Image(const SourceFrame& in, const cv::Rect& roi) {
+const cv::Mat* CameraStage::Image(const io::SourceFrame& in, const cv::Rect& roi) {
   if (in.jpeg.empty()) return &in.bgr;
   const std::string what = fmt::format("video '{}' frame {}", source_name_, in.frame);
   try {
@@ -93,7 +95,7 @@ const cv::Mat* CameraStage::Image(const SourceFrame& in, const cv::Rect& roi) {
     // A readable header of another size is the wrong video, not a damaged frame.
     cv::Size got = size_;
     try {
-      got = JpegRegionDecoder::ReadSize(in.jpeg.data(), in.jpeg.size(), what);
+      got = io::JpegRegionDecoder::ReadSize(in.jpeg.data(), in.jpeg.size(), what);
     } catch (const Error&) {
     }
     CheckSize(got, in.frame);
@@ -103,7 +105,7 @@ const cv::Mat* CameraStage::Image(const SourceFrame& in, const cv::Rect& roi) {
   return &decoded_;
 }
 
-CameraMessage CameraStage::Process(const SourceFrame& in) {
+CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   CameraMessage m;
   m.camera = camera_index_;
   m.frame = in.frame;
@@ -129,8 +131,8 @@ CameraMessage CameraStage::Process(const SourceFrame& in) {
   full = full || frame == nullptr;
   track_->Update(m.candidates, full);
   ++stats_.frames;
-  for (const BallObservation& o : m.candidates) stats_.candidates += !o.weak;
+  for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
   return m;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -16,15 +16,15 @@
 #include "fieldvision/pipeline/camera_message.h"
 #include "fieldvision/recon/triangulation.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 // A camera stage's detector: the ball candidates of one BGR frame, best first. Called from that
 // camera's thread only.
-using BallDetectFn = std::function<std::vector<BallObservation>(const cv::Mat& bgr)>;
+using BallDetectFn = std::function<std::vector<recon::BallObservation>(const cv::Mat& bgr)>;
 // A detector that can search a region only (roi empty: the whole frame). Pixels of `bgr` outside
 // roi may be stale and must not be read. Weak candidates are never tracked.
 using BallRegionDetectFn =
-    std::function<std::vector<BallObservation>(const cv::Mat& bgr, const cv::Rect& roi)>;
+    std::function<std::vector<recon::BallObservation>(const cv::Mat& bgr, const cv::Rect& roi)>;
 
 // Ball tracking in each camera stage (see above).
 struct BallTrackOptions {
@@ -45,33 +45,33 @@ struct CameraStageStats {
 };
 
 // At least one candidate that is not weak.
-bool HasAccepted(const std::vector<BallObservation>& obs);
+bool HasAccepted(const std::vector<recon::BallObservation>& obs);
 
 class CameraStage {
  public:
   // `camera_index` goes into the messages; `source_name` into errors. Throws fv::Error when the
   // detector is empty or the options are bad.
-  CameraStage(int camera_index, const Camera& camera, BallRegionDetectFn detector,
+  CameraStage(int camera_index, const camera::Camera& camera, BallRegionDetectFn detector,
               const BallTrackOptions& track, std::string source_name);
   ~CameraStage();
   CameraStage(CameraStage&&) noexcept;
   // The candidates of one frame. A damaged encoded frame is counted (stats) and gives a message
   // without candidates; a frame of another size than the camera's throws fv::Error.
-  CameraMessage Process(const SourceFrame& frame);
+  CameraMessage Process(const io::SourceFrame& frame);
   const CameraStageStats& stats() const { return stats_; }
 
  private:
   class Track;
-  const cv::Mat* Image(const SourceFrame& in, const cv::Rect& roi);
+  const cv::Mat* Image(const io::SourceFrame& in, const cv::Rect& roi);
   void CheckSize(const cv::Size& got, long long frame) const;
   int camera_index_;
   cv::Size size_;
   BallRegionDetectFn detector_;
   std::string source_name_;
   std::unique_ptr<Track> track_;
-  JpegRegionDecoder decoder_;
+  io::JpegRegionDecoder decoder_;
   cv::Mat decoded_;
   CameraStageStats stats_;
 };
 
-}  // namespace fv
+}  // namespace fv::pipeline

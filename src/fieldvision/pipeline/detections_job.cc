@@ -20,7 +20,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void DetectionsJobOptions::Check() const {
   FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --detections pair");
@@ -38,7 +38,7 @@ void DetectionsJobOptions::Check() const {
   eval.Check();
 }
 
-std::vector<CameraMessage> ParseDetections(const CsvTable& t, int camera, double sigma_px) {
+std::vector<CameraMessage> ParseDetections(const util::CsvTable& t, int camera, double sigma_px) {
   t.Require({"frame", "time_s", "u", "v"});
   const bool has_r = t.Has("radius_px"), has_score = t.Has("score");
   std::vector<CameraMessage> out;
@@ -64,7 +64,7 @@ std::vector<CameraMessage> ParseDetections(const CsvTable& t, int camera, double
     }
     // Empty u and v: a frame without a detection.
     if (t.Get(r, "u").empty() && t.Get(r, "v").empty()) continue;
-    BallObservation o;
+    recon::BallObservation o;
     o.centre_px = {t.GetDouble(r, "u"), t.GetDouble(r, "v")};
     FV_REQUIRE(o.centre_px.allFinite(), "{}: u, v are not finite", t.Where(r));
     o.sigma_px = sigma_px;
@@ -81,16 +81,17 @@ std::vector<CameraMessage> ParseDetections(const CsvTable& t, int camera, double
   }
   FV_REQUIRE(!out.empty(), "detections '{}': no rows", t.name());
   for (auto& m : out) {
-    std::stable_sort(
-        m.candidates.begin(), m.candidates.end(),
-        [](const BallObservation& a, const BallObservation& b) { return a.score > b.score; });
+    std::stable_sort(m.candidates.begin(), m.candidates.end(),
+                     [](const recon::BallObservation& a, const recon::BallObservation& b) {
+                       return a.score > b.score;
+                     });
   }
   return out;
 }
 
 std::vector<CameraMessage> ReadDetectionsCsv(const std::string& path, int camera, double sigma_px) {
   FV_REQUIRE(std::filesystem::exists(path), "detections file '{}' does not exist", path);
-  return ParseDetections(CsvTable::Read(path), camera, sigma_px);
+  return ParseDetections(util::CsvTable::Read(path), camera, sigma_px);
 }
 
 namespace {
@@ -98,7 +99,7 @@ namespace {
 // One detection against the flight model: parameters p0 (3), v0 (3), drag k (1), Magnus vector
 // s = c_M w (3) at the flight's reference time; residual in units of the detection's sigma.
 struct DetectionResidual {
-  DetectionResidual(const Camera& cam, const Eigen::Vector2d& uv, double dt, double g,
+  DetectionResidual(const camera::Camera& cam, const Eigen::Vector2d& uv, double dt, double g,
                     double sigma_px, bool integrate)
       : uv_(uv), dt_(dt), g_(g), sigma_(sigma_px), integrate_(integrate) {
     const auto block = cam.IntrinsicsBlock();
@@ -109,16 +110,16 @@ struct DetectionResidual {
   template <typename T>
   bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
     T p[3];
-    FlightPositionAt(p0, v0, k[0], sm, g_, dt_, integrate_, p);
-    T intr[kNumIntrinsics], rv[3], tv[3], uv[2];
-    for (int i = 0; i < kNumIntrinsics; ++i) intr[i] = T(intrinsics_[i]);
+    recon::FlightPositionAt(p0, v0, k[0], sm, g_, dt_, integrate_, p);
+    T intr[camera::kNumIntrinsics], rv[3], tv[3], uv[2];
+    for (int i = 0; i < camera::kNumIntrinsics; ++i) intr[i] = T(intrinsics_[i]);
     for (int i = 0; i < 3; ++i) rv[i] = T(rvec_[i]), tv[i] = T(tvec_[i]);
-    if (!ProjectWorldPoint(intr, rv, tv, p, uv)) return false;
+    if (!camera::ProjectWorldPoint(intr, rv, tv, p, uv)) return false;
     r[0] = (uv[0] - uv_.x()) / sigma_;
     r[1] = (uv[1] - uv_.y()) / sigma_;
     return true;
   }
-  double intrinsics_[kNumIntrinsics];
+  double intrinsics_[camera::kNumIntrinsics];
   double rvec_[3], tvec_[3];
   Eigen::Vector2d uv_;
   double dt_, g_, sigma_;
@@ -127,20 +128,21 @@ struct DetectionResidual {
 
 struct Bundled {
   bool ok = false;
-  FlightModel kind = FlightModel::kGravity;
-  BallisticModel model;
+  recon::FlightModel kind = recon::FlightModel::kGravity;
+  recon::BallisticModel model;
   double rms_px = 0.0;
   int observations = 0;
 };
 
 // The flight's model refitted on the detections of every camera between its first and last
 // seen samples (the candidate nearest the model's prediction, within a gate).
-Bundled BundleFlight(const std::vector<Camera>& cameras,
-                     const std::vector<std::vector<CameraMessage>>& messages, const Flight& f,
-                     const TrajectoryOptions& to, double sigma_px, double margin_s) {
+Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
+                     const std::vector<std::vector<CameraMessage>>& messages,
+                     const recon::Flight& f, const recon::TrajectoryOptions& to, double sigma_px,
+                     double margin_s) {
   Bundled out;
-  const BallisticModel start = f.model();
-  const FlightModel kind = f.model_kind();  // of the fit to the per-frame points
+  const recon::BallisticModel start = f.model();
+  const recon::FlightModel kind = f.model_kind();  // of the fit to the per-frame points
   const double t_ref = start.t0_s;
   struct Obs {
     int cam;
@@ -154,7 +156,7 @@ Bundled BundleFlight(const std::vector<Camera>& cameras,
       if (m.time_s < f.t_first_seen_s - margin_s || m.time_s > f.t_last_seen_s + margin_s) continue;
       const auto pred = cameras[c].Project(start.PositionAt(m.time_s));
       if (!pred) continue;
-      const BallObservation* best = nullptr;
+      const recon::BallObservation* best = nullptr;
       double best_d = gate_px;
       for (const auto& o : m.candidates) {
         const double d = (o.centre_px - *pred).norm();
@@ -166,14 +168,14 @@ Bundled BundleFlight(const std::vector<Camera>& cameras,
   if (static_cast<int>(obs.size()) * 2 < 6 + 4) return out;
   double p0[3] = {start.p0_m.x(), start.p0_m.y(), start.p0_m.z()};
   double v0[3] = {start.v0_mps.x(), start.v0_mps.y(), start.v0_mps.z()};
-  double k[1] = {kind == FlightModel::kGravity ? 0.0 : start.drag_per_m};
+  double k[1] = {kind == recon::FlightModel::kGravity ? 0.0 : start.drag_per_m};
   const double c_m = to.MagnusPerRad();
   const Eigen::Vector3d s0 = start.magnus_per_rad * start.spin_radps;
   double sm[3] = {s0.x(), s0.y(), s0.z()};
   // Each model in turn from the one before (gravity, drag, spin); the more complex one is kept
   // when its BIC over the 2 n reprojection residuals (in sigmas) is lower by spin_min_bic_gain.
-  auto solve = [&](FlightModel m, double* cost) {
-    const bool integrate = m != FlightModel::kGravity;
+  auto solve = [&](recon::FlightModel m, double* cost) {
+    const bool integrate = m != recon::FlightModel::kGravity;
     ceres::Problem problem;
     for (const auto& o : obs) {
       problem.AddResidualBlock(
@@ -181,18 +183,18 @@ Bundled BundleFlight(const std::vector<Camera>& cameras,
               cameras[o.cam], o.uv, o.time_s - t_ref, to.gravity_mps2, sigma_px, integrate)),
           new ceres::HuberLoss(2.0), p0, v0, k, sm);
     }
-    if (m == FlightModel::kGravity) {
+    if (m == recon::FlightModel::kGravity) {
       problem.SetParameterBlockConstant(k);
     } else {
       problem.SetParameterLowerBound(k, 0, 0.0);
       problem.SetParameterUpperBound(k, 0, to.max_drag_per_m);
     }
-    if (m == FlightModel::kSpin) {
+    if (m == recon::FlightModel::kSpin) {
       const double unit = 1.0 / (c_m * 2 * M_PI);
       const Eigen::Vector3d d = Eigen::Vector3d(v0[0], v0[1], v0[2]).normalized();
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<SpinPrior, 3, 3>(
-              new SpinPrior(d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
+          new ceres::AutoDiffCostFunction<recon::SpinPrior, 3, 3>(new recon::SpinPrior(
+              d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
           nullptr, sm);
     } else {
       problem.SetParameterBlockConstant(sm);
@@ -210,18 +212,22 @@ Bundled BundleFlight(const std::vector<Camera>& cameras,
   struct State {
     double p0[3], v0[3], k, sm[3];
     double bic;
-    FlightModel kind;
+    recon::FlightModel kind;
   };
   std::optional<State> best;
-  for (FlightModel m : {FlightModel::kGravity, FlightModel::kDrag, FlightModel::kSpin}) {
-    const int params = m == FlightModel::kGravity ? 6 : m == FlightModel::kDrag ? 7 : 10;
+  for (recon::FlightModel m :
+       {recon::FlightModel::kGravity, recon::FlightModel::kDrag, recon::FlightModel::kSpin}) {
+    const int params = m == recon::FlightModel::kGravity ? 6
+                       : m == recon::FlightModel::kDrag  ? 7
+                                                         : 10;
     if (nres < params + 4) break;
-    if (m != FlightModel::kSpin) sm[0] = sm[1] = sm[2] = 0.0;
-    if (m == FlightModel::kGravity) k[0] = 0.0;
+    if (m != recon::FlightModel::kSpin) sm[0] = sm[1] = sm[2] = 0.0;
+    if (m == recon::FlightModel::kGravity) k[0] = 0.0;
     double cost = 0;
     if (!solve(m, &cost)) break;
     const double bic = nres * std::log(std::max(2 * cost, 1e-12) / nres) + params * std::log(nres);
-    if (!best || bic < best->bic - (m == FlightModel::kGravity ? 0.0 : to.spin_min_bic_gain)) {
+    if (!best ||
+        bic < best->bic - (m == recon::FlightModel::kGravity ? 0.0 : to.spin_min_bic_gain)) {
       best =
           State{{p0[0], p0[1], p0[2]}, {v0[0], v0[1], v0[2]}, k[0], {sm[0], sm[1], sm[2]}, bic, m};
     }
@@ -230,10 +236,10 @@ Bundled BundleFlight(const std::vector<Camera>& cameras,
   out.model = start;
   out.model.p0_m = {best->p0[0], best->p0[1], best->p0[2]};
   out.model.v0_mps = {best->v0[0], best->v0[1], best->v0[2]};
-  out.model.drag_per_m = best->kind == FlightModel::kGravity ? 0.0 : best->k;
-  out.model.magnus_per_rad = best->kind == FlightModel::kSpin ? c_m : 0.0;
+  out.model.drag_per_m = best->kind == recon::FlightModel::kGravity ? 0.0 : best->k;
+  out.model.magnus_per_rad = best->kind == recon::FlightModel::kSpin ? c_m : 0.0;
   out.model.spin_radps =
-      best->kind == FlightModel::kSpin
+      best->kind == recon::FlightModel::kSpin
           ? Eigen::Vector3d(Eigen::Vector3d(best->sm[0], best->sm[1], best->sm[2]) / c_m)
           : Eigen::Vector3d::Zero();
   out.kind = best->kind;
@@ -267,9 +273,9 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   FV_REQUIRE(o.truth.empty() || std::filesystem::exists(o.truth), "truth file '{}' does not exist",
              o.truth);
   const int n = static_cast<int>(o.cameras.size());
-  std::vector<Camera> cameras;
+  std::vector<camera::Camera> cameras;
   for (int c = 0; c < n; ++c) {
-    cameras.push_back(ReadCameraYaml(o.cameras[c]));
+    cameras.push_back(camera::ReadCameraYaml(o.cameras[c]));
     FV_REQUIRE(cameras.back().has_pose,
                "camera file '{}' has no pose (rvec, tvec): calibrate its extrinsics first",
                o.cameras[c]);
@@ -291,7 +297,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     }
     sync.EndOfStream(c);
   }
-  TriangulationOptions topt = o.triangulation;
+  recon::TriangulationOptions topt = o.triangulation;
   topt.ball_radius_m = 0.5 * o.ball_diameter_m;
   BallPredictor predictor;
   while (auto f = sync.Next()) {
@@ -301,17 +307,17 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     if (!b.result.ok()) continue;
     const Eigen::Vector3d& p = b.result.point_world;
     if (!b.result.on_ground) predictor.Add(b.frame, p);
-    const BallSample s = BallSampleOf(b);
+    const recon::BallSample s = BallSampleOf(b);
     if (res.per_frame.empty() || s.time_s > res.per_frame.back().time_s) res.per_frame.push_back(s);
   }
   res.sync = sync.report();
   res.track = res.per_frame;
   // Flights, then the bundle.
-  TrajectoryOptions to;
+  recon::TrajectoryOptions to;
   to.ball_radius_m = topt.ball_radius_m;
   to.ball_mass_kg =
       o.ball_mass_kg > 0 ? o.ball_mass_kg : (o.ball_diameter_m < 0.05 ? 0.0027 : 0.43);
-  if (!o.flights.empty() || o.bundle) res.trajectory = AnalyzeTrajectory(res.per_frame, to);
+  if (!o.flights.empty() || o.bundle) res.trajectory = recon::AnalyzeTrajectory(res.per_frame, to);
   if (o.bundle && res.trajectory) {
     double ss = 0;
     long long nobs = 0;
@@ -320,8 +326,9 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     for (size_t i = 1; i < res.per_frame.size(); ++i) {
       dts.push_back(res.per_frame[i].time_s - res.per_frame[i - 1].time_s);
     }
-    const double margin = 0.5 * NearestRankPercentile(dts, 0.5);  // the upper middle; 0 if none
-    for (const Flight& f : res.trajectory->flights) {
+    const double margin =
+        0.5 * util::NearestRankPercentile(dts, 0.5);  // the upper middle; 0 if none
+    for (const recon::Flight& f : res.trajectory->flights) {
       const Bundled b = BundleFlight(cameras, messages, f, to, o.sigma_px, margin);
       if (!b.ok) continue;
       ++res.bundled_flights;
@@ -339,7 +346,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   res.positions = static_cast<long long>(res.track.size());
   const std::string tmp = o.out + ".part";
   {
-    CsvWriter csv(tmp, BallCsvColumns(), 6);
+    util::CsvWriter csv(tmp, recon::BallCsvColumns(), 6);
     for (const auto& s : res.track) {
       csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y()
           << s.ball_in_world.z() << s.n_cams << s.err_px;
@@ -350,13 +357,13 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   std::error_code ec;
   std::filesystem::rename(tmp, o.out, ec);
   FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
-  if (!o.truth.empty()) res.eval = EvaluateBallFiles(o.truth, o.out, o.eval);
+  if (!o.truth.empty()) res.eval = recon::EvaluateBallFiles(o.truth, o.out, o.eval);
   if (!o.flights.empty()) {
     const std::string ftmp = o.flights + ".part";
     {
       std::ofstream f(ftmp);
       FV_REQUIRE(f.good(), "cannot write '{}'", o.flights);
-      f << FlightsToJson(*res.trajectory).dump(2) << "\n";
+      f << recon::FlightsToJson(*res.trajectory).dump(2) << "\n";
       FV_REQUIRE(f.good(), "cannot write '{}'", o.flights);
     }
     std::filesystem::rename(ftmp, o.flights, ec);
@@ -365,4 +372,4 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   return res;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -20,7 +20,7 @@
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/triangulation.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 struct DetectionsJobOptions {
   std::vector<std::string> cameras;     // camera files, paired with `detections` in order
@@ -33,8 +33,8 @@ struct DetectionsJobOptions {
   std::string flights;         // optional FLIGHTS.json: the trajectory fit of the result
   bool bundle = true;          // refine flights on the 2D detections (else per-frame points)
   double ball_mass_kg = 0.0;   // for the spin model; 0: 2.7 g below 5 cm diameter, else 0.43 kg
-  TriangulationOptions triangulation;  // ball_radius_m is set from the diameter
-  BallEvalOptions eval;
+  recon::TriangulationOptions triangulation;  // ball_radius_m is set from the diameter
+  recon::BallEvalOptions eval;
   void Check() const;  // throws fv::Error naming the bad option
 };
 
@@ -43,13 +43,13 @@ struct DetectionsJobResult {
   long long positions = 0;   // rows written
   long long candidates = 0;  // detection rows read (all cameras)
   SyncReport sync;
-  std::vector<BallSample> track;               // what BALL.csv holds
-  std::vector<BallSample> per_frame;           // the per-frame triangulation (before the bundle)
-  int bundled_flights = 0;                     // flights refined on the 2D detections
-  long long bundled_rows = 0;                  // rows of BALL.csv taken from them
-  double bundle_rms_px = 0.0;                  // reprojection RMS of the bundled detections
-  std::optional<BallEvalResult> eval;          // with a truth file
-  std::optional<TrajectoryResult> trajectory;  // with `flights`
+  std::vector<recon::BallSample> track;       // what BALL.csv holds
+  std::vector<recon::BallSample> per_frame;   // the per-frame triangulation (before the bundle)
+  int bundled_flights = 0;                    // flights refined on the 2D detections
+  long long bundled_rows = 0;                 // rows of BALL.csv taken from them
+  double bundle_rms_px = 0.0;                 // reprojection RMS of the bundled detections
+  std::optional<recon::BallEvalResult> eval;  // with a truth file
+  std::optional<recon::TrajectoryResult> trajectory;  // with `flights`
   std::string Summary() const;
 };
 
@@ -58,8 +58,9 @@ struct DetectionsJobResult {
 // disagree on the time, or times that do not increase from frame to frame.
 std::vector<CameraMessage> ReadDetectionsCsv(const std::string& path, int camera,
                                              double sigma_px = 2.0);
-std::vector<CameraMessage> ParseDetections(const CsvTable& table, int camera, double sigma_px);
+std::vector<CameraMessage> ParseDetections(const util::CsvTable& table, int camera,
+                                           double sigma_px);
 
 DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& options);
 
-}  // namespace fv
+}  // namespace fv::pipeline

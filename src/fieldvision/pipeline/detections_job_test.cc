@@ -17,17 +17,17 @@
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
-std::vector<Camera> TableRig() {
-  std::vector<Camera> cams;
+std::vector<camera::Camera> TableRig() {
+  std::vector<camera::Camera> cams;
   const Eigen::Vector3d eyes[] = {{-3.5, -2.5, 2.0}, {3.5, -2.5, 2.2}, {0.5, 3.5, 2.5}};
   for (int c = 0; c < 3; ++c) {
-    Camera cam = Camera::FromFov(1280, 720, 60);
+    camera::Camera cam = camera::Camera::FromFov(1280, 720, 60);
     cam.name = fmt::format("cam{}", c);
     cam.has_pose = true;
-    cam.cam_from_world = Rigid3d::LookAt(eyes[c], Eigen::Vector3d(0, 0, 0.3));
+    cam.cam_from_world = geometry::Rigid3d::LookAt(eyes[c], Eigen::Vector3d(0, 0, 0.3));
     cams.push_back(cam);
   }
   return cams;
@@ -35,8 +35,8 @@ std::vector<Camera> TableRig() {
 
 // A stroke along the table (x) with drag and topspin, bouncing once on the table (bounce model
 // of trajectory.h), sampled at 25 Hz from 10 s.
-std::vector<std::pair<double, Eigen::Vector3d>> Flight(Rng& rng) {
-  BallisticModel m;
+std::vector<std::pair<double, Eigen::Vector3d>> Flight(util::Rng& rng) {
+  recon::BallisticModel m;
   m.t0_s = 10.0;
   m.p0_m = {-1.8, rng.Uniform(-0.3, 0.3), rng.Uniform(0.3, 0.4)};
   m.v0_mps = {rng.Uniform(5, 6), rng.Uniform(-0.3, 0.3), rng.Uniform(1.0, 1.5)};
@@ -44,10 +44,10 @@ std::vector<std::pair<double, Eigen::Vector3d>> Flight(Rng& rng) {
   m.magnus_per_rad = 0.0056;
   m.spin_radps = {0, 2 * M_PI * 40, 0};  // topspin for a flight along +x
   const double tb = *m.CrossingTime(0.02, m.t0_s, true);
-  BallisticModel after = m;
+  recon::BallisticModel after = m;
   after.t0_s = tb;
   m.StateAt(tb, &after.p0_m, &after.v0_mps);
-  BounceModel().Apply(0.02, &after.v0_mps, &after.spin_radps);
+  recon::BounceModel().Apply(0.02, &after.v0_mps, &after.spin_radps);
   std::vector<std::pair<double, Eigen::Vector3d>> out;
   for (int i = 0; i < 200; ++i) {
     const double t = 10.0 + 0.013 + i / 25.0;  // frames not aligned with the bounce
@@ -75,7 +75,7 @@ TEST(DetectionsJob, ThreeCamerasAt25HzWithFalseCandidates) {
   for (uint64_t k = 0; k < 10; ++k) {
     const uint64_t seed = seed0 + k;
     FV_SEED_TRACE(seed);
-    Rng rng(seed);
+    util::Rng rng(seed);
     const std::string dir = base + fmt::format("/f{}", k);
     std::filesystem::create_directories(dir);
     const auto flight = Flight(rng);
@@ -86,7 +86,7 @@ TEST(DetectionsJob, ThreeCamerasAt25HzWithFalseCandidates) {
     o.flights = dir + "/flights.json";
     for (int c = 0; c < 3; ++c) {
       const std::string cam_path = fmt::format("{}/cam{}.yaml", dir, c);
-      WriteCameraYaml(cams[c], cam_path);
+      camera::WriteCameraYaml(cams[c], cam_path);
       std::string det = "frame,time_s,u,v,score\n";
       for (size_t i = 0; i < flight.size(); ++i) {
         const auto uv = cams[c].Project(flight[i].second);
@@ -115,7 +115,7 @@ TEST(DetectionsJob, ThreeCamerasAt25HzWithFalseCandidates) {
     }
     ASSERT_TRUE(r.trajectory.has_value());
     int bounces = 0;
-    for (const auto& b : r.trajectory->breaks) bounces += b.kind == FlightEvent::kBounce;
+    for (const auto& b : r.trajectory->breaks) bounces += b.kind == recon::FlightEvent::kBounce;
     ++flights;
     bounce_found += bounces == 1;
     EXPECT_TRUE(std::filesystem::exists(o.flights));
@@ -123,17 +123,18 @@ TEST(DetectionsJob, ThreeCamerasAt25HzWithFalseCandidates) {
   std::cout << fmt::format(
       "detections: {} flights at 25 Hz, 2 px: 3D error median per frame {:.1f} mm, bundle {:.1f} "
       "mm (p95 {:.1f} / {:.1f} mm); bounce found in {} of {}\n",
-      flights, Median(per_frame) * 1e3, Median(bundled) * 1e3, Percentile(per_frame, 0.95) * 1e3,
-      Percentile(bundled, 0.95) * 1e3, bounce_found, flights);
-  EXPECT_LE(Median(bundled), 0.010);
-  EXPECT_LT(Median(bundled), Median(per_frame));
-  EXPECT_LT(Percentile(bundled, 0.95), 0.03);
+      flights, util::Median(per_frame) * 1e3, util::Median(bundled) * 1e3,
+      util::Percentile(per_frame, 0.95) * 1e3, util::Percentile(bundled, 0.95) * 1e3, bounce_found,
+      flights);
+  EXPECT_LE(util::Median(bundled), 0.010);
+  EXPECT_LT(util::Median(bundled), util::Median(per_frame));
+  EXPECT_LT(util::Percentile(bundled, 0.95), 0.03);
   EXPECT_GE(bounce_found, 9);
 }
 
 TEST(DetectionsJob, BadFilesAreOneLineErrorsNamingTheFile) {
   auto parse = [](const std::string& text) {
-    return ParseDetections(CsvTable::Parse(text, "det.csv"), 0, 2.0);
+    return ParseDetections(util::CsvTable::Parse(text, "det.csv"), 0, 2.0);
   };
   auto message = [&](const std::string& text) {
     try {
@@ -161,4 +162,4 @@ TEST(DetectionsJob, BadFilesAreOneLineErrorsNamingTheFile) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

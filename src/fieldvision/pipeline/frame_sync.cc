@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void SyncOptions::Check() const {
   FV_REQUIRE(std::isfinite(tolerance_s) && tolerance_s > 0,
@@ -159,4 +159,4 @@ std::optional<SyncedFrame> FrameSynchronizer::Next() {
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -14,7 +14,7 @@
 
 #include "fieldvision/pipeline/camera_message.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 enum class SyncMode { kFrameIndex, kTimestamp };
 
@@ -79,4 +79,4 @@ class FrameSynchronizer {
   SyncReport report_;
 };
 
-}  // namespace fv
+}  // namespace fv::pipeline

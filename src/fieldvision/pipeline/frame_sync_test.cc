@@ -9,10 +9,10 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
-using pipeline_testing::Msg;
+using test_util::Msg;
 
 // Feeds whole streams the way the fusion stage does (pull from the camera that is waited on).
 std::vector<SyncedFrame> Feed(FrameSynchronizer& sync,
@@ -80,7 +80,7 @@ TEST(FrameSync, ByIndexWithDropsDuplicatesAndDifferentLengths) {
 TEST(FrameSync, UnsynchronizedCamerasArePairedByTimeOnly) {
   const uint64_t seed = testing::TestSeed(22);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   // Camera 0 at 60 fps from t = 0; camera 1 at 60 fps started later with a clock offset of a
   // fraction of a frame and jitter; camera 2 at 30 fps (every other moment has no partner).
   const double dt = 1.0 / 60.0, tol = 0.3 * dt;
@@ -135,4 +135,4 @@ TEST(FrameSync, BadMessagesAreErrors) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -5,7 +5,7 @@
 #include "fieldvision/pipeline/camera_stage.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void BallPredictor::Add(long long frame, const Eigen::Vector3d& point_world) {
   frame_[1] = frame_[0];
@@ -22,8 +22,8 @@ std::optional<Eigen::Vector3d> BallPredictor::Predict(long long frame) const {
   return point_[0] + v * double(frame - frame_[0]);
 }
 
-BallSample BallSampleOf(const BallFrame& f) {
-  BallSample s;
+recon::BallSample BallSampleOf(const BallFrame& f) {
+  recon::BallSample s;
   s.frame = f.frame;
   s.time_s = f.time_s;
   s.ball_in_world = f.result.point_world;
@@ -32,23 +32,24 @@ BallSample BallSampleOf(const BallFrame& f) {
   return s;
 }
 
-BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
-                    const TriangulationOptions& options, const Eigen::Vector3d* prior) {
+BallFrame FuseFrame(const std::vector<camera::Camera>& cameras, const SyncedFrame& frame,
+                    const recon::TriangulationOptions& options, const Eigen::Vector3d* prior) {
   BallFrame out;
   out.frame = frame.frame;
   out.time_s = frame.time_s;
-  std::vector<std::vector<BallObservation>> candidates(cameras.size());
+  std::vector<std::vector<recon::BallObservation>> candidates(cameras.size());
   for (size_t c = 0; c < cameras.size() && c < frame.cameras.size(); ++c) {
     if (!frame.cameras[c]) continue;
     ++out.cameras_present;
     candidates[c] = frame.cameras[c]->candidates;
     if (HasAccepted(candidates[c])) ++out.cameras_with_blobs;
   }
-  out.result = TriangulateRobust(cameras, candidates, options, prior);
+  out.result = recon::TriangulateRobust(cameras, candidates, options, prior);
   return out;
 }
 
-FusionStage::FusionStage(std::vector<Camera> cameras, const TriangulationOptions& options)
+FusionStage::FusionStage(std::vector<camera::Camera> cameras,
+                         const recon::TriangulationOptions& options)
     : cameras_(std::move(cameras)), options_(options) {
   FV_REQUIRE(!cameras_.empty(), "fusion stage: no cameras");
   options.Check();
@@ -59,7 +60,7 @@ FusionStage::FusionStage(std::vector<Camera> cameras, const TriangulationOptions
 BallFrame FusionStage::Fuse(const SyncedFrame& group) {
   for (size_t c = 0; c < cameras_.size() && c < group.cameras.size(); ++c) {
     if (!group.cameras[c]) continue;
-    for (const BallObservation& o : group.cameras[c]->candidates) {
+    for (const recon::BallObservation& o : group.cameras[c]->candidates) {
       stats_.candidates_per_camera[c] += !o.weak;
     }
   }
@@ -81,4 +82,4 @@ BallFrame FusionStage::Fuse(const SyncedFrame& group) {
   return f;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

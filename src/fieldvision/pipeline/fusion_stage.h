@@ -13,7 +13,7 @@
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/triangulation.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 // The fused result of one synchronised frame.
 struct BallFrame {
@@ -21,15 +21,16 @@ struct BallFrame {
   double time_s = 0.0;
   int cameras_present = 0;     // cameras with a message for this frame
   int cameras_with_blobs = 0;  // of those, cameras with at least one candidate
-  TriangulationResult result;
+  recon::TriangulationResult result;
 };
 
 // The fusion of one synchronised frame (what the fusion stage does per frame).
-BallFrame FuseFrame(const std::vector<Camera>& cameras, const SyncedFrame& frame,
-                    const TriangulationOptions& options, const Eigen::Vector3d* prior = nullptr);
+BallFrame FuseFrame(const std::vector<camera::Camera>& cameras, const SyncedFrame& frame,
+                    const recon::TriangulationOptions& options,
+                    const Eigen::Vector3d* prior = nullptr);
 
 // The trajectory sample of a frame with a position (its point, cameras and error).
-BallSample BallSampleOf(const BallFrame& frame);
+recon::BallSample BallSampleOf(const BallFrame& frame);
 
 // The ball's expected position from the last positions (constant velocity over the last two,
 // when they are at most max_gap frames apart and the newest is at most max_gap frames old).
@@ -61,16 +62,16 @@ struct FusionStats {
 class FusionStage {
  public:
   // Throws fv::Error when there is no camera or the options are bad.
-  FusionStage(std::vector<Camera> cameras, const TriangulationOptions& options);
+  FusionStage(std::vector<camera::Camera> cameras, const recon::TriangulationOptions& options);
   BallFrame Fuse(const SyncedFrame& frame);
   const FusionStats& stats() const { return stats_; }
-  const std::vector<Camera>& cameras() const { return cameras_; }
+  const std::vector<camera::Camera>& cameras() const { return cameras_; }
 
  private:
-  std::vector<Camera> cameras_;
-  TriangulationOptions options_;
+  std::vector<camera::Camera> cameras_;
+  recon::TriangulationOptions options_;
   BallPredictor predictor_;
   FusionStats stats_;
 };
 
-}  // namespace fv
+}  // namespace fv::pipeline

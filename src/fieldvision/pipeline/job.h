@@ -9,7 +9,7 @@
 #include <mutex>
 #include <string>
 
-namespace fv {
+namespace fv::pipeline {
 
 struct JobProgress {
   std::string job;       // "ball", "node", "fuse"
@@ -48,4 +48,4 @@ inline bool StopRequested(const JobControl* control) {
   return control != nullptr && control->StopRequested();
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

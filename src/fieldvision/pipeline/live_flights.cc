@@ -5,7 +5,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void LiveFlightsOptions::Check() const {
   analysis.Check();
@@ -20,18 +20,18 @@ void LiveFlightsOptions::Check() const {
 
 LiveFlights::LiveFlights(const LiveFlightsOptions& options) : options_(options) { options.Check(); }
 
-std::vector<Flight> LiveFlights::CloseAll() {
-  std::vector<Flight> out;
+std::vector<recon::Flight> LiveFlights::CloseAll() {
+  std::vector<recon::Flight> out;
   if (track_.size() >= 3) {
     ++analyses_;
-    out = AnalyzeTrajectory(track_, options_.analysis).flights;
+    out = recon::AnalyzeTrajectory(track_, options_.analysis).flights;
   }
   track_.clear();
   return out;
 }
 
-std::vector<Flight> LiveFlights::Add(const BallSample& s) {
-  std::vector<Flight> out;
+std::vector<recon::Flight> LiveFlights::Add(const recon::BallSample& s) {
+  std::vector<recon::Flight> out;
   if (!std::isfinite(s.time_s) || !s.ball_in_world.allFinite()) return out;
   if (!track_.empty() && s.time_s <= track_.back().time_s) return out;
   if (!track_.empty() && s.time_s - track_.back().time_s > options_.track_gap_s) out = CloseAll();
@@ -42,9 +42,9 @@ std::vector<Flight> LiveFlights::Add(const BallSample& s) {
   if (s.time_s - last_analysis_s_ < options_.analyse_every_s || track_.size() < 3) return out;
   last_analysis_s_ = s.time_s;
   ++analyses_;
-  const TrajectoryResult r = AnalyzeTrajectory(track_, options_.analysis);
+  const recon::TrajectoryResult r = recon::AnalyzeTrajectory(track_, options_.analysis);
   if (r.flights.size() < 2) return out;
-  const Flight& open = r.flights.back();
+  const recon::Flight& open = r.flights.back();
   if (static_cast<int>(open.samples.size()) < options_.min_next_samples) return out;
   out.insert(out.end(), r.flights.begin(), r.flights.end() - 1);
   // The open flight's samples (and whatever follows) stay; the closed ones' leave.
@@ -53,6 +53,6 @@ std::vector<Flight> LiveFlights::Add(const BallSample& s) {
   return out;
 }
 
-std::vector<Flight> LiveFlights::Finish() { return CloseAll(); }
+std::vector<recon::Flight> LiveFlights::Finish() { return CloseAll(); }
 
-}  // namespace fv
+}  // namespace fv::pipeline

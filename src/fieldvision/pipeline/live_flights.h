@@ -10,13 +10,13 @@
 
 #include "fieldvision/recon/trajectory.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 struct LiveFlightsOptions {
   // The segmentation and fits (spin off: the live analysis runs often; drag auto).
-  TrajectoryOptions analysis = [] {
-    TrajectoryOptions t;
-    t.spin = SpinMode::kOff;
+  recon::TrajectoryOptions analysis = [] {
+    recon::TrajectoryOptions t;
+    t.spin = recon::SpinMode::kOff;
     return t;
   }();
   double analyse_every_s = 0.25;  // of ball time between analyses of the open track
@@ -30,17 +30,17 @@ class LiveFlights {
  public:
   explicit LiveFlights(const LiveFlightsOptions& options);
   // A fused position (time order; earlier ones are ignored); returns the flights it closed.
-  std::vector<Flight> Add(const BallSample& sample);
+  std::vector<recon::Flight> Add(const recon::BallSample& sample);
   // The end of the stream: the open track's flights.
-  std::vector<Flight> Finish();
+  std::vector<recon::Flight> Finish();
   long long analyses() const { return analyses_; }
 
  private:
-  std::vector<Flight> CloseAll();
+  std::vector<recon::Flight> CloseAll();
   LiveFlightsOptions options_;
-  std::vector<BallSample> track_;
+  std::vector<recon::BallSample> track_;
   double last_analysis_s_ = -1e300;
   long long analyses_ = 0;
 };
 
-}  // namespace fv
+}  // namespace fv::pipeline

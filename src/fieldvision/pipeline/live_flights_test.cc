@@ -14,15 +14,15 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
-std::vector<BallSample> KickTrack(uint64_t seed, TrajectoryOptions* options) {
+std::vector<recon::BallSample> KickTrack(uint64_t seed, recon::TrajectoryOptions* options) {
   const synth::SceneSpec spec = synth::Preset("kick", seed);
   const synth::BallTrajectory trajectory(spec.ball, spec.duration_s());
-  Rng rng(seed + 1000);
-  std::vector<BallSample> track =
-      recon_testing::NoisyTrack(trajectory, spec.num_frames, spec.fps, 0.005, rng, 4);
+  util::Rng rng(seed + 1000);
+  std::vector<recon::BallSample> track =
+      recon::test_util::NoisyTrack(trajectory, spec.num_frames, spec.fps, 0.005, rng, 4);
   options->ball_radius_m = spec.ball.radius_m();
   options->gravity_mps2 = spec.ball.physics.gravity_mps2;
   return track;
@@ -32,19 +32,19 @@ TEST(LiveFlights, SameFlightsAsTheWholeTrackEachOnce) {
   const uint64_t seed = testing::TestSeed(1);
   FV_SEED_TRACE(seed);
   LiveFlightsOptions o;
-  const std::vector<BallSample> track = KickTrack(seed, &o.analysis);
+  const std::vector<recon::BallSample> track = KickTrack(seed, &o.analysis);
   ASSERT_GT(track.size(), 60u);
-  const TrajectoryResult offline = AnalyzeTrajectory(track, o.analysis);
+  const recon::TrajectoryResult offline = recon::AnalyzeTrajectory(track, o.analysis);
   ASSERT_GE(offline.flights.size(), 2u) << offline.Summary();
 
   LiveFlights live(o);
-  std::vector<Flight> flights;
+  std::vector<recon::Flight> flights;
   size_t closed_before_end = 0;
-  for (const BallSample& s : track) {
-    for (Flight& f : live.Add(s)) flights.push_back(std::move(f));
+  for (const recon::BallSample& s : track) {
+    for (recon::Flight& f : live.Add(s)) flights.push_back(std::move(f));
   }
   closed_before_end = flights.size();
-  for (Flight& f : live.Finish()) flights.push_back(std::move(f));
+  for (recon::Flight& f : live.Finish()) flights.push_back(std::move(f));
   // All but the last one or two (too few samples after them) close before the end.
   EXPECT_GE(closed_before_end + 2, offline.flights.size()) << "flights closed only at the end";
   EXPECT_GE(closed_before_end, 1u);
@@ -63,21 +63,21 @@ TEST(LiveFlights, AGapClosesTheTrackAndBadOptionsAreNamed) {
   const uint64_t seed = testing::TestSeed(2);
   FV_SEED_TRACE(seed);
   LiveFlightsOptions o;
-  const std::vector<BallSample> track = KickTrack(seed, &o.analysis);
+  const std::vector<recon::BallSample> track = KickTrack(seed, &o.analysis);
   LiveFlights live(o);
   size_t n = 0;
-  for (const BallSample& s : track) n += live.Add(s).size();
+  for (const recon::BallSample& s : track) n += live.Add(s).size();
   // The same track again a second later: the first one's open flights close with its first
   // position.
-  BallSample later = track.front();
+  recon::BallSample later = track.front();
   later.time_s = track.back().time_s + 1.0;
-  const std::vector<Flight> closed = live.Add(later);
+  const std::vector<recon::Flight> closed = live.Add(later);
   EXPECT_FALSE(closed.empty());
-  for (const Flight& f : closed) EXPECT_LE(f.t_end_s, track.back().time_s + 0.2);
+  for (const recon::Flight& f : closed) EXPECT_LE(f.t_end_s, track.back().time_s + 0.2);
   EXPECT_TRUE(live.Finish().empty());  // one position: no flight
   o.track_gap_s = 0;
   EXPECT_THROW(LiveFlights live2(o), Error);
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

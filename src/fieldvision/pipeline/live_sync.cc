@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 void LiveSyncOptions::Check() const {
   FV_REQUIRE(std::isfinite(tolerance_s) && tolerance_s > 0,
@@ -164,4 +164,4 @@ std::vector<std::string> LiveSynchronizer::Problems(const std::vector<std::strin
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -19,7 +19,7 @@
 #include "fieldvision/pipeline/camera_message.h"
 #include "fieldvision/pipeline/frame_sync.h"
 
-namespace fv {
+namespace fv::pipeline {
 
 struct LiveSyncOptions {
   double tolerance_s = 0.008;  // half a frame at 60 fps
@@ -83,4 +83,4 @@ class LiveSynchronizer {
   long long groups_ = 0, complete_groups_ = 0;
 };
 
-}  // namespace fv
+}  // namespace fv::pipeline

@@ -8,15 +8,15 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::pipeline {
 namespace {
 
-using pipeline_testing::Msg;
+using test_util::Msg;
 
 TEST(LiveSync, PairsByTimeWithJitterAndOffsetsInFrameNumbers) {
   const uint64_t seed = testing::TestSeed(2);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   LiveSyncOptions o;
   o.tolerance_s = 0.008;
   LiveSynchronizer sync(3, o);
@@ -104,4 +104,4 @@ TEST(LiveSync, SkippedFramesAreNotWaitedFor) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::pipeline

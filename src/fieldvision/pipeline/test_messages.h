@@ -4,7 +4,7 @@
 
 #include "fieldvision/pipeline/camera_message.h"
 
-namespace fv::pipeline_testing {
+namespace fv::pipeline::test_util {
 
 inline CameraMessage Msg(int camera, long long frame, double time_s) {
   CameraMessage m;
@@ -14,4 +14,4 @@ inline CameraMessage Msg(int camera, long long frame, double time_s) {
   return m;
 }
 
-}  // namespace fv::pipeline_testing
+}  // namespace fv::pipeline::test_util

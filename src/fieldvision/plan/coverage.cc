@@ -17,7 +17,7 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-bool HasDistortion(const Camera& c) {
+bool HasDistortion(const camera::Camera& c) {
   for (double d : c.distortion) {
     if (d != 0.0) return true;
   }
@@ -80,7 +80,7 @@ void CoverageOptions::Check() const {
   CheckNonNegative(error_weight_per_m, "error_weight_per_m");
 }
 
-void CheckCoverageGrid(const FieldModel& field, const CoverageOptions& options) {
+void CheckCoverageGrid(const field::FieldModel& field, const CoverageOptions& options) {
   const double half_x =
       options.include_surround ? field.HalfLengthWithSurround() : 0.5 * field.length_m;
   const double half_y =
@@ -92,7 +92,7 @@ void CheckCoverageGrid(const FieldModel& field, const CoverageOptions& options) 
              options.grid_step_m, kMaxCells, field.name, 2 * half_x, 2 * half_y);
 }
 
-bool SeesPoint(const Camera& camera, const Eigen::Vector3d& p_world,
+bool SeesPoint(const camera::Camera& camera, const Eigen::Vector3d& p_world,
                const CoverageOptions& options) {
   const Eigen::Vector3d p_cam = camera.cam_from_world * p_world;
   if (!(p_cam.z() > 0)) return false;
@@ -121,7 +121,7 @@ double RayAngleDeg(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& centr
   return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
 }
 
-std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const Camera& camera,
+std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const camera::Camera& camera,
                                                               const Eigen::Vector3d& p_world) {
   if (!HasDistortion(camera)) {
     // Pinhole: d(uv)/d(p_cam) = [fx / Z, 0, -fx X / Z^2; 0, fy / Z, -fy Y / Z^2], times R.
@@ -134,8 +134,8 @@ std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const Camera& came
   }
   using Jet = ceres::Jet<double, 3>;
   const auto intr = camera.IntrinsicsBlock();
-  std::array<Jet, kNumIntrinsics> intr_jet;
-  for (int i = 0; i < kNumIntrinsics; ++i) intr_jet[i] = Jet(intr[i]);
+  std::array<Jet, camera::kNumIntrinsics> intr_jet;
+  for (int i = 0; i < camera::kNumIntrinsics; ++i) intr_jet[i] = Jet(intr[i]);
   const Eigen::Matrix3d& r = camera.cam_from_world.rotation;
   const Eigen::Vector3d& t = camera.cam_from_world.translation;
   Jet p_cam[3];
@@ -145,7 +145,7 @@ std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const Camera& came
     for (int col = 0; col < 3; ++col) p_cam[row].v[col] = r(row, col);
   }
   Jet uv[2];
-  if (!ProjectCameraPoint(intr_jet.data(), p_cam, uv)) return std::nullopt;
+  if (!camera::ProjectCameraPoint(intr_jet.data(), p_cam, uv)) return std::nullopt;
   Eigen::Matrix<double, 2, 3> j;
   j.row(0) = uv[0].v.transpose();
   j.row(1) = uv[1].v.transpose();
@@ -157,10 +157,11 @@ namespace {
 // Eigen-decomposition of the information matrix sum_i J_i^T J_i / sigma^2 of the point; nullopt
 // when a camera cannot project it or the rays leave a direction unobserved.
 std::optional<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>> InformationEigen(
-    const std::vector<const Camera*>& cameras, const Eigen::Vector3d& p_world, double sigma_px) {
+    const std::vector<const camera::Camera*>& cameras, const Eigen::Vector3d& p_world,
+    double sigma_px) {
   if (cameras.size() < 2) return std::nullopt;
   Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
-  for (const Camera* c : cameras) {
+  for (const camera::Camera* c : cameras) {
     const auto j = ProjectionJacobian(*c, p_world);
     if (!j) return std::nullopt;
     info += j->transpose() * *j;
@@ -175,20 +176,20 @@ std::optional<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>> InformationEigen(
 
 }  // namespace
 
-std::optional<Eigen::Matrix3d> TriangulationCovariance(const std::vector<const Camera*>& cameras,
-                                                       const Eigen::Vector3d& p_world,
-                                                       double sigma_px) {
+std::optional<Eigen::Matrix3d> TriangulationCovariance(
+    const std::vector<const camera::Camera*>& cameras, const Eigen::Vector3d& p_world,
+    double sigma_px) {
   const auto eig = InformationEigen(cameras, p_world, sigma_px);
   if (!eig) return std::nullopt;
   return eig->eigenvectors() * eig->eigenvalues().cwiseInverse().asDiagonal() *
          eig->eigenvectors().transpose();
 }
 
-CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldModel& field,
-                                const CoverageOptions& options) {
+CoverageResult EvaluateCoverage(const std::vector<camera::Camera>& cameras,
+                                const field::FieldModel& field, const CoverageOptions& options) {
   options.Check();
   FV_REQUIRE(!cameras.empty(), "coverage: no cameras");
-  for (const Camera& c : cameras) {
+  for (const camera::Camera& c : cameras) {
     c.Check("coverage: camera '" + c.name + "'");
     FV_REQUIRE(c.has_pose, "coverage: camera '{}' has no pose", c.name);
   }
@@ -208,11 +209,11 @@ CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldM
   const int nx = std::max(1, static_cast<int>(std::lround(2 * half_x / options.grid_step_m)));
   const int ny = std::max(1, static_cast<int>(std::lround(2 * half_y / options.grid_step_m)));
   std::vector<Eigen::Vector3d> centres;
-  for (const Camera& c : cameras) centres.push_back(c.CentreInWorld());
-  Progress progress("coverage", static_cast<long long>(heights.size()) * ny, "rows",
-                    options.progress);
+  for (const camera::Camera& c : cameras) centres.push_back(c.CentreInWorld());
+  util::Progress progress("coverage", static_cast<long long>(heights.size()) * ny, "rows",
+                          options.progress);
   long long rows_done = 0;
-  std::vector<const Camera*> seeing;
+  std::vector<const camera::Camera*> seeing;
   for (double h : heights) {
     CoverageLayer layer;
     layer.height_m = h;

@@ -74,24 +74,24 @@ struct CoverageResult {
 };
 
 // Whether `camera` sees a ball centred at `p_world` (see CoverageOptions).
-bool SeesPoint(const Camera& camera, const Eigen::Vector3d& p_world,
+bool SeesPoint(const camera::Camera& camera, const Eigen::Vector3d& p_world,
                const CoverageOptions& options);
 // Angle at `p_world` between the rays to the two camera centres, degrees in [0, 180].
 double RayAngleDeg(const Eigen::Vector3d& centre_a, const Eigen::Vector3d& centre_b,
                    const Eigen::Vector3d& p_world);
 // Jacobian d(pixel)/d(p_world) of the camera's projection (distortion included); nullopt behind.
-std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const Camera& camera,
+std::optional<Eigen::Matrix<double, 2, 3>> ProjectionJacobian(const camera::Camera& camera,
                                                               const Eigen::Vector3d& p_world);
 // First-order covariance of the point triangulated from `cameras` with isotropic pixel noise
 // sigma_px; nullopt when the rays do not determine the point (one camera, parallel rays).
-std::optional<Eigen::Matrix3d> TriangulationCovariance(const std::vector<const Camera*>& cameras,
-                                                       const Eigen::Vector3d& p_world,
-                                                       double sigma_px);
+std::optional<Eigen::Matrix3d> TriangulationCovariance(
+    const std::vector<const camera::Camera*>& cameras, const Eigen::Vector3d& p_world,
+    double sigma_px);
 
 // Throws fv::Error (naming the step and the field) when the grid would have over 4 million cells.
-void CheckCoverageGrid(const FieldModel& field, const CoverageOptions& options);
+void CheckCoverageGrid(const field::FieldModel& field, const CoverageOptions& options);
 
-CoverageResult EvaluateCoverage(const std::vector<Camera>& cameras, const FieldModel& field,
-                                const CoverageOptions& options);
+CoverageResult EvaluateCoverage(const std::vector<camera::Camera>& cameras,
+                                const field::FieldModel& field, const CoverageOptions& options);
 
 }  // namespace fv::plan

@@ -45,8 +45,8 @@ void Text(cv::Mat& img, const std::string& s, cv::Point at, double scale,
 
 // The image border of `cam` cast onto the plane z = height, as polylines (broken where the
 // border is above the horizon or very far away).
-std::vector<std::vector<cv::Point>> Footprint(const Camera& cam, double height, const TopView& view,
-                                              double max_range_m) {
+std::vector<std::vector<cv::Point>> Footprint(const camera::Camera& cam, double height,
+                                              const field::TopView& view, double max_range_m) {
   std::vector<Eigen::Vector2d> border;
   const int steps = 60;
   const double w = cam.width - 0.5, h = cam.height - 0.5;
@@ -59,7 +59,7 @@ std::vector<std::vector<cv::Point>> Footprint(const Camera& cam, double height, 
   for (const auto& uv : border) {
     const auto ray = cam.RayFromPixel(uv);
     std::optional<Eigen::Vector3d> hit;
-    if (ray) hit = IntersectHorizontalPlane(*ray, height);
+    if (ray) hit = geometry::IntersectHorizontalPlane(*ray, height);
     if (!hit || (*hit - centre).norm() > max_range_m) {
       if (!lines.back().empty()) lines.emplace_back();
       continue;
@@ -82,19 +82,20 @@ void CoverageMapOptions::Check() const {
 namespace {
 
 // The top view with room for cameras standing outside the drawn area.
-TopView MapView(const std::vector<Camera>& cameras, const FieldModel& field, int width_px) {
+field::TopView MapView(const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
+                       int width_px) {
   double extra_m = 0.3;
-  for (const Camera& c : cameras) {
+  for (const camera::Camera& c : cameras) {
     const Eigen::Vector3d p = c.CentreInWorld();
     extra_m = std::max(extra_m, std::abs(p.x()) - field.HalfLengthWithSurround() + 0.8);
     extra_m = std::max(extra_m, std::abs(p.y()) - field.HalfWidthWithSurround() + 0.8);
   }
-  return TopView::ForField(field, width_px, extra_m);
+  return field::TopView::ForField(field, width_px, extra_m);
 }
 
 // The layer's cells in their colours, blended over the field with `alpha`.
-void PaintCells(cv::Mat& img, const CoverageLayer& layer, CoverageMapKind kind, const TopView& view,
-                double err_scale, double alpha) {
+void PaintCells(cv::Mat& img, const CoverageLayer& layer, CoverageMapKind kind,
+                const field::TopView& view, double err_scale, double alpha) {
   cv::Mat overlay = img.clone();
   auto colour_of = [&](size_t cell) -> cv::Vec3b {
     switch (kind) {
@@ -128,10 +129,10 @@ void PaintCells(cv::Mat& img, const CoverageLayer& layer, CoverageMapKind kind, 
 }
 
 // Each camera's footprint, position, aim and label.
-void DrawCameras(cv::Mat& img, const std::vector<Camera>& cameras, double height_m,
-                 const TopView& view, double range_m, double scale, bool footprints) {
+void DrawCameras(cv::Mat& img, const std::vector<camera::Camera>& cameras, double height_m,
+                 const field::TopView& view, double range_m, double scale, bool footprints) {
   for (size_t k = 0; k < cameras.size(); ++k) {
-    const Camera& cam = cameras[k];
+    const camera::Camera& cam = cameras[k];
     const cv::Scalar& colour = kCameraColours[k % kCameraColours.size()];
     if (footprints) {
       for (const auto& line : Footprint(cam, height_m, view, range_m)) {
@@ -216,15 +217,15 @@ cv::Mat Legend(const CoverageLayer& layer, CoverageMapKind kind, const CoverageO
 }  // namespace
 
 cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
-                        const std::vector<Camera>& cameras, const FieldModel& field,
+                        const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
                         const CoverageOptions& coverage, const CoverageMapOptions& options) {
   options.Check();
-  const TopView view = MapView(cameras, field, options.width_px);
-  cv::Mat img = DrawField(field, view);
+  const field::TopView view = MapView(cameras, field, options.width_px);
+  cv::Mat img = field::DrawField(field, view);
   double err_scale = options.err_scale_m;
   if (err_scale <= 0) err_scale = std::isfinite(layer.err_max_m) ? layer.err_max_m : 0.1;
   PaintCells(img, layer, kind, view, err_scale, options.alpha);
-  DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255));
+  field::DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255));
   const double range_m =
       3 * std::hypot(field.HalfLengthWithSurround(), field.HalfWidthWithSurround());
   const double scale = options.width_px / 1400.0;

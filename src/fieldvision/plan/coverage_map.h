@@ -27,7 +27,7 @@ struct CoverageMapOptions {
 };
 
 cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
-                        const std::vector<Camera>& cameras, const FieldModel& field,
+                        const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
                         const CoverageOptions& coverage, const CoverageMapOptions& options = {});
 
 }  // namespace fv::plan

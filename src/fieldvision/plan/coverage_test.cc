@@ -17,9 +17,9 @@ namespace {
 
 // A camera looking straight down from `height_m` above the plane z = plane_z whose image covers
 // exactly [cx - sx/2, cx + sx/2) x (cy - sy/2, cy + sy/2] of that plane.
-Camera OverheadCamera(const std::string& name, Eigen::Vector2d centre, double size_x_m,
-                      double size_y_m, double plane_z, double height_m, double px_per_m) {
-  Camera c;
+camera::Camera OverheadCamera(const std::string& name, Eigen::Vector2d centre, double size_x_m,
+                              double size_y_m, double plane_z, double height_m, double px_per_m) {
+  camera::Camera c;
   c.name = name;
   c.width = static_cast<int>(std::lround(size_x_m * px_per_m));
   c.height = static_cast<int>(std::lround(size_y_m * px_per_m));
@@ -29,13 +29,13 @@ Camera OverheadCamera(const std::string& name, Eigen::Vector2d centre, double si
   Eigen::Matrix3d rot;
   rot << 1, 0, 0, 0, -1, 0, 0, 0, -1;  // image x = world x, image y = -world y, looking down
   const Eigen::Vector3d eye(centre.x(), centre.y(), plane_z + height_m);
-  c.cam_from_world = Rigid3d{rot, -rot * eye};
+  c.cam_from_world = geometry::Rigid3d{rot, -rot * eye};
   c.has_pose = true;
   return c;
 }
 
 TEST(CoverageTest, OverheadFootprintsGiveExactFractions) {
-  const FieldModel field = BuiltinField("robocup-msl");  // 18 x 12 m
+  const field::FieldModel field = field::BuiltinField("robocup-msl");  // 18 x 12 m
   CoverageOptions o;
   o.grid_step_m = 0.25;
   o.height_above_m = 0;
@@ -43,10 +43,10 @@ TEST(CoverageTest, OverheadFootprintsGiveExactFractions) {
   const double z = 0.5 * o.ball_diameter_m;
   // A sees the half x < 0, B the half y < 0, C the quarter x < 0, y < 0; D sees x > 0, y > 0
   // from a different height and resolution. By construction each quadrant has a known count.
-  const std::vector<Camera> cams = {OverheadCamera("A", {-4.5, 0}, 9, 12, z, 6.0, 40),
-                                    OverheadCamera("B", {0, -3}, 18, 6, z, 9.0, 30),
-                                    OverheadCamera("C", {-4.5, -3}, 9, 6, z, 3.0, 50),
-                                    OverheadCamera("D", {4.5, 3}, 9, 6, z, 12.0, 20)};
+  const std::vector<camera::Camera> cams = {OverheadCamera("A", {-4.5, 0}, 9, 12, z, 6.0, 40),
+                                            OverheadCamera("B", {0, -3}, 18, 6, z, 9.0, 30),
+                                            OverheadCamera("C", {-4.5, -3}, 9, 6, z, 3.0, 50),
+                                            OverheadCamera("D", {4.5, 3}, 9, 6, z, 12.0, 20)};
   const CoverageResult r = EvaluateCoverage(cams, field, o);
   ASSERT_EQ(r.layers.size(), 1u);
   const CoverageLayer& L = r.layers[0];
@@ -77,7 +77,7 @@ TEST(CoverageTest, OverheadFootprintsGiveExactFractions) {
 }
 
 TEST(CoverageTest, RaisedLayerShrinksOverheadFootprint) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   CoverageOptions o;
   o.grid_step_m = 0.25;
   o.height_above_m = 2.0;
@@ -85,7 +85,7 @@ TEST(CoverageTest, RaisedLayerShrinksOverheadFootprint) {
   const double z = 0.5 * o.ball_diameter_m;
   // From 8 m above the ball the footprint is 18 x 12 m; 2 m higher it is 3/4 of that: the cells
   // with |x| < 6.75 and |y| < 4.5, i.e. 54 x 36 of the 72 x 48 cells.
-  const Camera cam = OverheadCamera("top", {0, 0}, 18, 12, z, 8.0, 40);
+  const camera::Camera cam = OverheadCamera("top", {0, 0}, 18, 12, z, 8.0, 40);
   const CoverageResult r = EvaluateCoverage({cam}, field, o);
   ASSERT_EQ(r.layers.size(), 2u);
   EXPECT_DOUBLE_EQ(r.layers[0].fraction_exactly[1], 1.0);
@@ -94,12 +94,12 @@ TEST(CoverageTest, RaisedLayerShrinksOverheadFootprint) {
 }
 
 TEST(CoverageTest, BallTooSmallBeyondMaximumDistance) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   CoverageOptions o;
   o.grid_step_m = 0.5;
   o.height_above_m = 0;
   const double z = 0.5 * o.ball_diameter_m;
-  const Camera cam = OverheadCamera("top", {0, 0}, 18, 12, z, 5.0, 100);
+  const camera::Camera cam = OverheadCamera("top", {0, 0}, 18, 12, z, 5.0, 100);
   // The ball is f * D / distance pixels wide; at 5 m (right below) it is 100 px, so with
   // min_ball_px = 100 * 5 / 7 only points within sqrt(7^2 - 5^2) m of the nadir count.
   o.min_ball_px = 100.0 * 5.0 * o.ball_diameter_m / 7.0;
@@ -121,11 +121,11 @@ TEST(CoverageTest, BallTooSmallBeyondMaximumDistance) {
 TEST(CoverageTest, BestPairAngleIsClosestTo90) {
   const uint64_t seed = fv::testing::TestSeed(11);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const Eigen::Vector3d p(rng.Uniform(-5, 5), rng.Uniform(-3, 3), 0.11);
   // Cameras along directions at 10, 40 and 140 degrees in a tilted plane: pair angles 30, 130
   // and 100 degrees; the best is 100.
-  std::vector<Camera> cams;
+  std::vector<camera::Camera> cams;
   for (double deg : {10.0, 40.0, 140.0}) {
     const double t = deg * M_PI / 180;
     const Eigen::Vector3d dir(std::cos(t), std::sin(t) * std::cos(0.5),
@@ -133,7 +133,7 @@ TEST(CoverageTest, BestPairAngleIsClosestTo90) {
     cams.push_back(MakeAimedCamera("c", 640, 480, 60, p + rng.Uniform(6, 15) * dir, p));
   }
   EXPECT_NEAR(RayAngleDeg(cams[0].CentreInWorld(), cams[2].CentreInWorld(), p), 130.0, 1e-9);
-  FieldModel field = BuiltinField("robocup-msl");
+  field::FieldModel field = field::BuiltinField("robocup-msl");
   CoverageOptions o;
   o.height_above_m = 0;
   o.min_ball_px = 0;
@@ -152,7 +152,7 @@ TEST(CoverageTest, BestPairAngleIsClosestTo90) {
 }
 
 // Linear least squares on normalized rays, then Gauss-Newton on the reprojection error.
-Eigen::Vector3d Triangulate(const std::vector<Camera>& cams,
+Eigen::Vector3d Triangulate(const std::vector<camera::Camera>& cams,
                             const std::vector<Eigen::Vector2d>& uv) {
   Eigen::MatrixXd a(2 * cams.size(), 3);
   Eigen::VectorXd b(2 * cams.size());
@@ -186,14 +186,14 @@ Eigen::Vector3d Triangulate(const std::vector<Camera>& cams,
 TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const double sigma_px = 1.5;
   for (int trial = 0; trial < 6; ++trial) {
     // 2 to 4 cameras around the field at 3-8 m, aimed near the point, some with distortion.
     const Eigen::Vector3d p(rng.Uniform(-8, 8), rng.Uniform(-5, 5), rng.Uniform(0.11, 2.0));
     const int n = 2 + trial % 3;
-    std::vector<Camera> cams;
-    std::vector<const Camera*> ptrs;
+    std::vector<camera::Camera> cams;
+    std::vector<const camera::Camera*> ptrs;
     for (int k = 0; k < n; ++k) {
       // Headings spread around the point so that no two rays are nearly parallel.
       const double heading = 2 * M_PI * k / n + rng.Uniform(-0.4, 0.4);
@@ -202,7 +202,7 @@ TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
           p + Eigen::Vector3d(range * std::cos(heading), range * std::sin(heading), 0) +
           Eigen::Vector3d(0, 0, rng.Uniform(3, 8) - p.z());
       const Eigen::Vector3d aim = p + Eigen::Vector3d(rng.Uniform(-2, 2), rng.Uniform(-2, 2), 0);
-      Camera c = MakeAimedCamera("c", 1280, 960, rng.Uniform(50, 90), eye, aim);
+      camera::Camera c = MakeAimedCamera("c", 1280, 960, rng.Uniform(50, 90), eye, aim);
       if (k % 2 == 1) c.distortion = {rng.Uniform(-0.2, 0.05), rng.Uniform(0, 0.05), 0, 0, 0};
       cams.push_back(c);
     }
@@ -236,11 +236,12 @@ TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
 TEST(CoverageTest, ProjectionJacobianMatchesFiniteDifferences) {
   const uint64_t seed = fv::testing::TestSeed(9);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 10; ++trial) {
-    Camera c = MakeAimedCamera("c", 1280, 960, rng.Uniform(40, 100),
-                               {rng.Uniform(-12, 12), rng.Uniform(-8, -7), rng.Uniform(2, 8)},
-                               {rng.Uniform(-3, 3), rng.Uniform(-2, 2), 0});
+    camera::Camera c =
+        MakeAimedCamera("c", 1280, 960, rng.Uniform(40, 100),
+                        {rng.Uniform(-12, 12), rng.Uniform(-8, -7), rng.Uniform(2, 8)},
+                        {rng.Uniform(-3, 3), rng.Uniform(-2, 2), 0});
     if (trial % 2) c.distortion = {rng.Uniform(-0.3, 0.1), rng.Uniform(-0.05, 0.05), 0.001, 0, 0};
     const Eigen::Vector3d p(rng.Uniform(-4, 4), rng.Uniform(-3, 3), rng.Uniform(0, 2));
     const auto j = ProjectionJacobian(c, p);
@@ -256,10 +257,10 @@ TEST(CoverageTest, ProjectionJacobianMatchesFiniteDifferences) {
 
 TEST(CoverageTest, OneCameraOrParallelRaysGiveNoError) {
   const Eigen::Vector3d p(1, 2, 0.11);
-  const Camera a = MakeAimedCamera("a", 640, 480, 60, {10, 2, 4}, p);
+  const camera::Camera a = MakeAimedCamera("a", 640, 480, 60, {10, 2, 4}, p);
   EXPECT_FALSE(TriangulationCovariance({&a}, p, 1.0).has_value());
   // Two cameras on the same ray: the depth is not observable.
-  const Camera b = MakeAimedCamera("b", 640, 480, 60, p + 0.5 * (a.CentreInWorld() - p), p);
+  const camera::Camera b = MakeAimedCamera("b", 640, 480, 60, p + 0.5 * (a.CentreInWorld() - p), p);
   EXPECT_FALSE(TriangulationCovariance({&a, &b}, p, 1.0).has_value());
 }
 

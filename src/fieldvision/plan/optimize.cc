@@ -38,22 +38,23 @@ struct CamState {
 
 class Search {
  public:
-  Search(const FieldModel& field, const std::vector<MountPlace>& mounts, const Camera& model,
-         const CoverageOptions& coverage, const OptimizeOptions& options)
+  Search(const field::FieldModel& field, const std::vector<MountPlace>& mounts,
+         const camera::Camera& model, const CoverageOptions& coverage,
+         const OptimizeOptions& options)
       : field_(field), mounts_(mounts), model_(model), coverage_(coverage), options_(options) {
     coverage_.grid_step_m = options.grid_step_m;
     coverage_.height_above_m = 0;
     coverage_.progress = false;
   }
 
-  std::vector<Camera> Cameras(const std::vector<CamState>& state) const {
-    std::vector<Camera> cams;
+  std::vector<camera::Camera> Cameras(const std::vector<CamState>& state) const {
+    std::vector<camera::Camera> cams;
     for (size_t k = 0; k < state.size(); ++k) {
       const Eigen::Vector3d eye = mounts_[state[k].place].At(state[k].t);
       const Eigen::Vector3d target(state[k].aim.x(), state[k].aim.y(), options_.aim_height_m);
-      Camera c = model_;
+      camera::Camera c = model_;
       c.name = fmt::format("cam{}", k + 1);
-      c.cam_from_world = Rigid3d::LookAt(eye, target);
+      c.cam_from_world = geometry::Rigid3d::LookAt(eye, target);
       c.has_pose = true;
       cams.push_back(std::move(c));
     }
@@ -91,7 +92,7 @@ class Search {
     return s;
   }
 
-  std::vector<CamState> RandomStart(Rng& rng) const {
+  std::vector<CamState> RandomStart(util::Rng& rng) const {
     std::vector<CamState> s(options_.num_cameras);
     for (auto& c : s) {
       c.place = rng.UniformInt(0, static_cast<int>(mounts_.size()) - 1);
@@ -102,7 +103,7 @@ class Search {
     return s;
   }
 
-  void Move(std::vector<CamState>& s, Rng& rng, double shrink) const {
+  void Move(std::vector<CamState>& s, util::Rng& rng, double shrink) const {
     CamState& c = s[rng.UniformInt(0, static_cast<int>(s.size()) - 1)];
     const double u = rng.Uniform();
     const bool move_place = u < 0.55, move_aim = u >= 0.45;
@@ -129,9 +130,9 @@ class Search {
   int evaluations() const { return evaluations_; }
 
  private:
-  const FieldModel& field_;
+  const field::FieldModel& field_;
   const std::vector<MountPlace>& mounts_;
-  const Camera& model_;
+  const camera::Camera& model_;
   CoverageOptions coverage_;
   const OptimizeOptions& options_;
   int evaluations_ = 0;
@@ -139,7 +140,8 @@ class Search {
 
 }  // namespace
 
-std::vector<MountPlace> PerimeterMounts(const FieldModel& field, double offset_m, double height_m) {
+std::vector<MountPlace> PerimeterMounts(const field::FieldModel& field, double offset_m,
+                                        double height_m) {
   FV_REQUIRE(std::isfinite(offset_m) && offset_m >= 0, "perimeter offset must be >= 0 (got {})",
              offset_m);
   FV_REQUIRE(std::isfinite(height_m) && height_m > 0, "mount height must be > 0 (got {})",
@@ -206,7 +208,7 @@ void OptimizeOptions::Check() const {
   CheckFinite(aim_height_m, "aim_height_m");
 }
 
-double RigScore(const std::vector<Camera>& cameras, const FieldModel& field,
+double RigScore(const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
                 const CoverageOptions& coverage, double grid_step_m) {
   CoverageOptions o = coverage;
   o.grid_step_m = grid_step_m;
@@ -215,8 +217,8 @@ double RigScore(const std::vector<Camera>& cameras, const FieldModel& field,
   return EvaluateCoverage(cameras, field, o).score();
 }
 
-OptimizeResult OptimizeRig(const FieldModel& field, const std::vector<MountPlace>& mounts,
-                           const Camera& model, const CoverageOptions& coverage,
+OptimizeResult OptimizeRig(const field::FieldModel& field, const std::vector<MountPlace>& mounts,
+                           const camera::Camera& model, const CoverageOptions& coverage,
                            const OptimizeOptions& options) {
   options.Check();
   coverage.Check();
@@ -224,17 +226,17 @@ OptimizeResult OptimizeRig(const FieldModel& field, const std::vector<MountPlace
   for (const auto& m : mounts) {
     FV_REQUIRE(m.a.allFinite() && m.b.allFinite(), "optimize: mount '{}' is not finite", m.name);
   }
-  Camera cam_model = model;
+  camera::Camera cam_model = model;
   cam_model.has_pose = false;
   cam_model.Check("optimize: camera model");
   const auto start_time = std::chrono::steady_clock::now();
   Search search(field, mounts, cam_model, coverage, options);
-  Rng rng(options.seed);
+  util::Rng rng(options.seed);
   OptimizeResult result;
   std::vector<CamState> best;
   double best_score = -1e300;
-  Progress progress("optimize", static_cast<long long>(options.restarts) * options.iterations,
-                    "steps", options.progress);
+  util::Progress progress("optimize", static_cast<long long>(options.restarts) * options.iterations,
+                          "steps", options.progress);
   for (int r = 0; r < options.restarts; ++r) {
     std::vector<CamState> current = r == 0 ? search.EvenStart() : search.RandomStart(rng);
     double current_score = search.Score(current);
@@ -277,7 +279,7 @@ std::string OptimizeResult::Summary() const {
       "optimized {} cameras: score {:.4f} on the search grid (evenly spread start {:.4f}), {} "
       "evaluations in {:.1f} s\n",
       rig.cameras.size(), score, start_score, evaluations, seconds);
-  for (const Camera& c : rig.cameras) {
+  for (const camera::Camera& c : rig.cameras) {
     const Eigen::Vector3d p = c.CentreInWorld();
     const Eigen::Vector3d axis = c.cam_from_world.rotation.row(2).transpose();
     Eigen::Vector3d aim = p + 10 * axis;

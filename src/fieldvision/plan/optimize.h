@@ -31,7 +31,8 @@ struct MountPlace {
 };
 
 // The rectangle `offset_m` outside the field's lines at `height_m`: its 4 sides, corners included.
-std::vector<MountPlace> PerimeterMounts(const FieldModel& field, double offset_m, double height_m);
+std::vector<MountPlace> PerimeterMounts(const field::FieldModel& field, double offset_m,
+                                        double height_m);
 // {"mounts": [{"name": ..., "point": [x, y, z]} | {"name": ..., "line": [[x, y, z], [x, y, z]]}]}
 std::vector<MountPlace> MountsFromJson(const nlohmann::json& j, const std::string& context);
 std::vector<MountPlace> ReadMountsJson(const std::string& path);
@@ -61,12 +62,12 @@ struct OptimizeResult {
 };
 
 // `model` gives the cameras' image size and intrinsics (its pose is ignored).
-OptimizeResult OptimizeRig(const FieldModel& field, const std::vector<MountPlace>& mounts,
-                           const Camera& model, const CoverageOptions& coverage,
+OptimizeResult OptimizeRig(const field::FieldModel& field, const std::vector<MountPlace>& mounts,
+                           const camera::Camera& model, const CoverageOptions& coverage,
                            const OptimizeOptions& options);
 
 // The score of `cameras` with the coverage options on a grid of `grid_step_m`, one layer.
-double RigScore(const std::vector<Camera>& cameras, const FieldModel& field,
+double RigScore(const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
                 const CoverageOptions& coverage, double grid_step_m);
 
 }  // namespace fv::plan

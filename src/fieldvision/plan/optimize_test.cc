@@ -12,8 +12,8 @@ namespace {
 
 // The seed's reference rig: 4 cameras 1 m outside the corners of the 18 x 12 m field, 4 m high,
 // aimed at the centre, 1280 x 960 with 80 degrees horizontal field of view.
-std::vector<Camera> CornerRig() {
-  std::vector<Camera> cams;
+std::vector<camera::Camera> CornerRig() {
+  std::vector<camera::Camera> cams;
   for (const auto& [x, y] : {std::pair{-10.0, -7.0}, {10.0, -7.0}, {10.0, 7.0}, {-10.0, 7.0}}) {
     cams.push_back(MakeAimedCamera("corner", 1280, 960, 80, {x, y, 4}, {0, 0, 0}));
   }
@@ -21,7 +21,7 @@ std::vector<Camera> CornerRig() {
 }
 
 TEST(OptimizeTest, PerimeterMountsEncloseTheField) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const auto mounts = PerimeterMounts(field, 1.0, 4.0);
   ASSERT_EQ(mounts.size(), 4u);
   double total = 0;
@@ -36,14 +36,14 @@ TEST(OptimizeTest, PerimeterMountsEncloseTheField) {
 TEST(OptimizeTest, FindsARigAtLeastAsGoodAsTheCornerRig) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   CoverageOptions coverage;
   OptimizeOptions o;
   o.seed = seed;
   o.grid_step_m = 1.0;  // coarse so the test stays fast
   o.iterations = 600;
   o.restarts = 1;
-  const Camera model = Camera::FromFov(1280, 960, 80);
+  const camera::Camera model = camera::Camera::FromFov(1280, 960, 80);
   const OptimizeResult r = OptimizeRig(field, PerimeterMounts(field, 1.0, 4.0), model, coverage, o);
   const double corner = RigScore(CornerRig(), field, coverage, o.grid_step_m);
   EXPECT_GE(r.score, corner) << r.Summary();
@@ -51,7 +51,7 @@ TEST(OptimizeTest, FindsARigAtLeastAsGoodAsTheCornerRig) {
   // The reported score is the rig's score, and the cameras stay on the perimeter at 4 m.
   EXPECT_NEAR(RigScore(r.rig.cameras, field, coverage, o.grid_step_m), r.score, 1e-12);
   ASSERT_EQ(r.rig.cameras.size(), 4u);
-  for (const Camera& c : r.rig.cameras) {
+  for (const camera::Camera& c : r.rig.cameras) {
     const Eigen::Vector3d p = c.CentreInWorld();
     EXPECT_NEAR(p.z(), 4.0, 1e-9);
     EXPECT_NEAR(std::max(std::abs(p.x()) - 10.0, std::abs(p.y()) - 7.0), 0.0, 1e-9);
@@ -63,7 +63,7 @@ TEST(OptimizeTest, FindsARigAtLeastAsGoodAsTheCornerRig) {
 }
 
 TEST(OptimizeTest, PointMountsAndBadOptions) {
-  const FieldModel field = BuiltinField("robocup-msl");
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   const nlohmann::json j = {
       {"mounts", {{{"name", "pole"}, {"point", {-10, 0, 6}}}, {{"point", {10, 0, 6}}}}}};
   const auto mounts = MountsFromJson(j, "m.json");
@@ -75,9 +75,9 @@ TEST(OptimizeTest, PointMountsAndBadOptions) {
   o.iterations = 50;
   o.restarts = 1;
   const OptimizeResult r =
-      OptimizeRig(field, mounts, Camera::FromFov(1280, 960, 90), CoverageOptions(), o);
+      OptimizeRig(field, mounts, camera::Camera::FromFov(1280, 960, 90), CoverageOptions(), o);
   // Cameras can only stand on the two poles.
-  for (const Camera& c : r.rig.cameras) {
+  for (const camera::Camera& c : r.rig.cameras) {
     EXPECT_NEAR(std::abs(c.CentreInWorld().x()), 10.0, 1e-9);
     EXPECT_NEAR(c.CentreInWorld().z(), 6.0, 1e-9);
   }

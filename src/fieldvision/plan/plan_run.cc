@@ -67,7 +67,7 @@ std::optional<Rig> LoadGivenRig(const PlanRunOptions& options) {
   if (!given) return given;
   // A camera kilometres away sees nothing and would only stretch the maps.
   constexpr double kMaxDistanceM = 1e4;
-  for (const Camera& c : given->cameras) {
+  for (const camera::Camera& c : given->cameras) {
     const double d = c.CentreInWorld().norm();
     FV_REQUIRE(d <= kMaxDistanceM,
                "plan: camera '{}' of '{}' stands {:.3g} m from the field centre (at most {:.0f} "
@@ -83,16 +83,16 @@ std::string OutPath(const PlanRunOptions& options, const std::string& name) {
 
 // --optimize: searches a rig over the mounting places, scores a given rig the same way and
 // writes rig.json; returns the summary lines.
-std::string OptimizeStage(const PlanRunOptions& options, const FieldModel& field,
+std::string OptimizeStage(const PlanRunOptions& options, const field::FieldModel& field,
                           const std::optional<Rig>& given, PlanRunResult& result) {
   std::string summary;
   const std::vector<MountPlace> mounts =
       options.mounts_path.empty()
           ? PerimeterMounts(field, options.perimeter_offset_m, options.mount_height_m)
           : ReadMountsJson(options.mounts_path);
-  const Camera model =
+  const camera::Camera model =
       given ? given->cameras.front()
-            : Camera::FromFov(options.image_width, options.image_height, options.hfov_deg);
+            : camera::Camera::FromFov(options.image_width, options.image_height, options.hfov_deg);
   OptimizeResult opt = OptimizeRig(field, mounts, model, options.coverage, options.search);
   summary += opt.Summary();
   if (given) {
@@ -109,7 +109,7 @@ std::string OptimizeStage(const PlanRunOptions& options, const FieldModel& field
 }
 
 // The count, angle and error maps of every layer.
-void WriteCoverageMaps(const PlanRunOptions& options, const FieldModel& field,
+void WriteCoverageMaps(const PlanRunOptions& options, const field::FieldModel& field,
                        PlanRunResult& result) {
   const std::vector<std::pair<CoverageMapKind, std::string>> kinds = {
       {CoverageMapKind::kCount, "coverage"},
@@ -123,8 +123,8 @@ void WriteCoverageMaps(const PlanRunOptions& options, const FieldModel& field,
     }
     for (const auto& [kind, name] : kinds) {
       const std::string file = OutPath(options, name + (l == 0 ? "" : "_above") + ".png");
-      WriteImage(file, DrawCoverageMap(result.coverage.layers[l], kind, result.rig.cameras, field,
-                                       options.coverage, map));
+      io::WriteImage(file, DrawCoverageMap(result.coverage.layers[l], kind, result.rig.cameras,
+                                           field, options.coverage, map));
       result.files.push_back(file);
     }
   }
@@ -132,7 +132,7 @@ void WriteCoverageMaps(const PlanRunOptions& options, const FieldModel& field,
 
 }  // namespace
 
-json CoverageJson(const PlanRunResult& result, const FieldModel& field,
+json CoverageJson(const PlanRunResult& result, const field::FieldModel& field,
                   const PlanRunOptions& options) {
   const CoverageOptions& co = options.coverage;
   const CoverageLayer& ground = result.coverage.layers[0];
@@ -141,8 +141,9 @@ json CoverageJson(const PlanRunResult& result, const FieldModel& field,
   j["rig"] = result.rig.name;
   j["num_cameras"] = result.rig.cameras.size();
   j["cameras"] = json::array();
-  for (const Camera& c : result.rig.cameras) {
-    j["cameras"].push_back({{"name", c.name}, {"position", JsonFromVector(c.CentreInWorld())}});
+  for (const camera::Camera& c : result.rig.cameras) {
+    j["cameras"].push_back(
+        {{"name", c.name}, {"position", util::JsonFromVector(c.CentreInWorld())}});
   }
   j["options"] = {{"grid_step_m", co.grid_step_m},
                   {"include_surround", co.include_surround},
@@ -176,7 +177,7 @@ json CoverageJson(const PlanRunResult& result, const FieldModel& field,
 
 PlanRunResult RunPlan(const PlanRunOptions& options) {
   options.Check();
-  const FieldModel field = LoadField(options.field);
+  const field::FieldModel field = field::LoadField(options.field);
   CheckCoverageGrid(field, options.coverage);
   if (options.optimize) {
     CoverageOptions search_grid = options.coverage;

@@ -54,7 +54,7 @@ PlanRunResult RunPlan(const PlanRunOptions& options);
 
 // coverage.json: the rig, the options, the ball-height layer's figures at the top level, every
 // layer and, after a search, its scores.
-nlohmann::json CoverageJson(const PlanRunResult& result, const FieldModel& field,
+nlohmann::json CoverageJson(const PlanRunResult& result, const field::FieldModel& field,
                             const PlanRunOptions& options);
 
 }  // namespace fv::plan

@@ -73,7 +73,7 @@ TEST(PlanRunTest, OptimizeWritesARigThatReadsBack) {
   const Rig back = ReadRigJson(o.out_dir + "/rig.json");
   ASSERT_EQ(back.cameras.size(), 4u);
   CoverageOptions c = o.coverage;
-  EXPECT_NEAR(EvaluateCoverage(back.cameras, LoadField("robocup-msl"), c).score(),
+  EXPECT_NEAR(EvaluateCoverage(back.cameras, field::LoadField("robocup-msl"), c).score(),
               r.coverage.score(), 1e-9);
 }
 

@@ -24,7 +24,7 @@ const std::set<std::string> kCameraKeys = {"name",         "position", "look_at"
                                            "fy",           "cx",       "cy",       "distortion"};
 
 int PositiveInt(const json& obj, const std::string& key, const std::string& ctx) {
-  const int v = JsonInt(obj, key, ctx);
+  const int v = util::JsonInt(obj, key, ctx);
   FV_REQUIRE(v > 0 && v < 1000000, "{}: key '{}' must be a positive size (got {})", ctx, key, v);
   return v;
 }
@@ -51,42 +51,42 @@ json Merge(const json& defaults, const json& cam) {
   return merged;
 }
 
-Camera CameraFromJson(const json& j, const std::string& ctx) {
+camera::Camera CameraFromJson(const json& j, const std::string& ctx) {
   FV_REQUIRE(j.is_object(), "{}: must be an object", ctx);
   for (auto it = j.begin(); it != j.end(); ++it) {
     FV_REQUIRE(kCameraKeys.count(it.key()), "{}: unknown key '{}'", ctx, it.key());
   }
-  Camera cam;
+  camera::Camera cam;
   const int width = PositiveInt(j, "image_width", ctx);
   const int height = PositiveInt(j, "image_height", ctx);
   int num_focal = 0;
   for (const auto& k : {"hfov_deg", "focal_px", "fx"}) num_focal += j.contains(k) ? 1 : 0;
   FV_REQUIRE(num_focal == 1, "{}: give exactly one of 'hfov_deg', 'focal_px' or 'fx' + 'fy'", ctx);
   if (j.contains("hfov_deg")) {
-    const double hfov = JsonNumber(j, "hfov_deg", ctx);
+    const double hfov = util::JsonNumber(j, "hfov_deg", ctx);
     FV_REQUIRE(hfov > 0 && hfov < 180, "{}: key 'hfov_deg' must be in (0, 180) (got {})", ctx,
                hfov);
-    cam = Camera::FromFov(width, height, hfov);
+    cam = camera::Camera::FromFov(width, height, hfov);
   } else {
-    cam = Camera::FromFov(width, height, 90.0);
+    cam = camera::Camera::FromFov(width, height, 90.0);
     if (j.contains("focal_px")) {
-      cam.fx = cam.fy = JsonNumber(j, "focal_px", ctx);
+      cam.fx = cam.fy = util::JsonNumber(j, "focal_px", ctx);
     } else {
-      cam.fx = JsonNumber(j, "fx", ctx);
-      cam.fy = JsonNumber(j, "fy", ctx);
+      cam.fx = util::JsonNumber(j, "fx", ctx);
+      cam.fy = util::JsonNumber(j, "fy", ctx);
     }
     FV_REQUIRE(cam.fx > 0 && cam.fy > 0, "{}: focal length must be > 0", ctx);
   }
-  if (j.contains("cx")) cam.cx = JsonNumber(j, "cx", ctx);
-  if (j.contains("cy")) cam.cy = JsonNumber(j, "cy", ctx);
-  if (j.contains("distortion")) cam.distortion = JsonNumbers(j, "distortion", ctx);
-  cam.name = JsonString(j, "name", ctx, cam.name);
-  const Eigen::Vector3d eye = JsonVector<3>(j, "position", ctx);
+  if (j.contains("cx")) cam.cx = util::JsonNumber(j, "cx", ctx);
+  if (j.contains("cy")) cam.cy = util::JsonNumber(j, "cy", ctx);
+  if (j.contains("distortion")) cam.distortion = util::JsonNumbers(j, "distortion", ctx);
+  cam.name = util::JsonString(j, "name", ctx, cam.name);
+  const Eigen::Vector3d eye = util::JsonVector<3>(j, "position", ctx);
   // A position kilometres away is a typo (1e300 ended up at the origin of the pose arithmetic).
   FV_REQUIRE(eye.lpNorm<Eigen::Infinity>() <= 1e4,
              "{}: key 'position' must be within 10 km of the field centre (got {}, {}, {})", ctx,
              eye.x(), eye.y(), eye.z());
-  const double roll_deg = j.contains("roll_deg") ? JsonNumber(j, "roll_deg", ctx) : 0.0;
+  const double roll_deg = j.contains("roll_deg") ? util::JsonNumber(j, "roll_deg", ctx) : 0.0;
   int num_orient = 0;
   for (const auto& k : {"look_at", "yaw_deg", "rvec"}) num_orient += j.contains(k) ? 1 : 0;
   FV_REQUIRE(num_orient == 1,
@@ -94,21 +94,22 @@ Camera CameraFromJson(const json& j, const std::string& ctx) {
   Eigen::Vector3d target;
   if (j.contains("rvec")) {
     FV_REQUIRE(!j.contains("roll_deg"), "{}: 'roll_deg' cannot be combined with 'rvec'", ctx);
-    const Eigen::Vector3d rvec = JsonVector<3>(j, "rvec", ctx);
-    const Eigen::Matrix3d rot = RotationFromRvec(rvec);
-    cam.cam_from_world = Rigid3d{rot, -rot * eye};
+    const Eigen::Vector3d rvec = util::JsonVector<3>(j, "rvec", ctx);
+    const Eigen::Matrix3d rot = geometry::RotationFromRvec(rvec);
+    cam.cam_from_world = geometry::Rigid3d{rot, -rot * eye};
     cam.has_pose = true;
   } else {
     if (j.contains("look_at")) {
-      target = JsonVector<3>(j, "look_at", ctx);
+      target = util::JsonVector<3>(j, "look_at", ctx);
       FV_REQUIRE((target - eye).norm() > 1e-6, "{}: 'look_at' equals 'position'", ctx);
     } else {
-      const double yaw = JsonNumber(j, "yaw_deg", ctx) * kDeg;
-      const double pitch = JsonNumber(j, "pitch_deg", ctx) * kDeg;
+      const double yaw = util::JsonNumber(j, "yaw_deg", ctx) * kDeg;
+      const double pitch = util::JsonNumber(j, "pitch_deg", ctx) * kDeg;
       target = eye + Eigen::Vector3d(std::cos(pitch) * std::cos(yaw),
                                      std::cos(pitch) * std::sin(yaw), -std::sin(pitch));
     }
-    const Camera aimed = MakeAimedCamera(cam.name, width, height, 90, eye, target, roll_deg);
+    const camera::Camera aimed =
+        MakeAimedCamera(cam.name, width, height, 90, eye, target, roll_deg);
     cam.cam_from_world = aimed.cam_from_world;
     cam.has_pose = true;
   }
@@ -121,7 +122,7 @@ Camera CameraFromJson(const json& j, const std::string& ctx) {
 void Rig::Check(const std::string& context) const {
   FV_REQUIRE(!cameras.empty(), "{}: the rig has no cameras", context);
   for (size_t i = 0; i < cameras.size(); ++i) {
-    const Camera& c = cameras[i];
+    const camera::Camera& c = cameras[i];
     const std::string ctx = c.name.empty() ? fmt::format("{}: camera {}", context, i)
                                            : fmt::format("{}: camera {} '{}'", context, i, c.name);
     c.Check(ctx);
@@ -130,12 +131,12 @@ void Rig::Check(const std::string& context) const {
   }
 }
 
-Camera MakeAimedCamera(const std::string& name, int width, int height, double hfov_deg,
-                       const Eigen::Vector3d& position_in_world,
-                       const Eigen::Vector3d& target_in_world, double roll_deg) {
-  Camera cam = Camera::FromFov(width, height, hfov_deg);
+camera::Camera MakeAimedCamera(const std::string& name, int width, int height, double hfov_deg,
+                               const Eigen::Vector3d& position_in_world,
+                               const Eigen::Vector3d& target_in_world, double roll_deg) {
+  camera::Camera cam = camera::Camera::FromFov(width, height, hfov_deg);
   cam.name = name;
-  Rigid3d pose = Rigid3d::LookAt(position_in_world, target_in_world);
+  geometry::Rigid3d pose = geometry::Rigid3d::LookAt(position_in_world, target_in_world);
   if (roll_deg != 0.0) {
     const Eigen::Matrix3d roll =
         Eigen::AngleAxisd(roll_deg * kDeg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -156,7 +157,7 @@ Rig RigFromJson(const json& j, const std::string& context, const std::string& ba
                context, it.key());
   }
   Rig rig;
-  rig.name = JsonString(j, "name", context, rig.name);
+  rig.name = util::JsonString(j, "name", context, rig.name);
   json defaults = json::object();
   if (j.contains("defaults")) {
     FV_REQUIRE(j["defaults"].is_object(), "{}: key 'defaults' must be an object", context);
@@ -172,7 +173,7 @@ Rig RigFromJson(const json& j, const std::string& context, const std::string& ba
       FV_REQUIRE(cams[i]["yaml"].is_string(), "{}: key 'yaml' must be a string", ctx);
       std::filesystem::path p(cams[i]["yaml"].get<std::string>());
       if (p.is_relative() && !base_dir.empty()) p = std::filesystem::path(base_dir) / p;
-      Camera cam = ReadCameraYaml(p.string());
+      camera::Camera cam = camera::ReadCameraYaml(p.string());
       FV_REQUIRE(cam.has_pose, "{}: camera file '{}' has no pose (rvec/tvec)", ctx, p.string());
       if (cams[i].contains("name") && cams[i]["name"].is_string()) {
         cam.name = cams[i]["name"].get<std::string>();
@@ -181,7 +182,7 @@ Rig RigFromJson(const json& j, const std::string& context, const std::string& ba
       rig.cameras.push_back(cam);
       continue;
     }
-    Camera cam = CameraFromJson(Merge(defaults, cams[i]), ctx);
+    camera::Camera cam = CameraFromJson(Merge(defaults, cams[i]), ctx);
     if (cam.name.empty()) cam.name = fmt::format("cam{}", i + 1);
     rig.cameras.push_back(cam);
   }
@@ -213,19 +214,19 @@ json RigToJson(const Rig& rig) {
   json j;
   j["name"] = rig.name;
   j["cameras"] = json::array();
-  for (const Camera& c : rig.cameras) {
+  for (const camera::Camera& c : rig.cameras) {
     json cj;
     cj["name"] = c.name;
     const Eigen::Vector3d eye = c.CentreInWorld();
-    cj["position"] = JsonFromVector(eye);
+    cj["position"] = util::JsonFromVector(eye);
     const Eigen::Vector3d axis = c.cam_from_world.rotation.row(2).transpose();
-    const Rigid3d look = Rigid3d::LookAt(eye, eye + axis);
-    if (RotationAngleBetween(look.rotation, c.cam_from_world.rotation) < 1e-9) {
+    const geometry::Rigid3d look = geometry::Rigid3d::LookAt(eye, eye + axis);
+    if (geometry::RotationAngleBetween(look.rotation, c.cam_from_world.rotation) < 1e-9) {
       Eigen::Vector3d target = eye + 10.0 * axis;
       if (axis.z() < -1e-6) target = eye + (-eye.z() / axis.z()) * axis;  // aim point on z = 0
-      cj["look_at"] = JsonFromVector(target);
+      cj["look_at"] = util::JsonFromVector(target);
     } else {
-      cj["rvec"] = JsonFromVector(c.cam_from_world.Rvec());
+      cj["rvec"] = util::JsonFromVector(c.cam_from_world.Rvec());
     }
     cj["image_width"] = c.width;
     cj["image_height"] = c.height;
@@ -256,7 +257,7 @@ Rig RigFromCameraFiles(const std::vector<std::string>& paths) {
   Rig rig;
   rig.name = "cameras";
   for (const auto& p : paths) {
-    Camera cam = ReadCameraYaml(p);
+    camera::Camera cam = camera::ReadCameraYaml(p);
     FV_REQUIRE(cam.has_pose, "camera file '{}' has no pose (rvec/tvec); plan needs posed cameras",
                p);
     if (cam.name.empty()) cam.name = std::filesystem::path(p).stem().string();

@@ -22,7 +22,7 @@ namespace fv::plan {
 
 struct Rig {
   std::string name;
-  std::vector<Camera> cameras;  // all with poses
+  std::vector<camera::Camera> cameras;  // all with poses
 
   // Throws fv::Error naming `context` and the bad camera: no cameras, no pose, NaN, bad intrinsics.
   void Check(const std::string& context = "rig") const;
@@ -30,9 +30,9 @@ struct Rig {
 
 // A camera of the given size and horizontal field of view at `position_in_world` looking at
 // `target_in_world` (image up towards +z), turned by `roll_deg` about its optical axis.
-Camera MakeAimedCamera(const std::string& name, int width, int height, double hfov_deg,
-                       const Eigen::Vector3d& position_in_world,
-                       const Eigen::Vector3d& target_in_world, double roll_deg = 0.0);
+camera::Camera MakeAimedCamera(const std::string& name, int width, int height, double hfov_deg,
+                               const Eigen::Vector3d& position_in_world,
+                               const Eigen::Vector3d& target_in_world, double roll_deg = 0.0);
 
 // `base_dir` resolves "yaml" paths; `context` (the file name) starts every error message.
 Rig RigFromJson(const nlohmann::json& j, const std::string& context, const std::string& base_dir);

@@ -40,7 +40,7 @@ json CornerCamera(double x, double y) {
 TEST(RigTest, ReadsLookAtYawPitchAndDefaults) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const Eigen::Vector3d eye(rng.Uniform(-12, 12), rng.Uniform(-8, 8), rng.Uniform(2, 8));
   const Eigen::Vector3d target(rng.Uniform(-5, 5), rng.Uniform(-3, 3), 0);
   const Eigen::Vector3d d = target - eye;
@@ -59,13 +59,14 @@ TEST(RigTest, ReadsLookAtYawPitchAndDefaults) {
                      {"focal_px", 1000.0}}}}};
   const Rig rig = RigFromJson(j, "rig", "");
   ASSERT_EQ(rig.cameras.size(), 2u);
-  const Camera& a = rig.cameras[0];
-  const Camera& b = rig.cameras[1];
+  const camera::Camera& a = rig.cameras[0];
+  const camera::Camera& b = rig.cameras[1];
   EXPECT_EQ(a.width, 1280);
   EXPECT_NEAR(a.fx, 640 / std::tan(40 * M_PI / 180), 1e-9);
   EXPECT_NEAR(b.fx, 1000.0, 1e-12);
   EXPECT_NEAR((a.CentreInWorld() - eye).norm(), 0, 1e-9);
-  EXPECT_LT(RotationAngleBetween(a.cam_from_world.rotation, b.cam_from_world.rotation), 1e-9);
+  EXPECT_LT(geometry::RotationAngleBetween(a.cam_from_world.rotation, b.cam_from_world.rotation),
+            1e-9);
   // The aim point projects to the principal point.
   const auto uv = a.Project(target);
   ASSERT_TRUE(uv.has_value());
@@ -76,7 +77,7 @@ TEST(RigTest, ReadsLookAtYawPitchAndDefaults) {
 TEST(RigTest, WriteReadRoundTripIncludingYamlCameras) {
   const uint64_t seed = fv::testing::TestSeed(4);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const std::string dir = fv::testing::TempDir();
   Rig rig;
   rig.name = "round trip";
@@ -90,18 +91,19 @@ TEST(RigTest, WriteReadRoundTripIncludingYamlCameras) {
   const Rig back = ReadRigJson(dir + "/rig.json");
   ASSERT_EQ(back.cameras.size(), 2u);
   for (size_t k = 0; k < 2; ++k) {
-    const Camera& x = rig.cameras[k];
-    const Camera& y = back.cameras[k];
+    const camera::Camera& x = rig.cameras[k];
+    const camera::Camera& y = back.cameras[k];
     EXPECT_EQ(x.name, y.name);
     EXPECT_EQ(x.width, y.width);
     EXPECT_NEAR(x.fx, y.fx, 1e-9);
     EXPECT_NEAR(x.cx, y.cx, 1e-9);
     EXPECT_EQ(x.distortion, y.distortion);
     EXPECT_NEAR((x.CentreInWorld() - y.CentreInWorld()).norm(), 0, 1e-9);
-    EXPECT_LT(RotationAngleBetween(x.cam_from_world.rotation, y.cam_from_world.rotation), 1e-9);
+    EXPECT_LT(geometry::RotationAngleBetween(x.cam_from_world.rotation, y.cam_from_world.rotation),
+              1e-9);
   }
   // A rig listing camera YAMLs, relative to the rig file.
-  WriteCameraYaml(rig.cameras[1], dir + "/cam.yaml");
+  camera::WriteCameraYaml(rig.cameras[1], dir + "/cam.yaml");
   std::ofstream(dir + "/yaml_rig.json") << json({{"cameras", {{{"yaml", "cam.yaml"}}}}}).dump();
   const Rig from_yaml = ReadRigJson(dir + "/yaml_rig.json");
   ASSERT_EQ(from_yaml.cameras.size(), 1u);
@@ -169,8 +171,8 @@ TEST(RigTest, BadInputGivesOneLineErrors) {
   rig.cameras.push_back(MakeAimedCamera("nan", 640, 480, 60, {1, 2, 3}, {0, 0, 0}));
   rig.cameras[0].cam_from_world.translation.x() = NAN;
   ExpectOneLineNaming(ErrorOf([&] { rig.Check("my rig"); }), {"my rig", "nan"});
-  Camera intrinsics_only = Camera::FromFov(640, 480, 60);
-  WriteCameraYaml(intrinsics_only, dir + "/intr.yaml");
+  camera::Camera intrinsics_only = camera::Camera::FromFov(640, 480, 60);
+  camera::WriteCameraYaml(intrinsics_only, dir + "/intr.yaml");
   ExpectOneLineNaming(ErrorOf([&] { RigFromCameraFiles({dir + "/intr.yaml"}); }),
                       {"intr.yaml", "no pose"});
 }

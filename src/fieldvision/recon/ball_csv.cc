@@ -6,7 +6,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 
 const std::vector<std::string>& BallCsvColumns() {
   static const std::vector<std::string> kColumns = {"frame", "time_s", "x_m",   "y_m",
@@ -14,7 +14,7 @@ const std::vector<std::string>& BallCsvColumns() {
   return kColumns;
 }
 
-BallSample ReadBallCsvRow(const CsvTable& t, size_t r) {
+BallSample ReadBallCsvRow(const util::CsvTable& t, size_t r) {
   BallSample s;
   if (t.Has("time_s")) s.time_s = t.GetDouble(r, "time_s");
   s.ball_in_world = {t.GetDouble(r, "x_m"), t.GetDouble(r, "y_m"), t.GetDouble(r, "z_m")};
@@ -24,7 +24,7 @@ BallSample ReadBallCsvRow(const CsvTable& t, size_t r) {
   return s;
 }
 
-void CheckBallTrackRanges(const CsvTable& table) {
+void CheckBallTrackRanges(const util::CsvTable& table) {
   constexpr double kMaxFrame = 1e8, kMaxPositionM = 1e4, kMaxTimeS = 1e11;
   for (size_t r = 0; r < table.rows(); ++r) {
     const BallSample s = ReadBallCsvRow(table, r);
@@ -46,7 +46,7 @@ void CheckBallTrackRanges(const CsvTable& table) {
 
 namespace {
 
-BallSample ReadTt3dRow(const CsvTable& t, size_t r) {
+BallSample ReadTt3dRow(const util::CsvTable& t, size_t r) {
   BallSample s;
   s.time_s = t.GetDouble(r, "Timestamp");
   s.ball_in_world = {t.GetDouble(r, "X"), t.GetDouble(r, "Y"), t.GetDouble(r, "Z")};
@@ -55,7 +55,7 @@ BallSample ReadTt3dRow(const CsvTable& t, size_t r) {
 
 }  // namespace
 
-BallTrackFile ParseBallTrack(const CsvTable& t) {
+BallTrackFile ParseBallTrack(const util::CsvTable& t) {
   BallTrackFile out;
   if (t.Has("time_s") || t.Has("x_m") || t.Has("frame")) {
     t.Require({"time_s", "x_m", "y_m", "z_m"});
@@ -103,11 +103,11 @@ BallTrackFile ParseBallTrack(const CsvTable& t) {
 }
 
 BallTrackFile ReadBallTrack(const std::string& path) {
-  return ParseBallTrack(CsvTable::Read(path));
+  return ParseBallTrack(util::CsvTable::Read(path));
 }
 
 void WriteBallTrack(const std::string& path, const std::vector<BallSample>& samples) {
-  CsvWriter w(path, BallCsvColumns());
+  util::CsvWriter w(path, BallCsvColumns());
   for (const auto& s : samples) {
     w << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y() << s.ball_in_world.z()
       << s.n_cams << s.err_px;
@@ -116,4 +116,4 @@ void WriteBallTrack(const std::string& path, const std::vector<BallSample>& samp
   w.Close();
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -9,7 +9,7 @@
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/util/csv.h"
 
-namespace fv {
+namespace fv::recon {
 
 // frame,time_s,x_m,y_m,z_m,n_cams,err_px
 const std::vector<std::string>& BallCsvColumns();
@@ -17,12 +17,12 @@ const std::vector<std::string>& BallCsvColumns();
 // Row r of a BALL.csv table: x_m, y_m, z_m and, where the table has the column, frame, time_s,
 // n_cams and err_px (BallSample's defaults otherwise). Throws fv::Error naming the file and line
 // for a cell that is not a number; finiteness is the caller's to check.
-BallSample ReadBallCsvRow(const CsvTable& table, size_t r);
+BallSample ReadBallCsvRow(const util::CsvTable& table, size_t r);
 
 // Every row of a ball track table (BALL.csv, truth) in the ranges of a real recording: frame
 // numbers in [0, 1e8], positions within 10 km, times finite and within 1e11 s (Unix time fits).
 // Throws fv::Error naming file:line and the column.
-void CheckBallTrackRanges(const CsvTable& table);
+void CheckBallTrackRanges(const util::CsvTable& table);
 
 struct BallTrackFile {
   std::vector<BallSample> samples;   // strictly increasing times
@@ -33,9 +33,9 @@ struct BallTrackFile {
 // A ball track for fitting flights: throws fv::Error naming the file when columns are missing, no
 // row is valid or most rows are out of time order; skips (and names) single bad rows (not
 // numbers, NaN, times not increasing, duplicates).
-BallTrackFile ParseBallTrack(const CsvTable& table);
+BallTrackFile ParseBallTrack(const util::CsvTable& table);
 BallTrackFile ReadBallTrack(const std::string& path);
 // Writes BALL.csv (BallCsvColumns()).
 void WriteBallTrack(const std::string& path, const std::vector<BallSample>& samples);
 
-}  // namespace fv
+}  // namespace fv::recon

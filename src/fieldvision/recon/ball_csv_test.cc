@@ -5,11 +5,11 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(BallCsv, RowReadsTheColumnsTheTableHas) {
-  const CsvTable full = CsvTable::Parse(
+  const util::CsvTable full = util::CsvTable::Parse(
       "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n7,0.28,1.5,-2,0.11,3,0.75\n", "BALL.csv");
   const BallSample s = ReadBallCsvRow(full, 0);
   EXPECT_EQ(s.frame, 7);
@@ -18,13 +18,14 @@ TEST(BallCsv, RowReadsTheColumnsTheTableHas) {
   EXPECT_EQ(s.n_cams, 3);
   EXPECT_DOUBLE_EQ(s.err_px, 0.75);
   // A truth file with only frame and position: the rest keeps BallSample's defaults.
-  const BallSample t = ReadBallCsvRow(CsvTable::Parse("x_m,frame,z_m,y_m\n1,4,3,2\n", "t.csv"), 0);
+  const BallSample t =
+      ReadBallCsvRow(util::CsvTable::Parse("x_m,frame,z_m,y_m\n1,4,3,2\n", "t.csv"), 0);
   EXPECT_EQ(t.frame, 4);
   EXPECT_EQ(t.ball_in_world, Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(t.n_cams, BallSample().n_cams);
   EXPECT_EQ(t.time_s, BallSample().time_s);
   try {
-    ReadBallCsvRow(CsvTable::Parse("frame,x_m,y_m,z_m\n1,1,abc,3\n", "b.csv"), 0);
+    ReadBallCsvRow(util::CsvTable::Parse("frame,x_m,y_m,z_m\n1,1,abc,3\n", "b.csv"), 0);
     ADD_FAILURE() << "a cell that is not a number must throw";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("b.csv"), std::string::npos) << e.what();
@@ -42,7 +43,7 @@ TEST(BallCsv, WrittenTrackReadsBack) {
   }
   const std::string path = testing::TempDir() + "/ball_csv_roundtrip.csv";
   WriteBallTrack(path, samples);
-  const CsvTable table = CsvTable::Read(path);
+  const util::CsvTable table = util::CsvTable::Read(path);
   for (const auto& c : BallCsvColumns()) EXPECT_TRUE(table.Has(c)) << c;
   const BallTrackFile back = ReadBallTrack(path);
   EXPECT_EQ(back.layout, "ball");
@@ -57,4 +58,4 @@ TEST(BallCsv, WrittenTrackReadsBack) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -10,12 +10,12 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 // A truth or estimate file by frame (BALL.csv columns; frame and x_m, y_m, z_m required); n_cams
 // is -1 when the file has no such column.
-std::map<long long, BallSample> ReadTrack(const CsvTable& t) {
+std::map<long long, BallSample> ReadTrack(const util::CsvTable& t) {
   t.Require({"frame", "x_m", "y_m", "z_m"});
   std::map<long long, BallSample> out;
   for (size_t r = 0; r < t.rows(); ++r) {
@@ -36,7 +36,7 @@ void BallEvalOptions::Check() const {
   CheckPositive(outlier_m, "BallEvalOptions.outlier_m");
 }
 
-BallEvalResult EvaluateBall(const CsvTable& truth_table, const CsvTable& est_table,
+BallEvalResult EvaluateBall(const util::CsvTable& truth_table, const util::CsvTable& est_table,
                             const BallEvalOptions& options) {
   options.Check();
   const auto truth = ReadTrack(truth_table);
@@ -68,9 +68,9 @@ BallEvalResult EvaluateBall(const CsvTable& truth_table, const CsvTable& est_tab
     if (!truth.count(frame)) ++r.estimates_without_truth;
   }
   if (!errs.empty()) {
-    r.mean_mm = Mean(errs);
-    r.median_mm = Percentile(errs, 0.5);
-    r.p95_mm = Percentile(errs, 0.95);
+    r.mean_mm = util::Mean(errs);
+    r.median_mm = util::Percentile(errs, 0.5);
+    r.p95_mm = util::Percentile(errs, 0.95);
     r.max_mm = *std::max_element(errs.begin(), errs.end());
   }
   return r;
@@ -78,7 +78,7 @@ BallEvalResult EvaluateBall(const CsvTable& truth_table, const CsvTable& est_tab
 
 BallEvalResult EvaluateBallFiles(const std::string& truth_csv, const std::string& est_csv,
                                  const BallEvalOptions& options) {
-  return EvaluateBall(CsvTable::Read(truth_csv), CsvTable::Read(est_csv), options);
+  return EvaluateBall(util::CsvTable::Read(truth_csv), util::CsvTable::Read(est_csv), options);
 }
 
 std::string BallEvalResult::Table(bool per_row) const {
@@ -110,4 +110,4 @@ std::string BallEvalResult::Table(bool per_row) const {
   return s;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -11,7 +11,7 @@
 
 #include "fieldvision/util/csv.h"
 
-namespace fv {
+namespace fv::recon {
 
 struct BallEvalOptions {
   int min_truth_cams = 2;  // truth frames that count for the found rate (truth n_cams >= this)
@@ -50,9 +50,9 @@ struct BallEvalResult {
 // Truth needs frame,x_m,y_m,z_m (time_s and n_cams optional); the estimate frame,x_m,y_m,z_m
 // (time_s, n_cams optional). Throws fv::Error naming the file and line for missing columns,
 // non-finite values or a frame listed twice.
-BallEvalResult EvaluateBall(const CsvTable& truth, const CsvTable& est,
+BallEvalResult EvaluateBall(const util::CsvTable& truth, const util::CsvTable& est,
                             const BallEvalOptions& options = {});
 BallEvalResult EvaluateBallFiles(const std::string& truth_csv, const std::string& est_csv,
                                  const BallEvalOptions& options = {});
 
-}  // namespace fv
+}  // namespace fv::recon

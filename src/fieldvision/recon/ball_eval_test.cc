@@ -8,13 +8,13 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(BallEval, MatchesByFrameAndSummarises) {
   const uint64_t seed = testing::TestSeed(31);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   std::string truth = "frame,time_s,x_m,y_m,z_m,n_cams\n";
   std::string est = "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n";
   std::vector<double> errs;
@@ -30,8 +30,8 @@ TEST(BallEval, MatchesByFrameAndSummarises) {
     errs.push_back(1000 * e);
   }
   est += "99,1.65,0,0,0,2,0.1\n";  // no truth for this frame
-  const BallEvalResult r =
-      EvaluateBall(CsvTable::Parse(truth, "truth.csv"), CsvTable::Parse(est, "ball.csv"));
+  const BallEvalResult r = EvaluateBall(util::CsvTable::Parse(truth, "truth.csv"),
+                                        util::CsvTable::Parse(est, "ball.csv"));
   EXPECT_EQ(r.truth_frames, 50);
   EXPECT_EQ(r.visible_frames, 45);
   EXPECT_EQ(r.visible_found, 43);
@@ -51,23 +51,24 @@ TEST(BallEval, MatchesByFrameAndSummarises) {
 }
 
 TEST(BallEval, BadFilesNameTheLine) {
-  const CsvTable truth = CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n", "truth.csv");
+  const util::CsvTable truth = util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n", "truth.csv");
   try {
-    EvaluateBall(truth, CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n0,1,2,3\n", "ball.csv"));
+    EvaluateBall(truth, util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n0,1,2,3\n", "ball.csv"));
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("ball.csv:3"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(EvaluateBall(truth, CsvTable::Parse("frame,x_m,y_m,z_m\n0,nan,2,3\n", "b.csv")),
+  EXPECT_THROW(
+      EvaluateBall(truth, util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,nan,2,3\n", "b.csv")), Error);
+  EXPECT_THROW(EvaluateBall(truth, util::CsvTable::Parse("frame,x_m,y_m\n0,1,2\n", "b.csv")),
                Error);
-  EXPECT_THROW(EvaluateBall(truth, CsvTable::Parse("frame,x_m,y_m\n0,1,2\n", "b.csv")), Error);
   EXPECT_THROW(EvaluateBallFiles("/nonexistent/truth.csv", "/nonexistent/b.csv"), Error);
 }
 
 TEST(BallEval, NothingMatchedReportsNoError) {
   const BallEvalResult r =
-      EvaluateBall(CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n1,1,2,3\n", "truth.csv"),
-                   CsvTable::Parse("frame,x_m,y_m,z_m\n5,1,2,3\n", "ball.csv"));
+      EvaluateBall(util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n1,1,2,3\n", "truth.csv"),
+                   util::CsvTable::Parse("frame,x_m,y_m,z_m\n5,1,2,3\n", "ball.csv"));
   EXPECT_TRUE(r.rows.empty());
   const std::string table = r.Table(false);
   EXPECT_EQ(table.find("mean"), std::string::npos) << table;
@@ -75,4 +76,4 @@ TEST(BallEval, NothingMatchedReportsNoError) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

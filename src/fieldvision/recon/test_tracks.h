@@ -10,11 +10,12 @@
 #include "fieldvision/synth/ball_physics.h"
 #include "fieldvision/util/random.h"
 
-namespace fv::recon_testing {
+namespace fv::recon::test_util {
 
 // Frames 0..num_frames-1 at time frame / fps; each position noisy by N(0, sigma_m) per axis.
 inline std::vector<BallSample> NoisyTrack(const synth::BallTrajectory& trajectory, int num_frames,
-                                          double fps, double sigma_m, Rng& rng, int n_cams = 0) {
+                                          double fps, double sigma_m, util::Rng& rng,
+                                          int n_cams = 0) {
   std::vector<BallSample> track;
   for (int f = 0; f < num_frames; ++f) {
     BallSample s;
@@ -29,4 +30,4 @@ inline std::vector<BallSample> NoisyTrack(const synth::BallTrajectory& trajector
   return track;
 }
 
-}  // namespace fv::recon_testing
+}  // namespace fv::recon::test_util

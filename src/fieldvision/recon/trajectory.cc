@@ -15,7 +15,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 // The model's Magnus vector s = c_M w.
@@ -309,7 +309,7 @@ double EstimateTrackNoise(const std::vector<BallSample>& track, double g) {
     for (int a = 0; a < 3; ++a) e.push_back(std::abs(d[a]) / w);
   }
   if (e.empty()) return 0.01;
-  return std::max(1e-3, kMadToSigma * NearestRankPercentile(e, 0.5));
+  return std::max(1e-3, util::kMadToSigma * util::NearestRankPercentile(e, 0.5));
 }
 
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
@@ -348,7 +348,8 @@ void ScoreFit(const std::vector<BallSample>& samples, double t_ref,
   }
   for (double x : r) ss += x * x;
   fit.rmse_m = std::sqrt(ss / n);
-  const double robust_sigma = kMadToSigma * NearestRankPercentile(r, 0.5) / std::sqrt(3.0);
+  const double robust_sigma =
+      util::kMadToSigma * util::NearestRankPercentile(r, 0.5) / std::sqrt(3.0);
   const double thr =
       std::max(options.outlier_sigmas * std::max(noise_m, robust_sigma), options.min_outlier_m);
   for (int i = 0; i < n; ++i) {
@@ -1065,7 +1066,7 @@ std::optional<FittedPiece> FitPiece(const std::vector<BallSample>& track,
 
 }  // namespace
 
-namespace trajectory_detail {
+namespace detail {
 
 void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOptions& options,
                      double noise_m, std::vector<Flight>* flights,
@@ -1171,12 +1172,12 @@ void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool
   std::sort(f->samples.begin(), f->samples.end());
 }
 
-}  // namespace trajectory_detail
+}  // namespace detail
 
-using trajectory_detail::AttachOutliers;
-using trajectory_detail::MergeBounces;
-using trajectory_detail::PlaceEndpoints;
-using trajectory_detail::ResolveContacts;
+using detail::AttachOutliers;
+using detail::MergeBounces;
+using detail::PlaceEndpoints;
+using detail::ResolveContacts;
 
 TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
                                    const TrajectoryOptions& options) {
@@ -1225,4 +1226,4 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
   return res;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 
-namespace fv {
+namespace fv::recon {
 
 // One 3D ball position (a row of BALL.csv).
 struct BallSample {
@@ -255,4 +255,4 @@ PlaneQuadraticFit FitPlaneQuadratic(const std::vector<BallSample>& samples,
 TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
                                    const TrajectoryOptions& options);
 
-}  // namespace fv
+}  // namespace fv::recon

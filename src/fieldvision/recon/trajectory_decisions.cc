@@ -10,7 +10,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 // Signed distance of p to the rectangle |x| <= hx, |y| <= hy: > 0 inside.
@@ -167,17 +167,18 @@ void AddFlightEvents(const TrajectoryResult& result, std::vector<TimelineEvent>*
 }
 
 // "auto": tennis or basketball when the field's name says so, else football.
-std::string ResolveRule(const std::string& rule, const FieldModel& field) {
+std::string ResolveRule(const std::string& rule, const field::FieldModel& field) {
   if (rule != "auto") return rule;
-  const std::string n = ToLower(field.name);
+  const std::string n = util::ToLower(field.name);
   return n.find("tennis") != std::string::npos       ? "tennis"
          : n.find("basketball") != std::string::npos ? "basketball"
                                                      : "football";
 }
 
 // In/out of each landing against the playing area under `rule`, and touches of each named line.
-std::vector<LandingCall> CallLandings(const TrajectoryResult& result, const FieldModel& field,
-                                      const std::string& rule, double r, const DecisionOptions& d) {
+std::vector<LandingCall> CallLandings(const TrajectoryResult& result,
+                                      const field::FieldModel& field, const std::string& rule,
+                                      double r, const DecisionOptions& d) {
   std::vector<LandingCall> landings;
   for (const auto& f : result.flights) {
     LandingCall c;
@@ -199,7 +200,7 @@ std::vector<LandingCall> CallLandings(const TrajectoryResult& result, const Fiel
       double gap = 1e9;
       for (const auto& s : field.segments) {
         if (s.name != name) continue;
-        gap = std::min(gap, DistanceToSegment(c.point_m, s.a, s.b) - 0.5 * s.width_m);
+        gap = std::min(gap, field::DistanceToSegment(c.point_m, s.a, s.b) - 0.5 * s.width_m);
       }
       LandingCall lc = c;
       lc.against = name;
@@ -215,7 +216,7 @@ std::vector<LandingCall> CallLandings(const TrajectoryResult& result, const Fiel
 // Walks the ball's path in time steps: goal-line crossings (the whole ball beyond the line between
 // the posts and under the bar) and shots down through a hoop.
 void ScanGoalsAndShots(const std::vector<BallSample>& track, const TrajectoryResult& result,
-                       const FieldModel& field, double r, const DecisionOptions& d,
+                       const field::FieldModel& field, double r, const DecisionOptions& d,
                        Decisions* out) {
   // Scan the ball's path for goal-line crossings and made shots.
   if (!track.empty() && (!field.goals.empty() || !field.hoops.empty())) {
@@ -227,7 +228,7 @@ void ScanGoalsAndShots(const std::vector<BallSample>& track, const TrajectoryRes
       int fl = -1;
       const Eigen::Vector3d p = path.At(t, &fl);
       for (size_t g = 0; g < field.goals.size(); ++g) {
-        const FieldGoal& goal = field.goals[g];
+        const field::FieldGoal& goal = field.goals[g];
         const bool beyond = goal.side * (p.x() - goal.line_x_m) > 0.5 * field.line_width_m + r;
         const bool inside = beyond && p.y() >= goal.y_min_m && p.y() <= goal.y_max_m &&
                             p.z() <= goal.height_m && p.z() >= -r;
@@ -262,7 +263,7 @@ void ScanGoalsAndShots(const std::vector<BallSample>& track, const TrajectoryRes
 }  // namespace
 
 Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryResult& result,
-                        const FieldModel* field, const TrajectoryOptions& o,
+                        const field::FieldModel* field, const TrajectoryOptions& o,
                         const DecisionOptions& d) {
   d.Check();
   Decisions out;
@@ -331,4 +332,4 @@ nlohmann::json Decisions::ToJson() const {
   return j;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

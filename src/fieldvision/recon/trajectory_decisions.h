@@ -15,7 +15,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/recon/trajectory.h"
 
-namespace fv {
+namespace fv::recon {
 
 struct DecisionOptions {
   std::string rule = "auto";       // auto (from the field's name), football, tennis, basketball
@@ -71,7 +71,7 @@ Eigen::Vector3d BallPathAt(const std::vector<BallSample>& track, const Trajector
 
 // Calls for a track; with an empty field (no length) only the timeline of kicks and bounces.
 Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryResult& result,
-                        const FieldModel* field, const TrajectoryOptions& options,
+                        const field::FieldModel* field, const TrajectoryOptions& options,
                         const DecisionOptions& decision_options);
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -9,7 +9,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 struct Scene {
@@ -17,7 +17,7 @@ struct Scene {
   TrajectoryResult result;
 };
 
-Scene RunScene(const BallSimulation& sim, const TrajectoryOptions& to, Rng& rng) {
+Scene RunScene(const BallSimulation& sim, const TrajectoryOptions& to, util::Rng& rng) {
   Scene s;
   s.track = sim.Sample(50.0, 0.005, 0.0, 0.0, 0.0, rng);
   s.result = AnalyzeTrajectory(s.track, to);
@@ -27,10 +27,10 @@ Scene RunScene(const BallSimulation& sim, const TrajectoryOptions& to, Rng& rng)
 TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
   const uint64_t seed = testing::TestSeed(31);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   ASSERT_FALSE(field.goals.empty());
-  const FieldGoal* right = nullptr;
+  const field::FieldGoal* right = nullptr;
   for (const auto& g : field.goals)
     if (g.side > 0) right = &g;
   ASSERT_NE(right, nullptr);
@@ -71,8 +71,8 @@ TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
 TEST(TrajectoryDecisions, InOrOutOfTheTouchLineByTheBallsFootprint) {
   const uint64_t seed = testing::TestSeed(33);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("robocup-msl");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
   TrajectoryOptions to;
   int checked = 0;
   for (int trial = 0; trial < 6; ++trial) {
@@ -108,10 +108,10 @@ TEST(TrajectoryDecisions, InOrOutOfTheTouchLineByTheBallsFootprint) {
 TEST(TrajectoryDecisions, MadeShotPassesDownThroughTheRing) {
   const uint64_t seed = testing::TestSeed(35);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const FieldModel field = BuiltinField("basketball-fiba");
+  util::Rng rng(seed);
+  const field::FieldModel field = field::BuiltinField("basketball-fiba");
   ASSERT_FALSE(field.hoops.empty());
-  const FieldHoop& hoop = field.hoops.front();
+  const field::FieldHoop& hoop = field.hoops.front();
   TrajectoryOptions to;
   to.ball_radius_m = 0.12;
   for (const double miss : {0.0, 0.45}) {
@@ -143,4 +143,4 @@ TEST(TrajectoryDecisions, MadeShotPassesDownThroughTheRing) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

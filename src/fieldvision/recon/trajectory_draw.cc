@@ -10,7 +10,7 @@
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 const cv::Scalar kWhite(255, 255, 255), kBlack(0, 0, 0), kGrey(150, 150, 150);
@@ -245,8 +245,8 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
   return img;
 }
 
-FieldModel RotateFieldQuarter(const FieldModel& f) {
-  FieldModel r = f;
+field::FieldModel RotateFieldQuarter(const field::FieldModel& f) {
+  field::FieldModel r = f;
   auto rot = [](const Eigen::Vector2d& p) { return Eigen::Vector2d(-p.y(), p.x()); };
   std::swap(r.length_m, r.width_m);
   for (auto& sgm : r.segments) sgm.a = rot(sgm.a), sgm.b = rot(sgm.b);
@@ -270,8 +270,8 @@ FieldModel RotateFieldQuarter(const FieldModel& f) {
 }
 
 cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryResult& result,
-                       const FieldModel* field, const Decisions* decisions, int width_px) {
-  TopView view;
+                       const field::FieldModel* field, const Decisions* decisions, int width_px) {
+  field::TopView view;
   cv::Mat img;
   double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
   auto grow = [&](const Eigen::Vector3d& p) {
@@ -286,10 +286,10 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
     const double ex =
         std::max({0.0, x1 - field->HalfLengthWithSurround(), -x0 - field->HalfLengthWithSurround(),
                   y1 - field->HalfWidthWithSurround(), -y0 - field->HalfWidthWithSurround()});
-    view = TopView::ForField(*field, width_px, std::min(ex + 0.2, 50.0));
-    FieldDrawOptions fo;
+    view = field::TopView::ForField(*field, width_px, std::min(ex + 0.2, 50.0));
+    field::FieldDrawOptions fo;
     fo.keypoints = false;
-    img = DrawField(*field, view, fo);
+    img = field::DrawField(*field, view, fo);
     // A table-tennis net across the middle (x = 0).
     for (const auto& k : field->keypoints) {
       if (k.name == "net_post_top") {
@@ -383,4 +383,4 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -16,7 +16,7 @@
 #include "fieldvision/recon/trajectory_decisions.h"
 #include "fieldvision/recon/trajectory_predict.h"
 
-namespace fv {
+namespace fv::recon {
 
 cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryResult& result,
                        const Flight& flight, const TrajectoryOptions& options,
@@ -28,9 +28,10 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
 // field may be null (a plain grid around the track). Axes in metres, scale bar, legend; the
 // extrapolated parts of flights thin and their origins and landings hollow.
 cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryResult& result,
-                       const FieldModel* field, const Decisions* decisions, int width_px = 1400);
+                       const field::FieldModel* field, const Decisions* decisions,
+                       int width_px = 1400);
 
 // The field turned a quarter turn (x -> y): for tracks recorded with the length along y (TT3D).
-FieldModel RotateFieldQuarter(const FieldModel& field);
+field::FieldModel RotateFieldQuarter(const field::FieldModel& field);
 
-}  // namespace fv
+}  // namespace fv::recon

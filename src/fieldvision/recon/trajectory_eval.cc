@@ -9,7 +9,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -21,7 +21,7 @@ double MedianFinite(const std::vector<BounceTrackScore>& v, double BounceTrackSc
   for (const auto& s : v) {
     if (s.scored && std::isfinite(s.*m)) x.push_back(s.*m);
   }
-  return x.empty() ? kNaN : Median(x);
+  return x.empty() ? kNaN : util::Median(x);
 }
 
 }  // namespace
@@ -185,4 +185,4 @@ std::string BounceTrackSummary::Table() const {
   return s;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -10,7 +10,7 @@
 
 #include "fieldvision/recon/trajectory.h"
 
-namespace fv {
+namespace fv::recon {
 
 struct BounceTrackScore {
   std::string path;
@@ -55,4 +55,4 @@ BounceTrackScore ScoreBounceTrack(const std::string& path, const std::vector<Bal
                                   const BounceEvalOptions& eval = {});
 BounceTrackSummary Summarize(std::vector<BounceTrackScore> tracks);
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -9,7 +9,7 @@
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/recon/trajectory.h"
 
-namespace fv {
+namespace fv::recon {
 
 // The contract's flight fields plus events, seen span, speed, flight time, both fits and the
 // seed's method.
@@ -20,4 +20,4 @@ nlohmann::json FlightToJson(const Flight& f);
 nlohmann::json FlightsToJson(const TrajectoryResult& result,
                              const TrajectoryOptions* options = nullptr);
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -8,14 +8,14 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 const char* kHeader = "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n";
 
 std::string ErrorOf(const std::string& text) {
   try {
-    ParseBallTrack(CsvTable::Parse(text, "BALL.csv"));
+    ParseBallTrack(util::CsvTable::Parse(text, "BALL.csv"));
   } catch (const Error& e) {
     return e.what();
   }
@@ -41,7 +41,7 @@ TEST(TrajectoryIo, BadRowsAreNamedAndSkipped) {
                            "5,0.05,1,2,3,2,0.5\n"    // out of order
                            "6,0.08,1,2,inf,2,0.5\n"  // infinite
                            "7,0.10,1,2,3,2,\n";      // empty err_px
-  const BallTrackFile f = ParseBallTrack(CsvTable::Parse(text, "BALL.csv"));
+  const BallTrackFile f = ParseBallTrack(util::CsvTable::Parse(text, "BALL.csv"));
   ASSERT_EQ(f.samples.size(), 2u);
   EXPECT_EQ(f.samples[0].frame, 0);
   EXPECT_EQ(f.samples[1].frame, 4);
@@ -62,8 +62,8 @@ TEST(TrajectoryIo, ReversedFileIsAnErrorNotASilentTruncation) {
 }
 
 TEST(TrajectoryIo, Tt3dLayoutAndRoundTrip) {
-  const BallTrackFile f = ParseBallTrack(
-      CsvTable::Parse("Timestamp,X,Y,Z\n12.0,0.1,0.2,0.3\n12.005,0.11,0.19,0.31\n", "tt.csv"));
+  const BallTrackFile f = ParseBallTrack(util::CsvTable::Parse(
+      "Timestamp,X,Y,Z\n12.0,0.1,0.2,0.3\n12.005,0.11,0.19,0.31\n", "tt.csv"));
   EXPECT_EQ(f.layout, "tt3d");
   ASSERT_EQ(f.samples.size(), 2u);
   EXPECT_DOUBLE_EQ(f.samples[1].ball_in_world.z(), 0.31);
@@ -78,4 +78,4 @@ TEST(TrajectoryIo, Tt3dLayoutAndRoundTrip) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -6,7 +6,7 @@
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(TrajectoryLimits, OptionsOutOfRangeNameTheField) {
@@ -39,4 +39,4 @@ TEST(TrajectoryLimits, JobValuesOutOfRangeNameTheField) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-namespace fv {
+namespace fv::recon {
 
 constexpr double kMaxStepS = 0.002;  // RK4 step
 
@@ -84,4 +84,4 @@ struct SpinPrior {
   Eigen::Matrix3d W_;
 };
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(FlightPositionAt, ParabolaAndIntegratedFlightAgreeWithoutDragOrSpin) {
@@ -25,4 +25,4 @@ TEST(FlightPositionAt, ParabolaAndIntegratedFlightAgreeWithoutDragOrSpin) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

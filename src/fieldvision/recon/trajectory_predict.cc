@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 using Vec10 = Eigen::Matrix<double, 10, 1>;
@@ -217,4 +217,4 @@ std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -12,7 +12,7 @@
 
 #include "fieldvision/recon/trajectory.h"
 
-namespace fv {
+namespace fv::recon {
 
 struct LandingPrediction {
   bool ok = false;
@@ -57,4 +57,4 @@ std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
                                     const TrajectoryOptions& options,
                                     const SmootherOptions& smoother);
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -10,13 +10,13 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(TrajectoryPredict, LandingFromTheFirstHalfWithin25cmAndInsideTheEllipse) {
   const uint64_t seed = testing::TestSeed(21);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   int inside = 0, total = 0;
   double worst = 0;
   for (int trial = 0; trial < 20; ++trial) {
@@ -56,7 +56,7 @@ TEST(TrajectoryPredict, LandingFromTheFirstHalfWithin25cmAndInsideTheEllipse) {
 TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
   const uint64_t seed = testing::TestSeed(23);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallSimOptions o;
   o.start_m = {-6, 0, 0.11};
   o.kicks = {{0.2, {9, 1, 7}}};
@@ -92,4 +92,4 @@ TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

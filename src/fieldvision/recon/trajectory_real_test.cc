@@ -12,7 +12,7 @@
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TrajectoryOptions TableTennis() {
@@ -138,4 +138,4 @@ TEST(TrajectoryReal, Tt3dAllFilesResiduals) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -15,7 +15,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
-namespace fv {
+namespace fv::recon {
 
 void TrajectoryJob::Check() const {
   FV_REQUIRE(!in_path.empty(), "trajectory: --in is required");
@@ -83,7 +83,7 @@ void LogSkipped(const BallTrackFile& input, std::ostream& log) {
 
 // Writes JSON through a temporary file beside `path`.
 void WriteJson(const std::string& path, const nlohmann::json& j, const char* what) {
-  AtomicWrite(
+  io::AtomicWrite(
       path,
       [&](const std::string& tmp) {
         std::ofstream f(tmp);
@@ -152,7 +152,7 @@ nlohmann::json FlightsJson(const TrajectoryJobResult& out, double predict_fracti
     if (p.ok) {
       pj["samples_used"] = p.samples_used;
       pj["t_cut_s"] = p.t_cut_s;
-      pj["landing"] = JsonFromVector(p.landing_m, 4);
+      pj["landing"] = util::JsonFromVector(p.landing_m, 4);
       pj["t_landing_s"] = p.t_landing_s;
       pj["sigma_t_s"] = p.sigma_t_s;
       pj["ellipse95"] = {{"semi_major_m", p.semi_major_m},
@@ -170,7 +170,7 @@ nlohmann::json FlightsJson(const TrajectoryJobResult& out, double predict_fracti
 }
 
 void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flights,
-                            const FieldModel* field, TrajectoryJobResult& out) {
+                            const field::FieldModel* field, TrajectoryJobResult& out) {
   const auto& track = out.input.samples;
   const TrajectoryResult& r = out.result;
   // Everything is computed and the pictures' folder made before the first output is replaced;
@@ -199,7 +199,7 @@ void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flig
   }
   if (!job.smoothed_path.empty()) {
     const std::vector<BallSample> smoothed = SmoothTrack(track, r, out.options, job.smoother);
-    AtomicWrite(
+    io::AtomicWrite(
         job.smoothed_path, [&](const std::string& tmp) { WriteBallTrack(tmp, smoothed); },
         "--smoothed");
   }
@@ -207,8 +207,8 @@ void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flig
   // Drawn one at a time (a long track has thousands of flights).
   auto write = [&](const std::string& name, const cv::Mat& img) {
     const std::string path = (std::filesystem::path(job.images_dir) / name).string();
-    AtomicWrite(
-        path, [&](const std::string& tmp) { WriteImage(tmp, img); }, "--images");
+    io::AtomicWrite(
+        path, [&](const std::string& tmp) { io::WriteImage(tmp, img); }, "--images");
     out.images.push_back(path);
   };
   write("track_height.png", DrawTrackHeight(track, r, out.options));
@@ -227,9 +227,9 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   const auto& track = out.input.samples;
   LogSkipped(out.input, log);
   out.options = TrajectoryOptionsFor(job, out.input.layout, log);
-  FieldModel field;
+  field::FieldModel field;
   const bool has_field = !job.field.empty();
-  if (has_field) field = LoadField(job.field);
+  if (has_field) field = field::LoadField(job.field);
   if (has_field && out.input.layout == "tt3d") {
     // TT3D files have the table's length along y: the field is turned to match.
     field = RotateFieldQuarter(field);
@@ -293,23 +293,23 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
   TrajectoryBatchResult res;
   res.files = files;
   res.summary_csv = (fs::path(job.out_path) / "summary.csv").string();
-  AtomicOutput summary(res.summary_csv, "summary.csv");
+  io::AtomicOutput summary(res.summary_csv, "summary.csv");
   std::vector<BounceTrackScore> scores;
   {
-    CsvWriter csv(summary.temp_path(), {"file",           "flight",
-                                        "start_event",    "end_event",
-                                        "t_start_s",      "t_end_s",
-                                        "origin_x_m",     "origin_y_m",
-                                        "origin_z_m",     "origin_extrapolated",
-                                        "landing_x_m",    "landing_y_m",
-                                        "landing_z_m",    "landing_extrapolated",
-                                        "apex_z_m",       "speed_mps",
-                                        "model",          "rmse_m",
-                                        "rmse_gravity_m", "rmse_drag_m",
-                                        "rmse_spin_m",    "rmse_free_accel_m",
-                                        "spin_revps",     "spin_axis_x",
-                                        "spin_axis_y",    "spin_axis_z"},
-                  5);
+    util::CsvWriter csv(summary.temp_path(), {"file",           "flight",
+                                              "start_event",    "end_event",
+                                              "t_start_s",      "t_end_s",
+                                              "origin_x_m",     "origin_y_m",
+                                              "origin_z_m",     "origin_extrapolated",
+                                              "landing_x_m",    "landing_y_m",
+                                              "landing_z_m",    "landing_extrapolated",
+                                              "apex_z_m",       "speed_mps",
+                                              "model",          "rmse_m",
+                                              "rmse_gravity_m", "rmse_drag_m",
+                                              "rmse_spin_m",    "rmse_free_accel_m",
+                                              "spin_revps",     "spin_axis_x",
+                                              "spin_axis_y",    "spin_axis_z"},
+                        5);
     for (const auto& file : files) {
       const std::string stem = fs::path(file).stem().string();
       TrajectoryJob j = job;
@@ -357,4 +357,4 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
   return res;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

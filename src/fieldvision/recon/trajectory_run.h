@@ -13,7 +13,7 @@
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/recon/trajectory_predict.h"
 
-namespace fv {
+namespace fv::recon {
 
 struct TrajectoryJob {
   std::string in_path;           // BALL.csv or Timestamp,X,Y,Z
@@ -64,4 +64,4 @@ struct TrajectoryBatchResult {
 TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
                                          const std::vector<std::string>& files, std::ostream& log);
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -9,7 +9,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/recon/trajectory_run.h"
 
-namespace fv {
+namespace fv::recon {
 
 // The analysis options for a track: the job's ball, mass and slack, or the defaults of the
 // track's layout ("tt3d": table tennis, else football); says on `log` what it assumed.
@@ -23,6 +23,6 @@ nlohmann::json FlightsJson(const TrajectoryJobResult& out, double predict_fracti
 // Writes --out, --report, --smoothed and --images (each through a temporary file) and lists the
 // pictures in out.images.
 void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flights,
-                            const FieldModel* field, TrajectoryJobResult& out);
+                            const field::FieldModel* field, TrajectoryJobResult& out);
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -13,13 +13,13 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
   const uint64_t seed = testing::TestSeed(41);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallSimOptions o;
   o.start_m = {-6, -1, 0.11};
   o.kicks = {{0.2, {8, 1.5, 6}}};
@@ -84,7 +84,7 @@ TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
 TEST(TrajectoryRun, LongBlockWithManyBounces) {
   const uint64_t seed = testing::TestSeed(43);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   std::vector<BallSample> track;
   const double g = 9.81, r = 0.11, fps = 60;
   double t0 = 0, vz = 4.0;
@@ -148,4 +148,4 @@ TEST(TrajectoryRunStages, OptionsFollowTheLayoutUnlessGiven) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

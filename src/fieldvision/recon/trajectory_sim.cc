@@ -5,7 +5,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 
 void BallSimOptions::Check() const {
   CheckPositive(duration_s, "duration_s");
@@ -127,8 +127,8 @@ Eigen::Vector3d BallSimulation::BallAt(double time_s) const {
 }
 
 std::vector<BallSample> BallSimulation::Sample(double fps, double noise_m, double dropout,
-                                               double outlier_rate, double outlier_m, Rng& rng,
-                                               double t0_s) const {
+                                               double outlier_rate, double outlier_m,
+                                               util::Rng& rng, double t0_s) const {
   CheckPositive(fps, "fps");
   std::vector<BallSample> out;
   const int frames = static_cast<int>(std::floor((options_.duration_s - t0_s) * fps));
@@ -150,4 +150,4 @@ std::vector<BallSample> BallSimulation::Sample(double fps, double noise_m, doubl
   return out;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -11,7 +11,7 @@
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/util/random.h"
 
-namespace fv {
+namespace fv::recon {
 
 struct BallKick {
   double time_s = 0.0;
@@ -50,7 +50,7 @@ class BallSimulation {
   // probability dropout and replaced by an outlier (offset of outlier_m in a random direction)
   // with probability outlier_rate.
   std::vector<BallSample> Sample(double fps, double noise_m, double dropout, double outlier_rate,
-                                 double outlier_m, Rng& rng, double t0_s = 0.0) const;
+                                 double outlier_m, util::Rng& rng, double t0_s = 0.0) const;
 
  private:
   BallSimOptions options_;
@@ -59,4 +59,4 @@ class BallSimulation {
   std::vector<FlightTruth> flights_;
 };
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -8,7 +8,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TrajectoryOptions TableTennis() {
@@ -21,7 +21,7 @@ TrajectoryOptions TableTennis() {
 
 // A table-tennis stroke from behind one end of the table towards the other, with drag and the
 // given spin about the axis perpendicular to the flight (topspin > 0).
-BallisticModel Stroke(Rng& rng, const TrajectoryOptions& o, double topspin_revps,
+BallisticModel Stroke(util::Rng& rng, const TrajectoryOptions& o, double topspin_revps,
                       double sidespin_revps) {
   BallisticModel m;
   m.t0_s = 0.0;
@@ -35,7 +35,7 @@ BallisticModel Stroke(Rng& rng, const TrajectoryOptions& o, double topspin_revps
 }
 
 std::vector<BallSample> SampleUntilTable(const BallisticModel& m, double fps, double noise_m,
-                                         double zr, Rng& rng) {
+                                         double zr, util::Rng& rng) {
   std::vector<BallSample> out;
   for (int i = 0;; ++i) {
     const double t = m.t0_s + i / fps;
@@ -57,7 +57,7 @@ TEST(TrajectorySpin, SpinIsRecoveredWithin10PercentAndChosenByBic) {
   for (uint64_t k = 0; k < 3; ++k) {
     const uint64_t seed = seed0 + k;
     FV_SEED_TRACE(seed);
-    Rng rng(seed);
+    util::Rng rng(seed);
     const BallisticModel truth = Stroke(rng, o, rng.Uniform(30, 60), rng.Uniform(-15, 15));
     const auto track = SampleUntilTable(truth, 180.0, 0.002, o.ball_radius_m, rng);
     ASSERT_GE(track.size(), 30u);
@@ -88,7 +88,7 @@ TEST(TrajectorySpin, NoSpinIsNotChosen) {
   for (uint64_t k = 0; k < 3; ++k) {
     const uint64_t seed = seed0 + k;
     FV_SEED_TRACE(seed);
-    Rng rng(seed);
+    util::Rng rng(seed);
     const BallisticModel truth = Stroke(rng, o, 0.0, 0.0);
     const auto track = SampleUntilTable(truth, 180.0, 0.002, o.ball_radius_m, rng);
     const TrajectoryResult r = AnalyzeTrajectory(track, o);
@@ -132,7 +132,7 @@ TEST(TrajectorySpin, GlitchIsAnOutlierNotAHit) {
       const uint64_t seed = seed0 + k;
       FV_SEED_TRACE(seed);
       SCOPED_TRACE(::testing::Message() << run << " glitched samples");
-      Rng rng(seed);
+      util::Rng rng(seed);
       const BallisticModel truth = Stroke(rng, o, 40.0, 0.0);
       auto track = SampleUntilTable(truth, 360.0, 0.001, o.ball_radius_m, rng);
       // In the middle (k = 0) or a few samples before the end of the track (k = 1), where only
@@ -159,4 +159,4 @@ TEST(TrajectorySpin, GlitchIsAnOutlierNotAHit) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -6,7 +6,7 @@
 
 #include "fieldvision/recon/trajectory.h"
 
-namespace fv::trajectory_detail {
+namespace fv::recon::detail {
 
 // Events between consecutive pieces that are both fitted (piece_of_flight: each flight's piece):
 // bounce (low, descending then rising) or hit, with the contact time where the two arcs meet; a
@@ -27,4 +27,4 @@ void MergeBounces(const std::vector<BallSample>& track, const TrajectoryOptions&
 void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool>& outlier,
                     Flight* f);
 
-}  // namespace fv::trajectory_detail
+}  // namespace fv::recon::detail

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-namespace fv::trajectory_detail {
+namespace fv::recon::detail {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -100,4 +100,4 @@ TEST(TrajectoryStages, OutliersInAFlightsSpanJoinIt) {
 }
 
 }  // namespace
-}  // namespace fv::trajectory_detail
+}  // namespace fv::recon::detail

@@ -15,7 +15,7 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 TEST(TrajectorySynth, KickPresetFlightsFromTruthWith5mmNoise) {
@@ -27,9 +27,9 @@ TEST(TrajectorySynth, KickPresetFlightsFromTruthWith5mmNoise) {
     FV_SEED_TRACE(seed);
     const synth::SceneSpec spec = synth::Preset("kick", seed);
     const synth::BallTrajectory traj(spec.ball, spec.duration_s());
-    Rng rng(seed + 1000);
+    util::Rng rng(seed + 1000);
     const std::vector<BallSample> track =
-        recon_testing::NoisyTrack(traj, spec.num_frames, spec.fps, 0.005, rng);
+        test_util::NoisyTrack(traj, spec.num_frames, spec.fps, 0.005, rng);
     TrajectoryOptions o;
     o.ball_radius_m = spec.ball.radius_m();
     o.gravity_mps2 = spec.ball.physics.gravity_mps2;
@@ -66,6 +66,6 @@ TEST(TrajectorySynth, KickPresetFlightsFromTruthWith5mmNoise) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon
 
 #endif

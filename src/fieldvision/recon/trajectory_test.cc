@@ -9,11 +9,11 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 // A random kick on an 18 x 12 m field (and a second kick after the ball has settled).
-BallSimOptions RandomKickScene(Rng& rng, double drag_per_m = 0.0) {
+BallSimOptions RandomKickScene(util::Rng& rng, double drag_per_m = 0.0) {
   BallSimOptions o;
   o.start_m = {rng.Uniform(-6, 0), rng.Uniform(-4, 4), 0.11};
   const double heading = rng.Uniform(-0.5, 0.5);
@@ -48,7 +48,7 @@ TEST(Trajectory, FindsEveryFlightWithOriginAndLandingWithin2cmAt5mmNoise) {
   for (uint64_t k = 0; k < 3; ++k) {
     const uint64_t seed = seed0 + k;
     FV_SEED_TRACE(seed);
-    Rng rng(seed);
+    util::Rng rng(seed);
     const BallSimulation sim(RandomKickScene(rng));
     const auto track = sim.Sample(50.0, 0.005, 0.05, 0.02, 0.5, rng);
     TrajectoryOptions o;
@@ -108,7 +108,7 @@ TEST(Trajectory, FindsEveryFlightWithOriginAndLandingWithin2cmAt5mmNoise) {
 TEST(Trajectory, BouncesAreBouncesAndAMidAirHitIsAHit) {
   const uint64_t seed = testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallSimOptions o;
   o.start_m = {-5, 0, 0.11};
   o.kicks = {{0.2, {7, 1, 7}}, {1.0, {-6, 0.5, 2}}};  // the second is a header at ~3 m height
@@ -132,7 +132,7 @@ TEST(Trajectory, BouncesAreBouncesAndAMidAirHitIsAHit) {
 TEST(Trajectory, DragFitReducesResidualAndRecoversK) {
   const uint64_t seed = testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallSimOptions o;
   o.start_m = {-8, -2, 0.11};
   o.kicks = {{0.1, {20, 3, 12}}};
@@ -211,4 +211,4 @@ TEST(Trajectory, TooShortOrUnsortedTracks) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

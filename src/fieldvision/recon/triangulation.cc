@@ -7,9 +7,9 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv::triangulation_detail {
+namespace fv::recon::detail {
 
-double Depth(const Camera& cam, const Eigen::Vector3d& p_world) {
+double Depth(const camera::Camera& cam, const Eigen::Vector3d& p_world) {
   return (cam.cam_from_world * p_world).z();
 }
 
@@ -27,7 +27,7 @@ void CheckObservation(const BallObservation& obs, const std::string& what) {
              "{}: sigma_px must be finite and > 0 (got {})", what, obs.sigma_px);
 }
 
-void CheckCamera(const std::vector<Camera>& cameras, int index) {
+void CheckCamera(const std::vector<camera::Camera>& cameras, int index) {
   FV_REQUIRE(index >= 0 && index < static_cast<int>(cameras.size()),
              "triangulation: camera index {} out of range (have {} cameras)", index,
              cameras.size());
@@ -35,7 +35,7 @@ void CheckCamera(const std::vector<Camera>& cameras, int index) {
              index, cameras[index].name);
 }
 
-bool InFrontOfAll(const std::vector<Camera>& cameras, const std::vector<View>& views,
+bool InFrontOfAll(const std::vector<camera::Camera>& cameras, const std::vector<View>& views,
                   const Eigen::Vector3d& p, double min_depth_m) {
   for (const View& v : views) {
     if (!(Depth(cameras[v.camera], p) > min_depth_m)) return false;
@@ -52,12 +52,12 @@ bool NoBallThere(const Eigen::Vector3d& p, const TriangulationOptions& o, double
          (!o.allowed_region.isEmpty() && !o.allowed_region.contains(p));
 }
 
-}  // namespace fv::triangulation_detail
+}  // namespace fv::recon::detail
 
-namespace fv {
+namespace fv::recon {
 
-using triangulation_detail::CameraBlock;
-using triangulation_detail::PredictCentre;
+using detail::CameraBlock;
+using detail::PredictCentre;
 
 void TriangulationOptions::Check() const {
   CheckNonNegative(ball_radius_m, "TriangulationOptions.ball_radius_m");
@@ -103,7 +103,7 @@ const char* ToString(TriangulationStatus status) {
   return "?";
 }
 
-std::optional<Eigen::Vector2d> PredictBallCentre(const Camera& camera,
+std::optional<Eigen::Vector2d> PredictBallCentre(const camera::Camera& camera,
                                                  const Eigen::Vector3d& point_world,
                                                  double radius_m) {
   const CameraBlock block(camera);
@@ -112,4 +112,4 @@ std::optional<Eigen::Vector2d> PredictBallCentre(const Camera& camera,
   return uv;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

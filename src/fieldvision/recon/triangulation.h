@@ -15,7 +15,7 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/geometry/rigid.h"
 
-namespace fv {
+namespace fv::recon {
 
 // One ball candidate seen by one camera (what a detector reports), in that camera's pixels.
 struct BallObservation {
@@ -45,7 +45,8 @@ struct RayPairResult {
 // The closest point of two rays (directions need not be unit length). Rays closer to parallel
 // than `min_angle_deg` give kParallel; a closest point behind either origin gives kBehind (the
 // midpoint is still filled in). Never throws for geometry; throws fv::Error for NaN input.
-RayPairResult ClosestPointOfRays(const Ray3d& a, const Ray3d& b, double min_angle_deg = 0.01);
+RayPairResult ClosestPointOfRays(const geometry::Ray3d& a, const geometry::Ray3d& b,
+                                 double min_angle_deg = 0.01);
 
 // ---- N views --------------------------------------------------------------------------------
 
@@ -139,13 +140,13 @@ struct View {
 
 // Linear triangulation only (weighted DLT on undistorted normalized points). nullopt when fewer
 // than two views, a pixel cannot be undistorted or the solution is at infinity.
-std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<Camera>& cameras,
+std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<camera::Camera>& cameras,
                                                  const std::vector<View>& views);
 
 // All views together: DLT, refinement, residuals and covariance. No outlier rejection (see
 // TriangulateRobust). Throws fv::Error for a camera index out of range, a camera without a pose
 // or a non-finite observation.
-TriangulationResult TriangulatePoint(const std::vector<Camera>& cameras,
+TriangulationResult TriangulatePoint(const std::vector<camera::Camera>& cameras,
                                      const std::vector<View>& views,
                                      const TriangulationOptions& options = {});
 
@@ -156,7 +157,7 @@ TriangulationResult TriangulatePoint(const std::vector<Camera>& cameras,
 // with at least min_views_all_weak cameras. Throws fv::Error when
 // candidates.size() != cameras.size().
 // `prior`: where the ball is expected (e.g. extrapolated from the last frames), or null.
-TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
+TriangulationResult TriangulateRobust(const std::vector<camera::Camera>& cameras,
                                       const std::vector<std::vector<BallObservation>>& candidates,
                                       const TriangulationOptions& options = {},
                                       const Eigen::Vector3d* prior = nullptr);
@@ -164,14 +165,14 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
 // One camera, the ball resting on the ground (centre at z = options.ball_radius_m): intersects
 // the ray with that plane and refines x, y. Status kBehindCamera when the ray does not reach the
 // plane in front of the camera.
-TriangulationResult LocateOnGround(const Camera& camera, int camera_index,
+TriangulationResult LocateOnGround(const camera::Camera& camera, int camera_index,
                                    const BallObservation& observation,
                                    const TriangulationOptions& options = {});
 
 // The model's prediction of where `camera` sees the ball centred at `point_world` (the outline's
 // centre when radius_m > 0); nullopt when the point is not in front of the camera.
-std::optional<Eigen::Vector2d> PredictBallCentre(const Camera& camera,
+std::optional<Eigen::Vector2d> PredictBallCentre(const camera::Camera& camera,
                                                  const Eigen::Vector3d& point_world,
                                                  double radius_m);
 
-}  // namespace fv
+}  // namespace fv::recon

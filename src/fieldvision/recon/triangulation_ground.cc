@@ -5,13 +5,13 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 
-using triangulation_detail::CheckObservation;
-using triangulation_detail::Depth;
-using triangulation_detail::Refine;
+using detail::CheckObservation;
+using detail::Depth;
+using detail::Refine;
 
-TriangulationResult LocateOnGround(const Camera& camera, int camera_index,
+TriangulationResult LocateOnGround(const camera::Camera& camera, int camera_index,
                                    const BallObservation& observation,
                                    const TriangulationOptions& options) {
   options.Check();
@@ -23,13 +23,13 @@ TriangulationResult LocateOnGround(const Camera& camera, int camera_index,
     result.status = TriangulationStatus::kDegenerate;
     return result;
   }
-  const auto hit = IntersectHorizontalPlane(*ray, options.ball_radius_m);
+  const auto hit = geometry::IntersectHorizontalPlane(*ray, options.ball_radius_m);
   if (!hit || !(Depth(camera, *hit) > options.min_depth_m)) {
     result.status = TriangulationStatus::kBehindCamera;
     return result;
   }
   Eigen::Vector3d p(hit->x(), hit->y(), options.ball_radius_m);
-  std::vector<Camera> cams = {camera};
+  std::vector<camera::Camera> cams = {camera};
   std::vector<View> views = {{0, observation}};
   Refine(cams, views, {0}, true, options, &p, &result);
   for (auto& v : result.views) v.camera = camera_index;
@@ -39,4 +39,4 @@ TriangulationResult LocateOnGround(const Camera& camera, int camera_index,
   return result;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -9,12 +9,12 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 
-using triangulation_detail::CheckCamera;
-using triangulation_detail::CheckObservation;
+using detail::CheckCamera;
+using detail::CheckObservation;
 
-std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<Camera>& cameras,
+std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<camera::Camera>& cameras,
                                                  const std::vector<View>& views) {
   if (views.size() < 2) return std::nullopt;
   // Centre the world on the mean camera centre for conditioning.
@@ -26,7 +26,7 @@ std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<Camera>& came
   centre /= static_cast<double>(views.size());
   Eigen::MatrixXd a(2 * views.size(), 4);
   for (size_t i = 0; i < views.size(); ++i) {
-    const Camera& cam = cameras[views[i].camera];
+    const camera::Camera& cam = cameras[views[i].camera];
     CheckObservation(views[i].observation, "triangulation");
     const auto xn = cam.Undistort(views[i].observation.centre_px);
     if (!xn) return std::nullopt;
@@ -50,4 +50,4 @@ std::optional<Eigen::Vector3d> TriangulateLinear(const std::vector<Camera>& came
   return p;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

@@ -13,7 +13,7 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv::triangulation_detail {
+namespace fv::recon::detail {
 
 // Weighted reprojection residual of one view; `Ground` optimises x, y with z fixed.
 template <bool Ground>
@@ -36,7 +36,7 @@ struct ReprojectionCost {
 };
 
 // Refines `p` (3 values, or x, y when `ground`) on the views; fills residuals, rms, covariance.
-void Refine(const std::vector<Camera>& cameras, const std::vector<View>& views,
+void Refine(const std::vector<camera::Camera>& cameras, const std::vector<View>& views,
             const std::vector<int>& candidate_index, bool ground, const TriangulationOptions& o,
             Eigen::Vector3d* p, TriangulationResult* result) {
   double x[3] = {p->x(), p->y(), p->z()};
@@ -119,7 +119,7 @@ void Refine(const std::vector<Camera>& cameras, const std::vector<View>& views,
   result->point_world = *p;
 }
 
-TriangulationResult TriangulateViews(const std::vector<Camera>& cameras,
+TriangulationResult TriangulateViews(const std::vector<camera::Camera>& cameras,
                                      const std::vector<View>& views,
                                      const std::vector<int>& candidate_index,
                                      const TriangulationOptions& o) {
@@ -167,15 +167,15 @@ TriangulationResult TriangulateViews(const std::vector<Camera>& cameras,
   return result;
 }
 
-}  // namespace fv::triangulation_detail
+}  // namespace fv::recon::detail
 
-namespace fv {
+namespace fv::recon {
 
-using triangulation_detail::CheckCamera;
-using triangulation_detail::CheckObservation;
-using triangulation_detail::TriangulateViews;
+using detail::CheckCamera;
+using detail::CheckObservation;
+using detail::TriangulateViews;
 
-TriangulationResult TriangulatePoint(const std::vector<Camera>& cameras,
+TriangulationResult TriangulatePoint(const std::vector<camera::Camera>& cameras,
                                      const std::vector<View>& views,
                                      const TriangulationOptions& options) {
   options.Check();
@@ -186,4 +186,4 @@ TriangulationResult TriangulatePoint(const std::vector<Camera>& cameras,
   return TriangulateViews(cameras, views, {}, options);
 }
 
-}  // namespace fv
+}  // namespace fv::recon

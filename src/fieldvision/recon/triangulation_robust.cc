@@ -13,9 +13,9 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv::triangulation_detail {
+namespace fv::recon::detail {
 
-RankedCandidates RankCandidates(const std::vector<Camera>& cameras,
+RankedCandidates RankCandidates(const std::vector<camera::Camera>& cameras,
                                 const std::vector<std::vector<BallObservation>>& candidates,
                                 const TriangulationOptions& o) {
   const int num_cams = static_cast<int>(cameras.size());
@@ -43,16 +43,16 @@ RankedCandidates RankCandidates(const std::vector<Camera>& cameras,
   return r;
 }
 
-bool RadiusConsistent(const Camera& camera, const BallObservation& obs, const Eigen::Vector3d& p,
-                      double ball_radius_m, double max_ratio) {
+bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
+                      const Eigen::Vector3d& p, double ball_radius_m, double max_ratio) {
   if (max_ratio <= 0 || obs.radius_px <= 0 || ball_radius_m <= 0) return true;
   const double expected = ball_radius_m * std::sqrt(camera.fx * camera.fy) / Depth(camera, p);
   const double ratio = obs.radius_px / expected;
   return ratio <= max_ratio && ratio >= 1.0 / max_ratio;
 }
 
-double ConsistentError(const Camera& camera, const BallObservation& obs, const Eigen::Vector3d& p,
-                       const TriangulationOptions& o) {
+double ConsistentError(const camera::Camera& camera, const BallObservation& obs,
+                       const Eigen::Vector3d& p, const TriangulationOptions& o) {
   if (!(Depth(camera, p) > o.min_depth_m)) return -1;
   const auto uv = PredictBallCentre(camera, p, ModelRadius(o));
   if (!uv) return -1;
@@ -65,7 +65,7 @@ double ConsistentError(const Camera& camera, const BallObservation& obs, const E
   return err;
 }
 
-double GatherConsistent(const std::vector<Camera>& cameras,
+double GatherConsistent(const std::vector<camera::Camera>& cameras,
                         const std::vector<std::vector<BallObservation>>& candidates,
                         const RankedCandidates& ranked, const TriangulationOptions& o,
                         const Eigen::Vector3d& p, std::vector<int>* pick) {
@@ -102,7 +102,7 @@ bool StrongEnough(const std::vector<std::vector<BallObservation>>& candidates,
          prior != nullptr && (p - *prior).norm() <= o.prior_gate_m;
 }
 
-BestHypothesis SearchHypotheses(const std::vector<Camera>& cameras,
+BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
                                 const std::vector<std::vector<BallObservation>>& candidates,
                                 const RankedCandidates& ranked, const TriangulationOptions& o,
                                 bool require_strong, const Eigen::Vector3d* prior) {
@@ -150,7 +150,7 @@ BestHypothesis SearchHypotheses(const std::vector<Camera>& cameras,
   return best;
 }
 
-TriangulationResult RefineConsistentSet(const std::vector<Camera>& cameras,
+TriangulationResult RefineConsistentSet(const std::vector<camera::Camera>& cameras,
                                         const std::vector<std::vector<BallObservation>>& candidates,
                                         const RankedCandidates& ranked,
                                         const TriangulationOptions& o, std::vector<int> pick) {
@@ -196,22 +196,22 @@ TriangulationResult RefineConsistentSet(const std::vector<Camera>& cameras,
   return result;
 }
 
-}  // namespace fv::triangulation_detail
+}  // namespace fv::recon::detail
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
-using triangulation_detail::BestHypothesis;
-using triangulation_detail::NoBallThere;
-using triangulation_detail::RankCandidates;
-using triangulation_detail::RankedCandidates;
-using triangulation_detail::RefineConsistentSet;
-using triangulation_detail::SearchHypotheses;
-using triangulation_detail::StrongEnough;
+using detail::BestHypothesis;
+using detail::NoBallThere;
+using detail::RankCandidates;
+using detail::RankedCandidates;
+using detail::RefineConsistentSet;
+using detail::SearchHypotheses;
+using detail::StrongEnough;
 
 // The robust search. With require_strong, the final set must keep a candidate that is not weak
 // (or have min_views_all_weak views), and there is no single-camera ground mode.
-TriangulationResult RobustCore(const std::vector<Camera>& cameras,
+TriangulationResult RobustCore(const std::vector<camera::Camera>& cameras,
                                const std::vector<std::vector<BallObservation>>& candidates,
                                const TriangulationOptions& o, bool require_strong,
                                const Eigen::Vector3d* prior) {
@@ -269,7 +269,7 @@ TriangulationResult RobustCore(const std::vector<Camera>& cameras,
 
 }  // namespace
 
-TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
+TriangulationResult TriangulateRobust(const std::vector<camera::Camera>& cameras,
                                       const std::vector<std::vector<BallObservation>>& candidates,
                                       const TriangulationOptions& o, const Eigen::Vector3d* prior) {
   o.Check();
@@ -302,4 +302,4 @@ TriangulationResult TriangulateRobust(const std::vector<Camera>& cameras,
   return with_weak.ok() ? with_weak : result;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

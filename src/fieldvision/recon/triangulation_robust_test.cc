@@ -8,26 +8,26 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
-using namespace triangulation_detail;  // NOLINT: the stages under test
+using namespace detail;  // NOLINT: the stages under test
 
 // Three cameras 10 m from the field centre, 5 m high, looking at it.
-std::vector<Camera> RingCameras() {
-  std::vector<Camera> cams;
+std::vector<camera::Camera> RingCameras() {
+  std::vector<camera::Camera> cams;
   for (int i = 0; i < 3; ++i) {
     const double a = 2 * M_PI * i / 3;
-    Camera c = Camera::FromFov(1280, 960, 70);
-    c.cam_from_world =
-        Rigid3d::LookAt(Eigen::Vector3d(10 * std::cos(a), 10 * std::sin(a), 5), {0, 0, 0});
+    camera::Camera c = camera::Camera::FromFov(1280, 960, 70);
+    c.cam_from_world = geometry::Rigid3d::LookAt(
+        Eigen::Vector3d(10 * std::cos(a), 10 * std::sin(a), 5), {0, 0, 0});
     c.has_pose = true;
     cams.push_back(c);
   }
   return cams;
 }
 
-BallObservation Seen(const Camera& cam, const Eigen::Vector3d& p, double score = 1.0) {
+BallObservation Seen(const camera::Camera& cam, const Eigen::Vector3d& p, double score = 1.0) {
   BallObservation o;
   o.centre_px = *PredictBallCentre(cam, p, 0.0);
   o.score = score;
@@ -35,7 +35,7 @@ BallObservation Seen(const Camera& cam, const Eigen::Vector3d& p, double score =
 }
 
 // Seen with a centre known to 0.2 px.
-BallObservation SeenSharp(const Camera& cam, const Eigen::Vector3d& p, double score) {
+BallObservation SeenSharp(const camera::Camera& cam, const Eigen::Vector3d& p, double score) {
   BallObservation o = Seen(cam, p, score);
   o.sigma_px = 0.2;
   return o;
@@ -181,4 +181,4 @@ TEST(RobustTriangulation, AnObjectOutsideTheAllowedRegionGivesWayToTheBall) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -10,27 +10,27 @@
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::recon {
 namespace {
 
 // Four cameras at the corners of an 18 x 12 m field, 6 m high, looking at the centre.
-std::vector<Camera> CornerCameras(Rng* rng = nullptr) {
-  std::vector<Camera> cams;
+std::vector<camera::Camera> CornerCameras(util::Rng* rng = nullptr) {
+  std::vector<camera::Camera> cams;
   const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
   for (int i = 0; i < 4; ++i) {
-    Camera c = Camera::FromFov(1280, 960, 75);
+    camera::Camera c = camera::Camera::FromFov(1280, 960, 75);
     c.name = "cam" + std::to_string(i);
     if (rng) c.distortion = {rng->Uniform(-0.2, 0.0), rng->Uniform(0, 0.05), 0, 0, 0};
     const Eigen::Vector3d eye(sx[i] * 11.0, sy[i] * 8.0, 6.0);
-    c.cam_from_world = Rigid3d::LookAt(eye, Eigen::Vector3d(0, 0, 0));
+    c.cam_from_world = geometry::Rigid3d::LookAt(eye, Eigen::Vector3d(0, 0, 0));
     c.has_pose = true;
     cams.push_back(c);
   }
   return cams;
 }
 
-BallObservation Observe(const Camera& cam, const Eigen::Vector3d& p, double radius_m,
-                        double sigma_px, Rng* rng) {
+BallObservation Observe(const camera::Camera& cam, const Eigen::Vector3d& p, double radius_m,
+                        double sigma_px, util::Rng* rng) {
   auto uv = PredictBallCentre(cam, p, radius_m);
   EXPECT_TRUE(uv.has_value());
   BallObservation o;
@@ -41,14 +41,14 @@ BallObservation Observe(const Camera& cam, const Eigen::Vector3d& p, double radi
   return o;
 }
 
-Eigen::Vector3d RandomBall(Rng& rng) {
+Eigen::Vector3d RandomBall(util::Rng& rng) {
   return {rng.Uniform(-8, 8), rng.Uniform(-5, 5), rng.Uniform(0.11, 3.0)};
 }
 
 TEST(ClosestPointOfRays, IntersectingAndSkewRays) {
   const uint64_t seed = testing::TestSeed(11);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 50; ++trial) {
     const Eigen::Vector3d p(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(0, 3));
     const Eigen::Vector3d oa(rng.Uniform(-20, -10), rng.Uniform(-5, 5), rng.Uniform(2, 8));
@@ -67,8 +67,8 @@ TEST(ClosestPointOfRays, IntersectingAndSkewRays) {
 }
 
 TEST(ClosestPointOfRays, ParallelRaysAreAValue) {
-  const Ray3d a{{0, 0, 0}, {1, 0, 0}};
-  const Ray3d b{{0, 2, 0}, {1, 0, 0}};
+  const geometry::Ray3d a{{0, 0, 0}, {1, 0, 0}};
+  const geometry::Ray3d b{{0, 2, 0}, {1, 0, 0}};
   const RayPairResult r = ClosestPointOfRays(a, b);
   EXPECT_EQ(r.status, RayPairStatus::kParallel);
   EXPECT_NEAR(r.gap_m, 2.0, 1e-12);
@@ -82,8 +82,8 @@ TEST(ClosestPointOfRays, ParallelRaysAreAValue) {
 TEST(ClosestPointOfRays, NearParallelRaysMeetFarAway) {
   // Two rays 1 m apart converging at 0.05 degrees meet about 1146 m away.
   const double angle = 0.05 * M_PI / 180.0;
-  const Ray3d a{{0, 0, 0}, {1, 0, 0}};
-  const Ray3d b{{0, 1, 0}, {std::cos(angle), -std::sin(angle), 0}};
+  const geometry::Ray3d a{{0, 0, 0}, {1, 0, 0}};
+  const geometry::Ray3d b{{0, 1, 0}, {std::cos(angle), -std::sin(angle), 0}};
   const RayPairResult r = ClosestPointOfRays(a, b);
   ASSERT_TRUE(r.ok());
   EXPECT_NEAR(r.midpoint.x(), 1.0 / std::tan(angle), 1e-3);
@@ -103,7 +103,7 @@ TEST(ClosestPointOfRays, PointBehindARayIsFlagged) {
 TEST(Triangulation, LinearIsExactWithoutNoise) {
   const uint64_t seed = testing::TestSeed(12);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   for (int trial = 0; trial < 30; ++trial) {
     const Eigen::Vector3d p = RandomBall(rng);
@@ -118,7 +118,7 @@ TEST(Triangulation, LinearIsExactWithoutNoise) {
 TEST(Triangulation, RefinedPointAndCovarianceMatchTheNoise) {
   const uint64_t seed = testing::TestSeed(13);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.outline_centre = true;
@@ -148,8 +148,8 @@ TEST(Triangulation, RefinedPointAndCovarianceMatchTheNoise) {
 TEST(Triangulation, OutlineCentreModelRemovesThePerspectiveBias) {
   // Project points of the sphere's silhouette (the tangent circle) with the camera, fit an
   // ellipse: its centre is what a detector measures, and the model must predict it.
-  Camera cam = Camera::FromFov(1280, 960, 75);
-  cam.cam_from_world = Rigid3d::LookAt({-11, -8, 6}, {0, 0, 0});
+  camera::Camera cam = camera::Camera::FromFov(1280, 960, 75);
+  cam.cam_from_world = geometry::Rigid3d::LookAt({-11, -8, 6}, {0, 0, 0});
   cam.has_pose = true;
   const double r = 0.11;
   for (const Eigen::Vector3d ball :
@@ -180,9 +180,9 @@ TEST(Triangulation, OutlineCentreModelRemovesThePerspectiveBias) {
 
 TEST(Triangulation, NearParallelRaysAreDegenerateOrUncertain) {
   // Two cameras side by side looking at a point far away: the ray angle shrinks with distance.
-  std::vector<Camera> cams(2, Camera::FromFov(1280, 960, 60));
-  cams[0].cam_from_world = Rigid3d::LookAt({0, -0.5, 1}, {100, 0, 1});
-  cams[1].cam_from_world = Rigid3d::LookAt({0, 0.5, 1}, {100, 0, 1});
+  std::vector<camera::Camera> cams(2, camera::Camera::FromFov(1280, 960, 60));
+  cams[0].cam_from_world = geometry::Rigid3d::LookAt({0, -0.5, 1}, {100, 0, 1});
+  cams[1].cam_from_world = geometry::Rigid3d::LookAt({0, 0.5, 1}, {100, 0, 1});
   cams[0].has_pose = cams[1].has_pose = true;
   TriangulationOptions opt;
   double last_var = 0;
@@ -211,11 +211,11 @@ TEST(Triangulation, PointBehindACameraIsRejected) {
   // Camera 1 looks away from the field: the pixel it reports for the ball direction is behind.
   auto cams = CornerCameras();
   const Eigen::Vector3d p(1, 1, 0.5);
-  Camera away = cams[1];
+  camera::Camera away = cams[1];
   const Eigen::Vector3d eye = cams[1].CentreInWorld();
-  away.cam_from_world = Rigid3d::LookAt(eye, eye + (eye - p));  // p is straight behind it
+  away.cam_from_world = geometry::Rigid3d::LookAt(eye, eye + (eye - p));  // p is straight behind it
   // A blob at the image centre of `away` is on the ray pointing away from p.
-  std::vector<Camera> two = {cams[0], away};
+  std::vector<camera::Camera> two = {cams[0], away};
   BallObservation centre;
   centre.centre_px = {away.cx, away.cy};
   std::vector<View> views = {{0, Observe(cams[0], p, 0, 0, nullptr)}, {1, centre}};
@@ -225,7 +225,7 @@ TEST(Triangulation, PointBehindACameraIsRejected) {
               r.status == TriangulationStatus::kDegenerate)
       << ToString(r.status);
   // In robust mode with the other three cameras the backward camera's blob is simply unused.
-  std::vector<Camera> four = {cams[0], away, cams[2], cams[3]};
+  std::vector<camera::Camera> four = {cams[0], away, cams[2], cams[3]};
   std::vector<std::vector<BallObservation>> cand(4);
   for (int c : {0, 2, 3}) cand[c] = {Observe(four[c], p, 0, 0, nullptr)};
   cand[1] = {centre};
@@ -239,7 +239,7 @@ TEST(Triangulation, PointBehindACameraIsRejected) {
 TEST(Triangulation, OneCameraOnlyNeedsTheGroundAssumption) {
   const uint64_t seed = testing::TestSeed(14);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.ball_radius_m = 0.11;
@@ -268,7 +268,7 @@ TEST(Triangulation, OneCameraOnlyNeedsTheGroundAssumption) {
 TEST(Triangulation, FalseBlobInOneCameraNeverMovesTheBall) {
   const uint64_t seed = testing::TestSeed(15);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.outline_centre = true;
@@ -332,7 +332,7 @@ TEST(Triangulation, BadInputThrowsNamingIt) {
 TEST(Triangulation, WeakCandidatesOnlyCompleteOrConfirm) {
   const uint64_t seed = testing::TestSeed(21);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.ball_radius_m = 0.11;
@@ -395,4 +395,4 @@ TEST(Triangulation, WeakCandidatesOnlyCompleteOrConfirm) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::recon

@@ -7,11 +7,12 @@
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::recon {
 
-using triangulation_detail::kRadToDeg;
+using detail::kRadToDeg;
 
-RayPairResult ClosestPointOfRays(const Ray3d& a, const Ray3d& b, double min_angle_deg) {
+RayPairResult ClosestPointOfRays(const geometry::Ray3d& a, const geometry::Ray3d& b,
+                                 double min_angle_deg) {
   FV_REQUIRE(a.origin.allFinite() && a.direction.allFinite() && b.origin.allFinite() &&
                  b.direction.allFinite(),
              "ClosestPointOfRays: a ray has a non-finite origin or direction");
@@ -43,4 +44,4 @@ RayPairResult ClosestPointOfRays(const Ray3d& a, const Ray3d& b, double min_angl
   return r;
 }
 
-}  // namespace fv
+}  // namespace fv::recon

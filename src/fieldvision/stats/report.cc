@@ -22,12 +22,12 @@ namespace fs = std::filesystem;
 namespace {
 
 void Write(const std::string& path, const cv::Mat& img, ReportFiles& files) {
-  WriteImage(path, img);
+  io::WriteImage(path, img);
   files.files.push_back(path);
 }
 
 // Zones drawn on a top view: outline and name.
-void DrawZones(cv::Mat& img, const std::vector<Zone>& zones, const TopView& view) {
+void DrawZones(cv::Mat& img, const std::vector<Zone>& zones, const field::TopView& view) {
   for (const auto& z : zones) {
     std::vector<cv::Point> pts;
     for (const auto& v : z.polygon_m) pts.push_back(view.ToPixel(v));
@@ -42,7 +42,7 @@ void DrawZones(cv::Mat& img, const std::vector<Zone>& zones, const TopView& view
 
 // Time spent per square metre (seconds): each sample weighs the time to the next one (at most
 // 0.5 s), spread by a Gaussian of heat_sigma_m.
-cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const TopView& view,
+cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const field::TopView& view,
                     const StatsOptions& o) {
   cv::Mat acc = cv::Mat::zeros(view.size, CV_32F);
   for (const auto* s : tracks) {
@@ -86,11 +86,11 @@ double ScaleMax(const cv::Mat& density) {
 
 // Heat map of time spent over the field drawing, with its colour scale (seconds per square
 // metre) on the right and the zones drawn.
-cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const FieldModel& field,
-                const TopView& view, const StatsOptions& o, const std::string& title) {
+cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const field::FieldModel& field,
+                const field::TopView& view, const StatsOptions& o, const std::string& title) {
   const cv::Mat density = TimeDensity(tracks, view, o);
   const double vmax = ScaleMax(density);
-  cv::Mat img = DrawField(field, view);
+  cv::Mat img = field::DrawField(field, view);
   if (vmax > 0) {
     cv::Mat norm8, colour;
     density.convertTo(norm8, CV_8U, 255.0 / vmax);  // saturates above vmax
@@ -104,7 +104,7 @@ cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const FieldModel&
         for (int k = 0; k < 3; ++k) d[k] = cv::saturate_cast<uchar>((1 - a) * d[k] + a * c[k]);
       }
     }
-    DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255), 1);
+    field::DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255), 1);
   }
   DrawZones(img, o.zones, view);
   cv::putText(img, title, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7, {255, 255, 255}, 2);
@@ -142,8 +142,8 @@ std::string LabelOf(int id, const std::map<int, std::string>& name_of) {
 }
 
 // The radar (top) view at time t: trails of the last seconds and current positions with labels.
-void DrawRadar(cv::Mat& img, const StatsResult& r, const TopView& view, double t, double trail_s,
-               const StatsOptions& o) {
+void DrawRadar(cv::Mat& img, const StatsResult& r, const field::TopView& view, double t,
+               double trail_s, const StatsOptions& o) {
   for (const auto& s : r.tracks) {
     const auto tm = o.team_of.find(s.id);
     const cv::Scalar c = track::TrackColour(s.id, tm == o.team_of.end() ? -1 : tm->second);
@@ -252,7 +252,7 @@ struct ReportParts {
   const StatsResult& r;
   const StatsOptions& o;
   std::string out_dir;
-  TopView view;
+  field::TopView view;
   double t0 = 1e300, t1 = -1e300;  // first and last time of all tracks
   std::vector<std::string> band_names;
   std::vector<int> teams;        // with a heat map
@@ -273,11 +273,11 @@ std::vector<std::string> BandNames(const StatsOptions& o) {
 }
 
 // Heat maps: all players, each team and the longest tracks.
-void WriteHeatMaps(const FieldModel& field, ReportParts& rp, ReportFiles& files) {
+void WriteHeatMaps(const field::FieldModel& field, ReportParts& rp, ReportFiles& files) {
   const StatsResult& r = rp.r;
   const StatsOptions& o = rp.o;
   const std::string& out_dir = rp.out_dir;
-  const TopView& view = rp.view;
+  const field::TopView& view = rp.view;
   std::vector<const SmoothTrack*> all;
   std::map<int, std::vector<const SmoothTrack*>> by_team;
   std::map<int, const PlayerStats*> player_of;
@@ -308,12 +308,12 @@ void WriteHeatMaps(const FieldModel& field, ReportParts& rp, ReportFiles& files)
 }
 
 // Radar: whole trajectories; and the video (10 frames per second of play).
-void WriteRadar(const FieldModel& field, ReportParts& rp, ReportFiles& files) {
+void WriteRadar(const field::FieldModel& field, ReportParts& rp, ReportFiles& files) {
   const StatsResult& r = rp.r;
   const StatsOptions& o = rp.o;
-  const TopView& view = rp.view;
+  const field::TopView& view = rp.view;
   {
-    cv::Mat img = DrawField(field, view);
+    cv::Mat img = field::DrawField(field, view);
     DrawZones(img, o.zones, view);
     DrawRadar(img, r, view, rp.t1, rp.t1 - rp.t0 + 1, o);
     cv::putText(img, "radar: all trajectories", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
@@ -327,7 +327,7 @@ void WriteRadar(const FieldModel& field, ReportParts& rp, ReportFiles& files) {
     return;
   }
   const std::string path = rp.out_dir + "/radar.mp4";
-  cv::Mat base = DrawField(field, view);
+  cv::Mat base = field::DrawField(field, view);
   DrawZones(base, o.zones, view);
   track::PlayableVideoWriter vw(path, 10.0, base.size());
   for (double t = rp.t0; t <= rp.t1; t += 0.1) {
@@ -350,7 +350,7 @@ void WriteTables(const ReportParts& rp, ReportFiles& files) {
   // Distances between players.
   {
     const std::string path = out_dir + "/distances.csv";
-    CsvWriter w(path, {"time_s", "id_a", "id_b", "distance_m"}, 3);
+    util::CsvWriter w(path, {"time_s", "id_a", "id_b", "distance_m"}, 3);
     for (const auto& [t, a, b, d] : r.pair_distances) {
       w << t << a << b << d;
       w.EndRow();
@@ -366,7 +366,7 @@ void WriteTables(const ReportParts& rp, ReportFiles& files) {
                                        "sprints"};
     for (const auto& b : rp.band_names) header.push_back("time_" + b + "_mps_s");
     for (const auto& z : o.zones) header.push_back("time_in_" + z.name + "_s");
-    CsvWriter w(path, header, 2);
+    util::CsvWriter w(path, header, 2);
     for (const auto& p : r.players) {
       w << p.id << p.name << p.team << p.first_s << p.last_s << p.distance_m << p.top_speed_mps
         << p.mean_speed_mps << p.sprints;
@@ -379,7 +379,7 @@ void WriteTables(const ReportParts& rp, ReportFiles& files) {
   }
   {
     const std::string path = out_dir + "/speed_profiles.csv";
-    CsvWriter w(path, {"id", "time_s", "speed_mps"}, 2);
+    util::CsvWriter w(path, {"id", "time_s", "speed_mps"}, 2);
     for (const auto& p : r.players) {
       for (const auto& [t, v] : p.speed_profile) {
         w << p.id << t << v;
@@ -501,15 +501,15 @@ void WriteIndexHtml(const std::string& path, const ReportParts& rp, const Report
 
 }  // namespace
 
-ReportFiles WriteStatsReport(const StatsResult& r, const FieldModel& field, const StatsOptions& o,
-                             const std::string& out_dir) {
+ReportFiles WriteStatsReport(const StatsResult& r, const field::FieldModel& field,
+                             const StatsOptions& o, const std::string& out_dir) {
   o.Check();
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   FV_REQUIRE(!ec && fs::is_directory(out_dir), "cannot create output folder '{}'", out_dir);
   ReportFiles files;
   // Heat maps: every player and the extent of all positions beyond the field.
-  ReportParts rp{r, o, out_dir, TopView::ForField(field, o.image_width_px, 2.0)};
+  ReportParts rp{r, o, out_dir, field::TopView::ForField(field, o.image_width_px, 2.0)};
   WriteHeatMaps(field, rp, files);
   for (const auto& s : r.tracks) {
     rp.t0 = std::min(rp.t0, s.time_s.front());

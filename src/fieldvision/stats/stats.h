@@ -122,7 +122,7 @@ struct ReportFiles {
 // and the zones drawn; radar.png and radar.mp4 (H.264, skipped with a note where OpenCV has no
 // encoder); players.csv, speed_profiles.csv, distances.csv; index.html with sortable tables,
 // speed-over-time charts per player (inline SVG) and links to every file.
-ReportFiles WriteStatsReport(const StatsResult& result, const FieldModel& field,
+ReportFiles WriteStatsReport(const StatsResult& result, const field::FieldModel& field,
                              const StatsOptions& options, const std::string& out_dir);
 
 }  // namespace fv::stats

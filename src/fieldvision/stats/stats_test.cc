@@ -18,7 +18,8 @@ namespace {
 
 // A player walking 1.5 m/s along +x for 10 s, then sprinting 7 m/s for 3 s, then standing 3 s,
 // with Gaussian position noise; 25 frames/s.
-std::vector<track::TrackRow> Runner(Rng& rng, int id, double y, double noise_m, double* distance) {
+std::vector<track::TrackRow> Runner(util::Rng& rng, int id, double y, double noise_m,
+                                    double* distance) {
   std::vector<track::TrackRow> rows;
   const double fps = 25;
   double x = -20;
@@ -45,7 +46,7 @@ std::vector<track::TrackRow> Runner(Rng& rng, int id, double y, double noise_m, 
 TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
   const uint64_t seed = fv::testing::TestSeed(21);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   double truth = 0;
   const auto rows = Runner(rng, 4, 0.0, 0.05, &truth);
   StatsOptions o;
@@ -77,7 +78,7 @@ TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
 TEST(Stats, PairDistancesAndReport) {
   const uint64_t seed = fv::testing::TestSeed(22);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   double d1 = 0, d2 = 0;
   auto rows = Runner(rng, 1, -3.0, 0.02, &d1);
   const auto other = Runner(rng, 2, 3.0, 0.02, &d2);
@@ -89,7 +90,7 @@ TEST(Stats, PairDistancesAndReport) {
   ASSERT_FALSE(r.pair_distances.empty());
   for (const auto& [t, a, b, d] : r.pair_distances) EXPECT_NEAR(d, 6.0, 0.2) << "t " << t;
   const std::string dir = fv::testing::TempDir() + "/report";
-  const FieldModel field = BuiltinField("futsal");
+  const field::FieldModel field = field::BuiltinField("futsal");
   const ReportFiles files = WriteStatsReport(r, field, o, dir);
   for (const char* f :
        {"stats.json", "index.html", "heatmap_all.png", "heatmap_team0.png", "heatmap_team1.png",
@@ -103,13 +104,13 @@ TEST(Stats, PairDistancesAndReport) {
     EXPECT_EQ(files.notes.size(), 1u);
   }
   // players.csv has one row per player with the table's numbers.
-  const CsvTable players = CsvTable::Read(dir + "/players.csv");
+  const util::CsvTable players = util::CsvTable::Read(dir + "/players.csv");
   ASSERT_EQ(players.rows(), 2u);
   EXPECT_NEAR(players.GetDouble(0, "distance_m"), r.players[0].distance_m, 0.01);
   // The hottest place of player 1's map is where it stood longest: the end of its path.
   const cv::Mat heat = cv::imread(dir + "/heatmap_player1.png");
   ASSERT_FALSE(heat.empty());
-  const TopView view = TopView::ForField(field, o.image_width_px, 2.0);
+  const field::TopView view = field::TopView::ForField(field, o.image_width_px, 2.0);
   const cv::Point2d end = view.ToPixel({*rows[16 * 25 - 1].x_m, -3.0});
   const cv::Point2d start = view.ToPixel({-12.0, -3.0});  // walked through, off the lines
   // JET maps the top of the scale to dark red: more red than blue at the end, less red where it
@@ -133,7 +134,7 @@ TEST(Stats, PairDistancesAndReport) {
 TEST(Stats, TimeFromTracksAndRateOverride) {
   const uint64_t seed = fv::testing::TestSeed(23);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   std::vector<track::TrackRow> rows;
   const double v = 1.5, fps = 10;  // walking 1.5 m/s filmed at 10 frames/s
   for (int f = 0; f < 100; ++f) {

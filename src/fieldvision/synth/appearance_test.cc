@@ -154,8 +154,8 @@ TEST(SynthAppearance, PrintTurnsWithTheKicksSpin) {
   s.ball.kicks[0].spin_radps = Eigen::Vector3d(0, 0, 2 * M_PI);  // one turn per second about z
   const SceneRenderer spun(s);
   // A quarter turn 0.25 s after the kick; the flight is the same.
-  const Eigen::Matrix3d r0 = RotationFromRvec(s.ball.orientation_rvec);
-  const Eigen::Matrix3d quarter = RotationFromRvec(Eigen::Vector3d(0, 0, M_PI / 2));
+  const Eigen::Matrix3d r0 = geometry::RotationFromRvec(s.ball.orientation_rvec);
+  const Eigen::Matrix3d quarter = geometry::RotationFromRvec(Eigen::Vector3d(0, 0, M_PI / 2));
   EXPECT_LT((spun.BallOrientation(0.35) - quarter * r0).norm(), 1e-9);
   EXPECT_LT((spun.BallOrientation(0.05) - r0).norm(), 1e-12);
   EXPECT_LT((still.BallOrientation(0.35) - r0).norm(), 1e-12);
@@ -227,7 +227,7 @@ TEST(SynthAppearance, FisheyeCamerasLoadBackAndSeeBallsNearTheBorder) {
   // The lens: close to r = f theta.
   const std::vector<double> d = FisheyeDistortion();
   ASSERT_EQ(d.size(), 8u);
-  Camera lens = Camera::FromFov(640, 480, 60);
+  camera::Camera lens = camera::Camera::FromFov(640, 480, 60);
   lens.fx = lens.fy = FisheyeFocalPx(640, 130);
   lens.distortion = d;
   for (double deg : {20.0, 45.0, 65.0, 80.0}) {
@@ -241,10 +241,10 @@ TEST(SynthAppearance, FisheyeCamerasLoadBackAndSeeBallsNearTheBorder) {
   s.num_frames = 4;
   const SceneRenderer scene(s);
   const std::string dir = fv::testing::TempDir();
-  for (const Camera& cam : scene.cameras()) {
+  for (const camera::Camera& cam : scene.cameras()) {
     const std::string path = dir + "/" + cam.name + ".yaml";
-    WriteCameraYaml(cam, path);
-    const Camera back = ReadCameraYaml(path);
+    camera::WriteCameraYaml(cam, path);
+    const camera::Camera back = camera::ReadCameraYaml(path);
     ASSERT_EQ(back.distortion.size(), 8u);
     for (int f = 0; f < s.num_frames; ++f) {
       const Eigen::Vector3d p = scene.BallAt(scene.FrameTime(f));

@@ -17,7 +17,7 @@
 namespace fv::synth {
 
 struct SceneRenderer::CameraData {
-  Camera cam;
+  camera::Camera cam;
   Eigen::Vector3d origin;
   std::vector<Eigen::Vector3f> ray;  // unit world direction per pixel; NaN where undefined
   cv::Mat bg;                        // CV_8UC3
@@ -74,8 +74,8 @@ double Lambert(const LightingSpec& l, double ndl, double base, double slope) {
   return l.ambient >= 0 ? l.ambient + (1 - l.ambient) * lit : base + slope * lit;
 }
 
-Camera MakeCamera(const CameraSpec& s, int index) {
-  Camera c;
+camera::Camera MakeCamera(const CameraSpec& s, int index) {
+  camera::Camera c;
   if (s.fx > 0) {
     c.width = s.width;
     c.height = s.height;
@@ -84,20 +84,20 @@ Camera MakeCamera(const CameraSpec& s, int index) {
     c.cx = 0.5 * (s.width - 1);
     c.cy = 0.5 * (s.height - 1);
   } else {
-    c = Camera::FromFov(s.width, s.height, s.hfov_deg);
+    c = camera::Camera::FromFov(s.width, s.height, s.hfov_deg);
   }
   c.name = s.name;
   c.distortion = s.distortion;
   c.has_pose = true;
-  c.cam_from_world = s.has_rvec_tvec ? Rigid3d::FromRvecTvec(s.rvec, s.tvec)
-                                     : Rigid3d::LookAt(s.position_m, s.look_at_m);
+  c.cam_from_world = s.has_rvec_tvec ? geometry::Rigid3d::FromRvecTvec(s.rvec, s.tvec)
+                                     : geometry::Rigid3d::LookAt(s.position_m, s.look_at_m);
   c.notes["source"] = "fieldvision synth";
   c.Check(fmt::format("cameras[{}]", index));
   return c;
 }
 
 // The world ray of every pixel: exact undistortion seeded from a coarse grid, refined by Newton.
-std::vector<Eigen::Vector3f> PixelRays(const Camera& cam) {
+std::vector<Eigen::Vector3f> PixelRays(const camera::Camera& cam) {
   const int w = cam.width, h = cam.height;
   std::vector<Eigen::Vector3f> rays(static_cast<size_t>(w) * h);
   const Eigen::Matrix3d world_from_cam = cam.cam_from_world.rotation.transpose();
@@ -128,8 +128,8 @@ std::vector<Eigen::Vector3f> PixelRays(const Camera& cam) {
     }
   }
   using Jet = ceres::Jet<double, 2>;
-  std::array<Jet, kNumDistortion> dj;
-  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(dist[i]);
+  std::array<Jet, camera::kNumDistortion> dj;
+  for (int i = 0; i < camera::kNumDistortion; ++i) dj[i] = Jet(dist[i]);
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
       const Eigen::Vector2d target((u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy);
@@ -144,7 +144,7 @@ std::vector<Eigen::Vector3f> PixelRays(const Camera& cam) {
             b * ((1 - a) * grid[k01] + a * grid[k11]);
         for (int it = 0; it < 6; ++it) {
           Jet xd, yd;
-          DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
+          camera::DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
           const Eigen::Vector2d r(xd.a - target.x(), yd.a - target.y());
           if (std::abs(r.x() * cam.fx) + std::abs(r.y() * cam.fy) < 1e-9) {
             converged = true;
@@ -173,7 +173,7 @@ std::vector<Eigen::Vector3f> PixelRays(const Camera& cam) {
 
 // The static world seen by the background pass.
 struct StaticWorld {
-  const FieldModel* field = nullptr;
+  const field::FieldModel* field = nullptr;
   double hl = 0, hw = 0;  // half extents with the surround (walls stand there)
   double wall_h = 2.6;
   double stripe_w = 1.5;
@@ -200,7 +200,7 @@ struct StaticWorld {
   }
 
   Vec3 Ground(double x, double y, double fp) const {
-    const FieldModel& f = *field;
+    const field::FieldModel& f = *field;
     const bool playing = std::abs(x) <= 0.5 * f.length_m && std::abs(y) <= 0.5 * f.width_m;
     const double fine = std::clamp(1.0 - fp / 0.06, 0.0, 1.0);
     Vec3 c;
@@ -261,7 +261,7 @@ struct StaticWorld {
   double Shade(const Vec3& n) const { return Lambert(*lighting, n.dot(light), 0.55, 0.5); }
 };
 
-StaticWorld MakeStaticWorld(const FieldModel& f, const SceneSpec& spec) {
+StaticWorld MakeStaticWorld(const field::FieldModel& f, const SceneSpec& spec) {
   StaticWorld w;
   w.field = &f;
   w.hl = f.HalfLengthWithSurround();
@@ -280,7 +280,7 @@ StaticWorld MakeStaticWorld(const FieldModel& f, const SceneSpec& spec) {
     }
   }
   const Vec3 white(240, 240, 240), grey(200, 200, 200);
-  for (const FieldGoal& g : f.goals) {
+  for (const field::FieldGoal& g : f.goals) {
     const double r = 0.5 * g.post_width_m;
     const double x = g.line_x_m + g.side * r;
     const double xb = g.line_x_m + g.side * (g.depth_m + r);
@@ -423,7 +423,7 @@ void PaintLines(const StaticWorld& world, const SceneRenderer::CameraData& cd,
 
 void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
                       const SceneSpec& spec) {
-  const Camera& cam = cd.cam;
+  const camera::Camera& cam = cd.cam;
   const int w = cam.width, h = cam.height;
   cd.bg.create(h, w, CV_8UC3);
   cd.depth.create(h, w, CV_32F);
@@ -453,7 +453,8 @@ void RenderBackground(const StaticWorld& world, SceneRenderer::CameraData& cd,
 }
 
 // Image box (clipped) of a world box; empty when entirely behind the camera.
-cv::Rect ProjectBox(const Camera& cam, const Vec3& lo, const Vec3& hi, double margin_px = 2) {
+cv::Rect ProjectBox(const camera::Camera& cam, const Vec3& lo, const Vec3& hi,
+                    double margin_px = 2) {
   double umin = kInf, vmin = kInf, umax = -kInf, vmax = -kInf;
   int behind = 0;
   for (int k = 0; k < 8; ++k) {
@@ -485,7 +486,7 @@ cv::Rect ProjectBox(const Camera& cam, const Vec3& lo, const Vec3& hi, double ma
 }
 
 // Projected centre and apparent radius of a sphere (from its silhouette circle).
-bool ProjectSphere(const Camera& cam, const Vec3& c, double r, Eigen::Vector2d* uv,
+bool ProjectSphere(const camera::Camera& cam, const Vec3& c, double r, Eigen::Vector2d* uv,
                    double* radius_px) {
   const Vec3 o = cam.CentreInWorld();
   const Vec3 dv = c - o;
@@ -518,14 +519,14 @@ bool ProjectSphere(const Camera& cam, const Vec3& c, double r, Eigen::Vector2d* 
 
 SceneRenderer::SceneRenderer(const SceneSpec& spec) : spec_(spec) {
   spec_.Check();
-  field_ = LoadField(spec_.field);
+  field_ = field::LoadField(spec_.field);
   for (size_t i = 0; i < spec_.cameras.size(); ++i) {
     cameras_.push_back(MakeCamera(spec_.cameras[i], static_cast<int>(i)));
   }
   if (spec_.ball.enabled) {
     trajectory_ = std::make_unique<BallTrajectory>(spec_.ball, spec_.duration_s());
   }
-  Rng rng(spec_.seed * 6364136223846793005ULL + 1442695040888963407ULL);
+  util::Rng rng(spec_.seed * 6364136223846793005ULL + 1442695040888963407ULL);
   noise_table_.resize(65536);
   for (auto& n : noise_table_) {
     n = static_cast<int16_t>(
@@ -571,7 +572,7 @@ Eigen::Vector3d SceneRenderer::BallAt(double time_s) const {
 
 Eigen::Matrix3d SceneRenderer::BallOrientation(double time_s) const {
   const BallSpec& ball = spec_.ball;
-  Eigen::Matrix3d r = RotationFromRvec(ball.orientation_rvec);
+  Eigen::Matrix3d r = geometry::RotationFromRvec(ball.orientation_rvec);
   if (!ball.placements.empty()) {
     // A seeded turn per placement, so that each shows another side of the print.
     const long frame = std::lround(std::floor(time_s * spec_.fps + 0.5));
@@ -582,7 +583,7 @@ Eigen::Matrix3d SceneRenderer::BallOrientation(double time_s) const {
     const double az = 2 * M_PI * (SplitMix(state) >> 11) * 0x1.0p-53;
     const double angle = M_PI * (SplitMix(state) >> 11) * 0x1.0p-53;
     const double rho = std::sqrt(std::max(0.0, 1 - z * z));
-    return RotationFromRvec(angle * Vec3(rho * std::cos(az), rho * std::sin(az), z)) * r;
+    return geometry::RotationFromRvec(angle * Vec3(rho * std::cos(az), rho * std::sin(az), z)) * r;
   }
   // Kicks: each spins the ball from its time until the next kick.
   std::vector<KickSpec> kicks = ball.kicks;
@@ -590,13 +591,13 @@ Eigen::Matrix3d SceneRenderer::BallOrientation(double time_s) const {
                    [](const KickSpec& a, const KickSpec& b) { return a.time_s < b.time_s; });
   for (size_t k = 0; k < kicks.size() && kicks[k].time_s < time_s; ++k) {
     const double end = k + 1 < kicks.size() ? std::min(time_s, kicks[k + 1].time_s) : time_s;
-    r = RotationFromRvec(kicks[k].spin_radps * (end - kicks[k].time_s)) * r;
+    r = geometry::RotationFromRvec(kicks[k].spin_radps * (end - kicks[k].time_s)) * r;
   }
   return r;
 }
 
 std::vector<BallSample> SceneRenderer::BallSamples(int camera, double t) const {
-  const Camera& cam = cameras_[camera];
+  const camera::Camera& cam = cameras_[camera];
   const bool patterned = spec_.ball.pattern != "none";
   // Sub-exposure samples: about one per half pixel of image motion.
   const double e = spec_.exposure_s;
@@ -936,7 +937,7 @@ double BallCoverage(const SceneRenderer::CameraData& cd, double r, const Vec3& c
 // The ball's projection and the visible share of its disc at mid-exposure.
 BallCameraTruth BallVisibility(const FrameCanvas& fc, const Vec3& ball_mid, double r_ball) {
   const auto& cd = fc.cd;
-  const Camera& cam = cd.cam;
+  const camera::Camera& cam = cd.cam;
   BallCameraTruth bt;
   Eigen::Vector2d uv_mid;
   double rad_mid = 0;
@@ -993,7 +994,7 @@ Vec3 BallColour(const BallSpec& ball, const FrameCanvas& fc, const Eigen::Matrix
 // The ball anti-aliased, shaded and averaged over the sub-exposure samples (motion blur).
 void DrawBall(FrameCanvas& fc, const BallSpec& ball, const std::vector<BallSample>& samples) {
   const auto& cd = fc.cd;
-  const Camera& cam = cd.cam;
+  const camera::Camera& cam = cd.cam;
   const double r_ball = ball.radius_m();
   cv::Rect box;
   std::vector<BallSample> seen;

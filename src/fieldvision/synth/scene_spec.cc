@@ -19,7 +19,7 @@ using nlohmann::json;
 json PathToJson(const PathSpec& p) {
   json j;
   j["waypoints_m"] = json::array();
-  for (const auto& w : p.waypoints_m) j["waypoints_m"].push_back(JsonFromVector(w));
+  for (const auto& w : p.waypoints_m) j["waypoints_m"].push_back(util::JsonFromVector(w));
   j["speed_mps"] = p.speed_mps;
   if (!p.speeds_mps.empty()) j["speeds_mps"] = p.speeds_mps;
   j["start_s"] = p.start_s;
@@ -27,15 +27,15 @@ json PathToJson(const PathSpec& p) {
 }
 
 PathSpec PathFromJson(const json& o, const std::string& ctx) {
-  JsonKnownKeys(o, ctx, {"waypoints_m", "speed_mps", "speeds_mps", "start_s"});
+  util::JsonKnownKeys(o, ctx, {"waypoints_m", "speed_mps", "speeds_mps", "start_s"});
   PathSpec p;
-  const json& w = JsonArray(o, "waypoints_m", ctx);
+  const json& w = util::JsonArray(o, "waypoints_m", ctx);
   for (size_t i = 0; i < w.size(); ++i) {
-    p.waypoints_m.push_back(JsonVectorOf<2>(w[i], fmt::format("{}.waypoints_m[{}]", ctx, i)));
+    p.waypoints_m.push_back(util::JsonVectorOf<2>(w[i], fmt::format("{}.waypoints_m[{}]", ctx, i)));
   }
-  p.speed_mps = JsonNumber(o, "speed_mps", ctx, p.speed_mps);
-  p.speeds_mps = JsonNumbers(o, "speeds_mps", ctx, false);
-  p.start_s = JsonNumber(o, "start_s", ctx, p.start_s);
+  p.speed_mps = util::JsonNumber(o, "speed_mps", ctx, p.speed_mps);
+  p.speeds_mps = util::JsonNumbers(o, "speeds_mps", ctx, false);
+  p.start_s = util::JsonNumber(o, "start_s", ctx, p.start_s);
   return p;
 }
 
@@ -43,153 +43,159 @@ PathSpec PathFromJson(const json& o, const std::string& ctx) {
 
 CameraSpec CameraSpecFromJson(const json& c, size_t i) {
   const std::string ctx = fmt::format("cameras[{}]", i);
-  JsonKnownKeys(c, ctx,
-                {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion", "position_m",
-                 "look_at_m", "rvec", "tvec"});
+  util::JsonKnownKeys(c, ctx,
+                      {"name", "width", "height", "hfov_deg", "fx", "fy", "distortion",
+                       "position_m", "look_at_m", "rvec", "tvec"});
   CameraSpec cs;
-  cs.name = JsonString(c, "name", ctx, fmt::format("cam{}", i + 1));
-  cs.width = JsonInt(c, "width", ctx, cs.width);
-  cs.height = JsonInt(c, "height", ctx, cs.height);
-  cs.hfov_deg = JsonNumber(c, "hfov_deg", ctx, cs.hfov_deg);
-  cs.fx = JsonNumber(c, "fx", ctx, 0.0);
-  cs.fy = JsonNumber(c, "fy", ctx, cs.fx);
-  cs.distortion = JsonNumbers(c, "distortion", ctx, false);
-  if (JsonHas(c, "rvec") || JsonHas(c, "tvec")) {
-    FV_REQUIRE(JsonHas(c, "rvec") && JsonHas(c, "tvec"), "{}: give both rvec and tvec", ctx);
+  cs.name = util::JsonString(c, "name", ctx, fmt::format("cam{}", i + 1));
+  cs.width = util::JsonInt(c, "width", ctx, cs.width);
+  cs.height = util::JsonInt(c, "height", ctx, cs.height);
+  cs.hfov_deg = util::JsonNumber(c, "hfov_deg", ctx, cs.hfov_deg);
+  cs.fx = util::JsonNumber(c, "fx", ctx, 0.0);
+  cs.fy = util::JsonNumber(c, "fy", ctx, cs.fx);
+  cs.distortion = util::JsonNumbers(c, "distortion", ctx, false);
+  if (util::JsonHas(c, "rvec") || util::JsonHas(c, "tvec")) {
+    FV_REQUIRE(util::JsonHas(c, "rvec") && util::JsonHas(c, "tvec"), "{}: give both rvec and tvec",
+               ctx);
     cs.has_rvec_tvec = true;
-    cs.rvec = JsonVector<3>(c, "rvec", ctx, cs.rvec);
-    cs.tvec = JsonVector<3>(c, "tvec", ctx, cs.tvec);
+    cs.rvec = util::JsonVector<3>(c, "rvec", ctx, cs.rvec);
+    cs.tvec = util::JsonVector<3>(c, "tvec", ctx, cs.tvec);
   } else {
-    FV_REQUIRE(JsonHas(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)", ctx);
-    FV_REQUIRE(JsonHas(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
-    cs.position_m = JsonVector<3>(c, "position_m", ctx, cs.position_m);
-    cs.look_at_m = JsonVector<3>(c, "look_at_m", ctx, cs.look_at_m);
+    FV_REQUIRE(util::JsonHas(c, "position_m"), "{}.position_m: missing (or give rvec and tvec)",
+               ctx);
+    FV_REQUIRE(util::JsonHas(c, "look_at_m"), "{}.look_at_m: missing (or give rvec and tvec)", ctx);
+    cs.position_m = util::JsonVector<3>(c, "position_m", ctx, cs.position_m);
+    cs.look_at_m = util::JsonVector<3>(c, "look_at_m", ctx, cs.look_at_m);
   }
   return cs;
 }
 
 BallSpec BallSpecFromJson(const json& b, BallSpec ball) {
-  JsonKnownKeys(
+  util::JsonKnownKeys(
       b, "ball",
       {"enabled", "diameter_m", "colour_bgr", "placements", "hold_frames", "kicks", "held_by",
        "physics", "specular", "shininess", "pattern", "pattern_bgr", "orientation_rvec"});
-  ball.enabled = JsonBool(b, "enabled", "ball", true);
-  ball.diameter_m = JsonNumber(b, "diameter_m", "ball", ball.diameter_m);
-  ball.colour_bgr = JsonVector<3>(b, "colour_bgr", "ball", ball.colour_bgr);
-  const json& pl = JsonArray(b, "placements", "ball");
+  ball.enabled = util::JsonBool(b, "enabled", "ball", true);
+  ball.diameter_m = util::JsonNumber(b, "diameter_m", "ball", ball.diameter_m);
+  ball.colour_bgr = util::JsonVector<3>(b, "colour_bgr", "ball", ball.colour_bgr);
+  const json& pl = util::JsonArray(b, "placements", "ball");
   for (size_t i = 0; i < pl.size(); ++i) {
-    ball.placements.push_back(JsonVectorOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
+    ball.placements.push_back(util::JsonVectorOf<3>(pl[i], fmt::format("ball.placements[{}]", i)));
   }
-  ball.hold_frames = JsonInt(b, "hold_frames", "ball", ball.hold_frames);
-  const json& ks = JsonArray(b, "kicks", "ball");
+  ball.hold_frames = util::JsonInt(b, "hold_frames", "ball", ball.hold_frames);
+  const json& ks = util::JsonArray(b, "kicks", "ball");
   for (size_t i = 0; i < ks.size(); ++i) {
     const std::string ctx = fmt::format("ball.kicks[{}]", i);
-    JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps", "spin_radps"});
+    util::JsonKnownKeys(ks[i], ctx, {"time_s", "position_m", "velocity_mps", "spin_radps"});
     KickSpec k;
-    k.time_s = JsonNumber(ks[i], "time_s", ctx, 0.0);
-    FV_REQUIRE(JsonHas(ks[i], "position_m"), "{}.position_m: missing", ctx);
-    k.position_m = JsonVector<3>(ks[i], "position_m", ctx, k.position_m);
-    FV_REQUIRE(JsonHas(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
-    k.velocity_mps = JsonVector<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
-    k.spin_radps = JsonVector<3>(ks[i], "spin_radps", ctx, k.spin_radps);
+    k.time_s = util::JsonNumber(ks[i], "time_s", ctx, 0.0);
+    FV_REQUIRE(util::JsonHas(ks[i], "position_m"), "{}.position_m: missing", ctx);
+    k.position_m = util::JsonVector<3>(ks[i], "position_m", ctx, k.position_m);
+    FV_REQUIRE(util::JsonHas(ks[i], "velocity_mps"), "{}.velocity_mps: missing", ctx);
+    k.velocity_mps = util::JsonVector<3>(ks[i], "velocity_mps", ctx, k.velocity_mps);
+    k.spin_radps = util::JsonVector<3>(ks[i], "spin_radps", ctx, k.spin_radps);
     ball.kicks.push_back(k);
   }
-  ball.held_by = JsonInt(b, "held_by", "ball", ball.held_by);
-  ball.specular = JsonNumber(b, "specular", "ball", ball.specular);
-  ball.shininess = JsonNumber(b, "shininess", "ball", ball.shininess);
-  ball.pattern = JsonString(b, "pattern", "ball", ball.pattern);
-  ball.pattern_bgr = JsonVector<3>(b, "pattern_bgr", "ball", ball.pattern_bgr);
-  ball.orientation_rvec = JsonVector<3>(b, "orientation_rvec", "ball", ball.orientation_rvec);
-  const json& ph = JsonObject(b, "physics", "ball");
+  ball.held_by = util::JsonInt(b, "held_by", "ball", ball.held_by);
+  ball.specular = util::JsonNumber(b, "specular", "ball", ball.specular);
+  ball.shininess = util::JsonNumber(b, "shininess", "ball", ball.shininess);
+  ball.pattern = util::JsonString(b, "pattern", "ball", ball.pattern);
+  ball.pattern_bgr = util::JsonVector<3>(b, "pattern_bgr", "ball", ball.pattern_bgr);
+  ball.orientation_rvec = util::JsonVector<3>(b, "orientation_rvec", "ball", ball.orientation_rvec);
+  const json& ph = util::JsonObject(b, "physics", "ball");
   const std::string pc = "ball.physics";
-  JsonKnownKeys(ph, pc,
-                {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
-                 "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
+  util::JsonKnownKeys(
+      ph, pc,
+      {"gravity_mps2", "drag_coefficient", "air_density_kgm3", "mass_kg", "restitution",
+       "bounce_friction", "rolling_resistance", "min_bounce_speed_mps", "time_step_s"});
   BallPhysics& p = ball.physics;
-  p.gravity_mps2 = JsonNumber(ph, "gravity_mps2", pc, p.gravity_mps2);
-  p.drag_coefficient = JsonNumber(ph, "drag_coefficient", pc, p.drag_coefficient);
-  p.air_density_kgm3 = JsonNumber(ph, "air_density_kgm3", pc, p.air_density_kgm3);
-  p.mass_kg = JsonNumber(ph, "mass_kg", pc, p.mass_kg);
-  p.restitution = JsonNumber(ph, "restitution", pc, p.restitution);
-  p.bounce_friction = JsonNumber(ph, "bounce_friction", pc, p.bounce_friction);
-  p.rolling_resistance = JsonNumber(ph, "rolling_resistance", pc, p.rolling_resistance);
-  p.min_bounce_speed_mps = JsonNumber(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
-  p.time_step_s = JsonNumber(ph, "time_step_s", pc, p.time_step_s);
+  p.gravity_mps2 = util::JsonNumber(ph, "gravity_mps2", pc, p.gravity_mps2);
+  p.drag_coefficient = util::JsonNumber(ph, "drag_coefficient", pc, p.drag_coefficient);
+  p.air_density_kgm3 = util::JsonNumber(ph, "air_density_kgm3", pc, p.air_density_kgm3);
+  p.mass_kg = util::JsonNumber(ph, "mass_kg", pc, p.mass_kg);
+  p.restitution = util::JsonNumber(ph, "restitution", pc, p.restitution);
+  p.bounce_friction = util::JsonNumber(ph, "bounce_friction", pc, p.bounce_friction);
+  p.rolling_resistance = util::JsonNumber(ph, "rolling_resistance", pc, p.rolling_resistance);
+  p.min_bounce_speed_mps = util::JsonNumber(ph, "min_bounce_speed_mps", pc, p.min_bounce_speed_mps);
+  p.time_step_s = util::JsonNumber(ph, "time_step_s", pc, p.time_step_s);
   return ball;
 }
 
 RobotSpec RobotSpecFromJson(const json& robot, size_t i) {
   const std::string ctx = fmt::format("robots[{}]", i);
-  JsonKnownKeys(
+  util::JsonKnownKeys(
       robot, ctx,
       {"path", "position_m", "radius_m", "height_m", "colour_bgr", "handler", "heading_deg"});
   RobotSpec r;
-  if (JsonHas(robot, "path")) r.path = PathFromJson(robot["path"], ctx + ".path");
-  if (JsonHas(robot, "position_m")) {
-    r.path.waypoints_m.insert(r.path.waypoints_m.begin(),
-                              JsonVector<2>(robot, "position_m", ctx, Eigen::Vector2d::Zero()));
+  if (util::JsonHas(robot, "path")) r.path = PathFromJson(robot["path"], ctx + ".path");
+  if (util::JsonHas(robot, "position_m")) {
+    r.path.waypoints_m.insert(
+        r.path.waypoints_m.begin(),
+        util::JsonVector<2>(robot, "position_m", ctx, Eigen::Vector2d::Zero()));
   }
-  r.radius_m = JsonNumber(robot, "radius_m", ctx, r.radius_m);
-  r.height_m = JsonNumber(robot, "height_m", ctx, r.height_m);
-  r.colour_bgr = JsonVector<3>(robot, "colour_bgr", ctx, r.colour_bgr);
-  r.handler = JsonBool(robot, "handler", ctx, r.handler);
-  r.heading_deg = JsonNumber(robot, "heading_deg", ctx, r.heading_deg);
+  r.radius_m = util::JsonNumber(robot, "radius_m", ctx, r.radius_m);
+  r.height_m = util::JsonNumber(robot, "height_m", ctx, r.height_m);
+  r.colour_bgr = util::JsonVector<3>(robot, "colour_bgr", ctx, r.colour_bgr);
+  r.handler = util::JsonBool(robot, "handler", ctx, r.handler);
+  r.heading_deg = util::JsonNumber(robot, "heading_deg", ctx, r.heading_deg);
   return r;
 }
 
 PersonSpec PersonSpecFromJson(const json& person, size_t i) {
   const std::string ctx = fmt::format("people[{}]", i);
-  JsonKnownKeys(person, ctx, {"id", "team", "path", "height_m", "skin_bgr"});
+  util::JsonKnownKeys(person, ctx, {"id", "team", "path", "height_m", "skin_bgr"});
   PersonSpec p;
-  p.id = JsonInt(person, "id", ctx, static_cast<int>(i) + 1);
-  p.team = JsonInt(person, "team", ctx, 0);
-  FV_REQUIRE(JsonHas(person, "path"), "{}.path: missing", ctx);
+  p.id = util::JsonInt(person, "id", ctx, static_cast<int>(i) + 1);
+  p.team = util::JsonInt(person, "team", ctx, 0);
+  FV_REQUIRE(util::JsonHas(person, "path"), "{}.path: missing", ctx);
   p.path = PathFromJson(person["path"], ctx + ".path");
-  p.height_m = JsonNumber(person, "height_m", ctx, p.height_m);
-  p.skin_bgr = JsonVector<3>(person, "skin_bgr", ctx, p.skin_bgr);
+  p.height_m = util::JsonNumber(person, "height_m", ctx, p.height_m);
+  p.skin_bgr = util::JsonVector<3>(person, "skin_bgr", ctx, p.skin_bgr);
   return p;
 }
 
 TeamSpec TeamSpecFromJson(const json& team, size_t i) {
   const std::string ctx = fmt::format("teams[{}]", i);
-  JsonKnownKeys(team, ctx, {"name", "shirt_bgr", "shorts_bgr"});
+  util::JsonKnownKeys(team, ctx, {"name", "shirt_bgr", "shorts_bgr"});
   TeamSpec t;
-  t.name = JsonString(team, "name", ctx, fmt::format("team{}", i));
-  t.shirt_bgr = JsonVector<3>(team, "shirt_bgr", ctx, t.shirt_bgr);
-  t.shorts_bgr = JsonVector<3>(team, "shorts_bgr", ctx, t.shorts_bgr);
+  t.name = util::JsonString(team, "name", ctx, fmt::format("team{}", i));
+  t.shirt_bgr = util::JsonVector<3>(team, "shirt_bgr", ctx, t.shirt_bgr);
+  t.shorts_bgr = util::JsonVector<3>(team, "shorts_bgr", ctx, t.shorts_bgr);
   return t;
 }
 
 ConeSpec ConeSpecFromJson(const json& cone, size_t i) {
   const std::string ctx = fmt::format("cones[{}]", i);
-  JsonKnownKeys(cone, ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
+  util::JsonKnownKeys(cone, ctx, {"position_m", "height_m", "base_radius_m", "colour_bgr"});
   ConeSpec c;
-  FV_REQUIRE(JsonHas(cone, "position_m"), "{}.position_m: missing", ctx);
-  c.position_m = JsonVector<2>(cone, "position_m", ctx, c.position_m);
-  c.height_m = JsonNumber(cone, "height_m", ctx, c.height_m);
-  c.base_radius_m = JsonNumber(cone, "base_radius_m", ctx, c.base_radius_m);
-  c.colour_bgr = JsonVector<3>(cone, "colour_bgr", ctx, c.colour_bgr);
+  FV_REQUIRE(util::JsonHas(cone, "position_m"), "{}.position_m: missing", ctx);
+  c.position_m = util::JsonVector<2>(cone, "position_m", ctx, c.position_m);
+  c.height_m = util::JsonNumber(cone, "height_m", ctx, c.height_m);
+  c.base_radius_m = util::JsonNumber(cone, "base_radius_m", ctx, c.base_radius_m);
+  c.colour_bgr = util::JsonVector<3>(cone, "colour_bgr", ctx, c.colour_bgr);
   return c;
 }
 
 LightingSpec LightingSpecFromJson(const json& l, LightingSpec lighting) {
-  JsonKnownKeys(
+  util::JsonKnownKeys(
       l, "lighting",
       {"light_dir", "sun_elevation_deg", "sun_azimuth_deg", "ambient", "gain_amplitude", "period_s",
        "white_balance_amplitude", "white_balance_period_s", "vignetting", "shadows"});
   const std::string lc = "lighting";
-  lighting.light_dir = JsonVector<3>(l, "light_dir", lc, lighting.light_dir);
-  lighting.sun_elevation_deg = JsonNumber(l, "sun_elevation_deg", lc, lighting.sun_elevation_deg);
-  lighting.sun_azimuth_deg = JsonNumber(l, "sun_azimuth_deg", lc, lighting.sun_azimuth_deg);
-  lighting.ambient = JsonNumber(l, "ambient", lc, lighting.ambient);
+  lighting.light_dir = util::JsonVector<3>(l, "light_dir", lc, lighting.light_dir);
+  lighting.sun_elevation_deg =
+      util::JsonNumber(l, "sun_elevation_deg", lc, lighting.sun_elevation_deg);
+  lighting.sun_azimuth_deg = util::JsonNumber(l, "sun_azimuth_deg", lc, lighting.sun_azimuth_deg);
+  lighting.ambient = util::JsonNumber(l, "ambient", lc, lighting.ambient);
   lighting.white_balance_amplitude =
-      JsonNumber(l, "white_balance_amplitude", lc, lighting.white_balance_amplitude);
+      util::JsonNumber(l, "white_balance_amplitude", lc, lighting.white_balance_amplitude);
   lighting.white_balance_period_s =
-      JsonNumber(l, "white_balance_period_s", lc, lighting.white_balance_period_s);
-  lighting.gain_amplitude = JsonNumber(l, "gain_amplitude", "lighting", lighting.gain_amplitude);
-  lighting.period_s = JsonNumber(l, "period_s", "lighting", lighting.period_s);
-  lighting.vignetting = JsonNumber(l, "vignetting", "lighting", lighting.vignetting);
-  lighting.shadows = JsonBool(l, "shadows", "lighting", lighting.shadows);
+      util::JsonNumber(l, "white_balance_period_s", lc, lighting.white_balance_period_s);
+  lighting.gain_amplitude =
+      util::JsonNumber(l, "gain_amplitude", "lighting", lighting.gain_amplitude);
+  lighting.period_s = util::JsonNumber(l, "period_s", "lighting", lighting.period_s);
+  lighting.vignetting = util::JsonNumber(l, "vignetting", "lighting", lighting.vignetting);
+  lighting.shadows = util::JsonBool(l, "shadows", "lighting", lighting.shadows);
   return lighting;
 }
 
@@ -217,7 +223,7 @@ void CheckColour(const Eigen::Vector3d& c, const std::string& ctx) {
 }
 
 // A rig of 4 cameras at the corners of a field, outside the playing area, looking at it.
-std::vector<CameraSpec> CornerRig(const FieldModel& f, double height_m, int w, int h,
+std::vector<CameraSpec> CornerRig(const field::FieldModel& f, double height_m, int w, int h,
                                   double hfov_deg) {
   std::vector<CameraSpec> cams;
   const double hx = 0.5 * f.length_m + 0.9 * f.surround_m;
@@ -243,7 +249,7 @@ SceneSpec MslCornerScene(uint64_t seed, double fps, int num_frames) {
   SceneSpec s;
   s.seed = seed;
   s.field = "robocup-msl";
-  s.cameras = CornerRig(BuiltinField(s.field), 4.0, 1280, 960, 75.0);
+  s.cameras = CornerRig(field::BuiltinField(s.field), 4.0, 1280, 960, 75.0);
   s.fps = fps;
   s.num_frames = num_frames;
   return s;
@@ -251,8 +257,8 @@ SceneSpec MslCornerScene(uint64_t seed, double fps, int num_frames) {
 
 SceneSpec StaticPreset(uint64_t seed) {
   SceneSpec s = MslCornerScene(seed, 30, 16);
-  const FieldModel f = BuiltinField(s.field);
-  Rng rng(seed * 7919 + 17);
+  const field::FieldModel f = field::BuiltinField(s.field);
+  util::Rng rng(seed * 7919 + 17);
   const double r = s.ball.radius_m();
   for (int i = 0; i < s.num_frames; ++i) {
     Eigen::Vector3d p(rng.Uniform(-0.42, 0.42) * f.length_m, rng.Uniform(-0.42, 0.42) * f.width_m,
@@ -269,7 +275,7 @@ SceneSpec StaticPreset(uint64_t seed) {
 
 SceneSpec KickPreset(uint64_t seed) {
   SceneSpec s = MslCornerScene(seed, 60, 192);
-  Rng rng(seed * 104729 + 3);
+  util::Rng rng(seed * 104729 + 3);
   const double r = s.ball.radius_m();
   KickSpec k;
   k.time_s = 0.25;
@@ -307,7 +313,7 @@ SceneSpec PlayersPreset(uint64_t seed) {
   SceneSpec s;
   s.seed = seed;
   s.field = "robocup-msl";
-  const FieldModel f = BuiltinField(s.field);
+  const field::FieldModel f = field::BuiltinField(s.field);
   CameraSpec c;
   c.name = "side";
   c.width = 1280;
@@ -320,7 +326,7 @@ SceneSpec PlayersPreset(uint64_t seed) {
   s.fps = 25;
   s.num_frames = 250;
   s.ball.enabled = false;
-  Rng rng(seed * 15485863 + 11);
+  util::Rng rng(seed * 15485863 + 11);
   const double hx = 0.45 * f.length_m, hy = 0.42 * f.width_m;
   for (int i = 0; i < 8; ++i) {
     PersonSpec p;
@@ -385,12 +391,12 @@ SceneSpec LowSunKickPreset(uint64_t seed) {
 // are placed where cam1 sees them near its image border (within 12 % of the width of it).
 SceneSpec FisheyePreset(uint64_t seed) {
   SceneSpec s = StaticPreset(seed);
-  const FieldModel f = BuiltinField(s.field);
+  const field::FieldModel f = field::BuiltinField(s.field);
   for (CameraSpec& c : s.cameras) {
     c.fx = c.fy = FisheyeFocalPx(c.width, 130.0);
     c.distortion = FisheyeDistortion();
   }
-  Camera cam1;
+  camera::Camera cam1;
   cam1.width = s.cameras[0].width;
   cam1.height = s.cameras[0].height;
   cam1.fx = cam1.fy = s.cameras[0].fx;
@@ -398,8 +404,8 @@ SceneSpec FisheyePreset(uint64_t seed) {
   cam1.cy = 0.5 * (cam1.height - 1);
   cam1.distortion = s.cameras[0].distortion;
   cam1.has_pose = true;
-  cam1.cam_from_world = Rigid3d::LookAt(s.cameras[0].position_m, s.cameras[0].look_at_m);
-  Rng rng(seed * 2654435761ULL + 5);
+  cam1.cam_from_world = geometry::Rigid3d::LookAt(s.cameras[0].position_m, s.cameras[0].look_at_m);
+  util::Rng rng(seed * 2654435761ULL + 5);
   const double r = s.ball.radius_m();
   const double margin = 0.12 * cam1.width;
   s.ball.placements.clear();
@@ -428,7 +434,7 @@ SceneSpec HeldPreset(uint64_t seed) {
   s.ball.placements.clear();
   s.num_frames = 24;
   s.fps = 30;
-  Rng rng(seed * 40503 + 9);
+  util::Rng rng(seed * 40503 + 9);
   RobotSpec r1;
   r1.handler = true;
   r1.heading_deg = rng.Uniform(0.0, 360.0);
@@ -650,11 +656,11 @@ json CameraSpecToJson(const CameraSpec& c) {
   }
   cj["distortion"] = c.distortion;
   if (c.has_rvec_tvec) {
-    cj["rvec"] = JsonFromVector(c.rvec);
-    cj["tvec"] = JsonFromVector(c.tvec);
+    cj["rvec"] = util::JsonFromVector(c.rvec);
+    cj["tvec"] = util::JsonFromVector(c.tvec);
   } else {
-    cj["position_m"] = JsonFromVector(c.position_m);
-    cj["look_at_m"] = JsonFromVector(c.look_at_m);
+    cj["position_m"] = util::JsonFromVector(c.position_m);
+    cj["look_at_m"] = util::JsonFromVector(c.look_at_m);
   }
   return cj;
 }
@@ -664,16 +670,16 @@ json BallSpecToJson(const BallSpec& ball) {
   json b;
   b["enabled"] = ball.enabled;
   b["diameter_m"] = ball.diameter_m;
-  b["colour_bgr"] = JsonFromVector(ball.colour_bgr);
+  b["colour_bgr"] = util::JsonFromVector(ball.colour_bgr);
   b["placements"] = json::array();
-  for (const auto& p : ball.placements) b["placements"].push_back(JsonFromVector(p));
+  for (const auto& p : ball.placements) b["placements"].push_back(util::JsonFromVector(p));
   b["hold_frames"] = ball.hold_frames;
   b["kicks"] = json::array();
   for (const auto& k : ball.kicks) {
     json kj = {{"time_s", k.time_s},
-               {"position_m", JsonFromVector(k.position_m)},
-               {"velocity_mps", JsonFromVector(k.velocity_mps)}};
-    if (!k.spin_radps.isZero()) kj["spin_radps"] = JsonFromVector(k.spin_radps);
+               {"position_m", util::JsonFromVector(k.position_m)},
+               {"velocity_mps", util::JsonFromVector(k.velocity_mps)}};
+    if (!k.spin_radps.isZero()) kj["spin_radps"] = util::JsonFromVector(k.spin_radps);
     b["kicks"].push_back(kj);
   }
   // The appearance keys are written when they differ from the defaults (older scenes unchanged).
@@ -683,10 +689,10 @@ json BallSpecToJson(const BallSpec& ball) {
   if (ball.shininess != db.shininess) b["shininess"] = ball.shininess;
   if (ball.pattern != db.pattern) {
     b["pattern"] = ball.pattern;
-    b["pattern_bgr"] = JsonFromVector(ball.pattern_bgr);
+    b["pattern_bgr"] = util::JsonFromVector(ball.pattern_bgr);
   }
   if (!ball.orientation_rvec.isZero()) {
-    b["orientation_rvec"] = JsonFromVector(ball.orientation_rvec);
+    b["orientation_rvec"] = util::JsonFromVector(ball.orientation_rvec);
   }
   const BallPhysics& p = ball.physics;
   b["physics"] = {{"gravity_mps2", p.gravity_mps2},
@@ -718,7 +724,7 @@ json SceneSpecToJson(const SceneSpec& s) {
     json rj = {{"path", PathToJson(r.path)},
                {"radius_m", r.radius_m},
                {"height_m", r.height_m},
-               {"colour_bgr", JsonFromVector(r.colour_bgr)}};
+               {"colour_bgr", util::JsonFromVector(r.colour_bgr)}};
     if (r.handler) {
       rj["handler"] = true;
       rj["heading_deg"] = r.heading_deg;
@@ -731,22 +737,22 @@ json SceneSpecToJson(const SceneSpec& s) {
                            {"team", p.team},
                            {"path", PathToJson(p.path)},
                            {"height_m", p.height_m},
-                           {"skin_bgr", JsonFromVector(p.skin_bgr)}});
+                           {"skin_bgr", util::JsonFromVector(p.skin_bgr)}});
   }
   j["teams"] = json::array();
   for (const auto& t : s.teams) {
     j["teams"].push_back({{"name", t.name},
-                          {"shirt_bgr", JsonFromVector(t.shirt_bgr)},
-                          {"shorts_bgr", JsonFromVector(t.shorts_bgr)}});
+                          {"shirt_bgr", util::JsonFromVector(t.shirt_bgr)},
+                          {"shorts_bgr", util::JsonFromVector(t.shorts_bgr)}});
   }
   j["cones"] = json::array();
   for (const auto& c : s.cones) {
-    j["cones"].push_back({{"position_m", JsonFromVector(c.position_m)},
+    j["cones"].push_back({{"position_m", util::JsonFromVector(c.position_m)},
                           {"height_m", c.height_m},
                           {"base_radius_m", c.base_radius_m},
-                          {"colour_bgr", JsonFromVector(c.colour_bgr)}});
+                          {"colour_bgr", util::JsonFromVector(c.colour_bgr)}});
   }
-  j["lighting"] = {{"light_dir", JsonFromVector(s.lighting.light_dir)},
+  j["lighting"] = {{"light_dir", util::JsonFromVector(s.lighting.light_dir)},
                    {"gain_amplitude", s.lighting.gain_amplitude},
                    {"period_s", s.lighting.period_s},
                    {"vignetting", s.lighting.vignetting},
@@ -769,54 +775,54 @@ json SceneSpecToJson(const SceneSpec& s) {
 
 SceneSpec SceneSpecFromJson(const json& j, const std::string& context) {
   try {
-    JsonKnownKeys(j, "",
-                  {"field", "fps", "num_frames", "duration_s", "seed", "exposure_s", "cameras",
-                   "ball", "robots", "people", "teams", "cones", "lighting", "noise_sigma",
-                   "jpeg_quality", "format"});
+    util::JsonKnownKeys(j, "",
+                        {"field", "fps", "num_frames", "duration_s", "seed", "exposure_s",
+                         "cameras", "ball", "robots", "people", "teams", "cones", "lighting",
+                         "noise_sigma", "jpeg_quality", "format"});
     SceneSpec s;
-    s.field = JsonString(j, "field", "", s.field);
-    s.fps = JsonNumber(j, "fps", "", s.fps);
+    s.field = util::JsonString(j, "field", "", s.field);
+    s.fps = util::JsonNumber(j, "fps", "", s.fps);
     FV_REQUIRE(s.fps > 0, "fps: must be > 0");
-    if (JsonHas(j, "num_frames")) {
-      s.num_frames = JsonInt(j, "num_frames", "", s.num_frames);
-    } else if (JsonHas(j, "duration_s")) {
-      const double d = JsonNumber(j, "duration_s", "", 1.0);
+    if (util::JsonHas(j, "num_frames")) {
+      s.num_frames = util::JsonInt(j, "num_frames", "", s.num_frames);
+    } else if (util::JsonHas(j, "duration_s")) {
+      const double d = util::JsonNumber(j, "duration_s", "", 1.0);
       FV_REQUIRE(d > 0 && d < 1e5, "duration_s: must be in (0, 1e5)");
       s.num_frames = std::max(1, static_cast<int>(std::lround(d * s.fps)));
     }
-    if (JsonHas(j, "seed")) {
+    if (util::JsonHas(j, "seed")) {
       FV_REQUIRE(j["seed"].is_number_unsigned() || j["seed"].is_number_integer(),
                  "seed: must be a non-negative integer");
       FV_REQUIRE(!j["seed"].is_number_integer() || j["seed"].get<int64_t>() >= 0,
                  "seed: must be a non-negative integer");
       s.seed = j["seed"].get<uint64_t>();
     }
-    s.exposure_s = JsonNumber(j, "exposure_s", "", s.exposure_s);
-    const json& cams = JsonArray(j, "cameras", "");
+    s.exposure_s = util::JsonNumber(j, "exposure_s", "", s.exposure_s);
+    const json& cams = util::JsonArray(j, "cameras", "");
     s.cameras.clear();
     for (size_t i = 0; i < cams.size(); ++i) s.cameras.push_back(CameraSpecFromJson(cams[i], i));
-    if (JsonHas(j, "ball")) {
-      s.ball = BallSpecFromJson(JsonObject(j, "ball", ""), s.ball);
+    if (util::JsonHas(j, "ball")) {
+      s.ball = BallSpecFromJson(util::JsonObject(j, "ball", ""), s.ball);
     } else {
       s.ball.enabled = false;
     }
-    const json& robots = JsonArray(j, "robots", "");
+    const json& robots = util::JsonArray(j, "robots", "");
     for (size_t i = 0; i < robots.size(); ++i) s.robots.push_back(RobotSpecFromJson(robots[i], i));
-    const json& people = JsonArray(j, "people", "");
+    const json& people = util::JsonArray(j, "people", "");
     for (size_t i = 0; i < people.size(); ++i) s.people.push_back(PersonSpecFromJson(people[i], i));
-    if (JsonHas(j, "teams")) {
-      const json& teams = JsonArray(j, "teams", "");
+    if (util::JsonHas(j, "teams")) {
+      const json& teams = util::JsonArray(j, "teams", "");
       s.teams.clear();
       for (size_t i = 0; i < teams.size(); ++i) s.teams.push_back(TeamSpecFromJson(teams[i], i));
     }
-    const json& cones = JsonArray(j, "cones", "");
+    const json& cones = util::JsonArray(j, "cones", "");
     for (size_t i = 0; i < cones.size(); ++i) s.cones.push_back(ConeSpecFromJson(cones[i], i));
-    if (JsonHas(j, "lighting")) {
-      s.lighting = LightingSpecFromJson(JsonObject(j, "lighting", ""), s.lighting);
+    if (util::JsonHas(j, "lighting")) {
+      s.lighting = LightingSpecFromJson(util::JsonObject(j, "lighting", ""), s.lighting);
     }
-    s.noise_sigma = JsonNumber(j, "noise_sigma", "", s.noise_sigma);
-    s.jpeg_quality = JsonInt(j, "jpeg_quality", "", s.jpeg_quality);
-    s.format = JsonString(j, "format", "", s.format);
+    s.noise_sigma = util::JsonNumber(j, "noise_sigma", "", s.noise_sigma);
+    s.jpeg_quality = util::JsonInt(j, "jpeg_quality", "", s.jpeg_quality);
+    s.format = util::JsonString(j, "format", "", s.format);
     s.Check();
     return s;
   } catch (const Error& e) {
@@ -903,10 +909,10 @@ json FlightsToJson(const std::vector<Flight>& flights) {
   for (const auto& f : flights) {
     a.push_back({{"t_start_s", f.t_start_s},
                  {"t_end_s", f.t_end_s},
-                 {"origin", JsonFromVector(f.origin)},
-                 {"landing", JsonFromVector(f.landing)},
-                 {"apex", JsonFromVector(f.apex)},
-                 {"v0_mps", JsonFromVector(f.v0_mps)}});
+                 {"origin", util::JsonFromVector(f.origin)},
+                 {"landing", util::JsonFromVector(f.landing)},
+                 {"apex", util::JsonFromVector(f.apex)},
+                 {"v0_mps", util::JsonFromVector(f.v0_mps)}});
   }
   return a;
 }

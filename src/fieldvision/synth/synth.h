@@ -1,9 +1,9 @@
-// The synthetic world: N calibrated cameras (fv::Camera's model, so projections agree exactly)
-// looking at a field with a ball, robots, people and distractors, rendered by ray casting with
-// exact ground truth. Per camera the pixel rays and the static background are computed once; per
-// frame only the moving objects' image boxes are ray-cast (sphere, cylinder, capsules), the ball
-// shaded (Lambert with an ambient share, Phong highlight, a printed pattern turning with its spin)
-// and motion-blurred, then exposure and white-balance drift, vignetting, noise and MJPG. Ball
+// The synthetic world: N calibrated cameras (fv::camera::Camera's model, so projections agree
+// exactly) looking at a field with a ball, robots, people and distractors, rendered by ray casting
+// with exact ground truth. Per camera the pixel rays and the static background are computed once;
+// per frame only the moving objects' image boxes are ray-cast (sphere, cylinder, capsules), the
+// ball shaded (Lambert with an ambient share, Phong highlight, a printed pattern turning with its
+// spin) and motion-blurred, then exposure and white-balance drift, vignetting, noise and MJPG. Ball
 // physics: ball_physics.h. Use: DEVELOPERS.md, "The synthetic world".
 #pragma once
 
@@ -152,7 +152,7 @@ struct LightingSpec {
 };
 
 struct SceneSpec {
-  std::string field = "robocup-msl";  // built-in name or JSON path (fv::LoadField)
+  std::string field = "robocup-msl";  // built-in name or JSON path (fv::field::LoadField)
   std::vector<CameraSpec> cameras;
   double fps = 60.0;
   int num_frames = 60;
@@ -253,8 +253,8 @@ class SceneRenderer {
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   const SceneSpec& spec() const { return spec_; }
-  const std::vector<Camera>& cameras() const { return cameras_; }
-  const FieldModel& field() const { return field_; }
+  const std::vector<camera::Camera>& cameras() const { return cameras_; }
+  const field::FieldModel& field() const { return field_; }
   int num_frames() const { return spec_.num_frames; }
   double fps() const { return spec_.fps; }
   double FrameTime(int frame) const { return frame / spec_.fps; }
@@ -286,8 +286,8 @@ class SceneRenderer {
   // The ball's centre and turn at sub-exposure times (about one per half pixel of motion).
   std::vector<BallSample> BallSamples(int camera, double t) const;
   SceneSpec spec_;
-  FieldModel field_;
-  std::vector<Camera> cameras_;
+  field::FieldModel field_;
+  std::vector<camera::Camera> cameras_;
   std::unique_ptr<BallTrajectory> trajectory_;
   std::vector<std::unique_ptr<CameraData>> data_;
   std::vector<int16_t> noise_table_;  // Gaussian noise values, indexed by a per-frame hash

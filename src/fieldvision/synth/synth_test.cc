@@ -107,7 +107,7 @@ TEST(SceneSpec, BadValuesNameTheKey) {
 TEST(BallPhysics, NoDragKickIsTheClosedFormParabola) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallSpec ball;
   ball.physics.drag_coefficient = 0;
   KickSpec k;
@@ -137,7 +137,7 @@ TEST(BallPhysics, NoDragKickIsTheClosedFormParabola) {
 TEST(BallPhysics, BouncesLoseEnergyAndFlightsTouchTheGround) {
   const uint64_t seed = fv::testing::TestSeed(4);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   BallSpec ball;
   KickSpec k;
   k.time_s = 0.1;
@@ -173,7 +173,7 @@ TEST(BallPhysics, BouncesLoseEnergyAndFlightsTouchTheGround) {
 TEST(Renderer, BallCentreProjectsInsideItsBlob) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   std::vector<Eigen::Vector3d> places;
   for (int i = 0; i < 4; ++i) {
     places.push_back(Eigen::Vector3d(rng.Uniform(-4, 0), rng.Uniform(-3, 1), rng.Uniform(0.3, 2)));
@@ -187,7 +187,7 @@ TEST(Renderer, BallCentreProjectsInsideItsBlob) {
     EXPECT_LT((truth.centre_m - places[f]).norm(), 1e-12);
     for (size_t c = 0; c < images.size(); ++c) {
       const BallCameraTruth& bt = truth.cameras[c];
-      const Camera& cam = scene.cameras()[c];
+      const camera::Camera& cam = scene.cameras()[c];
       if (!bt.in_front || !cam.InImage(bt.uv_px, bt.radius_px + 2)) continue;
       // The projection agrees with the camera model.
       EXPECT_LT((*cam.Project(truth.centre_m) - bt.uv_px).norm(), 1e-9);
@@ -229,10 +229,10 @@ TEST(Renderer, BallBehindARobotIsNotVisible) {
 
 TEST(Renderer, PaintedLinesAreWhiteAndGrassIsGreen) {
   const SceneRenderer scene(CleanScene({Eigen::Vector3d(30, 30, 0.11)}, 1));
-  const FieldModel& field = scene.field();
+  const field::FieldModel& field = scene.field();
   int white = 0, green = 0;
   for (size_t c = 0; c < scene.cameras().size(); ++c) {
-    const Camera& cam = scene.cameras()[c];
+    const camera::Camera& cam = scene.cameras()[c];
     const cv::Mat img = scene.RenderCamera(static_cast<int>(c), 0);
     for (const Eigen::Vector2d& p : field.SampleLines(0.5)) {
       const auto uv = cam.Project(Eigen::Vector3d(p.x(), p.y(), 0));
@@ -244,7 +244,7 @@ TEST(Renderer, PaintedLinesAreWhiteAndGrassIsGreen) {
       EXPECT_GT(std::min({px[0], px[1], px[2]}), 150) << "line point " << p.transpose();
       ++white;
     }
-    Rng rng(11);
+    util::Rng rng(11);
     for (int k = 0; k < 200; ++k) {
       const Eigen::Vector2d p(rng.Uniform(-9, 9), rng.Uniform(-6, 6));
       if (field.DistanceToPaint(p) < 0.5) continue;
@@ -294,7 +294,7 @@ TEST(Renderer, PlayerBoxesContainTheFigures) {
   ResizeCameras(s, 320, 240);
   s.num_frames = 5;
   const SceneRenderer scene(s);
-  const Camera& cam = scene.cameras()[0];
+  const camera::Camera& cam = scene.cameras()[0];
   int checked = 0;
   for (int f = 0; f < 5; f += 2) {
     const std::vector<PersonTruth> truth = scene.PlayerTruth(f);
@@ -366,15 +366,15 @@ TEST(Writer, ReproducibleFilesWithContractHeaders) {
     ASSERT_TRUE(fs::exists(dir + "/a/" + name)) << name;
     EXPECT_EQ(ReadAll(dir + "/a/" + name), ReadAll(dir + "/b/" + name)) << name;
   }
-  EXPECT_EQ(CsvTable::Read(dir + "/a/truth.csv").header(),
+  EXPECT_EQ(util::CsvTable::Read(dir + "/a/truth.csv").header(),
             (std::vector<std::string>{"frame", "time_s", "x_m", "y_m", "z_m", "n_cams"}));
-  EXPECT_EQ(CsvTable::Read(dir + "/a/truth.csv").rows(), 20u);
+  EXPECT_EQ(util::CsvTable::Read(dir + "/a/truth.csv").rows(), 20u);
   EXPECT_EQ(
-      CsvTable::Read(dir + "/a/truth_2d.csv").header(),
+      util::CsvTable::Read(dir + "/a/truth_2d.csv").header(),
       (std::vector<std::string>{"frame", "cam", "u_px", "v_px", "radius_px", "visible_fraction"}));
-  EXPECT_EQ(CsvTable::Read(dir + "/a/players.csv").header(),
+  EXPECT_EQ(util::CsvTable::Read(dir + "/a/players.csv").header(),
             (std::vector<std::string>{"frame", "time_s", "id", "team", "x_m", "y_m"}));
-  EXPECT_EQ(CsvTable::Read(dir + "/a/players_2d.csv").header(),
+  EXPECT_EQ(util::CsvTable::Read(dir + "/a/players_2d.csv").header(),
             (std::vector<std::string>{"frame", "cam", "id", "bb_left", "bb_top", "bb_width",
                                       "bb_height", "visible_fraction"}));
   const nlohmann::json flights = nlohmann::json::parse(ReadAll(dir + "/a/flights.json"));
@@ -385,7 +385,7 @@ TEST(Writer, ReproducibleFilesWithContractHeaders) {
   }
   // Camera files read back to the renderer's cameras.
   const SceneRenderer scene(s);
-  const Camera cam = ReadCameraYaml(dir + "/a/cam2.yaml");
+  const camera::Camera cam = camera::ReadCameraYaml(dir + "/a/cam2.yaml");
   const Eigen::Vector3d p(1, 2, 0.5);
   EXPECT_LT((*cam.Project(p) - *scene.cameras()[1].Project(p)).norm(), 1e-6);
   // Videos open with the right size and frame count.

@@ -85,9 +85,9 @@ void WriteSpecAndCameras(const SceneSpec& spec, const SceneRenderer& scene,
   out << SceneSpecToJson(spec).dump(2) << "\n";
   FV_REQUIRE(out.good(), "cannot write '{}'", p);
   res.files.push_back(p);
-  for (const Camera& cam : scene.cameras()) {
+  for (const camera::Camera& cam : scene.cameras()) {
     const std::string yaml = folder.Path(cam.name + ".yaml");
-    WriteCameraYaml(cam, yaml);
+    camera::WriteCameraYaml(cam, yaml);
     res.files.push_back(yaml);
   }
 }
@@ -105,7 +105,7 @@ std::vector<std::unique_ptr<CameraOut>> OpenOutputs(const SceneSpec& spec,
                                                     const SceneRenderer& scene,
                                                     const SceneFolder& folder) {
   std::vector<std::unique_ptr<CameraOut>> outs;
-  for (const Camera& cam : scene.cameras()) {
+  for (const camera::Camera& cam : scene.cameras()) {
     outs.push_back(std::make_unique<CameraOut>());
     CameraOut& out = *outs.back();
     if (spec.format != "avi") {
@@ -171,7 +171,7 @@ void RenderAndWrite(const SceneSpec& spec, const SceneRenderer& scene, const Sce
       }
     }
   };
-  Progress prog("synth: rendering", total, "frames", progress);
+  util::Progress prog("synth: rendering", total, "frames", progress);
   const int n_threads = static_cast<int>(
       std::min<long long>(total, std::max(1u, std::thread::hardware_concurrency())));
   std::vector<std::thread> threads;
@@ -198,9 +198,10 @@ void WriteBallTruth(const SceneSpec& spec, const SceneRenderer& scene, const Sce
                     const std::vector<std::vector<CameraFrameStats>>& stats,
                     WriteSceneResult& res) {
   const int nc = res.num_cameras, nf = spec.num_frames;
-  CsvWriter truth(folder.Path("truth.csv"), {"frame", "time_s", "x_m", "y_m", "z_m", "n_cams"}, 6);
-  CsvWriter truth2d(folder.Path("truth_2d.csv"),
-                    {"frame", "cam", "u_px", "v_px", "radius_px", "visible_fraction"}, 4);
+  util::CsvWriter truth(folder.Path("truth.csv"),
+                        {"frame", "time_s", "x_m", "y_m", "z_m", "n_cams"}, 6);
+  util::CsvWriter truth2d(folder.Path("truth_2d.csv"),
+                          {"frame", "cam", "u_px", "v_px", "radius_px", "visible_fraction"}, 4);
   if (spec.ball.enabled) {
     for (int f = 0; f < nf; ++f) {
       const Eigen::Vector3d c = scene.BallAt(scene.FrameTime(f));
@@ -229,8 +230,9 @@ void WritePlayerTruth(const SceneSpec& spec, const SceneRenderer& scene, const S
                       const std::vector<std::vector<CameraFrameStats>>& stats,
                       WriteSceneResult& res) {
   const int nc = res.num_cameras, nf = spec.num_frames;
-  CsvWriter players(folder.Path("players.csv"), {"frame", "time_s", "id", "team", "x_m", "y_m"}, 4);
-  CsvWriter players2d(
+  util::CsvWriter players(folder.Path("players.csv"),
+                          {"frame", "time_s", "id", "team", "x_m", "y_m"}, 4);
+  util::CsvWriter players2d(
       folder.Path("players_2d.csv"),
       {"frame", "cam", "id", "bb_left", "bb_top", "bb_width", "bb_height", "visible_fraction"}, 4);
   for (int f = 0; f < nf; ++f) {
@@ -289,7 +291,7 @@ WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir, b
   }
   if (!spec.people.empty()) WritePlayerTruth(spec, scene, folder, stats, res);
   std::vector<std::string> names;
-  for (const Camera& c : scene.cameras()) {
+  for (const camera::Camera& c : scene.cameras()) {
     names.push_back(fmt::format("{}  {}x{}  frame 0", c.name, c.width, c.height));
   }
   const cv::Mat sheet = ContactSheet(first, names, first.size() > 1 ? 640 : 960);

@@ -40,11 +40,11 @@ std::string TrackerStats::Summary() const {
                      frames, tracks_started, refound, first_stage_matches, second_stage_matches);
 }
 
-std::optional<Eigen::Vector2d> FootOnGround(const Camera& camera, const cv::Rect2d& box,
+std::optional<Eigen::Vector2d> FootOnGround(const camera::Camera& camera, const cv::Rect2d& box,
                                             double offset_m) {
   const auto ray = camera.RayFromPixel({box.x + 0.5 * box.width, box.y + box.height});
   if (!ray) return std::nullopt;
-  const auto p = IntersectHorizontalPlane(*ray, 0.0);
+  const auto p = geometry::IntersectHorizontalPlane(*ray, 0.0);
   if (!p) return std::nullopt;
   Eigen::Vector2d g = p->head<2>();
   const Eigen::Vector2d away = g - camera.CentreInWorld().head<2>();
@@ -127,7 +127,7 @@ void ByteTracker::Track::ResetSot() {
 }
 
 FrameDetections SortDetections(const std::vector<Detection>& detections, const cv::Mat& frame,
-                               const TrackerOptions& o, const Camera* camera) {
+                               const TrackerOptions& o, const camera::Camera* camera) {
   const size_t n = detections.size();
   FrameDetections fd;
   fd.field_m.resize(n);
@@ -197,7 +197,8 @@ bool InReidReach(const ByteTracker::Track& t, const Detection& det,
   return cv::norm(a - b) <= o.reid_speed_px * t.lost_frames + det.box.height;
 }
 
-ByteTracker::ByteTracker(const TrackerOptions& options, const Camera* camera) : o_(options) {
+ByteTracker::ByteTracker(const TrackerOptions& options, const camera::Camera* camera)
+    : o_(options) {
   o_.Check();
   if (camera != nullptr && camera->has_pose) camera_ = *camera;
 }

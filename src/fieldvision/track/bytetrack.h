@@ -69,7 +69,7 @@ struct TrackerStats {
 class ByteTracker {
  public:
   // `camera` (may be null or without pose) enables the association on the field plane.
-  ByteTracker(const TrackerOptions& options, const Camera* camera);
+  ByteTracker(const TrackerOptions& options, const camera::Camera* camera);
   ~ByteTracker();
   // One frame's detections (and the frame, for appearance and SOT; may be empty) -> the tracks
   // reported in this frame.
@@ -92,7 +92,7 @@ class ByteTracker {
   std::vector<TrackState> Report() const;
 
   TrackerOptions o_;
-  std::optional<Camera> camera_;
+  std::optional<camera::Camera> camera_;
   std::vector<std::unique_ptr<Track>> tracks_;
   cv::Mat previous_frame_;
   int next_id_ = 1;
@@ -102,7 +102,7 @@ class ByteTracker {
 
 // Ground position of a person's box: the bottom centre on the plane z = 0, moved `offset_m`
 // horizontally away from the camera; nullopt when the ray misses the ground.
-std::optional<Eigen::Vector2d> FootOnGround(const Camera& camera, const cv::Rect2d& box,
+std::optional<Eigen::Vector2d> FootOnGround(const camera::Camera& camera, const cv::Rect2d& box,
                                             double offset_m = 0.0);
 
 // HSV hue-saturation histogram (normalised) of the torso part of a box; empty when the box is

@@ -51,7 +51,7 @@ struct FrameDetections {
 
 // Splits detections by score, with foot points (camera may be null) and torso histograms.
 FrameDetections SortDetections(const std::vector<Detection>& detections, const cv::Mat& frame,
-                               const TrackerOptions& o, const Camera* camera);
+                               const TrackerOptions& o, const camera::Camera* camera);
 
 // A lost track whose predicted foot point left the image has left the scene.
 bool LeftImage(const ByteTracker::Track& t, const cv::Size& frame);

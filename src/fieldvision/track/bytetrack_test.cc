@@ -24,7 +24,7 @@ struct Walker {
 TEST(ByteTracker, KeepsIdsThroughCrossingsAndMisses) {
   const uint64_t seed = fv::testing::TestSeed(11);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   std::vector<Walker> people;
   for (int i = 0; i < 6; ++i) {
     // Pairs walk towards each other on nearby rows and cross in the middle.
@@ -72,7 +72,7 @@ TEST(ByteTracker, AppearanceKeepsIdsOfPeopleWalkingSideBySide) {
   FV_SEED_TRACE(seed);
   const cv::Scalar shirts[2] = {cv::Scalar(30, 30, 200), cv::Scalar(200, 60, 30)};
   auto run = [&](double appearance_weight) {
-    Rng rng(seed);
+    util::Rng rng(seed);
     TrackerOptions o;
     o.appearance_weight = appearance_weight;
     ByteTracker tracker(o, nullptr);

@@ -106,25 +106,25 @@ DetectionsFile ReadDetectionsCsv(const std::string& path) {
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    const std::string t = Trim(line);
+    const std::string t = util::Trim(line);
     if (t.empty() || t[0] == '#') continue;
-    const std::vector<std::string> f = Split(t, ',');
+    const std::vector<std::string> f = util::Split(t, ',');
     const std::string where = fmt::format("detections file {}:{}", path, line_no);
     FV_REQUIRE(f.size() >= 7,
                "{}: expected at least 7 columns (frame,-1,bb_left,bb_top,bb_width,bb_height,"
                "score), got {}",
                where, f.size());
-    const long long frame = ParseInt(Trim(f[0]), where + " frame");
+    const long long frame = util::ParseInt(util::Trim(f[0]), where + " frame");
     FV_REQUIRE(frame >= 1 && frame <= 10000000, "{}: frame {} (frames are 1-based)", where, frame);
     Detection d;
-    d.box = cv::Rect2d(ParseDouble(Trim(f[2]), where + " bb_left"),
-                       ParseDouble(Trim(f[3]), where + " bb_top"),
-                       ParseDouble(Trim(f[4]), where + " bb_width"),
-                       ParseDouble(Trim(f[5]), where + " bb_height"));
+    d.box = cv::Rect2d(util::ParseDouble(util::Trim(f[2]), where + " bb_left"),
+                       util::ParseDouble(util::Trim(f[3]), where + " bb_top"),
+                       util::ParseDouble(util::Trim(f[4]), where + " bb_width"),
+                       util::ParseDouble(util::Trim(f[5]), where + " bb_height"));
     FV_REQUIRE(std::isfinite(d.box.x) && std::isfinite(d.box.y) && d.box.width >= 0 &&
                    d.box.height >= 0 && std::isfinite(d.box.width) && std::isfinite(d.box.height),
                "{}: box must be finite with a non-negative size", where);
-    d.score = ParseDouble(Trim(f[6]), where + " score");
+    d.score = util::ParseDouble(util::Trim(f[6]), where + " score");
     FV_REQUIRE(std::isfinite(d.score), "{}: score is not finite", where);
     if (out.frames.size() < size_t(frame)) out.frames.resize(frame);
     out.frames[frame - 1].push_back(d);
@@ -204,7 +204,7 @@ class HogDetector : public PersonDetector {
 
 class MotionDetector : public PersonDetector {
  public:
-  MotionDetector(const DetectorOptions& o, const Camera* camera, FootFilter filter)
+  MotionDetector(const DetectorOptions& o, const camera::Camera* camera, FootFilter filter)
       : o_(o), filter_(std::move(filter)) {
     if (camera != nullptr && camera->has_pose) camera_ = *camera;
     mog_ = cv::createBackgroundSubtractorMOG2(o.motion_history, o.motion_var_threshold, true);
@@ -216,7 +216,7 @@ class MotionDetector : public PersonDetector {
     if (!camera_) return std::nullopt;
     const auto ray = camera_->RayFromPixel({foot.x, foot.y});
     if (!ray) return std::nullopt;
-    const auto ground = IntersectHorizontalPlane(*ray, 0.0);
+    const auto ground = geometry::IntersectHorizontalPlane(*ray, 0.0);
     if (!ground) return std::nullopt;
     const auto head = camera_->Project(*ground + Eigen::Vector3d(0, 0, o_.person_height_m));
     if (!head) return std::nullopt;
@@ -270,7 +270,7 @@ class MotionDetector : public PersonDetector {
  private:
   DetectorOptions o_;
   FootFilter filter_;
-  std::optional<Camera> camera_;
+  std::optional<camera::Camera> camera_;
   cv::Ptr<cv::BackgroundSubtractorMOG2> mog_;
 };
 
@@ -333,8 +333,8 @@ std::vector<Detection> DecodeNanoDet(const std::vector<cv::Mat>& outputs, int ne
   return dets;
 }
 
-std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options, const Camera* camera,
-                                             FootFilter filter) {
+std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options,
+                                             const camera::Camera* camera, FootFilter filter) {
   options.Check();
   if (options.threads > 0) cv::setNumThreads(options.threads);
   if (options.kind == "nanodet")

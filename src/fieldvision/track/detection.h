@@ -80,7 +80,7 @@ using FootFilter = std::function<bool(const cv::Point2d& foot_px)>;
 // detector the expected person size; `filter` (may be empty) drops detections outside the area.
 // Throws fv::Error for bad options or a missing/corrupt model (saying how to get it).
 std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options,
-                                             const Camera* camera = nullptr,
+                                             const camera::Camera* camera = nullptr,
                                              FootFilter filter = {});
 
 // The filtering every detector applies: drops boxes shorter than options.min_height_px and those

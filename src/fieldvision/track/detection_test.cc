@@ -37,7 +37,7 @@ std::vector<cv::Mat> FakeOutputs(int w, int h, int col, int row, const int sides
 TEST(NanoDetDecode, RecoversTheBoxOfAOneHotDistribution) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     const int w = 416, h = 320;
     const int col = rng.UniformInt(4, 20), row = rng.UniformInt(4, 14);
@@ -57,7 +57,7 @@ TEST(NanoDetDecode, RecoversTheBoxOfAOneHotDistribution) {
 TEST(DetectionsFile, RoundTripsExactlyAndFilteringIsIdempotent) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   DetectionsFile in;
   in.frames.resize(6);
   for (int f = 0; f < 6; ++f) {

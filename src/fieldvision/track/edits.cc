@@ -64,7 +64,8 @@ std::vector<int> TopLevelElementLines(const std::string& text) {
 
 int IdFrom(const json& v, const std::string& where) {
   if (v.is_number_integer()) return v.get<int>();
-  if (v.is_string()) return static_cast<int>(ParseInt(Trim(v.get<std::string>()), where + " id"));
+  if (v.is_string())
+    return static_cast<int>(util::ParseInt(util::Trim(v.get<std::string>()), where + " id"));
   Throw("{}: expected an id (a whole number), got {}", where, v.dump());
 }
 
@@ -143,14 +144,15 @@ TrackEdits ReadTrackEdits(const std::string& path) {
 }
 
 Roster ReadRoster(const std::string& path) {
-  const CsvTable t = CsvTable::Read(path);
+  const util::CsvTable t = util::CsvTable::Read(path);
   t.Require({"id", "team"});
   Roster r;
   for (size_t i = 0; i < t.rows(); ++i) {
     const int id = static_cast<int>(t.GetInt(i, "id"));
     const int team = static_cast<int>(t.GetInt(i, "team"));
     if (team >= 0) r.team_of[id] = team;
-    if (t.Has("name") && !Trim(t.Get(i, "name")).empty()) r.name_of[id] = Trim(t.Get(i, "name"));
+    if (t.Has("name") && !util::Trim(t.Get(i, "name")).empty())
+      r.name_of[id] = util::Trim(t.Get(i, "name"));
   }
   return r;
 }
@@ -161,7 +163,7 @@ void WriteRoster(const Roster& roster, const std::string& path) {
   for (const auto& [id, n] : roster.name_of) ids.insert(id);
   const std::string tmp = path + ".tmp";
   {
-    CsvWriter w(tmp, {"id", "team", "name"});
+    util::CsvWriter w(tmp, {"id", "team", "name"});
     for (int id : ids) {
       const auto t = roster.team_of.find(id);
       const auto n = roster.name_of.find(id);

@@ -17,10 +17,10 @@ using Mat4 = Eigen::Matrix4d;
 using Vec4 = Eigen::Vector4d;
 
 // The ground point under pixel (u, v), or false.
-bool Ground(const Camera& camera, double u, double v, Eigen::Vector2d* g) {
+bool Ground(const camera::Camera& camera, double u, double v, Eigen::Vector2d* g) {
   const auto ray = camera.RayFromPixel({u, v});
   if (!ray) return false;
-  const auto p = IntersectHorizontalPlane(*ray, 0.0);
+  const auto p = geometry::IntersectHorizontalPlane(*ray, 0.0);
   if (!p) return false;
   *g = p->head<2>();
   return true;
@@ -28,7 +28,7 @@ bool Ground(const Camera& camera, double u, double v, Eigen::Vector2d* g) {
 
 // Measurement covariance of the foot point of `box`: the footprint of +-sigma_px vertically
 // (along the image column) plus the same horizontally, with a floor.
-Eigen::Matrix2d FootCovariance(const Camera& camera, const cv::Rect2d& box,
+Eigen::Matrix2d FootCovariance(const camera::Camera& camera, const cv::Rect2d& box,
                                const GroundSmoothOptions& o) {
   const double u = box.x + 0.5 * box.width, v = box.y + box.height;
   const double s_px = std::max(o.foot_sigma_frac * box.height, 0.5);
@@ -66,8 +66,9 @@ std::string GroundSmoothResult::Summary() const {
 }
 
 GroundSmoothResult SmoothGroundTracks(std::vector<TrackRow>& rows,
-                                      const std::vector<bool>& measured, const Camera& camera,
-                                      double fps, const GroundSmoothOptions& o) {
+                                      const std::vector<bool>& measured,
+                                      const camera::Camera& camera, double fps,
+                                      const GroundSmoothOptions& o) {
   o.Check();
   FV_REQUIRE(std::isfinite(fps) && fps > 0, "SmoothGroundTracks: fps must be > 0 (got {})", fps);
   FV_REQUIRE(measured.empty() || measured.size() == rows.size(),

@@ -34,7 +34,8 @@ struct GroundSmoothResult {
 // interpolated rows); empty: all rows with a position are. `camera` (calibrated) gives each
 // foot point's noise; `fps` the time step.
 GroundSmoothResult SmoothGroundTracks(std::vector<TrackRow>& rows,
-                                      const std::vector<bool>& measured, const Camera& camera,
-                                      double fps, const GroundSmoothOptions& options = {});
+                                      const std::vector<bool>& measured,
+                                      const camera::Camera& camera, double fps,
+                                      const GroundSmoothOptions& options = {});
 
 }  // namespace fv::track

@@ -12,15 +12,15 @@
 namespace fv::track {
 namespace {
 
-Camera SideCamera() {
-  Camera c = Camera::FromFov(1280, 720, 70);
-  c.cam_from_world = Rigid3d::LookAt({0, -14, 6}, {0, 0, 0});
+camera::Camera SideCamera() {
+  camera::Camera c = camera::Camera::FromFov(1280, 720, 70);
+  c.cam_from_world = geometry::Rigid3d::LookAt({0, -14, 6}, {0, 0, 0});
   c.has_pose = true;
   return c;
 }
 
 // The image box of a 1.8 m person standing at (x, y), its bottom moved by noise_px.
-cv::Rect2d BoxAt(const Camera& cam, double x, double y, double noise_px) {
+cv::Rect2d BoxAt(const camera::Camera& cam, double x, double y, double noise_px) {
   const auto foot = cam.Project({x, y, 0});
   const auto head = cam.Project({x, y, 1.8});
   const double h = foot->y() - head->y();
@@ -32,8 +32,8 @@ cv::Rect2d BoxAt(const Camera& cam, double x, double y, double noise_px) {
 TEST(GroundSmoother, NoisyFootPointsOfAWalkAreSmoothed) {
   const uint64_t seed = testing::TestSeed(41);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
-  const Camera cam = SideCamera();
+  util::Rng rng(seed);
+  const camera::Camera cam = SideCamera();
   const double fps = 25;
   std::vector<TrackRow> rows;
   std::vector<bool> measured;
@@ -82,7 +82,7 @@ TEST(GroundSmoother, NoisyFootPointsOfAWalkAreSmoothed) {
   GroundSmoothOptions off;
   off.enabled = false;
   EXPECT_EQ(SmoothGroundTracks(same, measured, cam, fps, off).tracks, 0);
-  Camera no_pose = cam;
+  camera::Camera no_pose = cam;
   no_pose.has_pose = false;
   EXPECT_EQ(SmoothGroundTracks(same, measured, no_pose, fps).tracks, 0);
   for (size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(same[i].x_m, rows[i].x_m);

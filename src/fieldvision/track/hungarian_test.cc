@@ -38,7 +38,7 @@ double BestCost(const std::vector<std::vector<double>>& c, double forbidden, int
 TEST(Hungarian, MatchesBruteForceOnRandomMatrices) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   for (int trial = 0; trial < 200; ++trial) {
     const int rows = rng.UniformInt(1, 5), cols = rng.UniformInt(rows, 6);
     std::vector<std::vector<double>> c(rows, std::vector<double>(cols));

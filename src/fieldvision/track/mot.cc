@@ -41,10 +41,10 @@ void WriteReplacing(const std::string& path, WriteFn write) {
 
 void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) {
   WriteReplacing(path, [&](const std::string& tmp) {
-    CsvWriter w(tmp,
-                {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "x_m", "y_m",
-                 "time_s"},
-                4);
+    util::CsvWriter w(tmp,
+                      {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "x_m",
+                       "y_m", "time_s"},
+                      4);
     for (const auto& r : rows) {
       w << r.frame << r.id << r.box.x << r.box.y << r.box.width << r.box.height << r.conf;
       if (r.x_m && r.y_m) {
@@ -94,36 +94,38 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
   bool header = false;
   while (std::getline(in, line)) {
     ++line_no;
-    const std::string t = Trim(line);
+    const std::string t = util::Trim(line);
     if (t.empty()) continue;
     if (line_no == 1 && !std::isdigit(static_cast<unsigned char>(t[0])) && t[0] != '-') {
-      FV_REQUIRE(StartsWith(t, "frame,id,bb_left"),
+      FV_REQUIRE(util::StartsWith(t, "frame,id,bb_left"),
                  "{}: header must start with frame,id,bb_left,bb_top,bb_width,bb_height", path);
-      const std::vector<std::string> names = Split(t, ',');
+      const std::vector<std::string> names = util::Split(t, ',');
       col.clear();
-      for (size_t i = 0; i < names.size(); ++i) col[Trim(names[i])] = static_cast<int>(i);
+      for (size_t i = 0; i < names.size(); ++i) col[util::Trim(names[i])] = static_cast<int>(i);
       for (const char* need : {"bb_top", "bb_width", "bb_height"}) {
         FV_REQUIRE(col.count(need), "{}: header has no column '{}'", path, need);
       }
       header = true;
       continue;
     }
-    const std::vector<std::string> f = Split(t, ',');
+    const std::vector<std::string> f = util::Split(t, ',');
     FV_REQUIRE(f.size() >= 6, "{}:{}: expected at least 6 columns, got {}", path, line_no,
                f.size());
     const std::string where = fmt::format("{}:{}", path, line_no);
     auto field = [&](const char* name) -> std::string {
       const auto it = col.find(name);
       if (it == col.end() || it->second >= static_cast<int>(f.size())) return {};
-      return Trim(f[it->second]);
+      return util::Trim(f[it->second]);
     };
-    auto number = [&](const char* name) { return ParseDouble(field(name), where + " " + name); };
+    auto number = [&](const char* name) {
+      return util::ParseDouble(field(name), where + " " + name);
+    };
     TrackRow r;
-    const long long frame = ParseInt(field("frame"), where + " frame");
+    const long long frame = util::ParseInt(field("frame"), where + " frame");
     FV_REQUIRE(frame >= 0 && frame <= kMaxFrame, "{}: frame {} is not in [0, {}]", where, frame,
                kMaxFrame);
     r.frame = static_cast<int>(frame);
-    r.id = static_cast<int>(ParseInt(field("id"), where + " id"));
+    r.id = static_cast<int>(util::ParseInt(field("id"), where + " id"));
     r.box =
         cv::Rect2d(number("bb_left"), number("bb_top"), number("bb_width"), number("bb_height"));
     FV_REQUIRE(std::abs(r.box.x) <= kMaxPixel && std::abs(r.box.y) <= kMaxPixel &&
@@ -148,8 +150,8 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
       }
     } else if (f.size() == 9) {
       // MOT16/17/20 ground truth: class and visibility.
-      r.mot_class = static_cast<int>(ParseDouble(Trim(f[7]), where + " class"));
-      r.visibility = ParseDouble(Trim(f[8]), where + " visibility");
+      r.mot_class = static_cast<int>(util::ParseDouble(util::Trim(f[7]), where + " class"));
+      r.visibility = util::ParseDouble(util::Trim(f[8]), where + " visibility");
     }
     rows.push_back(r);
   }

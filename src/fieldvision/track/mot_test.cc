@@ -13,7 +13,7 @@ namespace fv::track {
 namespace {
 
 // Random walkers: `people` tracks over `frames` frames.
-std::vector<TrackRow> Walkers(Rng& rng, int people, int frames) {
+std::vector<TrackRow> Walkers(util::Rng& rng, int people, int frames) {
   std::vector<TrackRow> rows;
   for (int p = 0; p < people; ++p) {
     double x = rng.Uniform(0, 600), y = rng.Uniform(0, 400);
@@ -28,7 +28,7 @@ std::vector<TrackRow> Walkers(Rng& rng, int people, int frames) {
 TEST(Mot, PerfectTracksScoreOne) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto gt = Walkers(rng, 5, 50);
   auto est = gt;
   for (auto& r : est) r.id += 100;  // ids need not be equal
@@ -44,7 +44,7 @@ TEST(Mot, PerfectTracksScoreOne) {
 TEST(Mot, CountsMissesFalsePositivesAndSwitches) {
   const uint64_t seed = fv::testing::TestSeed(4);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const int frames = 40;
   const auto gt = Walkers(rng, 3, frames);
   std::vector<TrackRow> est;
@@ -125,7 +125,7 @@ TEST(Mot, NumbersOutOfRangeNameTheLine) {
 TEST(Mot, TwoBoxesOfOneIdInAFrameAreRefused) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   const auto gt = Walkers(rng, 2, 10);
   auto est = gt;
   est.push_back(gt[3]);  // frame 3 of id 1 twice: IDF1 was 1.1
@@ -216,7 +216,7 @@ TEST(Mot, Mot17RulesIgnoreDistractorsAndZeroMarkedRows) {
 TEST(Mot, FrameAlignment) {
   const uint64_t seed = fv::testing::TestSeed(5);
   FV_SEED_TRACE(seed);
-  Rng rng(seed);
+  util::Rng rng(seed);
   auto gt = Walkers(rng, 4, 30);
   for (auto& r : gt) r.frame += 1;  // 1..30
   std::vector<TrackRow> est;

@@ -37,14 +37,14 @@ cv::Scalar TrackColour(int id, int team) {
 }
 
 TrackOverlay::TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int> team_of,
-                           std::map<int, std::string> name_of, const Camera* camera,
-                           const FieldModel* field, const OverlayOptions& options)
+                           std::map<int, std::string> name_of, const camera::Camera* camera,
+                           const field::FieldModel* field, const OverlayOptions& options)
     : team_of_(std::move(team_of)), name_of_(std::move(name_of)), o_(options) {
   o_.Check();
   for (const auto& r : rows) by_frame_[r.frame].push_back(r);
   if (camera != nullptr && camera->has_pose && field != nullptr && o_.field_lines) {
-    camera_ = std::make_unique<Camera>(*camera);
-    field_ = std::make_unique<FieldModel>(*field);
+    camera_ = std::make_unique<camera::Camera>(*camera);
+    field_ = std::make_unique<field::FieldModel>(*field);
   }
 }
 
@@ -169,7 +169,7 @@ PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv
              path, fps);
   FV_REQUIRE(size.width > 0 && size.height > 0, "video '{}': empty frame size", path);
   path_ = path;
-  const bool mp4 = EndsWith(ToLower(path), ".mp4");
+  const bool mp4 = util::EndsWith(util::ToLower(path), ".mp4");
   if (mp4 && H264Available()) {
     tmp_ = TempPathFor(path_);
     if (TryOpen(writer_, tmp_, cv::VideoWriter::fourcc('a', 'v', 'c', '1'), fps, size)) {
@@ -222,10 +222,10 @@ std::string DrawVideoResult::Summary() const {
 
 DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out,
                                 const TrackOverlay& overlay, double fps, int max_frames) {
-  auto source = VideoSource::Open(video);
+  auto source = io::VideoSource::Open(video);
   const double rate = fps > 0 ? fps : source->fps();
   PlayableVideoWriter writer(out, rate, {source->width(), source->height()});
-  Frame f;
+  io::Frame f;
   while ((max_frames <= 0 || source->frames_read() < max_frames) && source->Read(f)) {
     cv::Mat img = f.bgr.clone();
     overlay.Draw(img, f.index + 1);

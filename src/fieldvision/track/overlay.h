@@ -38,8 +38,8 @@ class TrackOverlay {
   // `rows` as in TRACKS.csv (1-based frames); `team_of` and `name_of` by id (may be empty);
   // `camera` (may be null or without pose) and `field` (may be null) for the field lines.
   TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int> team_of,
-               std::map<int, std::string> name_of, const Camera* camera, const FieldModel* field,
-               const OverlayOptions& options = {});
+               std::map<int, std::string> name_of, const camera::Camera* camera,
+               const field::FieldModel* field, const OverlayOptions& options = {});
   // Draws TRACKS.csv frame `frame` (1-based) onto `bgr`.
   void Draw(cv::Mat& bgr, int frame) const;
 
@@ -47,8 +47,8 @@ class TrackOverlay {
   std::map<int, std::vector<TrackRow>> by_frame_;
   std::map<int, int> team_of_;
   std::map<int, std::string> name_of_;
-  std::unique_ptr<Camera> camera_;
-  std::unique_ptr<FieldModel> field_;
+  std::unique_ptr<camera::Camera> camera_;
+  std::unique_ptr<field::FieldModel> field_;
   cv::Mat field_layer_, field_mask_;  // projected lines, drawn once
   OverlayOptions o_;
 };
@@ -85,8 +85,8 @@ struct DrawVideoResult {
   std::string Summary() const;
 };
 
-// Reads `video` (any file or image pattern fv::VideoSource opens) and writes each frame with the
-// overlay drawn (one output frame per input frame, at the video's rate; `fps` > 0 overrides),
+// Reads `video` (any file or image pattern fv::io::VideoSource opens) and writes each frame with
+// the overlay drawn (one output frame per input frame, at the video's rate; `fps` > 0 overrides),
 // up to `max_frames` (0: all).
 DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out,
                                 const TrackOverlay& overlay, double fps = 0, int max_frames = 0);

@@ -42,7 +42,7 @@ std::string Attr(const std::string& tag, const std::string& name) {
 double NumAttr(const std::string& tag, const std::string& name, const std::string& where) {
   const std::string v = Attr(tag, name);
   FV_REQUIRE(!v.empty(), "{}: attribute '{}' missing", where, name);
-  return ParseDouble(v, where + " " + name);
+  return util::ParseDouble(v, where + " " + name);
 }
 
 // A frame number or id: a whole number in [0, 1e8] (NaN, 1e300 and 2e9 are refused).
@@ -68,11 +68,11 @@ std::vector<TrackRow> ReadPetsCvml(const std::string& path) {
     const std::string tag = text.substr(pos, end - pos + 1);
     pos = end + 1;
     const std::string where = fmt::format("{} (frame {})", path, frame);
-    if (StartsWith(tag, "<frame ")) {
+    if (util::StartsWith(tag, "<frame ")) {
       frame = IndexAttr(tag, "number", where);
-    } else if (StartsWith(tag, "<object ")) {
+    } else if (util::StartsWith(tag, "<object ")) {
       id = IndexAttr(tag, "id", where);
-    } else if (StartsWith(tag, "<box ")) {
+    } else if (util::StartsWith(tag, "<box ")) {
       FV_REQUIRE(frame >= 0 && id >= 0, "{}: <box> outside a frame/object", where);
       const double xc = NumAttr(tag, "xc", where), yc = NumAttr(tag, "yc", where);
       const double w = NumAttr(tag, "w", where), h = NumAttr(tag, "h", where);
@@ -166,7 +166,7 @@ std::string TsaiConversion::Summary() const {
 }
 
 TsaiConversion CameraFromTsai(const TsaiParameters& p, const std::string& name) {
-  Camera cam;
+  camera::Camera cam;
   cam.name = name;
   cam.width = p.width;
   cam.height = p.height;
@@ -209,7 +209,7 @@ TsaiConversion CameraFromTsai(const TsaiParameters& p, const std::string& name) 
       const Eigen::Vector2d px(gx * (p.width - 1) / 10.0, gy * (p.height - 1) / 10.0);
       const auto ray = cam.RayFromPixel(px);
       if (!ray) continue;
-      const auto g = IntersectHorizontalPlane(*ray, 0.0);
+      const auto g = geometry::IntersectHorizontalPlane(*ray, 0.0);
       if (!g) continue;
       const Eigen::Vector2d t = TsaiProject(p, *g);
       out.max_fit_error_px = std::max(out.max_fit_error_px, (t - px).norm());

@@ -34,7 +34,7 @@ TsaiParameters ReadTsaiXml(const std::string& path);
 Eigen::Vector2d TsaiProject(const TsaiParameters& p, const Eigen::Vector3d& world_m);
 
 struct TsaiConversion {
-  Camera camera;
+  camera::Camera camera;
   double max_fit_error_px = 0;  // largest difference from Tsai's projection over the image
   std::string Summary() const;
 };

@@ -32,8 +32,8 @@ TEST(Tsai, ConvertedCameraReproducesTsaiProjection) {
   EXPECT_GT(centre.z(), 3.0) << c.Summary();
   // Round trip through the YAML file.
   const std::string path = fv::testing::TempDir() + "/cam.yaml";
-  WriteCameraYaml(c.camera, path);
-  const Camera back = ReadCameraYaml(path);
+  camera::WriteCameraYaml(c.camera, path);
+  const camera::Camera back = camera::ReadCameraYaml(path);
   const Eigen::Vector3d world(5.0, 10.0, 0.0);
   const auto a = back.Project(world);
   ASSERT_TRUE(a.has_value());
@@ -64,7 +64,7 @@ TEST(Pets, AnnotationsImportAndFeetLieOnAPlausibleGround) {
   }
   EXPECT_TRUE(found);
   // Feet of all annotated people map to the ground within a scene some tens of metres across.
-  const Camera cam = CameraFromTsai(ReadTsaiXml(PetsDir() + "/View_001.xml")).camera;
+  const camera::Camera cam = CameraFromTsai(ReadTsaiXml(PetsDir() + "/View_001.xml")).camera;
   Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
   int on_ground = 0;
   for (const auto& r : rows) {

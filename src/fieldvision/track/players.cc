@@ -19,8 +19,8 @@
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/track/players_internal.h"
 #include "fieldvision/util/error.h"
-#include "fieldvision/util/stats.h"
 #include "fieldvision/util/progress.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::track {
 namespace {
@@ -35,14 +35,14 @@ double Seconds(Clock::time_point a, Clock::time_point b) {
 class FrameReader {
  public:
   FrameReader(const std::string& path, int max_frames, bool sequence) : max_frames_(max_frames) {
-    FrameSourceOptions so;
-    so.time = TimeSource::kContainer;
+    io::FrameSourceOptions so;
+    so.time = io::TimeSource::kContainer;
     if (sequence) so.fps = 25.0;  // the rate OpenCV reported for image patterns; --fps overrides
     // OpenCV's backends log their failures to stderr; the one-line error says it.
     const auto log_level = cv::utils::logging::getLogLevel();
     cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
     try {
-      source_ = OpenFrameSource(path, so);
+      source_ = io::OpenFrameSource(path, so);
     } catch (...) {
       cv::utils::logging::setLogLevel(log_level);
       throw;
@@ -114,7 +114,7 @@ class FrameReader {
     cv_.notify_all();
   }
 
-  std::unique_ptr<FrameSource> source_;
+  std::unique_ptr<io::FrameSource> source_;
   std::string error_;
   int max_frames_;
   double fps_ = 0;
@@ -176,7 +176,7 @@ FrameTimes TimesOfFrames(const std::vector<double>& container_ms, double contain
   if (increasing) {
     std::vector<double> steps;
     for (size_t i = 1; i < n; ++i) steps.push_back(container_ms[i] - container_ms[i - 1]);
-    t.fps = 1000.0 / NearestRankPercentile(steps, 0.5);
+    t.fps = 1000.0 / util::NearestRankPercentile(steps, 0.5);
     t.source = fmt::format("the video's timestamps (median {:.2f} frames/s)", t.fps);
     t.time_s.resize(n);
     for (size_t i = 0; i < n; ++i) t.time_s[i] = container_ms[i] / 1000.0;
@@ -244,7 +244,7 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
       }
       std::vector<double> hs;
       for (const TrackRow* r : w) hs.push_back(r->box.height);
-      const double full = o.full_height_ratio * NearestRankPercentile(hs, 0.5);
+      const double full = o.full_height_ratio * util::NearestRankPercentile(hs, 0.5);
       std::vector<const TrackRow*> good;
       for (const TrackRow* r : w) {
         if (r->box.height >= full) good.push_back(r);
@@ -368,7 +368,7 @@ std::string PlayersResult::Summary() const {
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "");
 }
 
-void CheckCameraMatchesVideo(const Camera& camera, int width, int height,
+void CheckCameraMatchesVideo(const camera::Camera& camera, int width, int height,
                              const std::string& video) {
   FV_REQUIRE(camera.width == width && camera.height == height,
              "camera '{}' is for {}x{} images but video '{}' is {}x{}: use the camera file made "
@@ -377,7 +377,7 @@ void CheckCameraMatchesVideo(const Camera& camera, int width, int height,
              width, height);
 }
 
-int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const Camera* camera,
+int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const camera::Camera* camera,
                     double foot_offset_m) {
   if (max_gap <= 0) return 0;
   std::map<int, std::vector<TrackRow>> by_id;
@@ -418,15 +418,16 @@ int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const Camera* came
   return added;
 }
 
-FootFilter FieldFootFilter(const Camera& camera, const FieldModel* field, double margin_m) {
-  const Camera cam = camera;
-  std::optional<FieldModel> f;
+FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel* field,
+                           double margin_m) {
+  const camera::Camera cam = camera;
+  std::optional<field::FieldModel> f;
   if (field != nullptr) f = *field;
   const double margin = margin_m;
   return [cam, f, margin](const cv::Point2d& foot) {
     const auto ray = cam.RayFromPixel({foot.x, foot.y});
     if (!ray) return false;
-    const auto g = IntersectHorizontalPlane(*ray, 0.0);
+    const auto g = geometry::IntersectHorizontalPlane(*ray, 0.0);
     if (!g) return false;
     if (!f) return true;
     return std::abs(g->x()) <= 0.5 * f->length_m + margin &&
@@ -533,7 +534,7 @@ void RecordTracks(const std::vector<TrackState>& states, const cv::Mat& frame, i
 
 // After the pass: short tracks dropped, tracklets joined, gaps filled, ground tracks smoothed,
 // teams and the rows' times.
-void FinishTracks(const PlayersOptions& options, const Camera* camera, bool calibrated,
+void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, bool calibrated,
                   cv::Size image, const PlayersPass& pass, bool sequence, double video_fps,
                   PlayersResult& result) {
   const int frames = result.frames;
@@ -574,8 +575,8 @@ void FinishTracks(const PlayersOptions& options, const Camera* camera, bool cali
 
 }  // namespace
 
-PlayersResult RunPlayers(const std::string& video, const Camera* camera, const FieldModel* field,
-                         const PlayersOptions& options) {
+PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
+                         const field::FieldModel* field, const PlayersOptions& options) {
   options.Check();
   const auto t_start = Clock::now();
   const bool calibrated = camera != nullptr && camera->has_pose;
@@ -583,7 +584,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   if (calibrated) filter = FieldFootFilter(*camera, field, options.field_margin_m);
   // Open the video first: a bad video is reported before the model is loaded.
   // An image sequence is read up to its last file (reading past it makes OpenCV warn).
-  const size_t sequence_files = ListImageSequence(video).size();
+  const size_t sequence_files = io::ListImageSequence(video).size();
   int frame_limit = options.max_frames;
   if (sequence_files > 0) {
     const int n = static_cast<int>(sequence_files);
@@ -612,7 +613,7 @@ PlayersResult RunPlayers(const std::string& video, const Camera* camera, const F
   if (options.max_frames > 0 && (total <= 0 || total > options.max_frames)) {
     total = options.max_frames;
   }
-  Progress progress("players", total, "frames", options.progress);
+  util::Progress progress("players", total, "frames", options.progress);
   PlayersPass pass;
   cv::Mat frame;
   int index = 0;

@@ -67,7 +67,7 @@ struct PlayersOptions {
   StitchOptions stitch;        // offline joining of tracklets (before gap interpolation)
   GroundSmoothOptions smooth;  // offline smoothing of field positions (calibrated camera)
   bool teams = false;          // assign teams (k-means, k = 2, on torso colour)
-  bool progress = true;        // fv::Progress on stderr
+  bool progress = true;        // fv::util::Progress on stderr
   // Overrides the video's time: frame i (0-based) is at i / fps seconds. 0: the video's
   // timestamps, else its frame rate (TimesOfFrames).
   double fps = 0;
@@ -120,14 +120,15 @@ struct PlayersResult {
 };
 
 // Throws fv::Error when the camera's image size differs from the video's (names both).
-void CheckCameraMatchesVideo(const Camera& camera, int width, int height, const std::string& video);
+void CheckCameraMatchesVideo(const camera::Camera& camera, int width, int height,
+                             const std::string& video);
 
 // Runs the pipeline on a video (any file OpenCV reads or an image pattern). `camera` may be
 // null or uncalibrated (no pose): then boxes only, no field positions. `field` (optional) limits
 // detections. Rows number frames from 1 and carry the frame's time (TimesOfFrames; an image
 // sequence has a time only with options.fps).
-PlayersResult RunPlayers(const std::string& video, const Camera* camera, const FieldModel* field,
-                         const PlayersOptions& options);
+PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
+                         const field::FieldModel* field, const PlayersOptions& options);
 
 // Joins tracklets in `rows` (StitchOptions); `appearance` by id (ids without one are joined on
 // motion alone only if options.max_appearance_distance >= 1); `image` is the frame size (for the
@@ -136,7 +137,7 @@ int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppear
                     const StitchOptions& options, double fps, cv::Size image);
 
 // Linear interpolation of gaps (<= max_gap frames) inside each track; returns the rows added.
-int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const Camera* camera,
+int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const camera::Camera* camera,
                     double foot_offset_m = 0.0);
 
 }  // namespace fv::track

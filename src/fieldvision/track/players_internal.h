@@ -44,7 +44,8 @@ std::vector<TrackletLink> TrackletLinks(const std::map<int, Tracklet>& tracklets
 int JoinTracklets(const std::vector<TrackletLink>& links, std::vector<TrackRow>& rows);
 
 // Whether a foot point lies on the ground within the field (and margin) when a field is given.
-FootFilter FieldFootFilter(const Camera& camera, const FieldModel* field, double margin_m);
+FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel* field,
+                           double margin_m);
 
 // Adds the torso histograms of confident, unpredicted tracks that no other track overlaps.
 void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& frame,

@@ -45,7 +45,7 @@ TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
   PlayersOptions o;
   o.progress = false;
   o.detector.kind = "motion";
-  const Camera cam = Camera::FromFov(640, 480, 60);
+  const camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
   // A video that cannot be opened.
   try {
     RunPlayers(dir + "/missing.avi", &cam, nullptr, o);
@@ -71,7 +71,7 @@ TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
     EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }
   // A missing detector model says how to get it.
-  const Camera small = Camera::FromFov(320, 240, 60);
+  const camera::Camera small = camera::Camera::FromFov(320, 240, 60);
   o.detector.kind = "nanodet";
   o.detector.model_path = dir + "/nanodet.onnx";
   try {
@@ -198,8 +198,8 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   const std::string dir = fv::testing::TempDir();
   synth::WriteScene(spec, dir, false);
   synth::SceneRenderer scene(spec);
-  const Camera cam = scene.cameras()[0];
-  const FieldModel field = scene.field();
+  const camera::Camera cam = scene.cameras()[0];
+  const field::FieldModel field = scene.field();
   const std::string video = dir + "/" + cam.name + ".avi";
   PlayersOptions o;
   o.progress = false;
@@ -252,8 +252,8 @@ TEST(Players, SynthScenePositionsAndStableIds) {
   const std::string dir = fv::testing::TempDir();
   synth::WriteScene(spec, dir, false);
   synth::SceneRenderer scene(spec);
-  const Camera cam = scene.cameras()[0];
-  const FieldModel field = scene.field();
+  const camera::Camera cam = scene.cameras()[0];
+  const field::FieldModel field = scene.field();
   PlayersOptions o;
   o.progress = false;
   o.detector.input_width = 416;

@@ -8,7 +8,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
-namespace fv {
+namespace fv::util {
 
 CsvTable CsvTable::Read(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -132,4 +132,4 @@ void CsvWriter::Close() {
   out_.close();
 }
 
-}  // namespace fv
+}  // namespace fv::util

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace fv {
+namespace fv::util {
 
 class CsvTable {
  public:
@@ -59,4 +59,4 @@ class CsvWriter {
   int precision_;
 };
 
-}  // namespace fv
+}  // namespace fv::util

@@ -7,7 +7,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::util {
 namespace {
 
 TEST(Csv, RoundTrip) {
@@ -53,4 +53,4 @@ TEST(Csv, WriterRejectsRaggedRows) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::util

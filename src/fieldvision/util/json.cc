@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::util {
 namespace {
 
 using nlohmann::json;
@@ -148,4 +148,4 @@ double JsonRound(double v, int decimals) {
   return std::round(v * f) / f;
 }
 
-}  // namespace fv
+}  // namespace fv::util

@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-namespace fv {
+namespace fv::util {
 
 // "ctx.key", or "key" when ctx is empty: the context of a nested object.
 std::string JsonPath(const std::string& ctx, const std::string& key);
@@ -75,4 +75,4 @@ Eigen::Matrix<double, N, 1> JsonVector(const nlohmann::json& obj, const std::str
                          (ctx.empty() ? std::string() : ctx + ": ") + "key '" + key + "'");
 }
 
-}  // namespace fv
+}  // namespace fv::util

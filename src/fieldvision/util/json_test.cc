@@ -7,7 +7,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::util {
 namespace {
 
 using nlohmann::json;
@@ -78,4 +78,4 @@ TEST(Json, VectorWriterRoundTrips) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::util

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-namespace fv {
+namespace fv::util {
 
 Progress::Progress(std::string label, long long total, std::string unit, bool enabled)
     : label_(std::move(label)),
@@ -68,4 +68,4 @@ void Progress::Finish() {
   if (enabled_) Print(true);
 }
 
-}  // namespace fv
+}  // namespace fv::util

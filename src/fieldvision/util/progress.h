@@ -5,7 +5,7 @@
 #include <chrono>
 #include <string>
 
-namespace fv {
+namespace fv::util {
 
 class Progress {
  public:
@@ -30,4 +30,4 @@ class Progress {
   std::chrono::steady_clock::time_point last_print_;
 };
 
-}  // namespace fv
+}  // namespace fv::util

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <random>
 
-namespace fv {
+namespace fv::util {
 
 class Rng {
  public:
@@ -25,4 +25,4 @@ class Rng {
   uint64_t seed_;
 };
 
-}  // namespace fv
+}  // namespace fv::util

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace fv {
+namespace fv::util {
 
 double Percentile(std::vector<double> values, double q) {
   if (values.empty()) return 0.0;
@@ -57,4 +57,4 @@ double RobustSigma(const std::vector<double>& values) {
   return kMadToSigma * Median(std::move(dev));
 }
 
-}  // namespace fv
+}  // namespace fv::util

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-namespace fv {
+namespace fv::util {
 
 // q in [0, 1]; 0 for an empty sample. Non-finite values must be removed by the caller.
 double Percentile(std::vector<double> values, double q);
@@ -21,4 +21,4 @@ inline constexpr double kMadToSigma = 1.4826;
 // 1.4826 * median |x - median|: a normal sigma that ignores up to half the sample as outliers.
 double RobustSigma(const std::vector<double>& values);
 
-}  // namespace fv
+}  // namespace fv::util

@@ -6,7 +6,7 @@
 
 #include "fieldvision/util/testing.h"
 
-namespace fv {
+namespace fv::util {
 namespace {
 
 TEST(Stats, PercentileInterpolatesLikeNumpy) {
@@ -48,4 +48,4 @@ TEST(Stats, MeanRmsRobustSigma) {
 }
 
 }  // namespace
-}  // namespace fv
+}  // namespace fv::util

@@ -7,7 +7,7 @@
 
 #include "fieldvision/util/error.h"
 
-namespace fv {
+namespace fv::util {
 
 std::vector<std::string> Split(std::string_view s, char sep) {
   std::vector<std::string> out;
@@ -78,4 +78,4 @@ long long ParseInt(std::string_view s, std::string_view context) {
   return v;
 }
 
-}  // namespace fv
+}  // namespace fv::util

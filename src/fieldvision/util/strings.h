@@ -5,7 +5,7 @@
 #include <string_view>
 #include <vector>
 
-namespace fv {
+namespace fv::util {
 
 std::vector<std::string> Split(std::string_view s, char sep);
 std::string Trim(std::string_view s);
@@ -17,4 +17,4 @@ std::string ToLower(std::string_view s);
 double ParseDouble(std::string_view s, std::string_view context);
 long long ParseInt(std::string_view s, std::string_view context);
 
-}  // namespace fv
+}  // namespace fv::util

@@ -102,20 +102,20 @@ int ParseInt(const std::string& text, const std::string& what) {
 
 // ---- library adapters
 
-FieldModel LoadFieldIn(const Workspace& ws, const std::string& name_or_path) {
-  for (const auto& n : BuiltinFieldNames()) {
-    if (n == name_or_path) return BuiltinField(n);
+field::FieldModel LoadFieldIn(const Workspace& ws, const std::string& name_or_path) {
+  for (const auto& n : field::BuiltinFieldNames()) {
+    if (n == name_or_path) return field::BuiltinField(n);
   }
   if (name_or_path.size() < 5 || name_or_path.substr(name_or_path.size() - 5) != ".json") {
     std::string names;
-    for (const auto& n : BuiltinFieldNames()) names += (names.empty() ? "" : ", ") + n;
+    for (const auto& n : field::BuiltinFieldNames()) names += (names.empty() ? "" : ", ") + n;
     throw HttpError(
         404, "unknown field '" + name_or_path + "' (built in: " + names + ", or a .json file)");
   }
-  return LoadField(ws.Resolve(name_or_path).string());
+  return field::LoadField(ws.Resolve(name_or_path).string());
 }
 
-json CameraToJson(const Camera& c) {
+json CameraToJson(const camera::Camera& c) {
   json j = {{"name", c.name},
             {"width", c.width},
             {"height", c.height},
@@ -139,7 +139,7 @@ json CameraToJson(const Camera& c) {
 
 // Field lines and keypoints as the camera sees them: polylines in pixels (split where a point is
 // behind the camera or far outside the image).
-json ProjectField(const Camera& cam, const FieldModel& field) {
+json ProjectField(const camera::Camera& cam, const field::FieldModel& field) {
   json lines = json::array();
   const double margin = 0.5 * std::max(cam.width, cam.height);
   auto add_polyline = [&](const std::function<Eigen::Vector2d(double)>& at, double length_m) {
@@ -181,7 +181,8 @@ json ProjectField(const Camera& cam, const FieldModel& field) {
   return {{"lines_px", lines}, {"keypoints_px", keypoints}};
 }
 
-std::vector<calib::PointCorrespondence> ParseClicks(const json& body, const FieldModel& field) {
+std::vector<calib::PointCorrespondence> ParseClicks(const json& body,
+                                                    const field::FieldModel& field) {
   if (!body.contains("points") || !body["points"].is_array()) {
     throw HttpError(400, "missing key 'points' (an array of {name, u, v})");
   }
@@ -197,7 +198,7 @@ std::vector<calib::PointCorrespondence> ParseClicks(const json& body, const Fiel
     c.uv_px = {p["u"].get<double>(), p["v"].get<double>()};
     if (p.contains("name") && p["name"].is_string()) {
       c.name = p["name"].get<std::string>();
-      const FieldKeypoint* k = field.FindKeypoint(c.name);
+      const field::FieldKeypoint* k = field.FindKeypoint(c.name);
       if (!k) throw HttpError(400, where + ": '" + c.name + "' is not a keypoint of " + field.name);
       c.p_world = k->position_m;
     } else if (p.contains("x") && p.contains("y")) {
@@ -211,7 +212,7 @@ std::vector<calib::PointCorrespondence> ParseClicks(const json& body, const Fiel
   return points;
 }
 
-json PoseToJson(const calib::ExtrinsicsResult& r, const FieldModel& field) {
+json PoseToJson(const calib::ExtrinsicsResult& r, const field::FieldModel& field) {
   json points = json::array();
   for (const auto& p : r.points) {
     json j = {{"name", p.name},
@@ -306,30 +307,30 @@ json IntrinsicsToJson(const Workspace& ws, const calib::IntrinsicsResult& r) {
       {"summary", OneLine(r.Summary())}};
 }
 
-ColourRange RangeFromJson(const json& j) {
+detect::ColourRange RangeFromJson(const json& j) {
   if (!j.is_object() || !j.contains("min") || !j.contains("max")) {
     throw HttpError(400, "'range' needs min and max ([h, s, v])");
   }
-  ColourRange r;
+  detect::ColourRange r;
   try {
     r.min = j["min"].get<std::array<double, 3>>();
     r.max = j["max"].get<std::array<double, 3>>();
   } catch (const json::exception&) {
     throw HttpError(400, "'range' min and max must be three numbers each");
   }
-  if (j.value("space", "hsv") == "yuv") r.space = ColourSpace::kYuv;
+  if (j.value("space", "hsv") == "yuv") r.space = detect::ColourSpace::kYuv;
   return r;
 }
 
-json RangeToJson(const ColourRange& r) {
-  return {{"space", r.space == ColourSpace::kHsv ? "hsv" : "yuv"},
+json RangeToJson(const detect::ColourRange& r) {
+  return {{"space", r.space == detect::ColourSpace::kHsv ? "hsv" : "yuv"},
           {"min", {Round(r.min[0], 0.01), Round(r.min[1], 0.01), Round(r.min[2], 0.01)}},
           {"max", {Round(r.max[0], 0.01), Round(r.max[1], 0.01), Round(r.max[2], 0.01)}}};
 }
 
 // A preset's field and line classes with the ball class replaced by `range`.
-ColourSpec SpecWithBallRange(const ColourRange& range) {
-  ColourSpec spec = PresetColourSpec("orange");
+detect::ColourSpec SpecWithBallRange(const detect::ColourRange& range) {
+  detect::ColourSpec spec = detect::PresetColourSpec("orange");
   const int ball = spec.Find(spec.ball_class);
   spec.classes[ball].ranges = {range};
   spec.Check("studio colour");
@@ -459,8 +460,8 @@ std::vector<Route> FolderRoutes() {
       {{"GET", "/api/info", "working folder, built-in fields and colour presets"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          return Json({{"root", ws.root().string()},
-                      {"fields", BuiltinFieldNames()},
-                      {"colour_presets", ColourPresetNames()}});
+                      {"fields", field::BuiltinFieldNames()},
+                      {"colour_presets", detect::ColourPresetNames()}});
        }},
       {{"GET", "/api/files", "files of the working folder: [{path, size, kind}]"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
@@ -468,12 +469,12 @@ std::vector<Route> FolderRoutes() {
        }},
       {{"GET", "/api/field", "?name=NAME_OR_JSON: the field model (field show --json)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
-         return Json(FieldToJson(LoadFieldIn(ws, Param(r, "name"))));
+         return Json(field::FieldToJson(LoadFieldIn(ws, Param(r, "name"))));
        }},
       {{"GET", "/api/video", "?path=V: width, height, frames, fps"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
-         auto source = VideoSource::Open(p.string());
+         auto source = io::VideoSource::Open(p.string());
          return Json({{"path", ws.Relative(p)},
                       {"width", source->width()},
                       {"height", source->height()},
@@ -485,12 +486,12 @@ std::vector<Route> FolderRoutes() {
          const fs::path p = ws.Resolve(Param(r, "path"));
          const int frame = r.params.count("frame") ? ParseInt(r.params.at("frame"), "frame") : 0;
          if (frame < 0) throw HttpError(400, "frame must be >= 0");
-         const cv::Mat bgr = ReadVideoFrame(p.string(), frame);
+         const cv::Mat bgr = detect::ReadVideoFrame(p.string(), frame);
          return ApiResponse{200, "image/png", EncodePng(bgr)};
        }},
       {{"GET", "/api/camera", "?path=CAM.yaml: the camera (intrinsics, pose, position)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
-         return Json(CameraToJson(ReadCameraYaml(ws.Resolve(Param(r, "path")).string())));
+         return Json(CameraToJson(camera::ReadCameraYaml(ws.Resolve(Param(r, "path")).string())));
        }},
   };
 }
@@ -502,7 +503,8 @@ std::vector<Route> CalibrationRoutes() {
         "{camera, field}: the field's lines and keypoints in the camera's image"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
-         const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         const camera::Camera cam =
+             camera::ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          if (!cam.has_pose) throw HttpError(422, "camera file has no pose (rvec, tvec)");
          return Json(ProjectField(cam, LoadFieldIn(ws, Get<std::string>(body, "field"))));
        }},
@@ -510,8 +512,9 @@ std::vector<Route> CalibrationRoutes() {
         "{camera, field, points: [{name, u, v}]}: pose, residuals (px, mm), reprojected lines"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
-         const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
-         const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
+         const camera::Camera cam =
+             camera::ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         const field::FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
          const auto points = ParseClicks(body, field);
          return Json(PoseToJson(calib::EstimatePose(cam, points), field));
        }},
@@ -519,8 +522,9 @@ std::vector<Route> CalibrationRoutes() {
         "{camera, field, points, out[, points_out]}: estimate the pose and write the camera file"},
        [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
-         const Camera cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
-         const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
+         const camera::Camera cam =
+             camera::ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+         const field::FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
          const auto points = ParseClicks(body, field);
          const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
          fs::path points_out;
@@ -528,7 +532,7 @@ std::vector<Route> CalibrationRoutes() {
            points_out = ws.ResolveOutput(Get<std::string>(body, "points_out"));
          }
          const calib::ExtrinsicsResult result = calib::EstimatePose(cam, points);
-         WriteCameraYaml(result.camera, out.string());
+         camera::WriteCameraYaml(result.camera, out.string());
          json j = PoseToJson(result, field);
          j["wrote"] = {ws.Relative(out)};
          if (!points_out.empty()) {
@@ -550,8 +554,8 @@ std::vector<Route> CalibrationRoutes() {
        [](const Workspace& ws, EventHub* events, JobRunner*, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const std::string camera_path = Get<std::string>(body, "camera");
-         Camera cam = ReadCameraYaml(ws.Resolve(camera_path).string());
-         const FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
+         camera::Camera cam = camera::ReadCameraYaml(ws.Resolve(camera_path).string());
+         const field::FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
          const std::string video_path = Get<std::string>(body, "video");
          const fs::path video = ws.Resolve(video_path);
          fs::path out;
@@ -565,7 +569,7 @@ std::vector<Route> CalibrationRoutes() {
          }
          const int frame = GetOr<int>(body, "frame", 0);
          if (frame < 0) throw HttpError(400, "frame must be >= 0");
-         const cv::Mat bgr = ReadVideoFrame(video.string(), frame);
+         const cv::Mat bgr = detect::ReadVideoFrame(video.string(), frame);
          calib::CheckImageSize(bgr, cam, video_path, camera_path);
          const calib::RefineOptions options;
          const auto pixels = calib::DetectLinePixels(bgr, cam, field, options.detect);
@@ -590,7 +594,7 @@ std::vector<Route> CalibrationRoutes() {
                    {"wrote", json::array()}};
          j.update(ProjectField(res.camera, field));
          if (!out.empty() && res.accepted) {
-           WriteCameraYaml(res.camera, out.string());
+           camera::WriteCameraYaml(res.camera, out.string());
            j["wrote"].push_back(ws.Relative(out));
            Saved(events, ws, out, "camera");
          }
@@ -633,7 +637,7 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
          json j = IntrinsicsToJson(ws, res);
          j["wrote"] = json::array();
          if (!out.empty()) {
-           WriteCameraYaml(res.camera, out.string());
+           camera::WriteCameraYaml(res.camera, out.string());
            j["wrote"].push_back(ws.Relative(out));
            Saved(events, ws, out, "camera");
          }
@@ -670,7 +674,7 @@ std::vector<Route> ColourRoutes() {
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
-         ColourLearnOptions o;
+         detect::ColourLearnOptions o;
          o.points = ParseUvList(body, "points");
          o.negative_points = ParseUvList(body, "negative_points");
          if (body.contains("roi")) {
@@ -678,8 +682,8 @@ std::vector<Route> ColourRoutes() {
            o.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
          }
          if (o.points.empty() && !o.roi) throw HttpError(400, "give 'points' or 'roi'");
-         const cv::Mat bgr = ReadVideoFrame(video.string(), GetOr<int>(body, "frame", 0));
-         const ColourLearnResult res = LearnColour(bgr, o);
+         const cv::Mat bgr = detect::ReadVideoFrame(video.string(), GetOr<int>(body, "frame", 0));
+         const detect::ColourLearnResult res = detect::LearnColour(bgr, o);
          return Json({{"range", RangeToJson(res.range)},
                       {"positives", res.positives},
                       {"negatives", res.negatives},
@@ -691,39 +695,41 @@ std::vector<Route> ColourRoutes() {
         "{range: {min, max}, out}: write a colour file (ball class + field + line)"},
        [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
-         const ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
+         const detect::ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
          const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
-         WriteColourSpec(spec, out.string());
+         detect::WriteColourSpec(spec, out.string());
          Saved(events, ws, out, "colour");
-         return Json({{"wrote", {ws.Relative(out)}}, {"spec", ColourSpecToJson(spec)}});
+         return Json({{"wrote", {ws.Relative(out)}}, {"spec", detect::ColourSpecToJson(spec)}});
        }},
       {{"POST", "/api/colour/detect",
         "{video, frames: [N], colour: FILE_OR_PRESET | range, camera?}: ball candidates"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
-         ColourSpec spec;
+         detect::ColourSpec spec;
          if (body.contains("range")) {
            spec = SpecWithBallRange(RangeFromJson(body["range"]));
          } else {
            const std::string c = GetOr<std::string>(body, "colour", "orange");
            bool preset = false;
-           for (const auto& n : ColourPresetNames()) preset = preset || n == c;
-           spec = preset ? PresetColourSpec(c) : ReadColourSpec(ws.Resolve(c).string());
+           for (const auto& n : detect::ColourPresetNames()) preset = preset || n == c;
+           spec = preset ? detect::PresetColourSpec(c)
+                         : detect::ReadColourSpec(ws.Resolve(c).string());
          }
-         std::optional<Camera> cam;
+         std::optional<camera::Camera> cam;
          if (body.contains("camera")) {
-           cam = ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
+           cam = camera::ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          }
          std::vector<int> frames = GetOr<std::vector<int>>(body, "frames", {0});
          if (frames.empty() || frames.size() > 50) {
            throw HttpError(400, "'frames' must list 1 to 50 frame numbers");
          }
-         BallDetector detector(BallDetectorOptions{}, spec, cam ? &*cam : nullptr, nullptr);
+         detect::BallDetector detector(detect::BallDetectorOptions{}, spec, cam ? &*cam : nullptr,
+                                       nullptr);
          json out = json::array();
          for (int f : frames) {
            if (f < 0) throw HttpError(400, "frame numbers must be >= 0");
-           const cv::Mat bgr = ReadVideoFrame(video.string(), f);
+           const cv::Mat bgr = detect::ReadVideoFrame(video.string(), f);
            json cands = json::array();
            for (const auto& c : detector.Detect(bgr)) {
              cands.push_back({{"u", Round(c.centre_px.x(), 1e-3)},
@@ -758,7 +764,7 @@ std::vector<track::TrackRow> ReadStatsInput(const Workspace& ws, const json& bod
 ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiRequest& r) {
   const json body = Body(r);
   const fs::path out = ResolveOutputFolder(ws, Get<std::string>(body, "out"));
-  const FieldModel field = LoadFieldIn(ws, GetOr<std::string>(body, "field", "robocup-msl"));
+  const field::FieldModel field = LoadFieldIn(ws, GetOr<std::string>(body, "field", "robocup-msl"));
   std::vector<std::pair<std::string, cv::Mat>> images;
   const json sent = GetOr<json>(body, "images", json::object());
   if (!sent.is_object() || sent.size() > 8) {
@@ -791,7 +797,8 @@ ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiReques
   stats::ReportFiles files;
   try {
     files = stats::WriteStatsReport(res, field, o, tmp.string());
-    CsvWriter alerts((tmp / "zone_alerts.csv").string(), {"zone", "id", "enter_s", "exit_s"}, 3);
+    util::CsvWriter alerts((tmp / "zone_alerts.csv").string(), {"zone", "id", "enter_s", "exit_s"},
+                           3);
     for (const auto& e : res.events) {
       alerts << e.zone << e.id << e.enter_s << e.exit_s;
       alerts.EndRow();
@@ -828,7 +835,8 @@ std::vector<Route> TrackRoutes() {
   return {
       {{"GET", "/api/ball", "?path=BALL.csv: the ball track (time, position, cameras, error)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
-         const BallTrackFile track = ReadBallTrack(ws.Resolve(Param(r, "path")).string());
+         const recon::BallTrackFile track =
+             recon::ReadBallTrack(ws.Resolve(Param(r, "path")).string());
          json samples = json::array();
          for (const auto& s : track.samples) {
            samples.push_back({s.frame, s.time_s, Round(s.ball_in_world.x()),
@@ -843,7 +851,7 @@ std::vector<Route> TrackRoutes() {
         "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s, team when the "
         "file has that column)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
-         const CsvTable t = CsvTable::Read(ws.Resolve(Param(r, "path")).string());
+         const util::CsvTable t = util::CsvTable::Read(ws.Resolve(Param(r, "path")).string());
          t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
          json rows = json::array();
          auto num = [&](size_t i, const char* col) -> json {

@@ -104,7 +104,7 @@ class StudioApiTest : public ::testing::Test {
 
   // The ball's truth in cam1 at frame 0 (truth_2d.csv).
   Eigen::Vector3d BallTruth() {
-    const CsvTable t = CsvTable::Read((dir_ / "scene/truth_2d.csv").string());
+    const util::CsvTable t = util::CsvTable::Read((dir_ / "scene/truth_2d.csv").string());
     for (size_t i = 0; i < t.rows(); ++i) {
       if (t.GetInt(i, "frame") == 0 && t.Get(i, "cam") == "cam1") {
         return {t.GetDouble(i, "u_px"), t.GetDouble(i, "v_px"), t.GetDouble(i, "radius_px")};
@@ -183,7 +183,7 @@ TEST_F(StudioApiTest, FieldVideoFrameAndCamera) {
 
   const Reply cam = Get("/api/camera?path=scene/cam1.yaml");
   ASSERT_EQ(cam.status, 200);
-  const Camera truth = ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
+  const camera::Camera truth = camera::ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
   EXPECT_TRUE(cam.j()["has_pose"].get<bool>());
   EXPECT_NEAR(cam.j()["position_m"][0].get<double>(), truth.CentreInWorld().x(), 1e-9);
   ExpectError(Get("/api/camera?path=scene/truth.csv"), 422, "truth.csv");
@@ -304,7 +304,7 @@ TEST_F(StudioApiTest, PoseFromClickedKeypoints) {
   body["points"] = points;
   const Reply pose = Post("/api/calibrate/pose", body);
   ASSERT_EQ(pose.status, 200) << pose.body;
-  const Camera truth = ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
+  const camera::Camera truth = camera::ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
   const json j = pose.j();
   const Eigen::Vector3d position(j["camera_position_m"][0], j["camera_position_m"][1],
                                  j["camera_position_m"][2]);
@@ -317,23 +317,23 @@ TEST_F(StudioApiTest, PoseFromClickedKeypoints) {
   body["points_out"] = "scene/cam1_points.csv";
   const Reply saved = Post("/api/calibrate/save", body);
   ASSERT_EQ(saved.status, 200) << saved.body;
-  const Camera written = ReadCameraYaml((dir_ / "scene/cam1_studio.yaml").string());
+  const camera::Camera written = camera::ReadCameraYaml((dir_ / "scene/cam1_studio.yaml").string());
   EXPECT_LT((written.CentreInWorld() - truth.CentreInWorld()).norm(), 0.005);
-  EXPECT_EQ(CsvTable::Read((dir_ / "scene/cam1_points.csv").string()).rows(), points.size());
+  EXPECT_EQ(util::CsvTable::Read((dir_ / "scene/cam1_points.csv").string()).rows(), points.size());
 }
 
 TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
   FV_SEED_TRACE(seed_);
   // cam1 moved 12 cm and turned 0.4 degrees off the truth: the lines of its frame pull it back.
-  const Camera truth = ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
-  Camera off = truth;
+  const camera::Camera truth = camera::ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
+  camera::Camera off = truth;
   const Eigen::Matrix3d turn =
       Eigen::AngleAxisd(0.4 * M_PI / 180, Eigen::Vector3d(1, 2, 0.5).normalized()).matrix();
   off.cam_from_world.rotation = turn * truth.cam_from_world.rotation;
   off.cam_from_world.translation = turn * truth.cam_from_world.translation;
   off.cam_from_world.translation +=
       off.cam_from_world.rotation * Eigen::Vector3d(0.08, -0.06, 0.06);
-  WriteCameraYaml(off, (dir_ / "scene/cam1_off.yaml").string());
+  camera::WriteCameraYaml(off, (dir_ / "scene/cam1_off.yaml").string());
   const double before_m = (off.CentreInWorld() - truth.CentreInWorld()).norm();
 
   json body = {{"camera", "scene/cam1_off.yaml"},
@@ -350,7 +350,8 @@ TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
   EXPECT_FALSE(j["lines_px"].empty());
   EXPECT_LT(j["after"]["mean_mm"].get<double>(), 0.5 * j["before"]["mean_mm"].get<double>())
       << j["summary"];
-  const Camera refined = ReadCameraYaml((dir_ / "scene/cam1_refined.yaml").string());
+  const camera::Camera refined =
+      camera::ReadCameraYaml((dir_ / "scene/cam1_refined.yaml").string());
   const double after_m = (refined.CentreInWorld() - truth.CentreInWorld()).norm();
   EXPECT_LT(after_m, 0.3 * before_m) << "before " << before_m << " m, after " << after_m << " m";
   EXPECT_EQ(j["wrote"][0], "scene/cam1_refined.yaml");
@@ -366,9 +367,9 @@ TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
   EXPECT_TRUE(from_clicks.j()["wrote"].empty());
 
   // Bad requests.
-  Camera no_pose = truth;
+  camera::Camera no_pose = truth;
   no_pose.has_pose = false;
-  WriteCameraYaml(no_pose, (dir_ / "scene/cam1_intrinsics.yaml").string());
+  camera::WriteCameraYaml(no_pose, (dir_ / "scene/cam1_intrinsics.yaml").string());
   body = {{"camera", "scene/cam1_intrinsics.yaml"},
           {"field", "robocup-msl"},
           {"video", "scene/cam1.avi"}};
@@ -380,10 +381,10 @@ TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
   body["out"] = "../escape.yaml";
   ExpectError(Post("/api/calibrate/refine", body), 403, "");
   EXPECT_FALSE(fs::exists(dir_.parent_path() / "escape.yaml"));
-  Camera small = truth;
+  camera::Camera small = truth;
   small.width = 320;
   small.height = 240;
-  WriteCameraYaml(small, (dir_ / "scene/small.yaml").string());
+  camera::WriteCameraYaml(small, (dir_ / "scene/small.yaml").string());
   body = {{"camera", "scene/small.yaml"}, {"field", "robocup-msl"}, {"video", "scene/cam1.avi"}};
   ExpectError(Post("/api/calibrate/refine", body), 422, "");
 }
@@ -391,7 +392,7 @@ TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
 TEST_F(StudioApiTest, IntrinsicsFromBoardImagesWithPerViewErrors) {
   FV_SEED_TRACE(seed_);
   // Eight views of a 9x6 chessboard (25 mm) seen by a 640x480 camera, fx = fy = 600.
-  Camera cam;
+  camera::Camera cam;
   cam.width = 640;
   cam.height = 480;
   cam.fx = cam.fy = 600;
@@ -401,12 +402,12 @@ TEST_F(StudioApiTest, IntrinsicsFromBoardImagesWithPerViewErrors) {
   calib::BoardSpec board;
   const calib::BoardPicture picture = calib::DrawBoard(board, 3000);
   fs::create_directories(dir_ / "boards");
-  Rng rng(seed_);
+  util::Rng rng(seed_);
   const Eigen::Vector3d centre((board.cols - 1) * board.square_m / 2,
                                (board.rows - 1) * board.square_m / 2, 0);
   for (int i = 0; i < 8; ++i) {
     const double ax = rng.Uniform(-0.5, 0.5), ay = rng.Uniform(-0.5, 0.5);
-    Rigid3d cam_from_board;
+    geometry::Rigid3d cam_from_board;
     cam_from_board.rotation = (Eigen::AngleAxisd(ax, Eigen::Vector3d::UnitX()) *
                                Eigen::AngleAxisd(ay, Eigen::Vector3d::UnitY()) *
                                Eigen::AngleAxisd(rng.Uniform(-0.3, 0.3), Eigen::Vector3d::UnitZ()))
@@ -439,7 +440,7 @@ TEST_F(StudioApiTest, IntrinsicsFromBoardImagesWithPerViewErrors) {
   }
   EXPECT_EQ(j["num_used"], 8);
   EXPECT_EQ(j["wrote"][0], "boards/cam.yaml");
-  const Camera written = ReadCameraYaml((dir_ / "boards/cam.yaml").string());
+  const camera::Camera written = camera::ReadCameraYaml((dir_ / "boards/cam.yaml").string());
   EXPECT_NEAR(written.fx, j["camera"]["fx"].get<double>(), 1e-3);
   EXPECT_EQ(written.name, "studio_cam");
 
@@ -575,7 +576,7 @@ TEST_F(StudioApiTest, BallColourLearnSaveDetect) {
 
   const Reply saved = Post("/api/colour/save", json{{"range", range}, {"out", "ball.json"}});
   ASSERT_EQ(saved.status, 200) << saved.body;
-  EXPECT_NO_THROW(ReadColourSpec((dir_ / "ball.json").string()));
+  EXPECT_NO_THROW(detect::ReadColourSpec((dir_ / "ball.json").string()));
 
   const Reply det = Post("/api/colour/detect", json{{"video", "scene/cam1.avi"},
                                                     {"frames", {0, 1}},
@@ -710,7 +711,7 @@ TEST_F(StudioApiTest, PlayersExport) {
     EXPECT_EQ(e.path().filename(), "walk") << "left behind: " << e.path();
   }
   // The statistics are the library's (as /api/players/stats), the alerts one row per stay.
-  const CsvTable players = CsvTable::Read((dir_ / "exports/walk/players.csv").string());
+  const util::CsvTable players = util::CsvTable::Read((dir_ / "exports/walk/players.csv").string());
   ASSERT_EQ(players.rows(), 2u);
   for (size_t i = 0; i < players.rows(); ++i) {
     if (players.GetInt(i, "id") == 3) {
@@ -718,7 +719,8 @@ TEST_F(StudioApiTest, PlayersExport) {
       EXPECT_NEAR(players.GetDouble(i, "time_in_strip_s"), 1.0 / 1.5, 0.1);
     }
   }
-  const CsvTable alerts = CsvTable::Read((dir_ / "exports/walk/zone_alerts.csv").string());
+  const util::CsvTable alerts =
+      util::CsvTable::Read((dir_ / "exports/walk/zone_alerts.csv").string());
   ASSERT_EQ(alerts.rows(), 1u);
   EXPECT_EQ(alerts.Get(0, "zone"), "strip");
   EXPECT_EQ(alerts.GetInt(0, "id"), 3);
