@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -311,8 +312,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
                                  "precise",  "reason"},
         4);
   }
-  util::Progress progress("eval detect", static_cast<long long>(items.size()), "images",
-                          o.progress);
+  util::Progress progress("eval detect", std::ssize(items), "images", o.progress);
   io::Frame frame;
   for (size_t i = 0; i < items.size(); ++i) {
     const LabelledImage& item = items[i];
