@@ -17,7 +17,6 @@
 #include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
-#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::io::backend {
@@ -92,14 +91,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
             : options.time == TimeSource::kContainer ? TimeOrigin::kContainer
                                                      : TimeOrigin::kFrameRate;
   if (options.time == TimeSource::kCsv) {
-    const util::CsvTable t = util::CsvTable::Read(options.timestamps_csv);
-    t.Require({"frame", "time_s"});
-    for (size_t r = 0; r < t.rows(); ++r) {
-      const long long f = t.GetInt(r, "frame");
-      const double ts = t.GetDouble(r, "time_s");
-      FV_REQUIRE(std::isfinite(ts), "{}: time_s is not finite", t.Where(r));
-      FV_REQUIRE(times_.emplace(f, ts).second, "{}: frame {} listed twice", t.Where(r), f);
-    }
+    times_ = ReadTimestampsCsv(options.timestamps_csv);
   }
   // Motion JPEG through FFmpeg: the packets themselves are the JPEG frames.
   const int fourcc = static_cast<int>(capture_.get(cv::CAP_PROP_FOURCC));

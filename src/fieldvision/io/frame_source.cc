@@ -9,6 +9,7 @@
 
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -44,6 +45,36 @@ void FrameSourceOptions::Check() const {
   FV_REQUIRE(width >= 0 && height >= 0, "FrameSourceOptions.width/height must be >= 0");
   FV_REQUIRE(std::isfinite(exposure_us) && exposure_us >= 0,
              "FrameSourceOptions.exposure_us must be >= 0 (got {})", exposure_us);
+}
+
+std::map<long long, double> ReadTimestampsCsv(const std::string& path) {
+  const util::CsvTable t = util::CsvTable::Read(path);
+  t.Require({"frame", "time_s"});
+  FV_REQUIRE(t.rows() > 0, "timestamps '{}' have a header but no rows", path);
+  std::map<long long, std::pair<double, size_t>> rows;  // frame -> time, row
+  for (size_t r = 0; r < t.rows(); ++r) {
+    const long long f = t.GetInt(r, "frame");
+    const double ts = t.GetDouble(r, "time_s");
+    FV_REQUIRE(f >= 0, "{}: frame {} is negative (frames count from 0)", t.Where(r), f);
+    FV_REQUIRE(std::isfinite(ts) && ts >= 0 && ts <= kMaxTimestampS,
+               "{}: time_s {} is not in [0, {:g}] s", t.Where(r), ts, kMaxTimestampS);
+    FV_REQUIRE(rows.emplace(f, std::make_pair(ts, r)).second, "{}: frame {} listed twice",
+               t.Where(r), f);
+  }
+  std::map<long long, double> times;
+  const std::pair<const long long, std::pair<double, size_t>>* previous = nullptr;
+  for (const auto& row : rows) {
+    if (previous != nullptr) {
+      FV_REQUIRE(row.second.first > previous->second.first,
+                 "{}: time_s {} of frame {} is not after {} of frame {} (times must increase with "
+                 "the frame)",
+                 t.Where(row.second.second), row.second.first, row.first, previous->second.first,
+                 previous->first);
+    }
+    times.emplace_hint(times.end(), row.first, row.second.first);
+    previous = &row;
+  }
+  return times;
 }
 
 bool FrameSource::SkipFrame() {

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -70,6 +71,12 @@ struct FrameSourceOptions {
   std::string trigger;
   void Check() const;  // throws fv::Error naming the bad field
 };
+
+// The frame,time_s file of TimeSource::kCsv, frame -> time_s. Throws fv::Error naming file and
+// line for a frame below 0 or listed twice, a time that is not a number in [0, kMaxTimestampS] or
+// one that does not increase with the frame.
+inline constexpr double kMaxTimestampS = 1e10;  // Unix seconds until the year 2286
+std::map<long long, double> ReadTimestampsCsv(const std::string& path);
 
 class FrameSource {
  public:

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -130,6 +131,55 @@ TEST(FrameSource, TruncatedFileFailsAtItsEndEncodedOrNot) {
     }
     EXPECT_LT(n, 16);
   }
+}
+
+// Issue 18: a --timestamps file is read whole and checked before any frame: a negative frame, a
+// time that is not a number in range or that does not increase with the frame is an error naming
+// file and line, for a video file and for a folder of images alike.
+TEST(FrameSource, TimestampsCsvRangesNameFileAndLine) {
+  const std::string dir = testing::TempDir();
+  const std::string video = WriteMjpg(dir, 3, 25);
+  const std::string good = dir + "/ts.csv";
+  std::ofstream(good) << "frame,time_s\n1,0.04\n0,0\n2,0.08\n";
+  const std::map<long long, double> times = ReadTimestampsCsv(good);
+  ASSERT_EQ(times.size(), 3u);
+  EXPECT_DOUBLE_EQ(times.at(1), 0.04);
+  const struct {
+    const char* rows;  // rows 3 and 4 (lines 4 and 5) after 0,0 and 1,0.04
+    const char* line;  // the line the error names
+    const char* says;
+  } cases[] = {
+      {"2,-0.08\n3,0.12\n", "bad.csv:4", "not in [0"},
+      {"2,nan\n3,0.12\n", "bad.csv:4", "not in [0"},
+      {"2,1e300\n3,0.12\n", "bad.csv:4", "not in [0"},
+      {"2,soon\n3,0.12\n", "bad.csv:4", "soon"},
+      {"-2,0.08\n3,0.12\n", "bad.csv:4", "negative"},
+      {"2,0.08\n3,0.02\n", "bad.csv:5", "not after"},
+      {"2,0.08\n3,0.08\n", "bad.csv:5", "not after"},
+      {"2,0.08\n1,0.12\n", "bad.csv:5", "listed twice"},
+  };
+  const std::string bad = dir + "/bad.csv";
+  cv::imwrite(dir + "/a.png", cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(90)));
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.rows);
+    std::ofstream(bad, std::ios::trunc) << "frame,time_s\n0,0\n1,0.04\n" << c.rows;
+    FrameSourceOptions o;
+    o.time = TimeSource::kCsv;
+    o.timestamps_csv = bad;
+    for (const std::string& spec : {video, dir + "/*.png"}) {
+      try {
+        OpenFrameSource(spec, o);
+        ADD_FAILURE() << "accepted for " << spec;
+      } catch (const Error& e) {
+        const std::string msg = e.what();
+        EXPECT_NE(msg.find(c.line), std::string::npos) << msg;
+        EXPECT_NE(msg.find(c.says), std::string::npos) << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+      }
+    }
+  }
+  std::ofstream(bad, std::ios::trunc) << "frame,time_s\n";
+  EXPECT_THROW(ReadTimestampsCsv(bad), Error);
 }
 
 TEST(FrameSource, RealtimeFileIsStampedOnTheSystemClockAndSkipsWhatIsGone) {

@@ -11,7 +11,6 @@
 
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
-#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -31,9 +30,7 @@ class ImageListSource : public FrameSource {
     encoded_ = o.encoded;
     for (const std::string& f : files_) encoded_ = encoded_ && IsJpeg(f);
     if (o.time == TimeSource::kCsv) {
-      const util::CsvTable t = util::CsvTable::Read(o.timestamps_csv);
-      t.Require({"frame", "time_s"});
-      for (size_t r = 0; r < t.rows(); ++r) times_[t.GetInt(r, "frame")] = t.GetDouble(r, "time_s");
+      times_ = ReadTimestampsCsv(o.timestamps_csv);
       origin_ = TimeOrigin::kCsv;
       csv_ = o.timestamps_csv;
     }

@@ -10,10 +10,8 @@
 namespace fv::io {
 namespace fs = std::filesystem;
 
-namespace {
-
-// Same file: by inode when both exist, else by normalised absolute path.
-bool SameFile(const fs::path& a, const fs::path& b) {
+bool SameFile(const std::string& a_name, const std::string& b_name) {
+  const fs::path a = a_name, b = b_name;
   std::error_code ec;
   if (fs::exists(a, ec) && fs::exists(b, ec)) {
     const bool same = fs::equivalent(a, b, ec);
@@ -25,8 +23,6 @@ bool SameFile(const fs::path& a, const fs::path& b) {
   if (ec) return false;
   return ca == cb;
 }
-
-}  // namespace
 
 void CheckOutputPath(const std::string& out, const std::vector<std::string>& inputs,
                      std::string_view what) {

@@ -11,6 +11,10 @@
 
 namespace fv::io {
 
+// Whether `a` and `b` are one file: by inode when both exist (symlinks and hard links count), else
+// by normalised absolute path.
+bool SameFile(const std::string& a, const std::string& b);
+
 // Throws fv::Error (one line, naming `what` and both paths) when `out` is the same file as one of
 // `inputs` (compared with std::filesystem::equivalent, so symlinks and hard links count; also by
 // weakly_canonical path for files that do not exist yet). Empty paths are skipped.

@@ -48,6 +48,9 @@ TEST(CheckOutputPath, RefusesTheSameFileByNameLinkAndHardLink) {
     EXPECT_NE(msg.find("--truth"), std::string::npos);
     EXPECT_NE(msg.find(in), std::string::npos);
   }
+  EXPECT_TRUE(SameFile(in, dir + "/./in.csv"));
+  EXPECT_TRUE(SameFile(dir + "/link.csv", dir + "/hard.csv"));
+  EXPECT_FALSE(SameFile(in, dir + "/out.csv"));
   // Other files, and outputs that do not exist yet, pass.
   EXPECT_NO_THROW(CheckOutputPath(dir + "/out.csv", {in, dir + "/other.csv"}));
   EXPECT_NO_THROW(CheckOutputPath("", {in}));
