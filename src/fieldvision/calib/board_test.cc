@@ -13,6 +13,7 @@
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -84,9 +85,7 @@ void WriteViews(const BoardSpec& b, const cv::Matx33d& k, cv::Size size, int n, 
 }
 
 TEST(Board, SyntheticChessboardViewsRecoverTheFocalLength) {
-  const uint64_t seed = fv::testing::TestSeed(21);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(21);
   const cv::Size size(640, 480);
   const cv::Matx33d k(600, 0, 322, 0, 600, 236, 0, 0, 1);
   IntrinsicsOptions o;
@@ -106,9 +105,7 @@ TEST(Board, SyntheticChessboardViewsRecoverTheFocalLength) {
 }
 
 TEST(Board, ChArUcoPartialViewsCount) {
-  const uint64_t seed = fv::testing::TestSeed(22);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(22);
   const cv::Size size(640, 480);
   const cv::Matx33d k(580, 0, 318, 0, 580, 242, 0, 0, 1);
   BoardSpec b{BoardType::kCharuco, 7, 5, 0.04, 0.03, "DICT_4X4_50"};
@@ -145,9 +142,7 @@ TEST(Board, ChArUcoPartialViewsCount) {
 }
 
 TEST(Board, VideoIsSampledEvenly) {
-  const uint64_t seed = fv::testing::TestSeed(23);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(23);
   const cv::Size size(640, 480);
   const cv::Matx33d k(600, 0, 322, 0, 600, 236, 0, 0, 1);
   BoardSpec b{BoardType::kChessboard, 7, 5, 0.03};

@@ -9,6 +9,7 @@
 #include "fieldvision/calib/calib_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -30,9 +31,7 @@ TEST(Extrinsics, EightKeypointsWithOnePixelNoiseWithin5cmAt20m) {
   // 40 independent clicks of 8 keypoints with 1 px noise: the camera position error is a
   // random variable (the estimate is maximum likelihood; its spread is the geometry's), so we
   // check its median and 90th percentile.
-  const uint64_t seed = fv::testing::TestSeed(3);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(3);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   const camera::Camera truth = TwentyMetreCamera();
   ASSERT_NEAR(truth.CentreInWorld().norm(), 20.4, 0.1);
@@ -60,9 +59,7 @@ TEST(Extrinsics, EightKeypointsWithOnePixelNoiseWithin5cmAt20m) {
 }
 
 TEST(Extrinsics, GrossOutlierIsRejected) {
-  const uint64_t seed = fv::testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(5);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   const camera::Camera truth = TwentyMetreCamera();
   auto pts = ClickKeypoints(truth, field, 10, 0.5, rng);

@@ -8,6 +8,7 @@
 #include "fieldvision/calib/calib_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -77,9 +78,7 @@ TEST(Focal, EightKeypointsGiveTheFocalLengthWithAnHonestUncertainty) {
 }
 
 TEST(Focal, RadialDistortionToo) {
-  const uint64_t seed = fv::testing::TestSeed(82);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(82);
   const field::FieldModel field = field::BuiltinField("futsal");
   const camera::Camera truth = Phone(70, -0.12);
   const auto pts = test_util::ClickKeypoints(truth, field, 16, 0.3, rng);
@@ -93,9 +92,7 @@ TEST(Focal, RadialDistortionToo) {
 }
 
 TEST(Focal, GroundHomographyAndBadInputs) {
-  const uint64_t seed = fv::testing::TestSeed(83);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(83);
   const field::FieldModel field = field::BuiltinField("futsal");
   const camera::Camera truth = Phone(55);
   auto pts = test_util::ClickKeypoints(truth, field, 8, 0.5, rng);

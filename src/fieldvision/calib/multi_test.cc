@@ -14,6 +14,7 @@
 #include "fieldvision/calib/pose2sim.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -156,9 +157,7 @@ double WorstBaselineFraction(const RigComparison& cmp) {
 }
 
 TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
-  const uint64_t seed = fv::testing::TestSeed(61);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(61);
   const auto truth = ArcRig(4, 1.6, 100, 1280, 720, 60, rng);
   const MultiOptions o = ProjectedOptions();  // p1 p2 kept only where they pay (the truth: none)
   auto frames = ProjectedMoments(truth, o.board, 40, rng);
@@ -246,9 +245,7 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
 // only. Its principal point is then weaker (p1 p2 trade off against it): relative rotations
 // 0.02-0.07 deg over seeds 1-8, baselines within 0.05 %.
 TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
-  const uint64_t seed = fv::testing::TestSeed(66);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(66);
   auto truth = ArcRig(3, 1.6, 80, 1280, 720, 60, rng);
   truth[1].distortion[2] = 1.5e-3;  // p1, p2: a decentred lens (0.5-1.5 px at the edges)
   truth[1].distortion[3] = -1.0e-3;
@@ -281,9 +278,7 @@ TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
 // Rendered pictures through folders, paired by frame number (a right image missing, a moment
 // where the right camera does not see the board).
 TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
-  const uint64_t seed = fv::testing::TestSeed(62);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(62);
   const auto [left, right] =
       StereoPair(Eigen::Vector3d(0.01, -0.05, 0.005), Eigen::Vector3d(-0.1, 0.002, 0.004));
   MultiOptions o = RenderedOptions({BoardType::kChessboard, 9, 6, 0.025});
@@ -329,9 +324,7 @@ TEST(Multi, RenderedStereoFoldersPairByFrameNumber) {
 
 // Two synchronized MJPG videos: sampled at the same frames, paired by frame number.
 TEST(Multi, SynchronizedVideos) {
-  const uint64_t seed = fv::testing::TestSeed(65);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(65);
   const auto [left, right] =
       StereoPair(Eigen::Vector3d(0.0, -0.08, 0.0), Eigen::Vector3d(-0.12, 0, 0));
   MultiOptions o = RenderedOptions({BoardType::kChessboard, 7, 5, 0.03});
@@ -372,9 +365,7 @@ TEST(Multi, SynchronizedVideos) {
 }
 
 TEST(Multi, ChArUcoPartialViewsAndAWrongDictionary) {
-  const uint64_t seed = fv::testing::TestSeed(63);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(63);
   camera::Camera a = camera::Camera::FromFov(640, 480, 65);
   a.name = "a";
   a.has_pose = true;
@@ -460,9 +451,7 @@ TEST(Multi, UnpairableViewsAndUnlinkedCamerasAreErrorsNamingTheCamera) {
   EXPECT_NE(err.find("give the images of one moment the same number"), std::string::npos) << err;
 
   // Camera c never sees the board together with a or b.
-  const uint64_t seed = fv::testing::TestSeed(64);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(64);
   const auto rig = ArcRig(3, 2.5, 60, 1280, 720, 60, rng);
   MultiOptions o;
   o.board = {BoardType::kChessboard, 8, 6, 0.06};

@@ -6,6 +6,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -26,9 +27,7 @@ std::vector<camera::Camera> ThreeCameras() {
 }
 
 TEST(Rig, JointRefinementMovesEveryCameraTowardsTheTruth) {
-  const uint64_t seed = fv::testing::TestSeed(31);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(31);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   const auto truth = ThreeCameras();
   // Shared free points (a ball held at several places, unknown position) and field keypoints.

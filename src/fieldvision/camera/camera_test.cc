@@ -8,6 +8,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::camera {
@@ -45,9 +46,7 @@ Eigen::Vector3d RandomPointInView(util::Rng& rng, const Camera& cam) {
 class CameraModel : public ::testing::TestWithParam<int> {};
 
 TEST_P(CameraModel, AgreesWithOpenCvProjectPoints) {
-  const uint64_t seed = testing::TestSeed(100 + GetParam());
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(100 + GetParam());
   for (int trial = 0; trial < 20; ++trial) {
     const Camera cam = RandomCamera(rng, GetParam());
     std::vector<cv::Point3d> pts;
@@ -73,9 +72,7 @@ TEST_P(CameraModel, AgreesWithOpenCvProjectPoints) {
 }
 
 TEST_P(CameraModel, ProjectUnprojectRoundTrip) {
-  const uint64_t seed = testing::TestSeed(200 + GetParam());
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(200 + GetParam());
   for (int trial = 0; trial < 20; ++trial) {
     const Camera cam = RandomCamera(rng, GetParam());
     for (int i = 0; i < 50; ++i) {

@@ -7,6 +7,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::dnn {
@@ -38,9 +39,7 @@ std::vector<cv::Mat> FakeOutputs(int w, int h, const std::vector<Hot>& hot) {
 }
 
 TEST(DecodeNanoDet, RecoversBoxesOfTheAskedClassesAtEveryStride) {
-  const uint64_t seed = fv::testing::TestSeed(12);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(12);
   const int w = 416, h = 320;
   for (int trial = 0; trial < 20; ++trial) {
     const int stride = std::array<int, 3>{8, 16, 32}[rng.UniformInt(0, 2)];

@@ -3,15 +3,13 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::geometry {
 namespace {
 
 TEST(Rigid3d, RvecRoundTripAndInverse) {
-  const uint64_t seed = testing::TestSeed(7);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(7);
   for (int i = 0; i < 100; ++i) {
     Eigen::Vector3d rvec(rng.Normal(), rng.Normal(), rng.Normal());
     if (rvec.norm() > 3.0) rvec *= 3.0 / rvec.norm();

@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::io {
 namespace {
@@ -31,9 +31,7 @@ std::vector<uint8_t> TestJpeg(util::Rng& rng, int w, int h, cv::Mat* image = nul
 }
 
 TEST(JpegRegionDecoder, WholeImageAndRegionsMatchAFullDecode) {
-  const uint64_t seed = testing::TestSeed(31);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(31);
   const std::vector<uint8_t> jpeg = TestJpeg(rng, 333, 250);
   EXPECT_EQ(JpegRegionDecoder::ReadSize(jpeg.data(), jpeg.size(), "t.jpg"), cv::Size(333, 250));
   JpegRegionDecoder dec;
@@ -63,9 +61,7 @@ TEST(JpegRegionDecoder, WholeImageAndRegionsMatchAFullDecode) {
 }
 
 TEST(JpegRegionDecoder, DamagedDataIsCountedOrAnErrorNamingTheInput) {
-  const uint64_t seed = testing::TestSeed(32);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(32);
   std::vector<uint8_t> jpeg = TestJpeg(rng, 160, 120);
   JpegRegionDecoder dec;
   cv::Mat img;

@@ -5,7 +5,7 @@
 #include "fieldvision/net/fuse.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::net {
 namespace {
@@ -121,9 +121,7 @@ TEST(Messages, RefusalsSayWhy) {
 }
 
 TEST(ClockSync, ShortestRoundTripGivesTheOffset) {
-  const uint64_t seed = testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(5);
   const double true_offset = 0.0803;  // fuse - node
   ClockSync sync(16);
   EXPECT_FALSE(sync.Estimate());

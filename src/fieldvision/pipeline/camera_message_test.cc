@@ -4,15 +4,13 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::pipeline {
 namespace {
 
 TEST(CameraMessage, JsonLineRoundTripsExactly) {
-  const uint64_t seed = testing::TestSeed(21);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(21);
   for (int trial = 0; trial < 20; ++trial) {
     CameraMessage m;
     m.camera = rng.UniformInt(0, 7);

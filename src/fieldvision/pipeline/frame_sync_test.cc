@@ -7,7 +7,7 @@
 #include "fieldvision/pipeline/test_messages.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::pipeline {
 namespace {
@@ -78,9 +78,7 @@ TEST(FrameSync, ByIndexWithDropsDuplicatesAndDifferentLengths) {
 }
 
 TEST(FrameSync, UnsynchronizedCamerasArePairedByTimeOnly) {
-  const uint64_t seed = testing::TestSeed(22);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(22);
   // Camera 0 at 60 fps from t = 0; camera 1 at 60 fps started later with a clock offset of a
   // fraction of a frame and jitter; camera 2 at 30 fps (every other moment has no partner).
   const double dt = 1.0 / 60.0, tol = 0.3 * dt;

@@ -6,7 +6,7 @@
 
 #include "fieldvision/pipeline/test_messages.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::pipeline {
 namespace {
@@ -14,9 +14,7 @@ namespace {
 using test_util::Msg;
 
 TEST(LiveSync, PairsByTimeWithJitterAndOffsetsInFrameNumbers) {
-  const uint64_t seed = testing::TestSeed(2);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(2);
   LiveSyncOptions o;
   o.tolerance_s = 0.008;
   LiveSynchronizer sync(3, o);

@@ -10,7 +10,7 @@
 #include "fieldvision/plan/rig_json.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::plan {
 namespace {
@@ -119,9 +119,7 @@ TEST(CoverageTest, BallTooSmallBeyondMaximumDistance) {
 }
 
 TEST(CoverageTest, BestPairAngleIsClosestTo90) {
-  const uint64_t seed = fv::testing::TestSeed(11);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(11);
   const Eigen::Vector3d p(rng.Uniform(-5, 5), rng.Uniform(-3, 3), 0.11);
   // Cameras along directions at 10, 40 and 140 degrees in a tilted plane: pair angles 30, 130
   // and 100 degrees; the best is 100.
@@ -184,9 +182,7 @@ Eigen::Vector3d Triangulate(const std::vector<camera::Camera>& cams,
 }
 
 TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
-  const uint64_t seed = fv::testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(5);
   const double sigma_px = 1.5;
   for (int trial = 0; trial < 6; ++trial) {
     // 2 to 4 cameras around the field at 3-8 m, aimed near the point, some with distortion.
@@ -234,9 +230,7 @@ TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
 }
 
 TEST(CoverageTest, ProjectionJacobianMatchesFiniteDifferences) {
-  const uint64_t seed = fv::testing::TestSeed(9);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(9);
   for (int trial = 0; trial < 10; ++trial) {
     camera::Camera c =
         MakeAimedCamera("c", 1280, 960, rng.Uniform(40, 100),

@@ -9,6 +9,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::plan {
@@ -38,9 +39,7 @@ json CornerCamera(double x, double y) {
 }
 
 TEST(RigTest, ReadsLookAtYawPitchAndDefaults) {
-  const uint64_t seed = fv::testing::TestSeed(3);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(3);
   const Eigen::Vector3d eye(rng.Uniform(-12, 12), rng.Uniform(-8, 8), rng.Uniform(2, 8));
   const Eigen::Vector3d target(rng.Uniform(-5, 5), rng.Uniform(-3, 3), 0);
   const Eigen::Vector3d d = target - eye;
@@ -75,9 +74,7 @@ TEST(RigTest, ReadsLookAtYawPitchAndDefaults) {
 }
 
 TEST(RigTest, WriteReadRoundTripIncludingYamlCameras) {
-  const uint64_t seed = fv::testing::TestSeed(4);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(4);
   const std::string dir = fv::testing::TempDir();
   Rig rig;
   rig.name = "round trip";

@@ -6,15 +6,13 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::recon {
 namespace {
 
 TEST(BallEval, MatchesByFrameAndSummarises) {
-  const uint64_t seed = testing::TestSeed(31);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(31);
   std::string truth = "frame,time_s,x_m,y_m,z_m,n_cams\n";
   std::string est = "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n";
   std::vector<double> errs;

@@ -7,7 +7,7 @@
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::recon {
 namespace {
@@ -25,9 +25,7 @@ Scene RunScene(const BallSimulation& sim, const TrajectoryOptions& to, util::Rng
 }
 
 TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
-  const uint64_t seed = testing::TestSeed(31);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(31);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   ASSERT_FALSE(field.goals.empty());
   const field::FieldGoal* right = nullptr;
@@ -69,9 +67,7 @@ TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
 }
 
 TEST(TrajectoryDecisions, InOrOutOfTheTouchLineByTheBallsFootprint) {
-  const uint64_t seed = testing::TestSeed(33);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(33);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   TrajectoryOptions to;
   int checked = 0;
@@ -106,9 +102,7 @@ TEST(TrajectoryDecisions, InOrOutOfTheTouchLineByTheBallsFootprint) {
 }
 
 TEST(TrajectoryDecisions, MadeShotPassesDownThroughTheRing) {
-  const uint64_t seed = testing::TestSeed(35);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(35);
   const field::FieldModel field = field::BuiltinField("basketball-fiba");
   ASSERT_FALSE(field.hoops.empty());
   const field::FieldHoop& hoop = field.hoops.front();

@@ -8,15 +8,13 @@
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::recon {
 namespace {
 
 TEST(TrajectoryPredict, LandingFromTheFirstHalfWithin25cmAndInsideTheEllipse) {
-  const uint64_t seed = testing::TestSeed(21);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(21);
   int inside = 0, total = 0;
   double worst = 0;
   for (int trial = 0; trial < 20; ++trial) {
@@ -54,9 +52,7 @@ TEST(TrajectoryPredict, LandingFromTheFirstHalfWithin25cmAndInsideTheEllipse) {
 }
 
 TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
-  const uint64_t seed = testing::TestSeed(23);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(23);
   BallSimOptions o;
   o.start_m = {-6, 0, 0.11};
   o.kicks = {{0.2, {9, 1, 7}}};

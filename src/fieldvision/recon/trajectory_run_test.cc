@@ -11,15 +11,14 @@
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::recon {
 namespace {
 
 TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
-  const uint64_t seed = testing::TestSeed(41);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(41);
   BallSimOptions o;
   o.start_m = {-6, -1, 0.11};
   o.kicks = {{0.2, {8, 1.5, 6}}};
@@ -82,9 +81,7 @@ TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
 // A ball that never rests (60 hops in one airborne block): every bounce is found. Finding the
 // breaks took O(samples x breaks^2) (a 40,000-row track of such hops did not finish).
 TEST(TrajectoryRun, LongBlockWithManyBounces) {
-  const uint64_t seed = testing::TestSeed(43);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(43);
   std::vector<BallSample> track;
   const double g = 9.81, r = 0.11, fps = 60;
   double t0 = 0, vz = 4.0;

@@ -7,6 +7,7 @@
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::recon {
@@ -106,9 +107,7 @@ TEST(Trajectory, FindsEveryFlightWithOriginAndLandingWithin2cmAt5mmNoise) {
 }
 
 TEST(Trajectory, BouncesAreBouncesAndAMidAirHitIsAHit) {
-  const uint64_t seed = testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(5);
   BallSimOptions o;
   o.start_m = {-5, 0, 0.11};
   o.kicks = {{0.2, {7, 1, 7}}, {1.0, {-6, 0.5, 2}}};  // the second is a header at ~3 m height
@@ -130,9 +129,7 @@ TEST(Trajectory, BouncesAreBouncesAndAMidAirHitIsAHit) {
 }
 
 TEST(Trajectory, DragFitReducesResidualAndRecoversK) {
-  const uint64_t seed = testing::TestSeed(7);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(7);
   BallSimOptions o;
   o.start_m = {-8, -2, 0.11};
   o.kicks = {{0.1, {20, 3, 12}}};

@@ -8,7 +8,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::recon {
 namespace {
@@ -46,9 +46,7 @@ Eigen::Vector3d RandomBall(util::Rng& rng) {
 }
 
 TEST(ClosestPointOfRays, IntersectingAndSkewRays) {
-  const uint64_t seed = testing::TestSeed(11);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(11);
   for (int trial = 0; trial < 50; ++trial) {
     const Eigen::Vector3d p(rng.Uniform(-5, 5), rng.Uniform(-5, 5), rng.Uniform(0, 3));
     const Eigen::Vector3d oa(rng.Uniform(-20, -10), rng.Uniform(-5, 5), rng.Uniform(2, 8));
@@ -101,9 +99,7 @@ TEST(ClosestPointOfRays, PointBehindARayIsFlagged) {
 }
 
 TEST(Triangulation, LinearIsExactWithoutNoise) {
-  const uint64_t seed = testing::TestSeed(12);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(12);
   const auto cams = CornerCameras(&rng);
   for (int trial = 0; trial < 30; ++trial) {
     const Eigen::Vector3d p = RandomBall(rng);
@@ -116,9 +112,7 @@ TEST(Triangulation, LinearIsExactWithoutNoise) {
 }
 
 TEST(Triangulation, RefinedPointAndCovarianceMatchTheNoise) {
-  const uint64_t seed = testing::TestSeed(13);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(13);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.outline_centre = true;
@@ -237,9 +231,7 @@ TEST(Triangulation, PointBehindACameraIsRejected) {
 }
 
 TEST(Triangulation, OneCameraOnlyNeedsTheGroundAssumption) {
-  const uint64_t seed = testing::TestSeed(14);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(14);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.ball_radius_m = 0.11;
@@ -266,9 +258,7 @@ TEST(Triangulation, OneCameraOnlyNeedsTheGroundAssumption) {
 }
 
 TEST(Triangulation, FalseBlobInOneCameraNeverMovesTheBall) {
-  const uint64_t seed = testing::TestSeed(15);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(15);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.outline_centre = true;
@@ -330,9 +320,7 @@ TEST(Triangulation, BadInputThrowsNamingIt) {
 // accepted candidate starts, never move one that accepted candidates give, and alone count only
 // when three or more cameras agree near the predicted position (a cone is consistent too).
 TEST(Triangulation, WeakCandidatesOnlyCompleteOrConfirm) {
-  const uint64_t seed = testing::TestSeed(21);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(21);
   const auto cams = CornerCameras(&rng);
   TriangulationOptions opt;
   opt.ball_radius_m = 0.11;

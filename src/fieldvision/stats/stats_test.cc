@@ -11,6 +11,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::stats {
@@ -44,9 +45,7 @@ std::vector<track::TrackRow> Runner(util::Rng& rng, int id, double y, double noi
 }
 
 TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
-  const uint64_t seed = fv::testing::TestSeed(21);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(21);
   double truth = 0;
   const auto rows = Runner(rng, 4, 0.0, 0.05, &truth);
   StatsOptions o;
@@ -76,9 +75,7 @@ TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
 }
 
 TEST(Stats, PairDistancesAndReport) {
-  const uint64_t seed = fv::testing::TestSeed(22);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(22);
   double d1 = 0, d2 = 0;
   auto rows = Runner(rng, 1, -3.0, 0.02, &d1);
   const auto other = Runner(rng, 2, 3.0, 0.02, &d2);
@@ -132,9 +129,7 @@ TEST(Stats, PairDistancesAndReport) {
 // The time comes from TRACKS.csv's time_s (here 10 frames/s, the rate of the video), --fps
 // overrides it, and tracks without time_s and without --fps are an error that says what to do.
 TEST(Stats, TimeFromTracksAndRateOverride) {
-  const uint64_t seed = fv::testing::TestSeed(23);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(23);
   std::vector<track::TrackRow> rows;
   const double v = 1.5, fps = 10;  // walking 1.5 m/s filmed at 10 frames/s
   for (int f = 0; f < 100; ++f) {

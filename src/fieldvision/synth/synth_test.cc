@@ -15,6 +15,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::synth {
@@ -105,9 +106,7 @@ TEST(SceneSpec, BadValuesNameTheKey) {
 }
 
 TEST(BallPhysics, NoDragKickIsTheClosedFormParabola) {
-  const uint64_t seed = fv::testing::TestSeed(3);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(3);
   BallSpec ball;
   ball.physics.drag_coefficient = 0;
   KickSpec k;
@@ -135,9 +134,7 @@ TEST(BallPhysics, NoDragKickIsTheClosedFormParabola) {
 }
 
 TEST(BallPhysics, BouncesLoseEnergyAndFlightsTouchTheGround) {
-  const uint64_t seed = fv::testing::TestSeed(4);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(4);
   BallSpec ball;
   KickSpec k;
   k.time_s = 0.1;

@@ -10,6 +10,7 @@
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::track {
@@ -22,9 +23,7 @@ struct Walker {
 // People crossing each other: detections with noise, misses and low scores while occluded, plus
 // clutter; the tracker must keep one id per person.
 TEST(ByteTracker, KeepsIdsThroughCrossingsAndMisses) {
-  const uint64_t seed = fv::testing::TestSeed(11);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(11);
   std::vector<Walker> people;
   for (int i = 0; i < 6; ++i) {
     // Pairs walk towards each other on nearby rows and cross in the middle.

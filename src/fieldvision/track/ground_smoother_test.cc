@@ -7,7 +7,7 @@
 #include "fieldvision/track/bytetrack.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::track {
 namespace {
@@ -30,9 +30,7 @@ cv::Rect2d BoxAt(const camera::Camera& cam, double x, double y, double noise_px)
 // A person walking a curve at 1.5-3 m/s, seen with foot points that jitter by 5 % of the box
 // height: the smoothed positions are much closer to the path, and gaps get positions.
 TEST(GroundSmoother, NoisyFootPointsOfAWalkAreSmoothed) {
-  const uint64_t seed = testing::TestSeed(41);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  testing::SeededRng rng(41);
   const camera::Camera cam = SideCamera();
   const double fps = 25;
   std::vector<TrackRow> rows;

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
 
 namespace fv::track {
 namespace {
@@ -36,9 +36,7 @@ double BestCost(const std::vector<std::vector<double>>& c, double forbidden, int
 }
 
 TEST(Hungarian, MatchesBruteForceOnRandomMatrices) {
-  const uint64_t seed = fv::testing::TestSeed(7);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(7);
   for (int trial = 0; trial < 200; ++trial) {
     const int rows = rng.UniformInt(1, 5), cols = rng.UniformInt(rows, 6);
     std::vector<std::vector<double>> c(rows, std::vector<double>(cols));

@@ -7,6 +7,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::track {
@@ -26,9 +27,7 @@ std::vector<TrackRow> Walkers(util::Rng& rng, int people, int frames) {
 }
 
 TEST(Mot, PerfectTracksScoreOne) {
-  const uint64_t seed = fv::testing::TestSeed(3);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(3);
   const auto gt = Walkers(rng, 5, 50);
   auto est = gt;
   for (auto& r : est) r.id += 100;  // ids need not be equal
@@ -42,9 +41,7 @@ TEST(Mot, PerfectTracksScoreOne) {
 }
 
 TEST(Mot, CountsMissesFalsePositivesAndSwitches) {
-  const uint64_t seed = fv::testing::TestSeed(4);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(4);
   const int frames = 40;
   const auto gt = Walkers(rng, 3, frames);
   std::vector<TrackRow> est;
@@ -123,9 +120,7 @@ TEST(Mot, NumbersOutOfRangeNameTheLine) {
 }
 
 TEST(Mot, TwoBoxesOfOneIdInAFrameAreRefused) {
-  const uint64_t seed = fv::testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(5);
   const auto gt = Walkers(rng, 2, 10);
   auto est = gt;
   est.push_back(gt[3]);  // frame 3 of id 1 twice: IDF1 was 1.1
@@ -214,9 +209,7 @@ TEST(Mot, Mot17RulesIgnoreDistractorsAndZeroMarkedRows) {
 // An estimate numbered from 0 against 1-based ground truth: the shift is reported, and
 // --frame-offset 1 scores it fully; estimated rows beyond the ground truth's frames are left out.
 TEST(Mot, FrameAlignment) {
-  const uint64_t seed = fv::testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(5);
   auto gt = Walkers(rng, 4, 30);
   for (auto& r : gt) r.frame += 1;  // 1..30
   std::vector<TrackRow> est;
