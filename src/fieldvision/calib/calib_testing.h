@@ -10,6 +10,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::calib::test_util {
 
@@ -106,9 +107,8 @@ inline double FieldPositionErrorM(const std::vector<camera::Camera>& a,
       }
     }
   }
-  std::sort(err.begin(), err.end());
-  *max = err.back();
-  return err[err.size() / 2];
+  *max = *std::max_element(err.begin(), err.end());
+  return util::NearestRankPercentile(err, 0.5);
 }
 
 }  // namespace fv::calib::test_util

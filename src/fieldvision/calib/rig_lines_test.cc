@@ -10,7 +10,8 @@
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
-#include "fieldvision/util/testing.h"
+#include "fieldvision/util/seeded_rng.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::calib {
 namespace {
@@ -37,17 +38,10 @@ const Rendered& Scene() {
   return rendered;
 }
 
-double Quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  return v[static_cast<size_t>(q * (v.size() - 1) + 0.5)];
-}
-
 // Six clicks with 1 px noise place the rig within a few centimetres; the lines seen by all four
 // cameras then bring it within 1 cm (issue 16's target), every camera's line error down.
 TEST(RigLines, SixNoisyClicksThenTheLinesOfAllCamerasPlaceTheRigWithin1cm) {
-  const uint64_t seed = fv::testing::TestSeed(81);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(81);
   const std::vector<camera::Camera>& truth = Scene().scene.cameras();
   ASSERT_EQ(truth.size(), 4u);
   const field::FieldModel& field = Scene().scene.field();
@@ -89,24 +83,25 @@ TEST(RigLines, SixNoisyClicksThenTheLinesOfAllCamerasPlaceTheRigWithin1cm) {
     refined_spread.push_back(WorstCentreErrorM(r2.cameras, truth));
   }
   std::cout << "worst camera centre error over " << kTrials
-            << " placements: 6 clicks in one camera: median " << 1000 * Quantile(clicked, 0.5)
-            << " mm, max " << 1000 * Quantile(clicked, 1.0) << " mm; refined with the lines of 4 "
-            << "cameras: median " << 1000 * Quantile(refined, 0.5) << " mm, max "
-            << 1000 * Quantile(refined, 1.0) << " mm\n  2 clicks in each of 3 cameras: median "
-            << 1000 * Quantile(clicked_spread, 0.5) << " mm, max "
-            << 1000 * Quantile(clicked_spread, 1.0) << " mm; refined: median "
-            << 1000 * Quantile(refined_spread, 0.5) << " mm, max "
-            << 1000 * Quantile(refined_spread, 1.0) << " mm\n";
-  EXPECT_LT(Quantile(refined, 0.5), 0.01);
-  EXPECT_LT(Quantile(refined, 1.0), 0.02);
-  EXPECT_LT(Quantile(refined_spread, 0.5), 0.01);
-  EXPECT_LT(Quantile(refined_spread, 1.0), 0.02);
+            << " placements: 6 clicks in one camera: median "
+            << 1000 * util::NearestRankPercentile(clicked, 0.5) << " mm, max "
+            << 1000 * util::NearestRankPercentile(clicked, 1.0)
+            << " mm; refined with the lines of 4 "
+            << "cameras: median " << 1000 * util::NearestRankPercentile(refined, 0.5) << " mm, max "
+            << 1000 * util::NearestRankPercentile(refined, 1.0)
+            << " mm\n  2 clicks in each of 3 cameras: median "
+            << 1000 * util::NearestRankPercentile(clicked_spread, 0.5) << " mm, max "
+            << 1000 * util::NearestRankPercentile(clicked_spread, 1.0) << " mm; refined: median "
+            << 1000 * util::NearestRankPercentile(refined_spread, 0.5) << " mm, max "
+            << 1000 * util::NearestRankPercentile(refined_spread, 1.0) << " mm\n";
+  EXPECT_LT(util::NearestRankPercentile(refined, 0.5), 0.01);
+  EXPECT_LT(util::NearestRankPercentile(refined, 1.0), 0.02);
+  EXPECT_LT(util::NearestRankPercentile(refined_spread, 0.5), 0.01);
+  EXPECT_LT(util::NearestRankPercentile(refined_spread, 1.0), 0.02);
 }
 
 TEST(RigLines, CamerasWithoutFramesFollowAndBadInputsAreErrors) {
-  const uint64_t seed = fv::testing::TestSeed(82);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(82);
   const std::vector<camera::Camera>& truth = Scene().scene.cameras();
   const field::FieldModel& field = Scene().scene.field();
   const std::vector<cv::Mat>& frames = Scene().frames;

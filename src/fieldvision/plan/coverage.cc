@@ -11,6 +11,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::plan {
 namespace {
@@ -22,13 +23,6 @@ bool HasDistortion(const camera::Camera& c) {
     if (d != 0.0) return true;
   }
   return false;
-}
-
-double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t k = static_cast<size_t>(std::ceil(q * v.size()));
-  return v[std::min(v.size() - 1, k == 0 ? 0 : k - 1)];
 }
 
 void ComputeStatistics(const CoverageOptions& o, int num_cameras, CoverageLayer& layer) {
@@ -53,10 +47,10 @@ void ComputeStatistics(const CoverageOptions& o, int num_cameras, CoverageLayer&
   for (double& f : layer.fraction_exactly) f /= n;
   layer.fraction_at_least_2 = static_cast<double>(at_least_2) / n;
   layer.fraction_good = static_cast<double>(good) / n;
-  layer.angle_median_deg = Quantile(angles, 0.5);
+  layer.angle_median_deg = angles.empty() ? NAN : util::RankPercentile(angles, 0.5);
   layer.fraction_angle_good_of_2 = at_least_2 > 0 ? static_cast<double>(good) / at_least_2 : NAN;
-  layer.err_median_m = Quantile(errors, 0.5);
-  layer.err_p95_m = Quantile(errors, 0.95);
+  layer.err_median_m = errors.empty() ? NAN : util::RankPercentile(errors, 0.5);
+  layer.err_p95_m = errors.empty() ? NAN : util::RankPercentile(errors, 0.95);
   layer.err_max_m = errors.empty() ? NAN : *std::max_element(errors.begin(), errors.end());
   layer.err_max_axis_max_m = axes.empty() ? NAN : *std::max_element(axes.begin(), axes.end());
   layer.score = layer.fraction_good -

@@ -10,6 +10,7 @@
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::recon {
@@ -120,11 +121,7 @@ TEST(TrajectoryReal, Tt3dAllFilesResiduals) {
       wd.push_back(f.with_drag.rmse_m);
     }
   }
-  auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
+  const auto median = [](std::vector<double> v) { return util::NearestRankPercentile(v, 0.5); };
   std::cout << fmt::format(
       "tt3d: {} files, {} flights, {} bounces, {} hits, {} files with a bounce; median rmse "
       "gravity {:.1f} mm, drag {:.1f} mm over {} flights fitted both ways (max {:.1f} / {:.1f} "

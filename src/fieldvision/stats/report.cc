@@ -16,6 +16,7 @@
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::stats {
 namespace fs = std::filesystem;
@@ -70,7 +71,7 @@ cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const field::
 // The top of the colour scale: the 99th percentile of the cells with time (one person standing
 // still in one spot does not take the whole range).
 double ScaleMax(const cv::Mat& density) {
-  std::vector<float> v;
+  std::vector<double> v;
   double mx = 0;
   cv::minMaxLoc(density, nullptr, &mx);
   for (int y = 0; y < density.rows; ++y) {
@@ -80,8 +81,7 @@ double ScaleMax(const cv::Mat& density) {
     }
   }
   if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() * 99 / 100, v.end());
-  return std::max<double>(v[v.size() * 99 / 100], 1e-6);
+  return std::max(util::RankPercentile(std::move(v), 0.99), 1e-6);
 }
 
 // Heat map of time spent over the field drawing, with its colour scale (seconds per square

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::stats {
 
@@ -186,8 +187,7 @@ double FrameRateOfRows(const std::vector<track::TrackRow>& rows) {
                next->first);
     steps.push_back((next->second - it->second) / (next->first - it->first));
   }
-  std::sort(steps.begin(), steps.end());
-  return steps.empty() ? 0.0 : 1.0 / steps[steps.size() / 2];
+  return steps.empty() ? 0.0 : 1.0 / util::NearestRankPercentile(steps, 0.5);
 }
 
 PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,

@@ -34,6 +34,14 @@ double NearestRankPercentile(const std::vector<int>& values, double q) {
   return NearestRankPercentile(std::vector<double>(values.begin(), values.end()), q);
 }
 
+double RankPercentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto rank = static_cast<size_t>(std::ceil(q * values.size()));
+  const size_t k = std::min(values.size() - 1, rank == 0 ? 0 : rank - 1);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
 double Mean(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   double s = 0.0;

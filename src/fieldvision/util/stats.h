@@ -14,6 +14,9 @@ double Median(std::vector<double> values);
 // and an even n the upper of the two middle values. 0 for an empty sample.
 double NearestRankPercentile(std::vector<double> values, double q);
 double NearestRankPercentile(const std::vector<int>& values, double q);
+// The sample at rank ceil(q n) counted from 1 (the textbook nearest rank): for q = 0.5 and an even
+// n the lower of the two middle values. 0 for an empty sample.
+double RankPercentile(std::vector<double> values, double q);
 double Mean(const std::vector<double>& values);
 double Rms(const std::vector<double>& values);
 // Ratio of a normal distribution's sigma to its median absolute deviation.

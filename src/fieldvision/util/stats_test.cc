@@ -34,6 +34,16 @@ TEST(Stats, NearestRankPercentileIsASample) {
   EXPECT_DOUBLE_EQ(NearestRankPercentile(std::vector<double>{}, 0.5), 0.0);
 }
 
+TEST(Stats, RankPercentileIsTheSampleAtRankCeilQN) {
+  const std::vector<double> v = {4, 1, 3, 2, 5, 6};
+  EXPECT_DOUBLE_EQ(RankPercentile(v, 0.5), 3.0);  // rank 3: lower middle for an even n
+  EXPECT_DOUBLE_EQ(RankPercentile(std::vector<double>{4, 1, 3, 2, 5}, 0.5), 3.0);  // rank 2.5 -> 3
+  EXPECT_DOUBLE_EQ(RankPercentile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(RankPercentile(v, 1.0), 6.0);
+  EXPECT_DOUBLE_EQ(RankPercentile(v, 0.8), 5.0);  // rank 4.8 -> 5
+  EXPECT_DOUBLE_EQ(RankPercentile(std::vector<double>{}, 0.5), 0.0);
+}
+
 TEST(Stats, MeanRmsRobustSigma) {
   EXPECT_DOUBLE_EQ(Mean({1, 2, 3}), 2.0);
   EXPECT_DOUBLE_EQ(Rms({3, 4}), std::sqrt(12.5));
