@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/random.h"
 
@@ -180,19 +181,7 @@ std::vector<MountPlace> MountsFromJson(const json& j, const std::string& context
 }
 
 std::vector<MountPlace> ReadMountsJson(const std::string& path) {
-  FV_REQUIRE(std::filesystem::is_regular_file(path), "mounts file '{}' does not exist", path);
-  std::ifstream in(path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    Throw("mounts file '{}' is not valid JSON (byte {})", path, e.byte);
-  } catch (const json::exception& e) {
-    // e.g. a number too large for a double; drop nlohmann's "[json.exception...] " prefix.
-    const std::string what = e.what();
-    Throw("mounts file '{}' is not valid JSON: {}", path, what.substr(what.find("] ") + 2));
-  }
-  return MountsFromJson(j, "mounts file '" + path + "'");
+  return MountsFromJson(util::ReadJsonFile(path, "mounts"), "mounts file '" + path + "'");
 }
 
 void OptimizeOptions::Check() const {

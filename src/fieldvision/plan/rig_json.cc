@@ -191,19 +191,7 @@ Rig RigFromJson(const json& j, const std::string& context, const std::string& ba
 }
 
 Rig ReadRigJson(const std::string& path) {
-  FV_REQUIRE(std::filesystem::is_regular_file(path), "rig file '{}' does not exist", path);
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "rig file '{}' cannot be read", path);
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    Throw("rig file '{}' is not valid JSON (byte {})", path, e.byte);
-  } catch (const json::exception& e) {
-    // e.g. a number too large for a double; drop nlohmann's "[json.exception...] " prefix.
-    const std::string what = e.what();
-    Throw("rig file '{}' is not valid JSON: {}", path, what.substr(what.find("] ") + 2));
-  }
+  const json j = util::ReadJsonFile(path, "rig");
   const std::string base = std::filesystem::path(path).parent_path().string();
   Rig rig = RigFromJson(j, "rig file '" + path + "'", base);
   if (rig.name.empty()) rig.name = std::filesystem::path(path).stem().string();

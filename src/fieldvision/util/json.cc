@@ -1,6 +1,8 @@
 #include "fieldvision/util/json.h"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include <fmt/format.h>
@@ -26,6 +28,21 @@ const json* Member(const json& obj, const std::string& key, const std::string& c
 }
 
 }  // namespace
+
+json ReadJsonFile(const std::string& path, const std::string& what) {
+  FV_REQUIRE(std::filesystem::is_regular_file(path), "{} file '{}' does not exist", what, path);
+  std::ifstream in(path);
+  FV_REQUIRE(in.good(), "{} file '{}' cannot be read", what, path);
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    Throw("{} file '{}' is not valid JSON (byte {})", what, path, e.byte);
+  } catch (const json::exception& e) {
+    // e.g. a number too large for a double; drop nlohmann's "[json.exception...] " prefix.
+    const std::string message = e.what();
+    Throw("{} file '{}' is not valid JSON: {}", what, path, message.substr(message.find("] ") + 2));
+  }
+}
 
 std::string JsonPath(const std::string& ctx, const std::string& key) {
   return ctx.empty() ? key : ctx + "." + key;

@@ -12,6 +12,10 @@
 
 namespace fv::util {
 
+// The JSON in the file at `path`; `what` names the file in errors ("rig file 'x' does not exist",
+// "... cannot be read", "... is not valid JSON (byte n)").
+nlohmann::json ReadJsonFile(const std::string& path, const std::string& what);
+
 // "ctx.key", or "key" when ctx is empty: the context of a nested object.
 std::string JsonPath(const std::string& ctx, const std::string& key);
 // True when `obj` is an object holding `key`.
