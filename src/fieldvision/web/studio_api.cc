@@ -25,6 +25,7 @@
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/csv.h"
+#include "fieldvision/util/json.h"
 
 namespace fv::web {
 
@@ -50,8 +51,6 @@ ApiResponse ErrorResponse(int status, const std::string& message) {
 }
 
 double Round(double v, double step = 1e-4) { return std::round(v / step) * step; }
-
-json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 // ---- request helpers
 
@@ -127,9 +126,9 @@ json CameraToJson(const camera::Camera& c) {
             {"has_pose", c.has_pose}};
   if (c.rms_px) j["rms_px"] = *c.rms_px;
   if (c.has_pose) {
-    j["rvec"] = Vec(c.cam_from_world.Rvec());
-    j["tvec"] = Vec(c.cam_from_world.translation);
-    j["position_m"] = Vec(c.CentreInWorld());
+    j["rvec"] = util::JsonFromVector(c.cam_from_world.Rvec());
+    j["tvec"] = util::JsonFromVector(c.cam_from_world.translation);
+    j["position_m"] = util::JsonFromVector(c.CentreInWorld());
     const Eigen::Matrix3d& r = c.cam_from_world.rotation;
     j["cam_from_world_rotation"] = {r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1),
                                     r(1, 2), r(2, 0), r(2, 1), r(2, 2)};
@@ -231,7 +230,7 @@ json PoseToJson(const calib::ExtrinsicsResult& r, const field::FieldModel& field
             {"max_err_px", Round(r.max_err_px)},
             {"mean_err_mm", Round(r.mean_err_mm, 0.01)},
             {"max_err_mm", Round(r.max_err_mm, 0.01)},
-            {"camera_position_m", Vec(r.camera_position_m)},
+            {"camera_position_m", util::JsonFromVector(r.camera_position_m)},
             {"summary", OneLine(r.Summary())}};
   j.update(ProjectField(r.camera, field));
   return j;
@@ -588,7 +587,7 @@ std::vector<Route> CalibrationRoutes() {
                    {"moved_m", Round(res.moved_m, 1e-5)},
                    {"rotated_deg", Round(res.rotated_deg, 1e-5)},
                    {"camera", CameraToJson(res.camera)},
-                   {"camera_position_m", Vec(res.camera.CentreInWorld())},
+                   {"camera_position_m", util::JsonFromVector(res.camera.CentreInWorld())},
                    {"line_pixels", line_pixels},
                    {"summary", OneLine(res.Summary())},
                    {"wrote", json::array()}};
