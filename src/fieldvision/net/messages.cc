@@ -7,6 +7,7 @@
 
 #include "fieldvision/pipeline/camera_message.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 
 namespace fv::net {
 namespace {
@@ -76,19 +77,18 @@ struct Encoder {
             {"n_cams", m.n_cams}, {"err_px", m.err_px}, {"latency_s", m.latency_s}};
   }
   json operator()(const FlightMessage& m) const {
-    const auto v = [](const double* p) { return json::array({p[0], p[1], p[2]}); };
     return {{"type", "flight"},
             {"index", m.index},
             {"start", m.start},
             {"end", m.end},
             {"t_start_s", m.t_start_s},
             {"t_end_s", m.t_end_s},
-            {"origin_m", v(m.origin_m)},
-            {"landing_m", v(m.landing_m)},
+            {"origin_m", util::JsonFromVector(Eigen::Vector3d(m.origin_m))},
+            {"landing_m", util::JsonFromVector(Eigen::Vector3d(m.landing_m))},
             {"t_landing_s", m.t_landing_s},
             {"landing_extrapolated", m.landing_extrapolated},
-            {"apex_m", v(m.apex_m)},
-            {"v0_mps", v(m.v0_mps)},
+            {"apex_m", util::JsonFromVector(Eigen::Vector3d(m.apex_m))},
+            {"v0_mps", util::JsonFromVector(Eigen::Vector3d(m.v0_mps))},
             {"speed_mps", m.speed_mps},
             {"rmse_m", m.rmse_m},
             {"model", m.model},
