@@ -12,6 +12,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -25,13 +26,27 @@ cv::Mat ReadRef(const std::string& path, const char* key) {
   return m;
 }
 
+// OpenCV's 9x6 chessboard of 25 mm squares, without the progress bar.
+IntrinsicsOptions ChessboardOptions() {
+  IntrinsicsOptions o;
+  o.board = {BoardType::kChessboard, 9, 6, 0.025};
+  o.progress = false;
+  return o;
+}
+
+// fx, fy, cx and cy each within `share` of the reference camera matrix `k`.
+void ExpectNearMatrix(const camera::Camera& c, const cv::Mat& k, double share) {
+  EXPECT_NEAR(c.fx, k.at<double>(0, 0), share * k.at<double>(0, 0));
+  EXPECT_NEAR(c.fy, k.at<double>(1, 1), share * k.at<double>(1, 1));
+  EXPECT_NEAR(c.cx, k.at<double>(0, 2), share * k.at<double>(0, 2));
+  EXPECT_NEAR(c.cy, k.at<double>(1, 2), share * k.at<double>(1, 2));
+}
+
 TEST(Intrinsics, OpenCvLeftChessboardMatchesReference) {
   const std::string data = fv::testing::SharedDataDir();
   if (data.empty()) GTEST_SKIP() << "no shared data";
   const std::string dir = data + "/opencv-chessboard";
-  IntrinsicsOptions o;
-  o.board = {BoardType::kChessboard, 9, 6, 0.025};
-  o.progress = false;
+  IntrinsicsOptions o = ChessboardOptions();
   // The reference was made by OpenCV's calibration sample: CALIB_FIX_ASPECT_RATIO and an
   // uncapped 11 px cornerSubPix half window.
   o.fix_aspect_ratio = true;
@@ -44,10 +59,7 @@ TEST(Intrinsics, OpenCvLeftChessboardMatchesReference) {
   const double ref_rms = static_cast<double>(fs["avg_reprojection_error"]);
   EXPECT_EQ(r.num_images, 13);
   EXPECT_EQ(r.num_used, 13) << r.Summary();
-  EXPECT_NEAR(r.camera.fx, k.at<double>(0, 0), 0.005 * k.at<double>(0, 0));
-  EXPECT_NEAR(r.camera.fy, k.at<double>(1, 1), 0.005 * k.at<double>(1, 1));
-  EXPECT_NEAR(r.camera.cx, k.at<double>(0, 2), 0.005 * k.at<double>(0, 2));
-  EXPECT_NEAR(r.camera.cy, k.at<double>(1, 2), 0.005 * k.at<double>(1, 2));
+  ExpectNearMatrix(r.camera, k, 0.005);
   EXPECT_NEAR(r.rms_px, ref_rms, 0.05);
   EXPECT_EQ(r.camera.width, 640);
   EXPECT_EQ(r.camera.height, 480);
@@ -60,17 +72,12 @@ TEST(Intrinsics, DefaultsFitTheLeftViewsBetterThanTheReference) {
   const std::string data = fv::testing::SharedDataDir();
   if (data.empty()) GTEST_SKIP() << "no shared data";
   const std::string dir = data + "/opencv-chessboard";
-  IntrinsicsOptions o;
-  o.board = {BoardType::kChessboard, 9, 6, 0.025};
-  o.progress = false;
+  IntrinsicsOptions o = ChessboardOptions();
   const IntrinsicsResult r = CalibrateIntrinsics(dir + "/left*.jpg", o);
   const cv::Mat k = ReadRef(dir + "/left_intrinsics.yml", "camera_matrix");
   EXPECT_EQ(r.num_used, 13) << r.Summary();
   EXPECT_LT(r.rms_px, 0.3) << r.Summary();
-  EXPECT_NEAR(r.camera.fx, k.at<double>(0, 0), 0.01 * k.at<double>(0, 0));
-  EXPECT_NEAR(r.camera.fy, k.at<double>(1, 1), 0.01 * k.at<double>(1, 1));
-  EXPECT_NEAR(r.camera.cx, k.at<double>(0, 2), 0.01 * k.at<double>(0, 2));
-  EXPECT_NEAR(r.camera.cy, k.at<double>(1, 2), 0.01 * k.at<double>(1, 2));
+  ExpectNearMatrix(r.camera, k, 0.01);
 }
 
 // Board views made by projecting the board's corners through a known camera (with noise).
@@ -104,12 +111,8 @@ std::vector<BoardView> ProjectedViews(const BoardSpec& b, const cv::Matx33d& k,
 }
 
 TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
-  const uint64_t seed = fv::testing::TestSeed(51);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
-  IntrinsicsOptions o;
-  o.board = {BoardType::kChessboard, 9, 6, 0.025};
-  o.progress = false;
+  fv::testing::SeededRng rng(51);
+  IntrinsicsOptions o = ChessboardOptions();
   const cv::Matx33d k(540, 0, 330, 0, 540, 238, 0, 0, 1);
   const std::vector<double> d = {-0.25, 0.08, 0.0, 0.0, 0.0};
   auto views = ProjectedViews(o.board, k, d, 12, 0.1, 0.15, rng);
@@ -129,9 +132,7 @@ TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
 }
 
 TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
-  const uint64_t seed = fv::testing::TestSeed(52);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(52);
   IntrinsicsOptions o;
   o.board = {BoardType::kChessboard, 4, 3, 0.02};
   o.progress = false;
@@ -171,9 +172,7 @@ TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
 
 TEST(Intrinsics, TooFewViewsIsAnError) {
   util::Rng rng(1);
-  IntrinsicsOptions o;
-  o.board = {BoardType::kChessboard, 9, 6, 0.025};
-  o.progress = false;
+  IntrinsicsOptions o = ChessboardOptions();
   auto views = ProjectedViews(o.board, cv::Matx33d(540, 0, 330, 0, 540, 238, 0, 0, 1), {}, 2, 0.1,
                               0.15, rng);
   views.push_back({"empty", cv::Size(640, 480), {}, {}, {}});

@@ -9,6 +9,7 @@
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::calib {
@@ -31,9 +32,7 @@ synth::SceneSpec TwentyMetreScene(uint64_t seed) {
 }
 
 TEST(LineDistanceMap, MatchesExactDistances) {
-  const uint64_t seed = fv::testing::TestSeed(11);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(11);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   const LineDistanceMap map(field, 0.01, 1.0);
   for (int i = 0; i < 500; ++i) {
@@ -102,11 +101,17 @@ TEST(Refine, StartFarOffIsNotMadeWorse) {
   EXPECT_LE(after, before + 1e-9) << r.Summary();
 }
 
-TEST(Refine, ImageOfAnotherSizeIsAnError) {
-  camera::Camera cam = camera::Camera::FromFov(1280, 960, 60);
+// A 60 degree camera of the given size at (-15, -12, 7) m looking at the field's centre.
+camera::Camera CornerCamera(int width, int height) {
+  camera::Camera cam = camera::Camera::FromFov(width, height, 60);
   cam.has_pose = true;
   cam.cam_from_world =
       geometry::Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  return cam;
+}
+
+TEST(Refine, ImageOfAnotherSizeIsAnError) {
+  const camera::Camera cam = CornerCamera(1280, 960);
   const cv::Mat small(480, 640, CV_8UC3, cv::Scalar(0, 120, 0));
   try {
     RefineWithLines(cam, small, field::BuiltinField("robocup-msl"));
@@ -119,10 +124,7 @@ TEST(Refine, ImageOfAnotherSizeIsAnError) {
 }
 
 TEST(Refine, NoLinesIsAValueNotAnException) {
-  camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
-  cam.has_pose = true;
-  cam.cam_from_world =
-      geometry::Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
+  const camera::Camera cam = CornerCamera(640, 480);
   const cv::Mat grass(480, 640, CV_8UC3, cv::Scalar(40, 130, 40));
   const RefineResult r = RefineWithLines(cam, grass, field::BuiltinField("robocup-msl"));
   EXPECT_FALSE(r.accepted);

@@ -8,6 +8,7 @@
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::track {
@@ -35,9 +36,7 @@ std::vector<cv::Mat> FakeOutputs(int w, int h, int col, int row, const int sides
 }
 
 TEST(NanoDetDecode, RecoversTheBoxOfAOneHotDistribution) {
-  const uint64_t seed = fv::testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(5);
   for (int trial = 0; trial < 20; ++trial) {
     const int w = 416, h = 320;
     const int col = rng.UniformInt(4, 20), row = rng.UniformInt(4, 14);
@@ -55,9 +54,7 @@ TEST(NanoDetDecode, RecoversTheBoxOfAOneHotDistribution) {
 }
 
 TEST(DetectionsFile, RoundTripsExactlyAndFilteringIsIdempotent) {
-  const uint64_t seed = fv::testing::TestSeed(5);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+  fv::testing::SeededRng rng(5);
   DetectionsFile in;
   in.frames.resize(6);
   for (int f = 0; f < 6; ++f) {
@@ -153,24 +150,16 @@ TEST(Detector, BadOptionsAndModelsGiveClearErrors) {
   const std::string dir = fv::testing::TempDir();
   o = {};
   o.model_path = dir + "/missing.onnx";
-  try {
-    MakeDetector(o);
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("make build"), std::string::npos) << e.what();
-  }
+  const std::string missing = fv::testing::ErrorOf([&] { MakeDetector(o); });
+  EXPECT_NE(missing.find("make build"), std::string::npos) << missing;
   {
     std::ofstream f(dir + "/corrupt.onnx", std::ios::binary);
     f << "this is not a protobuf";
   }
   o.model_path = dir + "/corrupt.onnx";
-  try {
-    MakeDetector(o);
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("corrupt.onnx"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("make build"), std::string::npos) << e.what();
-  }
+  const std::string corrupt = fv::testing::ErrorOf([&] { MakeDetector(o); });
+  EXPECT_NE(corrupt.find("corrupt.onnx"), std::string::npos) << corrupt;
+  EXPECT_NE(corrupt.find("make build"), std::string::npos) << corrupt;
 }
 
 // The converted pretrained model (made by `make build`) finds the person in darknet's sample
