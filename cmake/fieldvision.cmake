@@ -30,8 +30,8 @@ function(fv_module)
     file(GLOB tests CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*_test.cc)
     if(tests)
       add_executable(${M_NAME}_test ${tests})
-      target_link_libraries(${M_NAME}_test PRIVATE ${lib} ${test_deps} fv_testing GTest::gtest
-                            GTest::gtest_main)
+      target_link_libraries(${M_NAME}_test PRIVATE ${lib} ${test_deps} fv_testing GTest::gmock
+                            GTest::gtest GTest::gtest_main)
       gtest_discover_tests(${M_NAME}_test
         WORKING_DIRECTORY ${CMAKE_BINARY_DIR}
         PROPERTIES ENVIRONMENT "FV_TEST_TMP=${CMAKE_BINARY_DIR}/test-tmp"

@@ -1,5 +1,6 @@
 #include "fieldvision/calib/check.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/synth/synth.h"
@@ -9,6 +10,9 @@
 
 namespace fv::calib {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 TEST(Check, TruePoseHasSmallLineErrorAndAShiftedOneLarge) {
   synth::SceneSpec spec = synth::Preset("static", fv::testing::TestSeed(41));
@@ -56,12 +60,8 @@ TEST(Check, CameraWithoutPoseOrWrongSizeIsAnError) {
   cam.cam_from_world =
       geometry::Rigid3d::LookAt(Eigen::Vector3d(-15, -12, 7), Eigen::Vector3d::Zero());
   const cv::Mat other(360, 640, CV_8UC3, cv::Scalar(0, 100, 0));
-  try {
-    CheckCalibration(cam, other, field, {});
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("640x360"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { CheckCalibration(cam, other, field, {}); },
+              ThrowsMessage<Error>(HasSubstr("640x360")));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/calib/calib_testing.h"
@@ -14,6 +15,10 @@
 
 namespace fv::calib {
 namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // One camera about 20 m from the centre of the RoboCup MSL field, the static scene (no robots).
 synth::SceneSpec TwentyMetreScene(uint64_t seed) {
@@ -113,14 +118,8 @@ camera::Camera CornerCamera(int width, int height) {
 TEST(Refine, ImageOfAnotherSizeIsAnError) {
   const camera::Camera cam = CornerCamera(1280, 960);
   const cv::Mat small(480, 640, CV_8UC3, cv::Scalar(0, 120, 0));
-  try {
-    RefineWithLines(cam, small, field::BuiltinField("robocup-msl"));
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("640x480"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("1280x960"), std::string::npos) << msg;
-  }
+  EXPECT_THAT([&] { RefineWithLines(cam, small, field::BuiltinField("robocup-msl")); },
+              ThrowsMessage<Error>(AllOf(HasSubstr("640x480"), HasSubstr("1280x960"))));
 }
 
 TEST(Refine, NoLinesIsAValueNotAnException) {

@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/error.h"
@@ -11,6 +12,9 @@
 
 namespace fv::calib {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 std::vector<camera::Camera> ThreeCameras() {
   const std::vector<Eigen::Vector3d> eyes = {{-15, -12, 7}, {14, -11, 6}, {0, 16, 8}};
@@ -93,22 +97,12 @@ TEST(Rig, BadInputsAreErrorsNamingThem) {
   }
   obs[1].push_back({"lonely", {10, 10}, std::nullopt});
   const std::vector<camera::Camera> two(cams.begin(), cams.begin() + 2);
-  try {
-    RefineRig(two, obs);
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("lonely"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { RefineRig(two, obs); }, ThrowsMessage<Error>(HasSubstr("lonely")));
   EXPECT_THROW(RefineRig(cams, obs), Error);  // 3 cameras, 2 lists
   camera::Camera no_pose = cams[0];
   no_pose.has_pose = false;
   obs[1].pop_back();
-  try {
-    RefineRig({no_pose, cams[1]}, obs);
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("cam1"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { RefineRig({no_pose, cams[1]}, obs); }, ThrowsMessage<Error>(HasSubstr("cam1")));
 }
 
 TEST(Rig, ReadsObservationFiles) {

@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
@@ -13,6 +14,9 @@
 
 namespace fv::camera {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // A camera 20 m from the field centre with plausible distortion of `n` coefficients.
 Camera RandomCamera(util::Rng& rng, int n) {
@@ -241,12 +245,8 @@ INSTANTIATE_TEST_SUITE_P(
     BadFileName);
 
 TEST(CameraIo, MissingFile) {
-  try {
-    ReadCameraYaml("/nonexistent/cam.yaml");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent/cam.yaml"), std::string::npos);
-  }
+  EXPECT_THAT([&] { ReadCameraYaml("/nonexistent/cam.yaml"); },
+              ThrowsMessage<Error>(HasSubstr("/nonexistent/cam.yaml")));
 }
 
 }  // namespace

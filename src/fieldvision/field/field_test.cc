@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/field/field_draw.h"
@@ -11,6 +12,9 @@
 
 namespace fv::field {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 Eigen::Vector3d Kp(const FieldModel& f, const std::string& name) {
   const FieldKeypoint* k = f.FindKeypoint(name);
@@ -122,22 +126,12 @@ TEST(Fields, DistancesToLines) {
 }
 
 TEST(Fields, BadNamesAndFiles) {
-  try {
-    BuiltinField("rugby");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("robocup-msl"), std::string::npos);
-  }
+  EXPECT_THAT([&] { BuiltinField("rugby"); }, ThrowsMessage<Error>(HasSubstr("robocup-msl")));
   const std::string dir = testing::TempDir();
   std::ofstream(dir + "/bad.json") << "{ not json";
   EXPECT_THROW(LoadField(dir + "/bad.json"), Error);
   std::ofstream(dir + "/nolen.json") << R"({"name": "x", "width_m": 10})";
-  try {
-    LoadField(dir + "/nolen.json");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("length_m"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { LoadField(dir + "/nolen.json"); }, ThrowsMessage<Error>(HasSubstr("length_m")));
   std::ofstream(dir + "/dup.json")
       << R"({"length_m": 10, "width_m": 5, "keypoints": [{"name": "a", "position_m": [0,0,0]},
             {"name": "a", "position_m": [1,0,0]}]})";
@@ -150,12 +144,7 @@ TEST(Fields, BadNamesAndFiles) {
         R"("length_m": 100, "width_m": 50, "surround_m": 1e9)"}) {
     SCOPED_TRACE(size);
     std::ofstream(dir + "/huge.json", std::ios::trunc) << "{\"name\": \"huge\", " << size << "}";
-    try {
-      LoadField(dir + "/huge.json");
-      ADD_FAILURE() << "no error";
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("huge"), std::string::npos) << e.what();
-    }
+    EXPECT_THAT([&] { LoadField(dir + "/huge.json"); }, ThrowsMessage<Error>(HasSubstr("huge")));
   }
   std::ofstream(dir + "/polo.json", std::ios::trunc) << R"({"length_m": 275, "width_m": 146})";
   EXPECT_NO_THROW(LoadField(dir + "/polo.json"));

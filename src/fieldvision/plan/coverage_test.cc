@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
 
@@ -14,6 +15,9 @@
 
 namespace fv::plan {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // A camera looking straight down from `height_m` above the plane z = plane_z whose image covers
 // exactly [cx - sx/2, cx + sx/2) x (cy - sy/2, cy + sy/2] of that plane.
@@ -261,12 +265,7 @@ TEST(CoverageTest, OneCameraOrParallelRaysGiveNoError) {
 TEST(CoverageTest, OptionsCheckNamesTheField) {
   CoverageOptions o;
   o.grid_step_m = 0;
-  try {
-    o.Check();
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("grid_step_m"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { o.Check(); }, ThrowsMessage<Error>(HasSubstr("grid_step_m")));
   o = CoverageOptions();
   o.good_angle_min_deg = 130;
   EXPECT_THROW(o.Check(), Error);

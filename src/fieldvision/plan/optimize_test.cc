@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/error.h"
@@ -9,6 +10,9 @@
 
 namespace fv::plan {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // The seed's reference rig: 4 cameras 1 m outside the corners of the 18 x 12 m field, 4 m high,
 // aimed at the centre, 1280 x 960 with 80 degrees horizontal field of view.
@@ -82,19 +86,13 @@ TEST(OptimizeTest, PointMountsAndBadOptions) {
     EXPECT_NEAR(c.CentreInWorld().z(), 6.0, 1e-9);
   }
   EXPECT_THROW(MountsFromJson({{"mounts", {{{"line", {{0, 0, 1}}}}}}}, "m.json"), Error);
-  try {
-    MountsFromJson({{"mounts", {{{"point", {0, "x", 1}}}}}}, "m.json");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("mounts[0].point"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT(
+      [&] {
+        MountsFromJson({{"mounts", {{{"point", {0, "x", 1}}}}}}, "m.json");
+      },
+      ThrowsMessage<Error>(HasSubstr("mounts[0].point")));
   o.num_cameras = 0;
-  try {
-    o.Check();
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("num_cameras"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { o.Check(); }, ThrowsMessage<Error>(HasSubstr("num_cameras")));
 }
 
 }  // namespace

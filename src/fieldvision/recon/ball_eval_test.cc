@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/error.h"
@@ -10,6 +11,9 @@
 
 namespace fv::recon {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 TEST(BallEval, MatchesByFrameAndSummarises) {
   testing::SeededRng rng(31);
@@ -50,12 +54,12 @@ TEST(BallEval, MatchesByFrameAndSummarises) {
 
 TEST(BallEval, BadFilesNameTheLine) {
   const util::CsvTable truth = util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n", "truth.csv");
-  try {
-    EvaluateBall(truth, util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n0,1,2,3\n", "ball.csv"));
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("ball.csv:3"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT(
+      [&] {
+        EvaluateBall(truth,
+                     util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,1,2,3\n0,1,2,3\n", "ball.csv"));
+      },
+      ThrowsMessage<Error>(HasSubstr("ball.csv:3")));
   EXPECT_THROW(
       EvaluateBall(truth, util::CsvTable::Parse("frame,x_m,y_m,z_m\n0,nan,2,3\n", "b.csv")), Error);
   EXPECT_THROW(EvaluateBall(truth, util::CsvTable::Parse("frame,x_m,y_m\n0,1,2\n", "b.csv")),

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/recon/trajectory_sim.h"
@@ -12,6 +13,9 @@
 
 namespace fv::recon {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // A random kick on an 18 x 12 m field (and a second kick after the ball has settled).
 BallSimOptions RandomKickScene(util::Rng& rng, double drag_per_m = 0.0) {
@@ -186,12 +190,7 @@ TEST(Trajectory, SeedPlaneQuadraticOnAnExactArc) {
 TEST(Trajectory, OptionsCheckNamesTheField) {
   TrajectoryOptions o;
   o.ball_radius_m = -1;
-  try {
-    o.Check();
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("ball_radius_m"), std::string::npos);
-  }
+  EXPECT_THAT([&] { o.Check(); }, ThrowsMessage<Error>(HasSubstr("ball_radius_m")));
   o = TrajectoryOptions();
   o.window_samples = 2;
   EXPECT_THROW(o.Check(), Error);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -12,6 +13,9 @@
 
 namespace fv::recon {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // Four cameras at the corners of an 18 x 12 m field, 6 m high, looking at the centre.
 std::vector<camera::Camera> CornerCameras(util::Rng* rng = nullptr) {
@@ -305,12 +309,7 @@ TEST(Triangulation, BadInputThrowsNamingIt) {
   EXPECT_THROW(TriangulatePoint(no_pose, {{0, {}}, {1, {}}}), Error);
   TriangulationOptions opt;
   opt.inlier_threshold_px = -1;
-  try {
-    opt.Check();
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("inlier_threshold_px"), std::string::npos);
-  }
+  EXPECT_THAT([&] { opt.Check(); }, ThrowsMessage<Error>(HasSubstr("inlier_threshold_px")));
   opt = {};
   opt.max_radius_ratio = 0.5;
   EXPECT_THROW(opt.Check(), Error);

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -16,6 +17,9 @@
 
 namespace fv::stats {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // A player walking 1.5 m/s along +x for 10 s, then sprinting 7 m/s for 3 s, then standing 3 s,
 // with Gaussian position noise; 25 frames/s.
@@ -155,12 +159,8 @@ TEST(Stats, TimeFromTracksAndRateOverride) {
   EXPECT_NEAR(fast.players[0].top_speed_mps, v * 2.5, 0.6);
   EXPECT_NE(fast.Summary().find("--fps 25"), std::string::npos) << fast.Summary();
   for (auto& row : rows) row.time_s.reset();
-  try {
-    ComputeStats(rows, StatsOptions{});
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--fps"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { ComputeStats(rows, StatsOptions{}); },
+              ThrowsMessage<fv::Error>(HasSubstr("--fps")));
   EXPECT_NO_THROW(ComputeStats(rows, o));
 }
 
@@ -169,12 +169,8 @@ TEST(Stats, BadInputs) {
   o.fps = -1;
   EXPECT_THROW(o.Check(), fv::Error);
   std::vector<track::TrackRow> no_positions = {{0, 1, cv::Rect2d(0, 0, 1, 1), 1, {}, {}}};
-  try {
-    ComputeStats(no_positions, StatsOptions{});
-    FAIL();
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("x_m"), std::string::npos);
-  }
+  EXPECT_THAT([&] { ComputeStats(no_positions, StatsOptions{}); },
+              ThrowsMessage<fv::Error>(HasSubstr("x_m")));
   const std::string dir = fv::testing::TempDir();
   {
     std::ofstream f(dir + "/zones.json");

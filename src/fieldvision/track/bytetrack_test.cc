@@ -3,6 +3,7 @@
 #include <map>
 #include <set>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -15,6 +16,9 @@
 
 namespace fv::track {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 struct Walker {
   double x, y, vx, vy;
@@ -113,12 +117,7 @@ TEST(ByteTracker, OptionsAreChecked) {
   EXPECT_THROW(ByteTracker(o, nullptr), fv::Error);
   o = {};
   o.sot = "tld";
-  try {
-    ByteTracker t(o, nullptr);
-    FAIL();
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("sot"), std::string::npos);
-  }
+  EXPECT_THAT([&] { ByteTracker t(o, nullptr); }, ThrowsMessage<fv::Error>(HasSubstr("sot")));
 }
 
 TEST(ByteTrackerStages, SortDetectionsSplitsByScoreAndMarksOverlaps) {

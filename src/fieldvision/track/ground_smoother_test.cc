@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/track/bytetrack.h"
@@ -11,6 +12,9 @@
 
 namespace fv::track {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 camera::Camera SideCamera() {
   camera::Camera c = camera::Camera::FromFov(1280, 720, 70);
@@ -87,12 +91,8 @@ TEST(GroundSmoother, NoisyFootPointsOfAWalkAreSmoothed) {
   // Contract violations name the field.
   GroundSmoothOptions bad;
   bad.accel_sigma_mps2 = -1;
-  try {
-    SmoothGroundTracks(same, measured, cam, fps, bad);
-    FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("accel_sigma_mps2"), std::string::npos);
-  }
+  EXPECT_THAT([&] { SmoothGroundTracks(same, measured, cam, fps, bad); },
+              ThrowsMessage<Error>(HasSubstr("accel_sigma_mps2")));
   EXPECT_THROW(SmoothGroundTracks(same, {true}, cam, fps), Error);
 }
 

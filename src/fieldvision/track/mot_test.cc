@@ -3,6 +3,7 @@
 
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/error.h"
@@ -12,6 +13,10 @@
 
 namespace fv::track {
 namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // Random walkers: `people` tracks over `frames` frames.
 std::vector<TrackRow> Walkers(util::Rng& rng, int people, int frames) {
@@ -93,12 +98,8 @@ TEST(Mot, CsvRoundTripAndBadFile) {
     std::ofstream bad(dir + "/bad.csv");
     bad << "frame,id,bb_left,bb_top,bb_width,bb_height\n1,2,abc,4,5,6\n";
   }
-  try {
-    ReadTracksCsv(dir + "/bad.csv");
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.csv:2"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { ReadTracksCsv(dir + "/bad.csv"); },
+              ThrowsMessage<fv::Error>(HasSubstr("bad.csv:2")));
 }
 
 TEST(Mot, NumbersOutOfRangeNameTheLine) {
@@ -110,12 +111,8 @@ TEST(Mot, NumbersOutOfRangeNameTheLine) {
         "1,1,0,0,10,20,1,,,nan"}) {
     SCOPED_TRACE(row);
     std::ofstream(dir + "/r.csv", std::ios::trunc) << header << "1,1,0,0,10,20,1,,,\n" << row;
-    try {
-      ReadTracksCsv(dir + "/r.csv");
-      ADD_FAILURE() << "no error";
-    } catch (const fv::Error& e) {
-      EXPECT_NE(std::string(e.what()).find("r.csv:3"), std::string::npos) << e.what();
-    }
+    EXPECT_THAT([&] { ReadTracksCsv(dir + "/r.csv"); },
+                ThrowsMessage<fv::Error>(HasSubstr("r.csv:3")));
   }
 }
 
@@ -125,15 +122,10 @@ TEST(Mot, TwoBoxesOfOneIdInAFrameAreRefused) {
   auto est = gt;
   est.push_back(gt[3]);  // frame 3 of id 1 twice: IDF1 was 1.1
   for (const bool in_est : {true, false}) {
-    try {
-      in_est ? EvaluateMot(gt, est) : EvaluateMot(est, gt);
-      ADD_FAILURE() << "no error";
-    } catch (const fv::Error& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find(in_est ? "estimate" : "ground truth"), std::string::npos) << what;
-      EXPECT_NE(what.find("id 1 has two boxes in frame 3 (rows 4 and 21)"), std::string::npos)
-          << what;
-    }
+    EXPECT_THAT([&] { in_est ? EvaluateMot(gt, est) : EvaluateMot(est, gt); },
+                ThrowsMessage<fv::Error>(
+                    AllOf(HasSubstr(in_est ? "estimate" : "ground truth"),
+                          HasSubstr("id 1 has two boxes in frame 3 (rows 4 and 21)"))));
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/camera/camera_io.h"
@@ -14,6 +15,9 @@
 
 namespace fv::track {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 std::string PetsDir() {
   const std::string d = fv::testing::SharedDataDir();
@@ -89,12 +93,8 @@ TEST(Pets, BadFilesGiveErrorsNamingThem) {
     std::ofstream f(dir + "/bad.xml");
     f << "<Camera><Geometry width=\"768\"/></Camera>";
   }
-  try {
-    ReadTsaiXml(dir + "/bad.xml");
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("bad.xml"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { ReadTsaiXml(dir + "/bad.xml"); },
+              ThrowsMessage<fv::Error>(HasSubstr("bad.xml")));
 }
 
 }  // namespace

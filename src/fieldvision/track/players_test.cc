@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -25,6 +26,11 @@
 
 namespace fv::track {
 namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::Not;
+using ::testing::ThrowsMessage;
 
 std::string WriteNoiseVideo(const std::string& path, int w, int h, int frames, uint64_t seed) {
   cv::VideoWriter vw(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, cv::Size(w, h));
@@ -47,12 +53,8 @@ TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
   o.detector.kind = "motion";
   const camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
   // A video that cannot be opened.
-  try {
-    RunPlayers(dir + "/missing.avi", &cam, nullptr, o);
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("missing.avi"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { RunPlayers(dir + "/missing.avi", &cam, nullptr, o); },
+              ThrowsMessage<fv::Error>(HasSubstr("missing.avi")));
   // A file that is not a video.
   {
     std::ofstream f(dir + "/junk.avi");
@@ -61,25 +63,15 @@ TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
   EXPECT_THROW(RunPlayers(dir + "/junk.avi", &cam, nullptr, o), fv::Error);
   // A camera file made for another resolution.
   const std::string video = WriteNoiseVideo(dir + "/small.avi", 320, 240, 3, seed);
-  try {
-    RunPlayers(video, &cam, nullptr, o);
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("640x480"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("320x240"), std::string::npos) << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-  }
+  EXPECT_THAT([&] { RunPlayers(video, &cam, nullptr, o); },
+              ThrowsMessage<fv::Error>(
+                  AllOf(HasSubstr("640x480"), HasSubstr("320x240"), Not(HasSubstr("\n")))));
   // A missing detector model says how to get it.
   const camera::Camera small = camera::Camera::FromFov(320, 240, 60);
   o.detector.kind = "nanodet";
   o.detector.model_path = dir + "/nanodet.onnx";
-  try {
-    RunPlayers(video, &small, nullptr, o);
-    FAIL() << "no error";
-  } catch (const fv::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("make build"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { RunPlayers(video, &small, nullptr, o); },
+              ThrowsMessage<fv::Error>(HasSubstr("make build")));
 }
 
 TEST(Players, InterpolationFillsShortGapsOnly) {

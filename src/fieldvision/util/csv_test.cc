@@ -2,6 +2,7 @@
 
 #include <fstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/error.h"
@@ -9,6 +10,9 @@
 
 namespace fv::util {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 TEST(Csv, RoundTrip) {
   const std::string path = testing::TempDir() + "/a.csv";
@@ -29,19 +33,10 @@ TEST(Csv, RoundTrip) {
 
 TEST(Csv, ErrorsNameTheInput) {
   EXPECT_THROW(CsvTable::Read("/nonexistent/x.csv"), Error);
-  try {
-    CsvTable::Parse("a,b\n1,2\n3\n", "f.csv");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("f.csv:3"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { CsvTable::Parse("a,b\n1,2\n3\n", "f.csv"); },
+              ThrowsMessage<Error>(HasSubstr("f.csv:3")));
   CsvTable t = CsvTable::Parse("a,b\n1,x\n", "g.csv");
-  try {
-    t.GetDouble(0, "b");
-    FAIL();
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("g.csv:2"), std::string::npos) << e.what();
-  }
+  EXPECT_THAT([&] { t.GetDouble(0, "b"); }, ThrowsMessage<Error>(HasSubstr("g.csv:2")));
   EXPECT_THROW(t.Require({"a", "c"}), Error);
   EXPECT_THROW(CsvTable::Parse("", "empty.csv"), Error);
 }
