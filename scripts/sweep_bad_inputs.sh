@@ -293,7 +293,8 @@ JSON_BAD="not_json nan_token deep array empty binary truncated folder missing"
 FIELD_BAD="$JSON_BAD field_huge field_neg field_type"
 # --quick: these cases only (one or two per input kind, each from an issue 18 finding).
 QUICK_CASES='^(detect --camera nan_focal|detect --video truncated|detect out=same|ball --truth=out'
-QUICK_CASES+='|ball --camera huge_width|ball --detections det_huge_frame'
+QUICK_CASES+='|ball --camera huge_width|ball --detections det_huge_frame|ball --video truncated'
+QUICK_CASES+='|ball --timestamps ts_backwards|calibrate refine --overlay=image|trajectory --images=file'
 QUICK_CASES+='|trajectory out=link|trajectory --gravity=nan|trajectory --in binary|eval ball --est nan_x'
 QUICK_CASES+='|eval tracks --gt tracks_dup|stats --tracks tracks_nan_x|stats --zones zones_huge'
 QUICK_CASES+='|stats --fps 1e-300|field show field_huge|plan --step tiny|plan --rig rig_huge'

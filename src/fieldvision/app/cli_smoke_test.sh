@@ -220,4 +220,29 @@ check "studio: --assets a missing folder" nonzero timeout 20 $FV studio --assets
 check "node: --start-at 1e300" nonzero $FV node --camera "$TMP/sc/cam1.yaml" \
   --video "$TMP/sc/cam1/%05d.png" --connect tcp://127.0.0.1:1 --connect-wait 0.2 \
   --start-at 1e300 --no-progress
+# ball: a video given twice under two names, a truncated video and a bad --timestamps file
+# (issue 18): one line naming the input, the existing --out unchanged, no temporary file left.
+"$FV" synth --preset kick --frames 6 --width 320 --height 240 --out "$TMP/bv" --quiet \
+  >/dev/null 2>&1 || { echo "FAIL synth of the ball fixture"; fail=1; }
+B2=(--camera "$TMP/bv/cam1.yaml" --camera "$TMP/bv/cam2.yaml" --no-progress)
+check "ball: one video as v.avi and ./v.avi" nonzero $FV ball "${B2[@]}" --video "$TMP/bv/cam1.avi" \
+  --video "$TMP/bv/./cam1.avi" --out "$TMP/bv/b.csv"
+grep -q "given twice" "$TMP/err" || { echo "FAIL ball: the alias of a video is not refused"; fail=1; }
+printf 'existing output\n' >"$TMP/bv/old.csv"
+head -c 40000 "$TMP/bv/cam1.avi" >"$TMP/bv/cut.avi"
+check "ball: a truncated video" nonzero $FV ball "${B2[@]}" --video "$TMP/bv/cut.avi" \
+  --video "$TMP/bv/cam2.avi" --out "$TMP/bv/old.csv"
+grep -q "cut.avi" "$TMP/err" || { echo "FAIL ball: truncated video not named"; fail=1; }
+ls "$TMP/bv" | grep -q part && { echo "FAIL ball: a temporary file is left"; fail=1; }
+printf 'frame,time_s\n0,0\n1,0.0167\n2,0.01\n3,0.05\n4,0.0667\n5,0.0833\n' >"$TMP/bv/ts.csv"
+check "ball: --timestamps going backwards" nonzero $FV ball "${B2[@]}" --video "$TMP/bv/cam1.avi" \
+  --video "$TMP/bv/cam2.avi" --timestamps "$TMP/bv/ts.csv" --timestamps "$TMP/bv/ts.csv" \
+  --out "$TMP/bv/old.csv"
+grep -q "ts.csv:4" "$TMP/err" || { echo "FAIL ball: timestamps line not named"; fail=1; }
+[ "$(cat "$TMP/bv/old.csv")" = "existing output" ] || { echo "FAIL ball: --out changed"; fail=1; }
+# calibrate check on a frame without a field line: an error, not "line error 0.0 mm".
+{ printf 'P6\n320 240\n255\n'; head -c 230400 /dev/zero; } >"$TMP/black.ppm"
+check "calibrate check: no line in view" nonzero $FV calibrate check --field robocup-msl \
+  --camera "$TMP/bv/cam1.yaml" --image "$TMP/black.ppm" --out "$TMP/bv/chk.png"
+grep -q "sees no line" "$TMP/err" || { echo "FAIL calibrate check: not the no-line error"; fail=1; }
 exit $fail

@@ -9,6 +9,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/field/field.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -24,7 +25,9 @@ void BallJobOptions::Check() const {
              "--ground for positions on the ground)");
   for (size_t i = 0; i < videos.size(); ++i) {
     for (size_t j = 0; j < i; ++j) {
-      FV_REQUIRE(videos[i] != videos[j], "ball: video '{}' is given twice", videos[i]);
+      // One file under two names (./v.avi and v.avi, a link) is the same video.
+      FV_REQUIRE(!io::SameFile(videos[i], videos[j]), "ball: video '{}' is given twice (as '{}')",
+                 videos[i], videos[j]);
     }
   }
   FV_REQUIRE(timestamps.empty() || timestamps.size() == videos.size(),
@@ -150,10 +153,11 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   }
 
   BallJobResult result;
-  // Write to a temporary name, rename at the end: a failed run leaves no half file.
-  const std::string tmp = o.out + ".part";
+  // Write to a temporary file beside the output, rename at the end: a failed run (a truncated
+  // video, a bad timestamp) leaves neither a half file nor a temporary one.
+  io::AtomicOutput out(o.out);
   {
-    util::CsvWriter csv(tmp, recon::BallCsvColumns(), 6);
+    util::CsvWriter csv(out.temp_path(), recon::BallCsvColumns(), 6);
     result.summary =
         RunBallPipelineTracked(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
           if (!f.result.ok()) return;
@@ -165,9 +169,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
         });
     csv.Close();
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, o.out, ec);
-  FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
+  out.Commit();
   if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);
   return result;
 }
