@@ -20,7 +20,6 @@
 namespace fv::calib {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
@@ -185,8 +184,8 @@ TEST(Board, NoBoardInAnyImageIsAnErrorNamingTheInput) {
   o.board = {BoardType::kChessboard, 9, 6, 0.025};
   o.progress = false;
   EXPECT_THAT([&] { CalibrateIntrinsics(dir, o); },
-              ThrowsMessage<Error>(
-                  AllOf(HasSubstr("no chessboard 9x6"), HasSubstr(dir), HasSubstr("3 images"))));
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("no chessboard 9x6"), HasSubstr(dir),
+                                                    HasSubstr("3 images"))));
 }
 
 TEST(Board, ImagesOfDifferentSizesAreAnError) {

@@ -16,9 +16,7 @@
 namespace fv::calib {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
-using ::testing::Not;
 using ::testing::ThrowsMessage;
 
 using test_util::ClickKeypoints;
@@ -127,9 +125,10 @@ TEST(Extrinsics, UnknownKeypointNameIsAnErrorNamingIt) {
     std::ofstream f(path);
     f << "u,v,name\n100,200,centre_spot\n300,400,centre_sport\n";
   }
-  EXPECT_THAT([&] { ReadPointsCsv(path, &field); },
-              ThrowsMessage<Error>(
-                  AllOf(HasSubstr("centre_sport"), HasSubstr("bad.csv:3"), Not(HasSubstr("\n")))));
+  EXPECT_THAT(
+      [&] { ReadPointsCsv(path, &field); },
+      ThrowsMessage<Error>(::testing::AllOf(HasSubstr("centre_sport"), HasSubstr("bad.csv:3"),
+                                            ::testing::Not(HasSubstr("\n")))));
 }
 
 TEST(Extrinsics, MissingColumnsAndNaNAreErrors) {

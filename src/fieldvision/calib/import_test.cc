@@ -13,7 +13,6 @@
 namespace fv::calib {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
@@ -73,7 +72,7 @@ TEST(Import, BadTomlNamesFileAndKey) {
   const std::string path = fv::testing::TempDir() + "/bad.toml";
   std::ofstream(path) << "[cam_1]\nname = \"x\"\nmatrix = [[1, 0, 2], [0, 1]]\nsize = [10, 10]\n";
   EXPECT_THAT([&] { ReadCalibrationToml(path); },
-              ThrowsMessage<Error>(AllOf(HasSubstr("bad.toml"), HasSubstr("matrix"))));
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("bad.toml"), HasSubstr("matrix"))));
   std::ofstream(path) << "[cam_1]\nmatrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]\n";
   EXPECT_THROW(ReadCalibrationToml(path), Error);  // not closed
   EXPECT_THROW(ReadCalibrationToml(path + ".missing"), Error);

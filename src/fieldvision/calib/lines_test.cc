@@ -16,7 +16,6 @@
 namespace fv::calib {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
@@ -119,7 +118,7 @@ TEST(Refine, ImageOfAnotherSizeIsAnError) {
   const camera::Camera cam = CornerCamera(1280, 960);
   const cv::Mat small(480, 640, CV_8UC3, cv::Scalar(0, 120, 0));
   EXPECT_THAT([&] { RefineWithLines(cam, small, field::BuiltinField("robocup-msl")); },
-              ThrowsMessage<Error>(AllOf(HasSubstr("640x480"), HasSubstr("1280x960"))));
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("640x480"), HasSubstr("1280x960"))));
 }
 
 TEST(Refine, NoLinesIsAValueNotAnException) {

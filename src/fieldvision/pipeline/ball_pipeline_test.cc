@@ -21,9 +21,7 @@
 namespace fv::pipeline {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
-using ::testing::Not;
 using ::testing::ThrowsMessage;
 
 constexpr double kRadius = 0.25;
@@ -333,8 +331,9 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
         RunBallPipeline(cams, sources, {Centroid, Centroid, Centroid}, opt,
                         [](const BallFrame&) {});
       },
-      ThrowsMessage<Error>(AllOf(HasSubstr("640x480"), HasSubstr("320x240"), HasSubstr("cam1.avi"),
-                                 Not(HasSubstr("\n")))));
+      ThrowsMessage<Error>(::testing::AllOf(HasSubstr("640x480"), HasSubstr("320x240"),
+                                            HasSubstr("cam1.avi"),
+                                            ::testing::Not(HasSubstr("\n")))));
   // The same through the job, with camera files.
   BallJobOptions job;
   for (int c = 0; c < 3; ++c) {
@@ -345,8 +344,8 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   job.out = dir + "/ball.csv";
   job.pipeline.progress = false;
   EXPECT_THAT([&] { RunBallJob(job); },
-              ThrowsMessage<Error>(
-                  AllOf(HasSubstr("cam1.yaml"), HasSubstr("640x480"), HasSubstr("320x240"))));
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("cam1.yaml"), HasSubstr("640x480"),
+                                                    HasSubstr("320x240"))));
   EXPECT_FALSE(std::filesystem::exists(job.out));
 }
 

@@ -14,7 +14,6 @@
 namespace fv::track {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
@@ -124,8 +123,8 @@ TEST(Mot, TwoBoxesOfOneIdInAFrameAreRefused) {
   for (const bool in_est : {true, false}) {
     EXPECT_THAT([&] { in_est ? EvaluateMot(gt, est) : EvaluateMot(est, gt); },
                 ThrowsMessage<fv::Error>(
-                    AllOf(HasSubstr(in_est ? "estimate" : "ground truth"),
-                          HasSubstr("id 1 has two boxes in frame 3 (rows 4 and 21)"))));
+                    ::testing::AllOf(HasSubstr(in_est ? "estimate" : "ground truth"),
+                                     HasSubstr("id 1 has two boxes in frame 3 (rows 4 and 21)"))));
   }
 }
 

@@ -27,9 +27,7 @@
 namespace fv::track {
 namespace {
 
-using ::testing::AllOf;
 using ::testing::HasSubstr;
-using ::testing::Not;
 using ::testing::ThrowsMessage;
 
 std::string WriteNoiseVideo(const std::string& path, int w, int h, int frames, uint64_t seed) {
@@ -64,8 +62,8 @@ TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
   // A camera file made for another resolution.
   const std::string video = WriteNoiseVideo(dir + "/small.avi", 320, 240, 3, seed);
   EXPECT_THAT([&] { RunPlayers(video, &cam, nullptr, o); },
-              ThrowsMessage<fv::Error>(
-                  AllOf(HasSubstr("640x480"), HasSubstr("320x240"), Not(HasSubstr("\n")))));
+              ThrowsMessage<fv::Error>(::testing::AllOf(HasSubstr("640x480"), HasSubstr("320x240"),
+                                                        ::testing::Not(HasSubstr("\n")))));
   // A missing detector model says how to get it.
   const camera::Camera small = camera::Camera::FromFov(320, 240, 60);
   o.detector.kind = "nanodet";
