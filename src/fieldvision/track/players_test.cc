@@ -176,6 +176,14 @@ TEST(Players, ImageSequenceHasNoTimeWithoutFps) {
 }
 
 #ifdef FV_HAVE_SYNTH
+// `spec` with its cameras at 640x480, written to a fresh folder (returned).
+std::string WriteAt640x480(synth::SceneSpec& spec) {
+  synth::ResizeCameras(spec, 640, 480);
+  const std::string dir = fv::testing::TempDir();
+  synth::WriteScene(spec, dir, false);
+  return dir;
+}
+
 // A 3-frame clip at 10 frames/s (not 25): tracks with 1-based frames and the video's time, boxes
 // without a camera, and the overlay video with one frame per input frame.
 TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
@@ -184,9 +192,7 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   synth::SceneSpec spec = synth::Preset("players", seed);
   spec.num_frames = 3;
   spec.fps = 10;
-  synth::ResizeCameras(spec, 640, 480);
-  const std::string dir = fv::testing::TempDir();
-  synth::WriteScene(spec, dir, false);
+  const std::string dir = WriteAt640x480(spec);
   synth::SceneRenderer scene(spec);
   const camera::Camera cam = scene.cameras()[0];
   const field::FieldModel field = scene.field();
@@ -238,9 +244,7 @@ TEST(Players, SynthScenePositionsAndStableIds) {
   FV_SEED_TRACE(seed);
   synth::SceneSpec spec = synth::Preset("players", seed);
   spec.num_frames = 50;
-  synth::ResizeCameras(spec, 640, 480);
-  const std::string dir = fv::testing::TempDir();
-  synth::WriteScene(spec, dir, false);
+  const std::string dir = WriteAt640x480(spec);
   synth::SceneRenderer scene(spec);
   const camera::Camera cam = scene.cameras()[0];
   const field::FieldModel field = scene.field();
