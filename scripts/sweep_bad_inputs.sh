@@ -295,6 +295,7 @@ FIELD_BAD="$JSON_BAD field_huge field_neg field_type"
 QUICK_CASES='^(detect --camera nan_focal|detect --video truncated|detect out=same|ball --truth=out'
 QUICK_CASES+='|ball --camera huge_width|ball --detections det_huge_frame|ball --video truncated'
 QUICK_CASES+='|ball --timestamps ts_backwards|calibrate refine --overlay=image|trajectory --images=file'
+QUICK_CASES+='|calibrate refine out=same'
 QUICK_CASES+='|trajectory out=link|trajectory --gravity=nan|trajectory --in binary|eval ball --est nan_x'
 QUICK_CASES+='|eval tracks --gt tracks_dup|stats --tracks tracks_nan_x|stats --zones zones_huge'
 QUICK_CASES+='|stats --fps 1e-300|field show field_huge|plan --step tiny|plan --rig rig_huge'
