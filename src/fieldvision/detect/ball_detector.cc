@@ -110,6 +110,12 @@ std::string OutlineProblem(const BallFit& fit, double visible, double leak,
   return "";
 }
 
+// Whether a measured region stands out from its surroundings: by its colour difference
+// (min_contrast) or by its hue difference alone (min_hue_contrast).
+bool StandsOut(const BallRegion& r, const BallDetectorOptions& o) {
+  return r.contrast >= o.min_contrast || r.hue_contrast >= o.min_hue_contrast;
+}
+
 // The first region check the candidate fails ("" when it passes them all); with
 // `shape_only` the colour checks (leak, contrast) are left out.
 std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o,
@@ -133,7 +139,7 @@ std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o,
   if (r.leak > o.max_ring_leak) {
     return fmt::format("ball colour around the circle ({:.0f} % of a ring)", 100 * r.leak);
   }
-  if (r.contrast < o.min_contrast) {
+  if (!StandsOut(r, o)) {
     return fmt::format("too little contrast with the surroundings (Delta E {:.0f})", r.contrast);
   }
   return "";
@@ -199,6 +205,7 @@ void BallDetectorOptions::Check() const {
   CheckNonNegative(max_region_spill, "max_region_spill");
   CheckInRange(max_ring_leak, 0.0, 1.0, "max_ring_leak");
   CheckNonNegative(min_contrast, "min_contrast");
+  CheckNonNegative(min_hue_contrast, "min_hue_contrast");
   CheckInRange(max_region_outside, 0.0, 1.0, "max_region_outside");
   FV_REQUIRE(max_region_extent >= 1.0, "max_region_extent must be >= 1 (got {})",
              max_region_extent);
@@ -417,6 +424,7 @@ std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, cons
       cand.spill = region.spill;
       cand.leak = region.leak;
       cand.contrast = region.contrast;
+      cand.hue_contrast = region.hue_contrast;
       cand.region_outside = region.outside;
       cand.region_extent = region.extent;
       cand.centre_px = region.centre_px;
@@ -474,7 +482,7 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
   const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
                              RegionProblem(region, o, /*shape_only=*/true).empty();
   // A measured region must stand out from its surroundings on either path (min_contrast).
-  const bool stands_out = !region.ok || region.contrast >= o.min_contrast;
+  const bool stands_out = !region.ok || StandsOut(region, o);
   const bool precise_ok =
       fit.ok && fit_why.empty() && size_why.empty() && region_agrees && stands_out;
   std::string region_why;

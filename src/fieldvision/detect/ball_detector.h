@@ -53,6 +53,7 @@ struct BallCandidate {
   double spill = 0.0;           // region beyond the circle, as a share of the disc
   double leak = 0.0;            // ball colour in a ring around the circle
   double contrast = 0.0;        // CIELAB distance between the disc's and the ring's colours
+  double hue_contrast = 0.0;    // its hue part (CIE94 Delta H)
   double region_outside = 0.0;  // convex outline beyond the region's circle
   double region_extent = 0.0;   // the convex outline's far reach, in radii
   bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
@@ -98,10 +99,13 @@ struct BallDetectorOptions {
   // The convex outline's far reach from the centre, in radii (1.41: a square's corners).
   double max_region_extent = 1.25;
   // A ball stands out from its surroundings: CIELAB Delta E between the median colours of the
-  // disc's ball-class pixels and of a ring (ball_region.h), required of every accepted candidate
-  // with a region; a candidate's score grows with its contrast up to twice this. Chosen on the
-  // real SSL and MSL photos as a whole (35-45 tried: 40 keeps SSL's precision, MSL gains most).
+  // disc's ball-class pixels and of a ring (ball_region.h) of at least min_contrast, or a hue
+  // difference (CIE94 Delta H: a shaded ball stays of its hue) of at least min_hue_contrast,
+  // required of every accepted candidate with a region; a candidate's score grows with its
+  // contrast up to twice min_contrast. Chosen on the real SSL and MSL photos as a whole and the
+  // low-sun renders (min_contrast 35-45, min_hue_contrast 20-30 tried).
   double min_contrast = 40.0;
+  double min_hue_contrast = 25.0;
   // Whether a failed region shape check also rejects a candidate whose sub-pixel outline fit
   // passed all its own checks.
   bool region_vetoes_fit = false;

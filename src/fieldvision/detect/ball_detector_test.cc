@@ -53,7 +53,8 @@ TEST(BallDetector, LowContrastDiscIsDiscShapedAConeIsNot) {
   FV_SEED_TRACE(seed);
   util::Rng rng(seed);
   BallDetectorOptions o;
-  o.min_contrast = 300;     // above any CIELAB distance: every region fails the contrast check
+  o.min_contrast = 300;  // above any CIELAB distance: every region fails the contrast check
+  o.min_hue_contrast = 300;
   o.max_fit_rms_px = 1e-6;  // and no outline fit passes: the region path decides
   const BallDetector det(o, nullptr, nullptr);
   cv::Mat img = test_util::FieldImage(640, 480, rng);
@@ -76,6 +77,48 @@ TEST(BallDetector, LowContrastDiscIsDiscShapedAConeIsNot) {
   }
   EXPECT_EQ(discs, 1);
   EXPECT_GE(cones, 1);
+}
+
+// A yellow ball in shade (olive) on grass differs from it little in lightness and chroma but
+// much in hue: it stands out by its hue (min_hue_contrast) though its Delta E is below
+// min_contrast. A beige patch on a white wall, of the yellow class's pale range, differs in
+// lightness and chroma only: rejected.
+TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
+  const uint64_t seed = fv::testing::TestSeed(25);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  BallDetectorOptions o;
+  o.colour = "yellow";
+  const BallDetector det(o, nullptr, nullptr);
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    const double r = rng.Uniform(8, 20);
+    test_util::PaintDisc(img, c, r, cv::Vec3b(15, 120, 130), 0.3);  // olive: a shaded yellow
+    const auto cands = det.Detect(img);
+    ASSERT_FALSE(cands.empty());
+    const BallCandidate& best = cands.front();
+    SCOPED_TRACE("r " + std::to_string(r) + " contrast " + std::to_string(best.contrast) + " hue " +
+                 std::to_string(best.hue_contrast) + " " + best.reason);
+    EXPECT_LT(best.contrast, o.min_contrast);
+    EXPECT_GE(best.hue_contrast, o.min_hue_contrast);
+    EXPECT_TRUE(best.accepted);
+    EXPECT_LT((best.centre_px - c).norm(), 0.1 * r + 0.5);
+  }
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat wall(240, 320, CV_8UC3, cv::Scalar(230, 235, 235));
+    cv::Mat noise(wall.size(), CV_8UC3);
+    cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
+    wall += noise;
+    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    const double r = rng.Uniform(8, 20);
+    test_util::PaintDisc(wall, c, r, cv::Vec3b(150, 200, 215), 0.95);  // beige
+    const auto cands = det.Detect(wall);
+    ASSERT_FALSE(cands.empty());
+    const BallCandidate& best = cands.front();
+    EXPECT_FALSE(best.accepted) << "contrast " << best.contrast << " hue " << best.hue_contrast;
+    EXPECT_LT(best.hue_contrast, o.min_hue_contrast);
+  }
 }
 
 TEST(BallDetector, BadInputGivesErrors) {

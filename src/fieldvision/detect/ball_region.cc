@@ -116,6 +116,9 @@ void BallRegionOptions::Check() const {
   CheckPositive(inlier_px, "BallRegionOptions.inlier_px");
   CheckInRange(hidden_value, 0, 255, "BallRegionOptions.hidden_value");
   CheckInRange(min_seen, 0.1, 1.0, "BallRegionOptions.min_seen");
+  CheckInRange(own_reach, 0.0, 2.0, "BallRegionOptions.own_reach");
+  CheckInRange(own_share, 0.0, 1.0, "BallRegionOptions.own_share");
+  CheckNonNegative(own_max_delta_e, "BallRegionOptions.own_max_delta_e");
   FV_REQUIRE(ring_inner >= 1.0 && ring_outer > ring_inner,
              "BallRegionOptions: need 1 <= ring_inner < ring_outer (got {}, {})", ring_inner,
              ring_outer);
@@ -133,10 +136,97 @@ std::string BallRegion::Summary() const {
 
 namespace {
 
+// Median CIELAB colour (OpenCV 8-bit scale) of `lab`'s pixels where `select` holds for the
+// distance `dist` and the class mask `raw` value; false if none. Histogram medians: linear time.
+template <typename Select>
+bool MedianLab(const cv::Mat& lab, const cv::Mat& dist, const cv::Mat& raw, Select select,
+               Eigen::Vector3d* out) {
+  std::array<std::array<int, 256>, 3> hist{};
+  int n = 0;
+  for (int y = 0; y < lab.rows; ++y) {
+    const uint8_t* l = lab.ptr<uint8_t>(y);
+    const float* d = dist.ptr<float>(y);
+    const uint8_t* m = raw.ptr<uint8_t>(y);
+    for (int x = 0; x < lab.cols; ++x) {
+      if (!select(d[x], m[x] != 0)) continue;
+      ++n;
+      for (int ch = 0; ch < 3; ++ch) ++hist[ch][l[3 * x + ch]];
+    }
+  }
+  if (n == 0) return false;
+  for (int ch = 0; ch < 3; ++ch) {
+    int seen = 0, v = 0;
+    while (v < 255 && (seen += hist[ch][v]) * 2 < n) ++v;
+    (*out)[ch] = v;
+  }
+  return true;
+}
+
+// The region grown by its own colour (BallRegionOptions::own_reach): seeded region growing
+// (Adams & Bischof, PAMI 1994) against the surroundings' median colour. Distances to the region
+// come from one distance transform; colour distances are CIELAB Delta E 1976, squared.
+void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOptions& o,
+                     cv::Mat* region) {
+  const cv::Rect box = cv::boundingRect(*region);
+  if (box.area() == 0) return;
+  const float r = 0.5f * static_cast<float>(std::max(box.width, box.height));
+  cv::Mat dist;  // distance to the region, pixels (0 inside it)
+  cv::distanceTransform(~*region, dist, cv::DIST_L2, cv::DIST_MASK_3);
+  Eigen::Vector3d own, around;
+  const bool has_own = MedianLab(
+                           lab, dist, raw, [](float d, bool c) { return d == 0 && c; }, &own) ||
+                       MedianLab(
+                           lab, dist, raw, [](float d, bool) { return d == 0; }, &own);
+  const float ring_in = std::max(1.0f, 0.3f * r), ring_out = std::max(3.0f, 0.6f * r);
+  if (!has_own ||
+      !MedianLab(
+          lab, dist, raw, [&](float d, bool c) { return d > ring_in && d <= ring_out && !c; },
+          &around)) {
+    return;
+  }
+  constexpr float kL = 100.0f / 255.0f;  // OpenCV's 8-bit L to CIELAB L
+  auto delta_e2 = [&](const uint8_t* p, const Eigen::Vector3d& q) {
+    const float dl = kL * (p[0] - static_cast<float>(q[0]));
+    const float da = p[1] - static_cast<float>(q[1]), db = p[2] - static_cast<float>(q[2]);
+    return dl * dl + da * da + db * db;
+  };
+  const Eigen::Vector3f d_oa((own - around).cast<float>());
+  const float separation2 =
+      kL * kL * d_oa.x() * d_oa.x() + d_oa.y() * d_oa.y() + d_oa.z() * d_oa.z();
+  const float limit2 = std::min(static_cast<float>(o.own_max_delta_e * o.own_max_delta_e),
+                                static_cast<float>(o.own_share * o.own_share) * separation2);
+  const float reach = std::max(1.0f, static_cast<float>(o.own_reach) * r);
+  cv::Mat joined = region->clone();
+  for (int y = 0; y < lab.rows; ++y) {
+    const uint8_t* l = lab.ptr<uint8_t>(y);
+    const float* d = dist.ptr<float>(y);
+    uint8_t* j = joined.ptr<uint8_t>(y);
+    for (int x = 0; x < lab.cols; ++x) {
+      if (d[x] == 0 || d[x] > reach) continue;
+      const float d_own2 = delta_e2(l + 3 * x, own);
+      if (d_own2 < limit2 && d_own2 < delta_e2(l + 3 * x, around)) j[x] = 255;
+    }
+  }
+  // Keep what is connected to the region.
+  cv::Mat labels;
+  const int n = cv::connectedComponents(joined, labels, 8, CV_32S);
+  std::vector<char> keep(n, 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* lb = labels.ptr<int>(y);
+    const uint8_t* m = region->ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) keep[lb[x]] |= m[x] != 0;
+  }
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* lb = labels.ptr<int>(y);
+    uint8_t* m = region->ptr<uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) m[x] = lb[x] > 0 && keep[lb[x]] ? 255 : 0;
+  }
+}
+
 // The gathered region grown through the widened class near its core and closed (print, seams);
 // empty when no ball-coloured pixel touches the seed.
-cv::Mat GrowAndCloseRegion(const cv::Mat& raw, const cv::Mat& grow, const cv::Rect& seed,
-                           const BallRegionOptions& o) {
+cv::Mat GrowAndCloseRegion(const cv::Mat& raw, const cv::Mat& grow, const cv::Mat& lab,
+                           const cv::Rect& seed, const BallRegionOptions& o) {
   cv::Mat labels, stats, centroids;
   cv::connectedComponentsWithStats(raw, labels, stats, centroids, 8, CV_32S);
   cv::Rect bounds;
@@ -153,6 +243,7 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& raw, const cv::Mat& grow, const cv::Re
         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
     cv::bitwise_or(region, grow & near, region);
   }
+  if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region);
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
   if (k >= 1) {
     cv::morphologyEx(region, region, cv::MORPH_CLOSE,
@@ -271,13 +362,12 @@ double OutlineExtent(const std::vector<Vector2d>& pts, const Vector2d& c, double
   return rel.size() >= 2 ? rel[1] : rel[0];
 }
 
-// Fill, spill, leak, purity and contrast of the circle (c, r) over `window`: `filled` is the
-// closed, filled region, `raw` the ball class (window coordinates); `area` the region's area.
-void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& filled,
-                          const cv::Mat& raw, const Vector2d& c, double r, double area,
-                          const BallRegionOptions& o, BallRegion* out) {
-  cv::Mat lab;
-  cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
+// Fill, spill, leak, purity and contrast of the circle (c, r) over `window` (`lab` its CIELAB):
+// `filled` is the closed, filled region, `raw` the ball class (window coordinates); `area` the
+// region's area.
+void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& lab,
+                          const cv::Mat& filled, const cv::Mat& raw, const Vector2d& c, double r,
+                          double area, const BallRegionOptions& o, BallRegion* out) {
   std::array<std::vector<double>, 3> disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
@@ -329,6 +419,12 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
       d2 += dv * dv;
     }
     out->contrast = std::sqrt(d2);
+    // Delta H^2 = Delta a^2 + Delta b^2 - Delta C^2.
+    const double a1 = util::Median(disc_lab[1]) - 128, b1 = util::Median(disc_lab[2]) - 128;
+    const double a2 = util::Median(ring_lab[1]) - 128, b2 = util::Median(ring_lab[2]) - 128;
+    const double dc = std::hypot(a1, b1) - std::hypot(a2, b2);
+    out->hue_contrast =
+        std::sqrt(std::max(0.0, (a1 - a2) * (a1 - a2) + (b1 - b2) * (b1 - b2) - dc * dc));
   }
 }
 
@@ -350,7 +446,9 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   const cv::Mat raw = ClassMask(bgr, table, ball_bit, window);
   const cv::Mat grow =
       grow_table == nullptr ? raw : ClassMask(bgr, *grow_table, grow_table->BallBit(), window);
-  const cv::Mat region = GrowAndCloseRegion(raw, grow, seed, o);
+  cv::Mat lab;
+  cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
+  const cv::Mat region = GrowAndCloseRegion(raw, grow, lab, seed, o);
   if (region.empty()) {
     out.failure = "no ball-coloured pixels at the blob";
     return out;
@@ -402,7 +500,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   out.centre_px = c;
   out.radius_px = r;
   out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(on.inliers, 1)) + 0.05;
-  MeasureRegionColours(bgr, window, filled, raw, c, r, area, o, &out);
+  MeasureRegionColours(bgr, window, lab, filled, raw, c, r, area, o, &out);
   out.ok = true;
   return out;
 }

@@ -1,6 +1,7 @@
 // The region check of a ball candidate: what a real ball looks like once its colour blob is
 // taken whole. Around a blob, the ball-coloured pixels (full resolution) that touch it are
-// gathered, gaps from a print, seams or a highlight are closed and holes filled; the convex part
+// gathered and grown by the ball's own colour (seeded region growing, Adams & Bischof, PAMI 1994),
+// gaps from a print, seams or a highlight are closed and holes filled; the convex part
 // of the region's outline gets a robust circle (RANSAC + geometric fit), so an occluder's edge or
 // the image border does not pull it. The measurements say how disc-like the region is: the share
 // of the circle's angle with outline on it, the share of the disc that is filled, what spills
@@ -32,6 +33,14 @@ struct BallRegionOptions {
   // 0 turns this off.
   int hidden_value = 40;
   double min_seen = 0.5;  // least share of the circle's angles seen (not outside, not hidden)
+  // Growth by the ball's own colour (seeded region growing): pixels within own_reach radii of
+  // the region join, when connected to it, if their CIELAB colour is nearer the region's median
+  // colour than the surroundings' and within own_share of the distance between the two (and at
+  // most own_max_delta_e). A ball whose colour only partly falls in the class (white balance,
+  // shading, a reddish orange) is taken whole. own_reach 0 turns this off.
+  double own_reach = 1.0;
+  double own_share = 0.3;
+  double own_max_delta_e = 20.0;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -61,6 +70,8 @@ struct BallRegion {
   // a ball's colour stands out from what is around it, a patch of a wall does not. The print
   // and the shaded side are left out (a yellow ball's shadow is olive, near the grass).
   double contrast = 0.0;
+  // The hue part of that difference (CIE94 Delta H): what shading and exposure hardly change.
+  double hue_contrast = 0.0;
   double solidity = 0.0;   // region area / convex hull area
   int outline_points = 0;  // convex outline points used by the circle fit
   int inliers = 0;

@@ -158,6 +158,44 @@ TEST(BallRegion, ShadedBallHeldByADarkRobot) {
   }
 }
 
+// A reddish orange ball whose one half falls outside the orange class (hue below 6 deg): the
+// region grows through the ball's own colour and takes it whole; without that growth it holds
+// only the half in the class.
+TEST(BallRegion, BallPartlyOutsideItsClassGrowsByItsOwnColour) {
+  const uint64_t seed = fv::testing::TestSeed(9);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  const std::unique_ptr<ColourTable> grow_table =
+      std::make_unique<ColourTable>(WidenedBallSpec(PresetColourSpec("orange"), 4.0, 0.6));
+  BallRegionOptions off;
+  off.own_reach = 0.0;
+  for (int trial = 0; trial < 5; ++trial) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const double r = rng.Uniform(8, 25);
+    const Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    test_util::PaintDisc(img, c, r, cv::Vec3b(0, 36, 240));  // hue 9 deg: in the class
+    cv::Mat red = img.clone();
+    test_util::PaintDisc(red, c, r, cv::Vec3b(0, 3, 240));  // hue 1 deg: outside it
+    red(cv::Rect(0, 0, static_cast<int>(c.x()), img.rows))
+        .copyTo(img(cv::Rect(0, 0, static_cast<int>(c.x()), img.rows)));
+    const cv::Rect seed_box(static_cast<int>(c.x()), static_cast<int>(c.y() - 0.5 * r),
+                            static_cast<int>(0.5 * r), static_cast<int>(r));
+    const BallRegion own =
+        AnalyseBallRegion(img, table, table.BallBit(), seed_box, {}, {}, grow_table.get());
+    const BallRegion half =
+        AnalyseBallRegion(img, table, table.BallBit(), seed_box, {}, off, grow_table.get());
+    ASSERT_TRUE(own.ok) << own.failure;
+    SCOPED_TRACE("r " + std::to_string(r) + ": " + own.Summary() + " / " +
+                 (half.ok ? half.Summary() : half.failure));
+    EXPECT_LT((own.centre_px - c).norm(), 0.1 * r + 0.5);
+    EXPECT_NEAR(own.radius_px, r, 0.1 * r + 0.5);
+    EXPECT_GT(own.fill, 0.85);
+    EXPECT_GT(own.arc_cover, 0.8);
+    if (half.ok) EXPECT_LT(half.fill, own.fill - 0.2);
+  }
+}
+
 TEST(BallRegion, ShapesThatAreNotBallsAreRejected) {
   const uint64_t seed = fv::testing::TestSeed(7);
   FV_SEED_TRACE(seed);
