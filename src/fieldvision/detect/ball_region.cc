@@ -162,14 +162,11 @@ bool MedianLab(const cv::Mat& lab, const cv::Mat& dist, const cv::Mat& raw, Sele
   return true;
 }
 
-// The region grown by its own colour (BallRegionOptions::own_reach): seeded region growing
-// (Adams & Bischof, PAMI 1994) against the surroundings' median colour. Distances to the region
-// come from one distance transform; colour distances are CIELAB Delta E 1976, squared.
-void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOptions& o,
-                     cv::Mat* region) {
-  const cv::Rect box = cv::boundingRect(*region);
-  if (box.area() == 0) return;
-  const float r = 0.5f * static_cast<float>(std::max(box.width, box.height));
+// The region grown by its own colour (BallRegionOptions::own_reach; r its radius): seeded region
+// growing (Adams & Bischof, PAMI 1994) against the surroundings' median colour. Distances to the
+// region come from one distance transform; colour distances are CIELAB Delta E 1976, squared.
+void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOptions& o, float r,
+                       cv::Mat* region) {
   cv::Mat dist;  // distance to the region, pixels (0 inside it)
   cv::distanceTransform(~*region, dist, cv::DIST_L2, cv::DIST_MASK_3);
   Eigen::Vector3d own, around;
@@ -221,6 +218,20 @@ void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOpt
     uint8_t* m = region->ptr<uint8_t>(y);
     for (int x = 0; x < labels.cols; ++x) m[x] = lb[x] > 0 && keep[lb[x]] ? 255 : 0;
   }
+}
+
+// GrowByOwnColourIn on the part of the window within reach of the region (and its ring).
+void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOptions& o,
+                     cv::Mat* region) {
+  const cv::Rect box = cv::boundingRect(*region);
+  if (box.area() == 0) return;
+  const float r = 0.5f * static_cast<float>(std::max(box.width, box.height));
+  const int margin =
+      static_cast<int>(std::ceil(std::max({3.0f, 0.6f * r, static_cast<float>(o.own_reach) * r}))) +
+      2;
+  const cv::Rect sub = Grow(box, margin) & cv::Rect(0, 0, region->cols, region->rows);
+  cv::Mat part = (*region)(sub);
+  GrowByOwnColourIn(lab(sub), raw(sub), o, r, &part);
 }
 
 // The gathered region grown through the widened class near its core and closed (print, seams);
