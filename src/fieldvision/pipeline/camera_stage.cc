@@ -40,12 +40,17 @@ class CameraStage::Track {
     const cv::Rect r = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(cv::Point(0, 0), image);
     return r.area() > 0 ? r : cv::Rect();
   }
+  // Whether the window's best accepted candidate is where the ball was expected (within two of its
+  // radii): if not, the track may have been taken by another object and the frame is searched
+  // whole.
+  bool Confirms(const std::vector<recon::BallObservation>& obs) const {
+    const recon::BallObservation* best = Best(obs);
+    return best != nullptr &&
+           (best->centre_px - (centre_ + velocity_)).norm() <= 2.0 * radius_ + 2.0;
+  }
   void Update(const std::vector<recon::BallObservation>& obs, bool full) {
     since_full_ = full ? 0 : since_full_ + 1;
-    const recon::BallObservation* best = nullptr;
-    for (const recon::BallObservation& b : obs) {
-      if (!b.weak && (best == nullptr || b.score > best->score)) best = &b;
-    }
+    const recon::BallObservation* best = Best(obs);
     if (best == nullptr) {
       active_ = false;
       return;
@@ -57,6 +62,13 @@ class CameraStage::Track {
   }
 
  private:
+  static const recon::BallObservation* Best(const std::vector<recon::BallObservation>& obs) {
+    const recon::BallObservation* best = nullptr;
+    for (const recon::BallObservation& b : obs) {
+      if (!b.weak && (best == nullptr || b.score > best->score)) best = &b;
+    }
+    return best;
+  }
   BallTrackOptions o_;
   bool active_ = false;
   int since_full_ = 0;
@@ -118,7 +130,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
     if (!full) {
       m.candidates = detector_(*frame, window);
       ++stats_.window_scans;
-      full = !HasAccepted(m.candidates);
+      full = !track_->Confirms(m.candidates);
     }
     if (full && !window.empty()) frame = Image(in, cv::Rect());
     if (frame == nullptr) {

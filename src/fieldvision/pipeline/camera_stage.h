@@ -1,8 +1,9 @@
 // The camera stage of the ball pipeline: one camera's frames in, timestamped ball candidates out
 // (CameraMessage). It tracks the ball in the image and searches a window around where it is
 // expected (constant velocity in the image), decoding encoded frames (SourceFrame::jpeg) only
-// there; the whole frame when the window has no accepted candidate, when the ball was not seen in
-// the previous frame and at least every full_scan_every frames. The same stage serves the
+// there; the whole frame when the window has no accepted candidate or its best one is not where
+// the ball was expected (another object took the window), when the ball was not seen in the
+// previous frame and at least every full_scan_every frames. The same stage serves the
 // in-process pipeline (ball_pipeline.h) and the camera node (net/node.h).
 #pragma once
 
