@@ -249,6 +249,26 @@ std::string DetectEvalResult::Summary(int list) const {
   return s;
 }
 
+namespace {
+
+// The next image: the video's next frame (false at its end) or the item's image file, checked
+// against the camera's size (both named).
+bool NextImage(io::VideoSource* video, const LabelledImage& item, const camera::Camera* camera,
+               const std::string& camera_file, io::Frame* frame, cv::Mat* bgr) {
+  if (video != nullptr) {
+    if (!video->Read(*frame)) return false;
+    *bgr = frame->bgr;
+  } else {
+    *bgr = io::ReadImage(item.image);
+  }
+  FV_REQUIRE(camera == nullptr || (bgr->cols == camera->width && bgr->rows == camera->height),
+             "{} is {}x{} but camera file '{}' is {}x{}", item.image, bgr->cols, bgr->rows,
+             camera_file, camera->width, camera->height);
+  return true;
+}
+
+}  // namespace
+
 DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   o.Check();
   std::vector<LabelledImage> items;
@@ -317,14 +337,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   for (size_t i = 0; i < items.size(); ++i) {
     const LabelledImage& item = items[i];
     cv::Mat bgr;
-    if (video != nullptr) {
-      if (!video->Read(frame)) {
-        items.resize(i);
-        break;
-      }
-      bgr = frame.bgr;
-    } else {
-      bgr = io::ReadImage(item.image);
+    if (!NextImage(video.get(), item, camera.get(), o.camera, &frame, &bgr)) {
+      items.resize(i);
+      break;
     }
     const auto candidates = detector.Detect(bgr);
     DetectEvalImage r = ScoreImage(candidates, item.boxes, o.grow);
