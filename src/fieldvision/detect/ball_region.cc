@@ -181,17 +181,14 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
           &around)) {
     return;
   }
-  constexpr float kL = 100.0f / 255.0f;  // OpenCV's 8-bit L to CIELAB L
-  auto delta_e2 = [&](const uint8_t* p, const Eigen::Vector3d& q) {
-    const float dl = kL * (p[0] - static_cast<float>(q[0]));
-    const float da = p[1] - static_cast<float>(q[1]), db = p[2] - static_cast<float>(q[2]);
-    return dl * dl + da * da + db * db;
-  };
-  const Eigen::Vector3f d_oa((own - around).cast<float>());
-  const float separation2 =
-      kL * kL * d_oa.x() * d_oa.x() + d_oa.y() * d_oa.y() + d_oa.z() * d_oa.z();
-  const float limit2 = std::min(static_cast<float>(o.own_max_delta_e * o.own_max_delta_e),
-                                static_cast<float>(o.own_share * o.own_share) * separation2);
+  // CIELAB with L on its own scale (OpenCV's 8-bit L is L * 255 / 100): squared norms are
+  // Delta E 1976 squared.
+  const Eigen::Vector3f scale(100.0f / 255.0f, 1.0f, 1.0f);
+  const Eigen::Vector3f own_f = own.cast<float>().cwiseProduct(scale);
+  const Eigen::Vector3f around_f = around.cast<float>().cwiseProduct(scale);
+  const float limit2 =
+      std::min(static_cast<float>(o.own_max_delta_e * o.own_max_delta_e),
+               static_cast<float>(o.own_share * o.own_share) * (own_f - around_f).squaredNorm());
   const float reach = std::max(1.0f, static_cast<float>(o.own_reach) * r);
   cv::Mat joined = region->clone();
   for (int y = 0; y < lab.rows; ++y) {
@@ -200,8 +197,10 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
     uint8_t* j = joined.ptr<uint8_t>(y);
     for (int x = 0; x < lab.cols; ++x) {
       if (d[x] == 0 || d[x] > reach) continue;
-      const float d_own2 = delta_e2(l + 3 * x, own);
-      if (d_own2 < limit2 && d_own2 < delta_e2(l + 3 * x, around)) j[x] = 255;
+      const Eigen::Vector3f p =
+          Eigen::Vector3f(l[3 * x], l[3 * x + 1], l[3 * x + 2]).cwiseProduct(scale);
+      const float d_own2 = (p - own_f).squaredNorm();
+      if (d_own2 < limit2 && d_own2 < (p - around_f).squaredNorm()) j[x] = 255;
     }
   }
   // Keep what is connected to the region.
@@ -422,20 +421,17 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   out->purity = area > 0 ? pure / area : 0.0;
   if (disc_lab[0].empty()) disc_lab = std::move(core_lab);
   if (!disc_lab[0].empty() && !ring_lab[0].empty()) {
-    double d2 = 0;
-    for (int ch = 0; ch < 3; ++ch) {
-      // OpenCV's 8-bit Lab: L * 255 / 100, a + 128, b + 128.
-      const double scale = ch == 0 ? 100.0 / 255.0 : 1.0;
-      const double dv = scale * (util::Median(disc_lab[ch]) - util::Median(ring_lab[ch]));
-      d2 += dv * dv;
-    }
-    out->contrast = std::sqrt(d2);
+    // OpenCV's 8-bit Lab: L * 255 / 100, a + 128, b + 128.
+    const auto median_lab = [](const std::array<std::vector<double>, 3>& v) {
+      return Eigen::Vector3d(util::Median(v[0]) * 100.0 / 255.0, util::Median(v[1]) - 128.0,
+                             util::Median(v[2]) - 128.0);
+    };
+    const Eigen::Vector3d disc_c = median_lab(disc_lab), ring_c = median_lab(ring_lab);
+    out->contrast = (disc_c - ring_c).norm();
     // Delta H^2 = Delta a^2 + Delta b^2 - Delta C^2.
-    const double a1 = util::Median(disc_lab[1]) - 128, b1 = util::Median(disc_lab[2]) - 128;
-    const double a2 = util::Median(ring_lab[1]) - 128, b2 = util::Median(ring_lab[2]) - 128;
-    const double dc = std::hypot(a1, b1) - std::hypot(a2, b2);
+    const double dc = disc_c.tail<2>().norm() - ring_c.tail<2>().norm();
     out->hue_contrast =
-        std::sqrt(std::max(0.0, (a1 - a2) * (a1 - a2) + (b1 - b2) * (b1 - b2) - dc * dc));
+        std::sqrt(std::max(0.0, (disc_c - ring_c).tail<2>().squaredNorm() - dc * dc));
   }
 }
 
