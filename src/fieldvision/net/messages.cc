@@ -1,7 +1,5 @@
 #include "fieldvision/net/messages.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -14,23 +12,17 @@ namespace {
 
 using nlohmann::json;
 
-double Num(const json& j, const char* key) {
-  FV_REQUIRE(j.contains(key) && j[key].is_number(), "message: '{}' missing or not a number", key);
-  const double v = j[key].get<double>();
-  FV_REQUIRE(std::isfinite(v), "message: '{}' is not finite", key);
-  return v;
-}
+// The message's fields through util's strict readers: "message: missing key 'k'", "message: key
+// 'k' must be a number" (or is not finite, must be an integer, must be a string).
+constexpr const char* kCtx = "message";
 
-long long Int(const json& j, const char* key) {
-  FV_REQUIRE(j.contains(key) && j[key].is_number_integer(),
-             "message: '{}' missing or not an integer", key);
-  return j[key].get<long long>();
-}
+double Num(const json& j, const char* key) { return util::JsonNumber(j, key, kCtx); }
+
+long long Int(const json& j, const char* key) { return util::JsonInt64(j, key, kCtx); }
 
 std::string Str(const json& j, const char* key, size_t max_len = 256) {
-  FV_REQUIRE(j.contains(key) && j[key].is_string(), "message: '{}' missing or not a string", key);
-  std::string s = j[key].get<std::string>();
-  FV_REQUIRE(s.size() <= max_len, "message: '{}' longer than {} characters", key, max_len);
+  std::string s = util::JsonString(j, key, kCtx);
+  FV_REQUIRE(s.size() <= max_len, "message: key '{}' longer than {} characters", key, max_len);
   return s;
 }
 
@@ -97,13 +89,7 @@ struct Encoder {
 };
 
 void Vec3(const json& j, const char* key, double* out) {
-  FV_REQUIRE(j.contains(key) && j[key].is_array() && j[key].size() == 3,
-             "message: '{}' missing or not 3 numbers", key);
-  for (int i = 0; i < 3; ++i) {
-    FV_REQUIRE(j[key][i].is_number(), "message: '{}' missing or not 3 numbers", key);
-    out[i] = j[key][i].get<double>();
-    FV_REQUIRE(std::isfinite(out[i]), "message: '{}' is not finite", key);
-  }
+  Eigen::Vector3d::Map(out) = util::JsonVector<3>(j, key, kCtx);
 }
 
 }  // namespace
@@ -179,8 +165,8 @@ Message DecodeChecked(const void* data, size_t size) {
     HelloMessage m;
     m.camera = Str(j, "camera");
     m.session = Str(j, "session");
-    m.width = static_cast<int>(Int(j, "width"));
-    m.height = static_cast<int>(Int(j, "height"));
+    m.width = util::JsonInt(j, "width", kCtx);
+    m.height = util::JsonInt(j, "height", kCtx);
     m.fps = Num(j, "fps");
     m.source = Str(j, "source", 4096);
     m.clock = Clock(j);
@@ -194,7 +180,7 @@ Message DecodeChecked(const void* data, size_t size) {
     m.x_m = Num(j, "x_m");
     m.y_m = Num(j, "y_m");
     m.z_m = Num(j, "z_m");
-    m.n_cams = static_cast<int>(Int(j, "n_cams"));
+    m.n_cams = util::JsonInt(j, "n_cams", kCtx);
     m.err_px = Num(j, "err_px");
     m.latency_s = Num(j, "latency_s");
     return m;
@@ -209,9 +195,7 @@ Message DecodeChecked(const void* data, size_t size) {
     Vec3(j, "origin_m", m.origin_m);
     Vec3(j, "landing_m", m.landing_m);
     m.t_landing_s = Num(j, "t_landing_s");
-    FV_REQUIRE(j.contains("landing_extrapolated") && j["landing_extrapolated"].is_boolean(),
-               "message: 'landing_extrapolated' missing or not a boolean");
-    m.landing_extrapolated = j["landing_extrapolated"].get<bool>();
+    m.landing_extrapolated = util::JsonBool(j, "landing_extrapolated", kCtx);
     Vec3(j, "apex_m", m.apex_m);
     Vec3(j, "v0_mps", m.v0_mps);
     m.speed_mps = Num(j, "speed_mps");

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 
 #include <fmt/format.h>
@@ -10,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/stats.h"
 
 namespace fv::stats {
@@ -63,34 +63,25 @@ bool InPolygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& 
 }
 
 std::vector<Zone> ReadZones(const std::string& path) {
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "cannot open zones file '{}'", path);
-  nlohmann::json j;
-  try {
-    in >> j;
-  } catch (const std::exception& e) {
-    Throw("zones file '{}' is not valid JSON", path);
-  }
+  const nlohmann::json j = util::ReadJsonFile(path, "zones");
   FV_REQUIRE(j.is_array(), "zones file '{}': expected an array of {{name, polygon}}", path);
   std::vector<Zone> zones;
   for (size_t i = 0; i < j.size(); ++i) {
     Zone z;
-    FV_REQUIRE(j[i].contains("polygon") && j[i]["polygon"].is_array(),
+    FV_REQUIRE(util::JsonHas(j[i], "polygon") && j[i]["polygon"].is_array(),
                "zones file '{}': zone {} has no polygon", path, i);
-    FV_REQUIRE(!j[i].contains("name") || j[i]["name"].is_string(),
-               "zones file '{}': zone {}'s name is not a string", path, i);
-    z.name = j[i].value("name", fmt::format("zone{}", i + 1));
+    z.name = util::JsonString(j[i], "name", fmt::format("zones file '{}': zone {}", path, i),
+                              fmt::format("zone{}", i + 1));
+    const std::string ctx = fmt::format("zones file '{}': zone '{}'", path, z.name);
     for (const auto& v : j[i]["polygon"]) {
-      FV_REQUIRE(v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number(),
-                 "zones file '{}': zone '{}' has a vertex that is not [x, y]", path, z.name);
-      z.polygon_m.emplace_back(v[0].get<double>(), v[1].get<double>());
+      z.polygon_m.push_back(
+          util::JsonVectorOf<2>(v, fmt::format("{}: vertex {}", ctx, z.polygon_m.size())));
       // Field coordinates: metres from the centre; 10 km is beyond any field.
-      FV_REQUIRE(z.polygon_m.back().allFinite() && z.polygon_m.back().cwiseAbs().maxCoeff() <= 1e4,
-                 "zones file '{}': zone '{}' has a vertex out of range ({}, {})", path, z.name,
-                 z.polygon_m.back().x(), z.polygon_m.back().y());
+      FV_REQUIRE(z.polygon_m.back().cwiseAbs().maxCoeff() <= 1e4,
+                 "{} has a vertex out of range ({}, {})", ctx, z.polygon_m.back().x(),
+                 z.polygon_m.back().y());
     }
-    FV_REQUIRE(z.polygon_m.size() >= 3, "zones file '{}': zone '{}' needs 3 or more vertices", path,
-               z.name);
+    FV_REQUIRE(z.polygon_m.size() >= 3, "{} needs 3 or more vertices", ctx);
     zones.push_back(z);
   }
   return zones;

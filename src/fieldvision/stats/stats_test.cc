@@ -244,6 +244,11 @@ TEST(Zones, HugeVerticesAndNonStringNamesAreOneLineErrors) {
   std::ofstream(path) << R"([{"name": 5, "polygon": [[0, 0], [1, 0], [5, 3]]}])";
   const std::string e = fv::testing::ErrorOf([&] { ReadZones(path); });
   EXPECT_NE(e.find(path), std::string::npos) << e;
+  std::ofstream(path) << R"([{"name": "box", "polygon": [[0, 0], [1], [5, 3]]}])";
+  EXPECT_THAT([&] { ReadZones(path); },
+              ThrowsMessage<fv::Error>(HasSubstr("zone 'box': vertex 1 must be an array of 2")));
+  EXPECT_THAT([&] { ReadZones(path + ".none"); },
+              ThrowsMessage<fv::Error>(HasSubstr("zones file '" + path + ".none' does not exist")));
 }
 
 }  // namespace

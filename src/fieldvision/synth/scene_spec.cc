@@ -1,7 +1,6 @@
 // SceneSpec: validation, JSON round trip and the presets.
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 
 #include <fmt/format.h>
@@ -833,15 +832,7 @@ SceneSpec SceneSpecFromJson(const json& j, const std::string& context) {
 }
 
 SceneSpec ReadSceneSpec(const std::string& path) {
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "cannot open scene file '{}'", path);
-  json j;
-  try {
-    in >> j;
-  } catch (const json::exception& e) {
-    Throw("{}: not valid JSON ({})", path, e.what());
-  }
-  return SceneSpecFromJson(j, path);
+  return SceneSpecFromJson(util::ReadJsonFile(path, "scene"), path);
 }
 
 std::vector<std::string> PresetNames() {

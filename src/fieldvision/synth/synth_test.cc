@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -22,6 +23,8 @@ namespace fv::synth {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // A small clean scene: two cameras, no noise, lighting or shadows, ball at given places.
 SceneSpec CleanScene(const std::vector<Eigen::Vector3d>& places, uint64_t seed) {
@@ -102,7 +105,13 @@ TEST(SceneSpec, BadValuesNameTheKey) {
   bad["cameras"][0]["look_at_m"] = bad["cameras"][0]["position_m"];
   EXPECT_NE(error_of(bad).find("cameras[0].look_at_m"), std::string::npos);
   EXPECT_THROW(Preset("nope", 1), Error);
-  EXPECT_THROW(ReadSceneSpec("/nonexistent/scene.json"), Error);
+  EXPECT_THAT(
+      [] { ReadSceneSpec("/nonexistent/scene.json"); },
+      ThrowsMessage<Error>(HasSubstr("scene file '/nonexistent/scene.json' does not exist")));
+  const std::string broken = fv::testing::TempDir() + "/broken_scene.json";
+  std::ofstream(broken) << "{\"fps\": 30,";
+  EXPECT_THAT([&] { ReadSceneSpec(broken); },
+              ThrowsMessage<Error>(HasSubstr("scene file '" + broken + "' is not valid JSON")));
 }
 
 TEST(BallPhysics, NoDragKickIsTheClosedFormParabola) {

@@ -69,14 +69,22 @@ double JsonNumber(const json& obj, const std::string& key, const std::string& ct
 
 int JsonInt(const json& obj, const std::string& key, const std::string& ctx,
             std::optional<int> fallback) {
+  if (fallback && !JsonHas(obj, key)) return *fallback;
+  const int64_t v = JsonInt64(obj, key, ctx);
+  FV_REQUIRE(v >= std::numeric_limits<int>::min() && v <= std::numeric_limits<int>::max(),
+             "{} is out of range", Named(key, ctx));
+  return static_cast<int>(v);
+}
+
+int64_t JsonInt64(const json& obj, const std::string& key, const std::string& ctx,
+                  std::optional<int64_t> fallback) {
   const json* v = Member(obj, key, ctx, fallback.has_value());
   if (!v) return *fallback;
   FV_REQUIRE(v->is_number_integer(), "{} must be an integer", Named(key, ctx));
-  FV_REQUIRE(v->is_number_unsigned() ? v->get<uint64_t>() <= std::numeric_limits<int>::max()
-                                     : v->get<int64_t>() >= std::numeric_limits<int>::min() &&
-                                           v->get<int64_t>() <= std::numeric_limits<int>::max(),
+  FV_REQUIRE(!v->is_number_unsigned() ||
+                 v->get<uint64_t>() <= static_cast<uint64_t>(std::numeric_limits<int64_t>::max()),
              "{} is out of range", Named(key, ctx));
-  return static_cast<int>(v->get<int64_t>());
+  return v->get<int64_t>();
 }
 
 bool JsonBool(const json& obj, const std::string& key, const std::string& ctx,

@@ -2,6 +2,7 @@
 // context (the file and the path inside it) and the key; vectors are arrays of numbers.
 #pragma once
 
+#include <cstdint>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -27,6 +28,8 @@ double JsonNumber(const nlohmann::json& obj, const std::string& key, const std::
                   std::optional<double> fallback = std::nullopt);
 int JsonInt(const nlohmann::json& obj, const std::string& key, const std::string& ctx,
             std::optional<int> fallback = std::nullopt);
+int64_t JsonInt64(const nlohmann::json& obj, const std::string& key, const std::string& ctx,
+                  std::optional<int64_t> fallback = std::nullopt);
 bool JsonBool(const nlohmann::json& obj, const std::string& key, const std::string& ctx,
               std::optional<bool> fallback = std::nullopt);
 std::string JsonString(const nlohmann::json& obj, const std::string& key, const std::string& ctx,

@@ -26,6 +26,8 @@ TEST(Json, ReadersReturnValuesAndFallbacks) {
   EXPECT_DOUBLE_EQ(JsonNumber(o, "missing", "f", 4.0), 4.0);
   EXPECT_EQ(JsonInt(o, "n", "f"), 7);
   EXPECT_EQ(JsonInt(o, "missing", "f", -1), -1);
+  EXPECT_EQ(JsonInt64(json{{"t", 1LL << 40}}, "t", "f"), 1LL << 40);
+  EXPECT_EQ(JsonInt64(o, "missing", "f", -2), -2);
   EXPECT_TRUE(JsonBool(o, "b", "f"));
   EXPECT_EQ(JsonString(o, "s", "f"), "hi");
   EXPECT_EQ(JsonString(o, "missing", "f", "dflt"), "dflt");
@@ -46,6 +48,11 @@ TEST(Json, ErrorsNameTheFileAndTheKey) {
   ExpectNames(ErrorOf([&] { JsonNumber(o, "x", f); }), {"r.json", "'x'", "number"});
   ExpectNames(ErrorOf([&] { JsonInt(o, "n", f); }), {"r.json", "'n'", "integer"});
   ExpectNames(ErrorOf([&] { JsonInt(o, "big", f); }), {"r.json", "'big'", "range"});
+  ExpectNames(ErrorOf([&] { JsonInt64(o, "n", f); }), {"r.json", "'n'", "integer"});
+  ExpectNames(ErrorOf([&] {
+                JsonInt64(json{{"u", UINT64_MAX}}, "u", f);
+              }),
+              {"r.json", "'u'", "range"});
   ExpectNames(ErrorOf([&] { JsonBool(o, "x", f); }), {"r.json", "'x'", "true or false"});
   ExpectNames(ErrorOf([&] { JsonString(o, "n", f); }), {"r.json", "'n'", "string"});
   ExpectNames(ErrorOf([&] { JsonVector<3>(o, "v", f); }), {"r.json", "'v'", "3 numbers"});
