@@ -17,6 +17,7 @@
 #include "fieldvision/track/players_internal.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
 
 #if __has_include("fieldvision/synth/synth.h")
@@ -327,9 +328,8 @@ TEST(Players, SynthScenePositionsAndStableIds) {
     }
   }
   ASSERT_GT(matched, static_cast<int>(r.rows.size() * 0.8)) << r.Summary();
-  std::sort(errors.begin(), errors.end());
-  const double median = errors[errors.size() / 2];
-  const double p90 = errors[errors.size() * 9 / 10];
+  const double median = util::NearestRankPercentile(errors, 0.5);
+  const double p90 = util::RankPercentile(errors, 0.9);
   std::cout << "synth players: " << matched << " of " << r.rows.size()
             << " rows matched, field error median " << median << " m, p90 " << p90 << " m, "
             << switches << " id switches, " << reentries << " new ids after leaving the image\n";
