@@ -177,15 +177,29 @@ BallTrajectory::BallTrajectory(const BallSpec& ball, double end_time_s) {
   }
 }
 
+namespace {
+
+// The samples i and j = i + 1 around time_s (t.front() < time_s < t.back()): the last sample with
+// t <= time_s, so that at a contact the later (post-bounce) sample is used; s is time_s's share of
+// the way from t[i] to t[j] (1 where they coincide).
+struct Bracket {
+  size_t i, j;
+  double dt, s;
+};
+
+Bracket BracketOf(const std::vector<double>& t, double time_s) {
+  const size_t i = std::upper_bound(t.begin(), t.end(), time_s) - t.begin() - 1;
+  const double dt = t[i + 1] - t[i];
+  return {i, i + 1, dt, dt > 0 ? (time_s - t[i]) / dt : 1.0};
+}
+
+}  // namespace
+
 Eigen::Vector3d BallTrajectory::PositionAt(double time_s) const {
   if (time_s <= t_.front()) return p_.front();
   if (time_s >= t_.back()) return p_.back();
-  // Last sample with t <= time_s; at a contact the later (post-bounce) sample is used.
-  const size_t i = std::upper_bound(t_.begin(), t_.end(), time_s) - t_.begin() - 1;
-  const size_t j = i + 1;
-  const double dt = t_[j] - t_[i];
+  const auto [i, j, dt, s] = BracketOf(t_, time_s);
   if (dt <= 0) return p_[j];
-  const double s = (time_s - t_[i]) / dt;
   const double s2 = s * s, s3 = s2 * s;
   const double h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s, h01 = -2 * s3 + 3 * s2,
                h11 = s3 - s2;
@@ -195,11 +209,8 @@ Eigen::Vector3d BallTrajectory::PositionAt(double time_s) const {
 Eigen::Vector3d BallTrajectory::VelocityAt(double time_s) const {
   if (time_s <= t_.front()) return v_.front();
   if (time_s >= t_.back()) return v_.back();
-  const size_t i = std::upper_bound(t_.begin(), t_.end(), time_s) - t_.begin() - 1;
-  const size_t j = i + 1;
-  const double dt = t_[j] - t_[i];
+  const auto [i, j, dt, s] = BracketOf(t_, time_s);
   if (dt <= 0) return v_[j];
-  const double s = (time_s - t_[i]) / dt;
   return (1 - s) * v_[i] + s * v_[j];
 }
 

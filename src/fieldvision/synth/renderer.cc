@@ -1,8 +1,6 @@
 // SceneRenderer: pixel rays and backgrounds per camera, then per frame the boxes of moving objects.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <thread>
 
 #include <ceres/jet.h>
 #include <fmt/format.h>
@@ -12,6 +10,7 @@
 #include "fieldvision/synth/figures.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/parallel.h"
 #include "fieldvision/util/random.h"
 
 namespace fv::synth {
@@ -534,24 +533,15 @@ SceneRenderer::SceneRenderer(const SceneSpec& spec) : spec_(spec) {
   }
   const StaticWorld world = MakeStaticWorld(field_, spec_);
   data_.resize(cameras_.size());
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i = next++; i < cameras_.size(); i = next++) {
-      auto cd = std::make_unique<CameraData>();
-      cd->cam = cameras_[i];
-      cd->origin = cd->cam.CentreInWorld();
-      cd->pixel_angle = 1.0 / std::sqrt(cd->cam.fx * cd->cam.fy);
-      cd->ray = PixelRays(cd->cam);
-      RenderBackground(world, *cd, spec_);
-      data_[i] = std::move(cd);
-    }
-  };
-  const size_t n_threads =
-      std::min<size_t>(cameras_.size(), std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> threads;
-  for (size_t t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (auto& t : threads) t.join();
+  util::ParallelFor(cameras_.size(), [&](size_t i) {
+    auto cd = std::make_unique<CameraData>();
+    cd->cam = cameras_[i];
+    cd->origin = cd->cam.CentreInWorld();
+    cd->pixel_angle = 1.0 / std::sqrt(cd->cam.fx * cd->cam.fy);
+    cd->ray = PixelRays(cd->cam);
+    RenderBackground(world, *cd, spec_);
+    data_[i] = std::move(cd);
+  });
 }
 
 SceneRenderer::~SceneRenderer() = default;
@@ -1107,18 +1097,8 @@ cv::Mat SceneRenderer::RenderInternal(int camera, int frame, CameraFrameStats* s
 
 std::vector<cv::Mat> SceneRenderer::Render(int frame) const {
   std::vector<cv::Mat> out(cameras_.size());
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i = next++; i < cameras_.size(); i = next++) {
-      out[i] = RenderCamera(static_cast<int>(i), frame);
-    }
-  };
-  const size_t n_threads =
-      std::min<size_t>(cameras_.size(), std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> threads;
-  for (size_t k = 1; k < n_threads; ++k) threads.emplace_back(worker);
-  worker();
-  for (auto& th : threads) th.join();
+  util::ParallelFor(cameras_.size(),
+                    [&](size_t i) { out[i] = RenderCamera(static_cast<int>(i), frame); });
   return out;
 }
 
