@@ -2,6 +2,7 @@
 #include <iostream>
 #include <memory>
 
+#include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/io/output_path.h"
@@ -56,11 +57,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--flights", o->det.flights,
                   "With --detections: also fit the flights and write FLIGHTS.json");
-  cmd->add_option("--ball-diameter", o->job.ball_diameter_m, "Ball diameter in metres")
-      ->check(FiniteRange(0.01, 2.0))
-      ->capture_default_str();
-  cmd->add_option("--color,--colour", o->job.colour, "Colour preset or colour file of the ball")
-      ->capture_default_str();
+  AddBallDiameterOption(cmd, o->job.ball_diameter_m);
+  AddBallColourOption(cmd, o->job.colour);
   AddDetectorOptions(cmd, o->job.dnn);
   cmd->add_option("--out", o->job.out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")
       ->required();
@@ -83,19 +81,12 @@ void Setup(CLI::App& app, int& exit_code) {
                 "newest frames when fusion falls behind (drops frames)");
   cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames")
       ->check(CLI::Range(0LL, 1000000000LL));
-  cmd->add_option("--inlier-px", o->job.pipeline.triangulation.inlier_threshold_px,
-                  "A camera agrees when it sees the ball within this many pixels")
-      ->check(FiniteRange(0.01, 1000.0))
-      ->capture_default_str();
-  cmd->add_flag("--ground", o->job.pipeline.triangulation.single_camera_ground,
-                "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
+  AddFusionOptions(cmd, o->job.pipeline.triangulation);
   cmd->add_flag("!--whole-frames", o->job.pipeline.track.enabled,
                 "Search every frame whole (no tracking window)");
   cmd->add_option("--full-scan-every", o->job.pipeline.track.full_scan_every,
                   "While tracking, search the whole frame at least every N frames")
       ->capture_default_str();
-  cmd->add_flag("!--no-weak", o->job.pipeline.triangulation.use_weak,
-                "Never use candidates that failed a shape check to complete a position");
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o, cmd] {
     FV_REQUIRE(!o->det.detections.empty() ||

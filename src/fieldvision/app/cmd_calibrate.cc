@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/app/camera_folder.h"
 #include "fieldvision/app/cmd_calibrate_board.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/check.h"
@@ -76,30 +77,6 @@ cv::Mat ReadImage(const std::string& path) {
 }
 
 void Warn(const std::string& message) { std::cerr << "warning: " << message << "\n"; }
-
-// A rig folder (`calibrate multi --out DIR`): every camera file in it, by file name; each camera
-// named by its `name` or the file's stem.
-std::vector<camera::Camera> ReadRigFolder(const std::string& dir) {
-  namespace fs = std::filesystem;
-  FV_REQUIRE(fs::is_directory(dir), "rig '{}' is not a folder (give the folder of calibrate multi)",
-             dir);
-  std::vector<std::string> files;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    const std::string ext = e.path().extension().string();
-    if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml"))
-      files.push_back(e.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  std::vector<camera::Camera> rig;
-  for (const auto& f : files) {
-    camera::Camera c = camera::ReadCameraYaml(f);
-    if (c.name.empty()) c.name = fs::path(f).stem().string();
-    FV_REQUIRE(c.has_pose, "rig '{}': camera file '{}' has no pose (rvec/tvec)", dir, f);
-    rig.push_back(c);
-  }
-  FV_REQUIRE(!rig.empty(), "rig '{}' has no camera files (*.yaml)", dir);
-  return rig;
-}
 
 // The rig camera named by `which`: a camera name or the path/stem of one of its files.
 int FindRigCamera(const std::vector<camera::Camera>& rig, const std::string& which,
@@ -230,7 +207,7 @@ void PrintPointTable(const std::vector<PointResidual>& pts) {
 }
 
 void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
-  const std::vector<camera::Camera> rig = ReadRigFolder(c.rig);
+  const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
   std::vector<std::vector<PointCorrespondence>> pts(rig.size());
   for (const auto& arg : c.points) {
     const size_t eq = arg.find('=');
@@ -377,7 +354,7 @@ void WriteOverlay(const std::string& path, const camera::Camera& cam, const cv::
 // A rig on the field refined with the lines in frames of any of its cameras: one rigid
 // correction for the whole rig (calib/rig_lines.h).
 void RunRefineRig(const RefineCli& c) {
-  const std::vector<camera::Camera> rig = ReadRigFolder(c.rig);
+  const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
   std::vector<std::string> names;
   const std::vector<cv::Mat> frames = ReadRigFrames(rig, c.images, c.camera, c.rig, &names);
   const field::FieldModel field = field::LoadField(c.field);
@@ -474,10 +451,7 @@ void RunRig(const RigCli& c) {
   std::vector<camera::Camera> cams;
   std::vector<std::vector<RigObservation>> obs;
   for (size_t i = 0; i < c.cameras.size(); ++i) {
-    cams.push_back(camera::ReadCameraYaml(c.cameras[i]));
-    if (cams.back().name.empty()) {
-      cams.back().name = std::filesystem::path(c.cameras[i]).stem().string();
-    }
+    cams.push_back(ReadNamedCamera(c.cameras[i]));
     obs.push_back(ReadRigObservations(c.points[i], field.get()));
   }
   const RigResult r = [&] {
@@ -521,21 +495,11 @@ void SetupIntrinsics(CLI::App* group) {
       "intrinsics", "Intrinsics from chessboard or ChArUco views (a folder, a glob or a video)");
   in->add_option("--images", ic->images, "Folder, glob pattern ('dir/*.jpg') or video")->required();
   AddBoardOptions(in, ic->board);
-  in->add_option("--model", ic->o.num_distortion,
-                 "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
-      ->check(CLI::IsMember({4, 5, 8, 12, 14}))
-      ->capture_default_str();
+  AddBoardFitOptions(in, ic->o);
   in->add_flag("--fix-aspect", ic->o.fix_aspect_ratio, "Keep fx = fy");
   in->add_flag("--zero-tangent", ic->o.zero_tangent, "No tangential distortion");
   in->add_flag("--fix-principal-point", ic->o.fix_principal_point,
                "Principal point at the image centre");
-  in->add_option("--outlier-factor", ic->o.outlier_factor,
-                 "Drop views with RMS above this x the median (and above --outlier-min-px)")
-      ->check(FiniteRange(1, 1000))
-      ->capture_default_str();
-  in->add_option("--outlier-min-px", ic->o.outlier_min_px, "See --outlier-factor")
-      ->check(FiniteRange(0, 1000))
-      ->capture_default_str();
   in->add_option("--subpix-window", ic->o.detect.subpix_half_window_px,
                  "cornerSubPix half window in pixels")
       ->check(FiniteRange(1, 50))
@@ -544,9 +508,6 @@ void SetupIntrinsics(CLI::App* group) {
                  "Cap the half window at this fraction of the smallest square (0: no cap, as "
                  "OpenCV's calibration sample)")
       ->check(FiniteRange(0, 1))
-      ->capture_default_str();
-  in->add_option("--max-frames", ic->o.source.max_video_frames, "Frames sampled from a video")
-      ->check(FiniteRange(1, 100000))
       ->capture_default_str();
   in->add_option("--name", ic->name, "Camera name written to the file");
   in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
@@ -675,9 +636,7 @@ void SetupRig(CLI::App* group) {
 }
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(
-      app, "calibrate",
-      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
+  CLI::App* group = CommandGroup(app, "calibrate");
   SetupIntrinsics(group);
   SetupExtrinsics(group);
   SetupRefine(group);

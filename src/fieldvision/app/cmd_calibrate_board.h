@@ -1,5 +1,6 @@
 // The board options shared by `calibrate intrinsics` and `calibrate multi` (--board, --cols,
-// --rows, --square, --marker, --dictionary) and their calib::BoardSpec; the calibrate commands'
+// --rows, --square, --marker, --dictionary) and their calib::BoardSpec, the board fit's options
+// they share; the calibrate commands'
 // checks of an output file (its folder exists, it is not a device or a folder) before any work.
 #pragma once
 
@@ -49,6 +50,27 @@ inline void AddBoardOptions(CLI::App* cmd, BoardCli& b) {
   cmd->add_option("--marker", b.marker_m, "ChArUco marker side in metres (default 0.7 x square)")
       ->check(FiniteRange(1e-4, 1));
   cmd->add_option("--dictionary", b.dictionary, "ChArUco ArUco dictionary")->capture_default_str();
+}
+
+// The board fit's options that `calibrate intrinsics` and `calibrate multi` share (--model,
+// --outlier-factor, --outlier-min-px, --max-frames); `Options` is calib::IntrinsicsOptions or
+// calib::MultiOptions.
+template <typename Options>
+void AddBoardFitOptions(CLI::App* cmd, Options& o) {
+  cmd->add_option("--model", o.num_distortion,
+                  "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
+      ->check(CLI::IsMember({4, 5, 8, 12, 14}))
+      ->capture_default_str();
+  cmd->add_option("--outlier-factor", o.outlier_factor,
+                  "Drop views with RMS above this x the median (and above --outlier-min-px)")
+      ->check(FiniteRange(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--outlier-min-px", o.outlier_min_px, "See --outlier-factor")
+      ->check(FiniteRange(0, 1000))
+      ->capture_default_str();
+  cmd->add_option("--max-frames", o.source.max_video_frames, "Frames sampled from a video")
+      ->check(FiniteRange(1, 100000))
+      ->capture_default_str();
 }
 
 // Throws (one line naming the option, the path and the fix) when the folder of output file `out`

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/app/camera_folder.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/import.h"
 #include "fieldvision/calib/pose2sim.h"
@@ -112,44 +113,18 @@ void RunImport(const ImportCli& c) {
 void RunExport(const ExportCli& c) {
   std::vector<std::string> files = c.cameras;
   if (!c.rig.empty()) {
-    FV_REQUIRE(std::filesystem::is_directory(c.rig), "rig '{}' is not a folder", c.rig);
-    for (const auto& e : std::filesystem::directory_iterator(c.rig)) {
-      const std::string ext = e.path().extension().string();
-      if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml")) {
-        files.push_back(e.path().string());
-      }
-    }
+    const std::vector<std::string> in_rig = CameraFilesIn(c.rig);
+    files.insert(files.end(), in_rig.begin(), in_rig.end());
     std::sort(files.begin(), files.end());
   }
   FV_REQUIRE(!files.empty(), "give --camera CAM.yaml (repeat) or --rig DIR");
   std::vector<camera::Camera> cams;
-  for (const auto& f : files) {
-    cams.push_back(camera::ReadCameraYaml(f));
-    if (cams.back().name.empty()) cams.back().name = std::filesystem::path(f).stem().string();
-  }
+  for (const auto& f : files) cams.push_back(ReadNamedCamera(f));
   calib::WriteCalibrationToml(cams, c.toml);
   std::cout << "wrote " << c.toml << " (" << cams.size() << " cameras)\n";
 }
 
 // ---- compare
-std::vector<camera::Camera> ReadCameraFolder(const std::string& dir) {
-  FV_REQUIRE(std::filesystem::is_directory(dir), "rig '{}' is not a folder", dir);
-  std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) {
-    const std::string ext = e.path().extension().string();
-    if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml"))
-      files.push_back(e.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  std::vector<camera::Camera> cams;
-  for (const auto& f : files) {
-    cams.push_back(camera::ReadCameraYaml(f));
-    if (cams.back().name.empty()) cams.back().name = std::filesystem::path(f).stem().string();
-  }
-  FV_REQUIRE(!cams.empty(), "rig '{}' has no camera files (*.yaml)", dir);
-  return cams;
-}
-
 struct CompareCli {
   std::vector<std::string> rigs;
 };
@@ -187,9 +162,7 @@ void RunCompare(const CompareCli& c) {
 }
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(
-      app, "calibrate",
-      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
+  CLI::App* group = CommandGroup(app, "calibrate");
   auto c = std::make_shared<ImportCli>();
   CLI::App* cmd = group->add_subcommand(
       "import",

@@ -122,9 +122,7 @@ void RunMulti(MultiCli& c) {
 }
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(
-      app, "calibrate",
-      "Calibrate cameras: intrinsics, pose from field points, refinement against lines");
+  CLI::App* group = CommandGroup(app, "calibrate");
   auto c = std::make_shared<MultiCli>();
   CLI::App* cmd = group->add_subcommand(
       "multi",
@@ -141,10 +139,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "NAME=CAM.yaml: known intrinsics of a camera, kept fixed (repeat)");
   cmd->add_flag("--fix-intrinsics", c->fix_intrinsics,
                 "Keep every camera's own intrinsics fixed in the joint adjustment");
-  cmd->add_option("--model", c->o.num_distortion,
-                  "Distortion coefficients: 4, 5 (default), 8 (rational), 12, 14")
-      ->check(CLI::IsMember({4, 5, 8, 12, 14}))
-      ->capture_default_str();
+  AddBoardFitOptions(cmd, c->o);
   cmd->add_option("--tangential", c->tangential,
                   "Tangential distortion p1 p2: auto (per camera, kept only where it lowers the "
                   "reprojection error by more than its 2 parameters cost: BIC), free or zero")
@@ -153,18 +148,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--loss-px", c->o.loss_px, "Huber scale of the bundle adjustment in pixels")
       ->check(FiniteRange(0.01, 1000))
       ->capture_default_str();
-  cmd->add_option("--outlier-factor", c->o.outlier_factor,
-                  "Drop views with RMS above this x the median (and above --outlier-min-px)")
-      ->check(FiniteRange(1, 1000))
-      ->capture_default_str();
-  cmd->add_option("--outlier-min-px", c->o.outlier_min_px, "See --outlier-factor")
-      ->check(FiniteRange(0, 1000))
-      ->capture_default_str();
   cmd->add_option("--min-shared", c->o.min_shared_views,
                   "Views two cameras must share to be linked")
-      ->check(FiniteRange(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--max-frames", c->o.source.max_video_frames, "Frames sampled from a video")
       ->check(FiniteRange(1, 100000))
       ->capture_default_str();
   cmd->add_option("--out", c->out, "Folder for NAME.yaml per camera and the pictures")->required();

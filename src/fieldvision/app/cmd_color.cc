@@ -63,7 +63,7 @@ void Learn(const ColorLearnArgs& a) {
 }
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(app, "color", "Colour classes for the ball");
+  CLI::App* group = CommandGroup(app, "color");
   auto a = std::make_shared<ColorLearnArgs>();
   CLI::App* learn = group->add_subcommand(
       "learn",

@@ -1,6 +1,7 @@
 // `fieldvision detect`: ball candidates in every frame of one camera's video (detect_video.h).
 #include <iostream>
 
+#include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/camera/camera_io.h"
@@ -21,13 +22,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Camera file (YAML); without it no size check or field mask");
   cmd->add_option("--video", o->video, "Video file or image pattern (dir/%05d.png)")->required();
   cmd->add_option("--out", o->out, "CSV of every candidate per frame")->required();
-  cmd->add_option("--color", o->detector.colour,
-                  "Colour preset (orange, yellow, white, pink, red, blue, green, black) or colour "
-                  "file from `color learn`")
-      ->capture_default_str();
-  cmd->add_option("--ball-diameter", o->detector.diameter_m, "Ball diameter in metres")
-      ->check(FiniteRange(0.01, 2.0))
-      ->capture_default_str();
+  AddBallColourOption(cmd, o->detector.colour);
+  AddBallDiameterOption(cmd, o->detector.diameter_m);
   cmd->add_option("--field", o->field,
                   "Field (built-in name or JSON): ignore everything outside the field of play "
                   "(needs a camera with a pose)");

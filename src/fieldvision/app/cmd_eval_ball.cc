@@ -19,7 +19,7 @@ struct EvalBallCliOptions {
 };
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
+  CLI::App* group = CommandGroup(app, "eval");
   auto o = std::make_shared<EvalBallCliOptions>();
   CLI::App* cmd = group->add_subcommand("ball", "Error table of a ball track against truth");
   cmd->add_option("--truth", o->truth, "Truth CSV: frame,x_m,y_m,z_m[,time_s,n_cams]")->required();

@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 
+#include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/detect/detect_eval.h"
@@ -11,7 +12,7 @@ namespace fv::app {
 namespace {
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
+  CLI::App* group = CommandGroup(app, "eval");
   auto o = std::make_shared<detect::DetectEvalOptions>();
   CLI::App* cmd = group->add_subcommand(
       "detect",
@@ -25,8 +26,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "images) or a CSV with image|frame,x,y,w,h in pixels");
   cmd->add_option("--class", o->class_id, "YOLO class of the ball")->capture_default_str();
   cmd->add_option("--camera", o->camera, "Camera file (size checks)");
-  cmd->add_option("--color", o->detector.colour, "Colour preset or colour file")
-      ->capture_default_str();
+  AddBallColourOption(cmd, o->detector.colour);
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn);
   cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")

@@ -61,7 +61,7 @@ struct ImportPetsCli {
 };
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(app, "eval", "Compare results with ground truth");
+  CLI::App* group = CommandGroup(app, "eval");
   auto c = std::make_shared<EvalTracksCli>();
   CLI::App* cmd = group->add_subcommand(
       "tracks", "MOTA, MOTP, IDF1 and HOTA of player tracks against ground truth (MOTChallenge)");

@@ -1,17 +1,16 @@
 // `fieldvision fuse`: the fusion node; pairs the camera nodes' detections by capture time,
 // places the ball in 3D, writes BALL.csv and publishes positions (net/fuse.h).
-#include <csignal>
 #include <iostream>
 #include <memory>
 
+#include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/stop_on_signal.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/net/fuse.h"
 
 namespace fv::app {
 namespace {
-
-pipeline::JobControl* g_fuse_control = nullptr;
 
 void Setup(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<net::FuseOptions>();
@@ -43,35 +42,20 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Longest wait (s) for a slow camera before a frame is fused without it")
       ->check(FiniteRange(0, 60))
       ->capture_default_str();
-  cmd->add_option("--ball-diameter", o->ball_diameter_m, "Ball diameter in metres")
-      ->check(FiniteRange(0.01, 2))
-      ->capture_default_str();
-  cmd->add_option("--inlier-px", o->triangulation.inlier_threshold_px,
-                  "A camera agrees when it sees the ball within this many pixels")
-      ->check(FiniteRange(0.01, 1000))
-      ->capture_default_str();
-  cmd->add_flag("--ground", o->triangulation.single_camera_ground,
-                "Seen by one camera only: place the ball on the ground (n_cams 1)");
-  cmd->add_flag("!--no-weak", o->triangulation.use_weak,
-                "Never use candidates that failed a shape check to complete a position");
+  AddBallDiameterOption(cmd, o->ball_diameter_m);
+  AddFusionOptions(cmd, o->triangulation);
   cmd->add_flag("!--no-flights", o->flights,
                 "Do not analyse flights (published on topic `flight` as each one closes)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     io::CheckOutputPath(o->out, o->cameras);
     pipeline::JobControl control;
-    g_fuse_control = &control;
-    auto on_signal = [](int) {
-      if (g_fuse_control != nullptr) g_fuse_control->Stop();
-    };
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
+    const StopOnSignal stop_on_signal(control);
     o->control = &control;
     o->on_listening = [](const std::string& endpoint) {
       std::cout << "fuse: listening on " << endpoint << std::endl;
     };
     const net::FuseSummary s = net::RunFuse(*o);
-    g_fuse_control = nullptr;
     std::cout << s.ToString() << "\n";
     std::cout << "wrote " << o->out << " (" << s.rows_written << " rows)\n";
   });

@@ -1,17 +1,16 @@
 // `fieldvision node`: a camera node; finds the ball in one camera's frames and sends timestamped
 // detections to the fusion node (net/node.h).
-#include <csignal>
 #include <iostream>
 #include <memory>
 
+#include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/stop_on_signal.h"
 #include "fieldvision/net/node.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
-
-pipeline::JobControl* g_node_control = nullptr;
 
 void Setup(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<net::NodeOptions>();
@@ -38,11 +37,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "newest, the lowest latency)")
       ->check(FiniteRange(1, 1000))
       ->capture_default_str();
-  cmd->add_option("--ball-diameter", o->ball_diameter_m, "Ball diameter in metres")
-      ->check(FiniteRange(0.01, 2))
-      ->capture_default_str();
-  cmd->add_option("--color,--colour", o->colour, "Colour preset or colour file of the ball")
-      ->capture_default_str();
+  AddBallDiameterOption(cmd, o->ball_diameter_m);
+  AddBallColourOption(cmd, o->colour);
   cmd->add_option("--field", o->field, "Field (name or JSON): look for the ball only over it");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames")
       ->check(FiniteRange(0, 1e12));
@@ -61,15 +57,9 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     pipeline::JobControl control;
-    g_node_control = &control;
-    auto on_signal = [](int) {
-      if (g_node_control != nullptr) g_node_control->Stop();
-    };
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
+    const StopOnSignal stop_on_signal(control);
     o->control = &control;
     const net::NodeSummary s = net::RunNode(*o);
-    g_node_control = nullptr;
     std::cout << s.ToString() << "\n";
     // A node whose fusion node never answered has done nothing: say so in the exit code.
     FV_REQUIRE(s.frames == 0 || s.sent > 0 || s.has_offset,

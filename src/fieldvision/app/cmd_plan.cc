@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 
+#include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/plan/optimize.h"
 #include "fieldvision/plan/plan_run.h"
@@ -27,9 +28,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(1e-6, 100))
       ->capture_default_str();
   cmd->add_flag("--surround", c.include_surround, "Grid over the run-off area too");
-  cmd->add_option("--ball-diameter", c.ball_diameter_m, "Ball diameter in metres")
-      ->check(FiniteRange(0.01, 2))
-      ->capture_default_str();
+  AddBallDiameterOption(cmd, c.ball_diameter_m);
   cmd->add_option("--height-above", c.height_above_m,
                   "Second layer of points this far above the ball's height (0: none)")
       ->check(FiniteRange(0, 100))
@@ -58,47 +57,32 @@ void Setup(CLI::App& app, int& exit_code) {
   c.progress = true;
   CLI::Option* optimize =
       cmd->add_flag("--optimize", o->optimize, "Search for the best rig and write DIR/rig.json");
-  cmd->add_option("--cameras", o->search.num_cameras, "Number of cameras to place (--optimize)")
-      ->check(FiniteRange(1, 32))
-      ->capture_default_str()
-      ->needs(optimize);
+  // The search's options: range-checked, showing their defaults, only with --optimize.
+  auto search_option = [&](const std::string& name, auto& value, const std::string& help, double lo,
+                           double hi) {
+    cmd->add_option(name, value, help)
+        ->check(FiniteRange(lo, hi))
+        ->capture_default_str()
+        ->needs(optimize);
+  };
+  search_option("--cameras", o->search.num_cameras, "Number of cameras to place (--optimize)", 1,
+                32);
   cmd->add_option("--mounts", o->mounts_path,
                   "Mounting places JSON: {\"mounts\": [{\"point\": [x,y,z]} | {\"line\": "
                   "[[x,y,z],[x,y,z]]}]}; default: the perimeter")
       ->needs(optimize);
-  cmd->add_option("--perimeter-offset", o->perimeter_offset_m,
-                  "Default mounts: rectangle this far outside the lines (m)")
-      ->check(FiniteRange(0, 100))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--mount-height", o->mount_height_m, "Default mounts: height (m)")
-      ->check(FiniteRange(0.01, 100))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--width", o->image_width, "Image width of the cameras to place")
-      ->check(FiniteRange(16, 16384))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--height", o->image_height, "Image height of the cameras to place")
-      ->check(FiniteRange(16, 16384))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--hfov", o->hfov_deg, "Horizontal field of view of the cameras to place (deg)")
-      ->check(FiniteRange(1, 179))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--search-step", o->search.grid_step_m, "Grid cell size during the search (m)")
-      ->check(FiniteRange(1e-6, 100))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--iterations", o->search.iterations, "Annealing steps per restart")
-      ->check(FiniteRange(1, 1000000))
-      ->capture_default_str()
-      ->needs(optimize);
-  cmd->add_option("--restarts", o->search.restarts, "Restarts (the first from an even spread)")
-      ->check(FiniteRange(1, 100))
-      ->capture_default_str()
-      ->needs(optimize);
+  search_option("--perimeter-offset", o->perimeter_offset_m,
+                "Default mounts: rectangle this far outside the lines (m)", 0, 100);
+  search_option("--mount-height", o->mount_height_m, "Default mounts: height (m)", 0.01, 100);
+  search_option("--width", o->image_width, "Image width of the cameras to place", 16, 16384);
+  search_option("--height", o->image_height, "Image height of the cameras to place", 16, 16384);
+  search_option("--hfov", o->hfov_deg, "Horizontal field of view of the cameras to place (deg)", 1,
+                179);
+  search_option("--search-step", o->search.grid_step_m, "Grid cell size during the search (m)",
+                1e-6, 100);
+  search_option("--iterations", o->search.iterations, "Annealing steps per restart", 1, 1000000);
+  search_option("--restarts", o->search.restarts, "Restarts (the first from an even spread)", 1,
+                100);
   cmd->add_option("--seed", o->search.seed, "Random seed of the search")
       ->capture_default_str()
       ->needs(optimize);

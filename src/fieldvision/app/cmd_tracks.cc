@@ -90,7 +90,7 @@ void RunTracksDraw(const TracksDrawCli& c) {
 }
 
 void Setup(CLI::App& app, int& exit_code) {
-  CLI::App* group = CommandGroup(app, "tracks", "Fix player tracks by hand");
+  CLI::App* group = CommandGroup(app, "tracks");
   auto c = std::make_shared<TracksEditCli>();
   CLI::App* cmd = group->add_subcommand(
       "edit",

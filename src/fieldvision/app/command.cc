@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -33,11 +36,19 @@ void SetUpAllCommands(CLI::App& app, int& exit_code) {
   for (const auto& e : entries) e.setup(app, exit_code);
 }
 
-CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string& description) {
+CLI::App* CommandGroup(CLI::App& app, const std::string& name) {
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
     if (sub->get_name() == name) return sub;
   }
-  CLI::App* group = app.add_subcommand(name, description);
+  static const std::map<std::string, std::string> kDescriptions = {
+      {"calibrate",
+       "Calibrate cameras: intrinsics, pose from field points, refinement against lines"},
+      {"color", "Colour classes for the ball"},
+      {"eval", "Compare results with ground truth"},
+      {"tracks", "Fix player tracks by hand"}};
+  const auto description = kDescriptions.find(name);
+  FV_REQUIRE(description != kDescriptions.end(), "no command group '{}'", name);
+  CLI::App* group = app.add_subcommand(name, description->second);
   group->require_subcommand(1);
   return group;
 }

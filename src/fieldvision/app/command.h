@@ -20,9 +20,9 @@ struct CommandRegistration {
 
 void SetUpAllCommands(CLI::App& app, int& exit_code);
 
-// A command group (e.g. "calibrate", "eval") shared by several cmd_*.cc files: returns the
-// existing subcommand or adds it.
-CLI::App* CommandGroup(CLI::App& app, const std::string& name, const std::string& description);
+// A command group shared by several cmd_*.cc files ("calibrate", "eval", "color", "tracks"):
+// returns the existing subcommand or adds it with the group's one description (command.cc).
+CLI::App* CommandGroup(CLI::App& app, const std::string& name);
 
 // An option check: a finite number in [lo, hi]. CLI::Range lets NaN through; CLI11 puts the
 // option's name before the message ("--step: value nan is not a number in [0.001, 100]").

@@ -1,0 +1,41 @@
+// The ball options that several subcommands declare alike: --ball-diameter (ball, node, fuse,
+// detect, plan), --color (ball, node, detect, eval detect) and the fusion's --inlier-px, --ground
+// and --no-weak (ball, fuse; recon/triangulation.h).
+#pragma once
+
+#include <string>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "fieldvision/app/command.h"
+#include "fieldvision/detect/colour.h"
+#include "fieldvision/recon/triangulation.h"
+
+namespace fv::app {
+
+inline void AddBallDiameterOption(CLI::App* cmd, double& diameter_m) {
+  cmd->add_option("--ball-diameter", diameter_m, "Ball diameter in metres")
+      ->check(FiniteRange(0.01, 2.0))
+      ->capture_default_str();
+}
+
+inline void AddBallColourOption(CLI::App* cmd, std::string& colour) {
+  cmd->add_option("--color,--colour", colour,
+                  fmt::format("Colour preset ({}) or colour file from `color learn`",
+                              fmt::join(detect::ColourPresetNames(), ", ")))
+      ->capture_default_str();
+}
+
+inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
+  cmd->add_option("--inlier-px", t.inlier_threshold_px,
+                  "A camera agrees when it sees the ball within this many pixels")
+      ->check(FiniteRange(0.01, 1000.0))
+      ->capture_default_str();
+  cmd->add_flag("--ground", t.single_camera_ground,
+                "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
+  cmd->add_flag("!--no-weak", t.use_weak,
+                "Never use candidates that failed a shape check to complete a position");
+}
+
+}  // namespace fv::app
