@@ -108,36 +108,34 @@ TEST(RigPlace, SixClicksWithOnePixelNoisePlaceTheRig) {
     field_spread.push_back(test_util::FieldPositionErrorM(b.cameras, truth, field, &field_max));
     field_max_spread.push_back(field_max);
   }
-  for (auto* v : {&one_cam, &spread, &field_one, &field_spread, &field_max_one, &field_max_spread,
-                  &bound_one}) {
-    std::sort(v->begin(), v->end());
-  }
+  auto median = [](const std::vector<double>& v) { return util::NearestRankPercentile(v, 0.5); };
+  auto max = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
   std::cout << "points of the field (1 m grid, heights 0 and 1 m) as the placed rig puts them, "
                "over 20 placements: 6 clicks in one camera: median "
-            << 1000 * field_one[10] << " mm (worst point: median " << 1000 * field_max_one[10]
-            << " mm, max " << 1000 * field_max_one.back()
-            << " mm); 2 clicks in each of 3 cameras: median " << 1000 * field_spread[10]
-            << " mm (worst point: median " << 1000 * field_max_spread[10] << " mm, max "
-            << 1000 * field_max_spread.back() << " mm); the Cramer-Rao bound of 6 clicks in one "
-            << "camera: median point std " << 1000 * bound_one[10] << " mm\n";
+            << 1000 * median(field_one) << " mm (worst point: median "
+            << 1000 * median(field_max_one) << " mm, max " << 1000 * max(field_max_one)
+            << " mm); 2 clicks in each of 3 cameras: median " << 1000 * median(field_spread)
+            << " mm (worst point: median " << 1000 * median(field_max_spread) << " mm, max "
+            << 1000 * max(field_max_spread) << " mm); the Cramer-Rao bound of 6 clicks in one "
+            << "camera: median point std " << 1000 * median(bound_one) << " mm\n";
   std::cout << "worst camera centre error over 20 placements: 6 clicks in one camera: median "
-            << 1000 * one_cam[10] << " mm, max " << 1000 * one_cam.back()
-            << " mm; 2 clicks in each of 3 cameras: median " << 1000 * spread[10] << " mm, max "
-            << 1000 * spread.back() << " mm\n";
+            << 1000 * median(one_cam) << " mm, max " << 1000 * max(one_cam)
+            << " mm; 2 clicks in each of 3 cameras: median " << 1000 * median(spread) << " mm, max "
+            << 1000 * max(spread) << " mm\n";
   // 1 px is about 2 cm on the ground at 20 m: six clicks place the rig within a few cm (the
   // optimum: checked above against the truth's own fit), not 1 cm.
   // The field itself (where the rig puts the ball) is placed better than the camera centres, but
   // not within 1 cm from 6 clicks of 1 px (median 18-21 mm over seeds 1-6, 27 mm with the clicks
   // spread over three cameras): no estimate can, the Cramer-Rao bound of these clicks is 20 mm
   // (median point std). The painted lines bring it to about a millimetre (rig_lines_test).
-  EXPECT_LT(field_one[10], 0.035);
+  EXPECT_LT(median(field_one), 0.035);
   // An efficient estimate: the field error is the bound's (a median distance vs a 3D std).
-  EXPECT_LT(field_one[10], 1.5 * bound_one[10]);
-  EXPECT_LT(field_spread[10], 0.06);
-  EXPECT_LT(one_cam[10], 0.06);
-  EXPECT_LT(one_cam.back(), 0.15);
-  EXPECT_LT(spread[10], 0.10);
-  EXPECT_LT(spread.back(), 0.30);
+  EXPECT_LT(median(field_one), 1.5 * median(bound_one));
+  EXPECT_LT(median(field_spread), 0.06);
+  EXPECT_LT(median(one_cam), 0.06);
+  EXPECT_LT(max(one_cam), 0.15);
+  EXPECT_LT(median(spread), 0.10);
+  EXPECT_LT(max(spread), 0.30);
 }
 
 TEST(RigPlace, AGrossClickIsLeftOutAndCarryKeepsRelativePoses) {
