@@ -14,6 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/io_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
@@ -99,23 +100,7 @@ TEST(FrameSource, ImageGlobAndFolderEncodedOrNot) {
 }
 
 TEST(FrameSource, TruncatedFileFailsAtItsEndEncodedOrNot) {
-  const std::string video = testing::TempDir() + "/cut.avi";
-  {
-    // Noisy frames: JPEGs large against the container's header, so a cut lands in the frames.
-    cv::VideoWriter w(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25, cv::Size(320, 240));
-    cv::RNG rng(7);
-    for (int i = 0; i < 16; ++i) {
-      cv::Mat m(240, 320, CV_8UC3);
-      rng.fill(m, cv::RNG::UNIFORM, 0, 256);
-      w.write(m);
-    }
-  }
-  {
-    std::ifstream in(video, std::ios::binary);
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    in.close();
-    std::ofstream(video, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() / 2);
-  }
+  const std::string video = test_util::WriteTruncatedMjpg(testing::TempDir() + "/cut.avi", 0.5);
   for (const bool encoded : {false, true}) {
     SCOPED_TRACE(encoded ? "encoded" : "decoded");
     FrameSourceOptions o;

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/io_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
@@ -58,28 +59,8 @@ TEST(VideoSource, MjpgFileFramesAndTimes) {
   EXPECT_EQ(n, 7);
 }
 
-// A 16-frame MJPG video cut to `keep` of its bytes (the header still announces 16 frames).
-std::string WriteTruncatedMjpg(const std::string& path, double keep) {
-  {
-    // Noisy frames: JPEGs large against the container's header, so a cut lands in the frames.
-    cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(320, 240));
-    cv::RNG rng(7);
-    for (int i = 0; i < 16; ++i) {
-      cv::Mat m(240, 320, CV_8UC3);
-      rng.fill(m, cv::RNG::UNIFORM, 0, 256);
-      w.write(m);
-    }
-  }
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  in.close();
-  std::ofstream(path, std::ios::binary | std::ios::trunc)
-      << bytes.substr(0, static_cast<size_t>(keep * bytes.size()));
-  return path;
-}
-
 TEST(VideoSource, TruncatedVideoFailsAtItsEndNamingTheFrames) {
-  const std::string path = WriteTruncatedMjpg(testing::TempDir() + "/cut.avi", 0.5);
+  const std::string path = test_util::WriteTruncatedMjpg(testing::TempDir() + "/cut.avi", 0.5);
   auto src = VideoSource::Open(path);
   EXPECT_EQ(src->frame_count(), 16);
   Frame f;

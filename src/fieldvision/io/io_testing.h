@@ -1,0 +1,34 @@
+// Helpers shared by the io tests (header only, not part of the library): a video file cut short.
+#pragma once
+
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/videoio.hpp>
+
+namespace fv::io::test_util {
+
+// A 16-frame 320x240 MJPG video at 25 fps cut to `keep` of its bytes (the header still announces
+// 16 frames); returns `path`.
+inline std::string WriteTruncatedMjpg(const std::string& path, double keep) {
+  {
+    // Noisy frames: JPEGs large against the container's header, so a cut lands in the frames.
+    cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(320, 240));
+    cv::RNG rng(7);
+    for (int i = 0; i < 16; ++i) {
+      cv::Mat m(240, 320, CV_8UC3);
+      rng.fill(m, cv::RNG::UNIFORM, 0, 256);
+      w.write(m);
+    }
+  }
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      << bytes.substr(0, static_cast<size_t>(keep * bytes.size()));
+  return path;
+}
+
+}  // namespace fv::io::test_util
