@@ -265,10 +265,7 @@ SceneSpec StaticPreset(uint64_t seed) {
     if (i % 3 != 0) p.z() = rng.Uniform(r, 3.0);
     s.ball.placements.push_back(p);
   }
-  s.ball.hold_frames = 1;
-  s.exposure_s = 0;
   s.noise_sigma = 1.5;
-  s.format = "avi";
   return s;
 }
 
@@ -302,9 +299,6 @@ SceneSpec KickPreset(uint64_t seed) {
   s.cones = {cone};
   s.lighting.gain_amplitude = 0.08;
   s.lighting.period_s = 6.0;
-  s.noise_sigma = 2.0;
-  s.jpeg_quality = 90;
-  s.format = "avi";
   return s;
 }
 
