@@ -331,6 +331,18 @@ std::string RefineResult::Summary() const {
       after.Summary(), moved_m * 1000, rotated_deg, iterations);
 }
 
+std::string LineRefinementRefusal(double moved_m, double max_move_m, double initial_cost,
+                                  double final_cost, bool rig) {
+  if (moved_m > max_move_m) {
+    return fmt::format(
+        "{} would move {:.2f} m (> {:.2f} m): {} start pose is too far off or the lines are "
+        "ambiguous",
+        rig ? "a camera" : "the camera", moved_m, max_move_m, rig ? "the rig's" : "the");
+  }
+  if (!(final_cost <= initial_cost)) return "no improvement";
+  return "";
+}
+
 LossScaleSolve SolveOverLossScales(const std::function<void(ceres::Problem&, double)>& build,
                                    const std::vector<double>& scales, int max_iterations,
                                    Eigen::Vector3d* rvec, Eigen::Vector3d* tvec,
@@ -409,14 +421,11 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
                        180.0 / M_PI;
   if (!rvec.allFinite() || !tvec.allFinite()) {
     result.status = "the optimisation diverged";
-  } else if (result.moved_m > options.max_move_m) {
-    result.status = fmt::format(
-        "the camera would move {:.2f} m (> {:.2f} m): the start pose is "
-        "too far off or the lines are ambiguous",
-        result.moved_m, options.max_move_m);
-  } else if (!(result.final_cost <= result.initial_cost)) {
-    result.status = "no improvement";
-  } else {
+    return result;
+  }
+  result.status = LineRefinementRefusal(result.moved_m, options.max_move_m, result.initial_cost,
+                                        result.final_cost, /*rig=*/false);
+  if (result.status.empty()) {
     result.accepted = true;
     result.camera = refined;
     result.after = LineError(refined, pixels, field, options.gate_m);

@@ -138,6 +138,12 @@ LossScaleSolve SolveOverLossScales(const std::function<void(ceres::Problem&, dou
                                    const Eigen::Vector3d& rvec_start,
                                    const Eigen::Vector3d& tvec_start);
 
+// The acceptance test of both line refinements: empty when the refined pose is taken, else why
+// not (a camera moved more than max_move_m, naming `rig`'s start pose or the camera's; the robust
+// cost did not fall).
+std::string LineRefinementRefusal(double moved_m, double max_move_m, double initial_cost,
+                                  double final_cost, bool rig);
+
 // Checks that an image matches the camera's size; throws naming both.
 void CheckImageSize(const cv::Mat& image, const camera::Camera& camera,
                     const std::string& image_name, const std::string& camera_name);

@@ -1,5 +1,6 @@
 #include "fieldvision/calib/lines.h"
 
+#include <cmath>
 #include <iostream>
 
 #include <gmock/gmock.h>
@@ -127,6 +128,16 @@ TEST(Refine, NoLinesIsAValueNotAnException) {
   const RefineResult r = RefineWithLines(cam, grass, field::BuiltinField("robocup-msl"));
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.status.find("line pixels"), std::string::npos) << r.status;
+}
+
+TEST(Refine, RefusalSaysWhy) {
+  EXPECT_EQ(LineRefinementRefusal(0.1, 0.5, 2.0, 1.0, false), "");
+  EXPECT_EQ(LineRefinementRefusal(0.1, 0.5, 1.0, 2.0, false), "no improvement");
+  EXPECT_EQ(LineRefinementRefusal(0.1, 0.5, 1.0, std::nan(""), true), "no improvement");
+  EXPECT_THAT(LineRefinementRefusal(0.8, 0.5, 2.0, 1.0, false),
+              HasSubstr("the camera would move 0.80 m (> 0.50 m): the start pose"));
+  EXPECT_THAT(LineRefinementRefusal(0.8, 0.5, 2.0, 1.0, true),
+              HasSubstr("a camera would move 0.80 m (> 0.50 m): the rig's start pose"));
 }
 
 }  // namespace

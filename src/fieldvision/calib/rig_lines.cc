@@ -152,14 +152,9 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<camera::Camera>& rig,
         std::max(result.moved_m, (refined[i].CentreInWorld() - rig[i].CentreInWorld()).norm());
   }
   result.rotated_deg = rvec.norm() * 180.0 / M_PI;
-  if (result.moved_m > options.max_move_m) {
-    result.status = fmt::format(
-        "a camera would move {:.2f} m (> {:.2f} m): the rig's start pose is too far off or the "
-        "lines are ambiguous",
-        result.moved_m, options.max_move_m);
-  } else if (!(result.final_cost <= result.initial_cost)) {
-    result.status = "no improvement";
-  } else {
+  result.status = LineRefinementRefusal(result.moved_m, options.max_move_m, result.initial_cost,
+                                        result.final_cost, /*rig=*/true);
+  if (result.status.empty()) {
     result.accepted = true;
     result.cameras = refined;
     for (size_t i = 0; i < rig.size(); ++i) {

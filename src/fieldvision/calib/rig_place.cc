@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "fieldvision/calib/costs.h"
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/util/error.h"
 
@@ -17,13 +18,12 @@ namespace fv::calib {
 namespace {
 
 // A world point seen by camera i of the rig: p_ref = R p + t (ref_from_world), then the camera's
-// fixed pose in the rig and its intrinsics.
+// fixed pose in the rig and its intrinsics (FixedPointReprojection's projection).
 struct RigPointCost {
   RigPointCost(const camera::Camera& cam, const Eigen::Vector2d& uv, const Eigen::Vector3d& p)
-      : intr(cam.IntrinsicsBlock()),
+      : project(cam.IntrinsicsBlock(), uv, Eigen::Vector3d::Zero()),
         cam_r(cam.cam_from_world.Rvec()),
         cam_t(cam.cam_from_world.translation),
-        uv(uv),
         p(p) {}
   template <typename T>
   bool operator()(const T* r, const T* t, T* residual) const {
@@ -31,22 +31,12 @@ struct RigPointCost {
     T p_ref[3];
     ceres::AngleAxisRotatePoint(r, pw, p_ref);
     for (int k = 0; k < 3; ++k) p_ref[k] += t[k];
-    T in[camera::kNumIntrinsics], cr[3], ct[3];
-    for (int k = 0; k < camera::kNumIntrinsics; ++k) in[k] = T(intr[k]);
-    for (int k = 0; k < 3; ++k) {
-      cr[k] = T(cam_r[k]);
-      ct[k] = T(cam_t[k]);
-    }
-    T px[2];
-    if (!camera::ProjectWorldPoint(in, cr, ct, p_ref, px)) return false;
-    residual[0] = px[0] - T(uv.x());
-    residual[1] = px[1] - T(uv.y());
-    return true;
+    const T cr[3] = {T(cam_r[0]), T(cam_r[1]), T(cam_r[2])};
+    const T ct[3] = {T(cam_t[0]), T(cam_t[1]), T(cam_t[2])};
+    return project.Project(cr, ct, p_ref, residual);
   }
-  std::array<double, camera::kNumIntrinsics> intr;
-  Eigen::Vector3d cam_r, cam_t;
-  Eigen::Vector2d uv;
-  Eigen::Vector3d p;
+  FixedPointReprojection project;  // the intrinsics and the pixel (its own point is unused)
+  Eigen::Vector3d cam_r, cam_t, p;
 };
 
 struct Obs {
