@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <set>
 
@@ -10,9 +11,11 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "fieldvision/recon/trajectory_path.h"
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/recon/trajectory_stages.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/parallel.h"
 #include "fieldvision/util/stats.h"
 
 namespace fv::recon {
@@ -143,6 +146,33 @@ void BallisticModel::StateAt(double time_s, Eigen::Vector3d* p_m, Eigen::Vector3
   StepModel(*this, &p, &v, dt);
   if (p_m) *p_m = p;
   if (v_mps) *v_mps = v;
+}
+
+void BallisticModel::Advance(double dt_s, Eigen::Vector3d* p_m, Eigen::Vector3d* v_mps) const {
+  if (Parabola()) {
+    *p_m += *v_mps * dt_s;
+    p_m->z() -= 0.5 * gravity_mps2 * dt_s * dt_s;
+    v_mps->z() -= gravity_mps2 * dt_s;
+  } else {
+    StepModel(*this, p_m, v_mps, dt_s);
+  }
+}
+
+std::vector<Eigen::Vector3d> BallisticModel::PositionsAt(const std::vector<double>& times_s) const {
+  std::vector<Eigen::Vector3d> out(times_s.size());
+  if (times_s.empty()) return out;
+  if (Parabola()) {
+    for (size_t i = 0; i < times_s.size(); ++i) out[i] = PositionAt(times_s[i]);
+    return out;
+  }
+  Eigen::Vector3d p, v;
+  StateAt(times_s[0], &p, &v);
+  out[0] = p;
+  for (size_t i = 1; i < times_s.size(); ++i) {
+    Advance(times_s[i] - times_s[i - 1], &p, &v);
+    out[i] = p;
+  }
+  return out;
 }
 
 double BallisticModel::SpinRevPerS() const { return spin_radps.norm() / (2 * M_PI); }
@@ -399,11 +429,20 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
     for (int i = 0; i < 3; ++i) p0[i] = line.a[i], v0[i] = line.b[i];
   }
   const double huber = 3.0 * std::max(noise_m, 1e-3);
+  // The drag and spin models' residuals read one path integrated through all samples.
+  std::vector<double> dt_s(n);
+  for (int i = 0; i < n; ++i) dt_s[i] = samples[i].time_s - t_ref;
+  FlightPath path(dt_s, g);
   auto solve = [&](FlightModel m) {
     ceres::Problem problem;
-    for (const auto& s : samples) {
-      auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 3, 3, 1, 3>(
-          new SampleResidual(s.ball_in_world, s.time_s - t_ref, g, m != FlightModel::kGravity));
+    for (int i = 0; i < n; ++i) {
+      const BallSample& s = samples[i];
+      ceres::CostFunction* cost =
+          m == FlightModel::kGravity
+              ? static_cast<ceres::CostFunction*>(
+                    new ceres::AutoDiffCostFunction<SampleResidual, 3, 3, 3, 1, 3>(
+                        new SampleResidual(s.ball_in_world, dt_s[i], g, false)))
+              : new FlightPathResidual(&path, i, s.ball_in_world);
       problem.AddResidualBlock(cost, new ceres::HuberLoss(huber), p0, v0, k, sm);
     }
     if (m != FlightModel::kGravity) {
@@ -452,6 +491,8 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
   }
   ScoreFit(samples, t_ref, options, noise_m, &fit);
   fit.ok = ok && std::isfinite(fit.rmse_m);
+  fit.path_sweeps = path.sweeps();
+  fit.path_steps = path.steps();
   return fit;
 }
 
@@ -800,24 +841,27 @@ struct Segmenter {
       if (it != breaks.begin()) *a = std::max(*a, *std::prev(it) + 1);
       return *a < *b;
     };
-    std::vector<double> queued(std::max(hi, 0), -1.0);  // ratio in `queue`, -1: none
-    std::set<std::pair<double, int>> queue;             // (-ratio, k): largest, then first
-    std::vector<Candidate> score(std::max(hi, 0));
+    // Per gap k in [lo, hi), at k - lo (the block's size, not the list's: a long track has
+    // thousands of blocks).
+    const int m = std::max(hi - lo, 0);
+    std::vector<double> queued(m, -1.0);     // ratio in `queue`, -1: none
+    std::set<std::pair<double, int>> queue;  // (-ratio, k): largest, then first
+    std::vector<Candidate> score(m);
     auto rescore = [&](int k) {
-      if (queued[k] >= 0) queue.erase({-queued[k], k});
-      queued[k] = -1.0;
+      if (queued[k - lo] >= 0) queue.erase({-queued[k - lo], k});
+      queued[k - lo] = -1.0;
       int a = 0, b = 0;
       if (!bounds(k, &a, &b)) return;
-      score[k] = Score(list, k, a, b);
-      if (score[k].ratio > 1.0) {
-        queued[k] = score[k].ratio;
-        queue.insert({-queued[k], k});
+      score[k - lo] = Score(list, k, a, b);
+      if (score[k - lo].ratio > 1.0) {
+        queued[k - lo] = score[k - lo].ratio;
+        queue.insert({-queued[k - lo], k});
       }
     };
     for (int k = lo; k + 1 < hi; ++k) rescore(k);
     const double reach_s = 4 * o.window_s;  // beyond any window (3 window_s), with a margin
     while (!queue.empty()) {
-      const Candidate best = score[queue.begin()->second];
+      const Candidate best = score[queue.begin()->second - lo];
       // Localise: the split of the neighbourhood with the least residual.
       int a = std::max(lo, best.pos - 2 * o.window_samples);
       int b = std::min(hi - 1, best.pos + 1 + 2 * o.window_samples);
@@ -874,12 +918,14 @@ double MeetingTime(const BallisticModel& a, const BallisticModel& b, double t_a,
   const double lo = t_a - 0.05, hi = t_b + 0.05;
   double best_t = 0.5 * (t_a + t_b), best = std::numeric_limits<double>::infinity();
   const int steps = std::clamp(static_cast<int>((hi - lo) / 0.0005), 4, 4000);
+  std::vector<double> times(steps + 1);
+  for (int s = 0; s <= steps; ++s) times[s] = lo + (hi - lo) * s / steps;
+  const auto pa = a.PositionsAt(times), pb = b.PositionsAt(times);
   for (int s = 0; s <= steps; ++s) {
-    const double t = lo + (hi - lo) * s / steps;
-    const double d = (a.PositionAt(t) - b.PositionAt(t)).norm();
+    const double d = (pa[s] - pb[s]).norm();
     if (d < best) {
       best = d;
-      best_t = t;
+      best_t = times[s];
     }
   }
   return best_t;
@@ -1026,42 +1072,89 @@ bool ChooseModel(const std::vector<BallSample>& s, int piece_samples,
   return true;
 }
 
+// A piece on its way to a flight (FitPiece's stages).
 struct FittedPiece {
   Flight flight;
-  double lo_s, hi_s;  // the contact times before and after lie within these
+  std::vector<BallSample> s;                               // the samples fitted
+  int count = 0;                                           // the piece's samples before trimming
+  double lo_s = -std::numeric_limits<double>::infinity();  // the contact times before and after
+  double hi_s = std::numeric_limits<double>::infinity();   // lie within these
+  bool trimmed = false;                                    // missed ends were dropped
 };
 
-// One piece fitted as a flight; nullopt for a hop too short to fit (counted in *short_hops, as
-// are trimmed ends). Joined ground samples leave *on_ground.
-std::optional<FittedPiece> FitPiece(const std::vector<BallSample>& track,
-                                    const std::vector<int>& air, const Piece& pc,
-                                    const std::vector<bool>& outlier,
-                                    const TrajectoryOptions& options, double noise_m,
-                                    std::vector<bool>* on_ground, int* short_hops) {
-  const int count = pc.b - pc.a + 1;
-  if (count < options.min_flight_samples) {
-    ++*short_hops;
-    return std::nullopt;
-  }
-  std::vector<BallSample> s;
+// The first stage of fitting a piece (pieces in any order): its gravity fit without the ends it
+// misses; nullopt for a hop too short to fit.
+std::optional<FittedPiece> StartPiece(const std::vector<BallSample>& track,
+                                      const std::vector<int>& air, const Piece& pc,
+                                      const TrajectoryOptions& options, double noise_m) {
   FittedPiece fp;
+  fp.count = pc.b - pc.a + 1;
+  if (fp.count < options.min_flight_samples) return std::nullopt;
   Flight& f = fp.flight;
   for (int p = pc.a; p <= pc.b; ++p) {
-    s.push_back(track[air[p]]);
+    fp.s.push_back(track[air[p]]);
     f.samples.push_back(air[p]);
   }
   f.start_event = pc.start;
   f.end_event = pc.end;
-  f.no_drag = FitBallistic(s, false, options, noise_m);
-  if (TrimMissedEnds(options, noise_m, &s, &f)) ++*short_hops;
-  JoinGroundApproach(track, outlier, options, noise_m, on_ground, &s, &f, &fp.lo_s, &fp.hi_s);
-  if (!ChooseModel(s, count, options, noise_m, &f)) {
-    ++*short_hops;
-    return std::nullopt;
-  }
-  f.free_accel = FitConstantAcceleration(s);
-  f.seed = FitPlaneQuadratic(s, options);
+  f.no_drag = FitBallistic(fp.s, false, options, noise_m);
+  fp.trimmed = TrimMissedEnds(options, noise_m, &fp.s, &f);
   return fp;
+}
+
+// The last stage (any order, after the ground approaches are joined in track order): the drag and
+// spin fits, the model chosen and the reference fits. False when no model fits (a short hop).
+bool FinishPiece(const TrajectoryOptions& options, double noise_m, FittedPiece* fp) {
+  Flight& f = fp->flight;
+  const bool ok = ChooseModel(fp->s, fp->count, options, noise_m, &f);
+  if (ok) {
+    f.free_accel = FitConstantAcceleration(fp->s);
+    f.seed = FitPlaneQuadratic(fp->s, options);
+  }
+  fp->s = {};
+  return ok;
+}
+
+// Every piece fitted as a flight (the costly drag and spin fits on all threads; the same result
+// as one piece after the other); nullopt for a hop too short to fit (counted in *short_hops, as
+// are trimmed ends). Joined ground samples leave *on_ground.
+std::vector<std::optional<FittedPiece>> FitPieces(const std::vector<BallSample>& track,
+                                                  const std::vector<int>& air,
+                                                  const std::vector<Piece>& pieces,
+                                                  const std::vector<bool>& outlier,
+                                                  const TrajectoryOptions& options, double noise_m,
+                                                  std::vector<bool>* on_ground, int* short_hops) {
+  std::vector<std::optional<FittedPiece>> fitted(pieces.size());
+  util::ParallelFor(pieces.size(), [&](size_t i) {
+    fitted[i] = StartPiece(track, air, pieces[i], options, noise_m);
+  });
+  // A piece takes the ground samples next to it that lie on its arc: in track order.
+  for (auto& fp : fitted) {
+    if (!fp) {
+      ++*short_hops;
+      continue;
+    }
+    *short_hops += fp->trimmed;
+    JoinGroundApproach(track, outlier, options, noise_m, on_ground, &fp->s, &fp->flight, &fp->lo_s,
+                       &fp->hi_s);
+  }
+  std::mutex progress_mutex;
+  size_t done = 0;
+  std::vector<char> ok(pieces.size(), 0);
+  util::ParallelFor(pieces.size(), [&](size_t i) {
+    if (fitted[i]) ok[i] = FinishPiece(options, noise_m, &*fitted[i]);
+    if (options.progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      options.progress(++done, pieces.size());
+    }
+  });
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    if (fitted[i] && !ok[i]) {
+      ++*short_hops;
+      fitted[i].reset();
+    }
+  }
+  return fitted;
 }
 
 }  // namespace
@@ -1164,10 +1257,14 @@ void MergeBounces(const std::vector<BallSample>& track, const TrajectoryOptions&
 
 void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool>& outlier,
                     Flight* f) {
-  for (size_t k = 0; k < track.size(); ++k) {
-    if (outlier[k] && track[k].time_s >= f->t_first_seen_s && track[k].time_s <= f->t_last_seen_s) {
-      f->samples.push_back(static_cast<int>(k));
-    }
+  // The samples within the seen span (times increase along the track).
+  const auto lo = std::lower_bound(track.begin(), track.end(), f->t_first_seen_s,
+                                   [](const BallSample& s, double t) { return s.time_s < t; });
+  const auto hi = std::upper_bound(track.begin(), track.end(), f->t_last_seen_s,
+                                   [](double t, const BallSample& s) { return t < s.time_s; });
+  for (auto it = lo; it < hi; ++it) {
+    const size_t k = it - track.begin();
+    if (outlier[k]) f->samples.push_back(static_cast<int>(k));
   }
   std::sort(f->samples.begin(), f->samples.end());
 }
@@ -1206,14 +1303,13 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
   std::vector<Flight> flights;
   std::vector<int> piece_of_flight;
   std::vector<std::pair<double, double>> limits;  // contact times lie within these
+  auto fitted = FitPieces(track, air, pieces, res.outlier, options, res.noise_m, &res.on_ground,
+                          &res.short_hops);
   for (size_t pi = 0; pi < pieces.size(); ++pi) {
-    if (options.progress) options.progress(pi, pieces.size());
-    auto fp = FitPiece(track, air, pieces[pi], res.outlier, options, res.noise_m, &res.on_ground,
-                       &res.short_hops);
-    if (!fp) continue;
-    flights.push_back(std::move(fp->flight));
+    if (!fitted[pi]) continue;
+    flights.push_back(std::move(fitted[pi]->flight));
     piece_of_flight.push_back(static_cast<int>(pi));
-    limits.emplace_back(fp->lo_s, fp->hi_s);
+    limits.emplace_back(fitted[pi]->lo_s, fitted[pi]->hi_s);
   }
   ResolveContacts(piece_of_flight, options, res.noise_m, &flights, &res.breaks);
   for (size_t i = 0; i < flights.size(); ++i) {

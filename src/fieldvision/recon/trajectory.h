@@ -46,6 +46,11 @@ struct BallisticModel {
   Eigen::Vector3d PositionAt(double time_s) const;
   Eigen::Vector3d VelocityAt(double time_s) const;
   void StateAt(double time_s, Eigen::Vector3d* p_m, Eigen::Vector3d* v_mps) const;
+  // Moves a state of this model (position, velocity at some time) on by dt_s (either sign).
+  void Advance(double dt_s, Eigen::Vector3d* p_m, Eigen::Vector3d* v_mps) const;
+  // Positions at increasing times, each integrated from the one before (O(span), where
+  // PositionAt per time integrates from t0_s each time); a parabola's in closed form.
+  std::vector<Eigen::Vector3d> PositionsAt(const std::vector<double>& times_s) const;
   // The first time after (forward) or before (!forward) `from_s` where the centre height crosses
   // z_m, searched up to max_s away; nullopt if none.
   std::optional<double> CrossingTime(double z_m, double from_s, bool forward,
@@ -58,7 +63,10 @@ struct BallisticFit {
   bool ok = false;
   double rmse_m = 0.0;  // over the inliers
   int inliers = 0;
-  int iterations = 0;        // Ceres iterations
+  int iterations = 0;  // Ceres iterations
+  // Work of the drag and spin models' residuals: paths integrated through all samples (one per
+  // evaluation at new parameters) and RK4 steps in all (trajectory_path.h).
+  long long path_sweeps = 0, path_steps = 0;
   std::vector<bool> inlier;  // per sample given to the fit
   int parameters = 0;        // free parameters (6 gravity, 7 drag, 10 spin)
   // Sum of squared residuals with each sample's residual capped at the outlier threshold of the
@@ -160,8 +168,8 @@ struct TrajectoryOptions {
   double spin_along_prior_revps = 5.0;
   double MagnusPerRad() const;
   BounceModel bounce;  // for predicting the flight after a bounce
-  // Called with (arcs fitted, arcs in all) while the flights are fitted (a progress line for long
-  // tracks); empty: none.
+  // Called with (arcs fitted, arcs in all) as each arc's drag and spin fits end (the arcs are
+  // fitted on all threads; calls come one at a time); empty: none.
   std::function<void(size_t done, size_t total)> progress;
 
   void Check() const;

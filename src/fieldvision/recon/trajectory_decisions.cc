@@ -84,7 +84,7 @@ class BallPathCursor {
     if (!active_.empty()) {
       const Flight& f = flights[*active_.begin()];
       if (flight) *flight = f.index;
-      return f.model().PositionAt(time_s);
+      return ModelAt(*active_.begin(), time_s);
     }
     if (flight) *flight = -1;
     // Linear between the nearest non-outlier samples (as BallPathAt).
@@ -107,8 +107,26 @@ class BallPathCursor {
   }
 
  private:
+  // The flight's position: a drag or spin model is walked on from the time asked before (one
+  // integration from the model's reference time per call cost O(flight time) each).
+  Eigen::Vector3d ModelAt(int i, double time_s) {
+    const BallisticModel& m = result_.flights[i].model();
+    if (m.Parabola()) return m.PositionAt(time_s);
+    if (walk_flight_ != i || time_s < walk_t_s_) {
+      m.StateAt(time_s, &walk_p_, &walk_v_);
+      walk_flight_ = i;
+    } else {
+      m.Advance(time_s - walk_t_s_, &walk_p_, &walk_v_);
+    }
+    walk_t_s_ = time_s;
+    return walk_p_;
+  }
+
   const std::vector<BallSample>& track_;
   const TrajectoryResult& result_;
+  int walk_flight_ = -1;
+  double walk_t_s_ = 0.0;
+  Eigen::Vector3d walk_p_, walk_v_;
   std::vector<int> by_start_;
   size_t next_start_ = 0;
   std::set<int> active_;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include <Eigen/Core>
 
@@ -14,19 +15,27 @@ namespace fv::recon {
 
 constexpr double kMaxStepS = 0.002;  // RK4 step
 
-// a = -g z - k |v| v + s x v, with s = c_M w (the Magnus vector, 1/s).
-template <typename T>
-void FlightAccel(const T v[3], const T& k, const T s[3], double g, T a[3]) {
+// a = -g z - k |v| v + s x v, with s = c_M w (the Magnus vector, 1/s). k and s may be of another
+// scalar type than the state (plain numbers when no derivatives by them are wanted).
+template <typename T, typename K, typename S>
+void FlightAccel(const T v[3], const K& k, const S s[3], double g, T a[3]) {
   using std::sqrt;
   const T speed = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + T(1e-12));
-  a[0] = -k * speed * v[0] + (s[1] * v[2] - s[2] * v[1]);
-  a[1] = -k * speed * v[1] + (s[2] * v[0] - s[0] * v[2]);
-  a[2] = -k * speed * v[2] + (s[0] * v[1] - s[1] * v[0]);
+  const T ks = -k * speed;
+  for (int i = 0; i < 3; ++i) a[i] = ks * v[i];
+  // A constant zero Magnus vector (a drag-only or drag-free model) adds only zeros.
+  bool magnus = true;
+  if constexpr (std::is_same_v<S, double>) magnus = s[0] != 0.0 || s[1] != 0.0 || s[2] != 0.0;
+  if (magnus) {
+    a[0] = a[0] + (s[1] * v[2] - s[2] * v[1]);
+    a[1] = a[1] + (s[2] * v[0] - s[0] * v[2]);
+    a[2] = a[2] + (s[0] * v[1] - s[1] * v[0]);
+  }
   a[2] -= T(g);
 }
 
-template <typename T>
-void FlightRk4Step(T p[3], T v[3], const T& k, const T s[3], double g, double h) {
+template <typename T, typename K, typename S>
+void FlightRk4Step(T p[3], T v[3], const K& k, const S s[3], double g, double h) {
   T a1[3], a2[3], a3[3], a4[3], vt[3];
   FlightAccel(v, k, s, g, a1);
   for (int i = 0; i < 3; ++i) vt[i] = v[i] + 0.5 * h * a1[i];
@@ -43,12 +52,13 @@ void FlightRk4Step(T p[3], T v[3], const T& k, const T s[3], double g, double h)
   }
 }
 
-// Propagates (p, v) by dt seconds (either sign).
-template <typename T>
-void PropagateFlight(T p[3], T v[3], const T& k, const T s[3], double g, double dt) {
+// Propagates (p, v) by dt seconds (either sign); returns the number of RK4 steps.
+template <typename T, typename K, typename S>
+int PropagateFlight(T p[3], T v[3], const K& k, const S s[3], double g, double dt) {
   const int n = std::max(1, static_cast<int>(std::ceil(std::abs(dt) / kMaxStepS)));
   const double h = dt / n;
   for (int i = 0; i < n; ++i) FlightRk4Step(p, v, k, s, g, h);
+  return n;
 }
 
 // The position `dt` seconds after (p0, v0): integrated with drag k and Magnus vector s, or, with

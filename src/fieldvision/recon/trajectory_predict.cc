@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -64,6 +65,8 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, FlightM
     if (fit.inlier[i]) used.push_back(static_cast<int>(i));
   }
   if (static_cast<int>(used.size()) < 4) return pr;
+  std::vector<double> used_times;
+  for (int i : used) used_times.push_back(samples[i].time_s);
   Eigen::MatrixXd J(3 * used.size(), np);
   Eigen::Matrix<double, 3, Eigen::Dynamic> JL(3, np);
   for (int p = 0; p < np; ++p) {
@@ -72,10 +75,8 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, FlightM
     a[p] += h;
     b[p] -= h;
     const BallisticModel ma = WithParams(m, a, c_m), mb = WithParams(m, b, c_m);
-    for (size_t k = 0; k < used.size(); ++k) {
-      const double t = samples[used[k]].time_s;
-      J.block<3, 1>(3 * k, p) = (ma.PositionAt(t) - mb.PositionAt(t)) / (2 * h);
-    }
+    const auto pa = ma.PositionsAt(used_times), pb = mb.PositionsAt(used_times);
+    for (size_t k = 0; k < used.size(); ++k) J.block<3, 1>(3 * k, p) = (pa[k] - pb[k]) / (2 * h);
     Eigen::Vector3d la, lb;
     if (!landing(ma, &la) || !landing(mb, &lb)) return pr;
     JL.col(p) = (la - lb) / (2 * h);

@@ -14,6 +14,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
+#include "fieldvision/util/parallel.h"
 
 namespace fv::recon {
 
@@ -239,9 +240,11 @@ TrajectoryJobResult RunTrajectory(const TrajectoryJob& job, std::ostream& log) {
   const TrajectoryResult& r = out.result;
   log << fmt::format("{}: {} samples, {:.2f} s; {}\n", job.in_path, track.size(),
                      track.empty() ? 0.0 : track.back().time_s - track.front().time_s, r.Summary());
-  for (const auto& f : r.flights) {
-    out.predictions.push_back(PredictFlightLanding(track, r, f, job.predict_fraction, out.options));
-  }
+  out.predictions.resize(r.flights.size());
+  util::ParallelFor(r.flights.size(), [&](size_t i) {
+    out.predictions[i] =
+        PredictFlightLanding(track, r, r.flights[i], job.predict_fraction, out.options);
+  });
   out.decisions = MakeDecisions(track, r, has_field ? &field : nullptr, out.options, job.decisions);
   const nlohmann::json flights = FlightsJson(out, job.predict_fraction);
   WriteTrajectoryOutputs(job, flights, has_field ? &field : nullptr, out);
