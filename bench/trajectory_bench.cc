@@ -2,15 +2,24 @@
 // to fit one pre-bounce flight with gravity only (the baseline), drag, and drag + spin (Magnus),
 // and, printed before the timings, the accuracy table of every model on every track (pre-bounce
 // residual, landing predicted from the first half against the measured bounce; trajectory_eval.h).
+// Long tracks (issue 18): the whole `trajectory` job (read BALL.csv, analyse, predict, write
+// FLIGHTS.json) on 20,000 rows of repeated kicks (the baseline) and on 2,000,000 rows, printed
+// as the time per row against the baseline's (1.0: linear).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
+#include <sstream>
 
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/recon/trajectory_run.h"
+#include "fieldvision/recon/trajectory_sim.h"
+#include "fieldvision/util/random.h"
 
 namespace {
 
@@ -63,6 +72,68 @@ BENCHMARK(BM_FitGravity)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitDrag)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitSpin)->Unit(benchmark::kMillisecond);
 
+// A BALL.csv of `rows` rows at 100 Hz: eight random kicks with bounces, rolling and rest
+// (5 mm noise, 1 % outliers), one after the other, each from where the one before stopped.
+std::string LongTrackFile(long long rows) {
+  static std::map<long long, std::string> files;
+  if (files.count(rows)) return files[rows];
+  std::vector<std::vector<fv::recon::BallSample>> kicks;
+  std::vector<Eigen::Vector3d> shifts;
+  fv::util::Rng rng(18);
+  for (int k = 0; k < 8; ++k) {
+    fv::recon::BallSimOptions o;
+    o.start_m = Eigen::Vector3d(0, 0, 0.11);
+    o.kicks = {
+        {0.3, Eigen::Vector3d(rng.Uniform(-12, 12), rng.Uniform(-8, 8), rng.Uniform(3, 10))}};
+    o.restitution = 0.6;
+    o.rolling_decel_mps2 = 3.0;
+    o.duration_s = 5.0;
+    const fv::recon::BallSimulation sim(o);
+    kicks.push_back(sim.Sample(100.0, 0.005, 0.0, 0.01, 0.5, rng));
+    shifts.push_back(sim.BallAt(o.duration_s) - o.start_m);
+  }
+  std::vector<fv::recon::BallSample> track;
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();
+  double t0 = 0.0;
+  for (long long k = 0; static_cast<long long>(track.size()) < rows; ++k) {
+    const auto& kick = kicks[k % kicks.size()];
+    for (fv::recon::BallSample s : kick) {
+      if (static_cast<long long>(track.size()) >= rows) break;
+      s.time_s += t0;
+      s.frame = static_cast<long long>(track.size());
+      s.ball_in_world += at;
+      track.push_back(s);
+    }
+    t0 = track.back().time_s + 0.01;
+    at += shifts[k % kicks.size()];
+    if (at.head<2>().norm() > 40) at = Eigen::Vector3d::Zero();  // stay near the field
+  }
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("fv_bench_track_" + std::to_string(rows) + ".csv"))
+          .string();
+  fv::recon::WriteBallTrack(path, track);
+  return files[rows] = path;
+}
+
+// The `trajectory` job on a long track; counters: rows, flights, microseconds per row.
+void BM_TrajectoryJob(benchmark::State& state) {
+  fv::recon::TrajectoryJob job;
+  job.in_path = LongTrackFile(state.range(0));
+  job.out_path = job.in_path + ".json";
+  size_t flights = 0;
+  for (auto _ : state) {
+    std::ostringstream log;
+    flights = fv::recon::RunTrajectory(job, log).result.flights.size();
+  }
+  state.counters["rows"] = static_cast<double>(state.range(0));
+  state.counters["flights"] = static_cast<double>(flights);
+  state.counters["us_per_row"] = benchmark::Counter(
+      static_cast<double>(state.range(0)) * 1e-6,
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_TrajectoryJob)->Arg(20000)->Iterations(3)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_TrajectoryJob)->Arg(2000000)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -80,7 +151,20 @@ int main(int argc, char** argv) {
     std::cout << fv::recon::Summarize(scores).Table() << "\n";
   }
   benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
+  struct Reporter : benchmark::ConsoleReporter {
+    std::map<std::string, double> s;  // real time per iteration, seconds
+    void ReportRuns(const std::vector<Run>& runs) override {
+      for (const auto& r : runs) s[r.benchmark_name()] = r.GetAdjustedRealTime();
+      ConsoleReporter::ReportRuns(runs);
+    }
+  } reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
+  const auto base = reporter.s.find("BM_TrajectoryJob/20000/iterations:3/real_time");
+  const auto big = reporter.s.find("BM_TrajectoryJob/2000000/iterations:1/real_time");
+  if (base != reporter.s.end() && big != reporter.s.end() && base->second > 0) {
+    printf("ratio trajectory 2,000,000 rows: %.1f s, %.2fx the time per row of 20,000 rows\n",
+           big->second, big->second / 2e6 / (base->second / 2e4));
+  }
   return 0;
 }

@@ -2,17 +2,15 @@
 // line/goal/basket calls, write FLIGHTS.json, pictures and a smoothed track (trajectory_run.h).
 #include <unistd.h>
 
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <memory>
-
-#include <fmt/format.h>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
 
 namespace fv::app {
 namespace {
@@ -21,6 +19,7 @@ struct TrajectoryCliOptions {
   recon::TrajectoryJob job;
   std::string drag = "auto";
   std::string spin = "auto";
+  bool progress = true;
 };
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -74,6 +73,8 @@ void Setup(CLI::App& app, int& exit_code) {
   c->add_option("--predict-fraction", j.predict_fraction,
                 "Part of each flight used to predict its landing (default 0.5)")
       ->check(CLI::Range(0.05, 1.0));
+  c->add_flag("!--no-progress", o->progress,
+              "Do not show progress (shown on a terminal only, while the arcs are fitted)");
   c->callback([o, rule, line, &exit_code] {
     for (const CLI::Option* opt : {rule, line}) {
       FV_REQUIRE(opt->count() == 0 || !o->job.field.empty(),
@@ -95,21 +96,20 @@ void Setup(CLI::App& app, int& exit_code) {
                                       {o->job.report_path, "--report"}}) {
         if (!out.empty()) io::ResolveOutputPath(out, what);
       }
-      // A progress line on a terminal while the arcs of a long track are fitted.
-      bool shown = false;
-      if (isatty(fileno(stderr))) {
-        auto last = std::chrono::steady_clock::now();
-        o->job.analysis.progress = [last, &shown](size_t done, size_t total) mutable {
-          const auto now = std::chrono::steady_clock::now();
-          if (now - last < std::chrono::milliseconds(500)) return;
-          last = now;
-          std::cerr << fmt::format("\rtrajectory: fitting arc {} of {} ", done + 1, total)
-                    << std::flush;
-          shown = true;
+      // Progress on a terminal while the arcs of a long track are fitted; logs stay quiet.
+      std::unique_ptr<util::Progress> bar;
+      if (o->progress && isatty(fileno(stderr))) {
+        o->job.analysis.progress = [&bar](size_t done, size_t total) {
+          if (!bar) {
+            bar = std::make_unique<util::Progress>("trajectory: fitting arcs",
+                                                   static_cast<long long>(total), "arcs");
+          }
+          bar->Update(static_cast<long long>(done));
         };
       }
       recon::RunTrajectory(o->job, std::cout);
-      if (shown) std::cerr << "\r\033[K" << std::flush;
+      o->job.analysis.progress = nullptr;
+      if (bar) bar->Finish();
     } else {
       recon::RunTrajectoryBatch(o->job, files, std::cout);
     }
