@@ -50,9 +50,14 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o) {
   cmd->add_flag("!--dnn-crops-only", o.whole_frame,
                 "With both: check colour candidates in crops only, no whole-frame search (about "
                 "12x faster; nothing completes colour)");
+  cmd->add_option("--dnn-keep-score", o.keep_score,
+                  "With both: a colour-accepted candidate the network does not confirm is kept "
+                  "from this colour score (1: never; colour scores stay below 1)")
+      ->check(FiniteRange(0.0, 1.0))
+      ->capture_default_str();
   cmd->add_flag("!--dnn-keep", o.demote_unconfirmed,
-                "With both: keep colour-accepted candidates the network does not confirm "
-                "(default: rejected)");
+                "With both: keep every colour-accepted candidate the network does not confirm "
+                "(default: those below --dnn-keep-score are rejected)");
 }
 
 }  // namespace fv::app

@@ -58,7 +58,10 @@ struct BallCandidate {
   double region_extent = 0.0;   // the convex outline's far reach, in radii
   bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
   bool small = false;           // found by the small-ball stage (small_ball.h)
-  std::string reason;           // why rejected ("" when accepted)
+  // The network's sports-ball score (dnn_ball.h; 0 where it found none or did not look, -1 when
+  // the detector has no network).
+  double network_score = -1.0;
+  std::string reason;  // why rejected ("" when accepted)
 };
 
 struct BallDetectorOptions {

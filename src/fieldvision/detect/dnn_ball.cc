@@ -44,6 +44,7 @@ void DnnBallOptions::Check() const {
   CheckInRange(accept_score, 0.0, 1.0, "dnn accept_score");
   CheckInRange(complete_score, 0.0, 1.0, "dnn complete_score");
   CheckInRange(confirm_score, 0.0, 1.0, "dnn confirm_score");
+  CheckInRange(keep_score, 0.0, 1.0, "dnn keep_score");
   CheckInRange(nms_iou, 0.0, 1.0, "dnn nms_iou");
   CheckInRange(crop_radii, 1.0, 20.0, "dnn crop_radii");
   FV_REQUIRE(min_crop_px >= 8, "dnn min_crop_px must be >= 8 (got {})", min_crop_px);
@@ -60,6 +61,7 @@ BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score) {
   c.radius_px = 0.25 * (box.box.width + box.box.height);
   c.sigma_px = std::max(0.1 * c.radius_px, 0.3);
   c.score = box.score;
+  c.network_score = box.score;
   c.accepted = box.score >= accept_score;
   c.reason = c.accepted ? "" : "network score below the accept score";
   return c;
@@ -95,11 +97,12 @@ std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate
   std::vector<Ranked> ranked;
   for (size_t i = 0; i < colour.size(); ++i) {
     BallCandidate c = colour[i];
+    c.network_score = confirm[i];
     if (confirm[i] >= o.confirm_score) {
       c.accepted = true;
       c.reason.clear();
       ranked.push_back({c, 0, confirm[i]});
-    } else if (c.accepted && !o.demote_unconfirmed) {
+    } else if (c.accepted && (!o.demote_unconfirmed || c.score >= o.keep_score)) {
       ranked.push_back({c, 1, c.score});
     } else {
       if (c.accepted) {

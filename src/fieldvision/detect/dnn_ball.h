@@ -49,6 +49,11 @@ struct DnnBallOptions {
   // within [1 / box_size_ratio, box_size_ratio] of its radius confirms it from this score.
   double confirm_score = 0.1;
   double box_size_ratio = 2.5;
+  // A colour-accepted candidate the network does not confirm is kept (ranked after the confirmed
+  // ones) when its colour score reaches keep_score, else rejected; demote_unconfirmed = false
+  // keeps every one. A clear disc of the ball's colour needs no network: the network confirms
+  // about half the MSL balls (printed, far) while no colour false detection there scores >= 0.57.
+  double keep_score = 0.6;
   bool demote_unconfirmed = true;
   // Throws fv::Error naming the bad field.
   void Check() const;
@@ -69,8 +74,9 @@ std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
 // The "both" stage, without the network (tested on its own): `colour` (best first) with each
 // one's network score `confirm` (crop or whole frame, 0 when not checked; same length), and the
 // whole-frame network balls `dnn` (candidates, best first). Returns the candidates best first:
-// confirmed ones (accepted, by network score), then colour-accepted unconfirmed ones (rejected with
-// demote_unconfirmed), then completing network balls from complete_score, then the rest.
+// confirmed ones (accepted, by network score), then colour-accepted unconfirmed ones (those below
+// keep_score rejected with demote_unconfirmed), then completing network balls from
+// complete_score, then the rest.
 std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate>& colour,
                                                  const std::vector<double>& confirm,
                                                  const std::vector<BallCandidate>& dnn,

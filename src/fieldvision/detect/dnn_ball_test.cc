@@ -42,6 +42,7 @@ TEST(CandidateFromBox, CentreAndMeanHalfSide) {
   EXPECT_DOUBLE_EQ(c.centre_px.y(), 26.0);
   EXPECT_DOUBLE_EQ(c.radius_px, 5.0);
   EXPECT_TRUE(c.accepted);
+  EXPECT_DOUBLE_EQ(c.network_score, 0.6);
   EXPECT_FALSE(CandidateFromBox({cv::Rect2d(10, 20, 8, 12), 0.4, 32}, 0.5).accepted);
 }
 
@@ -55,6 +56,7 @@ TEST(CombineBallCandidates, ConfirmsKeepsOrDemotesAndCompletes) {
     DnnBallOptions o;
     o.detector = "both";
     o.demote_unconfirmed = rng.Uniform() < 0.5;
+    o.keep_score = rng.Uniform(0.3, 1.0);
     std::vector<BallCandidate> colour;
     std::vector<double> confirm;
     const int n = rng.UniformInt(0, 6);
@@ -81,9 +83,11 @@ TEST(CombineBallCandidates, ConfirmsKeepsOrDemotesAndCompletes) {
       } else {
         const int i = static_cast<int>(std::lround((c.centre_px.x() - 50) / 100));
         const bool confirmed = confirm[i] >= o.confirm_score;
-        const bool kept = colour[i].accepted && !o.demote_unconfirmed;
+        const bool kept =
+            colour[i].accepted && (!o.demote_unconfirmed || colour[i].score >= o.keep_score);
         tier = confirmed ? 0 : (kept ? 1 : 3);
         EXPECT_EQ(c.accepted, confirmed || kept) << i;
+        EXPECT_EQ(c.network_score, confirm[i]) << i;
         EXPECT_EQ(c.reason.empty(), c.accepted) << i;
       }
       EXPECT_GE(tier, last_tier);
