@@ -23,7 +23,7 @@ void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, 
 // each arc's gravity fit).
 void MergeBounces(const std::vector<BallSample>& track, const TrajectoryOptions& options,
                   std::vector<Flight>* flights);
-// Outliers inside a flight's seen span belong to it (for the pictures).
+// Outliers inside a flight's seen span belong to it (for the pictures); the track in time order.
 void AttachOutliers(const std::vector<BallSample>& track, const std::vector<bool>& outlier,
                     Flight* f);
 
