@@ -101,8 +101,8 @@ void Setup(CLI::App& app, int& exit_code) {
       if (o->progress && isatty(fileno(stderr))) {
         o->job.analysis.progress = [&bar](size_t done, size_t total) {
           if (!bar) {
-            bar = std::make_unique<util::Progress>("trajectory: fitting arcs",
-                                                   static_cast<long long>(total), "arcs");
+            bar = std::make_unique<util::Progress>("trajectory", static_cast<long long>(total),
+                                                   "arcs");
           }
           bar->Update(static_cast<long long>(done));
         };
