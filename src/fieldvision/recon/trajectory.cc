@@ -698,51 +698,56 @@ struct Segmenter {
       for (int i = 0; i < n; ++i) {
         if (!out[i]) good.push_back(i);
       }
-      std::vector<bool> next(n, false);
+      std::vector<char> next(n, 0);  // written from several threads: not vector<bool>
       const int m = static_cast<int>(good.size());
-      for (int i = 0; i < n; ++i) {
-        // Neighbours among the currently good samples, excluding i itself: the windows walk
-        // `good` away from i (positions below lo_pos on the left, from hi_pos on the right).
-        const int lo_pos =
-            static_cast<int>(std::lower_bound(good.begin(), good.end(), i) - good.begin());
-        const int hi_pos =
-            static_cast<int>(std::upper_bound(good.begin(), good.end(), i) - good.begin());
-        const auto left = Window(good, track, lo_pos - 1, -1, 0, m, o.window_s, o.window_samples);
-        const auto right = Window(good, track, hi_pos, +1, 0, m, o.window_s, o.window_samples);
-        int fits = 0, misses = 0;
-        auto misses_line = [&](const GravityLine& L, int k) {
-          const double err = (L.At(track[k].time_s, g) - track[k].ball_in_world).norm();
-          const double sd = L.PredictionSd(track[k].time_s);
-          const double thr = std::max(
-              o.min_outlier_m, o.outlier_sigmas * sigma * std::sqrt(3.0) * std::sqrt(1 + sd * sd));
-          return err > thr;
-        };
-        std::optional<GravityLine> missed;  // the fit of the side that missed
-        bool missed_left = false;
-        for (const auto* w : {&left, &right}) {
-          if (static_cast<int>(w->size()) < o.window_samples) continue;
-          const double span_ok = std::abs(track[(*w)[w->size() / 2]].time_s - track[i].time_s);
-          if (span_ok > 3 * o.window_s) continue;
-          const GravityLine L = FitGravityLine(track, *w, g, track[i].time_s);
-          ++fits;
-          if (misses_line(L, i)) {
-            ++misses;
-            missed = L;
-            missed_left = w == &left;
+      // Each sample on its own (blocks of samples on all threads).
+      constexpr int kBlock = 4096;
+      util::ParallelFor((n + kBlock - 1) / kBlock, [&](size_t b) {
+        for (int i = static_cast<int>(b) * kBlock;
+             i < std::min(n, static_cast<int>(b + 1) * kBlock); ++i) {
+          // Neighbours among the currently good samples, excluding i itself: the windows walk
+          // `good` away from i (positions below lo_pos on the left, from hi_pos on the right).
+          const int lo_pos =
+              static_cast<int>(std::lower_bound(good.begin(), good.end(), i) - good.begin());
+          const int hi_pos =
+              static_cast<int>(std::upper_bound(good.begin(), good.end(), i) - good.begin());
+          const auto left = Window(good, track, lo_pos - 1, -1, 0, m, o.window_s, o.window_samples);
+          const auto right = Window(good, track, hi_pos, +1, 0, m, o.window_s, o.window_samples);
+          int fits = 0, misses = 0;
+          auto misses_line = [&](const GravityLine& L, int k) {
+            const double err = (L.At(track[k].time_s, g) - track[k].ball_in_world).norm();
+            const double sd = L.PredictionSd(track[k].time_s);
+            const double thr = std::max(o.min_outlier_m, o.outlier_sigmas * sigma * std::sqrt(3.0) *
+                                                             std::sqrt(1 + sd * sd));
+            return err > thr;
+          };
+          std::optional<GravityLine> missed;  // the fit of the side that missed
+          bool missed_left = false;
+          for (const auto* w : {&left, &right}) {
+            if (static_cast<int>(w->size()) < o.window_samples) continue;
+            const double span_ok = std::abs(track[(*w)[w->size() / 2]].time_s - track[i].time_s);
+            if (span_ok > 3 * o.window_s) continue;
+            const GravityLine L = FitGravityLine(track, *w, g, track[i].time_s);
+            ++fits;
+            if (misses_line(L, i)) {
+              ++misses;
+              missed = L;
+              missed_left = w == &left;
+            }
+          }
+          if (fits == 2) {
+            next[i] = misses == 2;
+          } else if (fits == 1 && misses == 1) {
+            // One side only (near a track end or a break): a jump there is either a glitch or the
+            // start of a new arc. An outlier only when the next sample on the other side returns
+            // to the arc (an isolated jump); without such a sample nothing says which.
+            const int other = missed_left ? (hi_pos < m ? good[hi_pos] : -1)
+                                          : (lo_pos > 0 ? good[lo_pos - 1] : -1);
+            next[i] = other >= 0 && !misses_line(*missed, other);
           }
         }
-        if (fits == 2) {
-          next[i] = misses == 2;
-        } else if (fits == 1 && misses == 1) {
-          // One side only (near a track end or a break): a jump there is either a glitch or the
-          // start of a new arc. An outlier only when the next sample on the other side returns
-          // to the arc (an isolated jump); without such a sample nothing says which.
-          const int other =
-              missed_left ? (hi_pos < m ? good[hi_pos] : -1) : (lo_pos > 0 ? good[lo_pos - 1] : -1);
-          next[i] = other >= 0 && !misses_line(*missed, other);
-        }
-      }
-      out = next;
+      });
+      out.assign(next.begin(), next.end());
     }
     return out;
   }
