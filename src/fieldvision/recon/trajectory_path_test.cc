@@ -88,5 +88,32 @@ TEST(FlightPath, FitWorkPerEvaluationFollowsTheSpan) {
   }
 }
 
+// A model walked through increasing times (BallisticModel::PositionsAt, Advance) is where one
+// integration from t0 per time puts it; a parabola exactly.
+TEST(FlightPath, ModelWalkMatchesPositionAt) {
+  BallisticModel m;
+  m.t0_s = 1.0;
+  m.p0_m = {1, 2, 3};
+  m.v0_mps = {12, -3, 6};
+  std::vector<double> times;
+  for (int i = 0; i <= 300; ++i) times.push_back(0.4 + 0.0037 * i);
+  for (const bool spin : {false, true}) {
+    SCOPED_TRACE(spin);
+    m.drag_per_m = spin ? 0.02 : 0.0;
+    m.magnus_per_rad = spin ? 0.006 : 0.0;
+    m.spin_radps = spin ? Eigen::Vector3d(20, -40, 60) : Eigen::Vector3d::Zero();
+    const auto walked = m.PositionsAt(times);
+    ASSERT_EQ(walked.size(), times.size());
+    for (size_t i = 0; i < times.size(); ++i) {
+      const Eigen::Vector3d p = m.PositionAt(times[i]);
+      if (spin) {
+        EXPECT_LT((walked[i] - p).norm(), 1e-9) << times[i];
+      } else {
+        EXPECT_EQ(walked[i], p) << times[i];
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace fv::recon
