@@ -16,9 +16,10 @@ void BallPredictor::Add(long long frame, const Eigen::Vector3d& point_world) {
 }
 
 std::optional<Eigen::Vector3d> BallPredictor::Predict(long long frame) const {
-  if (count_ == 0 || frame - frame_[0] > max_gap_ || frame < frame_[0]) return std::nullopt;
-  if (count_ < 2 || frame_[0] - frame_[1] > max_gap_ || frame_[0] <= frame_[1]) return point_[0];
+  if (count_ < 2 || frame - frame_[0] > max_gap_ || frame < frame_[0]) return std::nullopt;
+  if (frame_[0] - frame_[1] > max_gap_ || frame_[0] <= frame_[1]) return std::nullopt;
   const Eigen::Vector3d v = (point_[0] - point_[1]) / double(frame_[0] - frame_[1]);
+  if (v.norm() > max_step_m_) return std::nullopt;
   return point_[0] + v * double(frame - frame_[0]);
 }
 

@@ -32,16 +32,21 @@ BallFrame FuseFrame(const std::vector<camera::Camera>& cameras, const SyncedFram
 // The trajectory sample of a frame with a position (its point, cameras and error).
 recon::BallSample BallSampleOf(const BallFrame& frame);
 
-// The ball's expected position from the last positions (constant velocity over the last two,
-// when they are at most max_gap frames apart and the newest is at most max_gap frames old).
+// The ball's expected position from the last two positions (constant velocity), only while they
+// form a track: at most max_gap frames apart, the newest at most max_gap frames old, and at most
+// max_step_m apart per frame (independent placements, as in a static scene or a jump to
+// another object, are no track). The prior gates the next frame's hypotheses (recon::
+// TriangulationOptions::gate_by_prior).
 class BallPredictor {
  public:
-  explicit BallPredictor(int max_gap = 5) : max_gap_(max_gap) {}
+  explicit BallPredictor(int max_gap = 5, double max_step_m = 1.5)
+      : max_gap_(max_gap), max_step_m_(max_step_m) {}
   void Add(long long frame, const Eigen::Vector3d& point_world);
   std::optional<Eigen::Vector3d> Predict(long long frame) const;
 
  private:
   int max_gap_;
+  double max_step_m_;
   int count_ = 0;
   long long frame_[2] = {0, 0};  // [0] newest
   Eigen::Vector3d point_[2];

@@ -95,6 +95,13 @@ struct TriangulationOptions {
   // such set): a static ball-like object (a cone) seen by every camera is consistent too.
   int min_views_all_weak = 3;
   double prior_gate_m = 1.0;
+  // With a prior, a two-view hypothesis farther than prior_gate_m from it is no ball (it cannot
+  // have jumped there): a static ball-like object elsewhere that more cameras agree on never
+  // takes a tracked ball's place (pipeline/fusion_stage.h's predictor forgets a track after a
+  // few frames without a position, so a ball lost longer is searched everywhere again). false:
+  // the prior only admits sets of weak views. Gating a track's measurements by its prediction,
+  // as in Bar-Shalom & Fortmann, "Tracking and Data Association" (1988).
+  bool gate_by_prior = true;
 
   void Check() const;  // throws fv::Error naming the bad field
 };

@@ -124,6 +124,10 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
               ClosestPointOfRays(*ranked.rays[ca][ka], *ranked.rays[cb][kb], o.min_angle_deg);
           if (!rp.ok()) continue;
           if (NoBallThere(rp.midpoint, o)) continue;
+          if (o.gate_by_prior && prior != nullptr &&
+              (rp.midpoint - *prior).norm() > o.prior_gate_m) {
+            continue;  // the ball cannot be there (far from where it is expected)
+          }
           ++best.hypotheses;
           const double cost = GatherConsistent(cameras, candidates, ranked, o, rp.midpoint, &pick);
           if (pick[ca] != ka || pick[cb] != kb) continue;  // the pair itself must agree
@@ -281,7 +285,7 @@ TriangulationResult TriangulateRobust(const std::vector<camera::Camera>& cameras
   for (const auto& list : candidates) {
     for (const BallObservation& obs : list) any_weak = any_weak || obs.weak;
   }
-  if (!any_weak) return RobustCore(cameras, candidates, o, false, nullptr);
+  if (!any_weak) return RobustCore(cameras, candidates, o, false, prior);
   // The candidates that are not weak first, alone: a weak one never moves what they give.
   std::vector<std::vector<BallObservation>> strong(candidates.size());
   std::vector<std::vector<int>> index(candidates.size());
@@ -292,7 +296,7 @@ TriangulationResult TriangulateRobust(const std::vector<camera::Camera>& cameras
       index[c].push_back(static_cast<int>(k));
     }
   }
-  TriangulationResult result = RobustCore(cameras, strong, o, false, nullptr);
+  TriangulationResult result = RobustCore(cameras, strong, o, false, prior);
   for (ViewResidual& v : result.views) {
     if (v.candidate >= 0) v.candidate = index[v.camera][v.candidate];
   }

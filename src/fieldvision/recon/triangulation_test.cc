@@ -381,5 +381,48 @@ TEST(Triangulation, WeakCandidatesOnlyCompleteOrConfirm) {
   }
 }
 
+// A static ball-like object that three cameras agree on takes the place of a ball two cameras
+// see, unless a prior (the tracked ball's predicted position) says where the ball can be: then
+// only hypotheses near it count, and with a prior far from both there is no position.
+TEST(Triangulation, APriorGatesTheHypotheses) {
+  testing::SeededRng rng(23);
+  const auto cams = CornerCameras(&rng);
+  TriangulationOptions opt;
+  opt.ball_radius_m = 0.11;
+  int trials = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d ball = RandomBall(rng);
+    const Eigen::Vector3d thing(rng.Uniform(-8, 8), rng.Uniform(-5, 5), rng.Uniform(0.3, 2.0));
+    if ((ball - thing).norm() < 3.0) continue;
+    ++trials;
+    auto seen = [&](int c, const Eigen::Vector3d& p) {
+      BallObservation o = Observe(cams[c], p, 0.0, 0.3, &rng);
+      o.sigma_px = 0.3;
+      o.score = 0.6;
+      return o;
+    };
+    std::vector<std::vector<BallObservation>> cand(4);
+    for (int c = 0; c < 3; ++c) cand[c].push_back(seen(c, thing));
+    cand[2].push_back(seen(2, ball));
+    cand[3].push_back(seen(3, ball));
+    auto r = TriangulateRobust(cams, cand, opt);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_LT((r.point_world - thing).norm(), 0.05);  // more cameras win without a prior
+    const Eigen::Vector3d expected = ball + Eigen::Vector3d(0.4, -0.3, 0.1);
+    r = TriangulateRobust(cams, cand, opt, &expected);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_LT((r.point_world - ball).norm(), 0.05);
+    EXPECT_EQ(r.num_views(), 2);
+    const Eigen::Vector3d far(50, 50, 1);
+    EXPECT_FALSE(TriangulateRobust(cams, cand, opt, &far).ok());
+    opt.gate_by_prior = false;  // the prior then only admits weak sets
+    r = TriangulateRobust(cams, cand, opt, &expected);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_LT((r.point_world - thing).norm(), 0.05);
+    opt.gate_by_prior = true;
+  }
+  EXPECT_GT(trials, 5);
+}
+
 }  // namespace
 }  // namespace fv::recon
