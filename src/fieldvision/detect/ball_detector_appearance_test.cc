@@ -11,6 +11,7 @@
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/synth/synth.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::detect {
@@ -21,10 +22,7 @@ struct Score {
   std::vector<double> err_px;
   double Share() const { return expected > 0 ? static_cast<double>(accepted) / expected : 0.0; }
   double MedianErr() const {
-    if (err_px.empty()) return 1e9;
-    std::vector<double> e = err_px;
-    std::nth_element(e.begin(), e.begin() + e.size() / 2, e.end());
-    return e[e.size() / 2];
+    return err_px.empty() ? 1e9 : util::NearestRankPercentile(err_px, 0.5);
   }
 };
 

@@ -8,15 +8,15 @@
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/synth/synth.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::detect {
 namespace {
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 1e9;
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
+// The median, and a failing value when nothing was measured.
+double Median(const std::vector<double>& v) {
+  return v.empty() ? 1e9 : util::NearestRankPercentile(v, 0.5);
 }
 
 const BallCandidate* BestAccepted(const std::vector<BallCandidate>& c) {

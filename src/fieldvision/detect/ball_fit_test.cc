@@ -6,14 +6,15 @@
 
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::detect {
 namespace {
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 1e9 : v[v.size() / 2];
+// The median, and a failing value when nothing was measured.
+double Median(const std::vector<double>& v) {
+  return v.empty() ? 1e9 : util::NearestRankPercentile(v, 0.5);
 }
 
 TEST(FitCircle, IgnoresOutliers) {
