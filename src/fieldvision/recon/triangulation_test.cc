@@ -328,14 +328,12 @@ TEST(Triangulation, WeakCandidatesOnlyCompleteOrConfirm) {
     if ((ball - cone).norm() < 2.0) continue;
     auto weak = [&](int c, const Eigen::Vector3d& p) {
       BallObservation o = Observe(cams[c], p, 0.0, 0.3, &rng);
-      o.sigma_px = 0.3;
       o.weak = true;
       o.score = 0.9;  // higher than the accepted ones: the score must not decide
       return o;
     };
     auto strong = [&](int c) {
       BallObservation o = Observe(cams[c], ball, 0.0, 0.3, &rng);
-      o.sigma_px = 0.3;
       o.score = 0.5;
       return o;
     };
@@ -397,7 +395,6 @@ TEST(Triangulation, APriorGatesTheHypotheses) {
     ++trials;
     auto seen = [&](int c, const Eigen::Vector3d& p) {
       BallObservation o = Observe(cams[c], p, 0.0, 0.3, &rng);
-      o.sigma_px = 0.3;
       o.score = 0.6;
       return o;
     };
