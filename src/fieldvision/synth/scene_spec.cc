@@ -243,6 +243,11 @@ std::vector<CameraSpec> CornerRig(const field::FieldModel& f, double height_m, i
   return cams;
 }
 
+// Random draws in the presets are one per statement: the arguments of one call are evaluated in
+// an unspecified order (GCC right to left, clang left to right), so a call with two draws gave
+// each compiler another scene for the same seed. They are sequenced in GCC's order, which keeps
+// the scenes written so far.
+
 // The presets' start: the MSL field seen by the 4-camera corner rig (1280x960, 75 deg, 4 m up).
 SceneSpec MslCornerScene(uint64_t seed, double fps, int num_frames) {
   SceneSpec s;
@@ -260,8 +265,9 @@ SceneSpec StaticPreset(uint64_t seed) {
   util::Rng rng(seed * 7919 + 17);
   const double r = s.ball.radius_m();
   for (int i = 0; i < s.num_frames; ++i) {
-    Eigen::Vector3d p(rng.Uniform(-0.42, 0.42) * f.length_m, rng.Uniform(-0.42, 0.42) * f.width_m,
-                      r);
+    const double y = rng.Uniform(-0.42, 0.42) * f.width_m;  // sequenced: see MslCornerScene
+    const double x = rng.Uniform(-0.42, 0.42) * f.length_m;
+    Eigen::Vector3d p(x, y, r);
     if (i % 3 != 0) p.z() = rng.Uniform(r, 3.0);
     s.ball.placements.push_back(p);
   }
@@ -275,9 +281,12 @@ SceneSpec KickPreset(uint64_t seed) {
   const double r = s.ball.radius_m();
   KickSpec k;
   k.time_s = 0.25;
-  k.position_m = Eigen::Vector3d(-5.5 + rng.Uniform(-0.5, 0.5), -2.0 + rng.Uniform(-0.5, 0.5), r);
-  k.velocity_mps = Eigen::Vector3d(5.5 + rng.Uniform(-0.5, 0.5), 2.0 + rng.Uniform(-0.5, 0.5),
-                                   7.0 + rng.Uniform(-0.4, 0.4));
+  k.position_m.y() = -2.0 + rng.Uniform(-0.5, 0.5);  // sequenced: see MslCornerScene
+  k.position_m.x() = -5.5 + rng.Uniform(-0.5, 0.5);
+  k.position_m.z() = r;
+  k.velocity_mps.z() = 7.0 + rng.Uniform(-0.4, 0.4);
+  k.velocity_mps.y() = 2.0 + rng.Uniform(-0.5, 0.5);
+  k.velocity_mps.x() = 5.5 + rng.Uniform(-0.5, 0.5);
   s.ball.kicks.push_back(k);
   s.exposure_s = 1.0 / 250.0;
   // A robot just in front of the ball's start as seen from cam1 (hides it before the kick), one
@@ -295,7 +304,8 @@ SceneSpec KickPreset(uint64_t seed) {
   r3.colour_bgr = Eigen::Vector3d(25, 25, 30);
   s.robots = {r1, r2, r3};
   ConeSpec cone;
-  cone.position_m = Eigen::Vector2d(1.0 + rng.Uniform(-1, 1), -3.5 + rng.Uniform(-0.5, 0.5));
+  cone.position_m.y() = -3.5 + rng.Uniform(-0.5, 0.5);  // sequenced: see MslCornerScene
+  cone.position_m.x() = 1.0 + rng.Uniform(-1, 1);
   s.cones = {cone};
   s.lighting.gain_amplitude = 0.08;
   s.lighting.period_s = 6.0;
@@ -330,8 +340,8 @@ SceneSpec PlayersPreset(uint64_t seed) {
     p.skin_bgr = Eigen::Vector3d(110 + 60 * tone, 140 + 50 * tone, 175 + 60 * tone);
     // Paths cross the field: each starts on one side and goes to the other, with random turns.
     const double side = (i % 2 == 0) ? -1.0 : 1.0;
-    p.path.waypoints_m.push_back(
-        Eigen::Vector2d(side * rng.Uniform(0.3, 1.0) * hx, rng.Uniform(-hy, hy)));
+    const double y0 = rng.Uniform(-hy, hy);  // sequenced: see MslCornerScene
+    p.path.waypoints_m.push_back(Eigen::Vector2d(side * rng.Uniform(0.3, 1.0) * hx, y0));
     const int n = 3 + rng.UniformInt(0, 2);
     for (int k = 0; k < n; ++k) {
       const double x = (k % 2 == 0 ? -side : side) * rng.Uniform(0.2, 1.0) * hx;
@@ -404,8 +414,10 @@ SceneSpec FisheyePreset(uint64_t seed) {
   s.ball.placements.clear();
   for (int tries = 0; tries < 200000 && static_cast<int>(s.ball.placements.size()) < s.num_frames;
        ++tries) {
-    const Eigen::Vector3d p(rng.Uniform(-0.5, 0.5) * f.length_m, rng.Uniform(-0.5, 0.5) * f.width_m,
-                            rng.Uniform() < 0.5 ? r : rng.Uniform(r, 2.0));
+    // Sequenced: see MslCornerScene.
+    const double z = rng.Uniform() < 0.5 ? r : rng.Uniform(r, 2.0);
+    const double y = rng.Uniform(-0.5, 0.5) * f.width_m;
+    const Eigen::Vector3d p(rng.Uniform(-0.5, 0.5) * f.length_m, y, z);
     const auto uv = cam1.Project(p);
     if (!uv) continue;
     const double border =
@@ -431,7 +443,8 @@ SceneSpec HeldPreset(uint64_t seed) {
   RobotSpec r1;
   r1.handler = true;
   r1.heading_deg = rng.Uniform(0.0, 360.0);
-  r1.path.waypoints_m = {Eigen::Vector2d(rng.Uniform(-4, 4), rng.Uniform(-3, 3))};
+  const double y1 = rng.Uniform(-3, 3);  // sequenced: see MslCornerScene
+  r1.path.waypoints_m = {Eigen::Vector2d(rng.Uniform(-4, 4), y1)};
   r1.path.waypoints_m.push_back(r1.path.waypoints_m[0] + Eigen::Vector2d(1.5, 1.0));
   r1.path.speed_mps = 1.0;
   RobotSpec r2;
