@@ -1,6 +1,7 @@
 #include "fieldvision/detect/ball_fit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 
@@ -31,6 +32,11 @@ inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
     (*out)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
   }
   return true;
+}
+
+// The domain of Sample.
+inline bool InsideForSampling(const cv::Mat& img, const Vector2d& p) {
+  return p.x() >= 0 && p.y() >= 0 && p.x() <= img.cols - 1 && p.y() <= img.rows - 1;
 }
 
 inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, double x, double y) {
@@ -93,6 +99,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;
   e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), 24, 180);
   std::vector<Vector3d> prof;
+  std::vector<char> have;
   std::vector<double> grad;
   for (int k = 0; k < e.rays; ++k) {
     const double th = 2 * M_PI * (k + 0.5) / e.rays;
@@ -104,20 +111,26 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     const double t0 = std::min(0.35 * r, std::max(t_lo - kSide - kStep, 0.0));
     const double t_end = r + std::max(half, 0.6 * r) + 2.0;
     const int m = static_cast<int>((t_end - t0) / kStep) + 1;
+    // The profile lies inside the image when both its ends do; it is sampled where it is read.
+    const Vector2d p_first = c + t0 * u, p_last = c + (t0 + (m - 1) * kStep) * u;
+    if (!InsideForSampling(img, p_first) || !InsideForSampling(img, p_last)) continue;
     prof.resize(m);
-    bool inside_image = true;
-    for (int i = 0; i < m && inside_image; ++i) {
-      const Vector2d p = c + (t0 + i * kStep) * u;
-      inside_image = Sample(img, p.x(), p.y(), &prof[i]);
-    }
-    if (!inside_image) continue;
+    have.assign(m, 0);
+    const auto at = [&](int i) -> const Vector3d& {
+      if (!have[i]) {
+        const Vector2d p = c + (t0 + i * kStep) * u;
+        Sample(img, p.x(), p.y(), &prof[i]);
+        have[i] = 1;
+      }
+      return prof[i];
+    };
     // Gradient magnitude (central differences over 0.5 px) in the search window.
     grad.assign(m, 0.0);
     double g_max = 0;
     for (int i = 1; i + 1 < m; ++i) {
       const double t = t0 + i * kStep;
       if (t < t_lo || t > t_hi) continue;
-      grad[i] = (prof[i + 1] - prof[i - 1]).norm();
+      grad[i] = (at(i + 1) - at(i - 1)).norm();
       g_max = std::max(g_max, grad[i]);
     }
     if (g_max < 0.1 * o.min_contrast) continue;
@@ -132,21 +145,21 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     if (peak < 0) continue;
     int ia = std::max(0, peak - static_cast<int>(kSide / kStep));
     int ib = std::min(m - 1, peak + static_cast<int>(kSide / kStep));
-    Vector3d a = 0.5 * (prof[ia] + prof[std::max(ia - 1, 0)]);
-    Vector3d b = 0.5 * (prof[ib] + prof[std::min(ib + 1, m - 1)]);
+    Vector3d a = 0.5 * (at(ia) + at(std::max(ia - 1, 0)));
+    Vector3d b = 0.5 * (at(ib) + at(std::min(ib + 1, m - 1)));
     // A wide ramp (motion blur along this ray): the colours 3 px from the peak differ much more
     // than those 1.5 px from it, so both local colours lie on the ramp; use the ray's ends
     // instead (the halfway crossing of a swept disc is still its outline).
     const int ka = std::max(0, peak - static_cast<int>(2 * kSide / kStep));
     const int kb = std::min(m - 1, peak + static_cast<int>(2 * kSide / kStep));
     bool ramp = false;
-    if ((prof[kb] - prof[ka]).squaredNorm() > 1.6 * 1.6 * (b - a).squaredNorm() &&
+    if ((at(kb) - at(ka)).squaredNorm() > 1.6 * 1.6 * (b - a).squaredNorm() &&
         IsBall(img, table, bit, c.x() + t0 * u.x(), c.y() + t0 * u.y())) {
       ramp = true;
       ia = 0;
       ib = m - 1;
-      a = prof[0];
-      b = prof[m - 1];
+      a = at(0);
+      b = at(m - 1);
     }
     const Vector3d ab = b - a;
     const double contrast2 = ab.squaredNorm();
@@ -157,10 +170,10 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
       ++e.outside_ball;
       continue;
     }
-    double prev_p = (prof[ia] - a).dot(ab) / contrast2;
+    double prev_p = (at(ia) - a).dot(ab) / contrast2;
     double t10 = -1, t90 = -1, te = -1;
     for (int i = ia + 1; i <= ib; ++i) {
-      const double q = (prof[i] - a).dot(ab) / contrast2;
+      const double q = (at(i) - a).dot(ab) / contrast2;
       auto cross = [&](double level) {
         return t0 + (i - 1 + (level - prev_p) / (q - prev_p)) * kStep;
       };
@@ -256,6 +269,7 @@ double EllipsePolarRadius(const cv::RotatedRect& e, double direction) {
 // The image outline of the cone (axis, half-angle) as a polar function around the projection
 // of the axis: the search reference for outline points of a sphere seen in perspective.
 struct ConeOutline {
+  static constexpr int kSamples = 720;
   bool ok = false;
   Vector2d centre = Vector2d::Zero();
   double mean_radius = 0.0;
@@ -266,11 +280,21 @@ struct ConeOutline {
     if (!c) return;
     centre = *c;
     const Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+    // cos and sin of the 720 directions around the axis, computed once.
+    static const std::array<std::pair<double, double>, kSamples> kCosSin = [] {
+      std::array<std::pair<double, double>, kSamples> cs;
+      for (int k = 0; k < kSamples; ++k) {
+        const double phi = 2 * M_PI * k / kSamples;
+        cs[k] = {std::cos(phi), std::sin(phi)};
+      }
+      return cs;
+    }();
+    const Vector3d along = std::cos(alpha) * axis;
+    const double sin_alpha = std::sin(alpha);
     std::vector<std::pair<double, double>> polar;
-    for (int k = 0; k < 720; ++k) {
-      const double phi = 2 * M_PI * k / 720;
-      const Vector3d v =
-          std::cos(alpha) * axis + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
+    polar.reserve(kSamples);
+    for (int k = 0; k < kSamples; ++k) {
+      const Vector3d v = along + sin_alpha * (kCosSin[k].first * e1 + kCosSin[k].second * e2);
       const auto p = cam.ProjectFromCamera(v);
       if (!p) return;
       const Vector2d d = *p - centre;

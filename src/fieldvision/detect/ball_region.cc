@@ -21,18 +21,29 @@ cv::Rect Grow(const cv::Rect& r, int g) {
   return {r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g};
 }
 
-// Ball-class pixels of `window` (CV_8U, 255 = ball).
-cv::Mat ClassMask(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
-                  const cv::Rect& window) {
-  cv::Mat mask(window.size(), CV_8U);
+// Ball-class pixels of `window` (CV_8U, 255 = ball) in `raw`, and in `grow` those of
+// `grow_table` (the same matrix as `raw` when there is none), in one pass over the pixels.
+void ClassMasks(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
+                const ColourTable* grow_table, const cv::Rect& window, cv::Mat* raw,
+                cv::Mat* grow) {
+  raw->create(window.size(), CV_8U);
+  if (grow_table == nullptr) {
+    *grow = *raw;
+  } else {
+    grow->create(window.size(), CV_8U);
+  }
+  const uint8_t grow_bit = grow_table == nullptr ? 0 : grow_table->BallBit();
   for (int y = 0; y < window.height; ++y) {
     const uint8_t* p = bgr.ptr<uint8_t>(window.y + y) + 3 * static_cast<ptrdiff_t>(window.x);
-    uint8_t* m = mask.ptr<uint8_t>(y);
+    uint8_t* m = raw->ptr<uint8_t>(y);
+    uint8_t* g = grow->ptr<uint8_t>(y);
     for (int x = 0; x < window.width; ++x, p += 3) {
       m[x] = (table.Classify(p[0], p[1], p[2]) & bit) != 0 ? 255 : 0;
+      if (grow_table != nullptr) {
+        g[x] = (grow_table->Classify(p[0], p[1], p[2]) & grow_bit) != 0 ? 255 : 0;
+      }
     }
   }
-  return mask;
 }
 
 // The components of `labels` near the seed, gathered twice (fragments of a printed ball).
@@ -450,9 +461,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     out.failure = "seed outside the searched region";
     return out;
   }
-  const cv::Mat raw = ClassMask(bgr, table, ball_bit, window);
-  const cv::Mat grow =
-      grow_table == nullptr ? raw : ClassMask(bgr, *grow_table, grow_table->BallBit(), window);
+  cv::Mat raw, grow;
+  ClassMasks(bgr, table, ball_bit, grow_table, window, &raw, &grow);
   cv::Mat lab;
   cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
   const cv::Mat region = GrowAndCloseRegion(raw, grow, lab, seed, o);
