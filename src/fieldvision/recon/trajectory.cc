@@ -34,23 +34,6 @@ void StepModel(const BallisticModel& m, Eigen::Vector3d* p, Eigen::Vector3d* v, 
   *v = {va[0], va[1], va[2]};
 }
 
-// Residual of one sample against the model with parameters p0 (3), v0 (3), k (1) and the Magnus
-// vector s (3) at t0.
-struct SampleResidual {
-  SampleResidual(const Eigen::Vector3d& x, double dt, double g, bool integrate)
-      : x_(x), dt_(dt), g_(g), integrate_(integrate) {}
-  template <typename T>
-  bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
-    T p[3];
-    FlightPositionAt(p0, v0, k[0], sm, g_, dt_, integrate_, p);
-    for (int i = 0; i < 3; ++i) r[i] = p[i] - x_[i];
-    return true;
-  }
-  Eigen::Vector3d x_;
-  double dt_, g_;
-  bool integrate_;
-};
-
 // Least-squares line per axis through gravity-corrected positions q = p + (0, 0, g t^2 / 2)
 // (relative to t_ref): q(t) = a + b (t - t_ref). A ballistic arc without drag is a line in q.
 struct GravityLine {
@@ -394,6 +377,20 @@ void ScoreFit(const std::vector<BallSample>& samples, double t_ref,
       nobs * std::log(std::max(fit.capped_sse_m2, 1e-18) / nobs) + fit.parameters * std::log(nobs);
 }
 
+// d cost / d k of the samples' robust cost (FlightResiduals) at these parameters.
+double CostSlopeInDrag(FlightPath* path, const std::vector<double>& dt_s,
+                       const std::vector<Eigen::Vector3d>& x_m, double g, double huber,
+                       const double* p0, const double* v0, const double* k, const double* sm) {
+  const FlightResiduals cost(path, dt_s, x_m, g, huber);
+  std::vector<double> r(cost.num_residuals()), dr_dk(cost.num_residuals());
+  const double* params[4] = {p0, v0, k, sm};
+  double* jacobians[4] = {nullptr, nullptr, dr_dk.data(), nullptr};
+  cost.Evaluate(params, r.data(), jacobians);
+  double slope = 0.0;
+  for (size_t i = 0; i < r.size(); ++i) slope += r[i] * dr_dk[i];
+  return slope;
+}
+
 }  // namespace
 
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel kind,
@@ -408,7 +405,8 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
   const double t_ref = samples[n / 2].time_s;
   const double c_m = options.MagnusPerRad();
   double p0[3], v0[3];
-  double k[1] = {kind != FlightModel::kGravity ? 0.01 : 0.0};
+  constexpr double kDragStartPerM = 0.01;  // a cold drag stage's first k
+  double k[1] = {kind != FlightModel::kGravity ? kDragStartPerM : 0.0};
   double sm[3] = {0, 0, 0};
   bool warm = false;
   if (start != nullptr) {
@@ -417,6 +415,8 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
     for (int i = 0; i < 3; ++i) p0[i] = p[i], v0[i] = v[i];
     if (kind != FlightModel::kGravity)
       k[0] = std::clamp(start->drag_per_m, 0.0, options.max_drag_per_m);
+    // A drag fit from a parabola starts where a cold one's drag stage does.
+    if (kind == FlightModel::kDrag && start->Parabola()) k[0] = kDragStartPerM;
     if (kind == FlightModel::kSpin) {
       const Eigen::Vector3d s0 = MagnusVector(*start);
       for (int i = 0; i < 3; ++i) sm[i] = s0[i];
@@ -433,19 +433,16 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
   std::vector<double> dt_s(n);
   for (int i = 0; i < n; ++i) dt_s[i] = samples[i].time_s - t_ref;
   FlightPath path(dt_s, g);
-  auto solve = [&](FlightModel m) {
+  std::vector<Eigen::Vector3d> x_m(n);
+  for (int i = 0; i < n; ++i) x_m[i] = samples[i].ball_in_world;
+  // hold_k: k stays where it is (0: the drag model's lower bound).
+  auto solve = [&](FlightModel m, bool hold_k = false) {
     ceres::Problem problem;
-    for (int i = 0; i < n; ++i) {
-      const BallSample& s = samples[i];
-      ceres::CostFunction* cost =
-          m == FlightModel::kGravity
-              ? static_cast<ceres::CostFunction*>(
-                    new ceres::AutoDiffCostFunction<SampleResidual, 3, 3, 3, 1, 3>(
-                        new SampleResidual(s.ball_in_world, dt_s[i], g, false)))
-              : new FlightPathResidual(&path, i, s.ball_in_world);
-      problem.AddResidualBlock(cost, new ceres::HuberLoss(huber), p0, v0, k, sm);
-    }
-    if (m != FlightModel::kGravity) {
+    // Every sample under its own Huber loss (one block for all: FlightResiduals).
+    problem.AddResidualBlock(
+        new FlightResiduals(m == FlightModel::kGravity ? nullptr : &path, dt_s, x_m, g, huber),
+        nullptr, p0, v0, k, sm);
+    if (m != FlightModel::kGravity && !hold_k) {
       problem.SetParameterLowerBound(k, 0, 0.0);
       problem.SetParameterUpperBound(k, 0, options.max_drag_per_m);
     } else {
@@ -473,13 +470,35 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
     fit.iterations += static_cast<int>(summary.iterations.size());
     return summary.IsSolutionUsable();
   };
-  // Cold starts go up the hierarchy (gravity, drag, spin), each from the one before.
+  // Cold starts go up the hierarchy (gravity, drag, spin), each from the one before. Where the
+  // cost does not fall as k leaves its lower bound 0 at the optimum for k = 0 (d cost / d k >= 0,
+  // Karush-Kuhn-Tucker), that optimum is the bounded problem's: k = 0 is kept, the drag stage from
+  // a parabola's optimum needs no solve and the spin stage from k = 0 is solved with k held (the
+  // bounded solve creeps along the bound: most of the iterations of drag-free flights).
+  auto no_drag_is_optimal = [&] {
+    const double k_was = k[0];
+    k[0] = 0.0;
+    if (CostSlopeInDrag(&path, dt_s, x_m, g, huber, p0, v0, k, sm) >= 0.0) return true;
+    k[0] = k_was;
+    return false;
+  };
   bool ok = true;
   if (!warm || kind == FlightModel::kGravity) ok = solve(FlightModel::kGravity);
   if (ok && kind != FlightModel::kGravity && !(warm && kind == FlightModel::kSpin)) {
-    ok = solve(FlightModel::kDrag);
+    // From a parabola: its optimum for these samples first (at once from their gravity fit).
+    const bool parabola = !warm || start->Parabola();
+    if (warm && parabola) ok = solve(FlightModel::kGravity);
+    if (ok && !(parabola && no_drag_is_optimal())) ok = solve(FlightModel::kDrag);
   }
-  if (ok && kind == FlightModel::kSpin) ok = solve(FlightModel::kSpin);
+  if (ok && kind == FlightModel::kSpin) {
+    const double p0_was[3] = {p0[0], p0[1], p0[2]}, v0_was[3] = {v0[0], v0[1], v0[2]},
+                 sm_was[3] = {sm[0], sm[1], sm[2]};
+    const bool held = k[0] == 0.0 && solve(FlightModel::kSpin, true) && no_drag_is_optimal();
+    if (!held) {
+      for (int i = 0; i < 3; ++i) p0[i] = p0_was[i], v0[i] = v0_was[i], sm[i] = sm_was[i];
+      ok = solve(FlightModel::kSpin);
+    }
+  }
   fit.model.t0_s = t_ref;
   fit.model.p0_m = Eigen::Vector3d(p0[0], p0[1], p0[2]);
   fit.model.v0_mps = Eigen::Vector3d(v0[0], v0[1], v0[2]);
@@ -1056,7 +1075,11 @@ bool ChooseModel(const std::vector<BallSample>& s, int piece_samples,
   const double span = f->t_last_seen_s - f->t_first_seen_s;
   const bool try_drag = options.drag == DragMode::kOn ||
                         (options.drag == DragMode::kAuto && piece_samples >= 8 && span >= 0.15);
-  if (try_drag) f->with_drag = FitBallistic(s, true, options, noise_m);
+  // From the gravity fit of these samples: the cold fit's first stage (the same result).
+  if (try_drag) {
+    f->with_drag = FitBallistic(s, FlightModel::kDrag, options, noise_m,
+                                f->no_drag.ok ? &f->no_drag.model : nullptr);
+  }
   f->drag_used = f->with_drag.ok &&
                  (options.drag == DragMode::kOn || f->with_drag.rmse_m < 0.9 * f->no_drag.rmse_m);
   const bool try_spin =

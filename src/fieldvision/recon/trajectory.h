@@ -251,7 +251,8 @@ double EstimateTrackNoise(const std::vector<BallSample>& track, double gravity_m
 // 3 sigma; samples farther than max(outlier_sigmas sigma, min_outlier_m) are outliers.
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, bool fit_drag,
                           const TrajectoryOptions& options, double noise_m);
-// The same for any model; kSpin starts from `start` when given (e.g. the drag fit).
+// The same for any model, started from `start` when given: kSpin from the drag fit, say, and kDrag
+// from the gravity fit of the same samples (what a cold kDrag fit computes first: the same result).
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel kind,
                           const TrajectoryOptions& options, double noise_m,
                           const BallisticModel* start = nullptr);

@@ -2,13 +2,13 @@
 // positions and their derivatives by the 10 parameters (p0, v0, drag k, Magnus vector s; Ceres
 // Jets through trajectory_physics.h's RK4) from one sweep forward and one backward from the
 // reference time, instead of one integration from the reference time per sample (O(span) per
-// evaluation instead of O(samples x span)). FlightPathResidual is one sample's residual that reads
-// the shared path, so that each sample keeps its own robust loss in Ceres.
+// evaluation instead of O(samples x span)). FlightResiduals are all samples' residuals, each under
+// its own robust loss, in one Ceres block.
 #pragma once
 
 #include <vector>
 
-#include <ceres/sized_cost_function.h>
+#include <ceres/cost_function.h>
 #include <Eigen/Core>
 
 namespace fv::recon {
@@ -35,7 +35,7 @@ class FlightPath {
   long long steps() const { return steps_; }
 
  private:
-  template <typename T, typename S>
+  template <int L>  // derivative lanes: 0 (values), 4 (v0, k) or 7 (v0, k, s)
   void Integrate(const double* const* params);
 
   std::vector<double> dt_;
@@ -50,18 +50,25 @@ class FlightPath {
   long long sweeps_ = 0, steps_ = 0;
 };
 
-// Residual of sample i, position x_m, against the shared path (parameter blocks 3, 3, 1, 3).
-class FlightPathResidual : public ceres::SizedCostFunction<3, 3, 3, 1, 3> {
+// The residuals of all samples of a fit in one block (parameter blocks p0 3, v0 3, k 1, s 3), each
+// sample under its own Huber loss (scale huber_m) as Ceres applies one to a residual block: a
+// sample's position error scaled by sqrt(rho') (Ceres's Corrector for a loss with rho'' <= 0, as
+// the Huber loss always has), and one last row sqrt(sum of rho - rho' |r|^2) with a zero Jacobian
+// that makes the block's cost 0.5 sum rho(|r|^2). The same problem, steps and optimum as a
+// residual block with a HuberLoss per sample, without Ceres's work per block (most of a small
+// fit's time). `path` nullptr: the drag-free parabola in closed form, else the integrated path.
+class FlightResiduals : public ceres::CostFunction {
  public:
-  FlightPathResidual(FlightPath* path, int i, const Eigen::Vector3d& x_m)
-      : path_(path), i_(i), x_(x_m) {}
+  FlightResiduals(FlightPath* path, std::vector<double> dt_s, std::vector<Eigen::Vector3d> x_m,
+                  double gravity_mps2, double huber_m);
   bool Evaluate(const double* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
   FlightPath* path_;
-  int i_;
-  Eigen::Vector3d x_;
+  std::vector<double> dt_;
+  std::vector<Eigen::Vector3d> x_;
+  double g_, huber_;
 };
 
 }  // namespace fv::recon

@@ -13,7 +13,7 @@
 
 namespace fv::recon {
 
-constexpr double kMaxStepS = 0.002;  // RK4 step
+constexpr double kMaxStepS = 0.01;  // RK4 step
 
 // a = -g z - k |v| v + s x v, with s = c_M w (the Magnus vector, 1/s). k and s may be of another
 // scalar type than the state (plain numbers when no derivatives by them are wanted).
