@@ -139,10 +139,15 @@ std::vector<BallSample> BallSimulation::Sample(double fps, double noise_m, doubl
     s.frame = f;
     s.time_s = t;
     s.n_cams = 2;
-    s.ball_in_world = BallAt(t) + Eigen::Vector3d(rng.Normal(0, noise_m), rng.Normal(0, noise_m),
-                                                  rng.Normal(0, noise_m));
+    // One draw per statement, z first: the arguments of one call are evaluated in an unspecified
+    // order (GCC right to left, clang left to right); GCC's order keeps the samples so far and
+    // gives clang the same.
+    Eigen::Vector3d e;
+    for (int a = 2; a >= 0; --a) e[a] = rng.Normal(0, noise_m);
+    s.ball_in_world = BallAt(t) + e;
     if (rng.Uniform() < outlier_rate) {
-      Eigen::Vector3d d(rng.Normal(), rng.Normal(), rng.Normal());
+      Eigen::Vector3d d;
+      for (int a = 2; a >= 0; --a) d[a] = rng.Normal();
       s.ball_in_world += outlier_m * d.normalized();
     }
     out.push_back(s);
