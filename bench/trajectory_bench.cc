@@ -83,8 +83,12 @@ std::string LongTrackFile(long long rows) {
   for (int k = 0; k < 8; ++k) {
     fv::recon::BallSimOptions o;
     o.start_m = Eigen::Vector3d(0, 0, 0.11);
-    o.kicks = {
-        {0.3, Eigen::Vector3d(rng.Uniform(-12, 12), rng.Uniform(-8, 8), rng.Uniform(3, 10))}};
+    // One draw per statement, z first (GCC's order of a call's arguments; clang's differs).
+    Eigen::Vector3d v;
+    v.z() = rng.Uniform(3, 10);
+    v.y() = rng.Uniform(-8, 8);
+    v.x() = rng.Uniform(-12, 12);
+    o.kicks = {{0.3, v}};
     o.restitution = 0.6;
     o.rolling_decel_mps2 = 3.0;
     o.duration_s = 5.0;
