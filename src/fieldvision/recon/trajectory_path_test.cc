@@ -205,7 +205,7 @@ TEST(FlightPath, OneBlockInTenMsStepsFitsAsBlocksPerSampleInTwoMsSteps) {
     truth.spin_radps =
         2 * M_PI * (table_tennis ? Eigen::Vector3d(-60, 0, 20) : Eigen::Vector3d(0, 2, 6));
     const double noise = table_tennis ? 0.002 : 0.005, fps = table_tennis ? 120 : 100;
-    const int n = table_tennis ? 50 : 120;
+    const int n = table_tennis ? 50 : 70;
     std::vector<BallSample> samples(n);
     for (int i = 0; i < n; ++i) {
       samples[i].time_s = i / fps;
