@@ -126,29 +126,31 @@ struct FitBefore {
     template <typename T>
     bool operator()(const T* p0, const T* v0, const T* k, const T* s, T* r) const {
       T p[3] = {p0[0], p0[1], p0[2]}, v[3] = {v0[0], v0[1], v0[2]};
-      const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(dt) / 0.002)));
+      const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(dt) / step_s)));
       for (int i = 0; i < steps; ++i) FlightRk4Step(p, v, k[0], s, g, dt / steps);
       for (int j = 0; j < 3; ++j) r[j] = p[j] - x[j];
       return true;
     }
     Eigen::Vector3d x;
-    double dt, g;
+    double dt, g, step_s;
   };
 
   // Solves from `start` (at the samples' reference time) for the drag (and the spin) model.
-  // converged: to tolerances far below Ceres's defaults (the bounded solve creeps along k = 0).
+  // converged: to tolerances far below Ceres's defaults (the bounded solve creeps along k = 0),
+  // in steps of step_s (2 ms before; any step integrates a parabola exactly).
   static BallisticModel Solve(const std::vector<BallSample>& samples, const BallisticModel& start,
                               bool spin, const TrajectoryOptions& o, double noise_m,
-                              bool converged = false) {
+                              bool converged = false, double step_s = 0.002) {
     const int n = static_cast<int>(samples.size());
     const double t_ref = samples[n / 2].time_s, c_m = o.MagnusPerRad();
     double p0[3], v0[3], k[1] = {start.drag_per_m}, s[3] = {0, 0, 0};
     for (int j = 0; j < 3; ++j) p0[j] = start.p0_m[j], v0[j] = start.v0_mps[j];
     ceres::Problem problem;
     for (const BallSample& b : samples) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Residual, 3, 3, 3, 1, 3>(
-                                   new Residual{b.ball_in_world, b.time_s - t_ref, o.gravity_mps2}),
-                               new ceres::HuberLoss(3.0 * std::max(noise_m, 1e-3)), p0, v0, k, s);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<Residual, 3, 3, 3, 1, 3>(
+              new Residual{b.ball_in_world, b.time_s - t_ref, o.gravity_mps2, step_s}),
+          new ceres::HuberLoss(3.0 * std::max(noise_m, 1e-3)), p0, v0, k, s);
     }
     problem.SetParameterLowerBound(k, 0, 0.0);
     problem.SetParameterUpperBound(k, 0, o.max_drag_per_m);
@@ -279,9 +281,10 @@ TEST(FlightPath, DragFreeFlightFitsAtTheBoundBetterThanTheBoundedSolve) {
   EXPECT_GT(cost(pushed), cost(drag.model));
   BallisticModel start = gravity.model;
   start.drag_per_m = 0.01;
-  const BallisticModel drag_before = FitBefore::Solve(samples, start, false, o, noise, true);
+  // (Steps of 0.1 s: near k = 0 and without spin the path is all but a parabola.)
+  const BallisticModel drag_before = FitBefore::Solve(samples, start, false, o, noise, true, 0.1);
   start.drag_per_m = 0.0;
-  const BallisticModel spin_before = FitBefore::Solve(samples, start, true, o, noise, true);
+  const BallisticModel spin_before = FitBefore::Solve(samples, start, true, o, noise, true, 0.1);
   EXPECT_LT(cost(drag.model), cost(drag_before));
   EXPECT_LE(cost(spin.model), cost(spin_before) * (1 + 1e-12));
 }
