@@ -39,6 +39,12 @@ std::string BallPipelineSummary::ToString() const {
         "camera, consistent with the others)\n",
         weak_positions);
   }
+  if (hovering_dropped > 0) {
+    s += fmt::format(
+        "{} airborne points dropped because they stood still (ball-coloured things that two "
+        "cameras agree on; a ball cannot hover)\n",
+        hovering_dropped);
+  }
   if (frames > frames_with_position) {
     s += fmt::format(
         "no position: {} frames with candidates in fewer than 2 cameras, {} frames "
@@ -180,6 +186,7 @@ void AddFusionStats(const FusionStats& f, BallPipelineSummary* summary) {
   summary->frames_with_position = f.frames_with_position;
   summary->ground_positions = f.ground_positions;
   summary->weak_positions = f.weak_positions;
+  summary->hovering_dropped = f.hovering_dropped;
   summary->frames_few_blobs = f.frames_few_blobs;
   summary->frames_inconsistent = f.frames_inconsistent;
   summary->used_per_camera = f.used_per_camera;

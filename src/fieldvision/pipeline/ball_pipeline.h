@@ -42,6 +42,7 @@ struct BallPipelineSummary {
   long long frames_with_position = 0;     // 3D (or ground) positions
   long long ground_positions = 0;         // single-camera ground positions among them
   long long weak_positions = 0;       // positions completed with weak candidates (triangulation.h)
+  long long hovering_dropped = 0;     // airborne points that stood still, dropped (HoverFilter)
   long long frames_few_blobs = 0;     // no position: fewer than 2 cameras had candidates
   long long frames_inconsistent = 0;  // no position although >= 2 cameras had candidates
   double mean_err_px = 0.0;           // mean of the positions' RMS reprojection errors

@@ -1,11 +1,20 @@
 #include "fieldvision/pipeline/fusion_stage.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "fieldvision/pipeline/camera_stage.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::pipeline {
+namespace {
+
+// A track that moves at least this much a frame (3 m/s at 60 fps) is exempt from the hover
+// filter; a hovering point is fused again without its candidates at most this many times.
+constexpr double kMovingTrackStepM = 0.05;
+constexpr int kMaxHoverRetries = 2;
+
+}  // namespace
 
 void BallPredictor::Add(long long frame, const Eigen::Vector3d& point_world) {
   frame_[1] = frame_[0];
@@ -21,6 +30,61 @@ std::optional<Eigen::Vector3d> BallPredictor::Predict(long long frame) const {
   const Eigen::Vector3d v = (point_[0] - point_[1]) / double(frame_[0] - frame_[1]);
   if (v.norm() > max_step_m_) return std::nullopt;
   return point_[0] + v * double(frame - frame_[0]);
+}
+
+std::optional<double> BallPredictor::StepPerFrame(long long frame) const {
+  if (!Predict(frame)) return std::nullopt;
+  return (point_[0] - point_[1]).norm() / double(frame_[0] - frame_[1]);
+}
+
+void HoverFilterOptions::Check() const {
+  FV_REQUIRE(radius_m > 0 && std::isfinite(radius_m), "HoverFilterOptions.radius_m must be > 0");
+  FV_REQUIRE(min_span_s >= 0 && std::isfinite(min_span_s),
+             "HoverFilterOptions.min_span_s must be >= 0");
+  FV_REQUIRE(min_count >= 2, "HoverFilterOptions.min_count must be >= 2 (got {})", min_count);
+  FV_REQUIRE(airborne_m >= 0 && std::isfinite(airborne_m),
+             "HoverFilterOptions.airborne_m must be >= 0");
+  FV_REQUIRE(memory_s > min_span_s && std::isfinite(memory_s),
+             "HoverFilterOptions.memory_s must exceed min_span_s");
+}
+
+HoverFilter::HoverFilter(const HoverFilterOptions& options, double ball_radius_m)
+    : options_(options), ball_radius_m_(ball_radius_m) {
+  options_.Check();
+}
+
+bool HoverFilter::Airborne(const recon::TriangulationResult& result) const {
+  if (!result.ok() || result.on_ground) return false;
+  return Airborne(result.point_world, std::sqrt(std::max(result.covariance(2, 2), 0.0)));
+}
+
+bool HoverFilter::Airborne(const Eigen::Vector3d& point_world, double sigma_z_m) const {
+  return point_world.z() - ball_radius_m_ > options_.airborne_m + 3 * sigma_z_m;
+}
+
+void HoverFilter::Record(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {
+  const auto stale = std::find_if(seen_.begin(), seen_.end(), [&](const Seen& s) {
+    return s.time_s >= time_s - options_.memory_s;
+  });
+  seen_.erase(seen_.begin(), stale);
+  seen_.push_back({time_s, point_world, sigma_m});
+  constexpr size_t kMaxRemembered = 8192;
+  if (seen_.size() > kMaxRemembered) seen_.erase(seen_.begin());
+}
+
+bool HoverFilter::RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {
+  std::vector<double> times;  // earlier frames that saw this point
+  for (const Seen& s : seen_) {
+    const double tolerance_m = std::max(options_.radius_m, 3 * std::hypot(sigma_m, s.sigma_m));
+    if (s.time_s < time_s && (s.point_world - point_world).norm() <= tolerance_m) {
+      times.push_back(s.time_s);
+    }
+  }
+  Record(time_s, point_world, sigma_m);
+  std::sort(times.begin(), times.end());
+  const int count = 1 + static_cast<int>(std::unique(times.begin(), times.end()) - times.begin());
+  return count >= options_.min_count && !times.empty() &&
+         time_s - times.front() >= options_.min_span_s;
 }
 
 recon::BallSample BallSampleOf(const BallFrame& f) {
@@ -51,7 +115,9 @@ BallFrame FuseFrame(const std::vector<camera::Camera>& cameras, const SyncedFram
 
 FusionStage::FusionStage(std::vector<camera::Camera> cameras,
                          const recon::TriangulationOptions& options)
-    : cameras_(std::move(cameras)), options_(options) {
+    : cameras_(std::move(cameras)),
+      options_(options),
+      hover_(HoverFilterOptions(), options.ball_radius_m) {
   FV_REQUIRE(!cameras_.empty(), "fusion stage: no cameras");
   options.Check();
   stats_.used_per_camera.assign(cameras_.size(), 0);
@@ -67,6 +133,35 @@ BallFrame FusionStage::Fuse(const SyncedFrame& group) {
   }
   const auto prior = predictor_.Predict(group.frame);
   BallFrame f = FuseFrame(cameras_, group, options_, prior ? &*prior : nullptr);
+  // An airborne point that stands still is something ball-coloured, not the ball (HoverFilter):
+  // fuse again without its candidates, unless a moving track (a ball passing a point twice,
+  // up and down) led there.
+  const auto step_m = predictor_.StepPerFrame(group.frame);
+  const bool moving_track = step_m && *step_m >= kMovingTrackStepM;
+  for (const auto& alt : f.result.alternatives) {
+    // An alternative's height is known to about its 3D size.
+    if (hover_.Airborne(alt.point_world, alt.sigma_m)) {
+      hover_.Record(group.time_s, alt.point_world, alt.sigma_m);
+    }
+  }
+  SyncedFrame without;
+  for (int attempt = 0; attempt < kMaxHoverRetries && hover_.Airborne(f.result); ++attempt) {
+    const double sigma_m = std::sqrt(std::max(f.result.covariance.trace(), 0.0));
+    if (!hover_.RecordAndTest(group.time_s, f.result.point_world, sigma_m) || moving_track) {
+      break;
+    }
+    ++stats_.hovering_dropped;
+    if (attempt == 0) without = group;
+    for (const recon::ViewResidual& v : f.result.views) {
+      auto& message = without.cameras[v.camera];
+      if (!message || v.candidate < 0 ||
+          v.candidate >= static_cast<int>(message->candidates.size())) {
+        continue;
+      }
+      message->candidates.erase(message->candidates.begin() + v.candidate);
+    }
+    f = FuseFrame(cameras_, without, options_, prior ? &*prior : nullptr);
+  }
   if (f.result.ok() && !f.result.on_ground) predictor_.Add(f.frame, f.result.point_world);
   ++stats_.frames;
   if (f.result.ok()) {

@@ -43,6 +43,8 @@ class BallPredictor {
       : max_gap_(max_gap), max_step_m_(max_step_m) {}
   void Add(long long frame, const Eigen::Vector3d& point_world);
   std::optional<Eigen::Vector3d> Predict(long long frame) const;
+  // The track's speed in metres per frame where Predict gives a position, else nullopt.
+  std::optional<double> StepPerFrame(long long frame) const;
 
  private:
   int max_gap_;
@@ -52,11 +54,52 @@ class BallPredictor {
   Eigen::Vector3d point_[2];
 };
 
+// Ball-coloured things that stand still above the ground (a seat in the stands, a sign, seen
+// as a ball by two cameras whose rays meet there): a ball cannot hover, so an airborne position
+// (higher than a resting ball by airborne_m and three standard deviations of its height) that
+// repeats one point (within radius_m or three standard deviations of the two positions' distance)
+// at least min_count times over at least min_span_s is not the ball. A ball that passes one
+// point twice (up and down) does so within a fast track, which the fusion stage exempts; a free
+// ball near its apex stays within 10 cm for about 0.29 s.
+struct HoverFilterOptions {
+  double radius_m = 0.10;    // the same point: closer than this
+  double min_span_s = 0.3;   // seen there over at least this long
+  int min_count = 3;         // this many times, the position tested included
+  double airborne_m = 0.05;  // height above a resting ball's centre that is airborne
+  double memory_s = 60.0;    // airborne positions are remembered this long
+  // Throws fv::Error naming the bad field.
+  void Check() const;
+};
+
+class HoverFilter {
+ public:
+  explicit HoverFilter(const HoverFilterOptions& options = {}, double ball_radius_m = 0.11);
+  // Whether a 3D result lies above a resting ball by more than airborne_m and 3 sigma.
+  bool Airborne(const recon::TriangulationResult& result) const;
+  bool Airborne(const Eigen::Vector3d& point_world, double sigma_z_m) const;
+  // Remembers an airborne position (a consistent hypothesis that was not chosen).
+  void Record(double time_s, const Eigen::Vector3d& point_world, double sigma_m);
+  // Remembers an airborne position (sigma_m: its 3D RMS uncertainty); true when it repeats a
+  // point that hovers (seen there in min_count frames, this one included).
+  bool RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m = 0.0);
+
+ private:
+  HoverFilterOptions options_;
+  double ball_radius_m_;
+  struct Seen {
+    double time_s;
+    Eigen::Vector3d point_world;
+    double sigma_m;
+  };
+  std::vector<Seen> seen_;  // oldest first
+};
+
 struct FusionStats {
   long long frames = 0;                          // synchronised frames
   long long frames_with_position = 0;            // 3D (or ground) positions
   long long ground_positions = 0;                // single-camera ground positions among them
   long long weak_positions = 0;                  // positions completed with weak candidates
+  long long hovering_dropped = 0;                // airborne points that stand still (HoverFilter)
   long long frames_few_blobs = 0;                // no position: fewer than 2 cameras had candidates
   long long frames_inconsistent = 0;             // no position although >= 2 cameras had candidates
   double sum_err_px = 0.0;                       // sum of the positions' RMS reprojection errors
@@ -76,6 +119,7 @@ class FusionStage {
   std::vector<camera::Camera> cameras_;
   recon::TriangulationOptions options_;
   BallPredictor predictor_;
+  HoverFilter hover_;
   FusionStats stats_;
 };
 

@@ -1,8 +1,13 @@
-// The fusion stage's predictor: a prior only from a track (two recent positions a plausible step
-// apart), never from independent placements.
+// The fusion stage's predictor (a prior only from a track, two recent positions a plausible step
+// apart, never from independent placements) and its hover filter (an airborne point that stands
+// still is not the ball).
 #include "fieldvision/pipeline/fusion_stage.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
+
+#include "fieldvision/util/error.h"
 
 namespace fv::pipeline {
 namespace {
@@ -27,6 +32,107 @@ TEST(BallPredictor, PredictsAlongATrackOnly) {
   p.Add(21, Vector3d(6.6, -3, 0.11));
   ASSERT_TRUE(p.Predict(22).has_value());
   EXPECT_TRUE(p.Predict(22)->isApprox(Vector3d(6.7, -3, 0.11)));
+}
+
+TEST(HoverFilter, AStillAirbornePointIsFlaggedAfterTheSpan) {
+  HoverFilter filter;  // 10 cm, 0.3 s, 3 frames
+  const Vector3d sign(3.0, -6.8, 0.62);
+  int first_flagged = -1;
+  for (int f = 0; f < 40; ++f) {
+    // Jitter of a few cm, as a far object's triangulation has.
+    const Vector3d p = sign + 0.02 * Vector3d(std::sin(f), std::cos(3 * f), std::sin(7 * f));
+    if (filter.RecordAndTest(f / 60.0, p, 0.01) && first_flagged < 0) first_flagged = f;
+  }
+  EXPECT_EQ(first_flagged, 18);  // 0.3 s after the first sighting at 60 fps
+}
+
+TEST(HoverFilter, AFlyingBallIsNeverFlagged) {
+  HoverFilter filter;
+  for (int f = 0; f < 70; ++f) {  // kicked at 12 m/s, 30 deg up: 1.15 s of flight
+    const double t = f / 60.0;
+    const Vector3d p(-3 + 10.4 * t, 0.5, 0.11 + 6.0 * t - 0.5 * 9.81 * t * t);
+    if (p.z() < 0.11) break;
+    EXPECT_FALSE(filter.RecordAndTest(t, p, 0.005)) << "frame " << f;
+  }
+}
+
+TEST(HoverFilter, OnlyPointsAboveARestingBallAreAirborne) {
+  HoverFilter filter(HoverFilterOptions(), /*ball_radius_m=*/0.11);
+  EXPECT_FALSE(filter.Airborne(Vector3d(1, 2, 0.11), 0.002));  // resting
+  EXPECT_FALSE(filter.Airborne(Vector3d(1, 2, 0.15), 0.002));  // within 5 cm
+  EXPECT_TRUE(filter.Airborne(Vector3d(1, 2, 0.30), 0.002));
+  EXPECT_FALSE(filter.Airborne(Vector3d(1, 2, 0.30), 0.1));  // too uncertain to tell
+  recon::TriangulationResult on_ground;
+  on_ground.status = recon::TriangulationStatus::kOk;
+  on_ground.on_ground = true;
+  on_ground.point_world = Vector3d(1, 2, 0.5);
+  EXPECT_FALSE(filter.Airborne(on_ground));
+}
+
+TEST(HoverFilter, BadOptionsAreRefused) {
+  HoverFilterOptions o;
+  o.min_count = 1;
+  EXPECT_THROW(HoverFilter{o}, fv::Error);
+  o = HoverFilterOptions();
+  o.radius_m = std::nan("");
+  EXPECT_THROW(HoverFilter{o}, fv::Error);
+}
+
+// Three cameras 10 m from the field centre, 5 m high, looking at it.
+std::vector<camera::Camera> RingCameras() {
+  std::vector<camera::Camera> cams;
+  for (int i = 0; i < 3; ++i) {
+    const double a = 2 * M_PI * i / 3;
+    camera::Camera c = camera::Camera::FromFov(1280, 960, 70);
+    c.name = "cam" + std::to_string(i + 1);
+    c.cam_from_world = geometry::Rigid3d::LookAt(
+        Eigen::Vector3d(10 * std::cos(a), 10 * std::sin(a), 5), {0, 0, 0});
+    c.has_pose = true;
+    cams.push_back(c);
+  }
+  return cams;
+}
+
+recon::BallObservation SeenAt(const camera::Camera& cam, const Vector3d& p, double score) {
+  recon::BallObservation o;
+  o.centre_px = *recon::PredictBallCentre(cam, p, 0.11);
+  o.radius_px = 0.11 * cam.fx / (cam.cam_from_world * p).z();
+  o.sigma_px = 0.3;
+  o.score = score;
+  return o;
+}
+
+// A yellow sign that cameras 1 and 2 both take for a ball stands 0.6 m above the ground; the
+// ball rests in view of all three cameras, then is hidden (picked up). The sign, seen all along
+// as a consistent pair that was not chosen, must not take the ball's place.
+TEST(FusionStage, AStillSignDoesNotReplaceALostBall) {
+  const std::vector<camera::Camera> cams = RingCameras();
+  FusionStage fusion(cams, recon::TriangulationOptions());
+  const Vector3d ball(-1.0, 0.5, 0.11), sign(2.0, 1.5, 0.6);
+  int ball_frames = 0, sign_frames = 0;
+  for (int f = 0; f < 60; ++f) {
+    SyncedFrame group;
+    group.frame = f;
+    group.time_s = f / 60.0;
+    group.cameras.resize(cams.size());
+    for (int c = 0; c < 3; ++c) {
+      CameraMessage m;
+      m.camera = c;
+      m.frame = f;
+      m.time_s = group.time_s;
+      if (f < 30) m.candidates.push_back(SeenAt(cams[c], ball, 0.5));
+      if (c < 2) m.candidates.push_back(SeenAt(cams[c], sign, 0.6));
+      group.cameras[c] = m;
+    }
+    const BallFrame out = fusion.Fuse(group);
+    if (!out.result.ok()) continue;
+    if ((out.result.point_world - ball).norm() < 0.05) ++ball_frames;
+    if ((out.result.point_world - sign).norm() < 0.05) ++sign_frames;
+  }
+  EXPECT_EQ(ball_frames, 30);
+  EXPECT_EQ(sign_frames, 0);
+  // For 5 frames the resting ball's track gates the sign out; then it is chosen and dropped.
+  EXPECT_EQ(fusion.stats().hovering_dropped, 25);
 }
 
 }  // namespace

@@ -135,6 +135,14 @@ struct TriangulationResult {
   int iterations = 0;               // Ceres iterations of the final refinement
   int hypotheses = 0;               // robust mode: two-view hypotheses scored
   int weak_views = 0;               // robust mode: views from weak candidates
+  // Robust mode: the points of the consistent two-view hypotheses (every view within three
+  // standard deviations), the chosen one's among them, each with its 1-sigma size from the rays'
+  // geometry; they tell a caller where ball-coloured things stand (pipeline/fusion_stage.h).
+  struct Alternative {
+    Eigen::Vector3d point_world = Eigen::Vector3d::Zero();
+    double sigma_m = 0.0;
+  };
+  std::vector<Alternative> alternatives;
   bool ok() const { return status == TriangulationStatus::kOk; }
   int num_views() const { return static_cast<int>(views.size()); }
 };

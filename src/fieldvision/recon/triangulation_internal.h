@@ -111,7 +111,8 @@ struct BestHypothesis {
   std::vector<int> pick;  // candidate per camera, -1: none
   int n = 0;              // cameras in the set
   double cost = 0, score = 0;
-  int hypotheses = 0;  // two-view hypotheses scored
+  int hypotheses = 0;                                          // two-view hypotheses scored
+  std::vector<TriangulationResult::Alternative> alternatives;  // consistent hypotheses' points
 };
 // Every two-view hypothesis: the set with the most cameras, then the highest total score, then
 // the smallest error.

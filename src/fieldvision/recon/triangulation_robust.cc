@@ -102,6 +102,21 @@ bool StrongEnough(const std::vector<std::vector<BallObservation>>& candidates,
          prior != nullptr && (p - *prior).norm() <= o.prior_gate_m;
 }
 
+// A hypothesis whose views lie within three standard deviations on average is consistent (its
+// point is kept among the alternatives, at most kMaxAlternatives of them).
+constexpr double kConsistentChi2PerView = 9.0;
+constexpr size_t kMaxAlternatives = 64;
+
+// 1-sigma size of the midpoint of two rays: each ray's lateral uncertainty at its depth
+// (depth * sigma_px / focal length), over the sine of the angle between the rays.
+double PairSigma(const camera::Camera& cam_a, const BallObservation& a, const camera::Camera& cam_b,
+                 const BallObservation& b, const RayPairResult& rp) {
+  const double lateral_a = std::abs(rp.s_a) * a.sigma_px / std::sqrt(cam_a.fx * cam_a.fy);
+  const double lateral_b = std::abs(rp.s_b) * b.sigma_px / std::sqrt(cam_b.fx * cam_b.fy);
+  const double sin_angle = std::max(std::sin(rp.angle_deg * M_PI / 180.0), 1e-3);
+  return std::hypot(lateral_a, lateral_b) / sin_angle;
+}
+
 BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
                                 const std::vector<std::vector<BallObservation>>& candidates,
                                 const RankedCandidates& ranked, const TriangulationOptions& o,
@@ -124,15 +139,20 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
               ClosestPointOfRays(*ranked.rays[ca][ka], *ranked.rays[cb][kb], o.min_angle_deg);
           if (!rp.ok()) continue;
           if (NoBallThere(rp.midpoint, o)) continue;
-          if (o.gate_by_prior && prior != nullptr &&
-              (rp.midpoint - *prior).norm() > o.prior_gate_m) {
-            continue;  // the ball cannot be there (far from where it is expected)
-          }
-          ++best.hypotheses;
+          // The prior decides where the ball may be, but every consistent set is reported.
+          const bool gated =
+              o.gate_by_prior && prior != nullptr && (rp.midpoint - *prior).norm() > o.prior_gate_m;
+          if (!gated) ++best.hypotheses;
           const double cost = GatherConsistent(cameras, candidates, ranked, o, rp.midpoint, &pick);
           if (pick[ca] != ka || pick[cb] != kb) continue;  // the pair itself must agree
           const int n = CountPicked(pick);
           if (require_strong && !StrongEnough(candidates, pick, rp.midpoint, o, prior)) continue;
+          if (cost <= kConsistentChi2PerView * n && best.alternatives.size() < kMaxAlternatives) {
+            best.alternatives.push_back(
+                {rp.midpoint,
+                 PairSigma(cameras[ca], candidates[ca][ka], cameras[cb], candidates[cb][kb], rp)});
+          }
+          if (gated) continue;  // the ball cannot be there (far from where it is expected)
           double score = 0;
           for (int c : seen) {
             if (pick[c] >= 0) score += candidates[c][pick[c]].score;
@@ -238,10 +258,12 @@ TriangulationResult RobustCore(const std::vector<camera::Camera>& cameras,
   constexpr int kMaxSearches = 3;
   RankedCandidates search = ranked;
   int hypotheses = 0;
+  std::vector<TriangulationResult::Alternative> alternatives;
   for (int attempt = 0; attempt < kMaxSearches; ++attempt) {
     const BestHypothesis best =
         SearchHypotheses(cameras, candidates, search, o, require_strong, prior);
     hypotheses += best.hypotheses;
+    alternatives.insert(alternatives.end(), best.alternatives.begin(), best.alternatives.end());
     if (best.n < 2) {
       result = TriangulationResult();
       result.status = TriangulationStatus::kNoConsistentSet;
@@ -268,6 +290,7 @@ TriangulationResult RobustCore(const std::vector<camera::Camera>& cameras,
     }
   }
   result.hypotheses = hypotheses;
+  result.alternatives = std::move(alternatives);
   return result;
 }
 
@@ -303,7 +326,10 @@ TriangulationResult TriangulateRobust(const std::vector<camera::Camera>& cameras
   if ((result.ok() && !result.on_ground) || !o.use_weak) return result;
   TriangulationResult with_weak = RobustCore(cameras, candidates, o, true, prior);
   with_weak.hypotheses += result.hypotheses;
-  return with_weak.ok() ? with_weak : result;
+  if (!with_weak.ok()) return result;
+  // The strong candidates' consistent points are the reliable ones (a weak one never moves them).
+  with_weak.alternatives = std::move(result.alternatives);
+  return with_weak;
 }
 
 }  // namespace fv::recon
