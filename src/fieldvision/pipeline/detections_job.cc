@@ -13,6 +13,7 @@
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
+#include "fieldvision/pipeline/fusion_stage.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/recon/trajectory_physics.h"
@@ -299,14 +300,11 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   }
   recon::TriangulationOptions topt = o.triangulation;
   topt.ball_radius_m = 0.5 * o.ball_diameter_m;
-  BallPredictor predictor;
+  FusionStage fusion(cameras, topt);  // the same fusion as the ball pipeline's
   while (auto f = sync.Next()) {
     ++res.frames;
-    const auto prior = predictor.Predict(f->frame);
-    const BallFrame b = FuseFrame(cameras, *f, topt, prior ? &*prior : nullptr);
+    const BallFrame b = fusion.Fuse(*f);
     if (!b.result.ok()) continue;
-    const Eigen::Vector3d& p = b.result.point_world;
-    if (!b.result.on_ground) predictor.Add(b.frame, p);
     const recon::BallSample s = BallSampleOf(b);
     if (res.per_frame.empty() || s.time_s > res.per_frame.back().time_s) res.per_frame.push_back(s);
   }
