@@ -24,7 +24,11 @@ TEST(LearnColour, PinkBallFromARegionAndFromPoints) {
   util::Rng rng(seed);
   cv::Mat img = test_util::FieldImage(320, 240, rng);
   const cv::Vec3b pink(180, 105, 255);
-  const Eigen::Vector2d c(rng.Uniform(100, 220), rng.Uniform(80, 160));
+  // One draw per statement, in GCC's order (a call's arguments are evaluated in an unspecified
+  // order, so clang would place the ball elsewhere for the same seed).
+  const double cy = rng.Uniform(80, 160);
+  const double cx = rng.Uniform(100, 220);
+  const Eigen::Vector2d c(cx, cy);
   const double r = 14;
   test_util::PaintDisc(img, c, r, pink);
   cv::Mat ball(img.size(), CV_8U, cv::Scalar(0));

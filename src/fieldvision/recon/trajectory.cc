@@ -391,6 +391,36 @@ double CostSlopeInDrag(FlightPath* path, const std::vector<double>& dt_s,
   return slope;
 }
 
+// The parameters a fit starts from: those of `start` at t_ref when given (warm, true), else the
+// gravity line through all samples (false); k and the Magnus vector as each model needs them.
+bool StartState(const std::vector<BallSample>& samples, FlightModel kind,
+                const TrajectoryOptions& options, double t_ref, const BallisticModel* start,
+                double p0[3], double v0[3], double k[1], double sm[3]) {
+  constexpr double kDragStartPerM = 0.01;  // a cold drag stage's first k
+  k[0] = kind != FlightModel::kGravity ? kDragStartPerM : 0.0;
+  sm[0] = sm[1] = sm[2] = 0.0;
+  if (start == nullptr) {
+    std::vector<int> all(samples.size());
+    std::iota(all.begin(), all.end(), 0);
+    const GravityLine line = FitGravityLine(samples, all, options.gravity_mps2, t_ref);
+    for (int i = 0; i < 3; ++i) p0[i] = line.a[i], v0[i] = line.b[i];
+    return false;
+  }
+  Eigen::Vector3d p, v;
+  start->StateAt(t_ref, &p, &v);
+  for (int i = 0; i < 3; ++i) p0[i] = p[i], v0[i] = v[i];
+  if (kind != FlightModel::kGravity) {
+    k[0] = std::clamp(start->drag_per_m, 0.0, options.max_drag_per_m);
+  }
+  // A drag fit from a parabola starts where a cold one's drag stage does.
+  if (kind == FlightModel::kDrag && start->Parabola()) k[0] = kDragStartPerM;
+  if (kind == FlightModel::kSpin) {
+    const Eigen::Vector3d s0 = MagnusVector(*start);
+    for (int i = 0; i < 3; ++i) sm[i] = s0[i];
+  }
+  return true;
+}
+
 }  // namespace
 
 BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel kind,
@@ -404,30 +434,8 @@ BallisticFit FitBallistic(const std::vector<BallSample>& samples, FlightModel ki
   const double g = options.gravity_mps2;
   const double t_ref = samples[n / 2].time_s;
   const double c_m = options.MagnusPerRad();
-  double p0[3], v0[3];
-  constexpr double kDragStartPerM = 0.01;  // a cold drag stage's first k
-  double k[1] = {kind != FlightModel::kGravity ? kDragStartPerM : 0.0};
-  double sm[3] = {0, 0, 0};
-  bool warm = false;
-  if (start != nullptr) {
-    Eigen::Vector3d p, v;
-    start->StateAt(t_ref, &p, &v);
-    for (int i = 0; i < 3; ++i) p0[i] = p[i], v0[i] = v[i];
-    if (kind != FlightModel::kGravity)
-      k[0] = std::clamp(start->drag_per_m, 0.0, options.max_drag_per_m);
-    // A drag fit from a parabola starts where a cold one's drag stage does.
-    if (kind == FlightModel::kDrag && start->Parabola()) k[0] = kDragStartPerM;
-    if (kind == FlightModel::kSpin) {
-      const Eigen::Vector3d s0 = MagnusVector(*start);
-      for (int i = 0; i < 3; ++i) sm[i] = s0[i];
-    }
-    warm = true;
-  } else {
-    std::vector<int> all(n);
-    std::iota(all.begin(), all.end(), 0);
-    const GravityLine line = FitGravityLine(samples, all, g, t_ref);
-    for (int i = 0; i < 3; ++i) p0[i] = line.a[i], v0[i] = line.b[i];
-  }
+  double p0[3], v0[3], k[1], sm[3];
+  const bool warm = StartState(samples, kind, options, t_ref, start, p0, v0, k, sm);
   const double huber = 3.0 * std::max(noise_m, 1e-3);
   // The drag and spin models' residuals read one path integrated through all samples.
   std::vector<double> dt_s(n);
