@@ -1,5 +1,7 @@
 #include "fieldvision/io/output_path.h"
 
+#include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -8,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
@@ -80,6 +83,40 @@ TEST(AtomicWrite, ReplacesOnlyOnSuccessAndLeavesNoTemporary) {
   // A writer that wrote nothing does not destroy the output.
   EXPECT_THROW(AtomicWrite(out, [](const std::string&) {}), Error);
   EXPECT_EQ(ReadText(out), "new\n");
+}
+
+// A disk that fills up during the write (here: a 64 KB file size limit, RLIMIT_FSIZE, with
+// SIGXFSZ ignored so that write() fails as on a full disk): a one-line error, the old output
+// kept, no temporary file left.
+TEST(AtomicWrite, AFullDiskKeepsTheOutputAndLeavesNoTemporary) {
+  const std::string dir = testing::TempDir();
+  const std::string out = dir + "/ball.csv";
+  WriteText(out, "old\n");
+  rlimit was{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &was), 0);
+  const auto old_handler = signal(SIGXFSZ, SIG_IGN);
+  rlimit small = was;
+  small.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  try {
+    AtomicWrite(out, [](const std::string& tmp) {
+      util::CsvWriter csv(tmp, {"frame", "x_m", "y_m", "z_m"});
+      for (int i = 0; i < 100000; ++i) {  // about 3 MB
+        csv << i << 0.1 * i << -0.2 * i << 0.11;
+        csv.EndRow();
+      }
+      csv.Close();
+    });
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &was);
+  signal(SIGXFSZ, old_handler);
+  EXPECT_NE(message.find("error while writing"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_EQ(ReadText(out), "old\n");
+  EXPECT_EQ(CountFiles(dir), 1);
 }
 
 TEST(AtomicWrite, WritesThroughASymlinkAndRefusesDevicesAndFolders) {
