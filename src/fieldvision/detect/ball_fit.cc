@@ -17,9 +17,14 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
+// The domain of Sample.
+inline bool InsideForSampling(const cv::Mat& img, const Vector2d& p) {
+  return p.x() >= 0 && p.y() >= 0 && p.x() <= img.cols - 1 && p.y() <= img.rows - 1;
+}
+
 // Bilinear BGR sample; false outside the image.
 inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
-  if (!(x >= 0 && y >= 0 && x <= img.cols - 1 && y <= img.rows - 1)) return false;
+  if (!InsideForSampling(img, Vector2d(x, y))) return false;
   const int x0 = std::min(static_cast<int>(x), img.cols - 2 >= 0 ? img.cols - 2 : 0);
   const int y0 = std::min(static_cast<int>(y), img.rows - 2 >= 0 ? img.rows - 2 : 0);
   const int x1 = std::min(x0 + 1, img.cols - 1), y1 = std::min(y0 + 1, img.rows - 1);
@@ -32,11 +37,6 @@ inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
     (*out)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
   }
   return true;
-}
-
-// The domain of Sample.
-inline bool InsideForSampling(const cv::Mat& img, const Vector2d& p) {
-  return p.x() >= 0 && p.y() >= 0 && p.x() <= img.cols - 1 && p.y() <= img.rows - 1;
 }
 
 inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, double x, double y) {

@@ -63,13 +63,10 @@ bool HoverFilter::Airborne(const Eigen::Vector3d& point_world, double sigma_z_m)
 }
 
 void HoverFilter::Record(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {
-  const auto stale = std::find_if(seen_.begin(), seen_.end(), [&](const Seen& s) {
-    return s.time_s >= time_s - options_.memory_s;
-  });
-  seen_.erase(seen_.begin(), stale);
+  while (!seen_.empty() && seen_.front().time_s < time_s - options_.memory_s) seen_.pop_front();
   seen_.push_back({time_s, point_world, sigma_m});
   constexpr size_t kMaxRemembered = 8192;
-  if (seen_.size() > kMaxRemembered) seen_.erase(seen_.begin());
+  if (seen_.size() > kMaxRemembered) seen_.pop_front();
 }
 
 bool HoverFilter::RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {

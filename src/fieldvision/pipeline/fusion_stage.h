@@ -4,6 +4,7 @@
 // stage serves the in-process pipeline (ball_pipeline.h) and the fusion node (net/fuse.h).
 #pragma once
 
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,7 +92,7 @@ class HoverFilter {
     Eigen::Vector3d point_world;
     double sigma_m;
   };
-  std::vector<Seen> seen_;  // oldest first
+  std::deque<Seen> seen_;  // oldest first
 };
 
 struct FusionStats {
