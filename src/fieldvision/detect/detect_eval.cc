@@ -368,7 +368,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   progress.Finish();
   result.seconds = progress.ElapsedSeconds();
   if (cand_csv != nullptr) {
-    cand_csv->Close();
+    try {
+      cand_csv->Close();
+    } catch (const Error& e) {
+      cand_file->Rethrow(e);
+    }
     cand_file->Commit();
   }
   if (!o.out.empty()) {

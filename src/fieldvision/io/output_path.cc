@@ -78,10 +78,23 @@ void AtomicOutput::Commit() {
   committed_ = true;
 }
 
+void AtomicOutput::Rethrow(const std::exception& error) const {
+  std::string message = error.what();
+  for (size_t at = message.find(temp_); at != std::string::npos;
+       at = message.find(temp_, at + out_.size())) {
+    message.replace(at, temp_.size(), out_);
+  }
+  throw Error(message);
+}
+
 void AtomicWrite(const std::string& out, const std::function<void(const std::string&)>& write,
                  std::string_view what) {
   AtomicOutput file(out, what);
-  write(file.temp_path());
+  try {
+    write(file.temp_path());
+  } catch (const Error& e) {
+    file.Rethrow(e);
+  }
   file.Commit();
 }
 

@@ -55,6 +55,9 @@ class AtomicOutput {
   const std::string& target_path() const { return target_; }
   // Renames the temporary file over the target; throws fv::Error naming the output on failure.
   void Commit();
+  // Throws `error` again with the temporary file's name replaced by the output's (a writer's
+  // message names the file it wrote: the user knows the output, not the temporary file).
+  [[noreturn]] void Rethrow(const std::exception& error) const;
 
  private:
   std::string out_;

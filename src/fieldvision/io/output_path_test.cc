@@ -114,6 +114,8 @@ TEST(AtomicWrite, AFullDiskKeepsTheOutputAndLeavesNoTemporary) {
   setrlimit(RLIMIT_FSIZE, &was);
   signal(SIGXFSZ, old_handler);
   EXPECT_NE(message.find("error while writing"), std::string::npos) << message;
+  EXPECT_NE(message.find(out), std::string::npos) << message;  // the output, not the temporary
+  EXPECT_EQ(message.find(".part"), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   EXPECT_EQ(ReadText(out), "old\n");
   EXPECT_EQ(CountFiles(dir), 1);

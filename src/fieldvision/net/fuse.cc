@@ -506,8 +506,12 @@ FuseSummary FuseServer::Run() {
     flight_worker_->Finish();
     PublishFlights();
   }
-  csv.Close();
   csv_ = nullptr;
+  try {
+    csv.Close();
+  } catch (const Error& e) {
+    out_file.Rethrow(e);
+  }
   out_file.Commit();
   summary_.fusion = fusion_->stats();
   summary_.sync = sync_->stats();

@@ -155,9 +155,8 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   BallJobResult result;
   // Write to a temporary file beside the output, rename at the end: a failed run (a truncated
   // video, a bad timestamp) leaves neither a half file nor a temporary one.
-  io::AtomicOutput out(o.out);
-  {
-    util::CsvWriter csv(out.temp_path(), recon::BallCsvColumns(), 6);
+  io::AtomicWrite(o.out, [&](const std::string& temp_path) {
+    util::CsvWriter csv(temp_path, recon::BallCsvColumns(), 6);
     result.summary =
         RunBallPipelineTracked(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
           if (!f.result.ok()) return;
@@ -168,8 +167,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
           ++result.rows_written;
         });
     csv.Close();
-  }
-  out.Commit();
+  });
   if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);
   return result;
 }

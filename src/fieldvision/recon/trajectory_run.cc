@@ -351,7 +351,11 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
       for (const auto& b : r.result.breaks) bounce |= b.kind == FlightEvent::kBounce;
       if (bounce) scores.push_back(ScoreBounceTrack(file, r.input.samples, r.options));
     }
-    csv.Close();
+    try {
+      csv.Close();
+    } catch (const Error& e) {
+      summary.Rethrow(e);
+    }
   }
   summary.Commit();
   if (!scores.empty()) log << Summarize(scores).Table();
