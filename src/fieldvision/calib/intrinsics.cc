@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <limits>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -66,6 +67,8 @@ void IntrinsicsOptions::Check() const {
   FV_REQUIRE(min_views >= 1, "min_views must be >= 1 (got {})", min_views);
   FV_REQUIRE(coverage_grid >= 1 && coverage_grid <= 32, "coverage_grid must be in [1, 32] (got {})",
              coverage_grid);
+  CheckInRange(focal_profile_factor, 1.01, 4.0, "focal_profile_factor");
+  CheckNonNegative(focal_profile_min_gain, "focal_profile_min_gain");
 }
 
 std::string CoverageReport::Describe() const {
@@ -89,7 +92,8 @@ std::string IntrinsicsResult::Summary() const {
   for (size_t i = 0; i < camera.distortion.size(); ++i) {
     s += fmt::format("{}{:.5g}", i ? ", " : "", camera.distortion[i]);
   }
-  return s + "]";
+  return s + fmt::format("]; with the focal length held lower / higher: rms {:.3f} / {:.3f} px",
+                         rms_focal_lower_px, rms_focal_higher_px);
 }
 
 namespace {  // The stages of CalibrateFromViews.
@@ -200,6 +204,30 @@ CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector
   return fit;
 }
 
+// The RMS of the fit on the used views redone with the focal length held at `factor` times the
+// estimate (principal point, distortion and poses refitted from the estimate).
+double RmsWithFocalScaled(const std::vector<BoardView>& views, const CvFit& fit,
+                          const cv::Size& size, const IntrinsicsOptions& options, double factor) {
+  std::vector<std::vector<cv::Point3f>> obj;
+  std::vector<std::vector<cv::Point2f>> img;
+  for (int i : fit.used) {
+    obj.push_back(views[i].object_points);
+    img.push_back(views[i].image_points);
+  }
+  cv::Mat k = fit.k.clone(), d = fit.d.clone();
+  k.at<double>(0, 0) *= factor;
+  k.at<double>(1, 1) *= factor;
+  std::vector<cv::Mat> rvecs, tvecs;
+  try {
+    return cv::calibrateCamera(
+        obj, img, size, k, d, rvecs, tvecs,
+        CalibFlags(options) | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+  } catch (const cv::Exception&) {
+    return std::numeric_limits<double>::infinity();  // no fit at all: the focal length matters
+  }
+}
+
 // The camera and the standard deviations of its intrinsics from the fit.
 void SetCamera(const CvFit& fit, const cv::Size& size, const IntrinsicsOptions& options,
                IntrinsicsResult* out) {
@@ -293,6 +321,13 @@ void AddWarnings(const cv::Size& size, const IntrinsicsOptions& options, int max
                     "poorly constrained; tilt the board by 20-45 deg",
                     cov.tilt_range_deg));
   }
+  const double moved_rms = std::min(result.rms_focal_lower_px, result.rms_focal_higher_px);
+  if (moved_rms < (1.0 + options.focal_profile_min_gain) * result.rms_px) {
+    w.push_back(fmt::format(
+        "the views do not pin the focal length down: held {:.0f}% lower or higher it still fits "
+        "with RMS {:.3f} px (best {:.3f} px); tilt the board by 20-45 deg",
+        100 * (options.focal_profile_factor - 1), moved_rms, result.rms_px));
+  }
   if (result.std_fx_px > 0.01 * cam.fx || result.std_fy_px > 0.01 * cam.fy) {
     w.push_back(fmt::format("focal length uncertain: std {:.1f} px ({:.1f}%)", result.std_fx_px,
                             100 * result.std_fx_px / cam.fx));
@@ -336,6 +371,10 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * result.num_found));
   const CvFit fit = FitDroppingOutliers(views, found, size, options, max_drop, &result);
   SetCamera(fit, size, options, &result);
+  result.rms_focal_lower_px =
+      RmsWithFocalScaled(views, fit, size, options, 1.0 / options.focal_profile_factor);
+  result.rms_focal_higher_px =
+      RmsWithFocalScaled(views, fit, size, options, options.focal_profile_factor);
   result.coverage = Coverage(views, fit, size, options.coverage_grid);
   AddWarnings(size, options, max_drop, &result);
   AddNotes(options, &result);

@@ -33,8 +33,13 @@ struct IntrinsicsOptions {
   double outlier_factor = 4.0;
   double outlier_min_px = 1.5;
   double max_drop_fraction = 0.3;
-  int min_views = 3;        // fewer usable views is an error
-  int coverage_grid = 4;    // coverage report: grid cells per side
+  int min_views = 3;      // fewer usable views is an error
+  int coverage_grid = 4;  // coverage report: grid cells per side
+  // Focal-length check: the fit is redone with the focal length held this factor lower and
+  // higher; when either still reaches an RMS under (1 + focal_profile_min_gain) x the fit's, the
+  // views do not pin the focal length down (a warning).
+  double focal_profile_factor = 1.25;
+  double focal_profile_min_gain = 0.5;
   bool progress = true;     // progress on stderr while detecting corners
   std::string camera_name;  // written to the camera file
 
@@ -70,6 +75,10 @@ struct IntrinsicsResult {
   CoverageReport coverage;
   // Standard deviations of fx, fy, cx, cy in pixels (from OpenCV's covariance estimate).
   double std_fx_px = 0, std_fy_px = 0, std_cx_px = 0, std_cy_px = 0;
+  // The RMS (px) of the fit redone with the focal length held focal_profile_factor times lower
+  // and higher (all else refitted): views that pin the focal length down pay for moving it; near
+  // fronto-parallel views do not, whatever the covariance estimate says.
+  double rms_focal_lower_px = 0.0, rms_focal_higher_px = 0.0;
   std::vector<std::string> warnings;
   std::string Summary() const;
 };

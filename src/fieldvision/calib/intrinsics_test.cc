@@ -150,13 +150,10 @@ TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
   EXPECT_NEAR(r.camera.distortion[0], -0.25, 0.02);
 }
 
-TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
-  fv::testing::SeededRng rng(52);
-  IntrinsicsOptions o;
-  o.board = {BoardType::kChessboard, 4, 3, 0.02};
-  o.progress = false;
+// Five views of a small board always near the same spot, barely tilted: the model is not
+// constrained (the focal length can run off to several times the truth).
+std::vector<BoardView> CornerViews(const IntrinsicsOptions& o, util::Rng& rng) {
   const cv::Matx33d k(540, 0, 330, 0, 540, 238, 0, 0, 1);
-  // A small board always near the same spot, barely tilted: the model is not constrained.
   std::vector<BoardView> views;
   for (int i = 0; i < 5; ++i) {
     BoardView v;
@@ -176,17 +173,29 @@ TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
     v.object_points = obj;
     views.push_back(v);
   }
-  const IntrinsicsResult r = CalibrateFromViews(views, o);
-  std::string all;
-  for (const auto& w : r.warnings) all += w + "\n";
-  EXPECT_NE(all.find("only 5 views"), std::string::npos) << all;
-  EXPECT_NE(all.find("cover only"), std::string::npos) << all;
-  // The focal length is not pinned down: the board hardly tilts, which is either seen in the
-  // estimated tilts or in the focal length's standard deviation.
-  EXPECT_TRUE(all.find("board orientations differ") != std::string::npos ||
-              all.find("focal length uncertain") != std::string::npos)
-      << all << r.Summary() << " tilt range " << r.coverage.tilt_range_deg;
-  EXPECT_LT(r.coverage.cell_fraction, 0.3);
+  return views;
+}
+
+TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
+  fv::testing::SeededRng rng(52);
+  IntrinsicsOptions o;
+  o.board = {BoardType::kChessboard, 4, 3, 0.02};
+  o.progress = false;
+  // Whatever the noise: the estimated tilts and the covariance can both look fine when the focal
+  // length ran off (at seeds 4, 13, 15 and 37 of an earlier sweep it came out near 4500 px for
+  // 540 with no warning); the focal profile says it either way.
+  for (int draw = 0; draw < 20; ++draw) {
+    SCOPED_TRACE(draw);
+    const IntrinsicsResult r = CalibrateFromViews(CornerViews(o, rng), o);
+    std::string all;
+    for (const auto& w : r.warnings) all += w + "\n";
+    EXPECT_NE(all.find("only 5 views"), std::string::npos) << all;
+    EXPECT_NE(all.find("cover only"), std::string::npos) << all;
+    EXPECT_NE(all.find("do not pin the focal length down"), std::string::npos)
+        << all << r.Summary() << " focal profile " << r.rms_focal_lower_px << " "
+        << r.rms_focal_higher_px;
+    EXPECT_LT(r.coverage.cell_fraction, 0.3);
+  }
 }
 
 TEST(Intrinsics, TooFewViewsIsAnError) {
