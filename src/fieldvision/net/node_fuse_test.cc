@@ -91,15 +91,17 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = scene.cameras;
   fo.out = scene.dir + "/live.csv";
-  fo.idle_exit_s = 1.5;      // longer than the nodes' ping interval (0.5 s)
-  fo.sync.max_wait_s = 3.0;  // a loaded test machine may run a node late; wait for it
+  fo.idle_exit_s = 1.5;  // longer than the nodes' ping interval (0.5 s)
+  // A loaded test machine (or a sanitizer build) may run a node late; wait for it.
+  fo.sync.max_wait_s = 3.0 * fv::testing::SlowdownFactor();
   fo.progress = false;
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
 
-  const double offset_s = 0.080;                       // node 1's clock is 80 ms ahead
-  const double start_at = io::SystemClockNow() + 1.0;  // every node connected by then
+  const double offset_s = 0.080;  // node 1's clock is 80 ms ahead
+  // Every node connected by then (a sanitizer build takes longer to start a node).
+  const double start_at = io::SystemClockNow() + 1.0 * fv::testing::SlowdownFactor();
   std::vector<NodeSummary> nodes(scene.cameras.size());
   std::vector<std::thread> threads;
   for (size_t c = 0; c < scene.cameras.size(); ++c) {

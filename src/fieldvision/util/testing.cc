@@ -32,4 +32,18 @@ std::string SharedDataDir() {
   return "";
 }
 
+double SlowdownFactor() {
+#if defined(__SANITIZE_ADDRESS__)
+  return 10.0;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  return 10.0;
+#else
+  return 1.0;
+#endif
+#else
+  return 1.0;
+#endif
+}
+
 }  // namespace fv::testing

@@ -16,6 +16,9 @@ uint64_t TestSeed(uint64_t fallback = 1);
 std::string TempDir();
 // ../shared/data next to the source tree; empty string if absent.
 std::string SharedDataDir();
+// How much slower this build runs than a plain one: 10 under AddressSanitizer (the waiting
+// margins of tests that run in real time scale by it), else 1.
+double SlowdownFactor();
 // What `f` throws (an fv::Error or other std::exception), or "" when it returns.
 template <typename F>
 std::string ErrorOf(F&& f) {
