@@ -110,10 +110,16 @@ std::string OutlineProblem(const BallFit& fit, double visible, double leak,
   return "";
 }
 
+// The share of min_contrast and min_hue_contrast a region needs: less on the field.
+double LeastContrastFactor(const BallRegion& r, const BallDetectorOptions& o) {
+  return r.field_ring >= o.min_field_ring ? o.field_contrast_factor : 1.0;
+}
+
 // Whether a measured region stands out from its surroundings: by its colour difference
-// (min_contrast) or by its hue difference alone (min_hue_contrast).
+// (min_contrast) or by its hue difference alone (min_hue_contrast), less on the field.
 bool StandsOut(const BallRegion& r, const BallDetectorOptions& o) {
-  return r.contrast >= o.min_contrast || r.hue_contrast >= o.min_hue_contrast;
+  const double f = LeastContrastFactor(r, o);
+  return r.contrast >= f * o.min_contrast || r.hue_contrast >= f * o.min_hue_contrast;
 }
 
 // The first region check the candidate fails ("" when it passes them all); with
@@ -206,6 +212,8 @@ void BallDetectorOptions::Check() const {
   CheckInRange(max_ring_leak, 0.0, 1.0, "max_ring_leak");
   CheckNonNegative(min_contrast, "min_contrast");
   CheckNonNegative(min_hue_contrast, "min_hue_contrast");
+  CheckInRange(min_field_ring, 0.0, 1.0, "min_field_ring");
+  CheckInRange(field_contrast_factor, 0.0, 1.0, "field_contrast_factor");
   CheckInRange(max_region_outside, 0.0, 1.0, "max_region_outside");
   FV_REQUIRE(max_region_extent >= 1.0, "max_region_extent must be >= 1 (got {})",
              max_region_extent);
@@ -509,9 +517,10 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
                                               (region.radius_px / (region.radius_px + 1.0)) *
                                               region_size_factor
                                         : 0.0;
-  // Balls stand out: the score grows with the contrast up to twice the least one.
-  const double contrast_factor = region.ok && o.min_contrast > 0
-                                     ? std::clamp(region.contrast / (2 * o.min_contrast), 0.25, 1.0)
+  // Balls stand out: the score grows with the contrast up to twice the least one (there).
+  const double least_contrast = LeastContrastFactor(region, o) * o.min_contrast;
+  const double contrast_factor = region.ok && least_contrast > 0
+                                     ? std::clamp(region.contrast / (2 * least_contrast), 0.25, 1.0)
                                      : 1.0;
   if (precise_ok) {
     cand.centre_px = fit.centre_px;

@@ -121,6 +121,49 @@ TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
   }
 }
 
+// A yellow ball seen yellow-green (a greenish camera) on the green field differs from it by less
+// than min_contrast and min_hue_contrast, but its ring is field-coloured: it needs only
+// field_contrast_factor of them (accepted). The same disc on a wall of about the same contrast
+// that is not the field is rejected.
+TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
+  const uint64_t seed = fv::testing::TestSeed(31);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  BallDetectorOptions o;
+  o.colour = "yellow";
+  const BallDetector det(o, nullptr, nullptr);
+  const cv::Vec3b yellow_green(70, 180, 150);  // hue 76 deg, saturation 156
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    const double r = rng.Uniform(8, 20);
+    test_util::PaintDisc(img, c, r, yellow_green, 0.3);
+    const auto cands = det.Detect(img);
+    ASSERT_FALSE(cands.empty());
+    const BallCandidate& best = cands.front();
+    SCOPED_TRACE("r " + std::to_string(r) + " contrast " + std::to_string(best.contrast) + " hue " +
+                 std::to_string(best.hue_contrast) + " " + best.reason);
+    EXPECT_LT(best.contrast, o.min_contrast);
+    EXPECT_LT(best.hue_contrast, o.min_hue_contrast);
+    EXPECT_TRUE(best.accepted);
+    EXPECT_LT((best.centre_px - c).norm(), 0.1 * r + 0.5);
+  }
+  for (int trial = 0; trial < 4; ++trial) {
+    cv::Mat wall(240, 320, CV_8UC3, cv::Scalar(100, 150, 150));  // hue 60 deg, pale: no class
+    cv::Mat noise(wall.size(), CV_8UC3);
+    cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
+    wall += noise;
+    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    const double r = rng.Uniform(8, 20);
+    test_util::PaintDisc(wall, c, r, yellow_green, 0.3);
+    const auto cands = det.Detect(wall);
+    ASSERT_FALSE(cands.empty());
+    const BallCandidate& best = cands.front();
+    EXPECT_FALSE(best.accepted) << "contrast " << best.contrast << " hue " << best.hue_contrast;
+    EXPECT_NE(best.reason.find("contrast"), std::string::npos) << best.reason;
+  }
+}
+
 TEST(BallDetector, BadInputGivesErrors) {
   BallDetectorOptions o;
   o.scan_step_px = 0;

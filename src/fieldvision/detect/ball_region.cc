@@ -388,11 +388,12 @@ double OutlineExtent(const std::vector<Vector2d>& pts, const Vector2d& c, double
 // region's area.
 void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& lab,
                           const cv::Mat& filled, const cv::Mat& raw, const Vector2d& c, double r,
-                          double area, const BallRegionOptions& o, BallRegion* out) {
+                          double area, const BallRegionOptions& o, const ColourTable& table,
+                          uint8_t field_bit, BallRegion* out) {
   std::array<std::vector<double>, 3> disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
-  long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, pure = 0;
+  long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, ring_field = 0, pure = 0;
   for (int y = 0; y < window.height; ++y) {
     const uint8_t* f = filled.ptr<uint8_t>(y);
     const uint8_t* m = raw.ptr<uint8_t>(y);
@@ -416,6 +417,10 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
         if (m[x] == 0) {  // what is around the ball, not more of its colour (that is leak)
           const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
           for (int ch = 0; ch < 3; ++ch) ring_lab[ch].push_back(l[ch]);
+          if (field_bit != 0) {
+            const uint8_t* p = bgr.ptr<uint8_t>(window.y + y) + 3 * (window.x + x);
+            ring_field += (table.Classify(p[0], p[1], p[2]) & field_bit) != 0;
+          }
         }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
@@ -429,6 +434,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   out->fill = disc > 0 ? double(disc_in) / disc : 0.0;
   out->spill = spill / (M_PI * r * r);
   out->leak = ring > 0 ? double(ring_ball) / ring : 0.0;
+  out->field_ring = ring > 0 ? double(ring_field) / ring : 0.0;
   out->purity = area > 0 ? pure / area : 0.0;
   if (disc_lab[0].empty()) disc_lab = std::move(core_lab);
   if (!disc_lab[0].empty() && !ring_lab[0].empty()) {
@@ -517,7 +523,12 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   out.centre_px = c;
   out.radius_px = r;
   out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(on.inliers, 1)) + 0.05;
-  MeasureRegionColours(bgr, window, lab, filled, raw, c, r, area, o, &out);
+  // The field's surface: its colour and its painted lines.
+  uint8_t field_bit = 0;
+  for (const char* name : {"field", "line"}) {
+    if (table.spec().Find(name) >= 0) field_bit |= table.ClassBit(name);
+  }
+  MeasureRegionColours(bgr, window, lab, filled, raw, c, r, area, o, table, field_bit, &out);
   out.ok = true;
   return out;
 }

@@ -72,6 +72,9 @@ struct BallRegion {
   double contrast = 0.0;
   // The hue part of that difference (CIE94 Delta H): what shading and exposure hardly change.
   double hue_contrast = 0.0;
+  // Share of the leak ring's pixels in the colour spec's "field" or "line" classes (0 without
+  // them): a ball on the field is set apart by the classes themselves.
+  double field_ring = 0.0;
   double solidity = 0.0;   // region area / convex hull area
   int outline_points = 0;  // convex outline points used by the circle fit
   int inliers = 0;
