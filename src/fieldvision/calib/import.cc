@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
 
+#include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::calib {
@@ -302,6 +303,8 @@ std::vector<camera::Camera> ReadOpenCvStereo(const std::vector<std::string>& pat
   CheckPositive(metres_per_unit, "metres_per_unit");
   cv::Mat m[2], d[2], r, t;
   for (const auto& p : paths) {
+    FV_REQUIRE(std::filesystem::is_regular_file(p), "OpenCV stereo file '{}' does not exist", p);
+    camera::CheckOpenCvYamlText(p, "OpenCV stereo file");
     cv::FileStorage fs;
     try {
       fs.open(p, cv::FileStorage::READ);

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include <opencv2/core.hpp>
 
@@ -124,8 +125,25 @@ Camera ReadCameraYamlFrom(const cv::FileStorage& fs, const std::string& path) {
 
 }  // namespace
 
+void CheckOpenCvYamlText(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  FV_REQUIRE(!ec, "{} '{}' cannot be read: {}", what, path, ec.message());
+  FV_REQUIRE(size <= (64u << 20), "{} '{}' is {} bytes: not a calibration file", what, path, size);
+  std::ifstream in(path, std::ios::binary);
+  FV_REQUIRE(in.good(), "{} '{}' cannot be read", what, path);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (line.rfind("---", 0) != 0) continue;
+    const size_t rest = line.find_first_not_of(" \t\r", 3);
+    FV_REQUIRE(rest == std::string::npos || line[rest] == '#',
+               "{} '{}' line {}: '---' must stand alone on its line", what, path, n);
+  }
+}
+
 Camera ReadCameraYaml(const std::string& path) {
   FV_REQUIRE(std::filesystem::is_regular_file(path), "camera file '{}' does not exist", path);
+  CheckOpenCvYamlText(path, "camera file");
   cv::FileStorage fs;
   try {
     fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);

@@ -10,6 +10,11 @@ namespace fv::camera {
 
 // Reads and validates a camera file; every problem throws fv::Error naming the file and the key.
 Camera ReadCameraYaml(const std::string& path);
+// Throws fv::Error naming `what`, the file and the line when an OpenCV YAML file has a line that
+// starts a document ("---") with more on it: OpenCV 4.6's parser never returns on some of those
+// ("--- A: 1" then a line "--m"; found by fuzz/camera_yaml_fuzz), and OpenCV writes "---" alone.
+// Files over 64 MB are refused (OpenCV reads them whole).
+void CheckOpenCvYamlText(const std::string& path, const std::string& what);
 // Writes the camera file (to a temporary name first, then renamed, so a failure loses nothing).
 void WriteCameraYaml(const Camera& camera, const std::string& path);
 

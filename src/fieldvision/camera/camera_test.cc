@@ -241,7 +241,9 @@ INSTANTIATE_TEST_SUITE_P(
                 FV_HDR FV_K FV_D "rvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: d\n  data: "
                                  "[0, 0, 0]\ntvec: !!opencv-matrix\n  rows: 3\n  cols: 1\n  dt: "
                                  "d\n  data: [0, 1e300, 0]\n",
-                "tvec"}),
+                "tvec"},
+        // Found by fuzz/camera_yaml_fuzz: OpenCV 4.6's parser never returned (a CPU-bound hang).
+        BadFile{"content after the document start", "%YAML:1.0\n--- A: 1\nna\n--m", "line 2"}),
     BadFileName);
 
 TEST(CameraIo, MissingFile) {
