@@ -79,6 +79,36 @@ TEST(BallDetector, LowContrastDiscIsDiscShapedAConeIsNot) {
   EXPECT_GE(cones, 1);
 }
 
+// A disc of `bgr` (PaintDisc's `shade`) at a random place and size in `img`, and what `det`
+// finds in the image.
+struct PaintedDisc {
+  Eigen::Vector2d centre;
+  double radius_px;
+  std::vector<BallCandidate> candidates;
+  std::string Trace() const {
+    const BallCandidate& best = candidates.front();
+    return "r " + std::to_string(radius_px) + " contrast " + std::to_string(best.contrast) +
+           " hue " + std::to_string(best.hue_contrast) + " " + best.reason;
+  }
+};
+PaintedDisc DetectPaintedDisc(const BallDetector& det, cv::Mat img, const cv::Vec3b& bgr,
+                              double shade, util::Rng& rng) {
+  PaintedDisc p;
+  p.centre = Eigen::Vector2d(rng.Uniform(60, 260), rng.Uniform(60, 180));
+  p.radius_px = rng.Uniform(8, 20);
+  test_util::PaintDisc(img, p.centre, p.radius_px, bgr, shade);
+  p.candidates = det.Detect(img);
+  return p;
+}
+
+// A plain 320x240 wall of `bgr` with a little sensor noise.
+cv::Mat NoisyWall(const cv::Scalar& bgr) {
+  cv::Mat wall(240, 320, CV_8UC3, bgr);
+  cv::Mat noise(wall.size(), CV_8UC3);
+  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
+  return wall + noise;
+}
+
 // A yellow ball in shade (olive) on grass differs from it little in lightness and chroma but
 // much in hue: it stands out by its hue (min_hue_contrast) though its Delta E is below
 // min_contrast. A beige patch on a white wall, of the yellow class's pale range, differs in
@@ -91,31 +121,21 @@ TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
   o.colour = "yellow";
   const BallDetector det(o, nullptr, nullptr);
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat img = test_util::FieldImage(320, 240, rng);
-    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
-    const double r = rng.Uniform(8, 20);
-    test_util::PaintDisc(img, c, r, cv::Vec3b(15, 120, 130), 0.3);  // olive: a shaded yellow
-    const auto cands = det.Detect(img);
-    ASSERT_FALSE(cands.empty());
-    const BallCandidate& best = cands.front();
-    SCOPED_TRACE("r " + std::to_string(r) + " contrast " + std::to_string(best.contrast) + " hue " +
-                 std::to_string(best.hue_contrast) + " " + best.reason);
+    const PaintedDisc p = DetectPaintedDisc(det, test_util::FieldImage(320, 240, rng),
+                                            cv::Vec3b(15, 120, 130), 0.3, rng);  // olive
+    ASSERT_FALSE(p.candidates.empty());
+    const BallCandidate& best = p.candidates.front();
+    SCOPED_TRACE(p.Trace());
     EXPECT_LT(best.contrast, o.min_contrast);
     EXPECT_GE(best.hue_contrast, o.min_hue_contrast);
     EXPECT_TRUE(best.accepted);
-    EXPECT_LT((best.centre_px - c).norm(), 0.1 * r + 0.5);
+    EXPECT_LT((best.centre_px - p.centre).norm(), 0.1 * p.radius_px + 0.5);
   }
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat wall(240, 320, CV_8UC3, cv::Scalar(230, 235, 235));
-    cv::Mat noise(wall.size(), CV_8UC3);
-    cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
-    wall += noise;
-    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
-    const double r = rng.Uniform(8, 20);
-    test_util::PaintDisc(wall, c, r, cv::Vec3b(150, 200, 215), 0.95);  // beige
-    const auto cands = det.Detect(wall);
-    ASSERT_FALSE(cands.empty());
-    const BallCandidate& best = cands.front();
+    const PaintedDisc p = DetectPaintedDisc(det, NoisyWall(cv::Scalar(230, 235, 235)),
+                                            cv::Vec3b(150, 200, 215), 0.95, rng);  // beige
+    ASSERT_FALSE(p.candidates.empty());
+    const BallCandidate& best = p.candidates.front();
     EXPECT_FALSE(best.accepted) << "contrast " << best.contrast << " hue " << best.hue_contrast;
     EXPECT_LT(best.hue_contrast, o.min_hue_contrast);
   }
@@ -134,31 +154,22 @@ TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
   const BallDetector det(o, nullptr, nullptr);
   const cv::Vec3b yellow_green(70, 180, 150);  // hue 76 deg, saturation 156
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat img = test_util::FieldImage(320, 240, rng);
-    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
-    const double r = rng.Uniform(8, 20);
-    test_util::PaintDisc(img, c, r, yellow_green, 0.3);
-    const auto cands = det.Detect(img);
-    ASSERT_FALSE(cands.empty());
-    const BallCandidate& best = cands.front();
-    SCOPED_TRACE("r " + std::to_string(r) + " contrast " + std::to_string(best.contrast) + " hue " +
-                 std::to_string(best.hue_contrast) + " " + best.reason);
+    const PaintedDisc p =
+        DetectPaintedDisc(det, test_util::FieldImage(320, 240, rng), yellow_green, 0.3, rng);
+    ASSERT_FALSE(p.candidates.empty());
+    const BallCandidate& best = p.candidates.front();
+    SCOPED_TRACE(p.Trace());
     EXPECT_LT(best.contrast, o.min_contrast);
     EXPECT_LT(best.hue_contrast, o.min_hue_contrast);
     EXPECT_TRUE(best.accepted);
-    EXPECT_LT((best.centre_px - c).norm(), 0.1 * r + 0.5);
+    EXPECT_LT((best.centre_px - p.centre).norm(), 0.1 * p.radius_px + 0.5);
   }
   for (int trial = 0; trial < 4; ++trial) {
-    cv::Mat wall(240, 320, CV_8UC3, cv::Scalar(100, 150, 150));  // hue 60 deg, pale: no class
-    cv::Mat noise(wall.size(), CV_8UC3);
-    cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
-    wall += noise;
-    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
-    const double r = rng.Uniform(8, 20);
-    test_util::PaintDisc(wall, c, r, yellow_green, 0.3);
-    const auto cands = det.Detect(wall);
-    ASSERT_FALSE(cands.empty());
-    const BallCandidate& best = cands.front();
+    // Hue 60 deg, pale: no class.
+    const PaintedDisc p =
+        DetectPaintedDisc(det, NoisyWall(cv::Scalar(100, 150, 150)), yellow_green, 0.3, rng);
+    ASSERT_FALSE(p.candidates.empty());
+    const BallCandidate& best = p.candidates.front();
     EXPECT_FALSE(best.accepted) << "contrast " << best.contrast << " hue " << best.hue_contrast;
     EXPECT_NE(best.reason.find("contrast"), std::string::npos) << best.reason;
   }

@@ -368,12 +368,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   progress.Finish();
   result.seconds = progress.ElapsedSeconds();
   if (cand_csv != nullptr) {
-    try {
-      cand_csv->Close();
-    } catch (const Error& e) {
-      cand_file->Rethrow(e);
-    }
-    cand_file->Commit();
+    cand_file->CloseAndCommit(*cand_csv);
   }
   if (!o.out.empty()) {
     io::AtomicWrite(o.out, [&](const std::string& tmp) {

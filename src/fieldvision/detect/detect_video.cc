@@ -129,14 +129,9 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     progress.Update(result.frames);
   }
   progress.Finish();
-  try {
-    csv.Close();
-  } catch (const Error& e) {
-    out_file.Rethrow(e);
-  }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   FV_REQUIRE(result.frames > 0, "video '{}' has no frames", o.video);
-  out_file.Commit();
+  out_file.CloseAndCommit(csv);
   return result;
 }
 

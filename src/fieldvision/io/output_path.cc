@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <system_error>
 
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::io {
@@ -85,6 +86,15 @@ void AtomicOutput::Rethrow(const std::exception& error) const {
     message.replace(at, temp_.size(), out_);
   }
   throw Error(message);
+}
+
+void AtomicOutput::CloseAndCommit(util::CsvWriter& csv) {
+  try {
+    csv.Close();
+  } catch (const Error& e) {
+    Rethrow(e);
+  }
+  Commit();
 }
 
 void AtomicWrite(const std::string& out, const std::function<void(const std::string&)>& write,

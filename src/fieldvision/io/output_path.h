@@ -9,6 +9,10 @@
 #include <type_traits>
 #include <vector>
 
+namespace fv::util {
+class CsvWriter;
+}  // namespace fv::util
+
 namespace fv::io {
 
 // Whether `a` and `b` are one file: by inode when both exist (symlinks and hard links count), else
@@ -58,6 +62,9 @@ class AtomicOutput {
   // Throws `error` again with the temporary file's name replaced by the output's (a writer's
   // message names the file it wrote: the user knows the output, not the temporary file).
   [[noreturn]] void Rethrow(const std::exception& error) const;
+  // Closes `csv` (written to temp_path(); a failed write is reported naming the output) and
+  // commits.
+  void CloseAndCommit(util::CsvWriter& csv);
 
  private:
   std::string out_;

@@ -507,12 +507,7 @@ FuseSummary FuseServer::Run() {
     PublishFlights();
   }
   csv_ = nullptr;
-  try {
-    csv.Close();
-  } catch (const Error& e) {
-    out_file.Rethrow(e);
-  }
-  out_file.Commit();
+  out_file.CloseAndCommit(csv);
   summary_.fusion = fusion_->stats();
   summary_.sync = sync_->stats();
   summary_.sync_problems = sync_->Problems(names_);

@@ -351,13 +351,8 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
       for (const auto& b : r.result.breaks) bounce |= b.kind == FlightEvent::kBounce;
       if (bounce) scores.push_back(ScoreBounceTrack(file, r.input.samples, r.options));
     }
-    try {
-      csv.Close();
-    } catch (const Error& e) {
-      summary.Rethrow(e);
-    }
+    summary.CloseAndCommit(csv);
   }
-  summary.Commit();
   if (!scores.empty()) log << Summarize(scores).Table();
   log << fmt::format("wrote {} ({} tracks, {} failed; -1: not fitted)\n", res.summary_csv,
                      files.size() - res.failed.size(), res.failed.size());
