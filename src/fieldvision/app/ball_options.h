@@ -1,6 +1,7 @@
 // The ball options that several subcommands declare alike: --ball-diameter (ball, node, fuse,
 // detect, plan), --color (ball, node, detect, eval detect) and the fusion's --inlier-px, --ground
-// and --no-weak (ball, fuse; recon/triangulation.h).
+// and --no-weak (ball, fuse; recon/triangulation.h), the tracking window's --whole-frames,
+// --full-scan-every and --scan-bands (ball, node; pipeline/camera_stage.h).
 #pragma once
 
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/detect/colour.h"
+#include "fieldvision/pipeline/camera_stage.h"
 #include "fieldvision/recon/triangulation.h"
 
 namespace fv::app {
@@ -36,6 +38,18 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
   cmd->add_flag("!--no-weak", t.use_weak,
                 "Never use candidates that failed a shape check to complete a position");
+}
+
+inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
+  cmd->add_flag("!--whole-frames", t.enabled, "Search every frame whole (no tracking window)");
+  cmd->add_option("--full-scan-every", t.full_scan_every,
+                  "While tracking, search the whole frame for other balls every N frames")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_flag("--scan-bands", t.bands,
+                "While tracking, search one band of rows a frame instead, covering the whole frame "
+                "every --full-scan-every frames (no spike in work per frame; about twice the "
+                "work on average)");
 }
 
 }  // namespace fv::app

@@ -82,11 +82,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames")
       ->check(CLI::Range(0LL, 1000000000LL));
   AddFusionOptions(cmd, o->job.pipeline.triangulation);
-  cmd->add_flag("!--whole-frames", o->job.pipeline.track.enabled,
-                "Search every frame whole (no tracking window)");
-  cmd->add_option("--full-scan-every", o->job.pipeline.track.full_scan_every,
-                  "While tracking, search the whole frame at least every N frames")
-      ->capture_default_str();
+  AddTrackOptions(cmd, o->job.pipeline.track);
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o, cmd] {
     FV_REQUIRE(!o->det.detections.empty() ||

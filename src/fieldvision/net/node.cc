@@ -58,8 +58,9 @@ std::string NodeSummary::ToString() const {
     s += "\nclock: no reply from the fusion node";
   }
   if (stage.window_scans > 0) {
-    s += fmt::format("\n{} frames searched in a window around the ball, {} whole",
-                     stage.window_scans, stage.full_scans);
+    s += fmt::format(
+        "\n{} frames searched in a window around the ball ({} and a band of rows), {} whole",
+        stage.window_scans, stage.band_scans, stage.full_scans);
   }
   if (stage.bad_frames > 0) {
     s += fmt::format("\n{} frames could not be decoded (first: {})", stage.bad_frames,

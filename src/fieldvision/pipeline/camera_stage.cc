@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 
@@ -26,10 +27,13 @@ bool HasAccepted(const std::vector<recon::BallObservation>& obs) {
 // Where a camera stage looks next: the window around the ball's predicted image position.
 class CameraStage::Track {
  public:
-  explicit Track(const BallTrackOptions& o) : o_(o) {}
+  // `phase`: the whole frame is searched in the frames n (from 0) where (n + phase) %
+  // full_scan_every is 0, besides when the ball is lost; cameras with other phases do so in other
+  // frames.
+  Track(const BallTrackOptions& o, int phase) : o_(o), phase_(phase) {}
   // The window for the next frame, or an empty rectangle for the whole frame.
   cv::Rect Window(const cv::Size& image) const {
-    if (!o_.enabled || !active_ || since_full_ + 1 >= o_.full_scan_every) return {};
+    if (!o_.enabled || !active_ || (!o_.bands && Slot() == 0)) return {};
     const Eigen::Vector2d p = centre_ + velocity_;
     const double half =
         std::max<double>(o_.min_window_px, o_.window_radii * radius_ + velocity_.norm());
@@ -40,6 +44,15 @@ class CameraStage::Track {
     const cv::Rect r = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(cv::Point(0, 0), image);
     return r.area() > 0 ? r : cv::Rect();
   }
+  // The band of rows to search besides the window in this frame (empty: none).
+  cv::Rect Band(const cv::Size& image) const {
+    if (!o_.enabled || !active_ || !o_.bands) return {};
+    const int core = (image.height + o_.full_scan_every - 1) / o_.full_scan_every;
+    const int margin = static_cast<int>(std::ceil(1.5 * 4.0 * radius_ + 4.0));
+    const int y0 = std::max(0, Slot() * core - margin);
+    const int y1 = std::min(image.height, (Slot() + 1) * core + margin);
+    return y1 > y0 ? cv::Rect(0, y0, image.width, y1 - y0) : cv::Rect();
+  }
   // Whether the window's best accepted candidate is where the ball was expected (within two of its
   // radii): if not, the track may have been taken by another object and the frame is searched
   // whole.
@@ -48,8 +61,8 @@ class CameraStage::Track {
     return best != nullptr &&
            (best->centre_px - (centre_ + velocity_)).norm() <= 2.0 * radius_ + 2.0;
   }
-  void Update(const std::vector<recon::BallObservation>& obs, bool full) {
-    since_full_ = full ? 0 : since_full_ + 1;
+  void Update(const std::vector<recon::BallObservation>& obs) {
+    ++frames_;
     const recon::BallObservation* best = Best(obs);
     if (best == nullptr) {
       active_ = false;
@@ -71,11 +84,55 @@ class CameraStage::Track {
   }
   BallTrackOptions o_;
   bool active_ = false;
-  int since_full_ = 0;
+  int Slot() const { return static_cast<int>((frames_ + phase_) % o_.full_scan_every); }
+  int phase_;
+  long long frames_ = 0;  // frames seen
   Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
   double radius_ = 0.0;
 };
+
+namespace {
+
+// The camera's phase in the whole-frame searches, from its name (FNV-1a): the same camera gets the
+// same phase in a node as in the in-process pipeline, so both give the same candidates.
+int ScanPhase(const std::string& camera_name, int full_scan_every) {
+  uint64_t h = 14695981039346656037ull;
+  for (const char c : camera_name) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return static_cast<int>(h % static_cast<uint64_t>(full_scan_every));
+}
+
+// Adds the band's candidates to the window's, except those on a ball already there; accepted
+// first, best first, and no more weak candidates than either list had.
+void AddBandCandidates(std::vector<recon::BallObservation> band,
+                       std::vector<recon::BallObservation>* candidates) {
+  auto weak_count = [](const std::vector<recon::BallObservation>& v) {
+    return std::count_if(v.begin(), v.end(),
+                         [](const recon::BallObservation& o) { return o.weak; });
+  };
+  const auto max_weak = std::max(weak_count(band), weak_count(*candidates));
+  const size_t from_window = candidates->size();
+  for (recon::BallObservation& b : band) {
+    const bool known =
+        std::any_of(candidates->begin(), candidates->begin() + static_cast<long>(from_window),
+                    [&](const recon::BallObservation& c) {
+                      return (c.centre_px - b.centre_px).norm() < std::max(c.radius_px, 2.0);
+                    });
+    if (!known) candidates->push_back(std::move(b));
+  }
+  std::stable_sort(candidates->begin(), candidates->end(),
+                   [](const recon::BallObservation& a, const recon::BallObservation& b) {
+                     if (a.weak != b.weak) return !a.weak;
+                     return a.score > b.score;
+                   });
+  long weak = 0;
+  candidates->erase(
+      std::remove_if(candidates->begin(), candidates->end(),
+                     [&](const recon::BallObservation& o) { return o.weak && ++weak > max_weak; }),
+      candidates->end());
+}
+
+}  // namespace
 
 CameraStage::CameraStage(int camera_index, const camera::Camera& camera,
                          BallRegionDetectFn detector, const BallTrackOptions& track,
@@ -84,8 +141,9 @@ CameraStage::CameraStage(int camera_index, const camera::Camera& camera,
       size_(camera.width, camera.height),
       detector_(std::move(detector)),
       source_name_(std::move(source_name)),
-      track_(std::make_unique<Track>(track)) {
+      track_() {
   track.Check();
+  track_ = std::make_unique<Track>(track, ScanPhase(camera.name, track.full_scan_every));
   FV_REQUIRE(detector_ != nullptr, "camera stage {}: no detector", camera_index);
 }
 
@@ -117,6 +175,17 @@ const cv::Mat* CameraStage::Image(const io::SourceFrame& in, const cv::Rect& roi
   return &decoded_;
 }
 
+// While the window confirms the track: the next band of rows, when bands are on.
+void CameraStage::SearchBand(const io::SourceFrame& in,
+                             std::vector<recon::BallObservation>* candidates) {
+  const cv::Rect band = track_->Band(size_);
+  if (band.empty()) return;
+  const cv::Mat* frame = Image(in, band);
+  if (frame == nullptr) return;
+  AddBandCandidates(detector_(*frame, band), candidates);
+  ++stats_.band_scans;
+}
+
 CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   CameraMessage m;
   m.camera = camera_index_;
@@ -131,6 +200,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       m.candidates = detector_(*frame, window);
       ++stats_.window_scans;
       full = !track_->Confirms(m.candidates);
+      if (!full) SearchBand(in, &m.candidates);
     }
     if (full && !window.empty()) frame = Image(in, cv::Rect());
     if (frame == nullptr) {
@@ -140,8 +210,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       ++stats_.full_scans;
     }
   }
-  full = full || frame == nullptr;
-  track_->Update(m.candidates, full);
+  track_->Update(m.candidates);
   ++stats_.frames;
   for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
   return m;

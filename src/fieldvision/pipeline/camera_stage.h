@@ -2,9 +2,13 @@
 // (CameraMessage). It tracks the ball in the image and searches a window around where it is
 // expected (constant velocity in the image), decoding encoded frames (SourceFrame::jpeg) only
 // there; the whole frame when the window has no accepted candidate or its best one is not where
-// the ball was expected (another object took the window), when the ball was not seen in the
-// previous frame and at least every full_scan_every frames. The same stage serves the
-// in-process pipeline (ball_pipeline.h) and the camera node (net/node.h).
+// the ball was expected (another object took the window) and when the ball was not seen in the
+// previous frame. While tracking it looks for other balls too: the whole frame every
+// full_scan_every frames, each camera at its own phase (from its name) so that the cameras of a
+// rig do not all pay for it in the same frame; or (bands) one band of rows a frame besides the
+// window, in turn, covering the whole frame as often at a bounded cost per frame (no spikes; about
+// twice the work on average). The same stage serves the in-process pipeline (ball_pipeline.h) and
+// the camera node (net/node.h).
 #pragma once
 
 #include <functional>
@@ -30,7 +34,11 @@ using BallRegionDetectFn =
 // Ball tracking in each camera stage (see above).
 struct BallTrackOptions {
   bool enabled = true;
-  int full_scan_every = 20;
+  int full_scan_every = 20;  // while tracking, the whole frame is covered every N frames
+  // Cover it in bands, one a frame (the frame's height / full_scan_every, widened on both sides by
+  // 1.5 diameters of a ball twice the tracked one's size, plus 4 px, so that such a ball lies
+  // wholly inside some band with the detector's margin); false: the whole frame at once.
+  bool bands = false;
   double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
   int min_window_px = 40;     // half-size of the window at least
   void Check() const;         // throws fv::Error naming the bad field
@@ -41,6 +49,7 @@ struct CameraStageStats {
   long long candidates = 0;    // accepted candidates reported
   long long full_scans = 0;    // frames searched whole
   long long window_scans = 0;  // frames searched in a window
+  long long band_scans = 0;    // of these, also in a band of rows
   long long bad_frames = 0;    // encoded frames that could not be decoded
   std::string first_bad_frame;
 };
@@ -65,6 +74,7 @@ class CameraStage {
   class Track;
   const cv::Mat* Image(const io::SourceFrame& in, const cv::Rect& roi);
   void CheckSize(const cv::Size& got, long long frame) const;
+  void SearchBand(const io::SourceFrame& in, std::vector<recon::BallObservation>* candidates);
   int camera_index_;
   cv::Size size_;
   BallRegionDetectFn detector_;

@@ -1,5 +1,6 @@
 // The camera stage's tracking window: a ball that leaves the window where another accepted object
-// lies is found again by a whole-frame search in that frame, not after full_scan_every frames.
+// lies is found again by a whole-frame search in that frame, not after full_scan_every frames;
+// while tracking, bands of rows cover the whole frame every full_scan_every frames.
 #include "fieldvision/pipeline/camera_stage.h"
 
 #include <gtest/gtest.h>
@@ -63,6 +64,95 @@ TEST(CameraStage, ABallThatLeavesItsWindowIsSearchedForInTheWholeFrame) {
                           << ") is not among the " << m.candidates.size() << " candidates";
   }
   EXPECT_LT(stage.stats().full_scans, 4);  // the first frame, and where the ball jumped
+}
+
+TEST(CameraStage, WhileTrackingBandsCoverTheFrameAndFindAnotherBall) {
+  const camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
+  // The ball rests at (320, 100); another ball-like object appears at frame 3 at (500, 430),
+  // far outside the window. Every frame's searched regions are recorded.
+  const Vector2d ball(320, 100), other(500, 430);
+  std::vector<std::vector<Thing>> frames;
+  for (int f = 0; f < 24; ++f) {
+    frames.push_back({{ball, 0.9}});
+    if (f >= 3) frames.back().push_back({other, 0.6});
+  }
+  long long f = 0;
+  std::vector<std::vector<cv::Rect>> searched(frames.size());
+  auto scripted = Scripted(&frames, &f);
+  auto recording = [&](const cv::Mat& bgr, const cv::Rect& roi) {
+    searched[f].push_back(roi);
+    return scripted(bgr, roi);
+  };
+  BallTrackOptions track;
+  track.full_scan_every = 8;
+  track.bands = true;
+  CameraStage stage(0, cam, recording, track, "scripted");
+  long long first_seen = -1;
+  for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+    io::SourceFrame in;
+    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+    in.frame = f;
+    const CameraMessage m = stage.Process(in);
+    ASSERT_FALSE(m.candidates.empty()) << "frame " << f;
+    EXPECT_NEAR((m.candidates[0].centre_px - ball).norm(), 0.0, 1e-9) << "frame " << f;
+    const bool has_other = std::any_of(m.candidates.begin(), m.candidates.end(),
+                                       [&](auto& o) { return (o.centre_px - other).norm() < 1; });
+    if (has_other && first_seen < 0) first_seen = f;
+    EXPECT_LE(m.candidates.size(), 2u) << "frame " << f << ": a ball reported twice";
+  }
+  EXPECT_EQ(stage.stats().full_scans, 1);  // the first frame only
+  EXPECT_EQ(stage.stats().band_scans, 23);
+  ASSERT_GE(first_seen, 3);
+  EXPECT_LT(first_seen, 3 + 8) << "not found within one cover of the frame";
+  // Any 8 frames in a row search one band each (besides the window): together every row, each band
+  // a bounded share of the frame (480 / 8 rows plus 1.5 diameters of a ball twice the tracked one's
+  // size, plus 4 px, each side: the scripted balls have a 5 px radius).
+  std::vector<int> rows(480, 0);
+  for (int g = 1; g <= 8; ++g) {
+    ASSERT_EQ(searched[g].size(), 2u) << "frame " << g;
+    const cv::Rect& band = searched[g][1];
+    EXPECT_EQ(band.x, 0);
+    EXPECT_EQ(band.width, 640);
+    EXPECT_LE(band.height, 60 + 2 * 34) << "frame " << g;
+    for (int y = band.y; y < band.y + band.height; ++y) ++rows[y];
+  }
+  EXPECT_EQ(std::count(rows.begin(), rows.end(), 0), 0) << "rows never searched";
+}
+
+TEST(CameraStage, CamerasSearchWholeFramesEveryFullScanEveryFramesEachAtItsOwnPhase) {
+  // A resting ball, always found: besides the first frame, each camera searches the whole frame
+  // once every 8 frames, and cameras of a rig mostly in different frames.
+  std::vector<std::vector<Thing>> frames(33, {{Vector2d(320, 100), 0.9}});
+  long long f = 0;
+  BallTrackOptions track;
+  track.full_scan_every = 8;
+  std::vector<int> whole_in_frame(frames.size(), 0);
+  for (const char* name : {"cam1", "cam2", "cam3", "cam4", "left", "right"}) {
+    camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
+    cam.name = name;
+    std::vector<long long> whole;
+    auto scripted = Scripted(&frames, &f);
+    auto recording = [&](const cv::Mat& bgr, const cv::Rect& roi) {
+      if (roi.empty()) whole.push_back(f);
+      return scripted(bgr, roi);
+    };
+    CameraStage stage(0, cam, recording, track, "scripted");
+    for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+      io::SourceFrame in;
+      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+      in.frame = f;
+      stage.Process(in);
+    }
+    ASSERT_GE(whole.size(), 5u) << name;
+    EXPECT_EQ(whole[0], 0) << name;
+    EXPECT_LE(whole[1], 8) << name;
+    for (size_t i = 2; i < whole.size(); ++i) EXPECT_EQ(whole[i] - whole[i - 1], 8) << name;
+    for (size_t i = 1; i < whole.size(); ++i) ++whole_in_frame[whole[i]];
+    EXPECT_EQ(stage.stats().full_scans, static_cast<long long>(whole.size()));
+    EXPECT_EQ(stage.stats().band_scans, 0);
+  }
+  // 6 cameras in 8 phases: not all in one frame (at most 2 share one, for these names).
+  EXPECT_LE(*std::max_element(whole_in_frame.begin() + 1, whole_in_frame.end()), 2);
 }
 
 }  // namespace
