@@ -7,8 +7,8 @@
 # ZeroMQ, clock correction, pairing and triangulation alone. Also prints the frames the nodes
 # could not keep up with (skipped by the source), where the latency goes (the nodes' source
 # buffer, their work per frame, transport, pairing), the machine's load and the accuracy against
-# the scene's truth. A third run has the nodes look for other balls in one band of rows a frame
-# (--scan-bands) instead of whole frames every 20 frames.
+# the scene's truth. A third run has the nodes split their search for other balls (the whole
+# frame every 20 frames) into two bands of rows in consecutive frames (--scan-bands 2).
 # Usage: bench/ball_pipeline_live.sh [BUILD_DIR] [WIDTHxHEIGHT]   (default 1280x960; the scene is
 # cached in BUILD_DIR/bench-data)
 set -euo pipefail
@@ -53,7 +53,7 @@ run() {  # name extra-node-args...
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
 run transport --no-detect
 run detect
-run detect-bands --scan-bands  # other balls looked for in bands of rows, not whole frames
+run detect-2-bands --scan-bands 2  # the search for other balls in two halves, not whole frames
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 "$FV" eval ball --truth "$SCENE/truth.csv" --est "$SCENE/live_detect.csv" | tail -2
 awk 'NR == FNR { b50 = $1; b95 = $2; next } { printf "detection adds: p50 %.1f ms, p95 %.1f ms (%.2fx, %.2fx the transport-only baseline)\n", $1 - b50, $2 - b95, $1 / b50, $2 / b95 }' \

@@ -46,10 +46,11 @@ inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
                   "While tracking, search the whole frame for other balls every N frames")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_flag("--scan-bands", t.bands,
-                "While tracking, search one band of rows a frame instead, covering the whole frame "
-                "every --full-scan-every frames (no spike in work per frame; about twice the "
-                "work on average)");
+  cmd->add_option("--scan-bands", t.scan_bands,
+                  "Split that search into N bands of rows, one a frame (1..--full-scan-every): a "
+                  "lower peak of work per frame, a little more work on average")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
 }
 
 }  // namespace fv::app

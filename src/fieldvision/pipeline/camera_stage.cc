@@ -13,6 +13,9 @@ namespace fv::pipeline {
 void BallTrackOptions::Check() const {
   FV_REQUIRE(full_scan_every >= 1, "BallTrackOptions.full_scan_every must be >= 1 (got {})",
              full_scan_every);
+  FV_REQUIRE(scan_bands >= 1 && scan_bands <= full_scan_every,
+             "BallTrackOptions.scan_bands must be 1..full_scan_every ({}) (got {})",
+             full_scan_every, scan_bands);
   FV_REQUIRE(std::isfinite(window_radii) && window_radii >= 2,
              "BallTrackOptions.window_radii must be >= 2 (got {})", window_radii);
   FV_REQUIRE(min_window_px >= 8, "BallTrackOptions.min_window_px must be >= 8 (got {})",
@@ -33,7 +36,7 @@ class CameraStage::Track {
   Track(const BallTrackOptions& o, int phase) : o_(o), phase_(phase) {}
   // The window for the next frame, or an empty rectangle for the whole frame.
   cv::Rect Window(const cv::Size& image) const {
-    if (!o_.enabled || !active_ || (!o_.bands && Slot() == 0)) return {};
+    if (!o_.enabled || !active_ || (o_.scan_bands == 1 && Slot() == 0)) return {};
     const Eigen::Vector2d p = centre_ + velocity_;
     const double half =
         std::max<double>(o_.min_window_px, o_.window_radii * radius_ + velocity_.norm());
@@ -46,8 +49,8 @@ class CameraStage::Track {
   }
   // The band of rows to search besides the window in this frame (empty: none).
   cv::Rect Band(const cv::Size& image) const {
-    if (!o_.enabled || !active_ || !o_.bands) return {};
-    const int core = (image.height + o_.full_scan_every - 1) / o_.full_scan_every;
+    if (!o_.enabled || !active_ || o_.scan_bands == 1 || Slot() >= o_.scan_bands) return {};
+    const int core = (image.height + o_.scan_bands - 1) / o_.scan_bands;
     const int margin = static_cast<int>(std::ceil(1.5 * 4.0 * radius_ + 4.0));
     const int y0 = std::max(0, Slot() * core - margin);
     const int y1 = std::min(image.height, (Slot() + 1) * core + margin);
@@ -175,7 +178,7 @@ const cv::Mat* CameraStage::Image(const io::SourceFrame& in, const cv::Rect& roi
   return &decoded_;
 }
 
-// While the window confirms the track: the next band of rows, when bands are on.
+// While the window confirms the track: this frame's band of rows, if it has one.
 void CameraStage::SearchBand(const io::SourceFrame& in,
                              std::vector<recon::BallObservation>* candidates) {
   const cv::Rect band = track_->Band(size_);

@@ -5,10 +5,10 @@
 // the ball was expected (another object took the window) and when the ball was not seen in the
 // previous frame. While tracking it looks for other balls too: the whole frame every
 // full_scan_every frames, each camera at its own phase (from its name) so that the cameras of a
-// rig do not all pay for it in the same frame; or (bands) one band of rows a frame besides the
-// window, in turn, covering the whole frame as often at a bounded cost per frame (no spikes; about
-// twice the work on average). The same stage serves the in-process pipeline (ball_pipeline.h) and
-// the camera node (net/node.h).
+// rig do not all pay for it in the same frame; that search may be split into bands of rows, one a
+// frame besides the window, for a lower peak of work per frame (a latency spike on a live node)
+// at some more work on average (the bands overlap). The same stage serves the in-process
+// pipeline (ball_pipeline.h) and the camera node (net/node.h).
 #pragma once
 
 #include <functional>
@@ -34,11 +34,12 @@ using BallRegionDetectFn =
 // Ball tracking in each camera stage (see above).
 struct BallTrackOptions {
   bool enabled = true;
-  int full_scan_every = 20;  // while tracking, the whole frame is covered every N frames
-  // Cover it in bands, one a frame (the frame's height / full_scan_every, widened on both sides by
-  // 1.5 diameters of a ball twice the tracked one's size, plus 4 px, so that such a ball lies
-  // wholly inside some band with the detector's margin); false: the whole frame at once.
-  bool bands = false;
+  int full_scan_every = 20;  // while tracking, the whole frame is searched every N frames
+  // In this many bands of rows (1..full_scan_every), one a frame in consecutive frames: the
+  // frame's height / scan_bands, widened on both sides by 1.5 diameters of a ball twice the tracked
+  // one's size plus 4 px, so that such a ball lies wholly inside some band with the detector's
+  // margin. 1: the whole frame at once.
+  int scan_bands = 1;
   double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
   int min_window_px = 40;     // half-size of the window at least
   void Check() const;         // throws fv::Error naming the bad field

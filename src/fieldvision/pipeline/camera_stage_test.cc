@@ -85,7 +85,7 @@ TEST(CameraStage, WhileTrackingBandsCoverTheFrameAndFindAnotherBall) {
   };
   BallTrackOptions track;
   track.full_scan_every = 8;
-  track.bands = true;
+  track.scan_bands = 8;
   CameraStage stage(0, cam, recording, track, "scripted");
   long long first_seen = -1;
   for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
@@ -117,6 +117,35 @@ TEST(CameraStage, WhileTrackingBandsCoverTheFrameAndFindAnotherBall) {
     for (int y = band.y; y < band.y + band.height; ++y) ++rows[y];
   }
   EXPECT_EQ(std::count(rows.begin(), rows.end(), 0), 0) << "rows never searched";
+}
+
+TEST(CameraStage, TheWholeFrameSearchInTwoBandsTakesTwoFramesOfEachPeriod) {
+  const camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
+  std::vector<std::vector<Thing>> frames(1 + 16, {{Vector2d(320, 100), 0.9}});
+  long long f = 0;
+  std::vector<cv::Rect> bands;
+  auto scripted = Scripted(&frames, &f);
+  auto recording = [&](const cv::Mat& bgr, const cv::Rect& roi) {
+    if (!roi.empty() && roi.width == 640) bands.push_back(roi);
+    return scripted(bgr, roi);
+  };
+  BallTrackOptions track;
+  track.full_scan_every = 8;
+  track.scan_bands = 2;
+  CameraStage stage(0, cam, recording, track, "scripted");
+  for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+    io::SourceFrame in;
+    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+    in.frame = f;
+    stage.Process(in);
+  }
+  EXPECT_EQ(stage.stats().full_scans, 1);
+  ASSERT_EQ(bands.size(), 4u);  // two in each period of 8 frames after the first frame
+  for (const cv::Rect& b : bands) EXPECT_LE(b.height, 240 + 2 * 34);
+  EXPECT_EQ(std::min(bands[0].y, bands[1].y), 0);
+  EXPECT_EQ(std::max(bands[0].y + bands[0].height, bands[1].y + bands[1].height), 480);
+  EXPECT_GE(std::min(bands[0].y + bands[0].height, bands[1].y + bands[1].height),
+            std::max(bands[0].y, bands[1].y) + 2 * 34);  // overlapping by the margins
 }
 
 TEST(CameraStage, CamerasSearchWholeFramesEveryFullScanEveryFramesEachAtItsOwnPhase) {
