@@ -71,17 +71,25 @@ void HoverFilter::Record(double time_s, const Eigen::Vector3d& point_world, doub
 
 bool HoverFilter::RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {
   std::vector<double> times;  // earlier frames that saw this point
+  double z_min = point_world.z(), z_max = point_world.z();
   for (const Seen& s : seen_) {
     const double tolerance_m = std::max(options_.radius_m, 3 * std::hypot(sigma_m, s.sigma_m));
     if (s.time_s < time_s && (s.point_world - point_world).norm() <= tolerance_m) {
       times.push_back(s.time_s);
+      z_min = std::min(z_min, s.point_world.z());
+      z_max = std::max(z_max, s.point_world.z());
     }
   }
   Record(time_s, point_world, sigma_m);
   std::sort(times.begin(), times.end());
   const int count = 1 + static_cast<int>(std::unique(times.begin(), times.end()) - times.begin());
-  return count >= options_.min_count && !times.empty() &&
-         time_s - times.front() >= options_.min_span_s;
+  if (count < options_.min_count || times.empty() || time_s - times.front() < options_.min_span_s) {
+    return false;
+  }
+  // A free ball's heights span at least g T^2 / 8 over any T seconds (T/2 each side of an apex).
+  constexpr double kGravity = 9.81;
+  const double t = options_.min_span_s;
+  return z_max - z_min < 0.5 * kGravity * t * t / 8;
 }
 
 recon::BallSample BallSampleOf(const BallFrame& f) {

@@ -59,11 +59,12 @@ class BallPredictor {
 // as a ball by two cameras whose rays meet there): a ball cannot hover, so an airborne position
 // (higher than a resting ball by airborne_m and three standard deviations of its height) that
 // repeats one point (within radius_m or three standard deviations of the two positions' distance)
-// at least min_count times over at least min_span_s is not the ball. A ball that passes one
-// point twice (up and down) does so within a fast track, which the fusion stage exempts; a free
-// ball near its apex stays within 10 cm for about 0.29 s.
+// at least min_count times over at least min_span_s, all those heights within half of g T^2 / 8
+// (T = min_span_s), is not the ball: a free ball's heights span at least g T^2 / 8 over any T
+// seconds (11 cm in 0.3 s, about its apex), however slowly it moves across or often it comes
+// back (juggled). A ghost's horizontal position jitters with its blobs' shapes, hence 25 cm.
 struct HoverFilterOptions {
-  double radius_m = 0.10;    // the same point: closer than this
+  double radius_m = 0.25;    // the same point: closer than this
   double min_span_s = 0.3;   // seen there over at least this long
   int min_count = 3;         // this many times, the position tested included
   double airborne_m = 0.05;  // height above a resting ball's centre that is airborne

@@ -35,7 +35,7 @@ TEST(BallPredictor, PredictsAlongATrackOnly) {
 }
 
 TEST(HoverFilter, AStillAirbornePointIsFlaggedAfterTheSpan) {
-  HoverFilter filter;  // 10 cm, 0.3 s, 3 frames
+  HoverFilter filter;  // 25 cm, 0.3 s, 3 frames
   const Vector3d sign(3.0, -6.8, 0.62);
   int first_flagged = -1;
   for (int f = 0; f < 40; ++f) {
@@ -53,6 +53,34 @@ TEST(HoverFilter, AFlyingBallIsNeverFlagged) {
     const Vector3d p(-3 + 10.4 * t, 0.5, 0.11 + 6.0 * t - 0.5 * 9.81 * t * t);
     if (p.z() < 0.11) break;
     EXPECT_FALSE(filter.RecordAndTest(t, p, 0.005)) << "frame " << f;
+  }
+}
+
+TEST(HoverFilter, AGhostThatJittersAlongTheStandsIsFlagged) {
+  // Two cameras' seat candidates meeting above the field: its x wanders by 15 cm from frame to
+  // frame (the blobs' shapes), its height by 1 cm.
+  HoverFilter filter;
+  const Vector3d ghost(1.1, 3.83, 2.45);
+  int first_flagged = -1;
+  for (int f = 0; f < 40; ++f) {
+    const Vector3d p =
+        ghost + Vector3d(0.075 * std::sin(2.1 * f), 0.01 * std::cos(f), 0.01 * std::sin(5 * f));
+    if (filter.RecordAndTest(f / 60.0, p, 0.01) && first_flagged < 0) first_flagged = f;
+  }
+  EXPECT_GE(first_flagged, 18);
+  EXPECT_LE(first_flagged, 24);
+}
+
+TEST(HoverFilter, ASlowBallNearItsApexOrPassingAPointTwiceIsNeverFlagged) {
+  // Thrown up at 3 m/s and drifting at 0.2 m/s: 0.45 s within 25 cm of its apex; then juggled
+  // again from the same place (the same heights twice).
+  HoverFilter filter;
+  for (int f = 0; f < 120; ++f) {
+    const double t = f / 60.0;
+    const double in_throw = std::fmod(t, 0.6);
+    const Vector3d p(2 + 0.2 * in_throw, 1,
+                     0.5 + 3.0 * in_throw - 0.5 * 9.81 * in_throw * in_throw);
+    EXPECT_FALSE(filter.RecordAndTest(t, p, 0.01)) << "frame " << f;
   }
 }
 
