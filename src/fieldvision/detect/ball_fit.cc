@@ -463,9 +463,14 @@ bool RansacCircle(const std::vector<Vector2d>& pts, double thr, int iterations, 
     Vector2d c;
     double r;
     if (!CircleFrom3(pts[i], pts[j], pts[k], &c, &r)) continue;
-    int count = 0;
-    for (const auto& p : pts) count += std::abs((p - c).norm() - r) < thr;
-    if (count > best) {
+    // A triple that cannot beat the best even with every remaining point an inlier stops.
+    int count = 0, left = n;
+    for (const auto& p : pts) {
+      if (count + left <= best) break;
+      count += std::abs((p - c).norm() - r) < thr;
+      --left;
+    }
+    if (left == 0 && count > best) {
       best = count;
       best_c = c;
       best_r = r;

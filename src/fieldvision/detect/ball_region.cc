@@ -46,19 +46,103 @@ void ClassMasks(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
   }
 }
 
-// The components of `labels` near the seed, gathered twice (fragments of a printed ball).
-cv::Mat GatherComponents(const cv::Mat& labels, const cv::Mat& stats, const cv::Rect& seed,
-                         double gather_fraction, cv::Rect* bounds) {
-  const int n = stats.rows;
+// The 8-connected components of a binary mask (CV_8U, non-zero set) as runs of set pixels, row
+// by row: what cv::connectedComponents finds, without a label image.
+struct MaskComponents {
+  struct Run {
+    int y, x0, x1;  // x0..x1 inclusive
+  };
+  std::vector<Run> runs;
+  std::vector<int> component;  // of each run, 0..count-1
+  int count = 0;
+};
+
+int FindRoot(std::vector<int>& parent, int i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+MaskComponents LabelMask(const cv::Mat& mask) {
+  MaskComponents mc;
+  std::vector<int> parent;
+  int prev_begin = 0, prev_end = 0;
+  for (int y = 0; y < mask.rows; ++y) {
+    const uint8_t* m = mask.ptr<uint8_t>(y);
+    const int cur_begin = static_cast<int>(mc.runs.size());
+    for (int x = 0; x < mask.cols; ++x) {
+      if (m[x] == 0) continue;
+      const int x0 = x;
+      while (x + 1 < mask.cols && m[x + 1] != 0) ++x;
+      mc.runs.push_back({y, x0, x});
+      parent.push_back(static_cast<int>(parent.size()));
+    }
+    const int cur_end = static_cast<int>(mc.runs.size());
+    // Runs of consecutive rows touch (8-connected) when they overlap or meet at a corner.
+    for (int a = prev_begin, b = cur_begin; a < prev_end && b < cur_end;) {
+      const auto& p = mc.runs[a];
+      const auto& c = mc.runs[b];
+      if (p.x0 <= c.x1 + 1 && c.x0 <= p.x1 + 1) {
+        const int ra = FindRoot(parent, a), rb = FindRoot(parent, b);
+        if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+      }
+      if (p.x1 < c.x1) {
+        ++a;
+      } else {
+        ++b;
+      }
+    }
+    prev_begin = cur_begin;
+    prev_end = cur_end;
+  }
+  mc.component.resize(mc.runs.size());
+  std::vector<int> id(mc.runs.size(), -1);
+  for (size_t i = 0; i < mc.runs.size(); ++i) {
+    int& c = id[FindRoot(parent, static_cast<int>(i))];
+    if (c < 0) c = mc.count++;
+    mc.component[i] = c;
+  }
+  return mc;
+}
+
+// The mask (CV_8U, 255 set) of the components of `mc` with `chosen` set, `size` large.
+cv::Mat PaintComponents(const MaskComponents& mc, const std::vector<char>& chosen,
+                        const cv::Size& size) {
+  cv::Mat out(size, CV_8U, cv::Scalar(0));
+  for (size_t i = 0; i < mc.runs.size(); ++i) {
+    if (!chosen[mc.component[i]]) continue;
+    const auto& run = mc.runs[i];
+    uint8_t* m = out.ptr<uint8_t>(run.y);
+    std::fill(m + run.x0, m + run.x1 + 1, uint8_t{255});
+  }
+  return out;
+}
+
+// The components of `mask` (window coordinates) near the seed, gathered twice (fragments of a
+// printed ball).
+cv::Mat GatherComponents(const cv::Mat& mask, const cv::Rect& seed, double gather_fraction,
+                         cv::Rect* bounds) {
+  const MaskComponents mc = LabelMask(mask);
+  const int n = mc.count;
+  std::vector<cv::Rect> boxes(n);
+  std::vector<char> has(n, 0);
+  for (size_t i = 0; i < mc.runs.size(); ++i) {
+    const auto& run = mc.runs[i];
+    const cv::Rect r(run.x0, run.y, run.x1 - run.x0 + 1, 1);
+    const int c = mc.component[i];
+    boxes[c] = has[c] ? (boxes[c] | r) : r;
+    has[c] = 1;
+  }
   std::vector<char> chosen(n, 0);
   cv::Rect reach = seed;
   cv::Rect box;
   for (int round = 0; round < 2; ++round) {
     const double r = 0.5 * std::max(reach.width, reach.height);
     const cv::Rect grown = Grow(reach, static_cast<int>(std::ceil(gather_fraction * r)) + 2);
-    for (int i = 1; i < n; ++i) {
-      const cv::Rect b(stats.at<int>(i, cv::CC_STAT_LEFT), stats.at<int>(i, cv::CC_STAT_TOP),
-                       stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT));
+    for (int i = 0; i < n; ++i) {
+      const cv::Rect& b = boxes[i];
       // The first round takes what touches the seed itself, the second what is near it.
       const cv::Rect& target = round == 0 ? seed : grown;
       if (!chosen[i] && (b & target).area() > 0) {
@@ -70,13 +154,7 @@ cv::Mat GatherComponents(const cv::Mat& labels, const cv::Mat& stats, const cv::
     reach = box;
   }
   *bounds = box;
-  cv::Mat region(labels.size(), CV_8U, cv::Scalar(0));
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* l = labels.ptr<int>(y);
-    uint8_t* m = region.ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) m[x] = chosen[l[x]] ? 255 : 0;
-  }
-  return region;
+  return PaintComponents(mc, chosen, mask.size());
 }
 
 // RANSAC for the circle of a partly hidden disc: an occluder's edge lies inside the true circle,
@@ -100,12 +178,15 @@ bool OuterCircle(const std::vector<Vector2d>& pts, double thr, int iterations, V
     Vector2d cc;
     double r = 0;
     if (!CircleFrom3(pts[i], pts[j], pts[k], &cc, &r)) continue;
-    int score = 0;
+    // A hypothesis that cannot beat the best even with every remaining point an inlier stops.
+    int score = 0, left = n;
     for (const auto& p : pts) {
+      if (score + left <= best) break;
       const double e = (p - cc).norm() - r;
       score += std::abs(e) < thr ? 1 : (e > 0 ? -1 : 0);
+      --left;
     }
-    if (score > best) {
+    if (left == 0 && score > best) {
       best = score;
       best_c = cc;
       best_r = r;
@@ -215,19 +296,14 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
     }
   }
   // Keep what is connected to the region.
-  cv::Mat labels;
-  const int n = cv::connectedComponents(joined, labels, 8, CV_32S);
-  std::vector<char> keep(n, 0);
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* lb = labels.ptr<int>(y);
-    const uint8_t* m = region->ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) keep[lb[x]] |= m[x] != 0;
+  const MaskComponents mc = LabelMask(joined);
+  std::vector<char> keep(mc.count, 0);
+  for (size_t i = 0; i < mc.runs.size(); ++i) {
+    const auto& run = mc.runs[i];
+    const uint8_t* m = region->ptr<uint8_t>(run.y);
+    keep[mc.component[i]] |= std::any_of(m + run.x0, m + run.x1 + 1, [](uint8_t v) { return v; });
   }
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* lb = labels.ptr<int>(y);
-    uint8_t* m = region->ptr<uint8_t>(y);
-    for (int x = 0; x < labels.cols; ++x) m[x] = lb[x] > 0 && keep[lb[x]] ? 255 : 0;
-  }
+  PaintComponents(mc, keep, region->size()).copyTo(*region);
 }
 
 // GrowByOwnColourIn on the part of the window within reach of the region (and its ring).
@@ -248,10 +324,8 @@ void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOpt
 // empty when no ball-coloured pixel touches the seed.
 cv::Mat GrowAndCloseRegion(const cv::Mat& raw, const cv::Mat& grow, const cv::Mat& lab,
                            const cv::Rect& seed, const BallRegionOptions& o) {
-  cv::Mat labels, stats, centroids;
-  cv::connectedComponentsWithStats(raw, labels, stats, centroids, 8, CV_32S);
   cv::Rect bounds;
-  cv::Mat region = GatherComponents(labels, stats, seed, o.gather_fraction, &bounds);
+  cv::Mat region = GatherComponents(raw, seed, o.gather_fraction, &bounds);
   if (bounds.area() == 0) return {};
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
   if (grow.data != raw.data) {
