@@ -21,30 +21,56 @@ cv::Rect Grow(const cv::Rect& r, int g) {
   return {r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g};
 }
 
-// Ball-class pixels of `window` (CV_8U, 255 = ball) in `raw`, and in `grow` those of
-// `grow_table` (the same matrix as `raw` when there is none), in one pass over the pixels.
-void ClassMasks(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
-                const ColourTable* grow_table, const cv::Rect& window, cv::Mat* raw,
-                cv::Mat* grow) {
-  raw->create(window.size(), CV_8U);
-  if (grow_table == nullptr) {
-    *grow = *raw;
-  } else {
-    grow->create(window.size(), CV_8U);
-  }
-  const uint8_t grow_bit = grow_table == nullptr ? 0 : grow_table->BallBit();
-  for (int y = 0; y < window.height; ++y) {
-    const uint8_t* p = bgr.ptr<uint8_t>(window.y + y) + 3 * static_cast<ptrdiff_t>(window.x);
+// The class bits of `table` of every pixel of `bgr_window` in `cls` (CV_8U) and its `bit` class
+// in `raw` (CV_8U, 255 = in the class), in one pass over the pixels.
+void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit, cv::Mat* raw,
+                cv::Mat* cls) {
+  raw->create(bgr_window.size(), CV_8U);
+  cls->create(bgr_window.size(), CV_8U);
+  for (int y = 0; y < bgr_window.rows; ++y) {
+    const uint8_t* p = bgr_window.ptr<uint8_t>(y);
     uint8_t* m = raw->ptr<uint8_t>(y);
-    uint8_t* g = grow->ptr<uint8_t>(y);
-    for (int x = 0; x < window.width; ++x, p += 3) {
-      m[x] = (table.Classify(p[0], p[1], p[2]) & bit) != 0 ? 255 : 0;
-      if (grow_table != nullptr) {
-        g[x] = (grow_table->Classify(p[0], p[1], p[2]) & grow_bit) != 0 ? 255 : 0;
-      }
+    uint8_t* k = cls->ptr<uint8_t>(y);
+    for (int x = 0; x < bgr_window.cols; ++x, p += 3) {
+      k[x] = table.Classify(p[0], p[1], p[2]);
+      m[x] = (k[x] & bit) != 0 ? 255 : 0;
     }
   }
 }
+
+// The window's CIELAB (cv::COLOR_BGR2Lab, converted pixel by pixel), converted only where asked
+// for: most of the window is never read.
+class LabWindow {
+ public:
+  explicit LabWindow(const cv::Mat& bgr_window)
+      : bgr_(bgr_window), lab_(bgr_window.size(), CV_8UC3) {}
+  // Valid inside every rectangle passed to Need.
+  const cv::Mat& lab() const { return lab_; }
+  void Need(const cv::Rect& rect) {
+    const cv::Rect r = rect & cv::Rect(0, 0, lab_.cols, lab_.rows);
+    const cv::Rect both = r & done_;
+    if (both.area() == 0) {
+      Convert(r);
+      if (done_.area() == 0) done_ = r;
+      return;
+    }
+    // r less what the first rectangle converted: the rows above and below it, then the columns
+    // left and right of it.
+    Convert({r.x, r.y, r.width, both.y - r.y});
+    Convert({r.x, both.br().y, r.width, r.br().y - both.br().y});
+    Convert({r.x, both.y, both.x - r.x, both.height});
+    Convert({both.br().x, both.y, r.br().x - both.br().x, both.height});
+  }
+
+ private:
+  void Convert(const cv::Rect& r) {
+    if (r.width <= 0 || r.height <= 0) return;
+    cv::Mat dst = lab_(r);
+    cv::cvtColor(bgr_(r), dst, cv::COLOR_BGR2Lab);
+  }
+  cv::Mat bgr_, lab_;
+  cv::Rect done_;
+};
 
 // The 8-connected components of a binary mask (CV_8U, non-zero set) as runs of set pixels, row
 // by row: what cv::connectedComponents finds, without a label image.
@@ -307,7 +333,7 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
 }
 
 // GrowByOwnColourIn on the part of the window within reach of the region (and its ring).
-void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOptions& o,
+void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions& o,
                      cv::Mat* region) {
   const cv::Rect box = cv::boundingRect(*region);
   if (box.area() == 0) return;
@@ -317,26 +343,38 @@ void GrowByOwnColour(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOpt
       2;
   const cv::Rect sub = Grow(box, margin) & cv::Rect(0, 0, region->cols, region->rows);
   cv::Mat part = (*region)(sub);
-  GrowByOwnColourIn(lab(sub), raw(sub), o, r, &part);
+  lab->Need(sub);
+  GrowByOwnColourIn(lab->lab()(sub), raw(sub), o, r, &part);
 }
 
 // The gathered region grown through the widened class near its core and closed (print, seams);
-// empty when no ball-coloured pixel touches the seed.
-cv::Mat GrowAndCloseRegion(const cv::Mat& raw, const cv::Mat& grow, const cv::Mat& lab,
-                           const cv::Rect& seed, const BallRegionOptions& o) {
+// empty when no ball-coloured pixel touches the seed. `grow_table`: the widened class (null: none).
+cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
+                           const ColourTable* grow_table, LabWindow* lab, const cv::Rect& seed,
+                           const BallRegionOptions& o) {
   cv::Rect bounds;
   cv::Mat region = GatherComponents(raw, seed, o.gather_fraction, &bounds);
   if (bounds.area() == 0) return {};
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
-  if (grow.data != raw.data) {
+  if (grow_table != nullptr) {
     // Hysteresis with a reach: widened-class pixels join only near the core (a shaded rim, a
-    // pale cap), so a neighbour of a similar colour is not taken in.
+    // pale cap), so a neighbour of a similar colour is not taken in. Nothing farther than the
+    // reach from the gathered bounds can join: only that part is dilated and classified.
     const int reach = std::max(1, static_cast<int>(std::lround(o.grow_fraction * r_region)));
+    const cv::Rect sub = Grow(bounds, reach) & cv::Rect(0, 0, raw.cols, raw.rows);
     cv::Mat near;
     cv::dilate(
-        region, near,
+        region(sub), near,
         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
-    cv::bitwise_or(region, grow & near, region);
+    const uint8_t grow_bit = grow_table->BallBit();
+    for (int y = 0; y < sub.height; ++y) {
+      const uint8_t* p = bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x);
+      const uint8_t* nr = near.ptr<uint8_t>(y);
+      uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
+      for (int x = 0; x < sub.width; ++x, p += 3) {
+        if (nr[x] != 0 && (grow_table->Classify(p[0], p[1], p[2]) & grow_bit) != 0) m[x] = 255;
+      }
+    }
   }
   if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region);
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
@@ -461,8 +499,8 @@ double OutlineExtent(const std::vector<Vector2d>& pts, const Vector2d& c, double
 // `filled` is the closed, filled region, `raw` the ball class (window coordinates); `area` the
 // region's area.
 void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& lab,
-                          const cv::Mat& filled, const cv::Mat& raw, const Vector2d& c, double r,
-                          double area, const BallRegionOptions& o, const ColourTable& table,
+                          const cv::Mat& filled, const cv::Mat& raw, const cv::Mat& cls,
+                          const Vector2d& c, double r, double area, const BallRegionOptions& o,
                           uint8_t field_bit, BallRegion* out) {
   std::array<std::vector<double>, 3> disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
@@ -491,10 +529,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
         if (m[x] == 0) {  // what is around the ball, not more of its colour (that is leak)
           const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
           for (int ch = 0; ch < 3; ++ch) ring_lab[ch].push_back(l[ch]);
-          if (field_bit != 0) {
-            const uint8_t* p = bgr.ptr<uint8_t>(window.y + y) + 3 * (window.x + x);
-            ring_field += (table.Classify(p[0], p[1], p[2]) & field_bit) != 0;
-          }
+          ring_field += (cls.ptr<uint8_t>(y)[x] & field_bit) != 0;
         }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
@@ -541,11 +576,11 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     out.failure = "seed outside the searched region";
     return out;
   }
-  cv::Mat raw, grow;
-  ClassMasks(bgr, table, ball_bit, grow_table, window, &raw, &grow);
-  cv::Mat lab;
-  cv::cvtColor(bgr(window), lab, cv::COLOR_BGR2Lab);
-  const cv::Mat region = GrowAndCloseRegion(raw, grow, lab, seed, o);
+  const cv::Mat bgr_window = bgr(window);
+  cv::Mat raw, cls;
+  ClassMasks(bgr_window, table, ball_bit, &raw, &cls);
+  LabWindow lab(bgr_window);
+  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow_table, &lab, seed, o);
   if (region.empty()) {
     out.failure = "no ball-coloured pixels at the blob";
     return out;
@@ -602,7 +637,14 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   for (const char* name : {"field", "line"}) {
     if (table.spec().Find(name) >= 0) field_bit |= table.ClassBit(name);
   }
-  MeasureRegionColours(bgr, window, lab, filled, raw, c, r, area, o, table, field_bit, &out);
+  // The colours are read within the leak ring's outer radius.
+  const double ro = o.ring_outer * r;
+  const cv::Point ring_tl(static_cast<int>(std::floor(c.x() - ro)) - 1,
+                          static_cast<int>(std::floor(c.y() - ro)) - 1);
+  const cv::Point ring_br(static_cast<int>(std::ceil(c.x() + ro)) + 2,
+                          static_cast<int>(std::ceil(c.y() + ro)) + 2);
+  lab.Need(cv::Rect(ring_tl, ring_br) - window.tl());
+  MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, c, r, area, o, field_bit, &out);
   out.ok = true;
   return out;
 }
