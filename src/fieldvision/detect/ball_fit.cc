@@ -266,6 +266,36 @@ double EllipsePolarRadius(const cv::RotatedRect& e, double direction) {
   return 1.0 / std::sqrt((c / a) * (c / a) + (s / b) * (s / b));
 }
 
+// Sorts (angle, radius) samples as std::sort does. Samples taken once round a convex outline are
+// already in order but for a rotation, or its reverse: then in linear time.
+void SortPolar(std::vector<std::pair<double, double>>* polar) {
+  auto& v = *polar;
+  const size_t n = v.size();
+  // Where the angles, cyclically, rise strictly but for one step down (n when they do not).
+  const auto rotation_start = [&v, n] {
+    size_t downs = 0, start = n;
+    for (size_t i = 0; i < n; ++i) {
+      const double a = v[i].first, b = v[(i + 1) % n].first;
+      if (!(a < b || b < a)) return n;  // equal or NaN
+      if (b < a) {
+        ++downs;
+        start = (i + 1) % n;
+      }
+    }
+    return downs == 1 ? start : n;
+  };
+  size_t start = rotation_start();
+  if (start == n) {
+    std::reverse(v.begin(), v.end());
+    start = rotation_start();
+  }
+  if (start == n) {
+    std::sort(v.begin(), v.end());
+  } else {
+    std::rotate(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(start), v.end());
+  }
+}
+
 // The image outline of the cone (axis, half-angle) as a polar function around the projection
 // of the axis: the search reference for outline points of a sphere seen in perspective.
 struct ConeOutline {
@@ -302,7 +332,7 @@ struct ConeOutline {
       if (th < 0) th += 2 * M_PI;
       polar.push_back({th, d.norm()});
     }
-    std::sort(polar.begin(), polar.end());
+    SortPolar(&polar);
     radius_at.assign(360, 0.0);
     size_t j = 0;
     for (int deg = 0; deg < 360; ++deg) {

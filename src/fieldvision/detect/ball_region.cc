@@ -379,8 +379,14 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
   if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region);
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
   if (k >= 1) {
-    cv::morphologyEx(region, region, cv::MORPH_CLOSE,
+    // Closing changes nothing farther than k from the region; 2 k + 1 out the part's own border
+    // (eroded as if set) meets only pixels the dilation left clear.
+    const cv::Rect sub =
+        Grow(cv::boundingRect(region), 2 * k + 1) & cv::Rect(0, 0, region.cols, region.rows);
+    cv::Mat part = region(sub).clone();
+    cv::morphologyEx(part, part, cv::MORPH_CLOSE,
                      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
+    part.copyTo(region(sub));
   }
   return region;
 }
@@ -497,20 +503,21 @@ double OutlineExtent(const std::vector<Vector2d>& pts, const Vector2d& c, double
 
 // Fill, spill, leak, purity and contrast of the circle (c, r) over `window` (`lab` its CIELAB):
 // `filled` is the closed, filled region, `raw` the ball class (window coordinates); `area` the
-// region's area.
+// region's area. Only the pixels in `read` (window coordinates) count: those within the ring's
+// outer radius and those of the region.
 void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& lab,
                           const cv::Mat& filled, const cv::Mat& raw, const cv::Mat& cls,
-                          const Vector2d& c, double r, double area, const BallRegionOptions& o,
-                          uint8_t field_bit, BallRegion* out) {
+                          const cv::Rect& read, const Vector2d& c, double r, double area,
+                          const BallRegionOptions& o, uint8_t field_bit, BallRegion* out) {
   std::array<std::vector<double>, 3> disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
   long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, ring_field = 0, pure = 0;
-  for (int y = 0; y < window.height; ++y) {
+  for (int y = read.y; y < read.y + read.height; ++y) {
     const uint8_t* f = filled.ptr<uint8_t>(y);
     const uint8_t* m = raw.ptr<uint8_t>(y);
     const double dy = window.y + y - c.y();
-    for (int x = 0; x < window.width; ++x) {
+    for (int x = read.x; x < read.x + read.width; ++x) {
       const double dx = window.x + x - c.x();
       const double d = std::sqrt(dx * dx + dy * dy);
       if (d < r) {
@@ -643,8 +650,12 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
                           static_cast<int>(std::floor(c.y() - ro)) - 1);
   const cv::Point ring_br(static_cast<int>(std::ceil(c.x() + ro)) + 2,
                           static_cast<int>(std::ceil(c.y() + ro)) + 2);
-  lab.Need(cv::Rect(ring_tl, ring_br) - window.tl());
-  MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, c, r, area, o, field_bit, &out);
+  const cv::Rect ring_box = cv::Rect(ring_tl, ring_br) - window.tl();
+  lab.Need(ring_box);
+  const cv::Rect read =
+      (ring_box | cv::boundingRect(filled)) & cv::Rect(0, 0, window.width, window.height);
+  MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, read, c, r, area, o, field_bit,
+                       &out);
   out.ok = true;
   return out;
 }
