@@ -392,32 +392,27 @@ cv::Rect GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOpt
 cv::Mat DilateMask(const cv::Mat& mask, const cv::Rect& from, const cv::Mat& element,
                    const cv::Rect& to) {
   cv::Mat out(to.size(), CV_8U, cv::Scalar(0));
-  // dst(p) = max over the element of src(p + e - anchor): a source pixel s reaches s - e + anchor,
-  // a row of the element a span of rows dy, columns dx0..dx1 from it.
-  struct Span {
-    int dy, dx0, dx1;
-  };
-  std::vector<Span> spans;
   const int ax = element.cols / 2, ay = element.rows / 2;
   for (int i = 0; i < element.rows; ++i) {
     const uint8_t* e = element.ptr<uint8_t>(i);
-    int j0 = 0, j1 = element.cols - 1;
-    while (j0 < element.cols && e[j0] == 0) ++j0;
+    const int j0 =
+        static_cast<int>(std::find_if(e, e + element.cols, [](uint8_t v) { return v; }) - e);
     if (j0 == element.cols) continue;
+    int j1 = element.cols - 1;
     while (e[j1] == 0) --j1;
-    spans.push_back({ay - i, ax - j1, ax - j0});
-  }
-  for (int y = from.y; y < from.y + from.height; ++y) {
-    const uint8_t* m = mask.ptr<uint8_t>(y);
-    for (int x = from.x; x < from.x + from.width; ++x) {
-      if (m[x] == 0) continue;
-      const int x0 = x;
-      while (x + 1 < from.x + from.width && m[x + 1] != 0) ++x;
-      for (const Span& sp : spans) {
-        const int ty = y + sp.dy;
-        if (ty < to.y || ty >= to.y + to.height) continue;
-        const int lo = std::max(x0 + sp.dx0, to.x), hi = std::min(x + sp.dx1, to.x + to.width - 1);
-        uint8_t* o = out.ptr<uint8_t>(ty - to.y);
+    // dst(p) = max over the element of src(p + e - anchor): a source pixel s reaches s - e +
+    // anchor.
+    const int dy = ay - i, dx0 = ax - j1, dx1 = ax - j0;
+    for (int y = from.y; y < from.y + from.height; ++y) {
+      const int ty = y + dy;
+      if (ty < to.y || ty >= to.y + to.height) continue;
+      const uint8_t* m = mask.ptr<uint8_t>(y);
+      uint8_t* o = out.ptr<uint8_t>(ty - to.y);
+      for (int x = from.x; x < from.x + from.width; ++x) {
+        if (m[x] == 0) continue;
+        const int x0 = x;
+        while (x + 1 < from.x + from.width && m[x + 1] != 0) ++x;
+        const int lo = std::max(x0 + dx0, to.x), hi = std::min(x + dx1, to.x + to.width - 1);
         if (lo <= hi) std::fill(o + (lo - to.x), o + (hi - to.x) + 1, uint8_t{255});
       }
     }
@@ -465,14 +460,10 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     // Closing changes nothing farther than k from the region; 2 k + 1 out the part's own border
     // (eroded as if set) meets only pixels the dilation left clear.
     const cv::Rect sub = Grow(box, 2 * k + 1) & cv::Rect(0, 0, region.cols, region.rows);
-    // cv::morphologyEx(MORPH_CLOSE) by runs: the dilation, then the erosion as the complement of
-    // the complement's dilation (beyond the part counts as set for it, as for cv::erode).
-    const cv::Mat element =
-        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1));
-    const cv::Rect all(0, 0, sub.width, sub.height);
-    const cv::Mat dilated = DilateMask(region(sub), all, element, all);
-    const cv::Mat closed = ~DilateMask(~dilated, all, element, all);
-    closed.copyTo(region(sub));
+    cv::Mat part = region(sub).clone();
+    cv::morphologyEx(part, part, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
+    part.copyTo(region(sub));
     box = sub;
   }
   *extent = box;
@@ -481,12 +472,9 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
 
 // The region's largest outer contour and the region it bounds, filled (holes from a print or a
 // highlight belong to the ball); false when there is no outline.
-// `extent` holds every set pixel of the region: only that part (and a pixel around it) is traced.
-bool LargestFilledOutline(const cv::Mat& region, const cv::Rect& extent,
-                          std::vector<cv::Point>* contour, cv::Mat* filled) {
+bool LargestFilledOutline(const cv::Mat& region, std::vector<cv::Point>* contour, cv::Mat* filled) {
   std::vector<std::vector<cv::Point>> contours;
-  const cv::Rect sub = Grow(extent, 1) & cv::Rect(0, 0, region.cols, region.rows);
-  cv::findContours(region(sub), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, sub.tl());
+  cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   if (contours.empty()) return false;
   const auto largest =
       std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
@@ -686,7 +674,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   }
   std::vector<cv::Point> contour;
   cv::Mat filled;
-  if (!LargestFilledOutline(region, extent, &contour, &filled)) {
+  if (!LargestFilledOutline(region, &contour, &filled)) {
     out.failure = "no outline";
     return out;
   }
