@@ -333,10 +333,10 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
 }
 
 // GrowByOwnColourIn on the part of the window within reach of the region (and its ring).
-// `box` is the region's bounding box; returns the part of the window that may have changed.
-cv::Rect GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions& o,
-                         const cv::Rect& box, cv::Mat* region) {
-  if (box.area() == 0) return box;
+void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions& o,
+                     cv::Mat* region) {
+  const cv::Rect box = cv::boundingRect(*region);
+  if (box.area() == 0) return;
   const float r = 0.5f * static_cast<float>(std::max(box.width, box.height));
   const int margin =
       static_cast<int>(std::ceil(std::max({3.0f, 0.6f * r, static_cast<float>(o.own_reach) * r}))) +
@@ -345,54 +345,16 @@ cv::Rect GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOpt
   cv::Mat part = (*region)(sub);
   lab->Need(sub);
   GrowByOwnColourIn(lab->lab()(sub), raw(sub), o, r, &part);
-  return sub;
-}
-
-// cv::dilate of the set pixels of `mask` inside `from` by `element` (anchor at its centre;
-// nothing beyond the mask counts), the part `to` of it (CV_8U, 255 set): one span per run of set
-// pixels and row of the element.
-cv::Mat DilateMask(const cv::Mat& mask, const cv::Rect& from, const cv::Mat& element,
-                   const cv::Rect& to) {
-  cv::Mat out(to.size(), CV_8U, cv::Scalar(0));
-  const int ax = element.cols / 2, ay = element.rows / 2;
-  for (int i = 0; i < element.rows; ++i) {
-    const uint8_t* e = element.ptr<uint8_t>(i);
-    const int j0 =
-        static_cast<int>(std::find_if(e, e + element.cols, [](uint8_t v) { return v; }) - e);
-    if (j0 == element.cols) continue;
-    int j1 = element.cols - 1;
-    while (e[j1] == 0) --j1;
-    // dst(p) = max over the element of src(p + e - anchor): a source pixel s reaches s - e +
-    // anchor.
-    const int dy = ay - i, dx0 = ax - j1, dx1 = ax - j0;
-    for (int y = from.y; y < from.y + from.height; ++y) {
-      const int ty = y + dy;
-      if (ty < to.y || ty >= to.y + to.height) continue;
-      const uint8_t* m = mask.ptr<uint8_t>(y);
-      uint8_t* o = out.ptr<uint8_t>(ty - to.y);
-      for (int x = from.x; x < from.x + from.width; ++x) {
-        if (m[x] == 0) continue;
-        const int x0 = x;
-        while (x + 1 < from.x + from.width && m[x + 1] != 0) ++x;
-        const int lo = std::max(x0 + dx0, to.x), hi = std::min(x + dx1, to.x + to.width - 1);
-        if (lo <= hi) std::fill(o + (lo - to.x), o + (hi - to.x) + 1, uint8_t{255});
-      }
-    }
-  }
-  return out;
 }
 
 // The gathered region grown through the widened class near its core and closed (print, seams);
 // empty when no ball-coloured pixel touches the seed. `grow_table`: the widened class (null: none).
-// `extent` receives a rectangle that holds the region.
 cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
                            const ColourTable* grow_table, LabWindow* lab, const cv::Rect& seed,
-                           const BallRegionOptions& o, cv::Rect* extent) {
+                           const BallRegionOptions& o) {
   cv::Rect bounds;
   cv::Mat region = GatherComponents(raw, seed, o.gather_fraction, &bounds);
   if (bounds.area() == 0) return {};
-  cv::Rect box = bounds;  // the region's bounding box (after own-colour growth: a rectangle
-                          // that holds it)
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
   if (grow_table != nullptr) {
     // Hysteresis with a reach: widened-class pixels join only near the core (a shaded rim, a
@@ -400,35 +362,32 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     // reach from the gathered bounds can join: only that part is dilated and classified.
     const int reach = std::max(1, static_cast<int>(std::lround(o.grow_fraction * r_region)));
     const cv::Rect sub = Grow(bounds, reach) & cv::Rect(0, 0, raw.cols, raw.rows);
-    const cv::Mat near = DilateMask(
-        region, bounds,
-        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)), sub);
+    cv::Mat near;
+    cv::dilate(
+        region(sub), near,
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
     const uint8_t grow_bit = grow_table->BallBit();
     for (int y = 0; y < sub.height; ++y) {
       const uint8_t* p = bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x);
       const uint8_t* nr = near.ptr<uint8_t>(y);
       uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
       for (int x = 0; x < sub.width; ++x, p += 3) {
-        if (nr[x] != 0 && (grow_table->Classify(p[0], p[1], p[2]) & grow_bit) != 0) {
-          m[x] = 255;
-          box |= cv::Rect(sub.x + x, sub.y + y, 1, 1);
-        }
+        if (nr[x] != 0 && (grow_table->Classify(p[0], p[1], p[2]) & grow_bit) != 0) m[x] = 255;
       }
     }
   }
-  if (o.own_reach > 0) box = GrowByOwnColour(lab, raw, o, box, &region);
+  if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region);
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
   if (k >= 1) {
     // Closing changes nothing farther than k from the region; 2 k + 1 out the part's own border
     // (eroded as if set) meets only pixels the dilation left clear.
-    const cv::Rect sub = Grow(box, 2 * k + 1) & cv::Rect(0, 0, region.cols, region.rows);
+    const cv::Rect sub =
+        Grow(cv::boundingRect(region), 2 * k + 1) & cv::Rect(0, 0, region.cols, region.rows);
     cv::Mat part = region(sub).clone();
     cv::morphologyEx(part, part, cv::MORPH_CLOSE,
                      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
     part.copyTo(region(sub));
-    box = sub;
   }
-  *extent = box;
   return region;
 }
 
@@ -628,8 +587,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   cv::Mat raw, cls;
   ClassMasks(bgr_window, table, ball_bit, &raw, &cls);
   LabWindow lab(bgr_window);
-  cv::Rect extent;
-  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow_table, &lab, seed, o, &extent);
+  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow_table, &lab, seed, o);
   if (region.empty()) {
     out.failure = "no ball-coloured pixels at the blob";
     return out;
@@ -694,7 +652,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
                           static_cast<int>(std::ceil(c.y() + ro)) + 2);
   const cv::Rect ring_box = cv::Rect(ring_tl, ring_br) - window.tl();
   lab.Need(ring_box);
-  const cv::Rect read = (ring_box | extent) & cv::Rect(0, 0, window.width, window.height);
+  const cv::Rect read =
+      (ring_box | cv::boundingRect(filled)) & cv::Rect(0, 0, window.width, window.height);
   MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, read, c, r, area, o, field_bit,
                        &out);
   out.ok = true;
