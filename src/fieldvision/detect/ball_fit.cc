@@ -576,7 +576,7 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
       s->inl.assign(s->edges.points.size(), 1);
     }
     Vector3d new_axis;
-    double new_alpha;
+    double new_alpha = 0.0;
     if (!RobustCone(s->edges.points, camera, thr, have_cone ? &axis : nullptr,
                     have_cone ? alpha : 0.0, &s->inl, &s->res, &new_axis, &new_alpha)) {
       break;
