@@ -33,8 +33,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(0, 1e10))
       ->needs(realtime);
   cmd->add_option("--live-buffer", o->live_buffer_frames,
-                  "Frames a live source holds for a slow node (the oldest are dropped; 1: only the "
-                  "newest, the lowest latency)")
+                  "Frames a live source holds for a slow node (the oldest are dropped; 2 absorbs "
+                  "one slow frame; 1: only the newest, for a node too slow on average)")
       ->check(FiniteRange(1, 1000))
       ->capture_default_str();
   AddBallDiameterOption(cmd, o->ball_diameter_m);
