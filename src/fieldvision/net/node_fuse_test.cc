@@ -1,7 +1,9 @@
 // Camera nodes and the fusion node on loopback: a synth kick scene played live by one node per
 // camera gives the same positions as the offline `ball` job, also with one node's clock 80 ms
-// off; bad messages are counted while the fusion node keeps running.
+// off and with a node stopped and restarted mid-scene; bad messages are counted while the fusion
+// node keeps running.
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <future>
 #include <map>
@@ -74,17 +76,51 @@ Scene WriteKick(uint64_t seed) {
   return s;
 }
 
-TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
-  const uint64_t seed = testing::TestSeed(3);
-  FV_SEED_TRACE(seed);
-  const Scene scene = WriteKick(seed);
+// The offline `ball` job's positions of the scene.
+std::map<long long, Row> OfflineBall(const Scene& scene) {
   pipeline::BallJobOptions job;
   job.cameras = scene.cameras;
   job.videos = scene.videos;
   job.out = scene.dir + "/offline.csv";
   job.pipeline.progress = false;
   pipeline::RunBallJob(job);
-  const auto offline = ReadBall(job.out);
+  return ReadBall(job.out);
+}
+
+// Every offline position is in `live` within 0.5 mm, from as many cameras.
+void ExpectSamePositions(const std::map<long long, Row>& offline,
+                         const std::map<long long, Row>& live) {
+  ASSERT_EQ(live.size(), offline.size());
+  for (const auto& [frame, a] : offline) {
+    ASSERT_TRUE(live.count(frame)) << "frame " << frame;
+    const Row& b = live.at(frame);
+    EXPECT_NEAR(a.x, b.x, 5e-4) << "frame " << frame;
+    EXPECT_NEAR(a.y, b.y, 5e-4) << "frame " << frame;
+    EXPECT_NEAR(a.z, b.z, 5e-4) << "frame " << frame;
+    EXPECT_EQ(a.n_cams, b.n_cams) << "frame " << frame;
+  }
+}
+
+// A node playing `c`'s video of `scene` in real time from `start_at` (never skipping frames: a
+// late node is late).
+NodeOptions PlaybackNode(const Scene& scene, size_t c, const std::string& endpoint,
+                         double start_at) {
+  NodeOptions no;
+  no.camera = scene.cameras[c];
+  no.video = scene.videos[c];
+  no.connect = endpoint;
+  no.realtime = true;
+  no.start_at_s = start_at;
+  no.live_buffer_frames = 1000;
+  no.progress = false;
+  return no;
+}
+
+TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
+  const uint64_t seed = testing::TestSeed(3);
+  FV_SEED_TRACE(seed);
+  const Scene scene = WriteKick(seed);
+  const auto offline = OfflineBall(scene);
   ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
 
   FuseOptions fo;
@@ -106,15 +142,8 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   std::vector<std::thread> threads;
   for (size_t c = 0; c < scene.cameras.size(); ++c) {
     threads.emplace_back([&, c] {
-      NodeOptions no;
-      no.camera = scene.cameras[c];
-      no.video = scene.videos[c];
-      no.connect = endpoint;
-      no.realtime = true;
-      no.start_at_s = start_at;
-      no.live_buffer_frames = 1000;  // a late node is late, never skips frames
+      NodeOptions no = PlaybackNode(scene, c, endpoint, start_at);
       no.clock_offset_s = c == 1 ? offset_s : 0.0;
-      no.progress = false;
       nodes[c] = RunNode(no);
     });
   }
@@ -133,15 +162,7 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   SCOPED_TRACE(fused.ToString());
   EXPECT_EQ(fused.groups, 30);
   const auto live = ReadBall(fo.out);
-  ASSERT_EQ(live.size(), offline.size());
-  for (const auto& [frame, a] : offline) {
-    ASSERT_TRUE(live.count(frame)) << "frame " << frame;
-    const Row& b = live.at(frame);
-    EXPECT_NEAR(a.x, b.x, 5e-4) << "frame " << frame;
-    EXPECT_NEAR(a.y, b.y, 5e-4) << "frame " << frame;
-    EXPECT_NEAR(a.z, b.z, 5e-4) << "frame " << frame;
-    EXPECT_EQ(a.n_cams, b.n_cams) << "frame " << frame;
-  }
+  ExpectSamePositions(offline, live);
   // The flights fuse closed on the way are those of the whole track's analysis (the kick).
   std::vector<recon::BallSample> track;
   for (const auto& [frame, r] : live) {
@@ -158,6 +179,69 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   ASSERT_EQ(fused.flights.size(), whole.flights.size()) << whole.Summary();
   EXPECT_EQ(fused.flights_published, 0);  // no --publish
   EXPECT_LT((fused.flights[0].origin_m - whole.flights[0].origin_m).norm(), 0.05);
+}
+
+// Node 2 is stopped after 8 of the 30 frames and started again (a new session, as after a
+// crash): the others go on without it meanwhile (those frames are fused from the other
+// cameras), it is re-admitted (its frames from before the restart are dropped as late) and every
+// frame fused from as many cameras as offline is the offline position.
+TEST(NodeFuse, ANodeRestartedMidSceneIsReadmittedWithTheOfflinePositions) {
+  const uint64_t seed = testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  const Scene scene = WriteKick(seed);
+  const auto offline = OfflineBall(scene);
+  ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
+  FuseOptions fo;
+  fo.listen = "tcp://127.0.0.1:*";
+  fo.cameras = scene.cameras;
+  fo.out = scene.dir + "/live_restart.csv";
+  fo.idle_exit_s = 1.5;
+  fo.sync.max_wait_s = 3.0 * fv::testing::SlowdownFactor();
+  fo.progress = false;
+  FuseSummary fused;
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
+  const double start_at = io::SystemClockNow() + 1.0 * fv::testing::SlowdownFactor();
+  constexpr long long kStopAfter = 8;
+  std::vector<NodeSummary> nodes(scene.cameras.size());
+  NodeSummary restarted;
+  std::vector<std::thread> threads;
+  for (size_t c = 0; c < scene.cameras.size(); ++c) {
+    threads.emplace_back([&, c] {
+      NodeOptions no = PlaybackNode(scene, c, endpoint, start_at);
+      if (c == 1) {
+        no.max_frames = kStopAfter;
+        nodes[c] = RunNode(no);
+        no.max_frames = 0;
+        restarted = RunNode(no);
+      } else {
+        nodes[c] = RunNode(no);
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  fuse.join();
+  SCOPED_TRACE(fused.ToString());
+  EXPECT_EQ(nodes[1].frames, kStopAfter);
+  EXPECT_EQ(restarted.frames, 30);  // its buffer from the start: the first ones come late
+  EXPECT_EQ(fused.cameras[1].sessions, 2);
+  EXPECT_EQ(fused.sync[1].restarts, 1);
+  EXPECT_GT(fused.sync[1].paired, kStopAfter) << "the restarted node's frames were never used";
+  EXPECT_EQ(fused.groups, 30);
+  const auto live = ReadBall(fo.out);
+  ASSERT_EQ(live.size(), offline.size());
+  for (const auto& [frame, a] : offline) {
+    ASSERT_TRUE(live.count(frame)) << "frame " << frame;
+    const Row& b = live.at(frame);
+    const double off_m = std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
+    if (b.n_cams == a.n_cams) {
+      EXPECT_LT(off_m, 5e-4) << "frame " << frame;
+    } else {  // the restart's gap: fewer cameras
+      EXPECT_GE(frame, kStopAfter) << "a camera missing before the restart";
+      EXPECT_LT(b.n_cams, a.n_cams) << "frame " << frame;
+      EXPECT_LT(off_m, 0.05) << "frame " << frame;
+    }
+  }
 }
 
 TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
