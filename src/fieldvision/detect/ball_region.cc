@@ -315,8 +315,9 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
     uint8_t* j = joined.ptr<uint8_t>(y);
     for (int x = 0; x < lab.cols; ++x) {
       if (d[x] == 0 || d[x] > reach) continue;
+      const uint8_t* lab_px = l + 3 * static_cast<ptrdiff_t>(x);
       const Eigen::Vector3f p =
-          Eigen::Vector3f(l[3 * x], l[3 * x + 1], l[3 * x + 2]).cwiseProduct(scale);
+          Eigen::Vector3f(lab_px[0], lab_px[1], lab_px[2]).cwiseProduct(scale);
       const float d_own2 = (p - own_f).squaredNorm();
       if (d_own2 < limit2 && d_own2 < (p - around_f).squaredNorm()) j[x] = 255;
     }

@@ -37,7 +37,7 @@
 namespace fv::net {
 
 constexpr int kSchemaVersion = 1;
-constexpr size_t kMaxMessageBytes = 64 * 1024;  // larger messages are dropped and counted
+constexpr size_t kMaxMessageBytes = size_t{64} * 1024;  // larger messages are dropped and counted
 
 struct HelloMessage {
   std::string camera, session;
