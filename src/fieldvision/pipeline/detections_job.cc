@@ -265,7 +265,10 @@ std::string DetectionsJobResult::Summary() const {
                      bundled_flights, bundled_rows, bundle_rms_px);
   }
   for (const auto& p : sync.Problems()) s += "\n  " + p;
-  if (trajectory) s += "\n" + trajectory->Summary();
+  if (trajectory) {
+    s += '\n';
+    s += trajectory->Summary();
+  }
   return s;
 }
 

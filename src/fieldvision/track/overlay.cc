@@ -140,7 +140,8 @@ bool TryOpen(cv::VideoWriter& w, const std::string& path, int fourcc, double fps
 // `dir/name.ext` -> `dir/.name.tmp.ext` (the container is chosen by the extension).
 std::string TempPathFor(const std::string& path) {
   const fs::path p(path);
-  return (p.parent_path() / ("." + p.stem().string() + ".tmp" + p.extension().string())).string();
+  return (p.parent_path() / fmt::format(".{}.tmp{}", p.stem().string(), p.extension().string()))
+      .string();
 }
 
 }  // namespace
