@@ -116,6 +116,19 @@ NodeOptions PlaybackNode(const Scene& scene, size_t c, const std::string& endpoi
   return no;
 }
 
+// A fusion node for `scene` on a free loopback port, writing `out` in the scene's folder.
+FuseOptions LoopbackFuse(const Scene& scene, const std::string& out) {
+  FuseOptions fo;
+  fo.listen = "tcp://127.0.0.1:*";
+  fo.cameras = scene.cameras;
+  fo.out = scene.dir + "/" + out;
+  fo.idle_exit_s = 1.5;  // longer than the nodes' ping interval (0.5 s)
+  // A loaded test machine (or a sanitizer build) may run a node late; wait for it.
+  fo.sync.max_wait_s = 3.0 * fv::testing::SlowdownFactor();
+  fo.progress = false;
+  return fo;
+}
+
 TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   const uint64_t seed = testing::TestSeed(3);
   FV_SEED_TRACE(seed);
@@ -123,14 +136,7 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   const auto offline = OfflineBall(scene);
   ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
 
-  FuseOptions fo;
-  fo.listen = "tcp://127.0.0.1:*";
-  fo.cameras = scene.cameras;
-  fo.out = scene.dir + "/live.csv";
-  fo.idle_exit_s = 1.5;  // longer than the nodes' ping interval (0.5 s)
-  // A loaded test machine (or a sanitizer build) may run a node late; wait for it.
-  fo.sync.max_wait_s = 3.0 * fv::testing::SlowdownFactor();
-  fo.progress = false;
+  FuseOptions fo = LoopbackFuse(scene, "live.csv");
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
@@ -191,13 +197,7 @@ TEST(NodeFuse, ANodeRestartedMidSceneIsReadmittedWithTheOfflinePositions) {
   const Scene scene = WriteKick(seed);
   const auto offline = OfflineBall(scene);
   ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
-  FuseOptions fo;
-  fo.listen = "tcp://127.0.0.1:*";
-  fo.cameras = scene.cameras;
-  fo.out = scene.dir + "/live_restart.csv";
-  fo.idle_exit_s = 1.5;
-  fo.sync.max_wait_s = 3.0 * fv::testing::SlowdownFactor();
-  fo.progress = false;
+  FuseOptions fo = LoopbackFuse(scene, "live_restart.csv");
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);

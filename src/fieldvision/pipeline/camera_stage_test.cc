@@ -34,6 +34,14 @@ BallRegionDetectFn Scripted(const std::vector<std::vector<Thing>>* frames, const
   };
 }
 
+// A blank 640x480 frame numbered `f` through the stage (the scripted detectors ignore pixels).
+CameraMessage ProcessBlank(CameraStage& stage, long long f) {
+  io::SourceFrame in;
+  in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+  in.frame = f;
+  return stage.Process(in);
+}
+
 TEST(CameraStage, ABallThatLeavesItsWindowIsSearchedForInTheWholeFrame) {
   const camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
   // The ball rolls right at 10 px a frame, then bounces up at 40 px a frame: out of the window
@@ -52,10 +60,7 @@ TEST(CameraStage, ABallThatLeavesItsWindowIsSearchedForInTheWholeFrame) {
   track.full_scan_every = 100;
   CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted");
   for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
-    io::SourceFrame in;
-    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
-    in.frame = f;
-    const CameraMessage m = stage.Process(in);
+    const CameraMessage m = ProcessBlank(stage, f);
     const Vector2d& want = frames[f][0].centre_px;
     const bool has_ball = std::any_of(m.candidates.begin(), m.candidates.end(), [&](const auto& o) {
       return (o.centre_px - want).norm() < 1;
@@ -89,10 +94,7 @@ TEST(CameraStage, WhileTrackingBandsCoverTheFrameAndFindAnotherBall) {
   CameraStage stage(0, cam, recording, track, "scripted");
   long long first_seen = -1;
   for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
-    io::SourceFrame in;
-    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
-    in.frame = f;
-    const CameraMessage m = stage.Process(in);
+    const CameraMessage m = ProcessBlank(stage, f);
     ASSERT_FALSE(m.candidates.empty()) << "frame " << f;
     EXPECT_NEAR((m.candidates[0].centre_px - ball).norm(), 0.0, 1e-9) << "frame " << f;
     const bool has_other = std::any_of(m.candidates.begin(), m.candidates.end(),
@@ -134,10 +136,7 @@ TEST(CameraStage, TheWholeFrameSearchInTwoBandsTakesTwoFramesOfEachPeriod) {
   track.scan_bands = 2;
   CameraStage stage(0, cam, recording, track, "scripted");
   for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
-    io::SourceFrame in;
-    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
-    in.frame = f;
-    stage.Process(in);
+    ProcessBlank(stage, f);
   }
   EXPECT_EQ(stage.stats().full_scans, 1);
   ASSERT_EQ(bands.size(), 4u);  // two in each period of 8 frames after the first frame
@@ -167,10 +166,7 @@ TEST(CameraStage, CamerasSearchWholeFramesEveryFullScanEveryFramesEachAtItsOwnPh
     };
     CameraStage stage(0, cam, recording, track, "scripted");
     for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
-      io::SourceFrame in;
-      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
-      in.frame = f;
-      stage.Process(in);
+      ProcessBlank(stage, f);
     }
     ASSERT_GE(whole.size(), 5u) << name;
     EXPECT_EQ(whole[0], 0) << name;
