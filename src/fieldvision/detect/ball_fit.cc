@@ -53,12 +53,14 @@ struct Edges {
   int rays = 0;
 };
 
-// Rough outline: along each ray, where the colour class stops being the ball.
+// Rough outline: along each ray, where the colour class stops being the ball. A gap shorter than
+// half the rough radius (a print's line, a seam, a dark patch of the shaded side) does not end it.
 Edges ClassEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
                  double r0) {
   Edges e;
   e.rays = std::clamp(static_cast<int>(2 * M_PI * r0 / 1.5), 16, 96);
   const double t_max = 1.6 * r0 + 3.0;
+  const int max_misses = std::max(2, static_cast<int>(std::lround(r0)));  // 0.5 px samples
   for (int k = 0; k < e.rays; ++k) {
     const double th = 2 * M_PI * k / e.rays;
     const Vector2d u(std::cos(th), std::sin(th));
@@ -67,28 +69,85 @@ Edges ClassEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, cons
     double last_ball = 0;
     for (double t = 0; t <= t_max; t += 0.5) {
       const Vector2d p = c + t * u;
-      if (p.x() < 0 || p.y() < 0 || p.x() > img.cols - 1 || p.y() > img.rows - 1) {
-        seen = false;  // the outline leaves the image: no point on this ray
-        break;
-      }
+      if (p.x() < 0 || p.y() < 0 || p.x() > img.cols - 1 || p.y() > img.rows - 1) break;
       if (IsBall(img, table, bit, p.x(), p.y())) {
         seen = true;
         misses = 0;
         last_ball = t;
-      } else if (seen && ++misses >= 2) {
-        e.points.push_back(c + (last_ball + 0.25) * u);
+      } else if (seen && ++misses >= max_misses) {
         break;
       }
     }
+    // An outline point where the ball ends at least 1 px before the ray leaves the image or the
+    // search (a ball clipped by the border gives none there).
+    if (seen && misses >= 2) e.points.push_back(c + (last_ball + 0.25) * u);
   }
   return e;
 }
 
+// One candidate edge of a ray (c + t u, profile samples at(i) at t0 + i step, m of them) at the
+// gradient peak `peak`: the ray's own colours 1.5 px inside and outside it (or the ray's ends
+// across a wide motion-blur ramp) and where the profile crosses halfway between them. t < 0 when
+// the step is too weak, its inside is not the ball or its outside is the ball too (outside_ball).
+struct RayEdge {
+  double t = -1, t10 = -1, t90 = -1;
+  bool ramp = false;
+  bool outside_ball = false;
+};
+
+template <typename Profile>
+RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
+                   const Vector2d& u, double t0, double step, int m, int peak, Profile& at,
+                   const BallFitOptions& o) {
+  constexpr double kSide = 1.5;
+  RayEdge edge;
+  int ia = std::max(0, peak - static_cast<int>(kSide / step));
+  int ib = std::min(m - 1, peak + static_cast<int>(kSide / step));
+  Vector3d a = 0.5 * (at(ia) + at(std::max(ia - 1, 0)));
+  Vector3d b = 0.5 * (at(ib) + at(std::min(ib + 1, m - 1)));
+  // A wide ramp (motion blur along this ray): the colours 3 px from the peak differ much more
+  // than those 1.5 px from it, so both local colours lie on the ramp; use the ray's ends
+  // instead (the halfway crossing of a swept disc is still its outline).
+  const int ka = std::max(0, peak - static_cast<int>(2 * kSide / step));
+  const int kb = std::min(m - 1, peak + static_cast<int>(2 * kSide / step));
+  if ((at(kb) - at(ka)).squaredNorm() > 1.6 * 1.6 * (b - a).squaredNorm() &&
+      IsBall(img, table, bit, c.x() + t0 * u.x(), c.y() + t0 * u.y())) {
+    edge.ramp = true;
+    ia = 0;
+    ib = m - 1;
+    a = at(0);
+    b = at(m - 1);
+  }
+  const Vector3d ab = b - a;
+  const double contrast2 = ab.squaredNorm();
+  if (contrast2 < o.min_contrast * o.min_contrast) return edge;
+  const Vector2d pin = c + (t0 + ia * step) * u, pout = c + (t0 + ib * step) * u;
+  if (!IsBall(img, table, bit, pin.x(), pin.y())) return edge;  // inside is not the ball
+  if (IsBall(img, table, bit, pout.x(), pout.y())) {            // outside is ball-coloured
+    edge.outside_ball = true;
+    return edge;
+  }
+  double prev_p = (at(ia) - a).dot(ab) / contrast2;
+  for (int i = ia + 1; i <= ib; ++i) {
+    const double q = (at(i) - a).dot(ab) / contrast2;
+    auto cross = [&](double level) {
+      return t0 + (i - 1 + (level - prev_p) / (q - prev_p)) * step;
+    };
+    if (edge.t10 < 0 && prev_p < 0.1 && q >= 0.1) edge.t10 = cross(0.1);
+    if (edge.t < 0 && prev_p < 0.5 && q >= 0.5) edge.t = cross(0.5);
+    if (edge.t >= 0 && prev_p < 0.9 && q >= 0.9) {
+      edge.t90 = cross(0.9);
+      break;
+    }
+    prev_p = q;
+  }
+  return edge;
+}
+
 // Sub-pixel outline: along each ray from `c`, search around the reference radius ref(theta)
-// for the first strong colour step (largest gradient), then take the ray's own colours 1.5 px
-// inside and outside it and find where the profile crosses halfway between them (linear
-// interpolation of bilinear samples). Local references keep shading and a changing background
-// (a line just beyond the ball) from biasing the edge.
+// for the outermost strong colour step from the ball to something else (EdgeAtPeak). Local
+// references keep shading and a changing background (a line just beyond the ball) from biasing
+// the edge.
 Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
                     const std::function<double(double)>& ref, double mean_radius,
                     const BallFitOptions& o) {
@@ -101,6 +160,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   std::vector<Vector3d> prof;
   std::vector<char> have;
   std::vector<double> grad;
+  std::vector<int> peaks;
   for (int k = 0; k < e.rays; ++k) {
     const double th = 2 * M_PI * (k + 0.5) / e.rays;
     const Vector2d u(std::cos(th), std::sin(th));
@@ -134,57 +194,30 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
       g_max = std::max(g_max, grad[i]);
     }
     if (g_max < 0.1 * o.min_contrast) continue;
-    // The first local maximum above half the largest, going outwards.
-    int peak = -1;
+    // Peaks above half the largest, tried from the outermost inwards: the silhouette is the
+    // outermost step from the ball to something else (a print's lines and the shading's
+    // terminator lie inside it). Steps whose inside is not the ball (the background beyond it)
+    // are passed over; one whose outside is the ball too ends the search.
+    peaks.clear();
     for (int i = 2; i + 2 < m; ++i) {
       if (grad[i] >= 0.5 * g_max && grad[i] >= grad[i - 1] && grad[i] >= grad[i + 1]) {
-        peak = i;
-        break;
+        peaks.push_back(i);
       }
     }
-    if (peak < 0) continue;
-    int ia = std::max(0, peak - static_cast<int>(kSide / kStep));
-    int ib = std::min(m - 1, peak + static_cast<int>(kSide / kStep));
-    Vector3d a = 0.5 * (at(ia) + at(std::max(ia - 1, 0)));
-    Vector3d b = 0.5 * (at(ib) + at(std::min(ib + 1, m - 1)));
-    // A wide ramp (motion blur along this ray): the colours 3 px from the peak differ much more
-    // than those 1.5 px from it, so both local colours lie on the ramp; use the ray's ends
-    // instead (the halfway crossing of a swept disc is still its outline).
-    const int ka = std::max(0, peak - static_cast<int>(2 * kSide / kStep));
-    const int kb = std::min(m - 1, peak + static_cast<int>(2 * kSide / kStep));
-    bool ramp = false;
-    if ((at(kb) - at(ka)).squaredNorm() > 1.6 * 1.6 * (b - a).squaredNorm() &&
-        IsBall(img, table, bit, c.x() + t0 * u.x(), c.y() + t0 * u.y())) {
-      ramp = true;
-      ia = 0;
-      ib = m - 1;
-      a = at(0);
-      b = at(m - 1);
-    }
-    const Vector3d ab = b - a;
-    const double contrast2 = ab.squaredNorm();
-    if (contrast2 < o.min_contrast * o.min_contrast) continue;
-    const Vector2d pin = c + (t0 + ia * kStep) * u, pout = c + (t0 + ib * kStep) * u;
-    if (!IsBall(img, table, bit, pin.x(), pin.y())) continue;  // inside is not the ball
-    if (IsBall(img, table, bit, pout.x(), pout.y())) {         // outside is ball-coloured
-      ++e.outside_ball;
-      continue;
-    }
-    double prev_p = (at(ia) - a).dot(ab) / contrast2;
-    double t10 = -1, t90 = -1, te = -1;
-    for (int i = ia + 1; i <= ib; ++i) {
-      const double q = (at(i) - a).dot(ab) / contrast2;
-      auto cross = [&](double level) {
-        return t0 + (i - 1 + (level - prev_p) / (q - prev_p)) * kStep;
-      };
-      if (t10 < 0 && prev_p < 0.1 && q >= 0.1) t10 = cross(0.1);
-      if (te < 0 && prev_p < 0.5 && q >= 0.5) te = cross(0.5);
-      if (te >= 0 && prev_p < 0.9 && q >= 0.9) {
-        t90 = cross(0.9);
+    double te = -1, t10 = -1, t90 = -1;
+    bool ramp = false, outside_ball = false;
+    for (auto it = peaks.rbegin(); it != peaks.rend() && te < 0; ++it) {
+      const RayEdge edge = EdgeAtPeak(img, table, bit, c, u, t0, kStep, m, *it, at, o);
+      if (edge.outside_ball) {  // the colour goes on beyond: no silhouette on this ray
+        outside_ball = true;
         break;
       }
-      prev_p = q;
+      te = edge.t;
+      t10 = edge.t10;
+      t90 = edge.t90;
+      ramp = edge.ramp;
     }
+    if (te < 0 && outside_ball) ++e.outside_ball;
     if (te < 0) continue;
     e.points.push_back(c + te * u);
     e.ramp_px.push_back(ramp && t10 >= 0 && t90 >= 0 ? (t90 - t10) / 0.8 : 0.0);
