@@ -61,6 +61,9 @@ Edges ClassEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, cons
   e.rays = std::clamp(static_cast<int>(2 * M_PI * r0 / 1.5), 16, 96);
   const double t_max = 1.6 * r0 + 3.0;
   const int max_misses = std::max(2, static_cast<int>(std::lround(r0)));  // 0.5 px samples
+  // Gaps within half the rough radius never end a ray: a rough centre on a print's line (a
+  // dark cross through the ball) would otherwise give points next to it.
+  const double min_edge = 0.5 * r0;
   for (int k = 0; k < e.rays; ++k) {
     const double th = 2 * M_PI * k / e.rays;
     const Vector2d u(std::cos(th), std::sin(th));
@@ -74,13 +77,15 @@ Edges ClassEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, cons
         seen = true;
         misses = 0;
         last_ball = t;
-      } else if (seen && ++misses >= max_misses) {
+      } else if (seen && ++misses >= max_misses && last_ball >= min_edge) {
         break;
       }
     }
     // An outline point where the ball ends at least 1 px before the ray leaves the image or the
     // search (a ball clipped by the border gives none there).
-    if (seen && misses >= 2) e.points.push_back(c + (last_ball + 0.25) * u);
+    if (seen && misses >= 2 && last_ball >= min_edge) {
+      e.points.push_back(c + (last_ball + 0.25) * u);
+    }
   }
   return e;
 }
