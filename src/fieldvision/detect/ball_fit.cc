@@ -17,27 +17,59 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-// The domain of Sample.
+// The domain of Sampler.
 inline bool InsideForSampling(const cv::Mat& img, const Vector2d& p) {
   return p.x() >= 0 && p.y() >= 0 && p.x() <= img.cols - 1 && p.y() <= img.rows - 1;
 }
 
-// Bilinear BGR sample; false outside the image.
-inline bool Sample(const cv::Mat& img, double x, double y, Vector3d* out) {
-  if (!InsideForSampling(img, Vector2d(x, y))) return false;
-  const int x0 = std::min(static_cast<int>(x), img.cols - 2 >= 0 ? img.cols - 2 : 0);
-  const int y0 = std::min(static_cast<int>(y), img.rows - 2 >= 0 ? img.rows - 2 : 0);
-  const int x1 = std::min(x0 + 1, img.cols - 1), y1 = std::min(y0 + 1, img.rows - 1);
-  const double fx = x - x0, fy = y - y0;
-  const uint8_t* a = img.ptr<uint8_t>(y0) + 3 * static_cast<ptrdiff_t>(x0);
-  const uint8_t* b = img.ptr<uint8_t>(y0) + 3 * static_cast<ptrdiff_t>(x1);
-  const uint8_t* c = img.ptr<uint8_t>(y1) + 3 * static_cast<ptrdiff_t>(x0);
-  const uint8_t* d = img.ptr<uint8_t>(y1) + 3 * static_cast<ptrdiff_t>(x1);
-  for (int k = 0; k < 3; ++k) {
-    (*out)[k] = (1 - fy) * ((1 - fx) * a[k] + fx * b[k]) + fy * ((1 - fx) * c[k] + fx * d[k]);
+// Bilinear BGR samples of an image; false outside it.
+struct Sampler {
+  const uint8_t* data;
+  size_t step;
+  int cols, rows, x_last0, y_last0;
+  explicit Sampler(const cv::Mat& img)
+      : data(img.data),
+        step(img.step[0]),
+        cols(img.cols),
+        rows(img.rows),
+        x_last0(img.cols - 2 >= 0 ? img.cols - 2 : 0),
+        y_last0(img.rows - 2 >= 0 ? img.rows - 2 : 0) {}
+  bool operator()(double x, double y, Vector3d* out) const {
+    if (!(x >= 0 && y >= 0 && x <= cols - 1 && y <= rows - 1)) return false;
+    const int x0 = std::min(static_cast<int>(x), x_last0);
+    const int y0 = std::min(static_cast<int>(y), y_last0);
+    const int x1 = std::min(x0 + 1, cols - 1), y1 = std::min(y0 + 1, rows - 1);
+    const double fx = x - x0, fy = y - y0, gx = 1 - fx, gy = 1 - fy;
+    const uint8_t* row0 = data + step * static_cast<size_t>(y0);
+    const uint8_t* row1 = data + step * static_cast<size_t>(y1);
+    const uint8_t* a = row0 + 3 * static_cast<ptrdiff_t>(x0);
+    const uint8_t* b = row0 + 3 * static_cast<ptrdiff_t>(x1);
+    const uint8_t* c = row1 + 3 * static_cast<ptrdiff_t>(x0);
+    const uint8_t* d = row1 + 3 * static_cast<ptrdiff_t>(x1);
+    for (int k = 0; k < 3; ++k) {
+      (*out)[k] = gy * (gx * a[k] + fx * b[k]) + fy * (gx * c[k] + fx * d[k]);
+    }
+    return true;
   }
-  return true;
-}
+};
+
+// sqrt(a) >= sqrt(b) for a, b >= 0, mostly without the square roots.
+inline bool SqrtGe(double a, double b) { return a >= b || std::sqrt(a) == std::sqrt(b); }
+
+// sqrt(a) >= h for a >= 0, mostly without the square root: decided on a against h^2 away from it.
+class SqrtAtLeast {
+ public:
+  explicit SqrtAtLeast(double h)
+      : h_(h), lo_(h * h * (1 - 1e-9)), hi_(h * h * (1 + 1e-9)), exact_(!(h * h > 1e-200)) {}
+  bool operator()(double a) const {
+    if (exact_ || (a >= lo_ && a <= hi_)) return std::sqrt(a) >= h_;
+    return a > hi_;
+  }
+
+ private:
+  double h_, lo_, hi_;
+  bool exact_;
+};
 
 inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, double x, double y) {
   const int xi = static_cast<int>(std::lround(x)), yi = static_cast<int>(std::lround(y));
@@ -162,9 +194,10 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   const double max_r = std::max(img.cols, img.rows);
   if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;
   e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), 24, 180);
+  const Sampler sample(img);
   std::vector<Vector3d> prof;
   std::vector<char> have;
-  std::vector<double> grad;
+  std::vector<double> grad2;
   std::vector<int> peaks;
   for (int k = 0; k < e.rays; ++k) {
     const double th = 2 * M_PI * (k + 0.5) / e.rays;
@@ -184,28 +217,47 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     const auto at = [&](int i) -> const Vector3d& {
       if (!have[i]) {
         const Vector2d p = c + (t0 + i * kStep) * u;
-        Sample(img, p.x(), p.y(), &prof[i]);
+        sample(p.x(), p.y(), &prof[i]);
         have[i] = 1;
       }
       return prof[i];
     };
-    // Gradient magnitude (central differences over 0.5 px) in the search window.
-    grad.assign(m, 0.0);
-    double g_max = 0;
+    // The search window [g_lo, g_hi] (t within [t_lo, t_hi]; t rises with i), sampled at once.
+    int g_lo = m, g_hi = -1;
     for (int i = 1; i + 1 < m; ++i) {
       const double t = t0 + i * kStep;
       if (t < t_lo || t > t_hi) continue;
-      grad[i] = (at(i + 1) - at(i - 1)).norm();
-      g_max = std::max(g_max, grad[i]);
+      g_lo = std::min(g_lo, i);
+      g_hi = i;
     }
+    for (int i = g_lo - 1; i <= g_hi + 1; ++i) {
+      const Vector2d p = c + (t0 + i * kStep) * u;
+      sample(p.x(), p.y(), &prof[i]);
+      have[i] = 1;
+    }
+    // Squared gradient magnitude (central differences over 0.5 px) in the search window: the
+    // magnitude's comparisons are made on the squares (the square root is monotonic).
+    grad2.assign(m, 0.0);
+    double g2_max = 0;
+    for (int i = g_lo; i <= g_hi; ++i) {
+      grad2[i] = (prof[i + 1] - prof[i - 1]).squaredNorm();
+      g2_max = std::max(g2_max, grad2[i]);
+    }
+    const double g_max = std::sqrt(g2_max);
     if (g_max < 0.1 * o.min_contrast) continue;
     // Peaks above half the largest, tried from the outermost inwards: the silhouette is the
     // outermost step from the ball to something else (a print's lines and the shading's
     // terminator lie inside it). Steps whose inside is not the ball (the background beyond it)
-    // are passed over; one whose outside is the ball too ends the search.
+    // are passed over; one whose outside is the ball too ends the search. Outside the window
+    // the gradient is 0, below half a positive largest.
+    const SqrtAtLeast above_half(0.5 * g_max);
+    const bool window_only = 0.5 * g_max > 0;
+    const int p_lo = window_only ? std::max(2, g_lo) : 2;
+    const int p_end = window_only ? std::min(m - 2, g_hi + 1) : m - 2;
     peaks.clear();
-    for (int i = 2; i + 2 < m; ++i) {
-      if (grad[i] >= 0.5 * g_max && grad[i] >= grad[i - 1] && grad[i] >= grad[i + 1]) {
+    for (int i = p_lo; i < p_end; ++i) {
+      if (above_half(grad2[i]) && SqrtGe(grad2[i], grad2[i - 1]) &&
+          SqrtGe(grad2[i], grad2[i + 1])) {
         peaks.push_back(i);
       }
     }
