@@ -1,6 +1,7 @@
 #include "fieldvision/detect/blobs.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 
@@ -34,7 +35,16 @@ void ClassifyRow(const uint8_t* row, int n, int x_start, int step, const ColourT
   const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x_start);
   const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(st);
   if (table.bits_per_channel() == 8) {
-    for (int i = 0; i < n; ++i, p += stride) {
+    // A pixel's packed BGR in one 4-byte load (the byte after it masked off; little-endian), but
+    // for the row's last sample, whose next byte may lie past the image.
+    const int n_load4 = std::endian::native == std::endian::little ? n - 1 : 0;
+    int i = 0;
+    for (; i < n_load4; ++i, p += stride) {
+      uint32_t v;
+      std::memcpy(&v, p, sizeof(v));
+      cls[i] = lut[v & 0xFFFFFFu];
+    }
+    for (; i < n; ++i, p += stride) {
       cls[i] = lut[uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16];
     }
   } else {
