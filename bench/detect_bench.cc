@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/ball_fit.h"
 #include "fieldvision/detect/blobs.h"
 #include "fieldvision/detect/colour.h"
 #include "fieldvision/detect/dnn_ball.h"
@@ -170,6 +171,37 @@ BENCHMARK(BM_BallDetector)
     ->Args({2, 0})
     ->Args({4, 1})
     ->Unit(benchmark::kMicrosecond);
+
+// The sub-pixel outline fit alone (detect/ball_fit.h, with the camera) on each candidate the
+// detector refines in the frame, seeded at the candidate's centre and radius: most of the
+// detector's time after the region stage.
+void BM_BallFit(benchmark::State& state) {
+  const BenchFrame& f = TestFrame();
+  BaselineSeconds();
+  const fv::detect::BallDetectorOptions o;
+  const fv::detect::BallDetector det(o, &f.camera, nullptr);
+  const auto table = fv::detect::ColourTable::Shared(fv::detect::PresetColourSpec("orange"));
+  std::vector<fv::detect::BallCandidate> seeds;
+  for (const auto& c : det.DetectWithSummary(f.bgr).candidates) {
+    if (c.radius_px >= 0.5 * o.min_radius_px) seeds.push_back(c);
+  }
+  int ok = 0;
+  double total = 0;
+  for (auto _ : state) {
+    const double t0 = CpuSeconds();
+    ok = 0;
+    for (const auto& c : seeds) {
+      ok += fv::detect::FitBall(f.bgr, *table, table->BallBit(), c.centre_px, c.radius_px,
+                                &f.camera, o.fit)
+                .ok;
+    }
+    total += CpuSeconds() - t0;
+  }
+  SetCounters(state, total);
+  state.counters["fits"] = static_cast<double>(seeds.size());
+  state.counters["ok"] = ok;
+}
+BENCHMARK(BM_BallFit)->Unit(benchmark::kMicrosecond);
 
 // Seconds per frame of the colour detector (step 2, region stage on; median of 9 runs), once.
 double ColourSeconds() {
