@@ -22,35 +22,53 @@ inline bool InsideForSampling(const cv::Mat& img, const Vector2d& p) {
   return p.x() >= 0 && p.y() >= 0 && p.x() <= img.cols - 1 && p.y() <= img.rows - 1;
 }
 
-// Bilinear BGR samples of an image; false outside it.
-struct Sampler {
-  const uint8_t* data;
-  size_t step;
-  int cols, rows, x_last0, y_last0;
+// Bilinear BGR samples of an image; false outside it. The corner pixels of the last cell sampled
+// are kept as doubles: samples a quarter pixel apart along a ray mostly share their cell.
+class Sampler {
+ public:
   explicit Sampler(const cv::Mat& img)
-      : data(img.data),
-        step(img.step[0]),
-        cols(img.cols),
-        rows(img.rows),
-        x_last0(img.cols - 2 >= 0 ? img.cols - 2 : 0),
-        y_last0(img.rows - 2 >= 0 ? img.rows - 2 : 0) {}
-  bool operator()(double x, double y, Vector3d* out) const {
-    if (!(x >= 0 && y >= 0 && x <= cols - 1 && y <= rows - 1)) return false;
-    const int x0 = std::min(static_cast<int>(x), x_last0);
-    const int y0 = std::min(static_cast<int>(y), y_last0);
-    const int x1 = std::min(x0 + 1, cols - 1), y1 = std::min(y0 + 1, rows - 1);
+      : data_(img.data),
+        step_(img.step[0]),
+        cols_(img.cols),
+        rows_(img.rows),
+        x_last0_(img.cols - 2 >= 0 ? img.cols - 2 : 0),
+        y_last0_(img.rows - 2 >= 0 ? img.rows - 2 : 0) {}
+  bool operator()(double x, double y, Vector3d* out) {
+    if (!(x >= 0 && y >= 0 && x <= cols_ - 1 && y <= rows_ - 1)) return false;
+    const int x0 = std::min(static_cast<int>(x), x_last0_);
+    const int y0 = std::min(static_cast<int>(y), y_last0_);
+    if (x0 != cell_x0_ || y0 != cell_y0_) Load(x0, y0);
     const double fx = x - x0, fy = y - y0, gx = 1 - fx, gy = 1 - fy;
-    const uint8_t* row0 = data + step * static_cast<size_t>(y0);
-    const uint8_t* row1 = data + step * static_cast<size_t>(y1);
+    for (int k = 0; k < 3; ++k) {
+      (*out)[k] = gy * (gx * a_[k] + fx * b_[k]) + fy * (gx * c_[k] + fx * d_[k]);
+    }
+    return true;
+  }
+
+ private:
+  void Load(int x0, int y0) {
+    const int x1 = std::min(x0 + 1, cols_ - 1), y1 = std::min(y0 + 1, rows_ - 1);
+    const uint8_t* row0 = data_ + step_ * static_cast<size_t>(y0);
+    const uint8_t* row1 = data_ + step_ * static_cast<size_t>(y1);
     const uint8_t* a = row0 + 3 * static_cast<ptrdiff_t>(x0);
     const uint8_t* b = row0 + 3 * static_cast<ptrdiff_t>(x1);
     const uint8_t* c = row1 + 3 * static_cast<ptrdiff_t>(x0);
     const uint8_t* d = row1 + 3 * static_cast<ptrdiff_t>(x1);
     for (int k = 0; k < 3; ++k) {
-      (*out)[k] = gy * (gx * a[k] + fx * b[k]) + fy * (gx * c[k] + fx * d[k]);
+      a_[k] = a[k];
+      b_[k] = b[k];
+      c_[k] = c[k];
+      d_[k] = d[k];
     }
-    return true;
+    cell_x0_ = x0;
+    cell_y0_ = y0;
   }
+
+  const uint8_t* data_;
+  size_t step_;
+  int cols_, rows_, x_last0_, y_last0_;
+  int cell_x0_ = -1, cell_y0_ = -1;
+  double a_[3] = {}, b_[3] = {}, c_[3] = {}, d_[3] = {};
 };
 
 // sqrt(a) >= sqrt(b) for a, b >= 0, mostly without the square roots.
@@ -194,7 +212,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   const double max_r = std::max(img.cols, img.rows);
   if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;
   e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), 24, 180);
-  const Sampler sample(img);
+  Sampler sample(img);
   std::vector<Vector3d> prof;
   std::vector<char> have;
   std::vector<double> grad2;
