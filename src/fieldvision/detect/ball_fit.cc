@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/camera/projection.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -89,8 +90,16 @@ class SqrtAtLeast {
   bool exact_;
 };
 
+// std::lround (halves away from zero) without the library call for |x| < 1e9.
+inline long RoundHalfAway(double x) {
+  if (!(x > -1e9 && x < 1e9)) return std::lround(x);
+  const long t = static_cast<long>(x);  // towards zero
+  const double f = x - t;               // exact
+  return f >= 0.5 ? t + 1 : f <= -0.5 ? t - 1 : t;
+}
+
 inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, double x, double y) {
-  const int xi = static_cast<int>(std::lround(x)), yi = static_cast<int>(std::lround(y));
+  const int xi = static_cast<int>(RoundHalfAway(x)), yi = static_cast<int>(RoundHalfAway(y));
   if (xi < 0 || yi < 0 || xi >= img.cols || yi >= img.rows) return false;
   const uint8_t* p = img.ptr<uint8_t>(yi) + 3 * static_cast<ptrdiff_t>(xi);
   return (table.Classify(p[0], p[1], p[2]) & bit) != 0;
@@ -431,11 +440,13 @@ struct ConeOutline {
     const double sin_alpha = std::sin(alpha);
     std::vector<std::pair<double, double>> polar;
     polar.reserve(kSamples);
+    // Camera::ProjectFromCamera with the intrinsics gathered once.
+    const auto intrinsics = cam.IntrinsicsBlock();
     for (int k = 0; k < kSamples; ++k) {
       const Vector3d v = along + sin_alpha * (kCosSin[k].first * e1 + kCosSin[k].second * e2);
-      const auto p = cam.ProjectFromCamera(v);
-      if (!p) return;
-      const Vector2d d = *p - centre;
+      Vector2d p;
+      if (!camera::ProjectCameraPoint(intrinsics.data(), v.data(), p.data())) return;
+      const Vector2d d = p - centre;
       double th = std::atan2(d.y(), d.x());
       if (th < 0) th += 2 * M_PI;
       polar.push_back({th, d.norm()});
