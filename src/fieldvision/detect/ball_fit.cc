@@ -33,9 +33,11 @@ class Sampler {
         cols_(img.cols),
         rows_(img.rows),
         x_last0_(img.cols - 2 >= 0 ? img.cols - 2 : 0),
-        y_last0_(img.rows - 2 >= 0 ? img.rows - 2 : 0) {}
+        y_last0_(img.rows - 2 >= 0 ? img.rows - 2 : 0),
+        x_max_(img.cols - 1),
+        y_max_(img.rows - 1) {}
   bool operator()(double x, double y, Vector3d* out) {
-    if (!(x >= 0 && y >= 0 && x <= cols_ - 1 && y <= rows_ - 1)) return false;
+    if (!(x >= 0 && y >= 0 && x <= x_max_ && y <= y_max_)) return false;
     const int x0 = std::min(static_cast<int>(x), x_last0_);
     const int y0 = std::min(static_cast<int>(y), y_last0_);
     if (x0 != cell_x0_ || y0 != cell_y0_) Load(x0, y0);
@@ -68,6 +70,7 @@ class Sampler {
   const uint8_t* data_;
   size_t step_;
   int cols_, rows_, x_last0_, y_last0_;
+  double x_max_, y_max_;  // the last column and row
   int cell_x0_ = -1, cell_y0_ = -1;
   double a_[3] = {}, b_[3] = {}, c_[3] = {}, d_[3] = {};
 };
@@ -249,13 +252,21 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
       }
       return prof[i];
     };
-    // The search window [g_lo, g_hi] (t within [t_lo, t_hi]; t rises with i), sampled at once.
+    // The search window [g_lo, g_hi] (t within [t_lo, t_hi]; m, -1: none), sampled at once. t
+    // rises with i: the window's ends are found from the nearest indices.
+    const auto t_at = [&](int i) { return t0 + i * kStep; };
     int g_lo = m, g_hi = -1;
-    for (int i = 1; i + 1 < m; ++i) {
-      const double t = t0 + i * kStep;
-      if (t < t_lo || t > t_hi) continue;
-      g_lo = std::min(g_lo, i);
-      g_hi = i;
+    if (m >= 3) {
+      int lo = std::clamp(static_cast<int>(std::ceil((t_lo - t0) / kStep)), 1, m - 1);
+      while (lo > 1 && t_at(lo - 1) >= t_lo) --lo;
+      while (lo < m - 1 && t_at(lo) < t_lo) ++lo;  // the first i >= 1 with t >= t_lo, or m - 1
+      int hi = std::clamp(static_cast<int>(std::floor((t_hi - t0) / kStep)), 0, m - 2);
+      while (hi < m - 2 && t_at(hi + 1) <= t_hi) ++hi;
+      while (hi > 0 && t_at(hi) > t_hi) --hi;  // the last i <= m - 2 with t <= t_hi, or 0
+      if (lo <= hi) {
+        g_lo = lo;
+        g_hi = hi;
+      }
     }
     for (int i = g_lo - 1; i <= g_hi + 1; ++i) {
       const Vector2d p = c + (t0 + i * kStep) * u;
