@@ -76,6 +76,9 @@ void TriangulationOptions::Check() const {
                "TriangulationOptions.allowed_region must be finite");
   }
   CheckPositive(prior_gate_m, "TriangulationOptions.prior_gate_m");
+  FV_REQUIRE(prior_override_views == 0 || prior_override_views >= 2,
+             "TriangulationOptions.prior_override_views must be 0 (never) or >= 2 (got {})",
+             prior_override_views);
   FV_REQUIRE(max_radius_ratio == 0.0 || max_radius_ratio > 1.0,
              "TriangulationOptions.max_radius_ratio must be 0 (off) or > 1 (got {})",
              max_radius_ratio);

@@ -102,6 +102,11 @@ struct TriangulationOptions {
   // the prior only admits sets of weak views. Gating a track's measurements by its prediction,
   // as in Bar-Shalom & Fortmann, "Tracking and Data Association" (1988).
   bool gate_by_prior = true;
+  // Unless nothing lies within prior_gate_m of the prior and at least this many cameras agree on
+  // a point elsewhere: the ball did move there (a hard kick at a low frame rate, a ball put down
+  // anew), as a static ghost seen by that many cameras is rare (and fusion's hover filter drops
+  // it). 0: never.
+  int prior_override_views = 3;
 
   void Check() const;  // throws fv::Error naming the bad field
 };

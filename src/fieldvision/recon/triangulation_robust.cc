@@ -117,11 +117,30 @@ double PairSigma(const camera::Camera& cam_a, const BallObservation& a, const ca
   return std::hypot(lateral_a, lateral_b) / sin_angle;
 }
 
+namespace {
+
+// Keeps the set (n cameras, cost, total detector score) in `best` when it is better: more cameras
+// first, then a higher total score, then a smaller error.
+void KeepBetter(int n, double cost, double score, const std::vector<int>& pick,
+                BestHypothesis* best) {
+  const bool better =
+      n > best->n || (n == best->n && (score > best->score + 1e-9 ||
+                                       (score > best->score - 1e-9 && cost < best->cost)));
+  if (better) {
+    best->n = n;
+    best->cost = cost;
+    best->score = score;
+    best->pick = pick;
+  }
+}
+
+}  // namespace
+
 BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
                                 const std::vector<std::vector<BallObservation>>& candidates,
                                 const RankedCandidates& ranked, const TriangulationOptions& o,
                                 bool require_strong, const Eigen::Vector3d* prior) {
-  BestHypothesis best;
+  BestHypothesis best, far;
   std::vector<int> pick;
   const std::vector<int>& seen = ranked.seen;
   for (size_t ia = 0; ia < seen.size(); ++ia) {
@@ -152,24 +171,23 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
                 {rp.midpoint,
                  PairSigma(cameras[ca], candidates[ca][ka], cameras[cb], candidates[cb][kb], rp)});
           }
-          if (gated) continue;  // the ball cannot be there (far from where it is expected)
+          // Far from where the ball is expected: only a set of prior_override_views cameras,
+          // and only when nothing lies near the prior (below).
+          if (gated && (o.prior_override_views == 0 || n < o.prior_override_views)) continue;
           double score = 0;
           for (int c : seen) {
             if (pick[c] >= 0) score += candidates[c][pick[c]].score;
           }
-          // More cameras first, then higher total detector score, then smaller error.
-          const bool better =
-              n > best.n || (n == best.n && (score > best.score + 1e-9 ||
-                                             (score > best.score - 1e-9 && cost < best.cost)));
-          if (better) {
-            best.n = n;
-            best.cost = cost;
-            best.score = score;
-            best.pick = pick;
-          }
+          KeepBetter(n, cost, score, pick, gated ? &far : &best);
         }
       }
     }
+  }
+  if (best.n < 2 && far.n >= 2) {  // a new place that many cameras agree on: the ball moved
+    best.n = far.n;
+    best.cost = far.cost;
+    best.score = far.score;
+    best.pick = far.pick;
   }
   return best;
 }

@@ -410,8 +410,17 @@ TEST(Triangulation, APriorGatesTheHypotheses) {
     ASSERT_TRUE(r.ok()) << ToString(r.status);
     EXPECT_LT((r.point_world - ball).norm(), 0.05);
     EXPECT_EQ(r.num_views(), 2);
+    // Nothing near a far prior: the set of 3 cameras elsewhere is taken (the ball moved there),
+    // a set of fewer than prior_override_views never.
     const Eigen::Vector3d far(50, 50, 1);
+    r = TriangulateRobust(cams, cand, opt, &far);
+    ASSERT_TRUE(r.ok()) << ToString(r.status);
+    EXPECT_LT((r.point_world - thing).norm(), 0.05);
+    opt.prior_override_views = 4;
     EXPECT_FALSE(TriangulateRobust(cams, cand, opt, &far).ok());
+    opt.prior_override_views = 0;
+    EXPECT_FALSE(TriangulateRobust(cams, cand, opt, &far).ok());
+    opt.prior_override_views = 3;
     opt.gate_by_prior = false;  // the prior then only admits weak sets
     r = TriangulateRobust(cams, cand, opt, &expected);
     ASSERT_TRUE(r.ok()) << ToString(r.status);
