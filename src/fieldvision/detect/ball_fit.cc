@@ -23,8 +23,9 @@ inline bool InsideForSampling(const cv::Mat& img, const Vector2d& p) {
   return p.x() >= 0 && p.y() >= 0 && p.x() <= img.cols - 1 && p.y() <= img.rows - 1;
 }
 
-// Bilinear BGR samples of an image; false outside it. The corner pixels of the last cell sampled
-// are kept as doubles: samples a quarter pixel apart along a ray mostly share their cell.
+// Bilinear BGR samples of an image (points where InsideForSampling holds). The corner pixels of
+// the last cell sampled are kept as doubles (samples a quarter pixel apart along a ray mostly
+// share their cell).
 class Sampler {
  public:
   explicit Sampler(const cv::Mat& img)
@@ -33,19 +34,17 @@ class Sampler {
         cols_(img.cols),
         rows_(img.rows),
         x_last0_(img.cols - 2 >= 0 ? img.cols - 2 : 0),
-        y_last0_(img.rows - 2 >= 0 ? img.rows - 2 : 0),
-        x_max_(img.cols - 1),
-        y_max_(img.rows - 1) {}
-  bool operator()(double x, double y, Vector3d* out) {
-    if (!(x >= 0 && y >= 0 && x <= x_max_ && y <= y_max_)) return false;
+        y_last0_(img.rows - 2 >= 0 ? img.rows - 2 : 0) {}
+  // A point inside the image, e.g. one on the segment between two inside points c + t u (the
+  // coordinates computed so are monotonic in t).
+  void Inside(double x, double y, Vector3d* out) {
     const int x0 = std::min(static_cast<int>(x), x_last0_);
     const int y0 = std::min(static_cast<int>(y), y_last0_);
     if (x0 != cell_x0_ || y0 != cell_y0_) Load(x0, y0);
-    const double fx = x - x0, fy = y - y0, gx = 1 - fx, gy = 1 - fy;
+    const double fx = x - cell_x0d_, fy = y - cell_y0d_, gx = 1 - fx, gy = 1 - fy;
     for (int k = 0; k < 3; ++k) {
       (*out)[k] = gy * (gx * a_[k] + fx * b_[k]) + fy * (gx * c_[k] + fx * d_[k]);
     }
-    return true;
   }
 
  private:
@@ -65,13 +64,15 @@ class Sampler {
     }
     cell_x0_ = x0;
     cell_y0_ = y0;
+    cell_x0d_ = x0;
+    cell_y0d_ = y0;
   }
 
   const uint8_t* data_;
   size_t step_;
   int cols_, rows_, x_last0_, y_last0_;
-  double x_max_, y_max_;  // the last column and row
   int cell_x0_ = -1, cell_y0_ = -1;
+  double cell_x0d_ = -1, cell_y0d_ = -1;
   double a_[3] = {}, b_[3] = {}, c_[3] = {}, d_[3] = {};
 };
 
@@ -239,7 +240,8 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     const double t0 = std::min(0.35 * r, std::max(t_lo - kSide - kStep, 0.0));
     const double t_end = r + std::max(half, 0.6 * r) + 2.0;
     const int m = static_cast<int>((t_end - t0) / kStep) + 1;
-    // The profile lies inside the image when both its ends do; it is sampled where it is read.
+    // The profile lies inside the image when both its ends do (Sampler::Inside); it is sampled
+    // where it is read.
     const Vector2d p_first = c + t0 * u, p_last = c + (t0 + (m - 1) * kStep) * u;
     if (!InsideForSampling(img, p_first) || !InsideForSampling(img, p_last)) continue;
     prof.resize(m);
@@ -247,7 +249,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     const auto at = [&](int i) -> const Vector3d& {
       if (!have[i]) {
         const Vector2d p = c + (t0 + i * kStep) * u;
-        sample(p.x(), p.y(), &prof[i]);
+        sample.Inside(p.x(), p.y(), &prof[i]);
         have[i] = 1;
       }
       return prof[i];
@@ -270,7 +272,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     }
     for (int i = g_lo - 1; i <= g_hi + 1; ++i) {
       const Vector2d p = c + (t0 + i * kStep) * u;
-      sample(p.x(), p.y(), &prof[i]);
+      sample.Inside(p.x(), p.y(), &prof[i]);
       have[i] = 1;
     }
     // Squared gradient magnitude (central differences over 0.5 px) in the search window: the
