@@ -159,9 +159,16 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
   FrameSynchronizer sync(static_cast<int>(cameras.size()), options.sync);
   FusionStage fusion(cameras, options.triangulation);
   util::Progress progress("ball", total, "frames", options.progress);
+  const bool second_pass = options.second_pass && options.queue_policy == QueuePolicy::kBlock;
+  std::vector<SyncedFrame> groups;  // kept for the second pass
   while (!stopping()) {
     while (auto group = sync.Next()) {
-      on_frame(fusion.Fuse(*group));
+      const BallFrame f = fusion.Fuse(*group);
+      if (second_pass) {
+        groups.push_back(std::move(*group));
+      } else {
+        on_frame(f);
+      }
       progress.Update(fusion.stats().frames);
       if (options.control != nullptr) {
         options.control->Report({"ball", fusion.stats().frames, total, "frames", ""});
@@ -178,7 +185,17 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
   }
   progress.Finish();
   summary->sync = sync.report();
-  AddFusionStats(fusion.stats(), summary);
+  if (!second_pass) {
+    AddFusionStats(fusion.stats(), summary);
+    return;
+  }
+  FusionStage again(cameras, options.triangulation);
+  again.RememberHovering(fusion);
+  for (const SyncedFrame& group : groups) {
+    if (stopping()) break;
+    on_frame(again.Fuse(group));
+  }
+  AddFusionStats(again.stats(), summary);
 }
 
 void AddFusionStats(const FusionStats& f, BallPipelineSummary* summary) {

@@ -28,9 +28,13 @@ struct BallPipelineOptions {
   int queue_capacity = 3;                          // messages per camera queue (the seed's 3)
   QueuePolicy queue_policy = QueuePolicy::kBlock;  // kDropOldest for live input
   recon::TriangulationOptions triangulation;
-  BallTrackOptions track;         // used with BallRegionDetectFn detectors
-  long long max_frames = 0;       // stop each camera after this many frames; 0: all
-  bool progress = true;           // frames, fps and time left on stderr
+  BallTrackOptions track;    // used with BallRegionDetectFn detectors
+  long long max_frames = 0;  // stop each camera after this many frames; 0: all
+  bool progress = true;      // frames, fps and time left on stderr
+  // Offline (kBlock): fuse every frame a second time, knowing each still airborne point from its
+  // whole life (FusionStage::RememberHovering), so a ghost is dropped from its first frame and not
+  // only 0.3 s later; on_frame then sees the second pass's frames, after the first pass.
+  bool second_pass = true;
   JobControl* control = nullptr;  // optional: progress callback and stop check (not owned)
   void Check() const;             // throws fv::Error naming the bad field
 };

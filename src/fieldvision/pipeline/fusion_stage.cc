@@ -69,12 +69,16 @@ void HoverFilter::Record(double time_s, const Eigen::Vector3d& point_world, doub
   if (seen_.size() > kMaxRemembered) seen_.pop_front();
 }
 
+void HoverFilter::Remember(const HoverFilter& other) {
+  seen_.insert(seen_.end(), other.seen_.begin(), other.seen_.end());
+}
+
 bool HoverFilter::RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {
-  std::vector<double> times;  // earlier frames that saw this point
+  std::vector<double> times;  // other frames that saw this point
   double z_min = point_world.z(), z_max = point_world.z();
   for (const Seen& s : seen_) {
     const double tolerance_m = std::max(options_.radius_m, 3 * std::hypot(sigma_m, s.sigma_m));
-    if (s.time_s < time_s && (s.point_world - point_world).norm() <= tolerance_m) {
+    if (s.time_s != time_s && (s.point_world - point_world).norm() <= tolerance_m) {
       times.push_back(s.time_s);
       z_min = std::min(z_min, s.point_world.z());
       z_max = std::max(z_max, s.point_world.z());
@@ -82,8 +86,10 @@ bool HoverFilter::RecordAndTest(double time_s, const Eigen::Vector3d& point_worl
   }
   Record(time_s, point_world, sigma_m);
   std::sort(times.begin(), times.end());
-  const int count = 1 + static_cast<int>(std::unique(times.begin(), times.end()) - times.begin());
-  if (count < options_.min_count || times.empty() || time_s - times.front() < options_.min_span_s) {
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  const int count = 1 + static_cast<int>(times.size());
+  if (count < options_.min_count || times.empty() ||
+      std::max(times.back(), time_s) - std::min(times.front(), time_s) < options_.min_span_s) {
     return false;
   }
   // A free ball's heights span at least g T^2 / 8 over any T seconds (T/2 each side of an apex).

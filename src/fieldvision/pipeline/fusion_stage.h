@@ -82,8 +82,12 @@ class HoverFilter {
   // Remembers an airborne position (a consistent hypothesis that was not chosen).
   void Record(double time_s, const Eigen::Vector3d& point_world, double sigma_m);
   // Remembers an airborne position (sigma_m: its 3D RMS uncertainty); true when it repeats a
-  // point that hovers (seen there in min_count frames, this one included).
+  // point that hovers (seen there in min_count frames, this one included). Positions remembered
+  // at other times count, later ones too (Remember).
   bool RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m = 0.0);
+  // Adds what `other` remembers (a first pass over the same clip): a second pass then knows each
+  // still point from its whole life and drops a ghost from its first frame on.
+  void Remember(const HoverFilter& other);
 
  private:
   HoverFilterOptions options_;
@@ -114,6 +118,9 @@ class FusionStage {
   // Throws fv::Error when there is no camera or the options are bad.
   FusionStage(std::vector<camera::Camera> cameras, const recon::TriangulationOptions& options);
   BallFrame Fuse(const SyncedFrame& frame);
+  // A second pass over a clip: the airborne positions `first_pass` saw, at any time, count for
+  // the hover test (HoverFilter::Remember).
+  void RememberHovering(const FusionStage& first_pass) { hover_.Remember(first_pass.hover_); }
   const FusionStats& stats() const { return stats_; }
   const std::vector<camera::Camera>& cameras() const { return cameras_; }
 

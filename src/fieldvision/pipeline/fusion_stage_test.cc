@@ -46,6 +46,33 @@ TEST(HoverFilter, AStillAirbornePointIsFlaggedAfterTheSpan) {
   EXPECT_EQ(first_flagged, 18);  // 0.3 s after the first sighting at 60 fps
 }
 
+TEST(HoverFilter, ASecondPassFlagsAGhostFromItsFirstFrame) {
+  // The first pass over a clip remembers the ghost's whole life; the second one, knowing it,
+  // flags it from its first sighting, while the flying ball of the same clip stays a ball.
+  const Vector3d ghost(1.1, 3.83, 2.45);
+  auto ghost_at = [&](int f) -> Vector3d {
+    return ghost + Vector3d(0.075 * std::sin(2.1 * f), 0.01 * std::cos(f), 0.01 * std::sin(5 * f));
+  };
+  auto ball_at = [](int f) -> Vector3d {
+    const double t = f / 60.0;
+    return Vector3d(-3 + 10.4 * t, 0.5, 0.11 + 6.0 * t - 0.5 * 9.81 * t * t);
+  };
+  HoverFilter first;
+  for (int f = 0; f < 40; ++f) {
+    first.RecordAndTest(f / 60.0, ghost_at(f), 0.01);
+    first.RecordAndTest(f / 60.0, ball_at(f), 0.005);
+  }
+  HoverFilter second;
+  second.Remember(first);
+  for (int f = 0; f < 40; ++f) {
+    EXPECT_TRUE(second.RecordAndTest(f / 60.0, ghost_at(f), 0.01)) << "frame " << f;
+    EXPECT_FALSE(second.RecordAndTest(f / 60.0, ball_at(f), 0.005)) << "frame " << f;
+  }
+  // Without the first pass the ghost passes for its first 0.3 s.
+  HoverFilter alone;
+  EXPECT_FALSE(alone.RecordAndTest(0.0, ghost_at(0), 0.01));
+}
+
 TEST(HoverFilter, AFlyingBallIsNeverFlagged) {
   HoverFilter filter;
   for (int f = 0; f < 70; ++f) {  // kicked at 12 m/s, 30 deg up: 1.15 s of flight
