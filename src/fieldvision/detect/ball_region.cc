@@ -27,13 +27,19 @@ void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit
                 cv::Mat* cls) {
   raw->create(bgr_window.size(), CV_8U);
   cls->create(bgr_window.size(), CV_8U);
+  // The table's pointer kept in a local: the byte stores below may alias anything, so a call to
+  // Classify per pixel reloads it (and the table's depth) every time.
+  const uint8_t* lut = table.data();
+  const bool direct = table.bits_per_channel() == 8;
   for (int y = 0; y < bgr_window.rows; ++y) {
     const uint8_t* p = bgr_window.ptr<uint8_t>(y);
     uint8_t* m = raw->ptr<uint8_t>(y);
     uint8_t* k = cls->ptr<uint8_t>(y);
     for (int x = 0; x < bgr_window.cols; ++x, p += 3) {
-      k[x] = table.Classify(p[0], p[1], p[2]);
-      m[x] = (k[x] & bit) != 0 ? 255 : 0;
+      const uint32_t packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+      const uint8_t c = lut[direct ? packed : table.Index(packed)];
+      k[x] = c;
+      m[x] = (c & bit) != 0 ? 255 : 0;
     }
   }
 }
@@ -334,9 +340,10 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
 }
 
 // GrowByOwnColourIn on the part of the window within reach of the region (and its ring).
+// `*extent` holds every pixel of the region, before and after.
 void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions& o,
-                     cv::Mat* region) {
-  const cv::Rect box = cv::boundingRect(*region);
+                     cv::Mat* region, cv::Rect* extent) {
+  const cv::Rect box = cv::boundingRect((*region)(*extent)) + extent->tl();
   if (box.area() == 0) return;
   const float r = 0.5f * static_cast<float>(std::max(box.width, box.height));
   const int margin =
@@ -346,16 +353,19 @@ void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions
   cv::Mat part = (*region)(sub);
   lab->Need(sub);
   GrowByOwnColourIn(lab->lab()(sub), raw(sub), o, r, &part);
+  *extent = sub;
 }
 
 // The gathered region grown through the widened class near its core and closed (print, seams);
 // empty when no ball-coloured pixel touches the seed. `grow_table`: the widened class (null: none).
+// `*extent` (window coordinates) holds every pixel of the region: only that part is scanned.
 cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
                            const ColourTable* grow_table, LabWindow* lab, const cv::Rect& seed,
-                           const BallRegionOptions& o) {
+                           const BallRegionOptions& o, cv::Rect* extent) {
   cv::Rect bounds;
   cv::Mat region = GatherComponents(raw, seed, o.gather_fraction, &bounds);
   if (bounds.area() == 0) return {};
+  *extent = bounds;
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
   if (grow_table != nullptr) {
     // Hysteresis with a reach: widened-class pixels join only near the core (a shaded rim, a
@@ -368,26 +378,32 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
         region(sub), near,
         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
     const uint8_t grow_bit = grow_table->BallBit();
+    const uint8_t* lut = grow_table->data();
+    const bool direct = grow_table->bits_per_channel() == 8;
     for (int y = 0; y < sub.height; ++y) {
       const uint8_t* p = bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x);
       const uint8_t* nr = near.ptr<uint8_t>(y);
       uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
       for (int x = 0; x < sub.width; ++x, p += 3) {
-        if (nr[x] != 0 && (grow_table->Classify(p[0], p[1], p[2]) & grow_bit) != 0) m[x] = 255;
+        if (nr[x] == 0) continue;
+        const uint32_t packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+        if ((lut[direct ? packed : grow_table->Index(packed)] & grow_bit) != 0) m[x] = 255;
       }
     }
+    *extent = sub;
   }
-  if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region);
+  if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region, extent);
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
   if (k >= 1) {
     // Closing changes nothing farther than k from the region; 2 k + 1 out the part's own border
     // (eroded as if set) meets only pixels the dilation left clear.
-    const cv::Rect sub =
-        Grow(cv::boundingRect(region), 2 * k + 1) & cv::Rect(0, 0, region.cols, region.rows);
+    const cv::Rect sub = Grow(cv::boundingRect(region(*extent)) + extent->tl(), 2 * k + 1) &
+                         cv::Rect(0, 0, region.cols, region.rows);
     cv::Mat part = region(sub).clone();
     cv::morphologyEx(part, part, cv::MORPH_CLOSE,
                      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
     part.copyTo(region(sub));
+    *extent = sub;
   }
   return region;
 }
@@ -588,7 +604,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   cv::Mat raw, cls;
   ClassMasks(bgr_window, table, ball_bit, &raw, &cls);
   LabWindow lab(bgr_window);
-  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow_table, &lab, seed, o);
+  cv::Rect extent;
+  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow_table, &lab, seed, o, &extent);
   if (region.empty()) {
     out.failure = "no ball-coloured pixels at the blob";
     return out;
@@ -653,8 +670,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
                           static_cast<int>(std::ceil(c.y() + ro)) + 2);
   const cv::Rect ring_box = cv::Rect(ring_tl, ring_br) - window.tl();
   lab.Need(ring_box);
-  const cv::Rect read =
-      (ring_box | cv::boundingRect(filled)) & cv::Rect(0, 0, window.width, window.height);
+  const cv::Rect read = (ring_box | (cv::boundingRect(filled(extent)) + extent.tl())) &
+                        cv::Rect(0, 0, window.width, window.height);
   MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, read, c, r, area, o, field_bit,
                        &out);
   out.ok = true;
