@@ -4,7 +4,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -20,6 +22,9 @@ void BallPipelineOptions::Check() const {
   FV_REQUIRE(queue_capacity >= 1 && queue_capacity <= 10000,
              "BallPipelineOptions.queue_capacity must be in [1, 10000] (got {})", queue_capacity);
   FV_REQUIRE(max_frames >= 0, "BallPipelineOptions.max_frames must be >= 0 (got {})", max_frames);
+  FV_REQUIRE(second_pass_lag_s >= 0 && std::isfinite(second_pass_lag_s),
+             "BallPipelineOptions.second_pass_lag_s must be finite and >= 0 (got {})",
+             second_pass_lag_s);
   triangulation.Check();
   track.Check();
 }
@@ -160,12 +165,24 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
   FusionStage fusion(cameras, options.triangulation);
   util::Progress progress("ball", total, "frames", options.progress);
   const bool second_pass = options.second_pass && options.queue_policy == QueuePolicy::kBlock;
-  std::vector<SyncedFrame> groups;  // kept for the second pass
+  FusionStage again(cameras, options.triangulation);
+  std::deque<SyncedFrame> pending;  // fused once, waiting for the second pass
+  double remembered_s = -std::numeric_limits<double>::infinity();
+  // The second pass over the frames the first one has passed by the lag (all at the end).
+  const auto fuse_again = [&](double up_to_s) {
+    remembered_s = again.RememberHovering(fusion, remembered_s);
+    while (!pending.empty() && pending.front().time_s <= up_to_s && !stopping()) {
+      on_frame(again.Fuse(pending.front()));
+      pending.pop_front();
+    }
+  };
   while (!stopping()) {
     while (auto group = sync.Next()) {
       const BallFrame f = fusion.Fuse(*group);
       if (second_pass) {
-        groups.push_back(std::move(*group));
+        const double now_s = group->time_s;
+        pending.push_back(std::move(*group));
+        fuse_again(now_s - options.second_pass_lag_s);
       } else {
         on_frame(f);
       }
@@ -189,12 +206,7 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
     AddFusionStats(fusion.stats(), summary);
     return;
   }
-  FusionStage again(cameras, options.triangulation);
-  again.RememberHovering(fusion);
-  for (const SyncedFrame& group : groups) {
-    if (stopping()) break;
-    on_frame(again.Fuse(group));
-  }
+  fuse_again(std::numeric_limits<double>::infinity());
   AddFusionStats(again.stats(), summary);
 }
 

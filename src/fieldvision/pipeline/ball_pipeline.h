@@ -31,10 +31,12 @@ struct BallPipelineOptions {
   BallTrackOptions track;    // used with BallRegionDetectFn detectors
   long long max_frames = 0;  // stop each camera after this many frames; 0: all
   bool progress = true;      // frames, fps and time left on stderr
-  // Offline (kBlock): fuse every frame a second time, knowing each still airborne point from its
-  // whole life (FusionStage::RememberHovering), so a ghost is dropped from its first frame and not
-  // only 0.3 s later; on_frame then sees the second pass's frames, after the first pass.
+  // Offline (kBlock): fuse every frame a second time, second_pass_lag_s behind the first pass,
+  // knowing each still airborne point from the first pass's sightings up to then (its future
+  // included; FusionStage::RememberHovering), so a ghost is dropped from its first frame and not
+  // only 0.3 s (HoverFilterOptions::min_span_s) later. on_frame sees the second pass's frames.
   bool second_pass = true;
+  double second_pass_lag_s = 1.0;
   JobControl* control = nullptr;  // optional: progress callback and stop check (not owned)
   void Check() const;             // throws fv::Error naming the bad field
 };

@@ -69,8 +69,15 @@ void HoverFilter::Record(double time_s, const Eigen::Vector3d& point_world, doub
   if (seen_.size() > kMaxRemembered) seen_.pop_front();
 }
 
-void HoverFilter::Remember(const HoverFilter& other) {
-  seen_.insert(seen_.end(), other.seen_.begin(), other.seen_.end());
+double HoverFilter::RememberAfter(const HoverFilter& other, double after_time_s) {
+  double latest = after_time_s;
+  for (const Seen& s : other.seen_) {
+    if (s.time_s > after_time_s) {
+      seen_.push_back(s);
+      latest = std::max(latest, s.time_s);
+    }
+  }
+  return latest;
 }
 
 bool HoverFilter::RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m) {

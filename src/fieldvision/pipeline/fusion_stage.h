@@ -83,11 +83,12 @@ class HoverFilter {
   void Record(double time_s, const Eigen::Vector3d& point_world, double sigma_m);
   // Remembers an airborne position (sigma_m: its 3D RMS uncertainty); true when it repeats a
   // point that hovers (seen there in min_count frames, this one included). Positions remembered
-  // at other times count, later ones too (Remember).
+  // at other times count, later ones too (RememberAfter).
   bool RecordAndTest(double time_s, const Eigen::Vector3d& point_world, double sigma_m = 0.0);
-  // Adds what `other` remembers (a first pass over the same clip): a second pass then knows each
-  // still point from its whole life and drops a ghost from its first frame on.
-  void Remember(const HoverFilter& other);
+  // Adds what `other` remembers after `after_time_s` (a first pass over the same clip, running
+  // ahead): a second pass then knows each still point from its future too and drops a ghost from
+  // its first frame on. Returns the latest time added (after_time_s when none).
+  double RememberAfter(const HoverFilter& other, double after_time_s);
 
  private:
   HoverFilterOptions options_;
@@ -118,9 +119,11 @@ class FusionStage {
   // Throws fv::Error when there is no camera or the options are bad.
   FusionStage(std::vector<camera::Camera> cameras, const recon::TriangulationOptions& options);
   BallFrame Fuse(const SyncedFrame& frame);
-  // A second pass over a clip: the airborne positions `first_pass` saw, at any time, count for
-  // the hover test (HoverFilter::Remember).
-  void RememberHovering(const FusionStage& first_pass) { hover_.Remember(first_pass.hover_); }
+  // A second pass over a clip: the airborne positions `first_pass` saw after `after_time_s`, later
+  // ones too, count for the hover test (HoverFilter::RememberAfter); returns the latest time added.
+  double RememberHovering(const FusionStage& first_pass, double after_time_s) {
+    return hover_.RememberAfter(first_pass.hover_, after_time_s);
+  }
   const FusionStats& stats() const { return stats_; }
   const std::vector<camera::Camera>& cameras() const { return cameras_; }
 

@@ -63,7 +63,7 @@ TEST(HoverFilter, ASecondPassFlagsAGhostFromItsFirstFrame) {
     first.RecordAndTest(f / 60.0, ball_at(f), 0.005);
   }
   HoverFilter second;
-  second.Remember(first);
+  second.RememberAfter(first, -1.0);
   for (int f = 0; f < 40; ++f) {
     EXPECT_TRUE(second.RecordAndTest(f / 60.0, ghost_at(f), 0.01)) << "frame " << f;
     EXPECT_FALSE(second.RecordAndTest(f / 60.0, ball_at(f), 0.005)) << "frame " << f;
