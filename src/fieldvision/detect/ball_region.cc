@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
 #include <functional>
 
@@ -409,18 +410,21 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
 }
 
 // The region's largest outer contour and the region it bounds, filled (holes from a print or a
-// highlight belong to the ball); false when there is no outline.
-bool LargestFilledOutline(const cv::Mat& region, std::vector<cv::Point>* contour, cv::Mat* filled) {
+// highlight belong to the ball); false when there is no outline. `extent` holds every pixel of
+// the region: only that part is traced and filled.
+bool LargestFilledOutline(const cv::Mat& region, const cv::Rect& extent,
+                          std::vector<cv::Point>* contour, cv::Mat* filled) {
   std::vector<std::vector<cv::Point>> contours;
-  cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  cv::findContours(region(extent), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE, extent.tl());
   if (contours.empty()) return false;
   const auto largest =
       std::max_element(contours.begin(), contours.end(), [](const auto& a, const auto& b) {
         return cv::contourArea(a) + a.size() < cv::contourArea(b) + b.size();
       });
   *filled = cv::Mat(region.size(), CV_8U, cv::Scalar(0));
-  cv::drawContours(*filled, contours, static_cast<int>(largest - contours.begin()), 255,
-                   cv::FILLED);
+  cv::Mat part = (*filled)(extent);
+  cv::drawContours(part, contours, static_cast<int>(largest - contours.begin()), 255, cv::FILLED,
+                   cv::LINE_8, cv::noArray(), INT_MAX, -extent.tl());
   *contour = std::move(*largest);
   return true;
 }
@@ -612,14 +616,14 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   }
   std::vector<cv::Point> contour;
   cv::Mat filled;
-  if (!LargestFilledOutline(region, &contour, &filled)) {
+  if (!LargestFilledOutline(region, extent, &contour, &filled)) {
     out.failure = "no outline";
     return out;
   }
   std::vector<cv::Point> hull;
   cv::convexHull(contour, hull);
   const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
-  const double area = cv::countNonZero(filled);
+  const double area = cv::countNonZero(filled(extent));
   out.area_px = area;
   out.solidity = std::min(1.0, area / hull_area);
   const double r_est = std::sqrt(hull_area / M_PI);
