@@ -261,31 +261,25 @@ std::string BallRegion::Summary() const {
 
 namespace {
 
-// Median CIELAB colour (OpenCV 8-bit scale) of `lab`'s pixels where `select` holds for the
-// distance `dist` and the class mask `raw` value; false if none. Histogram medians: linear time.
-template <typename Select>
-bool MedianLab(const cv::Mat& lab, const cv::Mat& dist, const cv::Mat& raw, Select select,
-               Eigen::Vector3d* out) {
+// A histogram of CIELAB colours (OpenCV 8-bit scale): medians in linear time.
+struct LabHistogram {
   std::array<std::array<int, 256>, 3> hist{};
   int n = 0;
-  for (int y = 0; y < lab.rows; ++y) {
-    const uint8_t* l = lab.ptr<uint8_t>(y);
-    const float* d = dist.ptr<float>(y);
-    const uint8_t* m = raw.ptr<uint8_t>(y);
-    for (int x = 0; x < lab.cols; ++x) {
-      if (!select(d[x], m[x] != 0)) continue;
-      ++n;
-      for (int ch = 0; ch < 3; ++ch) ++hist[ch][l[3 * x + ch]];
+  void Add(const uint8_t* lab_px) {
+    ++n;
+    for (int ch = 0; ch < 3; ++ch) ++hist[ch][lab_px[ch]];
+  }
+  // The median colour; false if empty.
+  bool Median(Eigen::Vector3d* out) const {
+    if (n == 0) return false;
+    for (int ch = 0; ch < 3; ++ch) {
+      int seen = 0, v = 0;
+      while (v < 255 && (seen += hist[ch][v]) * 2 < n) ++v;
+      (*out)[ch] = v;
     }
+    return true;
   }
-  if (n == 0) return false;
-  for (int ch = 0; ch < 3; ++ch) {
-    int seen = 0, v = 0;
-    while (v < 255 && (seen += hist[ch][v]) * 2 < n) ++v;
-    (*out)[ch] = v;
-  }
-  return true;
-}
+};
 
 // The region grown by its own colour (BallRegionOptions::own_reach; r its radius): seeded region
 // growing (Adams & Bischof, PAMI 1994) against the surroundings' median colour. Distances to the
@@ -294,18 +288,27 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
                        cv::Mat* region) {
   cv::Mat dist;  // distance to the region, pixels (0 inside it)
   cv::distanceTransform(~*region, dist, cv::DIST_L2, cv::DIST_MASK_3);
-  Eigen::Vector3d own, around;
-  const bool has_own = MedianLab(
-                           lab, dist, raw, [](float d, bool c) { return d == 0 && c; }, &own) ||
-                       MedianLab(
-                           lab, dist, raw, [](float d, bool) { return d == 0; }, &own);
+  // The region's ball-class pixels (all of its pixels when none is) and the ring's pixels
+  // outside the class, in one pass.
   const float ring_in = std::max(1.0f, 0.3f * r), ring_out = std::max(3.0f, 0.6f * r);
-  if (!has_own ||
-      !MedianLab(
-          lab, dist, raw, [&](float d, bool c) { return d > ring_in && d <= ring_out && !c; },
-          &around)) {
-    return;
+  LabHistogram own_class, own_all, ring;
+  for (int y = 0; y < lab.rows; ++y) {
+    const uint8_t* l = lab.ptr<uint8_t>(y);
+    const float* d = dist.ptr<float>(y);
+    const uint8_t* m = raw.ptr<uint8_t>(y);
+    for (int x = 0; x < lab.cols; ++x) {
+      const uint8_t* lab_px = l + 3 * static_cast<ptrdiff_t>(x);
+      if (d[x] == 0) {
+        own_all.Add(lab_px);
+        if (m[x] != 0) own_class.Add(lab_px);
+      } else if (d[x] > ring_in && d[x] <= ring_out && m[x] == 0) {
+        ring.Add(lab_px);
+      }
+    }
   }
+  Eigen::Vector3d own, around;
+  const bool has_own = own_class.Median(&own) || own_all.Median(&own);
+  if (!has_own || !ring.Median(&around)) return;
   // CIELAB with L on its own scale (OpenCV's 8-bit L is L * 255 / 100): squared norms are
   // Delta E 1976 squared.
   const Eigen::Vector3f scale(100.0f / 255.0f, 1.0f, 1.0f);
