@@ -377,21 +377,42 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     // reach from the gathered bounds can join: only that part is dilated and classified.
     const int reach = std::max(1, static_cast<int>(std::lround(o.grow_fraction * r_region)));
     const cv::Rect sub = Grow(bounds, reach) & cv::Rect(0, 0, raw.cols, raw.rows);
-    cv::Mat near;
-    cv::dilate(
-        region(sub), near,
-        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
+    // The widened class's pixels not yet in the region, and their bounds: the dilation is needed
+    // only there (within reach of them), and not at all when there are none.
     const uint8_t grow_bit = grow_table->BallBit();
     const uint8_t* lut = grow_table->data();
     const bool direct = grow_table->bits_per_channel() == 8;
+    cv::Mat cand(sub.size(), CV_8U);
+    int x0 = sub.width, x1 = -1, y0 = sub.height, y1 = -1;
     for (int y = 0; y < sub.height; ++y) {
       const uint8_t* p = bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x);
-      const uint8_t* nr = near.ptr<uint8_t>(y);
-      uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
+      const uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
+      uint8_t* c = cand.ptr<uint8_t>(y);
       for (int x = 0; x < sub.width; ++x, p += 3) {
-        if (nr[x] == 0) continue;
         const uint32_t packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
-        if ((lut[direct ? packed : grow_table->Index(packed)] & grow_bit) != 0) m[x] = 255;
+        c[x] = m[x] == 0 && (lut[direct ? packed : grow_table->Index(packed)] & grow_bit) != 0;
+        if (c[x] != 0) {
+          x0 = std::min(x0, x);
+          x1 = std::max(x1, x);
+          y0 = std::min(y0, y);
+          y1 = y;
+        }
+      }
+    }
+    if (x1 >= 0) {
+      const cv::Rect cbox = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1) + sub.tl();
+      const cv::Rect dbox = Grow(cbox, reach) & cv::Rect(0, 0, raw.cols, raw.rows);
+      cv::Mat near;
+      cv::dilate(
+          region(dbox), near,
+          cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
+      for (int y = cbox.y; y < cbox.br().y; ++y) {
+        const uint8_t* c = cand.ptr<uint8_t>(y - sub.y);
+        const uint8_t* nr = near.ptr<uint8_t>(y - dbox.y);
+        uint8_t* m = region.ptr<uint8_t>(y);
+        for (int x = cbox.x; x < cbox.br().x; ++x) {
+          if (c[x - sub.x] != 0 && nr[x - dbox.x] != 0) m[x] = 255;
+        }
       }
     }
     *extent = sub;
