@@ -11,7 +11,6 @@
 
 #include "fieldvision/detect/ball_fit.h"
 #include "fieldvision/util/error.h"
-#include "fieldvision/util/stats.h"
 
 namespace fv::detect {
 namespace {
@@ -278,6 +277,21 @@ struct LabHistogram {
       (*out)[ch] = v;
     }
     return true;
+  }
+  // util::Median of the channel's values (the mean of the two middle ones for an even count).
+  double ChannelMedian(int ch) const {
+    const double pos = 0.5 * static_cast<double>(n - 1);
+    const int lo = static_cast<int>(std::floor(pos));
+    const int hi = std::min(lo + 1, n - 1);
+    const double v_lo = Ranked(ch, lo);
+    if (hi == lo) return v_lo;
+    return v_lo + (pos - static_cast<double>(lo)) * (Ranked(ch, hi) - v_lo);
+  }
+  // The channel's value of rank k (0: the smallest).
+  double Ranked(int ch, int k) const {
+    int seen = 0, v = 0;
+    while (v < 255 && (seen += hist[ch][v]) <= k) ++v;
+    return v;
   }
 };
 
@@ -554,7 +568,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
                           const cv::Mat& filled, const cv::Mat& raw, const cv::Mat& cls,
                           const cv::Rect& read, const Vector2d& c, double r, double area,
                           const BallRegionOptions& o, uint8_t field_bit, BallRegion* out) {
-  std::array<std::vector<double>, 3> disc_lab, core_lab, ring_lab;
+  LabHistogram disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
   long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, ring_field = 0, pure = 0;
@@ -579,15 +593,13 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
         ++ring;
         ring_ball += m[x] != 0;
         if (m[x] == 0) {  // what is around the ball, not more of its colour (that is leak)
-          const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
-          for (int ch = 0; ch < 3; ++ch) ring_lab[ch].push_back(l[ch]);
+          ring_lab.Add(lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x));
           ring_field += (cls.ptr<uint8_t>(y)[x] & field_bit) != 0;
         }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
         // The ball's own colour (not its print, shadow or a hidden part), else the whole core.
-        auto& dest = m[x] != 0 ? disc_lab : core_lab;
-        for (int ch = 0; ch < 3; ++ch) dest[ch].push_back(l[ch]);
+        (m[x] != 0 ? disc_lab : core_lab).Add(l);
       }
       pure += f[x] != 0 && m[x] != 0;
     }
@@ -597,14 +609,14 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   out->leak = ring > 0 ? double(ring_ball) / ring : 0.0;
   out->field_ring = ring > 0 ? double(ring_field) / ring : 0.0;
   out->purity = area > 0 ? pure / area : 0.0;
-  if (disc_lab[0].empty()) disc_lab = std::move(core_lab);
-  if (!disc_lab[0].empty() && !ring_lab[0].empty()) {
+  const LabHistogram& disc_h = disc_lab.n > 0 ? disc_lab : core_lab;
+  if (disc_h.n > 0 && ring_lab.n > 0) {
     // OpenCV's 8-bit Lab: L * 255 / 100, a + 128, b + 128.
-    const auto median_lab = [](const std::array<std::vector<double>, 3>& v) {
-      return Eigen::Vector3d(util::Median(v[0]) * 100.0 / 255.0, util::Median(v[1]) - 128.0,
-                             util::Median(v[2]) - 128.0);
+    const auto median_lab = [](const LabHistogram& h) {
+      return Eigen::Vector3d(h.ChannelMedian(0) * 100.0 / 255.0, h.ChannelMedian(1) - 128.0,
+                             h.ChannelMedian(2) - 128.0);
     };
-    const Eigen::Vector3d disc_c = median_lab(disc_lab), ring_c = median_lab(ring_lab);
+    const Eigen::Vector3d disc_c = median_lab(disc_h), ring_c = median_lab(ring_lab);
     out->contrast = (disc_c - ring_c).norm();
     // Delta H^2 = Delta a^2 + Delta b^2 - Delta C^2.
     const double dc = disc_c.tail<2>().norm() - ring_c.tail<2>().norm();
