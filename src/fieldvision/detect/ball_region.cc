@@ -434,9 +434,12 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
   if (o.own_reach > 0) GrowByOwnColour(lab, raw, o, &region, extent);
   const int k = std::min(4, static_cast<int>(std::lround(o.close_fraction * r_region)));
   if (k >= 1) {
-    // Closing changes nothing farther than k from the region; 2 k + 1 out the part's own border
-    // (eroded as if set) meets only pixels the dilation left clear.
-    const cv::Rect sub = Grow(cv::boundingRect(region(*extent)) + extent->tl(), 2 * k + 1) &
+    // Closing sets nothing outside the region's bounds (the element's middle row and column
+    // span +-k), and k + 1 out is enough: the dilation is exact within k of the bounds (no region
+    // beyond them), and each pixel whose erosion reaches past the part's border (eroded as if
+    // set) also reaches, on its own row or column, a pixel k + 1 out that the dilation left
+    // clear, unless the window's edge clips that side (as it clips a wider part).
+    const cv::Rect sub = Grow(cv::boundingRect(region(*extent)) + extent->tl(), k + 1) &
                          cv::Rect(0, 0, region.cols, region.rows);
     cv::Mat part = region(sub).clone();
     cv::morphologyEx(part, part, cv::MORPH_CLOSE,
