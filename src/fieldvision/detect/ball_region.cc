@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -36,8 +37,17 @@ void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit
     const uint8_t* p = bgr_window.ptr<uint8_t>(y);
     uint8_t* m = raw->ptr<uint8_t>(y);
     uint8_t* k = cls->ptr<uint8_t>(y);
-    for (int x = 0; x < bgr_window.cols; ++x, p += 3) {
-      const uint32_t packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+    const int last = bgr_window.cols - 1;
+    for (int x = 0; x <= last; ++x, p += 3) {
+      // B | G << 8 | R << 16 by one 4-byte load (little-endian) but at the row's last pixel,
+      // whose fourth byte may lie past the image.
+      uint32_t packed;
+      if (std::endian::native == std::endian::little && x < last) {
+        std::memcpy(&packed, p, sizeof(packed));
+        packed &= 0xFFFFFFu;
+      } else {
+        packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
+      }
       const uint8_t c = lut[direct ? packed : table.Index(packed)];
       k[x] = c;
       m[x] = (c & bit) != 0 ? 255 : 0;
