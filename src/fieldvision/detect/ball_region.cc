@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -24,34 +23,16 @@ cv::Rect Grow(const cv::Rect& r, int g) {
 }
 
 // The class bits of `table` of every pixel of `bgr_window` in `cls` (CV_8U) and its `bit` class
-// in `raw` (CV_8U, 255 = in the class), in one pass over the pixels.
+// in `raw` (CV_8U, 255 = in the class), row by row.
 void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit, cv::Mat* raw,
                 cv::Mat* cls) {
   raw->create(bgr_window.size(), CV_8U);
   cls->create(bgr_window.size(), CV_8U);
-  // The table's pointer kept in a local: the byte stores below may alias anything, so a call to
-  // Classify per pixel reloads it (and the table's depth) every time.
-  const uint8_t* lut = table.data();
-  const bool direct = table.bits_per_channel() == 8;
   for (int y = 0; y < bgr_window.rows; ++y) {
-    const uint8_t* p = bgr_window.ptr<uint8_t>(y);
-    uint8_t* m = raw->ptr<uint8_t>(y);
     uint8_t* k = cls->ptr<uint8_t>(y);
-    const int last = bgr_window.cols - 1;
-    for (int x = 0; x <= last; ++x, p += 3) {
-      // B | G << 8 | R << 16 by one 4-byte load (little-endian) but at the row's last pixel,
-      // whose fourth byte may lie past the image.
-      uint32_t packed;
-      if (std::endian::native == std::endian::little && x < last) {
-        std::memcpy(&packed, p, sizeof(packed));
-        packed &= 0xFFFFFFu;
-      } else {
-        packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
-      }
-      const uint8_t c = lut[direct ? packed : table.Index(packed)];
-      k[x] = c;
-      m[x] = (c & bit) != 0 ? 255 : 0;
-    }
+    table.ClassifyRow(bgr_window.ptr<uint8_t>(y), bgr_window.cols, 1, k);
+    uint8_t* m = raw->ptr<uint8_t>(y);
+    for (int x = 0; x < bgr_window.cols; ++x) m[x] = (k[x] & bit) != 0 ? 255 : 0;
   }
 }
 
@@ -418,17 +399,15 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     // The widened class's pixels not yet in the region, and their bounds: the dilation is needed
     // only there (within reach of them), and not at all when there are none.
     const uint8_t grow_bit = grow_table->BallBit();
-    const uint8_t* lut = grow_table->data();
-    const bool direct = grow_table->bits_per_channel() == 8;
     cv::Mat cand(sub.size(), CV_8U);
     int x0 = sub.width, x1 = -1, y0 = sub.height, y1 = -1;
     for (int y = 0; y < sub.height; ++y) {
-      const uint8_t* p = bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x);
       const uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
       uint8_t* c = cand.ptr<uint8_t>(y);
-      for (int x = 0; x < sub.width; ++x, p += 3) {
-        const uint32_t packed = uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16;
-        c[x] = m[x] == 0 && (lut[direct ? packed : grow_table->Index(packed)] & grow_bit) != 0;
+      grow_table->ClassifyRow(
+          bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x), sub.width, 1, c);
+      for (int x = 0; x < sub.width; ++x) {
+        c[x] = m[x] == 0 && (c[x] & grow_bit) != 0;
         if (c[x] != 0) {
           x0 = std::min(x0, x);
           x1 = std::max(x1, x);

@@ -1,7 +1,6 @@
 #include "fieldvision/detect/blobs.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstring>
 
@@ -26,34 +25,12 @@ void Union(std::vector<int>& parent, int a, int b) {
   if (a != b) parent[std::max(a, b)] = std::min(a, b);
 }
 
-// Classifies samples x = x_start, x_start + step, ... of one row into `cls`.
+// Classifies samples x = x_start, x_start + step, ... of one row into `cls` (kStep > 0: the step
+// known at compile time).
 template <int kStep>
 void ClassifyRow(const uint8_t* row, int n, int x_start, int step, const ColourTable& table,
                  uint8_t* cls) {
-  const uint8_t* lut = table.data();
-  const int st = kStep > 0 ? kStep : step;
-  const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x_start);
-  const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(st);
-  if (table.bits_per_channel() == 8) {
-    // A pixel's packed BGR in one 4-byte load (the byte after it masked off; little-endian), but
-    // for the row's last sample, whose next byte may lie past the image.
-    const int n_load4 = std::endian::native == std::endian::little ? n - 1 : 0;
-    int i = 0;
-    for (; i < n_load4; ++i, p += stride) {
-      uint32_t v;
-      std::memcpy(&v, p, sizeof(v));
-      cls[i] = lut[v & 0xFFFFFFu];
-    }
-    for (; i < n; ++i, p += stride) {
-      cls[i] = lut[uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16];
-    }
-  } else {
-    const int b = table.bits_per_channel();
-    const int s = 8 - b;
-    for (int i = 0; i < n; ++i, p += stride) {
-      cls[i] = lut[uint32_t(p[0] >> s) | uint32_t(p[1] >> s) << b | uint32_t(p[2] >> s) << (2 * b)];
-    }
-  }
+  table.ClassifyRow(row + 3 * static_cast<ptrdiff_t>(x_start), n, kStep > 0 ? kStep : step, cls);
 }
 
 }  // namespace

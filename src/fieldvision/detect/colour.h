@@ -8,7 +8,9 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -96,6 +98,24 @@ class ColourTable {
     return table_[Index(uint32_t(b) | uint32_t(g) << 8 | uint32_t(r) << 16)];
   }
   const uint8_t* data() const { return table_.data(); }
+  // Class bits of n pixels of a BGR row, `step` pixels apart from `bgr` on, into `cls`. With the
+  // exact table a pixel's packed value is one 4-byte load (little-endian, the byte after it
+  // masked off), but the last pixel's, whose next byte may lie past the row.
+  void ClassifyRow(const uint8_t* bgr, int n, int step, uint8_t* cls) const {
+    const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(step);
+    const uint8_t* lut = table_.data();
+    int i = 0;
+    if (bits_ == 8 && std::endian::native == std::endian::little) {
+      for (; i + 1 < n; ++i, bgr += stride) {
+        uint32_t v;
+        std::memcpy(&v, bgr, sizeof(v));
+        cls[i] = lut[v & 0xFFFFFFu];
+      }
+    }
+    for (; i < n; ++i, bgr += stride) {
+      cls[i] = lut[Index(uint32_t(bgr[0]) | uint32_t(bgr[1]) << 8 | uint32_t(bgr[2]) << 16)];
+    }
+  }
   // Class bits of every pixel of a BGR image (CV_8U).
   cv::Mat ClassifyImage(const cv::Mat& bgr) const;
 
