@@ -22,6 +22,11 @@ cv::Rect Grow(const cv::Rect& r, int g) {
   return {r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g};
 }
 
+// m[x] = 255 where k[x] has `bit`, else 0 (x < n); the rows do not overlap, so it vectorises.
+void BitMaskRow(const uint8_t* __restrict k, int n, uint8_t bit, uint8_t* __restrict m) {
+  for (int x = 0; x < n; ++x) m[x] = (k[x] & bit) != 0 ? 255 : 0;
+}
+
 // The class bits of `table` of every pixel of `bgr_window` in `cls` (CV_8U) and its `bit` class
 // in `raw` (CV_8U, 255 = in the class), row by row.
 void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit, cv::Mat* raw,
@@ -31,8 +36,7 @@ void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit
   for (int y = 0; y < bgr_window.rows; ++y) {
     uint8_t* k = cls->ptr<uint8_t>(y);
     table.ClassifyRow(bgr_window.ptr<uint8_t>(y), bgr_window.cols, 1, k);
-    uint8_t* m = raw->ptr<uint8_t>(y);
-    for (int x = 0; x < bgr_window.cols; ++x) m[x] = (k[x] & bit) != 0 ? 255 : 0;
+    BitMaskRow(k, bgr_window.cols, bit, raw->ptr<uint8_t>(y));
   }
 }
 
