@@ -422,17 +422,18 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     }
     if (x1 >= 0) {
       const cv::Rect cbox = cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1) + sub.tl();
-      const cv::Rect dbox = Grow(cbox, reach) & cv::Rect(0, 0, raw.cols, raw.rows);
+      // The dilation of a part of the region (not BORDER_ISOLATED) reads the region around the
+      // part too: only cbox's pixels are computed.
       cv::Mat near;
       cv::dilate(
-          region(dbox), near,
+          region(cbox), near,
           cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * reach + 1, 2 * reach + 1)));
       for (int y = cbox.y; y < cbox.br().y; ++y) {
         const uint8_t* c = cand.ptr<uint8_t>(y - sub.y);
-        const uint8_t* nr = near.ptr<uint8_t>(y - dbox.y);
+        const uint8_t* nr = near.ptr<uint8_t>(y - cbox.y);
         uint8_t* m = region.ptr<uint8_t>(y);
         for (int x = cbox.x; x < cbox.br().x; ++x) {
-          if (c[x - sub.x] != 0 && nr[x - dbox.x] != 0) m[x] = 255;
+          if (c[x - sub.x] != 0 && nr[x - cbox.x] != 0) m[x] = 255;
         }
       }
     }
