@@ -1,7 +1,7 @@
 // The ball options that several subcommands declare alike: --ball-diameter (ball, node, fuse,
 // detect, plan), --color (ball, node, detect, eval detect) and the fusion's --inlier-px, --ground
 // and --no-weak (ball, fuse; recon/triangulation.h), the tracking window's --whole-frames,
-// --full-scan-every and --scan-bands (ball, node; pipeline/camera_stage.h).
+// --full-scan-every, --scan-bands and --guided-frames (ball, node; pipeline/camera_stage.h).
 #pragma once
 
 #include <string>
@@ -50,6 +50,11 @@ inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
                   "Split that search into N bands of rows, one a frame (1..--full-scan-every): a "
                   "lower peak of work per frame, a little more work on average")
       ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--guided-frames", t.max_guided_frames,
+                  "Where the search finds no ball at the tracked ball's expected place, fit one "
+                  "there with its size, for at most N frames in a row (0: never)")
+      ->check(CLI::Range(0, 100000))
       ->capture_default_str();
 }
 

@@ -206,6 +206,8 @@ void BallDetectorOptions::Check() const {
   FV_REQUIRE(max_refine >= 1, "max_refine must be >= 1 (got {})", max_refine);
   FV_REQUIRE(weak_min_inlier_fraction >= 0 && weak_min_inlier_fraction <= 1,
              "weak_min_inlier_fraction must be in [0, 1] (got {})", weak_min_inlier_fraction);
+  CheckInRange(guided_radius_change, 0.0, 1.0, "guided_radius_change");
+  CheckInRange(guided_max_shift_radii, 0.0, 10.0, "guided_max_shift_radii");
   CheckInRange(min_arc_cover, 0.0, 1.0, "min_arc_cover");
   CheckInRange(min_region_fill, 0.0, 1.0, "min_region_fill");
   CheckNonNegative(max_region_spill, "max_region_spill");
@@ -557,6 +559,58 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
       cand.sigma_px = fit.sigma_px;
     }
   }
+}
+
+std::optional<BallCandidate> BallDetector::FitAt(const cv::Mat& bgr, const cv::Rect& region,
+                                                 const Vector2d& centre_px,
+                                                 double radius_px) const {
+  FV_REQUIRE(bgr.type() == CV_8UC3, "ball detector: the frame must be 8-bit BGR (got type {})",
+             bgr.type());
+  const BallDetectorOptions& o = options_;
+  if (!centre_px.allFinite() || !std::isfinite(radius_px) || radius_px < 0.5 * o.min_radius_px ||
+      radius_px > o.max_radius_px) {
+    return std::nullopt;
+  }
+  // The fit's rays reach 1.6 radii and its edge search a few pixels beyond; they stop at the
+  // image's border, so only the part of that square inside the image must lie in `region`.
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect roi = region.empty() ? image : region & image;
+  const int reach = static_cast<int>(std::ceil(2.0 * radius_px + 6.0));
+  const cv::Rect need =
+      cv::Rect(static_cast<int>(std::floor(centre_px.x())) - reach,
+               static_cast<int>(std::floor(centre_px.y())) - reach, 2 * reach + 2, 2 * reach + 2) &
+      image;
+  if (need.empty() || (need & roi) != need) return std::nullopt;
+  const BallFit fit = FitBall(bgr, *table_, ball_bit_, centre_px, radius_px, camera_, o.fit);
+  if (!fit.ok || std::abs(fit.radius_px - radius_px) > o.guided_radius_change * radius_px + 0.5 ||
+      (fit.centre_px - centre_px).norm() > o.guided_max_shift_radii * radius_px + 1.0 ||
+      fit.inlier_fraction < o.weak_min_inlier_fraction || fit.rms_px > o.max_fit_rms_px) {
+    return std::nullopt;
+  }
+  double visible = 0.0, leak = 1.0;
+  DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
+             fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
+  double size_factor = 1.0;
+  if (visible < o.min_visible_fraction ||
+      !SizeProblem(fit.centre_px, fit.radius_px, &size_factor).empty()) {
+    return std::nullopt;
+  }
+  BallCandidate c;
+  c.centre_px = fit.centre_px;
+  c.radius_px = fit.radius_px;
+  c.sigma_px = fit.sigma_px;
+  c.accepted = true;
+  c.guided = true;
+  c.precise = true;
+  c.visible_fraction = visible;
+  c.inlier_fraction = fit.inlier_fraction;
+  c.outside_fraction = fit.outside_fraction;
+  c.dents = fit.dents;
+  c.blurred = fit.blurred;
+  // Below a detected ball of the same fit: the place was given, not found.
+  c.score = 0.5 * fit.inlier_fraction * std::min(1.0, visible / 0.9) *
+            std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor;
+  return c;
 }
 
 void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,

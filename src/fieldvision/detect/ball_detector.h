@@ -58,6 +58,7 @@ struct BallCandidate {
   double region_extent = 0.0;   // the convex outline's far reach, in radii
   bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
   bool small = false;           // found by the small-ball stage (small_ball.h)
+  bool guided = false;          // fitted where a tracker expected the ball (FitAt)
   // The network's sports-ball score (dnn_ball.h; 0 where it found none or did not look, -1 when
   // the detector has no network).
   double network_score = -1.0;
@@ -128,6 +129,10 @@ struct BallDetectorOptions {
   double grow_factor = 0.6;
   // Weak candidates (see BallCandidate::weak) need at least this share of rays on the circle.
   double weak_min_inlier_fraction = 0.5;
+  // FitAt (a tracked ball's expected place): the fitted radius within this share of the expected
+  // one, the centre within this many expected radii of the expected place.
+  double guided_radius_change = 0.2;
+  double guided_max_shift_radii = 1.0;
   BallFitOptions fit;
   // Balls of a few pixels whose colour is mixed with the background (small_ball.h).
   SmallBallOptions small;
@@ -164,6 +169,14 @@ class BallDetector {
   BallDetectionResult DetectWithSummary(const cv::Mat& bgr,
                                         const cv::Rect& region = cv::Rect()) const;
 
+  // A ball where a tracker expects one (`centre_px`, `radius_px`: its prediction), for a frame
+  // where Detect accepted none there (a ball merged with a neighbour of its colour, or passing
+  // over one): the outline fit seeded there, accepted when the free part of the outline fits a
+  // circle of about that radius near that place (guided_radius_change, guided_max_shift_radii)
+  // with enough ball colour inside and the size check passed; no region, leak or contrast
+  // checks. Reads nothing outside `region` (empty: the frame); nullopt when the fit disagrees.
+  std::optional<BallCandidate> FitAt(const cv::Mat& bgr, const cv::Rect& region,
+                                     const Eigen::Vector2d& centre_px, double radius_px) const;
   const BallDetectorOptions& options() const { return options_; }
   const ColourTable& table() const { return *table_; }
   // The field-of-play mask (CV_8U, 255 inside) or empty when not used.

@@ -175,6 +175,53 @@ TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
   }
 }
 
+// A ball merged with a board of its colour (a sign, a robot's orange part): the blob is not a
+// disc, but where a tracker expects the ball, FitAt fits its free outline.
+TEST(BallDetector, FitAtFindsABallMergedWithABoardOfItsColourWhereItIsExpected) {
+  const uint64_t seed = fv::testing::TestSeed(27);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  std::vector<double> errors;
+  int found = 0;
+  constexpr int kTrials = 20;
+  for (int i = 0; i < kTrials; ++i) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(120, 200), rng.Uniform(90, 150));
+    const double r = rng.Uniform(6, 14);
+    // The board covers a third of the ball's width on one side, well past it along the other axis.
+    const int side = static_cast<int>(rng.Uniform(0, 4));
+    const double near = r / 3.0;  // the board's edge: r - near inside the ball's edge
+    cv::Rect board;
+    if (side == 0) board = cv::Rect(int(c.x() + near), int(c.y() - 3 * r), int(3 * r), int(6 * r));
+    if (side == 1)
+      board = cv::Rect(int(c.x() - near - 3 * r), int(c.y() - 3 * r), int(3 * r), int(6 * r));
+    if (side == 2) board = cv::Rect(int(c.x() - 3 * r), int(c.y() + near), int(6 * r), int(3 * r));
+    if (side == 3)
+      board = cv::Rect(int(c.x() - 3 * r), int(c.y() - near - 3 * r), int(6 * r), int(3 * r));
+    const cv::Vec3b orange = test_util::kOrange;
+    cv::rectangle(img, board, cv::Scalar(orange[0], orange[1], orange[2]), cv::FILLED);
+    test_util::PaintDisc(img, c, r);
+    const Eigen::Vector2d expected =
+        c + Eigen::Vector2d(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.5, 1.5));
+    const std::optional<BallCandidate> fit = det.FitAt(img, cv::Rect(), expected, 1.1 * r);
+    if (!fit) continue;
+    ++found;
+    EXPECT_TRUE(fit->accepted && fit->guided);
+    EXPECT_NEAR(fit->radius_px, r, 0.1 * r + 0.3) << "trial " << i;
+    errors.push_back((fit->centre_px - c).norm());
+    // Nothing ball-like on the grass, a radius far from the ball's, a region without the ball.
+    EXPECT_FALSE(det.FitAt(img, cv::Rect(), Eigen::Vector2d(40, 40), r)) << "trial " << i;
+    EXPECT_FALSE(det.FitAt(img, cv::Rect(), expected, 2.5 * r)) << "trial " << i;
+    EXPECT_FALSE(det.FitAt(img, cv::Rect(0, 0, int(c.x()), 240), expected, r)) << "trial " << i;
+  }
+  EXPECT_GE(found, kTrials - 2);
+  ASSERT_FALSE(errors.empty());
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.3);
+  EXPECT_LT(errors.back(), 1.0);
+}
+
 TEST(BallDetector, BadInputGivesErrors) {
   BallDetectorOptions o;
   o.scan_step_px = 0;

@@ -248,4 +248,11 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
   return CombineBallCandidates(colour, confirm, whole, dnn_options_);
 }
 
+std::optional<BallCandidate> AnyBallDetector::FitAt(const cv::Mat& bgr, const cv::Rect& region,
+                                                    const Eigen::Vector2d& centre_px,
+                                                    double radius_px) const {
+  if (dnn_ != nullptr && !dnn_options_.uses_colour()) return std::nullopt;
+  return colour_->FitAt(bgr, region, centre_px, radius_px);
+}
+
 }  // namespace fv::detect

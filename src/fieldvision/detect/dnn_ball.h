@@ -14,6 +14,7 @@
 
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -113,6 +114,10 @@ class AnyBallDetector {
   // Candidates best first (BallDetector::Detect's contract: `region` empty = whole frame;
   // nothing outside it is read).
   std::vector<BallCandidate> Detect(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
+  // BallDetector::FitAt with the colour detector (a tracked ball's expected place); nullopt
+  // without one (--detector dnn).
+  std::optional<BallCandidate> FitAt(const cv::Mat& bgr, const cv::Rect& region,
+                                     const Eigen::Vector2d& centre_px, double radius_px) const;
   const BallDetector& colour() const { return *colour_; }
 
  private:

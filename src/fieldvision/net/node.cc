@@ -269,7 +269,8 @@ NodeSummary RunNode(const NodeOptions& o) {
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
   auto detector = std::make_shared<detect::BallDetector>(dopt, &camera, field ? &*field : nullptr);
-  pipeline::CameraStage stage(0, camera, pipeline::BallDetectFnFor(detector), o.track, o.video);
+  pipeline::CameraStage stage(0, camera, pipeline::BallDetectFnFor(detector), o.track, o.video,
+                              pipeline::BallGuidedFnFor(detector));
   if (o.detect) {
     // The first detection pays for lazy set-up (OpenCV, the decoder, page faults: ~1 s on a
     // loaded machine); pay it on a blank frame before the stream starts, not on its first frames.

@@ -54,6 +54,16 @@ camera::Camera ReadRigCamera(const std::string& path) {
 
 namespace {
 
+recon::BallObservation Observation(const detect::BallCandidate& b) {
+  recon::BallObservation obs;
+  obs.weak = !b.accepted;
+  obs.centre_px = b.centre_px;
+  obs.radius_px = b.radius_px;
+  obs.sigma_px = std::max(b.sigma_px, 0.05);
+  obs.score = b.score;
+  return obs;
+}
+
 // Accepted candidates, then the best few weak ones (fusion uses those only to complete a
 // position that an accepted candidate of another camera starts).
 std::vector<recon::BallObservation> Observations(
@@ -64,15 +74,21 @@ std::vector<recon::BallObservation> Observations(
   for (const detect::BallCandidate& b : candidates) {
     if (!b.accepted && !(b.weak && weak < kMaxWeak)) continue;
     weak += !b.accepted;
-    recon::BallObservation obs;
-    obs.weak = !b.accepted;
-    obs.centre_px = b.centre_px;
-    obs.radius_px = b.radius_px;
-    obs.sigma_px = std::max(b.sigma_px, 0.05);
-    obs.score = b.score;
-    out.push_back(obs);
+    out.push_back(Observation(b));
   }
   return out;
+}
+
+// FitAt of either detector as a camera stage's guided fit.
+template <typename Detector>
+BallGuidedFn GuidedFnFor(std::shared_ptr<Detector> detector) {
+  return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi,
+                                     const Eigen::Vector2d& centre_px,
+                                     double radius_px) -> std::optional<recon::BallObservation> {
+    const std::optional<detect::BallCandidate> c = det->FitAt(bgr, roi, centre_px, radius_px);
+    if (!c) return std::nullopt;
+    return Observation(*c);
+  };
 }
 
 }  // namespace
@@ -87,6 +103,14 @@ BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::AnyBallDetector> dete
   return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
     return Observations(det->Detect(bgr, roi));
   };
+}
+
+BallGuidedFn BallGuidedFnFor(std::shared_ptr<detect::BallDetector> detector) {
+  return GuidedFnFor(std::move(detector));
+}
+
+BallGuidedFn BallGuidedFnFor(std::shared_ptr<detect::AnyBallDetector> detector) {
+  return GuidedFnFor(std::move(detector));
 }
 
 BallJobResult RunBallJob(const BallJobOptions& o) {
@@ -104,6 +128,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   }
   const int n = static_cast<int>(o.cameras.size());
   std::vector<camera::Camera> cameras;
+  cameras.reserve(n);
   for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) field = field::LoadField(o.field);
@@ -136,9 +161,12 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
   std::vector<BallRegionDetectFn> detect_fns;
+  std::vector<BallGuidedFn> guided_fns;
   for (int c = 0; c < n; ++c) {
-    detect_fns.push_back(BallDetectFnFor(std::make_shared<detect::AnyBallDetector>(
-        dopt, o.dnn, &cameras[c], field ? &*field : nullptr)));
+    auto detector = std::make_shared<detect::AnyBallDetector>(dopt, o.dnn, &cameras[c],
+                                                              field ? &*field : nullptr);
+    detect_fns.push_back(BallDetectFnFor(detector));
+    guided_fns.push_back(BallGuidedFnFor(detector));
   }
   BallPipelineOptions popt = o.pipeline;
   popt.sync.mode = o.sync == "time" ? SyncMode::kTimestamp : SyncMode::kFrameIndex;
@@ -157,15 +185,17 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   // video, a bad timestamp) leaves neither a half file nor a temporary one.
   io::AtomicWrite(o.out, [&](const std::string& temp_path) {
     util::CsvWriter csv(temp_path, recon::BallCsvColumns(), 6);
-    result.summary =
-        RunBallPipelineTracked(cameras, sources, detect_fns, popt, [&](const BallFrame& f) {
+    result.summary = RunBallPipelineTracked(
+        cameras, sources, detect_fns, popt,
+        [&](const BallFrame& f) {
           if (!f.result.ok()) return;
           const Eigen::Vector3d& p = f.result.point_world;
           csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
               << f.result.rms_px;
           csv.EndRow();
           ++result.rows_written;
-        });
+        },
+        guided_fns);
     csv.Close();
   });
   if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);

@@ -51,5 +51,8 @@ camera::Camera ReadRigCamera(const std::string& path);
 BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::BallDetector> detector);
 // The same for the detector chosen by --detector (colour, dnn or both).
 BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::AnyBallDetector> detector);
+// A camera stage's guided fit (detect::BallDetector::FitAt) from a detector.
+BallGuidedFn BallGuidedFnFor(std::shared_ptr<detect::BallDetector> detector);
+BallGuidedFn BallGuidedFnFor(std::shared_ptr<detect::AnyBallDetector> detector);
 
 }  // namespace fv::pipeline

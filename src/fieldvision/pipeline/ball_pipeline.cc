@@ -8,6 +8,7 @@
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <fmt/format.h>
@@ -27,6 +28,7 @@ void BallPipelineOptions::Check() const {
              second_pass_lag_s);
   triangulation.Check();
   track.Check();
+  hint.Check();
 }
 
 std::string BallPipelineSummary::ToString() const {
@@ -65,12 +67,16 @@ std::string BallPipelineSummary::ToString() const {
     s += c + 1 < num_cameras ? "," : "";
   }
   s += fmt::format("\n{:.2f} s, {:.1f} frames/s", seconds, fps);
-  long long full = 0, window = 0;
+  long long full = 0, window = 0, fitted = 0;
   for (long long f : full_scans) full += f;
   for (long long w : window_scans) window += w;
+  for (long long g : guided) fitted += g;
   if (window > 0) {
     s += fmt::format(", {} camera frames searched in a window around the ball, {} whole", window,
                      full);
+  }
+  if (fitted > 0) {
+    s += fmt::format(", {} balls fitted where expected (not found by the search)", fitted);
   }
   for (const std::string& p : sync.Problems()) s += "\nsync: " + p;
   for (int c = 0; c < num_cameras && c < static_cast<int>(bad_frames.size()); ++c) {
@@ -134,6 +140,7 @@ BallPipelineSummary EmptyBallPipelineSummary(const std::vector<camera::Camera>& 
   summary.bad_frames.assign(n, 0);
   summary.first_bad_frame.assign(n, "");
   summary.window_scans.assign(n, 0);
+  summary.guided.assign(n, 0);
   return summary;
 }
 
@@ -160,7 +167,7 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
                       const BallPipelineOptions& options, long long total,
                       const std::function<bool()>& stopping,
                       const std::function<void(const BallFrame&)>& on_frame,
-                      BallPipelineSummary* summary) {
+                      BallPipelineSummary* summary, BallHintBoard* hints) {
   FrameSynchronizer sync(static_cast<int>(cameras.size()), options.sync);
   FusionStage fusion(cameras, options.triangulation);
   util::Progress progress("ball", total, "frames", options.progress);
@@ -179,6 +186,9 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
   while (!stopping()) {
     while (auto group = sync.Next()) {
       const BallFrame f = fusion.Fuse(*group);
+      if (hints != nullptr && f.result.ok() && !f.result.on_ground) {
+        hints->Publish(f.time_s, f.result.point_world, options.triangulation.ball_radius_m);
+      }
       if (second_pass) {
         const double now_s = group->time_s;
         pending.push_back(std::move(*group));
@@ -195,6 +205,7 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
     const int c = sync.Waiting();
     if (c < 0) break;  // cannot happen: Next() decides when nobody is waiting
     if (auto m = queues[c]->Pop()) {
+      if (hints != nullptr) hints->Popped(c);
       sync.Add(std::move(*m));
     } else if (!stopping()) {
       sync.EndOfStream(c);
@@ -228,8 +239,8 @@ namespace {
 // The first error of any stage; stopping closes every queue so that no stage waits.
 class StageErrors {
  public:
-  StageErrors(const CameraQueues& queues, const JobControl* control)
-      : queues_(queues), control_(control) {}
+  StageErrors(const CameraQueues& queues, const JobControl* control, BallHintBoard* hints)
+      : queues_(queues), control_(control), hints_(hints) {}
   void Fail(const std::exception_ptr& e) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -240,6 +251,7 @@ class StageErrors {
   void StopAll() {
     stop_ = true;
     for (auto& q : queues_) q->Close();
+    if (hints_ != nullptr) hints_->Close();
   }
   bool Stopping() const { return stop_ || StopRequested(control_); }
   void RethrowFirst() const {
@@ -249,6 +261,7 @@ class StageErrors {
  private:
   const CameraQueues& queues_;
   const JobControl* control_;
+  BallHintBoard* hints_;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::exception_ptr error_;
@@ -260,9 +273,12 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& ca
                                            std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                            const std::vector<BallRegionDetectFn>& detectors,
                                            const BallPipelineOptions& options,
-                                           const std::function<void(const BallFrame&)>& on_frame) {
+                                           const std::function<void(const BallFrame&)>& on_frame,
+                                           const std::vector<BallGuidedFn>& guided) {
   options.Check();
   CheckBallPipelineInputs(cameras, sources, detectors);
+  FV_REQUIRE(guided.empty() || guided.size() == cameras.size(),
+             "ball pipeline: {} cameras but {} guided fits", cameras.size(), guided.size());
   const int n = static_cast<int>(cameras.size());
   BallPipelineSummary summary = EmptyBallPipelineSummary(cameras);
   CameraQueues queues;
@@ -273,10 +289,19 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& ca
   for (int c = 0; c < n; ++c) {
     queues.push_back(std::make_unique<BoundedQueue<CameraMessage>>(options.queue_capacity,
                                                                    options.queue_policy));
-    stages.emplace_back(c, cameras[c], detectors[c], options.track, sources[c]->name());
+    stages.emplace_back(c, cameras[c], detectors[c], options.track, sources[c]->name(),
+                        guided.empty() ? BallGuidedFn() : guided[c]);
     frame_counts.push_back(sources[c]->FrameCount());
   }
-  StageErrors errors(queues, options.control);
+  // The fusion's hints, with tracking windows on posed cameras: offline deterministic (waits).
+  const bool posed = std::all_of(cameras.begin(), cameras.end(),
+                                 [](const camera::Camera& c) { return c.has_pose; });
+  std::optional<BallHintBoard> hints;
+  if (options.hints && options.track.enabled && posed) {
+    hints.emplace(n, options.hint, options.queue_policy == QueuePolicy::kBlock);
+    for (CameraStage& s : stages) s.SetHints(&*hints);
+  }
+  StageErrors errors(queues, options.control, hints ? &*hints : nullptr);
   const std::function<bool()> stopping = [&errors] { return errors.Stopping(); };
   const long long total = ExpectedPipelineFrames(frame_counts, options.max_frames);
 
@@ -293,7 +318,8 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& ca
     });
   }
   try {  // the fusion stage, in this thread
-    FuseCameraQueues(cameras, queues, options, total, stopping, on_frame, &summary);
+    FuseCameraQueues(cameras, queues, options, total, stopping, on_frame, &summary,
+                     hints ? &*hints : nullptr);
   } catch (...) {
     errors.Fail(std::current_exception());
   }
@@ -305,6 +331,7 @@ BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& ca
     const CameraStageStats& st = stages[c].stats();
     summary.full_scans[c] = st.full_scans;
     summary.window_scans[c] = st.window_scans;
+    summary.guided[c] = st.guided;
     summary.bad_frames[c] = st.bad_frames;
     summary.first_bad_frame[c] = st.first_bad_frame;
   }

@@ -37,6 +37,10 @@ struct BallPipelineOptions {
   // only 0.3 s (HoverFilterOptions::min_span_s) later. on_frame sees the second pass's frames.
   bool second_pass = true;
   double second_pass_lag_s = 1.0;
+  // The fusion hands the ball's 3D position back to the camera stages (ball_hints.h), with
+  // tracked detectors and posed cameras.
+  bool hints = true;
+  BallHintOptions hint;
   JobControl* control = nullptr;  // optional: progress callback and stop check (not owned)
   void Check() const;             // throws fv::Error naming the bad field
 };
@@ -57,6 +61,7 @@ struct BallPipelineSummary {
   std::vector<size_t> queue_drops;               // messages dropped by the queues
   std::vector<long long> full_scans;             // frames searched whole, per camera
   std::vector<long long> window_scans;           // frames searched in a window, per camera
+  std::vector<long long> guided;                 // guided fits (camera_stage.h), per camera
   std::vector<long long> bad_frames;             // encoded frames that could not be decoded
   std::vector<std::string> first_bad_frame;      // the error of the first of them
   SyncReport sync;
@@ -75,12 +80,14 @@ BallPipelineSummary RunBallPipeline(const std::vector<camera::Camera>& cameras,
                                     const BallPipelineOptions& options,
                                     const std::function<void(const BallFrame&)>& on_frame);
 // The same with detectors that can search a window (options.track): each camera stage tracks
-// the ball and decodes encoded frames (SourceFrame::jpeg) only where it looks.
+// the ball and decodes encoded frames (SourceFrame::jpeg) only where it looks. `guided`: empty,
+// or a guided fit per camera (camera_stage.h; an empty one: none for that camera).
 BallPipelineSummary RunBallPipelineTracked(const std::vector<camera::Camera>& cameras,
                                            std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                            const std::vector<BallRegionDetectFn>& detectors,
                                            const BallPipelineOptions& options,
-                                           const std::function<void(const BallFrame&)>& on_frame);
+                                           const std::function<void(const BallFrame&)>& on_frame,
+                                           const std::vector<BallGuidedFn>& guided = {});
 
 // The stages of RunBallPipelineTracked, in order; each callable alone.
 // Throws fv::Error for lists of different sizes, a missing video or detector, or a video whose
@@ -101,11 +108,12 @@ void ReadCameraStream(io::FrameSource& source, CameraStage& stage,
 using CameraQueues = std::vector<std::unique_ptr<BoundedQueue<CameraMessage>>>;
 // The fusion stage: synchronises the queues' messages, fuses each frame and calls `on_frame`,
 // until every stream ended or `stopping()`; sets the summary's sync report and fusion counts.
+// `hints` (optional): receives each first-pass 3D position and each pop (ball_hints.h).
 void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQueues& queues,
                       const BallPipelineOptions& options, long long total,
                       const std::function<bool()>& stopping,
                       const std::function<void(const BallFrame&)>& on_frame,
-                      BallPipelineSummary* summary);
+                      BallPipelineSummary* summary, BallHintBoard* hints = nullptr);
 // Copies the fusion counts into the summary (mean error: the sum over the positions).
 void AddFusionStats(const FusionStats& stats, BallPipelineSummary* summary);
 

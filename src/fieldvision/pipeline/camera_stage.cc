@@ -18,6 +18,8 @@ void BallTrackOptions::Check() const {
              full_scan_every, scan_bands);
   FV_REQUIRE(std::isfinite(window_radii) && window_radii >= 2,
              "BallTrackOptions.window_radii must be >= 2 (got {})", window_radii);
+  FV_REQUIRE(max_guided_frames >= 0, "BallTrackOptions.max_guided_frames must be >= 0 (got {})",
+             max_guided_frames);
   FV_REQUIRE(min_window_px >= 8, "BallTrackOptions.min_window_px must be >= 8 (got {})",
              min_window_px);
 }
@@ -37,6 +39,10 @@ class CameraStage::Track {
   // The window for the next frame, or an empty rectangle for the whole frame.
   cv::Rect Window(const cv::Size& image) const {
     if (!o_.enabled || !active_ || (o_.scan_bands == 1 && Slot() == 0)) return {};
+    return ExpectedWindow(image);
+  }
+  // The window around the expected place, whatever the frame's slot.
+  cv::Rect ExpectedWindow(const cv::Size& image) const {
     const Eigen::Vector2d p = centre_ + velocity_;
     const double half =
         std::max<double>(o_.min_window_px, o_.window_radii * radius_ + velocity_.norm());
@@ -64,13 +70,33 @@ class CameraStage::Track {
     return best != nullptr &&
            (best->centre_px - (centre_ + velocity_)).norm() <= 2.0 * radius_ + 2.0;
   }
-  void Update(const std::vector<recon::BallObservation>& obs) {
+  // Whether a guided fit may look for the ball at its expected place (Expected).
+  bool MayGuide() const { return o_.enabled && active_ && guided_run_ < o_.max_guided_frames; }
+  Eigen::Vector2d ExpectedCentre() const { return centre_ + velocity_; }
+  // Where the fusion expects the ball: taken unless the track expects it there too.
+  void Steer(const ExpectedBall& e) {
+    if (!o_.enabled) return;
+    if (active_ &&
+        (ExpectedCentre() - e.centre_px).norm() <= 2.0 * std::max(radius_, e.radius_px) + 2.0) {
+      return;
+    }
+    centre_ = e.centre_px - e.step_px;
+    velocity_ = e.step_px;
+    radius_ = std::max(e.radius_px, 2.0);
+    active_ = true;
+  }
+  double radius() const { return radius_; }
+  // `guided`: the candidate of obs that a guided fit gave, or null.
+  void Update(const std::vector<recon::BallObservation>& obs,
+              const recon::BallObservation* guided) {
     ++frames_;
     const recon::BallObservation* best = Best(obs);
     if (best == nullptr) {
       active_ = false;
+      guided_run_ = 0;
       return;
     }
+    guided_run_ = best == guided ? guided_run_ + 1 : 0;
     velocity_ = active_ ? Eigen::Vector2d(best->centre_px - centre_) : Eigen::Vector2d::Zero();
     centre_ = best->centre_px;
     radius_ = std::max(best->radius_px, 2.0);
@@ -90,6 +116,7 @@ class CameraStage::Track {
   int Slot() const { return static_cast<int>((frames_ + phase_) % o_.full_scan_every); }
   int phase_;
   long long frames_ = 0;  // frames seen
+  int guided_run_ = 0;    // frames in a row tracked by guided fits alone
   Eigen::Vector2d centre_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d velocity_ = Eigen::Vector2d::Zero();
   double radius_ = 0.0;
@@ -139,10 +166,12 @@ void AddBandCandidates(std::vector<recon::BallObservation> band,
 
 CameraStage::CameraStage(int camera_index, const camera::Camera& camera,
                          BallRegionDetectFn detector, const BallTrackOptions& track,
-                         std::string source_name)
+                         std::string source_name, BallGuidedFn guided)
     : camera_index_(camera_index),
+      camera_(camera),
       size_(camera.width, camera.height),
       detector_(std::move(detector)),
+      guided_(std::move(guided)),
       source_name_(std::move(source_name)),
       track_() {
   track.Check();
@@ -189,7 +218,31 @@ void CameraStage::SearchBand(const io::SourceFrame& in,
   ++stats_.band_scans;
 }
 
+long CameraStage::AddGuided(const cv::Mat& frame, std::vector<recon::BallObservation>* candidates) {
+  if (!guided_ || !track_->MayGuide() || track_->Confirms(*candidates)) return -1;
+  std::optional<recon::BallObservation> found =
+      guided_(frame, track_->ExpectedWindow(size_), track_->ExpectedCentre(), track_->radius());
+  if (!found || found->weak) return -1;
+  // After the accepted candidates, before the weak ones.
+  const auto at = std::find_if(candidates->begin(), candidates->end(),
+                               [](const recon::BallObservation& o) { return o.weak; });
+  const long index = at - candidates->begin();
+  candidates->insert(at, *found);
+  ++stats_.guided;
+  return index;
+}
+
+void CameraStage::FollowHint(const io::SourceFrame& in) {
+  if (hints_ == nullptr) return;
+  const std::optional<BallHint> hint = hints_->Get(camera_index_, stats_.frames);
+  const double dt_s = stats_.frames > 0 ? in.time_s - last_time_s_ : 0.0;
+  last_time_s_ = in.time_s;
+  if (!hint) return;
+  if (auto e = ExpectBall(*hint, camera_, in.time_s, dt_s, hints_->options())) track_->Steer(*e);
+}
+
 CameraMessage CameraStage::Process(const io::SourceFrame& in) {
+  FollowHint(in);
   CameraMessage m;
   m.camera = camera_index_;
   m.frame = in.frame;
@@ -213,7 +266,8 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       ++stats_.full_scans;
     }
   }
-  track_->Update(m.candidates);
+  const long guided = frame != nullptr ? AddGuided(*frame, &m.candidates) : -1;
+  track_->Update(m.candidates, guided >= 0 ? &m.candidates[guided] : nullptr);
   ++stats_.frames;
   for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
   return m;

@@ -7,17 +7,23 @@
 // full_scan_every frames, each camera at its own phase (from its name) so that the cameras of a
 // rig do not all pay for it in the same frame; that search may be split into bands of rows, one a
 // frame besides the window, for a lower peak of work per frame (a latency spike on a live node)
-// at some more work on average (the bands overlap). The same stage serves the in-process
+// at some more work on average (the bands overlap). When neither search accepts a ball where the
+// tracked one is expected, a guided fit (BallGuidedFn) looks for it at that place with its size,
+// for at most max_guided_frames frames in a row. With the fusion's hints (ball_hints.h) the
+// expected place is where the cameras together last saw the ball, when the image track
+// disagrees. The same stage serves the in-process
 // pipeline (ball_pipeline.h) and the camera node (net/node.h).
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/jpeg_region.h"
+#include "fieldvision/pipeline/ball_hints.h"
 #include "fieldvision/pipeline/camera_message.h"
 #include "fieldvision/recon/triangulation.h"
 
@@ -31,6 +37,11 @@ using BallDetectFn = std::function<std::vector<recon::BallObservation>(const cv:
 using BallRegionDetectFn =
     std::function<std::vector<recon::BallObservation>(const cv::Mat& bgr, const cv::Rect& roi)>;
 
+// A ball of about `radius_px` at `centre_px` (a tracked ball's expected place), or nullopt; reads
+// nothing of `bgr` outside roi (detect::BallDetector::FitAt).
+using BallGuidedFn = std::function<std::optional<recon::BallObservation>(
+    const cv::Mat& bgr, const cv::Rect& roi, const Eigen::Vector2d& centre_px, double radius_px)>;
+
 // Ball tracking in each camera stage (see above).
 struct BallTrackOptions {
   bool enabled = true;
@@ -42,7 +53,10 @@ struct BallTrackOptions {
   int scan_bands = 1;
   double window_radii = 6.0;  // half-size of the window in ball radii, plus the image motion
   int min_window_px = 40;     // half-size of the window at least
-  void Check() const;         // throws fv::Error naming the bad field
+  // Frames in a row that the track may go on by guided fits alone (0: no guided fits); then it
+  // needs a ball the detector finds by itself.
+  int max_guided_frames = 15;
+  void Check() const;  // throws fv::Error naming the bad field
 };
 
 struct CameraStageStats {
@@ -51,6 +65,7 @@ struct CameraStageStats {
   long long full_scans = 0;    // frames searched whole
   long long window_scans = 0;  // frames searched in a window
   long long band_scans = 0;    // of these, also in a band of rows
+  long long guided = 0;        // candidates from guided fits
   long long bad_frames = 0;    // encoded frames that could not be decoded
   std::string first_bad_frame;
 };
@@ -60,15 +75,17 @@ bool HasAccepted(const std::vector<recon::BallObservation>& obs);
 
 class CameraStage {
  public:
-  // `camera_index` goes into the messages; `source_name` into errors. Throws fv::Error when the
-  // detector is empty or the options are bad.
+  // `camera_index` goes into the messages; `source_name` into errors; `guided` may be empty (no
+  // guided fits). Throws fv::Error when the detector is empty or the options are bad.
   CameraStage(int camera_index, const camera::Camera& camera, BallRegionDetectFn detector,
-              const BallTrackOptions& track, std::string source_name);
+              const BallTrackOptions& track, std::string source_name, BallGuidedFn guided = {});
   ~CameraStage();
   CameraStage(CameraStage&&) noexcept;
   // The candidates of one frame. A damaged encoded frame is counted (stats) and gives a message
   // without candidates; a frame of another size than the camera's throws fv::Error.
   CameraMessage Process(const io::SourceFrame& frame);
+  // The fusion's hints for this camera (null: none; not owned, must outlive the stage's use).
+  void SetHints(BallHintBoard* hints) { hints_ = hints; }
   const CameraStageStats& stats() const { return stats_; }
 
  private:
@@ -76,9 +93,18 @@ class CameraStage {
   const cv::Mat* Image(const io::SourceFrame& in, const cv::Rect& roi);
   void CheckSize(const cv::Size& got, long long frame) const;
   void SearchBand(const io::SourceFrame& in, std::vector<recon::BallObservation>* candidates);
+  // A guided fit at the expected place when no accepted candidate is there: the index in
+  // `candidates` of the one it added (after the accepted ones), or -1.
+  long AddGuided(const cv::Mat& frame, std::vector<recon::BallObservation>* candidates);
+  // Steers the track to where the fusion expects the ball in this frame, if it knows.
+  void FollowHint(const io::SourceFrame& in);
   int camera_index_;
+  camera::Camera camera_;
   cv::Size size_;
   BallRegionDetectFn detector_;
+  BallGuidedFn guided_;
+  BallHintBoard* hints_ = nullptr;
+  double last_time_s_ = 0.0;
   std::string source_name_;
   std::unique_ptr<Track> track_;
   io::JpegRegionDecoder decoder_;

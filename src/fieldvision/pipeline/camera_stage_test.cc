@@ -1,6 +1,8 @@
 // The camera stage's tracking window: a ball that leaves the window where another accepted object
 // lies is found again by a whole-frame search in that frame, not after full_scan_every frames;
-// while tracking, bands of rows cover the whole frame every full_scan_every frames.
+// while tracking, bands of rows cover the whole frame every full_scan_every frames; the fusion's
+// hints move the window off a better-scored static thing onto the ball, and guided fits go on
+// where the search finds no ball, for at most max_guided_frames frames.
 #include "fieldvision/pipeline/camera_stage.h"
 
 #include <gtest/gtest.h>
@@ -178,6 +180,94 @@ TEST(CameraStage, CamerasSearchWholeFramesEveryFullScanEveryFramesEachAtItsOwnPh
   }
   // 6 cameras in 8 phases: not all in one frame (at most 2 share one, for these names).
   EXPECT_LE(*std::max_element(whole_in_frame.begin() + 1, whole_in_frame.end()), 2);
+}
+
+// A posed 640x480 camera at the origin looking along +z, and the point 10 m deep at a pixel.
+camera::Camera PosedCamera() {
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
+  cam.has_pose = true;
+  return cam;
+}
+Eigen::Vector3d PointAt(const camera::Camera& cam, const Vector2d& px) {
+  const auto ray = cam.RayFromPixel(px);
+  return ray->At(10.0 / ray->direction.z());
+}
+
+TEST(CameraStage, TheFusionsHintsMoveTheWindowFromABetterScoredThingToTheBall) {
+  // A seat scores higher than the ball; the first whole-frame search takes the seat, and the
+  // window stays on it. The fusion knows the ball (it publishes the ball's 3D position seen
+  // in the previous frame): with its hints the ball is among the candidates in every frame.
+  const camera::Camera cam = PosedCamera();
+  std::vector<std::vector<Thing>> frames;
+  std::vector<Vector2d> ball;
+  for (int f = 0; f < 20; ++f) {
+    ball.emplace_back(100 + 6 * f, 300);
+    frames.push_back({{Vector2d(500, 100), 0.9}, {ball.back(), 0.5}});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  for (const bool hinted : {false, true}) {
+    long long f = 0;
+    CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted");
+    BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+    if (hinted) stage.SetHints(&board);
+    int with_ball = 0;
+    for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+      if (f > 0) board.Publish((f - 1) / 60.0, PointAt(cam, ball[f - 1]), 0.11);
+      io::SourceFrame in;
+      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+      in.frame = f;
+      in.time_s = f / 60.0;
+      const CameraMessage m = stage.Process(in);
+      with_ball += std::any_of(m.candidates.begin(), m.candidates.end(),
+                               [&](const auto& o) { return (o.centre_px - ball[f]).norm() < 1; });
+    }
+    if (hinted) {
+      EXPECT_EQ(with_ball, 20);
+    } else {
+      EXPECT_LE(with_ball, 2);  // the first whole-frame search only
+    }
+  }
+}
+
+TEST(CameraStage, GuidedFitsGoOnWhereTheSearchLosesTheBallForMaxGuidedFrames) {
+  // The ball rolls right; from frame 5 the search no longer finds it (merged with a board).
+  // A guided fit at the expected place finds it there for max_guided_frames frames in a row.
+  const camera::Camera cam = PosedCamera();
+  std::vector<std::vector<Thing>> frames;
+  std::vector<Vector2d> ball;
+  for (int f = 0; f < 15; ++f) {
+    ball.emplace_back(100 + 5 * f, 200);
+    frames.push_back(f < 5 ? std::vector<Thing>{{ball.back(), 0.8}} : std::vector<Thing>{});
+  }
+  long long f = 0;
+  std::vector<long long> asked;
+  BallGuidedFn guided = [&](const cv::Mat&, const cv::Rect& roi, const Vector2d& centre_px,
+                            double radius_px) -> std::optional<recon::BallObservation> {
+    asked.push_back(f);
+    EXPECT_TRUE(roi.contains(cv::Point(int(centre_px.x()), int(centre_px.y()))));
+    EXPECT_NEAR(radius_px, 5.0, 1e-9);
+    if ((centre_px - ball[f]).norm() > 3.0) return std::nullopt;
+    recon::BallObservation o;
+    o.centre_px = ball[f];
+    o.radius_px = 5.0;
+    o.score = 0.3;
+    return o;
+  };
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  track.max_guided_frames = 4;
+  CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted", guided);
+  std::vector<long long> with_ball;
+  for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+    const CameraMessage m = ProcessBlank(stage, f);
+    for (const recon::BallObservation& o : m.candidates) {
+      if ((o.centre_px - ball[f]).norm() < 1) with_ball.push_back(f);
+    }
+  }
+  EXPECT_EQ(with_ball, (std::vector<long long>{0, 1, 2, 3, 4, 5, 6, 7, 8}));
+  EXPECT_EQ(asked, (std::vector<long long>{5, 6, 7, 8}));  // then the track is lost
+  EXPECT_EQ(stage.stats().guided, 4);
 }
 
 }  // namespace

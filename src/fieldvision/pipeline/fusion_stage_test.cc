@@ -186,8 +186,9 @@ TEST(FusionStage, AStillSignDoesNotReplaceALostBall) {
   }
   EXPECT_EQ(ball_frames, 30);
   EXPECT_EQ(sign_frames, 0);
-  // For 5 frames the resting ball's track gates the sign out; then it is chosen and dropped.
-  EXPECT_EQ(fusion.stats().hovering_dropped, 25);
+  // For 12 frames (BallPredictor's max_gap) the resting ball's track gates the sign out; then
+  // it is chosen and dropped.
+  EXPECT_EQ(fusion.stats().hovering_dropped, 30 - 12);
 }
 
 }  // namespace

@@ -1,0 +1,80 @@
+// What the fusion stage knows of the ball, handed back to the camera stages: the last fused 3D
+// position and its velocity, so that a camera whose own image track has settled on a
+// ball-coloured thing (a seat, a board: the best-scored candidate is not always the ball) looks
+// where the cameras together saw the ball, and fits it there (camera_stage.h). Offline the
+// board is deterministic: a camera stage reads, for its message k, the state the fusion had when
+// it took that camera's message k - lag off the queue (it waits for that), so results do not
+// depend on thread timing; it cannot deadlock, since a stage that waits has at least `lag`
+// messages queued for the fusion. Live (no waiting), a stage reads the newest state.
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fieldvision/camera/camera.h"
+
+namespace fv::pipeline {
+
+// The ball's fused state.
+struct BallHint {
+  double time_s = 0.0;  // when it was seen there
+  Eigen::Vector3d ball_in_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();  // zero from a single position
+  double radius_m = 0.11;
+};
+
+// Where a camera expects the ball at a time: its image centre and radius, and its image motion
+// per `frame_dt_s`.
+struct ExpectedBall {
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  Eigen::Vector2d step_px = Eigen::Vector2d::Zero();
+};
+
+struct BallHintOptions {
+  int lag_messages = 2;         // offline: message k reads the state at the pop of k - lag (>= 1)
+  double max_age_s = 0.25;      // a state older than this (at the frame's time) is no hint
+  double max_gap_s = 0.1;       // two positions farther apart in time give no velocity
+  double max_speed_mps = 60.0;  // a faster step between two positions is a jump, no velocity
+  void Check() const;           // throws fv::Error naming the bad field
+};
+
+// The ball's expected image position in `camera` at `time_s` (constant velocity from the hint),
+// nullopt when the hint is too old, the ball is behind the camera or outside the image.
+std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camera& camera,
+                                       double time_s, double frame_dt_s,
+                                       const BallHintOptions& options);
+
+class BallHintBoard {
+ public:
+  // `wait`: offline (deterministic; see above); false: live.
+  BallHintBoard(int cameras, const BallHintOptions& options, bool wait);
+  const BallHintOptions& options() const { return options_; }
+  // Fusion thread: a fused 3D position (not a ground one) at `time_s`.
+  void Publish(double time_s, const Eigen::Vector3d& ball_in_world, double radius_m);
+  // Fusion thread: it took `camera`'s next message off its queue.
+  void Popped(int camera);
+  // Camera thread: the state for that camera's message `index` (0-based); nullopt when none.
+  // Offline it waits until the fusion popped message index - lag, or the board is closed.
+  std::optional<BallHint> Get(int camera, long long index);
+  // Releases every waiting camera (the fusion ended or failed); Get then returns nullopt.
+  void Close();
+
+ private:
+  BallHintOptions options_;
+  bool wait_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool closed_ = false;
+  std::optional<BallHint> state_;
+  std::vector<long long> popped_;  // messages popped per camera
+  // Per camera, the state at each of its last pops (back: the latest, popped_[c] - 1).
+  std::vector<std::deque<std::optional<BallHint>>> at_pop_;
+};
+
+}  // namespace fv::pipeline

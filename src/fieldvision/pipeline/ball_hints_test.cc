@@ -1,0 +1,106 @@
+// The fusion's hints to the camera stages: offline a stage's message k reads the state the
+// fusion had when it popped message k - lag (waiting for it), whatever the threads' timing;
+// Close releases a waiting stage; the expected image position follows the ball's velocity.
+#include "fieldvision/pipeline/ball_hints.h"
+
+#include <chrono>
+#include <future>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv::pipeline {
+namespace {
+
+using Eigen::Vector3d;
+
+TEST(BallHintBoard, AMessageReadsTheStateAtThePopOfTheMessageLagBefore) {
+  BallHintOptions o;
+  o.lag_messages = 2;
+  BallHintBoard board(2, o, /*wait=*/true);
+  EXPECT_FALSE(board.Get(0, 0));  // nothing to wait for, nothing known
+  EXPECT_FALSE(board.Get(0, 1));
+  board.Popped(0);  // message 0 popped before any position: message 2 reads none
+  board.Publish(0.0, Vector3d(1, 0, 0), 0.11);
+  board.Popped(0);  // message 1: the position at t = 0
+  board.Publish(0.1, Vector3d(2, 0, 0), 0.11);
+  board.Popped(1);
+  EXPECT_FALSE(board.Get(0, 2));
+  const std::optional<BallHint> h3 = board.Get(0, 3);
+  ASSERT_TRUE(h3);
+  EXPECT_EQ(h3->ball_in_world, Vector3d(1, 0, 0));
+  EXPECT_EQ(h3->velocity_mps, Vector3d::Zero());  // one position: no velocity
+  // Camera 1's message 2 reads the state at its pop 0: both positions, the velocity 10 m/s.
+  const std::optional<BallHint> h = board.Get(1, 2);
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->ball_in_world, Vector3d(2, 0, 0));
+  EXPECT_NEAR(h->velocity_mps.x(), 10.0, 1e-9);
+  EXPECT_NEAR(h->time_s, 0.1, 1e-12);
+  // Later publications do not change what an earlier pop saw.
+  board.Publish(0.2, Vector3d(3, 0, 0), 0.11);
+  EXPECT_EQ(board.Get(0, 3)->ball_in_world, Vector3d(1, 0, 0));
+}
+
+TEST(BallHintBoard, AStageWaitsForThePopAndCloseReleasesIt) {
+  BallHintBoard board(1, BallHintOptions{}, /*wait=*/true);
+  board.Publish(0.0, Vector3d(1, 2, 3), 0.11);
+  auto waiting = std::async(std::launch::async, [&] { return board.Get(0, 2); });
+  EXPECT_EQ(waiting.wait_for(std::chrono::milliseconds(50)), std::future_status::timeout);
+  board.Popped(0);
+  ASSERT_EQ(waiting.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+  const std::optional<BallHint> h = waiting.get();
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->ball_in_world, Vector3d(1, 2, 3));
+  auto released = std::async(std::launch::async, [&] { return board.Get(0, 5); });
+  EXPECT_EQ(released.wait_for(std::chrono::milliseconds(50)), std::future_status::timeout);
+  board.Close();
+  ASSERT_EQ(released.wait_for(std::chrono::seconds(10)), std::future_status::ready);
+  EXPECT_FALSE(released.get());
+  // Live: no waiting, the newest state.
+  BallHintBoard live(1, BallHintOptions{}, /*wait=*/false);
+  EXPECT_FALSE(live.Get(0, 7));
+  live.Publish(0.5, Vector3d(4, 5, 6), 0.11);
+  EXPECT_EQ(live.Get(0, 7)->ball_in_world, Vector3d(4, 5, 6));
+}
+
+TEST(BallHintBoard, AJumpOrAGapGivesNoVelocity) {
+  BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+  board.Publish(0.0, Vector3d(0, 0, 0), 0.11);
+  board.Publish(1.0 / 60, Vector3d(5, 0, 0), 0.11);  // 300 m/s: another object
+  EXPECT_EQ(board.Get(0, 0)->velocity_mps, Vector3d::Zero());
+  board.Publish(1.0, Vector3d(5.1, 0, 0), 0.11);  // a second later
+  EXPECT_EQ(board.Get(0, 0)->velocity_mps, Vector3d::Zero());
+  EXPECT_THROW(BallHintBoard(0, BallHintOptions{}, true), Error);
+  BallHintOptions bad;
+  bad.lag_messages = 0;
+  EXPECT_THROW(bad.Check(), Error);
+}
+
+TEST(ExpectBall, ProjectsTheBallAheadWithItsVelocityAndSize) {
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
+  cam.has_pose = true;  // at the origin, looking along +z
+  BallHint h;
+  h.time_s = 1.0;
+  h.ball_in_world = Vector3d(0, 0, 10);
+  h.velocity_mps = Vector3d(6, 0, 0);
+  h.radius_m = 0.11;
+  BallHintOptions o;
+  const std::optional<ExpectedBall> e = ExpectBall(h, cam, 1.1, 0.05, o);
+  ASSERT_TRUE(e);
+  const Eigen::Vector2d at = *cam.Project(Vector3d(0.6, 0, 10));
+  EXPECT_LT((e->centre_px - at).norm(), 1e-6);
+  EXPECT_NEAR(e->radius_px, cam.fx * 0.11 / 10.0, 0.05);
+  EXPECT_NEAR(e->step_px.x(), cam.fx * 0.3 / 10.0, 1e-6);               // 0.3 m in 0.05 s
+  EXPECT_FALSE(ExpectBall(h, cam, 1.0 + o.max_age_s + 0.01, 0.05, o));  // too old
+  EXPECT_FALSE(ExpectBall(h, cam, 0.9, 0.05, o));                       // from the future
+  h.ball_in_world = Vector3d(0, 0, -10);                                // behind the camera
+  h.velocity_mps.setZero();
+  EXPECT_FALSE(ExpectBall(h, cam, 1.0, 0.05, o));
+  h.ball_in_world = Vector3d(50, 0, 10);  // outside the image
+  EXPECT_FALSE(ExpectBall(h, cam, 1.0, 0.05, o));
+}
+
+}  // namespace
+}  // namespace fv::pipeline
