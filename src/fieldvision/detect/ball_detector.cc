@@ -581,14 +581,17 @@ std::optional<BallCandidate> BallDetector::FitAt(const cv::Mat& bgr, const cv::R
                static_cast<int>(std::floor(centre_px.y())) - reach, 2 * reach + 2, 2 * reach + 2) &
       image;
   if (need.empty() || (need & roi) != need) return std::nullopt;
-  const BallFit fit = FitBall(bgr, *table_, ball_bit_, centre_px, radius_px, camera_, o.fit);
+  // The widened class: the expected ball may be in shade, pale or blurred all over.
+  const ColourTable& table = grow_table_ ? *grow_table_ : *table_;
+  const uint8_t bit = table.BallBit();
+  const BallFit fit = FitBall(bgr, table, bit, centre_px, radius_px, camera_, o.fit);
   if (!fit.ok || std::abs(fit.radius_px - radius_px) > o.guided_radius_change * radius_px + 0.5 ||
       (fit.centre_px - centre_px).norm() > o.guided_max_shift_radii * radius_px + 1.0 ||
       fit.inlier_fraction < o.weak_min_inlier_fraction || fit.rms_px > o.max_fit_rms_px) {
     return std::nullopt;
   }
   double visible = 0.0, leak = 1.0;
-  DiscShares(bgr, *table_, ball_bit_, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
+  DiscShares(bgr, table, bit, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
              fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
   double size_factor = 1.0;
   if (visible < o.min_visible_fraction ||

@@ -6,12 +6,25 @@
 #include "fieldvision/util/error.h"
 
 namespace fv::pipeline {
+namespace {
+
+constexpr double kGravityMps2 = 9.81;
+
+// Where a hinted ball is `age_s` after its time.
+Eigen::Vector3d BallAfter(const BallHint& h, double age_s) {
+  Eigen::Vector3d p = h.ball_in_world + age_s * h.velocity_mps;
+  if (h.airborne) p.z() -= 0.5 * kGravityMps2 * age_s * age_s;
+  return p;
+}
+
+}  // namespace
 
 void BallHintOptions::Check() const {
   FV_REQUIRE(lag_messages >= 1, "BallHintOptions.lag_messages must be >= 1 (got {})", lag_messages);
   CheckPositive(max_age_s, "BallHintOptions.max_age_s");
   CheckPositive(max_gap_s, "BallHintOptions.max_gap_s");
   CheckPositive(max_speed_mps, "BallHintOptions.max_speed_mps");
+  CheckNonNegative(airborne_m, "BallHintOptions.airborne_m");
 }
 
 std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camera& camera,
@@ -19,7 +32,7 @@ std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camer
                                        const BallHintOptions& options) {
   const double age_s = time_s - hint.time_s;
   if (!(age_s >= 0.0 && age_s <= options.max_age_s) || !camera.has_pose) return std::nullopt;
-  const Eigen::Vector3d at = hint.ball_in_world + age_s * hint.velocity_mps;
+  const Eigen::Vector3d at = BallAfter(hint, age_s);
   const std::optional<Eigen::Vector2d> uv = camera.Project(at);
   if (!uv || !uv->allFinite() || !camera.InImage(*uv)) return std::nullopt;
   const Eigen::Vector3d in_cam = camera.cam_from_world * at;
@@ -28,7 +41,7 @@ std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camer
   e.centre_px = *uv;
   e.radius_px = hint.radius_m / camera.PixelFootprintM(at);
   const std::optional<Eigen::Vector2d> before =
-      camera.Project(at - std::max(frame_dt_s, 0.0) * hint.velocity_mps);
+      camera.Project(BallAfter(hint, age_s - std::max(frame_dt_s, 0.0)));
   if (before && before->allFinite()) e.step_px = *uv - *before;
   if (!std::isfinite(e.radius_px) || !e.step_px.allFinite()) return std::nullopt;
   return e;
@@ -47,10 +60,14 @@ void BallHintBoard::Publish(double time_s, const Eigen::Vector3d& ball_in_world,
   h.time_s = time_s;
   h.ball_in_world = ball_in_world;
   h.radius_m = radius_m;
+  const double flying_z = radius_m + options_.airborne_m;
   if (state_) {
     const double dt = time_s - state_->time_s;
-    const Eigen::Vector3d v = (ball_in_world - state_->ball_in_world) / dt;
+    Eigen::Vector3d v = (ball_in_world - state_->ball_in_world) / dt;
     if (dt > 0 && dt <= options_.max_gap_s && v.norm() <= options_.max_speed_mps) {
+      // In flight the step's mean velocity is the one half a step back.
+      h.airborne = ball_in_world.z() > flying_z && state_->ball_in_world.z() > flying_z;
+      if (h.airborne) v.z() -= 0.5 * kGravityMps2 * dt;
       h.velocity_mps = v;
     }
   }

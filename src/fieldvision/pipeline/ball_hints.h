@@ -20,12 +20,14 @@
 
 namespace fv::pipeline {
 
-// The ball's fused state.
+// The ball's fused state (world z up).
 struct BallHint {
   double time_s = 0.0;  // when it was seen there
   Eigen::Vector3d ball_in_world = Eigen::Vector3d::Zero();
-  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();  // zero from a single position
+  // At time_s; zero from a single position. In flight (airborne) gravity acts on it.
+  Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   double radius_m = 0.11;
+  bool airborne = false;  // both positions it came from were above a resting ball
 };
 
 // Where a camera expects the ball at a time: its image centre and radius, and its image motion
@@ -41,11 +43,13 @@ struct BallHintOptions {
   double max_age_s = 0.25;      // a state older than this (at the frame's time) is no hint
   double max_gap_s = 0.1;       // two positions farther apart in time give no velocity
   double max_speed_mps = 60.0;  // a faster step between two positions is a jump, no velocity
+  double airborne_m = 0.05;     // above a resting ball's centre by this much: in flight
   void Check() const;           // throws fv::Error naming the bad field
 };
 
-// The ball's expected image position in `camera` at `time_s` (constant velocity from the hint),
-// nullopt when the hint is too old, the ball is behind the camera or outside the image.
+// The ball's expected image position in `camera` at `time_s` (from the hint: constant velocity,
+// plus gravity in flight), nullopt when the hint is too old, the ball is behind the camera or
+// outside the image.
 std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camera& camera,
                                        double time_s, double frame_dt_s,
                                        const BallHintOptions& options);
