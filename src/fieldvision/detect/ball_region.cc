@@ -496,20 +496,64 @@ bool LargestFilledOutline(const cv::Mat& region, const cv::Rect& extent,
   return true;
 }
 
-// Points of `contour` (window coordinates) on its convex hull within `tolerance_px`, in image
-// coordinates, leaving out those on the border of `lim` (a clipped outline).
+// The squared distance of `p` from the segment a..b.
+double SegmentDistance2(const cv::Point& p, const cv::Point& a, const cv::Point& b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, px = p.x - a.x, py = p.y - a.y;
+  const double t = px * dx + py * dy, len2 = dx * dx + dy * dy;
+  if (t <= 0) return px * px + py * py;
+  if (t >= len2) return (p.x - b.x) * double(p.x - b.x) + (p.y - b.y) * double(p.y - b.y);
+  const double cross = px * dy - py * dx;
+  return cross * cross / len2;
+}
+
+// Points of `contour` (window coordinates) on its convex hull (`hull_index`: its vertices'
+// indices in `contour`, as cv::convexHull gives them) within `tolerance_px`, in image coordinates,
+// leaving out those on the border of `lim` (a clipped outline). The distance is
+// cv::pointPolygonTest's (the least over the hull's edges), but a point that is a hull vertex, or
+// is clearly within the tolerance of the hull edge between the vertices before and after it on
+// the contour (an upper bound of that least distance), is taken without it.
 std::vector<Vector2d> ConvexOutlinePoints(const std::vector<cv::Point>& contour,
+                                          const std::vector<int>& hull_index,
                                           const std::vector<cv::Point>& hull,
                                           const cv::Point& window_tl, const cv::Rect& lim,
                                           double tolerance_px) {
+  const int n = static_cast<int>(contour.size());
+  // The hull vertex at or before (after) each contour point, cyclically, and each vertex's place
+  // on the hull.
+  const int h = static_cast<int>(hull_index.size());
+  std::vector<int> before(n, -1), after(n, -1), place(n, -1);
+  if (h > 0) {
+    for (int k = 0; k < h; ++k) {
+      const int i = hull_index[k];
+      before[i] = after[i] = i;
+      place[i] = k;
+    }
+    int last = *std::max_element(hull_index.begin(), hull_index.end());
+    for (int i = 0; i < n; ++i) last = before[i] = before[i] >= 0 ? before[i] : last;
+    int next = *std::min_element(hull_index.begin(), hull_index.end());
+    for (int i = n - 1; i >= 0; --i) next = after[i] = after[i] >= 0 ? after[i] : next;
+  }
+  // Well inside the tolerance (the margin covers rounding).
+  const double sure2 = tolerance_px * tolerance_px * (1 - 1e-9);
   std::vector<Vector2d> pts;
-  for (const auto& p : contour) {
+  for (int i = 0; i < n; ++i) {
+    const cv::Point& p = contour[i];
     const int gx = p.x + window_tl.x, gy = p.y + window_tl.y;
     const bool at_border =
         gx <= lim.x || gy <= lim.y || gx >= lim.x + lim.width - 1 || gy >= lim.y + lim.height - 1;
     if (at_border) continue;
-    const double d = cv::pointPolygonTest(hull, cv::Point2f(p.x, p.y), true);
-    if (std::abs(d) <= tolerance_px) pts.emplace_back(gx, gy);
+    bool near = false;
+    if (h > 0) {
+      // The vertices before and after the point make a hull edge (not a chord) when they are
+      // next to each other on the hull.
+      const int step = (place[after[i]] - place[before[i]] + h) % h;
+      near = before[i] == i || ((step <= 1 || step == h - 1) &&
+                                SegmentDistance2(p, contour[before[i]], contour[after[i]]) < sure2);
+    }
+    if (!near) {
+      near = std::abs(cv::pointPolygonTest(hull, cv::Point2f(p.x, p.y), true)) <= tolerance_px;
+    }
+    if (near) pts.emplace_back(gx, gy);
   }
   return pts;
 }
@@ -685,15 +729,19 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
     out.failure = "no outline";
     return out;
   }
+  // The hull's vertices as indices into the contour; the points are those cv::convexHull gives.
+  std::vector<int> hull_index;
+  cv::convexHull(contour, hull_index, false, false);
   std::vector<cv::Point> hull;
-  cv::convexHull(contour, hull);
+  hull.reserve(hull_index.size());
+  for (const int i : hull_index) hull.push_back(contour[i]);
   const double hull_area = cv::contourArea(hull) + 0.5 * cv::arcLength(hull, true) + 1.0;
   const double area = cv::countNonZero(filled(extent));
   out.area_px = area;
   out.solidity = std::min(1.0, area / hull_area);
   const double r_est = std::sqrt(hull_area / M_PI);
-  const std::vector<Vector2d> pts =
-      ConvexOutlinePoints(contour, hull, window.tl(), lim, o.hull_tolerance_px + 0.03 * r_est);
+  const std::vector<Vector2d> pts = ConvexOutlinePoints(contour, hull_index, hull, window.tl(), lim,
+                                                        o.hull_tolerance_px + 0.03 * r_est);
   out.outline_points = static_cast<int>(pts.size());
   if (pts.size() < 5) {
     out.failure = "too few convex outline points";
