@@ -52,37 +52,83 @@ void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit
 }
 
 // The window's CIELAB (cv::COLOR_BGR2Lab, converted pixel by pixel), converted only where asked
-// for: most of the window is never read.
+// for: most of the window is never read. Each row's converted pixels are one run of columns; what
+// a request adds to them is gathered and converted in one call (the conversion of a pixel does not
+// depend on its neighbours).
 class LabWindow {
  public:
   explicit LabWindow(const cv::Mat& bgr_window)
-      : bgr_(bgr_window), lab_(bgr_window.size(), CV_8UC3) {}
-  // Valid inside every rectangle passed to Need.
+      : bgr_(bgr_window),
+        lab_(bgr_window.size(), CV_8UC3),
+        lo_(bgr_window.rows, 0),
+        hi_(bgr_window.rows, 0) {}
+  // Valid inside every rectangle passed to Need and where NeedWithin asked for it.
   const cv::Mat& lab() const { return lab_; }
   void Need(const cv::Rect& rect) {
     const cv::Rect r = rect & cv::Rect(0, 0, lab_.cols, lab_.rows);
-    const cv::Rect both = r & done_;
-    if (both.area() == 0) {
-      Convert(r);
-      if (done_.area() == 0) done_ = r;
-      return;
+    pieces_.clear();
+    for (int y = r.y; y < r.br().y; ++y) AddRow(y, r.x, r.br().x);
+    ConvertPieces();
+  }
+  // The pixels of `rect` whose `dist` (CV_32F, rect's size) is at most `limit`: on each row, from
+  // the first to the last of them.
+  void NeedWithin(const cv::Rect& rect, const cv::Mat& dist, float limit) {
+    pieces_.clear();
+    for (int y = 0; y < rect.height; ++y) {
+      const float* d = dist.ptr<float>(y);
+      int x0 = 0, x1 = rect.width;
+      while (x0 < x1 && !(d[x0] <= limit)) ++x0;
+      while (x1 > x0 && !(d[x1 - 1] <= limit)) --x1;
+      if (x0 < x1) AddRow(rect.y + y, rect.x + x0, rect.x + x1);
     }
-    // r less what the first rectangle converted: the rows above and below it, then the columns
-    // left and right of it.
-    Convert({r.x, r.y, r.width, both.y - r.y});
-    Convert({r.x, both.br().y, r.width, r.br().y - both.br().y});
-    Convert({r.x, both.y, both.x - r.x, both.height});
-    Convert({both.br().x, both.y, r.br().x - both.br().x, both.height});
+    ConvertPieces();
   }
 
  private:
-  void Convert(const cv::Rect& r) {
-    if (r.width <= 0 || r.height <= 0) return;
-    cv::Mat dst = lab_(r);
-    cv::cvtColor(bgr_(r), dst, cv::COLOR_BGR2Lab);
+  struct Piece {
+    int y, x0, x1;
+  };
+  // Columns x0..x1-1 of row y, less those converted: the row's run grows to cover them.
+  void AddRow(int y, int x0, int x1) {
+    if (x0 >= x1) return;
+    if (lo_[y] >= hi_[y]) {
+      pieces_.push_back({y, x0, x1});
+      lo_[y] = x0;
+      hi_[y] = x1;
+      return;
+    }
+    if (x0 < lo_[y]) {
+      pieces_.push_back({y, x0, lo_[y]});
+      lo_[y] = x0;
+    }
+    if (x1 > hi_[y]) {
+      pieces_.push_back({y, hi_[y], x1});
+      hi_[y] = x1;
+    }
+  }
+  void ConvertPieces() {
+    int total = 0;
+    for (const Piece& p : pieces_) total += p.x1 - p.x0;
+    if (total == 0) return;
+    gathered_.create(1, total, CV_8UC3);
+    uint8_t* g = gathered_.ptr<uint8_t>(0);
+    for (const Piece& p : pieces_) {
+      const size_t n = 3 * static_cast<size_t>(p.x1 - p.x0);
+      std::memcpy(g, bgr_.ptr<uint8_t>(p.y) + 3 * static_cast<ptrdiff_t>(p.x0), n);
+      g += n;
+    }
+    cv::cvtColor(gathered_, converted_, cv::COLOR_BGR2Lab);
+    const uint8_t* c = converted_.ptr<uint8_t>(0);
+    for (const Piece& p : pieces_) {
+      const size_t n = 3 * static_cast<size_t>(p.x1 - p.x0);
+      std::memcpy(lab_.ptr<uint8_t>(p.y) + 3 * static_cast<ptrdiff_t>(p.x0), c, n);
+      c += n;
+    }
   }
   cv::Mat bgr_, lab_;
-  cv::Rect done_;
+  std::vector<int> lo_, hi_;  // each row's converted columns lo..hi-1 (none when lo >= hi)
+  std::vector<Piece> pieces_;
+  cv::Mat gathered_, converted_;
 };
 
 // The 8-connected components of a binary mask (CV_8U, non-zero set) as runs of set pixels, row
@@ -318,13 +364,19 @@ struct LabHistogram {
 // The region grown by its own colour (BallRegionOptions::own_reach; r its radius): seeded region
 // growing (Adams & Bischof, PAMI 1994) against the surroundings' median colour. Distances to the
 // region come from one distance transform; colour distances are CIELAB Delta E 1976, squared.
-void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionOptions& o, float r,
-                       cv::Mat* region) {
-  cv::Mat dist;  // distance to the region, pixels (0 inside it)
-  cv::distanceTransform(~*region, dist, cv::DIST_L2, cv::DIST_MASK_3);
+// The ring's outer distance and the reach of GrowByOwnColourIn.
+float OwnRingOut(float r) { return std::max(3.0f, 0.6f * r); }
+float OwnReach(const BallRegionOptions& o, float r) {
+  return std::max(1.0f, static_cast<float>(o.own_reach) * r);
+}
+
+// `dist`: the distance transform of the region's complement; `lab` is read only where it is at most
+// max(OwnRingOut(r), OwnReach(o, r)).
+void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const cv::Mat& dist,
+                       const BallRegionOptions& o, float r, cv::Mat* region) {
   // The region's ball-class pixels (all of its pixels when none is) and the ring's pixels
   // outside the class, in one pass.
-  const float ring_in = std::max(1.0f, 0.3f * r), ring_out = std::max(3.0f, 0.6f * r);
+  const float ring_in = std::max(1.0f, 0.3f * r), ring_out = OwnRingOut(r);
   LabHistogram own_class, own_all, ring;
   for (int y = 0; y < lab.rows; ++y) {
     const uint8_t* l = lab.ptr<uint8_t>(y);
@@ -351,7 +403,7 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const BallRegionO
   const float limit2 =
       std::min(static_cast<float>(o.own_max_delta_e * o.own_max_delta_e),
                static_cast<float>(o.own_share * o.own_share) * (own_f - around_f).squaredNorm());
-  const float reach = std::max(1.0f, static_cast<float>(o.own_reach) * r);
+  const float reach = OwnReach(o, r);
   cv::Mat joined = region->clone();
   for (int y = 0; y < lab.rows; ++y) {
     const uint8_t* l = lab.ptr<uint8_t>(y);
@@ -389,8 +441,10 @@ void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions
       2;
   const cv::Rect sub = Grow(box, margin) & cv::Rect(0, 0, region->cols, region->rows);
   cv::Mat part = (*region)(sub);
-  lab->Need(sub);
-  GrowByOwnColourIn(lab->lab()(sub), raw(sub), o, r, &part);
+  cv::Mat dist;  // distance to the region, pixels (0 inside it)
+  cv::distanceTransform(~part, dist, cv::DIST_L2, cv::DIST_MASK_3);
+  lab->NeedWithin(sub, dist, std::max(OwnRingOut(r), OwnReach(o, r)));
+  GrowByOwnColourIn(lab->lab()(sub), raw(sub), dist, o, r, &part);
   *extent = sub;
 }
 
