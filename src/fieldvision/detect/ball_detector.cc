@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/edge_circle.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -584,36 +585,58 @@ std::optional<BallCandidate> BallDetector::FitAt(const cv::Mat& bgr, const cv::R
   // The widened class: the expected ball may be in shade, pale or blurred all over.
   const ColourTable& table = grow_table_ ? *grow_table_ : *table_;
   const uint8_t bit = table.BallBit();
-  const BallFit fit = FitBall(bgr, table, bit, centre_px, radius_px, camera_, o.fit);
-  if (!fit.ok || std::abs(fit.radius_px - radius_px) > o.guided_radius_change * radius_px + 0.5 ||
-      (fit.centre_px - centre_px).norm() > o.guided_max_shift_radii * radius_px + 1.0 ||
-      fit.inlier_fraction < o.weak_min_inlier_fraction || fit.rms_px > o.max_fit_rms_px) {
-    return std::nullopt;
-  }
+  const std::optional<GuidedOutline> fit = FitGuidedOutline(bgr, table, bit, centre_px, radius_px);
+  if (!fit) return std::nullopt;
   double visible = 0.0, leak = 1.0;
-  DiscShares(bgr, table, bit, fit.centre_px, std::max(fit.radius_px - 0.7, 0.5),
-             fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
+  DiscShares(bgr, table, bit, fit->centre_px, std::max(fit->radius_px - 0.7, 0.5),
+             fit->radius_px + 1.5, fit->radius_px + 3.5, &visible, &leak);
   double size_factor = 1.0;
   if (visible < o.min_visible_fraction ||
-      !SizeProblem(fit.centre_px, fit.radius_px, &size_factor).empty()) {
+      !SizeProblem(fit->centre_px, fit->radius_px, &size_factor).empty()) {
     return std::nullopt;
   }
   BallCandidate c;
-  c.centre_px = fit.centre_px;
-  c.radius_px = fit.radius_px;
-  c.sigma_px = fit.sigma_px;
+  c.centre_px = fit->centre_px;
+  c.radius_px = fit->radius_px;
+  c.sigma_px = fit->sigma_px;
   c.accepted = true;
   c.guided = true;
   c.precise = true;
   c.visible_fraction = visible;
-  c.inlier_fraction = fit.inlier_fraction;
-  c.outside_fraction = fit.outside_fraction;
-  c.dents = fit.dents;
-  c.blurred = fit.blurred;
+  c.inlier_fraction = fit->inlier_fraction;
   // Below a detected ball of the same fit: the place was given, not found.
-  c.score = 0.5 * fit.inlier_fraction * std::min(1.0, visible / 0.9) *
-            std::exp(-0.5 * std::pow(fit.rms_px / 0.5, 2)) * size_factor;
+  c.score = 0.5 * fit->inlier_fraction * std::min(1.0, visible / 0.9) *
+            std::exp(-0.5 * std::pow(fit->rms_px / 0.5, 2)) * size_factor;
   return c;
+}
+
+std::optional<BallDetector::GuidedOutline> BallDetector::FitGuidedOutline(const cv::Mat& bgr,
+                                                                          const ColourTable& table,
+                                                                          uint8_t bit,
+                                                                          const Vector2d& centre_px,
+                                                                          double radius_px) const {
+  const BallDetectorOptions& o = options_;
+  const auto agrees = [&](const Vector2d& c, double r, double inliers, double rms) {
+    return std::abs(r - radius_px) <= o.guided_radius_change * radius_px + 0.5 &&
+           (c - centre_px).norm() <= o.guided_max_shift_radii * radius_px + 1.0 &&
+           inliers >= o.weak_min_inlier_fraction && rms <= o.max_fit_rms_px;
+  };
+  const BallFit fit = FitBall(bgr, table, bit, centre_px, radius_px, camera_, o.fit);
+  if (fit.ok && agrees(fit.centre_px, fit.radius_px, fit.inlier_fraction, fit.rms_px)) {
+    return GuidedOutline{fit.centre_px, fit.radius_px, fit.sigma_px, fit.rms_px,
+                         fit.inlier_fraction};
+  }
+  // The class does not outline it (a ball in front of a board of its colour): colour edges.
+  EdgeCircleOptions eo;
+  eo.min_step = o.fit.min_contrast;
+  eo.max_radius_change = o.guided_radius_change;
+  eo.max_shift_radii = o.guided_max_shift_radii;
+  eo.inlier_px = o.fit.inlier_px;
+  const EdgeCircle e = FitEdgeCircle(bgr, centre_px, radius_px, eo);
+  if (e.ok && agrees(e.centre_px, e.radius_px, e.inlier_fraction, e.rms_px)) {
+    return GuidedOutline{e.centre_px, e.radius_px, e.sigma_px, e.rms_px, e.inlier_fraction};
+  }
+  return std::nullopt;
 }
 
 void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,

@@ -171,10 +171,11 @@ class BallDetector {
 
   // A ball where a tracker expects one (`centre_px`, `radius_px`: its prediction), for a frame
   // where Detect accepted none there (a ball merged with a neighbour of its colour, or passing
-  // over one): the outline fit seeded there, accepted when the free part of the outline fits a
-  // circle of about that radius near that place (guided_radius_change, guided_max_shift_radii)
-  // with enough ball colour inside and the size check passed; no region, leak or contrast
-  // checks. Reads nothing outside `region` (empty: the frame); nullopt when the fit disagrees.
+  // over one): the outline fit in the widened ball class seeded there, else a circle on colour
+  // edges (edge_circle.h), accepted when it is of about that radius near that place
+  // (guided_radius_change, guided_max_shift_radii) with enough ball colour inside and the size
+  // check passed; no region, leak or contrast checks. Reads nothing outside `region` (empty: the
+  // frame); nullopt when no outline agrees.
   std::optional<BallCandidate> FitAt(const cv::Mat& bgr, const cv::Rect& region,
                                      const Eigen::Vector2d& centre_px, double radius_px) const;
   const BallDetectorOptions& options() const { return options_; }
@@ -190,6 +191,15 @@ class BallDetector {
   // "" when `radius` fits the radius limits and the ball's size at `centre` (posed camera);
   // else why not. `size_factor` (0.5..1) prefers the size of a ball on the ground there.
   std::string SizeProblem(const Eigen::Vector2d& centre, double radius, double* size_factor) const;
+  // FitAt's outline: the outline fit in `table`, else colour edges (edge_circle.h), agreeing with
+  // the expected circle; nullopt when neither does.
+  struct GuidedOutline {
+    Eigen::Vector2d centre_px;
+    double radius_px, sigma_px, rms_px, inlier_fraction;
+  };
+  std::optional<GuidedOutline> FitGuidedOutline(const cv::Mat& bgr, const ColourTable& table,
+                                                uint8_t bit, const Eigen::Vector2d& centre_px,
+                                                double radius_px) const;
   // The smallest radius (pixels) the size check accepts where the ball is expected at least
   // `expected_min_px` large (size_tolerance and half a pixel of slack).
   double SmallestPlausibleRadius(double expected_min_px) const;
