@@ -17,7 +17,70 @@ Eigen::Vector3d BallAfter(const BallHint& h, double age_s) {
   return p;
 }
 
+// A line through (tau, x) (tau: time from the newest position) by least squares, its value and
+// slope at tau = 0; `use` selects the positions.
+void FitLine(const std::vector<double>& tau, const std::vector<Eigen::Vector3d>& x,
+             const std::vector<char>& use, Eigen::Vector3d* at0, Eigen::Vector3d* slope) {
+  double n = 0, st = 0, stt = 0;
+  Eigen::Vector3d sx = Eigen::Vector3d::Zero(), stx = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < tau.size(); ++i) {
+    if (!use[i]) continue;
+    n += 1;
+    st += tau[i];
+    stt += tau[i] * tau[i];
+    sx += x[i];
+    stx += tau[i] * x[i];
+  }
+  const double den = n * stt - st * st;
+  *slope = den > 1e-12 ? Eigen::Vector3d((n * stx - st * sx) / den) : Eigen::Vector3d::Zero();
+  *at0 = (sx - *slope * st) / n;
+}
+
 }  // namespace
+
+BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, double radius_m,
+                 const BallHintOptions& o) {
+  BallHint h;
+  h.radius_m = radius_m;
+  h.time_s = recent.back().first;
+  h.ball_in_world = recent.back().second;
+  if (recent.size() < 2) return h;
+  const double flying_z = radius_m + o.airborne_m;
+  h.airborne = std::all_of(recent.begin(), recent.end(),
+                           [&](const auto& r) { return r.second.z() > flying_z; });
+  // In flight z + g tau^2 / 2 is a line in tau.
+  std::vector<double> tau;
+  std::vector<Eigen::Vector3d> x;
+  for (const auto& [t, p] : recent) {
+    tau.push_back(t - h.time_s);
+    x.push_back(p);
+    if (h.airborne) x.back().z() += 0.5 * kGravityMps2 * tau.back() * tau.back();
+  }
+  std::vector<char> use(x.size(), 1);
+  Eigen::Vector3d at0, v;
+  for (size_t left = x.size();; --left) {
+    FitLine(tau, x, use, &at0, &v);
+    if (left <= 2) break;
+    size_t worst = 0;
+    double worst_m = -1;
+    for (size_t i = 0; i < x.size(); ++i) {
+      const double d = use[i] ? (x[i] - (at0 + tau[i] * v)).norm() : -1.0;
+      if (d > worst_m) {
+        worst_m = d;
+        worst = i;
+      }
+    }
+    if (worst_m <= o.outlier_m) break;
+    use[worst] = 0;
+  }
+  if (v.norm() > o.max_speed_mps) {
+    h.airborne = false;
+    return h;  // a jump between objects: no velocity
+  }
+  h.ball_in_world = at0;
+  h.velocity_mps = v;
+  return h;
+}
 
 void BallHintOptions::Check() const {
   FV_REQUIRE(lag_messages >= 1, "BallHintOptions.lag_messages must be >= 1 (got {})", lag_messages);
@@ -25,6 +88,8 @@ void BallHintOptions::Check() const {
   CheckPositive(max_gap_s, "BallHintOptions.max_gap_s");
   CheckPositive(max_speed_mps, "BallHintOptions.max_speed_mps");
   CheckNonNegative(airborne_m, "BallHintOptions.airborne_m");
+  CheckPositive(fit_span_s, "BallHintOptions.fit_span_s");
+  CheckPositive(outlier_m, "BallHintOptions.outlier_m");
 }
 
 std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camera& camera,
@@ -56,22 +121,13 @@ BallHintBoard::BallHintBoard(int cameras, const BallHintOptions& options, bool w
 void BallHintBoard::Publish(double time_s, const Eigen::Vector3d& ball_in_world, double radius_m) {
   if (!std::isfinite(time_s) || !ball_in_world.allFinite()) return;
   std::lock_guard<std::mutex> lock(mutex_);
-  BallHint h;
-  h.time_s = time_s;
-  h.ball_in_world = ball_in_world;
-  h.radius_m = radius_m;
-  const double flying_z = radius_m + options_.airborne_m;
-  if (state_) {
-    const double dt = time_s - state_->time_s;
-    Eigen::Vector3d v = (ball_in_world - state_->ball_in_world) / dt;
-    if (dt > 0 && dt <= options_.max_gap_s && v.norm() <= options_.max_speed_mps) {
-      // In flight the step's mean velocity is the one half a step back.
-      h.airborne = ball_in_world.z() > flying_z && state_->ball_in_world.z() > flying_z;
-      if (h.airborne) v.z() -= 0.5 * kGravityMps2 * dt;
-      h.velocity_mps = v;
-    }
+  if (!recent_.empty() &&
+      (time_s <= recent_.back().first || time_s - recent_.back().first > options_.max_gap_s)) {
+    recent_.clear();  // out of order or after a gap: a new track
   }
-  state_ = h;
+  recent_.emplace_back(time_s, ball_in_world);
+  while (time_s - recent_.front().first > options_.fit_span_s + 1e-9) recent_.pop_front();
+  state_ = FitHint(recent_, radius_m, options_);
 }
 
 void BallHintBoard::Popped(int camera) {

@@ -12,6 +12,7 @@
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -44,7 +45,12 @@ struct BallHintOptions {
   double max_gap_s = 0.1;       // two positions farther apart in time give no velocity
   double max_speed_mps = 60.0;  // a faster step between two positions is a jump, no velocity
   double airborne_m = 0.05;     // above a resting ball's centre by this much: in flight
-  void Check() const;           // throws fv::Error naming the bad field
+  // The state is a line (a parabola in flight) fitted to the positions of the last fit_span_s
+  // (each within max_gap_s of the next), dropping the worst one while it is farther than
+  // outlier_m from the fit (a position on another object) and more than two remain.
+  double fit_span_s = 0.1;
+  double outlier_m = 0.15;
+  void Check() const;  // throws fv::Error naming the bad field
 };
 
 // The ball's expected image position in `camera` at `time_s` (from the hint: constant velocity,
@@ -53,6 +59,11 @@ struct BallHintOptions {
 std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camera& camera,
                                        double time_s, double frame_dt_s,
                                        const BallHintOptions& options);
+
+// The state from recent fused positions (time_s, position; oldest first, at least one) as
+// BallHintOptions describes; the newest position alone has no velocity.
+BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, double radius_m,
+                 const BallHintOptions& options);
 
 class BallHintBoard {
  public:
@@ -76,7 +87,8 @@ class BallHintBoard {
   std::condition_variable changed_;
   bool closed_ = false;
   std::optional<BallHint> state_;
-  std::vector<long long> popped_;  // messages popped per camera
+  std::deque<std::pair<double, Eigen::Vector3d>> recent_;  // (time_s, position), oldest first
+  std::vector<long long> popped_;                          // messages popped per camera
   // Per camera, the state at each of its last pops (back: the latest, popped_[c] - 1).
   std::vector<std::deque<std::optional<BallHint>>> at_pop_;
 };

@@ -102,6 +102,19 @@ TEST(BallHintBoard, AFlyingBallFallsAlongItsParabola) {
   EXPECT_EQ(ground.Get(0, 0)->velocity_mps.z(), 0.0);
 }
 
+TEST(BallHintBoard, APositionOnAnotherObjectDoesNotBendTheTrack) {
+  // A ball rolling at 6 m/s; the fusion's newest position is 0.4 m off (two cameras agreed on
+  // something else): the state stays on the track, with its velocity.
+  BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+  for (int f = 0; f < 5; ++f) board.Publish(f / 60.0, Vector3d(0.1 * f, 0, 0.11), 0.11);
+  board.Publish(5 / 60.0, Vector3d(0.5, 0.4, 0.11), 0.11);
+  const std::optional<BallHint> h = board.Get(0, 0);
+  ASSERT_TRUE(h);
+  EXPECT_LT((h->ball_in_world - Vector3d(0.5, 0, 0.11)).norm(), 1e-9);
+  EXPECT_LT((h->velocity_mps - Vector3d(6, 0, 0)).norm(), 1e-6);
+  EXPECT_NEAR(h->time_s, 5 / 60.0, 1e-12);
+}
+
 TEST(ExpectBall, ProjectsTheBallAheadWithItsVelocityAndSize) {
   camera::Camera cam = camera::Camera::FromFov(640, 480, 60.0);
   cam.has_pose = true;  // at the origin, looking along +z
