@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <utility>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -62,7 +63,7 @@ class LabWindow {
         lab_(bgr_window.size(), CV_8UC3),
         lo_(bgr_window.rows, 0),
         hi_(bgr_window.rows, 0) {}
-  // Valid inside every rectangle passed to Need and where NeedWithin asked for it.
+  // Valid inside every rectangle and span passed to Need and NeedSpans.
   const cv::Mat& lab() const { return lab_; }
   void Need(const cv::Rect& rect) {
     const cv::Rect r = rect & cv::Rect(0, 0, lab_.cols, lab_.rows);
@@ -70,16 +71,11 @@ class LabWindow {
     for (int y = r.y; y < r.br().y; ++y) AddRow(y, r.x, r.br().x);
     ConvertPieces();
   }
-  // The pixels of `rect` whose `dist` (CV_32F, rect's size) is at most `limit`: on each row, from
-  // the first to the last of them.
-  void NeedWithin(const cv::Rect& rect, const cv::Mat& dist, float limit) {
+  // Columns spans[y].first..spans[y].second-1 of each row y of `rect` (rect's coordinates).
+  void NeedSpans(const cv::Rect& rect, const std::vector<std::pair<int, int>>& spans) {
     pieces_.clear();
     for (int y = 0; y < rect.height; ++y) {
-      const float* d = dist.ptr<float>(y);
-      int x0 = 0, x1 = rect.width;
-      while (x0 < x1 && !(d[x0] <= limit)) ++x0;
-      while (x1 > x0 && !(d[x1 - 1] <= limit)) --x1;
-      if (x0 < x1) AddRow(rect.y + y, rect.x + x0, rect.x + x1);
+      AddRow(rect.y + y, rect.x + spans[y].first, rect.x + spans[y].second);
     }
     ConvertPieces();
   }
@@ -370,10 +366,12 @@ float OwnReach(const BallRegionOptions& o, float r) {
   return std::max(1.0f, static_cast<float>(o.own_reach) * r);
 }
 
-// `dist`: the distance transform of the region's complement; `lab` is read only where it is at most
-// max(OwnRingOut(r), OwnReach(o, r)).
+// `dist`: the distance transform of the region's complement; `spans`: on each row, the columns
+// from the first to the last pixel whose distance is at most max(OwnRingOut(r), OwnReach(o, r)),
+// the only ones read.
 void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const cv::Mat& dist,
-                       const BallRegionOptions& o, float r, cv::Mat* region) {
+                       const std::vector<std::pair<int, int>>& spans, const BallRegionOptions& o,
+                       float r, cv::Mat* region) {
   // The region's ball-class pixels (all of its pixels when none is) and the ring's pixels
   // outside the class, in one pass.
   const float ring_in = std::max(1.0f, 0.3f * r), ring_out = OwnRingOut(r);
@@ -382,7 +380,7 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const cv::Mat& di
     const uint8_t* l = lab.ptr<uint8_t>(y);
     const float* d = dist.ptr<float>(y);
     const uint8_t* m = raw.ptr<uint8_t>(y);
-    for (int x = 0; x < lab.cols; ++x) {
+    for (int x = spans[y].first; x < spans[y].second; ++x) {
       const uint8_t* lab_px = l + 3 * static_cast<ptrdiff_t>(x);
       if (d[x] == 0) {
         own_all.Add(lab_px);
@@ -409,7 +407,7 @@ void GrowByOwnColourIn(const cv::Mat& lab, const cv::Mat& raw, const cv::Mat& di
     const uint8_t* l = lab.ptr<uint8_t>(y);
     const float* d = dist.ptr<float>(y);
     uint8_t* j = joined.ptr<uint8_t>(y);
-    for (int x = 0; x < lab.cols; ++x) {
+    for (int x = spans[y].first; x < spans[y].second; ++x) {
       if (d[x] == 0 || d[x] > reach) continue;
       const uint8_t* lab_px = l + 3 * static_cast<ptrdiff_t>(x);
       const Eigen::Vector3f p =
@@ -441,10 +439,22 @@ void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions
       2;
   const cv::Rect sub = Grow(box, margin) & cv::Rect(0, 0, region->cols, region->rows);
   cv::Mat part = (*region)(sub);
-  cv::Mat dist;  // distance to the region, pixels (0 inside it)
-  cv::distanceTransform(~part, dist, cv::DIST_L2, cv::DIST_MASK_3);
-  lab->NeedWithin(sub, dist, std::max(OwnRingOut(r), OwnReach(o, r)));
-  GrowByOwnColourIn(lab->lab()(sub), raw(sub), dist, o, r, &part);
+  cv::Mat outside, dist;  // distance to the region, pixels (0 inside it)
+  cv::bitwise_not(part, outside);
+  cv::distanceTransform(outside, dist, cv::DIST_L2, cv::DIST_MASK_3);
+  // Nothing farther than the ring's outer distance and the reach is read: on each row, the
+  // columns from the first to the last pixel within them.
+  const float limit = std::max(OwnRingOut(r), OwnReach(o, r));
+  std::vector<std::pair<int, int>> spans(sub.height);
+  for (int y = 0; y < sub.height; ++y) {
+    const float* d = dist.ptr<float>(y);
+    int x0 = 0, x1 = sub.width;
+    while (x0 < x1 && !(d[x0] <= limit)) ++x0;
+    while (x1 > x0 && !(d[x1 - 1] <= limit)) --x1;
+    spans[y] = {x0, x1};
+  }
+  lab->NeedSpans(sub, spans);
+  GrowByOwnColourIn(lab->lab()(sub), raw(sub), dist, spans, o, r, &part);
   *extent = sub;
 }
 
