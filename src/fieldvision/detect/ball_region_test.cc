@@ -8,7 +8,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 #include <sstream>
+#include <utility>
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/test_images.h"
@@ -240,6 +242,72 @@ TEST(BallRegion, OptionsAreChecked) {
   BallDetectorOptions d;
   d.min_contrast = -1;
   EXPECT_THROW(d.Check(), Error);
+}
+
+// What the region's speed-ups rely on in OpenCV (ball_region.cc): a closing of a part widened
+// within the image (the part keeping k + 1 columns on both sides of the region) and a dilation
+// of a part that is not BORDER_ISOLATED read the same pixels as the narrower part; fillPoly fills
+// one contour as drawContours(FILLED); the Lab conversion of a pixel does not depend on where it
+// lies. Random masks and images, compared with the narrower or the original call.
+TEST(BallRegion, OpenCvBehaviourTheSpeedUpsRelyOn) {
+  std::mt19937 rng(17);
+  const auto grow = [](const cv::Rect& r, int g) {
+    return cv::Rect(r.x - g, r.y - g, r.width + 2 * g, r.height + 2 * g);
+  };
+  const auto wider = [](const cv::Rect& r, int cols) {
+    const int w = (r.width + 31) / 32 * 32;
+    return w <= cols ? cv::Rect(std::min(r.x, cols - w), r.y, w, r.height) : r;
+  };
+  for (int it = 0; it < 1500; ++it) {
+    const int w = 5 + rng() % 70, h = 5 + rng() % 70;
+    cv::Mat region(h, w, CV_8U, cv::Scalar(0));
+    for (int d = 0, n = 1 + rng() % 4; d < n; ++d) {
+      cv::circle(region, {int(rng() % w), int(rng() % h)}, 1 + rng() % 15, 255, -1);
+    }
+    for (int i = 0, n = rng() % 2 ? w * h / 6 : 0; i < n; ++i) {
+      region.at<uint8_t>(rng() % h, rng() % w) = rng() % 2 ? 255 : 0;
+    }
+    const cv::Rect bounds = cv::boundingRect(region);
+    if (bounds.area() == 0) continue;
+    const int k = 1 + rng() % 4;
+    const cv::Mat ellipse =
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1));
+    const cv::Rect sub = grow(bounds, k + 1) & cv::Rect(0, 0, w, h);
+    const cv::Rect wide =
+        sub.x == bounds.x - (k + 1) && sub.br().x == bounds.br().x + k + 1 ? wider(sub, w) : sub;
+    cv::Mat narrow_closed = region.clone(), wide_closed = region.clone();
+    for (auto [img, part_box] : {std::pair{&narrow_closed, sub}, std::pair{&wide_closed, wide}}) {
+      cv::Mat part = (*img)(part_box).clone();
+      cv::morphologyEx(part, part, cv::MORPH_CLOSE, ellipse);
+      part.copyTo((*img)(part_box));
+    }
+    ASSERT_EQ(cv::countNonZero(narrow_closed != wide_closed), 0) << "closing, case " << it;
+    const cv::Rect box(rng() % w, rng() % h, 1, 1);
+    const cv::Rect inner = cv::Rect(box.x, box.y, 1 + rng() % (w - box.x), 1 + rng() % (h - box.y));
+    cv::Mat near_all, near_part;
+    cv::dilate(region, near_all, ellipse);
+    const cv::Rect part_box = wider(inner, w);
+    cv::dilate(region(part_box), near_part, ellipse);
+    ASSERT_EQ(cv::countNonZero(near_all(inner) != near_part(inner - part_box.tl())), 0)
+        << "dilation, case " << it;
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(region, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+    for (size_t i = 0; i < contours.size(); ++i) {
+      cv::Mat drawn(h, w, CV_8U, cv::Scalar(0)), filled(h, w, CV_8U, cv::Scalar(0));
+      cv::drawContours(drawn, contours, static_cast<int>(i), 255, cv::FILLED);
+      cv::fillPoly(filled, std::vector<std::vector<cv::Point>>{contours[i]}, 255);
+      ASSERT_EQ(cv::countNonZero(drawn != filled), 0) << "fill, case " << it;
+    }
+  }
+  cv::Mat bgr(40, 70, CV_8UC3), lab;
+  cv::randu(bgr, 0, 256);
+  cv::cvtColor(bgr, lab, cv::COLOR_BGR2Lab);
+  for (int it = 0; it < 200; ++it) {
+    const cv::Rect r(rng() % 60, rng() % 30, 1 + rng() % 10, 1 + rng() % 10);
+    cv::Mat part_lab;
+    cv::cvtColor(bgr(r), part_lab, cv::COLOR_BGR2Lab);
+    ASSERT_EQ(cv::norm(part_lab, lab(r), cv::NORM_INF), 0) << "Lab, case " << it;
+  }
 }
 
 }  // namespace
