@@ -62,14 +62,8 @@ class LabWindow {
         lab_(bgr_window.size(), CV_8UC3),
         lo_(bgr_window.rows, 0),
         hi_(bgr_window.rows, 0) {}
-  // Valid inside every rectangle and span passed to Need and NeedSpans.
+  // Valid inside every span passed to NeedSpans.
   const cv::Mat& lab() const { return lab_; }
-  void Need(const cv::Rect& rect) {
-    const cv::Rect r = rect & cv::Rect(0, 0, lab_.cols, lab_.rows);
-    pieces_.clear();
-    for (int y = r.y; y < r.br().y; ++y) AddRow(y, r.x, r.br().x);
-    ConvertPieces();
-  }
   // Columns spans[y].first..spans[y].second-1 of each row y of `rect` (rect's coordinates).
   void NeedSpans(const cv::Rect& rect, const std::vector<std::pair<int, int>>& spans) {
     pieces_.clear();
@@ -852,7 +846,21 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   const cv::Point ring_br(static_cast<int>(std::ceil(c.x() + ro)) + 2,
                           static_cast<int>(std::ceil(c.y() + ro)) + 2);
   const cv::Rect ring_box = cv::Rect(ring_tl, ring_br) - window.tl();
-  lab.Need(ring_box);
+  {
+    // Lab is read only within ro of the centre (the ring and the core): on each row of the box,
+    // that chord, 1.5 px wider on both sides for rounding.
+    const cv::Rect box = ring_box & cv::Rect(0, 0, window.width, window.height);
+    std::vector<std::pair<int, int>> chords(box.height, {0, 0});
+    for (int y = 0; y < box.height; ++y) {
+      const double dy = window.y + box.y + y - c.y();
+      if (std::abs(dy) > ro + 1) continue;
+      const double half = std::sqrt(std::max(ro * ro - dy * dy, 0.0)) + 1.5;
+      const double cx = c.x() - window.x - box.x;
+      chords[y] = {std::clamp(static_cast<int>(std::floor(cx - half)), 0, box.width),
+                   std::clamp(static_cast<int>(std::ceil(cx + half)) + 1, 0, box.width)};
+    }
+    lab.NeedSpans(box, chords);
+  }
   const cv::Rect read = (ring_box | (cv::boundingRect(filled(extent)) + extent.tl())) &
                         cv::Rect(0, 0, window.width, window.height);
   MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, read, c, r, area, o, field_bit,
