@@ -64,6 +64,10 @@ check "ball: one camera" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/
 grep -q "one camera" "$TMP/err" || { echo "FAIL ball: one camera not named"; fail=1; }
 check "ball: a video twice" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v.avi" --out "$TMP/b.csv"
+check "ball: --write-detections for one of two cameras" nonzero $FV ball --camera "$TMP/c1.yaml" \
+  --video "$TMP/v.avi" --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" \
+  --write-detections "$TMP/d1.csv"
+grep -q "write-detections" "$TMP/err" || { echo "FAIL ball: --write-detections count not named"; fail=1; }
 check "ball: --tolerance 1e300" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --tolerance 1e300
 check "ball: --inlier-px nan" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \

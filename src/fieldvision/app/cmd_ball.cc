@@ -38,6 +38,18 @@ void RunDetections(BallCliOptions& o) {
 void RunBall(const BallCliOptions& o) {
   const pipeline::BallJobResult r = pipeline::RunBallJob(o.job);
   std::cout << r.summary.ToString() << "\n";
+  if (r.bundle && r.bundle->bundled_flights > 0) {
+    std::cout << fmt::format(
+        "{} flights refined on the cameras' candidates ({} rows, {:.2f} px RMS; --no-bundle: "
+        "each frame's own position)\n",
+        r.bundle->bundled_flights, r.bundle->bundled_rows, r.bundle->rms_px);
+  }
+  if (r.bundle && r.bundle->kept_flights > 0) {
+    std::cout << fmt::format(
+        "{} flights kept frame by frame (the flight model fits the candidates much worse than "
+        "the frames: not a free flight)\n",
+        r.bundle->kept_flights);
+  }
   std::cout << "wrote " << o.job.out << " (" << r.rows_written << " rows)\n";
   if (r.eval) std::cout << r.eval->Table(o.rows || r.eval->rows.size() <= 40) << "\n";
 }
@@ -62,6 +74,12 @@ void Setup(CLI::App& app, int& exit_code) {
   AddDetectorOptions(cmd, o->job.dnn);
   cmd->add_option("--out", o->job.out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")
       ->required();
+  cmd->add_option("--write-detections", o->job.detections_out,
+                  "Also write each camera's accepted candidates as DET.csv (frame,time_s,u,v,"
+                  "radius_px,score: what --detections reads), one per --camera in order");
+  cmd->add_flag("!--no-bundle", o->job.bundle,
+                "Offline: keep each frame's own position instead of refining each flight on the "
+                "cameras' candidates at the end");
   cmd->add_option("--truth", o->job.truth, "truth.csv: also print the error table");
   cmd->add_flag("--rows", o->rows, "With --truth: print every frame's error, not only summary");
   cmd->add_option("--field", o->job.field,
@@ -92,11 +110,22 @@ void Setup(CLI::App& app, int& exit_code) {
                                      o->job.field, o->job.colour, o->det.detections);
     io::CheckOutputPath(o->job.out, inputs);
     io::CheckOutputPath(o->det.flights, io::PathList(inputs, o->job.out), "--flights");
+    for (size_t i = 0; i < o->job.detections_out.size(); ++i) {
+      std::vector<std::string> others = io::PathList(inputs, o->job.out);
+      others.insert(others.end(), o->job.detections_out.begin(),
+                    o->job.detections_out.begin() + static_cast<long>(i));
+      io::CheckOutputPath(o->job.detections_out[i], others, "--write-detections");
+      o->job.detections_out[i] =
+          io::ResolveOutputPath(o->job.detections_out[i], "--write-detections");
+    }
     o->job.out = io::ResolveOutputPath(o->job.out);  // refuses a device or a folder
-    if (!o->det.flights.empty())
+    if (!o->det.flights.empty()) {
       o->det.flights = io::ResolveOutputPath(o->det.flights, "--flights");
+    }
     if (!o->det.detections.empty()) {
       FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
+      FV_REQUIRE(o->job.detections_out.empty(),
+                 "ball: --write-detections needs --video (the detections are the input here)");
       RunDetections(*o);
       return;
     }

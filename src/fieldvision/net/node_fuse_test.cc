@@ -83,6 +83,10 @@ std::map<long long, Row> OfflineBall(const Scene& scene) {
   job.videos = scene.videos;
   job.out = scene.dir + "/offline.csv";
   job.pipeline.progress = false;
+  // As the network path: the camera nodes get no hints from the fusion (pipeline/ball_hints.h),
+  // and the fusion node streams each frame's position (no end-of-clip flight bundle).
+  job.pipeline.hints = false;
+  job.bundle = false;
   pipeline::RunBallJob(job);
   return ReadBall(job.out);
 }

@@ -10,6 +10,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -36,11 +37,16 @@ void BallJobOptions::Check() const {
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
              "ball: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
   FV_REQUIRE(!out.empty(), "ball: --out is required");
+  FV_REQUIRE(detections_out.empty() || detections_out.size() == cameras.size(),
+             "ball: {} --write-detections for {} cameras (give one per camera or none)",
+             detections_out.size(), cameras.size());
   FV_REQUIRE(sync == "frame" || sync == "time", "ball: --sync must be 'frame' or 'time' (got '{}')",
              sync);
   dnn.Check();
   pipeline.Check();
   eval.Check();
+  FV_REQUIRE(std::isfinite(bundle_sigma_px) && bundle_sigma_px > 0,
+             "ball: bundle_sigma_px must be > 0 (got {})", bundle_sigma_px);
 }
 
 camera::Camera ReadRigCamera(const std::string& path) {
@@ -79,6 +85,14 @@ std::vector<recon::BallObservation> Observations(
   return out;
 }
 
+// A message's candidates as DET.csv rows.
+void WriteDetections(const CameraMessage& m, util::CsvWriter* csv) {
+  for (const recon::BallObservation& b : m.candidates) {
+    *csv << m.frame << m.time_s << b.centre_px.x() << b.centre_px.y() << b.radius_px << b.score;
+    csv->EndRow();
+  }
+}
+
 // FitAt of either detector as a camera stage's guided fit.
 template <typename Detector>
 BallGuidedFn GuidedFnFor(std::shared_ptr<Detector> detector) {
@@ -89,6 +103,36 @@ BallGuidedFn GuidedFnFor(std::shared_ptr<Detector> detector) {
     if (!c) return std::nullopt;
     return Observation(*c);
   };
+}
+
+// The job's videos, each checked against its camera's size. --live on files: a file is not
+// live; each is played at its own frame rate from one common start (as cameras would deliver
+// it), so frames drop only when fusion is slower than that.
+std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
+    const BallJobOptions& o, const std::vector<camera::Camera>& cameras) {
+  std::vector<std::unique_ptr<io::FrameSource>> sources;
+  const double live_start_s =
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() +
+      0.5;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    io::FrameSourceOptions vo;
+    vo.realtime = o.live;
+    vo.start_at_s = o.live ? live_start_s : 0.0;
+    if (!o.timestamps.empty()) {
+      vo.time = io::TimeSource::kCsv;
+      vo.timestamps_csv = o.timestamps[c];
+    } else if (o.sync == "time") {
+      vo.time = io::TimeSource::kContainer;
+    }
+    vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
+    auto src = io::OpenFrameSource(o.videos[c], vo);
+    const cv::Size size = src->FrameSize();
+    FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
+               "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
+               cameras[c].width, cameras[c].height, o.videos[c], size.width, size.height);
+    sources.push_back(std::move(src));
+  }
+  return sources;
 }
 
 }  // namespace
@@ -133,30 +177,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) field = field::LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
-  std::vector<std::unique_ptr<io::FrameSource>> sources;
-  // --live on files: a file is not live; each is played at its own frame rate from one common
-  // start (as cameras would deliver it), so frames drop only when fusion is slower than that.
-  const double live_start_s =
-      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() +
-      0.5;
-  for (int c = 0; c < n; ++c) {
-    io::FrameSourceOptions vo;
-    vo.realtime = o.live;
-    vo.start_at_s = o.live ? live_start_s : 0.0;
-    if (!o.timestamps.empty()) {
-      vo.time = io::TimeSource::kCsv;
-      vo.timestamps_csv = o.timestamps[c];
-    } else if (o.sync == "time") {
-      vo.time = io::TimeSource::kContainer;
-    }
-    vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
-    auto src = io::OpenFrameSource(o.videos[c], vo);
-    const cv::Size size = src->FrameSize();
-    FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
-               "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
-               cameras[c].width, cameras[c].height, o.videos[c], size.width, size.height);
-    sources.push_back(std::move(src));
-  }
+  std::vector<std::unique_ptr<io::FrameSource>> sources = OpenBallVideos(o, cameras);
   detect::BallDetectorOptions dopt;
   dopt.diameter_m = o.ball_diameter_m;
   dopt.colour = o.colour;
@@ -180,24 +201,59 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
         Eigen::Vector3d(-hx, -hy, -1e3), Eigen::Vector3d(hx, hy, dopt.max_height_m));
   }
 
+  // Each camera's accepted candidates as DET.csv, committed with BALL.csv.
+  std::vector<std::unique_ptr<io::AtomicOutput>> det_files;
+  std::vector<std::unique_ptr<util::CsvWriter>> det_csvs;
+  for (const std::string& path : o.detections_out) {
+    det_files.push_back(std::make_unique<io::AtomicOutput>(path, "--write-detections"));
+    det_csvs.push_back(std::make_unique<util::CsvWriter>(
+        det_files.back()->temp_path(),
+        std::vector<std::string>{"frame", "time_s", "u", "v", "radius_px", "score"}));
+  }
+  // Offline, each flight is refined at the end on the cameras' accepted candidates
+  // (detections_job.h's bundle) and the rows are written then; live, as the fusion gives them.
+  const bool bundle = o.bundle && !o.live;
+  std::vector<std::vector<CameraMessage>> accepted(n);
+  if (!det_csvs.empty() || bundle) {
+    popt.on_message = [&](const CameraMessage& m) {
+      CameraMessage kept = m;
+      std::erase_if(kept.candidates, [](const recon::BallObservation& b) { return b.weak; });
+      if (!det_csvs.empty()) WriteDetections(kept, det_csvs.at(m.camera).get());
+      if (bundle) accepted.at(m.camera).push_back(std::move(kept));
+    };
+  }
+
   BallJobResult result;
+  std::vector<recon::BallSample> track;
   // Write to a temporary file beside the output, rename at the end: a failed run (a truncated
   // video, a bad timestamp) leaves neither a half file nor a temporary one.
   io::AtomicWrite(o.out, [&](const std::string& temp_path) {
     util::CsvWriter csv(temp_path, recon::BallCsvColumns(), 6);
+    const auto write = [&](const recon::BallSample& s) {
+      csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y()
+          << s.ball_in_world.z() << s.n_cams << s.err_px;
+      csv.EndRow();
+      ++result.rows_written;
+    };
     result.summary = RunBallPipelineTracked(
         cameras, sources, detect_fns, popt,
         [&](const BallFrame& f) {
           if (!f.result.ok()) return;
-          const Eigen::Vector3d& p = f.result.point_world;
-          csv << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
-              << f.result.rms_px;
-          csv.EndRow();
-          ++result.rows_written;
+          if (bundle) {
+            track.push_back(BallSampleOf(f));
+          } else {
+            write(BallSampleOf(f));
+          }
         },
         guided_fns);
+    if (bundle) {
+      result.bundle =
+          BundleFlights(cameras, accepted, o.ball_diameter_m, 0.0, o.bundle_sigma_px, &track);
+      for (const recon::BallSample& s : track) write(s);
+    }
     csv.Close();
   });
+  for (size_t c = 0; c < det_files.size(); ++c) det_files[c]->CloseAndCommit(*det_csvs[c]);
   if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);
   return result;
 }

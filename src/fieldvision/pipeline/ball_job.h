@@ -12,6 +12,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/dnn_ball.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
+#include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/recon/ball_eval.h"
 
 namespace fv::pipeline {
@@ -25,7 +26,15 @@ struct BallJobOptions {
   detect::DnnBallOptions dnn;     // --detector colour|dnn|both (detect/dnn_ball.h)
   std::string field;              // optional field (name or JSON): detect only over it
   std::string out;                // BALL.csv
-  std::string truth;              // optional truth.csv for the error table
+  // Optional, one per camera: its accepted candidates as DET.csv (frame,time_s,u,v,radius_px,
+  // score; what `ball --detections` reads), to fuse again with other settings.
+  std::vector<std::string> detections_out;
+  // Offline (not live): refine each flight on the cameras' accepted candidates at the end
+  // (detections_job.h's physics-constrained bundle, 1-sigma bundle_sigma_px); positions inside a
+  // refined flight are the flight model's.
+  bool bundle = true;
+  double bundle_sigma_px = 2.0;
+  std::string truth;  // optional truth.csv for the error table
   // "frame" pairs frames by index; "time" by timestamps (the CSVs, else the container's).
   std::string sync = "frame";
   bool live = false;  // keep the newest messages (drop the oldest) instead of blocking
@@ -38,6 +47,7 @@ struct BallJobResult {
   BallPipelineSummary summary;
   std::optional<recon::BallEvalResult> eval;  // when a truth file was given
   long long rows_written = 0;
+  std::optional<FlightBundle> bundle;  // offline with `bundle`
 };
 
 BallJobResult RunBallJob(const BallJobOptions& options);

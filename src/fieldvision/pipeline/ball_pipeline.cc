@@ -206,6 +206,7 @@ void FuseCameraQueues(const std::vector<camera::Camera>& cameras, const CameraQu
     if (c < 0) break;  // cannot happen: Next() decides when nobody is waiting
     if (auto m = queues[c]->Pop()) {
       if (hints != nullptr) hints->Popped(c);
+      if (options.on_message) options.on_message(*m);
       sync.Add(std::move(*m));
     } else if (!stopping()) {
       sync.EndOfStream(c);

@@ -42,7 +42,9 @@ struct BallPipelineOptions {
   bool hints = true;
   BallHintOptions hint;
   JobControl* control = nullptr;  // optional: progress callback and stop check (not owned)
-  void Check() const;             // throws fv::Error naming the bad field
+  // Optional: each camera message as the fusion takes it off its queue (in the fusion thread).
+  std::function<void(const CameraMessage&)> on_message;
+  void Check() const;  // throws fv::Error naming the bad field
 };
 
 struct BallPipelineSummary {

@@ -349,6 +349,53 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(job.out));
 }
 
+// The job on videos: each camera's accepted candidates written as DET.csv (one row a frame
+// here), and the flight bundle at the end never moving a ball that does not fly freely (this one
+// is carried along a helix) away from where the frames put it.
+TEST(BallPipeline, TheJobWritesEachCamerasDetectionsAndKeepsANonBallisticTrack) {
+  const std::string dir = testing::TempDir() + "/job_detections";
+  std::filesystem::create_directories(dir);
+  constexpr int kFrames = 24;
+  const Scene s = MakeScene(dir, {kFrames, kFrames, kFrames}, {0, 0, 0});
+  BallJobOptions job;
+  for (int c = 0; c < 3; ++c) {
+    job.cameras.push_back(dir + "/cam" + std::to_string(c) + ".yaml");
+    camera::WriteCameraYaml(s.cams[c], job.cameras.back());
+    job.detections_out.push_back(dir + "/det" + std::to_string(c) + ".csv");
+  }
+  job.videos = s.videos;
+  job.ball_diameter_m = 2 * kRadius;
+  job.pipeline.progress = false;
+  double max_err_m[2] = {0, 0};
+  for (const bool bundle : {false, true}) {
+    job.bundle = bundle;
+    job.out = dir + (bundle ? "/ball_bundled.csv" : "/ball.csv");
+    const BallJobResult r = RunBallJob(job);
+    EXPECT_EQ(r.rows_written, kFrames) << "bundle " << bundle;
+    EXPECT_EQ(r.bundle.has_value(), bundle);
+    const util::CsvTable t = util::CsvTable::Read(job.out);
+    for (size_t i = 0; i < t.rows(); ++i) {
+      const Eigen::Vector3d p(t.GetDouble(i, "x_m"), t.GetDouble(i, "y_m"), t.GetDouble(i, "z_m"));
+      max_err_m[bundle] =
+          std::max(max_err_m[bundle], (p - BallAt(t.GetDouble(i, "time_s"))).norm());
+    }
+  }
+  EXPECT_LT(max_err_m[0], 0.02);
+  EXPECT_LT(max_err_m[1], 0.02);
+  for (int c = 0; c < 3; ++c) {
+    const util::CsvTable d = util::CsvTable::Read(job.detections_out[c]);
+    ASSERT_EQ(d.rows(), static_cast<size_t>(kFrames)) << "camera " << c;
+    for (size_t i = 0; i < d.rows(); ++i) {
+      const Eigen::Vector2d uv = *s.cams[c].Project(BallAt(d.GetDouble(i, "time_s")));
+      EXPECT_LT((Eigen::Vector2d(d.GetDouble(i, "u"), d.GetDouble(i, "v")) - uv).norm(), 0.5)
+          << "camera " << c << " row " << i;
+    }
+  }
+  // One file per camera or none.
+  job.detections_out.pop_back();
+  EXPECT_THROW(job.Check(), Error);
+}
+
 // The pipeline's stages one by one, in one thread: each camera's stream read into its queue
 // (stopping at max_frames), then fused; the counts as the whole pipeline gives them.
 TEST(BallPipelineStages, ReadThenFuseInOneThread) {

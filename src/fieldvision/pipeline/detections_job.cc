@@ -133,24 +133,60 @@ struct Bundled {
   recon::BallisticModel model;
   double rms_px = 0.0;
   int observations = 0;
+  // Over the observations at the times of per-frame positions: the model's RMS and theirs.
+  double model_rms_at_frames_px = 0.0;
+  double frames_rms_px = 0.0;
+  int at_frames = 0;
 };
+
+// A candidate of a flight's bundle.
+struct FlightObservation {
+  int cam;
+  Eigen::Vector2d uv;
+  double time_s;
+};
+
+// The bundled model against each frame's own position on the observations at the frames'
+// moments (the nearest per-frame position within half a frame, margin_s): both RMS.
+void CompareWithFrames(const std::vector<camera::Camera>& cameras,
+                       const std::vector<FlightObservation>& obs,
+                       const std::vector<recon::BallSample>& per_frame, double margin_s,
+                       Bundled* out) {
+  double ss_model = 0, ss_frames = 0;
+  for (const auto& o : obs) {
+    auto at = std::lower_bound(per_frame.begin(), per_frame.end(), o.time_s,
+                               [](const recon::BallSample& s, double t) { return s.time_s < t; });
+    if (at != per_frame.begin() &&
+        (at == per_frame.end() || o.time_s - std::prev(at)->time_s < at->time_s - o.time_s)) {
+      --at;
+    }
+    if (at == per_frame.end() || std::abs(at->time_s - o.time_s) > std::max(margin_s, 1e-6)) {
+      continue;
+    }
+    const auto uv_model = cameras[o.cam].Project(out->model.PositionAt(o.time_s));
+    const auto uv_frame = cameras[o.cam].Project(at->ball_in_world);
+    if (!uv_model || !uv_frame) continue;
+    ss_model += (*uv_model - o.uv).squaredNorm();
+    ss_frames += (*uv_frame - o.uv).squaredNorm();
+    ++out->at_frames;
+  }
+  if (out->at_frames > 0) {
+    out->model_rms_at_frames_px = std::sqrt(ss_model / out->at_frames);
+    out->frames_rms_px = std::sqrt(ss_frames / out->at_frames);
+  }
+}
 
 // The flight's model refitted on the detections of every camera between its first and last
 // seen samples (the candidate nearest the model's prediction, within a gate).
 Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
                      const std::vector<std::vector<CameraMessage>>& messages,
                      const recon::Flight& f, const recon::TrajectoryOptions& to, double sigma_px,
-                     double margin_s) {
+                     double margin_s, const std::vector<recon::BallSample>& per_frame) {
   Bundled out;
   const recon::BallisticModel start = f.model();
   const recon::FlightModel kind = f.model_kind();  // of the fit to the per-frame points
   const double t_ref = start.t0_s;
-  struct Obs {
-    int cam;
-    Eigen::Vector2d uv;
-    double time_s;
-  };
-  std::vector<Obs> obs;
+  std::vector<FlightObservation> obs;
   const double gate_px = 5 * sigma_px + 10.0;
   for (size_t c = 0; c < messages.size(); ++c) {
     for (const auto& m : messages[c]) {
@@ -251,11 +287,66 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   }
   out.observations = static_cast<int>(obs.size());
   out.rms_px = std::sqrt(ss / obs.size());
+  CompareWithFrames(cameras, obs, per_frame, margin_s, &out);
   out.ok = out.model.p0_m.allFinite() && out.model.v0_mps.allFinite();
   return out;
 }
 
+// The flight model's options for a ball of this size (mass 0: a table-tennis ball below 5 cm,
+// else a football).
+recon::TrajectoryOptions FlightOptions(double ball_diameter_m, double ball_mass_kg) {
+  recon::TrajectoryOptions to;
+  to.ball_radius_m = 0.5 * ball_diameter_m;
+  to.ball_mass_kg = ball_mass_kg > 0 ? ball_mass_kg : (ball_diameter_m < 0.05 ? 0.0027 : 0.43);
+  return to;
+}
+
 }  // namespace
+
+// A flight's model is kept when its RMS at the frames' moments is at most this times theirs plus
+// this many pixels.
+constexpr double kMaxModelRmsRatio = 2.5;
+constexpr double kModelRmsSlackPx = 0.3;
+
+FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
+                           const std::vector<std::vector<CameraMessage>>& messages,
+                           double ball_diameter_m, double ball_mass_kg, double sigma_px,
+                           std::vector<recon::BallSample>* track) {
+  FlightBundle out;
+  const std::vector<recon::BallSample> per_frame = *track;
+  const recon::TrajectoryOptions to = FlightOptions(ball_diameter_m, ball_mass_kg);
+  out.trajectory = recon::AnalyzeTrajectory(per_frame, to);
+  // Half the median frame interval around each flight's seen span.
+  std::vector<double> dts;
+  for (size_t i = 1; i < per_frame.size(); ++i) {
+    dts.push_back(per_frame[i].time_s - per_frame[i - 1].time_s);
+  }
+  const double margin = 0.5 * util::NearestRankPercentile(dts, 0.5);  // the upper middle; 0 if none
+  double ss = 0;
+  long long nobs = 0;
+  for (const recon::Flight& f : out.trajectory->flights) {
+    const Bundled b = BundleFlight(cameras, messages, f, to, sigma_px, margin, per_frame);
+    // A free flight's model explains the candidates about as well as each frame's own position
+    // does (those fit 3 parameters to each frame's 4+ coordinates: RMS about 0.5-0.8 of the
+    // model's); a ball carried, dribbled or deflected does not fit one and keeps its frames.
+    if (!b.ok || b.at_frames == 0 ||
+        b.model_rms_at_frames_px > kMaxModelRmsRatio * b.frames_rms_px + kModelRmsSlackPx) {
+      ++out.kept_flights;
+      continue;
+    }
+    ++out.bundled_flights;
+    ss += b.rms_px * b.rms_px * b.observations;
+    nobs += b.observations;
+    for (auto& s : *track) {
+      if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
+      s.ball_in_world = b.model.PositionAt(s.time_s);
+      s.err_px = b.rms_px;
+      ++out.bundled_rows;
+    }
+  }
+  if (nobs > 0) out.rms_px = std::sqrt(ss / nobs);
+  return out;
+}
 
 std::string DetectionsJobResult::Summary() const {
   std::string s = fmt::format("{} detections, {} moments paired by time, {} 3D positions",
@@ -314,35 +405,16 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   res.sync = sync.report();
   res.track = res.per_frame;
   // Flights, then the bundle.
-  recon::TrajectoryOptions to;
-  to.ball_radius_m = topt.ball_radius_m;
-  to.ball_mass_kg =
-      o.ball_mass_kg > 0 ? o.ball_mass_kg : (o.ball_diameter_m < 0.05 ? 0.0027 : 0.43);
-  if (!o.flights.empty() || o.bundle) res.trajectory = recon::AnalyzeTrajectory(res.per_frame, to);
-  if (o.bundle && res.trajectory) {
-    double ss = 0;
-    long long nobs = 0;
-    // Half the median frame interval around each flight's seen span.
-    std::vector<double> dts;
-    for (size_t i = 1; i < res.per_frame.size(); ++i) {
-      dts.push_back(res.per_frame[i].time_s - res.per_frame[i - 1].time_s);
-    }
-    const double margin =
-        0.5 * util::NearestRankPercentile(dts, 0.5);  // the upper middle; 0 if none
-    for (const recon::Flight& f : res.trajectory->flights) {
-      const Bundled b = BundleFlight(cameras, messages, f, to, o.sigma_px, margin);
-      if (!b.ok) continue;
-      ++res.bundled_flights;
-      ss += b.rms_px * b.rms_px * b.observations;
-      nobs += b.observations;
-      for (auto& s : res.track) {
-        if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
-        s.ball_in_world = b.model.PositionAt(s.time_s);
-        s.err_px = b.rms_px;
-        ++res.bundled_rows;
-      }
-    }
-    if (nobs > 0) res.bundle_rms_px = std::sqrt(ss / nobs);
+  if (o.bundle) {
+    FlightBundle b =
+        BundleFlights(cameras, messages, o.ball_diameter_m, o.ball_mass_kg, o.sigma_px, &res.track);
+    res.trajectory = std::move(b.trajectory);
+    res.bundled_flights = b.bundled_flights;
+    res.bundled_rows = b.bundled_rows;
+    res.bundle_rms_px = b.rms_px;
+  } else if (!o.flights.empty()) {
+    res.trajectory =
+        recon::AnalyzeTrajectory(res.per_frame, FlightOptions(o.ball_diameter_m, o.ball_mass_kg));
   }
   res.positions = static_cast<long long>(res.track.size());
   const std::string tmp = o.out + ".part";

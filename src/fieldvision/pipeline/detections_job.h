@@ -63,4 +63,21 @@ std::vector<CameraMessage> ParseDetections(const util::CsvTable& table, int came
 
 DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& options);
 
+// The flights of a per-frame track (time order), each refined on the cameras' candidates
+// (`messages`: per camera, in time order) by the physics-constrained bundle above; the track's
+// positions inside a refined flight become the flight model's (err_px: the flight's RMS), unless
+// the model explains the candidates much worse than the per-frame positions do (not a free
+// flight: a carried or deflected ball), which are then kept.
+struct FlightBundle {
+  std::optional<recon::TrajectoryResult> trajectory;
+  int bundled_flights = 0;
+  int kept_flights = 0;  // flights whose per-frame positions were kept
+  long long bundled_rows = 0;
+  double rms_px = 0.0;  // reprojection RMS of the candidates used
+};
+FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
+                           const std::vector<std::vector<CameraMessage>>& messages,
+                           double ball_diameter_m, double ball_mass_kg, double sigma_px,
+                           std::vector<recon::BallSample>* track);
+
 }  // namespace fv::pipeline
