@@ -58,7 +58,23 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
   }
   std::vector<char> use(x.size(), 1);
   Eigen::Vector3d at0, v;
-  for (size_t left = x.size();; --left) {
+  // Against the line of the older positions: the two newest both off it, the ball was kicked
+  // (the new line is theirs); the newest alone, it is on another object (dropped).
+  const size_t last = x.size() - 1;
+  if (last >= 3) {
+    std::vector<char> older(x.size(), 1);
+    older[last] = older[last - 1] = 0;
+    FitLine(tau, x, older, &at0, &v);
+    const auto off = [&](size_t i) { return (x[i] - (at0 + tau[i] * v)).norm() > o.outlier_m; };
+    if (off(last) && off(last - 1)) {
+      use = std::vector<char>(x.size(), 0);
+      use[last] = use[last - 1] = 1;
+    } else if (off(last)) {
+      use[last] = 0;
+    }
+  }
+  // Then the worst one dropped while it is off the line and more than two remain.
+  for (auto left = std::count(use.begin(), use.end(), 1);; --left) {
     FitLine(tau, x, use, &at0, &v);
     if (left <= 2) break;
     size_t worst = 0;

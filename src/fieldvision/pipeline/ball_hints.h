@@ -47,7 +47,8 @@ struct BallHintOptions {
   double airborne_m = 0.05;     // above a resting ball's centre by this much: in flight
   // The state is a line (a parabola in flight) fitted to the positions of the last fit_span_s
   // (each within max_gap_s of the next), dropping the worst one while it is farther than
-  // outlier_m from the fit (a position on another object) and more than two remain.
+  // outlier_m from the fit (a position on another object) and more than two remain; when the two
+  // newest are both dropped the ball was kicked, and the line is theirs.
   double fit_span_s = 0.1;
   double outlier_m = 0.15;
   void Check() const;  // throws fv::Error naming the bad field

@@ -113,6 +113,15 @@ TEST(BallHintBoard, APositionOnAnotherObjectDoesNotBendTheTrack) {
   EXPECT_LT((h->ball_in_world - Vector3d(0.5, 0, 0.11)).norm(), 1e-9);
   EXPECT_LT((h->velocity_mps - Vector3d(6, 0, 0)).norm(), 1e-6);
   EXPECT_NEAR(h->time_s, 5 / 60.0, 1e-12);
+  // Two positions off the track that agree with each other: the ball was kicked sideways.
+  BallHintBoard kicked(1, BallHintOptions{}, /*wait=*/false);
+  for (int f = 0; f < 4; ++f) kicked.Publish(f / 60.0, Vector3d(0.1 * f, 0, 0.11), 0.11);
+  kicked.Publish(4 / 60.0, Vector3d(0.3, 0.2, 0.11), 0.11);
+  kicked.Publish(5 / 60.0, Vector3d(0.3, 0.4, 0.11), 0.11);
+  const std::optional<BallHint> k = kicked.Get(0, 0);
+  ASSERT_TRUE(k);
+  EXPECT_LT((k->ball_in_world - Vector3d(0.3, 0.4, 0.11)).norm(), 1e-9);
+  EXPECT_LT((k->velocity_mps - Vector3d(0, 12, 0)).norm(), 1e-6);
 }
 
 TEST(ExpectBall, ProjectsTheBallAheadWithItsVelocityAndSize) {

@@ -80,6 +80,7 @@ class CameraStage::Track {
         (ExpectedCentre() - e.centre_px).norm() <= 2.0 * std::max(radius_, e.radius_px) + 2.0) {
       return;
     }
+    if (getenv("FV_DBG")) fprintf(stderr, "STEER act %d exp %.1f %.1f -> %.1f %.1f r %.1f\n", active_, ExpectedCentre().x(), ExpectedCentre().y(), e.centre_px.x(), e.centre_px.y(), e.radius_px);
     centre_ = e.centre_px - e.step_px;
     velocity_ = e.step_px;
     radius_ = std::max(e.radius_px, 2.0);
@@ -249,6 +250,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   m.time_s = in.time_s;
   const cv::Rect window = track_->Window(size_);
   bool full = window.empty();
+  long guided = -1;
   const cv::Mat* frame = Image(in, window);
   if (frame != nullptr) {
     CheckSize(frame->size(), in.frame);
@@ -256,7 +258,14 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       m.candidates = detector_(*frame, window);
       ++stats_.window_scans;
       full = !track_->Confirms(m.candidates);
-      if (!full) SearchBand(in, &m.candidates);
+      // Nothing accepted where the ball is expected: a guided fit there before the whole frame
+      // (a camera that sees the ball only that way would otherwise search every frame whole).
+      if (full) {
+        guided = AddGuided(*frame, &m.candidates);
+        full = guided < 0;
+      } else {
+        SearchBand(in, &m.candidates);
+      }
     }
     if (full && !window.empty()) frame = Image(in, cv::Rect());
     if (frame == nullptr) {
@@ -266,7 +275,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       ++stats_.full_scans;
     }
   }
-  const long guided = frame != nullptr ? AddGuided(*frame, &m.candidates) : -1;
+  if (guided < 0 && frame != nullptr) guided = AddGuided(*frame, &m.candidates);
   track_->Update(m.candidates, guided >= 0 ? &m.candidates[guided] : nullptr);
   ++stats_.frames;
   for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
