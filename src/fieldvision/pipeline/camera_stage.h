@@ -1,18 +1,18 @@
 // The camera stage of the ball pipeline: one camera's frames in, timestamped ball candidates out
 // (CameraMessage). It tracks the ball in the image and searches a window around where it is
 // expected (constant velocity in the image), decoding encoded frames (SourceFrame::jpeg) only
-// there; the whole frame when the window has no accepted candidate or its best one is not where
-// the ball was expected (another object took the window) and when the ball was not seen in the
-// previous frame. While tracking it looks for other balls too: the whole frame every
-// full_scan_every frames, each camera at its own phase (from its name) so that the cameras of a
-// rig do not all pay for it in the same frame; that search may be split into bands of rows, one a
-// frame besides the window, for a lower peak of work per frame (a latency spike on a live node)
-// at some more work on average (the bands overlap). When neither search accepts a ball where the
-// tracked one is expected, a guided fit (BallGuidedFn) looks for it at that place with its size,
-// for at most max_guided_frames frames in a row. With the fusion's hints (ball_hints.h) the
-// expected place is where the cameras together last saw the ball, when the image track
-// disagrees. The same stage serves the in-process
-// pipeline (ball_pipeline.h) and the camera node (net/node.h).
+// there. When the window has no accepted candidate where the ball is expected, a guided fit
+// (BallGuidedFn) looks for it at that place with its size (at most max_guided_frames frames in a
+// row); when that fails too (another object took the window) and when the ball was not seen in
+// the previous frame, the whole frame is searched. While tracking it looks for other balls too: the
+// whole frame every full_scan_every frames, each camera at its own phase (from its name) so that
+// the cameras of a rig do not all pay for it in the same frame; that search may be split into bands
+// of rows, one a frame besides the window, for a lower peak of work per frame (a latency spike on a
+// live node) at some more work on average (the bands overlap); after a whole-frame search without a
+// ball at the expected place the guided fit is tried there too. With the fusion's hints
+// (ball_hints.h) the expected place is where the cameras together last saw the ball, when the image
+// track disagrees. The same stage serves the in-process pipeline (ball_pipeline.h) and the camera
+// node (net/node.h).
 #pragma once
 
 #include <functional>
