@@ -80,7 +80,6 @@ class CameraStage::Track {
         (ExpectedCentre() - e.centre_px).norm() <= 2.0 * std::max(radius_, e.radius_px) + 2.0) {
       return;
     }
-    if (getenv("FV_DBG")) fprintf(stderr, "STEER act %d exp %.1f %.1f -> %.1f %.1f r %.1f\n", active_, ExpectedCentre().x(), ExpectedCentre().y(), e.centre_px.x(), e.centre_px.y(), e.radius_px);
     centre_ = e.centre_px - e.step_px;
     velocity_ = e.step_px;
     radius_ = std::max(e.radius_px, 2.0);
