@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fieldvision/detect/ball_fit.h"
+#include "fieldvision/detect/bilinear.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -17,32 +18,22 @@ using Eigen::Vector3d;
 
 constexpr double kStepPx = 0.25;  // profile sampling along a ray
 
-// BGR at (x, y), bilinear; false where the 2x2 neighbourhood leaves the image.
-bool Sample(const cv::Mat& img, double x, double y, Vector3d* bgr) {
-  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= img.cols || y0 + 1 >= img.rows) return false;
-  const double fx = x - x0, fy = y - y0;
-  const uint8_t* a = img.ptr<uint8_t>(y0) + 3 * static_cast<ptrdiff_t>(x0);
-  const uint8_t* b = img.ptr<uint8_t>(y0 + 1) + 3 * static_cast<ptrdiff_t>(x0);
-  for (int k = 0; k < 3; ++k) {
-    const double top = a[k] + fx * (a[k + 3] - a[k]);
-    const double bottom = b[k] + fx * (b[k + 3] - b[k]);
-    (*bgr)[k] = top + fy * (bottom - top);
-  }
-  return true;
-}
-
 // The strongest colour step along the ray c + t u, 0.6 r <= t <= 1.45 r (the step across 1 px,
 // the peak refined by a parabola), or nullopt when it is below min_step or the ray leaves the
 // image.
-std::optional<Vector2d> RayEdge(const cv::Mat& img, const Vector2d& c, const Vector2d& u, double r,
-                                double min_step) {
+std::optional<Vector2d> RayEdge(const cv::Mat& img, Sampler* sample, const Vector2d& c,
+                                const Vector2d& u, double r, double min_step) {
   const double t0 = 0.6 * r - 0.5, t1 = 1.45 * r + 0.5;
   const int n = static_cast<int>(std::floor((t1 - t0) / kStepPx)) + 1;
+  // The profile lies inside the image when both its ends do (Sampler::Inside).
+  if (!InsideForSampling(img, c + t0 * u) ||
+      !InsideForSampling(img, c + (t0 + (n - 1) * kStepPx) * u)) {
+    return std::nullopt;
+  }
   std::vector<Vector3d> profile(n);
   for (int i = 0; i < n; ++i) {
     const Vector2d p = c + (t0 + i * kStepPx) * u;
-    if (!Sample(img, p.x(), p.y(), &profile[i])) return std::nullopt;
+    sample->Inside(p.x(), p.y(), &profile[i]);
   }
   constexpr int kHalf = 2;  // samples in half a pixel
   int best = -1;
@@ -124,10 +115,11 @@ EdgeCircle FitEdgeCircle(const cv::Mat& bgr, const Vector2d& centre_px, double r
   const int rays = std::clamp(static_cast<int>(2 * M_PI * radius_px / 1.5), 16, 96);
   std::vector<Vector2d> pts;
   pts.reserve(rays);
+  Sampler sample(bgr);
   for (int k = 0; k < rays; ++k) {
     const double th = 2 * M_PI * k / rays;
-    const auto p =
-        RayEdge(bgr, centre_px, Vector2d(std::cos(th), std::sin(th)), radius_px, o.min_step);
+    const auto p = RayEdge(bgr, &sample, centre_px, Vector2d(std::cos(th), std::sin(th)), radius_px,
+                           o.min_step);
     if (p) pts.push_back(*p);
   }
   if (static_cast<int>(pts.size()) < rays / 2) return out;
