@@ -314,31 +314,41 @@ ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
       (r.space == ColourSpace::kHsv ? need_hsv : need_yuv) = true;
     }
   }
-  // One n x n image (b along columns, g along rows) per red level, converted by OpenCV.
-  cv::Mat bgr(n, n, CV_8UC3), hsv, yuv;
-  for (int ri = 0; ri < n; ++ri) {
-    for (int gi = 0; gi < n; ++gi) {
-      cv::Vec3b* row = bgr.ptr<cv::Vec3b>(gi);
-      for (int bi = 0; bi < n; ++bi) {
-        row[bi] = cv::Vec3b(uint8_t((bi << shift) + centre), uint8_t((gi << shift) + centre),
-                            uint8_t((ri << shift) + centre));
-      }
-    }
-    if (need_hsv) cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
-    if (need_yuv) cv::cvtColor(bgr, yuv, cv::COLOR_BGR2YUV);
-    uint8_t* out = table_.data() + size_t(ri) * n * n;
-    for (const auto& [bit, cr] : ranges) {
-      const cv::Mat& conv = cr.space == ColourSpace::kHsv ? hsv : yuv;
-      const uint8_t* p = conv.ptr<uint8_t>(0);  // continuous
-      const uint8_t* in0 = cr.in[0].data();
-      const uint8_t* in1 = cr.in[1].data();
-      const uint8_t* in2 = cr.in[2].data();
-      for (int i = 0; i < n * n; ++i) {
-        const uint8_t inside = in0[p[3 * i]] & in1[p[3 * i + 1]] & in2[p[3 * i + 2]];
-        out[i] |= uint8_t(bit * inside);
-      }
-    }
+  // One n x n image (b along columns, g along rows) per red level, converted by OpenCV; the red
+  // levels fill disjoint slices of the table, in parallel. OpenCV fills its own conversion tables
+  // on a first call without a lock: make that call here, before the threads.
+  {
+    const cv::Mat pixel(1, 1, CV_8UC3, cv::Scalar::all(0));
+    cv::Mat converted;
+    if (need_hsv) cv::cvtColor(pixel, converted, cv::COLOR_BGR2HSV_FULL);
+    if (need_yuv) cv::cvtColor(pixel, converted, cv::COLOR_BGR2YUV);
   }
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& red_levels) {
+    cv::Mat bgr(n, n, CV_8UC3), hsv, yuv;
+    for (int ri = red_levels.start; ri < red_levels.end; ++ri) {
+      for (int gi = 0; gi < n; ++gi) {
+        cv::Vec3b* row = bgr.ptr<cv::Vec3b>(gi);
+        for (int bi = 0; bi < n; ++bi) {
+          row[bi] = cv::Vec3b(uint8_t((bi << shift) + centre), uint8_t((gi << shift) + centre),
+                              uint8_t((ri << shift) + centre));
+        }
+      }
+      if (need_hsv) cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
+      if (need_yuv) cv::cvtColor(bgr, yuv, cv::COLOR_BGR2YUV);
+      uint8_t* out = table_.data() + size_t(ri) * n * n;
+      for (const auto& [bit, cr] : ranges) {
+        const cv::Mat& conv = cr.space == ColourSpace::kHsv ? hsv : yuv;
+        const uint8_t* p = conv.ptr<uint8_t>(0);  // continuous
+        const uint8_t* in0 = cr.in[0].data();
+        const uint8_t* in1 = cr.in[1].data();
+        const uint8_t* in2 = cr.in[2].data();
+        for (int i = 0; i < n * n; ++i) {
+          const uint8_t inside = in0[p[3 * i]] & in1[p[3 * i + 1]] & in2[p[3 * i + 2]];
+          out[i] |= uint8_t(bit * inside);
+        }
+      }
+    }
+  });
 }
 
 std::shared_ptr<const ColourTable> ColourTable::Shared(const ColourSpec& spec,
