@@ -110,6 +110,68 @@ TEST(ScanBlobs, CoarseStepFindsEachDiscOnceWithItsSize) {
   EXPECT_LT(half.blobs.size(), discs.size());
 }
 
+// Every step, image width (down to one sample a row) and region: the blobs are the 8-connected
+// components of the table's classes on the sample grid (ColourTable::ClassifyImage), with their
+// sample counts and bounds; for the exact and a quantised table.
+TEST(ScanBlobs, SampleGridComponentsForEveryStepWidthAndRegion) {
+  const uint64_t seed = fv::testing::TestSeed(23);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  for (int bits : {8, 6}) {
+    const ColourTable table(PresetColourSpec("orange"), bits);
+    for (int trial = 0; trial < 60; ++trial) {
+      const int w = rng.UniformInt(1, 70), h = rng.UniformInt(1, 40);
+      cv::Mat img(h, w, CV_8UC3);
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+          img.at<cv::Vec3b>(y, x) = rng.Uniform() < 0.4 ? kOrange : kGrass;
+        }
+      }
+      const int step = rng.UniformInt(1, 5);
+      const int rx = rng.UniformInt(0, w - 1), ry = rng.UniformInt(0, h - 1);
+      const cv::Rect region =
+          trial % 2 == 0 ? cv::Rect()
+                         : cv::Rect(rx, ry, rng.UniformInt(1, w - rx), rng.UniformInt(1, h - ry));
+      SCOPED_TRACE(::testing::Message() << "bits " << bits << " " << w << "x" << h << " step "
+                                        << step << " region " << region);
+      ScanOptions o;
+      o.step_px = step;
+      o.min_samples = 1;
+      const BlobScanResult r = ScanBlobs(img, table, table.BallBit(), o, cv::Mat(), region);
+      // The reference: the class on the grid offset + k * step within the region.
+      const cv::Rect roi = region.empty() ? cv::Rect(0, 0, w, h) : region;
+      const cv::Mat cls = table.ClassifyImage(img);
+      std::vector<int> xs, ys;
+      for (int x = step / 2; x < w; x += step) {
+        if (x >= roi.x && x < roi.x + roi.width) xs.push_back(x);
+      }
+      for (int y = step / 2; y < h; y += step) {
+        if (y >= roi.y && y < roi.y + roi.height) ys.push_back(y);
+      }
+      std::multiset<std::tuple<int, int, int, int, int>> ours, theirs;
+      for (const Blob& b : r.blobs) ours.insert({b.samples, b.x_min, b.y_min, b.x_max, b.y_max});
+      if (!xs.empty() && !ys.empty()) {
+        cv::Mat grid(static_cast<int>(ys.size()), static_cast<int>(xs.size()), CV_8U);
+        for (size_t j = 0; j < ys.size(); ++j) {
+          for (size_t i = 0; i < xs.size(); ++i) {
+            grid.at<uint8_t>(j, i) = (cls.at<uint8_t>(ys[j], xs[i]) & table.BallBit()) ? 255 : 0;
+          }
+        }
+        cv::Mat labels, stats, centroids;
+        const int n = cv::connectedComponentsWithStats(grid, labels, stats, centroids, 8);
+        for (int i = 1; i < n; ++i) {
+          const int* s = stats.ptr<int>(i);
+          const int x0 = s[cv::CC_STAT_LEFT], y0 = s[cv::CC_STAT_TOP];
+          theirs.insert({s[cv::CC_STAT_AREA], xs[x0], ys[y0], xs[x0 + s[cv::CC_STAT_WIDTH] - 1],
+                         ys[y0 + s[cv::CC_STAT_HEIGHT] - 1]});
+        }
+      }
+      EXPECT_EQ(ours, theirs);
+      EXPECT_EQ(r.samples, static_cast<long long>(xs.size() * ys.size()));
+    }
+  }
+}
+
 TEST(ScanBlobs, OptionsAreChecked) {
   ScanOptions o;
   o.step_px = 0;
