@@ -127,6 +127,9 @@ struct DetectionResidual {
   bool integrate_;
 };
 
+// A per-frame position this close to a flight's model lies on it (farther: 0.5 m off).
+constexpr double kNearM = 0.5;
+
 struct Bundled {
   bool ok = false;
   recon::FlightModel kind = recon::FlightModel::kGravity;
@@ -137,6 +140,9 @@ struct Bundled {
   double model_rms_at_frames_px = 0.0;
   double frames_rms_px = 0.0;
   int at_frames = 0;
+  // Per-frame positions within the flight's seen span, and those near the model (kNearM).
+  int span_frames = 0;
+  int near_frames = 0;
 };
 
 // A candidate of a flight's bundle.
@@ -151,7 +157,7 @@ struct FlightObservation {
 void CompareWithFrames(const std::vector<camera::Camera>& cameras,
                        const std::vector<FlightObservation>& obs,
                        const std::vector<recon::BallSample>& per_frame, double margin_s,
-                       Bundled* out) {
+                       double t_first_s, double t_last_s, Bundled* out) {
   double ss_model = 0, ss_frames = 0;
   for (const auto& o : obs) {
     auto at = std::lower_bound(per_frame.begin(), per_frame.end(), o.time_s,
@@ -169,6 +175,11 @@ void CompareWithFrames(const std::vector<camera::Camera>& cameras,
     ss_model += (*uv_model - o.uv).squaredNorm();
     ss_frames += (*uv_frame - o.uv).squaredNorm();
     ++out->at_frames;
+  }
+  for (const recon::BallSample& s : per_frame) {
+    if (s.time_s < t_first_s - 1e-9 || s.time_s > t_last_s + 1e-9) continue;
+    ++out->span_frames;
+    out->near_frames += (out->model.PositionAt(s.time_s) - s.ball_in_world).norm() <= kNearM;
   }
   if (out->at_frames > 0) {
     out->model_rms_at_frames_px = std::sqrt(ss_model / out->at_frames);
@@ -287,7 +298,7 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   }
   out.observations = static_cast<int>(obs.size());
   out.rms_px = std::sqrt(ss / obs.size());
-  CompareWithFrames(cameras, obs, per_frame, margin_s, &out);
+  CompareWithFrames(cameras, obs, per_frame, margin_s, f.t_first_seen_s, f.t_last_seen_s, &out);
   out.ok = out.model.p0_m.allFinite() && out.model.v0_mps.allFinite();
   return out;
 }
@@ -304,9 +315,13 @@ recon::TrajectoryOptions FlightOptions(double ball_diameter_m, double ball_mass_
 }  // namespace
 
 // A flight's model is kept when its RMS at the frames' moments is at most this times theirs plus
-// this many pixels.
+// this many pixels, and when at least kMinNearShare of the per-frame positions in its span lie
+// within kNearM of it: a "flight" through two places where the ball rested, taking the positions
+// between as outliers, passes candidates of other objects on its way and its RMS alone can look
+// good.
 constexpr double kMaxModelRmsRatio = 2.5;
 constexpr double kModelRmsSlackPx = 0.3;
+constexpr double kMinNearShare = 0.8;
 
 FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
                            const std::vector<std::vector<CameraMessage>>& messages,
@@ -330,7 +345,8 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
     // does (those fit 3 parameters to each frame's 4+ coordinates: RMS about 0.5-0.8 of the
     // model's); a ball carried, dribbled or deflected does not fit one and keeps its frames.
     if (!b.ok || b.at_frames == 0 ||
-        b.model_rms_at_frames_px > kMaxModelRmsRatio * b.frames_rms_px + kModelRmsSlackPx) {
+        b.model_rms_at_frames_px > kMaxModelRmsRatio * b.frames_rms_px + kModelRmsSlackPx ||
+        b.near_frames < kMinNearShare * b.span_frames) {
       ++out.kept_flights;
       continue;
     }
