@@ -11,6 +11,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/pipeline/detections_job.h"
+#include "fieldvision/pipeline/flight_refiner.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -210,21 +211,11 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
         det_files.back()->temp_path(),
         std::vector<std::string>{"frame", "time_s", "u", "v", "radius_px", "score"}));
   }
-  // Offline, each flight is refined at the end on the cameras' accepted candidates
-  // (detections_job.h's bundle) and the rows are written then; live, as the fusion gives them.
+  // Offline, each flight is refined on the cameras' accepted candidates (flight_refiner.h: piece
+  // by piece of the track, in bounded memory) and its rows written then; live, as the fusion gives
+  // them.
   const bool bundle = o.bundle && !o.live;
-  std::vector<std::vector<CameraMessage>> accepted(n);
-  if (!det_csvs.empty() || bundle) {
-    popt.on_message = [&](const CameraMessage& m) {
-      CameraMessage kept = m;
-      std::erase_if(kept.candidates, [](const recon::BallObservation& b) { return b.weak; });
-      if (!det_csvs.empty()) WriteDetections(kept, det_csvs.at(m.camera).get());
-      if (bundle) accepted.at(m.camera).push_back(std::move(kept));
-    };
-  }
-
   BallJobResult result;
-  std::vector<recon::BallSample> track;
   // Write to a temporary file beside the output, rename at the end: a failed run (a truncated
   // video, a bad timestamp) leaves neither a half file nor a temporary one.
   io::AtomicWrite(o.out, [&](const std::string& temp_path) {
@@ -235,21 +226,35 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
       csv.EndRow();
       ++result.rows_written;
     };
+    std::optional<FlightRefiner> refiner;
+    if (bundle) {
+      FlightRefinerOptions ro;
+      ro.ball_diameter_m = o.ball_diameter_m;
+      ro.sigma_px = o.bundle_sigma_px;
+      refiner.emplace(cameras, ro, write);
+    }
+    if (!det_csvs.empty() || refiner) {
+      popt.on_message = [&](const CameraMessage& m) {
+        CameraMessage kept = m;
+        std::erase_if(kept.candidates, [](const recon::BallObservation& b) { return b.weak; });
+        if (!det_csvs.empty()) WriteDetections(kept, det_csvs.at(m.camera).get());
+        if (refiner) refiner->AddMessage(std::move(kept));
+      };
+    }
     result.summary = RunBallPipelineTracked(
         cameras, sources, detect_fns, popt,
         [&](const BallFrame& f) {
           if (!f.result.ok()) return;
-          if (bundle) {
-            track.push_back(BallSampleOf(f));
+          if (refiner) {
+            refiner->AddSample(BallSampleOf(f));
           } else {
             write(BallSampleOf(f));
           }
         },
         guided_fns);
-    if (bundle) {
-      result.bundle =
-          BundleFlights(cameras, accepted, o.ball_diameter_m, 0.0, o.bundle_sigma_px, &track);
-      for (const recon::BallSample& s : track) write(s);
+    if (refiner) {
+      refiner->Finish();
+      result.bundle = refiner->totals();
     }
     csv.Close();
   });

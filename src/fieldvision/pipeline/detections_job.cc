@@ -360,6 +360,7 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
       ++out.bundled_rows;
     }
   }
+  out.observations = nobs;
   if (nobs > 0) out.rms_px = std::sqrt(ss / nobs);
   return out;
 }

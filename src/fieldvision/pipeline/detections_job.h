@@ -73,7 +73,8 @@ struct FlightBundle {
   int bundled_flights = 0;
   int kept_flights = 0;  // flights whose per-frame positions were kept
   long long bundled_rows = 0;
-  double rms_px = 0.0;  // reprojection RMS of the candidates used
+  double rms_px = 0.0;         // reprojection RMS of the candidates used
+  long long observations = 0;  // candidates used
 };
 FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
                            const std::vector<std::vector<CameraMessage>>& messages,
