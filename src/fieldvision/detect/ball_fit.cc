@@ -4,6 +4,9 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <mutex>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 #include <Eigen/Dense>
@@ -155,6 +158,25 @@ RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit, co
   return edge;
 }
 
+// SubpixelEdges's ray counts.
+constexpr int kMinRays = 24, kMaxRays = 180;
+
+// The directions (cos, sin) of SubpixelEdges's rays at 2 pi (k + 0.5) / rays, computed once for
+// each ray count (kMinRays..kMaxRays).
+const std::vector<std::pair<double, double>>& RayDirections(int rays) {
+  static std::array<std::once_flag, kMaxRays + 1> once;
+  static std::array<std::vector<std::pair<double, double>>, kMaxRays + 1> directions;
+  std::call_once(once[rays], [rays] {
+    auto& d = directions[rays];
+    d.resize(rays);
+    for (int k = 0; k < rays; ++k) {
+      const double th = 2 * M_PI * (k + 0.5) / rays;
+      d[k] = {std::cos(th), std::sin(th)};
+    }
+  });
+  return directions[rays];
+}
+
 // Sub-pixel outline: along each ray from `c`, search around the reference radius ref(theta)
 // for the outermost strong colour step from the ball to something else (EdgeAtPeak). Local
 // references keep shading and a changing background (a line just beyond the ball) from biasing
@@ -167,7 +189,8 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   // A degenerate reference (an ellipse or cone fit gone wild) gives no outline points.
   const double max_r = std::max(img.cols, img.rows);
   if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;
-  e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), 24, 180);
+  e.rays = std::clamp(static_cast<int>(std::lround(2 * M_PI * mean_radius)), kMinRays, kMaxRays);
+  const std::vector<std::pair<double, double>>& directions = RayDirections(e.rays);
   Sampler sample(img);
   std::vector<Vector3d> prof;
   std::vector<char> have;
@@ -175,7 +198,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
   std::vector<int> peaks;
   for (int k = 0; k < e.rays; ++k) {
     const double th = 2 * M_PI * (k + 0.5) / e.rays;
-    const Vector2d u(std::cos(th), std::sin(th));
+    const Vector2d u(directions[k].first, directions[k].second);
     const double r = ref(th);
     if (!std::isfinite(r) || r <= 0 || r > max_r) continue;
     const double half = std::max(2.0, 0.25 * r);
