@@ -22,8 +22,12 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-// sqrt(a) >= sqrt(b) for a, b >= 0, mostly without the square roots.
-inline bool SqrtGe(double a, double b) { return a >= b || std::sqrt(a) == std::sqrt(b); }
+// sqrt(a) >= sqrt(b) for a, b >= 0, mostly without the square roots: below b (1 - 1e-12) the
+// rounded roots differ (each is within an ulp of its root; the roots are over 1e-13 apart,
+// relatively).
+inline bool SqrtGe(double a, double b) {
+  return a >= b || (a >= b * (1 - 1e-12) && std::sqrt(a) == std::sqrt(b));
+}
 
 // sqrt(a) >= h for a >= 0, mostly without the square root: decided on a against h^2 away from it.
 class SqrtAtLeast {
