@@ -480,20 +480,66 @@ bool RobustCone(const std::vector<Vector2d>& pts, const camera::Camera& cam, dou
   const double f = std::sqrt(cam.fx * cam.fy);
   res->assign(n, 0.0);
   inl->resize(n);
-  auto select = [&](const Vector3d& ax, double al) {
+  const auto residual = [&](int i, const Vector3d& ax, double al) {
+    return (std::acos(std::clamp(rays[i].dot(ax), -1.0, 1.0)) - al) * f;
+  };
+  const auto select = [&](const Vector3d& ax, double al) {
     for (int i = 0; i < n; ++i) {
-      (*res)[i] = (std::acos(std::clamp(rays[i].dot(ax), -1.0, 1.0)) - al) * f;
+      (*res)[i] = residual(i, ax, al);
       (*inl)[i] = ok[i] && std::abs((*res)[i]) < thr;
     }
   };
+  // The inlier flags alone (the residuals are those of the next selection): a ray is an inlier
+  // when its angle to the axis lies in the band al -+ thr / f, decided on its cosine against the
+  // cosines of the band's ends, 1e-12 away from them (at least 1e-12 rad, far beyond the
+  // rounding of acos and of the residual), else by the residual. False when the band comes
+  // within 1e-6 of 0 or pi: then select.
+  const auto select_flags = [&](const Vector3d& ax, double al) {
+    const double lo = al - thr / f, hi = al + thr / f;
+    if (!(lo > 1e-6 && hi < M_PI - 1e-6)) return false;
+    const double c_lo = std::cos(hi), c_hi = std::cos(lo), eps = 1e-12;
+    for (int i = 0; i < n; ++i) {
+      const double c = std::clamp(rays[i].dot(ax), -1.0, 1.0);
+      if (c < c_lo - eps || c > c_hi + eps) {
+        (*inl)[i] = 0;
+      } else if (c > c_lo + eps && c < c_hi - eps) {
+        (*inl)[i] = ok[i];
+      } else {
+        (*inl)[i] = ok[i] && std::abs(residual(i, ax, al)) < thr;
+      }
+    }
+    return true;
+  };
+  // The cone of the last selection whose residuals are not in `res` yet.
+  bool res_pending = false;
+  Vector3d pending_axis = Vector3d::Zero();
+  double pending_alpha = 0;
+  const auto select_pending = [&](const Vector3d& ax, double al) {
+    res_pending = select_flags(ax, al);
+    if (res_pending) {
+      pending_axis = ax;
+      pending_alpha = al;
+    } else {
+      select(ax, al);
+    }
+  };
   if (axis0 != nullptr) {
-    select(*axis0, alpha0);
+    select_pending(*axis0, alpha0);
   } else {
     for (int i = 0; i < n; ++i) (*inl)[i] = (*inl)[i] && ok[i];
   }
   for (int round = 0; round < 3; ++round) {
-    if (!FitCone(rays, *inl, axis, alpha)) return false;
-    select(*axis, *alpha);
+    if (!FitCone(rays, *inl, axis, alpha)) {
+      if (res_pending) {
+        for (int i = 0; i < n; ++i) (*res)[i] = residual(i, pending_axis, pending_alpha);
+      }
+      return false;
+    }
+    if (round < 2) {
+      select_pending(*axis, *alpha);
+    } else {
+      select(*axis, *alpha);
+    }
   }
   return std::count(inl->begin(), inl->end(), 1) >= 3;
 }
