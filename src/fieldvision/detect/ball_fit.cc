@@ -375,7 +375,7 @@ void SortPolar(std::vector<std::pair<double, double>>* polar) {
   const auto rotation_start = [&v, n] {
     size_t downs = 0, start = n;
     for (size_t i = 0; i < n; ++i) {
-      const double a = v[i].first, b = v[(i + 1) % n].first;
+      const double a = v[i].first, b = v[i + 1 < n ? i + 1 : 0].first;
       if (!(a < b || b < a)) return n;  // equal or NaN
       if (b < a) {
         ++downs;
@@ -716,11 +716,11 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
     if (have_cone) {
       const ConeOutline outline(camera, axis, alpha);
       if (!outline.ok) break;
-      const Edges next = SubpixelEdges(
+      Edges next = SubpixelEdges(
           bgr, table, ball_bit, outline.centre, [&outline](double th) { return outline(th); },
           outline.mean_radius, o);
       if (next.points.size() < 5) break;
-      s->edges = next;
+      s->edges = std::move(next);
       s->inl.assign(s->edges.points.size(), 1);
     }
     Vector3d new_axis;
@@ -879,8 +879,8 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
   fit.inlier_fraction = fit.rays > 0 ? double(count) / fit.rays : 0.0;
   fit.sigma_px = CentreSigma(s.edges.points, s.inl, s.centre, rms);
   if (fit.blurred) fit.sigma_px = std::hypot(fit.sigma_px, 0.05 * fit.blur_length_px);
-  fit.edge_points = s.edges.points;
-  fit.edge_inlier = s.inl;
+  fit.edge_points = std::move(s.edges.points);
+  fit.edge_inlier = std::move(s.inl);
   return fit;
 }
 
