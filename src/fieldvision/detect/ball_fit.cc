@@ -601,16 +601,27 @@ bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* cen
     }
     if (count < 3) return false;
     for (int it = 0; it < 6; ++it) {
-      Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
-      Vector3d jtr = Vector3d::Zero();
+      // J^T J and J^T r of the rows j = (jx, jy, -1), as j j^T and j (len - r) sum them: the
+      // products with -1 are exact negations, each symmetric entry is summed once.
+      double xx = 0, xy = 0, yy = 0, x1 = 0, y1 = 0, n1 = 0, gx = 0, gy = 0, g1 = 0;
       for (int i = 0; i < n; ++i) {
         if (!(*inlier)[i]) continue;
         const Vector2d d = pts[i] - c;
         const double len = std::max(d.norm(), 1e-9);
-        const Vector3d j(-d.x() / len, -d.y() / len, -1.0);
-        jtj += j * j.transpose();
-        jtr += j * (len - r);
+        const double jx = -d.x() / len, jy = -d.y() / len, res = len - r;
+        xx += jx * jx;
+        xy += jx * jy;
+        yy += jy * jy;
+        x1 -= jx;
+        y1 -= jy;
+        n1 += 1.0;
+        gx += jx * res;
+        gy += jy * res;
+        g1 -= res;
       }
+      Eigen::Matrix3d jtj;
+      jtj << xx, xy, x1, xy, yy, y1, x1, y1, n1;
+      const Vector3d jtr(gx, gy, g1);
       const Vector3d step = -jtj.ldlt().solve(jtr);
       if (!step.allFinite()) return false;
       c += step.head<2>();
