@@ -46,6 +46,9 @@ void Setup(CLI::App& app, int& exit_code) {
   AddFusionOptions(cmd, o->triangulation);
   cmd->add_flag("!--no-flights", o->flights,
                 "Do not analyse flights (published on topic `flight` as each one closes)");
+  cmd->add_flag("!--no-hints", o->hints,
+                "Do not send the nodes hints (each fused position off the ground, where their "
+                "cameras then look for the ball)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     io::CheckOutputPath(o->out, o->cameras);

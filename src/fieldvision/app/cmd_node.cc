@@ -53,6 +53,9 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(-86400, 86400));
   cmd->add_flag("!--no-detect", o->detect,
                 "Send frames without looking for the ball (a latency baseline)");
+  cmd->add_flag("!--no-hints", o->hints,
+                "Ignore the fusion node's hints (where the cameras together saw the ball); by "
+                "default a camera that lost the ball looks there before searching the whole frame");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     pipeline::JobControl control;

@@ -92,6 +92,7 @@ std::string FuseSummary::ToString() const {
   }
   s += fmt::format("\n{} messages in {:.2f} s", messages, seconds);
   if (published > 0) s += fmt::format(", {} positions published", published);
+  if (hints_sent > 0) s += fmt::format(", {} hints sent to the nodes", hints_sent);
   if (!flights.empty()) {
     s += fmt::format("\n{} flights ({} published)", flights.size(), flights_published);
   }
@@ -198,7 +199,7 @@ std::optional<std::pair<std::string, std::string>> SenderOf(const Message& m) {
   if (const auto* k = std::get_if<SkipMessage>(&m)) return {{k->camera, k->session}};
   if (const auto* h = std::get_if<HelloMessage>(&m)) return {{h->camera, h->session}};
   if (const auto* b = std::get_if<ByeMessage>(&m)) return {{b->camera, b->session}};
-  return std::nullopt;  // a pong or a ball message
+  return std::nullopt;  // a pong, ball, flight or hint message
 }
 
 namespace {
@@ -225,6 +226,8 @@ class FuseServer {
   void Emit(const pipeline::SyncedFrame& group);
   FuseSummary::LatencyParts LatencyPartsOf(const pipeline::SyncedFrame& group, double latency_s);
   void PublishFlights();
+  // A hint (messages.h) to every node that has sent a message.
+  void SendHint(double time_s, const Eigen::Vector3d& ball_in_world);
   void ReportProgress(double now);
 
   const FuseOptions& o_;
@@ -236,6 +239,7 @@ class FuseServer {
   FuseSummary summary_;
   std::vector<std::string> names_;
   std::vector<std::string> sessions_;
+  std::vector<std::string> identities_;  // each camera's node (its ROUTER routing id), for hints
   std::set<std::string> warned_unknown_;
   std::string clock_kind_;  // "system" or "media", from the first frame
   zmq::context_t ctx_{1};
@@ -265,6 +269,7 @@ FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
     names_.push_back(cameras_[c].name);
   }
   sessions_.resize(n_);
+  identities_.resize(n_);
   timings_.resize(n_);
 }
 
@@ -333,6 +338,19 @@ void FuseServer::Emit(const pipeline::SyncedFrame& group) {
     if (pub_.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary_.published;
   }
   if (flight_worker_) flight_worker_->Add(pipeline::BallSampleOf(f));
+  if (o_.hints && !f.result.on_ground) SendHint(f.time_s, p);
+}
+
+void FuseServer::SendHint(double time_s, const Eigen::Vector3d& ball_in_world) {
+  const std::string bytes = Encode(HintMessage{time_s, ball_in_world.x(), ball_in_world.y(),
+                                               ball_in_world.z(), 0.5 * o_.ball_diameter_m});
+  for (const std::string& id : identities_) {
+    if (id.empty()) continue;
+    if (!router_.send(zmq::buffer(id), zmq::send_flags::sndmore | zmq::send_flags::dontwait)) {
+      continue;
+    }
+    if (router_.send(zmq::buffer(bytes), zmq::send_flags::dontwait)) ++summary_.hints_sent;
+  }
 }
 
 void FuseServer::PublishFlights() {
@@ -392,6 +410,7 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     return;
   }
   const int c = it->second;
+  identities_[c] = identity.to_string();
   if (sessions_[c] != session) {
     if (!sessions_[c].empty()) sync_->Restart(c);
     sessions_[c] = session;
@@ -447,8 +466,9 @@ void FuseServer::AddFrame(int c, const FrameMessage& f, double t1, double arriva
 void FuseServer::ReportProgress(double now) {
   if (now - last_report_ <= 0.5) return;
   last_report_ = now;
-  if (o_.control != nullptr)
+  if (o_.control != nullptr) {
     o_.control->Report({"fuse", fusion_->stats().frames, -1, "frames", ""});
+  }
   if (o_.progress) {
     std::cerr << fmt::format("\rfuse: {} frames, {} positions", fusion_->stats().frames,
                              summary_.rows_written)

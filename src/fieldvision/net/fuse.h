@@ -32,6 +32,9 @@ struct FuseOptions {
   bool flights = true;
   pipeline::LiveFlightsOptions flight_options;
   recon::TriangulationOptions triangulation;
+  // Each fused position off the ground goes back to every node as a hint (messages.h), where the
+  // camera stage looks for the ball (pipeline/ball_hints.h).
+  bool hints = true;
   bool progress = true;
   pipeline::JobControl* control =
       nullptr;  // optional: progress callback and stop check (e.g. Ctrl-C)
@@ -61,6 +64,7 @@ struct FuseSummary {
   pipeline::FusionStats fusion;
   long long rows_written = 0;
   long long published = 0;
+  long long hints_sent = 0;            // hint messages handed to the nodes' sockets
   std::vector<recon::Flight> flights;  // closed flights, in the order published
   long long flights_published = 0;
   std::vector<double> latency_s;  // capture -> fused, per frame fused (system clocks only)
@@ -77,8 +81,8 @@ struct FuseSummary {
 
 FuseSummary RunFuse(const FuseOptions& options);
 
-// The camera and session a node's message names; nullopt for a pong or a ball message (sent by
-// fuse, never to it).
+// The camera and session a node's message names; nullopt for a pong, ball, flight or hint message
+// (sent by fuse, never to it).
 std::optional<std::pair<std::string, std::string>> SenderOf(const Message& m);
 
 }  // namespace fv::net

@@ -68,6 +68,10 @@ struct Encoder {
             {"x_m", m.x_m},       {"y_m", m.y_m},       {"z_m", m.z_m},
             {"n_cams", m.n_cams}, {"err_px", m.err_px}, {"latency_s", m.latency_s}};
   }
+  json operator()(const HintMessage& m) const {
+    return {{"type", "hint"}, {"time_s", m.time_s}, {"x_m", m.x_m},
+            {"y_m", m.y_m},   {"z_m", m.z_m},       {"radius_m", m.radius_m}};
+  }
   json operator()(const FlightMessage& m) const {
     return {{"type", "flight"},
             {"index", m.index},
@@ -183,6 +187,16 @@ Message DecodeChecked(const void* data, size_t size) {
     m.n_cams = util::JsonInt(j, "n_cams", kCtx);
     m.err_px = Num(j, "err_px");
     m.latency_s = Num(j, "latency_s");
+    return m;
+  }
+  if (type == "hint") {
+    HintMessage m;
+    m.time_s = Num(j, "time_s");
+    m.x_m = Num(j, "x_m");
+    m.y_m = Num(j, "y_m");
+    m.z_m = Num(j, "z_m");
+    m.radius_m = Num(j, "radius_m");
+    FV_REQUIRE(m.radius_m > 0 && m.radius_m < 1, "message: 'radius_m' must be in (0, 1) m");
     return m;
   }
   if (type == "flight") {

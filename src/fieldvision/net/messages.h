@@ -14,6 +14,10 @@
 //   {"v":1,"type":"ping","camera":"cam1","session":"5f..","t0_s":..}
 //   {"v":1,"type":"bye","camera":"cam1","session":"5f..","frames":120}
 // fuse -> node: {"v":1,"type":"pong","t0_s":..,"t1_s":..,"t2_s":..}
+// fuse -> node: {"v":1,"type":"hint","time_s":..,"x_m":..,"y_m":..,"z_m":..,"radius_m":0.11}
+//   each fused position off the ground, to every node (pipeline/ball_hints.h: the node looks for
+//   the ball where the cameras together saw it); time_s on the fusion node's clock ("system") or
+//   the recording's ("media")
 // fuse PUB, topic "ball": {"v":1,"type":"ball","frame":12,"time_s":..,"x_m":..,"y_m":..,
 //   "z_m":..,"n_cams":3,"err_px":0.41,"latency_s":0.012}
 // fuse PUB, topic "flight", each flight once it has closed (the next one has begun, or the track
@@ -97,6 +101,13 @@ struct BallMessage {
   double latency_s = 0;  // fuse clock at publication - capture time (system clocks only)
 };
 
+// Where the cameras together saw the ball (fuse -> node).
+struct HintMessage {
+  double time_s = 0;
+  double x_m = 0, y_m = 0, z_m = 0;
+  double radius_m = 0.11;
+};
+
 // A flight (an airborne arc between two contacts) once it has closed (pipeline/live_flights.h).
 struct FlightMessage {
   long long index = 0;     // from 0 in this fusion run
@@ -115,7 +126,7 @@ struct FlightMessage {
 };
 
 using Message = std::variant<HelloMessage, FrameMessage, SkipMessage, PingMessage, PongMessage,
-                             ByeMessage, BallMessage, FlightMessage>;
+                             ByeMessage, BallMessage, FlightMessage, HintMessage>;
 
 // Why a message was refused (Decode throws MessageError).
 class MessageError : public Error {

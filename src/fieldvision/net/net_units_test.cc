@@ -106,6 +106,23 @@ TEST(Messages, SkipRoundTripsAndBadTimingsAreRefused) {
   EXPECT_THROW(Decode(negative.data(), negative.size()), MessageError);
 }
 
+TEST(Messages, HintRoundTripsAndABadRadiusIsRefused) {
+  const HintMessage h{1764612345.25, 1.5, -2.25, 0.75, 0.11};
+  const std::string bytes = Encode(h);
+  const Message m = Decode(bytes.data(), bytes.size());
+  const auto* back = std::get_if<HintMessage>(&m);
+  ASSERT_NE(back, nullptr);
+  EXPECT_EQ(back->time_s, h.time_s);
+  EXPECT_EQ(back->x_m, h.x_m);
+  EXPECT_EQ(back->y_m, h.y_m);
+  EXPECT_EQ(back->z_m, h.z_m);
+  EXPECT_EQ(back->radius_m, h.radius_m);
+  EXPECT_EQ(ReasonOf(R"({"v":1,"type":"hint","time_s":1,"x_m":0,"y_m":0,"z_m":1,"radius_m":0})"),
+            MessageError::Reason::kMalformed);
+  EXPECT_EQ(ReasonOf(R"({"v":1,"type":"hint","time_s":1,"x_m":0,"y_m":0,"radius_m":0.1})"),
+            MessageError::Reason::kMalformed);
+}
+
 TEST(Messages, RefusalsSayWhy) {
   using R = MessageError::Reason;
   EXPECT_EQ(ReasonOf(std::string(kMaxMessageBytes + 1, '{')), R::kOversized);
@@ -155,6 +172,7 @@ TEST(FuseStages, SenderOfNamesCameraAndSessionOfNodeMessages) {
   EXPECT_EQ(SenderOf(b), (std::pair<std::string, std::string>{"right", "s2"}));
   EXPECT_FALSE(SenderOf(PongMessage{}).has_value());
   EXPECT_FALSE(SenderOf(BallMessage{}).has_value());
+  EXPECT_FALSE(SenderOf(HintMessage{}).has_value());
 }
 
 }  // namespace

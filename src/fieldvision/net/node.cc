@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -71,6 +72,10 @@ std::string NodeSummary::ToString() const {
         "\nwork per frame (decoding, detection): p50 {:.1f} ms, p95 {:.1f} ms, max {:.1f} ms",
         1e3 * process_p50_s, 1e3 * process_p95_s, 1e3 * process_max_s);
   }
+  if (hints > 0) {
+    s += fmt::format("\n{} ball positions from the fusion node (hints), {} balls fitted there",
+                     hints, stage.guided);
+  }
   if (bad_replies > 0) s += fmt::format("\n{} bad replies ignored", bad_replies);
   s += fmt::format("\n{:.2f} s", seconds);
   return s;
@@ -87,8 +92,16 @@ std::string NewSession() {
 // inproc pair, pings the fusion node and keeps the clock estimate.
 class NodeLink {
  public:
-  NodeLink(zmq::context_t& ctx, const NodeOptions& o, std::string camera, std::string session)
-      : ctx_(ctx), o_(o), camera_(std::move(camera)), session_(std::move(session)) {
+  // `hints`: where the fusion node's hints go (null: ignored); `system_clock`: frame times are
+  // this machine's clock (else the recording's, as the fusion node's).
+  NodeLink(zmq::context_t& ctx, const NodeOptions& o, std::string camera, std::string session,
+           pipeline::BallHintBoard* hints, bool system_clock)
+      : ctx_(ctx),
+        o_(o),
+        camera_(std::move(camera)),
+        session_(std::move(session)),
+        hints_(hints),
+        system_clock_(system_clock) {
     // Bind the pair before the thread connects to it (inproc needs the bind first).
     to_link_ = zmq::socket_t(ctx_, zmq::socket_type::pair);
     to_link_.set(zmq::sockopt::sndhwm, 64);
@@ -96,7 +109,12 @@ class NodeLink {
     to_link_.bind("inproc://node-link");
     thread_ = std::thread([this] { Run(); });
   }
-  ~NodeLink() { Finish(); }
+  ~NodeLink() {
+    try {
+      Finish();
+    } catch (const std::exception&) {  // a socket error while unwinding: the thread is gone
+    }
+  }
 
   // From the main thread: a message for the fusion node; false when dropped (link busy).
   bool Send(const std::string& bytes) {
@@ -118,8 +136,21 @@ class NodeLink {
   std::atomic<int> samples{0};
   std::atomic<double> round_trip_s{0};
   std::atomic<long long> frames_for_bye{0};  // set by the main thread before Finish
+  std::atomic<long long> hints_used{0};
 
  private:
+  // A fusion node's hint, on this node's frame clock, to the camera stage's board.
+  void TakeHint(const HintMessage& h) {
+    if (hints_ == nullptr) return;
+    double time_s = h.time_s;
+    if (system_clock_) {
+      if (!has_offset_) return;
+      time_s -= offset_s_ + o_.clock_offset_s;  // fuse clock -> this node's frame clock
+    }
+    hints_->Publish(time_s, Eigen::Vector3d(h.x_m, h.y_m, h.z_m), h.radius_m);
+    ++hints_used;
+  }
+
   void Run() {
     zmq::socket_t from_main(ctx_, zmq::socket_type::pair);
     from_main.connect("inproc://node-link");
@@ -154,6 +185,8 @@ class NodeLink {
                 samples = clock.samples();
                 has_offset_ = true;
               }
+            } else if (const auto* hint = std::get_if<HintMessage>(&m)) {
+              TakeHint(*hint);
             }
           } catch (const Error&) {
             ++bad_replies;
@@ -195,6 +228,8 @@ class NodeLink {
   std::string camera_, session_;
   zmq::socket_t to_link_;
   std::thread thread_;
+  pipeline::BallHintBoard* hints_;
+  bool system_clock_;
   std::atomic<bool> has_offset_{false};
   std::atomic<double> offset_s_{0};
 };
@@ -246,6 +281,7 @@ void AddLinkSummary(const NodeLink& link, NodeSummary& summary) {
   summary.offset_s = link.offset_s();
   summary.round_trip_s = link.round_trip_s;
   summary.clock_samples = link.samples;
+  summary.hints = link.hints_used;
 }
 
 }  // namespace
@@ -279,15 +315,23 @@ NodeSummary RunNode(const NodeOptions& o) {
     warm.Process(WarmUpFrame(size, source->encoded()));
   }
 
+  std::optional<pipeline::BallHintBoard> hints;
+  if (o.hints && o.detect) {
+    pipeline::BallHintOptions ho;
+    ho.steer_tracking = false;
+    hints.emplace(1, ho, /*wait=*/false);
+    stage.SetHints(&*hints);
+  }
+
   NodeSummary summary;
   summary.camera = camera.name;
   const auto start = std::chrono::steady_clock::now();
   zmq::context_t ctx(1);
   const std::string session = NewSession();
   {
-    NodeLink link(ctx, o, camera.name, session);
-    WaitForClock(link, o);
     const bool system_clock = source->live();
+    NodeLink link(ctx, o, camera.name, session, hints ? &*hints : nullptr, system_clock);
+    WaitForClock(link, o);
     util::Progress progress("node " + camera.name,
                             o.max_frames > 0 ? o.max_frames : source->FrameCount(), "frames",
                             o.progress);

@@ -30,8 +30,11 @@ struct NodeOptions {
   std::string colour = "orange";
   std::string field;  // optional: look for the ball only over this field
   pipeline::BallTrackOptions track;
-  long long max_frames = 0;   // 0: all
-  bool detect = true;         // false: send frames without candidates (a latency baseline)
+  long long max_frames = 0;  // 0: all
+  bool detect = true;        // false: send frames without candidates (a latency baseline)
+  // A camera that lost the ball looks for it where the fusion node's newest hint (messages.h,
+  // pipeline/ball_hints.h) puts it, before searching the whole frame.
+  bool hints = true;
   double connect_wait_s = 5;  // wait this long for the fusion node's first clock reply
   double ping_interval_s = 0.5;
   // Added to this node's clock: simulates a machine whose clock is off (tests, benchmarks).
@@ -53,6 +56,7 @@ struct NodeSummary {
   double offset_s = 0;        // fuse clock - node clock
   double round_trip_s = 0;    // of the sample used
   long long bad_replies = 0;  // replies that were not valid messages
+  long long hints = 0;        // hints from the fusion node used
   pipeline::CameraStageStats stage;
   double process_p50_s = 0, process_p95_s = 0, process_max_s = 0;  // work per frame
   double seconds = 0;

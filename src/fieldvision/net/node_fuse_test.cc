@@ -6,9 +6,11 @@
 #include <cmath>
 #include <filesystem>
 #include <future>
+#include <iostream>
 #include <map>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <zmq.hpp>
 
@@ -130,6 +132,8 @@ FuseOptions LoopbackFuse(const Scene& scene, const std::string& out) {
   // A loaded test machine (or a sanitizer build) may run a node late; wait for it.
   fo.sync.max_wait_s = 3.0 * fv::testing::SlowdownFactor();
   fo.progress = false;
+  // As the offline job the positions are compared with: the nodes get no hints.
+  fo.hints = false;
   return fo;
 }
 
@@ -189,6 +193,61 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   ASSERT_EQ(fused.flights.size(), whole.flights.size()) << whole.Summary();
   EXPECT_EQ(fused.flights_published, 0);  // no --publish
   EXPECT_LT((fused.flights[0].origin_m - whole.flights[0].origin_m).norm(), 0.05);
+}
+
+// With hints (the default) the fusion node hands each position off the ground back to every
+// node, which converts its time to its own clock (node 1's is 80 ms ahead) and looks for the ball
+// there: every node uses them, and the positions stay those of the offline job where both have
+// one, none lost.
+TEST(NodeFuse, HintsReachEveryNodeOnItsOwnClock) {
+  const uint64_t seed = testing::TestSeed(9);
+  FV_SEED_TRACE(seed);
+  const Scene scene = WriteKick(seed);
+  const auto offline = OfflineBall(scene);
+  ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
+
+  FuseOptions fo = LoopbackFuse(scene, "hinted.csv");
+  fo.hints = true;
+  FuseSummary fused;
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
+  const double start_at = io::SystemClockNow() + 1.0 * fv::testing::SlowdownFactor();
+  std::vector<NodeSummary> nodes(scene.cameras.size());
+  std::vector<std::thread> threads;
+  for (size_t c = 0; c < scene.cameras.size(); ++c) {
+    threads.emplace_back([&, c] {
+      NodeOptions no = PlaybackNode(scene, c, endpoint, start_at);
+      no.clock_offset_s = c == 1 ? 0.080 : 0.0;
+      nodes[c] = RunNode(no);
+    });
+  }
+  for (auto& t : threads) t.join();
+  fuse.join();
+  SCOPED_TRACE(fused.ToString());
+  EXPECT_GT(fused.hints_sent, 0);
+  for (const NodeSummary& n : nodes) {
+    SCOPED_TRACE(n.ToString());
+    EXPECT_GT(n.hints, 0);
+  }
+  const auto live = ReadBall(fo.out);
+  EXPECT_GE(live.size(), offline.size());
+  // Against the scene's truth, as accurate as the offline job without hints.
+  const util::CsvTable truth = util::CsvTable::Read(scene.dir + "/truth.csv");
+  const auto mean_error = [&](const std::map<long long, Row>& rows) {
+    double sum = 0;
+    for (size_t r = 0; r < truth.rows(); ++r) {
+      const auto it = rows.find(truth.GetInt(r, "frame"));
+      if (it == rows.end()) continue;
+      sum += std::hypot(it->second.x - truth.GetDouble(r, "x_m"),
+                        it->second.y - truth.GetDouble(r, "y_m"),
+                        it->second.z - truth.GetDouble(r, "z_m"));
+    }
+    return rows.empty() ? 0.0 : sum / static_cast<double>(rows.size());
+  };
+  std::cout << fmt::format(
+      "hints: {} positions, mean error {:.2f} mm; offline without: {}, {:.2f} mm\n", live.size(),
+      1e3 * mean_error(live), offline.size(), 1e3 * mean_error(offline));
+  EXPECT_LT(mean_error(live), mean_error(offline) + 0.002);
 }
 
 // Node 2 is stopped after 8 of the 30 frames and started again (a new session, as after a
