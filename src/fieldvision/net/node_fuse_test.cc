@@ -137,19 +137,12 @@ FuseOptions LoopbackFuse(const Scene& scene, const std::string& out) {
   return fo;
 }
 
-TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
-  const uint64_t seed = testing::TestSeed(3);
-  FV_SEED_TRACE(seed);
-  const Scene scene = WriteKick(seed);
-  const auto offline = OfflineBall(scene);
-  ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
-
-  FuseOptions fo = LoopbackFuse(scene, "live.csv");
-  FuseSummary fused;
+// Runs a fusion node with `fo` and one playback node per camera of `scene` (node 1's clock
+// `offset_s` ahead) until all end; returns the nodes' summaries.
+std::vector<NodeSummary> RunLoopback(const Scene& scene, FuseOptions& fo, double offset_s,
+                                     FuseSummary* fused) {
   std::thread fuse;
-  const std::string endpoint = StartFuse(fo, &fused, &fuse);
-
-  const double offset_s = 0.080;  // node 1's clock is 80 ms ahead
+  const std::string endpoint = StartFuse(fo, fused, &fuse);
   // Every node connected by then (a sanitizer build takes longer to start a node).
   const double start_at = io::SystemClockNow() + 1.0 * fv::testing::SlowdownFactor();
   std::vector<NodeSummary> nodes(scene.cameras.size());
@@ -163,6 +156,20 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   }
   for (auto& t : threads) t.join();
   fuse.join();
+  return nodes;
+}
+
+TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
+  const uint64_t seed = testing::TestSeed(3);
+  FV_SEED_TRACE(seed);
+  const Scene scene = WriteKick(seed);
+  const auto offline = OfflineBall(scene);
+  ASSERT_GE(offline.size(), 10u) << "too few positions to compare";
+
+  FuseOptions fo = LoopbackFuse(scene, "live.csv");
+  FuseSummary fused;
+  const double offset_s = 0.080;  // node 1's clock is 80 ms ahead
+  const std::vector<NodeSummary> nodes = RunLoopback(scene, fo, offset_s, &fused);
 
   for (size_t c = 0; c < nodes.size(); ++c) {
     SCOPED_TRACE(nodes[c].ToString());
@@ -197,8 +204,8 @@ TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
 
 // With hints (the default) the fusion node hands each position off the ground back to every
 // node, which converts its time to its own clock (node 1's is 80 ms ahead) and looks for the ball
-// there: every node uses them, and the positions stay those of the offline job where both have
-// one, none lost.
+// there once it lost it: every node gets them, no position is lost and the positions are as
+// accurate as the offline job's without hints.
 TEST(NodeFuse, HintsReachEveryNodeOnItsOwnClock) {
   const uint64_t seed = testing::TestSeed(9);
   FV_SEED_TRACE(seed);
@@ -209,20 +216,7 @@ TEST(NodeFuse, HintsReachEveryNodeOnItsOwnClock) {
   FuseOptions fo = LoopbackFuse(scene, "hinted.csv");
   fo.hints = true;
   FuseSummary fused;
-  std::thread fuse;
-  const std::string endpoint = StartFuse(fo, &fused, &fuse);
-  const double start_at = io::SystemClockNow() + 1.0 * fv::testing::SlowdownFactor();
-  std::vector<NodeSummary> nodes(scene.cameras.size());
-  std::vector<std::thread> threads;
-  for (size_t c = 0; c < scene.cameras.size(); ++c) {
-    threads.emplace_back([&, c] {
-      NodeOptions no = PlaybackNode(scene, c, endpoint, start_at);
-      no.clock_offset_s = c == 1 ? 0.080 : 0.0;
-      nodes[c] = RunNode(no);
-    });
-  }
-  for (auto& t : threads) t.join();
-  fuse.join();
+  const std::vector<NodeSummary> nodes = RunLoopback(scene, fo, 0.080, &fused);
   SCOPED_TRACE(fused.ToString());
   EXPECT_GT(fused.hints_sent, 0);
   for (const NodeSummary& n : nodes) {
