@@ -6,6 +6,7 @@
 // whole (the baseline, measured in the same process), the stage searching every frame whole, and
 // the stage's search for other balls (the whole frame every 20 frames) split into 2 or 20 bands
 // of rows, one a frame (--scan-bands; `p95_ms`, `max_ms`: the peaks of work per frame).
+// The decoding alone: whole, and a window at the top, middle and bottom of the frame.
 // Counters from the thread's CPU time (robust on a loaded machine): ms per frame and
 // `cores_4x60`, the cores 4 cameras at 60 fps need for this work (2 cores: must stay under 2,
 // with room for the fusion node and the system). One thread (cv::setNumThreads(1)).
@@ -102,6 +103,29 @@ void BM_DecodeWhole(benchmark::State& state) {
   SetCounters(state, total);
 }
 BENCHMARK(BM_DecodeWhole)->Unit(benchmark::kMillisecond);
+
+// An 80 x 80 window (a tracked ball) whose top is at state.range(0) % of the frame's height: the
+// rows above it are entropy-decoded all the same (a JPEG without restart markers has no other way
+// to reach them), only the inverse DCT and colour conversion are saved; this bounds what tracking
+// can save on decoding.
+void BM_DecodeWindow(benchmark::State& state) {
+  const Clip& c = KickClip();
+  fv::io::JpegRegionDecoder decoder;
+  cv::Mat bgr;
+  const cv::Rect window(600, static_cast<int>(state.range(0) * (c.camera.height - 80) / 100), 80,
+                        80);
+  size_t i = 0;
+  double total = 0;
+  for (auto _ : state) {
+    const auto& f = c.frames[i++ % c.frames.size()];
+    const double t0 = CpuSeconds();
+    decoder.Decode(f.jpeg.data(), f.jpeg.size(), window, &bgr, "bench frame");
+    total += CpuSeconds() - t0;
+  }
+  SetCounters(state, total);
+  state.SetLabel(fmt::format("window rows {}..{}", window.y, window.y + window.height));
+}
+BENCHMARK(BM_DecodeWindow)->Arg(0)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond);
 
 // state.range(0): 0 every frame whole, else the tracking window and the whole frame every 20
 // frames in this many bands (1: the node's default).
