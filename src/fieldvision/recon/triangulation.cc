@@ -85,6 +85,8 @@ void TriangulationOptions::Check() const {
   FV_REQUIRE(weak_max_radius_ratio == 0.0 || weak_max_radius_ratio > 1.0,
              "TriangulationOptions.weak_max_radius_ratio must be 0 (off) or > 1 (got {})",
              weak_max_radius_ratio);
+  CheckNonNegative(radius_sigma_factor, "TriangulationOptions.radius_sigma_factor");
+  CheckNonNegative(radius_tolerance, "TriangulationOptions.radius_tolerance");
   FV_REQUIRE(min_views_all_weak == 0 || min_views_all_weak >= 2,
              "TriangulationOptions.min_views_all_weak must be 0 (never) or >= 2 (got {})",
              min_views_all_weak);

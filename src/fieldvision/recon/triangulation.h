@@ -107,6 +107,13 @@ struct TriangulationOptions {
   // anew), as a static ghost seen by that many cameras is rare (and fusion's hover filter drops
   // it). 0: never.
   int prior_override_views = 3;
+  // When the detector reports radius_px: a view whose radius differs from the one expected at the
+  // refined point by more than radius_tolerance (a share of the expected radius) plus 0.5 px has
+  // the rest (times radius_sigma_factor) added to its centre's sigma and the point is refined
+  // again. A circle fitted to part of the ball (its lit side, its shaded side lost against the
+  // background) is smaller and its centre off by about as much; 0: off.
+  double radius_sigma_factor = 1.0;
+  double radius_tolerance = 0.1;
 
   void Check() const;  // throws fv::Error naming the bad field
 };

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <ceres/ceres.h>
 #include <fmt/format.h>
@@ -119,6 +120,46 @@ void Refine(const std::vector<camera::Camera>& cameras, const std::vector<View>&
   result->point_world = *p;
 }
 
+// The ball's image radius at `p` in `cam`: the mean distance from its centre's projection to
+// those of two points a ball radius away across the viewing ray (lens distortion included).
+std::optional<double> ExpectedRadiusPx(const camera::Camera& cam, const Eigen::Vector3d& p,
+                                       double radius_m) {
+  const auto centre = cam.Project(p);
+  if (!centre) return std::nullopt;
+  const Eigen::Vector3d ray = (p - cam.CentreInWorld()).normalized();
+  const Eigen::Vector3d across = ray.unitOrthogonal();
+  double sum = 0;
+  for (const Eigen::Vector3d& d : {across, ray.cross(across)}) {
+    const auto edge = cam.Project(p + radius_m * d);
+    if (!edge) return std::nullopt;
+    sum += (*edge - *centre).norm();
+  }
+  return 0.5 * sum;
+}
+
+// The views with each centre's sigma grown by its radius' unexplained difference from the one
+// expected at `p` (TriangulationOptions::radius_sigma_factor); nullopt when none differs.
+std::optional<std::vector<View>> SizeWeightedViews(const std::vector<camera::Camera>& cameras,
+                                                   const std::vector<View>& views,
+                                                   const Eigen::Vector3d& p,
+                                                   const TriangulationOptions& o) {
+  if (o.radius_sigma_factor <= 0 || o.ball_radius_m <= 0) return std::nullopt;
+  std::vector<View> out = views;
+  bool changed = false;
+  for (View& v : out) {
+    if (v.observation.radius_px <= 0) continue;
+    const auto expected = ExpectedRadiusPx(cameras[v.camera], p, o.ball_radius_m);
+    if (!expected) continue;
+    const double excess =
+        std::abs(v.observation.radius_px - *expected) - o.radius_tolerance * *expected - 0.5;
+    if (!(excess > 0)) continue;
+    v.observation.sigma_px = std::hypot(v.observation.sigma_px, o.radius_sigma_factor * excess);
+    changed = true;
+  }
+  if (!changed) return std::nullopt;
+  return out;
+}
+
 TriangulationResult TriangulateViews(const std::vector<camera::Camera>& cameras,
                                      const std::vector<View>& views,
                                      const std::vector<int>& candidate_index,
@@ -161,6 +202,9 @@ TriangulationResult TriangulateViews(const std::vector<camera::Camera>& cameras,
     return result;
   }
   Refine(cameras, views, candidate_index, false, o, &p, &result);
+  if (const auto weighted = SizeWeightedViews(cameras, views, p, o)) {
+    Refine(cameras, *weighted, candidate_index, false, o, &p, &result);
+  }
   result.status = InFrontOfAll(cameras, views, p, o.min_depth_m)
                       ? TriangulationStatus::kOk
                       : TriangulationStatus::kBehindCamera;
