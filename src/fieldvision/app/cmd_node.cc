@@ -55,7 +55,8 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Send frames without looking for the ball (a latency baseline)");
   cmd->add_flag("!--no-hints", o->hints,
                 "Ignore the fusion node's hints (where the cameras together saw the ball); by "
-                "default a camera that lost the ball looks there before searching the whole frame");
+                "default the camera looks there when its own track lost the ball or follows "
+                "something else, as the offline `ball` does");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     pipeline::JobControl control;

@@ -317,9 +317,7 @@ NodeSummary RunNode(const NodeOptions& o) {
 
   std::optional<pipeline::BallHintBoard> hints;
   if (o.hints && o.detect) {
-    pipeline::BallHintOptions ho;
-    ho.steer_tracking = false;
-    hints.emplace(1, ho, /*wait=*/false);
+    hints.emplace(1, pipeline::BallHintOptions(), /*wait=*/false);
     stage.SetHints(&*hints);
   }
 

@@ -32,8 +32,9 @@ struct NodeOptions {
   pipeline::BallTrackOptions track;
   long long max_frames = 0;  // 0: all
   bool detect = true;        // false: send frames without candidates (a latency baseline)
-  // A camera that lost the ball looks for it where the fusion node's newest hint (messages.h,
-  // pipeline/ball_hints.h) puts it, before searching the whole frame.
+  // The camera looks for the ball where the fusion node's newest hint (messages.h,
+  // pipeline/ball_hints.h) puts it when its own track has lost it or follows something else, as
+  // the offline `ball` does.
   bool hints = true;
   double connect_wait_s = 5;  // wait this long for the fusion node's first clock reply
   double ping_interval_s = 0.5;

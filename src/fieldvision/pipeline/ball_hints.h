@@ -51,10 +51,6 @@ struct BallHintOptions {
   // newest are both dropped the ball was kicked, and the line is theirs.
   double fit_span_s = 0.1;
   double outlier_m = 0.15;
-  // Whether a hint may move a camera's window off the ball its own track follows (offline: the
-  // hint is exactly lag_messages old); false: only a camera that lost the ball looks where the
-  // hint puts it (a camera node, whose hints come late and at an uneven pace).
-  bool steer_tracking = true;
   void Check() const;  // throws fv::Error naming the bad field
 };
 

@@ -74,11 +74,10 @@ class CameraStage::Track {
   bool MayGuide() const { return o_.enabled && active_ && guided_run_ < o_.max_guided_frames; }
   Eigen::Vector2d ExpectedCentre() const { return centre_ + velocity_; }
   // Where the fusion expects the ball: taken unless the track expects it there too.
-  // `while_tracking`: also when the track follows something else.
-  void Steer(const ExpectedBall& e, bool while_tracking) {
+  void Steer(const ExpectedBall& e) {
     if (!o_.enabled) return;
-    if (active_ && (!while_tracking || (ExpectedCentre() - e.centre_px).norm() <=
-                                           2.0 * std::max(radius_, e.radius_px) + 2.0)) {
+    if (active_ &&
+        (ExpectedCentre() - e.centre_px).norm() <= 2.0 * std::max(radius_, e.radius_px) + 2.0) {
       return;
     }
     centre_ = e.centre_px - e.step_px;
@@ -239,9 +238,7 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
   const double dt_s = stats_.frames > 0 ? in.time_s - last_time_s_ : 0.0;
   last_time_s_ = in.time_s;
   if (!hint) return;
-  if (auto e = ExpectBall(*hint, camera_, in.time_s, dt_s, hints_->options())) {
-    track_->Steer(*e, hints_->options().steer_tracking);
-  }
+  if (auto e = ExpectBall(*hint, camera_, in.time_s, dt_s, hints_->options())) track_->Steer(*e);
 }
 
 CameraMessage CameraStage::Process(const io::SourceFrame& in) {
