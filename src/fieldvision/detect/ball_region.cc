@@ -39,28 +39,6 @@ void BitMaskRow(const uint8_t* __restrict k, int n, uint8_t bit, uint8_t* __rest
   for (int x = 0; x < n; ++x) m[x] = (k[x] & bit) != 0 ? 255 : 0;
 }
 
-// The class bits of n consecutive pixels of a BGR row (ColourTable::ClassifyRow with step 1). An
-// exact table's eight pixels an iteration, as blobs.cc's scan classifies its samples: each
-// pixel's packed value is one 4-byte load, the byte after it masked off, but the last pixel's.
-void ClassifyPixels(const ColourTable& table, const uint8_t* bgr, int n, uint8_t* cls) {
-  if (table.bits_per_channel() != 8 || std::endian::native != std::endian::little || n < 2) {
-    table.ClassifyRow(bgr, n, 1, cls);
-    return;
-  }
-  const uint8_t* lut = table.data();
-  const auto one = [&](int k) {
-    uint32_t v;
-    std::memcpy(&v, bgr + 3 * k, sizeof(v));
-    cls[k] = lut[v & 0xFFFFFFu];
-  };
-  int i = 0;
-  for (; i + 8 < n; i += 8, bgr += 24, cls += 8) {
-    one(0), one(1), one(2), one(3), one(4), one(5), one(6), one(7);
-  }
-  for (; i + 1 < n; ++i, bgr += 3, ++cls) one(0);
-  cls[0] = table.Classify(bgr[0], bgr[1], bgr[2]);
-}
-
 // The class bits of `table` of every pixel of `bgr_window` in `cls` (CV_8U) and its `bit` class
 // in `raw` (CV_8U, 255 = in the class), row by row.
 void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit, cv::Mat* raw,
@@ -69,7 +47,7 @@ void ClassMasks(const cv::Mat& bgr_window, const ColourTable& table, uint8_t bit
   cls->create(bgr_window.size(), CV_8U);
   for (int y = 0; y < bgr_window.rows; ++y) {
     uint8_t* k = cls->ptr<uint8_t>(y);
-    ClassifyPixels(table, bgr_window.ptr<uint8_t>(y), bgr_window.cols, k);
+    table.ClassifyRow<1>(bgr_window.ptr<uint8_t>(y), bgr_window.cols, 1, k);
     BitMaskRow(k, bgr_window.cols, bit, raw->ptr<uint8_t>(y));
   }
 }
@@ -499,9 +477,8 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     for (int y = 0; y < sub.height; ++y) {
       const uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
       uint8_t* c = cand.ptr<uint8_t>(y);
-      ClassifyPixels(*grow_table,
-                     bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x),
-                     sub.width, c);
+      grow_table->ClassifyRow<1>(
+          bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x), sub.width, 1, c);
       for (int x = 0; x < sub.width; ++x) {
         c[x] = m[x] == 0 && (c[x] & grow_bit) != 0;
         if (c[x] != 0) {

@@ -31,27 +31,7 @@ void Union(std::vector<int>& parent, int a, int b) {
 template <int kStep>
 void ClassifyRow(const uint8_t* row, int n, int x_start, int step, const ColourTable& table,
                  uint8_t* cls) {
-  const uint8_t* bgr = row + 3 * static_cast<ptrdiff_t>(x_start);
-  if (table.bits_per_channel() == 8 && std::endian::native == std::endian::little && n > 1) {
-    // ColourTable::ClassifyRow's exact-table loop, eight samples an iteration (the scan's
-    // inner loop: a third of its instructions are the loop's own otherwise). Each pixel's packed
-    // value is one 4-byte load, the byte after it masked off, but the last pixel's.
-    const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(kStep > 0 ? kStep : step);
-    const uint8_t* lut = table.data();
-    const auto one = [&](int k) {
-      uint32_t v;
-      std::memcpy(&v, bgr + k * stride, sizeof(v));
-      cls[k] = lut[v & 0xFFFFFFu];
-    };
-    int i = 0;
-    for (; i + 8 < n; i += 8, bgr += 8 * stride, cls += 8) {
-      one(0), one(1), one(2), one(3), one(4), one(5), one(6), one(7);
-    }
-    for (; i + 1 < n; ++i, bgr += stride, ++cls) one(0);
-    cls[0] = table.Classify(bgr[0], bgr[1], bgr[2]);
-    return;
-  }
-  table.ClassifyRow(bgr, n, kStep > 0 ? kStep : step, cls);
+  table.ClassifyRow<kStep>(row + 3 * static_cast<ptrdiff_t>(x_start), n, step, cls);
 }
 
 }  // namespace

@@ -98,21 +98,30 @@ class ColourTable {
     return table_[Index(uint32_t(b) | uint32_t(g) << 8 | uint32_t(r) << 16)];
   }
   const uint8_t* data() const { return table_.data(); }
-  // Class bits of n pixels of a BGR row, `step` pixels apart from `bgr` on, into `cls`. With the
-  // exact table a pixel's packed value is one 4-byte load (little-endian, the byte after it
-  // masked off), but the last pixel's, whose next byte may lie past the row.
+  // Class bits of n pixels of a BGR row, `step` pixels apart from `bgr` on, into `cls` (kStep >
+  // 0: the step known at compile time, for the scans' inner loops). With the exact table a
+  // pixel's packed value is one 4-byte load (little-endian, the byte after it masked off), but the
+  // last pixel's, whose next byte may lie past the row; eight pixels an iteration (a third of the
+  // loop's instructions are its own otherwise).
+  template <int kStep = 0>
   void ClassifyRow(const uint8_t* bgr, int n, int step, uint8_t* cls) const {
-    const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(step);
+    const ptrdiff_t stride = 3 * static_cast<ptrdiff_t>(kStep > 0 ? kStep : step);
     const uint8_t* lut = table_.data();
-    int i = 0;
-    if (bits_ == 8 && std::endian::native == std::endian::little) {
-      for (; i + 1 < n; ++i, bgr += stride) {
+    if (bits_ == 8 && std::endian::native == std::endian::little && n > 1) {
+      const auto one = [&](int k) {
         uint32_t v;
-        std::memcpy(&v, bgr, sizeof(v));
-        cls[i] = lut[v & 0xFFFFFFu];
+        std::memcpy(&v, bgr + k * stride, sizeof(v));
+        cls[k] = lut[v & 0xFFFFFFu];
+      };
+      int i = 0;
+      for (; i + 8 < n; i += 8, bgr += 8 * stride, cls += 8) {
+        one(0), one(1), one(2), one(3), one(4), one(5), one(6), one(7);
       }
+      for (; i + 1 < n; ++i, bgr += stride, ++cls) one(0);
+      cls[0] = Classify(bgr[0], bgr[1], bgr[2]);
+      return;
     }
-    for (; i < n; ++i, bgr += stride) {
+    for (int i = 0; i < n; ++i, bgr += stride) {
       cls[i] = lut[Index(uint32_t(bgr[0]) | uint32_t(bgr[1]) << 8 | uint32_t(bgr[2]) << 16)];
     }
   }
