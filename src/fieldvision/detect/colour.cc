@@ -342,7 +342,8 @@ ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
         const uint8_t* in0 = cr.in[0].data();
         const uint8_t* in1 = cr.in[1].data();
         const uint8_t* in2 = cr.in[2].data();
-        for (int i = 0; i < n * n; ++i) {
+        const size_t pixels = static_cast<size_t>(n) * static_cast<size_t>(n);
+        for (size_t i = 0; i < pixels; ++i) {
           const uint8_t inside = in0[p[3 * i]] & in1[p[3 * i + 1]] & in2[p[3 * i + 2]];
           out[i] |= uint8_t(bit * inside);
         }
