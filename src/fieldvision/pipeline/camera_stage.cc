@@ -43,7 +43,7 @@ class CameraStage::Track {
   }
   // The window around the expected place, whatever the frame's slot.
   cv::Rect ExpectedWindow(const cv::Size& image) const {
-    const Eigen::Vector2d p = centre_ + velocity_;
+    const Eigen::Vector2d p = ExpectedCentre();
     const double half =
         std::max<double>(o_.min_window_px, o_.window_radii * radius_ + velocity_.norm());
     const int x0 = static_cast<int>(std::floor(p.x() - half));
@@ -67,8 +67,7 @@ class CameraStage::Track {
   // whole.
   bool Confirms(const std::vector<recon::BallObservation>& obs) const {
     const recon::BallObservation* best = Best(obs);
-    return best != nullptr &&
-           (best->centre_px - (centre_ + velocity_)).norm() <= 2.0 * radius_ + 2.0;
+    return best != nullptr && (best->centre_px - ExpectedCentre()).norm() <= 2.0 * radius_ + 2.0;
   }
   // Whether a guided fit may look for the ball at its expected place (Expected).
   bool MayGuide() const { return o_.enabled && active_ && guided_run_ < o_.max_guided_frames; }
@@ -250,6 +249,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   const cv::Rect window = track_->Window(size_);
   bool full = window.empty();
   long guided = -1;
+  bool guided_tried = false;  // the same fit on the whole frame would read the same pixels
   const cv::Mat* frame = Image(in, window);
   if (frame != nullptr) {
     CheckSize(frame->size(), in.frame);
@@ -261,6 +261,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       // (a camera that sees the ball only that way would otherwise search every frame whole).
       if (full) {
         guided = AddGuided(*frame, &m.candidates);
+        guided_tried = true;
         full = guided < 0;
       } else {
         SearchBand(in, &m.candidates);
@@ -274,7 +275,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       ++stats_.full_scans;
     }
   }
-  if (guided < 0 && frame != nullptr) guided = AddGuided(*frame, &m.candidates);
+  if (!guided_tried && frame != nullptr) guided = AddGuided(*frame, &m.candidates);
   track_->Update(m.candidates, guided >= 0 ? &m.candidates[guided] : nullptr);
   ++stats_.frames;
   for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
