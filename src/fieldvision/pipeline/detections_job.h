@@ -67,7 +67,8 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& options);
 // (`messages`: per camera, in time order) by the physics-constrained bundle above; the track's
 // positions inside a refined flight become the flight model's (err_px: the flight's RMS), unless
 // the model explains the candidates much worse than the per-frame positions do (not a free
-// flight: a carried or deflected ball), which are then kept.
+// flight: a carried or deflected ball) or lies far from most of them (a "flight" between two
+// places where the ball rested), which are then kept.
 struct FlightBundle {
   std::optional<recon::TrajectoryResult> trajectory;
   int bundled_flights = 0;

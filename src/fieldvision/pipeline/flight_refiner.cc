@@ -90,10 +90,12 @@ void FlightRefiner::Flush(double before_s) {
   totals_.bundled_flights += b.bundled_flights;
   totals_.kept_flights += b.kept_flights;
   totals_.bundled_rows += b.bundled_rows;
-  ss_px_ += b.rms_px * b.rms_px * static_cast<double>(b.observations);
-  observations_ += b.observations;
-  totals_.observations = observations_;
-  totals_.rms_px = observations_ > 0 ? std::sqrt(ss_px_ / observations_) : 0.0;
+  // The RMS over every piece's candidates.
+  const double ss_px = totals_.rms_px * totals_.rms_px * static_cast<double>(totals_.observations) +
+                       b.rms_px * b.rms_px * static_cast<double>(b.observations);
+  totals_.observations += b.observations;
+  totals_.rms_px =
+      totals_.observations > 0 ? std::sqrt(ss_px / static_cast<double>(totals_.observations)) : 0.0;
 }
 
 }  // namespace fv::pipeline

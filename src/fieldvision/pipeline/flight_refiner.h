@@ -50,8 +50,6 @@ class FlightRefiner {
   std::vector<std::vector<CameraMessage>> messages_;  // per camera
   std::vector<recon::BallSample> track_;
   FlightBundle totals_;
-  double ss_px_ = 0.0;  // of the bundled candidates' residuals, over all pieces
-  long long observations_ = 0;
   long long pieces_ = 0;
 };
 
