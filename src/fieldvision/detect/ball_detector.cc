@@ -114,7 +114,9 @@ std::string OutlineProblem(const BallFit& fit, double visible, double leak,
 
 // The share of min_contrast and min_hue_contrast a region needs: less on the field.
 double LeastContrastFactor(const BallRegion& r, const BallDetectorOptions& o) {
-  return r.field_ring >= o.min_field_ring ? o.field_contrast_factor : 1.0;
+  return r.field_ring >= o.min_field_ring && r.grass_ring >= o.min_grass_ring
+             ? o.field_contrast_factor
+             : 1.0;
 }
 
 // Whether a measured region stands out from its surroundings: by its colour difference
@@ -229,6 +231,7 @@ void BallDetectorOptions::Check() const {
   CheckNonNegative(min_contrast, "min_contrast");
   CheckNonNegative(min_hue_contrast, "min_hue_contrast");
   CheckInRange(min_field_ring, 0.0, 1.0, "min_field_ring");
+  CheckInRange(min_grass_ring, 0.0, 1.0, "min_grass_ring");
   CheckInRange(field_contrast_factor, 0.0, 1.0, "field_contrast_factor");
   CheckInRange(max_region_outside, 0.0, 1.0, "max_region_outside");
   FV_REQUIRE(max_region_extent >= 1.0, "max_region_extent must be >= 1 (got {})",

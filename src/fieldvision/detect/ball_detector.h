@@ -117,6 +117,9 @@ struct BallDetectorOptions {
   // / 0.675 / 0.658 against 0.641 at precision 0.89 / 0.88 / 0.89 (0.88); low-sun-kick render
   // found 145 / 156 / 156 of 192 (140), positions 0.5 m off 9 / 6 / 6 (6).
   double min_field_ring = 0.7;
+  // ... of which at least this share is the field's own colour, not its lines: a ring of white
+  // alone is as likely a wall.
+  double min_grass_ring = 0.1;
   double field_contrast_factor = 0.5;
   // Whether a failed region shape check also rejects a candidate whose sub-pixel outline fit
   // passed all its own checks.

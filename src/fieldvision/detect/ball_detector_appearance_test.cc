@@ -20,6 +20,7 @@ namespace {
 
 struct Score {
   int expected = 0, accepted = 0;
+  int off_ball = 0;  // accepted candidates not within that distance of the ball
   std::vector<double> err_px;
   double Share() const { return expected > 0 ? static_cast<double>(accepted) / expected : 0.0; }
   double MedianErr() const {
@@ -29,9 +30,9 @@ struct Score {
 
 // Per image: is an accepted candidate within max(1.5 px, r / 2) of every ball with at least 70 %
 // of its disc visible (and a radius of at least 3 px)?
-Score ScoreScene(const synth::SceneSpec& spec, const std::string& colour) {
+Score ScoreScene(const synth::SceneSpec& spec, const std::string& colour,
+                 BallDetectorOptions options = {}) {
   const synth::SceneRenderer scene(spec);
-  BallDetectorOptions options;
   options.colour = colour;
   std::vector<std::unique_ptr<BallDetector>> detectors;
   for (const camera::Camera& cam : scene.cameras()) {
@@ -43,13 +44,18 @@ Score ScoreScene(const synth::SceneSpec& spec, const std::string& colour) {
     const auto truth = scene.BallTruth(f);
     for (size_t k = 0; k < images.size(); ++k) {
       const auto& t = truth.cameras[k];
+      const double near_px = std::max(1.5, 0.5 * t.radius_px);
+      const std::vector<BallCandidate> candidates = detectors[k]->Detect(images[k]);
+      for (const BallCandidate& c : candidates) {
+        s.off_ball += c.accepted && !(t.in_front && (c.centre_px - t.uv_px).norm() <= near_px);
+      }
       if (!t.in_front || t.visible_fraction < 0.7 || t.radius_px < 3) continue;
       ++s.expected;
       double best = 1e9;
-      for (const BallCandidate& c : detectors[k]->Detect(images[k])) {
+      for (const BallCandidate& c : candidates) {
         if (c.accepted) best = std::min(best, (c.centre_px - t.uv_px).norm());
       }
-      if (best <= std::max(1.5, 0.5 * t.radius_px)) {
+      if (best <= near_px) {
         ++s.accepted;
         s.err_px.push_back(best);
       } else {
@@ -77,10 +83,37 @@ TEST(BallDetectorAppearance, LowSunPrintedOrangeBall) {
   EXPECT_LT(s.MedianErr(), 0.8);
 }
 
+// Circles kept to the outer outline (BallFitOptions and BallRegionOptions inside_share): on the
+// low-sun scene's shaded, printed yellow balls the centres are nearer the truth than with the
+// same band inside as outside, about as many balls are found (17 against 18 of 24 measured) and
+// fewer other things pass as balls (50 against 85).
+TEST(BallDetectorAppearance, OuterOutlineCirclesOfShadedPrintedBalls) {
+  const uint64_t seed = fv::testing::TestSeed(1);
+  FV_SEED_TRACE(seed);
+  synth::SceneSpec spec = synth::Preset("low-sun", seed);
+  spec.num_frames = 6;
+  spec.ball.placements.resize(6);
+  BallDetectorOptions symmetric;
+  symmetric.fit.inside_share = 1.0;
+  symmetric.region.inside_share = 1.0;
+  const Score outer = ScoreScene(spec, "yellow");
+  const Score both = ScoreScene(spec, "yellow", symmetric);
+  const double mean = util::Mean(outer.err_px), mean_both = util::Mean(both.err_px);
+  std::cout << "low sun, yellow: " << outer.accepted << "/" << outer.expected
+            << " balls, centre error mean " << mean << " px, " << outer.off_ball
+            << " accepted off the ball (same band both ways: " << both.accepted << ", " << mean_both
+            << " px, " << both.off_ball << ")\n";
+  ASSERT_GE(outer.expected, 12);
+  EXPECT_GE(outer.accepted, both.accepted - 1);
+  EXPECT_LT(mean, 0.7 * mean_both);
+  EXPECT_LT(outer.off_ball, 0.85 * both.off_ball);
+}
+
 // The outline fit alone, seeded 1.2 px off and 10 % large at every ball of the low-sun scene
 // (printed yellow ball, shaded far side, busy stands behind balls in the air): the outline is the
 // silhouette, not a print's line or the terminator (first-step edges: median 2.2 px, p90 3.8 px;
-// outermost steps: 0.18 px, 0.44 px).
+// outermost steps: 0.18 px, 0.44 px). A circle kept to the outer outline (inside_share) is
+// nearer than one with the same band both ways.
 TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
@@ -89,7 +122,9 @@ TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
   spec.ball.placements.resize(10);
   const synth::SceneRenderer scene(spec);
   const ColourTable table(PresetColourSpec("yellow"));
-  std::vector<double> err_px;
+  BallFitOptions symmetric;
+  symmetric.inside_share = 1.0;
+  std::vector<double> err_px, err_symmetric_px;
   int no_fit = 0;
   for (int f = 0; f < scene.num_frames(); ++f) {
     const auto images = scene.Render(f);
@@ -102,24 +137,30 @@ TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
           t.uv_px.y() > images[k].rows - margin) {
         continue;
       }
-      const BallFit fit =
-          FitBall(images[k], table, table.BallBit(), t.uv_px + Eigen::Vector2d(1.0, 0.7),
-                  1.1 * t.radius_px, &scene.cameras()[k]);
-      if (!fit.ok) {
+      const Eigen::Vector2d seed_px = t.uv_px + Eigen::Vector2d(1.0, 0.7);
+      const BallFit fit = FitBall(images[k], table, table.BallBit(), seed_px, 1.1 * t.radius_px,
+                                  &scene.cameras()[k]);
+      const BallFit fit_symmetric = FitBall(images[k], table, table.BallBit(), seed_px,
+                                            1.1 * t.radius_px, &scene.cameras()[k], symmetric);
+      if (!fit.ok || !fit_symmetric.ok) {
         ++no_fit;
         continue;
       }
       err_px.push_back((fit.centre_px - t.uv_px).norm());
+      err_symmetric_px.push_back((fit_symmetric.centre_px - t.uv_px).norm());
     }
   }
   ASSERT_GE(err_px.size(), 25u);
   const double median = util::NearestRankPercentile(err_px, 0.5);
   const double p90 = util::NearestRankPercentile(err_px, 0.9);
+  const double mean = util::Mean(err_px), mean_symmetric = util::Mean(err_symmetric_px);
   std::cout << "outline fit of printed, shaded balls: " << err_px.size() << " fitted, " << no_fit
-            << " not, centre error median " << median << " px, p90 " << p90 << " px\n";
+            << " not, centre error median " << median << " px, p90 " << p90 << " px, mean " << mean
+            << " px (same band both ways: " << mean_symmetric << ")\n";
   EXPECT_LE(no_fit, 1);
   EXPECT_LT(median, 0.45);
   EXPECT_LT(p90, 1.5);
+  EXPECT_LT(mean, mean_symmetric);
 }
 
 TEST(BallDetectorAppearance, BallHeldInAHandler) {

@@ -460,10 +460,11 @@ struct ConeOutline {
   }
 };
 
-// Robust cone fit of outline pixels: initial inliers are `inl` (or those within thr of a given
-// cone), then three rounds of fit and re-selection. `res` receives pixel residuals.
+// Robust cone fit of outline pixels: initial inliers are `inl` (or those within the band of a
+// given cone: thr outside it, thr_in inside it), then three rounds of fit and re-selection.
+// `res` receives pixel residuals.
 bool RobustCone(const std::vector<Vector2d>& pts, const camera::Camera& cam, double thr,
-                const Vector3d* axis0, double alpha0, std::vector<char>* inl,
+                double thr_in, const Vector3d* axis0, double alpha0, std::vector<char>* inl,
                 std::vector<double>* res, Vector3d* axis, double* alpha) {
   const int n = static_cast<int>(pts.size());
   std::vector<Vector3d> rays(n);
@@ -486,7 +487,7 @@ bool RobustCone(const std::vector<Vector2d>& pts, const camera::Camera& cam, dou
   const auto select = [&](const Vector3d& ax, double al) {
     for (int i = 0; i < n; ++i) {
       (*res)[i] = residual(i, ax, al);
-      (*inl)[i] = ok[i] && std::abs((*res)[i]) < thr;
+      (*inl)[i] = ok[i] && (*res)[i] < thr && (*res)[i] > -thr_in;
     }
   };
   // The inlier flags alone (the residuals are those of the next selection): a ray is an inlier
@@ -495,7 +496,7 @@ bool RobustCone(const std::vector<Vector2d>& pts, const camera::Camera& cam, dou
   // rounding of acos and of the residual), else by the residual. False when the band comes
   // within 1e-6 of 0 or pi: then select.
   const auto select_flags = [&](const Vector3d& ax, double al) {
-    const double lo = al - thr / f, hi = al + thr / f;
+    const double lo = al - thr_in / f, hi = al + thr / f;
     if (!(lo > 1e-6 && hi < M_PI - 1e-6)) return false;
     const double c_lo = std::cos(hi), c_hi = std::cos(lo), eps = 1e-12;
     for (int i = 0; i < n; ++i) {
@@ -505,7 +506,8 @@ bool RobustCone(const std::vector<Vector2d>& pts, const camera::Camera& cam, dou
       } else if (c > c_lo + eps && c < c_hi - eps) {
         (*inl)[i] = ok[i];
       } else {
-        (*inl)[i] = ok[i] && std::abs(residual(i, ax, al)) < thr;
+        const double r = residual(i, ax, al);
+        (*inl)[i] = ok[i] && r < thr && r > -thr_in;
       }
     }
     return true;
@@ -551,6 +553,8 @@ void BallFitOptions::Check() const {
   CheckPositive(inlier_px, "BallFitOptions.inlier_px");
   FV_REQUIRE(ransac_iterations >= 1, "BallFitOptions.ransac_iterations must be >= 1");
   FV_REQUIRE(blur_min_aspect >= 1.0, "BallFitOptions.blur_min_aspect must be >= 1");
+  FV_REQUIRE(inside_share > 0.0 && inside_share <= 1.0,
+             "BallFitOptions.inside_share must be in (0, 1] (got {})", inside_share);
 }
 
 std::string BallFit::Summary() const {
@@ -575,7 +579,8 @@ bool CircleFrom3(const Vector2d& a, const Vector2d& b, const Vector2d& c, Vector
 }
 
 bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* centre, double* radius,
-               std::vector<char>* inlier) {
+               std::vector<char>* inlier, double inside_px) {
+  if (inside_px < 0) inside_px = inlier_px;
   const int n = static_cast<int>(pts.size());
   inlier->assign(n, 1);
   if (n < 3) return false;
@@ -596,7 +601,8 @@ bool FitCircle(const std::vector<Vector2d>& pts, double inlier_px, Vector2d* cen
   for (int round = 0; round < 4; ++round) {
     int count = 0;
     for (int i = 0; i < n; ++i) {
-      (*inlier)[i] = std::abs((pts[i] - c).norm() - r) < inlier_px;
+      const double e = (pts[i] - c).norm() - r;
+      (*inlier)[i] = e < inlier_px && e > -inside_px;
       count += (*inlier)[i];
     }
     if (count < 3) return false;
@@ -681,6 +687,9 @@ struct OutlineState {
   std::vector<double> res;
   Vector2d centre = Vector2d::Zero();
   double radius = 0;
+  bool cone = false;  // centre and radius are those of this cone (FitSphereCone)
+  Vector3d axis = Vector3d::UnitZ();
+  double alpha = 0;
 };
 
 // 1. and 2.: the rough outline from the colour classes with a robust circle, then the sub-pixel
@@ -702,8 +711,8 @@ std::string SubpixelCircle(const cv::Mat& bgr, const ColourTable& table, uint8_t
         bgr, table, ball_bit, c1, [r1](double) { return r1; }, r1, o);
     Vector2d c2 = c1;
     double r2 = r1;
-    if (!FitCircle(s->edges.points, o.inlier_px + 0.03 * r1 + (pass == 0 ? 0.5 : 0.0), &c2, &r2,
-                   &s->inl)) {
+    const double band = o.inlier_px + 0.03 * r1 + (pass == 0 ? 0.5 : 0.0);
+    if (!FitCircle(s->edges.points, band, &c2, &r2, &s->inl, o.inside_share * band)) {
       return "too few sub-pixel outline points";
     }
     c1 = c2;
@@ -736,7 +745,7 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
     }
     Vector3d new_axis;
     double new_alpha = 0.0;
-    if (!RobustCone(s->edges.points, camera, thr, have_cone ? &axis : nullptr,
+    if (!RobustCone(s->edges.points, camera, thr, o.inside_share * thr, have_cone ? &axis : nullptr,
                     have_cone ? alpha : 0.0, &s->inl, &s->res, &new_axis, &new_alpha)) {
       break;
     }
@@ -750,6 +759,9 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
     return;
   }
   s->centre = *uv;
+  s->cone = true;
+  s->axis = axis;
+  s->alpha = alpha;
   double sum = 0;
   int cnt = 0;
   for (size_t i = 0; i < s->edges.points.size(); ++i) {
@@ -759,6 +771,31 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
     }
   }
   if (cnt > 0) s->radius = sum / cnt;
+}
+
+// The outline's inliers and residuals for the checks (outside share, dents, inliers) from a
+// circle fitted with the same band both ways, from the outer outline's: a polygon's corners
+// stick out of that one, where the outer outline's circle passes near them.
+void ClassifyBothWays(const camera::Camera* camera, double thr, OutlineState* s) {
+  Vector2d c = s->centre;
+  double r = s->radius;
+  std::vector<char> inl;
+  if (!FitCircle(s->edges.points, thr, &c, &r, &inl)) return;
+  if (s->cone && camera != nullptr) {
+    // The cone from the circle's inliers, as the first cone pass does.
+    std::vector<double> res;
+    Vector3d axis;
+    double alpha = 0;
+    if (RobustCone(s->edges.points, *camera, thr, thr, nullptr, 0.0, &inl, &res, &axis, &alpha)) {
+      s->inl = std::move(inl);
+      s->res = std::move(res);
+    }
+    return;
+  }
+  s->inl = std::move(inl);
+  for (size_t i = 0; i < s->edges.points.size(); ++i) {
+    s->res[i] = (s->edges.points[i] - c).norm() - r;
+  }
 }
 
 // 4. Motion blur: an elongated outline that an ellipse explains much better than the circle
@@ -870,6 +907,7 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
     s.res.resize(n);
     for (int i = 0; i < n; ++i) s.res[i] = (s.edges.points[i] - s.centre).norm() - s.radius;
   }
+  if (o.inside_share < 1.0) ClassifyBothWays(camera, thr, &s);
   int count = 0;
   double rms = Rms(s.res, s.inl, &count);
   if (count < 0.8 * n && n >= 8) {

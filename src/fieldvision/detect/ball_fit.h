@@ -30,6 +30,12 @@ struct BallFitOptions {
                                   // (plus 3 % of the radius)
   int ransac_iterations = 60;     // for the first, rough outline
   double blur_min_aspect = 1.15;  // an outline this elongated that fits an ellipse is blurred
+  // Outline points inside the fit are inliers within this share of the band only (inlier_px
+  // plus 3 % of the radius): a print's line, the shading's terminator and an occluder's edge lie
+  // inside a ball's silhouette, never outside it, so the fit keeps to the outer outline (the
+  // silhouette). The checks' inliers (outside share, dents) come from a circle with the same band
+  // both ways, out of which a polygon's corners stick. 1: the same band both ways.
+  double inside_share = 0.7;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -64,10 +70,12 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
                 const camera::Camera* camera, const BallFitOptions& options = {});
 
 // Robust geometric circle fit of points (used by FitBall; exposed for tests): the initial guess
-// is refined by Gauss-Newton with outliers (farther than inlier_px) dropped; `inlier` receives
-// the final inlier flags. Returns false when fewer than 3 inliers remain.
+// is refined by Gauss-Newton with outliers (farther than inlier_px outside the circle, or
+// inside_px inside it; inside_px < 0: inlier_px) dropped; `inlier` receives the final inlier
+// flags. Returns false when fewer than 3 inliers remain.
 bool FitCircle(const std::vector<Eigen::Vector2d>& points, double inlier_px,
-               Eigen::Vector2d* centre, double* radius, std::vector<char>* inlier);
+               Eigen::Vector2d* centre, double* radius, std::vector<char>* inlier,
+               double inside_px = -1.0);
 
 // The circle through three points; false when they are (nearly) collinear.
 bool CircleFrom3(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,

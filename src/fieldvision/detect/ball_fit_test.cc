@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/testing.h"
@@ -38,6 +39,31 @@ TEST(FitCircle, IgnoresOutliers) {
   EXPECT_NEAR(radius, r, 0.05);
   for (int i = 0; i < 60; ++i)
     EXPECT_EQ(inlier[i] != 0, i % 3 != 0 || (pts[i] - c).norm() > r - 1.0);
+}
+
+// Points off a circle only inwards (a print's line, the terminator) within the symmetric band:
+// a narrower band inside keeps the fit on the outer outline.
+TEST(FitCircle, NarrowInsideBandKeepsToTheOuterOutline) {
+  const uint64_t seed = fv::testing::TestSeed(3);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const Eigen::Vector2d c(50, 50);
+  const double r = 10;
+  std::vector<Eigen::Vector2d> pts;
+  for (int i = 0; i < 72; ++i) {
+    const double th = 2 * M_PI * i / 72;
+    // A quarter of the outline lies 0.8 px inside the circle.
+    const double rr = (th < M_PI / 2 ? r - 0.8 : r) + rng.Normal(0, 0.05);
+    pts.push_back(c + rr * Eigen::Vector2d(std::cos(th), std::sin(th)));
+  }
+  Eigen::Vector2d both = c, outer = c;
+  double r_both = r, r_outer = r;
+  std::vector<char> inlier;
+  ASSERT_TRUE(FitCircle(pts, 1.0, &both, &r_both, &inlier));
+  ASSERT_TRUE(FitCircle(pts, 1.0, &outer, &r_outer, &inlier, 0.5));
+  EXPECT_GT((both - c).norm(), 0.2);  // the same band both ways: pulled towards the dent
+  EXPECT_LT((outer - c).norm(), 0.05);
+  EXPECT_NEAR(r_outer, r, 0.05);
 }
 
 // Shaded discs of 6..40 px diameter at random sub-pixel places on a noisy field.
@@ -139,6 +165,14 @@ TEST(FitBall, ConeFitIsUnbiasedInPerspective) {
   ASSERT_TRUE(with_camera.ok && without.ok);
   EXPECT_LT((with_camera.centre_px - uv).norm(), 0.1) << with_camera.Summary();
   EXPECT_GT((without.centre_px - uv).norm(), 0.3) << without.Summary();
+}
+
+TEST(FitBall, OptionsAreChecked) {
+  BallFitOptions o;
+  o.inside_share = 0.0;
+  EXPECT_THROW(o.Check(), Error);
+  o.inside_share = 1.5;
+  EXPECT_THROW(o.Check(), Error);
 }
 
 }  // namespace

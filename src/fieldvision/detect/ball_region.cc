@@ -247,9 +247,10 @@ cv::Mat GatherComponents(const cv::Mat& mask, const cv::Rect& seed, double gathe
 
 // RANSAC for the circle of a partly hidden disc: an occluder's edge lies inside the true circle,
 // nothing of the disc lies outside it, so points beyond the inlier band count against a
-// hypothesis (score = inliers - outside). Deterministic draws; FitCircle refines the winner.
-bool OuterCircle(const std::vector<Vector2d>& pts, double thr, int iterations, Vector2d* centre,
-                 double* radius, std::vector<char>* inlier) {
+// hypothesis (score = inliers - outside). Deterministic draws; FitCircle refines the winner with
+// the band thr outside the circle and thr_in inside it.
+bool OuterCircle(const std::vector<Vector2d>& pts, double thr, double thr_in, int iterations,
+                 Vector2d* centre, double* radius, std::vector<char>* inlier) {
   const int n = static_cast<int>(pts.size());
   if (n < 3) return false;
   uint64_t state = 0x2545F4914F6CDD1Dull ^ static_cast<uint64_t>(n);
@@ -283,7 +284,7 @@ bool OuterCircle(const std::vector<Vector2d>& pts, double thr, int iterations, V
   if (best < 3) return false;
   *centre = best_c;
   *radius = best_r;
-  return FitCircle(pts, thr, centre, radius, inlier);
+  return FitCircle(pts, thr, centre, radius, inlier, thr_in);
 }
 
 }  // namespace
@@ -294,6 +295,8 @@ void BallRegionOptions::Check() const {
   CheckInRange(grow_fraction, 0.0, 2.0, "BallRegionOptions.grow_fraction");
   CheckPositive(hull_tolerance_px, "BallRegionOptions.hull_tolerance_px");
   CheckPositive(inlier_px, "BallRegionOptions.inlier_px");
+  FV_REQUIRE(inside_share > 0.0 && inside_share <= 1.0,
+             "BallRegionOptions.inside_share must be in (0, 1] (got {})", inside_share);
   CheckInRange(hidden_value, 0, 255, "BallRegionOptions.hidden_value");
   CheckInRange(min_seen, 0.1, 1.0, "BallRegionOptions.min_seen");
   CheckInRange(own_reach, 0.0, 2.0, "BallRegionOptions.own_reach");
@@ -701,11 +704,13 @@ double OutlineExtent(const std::vector<Vector2d>& pts, const Vector2d& c, double
 void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::Mat& lab,
                           const cv::Mat& filled, const cv::Mat& raw, const cv::Mat& cls,
                           const cv::Rect& read, const Vector2d& c, double r, double area,
-                          const BallRegionOptions& o, uint8_t field_bit, BallRegion* out) {
+                          const BallRegionOptions& o, uint8_t field_bit, uint8_t grass_bit,
+                          BallRegion* out) {
   LabHistogram disc_lab, core_lab, ring_lab;
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
-  long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, ring_field = 0, pure = 0;
+  long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, ring_field = 0,
+            ring_grass = 0, pure = 0;
   for (int y = read.y; y < read.y + read.height; ++y) {
     const uint8_t* f = filled.ptr<uint8_t>(y);
     const uint8_t* m = raw.ptr<uint8_t>(y);
@@ -729,6 +734,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
         if (m[x] == 0) {  // what is around the ball, not more of its colour (that is leak)
           ring_lab.Add(lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x));
           ring_field += (cls.ptr<uint8_t>(y)[x] & field_bit) != 0;
+          ring_grass += (cls.ptr<uint8_t>(y)[x] & grass_bit) != 0;
         }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
@@ -742,6 +748,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   out->spill = spill / (M_PI * r * r);
   out->leak = ring > 0 ? double(ring_ball) / ring : 0.0;
   out->field_ring = ring > 0 ? double(ring_field) / ring : 0.0;
+  out->grass_ring = ring > 0 ? double(ring_grass) / ring : 0.0;
   out->purity = area > 0 ? pure / area : 0.0;
   const LabHistogram& disc_h = disc_lab.n > 0 ? disc_lab : core_lab;
   if (disc_h.n > 0 && ring_lab.n > 0) {
@@ -812,7 +819,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   double r = 0;
   std::vector<char> inl;
   const double thr = o.inlier_px + 0.06 * r_est;
-  if (!OuterCircle(pts, thr, 96, &c, &r, &inl) || !(r > 0.5) || r > 2.5 * r_est + 3) {
+  if (!OuterCircle(pts, thr, o.inside_share * thr, 96, &c, &r, &inl) || !(r > 0.5) ||
+      r > 2.5 * r_est + 3) {
     out.failure = "no circle in the outline";
     return out;
   }
@@ -829,17 +837,23 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   }
   out.inliers = on.inliers;
   out.outside = double(on.outside) / pts.size();
-  out.extent = OutlineExtent(pts, c, r);
+  // Corners are measured against the circle of the same band both ways: the outer outline's
+  // circle passes near a polygon's corners.
+  Vector2d c_both = c;
+  double r_both = r - 0.5;
+  std::vector<char> inl_both;
+  out.extent = FitCircle(pts, thr, &c_both, &r_both, &inl_both) && r_both > 0.5
+                   ? OutlineExtent(pts, c_both, r_both + 0.5)
+                   : OutlineExtent(pts, c, r);
   out.rms_px = on.inliers > 0 ? std::sqrt(on.sum_sq / on.inliers) : 0.0;
   out.arc_cover = double(hit) / known;
   out.centre_px = c;
   out.radius_px = r;
   out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(on.inliers, 1)) + 0.05;
   // The field's surface: its colour and its painted lines.
-  uint8_t field_bit = 0;
-  for (const char* name : {"field", "line"}) {
-    if (table.spec().Find(name) >= 0) field_bit |= table.ClassBit(name);
-  }
+  const uint8_t grass_bit = table.spec().Find("field") >= 0 ? table.ClassBit("field") : 0;
+  const uint8_t line_bit = table.spec().Find("line") >= 0 ? table.ClassBit("line") : 0;
+  const uint8_t field_bit = grass_bit | line_bit;
   // The colours are read within the leak ring's outer radius.
   const double ro = o.ring_outer * r;
   const cv::Point ring_tl(static_cast<int>(std::floor(c.x() - ro)) - 1,
@@ -865,7 +879,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   const cv::Rect read = (ring_box | (cv::boundingRect(filled(extent)) + extent.tl())) &
                         cv::Rect(0, 0, window.width, window.height);
   MeasureRegionColours(bgr, window, lab.lab(), filled, raw, cls, read, c, r, area, o, field_bit,
-                       &out);
+                       grass_bit, &out);
   out.ok = true;
   return out;
 }

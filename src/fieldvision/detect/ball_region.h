@@ -25,7 +25,12 @@ struct BallRegionOptions {
   double close_fraction = 0.2;   // closing radius as a share of the radius (print, seams), <= 4 px
   double hull_tolerance_px = 1.0;  // outline points this near the convex hull are "convex"
   double inlier_px = 0.8;          // circle inliers: within this plus 6 % of the radius
-  double ring_inner = 1.35;        // leak ring, in radii
+  // ... and, inside the circle, within this share of that band only: what is not the disc's
+  // outline (a print's line, the shading's terminator, an occluder) lies inside it, never
+  // outside, so the circle is fitted to the outer outline. The extent (corners) is measured
+  // against the circle with the same band both ways. 1: the same band both ways.
+  double inside_share = 0.6;
+  double ring_inner = 1.35;  // leak ring, in radii
   double ring_outer = 1.9;
   // Pixels darker than this (max of B, G, R) hide the ball rather than frame it: a black robot in
   // front of it, a fisheye lens's dark border. The circle's angles with such pixels just outside
@@ -75,8 +80,9 @@ struct BallRegion {
   // Share of the leak ring's pixels in the colour spec's "field" or "line" classes (0 without
   // them): a ball on the field is set apart by the classes themselves.
   double field_ring = 0.0;
-  double solidity = 0.0;   // region area / convex hull area
-  int outline_points = 0;  // convex outline points used by the circle fit
+  double grass_ring = 0.0;  // the same share in the "field" class alone (not its lines)
+  double solidity = 0.0;    // region area / convex hull area
+  int outline_points = 0;   // convex outline points used by the circle fit
   int inliers = 0;
   std::string Summary() const;
 };

@@ -239,8 +239,14 @@ TEST(BallRegion, OptionsAreChecked) {
   o = BallRegionOptions{};
   o.min_seen = 0.0;
   EXPECT_THROW(o.Check(), Error);
+  o = BallRegionOptions{};
+  o.inside_share = 0.0;
+  EXPECT_THROW(o.Check(), Error);
   BallDetectorOptions d;
   d.min_contrast = -1;
+  EXPECT_THROW(d.Check(), Error);
+  d = BallDetectorOptions{};
+  d.min_grass_ring = 1.5;
   EXPECT_THROW(d.Check(), Error);
 }
 
