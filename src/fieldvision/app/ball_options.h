@@ -34,6 +34,11 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                   "A camera agrees when it sees the ball within this many pixels")
       ->check(FiniteRange(0.01, 1000.0))
       ->capture_default_str();
+  cmd->add_option("--max-radius-ratio", t.max_radius_ratio,
+                  "A camera agrees only when its ball's radius is within this factor of the one "
+                  "expected at the point (0: any radius)")
+      ->check(FiniteRange(0.0, 0.0) | FiniteRange(1.01, 100.0))
+      ->capture_default_str();
   cmd->add_flag("--ground", t.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
   cmd->add_flag("!--no-weak", t.use_weak,

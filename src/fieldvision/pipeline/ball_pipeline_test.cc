@@ -40,6 +40,14 @@ std::vector<camera::Camera> SmallRig() {
   return cams;
 }
 
+// Pipeline options for these scenes: the triangulation knows their ball's radius (a camera whose
+// ball's size does not fit the point disagrees).
+BallPipelineOptions SceneOptions() {
+  BallPipelineOptions o;
+  o.triangulation.ball_radius_m = kRadius;
+  return o;
+}
+
 Eigen::Vector3d BallAt(double t) { return {2 * std::sin(t), 1.5 * std::cos(t), 0.5 + 0.3 * t}; }
 
 // An orange disc on green, centred on the projection of the ball centre, as MJPG video whose
@@ -108,7 +116,7 @@ std::vector<std::unique_ptr<io::FrameSource>> Open(const Scene& s,
 std::vector<BallFrame> RunTracked(const Scene& s,
                                   std::vector<std::unique_ptr<io::FrameSource>>& sources,
                                   BallPipelineSummary* summary) {
-  BallPipelineOptions opt;
+  BallPipelineOptions opt = SceneOptions();
   opt.progress = false;
   std::vector<BallFrame> frames;
   *summary = RunBallPipelineTracked(s.cams, sources,
@@ -121,7 +129,7 @@ TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
   const std::string dir = testing::TempDir();
   const Scene s = MakeScene(dir, {30, 30, 24}, {0, 0, 0});
   auto sources = Open(s, std::vector<io::FrameSourceOptions>(3));
-  BallPipelineOptions opt;
+  BallPipelineOptions opt = SceneOptions();
   opt.progress = false;
   std::vector<BallFrame> frames;
   const auto summary = RunBallPipeline(s.cams, sources, {Centroid, Centroid, Centroid}, opt,
@@ -146,7 +154,7 @@ TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
 TEST(BallPipeline, TrackedWindowsGiveTheWholeFramePositions) {
   const std::string dir = testing::TempDir();
   const Scene s = MakeScene(dir, {40, 40, 40}, {0, 0, 0});
-  BallPipelineOptions opt;
+  BallPipelineOptions opt = SceneOptions();
   opt.progress = false;
   std::vector<io::FrameSourceOptions> vo(3);
   for (auto& v : vo) v.encoded = true;
@@ -286,7 +294,7 @@ TEST(BallPipeline, UnsynchronizedVideosPairedByTimestampCsv) {
     vo[c].time = io::TimeSource::kCsv;
     vo[c].timestamps_csv = csv_path;
   }
-  BallPipelineOptions opt;
+  BallPipelineOptions opt = SceneOptions();
   opt.progress = false;
   opt.sync.mode = SyncMode::kTimestamp;
   opt.sync.tolerance_s = 0.3 / kFps;
@@ -324,7 +332,7 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   cams[1].cam_from_world = s.cams[1].cam_from_world;
   cams[1].has_pose = true;
   auto sources = Open(s, std::vector<io::FrameSourceOptions>(3));
-  BallPipelineOptions opt;
+  BallPipelineOptions opt = SceneOptions();
   opt.progress = false;
   EXPECT_THAT(
       [&] {
@@ -417,7 +425,7 @@ TEST(BallPipelineStages, ReadThenFuseInOneThread) {
   EXPECT_EQ(summary.camera_names, (std::vector<std::string>{"cam0", "camera 1", "cam2"}));
   ASSERT_EQ(summary.window_scans.size(), 3u);
 
-  BallPipelineOptions opt;
+  BallPipelineOptions opt = SceneOptions();
   opt.progress = false;
   CameraQueues queues;
   const std::function<bool()> never = [] { return false; };

@@ -85,6 +85,35 @@ TEST(RobustStages, ConsistencyChecksThresholdDepthAndRadius) {
   EXPECT_EQ(ConsistentError(cams[0], sized, p, o), -1);
 }
 
+// Two cameras' still objects of the ball's colour that meet at a point by chance, scored above
+// the ball that the two other cameras see: their sizes do not fit that point, so the ball is
+// taken (max_radius_ratio); with any radius allowed, the better scored ghost.
+TEST(RobustStages, AGhostWhoseSizesDoNotFitItIsNoBall) {
+  std::vector<camera::Camera> cams = RingCameras();
+  camera::Camera fourth = cams[0];
+  fourth.cam_from_world = geometry::Rigid3d::LookAt(Eigen::Vector3d(0, 0, 12), {0.1, 0.2, 0});
+  cams.push_back(fourth);
+  const Eigen::Vector3d ball(1.0, -1.0, 0.6), ghost(-2.0, 2.5, 1.5);
+  const auto sized = [](const camera::Camera& cam, const Eigen::Vector3d& p, double size,
+                        double score) {
+    BallObservation o = Seen(cam, p, score);
+    o.radius_px = size * 0.11 * std::sqrt(cam.fx * cam.fy) / (cam.cam_from_world * p).z();
+    return o;
+  };
+  const std::vector<std::vector<BallObservation>> cand = {{sized(cams[0], ball, 1.0, 0.5)},
+                                                          {sized(cams[1], ball, 1.0, 0.5)},
+                                                          {sized(cams[2], ghost, 2.2, 0.9)},
+                                                          {sized(cams[3], ghost, 0.4, 0.9)}};
+  TriangulationOptions o;
+  const TriangulationResult r = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(r.ok());
+  EXPECT_LT((r.point_world - ball).norm(), 1e-3);
+  o.max_radius_ratio = 0.0;
+  const TriangulationResult any = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(any.ok());
+  EXPECT_LT((any.point_world - ghost).norm(), 1e-3);
+}
+
 TEST(RobustStages, SearchFindsTheLargestAgreeingSetAndRefineKeepsIt) {
   const auto cams = RingCameras();
   TriangulationOptions o;
