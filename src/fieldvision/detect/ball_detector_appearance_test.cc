@@ -67,13 +67,19 @@ Score ScoreScene(const synth::SceneSpec& spec, const std::string& colour,
   return s;
 }
 
+// The low-sun preset cut to its first `frames` placements.
+synth::SceneSpec LowSunScene(uint64_t seed, int frames) {
+  synth::SceneSpec spec = synth::Preset("low-sun", seed);
+  spec.num_frames = frames;
+  spec.ball.placements.resize(frames);
+  return spec;
+}
+
 TEST(BallDetectorAppearance, LowSunPrintedOrangeBall) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
-  synth::SceneSpec spec = synth::Preset("low-sun", seed);
+  synth::SceneSpec spec = LowSunScene(seed, 8);
   spec.ball.colour_bgr = Eigen::Vector3d(0, 110, 255);  // orange, printed in dark blue
-  spec.num_frames = 8;
-  spec.ball.placements.resize(8);
   synth::ResizeCameras(spec, 960, 720);
   const Score s = ScoreScene(spec, "orange");
   std::cout << "low sun, printed orange ball: accepted " << s.accepted << "/" << s.expected
@@ -90,9 +96,7 @@ TEST(BallDetectorAppearance, LowSunPrintedOrangeBall) {
 TEST(BallDetectorAppearance, OuterOutlineCirclesOfShadedPrintedBalls) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
-  synth::SceneSpec spec = synth::Preset("low-sun", seed);
-  spec.num_frames = 6;
-  spec.ball.placements.resize(6);
+  synth::SceneSpec spec = LowSunScene(seed, 6);
   BallDetectorOptions symmetric;
   symmetric.fit.inside_share = 1.0;
   symmetric.region.inside_share = 1.0;
@@ -117,9 +121,7 @@ TEST(BallDetectorAppearance, OuterOutlineCirclesOfShadedPrintedBalls) {
 TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
-  synth::SceneSpec spec = synth::Preset("low-sun", seed);
-  spec.num_frames = 10;
-  spec.ball.placements.resize(10);
+  synth::SceneSpec spec = LowSunScene(seed, 10);
   const synth::SceneRenderer scene(spec);
   const ColourTable table(PresetColourSpec("yellow"));
   BallFitOptions symmetric;

@@ -687,9 +687,7 @@ struct OutlineState {
   std::vector<double> res;
   Vector2d centre = Vector2d::Zero();
   double radius = 0;
-  bool cone = false;  // centre and radius are those of this cone (FitSphereCone)
-  Vector3d axis = Vector3d::UnitZ();
-  double alpha = 0;
+  bool cone = false;  // centre and radius come from a cone (FitSphereCone), not a circle
 };
 
 // 1. and 2.: the rough outline from the colour classes with a robust circle, then the sub-pixel
@@ -760,8 +758,6 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
   }
   s->centre = *uv;
   s->cone = true;
-  s->axis = axis;
-  s->alpha = alpha;
   double sum = 0;
   int cnt = 0;
   for (size_t i = 0; i < s->edges.points.size(); ++i) {

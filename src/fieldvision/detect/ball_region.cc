@@ -838,13 +838,14 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   out.inliers = on.inliers;
   out.outside = double(on.outside) / pts.size();
   // Corners are measured against the circle of the same band both ways: the outer outline's
-  // circle passes near a polygon's corners.
+  // circle passes near a polygon's corners (with inside_share 1 the two are one circle).
   Vector2d c_both = c;
   double r_both = r - 0.5;
   std::vector<char> inl_both;
-  out.extent = FitCircle(pts, thr, &c_both, &r_both, &inl_both) && r_both > 0.5
-                   ? OutlineExtent(pts, c_both, r_both + 0.5)
-                   : OutlineExtent(pts, c, r);
+  out.extent =
+      o.inside_share < 1.0 && FitCircle(pts, thr, &c_both, &r_both, &inl_both) && r_both > 0.5
+          ? OutlineExtent(pts, c_both, r_both + 0.5)
+          : OutlineExtent(pts, c, r);
   out.rms_px = on.inliers > 0 ? std::sqrt(on.sum_sq / on.inliers) : 0.0;
   out.arc_cover = double(hit) / known;
   out.centre_px = c;
