@@ -10,7 +10,8 @@
 
 namespace fv::app {
 
-// The colour detector's radius limits and small-ball stage (`detect`, `eval detect`).
+// The colour detector's radius limits, small-ball stage and off-field score (`detect`, `eval
+// detect`).
 inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
   cmd->add_option("--min-radius", o.min_radius_px, "Smallest ball radius in pixels")
       ->check(FiniteRange(0.1, 10000.0))
@@ -22,6 +23,12 @@ inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
                   "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "
                   "camera, where the ball looks that small)")
       ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+  cmd->add_option("--off-field-score", o.off_field_min_score,
+                  "Without a posed camera: a candidate above the field's far edge (its colour "
+                  "seen from the bottom up) is accepted only from this score (0: anywhere; a "
+                  "ball in the air needs it)")
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
 }
 

@@ -236,6 +236,8 @@ void BallDetectorOptions::Check() const {
   CheckInRange(max_region_outside, 0.0, 1.0, "max_region_outside");
   FV_REQUIRE(max_region_extent >= 1.0, "max_region_extent must be >= 1 (got {})",
              max_region_extent);
+  CheckInRange(off_field_min_score, 0.0, 1.0, "off_field_min_score");
+  field_boundary.Check();
   CheckInRange(grow_hue_deg, 0.0, 60.0, "grow_hue_deg");
   CheckInRange(grow_factor, 0.0, 1.0, "grow_factor");
   region.Check();
@@ -273,6 +275,7 @@ void BallDetector::Init(const ColourSpec& colour) {
   if (camera_ != nullptr) camera_->Check();
   table_ = ColourTable::Shared(colour, options_.lut_bits);
   ball_bit_ = table_->BallBit();
+  field_bit_ = colour.Find("field") >= 0 ? table_->ClassBit("field") : 0;
   if (options_.use_region) {
     grow_table_ = ColourTable::Shared(
         WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor), options_.lut_bits);
@@ -412,9 +415,33 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     std::optional<BallCandidate> cand = EvaluateBlob(bgr, *blob, roi, &measured, &result.refined);
     if (cand) result.candidates.push_back(std::move(*cand));
   }
-  if (small_balls_ && result.accepted() == 0) AddSmallBalls(bgr, roi, &result);
+  std::optional<FieldBoundary> boundary;
+  RejectOffField(bgr, roi, &boundary, &result.candidates);
+  if (small_balls_ && result.accepted() == 0) {
+    AddSmallBalls(bgr, roi, &result);
+    RejectOffField(bgr, roi, &boundary, &result.candidates);
+  }
   RankAndDropDuplicates(&result.candidates);
   return result;
+}
+
+void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
+                                  std::optional<FieldBoundary>* boundary,
+                                  std::vector<BallCandidate>* candidates) const {
+  const double min_score = options_.off_field_min_score;
+  if ((camera_ != nullptr && camera_->has_pose) || field_bit_ == 0 || min_score <= 0) return;
+  for (BallCandidate& c : *candidates) {
+    if (!c.accepted || c.score >= min_score) continue;
+    if (!boundary->has_value()) {
+      *boundary = FindFieldBoundary(bgr, *table_, field_bit_, options_.field_boundary, roi);
+    }
+    const double above = (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px);
+    if (above > c.radius_px) {
+      c.accepted = false;
+      c.reason = fmt::format("above the field's edge ({:.0f} px) with score {:.2f} < {:.2f}", above,
+                             c.score, min_score);
+    }
+  }
 }
 
 std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, const Blob& blob,
