@@ -51,7 +51,7 @@ int ColumnSpot(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit, 
                const cv::Rect& roi, long long* field_pixels) {
   int score = 0, best = 0, spot = -1;
   for (int y = roi.y + roi.height - 1; y >= roi.y; --y) {
-    const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * x;
+    const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
     const bool field = (table.Classify(p[0], p[1], p[2]) & field_bit) != 0;
     *field_pixels += field;
     score += field ? 1 : -1;
