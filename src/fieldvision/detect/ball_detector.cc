@@ -425,16 +425,21 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   return result;
 }
 
+FieldBoundary BallDetector::OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region) const {
+  if ((camera_ != nullptr && camera_->has_pose) || field_bit_ == 0 ||
+      options_.off_field_min_score <= 0) {
+    return {};
+  }
+  return FindFieldBoundary(bgr, *table_, field_bit_, options_.field_boundary, region);
+}
+
 void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
                                   std::optional<FieldBoundary>* boundary,
                                   std::vector<BallCandidate>* candidates) const {
   const double min_score = options_.off_field_min_score;
-  if ((camera_ != nullptr && camera_->has_pose) || field_bit_ == 0 || min_score <= 0) return;
   for (BallCandidate& c : *candidates) {
     if (!c.accepted || c.score >= min_score) continue;
-    if (!boundary->has_value()) {
-      *boundary = FindFieldBoundary(bgr, *table_, field_bit_, options_.field_boundary, roi);
-    }
+    if (!boundary->has_value()) *boundary = OffFieldBoundary(bgr, roi);
     const double above = (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px);
     if (above > c.radius_px) {
       c.accepted = false;

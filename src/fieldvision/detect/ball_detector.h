@@ -194,6 +194,9 @@ class BallDetector {
                                      const Eigen::Vector2d& centre_px, double radius_px) const;
   const BallDetectorOptions& options() const { return options_; }
   const ColourTable& table() const { return *table_; }
+  // The field's far edge the off-field check uses in `region` of a frame (field_boundary.h); no
+  // boundary when the check is off (a posed camera, off_field_min_score 0, no field class).
+  FieldBoundary OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
   // The field-of-play mask (CV_8U, 255 inside) or empty when not used.
   const cv::Mat& field_mask() const { return field_mask_; }
   // Expected radius range [min, max] in pixels of the ball seen at `uv` (calibrated camera with

@@ -26,6 +26,20 @@ bool IsVideoPath(const std::string& path) {
   return util::EndsWith(p, ".avi") || util::EndsWith(p, ".mp4") || util::EndsWith(p, ".mkv");
 }
 
+// The field's far edge the off-field check used (BallDetector::OffFieldBoundary), labelled.
+void DrawFieldBoundary(cv::Mat& bgr, const FieldBoundary& boundary) {
+  if (!boundary.valid()) return;
+  std::vector<cv::Point> line;
+  for (int x = 0; x < bgr.cols; x += 4) {
+    line.emplace_back(x, cvRound(boundary.RowAt(x + 0.5)));
+  }
+  line.emplace_back(bgr.cols - 1, cvRound(boundary.RowAt(bgr.cols - 0.5)));
+  const cv::Scalar magenta(255, 0, 255);
+  cv::polylines(bgr, line, false, magenta, 1, cv::LINE_AA);
+  cv::putText(bgr, "field edge", line.front() + cv::Point(4, -4), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+              magenta, 1, cv::LINE_AA);
+}
+
 }  // namespace
 
 void DetectVideoOptions::Check() const {
@@ -118,6 +132,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     ++result.frames;
     if (writer.isOpened() || !draw_dir.empty()) {
       cv::Mat canvas = frame.bgr.clone();
+      DrawFieldBoundary(canvas, detector.colour().OffFieldBoundary(frame.bgr));
       DrawCandidates(canvas, cands);
       if (writer.isOpened()) {
         writer.write(canvas);

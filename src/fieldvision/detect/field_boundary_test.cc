@@ -108,8 +108,10 @@ TEST(FieldBoundary, TheDetectorRejectsADiscAboveTheFieldBelowTheScore) {
   }
   EXPECT_EQ(on_accepted, 1);
   EXPECT_EQ(above_seen, 1);
+  EXPECT_NEAR(strict.OffFieldBoundary(img).RowAt(500), 200, 1.5);
   o.off_field_min_score = 0;
   const BallDetector off(o, nullptr, nullptr);
+  EXPECT_FALSE(off.OffFieldBoundary(img).valid());
   int accepted = 0;
   for (const BallCandidate& c : off.Detect(img)) accepted += c.accepted;
   EXPECT_EQ(accepted, 2);
