@@ -40,9 +40,12 @@ void RunBall(const BallCliOptions& o) {
   std::cout << r.summary.ToString() << "\n";
   if (r.bundle && r.bundle->bundled_flights > 0) {
     std::cout << fmt::format(
-        "{} flights refined on the cameras' candidates ({} rows, {:.2f} px RMS; --no-bundle: "
+        "{} flights refined on the cameras' candidates ({} rows, {:.2f} px RMS{}; --no-bundle: "
         "each frame's own position)\n",
-        r.bundle->bundled_flights, r.bundle->bundled_rows, r.bundle->rms_px);
+        r.bundle->bundled_flights, r.bundle->bundled_rows, r.bundle->rms_px,
+        r.bundle->kept_rows > 0
+            ? fmt::format("; {} frames the model does not follow kept", r.bundle->kept_rows)
+            : "");
   }
   if (r.bundle && r.bundle->kept_flights > 0) {
     std::cout << fmt::format(

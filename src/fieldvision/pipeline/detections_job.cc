@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -143,6 +145,15 @@ struct Bundled {
   // Per-frame positions within the flight's seen span, and those near the model (kNearM).
   int span_frames = 0;
   int near_frames = 0;
+  // Per per-frame position (index into the per-frame track) with candidates at its moment: the
+  // RMS distance of each camera's candidate nearest the model's image, and nearest its own.
+  struct AtFrame {
+    double model_ss = 0.0, frame_ss = 0.0;
+    int n = 0;
+    double model_rms() const { return std::sqrt(model_ss / n); }
+    double frame_rms() const { return std::sqrt(frame_ss / n); }
+  };
+  std::map<size_t, AtFrame> at_frame;
 };
 
 // A candidate of a flight's bundle.
@@ -152,6 +163,52 @@ struct FlightObservation {
   double time_s;
 };
 
+// The per-frame position nearest `time_s` within margin_s (end: none).
+std::vector<recon::BallSample>::const_iterator NearestSample(
+    const std::vector<recon::BallSample>& per_frame, double time_s, double margin_s) {
+  auto at = std::lower_bound(per_frame.begin(), per_frame.end(), time_s,
+                             [](const recon::BallSample& s, double t) { return s.time_s < t; });
+  if (at != per_frame.begin() &&
+      (at == per_frame.end() || time_s - std::prev(at)->time_s < at->time_s - time_s)) {
+    --at;
+  }
+  if (at == per_frame.end() || std::abs(at->time_s - time_s) > std::max(margin_s, 1e-6)) {
+    return per_frame.end();
+  }
+  return at;
+}
+
+// Per frame of the flight's span, every camera's candidate nearest the model's image and the one
+// nearest the frame's own position's image (no gate: a moment the model does not follow has its
+// candidates far from it): both distances, into out->at_frame.
+void FitAtFrames(const std::vector<camera::Camera>& cameras,
+                 const std::vector<std::vector<CameraMessage>>& messages,
+                 const std::vector<recon::BallSample>& per_frame, double margin_s, double t_first_s,
+                 double t_last_s, Bundled* out) {
+  const auto nearest = [](const CameraMessage& m, const Eigen::Vector2d& uv) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& o : m.candidates) best = std::min(best, (o.centre_px - uv).squaredNorm());
+    return best;
+  };
+  for (size_t c = 0; c < messages.size(); ++c) {
+    for (const CameraMessage& m : messages[c]) {
+      if (m.candidates.empty() || m.time_s < t_first_s - margin_s ||
+          m.time_s > t_last_s + margin_s) {
+        continue;
+      }
+      const auto at = NearestSample(per_frame, m.time_s, margin_s);
+      if (at == per_frame.end()) continue;
+      const auto uv_model = cameras[c].Project(out->model.PositionAt(m.time_s));
+      const auto uv_frame = cameras[c].Project(at->ball_in_world);
+      if (!uv_model || !uv_frame) continue;
+      Bundled::AtFrame& a = out->at_frame[static_cast<size_t>(at - per_frame.begin())];
+      a.model_ss += nearest(m, *uv_model);
+      a.frame_ss += nearest(m, *uv_frame);
+      ++a.n;
+    }
+  }
+}
+
 // The bundled model against each frame's own position on the observations at the frames'
 // moments (the nearest per-frame position within half a frame, margin_s): both RMS.
 void CompareWithFrames(const std::vector<camera::Camera>& cameras,
@@ -160,15 +217,8 @@ void CompareWithFrames(const std::vector<camera::Camera>& cameras,
                        double t_first_s, double t_last_s, Bundled* out) {
   double ss_model = 0, ss_frames = 0;
   for (const auto& o : obs) {
-    auto at = std::lower_bound(per_frame.begin(), per_frame.end(), o.time_s,
-                               [](const recon::BallSample& s, double t) { return s.time_s < t; });
-    if (at != per_frame.begin() &&
-        (at == per_frame.end() || o.time_s - std::prev(at)->time_s < at->time_s - o.time_s)) {
-      --at;
-    }
-    if (at == per_frame.end() || std::abs(at->time_s - o.time_s) > std::max(margin_s, 1e-6)) {
-      continue;
-    }
+    const auto at = NearestSample(per_frame, o.time_s, margin_s);
+    if (at == per_frame.end()) continue;
     const auto uv_model = cameras[o.cam].Project(out->model.PositionAt(o.time_s));
     const auto uv_frame = cameras[o.cam].Project(at->ball_in_world);
     if (!uv_model || !uv_frame) continue;
@@ -299,6 +349,7 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   out.observations = static_cast<int>(obs.size());
   out.rms_px = std::sqrt(ss / obs.size());
   CompareWithFrames(cameras, obs, per_frame, margin_s, f.t_first_seen_s, f.t_last_seen_s, &out);
+  FitAtFrames(cameras, messages, per_frame, margin_s, f.t_first_seen_s, f.t_last_seen_s, &out);
   out.ok = out.model.p0_m.allFinite() && out.model.v0_mps.allFinite();
   return out;
 }
@@ -322,6 +373,27 @@ recon::TrajectoryOptions FlightOptions(double ball_diameter_m, double ball_mass_
 constexpr double kMaxModelRmsRatio = 2.5;
 constexpr double kModelRmsSlackPx = 0.3;
 constexpr double kMinNearShare = 0.8;
+
+// A frame keeps its own position inside a refined flight where the model explains that frame's
+// candidates much worse than both the flight's typical frame (the median of the frames' model
+// RMS) and the frame's own position do: a moment the model does not follow (a touch, a glitch of
+// the detections' timing) would otherwise move that frame by centimetres.
+namespace {
+
+double TypicalModelRms(const Bundled& b) {
+  std::vector<double> rms;
+  rms.reserve(b.at_frame.size());
+  for (const auto& [i, a] : b.at_frame) rms.push_back(a.model_rms());
+  return util::NearestRankPercentile(rms, 0.5);
+}
+
+bool ModelFailsAt(const Bundled::AtFrame& a, double typical_px) {
+  const double model = a.model_rms();
+  return model > kMaxModelRmsRatio * typical_px + kModelRmsSlackPx &&
+         model > kMaxModelRmsRatio * a.frame_rms() + kModelRmsSlackPx;
+}
+
+}  // namespace
 
 FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
                            const std::vector<std::vector<CameraMessage>>& messages,
@@ -353,8 +425,15 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
     ++out.bundled_flights;
     ss += b.rms_px * b.rms_px * b.observations;
     nobs += b.observations;
-    for (auto& s : *track) {
+    const double typical_px = TypicalModelRms(b);
+    for (size_t i = 0; i < track->size(); ++i) {
+      recon::BallSample& s = (*track)[i];
       if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
+      const auto a = b.at_frame.find(i);
+      if (a != b.at_frame.end() && ModelFailsAt(a->second, typical_px)) {
+        ++out.kept_rows;
+        continue;
+      }
       s.ball_in_world = b.model.PositionAt(s.time_s);
       s.err_px = b.rms_px;
       ++out.bundled_rows;
@@ -371,6 +450,7 @@ std::string DetectionsJobResult::Summary() const {
   if (bundled_flights > 0) {
     s += fmt::format("; {} flights refined on the 2D detections ({} rows, {:.2f} px RMS)",
                      bundled_flights, bundled_rows, bundle_rms_px);
+    if (kept_rows > 0) s += fmt::format(", {} frames the model does not follow kept", kept_rows);
   }
   for (const auto& p : sync.Problems()) s += "\n  " + p;
   if (trajectory) {
@@ -428,6 +508,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     res.trajectory = std::move(b.trajectory);
     res.bundled_flights = b.bundled_flights;
     res.bundled_rows = b.bundled_rows;
+    res.kept_rows = b.kept_rows;
     res.bundle_rms_px = b.rms_px;
   } else if (!o.flights.empty()) {
     res.trajectory =

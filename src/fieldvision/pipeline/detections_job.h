@@ -43,12 +43,13 @@ struct DetectionsJobResult {
   long long positions = 0;   // rows written
   long long candidates = 0;  // detection rows read (all cameras)
   SyncReport sync;
-  std::vector<recon::BallSample> track;       // what BALL.csv holds
-  std::vector<recon::BallSample> per_frame;   // the per-frame triangulation (before the bundle)
-  int bundled_flights = 0;                    // flights refined on the 2D detections
-  long long bundled_rows = 0;                 // rows of BALL.csv taken from them
-  double bundle_rms_px = 0.0;                 // reprojection RMS of the bundled detections
-  std::optional<recon::BallEvalResult> eval;  // with a truth file
+  std::vector<recon::BallSample> track;      // what BALL.csv holds
+  std::vector<recon::BallSample> per_frame;  // the per-frame triangulation (before the bundle)
+  int bundled_flights = 0;                   // flights refined on the 2D detections
+  long long bundled_rows = 0;                // rows of BALL.csv taken from them
+  long long kept_rows = 0;     // rows inside them that kept their own position (BundleFlights)
+  double bundle_rms_px = 0.0;  // reprojection RMS of the bundled detections
+  std::optional<recon::BallEvalResult> eval;          // with a truth file
   std::optional<recon::TrajectoryResult> trajectory;  // with `flights`
   std::string Summary() const;
 };
@@ -68,12 +69,14 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& options);
 // positions inside a refined flight become the flight model's (err_px: the flight's RMS), unless
 // the model explains the candidates much worse than the per-frame positions do (not a free
 // flight: a carried or deflected ball) or lies far from most of them (a "flight" between two
-// places where the ball rested), which are then kept.
+// places where the ball rested), which are then kept; so is a single frame whose candidates the
+// model explains much worse than its typical frame's and than the frame's own position.
 struct FlightBundle {
   std::optional<recon::TrajectoryResult> trajectory;
   int bundled_flights = 0;
   int kept_flights = 0;  // flights whose per-frame positions were kept
   long long bundled_rows = 0;
+  long long kept_rows = 0;     // rows inside refined flights that kept their own position
   double rms_px = 0.0;         // reprojection RMS of the candidates used
   long long observations = 0;  // candidates used
 };

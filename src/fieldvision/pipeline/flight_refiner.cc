@@ -90,6 +90,7 @@ void FlightRefiner::Flush(double before_s) {
   totals_.bundled_flights += b.bundled_flights;
   totals_.kept_flights += b.kept_flights;
   totals_.bundled_rows += b.bundled_rows;
+  totals_.kept_rows += b.kept_rows;
   // The RMS over every piece's candidates.
   const double ss_px = totals_.rms_px * totals_.rms_px * static_cast<double>(totals_.observations) +
                        b.rms_px * b.rms_px * static_cast<double>(b.observations);
