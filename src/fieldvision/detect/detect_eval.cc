@@ -1,7 +1,9 @@
 #include "fieldvision/detect/detect_eval.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -203,6 +205,41 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
   return r;
 }
 
+namespace {
+
+// A miss's reason without its numbers and where (what is in brackets, after "at" or ";"), so
+// that misses of one kind count together.
+std::string ReasonKind(const std::string& reason) {
+  std::string kind = reason.substr(0, reason.find_first_of("(;"));
+  for (const char* tail : {" at ", " "}) {
+    if (kind.ends_with(tail)) kind.erase(kind.size() - std::strlen(tail));
+  }
+  std::string out;
+  for (size_t i = 0; i < kind.size(); ++i) {
+    const bool digit = std::isdigit(static_cast<unsigned char>(kind[i])) != 0;
+    if (digit && (out.empty() || out.back() != 'N')) out += 'N';
+    if (!digit && !(kind[i] == '.' && !out.empty() && out.back() == 'N')) out += kind[i];
+  }
+  return out;
+}
+
+// "count kind, ..." over the images with a ball that were missed, most frequent first.
+std::string MissReasons(const std::vector<DetectEvalImage>& images) {
+  std::map<std::string, int> counts;
+  for (const auto& im : images) {
+    if (im.boxes > 0 && !im.hit) ++counts[ReasonKind(im.reason)];
+  }
+  std::vector<std::pair<int, std::string>> sorted;
+  sorted.reserve(counts.size());
+  for (const auto& [kind, n] : counts) sorted.emplace_back(-n, kind);
+  std::sort(sorted.begin(), sorted.end());
+  std::string s;
+  for (const auto& [n, kind] : sorted) s += fmt::format("{}{} {}", s.empty() ? "" : ", ", -n, kind);
+  return s;
+}
+
+}  // namespace
+
 std::string DetectEvalResult::Summary(int list) const {
   std::vector<double> err_px, err_rel;
   for (const auto& im : images) {
@@ -230,6 +267,8 @@ std::string DetectEvalResult::Summary(int list) const {
   for (const auto& im : images) on_ball += im.boxes > 0 && im.candidate_on_ball;
   s += fmt::format("\na candidate (accepted or not) lies on the ball in {}/{} images", on_ball,
                    with_ball);
+  const std::string reasons = MissReasons(images);
+  if (!reasons.empty()) s += "\nmisses by reason: " + reasons;
   if (no_label_file > 0) {
     s += fmt::format("\n{} images have no label file (taken as images without a ball)",
                      no_label_file);
