@@ -26,8 +26,8 @@ inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
       ->capture_default_str();
   cmd->add_option("--off-field-score", o.off_field_min_score,
                   "Without a posed camera: a candidate above the field's far edge (its colour "
-                  "seen from the bottom up) is accepted only from this score (0: anywhere; a "
-                  "ball in the air needs it)")
+                  "seen from the bottom up) is accepted only from this score or as a whole disc "
+                  "(0: anywhere)")
       ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
 }

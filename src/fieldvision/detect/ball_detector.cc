@@ -237,6 +237,8 @@ void BallDetectorOptions::Check() const {
   FV_REQUIRE(max_region_extent >= 1.0, "max_region_extent must be >= 1 (got {})",
              max_region_extent);
   CheckInRange(off_field_min_score, 0.0, 1.0, "off_field_min_score");
+  CheckInRange(off_field_min_visible, 0.0, 1.0, "off_field_min_visible");
+  CheckNonNegative(off_field_min_radius_px, "off_field_min_radius_px");
   field_boundary.Check();
   CheckInRange(grow_hue_deg, 0.0, 60.0, "grow_hue_deg");
   CheckInRange(grow_factor, 0.0, 1.0, "grow_factor");
@@ -436,15 +438,20 @@ FieldBoundary BallDetector::OffFieldBoundary(const cv::Mat& bgr, const cv::Rect&
 void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
                                   std::optional<FieldBoundary>* boundary,
                                   std::vector<BallCandidate>* candidates) const {
-  const double min_score = options_.off_field_min_score;
+  const BallDetectorOptions& o = options_;
+  const double min_score = o.off_field_min_score;
   for (BallCandidate& c : *candidates) {
     if (!c.accepted || c.score >= min_score) continue;
+    const bool whole_disc = c.region_ok && c.visible_fraction >= o.off_field_min_visible &&
+                            c.radius_px >= o.off_field_min_radius_px;
+    if (whole_disc) continue;
     if (!boundary->has_value()) *boundary = OffFieldBoundary(bgr, roi);
     const double above = (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px);
     if (above > c.radius_px) {
       c.accepted = false;
-      c.reason = fmt::format("above the field's edge ({:.0f} px) with score {:.2f} < {:.2f}", above,
-                             c.score, min_score);
+      c.reason =
+          fmt::format("above the field's edge ({:.0f} px), score {:.2f} < {:.2f}, not a whole disc",
+                      above, c.score, min_score);
     }
   }
 }

@@ -83,19 +83,35 @@ TEST(FieldBoundary, NoFieldNoBoundaryAndNothingOutsideTheRegionIsRead) {
   EXPECT_THROW(bad.Check(), Error);
 }
 
-// Without a posed camera, a disc above the field's edge needs off_field_min_score; on the field,
-// or with the check off, it is accepted.
+// Without a posed camera, a disc above the field's edge needs off_field_min_score or to be a
+// whole disc; on the field, or with the check off, it is accepted.
 TEST(FieldBoundary, TheDetectorRejectsADiscAboveTheFieldBelowTheScore) {
   const uint64_t seed = fv::testing::TestSeed(64);
   FV_SEED_TRACE(seed);
   util::Rng rng(seed);
   const Eigen::Vector2d above(rng.Uniform(450, 560), rng.Uniform(60, 120));
   const Eigen::Vector2d on(rng.Uniform(450, 560), rng.Uniform(300, 360));
+  const Eigen::Vector2d small(rng.Uniform(60, 200), rng.Uniform(60, 120));
   cv::Mat img = SideView(200, rng);
   test_util::PaintDisc(img, above, 10);
   test_util::PaintDisc(img, on, 10);
+  test_util::PaintDisc(img, small, 3);
   BallDetectorOptions o;
-  o.off_field_min_score = 1.0;  // scores stay below 1: every candidate above the edge rejected
+  o.off_field_min_score = 1.0;  // scores stay below 1: only whole discs above the edge accepted
+  const BallDetector whole(o, nullptr, nullptr);
+  int whole_above = 0, whole_small = 0, small_seen = 0;
+  for (const BallCandidate& c : whole.Detect(img)) {
+    if ((c.centre_px - above).norm() < 2) whole_above += c.accepted;
+    if ((c.centre_px - small).norm() < 2) {
+      ++small_seen;
+      whole_small += c.accepted;
+      EXPECT_NE(c.reason.find("not a whole disc"), std::string::npos) << c.reason;
+    }
+  }
+  EXPECT_EQ(whole_above, 1);  // a ball in the air, unhidden
+  EXPECT_EQ(small_seen, 1);
+  EXPECT_EQ(whole_small, 0);         // too small to judge its shape
+  o.off_field_min_radius_px = 1000;  // no whole disc: every candidate above the edge rejected
   const BallDetector strict(o, nullptr, nullptr);
   int on_accepted = 0, above_seen = 0;
   for (const BallCandidate& c : strict.Detect(img)) {
@@ -114,8 +130,11 @@ TEST(FieldBoundary, TheDetectorRejectsADiscAboveTheFieldBelowTheScore) {
   EXPECT_FALSE(off.OffFieldBoundary(img).valid());
   int accepted = 0;
   for (const BallCandidate& c : off.Detect(img)) accepted += c.accepted;
-  EXPECT_EQ(accepted, 2);
+  EXPECT_EQ(accepted, 3);
   o.off_field_min_score = 1.5;
+  EXPECT_THROW(o.Check(), Error);
+  o.off_field_min_score = 0.6;
+  o.off_field_min_visible = -0.1;
   EXPECT_THROW(o.Check(), Error);
 }
 
