@@ -21,10 +21,14 @@ using Eigen::Vector3d;
 void DiscShares(const cv::Mat& bgr, const ColourTable& table, uint8_t bit, const Vector2d& c,
                 double disc_r, double ring_r0, double ring_r1, double* disc, double* ring) {
   int n_disc = 0, b_disc = 0, n_ring = 0, b_ring = 0;
-  const int x0 = std::max(0, static_cast<int>(std::floor(c.x() - ring_r1)));
-  const int x1 = std::min(bgr.cols - 1, static_cast<int>(std::ceil(c.x() + ring_r1)));
-  const int y0 = std::max(0, static_cast<int>(std::floor(c.y() - ring_r1)));
-  const int y1 = std::min(bgr.rows - 1, static_cast<int>(std::ceil(c.y() + ring_r1)));
+  // Clamped before the conversion: a diverged fit's centre may lie far outside any int.
+  const auto clamped = [](double v, int hi) {
+    return static_cast<int>(std::clamp(v, -1.0, static_cast<double>(hi) + 1.0));
+  };
+  const int x0 = std::max(0, clamped(std::floor(c.x() - ring_r1), bgr.cols));
+  const int x1 = std::min(bgr.cols - 1, clamped(std::ceil(c.x() + ring_r1), bgr.cols));
+  const int y0 = std::max(0, clamped(std::floor(c.y() - ring_r1), bgr.rows));
+  const int y1 = std::min(bgr.rows - 1, clamped(std::ceil(c.y() + ring_r1), bgr.rows));
   for (int y = y0; y <= y1; ++y) {
     const uint8_t* row = bgr.ptr<uint8_t>(y);
     for (int x = x0; x <= x1; ++x) {
