@@ -916,6 +916,13 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
   }
   fit.outside_fraction = fit.rays > 0 ? double(outside) / fit.rays : 0.0;
   fit.dents = CountDents(s.res, s.inl);
+  // A fit that ran off (a degenerate cone or ellipse) is no fit of this seed.
+  const double reach = 10.0 * std::max(rough_radius_px, 1.0) + 10.0;
+  if (!s.centre.allFinite() || !std::isfinite(s.radius) ||
+      (s.centre - rough_centre_px).norm() > reach || s.radius > reach) {
+    fit.failure = "outline fit ran off its seed";
+    return fit;
+  }
   fit.ok = true;
   fit.centre_px = s.centre;
   fit.radius_px = s.radius;
