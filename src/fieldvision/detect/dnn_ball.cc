@@ -98,7 +98,8 @@ std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate
   for (size_t i = 0; i < colour.size(); ++i) {
     BallCandidate c = colour[i];
     c.network_score = confirm[i];
-    if (confirm[i] >= o.confirm_score) {
+    const double needed = c.off_field ? std::max(o.confirm_score, o.accept_score) : o.confirm_score;
+    if (confirm[i] >= needed) {
       c.accepted = true;
       c.reason.clear();
       ranked.push_back({c, 0, confirm[i]});

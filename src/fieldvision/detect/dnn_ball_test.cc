@@ -64,6 +64,8 @@ TEST(CombineBallCandidates, ConfirmsKeepsOrDemotesAndCompletes) {
       colour.push_back(
           Cand(100 * i + 50, 50, rng.Uniform(3, 20), rng.Uniform(), rng.Uniform() < 0.4));
       confirm.push_back(rng.Uniform() < 0.5 ? 0.0 : rng.Uniform());
+      // Rejected above the field's edge: confirmed only from accept_score.
+      colour.back().off_field = !colour.back().accepted && rng.Uniform() < 0.5;
     }
     std::vector<BallCandidate> net;
     // One on a colour candidate (covered), one far away (completes when strong enough).
@@ -82,7 +84,9 @@ TEST(CombineBallCandidates, ConfirmsKeepsOrDemotesAndCompletes) {
         EXPECT_EQ(c.accepted, far_score >= o.complete_score);
       } else {
         const int i = static_cast<int>(std::lround((c.centre_px.x() - 50) / 100));
-        const bool confirmed = confirm[i] >= o.confirm_score;
+        const bool confirmed =
+            confirm[i] >=
+            (colour[i].off_field ? std::max(o.confirm_score, o.accept_score) : o.confirm_score);
         const bool kept =
             colour[i].accepted && (!o.demote_unconfirmed || colour[i].score >= o.keep_score);
         tier = confirmed ? 0 : (kept ? 1 : 3);

@@ -105,6 +105,7 @@ TEST(FieldBoundary, TheDetectorRejectsADiscAboveTheFieldBelowTheScore) {
     if ((c.centre_px - small).norm() < 2) {
       ++small_seen;
       whole_small += c.accepted;
+      EXPECT_TRUE(c.off_field);
       EXPECT_NE(c.reason.find("not a whole disc"), std::string::npos) << c.reason;
     }
   }
