@@ -447,17 +447,13 @@ void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
   for (BallCandidate& c : *candidates) {
     const bool whole_disc = c.region_ok && c.visible_fraction >= o.off_field_min_visible &&
                             c.radius_px >= o.off_field_min_radius_px;
-    if (c.accepted && (c.score >= min_score || whole_disc)) continue;
+    if (!c.accepted || c.score >= min_score || whole_disc) continue;
     if (!boundary->has_value()) *boundary = OffFieldBoundary(bgr, roi);
-    const double above = (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px);
-    if (!(above > c.radius_px)) continue;
-    c.off_field = true;
-    if (c.accepted) {
-      c.accepted = false;
-      c.reason =
-          fmt::format("above the field's edge ({:.0f} px), score {:.2f} < {:.2f}, not a whole disc",
-                      above, c.score, min_score);
-    }
+    if (!(*boundary)->DiscAbove(c.centre_px.x(), c.centre_px.y(), c.radius_px)) continue;
+    c.accepted = false;
+    c.reason = fmt::format(
+        "above the field's edge ({:.0f} px), score {:.2f} < {:.2f}, not a whole disc",
+        (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px), c.score, min_score);
   }
 }
 

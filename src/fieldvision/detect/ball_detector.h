@@ -61,7 +61,7 @@ struct BallCandidate {
   bool small = false;           // found by the small-ball stage (small_ball.h)
   bool guided = false;          // fitted where a tracker expected the ball (FitAt)
   // Not accepted, its lowest point more than its radius above the field's far edge (no posed
-  // camera; off_field_min_score): a network confirms it only as a ball of its own (dnn_ball.h).
+  // camera): a network confirms it only as a ball of its own (set by "both", dnn_ball.h).
   bool off_field = false;
   // The network's sports-ball score (dnn_ball.h; 0 where it found none or did not look, -1 when
   // the detector has no network).
@@ -231,9 +231,8 @@ class BallDetector {
   // The small-ball stage's spots in `roi` as candidates (accepted unless the camera expects a
   // larger ball there).
   void AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi, BallDetectionResult* result) const;
-  // Rejects the accepted candidates that off_field_min_score rejects and marks every rejected
-  // candidate above the field's edge off_field (without a posed camera); `boundary` holds the
-  // frame's field boundary once found.
+  // Rejects the accepted candidates that off_field_min_score rejects (without a posed camera);
+  // `boundary` holds the frame's field boundary once found.
   void RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
                       std::optional<FieldBoundary>* boundary,
                       std::vector<BallCandidate>* candidates) const;

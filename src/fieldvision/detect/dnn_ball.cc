@@ -67,6 +67,13 @@ BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score) {
   return c;
 }
 
+void MarkOffField(const FieldBoundary& boundary, std::vector<BallCandidate>* candidates) {
+  if (!boundary.valid()) return;
+  for (BallCandidate& c : *candidates) {
+    c.off_field = !c.accepted && boundary.DiscAbove(c.centre_px.x(), c.centre_px.y(), c.radius_px);
+  }
+}
+
 std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
                                   const std::vector<BallCandidate>& dnn, const DnnBallOptions& o) {
   std::vector<double> out(colour.size(), 0.0);
@@ -238,7 +245,10 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
                                                    const cv::Rect& region) const {
   if (dnn_ == nullptr) return colour_->Detect(bgr, region);
   if (!dnn_options_.uses_colour()) return FilterDnn(dnn_->Detect(bgr, region));
-  const std::vector<BallCandidate> colour = colour_->Detect(bgr, region);
+  std::vector<BallCandidate> colour = colour_->Detect(bgr, region);
+  // Here, not in the colour detector: only the network's confirmation reads the mark, and the
+  // edge costs a pass over the frame's columns.
+  MarkOffField(colour_->OffFieldBoundary(bgr, region), &colour);
   std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
   std::vector<BallCandidate> whole;
   if (dnn_options_.whole_frame) {

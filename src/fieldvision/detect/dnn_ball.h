@@ -77,6 +77,10 @@ std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
                                   const std::vector<BallCandidate>& dnn,
                                   const DnnBallOptions& options);
 
+// Marks the candidates that are not accepted and lie above `boundary` (FieldBoundary::DiscAbove)
+// off_field: what "both" confirms only from accept_score.
+void MarkOffField(const FieldBoundary& boundary, std::vector<BallCandidate>* candidates);
+
 // The "both" stage, without the network (tested on its own): `colour` (best first) with each
 // one's network score `confirm` (crop or whole frame, 0 when not checked; same length), and the
 // whole-frame network balls `dnn` (candidates, best first). Returns the candidates best first:

@@ -39,6 +39,8 @@ class FieldBoundary {
   double RowAt(double x) const;
   // How far a point (x, y) lies above the boundary, in pixels (negative: below it).
   double Above(double x, double y) const { return RowAt(x) - y; }
+  // Whether a disc lies off the field: its lowest point more than its radius above the boundary.
+  bool DiscAbove(double x, double y, double radius) const { return Above(x, y + radius) > radius; }
   std::string Summary() const;
 
  private:
