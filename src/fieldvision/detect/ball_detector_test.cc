@@ -143,7 +143,7 @@ TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
 
 // A yellow ball seen yellow-green (a greenish camera) on the green field differs from it by less
 // than min_contrast and min_hue_contrast, but its ring is field-coloured: it needs only
-// field_contrast_factor of them (accepted). The same disc on a wall of about the same contrast
+// field_contrast_factor of them (accepted), also beside a black robot. The same disc on a wall of about the same contrast
 // that is not the field is rejected.
 TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
   const uint64_t seed = fv::testing::TestSeed(31);
@@ -163,6 +163,24 @@ TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
     EXPECT_LT(best.hue_contrast, o.min_hue_contrast);
     EXPECT_TRUE(best.accepted);
     EXPECT_LT((best.centre_px - p.centre).norm(), 0.1 * p.radius_px + 0.5);
+  }
+  for (int trial = 0; trial < 4; ++trial) {
+    // In front of a black robot that fills about 40 % of the ring: dark pixels hide the field rather
+    // than frame the ball, so the rest of the ring decides (at most half of it hidden).
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(80, 200), rng.Uniform(60, 180));
+    const double r = rng.Uniform(8, 20);
+    cv::rectangle(img, cv::Point(static_cast<int>(c.x() - 3 * r), 0),
+                  cv::Point(static_cast<int>(c.x() + 3 * r), static_cast<int>(c.y() - 0.2 * r)),
+                  cv::Scalar(20, 22, 24), cv::FILLED);
+    test_util::PaintDisc(img, c, r, yellow_green, 0.3);
+    const std::vector<BallCandidate> cands = det.Detect(img);
+    ASSERT_FALSE(cands.empty());
+    const BallCandidate& best = cands.front();
+    SCOPED_TRACE("r " + std::to_string(r) + " contrast " + std::to_string(best.contrast) + " " +
+                 best.reason);
+    EXPECT_TRUE(best.accepted);
+    EXPECT_LT((best.centre_px - c).norm(), 0.1 * r + 0.5);
   }
   for (int trial = 0; trial < 4; ++trial) {
     // Hue 60 deg, pale: no class.

@@ -710,7 +710,7 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   const double r_core = 0.8 * r;
   const double r_spill = 1.25 * r + 1.0, ri = o.ring_inner * r, ro = o.ring_outer * r;
   long long disc = 0, disc_in = 0, spill = 0, ring = 0, ring_ball = 0, ring_field = 0,
-            ring_grass = 0, pure = 0;
+            ring_grass = 0, ring_dark = 0, pure = 0;
   for (int y = read.y; y < read.y + read.height; ++y) {
     const uint8_t* f = filled.ptr<uint8_t>(y);
     const uint8_t* m = raw.ptr<uint8_t>(y);
@@ -733,8 +733,12 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
         ring_ball += m[x] != 0;
         if (m[x] == 0) {  // what is around the ball, not more of its colour (that is leak)
           ring_lab.Add(lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x));
-          ring_field += (cls.ptr<uint8_t>(y)[x] & field_bit) != 0;
-          ring_grass += (cls.ptr<uint8_t>(y)[x] & grass_bit) != 0;
+          if (o.hidden_value > 0 && IsDark(bgr, window.x + x, window.y + y, o.hidden_value)) {
+            ++ring_dark;
+          } else {
+            ring_field += (cls.ptr<uint8_t>(y)[x] & field_bit) != 0;
+            ring_grass += (cls.ptr<uint8_t>(y)[x] & grass_bit) != 0;
+          }
         }
       } else if (d < r_core) {
         const uint8_t* l = lab.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
@@ -747,8 +751,10 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
   out->fill = disc > 0 ? double(disc_in) / disc : 0.0;
   out->spill = spill / (M_PI * r * r);
   out->leak = ring > 0 ? double(ring_ball) / ring : 0.0;
-  out->field_ring = ring > 0 ? double(ring_field) / ring : 0.0;
-  out->grass_ring = ring > 0 ? double(ring_grass) / ring : 0.0;
+  // Dark pixels around the ball (a robot, a shadow) hide the field; at most half the ring.
+  const long long ring_seen = std::max(ring - ring_dark, (ring + 1) / 2);
+  out->field_ring = ring_seen > 0 ? double(ring_field) / ring_seen : 0.0;
+  out->grass_ring = ring_seen > 0 ? double(ring_grass) / ring_seen : 0.0;
   out->purity = area > 0 ? pure / area : 0.0;
   const LabHistogram& disc_h = disc_lab.n > 0 ? disc_lab : core_lab;
   if (disc_h.n > 0 && ring_lab.n > 0) {

@@ -78,7 +78,8 @@ struct BallRegion {
   // The hue part of that difference (CIE94 Delta H): what shading and exposure hardly change.
   double hue_contrast = 0.0;
   // Share of the leak ring's pixels in the colour spec's "field" or "line" classes (0 without
-  // them): a ball on the field is set apart by the classes themselves.
+  // them): a ball on the field is set apart by the classes themselves. Dark pixels (a robot
+  // behind the ball, hidden_value) hide the field and are left out, at most half the ring.
   double field_ring = 0.0;
   double grass_ring = 0.0;  // the same share in the "field" class alone (not its lines)
   double solidity = 0.0;    // region area / convex hull area
