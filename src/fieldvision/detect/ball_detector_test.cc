@@ -143,8 +143,8 @@ TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
 
 // A yellow ball seen yellow-green (a greenish camera) on the green field differs from it by less
 // than min_contrast and min_hue_contrast, but its ring is field-coloured: it needs only
-// field_contrast_factor of them (accepted), also beside a black robot. The same disc on a wall of about the same contrast
-// that is not the field is rejected.
+// field_contrast_factor of them (accepted), also in front of a black robot. The same disc on a
+// wall of about the same contrast that is not the field is rejected.
 TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
   const uint64_t seed = fv::testing::TestSeed(31);
   FV_SEED_TRACE(seed);
