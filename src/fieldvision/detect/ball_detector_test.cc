@@ -165,8 +165,8 @@ TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
     EXPECT_LT((best.centre_px - p.centre).norm(), 0.1 * p.radius_px + 0.5);
   }
   for (int trial = 0; trial < 4; ++trial) {
-    // In front of a black robot that fills about 40 % of the ring: dark pixels hide the field rather
-    // than frame the ball, so the rest of the ring decides (at most half of it hidden).
+    // In front of a black robot that fills about 40 % of the ring: dark pixels hide the field
+    // rather than frame the ball, so the rest of the ring decides (at most half of it hidden).
     cv::Mat img = test_util::FieldImage(320, 240, rng);
     const Eigen::Vector2d c(rng.Uniform(80, 200), rng.Uniform(60, 180));
     const double r = rng.Uniform(8, 20);
