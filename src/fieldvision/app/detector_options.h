@@ -10,8 +10,8 @@
 
 namespace fv::app {
 
-// The colour detector's radius limits, small-ball stage and off-field score (`detect`, `eval
-// detect`).
+// The colour detector's radius limits, small-ball stage, off-field score and lit-part check
+// (`detect`, `eval detect`).
 inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
   cmd->add_option("--min-radius", o.min_radius_px, "Smallest ball radius in pixels")
       ->check(FiniteRange(0.1, 10000.0))
@@ -29,6 +29,12 @@ inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
                   "seen from the bottom up) is accepted only from this score or as a whole disc "
                   "(0: anywhere)")
       ->check(FiniteRange(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--lit-ratio", o.min_lit_field_ratio,
+                  "A candidate whose lit part is darker than this times the field's median "
+                  "brightness is rejected (balls reflect more than grass; 0: no check; off for "
+                  "the black, blue and green presets)")
+      ->check(FiniteRange(0.0, 10.0))
       ->capture_default_str();
 }
 

@@ -243,6 +243,8 @@ void BallDetectorOptions::Check() const {
   CheckInRange(off_field_min_score, 0.0, 1.0, "off_field_min_score");
   CheckInRange(off_field_min_visible, 0.0, 1.0, "off_field_min_visible");
   CheckNonNegative(off_field_min_radius_px, "off_field_min_radius_px");
+  CheckNonNegative(min_lit_field_ratio, "min_lit_field_ratio");
+  field_brightness.Check();
   field_boundary.Check();
   CheckInRange(grow_hue_deg, 0.0, 60.0, "grow_hue_deg");
   CheckInRange(grow_factor, 0.0, 1.0, "grow_factor");
@@ -290,6 +292,10 @@ void BallDetector::Init(const ColourSpec& colour) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
   }
   small_balls_ = SmallBallsPossible();
+  const bool dark_ball = options_.colour == "black" || options_.colour == "blue" ||
+                         options_.colour == "green";
+  const bool posed = camera_ != nullptr && camera_->has_pose;
+  lit_check_ = options_.min_lit_field_ratio > 0 && field_bit_ != 0 && !dark_ball && !posed;
 }
 
 bool BallDetector::SmallBallsPossible() const {
@@ -427,6 +433,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     AddSmallBalls(bgr, roi, &result);
     RejectOffField(bgr, roi, &boundary, &result.candidates);
   }
+  RejectDarkerThanField(bgr, roi, &result.candidates);
   RankAndDropDuplicates(&result.candidates);
   return result;
 }
@@ -454,6 +461,25 @@ void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
     c.reason = fmt::format(
         "above the field's edge ({:.0f} px), score {:.2f} < {:.2f}, not a whole disc",
         (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px), c.score, min_score);
+  }
+}
+
+void BallDetector::RejectDarkerThanField(const cv::Mat& bgr, const cv::Rect& roi,
+                                         std::vector<BallCandidate>* candidates) const {
+  if (!lit_check_) return;
+  const double ratio = options_.min_lit_field_ratio;
+  std::optional<double> field_value;  // measured at the first accepted candidate
+  for (BallCandidate& c : *candidates) {
+    if (!c.accepted) continue;
+    if (!field_value) {
+      field_value = FieldValue(bgr, *table_, field_bit_, options_.field_brightness, roi);
+    }
+    if (*field_value < 0) return;  // too little field to tell
+    const double lit = LitValue(bgr, c.centre_px, c.radius_px, options_.field_brightness);
+    if (lit < 0 || lit >= ratio * *field_value) continue;
+    c.accepted = false;
+    c.reason = fmt::format("darker than the field (lit part V {:.0f} < {:.2f} x field V {:.0f})",
+                           lit, ratio, *field_value);
   }
 }
 

@@ -1,0 +1,88 @@
+#include "fieldvision/detect/field_brightness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "fieldvision/util/error.h"
+
+namespace fv::detect {
+
+void FieldBrightnessOptions::Check() const {
+  FV_REQUIRE(step_px >= 1, "FieldBrightnessOptions.step_px must be >= 1 (got {})", step_px);
+  CheckInRange(min_field_share, 0.0, 1.0, "FieldBrightnessOptions.min_field_share");
+  FV_REQUIRE(min_field_samples >= 1, "FieldBrightnessOptions.min_field_samples must be >= 1");
+  FV_REQUIRE(max_disc_samples >= 1, "FieldBrightnessOptions.max_disc_samples must be >= 1");
+}
+
+namespace {
+
+uint8_t Value(const cv::Mat& bgr, int x, int y) {
+  const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+  return std::max({p[0], p[1], p[2]});
+}
+
+// The q-quantile (0..1) of `v` (not empty); reorders it.
+double Quantile(std::vector<uint8_t>* v, double q) {
+  const size_t k = std::min(v->size() - 1, static_cast<size_t>(q * static_cast<double>(v->size())));
+  std::nth_element(v->begin(), v->begin() + static_cast<ptrdiff_t>(k), v->end());
+  return (*v)[k];
+}
+
+}  // namespace
+
+double FieldValue(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit,
+                  const FieldBrightnessOptions& o, const cv::Rect& roi_in) {
+  o.Check();
+  FV_REQUIRE(bgr.type() == CV_8UC3, "field brightness: the image must be 8-bit BGR");
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
+  if (field_bit == 0 || roi.empty()) return -1.0;
+  std::vector<uint8_t> values;
+  long long samples = 0;
+  for (int y = roi.y + o.step_px / 2; y < roi.y + roi.height; y += o.step_px) {
+    const uint8_t* row = bgr.ptr<uint8_t>(y);
+    for (int x = roi.x + o.step_px / 2; x < roi.x + roi.width; x += o.step_px) {
+      ++samples;
+      const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x);
+      if ((table.Classify(p[0], p[1], p[2]) & field_bit) != 0) {
+        values.push_back(std::max({p[0], p[1], p[2]}));
+      }
+    }
+  }
+  const auto n = static_cast<long long>(values.size());
+  if (n < o.min_field_samples || n < o.min_field_share * static_cast<double>(samples)) return -1.0;
+  return Quantile(&values, 0.5);
+}
+
+double LitValue(const cv::Mat& bgr, const Eigen::Vector2d& centre_px, double radius_px,
+                const FieldBrightnessOptions& o) {
+  FV_REQUIRE(bgr.type() == CV_8UC3, "field brightness: the image must be 8-bit BGR");
+  FV_REQUIRE(
+      std::isfinite(centre_px.x()) && std::isfinite(centre_px.y()) && std::isfinite(radius_px),
+      "field brightness: non-finite disc");
+  const double r = std::max(radius_px, 0.5);
+  const double area = M_PI * r * r;
+  const int step = std::max(1, static_cast<int>(std::sqrt(area / o.max_disc_samples)));
+  const int x0 = std::max(0, static_cast<int>(std::floor(centre_px.x() - r)));
+  const int x1 = std::min(bgr.cols - 1, static_cast<int>(std::ceil(centre_px.x() + r)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(centre_px.y() - r)));
+  const int y1 = std::min(bgr.rows - 1, static_cast<int>(std::ceil(centre_px.y() + r)));
+  std::vector<uint8_t> values;
+  for (int y = y0; y <= y1; y += step) {
+    for (int x = x0; x <= x1; x += step) {
+      const double dx = x - centre_px.x(), dy = y - centre_px.y();
+      if (dx * dx + dy * dy <= r * r) values.push_back(Value(bgr, x, y));
+    }
+  }
+  if (values.empty()) {
+    // A disc smaller than a pixel: the pixel under its centre.
+    const int x = static_cast<int>(std::floor(centre_px.x()));
+    const int y = static_cast<int>(std::floor(centre_px.y()));
+    if (x < 0 || y < 0 || x >= bgr.cols || y >= bgr.rows) return -1.0;
+    return Value(bgr, x, y);
+  }
+  return Quantile(&values, 0.9);
+}
+
+}  // namespace fv::detect
