@@ -292,8 +292,8 @@ void BallDetector::Init(const ColourSpec& colour) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
   }
   small_balls_ = SmallBallsPossible();
-  const bool dark_ball = options_.colour == "black" || options_.colour == "blue" ||
-                         options_.colour == "green";
+  const bool dark_ball =
+      options_.colour == "black" || options_.colour == "blue" || options_.colour == "green";
   const bool posed = camera_ != nullptr && camera_->has_pose;
   lit_check_ = options_.min_lit_field_ratio > 0 && field_bit_ != 0 && !dark_ball && !posed;
 }
