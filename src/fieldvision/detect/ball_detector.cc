@@ -295,7 +295,7 @@ void BallDetector::Init(const ColourSpec& colour) {
   const bool dark_ball =
       options_.colour == "black" || options_.colour == "blue" || options_.colour == "green";
   const bool posed = camera_ != nullptr && camera_->has_pose;
-  lit_check_ = options_.min_lit_field_ratio > 0 && field_bit_ != 0 && !dark_ball && !posed;
+  lit_check_ = options_.min_lit_field_ratio > 0 && !dark_ball && !posed;
 }
 
 bool BallDetector::SmallBallsPossible() const {
@@ -439,8 +439,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
 }
 
 FieldBoundary BallDetector::OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region) const {
-  if ((camera_ != nullptr && camera_->has_pose) || field_bit_ == 0 ||
-      options_.off_field_min_score <= 0) {
+  if ((camera_ != nullptr && camera_->has_pose) || options_.off_field_min_score <= 0) {
     return {};
   }
   return FindFieldBoundary(bgr, *table_, field_bit_, options_.field_boundary, region);

@@ -215,7 +215,7 @@ class BallDetector {
   const BallDetectorOptions& options() const { return options_; }
   const ColourTable& table() const { return *table_; }
   // The field's far edge the off-field check uses in `region` of a frame (field_boundary.h); no
-  // boundary when the check is off (a posed camera, off_field_min_score 0, no field class).
+  // boundary when the check is off (a posed camera, off_field_min_score 0).
   FieldBoundary OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
   // The field-of-play mask (CV_8U, 255 inside) or empty when not used.
   const cv::Mat& field_mask() const { return field_mask_; }
@@ -279,7 +279,7 @@ class BallDetector {
   uint8_t field_bit_ = 0;  // the spec's "field" class (0: none)
   cv::Mat field_mask_;
   bool small_balls_ = false;
-  bool lit_check_ = false;  // min_lit_field_ratio applies (a field class, not a dark preset)
+  bool lit_check_ = false;  // min_lit_field_ratio applies (no posed camera, not a dark preset)
 };
 
 // The field-of-play mask of a camera: the image of the prism over the field (plus margin) from

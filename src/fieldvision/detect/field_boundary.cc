@@ -15,6 +15,7 @@ void FieldBoundaryOptions::Check() const {
   CheckInRange(window_share, 0.0, 1.0, "FieldBoundaryOptions.window_share");
   CheckInRange(min_field_share, 0.0, 1.0, "FieldBoundaryOptions.min_field_share");
   CheckInRange(min_column_share, 0.0, 1.0, "FieldBoundaryOptions.min_column_share");
+  image_field.Check();
 }
 
 FieldBoundary::FieldBoundary(std::vector<double> xs, std::vector<double> ys)
@@ -47,12 +48,11 @@ namespace {
 
 // The column's spot: the row whose field pixels minus other pixels below it (from the bottom of
 // `roi`) are most, or -1 when no row has more field than other pixels below it.
-int ColumnSpot(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit, int x,
-               const cv::Rect& roi, long long* field_pixels) {
+template <typename IsField>
+int ColumnSpot(const cv::Rect& roi, const IsField& is_field, long long* field_pixels) {
   int score = 0, best = 0, spot = -1;
   for (int y = roi.y + roi.height - 1; y >= roi.y; --y) {
-    const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
-    const bool field = (table.Classify(p[0], p[1], p[2]) & field_bit) != 0;
+    const bool field = is_field(y);
     *field_pixels += field;
     score += field ? 1 : -1;
     if (score > best) best = score, spot = y;
@@ -60,23 +60,19 @@ int ColumnSpot(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit, 
   return spot;
 }
 
-}  // namespace
-
-FieldBoundary FindFieldBoundary(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit,
-                                const FieldBoundaryOptions& options, const cv::Rect& roi_in) {
-  options.Check();
-  FV_REQUIRE(bgr.type() == CV_8UC3, "field boundary: the image must be 8-bit BGR");
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
-  if (roi.width < 2 || roi.height < 2 || field_bit == 0) return {};
-  const int n = std::min(options.columns, roi.width);
-  std::vector<double> xs(n), spots(n);
+// The boundary through the spots of the columns `xs` of `roi`, `is_field(i, y)` telling whether
+// pixel (xs[i], y) is field; none when too little is.
+template <typename IsField>
+FieldBoundary BoundaryOfColumns(const std::vector<int>& xs, const cv::Rect& roi,
+                                const FieldBoundaryOptions& options, const IsField& is_field) {
+  const int n = static_cast<int>(xs.size());
+  std::vector<double> centres(n), spots(n);
   long long field_pixels = 0;
   int with_spot = 0;
   for (int i = 0; i < n; ++i) {
-    const int x = roi.x + static_cast<int>(std::lround((i + 0.5) * roi.width / n - 0.5));
-    xs[i] = x + 0.5;
-    const int spot = ColumnSpot(bgr, table, field_bit, x, roi, &field_pixels);
+    centres[i] = xs[i] + 0.5;
+    const int spot = ColumnSpot(
+        roi, [&](int y) { return is_field(i, y); }, &field_pixels);
     with_spot += spot >= 0;
     // A column without field bounds nothing: the top of the region.
     spots[i] = spot >= 0 ? spot : roi.y;
@@ -93,7 +89,40 @@ FieldBoundary FindFieldBoundary(const cv::Mat& bgr, const ColourTable& table, ui
     const auto last = spots.begin() + std::min(n, i + window + 1);
     ys[i] = *std::min_element(first, last);
   }
-  return FieldBoundary(std::move(xs), std::move(ys));
+  return FieldBoundary(std::move(centres), std::move(ys));
+}
+
+}  // namespace
+
+FieldBoundary FindFieldBoundary(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit,
+                                const FieldBoundaryOptions& options, const cv::Rect& roi_in) {
+  options.Check();
+  FV_REQUIRE(bgr.type() == CV_8UC3, "field boundary: the image must be 8-bit BGR");
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
+  if (roi.width < 2 || roi.height < 2) return {};
+  const int n = std::min(options.columns, roi.width);
+  std::vector<int> xs(n);
+  for (int i = 0; i < n; ++i) {
+    xs[i] = roi.x + static_cast<int>(std::lround((i + 0.5) * roi.width / n - 0.5));
+  }
+  if (field_bit != 0) {
+    FieldBoundary b = BoundaryOfColumns(xs, roi, options, [&](int i, int y) {
+      const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(xs[i]);
+      return (table.Classify(p[0], p[1], p[2]) & field_bit) != 0;
+    });
+    if (b.valid()) return b;
+  }
+  // The class finds too little field: the image's own field colour (image_field.h).
+  const std::optional<ImageFieldColour> colour =
+      FindImageFieldColour(bgr, roi, options.image_field);
+  if (!colour) return {};
+  std::vector<int> rows(roi.height);
+  for (int k = 0; k < roi.height; ++k) rows[k] = roi.y + k;
+  const cv::Mat lab = LabAt(bgr, xs, rows);
+  return BoundaryOfColumns(xs, roi, options, [&](int i, int y) {
+    return colour->Holds(lab.at<cv::Vec3b>(y - roi.y, i));
+  });
 }
 
 }  // namespace fv::detect

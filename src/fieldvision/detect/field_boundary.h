@@ -4,8 +4,10 @@
 // pixels minus other pixels below it (a field boundary spot: lines, robots and the ball are
 // gaps the field above them outweighs, a green shirt in the stands is not reached); then the
 // highest spot within a window of columns, so that robots and goals standing on the far edge do
-// not pull it down. The field-boundary spots of RoboCup robot vision (B-Human's and others'
-// field-boundary detection) without the model fit: a ball in the air lies above it too.
+// not pull it down. Where the colour spec's field class finds too little, the image's own field
+// colour (image_field.h: a teal or grey carpet). The field-boundary spots of RoboCup robot vision
+// (B-Human's and others' field-boundary detection) without the model fit: a ball in the air lies
+// above it too.
 #pragma once
 
 #include <string>
@@ -14,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/detect/colour.h"
+#include "fieldvision/detect/image_field.h"
 
 namespace fv::detect {
 
@@ -23,6 +26,8 @@ struct FieldBoundaryOptions {
   double min_field_share = 0.05;  // field-colour share of the sampled pixels for a boundary
   double min_column_share = 0.3;  // share of columns with a spot for a boundary (a column
                                   // without one leaves its window unbounded)
+  // Where the colour spec's field class finds too little field: the image's own field colour.
+  ImageFieldOptions image_field;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -47,9 +52,9 @@ class FieldBoundary {
   std::vector<double> xs_, ys_;
 };
 
-// The boundary of the field class `field_bit` of `table` in `roi` of a BGR image (the whole image
-// when empty; nothing outside it is read); no boundary (valid() false) when too little of it is
-// field-coloured.
+// The boundary of the field class `field_bit` of `table` (0: none) in `roi` of a BGR image (the
+// whole image when empty; nothing outside it is read), else of the image's own field colour
+// (image_field.h); no boundary (valid() false) when too little of it is field-coloured.
 FieldBoundary FindFieldBoundary(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit,
                                 const FieldBoundaryOptions& options = {},
                                 const cv::Rect& roi = cv::Rect());

@@ -65,16 +65,22 @@ TEST(FieldBoundary, NoFieldNoBoundaryAndNothingOutsideTheRegionIsRead) {
   util::Rng rng(seed);
   const ColourTable table(PresetColourSpec("orange"));
   const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(120, 120, 120));
-  const FieldBoundary none = FindFieldBoundary(grey, table, FieldBit(table));
+  FieldBoundaryOptions class_only;
+  class_only.image_field.enabled = false;
+  const FieldBoundary none = FindFieldBoundary(grey, table, FieldBit(table), class_only);
   EXPECT_FALSE(none.valid());
   EXPECT_LT(none.Above(10, 10), 0);  // nothing is above a missing boundary
   EXPECT_EQ(none.Summary(), "no field boundary");
+  // By its own colour (image_field.h) a grey image is all field: nothing lies above its top.
+  const FieldBoundary all = FindFieldBoundary(grey, table, FieldBit(table));
+  ASSERT_TRUE(all.valid());
+  EXPECT_EQ(all.RowAt(100), 0.0);
   // The field only in the region's columns: outside them the image is grey, and the boundary
   // found is the region's own.
   cv::Mat img = SideView(200, rng);
   img(cv::Rect(0, 0, 320, 480)).setTo(cv::Scalar(120, 120, 120));
   const FieldBoundary half =
-      FindFieldBoundary(img, table, FieldBit(table), {}, cv::Rect(400, 100, 200, 300));
+      FindFieldBoundary(img, table, FieldBit(table), class_only, cv::Rect(400, 100, 200, 300));
   ASSERT_TRUE(half.valid());
   EXPECT_NEAR(half.RowAt(500), 200, 1.5);
   EXPECT_THROW(FieldBoundary({1, 1}, {2, 3}), Error);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "fieldvision/util/error.h"
@@ -13,6 +14,7 @@ void FieldBrightnessOptions::Check() const {
   CheckInRange(min_field_share, 0.0, 1.0, "FieldBrightnessOptions.min_field_share");
   FV_REQUIRE(min_field_samples >= 1, "FieldBrightnessOptions.min_field_samples must be >= 1");
   FV_REQUIRE(max_disc_samples >= 1, "FieldBrightnessOptions.max_disc_samples must be >= 1");
+  image_field.Check();
 }
 
 namespace {
@@ -37,22 +39,38 @@ double FieldValue(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bi
   FV_REQUIRE(bgr.type() == CV_8UC3, "field brightness: the image must be 8-bit BGR");
   const cv::Rect image(0, 0, bgr.cols, bgr.rows);
   const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
-  if (field_bit == 0 || roi.empty()) return -1.0;
+  if (roi.empty()) return -1.0;
+  std::vector<int> xs, ys;
+  for (int x = roi.x + o.step_px / 2; x < roi.x + roi.width; x += o.step_px) xs.push_back(x);
+  for (int y = roi.y + o.step_px / 2; y < roi.y + roi.height; y += o.step_px) ys.push_back(y);
+  const double samples = static_cast<double>(xs.size()) * static_cast<double>(ys.size());
+  const auto enough = [&](const std::vector<uint8_t>& v) {
+    const auto n = static_cast<long long>(v.size());
+    return n >= o.min_field_samples && n >= o.min_field_share * samples;
+  };
   std::vector<uint8_t> values;
-  long long samples = 0;
-  for (int y = roi.y + o.step_px / 2; y < roi.y + roi.height; y += o.step_px) {
-    const uint8_t* row = bgr.ptr<uint8_t>(y);
-    for (int x = roi.x + o.step_px / 2; x < roi.x + roi.width; x += o.step_px) {
-      ++samples;
-      const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x);
-      if ((table.Classify(p[0], p[1], p[2]) & field_bit) != 0) {
-        values.push_back(std::max({p[0], p[1], p[2]}));
+  if (field_bit != 0) {
+    for (const int y : ys) {
+      for (const int x : xs) {
+        const uint8_t* p = bgr.ptr<uint8_t>(y) + 3 * static_cast<ptrdiff_t>(x);
+        if ((table.Classify(p[0], p[1], p[2]) & field_bit) != 0) values.push_back(Value(bgr, x, y));
+      }
+    }
+    if (enough(values)) return Quantile(&values, 0.5);
+  }
+  // The class finds too little field: the image's own field colour (image_field.h).
+  const std::optional<ImageFieldColour> colour = FindImageFieldColour(bgr, roi, o.image_field);
+  if (!colour) return -1.0;
+  const cv::Mat lab = LabAt(bgr, xs, ys);
+  values.clear();
+  for (size_t j = 0; j < ys.size(); ++j) {
+    for (size_t i = 0; i < xs.size(); ++i) {
+      if (colour->Holds(lab.at<cv::Vec3b>(static_cast<int>(j), static_cast<int>(i)))) {
+        values.push_back(Value(bgr, xs[i], ys[j]));
       }
     }
   }
-  const auto n = static_cast<long long>(values.size());
-  if (n < o.min_field_samples || n < o.min_field_share * static_cast<double>(samples)) return -1.0;
-  return Quantile(&values, 0.5);
+  return enough(values) ? Quantile(&values, 0.5) : -1.0;
 }
 
 double LitValue(const cv::Mat& bgr, const Eigen::Vector2d& centre_px, double radius_px,

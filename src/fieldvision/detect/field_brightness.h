@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/detect/colour.h"
+#include "fieldvision/detect/image_field.h"
 
 namespace fv::detect {
 
@@ -18,12 +19,15 @@ struct FieldBrightnessOptions {
   double min_field_share = 0.02;  // field share of the samples needed for a field brightness
   int min_field_samples = 50;
   int max_disc_samples = 2000;  // a large disc is read on a grid of about this many pixels
+  // Where the colour spec's field class finds too little field: the image's own field colour.
+  ImageFieldOptions image_field;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
 
-// The median V of the field-class pixels on the grid over `roi` (the whole image when empty), or
-// a negative value when too few of them are field.
+// The median V of the field-class pixels (`field_bit` of `table`, 0: none) on the grid over `roi`
+// (the whole image when empty), else of the image's own field colour; a negative value when too
+// few of them are field.
 double FieldValue(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bit,
                   const FieldBrightnessOptions& options = {}, const cv::Rect& roi = cv::Rect());
 

@@ -27,11 +27,17 @@ TEST(FieldBrightness, FieldValueIsTheGrassMedianAndNeedsField) {
   const double v = FieldValue(img, table, field_bit);
   EXPECT_GE(v, 123.0);
   EXPECT_LE(v, 143.0);
-  // Only the region asked for is read: the wall alone has no field.
-  EXPECT_LT(FieldValue(img, table, field_bit, {}, cv::Rect(0, 0, 320, 60)), 0.0);
-  EXPECT_LT(FieldValue(img, table, 0), 0.0);  // no field class
+  // Only the region asked for is read: the wall alone has no field of the class.
+  FieldBrightnessOptions class_only;
+  class_only.image_field.enabled = false;
+  EXPECT_LT(FieldValue(img, table, field_bit, class_only, cv::Rect(0, 0, 320, 60)), 0.0);
+  EXPECT_LT(FieldValue(img, table, 0, class_only), 0.0);  // no field class
   const cv::Mat grey(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
-  EXPECT_LT(FieldValue(grey, table, field_bit), 0.0);
+  EXPECT_LT(FieldValue(grey, table, field_bit, class_only), 0.0);
+  // Without the class, the image's own field colour (image_field.h): the grass again.
+  const double own = FieldValue(img, table, 0);
+  EXPECT_GE(own, 123.0);
+  EXPECT_LE(own, 143.0);
 }
 
 TEST(FieldBrightness, LitValueIsTheBrightPartOfTheDisc) {
