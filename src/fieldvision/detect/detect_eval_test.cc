@@ -111,7 +111,7 @@ TEST(DetectEval, RealRobocupPhotos) {
   const DetectEvalResult ssl = EvaluateDetector(o);
   std::cout << "SSL orange: " << ssl.Summary(0) << "\n";
   EXPECT_GE(ssl.recall(), 0.75);
-  EXPECT_GE(ssl.precision(), 0.92);
+  EXPECT_GE(ssl.precision(), 0.93);
   EXPECT_NE(ssl.Summary(0).find("misses by reason: "), std::string::npos);
   EXPECT_NE(ssl.Summary(0).find(" no candidate on the ball"), std::string::npos);
   // Balls of a few pixels, mixed with the grass (small_ball.h): more found, few more false.
@@ -127,8 +127,8 @@ TEST(DetectEval, RealRobocupPhotos) {
   o.detector.colour = "yellow";
   const DetectEvalResult msl = EvaluateDetector(o);
   std::cout << "MSL yellow: " << msl.Summary(0) << "\n";
-  EXPECT_GE(msl.recall(), 0.66);
-  EXPECT_GE(msl.precision(), 0.96);
+  EXPECT_GE(msl.recall(), 0.68);
+  EXPECT_GE(msl.precision(), 0.97);
   // Lamps, banners and spectators above the field's edge (field_boundary.h) and things darker
   // than the field (field_brightness.h) are what the checks without a camera take away.
   o.detector.off_field_min_score = 0;
