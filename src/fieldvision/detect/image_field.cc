@@ -1,7 +1,8 @@
 #include "fieldvision/detect/image_field.h"
 
+#include <algorithm>
 #include <cmath>
-#include <unordered_map>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -12,7 +13,7 @@ namespace fv::detect {
 void ImageFieldOptions::Check() const {
   CheckInRange(lower_share, 0.0, 1.0, "ImageFieldOptions.lower_share");
   FV_REQUIRE(lower_share > 0, "ImageFieldOptions.lower_share must be > 0");
-  FV_REQUIRE(step_px >= 1, "ImageFieldOptions.step_px must be >= 1 (got {})", step_px);
+  FV_REQUIRE(samples >= 1, "ImageFieldOptions.samples must be >= 1 (got {})", samples);
   CheckInRange(min_share, 0.0, 1.0, "ImageFieldOptions.min_share");
   CheckNonNegative(max_delta_l, "ImageFieldOptions.max_delta_l");
   CheckNonNegative(max_delta_ab, "ImageFieldOptions.max_delta_ab");
@@ -44,23 +45,25 @@ std::optional<ImageFieldColour> FindImageFieldColour(const cv::Mat& bgr, const c
   const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
   if (!o.enabled || roi.empty()) return std::nullopt;
   const int top = roi.y + static_cast<int>(std::floor((1.0 - o.lower_share) * roi.height));
+  const double lower_area = static_cast<double>(roi.width) * (roi.y + roi.height - top);
+  const int step = std::max(1, static_cast<int>(std::lround(std::sqrt(lower_area / o.samples))));
   std::vector<int> xs, ys;
-  for (int x = roi.x + o.step_px / 2; x < roi.x + roi.width; x += o.step_px) xs.push_back(x);
-  for (int y = top + o.step_px / 2; y < roi.y + roi.height; y += o.step_px) ys.push_back(y);
+  for (int x = roi.x + step / 2; x < roi.x + roi.width; x += step) xs.push_back(x);
+  for (int y = top + step / 2; y < roi.y + roi.height; y += step) ys.push_back(y);
   const cv::Mat lab = LabAt(bgr, xs, ys);
   if (lab.empty()) return std::nullopt;
   // The most common colour: a histogram of L / 16, a / 6, b / 6 bins, then the mean of its bin.
+  constexpr int kL = 16, kAb = 43;
   const auto key = [](const cv::Vec3b& p) {
-    return (p[0] / 16) * 65536 + (p[1] / 6) * 256 + p[2] / 6;
+    return ((p[0] / 16) * kAb + p[1] / 6) * kAb + p[2] / 6;
   };
-  std::unordered_map<int, int> counts;
+  std::vector<int> counts(kL * kAb * kAb, 0);
   for (int j = 0; j < lab.rows; ++j) {
     for (int i = 0; i < lab.cols; ++i) ++counts[key(lab.at<cv::Vec3b>(j, i))];
   }
-  int best_key = 0, best_count = 0;
-  for (const auto& [k, n] : counts) {
-    if (n > best_count || (n == best_count && k < best_key)) best_key = k, best_count = n;
-  }
+  const int best_key =
+      static_cast<int>(std::max_element(counts.begin(), counts.end()) - counts.begin());
+  const int best_count = counts[best_key];
   cv::Vec3d sum(0, 0, 0);
   for (int j = 0; j < lab.rows; ++j) {
     for (int i = 0; i < lab.cols; ++i) {

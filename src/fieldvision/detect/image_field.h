@@ -16,7 +16,7 @@ namespace fv::detect {
 struct ImageFieldOptions {
   bool enabled = true;
   double lower_share = 1.0 / 3.0;  // the region's lower part that is sampled
-  int step_px = 2;                 // its sampling grid
+  int samples = 20000;             // about this many pixels of it are sampled (a grid)
   double min_share = 0.4;          // samples near the most common colour for a field colour
   // OpenCV's 8-bit CIELAB: L * 255 / 100; a, b in their own units (+128).
   double max_delta_l = 50.0;

@@ -86,7 +86,7 @@ TEST(ImageField, NoCommonColourNoField) {
   EXPECT_FALSE(FindFieldBoundary(img, table, 0).valid());  // no class, no colour of its own
   EXPECT_LT(FieldValue(img, table, 0), 0.0);
   ImageFieldOptions bad;
-  bad.step_px = 0;
+  bad.samples = 0;
   EXPECT_THROW(bad.Check(), Error);
   bad = {};
   bad.lower_share = 0;
