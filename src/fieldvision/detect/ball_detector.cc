@@ -132,9 +132,9 @@ bool StandsOut(const BallRegion& r, const BallDetectorOptions& o) {
 
 // The first region check the candidate fails ("" when it passes them all); with
 // `shape_only` the colour checks (leak, contrast) are left out.
-std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o,
+std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o, double min_arc_cover,
                           bool shape_only = false) {
-  if (r.arc_cover < o.min_arc_cover) {
+  if (r.arc_cover < min_arc_cover) {
     return fmt::format("region outline not round ({:.0f} % of the circle)", 100 * r.arc_cover);
   }
   if (r.outside > o.max_region_outside) {
@@ -229,6 +229,7 @@ void BallDetectorOptions::Check() const {
   CheckInRange(guided_radius_change, 0.0, 1.0, "guided_radius_change");
   CheckInRange(guided_max_shift_radii, 0.0, 10.0, "guided_max_shift_radii");
   CheckInRange(min_arc_cover, 0.0, 1.0, "min_arc_cover");
+  CheckInRange(unposed_min_arc_cover, 0.0, 1.0, "unposed_min_arc_cover");
   CheckInRange(min_region_fill, 0.0, 1.0, "min_region_fill");
   CheckNonNegative(max_region_spill, "max_region_spill");
   CheckInRange(max_ring_leak, 0.0, 1.0, "max_ring_leak");
@@ -295,6 +296,7 @@ void BallDetector::Init(const ColourSpec& colour) {
   const bool dark_ball =
       options_.colour == "black" || options_.colour == "blue" || options_.colour == "green";
   const bool posed = camera_ != nullptr && camera_->has_pose;
+  min_arc_cover_ = posed ? options_.min_arc_cover : options_.unposed_min_arc_cover;
   lit_check_ = options_.min_lit_field_ratio > 0 && !dark_ball && !posed;
 }
 
@@ -573,7 +575,7 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
           : size_why;
   // Where the region was measured, the outline fit alone does not decide: both must agree.
   const bool region_agrees = !o.use_region || !region.ok || !o.region_vetoes_fit ||
-                             RegionProblem(region, o, /*shape_only=*/true).empty();
+                             RegionProblem(region, o, min_arc_cover_, /*shape_only=*/true).empty();
   // A measured region must stand out from its surroundings on either path (min_contrast).
   const bool stands_out = !region.ok || StandsOut(region, o);
   const bool precise_ok =
@@ -584,12 +586,12 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
   } else if (!region.ok) {
     region_why = region.failure;
   } else {
-    region_why = RegionProblem(region, o);
+    region_why = RegionProblem(region, o, min_arc_cover_);
     if (region_why.empty()) region_why = region_size_why;
   }
   const bool region_accept = region_why.empty();
-  cand.disc_shaped =
-      region.ok && region_size_why.empty() && RegionProblem(region, o, /*shape_only=*/true).empty();
+  cand.disc_shaped = region.ok && region_size_why.empty() &&
+                     RegionProblem(region, o, min_arc_cover_, /*shape_only=*/true).empty();
   if (fit.ok) {
     cand.blurred = fit.blurred;
     cand.inlier_fraction = fit.inlier_fraction;

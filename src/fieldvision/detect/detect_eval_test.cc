@@ -110,8 +110,8 @@ TEST(DetectEval, RealRobocupPhotos) {
   o.detector.colour = "orange";
   const DetectEvalResult ssl = EvaluateDetector(o);
   std::cout << "SSL orange: " << ssl.Summary(0) << "\n";
-  EXPECT_GE(ssl.recall(), 0.75);
-  EXPECT_GE(ssl.precision(), 0.93);
+  EXPECT_GE(ssl.recall(), 0.78);
+  EXPECT_GE(ssl.precision(), 0.925);
   EXPECT_NE(ssl.Summary(0).find("misses by reason: "), std::string::npos);
   EXPECT_NE(ssl.Summary(0).find(" no candidate on the ball"), std::string::npos);
   // Balls of a few pixels, mixed with the grass (small_ball.h): more found, few more false.
@@ -127,8 +127,16 @@ TEST(DetectEval, RealRobocupPhotos) {
   o.detector.colour = "yellow";
   const DetectEvalResult msl = EvaluateDetector(o);
   std::cout << "MSL yellow: " << msl.Summary(0) << "\n";
-  EXPECT_GE(msl.recall(), 0.68);
-  EXPECT_GE(msl.precision(), 0.97);
+  EXPECT_GE(msl.recall(), 0.70);
+  EXPECT_GE(msl.precision(), 0.96);
+  // Without a camera a region covering 45 % of its circle will do (a shaded lower half, a ball
+  // half behind a robot): more balls than with the posed cameras' 50 %, as few false ones.
+  o.detector.unposed_min_arc_cover = o.detector.min_arc_cover;
+  const DetectEvalResult half = EvaluateDetector(o);
+  std::cout << "MSL yellow, half the circle: " << half.Summary(0) << "\n";
+  EXPECT_GE(msl.recall(), half.recall() + 0.01);
+  EXPECT_GE(msl.precision(), half.precision() - 0.02);
+  o.detector.unposed_min_arc_cover = BallDetectorOptions().unposed_min_arc_cover;
   // Lamps, banners and spectators above the field's edge (field_boundary.h) and things darker
   // than the field (field_brightness.h) are what the checks without a camera take away.
   o.detector.off_field_min_score = 0;
