@@ -53,16 +53,16 @@ std::optional<ImageFieldColour> FindImageFieldColour(const cv::Mat& bgr, const c
   const cv::Mat lab = LabAt(bgr, xs, ys);
   if (lab.empty()) return std::nullopt;
   // The most common colour: a histogram of L / 16, a / 6, b / 6 bins, then the mean of its bin.
-  constexpr int kL = 16, kAb = 43;
+  constexpr size_t kL = 16, kAb = 43;
   const auto key = [](const cv::Vec3b& p) {
-    return ((p[0] / 16) * kAb + p[1] / 6) * kAb + p[2] / 6;
+    return ((size_t{p[0]} / 16) * kAb + p[1] / 6) * kAb + p[2] / 6;
   };
   std::vector<int> counts(kL * kAb * kAb, 0);
   for (int j = 0; j < lab.rows; ++j) {
     for (int i = 0; i < lab.cols; ++i) ++counts[key(lab.at<cv::Vec3b>(j, i))];
   }
-  const int best_key =
-      static_cast<int>(std::max_element(counts.begin(), counts.end()) - counts.begin());
+  const auto best_key =
+      static_cast<size_t>(std::max_element(counts.begin(), counts.end()) - counts.begin());
   const int best_count = counts[best_key];
   cv::Vec3d sum(0, 0, 0);
   for (int j = 0; j < lab.rows; ++j) {
