@@ -21,7 +21,8 @@ inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
       ->capture_default_str();
   cmd->add_option("--small-balls", o.small.mode,
                   "Balls of a few pixels mixed with the background: on, off, or auto (with a posed "
-                  "camera, where the ball looks that small)")
+                  "camera where the ball looks that small, without one anywhere); without a posed "
+                  "camera only on the field")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
   cmd->add_option("--off-field-score", o.off_field_min_score,

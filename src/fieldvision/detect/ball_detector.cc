@@ -252,6 +252,7 @@ void BallDetectorOptions::Check() const {
   region.Check();
   fit.Check();
   small.Check();
+  small_field.Check();
 }
 
 int BallDetectionResult::accepted() const {
@@ -303,7 +304,7 @@ void BallDetector::Init(const ColourSpec& colour) {
 bool BallDetector::SmallBallsPossible() const {
   const SmallBallOptions& o = options_.small;
   if (o.mode != "auto") return o.mode == "on";
-  if (camera_ == nullptr || !camera_->has_pose) return false;
+  if (camera_ == nullptr || !camera_->has_pose) return true;  // on the field (RejectSmallOffField)
   // Anywhere on a 32 x 24 grid (inside the field mask) where the ball may look that small.
   for (int j = 0; j < 24; ++j) {
     for (int i = 0; i < 32; ++i) {
@@ -434,6 +435,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   if (small_balls_ && result.accepted() == 0) {
     AddSmallBalls(bgr, roi, &result);
     RejectOffField(bgr, roi, &boundary, &result.candidates);
+    RejectSmallOffField(bgr, roi, &result.candidates);
   }
   RejectDarkerThanField(bgr, roi, &result.candidates);
   RankAndDropDuplicates(&result.candidates);
@@ -462,6 +464,26 @@ void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
     c.reason = fmt::format(
         "above the field's edge ({:.0f} px), score {:.2f} < {:.2f}, not a whole disc",
         (*boundary)->Above(c.centre_px.x(), c.centre_px.y() + c.radius_px), c.score, min_score);
+  }
+}
+
+void BallDetector::RejectSmallOffField(const cv::Mat& bgr, const cv::Rect& roi,
+                                       std::vector<BallCandidate>* candidates) const {
+  const FieldSurroundOptions& o = options_.small_field;
+  if (o.min_share <= 0 || (camera_ != nullptr && camera_->has_pose)) return;
+  std::optional<std::optional<ImageFieldColour>> image_field;  // found at the first spot
+  for (BallCandidate& c : *candidates) {
+    if (!c.accepted || !c.small) continue;
+    if (!image_field) {
+      image_field = FindImageFieldColour(bgr, roi, options_.field_brightness.image_field);
+    }
+    if (field_bit_ == 0 && !image_field->has_value()) return;  // no field to tell
+    const ImageFieldColour* own = image_field->has_value() ? &**image_field : nullptr;
+    const double share =
+        FieldShareAround(bgr, *table_, field_bit_, own, c.centre_px, c.radius_px, o);
+    if (share < 0 || share >= o.min_share) continue;
+    c.accepted = false;
+    c.reason = fmt::format("a small spot off the field ({:.0f} % of its ring field)", 100 * share);
   }
 }
 
@@ -737,8 +759,9 @@ void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
     c.score = 0.5 * std::min(1.0, s.contrast / (10 * o.min_contrast));
     double exp_min = 0, exp_max = 0;
     if (!ExpectedRadius(s.centre_px, &exp_min, &exp_max)) {
-      c.accepted = o.mode == "on";
-      if (!c.accepted) c.reason = "a small spot, ball size unknown here (small balls: auto)";
+      // Without a posed camera the field around the spot decides (RejectSmallOffField).
+      c.accepted = o.mode == "on" || camera_ == nullptr || !camera_->has_pose;
+      if (!c.accepted) c.reason = "a small spot where no ball can be seen (small balls: auto)";
     } else if (SmallestPlausibleRadius(exp_min) > o.max_radius_px) {
       c.reason = fmt::format("a small spot where the ball looks larger ({:.1f} px)", exp_min);
     } else {

@@ -301,9 +301,8 @@ NodeSummary RunNode(const NodeOptions& o) {
   FV_REQUIRE(size.width == camera.width && size.height == camera.height,
              "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,
              camera.height, o.video, size.width, size.height);
-  detect::BallDetectorOptions dopt;
-  dopt.diameter_m = o.ball_diameter_m;
-  dopt.colour = o.colour;
+  const detect::BallDetectorOptions dopt =
+      pipeline::TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   auto detector = std::make_shared<detect::BallDetector>(dopt, &camera, field ? &*field : nullptr);
   pipeline::CameraStage stage(0, camera, pipeline::BallDetectFnFor(detector), o.track, o.video,
                               pipeline::BallGuidedFnFor(detector));

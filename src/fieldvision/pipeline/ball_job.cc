@@ -50,6 +50,15 @@ void BallJobOptions::Check() const {
              "ball: bundle_sigma_px must be > 0 (got {})", bundle_sigma_px);
 }
 
+detect::BallDetectorOptions TrackingDetectorOptions(double ball_diameter_m,
+                                                    const std::string& colour) {
+  detect::BallDetectorOptions o;
+  o.diameter_m = ball_diameter_m;
+  o.colour = colour;
+  o.small.mode = "off";
+  return o;
+}
+
 camera::Camera ReadRigCamera(const std::string& path) {
   camera::Camera camera = camera::ReadCameraYaml(path);
   if (camera.name.empty()) camera.name = std::filesystem::path(path).stem().string();
@@ -179,9 +188,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   if (!o.field.empty()) field = field::LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
   std::vector<std::unique_ptr<io::FrameSource>> sources = OpenBallVideos(o, cameras);
-  detect::BallDetectorOptions dopt;
-  dopt.diameter_m = o.ball_diameter_m;
-  dopt.colour = o.colour;
+  const detect::BallDetectorOptions dopt = TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   std::vector<BallRegionDetectFn> detect_fns;
   std::vector<BallGuidedFn> guided_fns;
   for (int c = 0; c < n; ++c) {

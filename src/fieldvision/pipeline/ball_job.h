@@ -55,6 +55,12 @@ BallJobResult RunBallJob(const BallJobOptions& options);
 // A rig camera from its file: the pose is required; `name` defaults to the file's stem.
 camera::Camera ReadRigCamera(const std::string& path);
 
+// The detector options of a tracking camera (`ball`, camera nodes): posed rig cameras, no
+// small-ball stage (the tracker's guided fit finds a small ball at its expected size; spots taken
+// from the stage moved the low-sun-kick render's centres, mean 3.2 -> 4.1 mm).
+detect::BallDetectorOptions TrackingDetectorOptions(double ball_diameter_m,
+                                                    const std::string& colour);
+
 // A camera stage's detector from a ball detector: its accepted candidates, then the best few weak
 // ones (fusion uses those only to complete a position that an accepted candidate of another
 // camera starts).
