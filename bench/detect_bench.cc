@@ -172,6 +172,34 @@ BENCHMARK(BM_BallDetector)
     ->Args({4, 1})
     ->Unit(benchmark::kMicrosecond);
 
+// Without a camera (a photo) on a frame whose ball is painted over with grass: nothing is
+// accepted, so the small-ball stage (detect/small_ball.h; "auto", the default without a camera,
+// against "off") searches the whole frame, then the field check of its spots.
+void BM_BallDetectorNoBallNoCamera(benchmark::State& state) {
+  static const cv::Mat no_ball = [] {
+    fv::util::Rng rng(2);
+    return fv::detect::test_util::FieldImage(1280, 960, rng);
+  }();
+  BaselineSeconds();
+  fv::detect::BallDetectorOptions o;
+  o.small.mode = state.range(0) != 0 ? "auto" : "off";
+  const fv::detect::BallDetector det(o, nullptr, nullptr);
+  int accepted = 0;
+  double total = 0;
+  for (auto _ : state) {
+    const double t0 = CpuSeconds();
+    accepted = det.DetectWithSummary(no_ball).accepted();
+    total += CpuSeconds() - t0;
+  }
+  SetCounters(state, total);
+  state.counters["accepted"] = accepted;
+}
+BENCHMARK(BM_BallDetectorNoBallNoCamera)
+    ->ArgNames({"small"})
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMicrosecond);
+
 // The sub-pixel outline fit alone (detect/ball_fit.h, with the camera) on each candidate the
 // detector refines in the frame, seeded at the candidate's centre and radius: most of the
 // detector's time after the region stage.

@@ -131,7 +131,9 @@ BENCHMARK(BM_DecodeWindow)->Arg(0)->Arg(50)->Arg(100)->Unit(benchmark::kMillisec
 // frames in this many bands (1: the node's default).
 void BM_NodeFrame(benchmark::State& state) {
   const Clip& c = KickClip();
-  fv::detect::BallDetectorOptions dopt;
+  const fv::detect::BallDetectorOptions defaults;
+  const fv::detect::BallDetectorOptions dopt =
+      fv::pipeline::TrackingDetectorOptions(defaults.diameter_m, defaults.colour);
   auto detector = std::make_shared<fv::detect::BallDetector>(dopt, &c.camera, nullptr);
   fv::pipeline::BallTrackOptions track;
   track.enabled = state.range(0) != 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
@@ -25,6 +26,93 @@ void SmallBallOptions::Check() const {
   FV_REQUIRE(max_spots >= 1, "SmallBallOptions.max_spots must be at least 1 (got {})", max_spots);
 }
 
+namespace {
+
+// Per-thread images of a frame's size: allocating them anew for every frame cost more than the
+// filters (fresh pages, each faulted in).
+struct Scratch {
+  cv::Mat spot, big, small;     // unnormalised box sums (32-bit) of the 3x3, outer and inner boxes
+  cv::Mat contrast, extension;  // per pixel (0: no spot)
+};
+
+// The summed variance of the three channels over the ring between the inner and outer boxes
+// around (x, y) of `img` (borders replicated), about `mean`.
+double RingVariance(const cv::Mat& img, int x, int y, int inner_half, int outer_half,
+                    const cv::Vec3f& mean) {
+  double sum = 0;
+  int n = 0;
+  for (int dy = -outer_half; dy <= outer_half; ++dy) {
+    const auto* row = img.ptr<cv::Vec3b>(std::clamp(y + dy, 0, img.rows - 1));
+    for (int dx = -outer_half; dx <= outer_half; ++dx) {
+      if (std::abs(dx) <= inner_half && std::abs(dy) <= inner_half) continue;
+      const cv::Vec3b& p = row[std::clamp(x + dx, 0, img.cols - 1)];
+      for (int ch = 0; ch < 3; ++ch) {
+        const double e = p[ch] - mean[ch];
+        sum += e * e;
+      }
+      ++n;
+    }
+  }
+  return sum / n;
+}
+
+// The smallest extension t (o.extensions in order) at which ring + t (spot - ring) is in the
+// class, or 0.
+float Extension(const ColourTable& table, uint8_t bit, const cv::Vec3f& ring, const cv::Vec3f& d,
+                const SmallBallOptions& o) {
+  for (const double t : o.extensions) {
+    uint8_t u[3];
+    for (int ch = 0; ch < 3; ++ch) u[ch] = cv::saturate_cast<uint8_t>(ring[ch] + t * d[ch]);
+    if ((table.Classify(u[0], u[1], u[2]) & bit) != 0) return static_cast<float>(t);
+  }
+  return 0.0F;
+}
+
+struct Peak {
+  float k;
+  int x, y;
+};
+
+// The spot at a peak: contrast-weighted centre over 3x3; radius from the ball's share alpha of
+// each pixel within the inner box (the projection of pixel - background on ball - background),
+// summed into an area.
+SmallBall MeasureSpot(const cv::Mat& img, const Scratch& s, const Peak& pk, const cv::Point& tl,
+                      double n_ring, const SmallBallOptions& o) {
+  SmallBall b;
+  b.contrast = pk.k;
+  b.extension = s.extension.at<float>(pk.y, pk.x);
+  double wx = 0, wy = 0, w = 0;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int x = pk.x + dx, y = pk.y + dy;
+      if (x < 0 || y < 0 || x >= img.cols || y >= img.rows) continue;
+      const double k = s.contrast.at<float>(y, x);
+      wx += k * x, wy += k * y, w += k;
+    }
+  }
+  b.centre_px = Eigen::Vector2d(tl.x + wx / w, tl.y + wy / w);
+  const cv::Vec3i big = s.big.at<cv::Vec3i>(pk.y, pk.x), small = s.small.at<cv::Vec3i>(pk.y, pk.x);
+  const cv::Vec3i spot = s.spot.at<cv::Vec3i>(pk.y, pk.x);
+  cv::Vec3f bg, ball_minus_bg;
+  for (int ch = 0; ch < 3; ++ch) {
+    bg[ch] = static_cast<float>((big[ch] - small[ch]) / n_ring);
+    ball_minus_bg[ch] = static_cast<float>(b.extension * (spot[ch] / 9.0 - bg[ch]));
+  }
+  const double norm2 = ball_minus_bg.dot(ball_minus_bg);
+  double area = 0;
+  const int h = o.inner_box_px / 2;
+  for (int y = std::max(0, pk.y - h); y <= std::min(img.rows - 1, pk.y + h); ++y) {
+    for (int x = std::max(0, pk.x - h); x <= std::min(img.cols - 1, pk.x + h); ++x) {
+      const cv::Vec3f px = cv::Vec3f(img.at<cv::Vec3b>(y, x)) - bg;
+      area += std::clamp(px.dot(ball_minus_bg) / norm2, 0.0, 1.0);
+    }
+  }
+  b.radius_px = std::sqrt(area / M_PI);
+  return b;
+}
+
+}  // namespace
+
 std::vector<SmallBall> FindSmallBalls(const cv::Mat& bgr, const ColourTable& table, uint8_t bit,
                                       const cv::Rect& roi, const cv::Mat& mask,
                                       const SmallBallOptions& o) {
@@ -34,108 +122,89 @@ std::vector<SmallBall> FindSmallBalls(const cv::Mat& bgr, const ColourTable& tab
   const cv::Rect win =
       cv::Rect(roi.x - pad, roi.y - pad, roi.width + 2 * pad, roi.height + 2 * pad) & image;
   if (win.width < o.outer_box_px || win.height < o.outer_box_px) return out;
-  cv::Mat f, f2;
-  bgr(win).convertTo(f, CV_32FC3);
-  cv::multiply(f, f, f2);
+  const cv::Mat img = bgr(win);
+  thread_local Scratch s;
   // Spot: 3x3 mean; background: the ring between the inner and outer boxes (mean and spread).
-  cv::Mat spot, big, small, big2, small2;
-  cv::blur(f, spot, {3, 3}, {-1, -1}, cv::BORDER_REPLICATE);
+  // Integer box sums (exact) of the 8-bit image; the spread only where a spot can stand out.
   const cv::Size outer(o.outer_box_px, o.outer_box_px), inner(o.inner_box_px, o.inner_box_px);
-  cv::boxFilter(f, big, -1, outer, {-1, -1}, false, cv::BORDER_REPLICATE);
-  cv::boxFilter(f, small, -1, inner, {-1, -1}, false, cv::BORDER_REPLICATE);
-  cv::boxFilter(f2, big2, -1, outer, {-1, -1}, false, cv::BORDER_REPLICATE);
-  cv::boxFilter(f2, small2, -1, inner, {-1, -1}, false, cv::BORDER_REPLICATE);
+  cv::boxFilter(img, s.spot, CV_32S, {3, 3}, {-1, -1}, false, cv::BORDER_REPLICATE);
+  cv::boxFilter(img, s.big, CV_32S, outer, {-1, -1}, false, cv::BORDER_REPLICATE);
+  cv::boxFilter(img, s.small, CV_32S, inner, {-1, -1}, false, cv::BORDER_REPLICATE);
   const double n_ring = double(outer.area() - inner.area());
-  cv::Mat contrast(win.size(), CV_32F, cv::Scalar(0));
-  cv::Mat extension(win.size(), CV_32F, cv::Scalar(0));
-  cv::Mat background(win.size(), CV_32FC3);
-  for (int y = 0; y < win.height; ++y) {
-    const int gy = win.y + y;
-    const cv::Vec3f* s = spot.ptr<cv::Vec3f>(y);
-    const cv::Vec3f* b = big.ptr<cv::Vec3f>(y);
-    const cv::Vec3f* sm = small.ptr<cv::Vec3f>(y);
-    const cv::Vec3f* b2 = big2.ptr<cv::Vec3f>(y);
-    const cv::Vec3f* s2 = small2.ptr<cv::Vec3f>(y);
-    float* c = contrast.ptr<float>(y);
-    float* e = extension.ptr<float>(y);
-    cv::Vec3f* bg = background.ptr<cv::Vec3f>(y);
+  s.contrast.create(win.size(), CV_32F);
+  s.contrast.setTo(0);
+  s.extension.create(win.size(), CV_32F);
+  // |spot - ring| / (spread + noise) >= min_contrast needs |spot - ring| >= min_contrast x noise;
+  // tested on 9 n_ring (spot - ring) in integers (exact), the rest only where it passes.
+  const int n = outer.area() - inner.area();
+  const double scale = 9.0 * n;
+  const double min_scaled2 =
+      o.min_contrast * o.noise_level * o.min_contrast * o.noise_level * scale * scale;
+  const cv::Rect searched = roi & win;
+  // A row's squared differences in float first (a loop the compiler vectorises), then the exact
+  // integers where they may pass.
+  std::vector<float> row_e(3 * static_cast<size_t>(searched.width));
+  const float pre_threshold = static_cast<float>(0.999 * min_scaled2);
+  std::vector<Peak> hits;
+  for (int gy = searched.y; gy < searched.y + searched.height; ++gy) {
+    const int y = gy - win.y;
+    const cv::Vec3i* sp = s.spot.ptr<cv::Vec3i>(y);
+    const cv::Vec3i* b = s.big.ptr<cv::Vec3i>(y);
+    const cv::Vec3i* sm = s.small.ptr<cv::Vec3i>(y);
     const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(gy);
-    for (int x = 0; x < win.width; ++x) {
-      const int gx = win.x + x;
-      if (!roi.contains({gx, gy}) || (m != nullptr && m[gx] == 0)) continue;
-      double var = 0, diff2 = 0;
+    const int x0 = searched.x - win.x;
+    const int* spi = s.spot.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    const int* bi = s.big.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    const int* smi = s.small.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    for (size_t i = 0; i < row_e.size(); ++i) {
+      row_e[i] = static_cast<float>(spi[i] * n - 9 * (bi[i] - smi[i]));
+    }
+    for (int gx = searched.x; gx < searched.x + searched.width; ++gx) {
+      const int x = gx - win.x;
+      const float* e3 = &row_e[3 * static_cast<size_t>(gx - searched.x)];
+      if (e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2] < pre_threshold) continue;
+      int64_t scaled2 = 0;
+      for (int ch = 0; ch < 3; ++ch) {
+        const int64_t e = int64_t{sp[x][ch]} * n - 9 * int64_t{b[x][ch] - sm[x][ch]};
+        scaled2 += e * e;
+      }
+      if (static_cast<double>(scaled2) < min_scaled2 || (m != nullptr && m[gx] == 0)) continue;
       cv::Vec3f ring, d;
       for (int ch = 0; ch < 3; ++ch) {
         ring[ch] = static_cast<float>((b[x][ch] - sm[x][ch]) / n_ring);
-        var += std::max(0.0, (b2[x][ch] - s2[x][ch]) / n_ring - double(ring[ch]) * ring[ch]);
-        d[ch] = s[x][ch] - ring[ch];
-        diff2 += double(d[ch]) * d[ch];
+        d[ch] = static_cast<float>(sp[x][ch] / 9.0 - ring[ch]);
       }
-      bg[x] = ring;
-      const double k = std::sqrt(diff2) / (std::sqrt(var) + o.noise_level);
+      const float t = Extension(table, bit, ring, d, o);
+      if (t == 0.0F) continue;
+      const double var = RingVariance(img, x, y, o.inner_box_px / 2, o.outer_box_px / 2, ring);
+      const double k =
+          std::sqrt(static_cast<double>(scaled2)) / scale / (std::sqrt(var) + o.noise_level);
       if (k < o.min_contrast) continue;
-      for (const double t : o.extensions) {
-        uint8_t u[3];
-        for (int ch = 0; ch < 3; ++ch) {
-          u[ch] = cv::saturate_cast<uint8_t>(ring[ch] + t * d[ch]);
-        }
-        if ((table.Classify(u[0], u[1], u[2]) & bit) != 0) {
-          c[x] = static_cast<float>(k);
-          e[x] = static_cast<float>(t);
-          break;
-        }
-      }
+      s.contrast.at<float>(y, x) = static_cast<float>(k);
+      s.extension.at<float>(y, x) = t;
+      hits.push_back({static_cast<float>(k), x, y});
     }
   }
   // Local maxima (5x5) of the contrast, strongest first.
-  cv::Mat peaks;
-  cv::dilate(contrast, peaks, cv::Mat::ones(5, 5, CV_8U));
-  struct Peak {
-    float k;
-    int x, y;
-  };
   std::vector<Peak> found;
-  for (int y = 0; y < win.height; ++y) {
-    const float* c = contrast.ptr<float>(y);
-    const float* p = peaks.ptr<float>(y);
-    for (int x = 0; x < win.width; ++x) {
-      if (c[x] > 0 && c[x] >= p[x]) found.push_back({c[x], x, y});
+  for (const Peak& h : hits) {
+    bool peak = true;
+    for (int dy = -2; dy <= 2 && peak; ++dy) {
+      for (int dx = -2; dx <= 2 && peak; ++dx) {
+        const int x = h.x + dx, y = h.y + dy;
+        if (x < 0 || y < 0 || x >= win.width || y >= win.height) continue;
+        peak = s.contrast.at<float>(y, x) <= h.k;
+      }
     }
+    if (peak) found.push_back(h);
   }
-  std::sort(found.begin(), found.end(), [](const Peak& a, const Peak& b) { return a.k > b.k; });
+  std::stable_sort(found.begin(), found.end(),
+                   [](const Peak& a, const Peak& b) { return a.k > b.k; });
   for (const Peak& pk : found) {
     if (static_cast<int>(out.size()) >= o.max_spots) break;
-    SmallBall s;
-    s.contrast = pk.k;
-    s.extension = extension.at<float>(pk.y, pk.x);
-    // Centre: contrast-weighted mean over 3x3; radius: the ball's share alpha of each pixel
-    // within the inner box (the projection of pixel - background on ball - background), summed
-    // into an area.
-    double wx = 0, wy = 0, w = 0;
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int x = pk.x + dx, y = pk.y + dy;
-        if (x < 0 || y < 0 || x >= win.width || y >= win.height) continue;
-        const double k = contrast.at<float>(y, x);
-        wx += k * x, wy += k * y, w += k;
-      }
-    }
-    s.centre_px = Eigen::Vector2d(win.x + wx / w, win.y + wy / w);
-    const cv::Vec3f bg = background.at<cv::Vec3f>(pk.y, pk.x);
-    const cv::Vec3f centre = spot.at<cv::Vec3f>(pk.y, pk.x);
-    const cv::Vec3f ball_minus_bg = s.extension * (centre - bg);
-    const double norm2 = ball_minus_bg.dot(ball_minus_bg);
-    double area = 0;
-    const int h = o.inner_box_px / 2;
-    for (int y = std::max(0, pk.y - h); y <= std::min(win.height - 1, pk.y + h); ++y) {
-      for (int x = std::max(0, pk.x - h); x <= std::min(win.width - 1, pk.x + h); ++x) {
-        const cv::Vec3f px = f.at<cv::Vec3f>(y, x) - bg;
-        area += std::clamp(px.dot(ball_minus_bg) / norm2, 0.0, 1.0);
-      }
-    }
-    s.radius_px = std::sqrt(area / M_PI);
-    if (s.radius_px > o.max_radius_px) continue;
-    out.push_back(s);
+    const SmallBall b = MeasureSpot(img, s, pk, win.tl(), n_ring, o);
+    if (b.radius_px > o.max_radius_px) continue;
+    out.push_back(b);
   }
   return out;
 }
