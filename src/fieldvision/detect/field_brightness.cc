@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::detect {
 
@@ -24,12 +25,7 @@ uint8_t Value(const cv::Mat& bgr, int x, int y) {
   return std::max({p[0], p[1], p[2]});
 }
 
-// The q-quantile (0..1) of `v` (not empty); reorders it.
-double Quantile(std::vector<uint8_t>* v, double q) {
-  const size_t k = std::min(v->size() - 1, static_cast<size_t>(q * static_cast<double>(v->size())));
-  std::nth_element(v->begin(), v->begin() + static_cast<ptrdiff_t>(k), v->end());
-  return (*v)[k];
-}
+std::vector<double> AsDoubles(const std::vector<uint8_t>& v) { return {v.begin(), v.end()}; }
 
 }  // namespace
 
@@ -56,7 +52,7 @@ double FieldValue(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bi
         if ((table.Classify(p[0], p[1], p[2]) & field_bit) != 0) values.push_back(Value(bgr, x, y));
       }
     }
-    if (enough(values)) return Quantile(&values, 0.5);
+    if (enough(values)) return util::Median(AsDoubles(values));
   }
   // The class finds too little field: the image's own field colour (image_field.h).
   const std::optional<ImageFieldColour> colour = FindImageFieldColour(bgr, roi, o.image_field);
@@ -70,7 +66,7 @@ double FieldValue(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bi
       }
     }
   }
-  return enough(values) ? Quantile(&values, 0.5) : -1.0;
+  return enough(values) ? util::Median(AsDoubles(values)) : -1.0;
 }
 
 double LitValue(const cv::Mat& bgr, const Eigen::Vector2d& centre_px, double radius_px,
@@ -100,7 +96,7 @@ double LitValue(const cv::Mat& bgr, const Eigen::Vector2d& centre_px, double rad
     if (x < 0 || y < 0 || x >= bgr.cols || y >= bgr.rows) return -1.0;
     return Value(bgr, x, y);
   }
-  return Quantile(&values, 0.9);
+  return util::RankPercentile(AsDoubles(values), 0.9);
 }
 
 }  // namespace fv::detect
