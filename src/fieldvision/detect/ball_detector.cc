@@ -471,16 +471,24 @@ void BallDetector::RejectSmallOffField(const cv::Mat& bgr, const cv::Rect& roi,
                                        std::vector<BallCandidate>* candidates) const {
   const FieldSurroundOptions& o = options_.small_field;
   if (o.min_share <= 0 || (camera_ != nullptr && camera_->has_pose)) return;
-  std::optional<std::optional<ImageFieldColour>> image_field;  // found at the first spot
+  // The image's own field colour only where the field class finds too little around a spot (a
+  // carpet the class misses); found once.
+  std::optional<std::optional<ImageFieldColour>> image_field;
   for (BallCandidate& c : *candidates) {
     if (!c.accepted || !c.small) continue;
+    double share = field_bit_ != 0 ? FieldShareAround(bgr, *table_, field_bit_, nullptr,
+                                                      c.centre_px, c.radius_px, o)
+                                   : -1.0;
+    if (share >= o.min_share) continue;
     if (!image_field) {
       image_field = FindImageFieldColour(bgr, roi, options_.field_brightness.image_field);
     }
-    if (field_bit_ == 0 && !image_field->has_value()) return;  // no field to tell
-    const ImageFieldColour* own = image_field->has_value() ? &**image_field : nullptr;
-    const double share =
-        FieldShareAround(bgr, *table_, field_bit_, own, c.centre_px, c.radius_px, o);
+    if (image_field->has_value()) {
+      share =
+          FieldShareAround(bgr, *table_, field_bit_, &**image_field, c.centre_px, c.radius_px, o);
+    } else if (field_bit_ == 0) {
+      continue;  // no field to tell
+    }
     if (share < 0 || share >= o.min_share) continue;
     c.accepted = false;
     c.reason = fmt::format("a small spot off the field ({:.0f} % of its ring field)", 100 * share);
