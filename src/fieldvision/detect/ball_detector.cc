@@ -290,21 +290,20 @@ void BallDetector::Init(const ColourSpec& colour) {
     grow_table_ = ColourTable::Shared(
         WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor), options_.lut_bits);
   }
-  if (camera_ != nullptr && field_ != nullptr && camera_->has_pose && options_.use_field_mask) {
+  if (posed() && field_ != nullptr && options_.use_field_mask) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
   }
   small_balls_ = SmallBallsPossible();
   const bool dark_ball =
       options_.colour == "black" || options_.colour == "blue" || options_.colour == "green";
-  const bool posed = camera_ != nullptr && camera_->has_pose;
-  min_arc_cover_ = posed ? options_.min_arc_cover : options_.unposed_min_arc_cover;
-  lit_check_ = options_.min_lit_field_ratio > 0 && !dark_ball && !posed;
+  min_arc_cover_ = posed() ? options_.min_arc_cover : options_.unposed_min_arc_cover;
+  lit_check_ = options_.min_lit_field_ratio > 0 && !dark_ball && !posed();
 }
 
 bool BallDetector::SmallBallsPossible() const {
   const SmallBallOptions& o = options_.small;
   if (o.mode != "auto") return o.mode == "on";
-  if (camera_ == nullptr || !camera_->has_pose) return true;  // on the field (RejectSmallOffField)
+  if (!posed()) return true;  // on the field (RejectSmallOffField)
   // Anywhere on a 32 x 24 grid (inside the field mask) where the ball may look that small.
   for (int j = 0; j < 24; ++j) {
     for (int i = 0; i < 32; ++i) {
@@ -320,7 +319,7 @@ bool BallDetector::SmallBallsPossible() const {
 }
 
 bool BallDetector::ExpectedRadius(const Vector2d& uv, double* min_px, double* max_px) const {
-  if (camera_ == nullptr || !camera_->has_pose) return false;
+  if (!posed()) return false;
   const auto ray = camera_->RayFromPixel(uv);
   if (!ray) return false;
   const double r_m = 0.5 * options_.diameter_m;
@@ -443,7 +442,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
 }
 
 FieldBoundary BallDetector::OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region) const {
-  if ((camera_ != nullptr && camera_->has_pose) || options_.off_field_min_score <= 0) {
+  if (posed() || options_.off_field_min_score <= 0) {
     return {};
   }
   return FindFieldBoundary(bgr, *table_, field_bit_, options_.field_boundary, region);
@@ -470,7 +469,7 @@ void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
 void BallDetector::RejectSmallOffField(const cv::Mat& bgr, const cv::Rect& roi,
                                        std::vector<BallCandidate>* candidates) const {
   const FieldSurroundOptions& o = options_.small_field;
-  if (o.min_share <= 0 || (camera_ != nullptr && camera_->has_pose)) return;
+  if (o.min_share <= 0 || posed()) return;
   // The image's own field colour only where the field class finds too little around a spot (a
   // carpet the class misses); found once.
   std::optional<std::optional<ImageFieldColour>> image_field;
@@ -768,7 +767,7 @@ void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
     double exp_min = 0, exp_max = 0;
     if (!ExpectedRadius(s.centre_px, &exp_min, &exp_max)) {
       // Without a posed camera the field around the spot decides (RejectSmallOffField).
-      c.accepted = o.mode == "on" || camera_ == nullptr || !camera_->has_pose;
+      c.accepted = o.mode == "on" || !posed();
       if (!c.accepted) c.reason = "a small spot where no ball can be seen (small balls: auto)";
     } else if (SmallestPlausibleRadius(exp_min) > o.max_radius_px) {
       c.reason = fmt::format("a small spot where the ball looks larger ({:.1f} px)", exp_min);

@@ -240,6 +240,9 @@ class BallDetector {
 
  private:
   void Init(const ColourSpec& colour);
+  // A calibrated camera with a pose: size checks, the field mask; without one the checks of a
+  // photo (off-field, lit part, small spots on the field).
+  bool posed() const { return camera_ != nullptr && camera_->has_pose; }
   // "" when `radius` fits the radius limits and the ball's size at `centre` (posed camera);
   // else why not. `size_factor` (0.5..1) prefers the size of a ball on the ground there.
   std::string SizeProblem(const Eigen::Vector2d& centre, double radius, double* size_factor) const;
@@ -257,10 +260,10 @@ class BallDetector {
   double SmallestPlausibleRadius(double expected_min_px) const;
   // The small-ball stage's spots in `roi` as candidates (accepted unless the camera expects a
   // larger ball there).
+  void AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi, BallDetectionResult* result) const;
   // Small-ball candidates without a posed camera that do not lie on the field are rejected.
   void RejectSmallOffField(const cv::Mat& bgr, const cv::Rect& roi,
                            std::vector<BallCandidate>* candidates) const;
-  void AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi, BallDetectionResult* result) const;
   // Rejects the accepted candidates that off_field_min_score rejects (without a posed camera);
   // `boundary` holds the frame's field boundary once found.
   void RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
@@ -61,9 +60,7 @@ void PaintBall(cv::Mat& img, Look look, util::Rng& rng, Vector2d* c, double* r) 
     cv::rectangle(img, cv::Rect(x0, int(c->y() - 2 * *r), int(2 * *r), int(4 * *r)),
                   cv::Scalar(25, 25, 25), cv::FILLED);
   } else if (look == Look::kJpeg) {
-    std::vector<uchar> buf;
-    cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, 60});
-    img = cv::imdecode(buf, cv::IMREAD_COLOR);
+    img = test_util::JpegRoundTrip(img, 60);
   }
 }
 

@@ -6,7 +6,6 @@
 #include <string>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/ball_detector.h"
@@ -20,12 +19,6 @@ namespace {
 
 using Eigen::Vector2d;
 
-cv::Mat Jpeg(const cv::Mat& img) {
-  std::vector<uchar> buf;
-  cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, 80});
-  return cv::imdecode(buf, cv::IMREAD_COLOR);
-}
-
 // A 224 x 224 frame of grass with a black robot and a white board on it and a small orange spot
 // (radius 2.2 px, blurred) at `spot`.
 cv::Mat SpotScene(const Vector2d& spot, util::Rng& rng) {
@@ -34,7 +27,7 @@ cv::Mat SpotScene(const Vector2d& spot, util::Rng& rng) {
   cv::rectangle(img, cv::Rect(150, 140, 50, 30), cv::Scalar(230, 232, 235), cv::FILLED);  // board
   test_util::PaintDisc(img, spot, 2.2, test_util::kOrange, 0.3);
   cv::GaussianBlur(img, img, {0, 0}, 0.6);
-  return Jpeg(img);
+  return test_util::JpegRoundTrip(img, 80);
 }
 
 TEST(FieldSurround, ASpotOnTheGrassIsOnTheFieldOnARobotOrABoardItIsNot) {

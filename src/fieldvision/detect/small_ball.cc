@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
@@ -77,7 +76,7 @@ struct Peak {
 // each pixel within the inner box (the projection of pixel - background on ball - background),
 // summed into an area.
 SmallBall MeasureSpot(const cv::Mat& img, const Scratch& s, const Peak& pk, const cv::Point& tl,
-                      double n_ring, const SmallBallOptions& o) {
+                      int n_ring, const SmallBallOptions& o) {
   SmallBall b;
   b.contrast = pk.k;
   b.extension = s.extension.at<float>(pk.y, pk.x);
@@ -95,7 +94,7 @@ SmallBall MeasureSpot(const cv::Mat& img, const Scratch& s, const Peak& pk, cons
   const cv::Vec3i spot = s.spot.at<cv::Vec3i>(pk.y, pk.x);
   cv::Vec3f bg, ball_minus_bg;
   for (int ch = 0; ch < 3; ++ch) {
-    bg[ch] = static_cast<float>((big[ch] - small[ch]) / n_ring);
+    bg[ch] = static_cast<float>(double(big[ch] - small[ch]) / n_ring);
     ball_minus_bg[ch] = static_cast<float>(b.extension * (spot[ch] / 9.0 - bg[ch]));
   }
   const double norm2 = ball_minus_bg.dot(ball_minus_bg);
@@ -130,55 +129,47 @@ std::vector<SmallBall> FindSmallBalls(const cv::Mat& bgr, const ColourTable& tab
   cv::boxFilter(img, s.spot, CV_32S, {3, 3}, {-1, -1}, false, cv::BORDER_REPLICATE);
   cv::boxFilter(img, s.big, CV_32S, outer, {-1, -1}, false, cv::BORDER_REPLICATE);
   cv::boxFilter(img, s.small, CV_32S, inner, {-1, -1}, false, cv::BORDER_REPLICATE);
-  const double n_ring = double(outer.area() - inner.area());
+  const int n_ring = outer.area() - inner.area();
   s.contrast.create(win.size(), CV_32F);
   s.contrast.setTo(0);
   s.extension.create(win.size(), CV_32F);
-  // |spot - ring| / (spread + noise) >= min_contrast needs |spot - ring| >= min_contrast x noise;
-  // tested on 9 n_ring (spot - ring) in integers (exact), the rest only where it passes.
-  const int n = outer.area() - inner.area();
-  const double scale = 9.0 * n;
+  // e = 9 n_ring (spot - ring) in integers (exact, and exact as floats and their squares as
+  // doubles). |spot - ring| / (spread + noise) >= min_contrast needs |spot - ring| >= min_contrast
+  // x noise: a row's squares in float first (a loop the compiler vectorises), the exact ones only
+  // where they may pass, the spread only where the colour reaches the class.
+  const double scale = 9.0 * n_ring;
   const double min_scaled2 =
       o.min_contrast * o.noise_level * o.min_contrast * o.noise_level * scale * scale;
-  const cv::Rect searched = roi & win;
-  // A row's squared differences in float first (a loop the compiler vectorises), then the exact
-  // integers where they may pass.
-  std::vector<float> row_e(3 * static_cast<size_t>(searched.width));
   const float pre_threshold = static_cast<float>(0.999 * min_scaled2);
+  const cv::Rect searched = roi & win;
+  std::vector<float> row_e(3 * static_cast<size_t>(searched.width));
   std::vector<Peak> hits;
   for (int gy = searched.y; gy < searched.y + searched.height; ++gy) {
     const int y = gy - win.y;
-    const cv::Vec3i* sp = s.spot.ptr<cv::Vec3i>(y);
-    const cv::Vec3i* b = s.big.ptr<cv::Vec3i>(y);
-    const cv::Vec3i* sm = s.small.ptr<cv::Vec3i>(y);
-    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(gy);
     const int x0 = searched.x - win.x;
-    const int* spi = s.spot.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
-    const int* bi = s.big.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
-    const int* smi = s.small.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    const int* sp = s.spot.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    const int* b = s.big.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    const int* sm = s.small.ptr<int>(y) + 3 * static_cast<ptrdiff_t>(x0);
+    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(gy);
     for (size_t i = 0; i < row_e.size(); ++i) {
-      row_e[i] = static_cast<float>(spi[i] * n - 9 * (bi[i] - smi[i]));
+      row_e[i] = static_cast<float>(sp[i] * n_ring - 9 * (b[i] - sm[i]));
     }
     for (int gx = searched.x; gx < searched.x + searched.width; ++gx) {
-      const int x = gx - win.x;
-      const float* e3 = &row_e[3 * static_cast<size_t>(gx - searched.x)];
-      if (e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2] < pre_threshold) continue;
-      int64_t scaled2 = 0;
-      for (int ch = 0; ch < 3; ++ch) {
-        const int64_t e = int64_t{sp[x][ch]} * n - 9 * int64_t{b[x][ch] - sm[x][ch]};
-        scaled2 += e * e;
-      }
-      if (static_cast<double>(scaled2) < min_scaled2 || (m != nullptr && m[gx] == 0)) continue;
+      const size_t i = 3 * static_cast<size_t>(gx - searched.x);
+      const float* e = &row_e[i];
+      if (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] < pre_threshold) continue;
+      const double scaled2 = double(e[0]) * e[0] + double(e[1]) * e[1] + double(e[2]) * e[2];
+      if (scaled2 < min_scaled2 || (m != nullptr && m[gx] == 0)) continue;
       cv::Vec3f ring, d;
       for (int ch = 0; ch < 3; ++ch) {
-        ring[ch] = static_cast<float>((b[x][ch] - sm[x][ch]) / n_ring);
-        d[ch] = static_cast<float>(sp[x][ch] / 9.0 - ring[ch]);
+        ring[ch] = static_cast<float>(double(b[i + ch] - sm[i + ch]) / n_ring);
+        d[ch] = static_cast<float>(e[ch] / scale);
       }
+      const int x = gx - win.x;
       const float t = Extension(table, bit, ring, d, o);
       if (t == 0.0F) continue;
       const double var = RingVariance(img, x, y, o.inner_box_px / 2, o.outer_box_px / 2, ring);
-      const double k =
-          std::sqrt(static_cast<double>(scaled2)) / scale / (std::sqrt(var) + o.noise_level);
+      const double k = std::sqrt(scaled2) / scale / (std::sqrt(var) + o.noise_level);
       if (k < o.min_contrast) continue;
       s.contrast.at<float>(y, x) = static_cast<float>(k);
       s.extension.at<float>(y, x) = t;

@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/ball_detector.h"
@@ -18,12 +17,6 @@ namespace fv::detect {
 namespace {
 
 using Eigen::Vector2d;
-
-cv::Mat Jpeg(const cv::Mat& img, int quality) {
-  std::vector<uchar> buf;
-  cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, quality});
-  return cv::imdecode(buf, cv::IMREAD_COLOR);
-}
 
 TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
   const uint64_t seed = fv::testing::TestSeed(11);
@@ -42,7 +35,7 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
     const Vector2d c(rng.Uniform(20, 204), rng.Uniform(20, 204));
     test_util::PaintDisc(img, c, r, test_util::kOrange, 0.3);
     cv::GaussianBlur(img, img, {0, 0}, 0.7);
-    img = Jpeg(img, 75);
+    img = test_util::JpegRoundTrip(img, 75);
     ++trials;
     const auto cands = det.Detect(img);
     if (cands.empty() || !cands.front().accepted) {
@@ -66,7 +59,7 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
     cv::Mat img = test_util::FieldImage(224, 224, rng);
     cv::line(img, {0, 100 + 10 * trial}, {223, 120 + 10 * trial}, cv::Scalar(235, 235, 235), 3,
              cv::LINE_AA);
-    img = Jpeg(img, 75);
+    img = test_util::JpegRoundTrip(img, 75);
     EXPECT_TRUE(FindSmallBalls(img, table, table.BallBit(), {0, 0, 224, 224}, {}, o).empty());
   }
 }
@@ -78,7 +71,7 @@ TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
   cv::Mat img = test_util::FieldImage(224, 224, rng);
   const Vector2d c(101.3, 80.6);
   test_util::PaintDisc(img, c, 1.6, test_util::kOrange, 0.3);
-  img = Jpeg(img, 75);
+  img = test_util::JpegRoundTrip(img, 75);
   BallDetectorOptions on;
   on.small.mode = "on";
   const auto with = BallDetector(on, nullptr, nullptr).Detect(img);
