@@ -755,7 +755,8 @@ std::optional<BallDetector::GuidedOutline> BallDetector::FitGuidedOutline(const 
 void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
                                  BallDetectionResult* result) const {
   const SmallBallOptions& o = options_.small;
-  for (const SmallBall& s : FindSmallBalls(bgr, *table_, ball_bit_, roi, field_mask_, o)) {
+  const ColourTable& table = o.widened_class && grow_table_ ? *grow_table_ : *table_;
+  for (const SmallBall& s : FindSmallBalls(bgr, table, table.BallBit(), roi, field_mask_, o)) {
     BallCandidate c;
     c.centre_px = s.centre_px;
     c.radius_px = s.radius_px;

@@ -295,7 +295,8 @@ class BallDetector {
   const camera::Camera* camera_;
   const field::FieldModel* field_;
   std::shared_ptr<const ColourTable> table_;
-  std::shared_ptr<const ColourTable> grow_table_;  // the widened ball class (region growing)
+  // The widened ball class: region growing and the small spots' unmixed colour.
+  std::shared_ptr<const ColourTable> grow_table_;
   uint8_t ball_bit_ = 1;
   uint8_t field_bit_ = 0;  // the spec's "field" class (0: none)
   cv::Mat field_mask_;
