@@ -1,6 +1,7 @@
 #include "fieldvision/detect/detect_eval.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -171,6 +172,8 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
                            const std::vector<cv::Rect2d>& boxes, double grow) {
   DetectEvalImage r;
   r.boxes = static_cast<int>(boxes.size());
+  const auto half_size = [](const cv::Rect2d& b) { return 0.5 * std::max(b.width, b.height); };
+  for (const cv::Rect2d& b : boxes) r.ball_radius_px = std::max(r.ball_radius_px, half_size(b));
   auto box_of = [&](const BallCandidate& c) {
     return BoxHolding(boxes, grow, c.centre_px.x(), c.centre_px.y());
   };
@@ -195,6 +198,7 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
   r.hit = box != nullptr;
   if (r.hit) {
     r.reason.clear();
+    r.ball_radius_px = half_size(*box);
     const double cx = box->x + 0.5 * box->width, cy = box->y + 0.5 * box->height;
     r.centre_err_px = std::hypot(r.u - cx, r.v - cy);
     r.centre_err_rel = r.centre_err_px / (0.25 * (box->width + box->height));
@@ -240,6 +244,29 @@ std::string MissReasons(const std::vector<DetectEvalImage>& images) {
 
 }  // namespace
 
+std::string RecallBySize(const std::vector<DetectEvalImage>& images) {
+  static constexpr std::array<double, 4> kEdges = {3.0, 6.0, 12.0, 24.0};
+  std::array<int, kEdges.size() + 1> balls{}, hits{};
+  for (const DetectEvalImage& im : images) {
+    if (im.boxes == 0) continue;
+    const auto bin =
+        std::upper_bound(kEdges.begin(), kEdges.end(), im.ball_radius_px) - kEdges.begin();
+    ++balls[bin];
+    hits[bin] += im.hit;
+  }
+  std::string s;
+  for (size_t i = 0; i < balls.size(); ++i) {
+    if (balls[i] == 0) continue;
+    const std::string range = i == 0 ? fmt::format("< {:g} px", kEdges[0])
+                              : i == kEdges.size()
+                                  ? fmt::format(">= {:g} px", kEdges.back())
+                                  : fmt::format("{:g}-{:g} px", kEdges[i - 1], kEdges[i]);
+    s += fmt::format("{}{} {:.3f} ({}/{})", s.empty() ? "" : ", ", range,
+                     double(hits[i]) / balls[i], hits[i], balls[i]);
+  }
+  return s;
+}
+
 std::string DetectEvalResult::Summary(int list) const {
   std::vector<double> err_px, err_rel;
   for (const auto& im : images) {
@@ -256,6 +283,8 @@ std::string DetectEvalResult::Summary(int list) const {
       "{} false detections",
       images.size(), with_ball, detected, ratio(recall(), with_ball), hits, with_ball,
       ratio(precision(), detected), hits, detected, false_detections);
+  const std::string by_size = RecallBySize(images);
+  if (!by_size.empty()) s += "\nrecall by ball radius (half the box's longer side): " + by_size;
   if (!err_px.empty()) {
     s += fmt::format(
         "\ncentre error vs. box centre: median {:.2f} px, p90 {:.2f} px ({:.2f} / {:.2f} of the "
@@ -412,10 +441,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   if (!o.out.empty()) {
     io::AtomicWrite(o.out, [&](const std::string& tmp) {
       util::CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
-                              "centre_err_px", "candidate_on_ball", "reason"});
+                              "centre_err_px", "candidate_on_ball", "ball_radius_px", "reason"});
       for (const auto& im : result.images) {
         w << im.image << im.boxes << int(im.detected) << int(im.hit) << im.u << im.v << im.radius_px
-          << im.score << im.centre_err_px << int(im.candidate_on_ball) << ReplaceCommas(im.reason);
+          << im.score << im.centre_err_px << int(im.candidate_on_ball) << im.ball_radius_px
+          << ReplaceCommas(im.reason);
         w.EndRow();
       }
       w.Close();

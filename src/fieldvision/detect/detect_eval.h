@@ -58,8 +58,14 @@ struct DetectEvalImage {
   double centre_err_px = -1;       // hit: distance to the box centre
   double centre_err_rel = -1;      // ... divided by the box's half size
   bool candidate_on_ball = false;  // any candidate (accepted or not) inside a grown box
-  std::string reason;              // for a miss: the best rejected candidate on the ball's reason
+  // The ball's size: half the longer side of its box (the hit one, else the largest); 0 without.
+  double ball_radius_px = 0;
+  std::string reason;  // for a miss: the best rejected candidate on the ball's reason
 };
+
+// Recall per ball size (DetectEvalImage::ball_radius_px) in the bins < 3, 3-6, 6-12, 12-24 and
+// >= 24 px: "< 3 px 0.620 (31/50), 3-6 px ...", the empty bins left out ("" without balls).
+std::string RecallBySize(const std::vector<DetectEvalImage>& images);
 
 struct DetectEvalResult {
   std::vector<DetectEvalImage> images;
@@ -71,7 +77,8 @@ struct DetectEvalResult {
   double seconds = 0.0;
   double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
   double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }
-  // Recall, precision, centre errors and the first `list` misses and false detections.
+  // Recall (also per ball size), precision, centre errors and the first `list` misses and false
+  // detections.
   std::string Summary(int list = 30) const;
 };
 

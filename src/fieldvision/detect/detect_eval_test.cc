@@ -56,6 +56,36 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   }
 }
 
+// Each image's ball size is its hit box's half longer side (else its largest box's), and the
+// recall per size counts images with a ball in bins of 3, 6, 12 and 24 px.
+TEST(DetectEval, RecallPerBallSize) {
+  BallCandidate on_small;
+  on_small.centre_px = Eigen::Vector2d(12, 12);
+  on_small.radius_px = 2;
+  on_small.accepted = true;
+  const std::vector<cv::Rect2d> boxes = {cv::Rect2d(10, 10, 4, 5), cv::Rect2d(50, 50, 40, 30)};
+  const DetectEvalImage hit = ScoreImage({on_small}, boxes, 0.25);
+  EXPECT_TRUE(hit.hit);
+  EXPECT_DOUBLE_EQ(hit.ball_radius_px, 2.5);  // the hit box, not the larger one
+  const DetectEvalImage miss = ScoreImage({}, boxes, 0.25);
+  EXPECT_FALSE(miss.hit);
+  EXPECT_DOUBLE_EQ(miss.ball_radius_px, 20.0);
+  EXPECT_DOUBLE_EQ(ScoreImage({on_small}, {}, 0.25).ball_radius_px, 0.0);  // no ball
+  std::vector<DetectEvalImage> images = {hit, miss, ScoreImage({}, {}, 0.25)};
+  DetectEvalImage big = miss;
+  big.ball_radius_px = 24.0;  // a bin's lower edge belongs to it
+  big.hit = true;
+  images.push_back(big);
+  EXPECT_EQ(RecallBySize(images), "< 3 px 1.000 (1/1), 12-24 px 0.000 (0/1), >= 24 px 1.000 (1/1)");
+  EXPECT_EQ(RecallBySize({}), "");
+  DetectEvalResult r;
+  r.images = images;
+  r.with_ball = 3;
+  EXPECT_NE(r.Summary(0).find("recall by ball radius (half the box's longer side): < 3 px"),
+            std::string::npos)
+      << r.Summary(0);
+}
+
 TEST(DetectEval, BadLabelNamesFileAndLine) {
   const std::string dir = fv::testing::TempDir() + "/detect_eval_bad";
   fs::create_directories(dir);
