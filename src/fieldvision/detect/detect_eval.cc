@@ -32,8 +32,9 @@ namespace {
 std::vector<std::string> ImagesUnder(const std::string& dir) {
   std::vector<std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (e.is_regular_file() && io::IsImageFile(e.path().string()))
+    if (e.is_regular_file() && io::IsImageFile(e.path().string())) {
       files.push_back(e.path().string());
+    }
   }
   std::sort(files.begin(), files.end());
   return files;
@@ -382,8 +383,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   io::CheckOutputPath(o.out, inputs, "--out");
   io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
   std::unique_ptr<camera::Camera> camera;
-  if (!o.camera.empty())
+  if (!o.camera.empty()) {
     camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
+  }
   const AnyBallDetector detector(o.detector, o.dnn, camera.get(), nullptr);
 
   DetectEvalResult result;
@@ -431,7 +433,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     result.false_detections += r.detected && !r.hit;
     result.no_label_file += !item.has_label_file;
     result.images.push_back(std::move(r));
-    progress.Update(static_cast<long long>(i + 1));
+    progress.Update(static_cast<long long>(i) + 1);
   }
   progress.Finish();
   result.seconds = progress.ElapsedSeconds();
