@@ -59,6 +59,18 @@ cp "$TMP/imgs/a.png" "$TMP/a_copy.png"
 check "eval detect: --out an image it reads" nonzero $FV eval detect --video "$TMP/imgs" \
   --out "$TMP/imgs/a.png" --no-progress
 cmp -s "$TMP/imgs/a.png" "$TMP/a_copy.png" || { echo "FAIL eval detect: image overwritten"; fail=1; }
+mkdir -p "$TMP/limgs" "$TMP/nolabels" && cp "$TMP/imgs/a.png" "$TMP/limgs/a.png"
+check "color learn: --labels without a label file" nonzero $FV color learn --video "$TMP/limgs" \
+  --labels "$TMP/nolabels" --out "$TMP/l.json"
+grep -q "none of the 1 images has a label file" "$TMP/err" || {
+  echo "FAIL color learn: missing labels not named"; fail=1; }
+printf '0 0.5 0.5 0.2 0.2\n' > "$TMP/limgs/a.txt"
+check "color learn: --labels and --roi" nonzero $FV color learn --video "$TMP/limgs" \
+  --labels "$TMP/limgs" --roi 1,1,4,4 --out "$TMP/l.json"
+check "color learn: --labels, the class forced" 0 $FV color learn --video "$TMP/limgs" \
+  --labels "$TMP/limgs" --force --out "$TMP/l.json"
+grep -q "learned from 1 boxes in 1 of the 1 frames with a ball" "$TMP/out" || {
+  echo "FAIL color learn: --labels report"; fail=1; }
 check "ball: one camera" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --out "$TMP/b.csv"
 grep -q "one camera" "$TMP/err" || { echo "FAIL ball: one camera not named"; fail=1; }

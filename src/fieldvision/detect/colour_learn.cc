@@ -33,8 +33,9 @@ cv::Rect AroundRoi(const cv::Rect& r) {
 
 }  // namespace
 
-void ColourLearnOptions::Check() const {
-  FV_REQUIRE(!points.empty() || roi.has_value(), "give --points or --roi (the ball's pixels)");
+void ColourLearnOptions::Check(bool need_pixels) const {
+  FV_REQUIRE(!need_pixels || !points.empty() || roi.has_value(),
+             "give --points or --roi (the ball's pixels)");
   FV_REQUIRE(point_radius_px >= 0 && point_radius_px <= 20, "point_radius_px must be 0..20");
   CheckInRange(trim, 0.0, 0.2, "trim");
   CheckInRange(hue_margin_deg, 0.0, 90.0, "hue_margin_deg");
@@ -94,22 +95,32 @@ cv::Mat ReadVideoFrame(const std::string& video, int frame_index) {
 }
 
 ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& o) {
+  ColourLearnSample sample;
+  sample.bgr = bgr;
+  sample.points = o.points;
+  if (o.roi) sample.boxes.push_back(*o.roi);
+  sample.negative_points = o.negative_points;
+  return MarkLearnPixels(sample, o.point_radius_px);
+}
+
+ColourLearnMasks MarkLearnPixels(const ColourLearnSample& sample, int point_radius_px) {
+  const cv::Mat& bgr = sample.bgr;
   const cv::Rect frame_rect(0, 0, bgr.cols, bgr.rows);
   ColourLearnMasks m;
   m.positive = cv::Mat(bgr.size(), CV_8U, cv::Scalar(0));
   m.negative = cv::Mat(bgr.size(), CV_8U, cv::Scalar(0));
   m.near = cv::Mat(bgr.size(), CV_8U, cv::Scalar(0));
-  for (const auto& p : o.points) {
+  for (const auto& p : sample.points) {
     FV_REQUIRE(p.x() >= 0 && p.y() >= 0 && p.x() < bgr.cols && p.y() < bgr.rows,
                "point ({}, {}) is outside the {}x{} frame", p.x(), p.y(), bgr.cols, bgr.rows);
     const cv::Point c(cvRound(p.x()), cvRound(p.y()));
-    cv::circle(m.positive, c, o.point_radius_px, 255, cv::FILLED);
+    cv::circle(m.positive, c, point_radius_px, 255, cv::FILLED);
     cv::circle(m.near, c, 40, 255, cv::FILLED);
   }
-  if (o.roi) {
-    const cv::Rect r = *o.roi;
-    FV_REQUIRE((r & frame_rect) == r, "region {},{},{},{} is not inside the {}x{} frame", r.x, r.y,
-               r.width, r.height, bgr.cols, bgr.rows);
+  for (const cv::Rect& r : sample.boxes) {
+    FV_REQUIRE(r.area() > 0 && (r & frame_rect) == r,
+               "region {},{},{},{} is not inside the {}x{} frame", r.x, r.y, r.width, r.height,
+               bgr.cols, bgr.rows);
     // The ball's interior: the inscribed ellipse shrunk by 20 %.
     cv::ellipse(m.positive, cv::Point(r.x + r.width / 2, r.y + r.height / 2),
                 cv::Size(std::max(1, int(0.4 * r.width)), std::max(1, int(0.4 * r.height))), 0, 0,
@@ -117,11 +128,11 @@ ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& o
     m.near(AroundRoi(r) & frame_rect).setTo(255);
     DropBackgroundLikePixels(bgr, r, m.positive);
   }
-  for (const auto& p : o.negative_points) {
+  for (const auto& p : sample.negative_points) {
     FV_REQUIRE(p.x() >= 0 && p.y() >= 0 && p.x() < bgr.cols && p.y() < bgr.rows,
                "negative point ({}, {}) is outside the {}x{} frame", p.x(), p.y(), bgr.cols,
                bgr.rows);
-    cv::circle(m.negative, cv::Point(cvRound(p.x()), cvRound(p.y())), o.point_radius_px, 255,
+    cv::circle(m.negative, cv::Point(cvRound(p.x()), cvRound(p.y())), point_radius_px, 255,
                cv::FILLED);
   }
   return m;
@@ -281,12 +292,43 @@ cv::Mat LearnOverlay(const cv::Mat& bgr, const ColourSpec& spec, const cv::Mat& 
 ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
   o.Check();
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "colour learn: the frame is not 8-bit BGR");
-  cv::Mat hsv;
-  cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV_FULL);
-  const ColourLearnMasks masks = MarkLearnPixels(bgr, o);
-  const ColourLearnPixels px = GatherLearnPixels(hsv, masks);
+  ColourLearnSample sample;
+  sample.bgr = bgr;
+  sample.points = o.points;
+  if (o.roi) sample.boxes.push_back(*o.roi);
+  sample.negative_points = o.negative_points;
+  return LearnColour(std::vector<ColourLearnSample>{sample}, o);
+}
+
+ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
+                              const ColourLearnOptions& o) {
+  o.Check(/*need_pixels=*/false);
+  FV_REQUIRE(!samples.empty(), "colour learn: no frames to learn from");
+  const size_t budget = std::max<size_t>(1, kMaxLearnNegatives / samples.size());
+  ColourLearnPixels px;
+  cv::Mat first_positive;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const ColourLearnSample& sample = samples[i];
+    FV_REQUIRE(!sample.bgr.empty() && sample.bgr.type() == CV_8UC3,
+               "colour learn: frame {} is not 8-bit BGR", i);
+    FV_REQUIRE(!sample.points.empty() || !sample.boxes.empty(),
+               "colour learn: frame {} has no ball pixels (points or boxes)", i);
+    cv::Mat hsv;
+    cv::cvtColor(sample.bgr, hsv, cv::COLOR_BGR2HSV_FULL);
+    const ColourLearnMasks masks = MarkLearnPixels(sample, o.point_radius_px);
+    ColourLearnPixels frame_px = GatherLearnPixels(hsv, masks);
+    px.positive.insert(px.positive.end(), frame_px.positive.begin(), frame_px.positive.end());
+    const size_t n = frame_px.negative.size();
+    const size_t stride = (n + budget - 1) / budget;
+    for (size_t k = 0; k < n; k += std::max<size_t>(stride, 1)) {
+      px.negative.push_back(frame_px.negative[k]);
+    }
+    if (i == 0) first_positive = masks.positive;
+  }
   FV_REQUIRE(px.positive.size() >= 5,
              "only {} positive pixels; give more points or a larger region", px.positive.size());
+  const cv::Mat& bgr = samples.front().bgr;
+  const ColourLearnMasks masks{first_positive, cv::Mat(), cv::Mat()};
   ColourLearnResult result;
   result.range = ShrinkAgainstNegatives(InitialColourRange(px.positive, o), px, o.min_recall);
   result.positives = static_cast<int>(px.positive.size());

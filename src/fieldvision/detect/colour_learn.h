@@ -1,9 +1,12 @@
 // Learning a colour class from pixels a user points at (`fieldvision color learn`): positive
-// pixels (small neighbourhoods of clicked points, or the inscribed ellipse of a region around the
+// pixels (small neighbourhoods of clicked points, or the inscribed ellipse of a box around the
 // ball) give an HSV box from trimmed percentiles (hue as the shortest circular interval), widened
 // for shading; negative pixels (clicked, or by default the frame away from the positives) then
-// shrink the box greedily where that removes most negatives per positive lost. The result is a
-// colour file (class + field green + line white) and an overlay image of what the class selects.
+// shrink the box greedily where that removes most negatives per positive lost. One frame, or
+// several pooled (boxes across a video's frames, a folder of labelled images: the light and the
+// camera's white balance vary). The result is a colour file (class + field green + line white),
+// a purity report (the share of ball and of background pixels in the class) and an overlay image
+// of what the class selects.
 #pragma once
 
 #include <optional>
@@ -32,8 +35,17 @@ struct ColourLearnOptions {
   // reported as bad (ColourLearnResult::bad); `color learn` then does not write it.
   double max_background_share = 0.02;
   std::string class_name = "ball";
-  // Throws fv::Error naming the bad field.
-  void Check() const;
+  // Throws fv::Error naming the bad field; `need_pixels`: points or roi must be given (one frame).
+  void Check(bool need_pixels = true) const;
+};
+
+// One frame of several to learn from: the ball's pixels (points, or boxes around balls) and,
+// optionally, pixels that are not the class.
+struct ColourLearnSample {
+  cv::Mat bgr;
+  std::vector<Eigen::Vector2d> points;
+  std::vector<cv::Rect> boxes;
+  std::vector<Eigen::Vector2d> negative_points;
 };
 
 struct ColourLearnResult {
@@ -51,6 +63,14 @@ struct ColourLearnResult {
 // Learns from one BGR frame. Throws fv::Error for points or a region outside the frame, or too
 // few positives.
 ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& options);
+// Learns from several frames, their pixels pooled; each frame gives at most its share of
+// kMaxLearnNegatives background pixels (evenly spaced), so that every frame weighs alike. The
+// options' points, roi and negative points are not used; the overlay is the first frame's.
+// Throws fv::Error (naming the frame's index) for no frames, a frame that is not BGR or has no
+// ball pixels, pixels outside a frame, or too few positives in all.
+inline constexpr size_t kMaxLearnNegatives = 500000;
+ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
+                              const ColourLearnOptions& options);
 
 // The stages of LearnColour, in order; each callable alone.
 struct ColourLearnMasks {
@@ -60,6 +80,8 @@ struct ColourLearnMasks {
 };
 // Draws the points and the region into masks; throws fv::Error for any outside the frame.
 ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& options);
+// The same for a sample's points and boxes.
+ColourLearnMasks MarkLearnPixels(const ColourLearnSample& sample, int point_radius_px);
 // Clears the `positive` pixels inside `roi` that are closer to the median colour of the ring
 // around it than to the colour at its centre (a loose box also holds background).
 void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& positive);

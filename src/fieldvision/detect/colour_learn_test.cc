@@ -161,6 +161,65 @@ TEST(LearnColourStages, LooseRegionDropsItsBackground) {
   EXPECT_EQ(px.negative.size(), 34u * 34u - 20u * 20u);
 }
 
+// Boxes across frames: the ball under two lights (a sunlit and a shaded frame) is learned as one
+// class that holds both, where one frame's box alone misses the other's ball; two balls in one
+// frame are both positives (neither is taken for background).
+TEST(LearnColour, BoxesAcrossFramesHoldEveryLight) {
+  const uint64_t seed = fv::testing::TestSeed(19);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const Eigen::Vector2d c1(100, 90), c2(220, 150), c3(240, 70);
+  const double r = 14;
+  cv::Mat sunlit = test_util::FieldImage(320, 240, rng);
+  test_util::PaintDisc(sunlit, c1, r, cv::Vec3b(180, 105, 255));
+  cv::Mat shaded = test_util::FieldImage(320, 240, rng);
+  test_util::PaintDisc(shaded, c2, r, cv::Vec3b(70, 30, 110));
+  test_util::PaintDisc(shaded, c3, r, cv::Vec3b(70, 30, 110));
+  const auto box = [r](const Eigen::Vector2d& c) {
+    return cv::Rect(int(c.x() - r), int(c.y() - r), int(2 * r), int(2 * r));
+  };
+  const auto disc = [r](const cv::Mat& img, const Eigen::Vector2d& c) {
+    cv::Mat m(img.size(), CV_8U, cv::Scalar(0));
+    cv::circle(m, cv::Point(cvRound(c.x()), cvRound(c.y())), int(r - 2), 255, cv::FILLED);
+    return m;
+  };
+  ColourLearnSample a{sunlit, {}, {box(c1)}, {}};
+  ColourLearnSample b{shaded, {}, {box(c2), box(c3)}, {}};
+  ColourLearnOptions o;
+  const ColourLearnResult one = LearnColour(std::vector<ColourLearnSample>{a}, o);
+  const ColourLearnResult both = LearnColour({a, b}, o);
+  EXPECT_FALSE(both.bad) << both.Summary();
+  EXPECT_GT(both.recall, 0.9) << both.Summary();
+  const ColourTable t_one(one.spec), t_both(both.spec);
+  EXPECT_LT(Selected(t_one, shaded, disc(shaded, c2)), 0.5) << one.Summary();
+  for (const auto& [img, c] : {std::pair{sunlit, c1}, {shaded, c2}, {shaded, c3}}) {
+    EXPECT_GT(Selected(t_both, img, disc(img, c)), 0.9) << both.Summary();
+  }
+  cv::Mat rest(shaded.size(), CV_8U, cv::Scalar(255));
+  for (const auto& c : {c2, c3}) {
+    cv::circle(rest, cv::Point(cvRound(c.x()), cvRound(c.y())), int(r + 2), 0, cv::FILLED);
+  }
+  EXPECT_LT(Selected(t_both, shaded, rest), 0.005) << both.Summary();
+  // One frame as a sample learns what the one-frame call learns.
+  ColourLearnOptions single;
+  single.roi = box(c1);
+  const ColourLearnResult same = LearnColour(sunlit, single);
+  EXPECT_EQ(same.range.min, one.range.min);
+  EXPECT_EQ(same.range.max, one.range.max);
+  // Bad input names the frame.
+  EXPECT_THROW(LearnColour(std::vector<ColourLearnSample>{}, o), Error);
+  ColourLearnSample empty{shaded, {}, {}, {}};
+  try {
+    LearnColour({a, empty}, o);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 1 has no ball pixels"), std::string::npos)
+        << e.what();
+  }
+  ColourLearnSample outside{shaded, {}, {cv::Rect(300, 200, 40, 40)}, {}};
+  EXPECT_THROW(LearnColour({a, outside}, o), Error);
+}
+
 TEST(LearnColour, BadInputIsNamed) {
   cv::Mat img(100, 100, CV_8UC3, cv::Scalar(50, 140, 60));
   ColourLearnOptions o;

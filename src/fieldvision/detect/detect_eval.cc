@@ -338,22 +338,24 @@ bool NextImage(io::VideoSource* video, const LabelledImage& item, const camera::
 
 }  // namespace
 
-DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
-  o.Check();
+std::vector<LabelledImage> ListLabelledImages(const std::string& video, const std::string& labels,
+                                              int class_id, const std::string& what) {
   std::vector<LabelledImage> items;
   std::string root;
-  const bool is_dir = fs::is_directory(o.video);
-  std::vector<std::string> files = is_dir ? ImagesUnder(o.video) : io::ListImageSequence(o.video);
-  std::unique_ptr<io::VideoSource> video;
-  if (is_dir) root = o.video;
+  const bool is_dir = fs::is_directory(video);
+  std::vector<std::string> files = is_dir ? ImagesUnder(video) : io::ListImageSequence(video);
+  bool is_video = false;
+  if (is_dir) root = video;
   if (files.empty()) {
-    FV_REQUIRE(!is_dir, "eval detect: folder '{}' holds no image", o.video);
-    video = io::VideoSource::Open(o.video);  // throws naming the video
-    FV_REQUIRE(!o.labels.empty() && fs::path(o.labels).extension() == ".csv",
-               "eval detect: a video needs --labels LABELS.csv with columns frame,x,y,w,h");
-    for (int i = 0; i < std::max(0, video->frame_count()); ++i) {
+    FV_REQUIRE(!is_dir, "{}: folder '{}' holds no image", what, video);
+    const std::unique_ptr<io::VideoSource> source =
+        io::VideoSource::Open(video);  // throws naming the video
+    is_video = true;
+    FV_REQUIRE(!labels.empty() && fs::path(labels).extension() == ".csv",
+               "{}: a video needs --labels LABELS.csv with columns frame,x,y,w,h", what);
+    for (int i = 0; i < std::max(0, source->frame_count()); ++i) {
       LabelledImage item;
-      item.image = fmt::format("{}#{}", o.video, i);
+      item.image = fmt::format("{}#{}", video, i);
       item.frame = i;
       items.push_back(item);
     }
@@ -361,22 +363,30 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     if (root.empty()) root = fs::path(files.front()).parent_path().string();
     for (const auto& f : files) items.push_back(LabelledImage{f, -1, {}, false});
   }
-  if (!o.labels.empty() && fs::is_regular_file(o.labels)) {
-    items = ReadCsvLabels(items, o.labels);
-  } else if (video == nullptr) {
-    FV_REQUIRE(o.labels.empty() || fs::is_directory(o.labels),
-               "eval detect: labels '{}' is neither a folder of YOLO files nor a CSV file",
-               o.labels);
-    items = ReadYoloLabels(files, root, o.labels, o.class_id);
+  if (!labels.empty() && fs::is_regular_file(labels)) {
+    items = ReadCsvLabels(items, labels);
+  } else if (!is_video) {
+    FV_REQUIRE(labels.empty() || fs::is_directory(labels),
+               "{}: labels '{}' is neither a folder of YOLO files nor a CSV file", what, labels);
+    items = ReadYoloLabels(files, root, labels, class_id);
   } else {
-    Throw("eval detect: labels '{}' not found", o.labels);
+    Throw("{}: labels '{}' not found", what, labels);
   }
-  // Nothing to score without a single label file (a wrong --labels folder, a forgotten export).
+  // Nothing to use without a single label file (a wrong --labels folder, a forgotten export).
   const bool any_label = std::any_of(items.begin(), items.end(),
                                      [](const LabelledImage& it) { return it.has_label_file; });
   FV_REQUIRE(any_label || items.empty(),
-             "eval detect: none of the {} images has a label file (labels: '{}'): nothing to score",
-             items.size(), o.labels.empty() ? "beside the images" : o.labels);
+             "{}: none of the {} images has a label file (labels: '{}'): nothing to score", what,
+             items.size(), labels.empty() ? "beside the images" : labels);
+  return items;
+}
+
+DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
+  o.Check();
+  std::vector<LabelledImage> items =
+      ListLabelledImages(o.video, o.labels, o.class_id, "eval detect");
+  std::unique_ptr<io::VideoSource> video;
+  if (!items.empty() && items.front().frame >= 0) video = io::VideoSource::Open(o.video);
   // No output may be one of the images, label files or the camera read (an image inside --video).
   std::vector<std::string> inputs = {o.video, o.labels, o.camera};
   for (const LabelledImage& item : items) inputs.push_back(item.image);

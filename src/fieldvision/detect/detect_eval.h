@@ -30,6 +30,12 @@ struct LabelledImage {
 std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images,
                                           const std::string& image_root, const std::string& labels,
                                           int class_id);
+// The frames of `video` (a folder searched recursively, a glob, an image pattern, or a video
+// file with a CSV) with their ball boxes from `labels` (a YOLO folder, "" for YOLO files beside
+// the images, or a CSV `image|frame,x,y,w,h`); a video's items have their frame index. Throws
+// fv::Error starting with `what` for no images, labels that are neither, or no label file.
+std::vector<LabelledImage> ListLabelledImages(const std::string& video, const std::string& labels,
+                                              int class_id, const std::string& what);
 // One YOLO txt file: boxes of class `class_id` in pixels for an image of width x height.
 std::vector<cv::Rect2d> ReadYoloFile(const std::string& path, int class_id, int width, int height);
 
