@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "fieldvision/detect/detect_eval.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -69,13 +71,24 @@ void LearnFromLabels(const ColorLearnArgs& a) {
   FV_REQUIRE(!with_ball.empty(), "color learn: no box of class {} in the labels of '{}'",
              a.class_id, a.video);
   const size_t n = std::min(with_ball.size(), static_cast<size_t>(a.max_frames));
+  // A video's frames are read in order, once (the chosen ones come in order).
+  std::unique_ptr<io::VideoSource> video;
+  io::Frame frame;
+  const auto read = [&](const detect::LabelledImage& item) {
+    if (item.frame < 0) return io::ReadImage(item.image);
+    if (video == nullptr) video = io::VideoSource::Open(a.video);
+    while (frame.index < item.frame) {
+      FV_REQUIRE(video->Read(frame), "color learn: video '{}' ends before frame {}", a.video,
+                 item.frame);
+    }
+    return frame.bgr.clone();
+  };
   std::vector<detect::ColourLearnSample> samples;
   int boxes = 0;
   for (size_t k = 0; k < n; ++k) {
     const detect::LabelledImage& item = *with_ball[k * with_ball.size() / n];
     detect::ColourLearnSample sample;
-    sample.bgr =
-        item.frame >= 0 ? detect::ReadVideoFrame(a.video, item.frame) : io::ReadImage(item.image);
+    sample.bgr = read(item);
     const cv::Rect inside(0, 0, sample.bgr.cols, sample.bgr.rows);
     for (const cv::Rect2d& b : item.boxes) {
       const cv::Rect r = cv::Rect(cv::Point(cvRound(b.x), cvRound(b.y)),
