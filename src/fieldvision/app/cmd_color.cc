@@ -44,15 +44,15 @@ std::string MaskPath(const ColorLearnArgs& a) {
 // Writes the colour file unless the class is bad (then only with --force), the overlay, and the
 // purity report.
 void WriteLearned(const ColorLearnArgs& a, const detect::ColourLearnResult& r,
-                  const std::string& from) {
+                  const std::string& from, const std::string& advice) {
   std::cout << from << r.Summary() << "\n" << std::flush;
   if (!r.bad || a.force) detect::WriteColourSpec(r.spec, a.out);
   const std::string mask_out = MaskPath(a);
   io::WriteImage(mask_out, r.overlay);
   FV_REQUIRE(!r.bad || a.force,
-             "colour class selects {:.1f} % of the background: {} not written (see {}; point at "
-             "the ball more tightly, add --negative, or --force to write it anyway)",
-             100 * r.negative_rate, a.out, mask_out);
+             "colour class selects {:.1f} % of the background: {} not written (see {}; {}, or "
+             "--force to write it anyway)",
+             100 * r.negative_rate, a.out, mask_out, advice);
   std::cout << "wrote " << a.out << " (use it with --color " << a.out << ") and " << mask_out
             << " (what the class selects)\n";
 }
@@ -105,7 +105,8 @@ void LearnFromLabels(const ColorLearnArgs& a) {
   const detect::ColourLearnResult r = detect::LearnColour(samples, a.learn);
   WriteLearned(a, r,
                fmt::format("learned from {} boxes in {} of the {} frames with a ball\n", boxes,
-                           samples.size(), with_ball.size()));
+                           samples.size(), with_ball.size()),
+               "learn from fewer frames of one light (one venue, one camera) or tighter boxes");
 }
 
 void Learn(const ColorLearnArgs& a) {
@@ -132,7 +133,8 @@ void Learn(const ColorLearnArgs& a) {
                  frame.rows);
     }
   }
-  WriteLearned(a, detect::LearnColour(frame, o), "");
+  WriteLearned(a, detect::LearnColour(frame, o), "",
+               "point at the ball more tightly or add --negative");
 }
 
 void Setup(CLI::App& app, int& exit_code) {

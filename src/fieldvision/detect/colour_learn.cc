@@ -31,6 +31,16 @@ cv::Rect AroundRoi(const cv::Rect& r) {
   return cv::Rect(r.x - r.width / 4, r.y - r.height / 4, r.width * 3 / 2, r.height * 3 / 2);
 }
 
+// One frame's pixels as the options give them (the one-frame calls).
+ColourLearnSample SampleOf(const cv::Mat& bgr, const ColourLearnOptions& o) {
+  ColourLearnSample sample;
+  sample.bgr = bgr;
+  sample.points = o.points;
+  if (o.roi) sample.boxes.push_back(*o.roi);
+  sample.negative_points = o.negative_points;
+  return sample;
+}
+
 }  // namespace
 
 void ColourLearnOptions::Check(bool need_pixels) const {
@@ -95,12 +105,7 @@ cv::Mat ReadVideoFrame(const std::string& video, int frame_index) {
 }
 
 ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& o) {
-  ColourLearnSample sample;
-  sample.bgr = bgr;
-  sample.points = o.points;
-  if (o.roi) sample.boxes.push_back(*o.roi);
-  sample.negative_points = o.negative_points;
-  return MarkLearnPixels(sample, o.point_radius_px);
+  return MarkLearnPixels(SampleOf(bgr, o), o.point_radius_px);
 }
 
 ColourLearnMasks MarkLearnPixels(const ColourLearnSample& sample, int point_radius_px) {
@@ -292,12 +297,7 @@ cv::Mat LearnOverlay(const cv::Mat& bgr, const ColourSpec& spec, const cv::Mat& 
 ColourLearnResult LearnColour(const cv::Mat& bgr, const ColourLearnOptions& o) {
   o.Check();
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "colour learn: the frame is not 8-bit BGR");
-  ColourLearnSample sample;
-  sample.bgr = bgr;
-  sample.points = o.points;
-  if (o.roi) sample.boxes.push_back(*o.roi);
-  sample.negative_points = o.negative_points;
-  return LearnColour(std::vector<ColourLearnSample>{sample}, o);
+  return LearnColour(std::vector<ColourLearnSample>{SampleOf(bgr, o)}, o);
 }
 
 ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
@@ -316,7 +316,7 @@ ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
     cv::Mat hsv;
     cv::cvtColor(sample.bgr, hsv, cv::COLOR_BGR2HSV_FULL);
     const ColourLearnMasks masks = MarkLearnPixels(sample, o.point_radius_px);
-    ColourLearnPixels frame_px = GatherLearnPixels(hsv, masks);
+    const ColourLearnPixels frame_px = GatherLearnPixels(hsv, masks);
     px.positive.insert(px.positive.end(), frame_px.positive.begin(), frame_px.positive.end());
     const size_t n = frame_px.negative.size();
     const size_t stride = (n + budget - 1) / budget;
@@ -327,8 +327,6 @@ ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
   }
   FV_REQUIRE(px.positive.size() >= 5,
              "only {} positive pixels; give more points or a larger region", px.positive.size());
-  const cv::Mat& bgr = samples.front().bgr;
-  const ColourLearnMasks masks{first_positive, cv::Mat(), cv::Mat()};
   ColourLearnResult result;
   result.range = ShrinkAgainstNegatives(InitialColourRange(px.positive, o), px, o.min_recall);
   result.positives = static_cast<int>(px.positive.size());
@@ -337,7 +335,7 @@ ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
   result.negative_rate = ColourRangeShare(result.range, px.negative);
   result.bad = result.negative_rate > o.max_background_share;
   result.spec = LearnedColourSpec(result.range, o.class_name);
-  result.overlay = LearnOverlay(bgr, result.spec, masks.positive);
+  result.overlay = LearnOverlay(samples.front().bgr, result.spec, first_positive);
   return result;
 }
 
