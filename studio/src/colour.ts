@@ -1,10 +1,13 @@
-// Ball colour: click on the ball (shift-click: not the ball) or drag a box around it; the server
-// learns an HSV box (detect/colour_learn.h) that the sliders show and edit, the selected pixels
-// are shown live over the frame, the colour file is saved and the detector run on a few frames.
+// Ball colour: click on the ball (shift-click: not the ball) or drag a box around it, on one
+// frame or several (a new frame keeps the earlier frames' clicks: lights and white balance
+// differ); the server learns an HSV box (detect/colour_learn.h) that the sliders show and edit,
+// the selected pixels are shown live over the frame, the colour file is saved and the detector
+// run on a few frames.
 import * as api from './api';
 import { el, fileSelect, labelled, status } from './ui';
 
 type Range = { space: string; min: number[]; max: number[] };
+type Clicks = { frame: number; points: number[][]; negative_points: number[][]; roi?: number[] };
 
 interface DetectResult {
   frames: { frame: number; candidates: { u: number; v: number; radius_px: number; score: number; accepted: boolean }[] }[];
@@ -68,7 +71,7 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     el('section', { class: 'controls' }, labelled('Video', video), labelled('Frame', frame), load, clear),
     el('div', { class: 'workspace' },
       el('div', { class: 'main-view' }, image, msg, count),
-      el('div', { class: 'side' }, el('p', { class: 'hint', text: 'Click on the ball (shift-click: not the ball) or drag a box around it.' }),
+      el('div', { class: 'side' }, el('p', { class: 'hint', text: 'Click on the ball (shift-click: not the ball) or drag a box around it; open another frame to add its clicks.' }),
         ...sliderRows, el('p', {}, labelled('Save as', out)), save,
         el('h3', { text: 'Check: run the detector' }), labelled('Frames', detectFrames), detect, detectResult)),
   );
@@ -80,6 +83,9 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   let points: number[][] = [];
   let negatives: number[][] = [];
   let roi: number[] | null = null;
+  let shownFrame = 0;
+  // Clicks on frames opened before this one, learned together with this frame's.
+  let kept: Clicks[] = [];
   let drag: [number, number] | null = null;
   let dragNow: [number, number] | null = null;
   let found: { u: number; v: number; radius_px: number; accepted: boolean }[] = [];
@@ -156,14 +162,14 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     drawOverlay();
     if (!points.length && !roi) return;
     const seq = ++learnSent;
+    const here: Clicks = { frame: shownFrame, points, negative_points: negatives, ...(roi ? { roi } : {}) };
+    const body = kept.length ? { video: video.value, samples: [...kept, here] } : { video: video.value, ...here };
     try {
-      const r = await api.post<{ range: Range; recall: number; negative_rate: number; positives: number }>('/api/colour/learn', {
-        video: video.value, frame: Number(frame.value), points, negative_points: negatives, ...(roi ? { roi } : {}),
-      });
+      const r = await api.post<{ range: Range; recall: number; negative_rate: number; positives: number; frames: number }>('/api/colour/learn', body);
       if (seq !== learnSent) return;
       range = r.range;
       setSliders(r.range);
-      status(msg, `learned from ${r.positives} pixels: recall ${(100 * r.recall).toFixed(1)} %, ${(100 * r.negative_rate).toFixed(3)} % of other pixels selected`);
+      status(msg, `learned from ${r.positives} pixels on ${r.frames} frame${r.frames > 1 ? 's' : ''}: recall ${(100 * r.recall).toFixed(1)} %, ${(100 * r.negative_rate).toFixed(3)} % of other pixels selected`);
     } catch (e) {
       if (seq === learnSent) status(msg, (e as Error).message, true);
     } finally {
@@ -197,6 +203,7 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     void learn();
   });
   clear.onclick = () => {
+    kept = [];
     points = [];
     negatives = [];
     roi = null;
@@ -205,7 +212,16 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   };
   load.onclick = async () => {
     try {
-      img = await api.loadFrame(video.value, Number(frame.value));
+      const next = Number(frame.value);
+      img = await api.loadFrame(video.value, next);
+      // Another frame: this one's clicks are kept and learned with the next ones.
+      if (next !== shownFrame && (points.length || roi)) {
+        kept = [...kept.filter((k) => k.frame !== shownFrame), { frame: shownFrame, points, negative_points: negatives, ...(roi ? { roi } : {}) }];
+        points = [];
+        negatives = [];
+        roi = null;
+      }
+      shownFrame = next;
       image.width = img.naturalWidth;
       image.height = img.naturalHeight;
       const ctx = image.getContext('2d', { willReadFrequently: true })!;
@@ -215,13 +231,16 @@ export async function colourPage(root: HTMLElement): Promise<void> {
       const d = pixels.data;
       for (let i = 0, n = image.width * image.height; i < n; ++i) hsv.set(hsvOf(d[4 * i], d[4 * i + 1], d[4 * i + 2]), 3 * i);
       found = [];
-      status(msg, `frame ${frame.value} of ${video.value}: ${image.width}x${image.height}`);
+      status(msg, `frame ${frame.value} of ${video.value}: ${image.width}x${image.height}` + (kept.length ? `; clicks kept on ${kept.length} other frame${kept.length > 1 ? 's' : ''}` : ''));
       drawOverlay();
       image.dataset.ready = '1';
     } catch (e) {
       status(msg, (e as Error).message, true);
     }
   };
+  video.addEventListener('change', () => {
+    kept = [];  // clicks are on one video's frames
+  });
   save.onclick = async () => {
     if (!range) return status(msg, 'nothing to save: click on the ball or set the sliders first', true);
     try {

@@ -184,6 +184,19 @@ try {
     await page.waitForFunction((n) => Number(document.querySelector('#col-status').dataset.learned) >= n, clicks);
   }
   check(/learned/.test(await page.textContent('#col-status')), 'colour learned from the clicks');
+  // Another frame's clicks are learned together with these.
+  const f1 = truth2d.find((r) => Number(r.visible_fraction) > 0.9 && Number(r.radius_px) > 4 && Math.abs(Number(r.frame) - Number(f0.frame)) >= 5);
+  check(!!f1, 'the ball is visible in a second frame of cam1');
+  if (f1) {
+    await page.fill('#col-frame', f1.frame);
+    await page.click('#col-load');
+    await page.waitForFunction((f) => document.querySelector('#col-status').textContent.startsWith(`frame ${f} `), f1.frame);
+    await clickPixel(colourCanvas, Number(f1.u_px), Number(f1.v_px));
+    ++clicks;
+    await page.waitForFunction((n) => Number(document.querySelector('#col-status').dataset.learned) >= n, clicks);
+    const learned2 = await page.textContent('#col-status');
+    check(/on 2 frames/.test(learned2), `colour learned from clicks on two frames (${learned2})`);
+  }
   const selected = Number(await page.getAttribute('#col-count', 'data-selected'));
   check(selected > 0 && selected < 20 * Math.PI * br * br, `selected pixels shown (${selected} px; ball disc ${(Math.PI * br * br).toFixed(0)} px)`);
   await page.fill('#col-out', 'ball_colour.json');

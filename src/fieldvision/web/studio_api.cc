@@ -665,27 +665,52 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
   };
 }
 
+// One frame's clicks for colour learning: `j`'s frame (default 0), points, roi and negative
+// points on that frame of `video`; `what` names it in errors.
+detect::ColourLearnSample LearnSampleOf(const fs::path& video, const json& j,
+                                        const std::string& what) {
+  detect::ColourLearnSample sample;
+  sample.points = ParseUvList(j, "points");
+  sample.negative_points = ParseUvList(j, "negative_points");
+  if (j.contains("roi")) {
+    const auto roi = Get<std::array<int, 4>>(j, "roi");
+    sample.boxes.emplace_back(roi[0], roi[1], roi[2], roi[3]);
+  }
+  if (sample.points.empty() && sample.boxes.empty()) {
+    throw HttpError(400, what + ": give 'points' or 'roi'");
+  }
+  sample.bgr = detect::ReadVideoFrame(video.string(), GetOr<int>(j, "frame", 0));
+  return sample;
+}
+
 // Endpoints of ball colour: learning, saving, detection on a frame.
 std::vector<Route> ColourRoutes() {
   return {
       {{"POST", "/api/colour/learn",
-        "{video, frame, points: [[u, v]], roi: [x, y, w, h], negative_points}: HSV box"},
+        "{video, frame, points: [[u, v]], roi: [x, y, w, h], negative_points} or {video, "
+        "samples: [{frame, points, roi, negative_points}]} (clicks on several frames): HSV box"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
-         detect::ColourLearnOptions o;
-         o.points = ParseUvList(body, "points");
-         o.negative_points = ParseUvList(body, "negative_points");
-         if (body.contains("roi")) {
-           const auto roi = Get<std::array<int, 4>>(body, "roi");
-           o.roi = cv::Rect(roi[0], roi[1], roi[2], roi[3]);
+         std::vector<detect::ColourLearnSample> samples;
+         if (body.contains("samples")) {
+           const json& list = body["samples"];
+           if (!list.is_array() || list.empty() || list.size() > 100) {
+             throw HttpError(400, "'samples' must be an array of 1 to 100 frames' clicks");
+           }
+           for (size_t i = 0; i < list.size(); ++i) {
+             if (!list[i].is_object())
+               throw HttpError(400, fmt::format("samples[{}]: not an object", i));
+             samples.push_back(LearnSampleOf(video, list[i], fmt::format("samples[{}]", i)));
+           }
+         } else {
+           samples.push_back(LearnSampleOf(video, body, "the request"));
          }
-         if (o.points.empty() && !o.roi) throw HttpError(400, "give 'points' or 'roi'");
-         const cv::Mat bgr = detect::ReadVideoFrame(video.string(), GetOr<int>(body, "frame", 0));
-         const detect::ColourLearnResult res = detect::LearnColour(bgr, o);
+         const detect::ColourLearnResult res = detect::LearnColour(samples, {});
          return Json({{"range", RangeToJson(res.range)},
                       {"positives", res.positives},
                       {"negatives", res.negatives},
+                      {"frames", samples.size()},
                       {"recall", Round(res.recall)},
                       {"negative_rate", Round(res.negative_rate, 1e-6)},
                       {"summary", OneLine(res.Summary())}});

@@ -572,7 +572,22 @@ TEST_F(StudioApiTest, BallColourLearnSaveDetect) {
                              json{{"video", "scene/cam1.avi"}, {"frame", 0}, {"points", points}});
   ASSERT_EQ(learned.status, 200) << learned.body;
   EXPECT_GT(learned.j()["recall"].get<double>(), 0.8);
+  EXPECT_EQ(learned.j()["frames"], 1);
   const json range = learned.j()["range"];
+  // Clicks on several frames are learned together; a frame without clicks is named.
+  const json sample = {{"frame", 0}, {"points", points}};
+  const Reply pooled =
+      Post("/api/colour/learn", json{{"video", "scene/cam1.avi"}, {"samples", {sample, sample}}});
+  ASSERT_EQ(pooled.status, 200) << pooled.body;
+  EXPECT_EQ(pooled.j()["frames"], 2);
+  EXPECT_EQ(pooled.j()["positives"].get<int>(), 2 * learned.j()["positives"].get<int>());
+  EXPECT_EQ(pooled.j()["range"], range);
+  ExpectError(Post("/api/colour/learn",
+                   json{{"video", "scene/cam1.avi"}, {"samples", {sample, {{"frame", 1}}}}}),
+              400, "samples[1]: give 'points' or 'roi'");
+  ExpectError(
+      Post("/api/colour/learn", json{{"video", "scene/cam1.avi"}, {"samples", json::array()}}), 400,
+      "'samples' must be an array");
 
   const Reply saved = Post("/api/colour/save", json{{"range", range}, {"out", "ball.json"}});
   ASSERT_EQ(saved.status, 200) << saved.body;
