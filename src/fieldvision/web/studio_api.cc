@@ -261,8 +261,9 @@ std::string RelativeName(const Workspace& ws, const std::string& name) {
 }
 
 calib::BoardSpec BoardFromJson(const json& j) {
-  if (!j.is_object())
+  if (!j.is_object()) {
     throw HttpError(400, "'board' must be an object {type, cols, rows, square_m}");
+  }
   calib::BoardSpec b;
   b.type = calib::ParseBoardType(GetOr<std::string>(j, "type", "chessboard"));
   b.cols = Get<int>(j, "cols");
@@ -372,8 +373,9 @@ void WriteTextFile(const fs::path& path, const std::string& text) {
 std::string DecodeBase64(std::string_view text, const std::string& what) {
   if (text.rfind("data:", 0) == 0) {
     const size_t comma = text.find(',');
-    if (comma == std::string_view::npos)
+    if (comma == std::string_view::npos) {
       throw HttpError(400, what + " is a data: URL without data");
+    }
     text.remove_prefix(comma + 1);
   }
   std::string out;
@@ -420,7 +422,7 @@ cv::Mat DecodePngImage(const std::string& base64, const std::string& what) {
 // A folder to write into, named by a request: inside the working folder, not the folder itself,
 // its parent existing; it may exist (as a folder) or not.
 fs::path ResolveOutputFolder(const Workspace& ws, const std::string& path) {
-  const fs::path c = ws.Resolve(path, false);
+  fs::path c = ws.Resolve(path, false);
   if (c == ws.root()) throw HttpError(400, "output folder '" + path + "' is the studio folder");
   if (!fs::is_directory(c.parent_path())) {
     throw HttpError(404, "folder of output '" + path + "' does not exist");
@@ -538,8 +540,9 @@ std::vector<Route> CalibrationRoutes() {
            std::ostringstream csv;
            csv.precision(10);
            csv << "u,v,name\n";
-           for (const auto& p : points)
+           for (const auto& p : points) {
              csv << p.uv_px.x() << ',' << p.uv_px.y() << ',' << p.name << '\n';
+           }
            WriteTextFile(points_out, csv.str());
            j["wrote"].push_back(ws.Relative(points_out));
          }
@@ -559,8 +562,9 @@ std::vector<Route> CalibrationRoutes() {
          const fs::path video = ws.Resolve(video_path);
          fs::path out;
          if (body.contains("out")) out = ws.ResolveOutput(Get<std::string>(body, "out"));
-         if (body.contains("points"))
+         if (body.contains("points")) {
            cam = calib::EstimatePose(cam, ParseClicks(body, field)).camera;
+         }
          if (!cam.has_pose) {
            throw HttpError(422,
                            "no pose to refine: click 4 or more keypoints (or give a camera "
@@ -699,8 +703,9 @@ std::vector<Route> ColourRoutes() {
              throw HttpError(400, "'samples' must be an array of 1 to 100 frames' clicks");
            }
            for (size_t i = 0; i < list.size(); ++i) {
-             if (!list[i].is_object())
+             if (!list[i].is_object()) {
                throw HttpError(400, fmt::format("samples[{}]: not an object", i));
+             }
              samples.push_back(LearnSampleOf(video, list[i], fmt::format("samples[{}]", i)));
            }
          } else {
@@ -903,8 +908,9 @@ std::vector<Route> TrackRoutes() {
          json players = json::array();
          for (const auto& p : res.players) {
            json profile = json::array();
-           for (const auto& [t, v] : p.speed_profile)
+           for (const auto& [t, v] : p.speed_profile) {
              profile.push_back({Round(t, 1e-3), Round(v, 1e-3)});
+           }
            players.push_back({{"id", p.id},
                               {"team", p.team},
                               {"samples", p.samples},
@@ -1012,7 +1018,7 @@ std::vector<Route> JobRoutes() {
 }
 
 const std::vector<Route>& Routes() {
-  static const std::vector<Route> routes = [] {
+  static const std::vector<Route> kRoutes = [] {
     std::vector<Route> all;
     for (auto group : {FolderRoutes, CalibrationRoutes, IntrinsicsAndLiveRoutes, ColourRoutes,
                        TrackRoutes, JobRoutes}) {
@@ -1020,7 +1026,7 @@ const std::vector<Route>& Routes() {
     }
     return all;
   }();
-  return routes;
+  return kRoutes;
 }
 
 }  // namespace
@@ -1029,14 +1035,14 @@ StudioApi::StudioApi(const Workspace& workspace, EventHub* events, JobRunner* jo
     : workspace_(workspace), events_(events), jobs_(jobs), live_(live) {}
 
 const std::vector<Endpoint>& StudioApi::Endpoints() {
-  static const std::vector<Endpoint> endpoints = [] {
+  static const std::vector<Endpoint> kEndpoints = [] {
     std::vector<Endpoint> e;
     for (const auto& r : Routes()) e.push_back(r.endpoint);
     e.push_back(
         {"GET", "/api/events", "Server-Sent Events: saved files, job progress, live positions"});
     return e;
   }();
-  return endpoints;
+  return kEndpoints;
 }
 
 ApiResponse StudioApi::Handle(const ApiRequest& request) const {
