@@ -158,11 +158,13 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     }
   }
 
+  const clicksHere = (): Clicks => ({ frame: shownFrame, points, negative_points: negatives, ...(roi ? { roi } : {}) });
+
   async function learn() {
     drawOverlay();
     if (!points.length && !roi) return;
     const seq = ++learnSent;
-    const here: Clicks = { frame: shownFrame, points, negative_points: negatives, ...(roi ? { roi } : {}) };
+    const here = clicksHere();
     const body = kept.length ? { video: video.value, samples: [...kept, here] } : { video: video.value, ...here };
     try {
       const r = await api.post<{ range: Range; recall: number; negative_rate: number; positives: number; frames: number }>('/api/colour/learn', body);
@@ -214,12 +216,15 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     try {
       const next = Number(frame.value);
       img = await api.loadFrame(video.value, next);
-      // Another frame: this one's clicks are kept and learned with the next ones.
-      if (next !== shownFrame && (points.length || roi)) {
-        kept = [...kept.filter((k) => k.frame !== shownFrame), { frame: shownFrame, points, negative_points: negatives, ...(roi ? { roi } : {}) }];
-        points = [];
-        negatives = [];
-        roi = null;
+      // Another frame: this one's clicks are kept and learned with the next ones; a frame opened
+      // again gets its kept clicks back, to add to.
+      if (next !== shownFrame) {
+        if (points.length || roi) kept.push(clicksHere());
+        const back = kept.find((k) => k.frame === next);
+        kept = kept.filter((k) => k !== back);
+        points = back ? back.points : [];
+        negatives = back ? back.negative_points : [];
+        roi = back?.roi ?? null;
       }
       shownFrame = next;
       image.width = img.naturalWidth;

@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
-#include <memory>
 #include <utility>
 #include <vector>
 
@@ -13,7 +12,6 @@
 #include "fieldvision/detect/detect_eval.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/io/output_path.h"
-#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -71,24 +69,21 @@ void LearnFromLabels(const ColorLearnArgs& a) {
   FV_REQUIRE(!with_ball.empty(), "color learn: no box of class {} in the labels of '{}'",
              a.class_id, a.video);
   const size_t n = std::min(with_ball.size(), static_cast<size_t>(a.max_frames));
-  // A video's frames are read in order, once (the chosen ones come in order).
-  std::unique_ptr<io::VideoSource> video;
-  io::Frame frame;
-  const auto read = [&](const detect::LabelledImage& item) {
-    if (item.frame < 0) return io::ReadImage(item.image);
-    if (video == nullptr) video = io::VideoSource::Open(a.video);
-    while (frame.index < item.frame) {
-      FV_REQUIRE(video->Read(frame), "color learn: video '{}' ends before frame {}", a.video,
-                 item.frame);
-    }
-    return frame.bgr.clone();
-  };
+  std::vector<const detect::LabelledImage*> chosen;
+  for (size_t k = 0; k < n; ++k) chosen.push_back(with_ball[k * with_ball.size() / n]);
+  // A video's frames in one pass.
+  std::vector<cv::Mat> video_frames;
+  if (chosen.front()->frame >= 0) {
+    std::vector<int> indices;
+    for (const detect::LabelledImage* item : chosen) indices.push_back(item->frame);
+    video_frames = detect::ReadVideoFrames(a.video, indices);
+  }
   std::vector<detect::ColourLearnSample> samples;
   int boxes = 0;
   for (size_t k = 0; k < n; ++k) {
-    const detect::LabelledImage& item = *with_ball[k * with_ball.size() / n];
+    const detect::LabelledImage& item = *chosen[k];
     detect::ColourLearnSample sample;
-    sample.bgr = read(item);
+    sample.bgr = item.frame >= 0 ? video_frames[k] : io::ReadImage(item.image);
     const cv::Rect inside(0, 0, sample.bgr.cols, sample.bgr.rows);
     for (const cv::Rect2d& b : item.boxes) {
       const cv::Rect r = cv::Rect(cv::Point(cvRound(b.x), cvRound(b.y)),

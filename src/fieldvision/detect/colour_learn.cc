@@ -94,14 +94,24 @@ cv::Rect ParseRect(const std::string& text, const std::string& what) {
 }
 
 cv::Mat ReadVideoFrame(const std::string& video, int frame_index) {
-  FV_REQUIRE(frame_index >= 0, "--frame must be >= 0 (got {})", frame_index);
+  return ReadVideoFrames(video, {frame_index}).front();
+}
+
+std::vector<cv::Mat> ReadVideoFrames(const std::string& video, const std::vector<int>& frames) {
+  for (const int f : frames) FV_REQUIRE(f >= 0, "--frame must be >= 0 (got {})", f);
+  std::vector<cv::Mat> out(frames.size());
+  if (frames.empty()) return out;
+  const int last = *std::max_element(frames.begin(), frames.end());
   auto source = io::VideoSource::Open(video);
   io::Frame frame;
   while (source->Read(frame)) {
-    if (frame.index == frame_index) return frame.bgr;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      if (frames[i] == frame.index) out[i] = frame.bgr.clone();
+    }
+    if (frame.index == last) return out;
   }
   Throw("video '{}' has only {} frames; frame {} does not exist", video, source->frames_read(),
-        frame_index);
+        last);
 }
 
 ColourLearnMasks MarkLearnPixels(const cv::Mat& bgr, const ColourLearnOptions& o) {

@@ -110,6 +110,8 @@ cv::Mat LearnOverlay(const cv::Mat& bgr, const ColourSpec& spec, const cv::Mat& 
 // Reads frame `frame` of `video` (file or image pattern); throws naming the video when it cannot
 // be opened or is shorter.
 cv::Mat ReadVideoFrame(const std::string& video, int frame);
+// Frames `frames` (any order, repeats allowed) of `video`, read in one pass; the same errors.
+std::vector<cv::Mat> ReadVideoFrames(const std::string& video, const std::vector<int>& frames);
 
 // "u,v;u,v;..." -> points; "x,y,w,h" -> rectangle. Throw naming `what` on bad syntax.
 std::vector<Eigen::Vector2d> ParsePoints(const std::string& text, const std::string& what);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/test_images.h"
@@ -218,6 +219,30 @@ TEST(LearnColour, BoxesAcrossFramesHoldEveryLight) {
   }
   ColourLearnSample outside{shaded, {}, {cv::Rect(300, 200, 40, 40)}, {}};
   EXPECT_THROW(LearnColour({a, outside}, o), Error);
+}
+
+// Several frames of a video in one pass, in the order asked, repeats allowed; past the end the
+// error names the video and the frame.
+TEST(LearnColour, VideoFramesReadInOnePass) {
+  const std::string video = fv::testing::TempDir() + "/colour_learn_frames.avi";
+  {
+    cv::VideoWriter w(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30, {64, 48});
+    ASSERT_TRUE(w.isOpened());
+    for (int i = 0; i < 5; ++i) w.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(40, 50 * i, 60)));
+  }
+  const std::vector<cv::Mat> frames = ReadVideoFrames(video, {3, 0, 3});
+  ASSERT_EQ(frames.size(), 3u);
+  for (const auto& [k, level] : {std::pair{0, 150}, {1, 0}, {2, 150}}) {
+    ASSERT_FALSE(frames[k].empty());
+    EXPECT_NEAR(cv::mean(frames[k])[1], level, 4) << "frame " << k;
+  }
+  EXPECT_NEAR(cv::mean(ReadVideoFrame(video, 4))[1], 200, 4);
+  try {
+    ReadVideoFrames(video, {1, 9});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("frame 9 does not exist"), std::string::npos) << e.what();
+  }
 }
 
 TEST(LearnColour, BadInputIsNamed) {

@@ -669,10 +669,9 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
   };
 }
 
-// One frame's clicks for colour learning: `j`'s frame (default 0), points, roi and negative
-// points on that frame of `video`; `what` names it in errors.
-detect::ColourLearnSample LearnSampleOf(const fs::path& video, const json& j,
-                                        const std::string& what) {
+// One frame's clicks for colour learning: `j`'s points, roi and negative points (its frame,
+// `frame` or 0, is read by the caller); `what` names it in errors.
+detect::ColourLearnSample LearnSampleOf(const json& j, const std::string& what) {
   detect::ColourLearnSample sample;
   sample.points = ParseUvList(j, "points");
   sample.negative_points = ParseUvList(j, "negative_points");
@@ -683,7 +682,6 @@ detect::ColourLearnSample LearnSampleOf(const fs::path& video, const json& j,
   if (sample.points.empty() && sample.boxes.empty()) {
     throw HttpError(400, what + ": give 'points' or 'roi'");
   }
-  sample.bgr = detect::ReadVideoFrame(video.string(), GetOr<int>(j, "frame", 0));
   return sample;
 }
 
@@ -697,6 +695,7 @@ std::vector<Route> ColourRoutes() {
          const json body = Body(r);
          const fs::path video = ws.Resolve(Get<std::string>(body, "video"));
          std::vector<detect::ColourLearnSample> samples;
+         std::vector<int> frames;
          if (body.contains("samples")) {
            const json& list = body["samples"];
            if (!list.is_array() || list.empty() || list.size() > 100) {
@@ -706,11 +705,15 @@ std::vector<Route> ColourRoutes() {
              if (!list[i].is_object()) {
                throw HttpError(400, fmt::format("samples[{}]: not an object", i));
              }
-             samples.push_back(LearnSampleOf(video, list[i], fmt::format("samples[{}]", i)));
+             samples.push_back(LearnSampleOf(list[i], fmt::format("samples[{}]", i)));
+             frames.push_back(GetOr<int>(list[i], "frame", 0));
            }
          } else {
-           samples.push_back(LearnSampleOf(video, body, "the request"));
+           samples.push_back(LearnSampleOf(body, "the request"));
+           frames.push_back(GetOr<int>(body, "frame", 0));
          }
+         const std::vector<cv::Mat> bgr = detect::ReadVideoFrames(video.string(), frames);
+         for (size_t i = 0; i < samples.size(); ++i) samples[i].bgr = bgr[i];
          const detect::ColourLearnResult res = detect::LearnColour(samples, {});
          return Json({{"range", RangeToJson(res.range)},
                       {"positives", res.positives},
