@@ -70,11 +70,13 @@ void LearnFromLabels(const ColorLearnArgs& a) {
              a.class_id, a.video);
   const size_t n = std::min(with_ball.size(), static_cast<size_t>(a.max_frames));
   std::vector<const detect::LabelledImage*> chosen;
+  chosen.reserve(n);
   for (size_t k = 0; k < n; ++k) chosen.push_back(with_ball[k * with_ball.size() / n]);
   // A video's frames in one pass.
   std::vector<cv::Mat> video_frames;
   if (chosen.front()->frame >= 0) {
     std::vector<int> indices;
+    indices.reserve(n);
     for (const detect::LabelledImage* item : chosen) indices.push_back(item->frame);
     video_frames = detect::ReadVideoFrames(a.video, indices);
   }
