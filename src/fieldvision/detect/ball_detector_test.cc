@@ -102,10 +102,10 @@ PaintedDisc DetectPaintedDisc(const BallDetector& det, cv::Mat img, const cv::Ve
 }
 
 // A plain 320x240 wall of `bgr` with a little sensor noise.
-cv::Mat NoisyWall(const cv::Scalar& bgr) {
+cv::Mat NoisyWall(const cv::Scalar& bgr, util::Rng& rng) {
   cv::Mat wall(240, 320, CV_8UC3, bgr);
   cv::Mat noise(wall.size(), CV_8UC3);
-  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
+  test_util::FillNormal(noise, rng, 0, 2);
   return wall + noise;
 }
 
@@ -134,7 +134,7 @@ TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
     EXPECT_LT((best.centre_px - p.centre).norm(), 0.1 * p.radius_px + 0.5);
   }
   for (int trial = 0; trial < 4; ++trial) {
-    const PaintedDisc p = DetectPaintedDisc(det, NoisyWall(cv::Scalar(230, 235, 235)),
+    const PaintedDisc p = DetectPaintedDisc(det, NoisyWall(cv::Scalar(230, 235, 235), rng),
                                             cv::Vec3b(150, 200, 215), 0.95, rng);  // beige
     ASSERT_FALSE(p.candidates.empty());
     const BallCandidate& best = p.candidates.front();
@@ -187,7 +187,7 @@ TEST(BallDetector, AYellowGreenBallOnTheFieldIsAcceptedTheSameDiscOffItIsNot) {
   for (int trial = 0; trial < 4; ++trial) {
     // Hue 60 deg, pale: no class.
     const PaintedDisc p =
-        DetectPaintedDisc(det, NoisyWall(cv::Scalar(100, 150, 150)), yellow_green, 0.3, rng);
+        DetectPaintedDisc(det, NoisyWall(cv::Scalar(100, 150, 150), rng), yellow_green, 0.3, rng);
     ASSERT_FALSE(p.candidates.empty());
     const BallCandidate& best = p.candidates.front();
     EXPECT_FALSE(best.accepted) << "contrast " << best.contrast << " hue " << best.hue_contrast;

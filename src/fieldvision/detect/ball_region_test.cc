@@ -303,7 +303,7 @@ TEST(BallRegion, OpenCvBehaviourTheSpeedUpsRelyOn) {
     }
   }
   cv::Mat bgr(40, 70, CV_8UC3), lab;
-  cv::randu(bgr, 0, 256);
+  cv::RNG(rng()).fill(bgr, cv::RNG::UNIFORM, 0, 256);  // not the global RNG: follows the seed
   cv::cvtColor(bgr, lab, cv::COLOR_BGR2Lab);
   for (int it = 0; it < 200; ++it) {
     const cv::Rect r(rng() % 60, rng() % 30, 1 + rng() % 10, 1 + rng() % 10);

@@ -30,7 +30,7 @@ TEST(FitEdgeCircle, OutlinesAPrintedBallInFrontOfABoardOfItsColour) {
   for (int i = 0; i < kTrials; ++i) {
     cv::Mat img(160, 160, CV_8UC3, cv::Scalar(board[0], board[1], board[2]));
     cv::Mat noise(img.size(), CV_8UC3);
-    cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(2));
+    test_util::FillNormal(noise, rng, 0, 2);
     const Vector2d c(rng.Uniform(60, 100), rng.Uniform(60, 100));
     const double r = rng.Uniform(5, 20);
     test_util::PaintDisc(img, c, r, ball, 0.5);
@@ -61,7 +61,8 @@ TEST(FitEdgeCircle, OutlinesAPrintedBallInFrontOfABoardOfItsColour) {
 TEST(FitEdgeCircle, NothingOnAnEmptyBoardAndBadOptionsAreNamed) {
   cv::Mat img(100, 100, CV_8UC3, cv::Scalar(20, 200, 230));
   cv::Mat noise(img.size(), CV_8UC3);
-  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(3));
+  util::Rng rng(fv::testing::TestSeed(32));
+  test_util::FillNormal(noise, rng, 0, 3);
   img += noise;
   EXPECT_FALSE(FitEdgeCircle(img, Vector2d(50, 50), 10).ok);
   EXPECT_FALSE(FitEdgeCircle(img, Vector2d(2, 2), 10).ok);  // rays leave the image

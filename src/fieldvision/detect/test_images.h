@@ -20,6 +20,17 @@ namespace fv::detect::test_util {
 inline const cv::Vec3b kGrass(50, 140, 60);
 inline const cv::Vec3b kOrange(0, 110, 255);
 
+// `m` filled from `rng` (cv::randn/randu draw from OpenCV's global RNG, whose state depends on
+// what ran before in the process: a test's images would then not follow its seed).
+inline void FillNormal(cv::Mat& m, util::Rng& rng, double mean, double sigma) {
+  cv::RNG cv_rng(rng.engine()());
+  cv_rng.fill(m, cv::RNG::NORMAL, cv::Scalar::all(mean), cv::Scalar::all(sigma));
+}
+inline void FillUniform(cv::Mat& m, util::Rng& rng, double lo, double hi) {
+  cv::RNG cv_rng(rng.engine()());
+  cv_rng.fill(m, cv::RNG::UNIFORM, cv::Scalar::all(lo), cv::Scalar::all(hi));
+}
+
 // A grass-green image with mowing stripes, a few white lines and Gaussian noise.
 inline cv::Mat FieldImage(int width, int height, util::Rng& rng, double noise_sigma = 2.0) {
   cv::Mat img(height, width, CV_8UC3, cv::Scalar(kGrass[0], kGrass[1], kGrass[2]));
@@ -32,13 +43,12 @@ inline cv::Mat FieldImage(int width, int height, util::Rng& rng, double noise_si
            cv::LINE_AA);
   if (noise_sigma > 0) {
     cv::Mat noise(img.size(), CV_16SC3);
-    cv::randn(noise, 0, noise_sigma);
+    FillNormal(noise, rng, 0, noise_sigma);
     cv::Mat tmp;
     img.convertTo(tmp, CV_16SC3);
     tmp += noise;
     tmp.convertTo(img, CV_8UC3);
   }
-  (void)rng;
   return img;
 }
 
