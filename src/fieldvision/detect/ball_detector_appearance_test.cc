@@ -91,8 +91,10 @@ TEST(BallDetectorAppearance, LowSunPrintedOrangeBall) {
 
 // Circles kept to the outer outline (BallFitOptions and BallRegionOptions inside_share): on the
 // low-sun scene's shaded, printed yellow balls the centres are nearer the truth than with the
-// same band inside as outside, about as many balls are found (17 against 18 of 24 measured) and
-// fewer other things pass as balls (50 against 85).
+// same band inside as outside (mean 0.20 against 0.24 px measured: a print's lines lie inside
+// the silhouette; before the shaded side kept its outline, BallFitOptions::shade_max_offset,
+// 0.19 against 0.43 px), as many balls are found (19 of 24 both) and fewer other things pass as
+// balls (50 against 85).
 TEST(BallDetectorAppearance, OuterOutlineCirclesOfShadedPrintedBalls) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
@@ -109,7 +111,7 @@ TEST(BallDetectorAppearance, OuterOutlineCirclesOfShadedPrintedBalls) {
             << " px, " << both.off_ball << ")\n";
   ASSERT_GE(outer.expected, 12);
   EXPECT_GE(outer.accepted, both.accepted - 1);
-  EXPECT_LT(mean, 0.7 * mean_both);
+  EXPECT_LT(mean, 0.95 * mean_both);
   EXPECT_LT(outer.off_ball, 0.85 * both.off_ball);
 }
 

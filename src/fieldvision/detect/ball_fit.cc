@@ -59,6 +59,54 @@ inline bool IsBall(const cv::Mat& img, const ColourTable& table, uint8_t bit, do
   return (table.Classify(p[0], p[1], p[2]) & bit) != 0;
 }
 
+// The ball's own colour where it is lit (BallFitOptions::shade_max_offset): the mean colour of
+// its class pixels near the centre, whose multiples are the ball in shade.
+struct BallShade {
+  bool ok = false;
+  Vector3d direction = Vector3d::Zero();  // unit
+  double lit_sum = 0;                     // b + g + r
+  // Whether the (bilinear) colour inside a step is the ball in shade: near the line of the
+  // ball's colour scaled, darker than its lit part and than the step's outside. A mix of the lit
+  // ball and the outside (blur, JPEG chroma) is not darker than both, whereas a mix with a dark
+  // outside lies on that line too.
+  bool Holds(const Vector3d& bgr, const Vector3d& outside, const BallFitOptions& o) const {
+    if (!ok || o.shade_max_offset <= 0) return false;
+    const double sum = bgr.sum();
+    if (!(sum >= o.shade_min_brightness * lit_sum) || sum > lit_sum || sum >= outside.sum()) {
+      return false;
+    }
+    return (bgr - bgr.dot(direction) * direction).norm() <= o.shade_max_offset;
+  }
+};
+
+// The ball's class pixels within 0.8 r of c (at least five of them).
+BallShade MeasureShade(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
+                       double r) {
+  BallShade shade;
+  const double reach = 0.8 * r;
+  const int x0 = std::max(0, static_cast<int>(std::floor(c.x() - reach)));
+  const int x1 = std::min(img.cols - 1, static_cast<int>(std::ceil(c.x() + reach)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(c.y() - reach)));
+  const int y1 = std::min(img.rows - 1, static_cast<int>(std::ceil(c.y() + reach)));
+  Vector3d total = Vector3d::Zero();
+  int n = 0;
+  for (int y = y0; y <= y1; ++y) {
+    const uint8_t* row = img.ptr<uint8_t>(y);
+    for (int x = x0; x <= x1; ++x) {
+      if ((x - c.x()) * (x - c.x()) + (y - c.y()) * (y - c.y()) > reach * reach) continue;
+      const uint8_t* p = row + 3 * static_cast<ptrdiff_t>(x);
+      if ((table.Classify(p[0], p[1], p[2]) & bit) == 0) continue;
+      total += Vector3d(p[0], p[1], p[2]);
+      ++n;
+    }
+  }
+  if (n < 5 || !(total.norm() > 0)) return shade;
+  shade.ok = true;
+  shade.direction = total.normalized();
+  shade.lit_sum = total.sum() / n;
+  return shade;
+}
+
 struct Edges {
   std::vector<Vector2d> points;
   std::vector<double> ramp_px;  // width of a motion-blur ramp at each point (0: sharp edge)
@@ -114,9 +162,9 @@ struct RayEdge {
 };
 
 template <typename Profile>
-RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
-                   const Vector2d& u, double t0, double step, int m, int peak, Profile& at,
-                   const BallFitOptions& o) {
+RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit,
+                   const BallShade& shade, const Vector2d& c, const Vector2d& u, double t0,
+                   double step, int m, int peak, Profile& at, const BallFitOptions& o) {
   constexpr double kSide = 1.5;
   RayEdge edge;
   int ia = std::max(0, peak - static_cast<int>(kSide / step));
@@ -140,8 +188,9 @@ RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit, co
   const double contrast2 = ab.squaredNorm();
   if (contrast2 < o.min_contrast * o.min_contrast) return edge;
   const Vector2d pin = c + (t0 + ia * step) * u, pout = c + (t0 + ib * step) * u;
-  if (!IsBall(img, table, bit, pin.x(), pin.y())) return edge;  // inside is not the ball
-  if (IsBall(img, table, bit, pout.x(), pout.y())) {            // outside is ball-coloured
+  // The inside is neither the ball's class nor the ball in shade: the step lies beyond the ball.
+  if (!IsBall(img, table, bit, pin.x(), pin.y()) && !shade.Holds(a, b, o)) return edge;
+  if (IsBall(img, table, bit, pout.x(), pout.y())) {  // outside is ball-coloured
     edge.outside_ball = true;
     return edge;
   }
@@ -185,7 +234,8 @@ const std::vector<std::pair<double, double>>& RayDirections(int rays) {
 // for the outermost strong colour step from the ball to something else (EdgeAtPeak). Local
 // references keep shading and a changing background (a line just beyond the ball) from biasing
 // the edge.
-Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, const Vector2d& c,
+Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit,
+                    const BallShade& shade, const Vector2d& c,
                     const std::function<double(double)>& ref, double mean_radius,
                     const BallFitOptions& o) {
   constexpr double kStep = 0.25, kSide = 1.5;
@@ -274,7 +324,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, c
     double te = -1, t10 = -1, t90 = -1;
     bool ramp = false, outside_ball = false;
     for (auto it = peaks.rbegin(); it != peaks.rend() && te < 0; ++it) {
-      const RayEdge edge = EdgeAtPeak(img, table, bit, c, u, t0, kStep, m, *it, at, o);
+      const RayEdge edge = EdgeAtPeak(img, table, bit, shade, c, u, t0, kStep, m, *it, at, o);
       if (edge.outside_ball) {  // the colour goes on beyond: no silhouette on this ray
         outside_ball = true;
         break;
@@ -555,6 +605,8 @@ void BallFitOptions::Check() const {
   FV_REQUIRE(blur_min_aspect >= 1.0, "BallFitOptions.blur_min_aspect must be >= 1");
   FV_REQUIRE(inside_share > 0.0 && inside_share <= 1.0,
              "BallFitOptions.inside_share must be in (0, 1] (got {})", inside_share);
+  CheckInRange(shade_max_offset, 0.0, 255.0, "BallFitOptions.shade_max_offset");
+  CheckInRange(shade_min_brightness, 0.0, 1.0, "BallFitOptions.shade_min_brightness");
 }
 
 std::string BallFit::Summary() const {
@@ -682,6 +734,7 @@ namespace {
 // The outline fit in progress: the edge points, which are inliers, their residuals (filled by the
 // cone fit, else at the end) and the current circle.
 struct OutlineState {
+  BallShade shade;
   Edges edges;
   std::vector<char> inl;
   std::vector<double> res;
@@ -704,9 +757,10 @@ std::string SubpixelCircle(const cv::Mat& bgr, const ColourTable& table, uint8_t
       r1 > 3 * r0 + 3) {
     return "no circle in the rough outline";
   }
+  s->shade = MeasureShade(bgr, table, ball_bit, c1, r1);
   for (int pass = 0; pass < 2; ++pass) {
     s->edges = SubpixelEdges(
-        bgr, table, ball_bit, c1, [r1](double) { return r1; }, r1, o);
+        bgr, table, ball_bit, s->shade, c1, [r1](double) { return r1; }, r1, o);
     Vector2d c2 = c1;
     double r2 = r1;
     const double band = o.inlier_px + 0.03 * r1 + (pass == 0 ? 0.5 : 0.0);
@@ -735,8 +789,8 @@ void FitSphereCone(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bi
       const ConeOutline outline(camera, axis, alpha);
       if (!outline.ok) break;
       Edges next = SubpixelEdges(
-          bgr, table, ball_bit, outline.centre, [&outline](double th) { return outline(th); },
-          outline.mean_radius, o);
+          bgr, table, ball_bit, s->shade, outline.centre,
+          [&outline](double th) { return outline(th); }, outline.mean_radius, o);
       if (next.points.size() < 5) break;
       s->edges = std::move(next);
       s->inl.assign(s->edges.points.size(), 1);
@@ -807,7 +861,8 @@ void TryMotionBlurEllipse(const cv::Mat& bgr, const ColourTable& table, uint8_t 
     const Vector2d ec(e.center.x, e.center.y);
     const double mean_r = 0.25 * (e.size.width + e.size.height);
     const Edges be = SubpixelEdges(
-        bgr, table, ball_bit, ec, [&e](double th) { return EllipsePolarRadius(e, th); }, mean_r, o);
+        bgr, table, ball_bit, s->shade, ec, [&e](double th) { return EllipsePolarRadius(e, th); },
+        mean_r, o);
     if (be.points.size() < 8) break;
     cv_pts.clear();
     for (const auto& p : be.points) cv_pts.emplace_back(float(p.x()), float(p.y()));

@@ -36,6 +36,17 @@ struct BallFitOptions {
   // silhouette). The checks' inliers (outside share, dents) come from a circle with the same band
   // both ways, out of which a polygon's corners stick. 1: the same band both ways.
   double inside_share = 0.7;
+  // A step whose inside is not of the ball's colour class is still the silhouette when its
+  // inside is the ball in shade: within shade_max_offset (BGR units) of the line through black
+  // and the mean colour of the ball's class pixels, at shade_min_brightness..1 x their
+  // brightness. Shading scales a matte surface's colour; a print, the background and a board of
+  // a nearby hue lie off that line. Without this the shaded side's outline points fall on the
+  // terminator inside the ball and pull the circle towards the lit side. 0: off. Measured
+  // (offset 0 / 12 / 15 / 20 / 30; `eval detect` centre error median on the low-sun-kick render,
+  // MSL photo recall): 0.266 / 0.203 / 0.199 / 0.191 / 0.198 px, 0.718 / 0.709 / 0.709 / 0.701 /
+  // 0.692; the kick render and the SSL photos alike at 0..20.
+  double shade_max_offset = 15.0;
+  double shade_min_brightness = 0.2;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };

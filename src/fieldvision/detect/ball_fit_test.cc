@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/error.h"
@@ -92,6 +93,59 @@ TEST(FitBall, SubpixelCentreOfShadedDiscs) {
   EXPECT_LT(Median(err), 0.1);
   EXPECT_LT(*std::max_element(err.begin(), err.end()), 0.4);
   EXPECT_LT(Median(radius_err), 0.3);
+}
+
+// A low sun: the far side at 25 % of the lit side's brightness, out of the colour class. Its
+// outline is found where the ball in shade meets the grass (BallFitOptions::shade_max_offset);
+// with the shade test off the circle keeps to the lit part and shifts towards the light.
+TEST(FitBall, ShadedSideKeepsItsOutline) {
+  const uint64_t seed = fv::testing::TestSeed(6);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const ColourTable table(PresetColourSpec("yellow"));
+  const cv::Vec3b yellow(20, 215, 245);
+  BallFitOptions off;
+  off.shade_max_offset = 0;
+  std::vector<double> err, err_off, shift, shift_off;
+  // PaintDisc's light comes from the upper left (image x and y negative).
+  const Eigen::Vector2d to_light = Eigen::Vector2d(-0.4, -0.5).normalized();
+  for (int i = 0; i < 30; ++i) {
+    cv::Mat img = test_util::FieldImage(120, 120, rng);
+    const double r = rng.Uniform(5, 16);
+    const Eigen::Vector2d c(rng.Uniform(40, 80), rng.Uniform(40, 80));
+    test_util::PaintDisc(img, c, r, yellow, 0.75);
+    cv::GaussianBlur(img, img, {0, 0}, 0.6);
+    img = test_util::JpegRoundTrip(img, 90);
+    const Eigen::Vector2d rough = c + Eigen::Vector2d(rng.Uniform(-1, 1), rng.Uniform(-1, 1));
+    const double rough_r = r * rng.Uniform(0.85, 1.15);
+    const BallFit fit = FitBall(img, table, table.BallBit(), rough, rough_r, nullptr);
+    const BallFit fit_off = FitBall(img, table, table.BallBit(), rough, rough_r, nullptr, off);
+    ASSERT_TRUE(fit.ok) << fit.failure << " r=" << r;
+    ASSERT_TRUE(fit_off.ok) << fit_off.failure << " r=" << r;
+    err.push_back((fit.centre_px - c).norm());
+    err_off.push_back((fit_off.centre_px - c).norm());
+    shift.push_back((fit.centre_px - c).dot(to_light));
+    shift_off.push_back((fit_off.centre_px - c).dot(to_light));
+  }
+  EXPECT_LT(Median(err), 0.35);
+  EXPECT_LT(std::abs(Median(shift)), 0.1);
+  EXPECT_GT(Median(err_off), 1.5 * Median(err));  // the lit part alone: shifted towards the light
+  // Blurred against a dark background, the ball's edge has its chromaticity at any brightness
+  // (a mix with black): it is no shade (not darker than its outside) and the radius holds.
+  std::vector<double> radius_err;
+  for (int i = 0; i < 10; ++i) {
+    cv::Mat img(120, 120, CV_8UC3, cv::Scalar(25, 25, 30));
+    const double r = rng.Uniform(3, 12);
+    const Eigen::Vector2d c(rng.Uniform(40, 80), rng.Uniform(40, 80));
+    test_util::PaintDisc(img, c, r, yellow, 0.3);
+    cv::GaussianBlur(img, img, {0, 0}, 1.0);
+    img = test_util::JpegRoundTrip(img, 75);
+    const BallFit fit = FitBall(img, table, table.BallBit(), c, r, nullptr);
+    ASSERT_TRUE(fit.ok) << fit.failure << " r=" << r;
+    radius_err.push_back(std::abs(fit.radius_px - r));
+  }
+  EXPECT_LT(Median(radius_err), 0.3);
+  EXPECT_LT(*std::max_element(radius_err.begin(), radius_err.end()), 0.5);
 }
 
 TEST(FitBall, PartlyOccludedBallFitsTheFreeOutline) {
