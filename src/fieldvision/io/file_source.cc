@@ -34,10 +34,15 @@ std::string PatternFile(const std::string& pattern, long long index) {
   return m[1].str() + number + m[4].str();
 }
 
-bool HasJpegExtension(const std::string& path) {
+std::string LowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return ext;
+}
+
+bool HasJpegExtension(const std::string& path) {
+  const std::string ext = LowerExtension(path);
   return ext == ".jpg" || ext == ".jpeg";
 }
 
@@ -93,10 +98,13 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
   if (options.time == TimeSource::kCsv) {
     times_ = ReadTimestampsCsv(options.timestamps_csv);
   }
-  // Motion JPEG through FFmpeg: the packets themselves are the JPEG frames.
+  // Motion JPEG through FFmpeg: the packets themselves are the JPEG frames. Raw packets carry
+  // no container times (CAP_PROP_POS_MSEC stays 0), so with container times asked for only an
+  // AVI's (a fixed rate: frame / fps) are read raw; another container is decoded by FFmpeg.
   const int fourcc = static_cast<int>(capture_.get(cv::CAP_PROP_FOURCC));
+  const bool rate_times = options.time != TimeSource::kContainer || LowerExtension(path) == ".avi";
   if (options.encoded && !pattern && fourcc == cv::VideoWriter::fourcc('M', 'J', 'P', 'G') &&
-      capture_.getBackendName() == "FFMPEG") {
+      capture_.getBackendName() == "FFMPEG" && rate_times) {
     encoded_ = capture_.set(cv::CAP_PROP_FORMAT, -1);
   }
   // A pattern of JPEG files: the files themselves are the frames (OpenCV's image reader starts
@@ -208,7 +216,8 @@ double FileSource::TimeOf(long long f) {
     case TimeSource::kFrameRate:
       return f / fps_;
     case TimeSource::kContainer: {
-      if (jpeg_files_) return f / fps_;  // image files carry no capture times
+      // Image files carry no capture times, raw packets none that OpenCV reports (an AVI).
+      if (jpeg_files_ || encoded_) return f / fps_;
       const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
       return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
     }

@@ -21,8 +21,9 @@
 namespace fv::io {
 namespace {
 
-std::string WriteMjpg(const std::string& dir, int frames, double fps) {
-  const std::string path = dir + "/v.avi";
+std::string WriteMjpg(const std::string& dir, int frames, double fps,
+                      const std::string& name = "v.avi") {
+  const std::string path = dir + "/" + name;
   cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, cv::Size(64, 48));
   for (int i = 0; i < frames; ++i) w.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(10 * i, 80, 200)));
   return path;
@@ -54,6 +55,30 @@ TEST(FrameSource, FileEncodedAndDecodedAgree) {
     ++n;
   }
   EXPECT_EQ(n, 5);
+}
+
+// Container times asked for (`ball --sync time`): raw MJPG packets carry none that OpenCV
+// reports (every frame was at 0 s), so an AVI's come from its fixed rate and another container
+// is decoded by FFmpeg, which reports its times.
+TEST(FrameSource, EncodedFramesKeepContainerTimes) {
+  FrameSourceOptions o;
+  o.encoded = true;
+  o.time = TimeSource::kContainer;
+  auto avi = OpenFrameSource(WriteMjpg(testing::TempDir(), 5, 25), o);
+  EXPECT_TRUE(avi->encoded());
+  auto mkv = OpenFrameSource(WriteMjpg(testing::TempDir(), 5, 25, "v.mkv"), o);
+  EXPECT_FALSE(mkv->encoded());
+  for (auto* src : {avi.get(), mkv.get()}) {
+    SourceFrame f;
+    int n = 0;
+    while (src->ReadFrame(&f)) {
+      EXPECT_EQ(f.frame, n);
+      EXPECT_NEAR(f.time_s, n / 25.0, 1e-3) << src->name();
+      EXPECT_EQ(f.origin, TimeOrigin::kContainer);
+      ++n;
+    }
+    EXPECT_EQ(n, 5) << src->name();
+  }
 }
 
 // A glob and a folder of JPEG files: name order, encoded on request (the files' bytes) and
