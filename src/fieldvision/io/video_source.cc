@@ -137,6 +137,9 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
   } else if (!util::StartsWith(spec, "camera:") && spec.find(':') == std::string::npos) {
     FV_REQUIRE(fs::exists(spec), "video '{}' does not exist", spec);
     so.time = TimeSource::kContainer;
+    // Motion-JPEG decoded by libjpeg-turbo, as `ball` decodes it (OpenCV's FFmpeg reader
+    // upsamples chroma differently): detect, eval detect and ball see the same pixels.
+    so.encoded = true;
   }
   return std::make_unique<FrameSourceVideo>(spec, OpenFrameSource(spec, so));
 }
