@@ -305,14 +305,18 @@ try {
   await page.click('#v3-live');
   await page.waitForFunction(() => /waiting|running/.test(document.querySelector('#v3-live-status').textContent));
   const cameraArgs = [1, 2, 3, 4].flatMap((c) => ['--camera', `scene/cam${c}.yaml`]);
-  // Nodes send as fast as they read and the fusion node fuses the cameras it has heard from: on a
-  // loaded machine a node that starts late misses frames, so --ground places the ball from one
-  // camera too, and every fused frame with a ball is published.
+  // The nodes play their videos as cameras triggered together (--realtime --start-at: frame k at
+  // the same moment on every node, 3 s from now), so a node that starts late on a loaded machine
+  // still delivers its frames in time (sent as fast as read, one node's 40 frames came after the
+  // others' had been fused); --ground places the ball from one camera too, and every fused frame
+  // with a ball is published.
+  const startAt = (Date.now() / 1000 + 3).toFixed(3);
   const fuse = start(['fuse', '--listen', `tcp://127.0.0.1:${listenPort}`, ...cameraArgs, '--out', 'live_ball.csv',
     '--publish', `tcp://127.0.0.1:${publishPort}`, '--idle-exit', '1', '--max-wait', '10', '--ground', '--no-progress'], 'live_fuse.log');
   const fuseEnded = new Promise((resolve) => fuse.on('exit', resolve));
   for (const c of [1, 2, 3, 4]) {
-    start(['node', '--camera', `scene/cam${c}.yaml`, '--video', `scene/cam${c}.avi`, '--connect', `tcp://127.0.0.1:${listenPort}`, '--no-progress'], `live_node${c}.log`);
+    start(['node', '--camera', `scene/cam${c}.yaml`, '--video', `scene/cam${c}.avi`, '--connect', `tcp://127.0.0.1:${listenPort}`,
+      '--realtime', '--start-at', startAt, '--no-progress'], `live_node${c}.log`);
   }
   await Promise.race([fuseEnded, new Promise((r) => setTimeout(r, 60000))]);
   const fused = fs.existsSync(path.join(work, 'live_ball.csv')) ? readCsv(path.join(work, 'live_ball.csv')).length : 0;
