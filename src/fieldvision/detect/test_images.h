@@ -20,15 +20,12 @@ namespace fv::detect::test_util {
 inline const cv::Vec3b kGrass(50, 140, 60);
 inline const cv::Vec3b kOrange(0, 110, 255);
 
-// `m` filled from `rng` (cv::randn/randu draw from OpenCV's global RNG, whose state depends on
-// what ran before in the process: a test's images would then not follow its seed).
+// `m` filled with Gaussian noise from `rng` (cv::randn draws from OpenCV's global RNG, whose
+// state depends on what ran before in the process: a test's images would then not follow its
+// seed).
 inline void FillNormal(cv::Mat& m, util::Rng& rng, double mean, double sigma) {
   cv::RNG cv_rng(rng.engine()());
   cv_rng.fill(m, cv::RNG::NORMAL, cv::Scalar::all(mean), cv::Scalar::all(sigma));
-}
-inline void FillUniform(cv::Mat& m, util::Rng& rng, double lo, double hi) {
-  cv::RNG cv_rng(rng.engine()());
-  cv_rng.fill(m, cv::RNG::UNIFORM, cv::Scalar::all(lo), cv::Scalar::all(hi));
 }
 
 // A grass-green image with mowing stripes, a few white lines and Gaussian noise.

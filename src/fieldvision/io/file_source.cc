@@ -1,8 +1,6 @@
 // Frame-source backend: video files OpenCV reads and printf image patterns (dir/%05d.jpg), with
 // times from the frame rate, the container or a frame,time_s CSV. Motion-JPEG packets (through
 // FFmpeg) and JPEG files can be delivered encoded (the ball pipeline's window-decoding path).
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +16,7 @@
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::io::backend {
 namespace {
@@ -35,10 +34,7 @@ std::string PatternFile(const std::string& pattern, long long index) {
 }
 
 std::string LowerExtension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  return ext;
+  return util::ToLower(std::filesystem::path(path).extension().string());
 }
 
 bool HasJpegExtension(const std::string& path) {
