@@ -149,13 +149,17 @@ BallFrame FusionStage::Fuse(const SyncedFrame& group) {
       stats_.candidates_per_camera[c] += !o.weak;
     }
   }
-  const auto prior = predictor_.Predict(group.frame);
+  auto prior = predictor_.Predict(group.frame);
+  const auto step_m = predictor_.StepPerFrame(group.frame);
+  const bool moving_track = step_m && *step_m >= kMovingTrackStepM;
+  // A ball cannot hover: a track that stands still in the air is a ball-coloured thing's, and
+  // gating by it would keep the ball elsewhere out (even seen by every camera) until the hover
+  // filter has seen it long enough.
+  if (prior && !moving_track && hover_.Airborne(*prior, 0.0)) prior.reset();
   BallFrame f = FuseFrame(cameras_, group, options_, prior ? &*prior : nullptr);
   // An airborne point that stands still is something ball-coloured, not the ball (HoverFilter):
   // fuse again without its candidates, unless a moving track (a ball passing a point twice,
   // up and down) led there.
-  const auto step_m = predictor_.StepPerFrame(group.frame);
-  const bool moving_track = step_m && *step_m >= kMovingTrackStepM;
   for (const auto& alt : f.result.alternatives) {
     // An alternative's height is known to about its 3D size.
     if (hover_.Airborne(alt.point_world, alt.sigma_m)) {

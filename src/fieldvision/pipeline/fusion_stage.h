@@ -1,6 +1,7 @@
 // The fusion stage of the ball pipeline: a synchronised multi-camera frame (frame_sync.h) in, a
 // robustly triangulated ball position out (recon/triangulation.h), with the last positions as
-// the prior of the next frame (BallPredictor) and per-camera counts for the summary. The same
+// the prior of the next frame (BallPredictor; none from a track that stands still in the air,
+// which no ball does) and per-camera counts for the summary. The same
 // stage serves the in-process pipeline (ball_pipeline.h) and the fusion node (net/fuse.h).
 #pragma once
 

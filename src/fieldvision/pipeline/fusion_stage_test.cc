@@ -191,5 +191,37 @@ TEST(FusionStage, AStillSignDoesNotReplaceALostBall) {
   EXPECT_EQ(fusion.stats().hovering_dropped, 30 - 12);
 }
 
+// The same sign is all cameras 1 and 2 see for a moment (the ball is out of view), so the fusion
+// follows it; then the ball comes to rest in view of all three cameras. A track that stands
+// still in the air is no ball's and gives no prior: the ball is taken from its first frame (gated
+// by the sign's track, it was kept out until the hover filter had seen the sign for 0.3 s).
+TEST(FusionStage, AStillSignFollowedForAMomentDoesNotKeepTheBallOut) {
+  const std::vector<camera::Camera> cams = RingCameras();
+  FusionStage fusion(cams, recon::TriangulationOptions());
+  const Vector3d ball(-1.0, 0.5, 0.11), sign(2.0, 1.5, 0.6);
+  int ball_frames = 0, sign_frames = 0;
+  for (int f = 0; f < 30; ++f) {
+    SyncedFrame group;
+    group.frame = f;
+    group.time_s = f / 60.0;
+    group.cameras.resize(cams.size());
+    for (int c = 0; c < 3; ++c) {
+      CameraMessage m;
+      m.camera = c;
+      m.frame = f;
+      m.time_s = group.time_s;
+      if (f >= 5) m.candidates.push_back(SeenAt(cams[c], ball, 0.5));
+      if (c < 2) m.candidates.push_back(SeenAt(cams[c], sign, 0.6));
+      group.cameras[c] = m;
+    }
+    const BallFrame out = fusion.Fuse(group);
+    if (!out.result.ok()) continue;
+    if ((out.result.point_world - ball).norm() < 0.05) ++ball_frames;
+    if ((out.result.point_world - sign).norm() < 0.05) ++sign_frames;
+  }
+  EXPECT_EQ(ball_frames, 25);
+  EXPECT_EQ(sign_frames, 5);
+}
+
 }  // namespace
 }  // namespace fv::pipeline
