@@ -124,10 +124,14 @@ double LeastContrastFactor(const BallRegion& r, const BallDetectorOptions& o) {
 }
 
 // Whether a measured region stands out from its surroundings: by its colour difference
-// (min_contrast) or by its hue difference alone (min_hue_contrast), less on the field.
+// (min_contrast), by its hue difference alone (min_hue_contrast) or, against a neutral surround,
+// by its chroma (min_chroma_contrast); less on the field.
 bool StandsOut(const BallRegion& r, const BallDetectorOptions& o) {
   const double f = LeastContrastFactor(r, o);
-  return r.contrast >= f * o.min_contrast || r.hue_contrast >= f * o.min_hue_contrast;
+  const bool neutral_ring = r.ring_chroma <= o.max_neutral_ring_chroma &&
+                            r.ring_lightness >= o.min_neutral_ring_lightness;
+  return r.contrast >= f * o.min_contrast || r.hue_contrast >= f * o.min_hue_contrast ||
+         (neutral_ring && r.chroma_contrast >= f * o.min_chroma_contrast);
 }
 
 // The first region check the candidate fails ("" when it passes them all); with
@@ -235,6 +239,9 @@ void BallDetectorOptions::Check() const {
   CheckInRange(max_ring_leak, 0.0, 1.0, "max_ring_leak");
   CheckNonNegative(min_contrast, "min_contrast");
   CheckNonNegative(min_hue_contrast, "min_hue_contrast");
+  CheckNonNegative(min_chroma_contrast, "min_chroma_contrast");
+  CheckNonNegative(max_neutral_ring_chroma, "max_neutral_ring_chroma");
+  CheckNonNegative(min_neutral_ring_lightness, "min_neutral_ring_lightness");
   CheckInRange(min_field_ring, 0.0, 1.0, "min_field_ring");
   CheckInRange(min_grass_ring, 0.0, 1.0, "min_grass_ring");
   CheckInRange(field_contrast_factor, 0.0, 1.0, "field_contrast_factor");
@@ -549,6 +556,7 @@ std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, cons
       cand.leak = region.leak;
       cand.contrast = region.contrast;
       cand.hue_contrast = region.hue_contrast;
+      cand.chroma_contrast = region.chroma_contrast;
       cand.region_outside = region.outside;
       cand.region_extent = region.extent;
       cand.centre_px = region.centre_px;

@@ -51,17 +51,18 @@ struct BallCandidate {
   // The region check (ball_region.h): the blob taken whole, holes filled, a circle on its convex
   // outline.
   bool region_ok = false;
-  double arc_cover = 0.0;       // share of the circle's angle with outline on it
-  double fill = 0.0;            // share of the disc in the region
-  double spill = 0.0;           // region beyond the circle, as a share of the disc
-  double leak = 0.0;            // ball colour in a ring around the circle
-  double contrast = 0.0;        // CIELAB distance between the disc's and the ring's colours
-  double hue_contrast = 0.0;    // its hue part (CIE94 Delta H)
-  double region_outside = 0.0;  // convex outline beyond the region's circle
-  double region_extent = 0.0;   // the convex outline's far reach, in radii
-  bool precise = false;         // the centre is the sub-pixel outline fit's (else the region's)
-  bool small = false;           // found by the small-ball stage (small_ball.h)
-  bool guided = false;          // fitted where a tracker expected the ball (FitAt)
+  double arc_cover = 0.0;        // share of the circle's angle with outline on it
+  double fill = 0.0;             // share of the disc in the region
+  double spill = 0.0;            // region beyond the circle, as a share of the disc
+  double leak = 0.0;             // ball colour in a ring around the circle
+  double contrast = 0.0;         // CIELAB distance between the disc's and the ring's colours
+  double hue_contrast = 0.0;     // its hue part (CIE94 Delta H)
+  double chroma_contrast = 0.0;  // the disc's chroma minus the ring's (CIELAB C*)
+  double region_outside = 0.0;   // convex outline beyond the region's circle
+  double region_extent = 0.0;    // the convex outline's far reach, in radii
+  bool precise = false;          // the centre is the sub-pixel outline fit's (else the region's)
+  bool small = false;            // found by the small-ball stage (small_ball.h)
+  bool guided = false;           // fitted where a tracker expected the ball (FitAt)
   // Not accepted, its lowest point more than its radius above the field's far edge (no posed
   // camera): a network confirms it only as a ball of its own (set by "both", dnn_ball.h).
   bool off_field = false;
@@ -125,6 +126,20 @@ struct BallDetectorOptions {
   // low-sun renders (min_contrast 35-45, min_hue_contrast 20-30 tried).
   double min_contrast = 40.0;
   double min_hue_contrast = 25.0;
+  // Or, against a neutral surround (a ring of CIELAB chroma at most max_neutral_ring_chroma and
+  // lightness at least min_neutral_ring_lightness: grey stands, a white wall), by being more
+  // colourful than it by min_chroma_contrast: a shaded yellow ball against grey stands differs
+  // from them in chroma alone (Delta E 34-39, Delta H near 0). A dark ring is no neutral
+  // surround: any lit coloured spot (a robot's LED) is more colourful than black. Measured on
+  // the low-sun renders (detector alone, whole frames, balls >= 70 % visible; seeds 1, 6, 2, 3)
+  // at min_chroma_contrast off / 25 / 30 / 35: 50 / 58 / 57 / 51 of 64, 53 / 57 / 57 / 54 of 63,
+  // 50 / 53 / 53 / 51 of 64, 53 / 58 / 57 / 54 of 64; photos unchanged at 30 and 35 (SSL 0.863 /
+  // 0.940, MSL 0.709 / 0.976), at 25 MSL two more false detections. Without the lightness limit
+  // an SSL robot's LED passes; the chroma limit (10 / 15 / 20 measured alike) keeps a saturated
+  // disc on a pale wall of its own hue out.
+  double min_chroma_contrast = 30.0;
+  double max_neutral_ring_chroma = 12.0;
+  double min_neutral_ring_lightness = 20.0;
   // A ball on the field (at least min_field_ring of the ring in the colour spec's field or line
   // classes) is set apart by the classes themselves and needs field_contrast_factor x those
   // contrasts: a yellow ball in a greenish camera is a yellow-green disc on green. Measured

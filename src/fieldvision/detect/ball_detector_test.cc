@@ -143,6 +143,56 @@ TEST(BallDetector, AShadedBallStandsOutByItsHueAWallPatchDoesNot) {
   }
 }
 
+// A yellow ball in shade against grey stands differs from them in chroma alone (its Delta E and
+// Delta H are below min_contrast and min_hue_contrast): accepted. The same disc on a pale wall of
+// its own hue (not neutral) is rejected, and so is a coloured spot on a dark ring (an LED on a
+// robot) that only the chroma would set apart (min_contrast raised out of the way).
+TEST(BallDetector, AShadedBallStandsOutFromGreyStandsByItsChroma) {
+  const uint64_t seed = fv::testing::TestSeed(37);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  BallDetectorOptions o;
+  o.colour = "yellow";
+  o.min_lit_field_ratio = 0.0;
+  const BallDetector det(o, nullptr, nullptr);
+  const cv::Vec3b olive(40, 110, 120);  // CIELAB L 46, C 39
+  const auto detect_on = [&](const BallDetector& d, const cv::Scalar& wall) {
+    PaintedDisc p = DetectPaintedDisc(d, NoisyWall(wall, rng), olive, 0.2, rng);
+    EXPECT_FALSE(p.candidates.empty());
+    return p;
+  };
+  for (int trial = 0; trial < 4; ++trial) {
+    const PaintedDisc p = detect_on(det, cv::Scalar(100, 100, 100));  // grey, L 42
+    if (p.candidates.empty()) continue;
+    const BallCandidate& best = p.candidates.front();
+    SCOPED_TRACE(p.Trace() + " chroma " + std::to_string(best.chroma_contrast));
+    EXPECT_LT(best.contrast, o.min_contrast);
+    EXPECT_LT(best.hue_contrast, o.min_hue_contrast);
+    EXPECT_GE(best.chroma_contrast, o.min_chroma_contrast);
+    EXPECT_TRUE(best.accepted);
+    EXPECT_LT((best.centre_px - p.centre).norm(), 0.1 * p.radius_px + 0.5);
+  }
+  for (int trial = 0; trial < 4; ++trial) {
+    const PaintedDisc p = detect_on(det, cv::Scalar(70, 100, 105));  // pale olive, C 18
+    if (p.candidates.empty()) continue;
+    const BallCandidate& best = p.candidates.front();
+    EXPECT_FALSE(best.accepted) << p.Trace();
+    EXPECT_NE(best.reason.find("contrast"), std::string::npos) << best.reason;
+  }
+  BallDetectorOptions only_chroma = o;
+  only_chroma.min_contrast = 100;
+  const BallDetector det_chroma(only_chroma, nullptr, nullptr);
+  for (int trial = 0; trial < 4; ++trial) {
+    const PaintedDisc grey = detect_on(det_chroma, cv::Scalar(100, 100, 100));
+    const PaintedDisc dark = detect_on(det_chroma, cv::Scalar(35, 35, 35));  // L 13
+    if (grey.candidates.empty() || dark.candidates.empty()) continue;
+    EXPECT_TRUE(grey.candidates.front().accepted) << grey.Trace();
+    const BallCandidate& best = dark.candidates.front();
+    EXPECT_GE(best.chroma_contrast, o.min_chroma_contrast) << dark.Trace();
+    EXPECT_FALSE(best.accepted) << dark.Trace();
+  }
+}
+
 // A yellow ball seen yellow-green (a greenish camera) on the green field differs from it by less
 // than min_contrast and min_hue_contrast, but its ring is field-coloured: it needs only
 // field_contrast_factor of them (accepted), also in front of a black robot. The same disc on a

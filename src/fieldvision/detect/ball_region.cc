@@ -769,6 +769,9 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
     const double dc = disc_c.tail<2>().norm() - ring_c.tail<2>().norm();
     out->hue_contrast =
         std::sqrt(std::max(0.0, (disc_c - ring_c).tail<2>().squaredNorm() - dc * dc));
+    out->chroma_contrast = dc;
+    out->ring_chroma = ring_c.tail<2>().norm();
+    out->ring_lightness = ring_c.x();
   }
 }
 

@@ -77,6 +77,11 @@ struct BallRegion {
   double contrast = 0.0;
   // The hue part of that difference (CIE94 Delta H): what shading and exposure hardly change.
   double hue_contrast = 0.0;
+  // The disc's chroma (CIELAB C*) minus the ring's, and the ring's own chroma and lightness (L*):
+  // a coloured ball against grey stands differs from them in chroma, not in hue.
+  double chroma_contrast = 0.0;
+  double ring_chroma = 0.0;
+  double ring_lightness = 0.0;
   // Share of the leak ring's pixels in the colour spec's "field" or "line" classes (0 without
   // them): a ball on the field is set apart by the classes themselves. Dark pixels (a robot
   // behind the ball, hidden_value) hide the field and are left out, at most half the ring.
