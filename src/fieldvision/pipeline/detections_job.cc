@@ -209,21 +209,41 @@ void FitAtFrames(const std::vector<camera::Camera>& cameras,
   }
 }
 
+constexpr double kTrimSigmas = 4.0;
+constexpr double kTrimFloorPx = 0.5;
+constexpr int kTrimRounds = 3;
+
+// kTrimSigmas times the robust spread of 2D distances (their median over the Rayleigh median,
+// 1.1774 sigma), at least kTrimFloorPx.
+double OutlierLimit(std::vector<double> dist) {
+  const double sigma = util::NearestRankPercentile(dist, 0.5) / 1.1774;
+  return std::max(kTrimSigmas * sigma, kTrimFloorPx);
+}
+
 // The bundled model against each frame's own position on the observations at the frames'
-// moments (the nearest per-frame position within half a frame, margin_s): both RMS.
+// moments (the nearest per-frame position within half a frame, margin_s): both RMS, without
+// the candidates their own frames' positions explain far worse than the rest (OutlierLimit):
+// those are the detector's errors, not the model's.
 void CompareWithFrames(const std::vector<camera::Camera>& cameras,
                        const std::vector<FlightObservation>& obs,
                        const std::vector<recon::BallSample>& per_frame, double margin_s,
                        double t_first_s, double t_last_s, Bundled* out) {
-  double ss_model = 0, ss_frames = 0;
+  std::vector<double> d_model, d_frame;
   for (const auto& o : obs) {
     const auto at = NearestSample(per_frame, o.time_s, margin_s);
     if (at == per_frame.end()) continue;
     const auto uv_model = cameras[o.cam].Project(out->model.PositionAt(o.time_s));
     const auto uv_frame = cameras[o.cam].Project(at->ball_in_world);
     if (!uv_model || !uv_frame) continue;
-    ss_model += (*uv_model - o.uv).squaredNorm();
-    ss_frames += (*uv_frame - o.uv).squaredNorm();
+    d_model.push_back((*uv_model - o.uv).norm());
+    d_frame.push_back((*uv_frame - o.uv).norm());
+  }
+  const double limit = d_frame.empty() ? 0.0 : OutlierLimit(d_frame);
+  double ss_model = 0, ss_frames = 0;
+  for (size_t i = 0; i < d_frame.size(); ++i) {
+    if (d_frame[i] > limit) continue;
+    ss_model += d_model[i] * d_model[i];
+    ss_frames += d_frame[i] * d_frame[i];
     ++out->at_frames;
   }
   for (const recon::BallSample& s : per_frame) {
@@ -237,18 +257,13 @@ void CompareWithFrames(const std::vector<camera::Camera>& cameras,
   }
 }
 
-// The flight's model refitted on the detections of every camera between its first and last
-// seen samples (the candidate nearest the model's prediction, within a gate).
-Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
-                     const std::vector<std::vector<CameraMessage>>& messages,
-                     const recon::Flight& f, const recon::TrajectoryOptions& to, double sigma_px,
-                     double margin_s, const std::vector<recon::BallSample>& per_frame) {
-  Bundled out;
-  const recon::BallisticModel start = f.model();
-  const recon::FlightModel kind = f.model_kind();  // of the fit to the per-frame points
-  const double t_ref = start.t0_s;
+// The candidate of each camera's message in the flight's span nearest the model's image of
+// the ball (within a gate).
+std::vector<FlightObservation> GatherObservations(
+    const std::vector<camera::Camera>& cameras,
+    const std::vector<std::vector<CameraMessage>>& messages, const recon::Flight& f,
+    const recon::BallisticModel& start, double gate_px, double margin_s) {
   std::vector<FlightObservation> obs;
-  const double gate_px = 5 * sigma_px + 10.0;
   for (size_t c = 0; c < messages.size(); ++c) {
     for (const auto& m : messages[c]) {
       if (m.time_s < f.t_first_seen_s - margin_s || m.time_s > f.t_last_seen_s + margin_s) continue;
@@ -263,83 +278,154 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
       if (best) obs.push_back({static_cast<int>(c), best->centre_px, m.time_s});
     }
   }
-  if (static_cast<int>(obs.size()) * 2 < 6 + 4) return out;
-  double p0[3] = {start.p0_m.x(), start.p0_m.y(), start.p0_m.z()};
-  double v0[3] = {start.v0_mps.x(), start.v0_mps.y(), start.v0_mps.z()};
-  double k[1] = {kind == recon::FlightModel::kGravity ? 0.0 : start.drag_per_m};
-  const double c_m = to.MagnusPerRad();
-  const Eigen::Vector3d s0 = start.magnus_per_rad * start.spin_radps;
-  double sm[3] = {s0.x(), s0.y(), s0.z()};
-  // Each model in turn from the one before (gravity, drag, spin); the more complex one is kept
-  // when its BIC over the 2 n reprojection residuals (in sigmas) is lower by spin_min_bic_gain.
-  auto solve = [&](recon::FlightModel m, double* cost) {
-    const bool integrate = m != recon::FlightModel::kGravity;
-    ceres::Problem problem;
-    for (const auto& o : obs) {
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<DetectionResidual, 2, 3, 3, 1, 3>(new DetectionResidual(
-              cameras[o.cam], o.uv, o.time_s - t_ref, to.gravity_mps2, sigma_px, integrate)),
-          new ceres::HuberLoss(2.0), p0, v0, k, sm);
-    }
-    if (m == recon::FlightModel::kGravity) {
-      problem.SetParameterBlockConstant(k);
-    } else {
-      problem.SetParameterLowerBound(k, 0, 0.0);
-      problem.SetParameterUpperBound(k, 0, to.max_drag_per_m);
-    }
-    if (m == recon::FlightModel::kSpin) {
-      const double unit = 1.0 / (c_m * 2 * M_PI);
-      const Eigen::Vector3d d = Eigen::Vector3d(v0[0], v0[1], v0[2]).normalized();
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<recon::SpinPrior, 3, 3>(new recon::SpinPrior(
-              d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
-          nullptr, sm);
-    } else {
-      problem.SetParameterBlockConstant(sm);
-    }
-    ceres::Solver::Options so;
-    so.max_num_iterations = 50;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    *cost = summary.final_cost;
-    return summary.IsSolutionUsable();
-  };
+  return obs;
+}
+
+// A flight model's parameters during the fit (BallisticModel's, with c_M w for the spin).
+struct FlightParams {
+  double p0[3], v0[3], k[1], sm[3];
+  double bic = 0.0;
+  recon::FlightModel kind = recon::FlightModel::kGravity;
+};
+
+// Fits one model to the observations from `x` (in place); false when Ceres gives up.
+bool SolveFlightModel(const std::vector<camera::Camera>& cameras,
+                      const std::vector<FlightObservation>& obs, recon::FlightModel m,
+                      const recon::TrajectoryOptions& to, double sigma_px, double t_ref,
+                      FlightParams* x, double* cost) {
+  const bool integrate = m != recon::FlightModel::kGravity;
+  ceres::Problem problem;
+  for (const auto& o : obs) {
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<DetectionResidual, 2, 3, 3, 1, 3>(new DetectionResidual(
+            cameras[o.cam], o.uv, o.time_s - t_ref, to.gravity_mps2, sigma_px, integrate)),
+        new ceres::HuberLoss(2.0), x->p0, x->v0, x->k, x->sm);
+  }
+  if (m == recon::FlightModel::kGravity) {
+    problem.SetParameterBlockConstant(x->k);
+  } else {
+    problem.SetParameterLowerBound(x->k, 0, 0.0);
+    problem.SetParameterUpperBound(x->k, 0, to.max_drag_per_m);
+  }
+  if (m == recon::FlightModel::kSpin) {
+    const double unit = 1.0 / (to.MagnusPerRad() * 2 * M_PI);
+    const Eigen::Vector3d d = Eigen::Vector3d(x->v0[0], x->v0[1], x->v0[2]).normalized();
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<recon::SpinPrior, 3, 3>(
+            new recon::SpinPrior(d, unit / to.spin_prior_revps, unit / to.spin_along_prior_revps)),
+        nullptr, x->sm);
+  } else {
+    problem.SetParameterBlockConstant(x->sm);
+  }
+  ceres::Solver::Options so;
+  so.max_num_iterations = 50;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  *cost = summary.final_cost;
+  return summary.IsSolutionUsable();
+}
+
+// Each model in turn from the one before (gravity, drag, spin), starting from `start`; the more
+// complex one is kept when its BIC over the 2 n reprojection residuals (in sigmas) is lower by
+// spin_min_bic_gain.
+std::optional<FlightParams> SelectFlightModel(const std::vector<camera::Camera>& cameras,
+                                              const std::vector<FlightObservation>& obs,
+                                              const FlightParams& start,
+                                              const recon::TrajectoryOptions& to, double sigma_px,
+                                              double t_ref) {
+  FlightParams x = start;
   const double nres = 2.0 * obs.size();
-  struct State {
-    double p0[3], v0[3], k, sm[3];
-    double bic;
-    recon::FlightModel kind;
-  };
-  std::optional<State> best;
+  std::optional<FlightParams> best;
   for (recon::FlightModel m :
        {recon::FlightModel::kGravity, recon::FlightModel::kDrag, recon::FlightModel::kSpin}) {
     const int params = m == recon::FlightModel::kGravity ? 6
                        : m == recon::FlightModel::kDrag  ? 7
                                                          : 10;
     if (nres < params + 4) break;
-    if (m != recon::FlightModel::kSpin) sm[0] = sm[1] = sm[2] = 0.0;
-    if (m == recon::FlightModel::kGravity) k[0] = 0.0;
+    if (m != recon::FlightModel::kSpin) x.sm[0] = x.sm[1] = x.sm[2] = 0.0;
+    if (m == recon::FlightModel::kGravity) x.k[0] = 0.0;
     double cost = 0;
-    if (!solve(m, &cost)) break;
-    const double bic = nres * std::log(std::max(2 * cost, 1e-12) / nres) + params * std::log(nres);
+    if (!SolveFlightModel(cameras, obs, m, to, sigma_px, t_ref, &x, &cost)) break;
+    x.bic = nres * std::log(std::max(2 * cost, 1e-12) / nres) + params * std::log(nres);
+    x.kind = m;
     if (!best ||
-        bic < best->bic - (m == recon::FlightModel::kGravity ? 0.0 : to.spin_min_bic_gain)) {
-      best =
-          State{{p0[0], p0[1], p0[2]}, {v0[0], v0[1], v0[2]}, k[0], {sm[0], sm[1], sm[2]}, bic, m};
+        x.bic < best->bic - (m == recon::FlightModel::kGravity ? 0.0 : to.spin_min_bic_gain)) {
+      best = x;
     }
   }
+  return best;
+}
+
+// The ball's position at `time_s` under the parameters (t_ref: their time origin).
+recon::BallisticModel ModelOf(const FlightParams& x, const recon::BallisticModel& start,
+                              double c_m) {
+  recon::BallisticModel model = start;
+  model.p0_m = {x.p0[0], x.p0[1], x.p0[2]};
+  model.v0_mps = {x.v0[0], x.v0[1], x.v0[2]};
+  model.drag_per_m = x.kind == recon::FlightModel::kGravity ? 0.0 : x.k[0];
+  model.magnus_per_rad = x.kind == recon::FlightModel::kSpin ? c_m : 0.0;
+  model.spin_radps = x.kind == recon::FlightModel::kSpin
+                         ? Eigen::Vector3d(Eigen::Vector3d(x.sm[0], x.sm[1], x.sm[2]) / c_m)
+                         : Eigen::Vector3d::Zero();
+  return model;
+}
+
+// The observations the model explains within kTrimSigmas of their robust spread (OutlierLimit),
+// refitted up to kTrimRounds times: a centre a few pixels off (a fit to the ball and its shadow,
+// a frame's wrong candidate) is inside the Huber loss's quadratic zone at the detections'
+// nominal sigma, and at a flight's ends it tilts the velocity (low-sun kick render, seed 3: the
+// last 11 frames drifted to 15 mm).
+std::vector<FlightObservation> TrimObservations(const std::vector<camera::Camera>& cameras,
+                                                const std::vector<FlightObservation>& obs,
+                                                const recon::BallisticModel& model) {
+  std::vector<double> dist(obs.size(), std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < obs.size(); ++i) {
+    const auto uv = cameras[obs[i].cam].Project(model.PositionAt(obs[i].time_s));
+    if (uv) dist[i] = (*uv - obs[i].uv).norm();
+  }
+  const double limit = OutlierLimit(dist);
+  std::vector<FlightObservation> kept;
+  for (size_t i = 0; i < obs.size(); ++i) {
+    if (dist[i] <= limit) kept.push_back(obs[i]);
+  }
+  return kept;
+}
+
+// The flight's model refitted on the detections of every camera between its first and last
+// seen samples (the candidate nearest the model's prediction, within a gate), then once more
+// without the candidates it explains far worse than the rest (TrimObservations).
+Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
+                     const std::vector<std::vector<CameraMessage>>& messages,
+                     const recon::Flight& f, const recon::TrajectoryOptions& to, double sigma_px,
+                     double margin_s, const std::vector<recon::BallSample>& per_frame) {
+  Bundled out;
+  const recon::BallisticModel start = f.model();
+  const recon::FlightModel kind = f.model_kind();  // of the fit to the per-frame points
+  const double t_ref = start.t0_s;
+  const std::vector<FlightObservation> gathered =
+      GatherObservations(cameras, messages, f, start, 5 * sigma_px + 10.0, margin_s);
+  if (static_cast<int>(gathered.size()) * 2 < 6 + 4) return out;
+  std::vector<FlightObservation> obs = gathered;
+  const double c_m = to.MagnusPerRad();
+  const Eigen::Vector3d s0 = start.magnus_per_rad * start.spin_radps;
+  const FlightParams initial{{start.p0_m.x(), start.p0_m.y(), start.p0_m.z()},
+                             {start.v0_mps.x(), start.v0_mps.y(), start.v0_mps.z()},
+                             {kind == recon::FlightModel::kGravity ? 0.0 : start.drag_per_m},
+                             {s0.x(), s0.y(), s0.z()}};
+  std::optional<FlightParams> best = SelectFlightModel(cameras, obs, initial, to, sigma_px, t_ref);
   if (!best) return out;
-  out.model = start;
-  out.model.p0_m = {best->p0[0], best->p0[1], best->p0[2]};
-  out.model.v0_mps = {best->v0[0], best->v0[1], best->v0[2]};
-  out.model.drag_per_m = best->kind == recon::FlightModel::kGravity ? 0.0 : best->k;
-  out.model.magnus_per_rad = best->kind == recon::FlightModel::kSpin ? c_m : 0.0;
-  out.model.spin_radps =
-      best->kind == recon::FlightModel::kSpin
-          ? Eigen::Vector3d(Eigen::Vector3d(best->sm[0], best->sm[1], best->sm[2]) / c_m)
-          : Eigen::Vector3d::Zero();
+  for (int round = 0; round < kTrimRounds; ++round) {
+    std::vector<FlightObservation> kept =
+        TrimObservations(cameras, obs, ModelOf(*best, start, c_m));
+    if (kept.size() == obs.size() || static_cast<int>(kept.size()) * 2 < 6 + 4) break;
+    auto again = SelectFlightModel(cameras, kept, initial, to, sigma_px, t_ref);
+    if (!again) break;
+    best = again;
+    obs = std::move(kept);
+  }
+  out.model = ModelOf(*best, start, c_m);
   out.kind = best->kind;
   double ss = 0;
   for (const auto& o : obs) {
@@ -348,7 +434,8 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   }
   out.observations = static_cast<int>(obs.size());
   out.rms_px = std::sqrt(ss / obs.size());
-  CompareWithFrames(cameras, obs, per_frame, margin_s, f.t_first_seen_s, f.t_last_seen_s, &out);
+  CompareWithFrames(cameras, gathered, per_frame, margin_s, f.t_first_seen_s, f.t_last_seen_s,
+                    &out);
   FitAtFrames(cameras, messages, per_frame, margin_s, f.t_first_seen_s, f.t_last_seen_s, &out);
   out.ok = out.model.p0_m.allFinite() && out.model.v0_mps.allFinite();
   return out;

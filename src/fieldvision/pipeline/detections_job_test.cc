@@ -34,8 +34,8 @@ std::vector<camera::Camera> TableRig() {
 }
 
 // A stroke along the table (x) with drag and topspin, bouncing once on the table (bounce model
-// of trajectory.h), sampled at 25 Hz from 10 s.
-std::vector<std::pair<double, Eigen::Vector3d>> Flight(util::Rng& rng) {
+// of trajectory.h), sampled at rate_hz from 10 s.
+std::vector<std::pair<double, Eigen::Vector3d>> Flight(util::Rng& rng, double rate_hz = 25.0) {
   recon::BallisticModel m;
   m.t0_s = 10.0;
   m.p0_m = {-1.8, rng.Uniform(-0.3, 0.3), rng.Uniform(0.3, 0.4)};
@@ -49,8 +49,8 @@ std::vector<std::pair<double, Eigen::Vector3d>> Flight(util::Rng& rng) {
   m.StateAt(tb, &after.p0_m, &after.v0_mps);
   recon::BounceModel().Apply(0.02, &after.v0_mps, &after.spin_radps);
   std::vector<std::pair<double, Eigen::Vector3d>> out;
-  for (int i = 0; i < 200; ++i) {
-    const double t = 10.0 + 0.013 + i / 25.0;  // frames not aligned with the bounce
+  for (int i = 0; i < 1000; ++i) {
+    const double t = 10.0 + 0.013 + i / rate_hz;  // frames not aligned with the bounce
     const Eigen::Vector3d p = t < tb ? m.PositionAt(t) : after.PositionAt(t);
     if (p.x() > 2.5 || p.z() < 0.0) break;
     out.emplace_back(t, p);
@@ -178,6 +178,59 @@ TEST(DetectionsJob, AFrameTheModelDoesNotFollowKeepsItsOwnPosition) {
   // Where the trajectory fit does not already cut the flight at the glitch (a hit), the frame is
   // kept inside the refined flight.
   EXPECT_GE(kept, 1);
+}
+
+// At 60 Hz, centres good to 0.3 px, except one camera's in the flight's last three frames, 3 px off
+// (a fit to the ball and its shadow): inside the Huber loss's quadratic zone at the nominal 2 px
+// sigma they tilted the flight's end (its last positions 3-12 mm off, against 1-4 mm without them);
+// the bundle refits without the candidates it explains far worse than the rest.
+TEST(DetectionsJob, AFewCentresOffAtAFlightsEndDoNotTiltIt) {
+  const uint64_t seed0 = testing::TestSeed(53);
+  const auto cams = TableRig();
+  const std::string base = testing::TempDir();
+  std::vector<double> clean_errors, off_errors;
+  for (uint64_t k = 0; k < 5; ++k) {
+    const uint64_t seed = seed0 + k;
+    FV_SEED_TRACE(seed);
+    util::Rng rng(seed);
+    const auto flight = Flight(rng, 60.0);
+    ASSERT_GE(flight.size(), 20u);
+    for (const double off_px : {0.0, 3.0}) {
+      const std::string dir = base + fmt::format("/h{}_{}", k, off_px);
+      std::filesystem::create_directories(dir);
+      DetectionsJobOptions o;
+      o.ball_diameter_m = 0.04;
+      o.out = dir + "/ball.csv";
+      util::Rng noise(seed);
+      WriteRig(dir, cams, flight, 0.3, false, noise, &o);
+      ASSERT_FALSE(::testing::Test::HasFatalFailure());
+      // Camera 0's last three centres off_px to the right.
+      std::string det = "frame,time_s,u,v,score\n";
+      for (size_t i = 0; i < flight.size(); ++i) {
+        const auto uv = cams[0].Project(flight[i].second);
+        const double du = i + 3 >= flight.size() ? off_px : 0.0;
+        det += fmt::format("{},{:.6f},{:.3f},{:.3f},0.9\n", i, flight[i].first,
+                           uv->x() + du + noise.Normal(0, 0.3), uv->y() + noise.Normal(0, 0.3));
+      }
+      WriteFile(o.detections[0], det);
+      const DetectionsJobResult r = RunDetectionsJob(o);
+      SCOPED_TRACE(r.Summary());
+      ASSERT_GE(r.bundled_flights, 1);
+      for (const auto& s : r.track) {
+        if (s.frame + 3 < static_cast<int>(flight.size())) continue;
+        (off_px > 0 ? off_errors : clean_errors)
+            .push_back((s.ball_in_world - flight[s.frame].second).norm());
+      }
+    }
+  }
+  std::cout << fmt::format(
+      "last three frames, 3D error median / max: {:.2f} / {:.2f} mm clean, {:.2f} / {:.2f} mm "
+      "with one camera 3 px off\n",
+      util::Median(clean_errors) * 1e3,
+      *std::max_element(clean_errors.begin(), clean_errors.end()) * 1e3,
+      util::Median(off_errors) * 1e3,
+      *std::max_element(off_errors.begin(), off_errors.end()) * 1e3);
+  EXPECT_LT(util::Median(off_errors), util::Median(clean_errors) + 0.001);
 }
 
 TEST(DetectionsJob, BadFilesAreOneLineErrorsNamingTheFile) {
