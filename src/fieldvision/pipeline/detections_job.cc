@@ -358,7 +358,7 @@ std::optional<FlightParams> SelectFlightModel(const std::vector<camera::Camera>&
   return best;
 }
 
-// The ball's position at `time_s` under the parameters (t_ref: their time origin).
+// The flight model the parameters stand for (the rest of it, its time origin, from `start`).
 recon::BallisticModel ModelOf(const FlightParams& x, const recon::BallisticModel& start,
                               double c_m) {
   recon::BallisticModel model = start;
