@@ -154,7 +154,8 @@ Edges ClassEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit, cons
 // One candidate edge of a ray (c + t u, profile samples at(i) at t0 + i step, m of them) at the
 // gradient peak `peak`: the ray's own colours 1.5 px inside and outside it (or the ray's ends
 // across a wide motion-blur ramp) and where the profile crosses halfway between them. t < 0 when
-// the step is too weak, its inside is not the ball or its outside is the ball too (outside_ball).
+// the step is too weak, its inside is not the ball, its outside is the ball too (outside_ball)
+// or it is the edge of the ball's contact shadow on the field (shadow_band_ratio).
 struct RayEdge {
   double t = -1, t10 = -1, t90 = -1;
   bool ramp = false;
@@ -162,7 +163,7 @@ struct RayEdge {
 };
 
 template <typename Profile>
-RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit,
+RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit, uint8_t field_bit,
                    const BallShade& shade, const Vector2d& c, const Vector2d& u, double t0,
                    double step, int m, int peak, Profile& at, const BallFitOptions& o) {
   constexpr double kSide = 1.5;
@@ -193,6 +194,18 @@ RayEdge EdgeAtPeak(const cv::Mat& img, const ColourTable& table, uint8_t bit,
   if (IsBall(img, table, bit, pout.x(), pout.y())) {  // outside is ball-coloured
     edge.outside_ball = true;
     return edge;
+  }
+  if (field_bit != 0 && o.shadow_band_ratio > 0 && !edge.ramp &&
+      IsBall(img, table, field_bit, pout.x(), pout.y())) {
+    // The darkest sample between the inside and the step (BallFitOptions::shadow_band_ratio).
+    int dark = ia;
+    for (int i = ia + 1; i <= peak; ++i) {
+      if (at(i).sum() < at(dark).sum()) dark = i;
+    }
+    if (at(dark).sum() < o.shadow_band_ratio * std::min(a.sum(), b.sum()) &&
+        !shade.Holds(at(dark), b, o)) {
+      return edge;
+    }
   }
   double prev_p = (at(ia) - a).dot(ab) / contrast2;
   for (int i = ia + 1; i <= ib; ++i) {
@@ -240,6 +253,8 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit,
                     const BallFitOptions& o) {
   constexpr double kStep = 0.25, kSide = 1.5;
   Edges e;
+  const int field = table.spec().Find("field");
+  const uint8_t field_bit = field >= 0 ? table.ClassBit("field") : 0;
   // A degenerate reference (an ellipse or cone fit gone wild) gives no outline points.
   const double max_r = std::max(img.cols, img.rows);
   if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;
@@ -324,7 +339,8 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit,
     double te = -1, t10 = -1, t90 = -1;
     bool ramp = false, outside_ball = false;
     for (auto it = peaks.rbegin(); it != peaks.rend() && te < 0; ++it) {
-      const RayEdge edge = EdgeAtPeak(img, table, bit, shade, c, u, t0, kStep, m, *it, at, o);
+      const RayEdge edge =
+          EdgeAtPeak(img, table, bit, field_bit, shade, c, u, t0, kStep, m, *it, at, o);
       if (edge.outside_ball) {  // the colour goes on beyond: no silhouette on this ray
         outside_ball = true;
         break;
@@ -607,6 +623,7 @@ void BallFitOptions::Check() const {
              "BallFitOptions.inside_share must be in (0, 1] (got {})", inside_share);
   CheckInRange(shade_max_offset, 0.0, 255.0, "BallFitOptions.shade_max_offset");
   CheckInRange(shade_min_brightness, 0.0, 1.0, "BallFitOptions.shade_min_brightness");
+  CheckInRange(shadow_band_ratio, 0.0, 1.0, "BallFitOptions.shadow_band_ratio");
 }
 
 std::string BallFit::Summary() const {
