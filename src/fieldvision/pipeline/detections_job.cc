@@ -215,7 +215,7 @@ constexpr int kTrimRounds = 3;
 
 // kTrimSigmas times the robust spread of 2D distances (their median over the Rayleigh median,
 // 1.1774 sigma), at least kTrimFloorPx.
-double OutlierLimit(std::vector<double> dist) {
+double OutlierLimit(const std::vector<double>& dist) {
   const double sigma = util::NearestRankPercentile(dist, 0.5) / 1.1774;
   return std::max(kTrimSigmas * sigma, kTrimFloorPx);
 }
