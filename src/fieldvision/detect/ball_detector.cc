@@ -292,7 +292,7 @@ void BallDetector::Init(const ColourSpec& colour) {
   if (camera_ != nullptr) camera_->Check();
   table_ = ColourTable::Shared(colour, options_.lut_bits);
   ball_bit_ = table_->BallBit();
-  field_bit_ = colour.Find("field") >= 0 ? table_->ClassBit("field") : 0;
+  field_bit_ = table_->ClassBitOrZero("field");
   if (options_.use_region) {
     grow_table_ = ColourTable::Shared(
         WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor), options_.lut_bits);

@@ -253,8 +253,7 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit,
                     const BallFitOptions& o) {
   constexpr double kStep = 0.25, kSide = 1.5;
   Edges e;
-  const int field = table.spec().Find("field");
-  const uint8_t field_bit = field >= 0 ? table.ClassBit("field") : 0;
+  const uint8_t field_bit = table.ClassBitOrZero("field");
   // A degenerate reference (an ellipse or cone fit gone wild) gives no outline points.
   const double max_r = std::max(img.cols, img.rows);
   if (!std::isfinite(mean_radius) || mean_radius <= 0 || mean_radius > max_r) return e;

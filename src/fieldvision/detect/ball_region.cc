@@ -766,12 +766,12 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
     const Eigen::Vector3d disc_c = median_lab(disc_h), ring_c = median_lab(ring_lab);
     out->contrast = (disc_c - ring_c).norm();
     // Delta H^2 = Delta a^2 + Delta b^2 - Delta C^2.
-    const double dc = disc_c.tail<2>().norm() - ring_c.tail<2>().norm();
-    out->hue_contrast =
-        std::sqrt(std::max(0.0, (disc_c - ring_c).tail<2>().squaredNorm() - dc * dc));
-    out->chroma_contrast = dc;
     out->ring_chroma = ring_c.tail<2>().norm();
     out->ring_lightness = ring_c.x();
+    out->chroma_contrast = disc_c.tail<2>().norm() - out->ring_chroma;
+    const double dc = out->chroma_contrast;
+    out->hue_contrast =
+        std::sqrt(std::max(0.0, (disc_c - ring_c).tail<2>().squaredNorm() - dc * dc));
   }
 }
 
@@ -861,8 +861,8 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   out.radius_px = r;
   out.sigma_px = std::max(out.rms_px, 0.3) * std::sqrt(2.0 / std::max(on.inliers, 1)) + 0.05;
   // The field's surface: its colour and its painted lines.
-  const uint8_t grass_bit = table.spec().Find("field") >= 0 ? table.ClassBit("field") : 0;
-  const uint8_t line_bit = table.spec().Find("line") >= 0 ? table.ClassBit("line") : 0;
+  const uint8_t grass_bit = table.ClassBitOrZero("field");
+  const uint8_t line_bit = table.ClassBitOrZero("line");
   const uint8_t field_bit = grass_bit | line_bit;
   // The colours are read within the leak ring's outer radius.
   const double ro = o.ring_outer * r;

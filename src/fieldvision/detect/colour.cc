@@ -370,6 +370,11 @@ uint8_t ColourTable::ClassBit(const std::string& name) const {
   return uint8_t(1u << i);
 }
 
+uint8_t ColourTable::ClassBitOrZero(const std::string& name) const {
+  const int i = spec_.Find(name);
+  return i >= 0 ? uint8_t(1u << i) : 0;
+}
+
 cv::Mat ColourTable::ClassifyImage(const cv::Mat& bgr) const {
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "ClassifyImage: expected a BGR 8-bit image");
   cv::Mat out(bgr.size(), CV_8U);

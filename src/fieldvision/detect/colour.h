@@ -85,6 +85,8 @@ class ColourTable {
   int bits_per_channel() const { return bits_; }
   // Bit of a class (1 << index); throws naming the class when absent.
   uint8_t ClassBit(const std::string& name) const;
+  // The same, 0 when the spec has no such class (a preset without "field" or "line").
+  uint8_t ClassBitOrZero(const std::string& name) const;
   uint8_t BallBit() const { return ClassBit(spec_.ball_class); }
 
   // Table index of a packed BGR value (b | g << 8 | r << 16).

@@ -209,6 +209,10 @@ void FitAtFrames(const std::vector<camera::Camera>& cameras,
   }
 }
 
+// A flight is fitted on at least this many reprojection residuals (two per candidate): the
+// gravity model's 6 parameters and 4 more.
+constexpr int kMinResiduals = 6 + 4;
+
 constexpr double kTrimSigmas = 4.0;
 constexpr double kTrimFloorPx = 0.5;
 constexpr int kTrimRounds = 3;
@@ -394,8 +398,8 @@ std::vector<FlightObservation> TrimObservations(const std::vector<camera::Camera
 }
 
 // The flight's model refitted on the detections of every camera between its first and last
-// seen samples (the candidate nearest the model's prediction, within a gate), then once more
-// without the candidates it explains far worse than the rest (TrimObservations).
+// seen samples (the candidate nearest the model's prediction, within a gate), then again without
+// the candidates it explains far worse than the rest (TrimObservations), up to kTrimRounds times.
 Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
                      const std::vector<std::vector<CameraMessage>>& messages,
                      const recon::Flight& f, const recon::TrajectoryOptions& to, double sigma_px,
@@ -406,7 +410,7 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   const double t_ref = start.t0_s;
   const std::vector<FlightObservation> gathered =
       GatherObservations(cameras, messages, f, start, 5 * sigma_px + 10.0, margin_s);
-  if (static_cast<int>(gathered.size()) * 2 < 6 + 4) return out;
+  if (static_cast<int>(gathered.size()) * 2 < kMinResiduals) return out;
   std::vector<FlightObservation> obs = gathered;
   const double c_m = to.MagnusPerRad();
   const Eigen::Vector3d s0 = start.magnus_per_rad * start.spin_radps;
@@ -419,7 +423,7 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   for (int round = 0; round < kTrimRounds; ++round) {
     std::vector<FlightObservation> kept =
         TrimObservations(cameras, obs, ModelOf(*best, start, c_m));
-    if (kept.size() == obs.size() || static_cast<int>(kept.size()) * 2 < 6 + 4) break;
+    if (kept.size() == obs.size() || static_cast<int>(kept.size()) * 2 < kMinResiduals) break;
     auto again = SelectFlightModel(cameras, kept, initial, to, sigma_px, t_ref);
     if (!again) break;
     best = again;

@@ -4,6 +4,7 @@
 #include "fieldvision/pipeline/fusion_stage.h"
 
 #include <cmath>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -157,15 +158,17 @@ recon::BallObservation SeenAt(const camera::Camera& cam, const Vector3d& p, doub
   return o;
 }
 
-// A yellow sign that cameras 1 and 2 both take for a ball stands 0.6 m above the ground; the
-// ball rests in view of all three cameras, then is hidden (picked up). The sign, seen all along
-// as a consistent pair that was not chosen, must not take the ball's place.
-TEST(FusionStage, AStillSignDoesNotReplaceALostBall) {
-  const std::vector<camera::Camera> cams = RingCameras();
-  FusionStage fusion(cams, recon::TriangulationOptions());
-  const Vector3d ball(-1.0, 0.5, 0.11), sign(2.0, 1.5, 0.6);
+// A yellow sign 0.6 m above the ground that cameras 1 and 2 both take for a ball, in every frame,
+// and the ball at rest in view of all three cameras in the frames where `ball_seen`: fused frame
+// by frame (60 fps), how many positions lie on the ball and how many on the sign.
+struct SignAndBall {
   int ball_frames = 0, sign_frames = 0;
-  for (int f = 0; f < 60; ++f) {
+};
+SignAndBall FuseSignAndBall(FusionStage& fusion, const std::vector<camera::Camera>& cams,
+                            int frames, const std::function<bool(int)>& ball_seen) {
+  const Vector3d ball(-1.0, 0.5, 0.11), sign(2.0, 1.5, 0.6);
+  SignAndBall n;
+  for (int f = 0; f < frames; ++f) {
     SyncedFrame group;
     group.frame = f;
     group.time_s = f / 60.0;
@@ -175,52 +178,41 @@ TEST(FusionStage, AStillSignDoesNotReplaceALostBall) {
       m.camera = c;
       m.frame = f;
       m.time_s = group.time_s;
-      if (f < 30) m.candidates.push_back(SeenAt(cams[c], ball, 0.5));
+      if (ball_seen(f)) m.candidates.push_back(SeenAt(cams[c], ball, 0.5));
       if (c < 2) m.candidates.push_back(SeenAt(cams[c], sign, 0.6));
       group.cameras[c] = m;
     }
     const BallFrame out = fusion.Fuse(group);
     if (!out.result.ok()) continue;
-    if ((out.result.point_world - ball).norm() < 0.05) ++ball_frames;
-    if ((out.result.point_world - sign).norm() < 0.05) ++sign_frames;
+    if ((out.result.point_world - ball).norm() < 0.05) ++n.ball_frames;
+    if ((out.result.point_world - sign).norm() < 0.05) ++n.sign_frames;
   }
-  EXPECT_EQ(ball_frames, 30);
-  EXPECT_EQ(sign_frames, 0);
+  return n;
+}
+
+// The ball rests in view of all three cameras, then is hidden (picked up). The sign, seen all
+// along as a consistent pair that was not chosen, must not take the ball's place.
+TEST(FusionStage, AStillSignDoesNotReplaceALostBall) {
+  const std::vector<camera::Camera> cams = RingCameras();
+  FusionStage fusion(cams, recon::TriangulationOptions());
+  const SignAndBall n = FuseSignAndBall(fusion, cams, 60, [](int f) { return f < 30; });
+  EXPECT_EQ(n.ball_frames, 30);
+  EXPECT_EQ(n.sign_frames, 0);
   // For 12 frames (BallPredictor's max_gap) the resting ball's track gates the sign out; then
   // it is chosen and dropped.
   EXPECT_EQ(fusion.stats().hovering_dropped, 30 - 12);
 }
 
-// The same sign is all cameras 1 and 2 see for a moment (the ball is out of view), so the fusion
+// The sign is all cameras 1 and 2 see for a moment (the ball is out of view), so the fusion
 // follows it; then the ball comes to rest in view of all three cameras. A track that stands
 // still in the air is no ball's and gives no prior: the ball is taken from its first frame (gated
 // by the sign's track, it was kept out until the hover filter had seen the sign for 0.3 s).
 TEST(FusionStage, AStillSignFollowedForAMomentDoesNotKeepTheBallOut) {
   const std::vector<camera::Camera> cams = RingCameras();
   FusionStage fusion(cams, recon::TriangulationOptions());
-  const Vector3d ball(-1.0, 0.5, 0.11), sign(2.0, 1.5, 0.6);
-  int ball_frames = 0, sign_frames = 0;
-  for (int f = 0; f < 30; ++f) {
-    SyncedFrame group;
-    group.frame = f;
-    group.time_s = f / 60.0;
-    group.cameras.resize(cams.size());
-    for (int c = 0; c < 3; ++c) {
-      CameraMessage m;
-      m.camera = c;
-      m.frame = f;
-      m.time_s = group.time_s;
-      if (f >= 5) m.candidates.push_back(SeenAt(cams[c], ball, 0.5));
-      if (c < 2) m.candidates.push_back(SeenAt(cams[c], sign, 0.6));
-      group.cameras[c] = m;
-    }
-    const BallFrame out = fusion.Fuse(group);
-    if (!out.result.ok()) continue;
-    if ((out.result.point_world - ball).norm() < 0.05) ++ball_frames;
-    if ((out.result.point_world - sign).norm() < 0.05) ++sign_frames;
-  }
-  EXPECT_EQ(ball_frames, 25);
-  EXPECT_EQ(sign_frames, 5);
+  const SignAndBall n = FuseSignAndBall(fusion, cams, 30, [](int f) { return f >= 5; });
+  EXPECT_EQ(n.ball_frames, 25);
+  EXPECT_EQ(n.sign_frames, 5);
 }
 
 }  // namespace
