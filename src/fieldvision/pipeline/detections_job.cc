@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 
 #include <fmt/format.h>
 
@@ -18,6 +19,7 @@
 #include "fieldvision/pipeline/fusion_stage.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/recon/trajectory_path.h"
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -98,36 +100,6 @@ std::vector<CameraMessage> ReadDetectionsCsv(const std::string& path, int camera
 }
 
 namespace {
-
-// One detection against the flight model: parameters p0 (3), v0 (3), drag k (1), Magnus vector
-// s = c_M w (3) at the flight's reference time; residual in units of the detection's sigma.
-struct DetectionResidual {
-  DetectionResidual(const camera::Camera& cam, const Eigen::Vector2d& uv, double dt, double g,
-                    double sigma_px, bool integrate)
-      : uv_(uv), dt_(dt), g_(g), sigma_(sigma_px), integrate_(integrate) {
-    const auto block = cam.IntrinsicsBlock();
-    std::copy(block.begin(), block.end(), intrinsics_);
-    const Eigen::Vector3d r = cam.cam_from_world.Rvec();
-    for (int i = 0; i < 3; ++i) rvec_[i] = r[i], tvec_[i] = cam.cam_from_world.translation[i];
-  }
-  template <typename T>
-  bool operator()(const T* p0, const T* v0, const T* k, const T* sm, T* r) const {
-    T p[3];
-    recon::FlightPositionAt(p0, v0, k[0], sm, g_, dt_, integrate_, p);
-    T intr[camera::kNumIntrinsics], rv[3], tv[3], uv[2];
-    for (int i = 0; i < camera::kNumIntrinsics; ++i) intr[i] = T(intrinsics_[i]);
-    for (int i = 0; i < 3; ++i) rv[i] = T(rvec_[i]), tv[i] = T(tvec_[i]);
-    if (!camera::ProjectWorldPoint(intr, rv, tv, p, uv)) return false;
-    r[0] = (uv[0] - uv_.x()) / sigma_;
-    r[1] = (uv[1] - uv_.y()) / sigma_;
-    return true;
-  }
-  double intrinsics_[camera::kNumIntrinsics];
-  double rvec_[3], tvec_[3];
-  Eigen::Vector2d uv_;
-  double dt_, g_, sigma_;
-  bool integrate_;
-};
 
 // A per-frame position this close to a flight's model lies on it (farther: 0.5 m off).
 constexpr double kNearM = 0.5;
@@ -297,12 +269,19 @@ bool SolveFlightModel(const std::vector<camera::Camera>& cameras,
                       const std::vector<FlightObservation>& obs, recon::FlightModel m,
                       const recon::TrajectoryOptions& to, double sigma_px, double t_ref,
                       FlightParams* x, double* cost) {
-  const bool integrate = m != recon::FlightModel::kGravity;
+  std::vector<double> dt_s;
+  dt_s.reserve(obs.size());
+  for (const auto& o : obs) dt_s.push_back(o.time_s - t_ref);
+  // The drag and spin models' path, integrated once per evaluation for all observations.
+  std::unique_ptr<recon::FlightPath> path;
+  if (m != recon::FlightModel::kGravity) {
+    path = std::make_unique<recon::FlightPath>(dt_s, to.gravity_mps2);
+  }
   ceres::Problem problem;
-  for (const auto& o : obs) {
+  for (size_t i = 0; i < obs.size(); ++i) {
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<DetectionResidual, 2, 3, 3, 1, 3>(new DetectionResidual(
-            cameras[o.cam], o.uv, o.time_s - t_ref, to.gravity_mps2, sigma_px, integrate)),
+        new recon::FlightReprojection(path.get(), static_cast<int>(i), dt_s[i], to.gravity_mps2,
+                                      cameras[obs[i].cam], obs[i].uv, sigma_px),
         new ceres::HuberLoss(2.0), x->p0, x->v0, x->k, x->sm);
   }
   if (m == recon::FlightModel::kGravity) {

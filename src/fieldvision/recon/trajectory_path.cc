@@ -6,6 +6,9 @@
 #include <limits>
 #include <numeric>
 
+#include <ceres/jet.h>
+
+#include "fieldvision/camera/projection.h"
 #include "fieldvision/recon/trajectory_physics.h"
 
 namespace fv::recon {
@@ -234,6 +237,61 @@ bool FlightResiduals::Evaluate(const double* const* parameters, double* residual
   for (int b = 0; derivatives && b < 4; ++b) {
     if (jacobians[b] == nullptr) continue;
     for (int c = 0; c < kBlockSize[b]; ++c) jacobians[b][3 * n * kBlockSize[b] + c] = 0.0;
+  }
+  return true;
+}
+
+FlightReprojection::FlightReprojection(FlightPath* path, int index, double dt_s,
+                                       double gravity_mps2, const camera::Camera& camera,
+                                       const Eigen::Vector2d& uv_px, double sigma_px)
+    : path_(path), index_(index), dt_(dt_s), g_(gravity_mps2), uv_(uv_px), sigma_(sigma_px) {
+  const auto block = camera.IntrinsicsBlock();
+  std::copy(block.begin(), block.end(), intrinsics_);
+  const Eigen::Vector3d r = camera.cam_from_world.Rvec();
+  for (int i = 0; i < 3; ++i) rvec_[i] = r[i], tvec_[i] = camera.cam_from_world.translation[i];
+}
+
+bool FlightReprojection::Evaluate(const double* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  bool derivatives = false;
+  for (int b = 0; jacobians != nullptr && b < 4; ++b) derivatives |= jacobians[b] != nullptr;
+  FlightPath::Jacobian d = FlightPath::Jacobian::Zero();  // d position / d parameters
+  Eigen::Vector3d p;
+  if (path_ != nullptr) {
+    path_->Update(parameters, !derivatives              ? FlightPath::Need::kValues
+                              : jacobians[3] == nullptr ? FlightPath::Need::kNoSpin
+                                                        : FlightPath::Need::kAll);
+    p = path_->Position(index_);
+    if (derivatives) d = path_->Derivatives(index_);
+  } else {
+    // As FlightPositionAt without integration.
+    for (int j = 0; j < 3; ++j) {
+      p[j] = parameters[0][j] + parameters[1][j] * dt_;
+      d(j, j) = 1.0;
+      d(j, 3 + j) = dt_;
+    }
+    p[2] -= 0.5 * g_ * dt_ * dt_;
+  }
+  // The projection and its derivatives by the position (forward mode over the 3 coordinates).
+  using Jet3 = ceres::Jet<double, 3>;
+  Jet3 intr[camera::kNumIntrinsics], rv[3], tv[3], x[3], uv[2];
+  for (int i = 0; i < camera::kNumIntrinsics; ++i) intr[i] = Jet3(intrinsics_[i]);
+  for (int i = 0; i < 3; ++i) rv[i] = Jet3(rvec_[i]), tv[i] = Jet3(tvec_[i]), x[i] = Jet3(p[i], i);
+  if (!camera::ProjectWorldPoint(intr, rv, tv, x, uv)) return false;
+  residuals[0] = (uv[0].a - uv_.x()) / sigma_;
+  residuals[1] = (uv[1].a - uv_.y()) / sigma_;
+  if (!derivatives) return true;
+  Eigen::Matrix<double, 2, 3> duv_dx;
+  duv_dx.row(0) = uv[0].v.transpose() / sigma_;
+  duv_dx.row(1) = uv[1].v.transpose() / sigma_;
+  const Eigen::Matrix<double, 2, FlightPath::kParams> j_all = duv_dx * d;
+  for (int b = 0; b < 4; ++b) {
+    if (jacobians[b] == nullptr) continue;
+    for (int r = 0; r < 2; ++r) {
+      for (int c = 0; c < kBlockSize[b]; ++c) {
+        jacobians[b][r * kBlockSize[b] + c] = j_all(r, kBlockStart[b] + c);
+      }
+    }
   }
   return true;
 }

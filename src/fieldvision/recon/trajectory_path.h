@@ -9,7 +9,10 @@
 #include <vector>
 
 #include <ceres/cost_function.h>
+#include <ceres/sized_cost_function.h>
 #include <Eigen/Core>
+
+#include "fieldvision/camera/camera.h"
 
 namespace fv::recon {
 
@@ -69,6 +72,29 @@ class FlightResiduals : public ceres::CostFunction {
   std::vector<double> dt_;
   std::vector<Eigen::Vector3d> x_;
   double g_, huber_;
+};
+
+// One camera's detection of a flight: the pixel where the camera sees the flight's position at
+// the detection's time (sample `index` of `path`, or the drag-free parabola at dt_s when `path`
+// is null) minus the detection, in units of sigma_px; parameter blocks p0 3, v0 3, k 1, s 3. The
+// blocks of one fit share their path, which integrates once per parameter values: O(span) per
+// evaluation against O(samples x span) for a Jet integration per block. Ceres must evaluate the
+// blocks one after another (Solver::Options::num_threads 1, its default).
+class FlightReprojection : public ceres::SizedCostFunction<2, 3, 3, 1, 3> {
+ public:
+  FlightReprojection(FlightPath* path, int index, double dt_s, double gravity_mps2,
+                     const camera::Camera& camera, const Eigen::Vector2d& uv_px, double sigma_px);
+  bool Evaluate(const double* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  FlightPath* path_;
+  int index_;
+  double dt_, g_;
+  double intrinsics_[camera::kNumIntrinsics];
+  double rvec_[3], tvec_[3];
+  Eigen::Vector2d uv_;
+  double sigma_;
 };
 
 }  // namespace fv::recon

@@ -7,6 +7,7 @@
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
+#include "fieldvision/camera/projection.h"
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/recon/trajectory_sim.h"
@@ -57,6 +58,72 @@ TEST(FlightPath, MatchesOneIntegrationPerSample) {
     EXPECT_EQ(drag.Derivatives(i).leftCols<7>(), path.Derivatives(i).leftCols<7>());
     EXPECT_TRUE(drag.Derivatives(i).rightCols<3>().isZero());
   }
+}
+
+// A detection's reprojection residual from the shared path has the values and derivatives of a
+// Jet integration of its own through the camera (a distorted one), for each model: the spin
+// model's path, the drag model's (no derivatives by s) and the drag-free parabola (no path).
+TEST(FlightReprojection, MatchesAJetThroughTheCamera) {
+  testing::SeededRng rng(11);
+  const double g = 9.81;
+  camera::Camera cam = camera::Camera::FromFov(1280, 960, 70);
+  cam.distortion = {-0.12, 0.05, 0.001, -0.002, 0.0};
+  cam.cam_from_world = geometry::Rigid3d::LookAt(Eigen::Vector3d(-3, -12, 4), {4, 0, 1});
+  cam.has_pose = true;
+  const double p0[3] = {0.5, -1.0, 0.2}, v0[3] = {14.0, 3.0, 7.0}, k[1] = {0.015};
+  const double s[3] = {0.4, -0.3, 0.6};
+  const double* params[4] = {p0, v0, k, s};
+  std::vector<double> dt;
+  for (int i = -20; i <= 40; ++i) dt.push_back(i / 60.0 + rng.Uniform(-0.003, 0.003));
+  const Eigen::Vector2d uv(640.0, 480.0);
+  const double sigma = 0.7;
+  FlightPath path(dt, g);
+  using Jet = ceres::Jet<double, 10>;
+  Jet jp0[3], jv0[3], jk(k[0], 6), js[3], intr[camera::kNumIntrinsics], rv[3], tv[3];
+  for (int j = 0; j < 3; ++j) {
+    jp0[j] = Jet(p0[j], j);
+    jv0[j] = Jet(v0[j], 3 + j);
+    js[j] = Jet(s[j], 7 + j);
+  }
+  const auto block = cam.IntrinsicsBlock();
+  for (int i = 0; i < camera::kNumIntrinsics; ++i) intr[i] = Jet(block[i]);
+  const Eigen::Vector3d r = cam.cam_from_world.Rvec();
+  for (int j = 0; j < 3; ++j) rv[j] = Jet(r[j]), tv[j] = Jet(cam.cam_from_world.translation[j]);
+  for (const bool integrate : {true, false}) {
+    for (size_t i = 0; i < dt.size(); ++i) {
+      const FlightReprojection cost(integrate ? &path : nullptr, static_cast<int>(i), dt[i], g, cam,
+                                    uv, sigma);
+      double res[2], j0[6], j1[6], j2[2], j3[6];
+      double* jac[4] = {j0, j1, j2, j3};
+      ASSERT_TRUE(cost.Evaluate(params, res, jac)) << "dt " << dt[i];
+      Jet p[3], want[2];
+      FlightPositionAt(jp0, jv0, jk, js, g, dt[i], integrate, p);
+      ASSERT_TRUE(camera::ProjectWorldPoint(intr, rv, tv, p, want));
+      for (int row = 0; row < 2; ++row) {
+        const Jet e = (want[row] - uv[row]) / sigma;
+        EXPECT_NEAR(res[row], e.a, 1e-6) << "dt " << dt[i] << " integrate " << integrate;
+        const double scale = e.v.cwiseAbs().maxCoeff();
+        for (int c = 0; c < 10; ++c) {
+          const double got = c < 3    ? j0[row * 3 + c]
+                             : c < 6  ? j1[row * 3 + c - 3]
+                             : c == 6 ? j2[row]
+                                      : j3[row * 3 + c - 7];
+          EXPECT_NEAR(got, e.v[c], 1e-6 * scale) << "dt " << dt[i] << " c " << c;
+        }
+      }
+    }
+  }
+  // Without derivatives by s (a drag fit holds s constant): the others are the same.
+  FlightPath drag(dt, g);
+  const FlightReprojection with_spin(&path, 7, dt[7], g, cam, uv, sigma);
+  const FlightReprojection no_spin(&drag, 7, dt[7], g, cam, uv, sigma);
+  double a[2], b[2], a0[6], a1[6], a2[2], a3[6], b0[6], b1[6], b2[2];
+  double* ja[4] = {a0, a1, a2, a3};
+  double* jb[4] = {b0, b1, b2, nullptr};
+  ASSERT_TRUE(with_spin.Evaluate(params, a, ja));
+  ASSERT_TRUE(no_spin.Evaluate(params, b, jb));
+  for (int c = 0; c < 6; ++c) EXPECT_DOUBLE_EQ(a0[c], b0[c]);
+  EXPECT_DOUBLE_EQ(a2[1], b2[1]);
 }
 
 // The work of a drag or spin fit grows with the flight's span, not with samples x span (each
