@@ -26,6 +26,9 @@ void Setup(CLI::App& app, int& exit_code) {
                   "images) or a CSV with image|frame,x,y,w,h in pixels");
   cmd->add_option("--class", o->class_id, "YOLO class of the ball")->capture_default_str();
   cmd->add_option("--camera", o->camera, "Camera file (size checks)");
+  cmd->add_option("--field", o->field,
+                  "Field (built-in name or JSON): ignore everything outside the field of play, as "
+                  "`detect --field` (needs --camera with a pose)");
   AddBallColourOption(cmd, o->detector.colour);
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn);

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -165,6 +166,8 @@ void DetectEvalOptions::Check() const {
   FV_REQUIRE(class_id >= 0, "--class must be >= 0 (got {})", class_id);
   CheckInRange(grow, 0.0, 5.0, "grow");
   FV_REQUIRE(list_misses >= 0, "list_misses must be >= 0");
+  FV_REQUIRE(field.empty() || !camera.empty(),
+             "eval detect: --field needs --camera with a pose (the field is found through it)");
   detector.Check();
   dnn.Check();
 }
@@ -388,7 +391,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   std::unique_ptr<io::VideoSource> video;
   if (!items.empty() && items.front().frame >= 0) video = io::VideoSource::Open(o.video);
   // No output may be one of the images, label files or the camera read (an image inside --video).
-  std::vector<std::string> inputs = {o.video, o.labels, o.camera};
+  std::vector<std::string> inputs = {o.video, o.labels, o.camera, o.field};
   for (const LabelledImage& item : items) inputs.push_back(item.image);
   io::CheckOutputPath(o.out, inputs, "--out");
   io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
@@ -396,7 +399,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   if (!o.camera.empty()) {
     camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
   }
-  const AnyBallDetector detector(o.detector, o.dnn, camera.get(), nullptr);
+  std::optional<field::FieldModel> field;
+  if (!o.field.empty()) field = field::LoadField(o.field);
+  const AnyBallDetector detector(o.detector, o.dnn, camera.get(), field ? &*field : nullptr);
 
   DetectEvalResult result;
   std::unique_ptr<io::AtomicOutput> cand_file;

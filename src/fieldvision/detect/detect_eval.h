@@ -44,6 +44,7 @@ struct DetectEvalOptions {
   std::string labels;          // YOLO folder or CSV; "" = YOLO files beside the images
   int class_id = 0;            // YOLO class of the ball
   std::string camera;          // optional camera file (size checks); frames must then match it
+  std::string field;           // optional field (name or JSON): the field mask, with a posed camera
   double grow = 0.25;          // box growth for a hit (each side, share of the box size)
   int list_misses = 30;        // misses and false detections listed in the summary
   std::string out;             // optional CSV, one row per image

@@ -127,6 +127,21 @@ TEST(DetectEval, NothingToScoreIsNotAScore) {
   EXPECT_NE(r.Summary(0).find("recall n/a (0/0)"), std::string::npos) << r.Summary(0);
 }
 
+// The field mask comes through a posed camera: --field without --camera is an error naming it.
+TEST(DetectEval, FieldNeedsACamera) {
+  DetectEvalOptions o;
+  o.video = "frames/%05d.png";
+  o.field = "robocup-msl";
+  try {
+    o.Check();
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--field needs --camera"), std::string::npos) << e.what();
+  }
+  o.camera = "cam.yaml";
+  EXPECT_NO_THROW(o.Check());
+}
+
 // The real RoboCup photos (shared/data/robocup-ball-photos): a floor under today's measured
 // recall and precision so that a change that loses real balls shows up here.
 TEST(DetectEval, RealRobocupPhotos) {
