@@ -304,7 +304,7 @@ ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
   const int n = 1 << bits_;
   const int shift = 8 - bits_;
   const int centre = shift > 0 ? 1 << (shift - 1) : 0;
-  table_.assign(size_t(1) << (3 * bits_), 0);
+  table_ = util::HugeBuffer(size_t(1) << (3 * bits_));  // zeroed
   // Compiled ranges per class.
   std::vector<std::pair<uint8_t, CompiledRange>> ranges;
   bool need_hsv = false, need_yuv = false;
