@@ -91,6 +91,10 @@ RankedCandidates RankCandidates(const std::vector<camera::Camera>& cameras,
 // (true when max_ratio is 0 or a radius is unknown).
 bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
                       const Eigen::Vector3d& p, double ball_radius_m, double max_ratio);
+// The candidate's score weighted by how well its radius fits the depth of p
+// (TriangulationOptions::score_radius_sigma; the score itself when off or a radius is unknown).
+double RadiusWeightedScore(const camera::Camera& camera, const BallObservation& obs,
+                           const Eigen::Vector3d& p, const TriangulationOptions& o);
 // The candidate's reprojection error at p when it is consistent with p (in front, within the
 // threshold, radius checks), else -1.
 double ConsistentError(const camera::Camera& camera, const BallObservation& obs,

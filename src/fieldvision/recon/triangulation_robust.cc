@@ -51,6 +51,16 @@ bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
   return ratio <= max_ratio && ratio >= 1.0 / max_ratio;
 }
 
+double RadiusWeightedScore(const camera::Camera& camera, const BallObservation& obs,
+                           const Eigen::Vector3d& p, const TriangulationOptions& o) {
+  if (o.score_radius_sigma <= 0 || obs.radius_px <= 0 || o.ball_radius_m <= 0) return obs.score;
+  const double depth = Depth(camera, p);
+  if (!(depth > 0)) return obs.score;
+  const double expected = o.ball_radius_m * std::sqrt(camera.fx * camera.fy) / depth;
+  const double z = std::log(obs.radius_px / expected) / o.score_radius_sigma;
+  return obs.score * std::exp(-0.5 * z * z);
+}
+
 double ConsistentError(const camera::Camera& camera, const BallObservation& obs,
                        const Eigen::Vector3d& p, const TriangulationOptions& o) {
   if (!(Depth(camera, p) > o.min_depth_m)) return -1;
@@ -176,7 +186,8 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
           if (gated && (o.prior_override_views == 0 || n < o.prior_override_views)) continue;
           double score = 0;
           for (int c : seen) {
-            if (pick[c] >= 0) score += candidates[c][pick[c]].score;
+            if (pick[c] < 0) continue;
+            score += RadiusWeightedScore(cameras[c], candidates[c][pick[c]], rp.midpoint, o);
           }
           KeepBetter(n, cost, score, pick, gated ? &far : &best);
         }

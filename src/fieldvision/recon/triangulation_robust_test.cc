@@ -108,10 +108,46 @@ TEST(RobustStages, AGhostWhoseSizesDoNotFitItIsNoBall) {
   const TriangulationResult r = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(r.ok());
   EXPECT_LT((r.point_world - ball).norm(), 1e-3);
+  // Any radius allowed: the scores weighted by the sizes' fit still take the ball; the scores
+  // alone, the better scored ghost.
   o.max_radius_ratio = 0.0;
+  const TriangulationResult weighted = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(weighted.ok());
+  EXPECT_LT((weighted.point_world - ball).norm(), 1e-3);
+  o.score_radius_sigma = 0.0;
   const TriangulationResult any = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(any.ok());
   EXPECT_LT((any.point_world - ghost).norm(), 1e-3);
+}
+
+// One camera's ball paired with another camera's still ball-coloured thing on that camera's ray,
+// 30 % farther: as many cameras as the ball's own pair and a higher total score, but the first
+// camera's radius does not fit the farther point (score_radius_sigma), so the ball is taken;
+// with the scores alone, the pair along the ray.
+TEST(RobustStages, APairAlongOneCamerasRayGivesWayWhereItsRadiusDoesNotFit) {
+  const std::vector<camera::Camera> cams = RingCameras();
+  const Eigen::Vector3d ball(1.0, -1.0, 1.5);
+  const Eigen::Vector3d eye = cams[0].cam_from_world.Inverse().translation;
+  const Eigen::Vector3d thing = eye + 1.3 * (ball - eye);
+  const auto sized = [](const camera::Camera& cam, const Eigen::Vector3d& p, double score) {
+    BallObservation o = Seen(cam, p, score);
+    o.radius_px = 0.11 * std::sqrt(cam.fx * cam.fy) / (cam.cam_from_world * p).z();
+    return o;
+  };
+  const std::vector<std::vector<BallObservation>> cand = {
+      {sized(cams[0], ball, 0.3)}, {sized(cams[1], ball, 0.3)}, {sized(cams[2], thing, 0.45)}};
+  TriangulationOptions o;
+  ASSERT_GT(o.score_radius_sigma, 0.0);
+  const TriangulationResult r = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.num_views(), 2);
+  EXPECT_LT((r.point_world - ball).norm(), 1e-3);
+  EXPECT_NEAR(RadiusWeightedScore(cams[0], cand[0][0], ball, o), 0.3, 1e-9);
+  EXPECT_LT(RadiusWeightedScore(cams[0], cand[0][0], thing, o), 0.01);
+  o.score_radius_sigma = 0.0;
+  const TriangulationResult scores_only = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(scores_only.ok());
+  EXPECT_LT((scores_only.point_world - thing).norm(), 1e-3);
 }
 
 TEST(RobustStages, SearchFindsTheLargestAgreeingSetAndRefineKeepsIt) {

@@ -183,7 +183,8 @@ TEST(Triangulation, AViewWhoseRadiusDisagreesWeighsLess) {
   std::cout << "partial disc: mean error " << err_on * 1e3 << " mm, unweighted " << err_off * 1e3
             << " mm, clean " << err_clean * 1e3 << " mm\n";
   // Most of what the partial disc adds is gone.
-  EXPECT_LT(err_on - err_clean, 0.3 * (err_off - err_clean)) << "mean error " << err_on << " m, unweighted " << err_off;
+  EXPECT_LT(err_on - err_clean, 0.3 * (err_off - err_clean))
+      << "mean error " << err_on << " m, unweighted " << err_off;
   EXPECT_LT(err_clean, 0.008);
 }
 
