@@ -671,6 +671,10 @@ void BallDetector::Decide(const BallRegion& region, const BallFit& fit, const st
   } else {
     cand.accepted = false;
     cand.reason = !size_why.empty() ? size_why : (region.ok ? region_why : fit_why);
+    // Both paths failed: the outline fit's own reason too (eval detect lists it with the miss).
+    if (size_why.empty() && region.ok && !fit_why.empty() && fit_why != region_why) {
+      cand.reason += "; outline fit: " + fit_why;
+    }
     cand.score = region_score;
     cand.weak = fit.ok && size_why.empty() && !fit_why.empty() &&
                 fit.inlier_fraction >= o.weak_min_inlier_fraction &&

@@ -46,6 +46,26 @@ TEST(BallDetector, FindsDrawnBallsAndRejectsATriangle) {
   EXPECT_TRUE(cone_seen);
 }
 
+// A square of the ball's colour fails both paths, the region's shape and the outline fit; its
+// reason names both (eval detect lists it with a miss).
+TEST(BallDetector, ARejectedSquareGivesTheRegionsAndTheOutlinesReasons) {
+  const uint64_t seed = fv::testing::TestSeed(29);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  cv::Mat img = test_util::FieldImage(320, 240, rng);
+  const cv::Vec3b orange = test_util::kOrange;
+  const int side = static_cast<int>(rng.Uniform(20, 30));
+  cv::rectangle(img, cv::Rect(150, 100, side, side), cv::Scalar(orange[0], orange[1], orange[2]),
+                cv::FILLED);
+  const std::vector<BallCandidate> cands = det.Detect(img);
+  ASSERT_FALSE(cands.empty());
+  EXPECT_EQ(Accepted(cands), 0);
+  const BallCandidate& c = cands.front();
+  EXPECT_NE(c.reason.find("region"), std::string::npos) << c.reason;
+  EXPECT_NE(c.reason.find("; outline fit: "), std::string::npos) << c.reason;
+}
+
 // A disc that fails only the colour contrast is disc-shaped (worth a network's look); a cone is
 // not.
 TEST(BallDetector, LowContrastDiscIsDiscShapedAConeIsNot) {
