@@ -39,6 +39,12 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                   "expected at the point (0: any radius)")
       ->check(FiniteRange(0.0, 0.0) | FiniteRange(1.01, 100.0))
       ->capture_default_str();
+  cmd->add_option("--score-radius-sigma", t.score_radius_sigma,
+                  "Between sets of equally many cameras, each camera's score counts weighted by "
+                  "how well its ball's radius fits the point (this spread of the log ratio; 0: "
+                  "scores alone)")
+      ->check(FiniteRange(0.0, 10.0))
+      ->capture_default_str();
   cmd->add_flag("--ground", t.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
   cmd->add_flag("!--no-weak", t.use_weak,
