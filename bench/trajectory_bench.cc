@@ -5,7 +5,14 @@
 // Long tracks (issue 18): the whole `trajectory` job (read BALL.csv, analyse, predict, write
 // FLIGHTS.json) on 20,000 rows of repeated kicks (the baseline) and on 2,000,000 rows, printed
 // as the time per row against the baseline's (1.0: linear).
+// A flight refined on its detections (the spin model over 4 cameras' reprojections, as `ball`
+// refines each flight): every detection's residual read from one integrated path per evaluation
+// (recon::FlightReprojection), printed as `x_jet`, its speed-up over the baseline in the same
+// process, a Jet<10> Runge-Kutta integration from the reference time per detection.
 #include <benchmark/benchmark.h>
+
+#include <ceres/ceres.h>
+#include <ctime>
 
 #include <algorithm>
 #include <cstdio>
@@ -14,9 +21,12 @@
 #include <map>
 #include <sstream>
 
+#include "fieldvision/camera/projection.h"
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/recon/trajectory_io.h"
+#include "fieldvision/recon/trajectory_path.h"
+#include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/random.h"
@@ -71,6 +81,142 @@ void BM_FitSpin(benchmark::State& state) { Fit(state, fv::recon::FlightModel::kS
 BENCHMARK(BM_FitGravity)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitDrag)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FitSpin)->Unit(benchmark::kMillisecond);
+
+// --- A flight refined on 4 cameras' detections ---
+
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+struct Detection {
+  int cam;
+  Eigen::Vector2d uv;
+  double dt_s;
+};
+
+struct FlightScene {
+  std::vector<fv::camera::Camera> cameras;
+  std::vector<Detection> detections;
+};
+
+// A 1 s kick with backspin at 60 Hz seen by four corner cameras, centres with 0.3 px noise.
+const FlightScene& KickScene() {
+  static const FlightScene scene = [] {
+    FlightScene f;
+    const Eigen::Vector3d eyes[4] = {{-12, -9, 5}, {12, -9, 5}, {12, 9, 5}, {-12, 9, 5}};
+    for (const auto& eye : eyes) {
+      fv::camera::Camera c = fv::camera::Camera::FromFov(1280, 960, 70);
+      c.cam_from_world = fv::geometry::Rigid3d::LookAt(eye, {0, 0, 1});
+      c.has_pose = true;
+      f.cameras.push_back(c);
+    }
+    fv::util::Rng rng(7);
+    const double p0[3] = {-6, -2, 0.11}, v0[3] = {14, 4, 7}, k = 0.012, s[3] = {0.5, -1.7, 0};
+    for (int i = 0; i < 60; ++i) {
+      const double t = i / 60.0;
+      double p[3];
+      fv::recon::FlightPositionAt(p0, v0, k, s, 9.81, t, true, p);
+      for (int c = 0; c < 4; ++c) {
+        const auto uv = f.cameras[c].Project(Eigen::Vector3d(p[0], p[1], p[2]));
+        if (!uv) continue;
+        f.detections.push_back(
+            {c, *uv + Eigen::Vector2d(rng.Normal(0, 0.3), rng.Normal(0, 0.3)), t - 0.5});
+      }
+    }
+    return f;
+  }();
+  return scene;
+}
+
+// The baseline: one Jet integration from the reference time per detection.
+struct JetReprojection {
+  JetReprojection(const fv::camera::Camera& cam, const Eigen::Vector2d& uv, double dt)
+      : uv_(uv), dt_(dt) {
+    const auto block = cam.IntrinsicsBlock();
+    std::copy(block.begin(), block.end(), intr_);
+    const Eigen::Vector3d r = cam.cam_from_world.Rvec();
+    for (int i = 0; i < 3; ++i) rv_[i] = r[i], tv_[i] = cam.cam_from_world.translation[i];
+  }
+  template <typename T>
+  bool operator()(const T* p0, const T* v0, const T* k, const T* s, T* r) const {
+    T p[3], intr[fv::camera::kNumIntrinsics], rv[3], tv[3], uv[2];
+    fv::recon::FlightPositionAt(p0, v0, k[0], s, 9.81, dt_, true, p);
+    for (int i = 0; i < fv::camera::kNumIntrinsics; ++i) intr[i] = T(intr_[i]);
+    for (int i = 0; i < 3; ++i) rv[i] = T(rv_[i]), tv[i] = T(tv_[i]);
+    if (!fv::camera::ProjectWorldPoint(intr, rv, tv, p, uv)) return false;
+    r[0] = (uv[0] - uv_.x()) / 0.3;
+    r[1] = (uv[1] - uv_.y()) / 0.3;
+    return true;
+  }
+  Eigen::Vector2d uv_;
+  double dt_;
+  double intr_[fv::camera::kNumIntrinsics], rv_[3], tv_[3];
+};
+
+// Fits the spin model from a start 0.3 m and 1 m/s off; returns the position error at the
+// reference time (m).
+double RefineFlight(bool shared_path) {
+  const FlightScene& f = KickScene();
+  double p0[3] = {-6.3, -1.8, 0.4}, v0[3] = {13, 5, 6.5}, k[1] = {0.01}, s[3] = {0, 0, 0};
+  std::vector<double> dt;
+  for (const Detection& d : f.detections) dt.push_back(d.dt_s);
+  fv::recon::FlightPath path(dt, 9.81);
+  ceres::Problem problem;
+  for (size_t i = 0; i < f.detections.size(); ++i) {
+    const Detection& d = f.detections[i];
+    ceres::CostFunction* cost =
+        shared_path ? static_cast<ceres::CostFunction*>(new fv::recon::FlightReprojection(
+                          &path, static_cast<int>(i), d.dt_s, 9.81, f.cameras[d.cam], d.uv, 0.3))
+                    : new ceres::AutoDiffCostFunction<JetReprojection, 2, 3, 3, 1, 3>(
+                          new JetReprojection(f.cameras[d.cam], d.uv, d.dt_s));
+    problem.AddResidualBlock(cost, new ceres::HuberLoss(2.0), p0, v0, k, s);
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = 50;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  // The truth at the reference time (0.5 s into the kick).
+  const double p_true[3] = {-6, -2, 0.11}, v_true[3] = {14, 4, 7}, s_true[3] = {0.5, -1.7, 0};
+  double p_ref[3];
+  fv::recon::FlightPositionAt(p_true, v_true, 0.012, s_true, 9.81, 0.5, true, p_ref);
+  return std::hypot(p0[0] - p_ref[0], p0[1] - p_ref[1], p0[2] - p_ref[2]);
+}
+
+// Seconds (thread CPU) of the baseline's fit, median of 5, measured once.
+double JetFitSeconds() {
+  static const double seconds = [] {
+    std::vector<double> t;
+    for (int i = 0; i < 5; ++i) {
+      const double t0 = ThreadCpuSeconds();
+      benchmark::DoNotOptimize(RefineFlight(false));
+      t.push_back(ThreadCpuSeconds() - t0);
+    }
+    std::nth_element(t.begin(), t.begin() + 2, t.end());
+    return t[2];
+  }();
+  return seconds;
+}
+
+void BM_RefineFlightOnDetections(benchmark::State& state) {
+  const bool shared = state.range(0) == 1;
+  JetFitSeconds();
+  double cpu = 0;
+  for (auto _ : state) {
+    const double t0 = ThreadCpuSeconds();
+    benchmark::DoNotOptimize(RefineFlight(shared));
+    cpu += ThreadCpuSeconds() - t0;
+  }
+  const double per_fit = cpu / std::max<int64_t>(state.iterations(), 1);
+  state.counters["p_err_mm"] = 1e3 * RefineFlight(shared);
+  state.counters["detections"] = static_cast<double>(KickScene().detections.size());
+  state.counters["x_jet"] = JetFitSeconds() / per_fit;
+  state.SetLabel(shared ? "one path per evaluation" : "baseline: a Jet integration per detection");
+}
+BENCHMARK(BM_RefineFlightOnDetections)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // A BALL.csv of `rows` rows at 100 Hz: eight random kicks with bounces, rolling and rest
 // (5 mm noise, 1 % outliers), one after the other, each from where the one before stopped.
