@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -112,8 +113,8 @@ void FlightPath::Update(const double* const* params, Need level) {
   for (int b = 0; b < 4; ++b) {
     std::memcpy(key + kBlockStart[b], params[b], sizeof(double) * kBlockSize[b]);
   }
-  if (valid_ && std::memcmp(key, key_, sizeof(key)) == 0 && level_ >= level) return;
-  std::memcpy(key_, key, sizeof(key));
+  if (valid_ && std::equal(key, key + kParams, key_) && level_ >= level) return;
+  std::copy(key, key + kParams, key_);
   switch (level) {
     case Need::kValues:
       Integrate<0>(params);
@@ -137,7 +138,7 @@ void FlightPath::Integrate(const double* const* params) {
   // each from the state at the sample before; in steps of at most kMaxStepS (PropagateFlight's).
   for (const bool ahead : {true, false}) {
     double p[3], v[3];
-    constexpr int kLanes = L > 0 ? L : 4;  // (unused without lanes)
+    constexpr int kLanes = std::max(L, 4);  // (unused without lanes)
     double dp[3][kLanes] = {}, dv[3][kLanes] = {};
     for (int j = 0; j < 3; ++j) {
       p[j] = params[0][j];
@@ -225,7 +226,7 @@ bool FlightResiduals::Evaluate(const double* const* parameters, double* residual
     }
     for (int b = 0; b < 4; ++b) {
       if (jacobians[b] == nullptr) continue;
-      double* rows = jacobians[b] + 3 * i * kBlockSize[b];
+      double* rows = jacobians[b] + ptrdiff_t{3} * i * kBlockSize[b];
       for (int j = 0; j < 3; ++j) {
         for (int c = 0; c < kBlockSize[b]; ++c) {
           rows[j * kBlockSize[b] + c] = scale * d(j, kBlockStart[b] + c);
@@ -233,10 +234,12 @@ bool FlightResiduals::Evaluate(const double* const* parameters, double* residual
       }
     }
   }
-  residuals[3 * n] = std::sqrt(rest2);
+  residuals[ptrdiff_t{3} * n] = std::sqrt(rest2);
   for (int b = 0; derivatives && b < 4; ++b) {
     if (jacobians[b] == nullptr) continue;
-    for (int c = 0; c < kBlockSize[b]; ++c) jacobians[b][3 * n * kBlockSize[b] + c] = 0.0;
+    for (int c = 0; c < kBlockSize[b]; ++c) {
+      jacobians[b][ptrdiff_t{3} * n * kBlockSize[b] + c] = 0.0;
+    }
   }
   return true;
 }
