@@ -9,7 +9,6 @@
 
 #include <ceres/jet.h>
 
-#include "fieldvision/camera/projection.h"
 #include "fieldvision/recon/trajectory_physics.h"
 
 namespace fv::recon {
@@ -18,6 +17,30 @@ namespace {
 // The parameter blocks' sizes and their first index in the 10 parameters.
 constexpr int kBlockSize[4] = {3, 3, 1, 3};
 constexpr int kBlockStart[4] = {0, 3, 6, 7};
+
+// What the path must carry for the derivatives Ceres asks of a block over (p0, v0, k, s): none,
+// all but those by s (held constant), or all.
+FlightPath::Need NeedFor(double** jacobians) {
+  bool derivatives = false;
+  for (int b = 0; jacobians != nullptr && b < 4; ++b) derivatives |= jacobians[b] != nullptr;
+  if (!derivatives) return FlightPath::Need::kValues;
+  return jacobians[3] == nullptr ? FlightPath::Need::kNoSpin : FlightPath::Need::kAll;
+}
+
+// The drag-free parabola dt after the reference time (FlightPositionAt without integration) and
+// its derivatives by the 10 parameters (p0 and v0 only).
+Eigen::Vector3d ParabolaAt(const double* const* params, double dt, double g,
+                           FlightPath::Jacobian* d) {
+  Eigen::Vector3d p;
+  d->setZero();
+  for (int j = 0; j < 3; ++j) {
+    p[j] = params[0][j] + params[1][j] * dt;
+    (*d)(j, j) = 1.0;
+    (*d)(j, 3 + j) = dt;
+  }
+  p[2] -= 0.5 * g * dt * dt;
+  return p;
+}
 
 // Derivatives are carried only by v0 (lanes 0-2), k (3) and, when asked for, s (4-6): the
 // acceleration does not depend on the position, so d position / d p0 is the identity and
@@ -183,27 +206,16 @@ FlightResiduals::FlightResiduals(FlightPath* path, std::vector<double> dt_s,
 
 bool FlightResiduals::Evaluate(const double* const* parameters, double* residuals,
                                double** jacobians) const {
-  bool derivatives = false;
-  for (int b = 0; jacobians != nullptr && b < 4; ++b) derivatives |= jacobians[b] != nullptr;
-  if (path_ != nullptr) {
-    path_->Update(parameters, !derivatives              ? FlightPath::Need::kValues
-                              : jacobians[3] == nullptr ? FlightPath::Need::kNoSpin
-                                                        : FlightPath::Need::kAll);
-  }
+  const FlightPath::Need need = NeedFor(jacobians);
+  const bool derivatives = need != FlightPath::Need::kValues;
+  if (path_ != nullptr) path_->Update(parameters, need);
   const double b2 = huber_ * huber_;
-  FlightPath::Jacobian d = FlightPath::Jacobian::Zero();  // the parabola's: p0 and v0 only
-  for (int j = 0; j < 3; ++j) d(j, j) = 1.0;
+  FlightPath::Jacobian d;
   const int n = static_cast<int>(x_.size());
   double rest2 = 0.0;  // sum of rho - rho' |r|^2
   for (int i = 0; i < n; ++i) {
-    Eigen::Vector3d p;
-    if (path_ != nullptr) {
-      p = path_->Position(i);
-    } else {
-      // As FlightPositionAt without integration.
-      for (int j = 0; j < 3; ++j) p[j] = parameters[0][j] + parameters[1][j] * dt_[i];
-      p[2] -= 0.5 * g_ * dt_[i] * dt_[i];
-    }
+    const Eigen::Vector3d p =
+        path_ != nullptr ? path_->Position(i) : ParabolaAt(parameters, dt_[i], g_, &d);
     double r[3];
     for (int j = 0; j < 3; ++j) r[j] = p[j] - x_[i][j];
     // ceres::HuberLoss::Evaluate and ceres::internal::Corrector (rho'' <= 0: rows times
@@ -219,11 +231,7 @@ bool FlightResiduals::Evaluate(const double* const* parameters, double* residual
     }
     for (int j = 0; j < 3; ++j) residuals[3 * i + j] = scale * r[j];
     if (!derivatives) continue;
-    if (path_ != nullptr) {
-      d = path_->Derivatives(i);
-    } else {
-      for (int j = 0; j < 3; ++j) d(j, 3 + j) = dt_[i];
-    }
+    if (path_ != nullptr) d = path_->Derivatives(i);
     for (int b = 0; b < 4; ++b) {
       if (jacobians[b] == nullptr) continue;
       double* rows = jacobians[b] + ptrdiff_t{3} * i * kBlockSize[b];
@@ -247,40 +255,32 @@ bool FlightResiduals::Evaluate(const double* const* parameters, double* residual
 FlightReprojection::FlightReprojection(FlightPath* path, int index, double dt_s,
                                        double gravity_mps2, const camera::Camera& camera,
                                        const Eigen::Vector2d& uv_px, double sigma_px)
-    : path_(path), index_(index), dt_(dt_s), g_(gravity_mps2), uv_(uv_px), sigma_(sigma_px) {
-  const auto block = camera.IntrinsicsBlock();
-  std::copy(block.begin(), block.end(), intrinsics_);
-  const Eigen::Vector3d r = camera.cam_from_world.Rvec();
-  for (int i = 0; i < 3; ++i) rvec_[i] = r[i], tvec_[i] = camera.cam_from_world.translation[i];
-}
+    : path_(path),
+      index_(index),
+      dt_(dt_s),
+      g_(gravity_mps2),
+      camera_(camera),
+      uv_(uv_px),
+      sigma_(sigma_px) {}
 
 bool FlightReprojection::Evaluate(const double* const* parameters, double* residuals,
                                   double** jacobians) const {
-  bool derivatives = false;
-  for (int b = 0; jacobians != nullptr && b < 4; ++b) derivatives |= jacobians[b] != nullptr;
-  FlightPath::Jacobian d = FlightPath::Jacobian::Zero();  // d position / d parameters
+  const FlightPath::Need need = NeedFor(jacobians);
+  const bool derivatives = need != FlightPath::Need::kValues;
+  FlightPath::Jacobian d;  // d position / d parameters
   Eigen::Vector3d p;
   if (path_ != nullptr) {
-    path_->Update(parameters, !derivatives              ? FlightPath::Need::kValues
-                              : jacobians[3] == nullptr ? FlightPath::Need::kNoSpin
-                                                        : FlightPath::Need::kAll);
+    path_->Update(parameters, need);
     p = path_->Position(index_);
     if (derivatives) d = path_->Derivatives(index_);
   } else {
-    // As FlightPositionAt without integration.
-    for (int j = 0; j < 3; ++j) {
-      p[j] = parameters[0][j] + parameters[1][j] * dt_;
-      d(j, j) = 1.0;
-      d(j, 3 + j) = dt_;
-    }
-    p[2] -= 0.5 * g_ * dt_ * dt_;
+    p = ParabolaAt(parameters, dt_, g_, &d);
   }
   // The projection and its derivatives by the position (forward mode over the 3 coordinates).
   using Jet3 = ceres::Jet<double, 3>;
-  Jet3 intr[camera::kNumIntrinsics], rv[3], tv[3], x[3], uv[2];
-  for (int i = 0; i < camera::kNumIntrinsics; ++i) intr[i] = Jet3(intrinsics_[i]);
-  for (int i = 0; i < 3; ++i) rv[i] = Jet3(rvec_[i]), tv[i] = Jet3(tvec_[i]), x[i] = Jet3(p[i], i);
-  if (!camera::ProjectWorldPoint(intr, rv, tv, x, uv)) return false;
+  const Jet3 x[3] = {Jet3(p[0], 0), Jet3(p[1], 1), Jet3(p[2], 2)};
+  Jet3 uv[2];
+  if (!detail::PredictCentre(camera_, 0.0, x, uv)) return false;
   residuals[0] = (uv[0].a - uv_.x()) / sigma_;
   residuals[1] = (uv[1].a - uv_.y()) / sigma_;
   if (!derivatives) return true;

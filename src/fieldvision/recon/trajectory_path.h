@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "fieldvision/camera/camera.h"
+#include "fieldvision/recon/triangulation_internal.h"
 
 namespace fv::recon {
 
@@ -91,8 +92,7 @@ class FlightReprojection : public ceres::SizedCostFunction<2, 3, 3, 1, 3> {
   FlightPath* path_;
   int index_;
   double dt_, g_;
-  double intrinsics_[camera::kNumIntrinsics];
-  double rvec_[3], tvec_[3];
+  detail::CameraBlock camera_;
   Eigen::Vector2d uv_;
   double sigma_;
 };
