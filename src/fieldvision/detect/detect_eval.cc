@@ -400,7 +400,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
   }
   std::optional<field::FieldModel> field;
-  if (!o.field.empty()) field = field::LoadField(o.field);
+  if (!o.field.empty()) {
+    FV_REQUIRE(camera->has_pose, "eval detect: --field needs a camera with a pose ('{}' has none)",
+               o.camera);
+    field = field::LoadField(o.field);
+  }
   const AnyBallDetector detector(o.detector, o.dnn, camera.get(), field ? &*field : nullptr);
 
   DetectEvalResult result;

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
@@ -140,6 +141,22 @@ TEST(DetectEval, FieldNeedsACamera) {
   }
   o.camera = "cam.yaml";
   EXPECT_NO_THROW(o.Check());
+  // A camera without a pose: an error naming it, not a field silently ignored.
+  const std::string dir = fv::testing::TempDir() + "/detect_eval_field";
+  fs::create_directories(dir);
+  util::Rng rng(2);
+  cv::imwrite(dir + "/a.png", test_util::FieldImage(64, 48, rng));
+  WriteText(dir + "/a.txt", "0 0.5 0.5 0.2 0.2\n");
+  camera::WriteCameraYaml(camera::Camera::FromFov(64, 48, 60), dir + "/unposed.yaml");
+  o.video = dir;
+  o.camera = dir + "/unposed.yaml";
+  o.progress = false;
+  try {
+    EvaluateDetector(o);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unposed.yaml' has none"), std::string::npos) << e.what();
+  }
 }
 
 // The real RoboCup photos (shared/data/robocup-ball-photos): a floor under today's measured
