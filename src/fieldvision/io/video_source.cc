@@ -94,6 +94,10 @@ bool IsImageFile(const std::string& path) {
 
 std::vector<std::string> ListImageSequence(const std::string& spec) {
   std::vector<std::string> files;
+  if (fs::is_regular_file(spec)) {
+    if (IsImageFile(spec)) files.push_back(spec);  // one image: a sequence of one
+    return files;
+  }
   if (spec.find('%') != std::string::npos) {
     // printf pattern with one integer field (%d, %5d, %05d): frames from 0 (or 1) upwards until
     // the first missing number.

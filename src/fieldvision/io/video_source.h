@@ -63,7 +63,8 @@ class VideoSource {
   int next_index_ = 0;
 };
 
-// The image files an image-sequence spec names, in order (empty if it is not one).
+// The image files an image-sequence spec names, in order (empty if it is not one); an existing
+// image file (by its extension) is a sequence of one.
 std::vector<std::string> ListImageSequence(const std::string& spec);
 // At the end of a video file: throws fv::Error naming it when fewer frames were read than its
 // header announces (a truncated or damaged stream; 0 or less: not announced, nothing checked).

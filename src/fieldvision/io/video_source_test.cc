@@ -59,6 +59,24 @@ TEST(VideoSource, MjpgFileFramesAndTimes) {
   EXPECT_EQ(n, 7);
 }
 
+// One image file is a sequence of one, decoded as a folder's images are (libjpeg for a JPEG, not
+// FFmpeg, whose chroma upsampling differs): `detect` on one photo sees eval detect's pixels.
+TEST(VideoSource, OneJpegImageGivesImreadsPixels) {
+  const std::string path = testing::TempDir() + "/one.jpg";
+  cv::Mat bgr(48, 64, CV_8UC3);
+  cv::RNG rng(7);
+  rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);  // chroma that changes from pixel to pixel
+  ASSERT_TRUE(cv::imwrite(path, bgr));
+  const cv::Mat expected = cv::imread(path, cv::IMREAD_COLOR);
+  auto src = VideoSource::Open(path);
+  EXPECT_EQ(src->frame_count(), 1);
+  Frame f;
+  ASSERT_TRUE(src->Read(f));
+  ASSERT_EQ(f.bgr.size(), expected.size());
+  EXPECT_EQ(cv::norm(f.bgr, expected, cv::NORM_INF), 0.0);
+  EXPECT_FALSE(src->Read(f));
+}
+
 TEST(VideoSource, TruncatedVideoFailsAtItsEndNamingTheFrames) {
   const std::string path = test_util::WriteTruncatedMjpg(testing::TempDir() + "/cut.avi", 0.5);
   auto src = VideoSource::Open(path);
