@@ -445,7 +445,21 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   }
   RejectDarkerThanField(bgr, roi, &result.candidates);
   RankAndDropDuplicates(&result.candidates);
+  OnFieldFirst(bgr, roi, &boundary, &result.candidates);
   return result;
+}
+
+void BallDetector::OnFieldFirst(const cv::Mat& bgr, const cv::Rect& roi,
+                                std::optional<FieldBoundary>* boundary,
+                                std::vector<BallCandidate>* candidates) const {
+  if (posed() || options_.off_field_min_score <= 0) return;
+  const auto accepted_end = std::find_if(candidates->begin(), candidates->end(),
+                                         [](const BallCandidate& c) { return !c.accepted; });
+  if (accepted_end - candidates->begin() < 2) return;
+  if (!boundary->has_value()) *boundary = OffFieldBoundary(bgr, roi);
+  std::stable_partition(candidates->begin(), accepted_end, [&](const BallCandidate& c) {
+    return !(*boundary)->DiscAbove(c.centre_px.x(), c.centre_px.y(), c.radius_px);
+  });
 }
 
 FieldBoundary BallDetector::OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region) const {

@@ -284,6 +284,10 @@ class BallDetector {
   void RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
                       std::optional<FieldBoundary>* boundary,
                       std::vector<BallCandidate>* candidates) const;
+  // Among the accepted candidates (ranked), those above the field's far edge go after those on
+  // the field (without a posed camera).
+  void OnFieldFirst(const cv::Mat& bgr, const cv::Rect& roi, std::optional<FieldBoundary>* boundary,
+                    std::vector<BallCandidate>* candidates) const;
   // Rejects the accepted candidates darker than the field (min_lit_field_ratio).
   void RejectDarkerThanField(const cv::Mat& bgr, const cv::Rect& roi,
                              std::vector<BallCandidate>* candidates) const;

@@ -153,5 +153,36 @@ TEST(FieldBoundary, TheDetectorRejectsADiscAboveTheFieldBelowTheScore) {
   EXPECT_THROW(o.Check(), Error);
 }
 
+// Two accepted discs without a posed camera: the one on the field ranks first, even where the
+// one above the field's edge (a lamp, a logo, a whole disc) scores higher.
+TEST(FieldBoundary, AnAcceptedDiscOnTheFieldRanksBeforeOneAboveIt) {
+  const uint64_t seed = fv::testing::TestSeed(65);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const Eigen::Vector2d above(rng.Uniform(450, 560), rng.Uniform(60, 120));
+  const Eigen::Vector2d on(rng.Uniform(450, 560), rng.Uniform(300, 360));
+  cv::Mat img = SideView(200, rng);
+  test_util::PaintDisc(img, above, 14);
+  test_util::PaintDisc(img, on, 9);
+  // The disc on the field half hidden by a robot: a lower score than the whole one above.
+  cv::rectangle(img, cv::Rect(static_cast<int>(on.x()) - 20, static_cast<int>(on.y()) + 2, 40, 20),
+                cv::Scalar(25, 25, 25), cv::FILLED);
+  BallDetectorOptions o;
+  const BallDetector detector(o, nullptr, nullptr);
+  const std::vector<BallCandidate> ranked = detector.Detect(img);
+  const BallCandidate* above_c = nullptr;
+  for (const BallCandidate& c : ranked) {
+    if ((c.centre_px - above).norm() < 2) above_c = &c;
+  }
+  ASSERT_NE(above_c, nullptr);
+  ASSERT_TRUE(above_c->accepted) << above_c->reason;
+  ASSERT_FALSE(ranked.empty());
+  EXPECT_TRUE(ranked.front().accepted);
+  EXPECT_LT((ranked.front().centre_px - on).norm(), 3.0)
+      << "first " << ranked.front().centre_px.transpose() << " score " << ranked.front().score
+      << "; above-field disc score " << above_c->score;
+  EXPECT_LT(ranked.front().score, above_c->score);  // the order is not the scores'
+}
+
 }  // namespace
 }  // namespace fv::detect
