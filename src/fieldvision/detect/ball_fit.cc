@@ -112,6 +112,7 @@ struct Edges {
   std::vector<double> ramp_px;  // width of a motion-blur ramp at each point (0: sharp edge)
   int outside_ball = 0;         // rays whose outside is ball-coloured too
   int rays = 0;
+  int clipped = 0;  // rays whose search leaves the image (SubpixelEdges)
 };
 
 // Rough outline: along each ray, where the colour class stops being the ball. A gap shorter than
@@ -277,7 +278,10 @@ Edges SubpixelEdges(const cv::Mat& img, const ColourTable& table, uint8_t bit,
     // The profile lies inside the image when both its ends do (Sampler::Inside); it is sampled
     // where it is read.
     const Vector2d p_first = c + t0 * u, p_last = c + (t0 + (m - 1) * kStep) * u;
-    if (!InsideForSampling(img, p_first) || !InsideForSampling(img, p_last)) continue;
+    if (!InsideForSampling(img, p_first) || !InsideForSampling(img, p_last)) {
+      ++e.clipped;
+      continue;
+    }
     prof.resize(m);
     have.assign(m, 0);
     const auto at = [&](int i) -> const Vector3d& {
@@ -999,7 +1003,10 @@ BallFit FitBall(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
   fit.radius_px = s.radius;
   fit.rms_px = rms;
   fit.inliers = count;
-  fit.inlier_fraction = fit.rays > 0 ? double(count) / fit.rays : 0.0;
+  // A ball cut by the image's border is judged on the rays that stay inside the image (at least
+  // half of them: less outline is too little to call round).
+  const int judged = std::max(fit.rays - s.edges.clipped, (fit.rays + 1) / 2);
+  fit.inlier_fraction = judged > 0 ? double(count) / judged : 0.0;
   fit.sigma_px = CentreSigma(s.edges.points, s.inl, s.centre, rms);
   if (fit.blurred) fit.sigma_px = std::hypot(fit.sigma_px, 0.05 * fit.blur_length_px);
   fit.edge_points = std::move(s.edges.points);

@@ -73,7 +73,7 @@ struct BallFit {
   int rays = 0;
   int edges = 0;                 // rays with an outline point
   int inliers = 0;               // outline points on the fit
-  double inlier_fraction = 0.0;  // inliers / rays
+  double inlier_fraction = 0.0;  // inliers / rays inside the image (at least half the rays)
   // Rays where the colour goes on beyond the fit (outline outside it, or ball-coloured outside):
   // high for shapes that are not discs (a cone's apex), low for occluded balls.
   double outside_fraction = 0.0;

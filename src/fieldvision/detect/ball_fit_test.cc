@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
@@ -169,6 +170,34 @@ TEST(FitBall, PartlyOccludedBallFitsTheFreeOutline) {
     err.push_back((fit.centre_px - c).norm());
     EXPECT_LT(fit.inlier_fraction, 0.85) << fit.Summary();
     EXPECT_GT(fit.sigma_px, 0.0);
+  }
+  EXPECT_LT(Median(err), 0.3);
+}
+
+// A ball cut by the image's left border: its outline inside the image is all on the circle, so
+// it is judged round (an occluder, above, still counts against it), and the detector accepts it.
+TEST(FitBall, ABallCutByTheImageBorderIsJudgedOnItsOutlineInside) {
+  const uint64_t seed = fv::testing::TestSeed(9);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const ColourTable table(PresetColourSpec("orange"));
+  const BallDetector detector(BallDetectorOptions{}, nullptr, nullptr);
+  std::vector<double> err;
+  for (int i = 0; i < 12; ++i) {
+    cv::Mat img = test_util::FieldImage(120, 120, rng);
+    const double r = rng.Uniform(8, 18);
+    // 10..30 % of the radius beyond the border.
+    const Eigen::Vector2d c(r * rng.Uniform(0.7, 0.9), rng.Uniform(40, 80));
+    test_util::PaintDisc(img, c, r);
+    const BallFit fit =
+        FitBall(img, table, table.BallBit(), c + Eigen::Vector2d(0.2 * r, 0), 0.9 * r, nullptr);
+    ASSERT_TRUE(fit.ok) << fit.failure;
+    err.push_back((fit.centre_px - c).norm());
+    EXPECT_GE(fit.inlier_fraction, 0.85) << fit.Summary();
+    const std::vector<BallCandidate> cands = detector.Detect(img);
+    ASSERT_FALSE(cands.empty());
+    EXPECT_TRUE(cands.front().accepted) << cands.front().reason << " r " << r;
+    EXPECT_LT((cands.front().centre_px - c).norm(), 1.0);
   }
   EXPECT_LT(Median(err), 0.3);
 }
