@@ -39,8 +39,9 @@ TEST(FitCircle, IgnoresOutliers) {
   ASSERT_TRUE(FitCircle(pts, 1.0, &centre, &radius, &inlier));
   EXPECT_LT((centre - c).norm(), 0.05);
   EXPECT_NEAR(radius, r, 0.05);
-  for (int i = 0; i < 60; ++i)
+  for (int i = 0; i < 60; ++i) {
     EXPECT_EQ(inlier[i] != 0, i % 3 != 0 || (pts[i] - c).norm() > r - 1.0);
+  }
 }
 
 // Points off a circle only inwards (a print's line, the terminator) within the symmetric band:

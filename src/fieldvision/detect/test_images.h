@@ -98,8 +98,8 @@ inline void PaintDisc(cv::Mat& img, const Eigen::Vector2d& c, double r, cv::Vec3
 inline Eigen::Vector2d PaintSphere(cv::Mat& img, const camera::Camera& cam,
                                    const Eigen::Vector3d& centre, double radius,
                                    cv::Vec3b colour = kOrange) {
-  const Eigen::Vector2d uv(cam.fx * centre.x() / centre.z() + cam.cx,
-                           cam.fy * centre.y() / centre.z() + cam.cy);
+  Eigen::Vector2d uv(cam.fx * centre.x() / centre.z() + cam.cx,
+                     cam.fy * centre.y() / centre.z() + cam.cy);
   const double approx_r = cam.fx * radius / centre.norm() * 3.0 + 3;
   const int ss = 6;
   const int x0 = std::max(0, int(uv.x() - approx_r)),
@@ -122,8 +122,9 @@ inline Eigen::Vector2d PaintSphere(cv::Mat& img, const camera::Camera& cam,
       if (inside == 0) continue;
       const double cov = double(inside) / (ss * ss);
       cv::Vec3b& p = img.at<cv::Vec3b>(y, x);
-      for (int k = 0; k < 3; ++k)
+      for (int k = 0; k < 3; ++k) {
         p[k] = cv::saturate_cast<uint8_t>(cov * colour[k] + (1 - cov) * p[k]);
+      }
     }
   }
   return uv;

@@ -22,7 +22,7 @@ cv::Mat NumberedFrame(int i, int w = 64, int h = 48) {
 TEST(VideoSource, ImagePatternGlobAndFolderInOrder) {
   const std::string dir = testing::TempDir();
   for (int i = 0; i < 5; ++i) cv::imwrite(fmt::format("{}/{:05d}.png", dir, i), NumberedFrame(i));
-  for (const std::string spec : {dir + "/%05d.png", dir + "/*.png", dir}) {
+  for (const std::string& spec : {dir + "/%05d.png", dir + "/*.png", dir}) {
     SCOPED_TRACE(spec);
     auto src = VideoSource::Open(spec, {.fps = 25.0});
     EXPECT_EQ(src->frame_count(), 5);
@@ -98,7 +98,7 @@ TEST(VideoSource, FileNamesWithPatternCharactersAreFiles) {
   const std::string dir = testing::TempDir();
   for (const std::string name : {"100%.avi", "a*b.avi", "c?.avi"}) {
     SCOPED_TRACE(name);
-    const std::string path = dir + "/" + name;
+    const std::string path = fmt::format("{}/{}", dir, name);
     {
       cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(64, 48));
       ASSERT_TRUE(w.isOpened());
