@@ -155,10 +155,10 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
   std::unique_ptr<FrameSource> file;
   const bool regular = std::filesystem::is_regular_file(spec);
   const bool list =
-      (regular && IsImageFile(spec)) ||
-      (!regular &&
-       (spec.find_first_of("*?") != std::string::npos || std::filesystem::is_directory(spec) ||
-        (spec.find('%') != std::string::npos && !ListImageSequence(spec).empty())));
+      regular
+          ? IsImageFile(spec)
+          : spec.find_first_of("*?") != std::string::npos || std::filesystem::is_directory(spec) ||
+                (spec.find('%') != std::string::npos && !ListImageSequence(spec).empty());
   file = list ? backend::OpenImageList(spec, options) : backend::OpenFile(spec, options);
   if (options.realtime) return backend::Paced(std::move(file), options);
   return file;
