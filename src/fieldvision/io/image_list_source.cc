@@ -35,6 +35,8 @@ class ImageListSource : public FrameSource {
       csv_ = o.timestamps_csv;
     }
     const cv::Mat first = cv::imread(files_.front(), cv::IMREAD_COLOR);
+    FV_REQUIRE(!first.empty() || files_.front() != spec,
+               "image '{}' cannot be read (damaged or not an image)", spec);
     FV_REQUIRE(!first.empty(), "image sequence '{}': cannot read its first image '{}'", spec,
                files_.front());
     size_ = first.size();

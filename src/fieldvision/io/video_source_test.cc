@@ -127,6 +127,8 @@ TEST(VideoSource, BadInputsNameTheInput) {
   std::ofstream(dir + "/corrupt.avi") << "this is not a video at all";
   expect_error(dir + "/corrupt.avi", "corrupt.avi");
   expect_error(dir + "/none_%05d.png", "none_%05d.png");
+  std::ofstream(dir + "/broken.jpg") << "not a JPEG";
+  expect_error(dir + "/broken.jpg", "image '" + dir + "/broken.jpg' cannot be read");
   // A sequence whose later frame is unreadable fails at that frame, naming it.
   cv::imwrite(dir + "/s_00000.png", NumberedFrame(0));
   std::ofstream(dir + "/s_00001.png") << "broken";
