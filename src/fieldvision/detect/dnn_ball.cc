@@ -12,6 +12,7 @@ namespace fv::detect {
 namespace {
 
 constexpr double kPadGrey = 114.0;  // fill beyond the image in a crop (the usual letterbox grey)
+constexpr double kLowestCropScore = 0.01;  // network boxes read in a crop when scores are averaged
 
 int RoundUp32(double v) { return std::max(32, static_cast<int>(std::ceil(v / 32.0)) * 32); }
 
@@ -45,6 +46,7 @@ void DnnBallOptions::Check() const {
   CheckInRange(complete_score, 0.0, 1.0, "dnn complete_score");
   CheckInRange(confirm_score, 0.0, 1.0, "dnn confirm_score");
   CheckInRange(keep_score, 0.0, 1.0, "dnn keep_score");
+  CheckPositive(spot_min_contrast, "dnn spot_min_contrast");
   CheckInRange(nms_iou, 0.0, 1.0, "dnn nms_iou");
   CheckInRange(crop_radii, 1.0, 20.0, "dnn crop_radii");
   FV_REQUIRE(min_crop_px >= 8, "dnn min_crop_px must be >= 8 (got {})", min_crop_px);
@@ -173,6 +175,24 @@ std::vector<BallCandidate> DnnBallDetector::Detect(const cv::Mat& bgr, const cv:
   return out;
 }
 
+double DnnBallDetector::SquareScore(const cv::Mat& square, const Eigen::Vector2d& centre_px,
+                                    double radius_px) const {
+  const DnnBallOptions& o = options_;
+  std::vector<dnn::DnnBox> boxes;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    // Mirrored crops are averaged: a score under the confirm score still counts there.
+    const double lowest = std::min(o.score_threshold, o.confirm_score);
+    boxes = net_->Detect(square, cv::Size(o.crop_px, o.crop_px),
+                         o.mirror_crops ? kLowestCropScore : lowest, {dnn::kCocoSportsBall});
+  }
+  double best = 0.0;
+  for (const dnn::DnnBox& b : boxes) {
+    if (Confirms(centre_px, radius_px, b.box, o.box_size_ratio)) best = std::max(best, b.score);
+  }
+  return best;
+}
+
 std::vector<double> DnnBallDetector::CropScores(const cv::Mat& bgr,
                                                 const std::vector<BallCandidate>& candidates,
                                                 const cv::Rect& roi) const {
@@ -204,17 +224,14 @@ std::vector<double> DnnBallDetector::CropScores(const cv::Mat& bgr,
     cv::Mat square(side, side, CV_8UC3, cv::Scalar::all(kPadGrey));
     bgr(inside).copyTo(square(inside - crop.tl()));
     ++crops;
-    std::vector<dnn::DnnBox> boxes;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      boxes = net_->Detect(square, cv::Size(o.crop_px, o.crop_px),
-                           std::min(o.score_threshold, o.confirm_score), {dnn::kCocoSportsBall});
-    }
     const Eigen::Vector2d centre = c.centre_px - Eigen::Vector2d(crop.x, crop.y);
-    for (const dnn::DnnBox& b : boxes) {
-      if (Confirms(centre, c.radius_px, b.box, o.box_size_ratio)) {
-        scores[i] = std::max(scores[i], b.score);
-      }
+    scores[i] = SquareScore(square, centre, c.radius_px);
+    if (o.mirror_crops) {
+      cv::Mat mirrored;
+      cv::flip(square, mirrored, 1);
+      const double m =
+          SquareScore(mirrored, Eigen::Vector2d(side - centre.x(), centre.y()), c.radius_px);
+      scores[i] = 0.5 * (scores[i] + m);
     }
   }
   return scores;
@@ -224,7 +241,11 @@ AnyBallDetector::AnyBallDetector(const BallDetectorOptions& colour, const DnnBal
                                  const camera::Camera* camera, const field::FieldModel* field)
     : dnn_options_(dnn) {
   dnn_options_.Check();
-  colour_ = std::make_unique<BallDetector>(colour, camera, field);
+  BallDetectorOptions colour_options = colour;
+  if (dnn_options_.detector == "both") {
+    colour_options.small.min_contrast = dnn_options_.spot_min_contrast;
+  }
+  colour_ = std::make_unique<BallDetector>(colour_options, camera, field);
   if (dnn_options_.uses_dnn()) dnn_ = std::make_unique<DnnBallDetector>(dnn_options_);
 }
 

@@ -1,5 +1,6 @@
 #include "fieldvision/detect/dnn_ball.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -129,8 +130,9 @@ class DnnBallOnPhotos : public ::testing::Test {
       GTEST_SKIP() << "NanoDet model not set up (make build): " << e.what();
     }
     dir_ = fv::testing::SharedDataDir();
-    if (dir_.empty() || !std::filesystem::is_directory(dir_ + "/robocup-ball-photos/msl-yellow"))
+    if (dir_.empty() || !std::filesystem::is_directory(dir_ + "/robocup-ball-photos/msl-yellow")) {
       GTEST_SKIP() << "shared RoboCup photos absent";
+    }
     dir_ += "/robocup-ball-photos/msl-yellow/20190606-r2";
   }
   std::string dir_;
@@ -156,12 +158,75 @@ TEST_F(DnnBallOnPhotos, WindowSearchReadsOnlyTheWindow) {
   cv::Mat mask(img.size(), CV_8U, cv::Scalar(255));
   mask(roi).setTo(0);
   outside.copyTo(noisy, mask);
-  const std::vector<BallCandidate> probe = {Cand(roi.x + 5, roi.y + 5, 30, 0.5, true),
-                                            Cand(roi.x + roi.width / 2, roi.y + 40, 10, 0.5, true)};
+  const std::vector<BallCandidate> probe = {
+      Cand(roi.x + 5, roi.y + 5, 30, 0.5, true),
+      Cand(roi.x + 0.5 * roi.width, roi.y + 40, 10, 0.5, true)};
   EXPECT_EQ(det.CropScores(img, probe, roi), det.CropScores(noisy, probe, roi));
   const auto a = det.Detect(img, roi), b = det.Detect(noisy, roi);
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].centre_px, b[i].centre_px);
+}
+
+// Crops are scored as they are and mirrored (DnnBallOptions::mirror_crops): a frame and its
+// mirror image give each candidate the same score.
+TEST_F(DnnBallOnPhotos, MirroredFrameGivesTheSameCropScores) {
+  const std::string name = dir_ + "/cam0_20190606_204236";
+  const cv::Mat img = cv::imread(name + ".jpg");
+  ASSERT_FALSE(img.empty());
+  const std::vector<cv::Rect2d> boxes = ReadYoloFile(name + ".txt", 0, img.cols, img.rows);
+  ASSERT_FALSE(boxes.empty());
+  const cv::Rect2d& ball = boxes[0];
+  const double r = 0.25 * (ball.width + ball.height);
+  const std::vector<BallCandidate> cands = {
+      Cand(ball.x + 0.5 * ball.width, ball.y + 0.5 * ball.height, r, 0.5, true),
+      Cand(0.3 * img.cols, 0.6 * img.rows, 12, 0.5, true)};
+  std::vector<BallCandidate> mirrored = cands;
+  for (BallCandidate& c : mirrored) c.centre_px.x() = img.cols - c.centre_px.x();
+  cv::Mat flipped;
+  cv::flip(img, flipped, 1);
+  DnnBallOptions o;
+  o.detector = "both";
+  const DnnBallDetector det(o);
+  const std::vector<double> a = det.CropScores(img, cands), b = det.CropScores(flipped, mirrored);
+  EXPECT_GT(a[0], o.confirm_score) << "the labelled ball";
+  EXPECT_DOUBLE_EQ(a[0], b[0]);
+  EXPECT_DOUBLE_EQ(a[1], b[1]);
+}
+
+// "both" proposes small spots of a lower contrast than the colour detector alone takes
+// (DnnBallOptions::spot_min_contrast): a spot a third of the way from a noisy green carpet to
+// orange (contrast about 2.5) is a candidate in "both", none in "colour".
+TEST_F(DnnBallOnPhotos, BothProposesFainterSmallSpots) {
+  const uint64_t seed = fv::testing::TestSeed(1);
+  FV_SEED_TRACE(seed);
+  const cv::Vec3d carpet(60, 140, 60), orange(0, 128, 255);
+  cv::Mat noise(160, 160, CV_64FC3);
+  cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0.0, 12.0);
+  cv::Mat img(160, 160, CV_8UC3);
+  const cv::Point spot(80, 90);
+  for (int y = 0; y < img.rows; ++y) {
+    for (int x = 0; x < img.cols; ++x) {
+      const bool in = std::abs(x - spot.x) <= 1 && std::abs(y - spot.y) <= 1;
+      const cv::Vec3d c = in ? carpet + 0.38 * (orange - carpet) : carpet;
+      img.at<cv::Vec3b>(y, x) =
+          cv::Vec3b(cv::saturate_cast<uint8_t>(c[0] + noise.at<cv::Vec3d>(y, x)[0]),
+                    cv::saturate_cast<uint8_t>(c[1] + noise.at<cv::Vec3d>(y, x)[1]),
+                    cv::saturate_cast<uint8_t>(c[2] + noise.at<cv::Vec3d>(y, x)[2]));
+    }
+  }
+  BallDetectorOptions colour;
+  colour.colour = "orange";
+  const auto near_spot = [&](const std::vector<BallCandidate>& cands) {
+    return std::count_if(cands.begin(), cands.end(), [&](const BallCandidate& c) {
+      return c.small && (c.centre_px - Eigen::Vector2d(spot.x, spot.y)).norm() < 2.0;
+    });
+  };
+  DnnBallOptions o;
+  const AnyBallDetector colour_only(colour, o, nullptr, nullptr);
+  o.detector = "both";
+  const AnyBallDetector both(colour, o, nullptr, nullptr);
+  EXPECT_EQ(near_spot(colour_only.Detect(img)), 0);
+  EXPECT_EQ(near_spot(both.Detect(img)), 1);
 }
 
 // Nine MSL photos of one camera (eight with the ball; measured: colour 3 hits of 7 detections,
