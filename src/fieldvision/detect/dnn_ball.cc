@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/util/error.h"
@@ -241,6 +242,7 @@ AnyBallDetector::AnyBallDetector(const BallDetectorOptions& colour, const DnnBal
                                  const camera::Camera* camera, const field::FieldModel* field)
     : dnn_options_(dnn) {
   dnn_options_.Check();
+  colour_spot_contrast_ = colour.small.min_contrast;
   BallDetectorOptions colour_options = colour;
   if (dnn_options_.detector == "both") {
     colour_options.small.min_contrast = dnn_options_.spot_min_contrast;
@@ -262,6 +264,16 @@ std::vector<BallCandidate> AnyBallDetector::FilterDnn(std::vector<BallCandidate>
   return cands;
 }
 
+void AnyBallDetector::DemoteFaintSpots(std::vector<BallCandidate>* candidates) const {
+  for (BallCandidate& c : *candidates) {
+    if (!c.small || !c.accepted || c.contrast >= colour_spot_contrast_) continue;
+    c.accepted = false;
+    c.disc_shaped = true;  // checked by the network after the accepted ones
+    c.reason = fmt::format("a faint small spot (contrast {:.1f} < {:.1f}) the network must confirm",
+                           c.contrast, colour_spot_contrast_);
+  }
+}
+
 std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
                                                    const cv::Rect& region) const {
   if (dnn_ == nullptr) return colour_->Detect(bgr, region);
@@ -270,6 +282,7 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
   // Here, not in the colour detector: only the network's confirmation reads the mark, and the
   // edge costs a pass over the frame's columns.
   MarkOffField(colour_->OffFieldBoundary(bgr, region), &colour);
+  DemoteFaintSpots(&colour);
   std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
   std::vector<BallCandidate> whole;
   if (dnn_options_.whole_frame) {

@@ -134,7 +134,9 @@ class DnnBallDetector {
 
 // The detector chosen by options.detector: the colour detector, the network, or both combined.
 // In "dnn" mode the colour detector's radius limits and field mask still filter network balls;
-// in "both" its small spots are proposed from DnnBallOptions::spot_min_contrast.
+// in "both" its small spots are proposed from DnnBallOptions::spot_min_contrast, and those under
+// the colour detector's own contrast are accepted only when the network confirms them (not kept
+// by --dnn-keep).
 class AnyBallDetector {
  public:
   // Throws fv::Error for bad options, colour or model.
@@ -151,7 +153,11 @@ class AnyBallDetector {
 
  private:
   std::vector<BallCandidate> FilterDnn(std::vector<BallCandidate> candidates) const;
+  // "both": small spots fainter than the colour detector alone takes (its own
+  // SmallBallOptions::min_contrast) are not colour-accepted, only worth the network's look.
+  void DemoteFaintSpots(std::vector<BallCandidate>* candidates) const;
   DnnBallOptions dnn_options_;
+  double colour_spot_contrast_ = 0.0;
   std::unique_ptr<BallDetector> colour_;
   std::unique_ptr<DnnBallDetector> dnn_;
 };

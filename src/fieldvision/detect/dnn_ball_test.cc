@@ -195,7 +195,8 @@ TEST_F(DnnBallOnPhotos, MirroredFrameGivesTheSameCropScores) {
 
 // "both" proposes small spots of a lower contrast than the colour detector alone takes
 // (DnnBallOptions::spot_min_contrast): a spot a third of the way from a noisy green carpet to
-// orange (contrast about 2.5) is a candidate in "both", none in "colour".
+// orange (contrast about 2.5) is a candidate in "both", none in "colour", and only the network
+// accepts it.
 TEST_F(DnnBallOnPhotos, BothProposesFainterSmallSpots) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
@@ -227,6 +228,14 @@ TEST_F(DnnBallOnPhotos, BothProposesFainterSmallSpots) {
   const AnyBallDetector both(colour, o, nullptr, nullptr);
   EXPECT_EQ(near_spot(colour_only.Detect(img)), 0);
   EXPECT_EQ(near_spot(both.Detect(img)), 1);
+  // Fainter than colour alone takes: accepted only when the network confirms it, also when every
+  // colour-accepted candidate is kept (--dnn-keep).
+  o.demote_unconfirmed = false;
+  const AnyBallDetector keep(colour, o, nullptr, nullptr);
+  for (const BallCandidate& c : keep.Detect(img)) {
+    if (!c.small || (c.centre_px - Eigen::Vector2d(spot.x, spot.y)).norm() >= 2.0) continue;
+    EXPECT_EQ(c.accepted, c.network_score >= o.confirm_score) << c.reason;
+  }
 }
 
 // Nine MSL photos of one camera (eight with the ball; measured: colour 3 hits of 7 detections,
