@@ -52,10 +52,11 @@ struct DnnBallOptions {
   // 0.701 / 0.988 -> 0.709 / 0.988, at about 13 % more time per image.
   bool mirror_crops = true;
   // "both": small spots (small_ball.h) are proposed from this contrast instead of the colour
-  // detector's SmallBallOptions::min_contrast. Their colour score stays below keep_score, so the
-  // network judges each one (confirm_score). Measured on the SSL photos (with mirror_crops; 3 /
-  // 2.5 / 2.25 / 2 / 1.75 / 1.5): recall 0.887 / 0.893 / 0.893 / 0.905 / 0.912 / 0.915 at
-  // precision 0.960 / 0.961 / 0.958 / 0.955 / 0.955 / 0.952; MSL unchanged (its balls are larger).
+  // detector's SmallBallOptions::min_contrast; those under that are not colour-accepted, so the
+  // network judges each one (confirm_score), with demote_unconfirmed off too. Measured on the SSL
+  // photos (with mirror_crops; 3 / 2.5 / 2.25 / 2 / 1.75 / 1.5): recall 0.887 / 0.893 / 0.893 /
+  // 0.905 / 0.912 / 0.915 at precision 0.960 / 0.961 / 0.958 / 0.955 / 0.955 / 0.952; MSL unchanged
+  // (its balls are larger).
   double spot_min_contrast = 2.0;
   // A sports-ball box (crop or whole frame) that holds the candidate's centre and has a half size
   // within [1 / box_size_ratio, box_size_ratio] of its radius confirms it from this score; one
