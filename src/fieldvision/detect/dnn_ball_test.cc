@@ -201,26 +201,21 @@ TEST_F(DnnBallOnPhotos, BothProposesFainterSmallSpots) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
   const cv::Vec3d carpet(60, 140, 60), orange(0, 128, 255);
+  const cv::Vec3d faint = carpet + 0.38 * (orange - carpet);
   cv::Mat noise(160, 160, CV_64FC3);
   cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0.0, 12.0);
-  cv::Mat img(160, 160, CV_8UC3);
+  cv::Mat painted(160, 160, CV_64FC3, cv::Scalar(carpet[0], carpet[1], carpet[2]));
   const cv::Point spot(80, 90);
-  for (int y = 0; y < img.rows; ++y) {
-    for (int x = 0; x < img.cols; ++x) {
-      const bool in = std::abs(x - spot.x) <= 1 && std::abs(y - spot.y) <= 1;
-      const cv::Vec3d c = in ? carpet + 0.38 * (orange - carpet) : carpet;
-      img.at<cv::Vec3b>(y, x) =
-          cv::Vec3b(cv::saturate_cast<uint8_t>(c[0] + noise.at<cv::Vec3d>(y, x)[0]),
-                    cv::saturate_cast<uint8_t>(c[1] + noise.at<cv::Vec3d>(y, x)[1]),
-                    cv::saturate_cast<uint8_t>(c[2] + noise.at<cv::Vec3d>(y, x)[2]));
-    }
-  }
+  painted(cv::Rect(spot.x - 1, spot.y - 1, 3, 3)).setTo(cv::Scalar(faint[0], faint[1], faint[2]));
+  cv::Mat img;
+  cv::Mat(painted + noise).convertTo(img, CV_8UC3);  // rounded and saturated
   BallDetectorOptions colour;
   colour.colour = "orange";
+  const auto at_spot = [&](const BallCandidate& c) {
+    return c.small && (c.centre_px - Eigen::Vector2d(spot.x, spot.y)).norm() < 2.0;
+  };
   const auto near_spot = [&](const std::vector<BallCandidate>& cands) {
-    return std::count_if(cands.begin(), cands.end(), [&](const BallCandidate& c) {
-      return c.small && (c.centre_px - Eigen::Vector2d(spot.x, spot.y)).norm() < 2.0;
-    });
+    return std::count_if(cands.begin(), cands.end(), at_spot);
   };
   DnnBallOptions o;
   const AnyBallDetector colour_only(colour, o, nullptr, nullptr);
@@ -233,7 +228,7 @@ TEST_F(DnnBallOnPhotos, BothProposesFainterSmallSpots) {
   o.demote_unconfirmed = false;
   const AnyBallDetector keep(colour, o, nullptr, nullptr);
   for (const BallCandidate& c : keep.Detect(img)) {
-    if (!c.small || (c.centre_px - Eigen::Vector2d(spot.x, spot.y)).norm() >= 2.0) continue;
+    if (!at_spot(c)) continue;
     EXPECT_EQ(c.accepted, c.network_score >= o.confirm_score) << c.reason;
   }
 }
