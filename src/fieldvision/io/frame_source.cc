@@ -152,14 +152,13 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
   // numbered from 0 or 1 (a file that exists is a file, whatever its name). Other printf
   // patterns: OpenCV's reader. One image is decoded as a folder's are (libjpeg for a JPEG), not
   // by FFmpeg, whose chroma upsampling gives other pixels.
-  std::unique_ptr<FrameSource> file;
-  const bool regular = std::filesystem::is_regular_file(spec);
   const bool list =
-      regular
-          ? IsImageFile(spec)
+      std::filesystem::is_regular_file(spec)
+          ? !ListImageSequence(spec).empty()  // an image file is a sequence of one
           : spec.find_first_of("*?") != std::string::npos || std::filesystem::is_directory(spec) ||
                 (spec.find('%') != std::string::npos && !ListImageSequence(spec).empty());
-  file = list ? backend::OpenImageList(spec, options) : backend::OpenFile(spec, options);
+  std::unique_ptr<FrameSource> file =
+      list ? backend::OpenImageList(spec, options) : backend::OpenFile(spec, options);
   if (options.realtime) return backend::Paced(std::move(file), options);
   return file;
 }
