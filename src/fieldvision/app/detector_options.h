@@ -69,9 +69,16 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o) {
                   "from this colour score (1: never; colour scores stay below 1)")
       ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_option("--dnn-keep-field", o.keep_field_share,
+                  "With both: a colour-accepted candidate the network does not confirm is also "
+                  "kept when at least this share of a ring just around it is field (colour "
+                  "vouches for a ball on the carpet; 0: off)")
+      ->check(FiniteRange(0.0, 1.0))
+      ->capture_default_str();
   cmd->add_flag("!--dnn-keep", o.demote_unconfirmed,
                 "With both: keep every colour-accepted candidate the network does not confirm "
-                "(default: those below --dnn-keep-score are rejected)");
+                "(default: those below --dnn-keep-score and off the field, --dnn-keep-field, are "
+                "rejected)");
 }
 
 }  // namespace fv::app

@@ -487,29 +487,33 @@ void BallDetector::RejectOffField(const cv::Mat& bgr, const cv::Rect& roi,
   }
 }
 
+double BallDetector::FieldShare(const cv::Mat& bgr, const cv::Rect& roi,
+                                const Eigen::Vector2d& centre_px, double radius_px, double enough,
+                                ImageFieldCache* image_field) const {
+  const FieldSurroundOptions& o = options_.small_field;
+  const double share =
+      field_bit_ != 0 ? FieldShareAround(bgr, *table_, field_bit_, nullptr, centre_px, radius_px, o)
+                      : -1.0;
+  if (share >= enough) return share;
+  // The image's own field colour only where the field class finds too little (a carpet the
+  // class misses).
+  if (!*image_field) {
+    *image_field = FindImageFieldColour(bgr, roi, options_.field_brightness.image_field);
+  }
+  const std::optional<ImageFieldColour>& found = **image_field;
+  if (!found) return share;  // -1 without a field class: no field to tell
+  return FieldShareAround(bgr, *table_, field_bit_, &*found, centre_px, radius_px, o);
+}
+
 void BallDetector::RejectSmallOffField(const cv::Mat& bgr, const cv::Rect& roi,
                                        std::vector<BallCandidate>* candidates) const {
-  const FieldSurroundOptions& o = options_.small_field;
-  if (o.min_share <= 0 || posed()) return;
-  // The image's own field colour only where the field class finds too little around a spot (a
-  // carpet the class misses); found once.
-  std::optional<std::optional<ImageFieldColour>> image_field;
+  const double min_share = options_.small_field.min_share;
+  if (min_share <= 0 || posed()) return;
+  ImageFieldCache image_field;
   for (BallCandidate& c : *candidates) {
     if (!c.accepted || !c.small) continue;
-    double share = field_bit_ != 0 ? FieldShareAround(bgr, *table_, field_bit_, nullptr,
-                                                      c.centre_px, c.radius_px, o)
-                                   : -1.0;
-    if (share >= o.min_share) continue;
-    if (!image_field) {
-      image_field = FindImageFieldColour(bgr, roi, options_.field_brightness.image_field);
-    }
-    if (image_field->has_value()) {
-      share =
-          FieldShareAround(bgr, *table_, field_bit_, &**image_field, c.centre_px, c.radius_px, o);
-    } else if (field_bit_ == 0) {
-      continue;  // no field to tell
-    }
-    if (share < 0 || share >= o.min_share) continue;
+    const double share = FieldShare(bgr, roi, c.centre_px, c.radius_px, min_share, &image_field);
+    if (share < 0 || share >= min_share) continue;
     c.accepted = false;
     c.reason = fmt::format("a small spot off the field ({:.0f} % of its ring field)", 100 * share);
   }

@@ -23,6 +23,7 @@
 #include "fieldvision/detect/field_boundary.h"
 #include "fieldvision/detect/field_brightness.h"
 #include "fieldvision/detect/field_surround.h"
+#include "fieldvision/detect/image_field.h"
 #include "fieldvision/detect/small_ball.h"
 #include "fieldvision/field/field.h"
 
@@ -69,6 +70,9 @@ struct BallCandidate {
   // The network's sports-ball score (dnn_ball.h; 0 where it found none or did not look, -1 when
   // the detector has no network).
   double network_score = -1.0;
+  // The share of a ring just around it that is field (BallDetector::FieldShare), where "both"
+  // measured it for its keep rule (DnnBallOptions::keep_field_share); -1 elsewhere.
+  double field_share = -1.0;
   std::string reason;  // why rejected ("" when accepted)
 };
 
@@ -249,6 +253,14 @@ class BallDetector {
   FieldBoundary OffFieldBoundary(const cv::Mat& bgr, const cv::Rect& region = cv::Rect()) const;
   // The field-of-play mask (CV_8U, 255 inside) or empty when not used.
   const cv::Mat& field_mask() const { return field_mask_; }
+  // The image's own field colour of a frame (image_field.h), found at most once per frame.
+  using ImageFieldCache = std::optional<std::optional<ImageFieldColour>>;
+  // The share of a ring just around (centre_px, radius_px) that is field (field_surround.h,
+  // options.small_field's ring): the field class, or, where that holds less than `enough` there,
+  // the class or the image's own field colour (found once into *image_field); negative when
+  // neither tells (no field class and no field colour in the image).
+  double FieldShare(const cv::Mat& bgr, const cv::Rect& roi, const Eigen::Vector2d& centre_px,
+                    double radius_px, double enough, ImageFieldCache* image_field) const;
   // Expected radius range [min, max] in pixels of the ball seen at `uv` (calibrated camera with
   // pose), or false when unknown.
   bool ExpectedRadius(const Eigen::Vector2d& uv, double* min_px, double* max_px) const;

@@ -27,6 +27,17 @@ bool Confirms(const Eigen::Vector2d& centre, double radius, const cv::Rect2d& bo
 }
 
 // The candidate's crop side in pixels.
+// The network score that confirms colour candidate `c` (DnnBallOptions::confirm_score).
+double ConfirmScore(const BallCandidate& c, const DnnBallOptions& o) {
+  return c.off_field ? std::max(o.confirm_score, o.accept_score) : o.confirm_score;
+}
+
+// Whether a colour-accepted candidate the network does not confirm is kept.
+bool KeptUnconfirmed(const BallCandidate& c, const DnnBallOptions& o) {
+  return !o.demote_unconfirmed || c.score >= o.keep_score ||
+         (o.keep_field_share > 0 && c.field_share >= o.keep_field_share);
+}
+
 int CropSide(const BallCandidate& c, const DnnBallOptions& o) {
   return std::max(o.min_crop_px, static_cast<int>(std::lround(2.0 * o.crop_radii * c.radius_px)));
 }
@@ -47,6 +58,7 @@ void DnnBallOptions::Check() const {
   CheckInRange(complete_score, 0.0, 1.0, "dnn complete_score");
   CheckInRange(confirm_score, 0.0, 1.0, "dnn confirm_score");
   CheckInRange(keep_score, 0.0, 1.0, "dnn keep_score");
+  CheckInRange(keep_field_share, 0.0, 1.0, "dnn keep_field_share");
   CheckPositive(spot_min_contrast, "dnn spot_min_contrast");
   CheckInRange(nms_iou, 0.0, 1.0, "dnn nms_iou");
   CheckInRange(crop_radii, 1.0, 20.0, "dnn crop_radii");
@@ -56,6 +68,7 @@ void DnnBallOptions::Check() const {
   FV_REQUIRE(max_crops >= 0 && max_crops <= 100, "dnn max_crops must be in 0..100 (got {})",
              max_crops);
   CheckInRange(box_size_ratio, 1.0, 10.0, "dnn box_size_ratio");
+  CheckInRange(hold_min_radius_px, 0.0, 1000.0, "dnn hold_min_radius_px");
 }
 
 BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score) {
@@ -78,9 +91,13 @@ void MarkOffField(const FieldBoundary& boundary, std::vector<BallCandidate>* can
 }
 
 std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
-                                  const std::vector<BallCandidate>& dnn, const DnnBallOptions& o) {
+                                  const std::vector<BallCandidate>& dnn, const DnnBallOptions& o,
+                                  double input_scale) {
+  FV_REQUIRE(std::isfinite(input_scale) && input_scale > 0,
+             "HoldingScores: input scale must be positive (got {})", input_scale);
   std::vector<double> out(colour.size(), 0.0);
   for (size_t i = 0; i < colour.size(); ++i) {
+    if (colour[i].radius_px * input_scale < o.hold_min_radius_px) continue;
     for (const BallCandidate& d : dnn) {
       const cv::Rect2d box(d.centre_px.x() - d.radius_px, d.centre_px.y() - d.radius_px,
                            2 * d.radius_px, 2 * d.radius_px);
@@ -108,17 +125,21 @@ std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate
   for (size_t i = 0; i < colour.size(); ++i) {
     BallCandidate c = colour[i];
     c.network_score = confirm[i];
-    const double needed = c.off_field ? std::max(o.confirm_score, o.accept_score) : o.confirm_score;
-    if (confirm[i] >= needed) {
+    if (confirm[i] >= ConfirmScore(c, o)) {
       c.accepted = true;
       c.reason.clear();
       ranked.push_back({c, 0, confirm[i]});
-    } else if (c.accepted && (!o.demote_unconfirmed || c.score >= o.keep_score)) {
+    } else if (c.accepted && KeptUnconfirmed(c, o)) {
       ranked.push_back({c, 1, c.score});
     } else {
       if (c.accepted) {
         c.accepted = false;
-        c.reason = "not confirmed by the network";
+        c.reason = fmt::format("not confirmed by the network (colour score {:.2f} < {:.2f}",
+                               c.score, o.keep_score);
+        if (c.field_share >= 0) {
+          c.reason += fmt::format(", {:.0f} % of its ring field", 100 * c.field_share);
+        }
+        c.reason += ")";
       }
       ranked.push_back({c, 3, c.score});
     }
@@ -155,17 +176,14 @@ std::vector<BallCandidate> DnnBallDetector::Detect(const cv::Mat& bgr, const cv:
   const cv::Rect r = roi.empty() ? full : (roi & full);
   if (r.width < 8 || r.height < 8) return {};
   const cv::Mat view = bgr(r);
-  const int net_w = options_.input_width > 0
-                        ? options_.input_width
-                        : std::max(options_.min_input_width, RoundUp32(view.cols));
-  const int net_h = RoundUp32(net_w * double(view.rows) / view.cols);
+  const cv::Size net_size = InputSize(bgr.size(), r);
   std::vector<dnn::DnnBox> boxes;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const double threshold = options_.detector == "both"
                                  ? std::min(options_.score_threshold, options_.confirm_score)
                                  : options_.score_threshold;
-    boxes = net_->Detect(view, cv::Size(net_w, net_h), threshold, {dnn::kCocoSportsBall});
+    boxes = net_->Detect(view, net_size, threshold, {dnn::kCocoSportsBall});
   }
   std::vector<BallCandidate> out;
   for (const dnn::DnnBox& b : dnn::NmsBoxes(boxes, options_.nms_iou)) {
@@ -174,6 +192,16 @@ std::vector<BallCandidate> DnnBallDetector::Detect(const cv::Mat& bgr, const cv:
     out.push_back(std::move(c));
   }
   return out;
+}
+
+cv::Size DnnBallDetector::InputSize(const cv::Size& frame_size, const cv::Rect& roi) const {
+  const cv::Rect full(cv::Point(0, 0), frame_size);
+  const cv::Rect r = roi.empty() ? full : (roi & full);
+  FV_REQUIRE(!r.empty(), "dnn ball detector: empty search region");
+  const int net_w = options_.input_width > 0
+                        ? options_.input_width
+                        : std::max(options_.min_input_width, RoundUp32(r.width));
+  return {net_w, RoundUp32(net_w * static_cast<double>(r.height) / r.width)};
 }
 
 double DnnBallDetector::SquareScore(const cv::Mat& square, const Eigen::Vector2d& centre_px,
@@ -274,6 +302,20 @@ void AnyBallDetector::DemoteFaintSpots(std::vector<BallCandidate>* candidates) c
   }
 }
 
+void AnyBallDetector::MeasureFieldShares(const cv::Mat& bgr, const cv::Rect& region,
+                                         const std::vector<double>& confirm,
+                                         std::vector<BallCandidate>* candidates) const {
+  const DnnBallOptions& o = dnn_options_;
+  if (o.keep_field_share <= 0 || !o.demote_unconfirmed) return;
+  BallDetector::ImageFieldCache image_field;
+  for (size_t i = 0; i < candidates->size(); ++i) {
+    BallCandidate& c = (*candidates)[i];
+    if (!c.accepted || confirm[i] >= ConfirmScore(c, o) || c.score >= o.keep_score) continue;
+    c.field_share = colour_->FieldShare(bgr, region, c.centre_px, c.radius_px, o.keep_field_share,
+                                        &image_field);
+  }
+}
+
 std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
                                                    const cv::Rect& region) const {
   if (dnn_ == nullptr) return colour_->Detect(bgr, region);
@@ -287,9 +329,15 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
   std::vector<BallCandidate> whole;
   if (dnn_options_.whole_frame) {
     whole = FilterDnn(dnn_->Detect(bgr, region));
-    const std::vector<double> held = HoldingScores(colour, whole, dnn_options_);
+    const cv::Rect searched = region.empty() ? cv::Rect(0, 0, bgr.cols, bgr.rows)
+                                             : (region & cv::Rect(0, 0, bgr.cols, bgr.rows));
+    const double input_scale = searched.empty() ? 1.0
+                                                : dnn_->InputSize(bgr.size(), searched).width /
+                                                      static_cast<double>(searched.width);
+    const std::vector<double> held = HoldingScores(colour, whole, dnn_options_, input_scale);
     for (size_t i = 0; i < confirm.size(); ++i) confirm[i] = std::max(confirm[i], held[i]);
   }
+  MeasureFieldShares(bgr, region, confirm, &colour);
   return CombineBallCandidates(colour, confirm, whole, dnn_options_);
 }
 

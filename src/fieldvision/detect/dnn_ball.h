@@ -5,8 +5,9 @@
 // each is checked in a crop around it (crop_radii of its radius, resized to crop_px, so small
 // balls get the network's pixels) and against the whole-frame network balls that hold it. A
 // confirmed candidate is accepted (promoted when colour rejected it); an accepted one the network
-// does not confirm is rejected (demote_unconfirmed, the default) or kept; a whole-frame network
-// ball that no colour candidate lies in completes them. Low network scores suffice here because
+// does not confirm is kept only with a high colour score or the field around it
+// (demote_unconfirmed, the default) or always; a whole-frame network ball that no colour
+// candidate lies in completes them. Low network scores suffice here because
 // colour proposes the places (on the MSL photos a crop score >= 0.1 held 54 of 148 candidates on
 // balls and 8 of 2244 elsewhere). Propose with a cheap cue, confirm with a CNN, as in R-CNN
 // (Girshick et al., CVPR 2014).
@@ -67,6 +68,14 @@ struct DnnBallOptions {
   // SSL 0.823 / 0.964 in the simulation that chose it).
   double confirm_score = 0.1;
   double box_size_ratio = 2.5;
+  // A whole-frame network ball confirms a colour candidate it holds only when the candidate's
+  // radius in the network's input is at least this (8: NanoDet's finest stride, the ball two of
+  // its cells across). The whole-frame network does not resolve a smaller one: its box there is
+  // a robot or a lamp around the spot; the candidate's own (upsampled) crop judges it. Measured
+  // on the real photos (`both`, with keep_field_share; 0 / 6 / 8 / 12 px): SSL precision 0.949 /
+  // 0.958 / 0.961 / 0.961 at recall 0.912 (the whole-frame boxes had confirmed four far robots
+  // and no ball), MSL 0.761 / 0.989 throughout (the balls they confirm are 18-47 px).
+  double hold_min_radius_px = 8.0;
   // A colour-accepted candidate the network does not confirm is kept (ranked after the confirmed
   // ones) when its colour score reaches keep_score, else rejected; demote_unconfirmed = false
   // keeps every one. A clear disc of the ball's colour needs no network: the network confirms
@@ -76,6 +85,16 @@ struct DnnBallOptions {
   // 0.988 / 0.988 / 0.989 / 0.978; below 0.45 orange LEDs on the SSL robots (colour scores
   // 0.33-0.50) come in.
   double keep_score = 0.45;
+  // ... or when at least this share of a ring just around it is field (BallDetector::FieldShare;
+  // 0: off): colour alone vouches for a ball on the carpet or grass, as it does for small spots
+  // (field_surround.h), whereas orange LEDs on robots, a logo or a shirt are framed by other
+  // colours. The MSL balls the network misses are printed, partly hidden by a robot or held in
+  // its handler, with colour scores of 0.2-0.4. Measured on the real photos (`both`, share 0.1 /
+  // 0.3 / 0.4 / 0.5 / 0.7 / off): MSL recall 0.769 / 0.769 / 0.761 / 0.735 / 0.718 / 0.709 at
+  // precision 0.978 / 0.978 / 0.989 / 0.989 / 0.988 / 0.988, SSL 0.915 / 0.912 / 0.912 / 0.912 /
+  // 0.912 / 0.905 at 0.935 / 0.943 / 0.949 / 0.949 / 0.952 / 0.955 (an orange toy and a robot's
+  // orange part on the carpet come in).
+  double keep_field_share = 0.4;
   bool demote_unconfirmed = true;
   // Throws fv::Error naming the bad field.
   void Check() const;
@@ -88,10 +107,11 @@ struct DnnBallOptions {
 BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score);
 
 // The best score of the network balls `dnn` that confirm each colour candidate (hold its centre,
-// half size within box_size_ratio of its radius); 0 where none does.
+// half size within box_size_ratio of its radius); 0 where none does, and for candidates under
+// hold_min_radius_px in the network's input (`input_scale`: its pixels per frame pixel).
 std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
                                   const std::vector<BallCandidate>& dnn,
-                                  const DnnBallOptions& options);
+                                  const DnnBallOptions& options, double input_scale);
 
 // Marks the candidates that are not accepted and lie above `boundary` (FieldBoundary::DiscAbove)
 // off_field: what "both" confirms only from accept_score.
@@ -100,9 +120,9 @@ void MarkOffField(const FieldBoundary& boundary, std::vector<BallCandidate>* can
 // The "both" stage, without the network (tested on its own): `colour` (best first) with each
 // one's network score `confirm` (crop or whole frame, 0 when not checked; same length), and the
 // whole-frame network balls `dnn` (candidates, best first). Returns the candidates best first:
-// confirmed ones (accepted, by network score), then colour-accepted unconfirmed ones (those below
-// keep_score rejected with demote_unconfirmed), then completing network balls from
-// complete_score, then the rest.
+// confirmed ones (accepted, by network score), then colour-accepted unconfirmed ones (with
+// demote_unconfirmed those below keep_score whose field_share is below keep_field_share are
+// rejected), then completing network balls from complete_score, then the rest.
 std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate>& colour,
                                                  const std::vector<double>& confirm,
                                                  const std::vector<BallCandidate>& dnn,
@@ -117,6 +137,10 @@ class DnnBallDetector {
   // from score_threshold ("both": from confirm_score when lower), after NMS, best first, in the
   // frame's pixels.
   std::vector<BallCandidate> Detect(const cv::Mat& bgr, const cv::Rect& roi = cv::Rect()) const;
+  // The network's input size for Detect in `roi` of a frame of `frame_size` (the whole frame when
+  // empty): input_width (or the roi's width rounded up to a multiple of 32, at least
+  // min_input_width) by the roi's aspect; its width over the roi's is Detect's scale.
+  cv::Size InputSize(const cv::Size& frame_size, const cv::Rect& roi = cv::Rect()) const;
   // The crop score of each candidate (0 for those beyond max_crops, see DnnBallOptions); crops
   // stay inside `roi` (the whole frame when empty).
   std::vector<double> CropScores(const cv::Mat& bgr, const std::vector<BallCandidate>& candidates,
@@ -157,6 +181,11 @@ class AnyBallDetector {
   // "both": small spots fainter than the colour detector alone takes (its own
   // SmallBallOptions::min_contrast) are not colour-accepted, only worth the network's look.
   void DemoteFaintSpots(std::vector<BallCandidate>* candidates) const;
+  // "both": the field share of each colour-accepted candidate that only its field share can
+  // keep (not confirmed by `confirm`, below keep_score; DnnBallOptions::keep_field_share).
+  void MeasureFieldShares(const cv::Mat& bgr, const cv::Rect& region,
+                          const std::vector<double>& confirm,
+                          std::vector<BallCandidate>* candidates) const;
   DnnBallOptions dnn_options_;
   double colour_spot_contrast_ = 0.0;
   std::unique_ptr<BallDetector> colour_;

@@ -83,6 +83,16 @@ TEST(FieldSurround, ACarpetTheFieldClassMissesIsFieldByItsOwnColour) {
   const std::optional<ImageFieldColour> own = FindImageFieldColour(img, {});
   ASSERT_TRUE(own.has_value());
   EXPECT_GT(FieldShareAround(img, table, field, &*own, {100, 150}, 2.2), 0.9);
+  // The detector's FieldShare falls back on that colour, looked for once per frame; on grass the
+  // class suffices and the image is not searched.
+  const BallDetector detector(BallDetectorOptions{}, nullptr, nullptr);
+  BallDetector::ImageFieldCache cache;
+  EXPECT_GT(detector.FieldShare(img, {}, {100, 150}, 2.2, 0.5, &cache), 0.9);
+  EXPECT_TRUE(cache.has_value());
+  cv::Mat grass(224, 224, CV_8UC3, cv::Scalar(50, 140, 60));
+  BallDetector::ImageFieldCache unused;
+  EXPECT_GT(detector.FieldShare(grass, {}, {100, 150}, 2.2, 0.5, &unused), 0.9);
+  EXPECT_FALSE(unused.has_value());
   const auto cands = BallDetector(BallDetectorOptions{}, nullptr, nullptr).Detect(img);
   ASSERT_FALSE(cands.empty());
   EXPECT_TRUE(cands.front().accepted) << cands.front().reason;
