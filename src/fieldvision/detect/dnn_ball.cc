@@ -26,7 +26,6 @@ bool Confirms(const Eigen::Vector2d& centre, double radius, const cv::Rect2d& bo
          half * size_ratio >= radius;
 }
 
-// The candidate's crop side in pixels.
 // The network score that confirms colour candidate `c` (DnnBallOptions::confirm_score).
 double ConfirmScore(const BallCandidate& c, const DnnBallOptions& o) {
   return c.off_field ? std::max(o.confirm_score, o.accept_score) : o.confirm_score;
@@ -38,6 +37,7 @@ bool KeptUnconfirmed(const BallCandidate& c, const DnnBallOptions& o) {
          (o.keep_field_share > 0 && c.field_share >= o.keep_field_share);
 }
 
+// The candidate's crop side in pixels.
 int CropSide(const BallCandidate& c, const DnnBallOptions& o) {
   return std::max(o.min_crop_px, static_cast<int>(std::lround(2.0 * o.crop_radii * c.radius_px)));
 }
@@ -204,6 +204,13 @@ cv::Size DnnBallDetector::InputSize(const cv::Size& frame_size, const cv::Rect& 
   return {net_w, RoundUp32(net_w * static_cast<double>(r.height) / r.width)};
 }
 
+double DnnBallDetector::InputScale(const cv::Size& frame_size, const cv::Rect& roi) const {
+  const cv::Rect full(cv::Point(0, 0), frame_size);
+  const cv::Rect r = roi.empty() ? full : (roi & full);
+  FV_REQUIRE(!r.empty(), "dnn ball detector: empty search region");
+  return InputSize(frame_size, roi).width / static_cast<double>(r.width);
+}
+
 double DnnBallDetector::SquareScore(const cv::Mat& square, const Eigen::Vector2d& centre_px,
                                     double radius_px) const {
   const DnnBallOptions& o = options_;
@@ -329,11 +336,8 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
   std::vector<BallCandidate> whole;
   if (dnn_options_.whole_frame) {
     whole = FilterDnn(dnn_->Detect(bgr, region));
-    const cv::Rect searched = region.empty() ? cv::Rect(0, 0, bgr.cols, bgr.rows)
-                                             : (region & cv::Rect(0, 0, bgr.cols, bgr.rows));
-    const double input_scale = searched.empty() ? 1.0
-                                                : dnn_->InputSize(bgr.size(), searched).width /
-                                                      static_cast<double>(searched.width);
+    // Network balls come only from a searchable region, whose input scale is then defined.
+    const double input_scale = whole.empty() ? 1.0 : dnn_->InputScale(bgr.size(), region);
     const std::vector<double> held = HoldingScores(colour, whole, dnn_options_, input_scale);
     for (size_t i = 0; i < confirm.size(); ++i) confirm[i] = std::max(confirm[i], held[i]);
   }

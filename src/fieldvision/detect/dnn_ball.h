@@ -141,6 +141,8 @@ class DnnBallDetector {
   // empty): input_width (or the roi's width rounded up to a multiple of 32, at least
   // min_input_width) by the roi's aspect; its width over the roi's is Detect's scale.
   cv::Size InputSize(const cv::Size& frame_size, const cv::Rect& roi = cv::Rect()) const;
+  // The network's input pixels per frame pixel there (InputSize's width over the roi's).
+  double InputScale(const cv::Size& frame_size, const cv::Rect& roi = cv::Rect()) const;
   // The crop score of each candidate (0 for those beyond max_crops, see DnnBallOptions); crops
   // stay inside `roi` (the whole frame when empty).
   std::vector<double> CropScores(const cv::Mat& bgr, const std::vector<BallCandidate>& candidates,

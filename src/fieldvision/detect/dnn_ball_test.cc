@@ -309,6 +309,19 @@ TEST_F(DnnBallOnPhotos, ColourHitsOnTheCarpetAreKept) {
 // Two SSL photos (224 x 224, upscaled to the network's 416) whose ball is elsewhere: a
 // whole-frame network box around a far robot (2.3-2.8 px orange spots) does not confirm the spot,
 // as it did before hold_min_radius_px.
+TEST_F(DnnBallOnPhotos, InputScaleOfTheWholeFrameSearch) {
+  DnnBallOptions o;
+  o.detector = "both";
+  const DnnBallDetector net(o);
+  // A 224 px photo is upscaled to the smallest input (416); a 1280 px frame keeps its width; a
+  // window is scaled by its own width.
+  EXPECT_DOUBLE_EQ(net.InputScale({224, 224}), 416.0 / 224.0);
+  EXPECT_EQ(net.InputSize({224, 224}), cv::Size(416, 416));
+  EXPECT_DOUBLE_EQ(net.InputScale({1280, 960}), 1.0);
+  EXPECT_DOUBLE_EQ(net.InputScale({1280, 960}, cv::Rect(100, 100, 200, 100)), 416.0 / 200.0);
+  EXPECT_THROW(net.InputScale({1280, 960}, cv::Rect(2000, 0, 10, 10)), Error);
+}
+
 TEST_F(DnnBallOnPhotos, WholeFrameBoxesDoNotConfirmFarSpots) {
   const std::string ssl = dir_ + "/../../ssl-orange";
   for (const char* name : {"00109", "00208"}) {
