@@ -491,9 +491,9 @@ double BallDetector::FieldShare(const cv::Mat& bgr, const cv::Rect& roi,
                                 const Eigen::Vector2d& centre_px, double radius_px, double enough,
                                 ImageFieldCache* image_field) const {
   const FieldSurroundOptions& o = options_.small_field;
-  const double share =
-      field_bit_ != 0 ? FieldShareAround(bgr, *table_, field_bit_, nullptr, centre_px, radius_px, o)
-                      : -1.0;
+  const double share = field_bit_ != 0 ? FieldShareAround(bgr, *table_, field_bit_, nullptr,
+                                                          centre_px, radius_px, o, roi)
+                                       : -1.0;
   if (share >= enough) return share;
   // The image's own field colour only where the field class finds too little (a carpet the
   // class misses).
@@ -502,7 +502,7 @@ double BallDetector::FieldShare(const cv::Mat& bgr, const cv::Rect& roi,
   }
   const std::optional<ImageFieldColour>& found = **image_field;
   if (!found) return share;  // -1 without a field class: no field to tell
-  return FieldShareAround(bgr, *table_, field_bit_, &*found, centre_px, radius_px, o);
+  return FieldShareAround(bgr, *table_, field_bit_, &*found, centre_px, radius_px, o, roi);
 }
 
 void BallDetector::RejectSmallOffField(const cv::Mat& bgr, const cv::Rect& roi,

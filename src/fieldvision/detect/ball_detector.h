@@ -256,9 +256,10 @@ class BallDetector {
   // The image's own field colour of a frame (image_field.h), found at most once per frame.
   using ImageFieldCache = std::optional<std::optional<ImageFieldColour>>;
   // The share of a ring just around (centre_px, radius_px) that is field (field_surround.h,
-  // options.small_field's ring): the field class, or, where that holds less than `enough` there,
-  // the class or the image's own field colour (found once into *image_field); negative when
-  // neither tells (no field class and no field colour in the image).
+  // options.small_field's ring; only its pixels in `roi` are read, empty: the frame): the field
+  // class, or, where that holds less than `enough` there, the class or the image's own field
+  // colour (found once into *image_field); negative when neither tells (no field class and no
+  // field colour in the image, or no ring pixel in `roi`).
   double FieldShare(const cv::Mat& bgr, const cv::Rect& roi, const Eigen::Vector2d& centre_px,
                     double radius_px, double enough, ImageFieldCache* image_field) const;
   // Expected radius range [min, max] in pixels of the ball seen at `uv` (calibrated camera with

@@ -17,7 +17,7 @@ void FieldSurroundOptions::Check() const {
 
 double FieldShareAround(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bits,
                         const ImageFieldColour* image_field, const Eigen::Vector2d& centre_px,
-                        double radius_px, const FieldSurroundOptions& o) {
+                        double radius_px, const FieldSurroundOptions& o, const cv::Rect& roi) {
   o.Check();
   FV_REQUIRE(bgr.type() == CV_8UC3, "field surround: the image must be 8-bit BGR");
   FV_REQUIRE(std::isfinite(centre_px.x()) && std::isfinite(centre_px.y()) &&
@@ -29,10 +29,12 @@ double FieldShareAround(const cv::Mat& bgr, const ColourTable& table, uint8_t fi
   const int x1 = static_cast<int>(std::ceil(centre_px.x() + r_out));
   const int y0 = static_cast<int>(std::floor(centre_px.y() - r_out));
   const int y1 = static_cast<int>(std::ceil(centre_px.y() + r_out));
+  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect area = roi.empty() ? image : (roi & image);
   std::vector<cv::Vec3b> ring;
-  for (int y = std::max(0, y0); y <= std::min(bgr.rows - 1, y1); ++y) {
+  for (int y = std::max(area.y, y0); y <= std::min(area.y + area.height - 1, y1); ++y) {
     const auto* row = bgr.ptr<cv::Vec3b>(y);
-    for (int x = std::max(0, x0); x <= std::min(bgr.cols - 1, x1); ++x) {
+    for (int x = std::max(area.x, x0); x <= std::min(area.x + area.width - 1, x1); ++x) {
       const double d = std::hypot(x - centre_px.x(), y - centre_px.y());
       if (d >= r_in && d <= r_out) ring.push_back(row[x]);
     }

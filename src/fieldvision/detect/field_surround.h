@@ -28,9 +28,11 @@ struct FieldSurroundOptions {
 };
 
 // The field share of the ring around (centre_px, radius_px): pixels of `field_bits` in `table`,
-// or held by `image_field` (may be null). Negative when none of the ring lies in the image.
+// or held by `image_field` (may be null), among the ring's pixels in `roi` (empty: the image;
+// nothing outside it is read). Negative when none of the ring lies there.
 double FieldShareAround(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bits,
                         const ImageFieldColour* image_field, const Eigen::Vector2d& centre_px,
-                        double radius_px, const FieldSurroundOptions& options = {});
+                        double radius_px, const FieldSurroundOptions& options = {},
+                        const cv::Rect& roi = cv::Rect());
 
 }  // namespace fv::detect

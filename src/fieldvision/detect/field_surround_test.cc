@@ -98,6 +98,24 @@ TEST(FieldSurround, ACarpetTheFieldClassMissesIsFieldByItsOwnColour) {
   EXPECT_TRUE(cands.front().accepted) << cands.front().reason;
 }
 
+// Only the ring's pixels in the search region count (a tracking window: the frame outside it may
+// not even be decoded).
+TEST(FieldSurround, OnlyTheRegionIsRead) {
+  cv::Mat img(60, 60, CV_8UC3, cv::Scalar(50, 140, 60));  // grass
+  img.colRange(33, 60).setTo(cv::Scalar(0, 0, 0));        // right of the window: not field
+  const ColourTable table(PresetColourSpec("orange"));
+  const uint8_t field = table.ClassBit("field");
+  const Eigen::Vector2d spot(30, 30);
+  EXPECT_LT(FieldShareAround(img, table, field, nullptr, spot, 2.0), 0.9);
+  const cv::Rect window(0, 0, 33, 60);
+  EXPECT_DOUBLE_EQ(FieldShareAround(img, table, field, nullptr, spot, 2.0, {}, window), 1.0);
+  EXPECT_LT(FieldShareAround(img, table, field, nullptr, spot, 2.0, {}, cv::Rect(50, 0, 5, 5)),
+            0.0);
+  const BallDetector detector(BallDetectorOptions{}, nullptr, nullptr);
+  BallDetector::ImageFieldCache cache;
+  EXPECT_DOUBLE_EQ(detector.FieldShare(img, window, spot, 2.0, 0.5, &cache), 1.0);
+}
+
 TEST(FieldSurround, BadInputAndARingOutsideTheImage) {
   const cv::Mat img(50, 50, CV_8UC3, cv::Scalar(50, 140, 60));
   const ColourTable table(PresetColourSpec("orange"));
