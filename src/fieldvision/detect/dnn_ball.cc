@@ -15,6 +15,12 @@ namespace {
 constexpr double kPadGrey = 114.0;  // fill beyond the image in a crop (the usual letterbox grey)
 constexpr double kLowestCropScore = 0.01;  // network boxes read in a crop when scores are averaged
 
+// The part of a frame of `frame_size` searched for `roi` (the whole frame when empty).
+cv::Rect SearchArea(const cv::Size& frame_size, const cv::Rect& roi) {
+  const cv::Rect full(cv::Point(0, 0), frame_size);
+  return roi.empty() ? full : (roi & full);
+}
+
 int RoundUp32(double v) { return std::max(32, static_cast<int>(std::ceil(v / 32.0)) * 32); }
 
 // Whether a network box (centre, half size) confirms a candidate: holds its centre, similar size.
@@ -172,8 +178,7 @@ DnnBallDetector::DnnBallDetector(const DnnBallOptions& options) : options_(optio
 
 std::vector<BallCandidate> DnnBallDetector::Detect(const cv::Mat& bgr, const cv::Rect& roi) const {
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "dnn ball detector: expected a BGR frame");
-  const cv::Rect full(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect r = roi.empty() ? full : (roi & full);
+  const cv::Rect r = SearchArea(bgr.size(), roi);
   if (r.width < 8 || r.height < 8) return {};
   const cv::Mat view = bgr(r);
   const cv::Size net_size = InputSize(bgr.size(), r);
@@ -195,8 +200,7 @@ std::vector<BallCandidate> DnnBallDetector::Detect(const cv::Mat& bgr, const cv:
 }
 
 cv::Size DnnBallDetector::InputSize(const cv::Size& frame_size, const cv::Rect& roi) const {
-  const cv::Rect full(cv::Point(0, 0), frame_size);
-  const cv::Rect r = roi.empty() ? full : (roi & full);
+  const cv::Rect r = SearchArea(frame_size, roi);
   FV_REQUIRE(!r.empty(), "dnn ball detector: empty search region");
   const int net_w = options_.input_width > 0
                         ? options_.input_width
@@ -205,10 +209,8 @@ cv::Size DnnBallDetector::InputSize(const cv::Size& frame_size, const cv::Rect& 
 }
 
 double DnnBallDetector::InputScale(const cv::Size& frame_size, const cv::Rect& roi) const {
-  const cv::Rect full(cv::Point(0, 0), frame_size);
-  const cv::Rect r = roi.empty() ? full : (roi & full);
-  FV_REQUIRE(!r.empty(), "dnn ball detector: empty search region");
-  return InputSize(frame_size, roi).width / static_cast<double>(r.width);
+  const int net_w = InputSize(frame_size, roi).width;  // throws for an empty search region
+  return net_w / static_cast<double>(SearchArea(frame_size, roi).width);
 }
 
 double DnnBallDetector::SquareScore(const cv::Mat& square, const Eigen::Vector2d& centre_px,
@@ -234,8 +236,7 @@ std::vector<double> DnnBallDetector::CropScores(const cv::Mat& bgr,
                                                 const cv::Rect& roi) const {
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "dnn ball detector: expected a BGR frame");
   const DnnBallOptions& o = options_;
-  const cv::Rect full(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect area = roi.empty() ? full : (roi & full);
+  const cv::Rect area = SearchArea(bgr.size(), roi);
   std::vector<double> scores(candidates.size(), 0.0);
   // Accepted first, then weak or disc-shaped ones, then the rest, each in the detector's order.
   std::vector<size_t> order(candidates.size());

@@ -89,11 +89,11 @@ struct DnnBallOptions {
   // 0: off): colour alone vouches for a ball on the carpet or grass, as it does for small spots
   // (field_surround.h), whereas orange LEDs on robots, a logo or a shirt are framed by other
   // colours. The MSL balls the network misses are printed, partly hidden by a robot or held in
-  // its handler, with colour scores of 0.2-0.4. Measured on the real photos (`both`, share 0.1 /
-  // 0.3 / 0.4 / 0.5 / 0.7 / off): MSL recall 0.769 / 0.769 / 0.761 / 0.735 / 0.718 / 0.709 at
-  // precision 0.978 / 0.978 / 0.989 / 0.989 / 0.988 / 0.988, SSL 0.915 / 0.912 / 0.912 / 0.912 /
-  // 0.912 / 0.905 at 0.935 / 0.943 / 0.949 / 0.949 / 0.952 / 0.955 (an orange toy and a robot's
-  // orange part on the carpet come in).
+  // its handler, with colour scores of 0.2-0.4. Measured on the real photos (`both` before
+  // hold_min_radius_px; share 0.1 / 0.3 / 0.4 / 0.5 / 0.7 / off): MSL recall 0.769 / 0.769 /
+  // 0.761 / 0.735 / 0.718 / 0.709 at precision 0.978 / 0.978 / 0.989 / 0.989 / 0.988 / 0.988,
+  // SSL 0.915 / 0.912 / 0.912 / 0.912 / 0.912 / 0.905 at 0.935 / 0.943 / 0.949 / 0.949 / 0.952 /
+  // 0.955 (an orange toy and a robot's orange part on the carpet come in).
   double keep_field_share = 0.4;
   bool demote_unconfirmed = true;
   // Throws fv::Error naming the bad field.

@@ -306,9 +306,7 @@ TEST_F(DnnBallOnPhotos, ColourHitsOnTheCarpetAreKept) {
   EXPECT_EQ(off.hits, 2) << off.Summary(10);
 }
 
-// Two SSL photos (224 x 224, upscaled to the network's 416) whose ball is elsewhere: a
-// whole-frame network box around a far robot (2.3-2.8 px orange spots) does not confirm the spot,
-// as it did before hold_min_radius_px.
+// The whole-frame search's input scale, which hold_min_radius_px is measured in.
 TEST_F(DnnBallOnPhotos, InputScaleOfTheWholeFrameSearch) {
   DnnBallOptions o;
   o.detector = "both";
@@ -322,6 +320,9 @@ TEST_F(DnnBallOnPhotos, InputScaleOfTheWholeFrameSearch) {
   EXPECT_THROW(net.InputScale({1280, 960}, cv::Rect(2000, 0, 10, 10)), Error);
 }
 
+// Two SSL photos (224 x 224, upscaled to the network's 416) whose ball is elsewhere: a
+// whole-frame network box around a far robot (2.3-2.8 px orange spots) does not confirm the spot,
+// as it did before hold_min_radius_px.
 TEST_F(DnnBallOnPhotos, WholeFrameBoxesDoNotConfirmFarSpots) {
   const std::string ssl = dir_ + "/../../ssl-orange";
   for (const char* name : {"00109", "00208"}) {
