@@ -6,7 +6,7 @@
 set -euo pipefail
 BUILD="${1:-build}"
 FV="$BUILD/bin/fieldvision"
-SCENE="$BUILD/bench-data/ball-kick"
+SCENE="$BUILD/bench-data/ball-kick-q90"  # q90: MJPG frames at libjpeg quality 90
 [ -x "$FV" ] || { echo "ball_pipeline: $FV not built"; exit 1; }
 if [ ! -s "$SCENE/truth.csv" ]; then
   "$FV" synth --preset kick --out "$SCENE" >/dev/null

@@ -15,7 +15,7 @@ set -euo pipefail
 BUILD="${1:-build}"
 SIZE="${2:-1280x960}"
 FV="$BUILD/bin/fieldvision"
-SCENE="$BUILD/bench-data/ball-kick"
+SCENE="$BUILD/bench-data/ball-kick-q90"  # q90: MJPG frames at libjpeg quality 90
 [ "$SIZE" = 1280x960 ] || SCENE="$SCENE-$SIZE"
 [ -x "$FV" ] || { echo "ball_pipeline_live: $FV not built"; exit 1; }
 if [ ! -s "$SCENE/truth.csv" ]; then

@@ -166,7 +166,7 @@ struct SceneSpec {
   std::vector<ConeSpec> cones;
   LightingSpec lighting;
   double noise_sigma = 2.0;  // Gaussian sensor noise, 8-bit levels
-  int jpeg_quality = 90;
+  int jpeg_quality = 90;  // libjpeg's scale (cv::imwrite's), also for the MJPG frames of "avi"
   std::string format = "avi";  // "avi" (MJPG), "png" or "jpg" (image sequence <cam>/%05d.ext)
 
   double duration_s() const { return num_frames / fps; }
@@ -315,6 +315,12 @@ struct WriteSceneResult {
 // players_2d.csv (when there are people) and contact_sheet.png. Progress on stderr if asked.
 WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir,
                             bool progress = false);
+
+// The quality to give OpenCV's MJPG writer (cv::CAP_OPENCV_MJPEG) for frames quantised as
+// libjpeg (cv::imwrite) quantises at `jpeg_quality`: that writer divides the standard tables by
+// 0.12 x its own quality (1..12), so its 90 is about libjpeg's 95. It reaches libjpeg's 50..95
+// (SceneSpec::Check refuses other qualities for "avi").
+double MjpegWriterQuality(int jpeg_quality);
 
 // The first images of the cameras tiled with their names (tile width in pixels).
 cv::Mat ContactSheet(const std::vector<cv::Mat>& images, const std::vector<std::string>& names,

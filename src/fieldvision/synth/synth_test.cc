@@ -1,12 +1,14 @@
 #include "fieldvision/synth/synth.h"
 
 #include <cmath>
+#include <vector>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -442,6 +444,43 @@ TEST(Writer, ReproducibleFilesWithContractHeaders) {
   const cv::Mat i1 = r1.RenderCamera(0, 1), i2 = r2.RenderCamera(0, 1);
   EXPECT_GT(cv::norm(i1, i2, cv::NORM_L1), 0.0);
   EXPECT_EQ(cv::norm(i1, r1.RenderCamera(0, 1), cv::NORM_L1), 0.0);
+}
+
+// The first quantisation table (DQT, 64 values) of the first JPEG in `bytes`.
+std::vector<int> FirstQuantTable(const std::string& bytes) {
+  const size_t dqt = bytes.find("\xFF\xDB");
+  if (dqt == std::string::npos || dqt + 5 + 64 > bytes.size()) return {};
+  std::vector<int> q;
+  for (size_t i = 0; i < 64; ++i) q.push_back(static_cast<unsigned char>(bytes[dqt + 5 + i]));
+  return q;
+}
+
+TEST(Writer, MjpgFramesAreQuantisedAsTheSceneQualitySays) {
+  // cv::imwrite's quality is libjpeg's; the scene's jpeg_quality means the same in its videos.
+  SceneSpec s = CleanScene({Eigen::Vector3d(-2, -1, 0.5)}, 1);
+  const std::string dir = fv::testing::TempDir();
+  const cv::Mat grey(16, 16, CV_8UC3, cv::Scalar::all(128));
+  for (const int quality : {50, 75, 90, 95}) {
+    SCOPED_TRACE(quality);
+    s.jpeg_quality = quality;
+    WriteScene(s, dir + "/q");
+    std::vector<uchar> jpg;
+    cv::imencode(".jpg", grey, jpg, {cv::IMWRITE_JPEG_QUALITY, quality});
+    const std::vector<int> want = FirstQuantTable(std::string(jpg.begin(), jpg.end()));
+    const std::vector<int> got = FirstQuantTable(ReadAll(dir + "/q/a.avi"));
+    ASSERT_EQ(got.size(), 64u);
+    ASSERT_EQ(want.size(), 64u);
+    // The same table up to rounding (OpenCV's writer rounds its own way).
+    for (int i = 0; i < 64; ++i) EXPECT_NEAR(got[i], want[i], 1) << i;
+  }
+  // Beyond what that writer's tables reach: refused for videos, fine for image files.
+  for (const int quality : {30, 97}) {
+    s.format = "avi";
+    s.jpeg_quality = quality;
+    EXPECT_THAT([&] { s.Check(); }, ThrowsMessage<Error>(HasSubstr("jpeg_quality")));
+    s.format = "jpg";
+    EXPECT_NO_THROW(s.Check());
+  }
 }
 
 TEST(Writer, ImageSequencesAndBadOutput) {

@@ -24,6 +24,15 @@
 namespace fv::synth {
 namespace fs = std::filesystem;
 
+double MjpegWriterQuality(int jpeg_quality) {
+  FV_REQUIRE(jpeg_quality >= 1 && jpeg_quality <= 100, "JPEG quality {} is not in 1..100",
+             jpeg_quality);
+  // libjpeg scales its tables by s % (s = 5000 / q below 50, else 200 - 2 q); OpenCV's MJPG
+  // writer divides them by 0.12 x its quality, clamped to 1..12.
+  const double percent = jpeg_quality < 50 ? 5000.0 / jpeg_quality : 200.0 - 2.0 * jpeg_quality;
+  return 100.0 / (0.12 * std::max(percent, 1.0));
+}
+
 std::string WriteSceneResult::Summary() const {
   return fmt::format(
       "{} cameras x {} frames in {:.1f} s ({:.1f} frames/s over all cameras; set-up {:.1f} s); "
@@ -119,7 +128,7 @@ std::vector<std::unique_ptr<CameraOut>> OpenOutputs(const SceneSpec& spec,
     out.writer.open(out.file, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
                     spec.fps, cv::Size(cam.width, cam.height), true);
     FV_REQUIRE(out.writer.isOpened(), "cannot open video '{}' for writing", out.file);
-    out.writer.set(cv::VIDEOWRITER_PROP_QUALITY, spec.jpeg_quality);
+    out.writer.set(cv::VIDEOWRITER_PROP_QUALITY, MjpegWriterQuality(spec.jpeg_quality));
   }
   return outs;
 }
