@@ -165,8 +165,8 @@ struct SceneSpec {
       TeamSpec{}, TeamSpec{"blue", Eigen::Vector3d(180, 90, 20), Eigen::Vector3d(40, 30, 30)}};
   std::vector<ConeSpec> cones;
   LightingSpec lighting;
-  double noise_sigma = 2.0;  // Gaussian sensor noise, 8-bit levels
-  int jpeg_quality = 90;  // libjpeg's scale (cv::imwrite's), also for the MJPG frames of "avi"
+  double noise_sigma = 2.0;    // Gaussian sensor noise, 8-bit levels
+  int jpeg_quality = 90;       // libjpeg's scale (cv::imwrite's), also for the MJPG frames of "avi"
   std::string format = "avi";  // "avi" (MJPG), "png" or "jpg" (image sequence <cam>/%05d.ext)
 
   double duration_s() const { return num_frames / fps; }

@@ -1,10 +1,10 @@
 #include "fieldvision/synth/synth.h"
 
 #include <cmath>
-#include <vector>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
