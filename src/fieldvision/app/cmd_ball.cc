@@ -47,6 +47,11 @@ void RunBall(const BallCliOptions& o) {
             ? fmt::format("; {} frames the model does not follow kept", r.bundle->kept_rows)
             : "");
   }
+  if (r.bundle && r.bundle->rests.runs > 0) {
+    std::cout << fmt::format(
+        "{} resting balls refined on the cameras' candidates ({} rows, {:.2f} px RMS)\n",
+        r.bundle->rests.runs, r.bundle->rests.rows, r.bundle->rests.rms_px);
+  }
   if (r.bundle && r.bundle->kept_flights > 0) {
     std::cout << fmt::format(
         "{} flights kept frame by frame (the flight model fits the candidates much worse than "

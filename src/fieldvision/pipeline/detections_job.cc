@@ -17,6 +17,7 @@
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
 #include "fieldvision/pipeline/fusion_stage.h"
+#include "fieldvision/pipeline/rest_bundle.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/recon/trajectory_path.h"
@@ -41,6 +42,11 @@ void DetectionsJobOptions::Check() const {
   FV_REQUIRE(!out.empty(), "ball: --out is required");
   triangulation.Check();
   eval.Check();
+}
+
+double CandidateOutlierLimitPx(const std::vector<double>& dist_px) {
+  const double sigma = util::NearestRankPercentile(dist_px, 0.5) / 1.1774;
+  return std::max(4.0 * sigma, 0.5);
 }
 
 std::vector<CameraMessage> ParseDetections(const util::CsvTable& t, int camera, double sigma_px) {
@@ -185,21 +191,12 @@ void FitAtFrames(const std::vector<camera::Camera>& cameras,
 // gravity model's 6 parameters and 4 more.
 constexpr int kMinResiduals = 6 + 4;
 
-constexpr double kTrimSigmas = 4.0;
-constexpr double kTrimFloorPx = 0.5;
 constexpr int kTrimRounds = 3;
-
-// kTrimSigmas times the robust spread of 2D distances (their median over the Rayleigh median,
-// 1.1774 sigma), at least kTrimFloorPx.
-double OutlierLimit(const std::vector<double>& dist) {
-  const double sigma = util::NearestRankPercentile(dist, 0.5) / 1.1774;
-  return std::max(kTrimSigmas * sigma, kTrimFloorPx);
-}
 
 // The bundled model against each frame's own position on the observations at the frames'
 // moments (the nearest per-frame position within half a frame, margin_s): both RMS, without
-// the candidates their own frames' positions explain far worse than the rest (OutlierLimit):
-// those are the detector's errors, not the model's.
+// the candidates their own frames' positions explain far worse than the rest
+// (CandidateOutlierLimitPx): those are the detector's errors, not the model's.
 void CompareWithFrames(const std::vector<camera::Camera>& cameras,
                        const std::vector<FlightObservation>& obs,
                        const std::vector<recon::BallSample>& per_frame, double margin_s,
@@ -214,7 +211,7 @@ void CompareWithFrames(const std::vector<camera::Camera>& cameras,
     d_model.push_back((*uv_model - o.uv).norm());
     d_frame.push_back((*uv_frame - o.uv).norm());
   }
-  const double limit = d_frame.empty() ? 0.0 : OutlierLimit(d_frame);
+  const double limit = d_frame.empty() ? 0.0 : CandidateOutlierLimitPx(d_frame);
   double ss_model = 0, ss_frames = 0;
   for (size_t i = 0; i < d_frame.size(); ++i) {
     if (d_frame[i] > limit) continue;
@@ -355,7 +352,7 @@ recon::BallisticModel ModelOf(const FlightParams& x, const recon::BallisticModel
   return model;
 }
 
-// The observations the model explains within kTrimSigmas of their robust spread (OutlierLimit),
+// The observations the model explains within CandidateOutlierLimitPx of their distances,
 // refitted up to kTrimRounds times: a centre a few pixels off (a fit to the ball and its shadow,
 // a frame's wrong candidate) is inside the Huber loss's quadratic zone at the detections'
 // nominal sigma, and at a flight's ends it tilts the velocity (low-sun kick render, seed 3: the
@@ -368,7 +365,7 @@ std::vector<FlightObservation> TrimObservations(const std::vector<camera::Camera
     const auto uv = cameras[obs[i].cam].Project(model.PositionAt(obs[i].time_s));
     if (uv) dist[i] = (*uv - obs[i].uv).norm();
   }
-  const double limit = OutlierLimit(dist);
+  const double limit = CandidateOutlierLimitPx(dist);
   std::vector<FlightObservation> kept;
   for (size_t i = 0; i < obs.size(); ++i) {
     if (dist[i] <= limit) kept.push_back(obs[i]);
@@ -481,6 +478,7 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
   const double margin = 0.5 * util::NearestRankPercentile(dts, 0.5);  // the upper middle; 0 if none
   double ss = 0;
   long long nobs = 0;
+  std::vector<char> in_flight(track->size(), 0);  // rows a refined flight set
   for (const recon::Flight& f : out.trajectory->flights) {
     const Bundled b = BundleFlight(cameras, messages, f, to, sigma_px, margin, per_frame);
     // A free flight's model explains the candidates about as well as each frame's own position
@@ -506,11 +504,14 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
       }
       s.ball_in_world = b.model.PositionAt(s.time_s);
       s.err_px = b.rms_px;
+      in_flight[i] = 1;
       ++out.bundled_rows;
     }
   }
   out.observations = nobs;
   if (nobs > 0) out.rms_px = std::sqrt(ss / nobs);
+  out.rests = BundleRests(cameras, messages, to.ball_radius_m, margin, in_flight,
+                          RestBundleOptions(), track);
   return out;
 }
 
@@ -521,6 +522,10 @@ std::string DetectionsJobResult::Summary() const {
     s += fmt::format("; {} flights refined on the 2D detections ({} rows, {:.2f} px RMS)",
                      bundled_flights, bundled_rows, bundle_rms_px);
     if (kept_rows > 0) s += fmt::format(", {} frames the model does not follow kept", kept_rows);
+  }
+  if (rests.runs > 0) {
+    s += fmt::format("; {} resting balls refined on the 2D detections ({} rows, {:.2f} px RMS)",
+                     rests.runs, rests.rows, rests.rms_px);
   }
   for (const auto& p : sync.Problems()) s += "\n  " + p;
   if (trajectory) {
@@ -580,6 +585,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     res.bundled_rows = b.bundled_rows;
     res.kept_rows = b.kept_rows;
     res.bundle_rms_px = b.rms_px;
+    res.rests = b.rests;
   } else if (!o.flights.empty()) {
     res.trajectory =
         recon::AnalyzeTrajectory(res.per_frame, FlightOptions(o.ball_diameter_m, o.ball_mass_kg));

@@ -16,6 +16,7 @@
 
 #include "fieldvision/pipeline/camera_message.h"
 #include "fieldvision/pipeline/frame_sync.h"
+#include "fieldvision/pipeline/rest_bundle.h"
 #include "fieldvision/recon/ball_eval.h"
 #include "fieldvision/recon/trajectory.h"
 #include "fieldvision/recon/triangulation.h"
@@ -49,6 +50,7 @@ struct DetectionsJobResult {
   long long bundled_rows = 0;                // rows of BALL.csv taken from them
   long long kept_rows = 0;     // rows inside them that kept their own position (BundleFlights)
   double bundle_rms_px = 0.0;  // reprojection RMS of the bundled detections
+  RestBundle rests;            // resting runs refined (BundleFlights)
   std::optional<recon::BallEvalResult> eval;          // with a truth file
   std::optional<recon::TrajectoryResult> trajectory;  // with `flights`
   std::string Summary() const;
@@ -64,13 +66,19 @@ std::vector<CameraMessage> ParseDetections(const util::CsvTable& table, int came
 
 DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& options);
 
+// Candidates farther than this from a refined model's image are left out of the refit: four
+// times the robust spread of the distances (their median over the Rayleigh median, 1.1774
+// sigma), at least 0.5 px.
+double CandidateOutlierLimitPx(const std::vector<double>& dist_px);
+
 // The flights of a per-frame track (time order), each refined on the cameras' candidates
 // (`messages`: per camera, in time order) by the physics-constrained bundle above; the track's
 // positions inside a refined flight become the flight model's (err_px: the flight's RMS), unless
 // the model explains the candidates much worse than the per-frame positions do (not a free
 // flight: a carried or deflected ball) or lies far from most of them (a "flight" between two
 // places where the ball rested), which are then kept; so is a single frame whose candidates the
-// model explains much worse than its typical frame's and than the frame's own position.
+// model explains much worse than its typical frame's and than the frame's own position. Then the
+// rows outside refined flights where the ball rests take their run's point (BundleRests).
 struct FlightBundle {
   std::optional<recon::TrajectoryResult> trajectory;
   int bundled_flights = 0;
@@ -79,6 +87,7 @@ struct FlightBundle {
   long long kept_rows = 0;     // rows inside refined flights that kept their own position
   double rms_px = 0.0;         // reprojection RMS of the candidates used
   long long observations = 0;  // candidates used
+  RestBundle rests;            // then the runs where the ball rests (rest_bundle.h)
 };
 FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
                            const std::vector<std::vector<CameraMessage>>& messages,

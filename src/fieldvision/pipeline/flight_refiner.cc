@@ -8,6 +8,17 @@
 #include "fieldvision/util/error.h"
 
 namespace fv::pipeline {
+namespace {
+
+// The RMS over every piece's candidates: a piece's (rms_px over n) added to the totals'.
+void AddRms(double rms_px, long long n, double* total_rms_px, long long* total_n) {
+  const double ss = *total_rms_px * *total_rms_px * static_cast<double>(*total_n) +
+                    rms_px * rms_px * static_cast<double>(n);
+  *total_n += n;
+  *total_rms_px = *total_n > 0 ? std::sqrt(ss / static_cast<double>(*total_n)) : 0.0;
+}
+
+}  // namespace
 
 void FlightRefinerOptions::Check() const {
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0,
@@ -91,12 +102,10 @@ void FlightRefiner::Flush(double before_s) {
   totals_.kept_flights += b.kept_flights;
   totals_.bundled_rows += b.bundled_rows;
   totals_.kept_rows += b.kept_rows;
-  // The RMS over every piece's candidates.
-  const double ss_px = totals_.rms_px * totals_.rms_px * static_cast<double>(totals_.observations) +
-                       b.rms_px * b.rms_px * static_cast<double>(b.observations);
-  totals_.observations += b.observations;
-  totals_.rms_px =
-      totals_.observations > 0 ? std::sqrt(ss_px / static_cast<double>(totals_.observations)) : 0.0;
+  totals_.rests.runs += b.rests.runs;
+  totals_.rests.rows += b.rests.rows;
+  AddRms(b.rms_px, b.observations, &totals_.rms_px, &totals_.observations);
+  AddRms(b.rests.rms_px, b.rests.observations, &totals_.rests.rms_px, &totals_.rests.observations);
 }
 
 }  // namespace fv::pipeline

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/pipeline/test_messages.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -12,17 +13,7 @@
 namespace fv::pipeline {
 namespace {
 
-std::vector<camera::Camera> Rig() {
-  std::vector<camera::Camera> cams;
-  const Eigen::Vector3d eyes[] = {{-12, -9, 5}, {12, -9, 5.5}, {12, 9, 6}, {-12, 9, 4.5}};
-  for (int c = 0; c < 4; ++c) {
-    camera::Camera cam = camera::Camera::FromFov(1280, 960, 70);
-    cam.has_pose = true;
-    cam.cam_from_world = geometry::Rigid3d::LookAt(eyes[c], Eigen::Vector3d(0, 0, 1));
-    cams.push_back(cam);
-  }
-  return cams;
-}
+using test_util::CornerRig;
 
 struct Clip {
   std::vector<CameraMessage> messages;  // per frame, each camera's, in time order
@@ -74,7 +65,7 @@ TEST(FlightRefiner, PiecesAsTheWholeTrackAndTheFirstPieceDropped) {
   const uint64_t seed = testing::TestSeed(71);
   FV_SEED_TRACE(seed);
   util::Rng rng(seed);
-  const auto cams = Rig();
+  const auto cams = CornerRig();
   const Clip clip = TwoKicks(cams, rng);
 
   // The whole track at once.
@@ -113,7 +104,7 @@ TEST(FlightRefiner, PiecesAsTheWholeTrackAndTheFirstPieceDropped) {
 }
 
 TEST(FlightRefiner, BadOptionsAndOutOfOrderPositionsAreNamed) {
-  const auto cams = Rig();
+  const auto cams = CornerRig();
   const auto expect_named = [&](const FlightRefinerOptions& o, const std::string& field) {
     try {
       const FlightRefiner refiner(cams, o, [](const recon::BallSample&) {});
