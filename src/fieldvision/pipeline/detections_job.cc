@@ -454,6 +454,14 @@ double TypicalModelRms(const Bundled& b) {
   return util::NearestRankPercentile(rms, 0.5);
 }
 
+// A model's position this far below a ball resting on the ground is past the bounce that ended
+// its flight (a frame the segmentation left in it): the ball cannot be there.
+constexpr double kBelowGroundM = 0.01;
+
+bool BelowGround(const Eigen::Vector3d& p, const recon::TrajectoryOptions& to) {
+  return p.z() < to.ground_z_m + to.ball_radius_m - kBelowGroundM;
+}
+
 bool ModelFailsAt(const Bundled::AtFrame& a, double typical_px) {
   const double model = a.model_rms();
   return model > kMaxModelRmsRatio * typical_px + kModelRmsSlackPx &&
@@ -498,11 +506,12 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
       recon::BallSample& s = (*track)[i];
       if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
       const auto a = b.at_frame.find(i);
-      if (a != b.at_frame.end() && ModelFailsAt(a->second, typical_px)) {
+      const Eigen::Vector3d p = b.model.PositionAt(s.time_s);
+      if ((a != b.at_frame.end() && ModelFailsAt(a->second, typical_px)) || BelowGround(p, to)) {
         ++out.kept_rows;
         continue;
       }
-      s.ball_in_world = b.model.PositionAt(s.time_s);
+      s.ball_in_world = p;
       s.err_px = b.rms_px;
       in_flight[i] = 1;
       ++out.bundled_rows;
