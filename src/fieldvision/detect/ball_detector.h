@@ -67,6 +67,9 @@ struct BallCandidate {
   // Not accepted, its lowest point more than its radius above the field's far edge (no posed
   // camera): a network confirms it only as a ball of its own (set by "both", dnn_ball.h).
   bool off_field = false;
+  // Rejected by the colour checks and accepted on a network confirmation below the network's
+  // own accept score ("both", dnn_ball.h): multi-view fusion takes it as weak (ball_job.cc).
+  bool rescued = false;
   // The network's sports-ball score (dnn_ball.h; 0 where it found none or did not look, -1 when
   // the detector has no network).
   double network_score = -1.0;

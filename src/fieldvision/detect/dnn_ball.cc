@@ -132,6 +132,7 @@ std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate
     BallCandidate c = colour[i];
     c.network_score = confirm[i];
     if (confirm[i] >= ConfirmScore(c, o)) {
+      c.rescued = !c.accepted && confirm[i] < o.accept_score;
       c.accepted = true;
       c.reason.clear();
       ranked.push_back({c, 0, confirm[i]});

@@ -134,6 +134,29 @@ TEST(CombineBallCandidates, AnUnconfirmedCandidateOnTheFieldIsKept) {
   EXPECT_FALSE(CombineBallCandidates({c}, {0.02}, {}, o)[0].accepted);
 }
 
+// A candidate the colour checks rejected and the network confirmed below its own accept score is
+// accepted but marked rescued (multi-view fusion takes it as weak); from the accept score, or
+// when colour had accepted it, it is not.
+TEST(CombineBallCandidates, ALowConfirmationOfARejectedCandidateIsARescue) {
+  DnnBallOptions o;
+  o.detector = "both";
+  const BallCandidate rejected = Cand(50, 50, 8, 0.0, false);
+  const BallCandidate accepted = Cand(50, 50, 8, 0.6, true);
+  auto out = CombineBallCandidates({rejected}, {0.2}, {}, o);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(out[0].accepted);
+  EXPECT_TRUE(out[0].rescued);
+  out = CombineBallCandidates({rejected}, {o.accept_score}, {}, o);
+  EXPECT_TRUE(out[0].accepted);
+  EXPECT_FALSE(out[0].rescued);
+  out = CombineBallCandidates({accepted}, {0.2}, {}, o);
+  EXPECT_TRUE(out[0].accepted);
+  EXPECT_FALSE(out[0].rescued);
+  out = CombineBallCandidates({rejected}, {0.05}, {}, o);  // below the confirm score
+  EXPECT_FALSE(out[0].accepted);
+  EXPECT_FALSE(out[0].rescued);
+}
+
 TEST(HoldingScores, ABoxConfirmsTheCandidatesItHoldsOfASimilarSize) {
   DnnBallOptions o;
   const std::vector<BallCandidate> colour = {

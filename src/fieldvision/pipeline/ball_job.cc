@@ -72,7 +72,10 @@ namespace {
 
 recon::BallObservation Observation(const detect::BallCandidate& b) {
   recon::BallObservation obs;
-  obs.weak = !b.accepted;
+  // A ball the colour checks rejected and a low network score rescued completes positions only:
+  // a cone the network took for a ball at 0.1-0.3, seen by all four cameras of the kick render,
+  // outvoted the ball that three saw.
+  obs.weak = !b.accepted || b.rescued;
   obs.centre_px = b.centre_px;
   obs.radius_px = b.radius_px;
   obs.sigma_px = std::max(b.sigma_px, 0.05);
