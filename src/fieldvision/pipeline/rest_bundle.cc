@@ -22,6 +22,9 @@ void RestBundleOptions::Check() const {
   FV_REQUIRE(std::isfinite(min_duration_s) && min_duration_s >= 0,
              "RestBundleOptions.min_duration_s must be >= 0 (got {})", min_duration_s);
   FV_REQUIRE(min_frames >= 2, "RestBundleOptions.min_frames must be >= 2 (got {})", min_frames);
+  FV_REQUIRE(max_frames_per_camera >= 1,
+             "RestBundleOptions.max_frames_per_camera must be >= 1 (got {})",
+             max_frames_per_camera);
 }
 
 namespace {
@@ -85,18 +88,25 @@ size_t GrowRun(const std::vector<recon::BallSample>& track, const std::vector<ch
   return last;
 }
 
-// Each camera's non-weak candidate nearest the point's image in every frame of [t0, t1] (within
-// margin), within max(gate_px, half the candidate's radius).
+// Each camera's non-weak candidate nearest the point's image in the frames of [t0, t1] (within
+// margin), within max(gate_px, half the candidate's radius); at most max_frames frames a camera,
+// evenly spread (a ball resting for minutes adds nothing past a few seconds but work).
 std::vector<recon::View> GatherViews(const std::vector<camera::Camera>& cameras,
                                      const std::vector<std::vector<CameraMessage>>& messages,
                                      const Eigen::Vector3d& point, double t0_s, double t1_s,
-                                     double margin_s, double gate_px) {
+                                     double margin_s, double gate_px, int max_frames) {
   std::vector<recon::View> views;
   for (size_t c = 0; c < messages.size() && c < cameras.size(); ++c) {
     const auto uv = recon::PredictBallCentre(cameras[c], point, 0.0);
     if (!uv) continue;
+    const auto in_run = [&](const CameraMessage& m) {
+      return m.time_s >= t0_s - margin_s && m.time_s <= t1_s + margin_s;
+    };
+    const auto count = std::count_if(messages[c].begin(), messages[c].end(), in_run);
+    const long stride = std::max<long>(1, (count + max_frames - 1) / max_frames);
+    long k = 0;
     for (const CameraMessage& m : messages[c]) {
-      if (m.time_s < t0_s - margin_s || m.time_s > t1_s + margin_s) continue;
+      if (!in_run(m) || k++ % stride != 0) continue;
       const recon::BallObservation* best = nullptr;
       double best_d = 0.0;
       for (const recon::BallObservation& o : m.candidates) {
@@ -184,7 +194,7 @@ RestBundle BundleRests(const std::vector<camera::Camera>& cameras,
     mean /= static_cast<double>(run.last - run.first + 1);
     const std::vector<recon::View> views =
         GatherViews(cameras, messages, mean, (*track)[run.first].time_s, (*track)[run.last].time_s,
-                    margin_s, options.gate_px);
+                    margin_s, options.gate_px, options.max_frames_per_camera);
     if (DistinctCameras(views) < 2) continue;
     const recon::TriangulationResult r = TrimmedPoint(cameras, views, topt);
     // A point that left the run (a bad set of views) is no refinement of it.

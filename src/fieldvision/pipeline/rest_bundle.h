@@ -27,7 +27,10 @@ struct RestBundleOptions {
   double min_duration_s = 0.1;  // a shorter run is no run
   double max_gap_s = 0.1;       // positions farther apart in time start a new run
   double gate_px = 3.0;         // a candidate farther than this (or half its radius) is no view
-  void Check() const;           // throws fv::Error naming the bad field
+  // Of a longer run, this many frames a camera, evenly spread, are triangulated (the views'
+  // noise averages out within a few seconds; the triangulation's pairwise checks are quadratic).
+  int max_frames_per_camera = 120;
+  void Check() const;  // throws fv::Error naming the bad field
 };
 
 // Runs [first, last] of track (time order) where the ball rests; rows with skip[i] set (taken by

@@ -92,6 +92,10 @@ TEST(RestingRuns, StillPartsOfANoisyTrackAreRunsRollingOnesAreNot) {
   bad.min_frames = 1;  // below 2
   EXPECT_THAT([&] { FindRestingRuns(track, {}, bad); },
               ThrowsMessage<Error>(HasSubstr("min_frames")));
+  bad = {};
+  bad.max_frames_per_camera = 0;
+  EXPECT_THAT([&] { FindRestingRuns(track, {}, bad); },
+              ThrowsMessage<Error>(HasSubstr("max_frames_per_camera")));
   EXPECT_THAT([&] { FindRestingRuns(track, std::vector<char>(3, 0), o); },
               ThrowsMessage<Error>(HasSubstr("skip flags")));
 }
@@ -145,6 +149,14 @@ TEST(BundleRests, AStillBallTakesOnePointFromAllFramesCandidates) {
   EXPECT_LT(refined_err_m / refined, 0.5 * frames_err_m)
       << "frames' mean error " << frames_err_m * 1e3 << " mm";
   for (int f = 30; f < 40; ++f) EXPECT_EQ(track[f].ball_in_world, before[f].ball_in_world) << f;
+  // A long rest is triangulated on at most max_frames_per_camera frames a camera.
+  RestBundleOptions few;
+  few.max_frames_per_camera = 7;
+  std::vector<recon::BallSample> capped = before;
+  const RestBundle c = BundleRests(cams, messages, 0.11, 0.5 / 60.0, {}, few, &capped);
+  ASSERT_GE(c.runs, 1);
+  EXPECT_LE(c.observations, 4 * 7 * c.runs);
+  EXPECT_GE(c.observations, 4 * 5);
   // With one camera's candidates only there is nothing to refine on.
   std::vector<std::vector<CameraMessage>> one(cams.size());
   one[0] = messages[0];
