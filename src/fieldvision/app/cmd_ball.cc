@@ -49,8 +49,9 @@ void RunBall(const BallCliOptions& o) {
   }
   if (r.bundle && r.bundle->rests.runs > 0) {
     std::cout << fmt::format(
-        "{} resting balls refined on the cameras' candidates ({} rows, {:.2f} px RMS)\n",
-        r.bundle->rests.runs, r.bundle->rests.rows, r.bundle->rests.rms_px);
+        "{} resting ball{} refined on the cameras' candidates ({} rows, {:.2f} px RMS)\n",
+        r.bundle->rests.runs, r.bundle->rests.runs == 1 ? "" : "s", r.bundle->rests.rows,
+        r.bundle->rests.rms_px);
   }
   if (r.bundle && r.bundle->kept_flights > 0) {
     std::cout << fmt::format(

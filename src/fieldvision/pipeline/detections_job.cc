@@ -533,8 +533,8 @@ std::string DetectionsJobResult::Summary() const {
     if (kept_rows > 0) s += fmt::format(", {} frames the model does not follow kept", kept_rows);
   }
   if (rests.runs > 0) {
-    s += fmt::format("; {} resting balls refined on the 2D detections ({} rows, {:.2f} px RMS)",
-                     rests.runs, rests.rows, rests.rms_px);
+    s += fmt::format("; {} resting ball{} refined on the 2D detections ({} rows, {:.2f} px RMS)",
+                     rests.runs, rests.runs == 1 ? "" : "s", rests.rows, rests.rms_px);
   }
   for (const auto& p : sync.Problems()) s += "\n  " + p;
   if (trajectory) {
