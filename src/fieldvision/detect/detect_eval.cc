@@ -419,7 +419,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
             "weak",      "on_ball", "visible", "inliers",      "outside", "dents",
             "region",    "arc",     "fill",    "spill",        "leak",    "contrast",
             "outside_r", "extent",  "precise", "hue_contrast", "network", "field_share",
-            "reason"},
+            "rescued",   "reason"},
         4);
   }
   util::Progress progress("eval detect", std::ssize(items), "images", o.progress);
@@ -442,7 +442,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
                   << c.inlier_fraction << c.outside_fraction << c.dents << int(c.region_ok)
                   << c.arc_cover << c.fill << c.spill << c.leak << c.contrast << c.region_outside
                   << c.region_extent << int(c.precise) << c.hue_contrast << c.network_score
-                  << c.field_share << ReplaceCommas(c.reason);
+                  << c.field_share << int(c.rescued) << ReplaceCommas(c.reason);
         cand_csv->EndRow();
       }
     }

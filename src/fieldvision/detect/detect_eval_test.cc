@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -9,6 +10,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/test_images.h"
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
@@ -45,8 +47,22 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   o.video = dir;
   o.labels = dir + "/labels";
   o.progress = false;
+  o.candidates_out = dir + "/candidates.csv";
   const DetectEvalResult r = EvaluateDetector(o);
   EXPECT_EQ(r.images.size(), 4u);
+  // Every candidate a row, with its measurements; the accepted ones on the balls.
+  const util::CsvTable cands = util::CsvTable::Read(o.candidates_out);
+  for (const char* column : {"image", "u", "v", "radius_px", "accepted", "on_ball", "network",
+                             "field_share", "rescued", "reason"}) {
+    EXPECT_NE(std::find(cands.header().begin(), cands.header().end(), column), cands.header().end())
+        << column;
+  }
+  int accepted_on_ball = 0;
+  for (size_t i = 0; i < cands.rows(); ++i) {
+    accepted_on_ball += cands.GetInt(i, "accepted") == 1 && cands.GetInt(i, "on_ball") == 1;
+    EXPECT_EQ(cands.GetInt(i, "rescued"), 0);  // no network in colour
+  }
+  EXPECT_EQ(accepted_on_ball, 3);
   EXPECT_EQ(r.with_ball, 3);
   EXPECT_EQ(r.no_label_file, 1);
   EXPECT_EQ(r.hits, 3) << r.Summary();
