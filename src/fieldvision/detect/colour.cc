@@ -1,5 +1,6 @@
 #include "fieldvision/detect/colour.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -8,8 +9,10 @@
 #include <set>
 #include <sstream>
 
+#include <opencv2/core/version.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/colour_cache.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -352,6 +355,43 @@ ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
   });
 }
 
+ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel, util::HugeBuffer table)
+    : spec_(spec), bits_(bits_per_channel), table_(std::move(table)) {}
+
+bool ColourTable::AgreesWithSpec(int samples) const {
+  const int shift = 8 - bits_;
+  const int centre = shift > 0 ? 1 << (shift - 1) : 0;
+  uint32_t state = 12345u;
+  for (int i = 0; i < samples; ++i) {
+    state = state * 1664525u + 1013904223u;  // Numerical Recipes' LCG
+    const auto level = [&](int at) {
+      return uint8_t((((state >> at) & 0xFFu) >> shift << shift) + centre);
+    };
+    const uint8_t b = level(0), g = level(8), r = level(16);
+    const auto hsv = BgrToHsv(b, g, r);
+    const auto yuv = BgrToYuv(b, g, r);
+    uint8_t want = 0;
+    for (size_t k = 0; k < spec_.classes.size(); ++k) {
+      for (const ColourRange& range : spec_.classes[k].ranges) {
+        if (RangeContains(range, hsv, yuv)) want |= uint8_t(1u << k);
+      }
+    }
+    if (Classify(b, g, r) != want) return false;
+  }
+  return true;
+}
+
+namespace {
+
+// The disk cache's key (colour_cache.h): the table's format, OpenCV's version (its colour
+// conversions fill the table) and the spec.
+std::string DiskKey(const ColourSpec& spec, int bits) {
+  return fmt::format("colour table 1, {} bits, OpenCV {}\n{}", bits, CV_VERSION,
+                     ColourSpecToJson(spec).dump());
+}
+
+}  // namespace
+
 std::shared_ptr<const ColourTable> ColourTable::Shared(const ColourSpec& spec,
                                                        int bits_per_channel) {
   static std::mutex mutex;
@@ -359,7 +399,21 @@ std::shared_ptr<const ColourTable> ColourTable::Shared(const ColourSpec& spec,
   const std::string key = std::to_string(bits_per_channel) + ColourSpecToJson(spec).dump();
   std::lock_guard<std::mutex> lock(mutex);
   if (auto existing = cache[key].lock()) return existing;
-  auto table = std::make_shared<const ColourTable>(spec, bits_per_channel);
+  // From the disk cache when a table there agrees with the spec on a sample of colours (a table
+  // written by other code is rebuilt and written again).
+  spec.Check();
+  const std::string disk_key = DiskKey(spec, bits_per_channel);
+  std::shared_ptr<const ColourTable> table;
+  const size_t size = size_t(1) << (3 * std::clamp(bits_per_channel, 4, 8));
+  if (auto stored = LoadCachedTable(disk_key, size)) {
+    std::shared_ptr<const ColourTable> loaded(
+        new ColourTable(spec, bits_per_channel, std::move(*stored)));
+    if (loaded->AgreesWithSpec(4096)) table = std::move(loaded);
+  }
+  if (!table) {
+    table = std::make_shared<const ColourTable>(spec, bits_per_channel);
+    StoreCachedTable(disk_key, table->data(), size);
+  }
   cache[key] = table;
   return table;
 }

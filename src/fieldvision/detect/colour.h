@@ -79,9 +79,13 @@ bool RangeContains(const ColourRange& range, const std::array<double, 3>& hsv,
 class ColourTable {
  public:
   explicit ColourTable(const ColourSpec& spec, int bits_per_channel = 8);
-  // Shared, cached tables: detectors built for several cameras with one spec share one table.
+  // Shared, cached tables: detectors built for several cameras with one spec share one table,
+  // loaded from the disk cache (colour_cache.h) when it holds one, else built and stored there.
   static std::shared_ptr<const ColourTable> Shared(const ColourSpec& spec,
                                                    int bits_per_channel = 8);
+  // Whether `samples` pseudo-random colours (the same each call) classify as the spec's ranges
+  // say, colour by colour (BgrToHsv, BgrToYuv, RangeContains).
+  bool AgreesWithSpec(int samples) const;
 
   const ColourSpec& spec() const { return spec_; }
   int bits_per_channel() const { return bits_; }
@@ -133,6 +137,7 @@ class ColourTable {
   cv::Mat ClassifyImage(const cv::Mat& bgr) const;
 
  private:
+  ColourTable(const ColourSpec& spec, int bits_per_channel, util::HugeBuffer table);
   ColourSpec spec_;
   int bits_;
   util::HugeBuffer table_;  // on huge pages: 16 MB read at random, one read a pixel

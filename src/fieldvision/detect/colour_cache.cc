@@ -1,0 +1,122 @@
+#include "fieldvision/detect/colour_cache.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <system_error>
+
+#include <fmt/format.h>
+
+namespace fv::detect {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kMagic[] = "FVLUT1\n";
+constexpr size_t kMagicSize = sizeof(kMagic) - 1;
+
+uint64_t Fnv1a(const std::string& s) {
+  uint64_t h = 14695981039346656037ull;
+  for (const char c : s) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return h;
+}
+
+std::string CachePath(const std::string& key) {
+  const std::string dir = ColourCacheDir();
+  return dir.empty() ? "" : fmt::format("{}/colour-table-{:016x}.lut", dir, Fnv1a(key));
+}
+
+template <typename T>
+void Put(std::string* out, T v) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &v, sizeof(T));
+  out->append(bytes, sizeof(T));
+}
+
+// Reads a T at *at of `data`; false when the data ends first.
+template <typename T>
+bool Get(const std::string& data, size_t* at, T* v) {
+  if (data.size() - *at < sizeof(T)) return false;
+  std::memcpy(v, data.data() + *at, sizeof(T));
+  *at += sizeof(T);
+  return true;
+}
+
+}  // namespace
+
+std::string ColourCacheDir() {
+  const char* off = std::getenv("FV_NO_CACHE");
+  if (off != nullptr && std::string(off) != "0" && std::string(off) != "") return "";
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  if (xdg != nullptr && xdg[0] == '/') return std::string(xdg) + "/fieldvision";
+  const char* home = std::getenv("HOME");
+  if (home != nullptr && home[0] == '/') return std::string(home) + "/.cache/fieldvision";
+  return "";
+}
+
+std::optional<util::HugeBuffer> LoadCachedTable(const std::string& key, size_t size) {
+  const std::string path = CachePath(key);
+  if (path.empty()) return std::nullopt;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (data.compare(0, kMagicSize, kMagic) != 0) return std::nullopt;
+  size_t at = kMagicSize;
+  uint64_t key_size = 0, table_size = 0;
+  if (!Get(data, &at, &key_size) || data.size() - at < key_size ||
+      data.compare(at, key_size, key) != 0 || key_size != key.size()) {
+    return std::nullopt;
+  }
+  at += key_size;
+  if (!Get(data, &at, &table_size) || table_size != size) return std::nullopt;
+  util::HugeBuffer table(size);
+  size_t filled = 0;
+  while (filled < size) {
+    uint8_t value = 0;
+    uint32_t run = 0;
+    if (!Get(data, &at, &value) || !Get(data, &at, &run) || run == 0 || run > size - filled) {
+      return std::nullopt;
+    }
+    std::memset(table.data() + filled, value, run);
+    filled += run;
+  }
+  if (at != data.size()) return std::nullopt;
+  return table;
+}
+
+void StoreCachedTable(const std::string& key, const uint8_t* table, size_t size) {
+  const std::string path = CachePath(key);
+  if (path.empty() || table == nullptr) return;
+  std::string out(kMagic, kMagicSize);
+  Put<uint64_t>(&out, key.size());
+  out += key;
+  Put<uint64_t>(&out, size);
+  for (size_t i = 0; i < size;) {
+    size_t j = i + 1;
+    while (j < size && table[j] == table[i] && j - i < 0xFFFFFFFFu) ++j;
+    Put<uint8_t>(&out, table[i]);
+    Put<uint32_t>(&out, static_cast<uint32_t>(j - i));
+    i = j;
+  }
+  std::error_code ec;
+  fs::create_directories(fs::path(path).parent_path(), ec);
+  if (ec) return;
+  const std::string tmp = fmt::format("{}.{}.tmp", path, ::getpid());
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(out.data(), static_cast<std::streamsize>(out.size()));
+    if (!f.good()) {
+      f.close();
+      fs::remove(tmp, ec);
+      return;
+    }
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) fs::remove(tmp, ec);
+}
+
+}  // namespace fv::detect
