@@ -355,6 +355,18 @@ ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
   });
 }
 
+uint8_t ClassifyBySpec(const ColourSpec& spec, uint8_t b, uint8_t g, uint8_t r) {
+  const auto hsv = BgrToHsv(b, g, r);
+  const auto yuv = BgrToYuv(b, g, r);
+  uint8_t bits = 0;
+  for (size_t k = 0; k < spec.classes.size(); ++k) {
+    for (const ColourRange& range : spec.classes[k].ranges) {
+      if (RangeContains(range, hsv, yuv)) bits |= uint8_t(1u << k);
+    }
+  }
+  return bits;
+}
+
 ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel, util::HugeBuffer table)
     : spec_(spec), bits_(bits_per_channel), table_(std::move(table)) {}
 
@@ -368,15 +380,7 @@ bool ColourTable::AgreesWithSpec(int samples) const {
       return uint8_t((((state >> at) & 0xFFu) >> shift << shift) + centre);
     };
     const uint8_t b = level(0), g = level(8), r = level(16);
-    const auto hsv = BgrToHsv(b, g, r);
-    const auto yuv = BgrToYuv(b, g, r);
-    uint8_t want = 0;
-    for (size_t k = 0; k < spec_.classes.size(); ++k) {
-      for (const ColourRange& range : spec_.classes[k].ranges) {
-        if (RangeContains(range, hsv, yuv)) want |= uint8_t(1u << k);
-      }
-    }
-    if (Classify(b, g, r) != want) return false;
+    if (Classify(b, g, r) != ClassifyBySpec(spec_, b, g, r)) return false;
   }
   return true;
 }

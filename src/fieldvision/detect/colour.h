@@ -74,6 +74,8 @@ std::array<double, 3> BgrToHsv(uint8_t b, uint8_t g, uint8_t r);
 std::array<double, 3> BgrToYuv(uint8_t b, uint8_t g, uint8_t r);
 bool RangeContains(const ColourRange& range, const std::array<double, 3>& hsv,
                    const std::array<double, 3>& yuv);
+// The class bits the spec's ranges give one colour, computed directly (what a table holds).
+uint8_t ClassifyBySpec(const ColourSpec& spec, uint8_t b, uint8_t g, uint8_t r);
 
 // The compiled lookup table. bits_per_channel 8: exact 2^24 table; 5..7: quantised.
 class ColourTable {
