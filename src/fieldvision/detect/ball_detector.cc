@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/edge_circle.h"
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -423,8 +424,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   ScanOptions scan;
   scan.step_px = o.scan_step_px;
   scan.min_samples = o.min_samples;
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect roi = region.empty() ? image : region & image;
+  const cv::Rect roi = SearchArea(bgr.size(), region);
   const BlobScanResult blobs = ScanBlobs(bgr, *table_, ball_bit_, scan, field_mask_, roi);
   BallDetectionResult result;
   result.blobs = static_cast<int>(blobs.blobs.size());
@@ -718,7 +718,7 @@ std::optional<BallCandidate> BallDetector::FitAt(const cv::Mat& bgr, const cv::R
   // The fit's rays reach 1.6 radii and its edge search a few pixels beyond; they stop at the
   // image's border, so only the part of that square inside the image must lie in `region`.
   const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect roi = region.empty() ? image : region & image;
+  const cv::Rect roi = SearchArea(bgr.size(), region);
   const int reach = static_cast<int>(std::ceil(2.0 * radius_px + 6.0));
   const cv::Rect need =
       cv::Rect(static_cast<int>(std::floor(centre_px.x())) - reach,

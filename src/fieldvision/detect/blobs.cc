@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -152,8 +153,7 @@ BlobScanResult ScanBlobs(const cv::Mat& bgr, const ColourTable& table, uint8_t c
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "ScanBlobs: expected a BGR 8-bit image");
   FV_REQUIRE(mask.empty() || (mask.type() == CV_8U && mask.size() == bgr.size()),
              "ScanBlobs: mask must be CV_8U of the image size");
-  const cv::Rect roi = region.empty() ? cv::Rect(0, 0, bgr.cols, bgr.rows)
-                                      : region & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  const cv::Rect roi = SearchArea(bgr.size(), region);
   const int step = options.step_px;
   const int offset = step / 2;
   // The sample grid is that of the whole image (offset + k * step), so a region finds exactly

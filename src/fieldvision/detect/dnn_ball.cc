@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -14,12 +15,6 @@ namespace {
 
 constexpr double kPadGrey = 114.0;  // fill beyond the image in a crop (the usual letterbox grey)
 constexpr double kLowestCropScore = 0.01;  // network boxes read in a crop when scores are averaged
-
-// The part of a frame of `frame_size` searched for `roi` (the whole frame when empty).
-cv::Rect SearchArea(const cv::Size& frame_size, const cv::Rect& roi) {
-  const cv::Rect full(cv::Point(0, 0), frame_size);
-  return roi.empty() ? full : (roi & full);
-}
 
 int RoundUp32(double v) { return std::max(32, static_cast<int>(std::ceil(v / 32.0)) * 32); }
 

@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -29,8 +30,7 @@ double FieldShareAround(const cv::Mat& bgr, const ColourTable& table, uint8_t fi
   const int x1 = static_cast<int>(std::ceil(centre_px.x() + r_out));
   const int y0 = static_cast<int>(std::floor(centre_px.y() - r_out));
   const int y1 = static_cast<int>(std::ceil(centre_px.y() + r_out));
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect area = roi.empty() ? image : (roi & image);
+  const cv::Rect area = SearchArea(bgr.size(), roi);
   std::vector<cv::Vec3b> ring;
   for (int y = std::max(area.y, y0); y <= std::min(area.y + area.height - 1, y1); ++y) {
     const auto* row = bgr.ptr<cv::Vec3b>(y);
