@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/util/strings.h"
+
 namespace fv::detect {
 namespace {
 
@@ -19,15 +21,9 @@ namespace fs = std::filesystem;
 constexpr char kMagic[] = "FVLUT1\n";
 constexpr size_t kMagicSize = sizeof(kMagic) - 1;
 
-uint64_t Fnv1a(const std::string& s) {
-  uint64_t h = 14695981039346656037ull;
-  for (const char c : s) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
-  return h;
-}
-
 std::string CachePath(const std::string& key) {
   const std::string dir = ColourCacheDir();
-  return dir.empty() ? "" : fmt::format("{}/colour-table-{:016x}.lut", dir, Fnv1a(key));
+  return dir.empty() ? "" : fmt::format("{}/colour-table-{:016x}.lut", dir, util::Fnv1a64(key));
 }
 
 template <typename T>

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::pipeline {
 
@@ -126,9 +127,7 @@ namespace {
 // The camera's phase in the whole-frame searches, from its name (FNV-1a): the same camera gets the
 // same phase in a node as in the in-process pipeline, so both give the same candidates.
 int ScanPhase(const std::string& camera_name, int full_scan_every) {
-  uint64_t h = 14695981039346656037ull;
-  for (const char c : camera_name) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
-  return static_cast<int>(h % static_cast<uint64_t>(full_scan_every));
+  return static_cast<int>(util::Fnv1a64(camera_name) % static_cast<uint64_t>(full_scan_every));
 }
 
 // Adds the band's candidates to the window's, except those on a ball already there; accepted

@@ -78,4 +78,10 @@ long long ParseInt(std::string_view s, std::string_view context) {
   return v;
 }
 
+uint64_t Fnv1a64(std::string_view s) {
+  uint64_t h = 14695981039346656037ull;
+  for (const char c : s) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  return h;
+}
+
 }  // namespace fv::util

@@ -1,6 +1,8 @@
-// Small string helpers: split, trim, strict number parsing with a named context for errors.
+// Small string helpers: split, trim, strict number parsing with a named context for errors, and a
+// stable 64-bit hash (FNV-1a: the same on every compiler and run, unlike std::hash).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,5 +18,8 @@ std::string ToLower(std::string_view s);
 // Parses the whole string as a number; throws fv::Error naming `context` otherwise.
 double ParseDouble(std::string_view s, std::string_view context);
 long long ParseInt(std::string_view s, std::string_view context);
+
+// 64-bit FNV-1a of the bytes of `s` (Fowler, Noll, Vo).
+uint64_t Fnv1a64(std::string_view s);
 
 }  // namespace fv::util
