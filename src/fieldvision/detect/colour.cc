@@ -303,11 +303,11 @@ bool RangeContains(const ColourRange& range, const std::array<double, 3>& hsv,
 ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel)
     : spec_(spec), bits_(bits_per_channel) {
   spec_.Check();
-  FV_REQUIRE(bits_ >= 4 && bits_ <= 8, "lut_bits must be 4..8 (got {})", bits_);
+  const size_t entries = Entries(bits_);
   const int n = 1 << bits_;
   const int shift = 8 - bits_;
   const int centre = shift > 0 ? 1 << (shift - 1) : 0;
-  table_ = util::HugeBuffer(size_t(1) << (3 * bits_));  // zeroed
+  table_ = util::HugeBuffer(entries);  // zeroed
   // Compiled ranges per class.
   std::vector<std::pair<uint8_t, CompiledRange>> ranges;
   bool need_hsv = false, need_yuv = false;
@@ -367,6 +367,12 @@ uint8_t ClassifyBySpec(const ColourSpec& spec, uint8_t b, uint8_t g, uint8_t r) 
   return bits;
 }
 
+size_t ColourTable::Entries(int bits_per_channel) {
+  FV_REQUIRE(bits_per_channel >= 4 && bits_per_channel <= 8, "lut_bits must be 4..8 (got {})",
+             bits_per_channel);
+  return size_t(1) << (3 * bits_per_channel);
+}
+
 ColourTable::ColourTable(const ColourSpec& spec, int bits_per_channel, util::HugeBuffer table)
     : spec_(spec), bits_(bits_per_channel), table_(std::move(table)) {}
 
@@ -388,10 +394,9 @@ bool ColourTable::AgreesWithSpec(int samples) const {
 namespace {
 
 // The disk cache's key (colour_cache.h): the table's format, OpenCV's version (its colour
-// conversions fill the table) and the spec.
-std::string DiskKey(const ColourSpec& spec, int bits) {
-  return fmt::format("colour table 1, {} bits, OpenCV {}\n{}", bits, CV_VERSION,
-                     ColourSpecToJson(spec).dump());
+// conversions fill the table) and the spec (as JSON).
+std::string DiskKey(const std::string& spec_json, int bits) {
+  return fmt::format("colour table 1, {} bits, OpenCV {}\n{}", bits, CV_VERSION, spec_json);
 }
 
 }  // namespace
@@ -400,15 +405,16 @@ std::shared_ptr<const ColourTable> ColourTable::Shared(const ColourSpec& spec,
                                                        int bits_per_channel) {
   static std::mutex mutex;
   static std::map<std::string, std::weak_ptr<const ColourTable>> cache;
-  const std::string key = std::to_string(bits_per_channel) + ColourSpecToJson(spec).dump();
+  const std::string spec_json = ColourSpecToJson(spec).dump();
+  const std::string key = std::to_string(bits_per_channel) + spec_json;
   std::lock_guard<std::mutex> lock(mutex);
   if (auto existing = cache[key].lock()) return existing;
   // From the disk cache when a table there agrees with the spec on a sample of colours (a table
   // written by other code is rebuilt and written again).
   spec.Check();
-  const std::string disk_key = DiskKey(spec, bits_per_channel);
+  const std::string disk_key = DiskKey(spec_json, bits_per_channel);
   std::shared_ptr<const ColourTable> table;
-  const size_t size = size_t(1) << (3 * std::clamp(bits_per_channel, 4, 8));
+  const size_t size = Entries(bits_per_channel);
   if (auto stored = LoadCachedTable(disk_key, size)) {
     std::shared_ptr<const ColourTable> loaded(
         new ColourTable(spec, bits_per_channel, std::move(*stored)));

@@ -139,6 +139,8 @@ class ColourTable {
   cv::Mat ClassifyImage(const cv::Mat& bgr) const;
 
  private:
+  // Entries of a table of this many bits per channel; throws fv::Error outside 4..8.
+  static size_t Entries(int bits_per_channel);
   ColourTable(const ColourSpec& spec, int bits_per_channel, util::HugeBuffer table);
   ColourSpec spec_;
   int bits_;
