@@ -316,12 +316,6 @@ struct WriteSceneResult {
 WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir,
                             bool progress = false);
 
-// The quality to give OpenCV's MJPG writer (cv::CAP_OPENCV_MJPEG) for frames quantised as
-// libjpeg (cv::imwrite) quantises at `jpeg_quality`: that writer divides the standard tables by
-// 0.12 x its own quality (1..12), so its 90 is about libjpeg's 95. It reaches libjpeg's 50..95
-// (SceneSpec::Check refuses other qualities for "avi").
-double MjpegWriterQuality(int jpeg_quality);
-
 // The first images of the cameras tiled with their names (tile width in pixels).
 cv::Mat ContactSheet(const std::vector<cv::Mat>& images, const std::vector<std::string>& names,
                      int tile_width = 640);

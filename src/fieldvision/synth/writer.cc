@@ -24,14 +24,21 @@
 namespace fv::synth {
 namespace fs = std::filesystem;
 
+namespace {
+
+// The quality to give OpenCV's MJPG writer (cv::CAP_OPENCV_MJPEG) for frames quantised as
+// libjpeg (cv::imwrite) quantises at `jpeg_quality`: libjpeg scales the standard tables by s %
+// (s = 5000 / q below 50, else 200 - 2 q), that writer divides them by 0.12 x its own quality,
+// clamped to 1..12 (so its 90 is about libjpeg's 95). It reaches libjpeg's 50..95, which
+// SceneSpec::Check requires for "avi".
 double MjpegWriterQuality(int jpeg_quality) {
   FV_REQUIRE(jpeg_quality >= 1 && jpeg_quality <= 100, "JPEG quality {} is not in 1..100",
              jpeg_quality);
-  // libjpeg scales its tables by s % (s = 5000 / q below 50, else 200 - 2 q); OpenCV's MJPG
-  // writer divides them by 0.12 x its quality, clamped to 1..12.
   const double percent = jpeg_quality < 50 ? 5000.0 / jpeg_quality : 200.0 - 2.0 * jpeg_quality;
   return 100.0 / (0.12 * std::max(percent, 1.0));
 }
+
+}  // namespace
 
 std::string WriteSceneResult::Summary() const {
   return fmt::format(
