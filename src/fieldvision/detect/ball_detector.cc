@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -164,18 +163,6 @@ std::string RegionProblem(const BallRegion& r, const BallDetectorOptions& o, dou
   return "";
 }
 
-// OpenCV builds its CIELAB tables (about 0.1 s) on the first BGR2Lab conversion without a lock:
-// camera threads analysing their first regions at once would each build them, racing. Build them
-// once, before any detector runs.
-void BuildLabTablesOnce() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    const cv::Mat pixel(1, 1, CV_8UC3, cv::Scalar::all(0));
-    cv::Mat lab;
-    cv::cvtColor(pixel, lab, cv::COLOR_BGR2Lab);
-  });
-}
-
 }  // namespace
 
 double BallDetector::SmallestPlausibleRadius(double expected_min_px) const {
@@ -289,7 +276,6 @@ BallDetector::BallDetector(const BallDetectorOptions& options, const ColourSpec&
 
 void BallDetector::Init(const ColourSpec& colour) {
   colour.Check("colour spec");
-  if (options_.use_region) BuildLabTablesOnce();
   if (camera_ != nullptr) camera_->Check();
   table_ = ColourTable::Shared(colour, options_.lut_bits);
   ball_bit_ = table_->BallBit();

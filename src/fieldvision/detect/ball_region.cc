@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/ball_fit.h"
+#include "fieldvision/detect/lab.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -107,7 +108,7 @@ class LabWindow {
       std::memcpy(g, bgr_.ptr<uint8_t>(p.y) + 3 * static_cast<ptrdiff_t>(p.x0), n);
       g += n;
     }
-    cv::cvtColor(gathered_, converted_, cv::COLOR_BGR2Lab);
+    BgrToLab(gathered_, &converted_);
     const uint8_t* c = converted_.ptr<uint8_t>(0);
     for (const Piece& p : pieces_) {
       const size_t n = 3 * static_cast<size_t>(p.x1 - p.x0);

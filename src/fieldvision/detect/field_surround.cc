@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/lab.h"
 #include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
@@ -42,8 +43,7 @@ double FieldShareAround(const cv::Mat& bgr, const ColourTable& table, uint8_t fi
   if (ring.empty()) return -1.0;
   cv::Mat lab;
   if (image_field != nullptr) {
-    cv::cvtColor(cv::Mat(1, static_cast<int>(ring.size()), CV_8UC3, ring.data()), lab,
-                 cv::COLOR_BGR2Lab);
+    BgrToLab(cv::Mat(1, static_cast<int>(ring.size()), CV_8UC3, ring.data()), &lab);
   }
   int field = 0;
   for (size_t i = 0; i < ring.size(); ++i) {

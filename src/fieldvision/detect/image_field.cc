@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/lab.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -33,7 +34,7 @@ cv::Mat LabAt(const cv::Mat& bgr, const std::vector<int>& xs, const std::vector<
     for (size_t i = 0; i < xs.size(); ++i) dst[i] = src[xs[i]];
   }
   cv::Mat lab;
-  if (!gathered.empty()) cv::cvtColor(gathered, lab, cv::COLOR_BGR2Lab);
+  BgrToLab(gathered, &lab);
   return lab;
 }
 
