@@ -277,12 +277,21 @@ BallDetector::BallDetector(const BallDetectorOptions& options, const ColourSpec&
 void BallDetector::Init(const ColourSpec& colour) {
   colour.Check("colour spec");
   if (camera_ != nullptr) camera_->Check();
-  table_ = ColourTable::Shared(colour, options_.lut_bits);
+  // The widened ball class the regions grow through: a class of the same table when it fits.
+  table_ = ColourTable::Shared(
+      options_.use_region ? WithWidenedBall(colour, options_.grow_hue_deg, options_.grow_factor)
+                          : colour,
+      options_.lut_bits);
   ball_bit_ = table_->BallBit();
   field_bit_ = table_->ClassBitOrZero("field");
   if (options_.use_region) {
-    grow_table_ = ColourTable::Shared(
-        WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor), options_.lut_bits);
+    grow_bit_ = table_->ClassBitOrZero(WidenedBallClass(colour));
+    grow_table_ = grow_bit_ != 0
+                      ? table_
+                      : ColourTable::Shared(
+                            WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor),
+                            options_.lut_bits);
+    if (grow_bit_ == 0) grow_bit_ = grow_table_->BallBit();
   }
   if (posed() && field_ != nullptr && options_.use_field_mask) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
@@ -548,7 +557,8 @@ std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, cons
     const cv::Rect seed(blob.x_min - half, blob.y_min - half,
                         blob.x_max - blob.x_min + 2 * half + 1,
                         blob.y_max - blob.y_min + 2 * half + 1);
-    region = AnalyseBallRegion(bgr, *table_, ball_bit_, seed, roi, o.region, grow_table_.get());
+    region = AnalyseBallRegion(bgr, *table_, ball_bit_, seed, roi, o.region, grow_table_.get(),
+                               grow_bit_);
     if (region.ok) {
       if (measured->Holds(region)) return std::nullopt;  // a fragment of a region measured
       measured->centres.push_back(region.centre_px);
@@ -713,7 +723,7 @@ std::optional<BallCandidate> BallDetector::FitAt(const cv::Mat& bgr, const cv::R
   if (need.empty() || (need & roi) != need) return std::nullopt;
   // The widened class: the expected ball may be in shade, pale or blurred all over.
   const ColourTable& table = grow_table_ ? *grow_table_ : *table_;
-  const uint8_t bit = table.BallBit();
+  const uint8_t bit = grow_table_ ? grow_bit_ : ball_bit_;
   const std::optional<GuidedOutline> fit = FitGuidedOutline(bgr, table, bit, centre_px, radius_px);
   if (!fit) return std::nullopt;
   double visible = 0.0, leak = 1.0;
@@ -771,8 +781,10 @@ std::optional<BallDetector::GuidedOutline> BallDetector::FitGuidedOutline(const 
 void BallDetector::AddSmallBalls(const cv::Mat& bgr, const cv::Rect& roi,
                                  BallDetectionResult* result) const {
   const SmallBallOptions& o = options_.small;
-  const ColourTable& table = o.widened_class && grow_table_ ? *grow_table_ : *table_;
-  for (const SmallBall& s : FindSmallBalls(bgr, table, table.BallBit(), roi, field_mask_, o)) {
+  const bool widened = o.widened_class && grow_table_;
+  const ColourTable& table = widened ? *grow_table_ : *table_;
+  for (const SmallBall& s :
+       FindSmallBalls(bgr, table, widened ? grow_bit_ : ball_bit_, roi, field_mask_, o)) {
     BallCandidate c;
     c.centre_px = s.centre_px;
     c.radius_px = s.radius_px;

@@ -331,7 +331,8 @@ class BallDetector {
   const field::FieldModel* field_;
   std::shared_ptr<const ColourTable> table_;
   // The widened ball class: region growing and the small spots' unmixed colour.
-  std::shared_ptr<const ColourTable> grow_table_;
+  std::shared_ptr<const ColourTable> grow_table_;  // table_ when the widened class is one of its
+  uint8_t grow_bit_ = 0;                           // the widened class's bit in grow_table_
   uint8_t ball_bit_ = 1;
   uint8_t field_bit_ = 0;  // the spec's "field" class (0: none)
   cv::Mat field_mask_;

@@ -457,17 +457,23 @@ void GrowByOwnColour(LabWindow* lab, const cv::Mat& raw, const BallRegionOptions
 }
 
 // The gathered region grown through the widened class near its core and closed (print, seams);
-// empty when no ball-coloured pixel touches the seed. `grow_table`: the widened class (null: none).
+// empty when no ball-coloured pixel touches the seed. `grow`: the widened class's bit in each
+// pixel's class bits (`cls`, the window's own when given, else classified by `grow.table`).
 // `*extent` (window coordinates) holds every pixel of the region: only that part is scanned.
-cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
-                           const ColourTable* grow_table, LabWindow* lab, const cv::Rect& seed,
-                           const BallRegionOptions& o, cv::Rect* extent) {
+struct GrowClass {
+  const ColourTable* table = nullptr;  // null: no growing
+  uint8_t bit = 0;
+  const cv::Mat* cls = nullptr;  // the window's class bits from grow.table, or null
+};
+cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw, const GrowClass& grow,
+                           LabWindow* lab, const cv::Rect& seed, const BallRegionOptions& o,
+                           cv::Rect* extent) {
   cv::Rect bounds;
   cv::Mat region = GatherComponents(raw, seed, o.gather_fraction, &bounds);
   if (bounds.area() == 0) return {};
   *extent = bounds;
   const double r_region = 0.5 * std::max(bounds.width, bounds.height);
-  if (grow_table != nullptr) {
+  if (grow.table != nullptr) {
     // Hysteresis with a reach: widened-class pixels join only near the core (a shaded rim, a
     // pale cap), so a neighbour of a similar colour is not taken in. Nothing farther than the
     // reach from the gathered bounds can join: only that part is dilated and classified.
@@ -475,16 +481,20 @@ cv::Mat GrowAndCloseRegion(const cv::Mat& bgr_window, const cv::Mat& raw,
     const cv::Rect sub = Grow(bounds, reach) & cv::Rect(0, 0, raw.cols, raw.rows);
     // The widened class's pixels not yet in the region, and their bounds: the dilation is needed
     // only there (within reach of them), and not at all when there are none.
-    const uint8_t grow_bit = grow_table->BallBit();
     cv::Mat cand(sub.size(), CV_8U);
     int x0 = sub.width, x1 = -1, y0 = sub.height, y1 = -1;
     for (int y = 0; y < sub.height; ++y) {
       const uint8_t* m = region.ptr<uint8_t>(sub.y + y) + sub.x;
       uint8_t* c = cand.ptr<uint8_t>(y);
-      grow_table->ClassifyRow<1>(
-          bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x), sub.width, 1, c);
+      if (grow.cls != nullptr) {
+        std::memcpy(c, grow.cls->ptr<uint8_t>(sub.y + y) + sub.x, sub.width);
+      } else {
+        grow.table->ClassifyRow<1>(
+            bgr_window.ptr<uint8_t>(sub.y + y) + 3 * static_cast<ptrdiff_t>(sub.x), sub.width, 1,
+            c);
+      }
       for (int x = 0; x < sub.width; ++x) {
-        c[x] = m[x] == 0 && (c[x] & grow_bit) != 0;
+        c[x] = m[x] == 0 && (c[x] & grow.bit) != 0;
         if (c[x] != 0) {
           x0 = std::min(x0, x);
           x1 = std::max(x1, x);
@@ -780,7 +790,8 @@ void MeasureRegionColours(const cv::Mat& bgr, const cv::Rect& window, const cv::
 
 BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
                              const cv::Rect& seed_box, const cv::Rect& limit,
-                             const BallRegionOptions& o, const ColourTable* grow_table) {
+                             const BallRegionOptions& o, const ColourTable* grow_table,
+                             uint8_t grow_bit) {
   BallRegion out;
   const cv::Rect image(0, 0, bgr.cols, bgr.rows);
   const cv::Rect lim = limit.empty() ? image : (limit & image);
@@ -796,7 +807,10 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   ClassMasks(bgr_window, table, ball_bit, &raw, &cls);
   LabWindow lab(bgr_window);
   cv::Rect extent;
-  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow_table, &lab, seed, o, &extent);
+  const GrowClass grow{grow_table,
+                       grow_table == nullptr || grow_bit != 0 ? grow_bit : grow_table->BallBit(),
+                       grow_table == &table ? &cls : nullptr};
+  const cv::Mat region = GrowAndCloseRegion(bgr_window, raw, grow, &lab, seed, o, &extent);
   if (region.empty()) {
     out.failure = "no ball-coloured pixels at the blob";
     return out;

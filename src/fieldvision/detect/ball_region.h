@@ -95,10 +95,11 @@ struct BallRegion {
 
 // Analyses the blob whose bounds (full-resolution pixels) are `seed_box`; only pixels inside
 // `limit` are read (the whole image when empty). `table`'s ball class is the core colour (leak,
-// purity); `grow_table` (null: the same) the widened class the region grows through.
+// purity); class `grow_bit` (0: its ball class) of `grow_table` (null: none) the widened class the
+// region grows through (`table` itself when it holds that class too: its lookups are reused).
 BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8_t ball_bit,
                              const cv::Rect& seed_box, const cv::Rect& limit,
                              const BallRegionOptions& options = {},
-                             const ColourTable* grow_table = nullptr);
+                             const ColourTable* grow_table = nullptr, uint8_t grow_bit = 0);
 
 }  // namespace fv::detect

@@ -167,6 +167,9 @@ TEST(BallRegion, BallPartlyOutsideItsClassGrowsByItsOwnColour) {
   const ColourTable table(PresetColourSpec("orange"));
   const std::unique_ptr<ColourTable> grow_table =
       std::make_unique<ColourTable>(WidenedBallSpec(PresetColourSpec("orange"), 4.0, 0.6));
+  // The same classes in one table (the detector's): the same region.
+  const ColourTable one(WithWidenedBall(PresetColourSpec("orange"), 4.0, 0.6));
+  const uint8_t one_grow_bit = one.ClassBit(WidenedBallClass(PresetColourSpec("orange")));
   BallRegionOptions off;
   off.own_reach = 0.0;
   for (int trial = 0; trial < 5; ++trial) {
@@ -185,6 +188,11 @@ TEST(BallRegion, BallPartlyOutsideItsClassGrowsByItsOwnColour) {
     const BallRegion half =
         AnalyseBallRegion(img, table, table.BallBit(), seed_box, {}, off, grow_table.get());
     ASSERT_TRUE(own.ok) << own.failure;
+    const BallRegion same =
+        AnalyseBallRegion(img, one, one.BallBit(), seed_box, {}, {}, &one, one_grow_bit);
+    ASSERT_TRUE(same.ok) << same.failure;
+    EXPECT_EQ(same.centre_px, own.centre_px);
+    EXPECT_EQ(same.radius_px, own.radius_px);
     SCOPED_TRACE("r " + std::to_string(r) + ": " + own.Summary() + " / " +
                  (half.ok ? half.Summary() : half.failure));
     EXPECT_LT((own.centre_px - c).norm(), 0.1 * r + 0.5);

@@ -171,6 +171,17 @@ ColourSpec WidenedBallSpec(const ColourSpec& spec, double hue_deg, double factor
   return out;
 }
 
+std::string WidenedBallClass(const ColourSpec& spec) { return spec.ball_class + " (widened)"; }
+
+ColourSpec WithWidenedBall(const ColourSpec& spec, double hue_deg, double factor) {
+  ColourClass wide = WidenedBallSpec(spec, hue_deg, factor).classes[0];
+  wide.name = WidenedBallClass(spec);
+  if (spec.classes.size() >= 8 || spec.Find(wide.name) >= 0) return spec;
+  ColourSpec out = spec;
+  out.classes.push_back(std::move(wide));
+  return out;
+}
+
 json ColourSpecToJson(const ColourSpec& spec) {
   json classes = json::array();
   for (const auto& c : spec.classes) {

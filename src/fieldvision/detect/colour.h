@@ -59,6 +59,11 @@ ColourSpec PresetColourSpec(const std::string& ball_preset = "orange");
 // saturation and value minima times `factor`; YUV chroma +-2 * hue_deg, Y minimum times
 // `factor`. The result has the one class `ball_class`.
 ColourSpec WidenedBallSpec(const ColourSpec& spec, double hue_deg = 10.0, double factor = 0.6);
+// `spec` with that widened class added under the name WidenedBallClass(spec), so that one table
+// holds both (one lookup, one table to build, cache and keep in memory); `spec` unchanged when it
+// has no room (8 classes) or already has a class of that name.
+ColourSpec WithWidenedBall(const ColourSpec& spec, double hue_deg = 10.0, double factor = 0.6);
+std::string WidenedBallClass(const ColourSpec& spec);
 
 nlohmann::json ColourSpecToJson(const ColourSpec& spec);
 // Throws fv::Error naming `context` and the bad key.

@@ -57,6 +57,38 @@ TEST(ColourTable, TableAgreesWithTheRangesForRandomColours) {
   EXPECT_NE(t.Classify(0, 0, 255) & t.ClassBit("red"), 0);
 }
 
+// The widened ball class joins the spec as one more class: the spec's own classes keep their
+// bits, the new one classifies as WidenedBallSpec's; a full spec (8 classes) stays as it is.
+TEST(ColourSpec, WidenedBallIsOneMoreClassWhenThereIsRoom) {
+  const uint64_t seed = fv::testing::TestSeed(11);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const ColourSpec spec = PresetColourSpec("yellow");
+  const ColourSpec with = WithWidenedBall(spec, 10.0, 0.6);
+  ASSERT_EQ(with.classes.size(), spec.classes.size() + 1);
+  EXPECT_EQ(with.classes.back().name, WidenedBallClass(spec));
+  EXPECT_EQ(with.ball_class, spec.ball_class);
+  const ColourSpec wide = WidenedBallSpec(spec, 10.0, 0.6);
+  const uint8_t own = uint8_t((1u << spec.classes.size()) - 1);
+  const uint8_t wide_bit = uint8_t(1u << spec.classes.size());
+  const uint8_t ball_bit = uint8_t(1u << spec.Find(spec.ball_class));
+  int widened_only = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const uint8_t b = rng.UniformInt(0, 255), g = rng.UniformInt(0, 255),
+                  r = rng.UniformInt(0, 255);
+    const uint8_t bits = ClassifyBySpec(with, b, g, r);
+    ASSERT_EQ(bits & own, ClassifyBySpec(spec, b, g, r));
+    ASSERT_EQ((bits & wide_bit) != 0, ClassifyBySpec(wide, b, g, r) != 0);
+    widened_only += (bits & wide_bit) != 0 && (bits & ball_bit) == 0;
+  }
+  EXPECT_GT(widened_only, 0);  // the widened class is wider
+  ColourSpec full = spec;
+  while (full.classes.size() < 8) {
+    full.classes.push_back({"c" + std::to_string(full.classes.size()), spec.classes[0].ranges});
+  }
+  EXPECT_EQ(WithWidenedBall(full).classes.size(), 8u);
+}
+
 TEST(ColourTable, QuantisedTableMatchesTheExactTableAtCellCentres) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
