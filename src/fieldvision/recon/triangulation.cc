@@ -90,6 +90,7 @@ void TriangulationOptions::Check() const {
              weak_max_radius_ratio);
   CheckNonNegative(radius_sigma_factor, "TriangulationOptions.radius_sigma_factor");
   CheckNonNegative(radius_tolerance, "TriangulationOptions.radius_tolerance");
+  CheckNonNegative(radius_tolerance_px, "TriangulationOptions.radius_tolerance_px");
   FV_REQUIRE(min_views_all_weak == 0 || min_views_all_weak >= 2,
              "TriangulationOptions.min_views_all_weak must be 0 (never) or >= 2 (got {})",
              min_views_all_weak);

@@ -150,8 +150,8 @@ std::optional<std::vector<View>> SizeWeightedViews(const std::vector<camera::Cam
     if (v.observation.radius_px <= 0) continue;
     const auto expected = ExpectedRadiusPx(cameras[v.camera], p, o.ball_radius_m);
     if (!expected) continue;
-    const double excess =
-        std::abs(v.observation.radius_px - *expected) - o.radius_tolerance * *expected - 0.5;
+    const double excess = std::abs(v.observation.radius_px - *expected) -
+                          o.radius_tolerance * *expected - o.radius_tolerance_px;
     if (!(excess > 0)) continue;
     v.observation.sigma_px = std::hypot(v.observation.sigma_px, o.radius_sigma_factor * excess);
     changed = true;
