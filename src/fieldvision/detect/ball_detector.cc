@@ -433,12 +433,14 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   }
   std::optional<FieldBoundary> boundary;
   RejectOffField(bgr, roi, &boundary, &result.candidates);
+  // Every check of the blobs' candidates first: small balls are looked for when none is left.
+  RejectDarkerThanField(bgr, roi, &result.candidates);
   if (small_balls_ && result.accepted() == 0) {
     AddSmallBalls(bgr, roi, &result);
     RejectOffField(bgr, roi, &boundary, &result.candidates);
     RejectSmallOffField(bgr, roi, &result.candidates);
+    RejectDarkerThanField(bgr, roi, &result.candidates);
   }
-  RejectDarkerThanField(bgr, roi, &result.candidates);
   RankAndDropDuplicates(&result.candidates);
   OnFieldFirst(bgr, roi, &boundary, &result.candidates);
   return result;

@@ -89,6 +89,30 @@ TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
   EXPECT_TRUE(BallDetector(off, nullptr, nullptr).Detect(img).empty());
 }
 
+// A blob stage candidate that a later check rejects (a dark orange disc, darker than the field:
+// no lit ball) leaves no accepted candidate: the small ball is looked for then.
+TEST(SmallBall, LookedForWhenEveryBlobCandidateIsRejected) {
+  const uint64_t seed = fv::testing::TestSeed(13);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  cv::Mat img = test_util::FieldImage(224, 224, rng);
+  const Vector2d c(101.3, 80.6);
+  test_util::PaintDisc(img, c, 1.6, test_util::kOrange, 0.3);
+  test_util::PaintDisc(img, {160.0, 150.0}, 9.0, cv::Vec3b(0, 45, 100), 0.3);
+  img = test_util::JpegRoundTrip(img, 75);
+  const auto cands = BallDetector(BallDetectorOptions{}, nullptr, nullptr).Detect(img);
+  ASSERT_FALSE(cands.empty());
+  EXPECT_TRUE(cands.front().accepted) << cands.front().reason;
+  EXPECT_TRUE(cands.front().small);
+  EXPECT_LT((cands.front().centre_px - c).norm(), 1.0);
+  const auto disc = std::find_if(cands.begin(), cands.end(), [](const BallCandidate& b) {
+    return (b.centre_px - Vector2d(160.0, 150.0)).norm() < 3.0;
+  });
+  ASSERT_NE(disc, cands.end());
+  EXPECT_FALSE(disc->accepted);
+  EXPECT_NE(disc->reason.find("darker than the field"), std::string::npos) << disc->reason;
+}
+
 TEST(SmallBall, OptionsAreChecked) {
   SmallBallOptions o;
   o.mode = "sometimes";
