@@ -11,6 +11,7 @@
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::detect {
@@ -64,14 +65,19 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
   }
 }
 
-TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
-  const uint64_t seed = fv::testing::TestSeed(12);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
+// Grass with a ball of 1.6 px at `c` and, when `dark_disc`, a dark orange disc of 9 px elsewhere,
+// JPEG-compressed.
+cv::Mat GrassWithASmallBall(util::Rng& rng, const Vector2d& c, bool dark_disc) {
   cv::Mat img = test_util::FieldImage(224, 224, rng);
-  const Vector2d c(101.3, 80.6);
   test_util::PaintDisc(img, c, 1.6, test_util::kOrange, 0.3);
-  img = test_util::JpegRoundTrip(img, 75);
+  if (dark_disc) test_util::PaintDisc(img, {160.0, 150.0}, 9.0, cv::Vec3b(0, 45, 100), 0.3);
+  return test_util::JpegRoundTrip(img, 75);
+}
+
+TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
+  testing::SeededRng rng(12);
+  const Vector2d c(101.3, 80.6);
+  const cv::Mat img = GrassWithASmallBall(rng, c, false);
   BallDetectorOptions on;
   on.small.mode = "on";
   const auto with = BallDetector(on, nullptr, nullptr).Detect(img);
@@ -92,14 +98,9 @@ TEST(SmallBall, DetectorTakesThemOnlyWhereSmallBallsArePossible) {
 // A blob stage candidate that a later check rejects (a dark orange disc, darker than the field:
 // no lit ball) leaves no accepted candidate: the small ball is looked for then.
 TEST(SmallBall, LookedForWhenEveryBlobCandidateIsRejected) {
-  const uint64_t seed = fv::testing::TestSeed(13);
-  FV_SEED_TRACE(seed);
-  util::Rng rng(seed);
-  cv::Mat img = test_util::FieldImage(224, 224, rng);
+  testing::SeededRng rng(13);
   const Vector2d c(101.3, 80.6);
-  test_util::PaintDisc(img, c, 1.6, test_util::kOrange, 0.3);
-  test_util::PaintDisc(img, {160.0, 150.0}, 9.0, cv::Vec3b(0, 45, 100), 0.3);
-  img = test_util::JpegRoundTrip(img, 75);
+  const cv::Mat img = GrassWithASmallBall(rng, c, true);
   const auto cands = BallDetector(BallDetectorOptions{}, nullptr, nullptr).Detect(img);
   ASSERT_FALSE(cands.empty());
   EXPECT_TRUE(cands.front().accepted) << cands.front().reason;
