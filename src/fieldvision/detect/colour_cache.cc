@@ -2,12 +2,15 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -81,6 +84,8 @@ std::optional<util::HugeBuffer> LoadCachedTable(const std::string& key, size_t s
     filled += run;
   }
   if (at != data.size()) return std::nullopt;
+  std::error_code ec;  // used now: the last to be pruned
+  fs::last_write_time(path, fs::file_time_type::clock::now(), ec);
   return table;
 }
 
@@ -112,7 +117,27 @@ void StoreCachedTable(const std::string& key, const uint8_t* table, size_t size)
     }
   }
   fs::rename(tmp, path, ec);
-  if (ec) fs::remove(tmp, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return;
+  }
+  PruneColourCache(fs::path(path).parent_path().string(), kColourCacheFiles);
+}
+
+void PruneColourCache(const std::string& dir, size_t keep) {
+  std::vector<std::pair<fs::file_time_type, fs::path>> tables;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!util::StartsWith(name, "colour-table-") || !util::EndsWith(name, ".lut")) continue;
+    std::error_code time_ec;
+    const fs::file_time_type t = e.last_write_time(time_ec);
+    if (!time_ec) tables.emplace_back(t, e.path());
+  }
+  if (ec || tables.size() <= keep) return;
+  std::sort(tables.begin(), tables.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (size_t i = keep; i < tables.size(); ++i) fs::remove(tables[i].second, ec);
 }
 
 }  // namespace fv::detect

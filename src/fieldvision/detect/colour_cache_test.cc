@@ -3,6 +3,9 @@
 // are rebuilt or refused; FV_NO_CACHE=1 writes nothing.
 #include "fieldvision/detect/colour_cache.h"
 
+#include <sys/stat.h>
+
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "fieldvision/detect/colour.h"
@@ -63,6 +67,11 @@ class CacheHome {
   std::optional<std::string> old_xdg_, old_off_;
 };
 
+ino_t Inode(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
 bool SameTable(const ColourTable& a, const ColourTable& b) {
   const size_t n = size_t(1) << (3 * a.bits_per_channel());
   return a.bits_per_channel() == b.bits_per_channel() && std::memcmp(a.data(), b.data(), n) == 0;
@@ -74,10 +83,14 @@ TEST(ColourCache, ASharedTableIsWrittenOnceAndReadBackEqual) {
   const ColourTable built(spec, 6);
   { const auto first = ColourTable::Shared(spec, 6); }  // built and stored
   ASSERT_EQ(home.Files().size(), 1u);
-  const auto written = fs::last_write_time(home.Files()[0]);
+  const std::string file = home.Files()[0];
+  const ino_t written = Inode(file);
+  fs::last_write_time(file, fs::last_write_time(file) - std::chrono::hours(1));
+  const auto an_hour_ago = fs::last_write_time(file);
   const auto second = ColourTable::Shared(spec, 6);  // read back
   EXPECT_TRUE(SameTable(*second, built));
-  EXPECT_EQ(fs::last_write_time(home.Files()[0]), written);
+  EXPECT_EQ(Inode(file), written);                    // not written again
+  EXPECT_GT(fs::last_write_time(file), an_hour_ago);  // marked used
   EXPECT_TRUE(second->AgreesWithSpec(4096));
 }
 
@@ -111,6 +124,26 @@ TEST(ColourCache, DamagedOrForeignFilesAreRebuilt) {
   // The wrong size is no table.
   EXPECT_FALSE(LoadCachedTable(key, size_t(1) << 18).has_value());
   EXPECT_FALSE(LoadCachedTable("no such key", size_t(1) << 15).has_value());
+}
+
+TEST(ColourCache, PruningKeepsTheTablesUsedLast) {
+  const std::string dir = fv::testing::TempDir() + "/colour_cache_prune";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto now = fs::file_time_type::clock::now();
+  std::vector<std::string> tables;
+  for (int i = 0; i < 20; ++i) {
+    tables.push_back(fmt::format("{}/colour-table-{:016x}.lut", dir, i));
+    std::ofstream(tables.back()) << "t";
+    fs::last_write_time(tables.back(), now - std::chrono::minutes(20 - i));  // 19 used last
+  }
+  const std::string other = dir + "/notes.txt";
+  std::ofstream(other) << "kept";
+  fs::last_write_time(other, now - std::chrono::hours(5));
+  PruneColourCache(dir, 16);
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(fs::exists(tables[i]), i >= 4) << tables[i];
+  EXPECT_TRUE(fs::exists(other));
+  PruneColourCache(dir + "/missing", 16);  // no folder: nothing to do, no error
 }
 
 TEST(ColourCache, NoCacheWritesNothing) {
