@@ -14,7 +14,7 @@ namespace fv::detect {
 namespace {
 
 std::string WriteText(const std::string& name, const std::string& text) {
-  const std::string path = fv::testing::TempDir() + "/" + name;
+  std::string path = fv::testing::TempDir() + "/" + name;
   std::ofstream(path) << text;
   return path;
 }

@@ -40,8 +40,9 @@ BallObservation Observe(const camera::Camera& cam, const Eigen::Vector3d& p, dou
   EXPECT_TRUE(uv.has_value());
   BallObservation o;
   o.centre_px = *uv;
-  if (rng && sigma_px > 0)
+  if (rng && sigma_px > 0) {
     o.centre_px += Eigen::Vector2d(rng->Normal(0, sigma_px), rng->Normal(0, sigma_px));
+  }
   o.sigma_px = sigma_px > 0 ? sigma_px : 1.0;
   return o;
 }
@@ -109,6 +110,7 @@ TEST(Triangulation, LinearIsExactWithoutNoise) {
   for (int trial = 0; trial < 30; ++trial) {
     const Eigen::Vector3d p = RandomBall(rng);
     std::vector<View> views;
+    views.reserve(4);
     for (int c = 0; c < 4; ++c) views.push_back({c, Observe(cams[c], p, 0.0, 0, nullptr)});
     const auto x = TriangulateLinear(cams, views);
     ASSERT_TRUE(x.has_value());
@@ -203,7 +205,7 @@ TEST(Triangulation, OutlineCentreModelRemovesThePerspectiveBias) {
   cam.cam_from_world = geometry::Rigid3d::LookAt({-11, -8, 6}, {0, 0, 0});
   cam.has_pose = true;
   const double r = 0.11;
-  for (const Eigen::Vector3d ball :
+  for (const Eigen::Vector3d& ball :
        {Eigen::Vector3d(-8, -3, 0.11), Eigen::Vector3d(4, 5, 2.0), Eigen::Vector3d(-2, 3, 0.5)}) {
     const Eigen::Vector3d c = cam.CentreInWorld();
     const Eigen::Vector3d axis = (ball - c).normalized();
