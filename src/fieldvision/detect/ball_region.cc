@@ -13,6 +13,7 @@
 
 #include "fieldvision/detect/ball_fit.h"
 #include "fieldvision/detect/lab.h"
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -793,8 +794,7 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
                              const BallRegionOptions& o, const ColourTable* grow_table,
                              uint8_t grow_bit) {
   BallRegion out;
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect lim = limit.empty() ? image : (limit & image);
+  const cv::Rect lim = SearchArea(bgr.size(), limit);
   const double r0 = 0.5 * std::max(seed_box.width, seed_box.height);
   const cv::Rect window = Grow(seed_box, static_cast<int>(std::ceil(2.5 * r0)) + 6) & lim;
   const cv::Rect seed = (seed_box & window) - window.tl();

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -98,8 +99,7 @@ FieldBoundary FindFieldBoundary(const cv::Mat& bgr, const ColourTable& table, ui
                                 const FieldBoundaryOptions& options, const cv::Rect& roi_in) {
   options.Check();
   FV_REQUIRE(bgr.type() == CV_8UC3, "field boundary: the image must be 8-bit BGR");
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
+  const cv::Rect roi = SearchArea(bgr.size(), roi_in);
   if (roi.width < 2 || roi.height < 2) return {};
   const int n = std::min(options.columns, roi.width);
   std::vector<int> xs(n);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <vector>
 
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
@@ -33,8 +34,7 @@ double FieldValue(const cv::Mat& bgr, const ColourTable& table, uint8_t field_bi
                   const FieldBrightnessOptions& o, const cv::Rect& roi_in) {
   o.Check();
   FV_REQUIRE(bgr.type() == CV_8UC3, "field brightness: the image must be 8-bit BGR");
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
+  const cv::Rect roi = SearchArea(bgr.size(), roi_in);
   if (roi.empty()) return -1.0;
   std::vector<int> xs, ys;
   for (int x = roi.x + o.step_px / 2; x < roi.x + roi.width; x += o.step_px) xs.push_back(x);

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/lab.h"
+#include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -42,8 +43,7 @@ std::optional<ImageFieldColour> FindImageFieldColour(const cv::Mat& bgr, const c
                                                      const ImageFieldOptions& o) {
   o.Check();
   FV_REQUIRE(bgr.type() == CV_8UC3, "image field: the image must be 8-bit BGR");
-  const cv::Rect image(0, 0, bgr.cols, bgr.rows);
-  const cv::Rect roi = roi_in.empty() ? image : roi_in & image;
+  const cv::Rect roi = SearchArea(bgr.size(), roi_in);
   if (!o.enabled || roi.empty()) return std::nullopt;
   const int top = roi.y + static_cast<int>(std::floor((1.0 - o.lower_share) * roi.height));
   const double lower_area = static_cast<double>(roi.width) * (roi.y + roi.height - top);
