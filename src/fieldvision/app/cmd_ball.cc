@@ -48,10 +48,7 @@ void RunBall(const BallCliOptions& o) {
             : "");
   }
   if (r.bundle && r.bundle->rests.runs > 0) {
-    std::cout << fmt::format(
-        "{} resting ball{} refined on the cameras' candidates ({} rows, {:.2f} px RMS)\n",
-        r.bundle->rests.runs, r.bundle->rests.runs == 1 ? "" : "s", r.bundle->rests.rows,
-        r.bundle->rests.rms_px);
+    std::cout << r.bundle->rests.Summary("the cameras' candidates") << "\n";
   }
   if (r.bundle && r.bundle->kept_flights > 0) {
     std::cout << fmt::format(

@@ -532,10 +532,7 @@ std::string DetectionsJobResult::Summary() const {
                      bundled_flights, bundled_rows, bundle_rms_px);
     if (kept_rows > 0) s += fmt::format(", {} frames the model does not follow kept", kept_rows);
   }
-  if (rests.runs > 0) {
-    s += fmt::format("; {} resting ball{} refined on the 2D detections ({} rows, {:.2f} px RMS)",
-                     rests.runs, rests.runs == 1 ? "" : "s", rests.rows, rests.rms_px);
-  }
+  if (rests.runs > 0) s += "; " + rests.Summary("the 2D detections");
   for (const auto& p : sync.Problems()) s += "\n  " + p;
   if (trajectory) {
     s += '\n';

@@ -5,6 +5,8 @@
 #include <limits>
 #include <set>
 
+#include <fmt/format.h>
+
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/recon/triangulation.h"
 #include "fieldvision/util/error.h"
@@ -157,6 +159,12 @@ recon::TriangulationResult TrimmedPoint(const std::vector<camera::Camera>& camer
 }
 
 }  // namespace
+
+std::string RestBundle::Summary(const std::string& views) const {
+  if (runs == 0) return "";
+  return fmt::format("{} resting ball{} refined on {} ({} rows, {:.2f} px RMS)", runs,
+                     runs == 1 ? "" : "s", views, rows, rms_px);
+}
 
 std::vector<RestRun> FindRestingRuns(const std::vector<recon::BallSample>& track,
                                      const std::vector<char>& skip, const RestBundleOptions& o) {

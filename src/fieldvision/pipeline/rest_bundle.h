@@ -7,6 +7,7 @@
 // every frame shares (a shaded side) stays. Offline, after the flights (BundleFlights).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "fieldvision/camera/camera.h"
@@ -47,6 +48,8 @@ struct RestBundle {
   long long rows = 0;          // rows given their run's point
   long long observations = 0;  // candidates used
   double rms_px = 0.0;         // their reprojection RMS
+  // "N resting balls refined on <views> (R rows, E px RMS)"; "" when no run was refined.
+  std::string Summary(const std::string& views) const;
 };
 
 // Refines the resting runs of *track in place (ball_radius_m: the triangulation's size checks;

@@ -161,8 +161,16 @@ TEST(BundleRests, AStillBallTakesOnePointFromAllFramesCandidates) {
   std::vector<std::vector<CameraMessage>> one(cams.size());
   one[0] = messages[0];
   std::vector<recon::BallSample> same = before;
-  EXPECT_EQ(BundleRests(cams, one, 0.11, 0.5 / 60.0, {}, {}, &same).runs, 0);
+  const RestBundle none = BundleRests(cams, one, 0.11, 0.5 / 60.0, {}, {}, &same);
+  EXPECT_EQ(none.runs, 0);
   EXPECT_EQ(same[3].ball_in_world, before[3].ball_in_world);
+  // What `ball` prints: one line per kind of views, nothing without a run.
+  EXPECT_EQ(none.Summary("the views"), "");
+  const RestBundle one_run{1, 24, 96, 0.183};
+  EXPECT_EQ(one_run.Summary("the views"),
+            "1 resting ball refined on the views (24 rows, 0.18 px RMS)");
+  const RestBundle two_runs{2, 30, 100, 0.2};
+  EXPECT_EQ(two_runs.Summary("x"), "2 resting balls refined on x (30 rows, 0.20 px RMS)");
 }
 
 }  // namespace
