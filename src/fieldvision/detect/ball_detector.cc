@@ -286,12 +286,13 @@ void BallDetector::Init(const ColourSpec& colour) {
   field_bit_ = table_->ClassBitOrZero("field");
   if (options_.use_region) {
     grow_bit_ = table_->ClassBitOrZero(WidenedBallClass(colour));
-    grow_table_ = grow_bit_ != 0
-                      ? table_
-                      : ColourTable::Shared(
-                            WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor),
-                            options_.lut_bits);
-    if (grow_bit_ == 0) grow_bit_ = grow_table_->BallBit();
+    if (grow_bit_ != 0) {
+      grow_table_ = table_;
+    } else {  // no room in the spec: a table of its own
+      grow_table_ = ColourTable::Shared(
+          WidenedBallSpec(colour, options_.grow_hue_deg, options_.grow_factor), options_.lut_bits);
+      grow_bit_ = grow_table_->BallBit();
+    }
   }
   if (posed() && field_ != nullptr && options_.use_field_mask) {
     field_mask_ = FieldMask(*camera_, *field_, options_.field_margin_m, options_.max_height_m);
