@@ -29,6 +29,12 @@ for c in synth ball trajectory plan players stats detect "calibrate intrinsics" 
   check "$c --help" 0 $FV $c --help
 done
 check "field show" 0 $FV field show robocup-msl
+# OpenCV's codecs (a plugin, codecs.h) load only for a command that reads or writes images.
+if LD_DEBUG=files $FV field show robocup-msl 2>&1 | grep -q "libopencv_videoio\|libopencv_imgcodecs"; then
+  echo "FAIL field show loaded OpenCV's imgcodecs or videoio"; fail=1
+else
+  echo "ok   codecs not loaded by field show"
+fi
 check "field draw" 0 $FV field draw fifa --out "$TMP/fifa.png"
 [ -s "$TMP/fifa.png" ] || { echo "FAIL field draw wrote nothing"; fail=1; }
 check "unknown field" nonzero $FV field show rugby

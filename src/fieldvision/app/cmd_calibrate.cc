@@ -13,7 +13,6 @@
 #include <memory>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/app/camera_folder.h"
 #include "fieldvision/app/cmd_calibrate_board.h"
@@ -28,6 +27,7 @@
 #include "fieldvision/calib/rig_lines.h"
 #include "fieldvision/calib/rig_place.h"
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/io/output_path.h"
@@ -68,7 +68,7 @@ cv::Mat ReadImage(const std::string& path) {
   cv::Mat image;
   try {
     const QuietStderr quiet;
-    image = cv::imread(path, cv::IMREAD_COLOR);
+    image = codecs::ImRead(path, cv::IMREAD_COLOR);
   } catch (const cv::Exception&) {
     image.release();
   }

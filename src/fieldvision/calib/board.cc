@@ -10,9 +10,9 @@
 #include <fmt/format.h>
 #include <opencv2/aruco/charuco.hpp>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
@@ -311,7 +311,7 @@ cv::Mat ImageSource::Read(int i) const {
   cv::Mat image;
   if (!video_) {
     try {
-      image = cv::imread(names_[i], cv::IMREAD_UNCHANGED);
+      image = codecs::ImRead(names_[i], cv::IMREAD_UNCHANGED);
     } catch (const cv::Exception&) {
       image.release();
     }

@@ -6,11 +6,10 @@
 #include <optional>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
@@ -93,16 +92,17 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   io::AtomicOutput out_file(o.out);
   util::CsvWriter csv(out_file.temp_path(),
                       {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
-  cv::VideoWriter writer;
+  std::unique_ptr<cv::VideoWriter> writer;
   std::string draw_dir;
   if (!o.draw.empty()) {
     if (IsVideoPath(o.draw)) {
       const int fourcc = util::EndsWith(util::ToLower(o.draw), ".avi")
-                             ? cv::VideoWriter::fourcc('M', 'J', 'P', 'G')
-                             : cv::VideoWriter::fourcc('m', 'p', '4', 'v');
+                             ? codecs::FourCc('M', 'J', 'P', 'G')
+                             : codecs::FourCc('m', 'p', '4', 'v');
       const double fps = source->fps() > 0 ? source->fps() : 30.0;
-      writer.open(o.draw, fourcc, fps, cv::Size(source->width(), source->height()));
-      FV_REQUIRE(writer.isOpened(), "cannot write annotated video '{}'", o.draw);
+      writer = codecs::NewVideoWriter();
+      writer->open(o.draw, fourcc, fps, cv::Size(source->width(), source->height()));
+      FV_REQUIRE(writer->isOpened(), "cannot write annotated video '{}'", o.draw);
     } else {
       std::error_code ec;
       std::filesystem::create_directories(o.draw, ec);
@@ -130,15 +130,15 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     result.candidates += static_cast<long long>(cands.size());
     result.frames_with_ball += any;
     ++result.frames;
-    if (writer.isOpened() || !draw_dir.empty()) {
+    if (writer || !draw_dir.empty()) {
       cv::Mat canvas = frame.bgr.clone();
       DrawFieldBoundary(canvas, detector.colour().OffFieldBoundary(frame.bgr));
       DrawCandidates(canvas, cands);
-      if (writer.isOpened()) {
-        writer.write(canvas);
+      if (writer) {
+        writer->write(canvas);
       } else {
         const std::string path = fmt::format("{}/{:05d}.jpg", draw_dir, frame.index);
-        FV_REQUIRE(cv::imwrite(path, canvas), "cannot write '{}'", path);
+        FV_REQUIRE(codecs::ImWrite(path, canvas), "cannot write '{}'", path);
       }
     }
     progress.Update(result.frames);

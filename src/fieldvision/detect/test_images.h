@@ -9,10 +9,10 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/camera/camera.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/util/random.h"
 
 namespace fv::detect::test_util {
@@ -52,8 +52,8 @@ inline cv::Mat FieldImage(int width, int height, util::Rng& rng, double noise_si
 // `img` encoded as a JPEG of this quality and decoded again (4:2:0 chroma, block artefacts).
 inline cv::Mat JpegRoundTrip(const cv::Mat& img, int quality) {
   std::vector<uchar> buf;
-  cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, quality});
-  return cv::imdecode(buf, cv::IMREAD_COLOR);
+  codecs::ImEncode(".jpg", img, &buf, {cv::IMWRITE_JPEG_QUALITY, quality});
+  return codecs::ImDecode(buf, cv::IMREAD_COLOR);
 }
 
 // Paints a Lambert-shaded disc of radius r at centre c (pixel coordinates) by 8x8 supersampling;

@@ -1,6 +1,7 @@
 // Frame-source backend: video files OpenCV reads and printf image patterns (dir/%05d.jpg), with
-// times from the frame rate, the container or a frame,time_s CSV. Motion-JPEG packets (through
-// FFmpeg) and JPEG files can be delivered encoded (the ball pipeline's window-decoding path).
+// times from the frame rate, the container or a frame,time_s CSV. Motion-JPEG frames (an AVI's
+// read directly, another container's packets through FFmpeg) and JPEG files can be delivered
+// encoded (the ball pipeline's window-decoding path).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,8 +11,9 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
+#include "fieldvision/codecs/codecs.h"
+#include "fieldvision/io/avi_mjpeg.h"
 #include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
@@ -60,8 +62,9 @@ class FileSource : public FrameSource {
   std::string path_;
   FrameSourceOptions options_;
   TimeOrigin origin_ = TimeOrigin::kFrameRate;
-  cv::VideoCapture capture_;
-  std::map<long long, double> times_;  // kCsv
+  std::unique_ptr<AviMjpegReader> avi_;        // encoded: a Motion-JPEG AVI read directly
+  std::unique_ptr<cv::VideoCapture> capture_;  // else OpenCV's
+  std::map<long long, double> times_;          // kCsv
   bool encoded_ = false;
   bool jpeg_files_ = false;    // encoded: a pattern of JPEG files (else MJPG packets)
   long long first_file_ = -1;  // index of the first file of the pattern
@@ -81,12 +84,17 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
   FV_REQUIRE(pattern || std::filesystem::exists(path), "video '{}' does not exist", path);
   FV_REQUIRE(pattern || !std::filesystem::is_directory(path),
              "video '{}' is a folder (give an image pattern such as '{}/%05d.jpg')", path, path);
-  FV_REQUIRE(OpenVideoFile(capture_, path), "cannot open video '{}' (not a video OpenCV reads?)",
-             path);
-  const double container_fps = capture_.get(cv::CAP_PROP_FPS);
+  if (options.encoded && !pattern) avi_ = AviMjpegReader::Open(path);
+  if (!avi_) {
+    capture_ = codecs::NewVideoCapture();
+    FV_REQUIRE(OpenVideoFile(*capture_, path), "cannot open video '{}' (not a video OpenCV reads?)",
+               path);
+  }
+  const double container_fps = avi_ ? avi_->fps() : capture_->get(cv::CAP_PROP_FPS);
   fps_ = options.fps > 0 ? options.fps
                          : (std::isfinite(container_fps) && container_fps > 0 ? container_fps : 30);
-  const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+  const double count =
+      avi_ ? static_cast<double>(avi_->frame_count()) : capture_->get(cv::CAP_PROP_FRAME_COUNT);
   if (std::isfinite(count) && count > 0) frame_count_ = static_cast<long long>(count);
   origin_ = options.time == TimeSource::kCsv         ? TimeOrigin::kCsv
             : options.time == TimeSource::kContainer ? TimeOrigin::kContainer
@@ -97,11 +105,16 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
   // Motion JPEG through FFmpeg: the packets themselves are the JPEG frames. Raw packets carry
   // no container times (CAP_PROP_POS_MSEC stays 0), so with container times asked for only an
   // AVI's (a fixed rate: frame / fps) are read raw; another container is decoded by FFmpeg.
-  const int fourcc = static_cast<int>(capture_.get(cv::CAP_PROP_FOURCC));
-  const bool rate_times = options.time != TimeSource::kContainer || LowerExtension(path) == ".avi";
-  if (options.encoded && !pattern && fourcc == cv::VideoWriter::fourcc('M', 'J', 'P', 'G') &&
-      capture_.getBackendName() == "FFMPEG" && rate_times) {
-    encoded_ = capture_.set(cv::CAP_PROP_FORMAT, -1);
+  if (avi_) {
+    encoded_ = true;
+  } else if (options.encoded && !pattern) {
+    const int fourcc = static_cast<int>(capture_->get(cv::CAP_PROP_FOURCC));
+    const bool rate_times =
+        options.time != TimeSource::kContainer || LowerExtension(path) == ".avi";
+    if (fourcc == codecs::FourCc('M', 'J', 'P', 'G') &&
+        codecs::BackendName(*capture_) == "FFMPEG" && rate_times) {
+      encoded_ = capture_->set(cv::CAP_PROP_FORMAT, -1);
+    }
   }
   // A pattern of JPEG files: the files themselves are the frames (OpenCV's image reader starts
   // at the first of indices 0..1000 that exists; so does this).
@@ -118,7 +131,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
       long long n = 0;
       while (std::filesystem::exists(PatternFile(path, first_file_ + n))) ++n;
       frame_count_ = n;
-      capture_.release();
+      capture_->release();
       if (origin_ == TimeOrigin::kContainer) origin_ = TimeOrigin::kFrameRate;  // no times
     }
   }
@@ -137,11 +150,13 @@ bool FileSource::GrabEncoded(SourceFrame* out) {
     if (!in) return false;  // the end of the sequence
     out->jpeg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     FV_REQUIRE(!in.bad(), "cannot read '{}'", file);
+  } else if (avi_) {
+    if (!avi_->Next(&out->jpeg)) return false;
   } else {
     cv::Mat packet;
     bool ok = false;
     try {
-      ok = capture_.read(packet);
+      ok = capture_->read(packet);
     } catch (const cv::Exception&) {
       ok = false;
     }
@@ -157,7 +172,7 @@ bool FileSource::Grab(SourceFrame* out) {
   out->jpeg.clear();
   bool ok = false;
   try {
-    ok = capture_.read(out->bgr);
+    ok = capture_->read(out->bgr);
   } catch (const cv::Exception&) {
     ok = false;  // a corrupt frame ends the stream; the pipeline reports where
   }
@@ -194,7 +209,7 @@ bool FileSource::SkipFrame() {
   } else {
     bool ok = false;
     try {
-      ok = capture_.grab();  // no decoding
+      ok = capture_->grab();  // no decoding
     } catch (const cv::Exception&) {
       ok = false;
     }
@@ -214,7 +229,7 @@ double FileSource::TimeOf(long long f) {
     case TimeSource::kContainer: {
       // Image files carry no capture times, raw packets none that OpenCV reports (an AVI).
       if (jpeg_files_ || encoded_) return f / fps_;
-      const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+      const double ms = capture_->get(cv::CAP_PROP_POS_MSEC);
       return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
     }
     case TimeSource::kCsv: {

@@ -4,9 +4,7 @@
 // else the arrival time.
 #include <cmath>
 
-#include <opencv2/videoio.hpp>
-#include <opencv2/videoio/registry.hpp>
-
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/util/error.h"
@@ -19,9 +17,9 @@ class GStreamerSource : public LiveSource {
  public:
   GStreamerSource(const std::string& spec, const std::string& pipeline)
       : LiveSource(spec, "stream", true) {
-    FV_REQUIRE(OpenCapture(capture_, pipeline, cv::CAP_GSTREAMER),
+    FV_REQUIRE(OpenCapture(*capture_, pipeline, cv::CAP_GSTREAMER),
                "stream '{}' cannot be opened (GStreamer: '{}')", spec, pipeline);
-    fps_ = capture_.get(cv::CAP_PROP_FPS);
+    fps_ = capture_->get(cv::CAP_PROP_FPS);
     if (!(std::isfinite(fps_) && fps_ > 0)) fps_ = 30.0;
     ReadFirstFrame();
   }
@@ -29,7 +27,7 @@ class GStreamerSource : public LiveSource {
  private:
   bool Grab(SourceFrame* out) override {
     double arrival_s = 0, ms = 0;  // ms: the buffer's PTS
-    if (!ReadCapture(capture_, out, &arrival_s, &ms)) return false;
+    if (!ReadCapture(*capture_, out, &arrival_s, &ms)) return false;
     if (std::isfinite(ms) && ms >= 0 && (anchor_s_ == 0 || ms > last_ms_)) {
       if (anchor_s_ == 0) anchor_s_ = arrival_s - ms / 1000.0;
       last_ms_ = ms;
@@ -42,14 +40,14 @@ class GStreamerSource : public LiveSource {
     return true;
   }
 
-  cv::VideoCapture capture_;
+  std::unique_ptr<cv::VideoCapture> capture_ = codecs::NewVideoCapture();
   double anchor_s_ = 0;  // system time of PTS 0
   double last_ms_ = -1;
 };
 
 }  // namespace
 
-bool HaveGStreamer() { return cv::videoio_registry::hasBackend(cv::CAP_GSTREAMER); }
+bool HaveGStreamer() { return codecs::HasVideoBackend(cv::CAP_GSTREAMER); }
 
 std::unique_ptr<FrameSource> OpenGStreamer(const std::string& spec,
                                            const FrameSourceOptions& options) {

@@ -1,7 +1,6 @@
 #include "fieldvision/io/image_file.h"
 
-#include <opencv2/imgcodecs.hpp>
-
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::io {
@@ -9,7 +8,7 @@ namespace fv::io {
 cv::Mat ReadImage(const std::string& path) {
   cv::Mat image;
   try {
-    image = cv::imread(path, cv::IMREAD_COLOR);
+    image = codecs::ImRead(path, cv::IMREAD_COLOR);
   } catch (const cv::Exception&) {
     image.release();
   }
@@ -20,7 +19,7 @@ cv::Mat ReadImage(const std::string& path) {
 void WriteImage(const std::string& path, const cv::Mat& image) {
   bool ok = false;
   try {
-    ok = cv::imwrite(path, image);
+    ok = codecs::ImWrite(path, image);
   } catch (const cv::Exception&) {
     ok = false;
   }

@@ -7,8 +7,8 @@
 #include <map>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
@@ -34,7 +34,7 @@ class ImageListSource : public FrameSource {
       origin_ = TimeOrigin::kCsv;
       csv_ = o.timestamps_csv;
     }
-    const cv::Mat first = cv::imread(files_.front(), cv::IMREAD_COLOR);
+    const cv::Mat first = codecs::ImRead(files_.front(), cv::IMREAD_COLOR);
     FV_REQUIRE(!first.empty() || files_.front() != spec,
                "image '{}' cannot be read (damaged or not an image)", spec);
     FV_REQUIRE(!first.empty(), "image sequence '{}': cannot read its first image '{}'", spec,
@@ -54,7 +54,7 @@ class ImageListSource : public FrameSource {
       FV_REQUIRE(!out->jpeg.empty(), "image sequence '{}': frame {} ('{}') is empty", spec_, next_,
                  file);
     } else {
-      out->bgr = cv::imread(file, cv::IMREAD_COLOR);
+      out->bgr = codecs::ImRead(file, cv::IMREAD_COLOR);
       FV_REQUIRE(!out->bgr.empty(), "image sequence '{}': frame {} ('{}') cannot be read", spec_,
                  next_, file);
       FV_REQUIRE(out->bgr.size() == size_,

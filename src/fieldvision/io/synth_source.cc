@@ -11,8 +11,8 @@
 #include <thread>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
@@ -55,7 +55,7 @@ class SynthLiveSource : public FrameSource {
     out->bgr = cv::Mat();
     out->jpeg.clear();
     if (encoded_) {
-      cv::imencode(".jpg", bgr, out->jpeg, {cv::IMWRITE_JPEG_QUALITY, quality_});
+      codecs::ImEncode(".jpg", bgr, &out->jpeg, {cv::IMWRITE_JPEG_QUALITY, quality_});
     } else {
       out->bgr = bgr;
     }

@@ -4,8 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include <opencv2/videoio.hpp>
-
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/live_source.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/util/error.h"
@@ -20,16 +19,16 @@ class V4l2Source : public LiveSource {
       : LiveSource(spec, "camera", false) {
     FV_REQUIRE(std::filesystem::exists(device), "camera '{}': device '{}' does not exist", spec,
                device);
-    FV_REQUIRE(OpenCapture(capture_, device, cv::CAP_V4L2),
+    FV_REQUIRE(OpenCapture(*capture_, device, cv::CAP_V4L2),
                "camera '{}': cannot open '{}' as a V4L2 camera", spec, device);
-    if (o.width > 0) capture_.set(cv::CAP_PROP_FRAME_WIDTH, o.width);
-    if (o.height > 0) capture_.set(cv::CAP_PROP_FRAME_HEIGHT, o.height);
-    if (o.fps > 0) capture_.set(cv::CAP_PROP_FPS, o.fps);
+    if (o.width > 0) capture_->set(cv::CAP_PROP_FRAME_WIDTH, o.width);
+    if (o.height > 0) capture_->set(cv::CAP_PROP_FRAME_HEIGHT, o.height);
+    if (o.fps > 0) capture_->set(cv::CAP_PROP_FPS, o.fps);
     if (o.exposure_us > 0) {
-      capture_.set(cv::CAP_PROP_AUTO_EXPOSURE, 1);                 // V4L2 manual mode
-      capture_.set(cv::CAP_PROP_EXPOSURE, o.exposure_us / 100.0);  // units of 100 us
+      capture_->set(cv::CAP_PROP_AUTO_EXPOSURE, 1);                 // V4L2 manual mode
+      capture_->set(cv::CAP_PROP_EXPOSURE, o.exposure_us / 100.0);  // units of 100 us
     }
-    fps_ = capture_.get(cv::CAP_PROP_FPS);
+    fps_ = capture_->get(cv::CAP_PROP_FPS);
     if (!(std::isfinite(fps_) && fps_ > 0)) fps_ = o.fps > 0 ? o.fps : 30.0;
     ReadFirstFrame();
   }
@@ -38,7 +37,7 @@ class V4l2Source : public LiveSource {
   bool Grab(SourceFrame* out) override {
     // OpenCV's V4L2 backend reports the buffer's timestamp (ms on CLOCK_MONOTONIC).
     double arrival_s = 0, ms = 0;
-    if (!ReadCapture(capture_, out, &arrival_s, &ms)) return false;
+    if (!ReadCapture(*capture_, out, &arrival_s, &ms)) return false;
     const double device_s = std::isfinite(ms) && ms > 0 ? SystemFromMonotonic(ms / 1000.0) : 0;
     if (device_s > 0 && std::abs(device_s - arrival_s) < 1.0) {
       out->time_s = device_s;
@@ -50,7 +49,7 @@ class V4l2Source : public LiveSource {
     return true;
   }
 
-  cv::VideoCapture capture_;
+  std::unique_ptr<cv::VideoCapture> capture_ = codecs::NewVideoCapture();
 };
 
 }  // namespace

@@ -6,7 +6,6 @@
 #include <regex>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/util/error.h"

@@ -9,10 +9,10 @@
 #include <thread>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <zmq.hpp>
 
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/frame_source.h"
@@ -247,7 +247,7 @@ io::SourceFrame WarmUpFrame(cv::Size size, bool encoded) {
     cv::circle(blank.bgr, centre, r, colours[i], cv::FILLED, cv::LINE_AA);
   }
   if (encoded) {
-    cv::imencode(".jpg", blank.bgr, blank.jpeg);
+    codecs::ImEncode(".jpg", blank.bgr, &blank.jpeg);
     blank.bgr = cv::Mat();
   }
   return blank;

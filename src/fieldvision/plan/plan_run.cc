@@ -5,7 +5,6 @@
 #include <fstream>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"

@@ -10,11 +10,10 @@
 #include <thread>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/synth/figures.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/csv.h"
@@ -112,7 +111,7 @@ void WriteSpecAndCameras(const SceneSpec& spec, const SceneRenderer& scene,
 struct CameraOut {
   std::string file;
   std::mutex mutex;
-  cv::VideoWriter writer;
+  std::unique_ptr<cv::VideoWriter> writer;
   std::map<int, cv::Mat> pending;
   int next_write = 0;
 };
@@ -132,10 +131,12 @@ std::vector<std::unique_ptr<CameraOut>> OpenOutputs(const SceneSpec& spec,
       continue;
     }
     out.file = folder.Path(cam.name + ".avi");
-    out.writer.open(out.file, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
-                    spec.fps, cv::Size(cam.width, cam.height), true);
-    FV_REQUIRE(out.writer.isOpened(), "cannot open video '{}' for writing", out.file);
-    out.writer.set(cv::VIDEOWRITER_PROP_QUALITY, MjpegWriterQuality(spec.jpeg_quality));
+    out.writer = codecs::NewVideoWriter();
+    codecs::OpenVideoWriter(out.writer.get(), out.file, cv::CAP_OPENCV_MJPEG,
+                            codecs::FourCc('M', 'J', 'P', 'G'), spec.fps,
+                            cv::Size(cam.width, cam.height));
+    FV_REQUIRE(out.writer->isOpened(), "cannot open video '{}' for writing", out.file);
+    out.writer->set(cv::VIDEOWRITER_PROP_QUALITY, MjpegWriterQuality(spec.jpeg_quality));
   }
   return outs;
 }
@@ -158,12 +159,12 @@ void RenderAndWrite(const SceneSpec& spec, const SceneRenderer& scene, const Sce
   auto write_ready = [&](CameraOut& out, int c) {
     while (!out.pending.empty() && out.pending.begin()->first == out.next_write) {
       if (spec.format == "avi") {
-        out.writer.write(out.pending.begin()->second);
+        out.writer->write(out.pending.begin()->second);
       } else {
         const std::string p = fmt::format("{}/{}/{:05d}.{}", folder.dir, scene.cameras()[c].name,
                                           out.next_write, spec.format);
-        FV_REQUIRE(cv::imwrite(p, out.pending.begin()->second, params), "cannot write image '{}'",
-                   p);
+        FV_REQUIRE(codecs::ImWrite(p, out.pending.begin()->second, params),
+                   "cannot write image '{}'", p);
       }
       out.pending.erase(out.pending.begin());
       ++out.next_write;
@@ -203,7 +204,9 @@ void RenderAndWrite(const SceneSpec& spec, const SceneRenderer& scene, const Sce
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   for (auto& t : threads) t.join();
-  for (auto& o : outs) o->writer.release();
+  for (auto& o : outs) {
+    if (o->writer) o->writer->release();
+  }
   prog.Update(done.load());
   prog.Finish();
   FV_REQUIRE(error.empty(), "{}", error);
@@ -312,7 +315,7 @@ WriteSceneResult WriteScene(const SceneSpec& spec, const std::string& out_dir, b
   }
   const cv::Mat sheet = ContactSheet(first, names, first.size() > 1 ? 640 : 960);
   const std::string p = folder.Path("contact_sheet.png");
-  FV_REQUIRE(cv::imwrite(p, sheet), "cannot write '{}'", p);
+  FV_REQUIRE(codecs::ImWrite(p, sheet), "cannot write '{}'", p);
   res.files.push_back(p);
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;

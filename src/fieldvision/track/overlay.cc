@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/calib/check.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -124,12 +125,12 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
 namespace {
 
 // Opens a writer with OpenCV's log quiet (a missing encoder is an expected outcome here).
-bool TryOpen(cv::VideoWriter& w, const std::string& path, int fourcc, double fps, cv::Size size) {
+bool TryOpen(cv::VideoWriter* w, const std::string& path, int fourcc, double fps, cv::Size size) {
   const auto level = cv::utils::logging::getLogLevel();
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   bool ok = false;
   try {
-    ok = w.open(path, cv::CAP_FFMPEG, fourcc, fps, size) && w.isOpened();
+    ok = codecs::OpenVideoWriter(w, path, cv::CAP_FFMPEG, fourcc, fps, size) && w->isOpened();
   } catch (const cv::Exception&) {
     ok = false;
   }
@@ -149,11 +150,11 @@ std::string TempPathFor(const std::string& path) {
 bool H264Available() {
   static const bool available = [] {
     const fs::path p = fs::temp_directory_path() / fmt::format("fv_h264_probe_{}.mp4", ::getpid());
-    cv::VideoWriter w;
-    bool ok = TryOpen(w, p.string(), cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 10, {64, 64});
+    const auto w = codecs::NewVideoWriter();
+    bool ok = TryOpen(w.get(), p.string(), codecs::FourCc('a', 'v', 'c', '1'), 10, {64, 64});
     if (ok) {
-      w.write(cv::Mat(64, 64, CV_8UC3, cv::Scalar(0, 0, 0)));
-      w.release();
+      w->write(cv::Mat(64, 64, CV_8UC3, cv::Scalar(0, 0, 0)));
+      w->release();
       std::error_code ec;
       ok = fs::file_size(p, ec) > 0 && !ec;
     }
@@ -165,7 +166,7 @@ bool H264Available() {
 }
 
 PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size)
-    : size_(size) {
+    : writer_(codecs::NewVideoWriter()), size_(size) {
   FV_REQUIRE(fps > 0 && std::isfinite(fps), "video '{}': frame rate must be positive (got {})",
              path, fps);
   FV_REQUIRE(size.width > 0 && size.height > 0, "video '{}': empty frame size", path);
@@ -173,7 +174,7 @@ PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv
   const bool mp4 = util::EndsWith(util::ToLower(path), ".mp4");
   if (mp4 && H264Available()) {
     tmp_ = TempPathFor(path_);
-    if (TryOpen(writer_, tmp_, cv::VideoWriter::fourcc('a', 'v', 'c', '1'), fps, size)) {
+    if (TryOpen(writer_.get(), tmp_, codecs::FourCc('a', 'v', 'c', '1'), fps, size)) {
       codec_ = "H.264";
       return;
     }
@@ -186,14 +187,14 @@ PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv
         path_);
   }
   tmp_ = TempPathFor(path_);
-  FV_REQUIRE(TryOpen(writer_, tmp_, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, size),
+  FV_REQUIRE(TryOpen(writer_.get(), tmp_, codecs::FourCc('M', 'J', 'P', 'G'), fps, size),
              "cannot write video '{}' (folder missing or not writable?)", path_);
   codec_ = "MJPG";
 }
 
 PlayableVideoWriter::~PlayableVideoWriter() {
   if (!closed_) {
-    writer_.release();
+    writer_->release();
     std::error_code ec;
     fs::remove(tmp_, ec);
   }
@@ -203,13 +204,13 @@ void PlayableVideoWriter::Write(const cv::Mat& bgr) {
   FV_REQUIRE(bgr.size() == size_ && bgr.type() == CV_8UC3,
              "video '{}': frame {} is {}x{}, the video {}x{}", path_, frames_, bgr.cols, bgr.rows,
              size_.width, size_.height);
-  writer_.write(bgr);
+  writer_->write(bgr);
   ++frames_;
 }
 
 void PlayableVideoWriter::Close() {
   if (closed_) return;
-  writer_.release();
+  writer_->release();
   closed_ = true;
   std::error_code ec;
   fs::rename(tmp_, path_, ec);

@@ -69,7 +69,7 @@ class PlayableVideoWriter {
   int frames() const { return frames_; }
 
  private:
-  cv::VideoWriter writer_;
+  std::unique_ptr<cv::VideoWriter> writer_;  // made by the codecs plugin
   std::string path_, tmp_, codec_, note_;
   cv::Size size_;
   int frames_ = 0;

@@ -13,7 +13,6 @@
 #include <fmt/format.h>
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"

@@ -9,12 +9,12 @@
 #include <string_view>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/calib/extrinsics.h"
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/calib/lines.h"
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/colour.h"
 #include "fieldvision/detect/colour_learn.h"
@@ -352,7 +352,7 @@ std::vector<Eigen::Vector2d> ParseUvList(const json& body, const std::string& ke
 
 std::string EncodePng(const cv::Mat& image) {
   std::vector<uchar> buf;
-  cv::imencode(".png", image, buf, {cv::IMWRITE_PNG_COMPRESSION, 1});
+  codecs::ImEncode(".png", image, &buf, {cv::IMWRITE_PNG_COMPRESSION, 1});
   return std::string(buf.begin(), buf.end());
 }
 
@@ -414,7 +414,7 @@ cv::Mat DecodePngImage(const std::string& base64, const std::string& what) {
     throw HttpError(400, what + " is not a PNG image");
   }
   const std::vector<uchar> buf(bytes.begin(), bytes.end());
-  cv::Mat image = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
+  cv::Mat image = codecs::ImDecode(buf, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw HttpError(400, what + " is not a readable PNG image");
   return image;
 }

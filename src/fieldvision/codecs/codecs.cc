@@ -1,0 +1,93 @@
+#include "fieldvision/codecs/codecs.h"
+
+#include <dlfcn.h>
+
+#include <filesystem>
+#include <mutex>
+
+#include "fieldvision/codecs/plugin.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::codecs {
+namespace {
+
+constexpr const char* kPluginFile = "libfieldvision_codecs.so";
+
+// Where the plugin may be: beside the program's lib folder (bin/../lib, as built and as
+// installed), then where this build wrote it (test programs live elsewhere in the build).
+std::vector<std::filesystem::path> PluginCandidates() {
+  std::vector<std::filesystem::path> out;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) out.push_back(exe.parent_path().parent_path() / "lib" / kPluginFile);
+#ifdef FV_CODECS_PLUGIN
+  out.emplace_back(FV_CODECS_PLUGIN);
+#endif
+  return out;
+}
+
+const PluginApi* LoadPlugin() {
+  std::string tried;
+  for (const auto& path : PluginCandidates()) {
+    if (!std::filesystem::exists(path)) {
+      tried += (tried.empty() ? "" : ", ") + path.string();
+      continue;
+    }
+    void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    FV_REQUIRE(handle != nullptr, "cannot load the image and video codecs plugin '{}': {}",
+               path.string(), dlerror());
+    using Entry = const PluginApi* (*)();
+    auto entry = reinterpret_cast<Entry>(dlsym(handle, "fv_codecs_plugin_api"));
+    FV_REQUIRE(entry != nullptr, "codecs plugin '{}' has no fv_codecs_plugin_api", path.string());
+    const PluginApi* api = entry();
+    FV_REQUIRE(api != nullptr && api->version == kPluginApiVersion,
+               "codecs plugin '{}' is from another build (interface version {}, expected {})",
+               path.string(), api ? api->version : -1, kPluginApiVersion);
+    return api;  // never unloaded: its objects (captures, writers) may outlive any owner here
+  }
+  Throw(
+      "the image and video codecs plugin {} is missing (looked for {}; build the target "
+      "fieldvision_codecs)",
+      kPluginFile, tried);
+}
+
+const PluginApi& Api() {
+  static const PluginApi* api = LoadPlugin();
+  return *api;
+}
+
+}  // namespace
+
+void Load() { Api(); }
+
+cv::Mat ImRead(const std::string& path, int flags) { return Api().imread(path, flags); }
+
+bool ImWrite(const std::string& path, cv::InputArray image, const std::vector<int>& params) {
+  return Api().imwrite(path, image, params);
+}
+
+cv::Mat ImDecode(cv::InputArray buffer, int flags) { return Api().imdecode(buffer, flags); }
+
+bool ImEncode(const std::string& ext, cv::InputArray image, std::vector<uchar>* buffer,
+              const std::vector<int>& params) {
+  return Api().imencode(ext, image, *buffer, params);
+}
+
+std::unique_ptr<cv::VideoCapture> NewVideoCapture() {
+  return std::unique_ptr<cv::VideoCapture>(Api().new_capture());
+}
+
+std::unique_ptr<cv::VideoWriter> NewVideoWriter() {
+  return std::unique_ptr<cv::VideoWriter>(Api().new_writer());
+}
+
+bool OpenVideoWriter(cv::VideoWriter* writer, const std::string& path, int api, int fourcc,
+                     double fps, cv::Size size, bool is_color) {
+  return Api().open_writer(*writer, path, api, fourcc, fps, size, is_color);
+}
+
+std::string BackendName(const cv::VideoCapture& capture) { return Api().backend_name(capture); }
+
+bool HasVideoBackend(int api) { return Api().has_backend(api); }
+
+}  // namespace fv::codecs
