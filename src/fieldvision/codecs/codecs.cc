@@ -21,7 +21,8 @@ std::vector<std::filesystem::path> PluginCandidates() {
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) out.push_back(exe.parent_path().parent_path() / "lib" / kPluginFile);
 #ifdef FV_CODECS_PLUGIN
-  out.emplace_back(FV_CODECS_PLUGIN);
+  const std::filesystem::path built(FV_CODECS_PLUGIN);
+  if (out.empty() || std::filesystem::weakly_canonical(out[0], ec) != built) out.push_back(built);
 #endif
   return out;
 }
