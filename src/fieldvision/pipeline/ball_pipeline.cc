@@ -78,7 +78,7 @@ std::string BallPipelineSummary::ToString() const {
   if (fitted > 0) {
     s += fmt::format(", {} balls fitted where expected (not found by the search)", fitted);
   }
-  for (const std::string& p : sync.Problems()) s += "\nsync: " + p;
+  for (const std::string& p : sync.Problems(camera_names)) s += "\nsync: " + p;
   for (int c = 0; c < num_cameras && c < static_cast<int>(bad_frames.size()); ++c) {
     if (bad_frames[c] > 0) {
       s += fmt::format("\n{}: {} frames could not be decoded (first: {})", camera_names[c],

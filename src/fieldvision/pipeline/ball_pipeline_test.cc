@@ -145,7 +145,7 @@ TEST(BallPipeline, VideosOfDifferentLengthsByFrameIndex) {
   }
   EXPECT_EQ(summary.used_per_camera[2], 24);
   EXPECT_EQ(summary.sync.cameras[2].last_frame, 23);
-  EXPECT_NE(summary.ToString().find("camera 2: ended at frame 23"), std::string::npos);
+  EXPECT_NE(summary.ToString().find("sync: cam2: ended at frame 23"), std::string::npos);
 }
 
 // Each camera stage tracks the ball: MJPG frames are decoded only in a window around it (and

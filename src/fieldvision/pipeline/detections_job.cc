@@ -533,7 +533,7 @@ std::string DetectionsJobResult::Summary() const {
     if (kept_rows > 0) s += fmt::format(", {} frames the model does not follow kept", kept_rows);
   }
   if (rests.runs > 0) s += "; " + rests.Summary("the 2D detections");
-  for (const auto& p : sync.Problems()) s += "\n  " + p;
+  for (const auto& p : sync.Problems(camera_names)) s += "\n  " + p;
   if (trajectory) {
     s += '\n';
     s += trajectory->Summary();
@@ -557,6 +557,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     }
   }
   DetectionsJobResult res;
+  for (const camera::Camera& cam : cameras) res.camera_names.push_back(cam.name);
   SyncOptions so;
   so.mode = SyncMode::kTimestamp;
   so.tolerance_s = o.tolerance_s;
@@ -581,6 +582,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
     if (res.per_frame.empty() || s.time_s > res.per_frame.back().time_s) res.per_frame.push_back(s);
   }
   res.sync = sync.report();
+  res.sync.gaps_are_drops = false;
   res.track = res.per_frame;
   // Flights, then the bundle.
   if (o.bundle) {

@@ -44,6 +44,7 @@ struct DetectionsJobResult {
   long long positions = 0;   // rows written
   long long candidates = 0;  // detection rows read (all cameras)
   SyncReport sync;
+  std::vector<std::string> camera_names;     // the camera files' names, for the summary
   std::vector<recon::BallSample> track;      // what BALL.csv holds
   std::vector<recon::BallSample> per_frame;  // the per-frame triangulation (before the bundle)
   int bundled_flights = 0;                   // flights refined on the 2D detections

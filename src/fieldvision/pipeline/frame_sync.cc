@@ -33,7 +33,7 @@ int SyncedFrame::SetFrameAndTime() {
   return n;
 }
 
-std::vector<std::string> SyncReport::Problems() const {
+std::vector<std::string> SyncReport::Problems(const std::vector<std::string>& names) const {
   std::vector<std::string> out;
   long long max_last = -1;
   for (const auto& c : cameras) max_last = std::max(max_last, c.last_frame);
@@ -41,7 +41,10 @@ std::vector<std::string> SyncReport::Problems() const {
     const CameraSyncStats& c = cameras[i];
     std::vector<std::string> parts;
     if (c.received == 0) parts.push_back("no frames");
-    if (c.gaps > 0) parts.push_back(fmt::format("{} frames missing (dropped)", c.gaps));
+    if (c.gaps > 0) {
+      parts.push_back(gaps_are_drops ? fmt::format("{} frames missing (dropped)", c.gaps)
+                                     : fmt::format("{} frames without a detection", c.gaps));
+    }
     if (c.duplicates > 0) {
       parts.push_back(fmt::format("{} duplicated frames ignored", c.duplicates));
     }
@@ -55,7 +58,7 @@ std::vector<std::string> SyncReport::Problems() const {
     }
     if (c.first_frame > 0) parts.push_back(fmt::format("starts at frame {}", c.first_frame));
     if (!parts.empty()) {
-      std::string line = fmt::format("camera {}: ", i);
+      std::string line = (i < names.size() ? names[i] : fmt::format("camera {}", i)) + ": ";
       for (size_t k = 0; k < parts.size(); ++k) line += (k ? ", " : "") + parts[k];
       out.push_back(line);
     }

@@ -51,8 +51,13 @@ struct SyncReport {
   std::vector<CameraSyncStats> cameras;
   long long groups = 0;           // frames emitted
   long long complete_groups = 0;  // with every camera present
-  // One line per camera with a problem (empty when everything paired cleanly).
-  std::vector<std::string> Problems() const;
+  // Frames missing between messages are drops (videos, cameras); in detection files a frame
+  // without a row had no detection.
+  bool gaps_are_drops = true;
+  // One line per camera with a problem (empty when everything paired cleanly), each starting
+  // with the camera's name from `names` ("camera <index>" without one, as unnamed cameras are
+  // called in the pipelines' summaries).
+  std::vector<std::string> Problems(const std::vector<std::string>& names = {}) const;
 };
 
 class FrameSynchronizer {

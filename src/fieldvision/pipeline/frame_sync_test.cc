@@ -72,9 +72,17 @@ TEST(FrameSync, ByIndexWithDropsDuplicatesAndDifferentLengths) {
   EXPECT_EQ(r.complete_groups, 10);
   const auto problems = r.Problems();
   ASSERT_EQ(problems.size(), 2u);
-  EXPECT_NE(problems[0].find("2 frames missing"), std::string::npos);
+  EXPECT_EQ(problems[0].rfind("camera 1: ", 0), 0u) << problems[0];
+  EXPECT_NE(problems[0].find("2 frames missing (dropped)"), std::string::npos);
   EXPECT_NE(problems[0].find("1 duplicated"), std::string::npos);
   EXPECT_NE(problems[1].find("ended at frame 11"), std::string::npos);
+  // Named cameras; in detection files a frame without a row had no detection.
+  SyncReport detections = r;
+  detections.gaps_are_drops = false;
+  const auto named = detections.Problems({"left", "right", "top"});
+  ASSERT_EQ(named.size(), 2u);
+  EXPECT_EQ(named[0].rfind("right: 2 frames without a detection", 0), 0u) << named[0];
+  EXPECT_EQ(named[1].rfind("top: ", 0), 0u) << named[1];
 }
 
 TEST(FrameSync, UnsynchronizedCamerasArePairedByTimeOnly) {
