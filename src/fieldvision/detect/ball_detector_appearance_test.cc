@@ -238,6 +238,40 @@ TEST(BallDetectorAppearance, BallHeldInAHandler) {
   EXPECT_LT(s.MedianErr(), 0.8);
 }
 
+// A colour spec with all 8 classes has no room for the widened ball class the regions grow
+// through: it gets a table of its own (BallDetector::Init), and the detector finds what it finds
+// with the class in its main table.
+TEST(BallDetectorAppearance, FullColourSpecGrowsThroughATableOfItsOwn) {
+  const uint64_t seed = fv::testing::TestSeed(2);
+  FV_SEED_TRACE(seed);
+  synth::SceneSpec spec = LowSunScene(seed, 4);
+  synth::ResizeCameras(spec, 640, 480);
+  const synth::SceneRenderer scene(spec);
+  const ColourSpec yellow = PresetColourSpec("yellow");
+  ColourSpec full = yellow;
+  while (full.classes.size() < 8) {  // classes that hold no colour of these scenes
+    full.classes.push_back({"unused" + std::to_string(full.classes.size()),
+                            {{ColourSpace::kHsv, {300, 254, 254}, {301, 255, 255}}}});
+  }
+  ASSERT_EQ(WithWidenedBall(full).classes.size(), 8u);  // no room
+  const camera::Camera& cam = scene.cameras()[0];
+  const BallDetector one_table(BallDetectorOptions(), yellow, &cam, &scene.field());
+  const BallDetector two_tables(BallDetectorOptions(), full, &cam, &scene.field());
+  int accepted = 0;
+  for (int f = 0; f < scene.num_frames(); ++f) {
+    const cv::Mat image = scene.RenderCamera(0, f);
+    const auto a = one_table.Detect(image), b = two_tables.Detect(image);
+    ASSERT_EQ(a.size(), b.size()) << "frame " << f;
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].accepted, b[i].accepted) << "frame " << f << " candidate " << i;
+      EXPECT_LT((a[i].centre_px - b[i].centre_px).norm(), 1e-9) << "frame " << f;
+      EXPECT_NEAR(a[i].fill, b[i].fill, 1e-12) << "frame " << f;  // the grown region
+      accepted += a[i].accepted;
+    }
+  }
+  EXPECT_GT(accepted, 0);
+}
+
 }  // namespace
 }  // namespace fv::detect
 
