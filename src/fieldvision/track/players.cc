@@ -14,6 +14,7 @@
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/detect/lab.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/track/players_internal.h"
@@ -457,7 +458,7 @@ std::optional<cv::Vec3f> TorsoColour(const cv::Mat& frame, const cv::Rect2d& box
                          cv::Rect(0, 0, frame.cols, frame.rows);
   if (torso.area() <= 4) return std::nullopt;
   cv::Mat lab;
-  cv::cvtColor(frame(torso), lab, cv::COLOR_BGR2Lab);
+  detect::BgrToLab(frame(torso), &lab);
   const cv::Scalar m = cv::mean(lab);
   return cv::Vec3f(m[0] * 0.3, m[1], m[2]);  // chroma first
 }
