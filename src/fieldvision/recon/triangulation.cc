@@ -88,6 +88,7 @@ void TriangulationOptions::Check() const {
   FV_REQUIRE(weak_max_radius_ratio == 0.0 || weak_max_radius_ratio > 1.0,
              "TriangulationOptions.weak_max_radius_ratio must be 0 (off) or > 1 (got {})",
              weak_max_radius_ratio);
+  CheckNonNegative(min_two_view_score, "TriangulationOptions.min_two_view_score");
   CheckNonNegative(radius_sigma_factor, "TriangulationOptions.radius_sigma_factor");
   CheckNonNegative(radius_tolerance, "TriangulationOptions.radius_tolerance");
   CheckNonNegative(radius_tolerance_px, "TriangulationOptions.radius_tolerance_px");

@@ -199,6 +199,11 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
             if (pick[c] < 0) continue;
             score += RadiusWeightedScore(cameras[c], candidates[c][pick[c]], rp.midpoint, o);
           }
+          // Two faint things far from where the ball is expected: no ball.
+          if (n == 2 && score < o.min_two_view_score &&
+              (prior == nullptr || (rp.midpoint - *prior).norm() > o.prior_gate_m)) {
+            continue;
+          }
           KeepBetter(n, cost, score, pick, gated ? &far : &best);
         }
       }

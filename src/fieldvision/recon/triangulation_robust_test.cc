@@ -120,6 +120,29 @@ TEST(RobustStages, AGhostWhoseSizesDoNotFitItIsNoBall) {
   EXPECT_LT((any.point_world - ghost).norm(), 1e-3);
 }
 
+// The ball accepted by one camera only, and two faint still things in two others that meet at a
+// point: no position there (min_two_view_score), unless the ball is expected there (a prior) or
+// the two are scored as balls are.
+TEST(RobustStages, TwoFaintViewsFarFromThePriorAreNoBall) {
+  const auto cams = RingCameras();
+  const Eigen::Vector3d ghost(-2.0, 2.5, 1.5);
+  std::vector<std::vector<BallObservation>> cand = {
+      {Elsewhere(0.8)}, {Seen(cams[1], ghost, 0.07)}, {Seen(cams[2], ghost, 0.1)}};
+  TriangulationOptions o;
+  EXPECT_FALSE(TriangulateRobust(cams, cand, o).ok());
+  const Eigen::Vector3d near_ghost = ghost + Eigen::Vector3d(0.3, 0, 0);
+  const TriangulationResult expected = TriangulateRobust(cams, cand, o, &near_ghost);
+  ASSERT_TRUE(expected.ok());
+  EXPECT_LT((expected.point_world - ghost).norm(), 1e-3);
+  o.min_two_view_score = 0.0;
+  EXPECT_TRUE(TriangulateRobust(cams, cand, o).ok());
+  o = TriangulationOptions();
+  cand[1][0].score = cand[2][0].score = 0.15;  // 0.3 together
+  EXPECT_TRUE(TriangulateRobust(cams, cand, o).ok());
+  o.min_two_view_score = -1;
+  EXPECT_THROW(o.Check(), Error);
+}
+
 // One camera's ball paired with another camera's still ball-coloured thing on that camera's ray,
 // 30 % farther: as many cameras as the ball's own pair and a higher total score, but the first
 // camera's radius does not fit the farther point (score_radius_sigma), so the ball is taken;
