@@ -45,6 +45,11 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                   "scores alone)")
       ->check(FiniteRange(0.0, 10.0))
       ->capture_default_str();
+  cmd->add_option("--min-two-view-score", t.min_two_view_score,
+                  "Two cameras alone whose detector scores (weighted as above) total less are no "
+                  "ball unless it is expected there (0: off; not used with --detections)")
+      ->check(FiniteRange(0.0, 100.0))
+      ->capture_default_str();
   cmd->add_flag("--ground", t.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
   cmd->add_flag("!--no-weak", t.use_weak,
