@@ -192,6 +192,7 @@ void RenderAndWrite(const SceneSpec& spec, const SceneRenderer& scene, const Sce
   const int n_threads = static_cast<int>(
       std::min<long long>(total, std::max(1u, std::thread::hardware_concurrency())));
   std::vector<std::thread> threads;
+  threads.reserve(n_threads);
   for (int k = 0; k < n_threads; ++k) threads.emplace_back(worker);
   while (true) {
     bool all_done = done.load() >= total;

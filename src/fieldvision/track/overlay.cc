@@ -148,7 +148,7 @@ std::string TempPathFor(const std::string& path) {
 }  // namespace
 
 bool H264Available() {
-  static const bool available = [] {
+  static const bool kAvailable = [] {
     const fs::path p = fs::temp_directory_path() / fmt::format("fv_h264_probe_{}.mp4", ::getpid());
     const auto w = codecs::NewVideoWriter();
     bool ok = TryOpen(w.get(), p.string(), codecs::FourCc('a', 'v', 'c', '1'), 10, {64, 64});
@@ -162,7 +162,7 @@ bool H264Available() {
     fs::remove(p, ec);
     return ok;
   }();
-  return available;
+  return kAvailable;
 }
 
 PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size)

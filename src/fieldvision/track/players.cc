@@ -243,6 +243,7 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
         w.push_back(r);  // from the end inwards
       }
       std::vector<double> hs;
+      hs.reserve(w.size());
       for (const TrackRow* r : w) hs.push_back(r->box.height);
       const double full = o.full_height_ratio * util::NearestRankPercentile(hs, 0.5);
       std::vector<const TrackRow*> good;
@@ -420,11 +421,10 @@ int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const camera::Came
 
 FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel* field,
                            double margin_m) {
-  const camera::Camera cam = camera;
   std::optional<field::FieldModel> f;
   if (field != nullptr) f = *field;
   const double margin = margin_m;
-  return [cam, f, margin](const cv::Point2d& foot) {
+  return [cam = camera, f, margin](const cv::Point2d& foot) {  // copies: the filter outlives them
     const auto ray = cam.RayFromPixel({foot.x, foot.y});
     if (!ray) return false;
     const auto g = geometry::IntersectHorizontalPlane(*ray, 0.0);
