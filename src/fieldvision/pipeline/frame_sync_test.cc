@@ -97,8 +97,9 @@ TEST(FrameSync, UnsynchronizedCamerasArePairedByTimeOnly) {
   for (int f = 0; f < 100; ++f) {
     s[1].push_back(Msg(1, f, (f + late) * dt + offset + rng.Uniform(-0.02, 0.02) * dt));
   }
-  for (int f = 0; f < 60; ++f)
+  for (int f = 0; f < 60; ++f) {
     s[2].push_back(Msg(2, f, 2 * f * dt + rng.Uniform(-0.05, 0.05) * dt));
+  }
   SyncOptions opt;
   opt.mode = SyncMode::kTimestamp;
   opt.tolerance_s = tol;
