@@ -120,8 +120,6 @@ void Refine(const std::vector<camera::Camera>& cameras, const std::vector<View>&
   result->point_world = *p;
 }
 
-// The ball's image radius at `p` in `cam`: the mean distance from its centre's projection to
-// those of two points a ball radius away across the viewing ray (lens distortion included).
 std::optional<double> ExpectedRadiusPx(const camera::Camera& cam, const Eigen::Vector3d& p,
                                        double radius_m) {
   const auto centre = cam.Project(p);

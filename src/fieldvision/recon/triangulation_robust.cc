@@ -43,31 +43,22 @@ RankedCandidates RankCandidates(const std::vector<camera::Camera>& cameras,
   return r;
 }
 
-namespace {
-
-// The radius (pixels) of a ball at p in a pinhole camera with the mean focal length: what the
-// consistency and score checks compare a reported radius with.
-double PinholeRadiusPx(const camera::Camera& camera, const Eigen::Vector3d& p,
-                       double ball_radius_m) {
-  return ball_radius_m * std::sqrt(camera.fx * camera.fy) / Depth(camera, p);
-}
-
-}  // namespace
-
 bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
                       const Eigen::Vector3d& p, double ball_radius_m, double max_ratio) {
   if (max_ratio <= 0 || obs.radius_px <= 0 || ball_radius_m <= 0) return true;
-  const double ratio = obs.radius_px / PinholeRadiusPx(camera, p, ball_radius_m);
+  const auto expected = ExpectedRadiusPx(camera, p, ball_radius_m);
+  if (!expected || !(*expected > 0)) return false;  // not in front of the camera
+  const double ratio = obs.radius_px / *expected;
   return ratio <= max_ratio && ratio >= 1.0 / max_ratio;
 }
 
 double RadiusWeightedScore(const camera::Camera& camera, const BallObservation& obs,
                            const Eigen::Vector3d& p, const TriangulationOptions& o) {
   if (o.score_radius_sigma <= 0 || obs.radius_px <= 0 || o.ball_radius_m <= 0) return obs.score;
-  // Not in front of the camera (depth <= 0: the radius is negative or infinite): the score alone.
-  const double expected = PinholeRadiusPx(camera, p, o.ball_radius_m);
-  if (!(expected > 0) || !std::isfinite(expected)) return obs.score;
-  const double z = std::log(obs.radius_px / expected) / o.score_radius_sigma;
+  // Not in front of the camera (no projection): the score alone.
+  const auto expected = ExpectedRadiusPx(camera, p, o.ball_radius_m);
+  if (!expected || !(*expected > 0) || !std::isfinite(*expected)) return obs.score;
+  const double z = std::log(obs.radius_px / *expected) / o.score_radius_sigma;
   return obs.score * std::exp(-0.5 * z * z);
 }
 

@@ -154,7 +154,7 @@ TEST(RobustStages, APairAlongOneCamerasRayGivesWayWhereItsRadiusDoesNotFit) {
   const Eigen::Vector3d thing = eye + 1.3 * (ball - eye);
   const auto sized = [](const camera::Camera& cam, const Eigen::Vector3d& p, double score) {
     BallObservation o = Seen(cam, p, score);
-    o.radius_px = 0.11 * std::sqrt(cam.fx * cam.fy) / (cam.cam_from_world * p).z();
+    o.radius_px = *ExpectedRadiusPx(cam, p, 0.11);
     return o;
   };
   const std::vector<std::vector<BallObservation>> cand = {
