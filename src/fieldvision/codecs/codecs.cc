@@ -3,7 +3,8 @@
 #include <dlfcn.h>
 
 #include <filesystem>
-#include <mutex>
+#include <string>
+#include <vector>
 
 #include "fieldvision/codecs/plugin.h"
 #include "fieldvision/util/error.h"
