@@ -36,7 +36,33 @@
 namespace fv::app {
 namespace {
 
-using namespace fv::calib;
+using calib::CheckCalibration;
+using calib::CheckImageSize;
+using calib::CheckOptions;
+using calib::CheckResult;
+using calib::ExtrinsicsOptions;
+using calib::ExtrinsicsResult;
+using calib::FocalOptions;
+using calib::FocalResult;
+using calib::HomographyResult;
+using calib::IntrinsicsOptions;
+using calib::IntrinsicsResult;
+using calib::ParseImageSize;
+using calib::PointCorrespondence;
+using calib::PointResidual;
+using calib::ReadPointsCsv;
+using calib::ReadRigObservations;
+using calib::RefineOptions;
+using calib::RefineResult;
+using calib::RefineRigWithLines;
+using calib::RigObservation;
+using calib::RigOptions;
+using calib::RigPlacementOptions;
+using calib::RigPlacementResult;
+using calib::RigRefineResult;
+using calib::RigResult;
+using calib::WriteHomographyYaml;
+using calib::WritePointErrorTable;
 
 // Sends this process's stderr to /dev/null while it lives: libpng's default error handler, which
 // OpenCV's PNG decoder keeps, prints "libpng error: ..." before imread returns an empty image,
