@@ -1,15 +1,17 @@
 #include "fieldvision/io/avi_mjpeg.h"
 
+#include <algorithm>
+#include <array>
 #include <filesystem>
+
+#include "fieldvision/codecs/codecs.h"
 
 namespace fv::io {
 namespace {
 
+// A chunk id or list type as it reads from the file (codecs::FourCc's packing).
 constexpr uint32_t FourCc(const char (&s)[5]) {
-  return static_cast<uint32_t>(static_cast<uint8_t>(s[0])) |
-         static_cast<uint32_t>(static_cast<uint8_t>(s[1])) << 8 |
-         static_cast<uint32_t>(static_cast<uint8_t>(s[2])) << 16 |
-         static_cast<uint32_t>(static_cast<uint8_t>(s[3])) << 24;
+  return static_cast<uint32_t>(codecs::FourCc(s[0], s[1], s[2], s[3]));
 }
 
 uint32_t Le32(const uint8_t* p) {
@@ -114,17 +116,16 @@ bool AviMjpegReader::ReadStreamList(uint64_t end, int index) {
     const uint64_t start = static_cast<uint64_t>(in_.tellg());
     const uint64_t cend = start + size + (size & 1);
     if (cend > end) return false;
-    std::vector<uint8_t> b(std::min<uint32_t>(size, 64));
-    if (!in_.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(b.size()))) {
-      return false;
-    }
-    if (id == FourCc("strh") && b.size() >= 36) {
+    std::array<uint8_t, 64> b{};
+    const uint32_t n = std::min<uint32_t>(size, b.size());
+    if (!in_.read(reinterpret_cast<char*>(b.data()), n)) return false;
+    if (id == FourCc("strh") && n >= 36) {
       video = Le32(b.data()) == FourCc("vids");
       handler = Le32(b.data() + 4);
       scale = Le32(b.data() + 20);
       rate = Le32(b.data() + 24);
       length = Le32(b.data() + 32);
-    } else if (id == FourCc("strf") && b.size() >= 20 && video) {
+    } else if (id == FourCc("strf") && n >= 20 && video) {
       width_ = static_cast<int>(Le32(b.data() + 4));
       height_ = static_cast<int>(Le32(b.data() + 8));
       compression = Le32(b.data() + 16);
@@ -133,10 +134,9 @@ bool AviMjpegReader::ReadStreamList(uint64_t end, int index) {
   }
   if (!video || !(IsMjpeg(compression) || (compression == 0 && IsMjpeg(handler)))) return true;
   have_video_ = true;
-  const auto digit = [](int d) { return static_cast<uint32_t>('0' + d); };
-  const uint32_t nn = digit(index / 10) | digit(index % 10) << 8;
-  video_chunk_dc_ = nn | FourCc("00dc") >> 16 << 16;
-  video_chunk_db_ = nn | FourCc("00db") >> 16 << 16;
+  const char tens = static_cast<char>('0' + index / 10), ones = static_cast<char>('0' + index % 10);
+  video_chunk_dc_ = static_cast<uint32_t>(codecs::FourCc(tens, ones, 'd', 'c'));
+  video_chunk_db_ = static_cast<uint32_t>(codecs::FourCc(tens, ones, 'd', 'b'));
   if (scale > 0 && rate > 0) fps_ = static_cast<double>(rate) / scale;
   if (length > 0) frames_ = length;
   return true;

@@ -170,8 +170,9 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
           if (!rp.ok()) continue;
           if (NoBallThere(rp.midpoint, o)) continue;
           // The prior decides where the ball may be, but every consistent set is reported.
-          const bool gated =
-              o.gate_by_prior && prior != nullptr && (rp.midpoint - *prior).norm() > o.prior_gate_m;
+          const bool far_from_prior =
+              prior == nullptr || (rp.midpoint - *prior).norm() > o.prior_gate_m;
+          const bool gated = o.gate_by_prior && prior != nullptr && far_from_prior;
           if (!gated) ++best.hypotheses;
           const double cost = GatherConsistent(cameras, candidates, ranked, o, rp.midpoint, &pick);
           if (pick[ca] != ka || pick[cb] != kb) continue;  // the pair itself must agree
@@ -191,10 +192,7 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
             score += RadiusWeightedScore(cameras[c], candidates[c][pick[c]], rp.midpoint, o);
           }
           // Two faint things far from where the ball is expected: no ball.
-          if (n == 2 && score < o.min_two_view_score &&
-              (prior == nullptr || (rp.midpoint - *prior).norm() > o.prior_gate_m)) {
-            continue;
-          }
+          if (n == 2 && score < o.min_two_view_score && far_from_prior) continue;
           KeepBetter(n, cost, score, pick, gated ? &far : &best);
         }
       }
