@@ -5,6 +5,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "fieldvision/util/error.h"
 
@@ -33,6 +34,14 @@ int SyncedFrame::SetFrameAndTime() {
   return n;
 }
 
+std::string SyncProblemLine(const std::vector<std::string>& names, size_t camera,
+                            const std::vector<std::string>& parts) {
+  if (parts.empty()) return "";
+  return fmt::format("{}: {}",
+                     camera < names.size() ? names[camera] : fmt::format("camera {}", camera),
+                     fmt::join(parts, ", "));
+}
+
 std::vector<std::string> SyncReport::Problems(const std::vector<std::string>& names) const {
   std::vector<std::string> out;
   long long max_last = -1;
@@ -57,11 +66,7 @@ std::vector<std::string> SyncReport::Problems(const std::vector<std::string>& na
           fmt::format("ended at frame {} (others go on to {})", c.last_frame, max_last));
     }
     if (c.first_frame > 0) parts.push_back(fmt::format("starts at frame {}", c.first_frame));
-    if (!parts.empty()) {
-      std::string line = (i < names.size() ? names[i] : fmt::format("camera {}", i)) + ": ";
-      for (size_t k = 0; k < parts.size(); ++k) line += (k ? ", " : "") + parts[k];
-      out.push_back(line);
-    }
+    if (!parts.empty()) out.push_back(SyncProblemLine(names, i, parts));
   }
   return out;
 }

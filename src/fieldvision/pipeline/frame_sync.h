@@ -47,6 +47,11 @@ struct CameraSyncStats {
   bool ended = false;
 };
 
+// One camera's line of a synchronisation report: "<name>: part, part" (the name from `names`,
+// "camera <index>" without one); "" when there are no parts.
+std::string SyncProblemLine(const std::vector<std::string>& names, size_t camera,
+                            const std::vector<std::string>& parts);
+
 struct SyncReport {
   std::vector<CameraSyncStats> cameras;
   long long groups = 0;           // frames emitted

@@ -155,11 +155,7 @@ std::vector<std::string> LiveSynchronizer::Problems(const std::vector<std::strin
     if (s.overflow > 0) parts.push_back(fmt::format("{} dropped (buffer full)", s.overflow));
     if (s.unpaired > 0) parts.push_back(fmt::format("{} frames without a partner", s.unpaired));
     if (s.restarts > 0) parts.push_back(fmt::format("restarted {} times", s.restarts));
-    if (parts.empty()) continue;
-    std::string line =
-        (c < static_cast<int>(names.size()) ? names[c] : fmt::format("camera {}", c)) + ": ";
-    for (size_t i = 0; i < parts.size(); ++i) line += (i ? ", " : "") + parts[i];
-    out.push_back(line);
+    if (!parts.empty()) out.push_back(SyncProblemLine(names, static_cast<size_t>(c), parts));
   }
   return out;
 }
