@@ -4,7 +4,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build test demo bench format tidy clean studio sweep fuzz sanitize
+.PHONY: all deps configure build test demo bench format tidy clean studio sweep fuzz sanitize install
 
 all: build
 
@@ -26,6 +26,12 @@ test: build
 
 demo: build
 	bash scripts/demo.sh $(BUILD)
+
+# The program, its codecs plugin, the model and the studio's front end under PREFIX (bin/,
+# lib/fieldvision/, share/fieldvision/); the tree may be moved as a whole.
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD) --prefix $(PREFIX)
 
 # The studio web app over the current folder (http://127.0.0.1:8470/; Ctrl-C stops).
 studio: build

@@ -27,7 +27,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Subscribe the 3D view's live mode to a fusion node's positions from the start "
                   "(its --publish address, tcp://HOST:PORT)");
   cmd->add_option("--assets", o->assets,
-                  "Folder of the built front end (default: studio/dist of the source tree)");
+                  "Folder of the built front end (default: studio/dist of the source tree, else "
+                  "share/fieldvision/studio of the install)");
   cmd->callback([o, &exit_code] {
     // A front end given by hand must be there (the default one may be unbuilt: the page says so).
     FV_REQUIRE(o->assets.empty() || std::filesystem::is_regular_file(

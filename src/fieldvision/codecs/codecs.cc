@@ -6,24 +6,33 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "fieldvision/codecs/plugin.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/program_paths.h"
 
 namespace fv::codecs {
 namespace {
 
 constexpr const char* kPluginFile = "libfieldvision_codecs.so";
 
-// Where the plugin may be: beside the program's lib folder (bin/../lib, as built and as
-// installed), then where this build wrote it (test programs live elsewhere in the build).
+// Where the plugin may be: where the install rules put it (bin/../lib/fieldvision), beside the
+// program as built (build/bin/../lib), then where this build wrote it (test programs live
+// elsewhere in the build).
 std::vector<std::filesystem::path> PluginCandidates() {
   std::vector<std::filesystem::path> out;
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) out.push_back(exe.parent_path().parent_path() / "lib" / kPluginFile);
+  const std::filesystem::path bin = util::ProgramDir();
+  if (!bin.empty()) {
+    out.push_back(util::InstalledPluginDir() / kPluginFile);
+    out.push_back(bin.parent_path() / "lib" / kPluginFile);
+  }
 #ifdef FV_CODECS_PLUGIN
   const std::filesystem::path built(FV_CODECS_PLUGIN);
-  if (out.empty() || std::filesystem::weakly_canonical(out[0], ec) != built) out.push_back(built);
+  std::error_code ec;
+  bool listed = false;
+  for (const auto& p : out) listed = listed || std::filesystem::weakly_canonical(p, ec) == built;
+  if (!listed) out.push_back(built);
 #endif
   return out;
 }
@@ -45,6 +54,7 @@ const PluginApi* LoadPlugin() {
     FV_REQUIRE(api != nullptr && api->version == kPluginApiVersion,
                "codecs plugin '{}' is from another build (interface version {}, expected {})",
                path.string(), api ? api->version : -1, kPluginApiVersion);
+    spdlog::debug("codecs plugin: {}", path.string());
     return api;  // never unloaded: its objects (captures, writers) may outlive any owner here
   }
   Throw(

@@ -6,9 +6,11 @@
 #include <filesystem>
 #include <map>
 
+#include <spdlog/spdlog.h>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/program_paths.h"
 
 namespace fv::dnn {
 namespace fs = std::filesystem;
@@ -17,14 +19,20 @@ std::string FindModel(const std::string& file) {
   std::vector<fs::path> dirs;
   if (const char* env = std::getenv("FV_MODELS_DIR")) dirs.emplace_back(env);
   std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back(exe.parent_path().parent_path() / "models");
+  const fs::path bin = util::ProgramDir();
+  if (!bin.empty()) {
+    dirs.push_back(bin.parent_path() / "models");
+    dirs.push_back(util::InstalledDataDir() / "models");
+  }
   dirs.push_back(fs::current_path(ec) / "models");
   dirs.push_back(fs::current_path(ec) / "build" / "models");
   std::string looked;
   for (const auto& d : dirs) {
     const fs::path p = d / file;
-    if (fs::exists(p, ec)) return p.string();
+    if (fs::exists(p, ec)) {
+      spdlog::debug("model: {}", p.string());
+      return p.string();
+    }
     looked += (looked.empty() ? "" : ", ") + d.string();
   }
   Throw(

@@ -24,7 +24,8 @@ struct DnnBox {
   int class_id = 0;  // COCO class index (0 person, 32 sports ball)
 };
 
-// Where the set-up put the models: $FV_MODELS_DIR, <program dir>/../models, ./models,
+// Where the set-up put the models: $FV_MODELS_DIR, <program dir>/../models (as built),
+// <program dir>/../share/fieldvision/models (as installed), ./models,
 // ./build/models. Returns the first existing path of `file`, or throws fv::Error saying to run
 // `make build` (which runs scripts/fetch-models.sh).
 std::string FindModel(const std::string& file);

@@ -11,6 +11,7 @@
 #include <httplib.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/program_paths.h"
 #include "fieldvision/web/studio_api.h"
 
 #ifndef FV_STUDIO_DIST
@@ -36,6 +37,15 @@ bool IsLoopback(const std::string& host) {
 }
 
 namespace {
+
+// The front end as built in the source tree, else as installed (share/fieldvision/studio).
+fs::path DefaultAssetsDir() {
+  const fs::path built(FV_STUDIO_DIST);
+  std::error_code ec;
+  if (fs::is_regular_file(built / "index.html", ec)) return built;
+  const fs::path installed = util::InstalledDataDir() / "studio";
+  return fs::is_regular_file(installed / "index.html", ec) ? installed : built;
+}
 
 std::string RandomToken() {
   std::random_device rd;
@@ -94,11 +104,12 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   m.workspace = std::make_unique<Workspace>(options.root.empty() ? fs::current_path()
                                                                  : fs::path(options.root));
   std::string program = options.program;
-  if (program.empty()) program = fs::read_symlink("/proc/self/exe").string();
+  if (program.empty()) program = util::ProgramPath().string();
+  FV_REQUIRE(!program.empty(), "studio: cannot tell where the fieldvision program is");
   m.jobs = std::make_unique<JobRunner>(program, *m.workspace, &m.events);
   m.live = std::make_unique<LiveFeed>(&m.events);
   m.api = std::make_unique<StudioApi>(*m.workspace, &m.events, m.jobs.get(), m.live.get());
-  if (m.options.assets.empty()) m.options.assets = FV_STUDIO_DIST;
+  if (m.options.assets.empty()) m.options.assets = DefaultAssetsDir().string();
   m.assets_built = fs::is_regular_file(fs::path(m.options.assets) / "index.html");
   m.token_required = !IsLoopback(options.host);
   if (m.token_required && m.options.token.empty()) m.options.token = RandomToken();

@@ -17,7 +17,7 @@ struct StudioOptions {
   std::string host = "127.0.0.1";  // address to bind; not loopback -> token required
   int port = 8470;                 // 0: any free port
   std::string root;                // working folder; empty: the current folder
-  std::string assets;              // built front end (index.html); empty: studio/dist
+  std::string assets;              // built front end (index.html); empty: studio/dist or installed
   std::string token;               // for a non-loopback host; empty: a random one
   std::string program;             // the fieldvision executable jobs run; empty: this program
   // A fusion node's PUB address (fuse --publish) the 3D view's live mode subscribes to from the
