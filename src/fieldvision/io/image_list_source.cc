@@ -8,7 +8,8 @@
 
 #include <fmt/format.h>
 
-#include "fieldvision/codecs/codecs.h"
+#include "fieldvision/io/image_file.h"
+#include "fieldvision/io/jpeg_orientation.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
@@ -34,7 +35,7 @@ class ImageListSource : public FrameSource {
       origin_ = TimeOrigin::kCsv;
       csv_ = o.timestamps_csv;
     }
-    const cv::Mat first = codecs::ImRead(files_.front(), cv::IMREAD_COLOR);
+    const cv::Mat first = TryReadImage(files_.front());
     FV_REQUIRE(!first.empty() || files_.front() != spec,
                "image '{}' cannot be read (damaged or not an image)", spec);
     FV_REQUIRE(!first.empty(), "image sequence '{}': cannot read its first image '{}'", spec,
@@ -53,8 +54,11 @@ class ImageListSource : public FrameSource {
                  spec_, next_, file);
       FV_REQUIRE(!out->jpeg.empty(), "image sequence '{}': frame {} ('{}') is empty", spec_, next_,
                  file);
-    } else {
-      out->bgr = codecs::ImRead(file, cv::IMREAD_COLOR);
+      // A still to be turned (EXIF orientation) is delivered decoded, turned as cv::imread does.
+      if (JpegOrientation(out->jpeg.data(), out->jpeg.size()) != 1) out->jpeg.clear();
+    }
+    if (out->jpeg.empty()) {
+      out->bgr = TryReadImage(file);
       FV_REQUIRE(!out->bgr.empty(), "image sequence '{}': frame {} ('{}') cannot be read", spec_,
                  next_, file);
       FV_REQUIRE(out->bgr.size() == size_,
