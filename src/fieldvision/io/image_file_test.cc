@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/jpeg_orientation.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -151,6 +152,39 @@ TEST(ReadImage, SamePixelsAsImread) {
   EXPECT_TRUE(TryReadImage(dir + "/missing.jpg").empty());
   const std::string error = testing::ErrorOf([&] { ReadImage(dir + "/missing.jpg"); });
   EXPECT_NE(error.find("missing.jpg"), std::string::npos) << error;
+}
+
+// An image sequence kept encoded delivers a still to be turned decoded and turned (as its
+// size, from cv::imread, says), the others encoded.
+TEST(ReadImage, EncodedSequenceTurnsStillsAsImread) {
+  testing::SeededRng rng(7);
+  const std::string dir = testing::TempDir();
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", NoisyImage(rng, 80, 40), jpeg);
+  fs::create_directories(dir + "/turned");
+  fs::create_directories(dir + "/plain");
+  for (int i = 0; i < 2; ++i) {
+    WriteBytes(fmt::format("{}/turned/{:05d}.jpg", dir, i), WithSegment(jpeg, ExifApp1(6, i == 0)));
+    WriteBytes(fmt::format("{}/plain/{:05d}.jpg", dir, i), jpeg);
+  }
+  FrameSourceOptions o;
+  o.encoded = true;
+  auto turned = OpenFrameSource(dir + "/turned/%05d.jpg", o);
+  auto plain = OpenFrameSource(dir + "/plain/%05d.jpg", o);
+  EXPECT_EQ(turned->FrameSize(), cv::Size(40, 80));
+  EXPECT_EQ(plain->FrameSize(), cv::Size(80, 40));
+  const cv::Mat expected = cv::imread(dir + "/turned/00000.jpg", cv::IMREAD_COLOR);
+  SourceFrame f;
+  int n = 0;
+  while (turned->ReadFrame(&f)) {
+    EXPECT_TRUE(f.jpeg.empty());
+    ASSERT_EQ(f.bgr.size(), cv::Size(40, 80));
+    EXPECT_EQ(cv::norm(f.bgr, expected, cv::NORM_INF), 0.0);
+    ++n;
+  }
+  EXPECT_EQ(n, 2);
+  ASSERT_TRUE(plain->ReadFrame(&f));
+  EXPECT_EQ(f.jpeg, jpeg);
 }
 
 // The real photos (../shared/data): libjpeg-turbo's pixels are cv::imread's.
