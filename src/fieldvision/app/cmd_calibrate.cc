@@ -3,11 +3,7 @@
 // `extrinsics` also places a whole rig (--rig DIR, calib/rig_place.h), calibrates a camera without
 // intrinsics from the field alone (--image-size, calib/focal.h) or fits the ground homography
 // (--homography-only); `refine --rig DIR` carries the rig with the refined camera.
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -27,7 +23,6 @@
 #include "fieldvision/calib/rig_lines.h"
 #include "fieldvision/calib/rig_place.h"
 #include "fieldvision/camera/camera_io.h"
-#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/io/output_path.h"
@@ -64,40 +59,9 @@ using calib::RigResult;
 using calib::WriteHomographyYaml;
 using calib::WritePointErrorTable;
 
-// Sends this process's stderr to /dev/null while it lives: libpng's default error handler, which
-// OpenCV's PNG decoder keeps, prints "libpng error: ..." before imread returns an empty image,
-// and the error has one line, ours. Only around single-threaded reads.
-class QuietStderr {
- public:
-  QuietStderr() {
-    std::fflush(stderr);
-    saved_ = ::dup(STDERR_FILENO);
-    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
-    if (null >= 0) ::close(null);
-  }
-  ~QuietStderr() {
-    std::fflush(stderr);
-    if (saved_ < 0) return;
-    ::dup2(saved_, STDERR_FILENO);
-    ::close(saved_);
-  }
-  QuietStderr(const QuietStderr&) = delete;
-  QuietStderr& operator=(const QuietStderr&) = delete;
-
- private:
-  int saved_ = -1;
-};
-
 cv::Mat ReadImage(const std::string& path) {
   FV_REQUIRE(std::filesystem::is_regular_file(path), "image '{}' does not exist", path);
-  cv::Mat image;
-  try {
-    const QuietStderr quiet;
-    image = codecs::ImRead(path, cv::IMREAD_COLOR);
-  } catch (const cv::Exception&) {
-    image.release();
-  }
+  const cv::Mat image = io::TryReadImage(path);
   FV_REQUIRE(!image.empty(), "image '{}' cannot be read (corrupt or not an image)", path);
   return image;
 }

@@ -1,8 +1,12 @@
 #include "fieldvision/codecs/codecs.h"
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -68,17 +72,57 @@ const PluginApi& Api() {
   return *api;
 }
 
+// Sends stderr to /dev/null while any decode runs: libpng's and libjpeg's default handlers,
+// which OpenCV's decoders keep, print "libpng error: ..." or "Premature end of JPEG file" before
+// imread returns; our one-line error says what went wrong. Counted, so that decodes on several
+// threads share one redirection (the first in saves stderr, the last out restores it).
+class QuietStderr {
+ public:
+  QuietStderr() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (depth_++ > 0) return;
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (--depth_ > 0 || saved_ < 0) return;
+    std::fflush(stderr);
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+    saved_ = -1;
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  static inline std::mutex mutex_;
+  static inline int depth_ = 0;
+  static inline int saved_ = -1;
+};
+
 }  // namespace
 
 void Load() { Api(); }
 
-cv::Mat ImRead(const std::string& path, int flags) { return Api().imread(path, flags); }
+cv::Mat ImRead(const std::string& path, int flags) {
+  const PluginApi& api = Api();
+  const QuietStderr quiet;
+  return api.imread(path, flags);
+}
 
 bool ImWrite(const std::string& path, cv::InputArray image, const std::vector<int>& params) {
   return Api().imwrite(path, image, params);
 }
 
-cv::Mat ImDecode(cv::InputArray buffer, int flags) { return Api().imdecode(buffer, flags); }
+cv::Mat ImDecode(cv::InputArray buffer, int flags) {
+  const PluginApi& api = Api();
+  const QuietStderr quiet;
+  return api.imdecode(buffer, flags);
+}
 
 bool ImEncode(const std::string& ext, cv::InputArray image, std::vector<uchar>* buffer,
               const std::vector<int>& params) {

@@ -15,11 +15,12 @@
 
 namespace fv::codecs {
 
-// cv::imread: an empty image when the file is missing or does not decode.
+// cv::imread: an empty image when the file is missing or does not decode (the decoders' own
+// messages on stderr are dropped: the caller reports the failure).
 cv::Mat ImRead(const std::string& path, int flags = cv::IMREAD_COLOR);
 // cv::imwrite (the format from the extension): false when it cannot be written.
 bool ImWrite(const std::string& path, cv::InputArray image, const std::vector<int>& params = {});
-// cv::imdecode: an empty image when `buffer` does not decode.
+// cv::imdecode: an empty image when `buffer` does not decode (quiet, as ImRead).
 cv::Mat ImDecode(cv::InputArray buffer, int flags = cv::IMREAD_COLOR);
 // cv::imencode into `buffer`; false when the format `ext` (".jpg", ".png") cannot encode it.
 bool ImEncode(const std::string& ext, cv::InputArray image, std::vector<uchar>* buffer,

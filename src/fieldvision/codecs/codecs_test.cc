@@ -4,9 +4,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -57,6 +60,42 @@ TEST(Codecs, ImagesRoundTrip) {
   EXPECT_TRUE(ImRead(testing::TempDir() + "/missing.png").empty());
   EXPECT_TRUE(ImDecode(std::vector<uchar>{1, 2, 3}).empty());
   EXPECT_FALSE(ImWrite(testing::TempDir() + "/no-such-folder/a.png", image));
+}
+
+// Damaged images give empty images and nothing on stderr (libpng and libjpeg print there), also
+// from several threads at once; stderr works again afterwards.
+TEST(Codecs, DamagedImagesAreQuiet) {
+  cv::Mat image(40, 60, CV_8UC3);
+  cv::randu(image, 0, 256);
+  std::vector<uchar> png, jpeg;
+  ASSERT_TRUE(ImEncode(".png", image, &png));
+  ASSERT_TRUE(ImEncode(".jpg", image, &jpeg));
+  const std::string dir = testing::TempDir();
+  const std::vector<uchar> cut_png(png.begin(), png.begin() + png.size() / 2);
+  const std::vector<uchar> cut_jpeg(jpeg.begin(), jpeg.begin() + jpeg.size() / 2);
+  {
+    std::ofstream(dir + "/cut.png", std::ios::binary)
+        .write(reinterpret_cast<const char*>(cut_png.data()), std::streamsize(cut_png.size()));
+    std::ofstream(dir + "/cut.jpg", std::ios::binary)
+        .write(reinterpret_cast<const char*>(cut_jpeg.data()), std::streamsize(cut_jpeg.size()));
+  }
+  ::testing::internal::CaptureStderr();
+  EXPECT_TRUE(ImRead(dir + "/cut.png").empty());
+  EXPECT_FALSE(ImRead(dir + "/cut.jpg").empty());  // decoded as far as it goes
+  EXPECT_TRUE(ImDecode(cut_png).empty());
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&] {
+      for (int i = 0; i < 20; ++i) {
+        EXPECT_TRUE(ImRead(dir + "/cut.png").empty());
+        EXPECT_FALSE(ImDecode(png).empty());
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  std::fputs("after\n", stderr);
+  std::fflush(stderr);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "after\n");
 }
 
 TEST(Codecs, VideoWrittenAndReadBack) {

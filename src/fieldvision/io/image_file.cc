@@ -13,7 +13,8 @@ namespace fv::io {
 namespace {
 
 // The JPEG at `path` decoded by libjpeg-turbo; empty when it is no JPEG, needs turning or does
-// not decode completely (cv::imread then has its say).
+// not decode (cv::imread then has its say). Data that ends early is decoded as far as it goes,
+// as cv::imread does, without libjpeg's message on stderr.
 cv::Mat TryDecodeJpeg(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return {};
@@ -27,9 +28,7 @@ cv::Mat TryDecodeJpeg(const std::string& path) {
   if (JpegOrientation(bytes.data(), bytes.size()) != 1) return {};
   cv::Mat bgr;
   try {
-    JpegRegionDecoder decoder;
-    decoder.Decode(bytes.data(), bytes.size(), cv::Rect(), &bgr, path);
-    if (decoder.warnings() > 0) return {};
+    JpegRegionDecoder().Decode(bytes.data(), bytes.size(), cv::Rect(), &bgr, path);
   } catch (const Error&) {
     return {};
   }
