@@ -76,32 +76,39 @@ const PluginApi& Api() {
 // which OpenCV's decoders keep, print "libpng error: ..." or "Premature end of JPEG file" before
 // imread returns; our one-line error says what went wrong. Counted, so that decodes on several
 // threads share one redirection (the first in saves stderr, the last out restores it).
+struct QuietState {
+  std::mutex mutex;
+  int depth = 0;   // decodes running
+  int saved = -1;  // the real stderr while depth > 0
+};
+QuietState& Quiet() {
+  static QuietState state;
+  return state;
+}
+
 class QuietStderr {
  public:
   QuietStderr() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (depth_++ > 0) return;
+    QuietState& q = Quiet();
+    const std::lock_guard<std::mutex> lock(q.mutex);
+    if (q.depth++ > 0) return;
     std::fflush(stderr);
-    saved_ = ::dup(STDERR_FILENO);
+    q.saved = ::dup(STDERR_FILENO);
     const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (q.saved >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
     if (null >= 0) ::close(null);
   }
   ~QuietStderr() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (--depth_ > 0 || saved_ < 0) return;
+    QuietState& q = Quiet();
+    const std::lock_guard<std::mutex> lock(q.mutex);
+    if (--q.depth > 0 || q.saved < 0) return;
     std::fflush(stderr);
-    ::dup2(saved_, STDERR_FILENO);
-    ::close(saved_);
-    saved_ = -1;
+    ::dup2(q.saved, STDERR_FILENO);
+    ::close(q.saved);
+    q.saved = -1;
   }
   QuietStderr(const QuietStderr&) = delete;
   QuietStderr& operator=(const QuietStderr&) = delete;
-
- private:
-  static inline std::mutex mutex_;
-  static inline int depth_ = 0;
-  static inline int saved_ = -1;
 };
 
 }  // namespace
