@@ -61,7 +61,7 @@ using calib::WritePointErrorTable;
 
 cv::Mat ReadImage(const std::string& path) {
   FV_REQUIRE(std::filesystem::is_regular_file(path), "image '{}' does not exist", path);
-  const cv::Mat image = io::TryReadImage(path);
+  cv::Mat image = io::TryReadImage(path);
   FV_REQUIRE(!image.empty(), "image '{}' cannot be read (corrupt or not an image)", path);
   return image;
 }
