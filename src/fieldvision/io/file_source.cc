@@ -1,7 +1,8 @@
 // Frame-source backend: video files OpenCV reads and printf image patterns (dir/%05d.jpg), with
 // times from the frame rate, the container or a frame,time_s CSV. Motion-JPEG frames (an AVI's
 // read directly, another container's packets through FFmpeg) and JPEG files can be delivered
-// encoded (the ball pipeline's window-decoding path).
+// encoded (the ball pipeline's window-decoding path); an AVI's are decoded by libjpeg-turbo
+// either way, so every command sees the same pixels.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -62,7 +63,9 @@ class FileSource : public FrameSource {
   std::string path_;
   FrameSourceOptions options_;
   TimeOrigin origin_ = TimeOrigin::kFrameRate;
-  std::unique_ptr<AviMjpegReader> avi_;        // encoded: a Motion-JPEG AVI read directly
+  std::unique_ptr<AviMjpegReader> avi_;        // a Motion-JPEG AVI read directly
+  JpegRegionDecoder decoder_;                  // decoded: its frames (the encoded path's pixels)
+  std::vector<uint8_t> packet_;
   std::unique_ptr<cv::VideoCapture> capture_;  // else OpenCV's
   std::map<long long, double> times_;          // kCsv
   bool encoded_ = false;
@@ -84,7 +87,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
   FV_REQUIRE(pattern || std::filesystem::exists(path), "video '{}' does not exist", path);
   FV_REQUIRE(pattern || !std::filesystem::is_directory(path),
              "video '{}' is a folder (give an image pattern such as '{}/%05d.jpg')", path, path);
-  if (options.encoded && !pattern) avi_ = AviMjpegReader::Open(path);
+  if (!pattern) avi_ = AviMjpegReader::Open(path);
   if (!avi_) {
     capture_ = codecs::NewVideoCapture();
     FV_REQUIRE(OpenVideoFile(*capture_, path), "cannot open video '{}' (not a video OpenCV reads?)",
@@ -106,7 +109,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
   // no container times (CAP_PROP_POS_MSEC stays 0), so with container times asked for only an
   // AVI's (a fixed rate: frame / fps) are read raw; another container is decoded by FFmpeg.
   if (avi_) {
-    encoded_ = true;
+    encoded_ = options.encoded;
   } else if (options.encoded && !pattern) {
     const int fourcc = static_cast<int>(capture_->get(cv::CAP_PROP_FOURCC));
     const bool rate_times =
@@ -171,10 +174,21 @@ bool FileSource::GrabEncoded(SourceFrame* out) {
 bool FileSource::Grab(SourceFrame* out) {
   out->jpeg.clear();
   bool ok = false;
-  try {
-    ok = capture_->read(out->bgr);
-  } catch (const cv::Exception&) {
-    ok = false;  // a corrupt frame ends the stream; the pipeline reports where
+  if (avi_) {
+    // libjpeg-turbo, as the encoded path and the camera stages decode: the same pixels whether
+    // a frame is read decoded or encoded.
+    try {
+      ok = avi_->Next(&packet_) &&
+           !decoder_.Decode(packet_.data(), packet_.size(), cv::Rect(), &out->bgr, path_).empty();
+    } catch (const Error&) {
+      ok = false;  // a corrupt frame ends the stream; the pipeline reports where
+    }
+  } else {
+    try {
+      ok = capture_->read(out->bgr);
+    } catch (const cv::Exception&) {
+      ok = false;  // a corrupt frame ends the stream; the pipeline reports where
+    }
   }
   if (!ok || out->bgr.empty()) return false;
   if (out->bgr.channels() == 1) cv::cvtColor(out->bgr, out->bgr, cv::COLOR_GRAY2BGR);
@@ -209,7 +223,7 @@ bool FileSource::SkipFrame() {
   } else {
     bool ok = false;
     try {
-      ok = capture_->grab();  // no decoding
+      ok = avi_ ? avi_->Next(&packet_) : capture_->grab();  // no decoding
     } catch (const cv::Exception&) {
       ok = false;
     }
@@ -227,8 +241,9 @@ double FileSource::TimeOf(long long f) {
     case TimeSource::kFrameRate:
       return f / fps_;
     case TimeSource::kContainer: {
-      // Image files carry no capture times, raw packets none that OpenCV reports (an AVI).
-      if (jpeg_files_ || encoded_) return f / fps_;
+      // Image files carry no capture times, raw packets none that OpenCV reports (an AVI read
+      // directly: a fixed rate).
+      if (jpeg_files_ || encoded_ || avi_) return f / fps_;
       const double ms = capture_->get(cv::CAP_PROP_POS_MSEC);
       return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
     }
