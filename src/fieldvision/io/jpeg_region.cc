@@ -92,6 +92,10 @@ bool RunJob(Job* job, ErrorManager* err) {
   return true;
 }
 
+// Twice the bound of entropy coding (JpegRegionDecoder::Decode).
+constexpr double kMaxPixelsPerByte = 1024.0;
+constexpr int kMinCropWidth = 16;
+
 }  // namespace
 
 cv::Size JpegRegionDecoder::ReadSize(const uint8_t* data, size_t size, const std::string& what) {
@@ -107,14 +111,24 @@ cv::Rect JpegRegionDecoder::Decode(const uint8_t* data, size_t size, const cv::R
                                    cv::Mat* bgr, const std::string& what) {
   FV_REQUIRE(bgr != nullptr, "JpegRegionDecoder::Decode: no output image");
   const cv::Size image = ReadSize(data, size, what);
+  // Entropy coding spends at least a bit on each 8x8 block of each component (a DC difference),
+  // so real data holds at most 512 pixels a byte: a header announcing far more is damaged, and
+  // decoding it would fill gigabytes with nothing (found by fuzz/jpeg_still_fuzz.cc).
+  FV_REQUIRE(double(image.width) * image.height <= kMaxPixelsPerByte * double(size),
+             "{}: the header announces {}x{} pixels, more than {} bytes of JPEG data can hold "
+             "(damaged)",
+             what, image.width, image.height, size);
   if (bgr->size() != image || bgr->type() != CV_8UC3) bgr->create(image, CV_8UC3);
   const cv::Rect r = region.empty() ? cv::Rect() : region & cv::Rect(cv::Point(0, 0), image);
   FV_REQUIRE(region.empty() || !r.empty(), "{}: region {}x{}+{}+{} is outside the {}x{} image",
              what, region.width, region.height, region.x, region.y, image.width, image.height);
   // A cropped decode's first and last columns lack the chroma neighbours that fancy upsampling
   // uses: decode one column more on each side and leave those out of the exact rectangle.
+  // A crop only a few columns wide gets libjpeg-turbo's upsampling wrong even inside it (at the
+  // image's left edge, 55 levels off in one column): at least kMinCropWidth columns are decoded.
   const int x0 = r.empty() ? 0 : std::max(r.x - 1, 0);
-  const int x1 = r.empty() ? 0 : std::min(r.x + r.width + 1, image.width);
+  const int x1 =
+      r.empty() ? 0 : std::min(std::max(r.x + r.width + 1, x0 + kMinCropWidth), image.width);
   Job job{data, size, false, x0, r.y, x1 - x0, r.height, bgr, 0, 0, 0, 0, 0, 0};
   ErrorManager err;
   const bool ok = RunJob(&job, &err);

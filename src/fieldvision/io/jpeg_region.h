@@ -22,9 +22,10 @@ class JpegRegionDecoder {
   // Decodes `region` of the JPEG (clipped to the image and widened to whole blocks; empty: the
   // whole image) into `bgr`, which is (re)allocated to the image size when it is not already.
   // Returns the rectangle decoded exactly (as a whole-image decode would); besides it only the
-  // column just left and right of it may change. Throws fv::Error naming
-  // `what` for data libjpeg cannot decode; recoverable damage (data that ends early) is
-  // decoded as far as it goes and counted in warnings().
+  // column just left and right of it may change. Throws fv::Error naming `what` for data
+  // libjpeg cannot decode or whose header announces more pixels than the data can hold (over
+  // 1024 a byte); recoverable damage (data that ends early) is decoded as far as it goes and
+  // counted in warnings().
   cv::Rect Decode(const uint8_t* data, size_t size, const cv::Rect& region, cv::Mat* bgr,
                   const std::string& what);
 

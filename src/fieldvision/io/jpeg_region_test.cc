@@ -9,6 +9,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/seeded_rng.h"
+#include "fieldvision/util/testing.h"
 
 namespace fv::io {
 namespace {
@@ -30,6 +31,34 @@ std::vector<uint8_t> TestJpeg(util::Rng& rng, int w, int h, cv::Mat* image = nul
   return jpeg;
 }
 
+// A header announcing far more pixels than the data can hold (60000 x 60000 from 2 KB: a damaged
+// or crafted file) is an error before anything is allocated, not gigabytes of grey.
+TEST(JpegRegionDecoder, HeaderLargerThanItsDataIsAnError) {
+  testing::SeededRng rng(37);
+  std::vector<uint8_t> jpeg = TestJpeg(rng, 64, 48);
+  // The SOF0 segment: FF C0, length, precision, height, width (big-endian).
+  size_t sof = 0;
+  for (size_t i = 2; i + 8 < jpeg.size(); ++i) {
+    if (jpeg[i] == 0xFF && jpeg[i + 1] == 0xC0) {
+      sof = i;
+      break;
+    }
+  }
+  ASSERT_GT(sof, 0u);
+  for (int k : {5, 7}) {
+    jpeg[sof + k] = 0xEA;  // 60000 = 0xEA60
+    jpeg[sof + k + 1] = 0x60;
+  }
+  EXPECT_EQ(JpegRegionDecoder::ReadSize(jpeg.data(), jpeg.size(), "big.jpg"),
+            cv::Size(60000, 60000));
+  cv::Mat bgr;
+  const std::string error = testing::ErrorOf(
+      [&] { JpegRegionDecoder().Decode(jpeg.data(), jpeg.size(), cv::Rect(), &bgr, "big.jpg"); });
+  EXPECT_NE(error.find("big.jpg: the header announces 60000x60000 pixels"), std::string::npos)
+      << error;
+  EXPECT_TRUE(bgr.empty());
+}
+
 TEST(JpegRegionDecoder, WholeImageAndRegionsMatchAFullDecode) {
   testing::SeededRng rng(31);
   const std::vector<uint8_t> jpeg = TestJpeg(rng, 333, 250);
@@ -41,9 +70,17 @@ TEST(JpegRegionDecoder, WholeImageAndRegionsMatchAFullDecode) {
   // The same pixels as OpenCV's decoder (libjpeg-turbo with the same settings).
   const cv::Mat ref = cv::imdecode(jpeg, cv::IMREAD_COLOR);
   EXPECT_EQ(cv::norm(full, ref, cv::NORM_INF), 0.0);
+  // Random regions, then columns 1-3 wide at both edges and inside (a crop that narrow was
+  // upsampled wrongly at the left edge).
+  std::vector<cv::Rect> regions;
   for (int trial = 0; trial < 40; ++trial) {
     const int x = rng.UniformInt(-20, 320), y = rng.UniformInt(-20, 240);
-    const cv::Rect want(x, y, rng.UniformInt(1, 120), rng.UniformInt(1, 120));
+    regions.emplace_back(x, y, rng.UniformInt(1, 120), rng.UniformInt(1, 120));
+  }
+  for (int w = 1; w <= 3; ++w) {
+    for (int x : {0, 333 - w, 100, 17}) regions.emplace_back(x, 40, w, 90);
+  }
+  for (const cv::Rect& want : regions) {
     const cv::Rect clipped = want & cv::Rect(0, 0, 333, 250);
     if (clipped.empty()) continue;
     cv::Mat part(250, 333, CV_8UC3, cv::Scalar(7, 7, 7));
