@@ -214,18 +214,28 @@ double RmsWithFocalScaled(const std::vector<BoardView>& views, const CvFit& fit,
     obj.push_back(views[i].object_points);
     img.push_back(views[i].image_points);
   }
-  cv::Mat k = fit.k.clone(), d = fit.d.clone();
-  k.at<double>(0, 0) *= factor;
-  k.at<double>(1, 1) *= factor;
-  std::vector<cv::Mat> rvecs, tvecs;
-  try {
-    return cv::calibrateCamera(
-        obj, img, size, k, d, rvecs, tvecs,
-        CalibFlags(options) | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH,
-        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
-  } catch (const cv::Exception&) {
-    return std::numeric_limits<double>::infinity();  // no fit at all: the focal length matters
+  // From the fit, and when that start fails (a fit that ran off: its principal point outside
+  // the image, k3 in the hundreds), from the image's centre without distortion.
+  for (const bool from_fit : {true, false}) {
+    cv::Mat k = fit.k.clone();
+    cv::Mat d = from_fit ? fit.d.clone() : cv::Mat::zeros(fit.d.size(), fit.d.type());
+    if (!from_fit) {
+      k.at<double>(0, 2) = 0.5 * (size.width - 1);
+      k.at<double>(1, 2) = 0.5 * (size.height - 1);
+    }
+    k.at<double>(0, 0) *= factor;
+    k.at<double>(1, 1) *= factor;
+    std::vector<cv::Mat> rvecs, tvecs;
+    try {
+      const double rms = cv::calibrateCamera(
+          obj, img, size, k, d, rvecs, tvecs,
+          CalibFlags(options) | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH,
+          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+      if (std::isfinite(rms)) return rms;
+    } catch (const cv::Exception&) {
+    }
   }
+  return std::numeric_limits<double>::infinity();  // no fit at all: the focal length matters
 }
 
 // The camera and the standard deviations of its intrinsics from the fit.
@@ -331,6 +341,12 @@ void AddWarnings(const cv::Size& size, const IntrinsicsOptions& options, int max
   if (result.std_fx_px > 0.01 * cam.fx || result.std_fy_px > 0.01 * cam.fy) {
     w.push_back(fmt::format("focal length uncertain: std {:.1f} px ({:.1f}%)", result.std_fx_px,
                             100 * result.std_fx_px / cam.fx));
+  }
+  if (!(cam.cx >= 0 && cam.cx <= size.width && cam.cy >= 0 && cam.cy <= size.height)) {
+    w.push_back(fmt::format(
+        "principal point ({:.0f}, {:.0f}) outside the {}x{} image: the fit ran off; show the board "
+        "all over the image, tilted by 20-45 deg",
+        cam.cx, cam.cy, size.width, size.height));
   }
   if (result.std_cx_px > 0.02 * size.width || result.std_cy_px > 0.02 * size.height) {
     w.push_back(fmt::format("principal point uncertain: std {:.1f}, {:.1f} px", result.std_cx_px,

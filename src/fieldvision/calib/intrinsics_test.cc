@@ -195,6 +195,12 @@ TEST(Intrinsics, ViewsInOneCornerAreWarnedAbout) {
         << all << r.Summary() << " focal profile " << r.rms_focal_lower_px << " "
         << r.rms_focal_higher_px;
     EXPECT_LT(r.coverage.cell_fraction, 0.3);
+    // A fit that ran off as far as a principal point outside the image says so (seed 2, draw 3:
+    // fx 2593 for 540, cy 510 in a 480-row image; its focal profile failed to start there).
+    const camera::Camera& c = r.camera;
+    if (c.cx < 0 || c.cx > 640 || c.cy < 0 || c.cy > 480) {
+      EXPECT_NE(all.find("outside the 640x480 image: the fit ran off"), std::string::npos) << all;
+    }
   }
 }
 
