@@ -223,7 +223,9 @@ std::pair<int, int> ShortestHueInterval(const std::vector<cv::Vec3b>& hsv, doubl
 ColourRange InitialColourRange(const std::vector<cv::Vec3b>& positive,
                                const ColourLearnOptions& o) {
   const auto [best_start, best_len] = ShortestHueInterval(positive, o.trim);
-  std::vector<int> s, v;
+  // Nearest-rank percentiles (RankPercentile): the same pixels given twice (clicks on two
+  // frames of a still ball) learn the same class.
+  std::vector<double> s, v;
   for (const auto& p : positive) {
     s.push_back(p[1]);
     v.push_back(p[2]);
@@ -239,9 +241,9 @@ ColourRange InitialColourRange(const std::vector<cv::Vec3b>& positive,
     r.min[0] = std::fmod(h_lo + 360.0, 360.0);
     r.max[0] = std::fmod(h_hi + 360.0, 360.0);
   }
-  r.min[1] = std::max(0.0, util::NearestRankPercentile(s, o.trim) - o.saturation_margin);
+  r.min[1] = std::max(0.0, util::RankPercentile(s, o.trim) - o.saturation_margin);
   r.max[1] = 255;
-  r.min[2] = std::max(0.0, util::NearestRankPercentile(v, o.trim) - o.value_margin);
+  r.min[2] = std::max(0.0, util::RankPercentile(v, o.trim) - o.value_margin);
   r.max[2] = 255;
   return r;
 }
