@@ -239,7 +239,9 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
 }
 
 // The synthetic players scene (people of two teams crossing, running and walking): positions on
-// the field within 0.3 m of the truth and one id per person through the crossings.
+// the field within 0.3 m of the truth and one id per person through the crossings. Only at its
+// default seed: at seeds 2-5 teammates (identical figures here, so appearance cannot tell them
+// apart) cross closer and their ids switch 3-14 times in 50 frames, a limit of the tracker.
 TEST(Players, SynthScenePositionsAndStableIds) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
