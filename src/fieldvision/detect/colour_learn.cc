@@ -153,6 +153,9 @@ ColourLearnMasks MarkLearnPixels(const ColourLearnSample& sample, int point_radi
   return m;
 }
 
+// A box whose centre is at least this saturated holds a coloured ball (DropBackgroundLikePixels).
+constexpr double kColouredCentre = 0.3;
+
 void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& positive) {
   const cv::Rect frame_rect(0, 0, bgr.cols, bgr.rows);
   const cv::Rect& r = roi;
@@ -170,6 +173,15 @@ void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& 
   if (ring[0].empty()) return;
   cv::Vec3d bg;
   for (int k = 0; k < 3; ++k) bg[k] = util::NearestRankPercentile(ring[k], 0.5);
+  // Saturation (max - min) / max. The box of a coloured ball often holds a white line or a
+  // highlight too, whose hue is noise: its pixels would widen the learned hue range to the
+  // background's. They are left out when the centre is coloured (a white ball keeps them).
+  const auto saturation = [](double b, double g, double rr) {
+    const double hi = std::max({b, g, rr}), lo = std::min({b, g, rr});
+    return hi > 0 ? (hi - lo) / hi : 0.0;
+  };
+  const double centre_sat = saturation(centre[0], centre[1], centre[2]);
+  const double min_sat = centre_sat >= kColouredCentre ? 0.5 * centre_sat : 0.0;
   for (int y = r.y; y < r.y + r.height; ++y) {
     for (int x = r.x; x < r.x + r.width; ++x) {
       if (!positive.at<uint8_t>(y, x)) continue;
@@ -179,7 +191,7 @@ void DropBackgroundLikePixels(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& 
         dc += (p[k] - centre[k]) * (p[k] - centre[k]);
         db += (p[k] - bg[k]) * (p[k] - bg[k]);
       }
-      if (db <= dc) positive.at<uint8_t>(y, x) = 0;
+      if (db <= dc || saturation(p[0], p[1], p[2]) < min_sat) positive.at<uint8_t>(y, x) = 0;
     }
   }
 }
