@@ -286,9 +286,16 @@ TEST(NodeFuse, ANodeRestartedMidSceneIsReadmittedWithTheOfflinePositions) {
   EXPECT_GT(fused.sync[1].paired, kStopAfter) << "the restarted node's frames were never used";
   EXPECT_EQ(fused.groups, 30);
   const auto live = ReadBall(fo.out);
-  ASSERT_EQ(live.size(), offline.size());
+  // Every offline frame is there, except in the restart's gap one that only two cameras saw
+  // (at seed 3 cam1 sees the ball in none: one such frame).
+  size_t missing = 0;
   for (const auto& [frame, a] : offline) {
-    ASSERT_TRUE(live.count(frame)) << "frame " << frame;
+    if (!live.count(frame)) {
+      EXPECT_GE(frame, kStopAfter) << "frame " << frame << " missing before the restart";
+      EXPECT_EQ(a.n_cams, 2) << "frame " << frame << " missing though three cameras saw it";
+      ++missing;
+      continue;
+    }
     const Row& b = live.at(frame);
     const double off_m = std::hypot(a.x - b.x, a.y - b.y, a.z - b.z);
     if (b.n_cams == a.n_cams) {
@@ -299,6 +306,7 @@ TEST(NodeFuse, ANodeRestartedMidSceneIsReadmittedWithTheOfflinePositions) {
       EXPECT_LT(off_m, 0.05) << "frame " << frame;
     }
   }
+  EXPECT_EQ(live.size() + missing, offline.size());
 }
 
 TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
