@@ -93,27 +93,26 @@ std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& p_world) c
   return ProjectFromCamera(cam_from_world * p_world);
 }
 
-std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) const {
-  const auto intr = IntrinsicsBlock();
-  const double* d = intr.data() + 4;
-  const Eigen::Vector2d target((uv.x() - cx) / fx, (uv.y() - cy) / fy);
-  bool any = false;
-  for (int i = 0; i < kNumDistortion; ++i) any = any || d[i] != 0.0;
-  if (!any) return target;
-  // Newton's method on distort(x) = target with exact Jacobians from dual numbers.
+namespace {
+
+// Newton's method on distort(x) = target from `x` (exact Jacobians from dual numbers); the
+// solution, or nullopt when it does not converge or lies where the model folds (the Jacobian's
+// determinant not positive: a second, unphysical preimage beyond the radius where a barrel
+// distortion turns back).
+std::optional<Eigen::Vector2d> SolveDistortion(const double* d, const Eigen::Vector2d& target,
+                                               Eigen::Vector2d x, double fx, double fy) {
   using Jet = ceres::Jet<double, 2>;
   std::array<Jet, kNumDistortion> dj;
   for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(d[i]);
-  Eigen::Vector2d x = target;
   for (int iter = 0; iter < 50; ++iter) {
     Jet xd, yd;
     DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
     const Eigen::Vector2d r(xd.a - target.x(), yd.a - target.y());
-    if (r.norm() < 1e-14) return x;
     Eigen::Matrix2d j;
     j << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
     const double det = j.determinant();
-    if (!std::isfinite(det) || std::abs(det) < 1e-12) return std::nullopt;
+    if (!std::isfinite(det) || det < 1e-12) return std::nullopt;
+    if (r.norm() < 1e-14) return x;
     Eigen::Vector2d step = j.inverse() * r;
     // Damp large steps so the iteration stays in the region where the model is monotonic.
     const double max_step = 0.5 * (1.0 + x.norm());
@@ -124,8 +123,32 @@ std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) cons
   Jet xd, yd;
   DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
   const double err_px = std::hypot((xd.a - target.x()) * fx, (yd.a - target.y()) * fy);
-  if (err_px < 1e-6) return x;
+  const double det = xd.v[0] * yd.v[1] - xd.v[1] * yd.v[0];
+  if (err_px < 1e-6 && det > 1e-12) return x;
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) const {
+  const auto intr = IntrinsicsBlock();
+  const double* d = intr.data() + 4;
+  const Eigen::Vector2d target((uv.x() - cx) / fx, (uv.y() - cy) / fy);
+  bool any = false;
+  for (int i = 0; i < kNumDistortion; ++i) any = any || d[i] != 0.0;
+  if (!any) return target;
+  if (auto x = SolveDistortion(d, target, target, fx, fy)) return x;
+  // Newton from the distorted point failed or reached the folded part: follow the preimage
+  // from the image's centre outwards instead (continuation in kSteps steps), which stays on the
+  // part of the model connected to the centre; nullopt when the pixel lies beyond the fold.
+  constexpr int kSteps = 16;
+  Eigen::Vector2d x = Eigen::Vector2d::Zero();
+  for (int k = 1; k <= kSteps; ++k) {
+    const auto next = SolveDistortion(d, target * (double(k) / kSteps), x, fx, fy);
+    if (!next) return std::nullopt;
+    x = *next;
+  }
+  return x;
 }
 
 std::optional<geometry::Ray3d> Camera::RayFromPixel(const Eigen::Vector2d& uv) const {

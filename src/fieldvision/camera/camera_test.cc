@@ -97,6 +97,42 @@ TEST_P(CameraModel, ProjectUnprojectRoundTrip) {
 
 INSTANTIATE_TEST_SUITE_P(AllDistortionSizes, CameraModel, ::testing::Values(0, 4, 5, 8, 12, 14));
 
+// A strong barrel distortion (k1 -0.25) turns back at r = 1 / sqrt(0.75) = 1.155 (where the
+// distorted radius peaks at 0.770): a pixel at distorted radius 0.75 has two preimages, 1 and
+// 1.303; the ray is the one connected to the image's centre, and a pixel beyond the peak has
+// none. Newton's method from the pixel could land on the far one: for the 12-coefficient camera
+// below (one of the round trip's random cameras) it gave a ray 79 deg off the axis (normalised
+// (-4.40, 2.82), where the model is folded); the pixel lies beyond that model's peak.
+TEST(Camera, UndistortStaysOnTheBranchThroughTheCentre) {
+  {
+    Camera cam = Camera::FromFov(1280, 960, 90);
+    cam.fx = 729.6781432506026;
+    cam.fy = 722.4210567331595;
+    cam.cx = 622.89279071187093;
+    cam.cy = 471.30587631310385;
+    cam.distortion = {-0.24858846113007455,    -0.02583699382378768,    -0.00019671785743719319,
+                      -0.00082499718299071931, -9.7335114067485101e-05, -0.045165388743522751,
+                      0.0036078457606962076,   -0.0086195111181916178,  0.00069287531997788959,
+                      -8.4992185130459969e-06, -0.00043665201162106787, -2.9024374990691045e-05};
+    const auto x = cam.Undistort({94.216761322540378, 773.53222470884282});
+    EXPECT_TRUE(!x || x->norm() < 1.5) << x->transpose();
+  }
+  Camera cam = Camera::FromFov(1280, 960, 90);
+  cam.distortion = {-0.25, 0, 0, 0, 0};
+  for (const double angle : {0.0, 0.7, 2.0, 3.5}) {
+    const Eigen::Vector2d dir(std::cos(angle), std::sin(angle));
+    const Eigen::Vector2d uv(cam.cx + 0.75 * dir.x() * cam.fx, cam.cy + 0.75 * dir.y() * cam.fy);
+    const auto x = cam.Undistort(uv);
+    ASSERT_TRUE(x) << angle;
+    EXPECT_NEAR(x->norm(), 1.0, 1e-9) << angle;  // r (1 - 0.25 r^2) = 0.75, the smaller root
+    const auto back = cam.ProjectFromCamera(Eigen::Vector3d(x->x(), x->y(), 1.0));
+    ASSERT_TRUE(back);
+    EXPECT_LT((*back - uv).norm(), 1e-6);
+    const Eigen::Vector2d beyond(cam.cx + 0.8 * dir.x() * cam.fx, cam.cy + 0.8 * dir.y() * cam.fy);
+    EXPECT_FALSE(cam.Undistort(beyond)) << angle;
+  }
+}
+
 TEST(Camera, BehindAndFootprint) {
   Camera cam = Camera::FromFov(1000, 800, 90);
   cam.has_pose = true;  // identity pose: looking along +z
