@@ -24,6 +24,9 @@ const BallCandidate* BestAccepted(const std::vector<BallCandidate>& c) {
   return !c.empty() && c.front().accepted ? &c.front() : nullptr;
 }
 
+// Every fully visible ball of 6-40 px across is found, centred within a pixel. Not at every seed:
+// at 2 of seeds 1-12 one ball is rejected, in front of stands or a board of nearly its colour
+// ("too little contrast", "region has corners"), the detector's limit of issue 12.
 TEST(BallDetectorSynth, SubpixelCentreOverTheSizeRange) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);

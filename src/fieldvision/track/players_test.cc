@@ -186,7 +186,8 @@ std::string WriteAt640x480(synth::SceneSpec& spec) {
 }
 
 // A 3-frame clip at 10 frames/s (not 25): tracks with 1-based frames and the video's time, boxes
-// without a camera, and the overlay video with one frame per input frame.
+// without a camera, and the overlay video with one frame per input frame. At 4 of seeds 1-20 no
+// track is confirmed in so few frames at that rate (people move too far for the boxes to overlap).
 TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
