@@ -96,7 +96,7 @@ TEST(ScanBlobs, CoarseStepFindsEachDiscOnceWithItsSize) {
           ++matches;
           EXPECT_NEAR(b.equivalent_radius_px(), r, 0.15 * r + step);
           EXPECT_NEAR(b.fill_ratio(), M_PI / 4, 0.25);
-          EXPECT_LT(b.aspect_ratio(), 1.5);
+          EXPECT_LE(b.aspect_ratio(), 1.5);  // 3 by 2 samples of a small disc at step 4
         }
       }
       EXPECT_EQ(matches, 1) << "disc at " << c.transpose() << " r " << r;
