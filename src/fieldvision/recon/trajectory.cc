@@ -1197,8 +1197,27 @@ std::vector<std::optional<FittedPiece>> FitPieces(const std::vector<BallSample>&
 
 namespace detail {
 
+namespace {
+
+// A bounce whose two arcs do not meet, and whose ground crossings lie at least two sample
+// intervals apart (the arc after it rising from the ground later than the arc before it came
+// down), hid a hop between them: a bounce, then a kick of the hopping ball before the hop could be
+// fitted. Real bounces (table tennis, spin and drag) put the crossings within 1.2 intervals.
+bool UnseenHopBetween(const Flight& A, const Flight& B, double gap_m,
+                      const TrajectoryOptions& options, double noise_m, double sample_interval_s) {
+  const double apart_m =
+      std::max(options.min_outlier_m, options.outlier_sigmas * noise_m * std::sqrt(3.0));
+  if (!(gap_m > apart_m) || !(sample_interval_s > 0)) return false;
+  const double zr = options.ground_z_m + options.ball_radius_m;
+  const auto landed_s = A.model().CrossingTime(zr, A.t_last_seen_s, true, 10.0);
+  const auto rose_s = B.model().CrossingTime(zr, B.t_first_seen_s, false, 10.0);
+  return landed_s && rose_s && *rose_s - *landed_s >= 2 * sample_interval_s;
+}
+
+}  // namespace
+
 void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOptions& options,
-                     double noise_m, std::vector<Flight>* flights,
+                     double noise_m, double sample_interval_s, std::vector<Flight>* flights,
                      std::vector<TrackBreak>* breaks) {
   const double zr = options.ground_z_m + options.ball_radius_m;
   const double ground_tol = options.ground_tolerance_m + 3 * noise_m + 0.05;
@@ -1213,15 +1232,22 @@ void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOp
     }
     const double tm = MeetingTime(A.model(), B.model(), A.t_last_seen_s, B.t_first_seen_s);
     const Eigen::Vector3d pa = A.model().PositionAt(tm);
+    const Eigen::Vector3d pb = B.model().PositionAt(tm);
     const Eigen::Vector3d va = A.model().VelocityAt(tm);
     const Eigen::Vector3d vb = B.model().VelocityAt(tm);
     TrackBreak br;
     br.time_s = tm;
-    br.ball_in_world = 0.5 * (pa + B.model().PositionAt(tm));
+    br.ball_in_world = 0.5 * (pa + pb);
     br.velocity_change_mps = (vb - va).norm();
     br.kind = (br.ball_in_world.z() < zr + ground_tol && va.z() < 0 && vb.z() > 0)
                   ? FlightEvent::kBounce
                   : FlightEvent::kHit;
+    if (br.kind == FlightEvent::kBounce &&
+        UnseenHopBetween(A, B, (pa - pb).norm(), options, noise_m, sample_interval_s)) {
+      // Two ground contacts, each arc's own (as next to a hop too short to fit).
+      A.end_event = B.start_event = FlightEvent::kGround;
+      continue;
+    }
     if (br.kind == FlightEvent::kBounce) {
       br.bounce = FitBounce(va, A.model().spin_radps, vb, options.ball_radius_m);
     }
@@ -1347,7 +1373,10 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     piece_of_flight.push_back(static_cast<int>(pi));
     limits.emplace_back(fitted[pi]->lo_s, fitted[pi]->hi_s);
   }
-  ResolveContacts(piece_of_flight, options, res.noise_m, &flights, &res.breaks);
+  std::vector<double> intervals_s(n - 1);
+  for (int i = 1; i < n; ++i) intervals_s[i - 1] = track[i].time_s - track[i - 1].time_s;
+  ResolveContacts(piece_of_flight, options, res.noise_m,
+                  util::NearestRankPercentile(intervals_s, 0.5), &flights, &res.breaks);
   for (size_t i = 0; i < flights.size(); ++i) {
     flights[i].index = static_cast<int>(i);
     PlaceEndpoints(options, limits[i].first, limits[i].second, &flights[i]);

@@ -61,18 +61,37 @@ TEST(TrajectoryStages, ContactsAreBouncesOnTheGroundAndHitsInTheAir) {
                                  Arc(1.0, {0, 0, zr}, {2.5, 0, 3}, 1.02, 1.4)};
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   std::vector<TrackBreak> breaks;
-  ResolveContacts({0, 1}, o, 0.005, &flights, &breaks);
+  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
   ASSERT_EQ(breaks.size(), 1u);
   EXPECT_EQ(breaks[0].kind, FlightEvent::kBounce);
   EXPECT_NEAR(breaks[0].time_s, 1.0, 1e-3);
   EXPECT_EQ(flights[0].end_event, FlightEvent::kBounce);
   EXPECT_EQ(flights[1].start_event, FlightEvent::kBounce);
+  // Down at t = 1 s, up from 0.3 m further at 1.08 s (four sample intervals of 0.02 s later):
+  // the arcs do not meet, a hop was not seen between them. Each arc keeps its ground crossing.
+  flights = {Arc(1.0, {0, 0, zr}, {3, 0, -1.5}, 0.6, 0.98),
+             Arc(1.08, {0.3, 0, zr}, {-4, 0, 3}, 1.12, 1.4)};
+  flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
+  breaks.clear();
+  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
+  EXPECT_TRUE(breaks.empty());
+  EXPECT_EQ(flights[0].end_event, FlightEvent::kGround);
+  EXPECT_EQ(flights[1].start_event, FlightEvent::kGround);
+  // A bounce whose arcs miss each other by 6 cm with crossings one interval apart (spin, drag,
+  // a real ball's contact) stays a bounce.
+  flights = {Arc(1.0, {0, 0, zr}, {3, 0, -1.5}, 0.6, 0.98),
+             Arc(1.02, {0.06, 0, zr}, {2.5, 0, 3}, 1.04, 1.4)};
+  flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
+  breaks.clear();
+  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
+  ASSERT_EQ(breaks.size(), 1u);
+  EXPECT_EQ(breaks[0].kind, FlightEvent::kBounce);
   // The same turn 1.5 m up: a hit, which also ends and starts the flights.
   flights = {Arc(1.0, {0, 0, 1.5}, {3, 0, -1}, 0.6, 0.98),
              Arc(1.0, {0, 0, 1.5}, {-4, 0, 2}, 1.02, 1.4)};
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   breaks.clear();
-  ResolveContacts({0, 1}, o, 0.005, &flights, &breaks);
+  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
   ASSERT_EQ(breaks.size(), 1u);
   EXPECT_EQ(breaks[0].kind, FlightEvent::kHit);
   EXPECT_NEAR(flights[0].t_end_s, 1.0, 1e-3);
@@ -80,7 +99,7 @@ TEST(TrajectoryStages, ContactsAreBouncesOnTheGroundAndHitsInTheAir) {
   // A hop between them too short to fit (pieces 0 and 2): not resolved, ground contacts.
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   breaks.clear();
-  ResolveContacts({0, 2}, o, 0.005, &flights, &breaks);
+  ResolveContacts({0, 2}, o, 0.005, 0.02, &flights, &breaks);
   EXPECT_TRUE(breaks.empty());
   EXPECT_EQ(flights[0].end_event, FlightEvent::kGround);
   EXPECT_EQ(flights[1].start_event, FlightEvent::kGround);
