@@ -1011,15 +1011,53 @@ std::vector<Piece> CutIntoPieces(const std::vector<BallSample>& track,
   return pieces;
 }
 
+// How many samples at one end of `s` (the start or the end) lie off the arc, in a run from that
+// end: off the fit of all samples and off the gravity fit of the 8 samples next to the 3 at the
+// end (ScoreFit's rule over those 11). The whole flight's parabola misses the ends of a flight
+// with drag, and a hop's samples pull it; the local fit is not asked when there are fewer than 11
+// samples or it misses one of its own 8 (a glitch there tilts it). More than 3 is a longer run of
+// misses: model error such as spin.
+int MissedAtEnd(const std::vector<BallSample>& s, bool at_start, const BallisticFit& all,
+                const TrajectoryOptions& options, double noise_m) {
+  constexpr int kEnd = 3, kCore = 8;
+  const int ns = static_cast<int>(s.size());
+  std::vector<bool> on_arc;  // from the end inwards
+  for (int i = 0; i < ns; ++i) on_arc.push_back(all.inlier[at_start ? i : ns - 1 - i]);
+  if (ns >= kEnd + kCore) {
+    // The kEnd + kCore samples at this end, in time order; the core is the inner kCore.
+    const auto first = at_start ? s.begin() : s.end() - kEnd - kCore;
+    const std::vector<BallSample> local(first, first + kEnd + kCore);
+    const int core_begin = at_start ? kEnd : 0;
+    const std::vector<BallSample> core(local.begin() + core_begin,
+                                       local.begin() + core_begin + kCore);
+    BallisticFit fit = FitBallistic(core, false, options, noise_m);
+    fit.inlier.assign(local.size(), false);
+    fit.inliers = 0;
+    fit.capped_sse_m2 = 0.0;
+    ScoreFit(local, fit.model.t0_s, options, noise_m, &fit);
+    // A judge whose own samples lie on its arc (a glitch among them would tilt it).
+    const bool clean =
+        fit.ok && std::all_of(fit.inlier.begin() + core_begin,
+                              fit.inlier.begin() + core_begin + kCore, [](bool b) { return b; });
+    if (clean) {
+      for (int i = 0; i <= kEnd; ++i) {
+        on_arc[i] = on_arc[i] || fit.inlier[at_start ? i : kEnd + kCore - 1 - i];
+      }
+    }
+  }
+  int run = 0;
+  while (run < kEnd + 1 && run < ns && !on_arc[run]) ++run;
+  return run;
+}
+
 // Leading and trailing samples the arc misses belong to a neighbouring hop too short to be split
 // off by the local fits: drops them (at most 3 a side; a longer run of misses is model error such
 // as spin, kept) and fits again. True when it dropped any.
 bool TrimMissedEnds(const TrajectoryOptions& options, double noise_m, std::vector<BallSample>* s,
                     Flight* f) {
-  int lead = 0, trail = 0;
   const int ns = static_cast<int>(s->size());
-  while (lead < ns && !f->no_drag.inlier[lead]) ++lead;
-  while (trail < ns - lead && !f->no_drag.inlier[ns - 1 - trail]) ++trail;
+  int lead = MissedAtEnd(*s, true, f->no_drag, options, noise_m);
+  int trail = lead >= ns ? 0 : MissedAtEnd(*s, false, f->no_drag, options, noise_m);
   if (lead > 3) lead = 0;
   if (trail > 3) trail = 0;
   if ((lead == 0 && trail == 0) || ns - lead - trail < options.min_flight_samples) return false;
@@ -1041,8 +1079,12 @@ void JoinGroundApproach(const std::vector<BallSample>& track, const std::vector<
   *hi = std::numeric_limits<double>::infinity();
   const double thr =
       std::max(options.outlier_sigmas * noise_m * std::sqrt(3.0), options.min_outlier_m);
+  // On the arc, where the arc is not yet (or no longer) below the ground by more than 3 sigma:
+  // a sample at rest after the arc came down belongs to the next phase, however near it lies.
+  const double lowest_m = options.ground_z_m + options.ball_radius_m - 3 * noise_m;
   auto consistent = [&](int k) {
-    return (f->no_drag.model.PositionAt(track[k].time_s) - track[k].ball_in_world).norm() <= thr;
+    const Eigen::Vector3d p = f->no_drag.model.PositionAt(track[k].time_s);
+    return p.z() >= lowest_m && (p - track[k].ball_in_world).norm() <= thr;
   };
   bool added = false;
   for (int k = f->samples.front() - 1; k >= 0; --k) {
