@@ -125,6 +125,40 @@ void SmootherOptions::Check() const {
   CheckNonNegative(noise_m, "noise_m");
 }
 
+namespace {
+
+// Outliers in a run without inliers (between two flights' seen spans, as at a bounce): the
+// position of the flight whose span [start, end] holds their time, else the line between the
+// smoothed positions around the run (the nearest one at a track end).
+void FillUnseen(const std::vector<BallSample>& track, const TrajectoryResult& result,
+                const std::vector<bool>& unseen, std::vector<BallSample>* out) {
+  const int n = static_cast<int>(track.size());
+  for (int i = 0; i < n; ++i) {
+    if (!unseen[i]) continue;
+    const double t = track[i].time_s;
+    const Flight* holder = nullptr;
+    for (const Flight& f : result.flights) {
+      if (t >= f.t_start_s && t <= f.t_end_s) holder = &f;
+    }
+    if (holder != nullptr) {
+      (*out)[i].ball_in_world = holder->model().PositionAt(t);
+      continue;
+    }
+    int a = i - 1, b = i + 1;
+    while (a >= 0 && unseen[a]) --a;
+    while (b < n && unseen[b]) ++b;
+    if (a < 0 && b >= n) continue;  // nothing seen at all: the track's own positions
+    if (a < 0 || b >= n) {
+      (*out)[i].ball_in_world = (*out)[a < 0 ? b : a].ball_in_world;
+      continue;
+    }
+    const double w = (t - track[a].time_s) / (track[b].time_s - track[a].time_s);
+    (*out)[i].ball_in_world = (1 - w) * (*out)[a].ball_in_world + w * (*out)[b].ball_in_world;
+  }
+}
+
+}  // namespace
+
 std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
                                     const TrajectoryResult& result,
                                     const TrajectoryOptions& options, const SmootherOptions& so) {
@@ -160,16 +194,24 @@ std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
   const double g = options.gravity_mps2;
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
+  std::vector<bool> unseen(n, false);  // in a segment without inliers: filled in afterwards
   int i = 0;
   while (i < n) {
     int j = i;
     while (j < n && seg[j] == seg[i]) ++j;
     const bool grav = gravity[seg[i]];
     const int m = j - i;
+    int first_inlier = i;
+    while (first_inlier < j && result.outlier[first_inlier]) ++first_inlier;
+    if (first_inlier == j) {
+      for (int k = i; k < j; ++k) unseen[k] = true;
+      i = j;
+      continue;
+    }
     std::vector<Vec6> xf(m), xp(m);
     std::vector<Mat6> Pf(m), Pp(m), F(m);
     Vec6 x = Vec6::Zero();
-    x.head<3>() = track[i].ball_in_world;
+    x.head<3>() = track[first_inlier].ball_in_world;
     Mat6 P = Mat6::Zero();
     P.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * 1.0;
     P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * 400.0;
@@ -215,6 +257,7 @@ std::vector<BallSample> SmoothTrack(const std::vector<BallSample>& track,
     }
     i = j;
   }
+  FillUnseen(track, result, unseen, &out);
   return out;
 }
 

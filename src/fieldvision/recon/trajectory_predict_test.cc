@@ -87,5 +87,31 @@ TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
   EXPECT_THROW(SmoothTrack(track, r, to, bad), Error);
 }
 
+// Two wild samples around a bounce lie between the seen spans of the arcs before and after it:
+// the smoother has no measurement there and gives them the arcs' positions, not their own.
+TEST(TrajectoryPredict, OutliersBetweenTwoFlightsTakeTheFlightsPositions) {
+  testing::SeededRng rng(29);
+  BallSimOptions o;
+  o.start_m = {-6, 0, 0.11};
+  o.kicks = {{0.2, {8, 1, 6}}};
+  o.restitution = 0.6;
+  o.duration_s = 2.5;
+  const BallSimulation sim(o);
+  auto track = sim.Sample(50.0, 0.005, 0.0, 0.0, 0.0, rng);
+  const double t_bounce = sim.Flights().front().t_end_s;
+  size_t after = 0;  // the first sample after the bounce
+  while (after < track.size() && track[after].time_s < t_bounce) ++after;
+  ASSERT_TRUE(after > 0 && after < track.size());
+  track[after - 1].ball_in_world.z() += 0.6;
+  track[after].ball_in_world.z() -= 0.4;
+  const TrajectoryResult r = AnalyzeTrajectory(track, TrajectoryOptions());
+  const auto smooth = SmoothTrack(track, r, TrajectoryOptions(), SmootherOptions());
+  for (size_t i : {after - 1, after}) {
+    ASSERT_TRUE(r.outlier[i]) << r.Summary();
+    EXPECT_LT((smooth[i].ball_in_world - sim.BallAt(track[i].time_s)).norm(), 0.05)
+        << "t " << track[i].time_s << " s; " << r.Summary();
+  }
+}
+
 }  // namespace
 }  // namespace fv::recon
