@@ -1311,6 +1311,15 @@ void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOp
   }
 }
 
+namespace {
+
+bool InTheAir(const BallisticModel& m, double t_s, const TrajectoryOptions& options) {
+  return m.PositionAt(t_s).z() >
+         options.ground_z_m + options.ball_radius_m + options.ground_tolerance_m;
+}
+
+}  // namespace
+
 void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, Flight* f) {
   const double zr = options.ground_z_m + options.ball_radius_m;
   const BallisticModel& mdl = f->model();
@@ -1319,13 +1328,26 @@ void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, 
   } else {
     const auto t0 = mdl.CrossingTime(zr, f->t_first_seen_s, false, 10.0);
     f->t_start_s = t0 ? *t0 : f->t_first_seen_s;
-    // Kicked while rolling or hopping low: the arc starts after the last sample off it.
-    if (f->start_event == FlightEvent::kGround) f->t_start_s = std::max(f->t_start_s, lo_s);
+    // Kicked while rolling or hopping low: the arc starts after the last sample off it. When the
+    // arc is then well above the ground it began in the air (a touch, or a hop too short to fit).
+    if (f->start_event == FlightEvent::kGround && lo_s > f->t_start_s) {
+      f->t_start_s = lo_s;
+      if (InTheAir(mdl, lo_s, options)) f->start_event = FlightEvent::kHit;
+    }
     f->origin_m = mdl.PositionAt(f->t_start_s);
   }
   const auto t1 = mdl.CrossingTime(zr, f->t_last_seen_s, true, 10.0);
   f->t_landing_s = t1 ? *t1 : f->t_last_seen_s;
-  if (f->end_event == FlightEvent::kGround) f->t_landing_s = std::min(f->t_landing_s, hi_s);
+  // The first sample off the arc after it bounds a ground contact; an arc still well above the
+  // ground there ended in the air, and where it would have landed is extrapolated.
+  if (f->end_event == FlightEvent::kGround && hi_s < f->t_landing_s) {
+    if (InTheAir(mdl, hi_s, options)) {
+      f->end_event = FlightEvent::kHit;
+      f->t_end_s = hi_s;
+    } else {
+      f->t_landing_s = hi_s;
+    }
+  }
   f->landing_m = mdl.PositionAt(f->t_landing_s);
   if (f->end_event != FlightEvent::kHit) f->t_end_s = f->t_landing_s;
   f->origin_extrapolated = f->start_event == FlightEvent::kTrackStart;

@@ -17,7 +17,8 @@ void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOp
                      double noise_m, double sample_interval_s, std::vector<Flight>* flights,
                      std::vector<TrackBreak>* breaks);
 // Origin, landing, apex and launch velocity of a flight from its model and events; a ground
-// contact lies within the contact-time bounds [lo_s, hi_s] of its piece.
+// contact lies within the contact-time bounds [lo_s, hi_s] of its piece, and an arc still in the
+// air at its bound began or ended in the air there (a hit; the landing then extrapolated).
 void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, Flight* f);
 // A bounce is one point on the ground: the landing of the arc before and the origin of the arc
 // after, weighted by the inverse extrapolation variance of each (leverage of the contact time in

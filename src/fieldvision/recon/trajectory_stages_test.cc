@@ -40,11 +40,27 @@ TEST(TrajectoryStages, EndpointsAreWhereTheArcMeetsTheGround) {
   EXPECT_NEAR(f.speed_mps, f.v0_mps.norm(), 1e-12);
   EXPECT_FALSE(f.origin_extrapolated);
   EXPECT_FALSE(f.landing_extrapolated);
-  // The first sample seen on the ground after the arc bounds the landing time.
+  // The first sample seen on the ground after the arc bounds the landing time (the arc crosses
+  // the ground at 0.9975 s, 1.4 cm above it at 0.995 s).
   Flight bounded = Arc(0.0, {0, 0, 1}, {5, 0, 4}, 0.0, 0.5);
   bounded.start_event = bounded.end_event = FlightEvent::kGround;
-  PlaceEndpoints(o, -kInf, 0.9, &bounded);
-  EXPECT_DOUBLE_EQ(bounded.t_landing_s, 0.9);
+  PlaceEndpoints(o, -kInf, 0.995, &bounded);
+  EXPECT_DOUBLE_EQ(bounded.t_landing_s, 0.995);
+  EXPECT_EQ(bounded.end_event, FlightEvent::kGround);
+  // A bound while the arc is still 0.8 m up (a sample off it, then too few to fit): the flight
+  // ended in the air there, and where it would have landed is extrapolated.
+  Flight cut = Arc(0.0, {0, 0, 1}, {5, 0, 4}, 0.0, 0.5);
+  cut.start_event = cut.end_event = FlightEvent::kGround;
+  PlaceEndpoints(o, -kInf, 0.6, &cut);
+  EXPECT_EQ(cut.end_event, FlightEvent::kHit);
+  EXPECT_DOUBLE_EQ(cut.t_end_s, 0.6);
+  EXPECT_NEAR(cut.landing_m.z(), zr, 1e-6);
+  EXPECT_GT(cut.t_landing_s, 0.6);
+  EXPECT_TRUE(cut.landing_extrapolated);
+  // The same before the arc: it began in the air at the bound.
+  PlaceEndpoints(o, -0.05, kInf, &cut);
+  EXPECT_EQ(cut.start_event, FlightEvent::kHit);
+  EXPECT_DOUBLE_EQ(cut.t_start_s, -0.05);
   // A flight that runs off the end of the track lands by extrapolation.
   Flight open = Arc(0.0, {0, 0, 1}, {5, 0, 4}, 0.0, 0.5);
   open.end_event = FlightEvent::kTrackEnd;
