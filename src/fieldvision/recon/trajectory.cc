@@ -1235,6 +1235,21 @@ std::vector<std::optional<FittedPiece>> FitPieces(const std::vector<BallSample>&
   return fitted;
 }
 
+// A piece at the track's start or end whose samples and fitted arc all stay within the ground band
+// (FindGround's) is the ball at rest or rolling before a kick or after it settles, too few
+// samples for a ground phase: its arc would be a flight of a few centimetres.
+bool RestsAtTrackEnd(const std::vector<BallSample>& track, const Piece& pc, const Flight& f,
+                     const TrajectoryOptions& options, double noise_m) {
+  if (pc.start != FlightEvent::kTrackStart && pc.end != FlightEvent::kTrackEnd) return false;
+  const double band_m =
+      options.ground_z_m + options.ball_radius_m + options.ground_tolerance_m + 3 * noise_m;
+  for (int k : f.samples) {
+    if (track[k].ball_in_world.z() > band_m) return false;
+  }
+  double t_apex = 0.0;
+  return ApexOf(f.model(), f.t_first_seen_s, f.t_last_seen_s, &t_apex) <= band_m;
+}
+
 }  // namespace
 
 namespace detail {
@@ -1432,6 +1447,11 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
   auto fitted = FitPieces(track, air, pieces, res.outlier, options, res.noise_m, &res.on_ground,
                           &res.short_hops);
   for (size_t pi = 0; pi < pieces.size(); ++pi) {
+    if (fitted[pi] &&
+        RestsAtTrackEnd(track, pieces[pi], fitted[pi]->flight, options, res.noise_m)) {
+      for (int k : fitted[pi]->flight.samples) res.on_ground[k] = true;
+      fitted[pi].reset();
+    }
     if (!fitted[pi]) continue;
     flights.push_back(std::move(fitted[pi]->flight));
     piece_of_flight.push_back(static_cast<int>(pi));

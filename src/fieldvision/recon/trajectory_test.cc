@@ -110,6 +110,28 @@ TEST(Trajectory, FindsEveryFlightWithOriginAndLandingWithin2cmAt5mmNoise) {
   }
 }
 
+// Four samples at rest at the track's start, then a kick whose first sample is still within the
+// ground band: too few and too tilted for a ground phase, the rest is still no flight of its own.
+TEST(Trajectory, ABallAtRestBeforeAKickAtTheTrackStartIsOnTheGround) {
+  std::vector<BallSample> track;
+  const double rest_z[] = {0.110, 0.112, 0.109, 0.111};
+  for (int i = 0; i < 32; ++i) {
+    BallSample s;
+    s.frame = i;
+    s.time_s = 0.02 * i;
+    const double dt = s.time_s - 0.07;  // kicked at 0.07 s from (0, 0, 0.11) with (6, 0, 3) m/s
+    s.ball_in_world = i < 4 ? Eigen::Vector3d(0, 0, rest_z[i])
+                            : Eigen::Vector3d(6 * dt, 0, 0.11 + 3 * dt - 0.5 * 9.81 * dt * dt);
+    track.push_back(s);
+  }
+  const TrajectoryResult r = AnalyzeTrajectory(track, TrajectoryOptions());
+  SCOPED_TRACE(r.Summary());
+  ASSERT_EQ(r.flights.size(), 1u);
+  EXPECT_EQ(r.flights[0].start_event, FlightEvent::kGround);
+  EXPECT_NEAR(r.flights[0].t_start_s, 0.07, 0.005);
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(r.on_ground[i]) << i;
+}
+
 TEST(Trajectory, BouncesAreBouncesAndAMidAirHitIsAHit) {
   testing::SeededRng rng(5);
   BallSimOptions o;
