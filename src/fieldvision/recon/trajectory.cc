@@ -1256,26 +1256,98 @@ namespace detail {
 
 namespace {
 
-// A bounce whose two arcs do not meet, and whose ground crossings lie at least two sample
-// intervals apart (the arc after it rising from the ground later than the arc before it came
-// down), hid a hop between them: a bounce, then a kick of the hopping ball before the hop could be
-// fitted. Real bounces (table tennis, spin and drag) put the crossings within 1.2 intervals.
-bool UnseenHopBetween(const Flight& A, const Flight& B, double gap_m,
-                      const TrajectoryOptions& options, double noise_m, double sample_interval_s) {
-  const double apart_m =
-      std::max(options.min_outlier_m, options.outlier_sigmas * noise_m * std::sqrt(3.0));
-  if (!(gap_m > apart_m) || !(sample_interval_s > 0)) return false;
+// The samples of a hop hidden between a bounce's two arcs: the arcs do not meet, the arc after it
+// rises from the ground at least a sample interval after the arc before it came down, and samples
+// between their seen spans after that landing lie off both (left as outliers or trimmed). Empty
+// when there is no such hop. Real bounces can have arcs apart by centimetres and crossings frames
+// apart (table tennis at 180 Hz: 6 cm, 25 ms) but no sample between them.
+std::vector<BallSample> UnseenHopSamples(const std::vector<BallSample>& track, const Flight& A,
+                                         const Flight& B, double gap_m, double off_m,
+                                         const TrajectoryOptions& options, double sample_interval_s,
+                                         double* landed_s) {
+  std::vector<BallSample> hop;
+  if (!(gap_m > off_m)) return hop;
   const double zr = options.ground_z_m + options.ball_radius_m;
-  const auto landed_s = A.model().CrossingTime(zr, A.t_last_seen_s, true, 10.0);
-  const auto rose_s = B.model().CrossingTime(zr, B.t_first_seen_s, false, 10.0);
-  return landed_s && rose_s && *rose_s - *landed_s >= 2 * sample_interval_s;
+  const auto landed = A.model().CrossingTime(zr, A.t_last_seen_s, true, 10.0);
+  const auto rose = B.model().CrossingTime(zr, B.t_first_seen_s, false, 10.0);
+  if (!landed || !rose || *rose - *landed < sample_interval_s) return hop;
+  *landed_s = *landed;
+  const auto first = std::upper_bound(track.begin(), track.end(), *landed,
+                                      [](double t, const BallSample& s) { return t < s.time_s; });
+  for (auto it = first; it != track.end() && it->time_s < B.t_first_seen_s; ++it) {
+    const double off_a = (A.model().PositionAt(it->time_s) - it->ball_in_world).norm();
+    const double off_b = (B.model().PositionAt(it->time_s) - it->ball_in_world).norm();
+    if (off_a > off_m && off_b > off_m) hop.push_back(*it);
+  }
+  return hop;
+}
+
+// The hop from A's landing point through its samples (gravity only, its start fixed), and the kick
+// where it meets B's arc between its last sample and B's first: A ends in a bounce there, B starts
+// with a hit. False (nothing changed) when the hop does not rise or does not meet B's arc within
+// 2 off_m.
+bool ResolveUnseenHop(const std::vector<BallSample>& hop, double landed_s, double off_m,
+                      const TrajectoryOptions& options, Flight* A, Flight* B,
+                      std::vector<TrackBreak>* breaks) {
+  BallisticModel m;
+  m.t0_s = landed_s;
+  m.p0_m = A->model().PositionAt(landed_s);
+  m.gravity_mps2 = options.gravity_mps2;
+  // Least squares for the launch velocity: sum over samples of dt (x - p0 + g dt^2 / 2) / dt^2.
+  Eigen::Vector3d num = Eigen::Vector3d::Zero();
+  double den = 0.0;
+  for (const BallSample& s : hop) {
+    const double dt = s.time_s - landed_s;
+    Eigen::Vector3d r = s.ball_in_world - m.p0_m;
+    r.z() += 0.5 * m.gravity_mps2 * dt * dt;
+    num += dt * r;
+    den += dt * dt;
+  }
+  if (!(den > 0)) return false;
+  m.v0_mps = num / den;
+  if (m.v0_mps.z() <= 0) return false;
+  constexpr double kStepS = 0.0005;
+  double t_hit = hop.back().time_s, closest_m = std::numeric_limits<double>::infinity();
+  for (double t = hop.back().time_s; t <= B->t_first_seen_s + 1e-9; t += kStepS) {
+    const double d = (m.PositionAt(t) - B->model().PositionAt(t)).norm();
+    if (d < closest_m) {
+      closest_m = d;
+      t_hit = t;
+    }
+  }
+  if (closest_m > 2 * off_m) return false;
+  const Eigen::Vector3d va = A->model().VelocityAt(landed_s);
+  TrackBreak bounce;
+  bounce.time_s = landed_s;
+  bounce.ball_in_world = m.p0_m;
+  bounce.velocity_change_mps = (m.v0_mps - va).norm();
+  bounce.kind = FlightEvent::kBounce;
+  bounce.bounce = FitBounce(va, A->model().spin_radps, m.v0_mps, options.ball_radius_m);
+  TrackBreak hit;
+  hit.time_s = t_hit;
+  hit.ball_in_world = 0.5 * (m.PositionAt(t_hit) + B->model().PositionAt(t_hit));
+  hit.velocity_change_mps = (B->model().VelocityAt(t_hit) - m.VelocityAt(t_hit)).norm();
+  hit.kind = FlightEvent::kHit;
+  A->end_event = FlightEvent::kBounce;
+  B->start_event = FlightEvent::kHit;
+  B->t_start_s = t_hit;
+  breaks->push_back(bounce);
+  breaks->push_back(hit);
+  return true;
 }
 
 }  // namespace
 
-void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOptions& options,
-                     double noise_m, double sample_interval_s, std::vector<Flight>* flights,
+void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int>& piece_of_flight,
+                     const TrajectoryOptions& options, double noise_m, std::vector<Flight>* flights,
                      std::vector<TrackBreak>* breaks) {
+  std::vector<double> intervals_s;
+  for (size_t i = 1; i < track.size(); ++i) {
+    intervals_s.push_back(track[i].time_s - track[i - 1].time_s);
+  }
+  const double sample_interval_s = util::NearestRankPercentile(intervals_s, 0.5);
+  const double off_m =
+      std::max(options.min_outlier_m, options.outlier_sigmas * noise_m * std::sqrt(3.0));
   const double zr = options.ground_z_m + options.ball_radius_m;
   const double ground_tol = options.ground_tolerance_m + 3 * noise_m + 0.05;
   for (size_t i = 0; i + 1 < flights->size(); ++i) {
@@ -1299,10 +1371,17 @@ void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOp
     br.kind = (br.ball_in_world.z() < zr + ground_tol && va.z() < 0 && vb.z() > 0)
                   ? FlightEvent::kBounce
                   : FlightEvent::kHit;
-    if (br.kind == FlightEvent::kBounce &&
-        UnseenHopBetween(A, B, (pa - pb).norm(), options, noise_m, sample_interval_s)) {
-      // Two ground contacts, each arc's own (as next to a hop too short to fit).
-      A.end_event = B.start_event = FlightEvent::kGround;
+    double landed_s = 0.0;
+    const std::vector<BallSample> hop =
+        br.kind == FlightEvent::kBounce ? UnseenHopSamples(track, A, B, (pa - pb).norm(), off_m,
+                                                           options, sample_interval_s, &landed_s)
+                                        : std::vector<BallSample>();
+    if (!hop.empty()) {
+      // The bounce, the hop and the kick; or two ground contacts, each arc's own (as next to a
+      // hop too short to fit), when the hop does not join them.
+      if (!ResolveUnseenHop(hop, landed_s, off_m, options, &A, &B, breaks)) {
+        A.end_event = B.start_event = FlightEvent::kGround;
+      }
       continue;
     }
     if (br.kind == FlightEvent::kBounce) {
@@ -1457,10 +1536,7 @@ TrajectoryResult AnalyzeTrajectory(const std::vector<BallSample>& track,
     piece_of_flight.push_back(static_cast<int>(pi));
     limits.emplace_back(fitted[pi]->lo_s, fitted[pi]->hi_s);
   }
-  std::vector<double> intervals_s(n - 1);
-  for (int i = 1; i < n; ++i) intervals_s[i - 1] = track[i].time_s - track[i - 1].time_s;
-  ResolveContacts(piece_of_flight, options, res.noise_m,
-                  util::NearestRankPercentile(intervals_s, 0.5), &flights, &res.breaks);
+  ResolveContacts(track, piece_of_flight, options, res.noise_m, &flights, &res.breaks);
   for (size_t i = 0; i < flights.size(); ++i) {
     flights[i].index = static_cast<int>(i);
     PlaceEndpoints(options, limits[i].first, limits[i].second, &flights[i]);

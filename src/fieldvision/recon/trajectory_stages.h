@@ -10,12 +10,13 @@ namespace fv::recon::detail {
 
 // Events between consecutive pieces that are both fitted (piece_of_flight: each flight's piece):
 // bounce (low, descending then rising) or hit, with the contact time where the two arcs meet. A
-// bounce whose arcs do not meet and cross the ground at least two sample intervals (the track's
-// median) apart hid an unseen hop, and a break next to a hop too short to fit is unresolved too:
-// ground contacts (origin and landing from the arc's own crossing of the ground level).
-void ResolveContacts(const std::vector<int>& piece_of_flight, const TrajectoryOptions& options,
-                     double noise_m, double sample_interval_s, std::vector<Flight>* flights,
-                     std::vector<TrackBreak>* breaks);
+// bounce whose arcs do not meet, cross the ground a sample interval (the track's median) or more
+// apart and leave a sample of the track between them off both hid an unseen hop; it and a break
+// next to a hop too short to fit are unresolved: ground contacts (origin and landing from the
+// arc's own crossing of the ground level).
+void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int>& piece_of_flight,
+                     const TrajectoryOptions& options, double noise_m,
+                     std::vector<Flight>* flights, std::vector<TrackBreak>* breaks);
 // Origin, landing, apex and launch velocity of a flight from its model and events; a ground
 // contact lies within the contact-time bounds [lo_s, hi_s] of its piece, and an arc still in the
 // air at its bound began or ended in the air there (a hit; the landing then extrapolated).

@@ -2,6 +2,7 @@
 #include "fieldvision/recon/trajectory_stages.h"
 
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -69,6 +70,27 @@ TEST(TrajectoryStages, EndpointsAreWhereTheArcMeetsTheGround) {
   EXPECT_TRUE(open.origin_extrapolated);  // kTrackStart
 }
 
+std::function<Eigen::Vector3d(double)> Still(const Eigen::Vector3d& p) {
+  return [p](double) { return p; };
+}
+
+// Samples every 0.02 s over [0.6, 1.4] s: on the first arc up to its last seen time, on the second
+// from its first, and at between(t) in the span of neither.
+std::vector<BallSample> TrackOf(const std::vector<Flight>& f,
+                                const std::function<Eigen::Vector3d(double)>& between) {
+  std::vector<BallSample> track;
+  for (int i = 0; i <= 40; ++i) {
+    BallSample s;
+    s.frame = i;
+    s.time_s = 0.6 + 0.02 * i;
+    s.ball_in_world = s.time_s <= f[0].t_last_seen_s + 1e-9    ? f[0].model().PositionAt(s.time_s)
+                      : s.time_s >= f[1].t_first_seen_s - 1e-9 ? f[1].model().PositionAt(s.time_s)
+                                                               : between(s.time_s);
+    track.push_back(s);
+  }
+  return track;
+}
+
 TEST(TrajectoryStages, ContactsAreBouncesOnTheGroundAndHitsInTheAir) {
   TrajectoryOptions o;
   const double zr = o.ground_z_m + o.ball_radius_m;
@@ -77,29 +99,58 @@ TEST(TrajectoryStages, ContactsAreBouncesOnTheGroundAndHitsInTheAir) {
                                  Arc(1.0, {0, 0, zr}, {2.5, 0, 3}, 1.02, 1.4)};
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   std::vector<TrackBreak> breaks;
-  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
+  ResolveContacts(TrackOf(flights, Still({})), {0, 1}, o, 0.005, &flights, &breaks);
   ASSERT_EQ(breaks.size(), 1u);
   EXPECT_EQ(breaks[0].kind, FlightEvent::kBounce);
   EXPECT_NEAR(breaks[0].time_s, 1.0, 1e-3);
   EXPECT_EQ(flights[0].end_event, FlightEvent::kBounce);
   EXPECT_EQ(flights[1].start_event, FlightEvent::kBounce);
-  // Down at t = 1 s, up from 0.3 m further at 1.08 s (four sample intervals of 0.02 s later):
-  // the arcs do not meet, a hop was not seen between them. Each arc keeps its ground crossing.
+  // Down at t = 1 s, then a hop from there kicked at 1.08 s, seen at 1.02-1.06 s only (off both
+  // arcs): the bounce, the hop and the kick, where the hop meets the arc after it.
+  BallisticModel hop;
+  hop.t0_s = 1.0;
+  hop.p0_m = {0, 0, zr};
+  hop.v0_mps = {2, 0, 1.2};
   flights = {Arc(1.0, {0, 0, zr}, {3, 0, -1.5}, 0.6, 0.98),
-             Arc(1.08, {0.3, 0, zr}, {-4, 0, 3}, 1.12, 1.4)};
+             Arc(1.08, hop.PositionAt(1.08), {-4, 0, 3}, 1.12, 1.4)};
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   breaks.clear();
-  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
+  const BallisticModel after = flights[1].model();
+  ResolveContacts(
+      TrackOf(flights,
+              [&](double t) { return t < 1.08 - 1e-9 ? hop.PositionAt(t) : after.PositionAt(t); }),
+      {0, 1}, o, 0.005, &flights, &breaks);
+  ASSERT_EQ(breaks.size(), 2u);
+  EXPECT_EQ(breaks[0].kind, FlightEvent::kBounce);
+  EXPECT_NEAR(breaks[0].time_s, 1.0, 1e-3);
+  EXPECT_EQ(breaks[1].kind, FlightEvent::kHit);
+  EXPECT_NEAR(breaks[1].time_s, 1.08, 2e-3);
+  EXPECT_EQ(flights[0].end_event, FlightEvent::kBounce);
+  EXPECT_EQ(flights[1].start_event, FlightEvent::kHit);
+  EXPECT_NEAR(flights[1].t_start_s, 1.08, 2e-3);
+  // Samples between them off both arcs that no hop from the landing joins to the arc after (0.6
+  // m up): two ground contacts, each arc's own crossing.
+  flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
+  breaks.clear();
+  ResolveContacts(TrackOf(flights, Still({0.15, 0, 0.6})), {0, 1}, o, 0.005, &flights, &breaks);
   EXPECT_TRUE(breaks.empty());
   EXPECT_EQ(flights[0].end_event, FlightEvent::kGround);
   EXPECT_EQ(flights[1].start_event, FlightEvent::kGround);
-  // A bounce whose arcs miss each other by 6 cm with crossings one interval apart (spin, drag,
-  // a real ball's contact) stays a bounce.
-  flights = {Arc(1.0, {0, 0, zr}, {3, 0, -1.5}, 0.6, 0.98),
-             Arc(1.02, {0.06, 0, zr}, {2.5, 0, 3}, 1.04, 1.4)};
+  // The same arcs with the samples between on the first one: nothing says a hop, a bounce.
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   breaks.clear();
-  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
+  const BallisticModel first = flights[0].model();
+  ResolveContacts(TrackOf(flights, [&](double t) { return first.PositionAt(t); }), {0, 1}, o, 0.005,
+                  &flights, &breaks);
+  ASSERT_EQ(breaks.size(), 1u);
+  EXPECT_EQ(breaks[0].kind, FlightEvent::kBounce);
+  // Arcs 6 cm apart crossing the ground one interval apart, no sample between them (spin, drag, a
+  // real ball's contact): a bounce.
+  flights = {Arc(1.0, {0, 0, zr}, {3, 0, -1.5}, 0.6, 0.98),
+             Arc(1.02, {0.06, 0, zr}, {2.5, 0, 3}, 1.0, 1.4)};
+  flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
+  breaks.clear();
+  ResolveContacts(TrackOf(flights, Still({})), {0, 1}, o, 0.005, &flights, &breaks);
   ASSERT_EQ(breaks.size(), 1u);
   EXPECT_EQ(breaks[0].kind, FlightEvent::kBounce);
   // The same turn 1.5 m up: a hit, which also ends and starts the flights.
@@ -107,7 +158,7 @@ TEST(TrajectoryStages, ContactsAreBouncesOnTheGroundAndHitsInTheAir) {
              Arc(1.0, {0, 0, 1.5}, {-4, 0, 2}, 1.02, 1.4)};
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   breaks.clear();
-  ResolveContacts({0, 1}, o, 0.005, 0.02, &flights, &breaks);
+  ResolveContacts(TrackOf(flights, Still({})), {0, 1}, o, 0.005, &flights, &breaks);
   ASSERT_EQ(breaks.size(), 1u);
   EXPECT_EQ(breaks[0].kind, FlightEvent::kHit);
   EXPECT_NEAR(flights[0].t_end_s, 1.0, 1e-3);
@@ -115,7 +166,7 @@ TEST(TrajectoryStages, ContactsAreBouncesOnTheGroundAndHitsInTheAir) {
   // A hop between them too short to fit (pieces 0 and 2): not resolved, ground contacts.
   flights[0].end_event = flights[1].start_event = FlightEvent::kHit;
   breaks.clear();
-  ResolveContacts({0, 2}, o, 0.005, 0.02, &flights, &breaks);
+  ResolveContacts(TrackOf(flights, Still({})), {0, 2}, o, 0.005, &flights, &breaks);
   EXPECT_TRUE(breaks.empty());
   EXPECT_EQ(flights[0].end_event, FlightEvent::kGround);
   EXPECT_EQ(flights[1].start_event, FlightEvent::kGround);
