@@ -11,9 +11,10 @@ namespace fv::recon::detail {
 // Events between consecutive pieces that are both fitted (piece_of_flight: each flight's piece):
 // bounce (low, descending then rising) or hit, with the contact time where the two arcs meet. A
 // bounce whose arcs do not meet, cross the ground a sample interval (the track's median) or more
-// apart and leave a sample of the track between them off both hid an unseen hop; it and a break
-// next to a hop too short to fit are unresolved: ground contacts (origin and landing from the
-// arc's own crossing of the ground level).
+// apart and leave samples of the track between them off both hid a hop: fitted from the landing
+// through those samples, it gives a bounce and then a hit where it meets the next arc, or, when
+// it does not meet it, two ground contacts (origin and landing from each arc's own crossing of
+// the ground level), as next to a hop too short to fit.
 void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int>& piece_of_flight,
                      const TrajectoryOptions& options, double noise_m,
                      std::vector<Flight>* flights, std::vector<TrackBreak>* breaks);
