@@ -52,7 +52,8 @@ std::vector<std::pair<double, Eigen::Vector3d>> Flight(util::Rng& rng, double ra
   for (int i = 0; i < 1000; ++i) {
     const double t = 10.0 + 0.013 + i / rate_hz;  // frames not aligned with the bounce
     const Eigen::Vector3d p = t < tb ? m.PositionAt(t) : after.PositionAt(t);
-    if (p.x() > 2.5 || p.z() < 0.0) break;
+    // Until the ball leaves the table or comes down on it again (its centre at its radius).
+    if (p.x() > 2.5 || p.z() < 0.02) break;
     out.emplace_back(t, p);
   }
   return out;
