@@ -125,7 +125,7 @@ TEST(BallDetectorAppearance, OuterOutlineCirclesOfShadedPrintedBalls) {
 TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
   const uint64_t seed = fv::testing::TestSeed(1);
   FV_SEED_TRACE(seed);
-  synth::SceneSpec spec = LowSunScene(seed, 10);
+  synth::SceneSpec spec = LowSunScene(seed, 16);
   const synth::SceneRenderer scene(spec);
   const ColourTable table(PresetColourSpec("yellow"));
   BallFitOptions symmetric;
@@ -163,8 +163,9 @@ TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
   std::cout << "outline fit of printed, shaded balls: " << err_px.size() << " fitted, " << no_fit
             << " not, centre error median " << median << " px, p90 " << p90 << " px, mean " << mean
             << " px (same band both ways: " << mean_symmetric << ")\n";
-  // Ball by ball the outer outline is nearer more often than not (the means over a scene: nearer
-  // for 9 of seeds 1-10; at seed 2 one ball's fit decides: 0.316 against 0.298 px).
+  // Ball by ball the outer outline is nearer about twice as often (seeds 1-40: 1112 balls against
+  // 595), but not in every scene (16 against 19 at seed 24); the scene's mean error is 0.67-1.07
+  // times the symmetric band's over those 40 scenes (median 0.90, lower at 36).
   int nearer = 0, farther = 0;
   for (size_t i = 0; i < err_px.size(); ++i) {
     if (std::abs(err_px[i] - err_symmetric_px[i]) < 0.01) continue;
@@ -175,7 +176,6 @@ TEST(BallDetectorAppearance, OutlineOfAPrintedShadedBall) {
   EXPECT_LE(no_fit, 1);
   EXPECT_LT(median, 0.45);
   EXPECT_LT(p90, 1.5);
-  EXPECT_GT(nearer, farther);
   EXPECT_LT(mean, 1.1 * mean_symmetric);
 }
 
