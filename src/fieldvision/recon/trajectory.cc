@@ -1039,8 +1039,8 @@ int MissedAtEnd(const std::vector<BallSample>& s, bool at_start, const Ballistic
                 const TrajectoryOptions& options, double noise_m) {
   constexpr int kEnd = 3, kCore = 8;
   const int ns = static_cast<int>(s.size());
-  std::vector<bool> on_arc;  // from the end inwards
-  for (int i = 0; i < ns; ++i) on_arc.push_back(all.inlier[at_start ? i : ns - 1 - i]);
+  std::vector<bool> on_arc(ns);  // from the end inwards
+  for (int i = 0; i < ns; ++i) on_arc[i] = all.inlier[at_start ? i : ns - 1 - i];
   if (ns >= kEnd + kCore) {
     // The kEnd + kCore samples at this end, in time order; the core is the inner kCore.
     const auto first = at_start ? s.begin() : s.end() - kEnd - kCore;
