@@ -149,7 +149,7 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
         spec, spec.substr(0, colon));
   }
   // An image sequence: one image file, a glob, a folder or a printf pattern whose files are
-  // numbered from 0 or 1 (a file that exists is a file, whatever its name). Other printf
+  // numbered from one of 0..1000 (a file that exists is a file, whatever its name). Other printf
   // patterns: OpenCV's reader. One image is decoded as a folder's are (libjpeg for a JPEG), not
   // by FFmpeg, whose chroma upsampling gives other pixels.
   const bool list =

@@ -1,6 +1,6 @@
 // Frame sources behind one interface, chosen by the spec's form, one backend per file:
 //   dir/*.png, a folder of images (name order),     image_list_source.cc (frame rate or CSV;
-//   dir/%05d.jpg numbered from 0 or 1                JPEG files kept encoded on request)
+//   dir/%05d.jpg from one of 0..1000                 JPEG files kept encoded on request)
 //   a video file (or another image pattern)          file_source.cc (timestamps from the frame
 //                                                    rate, the container or a CSV; Motion-JPEG
 //                                                    and JPEG files kept encoded on request)

@@ -163,8 +163,9 @@ TEST(ReadImage, EncodedSequenceTurnsStillsAsImread) {
   cv::imencode(".jpg", NoisyImage(rng, 80, 40), jpeg);
   fs::create_directories(dir + "/turned");
   fs::create_directories(dir + "/plain");
-  for (int i = 0; i < 2; ++i) {
-    WriteBytes(fmt::format("{}/turned/{:05d}.jpg", dir, i), WithSegment(jpeg, ExifApp1(6, i == 0)));
+  // Numbered from 7 (a clip cut out of a longer one): as from 0, and as OpenCV's reader starts.
+  for (int i = 7; i < 9; ++i) {
+    WriteBytes(fmt::format("{}/turned/{:05d}.jpg", dir, i), WithSegment(jpeg, ExifApp1(6, i == 7)));
     WriteBytes(fmt::format("{}/plain/{:05d}.jpg", dir, i), jpeg);
   }
   FrameSourceOptions o;
@@ -173,7 +174,7 @@ TEST(ReadImage, EncodedSequenceTurnsStillsAsImread) {
   auto plain = OpenFrameSource(dir + "/plain/%05d.jpg", o);
   EXPECT_EQ(turned->FrameSize(), cv::Size(40, 80));
   EXPECT_EQ(plain->FrameSize(), cv::Size(80, 40));
-  const cv::Mat expected = cv::imread(dir + "/turned/00000.jpg", cv::IMREAD_COLOR);
+  const cv::Mat expected = cv::imread(dir + "/turned/00007.jpg", cv::IMREAD_COLOR);
   SourceFrame f;
   int n = 0;
   while (turned->ReadFrame(&f)) {

@@ -98,19 +98,23 @@ std::vector<std::string> ListImageSequence(const std::string& spec) {
     return files;
   }
   if (spec.find('%') != std::string::npos) {
-    // printf pattern with one integer field (%d, %5d, %05d): frames from 0 (or 1) upwards until
-    // the first missing number.
+    // printf pattern with one integer field (%d, %5d, %05d): frames from the first number of
+    // 0..1000 that names a file (as OpenCV's image reader starts) upwards until the first
+    // missing number.
     static const std::regex kOneIntField(R"([^%]*%0?[0-9]*d[^%]*)");
     if (!std::regex_match(spec, kOneIntField)) return {};
-    for (int start : {0, 1}) {
-      for (int i = start;; ++i) {
-        std::vector<char> buf(spec.size() + 32);
-        std::snprintf(buf.data(), buf.size(), spec.c_str(), i);
-        const std::string name(buf.data());
-        if (!fs::is_regular_file(name)) break;
-        files.push_back(name);
-      }
-      if (!files.empty()) break;
+    auto name_of = [&](int i) {
+      std::vector<char> buf(spec.size() + 32);
+      std::snprintf(buf.data(), buf.size(), spec.c_str(), i);
+      return std::string(buf.data());
+    };
+    constexpr int kLastStart = 1000;
+    int start = 0;
+    while (start <= kLastStart && !fs::is_regular_file(name_of(start))) ++start;
+    for (int i = start; start <= kLastStart; ++i) {
+      const std::string name = name_of(i);
+      if (!fs::is_regular_file(name)) break;
+      files.push_back(name);
     }
     return files;
   }
