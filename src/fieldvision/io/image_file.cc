@@ -12,34 +12,41 @@
 namespace fv::io {
 namespace {
 
-// The JPEG at `path` decoded by libjpeg-turbo; empty when it is no JPEG, needs turning or does
-// not decode (cv::imread then has its say). Data that ends early is decoded as far as it goes,
-// as cv::imread does, without libjpeg's message on stderr.
-cv::Mat TryDecodeJpeg(const std::string& path) {
+enum class JpegRead { kDecoded, kNotDecoded, kDamaged };
+
+// The JPEG at `path` decoded by libjpeg-turbo into *bgr: kNotDecoded when it is no JPEG, needs
+// turning or does not decode (cv::imread then has its say); kDamaged when its header announces
+// more pixels than its data can hold (cv::imread would allocate and fill them all, up to 1 Gpx).
+// Data that ends early is decoded as far as it goes, as cv::imread does, without libjpeg's
+// message on stderr.
+JpegRead TryDecodeJpeg(const std::string& path, cv::Mat* bgr) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
+  if (!in) return JpegRead::kNotDecoded;
   char magic[2] = {0, 0};
   if (!in.read(magic, 2) || static_cast<uint8_t>(magic[0]) != 0xFF ||
       static_cast<uint8_t>(magic[1]) != 0xD8) {
-    return {};
+    return JpegRead::kNotDecoded;
   }
   std::vector<uint8_t> bytes = {0xFF, 0xD8};
   bytes.insert(bytes.end(), std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (JpegOrientation(bytes.data(), bytes.size()) != 1) return {};
-  cv::Mat bgr;
   try {
-    JpegRegionDecoder().Decode(bytes.data(), bytes.size(), cv::Rect(), &bgr, path);
+    const cv::Size size = JpegRegionDecoder::ReadSize(bytes.data(), bytes.size(), path);
+    if (!JpegRegionDecoder::CanHold(bytes.size(), size)) return JpegRead::kDamaged;
+    if (JpegOrientation(bytes.data(), bytes.size()) != 1) return JpegRead::kNotDecoded;
+    JpegRegionDecoder().Decode(bytes.data(), bytes.size(), cv::Rect(), bgr, path);
   } catch (const Error&) {
-    return {};
+    return JpegRead::kNotDecoded;
   }
-  return bgr;
+  return JpegRead::kDecoded;
 }
 
 }  // namespace
 
 cv::Mat TryReadImage(const std::string& path) {
-  cv::Mat image = TryDecodeJpeg(path);
-  if (!image.empty()) return image;
+  cv::Mat image;
+  const JpegRead jpeg = TryDecodeJpeg(path, &image);
+  if (jpeg == JpegRead::kDecoded) return image;
+  if (jpeg == JpegRead::kDamaged) return {};
   try {
     image = codecs::ImRead(path, cv::IMREAD_COLOR);
   } catch (const cv::Exception&) {

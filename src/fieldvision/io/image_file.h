@@ -2,7 +2,8 @@
 // that names the path. JPEG files that need no turning (EXIF orientation 1) are decoded by
 // libjpeg-turbo straight into BGR (io::JpegRegionDecoder, the decoder of MJPG frames: the same
 // pixels as cv::imread, without its RGB to BGR pass or loading the codecs plugin); any other
-// image goes to cv::imread.
+// image goes to cv::imread, except a JPEG whose header announces more pixels than its data can
+// hold (damaged: cv::imread would allocate and fill them all, up to 1 Gpx).
 #pragma once
 
 #include <string>

@@ -188,6 +188,33 @@ TEST(ReadImage, EncodedSequenceTurnsStillsAsImread) {
   EXPECT_EQ(f.jpeg, jpeg);
 }
 
+// A JPEG whose header announces 30000 x 30000 pixels (within OpenCV's 2^30 limit) over a few
+// hundred bytes is damaged: not decoded, nor given to cv::imread, which would fill 2.7 GB; with
+// an EXIF orientation (cv::imread's case) the same.
+TEST(ReadImage, AHeaderAnnouncingMorePixelsThanItsDataHoldsIsDamaged) {
+  testing::SeededRng rng(11);
+  const std::string dir = testing::TempDir();
+  std::vector<uint8_t> jpeg;
+  cv::imencode(".jpg", NoisyImage(rng, 16, 16), jpeg);
+  size_t sof = 0;
+  for (size_t i = 2; i + 9 < jpeg.size(); ++i) {
+    if (jpeg[i] == 0xFF && jpeg[i + 1] == 0xC0) {
+      sof = i;
+      break;
+    }
+  }
+  ASSERT_GT(sof, 0u);
+  for (const size_t at : {sof + 5, sof + 7}) {  // height, width: 30000 = 0x7530
+    jpeg[at] = 0x75;
+    jpeg[at + 1] = 0x30;
+  }
+  WriteBytes(dir + "/huge.jpg", jpeg);
+  WriteBytes(dir + "/huge_turned.jpg", WithSegment(jpeg, ExifApp1(6, true)));
+  EXPECT_TRUE(TryReadImage(dir + "/huge.jpg").empty());
+  EXPECT_TRUE(TryReadImage(dir + "/huge_turned.jpg").empty());
+  EXPECT_THROW(ReadImage(dir + "/huge.jpg"), Error);
+}
+
 // The real photos (../shared/data): libjpeg-turbo's pixels are cv::imread's.
 TEST(ReadImage, RealPhotosDecodeAsImread) {
   const std::string data = testing::SharedDataDir();

@@ -107,14 +107,17 @@ cv::Size JpegRegionDecoder::ReadSize(const uint8_t* data, size_t size, const std
   return {job.width, job.height};
 }
 
+bool JpegRegionDecoder::CanHold(size_t size, const cv::Size& image) {
+  return double(image.width) * image.height <= kMaxPixelsPerByte * double(size);
+}
+
 cv::Rect JpegRegionDecoder::Decode(const uint8_t* data, size_t size, const cv::Rect& region,
                                    cv::Mat* bgr, const std::string& what) {
   FV_REQUIRE(bgr != nullptr, "JpegRegionDecoder::Decode: no output image");
   const cv::Size image = ReadSize(data, size, what);
-  // Entropy coding spends at least a bit on each 8x8 block of each component (a DC difference),
-  // so real data holds at most 512 pixels a byte: a header announcing far more is damaged, and
-  // decoding it would fill gigabytes with nothing (found by fuzz/jpeg_still_fuzz.cc).
-  FV_REQUIRE(double(image.width) * image.height <= kMaxPixelsPerByte * double(size),
+  // Decoding a header that announces far more than the data holds would fill gigabytes with
+  // nothing (found by fuzz/jpeg_still_fuzz.cc).
+  FV_REQUIRE(CanHold(size, image),
              "{}: the header announces {}x{} pixels, more than {} bytes of JPEG data can hold "
              "(damaged)",
              what, image.width, image.height, size);

@@ -18,6 +18,10 @@ class JpegRegionDecoder {
   // The image size from the JPEG header; throws fv::Error naming `what` when the data is not a
   // JPEG image.
   static cv::Size ReadSize(const uint8_t* data, size_t size, const std::string& what);
+  // Whether `size` bytes of JPEG data can hold an image of `image` pixels: entropy coding spends
+  // at least a bit on each 8x8 block of each component, so real data holds at most 512 pixels a
+  // byte; the bound is 1024. A header announcing more is damaged.
+  static bool CanHold(size_t size, const cv::Size& image);
 
   // Decodes `region` of the JPEG (clipped to the image and widened to whole blocks; empty: the
   // whole image) into `bgr`, which is (re)allocated to the image size when it is not already.
