@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/io/frame_source.h"
+#include "fieldvision/io/io_testing.h"
 #include "fieldvision/io/jpeg_orientation.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -196,18 +197,7 @@ TEST(ReadImage, AHeaderAnnouncingMorePixelsThanItsDataHoldsIsDamaged) {
   const std::string dir = testing::TempDir();
   std::vector<uint8_t> jpeg;
   cv::imencode(".jpg", NoisyImage(rng, 16, 16), jpeg);
-  size_t sof = 0;
-  for (size_t i = 2; i + 9 < jpeg.size(); ++i) {
-    if (jpeg[i] == 0xFF && jpeg[i + 1] == 0xC0) {
-      sof = i;
-      break;
-    }
-  }
-  ASSERT_GT(sof, 0u);
-  for (const size_t at : {sof + 5, sof + 7}) {  // height, width: 30000 = 0x7530
-    jpeg[at] = 0x75;
-    jpeg[at + 1] = 0x30;
-  }
+  ASSERT_TRUE(test_util::SetJpegHeaderSize(&jpeg, 30000, 30000));
   WriteBytes(dir + "/huge.jpg", jpeg);
   WriteBytes(dir + "/huge_turned.jpg", WithSegment(jpeg, ExifApp1(6, true)));
   EXPECT_TRUE(TryReadImage(dir + "/huge.jpg").empty());

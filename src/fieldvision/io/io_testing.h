@@ -1,14 +1,31 @@
-// Helpers shared by the io tests (header only, not part of the library): a video file cut short.
+// Helpers shared by the io tests (header only, not part of the library): a video file cut short,
+// a JPEG header that announces another size.
 #pragma once
 
+#include <cstdint>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
 namespace fv::io::test_util {
+
+// Rewrites the size in a baseline JPEG's SOF0 segment (FF C0, length, precision, height, width,
+// big-endian), leaving the data as it is; false when there is no SOF0 segment.
+inline bool SetJpegHeaderSize(std::vector<uint8_t>* jpeg, int width, int height) {
+  for (size_t i = 2; i + 8 < jpeg->size(); ++i) {
+    if ((*jpeg)[i] != 0xFF || (*jpeg)[i + 1] != 0xC0) continue;
+    (*jpeg)[i + 5] = static_cast<uint8_t>(height >> 8);
+    (*jpeg)[i + 6] = static_cast<uint8_t>(height & 0xFF);
+    (*jpeg)[i + 7] = static_cast<uint8_t>(width >> 8);
+    (*jpeg)[i + 8] = static_cast<uint8_t>(width & 0xFF);
+    return true;
+  }
+  return false;
+}
 
 // A 16-frame 320x240 MJPG video at 25 fps cut to `keep` of its bytes (the header still announces
 // 16 frames); returns `path`.

@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/io/io_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -36,19 +37,7 @@ std::vector<uint8_t> TestJpeg(util::Rng& rng, int w, int h, cv::Mat* image = nul
 TEST(JpegRegionDecoder, HeaderLargerThanItsDataIsAnError) {
   testing::SeededRng rng(37);
   std::vector<uint8_t> jpeg = TestJpeg(rng, 64, 48);
-  // The SOF0 segment: FF C0, length, precision, height, width (big-endian).
-  size_t sof = 0;
-  for (size_t i = 2; i + 8 < jpeg.size(); ++i) {
-    if (jpeg[i] == 0xFF && jpeg[i + 1] == 0xC0) {
-      sof = i;
-      break;
-    }
-  }
-  ASSERT_GT(sof, 0u);
-  for (int k : {5, 7}) {
-    jpeg[sof + k] = 0xEA;  // 60000 = 0xEA60
-    jpeg[sof + k + 1] = 0x60;
-  }
+  ASSERT_TRUE(test_util::SetJpegHeaderSize(&jpeg, 60000, 60000));
   EXPECT_EQ(JpegRegionDecoder::ReadSize(jpeg.data(), jpeg.size(), "big.jpg"),
             cv::Size(60000, 60000));
   cv::Mat bgr;
