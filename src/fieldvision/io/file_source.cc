@@ -1,14 +1,12 @@
-// Frame-source backend: video files OpenCV reads and printf image patterns (dir/%05d.jpg), with
-// times from the frame rate, the container or a frame,time_s CSV. Motion-JPEG frames (an AVI's
-// read directly, another container's packets through FFmpeg) and JPEG files can be delivered
-// encoded (the ball pipeline's window-decoding path); an AVI's are decoded by libjpeg-turbo
-// either way, so every command sees the same pixels.
+// Frame-source backend: video files OpenCV reads and the printf image patterns that are no image
+// sequence of existing files (image_list_source.cc reads those), with times from the frame rate,
+// the container or a frame,time_s CSV. Motion-JPEG frames (an AVI's read directly, another
+// container's packets through FFmpeg) can be delivered encoded (the ball pipeline's
+// window-decoding path); an AVI's are decoded by libjpeg-turbo either way, so every command sees
+// the same pixels.
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <map>
-#include <regex>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -24,25 +22,8 @@
 namespace fv::io::backend {
 namespace {
 
-// The file of frame `index` of a printf pattern with one integer field (dir/%05d.jpg), or ""
-// when the pattern has another form.
-std::string PatternFile(const std::string& pattern, long long index) {
-  static const std::regex kOneIntField(R"(^([^%]*)%(0?)([0-9]{0,3})d([^%]*)$)");
-  std::smatch m;
-  if (!std::regex_match(pattern, m, kOneIntField)) return "";
-  const size_t width = m[3].length() > 0 ? std::stoul(m[3].str()) : 0;
-  std::string number = std::to_string(index);
-  if (number.size() < width) number.insert(0, width - number.size(), m[2].length() ? '0' : ' ');
-  return m[1].str() + number + m[4].str();
-}
-
 std::string LowerExtension(const std::string& path) {
   return util::ToLower(std::filesystem::path(path).extension().string());
-}
-
-bool HasJpegExtension(const std::string& path) {
-  const std::string ext = LowerExtension(path);
-  return ext == ".jpg" || ext == ".jpeg";
 }
 
 class FileSource : public FrameSource {
@@ -63,15 +44,13 @@ class FileSource : public FrameSource {
   std::string path_;
   FrameSourceOptions options_;
   TimeOrigin origin_ = TimeOrigin::kFrameRate;
-  std::unique_ptr<AviMjpegReader> avi_;        // a Motion-JPEG AVI read directly
-  JpegRegionDecoder decoder_;                  // decoded: its frames (the encoded path's pixels)
+  std::unique_ptr<AviMjpegReader> avi_;  // a Motion-JPEG AVI read directly
+  JpegRegionDecoder decoder_;            // decoded: its frames (the encoded path's pixels)
   std::vector<uint8_t> packet_;
   std::unique_ptr<cv::VideoCapture> capture_;  // else OpenCV's
   std::map<long long, double> times_;          // kCsv
   bool encoded_ = false;
-  bool jpeg_files_ = false;    // encoded: a pattern of JPEG files (else MJPG packets)
-  long long first_file_ = -1;  // index of the first file of the pattern
-  SourceFrame pending_;        // the first frame, read when opening
+  SourceFrame pending_;  // the first frame, read when opening
   bool has_pending_ = false;
   long long next_frame_ = 0;
   long long frame_count_ = -1;
@@ -119,25 +98,6 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
       encoded_ = capture_->set(cv::CAP_PROP_FORMAT, -1);
     }
   }
-  // A pattern of JPEG files: the files themselves are the frames (OpenCV's image reader starts
-  // at the first of indices 0..1000 that exists; so does this).
-  if (options.encoded && pattern && HasJpegExtension(path) && !PatternFile(path, 0).empty()) {
-    for (long long i = 0; i <= 1000; ++i) {
-      if (std::filesystem::exists(PatternFile(path, i))) {
-        first_file_ = i;
-        break;
-      }
-    }
-    if (first_file_ >= 0) {
-      encoded_ = true;
-      jpeg_files_ = true;
-      long long n = 0;
-      while (std::filesystem::exists(PatternFile(path, first_file_ + n))) ++n;
-      frame_count_ = n;
-      capture_->release();
-      if (origin_ == TimeOrigin::kContainer) origin_ = TimeOrigin::kFrameRate;  // no times
-    }
-  }
   has_pending_ = encoded_ ? GrabEncoded(&pending_) : Grab(&pending_);
   FV_REQUIRE(has_pending_, "video '{}' has no readable frame", path);
   size_ = encoded_ ? JpegRegionDecoder::ReadSize(pending_.jpeg.data(), pending_.jpeg.size(),
@@ -147,13 +107,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
 
 bool FileSource::GrabEncoded(SourceFrame* out) {
   out->bgr = cv::Mat();
-  if (jpeg_files_) {
-    const std::string file = PatternFile(path_, first_file_ + next_frame_);
-    std::ifstream in(file, std::ios::binary);
-    if (!in) return false;  // the end of the sequence
-    out->jpeg.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    FV_REQUIRE(!in.bad(), "cannot read '{}'", file);
-  } else if (avi_) {
+  if (avi_) {
     if (!avi_->Next(&out->jpeg)) return false;
   } else {
     cv::Mat packet;
@@ -241,9 +195,9 @@ double FileSource::TimeOf(long long f) {
     case TimeSource::kFrameRate:
       return f / fps_;
     case TimeSource::kContainer: {
-      // Image files carry no capture times, raw packets none that OpenCV reports (an AVI read
-      // directly: a fixed rate).
-      if (jpeg_files_ || encoded_ || avi_) return f / fps_;
+      // Raw packets carry no capture times that OpenCV reports (an AVI read directly: a fixed
+      // rate).
+      if (encoded_ || avi_) return f / fps_;
       const double ms = capture_->get(cv::CAP_PROP_POS_MSEC);
       return std::isfinite(ms) ? ms / 1000.0 : f / fps_;
     }

@@ -3,7 +3,7 @@
 //   dir/%05d.jpg from one of 0..1000                 JPEG files kept encoded on request)
 //   a video file (or another image pattern)          file_source.cc (timestamps from the frame
 //                                                    rate, the container or a CSV; Motion-JPEG
-//                                                    and JPEG files kept encoded on request)
+//                                                    kept encoded on request)
 //   v4l2:/dev/videoN, camera:N                       v4l2_source.cc (kernel buffer timestamps)
 //   gst:PIPELINE, rtsp://...                         gstreamer_source.cc (stream timestamps)
 //   aravis:[DEVICE-ID]                               aravis_source.cc (GigE / USB3 Vision; only
