@@ -21,6 +21,18 @@
 namespace fv::recon {
 namespace {
 
+// How far (3D) a sample must lie from an arc to be off it: outlier_sigmas noise sigmas in each
+// axis, at least min_outlier_m.
+double OffArcM(const TrajectoryOptions& o, double noise_m) {
+  return std::max(o.min_outlier_m, o.outlier_sigmas * noise_m * std::sqrt(3.0));
+}
+
+// The top of the ground band: a ball centre at most this high is on the ground (resting height
+// plus ground_tolerance_m and 3 noise sigmas).
+double GroundBandTopM(const TrajectoryOptions& o, double noise_m) {
+  return o.ground_z_m + o.ball_radius_m + o.ground_tolerance_m + 3 * noise_m;
+}
+
 // The model's Magnus vector s = c_M w.
 Eigen::Vector3d MagnusVector(const BallisticModel& m) { return m.magnus_per_rad * m.spin_radps; }
 
@@ -801,16 +813,15 @@ struct Segmenter {
   std::vector<bool> FindGround(const std::vector<bool>& outlier) const {
     const int n = static_cast<int>(track.size());
     std::vector<bool> ground(n, false);
-    const double zr = o.ground_z_m + o.ball_radius_m;
-    const double tol = o.ground_tolerance_m + 3 * sigma;
+    const double top_m = GroundBandTopM(o, sigma);
     int i = 0;
     while (i < n) {
-      if (outlier[i] || track[i].ball_in_world.z() > zr + tol) {
+      if (outlier[i] || track[i].ball_in_world.z() > top_m) {
         ++i;
         continue;
       }
       int j = i, last = i;
-      while (j < n && (outlier[j] || track[j].ball_in_world.z() <= zr + tol)) {
+      while (j < n && (outlier[j] || track[j].ball_in_world.z() <= top_m)) {
         if (!outlier[j]) last = j;
         if (j > i && track[j].time_s - track[j - 1].time_s > o.max_gap_s) break;
         ++j;
@@ -1095,8 +1106,7 @@ void JoinGroundApproach(const std::vector<BallSample>& track, const std::vector<
   const int n = static_cast<int>(track.size());
   *lo = -std::numeric_limits<double>::infinity();
   *hi = std::numeric_limits<double>::infinity();
-  const double thr =
-      std::max(options.outlier_sigmas * noise_m * std::sqrt(3.0), options.min_outlier_m);
+  const double thr = OffArcM(options, noise_m);
   // On the arc, where the arc is not yet (or no longer) below the ground by more than 3 sigma:
   // a sample at rest after the arc came down belongs to the next phase, however near it lies.
   const double lowest_m = options.ground_z_m + options.ball_radius_m - 3 * noise_m;
@@ -1259,8 +1269,7 @@ std::vector<std::optional<FittedPiece>> FitPieces(const std::vector<BallSample>&
 bool RestsAtTrackEnd(const std::vector<BallSample>& track, const Piece& pc, const Flight& f,
                      const TrajectoryOptions& options, double noise_m) {
   if (pc.start != FlightEvent::kTrackStart && pc.end != FlightEvent::kTrackEnd) return false;
-  const double band_m =
-      options.ground_z_m + options.ball_radius_m + options.ground_tolerance_m + 3 * noise_m;
+  const double band_m = GroundBandTopM(options, noise_m);
   for (int k : f.samples) {
     if (track[k].ball_in_world.z() > band_m) return false;
   }
@@ -1360,12 +1369,12 @@ void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int
                      const TrajectoryOptions& options, double noise_m, std::vector<Flight>* flights,
                      std::vector<TrackBreak>* breaks) {
   std::vector<double> intervals_s;
+  intervals_s.reserve(track.size());
   for (size_t i = 1; i < track.size(); ++i) {
     intervals_s.push_back(track[i].time_s - track[i - 1].time_s);
   }
   const double sample_interval_s = util::NearestRankPercentile(intervals_s, 0.5);
-  const double off_m =
-      std::max(options.min_outlier_m, options.outlier_sigmas * noise_m * std::sqrt(3.0));
+  const double off_m = OffArcM(options, noise_m);
   const double zr = options.ground_z_m + options.ball_radius_m;
   const double ground_tol = options.ground_tolerance_m + 3 * noise_m + 0.05;
   for (size_t i = 0; i + 1 < flights->size(); ++i) {
