@@ -51,14 +51,19 @@ TEST(TrajectoryPredict, LandingFromTheFirstHalfWithin25cmAndInsideTheEllipse) {
   EXPECT_GE(inside, 15) << inside << " of " << total;
 }
 
-TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
-  testing::SeededRng rng(23);
+// A ball kicked at 0.2 s from (-6, 0) with `v_mps`, bouncing (restitution 0.6) until `duration_s`.
+BallSimOptions BouncingKick(const Eigen::Vector3d& v_mps, double duration_s) {
   BallSimOptions o;
   o.start_m = {-6, 0, 0.11};
-  o.kicks = {{0.2, {9, 1, 7}}};
+  o.kicks = {{0.2, v_mps}};
   o.restitution = 0.6;
-  o.duration_s = 3.0;
-  const BallSimulation sim(o);
+  o.duration_s = duration_s;
+  return o;
+}
+
+TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
+  testing::SeededRng rng(23);
+  const BallSimulation sim(BouncingKick({9, 1, 7}, 3.0));
   const double sigma = 0.02;
   const auto track = sim.Sample(50.0, sigma, 0.05, 0.02, 0.6, rng);
   TrajectoryOptions to;
@@ -91,12 +96,7 @@ TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
 // the smoother has no measurement there and gives them the arcs' positions, not their own.
 TEST(TrajectoryPredict, OutliersBetweenTwoFlightsTakeTheFlightsPositions) {
   testing::SeededRng rng(29);
-  BallSimOptions o;
-  o.start_m = {-6, 0, 0.11};
-  o.kicks = {{0.2, {8, 1, 6}}};
-  o.restitution = 0.6;
-  o.duration_s = 2.5;
-  const BallSimulation sim(o);
+  const BallSimulation sim(BouncingKick({8, 1, 6}, 2.5));
   auto track = sim.Sample(50.0, 0.005, 0.0, 0.0, 0.0, rng);
   const double t_bounce = sim.Flights().front().t_end_s;
   size_t after = 0;  // the first sample after the bounce
