@@ -106,7 +106,11 @@ TEST(ByteTracker, AppearanceKeepsIdsOfPeopleWalkingSideBySide) {
   const MotMetrics with = run(0.5);
   const MotMetrics without = run(0.0);
   // Seeds 1-20: no switch for 17, 1-2 for seeds 2, 6 and 15 (each with a detection left
-  // unmatched for a frame: 1-2 misses, one fragmentation).
+  // unmatched for a frame: 1-2 misses, one fragmentation). A limit of the tracker: at 6 of seeds
+  // 1-100 (25, 39, 51, 56, 75, 80) the walk loses the ids for a while (IDF1 0.70-0.94, up to 4
+  // switches): a track that took the other person's detection keeps that person's colours and
+  // a third track takes turns with it (over the 100 walks 34 switches with appearance, 358
+  // without).
   EXPECT_LE(with.id_switches, 2) << with.Summary();
   EXPECT_GT(with.idf1, 0.95) << with.Summary();
   EXPECT_LE(with.id_switches, without.id_switches) << without.Summary();
