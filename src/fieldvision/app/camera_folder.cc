@@ -21,8 +21,9 @@ std::vector<std::string> CameraFilesIn(const std::string& dir) {
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(dir)) {
     const std::string ext = e.path().extension().string();
-    if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml"))
+    if (e.is_regular_file() && (ext == ".yaml" || ext == ".yml")) {
       files.push_back(e.path().string());
+    }
   }
   std::sort(files.begin(), files.end());
   return files;

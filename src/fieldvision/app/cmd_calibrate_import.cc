@@ -119,6 +119,7 @@ void RunExport(const ExportCli& c) {
   }
   FV_REQUIRE(!files.empty(), "give --camera CAM.yaml (repeat) or --rig DIR");
   std::vector<camera::Camera> cams;
+  cams.reserve(files.size());
   for (const auto& f : files) cams.push_back(ReadNamedCamera(f));
   calib::WriteCalibrationToml(cams, c.toml);
   std::cout << "wrote " << c.toml << " (" << cams.size() << " cameras)\n";

@@ -18,7 +18,17 @@
 namespace fv::app {
 namespace {
 
-using namespace fv::calib;
+using fv::calib::CameraViews;
+using fv::calib::ImageSource;
+using fv::calib::MultiCoveragePicture;
+using fv::calib::MultiOptions;
+using fv::calib::MultiResult;
+using fv::calib::ParseCameraViews;
+using fv::calib::ParsePairing;
+using fv::calib::ParseTangentialModel;
+using fv::calib::TangentialModel;
+using fv::calib::WriteCalibrationToml;
+using fv::calib::WriteMultiCorners;
 
 struct MultiCli {
   std::string out, pairing = "auto", tangential = "auto";

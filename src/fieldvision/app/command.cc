@@ -68,9 +68,8 @@ CLI::Validator FiniteRange(double lo, double hi) {
 CLI::Validator Endpoint(bool bind) {
   return CLI::Validator(
       [bind](std::string& text) {
-        const std::string bad =
-            fmt::format("'{}' is not tcp://HOST:PORT (PORT 1..65535{}) or ipc://PATH", text,
-                        bind ? ", or * or 0 for a free one" : "");
+        std::string bad = fmt::format("'{}' is not tcp://HOST:PORT (PORT 1..65535{}) or ipc://PATH",
+                                      text, bind ? ", or * or 0 for a free one" : "");
         if (text.rfind("ipc://", 0) == 0) return text.size() > 6 ? std::string() : bad;
         if (text.rfind("tcp://", 0) != 0) return bad;
         const std::string rest = text.substr(6);

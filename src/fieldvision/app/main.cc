@@ -61,9 +61,7 @@ void QuietLibraries(bool verbose) {
   QuietGLib();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int Run(int argc, char** argv) {
   CLI::App app{
       "fieldvision: calibrate cameras against a sports field, find the ball, place it in 3D, fit "
       "its flight, plan camera rigs and track players."};
@@ -105,4 +103,17 @@ int main(int argc, char** argv) {
     return 1;
   }
   return exit_code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Run(argc, argv);
+  } catch (const std::exception& e) {  // while setting up, before the commands' own handling
+    std::cerr << "fieldvision: error: " << FirstLine(e.what()) << "\n";
+  } catch (...) {
+    std::cerr << "fieldvision: error: unknown exception\n";
+  }
+  return 1;
 }

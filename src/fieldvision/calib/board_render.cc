@@ -22,8 +22,9 @@ BoardPicture DrawBoard(const BoardSpec& b, double px_per_m) {
                         cv::Scalar(255));
     for (int r = 0; r <= b.rows; ++r) {
       for (int c = 0; c <= b.cols; ++c) {
-        if ((r + c) % 2 == 0)
+        if ((r + c) % 2 == 0) {
           out.image(cv::Rect(margin + c * sq, margin + r * sq, sq, sq)).setTo(0);
+        }
       }
     }
     // Inner corner (0, 0) is one square in from the board's corner, on the edge between picture

@@ -201,6 +201,7 @@ std::vector<Eigen::Vector2d> DetectLinePixels(const cv::Mat& image_bgr,
   RunCentres(mask, weight, max_width, false, &pixels);
   if (static_cast<int>(pixels.size()) > options.max_pixels) {
     std::vector<Eigen::Vector2d> kept;
+    kept.reserve(options.max_pixels);
     const double stride = static_cast<double>(pixels.size()) / options.max_pixels;
     for (int i = 0; i < options.max_pixels; ++i) {
       kept.push_back(pixels[static_cast<size_t>(i * stride)]);

@@ -275,6 +275,7 @@ std::vector<MultiFrame> PairViews(const std::vector<CameraDetections>& cameras, 
       }
     }
     std::vector<MultiFrame> out;
+    out.reserve(frames.size());
     for (auto& [f, m] : frames) out.push_back(std::move(m));
     return out;
   };
@@ -724,8 +725,8 @@ void AdjustRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOp
 }
 
 std::string ModelName(int num_distortion, bool tangential) {
-  static const char* kNames[] = {"k1", "k2", "p1", "p2", "k3", "k4",   "k5",
-                                 "k6", "s1", "s2", "s3", "s4", "tauX", "tauY"};
+  static const char* const kNames[] = {"k1", "k2", "p1", "p2", "k3", "k4",   "k5",
+                                       "k6", "s1", "s2", "s3", "s4", "tauX", "tauY"};
   std::string s;
   for (int i = 0; i < num_distortion; ++i) {
     if (!tangential && (i == 2 || i == 3)) continue;
@@ -1004,8 +1005,9 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
       static_cast<int>(std::floor(options.max_drop_fraction * state.NumUsedViews()));
   int dropped_total = 0;
   AdjustRig(&state, frames, options, max_drop, &dropped_total, &result);
-  if (options.tangential == TangentialModel::kAuto)
+  if (options.tangential == TangentialModel::kAuto) {
     ChooseTangential(&state, frames, options, &result);
+  }
   DescribeModels(state, options, &result);
   CollectCameras(names, frames, cams, state, options, &result);
   CollectPairs(frames, cams, state, options, &result);
@@ -1055,7 +1057,7 @@ cv::Mat MultiCoveragePicture(const MultiResult& result, int camera) {
   };
   // Grid of 4x4 cells with the number of used corners in each.
   const int grid = 4;
-  std::vector<int> counts(grid * grid, 0);
+  std::vector<int> counts(static_cast<size_t>(grid) * grid, 0);
   double max_err = 0.0;
   for (const auto& v : result.views) {
     if (v.camera != camera || !v.used) continue;

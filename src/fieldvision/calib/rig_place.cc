@@ -53,8 +53,9 @@ std::vector<geometry::Rigid3d> LinearRigPose(const std::vector<camera::Camera>& 
   bool planar = true;
   bool offset = false;
   for (const auto& o : obs) planar = planar && std::abs(o.p.z()) < 1e-9;
-  for (const auto& o : obs)
+  for (const auto& o : obs) {
     offset = offset || rig[o.camera].cam_from_world.translation.norm() > 1e-9;
+  }
   // Columns: R row-major (9), t (3), s (1); planar points drop R's third column (2, 5, 8).
   std::vector<int> cols;
   for (int k = 0; k < 13; ++k) {
@@ -68,7 +69,7 @@ std::vector<geometry::Rigid3d> LinearRigPose(const std::vector<camera::Camera>& 
     const auto n = cam.Undistort(obs[i].uv);
     if (!n) return {};
     Eigen::Matrix<double, 3, 13> m = Eigen::Matrix<double, 3, 13>::Zero();
-    for (int k = 0; k < 3; ++k) {
+    for (Eigen::Index k = 0; k < 3; ++k) {
       m.block<1, 3>(k, 3 * k) = obs[i].p.transpose();
       m(k, 9 + k) = 1.0;
     }

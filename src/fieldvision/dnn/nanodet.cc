@@ -82,10 +82,11 @@ std::vector<DnnBox> DecodeNanoDet(const std::vector<cv::Mat>& outputs, int net_w
       for (int class_id : classes) {
         const float score = c[idx * kCocoClasses + class_id];
         if (score < score_threshold) continue;
-        const double cx = (idx % fw + 0.5) * s, cy = (idx / fw + 0.5) * s;
+        const int col = idx % fw, row = idx / fw;  // the cell of this anchor
+        const double cx = (col + 0.5) * s, cy = (row + 0.5) * s;
         double side[4];
         for (int k = 0; k < 4; ++k) {
-          const float* bins = d + idx * 44 + k * kBins;
+          const float* bins = d + static_cast<ptrdiff_t>(idx * 44 + k * kBins);
           const float mx = *std::max_element(bins, bins + kBins);
           double sum = 0, mean = 0;
           for (int b = 0; b < kBins; ++b) {

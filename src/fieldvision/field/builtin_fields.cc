@@ -4,6 +4,8 @@
 // (FIBA), the centreline is offset by half a line width accordingly.
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "fieldvision/field/field.h"
 #include "fieldvision/util/error.h"
 
@@ -73,31 +75,31 @@ FieldModel Soccer(const std::string& name, const std::string& description, const
   b.Kp("centre_circle_right", s.centre_radius - h, 0);
   for (int side : {-1, 1}) {
     const std::string sn = SideName(side);
-    b.Seg("goal_line_" + sn, side * L2, -W2, side * L2, W2);
+    b.Seg(fmt::format("goal_line_{}", sn), side * L2, -W2, side * L2, W2);
     for (int t : {-1, 1}) {
       const std::string tn = YName(t);
-      b.Kp("corner_" + sn + "_" + tn, side * L2, t * W2);
+      b.Kp(fmt::format("corner_{}_{}", sn, tn), side * L2, t * W2);
       // Corner arc centred on the outer corner, inside the field.
       const double a0 = std::atan2(-t, -side);  // direction from the corner into the field
-      b.Arc("corner_arc_" + sn + "_" + tn, side * s.length / 2, t * s.width / 2,
+      b.Arc(fmt::format("corner_arc_{}_{}", sn, tn), side * s.length / 2, t * s.width / 2,
             s.corner_radius - h, a0 - M_PI / 4, a0 + M_PI / 4);
     }
     // Penalty area.
     const double xp = side * (s.length / 2 - s.penalty_depth + h);
     const double yp = s.penalty_width / 2 - h;
     if (!s.futsal_area) {
-      b.Seg("penalty_area_" + sn + "_front", xp, -yp, xp, yp);
+      b.Seg(fmt::format("penalty_area_{}_front", sn), xp, -yp, xp, yp);
       for (int t : {-1, 1}) {
         const std::string tn = YName(t);
-        b.Seg("penalty_area_" + sn + "_" + tn, side * L2, t * yp, xp, t * yp);
-        b.Kp("penalty_area_" + sn + "_" + tn + "_goal_line", side * L2, t * yp);
-        b.Kp("penalty_area_" + sn + "_" + tn, xp, t * yp);
+        b.Seg(fmt::format("penalty_area_{}_{}", sn, tn), side * L2, t * yp, xp, t * yp);
+        b.Kp(fmt::format("penalty_area_{}_{}_goal_line", sn, tn), side * L2, t * yp);
+        b.Kp(fmt::format("penalty_area_{}_{}", sn, tn), xp, t * yp);
       }
     } else {
       // Futsal: quarter circles of radius penalty_depth around the outside of each post.
       const double yq = s.goal_width / 2 + s.line;
       const double r = s.penalty_depth - h;
-      b.Seg("penalty_area_" + sn + "_front", side * (L2 - r), -yq, side * (L2 - r), yq);
+      b.Seg(fmt::format("penalty_area_{}_front", sn), side * (L2 - r), -yq, side * (L2 - r), yq);
       for (int t : {-1, 1}) {
         const std::string tn = YName(t);
         // From the direction into the field (towards x = 0) to the direction of the touch line.
@@ -105,29 +107,29 @@ FieldModel Soccer(const std::string& name, const std::string& description, const
         const double towards = t > 0 ? M_PI / 2 : -M_PI / 2;
         double a0 = std::min(into, towards), a1 = std::max(into, towards);
         if (a1 - a0 > M_PI) std::swap(a0, a1), a1 += 2 * M_PI;
-        b.Arc("penalty_area_" + sn + "_" + tn, side * L2, t * yq, r, a0, a1);
-        b.Kp("penalty_area_" + sn + "_" + tn + "_goal_line", side * L2, t * (yq + r));
-        b.Kp("penalty_area_" + sn + "_" + tn, side * (L2 - r), t * yq);
+        b.Arc(fmt::format("penalty_area_{}_{}", sn, tn), side * L2, t * yq, r, a0, a1);
+        b.Kp(fmt::format("penalty_area_{}_{}_goal_line", sn, tn), side * L2, t * (yq + r));
+        b.Kp(fmt::format("penalty_area_{}_{}", sn, tn), side * (L2 - r), t * yq);
       }
     }
     if (s.goal_area_depth > 0) {
       const double xg = side * (s.length / 2 - s.goal_area_depth + h);
       const double yg = s.goal_area_width / 2 - h;
-      b.Seg("goal_area_" + sn + "_front", xg, -yg, xg, yg);
+      b.Seg(fmt::format("goal_area_{}_front", sn), xg, -yg, xg, yg);
       for (int t : {-1, 1}) {
         const std::string tn = YName(t);
-        b.Seg("goal_area_" + sn + "_" + tn, side * L2, t * yg, xg, t * yg);
-        b.Kp("goal_area_" + sn + "_" + tn + "_goal_line", side * L2, t * yg);
-        b.Kp("goal_area_" + sn + "_" + tn, xg, t * yg);
+        b.Seg(fmt::format("goal_area_{}_{}", sn, tn), side * L2, t * yg, xg, t * yg);
+        b.Kp(fmt::format("goal_area_{}_{}_goal_line", sn, tn), side * L2, t * yg);
+        b.Kp(fmt::format("goal_area_{}_{}", sn, tn), xg, t * yg);
       }
     }
     const double xm = side * (s.length / 2 - s.penalty_mark);
-    b.Spot("penalty_mark_" + sn, xm, 0, s.spot_diameter);
-    b.Kp("penalty_mark_" + sn, xm, 0);
+    b.Spot(fmt::format("penalty_mark_{}", sn), xm, 0, s.spot_diameter);
+    b.Kp(fmt::format("penalty_mark_{}", sn), xm, 0);
     if (s.second_mark > 0) {
       const double x2 = side * (s.length / 2 - s.second_mark);
-      b.Spot("second_penalty_mark_" + sn, x2, 0, s.spot_diameter);
-      b.Kp("second_penalty_mark_" + sn, x2, 0);
+      b.Spot(fmt::format("second_penalty_mark_{}", sn), x2, 0, s.spot_diameter);
+      b.Kp(fmt::format("second_penalty_mark_{}", sn), x2, 0);
     }
     if (s.penalty_arc_radius > 0) {
       const double r = s.penalty_arc_radius - h;
@@ -135,11 +137,11 @@ FieldModel Soccer(const std::string& name, const std::string& description, const
       if (dx < r) {
         const double theta = std::acos(dx / r);
         const double dir = side < 0 ? 0.0 : M_PI;
-        b.Arc("penalty_arc_" + sn, xm, 0, r, dir - theta, dir + theta);
+        b.Arc(fmt::format("penalty_arc_{}", sn), xm, 0, r, dir - theta, dir + theta);
       }
     }
     FieldGoal g;
-    g.name = "goal_" + sn;
+    g.name = fmt::format("goal_{}", sn);
     g.side = side;
     g.line_x_m = side * L2;
     g.y_min_m = -s.goal_width / 2;
@@ -151,8 +153,8 @@ FieldModel Soccer(const std::string& name, const std::string& description, const
     for (int t : {-1, 1}) {
       const std::string tn = YName(t);
       const double yp_post = t * (s.goal_width / 2 + h);
-      b.Kp("goal_" + sn + "_post_" + tn, side * L2, yp_post, 0);
-      b.Kp("goal_" + sn + "_post_" + tn + "_high", side * L2, yp_post, s.goal_height);
+      b.Kp(fmt::format("goal_{}_post_{}", sn, tn), side * L2, yp_post, 0);
+      b.Kp(fmt::format("goal_{}_post_{}_high", sn, tn), side * L2, yp_post, s.goal_height);
     }
   }
   f.Check();
@@ -182,17 +184,17 @@ FieldModel Basketball() {
   b.Kp("centre_circle_right", 1.80 - h, 0);
   for (int side : {-1, 1}) {
     const std::string sn = SideName(side);
-    b.Seg("end_line_" + sn, side * L2, -W2, side * L2, W2);
+    b.Seg(fmt::format("end_line_{}", sn), side * L2, -W2, side * L2, W2);
     const double xb = side * (14.0 - 1.575);  // below the basket centre
     // Restricted area: 4.90 m wide (outer edges), free-throw line's far edge 5.80 m from the
     // end line's inner edge.
     const double yk = 2.45 - h;
     const double xf = side * (14.0 - 5.80 + h);
-    b.Seg("free_throw_line_" + sn, xf, -yk, xf, yk);
-    b.Arc("free_throw_circle_" + sn, xf, 0, 1.80 - h, side < 0 ? -M_PI / 2 : M_PI / 2,
+    b.Seg(fmt::format("free_throw_line_{}", sn), xf, -yk, xf, yk);
+    b.Arc(fmt::format("free_throw_circle_{}", sn), xf, 0, 1.80 - h, side < 0 ? -M_PI / 2 : M_PI / 2,
           side < 0 ? M_PI / 2 : 3 * M_PI / 2);
-    b.Kp("free_throw_" + sn + "_centre", xf, 0);
-    b.Kp("free_throw_circle_" + sn, xf - side * (1.80 - h), 0);
+    b.Kp(fmt::format("free_throw_{}_centre", sn), xf, 0);
+    b.Kp(fmt::format("free_throw_circle_{}", sn), xf - side * (1.80 - h), 0);
     // Three-point line: arc of 6.75 m (outer edge) around the basket, straight parts 0.90 m from
     // the side lines' inner edges.
     const double r3 = 6.75 - h;
@@ -200,27 +202,27 @@ FieldModel Basketball() {
     const double dx3 = std::sqrt(r3 * r3 - y3 * y3);
     const double theta = std::atan2(y3, dx3);
     const double dir = side < 0 ? 0.0 : M_PI;
-    b.Arc("three_point_arc_" + sn, xb, 0, r3, dir - theta, dir + theta);
-    b.Kp("three_point_" + sn + "_centre", xb - side * r3, 0);
+    b.Arc(fmt::format("three_point_arc_{}", sn), xb, 0, r3, dir - theta, dir + theta);
+    b.Kp(fmt::format("three_point_{}_centre", sn), xb - side * r3, 0);
     // No-charge semicircle: 1.25 m to its inner edge.
-    b.Arc("no_charge_" + sn, xb, 0, 1.25 + h, dir - M_PI / 2, dir + M_PI / 2);
+    b.Arc(fmt::format("no_charge_{}", sn), xb, 0, 1.25 + h, dir - M_PI / 2, dir + M_PI / 2);
     for (int t : {-1, 1}) {
       const std::string tn = YName(t);
-      b.Kp("corner_" + sn + "_" + tn, side * L2, t * W2);
-      b.Seg("restricted_area_" + sn + "_" + tn, side * L2, t * yk, xf, t * yk);
-      b.Kp("restricted_area_" + sn + "_" + tn + "_end_line", side * L2, t * yk);
-      b.Kp("restricted_area_" + sn + "_" + tn, xf, t * yk);
-      b.Seg("three_point_" + sn + "_" + tn, side * L2, t * y3, xb - side * dx3, t * y3);
-      b.Kp("three_point_" + sn + "_" + tn + "_end_line", side * L2, t * y3);
-      b.Kp("three_point_" + sn + "_" + tn, xb - side * dx3, t * y3);
+      b.Kp(fmt::format("corner_{}_{}", sn, tn), side * L2, t * W2);
+      b.Seg(fmt::format("restricted_area_{}_{}", sn, tn), side * L2, t * yk, xf, t * yk);
+      b.Kp(fmt::format("restricted_area_{}_{}_end_line", sn, tn), side * L2, t * yk);
+      b.Kp(fmt::format("restricted_area_{}_{}", sn, tn), xf, t * yk);
+      b.Seg(fmt::format("three_point_{}_{}", sn, tn), side * L2, t * y3, xb - side * dx3, t * y3);
+      b.Kp(fmt::format("three_point_{}_{}_end_line", sn, tn), side * L2, t * y3);
+      b.Kp(fmt::format("three_point_{}_{}", sn, tn), xb - side * dx3, t * y3);
     }
     FieldHoop hoop;
-    hoop.name = "hoop_" + sn;
+    hoop.name = fmt::format("hoop_{}", sn);
     hoop.centre_m = {xb, 0, 3.05};
     hoop.radius_m = 0.225;
     f.hoops.push_back(hoop);
-    b.Kp("hoop_" + sn, xb, 0, 3.05);
-    b.Kp("basket_" + sn + "_floor", xb, 0, 0);
+    b.Kp(fmt::format("hoop_{}", sn), xb, 0, 3.05);
+    b.Kp(fmt::format("basket_{}_floor", sn), xb, 0, 0);
   }
   f.Check();
   return f;
@@ -243,26 +245,26 @@ FieldModel Tennis() {
   const double xs = 6.40 - h;
   for (int t : {-1, 1}) {
     const std::string tn = YName(t);
-    b.Seg("doubles_side_line_" + tn, -xb, t * yd, xb, t * yd);
-    b.Seg("singles_side_line_" + tn, -xb, t * ys, xb, t * ys);
-    b.Kp("net_post_" + tn, 0, t * (5.485 + 0.914), 1.07);
-    b.Kp("net_" + tn + "_doubles", 0, t * yd, 0);
+    b.Seg(fmt::format("doubles_side_line_{}", tn), -xb, t * yd, xb, t * yd);
+    b.Seg(fmt::format("singles_side_line_{}", tn), -xb, t * ys, xb, t * ys);
+    b.Kp(fmt::format("net_post_{}", tn), 0, t * (5.485 + 0.914), 1.07);
+    b.Kp(fmt::format("net_{}_doubles", tn), 0, t * yd, 0);
   }
   b.Seg("centre_service_line", -xs, 0, xs, 0);
   b.Kp("net_centre", 0, 0, 0.914);
   b.Kp("net_centre_ground", 0, 0, 0);
   for (int side : {-1, 1}) {
     const std::string sn = SideName(side);
-    b.Seg("baseline_" + sn, side * xb, -yd, side * xb, yd, 0.10);
-    b.Seg("service_line_" + sn, side * xs, -ys, side * xs, ys);
-    b.Seg("centre_mark_" + sn, side * xb, 0, side * (11.885 - 0.10 - 0.10), 0);
-    b.Kp("centre_mark_" + sn, side * xb, 0);
-    b.Kp("service_" + sn + "_centre", side * xs, 0);
+    b.Seg(fmt::format("baseline_{}", sn), side * xb, -yd, side * xb, yd, 0.10);
+    b.Seg(fmt::format("service_line_{}", sn), side * xs, -ys, side * xs, ys);
+    b.Seg(fmt::format("centre_mark_{}", sn), side * xb, 0, side * (11.885 - 0.10 - 0.10), 0);
+    b.Kp(fmt::format("centre_mark_{}", sn), side * xb, 0);
+    b.Kp(fmt::format("service_{}_centre", sn), side * xs, 0);
     for (int t : {-1, 1}) {
       const std::string tn = YName(t);
-      b.Kp("corner_" + sn + "_" + tn, side * xb, t * yd);
-      b.Kp("singles_corner_" + sn + "_" + tn, side * xb, t * ys);
-      b.Kp("service_" + sn + "_" + tn, side * xs, t * ys);
+      b.Kp(fmt::format("corner_{}_{}", sn, tn), side * xb, t * yd);
+      b.Kp(fmt::format("singles_corner_{}_{}", sn, tn), side * xb, t * ys);
+      b.Kp(fmt::format("service_{}_{}", sn, tn), side * xs, t * ys);
     }
   }
   f.Check();
@@ -286,18 +288,18 @@ FieldModel TableTennis() {
   const double xe = 1.37 - 0.01, ye = 0.7625 - 0.01;  // centrelines of the 2 cm edge lines
   for (int t : {-1, 1}) {
     const std::string tn = YName(t);
-    b.Seg("side_line_" + tn, -1.37, t * ye, 1.37, t * ye);
-    b.Kp("net_post_" + tn, 0, t * (0.7625 + 0.1525), 0.1525);
-    b.Kp("net_" + tn, 0, t * 0.7625, 0);
-    b.Kp("net_top_" + tn, 0, t * 0.7625, 0.1525);
+    b.Seg(fmt::format("side_line_{}", tn), -1.37, t * ye, 1.37, t * ye);
+    b.Kp(fmt::format("net_post_{}", tn), 0, t * (0.7625 + 0.1525), 0.1525);
+    b.Kp(fmt::format("net_{}", tn), 0, t * 0.7625, 0);
+    b.Kp(fmt::format("net_top_{}", tn), 0, t * 0.7625, 0.1525);
   }
   b.Kp("net_top_centre", 0, 0, 0.1525);
   b.Seg("centre_line", -1.37, 0, 1.37, 0, 0.003);
   for (int side : {-1, 1}) {
     const std::string sn = SideName(side);
-    b.Seg("end_line_" + sn, side * xe, -0.7625, side * xe, 0.7625);
-    b.Kp("centre_line_end_" + sn, side * 1.37, 0);
-    for (int t : {-1, 1}) b.Kp("corner_" + sn + "_" + YName(t), side * 1.37, t * 0.7625);
+    b.Seg(fmt::format("end_line_{}", sn), side * xe, -0.7625, side * xe, 0.7625);
+    b.Kp(fmt::format("centre_line_end_{}", sn), side * 1.37, 0);
+    for (int t : {-1, 1}) b.Kp(fmt::format("corner_{}_", sn) + YName(t), side * 1.37, t * 0.7625);
   }
   f.Check();
   return f;

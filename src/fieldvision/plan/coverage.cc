@@ -203,6 +203,7 @@ CoverageResult EvaluateCoverage(const std::vector<camera::Camera>& cameras,
   const int nx = std::max(1, static_cast<int>(std::lround(2 * half_x / options.grid_step_m)));
   const int ny = std::max(1, static_cast<int>(std::lround(2 * half_y / options.grid_step_m)));
   std::vector<Eigen::Vector3d> centres;
+  centres.reserve(cameras.size());
   for (const camera::Camera& c : cameras) centres.push_back(c.CentreInWorld());
   util::Progress progress("coverage", static_cast<long long>(heights.size()) * ny, "rows",
                           options.progress);

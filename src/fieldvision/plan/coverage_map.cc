@@ -49,6 +49,7 @@ std::vector<std::vector<cv::Point>> Footprint(const camera::Camera& cam, double 
                                               const field::TopView& view, double max_range_m) {
   std::vector<Eigen::Vector2d> border;
   const int steps = 60;
+  border.reserve(4 * steps + 1);
   const double w = cam.width - 0.5, h = cam.height - 0.5;
   for (int s = 0; s < steps; ++s) border.emplace_back(-0.5 + (w + 0.5) * s / steps, -0.5);
   for (int s = 0; s < steps; ++s) border.emplace_back(w, -0.5 + (h + 0.5) * s / steps);

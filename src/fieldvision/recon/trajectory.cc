@@ -579,8 +579,9 @@ ConstantAccelerationFit FitConstantAcceleration(const std::vector<BallSample>& s
   f.v0_mps = X.row(1).transpose();
   f.accel_mps2 = X.row(2).transpose();
   double ss = 0;
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
     ss += (f.PositionAt(samples[i].time_s) - samples[i].ball_in_world).squaredNorm();
+  }
   f.rmse_m = std::sqrt(ss / n);
   f.ok = true;
   return f;

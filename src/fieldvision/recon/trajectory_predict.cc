@@ -66,6 +66,7 @@ LandingPrediction PredictLanding(const std::vector<BallSample>& samples, FlightM
   }
   if (static_cast<int>(used.size()) < 4) return pr;
   std::vector<double> used_times;
+  used_times.reserve(used.size());
   for (int i : used) used_times.push_back(samples[i].time_s);
   Eigen::MatrixXd J(3 * used.size(), np);
   Eigen::Matrix<double, 3, Eigen::Dynamic> JL(3, np);

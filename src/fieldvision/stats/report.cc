@@ -247,6 +247,9 @@ document.querySelectorAll('table.sortable th').forEach(function (th, col) {
 
 // What the report's parts share.
 struct ReportParts {
+  ReportParts(const StatsResult& r, const StatsOptions& o, std::string out_dir,
+              const field::TopView& view)
+      : r(r), o(o), out_dir(std::move(out_dir)), view(view) {}
   const StatsResult& r;
   const StatsOptions& o;
   std::string out_dir;
@@ -265,7 +268,7 @@ std::vector<std::string> BandNames(const StatsOptions& o) {
     const std::string lo = b == 0 ? "0" : fmt::format("{:g}", o.speed_bands_mps[b - 1]);
     const std::string hi =
         b < o.speed_bands_mps.size() ? fmt::format("{:g}", o.speed_bands_mps[b]) : "up";
-    band_names.push_back(lo + "-" + hi);
+    band_names.push_back(fmt::format("{}-{}", lo, hi));
   }
   return band_names;
 }
@@ -507,7 +510,7 @@ ReportFiles WriteStatsReport(const StatsResult& r, const field::FieldModel& fiel
   FV_REQUIRE(!ec && fs::is_directory(out_dir), "cannot create output folder '{}'", out_dir);
   ReportFiles files;
   // Heat maps: every player and the extent of all positions beyond the field.
-  ReportParts rp{r, o, out_dir, field::TopView::ForField(field, o.image_width_px, 2.0)};
+  ReportParts rp(r, o, out_dir, field::TopView::ForField(field, o.image_width_px, 2.0));
   WriteHeatMaps(field, rp, files);
   for (const auto& s : r.tracks) {
     rp.t0 = std::min(rp.t0, s.time_s.front());

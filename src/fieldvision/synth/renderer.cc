@@ -646,7 +646,7 @@ struct Pentagons {
 };
 
 const Pentagons& FootballPentagons() {
-  static const Pentagons p = [] {
+  static const Pentagons kPentagons = [] {
     Pentagons out;
     const double phi = 0.5 * (1 + std::sqrt(5.0));
     int k = 0;
@@ -681,7 +681,7 @@ const Pentagons& FootballPentagons() {
     }
     return out;
   }();
-  return p;
+  return kPentagons;
 }
 
 // Share of the pattern's print at a point x (unit vector in the ball's frame); px: a pixel's

@@ -384,8 +384,9 @@ SceneSpec LowSunKickPreset(uint64_t seed) {
   // Backspin of 8 turns per second about the horizontal axis across the flight.
   for (KickSpec& k : s.ball.kicks) {
     const Eigen::Vector3d v(k.velocity_mps.x(), k.velocity_mps.y(), 0.0);
-    if (v.norm() > 1e-9)
+    if (v.norm() > 1e-9) {
       k.spin_radps = 2 * M_PI * 8.0 * v.normalized().cross(Eigen::Vector3d::UnitZ());
+    }
   }
   return s;
 }

@@ -67,6 +67,7 @@ std::vector<Detection> Nms(const std::vector<Detection>& detections, double iou_
   cv::dnn::NMSBoxes(boxes, scores, static_cast<float>(score_threshold),
                     static_cast<float>(iou_threshold), keep);
   std::vector<Detection> out;
+  out.reserve(keep.size());
   for (int i : keep) out.push_back(detections[i]);
   std::sort(out.begin(), out.end(),
             [](const Detection& a, const Detection& b) { return a.score > b.score; });
@@ -337,11 +338,13 @@ std::unique_ptr<PersonDetector> MakeDetector(const DetectorOptions& options,
                                              const camera::Camera* camera, FootFilter filter) {
   options.Check();
   if (options.threads > 0) cv::setNumThreads(options.threads);
-  if (options.kind == "nanodet")
+  if (options.kind == "nanodet") {
     return std::make_unique<NanoDetDetector>(options, std::move(filter));
+  }
   if (options.kind == "hog") return std::make_unique<HogDetector>(options, std::move(filter));
-  if (options.kind == "motion")
+  if (options.kind == "motion") {
     return std::make_unique<MotionDetector>(options, camera, std::move(filter));
+  }
   return std::make_unique<OnnxYoloDetector>(options, std::move(filter));
 }
 

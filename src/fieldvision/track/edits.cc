@@ -64,8 +64,9 @@ std::vector<int> TopLevelElementLines(const std::string& text) {
 
 int IdFrom(const json& v, const std::string& where) {
   if (v.is_number_integer()) return v.get<int>();
-  if (v.is_string())
+  if (v.is_string()) {
     return static_cast<int>(util::ParseInt(util::Trim(v.get<std::string>()), where + " id"));
+  }
   Throw("{}: expected an id (a whole number), got {}", where, v.dump());
 }
 
@@ -104,7 +105,7 @@ TrackEdits ParseTrackEdits(const std::string& text, const std::string& path) {
     const json& arg = v.begin().value();
     if (op == "merge" || op == "drop") {
       e.kind = op == "merge" ? TrackEdit::Kind::kMerge : TrackEdit::Kind::kDrop;
-      e.ids = IdList(arg, where + ": " + op);
+      e.ids = IdList(arg, fmt::format("{}: {}", where, op));
       FV_REQUIRE(op != "merge" || e.ids.size() >= 2, "{}: merge needs two or more ids", where);
       FV_REQUIRE(!e.ids.empty(), "{}: {} needs one or more ids", where, op);
     } else if (op == "rename" || op == "team") {
@@ -114,7 +115,7 @@ TrackEdits ParseTrackEdits(const std::string& text, const std::string& path) {
       for (const auto& [k, val] : arg.items()) {
         FV_REQUIRE(val.is_number_integer(), "{}: {}: the value for id {} must be a whole number",
                    where, op, k);
-        e.to[IdFrom(json(k), where + ": " + op)] = val.get<int>();
+        e.to[IdFrom(json(k), fmt::format("{}: {}", where, op))] = val.get<int>();
       }
     } else if (op == "name") {
       e.kind = TrackEdit::Kind::kName;
@@ -151,8 +152,9 @@ Roster ReadRoster(const std::string& path) {
     const int id = static_cast<int>(t.GetInt(i, "id"));
     const int team = static_cast<int>(t.GetInt(i, "team"));
     if (team >= 0) r.team_of[id] = team;
-    if (t.Has("name") && !util::Trim(t.Get(i, "name")).empty())
+    if (t.Has("name") && !util::Trim(t.Get(i, "name")).empty()) {
       r.name_of[id] = util::Trim(t.Get(i, "name"));
+    }
   }
   return r;
 }

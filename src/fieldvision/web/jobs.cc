@@ -54,12 +54,9 @@ std::vector<std::string> CheckJobArguments(const Workspace& ws, const std::strin
       argv.push_back(a);
       continue;
     }
-    if (kInputs.count(option)) {
-      argv.push_back(ws.Resolve(a, true).string());
-    } else if (kOutputs.count(option)) {
-      argv.push_back(ws.Resolve(a, false).string());
-    } else if (kNameOrFile.count(option) && LooksLikePath(a)) {
-      argv.push_back(ws.Resolve(a, true).string());
+    const bool input = kInputs.count(option) || (kNameOrFile.count(option) && LooksLikePath(a));
+    if (input || kOutputs.count(option)) {
+      argv.push_back(ws.Resolve(a, input).string());
     } else if (LooksLikePath(a) || a.find('/') != std::string::npos) {
       throw HttpError(400, "job argument '" + a + "' looks like a path, but " +
                                (option.empty() ? "no option" : "option " + option) +
@@ -130,6 +127,7 @@ int JobRunner::Start(const std::string& command, const std::vector<std::string>&
     return a;
   }();
   std::vector<char*> argv;
+  argv.reserve(argv_strings.size() + 1);
   for (const auto& s : argv_strings) argv.push_back(const_cast<char*>(s.c_str()));
   argv.push_back(nullptr);
   const std::string root = workspace_.root().string();

@@ -40,7 +40,7 @@ namespace {
 
 // The front end as built in the source tree, else as installed (share/fieldvision/studio).
 fs::path DefaultAssetsDir() {
-  const fs::path built(FV_STUDIO_DIST);
+  fs::path built(FV_STUDIO_DIST);
   std::error_code ec;
   if (fs::is_regular_file(built / "index.html", ec)) return built;
   const fs::path installed = util::InstalledDataDir() / "studio";
