@@ -43,7 +43,7 @@ struct BenchFrame {
 };
 
 const BenchFrame& TestFrame() {
-  static const BenchFrame frame = [] {
+  static const BenchFrame kFrame = [] {
     cv::setNumThreads(1);
     BenchFrame f;
 #ifdef FV_BENCH_HAVE_SYNTH
@@ -62,7 +62,7 @@ const BenchFrame& TestFrame() {
 #endif
     return f;
   }();
-  return frame;
+  return kFrame;
 }
 
 // The OpenCV job: HSV conversion, the same orange range, 8-connected components with stats.
@@ -78,7 +78,7 @@ int OpenCvJob(const cv::Mat& bgr, cv::Mat& hsv, cv::Mat& mask, cv::Mat& labels, 
 
 // Seconds per frame of the OpenCV job (median of 25 runs), measured once.
 double BaselineSeconds() {
-  static const double seconds = [] {
+  static const double kSeconds = [] {
     const BenchFrame& f = TestFrame();
     cv::Mat hsv, mask, labels, stats, centroids;
     std::vector<double> t;
@@ -90,7 +90,7 @@ double BaselineSeconds() {
     std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
     return t[t.size() / 2];
   }();
-  return seconds;
+  return kSeconds;
 }
 
 void SetCounters(benchmark::State& state, double total_s) {
@@ -176,7 +176,7 @@ BENCHMARK(BM_BallDetector)
 // accepted, so the small-ball stage (detect/small_ball.h; "auto", the default without a camera,
 // against "off") searches the whole frame, then the field check of its spots.
 void BM_BallDetectorNoBallNoCamera(benchmark::State& state) {
-  static const cv::Mat no_ball = [] {
+  static const cv::Mat kNoBall = [] {
     fv::util::Rng rng(2);
     return fv::detect::test_util::FieldImage(1280, 960, rng);
   }();
@@ -188,7 +188,7 @@ void BM_BallDetectorNoBallNoCamera(benchmark::State& state) {
   double total = 0;
   for (auto _ : state) {
     const double t0 = CpuSeconds();
-    accepted = det.DetectWithSummary(no_ball).accepted();
+    accepted = det.DetectWithSummary(kNoBall).accepted();
     total += CpuSeconds() - t0;
   }
   SetCounters(state, total);
@@ -233,7 +233,7 @@ BENCHMARK(BM_BallFit)->Unit(benchmark::kMicrosecond);
 
 // Seconds per frame of the colour detector (step 2, region stage on; median of 9 runs), once.
 double ColourSeconds() {
-  static const double seconds = [] {
+  static const double kSeconds = [] {
     const BenchFrame& f = TestFrame();
     const fv::detect::BallDetector det(fv::detect::BallDetectorOptions(), &f.camera, nullptr);
     std::vector<double> t;
@@ -245,7 +245,7 @@ double ColourSeconds() {
     std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
     return t[t.size() / 2];
   }();
-  return seconds;
+  return kSeconds;
 }
 
 // The DNN path on the same frame (one thread). Args: mode (1 dnn, 2 both), whole_frame (both:

@@ -42,7 +42,7 @@ struct Clip {
 
 // Frames 10..69 of the kick scene (rest, the kick at 0.25 s, the flight), camera 1, 1280x960.
 const Clip& KickClip() {
-  static const Clip clip = [] {
+  static const Clip kClip = [] {
     cv::setNumThreads(1);
     fv::synth::SceneSpec spec = fv::synth::Preset("kick", 1);
     fv::synth::ResizeCameras(spec, 1280, 960);
@@ -59,11 +59,11 @@ const Clip& KickClip() {
     }
     return c;
   }();
-  return clip;
+  return kClip;
 }
 
 double BaselineSeconds() {  // whole decode of one frame, median of 3 passes
-  static const double seconds = [] {
+  static const double kSeconds = [] {
     const Clip& c = KickClip();
     fv::io::JpegRegionDecoder decoder;
     cv::Mat bgr;
@@ -78,7 +78,7 @@ double BaselineSeconds() {  // whole decode of one frame, median of 3 passes
     std::sort(t.begin(), t.end());
     return t[1];
   }();
-  return seconds;
+  return kSeconds;
 }
 
 void SetCounters(benchmark::State& state, double total_s) {

@@ -11,11 +11,11 @@
 namespace {
 
 const fv::synth::SceneRenderer& Scene() {
-  static const auto scene = [] {
+  static const auto kScene = [] {
     fv::synth::SceneSpec s = fv::synth::Preset("kick", 1);
     return std::make_unique<fv::synth::SceneRenderer>(s);
   }();
-  return *scene;
+  return *kScene;
 }
 
 // Baseline: copy the background image (one pass over the pixels).

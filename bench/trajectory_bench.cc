@@ -45,7 +45,7 @@ fv::recon::TrajectoryOptions TableTennis() {
 
 // The samples of 001.csv before its bounce.
 const std::vector<fv::recon::BallSample>& Flight() {
-  static const auto samples = [] {
+  static const auto kSamples = [] {
     std::vector<fv::recon::BallSample> s;
     const std::string p = kGt + "/001.csv";
     if (!std::filesystem::exists(p)) return s;
@@ -57,7 +57,7 @@ const std::vector<fv::recon::BallSample>& Flight() {
     }
     return s;
   }();
-  return samples;
+  return kSamples;
 }
 
 void Fit(benchmark::State& state, fv::recon::FlightModel kind) {
@@ -103,7 +103,7 @@ struct FlightScene {
 
 // A 1 s kick with backspin at 60 Hz seen by four corner cameras, centres with 0.3 px noise.
 const FlightScene& KickScene() {
-  static const FlightScene scene = [] {
+  static const FlightScene kScene = [] {
     FlightScene f;
     const Eigen::Vector3d eyes[4] = {{-12, -9, 5}, {12, -9, 5}, {12, 9, 5}, {-12, 9, 5}};
     for (const auto& eye : eyes) {
@@ -127,7 +127,7 @@ const FlightScene& KickScene() {
     }
     return f;
   }();
-  return scene;
+  return kScene;
 }
 
 // The baseline: one Jet integration from the reference time per detection.
@@ -188,7 +188,7 @@ double RefineFlight(bool shared_path) {
 
 // Seconds (thread CPU) of the baseline's fit, median of 5, measured once.
 double JetFitSeconds() {
-  static const double seconds = [] {
+  static const double kSeconds = [] {
     std::vector<double> t;
     for (int i = 0; i < 5; ++i) {
       const double t0 = ThreadCpuSeconds();
@@ -198,7 +198,7 @@ double JetFitSeconds() {
     std::nth_element(t.begin(), t.begin() + 2, t.end());
     return t[2];
   }();
-  return seconds;
+  return kSeconds;
 }
 
 void BM_RefineFlightOnDetections(benchmark::State& state) {
@@ -294,6 +294,7 @@ int main(int argc, char** argv) {
     }
     std::sort(files.begin(), files.end());
     std::vector<fv::recon::BounceTrackScore> scores;
+    scores.reserve(files.size());
     for (const auto& p : files) {
       scores.push_back(
           fv::recon::ScoreBounceTrack(p, fv::recon::ReadBallTrack(p).samples, TableTennis()));

@@ -93,6 +93,7 @@ BoardView ProjectView(const camera::Camera& cam, const BoardSpec& b,
 
 std::vector<std::string> Names(const std::vector<camera::Camera>& cams) {
   std::vector<std::string> n;
+  n.reserve(cams.size());
   for (const auto& c : cams) n.push_back(c.name);
   return n;
 }

@@ -34,8 +34,8 @@ struct Rendered {
   std::vector<cv::Mat> frames = scene.Render(0);
 };
 const Rendered& Scene() {
-  static const Rendered rendered;
-  return rendered;
+  static const Rendered kRendered;
+  return kRendered;
 }
 
 // Six clicks with 1 px noise place the rig within a few centimetres; the lines seen by all four

@@ -36,6 +36,7 @@ TEST(Rig, JointRefinementMovesEveryCameraTowardsTheTruth) {
   const auto truth = ThreeCameras();
   // Shared free points (a ball held at several places, unknown position) and field keypoints.
   std::vector<Eigen::Vector3d> balls;
+  balls.reserve(12);
   for (int i = 0; i < 12; ++i) {
     balls.emplace_back(rng.Uniform(-7, 7), rng.Uniform(-5, 5), rng.Uniform(0.1, 2.5));
   }

@@ -84,6 +84,7 @@ TEST(Codecs, DamagedImagesAreQuiet) {
   EXPECT_FALSE(ImRead(dir + "/cut.jpg").empty());  // decoded as far as it goes
   EXPECT_TRUE(ImDecode(cut_png).empty());
   std::vector<std::thread> threads;
+  threads.reserve(4);
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&] {
       for (int i = 0; i < 20; ++i) {

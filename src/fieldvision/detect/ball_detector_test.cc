@@ -285,11 +285,13 @@ TEST(BallDetector, FitAtFindsABallMergedWithABoardOfItsColourWhereItIsExpected) 
     const double near = r / 3.0;  // the board's edge: r - near inside the ball's edge
     cv::Rect board;
     if (side == 0) board = cv::Rect(int(c.x() + near), int(c.y() - 3 * r), int(3 * r), int(6 * r));
-    if (side == 1)
+    if (side == 1) {
       board = cv::Rect(int(c.x() - near - 3 * r), int(c.y() - 3 * r), int(3 * r), int(6 * r));
+    }
     if (side == 2) board = cv::Rect(int(c.x() - 3 * r), int(c.y() + near), int(6 * r), int(3 * r));
-    if (side == 3)
+    if (side == 3) {
       board = cv::Rect(int(c.x() - 3 * r), int(c.y() - near - 3 * r), int(6 * r), int(3 * r));
+    }
     const cv::Vec3b orange = test_util::kOrange;
     cv::rectangle(img, board, cv::Scalar(orange[0], orange[1], orange[2]), cv::FILLED);
     test_util::PaintDisc(img, c, r);

@@ -27,8 +27,9 @@ cv::Mat RandomClumps(util::Rng& rng, int w, int h) {
   cv::Mat img;
   cv::resize(small, img, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
   // Single stray pixels and diagonal touches.
-  for (int i = 0; i < 200; ++i)
+  for (int i = 0; i < 200; ++i) {
     img.at<cv::Vec3b>(rng.UniformInt(0, h - 1), rng.UniformInt(0, w - 1)) = kOrange;
+  }
   return img;
 }
 

@@ -37,11 +37,11 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
       const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
       const double r = rng.Uniform(6, 14);
       test_util::PaintDisc(img, c, r);
-      WriteText(dir + "/labels/" + stem + ".txt",
+      WriteText(fmt::format("{}/labels/{}.txt", dir, stem),
                 fmt::format("2 0.5 0.5 0.1 0.1\n0 {} {} {} {}\n", c.x() / 320, c.y() / 240,
                             2 * r / 320, 2 * r / 240));
     }
-    cv::imwrite(dir + "/" + stem + ".png", img);
+    cv::imwrite(fmt::format("{}/{}.png", dir, stem), img);
   }
   DetectEvalOptions o;
   o.video = dir;

@@ -162,8 +162,8 @@ TEST(FieldDraw, TopViewMapsCornersAndDrawsLines) {
   EXPECT_NEAR(back.y(), -2.0, 1e-12);
   const cv::Mat img = DrawField(f, v);
   // The halfway line is white at the centre column, grass beside it.
-  const cv::Vec3b on = img.at<cv::Vec3b>(static_cast<int>(c.y) + 40, static_cast<int>(c.x));
-  const cv::Vec3b off = img.at<cv::Vec3b>(static_cast<int>(c.y) + 40, static_cast<int>(c.x) + 20);
+  const cv::Vec3b& on = img.at<cv::Vec3b>(static_cast<int>(c.y) + 40, static_cast<int>(c.x));
+  const cv::Vec3b& off = img.at<cv::Vec3b>(static_cast<int>(c.y) + 40, static_cast<int>(c.x) + 20);
   EXPECT_GT(on[0], 200);
   EXPECT_LT(off[0], 100);
 }

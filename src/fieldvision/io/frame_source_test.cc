@@ -23,7 +23,7 @@ namespace {
 
 std::string WriteMjpg(const std::string& dir, int frames, double fps,
                       const std::string& name = "v.avi") {
-  const std::string path = dir + "/" + name;
+  std::string path = dir + "/" + name;
   cv::VideoWriter w(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps, cv::Size(64, 48));
   for (int i = 0; i < frames; ++i) w.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(10 * i, 80, 200)));
   return path;
@@ -90,7 +90,7 @@ TEST(FrameSource, ImageGlobAndFolderEncodedOrNot) {
     cv::imwrite(fmt::format("{}/f{:02d}.jpg", dir, i),
                 cv::Mat(48, 64, CV_8UC3, cv::Scalar(40 * i, 100, 200 - 40 * i)));
   }
-  for (const std::string spec : {dir + "/f*.jpg", dir}) {
+  for (const std::string& spec : {dir + "/f*.jpg", dir}) {
     for (const bool encoded : {false, true}) {
       SCOPED_TRACE(spec + (encoded ? " encoded" : ""));
       FrameSourceOptions o;

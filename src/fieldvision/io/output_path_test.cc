@@ -96,7 +96,7 @@ TEST(AtomicWrite, AFullDiskKeepsTheOutputAndLeavesNoTemporary) {
   ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &was), 0);
   const auto old_handler = signal(SIGXFSZ, SIG_IGN);
   rlimit small = was;
-  small.rlim_cur = 64 * 1024;
+  small.rlim_cur = rlim_t{64} * 1024;
   ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
   std::string message;
   try {

@@ -108,6 +108,7 @@ Scene MakeScene(const std::string& dir, const std::vector<int>& lengths,
 std::vector<std::unique_ptr<io::FrameSource>> Open(const Scene& s,
                                                    const std::vector<io::FrameSourceOptions>& vo) {
   std::vector<std::unique_ptr<io::FrameSource>> src;
+  src.reserve(3);
   for (int c = 0; c < 3; ++c) src.push_back(io::OpenFrameSource(s.videos[c], vo[c]));
   return src;
 }
@@ -234,6 +235,7 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
     EXPECT_FALSE(src.Read(&a, &fa, &ta));
   }
   std::vector<std::unique_ptr<io::FrameSource>> sources;
+  sources.reserve(patterns.size());
   for (const auto& p : patterns) sources.push_back(io::OpenFrameSource(p, enc));
   BallPipelineSummary summary;
   const std::vector<BallFrame> frames = RunTracked(s, sources, &summary);

@@ -248,7 +248,7 @@ TEST(DetectionsJob, BadFilesAreOneLineErrorsNamingTheFile) {
   };
   const std::string missing = message("frame,time_s,u\n0,0.0,10\n");
   EXPECT_NE(missing.find("det.csv"), std::string::npos) << missing;
-  EXPECT_NE(missing.find("v"), std::string::npos) << missing;
+  EXPECT_NE(missing.find('v'), std::string::npos) << missing;
   EXPECT_EQ(missing.find('\n'), std::string::npos) << missing;
   const std::string back = message("frame,time_s,u,v\n0,0.08,10,10\n1,0.04,11,11\n");
   EXPECT_NE(back.find("det.csv:3"), std::string::npos) << back;

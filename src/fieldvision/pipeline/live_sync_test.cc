@@ -30,7 +30,9 @@ TEST(LiveSync, PairsByTimeWithJitterAndOffsetsInFrameNumbers) {
   ASSERT_EQ(groups.size(), 50u);
   for (size_t k = 0; k < groups.size(); ++k) {
     ASSERT_EQ(groups[k].present(), 3);
-    for (int c = 0; c < 3; ++c) EXPECT_EQ(groups[k].cameras[c]->frame, 10 * c + (long long)k);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(groups[k].cameras[c]->frame, 10LL * c + static_cast<long long>(k));
+    }
   }
   EXPECT_EQ(sync.complete_groups(), 50);
 }

@@ -206,6 +206,7 @@ TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
       if (k % 2 == 1) c.distortion = {rng.Uniform(-0.2, 0.05), rng.Uniform(0, 0.05), 0, 0, 0};
       cams.push_back(c);
     }
+    ptrs.reserve(cams.size());
     for (const auto& c : cams) ptrs.push_back(&c);
     const auto cov = TriangulationCovariance(ptrs, p, sigma_px);
     ASSERT_TRUE(cov.has_value()) << "trial " << trial;
@@ -220,8 +221,9 @@ TEST(CoverageTest, ExpectedErrorMatchesMonteCarloTriangulation) {
     double sum_sq = 0;
     for (int s = 0; s < samples; ++s) {
       std::vector<Eigen::Vector2d> noisy = clean;
-      for (auto& uv : noisy)
+      for (auto& uv : noisy) {
         uv += Eigen::Vector2d(rng.Normal(0, sigma_px), rng.Normal(0, sigma_px));
+      }
       sum_sq += (Triangulate(cams, noisy) - p).squaredNorm();
     }
     const double measured = std::sqrt(sum_sq / samples);

@@ -22,7 +22,7 @@ std::string WriteCornerRig(const std::string& dir) {
   const json rig = {{"name", "corners"},
                     {"defaults", {{"image_width", 1280}, {"image_height", 960}, {"hfov_deg", 80}}},
                     {"cameras", cams}};
-  const std::string path = dir + "/rig.json";
+  std::string path = dir + "/rig.json";
   std::ofstream(path) << rig.dump(2);
   return path;
 }

@@ -29,8 +29,9 @@ TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   ASSERT_FALSE(field.goals.empty());
   const field::FieldGoal* right = nullptr;
-  for (const auto& g : field.goals)
+  for (const auto& g : field.goals) {
     if (g.side > 0) right = &g;
+  }
   ASSERT_NE(right, nullptr);
   TrajectoryOptions to;
   for (const double y_aim : {0.3 * right->y_max_m, right->y_max_m + 0.5}) {
@@ -48,8 +49,9 @@ TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
     for (double t = 0; t < o.duration_s; t += 1e-4) {
       const Eigen::Vector3d p = sim.BallAt(t);
       if (p.x() - right->line_x_m > 0.5 * field.line_width_m + to.ball_radius_m) {
-        if (p.y() >= right->y_min_m && p.y() <= right->y_max_m && p.z() <= right->height_m)
+        if (p.y() >= right->y_min_m && p.y() <= right->y_max_m && p.z() <= right->height_m) {
           t_true = t;
+        }
         break;
       }
     }

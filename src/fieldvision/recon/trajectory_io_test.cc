@@ -11,7 +11,7 @@
 namespace fv::recon {
 namespace {
 
-const char* kHeader = "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n";
+const char* const kHeader = "frame,time_s,x_m,y_m,z_m,n_cams,err_px\n";
 
 std::string ErrorOf(const std::string& text) {
   try {
@@ -53,8 +53,9 @@ TEST(TrajectoryIo, BadRowsAreNamedAndSkipped) {
 
 TEST(TrajectoryIo, ReversedFileIsAnErrorNotASilentTruncation) {
   std::string text = kHeader;
-  for (int i = 9; i >= 0; --i)
+  for (int i = 9; i >= 0; --i) {
     text += std::to_string(i) + "," + std::to_string(i * 0.02) + ",1,2,3,2,0\n";
+  }
   const std::string e = ErrorOf(text);
   EXPECT_NE(e.find("not increasing"), std::string::npos) << e;
   EXPECT_NE(ErrorOf(std::string(kHeader) + "0,nan,1,2,3,2,0\n").find("no valid rows"),

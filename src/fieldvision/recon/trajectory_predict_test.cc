@@ -84,9 +84,11 @@ TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
   sm = std::sqrt(sm / n);
   EXPECT_LT(sm, 0.6 * raw) << "raw " << raw << " smoothed " << sm;
   // Outliers are replaced by the smoothed path.
-  for (size_t i = 0; i < track.size(); ++i)
-    if (r.outlier[i])
+  for (size_t i = 0; i < track.size(); ++i) {
+    if (r.outlier[i]) {
       EXPECT_LT((smooth[i].ball_in_world - sim.BallAt(track[i].time_s)).norm(), 0.15);
+    }
+  }
   SmootherOptions bad;
   bad.accel_noise_mps2 = 0;
   EXPECT_THROW(SmoothTrack(track, r, to, bad), Error);

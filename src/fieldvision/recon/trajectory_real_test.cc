@@ -97,8 +97,9 @@ TEST(TrajectoryReal, Tt3dAllFilesResiduals) {
   const std::string gt = dir + "/tt3d-trajectories/3D_gt";
   if (!std::filesystem::exists(gt)) GTEST_SKIP() << "no " << gt;
   std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(gt))
+  for (const auto& e : std::filesystem::directory_iterator(gt)) {
     if (e.path().extension() == ".csv") files.push_back(e.path().string());
+  }
   std::sort(files.begin(), files.end());
   int flights = 0, bounces = 0, hits = 0, with_bounce = 0;
   std::vector<double> nd, wd;
@@ -121,7 +122,9 @@ TEST(TrajectoryReal, Tt3dAllFilesResiduals) {
       wd.push_back(f.with_drag.rmse_m);
     }
   }
-  const auto median = [](std::vector<double> v) { return util::NearestRankPercentile(v, 0.5); };
+  const auto median = [](std::vector<double> v) {
+    return util::NearestRankPercentile(std::move(v), 0.5);
+  };
   std::cout << fmt::format(
       "tt3d: {} files, {} flights, {} bounces, {} hits, {} files with a bounce; median rmse "
       "gravity {:.1f} mm, drag {:.1f} mm over {} flights fitted both ways (max {:.1f} / {:.1f} "

@@ -43,8 +43,10 @@ TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
   ASSERT_GE(j.size(), 2u);
   double prev = -1;
   for (const auto& f : j) {
-    for (const char* k : {"t_start_s", "t_end_s", "origin", "landing", "apex", "v0_mps", "rmse_m"})
+    for (const char* k :
+         {"t_start_s", "t_end_s", "origin", "landing", "apex", "v0_mps", "rmse_m"}) {
       EXPECT_TRUE(f.contains(k)) << k;
+    }
     EXPECT_EQ(f["origin"].size(), 3u);
     EXPECT_NEAR(f["landing"][2].get<double>(), 0.11, 1e-3);
     EXPECT_GT(f["t_start_s"].get<double>(), prev);

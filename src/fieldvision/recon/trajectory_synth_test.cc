@@ -39,8 +39,9 @@ TEST(TrajectorySynth, KickPresetFlightsFromTruthWith5mmNoise) {
     for (const auto& t : traj.flights()) {
       if (t.t_end_s - t.t_start_s < 0.25 || t.t_end_s > t_end) continue;
       const Flight* best = nullptr;
-      for (const auto& f : r.flights)
+      for (const auto& f : r.flights) {
         if (std::abs(f.t_start_s - t.t_start_s) < 0.05) best = &f;
+      }
       ASSERT_NE(best, nullptr) << "flight " << t.t_start_s << ".." << t.t_end_s << " not found";
       const double eo = (best->origin_m - t.origin).norm();
       const double el = (best->landing_m - t.landing).norm();

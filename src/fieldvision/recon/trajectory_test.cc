@@ -61,21 +61,25 @@ TEST(Trajectory, FindsEveryFlightWithOriginAndLandingWithin2cmAt5mmNoise) {
     const TrajectoryResult r = AnalyzeTrajectory(track, o);
     SCOPED_TRACE(r.Summary());
     if (getenv("FV_DEBUG")) {
-      for (const auto& t : sim.Flights())
+      for (const auto& t : sim.Flights()) {
         printf("truth %.3f..%.3f origin %.3f %.3f %.3f landing %.3f %.3f %.3f\n", t.t_start_s,
                t.t_end_s, t.origin_m.x(), t.origin_m.y(), t.origin_m.z(), t.landing_m.x(),
                t.landing_m.y(), t.landing_m.z());
-      for (const auto& f : r.flights)
+      }
+      for (const auto& f : r.flights) {
         printf(
             "found %.3f..%.3f (%s..%s) seen %.3f..%.3f n=%zu origin %.3f %.3f %.3f landing %.3f "
             "%.3f %.3f rmse %.4f\n",
             f.t_start_s, f.t_end_s, FlightEventName(f.start_event), FlightEventName(f.end_event),
             f.t_first_seen_s, f.t_last_seen_s, f.samples.size(), f.origin_m.x(), f.origin_m.y(),
             f.origin_m.z(), f.landing_m.x(), f.landing_m.y(), f.landing_m.z(), f.rmse_m);
-      for (size_t i = 0; i < track.size(); ++i)
-        if (getenv("FV_DEBUG")[0] == '2')
+      }
+      for (size_t i = 0; i < track.size(); ++i) {
+        if (getenv("FV_DEBUG")[0] == '2') {
           printf("  %.3f z=%.3f out=%d ground=%d\n", track[i].time_s, track[i].ball_in_world.z(),
                  (int)r.outlier[i], (int)r.on_ground[i]);
+        }
+      }
     }
     int checked = 0;
     for (const auto& t : sim.Flights()) {

@@ -183,6 +183,7 @@ TEST(Renderer, BallCentreProjectsInsideItsBlob) {
   FV_SEED_TRACE(seed);
   util::Rng rng(seed);
   std::vector<Eigen::Vector3d> places;
+  places.reserve(4);
   for (int i = 0; i < 4; ++i) {
     places.push_back(Eigen::Vector3d(rng.Uniform(-4, 0), rng.Uniform(-3, 1), rng.Uniform(0.3, 2)));
   }
@@ -247,8 +248,8 @@ TEST(Renderer, PaintedLinesAreWhiteAndGrassIsGreen) {
       if (!uv || !cam.InImage(*uv, 2)) continue;
       // Only where the line is at least ~2 px wide in the image.
       if (field.line_width_m / cam.PixelFootprintM(Eigen::Vector3d(p.x(), p.y(), 0)) < 4) continue;
-      const cv::Vec3b px = img.at<cv::Vec3b>(static_cast<int>(std::lround(uv->y())),
-                                             static_cast<int>(std::lround(uv->x())));
+      const cv::Vec3b& px = img.at<cv::Vec3b>(static_cast<int>(std::lround(uv->y())),
+                                              static_cast<int>(std::lround(uv->x())));
       EXPECT_GT(std::min({px[0], px[1], px[2]}), 150) << "line point " << p.transpose();
       ++white;
     }
@@ -258,8 +259,8 @@ TEST(Renderer, PaintedLinesAreWhiteAndGrassIsGreen) {
       if (field.DistanceToPaint(p) < 0.5) continue;
       const auto uv = cam.Project(Eigen::Vector3d(p.x(), p.y(), 0));
       if (!uv || !cam.InImage(*uv, 2)) continue;
-      const cv::Vec3b px = img.at<cv::Vec3b>(static_cast<int>(std::lround(uv->y())),
-                                             static_cast<int>(std::lround(uv->x())));
+      const cv::Vec3b& px = img.at<cv::Vec3b>(static_cast<int>(std::lround(uv->y())),
+                                              static_cast<int>(std::lround(uv->x())));
       EXPECT_GT(px[1], px[0] + 30) << "grass point " << p.transpose();
       EXPECT_GT(px[1], px[2] + 30) << "grass point " << p.transpose();
       ++green;

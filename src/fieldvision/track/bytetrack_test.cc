@@ -31,7 +31,8 @@ TEST(ByteTracker, KeepsIdsThroughCrossingsAndMisses) {
   std::vector<Walker> people;
   for (int i = 0; i < 6; ++i) {
     // Pairs walk towards each other on nearby rows and cross in the middle.
-    const double y = 100 + 60 * (i / 2) + rng.Uniform(-5, 5);
+    const int pair = i / 2;
+    const double y = 100 + 60 * pair + rng.Uniform(-5, 5);
     const bool left = i % 2 == 0;
     people.push_back({left ? 50.0 : 650.0, y, left ? 4.0 : -4.0, rng.Uniform(-0.3, 0.3)});
   }

@@ -30,8 +30,10 @@ std::vector<cv::Mat> FakeOutputs(int w, int h, int col, int row, const int sides
   }
   const int fw = (w + 15) / 16;
   const int idx = row * fw + col;
-  outs[1].ptr<float>()[idx * 80] = score;
-  for (int k = 0; k < 4; ++k) outs[4].ptr<float>()[idx * 44 + k * 11 + sides[k]] = 40.0f;
+  outs[1].ptr<float>()[static_cast<ptrdiff_t>(idx) * 80] = score;
+  for (int k = 0; k < 4; ++k) {
+    outs[4].ptr<float>()[static_cast<ptrdiff_t>(idx * 44 + k * 11 + sides[k])] = 40.0f;
+  }
   return outs;
 }
 

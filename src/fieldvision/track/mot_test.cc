@@ -65,7 +65,8 @@ TEST(Mot, CountsMissesFalsePositivesAndSwitches) {
   EXPECT_EQ(m.id_switches, 1);
   EXPECT_NEAR(m.mota, 1.0 - double(dropped + 1 + 1) / gt.size(), 1e-12);
   // IDF1: person 2 is split in halves, only one half counts.
-  const double idtp = (frames - dropped) + frames / 2 + frames;
+  const int half = frames / 2;
+  const double idtp = (frames - dropped) + half + frames;
   EXPECT_NEAR(m.idf1, 2 * idtp / (gt.size() + est.size()), 1e-12);
   EXPECT_LT(m.hota, 1.0);
   EXPECT_GT(m.hota, 0.5);

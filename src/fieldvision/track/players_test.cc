@@ -123,6 +123,7 @@ TEST(Players, StitchJoinsTrackletsOfOnePersonAndInterpolationFillsTheGap) {
   EXPECT_EQ(StitchTracklets(far, app, o, 25.0, image), 0);
   o = {};
   std::vector<TrackRow> border;
+  border.reserve(50);
   for (int f = 0; f < 30; ++f) border.push_back({f, 1, cv::Rect2d(0, 200, 30, 80), 0.9, {}, {}});
   for (int f = 40; f < 60; ++f) border.push_back({f, 2, cv::Rect2d(1, 200, 30, 80), 0.9, {}, {}});
   EXPECT_EQ(StitchTracklets(border, app, o, 25.0, image), 0);
@@ -180,7 +181,7 @@ TEST(Players, ImageSequenceHasNoTimeWithoutFps) {
 // `spec` with its cameras at 640x480, written to a fresh folder (returned).
 std::string WriteAt640x480(synth::SceneSpec& spec) {
   synth::ResizeCameras(spec, 640, 480);
-  const std::string dir = fv::testing::TempDir();
+  std::string dir = fv::testing::TempDir();
   synth::WriteScene(spec, dir, false);
   return dir;
 }
@@ -197,7 +198,7 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   const std::string dir = WriteAt640x480(spec);
   synth::SceneRenderer scene(spec);
   const camera::Camera cam = scene.cameras()[0];
-  const field::FieldModel field = scene.field();
+  const field::FieldModel& field = scene.field();
   const std::string video = dir + "/" + cam.name + ".avi";
   PlayersOptions o;
   o.progress = false;
@@ -253,7 +254,7 @@ TEST(Players, SynthScenePositionsAndStableIds) {
   const std::string dir = WriteAt640x480(spec);
   synth::SceneRenderer scene(spec);
   const camera::Camera cam = scene.cameras()[0];
-  const field::FieldModel field = scene.field();
+  const field::FieldModel& field = scene.field();
   const std::string video = dir + "/" + cam.name + "/%05d.png";
   PlayersOptions o;
   o.progress = false;
@@ -312,8 +313,9 @@ TEST(Players, SynthScenePositionsAndStableIds) {
       used_people.insert(p.who->id);
       ++matched;
       people.insert(p.who->id);
-      if (p.row->x_m)
+      if (p.row->x_m) {
         errors.push_back(std::hypot(*p.row->x_m - p.who->x_m, *p.row->y_m - p.who->y_m));
+      }
       const int id = p.row->id;
       auto it = last_id.find(p.who->id);
       if (it != last_id.end() && it->second != id) {

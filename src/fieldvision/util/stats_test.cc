@@ -52,6 +52,7 @@ TEST(Stats, MeanRmsRobustSigma) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal(10.0, 2.0);
   std::vector<double> v;
+  v.reserve(21000);
   for (int i = 0; i < 20000; ++i) v.push_back(normal(rng));
   for (int i = 0; i < 1000; ++i) v.push_back(1e6);  // 5 % gross outliers
   EXPECT_NEAR(RobustSigma(v), 2.0, 0.3);            // outliers inflate it only a little

@@ -681,7 +681,8 @@ TEST_F(StudioApiTest, PlayerStatsAndZoneAlerts) {
 }
 
 std::string Base64(const std::string& bytes) {
-  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  static const char* const kAlphabet =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   for (size_t i = 0; i < bytes.size(); i += 3) {
     const size_t n = std::min<size_t>(3, bytes.size() - i);
@@ -869,8 +870,9 @@ TEST_F(StudioApiTest, EventsStreamTellsOfSavedFiles) {
     });
   });
   // Save once the stream has said hello (events before it are not sent to it).
-  for (int i = 0; i < 1000 && !hello; ++i)
+  for (int i = 0; i < 1000 && !hello; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   EXPECT_TRUE(hello) << "no hello on the event stream";
   const Reply saved =
       Post("/api/colour/save",
