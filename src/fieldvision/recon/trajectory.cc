@@ -728,6 +728,17 @@ struct Segmenter {
   const TrajectoryOptions& o;
   double sigma;
 
+  // Whether a window's samples rest on the ground: all within the ground band and within the
+  // noise (or min_outlier_m) of each other.
+  bool Resting(const std::vector<int>& w) const {
+    const double top_m = GroundBandTopM(o, sigma);
+    const double spread_m = 2 * std::max(o.min_outlier_m, 3 * sigma);
+    return !w.empty() && std::all_of(w.begin(), w.end(), [&](int k) {
+      return track[k].ball_in_world.z() <= top_m &&
+             (track[k].ball_in_world - track[w.front()].ball_in_world).norm() <= spread_m;
+    });
+  }
+
   // Flags samples that both neighbouring local fits miss (two passes; each fit without its own
   // worst sample when it misses that one).
   std::vector<bool> FindOutliers() const {
@@ -797,11 +808,13 @@ struct Segmenter {
             next[i] = misses == 2;
           } else if (fits == 1 && misses == 1) {
             // One side only (near a track end or a break): a jump there is either a glitch or the
-            // start of a new arc. An outlier only when the next sample on the other side returns
-            // to the arc (an isolated jump); without such a sample nothing says which.
+            // start of a new arc. An outlier when the next sample on the other side returns to
+            // the arc (an isolated jump). Without such a sample nothing says which, but for the
+            // track's first sample before a ball at rest: no ball comes to rest from elsewhere
+            // within one sample interval (a last sample away from a resting ball may be a kick).
             const int other = missed_left ? (hi_pos < m ? good[hi_pos] : -1)
                                           : (lo_pos > 0 ? good[lo_pos - 1] : -1);
-            next[i] = other >= 0 && !misses_line(*missed, other);
+            next[i] = other >= 0 ? !misses_line(*missed, other) : !missed_left && Resting(right);
           }
         }
       });

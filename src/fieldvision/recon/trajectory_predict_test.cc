@@ -61,6 +61,10 @@ BallSimOptions BouncingKick(const Eigen::Vector3d& v_mps, double duration_s) {
   return o;
 }
 
+// Over seeds 1-200 it fails at 89 (a glitch one sample after the kick splits the kick's first two
+// samples off as a hop; smoothed RMS 49 mm against 39 mm raw) and 186 (a glitch near the track's
+// end is kept); 101 and 106 (a glitch as the track's first sample) hold since that sample is an
+// outlier.
 TEST(TrajectoryPredict, SmootherHalvesTheNoise) {
   testing::SeededRng rng(23);
   const BallSimulation sim(BouncingKick({9, 1, 7}, 3.0));

@@ -166,6 +166,42 @@ TEST(Trajectory, GlitchesInAShortHopLeaveItsGoodSamplesInliers) {
   ASSERT_EQ(r.flights.size(), 1u);
 }
 
+// A track that starts with a glitch (0.6 m to the side, as a detection on another object) before
+// the ball rests and is kicked: the first sample is an outlier, since no ball comes to rest from
+// elsewhere within one sample interval; it was kept (only a sample on the other side could tell),
+// joined the resting phase and the smoother moved the next samples 0.2-0.3 m towards it. A last
+// sample away from a resting ball is kept: the ball may have been kicked.
+TEST(Trajectory, AGlitchAsTheFirstSampleBeforeARestingBallIsAnOutlier) {
+  testing::SeededRng rng(7);
+  const auto resting_then_kicked = [&](double kick_s, double duration_s) {
+    std::vector<BallSample> track;
+    for (int i = 0; 0.02 * i < duration_s; ++i) {
+      BallSample s;
+      s.frame = i;
+      s.time_s = 0.02 * i;
+      const double dt = std::max(0.0, s.time_s - kick_s);
+      s.ball_in_world =
+          Eigen::Vector3d(1 + 8 * dt, 2, 0.11 + 5 * dt - 0.5 * 9.81 * dt * dt) +
+          Eigen::Vector3d(rng.Normal(0, 0.004), rng.Normal(0, 0.004), rng.Normal(0, 0.004));
+      track.push_back(s);
+    }
+    return track;
+  };
+  std::vector<BallSample> track = resting_then_kicked(0.3, 1.0);
+  track[0].ball_in_world += Eigen::Vector3d(0.0, 0.6, 0.0);
+  const TrajectoryResult r = AnalyzeTrajectory(track, TrajectoryOptions());
+  SCOPED_TRACE(r.Summary());
+  EXPECT_TRUE(r.outlier[0]);
+  for (size_t i = 1; i < track.size(); ++i) EXPECT_FALSE(r.outlier[i]) << "sample " << i;
+  ASSERT_EQ(r.flights.size(), 1u);
+  EXPECT_NEAR(r.flights[0].origin_m.y(), 2.0, 0.02);
+  // Kicked in the last sample interval: the last sample, 0.16 m from the resting ball, stays.
+  const std::vector<BallSample> kicked = resting_then_kicked(0.59, 0.62);
+  const TrajectoryResult k = AnalyzeTrajectory(kicked, TrajectoryOptions());
+  SCOPED_TRACE(k.Summary());
+  EXPECT_FALSE(k.outlier.back());
+}
+
 TEST(Trajectory, BouncesAreBouncesAndAMidAirHitIsAHit) {
   testing::SeededRng rng(5);
   BallSimOptions o;
