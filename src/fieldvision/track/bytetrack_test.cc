@@ -25,7 +25,8 @@ struct Walker {
 };
 
 // People crossing each other: detections with noise, misses and low scores while occluded, plus
-// clutter; the tracker must keep one id per person.
+// clutter; the tracker must keep one id per person. A limit of the tracker: at 2 of seeds 1-100
+// (36 and 52) a crossing swaps ids (5 switches, IDF1 0.88).
 TEST(ByteTracker, KeepsIdsThroughCrossingsAndMisses) {
   fv::testing::SeededRng rng(11);
   std::vector<Walker> people;
