@@ -111,7 +111,8 @@ std::vector<std::string> ListImageSequence(const std::string& spec) {
     constexpr int kLastStart = 1000;
     int start = 0;
     while (start <= kLastStart && !fs::is_regular_file(name_of(start))) ++start;
-    for (int i = start; start <= kLastStart; ++i) {
+    if (start > kLastStart) return files;
+    for (int i = start;; ++i) {
       const std::string name = name_of(i);
       if (!fs::is_regular_file(name)) break;
       files.push_back(name);
