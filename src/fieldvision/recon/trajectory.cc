@@ -1389,8 +1389,8 @@ void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int
   }
   const double sample_interval_s = util::NearestRankPercentile(intervals_s, 0.5);
   const double off_m = OffArcM(options, noise_m);
-  const double zr = options.ground_z_m + options.ball_radius_m;
-  const double ground_tol = options.ground_tolerance_m + 3 * noise_m + 0.05;
+  // A contact up to 5 cm above the ground band is low enough for a bounce.
+  const double bounce_top_m = GroundBandTopM(options, noise_m) + 0.05;
   for (size_t i = 0; i + 1 < flights->size(); ++i) {
     Flight& A = (*flights)[i];
     Flight& B = (*flights)[i + 1];
@@ -1409,7 +1409,7 @@ void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int
     br.time_s = tm;
     br.ball_in_world = 0.5 * (pa + pb);
     br.velocity_change_mps = (vb - va).norm();
-    br.kind = (br.ball_in_world.z() < zr + ground_tol && va.z() < 0 && vb.z() > 0)
+    br.kind = (br.ball_in_world.z() < bounce_top_m && va.z() < 0 && vb.z() > 0)
                   ? FlightEvent::kBounce
                   : FlightEvent::kHit;
     double landed_s = 0.0;
@@ -1449,8 +1449,7 @@ void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int
 namespace {
 
 bool InTheAir(const BallisticModel& m, double t_s, const TrajectoryOptions& options) {
-  return m.PositionAt(t_s).z() >
-         options.ground_z_m + options.ball_radius_m + options.ground_tolerance_m;
+  return m.PositionAt(t_s).z() > GroundBandTopM(options, 0.0);
 }
 
 }  // namespace
