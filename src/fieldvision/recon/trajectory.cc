@@ -751,6 +751,7 @@ struct Segmenter {
         if (!out[i]) good.push_back(i);
       }
       std::vector<char> next(n, 0);  // written from several threads: not vector<bool>
+      std::vector<SideFit> side(n);
       const int m = static_cast<int>(good.size());
       // Each sample on its own (blocks of samples on all threads).
       constexpr int kBlock = 4096;
@@ -766,13 +767,15 @@ struct Segmenter {
           const auto left = Window(good, track, lo_pos - 1, -1, 0, m, o.window_s, o.window_samples);
           const auto right = Window(good, track, hi_pos, +1, 0, m, o.window_s, o.window_samples);
           int fits = 0, misses = 0;
-          auto misses_line = [&](const GravityLine& L, int k) {
+          // Distance from a fit in units of the outlier threshold (> 1: missed).
+          auto miss_ratio = [&](const GravityLine& L, int k) {
             const double err = (L.At(track[k].time_s, g) - track[k].ball_in_world).norm();
             const double sd = L.PredictionSd(track[k].time_s);
             const double thr = std::max(o.min_outlier_m, o.outlier_sigmas * sigma * std::sqrt(3.0) *
                                                              std::sqrt(1 + sd * sd));
-            return err > thr;
+            return err / thr;
           };
+          auto misses_line = [&](const GravityLine& L, int k) { return miss_ratio(L, k) > 1.0; };
           // A window's fit without its worst sample when the fit misses that one: a glitch
           // inside the window would tilt it and make it miss the good samples next to it (three
           // 0.5 m glitches in a 0.26 s hop had all ten of its samples flagged).
@@ -792,20 +795,25 @@ struct Segmenter {
           };
           std::optional<GravityLine> missed;  // the fit of the side that missed
           bool missed_left = false;
+          double fit_ratio = 0.0;  // the fitting side's miss ratio
           for (const auto* w : {&left, &right}) {
             if (static_cast<int>(w->size()) < o.window_samples) continue;
             const double span_ok = std::abs(track[(*w)[w->size() / 2]].time_s - track[i].time_s);
             if (span_ok > 3 * o.window_s) continue;
             const GravityLine L = RobustLine(*w, track[i].time_s, misses_line);
             ++fits;
-            if (misses_line(L, i)) {
+            const double ratio = miss_ratio(L, i);
+            if (ratio > 1.0) {
               ++misses;
               missed = L;
               missed_left = w == &left;
+            } else {
+              fit_ratio = ratio;
             }
           }
           if (fits == 2) {
             next[i] = misses == 2;
+            if (misses == 1) side[i] = {missed_left ? 2 : 1, fit_ratio};
           } else if (fits == 1 && misses == 1) {
             // One side only (near a track end or a break): a jump there is either a glitch or the
             // start of a new arc. An outlier when the next sample on the other side returns to
@@ -818,9 +826,33 @@ struct Segmenter {
           }
         }
       });
+      if (pass > 0) FlagCrossedSides(out, side, &next);
       out.assign(next.begin(), next.end());
     }
     return out;
+  }
+
+  // The one side whose local fit a sample lies on, where the other side's fit misses it (at a
+  // break between arcs): 1 the earlier samples, 2 the later; 0 both or neither.
+  struct SideFit {
+    int side = 0;
+    double ratio = 0.0;  // distance from that fit in outlier thresholds
+  };
+
+  // Arcs follow each other in time: a sample on only the earlier arc cannot come after one on
+  // only the later arc. Of two such neighbours that both fits missed in the pass before (a
+  // glitch beside a break tilts the fits; none kept between them), one is a glitch that happens
+  // to lie near the other arc's extrapolation: the one farther from its fit stays an outlier.
+  static void FlagCrossedSides(const std::vector<bool>& was_outlier,
+                               const std::vector<SideFit>& side, std::vector<char>* next) {
+    int later_only = -1;  // the last kept sample on only the later arc
+    for (int i = 0; i < static_cast<int>(side.size()); ++i) {
+      if ((*next)[i]) continue;
+      if (side[i].side == 1 && later_only >= 0 && was_outlier[i] && was_outlier[later_only]) {
+        (*next)[side[i].ratio >= side[later_only].ratio ? i : later_only] = 1;
+      }
+      later_only = side[i].side == 2 ? i : -1;
+    }
   }
 
   // Samples in ground phases: within the tolerance of the resting height for min_ground_s.
