@@ -114,11 +114,17 @@ SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
       s.pos_m[i] = p[i];
       continue;
     }
-    Eigen::MatrixXd A(m, 3);
+    // Near a segment's end the window is one-sided and a quadratic's slope at its end swings
+    // with the noise: a line there.
+    const double before_s = t[i] - t[a], after_s = t[b] - t[i];
+    const int degree = std::min(before_s, after_s) < 0.5 * std::max(before_s, after_s) ? 1 : 2;
+    Eigen::MatrixXd A(m, degree + 1);
     Eigen::MatrixXd Y(m, 2);
     for (int k = 0; k < m; ++k) {
       const double dt = t[a + k] - t[i];
-      A.row(k) << 1.0, dt, dt * dt;
+      A(k, 0) = 1.0;
+      A(k, 1) = dt;
+      if (degree == 2) A(k, 2) = dt * dt;
       Y.row(k) = p[a + k].transpose();
     }
     const Eigen::MatrixXd coef = (A.transpose() * A).ldlt().solve(A.transpose() * Y);
@@ -137,9 +143,11 @@ double TimeOf(const track::TrackRow& r, double fps) {
 
 // Top speed: the largest mean speed over top_speed_window_s within a segment (the largest
 // instantaneous speed grows with the position noise: on the synthetic players scene walkers at
-// 1.4-1.6 m/s got 1.9-2.0 m/s).
+// 1.4-1.6 m/s got 1.9-2.0 m/s), from windows that the segment covers whole; a window cut by a
+// segment's end holds the end's noisier speeds more heavily (the largest partial one when no
+// window is whole).
 double TopSpeed(const SmoothTrack& s, const StatsOptions& o) {
-  double top = 0;
+  double top_whole = -1, top_partial = 0;
   const size_t n = s.time_s.size();
   const double half = 0.5 * o.top_speed_window_s;
   size_t a = 0, b = 0;
@@ -154,9 +162,18 @@ double TopSpeed(const SmoothTrack& s, const StatsOptions& o) {
       sum -= std::min(s.speed_mps[a], o.max_speed_mps);
       ++a;
     }
-    if (b > a) top = std::max(top, sum / static_cast<double>(b - a));
+    if (b <= a) continue;
+    const double mean = sum / static_cast<double>(b - a);
+    // Whole: on each side a sample of the segment was left out, or the last one in lies on the
+    // window's edge.
+    const bool whole_before =
+        (a > 0 && s.segment[a - 1] == s.segment[i]) || s.time_s[a] <= s.time_s[i] - half + 1e-9;
+    const bool whole_after =
+        (b < n && s.segment[b] == s.segment[i]) || s.time_s[b - 1] >= s.time_s[i] + half - 1e-9;
+    if (whole_before && whole_after) top_whole = std::max(top_whole, mean);
+    top_partial = std::max(top_partial, mean);
   }
-  return top;
+  return top_whole >= 0 ? top_whole : top_partial;
 }
 
 }  // namespace

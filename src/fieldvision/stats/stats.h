@@ -3,8 +3,9 @@
 // polygon and when); distances between players over time; heat maps per player and per team and
 // a radar (top) view as images, an annotated radar video, stats.json and an index.html report.
 // Positions are smoothed before differentiating (a centred Savitzky-Golay filter, quadratic, over
-// smooth_window_s; Savitzky & Golay 1964) because per-frame noise inflates distance and speed;
-// jumps faster than max_speed_mps are treated as track breaks.
+// smooth_window_s, linear where a track's end cuts the window to one side; Savitzky & Golay
+// 1964) because per-frame noise inflates distance and speed; jumps faster than max_speed_mps are
+// treated as track breaks.
 #pragma once
 
 #include <map>
@@ -31,7 +32,8 @@ struct StatsOptions {
   double max_speed_mps = 12.0;    // faster steps are track breaks (not running)
   double sprint_speed_mps = 5.5;  // a sprint is at least this fast ...
   double sprint_min_s = 1.0;      // ... for at least this long
-  // Top speed: the largest mean speed over this long (position noise inflates single samples).
+  // Top speed: the largest mean speed over this long (position noise inflates single samples),
+  // from windows a track piece covers whole where it has any.
   double top_speed_window_s = 1.0;
   std::vector<double> speed_bands_mps = {2.0, 4.0, 5.5, 7.0};  // band edges (walk, jog, run...)
   double min_track_s = 1.0;                                    // ignore tracks shorter than this
