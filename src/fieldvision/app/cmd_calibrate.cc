@@ -153,6 +153,7 @@ struct IntrinsicsCli {
   std::string images, out, name;
   BoardCli board;
   IntrinsicsOptions o;
+  std::string k3 = "free";
   bool quiet = false;
 };
 
@@ -160,6 +161,7 @@ void RunIntrinsics(IntrinsicsCli& c) {
   c.o.board = c.board.Spec();
   c.o.camera_name = c.name;
   c.o.progress = !c.quiet;
+  c.o.k3 = calib::ParseK3Model(c.k3);
   const IntrinsicsResult r = CalibrateIntrinsics(c.images, c.o);
   std::cout << fmt::format("{:<48s} {:>7s} {:>8s}  {}\n", "view", "corners", "rms_px", "status");
   for (const auto& v : r.views) {
@@ -486,6 +488,13 @@ void SetupIntrinsics(CLI::App* group) {
   in->add_option("--images", ic->images, "Folder, glob pattern ('dir/*.jpg') or video")->required();
   AddBoardOptions(in, ic->board);
   AddBoardFitOptions(in, ic->o);
+  in->add_option("--k3", ic->k3,
+                 "With --model 5, the r^6 term k3: free (OpenCV's default), auto (kept only "
+                 "where it pays by the BIC; better for a lens without it, worse for one with it "
+                 "where the board did not reach the image's corners) or zero; free and auto "
+                 "print how far apart the fits with and without k3 put the image's corners")
+      ->check(CLI::IsMember({"auto", "free", "zero"}))
+      ->capture_default_str();
   in->add_flag("--fix-aspect", ic->o.fix_aspect_ratio, "Keep fx = fy");
   in->add_flag("--zero-tangent", ic->o.zero_tangent, "No tangential distortion");
   in->add_flag("--fix-principal-point", ic->o.fix_principal_point,

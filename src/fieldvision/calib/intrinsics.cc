@@ -14,17 +14,20 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::calib {
 namespace {
 
-int CalibFlags(const IntrinsicsOptions& o) {
+// OpenCV's flags for the options' model; with 5 coefficients k3 is fitted when k3_free.
+int CalibFlags(const IntrinsicsOptions& o, bool k3_free) {
   int flags = 0;
   switch (o.num_distortion) {
     case 4:
       flags |= cv::CALIB_FIX_K3;
       break;
     case 5:
+      if (!k3_free) flags |= cv::CALIB_FIX_K3;
       break;
     case 8:
       flags |= cv::CALIB_RATIONAL_MODEL;
@@ -54,6 +57,14 @@ std::string Today() {
 void CheckDistortionModel(int n) {
   FV_REQUIRE(n == 4 || n == 5 || n == 8 || n == 12 || n == 14,
              "num_distortion must be 4, 5, 8, 12 or 14 (got {})", n);
+}
+
+K3Model ParseK3Model(const std::string& name) {
+  const std::string n = util::ToLower(name);
+  if (n == "auto") return K3Model::kAuto;
+  if (n == "free") return K3Model::kFree;
+  if (n == "zero") return K3Model::kZero;
+  Throw("k3 model '{}' is not known; use auto, free or zero", name);
 }
 
 void IntrinsicsOptions::Check() const {
@@ -92,8 +103,16 @@ std::string IntrinsicsResult::Summary() const {
   for (size_t i = 0; i < camera.distortion.size(); ++i) {
     s += fmt::format("{}{:.5g}", i ? ", " : "", camera.distortion[i]);
   }
-  return s + fmt::format("]; with the focal length held lower / higher: rms {:.3f} / {:.3f} px",
-                         rms_focal_lower_px, rms_focal_higher_px);
+  s += fmt::format("]; with the focal length held lower / higher: rms {:.3f} / {:.3f} px",
+                   rms_focal_lower_px, rms_focal_higher_px);
+  if (k3_tested) {
+    s += fmt::format(
+        "; k3 {} (rms {:.4f} px without, {:.4f} px with: BIC gain {:.1f}; the two fits put the "
+        "image corners {:.1f} px apart)",
+        k3_kept ? "fitted" : "left out", rms_without_k3_px, rms_with_k3_px, k3_bic_gain,
+        k3_corner_shift_px);
+  }
+  return s;
 }
 
 namespace {  // The stages of CalibrateFromViews.
@@ -144,10 +163,9 @@ struct CvFit {
 // calibrateCamera on the views with the board, dropping the worst view above the outlier
 // threshold and fitting again while the budget allows.
 CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector<int>& found,
-                          const cv::Size& size, const IntrinsicsOptions& options, int max_drop,
-                          IntrinsicsResult* out) {
+                          const cv::Size& size, const IntrinsicsOptions& options, int flags,
+                          int max_drop, IntrinsicsResult* out) {
   IntrinsicsResult& result = *out;
-  const int flags = CalibFlags(options);
   CvFit fit;
   std::vector<int>& used = fit.used;
   used = found;
@@ -207,7 +225,7 @@ CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector
 // The RMS of the fit on the used views redone with the focal length held at `factor` times the
 // estimate (principal point, distortion and poses refitted from the estimate).
 double RmsWithFocalScaled(const std::vector<BoardView>& views, const CvFit& fit,
-                          const cv::Size& size, const IntrinsicsOptions& options, double factor) {
+                          const cv::Size& size, int flags, double factor) {
   std::vector<std::vector<cv::Point3f>> obj;
   std::vector<std::vector<cv::Point2f>> img;
   for (int i : fit.used) {
@@ -229,13 +247,70 @@ double RmsWithFocalScaled(const std::vector<BoardView>& views, const CvFit& fit,
     try {
       const double rms = cv::calibrateCamera(
           obj, img, size, k, d, rvecs, tvecs,
-          CalibFlags(options) | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH,
+          flags | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH,
           cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
       if (std::isfinite(rms)) return rms;
     } catch (const cv::Exception&) {
     }
   }
   return std::numeric_limits<double>::infinity();  // no fit at all: the focal length matters
+}
+
+// How far apart two fits put the image's corners: each corner through the first fit back to its
+// ray, then through the second fit into the image (px, the largest of the four).
+double CornerShiftPx(const CvFit& a, const CvFit& b, const cv::Size& size) {
+  const std::vector<cv::Point2d> corners = {
+      {0, 0}, {size.width - 1.0, 0}, {0, size.height - 1.0}, {size.width - 1.0, size.height - 1.0}};
+  std::vector<cv::Point2d> normalized;
+  cv::undistortPoints(
+      corners, normalized, a.k, a.d, cv::noArray(), cv::noArray(),
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
+  std::vector<cv::Point3d> rays;
+  rays.reserve(normalized.size());
+  for (const auto& p : normalized) rays.emplace_back(p.x, p.y, 1.0);
+  std::vector<cv::Point2d> back;
+  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), b.k, b.d, back);
+  double worst = 0;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    worst = std::max(worst, cv::norm(back[i] - corners[i]));
+  }
+  return worst;
+}
+
+// With 5 coefficients: the fit of the other k3 model on the same views (`first` had k3 free
+// when first_free, its outliers dropped), compared by the BIC; K3Model::kAuto keeps the one it
+// prefers, kFree the free one. The kept fit's flags in *flags.
+CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
+                const IntrinsicsOptions& options, CvFit first, bool first_free, int* flags,
+                IntrinsicsResult* out) {
+  IntrinsicsResult trial = *out;
+  const int other_flags = CalibFlags(options, !first_free);
+  CvFit other = FitDroppingOutliers(views, first.used, size, options, other_flags, 0, &trial);
+  const CvFit& with = first_free ? first : other;
+  const CvFit& without = first_free ? other : first;
+  long long points = 0;
+  for (int i : first.used) points += static_cast<long long>(views[i].image_points.size());
+  // OpenCV's RMS is over the corners' squared distances: the sum of squares is RMS^2 points.
+  const double gain =
+      util::BicGain(without.rms * without.rms * static_cast<double>(points),
+                    with.rms * with.rms * static_cast<double>(points), 2 * points, 1);
+  const bool keep_free = options.k3 == K3Model::kFree || gain > 0;
+  const bool keep_other = keep_free != first_free;
+  if (keep_other) {
+    *out = std::move(trial);  // the views' errors of the kept fit
+  } else {
+    out->fits = trial.fits;
+  }
+  IntrinsicsResult& result = *out;
+  result.k3_tested = true;
+  result.k3_kept = keep_free;
+  result.rms_without_k3_px = without.rms;
+  result.rms_with_k3_px = with.rms;
+  result.k3_bic_gain = gain;
+  result.k3_corner_shift_px = CornerShiftPx(without, with, size);
+  if (!keep_other) return first;
+  *flags = other_flags;
+  return other;
 }
 
 // The camera and the standard deviations of its intrinsics from the fit.
@@ -320,10 +395,15 @@ void AddWarnings(const cv::Size& size, const IntrinsicsOptions& options, int max
                     100 * cov.cell_fraction));
   }
   if (options.num_distortion >= 5 && cov.radius_fraction < 0.75) {
+    std::string both;
+    if (result.k3_tested) {
+      both = fmt::format(" (with and without k3 the image corners lie {:.1f} px apart)",
+                         result.k3_corner_shift_px);
+    }
     w.push_back(
         fmt::format("corners reach only {:.0f}% of the half diagonal: the higher radial "
-                    "terms are not constrained",
-                    100 * cov.radius_fraction));
+                    "terms are not constrained{}",
+                    100 * cov.radius_fraction, both));
   }
   if (cov.tilt_range_deg < 15.0) {
     w.push_back(
@@ -372,6 +452,13 @@ void AddNotes(const IntrinsicsOptions& options, IntrinsicsResult* out) {
   if (!dropped_names.empty()) cam.notes["dropped_views"] = dropped_names;
   cam.notes["num_views"] = std::to_string(result.num_used);
   cam.notes["distortion_model"] = std::to_string(options.num_distortion) + " coefficients";
+  if (result.k3_tested) {
+    cam.notes["distortion_model"] +=
+        fmt::format(", k3 {} (BIC gain of fitting it {:.1f})",
+                    result.k3_kept ? "fitted" : "zero: it did not pay", result.k3_bic_gain);
+  } else if (options.num_distortion == 5 && options.k3 == K3Model::kZero) {
+    cam.notes["distortion_model"] += ", k3 zero";
+  }
   cam.notes["date"] = Today();
 }
 
@@ -385,12 +472,17 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   cv::Size size;
   const std::vector<int> found = CheckViews(views, options, &result, &size);
   const int max_drop = static_cast<int>(std::floor(options.max_drop_fraction * result.num_found));
-  const CvFit fit = FitDroppingOutliers(views, found, size, options, max_drop, &result);
+  int flags = CalibFlags(options, options.k3 == K3Model::kFree);
+  CvFit fit = FitDroppingOutliers(views, found, size, options, flags, max_drop, &result);
+  if (options.num_distortion == 5 && options.k3 != K3Model::kZero) {
+    fit = CompareK3(views, size, options, std::move(fit), options.k3 == K3Model::kFree, &flags,
+                    &result);
+  }
   SetCamera(fit, size, options, &result);
   result.rms_focal_lower_px =
-      RmsWithFocalScaled(views, fit, size, options, 1.0 / options.focal_profile_factor);
+      RmsWithFocalScaled(views, fit, size, flags, 1.0 / options.focal_profile_factor);
   result.rms_focal_higher_px =
-      RmsWithFocalScaled(views, fit, size, options, options.focal_profile_factor);
+      RmsWithFocalScaled(views, fit, size, flags, options.focal_profile_factor);
   result.coverage = Coverage(views, fit, size, options.coverage_grid);
   AddWarnings(size, options, max_drop, &result);
   AddNotes(options, &result);

@@ -979,11 +979,7 @@ void AddWarnings(int dropped_total, int max_drop, MultiResult* result) {
 
 bool TangentialPays(double sse_without, double sse_with, long long num_residuals,
                     double* bic_gain) {
-  double gain = -1e300;
-  if (num_residuals > 2 && sse_with > 0 && sse_without > 0) {
-    const double n = static_cast<double>(num_residuals);
-    gain = n * std::log(sse_without / sse_with) - 2.0 * std::log(n);
-  }
+  const double gain = util::BicGain(sse_without, sse_with, num_residuals, 2);
   if (bic_gain) *bic_gain = gain;
   return gain > 0;
 }

@@ -65,4 +65,10 @@ double RobustSigma(const std::vector<double>& values) {
   return kMadToSigma * Median(std::move(dev));
 }
 
+double BicGain(double sse_without, double sse_with, long long num_residuals, int extra_params) {
+  if (num_residuals <= extra_params || !(sse_with > 0) || !(sse_without > 0)) return -1e300;
+  const double n = static_cast<double>(num_residuals);
+  return n * std::log(sse_without / sse_with) - extra_params * std::log(n);
+}
+
 }  // namespace fv::util

@@ -1,6 +1,7 @@
 // Summary statistics used across modules (error tables, robust thresholds): percentiles with
 // linear interpolation between closest ranks (numpy's default) or the nearest rank, median, mean,
-// RMS and the median absolute deviation scaled to a normal sigma (Hampel 1974).
+// RMS, the median absolute deviation scaled to a normal sigma (Hampel 1974) and the Bayesian
+// information criterion's gain of a model with more parameters (Schwarz 1978).
 #pragma once
 
 #include <vector>
@@ -23,5 +24,10 @@ double Rms(const std::vector<double>& values);
 inline constexpr double kMadToSigma = 1.4826;
 // 1.4826 * median |x - median|: a normal sigma that ignores up to half the sample as outliers.
 double RobustSigma(const std::vector<double>& values);
+// How much the BIC drops when extra_params more parameters lower a least-squares fit's sum of
+// squared residuals from sse_without to sse_with over num_residuals residuals (Gaussian noise):
+// n ln(sse_without / sse_with) - extra_params ln n; > 0: they pay. -1e300 when either sum is
+// not positive or n <= extra_params.
+double BicGain(double sse_without, double sse_with, long long num_residuals, int extra_params);
 
 }  // namespace fv::util

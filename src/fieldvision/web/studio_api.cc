@@ -611,7 +611,8 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
   return {
       {{"POST", "/api/calibrate/intrinsics",
         "{images: FOLDER|GLOB|IMAGE|VIDEO, board: {type, cols, rows, square_m[, marker_m, "
-        "dictionary]}[, num_distortion, fix_aspect_ratio, zero_tangent, name, out]}: intrinsics "
+        "dictionary]}[, num_distortion, k3 (auto|free|zero), fix_aspect_ratio, zero_tangent, name, "
+        "out]}: intrinsics "
         "from board images with per-view errors; writes the camera file when out is given"},
        [](const Workspace& ws, EventHub* events, JobRunner*, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
@@ -623,6 +624,7 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
          o.camera_name = GetOr<std::string>(body, "name", "");
          o.progress = false;
          try {
+           o.k3 = calib::ParseK3Model(GetOr<std::string>(body, "k3", "free"));
            o.Check();
          } catch (const fv::Error& e) {
            throw HttpError(400, e.what());
