@@ -279,13 +279,19 @@ double CornerShiftPx(const CvFit& a, const CvFit& b, const cv::Size& size) {
 
 // With 5 coefficients: the fit of the other k3 model on the same views (`first` had k3 free
 // when first_free, its outliers dropped), compared by the BIC; K3Model::kAuto keeps the one it
-// prefers, kFree the free one. The kept fit's flags in *flags.
+// prefers, kFree the free one. The kept fit's flags in *flags; `first` alone (k3_tested false)
+// when the other fit fails.
 CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
                 const IntrinsicsOptions& options, CvFit first, bool first_free, int* flags,
                 IntrinsicsResult* out) {
   IntrinsicsResult trial = *out;
   const int other_flags = CalibFlags(options, !first_free);
-  CvFit other = FitDroppingOutliers(views, first.used, size, options, other_flags, 0, &trial);
+  CvFit other;
+  try {
+    other = FitDroppingOutliers(views, first.used, size, options, other_flags, 0, &trial);
+  } catch (const Error&) {
+    return first;  // the other model does not fit these views at all: no comparison
+  }
   const CvFit& with = first_free ? first : other;
   const CvFit& without = first_free ? other : first;
   long long points = 0;
