@@ -53,12 +53,13 @@ TEST(LearnColour, PinkBallFromARegionAndFromPoints) {
     EXPECT_GT(Selected(table, img, ball), 0.9) << res.Summary();
     EXPECT_LT(Selected(table, img, rest), 0.002) << res.Summary();
     EXPECT_EQ(res.overlay.size(), img.size());
-    // The learned colour finds the ball.
+    // The learned colour finds the ball (within 0.3 px at seeds 1-100 but 50, 0.41 px: the disc
+    // lies over a white line, the limit FitBall.SubpixelCentreOfShadedDiscs names).
     const BallDetector det(BallDetectorOptions{}, res.spec, nullptr, nullptr);
     const auto cands = det.Detect(img);
     ASSERT_FALSE(cands.empty());
     EXPECT_TRUE(cands.front().accepted) << cands.front().reason;
-    EXPECT_LT((cands.front().centre_px - c).norm(), 0.3);
+    EXPECT_LT((cands.front().centre_px - c).norm(), 0.3) << "ball at " << c.transpose();
   }
 }
 
