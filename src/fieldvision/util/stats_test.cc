@@ -58,5 +58,16 @@ TEST(Stats, MeanRmsRobustSigma) {
   EXPECT_NEAR(RobustSigma(v), 2.0, 0.3);            // outliers inflate it only a little
 }
 
+// Halving the sum of squares over 1000 residuals pays for one parameter by n ln 2 - ln n; a drop
+// of 0.1 % does not; sums that are not positive give no gain.
+TEST(Stats, BicGain) {
+  EXPECT_NEAR(BicGain(100, 50, 1000, 1), 1000 * std::log(2.0) - std::log(1000.0), 1e-9);
+  EXPECT_LT(BicGain(100, 99.9, 1000, 1), 0.0);
+  EXPECT_NEAR(BicGain(100, 50, 1000, 2), 1000 * std::log(2.0) - 2 * std::log(1000.0), 1e-9);
+  EXPECT_LT(BicGain(0, 50, 1000, 1), -1e299);
+  EXPECT_LT(BicGain(100, 0, 1000, 1), -1e299);
+  EXPECT_LT(BicGain(100, 50, 1, 1), -1e299);
+}
+
 }  // namespace
 }  // namespace fv::util
