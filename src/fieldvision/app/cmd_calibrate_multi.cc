@@ -81,7 +81,14 @@ void RunMulti(MultiCli& c) {
   }
   std::cout << "\ndistortion model:\n";
   for (const auto& rep : r.camera_reports) {
-    std::cout << fmt::format("  {:<12s} {}\n", rep.name, rep.model);
+    std::cout << fmt::format("  {:<12s} {}", rep.name, rep.model);
+    if (rep.own_k3_corner_shift_px > 0) {
+      std::cout << fmt::format(
+          "; alone, its fits with and without k3 put the image corners {:.1f} px apart (the "
+          "model is extrapolated where its boards did not reach)",
+          rep.own_k3_corner_shift_px);
+    }
+    std::cout << "\n";
   }
   std::cout << fmt::format("\n{:<24s} {:>12s} {:>12s} {:>7s}\n", "pair", "rotation_deg",
                            "baseline_mm", "shared");

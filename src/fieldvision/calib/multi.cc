@@ -183,6 +183,10 @@ std::string MultiResult::Summary() const {
     s += fmt::format(
         "\n  camera {}: {} of {} views used ({} images), rms {:.3f} px (alone {:.3f} px)", c.name,
         c.num_used, c.num_found, c.num_images, c.rms_px, c.own_rms_px);
+    if (c.own_k3_corner_shift_px > 0) {
+      s += fmt::format("; alone with and without k3 the image corners lie {:.1f} px apart",
+                       c.own_k3_corner_shift_px);
+    }
     if (cam) {
       s += fmt::format("; fx {:.2f} fy {:.2f} cx {:.2f} cy {:.2f}", cam->fx, cam->fy, cam->cx,
                        cam->cy);
@@ -416,6 +420,7 @@ std::vector<camera::Camera> InitialIntrinsics(const std::vector<std::string>& na
       const IntrinsicsResult ir = CalibrateFromViews(found, io);
       cams[c] = ir.camera;
       rep.own_rms_px = ir.rms_px;
+      rep.own_k3_corner_shift_px = ir.k3_tested ? ir.k3_corner_shift_px : 0.0;
     } catch (const Error& e) {
       Throw("camera '{}': {}", names[c], e.what());
     }

@@ -113,8 +113,12 @@ struct MultiCameraReport {
   std::string name;
   int num_images = 0, num_found = 0, num_used = 0;
   double own_rms_px = 0.0;  // its own calibrateCamera fit, before the joint adjustment
-  double rms_px = 0.0;      // joint fit, used views
-  int tree_parent = -1;     // camera it was chained from (-1: the reference)
+  // With 5 coefficients: how far apart its own fits with and without k3 put the image's corners
+  // (IntrinsicsResult::k3_corner_shift_px; 0 when not compared): where its boards stayed off the
+  // corners the model is extrapolated there.
+  double own_k3_corner_shift_px = 0.0;
+  double rms_px = 0.0;   // joint fit, used views
+  int tree_parent = -1;  // camera it was chained from (-1: the reference)
   int tree_shared_views = 0;
   // The distortion model kept: "k1 k2 p1 p2 k3" and why ("fixed", "--tangential zero", or the
   // camera's RMS without and with p1 p2 and the rig's BIC gain of the automatic choice).

@@ -494,6 +494,12 @@ TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
       CalibrateMulti({{"left", dir + "/left*.jpg"}, {"right", dir + "/right*.jpg"}}, o);
   ASSERT_EQ(r.pairs.size(), 1u);
   ASSERT_TRUE(r.pairs[0].has_opencv) << r.Summary();
+  // Each camera's own fits with and without k3 (the default 5 coefficients) are compared; these
+  // boards stay off the image's corners, and the two fits disagree there by pixels.
+  for (const auto& rep : r.camera_reports) {
+    EXPECT_GT(rep.own_k3_corner_shift_px, 1.0) << rep.name << "\n" << r.Summary();
+  }
+  EXPECT_NE(r.Summary().find("with and without k3"), std::string::npos) << r.Summary();
 
   // The baseline: the same corners, each camera's calibrateCamera, then stereoCalibrate.
   std::map<int, std::vector<cv::Point2f>> img[2];
