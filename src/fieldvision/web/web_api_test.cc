@@ -450,7 +450,8 @@ TEST_F(StudioApiTest, IntrinsicsFromBoardImagesWithPerViewErrors) {
   EXPECT_NEAR(written.fx, j["camera"]["fx"].get<double>(), 1e-3);
   EXPECT_EQ(written.name, "studio_cam");
 
-  // Bad requests: images outside, wildcards in a folder name, a bad board, no board found.
+  // Bad requests: images outside, wildcards in a folder name, a bad board, no board found, a k3
+  // model that is not one or not a string.
   body.erase("out");
   body["images"] = "../*.png";
   ExpectError(Post("/api/calibrate/intrinsics", body), 403, "");
@@ -463,6 +464,11 @@ TEST_F(StudioApiTest, IntrinsicsFromBoardImagesWithPerViewErrors) {
   ExpectError(Post("/api/calibrate/intrinsics", body), 422, "");
   body["board"] = "chessboard";
   ExpectError(Post("/api/calibrate/intrinsics", body), 400, "board");
+  body["board"] = chessboard;
+  body["k3"] = "maybe";
+  ExpectError(Post("/api/calibrate/intrinsics", body), 400, "k3");
+  body["k3"] = 5;
+  ExpectError(Post("/api/calibrate/intrinsics", body), 400, "k3");
 }
 
 TEST_F(StudioApiTest, LivePositionsFromAFusionNodeArriveAsEvents) {
