@@ -1,6 +1,7 @@
 #include "fieldvision/calib/intrinsics.h"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <numeric>
 
 #include <fmt/format.h>
+#include <Eigen/Core>
 #include <opencv2/calib3d.hpp>
 
 #include "fieldvision/util/error.h"
@@ -65,6 +67,22 @@ K3Model ParseK3Model(const std::string& name) {
   if (n == "free") return K3Model::kFree;
   if (n == "zero") return K3Model::kZero;
   Throw("k3 model '{}' is not known; use auto, free or zero", name);
+}
+
+double CornerShiftPx(const camera::Camera& a, const camera::Camera& b) {
+  FV_REQUIRE(a.width == b.width && a.height == b.height,
+             "corner shift: the cameras are {}x{} and {}x{}", a.width, a.height, b.width, b.height);
+  const double w = a.width - 1.0, h = a.height - 1.0;
+  const std::array<Eigen::Vector2d, 4> corners = {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0),
+                                                  Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)};
+  double worst = 0;
+  for (const Eigen::Vector2d& corner : corners) {
+    const auto ray = a.Undistort(corner);
+    const auto back = ray ? b.ProjectFromCamera(ray->homogeneous()) : std::nullopt;
+    if (!back) return std::numeric_limits<double>::infinity();
+    worst = std::max(worst, (*back - corner).norm());
+  }
+  return worst;
 }
 
 void IntrinsicsOptions::Check() const {
@@ -256,25 +274,20 @@ double RmsWithFocalScaled(const std::vector<BoardView>& views, const CvFit& fit,
   return std::numeric_limits<double>::infinity();  // no fit at all: the focal length matters
 }
 
-// How far apart two fits put the image's corners: each corner through the first fit back to its
-// ray, then through the second fit into the image (px, the largest of the four).
-double CornerShiftPx(const CvFit& a, const CvFit& b, const cv::Size& size) {
-  const std::vector<cv::Point2d> corners = {
-      {0, 0}, {size.width - 1.0, 0}, {0, size.height - 1.0}, {size.width - 1.0, size.height - 1.0}};
-  std::vector<cv::Point2d> normalized;
-  cv::undistortPoints(
-      corners, normalized, a.k, a.d, cv::noArray(), cv::noArray(),
-      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
-  std::vector<cv::Point3d> rays;
-  rays.reserve(normalized.size());
-  for (const auto& p : normalized) rays.emplace_back(p.x, p.y, 1.0);
-  std::vector<cv::Point2d> back;
-  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), b.k, b.d, back);
-  double worst = 0;
-  for (size_t i = 0; i < corners.size(); ++i) {
-    worst = std::max(worst, cv::norm(back[i] - corners[i]));
+// The lens of a fit: size, intrinsics and the options' number of distortion coefficients.
+camera::Camera LensOf(const CvFit& fit, const cv::Size& size, int num_distortion) {
+  camera::Camera cam;
+  cam.width = size.width;
+  cam.height = size.height;
+  cam.fx = fit.k.at<double>(0, 0);
+  cam.fy = fit.k.at<double>(1, 1);
+  cam.cx = fit.k.at<double>(0, 2);
+  cam.cy = fit.k.at<double>(1, 2);
+  cam.distortion.assign(num_distortion, 0.0);
+  for (int i = 0; i < num_distortion && i < static_cast<int>(fit.d.total()); ++i) {
+    cam.distortion[i] = fit.d.at<double>(i);
   }
-  return worst;
+  return cam;
 }
 
 // With 5 coefficients: the fit of the other k3 model on the same views (`first` had k3 free
@@ -313,7 +326,8 @@ CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
   result.rms_without_k3_px = without.rms;
   result.rms_with_k3_px = with.rms;
   result.k3_bic_gain = gain;
-  result.k3_corner_shift_px = CornerShiftPx(without, with, size);
+  result.k3_corner_shift_px = CornerShiftPx(LensOf(without, size, options.num_distortion),
+                                            LensOf(with, size, options.num_distortion));
   if (!keep_other) return first;
   *flags = other_flags;
   return other;
@@ -323,19 +337,10 @@ CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
 void SetCamera(const CvFit& fit, const cv::Size& size, const IntrinsicsOptions& options,
                IntrinsicsResult* out) {
   IntrinsicsResult& result = *out;
-  const cv::Mat &k = fit.k, &d = fit.d, &std_intr = fit.std_intr;
+  const cv::Mat& std_intr = fit.std_intr;
   camera::Camera& cam = result.camera;
+  cam = LensOf(fit, size, options.num_distortion);
   cam.name = options.camera_name;
-  cam.width = size.width;
-  cam.height = size.height;
-  cam.fx = k.at<double>(0, 0);
-  cam.fy = k.at<double>(1, 1);
-  cam.cx = k.at<double>(0, 2);
-  cam.cy = k.at<double>(1, 2);
-  cam.distortion.assign(options.num_distortion, 0.0);
-  for (int i = 0; i < options.num_distortion && i < static_cast<int>(d.total()); ++i) {
-    cam.distortion[i] = d.at<double>(i);
-  }
   cam.rms_px = fit.rms;
   cam.Check("calibrated camera");
   if (std_intr.total() >= 4) {

@@ -109,6 +109,11 @@ struct IntrinsicsResult {
 // min_views views are usable.
 IntrinsicsResult CalibrateIntrinsics(const std::string& images, const IntrinsicsOptions& options);
 
+// How far apart two lens models of one image size put the image's corners: each corner through
+// `a` back to its ray (camera::Camera::Undistort), then through `b` into the image; px, the
+// largest of the four; infinity when `a` cannot invert a corner (beyond where its model folds).
+double CornerShiftPx(const camera::Camera& a, const camera::Camera& b);
+
 // The fit alone, on views already detected (all of one size); used by the above and the tests.
 IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
                                     const IntrinsicsOptions& options);

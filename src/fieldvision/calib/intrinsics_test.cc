@@ -128,25 +128,35 @@ std::vector<BoardView> ProjectedViews(const BoardSpec& b, const cv::Matx33d& k,
   return views;
 }
 
-// How far a calibrated camera puts the image's corners from where the true lens (k, d) does:
-// the true corners' rays through the camera (px, the largest of the four).
+// How far a calibrated camera puts the image's corners from where the true lens (k, d) does.
 double CornerErrorPx(const camera::Camera& c, const cv::Matx33d& k, const std::vector<double>& d) {
-  const std::vector<cv::Point2d> corners = {{0, 0}, {639, 0}, {0, 479}, {639, 479}};
-  std::vector<cv::Point2d> normalized;
-  cv::undistortPoints(
-      corners, normalized, k, d, cv::noArray(), cv::noArray(),
-      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
-  std::vector<cv::Point3d> rays;
-  rays.reserve(normalized.size());
-  for (const auto& p : normalized) rays.emplace_back(p.x, p.y, 1.0);
-  const cv::Matx33d k_est(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
-  std::vector<cv::Point2d> back;
-  cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), k_est, c.distortion, back);
-  double worst = 0;
-  for (size_t i = 0; i < corners.size(); ++i) {
-    worst = std::max(worst, cv::norm(back[i] - corners[i]));
-  }
-  return worst;
+  camera::Camera truth = c;
+  truth.fx = k(0, 0);
+  truth.fy = k(1, 1);
+  truth.cx = k(0, 2);
+  truth.cy = k(1, 2);
+  truth.distortion = d;
+  return CornerShiftPx(truth, c);
+}
+
+// The corner distance of two lenses: zero for one lens; for focal lengths 1 % apart without
+// distortion, 1 % of the farthest corner's offset from the principal point.
+TEST(Intrinsics, CornerShiftOfTwoLenses) {
+  camera::Camera a;
+  a.width = 640;
+  a.height = 480;
+  a.fx = a.fy = 540;
+  a.cx = 330;
+  a.cy = 238;
+  a.distortion = {-0.25, 0.08, 0.0, 0.0, 0.0};
+  EXPECT_LT(CornerShiftPx(a, a), 1e-9);
+  camera::Camera b = a;
+  a.distortion.clear();
+  b.distortion.clear();
+  b.fx = b.fy = 1.01 * a.fx;
+  EXPECT_NEAR(CornerShiftPx(a, b), std::hypot(0.01 * 330, 0.01 * (479 - 238)), 1e-9);
+  b.width = 320;
+  EXPECT_THROW(CornerShiftPx(a, b), fv::Error);
 }
 
 TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
