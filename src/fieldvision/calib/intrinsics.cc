@@ -61,12 +61,12 @@ void CheckDistortionModel(int n) {
              "num_distortion must be 4, 5, 8, 12 or 14 (got {})", n);
 }
 
-K3Model ParseK3Model(const std::string& name) {
+TermModel ParseTermModel(const std::string& name, const std::string& what) {
   const std::string n = util::ToLower(name);
-  if (n == "auto") return K3Model::kAuto;
-  if (n == "free") return K3Model::kFree;
-  if (n == "zero") return K3Model::kZero;
-  Throw("k3 model '{}' is not known; use auto, free or zero", name);
+  if (n == "auto") return TermModel::kAuto;
+  if (n == "free") return TermModel::kFree;
+  if (n == "zero") return TermModel::kZero;
+  Throw("{} '{}' is not known; use auto, free or zero", what, name);
 }
 
 double CornerShiftPx(const camera::Camera& a, const camera::Camera& b) {

@@ -17,10 +17,14 @@ namespace fv::calib {
 // Throws fv::Error unless n is an OpenCV distortion model size: 4, 5, 8, 12 or 14.
 void CheckDistortionModel(int n);
 
-// The r^6 radial term k3 of the 5-coefficient model: chosen by the views, always fitted, or zero.
-enum class K3Model { kAuto, kFree, kZero };
-// "auto", "free" or "zero"; throws fv::Error naming the value otherwise.
-K3Model ParseK3Model(const std::string& name);
+// Optional distortion terms (k3; a rig camera's p1 p2): chosen by the views, always fitted, or
+// zero.
+enum class TermModel { kAuto, kFree, kZero };
+// "auto", "free" or "zero" (any case); throws fv::Error naming `what` and the value otherwise.
+TermModel ParseTermModel(const std::string& name, const std::string& what);
+// The r^6 radial term k3 of the 5-coefficient model.
+using K3Model = TermModel;
+inline K3Model ParseK3Model(const std::string& name) { return ParseTermModel(name, "k3 model"); }
 
 struct IntrinsicsOptions {
   BoardSpec board;

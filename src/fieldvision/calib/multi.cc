@@ -146,14 +146,6 @@ Pairing ParsePairing(const std::string& name) {
   Throw("pairing '{}' is not known; use auto, order or frame", name);
 }
 
-TangentialModel ParseTangentialModel(const std::string& name) {
-  const std::string n = util::ToLower(name);
-  if (n == "auto") return TangentialModel::kAuto;
-  if (n == "free") return TangentialModel::kFree;
-  if (n == "zero") return TangentialModel::kZero;
-  Throw("tangential model '{}' is not known; use auto, free or zero", name);
-}
-
 void MultiOptions::Check() const {
   board.Check();
   detect.Check();

@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/calib/board.h"
+#include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/camera/camera.h"
 
 namespace fv::calib {
@@ -36,8 +37,10 @@ enum class Pairing { kAuto, kOrder, kFrameNumber };
 Pairing ParsePairing(const std::string& name);
 
 // Tangential distortion (p1 p2) in the rig's fit: chosen per camera, always fitted, or zero.
-enum class TangentialModel { kAuto, kFree, kZero };
-TangentialModel ParseTangentialModel(const std::string& name);
+using TangentialModel = TermModel;
+inline TangentialModel ParseTangentialModel(const std::string& name) {
+  return ParseTermModel(name, "tangential model");
+}
 
 // Whether fitting one camera's p1 p2 lowers the sum of squared corner residuals (px^2) enough for
 // 2 more parameters: the Bayesian information criterion, n ln(sse_without / sse_with) > 2 ln n,
