@@ -152,9 +152,8 @@ Roster ReadRoster(const std::string& path) {
     const int id = static_cast<int>(t.GetInt(i, "id"));
     const int team = static_cast<int>(t.GetInt(i, "team"));
     if (team >= 0) r.team_of[id] = team;
-    if (t.Has("name") && !util::Trim(t.Get(i, "name")).empty()) {
-      r.name_of[id] = util::Trim(t.Get(i, "name"));
-    }
+    const std::string name = t.Has("name") ? util::Trim(t.Get(i, "name")) : std::string();
+    if (!name.empty()) r.name_of[id] = name;
   }
   return r;
 }
