@@ -156,9 +156,10 @@ TEST(FitBall, ShadedSideKeepsItsOutline) {
   EXPECT_LT(*std::max_element(radius_err.begin(), radius_err.end()), 0.5);
 }
 
-// Not at every seed: at 2 of seeds 1-20 a small ball (r 6.5 px) with a third hidden fits a
-// motion-blurred ellipse instead (the straight occluder's edge and the round side make a stadium
-// shape); requiring soft ends for a blur ellipse fixed that but cost a real MSL ball.
+// Not at every seed: at 6 of seeds 1-60 (9, 17, 23, 28, 53, 55) a small ball (r 6.5 px) with a
+// third hidden fits a motion-blurred ellipse instead (the straight occluder's edge and the round
+// side make a stadium shape); requiring soft ends for a blur ellipse fixed that but cost a real MSL
+// ball.
 TEST(FitBall, PartlyOccludedBallFitsTheFreeOutline) {
   const uint64_t seed = fv::testing::TestSeed(8);
   FV_SEED_TRACE(seed);

@@ -97,7 +97,9 @@ TEST(ScanBlobs, CoarseStepFindsEachDiscOnceWithItsSize) {
           ++matches;
           EXPECT_NEAR(b.equivalent_radius_px(), r, 0.15 * r + step);
           EXPECT_NEAR(b.fill_ratio(), M_PI / 4, 0.25);
-          EXPECT_LE(b.aspect_ratio(), 1.5);  // 3 by 2 samples of a small disc at step 4
+          // 3 by 2 samples of a small disc at step 4; a disc under 2 steps in radius can show
+          // in one row only, its edge rows' short chords not classified (r 4.4 at seed 56).
+          EXPECT_LE(b.aspect_ratio(), r < 2 * step ? 2.0 : 1.5) << "r " << r;
         }
       }
       EXPECT_EQ(matches, 1) << "disc at " << c.transpose() << " r " << r;
