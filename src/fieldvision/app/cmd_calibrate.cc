@@ -153,7 +153,7 @@ struct IntrinsicsCli {
   std::string images, out, name;
   BoardCli board;
   IntrinsicsOptions o;
-  std::string k3 = "free";
+  std::string k3 = "auto";
   bool quiet = false;
 };
 
@@ -489,10 +489,11 @@ void SetupIntrinsics(CLI::App* group) {
   AddBoardOptions(in, ic->board);
   AddBoardFitOptions(in, ic->o);
   in->add_option("--k3", ic->k3,
-                 "With --model 5, the r^6 term k3: free (OpenCV's default), auto (kept only "
-                 "where it pays by the BIC; better for a lens without it, worse for one with it "
-                 "where the board did not reach the image's corners) or zero; free and auto "
-                 "print how far apart the fits with and without k3 put the image's corners")
+                 "With --model 5, the r^6 term k3: auto (kept only on very strong evidence, BIC "
+                 "gain over 10: a board that stays off the image's corners extrapolates k3 "
+                 "there), free (OpenCV's) or zero; auto and free print how far apart the fits "
+                 "with and without k3 put the image's corners and how each predicts the "
+                 "outermost corners from the others")
       ->check(CLI::IsMember({"auto", "free", "zero"}))
       ->capture_default_str();
   in->add_flag("--fix-aspect", ic->o.fix_aspect_ratio, "Keep fx = fy");

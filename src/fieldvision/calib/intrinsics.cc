@@ -125,10 +125,11 @@ std::string IntrinsicsResult::Summary() const {
                    rms_focal_lower_px, rms_focal_higher_px);
   if (k3_tested) {
     s += fmt::format(
-        "; k3 {} (rms {:.4f} px without, {:.4f} px with: BIC gain {:.1f}; the two fits put the "
-        "image corners {:.1f} px apart)",
+        "; k3 {} (rms {:.4f} px without, {:.4f} px with: BIC gain {:.1f}; fitted on the inner "
+        "corners, the outermost {:.0f} % predicted at {:.2f} px rms without, {:.2f} px with; the "
+        "two fits put the image corners {:.1f} px apart)",
         k3_kept ? "fitted" : "left out", rms_without_k3_px, rms_with_k3_px, k3_bic_gain,
-        k3_corner_shift_px);
+        100 * kK3HoldOutShare, k3_outer_rms_without_px, k3_outer_rms_with_px, k3_corner_shift_px);
   }
   return s;
 }
@@ -290,6 +291,73 @@ camera::Camera LensOf(const CvFit& fit, const cv::Size& size, int num_distortion
   return cam;
 }
 
+// The distance from the image's centre beyond which the outermost `share` of the used views'
+// corners lie.
+double OuterRadiusPx(const std::vector<BoardView>& views, const std::vector<int>& used,
+                     const cv::Size& size, double share) {
+  const cv::Point2f centre(0.5F * static_cast<float>(size.width - 1),
+                           0.5F * static_cast<float>(size.height - 1));
+  std::vector<double> r;
+  for (int i : used) {
+    for (const auto& p : views[i].image_points) r.push_back(cv::norm(p - centre));
+  }
+  if (r.empty()) return 0.0;
+  const auto nth = r.begin() + static_cast<std::ptrdiff_t>((1.0 - share) * (r.size() - 1));
+  std::nth_element(r.begin(), nth, r.end());
+  return *nth;
+}
+
+// How well a lens model extrapolates: fitted (flags) on the corners of the used views inside
+// radius_px of the image's centre (views with at least 8 there), it predicts their corners
+// outside, each view's pose from the same fit. RMS in px; infinity when the fit fails or leaves
+// nothing to predict.
+double OuterPredictionRmsPx(const std::vector<BoardView>& views, const std::vector<int>& used,
+                            const cv::Size& size, int flags, double radius_px) {
+  const cv::Point2f centre(0.5F * static_cast<float>(size.width - 1),
+                           0.5F * static_cast<float>(size.height - 1));
+  std::vector<std::vector<cv::Point3f>> obj, outer_obj;
+  std::vector<std::vector<cv::Point2f>> img, outer_img;
+  for (int i : used) {
+    const BoardView& v = views[i];
+    std::vector<cv::Point3f> o_in, o_out;
+    std::vector<cv::Point2f> i_in, i_out;
+    for (size_t k = 0; k < v.image_points.size(); ++k) {
+      const bool inner = cv::norm(v.image_points[k] - centre) < radius_px;
+      (inner ? o_in : o_out).push_back(v.object_points[k]);
+      (inner ? i_in : i_out).push_back(v.image_points[k]);
+    }
+    if (i_in.size() < 8) continue;
+    obj.push_back(std::move(o_in));
+    img.push_back(std::move(i_in));
+    outer_obj.push_back(std::move(o_out));
+    outer_img.push_back(std::move(i_out));
+  }
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  if (obj.size() < 3) return kNone;
+  cv::Mat k = cv::Mat::eye(3, 3, CV_64F), d = cv::Mat::zeros(1, 14, CV_64F);
+  std::vector<cv::Mat> rvecs, tvecs;
+  try {
+    cv::calibrateCamera(
+        obj, img, size, k, d, rvecs, tvecs, flags,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+  } catch (const cv::Exception&) {
+    return kNone;
+  }
+  double sse = 0;
+  long long n = 0;
+  for (size_t v = 0; v < obj.size(); ++v) {
+    if (outer_obj[v].empty()) continue;
+    std::vector<cv::Point2f> projected;
+    cv::projectPoints(outer_obj[v], rvecs[v], tvecs[v], k, d, projected);
+    for (size_t i = 0; i < projected.size(); ++i) {
+      const cv::Point2f e = projected[i] - outer_img[v][i];
+      sse += e.dot(e);
+      ++n;
+    }
+  }
+  return n > 0 && std::isfinite(sse) ? std::sqrt(sse / static_cast<double>(n)) : kNone;
+}
+
 // With 5 coefficients: the fit of the other k3 model on the same views (`first` had k3 free
 // when first_free, its outliers dropped), compared by the BIC; K3Model::kAuto keeps the one it
 // prefers, kFree the free one. The kept fit's flags in *flags; `first` alone (k3_tested false)
@@ -313,7 +381,14 @@ CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
   const double gain =
       util::BicGain(without.rms * without.rms * static_cast<double>(points),
                     with.rms * with.rms * static_cast<double>(points), 2 * points, 1);
-  const bool keep_free = options.k3 == K3Model::kFree || gain > 0;
+  const bool keep_free = options.k3 == K3Model::kFree || gain > kK3MinBicGain;
+  // What the choice means beyond the board's reach: both models fitted on the inner corners
+  // predict the outermost ones.
+  const double radius_px = OuterRadiusPx(views, first.used, size, kK3HoldOutShare);
+  const double outer_with =
+      OuterPredictionRmsPx(views, first.used, size, CalibFlags(options, true), radius_px);
+  const double outer_without =
+      OuterPredictionRmsPx(views, first.used, size, CalibFlags(options, false), radius_px);
   const bool keep_other = keep_free != first_free;
   if (keep_other) {
     *out = std::move(trial);  // the views' errors of the kept fit
@@ -326,6 +401,8 @@ CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
   result.rms_without_k3_px = without.rms;
   result.rms_with_k3_px = with.rms;
   result.k3_bic_gain = gain;
+  result.k3_outer_rms_without_px = outer_without;
+  result.k3_outer_rms_with_px = outer_with;
   result.k3_corner_shift_px = CornerShiftPx(LensOf(without, size, options.num_distortion),
                                             LensOf(with, size, options.num_distortion));
   if (!keep_other) return first;
@@ -465,8 +542,8 @@ void AddNotes(const IntrinsicsOptions& options, IntrinsicsResult* out) {
   cam.notes["distortion_model"] = std::to_string(options.num_distortion) + " coefficients";
   if (result.k3_tested) {
     cam.notes["distortion_model"] +=
-        fmt::format(", k3 {} (BIC gain of fitting it {:.1f})",
-                    result.k3_kept ? "fitted" : "zero: it did not pay", result.k3_bic_gain);
+        fmt::format(", k3 {} (BIC gain of fitting it {:.1f}; kept by auto over {:.0f})",
+                    result.k3_kept ? "fitted" : "zero", result.k3_bic_gain, kK3MinBicGain);
   } else if (options.num_distortion == 5 && options.k3 == K3Model::kZero) {
     cam.notes["distortion_model"] += ", k3 zero";
   }

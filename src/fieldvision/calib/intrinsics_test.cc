@@ -179,8 +179,8 @@ TEST(Intrinsics, OutlierViewIsDroppedAndNamed) {
   EXPECT_EQ(r.camera.notes.at("dropped_views"), "view05");
   EXPECT_LT(r.rms_px, 0.2);
   EXPECT_NEAR(r.camera.fx, 540, 3);
-  EXPECT_TRUE(r.k3_tested);  // the fit without k3 is made for the comparison
-  EXPECT_TRUE(r.k3_kept);    // OpenCV's default model
+  EXPECT_TRUE(r.k3_tested);  // the fit with k3 is made for the comparison
+  EXPECT_FALSE(r.k3_kept);   // the lens has none (K3Model::kAuto, the default)
 }
 
 // A lens without k3 whose corners the board did not reach (about 75 % of the half diagonal):
@@ -201,6 +201,10 @@ TEST(Intrinsics, K3AutoLeavesItOutForALensWithoutIt) {
   EXPECT_NE(r.Summary().find("k3 left out"), std::string::npos) << r.Summary();
   EXPECT_NE(r.camera.notes.at("distortion_model").find("k3 zero"), std::string::npos);
   EXPECT_LT(CornerErrorPx(r.camera, k, d), 15.0) << r.Summary();
+  // How each model, fitted on the other corners, predicts the outermost 20 %: reported.
+  EXPECT_GT(r.k3_outer_rms_without_px, 0.0);
+  EXPECT_TRUE(std::isfinite(r.k3_outer_rms_with_px)) << r.Summary();
+  EXPECT_NE(r.Summary().find("the outermost 20 % predicted at"), std::string::npos);
 }
 
 // A lens with a strong r^6 term (k3 0.2) seen by 24 views that reach near the image's corners:

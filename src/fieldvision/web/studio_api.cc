@@ -624,7 +624,7 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
          o.camera_name = GetOr<std::string>(body, "name", "");
          o.progress = false;
          try {
-           o.k3 = calib::ParseK3Model(GetOr<std::string>(body, "k3", "free"));
+           o.k3 = calib::ParseK3Model(GetOr<std::string>(body, "k3", "auto"));
            o.Check();
          } catch (const fv::Error& e) {
            throw HttpError(400, e.what());
