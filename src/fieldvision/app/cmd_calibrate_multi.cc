@@ -31,7 +31,7 @@ using fv::calib::WriteCalibrationToml;
 using fv::calib::WriteMultiCorners;
 
 struct MultiCli {
-  std::string out, pairing = "auto", tangential = "auto";
+  std::string out, pairing = "auto", tangential = "auto", k3 = "auto";
   BoardCli board;
   std::vector<std::string> views, intrinsics;
   bool fix_intrinsics = false, zero_tangent = false, quiet = false, no_pictures = false;
@@ -44,6 +44,7 @@ void RunMulti(MultiCli& c) {
   c.o.progress = !c.quiet;
   c.o.refine_intrinsics = !c.fix_intrinsics;
   c.o.tangential = c.zero_tangent ? TangentialModel::kZero : ParseTangentialModel(c.tangential);
+  c.o.k3 = fv::calib::ParseK3Model(c.k3);
   std::vector<CameraViews> cams;
   for (const auto& v : c.views) cams.push_back(ParseCameraViews(v));
   for (const auto& k : c.intrinsics) {
@@ -162,6 +163,12 @@ void Setup(CLI::App& app, int& exit_code) {
                   "reprojection error by more than its 2 parameters cost: BIC), free or zero")
       ->capture_default_str();
   cmd->add_flag("--zero-tangent", c->zero_tangent, "The same as --tangential zero");
+  cmd->add_option("--k3", c->k3,
+                  "With --model 5, the r^6 term k3 per camera: auto (kept only on very strong "
+                  "evidence, BIC gain over 10: boards that stay off the image corners extrapolate "
+                  "k3 there), free (OpenCV's) or zero")
+      ->check(CLI::IsMember({"auto", "free", "zero"}))
+      ->capture_default_str();
   cmd->add_option("--loss-px", c->o.loss_px, "Huber scale of the bundle adjustment in pixels")
       ->check(FiniteRange(0.01, 1000))
       ->capture_default_str();

@@ -12,6 +12,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -346,7 +347,7 @@ std::vector<MultiFrame> PairViews(const std::vector<CameraDetections>& cameras, 
 
 namespace {  // The stages of CalibrateMultiFromFrames.
 
-constexpr int kP1 = 4 + 2, kP2 = 4 + 3;  // p1 p2 in the intrinsics block (OpenCV order)
+constexpr int kP1 = 4 + 2, kP2 = 4 + 3, kK3 = 4 + 4;  // in the intrinsics block (OpenCV order)
 
 void CheckFrames(const std::vector<std::string>& names, const std::vector<MultiFrame>& frames) {
   const int nc = static_cast<int>(names.size());
@@ -405,6 +406,7 @@ std::vector<camera::Camera> InitialIntrinsics(const std::vector<std::string>& na
     io.detect = options.detect;
     io.num_distortion = options.num_distortion;
     io.zero_tangent = options.tangential == TangentialModel::kZero;
+    io.k3 = options.k3;
     io.min_views = options.min_views;
     io.progress = false;
     io.camera_name = names[c];
@@ -526,6 +528,7 @@ struct RigState {
   std::vector<int> num_distortion;
   std::vector<bool> fixed;                        // intrinsics kept constant
   std::vector<bool> tangential;                   // p1 p2 free (else zero)
+  std::vector<bool> k3;                           // k3 free (else zero; 5+ coefficients)
   std::vector<Eigen::Vector3d> cam_r, cam_t;      // cam_from_ref
   std::vector<Eigen::Vector3d> board_r, board_t;  // ref_from_board per moment
   std::vector<bool> board_ok;
@@ -556,6 +559,8 @@ RigState StartState(const std::vector<std::string>& names, const std::vector<Mul
     s.fixed.push_back(!options.refine_intrinsics || options.known_intrinsics.count(names[c]) > 0);
     s.tangential.push_back(s.fixed[c] || options.tangential == TangentialModel::kFree);
     if (!s.tangential[c]) s.intr[c][kP1] = s.intr[c][kP2] = 0.0;
+    s.k3.push_back(s.num_distortion[c] >= 5 && (s.fixed[c] || options.k3 == K3Model::kFree));
+    if (s.num_distortion[c] >= 5 && !s.k3[c]) s.intr[c][kK3] = 0.0;
     s.cam_r[c] = cam_from_ref[c].Rvec();
     s.cam_t[c] = cam_from_ref[c].translation;
   }
@@ -644,6 +649,7 @@ void SolveRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOpt
     }
     std::vector<int> constant;
     if (!s->tangential[c]) constant = {kP1, kP2};
+    if (s->num_distortion[c] >= 5 && !s->k3[c]) constant.push_back(kK3);
     for (int i = 4 + s->num_distortion[c]; i < camera::kNumIntrinsics; ++i) constant.push_back(i);
     if (!constant.empty()) {
       problem.SetManifold(s->intr[c].data(),
@@ -721,12 +727,13 @@ void AdjustRig(RigState* s, const std::vector<MultiFrame>& frames, const MultiOp
   }
 }
 
-std::string ModelName(int num_distortion, bool tangential) {
+std::string ModelName(int num_distortion, bool tangential, bool k3) {
   static const char* const kNames[] = {"k1", "k2", "p1", "p2", "k3", "k4",   "k5",
                                        "k6", "s1", "s2", "s3", "s4", "tauX", "tauY"};
   std::string s;
   for (int i = 0; i < num_distortion; ++i) {
     if (!tangential && (i == 2 || i == 3)) continue;
+    if (!k3 && i == 4) continue;
     s += fmt::format("{}{}", s.empty() ? "" : " ", kNames[i]);
   }
   return s;
@@ -743,36 +750,68 @@ double RigSse(const RigState& s, const std::vector<MultiFrame>& frames, long lon
   return sse;
 }
 
-// TangentialModel::kAuto, from the rig fitted without p1 p2 (*s): forward selection. Each camera
-// still without them is tried with them (the whole rig fitted again); the one that lowers the
-// rig's squared error most keeps them if TangentialPays, and the others are tried again given it.
-// One camera's lens error moves the shared board poses and so every camera's residuals: freeing
-// all cameras at once would credit the others with its gain.
-void ChooseTangential(RigState* s, const std::vector<MultiFrame>& frames,
-                      const MultiOptions& options, MultiResult* result) {
+// An optional term of one camera's lens under automatic choice: p1 p2 (2 parameters) or k3 (1).
+struct TermChoice {
+  int camera = 0;
+  bool k3 = false;  // else p1 p2
+};
+
+// The terms still to choose: cameras not fixed, under --tangential auto / --k3 auto.
+std::vector<TermChoice> OpenTerms(const RigState& s, const MultiOptions& options) {
+  std::vector<TermChoice> open;
+  for (int c = 0; c < s.nc(); ++c) {
+    if (s.fixed[c]) continue;
+    if (options.tangential == TangentialModel::kAuto && !s.tangential[c]) {
+      open.push_back({c, false});
+    }
+    if (options.k3 == K3Model::kAuto && s.num_distortion[c] >= 5 && !s.k3[c]) {
+      open.push_back({c, true});
+    }
+  }
+  return open;
+}
+
+// The automatic choices, from the rig fitted without the open terms (*s): forward selection. Each
+// open term is tried (the whole rig fitted again); the one with the largest BIC gain
+// (util::BicGain on the rig's squared error, for its 2 or 1 parameters) is kept if it pays (k3:
+// over kK3MinBicGain, very strong evidence, as for one camera), and the others are tried again
+// given it. One camera's lens error moves the shared board poses and
+// so every camera's residuals: freeing all cameras at once would credit the others with its gain.
+void ChooseTerms(RigState* s, const std::vector<MultiFrame>& frames, const MultiOptions& options,
+                 MultiResult* result) {
   for (;;) {
     long long n = 0, n_c = 0;
     const double sse0 = RigSse(*s, frames, &n);
-    int best = -1;
     double best_gain = 0;
     RigState best_state;
-    for (int c = 0; c < s->nc(); ++c) {
-      if (s->fixed[c] || s->tangential[c]) continue;
+    bool found = false;
+    for (const TermChoice& term : OpenTerms(*s, options)) {
+      const int c = term.camera;
       RigState trial = *s;
-      trial.tangential[c] = true;
+      (term.k3 ? trial.k3 : trial.tangential)[c] = true;
       SolveRig(&trial, frames, options, result);
       long long n1 = 0;
+      const double gain = util::BicGain(sse0, RigSse(trial, frames, &n1), n, term.k3 ? 1 : 2);
+      const double rms0 = std::sqrt(2 * CameraSse(*s, frames, c, &n_c) / n_c);
+      const double rms1 = std::sqrt(2 * CameraSse(trial, frames, c, &n_c) / n_c);
       auto& rep = result->camera_reports[c];
-      TangentialPays(sse0, RigSse(trial, frames, &n1), n, &rep.tangential_bic);
-      rep.rms_without_tangential_px = std::sqrt(2 * CameraSse(*s, frames, c, &n_c) / n_c);
-      rep.rms_with_tangential_px = std::sqrt(2 * CameraSse(trial, frames, c, &n_c) / n_c);
-      if (rep.tangential_bic > best_gain) {
-        best = c;
-        best_gain = rep.tangential_bic;
+      if (term.k3) {
+        rep.k3_tested = true;
+        rep.rms_without_k3_px = rms0;
+        rep.rms_with_k3_px = rms1;
+        rep.k3_bic = gain;
+      } else {
+        rep.rms_without_tangential_px = rms0;
+        rep.rms_with_tangential_px = rms1;
+        rep.tangential_bic = gain;
+      }
+      if (gain > (term.k3 ? kK3MinBicGain : 0.0) && gain > best_gain) {
+        found = true;
+        best_gain = gain;
         best_state = std::move(trial);
       }
     }
-    if (best < 0) return;
+    if (!found) return;
     *s = std::move(best_state);
   }
 }
@@ -782,18 +821,28 @@ void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult*
   for (int c = 0; c < s.nc(); ++c) {
     auto& rep = result->camera_reports[c];
     rep.tangential = s.tangential[c];
-    const std::string name = ModelName(s.num_distortion[c], s.tangential[c]);
+    rep.k3 = s.k3[c];
+    const std::string name = ModelName(s.num_distortion[c], s.tangential[c], s.k3[c]);
     if (s.fixed[c]) {
       rep.model = name + " (intrinsics fixed)";
-    } else if (options.tangential != TangentialModel::kAuto) {
-      rep.model = name + (s.tangential[c] ? " (--tangential free)" : " (--tangential zero)");
-    } else {
-      rep.model = fmt::format(
-          "{} (p1 p2 {}: its rms {:.4f} px without them, {:.4f} px with; the rig's BIC gain "
-          "{:.1f})",
-          name, s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
-          rep.rms_with_tangential_px, rep.tangential_bic);
+      continue;
     }
+    std::vector<std::string> why;
+    if (options.tangential != TangentialModel::kAuto) {
+      why.push_back(s.tangential[c] ? "--tangential free" : "--tangential zero");
+    } else {
+      why.push_back(fmt::format(
+          "p1 p2 {}: its rms {:.4f} px without them, {:.4f} px with; the rig's BIC gain {:.1f}",
+          s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
+          rep.rms_with_tangential_px, rep.tangential_bic));
+    }
+    if (s.num_distortion[c] >= 5 && options.k3 == K3Model::kZero) why.push_back("--k3 zero");
+    if (rep.k3_tested) {
+      why.push_back(fmt::format(
+          "k3 {}: its rms {:.4f} px without it, {:.4f} px with; the rig's BIC gain {:.1f}",
+          s.k3[c] ? "kept" : "left out", rep.rms_without_k3_px, rep.rms_with_k3_px, rep.k3_bic));
+    }
+    rep.model = fmt::format("{} ({})", name, fmt::join(why, "; "));
   }
 }
 
@@ -895,6 +944,7 @@ void CompareWithOpenCv(const std::vector<MultiFrame>& frames,
   }
   if (obj.size() < 3) return;
   const bool zero_tangent = !s.tangential[i] && !s.tangential[j];
+  const bool zero_k3 = !s.k3[i] && !s.k3[j];
   auto k_of = [](const camera::Camera& c) {
     return cv::Mat(cv::Matx33d(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1));
   };
@@ -902,6 +952,7 @@ void CompareWithOpenCv(const std::vector<MultiFrame>& frames,
     cv::Mat d = c.distortion.empty() ? cv::Mat(cv::Mat::zeros(1, 5, CV_64F))
                                      : cv::Mat(c.distortion, true).reshape(1, 1);
     if (zero_tangent) d.at<double>(2) = d.at<double>(3) = 0.0;
+    if (zero_k3 && d.cols >= 5) d.at<double>(4) = 0.0;
     return d;
   };
   cv::Mat rot, t, e, fm;
@@ -909,7 +960,8 @@ void CompareWithOpenCv(const std::vector<MultiFrame>& frames,
     cv::Mat ki = k_of(cams[i]), kj = k_of(cams[j]), di = d_of(cams[i]), dj = d_of(cams[j]);
     p->opencv_rms_px = cv::stereoCalibrate(
         obj, img_i, img_j, ki, di, kj, dj, cv::Size(cams[i].width, cams[i].height), rot, t, e, fm,
-        cv::CALIB_USE_INTRINSIC_GUESS | (zero_tangent ? cv::CALIB_ZERO_TANGENT_DIST : 0));
+        cv::CALIB_USE_INTRINSIC_GUESS | (zero_tangent ? cv::CALIB_ZERO_TANGENT_DIST : 0) |
+            (zero_k3 ? cv::CALIB_FIX_K3 : 0));
   } catch (const cv::Exception&) {
     return;
   }
@@ -998,9 +1050,7 @@ MultiResult CalibrateMultiFromFrames(const std::vector<std::string>& names,
       static_cast<int>(std::floor(options.max_drop_fraction * state.NumUsedViews()));
   int dropped_total = 0;
   AdjustRig(&state, frames, options, max_drop, &dropped_total, &result);
-  if (options.tangential == TangentialModel::kAuto) {
-    ChooseTangential(&state, frames, options, &result);
-  }
+  ChooseTerms(&state, frames, options, &result);
   DescribeModels(state, options, &result);
   CollectCameras(names, frames, cams, state, options, &result);
   CollectPairs(frames, cams, state, options, &result);

@@ -60,6 +60,11 @@ struct MultiOptions {
   // frees them one camera at a time, the camera that lowers the rig's error most first, while
   // they pay for their 2 parameters (TangentialPays on the whole rig's residuals).
   TangentialModel tangential = TangentialModel::kAuto;
+  // k3 per camera with 5 coefficients: kFree (OpenCV's) fits it; kZero leaves it out; kAuto
+  // chooses it per camera in the same forward selection as p1 p2, kept only on very strong
+  // evidence (kK3MinBicGain). A rig whose boards stay off the image corners extrapolates k3
+  // there (IntrinsicsOptions::k3 has the measurements of each choice on real and projected views).
+  K3Model k3 = K3Model::kAuto;
   bool refine_intrinsics = true;  // intrinsics free in the bundle adjustment
   // Cameras whose intrinsics are known (by name): kept fixed, not calibrated again.
   std::map<std::string, camera::Camera> known_intrinsics;
@@ -124,10 +129,13 @@ struct MultiCameraReport {
   int tree_parent = -1;  // camera it was chained from (-1: the reference)
   int tree_shared_views = 0;
   // The distortion model kept: "k1 k2 p1 p2 k3" and why ("fixed", "--tangential zero", or the
-  // camera's RMS without and with p1 p2 and the rig's BIC gain of the automatic choice).
+  // camera's RMS without and with p1 p2, and k3, and the rig's BIC gain of the automatic choice).
   bool tangential = false;
   std::string model;
   double rms_without_tangential_px = 0.0, rms_with_tangential_px = 0.0, tangential_bic = 0.0;
+  // k3 the same way (k3 free: with 5+ coefficients and not --k3 zero; tested under --k3 auto).
+  bool k3 = false, k3_tested = false;
+  double rms_without_k3_px = 0.0, rms_with_k3_px = 0.0, k3_bic = 0.0;
 };
 
 struct MultiPairReport {
