@@ -301,8 +301,9 @@ TEST(Multi, K3IsChosenPerCamera) {
   std::cout << "image corners off (px), lenses without k3, with, without: auto";
   for (const MultiResult* m : {&r, &free, &zero}) {
     if (m != &r) std::cout << (m == &free ? "; free" : "; zero");
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < 3; ++c) {
       std::cout << fmt::format(" {:.2f}", CornerShiftPx(m->cameras[c], truth[c]));
+    }
   }
   std::cout << fmt::format("; k3 kept {} ({:.3f})\n", r.camera_reports[1].k3,
                            r.cameras[1].distortion[4]);
