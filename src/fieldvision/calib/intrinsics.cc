@@ -291,12 +291,15 @@ camera::Camera LensOf(const CvFit& fit, const cv::Size& size, int num_distortion
   return cam;
 }
 
+cv::Point2f ImageCentre(const cv::Size& size) {
+  return {0.5F * static_cast<float>(size.width - 1), 0.5F * static_cast<float>(size.height - 1)};
+}
+
 // The distance from the image's centre beyond which the outermost `share` of the used views'
 // corners lie.
 double OuterRadiusPx(const std::vector<BoardView>& views, const std::vector<int>& used,
                      const cv::Size& size, double share) {
-  const cv::Point2f centre(0.5F * static_cast<float>(size.width - 1),
-                           0.5F * static_cast<float>(size.height - 1));
+  const cv::Point2f centre = ImageCentre(size);
   std::vector<double> r;
   for (int i : used) {
     for (const auto& p : views[i].image_points) r.push_back(cv::norm(p - centre));
@@ -313,8 +316,7 @@ double OuterRadiusPx(const std::vector<BoardView>& views, const std::vector<int>
 // nothing to predict.
 double OuterPredictionRmsPx(const std::vector<BoardView>& views, const std::vector<int>& used,
                             const cv::Size& size, int flags, double radius_px) {
-  const cv::Point2f centre(0.5F * static_cast<float>(size.width - 1),
-                           0.5F * static_cast<float>(size.height - 1));
+  const cv::Point2f centre = ImageCentre(size);
   std::vector<std::vector<cv::Point3f>> obj, outer_obj;
   std::vector<std::vector<cv::Point2f>> img, outer_img;
   for (int i : used) {
@@ -359,9 +361,9 @@ double OuterPredictionRmsPx(const std::vector<BoardView>& views, const std::vect
 }
 
 // With 5 coefficients: the fit of the other k3 model on the same views (`first` had k3 free
-// when first_free, its outliers dropped), compared by the BIC; K3Model::kAuto keeps the one it
-// prefers, kFree the free one. The kept fit's flags in *flags; `first` alone (k3_tested false)
-// when the other fit fails.
+// when first_free, its outliers dropped), compared by the BIC; K3Model::kAuto keeps k3 where its
+// gain is over kK3MinBicGain, kFree always. The kept fit's flags in *flags; `first` alone
+// (k3_tested false) when the other fit fails.
 CvFit CompareK3(const std::vector<BoardView>& views, const cv::Size& size,
                 const IntrinsicsOptions& options, CvFit first, bool first_free, int* flags,
                 IntrinsicsResult* out) {

@@ -559,7 +559,9 @@ RigState StartState(const std::vector<std::string>& names, const std::vector<Mul
     s.fixed.push_back(!options.refine_intrinsics || options.known_intrinsics.count(names[c]) > 0);
     s.tangential.push_back(s.fixed[c] || options.tangential == TangentialModel::kFree);
     if (!s.tangential[c]) s.intr[c][kP1] = s.intr[c][kP2] = 0.0;
-    s.k3.push_back(s.num_distortion[c] >= 5 && (s.fixed[c] || options.k3 == K3Model::kFree));
+    // The choice is made with 5 coefficients, as for one camera; other models keep k3.
+    s.k3.push_back(s.num_distortion[c] >= 5 &&
+                   (s.fixed[c] || options.k3 == K3Model::kFree || s.num_distortion[c] != 5));
     if (s.num_distortion[c] >= 5 && !s.k3[c]) s.intr[c][kK3] = 0.0;
     s.cam_r[c] = cam_from_ref[c].Rvec();
     s.cam_t[c] = cam_from_ref[c].translation;
@@ -764,7 +766,7 @@ std::vector<TermChoice> OpenTerms(const RigState& s, const MultiOptions& options
     if (options.tangential == TangentialModel::kAuto && !s.tangential[c]) {
       open.push_back({c, false});
     }
-    if (options.k3 == K3Model::kAuto && s.num_distortion[c] >= 5 && !s.k3[c]) {
+    if (options.k3 == K3Model::kAuto && s.num_distortion[c] == 5 && !s.k3[c]) {
       open.push_back({c, true});
     }
   }
@@ -775,8 +777,8 @@ std::vector<TermChoice> OpenTerms(const RigState& s, const MultiOptions& options
 // open term is tried (the whole rig fitted again); the one with the largest BIC gain
 // (util::BicGain on the rig's squared error, for its 2 or 1 parameters) is kept if it pays (k3:
 // over kK3MinBicGain, very strong evidence, as for one camera), and the others are tried again
-// given it. One camera's lens error moves the shared board poses and
-// so every camera's residuals: freeing all cameras at once would credit the others with its gain.
+// given it. One camera's lens error moves the shared board poses and so every camera's
+// residuals: freeing all cameras at once would credit the others with its gain.
 void ChooseTerms(RigState* s, const std::vector<MultiFrame>& frames, const MultiOptions& options,
                  MultiResult* result) {
   for (;;) {
@@ -791,7 +793,15 @@ void ChooseTerms(RigState* s, const std::vector<MultiFrame>& frames, const Multi
       (term.k3 ? trial.k3 : trial.tangential)[c] = true;
       SolveRig(&trial, frames, options, result);
       long long n1 = 0;
-      const double gain = util::BicGain(sse0, RigSse(trial, frames, &n1), n, term.k3 ? 1 : 2);
+      const double sse1 = RigSse(trial, frames, &n1);
+      double gain = 0;
+      bool pays = false;
+      if (term.k3) {
+        gain = util::BicGain(sse0, sse1, n, 1);
+        pays = gain > kK3MinBicGain;
+      } else {
+        pays = TangentialPays(sse0, sse1, n, &gain);
+      }
       const double rms0 = std::sqrt(2 * CameraSse(*s, frames, c, &n_c) / n_c);
       const double rms1 = std::sqrt(2 * CameraSse(trial, frames, c, &n_c) / n_c);
       auto& rep = result->camera_reports[c];
@@ -805,7 +815,7 @@ void ChooseTerms(RigState* s, const std::vector<MultiFrame>& frames, const Multi
         rep.rms_with_tangential_px = rms1;
         rep.tangential_bic = gain;
       }
-      if (gain > (term.k3 ? kK3MinBicGain : 0.0) && gain > best_gain) {
+      if (pays && gain > best_gain) {
         found = true;
         best_gain = gain;
         best_state = std::move(trial);
@@ -836,7 +846,7 @@ void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult*
           s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
           rep.rms_with_tangential_px, rep.tangential_bic));
     }
-    if (s.num_distortion[c] >= 5 && options.k3 == K3Model::kZero) why.push_back("--k3 zero");
+    if (s.num_distortion[c] == 5 && options.k3 == K3Model::kZero) why.push_back("--k3 zero");
     if (rep.k3_tested) {
       why.push_back(fmt::format(
           "k3 {}: its rms {:.4f} px without it, {:.4f} px with; the rig's BIC gain {:.1f}",

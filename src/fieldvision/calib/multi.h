@@ -60,10 +60,11 @@ struct MultiOptions {
   // frees them one camera at a time, the camera that lowers the rig's error most first, while
   // they pay for their 2 parameters (TangentialPays on the whole rig's residuals).
   TangentialModel tangential = TangentialModel::kAuto;
-  // k3 per camera with 5 coefficients: kFree (OpenCV's) fits it; kZero leaves it out; kAuto
-  // chooses it per camera in the same forward selection as p1 p2, kept only on very strong
-  // evidence (kK3MinBicGain). A rig whose boards stay off the image corners extrapolates k3
-  // there (IntrinsicsOptions::k3 has the measurements of each choice on real and projected views).
+  // k3 per camera with 5 coefficients (other models keep it): kFree (OpenCV's) fits it; kZero
+  // leaves it out; kAuto chooses it per camera in the same forward selection as p1 p2, kept only on
+  // very strong evidence (kK3MinBicGain). A rig whose boards stay off the image corners
+  // extrapolates k3 there (IntrinsicsOptions::k3 has the measurements of each choice on real and
+  // projected views).
   K3Model k3 = K3Model::kAuto;
   bool refine_intrinsics = true;  // intrinsics free in the bundle adjustment
   // Cameras whose intrinsics are known (by name): kept fixed, not calibrated again.
@@ -133,7 +134,7 @@ struct MultiCameraReport {
   bool tangential = false;
   std::string model;
   double rms_without_tangential_px = 0.0, rms_with_tangential_px = 0.0, tangential_bic = 0.0;
-  // k3 the same way (k3 free: with 5+ coefficients and not --k3 zero; tested under --k3 auto).
+  // k3 the same way: whether it is fitted, and whether --k3 auto tried it (5 coefficients).
   bool k3 = false, k3_tested = false;
   double rms_without_k3_px = 0.0, rms_with_k3_px = 0.0, k3_bic = 0.0;
 };
