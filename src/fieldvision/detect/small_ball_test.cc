@@ -54,6 +54,7 @@ TEST(SmallBall, MixedPixelBallsAreFoundAndGrassIsNot) {
     EXPECT_NEAR(cands.front().radius_px, r, 0.5 * r + 0.3) << "r " << r;
   }
   // At least 8 of the 12 for 29 of seeds 1-30; 7 at seed 9, whose misses are all under 1.9 px.
+  // Fails at seed 61 of 1-100: 6 found, the 6 misses (r 1.6-2.6 px) without any candidate.
   EXPECT_GE(found, trials - 5) << misses;
   EXPECT_GT(small, 0);  // the smallest ones only by the small-ball stage
   // Grass with a white line: nothing of the ball's colour, however it is unmixed.

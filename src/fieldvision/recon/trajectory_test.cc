@@ -49,6 +49,8 @@ const Flight* Match(const TrajectoryResult& r, const FlightTruth& t) {
   return best_overlap > 0.5 * (t.t_end_s - t.t_start_s) ? best : nullptr;
 }
 
+// Three scenes per run (the seed and the next two). The 2 cm landing bound fails for the scenes
+// of seeds 33 (2.6 cm) and 62 (2.2 cm) of 1-64, so for runs at seeds 31-33 and 60-62.
 TEST(Trajectory, FindsEveryFlightWithOriginAndLandingWithin2cmAt5mmNoise) {
   const uint64_t seed0 = testing::TestSeed(11);
   for (uint64_t k = 0; k < 3; ++k) {
