@@ -20,8 +20,8 @@ void CheckDistortionModel(int n);
 // K3Model::kAuto keeps k3 where the evidence for it is very strong: a BIC gain (util::BicGain)
 // over 10 (Kass and Raftery, "Bayes factors", JASA 1995). Corner errors of real boards are not
 // independent, which inflates the gain: on the four real cameras of shared/data/pose2sim-4cam
-// (boards reaching 53-63 % of the half diagonal) the one with a gain of 3.5 got k3 3.5 and its
-// image corners 170 px from where the Qualisys reference puts them.
+// (boards reaching 53-63 % of the half diagonal) the one with a gain of 3.5 got k3 3.5 and a
+// radial distortion at the image's corner 168 px from the Qualisys reference's.
 inline constexpr double kK3MinBicGain = 10.0;
 // The share of the corners, outermost from the image's centre, held out to report how each
 // model extrapolates (IntrinsicsResult::k3_outer_rms_*).
@@ -50,7 +50,7 @@ struct IntrinsicsOptions {
   // board reached, the model extrapolates) and how each predicts the outermost corners from the
   // others. Real lenses (shared/data/pose2sim-4cam, boards reaching 53-63 % of the half diagonal,
   // against the Qualisys reference): the radial displacement at the image's corner is off by
-  // 0.4-19 px with kAuto (k3 left out on all four), 0.8-167 px with kFree. Projected views
+  // 0.4-19 px with kAuto (k3 left out on all four), 0.8-168 px with kFree. Projected views
   // (intrinsics tests): a lens without k3 seen by 12 views to about 75 % of the half diagonal,
   // image corners' error median 12.8 px, 161 at worst with kFree, 2.9 and 13.2 with kAuto; lenses
   // with k3 = +-0.05..0.1 seen by 16 views kept off the corners, kAuto's is 1.7-2.7 times kFree's
