@@ -805,16 +805,11 @@ void ChooseTerms(RigState* s, const std::vector<MultiFrame>& frames, const Multi
       const double rms0 = std::sqrt(2 * CameraSse(*s, frames, c, &n_c) / n_c);
       const double rms1 = std::sqrt(2 * CameraSse(trial, frames, c, &n_c) / n_c);
       auto& rep = result->camera_reports[c];
-      if (term.k3) {
-        rep.k3_tested = true;
-        rep.rms_without_k3_px = rms0;
-        rep.rms_with_k3_px = rms1;
-        rep.k3_bic = gain;
-      } else {
-        rep.rms_without_tangential_px = rms0;
-        rep.rms_with_tangential_px = rms1;
-        rep.tangential_bic = gain;
-      }
+      TermReport& tried = term.k3 ? rep.k3 : rep.tangential;
+      tried.tested = true;
+      tried.rms_without_px = rms0;
+      tried.rms_with_px = rms1;
+      tried.bic_gain = gain;
       if (pays && gain > best_gain) {
         found = true;
         best_gain = gain;
@@ -826,12 +821,19 @@ void ChooseTerms(RigState* s, const std::vector<MultiFrame>& frames, const Multi
   }
 }
 
+// Why an automatically chosen term is kept or left out ("p1 p2 kept: its rms ... without them").
+std::string TermWhy(const char* name, const char* pronoun, const TermReport& t) {
+  return fmt::format(
+      "{} {}: its rms {:.4f} px without {}, {:.4f} px with; the rig's BIC gain {:.1f}", name,
+      t.fitted ? "kept" : "left out", t.rms_without_px, pronoun, t.rms_with_px, t.bic_gain);
+}
+
 // Per camera: the model kept and why.
 void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult* result) {
   for (int c = 0; c < s.nc(); ++c) {
     auto& rep = result->camera_reports[c];
-    rep.tangential = s.tangential[c];
-    rep.k3 = s.k3[c];
+    rep.tangential.fitted = s.tangential[c];
+    rep.k3.fitted = s.k3[c];
     const std::string name = ModelName(s.num_distortion[c], s.tangential[c], s.k3[c]);
     if (s.fixed[c]) {
       rep.model = name + " (intrinsics fixed)";
@@ -841,17 +843,10 @@ void DescribeModels(const RigState& s, const MultiOptions& options, MultiResult*
     if (options.tangential != TangentialModel::kAuto) {
       why.push_back(s.tangential[c] ? "--tangential free" : "--tangential zero");
     } else {
-      why.push_back(fmt::format(
-          "p1 p2 {}: its rms {:.4f} px without them, {:.4f} px with; the rig's BIC gain {:.1f}",
-          s.tangential[c] ? "kept" : "left out", rep.rms_without_tangential_px,
-          rep.rms_with_tangential_px, rep.tangential_bic));
+      why.push_back(TermWhy("p1 p2", "them", rep.tangential));
     }
     if (s.num_distortion[c] == 5 && options.k3 == K3Model::kZero) why.push_back("--k3 zero");
-    if (rep.k3_tested) {
-      why.push_back(fmt::format(
-          "k3 {}: its rms {:.4f} px without it, {:.4f} px with; the rig's BIC gain {:.1f}",
-          s.k3[c] ? "kept" : "left out", rep.rms_without_k3_px, rep.rms_with_k3_px, rep.k3_bic));
-    }
+    if (rep.k3.tested) why.push_back(TermWhy("k3", "it", rep.k3));
     rep.model = fmt::format("{} ({})", name, fmt::join(why, "; "));
   }
 }

@@ -118,6 +118,13 @@ struct MultiViewReport {
   std::string dropped_because;
 };
 
+// One optional lens term of a camera in the rig (p1 p2, or k3): whether it is fitted, and where
+// the automatic choice tried it, the camera's RMS without and with it and the rig's BIC gain.
+struct TermReport {
+  bool fitted = false, tested = false;
+  double rms_without_px = 0.0, rms_with_px = 0.0, bic_gain = 0.0;
+};
+
 struct MultiCameraReport {
   std::string name;
   int num_images = 0, num_found = 0, num_used = 0;
@@ -131,12 +138,9 @@ struct MultiCameraReport {
   int tree_shared_views = 0;
   // The distortion model kept: "k1 k2 p1 p2 k3" and why ("fixed", "--tangential zero", or the
   // camera's RMS without and with p1 p2, and k3, and the rig's BIC gain of the automatic choice).
-  bool tangential = false;
   std::string model;
-  double rms_without_tangential_px = 0.0, rms_with_tangential_px = 0.0, tangential_bic = 0.0;
-  // k3 the same way: whether it is fitted, and whether --k3 auto tried it (5 coefficients).
-  bool k3 = false, k3_tested = false;
-  double rms_without_k3_px = 0.0, rms_with_k3_px = 0.0, k3_bic = 0.0;
+  TermReport tangential;  // p1 p2
+  TermReport k3;          // with 5 coefficients
 };
 
 struct MultiPairReport {

@@ -189,8 +189,8 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   // 0.049) and 42 (0.060, about 1.2 px of principal point; the broken view dropped). With the
   // true intrinsics: far within 0.05 deg (below).
   for (const auto& rep : r.camera_reports) {
-    EXPECT_FALSE(rep.tangential) << rep.name << ": " << rep.model;
-    EXPECT_LT(rep.tangential_bic, 0.0) << rep.name << ": " << rep.model;
+    EXPECT_FALSE(rep.tangential.fitted) << rep.name << ": " << rep.model;
+    EXPECT_LT(rep.tangential.bic_gain, 0.0) << rep.name << ": " << rep.model;
     EXPECT_NE(rep.model.find("left out"), std::string::npos) << rep.model;
   }
   EXPECT_LT(cmp.max_rotation_diff_deg, 0.07) << cmp.Summary() << "\n" << r.Summary();
@@ -223,7 +223,7 @@ TEST(Multi, FourCameraRigRelativePosesAndAnOutlierView) {
   std::cout << fmt::format("fitting p1 p2 too: relative rotations within {:.4f} deg\n",
                            cmp_tangent.max_rotation_diff_deg);
   EXPECT_LT(cmp_tangent.max_rotation_diff_deg, 0.15) << cmp_tangent.Summary();
-  EXPECT_TRUE(rt.camera_reports[0].tangential);
+  EXPECT_TRUE(rt.camera_reports[0].tangential.fitted);
   for (const auto& c : r.cameras) {
     EXPECT_EQ(c.distortion[2], 0.0);
     EXPECT_EQ(c.distortion[3], 0.0);
@@ -255,9 +255,9 @@ TEST(Multi, TangentialTermsAreKeptWhereALensHasThem) {
   const MultiOptions o = ProjectedOptions();
   const auto frames = ProjectedMoments(truth, o.board, 30, rng);
   const MultiResult r = CalibrateMultiFromFrames(Names(truth), frames, o);
-  EXPECT_FALSE(r.camera_reports[0].tangential) << r.Summary();
-  EXPECT_TRUE(r.camera_reports[1].tangential) << r.Summary();
-  EXPECT_FALSE(r.camera_reports[2].tangential) << r.Summary();
+  EXPECT_FALSE(r.camera_reports[0].tangential.fitted) << r.Summary();
+  EXPECT_TRUE(r.camera_reports[1].tangential.fitted) << r.Summary();
+  EXPECT_FALSE(r.camera_reports[2].tangential.fitted) << r.Summary();
   EXPECT_NEAR(r.cameras[1].distortion[2], 1.5e-3, 3e-4) << r.Summary();
   EXPECT_EQ(r.cameras[0].distortion[2], 0.0);
   EXPECT_NE(r.Summary().find("p1 p2 kept"), std::string::npos) << r.Summary();
@@ -305,23 +305,23 @@ TEST(Multi, K3IsChosenPerCamera) {
       std::cout << fmt::format(" {:.2f}", CornerShiftPx(m->cameras[c], truth[c]));
     }
   }
-  std::cout << fmt::format("; k3 kept {} ({:.3f})\n", r.camera_reports[1].k3,
+  std::cout << fmt::format("; k3 kept {} ({:.3f})\n", r.camera_reports[1].k3.fitted,
                            r.cameras[1].distortion[4]);
   for (int c : {0, 2}) {
-    EXPECT_FALSE(r.camera_reports[c].k3) << r.Summary();
-    EXPECT_TRUE(r.camera_reports[c].k3_tested) << r.Summary();
+    EXPECT_FALSE(r.camera_reports[c].k3.fitted) << r.Summary();
+    EXPECT_TRUE(r.camera_reports[c].k3.tested) << r.Summary();
     EXPECT_EQ(r.cameras[c].distortion[4], 0.0);
     EXPECT_NE(r.camera_reports[c].model.find("k3 left out"), std::string::npos) << r.Summary();
   }
-  EXPECT_TRUE(r.camera_reports[1].k3) << r.Summary();
+  EXPECT_TRUE(r.camera_reports[1].k3.fitted) << r.Summary();
   EXPECT_NEAR(r.cameras[1].distortion[4], 0.5, 0.1) << r.Summary();
   EXPECT_NE(r.camera_reports[1].model.find("k1 k2 k3 (--tangential zero; k3 kept"),
             std::string::npos)
       << r.Summary();
   for (int c = 0; c < 3; ++c) {
-    EXPECT_TRUE(free.camera_reports[c].k3);
+    EXPECT_TRUE(free.camera_reports[c].k3.fitted);
     EXPECT_NE(free.cameras[c].distortion[4], 0.0);
-    EXPECT_FALSE(zero.camera_reports[c].k3);
+    EXPECT_FALSE(zero.camera_reports[c].k3.fitted);
     EXPECT_EQ(zero.cameras[c].distortion[4], 0.0);
     EXPECT_NE(zero.camera_reports[c].model.find("--k3 zero"), std::string::npos);
   }
