@@ -21,6 +21,11 @@
 namespace fv::calib {
 namespace {
 
+// calibrateCamera's stop: 100 iterations or no change at double precision.
+cv::TermCriteria FitCriteria() {
+  return {cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON};
+}
+
 // OpenCV's flags for the options' model; with 5 coefficients k3 is fitted when k3_free.
 int CalibFlags(const IntrinsicsOptions& o, bool k3_free) {
   int flags = 0;
@@ -204,9 +209,8 @@ CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector
     rvecs.clear();
     tvecs.clear();
     try {
-      rms = cv::calibrateCamera(
-          obj, img, size, k, d, rvecs, tvecs, std_intr, std_extr, per_view, flags,
-          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+      rms = cv::calibrateCamera(obj, img, size, k, d, rvecs, tvecs, std_intr, std_extr, per_view,
+                                flags, FitCriteria());
     } catch (const cv::Exception& e) {
       Throw("calibration failed on {} views of the {} (degenerate views?): {}", used.size(),
             options.board.Describe(), e.err);
@@ -266,8 +270,7 @@ double RmsWithFocalScaled(const std::vector<BoardView>& views, const CvFit& fit,
     try {
       const double rms = cv::calibrateCamera(
           obj, img, size, k, d, rvecs, tvecs,
-          flags | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH,
-          cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+          flags | cv::CALIB_USE_INTRINSIC_GUESS | cv::CALIB_FIX_FOCAL_LENGTH, FitCriteria());
       if (std::isfinite(rms)) return rms;
     } catch (const cv::Exception&) {
     }
@@ -339,9 +342,7 @@ double OuterPredictionRmsPx(const std::vector<BoardView>& views, const std::vect
   cv::Mat k = cv::Mat::eye(3, 3, CV_64F), d = cv::Mat::zeros(1, 14, CV_64F);
   std::vector<cv::Mat> rvecs, tvecs;
   try {
-    cv::calibrateCamera(
-        obj, img, size, k, d, rvecs, tvecs, flags,
-        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, DBL_EPSILON));
+    cv::calibrateCamera(obj, img, size, k, d, rvecs, tvecs, flags, FitCriteria());
   } catch (const cv::Exception&) {
     return kNone;
   }
