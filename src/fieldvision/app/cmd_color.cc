@@ -61,7 +61,7 @@ void LearnFromLabels(const ColorLearnArgs& a) {
   FV_REQUIRE(a.points.empty() && a.roi.empty() && a.negatives.empty(),
              "--labels learns from the labelled boxes: leave out --points, --roi and --negative");
   const std::vector<detect::LabelledImage> items =
-      detect::ListLabelledImages(a.video, a.labels, a.class_id, "color learn");
+      detect::ListLabelledImages(a.video, {a.labels, a.class_id}, "color learn");
   std::vector<const detect::LabelledImage*> with_ball;
   for (const detect::LabelledImage& item : items) {
     if (!item.boxes.empty()) with_ball.push_back(&item);

@@ -21,10 +21,16 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--video", o->video,
                   "Images (a folder, searched recursively; a glob; dir/%05d.jpg) or a video file")
       ->required();
-  cmd->add_option("--labels", o->labels,
+  cmd->add_option("--labels", o->labels.labels,
                   "Folder of YOLO txt files (class cx cy w h, normalised; default: beside the "
-                  "images) or a CSV with image|frame,x,y,w,h in pixels");
-  cmd->add_option("--class", o->class_id, "YOLO class of the ball")->capture_default_str();
+                  "images), a CSV with image|frame,x,y,w,h in pixels, or synth's truth_2d.csv");
+  cmd->add_option("--class", o->labels.class_id, "YOLO class of the ball")->capture_default_str();
+  cmd->add_option("--label-cam", o->labels.camera,
+                  "truth_2d.csv: the camera whose rows label the video (default: the video's "
+                  "name, cam1.avi -> cam1)");
+  cmd->add_option("--min-visible", o->labels.min_visible,
+                  "truth_2d.csv: frames whose ball is less visible than this share are not judged")
+      ->capture_default_str();
   cmd->add_option("--camera", o->camera, "Camera file (size checks)");
   cmd->add_option("--field", o->field,
                   "Field (built-in name or JSON): ignore everything outside the field of play, as "

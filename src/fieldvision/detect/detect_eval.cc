@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -64,19 +65,58 @@ const cv::Rect2d* BoxHolding(const std::vector<cv::Rect2d>& boxes, double grow, 
   return nullptr;
 }
 
-// CSV labels: image (file name, path or stem) or frame, and x,y,w,h in pixels.
+// The camera whose rows of a truth_2d.csv label `video`: `wanted`, else the video's file name
+// without extension, else its folder's name (cam1.avi, cam1/%05d.png).
+std::string LabelCamera(const util::CsvTable& t, const std::string& video,
+                        const std::string& wanted) {
+  std::set<std::string> cams;
+  for (size_t r = 0; r < t.rows(); ++r) cams.insert(t.Get(r, "cam"));
+  const fs::path p(video);
+  const std::vector<std::string> tries =
+      wanted.empty()
+          ? std::vector<std::string>{p.stem().string(), p.parent_path().filename().string()}
+          : std::vector<std::string>{wanted};
+  for (const std::string& cam : tries) {
+    if (cams.count(cam) > 0) return cam;
+  }
+  std::string names;
+  for (const std::string& c : cams) names += (names.empty() ? "" : ", ") + c;
+  Throw("labels '{}' have no rows of camera '{}' (cameras: {}): name one with --label-cam",
+        t.name(), tries.front(), names.empty() ? "none" : names);
+}
+
+// CSV labels: image (file name, path or stem) or frame, and x,y,w,h in pixels, or the circles of
+// a truth_2d.csv (frame,cam,u_px,v_px,radius_px[,visible_fraction]), one camera's rows.
 std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items,
-                                         const std::string& path) {
-  const util::CsvTable t = util::CsvTable::Read(path);
-  t.Require({"x", "y", "w", "h"});
+                                         const std::string& video, const LabelOptions& o) {
+  const util::CsvTable t = util::CsvTable::Read(o.labels);
+  const std::string& path = o.labels;
+  const bool circles = t.Has("u_px") && t.Has("v_px") && t.Has("radius_px");
+  if (!circles) t.Require({"x", "y", "w", "h"});
   FV_REQUIRE(t.Has("image") || t.Has("frame"), "{}: needs a column 'image' or 'frame'", path);
+  const std::string cam = circles && t.Has("cam") ? LabelCamera(t, video, o.camera) : "";
   std::map<std::string, std::vector<cv::Rect2d>> by_key;
+  std::set<std::string> hidden;  // keys with a ball less visible than min_visible
   for (size_t r = 0; r < t.rows(); ++r) {
-    const cv::Rect2d box(t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "w"),
-                         t.GetDouble(r, "h"));
+    if (!cam.empty() && t.Get(r, "cam") != cam) continue;
+    cv::Rect2d box;
+    if (circles) {
+      const double u = t.GetDouble(r, "u_px"), v = t.GetDouble(r, "v_px");
+      const double radius = t.GetDouble(r, "radius_px");
+      box = cv::Rect2d(u - radius, v - radius, 2 * radius, 2 * radius);
+    } else {
+      box = cv::Rect2d(t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "w"),
+                       t.GetDouble(r, "h"));
+    }
     FV_REQUIRE(std::isfinite(box.x) && std::isfinite(box.y) && box.width > 0 && box.height > 0,
-               "{}: a box needs finite x, y and positive w, h", t.Where(r));
+               "{}: a box needs finite x, y and positive w, h (a circle: u_px, v_px and a "
+               "positive radius_px)",
+               t.Where(r));
     const std::string key = t.Has("image") ? t.Get(r, "image") : t.Get(r, "frame");
+    if (t.Has("visible_fraction") && !(t.GetDouble(r, "visible_fraction") >= o.min_visible)) {
+      hidden.insert(key);
+      continue;
+    }
     by_key[key].push_back(box);
   }
   std::vector<LabelledImage> out = items;
@@ -87,7 +127,14 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
       keys = {std::to_string(item.frame)};
     } else {
       const fs::path p(item.image);
-      keys = {item.image, p.filename().string(), p.stem().string()};
+      const std::string stem = p.stem().string();
+      keys = {item.image, p.filename().string(), stem};
+      // A numbered image (00012.png) is also that frame (12).
+      if (!stem.empty() && stem.size() < 18 &&
+          std::all_of(stem.begin(), stem.end(),
+                      [](unsigned char ch) { return std::isdigit(ch); })) {
+        keys.push_back(std::to_string(std::stoll(stem)));
+      }
     }
     for (const auto& k : keys) {
       const auto it = by_key.find(k);
@@ -96,6 +143,9 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
         break;
       }
     }
+    item.judged = !item.boxes.empty() ||
+                  std::none_of(keys.begin(), keys.end(),
+                               [&](const std::string& k) { return hidden.count(k) > 0; });
   }
   return out;
 }
@@ -163,7 +213,8 @@ std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images
 
 void DetectEvalOptions::Check() const {
   FV_REQUIRE(!video.empty(), "eval detect: --video is required");
-  FV_REQUIRE(class_id >= 0, "--class must be >= 0 (got {})", class_id);
+  FV_REQUIRE(labels.class_id >= 0, "--class must be >= 0 (got {})", labels.class_id);
+  CheckInRange(labels.min_visible, 0.0, 1.0, "min_visible");
   CheckInRange(grow, 0.0, 5.0, "grow");
   FV_REQUIRE(list_misses >= 0, "list_misses must be >= 0");
   FV_REQUIRE(field.empty() || !camera.empty(),
@@ -302,6 +353,10 @@ std::string DetectEvalResult::Summary(int list) const {
                    with_ball);
   const std::string reasons = MissReasons(images);
   if (!reasons.empty()) s += "\nmisses by reason: " + reasons;
+  if (not_judged > 0) {
+    s += fmt::format("\n{} images whose ball is less visible than the labels' minimum not judged",
+                     not_judged);
+  }
   if (no_label_file > 0) {
     s += fmt::format("\n{} images have no label file (taken as images without a ball)",
                      no_label_file);
@@ -341,8 +396,10 @@ bool NextImage(io::VideoSource* video, const LabelledImage& item, const camera::
 
 }  // namespace
 
-std::vector<LabelledImage> ListLabelledImages(const std::string& video, const std::string& labels,
-                                              int class_id, const std::string& what) {
+std::vector<LabelledImage> ListLabelledImages(const std::string& video,
+                                              const LabelOptions& label_options,
+                                              const std::string& what) {
+  const std::string& labels = label_options.labels;
   std::vector<LabelledImage> items;
   std::string root;
   const bool is_dir = fs::is_directory(video);
@@ -355,7 +412,9 @@ std::vector<LabelledImage> ListLabelledImages(const std::string& video, const st
         io::VideoSource::Open(video);  // throws naming the video
     is_video = true;
     FV_REQUIRE(!labels.empty() && fs::path(labels).extension() == ".csv",
-               "{}: a video needs --labels LABELS.csv with columns frame,x,y,w,h", what);
+               "{}: a video needs --labels LABELS.csv with columns frame,x,y,w,h (or synth's "
+               "truth_2d.csv)",
+               what);
     for (int i = 0; i < std::max(0, source->frame_count()); ++i) {
       LabelledImage item;
       item.image = fmt::format("{}#{}", video, i);
@@ -367,11 +426,11 @@ std::vector<LabelledImage> ListLabelledImages(const std::string& video, const st
     for (const auto& f : files) items.push_back(LabelledImage{f, -1, {}, false});
   }
   if (!labels.empty() && fs::is_regular_file(labels)) {
-    items = ReadCsvLabels(items, labels);
+    items = ReadCsvLabels(items, video, label_options);
   } else if (!is_video) {
     FV_REQUIRE(labels.empty() || fs::is_directory(labels),
                "{}: labels '{}' is neither a folder of YOLO files nor a CSV file", what, labels);
-    items = ReadYoloLabels(files, root, labels, class_id);
+    items = ReadYoloLabels(files, root, labels, label_options.class_id);
   } else {
     Throw("{}: labels '{}' not found", what, labels);
   }
@@ -386,12 +445,11 @@ std::vector<LabelledImage> ListLabelledImages(const std::string& video, const st
 
 DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   o.Check();
-  std::vector<LabelledImage> items =
-      ListLabelledImages(o.video, o.labels, o.class_id, "eval detect");
+  std::vector<LabelledImage> items = ListLabelledImages(o.video, o.labels, "eval detect");
   std::unique_ptr<io::VideoSource> video;
   if (!items.empty() && items.front().frame >= 0) video = io::VideoSource::Open(o.video);
   // No output may be one of the images, label files or the camera read (an image inside --video).
-  std::vector<std::string> inputs = {o.video, o.labels, o.camera, o.field};
+  std::vector<std::string> inputs = {o.video, o.labels.labels, o.camera, o.field};
   for (const LabelledImage& item : items) inputs.push_back(item.image);
   io::CheckOutputPath(o.out, inputs, "--out");
   io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
@@ -430,6 +488,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     if (!NextImage(video.get(), item, camera.get(), o.camera, &frame, &bgr)) {
       items.resize(i);
       break;
+    }
+    if (!item.judged) {
+      ++result.not_judged;
+      progress.Update(static_cast<long long>(i) + 1);
+      continue;
     }
     const auto candidates = detector.Detect(bgr);
     DetectEvalImage r = ScoreImage(candidates, item.boxes, o.grow);

@@ -1,10 +1,11 @@
 // Checking the ball detector on a user's labelled frames (`fieldvision eval detect`): images (a
 // folder, searched recursively, a glob or a pattern) or a video, with boxes as YOLO txt files
 // (one per image, `class cx cy w h` normalised; an image without a file has no ball) or a CSV
-// (`image|frame,x,y,w,h` in pixels). Per image the best accepted candidate counts as a hit when
-// its centre lies inside a labelled box grown by `grow` (25 % by default, each side); recall over
-// images with a ball, precision over images with a detection (the score of the shared RoboCup
-// photo sets, shared/data/robocup-ball-photos/README).
+// (`image|frame,x,y,w,h` in pixels, or the circles of `synth`'s truth_2d.csv, one camera's rows,
+// balls less visible than `min_visible` not judged). Per image the best accepted candidate counts
+// as a hit when its centre lies inside a labelled box grown by `grow` (25 % by default, each side);
+// recall over images with a ball, precision over images with a detection (the score of the shared
+// RoboCup photo sets, shared/data/robocup-ball-photos/README).
 #pragma once
 
 #include <string>
@@ -22,6 +23,19 @@ struct LabelledImage {
   int frame = -1;                 // frame index in a video; -1 for image files
   std::vector<cv::Rect2d> boxes;  // ball boxes in pixels (the chosen class only)
   bool has_label_file = false;    // YOLO: false when no label file was found (no ball)
+  bool judged = true;  // false: its only ball is less visible than the labels' min_visible
+};
+
+// Where the labels are and which of them count.
+struct LabelOptions {
+  std::string labels;  // YOLO folder or CSV; "" = YOLO files beside the images
+  int class_id = 0;    // YOLO class of the ball
+  // truth_2d.csv (frame,cam,u_px,v_px,radius_px,visible_fraction): the camera whose rows are the
+  // video's labels; "" = the video's file name without extension, else its folder's name.
+  std::string camera;
+  // truth_2d.csv: a frame whose ball is less visible than this is not judged (the issue's
+  // measure: every ball with at least 70 % of its outline visible).
+  double min_visible = 0.7;
 };
 
 // Reads the labels of `images` from `labels` (a folder of YOLO txt files or a CSV). YOLO files
@@ -31,18 +45,18 @@ std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images
                                           const std::string& image_root, const std::string& labels,
                                           int class_id);
 // The frames of `video` (a folder searched recursively, a glob, an image pattern, or a video
-// file with a CSV) with their ball boxes from `labels` (a YOLO folder, "" for YOLO files beside
-// the images, or a CSV `image|frame,x,y,w,h`); a video's items have their frame index. Throws
-// fv::Error starting with `what` for no images, labels that are neither, or no label file.
-std::vector<LabelledImage> ListLabelledImages(const std::string& video, const std::string& labels,
-                                              int class_id, const std::string& what);
+// file with a CSV) with their ball boxes from `labels.labels` (a YOLO folder, "" for YOLO files
+// beside the images, a CSV `image|frame,x,y,w,h`, or truth_2d.csv's circles); a video's items
+// have their frame index. Throws fv::Error starting with `what` for no images, labels that are
+// neither, no label file, or a truth_2d.csv without the video's camera.
+std::vector<LabelledImage> ListLabelledImages(const std::string& video, const LabelOptions& labels,
+                                              const std::string& what);
 // One YOLO txt file: boxes of class `class_id` in pixels for an image of width x height.
 std::vector<cv::Rect2d> ReadYoloFile(const std::string& path, int class_id, int width, int height);
 
 struct DetectEvalOptions {
-  std::string video;           // folder (recursive), glob, image pattern or video file
-  std::string labels;          // YOLO folder or CSV; "" = YOLO files beside the images
-  int class_id = 0;            // YOLO class of the ball
+  std::string video;  // folder (recursive), glob, image pattern or video file
+  LabelOptions labels;
   std::string camera;          // optional camera file (size checks); frames must then match it
   std::string field;           // optional field (name or JSON): the field mask, with a posed camera
   double grow = 0.25;          // box growth for a hit (each side, share of the box size)
@@ -81,6 +95,7 @@ struct DetectEvalResult {
   int hits = 0;
   int false_detections = 0;
   int no_label_file = 0;
+  int not_judged = 0;  // frames whose ball is less visible than LabelOptions::min_visible
   double seconds = 0.0;
   double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
   double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }

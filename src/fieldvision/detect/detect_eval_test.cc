@@ -45,7 +45,7 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   }
   DetectEvalOptions o;
   o.video = dir;
-  o.labels = dir + "/labels";
+  o.labels.labels = dir + "/labels";
   o.progress = false;
   o.candidates_out = dir + "/candidates.csv";
   const DetectEvalResult r = EvaluateDetector(o);
@@ -70,6 +70,58 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   EXPECT_DOUBLE_EQ(r.recall(), 1.0);
   for (const auto& im : r.images) {
     if (im.hit) EXPECT_LT(im.centre_err_rel, 0.2) << im.image;
+  }
+}
+
+// synth's truth_2d.csv labels a camera's frames (the camera named by the images' folder, frames
+// by their numbers); a frame whose ball is less visible than min_visible is not judged, and a
+// camera without rows is an error naming the cameras there are.
+TEST(DetectEval, SynthTruthCirclesLabelOneCamera) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const std::string dir = fv::testing::TempDir() + "/detect_eval_truth2d";
+  fs::remove_all(dir);
+  fs::create_directories(dir + "/cam2");
+  std::string truth = "frame,cam,u_px,v_px,radius_px,visible_fraction\n";
+  for (int f = 0; f < 4; ++f) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
+    const double r = rng.Uniform(6, 14);
+    test_util::PaintDisc(img, c, r);
+    cv::imwrite(fmt::format("{}/cam2/{:05d}.png", dir, f), img);
+    // cam1's rows lie elsewhere: only cam2's may score these frames. Frame 3's ball is taken
+    // as a third visible (not judged).
+    truth += fmt::format("{},cam1,{},{},{},1.0\n", f, 320 - c.x(), 240 - c.y(), r);
+    truth += fmt::format("{},cam2,{},{},{},{}\n", f, c.x(), c.y(), r, f == 3 ? 0.3 : 1.0);
+  }
+  WriteText(dir + "/truth_2d.csv", truth);
+  DetectEvalOptions o;
+  o.video = dir + "/cam2/%05d.png";
+  o.labels.labels = dir + "/truth_2d.csv";
+  o.progress = false;
+  const DetectEvalResult r = EvaluateDetector(o);
+  EXPECT_EQ(r.not_judged, 1) << r.Summary();
+  EXPECT_EQ(r.with_ball, 3) << r.Summary();
+  EXPECT_EQ(r.hits, 3) << r.Summary();
+  EXPECT_EQ(r.false_detections, 0) << r.Summary();
+  EXPECT_NE(r.Summary().find("1 images whose ball is less visible"), std::string::npos);
+  for (const auto& im : r.images) {
+    if (im.hit) EXPECT_LT(im.centre_err_px, 1.0) << im.image;
+  }
+  // All four judged at min_visible 0.2.
+  o.labels.min_visible = 0.2;
+  EXPECT_EQ(EvaluateDetector(o).with_ball, 4);
+  // Another camera named: cam1's circles are not on these balls.
+  o.labels.camera = "cam1";
+  EXPECT_EQ(EvaluateDetector(o).hits, 0);
+  o.labels.camera = "cam7";
+  try {
+    EvaluateDetector(o);
+    ADD_FAILURE() << "no error for a camera without rows";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera 'cam7' (cameras: cam1, cam2)"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -183,8 +235,8 @@ TEST(DetectEval, RealRobocupPhotos) {
   DetectEvalOptions o;
   o.progress = false;
   o.video = data + "/ssl-orange/images";
-  o.labels = data + "/ssl-orange/labels";
-  o.class_id = 1;
+  o.labels.labels = data + "/ssl-orange/labels";
+  o.labels.class_id = 1;
   o.detector.colour = "orange";
   const DetectEvalResult ssl = EvaluateDetector(o);
   std::cout << "SSL orange: " << ssl.Summary(0) << "\n";
@@ -208,8 +260,8 @@ TEST(DetectEval, RealRobocupPhotos) {
   EXPECT_GE(ssl.precision(), narrow.precision() - 0.005);
   o.detector.small.widened_class = true;
   o.video = data + "/msl-yellow";
-  o.labels = "";
-  o.class_id = 0;
+  o.labels.labels = "";
+  o.labels.class_id = 0;
   o.detector.colour = "yellow";
   const DetectEvalResult msl = EvaluateDetector(o);
   std::cout << "MSL yellow: " << msl.Summary(0) << "\n";

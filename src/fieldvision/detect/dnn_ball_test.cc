@@ -351,8 +351,8 @@ TEST_F(DnnBallOnPhotos, WholeFrameBoxesDoNotConfirmFarSpots) {
   for (const char* name : {"00109", "00208"}) {
     DetectEvalOptions o;
     o.video = ssl + "/images/" + name + ".jpg";
-    o.labels = ssl + "/labels";
-    o.class_id = 1;
+    o.labels.labels = ssl + "/labels";
+    o.labels.class_id = 1;
     o.progress = false;
     o.detector.colour = "orange";
     o.dnn.detector = "both";
