@@ -91,8 +91,9 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
                                          const std::string& video, const LabelOptions& o) {
   const util::CsvTable t = util::CsvTable::Read(o.labels);
   const std::string& path = o.labels;
-  const bool circles = t.Has("u_px") && t.Has("v_px") && t.Has("radius_px");
-  if (!circles) t.Require({"x", "y", "w", "h"});
+  const bool circles = t.Has("u_px");
+  t.Require(circles ? std::vector<std::string>{"u_px", "v_px", "radius_px"}
+                    : std::vector<std::string>{"x", "y", "w", "h"});
   FV_REQUIRE(t.Has("image") || t.Has("frame"), "{}: needs a column 'image' or 'frame'", path);
   const std::string cam = circles && t.Has("cam") ? LabelCamera(t, video, o.camera) : "";
   std::map<std::string, std::vector<cv::Rect2d>> by_key;
@@ -235,6 +236,7 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
   for (const auto& c : candidates) {
     if (box_of(c) == nullptr) continue;
     r.candidate_on_ball = true;
+    r.accepted_on_ball = r.accepted_on_ball || c.accepted;
     if (r.reason.empty() && !c.accepted) r.reason = c.reason;
   }
   // Candidates come best first; the first accepted one is the image's detection.
@@ -347,10 +349,15 @@ std::string DetectEvalResult::Summary(int list) const {
         util::Median(err_px), util::Percentile(err_px, 0.9), util::Median(err_rel),
         util::Percentile(err_rel, 0.9));
   }
-  int on_ball = 0;
-  for (const auto& im : images) on_ball += im.boxes > 0 && im.candidate_on_ball;
-  s += fmt::format("\na candidate (accepted or not) lies on the ball in {}/{} images", on_ball,
-                   with_ball);
+  int on_ball = 0, accepted_on_ball = 0;
+  for (const auto& im : images) {
+    on_ball += im.boxes > 0 && im.candidate_on_ball;
+    accepted_on_ball += im.boxes > 0 && im.accepted_on_ball;
+  }
+  s += fmt::format(
+      "\na candidate (accepted or not) lies on the ball in {}/{} images, an accepted one (first "
+      "or not) in {}/{}",
+      on_ball, with_ball, accepted_on_ball, with_ball);
   const std::string reasons = MissReasons(images);
   if (!reasons.empty()) s += "\nmisses by reason: " + reasons;
   if (not_judged > 0) {
@@ -526,11 +533,12 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   if (!o.out.empty()) {
     io::AtomicWrite(o.out, [&](const std::string& tmp) {
       util::CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
-                              "centre_err_px", "candidate_on_ball", "ball_radius_px", "reason"});
+                              "centre_err_px", "candidate_on_ball", "accepted_on_ball",
+                              "ball_radius_px", "reason"});
       for (const auto& im : result.images) {
         w << im.image << im.boxes << int(im.detected) << int(im.hit) << im.u << im.v << im.radius_px
-          << im.score << im.centre_err_px << int(im.candidate_on_ball) << im.ball_radius_px
-          << ReplaceCommas(im.reason);
+          << im.score << im.centre_err_px << int(im.candidate_on_ball) << int(im.accepted_on_ball)
+          << im.ball_radius_px << ReplaceCommas(im.reason);
         w.EndRow();
       }
       w.Close();

@@ -79,6 +79,7 @@ struct DetectEvalImage {
   double centre_err_px = -1;       // hit: distance to the box centre
   double centre_err_rel = -1;      // ... divided by the box's half size
   bool candidate_on_ball = false;  // any candidate (accepted or not) inside a grown box
+  bool accepted_on_ball = false;   // an accepted one there (a miss: another ranked first)
   // The ball's size: half the longer side of its box (the hit one, else the largest); 0 without.
   double ball_radius_px = 0;
   std::string reason;  // for a miss: the best rejected candidate on the ball's reason

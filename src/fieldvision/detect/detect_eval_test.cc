@@ -155,6 +155,31 @@ TEST(DetectEval, RecallPerBallSize) {
       << r.Summary(0);
 }
 
+// A ball accepted but ranked below something else is a miss, told apart from a rejected one.
+TEST(DetectEval, AcceptedOnTheBallButNotFirst) {
+  BallCandidate elsewhere, on_ball;
+  elsewhere.centre_px = Eigen::Vector2d(100, 100);
+  elsewhere.accepted = true;
+  on_ball.centre_px = Eigen::Vector2d(12, 12);
+  on_ball.accepted = true;
+  const std::vector<cv::Rect2d> boxes = {cv::Rect2d(10, 10, 4, 4)};
+  const DetectEvalImage second = ScoreImage({elsewhere, on_ball}, boxes, 0.25);
+  EXPECT_FALSE(second.hit);
+  EXPECT_TRUE(second.accepted_on_ball);
+  on_ball.accepted = false;
+  on_ball.reason = "too small";
+  const DetectEvalImage rejected = ScoreImage({elsewhere, on_ball}, boxes, 0.25);
+  EXPECT_FALSE(rejected.accepted_on_ball);
+  EXPECT_TRUE(rejected.candidate_on_ball);
+  DetectEvalResult r;
+  r.images = {second, rejected};
+  r.with_ball = 2;
+  EXPECT_NE(
+      r.Summary(0).find("lies on the ball in 2/2 images, an accepted one (first or not) in 1/2"),
+      std::string::npos)
+      << r.Summary(0);
+}
+
 TEST(DetectEval, BadLabelNamesFileAndLine) {
   const std::string dir = fv::testing::TempDir() + "/detect_eval_bad";
   fs::create_directories(dir);
