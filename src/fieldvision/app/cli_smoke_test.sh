@@ -77,6 +77,13 @@ check "color learn: --labels, the class forced" 0 $FV color learn --video "$TMP/
   --labels "$TMP/limgs" --force --out "$TMP/l.json"
 grep -q "learned from 1 boxes in 1 of the 1 frames with a ball" "$TMP/out" || {
   echo "FAIL color learn: --labels report"; fail=1; }
+# --detector auto: both on still images where the model was built (else colour, with a warning).
+check "detect: auto on a still image" 0 $FV detect --video "$TMP/limgs/a.png" --out "$TMP/da.csv" \
+  --no-progress
+head -1 "$TMP/out" | grep -q "^detector: both (auto: still images\|^detector: colour (auto: still images, but no NanoDet model" || {
+  echo "FAIL detect: the auto detector not said"; fail=1; }
+check "detect: --detector auto on ball" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --detector auto
 check "ball: one camera" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --out "$TMP/b.csv"
 grep -q "one camera" "$TMP/err" || { echo "FAIL ball: one camera not named"; fail=1; }

@@ -7,6 +7,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -33,7 +34,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
       ->capture_default_str();
   AddBallSizeOptions(cmd, o->detector);
-  AddDetectorOptions(cmd, o->dnn);
+  AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
@@ -43,7 +44,12 @@ void Setup(CLI::App& app, int& exit_code) {
         "detect: --field needs --camera with a pose (the field is found through it)");
     io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
     io::CheckOutputPath(o->draw, io::PathList(o->video, o->camera, o->field, o->out), "--draw");
+    std::string notice;
+    const std::string chosen =
+        ResolveAutoDetector(o->dnn, !io::ListImageSequence(o->video).empty(), &notice);
+    if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
+    if (!chosen.empty()) std::cout << chosen << "\n";
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
   });
   (void)exit_code;

@@ -1,5 +1,6 @@
 // `fieldvision eval detect`: the ball detector's recall, precision and centre error on labelled
 // frames (detect/detect_eval.h).
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -7,6 +8,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/detect/detect_eval.h"
+#include "fieldvision/io/video_source.h"
 
 namespace fv::app {
 namespace {
@@ -37,7 +39,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "`detect --field` (needs --camera with a pose)");
   AddBallColourOption(cmd, o->detector.colour);
   AddBallSizeOptions(cmd, o->detector);
-  AddDetectorOptions(cmd, o->dnn);
+  AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
   cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")
       ->capture_default_str();
   cmd->add_option("--list", o->list_misses, "Misses and false detections to list")
@@ -47,7 +49,13 @@ void Setup(CLI::App& app, int& exit_code) {
                   "CSV with every candidate and its measurements (for diagnosis)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
+    std::string notice;
+    const bool stills =
+        std::filesystem::is_directory(o->video) || !io::ListImageSequence(o->video).empty();
+    const std::string chosen = ResolveAutoDetector(o->dnn, stills, &notice);
+    if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
     const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
+    if (!chosen.empty()) std::cout << chosen << "\n";
     std::cout << r.Summary(o->list_misses) << "\n";
   });
   (void)exit_code;
