@@ -7,7 +7,6 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/output_path.h"
-#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -45,8 +44,7 @@ void Setup(CLI::App& app, int& exit_code) {
     io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
     io::CheckOutputPath(o->draw, io::PathList(o->video, o->camera, o->field, o->out), "--draw");
     std::string notice;
-    const std::string chosen =
-        ResolveAutoDetector(o->dnn, !io::ListImageSequence(o->video).empty(), &notice);
+    const std::string chosen = ResolveAutoDetector(o->dnn, IsStillImages(o->video), &notice);
     if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
     if (!chosen.empty()) std::cout << chosen << "\n";

@@ -1,6 +1,5 @@
 // `fieldvision eval detect`: the ball detector's recall, precision and centre error on labelled
 // frames (detect/detect_eval.h).
-#include <filesystem>
 #include <iostream>
 #include <memory>
 
@@ -8,7 +7,6 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/detect/detect_eval.h"
-#include "fieldvision/io/video_source.h"
 
 namespace fv::app {
 namespace {
@@ -50,9 +48,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     std::string notice;
-    const bool stills =
-        std::filesystem::is_directory(o->video) || !io::ListImageSequence(o->video).empty();
-    const std::string chosen = ResolveAutoDetector(o->dnn, stills, &notice);
+    const std::string chosen = ResolveAutoDetector(o->dnn, IsStillImages(o->video), &notice);
     if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
     const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
     if (!chosen.empty()) std::cout << chosen << "\n";

@@ -2,6 +2,7 @@
 // `eval detect` and `ball`.
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/dnn_ball.h"
 #include "fieldvision/dnn/nanodet.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -54,8 +56,9 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,
                               "shipped NanoDet model's COCO 'sports ball' class: any ball, "
                               "slower), or both (the network confirms colour candidates and "
                               "completes them)") +
-                      (auto_for_stills ? "; auto: both on still images (where the model was "
-                                         "built), colour on a video"
+                      (auto_for_stills ? "; auto: both on still images (a folder, a glob, one "
+                                         "image; where the model was built), colour on a video "
+                                         "or a numbered frame sequence"
                                        : ""))
       ->check(auto_for_stills ? CLI::IsMember({"auto", "colour", "dnn", "both"})
                               : CLI::IsMember({"colour", "dnn", "both"}))
@@ -95,7 +98,14 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,
                 "rejected)");
 }
 
-// `--detector auto`: both on still images (a folder of photos, a glob, an image pattern), where a
+// Whether `--video` names still photos (a folder, a glob, one image) rather than a camera's frames
+// (a video file, a stream, a numbered sequence dir/%05d.png).
+inline bool IsStillImages(const std::string& input) {
+  if (std::filesystem::is_directory(input)) return true;
+  return input.find('%') == std::string::npos && !io::ListImageSequence(input).empty();
+}
+
+// `--detector auto`: both on still images (IsStillImages), where a
 // frame's 0.1-0.9 s of network buys recall and precision (the RoboCup photos in shared/data, colour
 // -> both: SSL recall 0.869 -> 0.915 at precision 0.944 -> 0.962, MSL 0.709 -> 0.761 at 0.976 ->
 // 0.989); colour on a video, whose 30-60 frames a second the colour path keeps up with. Without
@@ -105,7 +115,7 @@ inline std::string ResolveAutoDetector(detect::DnnBallOptions& o, bool still_ima
                                        std::string* notice) {
   if (o.detector != "auto") return "";
   o.detector = "colour";
-  if (!still_images) return "detector: colour (auto: a video)";
+  if (!still_images) return "detector: colour (auto: a video or a numbered frame sequence)";
   try {
     if (o.model_path.empty()) o.model_path = dnn::FindModel("nanodet.onnx");
     o.detector = "both";
