@@ -82,8 +82,9 @@ check "detect: auto on a still image" 0 $FV detect --video "$TMP/limgs/a.png" --
   --no-progress
 head -1 "$TMP/out" | grep -q "^detector: both (auto: still images\|^detector: colour (auto: still images, but no NanoDet model" || {
   echo "FAIL detect: the auto detector not said"; fail=1; }
-check "detect: --detector auto on ball" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+check "ball: --detector auto" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --detector auto
+grep -q -- "--detector" "$TMP/err" || { echo "FAIL ball: --detector auto not named"; fail=1; }
 check "ball: one camera" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --out "$TMP/b.csv"
 grep -q "one camera" "$TMP/err" || { echo "FAIL ball: one camera not named"; fail=1; }

@@ -21,6 +21,7 @@ struct ColorLearnArgs {
   std::string video;
   std::string labels;
   int class_id = 0;
+  std::string label_cam;
   int max_frames = 200;
   int frame = 0;
   std::string points;
@@ -61,7 +62,7 @@ void LearnFromLabels(const ColorLearnArgs& a) {
   FV_REQUIRE(a.points.empty() && a.roi.empty() && a.negatives.empty(),
              "--labels learns from the labelled boxes: leave out --points, --roi and --negative");
   const std::vector<detect::LabelledImage> items =
-      detect::ListLabelledImages(a.video, {a.labels, a.class_id}, "color learn");
+      detect::ListLabelledImages(a.video, {a.labels, a.class_id, a.label_cam}, "color learn");
   std::vector<const detect::LabelledImage*> with_ball;
   for (const detect::LabelledImage& item : items) {
     if (!item.boxes.empty()) with_ball.push_back(&item);
@@ -153,6 +154,9 @@ void Setup(CLI::App& app, int& exit_code) {
   learn->add_option("--class", a->class_id, "With --labels: the YOLO class of the ball")
       ->check(FiniteRange(0, 1e6))
       ->capture_default_str();
+  learn->add_option("--label-cam", a->label_cam,
+                    "With --labels synth's truth_2d.csv: the camera whose rows label the video "
+                    "(default: the video's name, else its folder's)");
   learn
       ->add_option("--max-frames", a->max_frames,
                    "With --labels: learn from at most this many frames with a ball, evenly spread")

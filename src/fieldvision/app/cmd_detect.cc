@@ -44,10 +44,11 @@ void Setup(CLI::App& app, int& exit_code) {
     io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
     io::CheckOutputPath(o->draw, io::PathList(o->video, o->camera, o->field, o->out), "--draw");
     std::string notice;
-    const std::string chosen = ResolveAutoDetector(o->dnn, IsStillImages(o->video), &notice);
+    const std::string chosen =
+        ResolveAutoDetector(o->dnn, io::IsStillImageInput(o->video), &notice);
     if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
+    if (!chosen.empty()) std::cout << chosen << std::endl;  // before a run of minutes
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
-    if (!chosen.empty()) std::cout << chosen << "\n";
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
   });
   (void)exit_code;

@@ -27,7 +27,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--class", o->labels.class_id, "YOLO class of the ball")->capture_default_str();
   cmd->add_option("--label-cam", o->labels.camera,
                   "truth_2d.csv: the camera whose rows label the video (default: the video's "
-                  "name, cam1.avi -> cam1)");
+                  "name, cam1.avi -> cam1, else its folder's, cam1/%05d.png -> cam1)");
   cmd->add_option("--min-visible", o->labels.min_visible,
                   "truth_2d.csv: frames whose ball is less visible than this share are not judged")
       ->capture_default_str();
@@ -48,10 +48,11 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     std::string notice;
-    const std::string chosen = ResolveAutoDetector(o->dnn, IsStillImages(o->video), &notice);
+    const std::string chosen =
+        ResolveAutoDetector(o->dnn, io::IsStillImageInput(o->video), &notice);
     if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
+    if (!chosen.empty()) std::cout << chosen << std::endl;  // before a run of minutes
     const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
-    if (!chosen.empty()) std::cout << chosen << "\n";
     std::cout << r.Summary(o->list_misses) << "\n";
   });
   (void)exit_code;

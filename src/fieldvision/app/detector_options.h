@@ -2,7 +2,6 @@
 // `eval detect` and `ball`.
 #pragma once
 
-#include <filesystem>
 #include <string>
 
 #include <fmt/format.h>
@@ -98,19 +97,9 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,
                 "rejected)");
 }
 
-// Whether `--video` names still photos (a folder, a glob, one image) rather than a camera's frames
-// (a video file, a stream, a numbered sequence dir/%05d.png).
-inline bool IsStillImages(const std::string& input) {
-  if (std::filesystem::is_directory(input)) return true;
-  return input.find('%') == std::string::npos && !io::ListImageSequence(input).empty();
-}
-
-// `--detector auto`: both on still images (IsStillImages), where a
-// frame's 0.1-0.9 s of network buys recall and precision (the RoboCup photos in shared/data, colour
-// -> both: SSL recall 0.869 -> 0.915 at precision 0.944 -> 0.962, MSL 0.709 -> 0.761 at 0.976 ->
-// 0.989); colour on a video, whose 30-60 frames a second the colour path keeps up with. Without
-// the model (`make build` converts it) colour, and `notice` says so. Returns what it chose, for
-// the summary; any other choice stays as it is ("").
+// `--detector auto`: both on still images (io::IsStillImageInput; recall and precision on the
+// RoboCup photos for 0.1-0.9 s a frame), colour on a camera's frames. Without the model colour,
+// and `notice` says why. Returns the choice for the output's first line ("": not auto).
 inline std::string ResolveAutoDetector(detect::DnnBallOptions& o, bool still_images,
                                        std::string* notice) {
   if (o.detector != "auto") return "";

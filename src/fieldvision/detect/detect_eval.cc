@@ -79,10 +79,13 @@ std::string LabelCamera(const util::CsvTable& t, const std::string& video,
   for (const std::string& cam : tries) {
     if (cams.count(cam) > 0) return cam;
   }
-  std::string names;
-  for (const std::string& c : cams) names += (names.empty() ? "" : ", ") + c;
-  Throw("labels '{}' have no rows of camera '{}' (cameras: {}): name one with --label-cam",
-        t.name(), tries.front(), names.empty() ? "none" : names);
+  const auto joined = [](const auto& names) {
+    std::string s;
+    for (const std::string& n : names) s += (s.empty() ? "'" : ", '") + n + "'";
+    return s.empty() ? std::string("none") : s;
+  };
+  Throw("labels '{}' have no rows of camera {} (cameras: {}): name one with --label-cam", t.name(),
+        joined(tries), joined(cams));
 }
 
 // CSV labels: image (file name, path or stem) or frame, and x,y,w,h in pixels, or the circles of
@@ -96,10 +99,24 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
                     : std::vector<std::string>{"x", "y", "w", "h"});
   FV_REQUIRE(t.Has("image") || t.Has("frame"), "{}: needs a column 'image' or 'frame'", path);
   const std::string cam = circles && t.Has("cam") ? LabelCamera(t, video, o.camera) : "";
+  FV_REQUIRE(o.camera.empty() || !cam.empty(),
+             "--label-cam {} names a camera of a truth_2d.csv, but '{}' has no column 'cam'",
+             o.camera, path);
   std::map<std::string, std::vector<cv::Rect2d>> by_key;
   std::set<std::string> hidden;  // keys with a ball less visible than min_visible
   for (size_t r = 0; r < t.rows(); ++r) {
     if (!cam.empty() && t.Get(r, "cam") != cam) continue;
+    const std::string key = t.Has("image") ? t.Get(r, "image") : t.Get(r, "frame");
+    if (t.Has("visible_fraction")) {
+      const double visible = t.GetDouble(r, "visible_fraction");
+      FV_REQUIRE(visible >= 0 && visible <= 1, "{}: visible_fraction must be in [0, 1]",
+                 t.Where(r));
+      if (visible == 0) continue;  // outside the image or hidden: no ball to find there
+      if (visible < o.min_visible) {
+        hidden.insert(key);
+        continue;
+      }
+    }
     cv::Rect2d box;
     if (circles) {
       const double u = t.GetDouble(r, "u_px"), v = t.GetDouble(r, "v_px");
@@ -113,11 +130,6 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
                "{}: a box needs finite x, y and positive w, h (a circle: u_px, v_px and a "
                "positive radius_px)",
                t.Where(r));
-    const std::string key = t.Has("image") ? t.Get(r, "image") : t.Get(r, "frame");
-    if (t.Has("visible_fraction") && !(t.GetDouble(r, "visible_fraction") >= o.min_visible)) {
-      hidden.insert(key);
-      continue;
-    }
     by_key[key].push_back(box);
   }
   std::vector<LabelledImage> out = items;
@@ -236,6 +248,7 @@ DetectEvalImage ScoreImage(const std::vector<BallCandidate>& candidates,
   for (const auto& c : candidates) {
     if (box_of(c) == nullptr) continue;
     r.candidate_on_ball = true;
+    if (c.accepted && !r.accepted_on_ball) r.reason = "an accepted one ranked below it";
     r.accepted_on_ball = r.accepted_on_ball || c.accepted;
     if (r.reason.empty() && !c.accepted) r.reason = c.reason;
   }
@@ -432,6 +445,8 @@ std::vector<LabelledImage> ListLabelledImages(const std::string& video,
     if (root.empty()) root = fs::path(files.front()).parent_path().string();
     for (const auto& f : files) items.push_back(LabelledImage{f, -1, {}, false});
   }
+  FV_REQUIRE(label_options.camera.empty() || fs::is_regular_file(labels),
+             "{}: --label-cam names a camera of a truth_2d.csv file, not of YOLO labels", what);
   if (!labels.empty() && fs::is_regular_file(labels)) {
     items = ReadCsvLabels(items, video, label_options);
   } else if (!is_video) {

@@ -95,6 +95,9 @@ TEST(DetectEval, SynthTruthCirclesLabelOneCamera) {
     truth += fmt::format("{},cam1,{},{},{},1.0\n", f, 320 - c.x(), 240 - c.y(), r);
     truth += fmt::format("{},cam2,{},{},{},{}\n", f, c.x(), c.y(), r, f == 3 ? 0.3 : 1.0);
   }
+  // A fifth frame whose ball is outside cam2's image (visible 0): a frame without a ball there.
+  cv::imwrite(fmt::format("{}/cam2/{:05d}.png", dir, 4), test_util::FieldImage(320, 240, rng));
+  truth += "4,cam2,-40,120,8,0\n";
   WriteText(dir + "/truth_2d.csv", truth);
   DetectEvalOptions o;
   o.video = dir + "/cam2/%05d.png";
@@ -102,6 +105,7 @@ TEST(DetectEval, SynthTruthCirclesLabelOneCamera) {
   o.progress = false;
   const DetectEvalResult r = EvaluateDetector(o);
   EXPECT_EQ(r.not_judged, 1) << r.Summary();
+  EXPECT_EQ(r.images.size(), 4u) << r.Summary();  // the frame outside judged as without a ball
   EXPECT_EQ(r.with_ball, 3) << r.Summary();
   EXPECT_EQ(r.hits, 3) << r.Summary();
   EXPECT_EQ(r.false_detections, 0) << r.Summary();
@@ -120,9 +124,25 @@ TEST(DetectEval, SynthTruthCirclesLabelOneCamera) {
     EvaluateDetector(o);
     ADD_FAILURE() << "no error for a camera without rows";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("camera 'cam7' (cameras: cam1, cam2)"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("camera 'cam7' (cameras: 'cam1', 'cam2')"),
+              std::string::npos)
         << e.what();
   }
+  // Without --label-cam the names tried are the file's and the folder's.
+  o.labels.camera.clear();
+  fs::create_directories(dir + "/cam3");
+  fs::copy_file(fmt::format("{}/cam2/{:05d}.png", dir, 0), dir + "/cam3/00000.png");
+  o.video = dir + "/cam3/00000.png";
+  try {
+    EvaluateDetector(o);
+    ADD_FAILURE() << "no error for a camera without rows";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera '00000', 'cam3'"), std::string::npos) << e.what();
+  }
+  // --label-cam is for a truth_2d.csv: with YOLO labels it is an error, not ignored.
+  o.labels.camera = "cam2";
+  o.labels.labels = dir + "/cam2";
+  EXPECT_THROW(EvaluateDetector(o), Error);
 }
 
 // Each image's ball size is its hit box's half longer side (else its largest box's), and the

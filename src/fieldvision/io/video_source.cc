@@ -91,6 +91,23 @@ bool IsImageFile(const std::string& path) {
          ext == ".tiff" || ext == ".pgm" || ext == ".ppm" || ext == ".webp";
 }
 
+namespace {
+
+// A printf pattern with one integer field (dir/%05d.png): a camera's numbered frames.
+bool IsFramePattern(const std::string& spec) {
+  static const std::regex kOneIntField(R"([^%]*%0?[0-9]*d[^%]*)");
+  return spec.find('%') != std::string::npos && std::regex_match(spec, kOneIntField);
+}
+
+}  // namespace
+
+bool IsStillImageInput(const std::string& spec) {
+  std::error_code ec;
+  if (fs::is_directory(spec, ec)) return true;
+  if (fs::is_regular_file(spec, ec)) return IsImageFile(spec);
+  return !IsFramePattern(spec) && !ListImageSequence(spec).empty();
+}
+
 std::vector<std::string> ListImageSequence(const std::string& spec) {
   std::vector<std::string> files;
   if (fs::is_regular_file(spec)) {
@@ -101,8 +118,7 @@ std::vector<std::string> ListImageSequence(const std::string& spec) {
     // printf pattern with one integer field (%d, %5d, %05d): frames from the first number of
     // 0..1000 that names a file (as OpenCV's image reader starts) upwards until the first
     // missing number.
-    static const std::regex kOneIntField(R"([^%]*%0?[0-9]*d[^%]*)");
-    if (!std::regex_match(spec, kOneIntField)) return {};
+    if (!IsFramePattern(spec)) return {};
     auto name_of = [&](int i) {
       std::vector<char> buf(spec.size() + 32);
       std::snprintf(buf.data(), buf.size(), spec.c_str(), i);

@@ -66,6 +66,9 @@ class VideoSource {
 // The image files an image-sequence spec names, in order (empty if it is not one); an existing
 // image file (by its extension) is a sequence of one.
 std::vector<std::string> ListImageSequence(const std::string& spec);
+// Whether `spec` names still photos (a folder, a glob, one image file) rather than a camera's
+// frames (a video file, a stream, a numbered sequence dir/%05d.png).
+bool IsStillImageInput(const std::string& spec);
 // At the end of a video file: throws fv::Error naming it when fewer frames were read than its
 // header announces (a truncated or damaged stream; 0 or less: not announced, nothing checked).
 void CheckEndOfStream(const std::string& path, long long frames_read, long long frames_announced);

@@ -1,5 +1,6 @@
 #include "fieldvision/io/video_source.h"
 
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -37,6 +38,24 @@ TEST(VideoSource, ImagePatternGlobAndFolderInOrder) {
     }
     EXPECT_EQ(n, 5);
   }
+}
+
+// Still photos (a folder, a glob, one image, whatever its name) against a camera's frames (a
+// numbered sequence, a video file): what `--detector auto` decides by.
+TEST(VideoSource, StillImagesAreToldFromACamerasFrames) {
+  const std::string dir = testing::TempDir() + "/stills";
+  std::filesystem::create_directories(dir);
+  for (int i = 0; i < 3; ++i) cv::imwrite(fmt::format("{}/{:05d}.png", dir, i), NumberedFrame(i));
+  cv::imwrite(dir + "/50%.png", NumberedFrame(7));
+  std::ofstream(dir + "/notes.txt") << "not an image\n";
+  EXPECT_TRUE(IsStillImageInput(dir));
+  EXPECT_TRUE(IsStillImageInput(dir + "/*.png"));
+  EXPECT_TRUE(IsStillImageInput(dir + "/00001.png"));
+  EXPECT_TRUE(IsStillImageInput(dir + "/50%.png"));
+  EXPECT_FALSE(IsStillImageInput(dir + "/%05d.png"));
+  EXPECT_FALSE(IsStillImageInput(dir + "/notes.txt"));
+  EXPECT_FALSE(IsStillImageInput(dir + "/*.jpg"));  // matches nothing
+  EXPECT_FALSE(IsStillImageInput("rtsp://camera/stream"));
 }
 
 TEST(VideoSource, MjpgFileFramesAndTimes) {
