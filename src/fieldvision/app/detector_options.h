@@ -1,4 +1,4 @@
-// The `--detector colour|dnn|both` option group (detect/dnn_ball.h), shared by `detect`,
+// The `--detector auto|colour|dnn|both` option group (detect/dnn_ball.h), shared by `detect`,
 // `eval detect` and `ball`.
 #pragma once
 
