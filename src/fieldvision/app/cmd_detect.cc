@@ -43,11 +43,7 @@ void Setup(CLI::App& app, int& exit_code) {
         "detect: --field needs --camera with a pose (the field is found through it)");
     io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
     io::CheckOutputPath(o->draw, io::PathList(o->video, o->camera, o->field, o->out), "--draw");
-    std::string notice;
-    const std::string chosen =
-        ResolveAutoDetector(o->dnn, io::IsStillImageInput(o->video), &notice);
-    if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
-    if (!chosen.empty()) std::cout << chosen << std::endl;  // before a run of minutes
+    ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
   });

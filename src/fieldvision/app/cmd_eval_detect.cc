@@ -47,11 +47,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "CSV with every candidate and its measurements (for diagnosis)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
-    std::string notice;
-    const std::string chosen =
-        ResolveAutoDetector(o->dnn, io::IsStillImageInput(o->video), &notice);
-    if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
-    if (!chosen.empty()) std::cout << chosen << std::endl;  // before a run of minutes
+    ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
     std::cout << r.Summary(o->list_misses) << "\n";
   });

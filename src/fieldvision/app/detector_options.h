@@ -2,6 +2,7 @@
 // `eval detect` and `ball`.
 #pragma once
 
+#include <iostream>
 #include <string>
 
 #include <fmt/format.h>
@@ -113,6 +114,15 @@ inline std::string ResolveAutoDetector(detect::DnnBallOptions& o, bool still_ima
     *notice = fmt::format("no NanoDet model, so the colour detector alone ({})", e.what());
     return "detector: colour (auto: still images, but no NanoDet model)";
   }
+}
+
+// ResolveAutoDetector for the frames `input` names, its warning on stderr and its choice on
+// stdout, flushed before a run that may take minutes.
+inline void ChooseAutoDetector(detect::DnnBallOptions& o, const std::string& input) {
+  std::string notice;
+  const std::string chosen = ResolveAutoDetector(o, io::IsStillImageInput(input), &notice);
+  if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
+  if (!chosen.empty()) std::cout << chosen << std::endl;
 }
 
 }  // namespace fv::app

@@ -507,7 +507,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   for (size_t i = 0; i < items.size(); ++i) {
     const LabelledImage& item = items[i];
     cv::Mat bgr;
-    if (!NextImage(video.get(), item, camera.get(), o.camera, &frame, &bgr)) {
+    // A video's frames are read in turn; an image file not judged need not be read.
+    if ((item.judged || video != nullptr) &&
+        !NextImage(video.get(), item, camera.get(), o.camera, &frame, &bgr)) {
       items.resize(i);
       break;
     }
