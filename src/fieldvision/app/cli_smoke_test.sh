@@ -65,6 +65,13 @@ cp "$TMP/imgs/a.png" "$TMP/a_copy.png"
 check "eval detect: --out an image it reads" nonzero $FV eval detect --video "$TMP/imgs" \
   --out "$TMP/imgs/a.png" --no-progress
 cmp -s "$TMP/imgs/a.png" "$TMP/a_copy.png" || { echo "FAIL eval detect: image overwritten"; fail=1; }
+mkdir -p "$TMP/dimgs" && cp "$TMP/imgs/a.png" "$TMP/dimgs/a.png" && : > "$TMP/dimgs/a.txt"
+check "eval detect: --draw-misses inside the images' folder" nonzero $FV eval detect \
+  --video "$TMP/dimgs" --draw-misses "$TMP/dimgs/drawn" --detector colour --no-progress
+[ ! -e "$TMP/dimgs/drawn" ] || { echo "FAIL eval detect: --draw-misses folder made"; fail=1; }
+check "eval detect: --draw-misses" 0 $FV eval detect --video "$TMP/dimgs" \
+  --draw-misses "$TMP/drawn" --detector colour --no-progress
+grep -q "drew 0 misses" "$TMP/out" || { echo "FAIL eval detect: drawings not said"; fail=1; }
 mkdir -p "$TMP/limgs" "$TMP/nolabels" && cp "$TMP/imgs/a.png" "$TMP/limgs/a.png"
 check "color learn: --labels without a label file" nonzero $FV color learn --video "$TMP/limgs" \
   --labels "$TMP/nolabels" --out "$TMP/l.json"

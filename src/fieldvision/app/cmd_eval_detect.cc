@@ -45,6 +45,9 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", o->out, "CSV with one row per image");
   cmd->add_option("--candidates", o->candidates_out,
                   "CSV with every candidate and its measurements (for diagnosis)");
+  cmd->add_option("--draw-misses", o->draw_misses,
+                  "New (or empty) folder: each miss and false detection drawn as a JPEG (the "
+                  "labelled box, every candidate, the reason)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     ChooseAutoDetector(o->dnn, o->video);

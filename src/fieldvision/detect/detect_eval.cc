@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/eval_drawing.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_source.h"
@@ -381,6 +382,9 @@ std::string DetectEvalResult::Summary(int list) const {
     s += fmt::format("\n{} images have no label file (taken as images without a ball)",
                      no_label_file);
   }
+  if (!drawn_dir.empty()) {
+    s += fmt::format("\ndrew {} misses and false detections in {}", drawn, drawn_dir);
+  }
   s += fmt::format("\n{:.1f} s ({:.1f} ms per image)", seconds,
                    images.empty() ? 0.0 : 1e3 * seconds / images.size());
   int listed = 0;
@@ -475,6 +479,10 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   for (const LabelledImage& item : items) inputs.push_back(item.image);
   io::CheckOutputPath(o.out, inputs, "--out");
   io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
+  std::unique_ptr<MissDrawings> drawings;
+  if (!o.draw_misses.empty()) {
+    drawings = std::make_unique<MissDrawings>(o.draw_misses, o.video, inputs);
+  }
   std::unique_ptr<camera::Camera> camera;
   if (!o.camera.empty()) {
     camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
@@ -534,6 +542,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
       }
     }
     r.image = item.image;
+    if (drawings != nullptr) drawings->Add(static_cast<int>(i), item, r, candidates, bgr, o.grow);
     result.with_ball += r.boxes > 0;
     result.detected += r.detected;
     result.hits += r.hit;
@@ -544,6 +553,10 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   }
   progress.Finish();
   result.seconds = progress.ElapsedSeconds();
+  if (drawings != nullptr) {
+    result.drawn = drawings->written();
+    result.drawn_dir = drawings->dir();
+  }
   if (cand_csv != nullptr) {
     cand_file->CloseAndCommit(*cand_csv);
   }

@@ -63,6 +63,8 @@ struct DetectEvalOptions {
   int list_misses = 30;        // misses and false detections listed in the summary
   std::string out;             // optional CSV, one row per image
   std::string candidates_out;  // optional CSV, one row per candidate with its measurements
+  // Optional new (or empty) folder: each miss and false detection drawn (eval_drawing.h).
+  std::string draw_misses;
   bool progress = true;
   BallDetectorOptions detector;
   DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
@@ -97,6 +99,8 @@ struct DetectEvalResult {
   int false_detections = 0;
   int no_label_file = 0;
   int not_judged = 0;  // frames whose ball is less visible than LabelOptions::min_visible
+  int drawn = 0;       // images drawn into DetectEvalOptions::draw_misses
+  std::string drawn_dir;
   double seconds = 0.0;
   double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
   double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/eval_drawing.h"
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -217,6 +218,67 @@ TEST(DetectEval, BadLabelNamesFileAndLine) {
   DetectEvalOptions o;
   o.video = dir + "/missing";
   EXPECT_THROW(EvaluateDetector(o), Error);
+}
+
+// eval detect --draw-misses: one drawing per miss and per false detection, none for hits or
+// empty images; a folder with files, a file, or one inside the images' folder is refused.
+TEST(DetectEval, MissesAndFalseDetectionsAreDrawn) {
+  const uint64_t seed = fv::testing::TestSeed(7);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const std::string root = fv::testing::TempDir() + "/eval_drawing";
+  const std::string dir = root + "/images";
+  fs::remove_all(root);
+  fs::create_directories(dir + "/labels");
+  // hit: a labelled ball; miss: a box where no ball is; false: an unlabelled ball; empty.
+  for (const std::string stem : {"hit", "miss", "false", "empty"}) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(80, 240), rng.Uniform(80, 160));
+    if (stem == "hit" || stem == "false") test_util::PaintDisc(img, c, 10);
+    if (stem == "hit" || stem == "miss") {
+      WriteText(fmt::format("{}/labels/{}.txt", dir, stem),
+                fmt::format("0 {} {} {} {}\n", c.x() / 320, c.y() / 240, 20.0 / 320, 20.0 / 240));
+    } else {
+      WriteText(fmt::format("{}/labels/{}.txt", dir, stem), "");
+    }
+    cv::imwrite(fmt::format("{}/{}.png", dir, stem), img);
+  }
+  DetectEvalOptions o;
+  o.video = dir;
+  o.labels.labels = dir + "/labels";
+  o.progress = false;
+  o.draw_misses = root + "/drawn";
+  const DetectEvalResult r = EvaluateDetector(o);
+  EXPECT_EQ(r.hits, 1) << r.Summary();
+  EXPECT_EQ(r.drawn, 2) << r.Summary();
+  EXPECT_NE(r.Summary().find("drew 2 misses and false detections in " + o.draw_misses),
+            std::string::npos)
+      << r.Summary();
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(o.draw_misses)) {
+    names.push_back(e.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names.size(), 2u);
+  // Images in path order: empty.png (0), false.png (1), hit.png (2), miss.png (3).
+  EXPECT_EQ(names[0], "00001_false_false.jpg");
+  EXPECT_EQ(names[1], "00003_miss_miss.jpg");
+  const cv::Mat drawn = cv::imread(o.draw_misses + "/" + names[1]);
+  EXPECT_EQ(drawn.cols, 320 * EvalDrawingScale(320, 240));
+  const auto error_of = [&](const std::string& folder) {
+    DetectEvalOptions bad = o;
+    bad.draw_misses = folder;
+    try {
+      EvaluateDetector(bad);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of(o.draw_misses).find("is not empty"), std::string::npos);
+  EXPECT_NE(error_of(dir + "/drawn").find("lies in the images' folder"), std::string::npos);
+  EXPECT_NE(error_of(dir + "/hit.png").find("is not a folder"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir + "/drawn"));
 }
 
 // Nothing to score is said, not scored: no label file at all is an error, and a ratio of nothing

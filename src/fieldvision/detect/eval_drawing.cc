@@ -1,0 +1,170 @@
+#include "fieldvision/detect/eval_drawing.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <system_error>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "fieldvision/codecs/codecs.h"
+#include "fieldvision/detect/detect_video.h"
+#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/error.h"
+
+namespace fv::detect {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr double kFontScale = 0.45;
+constexpr int kLineHeight = 18;
+const cv::Scalar kCyan(255, 255, 0);
+
+// `text` broken at spaces into lines no wider than `width` pixels (a longer word alone).
+std::vector<std::string> Wrap(const std::string& text, int width) {
+  std::vector<std::string> lines;
+  std::istringstream words(text);
+  std::string word, line;
+  while (words >> word) {
+    std::string longer = line;
+    if (!longer.empty()) longer += ' ';
+    longer += word;
+    int baseline = 0;
+    if (!line.empty() && cv::getTextSize(longer, kFont, kFontScale, 1, &baseline).width > width) {
+      lines.push_back(line);
+      line = word;
+    } else {
+      line = longer;
+    }
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+// `lines` in white on a black band of the image's width.
+cv::Mat Band(const std::vector<std::string>& lines, int width) {
+  cv::Mat band(kLineHeight * static_cast<int>(lines.size()) + 6, width, CV_8UC3,
+               cv::Scalar::all(0));
+  for (size_t i = 0; i < lines.size(); ++i) {
+    cv::putText(band, lines[i], cv::Point(4, kLineHeight * static_cast<int>(i + 1)), kFont,
+                kFontScale, cv::Scalar::all(255), 1, cv::LINE_AA);
+  }
+  return band;
+}
+
+// A file name's part from an image's name: letters, digits, '-' and '.' kept, others '_'.
+std::string Slug(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
+  }
+  return out;
+}
+
+// Whether `inner` is `outer` or lies in it (paths compared made absolute, links followed).
+bool Within(const fs::path& inner, const fs::path& outer) {
+  if (inner.empty() || outer.empty()) return false;
+  const fs::path a = fs::weakly_canonical(fs::absolute(inner));
+  const fs::path b = fs::weakly_canonical(fs::absolute(outer));
+  auto [end_b, end_a] = std::mismatch(b.begin(), b.end(), a.begin(), a.end());
+  return end_b == b.end();
+}
+
+}  // namespace
+
+int EvalDrawingScale(int width, int height) {
+  const int shorter = std::max(1, std::min(width, height));
+  return std::clamp((480 + shorter - 1) / shorter, 1, 8);
+}
+
+cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, double grow,
+                      const std::vector<BallCandidate>& candidates,
+                      const std::vector<std::string>& title) {
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "DrawEvalImage: needs a BGR image");
+  const int k = EvalDrawingScale(bgr.cols, bgr.rows);
+  cv::Mat canvas;
+  cv::resize(bgr, canvas, cv::Size(), k, k, cv::INTER_NEAREST);
+  // Pixel i becomes pixels k i .. k i + k - 1: its centre moves to k i + (k - 1) / 2.
+  const double offset = 0.5 * (k - 1);
+  const auto scaled = [&](double x) { return k * x + offset; };
+  constexpr int kShift = 4;
+  const auto corner = [&](double x, double y) {
+    return cv::Point(cvRound(scaled(x) * (1 << kShift)), cvRound(scaled(y) * (1 << kShift)));
+  };
+  for (const cv::Rect2d& b : boxes) {
+    const cv::Rect2d g(b.x - grow * b.width, b.y - grow * b.height, b.width * (1 + 2 * grow),
+                       b.height * (1 + 2 * grow));
+    cv::rectangle(canvas, corner(g.x, g.y), corner(g.x + g.width, g.y + g.height), kCyan, 1,
+                  cv::LINE_AA, kShift);
+    cv::rectangle(canvas, corner(b.x, b.y), corner(b.x + b.width, b.y + b.height), kCyan, 2,
+                  cv::LINE_AA, kShift);
+  }
+  std::vector<BallCandidate> drawn = candidates;
+  for (BallCandidate& c : drawn) {
+    c.centre_px = Eigen::Vector2d(scaled(c.centre_px.x()), scaled(c.centre_px.y()));
+    c.radius_px *= k;
+  }
+  DrawCandidates(canvas, drawn);
+  std::vector<std::string> top;
+  for (const std::string& t : title) {
+    for (std::string& line : Wrap(t, canvas.cols - 8)) top.push_back(std::move(line));
+  }
+  const std::vector<std::string> legend = Wrap(
+      fmt::format("cyan box: the labelled ball; thin cyan: where a hit's centre lies (grown {:.0f} "
+                  "%); green: accepted candidate (score); red: rejected candidate; image x{}",
+                  100 * grow, k),
+      canvas.cols - 8);
+  cv::Mat out;
+  cv::vconcat(std::vector<cv::Mat>{Band(top, canvas.cols), canvas, Band(legend, canvas.cols)}, out);
+  return out;
+}
+
+MissDrawings::MissDrawings(const std::string& dir, const std::string& video,
+                           const std::vector<std::string>& images)
+    : dir_(dir) {
+  std::error_code ec;
+  FV_REQUIRE(!fs::exists(dir, ec) || fs::is_directory(dir, ec),
+             "--draw-misses: '{}' exists and is not a folder", dir);
+  FV_REQUIRE(!fs::is_directory(video, ec) || !Within(dir, video),
+             "--draw-misses: folder '{}' lies in the images' folder '{}' (a later run would score "
+             "the drawings); name one outside it",
+             dir, video);
+  for (const std::string& image : images) {
+    FV_REQUIRE(!Within(image, dir), "--draw-misses: folder '{}' holds the image '{}'", dir, image);
+  }
+  fs::create_directories(dir, ec);
+  FV_REQUIRE(fs::is_directory(dir, ec), "--draw-misses: cannot make folder '{}'", dir);
+  FV_REQUIRE(fs::is_empty(dir, ec) && !ec,
+             "--draw-misses: folder '{}' is not empty (an earlier run's drawings would mix with "
+             "these); name a new folder",
+             dir);
+}
+
+bool MissDrawings::Add(int index, const LabelledImage& item, const DetectEvalImage& scored,
+                       const std::vector<BallCandidate>& candidates, const cv::Mat& bgr,
+                       double grow) {
+  const bool miss = scored.boxes > 0 && !scored.hit;
+  const bool false_detection = scored.detected && !scored.hit;
+  if (!miss && !false_detection) return false;
+  std::vector<std::string> title = {item.image};
+  if (false_detection) {
+    title.push_back(fmt::format("false detection at ({:.1f}, {:.1f}) r {:.1f} px, score {:.2f}",
+                                scored.u, scored.v, scored.radius_px, scored.score));
+  }
+  if (miss) title.push_back("miss: " + (scored.reason.empty() ? "no candidate" : scored.reason));
+  const cv::Mat drawing = DrawEvalImage(bgr, item.boxes, grow, candidates, title);
+  const std::string name = item.frame >= 0 ? fmt::format("frame{:05d}", item.frame)
+                                           : fs::path(item.image).stem().string();
+  const std::string path =
+      fmt::format("{}/{:05d}_{}_{}.jpg", dir_, index, miss ? "miss" : "false", Slug(name));
+  FV_REQUIRE(codecs::ImWrite(path, drawing), "--draw-misses: cannot write '{}'", path);
+  ++written_;
+  return true;
+}
+
+}  // namespace fv::detect

@@ -1,0 +1,45 @@
+// What `eval detect --draw-misses DIR` shows of each miss and false detection: the frame (small
+// ones enlarged, pixels kept square), the labelled ball's box and the area a hit's centre must
+// lie in, every candidate as `detect --draw` draws them, what went wrong on a band above and a
+// legend below; one JPEG per image in a new (or empty) folder outside the images' folder.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/detect_eval.h"
+
+namespace fv::detect {
+
+// The drawing of one judged image: `title` lines on the band above (wrapped to the width).
+cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, double grow,
+                      const std::vector<BallCandidate>& candidates,
+                      const std::vector<std::string>& title);
+
+// The enlargement DrawEvalImage gives an image of this size: the smallest whole factor that
+// makes its shorter side at least 480 px (at most 8; 1 for larger images).
+int EvalDrawingScale(int width, int height);
+
+// Writes the misses and false detections of an `eval detect` run into `dir`.
+class MissDrawings {
+ public:
+  // Throws fv::Error (naming --draw-misses and the folder) when `dir` holds files, is not a
+  // folder, cannot be made, or lies in the folder of the images (`video`, searched recursively:
+  // a later run would score the drawings) or holds one of `images`.
+  MissDrawings(const std::string& dir, const std::string& video,
+               const std::vector<std::string>& images);
+  // Draws image number `index` when it is a miss or a false detection; returns whether it did.
+  bool Add(int index, const LabelledImage& item, const DetectEvalImage& scored,
+           const std::vector<BallCandidate>& candidates, const cv::Mat& bgr, double grow);
+  int written() const { return written_; }
+  const std::string& dir() const { return dir_; }
+
+ private:
+  std::string dir_;
+  int written_ = 0;
+};
+
+}  // namespace fv::detect
