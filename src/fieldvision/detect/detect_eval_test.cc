@@ -264,7 +264,8 @@ TEST(DetectEval, MissesAndFalseDetectionsAreDrawn) {
   EXPECT_EQ(names[0], "00001_false_false.jpg");
   EXPECT_EQ(names[1], "00003_miss_miss.jpg");
   const cv::Mat drawn = cv::imread(o.draw_misses + "/" + names[1]);
-  EXPECT_EQ(drawn.cols, 320 * EvalDrawingScale(320, 240));
+  // The frame enlarged twice and, beside it, the 20 px ball's close-up (60 px enlarged 4 times).
+  EXPECT_EQ(drawn.cols, 320 * EvalDrawingScale(320, 240) + 4 + 240);
   const auto error_of = [&](const std::string& folder) {
     DetectEvalOptions bad = o;
     bad.draw_misses = folder;

@@ -24,6 +24,7 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.45;
 constexpr int kLineHeight = 18;
 const cv::Scalar kCyan(255, 255, 0);
+constexpr int kZoomPx = 240;  // close-up side
 
 // `text` broken at spaces into lines no wider than `width` pixels (a longer word alone).
 std::vector<std::string> Wrap(const std::string& text, int width) {
@@ -82,34 +83,80 @@ int EvalDrawingScale(int width, int height) {
   return std::clamp((480 + shorter - 1) / shorter, 1, 8);
 }
 
-cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, double grow,
-                      const std::vector<BallCandidate>& candidates,
-                      const std::vector<std::string>& title) {
-  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "DrawEvalImage: needs a BGR image");
-  const int k = EvalDrawingScale(bgr.cols, bgr.rows);
-  cv::Mat canvas;
-  cv::resize(bgr, canvas, cv::Size(), k, k, cv::INTER_NEAREST);
+namespace {
+
+// The part `area` of `bgr` (black where it leaves the image) enlarged k times, pixels kept
+// square, with the boxes, their hit areas and the candidates drawn at their places.
+cv::Mat DrawnView(const cv::Mat& bgr, const cv::Rect& area, int k,
+                  const std::vector<cv::Rect2d>& boxes, double grow,
+                  const std::vector<BallCandidate>& candidates) {
+  cv::Mat part(area.size(), CV_8UC3, cv::Scalar::all(0));
+  const cv::Rect inside = area & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (!inside.empty()) bgr(inside).copyTo(part(inside - area.tl()));
+  cv::Mat view;
+  cv::resize(part, view, cv::Size(), k, k, cv::INTER_NEAREST);
   // Pixel i becomes pixels k i .. k i + k - 1: its centre moves to k i + (k - 1) / 2.
-  const double offset = 0.5 * (k - 1);
-  const auto scaled = [&](double x) { return k * x + offset; };
+  const auto sx = [&](double x) { return k * (x - area.x) + 0.5 * (k - 1); };
+  const auto sy = [&](double y) { return k * (y - area.y) + 0.5 * (k - 1); };
   constexpr int kShift = 4;
   const auto corner = [&](double x, double y) {
-    return cv::Point(cvRound(scaled(x) * (1 << kShift)), cvRound(scaled(y) * (1 << kShift)));
+    return cv::Point(cvRound(sx(x) * (1 << kShift)), cvRound(sy(y) * (1 << kShift)));
   };
   for (const cv::Rect2d& b : boxes) {
     const cv::Rect2d g(b.x - grow * b.width, b.y - grow * b.height, b.width * (1 + 2 * grow),
                        b.height * (1 + 2 * grow));
-    cv::rectangle(canvas, corner(g.x, g.y), corner(g.x + g.width, g.y + g.height), kCyan, 1,
+    cv::rectangle(view, corner(g.x, g.y), corner(g.x + g.width, g.y + g.height), kCyan, 1,
                   cv::LINE_AA, kShift);
-    cv::rectangle(canvas, corner(b.x, b.y), corner(b.x + b.width, b.y + b.height), kCyan, 2,
+    cv::rectangle(view, corner(b.x, b.y), corner(b.x + b.width, b.y + b.height), kCyan, 2,
                   cv::LINE_AA, kShift);
   }
   std::vector<BallCandidate> drawn = candidates;
   for (BallCandidate& c : drawn) {
-    c.centre_px = Eigen::Vector2d(scaled(c.centre_px.x()), scaled(c.centre_px.y()));
+    c.centre_px = Eigen::Vector2d(sx(c.centre_px.x()), sy(c.centre_px.y()));
     c.radius_px *= k;
   }
-  DrawCandidates(canvas, drawn);
+  DrawCandidates(view, drawn);
+  return view;
+}
+
+// `a` above `b`, the narrower one padded on the right with black.
+cv::Mat Stack(const cv::Mat& a, const cv::Mat& b) {
+  if (a.empty()) return b;
+  const int width = std::max(a.cols, b.cols);
+  cv::Mat out(a.rows + b.rows, width, CV_8UC3, cv::Scalar::all(0));
+  a.copyTo(out(cv::Rect(0, 0, a.cols, a.rows)));
+  b.copyTo(out(cv::Rect(0, a.rows, b.cols, b.rows)));
+  return out;
+}
+
+}  // namespace
+
+cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, double grow,
+                      const std::vector<BallCandidate>& candidates,
+                      const std::vector<std::string>& title, const std::vector<EvalZoom>& zooms) {
+  FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "DrawEvalImage: needs a BGR image");
+  const int k = EvalDrawingScale(bgr.cols, bgr.rows);
+  const cv::Mat frame =
+      DrawnView(bgr, cv::Rect(0, 0, bgr.cols, bgr.rows), k, boxes, grow, candidates);
+  // Close-ups, in a column beside the frame, of what it shows too small.
+  cv::Mat column;
+  for (const EvalZoom& z : zooms) {
+    const int side =
+        std::max(24, static_cast<int>(std::ceil(3 * std::max(z.around.width, z.around.height))));
+    const int kz = std::max(1, kZoomPx / side);
+    if (kz <= k) continue;
+    const cv::Point2d c(z.around.x + 0.5 * z.around.width, z.around.y + 0.5 * z.around.height);
+    const cv::Rect area(cvRound(c.x - 0.5 * side), cvRound(c.y - 0.5 * side), side, side);
+    column = Stack(column, Band({fmt::format("{} x{}", z.caption, kz)}, kZoomPx));
+    column = Stack(column, DrawnView(bgr, area, kz, boxes, grow, candidates));
+  }
+  cv::Mat canvas = frame;
+  if (!column.empty()) {
+    canvas = cv::Mat(std::max(frame.rows, column.rows), frame.cols + 4 + column.cols, CV_8UC3,
+                     cv::Scalar::all(0));
+    frame.copyTo(canvas(cv::Rect(0, 0, frame.cols, frame.rows)));
+    column.copyTo(canvas(cv::Rect(frame.cols + 4, 0, column.cols, column.rows)));
+  }
   std::vector<std::string> top;
   for (const std::string& t : title) {
     for (std::string& line : Wrap(t, canvas.cols - 8)) top.push_back(std::move(line));
@@ -157,7 +204,13 @@ bool MissDrawings::Add(int index, const LabelledImage& item, const DetectEvalIma
                                 scored.u, scored.v, scored.radius_px, scored.score));
   }
   if (miss) title.push_back("miss: " + (scored.reason.empty() ? "no candidate" : scored.reason));
-  const cv::Mat drawing = DrawEvalImage(bgr, item.boxes, grow, candidates, title);
+  std::vector<EvalZoom> zooms;
+  if (!item.boxes.empty()) zooms.push_back({item.boxes.front(), "labelled ball"});
+  if (false_detection) {
+    const double r = std::max(scored.radius_px, 2.0);
+    zooms.push_back({cv::Rect2d(scored.u - r, scored.v - r, 2 * r, 2 * r), "false detection"});
+  }
+  const cv::Mat drawing = DrawEvalImage(bgr, item.boxes, grow, candidates, title, zooms);
   const std::string name = item.frame >= 0 ? fmt::format("frame{:05d}", item.frame)
                                            : fs::path(item.image).stem().string();
   const std::string path =

@@ -1,7 +1,8 @@
 // What `eval detect --draw-misses DIR` shows of each miss and false detection: the frame (small
 // ones enlarged, pixels kept square), the labelled ball's box and the area a hit's centre must
-// lie in, every candidate as `detect --draw` draws them, what went wrong on a band above and a
-// legend below; one JPEG per image in a new (or empty) folder outside the images' folder.
+// lie in, every candidate as `detect --draw` draws them, close-ups of the ball and of a false
+// detection, what went wrong on a band above and a legend below; one JPEG per image in a new (or
+// empty) folder outside the images' folder.
 #pragma once
 
 #include <string>
@@ -14,10 +15,19 @@
 
 namespace fv::detect {
 
-// The drawing of one judged image: `title` lines on the band above (wrapped to the width).
+// A close-up beside the frame: the square of 3x the larger side of `around` (at least 24 px)
+// enlarged to about 240 px, drawn only where that enlarges more than the frame's own view.
+struct EvalZoom {
+  cv::Rect2d around;
+  std::string caption;
+};
+
+// The drawing of one judged image: `title` lines on the band above (wrapped to the width), the
+// frame, the close-ups in a column beside it, a legend below.
 cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, double grow,
                       const std::vector<BallCandidate>& candidates,
-                      const std::vector<std::string>& title);
+                      const std::vector<std::string>& title,
+                      const std::vector<EvalZoom>& zooms = {});
 
 // The enlargement DrawEvalImage gives an image of this size: the smallest whole factor that
 // makes its shorter side at least 480 px (at most 8; 1 for larger images).
