@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -39,7 +40,57 @@ void DrawFieldBoundary(cv::Mat& bgr, const FieldBoundary& boundary) {
               magenta, 1, cv::LINE_AA);
 }
 
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+constexpr double kFontScale = 0.45;
+constexpr int kLineHeight = 18;
+
+// `text` broken at spaces into lines no wider than `width` pixels (a longer word alone).
+std::vector<std::string> Wrap(const std::string& text, int width) {
+  std::vector<std::string> lines;
+  std::istringstream words(text);
+  std::string word, line;
+  while (words >> word) {
+    std::string longer = line;
+    if (!longer.empty()) longer += ' ';
+    longer += word;
+    int baseline = 0;
+    if (!line.empty() && cv::getTextSize(longer, kFont, kFontScale, 1, &baseline).width > width) {
+      lines.push_back(line);
+      line = word;
+    } else {
+      line = longer;
+    }
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
+// `lines` (already wrapped) in white on a black band `width` px wide.
+cv::Mat Band(const std::vector<std::string>& lines, int width) {
+  cv::Mat band(kLineHeight * static_cast<int>(lines.size()) + 6, width, CV_8UC3,
+               cv::Scalar::all(0));
+  for (size_t i = 0; i < lines.size(); ++i) {
+    cv::putText(band, lines[i], cv::Point(4, kLineHeight * static_cast<int>(i + 1)), kFont,
+                kFontScale, cv::Scalar::all(255), 1, cv::LINE_AA);
+  }
+  return band;
+}
+
 }  // namespace
+
+cv::Mat TextBand(const std::vector<std::string>& text, int width) {
+  std::vector<std::string> lines;
+  for (const std::string& t : text) {
+    for (std::string& line : Wrap(t, width - 8)) lines.push_back(std::move(line));
+  }
+  return Band(lines, width);
+}
+
+cv::Mat CandidateLegend(int width) {
+  return TextBand({"green: accepted candidate (score); red: rejected; magenta: the field's far "
+                   "edge (above it a higher score is needed)"},
+                  width);
+}
 
 void DetectVideoOptions::Check() const {
   FV_REQUIRE(!video.empty(), "--video is required");
@@ -101,7 +152,10 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
                              : codecs::FourCc('m', 'p', '4', 'v');
       const double fps = source->fps() > 0 ? source->fps() : 30.0;
       writer = codecs::NewVideoWriter();
-      writer->open(o.draw, fourcc, fps, cv::Size(source->width(), source->height()));
+      // The frame and, below it, the legend.
+      writer->open(
+          o.draw, fourcc, fps,
+          cv::Size(source->width(), source->height() + CandidateLegend(source->width()).rows));
       FV_REQUIRE(writer->isOpened(), "cannot write annotated video '{}'", o.draw);
     } else {
       std::error_code ec;
@@ -118,6 +172,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   util::Progress progress("detect", total, "frames", o.progress);
   const auto t0 = std::chrono::steady_clock::now();
   io::Frame frame;
+  cv::Mat legend;  // below each drawn frame, made once per frame width
   while ((o.max_frames < 0 || result.frames < o.max_frames) && source->Read(frame)) {
     const auto cands = detector.Detect(frame.bgr);
     bool any = false;
@@ -134,6 +189,8 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
       cv::Mat canvas = frame.bgr.clone();
       DrawFieldBoundary(canvas, detector.colour().OffFieldBoundary(frame.bgr));
       DrawCandidates(canvas, cands);
+      if (legend.cols != canvas.cols) legend = CandidateLegend(canvas.cols);
+      cv::vconcat(canvas, legend, canvas);
       if (writer) {
         writer->write(canvas);
       } else {

@@ -38,4 +38,11 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& options);
 // red (thin circle).
 void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates);
 
+// Lines of white text on a black band `width` px wide, each wrapped at spaces to fit.
+cv::Mat TextBand(const std::vector<std::string>& text, int width);
+
+// What DrawCandidates' colours and the off-field check's edge mean, as a TextBand (below each
+// frame `detect --draw` writes).
+cv::Mat CandidateLegend(int width);
+
 }  // namespace fv::detect

@@ -84,6 +84,27 @@ TEST(DetectVideo, WritesEveryCandidateAndDrawsThem) {
   for (int f = 0; f < 5; ++f) {
     EXPECT_TRUE(std::filesystem::exists(fmt::format("{}/{:05d}.jpg", o.draw, f)));
   }
+  // Each drawn frame has the legend below it: white text on black.
+  const cv::Mat first = cv::imread(o.draw + "/00000.jpg");
+  const cv::Mat frame = cv::imread(clip.dir + "/frames/00000.png");
+  ASSERT_FALSE(first.empty());
+  ASSERT_EQ(first.cols, frame.cols);
+  const cv::Mat legend = CandidateLegend(frame.cols);
+  ASSERT_EQ(first.rows, frame.rows + legend.rows);
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(first.rowRange(frame.rows, first.rows).reshape(1), &lo, &hi);
+  EXPECT_LT(lo, 30);
+  EXPECT_GT(hi, 200);
+}
+
+// A legend wider than its band wraps onto more lines rather than being cut.
+TEST(DetectVideo, LegendWrapsToTheWidth) {
+  const cv::Mat wide = CandidateLegend(1280), narrow = CandidateLegend(224);
+  EXPECT_EQ(wide.cols, 1280);
+  EXPECT_EQ(narrow.cols, 224);
+  EXPECT_GT(narrow.rows, 2 * wide.rows - 10);
+  const cv::Mat words = TextBand({"a b c d e f g h i j k l m n o p q r s t u v w x y z"}, 60);
+  EXPECT_GT(words.rows, 4 * TextBand({"a"}, 60).rows / 2);
 }
 
 TEST(DetectVideo, BadInputGivesOneLineErrorsNamingTheInput) {

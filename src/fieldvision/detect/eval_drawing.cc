@@ -4,7 +4,6 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <sstream>
 #include <system_error>
 
 #include <fmt/format.h>
@@ -20,43 +19,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
-constexpr double kFontScale = 0.45;
-constexpr int kLineHeight = 18;
 const cv::Scalar kCyan(255, 255, 0);
 constexpr int kZoomPx = 240;  // close-up side
-
-// `text` broken at spaces into lines no wider than `width` pixels (a longer word alone).
-std::vector<std::string> Wrap(const std::string& text, int width) {
-  std::vector<std::string> lines;
-  std::istringstream words(text);
-  std::string word, line;
-  while (words >> word) {
-    std::string longer = line;
-    if (!longer.empty()) longer += ' ';
-    longer += word;
-    int baseline = 0;
-    if (!line.empty() && cv::getTextSize(longer, kFont, kFontScale, 1, &baseline).width > width) {
-      lines.push_back(line);
-      line = word;
-    } else {
-      line = longer;
-    }
-  }
-  if (!line.empty()) lines.push_back(line);
-  return lines;
-}
-
-// `lines` in white on a black band of the image's width.
-cv::Mat Band(const std::vector<std::string>& lines, int width) {
-  cv::Mat band(kLineHeight * static_cast<int>(lines.size()) + 6, width, CV_8UC3,
-               cv::Scalar::all(0));
-  for (size_t i = 0; i < lines.size(); ++i) {
-    cv::putText(band, lines[i], cv::Point(4, kLineHeight * static_cast<int>(i + 1)), kFont,
-                kFontScale, cv::Scalar::all(255), 1, cv::LINE_AA);
-  }
-  return band;
-}
 
 // A file name's part from an image's name: letters, digits, '-' and '.' kept, others '_'.
 std::string Slug(const std::string& s) {
@@ -147,7 +111,7 @@ cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, 
     if (kz <= k) continue;
     const cv::Point2d c(z.around.x + 0.5 * z.around.width, z.around.y + 0.5 * z.around.height);
     const cv::Rect area(cvRound(c.x - 0.5 * side), cvRound(c.y - 0.5 * side), side, side);
-    column = Stack(column, Band({fmt::format("{} x{}", z.caption, kz)}, kZoomPx));
+    column = Stack(column, TextBand({fmt::format("{} x{}", z.caption, kz)}, kZoomPx));
     column = Stack(column, DrawnView(bgr, area, kz, boxes, grow, candidates));
   }
   cv::Mat canvas = frame;
@@ -157,17 +121,14 @@ cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, 
     frame.copyTo(canvas(cv::Rect(0, 0, frame.cols, frame.rows)));
     column.copyTo(canvas(cv::Rect(frame.cols + 4, 0, column.cols, column.rows)));
   }
-  std::vector<std::string> top;
-  for (const std::string& t : title) {
-    for (std::string& line : Wrap(t, canvas.cols - 8)) top.push_back(std::move(line));
-  }
-  const std::vector<std::string> legend = Wrap(
-      fmt::format("cyan box: the labelled ball; thin cyan: where a hit's centre lies (grown {:.0f} "
-                  "%); green: accepted candidate (score); red: rejected candidate; image x{}",
-                  100 * grow, k),
-      canvas.cols - 8);
+  const std::string legend = fmt::format(
+      "cyan box: the labelled ball; thin cyan: where a hit's centre lies (grown {:.0f} "
+      "%); green: accepted candidate (score); red: rejected candidate; image x{}",
+      100 * grow, k);
   cv::Mat out;
-  cv::vconcat(std::vector<cv::Mat>{Band(top, canvas.cols), canvas, Band(legend, canvas.cols)}, out);
+  cv::vconcat(
+      std::vector<cv::Mat>{TextBand(title, canvas.cols), canvas, TextBand({legend}, canvas.cols)},
+      out);
   return out;
 }
 
