@@ -112,6 +112,7 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
       if (r.time_s) time_s = r.time_s;
     }
   }
+  if (o_.legend) DrawLegend(bgr, scale);
   if (o_.time_label) {
     const std::string text = time_s ? fmt::format("frame {}  t = {:.2f} s", frame, *time_s)
                                     : fmt::format("frame {}", frame);
@@ -119,6 +120,54 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
     cv::putText(bgr, text, org, cv::FONT_HERSHEY_SIMPLEX, 0.6 * scale, {0, 0, 0}, 3, cv::LINE_AA);
     cv::putText(bgr, text, org, cv::FONT_HERSHEY_SIMPLEX, 0.6 * scale, {255, 255, 255}, 1,
                 cv::LINE_AA);
+  }
+}
+
+void TrackOverlay::DrawLegend(cv::Mat& bgr, double scale) const {
+  // Lines of (colour swatches, text); a swatch per team seen, else one line for id colours.
+  std::vector<std::pair<std::vector<cv::Scalar>, std::string>> lines;
+  std::vector<int> teams;
+  for (const auto& [id, team] : team_of_) {
+    if (team >= 0 && std::find(teams.begin(), teams.end(), team) == teams.end()) {
+      teams.push_back(team);
+    }
+  }
+  std::sort(teams.begin(), teams.end());
+  lines.reserve(teams.size() + 4);
+  for (int team : teams) lines.push_back({{TrackColour(0, team)}, fmt::format("team {}", team)});
+  if (teams.empty()) {
+    lines.push_back(
+        {{TrackColour(0, -1), TrackColour(1, -1), TrackColour(2, -1)}, "a colour per player id"});
+  }
+  lines.push_back({{}, "solid box: detected; dashed: carried without a detection"});
+  if (o_.trail_frames > 0) {
+    lines.push_back({{}, fmt::format("trail: feet over the last {} frames", o_.trail_frames)});
+  }
+  if (camera_) lines.push_back({{o_.field_colour}, "the field's lines"});
+  const double font = 0.45 * scale;
+  const int line_h = cvRound(18 * scale), swatch = cvRound(10 * scale), pad = cvRound(6 * scale);
+  int width = 0;
+  for (const auto& [swatches, text] : lines) {
+    int base = 0;
+    const int w = static_cast<int>(swatches.size()) * (swatch + 3) +
+                  cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, font, 1, &base).width;
+    width = std::max(width, w);
+  }
+  const cv::Rect box(0, bgr.rows - static_cast<int>(lines.size()) * line_h - 2 * pad,
+                     width + 2 * pad + 4, static_cast<int>(lines.size()) * line_h + 2 * pad);
+  const cv::Rect inside = box & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (inside.empty()) return;
+  cv::Mat shaded = bgr(inside);
+  shaded *= 0.35;  // darkened, the video still seen through it
+  for (size_t i = 0; i < lines.size(); ++i) {
+    int x = box.x + pad;
+    const int y = box.y + pad + static_cast<int>(i + 1) * line_h - cvRound(5 * scale);
+    for (const cv::Scalar& c : lines[i].first) {
+      cv::rectangle(bgr, cv::Rect(x, y - swatch, swatch, swatch), c, cv::FILLED);
+      x += swatch + 3;
+    }
+    cv::putText(bgr, lines[i].second, cv::Point(x + 2, y), cv::FONT_HERSHEY_SIMPLEX, font,
+                cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
 }
 

@@ -1,7 +1,7 @@
 // Tracks drawn on the video a coach looks at: per frame, each person's box in the team's colour
 // (else a colour per id), the id or roster name, a short trail of foot points and, with a posed
-// camera, the field's lines projected into the image (calib::DrawFieldOverlay); and a video
-// writer for what browsers play: H.264 in MP4 through OpenCV's FFmpeg backend ('avc1'), or
+// camera, the field's lines projected into the image (calib::DrawFieldOverlay), a legend; and a
+// video writer for what browsers play: H.264 in MP4 through OpenCV's FFmpeg backend ('avc1'), or
 // Motion-JPEG in AVI where that encoder is missing. `players --draw` uses both; other commands
 // (ball) can draw their own marks on the same frames before writing.
 #pragma once
@@ -26,6 +26,8 @@ struct OverlayOptions {
   bool field_lines = true;  // project the field's lines (needs a posed camera and a field)
   cv::Scalar field_colour = cv::Scalar(255, 255, 255);  // BGR
   bool time_label = true;                               // "frame N, t = S s" in the corner
+  // What the colours, dashed boxes, trails and lines mean, in the bottom-left corner.
+  bool legend = true;
   void Check() const;
 };
 
@@ -44,6 +46,8 @@ class TrackOverlay {
   void Draw(cv::Mat& bgr, int frame) const;
 
  private:
+  void DrawLegend(cv::Mat& bgr, double scale) const;
+
   std::map<int, std::vector<TrackRow>> by_frame_;
   std::map<int, int> team_of_;
   std::map<int, std::string> name_of_;

@@ -11,6 +11,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/track/overlay.h"
@@ -238,6 +239,33 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   cv::Mat raw;
   ASSERT_TRUE(in.read(raw));
   EXPECT_GT(cv::norm(first, raw, cv::NORM_L1) / raw.total(), 1.0);  // something was drawn
+}
+
+// The overlay's legend names the teams seen by their colours, and what dashed boxes and trails
+// are, in the bottom-left corner; without it that corner is the video's own.
+TEST(Overlay, LegendNamesTheTeamsSeen) {
+  TrackRow row;
+  row.frame = 1;
+  row.id = 3;
+  row.box = cv::Rect2d(500, 50, 40, 100);  // far from the legend's corner
+  const cv::Mat grey(480, 640, CV_8UC3, cv::Scalar::all(128));
+  const auto count = [](const cv::Mat& img, const cv::Scalar& c) {
+    cv::Mat mask;
+    cv::inRange(img, c - cv::Scalar::all(25), c + cv::Scalar::all(25), mask);
+    return cv::countNonZero(mask);
+  };
+  const cv::Rect corner(0, 360, 320, 120);
+  cv::Mat drawn = grey.clone();
+  TrackOverlay(std::vector<TrackRow>{row}, {{3, 0}, {5, 1}}, {}, nullptr, nullptr).Draw(drawn, 1);
+  EXPECT_GT(count(drawn(corner), TrackColour(0, 0)), 20) << "team 0's swatch";
+  EXPECT_GT(count(drawn(corner), TrackColour(0, 1)), 20) << "team 1's swatch";
+  EXPECT_EQ(count(drawn(corner), TrackColour(0, 2)), 0) << "no team 2";
+  EXPECT_GT(count(drawn(corner), cv::Scalar(255, 255, 255)), 50) << "text";
+  OverlayOptions quiet;
+  quiet.legend = false;
+  cv::Mat plain = grey.clone();
+  TrackOverlay(std::vector<TrackRow>{row}, {{3, 0}}, {}, nullptr, nullptr, quiet).Draw(plain, 1);
+  EXPECT_EQ(cv::norm(plain(corner), grey(corner), cv::NORM_INF), 0.0);
 }
 
 // The synthetic players scene (people of two teams crossing, running and walking): positions on
