@@ -69,6 +69,7 @@ mkdir -p "$TMP/dimgs" && cp "$TMP/imgs/a.png" "$TMP/dimgs/a.png" && : > "$TMP/di
 check "eval detect: --draw-misses inside the images' folder" nonzero $FV eval detect \
   --video "$TMP/dimgs" --draw-misses "$TMP/dimgs/drawn" --detector colour --no-progress
 [ ! -e "$TMP/dimgs/drawn" ] || { echo "FAIL eval detect: --draw-misses folder made"; fail=1; }
+grep -q "lies in the images' folder" "$TMP/err" || { echo "FAIL eval detect: folder not named"; fail=1; }
 check "eval detect: --draw-misses" 0 $FV eval detect --video "$TMP/dimgs" \
   --draw-misses "$TMP/drawn" --detector colour --no-progress
 grep -q "drew 0 misses" "$TMP/out" || { echo "FAIL eval detect: drawings not said"; fail=1; }

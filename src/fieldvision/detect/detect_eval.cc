@@ -481,7 +481,16 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
   std::unique_ptr<MissDrawings> drawings;
   if (!o.draw_misses.empty()) {
-    drawings = std::make_unique<MissDrawings>(o.draw_misses, o.video, inputs);
+    for (const auto& [path, what] :
+         {std::pair{o.out, "--out"}, {o.candidates_out, "--candidates"}}) {
+      FV_REQUIRE(path.empty() || !io::SameFile(path, o.draw_misses),
+                 "{} '{}' is the --draw-misses folder", what, path);
+    }
+    std::vector<std::string> image_files;
+    for (const LabelledImage& item : items) {
+      if (item.frame < 0) image_files.push_back(item.image);
+    }
+    drawings = std::make_unique<MissDrawings>(o.draw_misses, o.video, image_files);
   }
   std::unique_ptr<camera::Camera> camera;
   if (!o.camera.empty()) {

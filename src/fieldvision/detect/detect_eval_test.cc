@@ -280,6 +280,24 @@ TEST(DetectEval, MissesAndFalseDetectionsAreDrawn) {
   EXPECT_NE(error_of(dir + "/drawn").find("lies in the images' folder"), std::string::npos);
   EXPECT_NE(error_of(dir + "/hit.png").find("is not a folder"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir + "/drawn"));
+  // Nor beside images named by a glob or one by one, nor as --out.
+  DetectEvalOptions glob = o;
+  glob.video = dir + "/*.png";
+  glob.draw_misses = dir + "/drawn";
+  EXPECT_THROW(EvaluateDetector(glob), Error);
+  glob.video = dir + "/miss.png";
+  EXPECT_THROW(EvaluateDetector(glob), Error);
+  EXPECT_FALSE(fs::exists(dir + "/drawn"));
+  DetectEvalOptions same = o;
+  same.draw_misses = root + "/drawn2";
+  same.out = root + "/drawn2";
+  try {
+    EvaluateDetector(same);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is the --draw-misses folder"), std::string::npos)
+        << e.what();
+  }
 }
 
 // Nothing to score is said, not scored: no label file at all is an error, and a ratio of nothing

@@ -44,21 +44,42 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.45;
 constexpr int kLineHeight = 18;
 
-// `text` broken at spaces into lines no wider than `width` pixels (a longer word alone).
+int TextWidth(const std::string& text) {
+  int baseline = 0;
+  return cv::getTextSize(text, kFont, kFontScale, 1, &baseline).width;
+}
+
+// `text` broken into lines no wider than `width` pixels: at spaces, and a word too long for a
+// line (a file's path) after its '/' or, failing that, between characters.
 std::vector<std::string> Wrap(const std::string& text, int width) {
   std::vector<std::string> lines;
-  std::istringstream words(text);
-  std::string word, line;
-  while (words >> word) {
-    std::string longer = line;
-    if (!longer.empty()) longer += ' ';
-    longer += word;
-    int baseline = 0;
-    if (!line.empty() && cv::getTextSize(longer, kFont, kFontScale, 1, &baseline).width > width) {
+  std::string line;
+  const auto add = [&](const std::string& piece, bool space) {
+    const std::string longer = line.empty() ? piece : line + (space ? " " : "") + piece;
+    if (!line.empty() && TextWidth(longer) > width) {
       lines.push_back(line);
-      line = word;
+      line = piece;
     } else {
       line = longer;
+    }
+  };
+  std::istringstream words(text);
+  std::string word;
+  while (words >> word) {
+    if (TextWidth(word) <= width) {
+      add(word, true);
+      continue;
+    }
+    bool first = true;
+    std::string piece;
+    for (size_t c = 0; c < word.size(); ++c) {
+      piece += word[c];
+      const bool cut = word[c] == '/' || TextWidth(piece + word.substr(c + 1, 1)) > width;
+      if (cut || c + 1 == word.size()) {
+        add(piece, first);
+        first = false;
+        piece.clear();
+      }
     }
   }
   if (!line.empty()) lines.push_back(line);

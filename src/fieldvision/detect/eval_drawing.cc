@@ -4,14 +4,14 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <system_error>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/detect/detect_video.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -21,6 +21,8 @@ namespace {
 
 const cv::Scalar kCyan(255, 255, 0);
 constexpr int kZoomPx = 240;  // close-up side
+// The longest side an enlargement makes (JPEG holds at most 65500 px; memory).
+constexpr int kMaxDrawingPx = 8000;
 
 // A file name's part from an image's name: letters, digits, '-' and '.' kept, others '_'.
 std::string Slug(const std::string& s) {
@@ -44,7 +46,8 @@ bool Within(const fs::path& inner, const fs::path& outer) {
 
 int EvalDrawingScale(int width, int height) {
   const int shorter = std::max(1, std::min(width, height));
-  return std::clamp((480 + shorter - 1) / shorter, 1, 8);
+  const int longer = std::max(1, std::max(width, height));
+  return std::clamp((480 + shorter - 1) / shorter, 1, std::clamp(kMaxDrawingPx / longer, 1, 8));
 }
 
 namespace {
@@ -133,17 +136,23 @@ cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, 
 }
 
 MissDrawings::MissDrawings(const std::string& dir, const std::string& video,
-                           const std::vector<std::string>& images)
+                           const std::vector<std::string>& image_files)
     : dir_(dir) {
   std::error_code ec;
   FV_REQUIRE(!fs::exists(dir, ec) || fs::is_directory(dir, ec),
              "--draw-misses: '{}' exists and is not a folder", dir);
-  FV_REQUIRE(!fs::is_directory(video, ec) || !Within(dir, video),
-             "--draw-misses: folder '{}' lies in the images' folder '{}' (a later run would score "
-             "the drawings); name one outside it",
-             dir, video);
-  for (const std::string& image : images) {
-    FV_REQUIRE(!Within(image, dir), "--draw-misses: folder '{}' holds the image '{}'", dir, image);
+  // The folders a later run over the same images would list: --video's, each image's.
+  std::set<std::string> folders;
+  if (fs::is_directory(video, ec)) folders.insert(video);
+  for (const std::string& image : image_files) {
+    const fs::path parent = fs::path(image).parent_path();
+    folders.insert(parent.empty() ? "." : parent.string());
+  }
+  for (const std::string& folder : folders) {
+    FV_REQUIRE(!Within(dir, folder),
+               "--draw-misses: folder '{}' lies in the images' folder '{}' (a later run would "
+               "score the drawings); name one outside it",
+               dir, folder);
   }
   fs::create_directories(dir, ec);
   FV_REQUIRE(fs::is_directory(dir, ec), "--draw-misses: cannot make folder '{}'", dir);
@@ -176,7 +185,7 @@ bool MissDrawings::Add(int index, const LabelledImage& item, const DetectEvalIma
                                            : fs::path(item.image).stem().string();
   const std::string path =
       fmt::format("{}/{:05d}_{}_{}.jpg", dir_, index, miss ? "miss" : "false", Slug(name));
-  FV_REQUIRE(codecs::ImWrite(path, drawing), "--draw-misses: cannot write '{}'", path);
+  io::WriteImage(path, drawing);
   ++written_;
   return true;
 }

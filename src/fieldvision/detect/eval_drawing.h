@@ -30,17 +30,18 @@ cv::Mat DrawEvalImage(const cv::Mat& bgr, const std::vector<cv::Rect2d>& boxes, 
                       const std::vector<EvalZoom>& zooms = {});
 
 // The enlargement DrawEvalImage gives an image of this size: the smallest whole factor that
-// makes its shorter side at least 480 px (at most 8; 1 for larger images).
+// makes its shorter side at least 480 px (at most 8, and the longer side at most 8000 px; 1 for
+// larger images).
 int EvalDrawingScale(int width, int height);
 
 // Writes the misses and false detections of an `eval detect` run into `dir`.
 class MissDrawings {
  public:
   // Throws fv::Error (naming --draw-misses and the folder) when `dir` holds files, is not a
-  // folder, cannot be made, or lies in the folder of the images (`video`, searched recursively:
-  // a later run would score the drawings) or holds one of `images`.
+  // folder, cannot be made, or lies in `video` (a folder, searched recursively) or in the folder
+  // of one of `image_files` (a later run over them would score the drawings).
   MissDrawings(const std::string& dir, const std::string& video,
-               const std::vector<std::string>& images);
+               const std::vector<std::string>& image_files);
   // Draws image number `index` when it is a miss or a false detection; returns whether it did.
   bool Add(int index, const LabelledImage& item, const DetectEvalImage& scored,
            const std::vector<BallCandidate>& candidates, const cv::Mat& bgr, double grow);

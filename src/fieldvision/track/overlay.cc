@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <set>
 
 #include <unistd.h>
 
@@ -47,6 +48,7 @@ TrackOverlay::TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int>
     camera_ = std::make_unique<camera::Camera>(*camera);
     field_ = std::make_unique<field::FieldModel>(*field);
   }
+  if (o_.legend) legend_ = LegendLines();
 }
 
 void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
@@ -57,6 +59,8 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
     calib::DrawFieldOverlay(lines, *camera_, *field_, o_.field_colour, 1, 0.1);
     cv::addWeighted(lines, 0.6, bgr, 0.4, 0.0, bgr);
   }
+  // Under the tracks: players in its corner stay in full colour.
+  if (o_.legend) DrawLegend(bgr);
   const double scale = std::max(0.4, bgr.rows / 1000.0);
   // Trails: foot points of the last trail_frames frames, per id.
   if (o_.trail_frames > 0) {
@@ -112,7 +116,6 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
       if (r.time_s) time_s = r.time_s;
     }
   }
-  if (o_.legend) DrawLegend(bgr, scale);
   if (o_.time_label) {
     const std::string text = time_s ? fmt::format("frame {}  t = {:.2f} s", frame, *time_s)
                                     : fmt::format("frame {}", frame);
@@ -123,50 +126,61 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
   }
 }
 
-void TrackOverlay::DrawLegend(cv::Mat& bgr, double scale) const {
-  // Lines of (colour swatches, text); a swatch per team seen, else one line for id colours.
-  std::vector<std::pair<std::vector<cv::Scalar>, std::string>> lines;
-  std::vector<int> teams;
-  for (const auto& [id, team] : team_of_) {
-    if (team >= 0 && std::find(teams.begin(), teams.end(), team) == teams.end()) {
-      teams.push_back(team);
+std::vector<TrackOverlay::LegendLine> TrackOverlay::LegendLines() const {
+  // A swatch per team of the tracks drawn (TrackColour's four), and a line for the colours by id
+  // when some track has none of those teams.
+  std::set<int> teams;
+  bool by_id = false;
+  for (const auto& [frame, rows] : by_frame_) {
+    for (const TrackRow& r : rows) {
+      const auto t = team_of_.find(r.id);
+      if (t != team_of_.end() && t->second >= 0 && t->second < 4) {
+        teams.insert(t->second);
+      } else {
+        by_id = true;
+      }
     }
   }
-  std::sort(teams.begin(), teams.end());
+  std::vector<LegendLine> lines;
   lines.reserve(teams.size() + 4);
   for (int team : teams) lines.push_back({{TrackColour(0, team)}, fmt::format("team {}", team)});
-  if (teams.empty()) {
-    lines.push_back(
-        {{TrackColour(0, -1), TrackColour(1, -1), TrackColour(2, -1)}, "a colour per player id"});
+  if (by_id) {
+    lines.push_back({{TrackColour(0, -1), TrackColour(1, -1), TrackColour(2, -1)},
+                     teams.empty() ? "a colour per player id" : "no team: a colour per id"});
   }
   lines.push_back({{}, "solid box: detected; dashed: carried without a detection"});
   if (o_.trail_frames > 0) {
     lines.push_back({{}, fmt::format("trail: feet over the last {} frames", o_.trail_frames)});
   }
   if (camera_) lines.push_back({{o_.field_colour}, "the field's lines"});
+  return lines;
+}
+
+void TrackOverlay::DrawLegend(cv::Mat& bgr) const {
+  const double scale = std::max(0.8, bgr.rows / 1000.0);  // legible on 480-row video
   const double font = 0.45 * scale;
   const int line_h = cvRound(18 * scale), swatch = cvRound(10 * scale), pad = cvRound(6 * scale);
   int width = 0;
-  for (const auto& [swatches, text] : lines) {
+  for (const auto& [swatches, text] : legend_) {
     int base = 0;
     const int w = static_cast<int>(swatches.size()) * (swatch + 3) +
                   cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, font, 1, &base).width;
     width = std::max(width, w);
   }
-  const cv::Rect box(0, bgr.rows - static_cast<int>(lines.size()) * line_h - 2 * pad,
-                     width + 2 * pad + 4, static_cast<int>(lines.size()) * line_h + 2 * pad);
-  const cv::Rect inside = box & cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (inside.empty()) return;
-  cv::Mat shaded = bgr(inside);
+  const cv::Rect box(0, bgr.rows - static_cast<int>(legend_.size()) * line_h - 2 * pad,
+                     width + 2 * pad + 4, static_cast<int>(legend_.size()) * line_h + 2 * pad);
+  // A legend that would hide much of a small video is left out.
+  if (box.y < bgr.rows * 2 / 3 || box.width > bgr.cols * 2 / 3) return;
+  cv::Mat shaded = bgr(box);
   shaded *= 0.35;  // darkened, the video still seen through it
-  for (size_t i = 0; i < lines.size(); ++i) {
+  for (size_t i = 0; i < legend_.size(); ++i) {
     int x = box.x + pad;
     const int y = box.y + pad + static_cast<int>(i + 1) * line_h - cvRound(5 * scale);
-    for (const cv::Scalar& c : lines[i].first) {
+    for (const cv::Scalar& c : legend_[i].swatches) {
       cv::rectangle(bgr, cv::Rect(x, y - swatch, swatch, swatch), c, cv::FILLED);
       x += swatch + 3;
     }
-    cv::putText(bgr, lines[i].second, cv::Point(x + 2, y), cv::FONT_HERSHEY_SIMPLEX, font,
+    cv::putText(bgr, legend_[i].text, cv::Point(x + 2, y), cv::FONT_HERSHEY_SIMPLEX, font,
                 cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   }
 }

@@ -26,7 +26,8 @@ struct OverlayOptions {
   bool field_lines = true;  // project the field's lines (needs a posed camera and a field)
   cv::Scalar field_colour = cv::Scalar(255, 255, 255);  // BGR
   bool time_label = true;                               // "frame N, t = S s" in the corner
-  // What the colours, dashed boxes, trails and lines mean, in the bottom-left corner.
+  // What the colours, dashed boxes, trails and lines mean, in the bottom-left corner (left out
+  // where it would cover more than a third of the frame's height or two thirds of its width).
   bool legend = true;
   void Check() const;
 };
@@ -46,7 +47,12 @@ class TrackOverlay {
   void Draw(cv::Mat& bgr, int frame) const;
 
  private:
-  void DrawLegend(cv::Mat& bgr, double scale) const;
+  struct LegendLine {
+    std::vector<cv::Scalar> swatches;
+    std::string text;
+  };
+  std::vector<LegendLine> LegendLines() const;
+  void DrawLegend(cv::Mat& bgr) const;
 
   std::map<int, std::vector<TrackRow>> by_frame_;
   std::map<int, int> team_of_;
@@ -55,6 +61,7 @@ class TrackOverlay {
   std::unique_ptr<field::FieldModel> field_;
   cv::Mat field_layer_, field_mask_;  // projected lines, drawn once
   OverlayOptions o_;
+  std::vector<LegendLine> legend_;  // made once
 };
 
 // A video being written: H.264 in MP4 when `path` ends in .mp4 and OpenCV's FFmpeg has the

@@ -241,13 +241,17 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   EXPECT_GT(cv::norm(first, raw, cv::NORM_L1) / raw.total(), 1.0);  // something was drawn
 }
 
-// The overlay's legend names the teams seen by their colours, and what dashed boxes and trails
-// are, in the bottom-left corner; without it that corner is the video's own.
-TEST(Overlay, LegendNamesTheTeamsSeen) {
-  TrackRow row;
-  row.frame = 1;
-  row.id = 3;
-  row.box = cv::Rect2d(500, 50, 40, 100);  // far from the legend's corner
+// The overlay's legend names the teams of the tracks drawn by their colours (a roster team
+// without a track is left out), adds the colours by id when a track has no team of the four,
+// and says what dashed boxes and trails are, in the bottom-left corner; without it, or on a
+// frame too small for it, that corner is the video's own.
+TEST(Overlay, LegendNamesTheTeamsOfTheTracks) {
+  std::vector<TrackRow> rows(2);
+  rows[0].frame = rows[1].frame = 1;
+  rows[0].id = 3;
+  rows[1].id = 5;
+  rows[0].box = cv::Rect2d(500, 50, 40, 100);  // far from the legend's corner
+  rows[1].box = cv::Rect2d(560, 50, 40, 100);
   const cv::Mat grey(480, 640, CV_8UC3, cv::Scalar::all(128));
   const auto count = [](const cv::Mat& img, const cv::Scalar& c) {
     cv::Mat mask;
@@ -255,17 +259,31 @@ TEST(Overlay, LegendNamesTheTeamsSeen) {
     return cv::countNonZero(mask);
   };
   const cv::Rect corner(0, 360, 320, 120);
-  cv::Mat drawn = grey.clone();
-  TrackOverlay(std::vector<TrackRow>{row}, {{3, 0}, {5, 1}}, {}, nullptr, nullptr).Draw(drawn, 1);
-  EXPECT_GT(count(drawn(corner), TrackColour(0, 0)), 20) << "team 0's swatch";
-  EXPECT_GT(count(drawn(corner), TrackColour(0, 1)), 20) << "team 1's swatch";
-  EXPECT_EQ(count(drawn(corner), TrackColour(0, 2)), 0) << "no team 2";
-  EXPECT_GT(count(drawn(corner), cv::Scalar(255, 255, 255)), 50) << "text";
+  const auto draw = [&](const std::map<int, int>& team_of, const OverlayOptions& o,
+                        const cv::Mat& frame) {
+    cv::Mat drawn = frame.clone();
+    TrackOverlay(rows, team_of, {}, nullptr, nullptr, o).Draw(drawn, 1);
+    return drawn;
+  };
+  const int swatch = 8 * 8;  // a swatch is 8 x 8 px at this size
+  cv::Mat d = draw({{3, 0}, {5, 1}, {7, 2}}, {}, grey);
+  EXPECT_GE(count(d(corner), TrackColour(0, 0)), swatch) << "team 0";
+  EXPECT_GE(count(d(corner), TrackColour(0, 1)), swatch) << "team 1";
+  EXPECT_EQ(count(d(corner), TrackColour(0, 2)), 0) << "team 2 has no track";
+  EXPECT_EQ(count(d(corner), TrackColour(0, -1)), 0) << "every track has a team";
+  EXPECT_GT(count(d(corner), cv::Scalar(255, 255, 255)), 50) << "text";
+  d = draw({{3, 0}, {5, 7}}, {}, grey);  // team 7 has no colour of its own
+  EXPECT_GE(count(d(corner), TrackColour(0, 0)), swatch);
+  EXPECT_GE(count(d(corner), TrackColour(0, -1)), swatch) << "colours by id";
   OverlayOptions quiet;
   quiet.legend = false;
-  cv::Mat plain = grey.clone();
-  TrackOverlay(std::vector<TrackRow>{row}, {{3, 0}}, {}, nullptr, nullptr, quiet).Draw(plain, 1);
-  EXPECT_EQ(cv::norm(plain(corner), grey(corner), cv::NORM_INF), 0.0);
+  d = draw({{3, 0}}, quiet, grey);
+  EXPECT_EQ(cv::norm(d(corner), grey(corner), cv::NORM_INF), 0.0);
+  const cv::Mat tiny(24, 32, CV_8UC3, cv::Scalar::all(128));
+  OverlayOptions no_time;
+  no_time.time_label = false;
+  d = draw({{3, 0}}, no_time, tiny);
+  EXPECT_EQ(cv::norm(d, tiny, cv::NORM_INF), 0.0) << "no legend on a 32x24 frame";
 }
 
 // The synthetic players scene (people of two teams crossing, running and walking): positions on
