@@ -1,12 +1,17 @@
 // `fieldvision ball`: the ball in 3D from 2..N synchronised cameras (pipeline/ball_job.h).
+#include <filesystem>
 #include <iostream>
 #include <memory>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/pipeline/ball_job.h"
+#include "fieldvision/pipeline/ball_overlay.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/util/error.h"
 
@@ -17,7 +22,39 @@ struct BallCliOptions {
   pipeline::BallJobOptions job;
   bool rows = false;
   pipeline::DetectionsJobOptions det;  // with --detections instead of --video
+  pipeline::BallOverlayOptions draw;   // --draw DIR
 };
+
+// --draw: each camera's video with the 3D ball and its candidates (pipeline/ball_overlay.h),
+// frames paired by index; the candidates drawn are those --write-detections writes (into the
+// folder, as CAMERA_det.csv, when it is not given).
+void PrepareDraw(BallCliOptions& o) {
+  if (o.draw.dir.empty()) return;
+  FV_REQUIRE(o.job.timestamps.empty() && o.job.sync == "frame" && !o.job.live,
+             "ball: --draw pairs each camera's frames with BALL.csv by index: it needs --sync "
+             "frame (no --timestamps) and no --live");
+  o.draw.ball_diameter_m = o.job.ball_diameter_m;
+  o.draw.max_frames = o.job.pipeline.max_frames;
+  o.draw.progress = o.job.pipeline.progress;
+  o.draw.Check();
+  std::error_code ec;
+  std::filesystem::create_directories(o.draw.dir, ec);
+  FV_REQUIRE(std::filesystem::is_directory(o.draw.dir), "ball: cannot make the --draw folder '{}'",
+             o.draw.dir);
+  if (!o.job.detections_out.empty()) return;
+  for (const std::string& cam : o.job.cameras) {
+    o.job.detections_out.push_back(
+        fmt::format("{}/{}_det.csv", o.draw.dir, std::filesystem::path(cam).stem().string()));
+  }
+}
+
+void Draw(const BallCliOptions& o) {
+  std::vector<camera::Camera> cameras;
+  for (const std::string& path : o.job.cameras) cameras.push_back(pipeline::ReadRigCamera(path));
+  const pipeline::BallOverlayResult r =
+      pipeline::DrawBallOverlays(cameras, o.job.videos, o.job.out, o.job.detections_out, o.draw);
+  std::cout << r.Summary() << "\n";
+}
 
 void RunDetections(BallCliOptions& o) {
   pipeline::DetectionsJobOptions& d = o.det;
@@ -58,6 +95,7 @@ void RunBall(const BallCliOptions& o) {
   }
   std::cout << "wrote " << o.job.out << " (" << r.rows_written << " rows)\n";
   if (r.eval) std::cout << r.eval->Table(o.rows || r.eval->rows.size() <= 40) << "\n";
+  if (!o.draw.dir.empty()) Draw(o);
 }
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -83,6 +121,11 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--write-detections", o->job.detections_out,
                   "Also write each camera's accepted candidates as DET.csv (frame,time_s,u,v,"
                   "radius_px,score: what --detections reads), one per --camera in order");
+  cmd->add_option(
+      "--draw", o->draw.dir,
+      "Also write each camera's video with the ball's 3D position seen from it (at "
+      "its size) and the camera's accepted candidates into this folder (CAMERA.mp4; "
+      "frames paired by index; without --write-detections the candidates go there too)");
   cmd->add_flag("!--no-bundle", o->job.bundle,
                 "Offline: keep each frame's own position instead of refining each flight on the "
                 "cameras' candidates at the end");
@@ -112,6 +155,7 @@ void Setup(CLI::App& app, int& exit_code) {
     FV_REQUIRE(!o->det.detections.empty() ||
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");
+    if (o->det.detections.empty()) PrepareDraw(*o);
     const auto inputs = io::PathList(o->job.cameras, o->job.videos, o->job.timestamps, o->job.truth,
                                      o->job.field, o->job.colour, o->det.detections);
     io::CheckOutputPath(o->job.out, inputs);
@@ -130,6 +174,7 @@ void Setup(CLI::App& app, int& exit_code) {
     }
     if (!o->det.detections.empty()) {
       FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
+      FV_REQUIRE(o->draw.dir.empty(), "ball: --draw needs --video (the frames to draw on)");
       FV_REQUIRE(o->job.detections_out.empty(),
                  "ball: --write-detections needs --video (the detections are the input here)");
       RunDetections(*o);
