@@ -21,6 +21,7 @@ namespace {
 struct PlayersCli {
   std::string camera, video, out, field, onnx, draw, mot_out;
   track::PlayersOptions o;
+  track::OverlayOptions overlay;  // --draw
 };
 
 void RunPlayersCommand(const PlayersCli& c) {
@@ -71,11 +72,22 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
     const track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
-                                      field ? &*field : nullptr);
+                                      field ? &*field : nullptr, c.overlay);
     const track::DrawVideoResult d =
         track::DrawTracksVideo(c.video, c.draw, overlay, c.o.fps, c.o.max_frames);
     std::cout << d.Summary() << "\n";
   }
+}
+
+// --draw and how it draws.
+void AddDrawOptions(CLI::App* cmd, PlayersCli& c) {
+  cmd->add_option("--draw", c.draw,
+                  "Also write the video with boxes, ids, team colours, trails and (with a posed "
+                  "camera and --field) the field lines: H.264 .mp4, or MJPG .avi where OpenCV has "
+                  "no H.264 encoder");
+  cmd->add_flag("!--no-legend", c.overlay.legend,
+                "With --draw: leave out the legend in the bottom-left corner (teams, boxes, "
+                "trails, lines)");
 }
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -132,10 +144,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "this, half the clip); the summary says how many were dropped")
       ->check(FiniteRange(0, 1000000))
       ->capture_default_str();
-  cmd->add_option("--draw", c->draw,
-                  "Also write the video with boxes, ids, team colours, trails and (with a posed "
-                  "camera and --field) the field lines: H.264 .mp4, or MJPG .avi where OpenCV has "
-                  "no H.264 encoder");
+  AddDrawOptions(cmd, *c);
   cmd->add_option("--mot-out", c->mot_out,
                   "Also write the tracks as a MOTChallenge results file (no header, "
                   "frame,id,left,top,w,h,conf,-1,-1,-1) for TrackEval / py-motmetrics");

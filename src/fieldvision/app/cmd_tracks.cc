@@ -57,6 +57,7 @@ void RunTracksEdit(const TracksEditCli& c) {
 
 struct TracksDrawCli {
   std::string tracks, video, out, camera, field, roster_in;
+  track::OverlayOptions overlay;
   double fps = 0;
   int max_frames = 0;
 };
@@ -83,7 +84,8 @@ void RunTracksDraw(const TracksDrawCli& c) {
   std::optional<field::FieldModel> field;
   if (!c.field.empty()) field = field::LoadField(c.field);
   const track::TrackOverlay overlay(rows, roster.team_of, roster.name_of,
-                                    camera ? &*camera : nullptr, field ? &*field : nullptr);
+                                    camera ? &*camera : nullptr, field ? &*field : nullptr,
+                                    c.overlay);
   const track::DrawVideoResult d =
       track::DrawTracksVideo(c.video, c.out, overlay, c.fps, c.max_frames);
   std::cout << d.Summary() << "\n";
@@ -125,6 +127,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(0.01, 10000));
   draw->add_option("--max-frames", d->max_frames, "Draw at most this many frames (0: all)")
       ->check(FiniteRange(0, 1e9));
+  draw->add_flag("!--no-legend", d->overlay.legend,
+                 "Leave out the legend in the bottom-left corner (teams, boxes, trails, lines)");
   draw->callback([d] { RunTracksDraw(*d); });
 }
 
