@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <system_error>
 
 #include <fmt/format.h>
@@ -124,13 +125,15 @@ BallOverlayResult DrawBallOverlays(const std::vector<camera::Camera>& cameras,
       "camera's accepted candidates (score)";
   BallOverlayResult result;
   util::Progress progress("draw", -1, "camera frames", o.progress);
+  std::set<std::string> names;
   for (size_t i = 0; i < cameras.size(); ++i) {
     const camera::Camera& cam = cameras[i];
     const auto candidates =
         CandidatesByFrame(detections.empty() ? "" : detections[i], static_cast<int>(i));
     auto source = io::VideoSource::Open(videos[i]);
     const cv::Mat band = detect::TextBand({legend}, source->width());
-    const std::string name = cam.name.empty() ? fmt::format("cam{}", i + 1) : cam.name;
+    std::string name = cam.name.empty() ? fmt::format("cam{}", i + 1) : cam.name;
+    if (!names.insert(name).second) name += fmt::format("-{}", i + 1);  // two of one name
     track::PlayableVideoWriter writer(fmt::format("{}/{}.mp4", o.dir, name),
                                       source->fps() > 0 ? source->fps() : 30.0,
                                       {source->width(), source->height() + band.rows});
