@@ -59,6 +59,9 @@ grep -q "huge_truth.csv:2" "$TMP/err" || { echo "FAIL ball: truth line not named
 check "ball: --draw with --sync time" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --draw "$TMP/drawn_ball" --sync time
 grep -q "needs --sync frame" "$TMP/err" || { echo "FAIL ball: --draw's sync not named"; fail=1; }
+check "ball: --draw with --out a folder" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
+  --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP" --draw "$TMP/drawn_ball"
+[ ! -e "$TMP/drawn_ball" ] || { echo "FAIL ball: a failed run left its --draw folder"; fail=1; }
 printf 'frame,time_s,x_m,y_m,z_m\n' > "$TMP/empty_truth.csv"
 check "ball: --truth header only" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --truth "$TMP/empty_truth.csv"

@@ -23,6 +23,7 @@ struct BallCliOptions {
   bool rows = false;
   pipeline::DetectionsJobOptions det;  // with --detections instead of --video
   pipeline::BallOverlayOptions draw;   // --draw DIR
+  bool draw_dir_made = false;          // ... made by this run (removed if it fails empty)
 };
 
 // --draw: each camera's video with the 3D ball and its candidates (pipeline/ball_overlay.h),
@@ -38,6 +39,7 @@ void PrepareDraw(BallCliOptions& o) {
   o.draw.progress = o.job.pipeline.progress;
   o.draw.Check();
   std::error_code ec;
+  o.draw_dir_made = !std::filesystem::exists(o.draw.dir, ec);
   std::filesystem::create_directories(o.draw.dir, ec);
   FV_REQUIRE(std::filesystem::is_directory(o.draw.dir), "ball: cannot make the --draw folder '{}'",
              o.draw.dir);
@@ -98,6 +100,33 @@ void RunBall(const BallCliOptions& o) {
   if (!o.draw.dir.empty()) Draw(o);
 }
 
+// The outputs checked against the inputs and each other, then the run (videos or detections).
+void CheckOutputsAndRun(BallCliOptions& o) {
+  const auto inputs = io::PathList(o.job.cameras, o.job.videos, o.job.timestamps, o.job.truth,
+                                   o.job.field, o.job.colour, o.det.detections);
+  io::CheckOutputPath(o.job.out, inputs);
+  io::CheckOutputPath(o.det.flights, io::PathList(inputs, o.job.out), "--flights");
+  for (size_t i = 0; i < o.job.detections_out.size(); ++i) {
+    std::vector<std::string> others = io::PathList(inputs, o.job.out);
+    others.insert(others.end(), o.job.detections_out.begin(),
+                  o.job.detections_out.begin() + static_cast<long>(i));
+    io::CheckOutputPath(o.job.detections_out[i], others, "--write-detections");
+    o.job.detections_out[i] = io::ResolveOutputPath(o.job.detections_out[i], "--write-detections");
+  }
+  o.job.out = io::ResolveOutputPath(o.job.out);  // refuses a device or a folder
+  if (!o.det.flights.empty()) o.det.flights = io::ResolveOutputPath(o.det.flights, "--flights");
+  if (!o.det.detections.empty()) {
+    FV_REQUIRE(o.job.videos.empty(), "ball: give --video or --detections, not both");
+    FV_REQUIRE(o.draw.dir.empty(), "ball: --draw needs --video (the frames to draw on)");
+    FV_REQUIRE(o.job.detections_out.empty(),
+               "ball: --write-detections needs --video (the detections are the input here)");
+    RunDetections(o);
+    return;
+  }
+  if (!o.job.timestamps.empty()) o.job.sync = "time";
+  RunBall(o);
+}
+
 void Setup(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<BallCliOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -156,32 +185,13 @@ void Setup(CLI::App& app, int& exit_code) {
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");
     if (o->det.detections.empty()) PrepareDraw(*o);
-    const auto inputs = io::PathList(o->job.cameras, o->job.videos, o->job.timestamps, o->job.truth,
-                                     o->job.field, o->job.colour, o->det.detections);
-    io::CheckOutputPath(o->job.out, inputs);
-    io::CheckOutputPath(o->det.flights, io::PathList(inputs, o->job.out), "--flights");
-    for (size_t i = 0; i < o->job.detections_out.size(); ++i) {
-      std::vector<std::string> others = io::PathList(inputs, o->job.out);
-      others.insert(others.end(), o->job.detections_out.begin(),
-                    o->job.detections_out.begin() + static_cast<long>(i));
-      io::CheckOutputPath(o->job.detections_out[i], others, "--write-detections");
-      o->job.detections_out[i] =
-          io::ResolveOutputPath(o->job.detections_out[i], "--write-detections");
+    try {
+      CheckOutputsAndRun(*o);
+    } catch (...) {
+      std::error_code ec;
+      if (o->draw_dir_made) std::filesystem::remove(o->draw.dir, ec);  // only if still empty
+      throw;
     }
-    o->job.out = io::ResolveOutputPath(o->job.out);  // refuses a device or a folder
-    if (!o->det.flights.empty()) {
-      o->det.flights = io::ResolveOutputPath(o->det.flights, "--flights");
-    }
-    if (!o->det.detections.empty()) {
-      FV_REQUIRE(o->job.videos.empty(), "ball: give --video or --detections, not both");
-      FV_REQUIRE(o->draw.dir.empty(), "ball: --draw needs --video (the frames to draw on)");
-      FV_REQUIRE(o->job.detections_out.empty(),
-                 "ball: --write-detections needs --video (the detections are the input here)");
-      RunDetections(*o);
-      return;
-    }
-    if (!o->job.timestamps.empty()) o->job.sync = "time";
-    RunBall(*o);
   });
 }
 

@@ -583,6 +583,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
       w.Close();
     });
   }
+  if (drawings != nullptr) drawings->Keep();  // every output written
   return result;
 }
 

@@ -288,6 +288,13 @@ TEST(DetectEval, MissesAndFalseDetectionsAreDrawn) {
   glob.video = dir + "/miss.png";
   EXPECT_THROW(EvaluateDetector(glob), Error);
   EXPECT_FALSE(fs::exists(dir + "/drawn"));
+  // A run that fails on an image leaves no folder it made.
+  DetectEvalOptions failing = o;
+  failing.draw_misses = root + "/drawn3";
+  failing.camera = root + "/other.yaml";
+  camera::WriteCameraYaml(camera::Camera::FromFov(640, 480, 60), failing.camera);
+  EXPECT_THROW(EvaluateDetector(failing), Error);
+  EXPECT_FALSE(fs::exists(failing.draw_misses));
   DetectEvalOptions same = o;
   same.draw_misses = root + "/drawn2";
   same.out = root + "/drawn2";
