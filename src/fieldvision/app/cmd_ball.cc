@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <fmt/format.h>
@@ -21,32 +22,40 @@ namespace {
 struct BallCliOptions {
   pipeline::BallJobOptions job;
   bool rows = false;
-  pipeline::DetectionsJobOptions det;  // with --detections instead of --video
-  pipeline::BallOverlayOptions draw;   // --draw DIR
-  bool draw_dir_made = false;          // ... made by this run (removed if it fails empty)
+  pipeline::DetectionsJobOptions det;     // with --detections instead of --video
+  pipeline::BallOverlayOptions draw;      // --draw DIR
+  std::optional<io::NewFolder> draw_dir;  // ... a new folder, removed if the run fails empty
 };
 
 // --draw: each camera's video with the 3D ball and its candidates (pipeline/ball_overlay.h),
-// frames paired by index; the candidates drawn are those --write-detections writes (into the
-// folder, as CAMERA_det.csv, when it is not given).
+// frames paired by index, in a new or empty folder (nothing of the user's replaced); the
+// candidates drawn are those --write-detections writes (into the folder, NAME_det.csv, when it
+// is not given). Names from the camera files' names (pipeline::DrawNames).
 void PrepareDraw(BallCliOptions& o) {
   if (o.draw.dir.empty()) return;
   FV_REQUIRE(o.job.timestamps.empty() && o.job.sync == "frame" && !o.job.live,
              "ball: --draw pairs each camera's frames with BALL.csv by index: it needs --sync "
              "frame (no --timestamps) and no --live");
+  for (const std::string& video : o.job.videos) {
+    std::error_code ec;
+    FV_REQUIRE(std::filesystem::exists(video, ec) || video.find('%') != std::string::npos,
+               "ball: --draw reads the videos again after the run: '{}' must be a file or an "
+               "image pattern, not a live source",
+               video);
+  }
   o.draw.ball_diameter_m = o.job.ball_diameter_m;
   o.draw.max_frames = o.job.pipeline.max_frames;
   o.draw.progress = o.job.pipeline.progress;
   o.draw.Check();
-  std::error_code ec;
-  o.draw_dir_made = !std::filesystem::exists(o.draw.dir, ec);
-  std::filesystem::create_directories(o.draw.dir, ec);
-  FV_REQUIRE(std::filesystem::is_directory(o.draw.dir), "ball: cannot make the --draw folder '{}'",
-             o.draw.dir);
-  if (!o.job.detections_out.empty()) return;
+  std::vector<std::string> stems;
   for (const std::string& cam : o.job.cameras) {
-    o.job.detections_out.push_back(
-        fmt::format("{}/{}_det.csv", o.draw.dir, std::filesystem::path(cam).stem().string()));
+    stems.push_back(std::filesystem::path(cam).stem().string());
+  }
+  o.draw.names = pipeline::DrawNames(stems);
+  o.draw_dir.emplace(o.draw.dir, "--draw");
+  if (!o.job.detections_out.empty()) return;
+  for (const std::string& name : o.draw.names) {
+    o.job.detections_out.push_back(fmt::format("{}/{}_det.csv", o.draw.dir, name));
   }
 }
 
@@ -152,9 +161,11 @@ void Setup(CLI::App& app, int& exit_code) {
                   "radius_px,score: what --detections reads), one per --camera in order");
   cmd->add_option(
       "--draw", o->draw.dir,
-      "Also write each camera's video with the ball's 3D position seen from it (at "
-      "its size) and the camera's accepted candidates into this folder (CAMERA.mp4; "
-      "frames paired by index; without --write-detections the candidates go there too)");
+      "Also write, into this new (or empty) folder, each camera's video with the ball's 3D "
+      "position seen from it at its size and the camera's accepted candidates (NAME.mp4, or .avi "
+      "without an H.264 encoder, NAME the camera file's name; frames paired by index; without "
+      "--write-detections the candidates go there as NAME_det.csv; a failed drawing leaves "
+      "BALL.csv and those files)");
   cmd->add_flag("!--no-bundle", o->job.bundle,
                 "Offline: keep each frame's own position instead of refining each flight on the "
                 "cameras' candidates at the end");
@@ -187,9 +198,9 @@ void Setup(CLI::App& app, int& exit_code) {
     if (o->det.detections.empty()) PrepareDraw(*o);
     try {
       CheckOutputsAndRun(*o);
+      if (o->draw_dir) o->draw_dir->Keep();
     } catch (...) {
-      std::error_code ec;
-      if (o->draw_dir_made) std::filesystem::remove(o->draw.dir, ec);  // only if still empty
+      o->draw_dir.reset();  // the folders it made go while empty
       throw;
     }
   });

@@ -25,6 +25,7 @@ struct PlayersCli {
 };
 
 void RunPlayersCommand(const PlayersCli& c) {
+  FV_REQUIRE(c.overlay.legend || !c.draw.empty(), "players: --no-legend applies only with --draw");
   std::optional<camera::Camera> camera;
   if (!c.camera.empty()) camera = camera::ReadCameraYaml(c.camera);
   std::optional<field::FieldModel> field;

@@ -154,20 +154,7 @@ MissDrawings::MissDrawings(const std::string& dir, const std::string& video,
                "score the drawings); name one outside it",
                dir, folder);
   }
-  made_ = !fs::exists(dir, ec);
-  fs::create_directories(dir, ec);
-  FV_REQUIRE(fs::is_directory(dir, ec), "--draw-misses: cannot make folder '{}'", dir);
-  FV_REQUIRE(fs::is_empty(dir, ec) && !ec,
-             "--draw-misses: folder '{}' is not empty (an earlier run's drawings would mix with "
-             "these); name a new folder",
-             dir);
-}
-
-MissDrawings::~MissDrawings() {
-  if (made_ && written_ == 0 && !keep_) {
-    std::error_code ec;
-    fs::remove(dir_, ec);  // only an empty folder goes
-  }
+  folder_.emplace(dir, "--draw-misses");
 }
 
 bool MissDrawings::Add(int index, const LabelledImage& item, const DetectEvalImage& scored,

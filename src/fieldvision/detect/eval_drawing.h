@@ -5,6 +5,7 @@
 // empty) folder outside the images' folder.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/detect_eval.h"
+#include "fieldvision/io/output_path.h"
 
 namespace fv::detect {
 
@@ -42,23 +44,18 @@ class MissDrawings {
   // of one of `image_files` (a later run over them would score the drawings).
   MissDrawings(const std::string& dir, const std::string& video,
                const std::vector<std::string>& image_files);
-  // A folder it made and wrote nothing into is removed unless the run was kept (a failed run
-  // leaves nothing behind).
-  ~MissDrawings();
-  MissDrawings(const MissDrawings&) = delete;
-  MissDrawings& operator=(const MissDrawings&) = delete;
+  // The folder is io::NewFolder's: removed again when the run fails before drawing into it.
   // Draws image number `index` when it is a miss or a false detection; returns whether it did.
   bool Add(int index, const LabelledImage& item, const DetectEvalImage& scored,
            const std::vector<BallCandidate>& candidates, const cv::Mat& bgr, double grow);
-  void Keep() { keep_ = true; }  // the run succeeded: the folder stays, drawings or not
+  void Keep() { folder_->Keep(); }  // the run succeeded: the folder stays, drawings or not
   int written() const { return written_; }
   const std::string& dir() const { return dir_; }
 
  private:
   std::string dir_;
   int written_ = 0;
-  bool made_ = false;  // the folder did not exist before
-  bool keep_ = false;
+  std::optional<io::NewFolder> folder_;
 };
 
 }  // namespace fv::detect

@@ -108,4 +108,29 @@ void AtomicWrite(const std::string& out, const std::function<void(const std::str
   file.Commit();
 }
 
+NewFolder::NewFolder(const std::string& path, std::string_view what) : path_(path) {
+  std::error_code ec;
+  FV_REQUIRE(!path.empty(), "{}: no folder given", what);
+  FV_REQUIRE(!fs::exists(path, ec) || fs::is_directory(path, ec),
+             "{}: '{}' exists and is not a folder", what, path);
+  for (fs::path p = fs::absolute(path, ec); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    made_.push_back(p.string());
+    if (p == p.parent_path()) break;
+  }
+  fs::create_directories(path, ec);
+  FV_REQUIRE(fs::is_directory(path, ec), "{}: cannot make folder '{}'", what, path);
+  FV_REQUIRE(fs::is_empty(path, ec) && !ec,
+             "{}: folder '{}' is not empty (an earlier run's files would mix with these, or be "
+             "replaced); name a new folder",
+             what, path);
+}
+
+NewFolder::~NewFolder() {
+  if (keep_) return;
+  std::error_code ec;
+  for (const std::string& p : made_) {
+    if (!fs::remove(p, ec)) break;  // only empty folders go
+  }
+}
+
 }  // namespace fv::io

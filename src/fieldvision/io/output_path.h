@@ -44,6 +44,25 @@ std::vector<std::string> PathList(const Paths&... paths) {
 // symlink. Throws fv::Error when `out` exists and is not a regular file (device, folder, fifo).
 std::string ResolveOutputPath(const std::string& out, std::string_view what = "--out");
 
+// A folder for a run's outputs (`--draw DIR`), made with its missing parents and required empty
+// (an earlier run's files would mix in, and nothing of the user's is replaced); until Keep(),
+// the folders it made are removed again while empty (a failed run leaves nothing behind).
+// Throws fv::Error naming `what` and the folder.
+class NewFolder {
+ public:
+  NewFolder(const std::string& path, std::string_view what);
+  ~NewFolder();
+  NewFolder(const NewFolder&) = delete;
+  NewFolder& operator=(const NewFolder&) = delete;
+  void Keep() { keep_ = true; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::vector<std::string> made_;  // the deepest first
+  bool keep_ = false;
+};
+
 // A temporary file beside the (resolved) output; Commit() renames it over the output, the
 // destructor removes it when Commit() was not reached (a failed run leaves the output as it was).
 class AtomicOutput {

@@ -139,5 +139,36 @@ TEST(AtomicWrite, WritesThroughASymlinkAndRefusesDevicesAndFolders) {
   EXPECT_NE(testing::ErrorOf([&] { ResolveOutputPath(lost); }).find(lost), std::string::npos);
 }
 
+// A run's new output folder: made with its parents, refused when it holds files or is a file;
+// the folders it made go again unless kept, while empty; a folder that was there stays.
+TEST(NewFolder, MadeRequiredEmptyAndRemovedUnlessKept) {
+  const std::string dir = testing::TempDir();
+  {
+    NewFolder f(dir + "/a/b/c", "--draw");
+    EXPECT_TRUE(fs::is_directory(dir + "/a/b/c"));
+  }
+  EXPECT_FALSE(fs::exists(dir + "/a")) << "every folder it made is gone";
+  {
+    NewFolder f(dir + "/kept", "--draw");
+    f.Keep();
+  }
+  EXPECT_TRUE(fs::is_directory(dir + "/kept"));
+  {
+    NewFolder f(dir + "/kept", "--draw");  // there before: an empty folder is accepted, and stays
+  }
+  EXPECT_TRUE(fs::is_directory(dir + "/kept"));
+  {
+    NewFolder f(dir + "/full/sub", "--draw");
+    WriteText(dir + "/full/sub/x.txt", "x\n");  // a failed run's partial output stays
+  }
+  EXPECT_TRUE(fs::exists(dir + "/full/sub/x.txt"));
+  const std::string e1 = testing::ErrorOf([&] { NewFolder f(dir + "/full/sub", "--draw"); });
+  EXPECT_NE(e1.find("is not empty"), std::string::npos) << e1;
+  EXPECT_NE(e1.find("--draw"), std::string::npos) << e1;
+  const std::string e2 = testing::ErrorOf([&] { NewFolder f(dir + "/full/sub/x.txt", "--draw"); });
+  EXPECT_NE(e2.find("is not a folder"), std::string::npos) << e2;
+  EXPECT_EQ(e2.find('\n'), std::string::npos) << e2;
+}
+
 }  // namespace
 }  // namespace fv::io

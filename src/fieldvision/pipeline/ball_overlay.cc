@@ -1,5 +1,7 @@
 #include "fieldvision/pipeline/ball_overlay.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -70,7 +72,7 @@ bool DrawBall(cv::Mat& bgr, const camera::Camera& camera, const Eigen::Vector3d&
   if (side.squaredNorm() < 1e-12) side = sight.cross(Eigen::Vector3d::UnitX());
   const std::optional<Eigen::Vector2d> edge =
       camera.Project(ball_in_world + radius_m * side.normalized());
-  const double r_px = edge ? (*edge - *c).norm() : 4.0;
+  const double r_px = std::min(edge ? (*edge - *c).norm() : 4.0, std::hypot(bgr.cols, bgr.rows));
   constexpr int kShift = 4;
   const auto pt = [](const Eigen::Vector2d& p) {
     return cv::Point(cvRound(p.x() * (1 << kShift)), cvRound(p.y() * (1 << kShift)));
@@ -92,6 +94,25 @@ void FrameLabel(cv::Mat& bgr, const std::string& text) {
 }
 
 }  // namespace
+
+std::vector<std::string> DrawNames(const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  std::set<std::string> taken;
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::string name;
+    for (char c : names[i]) {
+      const bool keep =
+          std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
+      name += keep ? c : '_';
+    }
+    if (name.empty()) name = fmt::format("cam{}", i + 1);
+    if (name.front() == '.') name.insert(0, 1, '_');
+    std::string unique = name;
+    for (int k = 2; !taken.insert(unique).second; ++k) unique = fmt::format("{}-{}", name, k);
+    out.push_back(unique);
+  }
+  return out;
+}
 
 void BallOverlayOptions::Check() const {
   FV_REQUIRE(!dir.empty(), "--draw needs a folder");
@@ -116,24 +137,30 @@ BallOverlayResult DrawBallOverlays(const std::vector<camera::Camera>& cameras,
              videos.size());
   FV_REQUIRE(detections.empty() || detections.size() == cameras.size(),
              "--draw: {} cameras but {} detection files", cameras.size(), detections.size());
+  FV_REQUIRE(o.names.empty() || o.names.size() == cameras.size(), "--draw: {} cameras but {} names",
+             cameras.size(), o.names.size());
+  std::vector<std::string> names = o.names;
+  if (names.empty()) {
+    for (const camera::Camera& cam : cameras) names.push_back(cam.name);
+    names = DrawNames(names);
+  }
   const std::map<long long, Eigen::Vector3d> balls = BallByFrame(ball_csv);
   std::error_code ec;
-  fs::create_directories(o.dir, ec);
-  FV_REQUIRE(fs::is_directory(o.dir), "--draw: cannot make folder '{}'", o.dir);
+  FV_REQUIRE(fs::is_directory(o.dir, ec), "--draw: '{}' is not a folder", o.dir);
   const std::string legend =
       "cyan: the ball's 3D position (BALL.csv) seen from this camera, at its size; green: this "
       "camera's accepted candidates (score)";
   BallOverlayResult result;
   util::Progress progress("draw", -1, "camera frames", o.progress);
-  std::set<std::string> names;
   for (size_t i = 0; i < cameras.size(); ++i) {
     const camera::Camera& cam = cameras[i];
     const auto candidates =
         CandidatesByFrame(detections.empty() ? "" : detections[i], static_cast<int>(i));
     auto source = io::VideoSource::Open(videos[i]);
+    FV_REQUIRE(!source->live(), "--draw: '{}' is a live source (its frames now are not the run's)",
+               videos[i]);
     const cv::Mat band = detect::TextBand({legend}, source->width());
-    std::string name = cam.name.empty() ? fmt::format("cam{}", i + 1) : cam.name;
-    if (!names.insert(name).second) name += fmt::format("-{}", i + 1);  // two of one name
+    const std::string& name = names[i];
     track::PlayableVideoWriter writer(fmt::format("{}/{}.mp4", o.dir, name),
                                       source->fps() > 0 ? source->fps() : 30.0,
                                       {source->width(), source->height() + band.rows});

@@ -1,9 +1,6 @@
-// Each camera's video with the ball the rig placed (`fieldvision ball --draw DIR`): per frame the
-// 3D position of BALL.csv projected into the camera as a circle of the ball's projected size
-// (cyan), that camera's accepted candidates (its DET.csv, green, with their scores), the frame
-// and time, and a legend band below; one playable video per camera (track::PlayableVideoWriter),
-// frames paired by index (`ball --sync frame`). What a user looks at to trust a 3D position, or
-// to see which camera pulled it off.
+// Each camera's video with the ball the rig placed (`fieldvision ball --draw DIR`): the 3D
+// position of BALL.csv projected at the ball's size (cyan), the camera's accepted candidates
+// (its DET.csv, green), the camera and frame, a legend band; frames paired by index.
 #pragma once
 
 #include <string>
@@ -13,8 +10,16 @@
 
 namespace fv::pipeline {
 
+// File names for the cameras' videos from their names: characters other than letters, digits,
+// '-', '_' and '.' become '_', a leading '.' gets a '_' before it, an empty name is camN, and a
+// name already taken gets -2, -3, ...
+std::vector<std::string> DrawNames(const std::vector<std::string>& names);
+
 struct BallOverlayOptions {
-  std::string dir;                // the videos' folder (made)
+  std::string dir;  // the videos' folder (it must exist)
+  // The videos' names, one per camera (NAME.mp4, or .avi without an H.264 encoder); empty:
+  // DrawNames of the cameras' names.
+  std::vector<std::string> names;
   double ball_diameter_m = 0.22;  // the drawn circle's size
   long long max_frames = 0;       // frames drawn per camera (<= 0: all)
   bool progress = true;           // on a terminal
@@ -29,7 +34,8 @@ struct BallOverlayResult {
 };
 
 // `detections`: one DET.csv per camera (may be empty: no candidates drawn). Throws fv::Error
-// naming the file for an unreadable video, BALL.csv or DET.csv.
+// naming the file for an unreadable video, BALL.csv or DET.csv, or a live source (its frames now
+// are not the run's).
 BallOverlayResult DrawBallOverlays(const std::vector<camera::Camera>& cameras,
                                    const std::vector<std::string>& videos,
                                    const std::string& ball_csv,

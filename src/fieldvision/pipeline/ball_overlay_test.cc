@@ -58,6 +58,7 @@ TEST(BallOverlay, DrawsTheBallWhereEachCameraSeesIt) {
   BallOverlayOptions o;
   o.dir = dir + "/drawn";
   o.progress = false;
+  fs::create_directories(o.dir);
   const BallOverlayResult r = DrawBallOverlays(cams, videos, dir + "/ball.csv",
                                                {dir + "/cam1_det.csv", dir + "/cam2_det.csv"}, o);
   EXPECT_EQ(r.frames, 10) << r.Summary();
@@ -83,13 +84,33 @@ TEST(BallOverlay, DrawsTheBallWhereEachCameraSeesIt) {
     return n;
   };
   const cv::Vec3b cyan(255, 255, 0), green(0, 255, 0);
+  // A cyan tint on the grey frame (the video's compression spreads a 1-px line's colour).
+  const auto tinted = [](const cv::Mat& img, const Eigen::Vector2d& p, int reach) {
+    int n = 0;
+    for (int y = cvRound(p.y()) - reach; y <= cvRound(p.y()) + reach; ++y) {
+      for (int x = cvRound(p.x()) - reach; x <= cvRound(p.x()) + reach; ++x) {
+        if (x < 0 || y < 0 || x >= img.cols || y >= img.rows) continue;
+        const cv::Vec3b& q = img.at<cv::Vec3b>(y, x);
+        n += std::min(q[0], q[1]) - q[2] > 30;
+      }
+    }
+    return n;
+  };
   for (int c = 0; c < 2; ++c) {
     const cv::Mat f0 = frame_of(r.videos[c], 0), f2 = frame_of(r.videos[c], 2);
     ASSERT_FALSE(f2.empty()) << r.videos[c];
     EXPECT_GT(f2.rows, 240) << "a legend below the frame";
     const Eigen::Vector2d uv = *cams[c].Project(ball);
-    EXPECT_GT(colour_near(f2, uv, 12, cyan), 5) << "camera " << c;
     EXPECT_EQ(colour_near(f0, uv, 12, cyan), 0) << "no ball in frame 0, camera " << c;
+    // The outline at the ball's projected size: on the diagonals (where the ticks are not), cyan
+    // at that radius and none 3 px farther out.
+    const double r_px = 0.11 * cams[c].fx / (cams[c].cam_from_world * ball).z();
+    for (const Eigen::Vector2d& d : {Eigen::Vector2d(1, 1), Eigen::Vector2d(-1, 1),
+                                     Eigen::Vector2d(1, -1), Eigen::Vector2d(-1, -1)}) {
+      const Eigen::Vector2d unit = d.normalized();
+      EXPECT_GT(tinted(f2, uv + r_px * unit, 1), 0) << "camera " << c << " r " << r_px;
+      EXPECT_EQ(tinted(f2, uv + (r_px + 3) * unit, 0), 0) << "camera " << c;
+    }
   }
   EXPECT_GT(colour_near(frame_of(r.videos[0], 2), seen + Eigen::Vector2d(20, 0), 5, green), 3);
   EXPECT_EQ(colour_near(frame_of(r.videos[1], 2), *cams[1].Project(ball) + Eigen::Vector2d(20, 0),
@@ -103,6 +124,13 @@ TEST(BallOverlay, DrawsTheBallWhereEachCameraSeesIt) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("missing.csv"), std::string::npos) << e.what();
   }
+}
+
+// Video file names from camera names: safe characters only, never a path, each name once.
+TEST(BallOverlay, DrawNamesAreSafeAndUnique) {
+  EXPECT_EQ(
+      DrawNames({"cam1", "cam1", "cam1-2", "../x", "a/b", "", ".hidden"}),
+      (std::vector<std::string>{"cam1", "cam1-2", "cam1-2-2", "_.._x", "a_b", "cam6", "_.hidden"}));
 }
 
 }  // namespace
