@@ -147,6 +147,15 @@ std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
                cameras[c].width, cameras[c].height, o.videos[c], size.width, size.height);
     sources.push_back(std::move(src));
   }
+  // Frames paired by index are of one time only at one frame rate (else the fused times go back
+  // and forth where the shorter video ends).
+  for (size_t c = 1; o.sync == "frame" && o.timestamps.empty() && c < sources.size(); ++c) {
+    const double a = sources[0]->fps(), b = sources[c]->fps();
+    FV_REQUIRE(std::abs(a - b) <= 0.01 * std::max(a, b),
+               "ball: --sync frame pairs frames by index, but '{}' runs at {:.4g} frames/s and "
+               "'{}' at {:.4g} (an image pattern counts as 30): give each video's --timestamps",
+               o.videos[0], a, o.videos[c], b);
+  }
   return sources;
 }
 

@@ -359,6 +359,37 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(job.out));
 }
 
+// Pairing frames by index needs one frame rate: a camera at another rate is refused naming both
+// videos (the fused times would go back where the shorter video ends), unless timestamps pair
+// them.
+TEST(BallPipeline, TheJobRefusesFrameIndexPairingAcrossFrameRates) {
+  const std::string dir = testing::TempDir() + "/job_rates";
+  std::filesystem::create_directories(dir);
+  const Scene s = MakeScene(dir, {6, 6, 6}, {0, 0, 0});
+  BallJobOptions job;
+  for (int c = 0; c < 3; ++c) {
+    job.cameras.push_back(dir + "/cam" + std::to_string(c) + ".yaml");
+    camera::WriteCameraYaml(s.cams[c], job.cameras.back());
+  }
+  job.videos = s.videos;
+  // The third camera's frames again, at twice the rate.
+  job.videos[2] = dir + "/cam2_60.avi";
+  {
+    cv::VideoCapture in(s.videos[2]);
+    cv::VideoWriter out(job.videos[2], cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 2 * kFps,
+                        cv::Size(s.cams[2].width, s.cams[2].height));
+    cv::Mat f;
+    while (in.read(f)) out.write(f);
+  }
+  job.out = dir + "/ball.csv";
+  job.pipeline.progress = false;
+  EXPECT_THAT([&] { RunBallJob(job); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("--sync frame"),
+                                                    HasSubstr("cam0.avi"), HasSubstr("cam2_60.avi"),
+                                                    ::testing::Not(HasSubstr("\n")))));
+  EXPECT_FALSE(std::filesystem::exists(job.out));
+}
+
 // The job on videos: each camera's accepted candidates written as DET.csv (one row a frame
 // here), and the flight bundle at the end never moving a ball that does not fly freely (this one
 // is carried along a helix) away from where the frames put it.
