@@ -1,7 +1,6 @@
 #include "fieldvision/detect/eval_drawing.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -13,6 +12,7 @@
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::detect {
 namespace fs = std::filesystem;
@@ -23,15 +23,6 @@ const cv::Scalar kCyan(255, 255, 0);
 constexpr int kZoomPx = 240;  // close-up side
 // The longest side an enlargement makes (JPEG holds at most 65500 px; memory).
 constexpr int kMaxDrawingPx = 8000;
-
-// A file name's part from an image's name: letters, digits, '-' and '.' kept, others '_'.
-std::string Slug(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '.' ? c : '_';
-  }
-  return out;
-}
 
 // Whether `inner` is `outer` or lies in it (paths compared made absolute, links followed).
 bool Within(const fs::path& inner, const fs::path& outer) {
@@ -178,8 +169,8 @@ bool MissDrawings::Add(int index, const LabelledImage& item, const DetectEvalIma
   const cv::Mat drawing = DrawEvalImage(bgr, item.boxes, grow, candidates, title, zooms);
   const std::string name = item.frame >= 0 ? fmt::format("frame{:05d}", item.frame)
                                            : fs::path(item.image).stem().string();
-  const std::string path =
-      fmt::format("{}/{:05d}_{}_{}.jpg", dir_, index, miss ? "miss" : "false", Slug(name));
+  const std::string path = fmt::format("{}/{:05d}_{}_{}.jpg", dir_, index, miss ? "miss" : "false",
+                                       util::FileNamePart(name));
   io::WriteImage(path, drawing);
   ++written_;
   return true;

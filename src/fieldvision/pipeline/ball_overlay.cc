@@ -1,7 +1,6 @@
 #include "fieldvision/pipeline/ball_overlay.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -20,6 +19,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::pipeline {
 namespace fs = std::filesystem;
@@ -99,12 +99,7 @@ std::vector<std::string> DrawNames(const std::vector<std::string>& names) {
   std::vector<std::string> out;
   std::set<std::string> taken;
   for (size_t i = 0; i < names.size(); ++i) {
-    std::string name;
-    for (char c : names[i]) {
-      const bool keep =
-          std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
-      name += keep ? c : '_';
-    }
+    std::string name = util::FileNamePart(names[i]);
     if (name.empty()) name = fmt::format("cam{}", i + 1);
     if (name.front() == '.') name.insert(0, 1, '_');
     std::string unique = name;

@@ -46,6 +46,16 @@ std::string ToLower(std::string_view s) {
   return out;
 }
 
+std::string FileNamePart(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) {
+    const bool keep =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
+    if (!keep) c = '_';
+  }
+  return out;
+}
+
 namespace {
 
 // A value as an error message shows it: one line (control characters as '?'), at most 40

@@ -14,6 +14,9 @@ std::string Trim(std::string_view s);
 bool StartsWith(std::string_view s, std::string_view prefix);
 bool EndsWith(std::string_view s, std::string_view suffix);
 std::string ToLower(std::string_view s);
+// `s` as part of a file name: letters, digits, '-', '_' and '.' kept, every other byte '_' (so
+// never a path).
+std::string FileNamePart(std::string_view s);
 
 // Parses the whole string as a number; throws fv::Error naming `context` otherwise.
 double ParseDouble(std::string_view s, std::string_view context);
