@@ -59,6 +59,9 @@ grep -q "huge_truth.csv:2" "$TMP/err" || { echo "FAIL ball: truth line not named
 check "ball: --draw with --sync time" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --draw "$TMP/drawn_ball" --sync time
 grep -q "needs --sync frame" "$TMP/err" || { echo "FAIL ball: --draw's sync not named"; fail=1; }
+check "ball: --draw with a live source" nonzero $FV ball --camera "$TMP/c1.yaml" --video rtsp://x \
+  --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --draw "$TMP/drawn_ball"
+grep -q "rtsp://x" "$TMP/err" || { echo "FAIL ball: --draw's live source not named"; fail=1; }
 check "ball: --draw with --out a folder" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP" --draw "$TMP/drawn_ball"
 [ ! -e "$TMP/drawn_ball" ] || { echo "FAIL ball: a failed run left its --draw folder"; fail=1; }

@@ -11,6 +11,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/io/video_source.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/ball_overlay.h"
 #include "fieldvision/pipeline/detections_job.h"
@@ -38,9 +39,9 @@ void PrepareDraw(BallCliOptions& o) {
              "frame (no --timestamps) and no --live");
   for (const std::string& video : o.job.videos) {
     std::error_code ec;
-    FV_REQUIRE(std::filesystem::exists(video, ec) || video.find('%') != std::string::npos,
-               "ball: --draw reads the videos again after the run: '{}' must be a file or an "
-               "image pattern, not a live source",
+    FV_REQUIRE(std::filesystem::exists(video, ec) || !io::ListImageSequence(video).empty(),
+               "ball: --draw reads the videos again after the run: '{}' is no file and matches "
+               "no image (a live source cannot be read again)",
                video);
   }
   o.draw.ball_diameter_m = o.job.ball_diameter_m;
