@@ -166,7 +166,9 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
                       {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
   std::unique_ptr<cv::VideoWriter> writer;
   std::string draw_dir;
+  cv::Mat legend;  // below each drawn frame, made again only for a frame of another width
   if (!o.draw.empty()) {
+    legend = CandidateLegend(source->width());
     if (IsVideoPath(o.draw)) {
       const int fourcc = util::EndsWith(util::ToLower(o.draw), ".avi")
                              ? codecs::FourCc('M', 'J', 'P', 'G')
@@ -174,9 +176,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
       const double fps = source->fps() > 0 ? source->fps() : 30.0;
       writer = codecs::NewVideoWriter();
       // The frame and, below it, the legend.
-      writer->open(
-          o.draw, fourcc, fps,
-          cv::Size(source->width(), source->height() + CandidateLegend(source->width()).rows));
+      writer->open(o.draw, fourcc, fps, cv::Size(source->width(), source->height() + legend.rows));
       FV_REQUIRE(writer->isOpened(), "cannot write annotated video '{}'", o.draw);
     } else {
       std::error_code ec;
@@ -193,7 +193,6 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   util::Progress progress("detect", total, "frames", o.progress);
   const auto t0 = std::chrono::steady_clock::now();
   io::Frame frame;
-  cv::Mat legend;  // below each drawn frame, made once per frame width
   while ((o.max_frames < 0 || result.frames < o.max_frames) && source->Read(frame)) {
     const auto cands = detector.Detect(frame.bgr);
     bool any = false;
