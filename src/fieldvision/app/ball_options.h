@@ -47,7 +47,8 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
       ->capture_default_str();
   cmd->add_option("--min-two-view-score", t.min_two_view_score,
                   "Two cameras alone whose detector scores (weighted as above) total less are no "
-                  "ball unless it is expected there (0: off; not used with --detections)")
+                  "ball unless it is expected there (0: off; with --detections only when given: "
+                  "scores made elsewhere have no known scale)")
       ->check(FiniteRange(0.0, 100.0))
       ->capture_default_str();
   cmd->add_flag("--ground", t.single_camera_ground,

@@ -197,6 +197,7 @@ void Setup(CLI::App& app, int& exit_code) {
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");
     if (o->det.detections.empty()) PrepareDraw(*o);
+    o->det.own_scores = cmd->count("--min-two-view-score") > 0;
     try {
       CheckOutputsAndRun(*o);
       if (o->draw_dir) o->draw_dir->Keep();

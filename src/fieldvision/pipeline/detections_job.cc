@@ -574,7 +574,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
   recon::TriangulationOptions topt = o.triangulation;
   topt.ball_radius_m = 0.5 * o.ball_diameter_m;
   // Detections made elsewhere carry scores of no known scale (1 when the file has none).
-  topt.min_two_view_score = 0.0;
+  if (!o.own_scores) topt.min_two_view_score = 0.0;
   FusionStage fusion(cameras, topt);  // the same fusion as the ball pipeline's
   while (auto f = sync.Next()) {
     ++res.frames;

@@ -35,6 +35,10 @@ struct DetectionsJobOptions {
   bool bundle = true;          // refine flights on the 2D detections (else per-frame points)
   double ball_mass_kg = 0.0;   // for the spin model; 0: 2.7 g below 5 cm diameter, else 0.43 kg
   recon::TriangulationOptions triangulation;  // ball_radius_m is set from the diameter
+  // Whether the detections' scores are fieldvision's own (`ball --write-detections`),
+  // so that triangulation.min_two_view_score applies; scores made elsewhere have no known scale
+  // and it is not used.
+  bool own_scores = false;
   recon::BallEvalOptions eval;
   void Check() const;  // throws fv::Error naming the bad option
 };

@@ -234,6 +234,40 @@ TEST(DetectionsJob, AFewCentresOffAtAFlightsEndDoNotTiltIt) {
   EXPECT_LT(util::Median(off_errors), util::Median(clean_errors) + 0.001);
 }
 
+// Detections written by fieldvision (`ball --write-detections`) carry its scores: two faint, still
+// things of the ball's colour in two cameras that meet at a point while a third camera sees the
+// ball elsewhere are no ball when own_scores keeps triangulation.min_two_view_score; scores made
+// elsewhere (own_scores false) are of no known scale and the pair is taken.
+TEST(DetectionsJob, OwnScoresKeepTheTwoViewScoreCheck) {
+  const auto cams = TableRig();
+  const std::string dir = testing::TempDir();
+  const Eigen::Vector3d ghost(0.8, 0.6, 0.9), ball(-1.0, -0.4, 0.3);
+  DetectionsJobOptions o;
+  o.ball_diameter_m = 0.04;
+  o.bundle = false;
+  for (int c = 0; c < 3; ++c) {
+    const std::string cam_path = fmt::format("{}/cam{}.yaml", dir, c);
+    camera::WriteCameraYaml(cams[c], cam_path);
+    std::string det = "frame,time_s,u,v,score\n";
+    for (int i = 0; i < 5; ++i) {
+      const auto uv = cams[c].Project(c == 0 ? ball : ghost);
+      ASSERT_TRUE(uv.has_value());
+      det += fmt::format("{},{:.6f},{:.3f},{:.3f},{}\n", i, 0.04 * i, uv->x(), uv->y(),
+                         c == 0 ? 0.8 : 0.07);
+    }
+    WriteFile(fmt::format("{}/cam{}.csv", dir, c), det);
+    o.cameras.push_back(cam_path);
+    o.detections.push_back(fmt::format("{}/cam{}.csv", dir, c));
+  }
+  o.out = dir + "/elsewhere.csv";
+  const DetectionsJobResult elsewhere = RunDetectionsJob(o);
+  ASSERT_EQ(elsewhere.positions, 5);
+  EXPECT_LT((elsewhere.track[0].ball_in_world - ghost).norm(), 1e-3);
+  o.own_scores = true;
+  o.out = dir + "/own.csv";
+  EXPECT_EQ(RunDetectionsJob(o).positions, 0);
+}
+
 TEST(DetectionsJob, BadFilesAreOneLineErrorsNamingTheFile) {
   auto parse = [](const std::string& text) {
     return ParseDetections(util::CsvTable::Parse(text, "det.csv"), 0, 2.0);
