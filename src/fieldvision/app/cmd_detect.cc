@@ -29,7 +29,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "(needs a camera with a pose)");
   cmd->add_option(
       "--draw", o->draw,
-      "Draw the candidates: an annotated video (.avi, .mp4, .mkv) or a folder of JPEGs");
+      "Draw the candidates: an annotated video (.mp4: H.264 where OpenCV's FFmpeg has it, else "
+      "Motion-JPEG as .avi; .avi, .mkv: Motion-JPEG) or a folder of JPEGs");
   cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
       ->capture_default_str();
   AddBallSizeOptions(cmd, o->detector);
@@ -46,6 +47,7 @@ void Setup(CLI::App& app, int& exit_code) {
     ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
+    if (!r.drawn.empty()) std::cout << "drew " << r.drawn << "\n";
   });
   (void)exit_code;
 }

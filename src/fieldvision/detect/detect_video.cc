@@ -13,6 +13,7 @@
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_source.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
@@ -164,20 +165,15 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   io::AtomicOutput out_file(o.out);
   util::CsvWriter csv(out_file.temp_path(),
                       {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
-  std::unique_ptr<cv::VideoWriter> writer;
+  std::optional<io::PlayableVideoWriter> writer;  // renamed over --draw at the end
   std::string draw_dir;
   cv::Mat legend;  // below each drawn frame, made again only for a frame of another width
   if (!o.draw.empty()) {
     legend = CandidateLegend(source->width());
     if (IsVideoPath(o.draw)) {
-      const int fourcc = util::EndsWith(util::ToLower(o.draw), ".avi")
-                             ? codecs::FourCc('M', 'J', 'P', 'G')
-                             : codecs::FourCc('m', 'p', '4', 'v');
       const double fps = source->fps() > 0 ? source->fps() : 30.0;
-      writer = codecs::NewVideoWriter();
       // The frame and, below it, the legend.
-      writer->open(o.draw, fourcc, fps, cv::Size(source->width(), source->height() + legend.rows));
-      FV_REQUIRE(writer->isOpened(), "cannot write annotated video '{}'", o.draw);
+      writer.emplace(o.draw, fps, cv::Size(source->width(), source->height() + legend.rows));
     } else {
       std::error_code ec;
       std::filesystem::create_directories(o.draw, ec);
@@ -212,7 +208,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
       if (legend.cols != canvas.cols) legend = CandidateLegend(canvas.cols);
       cv::vconcat(canvas, legend, canvas);
       if (writer) {
-        writer->write(canvas);
+        writer->Write(canvas);
       } else {
         const std::string path = fmt::format("{}/{:05d}.jpg", draw_dir, frame.index);
         FV_REQUIRE(codecs::ImWrite(path, canvas), "cannot write '{}'", path);
@@ -223,6 +219,14 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   progress.Finish();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   FV_REQUIRE(result.frames > 0, "video '{}' has no frames", o.video);
+  if (writer) {
+    writer->Close();
+    result.drawn =
+        fmt::format("{} ({} frames, {}){}", writer->path(), writer->frames(), writer->codec(),
+                    writer->note().empty() ? "" : "; " + writer->note());
+  } else if (!draw_dir.empty()) {
+    result.drawn = fmt::format("{} ({} JPEGs)", draw_dir, result.frames);
+  }
   out_file.CloseAndCommit(csv);
   return result;
 }

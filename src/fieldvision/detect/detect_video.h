@@ -11,11 +11,13 @@
 namespace fv::detect {
 
 struct DetectVideoOptions {
-  std::string camera;   // camera YAML; "" for an uncalibrated camera (no size check, no mask)
-  std::string video;    // file or image pattern (dir/%05d.png)
-  std::string out;      // CSV: frame,u,v,radius_px,score,accepted,sigma_px
-  std::string field;    // built-in field name or JSON for the field mask; "" for none
-  std::string draw;     // "" none; *.avi / *.mp4 / *.mkv an annotated video; else a folder of JPEGs
+  std::string camera;  // camera YAML; "" for an uncalibrated camera (no size check, no mask)
+  std::string video;   // file or image pattern (dir/%05d.png)
+  std::string out;     // CSV: frame,u,v,radius_px,score,accepted,sigma_px
+  std::string field;   // built-in field name or JSON for the field mask; "" for none
+  // "" none; *.avi / *.mp4 / *.mkv an annotated video (io/video_writer.h: H.264 in MP4 where
+  // OpenCV's FFmpeg has it, else Motion-JPEG, a .mp4 path becoming .avi); else a folder of JPEGs
+  std::string draw;
   int max_frames = -1;  // -1: all
   bool progress = true;
   BallDetectorOptions detector;
@@ -29,6 +31,7 @@ struct DetectVideoResult {
   long long candidates = 0;
   int frames_with_ball = 0;  // frames with an accepted candidate
   double seconds = 0.0;
+  std::string drawn;  // what --draw wrote (the video's path, frames and codec), "" when nothing
   std::string Summary() const;
 };
 

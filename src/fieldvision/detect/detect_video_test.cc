@@ -53,17 +53,23 @@ Clip MakeClip(uint64_t seed, int frames) {
   return clip;
 }
 
+// `detect` on the clip with its camera, candidates to det.csv, drawn to `draw`.
+DetectVideoOptions ClipOptions(const Clip& clip, const std::string& draw) {
+  DetectVideoOptions o;
+  o.camera = clip.camera;
+  o.video = clip.pattern;
+  o.out = clip.dir + "/det.csv";
+  o.draw = draw;
+  o.progress = false;
+  return o;
+}
+
 TEST(DetectVideo, WritesEveryCandidateAndDrawsThem) {
   const uint64_t seed = fv::testing::TestSeed(12);
   FV_SEED_TRACE(seed);
   Clip clip;
   ASSERT_NO_FATAL_FAILURE(clip = MakeClip(seed, 5));
-  DetectVideoOptions o;
-  o.camera = clip.camera;
-  o.video = clip.pattern;
-  o.out = clip.dir + "/det.csv";
-  o.draw = clip.dir + "/drawn";
-  o.progress = false;
+  const DetectVideoOptions o = ClipOptions(clip, clip.dir + "/drawn");
   const DetectVideoResult r = DetectVideo(o);
   EXPECT_EQ(r.frames, 5);
   EXPECT_EQ(r.frames_with_ball, 5) << r.Summary();
@@ -95,6 +101,33 @@ TEST(DetectVideo, WritesEveryCandidateAndDrawsThem) {
   cv::minMaxLoc(first.rowRange(frame.rows, first.rows).reshape(1), &lo, &hi);
   EXPECT_LT(lo, 30);
   EXPECT_GT(hi, 200);
+}
+
+// An annotated video goes to a temporary file renamed over --draw at the end: a run that fails
+// on a damaged frame leaves an earlier video as it was; a run that ends says what it drew.
+TEST(DetectVideo, ADrawnVideoReplacesAnEarlierOneOnlyWhenTheRunEnds) {
+  const uint64_t seed = fv::testing::TestSeed(13);
+  FV_SEED_TRACE(seed);
+  Clip clip;
+  ASSERT_NO_FATAL_FAILURE(clip = MakeClip(seed, 5));
+  const DetectVideoOptions o = ClipOptions(clip, clip.dir + "/drawn.avi");
+  std::ofstream(o.draw) << "an earlier run's video";
+  const std::string damaged = clip.dir + "/frames/00003.png";
+  const std::string kept = clip.dir + "/kept.png";
+  std::filesystem::rename(damaged, kept);
+  std::ofstream(damaged) << "not a PNG";
+  EXPECT_THROW(DetectVideo(o), Error);
+  std::ifstream in(o.draw);
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "an earlier run's video");
+  std::filesystem::rename(kept, damaged);
+  const DetectVideoResult r = DetectVideo(o);
+  EXPECT_NE(r.drawn.find(o.draw), std::string::npos) << r.drawn;
+  EXPECT_NE(r.drawn.find("5 frames"), std::string::npos) << r.drawn;
+  cv::VideoCapture video(o.draw);
+  ASSERT_TRUE(video.isOpened());
+  EXPECT_EQ(video.get(cv::CAP_PROP_FRAME_COUNT), 5);
 }
 
 // A legend wider than its band wraps onto more lines rather than being cut.

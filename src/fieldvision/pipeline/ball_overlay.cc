@@ -13,9 +13,9 @@
 
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/video_source.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/recon/ball_csv.h"
-#include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
@@ -156,9 +156,9 @@ BallOverlayResult DrawBallOverlays(const std::vector<camera::Camera>& cameras,
                videos[i]);
     const cv::Mat band = detect::TextBand({legend}, source->width());
     const std::string& name = names[i];
-    track::PlayableVideoWriter writer(fmt::format("{}/{}.mp4", o.dir, name),
-                                      source->fps() > 0 ? source->fps() : 30.0,
-                                      {source->width(), source->height() + band.rows});
+    io::PlayableVideoWriter writer(fmt::format("{}/{}.mp4", o.dir, name),
+                                   source->fps() > 0 ? source->fps() : 30.0,
+                                   {source->width(), source->height() + band.rows});
     io::Frame f;
     while ((o.max_frames <= 0 || source->frames_read() < o.max_frames) && source->Read(f)) {
       cv::Mat img = f.bgr.clone();

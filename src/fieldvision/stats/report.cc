@@ -10,6 +10,7 @@
 
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/io/image_file.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
@@ -322,7 +323,7 @@ void WriteRadar(const field::FieldModel& field, ReportParts& rp, ReportFiles& fi
     Write(rp.out_dir + "/radar.png", img, files);
   }
   if (!o.write_video) return;
-  if (!track::H264Available()) {
+  if (!io::H264Available()) {
     files.notes.push_back(
         "radar video skipped: OpenCV's FFmpeg has no H.264 encoder here (a video browsers play)");
     return;
@@ -330,7 +331,7 @@ void WriteRadar(const field::FieldModel& field, ReportParts& rp, ReportFiles& fi
   const std::string path = rp.out_dir + "/radar.mp4";
   cv::Mat base = field::DrawField(field, view);
   DrawZones(base, o.zones, view);
-  track::PlayableVideoWriter vw(path, 10.0, base.size());
+  io::PlayableVideoWriter vw(path, 10.0, base.size());
   for (double t = rp.t0; t <= rp.t1; t += 0.1) {
     cv::Mat img = base.clone();
     DrawRadar(img, r, view, t, 3.0, o);

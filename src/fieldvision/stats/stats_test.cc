@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/field/field_draw.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -99,7 +100,7 @@ TEST(Stats, PairDistancesAndReport) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/" + f)) << f;
   }
   // The radar video browsers play, where OpenCV can write H.264; else a note says why not.
-  if (track::H264Available()) {
+  if (io::H264Available()) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/radar.mp4"));
   } else {
     EXPECT_EQ(files.notes.size(), 1u);

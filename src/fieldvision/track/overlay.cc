@@ -2,24 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <optional>
 #include <set>
 
-#include <unistd.h>
-
 #include <fmt/format.h>
-#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/calib/check.h"
-#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/video_source.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/error.h"
-#include "fieldvision/util/strings.h"
 
 namespace fv::track {
-namespace fs = std::filesystem;
 
 void OverlayOptions::Check() const {
   CheckNonNegative(trail_frames, "overlay trail_frames");
@@ -185,101 +179,6 @@ void TrackOverlay::DrawLegend(cv::Mat& bgr) const {
   }
 }
 
-namespace {
-
-// Opens a writer with OpenCV's log quiet (a missing encoder is an expected outcome here).
-bool TryOpen(cv::VideoWriter* w, const std::string& path, int fourcc, double fps, cv::Size size) {
-  const auto level = cv::utils::logging::getLogLevel();
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
-  bool ok = false;
-  try {
-    ok = codecs::OpenVideoWriter(w, path, cv::CAP_FFMPEG, fourcc, fps, size) && w->isOpened();
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  cv::utils::logging::setLogLevel(level);
-  return ok;
-}
-
-// `dir/name.ext` -> `dir/.name.tmp.ext` (the container is chosen by the extension).
-std::string TempPathFor(const std::string& path) {
-  const fs::path p(path);
-  return (p.parent_path() / fmt::format(".{}.tmp{}", p.stem().string(), p.extension().string()))
-      .string();
-}
-
-}  // namespace
-
-bool H264Available() {
-  static const bool kAvailable = [] {
-    const fs::path p = fs::temp_directory_path() / fmt::format("fv_h264_probe_{}.mp4", ::getpid());
-    const auto w = codecs::NewVideoWriter();
-    bool ok = TryOpen(w.get(), p.string(), codecs::FourCc('a', 'v', 'c', '1'), 10, {64, 64});
-    if (ok) {
-      w->write(cv::Mat(64, 64, CV_8UC3, cv::Scalar(0, 0, 0)));
-      w->release();
-      std::error_code ec;
-      ok = fs::file_size(p, ec) > 0 && !ec;
-    }
-    std::error_code ec;
-    fs::remove(p, ec);
-    return ok;
-  }();
-  return kAvailable;
-}
-
-PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size)
-    : writer_(codecs::NewVideoWriter()), size_(size) {
-  FV_REQUIRE(fps > 0 && std::isfinite(fps), "video '{}': frame rate must be positive (got {})",
-             path, fps);
-  FV_REQUIRE(size.width > 0 && size.height > 0, "video '{}': empty frame size", path);
-  path_ = path;
-  const bool mp4 = util::EndsWith(util::ToLower(path), ".mp4");
-  if (mp4 && H264Available()) {
-    tmp_ = TempPathFor(path_);
-    if (TryOpen(writer_.get(), tmp_, codecs::FourCc('a', 'v', 'c', '1'), fps, size)) {
-      codec_ = "H.264";
-      return;
-    }
-  }
-  if (mp4) {
-    path_ = fs::path(path).replace_extension(".avi").string();
-    note_ = fmt::format(
-        "OpenCV's FFmpeg has no H.264 encoder here: wrote Motion-JPEG to '{}' instead (browsers do "
-        "not play it; VLC or ffplay do)",
-        path_);
-  }
-  tmp_ = TempPathFor(path_);
-  FV_REQUIRE(TryOpen(writer_.get(), tmp_, codecs::FourCc('M', 'J', 'P', 'G'), fps, size),
-             "cannot write video '{}' (folder missing or not writable?)", path_);
-  codec_ = "MJPG";
-}
-
-PlayableVideoWriter::~PlayableVideoWriter() {
-  if (!closed_) {
-    writer_->release();
-    std::error_code ec;
-    fs::remove(tmp_, ec);
-  }
-}
-
-void PlayableVideoWriter::Write(const cv::Mat& bgr) {
-  FV_REQUIRE(bgr.size() == size_ && bgr.type() == CV_8UC3,
-             "video '{}': frame {} is {}x{}, the video {}x{}", path_, frames_, bgr.cols, bgr.rows,
-             size_.width, size_.height);
-  writer_->write(bgr);
-  ++frames_;
-}
-
-void PlayableVideoWriter::Close() {
-  if (closed_) return;
-  writer_->release();
-  closed_ = true;
-  std::error_code ec;
-  fs::rename(tmp_, path_, ec);
-  FV_REQUIRE(!ec, "cannot write video '{}' ({})", path_, ec.message());
-}
-
 std::string DrawVideoResult::Summary() const {
   return fmt::format("wrote {} ({} frames, {}){}", path, frames, codec,
                      note.empty() ? "" : "; " + note);
@@ -289,7 +188,7 @@ DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out
                                 const TrackOverlay& overlay, double fps, int max_frames) {
   auto source = io::VideoSource::Open(video);
   const double rate = fps > 0 ? fps : source->fps();
-  PlayableVideoWriter writer(out, rate, {source->width(), source->height()});
+  io::PlayableVideoWriter writer(out, rate, {source->width(), source->height()});
   io::Frame f;
   while ((max_frames <= 0 || source->frames_read() < max_frames) && source->Read(f)) {
     cv::Mat img = f.bgr.clone();

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/field/field.h"
@@ -63,32 +62,6 @@ class TrackOverlay {
   OverlayOptions o_;
   std::vector<LegendLine> legend_;  // made once
 };
-
-// A video being written: H.264 in MP4 when `path` ends in .mp4 and OpenCV's FFmpeg has the
-// encoder, else Motion-JPEG in AVI (the path's extension becomes .avi). Frames go to a temporary
-// file renamed to `path` by Close() (a failed run leaves an existing file as it was).
-class PlayableVideoWriter {
- public:
-  // Throws fv::Error naming the path when no writer opens.
-  PlayableVideoWriter(const std::string& path, double fps, cv::Size size);
-  ~PlayableVideoWriter();
-  void Write(const cv::Mat& bgr);
-  void Close();
-  const std::string& path() const { return path_; }    // the file written (extension may change)
-  const std::string& codec() const { return codec_; }  // "H.264" or "MJPG"
-  const std::string& note() const { return note_; }    // why MJPG, when it is
-  int frames() const { return frames_; }
-
- private:
-  std::unique_ptr<cv::VideoWriter> writer_;  // made by the codecs plugin
-  std::string path_, tmp_, codec_, note_;
-  cv::Size size_;
-  int frames_ = 0;
-  bool closed_ = false;
-};
-
-// Whether OpenCV's FFmpeg backend can write H.264 MP4 here (tried once on a tiny file).
-bool H264Available();
 
 struct DrawVideoResult {
   int frames = 0;
