@@ -7,6 +7,7 @@
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/jpeg_orientation.h"
 #include "fieldvision/io/jpeg_region.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::io {
@@ -62,13 +63,19 @@ cv::Mat ReadImage(const std::string& path) {
 }
 
 void WriteImage(const std::string& path, const cv::Mat& image) {
-  bool ok = false;
-  try {
-    ok = codecs::ImWrite(path, image);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", path);
+  // Beside the path, renamed over it when whole: a failed write leaves an earlier image.
+  AtomicWrite(
+      path,
+      [&](const std::string& temp_path) {
+        bool ok = false;
+        try {
+          ok = codecs::ImWrite(temp_path, image);
+        } catch (const cv::Exception&) {
+          ok = false;
+        }
+        FV_REQUIRE(ok, "cannot write image '{}' (check the folder and the extension)", temp_path);
+      },
+      "image");
 }
 
 }  // namespace fv::io

@@ -18,7 +18,8 @@ cv::Mat TryReadImage(const std::string& path);
 // An 8-bit BGR image; throws fv::Error naming `path` when it is missing or does not decode.
 cv::Mat ReadImage(const std::string& path);
 
-// Throws fv::Error naming `path` when the image cannot be written.
+// Writes beside `path` and renames over it when whole (a failed write leaves an earlier image);
+// throws fv::Error naming `path` when the image cannot be written.
 void WriteImage(const std::string& path, const cv::Mat& image);
 
 }  // namespace fv::io

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <vector>
 
 #include <fmt/format.h>
@@ -220,6 +221,24 @@ TEST(ReadImage, RealPhotosDecodeAsImread) {
     EXPECT_EQ(cv::norm(got, expected, cv::NORM_INF), 0.0) << e.path();
   }
   EXPECT_GT(n, 500);
+}
+
+// A write that fails (here: an empty image) leaves an earlier image as it was, and no temporary
+// file beside it; one that succeeds replaces it.
+TEST(WriteImage, AFailedWriteLeavesAnEarlierImage) {
+  const std::string dir = testing::TempDir();
+  const std::string path = dir + "/map.png";
+  const cv::Mat earlier(8, 8, CV_8UC3, cv::Scalar(10, 20, 30));
+  WriteImage(path, earlier);
+  const std::string message = testing::ErrorOf([&] { WriteImage(path, cv::Mat()); });
+  EXPECT_NE(message.find(path), std::string::npos) << message;
+  EXPECT_EQ(cv::norm(ReadImage(path), earlier, cv::NORM_INF), 0);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir),
+                          std::filesystem::directory_iterator()),
+            1);
+  const cv::Mat later(8, 8, CV_8UC3, cv::Scalar(200, 100, 0));
+  WriteImage(path, later);
+  EXPECT_EQ(cv::norm(ReadImage(path), later, cv::NORM_INF), 0);
 }
 
 }  // namespace

@@ -208,8 +208,7 @@ void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flig
   // Drawn one at a time (a long track has thousands of flights).
   auto write = [&](const std::string& name, const cv::Mat& img) {
     const std::string path = (std::filesystem::path(job.images_dir) / name).string();
-    io::AtomicWrite(
-        path, [&](const std::string& tmp) { io::WriteImage(tmp, img); }, "--images");
+    io::WriteImage(path, img);
     out.images.push_back(path);
   };
   write("track_height.png", DrawTrackHeight(track, r, out.options));
