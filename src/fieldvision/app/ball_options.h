@@ -1,7 +1,8 @@
 // The ball options that several subcommands declare alike: --ball-diameter (ball, node, fuse,
 // detect, plan), --color (ball, node, detect, eval detect) and the fusion's --inlier-px, --ground
 // and --no-weak (ball, fuse; recon/triangulation.h), the tracking window's --whole-frames,
-// --full-scan-every, --scan-bands and --guided-frames (ball, node; pipeline/camera_stage.h).
+// --full-scan-every, --scan-bands, --guided-frames and --unconfirmed-scan-every (ball, node;
+// pipeline/camera_stage.h).
 #pragma once
 
 #include <string>
@@ -71,6 +72,12 @@ inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
   cmd->add_option("--guided-frames", t.max_guided_frames,
                   "Where the search finds no ball at the tracked ball's expected place, fit one "
                   "there with its size, for at most N frames in a row (0: never)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd->add_option("--unconfirmed-scan-every", t.unconfirmed_scan_every,
+                  "While the cameras together have no position for the ball, each tracking "
+                  "camera searches the whole frame every N frames (0: only every "
+                  "--full-scan-every), so that a track on a still thing gives way to the ball")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
 }

@@ -17,6 +17,9 @@ void BallTrackOptions::Check() const {
   FV_REQUIRE(scan_bands >= 1 && scan_bands <= full_scan_every,
              "BallTrackOptions.scan_bands must be 1..full_scan_every ({}) (got {})",
              full_scan_every, scan_bands);
+  FV_REQUIRE(unconfirmed_scan_every >= 0,
+             "BallTrackOptions.unconfirmed_scan_every must be >= 0 (got {})",
+             unconfirmed_scan_every);
   FV_REQUIRE(std::isfinite(window_radii) && window_radii >= 2,
              "BallTrackOptions.window_radii must be >= 2 (got {})", window_radii);
   FV_REQUIRE(max_guided_frames >= 0, "BallTrackOptions.max_guided_frames must be >= 0 (got {})",
@@ -86,6 +89,7 @@ class CameraStage::Track {
     active_ = true;
   }
   double radius() const { return radius_; }
+  int unconfirmed_scan_every() const { return o_.unconfirmed_scan_every; }
   // `guided`: the candidate of obs that a guided fit gave, or null.
   void Update(const std::vector<recon::BallObservation>& obs,
               const recon::BallObservation* guided) {
@@ -235,8 +239,17 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
   const std::optional<BallHint> hint = hints_->Get(camera_index_, stats_.frames);
   const double dt_s = stats_.frames > 0 ? in.time_s - last_time_s_ : 0.0;
   last_time_s_ = in.time_s;
+  const bool recent = hint && in.time_s - hint->time_s <= hints_->options().max_age_s;
+  unconfirmed_ = recent ? 0 : unconfirmed_ + 1;
   if (!hint) return;
   if (auto e = ExpectBall(*hint, camera_, in.time_s, dt_s, hints_->options())) track_->Steer(*e);
+}
+
+bool CameraStage::UnconfirmedScan() {
+  const int every = track_->unconfirmed_scan_every();
+  if (hints_ == nullptr || every == 0 || unconfirmed_ < every) return false;
+  unconfirmed_ = 0;
+  return true;
 }
 
 CameraMessage CameraStage::Process(const io::SourceFrame& in) {
@@ -245,7 +258,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   m.camera = camera_index_;
   m.frame = in.frame;
   m.time_s = in.time_s;
-  const cv::Rect window = track_->Window(size_);
+  const cv::Rect window = UnconfirmedScan() ? cv::Rect() : track_->Window(size_);
   bool full = window.empty();
   long guided = -1;
   bool guided_tried = false;  // the same fit on the whole frame would read the same pixels

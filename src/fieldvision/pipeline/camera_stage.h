@@ -56,6 +56,13 @@ struct BallTrackOptions {
   // Frames in a row that the track may go on by guided fits alone (0: no guided fits); then it
   // needs a ball the detector finds by itself.
   int max_guided_frames = 15;
+  // With the fusion's hints: while the cameras together have had no position for the ball (no
+  // hint of at most BallHintOptions::max_age_s), a tracking camera searches the whole frame once
+  // every this many frames (0: only every full_scan_every). A track on a still ball-coloured
+  // thing that no other camera confirms gives way to the ball when it comes into view (the kick
+  // render, cam1 and cam2: the ball hidden from cam1 until frame 19, tracked from frame 33, the
+  // next whole-frame search, before).
+  int unconfirmed_scan_every = 5;
   void Check() const;  // throws fv::Error naming the bad field
 };
 
@@ -96,8 +103,11 @@ class CameraStage {
   // A guided fit at the expected place when no accepted candidate is there: the index in
   // `candidates` of the one it added (after the accepted ones), or -1.
   long AddGuided(const cv::Mat& frame, std::vector<recon::BallObservation>* candidates);
-  // Steers the track to where the fusion expects the ball in this frame, if it knows.
+  // Steers the track to where the fusion expects the ball in this frame, if it knows; counts the
+  // frames in a row without a recent fused position (unconfirmed_).
   void FollowHint(const io::SourceFrame& in);
+  // Whether this frame is searched whole because no fused position confirmed the track lately.
+  bool UnconfirmedScan();
   int camera_index_;
   camera::Camera camera_;
   cv::Size size_;
@@ -105,6 +115,7 @@ class CameraStage {
   BallGuidedFn guided_;
   BallHintBoard* hints_ = nullptr;
   double last_time_s_ = 0.0;
+  int unconfirmed_ = 0;  // frames in a row without a recent fused position (with hints)
   std::string source_name_;
   std::unique_ptr<Track> track_;
   io::JpegRegionDecoder decoder_;

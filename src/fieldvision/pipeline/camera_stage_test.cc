@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/util/error.h"
+
 namespace fv::pipeline {
 namespace {
 
@@ -228,6 +230,49 @@ TEST(CameraStage, TheFusionsHintsMoveTheWindowFromABetterScoredThingToTheBall) {
       EXPECT_LE(with_ball, 2);  // the first whole-frame search only
     }
   }
+}
+
+TEST(CameraStage, WithoutAFusedPositionAStillThingGivesWayToTheBallWithinUnconfirmedScanEvery) {
+  // The ball is hidden from this camera for 10 frames while a still thing of its colour is in
+  // view; the window settles on the thing. From frame 10 the ball is in view, better scored, away
+  // from the window. The cameras together have no position (nothing published): with hints the
+  // whole frame is searched every unconfirmed_scan_every frames and the ball is found by frame
+  // 10 + 5; without hints (or with 0) only at the full_scan_every slot.
+  const camera::Camera cam = PosedCamera();
+  std::vector<std::vector<Thing>> frames;
+  for (int f = 0; f < 40; ++f) {
+    frames.push_back({{Vector2d(500, 100), 0.2}});
+    if (f >= 10) frames.back().push_back({Vector2d(100 + 6 * f, 300), 0.9});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  for (const int every : {0, 5}) {
+    track.unconfirmed_scan_every = every;
+    long long f = 0;
+    CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted");
+    BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+    stage.SetHints(&board);
+    long long first_ball = -1;
+    for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+      io::SourceFrame in;
+      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+      in.frame = f;
+      in.time_s = f / 60.0;
+      const CameraMessage m = stage.Process(in);
+      const bool ball = std::any_of(m.candidates.begin(), m.candidates.end(),
+                                    [](const auto& o) { return o.centre_px.y() == 300; });
+      if (ball && first_ball < 0) first_ball = f;
+    }
+    if (every == 5) {
+      EXPECT_GE(first_ball, 10);
+      EXPECT_LE(first_ball, 15);
+      EXPECT_LE(stage.stats().full_scans, 40 / 5 + 2);  // and the first frame, the switch
+    } else {
+      EXPECT_EQ(first_ball, -1);  // the slot of full_scan_every 100 never comes
+    }
+  }
+  track.unconfirmed_scan_every = -1;
+  EXPECT_THROW(track.Check(), Error);
 }
 
 TEST(CameraStage, GuidedFitsGoOnWhereTheSearchLosesTheBallForMaxGuidedFrames) {
