@@ -292,4 +292,24 @@ grep -q "ts.csv:4" "$TMP/err" || { echo "FAIL ball: timestamps line not named"; 
 check "calibrate check: no line in view" nonzero $FV calibrate check --field robocup-msl \
   --camera "$TMP/bv/cam1.yaml" --image "$TMP/black.ppm" --out "$TMP/bv/chk.png"
 grep -q "sees no line" "$TMP/err" || { echo "FAIL calibrate check: not the no-line error"; fail=1; }
+# calibrate import: camera names from the file never leave --out; two of one name are refused.
+toml_cam() {  # toml_cam SECTION NAME
+  printf '[%s]\nname = "%s"\nsize = [ 640.0, 480.0,]\n' "$1" "$2"
+  printf 'matrix = [ [ 500.0, 0.0, 320.0,], [ 0.0, 500.0, 240.0,], [ 0.0, 0.0, 1.0,],]\n'
+  printf 'distortions = [ 0.0, 0.0, 0.0, 0.0,]\nrotation = [ 0.0, 0.0, 0.0,]\n'
+  printf 'translation = [ 0.0, 0.0, 2000.0,]\n\n'
+}
+mkdir -p "$TMP/imp/deep"
+{ toml_cam cam_0 ../../escaped; toml_cam cam_1 B; } >"$TMP/imp/calibration.toml"
+FV_ABS="$(cd "$(dirname "$FV")" && pwd)/$(basename "$FV")"
+(cd "$TMP/imp/deep" && check "calibrate import: a name with ../" 0 "$FV_ABS" calibrate import \
+  --toml ../calibration.toml --out rig)
+[ -e "$TMP/escaped.yaml" ] || [ -e "$TMP/imp/escaped.yaml" ] &&
+  { echo "FAIL calibrate import: a camera file written outside --out"; fail=1; }
+[ "$(ls "$TMP/imp/deep/rig" | wc -l)" = 2 ] || { echo "FAIL calibrate import: not 2 files"; fail=1; }
+{ toml_cam cam_0 A; toml_cam cam_1 A; } >"$TMP/imp/twice.toml"
+check "calibrate import: two cameras of one name" nonzero $FV calibrate import \
+  --toml "$TMP/imp/twice.toml" --out "$TMP/imp/twice"
+grep -q "two cameras named 'A'" "$TMP/err" || { echo "FAIL calibrate import: not refused"; fail=1; }
+[ -e "$TMP/imp/twice" ] && { echo "FAIL calibrate import: a refused run made --out"; fail=1; }
 exit $fail

@@ -53,6 +53,8 @@ std::string FileNamePart(std::string_view s) {
         std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
     if (!keep) c = '_';
   }
+  // Not a hidden file: leading dots become '_' too.
+  for (size_t i = 0; i < out.size() && out[i] == '.'; ++i) out[i] = '_';
   return out;
 }
 

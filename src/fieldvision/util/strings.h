@@ -14,8 +14,8 @@ std::string Trim(std::string_view s);
 bool StartsWith(std::string_view s, std::string_view prefix);
 bool EndsWith(std::string_view s, std::string_view suffix);
 std::string ToLower(std::string_view s);
-// `s` as part of a file name: letters, digits, '-', '_' and '.' kept, every other byte '_' (so
-// never a path).
+// `s` as part of a file name: letters, digits, '-', '_' and '.' kept, every other byte and
+// leading dots '_' (so never a path, nor a hidden file).
 std::string FileNamePart(std::string_view s);
 
 // Parses the whole string as a number; throws fv::Error naming `context` otherwise.

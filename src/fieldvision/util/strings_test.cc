@@ -15,7 +15,8 @@ TEST(Fnv1a64, PublishedVectors) {
 
 TEST(FileNamePart, KeepsSafeCharactersOnly) {
   EXPECT_EQ(FileNamePart("cam-1_a.b"), "cam-1_a.b");
-  EXPECT_EQ(FileNamePart("../a b/c\\d:e"), ".._a_b_c_d_e");
+  EXPECT_EQ(FileNamePart("../a b/c\\d:e"), "___a_b_c_d_e");
+  EXPECT_EQ(FileNamePart(".hidden.x"), "_hidden.x");
   EXPECT_EQ(FileNamePart(""), "");
 }
 
