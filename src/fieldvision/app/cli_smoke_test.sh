@@ -312,4 +312,9 @@ check "calibrate import: two cameras of one name" nonzero $FV calibrate import \
   --toml "$TMP/imp/twice.toml" --out "$TMP/imp/twice"
 grep -q "two cameras named 'A'" "$TMP/err" || { echo "FAIL calibrate import: not refused"; fail=1; }
 [ -e "$TMP/imp/twice" ] && { echo "FAIL calibrate import: a refused run made --out"; fail=1; }
+# A drawn video's name must say its container: refused before any work, naming the option.
+check "players --draw an image name" nonzero $FV players --video "$TMP/v.avi" --out "$TMP/pt.csv" \
+  --draw "$TMP/out.jpg"
+grep -q -- "--draw '.*out.jpg': a video's name ends in .mp4, .avi or .mkv" "$TMP/err" ||
+  { echo "FAIL players --draw out.jpg: not refused by its name"; fail=1; }
 exit $fail

@@ -9,6 +9,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/track/players.h"
@@ -186,6 +187,7 @@ void Setup(CLI::App& app, int& exit_code) {
                                     {c->o.detections_out, "--save-detections"}}) {
       io::CheckOutputPath(out, io::PathList(inputs, c->out), what);
     }
+    if (!c->draw.empty()) io::CheckVideoPath(c->draw, "--draw");
     // A device, a folder or a missing folder as an output is refused before the run.
     for (const auto& [out, what] : {std::pair{c->out, "--out"},
                                     {c->mot_out, "--mot-out"},

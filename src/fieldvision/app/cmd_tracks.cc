@@ -11,6 +11,7 @@
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_source.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
@@ -64,6 +65,7 @@ struct TracksDrawCli {
 
 // The video with the (edited) tracks drawn: names from the roster, team colours.
 void RunTracksDraw(const TracksDrawCli& c) {
+  io::CheckVideoPath(c.out, "--out");
   const auto rows = ReadTracks(c.tracks);
   std::string roster_in = c.roster_in;
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {

@@ -58,8 +58,16 @@ bool H264Available() {
   return kAvailable;
 }
 
+void CheckVideoPath(const std::string& path, std::string_view what) {
+  const std::string ext = util::ToLower(fs::path(path).extension().string());
+  FV_REQUIRE(ext == ".mp4" || ext == ".avi" || ext == ".mkv",
+             "{} '{}': a video's name ends in .mp4, .avi or .mkv{}", what, path,
+             ext.empty() ? "" : fmt::format(" (not {})", ext));
+}
+
 PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size)
     : writer_(codecs::NewVideoWriter()), size_(size) {
+  CheckVideoPath(path, "video");
   FV_REQUIRE(fps > 0 && std::isfinite(fps), "video '{}': frame rate must be positive (got {})",
              path, fps);
   FV_REQUIRE(size.width > 0 && size.height > 0, "video '{}': empty frame size", path);

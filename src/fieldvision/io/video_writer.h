@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
@@ -15,8 +16,8 @@ namespace fv::io {
 
 class PlayableVideoWriter {
  public:
-  // Throws fv::Error naming the path when no writer opens, the frame rate is not positive or the
-  // size is empty.
+  // Throws fv::Error naming the path when it is no video's name (CheckVideoPath), no writer
+  // opens, the frame rate is not positive or the size is empty.
   PlayableVideoWriter(const std::string& path, double fps, cv::Size size);
   ~PlayableVideoWriter();  // without Close(): the temporary file is removed
   PlayableVideoWriter(const PlayableVideoWriter&) = delete;
@@ -40,5 +41,10 @@ class PlayableVideoWriter {
 
 // Whether OpenCV's FFmpeg backend can write H.264 MP4 here (tried once on a tiny file).
 bool H264Available();
+
+// Throws fv::Error naming `what` and `path` unless the path ends in .mp4, .avi or .mkv (any
+// case): the writer picks the container by it, and another name (an image, a pattern) would be
+// written as something else or fail at the end of a run.
+void CheckVideoPath(const std::string& path, std::string_view what);
 
 }  // namespace fv::io

@@ -87,6 +87,13 @@ TEST(PlayableVideoWriter, BadSettingsAndFramesAreErrorsNamingThePath) {
               PlayableVideoWriter(missing, 25, {64, 48});
             }).find(missing),
             std::string::npos);
+  for (const char* name : {"/v.jpg", "/v_%03d.png", "/v"}) {
+    const std::string not_video = dir + name;
+    const std::string why = message([&] { PlayableVideoWriter(not_video, 25, {64, 48}); });
+    EXPECT_NE(why.find(not_video), std::string::npos) << why;
+    EXPECT_NE(why.find(".mp4, .avi or .mkv"), std::string::npos) << why;
+  }
+  EXPECT_NO_THROW(CheckVideoPath(dir + "/V.MKV", "--draw"));
   PlayableVideoWriter w(path, 25, {64, 48});
   const std::string wrong = message([&] { w.Write(cv::Mat(10, 10, CV_8UC3)); });
   EXPECT_NE(wrong.find(path), std::string::npos) << wrong;
