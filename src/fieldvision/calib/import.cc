@@ -11,6 +11,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::calib {
 namespace {
@@ -115,6 +116,7 @@ using TomlTable = std::map<std::string, TomlValue>;
 std::vector<std::pair<std::string, TomlTable>> ParseToml(const std::string& path) {
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "calibration file '{}' cannot be read", path);
+  util::SkipUtf8Bom(in);
   std::vector<std::pair<std::string, TomlTable>> out;
   out.emplace_back("", TomlTable{});
   std::string line, pending_key, pending;

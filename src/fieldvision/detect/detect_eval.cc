@@ -25,6 +25,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::detect {
 namespace fs = std::filesystem;
@@ -169,6 +170,7 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
 std::vector<cv::Rect2d> ReadYoloFile(const std::string& path, int class_id, int width, int height) {
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "cannot read label file '{}'", path);
+  util::SkipUtf8Bom(in);
   std::vector<cv::Rect2d> boxes;
   std::string line;
   int line_no = 0;

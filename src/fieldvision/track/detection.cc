@@ -102,6 +102,7 @@ void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& pat
 DetectionsFile ReadDetectionsCsv(const std::string& path) {
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "cannot open detections file '{}'", path);
+  util::SkipUtf8Bom(in);
   DetectionsFile out;
   std::string line;
   int line_no = 0;

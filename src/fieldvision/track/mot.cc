@@ -84,6 +84,7 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
   constexpr long long kMaxFrame = 100000000;  // 46 days at 25 frames/s; 2e9 is a damaged file
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "cannot open tracks file '{}'", path);
+  util::SkipUtf8Bom(in);
   std::vector<TrackRow> rows;
   std::string line;
   int line_no = 0;

@@ -22,6 +22,7 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& name) {
   CsvTable t;
   t.name_ = name;
   std::istringstream in(text);
+  SkipUtf8Bom(in);
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {

@@ -31,6 +31,17 @@ TEST(Csv, RoundTrip) {
   EXPECT_EQ(t.Get(1, "name"), "b");
 }
 
+// A CSV saved by a spreadsheet as "CSV UTF-8" starts with a byte-order mark: the header is read
+// without it.
+TEST(Csv, AByteOrderMarkBeforeTheHeaderIsSkipped) {
+  const CsvTable t = CsvTable::Parse(
+      "\xEF\xBB\xBF"
+      "frame,time_s\n0,0.5\n",
+      "excel.csv");
+  ASSERT_TRUE(t.Has("frame"));
+  EXPECT_EQ(t.GetDouble(0, "time_s"), 0.5);
+}
+
 TEST(Csv, ErrorsNameTheInput) {
   EXPECT_THROW(CsvTable::Read("/nonexistent/x.csv"), Error);
   EXPECT_THAT([&] { CsvTable::Parse("a,b\n1,2\n3\n", "f.csv"); },

@@ -58,6 +58,16 @@ std::string FileNamePart(std::string_view s) {
   return out;
 }
 
+void SkipUtf8Bom(std::istream& in) {
+  if (in.peek() != 0xEF) return;
+  const std::istream::pos_type start = in.tellg();
+  char bytes[3] = {};
+  in.read(bytes, 3);
+  if (in.gcount() == 3 && std::string_view(bytes, 3) == "\xEF\xBB\xBF") return;
+  in.clear();
+  in.seekg(start);  // not a mark: read from the start as it is
+}
+
 namespace {
 
 // A value as an error message shows it: one line (control characters as '?'), at most 40

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <istream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -17,6 +18,9 @@ std::string ToLower(std::string_view s);
 // `s` as part of a file name: letters, digits, '-', '_' and '.' kept, every other byte and
 // leading dots '_' (so never a path, nor a hidden file).
 std::string FileNamePart(std::string_view s);
+// Skips a UTF-8 byte-order mark at the stream's start (spreadsheets write one before a CSV's
+// header: "CSV UTF-8" in Excel); other bytes are left unread.
+void SkipUtf8Bom(std::istream& in);
 
 // Parses the whole string as a number; throws fv::Error naming `context` otherwise.
 double ParseDouble(std::string_view s, std::string_view context);

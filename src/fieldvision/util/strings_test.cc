@@ -1,6 +1,8 @@
 // The stable hash: the published FNV-1a 64-bit test vectors (every compiler and run alike); file
-// name parts that are never paths.
+// name parts that are never paths; a byte-order mark skipped.
 #include "fieldvision/util/strings.h"
+
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -18,6 +20,29 @@ TEST(FileNamePart, KeepsSafeCharactersOnly) {
   EXPECT_EQ(FileNamePart("../a b/c\\d:e"), "___a_b_c_d_e");
   EXPECT_EQ(FileNamePart(".hidden.x"), "_hidden.x");
   EXPECT_EQ(FileNamePart(""), "");
+}
+
+// A spreadsheet's UTF-8 byte-order mark before a CSV's header is skipped; other text is read as
+// it is, a lone 0xEF byte included.
+TEST(SkipUtf8Bom, SkipsAWholeMarkOnly) {
+  std::istringstream with(
+      "\xEF\xBB\xBF"
+      "frame,u\n");
+  SkipUtf8Bom(with);
+  std::string line;
+  std::getline(with, line);
+  EXPECT_EQ(line, "frame,u");
+  std::istringstream without("frame,u\n");
+  SkipUtf8Bom(without);
+  std::getline(without, line);
+  EXPECT_EQ(line, "frame,u");
+  std::istringstream partial("\xEF\xBBx\n");
+  SkipUtf8Bom(partial);
+  std::getline(partial, line);
+  EXPECT_EQ(line, "\xEF\xBBx");
+  std::istringstream empty("");
+  SkipUtf8Bom(empty);
+  EXPECT_FALSE(std::getline(empty, line));
 }
 
 }  // namespace
