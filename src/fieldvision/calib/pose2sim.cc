@@ -35,10 +35,19 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
   const std::string text = ss.str();
   static const std::regex kCamera(
       R"(<camera [^>]*serial=\"([^\"]*)\"[\s\S]*?<fov_video ([^>]*)/>[\s\S]*?<transform ([^>]*)/>\s*<intrinsic ([^>]*)/>)");
+  // A file cut short (a copy interrupted) would lose its last cameras without a word.
+  FV_REQUIRE(text.find("</calibration>") != std::string::npos,
+             "Qualisys calibration '{}' ends before '</calibration>' (truncated or not a .qca "
+             "file)",
+             path);
   std::vector<camera::Camera> cams;
   for (auto it = std::sregex_iterator(text.begin(), text.end(), kCamera);
        it != std::sregex_iterator(); ++it) {
     const auto fov = Attributes((*it)[2]);
+    for (const char* key : {"left", "right", "top", "bottom"}) {
+      FV_REQUIRE(fov.count(key), "Qualisys calibration '{}': camera {} has no fov_video {}", path,
+                 (*it)[1].str(), key);
+    }
     const auto t = Attributes((*it)[3]);
     const auto k = Attributes((*it)[4]);
     for (const char* key :
@@ -65,6 +74,14 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
     Eigen::Matrix3d r;
     r << t.at("r11"), t.at("r12"), t.at("r13"), t.at("r21"), t.at("r22"), t.at("r23"), t.at("r31"),
         t.at("r32"), t.at("r33");
+    // A rotation: orthonormal, determinant +1 (a mistyped entry makes the camera's centre, R^T
+    // times the position, land metres off).
+    FV_REQUIRE((r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-3 &&
+                   r.determinant() > 0,
+               "Qualisys calibration '{}': camera {}'s transform r11..r33 is not a rotation "
+               "(R R^T differs from the identity by {:.3g})",
+               path, (*it)[1].str(),
+               (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
     const Eigen::Vector3d position_m(t.at("x") / 1000, t.at("y") / 1000, t.at("z") / 1000);
     const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
     c.has_pose = true;
@@ -74,6 +91,15 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
     cams.push_back(c);
   }
   FV_REQUIRE(!cams.empty(), "Qualisys calibration '{}' has no cameras", path);
+  size_t tags = 0;
+  for (size_t at = text.find("<camera "); at != std::string::npos;
+       at = text.find("<camera ", at + 1)) {
+    ++tags;
+  }
+  FV_REQUIRE(tags == cams.size(),
+             "Qualisys calibration '{}': {} <camera> elements, {} of them whole (fov_video, "
+             "transform and intrinsic each)",
+             path, tags, cams.size());
   return cams;
 }
 

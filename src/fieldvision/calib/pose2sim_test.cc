@@ -4,7 +4,9 @@
 #include "fieldvision/calib/pose2sim.h"
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -53,6 +55,36 @@ TEST(Pose2Sim, QualisysReferenceProjectsTheScenePointsNearTheClicks) {
       EXPECT_LT((*uv - p.uv_px).norm(), 50.0) << "cam" << c + 1 << " " << p.name;
     }
   }
+}
+
+// A file cut short, a transform that is no rotation and a camera without its fov_video are
+// one-line errors naming the file (they were read as fewer cameras, or a camera metres off).
+TEST(Pose2Sim, DamagedQualisysFilesAreRefused) {
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "no shared data";
+  std::ifstream in(data + "/pose2sim-4cam/calibration/Calib.qca.txt");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  const std::string dir = fv::testing::TempDir();
+  const auto error_of = [&](const std::string& name, const std::string& content) {
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << content;
+    const std::string e = fv::testing::ErrorOf([&] { ReadQualisysCalibration(path); });
+    EXPECT_NE(e.find(path), std::string::npos) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    return e;
+  };
+  EXPECT_NE(error_of("cut.qca.txt", text.substr(0, text.size() / 2)).find("truncated"),
+            std::string::npos);
+  std::string rotated = text;
+  const size_t r11 = rotated.find("r11=\"") + 5;
+  rotated.replace(r11, rotated.find('"', r11) - r11, "5.5");
+  EXPECT_NE(error_of("rot.qca.txt", rotated).find("not a rotation"), std::string::npos);
+  std::string no_fov = text;
+  const size_t fov = no_fov.find("<fov_video ");
+  no_fov.replace(fov, no_fov.find("/>", fov) + 2 - fov, "<fov_video />");
+  EXPECT_NE(error_of("fov.qca.txt", no_fov).find("fov_video"), std::string::npos);
 }
 
 TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {
