@@ -317,4 +317,7 @@ check "players --draw an image name" nonzero $FV players --video "$TMP/v.avi" --
   --draw "$TMP/out.jpg"
 grep -q -- "--draw '.*out.jpg': a video's name ends in .mp4, .avi or .mkv" "$TMP/err" ||
   { echo "FAIL players --draw out.jpg: not refused by its name"; fail=1; }
+check "calibrate import: --units with a Qualisys file" nonzero $FV calibrate import \
+  --qualisys "$TMP/imp/none.qca.txt" --units cm --out "$TMP/imp/q"
+grep -q "units applies to --toml" "$TMP/err" || { echo "FAIL calibrate import: --units taken"; fail=1; }
 exit $fail

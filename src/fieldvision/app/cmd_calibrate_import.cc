@@ -100,6 +100,14 @@ void RunImport(const ImportCli& c) {
     const track::TsaiConversion conv = track::CameraFromTsai(p, name);
     camera::WriteCameraYaml(conv.camera, c.out);
     std::cout << conv.Summary() << "\ncamera " << name << "\nwrote " << c.out << "\n";
+    // Tsai's one-coefficient radial model is fitted exactly by OpenCV's for real lenses (PETS
+    // View_001: 0.000 px); a large difference is a distortion no lens has (a mistyped kappa1).
+    if (conv.max_fit_error_px > 1.0) {
+      std::cerr << fmt::format(
+          "warning: '{}': OpenCV's lens model differs from Tsai's by up to {:.1f} px over the "
+          "image: check kappa1 and the sensor sizes in the file\n",
+          c.tsai, conv.max_fit_error_px);
+    }
     return;
   }
   std::vector<camera::Camera> cams;
@@ -207,7 +215,13 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   cmd->add_option("--name", c->name,
                   "Camera name (default: the file's camera name, e.g. the Tsai name attribute)");
-  cmd->callback([c] { RunImport(*c); });
+  cmd->callback([c, cmd] {
+    // Tsai and Qualisys files say their unit (millimetres): --units would do nothing there.
+    FV_REQUIRE(cmd->count("--units") == 0 || !c->toml.empty() || !c->opencv_stereo.empty(),
+               "calibrate import: --units applies to --toml and --opencv-stereo only (Tsai and "
+               "Qualisys files are in millimetres)");
+    RunImport(*c);
+  });
 
   auto e = std::make_shared<ExportCli>();
   CLI::App* ex = group->add_subcommand(
