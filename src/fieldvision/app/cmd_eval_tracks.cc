@@ -82,6 +82,9 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--all-frames", c->o.clip_to_gt_frames,
                 "Also count estimated rows in frames outside the ground truth's first..last frame "
                 "(default: left out)");
+  cmd->add_flag("--est-frames", c->o.clip_to_est_frames,
+                "Score only the frames from the estimate's first to its last (an estimate of a "
+                "clip; default: ground truth outside them counts as misses, and a note says so)");
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
   cmd->callback([c] {
     io::CheckOutputPath(c->json, {c->gt, c->est}, "--json");

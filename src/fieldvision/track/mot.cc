@@ -169,6 +169,15 @@ std::string MotPreprocessing::Summary() const {
       "left out: {} ground-truth boxes (conf 0 or not a pedestrian), {} estimated boxes on "
       "distractors, {} estimated boxes outside the ground truth's frames",
       gt_ignored, est_on_distractors, est_outside_gt_frames);
+  if (gt_outside_est_frames > 0 && gt_clipped) {
+    s += fmt::format(", {} ground-truth boxes outside the estimate's frames {}..{}",
+                     gt_outside_est_frames, est_first, est_last);
+  } else if (gt_outside_est_frames > 0) {
+    s += fmt::format(
+        "; NOTE: the estimate covers frames {}..{} only: {} ground-truth boxes outside them count "
+        "as misses (--est-frames scores those frames only)",
+        est_first, est_last, gt_outside_est_frames);
+  }
   if (best_offset != 0 && iou_at_best > 1.02 * iou_at_zero) {
     s += fmt::format(
         "; WARNING: the frames look shifted: the boxes overlap better (summed IoU {:.0f} against "
@@ -213,6 +222,8 @@ std::string MotMetrics::ToJson() const {
                       {"gt_ignored", preprocessing.gt_ignored},
                       {"est_on_distractors", preprocessing.est_on_distractors},
                       {"est_outside_gt_frames", preprocessing.est_outside_gt_frames},
+                      {"gt_outside_est_frames", preprocessing.gt_outside_est_frames},
+                      {"gt_outside_est_frames_left_out", preprocessing.gt_clipped},
                       {"best_frame_offset", preprocessing.best_offset}};
   return j.dump(2);
 }
@@ -306,6 +317,19 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
     const size_t before = est.size();
     std::erase_if(est, [&](const TrackRow& r) { return r.frame < first || r.frame > last; });
     p.est_outside_gt_frames = static_cast<int>(before - est.size());
+  }
+  if (!est.empty()) {
+    const auto [lo, hi] =
+        std::minmax_element(est.begin(), est.end(),
+                            [](const TrackRow& a, const TrackRow& b) { return a.frame < b.frame; });
+    p.est_first = lo->frame;
+    p.est_last = hi->frame;
+    const auto outside = [&](const TrackRow& r) {
+      return r.frame < p.est_first || r.frame > p.est_last;
+    };
+    p.gt_outside_est_frames = static_cast<int>(std::count_if(gt.begin(), gt.end(), outside));
+    p.gt_clipped = o.clip_to_est_frames;
+    if (o.clip_to_est_frames) std::erase_if(gt, outside);
   }
 }
 

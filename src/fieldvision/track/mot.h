@@ -53,6 +53,9 @@ struct MotOptions {
   // Estimated rows in frames outside the ground truth's first..last frame are left out (a
   // ground truth that covers part of a video).
   bool clip_to_gt_frames = true;
+  // Ground-truth rows in frames outside the estimate's first..last frame are left out (an
+  // estimate of a clip of the video); false: they count as misses.
+  bool clip_to_est_frames = false;
   void Check() const;
 };
 
@@ -61,6 +64,12 @@ struct MotPreprocessing {
   int gt_ignored = 0;          // conf 0 or not a pedestrian (MOT17 rules)
   int est_on_distractors = 0;  // estimated boxes matched to a distractor (MOT17 rules)
   int est_outside_gt_frames = 0;
+  // Ground-truth boxes in frames outside the estimate's first..last frame (est_first..est_last,
+  // after frame_offset): left out with clip_to_est_frames, else counted as misses (Summary says
+  // so: a clip scored against a whole video's ground truth).
+  int gt_outside_est_frames = 0;
+  int est_first = 0, est_last = 0;
+  bool gt_clipped = false;
   // The frame offset (added to the estimate) whose matches (IoU >= 0.5) have the largest summed
   // IoU, tried over -2..2, and the sums at offset 0 and at that one: a 0-based file scored
   // against 1-based ground truth shows up as best_offset 1 (Summary warns).

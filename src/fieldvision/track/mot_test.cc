@@ -44,6 +44,29 @@ TEST(Mot, PerfectTracksScoreOne) {
   EXPECT_EQ(m.tp, 250);
 }
 
+// An estimate of a clip (the first 20 of 50 frames) scored against the whole video's ground
+// truth: the frames after it count as misses and the summary says so; clip_to_est_frames scores
+// the clip's frames only.
+TEST(Mot, AnEstimateOfAClipIsNotedOrScoredOverItsFrames) {
+  fv::testing::SeededRng rng(4);
+  const auto gt = Walkers(rng, 5, 50);
+  std::vector<TrackRow> clip;
+  for (const auto& r : gt) {
+    if (r.frame >= 5 && r.frame < 20) clip.push_back(r);
+  }
+  MotOptions o;
+  const MotMetrics whole = EvaluateMot(gt, clip, o);
+  EXPECT_EQ(whole.preprocessing.gt_outside_est_frames, 5 * 35);
+  EXPECT_NEAR(whole.recall, 0.3, 1e-9);
+  EXPECT_THAT(whole.preprocessing.Summary(), HasSubstr("covers frames 5..19 only"));
+  o.clip_to_est_frames = true;
+  const MotMetrics scored = EvaluateMot(gt, clip, o);
+  EXPECT_DOUBLE_EQ(scored.mota, 1.0);
+  EXPECT_EQ(scored.frames, 15);
+  EXPECT_THAT(scored.preprocessing.Summary(), ::testing::Not(HasSubstr("NOTE")));
+  EXPECT_EQ(EvaluateMot(gt, gt, o).preprocessing.gt_outside_est_frames, 0);
+}
+
 TEST(Mot, CountsMissesFalsePositivesAndSwitches) {
   fv::testing::SeededRng rng(4);
   const int frames = 40;
