@@ -313,6 +313,11 @@ LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::
   return s;
 }
 
+double LineErrorStats::TruncatedMeanMm() const {
+  if (num_pixels == 0) return 0.0;
+  return (mean_mm * num_inliers + 1000.0 * gate_m * (num_pixels - num_inliers)) / num_pixels;
+}
+
 void RefineOptions::Check() const {
   detect.Check();
   CheckInRange(lut_resolution_m, 0.001, 0.5, "lut_resolution_m");
@@ -426,10 +431,20 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
   }
   result.status = LineRefinementRefusal(result.moved_m, options.max_move_m, result.initial_cost,
                                         result.final_cost, /*rig=*/false);
+  const LineErrorStats after = LineError(refined, pixels, field, options.gate_m);
+  // The robust cost can fall while the line error the user sees rises (an exact pose moved by
+  // the lines' own noise): such a pose is no refinement.
+  if (result.status.empty() && after.TruncatedMeanMm() > result.before.TruncatedMeanMm()) {
+    result.status = fmt::format(
+        "the line error would rise ({:.1f} -> {:.1f} mm over the {} line "
+        "pixels on the field, each at most {:.0f} mm)",
+        result.before.TruncatedMeanMm(), after.TruncatedMeanMm(), after.num_pixels,
+        1000.0 * options.gate_m);
+  }
   if (result.status.empty()) {
     result.accepted = true;
     result.camera = refined;
-    result.after = LineError(refined, pixels, field, options.gate_m);
+    result.after = after;
   }
   return result;
 }

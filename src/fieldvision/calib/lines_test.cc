@@ -106,6 +106,29 @@ TEST(Refine, StartFarOffIsNotMadeWorse) {
   EXPECT_LE(after, before + 1e-9) << r.Summary();
 }
 
+// Started at the true pose, the lines' own noise may lower the robust cost while raising the
+// line error: the pose is then kept, with the reason (a refinement that makes a pose worse is
+// none).
+TEST(Refine, AnExactPoseIsKeptWhenRefiningWouldRaiseTheLineError) {
+  const uint64_t seed = fv::testing::TestSeed(7);
+  FV_SEED_TRACE(seed);
+  const synth::SceneRenderer scene(TwentyMetreScene(seed));
+  const camera::Camera& truth = scene.cameras()[0];
+  const auto pixels = DetectLinePixels(scene.Render(0)[0], truth, scene.field());
+  const RefineResult r = RefineWithLinePixels(truth, pixels, scene.field());
+  EXPECT_LE(r.after.TruncatedMeanMm(), r.before.TruncatedMeanMm()) << r.Summary();
+  if (!r.accepted) {
+    EXPECT_THAT(r.status, HasSubstr("line error would rise"));
+    EXPECT_EQ((r.camera.CentreInWorld() - truth.CentreInWorld()).norm(), 0.0);
+  }
+  LineErrorStats s;
+  s.num_pixels = 4;
+  s.num_inliers = 3;
+  s.mean_mm = 10.0;
+  s.gate_m = 0.5;
+  EXPECT_DOUBLE_EQ(s.TruncatedMeanMm(), (30.0 + 500.0) / 4);
+}
+
 // A 60 degree camera of the given size at (-15, -12, 7) m looking at the field's centre.
 camera::Camera CornerCamera(int width, int height) {
   camera::Camera cam = camera::Camera::FromFov(width, height, 60);

@@ -154,14 +154,23 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<camera::Camera>& rig,
   result.rotated_deg = rvec.norm() * 180.0 / M_PI;
   result.status = LineRefinementRefusal(result.moved_m, options.max_move_m, result.initial_cost,
                                         result.final_cost, /*rig=*/true);
+  // As for one camera (lines.cc): no move that raises the line error the user sees, summed over
+  // the cameras' line pixels on the field.
+  std::vector<LineErrorStats> after = result.before;
+  double sum_before = 0.0, sum_after = 0.0;
+  for (size_t i = 0; i < rig.size(); ++i) {
+    if (pixels[i].empty()) continue;
+    after[i] = LineError(refined[i], pixels[i], field, options.gate_m);
+    sum_before += result.before[i].TruncatedMeanMm() * result.before[i].num_pixels;
+    sum_after += after[i].TruncatedMeanMm() * after[i].num_pixels;
+  }
+  if (result.status.empty() && sum_after > sum_before) {
+    result.status = "the line error would rise (summed over the cameras' line pixels)";
+  }
   if (result.status.empty()) {
     result.accepted = true;
     result.cameras = refined;
-    for (size_t i = 0; i < rig.size(); ++i) {
-      if (!pixels[i].empty()) {
-        result.after[i] = LineError(refined[i], pixels[i], field, options.gate_m);
-      }
-    }
+    result.after = after;
   }
   return result;
 }
