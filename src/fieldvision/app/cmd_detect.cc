@@ -32,10 +32,17 @@ void Setup(CLI::App& app, int& exit_code) {
       "Draw the candidates: an annotated video (.mp4: H.264 where OpenCV's FFmpeg has it, else "
       "Motion-JPEG as .avi; .avi, .mkv: Motion-JPEG) or a folder of JPEGs");
   cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
+      ->check(CLI::Range(1, 16))
       ->capture_default_str();
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
-  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)");
+  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)")
+      ->check(CLI::Range(-1, 1000000000) & CLI::Validator(
+                                               [](const std::string& v) {
+                                                 return v == "0" ? "0 frames: give -1 (all) or more"
+                                                                 : "";
+                                               },
+                                               "-1 or > 0"));
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     // The field mask is the field seen through a posed camera; without one --field did nothing.

@@ -1,6 +1,7 @@
 #include "fieldvision/calib/import.h"
 
 #include <cctype>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -174,6 +175,7 @@ std::vector<double> Numbers(const TomlValue& v, const std::string& where) {
       out.insert(out.end(), inner.begin(), inner.end());
     } else {
       FV_REQUIRE(item.type == TomlValue::Type::kNumber, "{}: expected numbers", where);
+      FV_REQUIRE(std::isfinite(item.number), "{}: {} is not a finite number", where, item.number);
       out.push_back(item.number);
     }
   }

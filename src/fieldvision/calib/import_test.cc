@@ -76,6 +76,11 @@ TEST(Import, BadTomlNamesFileAndKey) {
   std::ofstream(path) << "[cam_1]\nmatrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]\n";
   EXPECT_THROW(ReadCalibrationToml(path), Error);  // not closed
   EXPECT_THROW(ReadCalibrationToml(path + ".missing"), Error);
+  std::ofstream(path) << "[cam_1]\nname = \"x\"\nsize = [10, 10]\n"
+                         "matrix = [[nan, 0, 2], [0, 1, 3], [0, 0, 1]]\n";
+  EXPECT_THAT([&] { ReadCalibrationToml(path); },
+              ThrowsMessage<Error>(
+                  ::testing::AllOf(HasSubstr("matrix"), HasSubstr("not a finite number"))));
   int w = 0, h = 0;
   ParseImageSize("1920x1080", "size", &w, &h);
   EXPECT_EQ(w, 1920);

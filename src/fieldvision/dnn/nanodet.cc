@@ -41,19 +41,17 @@ std::string FindModel(const std::string& file) {
       file, looked);
 }
 
-cv::dnn::Net LoadOnnx(const std::string& path) {
-  FV_REQUIRE(fs::exists(path),
-             "model '{}' not found; run `make build` to fetch and convert the detector", path);
+cv::dnn::Net LoadOnnx(const std::string& path, bool shipped) {
+  // `make build` fetches and converts the shipped model; a user's own model is theirs to mend.
+  const std::string again = shipped ? "; run `make build` to fetch and convert it again" : "";
+  FV_REQUIRE(fs::exists(path), "model '{}' not found{}", path, again);
   cv::dnn::Net net;
   try {
     net = cv::dnn::readNetFromONNX(path);
   } catch (const cv::Exception& e) {
-    Throw(
-        "model '{}' is corrupt or not an ONNX model OpenCV can read; run `make build` to fetch "
-        "and convert it again",
-        path);
+    Throw("model '{}' is corrupt or not an ONNX model OpenCV can read{}", path, again);
   }
-  FV_REQUIRE(!net.empty(), "model '{}' has no layers; run `make build` to fetch it again", path);
+  FV_REQUIRE(!net.empty(), "model '{}' has no layers{}", path, again);
   net.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
   net.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
   return net;
@@ -128,15 +126,14 @@ std::vector<DnnBox> NmsBoxes(const std::vector<DnnBox>& boxes, double iou_thresh
 }
 
 NanoDet::NanoDet(const std::string& model_path)
-    : path_(model_path.empty() ? FindModel("nanodet.onnx") : model_path), net_(LoadOnnx(path_)) {
+    : path_(model_path.empty() ? FindModel("nanodet.onnx") : model_path),
+      net_(LoadOnnx(path_, model_path.empty())) {
   // A forward pass on a blank image checks that the model has NanoDet's outputs.
   try {
     Run(cv::Mat(128, 128, CV_8UC3, cv::Scalar::all(0)));
   } catch (const cv::Exception& e) {
-    Throw(
-        "model '{}' does not run as NanoDet (outputs cls8..dis32 expected); run `make build` "
-        "to convert it again",
-        path_);
+    Throw("model '{}' does not run as NanoDet (outputs cls8..dis32 expected){}", path_,
+          model_path.empty() ? "; run `make build` to convert it again" : "");
   }
 }
 

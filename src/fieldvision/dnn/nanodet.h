@@ -31,8 +31,9 @@ struct DnnBox {
 std::string FindModel(const std::string& file);
 
 // An ONNX model on OpenCV's CPU backend. Throws fv::Error naming the path when it is missing or
-// not a model OpenCV can read.
-cv::dnn::Net LoadOnnx(const std::string& path);
+// not a model OpenCV can read (`shipped`: the project's own model, which `make build` fetches
+// again; the message says so).
+cv::dnn::Net LoadOnnx(const std::string& path, bool shipped = false);
 
 // NanoDet's decoder: the six outputs (cls8, cls16, cls32: 1 x N x 80; dis8, dis16, dis32:
 // 1 x N x 44) of a net_width x net_height input -> boxes of `classes` in network pixels with

@@ -125,7 +125,8 @@ TrackEdits ParseTrackEdits(const std::string& text, const std::string& path) {
         FV_REQUIRE(val.is_string(), "{}: name: the name of id {} must be a string", where, k);
         const std::string n = val.get<std::string>();
         FV_REQUIRE(n.find_first_of(",\n\r\"") == std::string::npos,
-                   "{}: name: '{}' must not contain commas, quotes or line breaks", where, n);
+                   "{}: name: '{}' must not contain commas, quotes or line breaks", where,
+                   util::Shown(n));
         e.names[IdFrom(json(k), where + ": name")] = n;
       }
     } else {

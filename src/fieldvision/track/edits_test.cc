@@ -110,6 +110,13 @@ TEST(TrackEdits, ErrorsNameFileAndLine) {
   EXPECT_EQ(json.find('\n'), std::string::npos);
   const std::string op = ErrorOf([&] { ParseTrackEdits("[\n\n {\"split\": [1]}]", "e"); });
   EXPECT_NE(op.find("e:3: unknown edit 'split'"), std::string::npos) << op;
+  const std::string line_break = ErrorOf([&] {
+    ApplyTrackEdits(rows, {}, ParseTrackEdits("[{\"name\": {\"1\": \"Ann\\nB\"}}]", "e"));
+  });
+  EXPECT_NE(line_break.find("'Ann?B' must not contain commas, quotes or line breaks"),
+            std::string::npos)
+      << line_break;
+  EXPECT_EQ(line_break.find('\n'), std::string::npos);
   const std::string one = ErrorOf([&] { ParseTrackEdits("[{\"merge\": [1]}]", "e"); });
   EXPECT_NE(one.find("e:1: merge needs two or more ids"), std::string::npos) << one;
   EXPECT_NE(ErrorOf([&] { ReadTrackEdits(dir + "/none.json"); }).find("none.json"),

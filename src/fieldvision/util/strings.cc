@@ -68,19 +68,13 @@ void SkipUtf8Bom(std::istream& in) {
   in.seekg(start);  // not a mark: read from the start as it is
 }
 
-namespace {
-
-// A value as an error message shows it: one line (control characters as '?'), at most 40
-// characters, so that a damaged file's bytes never make the message several lines.
-std::string Shown(const std::string& t) {
-  std::string out = t.substr(0, 40);
+std::string Shown(std::string_view t) {
+  std::string out(t.substr(0, 40));
   for (char& c : out) {
     if (std::iscntrl(static_cast<unsigned char>(c))) c = '?';
   }
   return t.size() > 40 ? out + "..." : out;
 }
-
-}  // namespace
 
 double ParseDouble(std::string_view s, std::string_view context) {
   const std::string t = Trim(s);

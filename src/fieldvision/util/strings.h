@@ -22,6 +22,10 @@ std::string FileNamePart(std::string_view s);
 // header: "CSV UTF-8" in Excel); other bytes are left unread.
 void SkipUtf8Bom(std::istream& in);
 
+// A value as an error message shows it: one line (control characters as '?'), at most 40
+// characters and "...", so that a file's bytes never make a message several lines.
+std::string Shown(std::string_view t);
+
 // Parses the whole string as a number; throws fv::Error naming `context` otherwise.
 double ParseDouble(std::string_view s, std::string_view context);
 long long ParseInt(std::string_view s, std::string_view context);
