@@ -77,7 +77,9 @@ inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
   cmd->add_option("--unconfirmed-scan-every", t.unconfirmed_scan_every,
                   "While the cameras together have no position for the ball, each tracking "
                   "camera searches the whole frame every N frames (0: only every "
-                  "--full-scan-every), so that a track on a still thing gives way to the ball")
+                  "--full-scan-every), so that a track on a still thing gives way to the ball (not "
+                  "on camera nodes: they cannot tell a fusion node without a position from one "
+                  "that sends no hints)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
 }

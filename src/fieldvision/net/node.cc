@@ -317,7 +317,9 @@ NodeSummary RunNode(const NodeOptions& o) {
   std::optional<pipeline::BallHintBoard> hints;
   if (o.hints && o.detect) {
     hints.emplace(1, pipeline::BallHintOptions(), /*wait=*/false);
-    stage.SetHints(&*hints);
+    // Hints arrive only while the fusion node has a position, and not at all when its hints are
+    // off: their absence says nothing (no unconfirmed whole-frame searches).
+    stage.SetHints(&*hints, /*silence_unconfirms=*/false);
   }
 
   NodeSummary summary;

@@ -247,7 +247,9 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
 
 bool CameraStage::UnconfirmedScan() {
   const int every = track_->unconfirmed_scan_every();
-  if (hints_ == nullptr || every == 0 || unconfirmed_ < every) return false;
+  if (hints_ == nullptr || !silence_unconfirms_ || every == 0 || unconfirmed_ < every) {
+    return false;
+  }
   unconfirmed_ = 0;
   return true;
 }

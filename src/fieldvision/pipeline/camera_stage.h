@@ -56,12 +56,12 @@ struct BallTrackOptions {
   // Frames in a row that the track may go on by guided fits alone (0: no guided fits); then it
   // needs a ball the detector finds by itself.
   int max_guided_frames = 15;
-  // With the fusion's hints: while the cameras together have had no position for the ball (no
-  // hint of at most BallHintOptions::max_age_s), a tracking camera searches the whole frame once
-  // every this many frames (0: only every full_scan_every). A track on a still ball-coloured
-  // thing that no other camera confirms gives way to the ball when it comes into view (the kick
-  // render, cam1 and cam2: the ball hidden from cam1 until frame 19, tracked from frame 33, the
-  // next whole-frame search, before).
+  // With the in-process fusion's hints: while the cameras together have had no position for the
+  // ball (no hint of at most BallHintOptions::max_age_s), a tracking camera searches the whole
+  // frame once every this many frames (0: only every full_scan_every; camera nodes: never). A track
+  // on a still ball-coloured thing that no other camera confirms gives way to the ball when it
+  // comes into view (the kick render, cam1 and cam2: the ball hidden from cam1 until frame 19,
+  // tracked from frame 33, the next whole-frame search, before).
   int unconfirmed_scan_every = 5;
   void Check() const;  // throws fv::Error naming the bad field
 };
@@ -92,7 +92,13 @@ class CameraStage {
   // without candidates; a frame of another size than the camera's throws fv::Error.
   CameraMessage Process(const io::SourceFrame& frame);
   // The fusion's hints for this camera (null: none; not owned, must outlive the stage's use).
-  void SetHints(BallHintBoard* hints) { hints_ = hints; }
+  // `silence_unconfirms`: a board without a recent position means the cameras together have
+  // none (the in-process fusion publishes every position), so unconfirmed_scan_every applies; a
+  // camera node cannot tell a fusion node that sends no hints from one without a position.
+  void SetHints(BallHintBoard* hints, bool silence_unconfirms = true) {
+    hints_ = hints;
+    silence_unconfirms_ = silence_unconfirms;
+  }
   const CameraStageStats& stats() const { return stats_; }
 
  private:
@@ -116,6 +122,7 @@ class CameraStage {
   BallHintBoard* hints_ = nullptr;
   double last_time_s_ = 0.0;
   int unconfirmed_ = 0;  // frames in a row without a recent fused position (with hints)
+  bool silence_unconfirms_ = true;
   std::string source_name_;
   std::unique_ptr<Track> track_;
   io::JpegRegionDecoder decoder_;

@@ -66,12 +66,12 @@ TEST(Players, BadInputsGiveOneLineErrorsNamingThem) {
   EXPECT_THAT([&] { RunPlayers(video, &cam, nullptr, o); },
               ThrowsMessage<fv::Error>(::testing::AllOf(HasSubstr("640x480"), HasSubstr("320x240"),
                                                         ::testing::Not(HasSubstr("\n")))));
-  // A missing detector model says how to get it.
+  // A missing detector model of the user's own is named.
   const camera::Camera small = camera::Camera::FromFov(320, 240, 60);
   o.detector.kind = "nanodet";
   o.detector.model_path = dir + "/nanodet.onnx";
   EXPECT_THAT([&] { RunPlayers(video, &small, nullptr, o); },
-              ThrowsMessage<fv::Error>(HasSubstr("make build")));
+              ThrowsMessage<fv::Error>(HasSubstr(dir + "/nanodet.onnx")));
 }
 
 TEST(Players, InterpolationFillsShortGapsOnly) {
