@@ -101,7 +101,6 @@ std::vector<std::string> DrawNames(const std::vector<std::string>& names) {
   for (size_t i = 0; i < names.size(); ++i) {
     std::string name = util::FileNamePart(names[i]);
     if (name.empty()) name = fmt::format("cam{}", i + 1);
-    if (name.front() == '.') name.insert(0, 1, '_');
     std::string unique = name;
     for (int k = 2; !taken.insert(unique).second; ++k) unique = fmt::format("{}-{}", name, k);
     out.push_back(unique);

@@ -130,7 +130,7 @@ TEST(BallOverlay, DrawsTheBallWhereEachCameraSeesIt) {
 TEST(BallOverlay, DrawNamesAreSafeAndUnique) {
   EXPECT_EQ(
       DrawNames({"cam1", "cam1", "cam1-2", "../x", "a/b", "", ".hidden"}),
-      (std::vector<std::string>{"cam1", "cam1-2", "cam1-2-2", "_.._x", "a_b", "cam6", "_.hidden"}));
+      (std::vector<std::string>{"cam1", "cam1-2", "cam1-2-2", "___x", "a_b", "cam6", "_hidden"}));
 }
 
 }  // namespace
