@@ -462,6 +462,10 @@ bool BelowGround(const Eigen::Vector3d& p, const recon::TrajectoryOptions& to) {
   return p.z() < to.ground_z_m + to.ball_radius_m - kBelowGroundM;
 }
 
+// A frame's own position outvotes the flight model only where its cameras check each other: two
+// views meet at a point whatever one of them is off by along the other's epipolar line.
+constexpr int kMinKeptViews = 3;
+
 bool ModelFailsAt(const Bundled::AtFrame& a, double typical_px) {
   const double model = a.model_rms();
   return model > kMaxModelRmsRatio * typical_px + kModelRmsSlackPx &&
@@ -507,7 +511,9 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
       if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
       const auto a = b.at_frame.find(i);
       const Eigen::Vector3d p = b.model.PositionAt(s.time_s);
-      if ((a != b.at_frame.end() && ModelFailsAt(a->second, typical_px)) || BelowGround(p, to)) {
+      if ((a != b.at_frame.end() && s.n_cams >= kMinKeptViews &&
+           ModelFailsAt(a->second, typical_px)) ||
+          BelowGround(p, to)) {
         ++out.kept_rows;
         continue;
       }
