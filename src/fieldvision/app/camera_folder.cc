@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
+
+#include <fmt/format.h>
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::app {
 
@@ -38,6 +42,27 @@ std::vector<camera::Camera> ReadCameraFolder(const std::string& dir, bool requir
   }
   FV_REQUIRE(!cams.empty(), "rig '{}' has no camera files (*.yaml)", dir);
   return cams;
+}
+
+std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams,
+                                         const std::string& dir, const std::string& what) {
+  std::error_code ec;
+  FV_REQUIRE(!std::filesystem::exists(dir, ec) || std::filesystem::is_directory(dir, ec),
+             "{} '{}' is a file: give a folder (one NAME.yaml per camera is written there)", what,
+             dir);
+  std::vector<std::string> paths;
+  std::map<std::string, std::string> named;  // file -> the camera's name
+  for (size_t i = 0; i < cams.size(); ++i) {
+    const std::string name = cams[i].name.empty() ? fmt::format("cam{}", i + 1) : cams[i].name;
+    const std::string file = util::FileNamePart(name) + ".yaml";
+    const auto [at, fresh] = named.emplace(file, name);
+    FV_REQUIRE(fresh, "{} would both be written to '{}' in {} '{}': rename one",
+               at->second == name ? fmt::format("two cameras named '{}'", name)
+                                  : fmt::format("cameras '{}' and '{}'", at->second, name),
+               file, what, dir);
+    paths.push_back((std::filesystem::path(dir) / file).string());
+  }
+  return paths;
 }
 
 }  // namespace fv::app

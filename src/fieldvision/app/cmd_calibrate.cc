@@ -128,6 +128,15 @@ std::vector<camera::Camera> ReportRigRefinement(const RigRefineResult& r,
         r.before[i].p95_mm);
   }
   if (!r.accepted) Warn("rig not refined: " + r.status + "; the camera files keep the input poses");
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (frames[i].empty() || r.after[i].num_inliers == 0 || r.after[i].mean_mm <= kLooseLinesMm) {
+      continue;
+    }
+    Warn(
+        fmt::format("{}'s field lines lie {:.0f} mm from the painted ones on average: is '{}' a "
+                    "frame of that camera, and --field its field?",
+                    r.cameras[i].name, r.after[i].mean_mm, names[i]));
+  }
   std::vector<camera::Camera> out = r.cameras;
   if (!r.accepted) return out;
   const auto num_frames =
@@ -143,11 +152,11 @@ std::vector<camera::Camera> ReportRigRefinement(const RigRefineResult& r,
 }
 
 void WriteRig(const std::vector<camera::Camera>& cams, const std::string& dir) {
+  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out");
   std::filesystem::create_directories(dir);
-  for (const auto& c : cams) {
-    const std::string path = (std::filesystem::path(dir) / (c.name + ".yaml")).string();
-    camera::WriteCameraYaml(c, path);
-    std::cout << "wrote " << path << "\n";
+  for (size_t i = 0; i < cams.size(); ++i) {
+    camera::WriteCameraYaml(cams[i], paths[i]);
+    std::cout << "wrote " << paths[i] << "\n";
   }
 }
 

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <regex>
 #include <sstream>
 
@@ -18,7 +17,6 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/util/error.h"
-#include "fieldvision/util/strings.h"
 
 namespace fv::app {
 namespace {
@@ -51,26 +49,10 @@ double MetresPerUnit(const std::string& units) {
   Throw("--units '{}' is not known; use m, cm or mm", units);
 }
 
-// NAME.yaml per camera in `dir`, NAME the camera's name made a safe file name (a name from the
-// file is never a path: "../x" or "/tmp/x" stay inside `dir`); two cameras whose files would be
-// the same are refused before anything is written.
+// NAME.yaml per camera in `dir` (CameraFilePaths: safe names, none shared).
 void WriteCameras(const std::vector<camera::Camera>& cams, const std::string& dir) {
+  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out");
   std::error_code ec;
-  FV_REQUIRE(!std::filesystem::exists(dir, ec) || std::filesystem::is_directory(dir, ec),
-             "--out '{}' is a file: give a folder (one NAME.yaml per camera is written there)",
-             dir);
-  std::vector<std::string> paths;
-  std::map<std::string, std::string> named;  // file -> the camera's name
-  for (size_t i = 0; i < cams.size(); ++i) {
-    const std::string name = cams[i].name.empty() ? fmt::format("cam{}", i + 1) : cams[i].name;
-    const std::string file = util::FileNamePart(name) + ".yaml";
-    const auto [at, fresh] = named.emplace(file, name);
-    FV_REQUIRE(fresh, "{} would both be written to '{}' in --out '{}': rename one",
-               at->second == name ? fmt::format("two cameras named '{}'", name)
-                                  : fmt::format("cameras '{}' and '{}'", at->second, name),
-               file, dir);
-    paths.push_back((std::filesystem::path(dir) / file).string());
-  }
   std::filesystem::create_directories(dir, ec);
   FV_REQUIRE(std::filesystem::is_directory(dir), "cannot make folder --out '{}'", dir);
   for (size_t i = 0; i < cams.size(); ++i) {

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/app/camera_folder.h"
 #include "fieldvision/app/cmd_calibrate_board.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/import.h"
@@ -121,13 +122,15 @@ void RunMulti(MultiCli& c) {
   for (const auto& w : r.warnings) std::cerr << "warning: " << w << "\n";
 
   namespace fs = std::filesystem;
+  const std::vector<std::string> paths = CameraFilePaths(r.cameras, c.out, "--out");
   fs::create_directories(c.out);
   for (size_t i = 0; i < r.cameras.size(); ++i) {
-    const std::string path = (fs::path(c.out) / (r.cameras[i].name + ".yaml")).string();
+    const std::string& path = paths[i];
     camera::WriteCameraYaml(r.cameras[i], path);
     std::cout << "wrote " << path << "\n";
     if (!c.no_pictures) {
-      const std::string pic = (fs::path(c.out) / (r.cameras[i].name + "_coverage.png")).string();
+      const std::string pic =
+          path.substr(0, path.size() - std::string(".yaml").size()) + "_coverage.png";
       io::WriteImage(pic, MultiCoveragePicture(r, static_cast<int>(i)));
       std::cout << "wrote " << pic << "\n";
     }

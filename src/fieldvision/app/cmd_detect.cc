@@ -1,4 +1,5 @@
 // `fieldvision detect`: ball candidates in every frame of one camera's video (detect_video.h).
+#include <charconv>
 #include <iostream>
 
 #include "fieldvision/app/ball_options.h"
@@ -7,6 +8,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
 #include "fieldvision/io/output_path.h"
+#include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -37,12 +39,16 @@ void Setup(CLI::App& app, int& exit_code) {
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)")
-      ->check(CLI::Range(-1, 1000000000) & CLI::Validator(
-                                               [](const std::string& v) {
-                                                 return v == "0" ? "0 frames: give -1 (all) or more"
-                                                                 : "";
-                                               },
-                                               "-1 or > 0"));
+      ->check(CLI::Validator(
+          [](const std::string& v) -> std::string {
+            long long n = 0;
+            const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+            const bool whole = ec == std::errc() && end == v.data() + v.size();
+            return whole && (n == -1 || (n > 0 && n <= 1000000000))
+                       ? ""
+                       : "'" + v + "': give -1 (all frames) or a count from 1";
+          },
+          "-1 or > 0"));
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     // The field mask is the field seen through a posed camera; without one --field did nothing.
@@ -50,7 +56,13 @@ void Setup(CLI::App& app, int& exit_code) {
         o->field.empty() || (!o->camera.empty() && camera::ReadCameraYaml(o->camera).has_pose),
         "detect: --field needs --camera with a pose (the field is found through it)");
     io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
-    io::CheckOutputPath(o->draw, io::PathList(o->video, o->camera, o->field, o->out), "--draw");
+    const auto inputs = io::PathList(o->video, o->camera, o->field, o->out);
+    io::CheckOutputPath(o->draw, inputs, "--draw");
+    if (io::IsVideoName(o->draw)) {
+      // Without an H.264 encoder a .mp4 is written as .avi: that name must spare the inputs too.
+      io::CheckOutputPath(io::FallbackVideoPath(o->draw), inputs, "--draw");
+      io::ResolveOutputPath(o->draw, "--draw");  // not a folder or a device
+    }
     ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";

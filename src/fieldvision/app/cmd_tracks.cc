@@ -72,6 +72,9 @@ void RunTracksDraw(const TracksDrawCli& c) {
     roster_in = track::RosterPathFor(c.tracks);
   }
   io::CheckOutputPath(c.out, {c.tracks, c.video, c.camera, c.field, roster_in});
+  // Without an H.264 encoder a .mp4 is written as .avi: that name must spare the inputs too.
+  io::CheckOutputPath(io::FallbackVideoPath(c.out),
+                      {c.tracks, c.video, c.camera, c.field, roster_in});
   io::ResolveOutputPath(c.out);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   std::optional<camera::Camera> camera;

@@ -239,8 +239,9 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
       FV_REQUIRE(!table.at("fisheye").boolean,
                  "{}: fisheye cameras are not supported (OpenCV's pinhole model only)", where);
     }
-    c.distortion = table.count("distortions") ? Numbers(table.at("distortions"), where)
-                                              : std::vector<double>{};
+    c.distortion = table.count("distortions")
+                       ? Numbers(table.at("distortions"), where + " distortions")
+                       : std::vector<double>{};
     if (!c.distortion.empty() && c.distortion.size() < 4) c.distortion.resize(4, 0.0);
     if (c.distortion.size() > 5 && c.distortion.size() < 8) c.distortion.resize(8, 0.0);
     if (table.count("rotation") && table.count("translation")) {

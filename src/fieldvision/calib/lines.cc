@@ -297,13 +297,19 @@ LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::
   LineErrorStats s;
   s.gate_m = gate_m;
   std::vector<double> mm;
+  double truncated_sum_mm = 0.0;
   for (const auto& uv : pixels) {
     const auto g = GroundPoint(camera, uv);
-    if (!g || !OnField(field, *g, 0.0)) continue;
+    if (!g || !OnField(field, *g, 0.0)) {
+      truncated_sum_mm += 1000.0 * gate_m;
+      continue;
+    }
     ++s.num_pixels;
     const double d = field.DistanceToLineCentres(g->head<2>());
+    truncated_sum_mm += 1000.0 * std::min(d, gate_m);
     if (d <= gate_m) mm.push_back(1000.0 * d);
   }
+  if (!pixels.empty()) s.truncated_mean_mm = truncated_sum_mm / static_cast<double>(pixels.size());
   s.num_inliers = static_cast<int>(mm.size());
   if (!mm.empty()) {
     s.mean_mm = util::Mean(mm);
@@ -311,11 +317,6 @@ LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::
     s.p95_mm = util::NearestRankPercentile(mm, 0.95);
   }
   return s;
-}
-
-double LineErrorStats::TruncatedMeanMm() const {
-  if (num_pixels == 0) return 0.0;
-  return (mean_mm * num_inliers + 1000.0 * gate_m * (num_pixels - num_inliers)) / num_pixels;
 }
 
 void RefineOptions::Check() const {
@@ -434,11 +435,11 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
   const LineErrorStats after = LineError(refined, pixels, field, options.gate_m);
   // The robust cost can fall while the line error the user sees rises (an exact pose moved by
   // the lines' own noise): such a pose is no refinement.
-  if (result.status.empty() && after.TruncatedMeanMm() > result.before.TruncatedMeanMm()) {
+  if (result.status.empty() && after.truncated_mean_mm > result.before.truncated_mean_mm) {
     result.status = fmt::format(
-        "the line error would rise ({:.1f} -> {:.1f} mm over the {} line "
-        "pixels on the field, each at most {:.0f} mm)",
-        result.before.TruncatedMeanMm(), after.TruncatedMeanMm(), after.num_pixels,
+        "the line error would rise (mean {:.1f} -> {:.1f} mm, {} -> {} line pixels within {:.0f} "
+        "mm of a line)",
+        result.before.mean_mm, after.mean_mm, result.before.num_inliers, after.num_inliers,
         1000.0 * options.gate_m);
   }
   if (result.status.empty()) {

@@ -79,9 +79,9 @@ struct LineErrorStats {
   double p95_mm = 0.0;
   double median_mm = 0.0;
   double gate_m = 0.0;
-  // Over every line pixel on the field, each at most gate_m: compares two poses that take
-  // different pixels within the gate (0 without pixels).
-  double TruncatedMeanMm() const;
+  // Over every line pixel given, each at most gate_m (a pixel off the field or above the
+  // horizon counts gate_m): compares two poses on the same pixels (0 without pixels).
+  double truncated_mean_mm = 0.0;
   std::string Summary() const;
 };
 

@@ -116,17 +116,16 @@ TEST(Refine, AnExactPoseIsKeptWhenRefiningWouldRaiseTheLineError) {
   const camera::Camera& truth = scene.cameras()[0];
   const auto pixels = DetectLinePixels(scene.Render(0)[0], truth, scene.field());
   const RefineResult r = RefineWithLinePixels(truth, pixels, scene.field());
-  EXPECT_LE(r.after.TruncatedMeanMm(), r.before.TruncatedMeanMm()) << r.Summary();
+  // The line error never rises (without the rule it did at the default seed: 4.4 -> 4.6 mm,
+  // the camera moved 1.6 mm off the truth); a kept pose says why and is the true one.
+  EXPECT_LE(r.after.truncated_mean_mm, r.before.truncated_mean_mm) << r.Summary();
   if (!r.accepted) {
     EXPECT_THAT(r.status, HasSubstr("line error would rise"));
     EXPECT_EQ((r.camera.CentreInWorld() - truth.CentreInWorld()).norm(), 0.0);
   }
-  LineErrorStats s;
-  s.num_pixels = 4;
-  s.num_inliers = 3;
-  s.mean_mm = 10.0;
-  s.gate_m = 0.5;
-  EXPECT_DOUBLE_EQ(s.TruncatedMeanMm(), (30.0 + 500.0) / 4);
+  // Every pixel counts, one off the field at the gate.
+  const std::vector<Eigen::Vector2d> sky = {{640.0, 5.0}};
+  EXPECT_DOUBLE_EQ(LineError(truth, sky, scene.field()).truncated_mean_mm, 500.0);
 }
 
 // A 60 degree camera of the given size at (-15, -12, 7) m looking at the field's centre.

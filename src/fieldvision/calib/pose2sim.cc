@@ -76,12 +76,16 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
         t.at("r32"), t.at("r33");
     // A rotation: orthonormal, determinant +1 (a mistyped entry makes the camera's centre, R^T
     // times the position, land metres off).
-    FV_REQUIRE((r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-3 &&
-                   r.determinant() > 0,
+    const double off_identity =
+        (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    FV_REQUIRE(off_identity < 1e-3,
                "Qualisys calibration '{}': camera {}'s transform r11..r33 is not a rotation "
                "(R R^T differs from the identity by {:.3g})",
-               path, (*it)[1].str(),
-               (r * r.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff());
+               path, (*it)[1].str(), off_identity);
+    FV_REQUIRE(r.determinant() > 0,
+               "Qualisys calibration '{}': camera {}'s transform r11..r33 mirrors (determinant "
+               "{:.3g}): not a rotation",
+               path, (*it)[1].str(), r.determinant());
     const Eigen::Vector3d position_m(t.at("x") / 1000, t.at("y") / 1000, t.at("z") / 1000);
     const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
     c.has_pose = true;

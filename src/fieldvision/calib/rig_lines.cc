@@ -154,15 +154,16 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<camera::Camera>& rig,
   result.rotated_deg = rvec.norm() * 180.0 / M_PI;
   result.status = LineRefinementRefusal(result.moved_m, options.max_move_m, result.initial_cost,
                                         result.final_cost, /*rig=*/true);
-  // As for one camera (lines.cc): no move that raises the line error the user sees, summed over
-  // the cameras' line pixels on the field.
+  // As for one camera (lines.cc): no move that raises the line error, over all the cameras'
+  // line pixels (each at most the gate; those off the field count the gate).
   std::vector<LineErrorStats> after = result.before;
   double sum_before = 0.0, sum_after = 0.0;
   for (size_t i = 0; i < rig.size(); ++i) {
     if (pixels[i].empty()) continue;
     after[i] = LineError(refined[i], pixels[i], field, options.gate_m);
-    sum_before += result.before[i].TruncatedMeanMm() * result.before[i].num_pixels;
-    sum_after += after[i].TruncatedMeanMm() * after[i].num_pixels;
+    const auto n = static_cast<double>(pixels[i].size());
+    sum_before += result.before[i].truncated_mean_mm * n;
+    sum_after += after[i].truncated_mean_mm * n;
   }
   if (result.status.empty() && sum_after > sum_before) {
     result.status = "the line error would rise (summed over the cameras' line pixels)";

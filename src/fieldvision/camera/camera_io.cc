@@ -5,10 +5,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <opencv2/core.hpp>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::camera {
 namespace {
@@ -144,9 +146,14 @@ void CheckOpenCvYamlText(const std::string& path, const std::string& what) {
 Camera ReadCameraYaml(const std::string& path) {
   FV_REQUIRE(std::filesystem::is_regular_file(path), "camera file '{}' does not exist", path);
   CheckOpenCvYamlText(path, "camera file");
+  // Read as text, without a UTF-8 byte-order mark (Windows Notepad writes one; OpenCV's parser
+  // refuses the file then).
+  std::ifstream in(path, std::ios::binary);
+  util::SkipUtf8Bom(in);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   cv::FileStorage fs;
   try {
-    fs.open(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
     FV_REQUIRE(fs.isOpened(), "camera file '{}' cannot be read as OpenCV YAML", path);
     FV_REQUIRE(fs.root().isMap(), "camera file '{}' is not a map of keys", path);
     return ReadCameraYamlFrom(fs, path);

@@ -1,6 +1,7 @@
 #include "fieldvision/camera/camera.h"
 
 #include <fstream>
+#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -171,6 +172,11 @@ TEST(CameraIo, YamlRoundTrip) {
   fs["rvec"] >> rvec;
   EXPECT_EQ(k.rows, 3);
   EXPECT_EQ(rvec.total(), 3u);
+  // Saved again by an editor that puts a UTF-8 byte-order mark first (Windows Notepad).
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  std::ofstream(path, std::ios::binary) << "\xEF\xBB\xBF" << text.str();
+  EXPECT_DOUBLE_EQ(ReadCameraYaml(path).fx, cam.fx);
 }
 
 TEST(CameraIo, ReadsOpenCvSampleCalibration) {

@@ -22,11 +22,6 @@
 namespace fv::detect {
 namespace {
 
-bool IsVideoPath(const std::string& path) {
-  const std::string p = util::ToLower(path);
-  return util::EndsWith(p, ".avi") || util::EndsWith(p, ".mp4") || util::EndsWith(p, ".mkv");
-}
-
 // The field's far edge the off-field check used (BallDetector::OffFieldBoundary), labelled.
 void DrawFieldBoundary(cv::Mat& bgr, const FieldBoundary& boundary) {
   if (!boundary.valid()) return;
@@ -170,10 +165,11 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   cv::Mat legend;  // below each drawn frame, made again only for a frame of another width
   if (!o.draw.empty()) {
     legend = CandidateLegend(source->width());
-    if (IsVideoPath(o.draw)) {
+    if (io::IsVideoName(o.draw)) {
       const double fps = source->fps() > 0 ? source->fps() : 30.0;
       // The frame and, below it, the legend.
-      writer.emplace(o.draw, fps, cv::Size(source->width(), source->height() + legend.rows));
+      writer.emplace(o.draw, fps, cv::Size(source->width(), source->height() + legend.rows),
+                     "--draw");
     } else {
       std::error_code ec;
       std::filesystem::create_directories(o.draw, ec);

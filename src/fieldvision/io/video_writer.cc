@@ -9,6 +9,7 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "fieldvision/codecs/codecs.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -31,13 +32,6 @@ bool TryOpen(cv::VideoWriter* w, const std::string& path, int fourcc, double fps
   return ok;
 }
 
-// `dir/name.ext` -> `dir/.name.tmp.ext` (the container is chosen by the extension).
-std::string TempPathFor(const std::string& path) {
-  const fs::path p(path);
-  return (p.parent_path() / fmt::format(".{}.tmp{}", p.stem().string(), p.extension().string()))
-      .string();
-}
-
 }  // namespace
 
 bool H264Available() {
@@ -58,47 +52,56 @@ bool H264Available() {
   return kAvailable;
 }
 
+bool IsVideoName(const std::string& path) {
+  const std::string ext = util::ToLower(fs::path(path).extension().string());
+  return ext == ".mp4" || ext == ".avi" || ext == ".mkv";
+}
+
 void CheckVideoPath(const std::string& path, std::string_view what) {
   const std::string ext = util::ToLower(fs::path(path).extension().string());
-  FV_REQUIRE(ext == ".mp4" || ext == ".avi" || ext == ".mkv",
-             "{} '{}': a video's name ends in .mp4, .avi or .mkv{}", what, path,
+  FV_REQUIRE(IsVideoName(path), "{} '{}': a video's name ends in .mp4, .avi or .mkv{}", what, path,
              ext.empty() ? "" : fmt::format(" (not {})", ext));
 }
 
-PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size)
+std::string FallbackVideoPath(const std::string& path) {
+  if (util::ToLower(fs::path(path).extension().string()) != ".mp4") return path;
+  return fs::path(path).replace_extension(".avi").string();
+}
+
+PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size,
+                                         std::string_view what)
     : writer_(codecs::NewVideoWriter()), size_(size) {
-  CheckVideoPath(path, "video");
-  FV_REQUIRE(fps > 0 && std::isfinite(fps), "video '{}': frame rate must be positive (got {})",
+  CheckVideoPath(path, what);
+  FV_REQUIRE(fps > 0 && std::isfinite(fps), "{} '{}': frame rate must be positive (got {})", what,
              path, fps);
-  FV_REQUIRE(size.width > 0 && size.height > 0, "video '{}': empty frame size", path);
+  FV_REQUIRE(size.width > 0 && size.height > 0, "{} '{}': empty frame size", what, path);
   path_ = path;
-  const bool mp4 = util::EndsWith(util::ToLower(path), ".mp4");
+  const bool mp4 = FallbackVideoPath(path) != path;
   if (mp4 && H264Available()) {
-    tmp_ = TempPathFor(path_);
-    if (TryOpen(writer_.get(), tmp_, codecs::FourCc('a', 'v', 'c', '1'), fps, size)) {
+    out_ = std::make_unique<AtomicOutput>(path_, what);
+    if (TryOpen(writer_.get(), out_->temp_path(), codecs::FourCc('a', 'v', 'c', '1'), fps, size)) {
       codec_ = "H.264";
       return;
     }
+    out_.reset();
   }
   if (mp4) {
-    path_ = fs::path(path).replace_extension(".avi").string();
+    path_ = FallbackVideoPath(path);
     note_ = fmt::format(
         "OpenCV's FFmpeg has no H.264 encoder here: wrote Motion-JPEG to '{}' instead (browsers do "
         "not play it; VLC or ffplay do)",
         path_);
   }
-  tmp_ = TempPathFor(path_);
-  FV_REQUIRE(TryOpen(writer_.get(), tmp_, codecs::FourCc('M', 'J', 'P', 'G'), fps, size),
-             "cannot write video '{}' (folder missing or not writable?)", path_);
+  // Beside the path (through a symlink to its target), unique per process, renamed at Close().
+  out_ = std::make_unique<AtomicOutput>(path_, what);
+  FV_REQUIRE(
+      TryOpen(writer_.get(), out_->temp_path(), codecs::FourCc('M', 'J', 'P', 'G'), fps, size),
+      "cannot write video '{}' (folder missing or not writable?)", path_);
   codec_ = "MJPG";
 }
 
 PlayableVideoWriter::~PlayableVideoWriter() {
-  if (!closed_) {
-    writer_->release();
-    std::error_code ec;
-    fs::remove(tmp_, ec);
-  }
+  if (!closed_) writer_->release();  // out_ then removes the temporary file
 }
 
 void PlayableVideoWriter::Write(const cv::Mat& bgr) {
@@ -113,9 +116,7 @@ void PlayableVideoWriter::Close() {
   if (closed_) return;
   writer_->release();
   closed_ = true;
-  std::error_code ec;
-  fs::rename(tmp_, path_, ec);
-  FV_REQUIRE(!ec, "cannot write video '{}' ({})", path_, ec.message());
+  out_->Commit();  // throws naming path_; the temporary file goes with out_
 }
 
 }  // namespace fv::io

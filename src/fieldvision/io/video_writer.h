@@ -1,7 +1,8 @@
 // Writing a video that plays where users look at it: H.264 in MP4 when the path ends in .mp4 and
 // OpenCV's FFmpeg has the encoder (browsers play it), else Motion-JPEG (a .mp4 path then becomes
-// .avi; .avi and .mkv keep their container). Frames go to a temporary file beside the path,
-// renamed to it by Close(): a run that fails leaves an existing file as it was. OpenCV's own log
+// .avi; .avi and .mkv keep their container). Frames go to a temporary file beside the path
+// (io::AtomicOutput: through a symlink, never onto a folder), renamed to it by Close(): a run
+// that fails leaves an existing file as it was. OpenCV's own log
 // lines about a missing encoder are kept from the terminal (an expected outcome here).
 #pragma once
 
@@ -12,13 +13,17 @@
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/io/output_path.h"
+
 namespace fv::io {
 
 class PlayableVideoWriter {
  public:
   // Throws fv::Error naming the path when it is no video's name (CheckVideoPath), no writer
   // opens, the frame rate is not positive or the size is empty.
-  PlayableVideoWriter(const std::string& path, double fps, cv::Size size);
+  // `what` names the path in errors (an option such as "--draw").
+  PlayableVideoWriter(const std::string& path, double fps, cv::Size size,
+                      std::string_view what = "video");
   ~PlayableVideoWriter();  // without Close(): the temporary file is removed
   PlayableVideoWriter(const PlayableVideoWriter&) = delete;
   PlayableVideoWriter& operator=(const PlayableVideoWriter&) = delete;
@@ -33,7 +38,8 @@ class PlayableVideoWriter {
 
  private:
   std::unique_ptr<cv::VideoWriter> writer_;  // made by the codecs plugin
-  std::string path_, tmp_, codec_, note_;
+  std::unique_ptr<AtomicOutput> out_;        // the temporary file beside path_
+  std::string path_, codec_, note_;
   cv::Size size_;
   int frames_ = 0;
   bool closed_ = false;
@@ -42,9 +48,13 @@ class PlayableVideoWriter {
 // Whether OpenCV's FFmpeg backend can write H.264 MP4 here (tried once on a tiny file).
 bool H264Available();
 
-// Throws fv::Error naming `what` and `path` unless the path ends in .mp4, .avi or .mkv (any
-// case): the writer picks the container by it, and another name (an image, a pattern) would be
-// written as something else or fail at the end of a run.
+// Whether the path ends in .mp4, .avi or .mkv (any case): the writer picks the container by it.
+bool IsVideoName(const std::string& path);
+// Throws fv::Error naming `what` and `path` unless IsVideoName: another name (an image, a
+// pattern) would be written as something else or fail at the end of a run.
 void CheckVideoPath(const std::string& path, std::string_view what);
+// The file a writer of `path` writes where OpenCV has no H.264 encoder: a .mp4 path as .avi, any
+// other as it is (callers check it against their inputs too).
+std::string FallbackVideoPath(const std::string& path);
 
 }  // namespace fv::io

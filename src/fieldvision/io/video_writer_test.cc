@@ -57,6 +57,27 @@ TEST(PlayableVideoWriter, AnExistingFileIsReplacedOnlyByAClosedVideo) {
   EXPECT_EQ(read, 3);
 }
 
+// A symlink is written through (the link stays, its target gets the video); a folder is refused
+// before any frame, naming it.
+TEST(PlayableVideoWriter, WritesThroughASymlinkAndRefusesAFolder) {
+  const std::string dir = testing::TempDir();
+  std::ofstream(dir + "/real.avi") << "old";
+  fs::create_symlink(dir + "/real.avi", dir + "/link.avi");
+  PlayableVideoWriter w(dir + "/link.avi", 25, {64, 48});
+  w.Write(TestFrame(0));
+  w.Close();
+  EXPECT_TRUE(fs::is_symlink(dir + "/link.avi"));
+  EXPECT_NE(FirstLine(dir + "/real.avi"), "old");
+  fs::create_directories(dir + "/folder.mp4");
+  const std::string e = testing::ErrorOf([&] {
+    PlayableVideoWriter(dir + "/folder.mp4", 25, {64, 48}, "--draw");
+  });
+  EXPECT_NE(e.find("--draw"), std::string::npos) << e;
+  EXPECT_NE(e.find("folder.mp4"), std::string::npos) << e;
+  EXPECT_EQ(FallbackVideoPath(dir + "/a.MP4"), dir + "/a.avi");
+  EXPECT_EQ(FallbackVideoPath(dir + "/a.mkv"), dir + "/a.mkv");
+}
+
 // A .mp4 path gets H.264 where OpenCV's FFmpeg has an encoder, else Motion-JPEG as .avi with a
 // note saying so (browsers do not play MPEG-4 Part 2 or Motion-JPEG in MP4).
 TEST(PlayableVideoWriter, Mp4IsH264OrSaysWhyNot) {

@@ -319,7 +319,7 @@ NodeSummary RunNode(const NodeOptions& o) {
     hints.emplace(1, pipeline::BallHintOptions(), /*wait=*/false);
     // Hints arrive only while the fusion node has a position, and not at all when its hints are
     // off: their absence says nothing (no unconfirmed whole-frame searches).
-    stage.SetHints(&*hints, /*silence_unconfirms=*/false);
+    stage.SetHints(&*hints, /*no_hint_means_unconfirmed=*/false);
   }
 
   NodeSummary summary;

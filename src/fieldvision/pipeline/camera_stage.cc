@@ -247,7 +247,7 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
 
 bool CameraStage::UnconfirmedScan() {
   const int every = track_->unconfirmed_scan_every();
-  if (hints_ == nullptr || !silence_unconfirms_ || every == 0 || unconfirmed_ < every) {
+  if (hints_ == nullptr || !no_hint_means_unconfirmed_ || every == 0 || unconfirmed_ < every) {
     return false;
   }
   unconfirmed_ = 0;

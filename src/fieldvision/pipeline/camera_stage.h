@@ -92,12 +92,12 @@ class CameraStage {
   // without candidates; a frame of another size than the camera's throws fv::Error.
   CameraMessage Process(const io::SourceFrame& frame);
   // The fusion's hints for this camera (null: none; not owned, must outlive the stage's use).
-  // `silence_unconfirms`: a board without a recent position means the cameras together have
+  // `no_hint_means_unconfirmed`: a board without a recent position means the cameras together have
   // none (the in-process fusion publishes every position), so unconfirmed_scan_every applies; a
   // camera node cannot tell a fusion node that sends no hints from one without a position.
-  void SetHints(BallHintBoard* hints, bool silence_unconfirms = true) {
+  void SetHints(BallHintBoard* hints, bool no_hint_means_unconfirmed = true) {
     hints_ = hints;
-    silence_unconfirms_ = silence_unconfirms;
+    no_hint_means_unconfirmed_ = no_hint_means_unconfirmed;
   }
   const CameraStageStats& stats() const { return stats_; }
 
@@ -122,7 +122,7 @@ class CameraStage {
   BallHintBoard* hints_ = nullptr;
   double last_time_s_ = 0.0;
   int unconfirmed_ = 0;  // frames in a row without a recent fused position (with hints)
-  bool silence_unconfirms_ = true;
+  bool no_hint_means_unconfirmed_ = true;
   std::string source_name_;
   std::unique_ptr<Track> track_;
   io::JpegRegionDecoder decoder_;

@@ -164,6 +164,10 @@ void MotOptions::Check() const {
   FV_REQUIRE(std::abs(frame_offset) <= 1000000, "frame_offset {} is out of range", frame_offset);
 }
 
+// The share of the ground truth's frames outside the estimate's span above which Summary notes
+// that the estimate may be of a clip.
+constexpr double kClipShare = 0.1;
+
 std::string MotPreprocessing::Summary() const {
   std::string s = fmt::format(
       "left out: {} ground-truth boxes (conf 0 or not a pedestrian), {} estimated boxes on "
@@ -172,10 +176,11 @@ std::string MotPreprocessing::Summary() const {
   if (gt_outside_est_frames > 0 && gt_clipped) {
     s += fmt::format(", {} ground-truth boxes outside the estimate's frames {}..{}",
                      gt_outside_est_frames, est_first, est_last);
-  } else if (gt_outside_est_frames > 0) {
+  } else if (gt_frames_outside_est > kClipShare * gt_frames) {
+    // A clip, not a tracker's warm-up or a track lost near the end.
     s += fmt::format(
         "; NOTE: the estimate covers frames {}..{} only: {} ground-truth boxes outside them count "
-        "as misses (--est-frames scores those frames only)",
+        "as misses (if the estimate is of a clip, --est-frames scores its frames only)",
         est_first, est_last, gt_outside_est_frames);
   }
   if (best_offset != 0 && iou_at_best > 1.02 * iou_at_zero) {
@@ -328,6 +333,13 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
       return r.frame < p.est_first || r.frame > p.est_last;
     };
     p.gt_outside_est_frames = static_cast<int>(std::count_if(gt.begin(), gt.end(), outside));
+    std::set<int> frames, frames_outside;
+    for (const TrackRow& r : gt) {
+      frames.insert(r.frame);
+      if (outside(r)) frames_outside.insert(r.frame);
+    }
+    p.gt_frames = static_cast<int>(frames.size());
+    p.gt_frames_outside_est = static_cast<int>(frames_outside.size());
     p.gt_clipped = o.clip_to_est_frames;
     if (o.clip_to_est_frames) std::erase_if(gt, outside);
   }

@@ -65,10 +65,11 @@ struct MotPreprocessing {
   int est_on_distractors = 0;  // estimated boxes matched to a distractor (MOT17 rules)
   int est_outside_gt_frames = 0;
   // Ground-truth boxes in frames outside the estimate's first..last frame (est_first..est_last,
-  // after frame_offset): left out with clip_to_est_frames, else counted as misses (Summary says
-  // so: a clip scored against a whole video's ground truth).
+  // after frame_offset): left out with clip_to_est_frames, else counted as misses (Summary notes
+  // it when over a tenth of the ground truth's frames lie outside: a clip of the video).
   int gt_outside_est_frames = 0;
   int est_first = 0, est_last = 0;
+  int gt_frames = 0, gt_frames_outside_est = 0;  // ground-truth frames with boxes, and outside
   bool gt_clipped = false;
   // The frame offset (added to the estimate) whose matches (IoU >= 0.5) have the largest summed
   // IoU, tried over -2..2, and the sums at offset 0 and at that one: a 0-based file scored

@@ -65,6 +65,12 @@ TEST(Mot, AnEstimateOfAClipIsNotedOrScoredOverItsFrames) {
   EXPECT_EQ(scored.frames, 15);
   EXPECT_THAT(scored.preprocessing.Summary(), ::testing::Not(HasSubstr("NOTE")));
   EXPECT_EQ(EvaluateMot(gt, gt, o).preprocessing.gt_outside_est_frames, 0);
+  // A tracker's warm-up (nothing in the first 3 of 50 frames) is no clip: no note.
+  std::vector<TrackRow> late;
+  for (const auto& r : gt) {
+    if (r.frame >= 3) late.push_back(r);
+  }
+  EXPECT_THAT(EvaluateMot(gt, late).preprocessing.Summary(), ::testing::Not(HasSubstr("NOTE")));
 }
 
 TEST(Mot, CountsMissesFalsePositivesAndSwitches) {

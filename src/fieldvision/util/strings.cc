@@ -49,8 +49,9 @@ std::string ToLower(std::string_view s) {
 std::string FileNamePart(std::string_view s) {
   std::string out(s);
   for (char& c : out) {
-    const bool keep =
-        std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
+    // Bytes of UTF-8 sequences (>= 0x80) are never '/' or '.': names in any script stay.
+    const auto b = static_cast<unsigned char>(c);
+    const bool keep = b >= 0x80 || std::isalnum(b) || c == '-' || c == '_' || c == '.';
     if (!keep) c = '_';
   }
   // Not a hidden file: leading dots become '_' too.

@@ -15,8 +15,8 @@ std::string Trim(std::string_view s);
 bool StartsWith(std::string_view s, std::string_view prefix);
 bool EndsWith(std::string_view s, std::string_view suffix);
 std::string ToLower(std::string_view s);
-// `s` as part of a file name: letters, digits, '-', '_' and '.' kept, every other byte and
-// leading dots '_' (so never a path, nor a hidden file).
+// `s` as part of a file name: ASCII letters, digits, '-', '_', '.' and non-ASCII (UTF-8) bytes
+// kept, every other byte and leading dots '_' (so never a path, nor a hidden file).
 std::string FileNamePart(std::string_view s);
 // Skips a UTF-8 byte-order mark at the stream's start (spreadsheets write one before a CSV's
 // header: "CSV UTF-8" in Excel); other bytes are left unread.

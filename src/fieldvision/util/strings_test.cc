@@ -19,6 +19,7 @@ TEST(FileNamePart, KeepsSafeCharactersOnly) {
   EXPECT_EQ(FileNamePart("cam-1_a.b"), "cam-1_a.b");
   EXPECT_EQ(FileNamePart("../a b/c\\d:e"), "___a_b_c_d_e");
   EXPECT_EQ(FileNamePart(".hidden.x"), "_hidden.x");
+  EXPECT_EQ(FileNamePart("\u5de6 cam"), "\u5de6_cam");  // a name in another script stays
   EXPECT_EQ(FileNamePart(""), "");
 }
 
