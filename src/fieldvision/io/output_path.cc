@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 #include "fieldvision/util/csv.h"
@@ -106,6 +107,18 @@ void AtomicWrite(const std::string& out, const std::function<void(const std::str
     file.Rethrow(e);
   }
   file.Commit();
+}
+
+void WriteTextFile(const std::string& out, std::string_view text, std::string_view what) {
+  AtomicWrite(
+      out,
+      [&](const std::string& temp_path) {
+        std::ofstream f(temp_path, std::ios::binary);
+        f << text;
+        f.close();
+        FV_REQUIRE(!f.fail(), "cannot write {} '{}'", what, out);
+      },
+      what);
 }
 
 NewFolder::NewFolder(const std::string& path, std::string_view what) : path_(path) {

@@ -97,4 +97,8 @@ class AtomicOutput {
 void AtomicWrite(const std::string& out, const std::function<void(const std::string&)>& write,
                  std::string_view what = "--out");
 
+// `text` as the whole file `out`, through AtomicWrite; throws fv::Error naming `what` and `out`
+// when it cannot be written.
+void WriteTextFile(const std::string& out, std::string_view text, std::string_view what);
+
 }  // namespace fv::io

@@ -170,5 +170,24 @@ TEST(NewFolder, MadeRequiredEmptyAndRemovedUnlessKept) {
   EXPECT_EQ(e2.find('\n'), std::string::npos) << e2;
 }
 
+// A whole text file through AtomicWrite: written, replaced whole, and a folder or a missing
+// folder refused naming what it is, leaving nothing beside it.
+TEST(WriteTextFile, WritesWholeOrNothingNamingWhatItIs) {
+  const std::string dir = testing::TempDir();
+  const std::string path = dir + "/rig.json";
+  WriteTextFile(path, "{}\n", "rig file");
+  EXPECT_EQ(ReadText(path), "{}\n");
+  WriteTextFile(path, "{\"cameras\": []}\n", "rig file");
+  EXPECT_EQ(ReadText(path), "{\"cameras\": []}\n");
+  fs::create_directories(dir + "/folder.json");
+  const std::string folder =
+      testing::ErrorOf([&] { WriteTextFile(dir + "/folder.json", "x", "rig file"); });
+  EXPECT_NE(folder.find("rig file"), std::string::npos) << folder;
+  const std::string missing =
+      testing::ErrorOf([&] { WriteTextFile(dir + "/no/such/rig.json", "x", "rig file"); });
+  EXPECT_NE(missing.find("rig.json"), std::string::npos) << missing;
+  EXPECT_EQ(CountFiles(dir), 2);  // rig.json and folder.json
+}
+
 }  // namespace
 }  // namespace fv::io

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/io/image_file.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
@@ -210,11 +211,8 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   }
   WriteCoverageMaps(options, field, result);
   const std::string json_path = OutPath(options, "coverage.json");
-  {
-    std::ofstream f(json_path);
-    FV_REQUIRE(f.good(), "cannot write '{}'", json_path);
-    f << CoverageJson(result, field, options).dump(2) << "\n";
-  }
+  io::WriteTextFile(json_path, CoverageJson(result, field, options).dump(2) + "\n",
+                    "coverage file");
   result.files.push_back(json_path);
   summary += fmt::format("wrote {} files to {}\n", result.files.size(), options.out_dir);
   result.summary = summary;

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
@@ -235,10 +236,7 @@ json RigToJson(const Rig& rig) {
 }
 
 void WriteRigJson(const Rig& rig, const std::string& path) {
-  std::ofstream out(path);
-  FV_REQUIRE(out.good(), "cannot write rig file '{}'", path);
-  out << RigToJson(rig).dump(2) << "\n";
-  FV_REQUIRE(out.good(), "cannot write rig file '{}'", path);
+  io::WriteTextFile(path, RigToJson(rig).dump(2) + "\n", "rig file");
 }
 
 Rig RigFromCameraFiles(const std::vector<std::string>& paths) {

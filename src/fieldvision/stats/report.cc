@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/io/image_file.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/overlay.h"
@@ -432,8 +434,7 @@ nlohmann::json StatsJson(const StatsResult& r, const StatsOptions& o, const Repo
 void WriteIndexHtml(const std::string& path, const ReportParts& rp, const ReportFiles& files) {
   const StatsResult& r = rp.r;
   const StatsOptions& o = rp.o;
-  std::ofstream h(path);
-  FV_REQUIRE(h.good(), "cannot write '{}'", path);
+  std::ostringstream h;
   h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>fieldvision stats</title>"
        "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
        "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}th{background:#eee}"
@@ -499,6 +500,7 @@ void WriteIndexHtml(const std::string& path, const ReportParts& rp, const Report
   h << "</div>\n<h3>Per player</h3>\n<div class=\"maps\">";
   for (int id : rp.player_maps) h << fmt::format("<img src=\"heatmap_player{}.png\">", id);
   h << "</div>\n" << kSortScript << "</body></html>\n";
+  io::WriteTextFile(path, h.str(), "report page");
 }
 
 }  // namespace
@@ -523,9 +525,7 @@ ReportFiles WriteStatsReport(const StatsResult& r, const field::FieldModel& fiel
   {
     const nlohmann::json j = StatsJson(r, o, files);
     const std::string path = out_dir + "/stats.json";
-    std::ofstream out(path);
-    FV_REQUIRE(out.good(), "cannot write '{}'", path);
-    out << j.dump(2) << "\n";
+    io::WriteTextFile(path, j.dump(2) + "\n", "stats file");
     files.files.push_back(path);
   }
   WriteIndexHtml(out_dir + "/index.html", rp, files);

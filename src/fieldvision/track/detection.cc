@@ -11,6 +11,7 @@
 #include <opencv2/video/background_segm.hpp>
 
 #include "fieldvision/geometry/rigid.h"
+#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -86,17 +87,15 @@ std::vector<Detection> FilterDetections(std::vector<Detection> dets, const Detec
 }
 
 void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& path) {
-  std::ofstream out(path);
-  FV_REQUIRE(out.good(), "cannot write detections file '{}'", path);
+  std::string out;
   for (size_t f = 0; f < detections.frames.size(); ++f) {
     for (const Detection& d : detections.frames[f]) {
       // {} is the shortest text that reads back as the same double.
-      out << fmt::format("{},-1,{},{},{},{},{}\n", f + 1, d.box.x, d.box.y, d.box.width,
+      out += fmt::format("{},-1,{},{},{},{},{}\n", f + 1, d.box.x, d.box.y, d.box.width,
                          d.box.height, d.score);
     }
   }
-  out.close();
-  FV_REQUIRE(!out.fail(), "cannot write detections file '{}'", path);
+  io::WriteTextFile(path, out, "detections file");
 }
 
 DetectionsFile ReadDetectionsCsv(const std::string& path) {
