@@ -44,6 +44,10 @@ std::vector<camera::Camera> ReadCameraFolder(const std::string& dir, bool requir
   return cams;
 }
 
+std::string CameraNameOr(const camera::Camera& camera, size_t i) {
+  return camera.name.empty() ? fmt::format("cam{}", i + 1) : camera.name;
+}
+
 std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams,
                                          const std::string& dir, const std::string& what) {
   std::error_code ec;
@@ -53,7 +57,7 @@ std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams
   std::vector<std::string> paths;
   std::map<std::string, std::string> named;  // file -> the camera's name
   for (size_t i = 0; i < cams.size(); ++i) {
-    const std::string name = cams[i].name.empty() ? fmt::format("cam{}", i + 1) : cams[i].name;
+    const std::string name = CameraNameOr(cams[i], i);
     const std::string file = util::FileNamePart(name) + ".yaml";
     const auto [at, fresh] = named.emplace(file, name);
     FV_REQUIRE(fresh, "{} would both be written to '{}' in {} '{}': rename one",

@@ -19,7 +19,10 @@ std::vector<std::string> CameraFilesIn(const std::string& dir);
 // `dir` holds none or, with `require_pose`, when one has no pose.
 std::vector<camera::Camera> ReadCameraFolder(const std::string& dir, bool require_pose = false);
 
-// Where each camera's file goes in `dir`: NAME.yaml, NAME its name (else camN) made a safe file
+// Camera i's name, else "cam<i+1>".
+std::string CameraNameOr(const camera::Camera& camera, size_t i);
+
+// Where each camera's file goes in `dir`: NAME.yaml, NAME CameraNameOr made a safe file
 // name (util::FileNamePart: never a path, "../x" stays in `dir`). Throws naming `what` and `dir`
 // when `dir` is a file or two cameras would share a file; nothing is made.
 std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams,

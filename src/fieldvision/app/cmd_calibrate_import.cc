@@ -56,7 +56,7 @@ void WriteCameras(const std::vector<camera::Camera>& cams, const std::string& di
   std::filesystem::create_directories(dir, ec);
   FV_REQUIRE(std::filesystem::is_directory(dir), "cannot make folder --out '{}'", dir);
   for (size_t i = 0; i < cams.size(); ++i) {
-    const std::string name = cams[i].name.empty() ? fmt::format("cam{}", i + 1) : cams[i].name;
+    const std::string name = CameraNameOr(cams[i], i);
     const std::string& path = paths[i];
     camera::WriteCameraYaml(cams[i], path);
     const Eigen::Vector3d c = cams[i].has_pose ? cams[i].CentreInWorld() : Eigen::Vector3d::Zero();

@@ -57,11 +57,10 @@ void Setup(CLI::App& app, int& exit_code) {
         "detect: --field needs --camera with a pose (the field is found through it)");
     io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
     const auto inputs = io::PathList(o->video, o->camera, o->field, o->out);
-    io::CheckOutputPath(o->draw, inputs, "--draw");
     if (io::IsVideoName(o->draw)) {
-      // Without an H.264 encoder a .mp4 is written as .avi: that name must spare the inputs too.
-      io::CheckOutputPath(io::FallbackVideoPath(o->draw), inputs, "--draw");
-      io::ResolveOutputPath(o->draw, "--draw");  // not a folder or a device
+      io::CheckVideoOutput(o->draw, inputs, "--draw");
+    } else {
+      io::CheckOutputPath(o->draw, inputs, "--draw");  // a folder of JPEGs
     }
     ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);

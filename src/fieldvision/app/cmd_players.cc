@@ -182,20 +182,14 @@ void Setup(CLI::App& app, int& exit_code) {
                c->o.detections_in);
     const auto inputs = io::PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
     io::CheckOutputPath(c->out, inputs);
-    for (const auto& [out, what] : {std::pair{c->mot_out, "--mot-out"},
-                                    {c->draw, "--draw"},
-                                    {c->o.detections_out, "--save-detections"}}) {
+    for (const auto& [out, what] :
+         {std::pair{c->mot_out, "--mot-out"}, {c->o.detections_out, "--save-detections"}}) {
       io::CheckOutputPath(out, io::PathList(inputs, c->out), what);
     }
-    if (!c->draw.empty()) {
-      io::CheckVideoPath(c->draw, "--draw");
-      // Without an H.264 encoder a .mp4 is written as .avi: that name must spare the inputs too.
-      io::CheckOutputPath(io::FallbackVideoPath(c->draw), io::PathList(inputs, c->out), "--draw");
-    }
+    if (!c->draw.empty()) io::CheckVideoOutput(c->draw, io::PathList(inputs, c->out), "--draw");
     // A device, a folder or a missing folder as an output is refused before the run.
     for (const auto& [out, what] : {std::pair{c->out, "--out"},
                                     {c->mot_out, "--mot-out"},
-                                    {c->draw, "--draw"},
                                     {c->o.detections_out, "--save-detections"}}) {
       if (!out.empty()) io::ResolveOutputPath(out, what);
     }

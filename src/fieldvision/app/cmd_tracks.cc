@@ -65,17 +65,12 @@ struct TracksDrawCli {
 
 // The video with the (edited) tracks drawn: names from the roster, team colours.
 void RunTracksDraw(const TracksDrawCli& c) {
-  io::CheckVideoPath(c.out, "--out");
-  const auto rows = ReadTracks(c.tracks);
   std::string roster_in = c.roster_in;
   if (roster_in.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
     roster_in = track::RosterPathFor(c.tracks);
   }
-  io::CheckOutputPath(c.out, {c.tracks, c.video, c.camera, c.field, roster_in});
-  // Without an H.264 encoder a .mp4 is written as .avi: that name must spare the inputs too.
-  io::CheckOutputPath(io::FallbackVideoPath(c.out),
-                      {c.tracks, c.video, c.camera, c.field, roster_in});
-  io::ResolveOutputPath(c.out);
+  io::CheckVideoOutput(c.out, {c.tracks, c.video, c.camera, c.field, roster_in}, "--out");
+  const auto rows = ReadTracks(c.tracks);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   std::optional<camera::Camera> camera;
   if (!c.camera.empty()) {

@@ -68,6 +68,14 @@ std::string FallbackVideoPath(const std::string& path) {
   return fs::path(path).replace_extension(".avi").string();
 }
 
+void CheckVideoOutput(const std::string& path, const std::vector<std::string>& inputs,
+                      std::string_view what) {
+  CheckVideoPath(path, what);
+  CheckOutputPath(path, inputs, what);
+  CheckOutputPath(FallbackVideoPath(path), inputs, what);
+  ResolveOutputPath(path, what);
+}
+
 PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size,
                                          std::string_view what)
     : writer_(codecs::NewVideoWriter()), size_(size) {

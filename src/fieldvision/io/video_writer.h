@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
@@ -56,5 +57,10 @@ void CheckVideoPath(const std::string& path, std::string_view what);
 // The file a writer of `path` writes where OpenCV has no H.264 encoder: a .mp4 path as .avi, any
 // other as it is (callers check it against their inputs too).
 std::string FallbackVideoPath(const std::string& path);
+// The checks of a video output before a run, naming `what`: a video's name (CheckVideoPath),
+// neither it nor its FallbackVideoPath one of `inputs` (CheckOutputPath), not a folder or a
+// device (ResolveOutputPath).
+void CheckVideoOutput(const std::string& path, const std::vector<std::string>& inputs,
+                      std::string_view what);
 
 }  // namespace fv::io

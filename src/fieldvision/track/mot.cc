@@ -332,11 +332,12 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
     const auto outside = [&](const TrackRow& r) {
       return r.frame < p.est_first || r.frame > p.est_last;
     };
-    p.gt_outside_est_frames = static_cast<int>(std::count_if(gt.begin(), gt.end(), outside));
     std::set<int> frames, frames_outside;
     for (const TrackRow& r : gt) {
       frames.insert(r.frame);
-      if (outside(r)) frames_outside.insert(r.frame);
+      if (!outside(r)) continue;
+      ++p.gt_outside_est_frames;
+      frames_outside.insert(r.frame);
     }
     p.gt_frames = static_cast<int>(frames.size());
     p.gt_frames_outside_est = static_cast<int>(frames_outside.size());
