@@ -1,9 +1,11 @@
 #include "fieldvision/util/json.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -29,12 +31,42 @@ const json* Member(const json& obj, const std::string& key, const std::string& c
 
 }  // namespace
 
+int JsonNestingDepth(std::string_view text, int stop_above) {
+  int depth = 0, deepest = 0;
+  bool in_string = false, escaped = false;
+  for (const char ch : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (ch == '\\') {
+        escaped = true;
+      } else if (ch == '"') {
+        in_string = false;
+      }
+    } else if (ch == '"') {
+      in_string = true;
+    } else if (ch == '[' || ch == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > stop_above) break;
+    } else if (ch == ']' || ch == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
 json ReadJsonFile(const std::string& path, const std::string& what) {
   FV_REQUIRE(std::filesystem::is_regular_file(path), "{} file '{}' does not exist", what, path);
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   FV_REQUIRE(in.good(), "{} file '{}' cannot be read", what, path);
+  std::stringstream text;
+  text << in.rdbuf();
+  FV_REQUIRE(!in.bad(), "{} file '{}' cannot be read", what, path);
+  FV_REQUIRE(JsonNestingDepth(text.view()) <= kMaxJsonDepth,
+             "{} file '{}' nests arrays or objects deeper than {} levels", what, path,
+             kMaxJsonDepth);
   try {
-    return json::parse(in);
+    return json::parse(text.view());
   } catch (const json::parse_error& e) {
     Throw("{} file '{}' is not valid JSON (byte {})", what, path, e.byte);
   } catch (const json::exception& e) {

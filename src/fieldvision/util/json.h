@@ -6,6 +6,7 @@
 #include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -14,8 +15,16 @@
 namespace fv::util {
 
 // The JSON in the file at `path`; `what` names the file in errors ("rig file 'x' does not exist",
-// "... cannot be read", "... is not valid JSON (byte n)").
+// "... cannot be read", "... is not valid JSON (byte n)", "... nests deeper than ...").
 nlohmann::json ReadJsonFile(const std::string& path, const std::string& what);
+
+// nlohmann's parser is iterative, but copying and dumping a value recurse: a value nested a
+// million levels deep overflows the stack there. Readers of untrusted JSON (HTTP bodies, files)
+// refuse text nested deeper than this; the project's own files nest a few levels.
+inline constexpr int kMaxJsonDepth = 256;
+// The deepest nesting of arrays and objects in JSON text (brackets inside strings do not count);
+// it stops counting once past `stop_above`.
+int JsonNestingDepth(std::string_view text, int stop_above = kMaxJsonDepth);
 
 // "ctx.key", or "key" when ctx is empty: the context of a nested object.
 std::string JsonPath(const std::string& ctx, const std::string& key);

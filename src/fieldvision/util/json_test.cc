@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
@@ -71,6 +74,26 @@ TEST(Json, ErrorsNameTheFileAndTheKey) {
   ExpectNames(ErrorOf([&] { JsonNumbers(o, "x", f); }), {"'x'", "element 1", "not a number"});
   ExpectNames(ErrorOf([&] { JsonVectorOf<2>(json(3), "placements[4]"); }),
               {"placements[4]", "2 numbers"});
+}
+
+TEST(Json, NestingDepthIgnoresStringsAndDeepFilesAreRefused) {
+  EXPECT_EQ(JsonNestingDepth(R"({"a": [1, {"b": [[]]}]})"), 5);
+  EXPECT_EQ(JsonNestingDepth(R"({"a": "[[[{{{\"]]]"})"), 1);  // brackets in a string
+  EXPECT_EQ(JsonNestingDepth("3"), 0);
+  // Counting stops once past the limit it is given.
+  EXPECT_EQ(JsonNestingDepth(std::string(1000, '['), 10), 11);
+  const std::string path = ::testing::TempDir() + "fv_deep.json";
+  {
+    std::ofstream out(path);
+    out << std::string(100000, '[') << std::string(100000, ']');
+  }
+  ExpectNames(ErrorOf([&] { ReadJsonFile(path, "rig"); }), {"rig file", "fv_deep.json", "deeper"});
+  {
+    std::ofstream out(path);
+    out << "{\"a\": [[1]]}";
+  }
+  EXPECT_EQ(ReadJsonFile(path, "rig")["a"][0][0], 1);
+  std::remove(path.c_str());
 }
 
 TEST(Json, VectorWriterRoundTrips) {

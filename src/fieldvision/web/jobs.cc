@@ -21,11 +21,13 @@ namespace {
 const std::set<std::string> kCommands = {"ball", "trajectory", "players", "stats",
                                          "plan", "detect",     "synth"};
 // Options whose value is a file or folder the job reads (must exist) or writes.
-const std::set<std::string> kInputs = {"--camera",     "--video",      "--in",     "--tracks",
-                                       "--rig",        "--detections", "--truth",  "--zones",
-                                       "--timestamps", "--scene",      "--images", "--teams"};
-const std::set<std::string> kOutputs = {"--out", "--draw", "--save-detections", "--mot-out",
-                                        "--flights-dir"};
+const std::set<std::string> kInputs = {
+    "--camera", "--video",      "--in",    "--tracks", "--rig",    "--detections", "--truth",
+    "--zones",  "--timestamps", "--scene", "--teams",  "--mounts", "--onnx"};
+const std::set<std::string> kOutputs = {
+    "--out",         "--draw",    "--save-detections",  "--mot-out",
+    "--flights-dir", "--flights", "--write-detections", "--images",
+    "--report",      "--smoothed"};
 // Options whose value is a name or, when it looks like one, a file.
 const std::set<std::string> kNameOrFile = {"--color", "--field", "--model"};
 

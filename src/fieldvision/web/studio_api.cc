@@ -1,12 +1,15 @@
 #include "fieldvision/web/studio_api.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <regex>
 #include <sstream>
 #include <string_view>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -64,6 +67,10 @@ const std::string& Param(const ApiRequest& r, const std::string& name) {
 
 json Body(const ApiRequest& r) {
   if (r.body.empty()) throw HttpError(400, "request body is empty (expected JSON)");
+  if (util::JsonNestingDepth(r.body) > util::kMaxJsonDepth) {
+    throw HttpError(400, fmt::format("request body nests arrays or objects deeper than {} levels",
+                                     util::kMaxJsonDepth));
+  }
   try {
     json j = json::parse(r.body);
     if (!j.is_object()) throw HttpError(400, "request body is not a JSON object");
@@ -76,6 +83,16 @@ json Body(const ApiRequest& r) {
 template <typename T>
 T Get(const json& body, const std::string& key) {
   if (!body.contains(key)) throw HttpError(400, "missing key '" + key + "'");
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    // nlohmann converts 3.7 to 3 and 1e300 to whatever the cast gives.
+    const json& v = body.at(key);
+    const bool in_range = v.is_number_unsigned()  ? std::in_range<T>(v.get<uint64_t>())
+                          : v.is_number_integer() ? std::in_range<T>(v.get<int64_t>())
+                                                  : false;
+    if (!in_range) {
+      throw HttpError(400, "key '" + key + "' must be an integer in range");
+    }
+  }
   try {
     return body.at(key).get<T>();
   } catch (const json::exception&) {
@@ -1011,10 +1028,16 @@ std::vector<Route> JobRoutes() {
       {{"GET", "/api/json", "?path=F.json: a JSON file of the folder (FLIGHTS.json, ...)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const fs::path p = ws.Resolve(Param(r, "path"));
-         std::ifstream in(p);
+         std::ifstream in(p, std::ios::binary);
          if (!in) throw HttpError(404, "cannot read '" + Param(r, "path") + "'");
+         std::stringstream text;
+         text << in.rdbuf();
+         if (util::JsonNestingDepth(text.view()) > util::kMaxJsonDepth) {
+           throw HttpError(422, fmt::format("'{}' nests arrays or objects deeper than {} levels",
+                                            Param(r, "path"), util::kMaxJsonDepth));
+         }
          try {
-           return Json(json::parse(in));
+           return Json(json::parse(text.view()));
          } catch (const json::parse_error&) {
            throw HttpError(422, "'" + Param(r, "path") + "' is not valid JSON");
          }

@@ -1,5 +1,8 @@
 #include "fieldvision/web/studio_server.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
 #include <atomic>
 #include <csignal>
 #include <filesystem>
@@ -33,7 +36,11 @@ void StudioOptions::Check() const {
 }
 
 bool IsLoopback(const std::string& host) {
-  return host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+  if (host == "localhost" || host == "::1") return true;
+  // A dotted IPv4 literal in 127/8 only: a name such as 127.attacker.example can resolve to
+  // anything (DNS rebinding).
+  in_addr address{};
+  return inet_pton(AF_INET, host.c_str(), &address) == 1 && (ntohl(address.s_addr) >> 24) == 127;
 }
 
 namespace {

@@ -27,7 +27,7 @@ struct StudioOptions {
   void Check() const;
 };
 
-// True for 127.0.0.1 (any 127/8), ::1 and localhost.
+// True for the IPv4 literals 127.0.0.0/8, ::1 and localhost (not other names beginning "127.").
 bool IsLoopback(const std::string& host);
 
 class StudioServer {

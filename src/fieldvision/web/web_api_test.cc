@@ -257,7 +257,12 @@ TEST_F(StudioApiTest, EveryEndpointRefusesBadFilesAndMalformedJson) {
     if (e.method != "POST") continue;
     SCOPED_TRACE(e.path);
     ExpectError(Post(e.path, std::string("{\"out\": ")), 400, "malformed JSON");
+    // Nested a million levels deep: copying or dumping it would overflow the server's stack.
+    const std::string deep =
+        "{\"zones\": " + std::string(1000000, '[') + std::string(1000000, ']') + "}";
+    ExpectError(Post(e.path, deep), 400, "deeper than");
   }
+  EXPECT_EQ(Get("/api/info").status, 200);  // the server still answers
 }
 
 TEST_F(StudioApiTest, MalformedRequests) {
@@ -271,6 +276,9 @@ TEST_F(StudioApiTest, MalformedRequests) {
   ExpectError({text->status, text->body}, 415, "application/json");
   EXPECT_FALSE(fs::exists(dir_ / "x.json"));
   ExpectError(Get("/api/info", {{"Host", "evil.example:8470"}}), 403, "loopback host");
+  // A name that merely begins like a loopback address resolves wherever its owner says.
+  ExpectError(Get("/api/info", {{"Host", "127.attacker.example:8470"}}), 403, "loopback host");
+  EXPECT_EQ(Get("/api/info", {{"Host", "127.0.0.1:8470"}}).status, 200);
   EXPECT_EQ(Get("/api/info", {{"Host", "localhost:8470"}}).status, 200);
   EXPECT_EQ(Get("/api/info", {{"Host", "[::1]:8470"}}).status, 200);
   ExpectError(Post("/api/calibrate/pose", std::string("")), 400, "empty");
@@ -831,6 +839,17 @@ TEST_F(StudioApiTest, JobsRunAndCancel) {
   EXPECT_EQ(done["state"], "done") << done.dump();
   EXPECT_EQ(done["exit_code"], 0);
   EXPECT_TRUE(fs::exists(dir_ / "jobs/a/cam1.avi"));
+  // trajectory's outputs besides --out (a new folder for --images) are files inside the folder.
+  const std::vector<std::string> fit = {"--in",     "jobs/a/truth.csv", "--out",      "jobs/t.json",
+                                        "--report", "jobs/r.json",      "--smoothed", "jobs/s.csv",
+                                        "--images", "jobs/pictures"};
+  const Reply trajectory = Post("/api/jobs", json{{"command", "trajectory"}, {"args", fit}});
+  ASSERT_EQ(trajectory.status, 200) << trajectory.body;
+  WaitForJob(*client_, trajectory.j()["id"], 120);
+  std::vector<std::string> outside = fit;
+  outside[5] = "../r.json";
+  ExpectError(Post("/api/jobs", json{{"command", "trajectory"}, {"args", outside}}), 403,
+              "outside");
 
   const Reply long_job = Post(
       "/api/jobs", json{{"command", "synth"},
@@ -855,6 +874,11 @@ TEST_F(StudioApiTest, JobsRunAndCancel) {
   ExpectError(Post("/api/jobs", json{{"command", "synth"}, {"args", {"--out=/tmp/x"}}}), 400,
               "not an option name");
   ExpectError(Post("/api/jobs/cancel", json{{"id", 999}}), 404, "no job 999");
+  // Not truncated to job 3 or cast to another number.
+  ExpectError(Post("/api/jobs/cancel", json{{"id", 3.7}}), 400, "integer");
+  ExpectError(Post("/api/jobs/cancel", json{{"id", 1e300}}), 400, "integer");
+  ExpectError(Post("/api/jobs/cancel", json{{"id", 1LL << 40}}), 400, "integer");
+  ExpectError(Post("/api/jobs/cancel", json{{"id", "3"}}), 400, "integer");
 #endif
 }
 
@@ -894,7 +918,10 @@ TEST_F(StudioApiTest, TokenRequiredOffLoopback) {
   FV_SEED_TRACE(seed_);
   EXPECT_TRUE(IsLoopback("127.0.0.1"));
   EXPECT_TRUE(IsLoopback("localhost"));
+  EXPECT_TRUE(IsLoopback("127.3.2.1"));
   EXPECT_FALSE(IsLoopback("0.0.0.0"));
+  EXPECT_FALSE(IsLoopback("127.attacker.example"));
+  EXPECT_FALSE(IsLoopback("127.0.0.1.nip.io"));
   EXPECT_FALSE(server_->token_required());
   StudioOptions o;
   o.host = "0.0.0.0";
