@@ -8,6 +8,7 @@
 #include "fieldvision/app/stop_on_signal.h"
 #include "fieldvision/io/output_path.h"
 #include "fieldvision/net/fuse.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -60,6 +61,10 @@ void Setup(CLI::App& app, int& exit_code) {
     };
     const net::FuseSummary s = net::RunFuse(*o);
     std::cout << s.ToString() << "\n";
+    FV_REQUIRE(s.written,
+               "fuse: no camera frame arrived, {} not written (do the nodes' --connect addresses "
+               "reach --listen {}?)",
+               o->out, o->listen);
     std::cout << "wrote " << o->out << " (" << s.rows_written << " rows)\n";
   });
 }

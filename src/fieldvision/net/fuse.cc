@@ -527,7 +527,10 @@ FuseSummary FuseServer::Run() {
     PublishFlights();
   }
   csv_ = nullptr;
-  out_file.CloseAndCommit(csv);
+  // Without a single frame (nodes pointed elsewhere, stopped before any came) an earlier file
+  // stays as it was.
+  summary_.written = summary_.groups > 0;
+  if (summary_.written) out_file.CloseAndCommit(csv);
   summary_.fusion = fusion_->stats();
   summary_.sync = sync_->stats();
   summary_.sync_problems = sync_->Problems(names_);

@@ -63,6 +63,7 @@ struct FuseSummary {
   long long groups = 0;
   pipeline::FusionStats fusion;
   long long rows_written = 0;
+  bool written = false;  // --out was written: false when no frame arrived (it is left as it was)
   long long published = 0;
   long long hints_sent = 0;            // hint messages handed to the nodes' sockets
   std::vector<recon::Flight> flights;  // closed flights, in the order published

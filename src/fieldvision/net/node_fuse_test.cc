@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <iostream>
 #include <map>
@@ -325,6 +326,10 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   fo.out = dir + "/ball.csv";
   fo.idle_exit_s = 0.5;
   fo.progress = false;
+  {
+    std::ofstream earlier(fo.out);
+    earlier << "an earlier run's rows\n";
+  }
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
@@ -356,7 +361,12 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   EXPECT_EQ(fused.oversized, 1);
   EXPECT_EQ(fused.unknown_camera, 1);
   EXPECT_EQ(fused.unsynced, 1);
-  EXPECT_TRUE(std::filesystem::exists(fo.out));
+  // Not one frame was fused: an earlier file is left as it was.
+  EXPECT_FALSE(fused.written);
+  std::ifstream kept(fo.out);
+  std::string line;
+  std::getline(kept, line);
+  EXPECT_EQ(line, "an earlier run's rows");
 }
 
 // Synth cameras on the world's clock: node 2 is stopped and started again (a new session) and
