@@ -131,7 +131,7 @@ same_file() {  # same_file NAME INPUT CMD...: non-zero exit, one line, INPUT unc
   shift 2
   cp "$input" "$TMP/before"
   check "$name" nonzero "$@"
-  grep -q "is the input" "$TMP/err" || { echo "FAIL $name: not the same-file error"; fail=1; }
+  grep -q "is the same file as" "$TMP/err" || { echo "FAIL $name: not the same-file error"; fail=1; }
   cmp -s "$input" "$TMP/before" || { echo "FAIL $name: input changed"; fail=1; }
 }
 same_file "detect: --out is --video" "$TMP/v.avi" $FV detect --video "$TMP/v.avi" --out "$TMP/v.avi"
@@ -144,6 +144,9 @@ same_file "players: --out is --video" "$TMP/v.avi" $FV players --video "$TMP/v.a
   --out "$TMP/v.avi"
 same_file "trajectory: --out is --in" "$TMP/t.csv" $FV trajectory --in "$TMP/t.csv" \
   --out "$TMP/t.csv"
+printf '{"earlier": true}\n' > "$TMP/o.json"
+same_file "trajectory: --smoothed is --out" "$TMP/o.json" $FV trajectory --in "$TMP/t.csv" \
+  --out "$TMP/o.json" --smoothed "$TMP/o.json"
 same_file "stats: --out holds --tracks" "$TMP/t.csv" $FV stats --tracks "$TMP/t.csv" \
   --field fifa --out "$TMP/t.csv"
 same_file "import-pets: --out is --xml" "$TMP/p.xml" $FV eval import-pets --xml "$TMP/p.xml" \

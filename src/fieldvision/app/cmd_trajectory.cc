@@ -84,10 +84,13 @@ void Setup(CLI::App& app, int& exit_code) {
     o->job.analysis.drag = recon::ParseDragMode(o->drag, "--drag");
     o->job.analysis.spin = recon::ParseDragMode(o->spin, "--spin");
     const auto files = recon::ExpandTrackInputs(o->job.in_path);
+    // Nor another output: --smoothed o.json --out o.json wrote the CSV over FLIGHTS.json.
+    std::vector<std::string> taken = io::PathList(o->job.in_path, files, o->job.field);
     for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
                                     {o->job.smoothed_path, "--smoothed"},
                                     {o->job.report_path, "--report"}}) {
-      io::CheckOutputPath(out, io::PathList(o->job.in_path, files, o->job.field), what);
+      io::CheckOutputPath(out, taken, what);
+      taken.push_back(out);
     }
     if (files.empty()) {
       // Output files, as every writer's: not a device or a folder, in a folder that exists.

@@ -31,8 +31,10 @@ void CheckOutputPath(const std::string& out, const std::vector<std::string>& inp
   if (out.empty()) return;
   for (const std::string& in : inputs) {
     if (in.empty()) continue;
-    FV_REQUIRE(!SameFile(out, in), "{} '{}' is the input '{}': choose another output", what, out,
-               in);
+    FV_REQUIRE(
+        !SameFile(out, in),
+        "{} '{}' is the same file as '{}' (read or written by this run): choose another output",
+        what, out, in);
   }
 }
 

@@ -20,8 +20,9 @@ namespace fv::io {
 bool SameFile(const std::string& a, const std::string& b);
 
 // Throws fv::Error (one line, naming `what` and both paths) when `out` is the same file as one of
-// `inputs` (compared with std::filesystem::equivalent, so symlinks and hard links count; also by
-// weakly_canonical path for files that do not exist yet). Empty paths are skipped.
+// `inputs`, the run's inputs and the outputs checked before it (compared with
+// std::filesystem::equivalent, so symlinks and hard links count; also by weakly_canonical path
+// for files that do not exist yet). Empty paths are skipped.
 void CheckOutputPath(const std::string& out, const std::vector<std::string>& inputs,
                      std::string_view what = "--out");
 

@@ -186,6 +186,14 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   }
   PlanRunResult result;
   const std::optional<Rig> given = LoadGivenRig(options);
+  // No file this run may write replaces one of its inputs (--optimize --rig DIR/rig.json --out
+  // DIR replaced the user's rig).
+  const std::vector<std::string> inputs = io::PathList(
+      options.rig_path, options.camera_paths, options.mounts_path, options.field);
+  for (const char* name : {"rig.json", "coverage.json", "coverage.png", "angle.png", "error.png",
+                           "coverage_above.png", "angle_above.png", "error_above.png"}) {
+    io::CheckOutputPath(OutPath(options, name), inputs, "--out");
+  }
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);
   FV_REQUIRE(std::filesystem::is_directory(options.out_dir), "cannot create output folder '{}'",

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -106,6 +107,20 @@ TEST(PlanRunTest, BadInputGivesOneLineErrors) {
   msg = error_of(o);
   EXPECT_NE(msg.find("pixel_noise_px"), std::string::npos) << msg;
   o.coverage.pixel_noise_px = 1;
+  // The rig given is in the output folder under the name the optimised rig gets: refused before
+  // anything is written, the user's rig kept.
+  {
+    PlanRunOptions in_place = o;
+    in_place.optimize = true;
+    in_place.out_dir = dir;  // WriteCornerRig wrote dir/rig.json
+    std::ifstream before_in(in_place.rig_path);
+    const std::string before((std::istreambuf_iterator<char>(before_in)), {});
+    msg = error_of(in_place);
+    EXPECT_NE(msg.find("--out"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("rig.json"), std::string::npos) << msg;
+    std::ifstream after_in(in_place.rig_path);
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before);
+  }
   // A camera 1e300 m away (it saw nothing and the rig was planned without a word).
   {
     json rig = json::parse(std::ifstream(WriteCornerRig(dir)));
