@@ -16,7 +16,14 @@ void LiveSyncOptions::Check() const {
   FV_REQUIRE(std::isfinite(max_wait_s) && max_wait_s > 0,
              "LiveSyncOptions.max_wait_s must be > 0 (got {})", max_wait_s);
   FV_REQUIRE(max_buffered >= 1, "LiveSyncOptions.max_buffered must be >= 1");
+  FV_REQUIRE(std::isfinite(max_time_jump_s) && max_time_jump_s >= 0,
+             "LiveSyncOptions.max_time_jump_s must be >= 0 (got {})", max_time_jump_s);
 }
+
+namespace {
+// Messages in a row in a new time base before a camera is followed there.
+constexpr int kConfirmJump = 3;
+}  // namespace
 
 LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& options)
     : n_(num_cameras),
@@ -26,7 +33,9 @@ LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& optio
       last_frame_(num_cameras, -1),
       last_time_(num_cameras, -std::numeric_limits<double>::infinity()),
       last_arrival_(num_cameras, -std::numeric_limits<double>::infinity()),
-      skip_until_s_(num_cameras, -std::numeric_limits<double>::infinity()) {
+      skip_until_s_(num_cameras, -std::numeric_limits<double>::infinity()),
+      jump_run_(num_cameras, 0),
+      jump_time_(num_cameras, 0.0) {
   FV_REQUIRE(num_cameras >= 1, "LiveSynchronizer: needs at least one camera");
   options.Check();
 }
@@ -40,6 +49,10 @@ bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
   last_arrival_[c] = arrival_s;
   if (!std::isfinite(m.time_s)) {
     ++s.out_of_order;
+    return false;
+  }
+  if (Implausible(c, m.time_s)) {
+    ++s.implausible;
     return false;
   }
   if (last_frame_[c] >= 0) {
@@ -66,6 +79,32 @@ bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
   }
   buffers_[c].push_back({std::move(m), arrival_s});
   return true;
+}
+
+bool LiveSynchronizer::Implausible(int c, double time_s) {
+  const double jump = options_.max_time_jump_s;
+  if (jump <= 0) return false;
+  double reference = last_time_[c];
+  if (last_frame_[c] < 0) {  // its first message: the other cameras' latest, if any
+    reference = -std::numeric_limits<double>::infinity();
+    for (int o = 0; o < n_; ++o) {
+      if (o != c && last_frame_[o] >= 0) reference = std::max(reference, last_time_[o]);
+    }
+  }
+  if (!std::isfinite(reference) || std::abs(time_s - reference) <= jump) {
+    jump_run_[c] = 0;
+    return false;
+  }
+  jump_run_[c] =
+      jump_run_[c] > 0 && std::abs(time_s - jump_time_[c]) <= jump ? jump_run_[c] + 1 : 1;
+  jump_time_[c] = time_s;
+  if (jump_run_[c] < kConfirmJump) return true;
+  // The camera goes on there: follow it, and forget groups decided past it.
+  jump_run_[c] = 0;
+  last_frame_[c] = -1;
+  last_time_[c] = -std::numeric_limits<double>::infinity();
+  if (decided_until_s_ > time_s) decided_until_s_ = time_s - options_.tolerance_s;
+  return false;
 }
 
 void LiveSynchronizer::Admit(int camera, double arrival_s) {
@@ -155,6 +194,10 @@ std::vector<std::string> LiveSynchronizer::Problems(const std::vector<std::strin
     if (s.overflow > 0) parts.push_back(fmt::format("{} dropped (buffer full)", s.overflow));
     if (s.unpaired > 0) parts.push_back(fmt::format("{} frames without a partner", s.unpaired));
     if (s.restarts > 0) parts.push_back(fmt::format("restarted {} times", s.restarts));
+    if (s.implausible > 0) {
+      parts.push_back(fmt::format("{} frames dropped for a time over {:g} s from the stream's",
+                                  s.implausible, options_.max_time_jump_s));
+    }
     if (!parts.empty()) out.push_back(SyncProblemLine(names, static_cast<size_t>(c), parts));
   }
   return out;

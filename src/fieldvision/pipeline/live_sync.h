@@ -25,7 +25,14 @@ struct LiveSyncOptions {
   double tolerance_s = 0.008;  // half a frame at 60 fps
   double max_wait_s = 0.1;     // longest wait for a camera's message of a group
   size_t max_buffered = 1000;  // messages held per camera (the oldest dropped beyond)
-  void Check() const;          // throws fv::Error naming the bad field
+  // A message whose time lies further than this from its camera's previous one (or, for its
+  // first, from the other cameras' latest) is dropped as implausible: one frame stamped an hour
+  // ahead would otherwise decide a group there, after which every camera's frames are late.
+  // A camera that goes on in the new time base (kConfirmJump messages in a row, each within this
+  // of the one before) is followed there, and when that lies before the groups already decided
+  // they are forgotten (the bad time had decided them). 0: off.
+  double max_time_jump_s = 10.0;
+  void Check() const;  // throws fv::Error naming the bad field
 };
 
 struct LiveCameraStats {
@@ -38,6 +45,7 @@ struct LiveCameraStats {
   long long late = 0;          // its group was already decided: dropped
   long long overflow = 0;      // dropped because the buffer was full
   long long restarts = 0;      // new sessions after the first
+  long long implausible = 0;   // a time far from the camera's stream (max_time_jump_s): dropped
   bool active = false;
 };
 
@@ -78,6 +86,11 @@ class LiveSynchronizer {
   std::vector<double> last_time_;
   std::vector<double> last_arrival_;
   std::vector<double> skip_until_s_;  // SkipUntil
+  std::vector<int> jump_run_;         // implausible messages in a row (max_time_jump_s)
+  std::vector<double> jump_time_;     // the time of the last of them
+  // Whether camera c's message at time_s is too far from its stream (max_time_jump_s), counting
+  // the run of such messages.
+  bool Implausible(int c, double time_s);
   bool any_group_ = false;
   double decided_until_s_ = 0;  // messages at or before this time are late
   long long groups_ = 0, complete_groups_ = 0;

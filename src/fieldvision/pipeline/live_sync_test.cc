@@ -72,6 +72,44 @@ TEST(LiveSync, ADeadCameraDoesNotStallTheOthersAndItsLateFramesAreDropped) {
   EXPECT_FALSE(sync.Problems({"a", "b"}).empty());
 }
 
+// One frame stamped an hour ahead (a node's clock glitch) is dropped and counted; the streams go
+// on pairing. A camera that stays in a new time base is followed there.
+TEST(LiveSync, AFrameStampedFarFromItsStreamDoesNotStallFusion) {
+  LiveSyncOptions o;
+  o.max_time_jump_s = 10;
+  LiveSynchronizer sync(2, o);
+  ASSERT_TRUE(sync.Add(Msg(0, 0, 1.0), 1.0));
+  EXPECT_FALSE(sync.Add(Msg(1, 0, 3600.0), 1.0));  // its first frame, an hour past camera 0's
+  ASSERT_TRUE(sync.Add(Msg(1, 1, 1.0), 1.0));
+  std::vector<SyncedFrame> groups;
+  for (int k = 1; k < 30; ++k) {
+    const double t = 1.0 + k / 30.0, arrival = t;
+    ASSERT_TRUE(sync.Add(Msg(0, k, t), arrival));
+    if (k == 10) EXPECT_FALSE(sync.Add(Msg(1, 100, 7200.0), arrival));  // mid-stream
+    ASSERT_TRUE(sync.Add(Msg(1, k + 1, t), arrival));
+    while (auto g = sync.Next(arrival)) groups.push_back(*g);
+  }
+  while (auto g = sync.Next(100, true)) groups.push_back(*g);
+  ASSERT_EQ(groups.size(), 30u);
+  for (const SyncedFrame& g : groups) EXPECT_EQ(g.present(), 2);
+  EXPECT_EQ(sync.stats()[1].implausible, 2);
+  EXPECT_EQ(sync.stats()[1].late, 0);
+  EXPECT_EQ(sync.stats()[0].late, 0);
+  EXPECT_FALSE(sync.Problems({"a", "b"}).empty());
+  // The clock both cameras stamp with is stepped back for good: after three frames there each
+  // camera is followed, and the groups pair again.
+  for (int k = 0; k < 6; ++k) {
+    const double t = -100 + k / 30.0, arrival = 3.0 + k / 30.0;
+    sync.Add(Msg(1, 200 + k, t), arrival);
+    sync.Add(Msg(0, 200 + k, t), arrival);
+    while (auto g = sync.Next(arrival)) groups.push_back(*g);
+  }
+  while (auto g = sync.Next(100, true)) groups.push_back(*g);
+  ASSERT_EQ(groups.size(), 34u);
+  EXPECT_EQ(groups.back().present(), 2);
+  EXPECT_EQ(groups.back().cameras[0]->frame, 205);
+}
+
 // A camera whose source skipped frames says so (SkipUntil): the others' frames before it are
 // paired at once instead of waiting for that camera; frames after it still wait.
 TEST(LiveSync, SkippedFramesAreNotWaitedFor) {
