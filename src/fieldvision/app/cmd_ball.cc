@@ -10,7 +10,7 @@
 #include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/ball_overlay.h"
@@ -25,7 +25,7 @@ struct BallCliOptions {
   bool rows = false;
   pipeline::DetectionsJobOptions det;     // with --detections instead of --video
   pipeline::BallOverlayOptions draw;      // --draw DIR
-  std::optional<io::NewFolder> draw_dir;  // ... a new folder, removed if the run fails empty
+  std::optional<util::NewFolder> draw_dir;  // ... a new folder, removed if the run fails empty
 };
 
 // --draw: each camera's video with the 3D ball and its candidates (pipeline/ball_overlay.h),
@@ -112,19 +112,19 @@ void RunBall(const BallCliOptions& o) {
 
 // The outputs checked against the inputs and each other, then the run (videos or detections).
 void CheckOutputsAndRun(BallCliOptions& o) {
-  const auto inputs = io::PathList(o.job.cameras, o.job.videos, o.job.timestamps, o.job.truth,
+  const auto inputs = util::PathList(o.job.cameras, o.job.videos, o.job.timestamps, o.job.truth,
                                    o.job.field, o.job.colour, o.det.detections);
-  io::CheckOutputPath(o.job.out, inputs);
-  io::CheckOutputPath(o.det.flights, io::PathList(inputs, o.job.out), "--flights");
+  util::CheckOutputPath(o.job.out, inputs);
+  util::CheckOutputPath(o.det.flights, util::PathList(inputs, o.job.out), "--flights");
   for (size_t i = 0; i < o.job.detections_out.size(); ++i) {
-    std::vector<std::string> others = io::PathList(inputs, o.job.out);
+    std::vector<std::string> others = util::PathList(inputs, o.job.out);
     others.insert(others.end(), o.job.detections_out.begin(),
                   o.job.detections_out.begin() + static_cast<long>(i));
-    io::CheckOutputPath(o.job.detections_out[i], others, "--write-detections");
-    o.job.detections_out[i] = io::ResolveOutputPath(o.job.detections_out[i], "--write-detections");
+    util::CheckOutputPath(o.job.detections_out[i], others, "--write-detections");
+    o.job.detections_out[i] = util::ResolveOutputPath(o.job.detections_out[i], "--write-detections");
   }
-  o.job.out = io::ResolveOutputPath(o.job.out);  // refuses a device or a folder
-  if (!o.det.flights.empty()) o.det.flights = io::ResolveOutputPath(o.det.flights, "--flights");
+  o.job.out = util::ResolveOutputPath(o.job.out);  // refuses a device or a folder
+  if (!o.det.flights.empty()) o.det.flights = util::ResolveOutputPath(o.det.flights, "--flights");
   if (!o.det.detections.empty()) {
     FV_REQUIRE(o.job.videos.empty(), "ball: give --video or --detections, not both");
     FV_REQUIRE(o.draw.dir.empty(), "ball: --draw needs --video (the frames to draw on)");

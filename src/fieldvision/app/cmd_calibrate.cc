@@ -25,7 +25,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -532,7 +532,7 @@ void SetupIntrinsics(CLI::App* group) {
   in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
   in->add_flag("--quiet", ic->quiet, "No progress");
   in->callback([ic] {
-    io::CheckOutputPath(ic->out, {ic->images});
+    util::CheckOutputPath(ic->out, {ic->images});
     CheckOutputFile(ic->out);
     RunIntrinsics(*ic);
   });
@@ -573,9 +573,9 @@ void SetupExtrinsics(CLI::App* group) {
       ->capture_default_str();
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
   ex->callback([ec] {
-    io::CheckOutputPath(ec->out,
-                        io::PathList(ec->points, ec->field, ec->images));  // may be --camera
-    io::CheckOutputPath(ec->table, io::PathList(ec->points, ec->field, ec->camera, ec->out),
+    util::CheckOutputPath(ec->out,
+                        util::PathList(ec->points, ec->field, ec->images));  // may be --camera
+    util::CheckOutputPath(ec->table, util::PathList(ec->points, ec->field, ec->camera, ec->out),
                         "--table");
     if (ec->rig.empty()) CheckOutputFile(ec->out);
     CheckOutputFile(ec->table, "--table");
@@ -609,10 +609,10 @@ void SetupRefine(CLI::App* group) {
   re->callback([rc] {
     std::vector<std::string> inputs = {rc->field};
     for (const auto& i : rc->images) inputs.push_back(i.substr(i.find('=') + 1));
-    io::CheckOutputPath(rc->out, inputs);  // --out may be --camera
+    util::CheckOutputPath(rc->out, inputs);  // --out may be --camera
     inputs.push_back(rc->camera);
     inputs.push_back(rc->out);
-    io::CheckOutputPath(rc->overlay, inputs, "--overlay");
+    util::CheckOutputPath(rc->overlay, inputs, "--overlay");
     if (rc->rig.empty()) CheckOutputFile(rc->out);
     CheckOutputFile(rc->overlay, "--overlay");
     RunRefine(*rc);
@@ -631,8 +631,8 @@ void SetupCheck(CLI::App* group) {
   ch->add_option("--points", cc->points, "Known points (u,v,name or u,v,x,y,z) to tabulate");
   ch->add_option("--table", cc->table, "Write the known points' error table (CSV)");
   ch->callback([cc] {
-    io::CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
-    io::CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out},
+    util::CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
+    util::CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out},
                         "--table");
     CheckOutputFile(cc->out);
     CheckOutputFile(cc->table, "--table");

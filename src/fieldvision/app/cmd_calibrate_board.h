@@ -12,7 +12,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/board.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -88,7 +88,7 @@ inline void CheckOutputFolder(const std::string& out, std::string_view what = "-
 inline void CheckOutputFile(const std::string& out, std::string_view what = "--out") {
   if (out.empty()) return;
   CheckOutputFolder(out, what);
-  io::ResolveOutputPath(out, what);
+  util::ResolveOutputPath(out, what);
 }
 
 }  // namespace fv::app

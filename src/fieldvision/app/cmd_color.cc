@@ -11,7 +11,7 @@
 #include "fieldvision/detect/colour_learn.h"
 #include "fieldvision/detect/detect_eval.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -180,11 +180,11 @@ void Setup(CLI::App& app, int& exit_code) {
   learn->add_option("--out", a->out, "Colour file to write (JSON)")->required();
   learn->add_option("--mask-out", a->mask_out, "Image of the selection (default: OUT-mask.png)");
   learn->callback([a] {
-    io::CheckOutputPath(a->out, {a->video, a->labels});
-    io::CheckOutputPath(MaskPath(*a), {a->video, a->labels, a->out}, "--mask-out");
+    util::CheckOutputPath(a->out, {a->video, a->labels});
+    util::CheckOutputPath(MaskPath(*a), {a->video, a->labels, a->out}, "--mask-out");
     // A device, a folder or a missing folder as an output is refused before any work.
-    io::ResolveOutputPath(a->out);
-    io::ResolveOutputPath(MaskPath(*a), "--mask-out");
+    util::ResolveOutputPath(a->out);
+    util::ResolveOutputPath(MaskPath(*a), "--mask-out");
     Learn(*a);
   });
   (void)exit_code;

@@ -7,7 +7,7 @@
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/error.h"
 
@@ -55,12 +55,12 @@ void Setup(CLI::App& app, int& exit_code) {
     FV_REQUIRE(
         o->field.empty() || (!o->camera.empty() && camera::ReadCameraYaml(o->camera).has_pose),
         "detect: --field needs --camera with a pose (the field is found through it)");
-    io::CheckOutputPath(o->out, io::PathList(o->video, o->camera, o->field, o->detector.colour));
-    const auto inputs = io::PathList(o->video, o->camera, o->field, o->out);
+    util::CheckOutputPath(o->out, util::PathList(o->video, o->camera, o->field, o->detector.colour));
+    const auto inputs = util::PathList(o->video, o->camera, o->field, o->out);
     if (io::IsVideoName(o->draw)) {
       io::CheckVideoOutput(o->draw, inputs, "--draw");
     } else {
-      io::CheckOutputPath(o->draw, inputs, "--draw");  // a folder of JPEGs
+      util::CheckOutputPath(o->draw, inputs, "--draw");  // a folder of JPEGs
     }
     ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);

@@ -5,7 +5,7 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/input_checks.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/util/error.h"
@@ -43,7 +43,7 @@ void RunEvalTracks(const EvalTracksCli& c) {
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
   if (!c.json.empty()) {
-    io::AtomicWrite(
+    util::AtomicWrite(
         c.json,
         [&](const std::string& tmp) {
           std::ofstream out(tmp);
@@ -87,8 +87,8 @@ void Setup(CLI::App& app, int& exit_code) {
                 "clip; default: ground truth outside them counts as misses, and a note says so)");
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
   cmd->callback([c] {
-    io::CheckOutputPath(c->json, {c->gt, c->est}, "--json");
-    if (!c->json.empty()) io::ResolveOutputPath(c->json, "--json");
+    util::CheckOutputPath(c->json, {c->gt, c->est}, "--json");
+    if (!c->json.empty()) util::ResolveOutputPath(c->json, "--json");
     RunEvalTracks(*c);
   });
 
@@ -99,8 +99,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   imp->add_option("--out", p->out, "MOT CSV (TRACKS.csv layout)")->required();
   imp->callback([p] {
-    io::CheckOutputPath(p->out, {p->xml});
-    io::ResolveOutputPath(p->out);  // not a device, a folder or in a missing folder
+    util::CheckOutputPath(p->out, {p->xml});
+    util::ResolveOutputPath(p->out);  // not a device, a folder or in a missing folder
     const auto rows = track::ReadPetsCvml(p->xml);
     track::WriteTracksCsv(rows, p->out);
     std::cout << "wrote " << rows.size() << " boxes to " << p->out << "\n";

@@ -6,7 +6,7 @@
 #include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/stop_on_signal.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/net/fuse.h"
 #include "fieldvision/util/error.h"
 
@@ -52,7 +52,7 @@ void Setup(CLI::App& app, int& exit_code) {
                 "cameras then look for the ball)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
-    io::CheckOutputPath(o->out, o->cameras);
+    util::CheckOutputPath(o->out, o->cameras);
     pipeline::JobControl control;
     const StopOnSignal stop_on_signal(control);
     o->control = &control;

@@ -8,7 +8,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
@@ -44,7 +44,7 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (!c.mot_out.empty()) track::WriteMotChallenge(r.rows, c.mot_out);
   if (!r.team_of.empty()) {
     const std::string teams = c.out + ".teams.csv";
-    io::AtomicWrite(
+    util::AtomicWrite(
         teams,
         [&](const std::string& tmp) {
           util::CsvWriter w(tmp, {"id", "team"});
@@ -180,18 +180,18 @@ void Setup(CLI::App& app, int& exit_code) {
                "players: --detections '{}' is empty (a det.txt has a row per detection: "
                "frame,-1,x,y,w,h,score)",
                c->o.detections_in);
-    const auto inputs = io::PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
-    io::CheckOutputPath(c->out, inputs);
+    const auto inputs = util::PathList(c->camera, c->video, c->field, c->onnx, c->o.detections_in);
+    util::CheckOutputPath(c->out, inputs);
     for (const auto& [out, what] :
          {std::pair{c->mot_out, "--mot-out"}, {c->o.detections_out, "--save-detections"}}) {
-      io::CheckOutputPath(out, io::PathList(inputs, c->out), what);
+      util::CheckOutputPath(out, util::PathList(inputs, c->out), what);
     }
-    if (!c->draw.empty()) io::CheckVideoOutput(c->draw, io::PathList(inputs, c->out), "--draw");
+    if (!c->draw.empty()) io::CheckVideoOutput(c->draw, util::PathList(inputs, c->out), "--draw");
     // A device, a folder or a missing folder as an output is refused before the run.
     for (const auto& [out, what] : {std::pair{c->out, "--out"},
                                     {c->mot_out, "--mot-out"},
                                     {c->o.detections_out, "--save-detections"}}) {
-      if (!out.empty()) io::ResolveOutputPath(out, what);
+      if (!out.empty()) util::ResolveOutputPath(out, what);
     }
     try {
       RunPlayersCommand(*c);

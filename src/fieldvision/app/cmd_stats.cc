@@ -6,11 +6,11 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/input_checks.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/io/output_path.h"
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::app {
@@ -79,11 +79,11 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(0.1, 20));
   cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.mp4");
   cmd->callback([c] {
-    const auto inputs = io::PathList(c->tracks, c->field, c->zones, c->teams);
-    io::CheckOutputPath(c->out, inputs);
+    const auto inputs = util::PathList(c->tracks, c->field, c->zones, c->teams);
+    util::CheckOutputPath(c->out, inputs);
     for (const char* name : {"distances.csv", "players.csv", "speed_profiles.csv", "stats.json",
                              "index.html", "radar.png", "radar.mp4", "heatmap_all.png"}) {
-      io::CheckOutputPath(c->out + "/" + name, inputs);
+      util::CheckOutputPath(c->out + "/" + name, inputs);
     }
     try {
       RunStats(*c);

@@ -9,7 +9,7 @@
 #include "fieldvision/app/input_checks.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/edits.h"
@@ -42,9 +42,9 @@ void RunTracksEdit(const TracksEditCli& c) {
   }
   // Neither the tracks nor the teams file beside them may overwrite an input.
   const std::vector<std::string> inputs = {c.tracks, c.edits, roster_in};
-  io::CheckOutputPath(c.out, inputs);
-  io::CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
-  io::ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
+  util::CheckOutputPath(c.out, inputs);
+  util::CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
+  util::ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);

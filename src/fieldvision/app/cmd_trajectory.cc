@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
@@ -85,11 +85,11 @@ void Setup(CLI::App& app, int& exit_code) {
     o->job.analysis.spin = recon::ParseDragMode(o->spin, "--spin");
     const auto files = recon::ExpandTrackInputs(o->job.in_path);
     // Nor another output: --smoothed o.json --out o.json wrote the CSV over FLIGHTS.json.
-    std::vector<std::string> taken = io::PathList(o->job.in_path, files, o->job.field);
+    std::vector<std::string> taken = util::PathList(o->job.in_path, files, o->job.field);
     for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
                                     {o->job.smoothed_path, "--smoothed"},
                                     {o->job.report_path, "--report"}}) {
-      io::CheckOutputPath(out, taken, what);
+      util::CheckOutputPath(out, taken, what);
       taken.push_back(out);
     }
     if (files.empty()) {
@@ -97,7 +97,7 @@ void Setup(CLI::App& app, int& exit_code) {
       for (const auto& [out, what] : {std::pair{o->job.out_path, "--out"},
                                       {o->job.smoothed_path, "--smoothed"},
                                       {o->job.report_path, "--report"}}) {
-        if (!out.empty()) io::ResolveOutputPath(out, what);
+        if (!out.empty()) util::ResolveOutputPath(out, what);
       }
       // Progress on a terminal while the arcs of a long track are fitted; logs stay quiet.
       std::unique_ptr<util::Progress> bar;

@@ -11,8 +11,10 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include "fieldvision/camera/camera_io.h"
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::calib {
 namespace {
@@ -369,27 +371,21 @@ HomographyResult EstimateGroundHomography(int width, int height,
 }
 
 void WriteHomographyYaml(const HomographyResult& h, const std::string& path) {
-  const std::string tmp = path + ".tmp.yaml";
-  {
-    cv::FileStorage fs;
-    try {
-      fs.open(tmp, cv::FileStorage::WRITE);
-    } catch (const cv::Exception&) {
-    }
-    FV_REQUIRE(fs.isOpened(), "homography file '{}' cannot be written", path);
-    cv::Mat m, inv;
-    cv::eigen2cv(h.image_from_ground, m);
-    const Eigen::Matrix3d g = h.image_from_ground.inverse();
-    cv::eigen2cv(g, inv);
-    fs << "image_width" << h.width << "image_height" << h.height;
-    fs << "homography_image_from_ground" << m;
-    fs << "homography_ground_from_image" << inv;
-    fs << "rms_px" << h.rms_px << "rms_mm" << h.rms_mm;
-    fs << "num_points" << static_cast<int>(h.points.size()) << "num_inliers" << h.num_inliers;
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  FV_REQUIRE(!ec, "homography file '{}' cannot be written: {}", path, ec.message());
+  util::AtomicWrite(
+      path,
+      [&](const std::string& tmp) {
+        cv::FileStorage fs = camera::OpenYamlWriter(tmp, path, "homography file");
+        cv::Mat m, inv;
+        cv::eigen2cv(h.image_from_ground, m);
+        const Eigen::Matrix3d g = h.image_from_ground.inverse();
+        cv::eigen2cv(g, inv);
+        fs << "image_width" << h.width << "image_height" << h.height;
+        fs << "homography_image_from_ground" << m;
+        fs << "homography_ground_from_image" << inv;
+        fs << "rms_px" << h.rms_px << "rms_mm" << h.rms_mm;
+        fs << "num_points" << static_cast<int>(h.points.size()) << "num_inliers" << h.num_inliers;
+      },
+      "homography file");
 }
 
 }  // namespace fv::calib

@@ -12,6 +12,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::calib {
@@ -269,36 +270,37 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
 
 void WriteCalibrationToml(const std::vector<camera::Camera>& cameras, const std::string& path) {
   FV_REQUIRE(!cameras.empty(), "no cameras to write to '{}'", path);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    FV_REQUIRE(out.good(), "calibration file '{}' cannot be written", path);
-    for (size_t i = 0; i < cameras.size(); ++i) {
-      const camera::Camera& c = cameras[i];
-      FV_REQUIRE(c.has_pose, "camera '{}' has no pose; calibration.toml needs one", c.name);
-      const std::string name = c.name.empty() ? fmt::format("cam_{}", i + 1) : c.name;
-      std::vector<double> d = c.distortion;
-      d.resize(std::max<size_t>(d.size(), 4), 0.0);
-      const Eigen::Vector3d r = c.cam_from_world.Rvec();
-      const Eigen::Vector3d& t = c.cam_from_world.translation;
-      out << "[" << name << "]\n";
-      out << "name = \"" << name << "\"\n";
-      out << "size = [ " << c.width << ".0, " << c.height << ".0,]\n";
-      out << "matrix = [ [ " << Num(c.fx) << ", 0.0, " << Num(c.cx) << ",], [ 0.0, " << Num(c.fy)
-          << ", " << Num(c.cy) << ",], [ 0.0, 0.0, 1.0,],]\n";
-      out << "distortions = [";
-      for (size_t k = 0; k < d.size(); ++k) out << " " << Num(d[k]) << ",";
-      out << "]\n";
-      out << "rotation = [ " << Num(r.x()) << ", " << Num(r.y()) << ", " << Num(r.z()) << ",]\n";
-      out << "translation = [ " << Num(t.x()) << ", " << Num(t.y()) << ", " << Num(t.z()) << ",]\n";
-      out << "fisheye = false\n\n";
-    }
-    out << "[metadata]\nadjusted = false\nerror = 0.0\n";
-    FV_REQUIRE(out.good(), "calibration file '{}' cannot be written", path);
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  FV_REQUIRE(!ec, "calibration file '{}' cannot be written: {}", path, ec.message());
+  util::AtomicWrite(
+      path,
+      [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        FV_REQUIRE(out.good(), "calibration file '{}' cannot be written", path);
+        for (size_t i = 0; i < cameras.size(); ++i) {
+          const camera::Camera& c = cameras[i];
+          FV_REQUIRE(c.has_pose, "camera '{}' has no pose; calibration.toml needs one", c.name);
+          const std::string name = c.name.empty() ? fmt::format("cam_{}", i + 1) : c.name;
+          std::vector<double> d = c.distortion;
+          d.resize(std::max<size_t>(d.size(), 4), 0.0);
+          const Eigen::Vector3d r = c.cam_from_world.Rvec();
+          const Eigen::Vector3d& t = c.cam_from_world.translation;
+          out << "[" << name << "]\n";
+          out << "name = \"" << name << "\"\n";
+          out << "size = [ " << c.width << ".0, " << c.height << ".0,]\n";
+          out << "matrix = [ [ " << Num(c.fx) << ", 0.0, " << Num(c.cx) << ",], [ 0.0, "
+              << Num(c.fy) << ", " << Num(c.cy) << ",], [ 0.0, 0.0, 1.0,],]\n";
+          out << "distortions = [";
+          for (size_t k = 0; k < d.size(); ++k) out << " " << Num(d[k]) << ",";
+          out << "]\n";
+          out << "rotation = [ " << Num(r.x()) << ", " << Num(r.y()) << ", " << Num(r.z())
+              << ",]\n";
+          out << "translation = [ " << Num(t.x()) << ", " << Num(t.y()) << ", " << Num(t.z())
+              << ",]\n";
+          out << "fisheye = false\n\n";
+        }
+        out << "[metadata]\nadjusted = false\nerror = 0.0\n";
+        FV_REQUIRE(out.good(), "calibration file '{}' cannot be written", path);
+      },
+      "calibration file");
 }
 
 std::vector<camera::Camera> ReadOpenCvStereo(const std::vector<std::string>& paths, int width,

@@ -19,6 +19,7 @@
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
@@ -1196,25 +1197,24 @@ cv::Mat MultiCoveragePicture(const MultiResult& result, int camera) {
 }
 
 void WriteMultiCorners(const std::string& path, const MultiResult& result) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    FV_REQUIRE(out.good(), "corners file '{}' cannot be written", path);
-    out << "camera,moment,image,corner_id,u_px,v_px,x_m,y_m,err_px,used\n";
-    for (const auto& v : result.views) {
-      for (size_t k = 0; k < v.image_points.size(); ++k) {
-        out << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.6f},{:.6f},{:.4f},{}\n",
-                           result.camera_reports[v.camera].name, v.frame, v.name,
-                           k < v.corner_ids.size() ? v.corner_ids[k] : static_cast<int>(k),
-                           v.image_points[k].x, v.image_points[k].y, v.object_points[k].x,
-                           v.object_points[k].y, v.err_px[k], v.used ? 1 : 0);
-      }
-    }
-    FV_REQUIRE(out.good(), "corners file '{}' cannot be written", path);
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  FV_REQUIRE(!ec, "corners file '{}' cannot be written: {}", path, ec.message());
+  util::AtomicWrite(
+      path,
+      [&](const std::string& tmp) {
+        std::ofstream out(tmp);
+        FV_REQUIRE(out.good(), "corners file '{}' cannot be written", path);
+        out << "camera,moment,image,corner_id,u_px,v_px,x_m,y_m,err_px,used\n";
+        for (const auto& v : result.views) {
+          for (size_t k = 0; k < v.image_points.size(); ++k) {
+            out << fmt::format("{},{},{},{},{:.4f},{:.4f},{:.6f},{:.6f},{:.4f},{}\n",
+                               result.camera_reports[v.camera].name, v.frame, v.name,
+                               k < v.corner_ids.size() ? v.corner_ids[k] : static_cast<int>(k),
+                               v.image_points[k].x, v.image_points[k].y, v.object_points[k].x,
+                               v.object_points[k].y, v.err_px[k], v.used ? 1 : 0);
+          }
+        }
+        FV_REQUIRE(out.good(), "corners file '{}' cannot be written", path);
+      },
+      "corners file");
 }
 
 }  // namespace fv::calib

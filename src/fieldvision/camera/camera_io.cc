@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::camera {
@@ -168,46 +169,51 @@ Camera ReadCameraYaml(const std::string& path) {
   }
 }
 
+cv::FileStorage OpenYamlWriter(const std::string& temp_path, const std::string& path,
+                               const std::string& what) {
+  cv::FileStorage fs;
+  try {
+    fs.open(temp_path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception&) {
+    Throw("cannot write {} '{}'", what, path);
+  }
+  FV_REQUIRE(fs.isOpened(), "cannot write {} '{}'", what, path);
+  return fs;
+}
+
 void WriteCameraYaml(const Camera& camera, const std::string& path) {
   camera.Check("camera to write to '" + path + "'");
-  const std::string tmp = path + ".tmp.yaml";
-  {
-    cv::FileStorage fs;
-    try {
-      fs.open(tmp, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-    } catch (const cv::Exception&) {
-      Throw("cannot write camera file '{}'", path);
-    }
-    FV_REQUIRE(fs.isOpened(), "cannot write camera file '{}'", path);
-    // cv::write, not <<: << takes strings that start with [ ] { } for structure marks.
-    if (!camera.name.empty()) cv::write(fs, "name", camera.name);
-    fs << "image_width" << camera.width << "image_height" << camera.height;
-    const cv::Mat k =
-        (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-    fs << "camera_matrix" << k;
-    std::vector<double> d = camera.distortion;
-    if (d.empty()) d.assign(5, 0.0);
-    fs << "distortion_coefficients" << cv::Mat(d, true).reshape(1, 1);
-    if (camera.has_pose) {
-      const Eigen::Vector3d r = camera.cam_from_world.Rvec();
-      const Eigen::Vector3d& t = camera.cam_from_world.translation;
-      fs << "rvec" << (cv::Mat_<double>(3, 1) << r.x(), r.y(), r.z());
-      fs << "tvec" << (cv::Mat_<double>(3, 1) << t.x(), t.y(), t.z());
-      const Eigen::Vector3d c = camera.CentreInWorld();
-      fs << "camera_position_m" << (cv::Mat_<double>(3, 1) << c.x(), c.y(), c.z());
-    }
-    if (camera.rms_px) fs << "rms_px" << *camera.rms_px;
-    if (!camera.notes.empty()) {
-      fs << "notes"
-         << "{";
-      for (const auto& [key, value] : camera.notes) cv::write(fs, key, value);
-      fs << "}";
-    }
-    fs.release();
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  FV_REQUIRE(!ec, "cannot write camera file '{}': {}", path, ec.message());
+  util::AtomicWrite(
+      path,
+      [&](const std::string& tmp) {
+        cv::FileStorage fs = OpenYamlWriter(tmp, path, "camera file");
+        // cv::write, not <<: << takes strings that start with [ ] { } for structure marks.
+        if (!camera.name.empty()) cv::write(fs, "name", camera.name);
+        fs << "image_width" << camera.width << "image_height" << camera.height;
+        const cv::Mat k =
+            (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+        fs << "camera_matrix" << k;
+        std::vector<double> d = camera.distortion;
+        if (d.empty()) d.assign(5, 0.0);
+        fs << "distortion_coefficients" << cv::Mat(d, true).reshape(1, 1);
+        if (camera.has_pose) {
+          const Eigen::Vector3d r = camera.cam_from_world.Rvec();
+          const Eigen::Vector3d& t = camera.cam_from_world.translation;
+          fs << "rvec" << (cv::Mat_<double>(3, 1) << r.x(), r.y(), r.z());
+          fs << "tvec" << (cv::Mat_<double>(3, 1) << t.x(), t.y(), t.z());
+          const Eigen::Vector3d c = camera.CentreInWorld();
+          fs << "camera_position_m" << (cv::Mat_<double>(3, 1) << c.x(), c.y(), c.z());
+        }
+        if (camera.rms_px) fs << "rms_px" << *camera.rms_px;
+        if (!camera.notes.empty()) {
+          fs << "notes"
+             << "{";
+          for (const auto& [key, value] : camera.notes) cv::write(fs, key, value);
+          fs << "}";
+        }
+        fs.release();
+      },
+      "camera file");
 }
 
 }  // namespace fv::camera

@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <opencv2/core/persistence.hpp>
+
 #include "fieldvision/camera/camera.h"
 
 namespace fv::camera {
@@ -17,5 +19,9 @@ Camera ReadCameraYaml(const std::string& path);
 void CheckOpenCvYamlText(const std::string& path, const std::string& what);
 // Writes the camera file (to a temporary name first, then renamed, so a failure loses nothing).
 void WriteCameraYaml(const Camera& camera, const std::string& path);
+// An OpenCV YAML writer on `temp_path` (whatever its extension) for the file `path`; throws
+// fv::Error "cannot write WHAT 'path'" when it cannot be opened.
+cv::FileStorage OpenYamlWriter(const std::string& temp_path, const std::string& path,
+                               const std::string& what);
 
 }  // namespace fv::camera

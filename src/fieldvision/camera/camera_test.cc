@@ -1,5 +1,6 @@
 #include "fieldvision/camera/camera.h"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -287,6 +288,21 @@ INSTANTIATE_TEST_SUITE_P(
         // Found by fuzz/camera_yaml_fuzz: OpenCV 4.6's parser never returned (a CPU-bound hang).
         BadFile{"content after the document start", "%YAML:1.0\n--- A: 1\nna\n--m", "line 2"}),
     BadFileName);
+
+// A camera file that cannot be written (its name is a folder) fails naming it and leaves no
+// temporary file beside it (calibrate import --tsai --out FOLDER left FOLDER.tmp.yaml).
+TEST(CameraIo, AFailedWriteLeavesNothingBehind) {
+  const std::string dir = testing::TempDir() + "/failed_write";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/cam.yaml");
+  Camera cam = Camera::FromFov(64, 48, 60);
+  const std::string message = testing::ErrorOf([&] { WriteCameraYaml(cam, dir + "/cam.yaml"); });
+  EXPECT_THAT(message, ::testing::HasSubstr("camera file"));
+  EXPECT_THAT(message, ::testing::HasSubstr("cam.yaml"));
+  int entries = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) entries += !e.path().empty();
+  EXPECT_EQ(entries, 1);  // the folder only
+}
 
 TEST(CameraIo, MissingFile) {
   EXPECT_THAT([&] { ReadCameraYaml("/nonexistent/cam.yaml"); },

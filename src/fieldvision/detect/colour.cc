@@ -13,7 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/colour_cache.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -261,7 +261,7 @@ ColourSpec ReadColourSpec(const std::string& path) {
 
 void WriteColourSpec(const ColourSpec& spec, const std::string& path) {
   spec.Check("colour spec to write");
-  io::WriteTextFile(path, ColourSpecToJson(spec).dump(2) + "\n", "colour file");
+  util::WriteTextFile(path, ColourSpecToJson(spec).dump(2) + "\n", "colour file");
 }
 
 ColourSpec LoadColourSpec(const std::string& preset_or_path) {

@@ -19,7 +19,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/eval_drawing.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
@@ -479,13 +479,13 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   // No output may be one of the images, label files or the camera read (an image inside --video).
   std::vector<std::string> inputs = {o.video, o.labels.labels, o.camera, o.field};
   for (const LabelledImage& item : items) inputs.push_back(item.image);
-  io::CheckOutputPath(o.out, inputs, "--out");
-  io::CheckOutputPath(o.candidates_out, inputs, "--candidates");
+  util::CheckOutputPath(o.out, inputs, "--out");
+  util::CheckOutputPath(o.candidates_out, inputs, "--candidates");
   std::unique_ptr<MissDrawings> drawings;
   if (!o.draw_misses.empty()) {
     for (const auto& [path, what] :
          {std::pair{o.out, "--out"}, {o.candidates_out, "--candidates"}}) {
-      FV_REQUIRE(path.empty() || !io::SameFile(path, o.draw_misses),
+      FV_REQUIRE(path.empty() || !util::SameFile(path, o.draw_misses),
                  "{} '{}' is the --draw-misses folder", what, path);
     }
     std::vector<std::string> image_files;
@@ -507,10 +507,10 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   const AnyBallDetector detector(o.detector, o.dnn, camera.get(), field ? &*field : nullptr);
 
   DetectEvalResult result;
-  std::unique_ptr<io::AtomicOutput> cand_file;
+  std::unique_ptr<util::AtomicOutput> cand_file;
   std::unique_ptr<util::CsvWriter> cand_csv;
   if (!o.candidates_out.empty()) {
-    cand_file = std::make_unique<io::AtomicOutput>(o.candidates_out, "--candidates");
+    cand_file = std::make_unique<util::AtomicOutput>(o.candidates_out, "--candidates");
     cand_csv = std::make_unique<util::CsvWriter>(
         cand_file->temp_path(),
         std::vector<std::string>{
@@ -572,7 +572,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     cand_file->CloseAndCommit(*cand_csv);
   }
   if (!o.out.empty()) {
-    io::AtomicWrite(o.out, [&](const std::string& tmp) {
+    util::AtomicWrite(o.out, [&](const std::string& tmp) {
       util::CsvWriter w(tmp, {"image", "boxes", "detected", "hit", "u", "v", "radius_px", "score",
                               "centre_err_px", "candidate_on_ball", "accepted_on_ball",
                               "ball_radius_px", "reason"});

@@ -11,7 +11,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/codecs/codecs.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/csv.h"
@@ -157,7 +157,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   const AnyBallDetector detector(o.detector, o.dnn, camera ? &*camera : nullptr,
                                  field ? &*field : nullptr);
   // Written beside --out and renamed over it at the end: a failed run leaves the old file.
-  io::AtomicOutput out_file(o.out);
+  util::AtomicOutput out_file(o.out);
   util::CsvWriter csv(out_file.temp_path(),
                       {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
   std::optional<io::PlayableVideoWriter> writer;  // renamed over --draw at the end

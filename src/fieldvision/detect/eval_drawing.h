@@ -13,7 +13,7 @@
 
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/detect_eval.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::detect {
 
@@ -44,7 +44,7 @@ class MissDrawings {
   // of one of `image_files` (a later run over them would score the drawings).
   MissDrawings(const std::string& dir, const std::string& video,
                const std::vector<std::string>& image_files);
-  // The folder is io::NewFolder's: removed again when the run fails before drawing into it.
+  // The folder is util::NewFolder's: removed again when the run fails before drawing into it.
   // Draws image number `index` when it is a miss or a false detection; returns whether it did.
   bool Add(int index, const LabelledImage& item, const DetectEvalImage& scored,
            const std::vector<BallCandidate>& candidates, const cv::Mat& bgr, double grow);
@@ -55,7 +55,7 @@ class MissDrawings {
  private:
   std::string dir_;
   int written_ = 0;
-  std::optional<io::NewFolder> folder_;
+  std::optional<util::NewFolder> folder_;
 };
 
 }  // namespace fv::detect

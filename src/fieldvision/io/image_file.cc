@@ -7,8 +7,8 @@
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/io/jpeg_orientation.h"
 #include "fieldvision/io/jpeg_region.h"
-#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::io {
 namespace {
@@ -64,7 +64,7 @@ cv::Mat ReadImage(const std::string& path) {
 
 void WriteImage(const std::string& path, const cv::Mat& image) {
   // Beside the path, renamed over it when whole: a failed write leaves an earlier image.
-  AtomicWrite(
+  util::AtomicWrite(
       path,
       [&](const std::string& temp_path) {
         bool ok = false;

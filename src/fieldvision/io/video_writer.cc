@@ -9,8 +9,8 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "fieldvision/codecs/codecs.h"
-#include "fieldvision/io/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::io {
@@ -71,9 +71,9 @@ std::string FallbackVideoPath(const std::string& path) {
 void CheckVideoOutput(const std::string& path, const std::vector<std::string>& inputs,
                       std::string_view what) {
   CheckVideoPath(path, what);
-  CheckOutputPath(path, inputs, what);
-  CheckOutputPath(FallbackVideoPath(path), inputs, what);
-  ResolveOutputPath(path, what);
+  util::CheckOutputPath(path, inputs, what);
+  util::CheckOutputPath(FallbackVideoPath(path), inputs, what);
+  util::ResolveOutputPath(path, what);
 }
 
 PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv::Size size,
@@ -86,7 +86,7 @@ PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv
   path_ = path;
   const bool mp4 = FallbackVideoPath(path) != path;
   if (mp4 && H264Available()) {
-    out_ = std::make_unique<AtomicOutput>(path_, what);
+    out_ = std::make_unique<util::AtomicOutput>(path_, what);
     if (TryOpen(writer_.get(), out_->temp_path(), codecs::FourCc('a', 'v', 'c', '1'), fps, size)) {
       codec_ = "H.264";
       return;
@@ -101,7 +101,7 @@ PlayableVideoWriter::PlayableVideoWriter(const std::string& path, double fps, cv
         path_);
   }
   // Beside the path (through a symlink to its target), unique per process, renamed at Close().
-  out_ = std::make_unique<AtomicOutput>(path_, what);
+  out_ = std::make_unique<util::AtomicOutput>(path_, what);
   FV_REQUIRE(
       TryOpen(writer_.get(), out_->temp_path(), codecs::FourCc('M', 'J', 'P', 'G'), fps, size),
       "cannot write video '{}' (folder missing or not writable?)", path_);

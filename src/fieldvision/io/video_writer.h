@@ -1,7 +1,7 @@
 // Writing a video that plays where users look at it: H.264 in MP4 when the path ends in .mp4 and
 // OpenCV's FFmpeg has the encoder (browsers play it), else Motion-JPEG (a .mp4 path then becomes
 // .avi; .avi and .mkv keep their container). Frames go to a temporary file beside the path
-// (io::AtomicOutput: through a symlink, never onto a folder), renamed to it by Close(): a run
+// (util::AtomicOutput: through a symlink, never onto a folder), renamed to it by Close(): a run
 // that fails leaves an existing file as it was. OpenCV's own log
 // lines about a missing encoder are kept from the terminal (an expected outcome here).
 #pragma once
@@ -14,7 +14,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::io {
 
@@ -39,7 +39,7 @@ class PlayableVideoWriter {
 
  private:
   std::unique_ptr<cv::VideoWriter> writer_;  // made by the codecs plugin
-  std::unique_ptr<AtomicOutput> out_;        // the temporary file beside path_
+  std::unique_ptr<util::AtomicOutput> out_;  // the temporary file beside path_
   std::string path_, codec_, note_;
   cv::Size size_;
   int frames_ = 0;

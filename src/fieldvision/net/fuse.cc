@@ -19,7 +19,7 @@
 #include <zmq.hpp>
 
 #include "fieldvision/io/frame_source.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/recon/ball_csv.h"
@@ -484,7 +484,7 @@ FuseSummary FuseServer::Run() {
     flight_worker_ = std::make_unique<FlightWorker>(fopt);
   }
   // Written beside --out and renamed at the end; a run that fails leaves no temporary file.
-  io::AtomicOutput out_file(o_.out);
+  util::AtomicOutput out_file(o_.out);
   util::CsvWriter csv(out_file.temp_path(), recon::BallCsvColumns(), 6);
   csv_ = &csv;
   const auto start = std::chrono::steady_clock::now();

@@ -11,7 +11,7 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/lab.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/pipeline/flight_refiner.h"
 #include "fieldvision/recon/ball_csv.h"
@@ -30,7 +30,7 @@ void BallJobOptions::Check() const {
   for (size_t i = 0; i < videos.size(); ++i) {
     for (size_t j = 0; j < i; ++j) {
       // One file under two names (./v.avi and v.avi, a link) is the same video.
-      FV_REQUIRE(!io::SameFile(videos[i], videos[j]), "ball: video '{}' is given twice (as '{}')",
+      FV_REQUIRE(!util::SameFile(videos[i], videos[j]), "ball: video '{}' is given twice (as '{}')",
                  videos[i], videos[j]);
     }
   }
@@ -226,10 +226,10 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   }
 
   // Each camera's accepted candidates as DET.csv, committed with BALL.csv.
-  std::vector<std::unique_ptr<io::AtomicOutput>> det_files;
+  std::vector<std::unique_ptr<util::AtomicOutput>> det_files;
   std::vector<std::unique_ptr<util::CsvWriter>> det_csvs;
   for (const std::string& path : o.detections_out) {
-    det_files.push_back(std::make_unique<io::AtomicOutput>(path, "--write-detections"));
+    det_files.push_back(std::make_unique<util::AtomicOutput>(path, "--write-detections"));
     det_csvs.push_back(std::make_unique<util::CsvWriter>(
         det_files.back()->temp_path(),
         std::vector<std::string>{"frame", "time_s", "u", "v", "radius_px", "score"}));
@@ -241,7 +241,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   BallJobResult result;
   // Write to a temporary file beside the output, rename at the end: a failed run (a truncated
   // video, a bad timestamp) leaves neither a half file nor a temporary one.
-  io::AtomicWrite(o.out, [&](const std::string& temp_path) {
+  util::AtomicWrite(o.out, [&](const std::string& temp_path) {
     util::CsvWriter csv(temp_path, recon::BallCsvColumns(), 6);
     const auto write = [&](const recon::BallSample& s) {
       csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y()

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
@@ -188,11 +188,11 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   const std::optional<Rig> given = LoadGivenRig(options);
   // No file this run may write replaces one of its inputs (--optimize --rig DIR/rig.json --out
   // DIR replaced the user's rig).
-  const std::vector<std::string> inputs = io::PathList(
+  const std::vector<std::string> inputs = util::PathList(
       options.rig_path, options.camera_paths, options.mounts_path, options.field);
   for (const char* name : {"rig.json", "coverage.json", "coverage.png", "angle.png", "error.png",
                            "coverage_above.png", "angle_above.png", "error_above.png"}) {
-    io::CheckOutputPath(OutPath(options, name), inputs, "--out");
+    util::CheckOutputPath(OutPath(options, name), inputs, "--out");
   }
   std::error_code ec;
   std::filesystem::create_directories(options.out_dir, ec);
@@ -219,7 +219,7 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   }
   WriteCoverageMaps(options, field, result);
   const std::string json_path = OutPath(options, "coverage.json");
-  io::WriteTextFile(json_path, CoverageJson(result, field, options).dump(2) + "\n",
+  util::WriteTextFile(json_path, CoverageJson(result, field, options).dump(2) + "\n",
                     "coverage file");
   result.files.push_back(json_path);
   summary += fmt::format("wrote {} files to {}\n", result.files.size(), options.out_dir);

@@ -6,7 +6,7 @@
 #include <set>
 
 #include "fieldvision/camera/camera_io.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 
@@ -236,7 +236,7 @@ json RigToJson(const Rig& rig) {
 }
 
 void WriteRigJson(const Rig& rig, const std::string& path) {
-  io::WriteTextFile(path, RigToJson(rig).dump(2) + "\n", "rig file");
+  util::WriteTextFile(path, RigToJson(rig).dump(2) + "\n", "rig file");
 }
 
 Rig RigFromCameraFiles(const std::vector<std::string>& paths) {

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/recon/trajectory_draw.h"
 #include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/recon/trajectory_run_internal.h"
@@ -84,7 +84,7 @@ void LogSkipped(const BallTrackFile& input, std::ostream& log) {
 
 // Writes JSON through a temporary file beside `path`.
 void WriteJson(const std::string& path, const nlohmann::json& j, const char* what) {
-  io::AtomicWrite(
+  util::AtomicWrite(
       path,
       [&](const std::string& tmp) {
         std::ofstream f(tmp);
@@ -200,7 +200,7 @@ void WriteTrajectoryOutputs(const TrajectoryJob& job, const nlohmann::json& flig
   }
   if (!job.smoothed_path.empty()) {
     const std::vector<BallSample> smoothed = SmoothTrack(track, r, out.options, job.smoother);
-    io::AtomicWrite(
+    util::AtomicWrite(
         job.smoothed_path, [&](const std::string& tmp) { WriteBallTrack(tmp, smoothed); },
         "--smoothed");
   }
@@ -295,7 +295,7 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
   TrajectoryBatchResult res;
   res.files = files;
   res.summary_csv = (fs::path(job.out_path) / "summary.csv").string();
-  io::AtomicOutput summary(res.summary_csv, "summary.csv");
+  util::AtomicOutput summary(res.summary_csv, "summary.csv");
   std::vector<BounceTrackScore> scores;
   {
     util::CsvWriter csv(summary.temp_path(), {"file",           "flight",

@@ -11,12 +11,12 @@
 
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/io/output_path.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/stats.h"
 
 namespace fv::stats {
@@ -500,7 +500,7 @@ void WriteIndexHtml(const std::string& path, const ReportParts& rp, const Report
   h << "</div>\n<h3>Per player</h3>\n<div class=\"maps\">";
   for (int id : rp.player_maps) h << fmt::format("<img src=\"heatmap_player{}.png\">", id);
   h << "</div>\n" << kSortScript << "</body></html>\n";
-  io::WriteTextFile(path, h.str(), "report page");
+  util::WriteTextFile(path, h.str(), "report page");
 }
 
 }  // namespace
@@ -525,7 +525,7 @@ ReportFiles WriteStatsReport(const StatsResult& r, const field::FieldModel& fiel
   {
     const nlohmann::json j = StatsJson(r, o, files);
     const std::string path = out_dir + "/stats.json";
-    io::WriteTextFile(path, j.dump(2) + "\n", "stats file");
+    util::WriteTextFile(path, j.dump(2) + "\n", "stats file");
     files.files.push_back(path);
   }
   WriteIndexHtml(out_dir + "/index.html", rp, files);

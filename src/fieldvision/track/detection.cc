@@ -11,7 +11,7 @@
 #include <opencv2/video/background_segm.hpp>
 
 #include "fieldvision/geometry/rigid.h"
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
 
@@ -95,7 +95,7 @@ void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& pat
                          d.box.height, d.score);
     }
   }
-  io::WriteTextFile(path, out, "detections file");
+  util::WriteTextFile(path, out, "detections file");
 }
 
 DetectionsFile ReadDetectionsCsv(const std::string& path) {

@@ -11,6 +11,7 @@
 
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::track {
@@ -163,21 +164,20 @@ void WriteRoster(const Roster& roster, const std::string& path) {
   std::set<int> ids;
   for (const auto& [id, t] : roster.team_of) ids.insert(id);
   for (const auto& [id, n] : roster.name_of) ids.insert(id);
-  const std::string tmp = path + ".tmp";
-  {
-    util::CsvWriter w(tmp, {"id", "team", "name"});
-    for (int id : ids) {
-      const auto t = roster.team_of.find(id);
-      const auto n = roster.name_of.find(id);
-      w << id << (t == roster.team_of.end() ? -1 : t->second)
-        << (n == roster.name_of.end() ? std::string() : n->second);
-      w.EndRow();
-    }
-    w.Close();
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  FV_REQUIRE(!ec, "cannot write roster '{}' ({})", path, ec.message());
+  util::AtomicWrite(
+      path,
+      [&](const std::string& tmp) {
+        util::CsvWriter w(tmp, {"id", "team", "name"});
+        for (int id : ids) {
+          const auto t = roster.team_of.find(id);
+          const auto n = roster.name_of.find(id);
+          w << id << (t == roster.team_of.end() ? -1 : t->second)
+            << (n == roster.name_of.end() ? std::string() : n->second);
+          w.EndRow();
+        }
+        w.Close();
+      },
+      "roster");
 }
 
 std::string RosterPathFor(const std::string& tracks_path) { return tracks_path + ".teams.csv"; }

@@ -15,32 +15,13 @@
 #include "fieldvision/track/mot_internal.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::track {
 
-namespace {
-
-// Writes through `path`.tmp renamed to `path` at the end.
-template <typename WriteFn>
-void WriteReplacing(const std::string& path, WriteFn write) {
-  const std::string tmp = path + ".tmp";
-  try {
-    write(tmp);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  FV_REQUIRE(!ec, "cannot write '{}' ({})", path, ec.message());
-}
-
-}  // namespace
-
 void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) {
-  WriteReplacing(path, [&](const std::string& tmp) {
+  util::AtomicWrite(path, [&](const std::string& tmp) {
     util::CsvWriter w(tmp,
                       {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "conf", "x_m",
                        "y_m", "time_s"},
@@ -65,7 +46,7 @@ void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) 
 }
 
 void WriteMotChallenge(const std::vector<TrackRow>& rows, const std::string& path) {
-  WriteReplacing(path, [&](const std::string& tmp) {
+  util::AtomicWrite(path, [&](const std::string& tmp) {
     std::ofstream out(tmp);
     FV_REQUIRE(out.good(), "cannot write MOTChallenge file '{}'", path);
     for (const auto& r : rows) {

@@ -29,6 +29,7 @@
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/json.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::web {
 
@@ -373,16 +374,25 @@ std::string EncodePng(const cv::Mat& image) {
   return std::string(buf.begin(), buf.end());
 }
 
-// Writes text to a temporary name beside `path`, then renames it (a failure loses nothing).
-void WriteTextFile(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    FV_REQUIRE(out.good(), "cannot write '{}'", path.string());
-    out << text;
-    FV_REQUIRE(out.good(), "error while writing '{}'", path.string());
+// Writes `zones` to `out` after the reader that `stats --zones` uses has checked them on the
+// temporary file (nothing is replaced by zones it would refuse); HttpError 400 naming the problem.
+void SaveZones(const json& zones, const fs::path& out) {
+  try {
+    util::AtomicWrite(
+        out.string(),
+        [&](const std::string& tmp) {
+          util::WriteTextFile(tmp, zones.dump(1) + "\n", "zones file");
+          stats::ReadZones(tmp);
+        },
+        "zones file");
+  } catch (const HttpError&) {
+    throw;
+  } catch (const fv::Error& e) {
+    std::string m = e.what();
+    const auto at = m.find(out.string());
+    if (at != std::string::npos) m.replace(at, out.string().size(), "request");
+    throw HttpError(400, m);
   }
-  fs::rename(tmp, path);
 }
 
 // Bytes of base64 text (RFC 4648, padding optional, a data: URL's prefix skipped); throws
@@ -560,7 +570,7 @@ std::vector<Route> CalibrationRoutes() {
            for (const auto& p : points) {
              csv << p.uv_px.x() << ',' << p.uv_px.y() << ',' << p.name << '\n';
            }
-           WriteTextFile(points_out, csv.str());
+           util::WriteTextFile(points_out.string(), csv.str(), "points file");
            j["wrote"].push_back(ws.Relative(points_out));
          }
          Saved(events, ws, out, "camera");
@@ -982,19 +992,7 @@ std::vector<Route> TrackRoutes() {
          const json zones = Get<json>(body, "zones");
          if (!zones.is_array()) throw HttpError(400, "'zones' must be an array");
          const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
-         // Checked by the reader that `stats --zones` uses, on a temporary copy.
-         const fs::path tmp = out.string() + ".check";
-         WriteTextFile(tmp, zones.dump(1) + "\n");
-         try {
-           stats::ReadZones(tmp.string());
-         } catch (const fv::Error& e) {
-           fs::remove(tmp);
-           std::string m = e.what();
-           const auto at = m.find(tmp.string());
-           if (at != std::string::npos) m.replace(at, tmp.string().size(), "request");
-           throw HttpError(400, m);
-         }
-         fs::rename(tmp, out);
+         SaveZones(zones, out);
          Saved(events, ws, out, "zones");
          return Json({{"wrote", {ws.Relative(out)}}, {"zones", zones.size()}});
        }},

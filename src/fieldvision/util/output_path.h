@@ -10,10 +10,8 @@
 #include <vector>
 
 namespace fv::util {
-class CsvWriter;
-}  // namespace fv::util
 
-namespace fv::io {
+class CsvWriter;
 
 // Whether `a` and `b` are one file: by inode when both exist (symlinks and hard links count), else
 // by normalised absolute path.
@@ -84,7 +82,7 @@ class AtomicOutput {
   [[noreturn]] void Rethrow(const std::exception& error) const;
   // Closes `csv` (written to temp_path(); a failed write is reported naming the output) and
   // commits.
-  void CloseAndCommit(util::CsvWriter& csv);
+  void CloseAndCommit(CsvWriter& csv);
 
  private:
   std::string out_;
@@ -102,4 +100,4 @@ void AtomicWrite(const std::string& out, const std::function<void(const std::str
 // when it cannot be written.
 void WriteTextFile(const std::string& out, std::string_view text, std::string_view what);
 
-}  // namespace fv::io
+}  // namespace fv::util

@@ -1,4 +1,4 @@
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 
 #include <unistd.h>
 
@@ -9,7 +9,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
-namespace fv::io {
+namespace fv::util {
 namespace fs = std::filesystem;
 
 bool SameFile(const std::string& a_name, const std::string& b_name) {
@@ -91,7 +91,7 @@ void AtomicOutput::Rethrow(const std::exception& error) const {
   throw Error(message);
 }
 
-void AtomicOutput::CloseAndCommit(util::CsvWriter& csv) {
+void AtomicOutput::CloseAndCommit(CsvWriter& csv) {
   try {
     csv.Close();
   } catch (const Error& e) {
@@ -148,4 +148,4 @@ NewFolder::~NewFolder() {
   }
 }
 
-}  // namespace fv::io
+}  // namespace fv::util

@@ -1,4 +1,4 @@
-#include "fieldvision/io/output_path.h"
+#include "fieldvision/util/output_path.h"
 
 #include <signal.h>
 #include <sys/resource.h>
@@ -14,7 +14,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/testing.h"
 
-namespace fv::io {
+namespace fv::util {
 namespace {
 namespace fs = std::filesystem;
 
@@ -101,7 +101,7 @@ TEST(AtomicWrite, AFullDiskKeepsTheOutputAndLeavesNoTemporary) {
   std::string message;
   try {
     AtomicWrite(out, [](const std::string& tmp) {
-      util::CsvWriter csv(tmp, {"frame", "x_m", "y_m", "z_m"});
+      CsvWriter csv(tmp, {"frame", "x_m", "y_m", "z_m"});
       for (int i = 0; i < 100000; ++i) {  // about 3 MB
         csv << i << 0.1 * i << -0.2 * i << 0.11;
         csv.EndRow();
@@ -190,4 +190,4 @@ TEST(WriteTextFile, WritesWholeOrNothingNamingWhatItIs) {
 }
 
 }  // namespace
-}  // namespace fv::io
+}  // namespace fv::util
