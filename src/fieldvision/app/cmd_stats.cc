@@ -77,6 +77,12 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(FiniteRange(0.01, 60));
   cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s")
       ->check(FiniteRange(0.1, 20));
+  cmd->add_option("--noise-floor", c->o.distance_noise_factor,
+                  "Distance counts a move once the smoothed position is this many times the "
+                  "track's estimated position noise from the last counted one (tracking noise of "
+                  "a standing player is no distance; 0: every smoothed step)")
+      ->capture_default_str()
+      ->check(FiniteRange(0, 10));
   cmd->add_flag("!--no-video", c->o.write_video, "Do not write radar.mp4");
   cmd->callback([c] {
     const auto inputs = util::PathList(c->tracks, c->field, c->zones, c->teams);

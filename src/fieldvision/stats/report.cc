@@ -412,6 +412,7 @@ nlohmann::json StatsJson(const StatsResult& r, const StatsOptions& o, const Repo
                          {"distance_m", p.distance_m},
                          {"top_speed_mps", p.top_speed_mps},
                          {"mean_speed_mps", p.mean_speed_mps},
+                         {"position_noise_m", p.position_noise_m},
                          {"sprints", p.sprints},
                          {"band_time_s", p.band_time_s},
                          {"zone_time_s", p.zone_time_s}};

@@ -27,6 +27,7 @@ void StatsOptions::Check() const {
   }
   CheckNonNegative(min_track_s, "min_track_s");
   CheckNonNegative(top_speed_window_s, "top_speed_window_s");
+  CheckNonNegative(distance_noise_factor, "distance_noise_factor");
   for (const auto& z : zones) {
     FV_REQUIRE(z.polygon_m.size() >= 3, "zone '{}' needs at least 3 vertices", z.name);
   }
@@ -87,6 +88,26 @@ std::vector<Zone> ReadZones(const std::string& path) {
   return zones;
 }
 
+namespace {
+
+// SmoothTrack::noise_m: second differences p[i-1] - 2 p[i] + p[i+1] of samples in one segment
+// whose two steps differ by under 10 % have sd sqrt(6) sigma per axis under white noise.
+double PositionNoise(const std::vector<double>& t, const std::vector<Eigen::Vector2d>& p,
+                     const std::vector<int>& segment) {
+  std::vector<double> second;
+  for (size_t i = 1; i + 1 < t.size(); ++i) {
+    if (segment[i - 1] != segment[i + 1]) continue;
+    const double before = t[i] - t[i - 1], after = t[i + 1] - t[i];
+    if (std::abs(after - before) > 0.1 * std::max(before, after)) continue;
+    const Eigen::Vector2d d = p[i - 1] - 2 * p[i] + p[i + 1];
+    second.push_back(d.x());
+    second.push_back(d.y());
+  }
+  return second.size() < 10 ? 0.0 : util::RobustSigma(second) / std::sqrt(6.0);
+}
+
+}  // namespace
+
 SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
                             const std::vector<Eigen::Vector2d>& p, const StatsOptions& o) {
   SmoothTrack s;
@@ -103,6 +124,7 @@ SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
     const bool brk = dt > max_gap_s || (p[i] - p[i - 1]).norm() > o.max_speed_mps * dt + 0.5;
     s.segment[i] = s.segment[i - 1] + (brk ? 1 : 0);
   }
+  s.noise_m = PositionNoise(t, p, s.segment);
   const double half = 0.5 * o.smooth_window_s;
   for (size_t i = 0; i < n; ++i) {
     // Local quadratic fit (Savitzky-Golay) over the neighbours in the same segment.
@@ -213,15 +235,24 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
   ps.band_time_s.assign(o.speed_bands_mps.size() + 1, 0.0);
   for (const auto& z : o.zones) ps.zone_time_s[z.name] = 0.0;
   ps.top_speed_mps = TopSpeed(s, o);
-  double sprint_run = 0, speed_time = 0, speed_sum = 0;
+  ps.position_noise_m = s.noise_m;
+  const double dead_band_m = o.distance_noise_factor * s.noise_m;
+  Eigen::Vector2d counted_to = s.pos_m.front();  // where the last counted move ended
+  double sprint_run = 0, speed_time = 0;
   std::map<std::string, std::optional<double>> inside_since;
   std::map<int, std::pair<double, int>> per_second;  // second -> (sum, count)
   for (size_t i = 0; i < t.size(); ++i) {
     const bool joined = i + 1 < t.size() && s.segment[i + 1] == s.segment[i];
     const double dt = joined ? t[i + 1] - t[i] : 0.0;
-    if (joined) ps.distance_m += (s.pos_m[i + 1] - s.pos_m[i]).norm();
+    if (i > 0 && s.segment[i] != s.segment[i - 1]) counted_to = s.pos_m[i];
+    if (joined) {
+      const double moved = (s.pos_m[i + 1] - counted_to).norm();
+      if (moved > dead_band_m) {
+        ps.distance_m += moved;
+        counted_to = s.pos_m[i + 1];
+      }
+    }
     const double v = std::min(s.speed_mps[i], o.max_speed_mps);
-    speed_sum += v * dt;
     speed_time += dt;
     size_t band = 0;
     while (band < o.speed_bands_mps.size() && v >= o.speed_bands_mps[band]) ++band;
@@ -247,7 +278,7 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
     }
   }
   if (sprint_run >= o.sprint_min_s) ps.sprints++;
-  ps.mean_speed_mps = speed_time > 0 ? speed_sum / speed_time : 0.0;
+  ps.mean_speed_mps = speed_time > 0 ? ps.distance_m / speed_time : 0.0;
   for (const auto& [sec, sc] : per_second) {
     ps.speed_profile.emplace_back(sec, sc.first / sc.second);
   }

@@ -79,6 +79,35 @@ TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
   EXPECT_NEAR(bands, p.last_s - p.first_s, 1e-6);
 }
 
+// Tracking noise is not running: a player standing for a minute with 10 cm position noise at
+// 25 frames/s, and one walking 6 m in that minute, with the same noise.
+TEST(Stats, NoiseOfAStandingPlayerIsNoDistance) {
+  fv::testing::SeededRng rng(22);
+  std::vector<track::TrackRow> rows;
+  for (int f = 0; f < 60 * 25; ++f) {
+    for (int id : {1, 2}) {
+      track::TrackRow r;
+      r.frame = f + 1;
+      r.time_s = f / 25.0;
+      r.id = id;
+      r.box = cv::Rect2d(0, 0, 10, 20);
+      r.x_m = (id == 1 ? 3.0 : -20.0 + 0.1 * *r.time_s) + rng.Normal(0, 0.1);
+      r.y_m = 5.0 * id + rng.Normal(0, 0.1);
+      rows.push_back(r);
+    }
+  }
+  const StatsResult r = ComputeStats(rows, StatsOptions());
+  ASSERT_EQ(r.players.size(), 2u);
+  for (const PlayerStats& p : r.players) EXPECT_NEAR(p.position_noise_m, 0.1, 0.01) << p.id;
+  EXPECT_LT(r.players[0].distance_m, 1.0);
+  EXPECT_NEAR(r.players[1].distance_m, 6.0, 1.0);
+  EXPECT_NEAR(r.players[1].mean_speed_mps, 0.1, 0.02);
+  // Every smoothed step counted, as before: 18 m standing still.
+  StatsOptions all_steps;
+  all_steps.distance_noise_factor = 0;
+  EXPECT_GT(ComputeStats(rows, all_steps).players[0].distance_m, 10.0);
+}
+
 TEST(Stats, PairDistancesAndReport) {
   fv::testing::SeededRng rng(22);
   double d1 = 0, d2 = 0;
