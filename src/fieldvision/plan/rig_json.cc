@@ -6,9 +6,9 @@
 #include <set>
 
 #include "fieldvision/camera/camera_io.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::plan {
 namespace {
@@ -129,6 +129,11 @@ void Rig::Check(const std::string& context) const {
     c.Check(ctx);
     FV_REQUIRE(c.has_pose, "{}: has no pose (rvec/tvec)", ctx);
     FV_REQUIRE(c.CentreInWorld().allFinite(), "{}: position is not finite", ctx);
+    // The ground is opaque: nothing on the field is seen from under it (z down is the usual
+    // cause).
+    FV_REQUIRE(c.CentreInWorld().z() >= 0,
+               "{}: {:.3g} m below the ground (z = {:.3g} m; z points up, the field at z = 0)", ctx,
+               -c.CentreInWorld().z(), c.CentreInWorld().z());
   }
 }
 

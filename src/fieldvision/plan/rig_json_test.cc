@@ -141,6 +141,14 @@ TEST(RigTest, BadInputGivesOneLineErrors) {
                             "r.json", "");
                       }),
                       {"cameras[0]", "'postion'"});
+  // Under the ground (z down by mistake): planned as seeing 90 % of the field from below.
+  ExpectOneLineNaming(ErrorOf([&] {
+                        RigFromJson(
+                            {{"defaults", defaults},
+                             {"cameras", {{{"position", {-10, -7, -4}}, {"look_at", {0, 0, 0}}}}}},
+                            "r.json", "");
+                      }),
+                      {"r.json", "4 m below the ground"});
   // NaN in a position (a JSON value built in code: the parser itself rejects NaN).
   json nan_cam = CornerCamera(1, 2);
   nan_cam["position"][1] = NAN;

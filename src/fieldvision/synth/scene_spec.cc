@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/geometry/rigid.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
@@ -478,8 +479,16 @@ void CheckCameraSpec(const CameraSpec& c, const std::string& ctx) {
   }
   if (c.has_rvec_tvec) {
     FV_REQUIRE(c.rvec.allFinite() && c.tvec.allFinite(), "{}.rvec/tvec: not finite", ctx);
+    // The ground is opaque: a camera under it sees nothing (a flipped z, z down, is the usual
+    // cause).
+    const double z = geometry::Rigid3d::FromRvecTvec(c.rvec, c.tvec).Inverse().translation.z();
+    FV_REQUIRE(z >= 0, "{}.rvec/tvec: the camera is {:.3g} m below the ground (z points up)", ctx,
+               -z);
   } else {
     FV_REQUIRE(c.position_m.allFinite(), "{}.position_m: not finite", ctx);
+    FV_REQUIRE(c.position_m.z() >= 0,
+               "{}.position_m: {:.3g} m below the ground (z points up; the ground is opaque)", ctx,
+               -c.position_m.z());
     FV_REQUIRE(c.look_at_m.allFinite(), "{}.look_at_m: not finite", ctx);
     const Eigen::Vector3d d = c.look_at_m - c.position_m;
     FV_REQUIRE(d.norm() > 1e-6, "{}.look_at_m: equals position_m", ctx);

@@ -106,6 +106,11 @@ TEST(SceneSpec, BadValuesNameTheKey) {
   bad = j;
   bad["cameras"][0]["look_at_m"] = bad["cameras"][0]["position_m"];
   EXPECT_NE(error_of(bad).find("cameras[0].look_at_m"), std::string::npos);
+  // Under the opaque ground (z down by mistake): it rendered the ball as fully visible.
+  bad = j;
+  bad["cameras"][0]["position_m"][2] = -4.0;
+  EXPECT_NE(error_of(bad).find("cameras[0].position_m: 4 m below the ground"), std::string::npos)
+      << error_of(bad);
   EXPECT_THROW(Preset("nope", 1), Error);
   EXPECT_THAT(
       [] { ReadSceneSpec("/nonexistent/scene.json"); },
