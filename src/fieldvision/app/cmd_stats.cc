@@ -40,7 +40,14 @@ void RunStats(const StatsCli& c) {
     o.team_of = roster.team_of;
     o.name_of = roster.name_of;
   }
-  const stats::StatsResult r = stats::ComputeStats(rows, o);
+  // The library's messages name the rows, not the file they came from.
+  const stats::StatsResult r = [&] {
+    try {
+      return stats::ComputeStats(rows, o);
+    } catch (const Error& e) {
+      Throw("tracks file '{}': {}", c.tracks, e.what());
+    }
+  }();
   // The radar video has 10 frames per second of play: refuse spans longer than any match (6 h).
   double t0 = 1e300, t1 = -1e300;
   for (const auto& s : r.tracks) {
