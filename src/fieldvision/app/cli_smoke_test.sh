@@ -270,6 +270,10 @@ check "studio: --assets a missing folder" nonzero timeout 20 $FV studio --assets
 check "node: --start-at 1e300" nonzero $FV node --camera "$TMP/sc/cam1.yaml" \
   --video "$TMP/sc/cam1/%05d.png" --connect tcp://127.0.0.1:1 --connect-wait 0.2 \
   --start-at 1e300 --no-progress
+# GStreamer's own CRITICAL lines (a pipeline OpenCV cannot end in an appsink) stay quiet.
+check "node: a GStreamer pipeline without a sink for OpenCV" nonzero timeout 30 $FV node \
+  --camera "$TMP/sc/cam1.yaml" --video 'gst:videotestsrc num-buffers=3 ! fakesink' \
+  --connect tcp://127.0.0.1:1 --connect-wait 0.2 --no-progress
 # ball: a video given twice under two names, a truncated video and a bad --timestamps file
 # (issue 18): one line naming the input, the existing --out unchanged, no temporary file left.
 "$FV" synth --preset kick --frames 6 --width 320 --height 240 --out "$TMP/bv" --quiet \

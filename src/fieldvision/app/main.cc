@@ -1,6 +1,4 @@
 // fieldvision: turn ordinary cameras around a sports field into a measuring instrument.
-#include <dlfcn.h>
-
 #include <cstdlib>
 #include <exception>
 #include <iostream>
@@ -12,6 +10,7 @@
 #include <opencv2/core/utils/logger.hpp>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/codecs/codecs.h"
 #include "fieldvision/util/error.h"
 
 namespace {
@@ -20,32 +19,6 @@ std::string FirstLine(const std::string& s) {
   std::string line = s.substr(0, s.find('\n'));
   while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
   return line;
-}
-
-// GLib's log (GStreamer's "GStreamer-CRITICAL **: ... Trying to dispose element pipeline0", 26
-// lines when OpenCV's GStreamer capture fails on a damaged file) goes through GLib's default
-// handler; it is replaced, found at run time so that no GLib header or link is needed, by one
-// that passes messages on only with --verbose.
-using GLogFunc = void (*)(const char* domain, int level, const char* message, void* data);
-GLogFunc g_glib_default_log = nullptr;
-bool g_verbose_libraries = false;
-
-void GLibLog(const char* domain, int level, const char* message, void* data) {
-  if (g_verbose_libraries && g_glib_default_log != nullptr) {
-    g_glib_default_log(domain, level, message, data);
-  }
-}
-
-void QuietGLib() {
-  using SetHandler = GLogFunc (*)(GLogFunc, void*);
-  static bool installed = false;
-  if (installed) return;
-  installed = true;
-  auto set = reinterpret_cast<SetHandler>(dlsym(RTLD_DEFAULT, "g_log_set_default_handler"));
-  auto fallback = reinterpret_cast<GLogFunc>(dlsym(RTLD_DEFAULT, "g_log_default_handler"));
-  if (set == nullptr) return;
-  set(&GLibLog, nullptr);
-  g_glib_default_log = fallback;
 }
 
 // Library log spam never reaches the user (one line per error): OpenCV, FFmpeg (read by OpenCV
@@ -57,8 +30,7 @@ void QuietLibraries(bool verbose) {
   setenv("OPENCV_FFMPEG_LOGLEVEL", verbose ? "32" : "-8", verbose);  // AV_LOG_INFO / AV_LOG_QUIET
   setenv("GST_DEBUG", verbose ? "2" : "0", verbose);
   FLAGS_minloglevel = verbose ? google::GLOG_INFO : google::GLOG_FATAL;
-  g_verbose_libraries = verbose;
-  QuietGLib();
+  fv::codecs::SetLibraryLogs(verbose);
 }
 
 int Run(int argc, char** argv) {

@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <mutex>
@@ -41,6 +42,30 @@ std::vector<std::filesystem::path> PluginCandidates() {
   return out;
 }
 
+// GLib's log (GStreamer's "GStreamer-CRITICAL **: ... Trying to dispose element pipeline0", 26
+// lines when OpenCV's GStreamer capture fails on a damaged file) goes through GLib's default
+// handler; once the plugin has brought GLib in, that is replaced, found at run time in the
+// plugin's dependencies (no GLib header or link needed), by one that passes messages on only
+// when SetLibraryLogs(true).
+using GLogFunc = void (*)(const char* domain, int level, const char* message, void* data);
+GLogFunc g_glib_default_log = nullptr;
+std::atomic<bool> g_library_logs{false};
+
+void GLibLog(const char* domain, int level, const char* message, void* data) {
+  if (g_library_logs && g_glib_default_log != nullptr) {
+    g_glib_default_log(domain, level, message, data);
+  }
+}
+
+void QuietGLib(void* plugin) {
+  using SetHandler = GLogFunc (*)(GLogFunc, void*);
+  auto set = reinterpret_cast<SetHandler>(dlsym(plugin, "g_log_set_default_handler"));
+  auto fallback = reinterpret_cast<GLogFunc>(dlsym(plugin, "g_log_default_handler"));
+  if (set == nullptr) return;  // no GLib (OpenCV built without GStreamer)
+  g_glib_default_log = fallback;
+  set(&GLibLog, nullptr);
+}
+
 const PluginApi* LoadPlugin() {
   std::string tried;
   for (const auto& path : PluginCandidates()) {
@@ -58,6 +83,7 @@ const PluginApi* LoadPlugin() {
     FV_REQUIRE(api != nullptr && api->version == kPluginApiVersion,
                "codecs plugin '{}' is from another build (interface version {}, expected {})",
                path.string(), api ? api->version : -1, kPluginApiVersion);
+    QuietGLib(handle);
     spdlog::debug("codecs plugin: {}", path.string());
     return api;  // never unloaded: its objects (captures, writers) may outlive any owner here
   }
@@ -114,6 +140,8 @@ class QuietStderr {
 }  // namespace
 
 void Load() { Api(); }
+
+void SetLibraryLogs(bool shown) { g_library_logs = shown; }
 
 cv::Mat ImRead(const std::string& path, int flags) {
   const PluginApi& api = Api();

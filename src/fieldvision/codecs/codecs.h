@@ -42,6 +42,10 @@ constexpr int FourCc(char c1, char c2, char c3, char c4) {
   return (c1 & 255) | ((c2 & 255) << 8) | ((c3 & 255) << 16) | ((c4 & 255) << 24);
 }
 
+// Whether the log of the libraries the plugin brings in (GLib / GStreamer) reaches stderr
+// (default: not; --verbose turns it on).
+void SetLibraryLogs(bool shown);
+
 // Loads the plugin now (e.g. on another thread while the program does other work); throws
 // fv::Error naming the plugin when it cannot be loaded. Every function above calls it.
 void Load();
