@@ -1,8 +1,8 @@
 // The ball options that several subcommands declare alike: --ball-diameter (ball, node, fuse,
 // detect, plan), --color (ball, node, detect, eval detect) and the fusion's --inlier-px, --ground
 // and --no-weak (ball, fuse; recon/triangulation.h), the tracking window's --whole-frames,
-// --full-scan-every, --scan-bands, --guided-frames (ball, node) and --unconfirmed-scan-every
-// (ball; pipeline/camera_stage.h).
+// --full-scan-every, --scan-bands, --guided-frames and --unconfirmed-scan-every (ball, node;
+// pipeline/camera_stage.h).
 #pragma once
 
 #include <string>
@@ -58,8 +58,7 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                 "Never use candidates that failed a shape check to complete a position");
 }
 
-// `unconfirmed`: --unconfirmed-scan-every too (ball; a camera node has no use for it).
-inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t, bool unconfirmed) {
+inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
   cmd->add_flag("!--whole-frames", t.enabled, "Search every frame whole (no tracking window)");
   cmd->add_option("--full-scan-every", t.full_scan_every,
                   "While tracking, search the whole frame for other balls every N frames")
@@ -75,11 +74,11 @@ inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t, bool u
                   "there with its size, for at most N frames in a row (0: never)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
-  if (!unconfirmed) return;
   cmd->add_option("--unconfirmed-scan-every", t.unconfirmed_scan_every,
                   "While the cameras together have no position for the ball, each tracking "
                   "camera searches the whole frame every N frames (0: only every "
-                  "--full-scan-every), so that a track on a still thing gives way to the ball")
+                  "--full-scan-every), so that a track on a still thing gives way to the ball "
+                  "(a camera node: once the fusion node tells of frames without one)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
 }

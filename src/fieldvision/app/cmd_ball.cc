@@ -190,7 +190,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames")
       ->check(CLI::Range(0LL, 1000000000LL));
   AddFusionOptions(cmd, o->job.pipeline.triangulation);
-  AddTrackOptions(cmd, o->job.pipeline.track, /*unconfirmed=*/true);
+  AddTrackOptions(cmd, o->job.pipeline.track);
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o, cmd] {
     FV_REQUIRE(!o->det.detections.empty() ||

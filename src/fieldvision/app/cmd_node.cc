@@ -42,7 +42,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--field", o->field, "Field (name or JSON): look for the ball only over it");
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames")
       ->check(FiniteRange(0, 1e12));
-  AddTrackOptions(cmd, o->track, /*unconfirmed=*/false);
+  AddTrackOptions(cmd, o->track);
   cmd->add_option("--connect-wait", o->connect_wait_s,
                   "Seconds to wait for the fusion node's first clock reply before starting")
       ->check(FiniteRange(0, 3600))

@@ -19,12 +19,12 @@
 #include <zmq.hpp>
 
 #include "fieldvision/io/frame_source.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
@@ -227,7 +227,7 @@ class FuseServer {
   FuseSummary::LatencyParts LatencyPartsOf(const pipeline::SyncedFrame& group, double latency_s);
   void PublishFlights();
   // A hint (messages.h) to every node that has sent a message.
-  void SendHint(double time_s, const Eigen::Vector3d& ball_in_world);
+  void SendHint(const HintMessage& hint);
   void ReportProgress(double now);
 
   const FuseOptions& o_;
@@ -324,7 +324,10 @@ void FuseServer::Emit(const pipeline::SyncedFrame& group) {
     summary_.latency_s.push_back(latency_s);
     summary_.latency_parts.push_back(LatencyPartsOf(group, latency_s));
   }
-  if (!f.result.ok()) return;
+  if (!f.result.ok()) {
+    if (o_.hints) SendHint(HintMessage{f.time_s, 0, 0, 0, 0.5 * o_.ball_diameter_m, true});
+    return;
+  }
   const Eigen::Vector3d& p = f.result.point_world;
   *csv_ << f.frame << f.time_s << p.x() << p.y() << p.z() << f.result.num_views()
         << f.result.rms_px;
@@ -338,12 +341,15 @@ void FuseServer::Emit(const pipeline::SyncedFrame& group) {
     if (pub_.send(zmq::buffer(Encode(b)), zmq::send_flags::dontwait)) ++summary_.published;
   }
   if (flight_worker_) flight_worker_->Add(pipeline::BallSampleOf(f));
-  if (o_.hints && !f.result.on_ground) SendHint(f.time_s, p);
+  // A single camera's ground guess is no position of the cameras together.
+  if (o_.hints) {
+    SendHint(
+        HintMessage{f.time_s, p.x(), p.y(), p.z(), 0.5 * o_.ball_diameter_m, f.result.on_ground});
+  }
 }
 
-void FuseServer::SendHint(double time_s, const Eigen::Vector3d& ball_in_world) {
-  const std::string bytes = Encode(HintMessage{time_s, ball_in_world.x(), ball_in_world.y(),
-                                               ball_in_world.z(), 0.5 * o_.ball_diameter_m});
+void FuseServer::SendHint(const HintMessage& hint) {
+  const std::string bytes = Encode(hint);
   for (const std::string& id : identities_) {
     if (id.empty()) continue;
     if (!router_.send(zmq::buffer(id), zmq::send_flags::sndmore | zmq::send_flags::dontwait)) {

@@ -69,6 +69,7 @@ struct Encoder {
             {"n_cams", m.n_cams}, {"err_px", m.err_px}, {"latency_s", m.latency_s}};
   }
   json operator()(const HintMessage& m) const {
+    if (m.lost) return {{"type", "hint"}, {"time_s", m.time_s}, {"lost", true}};
     return {{"type", "hint"}, {"time_s", m.time_s}, {"x_m", m.x_m},
             {"y_m", m.y_m},   {"z_m", m.z_m},       {"radius_m", m.radius_m}};
   }
@@ -192,6 +193,11 @@ Message DecodeChecked(const void* data, size_t size) {
   if (type == "hint") {
     HintMessage m;
     m.time_s = Num(j, "time_s");
+    if (j.contains("lost")) {
+      FV_REQUIRE(j["lost"].is_boolean() && j["lost"].get<bool>(), "message: 'lost' must be true");
+      m.lost = true;
+      return m;
+    }
     m.x_m = Num(j, "x_m");
     m.y_m = Num(j, "y_m");
     m.z_m = Num(j, "z_m");

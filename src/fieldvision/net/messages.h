@@ -101,11 +101,15 @@ struct BallMessage {
   double latency_s = 0;  // fuse clock at publication - capture time (system clocks only)
 };
 
-// Where the cameras together saw the ball (fuse -> node).
+// Where the cameras together saw the ball (fuse -> node), or (`lost`) that they had no position
+// for the frame at time_s: a node then searches its whole frame now and then
+// (pipeline/camera_stage.h, unconfirmed_scan_every) instead of keeping its window on a still
+// thing of the ball's colour. A lost hint has no position keys (older nodes count it malformed).
 struct HintMessage {
   double time_s = 0;
   double x_m = 0, y_m = 0, z_m = 0;
   double radius_m = 0.11;
+  bool lost = false;
 };
 
 // A flight (an airborne arc between two contacts) once it has closed (pipeline/live_flights.h).

@@ -121,6 +121,20 @@ TEST(Messages, HintRoundTripsAndABadRadiusIsRefused) {
             MessageError::Reason::kMalformed);
   EXPECT_EQ(ReasonOf(R"({"v":1,"type":"hint","time_s":1,"x_m":0,"y_m":0,"radius_m":0.1})"),
             MessageError::Reason::kMalformed);
+  // A frame without a position: no position keys, read back as lost.
+  HintMessage lost;
+  lost.time_s = 12.5;
+  lost.lost = true;
+  const std::string lost_bytes = Encode(lost);
+  EXPECT_EQ(lost_bytes.find("x_m"), std::string::npos) << lost_bytes;
+  const Message lm = Decode(lost_bytes.data(), lost_bytes.size());
+  const auto* lost_back = std::get_if<HintMessage>(&lm);
+  ASSERT_NE(lost_back, nullptr);
+  EXPECT_TRUE(lost_back->lost);
+  EXPECT_EQ(lost_back->time_s, 12.5);
+  EXPECT_FALSE(std::get<HintMessage>(m).lost);
+  EXPECT_EQ(ReasonOf(R"({"v":1,"type":"hint","time_s":1,"lost":false})"),
+            MessageError::Reason::kMalformed);
 }
 
 TEST(Messages, RefusalsSayWhy) {

@@ -142,6 +142,10 @@ class NodeLink {
   // A fusion node's hint, on this node's frame clock, to the camera stage's board.
   void TakeHint(const HintMessage& h) {
     if (hints_ == nullptr) return;
+    if (h.lost) {  // the fusion tells of frames without a position: unconfirmed scans apply
+      hints_->MarkTellsLoss();
+      return;
+    }
     double time_s = h.time_s;
     if (system_clock_) {
       if (!has_offset_) return;
@@ -317,8 +321,9 @@ NodeSummary RunNode(const NodeOptions& o) {
   std::optional<pipeline::BallHintBoard> hints;
   if (o.hints && o.detect) {
     hints.emplace(1, pipeline::BallHintOptions(), /*wait=*/false);
-    // Hints arrive only while the fusion node has a position, and not at all when its hints are
-    // off: their absence says nothing (no unconfirmed whole-frame searches).
+    // Positions arrive while the fusion node has one, lost hints when it has none, and nothing
+    // at all when its hints are off: their absence alone says nothing (the unconfirmed
+    // whole-frame searches start with the first lost hint).
     stage.SetHints(&*hints, /*no_hint_means_unconfirmed=*/false);
   }
 

@@ -8,6 +8,7 @@
 // messages queued for the fusion. Live (no waiting), a stage reads the newest state.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -80,6 +81,11 @@ class BallHintBoard {
   std::optional<BallHint> Get(int camera, long long index);
   // Releases every waiting camera (the fusion ended or failed); Get then returns nullopt.
   void Close();
+  // Whether the fusion tells of frames without a position too (a fusion node's lost hints, or
+  // any position published): then a board without a recent position means the cameras together
+  // have none (CameraStage's unconfirmed scans).
+  void MarkTellsLoss() { tells_loss_ = true; }
+  bool TellsLoss() const { return tells_loss_; }
 
  private:
   BallHintOptions options_;
@@ -87,6 +93,7 @@ class BallHintBoard {
   std::mutex mutex_;
   std::condition_variable changed_;
   bool closed_ = false;
+  std::atomic<bool> tells_loss_{false};
   std::optional<BallHint> state_;
   std::deque<std::pair<double, Eigen::Vector3d>> recent_;  // (time_s, position), oldest first
   std::vector<long long> popped_;                          // messages popped per camera

@@ -94,7 +94,8 @@ class CameraStage {
   // The fusion's hints for this camera (null: none; not owned, must outlive the stage's use).
   // `no_hint_means_unconfirmed`: a board without a recent position means the cameras together have
   // none (the in-process fusion publishes every position), so unconfirmed_scan_every applies; a
-  // camera node cannot tell a fusion node that sends no hints from one without a position.
+  // camera node cannot tell a fusion node that sends no hints from one without a position until
+  // the board says the fusion tells of losses (BallHintBoard::TellsLoss: lost hints).
   void SetHints(BallHintBoard* hints, bool no_hint_means_unconfirmed = true) {
     hints_ = hints;
     no_hint_means_unconfirmed_ = no_hint_means_unconfirmed;
@@ -113,7 +114,7 @@ class CameraStage {
   // frames in a row without a recent fused position (unconfirmed_).
   void FollowHint(const io::SourceFrame& in);
   // Whether this frame is searched whole because no fused position confirmed the track lately.
-  bool UnconfirmedScan();
+  bool UnconfirmedScan(long long frame);
   int camera_index_;
   camera::Camera camera_;
   cv::Size size_;

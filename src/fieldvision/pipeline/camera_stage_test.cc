@@ -275,6 +275,41 @@ TEST(CameraStage, WithoutAFusedPositionAStillThingGivesWayToTheBallWithinUnconfi
   EXPECT_THROW(track.Check(), Error);
 }
 
+// A camera node (no_hint_means_unconfirmed false) searches whole for want of a position only once
+// the fusion node has told of a frame without one (a lost hint), and then on frame numbers that
+// are multiples of unconfirmed_scan_every, so that the nodes search the same frames.
+TEST(CameraStage, ANodeSearchesWholeOnAlignedFramesOnceTheFusionTellsOfLoss) {
+  const camera::Camera cam = PosedCamera();
+  std::vector<std::vector<Thing>> frames;
+  for (int f = 0; f < 40; ++f) {
+    frames.push_back({{Vector2d(500, 100), 0.2}});
+    if (f >= 10) frames.back().push_back({Vector2d(100 + 6 * f, 300), 0.9});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  track.unconfirmed_scan_every = 5;
+  for (const bool tells : {false, true}) {
+    long long f = 0;
+    CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted");
+    BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+    stage.SetHints(&board, /*no_hint_means_unconfirmed=*/false);
+    long long first_ball = -1;
+    for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+      if (tells && f == 3) board.MarkTellsLoss();
+      io::SourceFrame in;
+      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+      in.frame = f;
+      in.time_s = f / 60.0;
+      const CameraMessage m = stage.Process(in);
+      const bool ball = std::any_of(m.candidates.begin(), m.candidates.end(),
+                                    [](const auto& o) { return o.centre_px.y() == 300; });
+      if (ball && first_ball < 0) first_ball = f;
+    }
+    // Told: the first whole search from frame 10 on falls on frame 10 (a multiple of 5).
+    EXPECT_EQ(first_ball, tells ? 10 : -1) << (tells ? "told of loss" : "never told");
+  }
+}
+
 TEST(CameraStage, GuidedFitsGoOnWhereTheSearchLosesTheBallForMaxGuidedFrames) {
   // The ball rolls right; from frame 5 the search no longer finds it (merged with a board).
   // A guided fit at the expected place finds it there for max_guided_frames frames in a row.
