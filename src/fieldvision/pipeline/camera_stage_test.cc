@@ -232,6 +232,36 @@ TEST(CameraStage, TheFusionsHintsMoveTheWindowFromABetterScoredThingToTheBall) {
   }
 }
 
+// A still thing of the ball's colour in view for 40 frames; from frame 10 the ball too, better
+// scored, away from it.
+std::vector<std::vector<Thing>> StillThingThenBall() {
+  std::vector<std::vector<Thing>> frames;
+  for (int f = 0; f < 40; ++f) {
+    frames.push_back({{Vector2d(500, 100), 0.2}});
+    if (f >= 10) frames.back().push_back({Vector2d(100 + 6 * f, 300), 0.9});
+  }
+  return frames;
+}
+
+// The first frame whose message has the ball of StillThingThenBall (-1: none); `before` is called
+// with each frame number before it is processed.
+long long FirstFrameWithTheBall(CameraStage& stage, const std::vector<std::vector<Thing>>& frames,
+                                long long* f, const std::function<void(long long)>& before) {
+  long long first_ball = -1;
+  for (*f = 0; *f < static_cast<long long>(frames.size()); ++*f) {
+    before(*f);
+    io::SourceFrame in;
+    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+    in.frame = *f;
+    in.time_s = *f / 60.0;
+    const CameraMessage m = stage.Process(in);
+    const bool ball = std::any_of(m.candidates.begin(), m.candidates.end(),
+                                  [](const auto& o) { return o.centre_px.y() == 300; });
+    if (ball && first_ball < 0) first_ball = *f;
+  }
+  return first_ball;
+}
+
 TEST(CameraStage, WithoutAFusedPositionAStillThingGivesWayToTheBallWithinUnconfirmedScanEvery) {
   // The ball is hidden from this camera for 10 frames while a still thing of its colour is in
   // view; the window settles on the thing. From frame 10 the ball is in view, better scored, away
@@ -239,11 +269,7 @@ TEST(CameraStage, WithoutAFusedPositionAStillThingGivesWayToTheBallWithinUnconfi
   // whole frame is searched every unconfirmed_scan_every frames and the ball is found by frame
   // 10 + 5; without hints (or with 0) only at the full_scan_every slot.
   const camera::Camera cam = PosedCamera();
-  std::vector<std::vector<Thing>> frames;
-  for (int f = 0; f < 40; ++f) {
-    frames.push_back({{Vector2d(500, 100), 0.2}});
-    if (f >= 10) frames.back().push_back({Vector2d(100 + 6 * f, 300), 0.9});
-  }
+  const std::vector<std::vector<Thing>> frames = StillThingThenBall();
   BallTrackOptions track;
   track.full_scan_every = 100;
   for (const int every : {0, 5}) {
@@ -252,17 +278,7 @@ TEST(CameraStage, WithoutAFusedPositionAStillThingGivesWayToTheBallWithinUnconfi
     CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted");
     BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
     stage.SetHints(&board);
-    long long first_ball = -1;
-    for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
-      io::SourceFrame in;
-      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
-      in.frame = f;
-      in.time_s = f / 60.0;
-      const CameraMessage m = stage.Process(in);
-      const bool ball = std::any_of(m.candidates.begin(), m.candidates.end(),
-                                    [](const auto& o) { return o.centre_px.y() == 300; });
-      if (ball && first_ball < 0) first_ball = f;
-    }
+    const long long first_ball = FirstFrameWithTheBall(stage, frames, &f, [](long long) {});
     if (every == 5) {
       EXPECT_GE(first_ball, 10);
       EXPECT_LE(first_ball, 15);
@@ -280,11 +296,7 @@ TEST(CameraStage, WithoutAFusedPositionAStillThingGivesWayToTheBallWithinUnconfi
 // are multiples of unconfirmed_scan_every, so that the nodes search the same frames.
 TEST(CameraStage, ANodeSearchesWholeOnAlignedFramesOnceTheFusionTellsOfLoss) {
   const camera::Camera cam = PosedCamera();
-  std::vector<std::vector<Thing>> frames;
-  for (int f = 0; f < 40; ++f) {
-    frames.push_back({{Vector2d(500, 100), 0.2}});
-    if (f >= 10) frames.back().push_back({Vector2d(100 + 6 * f, 300), 0.9});
-  }
+  const std::vector<std::vector<Thing>> frames = StillThingThenBall();
   BallTrackOptions track;
   track.full_scan_every = 100;
   track.unconfirmed_scan_every = 5;
@@ -293,18 +305,9 @@ TEST(CameraStage, ANodeSearchesWholeOnAlignedFramesOnceTheFusionTellsOfLoss) {
     CameraStage stage(0, cam, Scripted(&frames, &f), track, "scripted");
     BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
     stage.SetHints(&board, /*no_hint_means_unconfirmed=*/false);
-    long long first_ball = -1;
-    for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
-      if (tells && f == 3) board.MarkTellsLoss();
-      io::SourceFrame in;
-      in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
-      in.frame = f;
-      in.time_s = f / 60.0;
-      const CameraMessage m = stage.Process(in);
-      const bool ball = std::any_of(m.candidates.begin(), m.candidates.end(),
-                                    [](const auto& o) { return o.centre_px.y() == 300; });
-      if (ball && first_ball < 0) first_ball = f;
-    }
+    const long long first_ball = FirstFrameWithTheBall(stage, frames, &f, [&](long long k) {
+      if (tells && k == 3) board.MarkTellsLoss();
+    });
     // Told: the first whole search from frame 10 on falls on frame 10 (a multiple of 5).
     EXPECT_EQ(first_ball, tells ? 10 : -1) << (tells ? "told of loss" : "never told");
   }
