@@ -190,8 +190,12 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   // DIR replaced the user's rig).
   const std::vector<std::string> inputs = util::PathList(
       options.rig_path, options.camera_paths, options.mounts_path, options.field);
-  for (const char* name : {"rig.json", "coverage.json", "coverage.png", "angle.png", "error.png",
-                           "coverage_above.png", "angle_above.png", "error_above.png"}) {
+  std::vector<std::string> outputs = {"coverage.json", "coverage.png", "angle.png", "error.png"};
+  if (options.coverage.height_above_m > 0) {
+    outputs.insert(outputs.end(), {"coverage_above.png", "angle_above.png", "error_above.png"});
+  }
+  if (options.optimize) outputs.push_back("rig.json");  // a rig.json beside the maps is an input
+  for (const std::string& name : outputs) {
     util::CheckOutputPath(OutPath(options, name), inputs, "--out");
   }
   std::error_code ec;

@@ -120,6 +120,12 @@ TEST(PlanRunTest, BadInputGivesOneLineErrors) {
     EXPECT_NE(msg.find("rig.json"), std::string::npos) << msg;
     std::ifstream after_in(in_place.rig_path);
     EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_in)), {}), before);
+    // Without --optimize nothing is written over it: the maps go beside the rig.
+    in_place.optimize = false;
+    in_place.coverage.grid_step_m = 2.0;
+    in_place.map.width_px = 200;
+    EXPECT_NO_THROW(RunPlan(in_place));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/coverage.json"));
   }
   // A camera 1e300 m away (it saw nothing and the rig was planned without a word).
   {
