@@ -22,7 +22,7 @@ void LiveSyncOptions::Check() const {
 
 namespace {
 // Messages in a row in a new time base before a camera is followed there.
-constexpr int kConfirmJump = 3;
+constexpr int kConfirmJumpMessages = 3;
 }  // namespace
 
 LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& options)
@@ -35,7 +35,7 @@ LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& optio
       last_arrival_(num_cameras, -std::numeric_limits<double>::infinity()),
       skip_until_s_(num_cameras, -std::numeric_limits<double>::infinity()),
       jump_run_(num_cameras, 0),
-      jump_time_(num_cameras, 0.0) {
+      jump_time_s_(num_cameras, 0.0) {
   FV_REQUIRE(num_cameras >= 1, "LiveSynchronizer: needs at least one camera");
   options.Check();
 }
@@ -84,11 +84,14 @@ bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
 bool LiveSynchronizer::Implausible(int c, double time_s) {
   const double jump = options_.max_time_jump_s;
   if (jump <= 0) return false;
-  double reference = last_time_[c];
-  if (last_frame_[c] < 0) {  // its first message: the other cameras' latest, if any
+  // Its stream: its last frame, or where it said its source skipped to (SkipUntil).
+  double reference = std::max(last_time_[c], skip_until_s_[c]);
+  if (last_frame_[c] < 0) {  // its first message: the latest of the other active cameras, if any
     reference = -std::numeric_limits<double>::infinity();
     for (int o = 0; o < n_; ++o) {
-      if (o != c && last_frame_[o] >= 0) reference = std::max(reference, last_time_[o]);
+      if (o != c && stats_[o].active && last_frame_[o] >= 0) {
+        reference = std::max(reference, last_time_[o]);
+      }
     }
   }
   if (!std::isfinite(reference) || std::abs(time_s - reference) <= jump) {
@@ -96,14 +99,23 @@ bool LiveSynchronizer::Implausible(int c, double time_s) {
     return false;
   }
   jump_run_[c] =
-      jump_run_[c] > 0 && std::abs(time_s - jump_time_[c]) <= jump ? jump_run_[c] + 1 : 1;
-  jump_time_[c] = time_s;
-  if (jump_run_[c] < kConfirmJump) return true;
-  // The camera goes on there: follow it, and forget groups decided past it.
+      jump_run_[c] > 0 && std::abs(time_s - jump_time_s_[c]) <= jump ? jump_run_[c] + 1 : 1;
+  jump_time_s_[c] = time_s;
+  if (jump_run_[c] < kConfirmJumpMessages) return true;
+  // The camera goes on there: follow it. Groups decided past it are forgotten only when the
+  // other active cameras are there too (the clock they share was stepped back); one camera alone
+  // in another time base is left to be late, as before, rather than reopen decided times.
   jump_run_[c] = 0;
   last_frame_[c] = -1;
   last_time_[c] = -std::numeric_limits<double>::infinity();
-  if (decided_until_s_ > time_s) decided_until_s_ = time_s - options_.tolerance_s;
+  skip_until_s_[c] = -std::numeric_limits<double>::infinity();
+  bool rig_moved = true;
+  for (int o = 0; o < n_; ++o) {
+    if (o != c && stats_[o].active && last_frame_[o] >= 0) {
+      rig_moved = rig_moved && std::abs(last_time_[o] - time_s) <= jump;
+    }
+  }
+  if (rig_moved && decided_until_s_ > time_s) decided_until_s_ = time_s - options_.tolerance_s;
   return false;
 }
 

@@ -28,9 +28,9 @@ struct LiveSyncOptions {
   // A message whose time lies further than this from its camera's previous one (or, for its
   // first, from the other cameras' latest) is dropped as implausible: one frame stamped an hour
   // ahead would otherwise decide a group there, after which every camera's frames are late.
-  // A camera that goes on in the new time base (kConfirmJump messages in a row, each within this
-  // of the one before) is followed there, and when that lies before the groups already decided
-  // they are forgotten (the bad time had decided them). 0: off.
+  // A camera that goes on in the new time base (three messages in a row, each within this of the
+  // one before) is followed there; groups decided past it are forgotten when the other cameras
+  // are there too (their clock was stepped back). 0: off.
   double max_time_jump_s = 10.0;
   void Check() const;  // throws fv::Error naming the bad field
 };
@@ -87,7 +87,7 @@ class LiveSynchronizer {
   std::vector<double> last_arrival_;
   std::vector<double> skip_until_s_;  // SkipUntil
   std::vector<int> jump_run_;         // implausible messages in a row (max_time_jump_s)
-  std::vector<double> jump_time_;     // the time of the last of them
+  std::vector<double> jump_time_s_;   // the time of the last of them
   // Whether camera c's message at time_s is too far from its stream (max_time_jump_s), counting
   // the run of such messages.
   bool Implausible(int c, double time_s);

@@ -110,6 +110,38 @@ TEST(LiveSync, AFrameStampedFarFromItsStreamDoesNotStallFusion) {
   EXPECT_EQ(groups.back().cameras[0]->frame, 205);
 }
 
+// Legitimate streams the implausible-time rule must not touch: a camera whose source skipped over
+// 10 s (it said so), and one camera alone in another time base is followed without reopening the
+// groups the others decided.
+TEST(LiveSync, SkipsAndOneCameraInAnotherTimeBaseAreNotTakenForBadTimes) {
+  LiveSyncOptions o;
+  o.max_time_jump_s = 10;
+  LiveSynchronizer sync(2, o);
+  ASSERT_TRUE(sync.Add(Msg(0, 0, 1.0), 1.0));
+  ASSERT_TRUE(sync.Add(Msg(1, 0, 1.0), 1.0));
+  ASSERT_TRUE(sync.Next(1.0));
+  sync.SkipUntil(0, 30.0, 2.0);  // both sources dropped 29 s (a stalled network)
+  sync.SkipUntil(1, 30.0, 2.0);
+  ASSERT_TRUE(sync.Add(Msg(0, 1, 30.0), 2.0));
+  EXPECT_TRUE(sync.Add(Msg(1, 870, 30.0), 2.0));
+  EXPECT_EQ(sync.stats()[0].implausible + sync.stats()[1].implausible, 0);
+  const auto both = sync.Next(2.0);
+  ASSERT_TRUE(both);
+  EXPECT_EQ(both->present(), 2);
+  // Camera 1 alone restarts its clock at 0 (camera 0 goes on at 30 s): after three frames it is
+  // followed, but the time camera 0 decided stays decided (no group back in time).
+  double latest_group_s = both->time_s;
+  for (int k = 0; k < 6; ++k) {
+    sync.Add(Msg(1, 1000 + k, 0.1 + k / 30.0), 3.0 + k / 30.0);
+    sync.Add(Msg(0, 2 + k, 30.1 + k / 30.0), 3.0 + k / 30.0);
+    while (auto g = sync.Next(3.0 + k / 30.0)) {
+      EXPECT_GE(g->time_s, latest_group_s);
+      latest_group_s = g->time_s;
+    }
+  }
+  EXPECT_EQ(sync.stats()[1].implausible, 2);
+}
+
 // A camera whose source skipped frames says so (SkipUntil): the others' frames before it are
 // paired at once instead of waiting for that camera; frames after it still wait.
 TEST(LiveSync, SkippedFramesAreNotWaitedFor) {
