@@ -61,10 +61,14 @@ void Setup(CLI::App& app, int& exit_code) {
     };
     const net::FuseSummary s = net::RunFuse(*o);
     std::cout << s.ToString() << "\n";
-    FV_REQUIRE(s.written,
-               "fuse: no camera frame arrived, {} not written (do the nodes' --connect addresses "
+    FV_REQUIRE(s.written || s.messages > 0,
+               "fuse: no message arrived, {} not written (do the nodes' --connect addresses "
                "reach --listen {}?)",
                o->out, o->listen);
+    FV_REQUIRE(s.written,
+               "fuse: {} messages arrived but no frame could be fused (see the counts above), {} "
+               "not written",
+               s.messages, o->out);
     std::cout << "wrote " << o->out << " (" << s.rows_written << " rows)\n";
   });
 }

@@ -325,7 +325,7 @@ void FuseServer::Emit(const pipeline::SyncedFrame& group) {
     summary_.latency_parts.push_back(LatencyPartsOf(group, latency_s));
   }
   if (!f.result.ok()) {
-    if (o_.hints) SendHint(HintMessage{f.time_s, 0, 0, 0, 0.5 * o_.ball_diameter_m, true});
+    if (o_.hints) SendHint(HintMessage{.time_s = f.time_s, .lost = true});
     return;
   }
   const Eigen::Vector3d& p = f.result.point_world;
@@ -343,8 +343,12 @@ void FuseServer::Emit(const pipeline::SyncedFrame& group) {
   if (flight_worker_) flight_worker_->Add(pipeline::BallSampleOf(f));
   // A single camera's ground guess is no position of the cameras together.
   if (o_.hints) {
-    SendHint(
-        HintMessage{f.time_s, p.x(), p.y(), p.z(), 0.5 * o_.ball_diameter_m, f.result.on_ground});
+    SendHint(HintMessage{.time_s = f.time_s,
+                         .x_m = p.x(),
+                         .y_m = p.y(),
+                         .z_m = p.z(),
+                         .radius_m = 0.5 * o_.ball_diameter_m,
+                         .lost = f.result.on_ground});
   }
 }
 

@@ -81,9 +81,9 @@ class BallHintBoard {
   std::optional<BallHint> Get(int camera, long long index);
   // Releases every waiting camera (the fusion ended or failed); Get then returns nullopt.
   void Close();
-  // Whether the fusion tells of frames without a position too (a fusion node's lost hints, or
-  // any position published): then a board without a recent position means the cameras together
-  // have none (CameraStage's unconfirmed scans).
+  // Whether the fusion tells of frames without a position too (a fusion node's lost hints): then
+  // a board without a recent position means the cameras together have none (CameraStage's
+  // unconfirmed scans).
   void MarkTellsLoss() { tells_loss_ = true; }
   bool TellsLoss() const { return tells_loss_; }
 

@@ -247,17 +247,18 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
 
 bool CameraStage::UnconfirmedScan(long long frame) {
   const int every = track_->unconfirmed_scan_every();
+  // A camera node learns of a loss when its lost hints arrive, at another frame than the other
+  // nodes: it searches whole at the first frame it processes of each block of `every` frame
+  // numbers, so that the nodes search the same frames (a position needs two). In one process the
+  // cameras lose their confirmation together and count alike.
+  const long long block = every > 0 ? frame / every : 0;
+  const bool block_start = block != last_block_;
+  last_block_ = block;
   if (hints_ == nullptr || !(no_hint_means_unconfirmed_ || hints_->TellsLoss()) || every == 0 ||
       unconfirmed_ < every) {
     return false;
   }
-  // A camera node learns of the loss when its lost hints arrive, at another frame than the other
-  // nodes: it searches whole on frame numbers that are multiples of `every`, so that the cameras
-  // search the same frames, where a position needs two of them. (In one process the cameras
-  // lose their confirmation at the same frame and count alike; aligning there measured one
-  // frame fewer of 192 on the kick render's two-camera pairs with camera 1.) Fuse and three
-  // nodes --realtime on a 60-frame kick: 7 -> 20 positions unaligned, 34 aligned (offline 39).
-  if (!no_hint_means_unconfirmed_ && frame % every != 0) return false;
+  if (!no_hint_means_unconfirmed_ && !block_start) return false;
   unconfirmed_ = 0;
   return true;
 }

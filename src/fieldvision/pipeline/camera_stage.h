@@ -122,7 +122,8 @@ class CameraStage {
   BallGuidedFn guided_;
   BallHintBoard* hints_ = nullptr;
   double last_time_s_ = 0.0;
-  int unconfirmed_ = 0;  // frames in a row without a recent fused position (with hints)
+  int unconfirmed_ = 0;        // frames in a row without a recent fused position (with hints)
+  long long last_block_ = -1;  // frame / unconfirmed_scan_every of the last frame processed
   bool no_hint_means_unconfirmed_ = true;
   std::string source_name_;
   std::unique_ptr<Track> track_;
