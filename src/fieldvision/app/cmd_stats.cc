@@ -40,6 +40,7 @@ void RunStats(const StatsCli& c) {
     o.team_of = roster.team_of;
     o.name_of = roster.name_of;
   }
+  o.Check();
   // The library's messages name the rows, not the file they came from.
   const stats::StatsResult r = [&] {
     try {

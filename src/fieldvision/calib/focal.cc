@@ -374,7 +374,7 @@ void WriteHomographyYaml(const HomographyResult& h, const std::string& path) {
   util::AtomicWrite(
       path,
       [&](const std::string& tmp) {
-        cv::FileStorage fs = camera::OpenYamlWriter(tmp, path, "homography file");
+        cv::FileStorage fs = camera::NewYamlWriter();
         cv::Mat m, inv;
         cv::eigen2cv(h.image_from_ground, m);
         const Eigen::Matrix3d g = h.image_from_ground.inverse();
@@ -384,6 +384,7 @@ void WriteHomographyYaml(const HomographyResult& h, const std::string& path) {
         fs << "homography_ground_from_image" << inv;
         fs << "rms_px" << h.rms_px << "rms_mm" << h.rms_mm;
         fs << "num_points" << static_cast<int>(h.points.size()) << "num_inliers" << h.num_inliers;
+        camera::SaveYaml(fs, tmp, path, "homography file");
       },
       "homography file");
 }

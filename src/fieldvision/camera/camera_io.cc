@@ -169,16 +169,18 @@ Camera ReadCameraYaml(const std::string& path) {
   }
 }
 
-cv::FileStorage OpenYamlWriter(const std::string& temp_path, const std::string& path,
-                               const std::string& what) {
-  cv::FileStorage fs;
-  try {
-    fs.open(temp_path, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception&) {
-    Throw("cannot write {} '{}'", what, path);
-  }
-  FV_REQUIRE(fs.isOpened(), "cannot write {} '{}'", what, path);
-  return fs;
+cv::FileStorage NewYamlWriter() {
+  return cv::FileStorage(
+      ".yaml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+}
+
+void SaveYaml(cv::FileStorage& fs, const std::string& file, const std::string& path,
+              const std::string& what) {
+  const std::string text = fs.releaseAndGetString();
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  out.close();
+  FV_REQUIRE(!out.fail(), "cannot write {} '{}'", what, path);
 }
 
 void WriteCameraYaml(const Camera& camera, const std::string& path) {
@@ -186,7 +188,7 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
   util::AtomicWrite(
       path,
       [&](const std::string& tmp) {
-        cv::FileStorage fs = OpenYamlWriter(tmp, path, "camera file");
+        cv::FileStorage fs = NewYamlWriter();
         // cv::write, not <<: << takes strings that start with [ ] { } for structure marks.
         if (!camera.name.empty()) cv::write(fs, "name", camera.name);
         fs << "image_width" << camera.width << "image_height" << camera.height;
@@ -211,7 +213,7 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
           for (const auto& [key, value] : camera.notes) cv::write(fs, key, value);
           fs << "}";
         }
-        fs.release();
+        SaveYaml(fs, tmp, path, "camera file");
       },
       "camera file");
 }

@@ -19,9 +19,11 @@ Camera ReadCameraYaml(const std::string& path);
 void CheckOpenCvYamlText(const std::string& path, const std::string& what);
 // Writes the camera file (to a temporary name first, then renamed, so a failure loses nothing).
 void WriteCameraYaml(const Camera& camera, const std::string& path);
-// An OpenCV YAML writer on `temp_path` (whatever its extension) for the file `path`; throws
-// fv::Error "cannot write WHAT 'path'" when it cannot be opened.
-cv::FileStorage OpenYamlWriter(const std::string& temp_path, const std::string& path,
-                               const std::string& what);
+// An OpenCV YAML writer in memory: plain YAML whatever the file's name (a name ending in .gz or
+// .xml, or a temporary name, would choose another format). SaveYaml writes what it holds as the
+// whole of `file` (a temporary file, util::AtomicWrite); throws "cannot write WHAT 'path'".
+cv::FileStorage NewYamlWriter();
+void SaveYaml(cv::FileStorage& fs, const std::string& file, const std::string& path,
+              const std::string& what);
 
 }  // namespace fv::camera

@@ -11,12 +11,12 @@
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/lab.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/pipeline/flight_refiner.h"
 #include "fieldvision/recon/ball_csv.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::pipeline {
 

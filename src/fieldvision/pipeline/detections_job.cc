@@ -24,6 +24,7 @@
 #include "fieldvision/recon/trajectory_physics.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/stats.h"
 
 namespace fv::pipeline {
@@ -607,30 +608,18 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
         recon::AnalyzeTrajectory(res.per_frame, FlightOptions(o.ball_diameter_m, o.ball_mass_kg));
   }
   res.positions = static_cast<long long>(res.track.size());
-  const std::string tmp = o.out + ".part";
-  {
-    util::CsvWriter csv(tmp, recon::BallCsvColumns(), 6);
-    for (const auto& s : res.track) {
-      csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y()
-          << s.ball_in_world.z() << s.n_cams << s.err_px;
-      csv.EndRow();
-    }
-    csv.Close();
+  util::AtomicOutput out_file(o.out);
+  util::CsvWriter csv(out_file.temp_path(), recon::BallCsvColumns(), 6);
+  for (const auto& s : res.track) {
+    csv << s.frame << s.time_s << s.ball_in_world.x() << s.ball_in_world.y() << s.ball_in_world.z()
+        << s.n_cams << s.err_px;
+    csv.EndRow();
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, o.out, ec);
-  FV_REQUIRE(!ec, "cannot write '{}': {}", o.out, ec.message());
+  out_file.CloseAndCommit(csv);
   if (!o.truth.empty()) res.eval = recon::EvaluateBallFiles(o.truth, o.out, o.eval);
   if (!o.flights.empty()) {
-    const std::string ftmp = o.flights + ".part";
-    {
-      std::ofstream f(ftmp);
-      FV_REQUIRE(f.good(), "cannot write '{}'", o.flights);
-      f << recon::FlightsToJson(*res.trajectory).dump(2) << "\n";
-      FV_REQUIRE(f.good(), "cannot write '{}'", o.flights);
-    }
-    std::filesystem::rename(ftmp, o.flights, ec);
-    FV_REQUIRE(!ec, "cannot write '{}': {}", o.flights, ec.message());
+    util::WriteTextFile(o.flights, recon::FlightsToJson(*res.trajectory).dump(2) + "\n",
+                        "--flights");
   }
   return res;
 }

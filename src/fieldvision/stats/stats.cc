@@ -90,20 +90,24 @@ std::vector<Zone> ReadZones(const std::string& path) {
 
 namespace {
 
-// SmoothTrack::noise_m: second differences p[i-1] - 2 p[i] + p[i+1] of samples in one segment
-// whose two steps differ by under 10 % have sd sqrt(6) sigma per axis under white noise.
+// SmoothTrack::noise_m: the change of velocity across each sample, (p[i+1] - p[i]) / dt2 -
+// (p[i] - p[i-1]) / dt1, is zero for straight steady motion at any spacing and has variance
+// sigma^2 (1/dt1^2 + (1/dt1 + 1/dt2)^2 + 1/dt2^2) under white noise; its robust spread over that
+// scale is sigma. -1 with fewer than five such samples (too short to tell).
 double PositionNoise(const std::vector<double>& t, const std::vector<Eigen::Vector2d>& p,
                      const std::vector<int>& segment) {
-  std::vector<double> second;
+  std::vector<double> scaled;
   for (size_t i = 1; i + 1 < t.size(); ++i) {
     if (segment[i - 1] != segment[i + 1]) continue;
-    const double before = t[i] - t[i - 1], after = t[i + 1] - t[i];
-    if (std::abs(after - before) > 0.1 * std::max(before, after)) continue;
-    const Eigen::Vector2d d = p[i - 1] - 2 * p[i] + p[i + 1];
-    second.push_back(d.x());
-    second.push_back(d.y());
+    const double dt1 = t[i] - t[i - 1], dt2 = t[i + 1] - t[i];
+    if (!(dt1 > 0 && dt2 > 0)) continue;
+    const Eigen::Vector2d d = (p[i + 1] - p[i]) / dt2 - (p[i] - p[i - 1]) / dt1;
+    const double scale =
+        std::sqrt(1 / (dt1 * dt1) + (1 / dt1 + 1 / dt2) * (1 / dt1 + 1 / dt2) + 1 / (dt2 * dt2));
+    scaled.push_back(d.x() / scale);
+    scaled.push_back(d.y() / scale);
   }
-  return second.size() < 10 ? 0.0 : util::RobustSigma(second) / std::sqrt(6.0);
+  return scaled.size() < 10 ? -1.0 : util::RobustSigma(scaled);
 }
 
 }  // namespace
@@ -235,8 +239,8 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
   ps.band_time_s.assign(o.speed_bands_mps.size() + 1, 0.0);
   for (const auto& z : o.zones) ps.zone_time_s[z.name] = 0.0;
   ps.top_speed_mps = TopSpeed(s, o);
-  ps.position_noise_m = s.noise_m;
-  const double dead_band_m = o.distance_noise_factor * s.noise_m;
+  ps.position_noise_m = std::max(s.noise_m, 0.0);
+  const double dead_band_m = o.distance_noise_factor * std::max(s.noise_m, 0.0);
   Eigen::Vector2d counted_to = s.pos_m.front();  // where the last counted move ended
   double sprint_run = 0, speed_time = 0;
   std::map<std::string, std::optional<double>> inside_since;
@@ -335,13 +339,21 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
       p.emplace_back(*r->x_m, *r->y_m);
     }
     if (t.empty() || t.back() - t.front() < o.min_track_s) continue;
-    SmoothTrack s = SmoothPositions(id, t, p, o);
-    res.players.push_back(PlayerStatsOf(s, o, res.events));
+    res.tracks.push_back(SmoothPositions(id, t, p, o));
     t_min = std::min(t_min, t.front());
     t_max = std::max(t_max, t.back());
-    res.tracks.push_back(std::move(s));
   }
-  FV_REQUIRE(!res.players.empty(), "no track is longer than min_track_s = {} s", o.min_track_s);
+  FV_REQUIRE(!res.tracks.empty(), "no track is longer than min_track_s = {} s", o.min_track_s);
+  // A track too short to tell its noise takes the others' median (one camera, one tracker).
+  std::vector<double> known;
+  for (const SmoothTrack& s : res.tracks) {
+    if (s.noise_m >= 0) known.push_back(s.noise_m);
+  }
+  const double median_noise_m = known.empty() ? 0.0 : util::Median(known);
+  for (SmoothTrack& s : res.tracks) {
+    if (s.noise_m < 0) s.noise_m = median_noise_m;
+    res.players.push_back(PlayerStatsOf(s, o, res.events));
+  }
   res.duration_s = t_max - t_min;
   std::sort(res.events.begin(), res.events.end(),
             [](const ZoneEvent& a, const ZoneEvent& b) { return a.enter_s < b.enter_s; });

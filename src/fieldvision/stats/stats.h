@@ -86,8 +86,10 @@ struct SmoothTrack {
   std::vector<Eigen::Vector2d> pos_m;
   std::vector<double> speed_mps;
   std::vector<int> segment;  // pieces split at gaps and impossible jumps
-  // The raw positions' noise (1 sigma per axis): the robust spread of their second differences
-  // over evenly spaced samples, / sqrt(6) (a player's acceleration adds a few mm at 25 frames/s).
+  // The raw positions' noise (1 sigma per axis): the robust spread of the change of velocity
+  // across each sample, scaled to it (a player's acceleration adds a few mm at 25 frames/s);
+  // -1 from SmoothPositions when the track is too short to tell (ComputeStats then gives it the
+  // other tracks' median).
   double noise_m = 0;
 };
 

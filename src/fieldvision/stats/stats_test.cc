@@ -80,15 +80,17 @@ TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
 }
 
 // Tracking noise is not running: a player standing for a minute with 10 cm position noise at
-// 25 frames/s, and one walking 6 m in that minute, with the same noise.
+// 25 frames/s (stream timestamps jittered by up to 6 ms), and one walking 6 m in that minute,
+// with the same noise.
 TEST(Stats, NoiseOfAStandingPlayerIsNoDistance) {
   fv::testing::SeededRng rng(22);
   std::vector<track::TrackRow> rows;
   for (int f = 0; f < 60 * 25; ++f) {
+    const double jitter_s = rng.Uniform(-0.006, 0.006);
     for (int id : {1, 2}) {
       track::TrackRow r;
       r.frame = f + 1;
-      r.time_s = f / 25.0;
+      r.time_s = f / 25.0 + jitter_s;
       r.id = id;
       r.box = cv::Rect2d(0, 0, 10, 20);
       r.x_m = (id == 1 ? 3.0 : -20.0 + 0.1 * *r.time_s) + rng.Normal(0, 0.1);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
@@ -60,11 +61,13 @@ std::string ResolveOutputPath(const std::string& out, std::string_view what) {
 
 AtomicOutput::AtomicOutput(const std::string& out, std::string_view what)
     : out_(out), target_(ResolveOutputPath(out, what)) {
-  // Beside the target (same file system: rename is atomic), unique per process, keeping the
-  // extension that writers such as cv::VideoWriter and cv::imwrite choose the format by.
+  // Beside the target (same file system: rename is atomic), unique per process and write (two
+  // studio saves of one file at once), keeping the extension that writers such as
+  // cv::VideoWriter and cv::imwrite choose the format by.
   const fs::path t = target_;
-  temp_ = (t.parent_path() / (t.stem().string() + "." + std::to_string(::getpid()) + ".part" +
-                              t.extension().string()))
+  static std::atomic<long long> count{0};
+  temp_ = (t.parent_path() / (t.stem().string() + "." + std::to_string(::getpid()) + "-" +
+                              std::to_string(count++) + ".part" + t.extension().string()))
               .string();
 }
 

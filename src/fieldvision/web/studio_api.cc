@@ -381,7 +381,10 @@ void SaveZones(const json& zones, const fs::path& out) {
     util::AtomicWrite(
         out.string(),
         [&](const std::string& tmp) {
-          util::WriteTextFile(tmp, zones.dump(1) + "\n", "zones file");
+          std::ofstream file(tmp, std::ios::binary);
+          file << zones.dump(1) << "\n";
+          file.close();
+          FV_REQUIRE(!file.fail(), "cannot write zones file '{}'", out.string());
           stats::ReadZones(tmp);
         },
         "zones file");
