@@ -43,6 +43,12 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Longest wait (s) for a slow camera before a frame is fused without it")
       ->check(FiniteRange(0, 60))
       ->capture_default_str();
+  cmd->add_option("--max-time-jump", o->sync.max_time_jump_s,
+                  "A frame stamped further than this (s) from its camera's stream is dropped as "
+                  "a bad time, until the camera stays in the new time base for three frames (0: "
+                  "off)")
+      ->check(FiniteRange(0, 86400))
+      ->capture_default_str();
   AddBallDiameterOption(cmd, o->ball_diameter_m);
   AddFusionOptions(cmd, o->triangulation);
   cmd->add_flag("!--no-flights", o->flights,
