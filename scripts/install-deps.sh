@@ -5,7 +5,7 @@ set -euo pipefail
 [ "${FV_SKIP_INSTALL:-0}" = 1 ] && exit 0
 PKGS=(
   build-essential cmake ninja-build pkg-config
-  libopencv-dev libopencv-contrib-dev libjpeg62-turbo-dev
+  libopencv-dev libopencv-contrib-dev libjpeg62-turbo-dev libavutil-dev
   libeigen3-dev libceres-dev
   nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
@@ -23,7 +23,8 @@ done
 # ships the sample photo person.jpg that the detector test uses. npm also builds the studio's front
 # end (studio/); chromium runs its browser tests (never a downloaded browser). ZeroMQ joins camera
 # nodes and the fusion node (python3-zmq runs the README's example client). Optional, found when
-# installed: libaravis-dev (GigE / USB3 Vision cameras, `aravis:` sources).
+# installed: libaravis-dev (GigE / USB3 Vision cameras, `aravis:` sources). libavutil-dev (also
+# pulled in by OpenCV's packages) lets the codecs plugin count the damaged data FFmpeg conceals.
 command -v npm >/dev/null 2>&1 || missing+=(npm)
 [ ${#missing[@]} -eq 0 ] && exit 0
 SUDO=""

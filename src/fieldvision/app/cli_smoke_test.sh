@@ -327,4 +327,22 @@ grep -q -- "--draw '.*out.jpg': a video's name ends in .mp4, .avi or .mkv" "$TMP
 check "calibrate import: --units with a Qualisys file" nonzero $FV calibrate import \
   --qualisys "$TMP/imp/none.qca.txt" --units cm --out "$TMP/imp/q"
 grep -q "units applies to --toml" "$TMP/err" || { echo "FAIL calibrate import: --units taken"; fail=1; }
+# A video with damaged data (bytes zeroed in the middle): FFmpeg conceals it, the run says so.
+"$FV" synth --preset kick --frames 30 --width 320 --height 240 --out "$TMP/dmg" --quiet \
+  >/dev/null 2>&1
+"$FV" detect --video "$TMP/dmg/cam1.avi" --out "$TMP/dmg/d.csv" --draw "$TMP/dmg/v.mp4" \
+  --no-progress >/dev/null 2>&1
+if [ -s "$TMP/dmg/v.mp4" ]; then  # only where OpenCV's FFmpeg encodes H.264
+  size=$(stat -c %s "$TMP/dmg/v.mp4")
+  for k in 2 3 4 5; do
+    dd if=/dev/zero of="$TMP/dmg/v.mp4" bs=1 seek=$((size * k / 7)) count=300 conv=notrunc \
+      2>/dev/null
+  done
+  check "detect: a damaged H.264 video" 0 $FV detect --video "$TMP/dmg/v.mp4" \
+    --out "$TMP/dmg/d2.csv" --no-progress
+  grep -q "damaged data" "$TMP/err" || { echo "FAIL detect: damaged video not reported"; fail=1; }
+  check "detect: the undamaged video" 0 $FV detect --video "$TMP/dmg/cam1.avi" \
+    --out "$TMP/dmg/d3.csv" --no-progress
+  grep -q "damaged data" "$TMP/err" && { echo "FAIL detect: an intact video reported"; fail=1; }
+fi
 exit $fail

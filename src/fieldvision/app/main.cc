@@ -33,6 +33,17 @@ void QuietLibraries(bool verbose) {
   fv::codecs::SetLibraryLogs(verbose);
 }
 
+// FFmpeg conceals damaged video data (a cut download, a bad card) and OpenCV hands on the frames
+// without a word: results from them, and from the frames that refer to them, may be wrong.
+void WarnOfDamagedVideo() {
+  const long long problems = fv::codecs::DecoderProblems();
+  if (problems <= 0) return;
+  std::cerr << "fieldvision: warning: the video decoder reported damaged data " << problems
+            << (problems == 1 ? " time" : " times")
+            << " (frames concealed): results from those frames and the ones after them may be "
+               "wrong\n";
+}
+
 int Run(int argc, char** argv) {
   CLI::App app{
       "fieldvision: calibrate cameras against a sports field, find the ball, place it in 3D, fit "
@@ -74,6 +85,7 @@ int Run(int argc, char** argv) {
     std::cerr << "fieldvision: error: " << FirstLine(e.what()) << "\n";
     return 1;
   }
+  WarnOfDamagedVideo();
   return exit_code;
 }
 

@@ -93,8 +93,14 @@ const PluginApi* LoadPlugin() {
       kPluginFile, tried);
 }
 
+std::atomic<const PluginApi*> g_loaded{nullptr};
+
 const PluginApi& Api() {
-  static const PluginApi* api = LoadPlugin();
+  static const PluginApi* api = [] {
+    const PluginApi* loaded = LoadPlugin();
+    g_loaded = loaded;
+    return loaded;
+  }();
   return *api;
 }
 
@@ -142,6 +148,11 @@ class QuietStderr {
 void Load() { Api(); }
 
 void SetLibraryLogs(bool shown) { g_library_logs = shown; }
+
+long long DecoderProblems() {
+  const PluginApi* api = g_loaded;
+  return api != nullptr ? api->decoder_problems() : 0;
+}
 
 cv::Mat ImRead(const std::string& path, int flags) {
   const PluginApi& api = Api();

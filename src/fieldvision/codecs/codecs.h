@@ -42,6 +42,11 @@ constexpr int FourCc(char c1, char c2, char c3, char c4) {
   return (c1 & 255) | ((c2 & 255) << 8) | ((c3 & 255) << 16) | ((c4 & 255) << 24);
 }
 
+// Damaged data FFmpeg's decoders reported since the first call (each call after a capture opened
+// keeps FFmpeg's log counted: OpenCV sets its own callback at its first open); -1 when the plugin
+// was built without libavutil. 0 without loading the plugin when it is not loaded.
+long long DecoderProblems();
+
 // Whether the log of the libraries the plugin brings in (GLib / GStreamer) reaches stderr
 // (default: not; --verbose turns it on).
 void SetLibraryLogs(bool shown);

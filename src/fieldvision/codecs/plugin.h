@@ -10,7 +10,7 @@
 
 namespace fv::codecs {
 
-inline constexpr int kPluginApiVersion = 1;
+inline constexpr int kPluginApiVersion = 2;
 
 struct PluginApi {
   int version = kPluginApiVersion;
@@ -25,6 +25,10 @@ struct PluginApi {
                       double fps, cv::Size size, bool is_color);
   std::string (*backend_name)(const cv::VideoCapture& capture);
   bool (*has_backend)(int api);
+  // Damaged data FFmpeg's decoders reported (concealed errors) since the first call, which (and
+  // each later one) routes FFmpeg's log through the plugin's counter: call it after a capture
+  // opened (OpenCV sets its own log callback at its first open). -1: counting not built in.
+  long long (*decoder_problems)();
 };
 
 }  // namespace fv::codecs

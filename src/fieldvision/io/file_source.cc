@@ -71,6 +71,7 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
     capture_ = codecs::NewVideoCapture();
     FV_REQUIRE(OpenVideoFile(*capture_, path), "cannot open video '{}' (not a video OpenCV reads?)",
                path);
+    codecs::DecoderProblems();  // count what FFmpeg's decoders conceal (main warns)
   }
   const double container_fps = avi_ ? avi_->fps() : capture_->get(cv::CAP_PROP_FPS);
   fps_ = options.fps > 0 ? options.fps
