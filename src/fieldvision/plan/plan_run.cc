@@ -1,5 +1,6 @@
 #include "fieldvision/plan/plan_run.h"
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -7,9 +8,9 @@
 #include <fmt/format.h>
 
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::plan {
 namespace {
@@ -81,6 +82,29 @@ std::string OutPath(const PlanRunOptions& options, const std::string& name) {
   return (std::filesystem::path(options.out_dir) / name).string();
 }
 
+// The maps drawn for each layer, by the stem of their file names.
+constexpr std::array<std::pair<CoverageMapKind, const char*>, 3> kMapKinds = {
+    {{CoverageMapKind::kCount, "coverage"},
+     {CoverageMapKind::kAngle, "angle"},
+     {CoverageMapKind::kError, "error"}}};
+
+// A map's file: STEM.png for the ground layer, STEM_above.png for the one above it.
+std::string MapFileName(const char* stem, size_t layer) {
+  return std::string(stem) + (layer == 0 ? "" : "_above") + ".png";
+}
+
+// The files RunPlan writes into out_dir (rig.json only with --optimize: without it a rig.json
+// there may be the input).
+std::vector<std::string> OutputNames(const PlanRunOptions& options) {
+  std::vector<std::string> names = {"coverage.json"};
+  const size_t layers = options.coverage.height_above_m > 0 ? 2 : 1;
+  for (size_t l = 0; l < layers; ++l) {
+    for (const auto& [kind, stem] : kMapKinds) names.push_back(MapFileName(stem, l));
+  }
+  if (options.optimize) names.push_back("rig.json");
+  return names;
+}
+
 // --optimize: searches a rig over the mounting places, scores a given rig the same way and
 // writes rig.json; returns the summary lines.
 std::string OptimizeStage(const PlanRunOptions& options, const field::FieldModel& field,
@@ -111,18 +135,14 @@ std::string OptimizeStage(const PlanRunOptions& options, const field::FieldModel
 // The count, angle and error maps of every layer.
 void WriteCoverageMaps(const PlanRunOptions& options, const field::FieldModel& field,
                        PlanRunResult& result) {
-  const std::vector<std::pair<CoverageMapKind, std::string>> kinds = {
-      {CoverageMapKind::kCount, "coverage"},
-      {CoverageMapKind::kAngle, "angle"},
-      {CoverageMapKind::kError, "error"}};
   for (size_t l = 0; l < result.coverage.layers.size(); ++l) {
     CoverageMapOptions map = options.map;
     // Both layers' error maps on the ground layer's scale so they compare.
     if (map.err_scale_m <= 0 && std::isfinite(result.coverage.layers[0].err_max_m)) {
       map.err_scale_m = result.coverage.layers[0].err_max_m;
     }
-    for (const auto& [kind, name] : kinds) {
-      const std::string file = OutPath(options, name + (l == 0 ? "" : "_above") + ".png");
+    for (const auto& [kind, stem] : kMapKinds) {
+      const std::string file = OutPath(options, MapFileName(stem, l));
       io::WriteImage(file, DrawCoverageMap(result.coverage.layers[l], kind, result.rig.cameras,
                                            field, options.coverage, map));
       result.files.push_back(file);
@@ -188,14 +208,9 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   const std::optional<Rig> given = LoadGivenRig(options);
   // No file this run may write replaces one of its inputs (--optimize --rig DIR/rig.json --out
   // DIR replaced the user's rig).
-  const std::vector<std::string> inputs = util::PathList(
-      options.rig_path, options.camera_paths, options.mounts_path, options.field);
-  std::vector<std::string> outputs = {"coverage.json", "coverage.png", "angle.png", "error.png"};
-  if (options.coverage.height_above_m > 0) {
-    outputs.insert(outputs.end(), {"coverage_above.png", "angle_above.png", "error_above.png"});
-  }
-  if (options.optimize) outputs.push_back("rig.json");  // a rig.json beside the maps is an input
-  for (const std::string& name : outputs) {
+  const std::vector<std::string> inputs =
+      util::PathList(options.rig_path, options.camera_paths, options.mounts_path, options.field);
+  for (const std::string& name : OutputNames(options)) {
     util::CheckOutputPath(OutPath(options, name), inputs, "--out");
   }
   std::error_code ec;
@@ -224,7 +239,7 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   WriteCoverageMaps(options, field, result);
   const std::string json_path = OutPath(options, "coverage.json");
   util::WriteTextFile(json_path, CoverageJson(result, field, options).dump(2) + "\n",
-                    "coverage file");
+                      "coverage file");
   result.files.push_back(json_path);
   summary += fmt::format("wrote {} files to {}\n", result.files.size(), options.out_dir);
   result.summary = summary;
