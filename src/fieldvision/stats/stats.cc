@@ -240,7 +240,7 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
   for (const auto& z : o.zones) ps.zone_time_s[z.name] = 0.0;
   ps.top_speed_mps = TopSpeed(s, o);
   ps.position_noise_m = std::max(s.noise_m, 0.0);
-  const double dead_band_m = o.distance_noise_factor * std::max(s.noise_m, 0.0);
+  const double dead_band_m = o.distance_noise_factor * ps.position_noise_m;
   Eigen::Vector2d counted_to = s.pos_m.front();  // where the last counted move ended
   double sprint_run = 0, speed_time = 0;
   std::map<std::string, std::optional<double>> inside_since;
