@@ -11,6 +11,7 @@
 
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
@@ -31,27 +32,15 @@ int LineOfByte(const std::string& text, size_t byte) {
 std::vector<int> TopLevelElementLines(const std::string& text) {
   std::vector<int> lines;
   int depth = 0, line = 1;
-  bool in_string = false, escaped = false, expect_element = false;
-  for (char c : text) {
+  bool expect_element = false;
+  util::ScanJsonText(text, [&](char c, bool in_string) {
     if (c == '\n') ++line;
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-      }
-      continue;
-    }
-    if (std::isspace(static_cast<unsigned char>(c))) continue;
+    if (in_string || std::isspace(static_cast<unsigned char>(c))) return true;
     if (expect_element && depth == 1 && c != ']') {
       lines.push_back(line);
       expect_element = false;
     }
-    if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
+    if (c == '[' || c == '{') {
       ++depth;
       if (depth == 1 && c == '[') expect_element = true;
     } else if (c == ']' || c == '}') {
@@ -59,7 +48,8 @@ std::vector<int> TopLevelElementLines(const std::string& text) {
     } else if (c == ',' && depth == 1) {
       expect_element = true;
     }
-  }
+    return true;
+  });
   return lines;
 }
 

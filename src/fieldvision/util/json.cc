@@ -33,25 +33,15 @@ const json* Member(const json& obj, const std::string& key, const std::string& c
 
 int JsonNestingDepth(std::string_view text, int stop_above) {
   int depth = 0, deepest = 0;
-  bool in_string = false, escaped = false;
-  for (const char ch : text) {
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (ch == '\\') {
-        escaped = true;
-      } else if (ch == '"') {
-        in_string = false;
-      }
-    } else if (ch == '"') {
-      in_string = true;
-    } else if (ch == '[' || ch == '{') {
+  ScanJsonText(text, [&](char c, bool in_string) {
+    if (in_string) return true;
+    if (c == '[' || c == '{') {
       deepest = std::max(deepest, ++depth);
-      if (deepest > stop_above) break;
-    } else if (ch == ']' || ch == '}') {
-      --depth;
+      return deepest <= stop_above;
     }
-  }
+    if (c == ']' || c == '}') --depth;
+    return true;
+  });
   return deepest;
 }
 

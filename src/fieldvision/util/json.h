@@ -26,6 +26,29 @@ inline constexpr int kMaxJsonDepth = 256;
 // it stops counting once past `stop_above`.
 int JsonNestingDepth(std::string_view text, int stop_above = kMaxJsonDepth);
 
+// Walks JSON text without parsing it: f(c, in_string) for each character, in_string true inside
+// a string literal after its opening quote up to and with its closing one (an escaped \" does
+// not end it); f returns false to stop.
+template <typename F>
+void ScanJsonText(std::string_view text, F&& f) {
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    const bool inside = in_string;
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    }
+    if (!f(c, inside)) return;
+  }
+}
+
 // "ctx.key", or "key" when ctx is empty: the context of a nested object.
 std::string JsonPath(const std::string& ctx, const std::string& key);
 // True when `obj` is an object holding `key`.
