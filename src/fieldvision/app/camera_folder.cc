@@ -8,6 +8,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::app {
@@ -48,12 +49,35 @@ std::string CameraNameOr(const camera::Camera& camera, size_t i) {
   return camera.name.empty() ? fmt::format("cam{}", i + 1) : camera.name;
 }
 
-std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams,
-                                         const std::string& dir, const std::string& what) {
+void CheckRigOutput(const std::vector<std::string>& paths, const std::string& dir,
+                    const std::vector<std::string>& inputs, const std::string& what) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  FV_REQUIRE(!std::filesystem::exists(dir, ec) || std::filesystem::is_directory(dir, ec),
+  FV_REQUIRE(!fs::exists(dir, ec) || fs::is_directory(dir, ec),
              "{} '{}' is a file: give a folder (one NAME.yaml per camera is written there)", what,
              dir);
+  for (size_t i = 0; i < paths.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      FV_REQUIRE(!util::SameFile(paths[i], paths[j]),
+                 "two cameras would both be written to '{}' in {} '{}': rename one", paths[i], what,
+                 dir);
+    }
+    util::CheckOutputPath(paths[i], inputs, what);
+  }
+  if (!fs::is_directory(dir, ec)) return;
+  for (const std::string& file : CameraFilesIn(dir)) {
+    const bool ours = std::any_of(paths.begin(), paths.end(),
+                                  [&](const std::string& p) { return util::SameFile(p, file); });
+    FV_REQUIRE(ours,
+               "{} '{}' already holds the camera file '{}', which this run does not write: the "
+               "folder would mix two calibrations; give a new or empty folder",
+               what, dir, fs::path(file).filename().string());
+  }
+}
+
+std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams,
+                                         const std::string& dir, const std::string& what,
+                                         const std::vector<std::string>& inputs) {
   std::vector<std::string> paths;
   std::map<std::string, std::string> named;  // file -> the camera's name
   for (size_t i = 0; i < cams.size(); ++i) {
@@ -66,6 +90,7 @@ std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams
                file, what, dir);
     paths.push_back((std::filesystem::path(dir) / file).string());
   }
+  CheckRigOutput(paths, dir, inputs, what);
   return paths;
 }
 

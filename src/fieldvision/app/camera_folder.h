@@ -22,10 +22,20 @@ std::vector<camera::Camera> ReadCameraFolder(const std::string& dir, bool requir
 // Camera i's name, else "cam<i+1>".
 std::string CameraNameOr(const camera::Camera& camera, size_t i);
 
+// Checks `paths` as the camera files a run writes into the folder `dir` (`what`: the option)
+// before anything is written: `dir` is no file, no two paths are one file, none is one of
+// `inputs`, and `dir` holds no other camera file (*.yaml, *.yml): the rig commands read every
+// camera file of a folder, so an earlier calibration's cameras would mix in. Throws fv::Error
+// naming `what`, `dir` and the file.
+void CheckRigOutput(const std::vector<std::string>& paths, const std::string& dir,
+                    const std::vector<std::string>& inputs, const std::string& what);
+
 // Where each camera's file goes in `dir`: NAME.yaml, NAME CameraNameOr made a safe file
-// name (util::FileNamePart: never a path, "../x" stays in `dir`). Throws naming `what` and `dir`
-// when `dir` is a file or two cameras would share a file; nothing is made.
+// name (util::FileNamePart: never a path, "../x" stays in `dir`), checked by CheckRigOutput
+// (two cameras sharing a file are named). Throws fv::Error naming `what` and `dir`; nothing is
+// made.
 std::vector<std::string> CameraFilePaths(const std::vector<camera::Camera>& cams,
-                                         const std::string& dir, const std::string& what);
+                                         const std::string& dir, const std::string& what,
+                                         const std::vector<std::string>& inputs = {});
 
 }  // namespace fv::app

@@ -345,4 +345,41 @@ if [ -s "$TMP/dmg/v.mp4" ]; then  # only where OpenCV's FFmpeg encodes H.264
     --out "$TMP/dmg/d3.csv" --no-progress
   grep -q "damaged data" "$TMP/err" && { echo "FAIL detect: an intact video reported"; fail=1; }
 fi
+# No output replaces an input, and a rig folder never mixes two calibrations.
+same_file "eval detect: --out a label file" "$TMP/dimgs/a.txt" $FV eval detect \
+  --video "$TMP/dimgs" --out "$TMP/dimgs/a.txt" --detector colour --no-progress
+check "eval detect: --candidates is --out" nonzero $FV eval detect --video "$TMP/dimgs" \
+  --out "$TMP/ec.csv" --candidates "$TMP/ec.csv" --detector colour --no-progress
+same_file "calibrate intrinsics: --out a board image" "$TMP/sc/cam1/00000.png" $FV calibrate \
+  intrinsics --images "$TMP/sc/cam1" --cols 9 --rows 6 --square 0.025 \
+  --out "$TMP/sc/cam1/00000.png" --quiet
+same_file "calibrate export: --toml a camera file" "$TMP/imp/deep/rig/B.yaml" $FV calibrate export \
+  --rig "$TMP/imp/deep/rig" --toml "$TMP/imp/deep/rig/B.yaml"
+mkdir -p "$TMP/rigin" && cp "$TMP/sc/cam1.yaml" "$TMP/rigin/cam1.yaml"
+printf 'u,v,name,x,y,z\n160,120,p1,0,0,0\n' >"$TMP/rigin/p.csv"
+same_file "calibrate rig: --out-dir the cameras' folder" "$TMP/rigin/cam1.yaml" $FV calibrate rig \
+  --camera "$TMP/rigin/cam1.yaml" --points "$TMP/rigin/p.csv" --out-dir "$TMP/rigin"
+same_file "calibrate multi: --out the folder of --intrinsics" "$TMP/rigin/cam1.yaml" $FV calibrate \
+  multi --cols 9 --rows 6 --square 0.025 --views "cam1=$TMP/sc/cam1" \
+  --views "cam2=$TMP/sc/cam2" --intrinsics "cam1=$TMP/rigin/cam1.yaml" --out "$TMP/rigin" --quiet
+check "calibrate import: --out holds another rig's camera" nonzero $FV calibrate import \
+  --toml "$TMP/imp/calibration.toml" --out "$TMP/rigin"
+grep -q "already holds the camera file 'cam1.yaml'" "$TMP/err" ||
+  { echo "FAIL calibrate import: a folder of other cameras taken"; fail=1; }
+# tracks edit: a run without teams or names removes an earlier run's teams file beside --out.
+printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n1,1,10,10,5,10,0.9,0,0,0\n1,2,30,10,5,10,0.9,1,0,0\n' \
+  >"$TMP/tr.csv"
+echo '[{"team": {"1": 0}}]' >"$TMP/team.json" && echo '[{"rename": {"2": 7}}]' >"$TMP/ren.json"
+check "tracks edit: a team" 0 $FV tracks edit --tracks "$TMP/tr.csv" --edits "$TMP/team.json" \
+  --out "$TMP/ed.csv"
+[ -s "$TMP/ed.csv.teams.csv" ] || { echo "FAIL tracks edit: no teams file"; fail=1; }
+check "tracks edit: no team" 0 $FV tracks edit --tracks "$TMP/tr.csv" --edits "$TMP/ren.json" \
+  --out "$TMP/ed.csv"
+[ -e "$TMP/ed.csv.teams.csv" ] && { echo "FAIL tracks edit: an earlier run's teams kept"; fail=1; }
+printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n5,1,1000,900,5,10,0.9,0,0,0\n' \
+  >"$TMP/tr_far.csv"
+check "tracks draw: tracks of another video" 0 $FV tracks draw --tracks "$TMP/tr_far.csv" \
+  --video "$TMP/sc/cam1/%05d.png" --out "$TMP/trd.avi"
+[ "$(grep -c "is it the video they were tracked on" "$TMP/err")" = 2 ] ||
+  { echo "FAIL tracks draw: another video not said"; fail=1; }
 exit $fail

@@ -25,8 +25,8 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -151,8 +151,18 @@ std::vector<camera::Camera> ReportRigRefinement(const RigRefineResult& r,
   return out;
 }
 
-void WriteRig(const std::vector<camera::Camera>& cams, const std::string& dir) {
-  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out");
+// The files of NAME=FILE arguments (a plain FILE stays as it is).
+std::vector<std::string> FilesOf(const std::vector<std::string>& args) {
+  std::vector<std::string> files;
+  files.reserve(args.size());
+  for (const auto& a : args) files.push_back(a.substr(a.find('=') + 1));
+  return files;
+}
+
+// `inputs`: the files the run read besides the rig (points, frames, field).
+void WriteRig(const std::vector<camera::Camera>& cams, const std::string& dir,
+              const std::vector<std::string>& inputs) {
+  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out", inputs);
   std::filesystem::create_directories(dir);
   for (size_t i = 0; i < cams.size(); ++i) {
     camera::WriteCameraYaml(cams[i], paths[i]);
@@ -228,7 +238,7 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
       k = FindRigCamera(rig, arg.substr(0, eq), c.rig);
       file = arg.substr(eq + 1);
     }
-    const auto p = ReadPointsCsv(file, field);
+    const auto p = ReadPointsCsv(file, field, rig[k].width, rig[k].height);
     pts[k].insert(pts[k].end(), p.begin(), p.end());
   }
   RigPlacementOptions ro;
@@ -258,13 +268,13 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
     const std::vector<cv::Mat> frames = ReadRigFrames(out, c.images, c.camera, c.rig, &names);
     out = ReportRigRefinement(RefineRigWithLines(out, frames, *field), frames, names);
   }
-  WriteRig(out, c.out);
+  WriteRig(out, c.out, util::PathList(FilesOf(c.points), FilesOf(c.images), c.field));
 }
 
 void RunFocal(const ExtrinsicsCli& c, const field::FieldModel* field) {
   int w = 0, h = 0;
   ParseImageSize(c.image_size, "--image-size", &w, &h);
-  const auto pts = ReadPointsCsv(c.points.front(), field);
+  const auto pts = ReadPointsCsv(c.points.front(), field, w, h);
   if (c.homography_only) {
     const HomographyResult r = EstimateGroundHomography(w, h, pts, c.o.ransac_threshold_px);
     PrintPointTable(r.points);
@@ -319,7 +329,7 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
   }
   FV_REQUIRE(!c.homography_only, "--homography-only goes with --image-size, not --camera");
   const camera::Camera cam = camera::ReadCameraYaml(c.camera);
-  const auto pts = ReadPointsCsv(c.points.front(), field.get());
+  const auto pts = ReadPointsCsv(c.points.front(), field.get(), cam.width, cam.height);
   const ExtrinsicsResult r = EstimatePose(cam, pts, c.o);
   PrintPointTable(r.points);
   std::cout << r.Summary() << "\n";
@@ -364,7 +374,7 @@ void RunRefineRig(const RefineCli& c) {
   const field::FieldModel field = field::LoadField(c.field);
   const RigRefineResult r = RefineRigWithLines(rig, frames, field, c.o);
   const std::vector<camera::Camera> out = ReportRigRefinement(r, frames, names);
-  WriteRig(out, c.out);
+  WriteRig(out, c.out, util::PathList(FilesOf(c.images), c.field));
   if (!c.overlay.empty()) {
     // The overlay of the first camera with a frame.
     for (size_t i = 0; i < rig.size(); ++i) {
@@ -426,7 +436,7 @@ void RunCheck(const CheckCli& c) {
   CheckImageSize(image, cam, c.image, c.camera);
   const field::FieldModel field = field::LoadField(c.field);
   std::vector<PointCorrespondence> pts;
-  if (!c.points.empty()) pts = ReadPointsCsv(c.points, &field);
+  if (!c.points.empty()) pts = ReadPointsCsv(c.points, &field, cam.width, cam.height);
   const CheckResult r = CheckCalibration(cam, image, field, pts, c.o);
   if (!r.points.empty()) PrintPointTable(r.points);
   // No line pixel near a line: there is no line error to report (0.0 mm would read as perfect).
@@ -457,13 +467,20 @@ void RunRig(const RigCli& c) {
   FV_REQUIRE(c.cameras.size() == c.points.size(),
              "{} --camera but {} --points; give one points file per camera", c.cameras.size(),
              c.points.size());
+  // Each camera is written under its file's name: checked before the adjustment.
+  std::vector<std::string> paths;
+  for (const auto& f : c.cameras) {
+    paths.push_back(
+        (std::filesystem::path(c.out_dir) / std::filesystem::path(f).filename()).string());
+  }
+  CheckRigOutput(paths, c.out_dir, util::PathList(c.cameras, c.points, c.field), "--out-dir");
   std::unique_ptr<field::FieldModel> field;
   if (!c.field.empty()) field = std::make_unique<field::FieldModel>(field::LoadField(c.field));
   std::vector<camera::Camera> cams;
   std::vector<std::vector<RigObservation>> obs;
   for (size_t i = 0; i < c.cameras.size(); ++i) {
     cams.push_back(ReadNamedCamera(c.cameras[i]));
-    obs.push_back(ReadRigObservations(c.points[i], field.get()));
+    obs.push_back(ReadRigObservations(c.points[i], field.get(), cams[i].width, cams[i].height));
   }
   const RigResult r = [&] {
     try {
@@ -480,8 +497,9 @@ void RunRig(const RigCli& c) {
   std::cout << r.Summary() << "\n";
   if (r.free_points.empty()) {
     std::cout << "note: every point has a known position, so no point ties the cameras together: "
-                 "each camera's pose was refined against its own points only (as `calibrate "
-                 "extrinsics` would); name points seen by several cameras without x,y,z to "
+                 "each camera's pose was refined against its own points only (a robust fit from "
+                 "the given poses; `calibrate extrinsics` instead starts afresh and leaves "
+                 "outliers out by RANSAC); name points seen by several cameras without x,y,z to "
                  "adjust the rig jointly\n";
   }
   for (const auto& [name, p] : r.free_points) {
@@ -489,9 +507,7 @@ void RunRig(const RigCli& c) {
   }
   std::filesystem::create_directories(c.out_dir);
   for (size_t i = 0; i < r.cameras.size(); ++i) {
-    const std::string path =
-        (std::filesystem::path(c.out_dir) / std::filesystem::path(c.cameras[i]).filename())
-            .string();
+    const std::string& path = paths[i];
     camera::Camera out = r.cameras[i];
     out.notes["rig_rms_px"] = fmt::format("{:.3f}", r.reports[i].rms_after_px);
     camera::WriteCameraYaml(out, path);
@@ -532,7 +548,14 @@ void SetupIntrinsics(CLI::App* group) {
   in->add_option("--out", ic->out, "Camera file to write (.yaml)")->required();
   in->add_flag("--quiet", ic->quiet, "No progress");
   in->callback([ic] {
-    util::CheckOutputPath(ic->out, {ic->images});
+    // Not one of the board images either (a folder or a glob lists them).
+    std::vector<std::string> inputs = {ic->images};
+    if (std::filesystem::is_directory(ic->images) ||
+        ic->images.find_first_of("*?[") != std::string::npos) {
+      const calib::ImageSource images(ic->images);
+      for (int i = 0; i < images.size(); ++i) inputs.push_back(images.name(i));
+    }
+    util::CheckOutputPath(ic->out, inputs);
     CheckOutputFile(ic->out);
     RunIntrinsics(*ic);
   });
@@ -574,9 +597,9 @@ void SetupExtrinsics(CLI::App* group) {
   ex->add_option("--table", ec->table, "Also write the per-point error table (CSV)");
   ex->callback([ec] {
     util::CheckOutputPath(ec->out,
-                        util::PathList(ec->points, ec->field, ec->images));  // may be --camera
+                          util::PathList(ec->points, ec->field, ec->images));  // may be --camera
     util::CheckOutputPath(ec->table, util::PathList(ec->points, ec->field, ec->camera, ec->out),
-                        "--table");
+                          "--table");
     if (ec->rig.empty()) CheckOutputFile(ec->out);
     CheckOutputFile(ec->table, "--table");
     RunExtrinsics(*ec);
@@ -633,7 +656,7 @@ void SetupCheck(CLI::App* group) {
   ch->callback([cc] {
     util::CheckOutputPath(cc->out, {cc->camera, cc->image, cc->field, cc->points});
     util::CheckOutputPath(cc->table, {cc->camera, cc->image, cc->field, cc->points, cc->out},
-                        "--table");
+                          "--table");
     CheckOutputFile(cc->out);
     CheckOutputFile(cc->table, "--table");
     RunCheck(*cc);

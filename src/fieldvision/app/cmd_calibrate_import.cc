@@ -17,6 +17,7 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -50,8 +51,10 @@ double MetresPerUnit(const std::string& units) {
 }
 
 // NAME.yaml per camera in `dir` (CameraFilePaths: safe names, none shared).
-void WriteCameras(const std::vector<camera::Camera>& cams, const std::string& dir) {
-  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out");
+// `inputs`: the files read (none may be replaced).
+void WriteCameras(const std::vector<camera::Camera>& cams, const std::string& dir,
+                  const std::vector<std::string>& inputs) {
+  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out", inputs);
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   FV_REQUIRE(std::filesystem::is_directory(dir), "cannot make folder --out '{}'", dir);
@@ -80,6 +83,7 @@ void RunImport(const ImportCli& c) {
     if (name.empty()) name = TsaiCameraName(c.tsai);
     if (name.empty()) name = std::filesystem::path(c.tsai).stem().string();
     const track::TsaiConversion conv = track::CameraFromTsai(p, name);
+    util::CheckOutputPath(c.out, {c.tsai});
     camera::WriteCameraYaml(conv.camera, c.out);
     std::cout << conv.Summary() << "\ncamera " << name << "\nwrote " << c.out << "\n";
     // Tsai's one-coefficient radial model is fitted exactly by OpenCV's for real lenses (PETS
@@ -119,7 +123,7 @@ void RunImport(const ImportCli& c) {
       break;
     }
   }
-  WriteCameras(cams, c.out);
+  WriteCameras(cams, c.out, util::PathList(c.qualisys, c.toml, c.opencv_stereo));
 }
 
 void RunExport(const ExportCli& c) {
@@ -133,6 +137,7 @@ void RunExport(const ExportCli& c) {
   std::vector<camera::Camera> cams;
   cams.reserve(files.size());
   for (const auto& f : files) cams.push_back(ReadNamedCamera(f));
+  util::CheckOutputPath(c.toml, files, "--toml");
   calib::WriteCalibrationToml(cams, c.toml);
   std::cout << "wrote " << c.toml << " (" << cams.size() << " cameras)\n";
 }

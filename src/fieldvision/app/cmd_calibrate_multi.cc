@@ -47,7 +47,11 @@ void RunMulti(MultiCli& c) {
   c.o.tangential = c.zero_tangent ? TangentialModel::kZero : ParseTangentialModel(c.tangential);
   c.o.k3 = fv::calib::ParseK3Model(c.k3);
   std::vector<CameraViews> cams;
-  for (const auto& v : c.views) cams.push_back(ParseCameraViews(v));
+  std::vector<std::string> inputs;  // views and known intrinsics: no output may replace one
+  for (const auto& v : c.views) {
+    cams.push_back(ParseCameraViews(v));
+    inputs.push_back(cams.back().source);
+  }
   for (const auto& k : c.intrinsics) {
     const CameraViews kv = ParseCameraViews(k);  // NAME=CAM.yaml
     const auto view = std::find_if(cams.begin(), cams.end(),
@@ -63,8 +67,14 @@ void RunMulti(MultiCli& c) {
                k, kv.source, known.width, known.height, kv.name, view->source, first.cols,
                first.rows);
     c.o.known_intrinsics[kv.name] = known;
+    inputs.push_back(kv.source);
   }
   c.o.Check();
+  {  // The camera files go to --out as NAME.yaml: checked before the board search.
+    std::vector<camera::Camera> named(cams.size());
+    for (size_t i = 0; i < cams.size(); ++i) named[i].name = cams[i].name;
+    CameraFilePaths(named, c.out, "--out", inputs);
+  }
   const MultiResult r = CalibrateMulti(cams, c.o);
 
   std::cout << fmt::format("{:<12s} {:>6s} {:>6s} {:>6s} {:>9s} {:>9s} {:>9s} {:>9s} {:>9s}  {}\n",
@@ -122,7 +132,7 @@ void RunMulti(MultiCli& c) {
   for (const auto& w : r.warnings) std::cerr << "warning: " << w << "\n";
 
   namespace fs = std::filesystem;
-  const std::vector<std::string> paths = CameraFilePaths(r.cameras, c.out, "--out");
+  const std::vector<std::string> paths = CameraFilePaths(r.cameras, c.out, "--out", inputs);
   fs::create_directories(c.out);
   for (size_t i = 0; i < r.cameras.size(); ++i) {
     const std::string& path = paths[i];

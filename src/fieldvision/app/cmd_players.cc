@@ -8,13 +8,14 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_writer.h"
+#include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/track/players.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -42,21 +43,10 @@ void RunPlayersCommand(const PlayersCli& c) {
       track::RunPlayers(c.video, camera ? &*camera : nullptr, field ? &*field : nullptr, o);
   track::WriteTracksCsv(r.rows, c.out);
   if (!c.mot_out.empty()) track::WriteMotChallenge(r.rows, c.mot_out);
-  if (!r.team_of.empty()) {
-    const std::string teams = c.out + ".teams.csv";
-    util::AtomicWrite(
-        teams,
-        [&](const std::string& tmp) {
-          util::CsvWriter w(tmp, {"id", "team"});
-          for (const auto& [id, team] : r.team_of) {
-            w << id << team;
-            w.EndRow();
-          }
-          w.Close();
-        },
-        "--teams");
-    std::cout << "wrote " << teams << "\n";
-  }
+  track::Roster roster;
+  roster.team_of = r.team_of;
+  const std::string roster_done = track::SaveRosterFor(c.out, roster);
+  if (!roster_done.empty()) std::cout << roster_done << "\n";
   std::cout << r.Summary() << "\nwrote " << c.out << (c.mot_out.empty() ? "" : " and " + c.mot_out)
             << "\n";
   if (r.rows.empty()) {
@@ -186,6 +176,7 @@ void Setup(CLI::App& app, int& exit_code) {
          {std::pair{c->mot_out, "--mot-out"}, {c->o.detections_out, "--save-detections"}}) {
       util::CheckOutputPath(out, util::PathList(inputs, c->out), what);
     }
+    util::CheckOutputPath(track::RosterPathFor(c->out), inputs, "--out's teams file");
     if (!c->draw.empty()) io::CheckVideoOutput(c->draw, util::PathList(inputs, c->out), "--draw");
     // A device, a folder or a missing folder as an output is refused before the run.
     for (const auto& [out, what] : {std::pair{c->out, "--out"},

@@ -1,21 +1,24 @@
 // `fieldvision tracks edit`: fix identities in TRACKS.csv by hand (merge, rename, name, team,
 // drop) from a small JSON file, before `stats` (track/edits.h); `tracks draw`: see the result on
 // the video (track/overlay.h).
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <optional>
+
+#include <fmt/format.h>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/input_checks.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/field/field.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -48,12 +51,9 @@ void RunTracksEdit(const TracksEditCli& c) {
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);
-  std::cout << r.Summary() << "\nwrote " << c.out;
-  if (!r.roster.team_of.empty() || !r.roster.name_of.empty()) {
-    track::WriteRoster(r.roster, track::RosterPathFor(c.out));
-    std::cout << " and " << track::RosterPathFor(c.out) << " (teams and names, read by stats)";
-  }
-  std::cout << "\n";
+  std::cout << r.Summary() << "\nwrote " << c.out << "\n";
+  const std::string roster_done = track::SaveRosterFor(c.out, r.roster);
+  if (!roster_done.empty()) std::cout << roster_done << "\n";
 }
 
 struct TracksDrawCli {
@@ -62,6 +62,30 @@ struct TracksDrawCli {
   double fps = 0;
   int max_frames = 0;
 };
+
+// Tracks drawn on a video they were not made from run past its end or lie beside its frames.
+void WarnOfAnotherVideo(const std::vector<track::TrackRow>& rows, const track::DrawVideoResult& d,
+                        const std::string& video, int max_frames) {
+  int last_frame = 0;
+  long outside = 0;
+  const cv::Rect2d frame(0, 0, d.frame_size.width, d.frame_size.height);
+  for (const auto& r : rows) {
+    last_frame = std::max(last_frame, r.frame);
+    outside += (r.box & frame).area() <= 0;
+  }
+  if (max_frames <= 0 && last_frame > d.frames) {
+    std::cerr << fmt::format(
+        "warning: the tracks run to frame {} but video '{}' has {} frames: is it the video they "
+        "were tracked on?\n",
+        last_frame, video, d.frames);
+  }
+  if (outside > 0) {
+    std::cerr << fmt::format(
+        "warning: {} of {} boxes lie outside the {}x{} frames of video '{}': is it the video they "
+        "were tracked on?\n",
+        outside, rows.size(), d.frame_size.width, d.frame_size.height, video);
+  }
+}
 
 // The video with the (edited) tracks drawn: names from the roster, team colours.
 void RunTracksDraw(const TracksDrawCli& c) {
@@ -89,6 +113,7 @@ void RunTracksDraw(const TracksDrawCli& c) {
   const track::DrawVideoResult d =
       track::DrawTracksVideo(c.video, c.out, overlay, c.fps, c.max_frames);
   std::cout << d.Summary() << "\n";
+  WarnOfAnotherVideo(rows, d, c.video, c.max_frames);
 }
 
 void Setup(CLI::App& app, int& exit_code) {

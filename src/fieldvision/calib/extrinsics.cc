@@ -63,8 +63,24 @@ bool Better(const Candidate& a, const Candidate& b) {
 
 }  // namespace
 
+void RequireInImage(const Eigen::Vector2d& uv_px, int width, int height, const std::string& where) {
+  if (width <= 0 || height <= 0) return;
+  constexpr double kMarginPx = 1.0;
+  const auto inside = [&](int w, int h) {
+    return uv_px.x() >= -0.5 - kMarginPx && uv_px.x() <= w - 0.5 + kMarginPx &&
+           uv_px.y() >= -0.5 - kMarginPx && uv_px.y() <= h - 0.5 + kMarginPx;
+  };
+  if (inside(width, height)) return;
+  Throw("{}: the point at ({:.1f}, {:.1f}) px lies outside the {}x{} image{}", where, uv_px.x(),
+        uv_px.y(), width, height,
+        inside(height, width)
+            ? fmt::format(" (it would fit {}x{}: are width and height swapped?)", height, width)
+            : std::string());
+}
+
 std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path,
-                                               const field::FieldModel* field) {
+                                               const field::FieldModel* field, int width,
+                                               int height) {
   const util::CsvTable t = util::CsvTable::Read(path);
   std::vector<PointCorrespondence> pts;
   const bool xyz = t.Has("x") && t.Has("y") && t.Has("z");
@@ -74,6 +90,7 @@ std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path,
     PointCorrespondence p;
     p.uv_px = {t.GetDouble(r, "u"), t.GetDouble(r, "v")};
     FV_REQUIRE(p.uv_px.allFinite(), "{}: u and v must be finite", t.Where(r));
+    RequireInImage(p.uv_px, width, height, t.Where(r));
     if (t.Has("name")) p.name = t.Get(r, "name");
     if (xyz) {
       p.p_world = {t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "z")};

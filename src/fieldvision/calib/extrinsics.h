@@ -24,11 +24,18 @@ struct PointCorrespondence {
   Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
 };
 
+// Throws fv::Error naming `where` when the clicked pixel `uv_px` lies more than a pixel outside
+// a `width` x `height` image (pixel centres at integers; nothing checked for a size of 0), and
+// says so when it would lie inside with width and height swapped.
+void RequireInImage(const Eigen::Vector2d& uv_px, int width, int height, const std::string& where);
+
 // Reads POINTS.csv: a header and columns u,v,x,y,z (metres) or u,v,name (a keypoint of
-// `field`). Throws fv::Error naming the file and line for a missing column, a bad number or an
-// unknown keypoint name (or names when no field is given).
+// `field`). Throws fv::Error naming the file and line for a missing column, a bad number, an
+// unknown keypoint name (or names when no field is given) or, with an image size, a point
+// outside the image (RequireInImage).
 std::vector<PointCorrespondence> ReadPointsCsv(const std::string& path,
-                                               const field::FieldModel* field);
+                                               const field::FieldModel* field, int width = 0,
+                                               int height = 0);
 
 struct ExtrinsicsOptions {
   double ransac_threshold_px = 8.0;  // inlier threshold of RANSAC

@@ -148,5 +148,24 @@ TEST(Extrinsics, MissingColumnsAndNaNAreErrors) {
   EXPECT_THROW(ReadPointsCsv(dir + "/missing.csv", nullptr), Error);
 }
 
+TEST(Extrinsics, APointOutsideTheImageIsAnErrorNamingItsLine) {
+  const std::string path = fv::testing::TempDir() + "/outside.csv";
+  {
+    std::ofstream f(path);
+    f << "u,v,x,y,z\n0,0,0,0,0\n1087.4,1919.4,1,0,0\n500,1528,2,0,0\n";
+  }
+  // Inside a 1088x1920 (portrait) frame, corners included.
+  EXPECT_EQ(ReadPointsCsv(path, nullptr, 1088, 1920).size(), 3u);
+  EXPECT_EQ(ReadPointsCsv(path, nullptr).size(), 3u);  // no size: no check
+  // The same points with width and height swapped: the second lies below a 1088-high image.
+  EXPECT_THAT([&] { ReadPointsCsv(path, nullptr, 1920, 1088); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("outside.csv:3"),
+                                                    HasSubstr("outside the 1920x1088 image"),
+                                                    HasSubstr("swapped"))));
+  EXPECT_THAT([&] { ReadPointsCsv(path, nullptr, 640, 480); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("outside.csv:3"),
+                                                    ::testing::Not(HasSubstr("swapped")))));
+}
+
 }  // namespace
 }  // namespace fv::calib

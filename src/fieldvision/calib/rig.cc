@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "fieldvision/calib/costs.h"
+#include "fieldvision/calib/extrinsics.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
@@ -31,7 +32,8 @@ double RmsPx(const camera::Camera& cam, const std::vector<RigObservation>& obs,
 }  // namespace
 
 std::vector<RigObservation> ReadRigObservations(const std::string& path,
-                                                const field::FieldModel* field) {
+                                                const field::FieldModel* field, int width,
+                                                int height) {
   const util::CsvTable t = util::CsvTable::Read(path);
   t.Require({"u", "v", "name"});
   const bool xyz = t.Has("x") && t.Has("y") && t.Has("z");
@@ -42,6 +44,7 @@ std::vector<RigObservation> ReadRigObservations(const std::string& path,
     FV_REQUIRE(!o.name.empty(), "{}: empty point name", t.Where(r));
     o.uv_px = {t.GetDouble(r, "u"), t.GetDouble(r, "v")};
     FV_REQUIRE(o.uv_px.allFinite(), "{}: u and v must be finite", t.Where(r));
+    RequireInImage(o.uv_px, width, height, t.Where(r));
     if (xyz && !t.Get(r, "x").empty()) {
       o.p_world = Eigen::Vector3d(t.GetDouble(r, "x"), t.GetDouble(r, "y"), t.GetDouble(r, "z"));
       FV_REQUIRE(o.p_world->allFinite(), "{}: x, y and z must be finite", t.Where(r));

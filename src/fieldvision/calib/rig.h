@@ -23,9 +23,11 @@ struct RigObservation {
 };
 
 // Reads a camera's observations: columns u,v,name and optionally x,y,z. A name that is a
-// keypoint of `field` (may be null) gets its position; other names without x,y,z are free.
+// keypoint of `field` (may be null) gets its position; other names without x,y,z are free. With
+// an image size, a point outside the image is an error naming the line (RequireInImage).
 std::vector<RigObservation> ReadRigObservations(const std::string& path,
-                                                const field::FieldModel* field);
+                                                const field::FieldModel* field, int width = 0,
+                                                int height = 0);
 
 struct RigOptions {
   double huber_px = 3.0;  // robust loss scale

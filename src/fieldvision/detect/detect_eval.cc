@@ -19,10 +19,10 @@
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/eval_drawing.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
@@ -186,6 +186,10 @@ std::vector<cv::Rect2d> ReadYoloFile(const std::string& path, int class_id, int 
                     h <= 1.5;
     FV_REQUIRE(ok, "{}:{}: expected 'class cx cy w h' (YOLO, normalised to the image), got '{}'",
                path, line_no, line);
+    // Normalised: a box must overlap the image [0, 1] x [0, 1] (pixels would be far outside).
+    FV_REQUIRE(cx - 0.5 * w < 1 && cx + 0.5 * w > 0 && cy - 0.5 * h < 1 && cy + 0.5 * h > 0,
+               "{}:{}: the box '{}' lies outside the image (YOLO boxes are normalised to 0..1)",
+               path, line_no, line);
     if (static_cast<int>(cls) != class_id) continue;
     boxes.emplace_back((cx - 0.5 * w) * width, (cy - 0.5 * h) * height, w * width, h * height);
   }
@@ -217,6 +221,7 @@ std::vector<LabelledImage> ReadYoloLabels(const std::vector<std::string>& images
     for (const auto& t : tries) {
       if (fs::is_regular_file(t)) {
         item.has_label_file = true;
+        item.label_file = t.string();
         const cv::Mat im = io::ReadImage(image);  // the size normalises the boxes
         item.boxes = ReadYoloFile(t.string(), class_id, im.cols, im.rows);
         break;
@@ -449,7 +454,11 @@ std::vector<LabelledImage> ListLabelledImages(const std::string& video,
     }
   } else {
     if (root.empty()) root = fs::path(files.front()).parent_path().string();
-    for (const auto& f : files) items.push_back(LabelledImage{f, -1, {}, false});
+    for (const auto& f : files) {
+      LabelledImage item;
+      item.image = f;
+      items.push_back(item);
+    }
   }
   FV_REQUIRE(label_options.camera.empty() || fs::is_regular_file(labels),
              "{}: --label-cam names a camera of a truth_2d.csv file, not of YOLO labels", what);
@@ -478,9 +487,12 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   if (!items.empty() && items.front().frame >= 0) video = io::VideoSource::Open(o.video);
   // No output may be one of the images, label files or the camera read (an image inside --video).
   std::vector<std::string> inputs = {o.video, o.labels.labels, o.camera, o.field};
-  for (const LabelledImage& item : items) inputs.push_back(item.image);
+  for (const LabelledImage& item : items) {
+    inputs.push_back(item.image);
+    inputs.push_back(item.label_file);
+  }
   util::CheckOutputPath(o.out, inputs, "--out");
-  util::CheckOutputPath(o.candidates_out, inputs, "--candidates");
+  util::CheckOutputPath(o.candidates_out, util::PathList(inputs, o.out), "--candidates");
   std::unique_ptr<MissDrawings> drawings;
   if (!o.draw_misses.empty()) {
     for (const auto& [path, what] :

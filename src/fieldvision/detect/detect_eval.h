@@ -23,6 +23,7 @@ struct LabelledImage {
   int frame = -1;                 // frame index in a video; -1 for image files
   std::vector<cv::Rect2d> boxes;  // ball boxes in pixels (the chosen class only)
   bool has_label_file = false;    // YOLO: false when no label file was found (no ball)
+  std::string label_file;         // YOLO: the label file read ("" for a CSV or none)
   bool judged = true;  // false: its only ball is less visible than the labels' min_visible
 };
 

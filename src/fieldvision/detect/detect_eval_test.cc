@@ -1,5 +1,6 @@
 #include "fieldvision/detect/detect_eval.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -215,6 +216,12 @@ TEST(DetectEval, BadLabelNamesFileAndLine) {
   }
   WriteText(dir + "/b.txt", "0 0.5 0.5 -0.1 0.1\n");
   EXPECT_THROW(ReadYoloFile(dir + "/b.txt", 0, 100, 100), Error);
+  // A box beside the image (pixels, or a bad export) names its line; one cut by the edge is kept.
+  WriteText(dir + "/c.txt", "0 0.98 0.5 0.1 0.1\n1 1.5 0.5 0.1 0.1\n");
+  EXPECT_THAT([&] { ReadYoloFile(dir + "/c.txt", 0, 100, 100); },
+              ::testing::ThrowsMessage<Error>(::testing::HasSubstr("c.txt:2: the box")));
+  WriteText(dir + "/d.txt", "0 0.98 0.5 0.1 0.1\n");
+  EXPECT_EQ(ReadYoloFile(dir + "/d.txt", 0, 100, 100).size(), 1u);
   DetectEvalOptions o;
   o.video = dir + "/missing";
   EXPECT_THROW(EvaluateDetector(o), Error);

@@ -172,6 +172,19 @@ void WriteRoster(const Roster& roster, const std::string& path) {
 
 std::string RosterPathFor(const std::string& tracks_path) { return tracks_path + ".teams.csv"; }
 
+std::string SaveRosterFor(const std::string& tracks_path, const Roster& roster) {
+  const std::string path = RosterPathFor(tracks_path);
+  if (!roster.team_of.empty() || !roster.name_of.empty()) {
+    WriteRoster(roster, path);
+    return fmt::format("wrote {} (teams and names, read by stats and tracks draw)", path);
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return "";
+  FV_REQUIRE(std::filesystem::remove(path, ec), "cannot remove the earlier teams file '{}': {}",
+             path, ec.message());
+  return fmt::format("removed {} (an earlier run's teams and names: these tracks have none)", path);
+}
+
 std::string EditResult::Summary() const {
   return fmt::format(
       "{} ids -> {}: {} merged ({} frames with both: the surer box kept), {} renamed, {} named, "

@@ -52,6 +52,11 @@ Roster ReadRoster(const std::string& path);
 void WriteRoster(const Roster& roster, const std::string& path);
 // TRACKS.csv's roster file name: TRACKS.csv.teams.csv.
 std::string RosterPathFor(const std::string& tracks_path);
+// The roster of the tracks just written to `tracks_path`, beside them (RosterPathFor); a roster
+// without teams or names removes an earlier run's file there instead, which stats and tracks draw
+// would otherwise apply to other people. Returns what was done ("wrote F", "removed F (...)") or
+// "" when nothing was there to write or remove.
+std::string SaveRosterFor(const std::string& tracks_path, const Roster& roster);
 
 struct EditResult {
   std::vector<TrackRow> rows;

@@ -198,6 +198,7 @@ DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out
   writer.Close();
   DrawVideoResult r;
   r.frames = writer.frames();
+  r.frame_size = {source->width(), source->height()};
   r.path = writer.path();
   r.codec = writer.codec();
   r.note = writer.note();

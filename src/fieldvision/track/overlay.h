@@ -65,6 +65,7 @@ class TrackOverlay {
 
 struct DrawVideoResult {
   int frames = 0;
+  cv::Size frame_size;  // the video's
   std::string path, codec, note;
   std::string Summary() const;
 };
