@@ -467,6 +467,17 @@ bool BelowGround(const Eigen::Vector3d& p, const recon::TrajectoryOptions& to) {
 // views meet at a point whatever one of them is off by along the other's epipolar line.
 constexpr int kMinKeptViews = 3;
 
+// The rows a refined flight sets: those of its seen span, and the track's outliers between its
+// start and its bounce or hit (a last frame whose view an occluder cut is an outlier after the
+// last sample the flight kept).
+bool InFlightSpan(const recon::Flight& f, const recon::TrajectoryResult& t, size_t i,
+                  double time_s) {
+  constexpr double kEps = 1e-9;
+  if (time_s >= f.t_first_seen_s - kEps && time_s <= f.t_last_seen_s + kEps) return true;
+  return i < t.outlier.size() && t.outlier[i] && time_s >= f.t_start_s - kEps &&
+         time_s <= f.t_end_s + kEps;
+}
+
 bool ModelFailsAt(const Bundled::AtFrame& a, double typical_px) {
   const double model = a.model_rms();
   return model > kMaxModelRmsRatio * typical_px + kModelRmsSlackPx &&
@@ -509,7 +520,7 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
     const double typical_px = TypicalModelRms(b);
     for (size_t i = 0; i < track->size(); ++i) {
       recon::BallSample& s = (*track)[i];
-      if (s.time_s < f.t_first_seen_s - 1e-9 || s.time_s > f.t_last_seen_s + 1e-9) continue;
+      if (!InFlightSpan(f, *out.trajectory, i, s.time_s)) continue;
       const auto a = b.at_frame.find(i);
       const Eigen::Vector3d p = b.model.PositionAt(s.time_s);
       if ((a != b.at_frame.end() && s.n_cams >= kMinKeptViews &&
