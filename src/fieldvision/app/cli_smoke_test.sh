@@ -382,4 +382,11 @@ check "tracks draw: tracks of another video" 0 $FV tracks draw --tracks "$TMP/tr
   --video "$TMP/sc/cam1/%05d.png" --out "$TMP/trd.avi"
 [ "$(grep -c "is it the video they were tracked on" "$TMP/err")" = 2 ] ||
   { echo "FAIL tracks draw: another video not said"; fail=1; }
+# Progress: a line redrawn on a terminal; nothing in a log unless asked for (the studio's jobs).
+"$FV" synth --preset kick --frames 3 --width 160 --height 120 --out "$TMP/prog" >/dev/null \
+  2>"$TMP/prog.err"
+grep -q "elapsed" "$TMP/prog.err" && { echo "FAIL synth: progress lines in a log"; fail=1; }
+FV_PROGRESS=lines "$FV" synth --preset kick --frames 3 --width 160 --height 120 \
+  --out "$TMP/prog2" >/dev/null 2>"$TMP/prog.err"
+grep -q "elapsed" "$TMP/prog.err" || { echo "FAIL synth: FV_PROGRESS=lines gave no line"; fail=1; }
 exit $fail

@@ -1,15 +1,14 @@
 // `fieldvision trajectory`: split a ball track into flights, fit them, predict landings, make
 // line/goal/basket calls, write FLIGHTS.json, pictures and a smoothed track (trajectory_run.h).
-#include <unistd.h>
 
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "fieldvision/app/command.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/progress.h"
 
 namespace fv::app {
@@ -99,9 +98,9 @@ void Setup(CLI::App& app, int& exit_code) {
                                       {o->job.report_path, "--report"}}) {
         if (!out.empty()) util::ResolveOutputPath(out, what);
       }
-      // Progress on a terminal while the arcs of a long track are fitted; logs stay quiet.
+      // Progress while the arcs of a long track are fitted (util::Progress: logs stay quiet).
       std::unique_ptr<util::Progress> bar;
-      if (o->progress && isatty(fileno(stderr))) {
+      if (o->progress) {
         o->job.analysis.progress = [&bar](size_t done, size_t total) {
           if (!bar) {
             bar = std::make_unique<util::Progress>("trajectory", static_cast<long long>(total),

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 #include <fmt/format.h>
 
@@ -14,6 +16,8 @@ Progress::Progress(std::string label, long long total, std::string unit, bool en
       total_(total),
       enabled_(enabled),
       tty_(isatty(STDERR_FILENO) != 0),
+      lines_(!tty_ && std::getenv(kProgressEnv) != nullptr &&
+             std::strcmp(std::getenv(kProgressEnv), kProgressLines) == 0),
       start_(std::chrono::steady_clock::now()),
       last_print_(start_) {}
 
@@ -33,7 +37,7 @@ void Progress::Update(long long done) {
     if (now - last_print_ < std::chrono::milliseconds(200)) return;
     last_print_ = now;
     Print(false);
-  } else if (total_ > 0) {
+  } else if (lines_ && total_ > 0) {
     const int decile = static_cast<int>(10 * done_ / total_);
     if (decile > last_decile_ && decile < 10) {
       last_decile_ = decile;
@@ -65,7 +69,7 @@ void Progress::Print(bool final_line) {
 
 void Progress::Finish() {
   finished_ = true;
-  if (enabled_) Print(true);
+  if (enabled_ && (tty_ || lines_)) Print(true);
 }
 
 }  // namespace fv::util

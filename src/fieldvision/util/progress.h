@@ -1,11 +1,16 @@
 // Progress of a long job on stderr: items done, rate and time left. On a terminal it redraws one
-// line; otherwise it prints a line every ~10 % so logs stay short.
+// line; elsewhere (a log) it stays quiet, unless the environment asks for lines (kLinesEnv=lines:
+// a line every ~10 % and a last one, as the studio's jobs page reads them).
 #pragma once
 
 #include <chrono>
 #include <string>
 
 namespace fv::util {
+
+// The environment variable, and its value, that asks for progress lines off a terminal.
+inline constexpr const char* kProgressEnv = "FV_PROGRESS";
+inline constexpr const char* kProgressLines = "lines";
 
 class Progress {
  public:
@@ -24,6 +29,7 @@ class Progress {
   long long done_ = 0;
   bool enabled_;
   bool tty_;
+  bool lines_;  // off a terminal, lines asked for (kProgressEnv)
   bool finished_ = false;
   int last_decile_ = -1;
   std::chrono::steady_clock::time_point start_;

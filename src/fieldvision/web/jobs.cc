@@ -6,10 +6,16 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <set>
+#include <string>
 #include <thread>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
 
 namespace fv::web {
 
@@ -140,6 +146,17 @@ int JobRunner::Start(const std::string& command, const std::vector<std::string>&
   sigemptyset(&no_signals);
   int fds[2];
   FV_REQUIRE(pipe2(fds, O_CLOEXEC) == 0, "studio: cannot create a pipe for a job");
+  // The environment with progress lines asked for (util/progress.h): the jobs page shows them.
+  const std::string progress_env = fmt::format("{}={}", util::kProgressEnv, util::kProgressLines);
+  std::vector<char*> envp;
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::strncmp(*e, util::kProgressEnv, std::strlen(util::kProgressEnv)) != 0 ||
+        (*e)[std::strlen(util::kProgressEnv)] != '=') {
+      envp.push_back(*e);
+    }
+  }
+  envp.push_back(const_cast<char*>(progress_env.c_str()));
+  envp.push_back(nullptr);
   const pid_t pid = fork();
   if (pid < 0) {
     close(fds[0]);
@@ -154,7 +171,7 @@ int JobRunner::Start(const std::string& command, const std::vector<std::string>&
     const int null_fd = open("/dev/null", O_RDONLY);
     if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
     if (chdir(root.c_str()) != 0) _exit(126);
-    execv(argv[0], argv.data());
+    execve(argv[0], argv.data(), envp.data());
     _exit(127);
   }
   setpgid(pid, pid);
