@@ -82,12 +82,19 @@ grep -q "lies in the images' folder" "$TMP/err" || { echo "FAIL eval detect: fol
 check "eval detect: --draw-misses" 0 $FV eval detect --video "$TMP/dimgs" \
   --draw-misses "$TMP/drawn" --detector colour --no-progress
 grep -q "drew 0 misses" "$TMP/out" || { echo "FAIL eval detect: drawings not said"; fail=1; }
-mkdir -p "$TMP/limgs" "$TMP/nolabels" && cp "$TMP/imgs/a.png" "$TMP/limgs/a.png"
+# A rendered frame with its ball's YOLO box (the camera where the ball looks largest).
+mkdir -p "$TMP/limgs" "$TMP/nolabels"
+"$FV" synth --preset static --frames 1 --width 1280 --height 960 --format png --out "$TMP/lsyn" \
+  --quiet >/dev/null 2>&1 || { echo "FAIL synth of the label fixture"; fail=1; }
+read -r lcam lbox < <(awk -F, 'NR > 1 && $5 > r { r = $5; c = $2;
+  b = sprintf("%.6f %.6f %.6f %.6f", $3 / 1280, $4 / 960, 2 * $5 / 1280, 2 * $5 / 960) }
+  END { print c, b }' "$TMP/lsyn/truth_2d.csv")
+cp "$TMP/lsyn/$lcam/00000.png" "$TMP/limgs/a.png"
 check "color learn: --labels without a label file" nonzero $FV color learn --video "$TMP/limgs" \
   --labels "$TMP/nolabels" --out "$TMP/l.json"
 grep -q "none of the 1 images has a label file" "$TMP/err" || {
   echo "FAIL color learn: missing labels not named"; fail=1; }
-printf '0 0.5 0.5 0.2 0.2\n' > "$TMP/limgs/a.txt"
+printf '0 %s\n' "$lbox" > "$TMP/limgs/a.txt"
 check "color learn: --labels and --roi" nonzero $FV color learn --video "$TMP/limgs" \
   --labels "$TMP/limgs" --roi 1,1,4,4 --out "$TMP/l.json"
 check "color learn: --labels, the class forced" 0 $FV color learn --video "$TMP/limgs" \

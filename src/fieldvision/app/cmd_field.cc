@@ -49,11 +49,15 @@ void ShowField(const FieldShowOptions& o) {
 
 void DrawFieldCommand(const FieldDrawOptions2& o) {
   const field::FieldModel f = field::LoadField(o.field);
-  const field::TopView view = field::TopView::ForField(f, o.width_px);
+  const field::TopView view = field::TopView::ForField(f, o.width_px - field::kTopViewFrameWidthPx);
   field::FieldDrawOptions d;
   d.keypoints = true;
   d.keypoint_names = o.names;
-  const cv::Mat img = field::DrawField(f, view, d);
+  const cv::Mat img = field::FrameTopView(
+      field::DrawField(f, view, d), view,
+      fmt::format("field '{}': origin at its centre, x along its length; dots: named keypoints "
+                  "(red on the ground, yellow raised: goal posts, crossbars, hoops)",
+                  f.name));
   io::WriteImage(o.out, img);
   std::cout << "wrote " << o.out << " (" << img.cols << "x" << img.rows << ")\n";
 }

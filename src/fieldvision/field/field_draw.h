@@ -3,6 +3,8 @@
 // on the same canvas.
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
@@ -40,5 +42,21 @@ void DrawFieldLines(cv::Mat& image, const FieldModel& field, const TopView& view
 // A new BGR image of the field.
 cv::Mat DrawField(const FieldModel& field, const TopView& view,
                   const FieldDrawOptions& options = {});
+
+// Axis ticks: 1, 2 or 5 times a power of ten, about eight over `range`.
+double NiceStep(double range);
+// `v` rounded to a multiple of `step`, without the "-0" of a rounded negative zero.
+double TickValue(double v, double step);
+
+// Pixels FrameTopView adds left and right of the view (a view for an image `w` wide overall is
+// ForField(field, w - kTopViewFrameWidthPx)), and where the view lies in the framed image.
+inline constexpr int kTopViewFrameWidthPx = 80;
+inline constexpr int kTopViewFrameLeftPx = 60;
+inline constexpr int kTopViewFrameTopPx = 30;
+
+// `image`, a top view drawn with `view`, framed on white with axes in metres (ticks along x below
+// and y on the left, "x (m)", "y (m)"), a scale bar and `caption` under it (empty: no caption
+// line).
+cv::Mat FrameTopView(const cv::Mat& image, const TopView& view, const std::string& caption);
 
 }  // namespace fv::field

@@ -206,10 +206,8 @@ cv::Mat Legend(const CoverageLayer& layer, CoverageMapKind kind, const CoverageO
       Text(legend, fmt::format("{:.0f}", t), cv::Point(x - 8, strip_h - pad / 2), 0.4 * scale,
            cv::Scalar(255, 255, 255));
     }
-    if (!angle) {
-      Text(legend, "grey: < 2 cameras", cv::Point(x1 - int(140 * scale), pad - 2), 0.35 * scale,
-           cv::Scalar(200, 200, 200));
-    }
+    Text(legend, "grey: < 2 cameras", cv::Point(x1 - int(140 * scale), pad - 2), 0.35 * scale,
+         cv::Scalar(200, 200, 200));
   }
   Text(legend, title, cv::Point(pad, strip_h / 2 + 5), ts, cv::Scalar(255, 255, 255));
   return legend;
@@ -221,7 +219,8 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
                         const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
                         const CoverageOptions& coverage, const CoverageMapOptions& options) {
   options.Check();
-  const field::TopView view = MapView(cameras, field, options.width_px);
+  const field::TopView view =
+      MapView(cameras, field, options.width_px - field::kTopViewFrameWidthPx);
   cv::Mat img = field::DrawField(field, view);
   double err_scale = options.err_scale_m;
   if (err_scale <= 0) err_scale = std::isfinite(layer.err_max_m) ? layer.err_max_m : 0.1;
@@ -231,6 +230,7 @@ cv::Mat DrawCoverageMap(const CoverageLayer& layer, CoverageMapKind kind,
       3 * std::hypot(field.HalfLengthWithSurround(), field.HalfWidthWithSurround());
   const double scale = options.width_px / 1400.0;
   DrawCameras(img, cameras, layer.height_m, view, range_m, scale, options.footprints);
+  img = field::FrameTopView(img, view, "");
   cv::Mat out;
   cv::vconcat(img, Legend(layer, kind, coverage, err_scale, img.cols, scale), out);
   return out;

@@ -26,32 +26,19 @@ struct Axes {
   }
 };
 
-// A tick value without the "-0" of a rounded negative zero.
-double Tick(double v, double step) {
-  const double r = std::round(v / step) * step;
-  return r == 0.0 ? 0.0 : r;
-}
-
-double NiceStep(double range) {
-  const double raw = range / 8;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (m * p >= raw) return m * p;
-  }
-  return 10 * p;
-}
-
 void DrawGrid(cv::Mat& img, const Axes& a, const std::string& xlabel, const std::string& ylabel) {
-  const double sx = NiceStep(a.x1 - a.x0), sy = NiceStep(a.y1 - a.y0);
+  const double sx = field::NiceStep(a.x1 - a.x0), sy = field::NiceStep(a.y1 - a.y0);
   for (double x = std::ceil(a.x0 / sx) * sx; x <= a.x1; x += sx) {
     cv::line(img, a.P(x, a.y0), a.P(x, a.y1), cv::Scalar(225, 225, 225), 1);
-    cv::putText(img, fmt::format("{:g}", Tick(x, sx)), a.P(x, a.y0) + cv::Point2d(-10, 18),
-                cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1, cv::LINE_AA);
+    cv::putText(img, fmt::format("{:g}", field::TickValue(x, sx)),
+                a.P(x, a.y0) + cv::Point2d(-10, 18), cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1,
+                cv::LINE_AA);
   }
   for (double y = std::ceil(a.y0 / sy) * sy; y <= a.y1; y += sy) {
     cv::line(img, a.P(a.x0, y), a.P(a.x1, y), cv::Scalar(225, 225, 225), 1);
-    cv::putText(img, fmt::format("{:g}", Tick(y, sy)), a.P(a.x0, y) + cv::Point2d(-48, 5),
-                cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1, cv::LINE_AA);
+    cv::putText(img, fmt::format("{:g}", field::TickValue(y, sy)),
+                a.P(a.x0, y) + cv::Point2d(-48, 5), cv::FONT_HERSHEY_SIMPLEX, 0.45, kDark, 1,
+                cv::LINE_AA);
   }
   cv::rectangle(img, a.box, kDark, 1);
   cv::putText(img, xlabel, cv::Point(a.box.x + a.box.width / 2 - 60, a.box.br().y + 38),
@@ -305,7 +292,7 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
     view.y_max_m = y1;
     view.size = cv::Size(width_px, std::max(50, static_cast<int>((y1 - y0) * view.px_per_m)));
     img = cv::Mat(view.size, CV_8UC3, cv::Scalar(70, 70, 70));
-    const double step = NiceStep(x1 - x0);
+    const double step = field::NiceStep(x1 - x0);
     for (double x = std::ceil(x0 / step) * step; x <= x1; x += step) {
       cv::line(img, view.ToPixel({x, y0}), view.ToPixel({x, y1}), cv::Scalar(95, 95, 95), 1);
     }
@@ -351,35 +338,12 @@ cv::Mat DrawFlightsTop(const std::vector<BallSample>& track, const TrajectoryRes
                  c.extrapolated ? 1 : 2, cv::LINE_AA);
     }
   }
-  // Axes: a white frame with tick labels in metres, a scale bar and a legend.
-  const int ml = 60, mr = 20, mt = 30, mb = 70;
-  cv::Mat out(img.rows + mt + mb, img.cols + ml + mr, CV_8UC3, kWhite);
-  img.copyTo(out(cv::Rect(ml, mt, img.cols, img.rows)));
-  const Eigen::Vector2d lo = view.ToField({0.0, static_cast<double>(img.rows)});
-  const Eigen::Vector2d hi = view.ToField({static_cast<double>(img.cols), 0.0});
-  const double step = NiceStep(std::max(hi.x() - lo.x(), hi.y() - lo.y()));
-  for (double x = std::ceil(lo.x() / step) * step; x <= hi.x(); x += step) {
-    const double px = ml + view.ToPixel({x, 0}).x;
-    cv::line(out, {static_cast<int>(px), mt + img.rows}, {static_cast<int>(px), mt + img.rows + 5},
-             kDark, 1);
-    Text(out, fmt::format("{:g}", Tick(x, step)), {static_cast<int>(px) - 10, mt + img.rows + 20},
-         kDark, 0.45);
-  }
-  for (double y = std::ceil(lo.y() / step) * step; y <= hi.y(); y += step) {
-    const double py = mt + view.ToPixel({0, y}).y;
-    cv::line(out, {ml - 5, static_cast<int>(py)}, {ml, static_cast<int>(py)}, kDark, 1);
-    Text(out, fmt::format("{:g}", Tick(y, step)), {5, static_cast<int>(py) + 5}, kDark, 0.45);
-  }
-  Text(out, "x (m)", {ml + img.cols / 2 - 20, mt + img.rows + 38}, kBlack);
-  Text(out, "y (m)", {5, mt - 10}, kBlack);
-  const int bar = static_cast<int>(step * view.px_per_m);
-  cv::line(out, {out.cols - mr - bar, mt - 12}, {out.cols - mr, mt - 12}, kBlack, 3);
-  Text(out, fmt::format("{:g} m", step), {out.cols - mr - bar - 60, mt - 6}, kBlack, 0.45);
-  Text(out,
-       "top view. thick: seen part of a flight, thin: extrapolated; circles filled: seen, hollow: "
-       "extrapolated (black origin, coloured landing); red x: outliers",
-       {5, out.rows - 10}, kDark, 0.42);
-  return out;
+  // Axes in metres, a scale bar and the legend.
+  return field::FrameTopView(
+      img, view,
+      "top view. thick: seen part of a flight, thin: extrapolated; circles filled: seen, hollow: "
+      "extrapolated (black origin, coloured landing); rings: landing in (green) / out (red); red "
+      "x: outliers");
 }
 
 }  // namespace fv::recon

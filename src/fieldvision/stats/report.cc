@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -42,13 +43,23 @@ void DrawZones(cv::Mat& img, const std::vector<Zone>& zones, const field::TopVie
   }
 }
 
-// Time spent per square metre (seconds): each sample weighs the time to the next one (at most
-// 0.5 s), spread by a Gaussian of heat_sigma_m.
-cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const field::TopView& view,
-                    const StatsOptions& o) {
+// The longest time a sample of `s` stands for: a gap in the track counts no more than this,
+// 1.5 of its median step (a track sampled every 10 s still fills its map), at least 0.5 s.
+double MaxSampleWeight(const SmoothTrack& s) {
+  std::vector<double> steps;
+  for (size_t i = 1; i < s.time_s.size(); ++i) steps.push_back(s.time_s[i] - s.time_s[i - 1]);
+  if (steps.empty()) return 0.5;
+  return std::max(0.5, 1.5 * util::RankPercentile(std::move(steps), 0.5));
+}
+
+}  // namespace
+
+cv::Mat TimeSpentPerSquareMetre(const std::vector<const SmoothTrack*>& tracks,
+                                const field::TopView& view, const StatsOptions& o) {
   cv::Mat acc = cv::Mat::zeros(view.size, CV_32F);
   for (const auto* s : tracks) {
     const size_t n = s->pos_m.size();
+    const double max_dt = MaxSampleWeight(*s);
     for (size_t i = 0; i < n; ++i) {
       double dt = 0;
       if (i + 1 < n) {
@@ -56,7 +67,7 @@ cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const field::
       } else if (n > 1) {
         dt = s->time_s[i] - s->time_s[i - 1];
       }
-      dt = std::min(dt, 0.5);
+      dt = std::min(dt, max_dt);
       const cv::Point2d px = view.ToPixel(s->pos_m[i]);
       const int x = static_cast<int>(px.x), y = static_cast<int>(px.y);
       if (x >= 0 && y >= 0 && x < acc.cols && y < acc.rows) {
@@ -68,6 +79,8 @@ cv::Mat TimeDensity(const std::vector<const SmoothTrack*>& tracks, const field::
   cv::GaussianBlur(acc, acc, cv::Size(), sigma);
   return acc * (view.px_per_m * view.px_per_m);  // seconds per pixel -> per square metre
 }
+
+namespace {
 
 // The top of the colour scale: the 99th percentile of the cells with time (one person standing
 // still in one spot does not take the whole range).
@@ -85,45 +98,60 @@ double ScaleMax(const cv::Mat& density) {
   return std::max(util::RankPercentile(std::move(v), 0.99), 1e-6);
 }
 
-// Heat map of time spent over the field drawing, with its colour scale (seconds per square
-// metre) on the right and the zones drawn.
+// The heat map's colour over the field at a share `f` of the scale's top (the bar shows the same).
+cv::Vec3b HeatColour(double f, const cv::Vec3b& under) {
+  cv::Mat v(1, 1, CV_8U, cv::Scalar(cv::saturate_cast<uchar>(255 * std::clamp(f, 0.0, 1.0))));
+  cv::Mat c;
+  cv::applyColorMap(v, c, cv::COLORMAP_JET);
+  const double a = std::min(0.85, std::sqrt(std::clamp(f, 0.0, 1.0)));
+  cv::Vec3b out;
+  for (int k = 0; k < 3; ++k) {
+    out[k] = cv::saturate_cast<uchar>((1 - a) * under[k] + a * c.at<cv::Vec3b>(0, 0)[k]);
+  }
+  return out;
+}
+
+// Heat map of time spent over the field drawing (axes in metres), with its colour scale (seconds
+// per square metre, the colours as they look over the field) on the right and the zones drawn.
 cv::Mat HeatMap(const std::vector<const SmoothTrack*>& tracks, const field::FieldModel& field,
                 const field::TopView& view, const StatsOptions& o, const std::string& title) {
-  const cv::Mat density = TimeDensity(tracks, view, o);
+  const cv::Mat density = TimeSpentPerSquareMetre(tracks, view, o);
   const double vmax = ScaleMax(density);
-  cv::Mat img = field::DrawField(field, view);
+  const field::FieldDrawOptions draw;
+  cv::Mat img = field::DrawField(field, view, draw);
   if (vmax > 0) {
-    cv::Mat norm8, colour;
-    density.convertTo(norm8, CV_8U, 255.0 / vmax);  // saturates above vmax
-    cv::applyColorMap(norm8, colour, cv::COLORMAP_JET);
     for (int y = 0; y < img.rows; ++y) {
       for (int x = 0; x < img.cols; ++x) {
-        const float a =
-            std::min(0.85f, std::sqrt(std::min(1.0f, density.at<float>(y, x) / float(vmax))));
+        const double f = density.at<float>(y, x) / vmax;
         cv::Vec3b& d = img.at<cv::Vec3b>(y, x);
-        const cv::Vec3b c = colour.at<cv::Vec3b>(y, x);
-        for (int k = 0; k < 3; ++k) d[k] = cv::saturate_cast<uchar>((1 - a) * d[k] + a * c[k]);
+        d = HeatColour(f, d);
       }
     }
     field::DrawFieldLines(img, field, view, cv::Scalar(255, 255, 255), 1);
   }
   DrawZones(img, o.zones, view);
   cv::putText(img, title, {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7, {255, 255, 255}, 2);
+  if (vmax <= 0) {
+    cv::putText(img, "no position inside the picture", {10, img.rows / 2}, cv::FONT_HERSHEY_SIMPLEX,
+                0.8, {255, 255, 255}, 2, cv::LINE_AA);
+  }
+  img = field::FrameTopView(img, view, "");
   // Colour scale: a bar with ticks at 0, 1/2 and the top (>= top: the few busiest cells).
-  const int panel_w = 110, bar_w = 22, top = 52, bottom = img.rows - 20;
+  const int panel_w = 110, bar_w = 22, top = 52, bottom = img.rows - 50;
   cv::Mat out(img.rows, img.cols + panel_w, CV_8UC3, cv::Scalar(255, 255, 255));
   img.copyTo(out(cv::Rect(0, 0, img.cols, img.rows)));
+  if (vmax <= 0) return out;
   const int x0 = img.cols + 12;
   cv::putText(out, "time spent", {x0 - 4, 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1,
               cv::LINE_AA);
   cv::putText(out, "s per m^2", {x0 - 4, 32}, cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0}, 1,
               cv::LINE_AA);
+  const cv::Scalar& bg = draw.background;
+  const cv::Vec3b field_colour(cv::saturate_cast<uchar>(bg[0]), cv::saturate_cast<uchar>(bg[1]),
+                               cv::saturate_cast<uchar>(bg[2]));
   for (int y = top; y <= bottom; ++y) {
     const double f = double(bottom - y) / std::max(1, bottom - top);
-    cv::Mat v(1, 1, CV_8U, cv::Scalar(cv::saturate_cast<uchar>(255 * f)));
-    cv::Mat c;
-    cv::applyColorMap(v, c, cv::COLORMAP_JET);
-    cv::line(out, {x0, y}, {x0 + bar_w, y}, cv::Scalar(c.at<cv::Vec3b>(0, 0)), 1);
+    cv::line(out, {x0, y}, {x0 + bar_w, y}, cv::Scalar(HeatColour(f, field_colour)), 1);
   }
   cv::rectangle(out, {x0, top}, {x0 + bar_w, bottom}, {0, 0, 0}, 1);
   for (int k = 0; k <= 2; ++k) {
@@ -158,12 +186,13 @@ void DrawRadar(cv::Mat& img, const StatsResult& r, const field::TopView& view, d
       last = p;
       last_i = i;
     }
-    if (last && t - s.time_s[last_i] < 0.5) {
-      cv::circle(img, *last, 7, c, cv::FILLED, cv::LINE_AA);
-      cv::circle(img, *last, 7, {0, 0, 0}, 1, cv::LINE_AA);
-      cv::putText(img, LabelOf(s.id, o.name_of), *last + cv::Point2d(8, -8),
-                  cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1, cv::LINE_AA);
-    }
+    if (!last) continue;
+    // Where the player is now (filled), or where the track ended (hollow): every trail named.
+    const bool now = t - s.time_s[last_i] < 0.5;
+    if (now) cv::circle(img, *last, 7, c, cv::FILLED, cv::LINE_AA);
+    cv::circle(img, *last, 7, now ? cv::Scalar(0, 0, 0) : c, now ? 1 : 2, cv::LINE_AA);
+    cv::putText(img, LabelOf(s.id, o.name_of), *last + cv::Point2d(8, -8), cv::FONT_HERSHEY_SIMPLEX,
+                0.5, {255, 255, 255}, 1, cv::LINE_AA);
   }
 }
 
@@ -276,6 +305,40 @@ std::vector<std::string> BandNames(const StatsOptions& o) {
   return band_names;
 }
 
+// The top view of the heat maps and the radar: the field and its surround widened to the
+// positions beyond them, up to kMaxBeyondM; positions farther out (tracks of another field, or
+// a wrong camera) are left out and said in a note.
+constexpr double kMinMarginM = 2.0, kMaxBeyondM = 15.0;
+
+field::TopView ReportView(const StatsResult& r, const field::FieldModel& field,
+                          const StatsOptions& o, ReportFiles* files) {
+  const double hx = field.HalfLengthWithSurround(), hy = field.HalfWidthWithSurround();
+  double beyond = 0;
+  long long outside = 0, positions = 0;
+  std::set<int> outside_ids;
+  for (const auto& s : r.tracks) {
+    for (const auto& p : s.pos_m) {
+      const double b = std::max(std::abs(p.x()) - hx, std::abs(p.y()) - hy);
+      ++positions;
+      if (b > kMaxBeyondM) {
+        ++outside;
+        outside_ids.insert(s.id);
+      } else {
+        beyond = std::max(beyond, b);
+      }
+    }
+  }
+  if (outside > 0) {
+    files->notes.push_back(fmt::format(
+        "{} of {} positions ({} players) lie more than {:g} m outside field '{}' and its surround: "
+        "the heat maps and the radar leave them out (the tables count them); were the tracks made "
+        "on this field, with the right camera?",
+        outside, positions, outside_ids.size(), kMaxBeyondM, field.name));
+  }
+  const int width_px = std::max(100, o.image_width_px - field::kTopViewFrameWidthPx);
+  return field::TopView::ForField(field, width_px, std::max(kMinMarginM, beyond + 1.0));
+}
+
 // Heat maps: all players, each team and the longest tracks.
 void WriteHeatMaps(const field::FieldModel& field, ReportParts& rp, ReportFiles& files) {
   const StatsResult& r = rp.r;
@@ -322,7 +385,11 @@ void WriteRadar(const field::FieldModel& field, ReportParts& rp, ReportFiles& fi
     DrawRadar(img, r, view, rp.t1, rp.t1 - rp.t0 + 1, o);
     cv::putText(img, "radar: all trajectories", {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
                 {255, 255, 255}, 2);
-    Write(rp.out_dir + "/radar.png", img, files);
+    Write(rp.out_dir + "/radar.png",
+          field::FrameTopView(img, view,
+                              "trails: each player's whole track; filled dot: at the end of the "
+                              "clip, ring: where a track ended earlier"),
+          files);
   }
   if (!o.write_video) return;
   if (!io::H264Available()) {
@@ -333,13 +400,14 @@ void WriteRadar(const field::FieldModel& field, ReportParts& rp, ReportFiles& fi
   const std::string path = rp.out_dir + "/radar.mp4";
   cv::Mat base = field::DrawField(field, view);
   DrawZones(base, o.zones, view);
-  io::PlayableVideoWriter vw(path, 10.0, base.size());
+  const std::string caption = "trails: the last 3 s; filled dot: now, ring: where a track ended";
+  io::PlayableVideoWriter vw(path, 10.0, field::FrameTopView(base, view, caption).size());
   for (double t = rp.t0; t <= rp.t1; t += 0.1) {
     cv::Mat img = base.clone();
     DrawRadar(img, r, view, t, 3.0, o);
     cv::putText(img, fmt::format("t = {:.1f} s", t), {10, 24}, cv::FONT_HERSHEY_SIMPLEX, 0.7,
                 {255, 255, 255}, 2);
-    vw.Write(img);
+    vw.Write(field::FrameTopView(img, view, caption));
   }
   vw.Close();
   files.files.push_back(path);
@@ -513,8 +581,8 @@ ReportFiles WriteStatsReport(const StatsResult& r, const field::FieldModel& fiel
   fs::create_directories(out_dir, ec);
   FV_REQUIRE(!ec && fs::is_directory(out_dir), "cannot create output folder '{}'", out_dir);
   ReportFiles files;
-  // Heat maps: every player and the extent of all positions beyond the field.
-  ReportParts rp(r, o, out_dir, field::TopView::ForField(field, o.image_width_px, 2.0));
+  // Heat maps: every player, over the field and where the positions go beyond it.
+  ReportParts rp(r, o, out_dir, ReportView(r, field, o, &files));
   WriteHeatMaps(field, rp, files);
   for (const auto& s : r.tracks) {
     rp.t0 = std::min(rp.t0, s.time_s.front());

@@ -13,8 +13,10 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include "fieldvision/field/field.h"
+#include "fieldvision/field/field_draw.h"
 #include "fieldvision/track/mot.h"
 
 namespace fv::stats {
@@ -134,6 +136,12 @@ struct ReportFiles {
   std::vector<std::string> files;
   std::vector<std::string> notes;  // what was skipped and why (e.g. no H.264 encoder)
 };
+
+// Time spent per square metre (seconds) in each pixel of `view`: each sample weighs the time to
+// the next one, a gap counting at most 1.5 of the track's median step (at least 0.5 s), spread
+// by a Gaussian of options.heat_sigma_m; positions outside the view are left out.
+cv::Mat TimeSpentPerSquareMetre(const std::vector<const SmoothTrack*>& tracks,
+                                const field::TopView& view, const StatsOptions& options);
 
 // Writes into out_dir (created): stats.json; heat maps of time spent (heatmap_all.png,
 // heatmap_team<k>.png, heatmap_player<id>.png) with a colour scale in seconds per square metre

@@ -143,9 +143,12 @@ TEST(Stats, PairDistancesAndReport) {
   // The hottest place of player 1's map is where it stood longest: the end of its path.
   const cv::Mat heat = cv::imread(dir + "/heatmap_player1.png");
   ASSERT_FALSE(heat.empty());
-  const field::TopView view = field::TopView::ForField(field, o.image_width_px, 2.0);
-  const cv::Point2d end = view.ToPixel({*rows[16 * 25 - 1].x_m, -3.0});
-  const cv::Point2d start = view.ToPixel({-12.0, -3.0});  // walked through, off the lines
+  // The report's view: the field with a 2 m margin (every position on it), framed with axes.
+  const field::TopView view =
+      field::TopView::ForField(field, o.image_width_px - field::kTopViewFrameWidthPx, 2.0);
+  const cv::Point2d frame(field::kTopViewFrameLeftPx, field::kTopViewFrameTopPx);
+  const cv::Point2d end = view.ToPixel({*rows[16 * 25 - 1].x_m, -3.0}) + frame;
+  const cv::Point2d start = view.ToPixel({-12.0, -3.0}) + frame;  // walked through, off the lines
   // JET maps the top of the scale to dark red: more red than blue at the end, less red where it
   // only walked through.
   const cv::Vec3b e = heat.at<cv::Vec3b>(cv::Point(end));
@@ -160,6 +163,46 @@ TEST(Stats, PairDistancesAndReport) {
   EXPECT_NE(text.find("radar.png"), std::string::npos);
   EXPECT_NE(text.find("<svg"), std::string::npos);  // speed over time
   EXPECT_NE(text.find("players.csv"), std::string::npos);
+}
+
+// Positions far beyond the drawn field (tracks of another field, a wrong camera) are said in a
+// note, not dropped silently; a track sampled every 10 s fills its heat map with its whole time.
+TEST(Stats, PositionsBeyondThePictureAreNotedAndSparseSamplesCount) {
+  std::vector<track::TrackRow> rows;
+  for (int i = 0; i < 30; ++i) {
+    track::TrackRow a;
+    a.frame = i + 1;
+    a.id = 1;
+    a.box = cv::Rect2d(0, 0, 10, 20);
+    a.x_m = -5.0 + 0.01 * i;
+    a.y_m = 2.0;
+    a.time_s = 10.0 * i;  // one position every 10 s
+    rows.push_back(a);
+    track::TrackRow b = a;
+    b.id = 2;
+    b.y_m = 60.0;  // far beyond a futsal field
+    rows.push_back(b);
+  }
+  StatsOptions o;
+  o.write_video = false;
+  const StatsResult r = ComputeStats(rows, o);
+  const std::string dir = fv::testing::TempDir() + "/beyond";
+  const ReportFiles files = WriteStatsReport(r, field::BuiltinField("futsal"), o, dir);
+  ASSERT_EQ(files.notes.size(), 1u);
+  EXPECT_NE(files.notes[0].find("30 of 60 positions (1 players) lie more than"), std::string::npos)
+      << files.notes[0];
+  // Player 2's map says it is empty instead of drawing a scale from 0 to 0.
+  const cv::Mat empty = cv::imread(dir + "/heatmap_player2.png");
+  ASSERT_FALSE(empty.empty());
+  // Player 1's 30 positions 10 s apart stand for 300 s on its map (a fixed 0.5 s cap: 15 s).
+  const SmoothTrack* one = nullptr;
+  for (const auto& t : r.tracks) {
+    if (t.id == 1) one = &t;
+  }
+  ASSERT_NE(one, nullptr);
+  const field::TopView view = field::TopView::ForField(field::BuiltinField("futsal"), 800, 2.0);
+  const cv::Mat density = TimeSpentPerSquareMetre({one}, view, o);
+  EXPECT_NEAR(cv::sum(density)[0] / (view.px_per_m * view.px_per_m), 300.0, 3.0);
 }
 
 // The time comes from TRACKS.csv's time_s (here 10 frames/s, the rate of the video), --fps
