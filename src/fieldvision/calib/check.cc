@@ -1,6 +1,9 @@
 #include "fieldvision/calib/check.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -98,6 +101,68 @@ void DrawFieldOverlay(cv::Mat& image, const camera::Camera& camera, const field:
   }
 }
 
+namespace {
+
+// Title (the line error, over how many line pixels; the clicked points' error) and a legend of
+// the overlay's colours, on dark boxes in the top- and bottom-left corners.
+void DrawCheckLegend(CheckResult& result, const CheckOptions& options, const cv::Scalar& clicked) {
+  cv::Mat& img = result.overlay;
+  const auto text = [&img](const std::string& s, cv::Point p, double scale, int thick) {
+    cv::putText(img, s, p, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(0, 0, 0), thick + 2,
+                cv::LINE_AA);
+    cv::putText(img, s, p, cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(255, 255, 255), thick,
+                cv::LINE_AA);
+  };
+  std::string title = fmt::format("line error mean {:.0f} mm, p95 {:.0f} mm ({} of {} line pixels)",
+                                  result.lines.mean_mm, result.lines.p95_mm,
+                                  result.lines.num_inliers, result.lines.num_pixels);
+  if (!result.points.empty()) {
+    double ss = 0;
+    for (const auto& p : result.points) ss += p.err_px * p.err_px;
+    title += fmt::format("; clicked points {:.1f} px rms",
+                         std::sqrt(ss / static_cast<double>(result.points.size())));
+  }
+  // Sizes follow the image (1280 px wide: the title at 0.8, the legend at 0.5).
+  const double k = std::clamp(img.cols / 1280.0, 0.7, 1.5);
+  int base = 0;
+  const int title_w = cv::getTextSize(title, cv::FONT_HERSHEY_SIMPLEX, 0.8 * k, 2, &base).width;
+  const double title_scale = 0.8 * k * std::min(1.0, (img.cols - 24.0) / std::max(1, title_w));
+  text(title, {12, static_cast<int>(32 * k)}, title_scale, title_scale > 0.5 ? 2 : 1);
+  struct Entry {
+    cv::Scalar colour;
+    std::string label;
+  };
+  std::vector<Entry> entries = {
+      {options.model_colour, "the field's lines projected with this pose"}};
+  if (options.draw_line_pixels) {
+    entries.push_back({cv::Scalar(0, 255, 0), "line pixel within 5 cm of a line"});
+    entries.push_back(
+        {cv::Scalar(0, 255, 255), fmt::format("within {:.0f} cm (counted)", 100 * options.gate_m)});
+    entries.push_back({cv::Scalar(0, 0, 255), "farther: not counted"});
+  }
+  if (!result.points.empty()) entries.push_back({clicked, "clicked point -> its projection"});
+  const double label_scale = 0.5 * k;
+  int label_w = 0;
+  for (const auto& e : entries) {
+    label_w = std::max(
+        label_w, cv::getTextSize(e.label, cv::FONT_HERSHEY_SIMPLEX, label_scale, 1, &base).width);
+  }
+  const int row_h = static_cast<int>(22 * k), swatch = static_cast<int>(22 * k);
+  const int y0 = img.rows - 12 - row_h * static_cast<int>(entries.size());
+  cv::rectangle(img,
+                cv::Rect(6, y0 - row_h * 3 / 4, swatch + label_w + 30,
+                         row_h * static_cast<int>(entries.size()) + row_h / 2),
+                cv::Scalar(40, 40, 40), cv::FILLED);
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const int y = y0 + row_h * static_cast<int>(i);
+    cv::rectangle(img, cv::Rect(14, y - row_h / 2, swatch, row_h / 2), entries[i].colour,
+                  cv::FILLED);
+    text(entries[i].label, {22 + swatch, y}, label_scale, 1);
+  }
+}
+
+}  // namespace
+
 CheckResult CheckCalibration(const camera::Camera& camera, const cv::Mat& image_bgr,
                              const field::FieldModel& field,
                              const std::vector<PointCorrespondence>& known_points,
@@ -130,24 +195,21 @@ CheckResult CheckCalibration(const camera::Camera& camera, const cv::Mat& image_
       cv::circle(result.overlay, cv::Point2d(uv.x(), uv.y()), 1, c, -1);
     }
   }
+  const cv::Scalar clicked_colour(255, 255, 0);  // cyan: clicked points and their residuals
   if (!known_points.empty()) {
     result.points = PointResiduals(camera, known_points);
     for (const auto& p : result.points) {
-      cv::circle(result.overlay, cv::Point2d(p.uv_px.x(), p.uv_px.y()), 6, cv::Scalar(0, 255, 255),
-                 2, cv::LINE_AA);
+      cv::circle(result.overlay, cv::Point2d(p.uv_px.x(), p.uv_px.y()), 6, clicked_colour, 2,
+                 cv::LINE_AA);
       if (p.projected_px.allFinite()) {
         cv::line(result.overlay, cv::Point2d(p.uv_px.x(), p.uv_px.y()),
-                 cv::Point2d(p.projected_px.x(), p.projected_px.y()), cv::Scalar(0, 0, 255), 2,
-                 cv::LINE_AA);
+                 cv::Point2d(p.projected_px.x(), p.projected_px.y()), clicked_colour, 1, cv::LINE_AA);
+        cv::circle(result.overlay, cv::Point2d(p.projected_px.x(), p.projected_px.y()), 2, clicked_colour,
+                   cv::FILLED, cv::LINE_AA);
       }
     }
   }
-  const std::string text = fmt::format("line error mean {:.0f} mm, p95 {:.0f} mm",
-                                       result.lines.mean_mm, result.lines.p95_mm);
-  cv::putText(result.overlay, text, cv::Point(12, 32), cv::FONT_HERSHEY_SIMPLEX, 0.9,
-              cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-  cv::putText(result.overlay, text, cv::Point(12, 32), cv::FONT_HERSHEY_SIMPLEX, 0.9,
-              cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+  DrawCheckLegend(result, options, clicked_colour);
   return result;
 }
 

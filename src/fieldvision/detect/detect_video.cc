@@ -1,5 +1,6 @@
 #include "fieldvision/detect/detect_video.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -11,11 +12,11 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/codecs/codecs.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/strings.h"
 
@@ -104,8 +105,9 @@ cv::Mat TextBand(const std::vector<std::string>& text, int width) {
 }
 
 cv::Mat CandidateLegend(int width) {
-  return TextBand({"green: accepted candidate (score); red: rejected; magenta: the field's far "
-                   "edge (above it a higher score is needed)"},
+  return TextBand({"green: accepted candidate (score; the first-ranked, the ball, drawn thick and "
+                   "marked #1); red: rejected; magenta: the field's far edge (above it a higher "
+                   "score is needed)"},
                   width);
 }
 
@@ -128,16 +130,21 @@ void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates) 
   const auto pt = [](const Eigen::Vector2d& p) {
     return cv::Point(cvRound(p.x() * (1 << kShift)), cvRound(p.y() * (1 << kShift)));
   };
+  // Candidates come best first: the first accepted one is the frame's ball.
+  const auto first = std::find_if(candidates.begin(), candidates.end(),
+                                  [](const BallCandidate& c) { return c.accepted; });
   for (auto it = candidates.rbegin(); it != candidates.rend(); ++it) {
     const BallCandidate& c = *it;
     const int r = cvRound(std::max(c.radius_px, 1.0) * (1 << kShift));
     if (c.accepted) {
       const cv::Scalar green(0, 255, 0);
-      cv::circle(bgr, pt(c.centre_px), r, green, 1, cv::LINE_AA, kShift);
+      const bool ball = &c == &*first;
+      const int thick = ball ? 2 : 1;
+      cv::circle(bgr, pt(c.centre_px), r, green, thick, cv::LINE_AA, kShift);
       const Eigen::Vector2d dx(3, 0), dy(0, 3);
       cv::line(bgr, pt(c.centre_px - dx), pt(c.centre_px + dx), green, 1, cv::LINE_AA, kShift);
       cv::line(bgr, pt(c.centre_px - dy), pt(c.centre_px + dy), green, 1, cv::LINE_AA, kShift);
-      cv::putText(bgr, fmt::format("{:.2f}", c.score),
+      cv::putText(bgr, fmt::format("{}{:.2f}", ball ? "#1 " : "", c.score),
                   cv::Point(cvRound(c.centre_px.x() + c.radius_px + 4), cvRound(c.centre_px.y())),
                   cv::FONT_HERSHEY_SIMPLEX, 0.45, green, 1, cv::LINE_AA);
     } else {

@@ -12,6 +12,7 @@
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/progress.h"
 
 namespace fv::track {
 
@@ -189,12 +190,17 @@ DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out
   auto source = io::VideoSource::Open(video);
   const double rate = fps > 0 ? fps : source->fps();
   io::PlayableVideoWriter writer(out, rate, {source->width(), source->height()});
+  long long total = source->frame_count();
+  if (max_frames > 0) total = total > 0 ? std::min<long long>(total, max_frames) : max_frames;
+  util::Progress progress("drawing", total, "frames");
   io::Frame f;
   while ((max_frames <= 0 || source->frames_read() < max_frames) && source->Read(f)) {
     cv::Mat img = f.bgr.clone();
     overlay.Draw(img, f.index + 1);
     writer.Write(img);
+    progress.Update(writer.frames());
   }
+  progress.Finish();
   writer.Close();
   DrawVideoResult r;
   r.frames = writer.frames();
