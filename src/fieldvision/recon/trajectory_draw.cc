@@ -43,8 +43,17 @@ void DrawGrid(cv::Mat& img, const Axes& a, const std::string& xlabel, const std:
   cv::rectangle(img, a.box, kDark, 1);
   cv::putText(img, xlabel, cv::Point(a.box.x + a.box.width / 2 - 60, a.box.br().y + 38),
               cv::FONT_HERSHEY_SIMPLEX, 0.5, kBlack, 1, cv::LINE_AA);
-  cv::putText(img, ylabel, cv::Point(5, a.box.y - 8), cv::FONT_HERSHEY_SIMPLEX, 0.5, kBlack, 1,
-              cv::LINE_AA);
+  // Above the top tick label (drawn up to 5 px above the box's top).
+  cv::putText(img, ylabel, cv::Point(5, std::max(14, a.box.y - 18)), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              kBlack, 1, cv::LINE_AA);
+}
+
+// A curve clipped to the plot's box (a model run past the data stays out of the tick labels).
+void CurveInBox(cv::Mat& img, const cv::Rect& box, std::vector<cv::Point> pts, const cv::Scalar& c,
+                int thickness) {
+  for (cv::Point& p : pts) p -= box.tl();
+  cv::Mat inside = img(box & cv::Rect({0, 0}, img.size()));
+  cv::polylines(inside, pts, false, c, thickness, cv::LINE_AA);
 }
 
 void Text(cv::Mat& img, const std::string& s, cv::Point p, const cv::Scalar& c,
@@ -100,7 +109,7 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
       const Eigen::Vector3d p = m.PositionAt(ta + (tb - ta) * k / steps);
       pts.push_back(a.P(s_of(p), p.z()));
     }
-    cv::polylines(img, pts, false, c, th, cv::LINE_AA);
+    CurveInBox(img, a.box, std::move(pts), c, th);
   };
   // Other model thin, chosen model thick, seed quadratic orange.
   if (f.model_kind() != FlightModel::kGravity && f.no_drag.ok) {
@@ -123,7 +132,7 @@ cv::Mat DrawFlightSide(const std::vector<BallSample>& track, const TrajectoryRes
       const double z = f.seed.apex_m.z() - h * (s - sa) * (s - sa) / (w * w);
       pts.push_back(a.P(s, z));
     }
-    cv::polylines(img, pts, false, kOrange, 1, cv::LINE_AA);
+    CurveInBox(img, a.box, std::move(pts), kOrange, 1);
   }
   // The chosen model: thick over the seen samples, thin where it is extrapolated.
   curve(f.model(), t0, f.t_first_seen_s, kBlue, 1);
@@ -205,7 +214,7 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
       const double t = f.t_start_s + (f.t_end_s - f.t_start_s) * k / 150.0;
       pts.push_back(a.P(t, f.model().PositionAt(t).z()));
     }
-    cv::polylines(img, pts, false, FlightColour(f.index), 2, cv::LINE_AA);
+    CurveInBox(img, a.box, std::move(pts), FlightColour(f.index), 2);
     Text(img, std::to_string(f.index), a.P(f.t_apex_s, f.apex_m.z()) + cv::Point2d(-5, -10),
          FlightColour(f.index));
   }
