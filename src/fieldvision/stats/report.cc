@@ -98,16 +98,24 @@ double ScaleMax(const cv::Mat& density) {
   return std::max(util::RankPercentile(std::move(v), 0.99), 1e-6);
 }
 
+// The colour map's 256 colours (JET), made once.
+const cv::Mat& JetColours() {
+  static const cv::Mat kColours = [] {
+    cv::Mat ramp(1, 256, CV_8U), c;
+    for (int i = 0; i < 256; ++i) ramp.at<uchar>(0, i) = static_cast<uchar>(i);
+    cv::applyColorMap(ramp, c, cv::COLORMAP_JET);
+    return c;
+  }();
+  return kColours;
+}
+
 // The heat map's colour over the field at a share `f` of the scale's top (the bar shows the same).
 cv::Vec3b HeatColour(double f, const cv::Vec3b& under) {
-  cv::Mat v(1, 1, CV_8U, cv::Scalar(cv::saturate_cast<uchar>(255 * std::clamp(f, 0.0, 1.0))));
-  cv::Mat c;
-  cv::applyColorMap(v, c, cv::COLORMAP_JET);
-  const double a = std::min(0.85, std::sqrt(std::clamp(f, 0.0, 1.0)));
+  f = std::clamp(f, 0.0, 1.0);
+  const cv::Vec3b c = JetColours().at<cv::Vec3b>(0, cv::saturate_cast<uchar>(255 * f));
+  const double a = std::min(0.85, std::sqrt(f));
   cv::Vec3b out;
-  for (int k = 0; k < 3; ++k) {
-    out[k] = cv::saturate_cast<uchar>((1 - a) * under[k] + a * c.at<cv::Vec3b>(0, 0)[k]);
-  }
+  for (int k = 0; k < 3; ++k) out[k] = cv::saturate_cast<uchar>((1 - a) * under[k] + a * c[k]);
   return out;
 }
 
