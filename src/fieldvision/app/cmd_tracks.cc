@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <optional>
 
 #include <fmt/format.h>
@@ -66,12 +67,19 @@ struct TracksDrawCli {
 // Tracks drawn on a video they were not made from run past its end or lie beside its frames.
 void WarnOfAnotherVideo(const std::vector<track::TrackRow>& rows, const track::DrawVideoResult& d,
                         const std::string& video, int max_frames) {
-  int last_frame = 0;
+  int first_frame = std::numeric_limits<int>::max(), last_frame = 0;
   long outside = 0;
   const cv::Rect2d frame(0, 0, d.frame_size.width, d.frame_size.height);
   for (const auto& r : rows) {
+    first_frame = std::min(first_frame, r.frame);
     last_frame = std::max(last_frame, r.frame);
     outside += (r.box & frame).area() <= 0;
+  }
+  if (last_frame <= d.frames && (first_frame > 1 || last_frame < d.frames)) {
+    std::cout << fmt::format(
+        "the tracks cover frames {}-{} of the {} drawn; the others have no "
+        "boxes\n",
+        first_frame, last_frame, d.frames);
   }
   if (max_frames <= 0 && last_frame > d.frames) {
     std::cerr << fmt::format(
