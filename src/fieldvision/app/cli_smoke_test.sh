@@ -369,6 +369,11 @@ same_file "calibrate rig: --out-dir the cameras' folder" "$TMP/rigin/cam1.yaml" 
 same_file "calibrate multi: --out the folder of --intrinsics" "$TMP/rigin/cam1.yaml" $FV calibrate \
   multi --cols 9 --rows 6 --square 0.025 --views "cam1=$TMP/sc/cam1" \
   --views "cam2=$TMP/sc/cam2" --intrinsics "cam1=$TMP/rigin/cam1.yaml" --out "$TMP/rigin" --quiet
+# A rig placed in its own folder keeps its file names (first.yml holds the camera cam1).
+mkdir -p "$TMP/inplace" && cp "$TMP/sc/cam1.yaml" "$TMP/inplace/first.yml"
+check "calibrate extrinsics: --rig placed in its own folder" 0 $FV calibrate extrinsics \
+  --rig "$TMP/inplace" --points "cam1=$TMP/pts.csv" --field robocup-msl --out "$TMP/inplace"
+[ "$(ls "$TMP/inplace")" = "first.yml" ] || { echo "FAIL extrinsics --rig: files renamed"; fail=1; }
 check "calibrate import: --out holds another rig's camera" nonzero $FV calibrate import \
   --toml "$TMP/imp/calibration.toml" --out "$TMP/rigin"
 grep -q "already holds the camera file 'cam1.yaml'" "$TMP/err" ||

@@ -159,10 +159,24 @@ std::vector<std::string> FilesOf(const std::vector<std::string>& args) {
   return files;
 }
 
-// `inputs`: the files the run read besides the rig (points, frames, field).
-void WriteRig(const std::vector<camera::Camera>& cams, const std::string& dir,
-              const std::vector<std::string>& inputs) {
-  const std::vector<std::string> paths = CameraFilePaths(cams, dir, "--out", inputs);
+// Where a rig read from the folder `rig_dir` goes in `out_dir`: each camera under its file's
+// name (ReadCameraFolder's order), so that --out may be the rig's own folder; checked before the
+// work (CheckRigOutput; `inputs`: the files the run reads besides the rig).
+std::vector<std::string> RigOutputPaths(const std::string& rig_dir, const std::string& out_dir,
+                                        const std::vector<std::string>& inputs) {
+  std::vector<std::string> paths;
+  for (const std::string& f : CameraFilesIn(rig_dir)) {
+    paths.push_back(
+        (std::filesystem::path(out_dir) / std::filesystem::path(f).filename()).string());
+  }
+  CheckRigOutput(paths, out_dir, inputs, "--out");
+  return paths;
+}
+
+void WriteRig(const std::vector<camera::Camera>& cams, const std::vector<std::string>& paths,
+              const std::string& dir) {
+  FV_REQUIRE(cams.size() == paths.size(), "WriteRig: {} cameras but {} paths", cams.size(),
+             paths.size());
   std::filesystem::create_directories(dir);
   for (size_t i = 0; i < cams.size(); ++i) {
     camera::WriteCameraYaml(cams[i], paths[i]);
@@ -222,6 +236,8 @@ void PrintPointTable(const std::vector<PointResidual>& pts) {
 
 void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
   const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
+  const std::vector<std::string> paths =
+      RigOutputPaths(c.rig, c.out, util::PathList(FilesOf(c.points), FilesOf(c.images), c.field));
   std::vector<std::vector<PointCorrespondence>> pts(rig.size());
   for (const auto& arg : c.points) {
     const size_t eq = arg.find('=');
@@ -268,7 +284,7 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
     const std::vector<cv::Mat> frames = ReadRigFrames(out, c.images, c.camera, c.rig, &names);
     out = ReportRigRefinement(RefineRigWithLines(out, frames, *field), frames, names);
   }
-  WriteRig(out, c.out, util::PathList(FilesOf(c.points), FilesOf(c.images), c.field));
+  WriteRig(out, paths, c.out);
 }
 
 void RunFocal(const ExtrinsicsCli& c, const field::FieldModel* field) {
@@ -369,12 +385,14 @@ void WriteOverlay(const std::string& path, const camera::Camera& cam, const cv::
 // correction for the whole rig (calib/rig_lines.h).
 void RunRefineRig(const RefineCli& c) {
   const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
+  const std::vector<std::string> paths =
+      RigOutputPaths(c.rig, c.out, util::PathList(FilesOf(c.images), c.field));
   std::vector<std::string> names;
   const std::vector<cv::Mat> frames = ReadRigFrames(rig, c.images, c.camera, c.rig, &names);
   const field::FieldModel field = field::LoadField(c.field);
   const RigRefineResult r = RefineRigWithLines(rig, frames, field, c.o);
   const std::vector<camera::Camera> out = ReportRigRefinement(r, frames, names);
-  WriteRig(out, c.out, util::PathList(FilesOf(c.images), c.field));
+  WriteRig(out, paths, c.out);
   if (!c.overlay.empty()) {
     // The overlay of the first camera with a frame.
     for (size_t i = 0; i < rig.size(); ++i) {

@@ -75,7 +75,7 @@ void Setup(CLI::App& app, int& exit_code) {
   draw->add_option("field", draw_opts->field, "Built-in name or JSON file")->required();
   draw->add_option("--out", draw_opts->out, "Image to write (.png, .jpg)")->required();
   draw->add_option("--width", draw_opts->width_px, "Image width in pixels")
-      ->check(CLI::Range(100, 20000));
+      ->check(CLI::Range(300, 20000));
   draw->add_flag("!--no-names", draw_opts->names, "Do not write keypoint names");
   draw->callback([draw_opts] { DrawFieldCommand(*draw_opts); });
 }

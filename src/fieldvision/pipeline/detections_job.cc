@@ -520,7 +520,7 @@ FlightBundle BundleFlights(const std::vector<camera::Camera>& cameras,
     const double typical_px = TypicalModelRms(b);
     for (size_t i = 0; i < track->size(); ++i) {
       recon::BallSample& s = (*track)[i];
-      if (!InFlightSpan(f, *out.trajectory, i, s.time_s)) continue;
+      if (in_flight[i] || !InFlightSpan(f, *out.trajectory, i, s.time_s)) continue;
       const auto a = b.at_frame.find(i);
       const Eigen::Vector3d p = b.model.PositionAt(s.time_s);
       if ((a != b.at_frame.end() && s.n_cams >= kMinKeptViews &&
