@@ -159,17 +159,20 @@ std::vector<std::string> FilesOf(const std::vector<std::string>& args) {
   return files;
 }
 
-// Where a rig read from the folder `rig_dir` goes in `out_dir`: each camera under its file's
-// name (ReadCameraFolder's order), so that --out may be the rig's own folder; checked before the
-// work (CheckRigOutput; `inputs`: the files the run reads besides the rig).
-std::vector<std::string> RigOutputPaths(const std::string& rig_dir, const std::string& out_dir,
-                                        const std::vector<std::string>& inputs) {
+// Where the cameras read from `camera_files` go in `out_dir`: each under its file's name, so
+// that the output folder may be the cameras' own; checked before the work (CheckRigOutput naming
+// `what`; `inputs`: the files the run reads besides the cameras).
+std::vector<std::string> RigOutputPaths(const std::vector<std::string>& camera_files,
+                                        const std::string& out_dir,
+                                        const std::vector<std::string>& inputs,
+                                        const std::string& what) {
   std::vector<std::string> paths;
-  for (const std::string& f : CameraFilesIn(rig_dir)) {
+  paths.reserve(camera_files.size());
+  for (const std::string& f : camera_files) {
     paths.push_back(
         (std::filesystem::path(out_dir) / std::filesystem::path(f).filename()).string());
   }
-  CheckRigOutput(paths, out_dir, inputs, "--out");
+  CheckRigOutput(paths, out_dir, inputs, what);
   return paths;
 }
 
@@ -237,7 +240,8 @@ void PrintPointTable(const std::vector<PointResidual>& pts) {
 void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
   const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
   const std::vector<std::string> paths =
-      RigOutputPaths(c.rig, c.out, util::PathList(FilesOf(c.points), FilesOf(c.images), c.field));
+      RigOutputPaths(CameraFilesIn(c.rig), c.out,
+                     util::PathList(FilesOf(c.points), FilesOf(c.images), c.field), "--out");
   std::vector<std::vector<PointCorrespondence>> pts(rig.size());
   for (const auto& arg : c.points) {
     const size_t eq = arg.find('=');
@@ -385,8 +389,8 @@ void WriteOverlay(const std::string& path, const camera::Camera& cam, const cv::
 // correction for the whole rig (calib/rig_lines.h).
 void RunRefineRig(const RefineCli& c) {
   const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
-  const std::vector<std::string> paths =
-      RigOutputPaths(c.rig, c.out, util::PathList(FilesOf(c.images), c.field));
+  const std::vector<std::string> paths = RigOutputPaths(
+      CameraFilesIn(c.rig), c.out, util::PathList(FilesOf(c.images), c.field), "--out");
   std::vector<std::string> names;
   const std::vector<cv::Mat> frames = ReadRigFrames(rig, c.images, c.camera, c.rig, &names);
   const field::FieldModel field = field::LoadField(c.field);
@@ -485,13 +489,8 @@ void RunRig(const RigCli& c) {
   FV_REQUIRE(c.cameras.size() == c.points.size(),
              "{} --camera but {} --points; give one points file per camera", c.cameras.size(),
              c.points.size());
-  // Each camera is written under its file's name: checked before the adjustment.
-  std::vector<std::string> paths;
-  for (const auto& f : c.cameras) {
-    paths.push_back(
-        (std::filesystem::path(c.out_dir) / std::filesystem::path(f).filename()).string());
-  }
-  CheckRigOutput(paths, c.out_dir, util::PathList(c.cameras, c.points, c.field), "--out-dir");
+  const std::vector<std::string> paths = RigOutputPaths(
+      c.cameras, c.out_dir, util::PathList(c.cameras, c.points, c.field), "--out-dir");
   std::unique_ptr<field::FieldModel> field;
   if (!c.field.empty()) field = std::make_unique<field::FieldModel>(field::LoadField(c.field));
   std::vector<camera::Camera> cams;
@@ -648,8 +647,7 @@ void SetupRefine(CLI::App* group) {
                  "Also write the check image of the refined pose (with --rig: of the first "
                  "camera with a frame)");
   re->callback([rc] {
-    std::vector<std::string> inputs = {rc->field};
-    for (const auto& i : rc->images) inputs.push_back(i.substr(i.find('=') + 1));
+    std::vector<std::string> inputs = util::PathList(rc->field, FilesOf(rc->images));
     util::CheckOutputPath(rc->out, inputs);  // --out may be --camera
     inputs.push_back(rc->camera);
     inputs.push_back(rc->out);

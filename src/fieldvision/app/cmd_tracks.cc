@@ -64,9 +64,10 @@ struct TracksDrawCli {
   int max_frames = 0;
 };
 
-// Tracks drawn on a video they were not made from run past its end or lie beside its frames.
-void WarnOfAnotherVideo(const std::vector<track::TrackRow>& rows, const track::DrawVideoResult& d,
-                        const std::string& video, int max_frames) {
+// Which of the drawn frames the tracks cover; warnings where tracks drawn on a video they were not
+// made from run past its end or lie beside its frames.
+void ReportTracksOnVideo(const std::vector<track::TrackRow>& rows, const track::DrawVideoResult& d,
+                         const std::string& video, int max_frames) {
   int first_frame = std::numeric_limits<int>::max(), last_frame = 0;
   long outside = 0;
   const cv::Rect2d frame(0, 0, d.frame_size.width, d.frame_size.height);
@@ -121,7 +122,7 @@ void RunTracksDraw(const TracksDrawCli& c) {
   const track::DrawVideoResult d =
       track::DrawTracksVideo(c.video, c.out, overlay, c.fps, c.max_frames);
   std::cout << d.Summary() << "\n";
-  WarnOfAnotherVideo(rows, d, c.video, c.max_frames);
+  ReportTracksOnVideo(rows, d, c.video, c.max_frames);
 }
 
 void Setup(CLI::App& app, int& exit_code) {
