@@ -12,6 +12,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/codecs/codecs.h"
+#include "fieldvision/field/field_draw.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/csv.h"
@@ -41,48 +42,6 @@ constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.45;
 constexpr int kLineHeight = 18;
 
-int TextWidth(const std::string& text) {
-  int baseline = 0;
-  return cv::getTextSize(text, kFont, kFontScale, 1, &baseline).width;
-}
-
-// `text` broken into lines no wider than `width` pixels: at spaces, and a word too long for a
-// line (a file's path) after its '/' or, failing that, between characters.
-std::vector<std::string> Wrap(const std::string& text, int width) {
-  std::vector<std::string> lines;
-  std::string line;
-  const auto add = [&](const std::string& piece, bool space) {
-    const std::string longer = line.empty() ? piece : line + (space ? " " : "") + piece;
-    if (!line.empty() && TextWidth(longer) > width) {
-      lines.push_back(line);
-      line = piece;
-    } else {
-      line = longer;
-    }
-  };
-  std::istringstream words(text);
-  std::string word;
-  while (words >> word) {
-    if (TextWidth(word) <= width) {
-      add(word, true);
-      continue;
-    }
-    bool first = true;
-    std::string piece;
-    for (size_t c = 0; c < word.size(); ++c) {
-      piece += word[c];
-      const bool cut = word[c] == '/' || TextWidth(piece + word.substr(c + 1, 1)) > width;
-      if (cut || c + 1 == word.size()) {
-        add(piece, first);
-        first = false;
-        piece.clear();
-      }
-    }
-  }
-  if (!line.empty()) lines.push_back(line);
-  return lines;
-}
-
 // `lines` (already wrapped) in white on a black band `width` px wide.
 cv::Mat Band(const std::vector<std::string>& lines, int width) {
   cv::Mat band(kLineHeight * static_cast<int>(lines.size()) + 6, width, CV_8UC3,
@@ -99,7 +58,9 @@ cv::Mat Band(const std::vector<std::string>& lines, int width) {
 cv::Mat TextBand(const std::vector<std::string>& text, int width) {
   std::vector<std::string> lines;
   for (const std::string& t : text) {
-    for (std::string& line : Wrap(t, width - 8)) lines.push_back(std::move(line));
+    for (std::string& line : field::WrapText(t, width - 8, kFontScale)) {
+      lines.push_back(std::move(line));
+    }
   }
   return Band(lines, width);
 }

@@ -141,27 +141,56 @@ double TickValue(double v, double step) {
   return r == 0.0 ? 0.0 : r;
 }
 
+std::vector<std::string> WrapText(const std::string& text, int width_px, double font_scale) {
+  const auto text_width = [font_scale](const std::string& t) {
+    int baseline = 0;
+    return cv::getTextSize(t, cv::FONT_HERSHEY_SIMPLEX, font_scale, 1, &baseline).width;
+  };
+  std::vector<std::string> lines;
+  std::string line;
+  const auto add = [&](const std::string& piece, bool space) {
+    const std::string longer = line.empty() ? piece : line + (space ? " " : "") + piece;
+    if (!line.empty() && text_width(longer) > width_px) {
+      lines.push_back(line);
+      line = piece;
+    } else {
+      line = longer;
+    }
+  };
+  std::istringstream words(text);
+  std::string word;
+  while (words >> word) {
+    if (text_width(word) <= width_px) {
+      add(word, true);
+      continue;
+    }
+    bool first = true;
+    std::string piece;
+    for (size_t c = 0; c < word.size(); ++c) {
+      piece += word[c];
+      const bool cut = word[c] == '/' || text_width(piece + word.substr(c + 1, 1)) > width_px;
+      if (cut || c + 1 == word.size()) {
+        add(piece, first);
+        first = false;
+        piece.clear();
+      }
+    }
+  }
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+
 cv::Mat FrameTopView(const cv::Mat& image, const TopView& view, const std::string& caption) {
+  constexpr double kCaptionScale = 0.42;
   const cv::Scalar white(255, 255, 255), dark(60, 60, 60), black(0, 0, 0);
   auto text = [](cv::Mat& img, const std::string& s, cv::Point p, const cv::Scalar& c,
                  double scale) {
     cv::putText(img, s, p, cv::FONT_HERSHEY_SIMPLEX, scale, c, 1, cv::LINE_AA);
   };
   const int ml = kTopViewFrameLeftPx, mr = kTopViewFrameWidthPx - ml, mt = kTopViewFrameTopPx;
-  // The caption in lines that fit the width, broken between words.
-  std::vector<std::string> lines;
-  std::string word;
-  std::istringstream words(caption);
-  while (words >> word) {
-    const std::string longer = lines.empty() ? word : lines.back() + " " + word;
-    int base = 0;
-    const int w = cv::getTextSize(longer, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, &base).width;
-    if (lines.empty() || w > image.cols + ml + mr - 10) {
-      lines.push_back(word);
-    } else {
-      lines.back() = longer;
-    }
-  }
+  // The caption in lines that fit the width.
+  const std::vector<std::string> lines =
+      WrapText(caption, image.cols + ml + mr - 10, kCaptionScale);
   const int line_h = 17, mb = 45 + line_h * static_cast<int>(lines.size());
   cv::Mat out(image.rows + mt + mb, image.cols + ml + mr, CV_8UC3, white);
   image.copyTo(out(cv::Rect(ml, mt, image.cols, image.rows)));
@@ -184,7 +213,8 @@ cv::Mat FrameTopView(const cv::Mat& image, const TopView& view, const std::strin
   cv::line(out, {out.cols - mr - bar, mt - 12}, {out.cols - mr, mt - 12}, black, 3);
   text(out, fmt::format("{:g} m", step), {out.cols - mr - bar - 60, mt - 6}, black, 0.45);
   for (size_t i = 0; i < lines.size(); ++i) {
-    text(out, lines[i], {5, mt + image.rows + 45 + line_h * static_cast<int>(i) + 12}, dark, 0.42);
+    text(out, lines[i], {5, mt + image.rows + 45 + line_h * static_cast<int>(i) + 12}, dark,
+         kCaptionScale);
   }
   return out;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -47,6 +48,11 @@ cv::Mat DrawField(const FieldModel& field, const TopView& view,
 double NiceStep(double range);
 // `v` rounded to a multiple of `step`, without the "-0" of a rounded negative zero.
 double TickValue(double v, double step);
+
+// `text` broken into lines no wider than `width_px` in OpenCV's Hershey simplex font at
+// `font_scale` (thickness 1): at spaces, and a word too long for a line (a file's path) after its
+// '/' or, failing that, between characters.
+std::vector<std::string> WrapText(const std::string& text, int width_px, double font_scale);
 
 // Pixels FrameTopView adds left and right of the view (a view for an image `w` wide overall is
 // ForField(field, w - kTopViewFrameWidthPx)), and where the view lies in the framed image.
