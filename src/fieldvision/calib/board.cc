@@ -202,6 +202,27 @@ BoardView DetectBoard(const cv::Mat& image, const BoardSpec& board, const Detect
   return view;
 }
 
+std::string LargerChessboardSeen(const cv::Mat& image, const BoardSpec& board) {
+  if (board.type != BoardType::kChessboard || image.empty()) return "";
+  cv::Mat grey = ToGrey(image);
+  constexpr int kSearchWidthPx = 1280;  // as DetectOptions::search_max_width_px
+  if (grey.cols > kSearchWidthPx) {
+    cv::resize(grey, grey, cv::Size(), double(kSearchWidthPx) / grey.cols,
+               double(kSearchWidthPx) / grey.cols, cv::INTER_AREA);
+  }
+  const int flags =
+      cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK;
+  // A board one row and one column larger holds both of these.
+  for (const cv::Size larger :
+       {cv::Size(board.cols + 1, board.rows), cv::Size(board.cols, board.rows + 1)}) {
+    std::vector<cv::Point2f> corners;
+    if (cv::findChessboardCorners(grey, larger, corners, flags)) {
+      return fmt::format("{}x{} inner corners", larger.width, larger.height);
+    }
+  }
+  return "";
+}
+
 std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board) {
   if (board.type != BoardType::kCharuco) {
     return "(check --cols and --rows: inner corners, one fewer than the squares)";

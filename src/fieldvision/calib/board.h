@@ -77,6 +77,13 @@ BoardView DetectBoard(const cv::Mat& image, const BoardSpec& board, const Detect
 // else the options that describe the board. One clause, "(...)".
 std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board);
 
+// A chessboard larger than `board` in `image`, where `board` was found in it: OpenCV finds a
+// sub-board of the given size on a larger board, a different part in different views, which
+// shifts the board's origin between views (harmless for intrinsics alone, wrong relative poses
+// for a rig). "" when none (and for ChArUco, whose markers fix each corner's id), else a clause
+// naming the larger size, "9x6 inner corners".
+std::string LargerChessboardSeen(const cv::Mat& image, const BoardSpec& board);
+
 // Image sources for calibration.
 struct ImageSourceOptions {
   int max_video_frames = 60;  // a video is sampled evenly to at most this many frames

@@ -600,7 +600,18 @@ IntrinsicsResult CalibrateIntrinsics(const std::string& images, const Intrinsics
   FV_REQUIRE(any, "images '{}': no {} found in any of the {} images {}", images,
              options.board.Describe(), views.size(),
              BoardNotFoundHint(source.Read(0), options.board));
-  return CalibrateFromViews(views, options);
+  IntrinsicsResult result = CalibrateFromViews(views, options);
+  const auto first = std::find_if(views.begin(), views.end(),
+                                  [](const BoardView& v) { return !v.image_points.empty(); });
+  const std::string larger =
+      LargerChessboardSeen(source.Read(static_cast<int>(first - views.begin())), options.board);
+  if (!larger.empty()) {
+    result.warnings.push_back(fmt::format(
+        "'{}' shows a chessboard of {}, larger than the {}x{} given: a part of it was used, "
+        "a different part in different views; give the board's own --cols and --rows",
+        first->name, larger, options.board.cols, options.board.rows));
+  }
+  return result;
 }
 
 }  // namespace fv::calib

@@ -535,6 +535,22 @@ TEST(Multi, UnpairableViewsAndUnlinkedCamerasAreErrorsNamingTheCamera) {
   EXPECT_EQ(ParseCameraViews("left=d/*.jpg").source, "d/*.jpg");
 }
 
+// Told 8x6, OpenCV finds parts of the 9x6 board, a different part in different views: the rig
+// would be off by whole squares, so it is an error naming the camera, the image and the size.
+TEST(Multi, APartOfALargerChessboardIsAnError) {
+  const std::string data = fv::testing::SharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "no shared data";
+  const std::string dir = data + "/opencv-chessboard";
+  MultiOptions o;
+  o.board = {BoardType::kChessboard, 8, 6, 0.025};
+  o.progress = false;
+  const std::string err = fv::testing::ErrorOf([&] {
+    CalibrateMulti({{"left", dir + "/left*.jpg"}, {"right", dir + "/right*.jpg"}}, o);
+  });
+  EXPECT_NE(err.find("camera 'left': '" + dir + "/left0"), std::string::npos) << err;
+  EXPECT_NE(err.find("9x6 inner corners, larger than the 8x6 given"), std::string::npos) << err;
+}
+
 // OpenCV's stereo sample (9x6, 25 mm): the rig against OpenCV's stereoCalibrate on the same
 // detections, run here as the baseline.
 TEST(Multi, OpenCvStereoPairsMatchStereoCalibrate) {
