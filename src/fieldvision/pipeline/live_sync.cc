@@ -46,7 +46,7 @@ bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
   const int c = m.camera;
   LiveCameraStats& s = stats_[c];
   s.active = true;
-  last_arrival_[c] = arrival_s;
+  Heard(c, arrival_s);
   if (!std::isfinite(m.time_s)) {
     ++s.out_of_order;
     return false;
@@ -122,7 +122,7 @@ bool LiveSynchronizer::Implausible(int c, double time_s) {
 void LiveSynchronizer::Admit(int camera, double arrival_s) {
   FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
   stats_[camera].active = true;
-  last_arrival_[camera] = std::max(last_arrival_[camera], arrival_s);
+  Heard(camera, arrival_s);
 }
 
 void LiveSynchronizer::SkipUntil(int camera, double time_s, double arrival_s) {
@@ -130,7 +130,31 @@ void LiveSynchronizer::SkipUntil(int camera, double time_s, double arrival_s) {
   if (!std::isfinite(time_s)) return;
   skip_until_s_[camera] = std::max(skip_until_s_[camera], time_s);
   stats_[camera].active = true;
+  Heard(camera, arrival_s);
+}
+
+void LiveSynchronizer::Heard(int camera, double arrival_s) {
   last_arrival_[camera] = std::max(last_arrival_[camera], arrival_s);
+  first_arrival_s_ = std::min(first_arrival_s_, arrival_s);
+}
+
+bool LiveSynchronizer::WaitFor(int camera, double now_s) const {
+  // A camera never heard from is expected: it is waited for as if heard when the first camera
+  // was (nodes connect one after another).
+  const bool never_heard = !std::isfinite(last_arrival_[camera]);
+  const double heard_s = never_heard ? first_arrival_s_ : last_arrival_[camera];
+  return (stats_[camera].active || never_heard) && now_s - heard_s < options_.max_wait_s;
+}
+
+bool LiveSynchronizer::FarAheadOfALiveCamera(double time_s, double now_s) const {
+  if (options_.max_time_jump_s <= 0) return false;
+  for (int c = 0; c < n_; ++c) {
+    if (WaitFor(c, now_s) && std::isfinite(last_time_[c]) &&
+        time_s - last_time_[c] > options_.max_time_jump_s) {
+      return true;
+    }
+  }
+  return false;
 }
 
 void LiveSynchronizer::Restart(int camera) {
@@ -169,9 +193,13 @@ std::optional<SyncedFrame> LiveSynchronizer::Next(double now_s, bool flush) {
     if (!b.empty()) continue;                // it has sent something later: not in this group
     if (skip_until_s_[c] > until) continue;  // it skipped this group's frames
     // Nothing from camera c: wait for it only when it is active and not silent for long.
-    if (stats_[c].active && now_s - last_arrival_[c] < options_.max_wait_s) ready = false;
+    if (WaitFor(c, now_s)) ready = false;
   }
   if (!ready && !flush && now_s - first_arrival < options_.max_wait_s) return std::nullopt;
+  // A camera followed into a time base far ahead of the others' (max_time_jump_s) would decide
+  // that time for every camera, and the others' frames would all be late: it waits while they go
+  // on.
+  if (!flush && FarAheadOfALiveCamera(t, now_s)) return std::nullopt;
   SyncedFrame out;
   out.cameras.resize(n_);
   for (int c = 0; c < n_; ++c) {

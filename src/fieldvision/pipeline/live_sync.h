@@ -4,14 +4,16 @@
 // active camera has sent something later, or when its first message has waited `max_wait_s`
 // (a slow or dead camera never stalls the others: it is left out and its message, if it comes,
 // is late). Cameras that sent nothing for max_wait_s are not waited for, nor cameras that said
-// they skipped the frames (SkipUntil). Late, duplicate and
-// out-of-order messages are dropped and counted, never paired wrongly; gaps in frame numbers
+// they skipped the frames (SkipUntil); a camera not heard from yet is waited for until
+// max_wait_s after the first camera was heard (nodes connect one after another). Late, duplicate
+// and out-of-order messages are dropped and counted, never paired wrongly; gaps in frame numbers
 // count as dropped frames. A restarted camera (a new session) starts a fresh stream. A
 // single-threaded state machine; the fusion node feeds it. (frame_sync.h is the offline one:
 // it waits for every stream, as files never stall.)
 #pragma once
 
 #include <deque>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +32,8 @@ struct LiveSyncOptions {
   // ahead would otherwise decide a group there, after which every camera's frames are late.
   // A camera that goes on in the new time base (three messages in a row, each within this of the
   // one before) is followed there; groups decided past it are forgotten when the other cameras
-  // are there too (their clock was stepped back). 0: off.
+  // are there too (their clock was stepped back), and its groups wait while a camera it left
+  // behind goes on (else they would decide that time for all). 0: off.
   double max_time_jump_s = 10.0;
   void Check() const;  // throws fv::Error naming the bad field
 };
@@ -91,6 +94,14 @@ class LiveSynchronizer {
   // Whether camera c's message at time_s is too far from its stream (max_time_jump_s), counting
   // the run of such messages.
   bool Implausible(int c, double time_s);
+  void Heard(int camera, double arrival_s);
+  // Whether a group waits for camera `camera` (active or never heard from, and not silent for
+  // max_wait_s).
+  bool WaitFor(int camera, double now_s) const;
+  // Whether a group at time_s lies more than max_time_jump_s past the stream of a camera that
+  // is waited for.
+  bool FarAheadOfALiveCamera(double time_s, double now_s) const;
+  double first_arrival_s_ = std::numeric_limits<double>::infinity();  // of any camera
   bool any_group_ = false;
   double decided_until_s_ = 0;  // messages at or before this time are late
   long long groups_ = 0, complete_groups_ = 0;

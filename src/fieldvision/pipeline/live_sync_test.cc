@@ -142,6 +142,52 @@ TEST(LiveSync, SkipsAndOneCameraInAnotherTimeBaseAreNotTakenForBadTimes) {
   EXPECT_EQ(sync.stats()[1].implausible, 2);
 }
 
+// One camera's clock jumps forward for good (its node's clock stepped): it is followed there
+// after three frames, but its frames do not decide that time for the others, whose frames go on
+// pairing with each other (before, every frame of theirs was late from then on).
+TEST(LiveSync, OneCameraJumpingAheadDoesNotMakeTheOthersLate) {
+  LiveSyncOptions o;
+  o.max_time_jump_s = 10;
+  o.max_wait_s = 0.1;
+  LiveSynchronizer sync(3, o);
+  std::vector<SyncedFrame> groups;
+  for (int k = 0; k < 90; ++k) {
+    const double t = k / 60.0, arrival = 1.0 + k / 60.0;
+    for (int c = 0; c < 3; ++c) sync.Add(Msg(c, k, c == 0 && k >= 40 ? t + 1000 : t), arrival);
+    while (auto g = sync.Next(arrival)) groups.push_back(*g);
+  }
+  while (auto g = sync.Next(100, true)) groups.push_back(*g);
+  EXPECT_EQ(sync.stats()[1].late, 0);
+  EXPECT_EQ(sync.stats()[2].late, 0);
+  int paired_after_jump = 0;
+  for (const SyncedFrame& g : groups) {
+    if (g.cameras[1] && g.cameras[1]->frame >= 40) paired_after_jump += g.cameras[2] ? 1 : 0;
+  }
+  EXPECT_EQ(paired_after_jump, 50);
+}
+
+// Nodes connect one after another: a camera not heard from yet is waited for (up to max_wait_s
+// after the first camera was heard), so the first node's frames do not make the others' late.
+TEST(LiveSync, ACameraNotHeardFromYetIsWaitedFor) {
+  LiveSyncOptions o;
+  o.max_wait_s = 5;
+  LiveSynchronizer sync(2, o);
+  for (int k = 0; k < 30; ++k) ASSERT_TRUE(sync.Add(Msg(0, k, k / 60.0), 1.0 + k * 0.001));
+  EXPECT_FALSE(sync.Next(1.5));  // camera 1 may still connect
+  for (int k = 0; k < 30; ++k) ASSERT_TRUE(sync.Add(Msg(1, k, k / 60.0), 2.0));
+  int both = 0;
+  while (auto g = sync.Next(2.0)) both += g->present() == 2;
+  EXPECT_EQ(both, 30);
+  EXPECT_EQ(sync.stats()[1].late, 0);
+  // A camera that never connects delays the first groups by max_wait_s only.
+  LiveSynchronizer alone(2, o);
+  ASSERT_TRUE(alone.Add(Msg(0, 0, 0.0), 1.0));
+  EXPECT_FALSE(alone.Next(5.9));
+  EXPECT_TRUE(alone.Next(6.1));
+  ASSERT_TRUE(alone.Add(Msg(0, 1, 1 / 60.0), 6.2));
+  EXPECT_TRUE(alone.Next(6.2));
+}
+
 // A camera whose source skipped frames says so (SkipUntil): the others' frames before it are
 // paired at once instead of waiting for that camera; frames after it still wait.
 TEST(LiveSync, SkippedFramesAreNotWaitedFor) {
