@@ -108,6 +108,15 @@ bool LiveSynchronizer::Implausible(int c, double time_s) {
   jump_run_[c] = 0;
   last_frame_[c] = -1;
   last_time_[c] = -std::numeric_limits<double>::infinity();
+  // Its frames still held from the time base it left (a glitch it comes back from) would stand
+  // before the new ones for good.
+  auto& held = buffers_[c];
+  const auto left = std::remove_if(held.begin(), held.end(), [&](const Held& h) {
+    return std::abs(h.message.time_s - time_s) > jump;
+  });
+  stats_[c].implausible += held.end() - left;
+  stats_[c].received -= held.end() - left;
+  held.erase(left, held.end());
   skip_until_s_[c] = -std::numeric_limits<double>::infinity();
   bool rig_moved = true;
   for (int o = 0; o < n_; ++o) {
