@@ -1,7 +1,10 @@
 // Ctrl-C and SIGTERM ask a long-running command's job (`node`, `fuse`) to stop through its
-// JobControl (pipeline/job.h), which then returns what it has; while no StopOnSignal lives the
-// handlers do nothing.
+// JobControl (pipeline/job.h), which then returns what it has; a second one ends the process at
+// once (a source blocked in a read, e.g. a silent stream, never sees the stop). While no
+// StopOnSignal lives the handlers do nothing.
 #pragma once
+
+#include <unistd.h>
 
 #include <atomic>
 #include <csignal>
@@ -22,11 +25,20 @@ class StopOnSignal {
   StopOnSignal& operator=(const StopOnSignal&) = delete;
 
  private:
-  static void Handle(int) {
+  static void Handle(int sig) {
     pipeline::JobControl* control = target_;
-    if (control != nullptr) control->Stop();
+    if (control == nullptr) return;
+    if (stopping_.exchange(true)) {  // the second: the default action (the process ends)
+      std::signal(sig, SIG_DFL);
+      std::raise(sig);
+      return;
+    }
+    control->Stop();
+    constexpr char kSaid[] = "\nstopping (again to quit at once, outputs unwritten)\n";
+    [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, kSaid, sizeof(kSaid) - 1);
   }
   static inline std::atomic<pipeline::JobControl*> target_{nullptr};
+  static inline std::atomic<bool> stopping_{false};
 };
 
 }  // namespace fv::app

@@ -127,7 +127,7 @@ std::unique_ptr<FrameSource> OpenSynth(const std::string& spec, const FrameSourc
              "height, frames)",
              spec, params.begin()->first);
   synth::SceneSpec scene;
-  if (std::filesystem::exists(scene_name)) {
+  if (std::filesystem::is_regular_file(scene_name)) {
     scene = synth::ReadSceneSpec(scene_name);
   } else {
     bool known = false;

@@ -58,6 +58,12 @@ std::string FuseSummary::ToString() const {
                      c < fusion.used_per_camera.size() ? fusion.used_per_camera[c] : 0);
     if (r.has_offset) s += fmt::format(", clock offset {:+.4f} s", r.offset_s);
     if (r.sessions > 1) s += fmt::format(", {} sessions (restarted)", r.sessions);
+    if (r.refused > 0) {
+      s += fmt::format(
+          ", {} messages ignored (a second node as this camera, or another image "
+          "size)",
+          r.refused);
+    }
   }
   for (const std::string& p : sync_problems) s += "\nsync: " + p;
   const long long refused =
@@ -223,6 +229,14 @@ class FuseServer {
   void Receive(zmq::message_t& identity, const zmq::message_t& payload, double t1, double arrival);
   // One camera frame message of camera c.
   void AddFrame(int c, const FrameMessage& f, double t1, double arrival);
+  // Whether `session` may speak for camera c now: a second node sending as a camera whose node
+  // goes on is refused (warned once), a new session after the old one ended or went quiet is
+  // the camera restarted.
+  bool AcceptSession(int c, const std::string& session, double arrival);
+  // A hello whose image size is not the camera file's: warned once, the camera's frames refused.
+  void CheckHello(int c, const HelloMessage& h);
+  // One warning per kind of dropped message while running (all are counted in the summary).
+  void WarnDropped(const std::string& kind, const std::string& what);
   void Emit(const pipeline::SyncedFrame& group);
   FuseSummary::LatencyParts LatencyPartsOf(const pipeline::SyncedFrame& group, double latency_s);
   void PublishFlights();
@@ -239,7 +253,11 @@ class FuseServer {
   FuseSummary summary_;
   std::vector<std::string> names_;
   std::vector<std::string> sessions_;
+  std::vector<double> session_heard_s_;  // the current session's last message (steady clock)
+  std::vector<bool> session_ended_;      // it said bye
   std::vector<std::string> identities_;  // each camera's node (its ROUTER routing id), for hints
+  std::set<int> warned_second_node_, warned_size_;
+  std::set<std::string> warned_dropped_;  // kinds of dropped messages warned about
   std::set<std::string> warned_unknown_;
   std::string clock_kind_;  // "system" or "media", from the first frame
   zmq::context_t ctx_{1};
@@ -269,6 +287,8 @@ FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
     names_.push_back(cameras_[c].name);
   }
   sessions_.resize(n_);
+  session_heard_s_.assign(n_, -1e300);
+  session_ended_.assign(n_, false);
   identities_.resize(n_);
   timings_.resize(n_);
 }
@@ -387,12 +407,15 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     switch (e.reason()) {
       case MessageError::Reason::kOversized:
         ++summary_.oversized;
+        WarnDropped("oversized", e.what());
         break;
       case MessageError::Reason::kVersion:
         ++summary_.wrong_version;
+        WarnDropped("version", e.what());
         break;
       case MessageError::Reason::kMalformed:
         ++summary_.malformed;
+        WarnDropped("malformed", e.what());
         break;
     }
     return;
@@ -420,17 +443,19 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     return;
   }
   const int c = it->second;
+  if (!AcceptSession(c, session, arrival)) return;
   identities_[c] = identity.to_string();
-  if (sessions_[c] != session) {
-    if (!sessions_[c].empty()) sync_->Restart(c);
-    sessions_[c] = session;
-    ++summary_.cameras[c].sessions;
+  if (const auto* hello = std::get_if<HelloMessage>(&m)) CheckHello(c, *hello);
+  if (warned_size_.count(c) > 0) {
+    ++summary_.cameras[c].refused;  // frames of another image size than its camera file's
+    return;
   }
   if (std::holds_alternative<PingMessage>(m) || std::holds_alternative<HelloMessage>(m)) {
     sync_->Admit(c, arrival);  // connected: its frames are waited for
     return;
   }
   if (std::holds_alternative<ByeMessage>(m)) {
+    session_ended_[c] = true;
     sync_->EndOfStream(c);
     return;
   }
@@ -441,6 +466,47 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     return;
   }
   AddFrame(c, std::get<FrameMessage>(m), t1, arrival);
+}
+
+bool FuseServer::AcceptSession(int c, const std::string& session, double arrival) {
+  // A node pings every 0.5 s: quiet this long, it is gone (killed, unplugged).
+  constexpr double kGoneAfterS = 1.5;
+  if (sessions_[c] != session) {
+    if (!sessions_[c].empty() && !session_ended_[c] &&
+        arrival - session_heard_s_[c] < kGoneAfterS) {
+      ++summary_.cameras[c].refused;
+      if (warned_second_node_.insert(c).second) {
+        std::cerr << fmt::format(
+            "fuse: warning: a second node sends as camera '{}' while the first goes on: its "
+            "messages are ignored (give each node its own camera file)\n",
+            names_[c]);
+      }
+      return false;
+    }
+    if (!sessions_[c].empty()) sync_->Restart(c);
+    sessions_[c] = session;
+    session_ended_[c] = false;
+    warned_size_.erase(c);
+    ++summary_.cameras[c].sessions;
+  }
+  session_heard_s_[c] = arrival;
+  return true;
+}
+
+void FuseServer::CheckHello(int c, const HelloMessage& h) {
+  const camera::Camera& cam = cameras_[c];
+  if (h.width <= 0 || h.height <= 0 || (h.width == cam.width && h.height == cam.height)) return;
+  if (!warned_size_.insert(c).second) return;
+  std::cerr << fmt::format(
+      "fuse: warning: the node of camera '{}' sends {}x{} images but its camera file here is for "
+      "{}x{}: its frames are ignored (give fuse and the node the same camera file)\n",
+      names_[c], h.width, h.height, cam.width, cam.height);
+}
+
+void FuseServer::WarnDropped(const std::string& kind, const std::string& what) {
+  if (!warned_dropped_.insert(kind).second) return;
+  std::cerr << fmt::format("fuse: warning: message dropped: {} (more are counted at the end)\n",
+                           what);
 }
 
 void FuseServer::AddFrame(int c, const FrameMessage& f, double t1, double arrival) {
@@ -508,7 +574,10 @@ FuseSummary FuseServer::Run() {
       continue;  // a signal (Ctrl-C, SIGTERM): StopRequested decides
     }
     zmq::message_t identity, payload;
-    while (router_.recv(identity, zmq::recv_flags::dontwait)) {
+    // At most this many messages a turn: a flood does not hold off pairing and the stop check.
+    constexpr int kMaxMessagesPerTurn = 1000;
+    int taken = 0;
+    while (taken++ < kMaxMessagesPerTurn && router_.recv(identity, zmq::recv_flags::dontwait)) {
       const double t1 = io::SystemClockNow();
       const double arrival = SteadyNow();
       last_message = arrival;

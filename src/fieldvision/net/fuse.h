@@ -47,6 +47,9 @@ struct FuseCameraReport {
   std::string name;
   long long frames = 0;  // frame messages received
   long long sessions = 0;
+  // Messages ignored: from a second node sending as this camera while the first went on, or
+  // from a node whose images are not the size of this camera file's.
+  long long refused = 0;
   bool has_offset = false;
   double offset_s = 0;  // the node's last clock estimate (fuse - node)
 };

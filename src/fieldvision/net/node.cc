@@ -94,14 +94,17 @@ class NodeLink {
  public:
   // `hints`: where the fusion node's hints go (null: ignored); `system_clock`: frame times are
   // this machine's clock (else the recording's, as the fusion node's).
+  // `image_size`, `fps`: the source's, told in the hello (the fusion node checks the size).
   NodeLink(zmq::context_t& ctx, const NodeOptions& o, std::string camera, std::string session,
-           pipeline::BallHintBoard* hints, bool system_clock)
+           pipeline::BallHintBoard* hints, bool system_clock, cv::Size image_size, double fps)
       : ctx_(ctx),
         o_(o),
         camera_(std::move(camera)),
         session_(std::move(session)),
         hints_(hints),
-        system_clock_(system_clock) {
+        system_clock_(system_clock),
+        image_size_(image_size),
+        fps_(std::isfinite(fps) && fps > 0 ? fps : 0.0) {
     // Bind the pair before the thread connects to it (inproc needs the bind first).
     to_link_ = zmq::socket_t(ctx_, zmq::socket_type::pair);
     to_link_.set(zmq::sockopt::sndhwm, 64);
@@ -215,7 +218,13 @@ class NodeLink {
       }
       if (Now() >= next_ping) {
         if (!hello_sent) {
-          HelloMessage h{camera_, session_, 0, 0, 0, o_.video, "system"};
+          HelloMessage h{camera_,
+                         session_,
+                         image_size_.width,
+                         image_size_.height,
+                         fps_,
+                         o_.video,
+                         system_clock_ ? "system" : "media"};
           hello_sent = dealer.send(zmq::buffer(Encode(h)), zmq::send_flags::dontwait).has_value();
         }
         PingMessage p{camera_, session_, Now()};
@@ -234,6 +243,8 @@ class NodeLink {
   std::thread thread_;
   pipeline::BallHintBoard* hints_;
   bool system_clock_;
+  cv::Size image_size_;
+  double fps_;
   std::atomic<bool> has_offset_{false};
   std::atomic<double> offset_s_{0};
 };
@@ -334,7 +345,8 @@ NodeSummary RunNode(const NodeOptions& o) {
   const std::string session = NewSession();
   {
     const bool system_clock = source->live();
-    NodeLink link(ctx, o, camera.name, session, hints ? &*hints : nullptr, system_clock);
+    NodeLink link(ctx, o, camera.name, session, hints ? &*hints : nullptr, system_clock, size,
+                  source->fps());
     WaitForClock(link, o);
     util::Progress progress("node " + camera.name,
                             o.max_frames > 0 ? o.max_frames : source->FrameCount(), "frames",

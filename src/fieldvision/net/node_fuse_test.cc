@@ -369,6 +369,64 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   EXPECT_EQ(line, "an earlier run's rows");
 }
 
+// A second node sending as a camera whose node goes on is refused (both would be fused as one
+// camera, restarting its stream at every message), and so is a node whose images are not the
+// size of the camera file's (its pixels mean nothing here).
+TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
+  const std::string dir = testing::TempDir();
+  FuseOptions fo;
+  for (const std::string name : {"cam1", "cam2"}) {
+    camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
+    cam.name = name;
+    cam.has_pose = true;
+    cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
+    camera::WriteCameraYaml(cam, dir + "/" + name + ".yaml");
+    fo.cameras.push_back(dir + "/" + name + ".yaml");
+  }
+  fo.listen = "tcp://127.0.0.1:*";
+  fo.out = dir + "/ball.csv";
+  fo.idle_exit_s = 0.5;
+  fo.progress = false;
+  FuseSummary fused;
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
+  zmq::context_t ctx;
+  std::vector<zmq::socket_t> nodes;
+  for (int i = 0; i < 3; ++i) {
+    nodes.emplace_back(ctx, zmq::socket_type::dealer);
+    nodes.back().set(zmq::sockopt::linger, 2000);
+    nodes.back().connect(endpoint);
+  }
+  auto send = [&](int node, const std::string& bytes) {
+    nodes[node].send(zmq::buffer(bytes), zmq::send_flags::none);
+  };
+  auto frame = [](const std::string& camera, const std::string& session, int k) {
+    FrameMessage f;
+    f.camera = camera;
+    f.session = session;
+    f.clock = "media";
+    f.frame = k;
+    f.time_s = k / 30.0;
+    return Encode(f);
+  };
+  send(0, Encode(HelloMessage{"cam1", "first", 64, 48, 30, "a.avi", "media"}));
+  send(2, Encode(HelloMessage{"cam2", "big", 128, 96, 30, "c.avi", "media"}));
+  for (int k = 0; k < 5; ++k) {
+    send(0, frame("cam1", "first", k));
+    send(1, frame("cam1", "second", k));  // another node as cam1, while the first goes on
+    send(2, frame("cam2", "big", k));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  fuse.join();
+  SCOPED_TRACE(fused.ToString());
+  EXPECT_EQ(fused.cameras[0].sessions, 1);
+  EXPECT_EQ(fused.cameras[0].frames, 5);
+  EXPECT_EQ(fused.cameras[0].refused, 5);
+  EXPECT_EQ(fused.sync[0].restarts, 0);
+  EXPECT_EQ(fused.cameras[1].frames, 0);
+  EXPECT_EQ(fused.cameras[1].refused, 6);  // its hello and frames
+}
+
 // Synth cameras on the world's clock: node 2 is stopped and started again (a new session) and
 // is re-admitted; the fusion node is then restarted on the same address and the running node
 // reconnects to it by itself.
