@@ -95,7 +95,9 @@ namespace {
 
 // A printf pattern with one integer field (dir/%05d.png): a camera's numbered frames.
 bool IsFramePattern(const std::string& spec) {
-  static const std::regex kOneIntField(R"([^%]*%0?[0-9]*d[^%]*)");
+  // A field width of at most two digits: "%999999999d" made each name a gigabyte of padding
+  // for snprintf to count (seconds per name, a thousand names tried).
+  static const std::regex kOneIntField(R"([^%]*%0?[0-9]{0,2}d[^%]*)");
   return spec.find('%') != std::string::npos && std::regex_match(spec, kOneIntField);
 }
 
@@ -120,7 +122,7 @@ std::vector<std::string> ListImageSequence(const std::string& spec) {
     // missing number.
     if (!IsFramePattern(spec)) return {};
     auto name_of = [&](int i) {
-      std::vector<char> buf(spec.size() + 32);
+      std::vector<char> buf(spec.size() + 128);
       std::snprintf(buf.data(), buf.size(), spec.c_str(), i);
       return std::string(buf.data());
     };

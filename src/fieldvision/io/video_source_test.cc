@@ -146,6 +146,8 @@ TEST(VideoSource, BadInputsNameTheInput) {
   std::ofstream(dir + "/corrupt.avi") << "this is not a video at all";
   expect_error(dir + "/corrupt.avi", "corrupt.avi");
   expect_error(dir + "/none_%05d.png", "none_%05d.png");
+  // A field width no frame name has is no pattern (printing a thousand names took an hour).
+  expect_error(dir + "/%999999999d.png", "%999999999d.png");
   std::ofstream(dir + "/broken.jpg") << "not a JPEG";
   expect_error(dir + "/broken.jpg", "image '" + dir + "/broken.jpg' cannot be read");
   // A sequence whose later frame is unreadable fails at that frame, naming it.
