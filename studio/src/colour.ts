@@ -90,6 +90,7 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   let dragNow: [number, number] | null = null;
   let found: { u: number; v: number; radius_px: number; accepted: boolean }[] = [];
   let saved = '';
+  let savedRange = '';  // the sliders' range when `saved` was written
   // Learn requests sent and answered: a click sends one; only the newest answer is applied (an
   // older one arriving late would undo a later click), and #col-status's data-learned counts the
   // answers so a caller can wait for all of them.
@@ -244,13 +245,22 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     }
   };
   video.addEventListener('change', () => {
-    kept = [];  // clicks are on one video's frames
+    // Clicks are on one video's frames: another video starts afresh (its frame 0 is no frame
+    // seen yet, so nothing of this video's is learned on it).
+    kept = [];
+    points = [];
+    negatives = [];
+    roi = null;
+    found = [];
+    shownFrame = -1;
+    drawOverlay();
   });
   save.onclick = async () => {
     if (!range) return status(msg, 'nothing to save: click on the ball or set the sliders first', true);
     try {
       const r = await api.post<{ wrote: string[] }>('/api/colour/save', { range: rangeFromSliders(), out: out.value });
       saved = r.wrote[0];
+      savedRange = JSON.stringify(rangeFromSliders());
       status(msg, `wrote ${saved}`);
     } catch (e) {
       status(msg, (e as Error).message, true);
@@ -259,7 +269,9 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   detect.onclick = async () => {
     try {
       const frames = detectFrames.value.split(/[ ,]+/).filter(Boolean).map(Number);
-      const body = { video: video.value, frames, ...(saved ? { colour: saved } : { range: rangeFromSliders() }) };
+      // The saved file while the sliders still show what it holds, else the sliders' range.
+      const useSaved = saved && savedRange === JSON.stringify(rangeFromSliders()) ? saved : '';
+      const body = { video: video.value, frames, ...(useSaved ? { colour: useSaved } : { range: rangeFromSliders() }) };
       const r = await api.post<DetectResult>('/api/colour/detect', body);
       detectResult.replaceChildren(
         el('table', {}, el('tr', {}, ...['frame', 'accepted', 'best u, v px', 'radius px'].map((h) => el('th', { text: h }))),
@@ -272,7 +284,7 @@ export async function colourPage(root: HTMLElement): Promise<void> {
       );
       found = r.frames.find((f) => f.frame === Number(frame.value))?.candidates ?? [];
       drawOverlay();
-      status(msg, `detector run on ${frames.length} frame(s) with ${saved || 'the slider range'}`);
+      status(msg, `detector run on ${frames.length} frame(s) with ${useSaved || 'the slider range'}`);
     } catch (e) {
       status(msg, (e as Error).message, true);
     }

@@ -33,23 +33,48 @@ async function route(): Promise<void> {
 }
 
 const live = document.getElementById('live')!;
-const events = new EventSource(url('/api/events'));
-events.addEventListener('hello', () => (live.textContent = 'live'));
 // Pages listen for the server's events as 'studio-event' on the window ({type, data}).
 const relay = (type: string) => (e: Event) => {
   const data = JSON.parse((e as MessageEvent).data);
   window.dispatchEvent(new CustomEvent('studio-event', { detail: { type, data } }));
   return data;
 };
-events.addEventListener('saved', (e) => (live.textContent = `saved ${relay('saved')(e).path}`));
-events.addEventListener('job', (e) => {
-  const d = relay('job')(e);
-  live.textContent = `job ${d.id} ${d.command}: ${d.state}`;
+// One stream per visible tab: a browser gives a server six connections, and six tabs each
+// holding a stream left none for the pages' requests. A hidden tab closes its stream and, shown
+// again, resumes after the last event it had (the server replays what it still keeps).
+let events: EventSource | null = null;
+let lastId = '';
+function connect(): void {
+  const es = new EventSource(url('/api/events', lastId ? { since: lastId } : {}));
+  const seen = (e: Event) => {
+    const id = (e as MessageEvent).lastEventId;
+    if (id) lastId = id;
+  };
+  es.addEventListener('hello', () => (live.textContent = 'live'));
+  es.addEventListener('saved', (e) => {
+    seen(e);
+    live.textContent = `saved ${relay('saved')(e).path}`;
+  });
+  es.addEventListener('job', (e) => {
+    seen(e);
+    const d = relay('job')(e);
+    live.textContent = `job ${d.id} ${d.command}: ${d.state}`;
+  });
+  // Positions from a fusion node (live mode) and the live feed's state go to the pages only.
+  es.addEventListener('ball', (e) => (seen(e), relay('ball')(e)));
+  es.addEventListener('live', (e) => (seen(e), relay('live')(e)));
+  es.onerror = () => (live.textContent = 'server not reachable');
+  events = es;
+}
+document.addEventListener('visibilitychange', () => {
+  if (document.hidden) {
+    events?.close();
+    events = null;
+  } else if (!events) {
+    connect();
+  }
 });
-// Positions from a fusion node (live mode) and the live feed's state go to the pages only.
-events.addEventListener('ball', (e) => relay('ball')(e));
-events.addEventListener('live', (e) => relay('live')(e));
-events.onerror = () => (live.textContent = 'server not reachable');
+if (!document.hidden) connect();
 
 window.addEventListener('hashchange', () => void route());
 void route();

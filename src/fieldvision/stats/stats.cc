@@ -11,6 +11,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 #include "fieldvision/util/stats.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::stats {
 
@@ -63,6 +64,35 @@ bool InPolygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& 
   return inside;
 }
 
+namespace {
+
+// Whether segments ab and cd cross at a point inside both (touching ends do not count).
+bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d) {
+  const auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                       const Eigen::Vector2d& r) {
+    const double cross = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+    return cross > 1e-12 ? 1 : (cross < -1e-12 ? -1 : 0);
+  };
+  return side(a, b, c) * side(a, b, d) < 0 && side(c, d, a) * side(c, d, b) < 0;
+}
+
+// Whether two edges of the closed polygon that do not share a corner cross.
+bool CrossesItself(const std::vector<Eigen::Vector2d>& polygon) {
+  const size_t n = polygon.size();
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours through the closing edge
+      if (SegmentsCross(polygon[i], polygon[(i + 1) % n], polygon[j], polygon[(j + 1) % n])) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<Zone> ReadZones(const std::string& path) {
   const nlohmann::json j = util::ReadJsonFile(path, "zones");
   FV_REQUIRE(j.is_array(), "zones file '{}': expected an array of {{name, polygon}}", path);
@@ -83,6 +113,14 @@ std::vector<Zone> ReadZones(const std::string& path) {
                  z.polygon_m.back().y());
     }
     FV_REQUIRE(z.polygon_m.size() >= 3, "{} needs 3 or more vertices", ctx);
+    FV_REQUIRE(!util::Trim(z.name).empty(), "zones file '{}': zone {} has an empty name", path, i);
+    FV_REQUIRE(z.name.find_first_of("\n\r") == std::string::npos, "{}: a name on one line, please",
+               ctx);
+    for (const Zone& other : zones) {
+      FV_REQUIRE(other.name != z.name, "zones file '{}': two zones are named '{}'", path, z.name);
+    }
+    FV_REQUIRE(!CrossesItself(z.polygon_m),
+               "{}: its outline crosses itself (give the corners in order around it)", ctx);
     zones.push_back(z);
   }
   return zones;

@@ -343,5 +343,27 @@ TEST(Zones, HugeVerticesAndNonStringNamesAreOneLineErrors) {
               ThrowsMessage<fv::Error>(HasSubstr("zones file '" + path + ".none' does not exist")));
 }
 
+// Zones are columns of the coach's tables and rows of the alerts: a name must tell one from
+// another, and a polygon whose outline crosses itself (corners given out of order) has no
+// sensible inside.
+TEST(Zones, EmptyOrRepeatedNamesAndCrossedOutlinesAreErrors) {
+  const std::string path = fv::testing::TempDir() + "/zones.json";
+  std::ofstream(path) << R"([{"name": " ", "polygon": [[0, 0], [1, 0], [1, 1]]}])";
+  EXPECT_THAT([&] { ReadZones(path); }, ThrowsMessage<fv::Error>(HasSubstr("empty name")));
+  std::ofstream(path) << R"([{"name": "a", "polygon": [[0, 0], [1, 0], [1, 1]]},
+                            {"name": "a", "polygon": [[0, 0], [2, 0], [2, 2]]}])";
+  EXPECT_THAT([&] { ReadZones(path); },
+              ThrowsMessage<fv::Error>(HasSubstr("two zones are named 'a'")));
+  std::ofstream(path) << R"([{"name": "bow tie", "polygon": [[0, 0], [2, 2], [2, 0], [0, 2]]}])";
+  EXPECT_THAT([&] { ReadZones(path); },
+              ThrowsMessage<fv::Error>(HasSubstr("zone 'bow tie': its outline crosses itself")));
+  std::ofstream(path) << R"([{"name": "box, left", "polygon": [[0, 0], [2, 0], [2, 2], [0, 2]]},
+                            {"name": "L", "polygon": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2],
+                                                      [0, 2]]}])";
+  const auto zones = ReadZones(path);
+  ASSERT_EQ(zones.size(), 2u);
+  EXPECT_EQ(zones[0].name, "box, left");
+}
+
 }  // namespace
 }  // namespace fv::stats

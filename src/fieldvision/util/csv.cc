@@ -10,6 +10,59 @@
 
 namespace fv::util {
 
+namespace {
+
+// RFC 4180: a field with a comma or a double quote is quoted and its quotes doubled; line
+// breaks become spaces (a row is one line).
+std::string CsvField(std::string v) {
+  for (char& c : v) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  if (v.find_first_of(",\"") == std::string::npos) return v;
+  std::string q = "\"";
+  for (const char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+// The fields of one line, quoted ones (RFC 4180) unquoted; unquoted ones trimmed. Throws naming
+// `where` for a quote left open or text after a closing quote.
+std::vector<std::string> SplitCsvLine(const std::string& line, const std::string& where) {
+  std::vector<std::string> fields;
+  size_t i = 0;
+  for (;;) {
+    std::string field;
+    const size_t start = line.find_first_not_of(" \t", i);
+    if (start != std::string::npos && line[start] == '"') {
+      size_t j = start + 1;
+      for (;; ++j) {
+        FV_REQUIRE(j < line.size(), "{}: a quoted field is not closed", where);
+        if (line[j] != '"') {
+          field += line[j];
+        } else if (j + 1 < line.size() && line[j + 1] == '"') {
+          field += '"';
+          ++j;
+        } else {
+          break;
+        }
+      }
+      const size_t after = line.find_first_not_of(" \t", j + 1);
+      FV_REQUIRE(after == std::string::npos || line[after] == ',',
+                 "{}: text after a quoted field's closing quote", where);
+      fields.push_back(field);
+      if (after == std::string::npos) return fields;
+      i = after + 1;
+      continue;
+    }
+    const size_t comma = line.find(',', i);
+    fields.push_back(
+        Trim(line.substr(i, comma == std::string::npos ? std::string::npos : comma - i)));
+    if (comma == std::string::npos) return fields;
+    i = comma + 1;
+  }
+}
+
+}  // namespace
+
 CsvTable CsvTable::Read(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   FV_REQUIRE(in.good(), "cannot open CSV file '{}'", path);
@@ -29,8 +82,7 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& name) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (Trim(line).empty() || StartsWith(Trim(line), "#")) continue;
-    std::vector<std::string> fields = Split(line, ',');
-    for (auto& f : fields) f = Trim(f);
+    std::vector<std::string> fields = SplitCsvLine(line, fmt::format("{}:{}", name, line_no));
     if (t.header_.empty()) {
       t.header_ = fields;
       for (size_t i = 0; i < fields.size(); ++i) {
@@ -83,7 +135,7 @@ long long CsvTable::GetInt(size_t row, const std::string& column) const {
 CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& header, int precision)
     : path_(path), out_(path), columns_(header.size()), precision_(precision) {
   FV_REQUIRE(out_.good(), "cannot write CSV file '{}'", path);
-  for (size_t i = 0; i < header.size(); ++i) out_ << (i ? "," : "") << header[i];
+  for (size_t i = 0; i < header.size(); ++i) out_ << (i ? "," : "") << CsvField(header[i]);
   out_ << '\n';
 }
 
@@ -94,7 +146,7 @@ void CsvWriter::Sep() {
 
 CsvWriter& CsvWriter::operator<<(const std::string& v) {
   Sep();
-  out_ << v;
+  out_ << CsvField(v);
   return *this;
 }
 

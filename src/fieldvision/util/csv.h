@@ -1,5 +1,6 @@
 // CSV files with a header row: a strict reader that names file, line and column in its errors,
-// and a writer that formats doubles with a fixed precision.
+// and a writer that formats doubles with a fixed precision. Fields with commas or quotes are
+// quoted as RFC 4180 says (a zone or player name "box, left"); a row is one line.
 #pragma once
 
 #include <fstream>

@@ -31,6 +31,34 @@ TEST(Csv, RoundTrip) {
   EXPECT_EQ(t.Get(1, "name"), "b");
 }
 
+// Names with commas, quotes or line breaks (a zone "box, left", a player 'Ann "A."') keep every
+// row's columns: quoted as RFC 4180 says, read back as written (line breaks as spaces).
+TEST(Csv, FieldsWithCommasAndQuotesAreQuoted) {
+  const std::string path = testing::TempDir() + "/q.csv";
+  {
+    CsvWriter w(path, {"frame", "time in box, left", "name"});
+    w << 0 << 1.5 << "Ann \"A.\", left";
+    w.EndRow();
+    w << 1 << 2.0 << "two\nlines";
+    w.EndRow();
+    w.Close();
+  }
+  std::ifstream in(path);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "frame,\"time in box, left\",name");
+  const CsvTable t = CsvTable::Read(path);
+  ASSERT_EQ(t.rows(), 2u);
+  EXPECT_EQ(t.Get(0, "name"), "Ann \"A.\", left");
+  EXPECT_DOUBLE_EQ(t.GetDouble(0, "time in box, left"), 1.5);
+  EXPECT_EQ(t.Get(1, "name"), "two lines");
+  EXPECT_THAT([&] { CsvTable::Parse("a,b\n1,\"open\n", "o.csv"); },
+              ThrowsMessage<Error>(HasSubstr("o.csv:2: a quoted field is not closed")));
+  EXPECT_THAT([&] { CsvTable::Parse("a,b\n1,\"x\"y\n", "t.csv"); },
+              ThrowsMessage<Error>(HasSubstr("t.csv:2: text after")));
+  EXPECT_EQ(CsvTable::Parse("a, b\n 1 , \" x \"\n", "s.csv").Get(0, "b"), " x ");
+}
+
 // A CSV saved by a spreadsheet as "CSV UTF-8" starts with a byte-order mark: the header is read
 // without it.
 TEST(Csv, AByteOrderMarkBeforeTheHeaderIsSkipped) {

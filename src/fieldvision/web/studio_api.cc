@@ -557,10 +557,10 @@ std::vector<Route> CalibrationRoutes() {
              camera::ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          const field::FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
          const auto points = ParseClicks(body, field);
-         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"), {".yaml", ".yml"});
          fs::path points_out;
          if (body.contains("points_out")) {
-           points_out = ws.ResolveOutput(Get<std::string>(body, "points_out"));
+           points_out = ws.ResolveOutput(Get<std::string>(body, "points_out"), {".csv"});
          }
          const calib::ExtrinsicsResult result = calib::EstimatePose(cam, points);
          camera::WriteCameraYaml(result.camera, out.string());
@@ -591,7 +591,9 @@ std::vector<Route> CalibrationRoutes() {
          const std::string video_path = Get<std::string>(body, "video");
          const fs::path video = ws.Resolve(video_path);
          fs::path out;
-         if (body.contains("out")) out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         if (body.contains("out")) {
+           out = ws.ResolveOutput(Get<std::string>(body, "out"), {".yaml", ".yml"});
+         }
          if (body.contains("points")) {
            cam = calib::EstimatePose(cam, ParseClicks(body, field)).camera;
          }
@@ -667,7 +669,9 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
            if (source.name(i).find('#') == std::string::npos) ws.Resolve(source.name(i));
          }
          fs::path out;
-         if (body.contains("out")) out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         if (body.contains("out")) {
+           out = ws.ResolveOutput(Get<std::string>(body, "out"), {".yaml", ".yml"});
+         }
          const calib::IntrinsicsResult res = calib::CalibrateIntrinsics(spec, o);
          json j = IntrinsicsToJson(ws, res);
          j["wrote"] = json::array();
@@ -760,7 +764,7 @@ std::vector<Route> ColourRoutes() {
        [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const detect::ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
-         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"), {".json"});
          detect::WriteColourSpec(spec, out.string());
          Saved(events, ws, out, "colour");
          return Json({{"wrote", {ws.Relative(out)}}, {"spec", detect::ColourSpecToJson(spec)}});
@@ -994,7 +998,7 @@ std::vector<Route> TrackRoutes() {
          const json body = Body(r);
          const json zones = Get<json>(body, "zones");
          if (!zones.is_array()) throw HttpError(400, "'zones' must be an array");
-         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"));
+         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"), {".json"});
          SaveZones(zones, out);
          Saved(events, ws, out, "zones");
          return Json({{"wrote", {ws.Relative(out)}}, {"zones", zones.size()}});

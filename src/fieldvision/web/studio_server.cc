@@ -45,6 +45,9 @@ bool IsLoopback(const std::string& host) {
 
 namespace {
 
+// Longest life of one event stream, seconds (see /api/events).
+constexpr int kStreamS = 60;
+
 // The front end as built in the source tree, else as installed (share/fieldvision/studio).
 fs::path DefaultAssetsDir() {
   fs::path built(FV_STUDIO_DIST);
@@ -140,36 +143,54 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
          {401, "application/json",
           R"j({"error":"missing or wrong studio token (X-Studio-Token header or ?token=)"})j"});
   };
-  // Event stream first: the generic /api handler below would take it otherwise.
-  s.Get("/api/events", [this, unauthorized](const httplib::Request& req, httplib::Response& res) {
-    Impl& m = *impl_;
-    if (!m.Authorized(req)) return unauthorized(res);
-    auto cursor = std::make_shared<uint64_t>(m.events.Last());
-    auto first = std::make_shared<bool>(true);
-    res.set_header("Cache-Control", "no-store");
-    res.set_chunked_content_provider(
-        "text/event-stream", [this, cursor, first](size_t, httplib::DataSink& sink) {
-          std::string out;
-          if (*first) {
-            *first = false;
-            out = "retry: 2000\nevent: hello\ndata: {}\n\n";
-          } else if (!impl_->events.Wait(*cursor, out, std::chrono::seconds(10))) {
-            sink.done();
-            return false;
+  // Without a token, only pages served from a loopback name may call (DNS rebinding).
+  auto foreign_host = [this, send](const httplib::Request& req, httplib::Response& res) {
+    if (impl_->token_required || IsLoopback(HostName(req.get_header_value("Host")))) return false;
+    send(res, {403, "application/json",
+               R"j({"error":"requests must name a loopback host (Host header)"})j"});
+    return true;
+  };
+  // Event stream first: the generic /api handler below would take it otherwise. A stream ends
+  // after kStreamS (the browser reconnects after `retry`, naming the last event it had, and
+  // misses nothing the hub still keeps): a tab left open never holds a server thread for good.
+  s.Get("/api/events",
+        [this, unauthorized, foreign_host](const httplib::Request& req, httplib::Response& res) {
+          Impl& m = *impl_;
+          if (!m.Authorized(req)) return unauthorized(res);
+          if (foreign_host(req, res)) return;
+          auto cursor = std::make_shared<uint64_t>(m.events.Last());
+          // Resume after the last event the client had (EventSource's reconnect, or ?since=).
+          const std::string since = req.has_header("Last-Event-ID")
+                                        ? req.get_header_value("Last-Event-ID")
+                                        : req.get_param_value("since");
+          if (!since.empty() && since.size() < 20 &&
+              since.find_first_not_of("0123456789") == std::string::npos) {
+            *cursor = std::min<uint64_t>(*cursor, std::stoull(since));
           }
-          if (out.empty()) out = ": keep-alive\n\n";
-          return sink.write(out.data(), out.size());
+          auto first = std::make_shared<bool>(true);
+          const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(kStreamS);
+          res.set_header("Cache-Control", "no-store");
+          res.set_chunked_content_provider(
+              "text/event-stream", [this, cursor, first, end](size_t, httplib::DataSink& sink) {
+                std::string out;
+                if (*first) {
+                  *first = false;
+                  out = "retry: 2000\nevent: hello\ndata: {}\n\n";
+                } else if (std::chrono::steady_clock::now() > end ||
+                           !impl_->events.Wait(*cursor, out, std::chrono::seconds(10))) {
+                  sink.done();
+                  return false;
+                }
+                if (out.empty()) out = ": keep-alive\n\n";
+                return sink.write(out.data(), out.size());
+              });
         });
-  });
-  auto api = [this, send, unauthorized](const httplib::Request& req, httplib::Response& res) {
+  auto api = [this, send, unauthorized, foreign_host](const httplib::Request& req,
+                                                      httplib::Response& res) {
     Impl& m = *impl_;
     if (!m.Authorized(req)) return unauthorized(res);
-    // Without a token, only pages served from a loopback name may call (DNS rebinding), and a
-    // POST must be JSON, which a page of another origin cannot send without asking (CORS).
-    if (!m.token_required && !IsLoopback(HostName(req.get_header_value("Host")))) {
-      return send(res, {403, "application/json",
-                        R"j({"error":"requests must name a loopback host (Host header)"})j"});
-    }
+    if (foreign_host(req, res)) return;
+    // A POST must be JSON, which a page of another origin cannot send without asking (CORS).
     if (req.method == "POST" &&
         req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
       return send(res, {415, "application/json",

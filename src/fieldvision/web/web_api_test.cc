@@ -806,6 +806,19 @@ TEST_F(StudioApiTest, ZonesSaveAndRead) {
   EXPECT_EQ(Get("/api/zones?path=zones.json").j(), zones);  // the old file is kept
   EXPECT_FALSE(fs::exists(dir_ / "zones.json.check"));
   ExpectError(Get("/api/zones?path=scene/truth.csv"), 422, "not valid JSON");
+  // A save never replaces a file of another kind (a video, the scene's truth), and zones must be
+  // told apart.
+  const auto truth_before = fs::file_size(dir_ / "scene/truth.csv");
+  ExpectError(Post("/api/zones/save", json{{"zones", zones}, {"out", "scene/truth.csv"}}), 400,
+              "must end in .json");
+  EXPECT_EQ(fs::file_size(dir_ / "scene/truth.csv"), truth_before);
+  const json twice = {zones[0], zones[0]};
+  ExpectError(Post("/api/zones/save", json{{"zones", twice}, {"out", "zones.json"}}), 400,
+              "two zones are named 'box'");
+  ExpectError(
+      Post("/api/colour/save", json{{"range", {{"min", {0, 50, 50}}, {"max", {30, 255, 255}}}},
+                                    {"out", "scene/cam1.avi"}}),
+      400, "must end in .json");
 }
 
 // Polls a job until it is no longer running (at most `seconds`).
@@ -912,6 +925,34 @@ TEST_F(StudioApiTest, EventsStreamTellsOfSavedFiles) {
   EXPECT_TRUE(saw_saved);
   EXPECT_NE(received.find("event: hello"), std::string::npos) << received;
   EXPECT_NE(received.find("\"path\":\"c.json\""), std::string::npos) << received;
+}
+
+// A stream resumes after the last event its client had (a hidden tab shown again, EventSource's
+// own reconnect): what was published meanwhile is replayed. A foreign Host is refused here too
+// (the stream tells of jobs, their output and saved files).
+TEST_F(StudioApiTest, EventsStreamResumesAfterTheLastEventAndRefusesForeignHosts) {
+  FV_SEED_TRACE(seed_);
+  ExpectError(Get("/api/events", {{"Host", "evil.example:8470"}}), 403, "loopback host");
+  const Reply saved =
+      Post("/api/colour/save",
+           json{{"range", {{"min", {0, 50, 50}}, {"max", {30, 255, 255}}}}, {"out", "c.json"}});
+  ASSERT_EQ(saved.status, 200) << saved.body;
+  for (const bool header : {true, false}) {
+    std::string received;
+    httplib::Client stream("127.0.0.1", port_);
+    stream.set_read_timeout(20);
+    const auto read = [&](const char* data, size_t n) {
+      received.append(data, n);
+      return received.find("event: saved") == std::string::npos;
+    };
+    if (header) {
+      stream.Get("/api/events", httplib::Headers{{"Last-Event-ID", "0"}}, read);
+    } else {
+      stream.Get("/api/events?since=0", read);
+    }
+    EXPECT_NE(received.find("\"path\":\"c.json\""), std::string::npos) << received;
+    EXPECT_NE(received.find("id: 1\n"), std::string::npos) << received;
+  }
 }
 
 TEST_F(StudioApiTest, TokenRequiredOffLoopback) {

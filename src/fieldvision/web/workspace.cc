@@ -68,7 +68,18 @@ fs::path Workspace::Resolve(const std::string& path, bool must_exist) const {
   return c;
 }
 
-fs::path Workspace::ResolveOutput(const std::string& path) const {
+fs::path Workspace::ResolveOutput(const std::string& path,
+                                  const std::vector<std::string>& extensions) const {
+  if (!extensions.empty()) {
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
+      std::string names;
+      for (const std::string& e : extensions) names += (names.empty() ? "" : " or ") + e;
+      throw HttpError(400, "output '" + path + "' must end in " + names);
+    }
+  }
   fs::path c = Resolve(path, false);
   if (c == root_) throw HttpError(400, "output path '" + path + "' is the studio folder");
   if (!fs::is_directory(c.parent_path())) {

@@ -33,8 +33,11 @@ class Workspace {
   // absolute path. Throws HttpError 400 (empty), 403 (outside the folder) or 404 (`must_exist`
   // and absent). An image pattern (dir/%05d.png) must have its folder inside.
   std::filesystem::path Resolve(const std::string& path, bool must_exist = true) const;
-  // For writing: the parent folder must exist inside the root; throws 400/403/404 as Resolve.
-  std::filesystem::path ResolveOutput(const std::string& path) const;
+  // For writing: the parent folder must exist inside the root; throws 400/403/404 as Resolve,
+  // and 400 when the name does not end in one of `extensions` (any case; empty: any name), so
+  // that a save never replaces a video or an image with a camera or zones file.
+  std::filesystem::path ResolveOutput(const std::string& path,
+                                      const std::vector<std::string>& extensions = {}) const;
   // The path relative to the root, with '/' separators.
   std::string Relative(const std::filesystem::path& absolute) const;
 
