@@ -82,17 +82,27 @@ json Body(const ApiRequest& r) {
 }
 
 template <typename T>
+struct IsIntegerVector : std::false_type {};
+template <typename I>
+struct IsIntegerVector<std::vector<I>>
+    : std::bool_constant<std::is_integral_v<I> && !std::is_same_v<I, bool>> {};
+
+template <typename T>
 T Get(const json& body, const std::string& key) {
   if (!body.contains(key)) throw HttpError(400, "missing key '" + key + "'");
-  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
-    // nlohmann converts 3.7 to 3 and 1e300 to whatever the cast gives.
-    const json& v = body.at(key);
-    const bool in_range = v.is_number_unsigned()  ? std::in_range<T>(v.get<uint64_t>())
-                          : v.is_number_integer() ? std::in_range<T>(v.get<int64_t>())
+  // nlohmann converts 3.7 to 3 and 1e300 to whatever the cast gives.
+  const auto require_integer = [&](const json& v, auto type) {
+    using I = decltype(type);
+    const bool in_range = v.is_number_unsigned()  ? std::in_range<I>(v.get<uint64_t>())
+                          : v.is_number_integer() ? std::in_range<I>(v.get<int64_t>())
                                                   : false;
-    if (!in_range) {
-      throw HttpError(400, "key '" + key + "' must be an integer in range");
-    }
+    if (!in_range) throw HttpError(400, "key '" + key + "' must hold integers in range");
+  };
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    require_integer(body.at(key), T{});
+  } else if constexpr (IsIntegerVector<T>::value) {
+    if (!body.at(key).is_array()) throw HttpError(400, "key '" + key + "' must be an array");
+    for (const json& v : body.at(key)) require_integer(v, typename T::value_type{});
   }
   try {
     return body.at(key).get<T>();
@@ -442,6 +452,21 @@ cv::Mat DecodePngImage(const std::string& base64, const std::string& what) {
   static const std::string kSignature = "\x89PNG\r\n\x1a\n";
   if (bytes.compare(0, kSignature.size(), kSignature) != 0) {
     throw HttpError(400, what + " is not a PNG image");
+  }
+  // The size from the header (IHDR: width, height big-endian at bytes 16..23), before decoding:
+  // a 250 KB file may say 16000 x 16000 pixels (1 GB decoded).
+  constexpr size_t kIhdrEnd = 24;
+  constexpr uint64_t kMaxSidePx = 16384, kMaxPixels = 40'000'000;
+  if (bytes.size() < kIhdrEnd) throw HttpError(400, what + " is not a readable PNG image");
+  const auto be32 = [&](size_t at) {
+    uint64_t v = 0;
+    for (size_t k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(bytes[at + k]);
+    return v;
+  };
+  const uint64_t w = be32(16), h = be32(20);
+  if (w == 0 || h == 0 || w > kMaxSidePx || h > kMaxSidePx || w * h > kMaxPixels) {
+    throw HttpError(400, fmt::format("{} is {}x{} pixels: at most {} a side and {} million in all",
+                                     what, w, h, kMaxSidePx, kMaxPixels / 1'000'000));
   }
   const std::vector<uchar> buf(bytes.begin(), bytes.end());
   cv::Mat image = codecs::ImDecode(buf, cv::IMREAD_UNCHANGED);

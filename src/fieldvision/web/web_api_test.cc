@@ -302,6 +302,11 @@ TEST_F(StudioApiTest, MalformedRequests) {
   ExpectError(
       Post("/api/colour/detect", json{{"video", "scene/cam1.avi"}, {"frames", json::array()}}), 400,
       "frames");
+  // Numbers that are no int (frame 2^32 + 5 read as 5, 5.9 as 5, a box of 1e12 as INT_MIN).
+  for (const json& frames : {json{4294967301LL}, json{5.9}}) {
+    ExpectError(Post("/api/colour/detect", json{{"video", "scene/cam1.avi"}, {"frames", frames}}),
+                400, "key 'frames' must hold integers in range");
+  }
   ExpectError(Post("/api/colour/save", json{{"range", {{"min", {0, 0}}}}, {"out", "c.json"}}), 400,
               "range");
 }
@@ -782,6 +787,10 @@ TEST_F(StudioApiTest, PlayersExport) {
   for (const auto& [images, words] : std::vector<std::pair<json, std::string>>{
            {{{"heatmap", "not*base64"}}, "base64"},
            {{{"heatmap", Base64("GIF89a not a png")}}, "not a PNG"},
+           // A PNG header saying 16000 x 16000 pixels (1 GB decoded) in a few bytes.
+           {{{"heatmap",
+              Base64(std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\x3e\x80\0\0\x3e\x80", 24))}},
+            "16000x16000 pixels"},
            {{{"../x", heat_url}}, "image name"},
            {{{"heatmap", 3}}, "not a string"},
            {json::array(), "'images'"}}) {
