@@ -64,7 +64,7 @@ interface IntrinsicsResult {
 
 export async function calibratePage(root: HTMLElement): Promise<void> {
   const [list, info] = await Promise.all([api.files(), api.info()]);
-  const video = fileSelect('cal-video', list, ['video', 'images']);
+  const video = fileSelect('cal-video', list, ['video', 'images', 'image']);
   const frame = el('input', { id: 'cal-frame', type: 'number', value: '0', min: '0' });
   const camera = fileSelect('cal-camera', list, ['camera']);
   const field = optionsSelect('cal-field', info.fields, 'robocup-msl');
@@ -260,7 +260,9 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
           ? `refined against ${r.num_line_pixels} line pixels: line error mean ${r.before.mean_mm.toFixed(1)} → ${r.after.mean_mm.toFixed(1)} mm, median ${r.before.median_mm.toFixed(1)} → ${r.after.median_mm.toFixed(1)} mm, p95 ${r.before.p95_mm.toFixed(1)} → ${r.after.p95_mm.toFixed(1)} mm; camera moved ${(1000 * r.moved_m).toFixed(0)} mm, turned ${r.rotated_deg.toFixed(2)}°, now at (${p}) m`
           : `not refined: ${r.status} (line error mean ${r.before.mean_mm.toFixed(1)} mm over ${r.num_line_pixels} line pixels)`,
       }),
-      el('div', { class: 'hint', text: 'green: line pixels found in the frame; orange: the field lines at the refined pose. Saving writes the refined pose.' }),
+      el('div', { class: 'hint', text: r.accepted
+        ? 'green: line pixels found in the frame; orange: the field lines at the refined pose. Saving writes the refined pose.'
+        : 'green: line pixels found in the frame; orange: the field lines at the clicked pose. Saving writes the pose from the clicks.' }),
     );
   }
 

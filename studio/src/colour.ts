@@ -38,7 +38,7 @@ export function inRange(range: Range, h: number, s: number, v: number): boolean 
 
 export async function colourPage(root: HTMLElement): Promise<void> {
   const list = await api.files();
-  const video = fileSelect('col-video', list, ['video', 'images']);
+  const video = fileSelect('col-video', list, ['video', 'images', 'image']);
   const frame = el('input', { id: 'col-frame', type: 'number', value: '0', min: '0' });
   const load = el('button', { id: 'col-load', text: 'Open frame' });
   const clear = el('button', { id: 'col-clear', text: 'Clear clicks' });

@@ -232,9 +232,24 @@ export async function playersPage(root: HTMLElement): Promise<void> {
   }
 
   // Zone alerts: a row per zone, a bar per stay of a player (its colour and id), the board's time.
+  // Each zone's stays in lanes: a stay goes to the first lane free by its start, so stays that
+  // overlap (several players in one zone at once) are all seen, one above the other.
+  function zoneLanes(zoneName: string): PlayerStats['events'][] {
+    const lanes: PlayerStats['events'][] = [];
+    const stays = (playerStats?.events ?? []).filter((ev) => ev.zone === zoneName).sort((a, b) => a.enter_s - b.enter_s);
+    for (const e of stays) {
+      const free = lanes.find((l) => l[l.length - 1].exit_s <= e.enter_s);
+      if (free) free.push(e);
+      else lanes.push([e]);
+    }
+    return lanes;
+  }
+
   function drawAlerts(now: number) {
-    const rowsH = 22;
-    const h = 24 + rowsH * Math.max(1, zones.length);
+    const laneH = 16;
+    const lanesOf = zones.map((z) => zoneLanes(z.name));
+    const rowH = lanesOf.map((l) => 6 + laneH * Math.max(1, l.length));
+    const h = 24 + Math.max(22, rowH.reduce((a, b) => a + b, 0));
     if (alerts.height !== h) alerts.height = h;
     const ctx = alerts.getContext('2d')!;
     ctx.fillStyle = '#111';
@@ -250,27 +265,31 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       ctx.fillText('no zones file chosen', 8, 16);
     }
     const events = playerStats?.events ?? [];
+    let y = 4;
     zones.forEach((z, k) => {
-      const y = 4 + k * rowsH;
       ctx.fillStyle = '#ccc';
       ctx.fillText(z.name.slice(0, 14), 6, y + 14);
       ctx.fillStyle = '#222';
-      ctx.fillRect(left, y, alerts.width - left - 10, rowsH - 4);
-      for (const e of events.filter((ev) => ev.zone === z.name)) {
-        ctx.fillStyle = colourOf({ id: e.id, team: teamOf.get(e.id) ?? null });
-        ctx.globalAlpha = 0.8;
-        ctx.fillRect(x(e.enter_s), y + 2, Math.max(2, x(e.exit_s) - x(e.enter_s)), rowsH - 8);
-        ctx.globalAlpha = 1;
-        ctx.fillStyle = '#000';
-        ctx.fillText(String(e.id), x(e.enter_s) + 2, y + 13);
-      }
+      ctx.fillRect(left, y, alerts.width - left - 10, rowH[k] - 4);
+      lanesOf[k].forEach((lane, j) => {
+        const ly = y + 1 + j * laneH;
+        for (const e of lane) {
+          ctx.fillStyle = colourOf({ id: e.id, team: teamOf.get(e.id) ?? null });
+          ctx.globalAlpha = 0.8;
+          ctx.fillRect(x(e.enter_s), ly + 1, Math.max(2, x(e.exit_s) - x(e.enter_s)), laneH - 3);
+          ctx.globalAlpha = 1;
+          ctx.fillStyle = '#000';
+          ctx.fillText(String(e.id), x(e.enter_s) + 2, ly + 12);
+        }
+      });
+      y += rowH[k];
     });
     // Time axis and the board's time.
     ctx.fillStyle = '#aaa';
-    const y = alerts.height - 6;
+    const axisY = alerts.height - 6;
     for (let k = 0; k <= 5; ++k) {
       const s = t0 + ((t1 - t0) * k) / 5;
-      ctx.fillText(`${s.toFixed(1)} s`, x(s) - 10, y);
+      ctx.fillText(`${s.toFixed(1)} s`, x(s) - 10, axisY);
     }
     ctx.strokeStyle = '#ff0';
     ctx.beginPath();
@@ -419,6 +438,13 @@ export async function playersPage(root: HTMLElement): Promise<void> {
     }
   };
   time.addEventListener('input', () => draw(Number(time.value)));
+  // Real time: the tracks' own frame step (the median; PETS at 7-10 fps played 2.7 s a second
+  // at a fixed 40 ms).
+  const frameStepMs = () => {
+    const t = frames.map((f) => times.get(f) ?? 0);
+    const steps = t.slice(1).map((v, i) => v - t[i]).filter((d) => d > 0).sort((a, b) => a - b);
+    return steps.length ? Math.max(15, 1000 * steps[Math.floor(steps.length / 2)]) : 40;
+  };
   play.onclick = () => {
     if (timer) {
       clearInterval(timer);
@@ -435,6 +461,6 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       const i = (Number(time.value) + 1) % Math.max(1, frames.length);
       time.value = String(i);
       draw(i);
-    }, 40);
+    }, frameStepMs());
   };
 }

@@ -32,6 +32,7 @@ interface Flight {
   t_end_s: number;
   origin: number[];
   landing: number[];
+  landing_extrapolated?: boolean;
   apex: number[];
   start_event?: string;
   end_event?: string;
@@ -72,11 +73,17 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   const flights = fileSelect('v3-flights', list, ['json'], true);
   const field = optionsSelect('v3-field', info.fields, 'robocup-msl');
   const cameraBoxes = el('div', { id: 'v3-camera-files', class: 'checks' });
-  for (const f of list.filter((f) => f.kind === 'camera')) {
-    cameraBoxes.append(el('label', {}, el('input', { type: 'checkbox', value: f.path, checked: '' }), f.path));
-  }
   const guess = list.find((f) => f.kind === 'csv' && /ball/i.test(f.path));
   if (guess) ball.value = guess.path;
+  // Ticked: the cameras beside the ball file when it has some (cameras of other scenes in the
+  // folder would be drawn around this one), else all.
+  const folderOf = (p: string) => p.slice(0, p.lastIndexOf('/') + 1);
+  const cameraFiles = list.filter((f) => f.kind === 'camera');
+  const beside = guess ? cameraFiles.filter((f) => folderOf(f.path) === folderOf(guess.path)) : [];
+  for (const f of cameraFiles) {
+    const on = !beside.length || beside.includes(f);
+    cameraBoxes.append(el('label', {}, el('input', { type: 'checkbox', value: f.path, ...(on ? { checked: '' } : {}) }), f.path));
+  }
   const guessFlights = list.find((f) => f.kind === 'json' && /flight/i.test(f.path) && !/truth|synth/i.test(f.path));
   if (guessFlights) flights.value = guessFlights.path;
   const load = el('button', { id: 'v3-load', text: 'Show' });
@@ -353,7 +360,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   function setTime(i: number) {
     if (!samples.length) return;
     const s = samples[Math.min(i, samples.length - 1)];
-    timeLabel.textContent = ` t = ${s[1].toFixed(3)} s (frame ${s[0]}), ball at (${s[2].toFixed(2)}, ${s[3].toFixed(2)}, ${s[4].toFixed(2)}) m, ${s[5]} cameras`;
+    timeLabel.textContent = ` t = ${s[1].toFixed(3)} s (frame ${s[0]}), ball at (${s[2].toFixed(2)}, ${s[3].toFixed(2)}, ${s[4].toFixed(2)}) m from ${s[5]} cameras (rays drawn from every camera shown)`;
     setBall([s[2], s[3], s[4]]);
     plot?.setCursor({ left: plot.valToPos(s[1], 'x'), top: 10 });
     requestRender();
@@ -407,7 +414,7 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
       fa.forEach((x, i) => {
         const calls = (x.landing_calls ?? []).map((c) => c.call ?? (c.in === undefined ? '' : c.in ? 'in' : 'out')).filter(Boolean);
         flightList.append(el('li', {
-          text: `${i + 1}: ${x.t_start_s.toFixed(2)}–${x.t_end_s.toFixed(2)} s${x.start_event ? ` (${x.start_event} → ${x.end_event})` : ''}, apex ${x.apex[2].toFixed(2)} m, lands at (${x.landing[0].toFixed(2)}, ${x.landing[1].toFixed(2)}) m${calls.length ? ', ' + calls.join(', ') : ''}`,
+          text: `${i + 1}: ${x.t_start_s.toFixed(2)}–${x.t_end_s.toFixed(2)} s${x.start_event ? ` (${x.start_event} → ${x.end_event})` : ''}, apex ${x.apex[2].toFixed(2)} m, ${x.landing_extrapolated ? 'would land (extrapolated past the last sample) at' : 'lands at'} (${x.landing[0].toFixed(2)}, ${x.landing[1].toFixed(2)}) m${calls.length ? ', ' + calls.join(', ') : ''}`,
         }));
       });
       time.max = String(Math.max(0, samples.length - 1));

@@ -26,6 +26,7 @@
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/stats/stats.h"
+#include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/json.h"
@@ -841,9 +842,29 @@ std::vector<Route> ColourRoutes() {
 
 // Endpoints of ball and player tracks, player statistics, zones.
 // The player tracks and zones a statistics request names ({tracks[, zones]}), into `o`.
+// The teams and names of a tracks file as `stats` takes them: its roster (TRACKS.csv.teams.csv)
+// when there is one, else its own `team` column where it has one.
+track::Roster RosterOf(const fs::path& tracks) {
+  const std::string roster = track::RosterPathFor(tracks.string());
+  if (fs::is_regular_file(roster)) return track::ReadRoster(roster);
+  track::Roster r;
+  const util::CsvTable t = util::CsvTable::Read(tracks.string());
+  if (!t.Has("team") || !t.Has("id")) return r;
+  for (size_t i = 0; i < t.rows(); ++i) {
+    if (t.Get(i, "team").empty()) continue;
+    const int team = static_cast<int>(t.GetInt(i, "team"));
+    if (team >= 0) r.team_of.emplace(static_cast<int>(t.GetInt(i, "id")), team);
+  }
+  return r;
+}
+
 std::vector<track::TrackRow> ReadStatsInput(const Workspace& ws, const json& body,
                                             stats::StatsOptions& o) {
-  auto rows = track::ReadTracksCsv(ws.Resolve(Get<std::string>(body, "tracks")).string());
+  const fs::path tracks = ws.Resolve(Get<std::string>(body, "tracks"));
+  auto rows = track::ReadTracksCsv(tracks.string());
+  const track::Roster roster = RosterOf(tracks);
+  o.team_of = roster.team_of;
+  o.name_of = roster.name_of;
   o.write_video = false;
   if (body.contains("zones") && !body["zones"].is_null()) {
     o.zones = stats::ReadZones(ws.Resolve(Get<std::string>(body, "zones")).string());
@@ -941,20 +962,24 @@ std::vector<Route> TrackRoutes() {
                       {"skipped", track.skipped.size()}});
        }},
       {{"GET", "/api/tracks",
-        "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s, team when the "
-        "file has that column)"},
+        "?path=TRACKS.csv: player tracks (frame, id, box, x_m, y_m, time_s, team from its roster "
+        "TRACKS.csv.teams.csv or its own team column)"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
-         const util::CsvTable t = util::CsvTable::Read(ws.Resolve(Param(r, "path")).string());
+         const fs::path path = ws.Resolve(Param(r, "path"));
+         const util::CsvTable t = util::CsvTable::Read(path.string());
          t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
+         const track::Roster roster = RosterOf(path);
          json rows = json::array();
          auto num = [&](size_t i, const char* col) -> json {
            if (!t.Has(col) || t.Get(i, col).empty()) return nullptr;
            return t.GetDouble(i, col);
          };
          for (size_t i = 0; i < t.rows(); ++i) {
+           const auto team = roster.team_of.find(static_cast<int>(t.GetInt(i, "id")));
            rows.push_back({t.GetInt(i, "frame"), t.GetInt(i, "id"), num(i, "bb_left"),
                            num(i, "bb_top"), num(i, "bb_width"), num(i, "bb_height"), num(i, "x_m"),
-                           num(i, "y_m"), num(i, "time_s"), num(i, "team")});
+                           num(i, "y_m"), num(i, "time_s"),
+                           team == roster.team_of.end() ? json(nullptr) : json(team->second)});
          }
          return Json({{"columns",
                        {"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "x_m", "y_m",

@@ -202,6 +202,14 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   };
   s.Get(R"(/api/.*)", api);
   s.Post(R"(/api/.*)", api);
+  // Other methods: one line saying which are served (httplib answered an empty 400).
+  const auto other_method = [send](const httplib::Request&, httplib::Response& res) {
+    send(res, {405, "application/json",
+               R"j({"error":"method not allowed: the studio's API takes GET and POST"})j"});
+  };
+  s.Put(R"(/.*)", other_method);
+  s.Patch(R"(/.*)", other_method);
+  s.Delete(R"(/.*)", other_method);
   if (m.assets_built) {
     s.set_mount_point("/", m.options.assets);
   } else {

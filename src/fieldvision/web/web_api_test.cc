@@ -151,6 +151,14 @@ TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
   const Reply endpoints = Get("/api/endpoints");
   ASSERT_EQ(endpoints.status, 200);
   EXPECT_EQ(endpoints.j().size(), StudioApi::Endpoints().size());
+  // A lone numbered photo is an image (it was left out), a folder named build... is the user's
+  // (only a CMake build tree is not listed).
+  for (const char* folder : {"one", "buildings", "cmake-out"})
+    fs::create_directories(dir_ / folder);
+  cv::imwrite((dir_ / "one/00017.jpg").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 200, 255)));
+  cv::imwrite((dir_ / "buildings/a.png").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(9)));
+  cv::imwrite((dir_ / "cmake-out/b.png").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(9)));
+  std::ofstream(dir_ / "cmake-out/CMakeCache.txt") << "# CMake\n";
   const Reply files = Get("/api/files");
   ASSERT_EQ(files.status, 200);
   std::map<std::string, std::string> kinds;
@@ -158,8 +166,17 @@ TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
   EXPECT_EQ(kinds["scene/cam1.yaml"], "camera");
   EXPECT_EQ(kinds["scene/cam1.avi"], "video");
   EXPECT_EQ(kinds["scene/truth.csv"], "csv");
+  EXPECT_EQ(kinds["one/00017.jpg"], "image");
+  EXPECT_EQ(kinds["buildings/a.png"], "image");
+  EXPECT_EQ(kinds.count("cmake-out/b.png"), 0u);
   ExpectError(Get("/api/nothing"), 404, "unknown endpoint");
   ExpectError(Post("/api/info", json::object()), 405, "not allowed");
+  for (const auto& r :
+       {client_->Put("/api/zones/save", "{}", "application/json"),
+        client_->Patch("/api/info", "{}", "application/json"), client_->Delete("/api/info")}) {
+    ASSERT_TRUE(r);
+    ExpectError({r->status, r->body}, 405, "takes GET and POST");
+  }
 }
 
 TEST_F(StudioApiTest, FieldVideoFrameAndCamera) {
@@ -693,6 +710,17 @@ TEST_F(StudioApiTest, PlayerStatsAndZoneAlerts) {
   const Reply plain = Post("/api/players/stats", json{{"tracks", "WALK.csv"}});
   ASSERT_EQ(plain.status, 200) << plain.body;
   EXPECT_TRUE(plain.j()["events"].empty());
+  for (const auto& p : plain.j()["players"]) EXPECT_EQ(p["team"], -1);
+  // The teams `players` wrote beside the tracks, as `stats` takes them (they were left out:
+  // the page showed teams, the exported players.csv -1).
+  std::ofstream(dir_ / "WALK.csv.teams.csv") << "id,team,name\n3,1,Ann\n";
+  const Reply teams = Post("/api/players/stats", json{{"tracks", "WALK.csv"}});
+  ASSERT_EQ(teams.status, 200) << teams.body;
+  for (const auto& p : teams.j()["players"]) EXPECT_EQ(p["team"], p["id"] == 3 ? 1 : -1);
+  for (const auto& row : Get("/api/tracks?path=WALK.csv").j()["rows"]) {
+    EXPECT_EQ(row[9], row[1] == 3 ? json(1) : json(nullptr));
+  }
+  fs::remove(dir_ / "WALK.csv.teams.csv");
   ExpectError(Post("/api/players/stats", json{{"tracks", "scene/cam1.yaml"}}), 422, "cam1.yaml");
   ExpectError(Post("/api/players/stats", json{{"tracks", "WALK.csv"}, {"zones", "WALK.csv"}}), 422,
               "WALK.csv");

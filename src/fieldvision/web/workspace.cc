@@ -97,7 +97,8 @@ nlohmann::json Workspace::ListFiles(size_t max_files) const {
   nlohmann::json files = nlohmann::json::array();
   // Folders whose files are numbered images: listed as one pattern.
   static const std::regex kNumbered(R"(^(\d+)\.(png|jpg|jpeg|bmp)$)", std::regex::icase);
-  std::map<fs::path, std::pair<std::string, size_t>> sequences;  // folder -> (pattern, count)
+  // folder -> (pattern, its files)
+  std::map<fs::path, std::pair<std::string, std::vector<fs::path>>> sequences;
   std::vector<fs::path> paths;
   std::error_code ec;
   fs::recursive_directory_iterator it(root_, fs::directory_options::skip_permission_denied, ec);
@@ -105,7 +106,9 @@ nlohmann::json Workspace::ListFiles(size_t max_files) const {
     const fs::path& p = it->path();
     const std::string name = p.filename().string();
     if (it->is_directory(ec)) {
-      if (name.empty() || name[0] == '.' || name == "node_modules" || name.rfind("build", 0) == 0) {
+      // Hidden folders, npm's and build trees (CMake's, whatever their name): not the user's data.
+      if (name.empty() || name[0] == '.' || name == "node_modules" ||
+          fs::exists(p / "CMakeCache.txt", ec)) {
         it.disable_recursion_pending();
       }
       continue;
@@ -117,17 +120,21 @@ nlohmann::json Workspace::ListFiles(size_t max_files) const {
       if (s.first.empty()) {
         s.first = "%0" + std::to_string(m[1].length()) + "d." + m[2].str();
       }
-      ++s.second;
+      s.second.push_back(p);
       continue;
     }
     paths.push_back(p);
     if (paths.size() >= max_files) break;
   }
-  std::sort(paths.begin(), paths.end());
   for (const auto& [folder, s] : sequences) {
-    if (s.second < 2) continue;
-    files.push_back({{"path", Relative(folder / s.first)}, {"size", s.second}, {"kind", "images"}});
+    if (s.second.size() < 2) {  // one numbered image is an image
+      paths.insert(paths.end(), s.second.begin(), s.second.end());
+      continue;
+    }
+    files.push_back(
+        {{"path", Relative(folder / s.first)}, {"size", s.second.size()}, {"kind", "images"}});
   }
+  std::sort(paths.begin(), paths.end());
   for (const auto& p : paths) {
     std::error_code size_ec;
     const auto size = fs::file_size(p, size_ec);
