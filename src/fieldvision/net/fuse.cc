@@ -427,9 +427,12 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     return;
   }
   if (const auto* ping = std::get_if<PingMessage>(&m)) {
-    PongMessage pong{ping->t0_s, t1, 0};
+    PongMessage pong{ping->t0_s, t1, 0, o_.hints};
     pong.t2_s = io::SystemClockNow();
-    router_.send(identity, zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+    // A copy of the routing id: sending a zmq message empties it, and the node's id is kept
+    // below for its hints (every hint to a node whose last message was a ping was lost).
+    const std::string id = identity.to_string();
+    router_.send(zmq::buffer(id), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
     router_.send(zmq::buffer(Encode(pong)), zmq::send_flags::dontwait);
   }
   const auto& [camera, session] = *sender;

@@ -58,7 +58,8 @@ struct Encoder {
     return {{"type", "ping"}, {"camera", m.camera}, {"session", m.session}, {"t0_s", m.t0_s}};
   }
   json operator()(const PongMessage& m) const {
-    return {{"type", "pong"}, {"t0_s", m.t0_s}, {"t1_s", m.t1_s}, {"t2_s", m.t2_s}};
+    return {
+        {"type", "pong"}, {"t0_s", m.t0_s}, {"t1_s", m.t1_s}, {"t2_s", m.t2_s}, {"hints", m.hints}};
   }
   json operator()(const ByeMessage& m) const {
     return {{"type", "bye"}, {"camera", m.camera}, {"session", m.session}, {"frames", m.frames}};
@@ -165,7 +166,14 @@ Message DecodeChecked(const void* data, size_t size) {
   if (type == "ping") {
     return PingMessage{Str(j, "camera"), Str(j, "session"), Num(j, "t0_s")};
   }
-  if (type == "pong") return PongMessage{Num(j, "t0_s"), Num(j, "t1_s"), Num(j, "t2_s")};
+  if (type == "pong") {
+    PongMessage m{Num(j, "t0_s"), Num(j, "t1_s"), Num(j, "t2_s")};
+    if (j.contains("hints")) {
+      FV_REQUIRE(j["hints"].is_boolean(), "message: 'hints' must be true or false");
+      m.hints = j["hints"].get<bool>();
+    }
+    return m;
+  }
   if (type == "hello") {
     HelloMessage m;
     m.camera = Str(j, "camera");

@@ -85,6 +85,8 @@ struct PingMessage {
 
 struct PongMessage {
   double t0_s = 0, t1_s = 0, t2_s = 0;  // the ping's t0; fuse clock at receipt and at reply
+  // The fusion node sends a hint for every frame it decides (optional field; absent: false).
+  bool hints = false;
 };
 
 struct ByeMessage {

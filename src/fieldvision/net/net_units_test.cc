@@ -106,6 +106,20 @@ TEST(Messages, SkipRoundTripsAndBadTimingsAreRefused) {
   EXPECT_THROW(Decode(negative.data(), negative.size()), MessageError);
 }
 
+// A clock reply says whether the fusion node sends hints (nodes reading a file go in step with
+// them); a reply of an older fusion node, without the field, says no.
+TEST(Messages, PongTellsWhetherHintsAreSent) {
+  const PongMessage pong{1.0, 2.0, 3.0, true};
+  const std::string bytes = Encode(pong);
+  const Message back = Decode(bytes.data(), bytes.size());
+  ASSERT_TRUE(std::holds_alternative<PongMessage>(back));
+  EXPECT_TRUE(std::get<PongMessage>(back).hints);
+  const std::string old = R"({"v":1,"type":"pong","t0_s":1,"t1_s":2,"t2_s":3})";
+  EXPECT_FALSE(std::get<PongMessage>(Decode(old.data(), old.size())).hints);
+  const std::string bad = R"({"v":1,"type":"pong","t0_s":1,"t1_s":2,"t2_s":3,"hints":1})";
+  EXPECT_THROW(Decode(bad.data(), bad.size()), MessageError);
+}
+
 TEST(Messages, HintRoundTripsAndABadRadiusIsRefused) {
   const HintMessage h{1764612345.25, 1.5, -2.25, 0.75, 0.11};
   const std::string bytes = Encode(h);

@@ -4,6 +4,11 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <iostream>
+#include <limits>
+#include <mutex>
 #include <optional>
 #include <random>
 #include <thread>
@@ -72,6 +77,10 @@ std::string NodeSummary::ToString() const {
         "\nwork per frame (decoding, detection): p50 {:.1f} ms, p95 {:.1f} ms, max {:.1f} ms",
         1e3 * process_p50_s, 1e3 * process_p95_s, 1e3 * process_max_s);
   }
+  if (in_step_frames > 0) {
+    s += fmt::format("\nin step with the fusion node ({} frames waited for its decision{})",
+                     in_step_frames, in_step_to_end ? "" : ", then alone");
+  }
   if (hints > 0) {
     s += fmt::format("\n{} ball positions from the fusion node (hints), {} balls fitted there",
                      hints, stage.guided);
@@ -82,6 +91,10 @@ std::string NodeSummary::ToString() const {
 }
 
 namespace {
+
+// In step with the fusion node (a file read as fast as it can be): the longest wait for its
+// decision of a frame before going on alone (longer than `fuse --max-wait 5`).
+constexpr double kStepWaitS = 10.0;
 
 std::string NewSession() {
   std::random_device rd;
@@ -145,19 +158,40 @@ class NodeLink {
   // A fusion node's hint, on this node's frame clock, to the camera stage's board.
   void TakeHint(const HintMessage& h) {
     if (hints_ == nullptr) return;
-    if (h.lost) {  // the fusion tells of frames without a position: unconfirmed scans apply
-      hints_->MarkTellsLoss();
-      return;
-    }
     double time_s = h.time_s;
     if (system_clock_) {
       if (!has_offset_) return;
       time_s -= offset_s_ + o_.clock_offset_s;  // fuse clock -> this node's frame clock
     }
+    {
+      std::lock_guard<std::mutex> lock(decided_mutex_);
+      decided_s_ = std::max(decided_s_, time_s);
+    }
+    decided_changed_.notify_all();
+    if (h.lost) {  // the fusion tells of frames without a position: unconfirmed scans apply
+      hints_->MarkTellsLoss();
+      return;
+    }
     hints_->Publish(time_s, Eigen::Vector3d(h.x_m, h.y_m, h.z_m), h.radius_m);
     ++hints_used;
   }
 
+ public:
+  // Whether the fusion node said (in its clock replies) that it sends a hint for every frame.
+  bool fuse_sends_hints() const { return fuse_hints_; }
+  // Waits until the fusion node has decided the frame at `time_s` (on this node's frame clock:
+  // a hint of that time or later came), at most `timeout_s`; false when it did not.
+  bool WaitForDecision(double time_s, double timeout_s, const pipeline::JobControl* control) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    std::unique_lock<std::mutex> lock(decided_mutex_);
+    while (decided_s_ < time_s - 1e-6) {
+      if (std::chrono::steady_clock::now() >= until || StopRequested(control)) return false;
+      decided_changed_.wait_for(lock, std::chrono::milliseconds(50));
+    }
+    return true;
+  }
+
+ private:
   void Run() {
     zmq::socket_t from_main(ctx_, zmq::socket_type::pair);
     from_main.connect("inproc://node-link");
@@ -185,6 +219,7 @@ class NodeLink {
           try {
             const Message m = Decode(reply.data(), reply.size());
             if (const auto* pong = std::get_if<PongMessage>(&m)) {
+              fuse_hints_ = pong->hints;
               if (clock.Add(pong->t0_s, pong->t1_s, pong->t2_s, t3)) {
                 const ClockSample e = *clock.Estimate();
                 offset_s_ = e.offset_s;
@@ -245,6 +280,10 @@ class NodeLink {
   bool system_clock_;
   cv::Size image_size_;
   double fps_;
+  std::atomic<bool> fuse_hints_{false};
+  std::mutex decided_mutex_;
+  std::condition_variable decided_changed_;
+  double decided_s_ = -std::numeric_limits<double>::infinity();  // the latest hint's time
   std::atomic<bool> has_offset_{false};
   std::atomic<double> offset_s_{0};
 };
@@ -267,6 +306,39 @@ io::SourceFrame WarmUpFrame(cv::Size size, bool encoded) {
   }
   return blank;
 }
+
+// A file read as fast as it can be goes in step with the fusion node, as `ball` does
+// (ball_hints.h): frame k waits until the fusion decided frame k - lag, so that its hints arrive
+// in time to be used (else the node is through the file before the first one comes). Without a
+// decision for kStepWaitS it goes on alone, saying so.
+class InStep {
+ public:
+  InStep(bool on, std::string camera) : on_(on), camera_(std::move(camera)) {}
+  bool on() const { return on_; }
+  // Before a frame's work.
+  void Wait(NodeLink& link, const pipeline::JobControl* control, NodeSummary& summary) {
+    if (!on_ || static_cast<int>(sent_s_.size()) < lag_) return;
+    if (link.WaitForDecision(sent_s_.front(), kStepWaitS, control)) {
+      ++summary.in_step_frames;
+    } else if (!StopRequested(control)) {
+      on_ = false;
+      std::cerr << fmt::format(
+          "node {}: no hint from the fusion node for {:.0f} s: going on without waiting\n", camera_,
+          kStepWaitS);
+    }
+  }
+  // A frame at `time_s` was sent.
+  void Sent(double time_s) {
+    sent_s_.push_back(time_s);
+    if (static_cast<int>(sent_s_.size()) > lag_) sent_s_.pop_front();
+  }
+
+ private:
+  bool on_;
+  std::string camera_;
+  const int lag_ = pipeline::BallHintOptions().lag_messages;
+  std::deque<double> sent_s_;  // times of the last `lag_` frames sent
+};
 
 // Waits for the first clock reply (at most connect_wait_s) so that the first frames can be
 // placed in time.
@@ -324,9 +396,8 @@ NodeSummary RunNode(const NodeOptions& o) {
   if (o.detect) {
     // The first detection pays for lazy set-up (OpenCV, the decoder, page faults: ~1 s on a
     // loaded machine); pay it on a blank frame before the stream starts, not on its first frames.
-    pipeline::CameraStage warm(0, camera, pipeline::BallDetectFnFor(detector), o.track,
-                               "warm-up frame");
-    warm.Process(WarmUpFrame(size, source->encoded()));
+    pipeline::CameraStage(0, camera, pipeline::BallDetectFnFor(detector), o.track, "warm-up frame")
+        .Process(WarmUpFrame(size, source->encoded()));
   }
 
   std::optional<pipeline::BallHintBoard> hints;
@@ -358,6 +429,7 @@ NodeSummary RunNode(const NodeOptions& o) {
     m.clock = system_clock ? "system" : "media";
     std::vector<double> process_s;
     long long last_dropped = 0;
+    InStep step(hints && !system_clock && link.fuse_sends_hints(), camera.name);
     while (!StopRequested(o.control) && (o.max_frames == 0 || summary.frames < o.max_frames) &&
            source->ReadFrame(&in)) {
       const double read_s = io::SystemClockNow();
@@ -370,6 +442,7 @@ NodeSummary RunNode(const NodeOptions& o) {
         link.Send(Encode(skip));
         last_dropped = dropped;
       }
+      step.Wait(link, o.control, summary);
       pipeline::CameraMessage cm;
       if (o.detect) {
         cm = stage.Process(in);
@@ -389,6 +462,7 @@ NodeSummary RunNode(const NodeOptions& o) {
       m.has_offset = link.has_offset();
       m.offset_s = link.offset_s();
       m.candidates = std::move(cm.candidates);
+      step.Sent(cm.time_s);
       if (link.Send(Encode(m))) {
         ++summary.sent;
       } else {
@@ -400,6 +474,7 @@ NodeSummary RunNode(const NodeOptions& o) {
       }
     }
     progress.Finish();
+    summary.in_step_to_end = step.on() && summary.in_step_frames > 0;
     SetProcessTimes(process_s, summary);
     link.frames_for_bye = summary.frames;
     link.Finish();

@@ -58,6 +58,10 @@ struct NodeSummary {
   double round_trip_s = 0;    // of the sample used
   long long bad_replies = 0;  // replies that were not valid messages
   long long hints = 0;        // hints from the fusion node used
+  // A file read as fast as it can be: frames that waited for the fusion node's decision of the
+  // frame `lag` before (in step, as `ball`), and whether that held to the end.
+  long long in_step_frames = 0;
+  bool in_step_to_end = false;
   pipeline::CameraStageStats stage;
   double process_p50_s = 0, process_p95_s = 0, process_max_s = 0;  // work per frame
   double seconds = 0;

@@ -248,6 +248,44 @@ TEST(NodeFuse, HintsReachEveryNodeOnItsOwnClock) {
   EXPECT_LT(mean_error(live), mean_error(offline) + 0.002);
 }
 
+// Nodes reading their files as fast as they can (no --realtime) go in step with the fusion
+// node, as `ball` does: each frame waits for the fusion's decision of the frame two before, so
+// its hints come in time (before, a node was through its file before the first hint came, and a
+// hint to a node whose last message was a ping was lost). Every frame is fused with a position,
+// as accurate as in real time.
+TEST(NodeFuse, FilesReadAsFastAsTheyCanGoInStepWithTheHints) {
+  const uint64_t seed = testing::TestSeed(9);
+  FV_SEED_TRACE(seed);
+  const Scene scene = WriteKick(seed);
+  const auto offline = OfflineBall(scene);
+  FuseOptions fo = LoopbackFuse(scene, "stepped.csv");
+  fo.hints = true;
+  FuseSummary fused;
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
+  std::vector<NodeSummary> nodes(scene.cameras.size());
+  std::vector<std::thread> threads;
+  for (size_t c = 0; c < scene.cameras.size(); ++c) {
+    threads.emplace_back([&, c] {
+      NodeOptions no = PlaybackNode(scene, c, endpoint, 0.0);
+      no.realtime = false;
+      nodes[c] = RunNode(no);
+    });
+  }
+  for (auto& t : threads) t.join();
+  fuse.join();
+  SCOPED_TRACE(fused.ToString());
+  for (const NodeSummary& n : nodes) {
+    SCOPED_TRACE(n.ToString());
+    EXPECT_EQ(n.frames, 30);
+    EXPECT_TRUE(n.in_step_to_end);
+    EXPECT_EQ(n.in_step_frames, 28);  // all but the first two
+    EXPECT_GT(n.hints, 10);
+  }
+  const auto live = ReadBall(fo.out);
+  EXPECT_GE(live.size(), offline.size());
+}
+
 // Node 2 is stopped after 8 of the 30 frames and started again (a new session, as after a
 // crash): the others go on without it meanwhile (those frames are fused from the other
 // cameras), it is re-admitted (its frames from before the restart are dropped as late) and every

@@ -105,6 +105,88 @@ struct StudioServer::Impl {
     if (req.get_header_value("X-Studio-Token") == options.token) return true;
     return req.has_param("token") && req.get_param_value("token") == options.token;
   }
+
+  static void Send(httplib::Response& res, const ApiResponse& r) {
+    res.status = r.status;
+    res.set_content(r.body, r.content_type);
+    res.set_header("Cache-Control", "no-store");
+  }
+
+  // Answers the request itself when it may not call: a missing or wrong token, or, without a
+  // token, a page not served from a loopback name (DNS rebinding).
+  bool Refused(const httplib::Request& req, httplib::Response& res) const {
+    if (!Authorized(req)) {
+      Send(res,
+           {401, "application/json",
+            R"j({"error":"missing or wrong studio token (X-Studio-Token header or ?token=)"})j"});
+      return true;
+    }
+    if (token_required || IsLoopback(HostName(req.get_header_value("Host")))) return false;
+    Send(res, {403, "application/json",
+               R"j({"error":"requests must name a loopback host (Host header)"})j"});
+    return true;
+  }
+
+  // The event stream, first: the generic /api handler would take it otherwise. A stream ends
+  // after kStreamS (the browser reconnects after `retry`, naming the last event it had, and
+  // misses nothing the hub still keeps): a tab left open never holds a server thread for good.
+  void AddEventStream() {
+    server.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
+      if (Refused(req, res)) return;
+      auto cursor = std::make_shared<uint64_t>(events.Last());
+      // Resume after the last event the client had (EventSource's reconnect, or ?since=).
+      const std::string since = req.has_header("Last-Event-ID")
+                                    ? req.get_header_value("Last-Event-ID")
+                                    : req.get_param_value("since");
+      if (!since.empty() && since.size() < 20 &&
+          since.find_first_not_of("0123456789") == std::string::npos) {
+        *cursor = std::min<uint64_t>(*cursor, std::stoull(since));
+      }
+      auto first = std::make_shared<bool>(true);
+      const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(kStreamS);
+      res.set_header("Cache-Control", "no-store");
+      res.set_chunked_content_provider(
+          "text/event-stream", [this, cursor, first, end](size_t, httplib::DataSink& sink) {
+            std::string out;
+            if (*first) {
+              *first = false;
+              out = "retry: 2000\nevent: hello\ndata: {}\n\n";
+            } else if (std::chrono::steady_clock::now() > end ||
+                       !events.Wait(*cursor, out, std::chrono::seconds(10))) {
+              sink.done();
+              return false;
+            }
+            if (out.empty()) out = ": keep-alive\n\n";
+            return sink.write(out.data(), out.size());
+          });
+    });
+  }
+
+  // GET and POST /api/...; other methods get one line saying which are served (httplib
+  // answered an empty 400).
+  void AddApi() {
+    const auto handle = [this](const httplib::Request& req, httplib::Response& res) {
+      if (Refused(req, res)) return;
+      // A POST must be JSON, which a page of another origin cannot send without asking (CORS).
+      if (req.method == "POST" &&
+          req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
+        return Send(res, {415, "application/json",
+                          R"j({"error":"POST bodies must be sent as application/json"})j"});
+      }
+      ApiRequest r{req.method, req.path, {}, req.body};
+      for (const auto& [k, v] : req.params) r.params[k] = v;
+      Send(res, api->Handle(r));
+    };
+    server.Get(R"(/api/.*)", handle);
+    server.Post(R"(/api/.*)", handle);
+    const auto other_method = [](const httplib::Request&, httplib::Response& res) {
+      Send(res, {405, "application/json",
+                 R"j({"error":"method not allowed: the studio's API takes GET and POST"})j"});
+    };
+    server.Put(R"(/.*)", other_method);
+    server.Patch(R"(/.*)", other_method);
+    server.Delete(R"(/.*)", other_method);
+  }
 };
 
 StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_unique<Impl>()) {
@@ -133,83 +215,8 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
     int yes = 1;
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
   });
-  auto send = [](httplib::Response& res, const ApiResponse& r) {
-    res.status = r.status;
-    res.set_content(r.body, r.content_type);
-    res.set_header("Cache-Control", "no-store");
-  };
-  auto unauthorized = [send](httplib::Response& res) {
-    send(res,
-         {401, "application/json",
-          R"j({"error":"missing or wrong studio token (X-Studio-Token header or ?token=)"})j"});
-  };
-  // Without a token, only pages served from a loopback name may call (DNS rebinding).
-  auto foreign_host = [this, send](const httplib::Request& req, httplib::Response& res) {
-    if (impl_->token_required || IsLoopback(HostName(req.get_header_value("Host")))) return false;
-    send(res, {403, "application/json",
-               R"j({"error":"requests must name a loopback host (Host header)"})j"});
-    return true;
-  };
-  // Event stream first: the generic /api handler below would take it otherwise. A stream ends
-  // after kStreamS (the browser reconnects after `retry`, naming the last event it had, and
-  // misses nothing the hub still keeps): a tab left open never holds a server thread for good.
-  s.Get("/api/events",
-        [this, unauthorized, foreign_host](const httplib::Request& req, httplib::Response& res) {
-          Impl& m = *impl_;
-          if (!m.Authorized(req)) return unauthorized(res);
-          if (foreign_host(req, res)) return;
-          auto cursor = std::make_shared<uint64_t>(m.events.Last());
-          // Resume after the last event the client had (EventSource's reconnect, or ?since=).
-          const std::string since = req.has_header("Last-Event-ID")
-                                        ? req.get_header_value("Last-Event-ID")
-                                        : req.get_param_value("since");
-          if (!since.empty() && since.size() < 20 &&
-              since.find_first_not_of("0123456789") == std::string::npos) {
-            *cursor = std::min<uint64_t>(*cursor, std::stoull(since));
-          }
-          auto first = std::make_shared<bool>(true);
-          const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(kStreamS);
-          res.set_header("Cache-Control", "no-store");
-          res.set_chunked_content_provider(
-              "text/event-stream", [this, cursor, first, end](size_t, httplib::DataSink& sink) {
-                std::string out;
-                if (*first) {
-                  *first = false;
-                  out = "retry: 2000\nevent: hello\ndata: {}\n\n";
-                } else if (std::chrono::steady_clock::now() > end ||
-                           !impl_->events.Wait(*cursor, out, std::chrono::seconds(10))) {
-                  sink.done();
-                  return false;
-                }
-                if (out.empty()) out = ": keep-alive\n\n";
-                return sink.write(out.data(), out.size());
-              });
-        });
-  auto api = [this, send, unauthorized, foreign_host](const httplib::Request& req,
-                                                      httplib::Response& res) {
-    Impl& m = *impl_;
-    if (!m.Authorized(req)) return unauthorized(res);
-    if (foreign_host(req, res)) return;
-    // A POST must be JSON, which a page of another origin cannot send without asking (CORS).
-    if (req.method == "POST" &&
-        req.get_header_value("Content-Type").rfind("application/json", 0) != 0) {
-      return send(res, {415, "application/json",
-                        R"j({"error":"POST bodies must be sent as application/json"})j"});
-    }
-    ApiRequest r{req.method, req.path, {}, req.body};
-    for (const auto& [k, v] : req.params) r.params[k] = v;
-    send(res, m.api->Handle(r));
-  };
-  s.Get(R"(/api/.*)", api);
-  s.Post(R"(/api/.*)", api);
-  // Other methods: one line saying which are served (httplib answered an empty 400).
-  const auto other_method = [send](const httplib::Request&, httplib::Response& res) {
-    send(res, {405, "application/json",
-               R"j({"error":"method not allowed: the studio's API takes GET and POST"})j"});
-  };
-  s.Put(R"(/.*)", other_method);
-  s.Patch(R"(/.*)", other_method);
-  s.Delete(R"(/.*)", other_method);
+  m.AddEventStream();
+  m.AddApi();
   if (m.assets_built) {
     s.set_mount_point("/", m.options.assets);
   } else {
