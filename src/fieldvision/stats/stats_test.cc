@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -77,6 +78,45 @@ TEST(Stats, DistanceSpeedAndSprintsFromNoisyPositions) {
   double bands = 0;
   for (double b : p.band_time_s) bands += b;
   EXPECT_NEAR(bands, p.last_s - p.first_s, 1e-6);
+}
+
+// A jogger at 3 m/s along x for 60 s (180 m), seen at `fps`, every `every`-th frame kept, with
+// Gaussian position noise.
+std::vector<track::TrackRow> Jogger(util::Rng& rng, double fps, int every, double noise_m) {
+  std::vector<track::TrackRow> rows;
+  for (int f = 0; f <= 60 * fps; f += every) {
+    track::TrackRow r;
+    r.frame = f + 1;
+    r.time_s = f / fps;
+    r.id = 1;
+    r.box = cv::Rect2d(0, 0, 10, 20);
+    r.x_m = -30 + 3.0 * f / fps + rng.Normal(0, noise_m);
+    r.y_m = rng.Normal(0, noise_m);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// The numbers do not depend on how often a player is sampled: positions twice a second (frames
+// 0.52 s apart were each a gap: 0 m, no speed) and a high frame rate with 0.2 m of noise (steps
+// split as jumps: 144-151 m at 60 fps, a top speed of 12 m/s at 100 fps) give the jogger's 180 m.
+TEST(Stats, SparseOrFastNoisySamplesGiveTheSameDistanceAndSpeed) {
+  fv::testing::SeededRng rng(23);
+  struct Case {
+    double fps;
+    int every;
+    double noise_m;
+  };
+  for (const Case c : {Case{25, 13, 0.0}, Case{25, 1, 0.2}, Case{60, 1, 0.2}, Case{100, 1, 0.2}}) {
+    SCOPED_TRACE(fmt::format("{} fps, every {} frames, noise {} m", c.fps, c.every, c.noise_m));
+    const StatsResult r = ComputeStats(Jogger(rng, c.fps, c.every, c.noise_m), StatsOptions());
+    ASSERT_EQ(r.players.size(), 1u);
+    EXPECT_NEAR(r.players[0].distance_m, 180.0, 0.06 * 180.0);
+    EXPECT_NEAR(r.players[0].top_speed_mps, 3.0, 0.3);
+    double bands = 0;
+    for (double b : r.players[0].band_time_s) bands += b;
+    EXPECT_NEAR(bands, 60.0, 0.6);
+  }
 }
 
 // Tracking noise is not running: a player standing for a minute with 10 cm position noise at
@@ -327,6 +367,20 @@ TEST(StatsStages, FrameRateAndPairDistances) {
   EXPECT_EQ(std::get<1>(d[2]), 3);
   EXPECT_EQ(std::get<2>(d[2]), 4);
   EXPECT_NEAR(std::get<3>(d[2]), 3.0, 1e-9);
+  // Each second's distance is that of the sample nearest it (it was the first from half a
+  // second before): one walking away at 2 m/s, sampled every 0.1 s, from one standing.
+  SmoothTrack walker, stander;
+  walker.id = 1;
+  stander.id = 2;
+  for (int k = 0; k <= 30; ++k) {
+    walker.time_s.push_back(0.1 * k);
+    walker.pos_m.emplace_back(0.2 * k, 0.0);
+    stander.time_s.push_back(0.1 * k);
+    stander.pos_m.emplace_back(0.0, 0.0);
+  }
+  const auto apart = PairDistancesPerSecond({walker, stander}, 0.0, 3.0);
+  ASSERT_EQ(apart.size(), 4u);
+  for (const auto& [sec, a, b, metres] : apart) EXPECT_NEAR(metres, 2.0 * sec, 1e-9) << sec;
 }
 
 TEST(Zones, HugeVerticesAndNonStringNamesAreOneLineErrors) {
