@@ -92,6 +92,9 @@ std::string NodeSummary::ToString() const {
 
 namespace {
 
+// The kind of a message handed to the link thread (its first byte).
+constexpr char kFrameTag = 'f', kOtherTag = 'o';
+
 // In step with the fusion node (a file read as fast as it can be): the longest wait for its
 // decision of a frame before going on alone (longer than `fuse --max-wait 5`).
 constexpr double kStepWaitS = 10.0;
@@ -132,9 +135,12 @@ class NodeLink {
     }
   }
 
-  // From the main thread: a message for the fusion node; false when dropped (link busy).
-  bool Send(const std::string& bytes) {
-    return to_link_.send(zmq::buffer(bytes), zmq::send_flags::dontwait).has_value();
+  // From the main thread: a message for the fusion node (`frame`: a frame message, whose drops
+  // the link counts); false when dropped here (link busy). A tag byte before the message says
+  // which kind it is.
+  bool Send(const std::string& bytes, bool frame) {
+    const std::string tagged = (frame ? kFrameTag : kOtherTag) + bytes;
+    return to_link_.send(zmq::buffer(tagged), zmq::send_flags::dontwait).has_value();
   }
   // Sends the bye message, stops the thread (waiting at most ~1 s for the bye to leave).
   void Finish() {
@@ -147,7 +153,7 @@ class NodeLink {
   double Now() const { return io::SystemClockNow() + o_.clock_offset_s; }
   bool has_offset() const { return has_offset_; }
   double offset_s() const { return offset_s_; }
-  std::atomic<long long> send_dropped{0};
+  std::atomic<long long> send_dropped{0};  // frame messages the socket could not take
   std::atomic<long long> bad_replies{0};
   std::atomic<int> samples{0};
   std::atomic<double> round_trip_s{0};
@@ -239,11 +245,16 @@ class NodeLink {
         zmq::message_t msg;
         bool end = false;
         while (from_main.recv(msg, zmq::recv_flags::dontwait)) {
-          if (msg.to_string_view() == "end") {
+          const std::string_view tagged = msg.to_string_view();
+          if (tagged == "end") {
             end = true;
             break;
           }
-          if (!dealer.send(msg, zmq::send_flags::dontwait)) ++send_dropped;
+          if (tagged.empty()) continue;
+          const bool frame = tagged.front() == kFrameTag;
+          if (!dealer.send(zmq::buffer(tagged.substr(1)), zmq::send_flags::dontwait) && frame) {
+            ++send_dropped;
+          }
         }
         if (end) {
           ByeMessage bye{camera_, session_, frames_for_bye};
@@ -439,7 +450,7 @@ NodeSummary RunNode(const NodeOptions& o) {
         SkipMessage skip{camera.name, session,         in.frame,          m.time_s,
                          m.clock,     link.offset_s(), link.has_offset(), dropped - last_dropped};
         skip.time_s = system_clock ? in.time_s + o.clock_offset_s : in.time_s;
-        link.Send(Encode(skip));
+        link.Send(Encode(skip), /*frame=*/false);
         last_dropped = dropped;
       }
       step.Wait(link, o.control, summary);
@@ -463,7 +474,7 @@ NodeSummary RunNode(const NodeOptions& o) {
       m.offset_s = link.offset_s();
       m.candidates = std::move(cm.candidates);
       step.Sent(cm.time_s);
-      if (link.Send(Encode(m))) {
+      if (link.Send(Encode(m), /*frame=*/true)) {
         ++summary.sent;
       } else {
         ++summary.send_dropped;

@@ -589,6 +589,7 @@ ReportFiles WriteStatsReport(const StatsResult& r, const field::FieldModel& fiel
   fs::create_directories(out_dir, ec);
   FV_REQUIRE(!ec && fs::is_directory(out_dir), "cannot create output folder '{}'", out_dir);
   ReportFiles files;
+  if (!r.left_out.empty()) files.notes.push_back(LeftOutNote(r));
   // Heat maps: every player, over the field and where the positions go beyond it.
   ReportParts rp(r, o, out_dir, ReportView(r, field, o, &files));
   WriteHeatMaps(field, rp, files);

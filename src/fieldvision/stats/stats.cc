@@ -37,6 +37,17 @@ void StatsOptions::Check() const {
   CheckNonNegative(max_player_heatmaps, "max_player_heatmaps");
 }
 
+std::string LeftOutNote(const StatsResult& r) {
+  if (r.left_out.empty()) return "";
+  std::string ids;
+  for (size_t i = 0; i < r.left_out.size() && i < 12; ++i) {
+    ids += (i ? ", " : "") + std::to_string(r.left_out[i]);
+  }
+  if (r.left_out.size() > 12) ids += fmt::format(" and {} more", r.left_out.size() - 12);
+  return fmt::format("{} id{} left out, each followed for under {:g} s in all: {}",
+                     r.left_out.size(), r.left_out.size() > 1 ? "s" : "", r.min_track_s, ids);
+}
+
 std::string StatsResult::Summary() const {
   double total = 0, top = 0;
   int sprints = 0;
@@ -45,10 +56,12 @@ std::string StatsResult::Summary() const {
     top = std::max(top, p.top_speed_mps);
     sprints += p.sprints;
   }
-  return fmt::format(
+  std::string s = fmt::format(
       "{} players over {:.1f} s (time from {}, {:.2f} frames/s): {:.0f} m covered in all, top "
       "speed {:.2f} m/s, {} sprints, {} zone entries",
       players.size(), duration_s, time_source, fps, total, top, sprints, events.size());
+  if (!left_out.empty()) s += "; " + LeftOutNote(*this);
+  return s;
 }
 
 bool InPolygon(const std::vector<Eigen::Vector2d>& poly, const Eigen::Vector2d& p) {
@@ -368,10 +381,15 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
   std::map<int, std::vector<const track::TrackRow*>> by_id;
   for (const auto& r : rows) {
     if (r.x_m && r.y_m) by_id[r.id].push_back(&r);
+    FV_REQUIRE(options.fps <= 0 || r.frame >= 1,
+               "frame {}: tracks number frames from 1 (MOTChallenge), and with a frame rate "
+               "given time is (frame - 1) / fps",
+               r.frame);
   }
   FV_REQUIRE(!by_id.empty(),
              "the tracks have no field positions (x_m, y_m): run players with a calibrated camera");
   StatsResult res;
+  res.min_track_s = options.min_track_s;
   StatsOptions o = options;
   if (options.fps > 0) {
     res.time_source = fmt::format("--fps {:g}", options.fps);
@@ -393,12 +411,22 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
       t.push_back(time);
       p.emplace_back(*r->x_m, *r->y_m);
     }
-    if (t.empty() || t.back() - t.front() < o.min_track_s) continue;
-    res.tracks.push_back(SmoothPositions(id, t, p, o));
+    SmoothTrack s = SmoothPositions(id, t, p, o);
+    double followed_s = 0;
+    for (size_t i = 1; i < t.size(); ++i) {
+      if (s.segment[i] == s.segment[i - 1]) followed_s += t[i] - t[i - 1];
+    }
+    if (followed_s < o.min_track_s) {
+      res.left_out.push_back(id);
+      continue;
+    }
+    res.tracks.push_back(std::move(s));
     t_min = std::min(t_min, t.front());
     t_max = std::max(t_max, t.back());
   }
-  FV_REQUIRE(!res.tracks.empty(), "no track is longer than min_track_s = {} s", o.min_track_s);
+  FV_REQUIRE(!res.tracks.empty(),
+             "no player is followed for min_track_s = {} s ({} ids, each shorter)", o.min_track_s,
+             res.left_out.size());
   // A track too short to tell its noise takes the others' median (one camera, one tracker).
   std::vector<double> known;
   for (const SmoothTrack& s : res.tracks) {

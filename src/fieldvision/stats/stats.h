@@ -102,10 +102,17 @@ struct StatsResult {
   // Distances between pairs of players, one sample per second: (time_s, id_a, id_b, metres).
   std::vector<std::tuple<double, int, int, double>> pair_distances;
   double duration_s = 0;
+  // Ids followed for less than min_track_s in all (its segments' time: a fragment and a row
+  // seconds apart span more), left out of the numbers.
+  std::vector<int> left_out;
+  double min_track_s = 0;   // as in the options
   double fps = 0;           // the frame rate of the rows' time (median step)
   std::string time_source;  // where the time came from ("TRACKS.csv time_s" or "--fps N")
   std::string Summary() const;
 };
+
+// "2 ids left out, ...: 98, 99" for StatsResult::left_out ("" when none).
+std::string LeftOutNote(const StatsResult& r);
 
 // Positions come from rows with x_m/y_m, times from time_s (or options.fps); throws fv::Error if
 // there are no positions, or no time_s and no options.fps.

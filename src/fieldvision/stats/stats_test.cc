@@ -119,6 +119,34 @@ TEST(Stats, SparseOrFastNoisySamplesGiveTheSameDistanceAndSpeed) {
   }
 }
 
+// A fragment is as long as it was followed, not as the span of its rows: one row, then four
+// rows 3.3 s later (PETS id 17: "2.05 m/s top speed" from 0.3 s of data), and an id seen once,
+// are left out and named; the jogger stays.
+TEST(Stats, FragmentsFollowedForUnderASecondAreLeftOutAndNamed) {
+  fv::testing::SeededRng rng(29);
+  std::vector<track::TrackRow> rows = Jogger(rng, 10, 1, 0.0);
+  auto add = [&](int id, double t, double x) {
+    track::TrackRow r;
+    r.frame = static_cast<int>(std::lround(10 * t)) + 1;
+    r.time_s = t;
+    r.id = id;
+    r.box = cv::Rect2d(0, 0, 10, 20);
+    r.x_m = x;
+    r.y_m = 5.0;
+    rows.push_back(r);
+  };
+  add(17, 46.4, 0.0);
+  for (int k = 0; k < 4; ++k) add(17, 49.7 + 0.1 * k, 7.0 + 0.2 * k);
+  add(98, 12.0, 3.0);
+  const StatsResult r = ComputeStats(rows, StatsOptions());
+  ASSERT_EQ(r.players.size(), 1u);
+  EXPECT_EQ(r.players[0].id, 1);
+  EXPECT_EQ(r.left_out, (std::vector<int>{17, 98}));
+  EXPECT_NE(r.Summary().find("2 ids left out, each followed for under 1 s in all: 17, 98"),
+            std::string::npos)
+      << r.Summary();
+}
+
 // Tracking noise is not running: a player standing for a minute with 10 cm position noise at
 // 25 frames/s (stream timestamps jittered by up to 6 ms), and one walking 6 m in that minute,
 // with the same noise.
