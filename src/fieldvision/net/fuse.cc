@@ -448,7 +448,10 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
   const int c = it->second;
   if (!AcceptSession(c, session, arrival)) return;
   identities_[c] = identity.to_string();
-  if (const auto* hello = std::get_if<HelloMessage>(&m)) CheckHello(c, *hello);
+  if (const auto* hello = std::get_if<HelloMessage>(&m)) {
+    CheckHello(c, *hello);
+    sync_->SetFrameRate(c, hello->fps);
+  }
   if (warned_size_.count(c) > 0) {
     ++summary_.cameras[c].refused;  // frames of another image size than its camera file's
     return;

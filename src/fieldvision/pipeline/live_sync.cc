@@ -35,7 +35,8 @@ LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& optio
       last_arrival_(num_cameras, -std::numeric_limits<double>::infinity()),
       skip_until_s_(num_cameras, -std::numeric_limits<double>::infinity()),
       jump_run_(num_cameras, 0),
-      jump_time_s_(num_cameras, 0.0) {
+      jump_time_s_(num_cameras, 0.0),
+      frame_step_s_(num_cameras, 0.0) {
   FV_REQUIRE(num_cameras >= 1, "LiveSynchronizer: needs at least one camera");
   options.Check();
 }
@@ -65,6 +66,10 @@ bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
       return false;
     }
     s.gaps += m.frame - last_frame_[c] - 1;
+  }
+  if (last_frame_[c] >= 0 && m.frame > last_frame_[c]) {
+    const double step = (m.time_s - last_time_[c]) / static_cast<double>(m.frame - last_frame_[c]);
+    frame_step_s_[c] = frame_step_s_[c] > 0 ? 0.9 * frame_step_s_[c] + 0.1 * step : step;
   }
   last_frame_[c] = m.frame;
   last_time_[c] = m.time_s;
@@ -126,6 +131,28 @@ bool LiveSynchronizer::Implausible(int c, double time_s) {
   }
   if (rig_moved && decided_until_s_ > time_s) decided_until_s_ = time_s - options_.tolerance_s;
   return false;
+}
+
+void LiveSynchronizer::NumberInStream(SyncedFrame& out) {
+  // The reference: the camera with the most frames per second (the lowest index among equals).
+  int ref = -1;
+  for (int c = 0; c < n_; ++c) {
+    if (frame_step_s_[c] > 0 && (ref < 0 || frame_step_s_[c] < 0.9 * frame_step_s_[ref])) ref = c;
+  }
+  if (ref >= 0 && out.cameras[ref]) {
+    out.frame = out.cameras[ref]->frame;
+  } else if (ref >= 0 && last_frame_[ref] >= 0) {
+    out.frame =
+        last_frame_[ref] + std::llround((out.time_s - last_time_[ref]) / frame_step_s_[ref]);
+  }
+  if (numbered_ && out.frame <= last_out_frame_) out.frame = last_out_frame_ + 1;
+  numbered_ = true;
+  last_out_frame_ = out.frame;
+}
+
+void LiveSynchronizer::SetFrameRate(int camera, double fps) {
+  FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  if (std::isfinite(fps) && fps > 0 && fps < 1e4) frame_step_s_[camera] = 1.0 / fps;
 }
 
 void LiveSynchronizer::Admit(int camera, double arrival_s) {
@@ -218,6 +245,7 @@ std::optional<SyncedFrame> LiveSynchronizer::Next(double now_s, bool flush) {
     b.pop_front();
   }
   const int k = out.SetFrameAndTime();
+  NumberInStream(out);
   any_group_ = true;
   decided_until_s_ = std::max(decided_until_s_, until);
   ++groups_;

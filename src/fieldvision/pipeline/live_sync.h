@@ -7,7 +7,8 @@
 // they skipped the frames (SkipUntil); a camera not heard from yet is waited for until
 // max_wait_s after the first camera was heard (nodes connect one after another). Late, duplicate
 // and out-of-order messages are dropped and counted, never paired wrongly; gaps in frame numbers
-// count as dropped frames. A restarted camera (a new session) starts a fresh stream. A
+// count as dropped frames. A restarted camera (a new session) starts a fresh stream. A group's
+// frame number is the fastest camera's (NumberInStream), increasing from group to group. A
 // single-threaded state machine; the fusion node feeds it. (frame_sync.h is the offline one:
 // it waits for every stream, as files never stall.)
 #pragma once
@@ -63,6 +64,9 @@ class LiveSynchronizer {
   // Nothing captured before `time_s` will come from the camera (its source skipped frames): the
   // groups before it do not wait for it.
   void SkipUntil(int camera, double time_s, double arrival_s);
+  // The camera's frame rate as its source tells it (a node's hello): the groups' frame numbers
+  // follow the fastest camera from the first group on (else from when its rate is seen).
+  void SetFrameRate(int camera, double fps);
   // The camera restarted (a new session): its stream starts afresh.
   void Restart(int camera);
   // The camera's stream ended: it is no longer waited for.
@@ -102,6 +106,14 @@ class LiveSynchronizer {
   // is waited for.
   bool FarAheadOfALiveCamera(double time_s, double now_s) const;
   double first_arrival_s_ = std::numeric_limits<double>::infinity();  // of any camera
+  // A group's frame number: the fastest camera's (its frame, else where its frame count would
+  // be at the group's time), never below the last group's + 1; cameras of other rates or
+  // started at other times number their frames otherwise (the first present camera's gave 9,
+  // 19, 10, 21, ... with a 30 fps camera among 60 fps ones).
+  void NumberInStream(SyncedFrame& out);
+  std::vector<double> frame_step_s_;  // each camera's time per frame (smoothed)
+  bool numbered_ = false;
+  long long last_out_frame_ = 0;
   bool any_group_ = false;
   double decided_until_s_ = 0;  // messages at or before this time are late
   long long groups_ = 0, complete_groups_ = 0;

@@ -204,6 +204,31 @@ TEST(LiveSync, ACameraNotHeardFromYetIsWaitedFor) {
   EXPECT_TRUE(alone.Next(6.2));
 }
 
+// Cameras of other rates, or started at other times, number their frames otherwise: a group's
+// frame is the fastest camera's (where its count would be when it is missing), and increases
+// (the first present camera's gave 9, 19, 10, 21, ... with a 30 fps camera among 60 fps ones).
+TEST(LiveSync, GroupsAreNumberedByTheFastestCamera) {
+  LiveSyncOptions o;
+  LiveSynchronizer sync(2, o);
+  sync.SetFrameRate(0, 30);  // as the nodes' hellos say
+  sync.SetFrameRate(1, 60);
+  std::vector<SyncedFrame> groups;
+  for (int k = 0; k < 60; ++k) {
+    const double t = k / 60.0, arrival = 1.0 + t;
+    if (k % 2 == 0) ASSERT_TRUE(sync.Add(Msg(0, 100 + k / 2, t), arrival));  // 30 fps, from 100
+    if (k != 31) ASSERT_TRUE(sync.Add(Msg(1, k, t), arrival));               // 60 fps, one lost
+    while (auto g = sync.Next(arrival)) groups.push_back(*g);
+  }
+  while (auto g = sync.Next(100, true)) groups.push_back(*g);
+  ASSERT_GE(groups.size(), 58u);
+  for (size_t i = 1; i < groups.size(); ++i) {
+    EXPECT_GT(groups[i].frame, groups[i - 1].frame) << "group " << i;
+  }
+  for (const SyncedFrame& g : groups) {
+    EXPECT_EQ(g.frame, std::llround(g.time_s * 60)) << g.time_s;  // camera 1's numbers
+  }
+}
+
 // A camera whose source skipped frames says so (SkipUntil): the others' frames before it are
 // paired at once instead of waiting for that camera; frames after it still wait.
 TEST(LiveSync, SkippedFramesAreNotWaitedFor) {
