@@ -44,13 +44,17 @@ const relay = (type: string) => (e: Event) => {
 // again, resumes after the last event it had (the server replays what it still keeps).
 let events: EventSource | null = null;
 let lastId = '';
+let unreachable = 0;
 function connect(): void {
   const es = new EventSource(url('/api/events', lastId ? { since: lastId } : {}));
   const seen = (e: Event) => {
     const id = (e as MessageEvent).lastEventId;
     if (id) lastId = id;
   };
-  es.addEventListener('hello', () => (live.textContent = 'live'));
+  es.addEventListener('hello', () => {
+    clearTimeout(unreachable);
+    live.textContent = 'live';
+  });
   es.addEventListener('saved', (e) => {
     seen(e);
     live.textContent = `saved ${relay('saved')(e).path}`;
@@ -63,7 +67,12 @@ function connect(): void {
   // Positions from a fusion node (live mode) and the live feed's state go to the pages only.
   es.addEventListener('ball', (e) => (seen(e), relay('ball')(e)));
   es.addEventListener('live', (e) => (seen(e), relay('live')(e)));
-  es.onerror = () => (live.textContent = 'server not reachable');
+  // The server ends a stream every minute and the browser reconnects at once: only a stream
+  // not back within 5 s means the server is gone.
+  es.onerror = () => {
+    clearTimeout(unreachable);
+    unreachable = window.setTimeout(() => (live.textContent = 'server not reachable'), 5000);
+  };
   events = es;
 }
 document.addEventListener('visibilitychange', () => {

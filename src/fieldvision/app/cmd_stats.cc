@@ -31,15 +31,11 @@ void RunStats(const StatsCli& c) {
     FV_REQUIRE(!o.zones.empty(), "zones file '{}' has no zones (a JSON array of named polygons)",
                c.zones);
   }
-  std::string teams = c.teams;
-  if (teams.empty() && std::filesystem::exists(track::RosterPathFor(c.tracks))) {
-    teams = track::RosterPathFor(c.tracks);
-  }
-  if (!teams.empty()) {
-    const track::Roster roster = track::ReadRoster(teams);
-    o.team_of = roster.team_of;
-    o.name_of = roster.name_of;
-  }
+  // --teams, else the roster beside the tracks or their own team column (as the studio).
+  const track::Roster roster =
+      c.teams.empty() ? track::RosterForTracks(c.tracks) : track::ReadRoster(c.teams);
+  o.team_of = roster.team_of;
+  o.name_of = roster.name_of;
   o.Check();
   // The library's messages name the rows, not the file they came from.
   const stats::StatsResult r = [&] {
@@ -80,7 +76,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "JSON zones for alerts: [{\"name\": \"box\", \"polygon\": [[x, y], ...]}]");
   cmd->add_option("--teams", c->teams,
                   "id,team[,name] CSV (default: TRACKS.csv.teams.csv if present, as players "
-                  "--teams and tracks edit write it; team -1: none)");
+                  "--teams and tracks edit write it, else a team column of TRACKS.csv; team -1: "
+                  "none)");
   cmd->add_option("--smooth", c->o.smooth_window_s, "Smoothing window of positions in seconds")
       ->check(FiniteRange(0.01, 60));
   cmd->add_option("--sprint-speed", c->o.sprint_speed_mps, "Sprint threshold in m/s")

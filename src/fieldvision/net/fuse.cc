@@ -448,14 +448,12 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
   const int c = it->second;
   if (!AcceptSession(c, session, arrival)) return;
   identities_[c] = identity.to_string();
-  if (const auto* hello = std::get_if<HelloMessage>(&m)) {
-    CheckHello(c, *hello);
-    sync_->SetFrameRate(c, hello->fps);
-  }
+  if (const auto* hello = std::get_if<HelloMessage>(&m)) CheckHello(c, *hello);
   if (warned_size_.count(c) > 0) {
     ++summary_.cameras[c].refused;  // frames of another image size than its camera file's
     return;
   }
+  if (const auto* hello = std::get_if<HelloMessage>(&m)) sync_->SetFrameRate(c, hello->fps);
   if (std::holds_alternative<PingMessage>(m) || std::holds_alternative<HelloMessage>(m)) {
     sync_->Admit(c, arrival);  // connected: its frames are waited for
     return;
@@ -483,8 +481,9 @@ bool FuseServer::AcceptSession(int c, const std::string& session, double arrival
       ++summary_.cameras[c].refused;
       if (warned_second_node_.insert(c).second) {
         std::cerr << fmt::format(
-            "fuse: warning: a second node sends as camera '{}' while the first goes on: its "
-            "messages are ignored (give each node its own camera file)\n",
+            "fuse: warning: another node sends as camera '{}' while its node goes on (a second "
+            "node, or one restarted within 1.5 s): its messages are ignored until the first has "
+            "been quiet for 1.5 s (give each node its own camera file)\n",
             names_[c]);
       }
       return false;

@@ -212,7 +212,6 @@ class NodeLink {
     ClockSync clock;
     int pings = 0;
     double next_ping = Now();
-    bool hello_sent = false;
     std::vector<zmq::pollitem_t> items = {{from_main.handle(), 0, ZMQ_POLLIN, 0},
                                           {dealer.handle(), 0, ZMQ_POLLIN, 0}};
     for (;;) {
@@ -263,16 +262,16 @@ class NodeLink {
         }
       }
       if (Now() >= next_ping) {
-        if (!hello_sent) {
-          HelloMessage h{camera_,
-                         session_,
-                         image_size_.width,
-                         image_size_.height,
-                         fps_,
-                         o_.video,
-                         system_clock_ ? "system" : "media"};
-          hello_sent = dealer.send(zmq::buffer(Encode(h)), zmq::send_flags::dontwait).has_value();
-        }
+        // With every ping: a fusion node that refused this session at first (its earlier node
+        // not yet quiet) or restarted learns its size and rate all the same.
+        const HelloMessage h{camera_,
+                             session_,
+                             image_size_.width,
+                             image_size_.height,
+                             fps_,
+                             o_.video,
+                             system_clock_ ? "system" : "media"};
+        dealer.send(zmq::buffer(Encode(h)), zmq::send_flags::dontwait);
         PingMessage p{camera_, session_, Now()};
         dealer.send(zmq::buffer(Encode(p)), zmq::send_flags::dontwait);
         ++pings;
@@ -324,11 +323,14 @@ io::SourceFrame WarmUpFrame(cv::Size size, bool encoded) {
 // decision for kStepWaitS it goes on alone, saying so.
 class InStep {
  public:
+  // `on`: the node may go in step (a file read as fast as it can be, hints used); it does while
+  // the fusion node says it sends hints (its clock replies; a fusion node started later says so
+  // later).
   InStep(bool on, std::string camera) : on_(on), camera_(std::move(camera)) {}
   bool on() const { return on_; }
   // Before a frame's work.
   void Wait(NodeLink& link, const pipeline::JobControl* control, NodeSummary& summary) {
-    if (!on_ || static_cast<int>(sent_s_.size()) < lag_) return;
+    if (!on_ || !link.fuse_sends_hints() || static_cast<int>(sent_s_.size()) < lag_) return;
     if (link.WaitForDecision(sent_s_.front(), kStepWaitS, control)) {
       ++summary.in_step_frames;
     } else if (!StopRequested(control)) {
@@ -440,7 +442,7 @@ NodeSummary RunNode(const NodeOptions& o) {
     m.clock = system_clock ? "system" : "media";
     std::vector<double> process_s;
     long long last_dropped = 0;
-    InStep step(hints && !system_clock && link.fuse_sends_hints(), camera.name);
+    InStep step(hints && !system_clock, camera.name);
     while (!StopRequested(o.control) && (o.max_frames == 0 || summary.frames < o.max_frames) &&
            source->ReadFrame(&in)) {
       const double read_s = io::SystemClockNow();

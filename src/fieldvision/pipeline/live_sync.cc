@@ -36,7 +36,8 @@ LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& optio
       skip_until_s_(num_cameras, -std::numeric_limits<double>::infinity()),
       jump_run_(num_cameras, 0),
       jump_time_s_(num_cameras, 0.0),
-      frame_step_s_(num_cameras, 0.0) {
+      frame_step_s_(num_cameras, 0.0),
+      last_frame_arrival_s_(num_cameras, -std::numeric_limits<double>::infinity()) {
   FV_REQUIRE(num_cameras >= 1, "LiveSynchronizer: needs at least one camera");
   options.Check();
 }
@@ -78,6 +79,7 @@ bool LiveSynchronizer::Add(CameraMessage m, double arrival_s) {
     return false;
   }
   ++s.received;
+  last_frame_arrival_s_[c] = arrival_s;
   if (buffers_[c].size() >= options_.max_buffered) {
     buffers_[c].pop_front();
     ++s.overflow;
@@ -185,7 +187,10 @@ bool LiveSynchronizer::WaitFor(int camera, double now_s) const {
 bool LiveSynchronizer::FarAheadOfALiveCamera(double time_s, double now_s) const {
   if (options_.max_time_jump_s <= 0) return false;
   for (int c = 0; c < n_; ++c) {
-    if (WaitFor(c, now_s) && std::isfinite(last_time_[c]) &&
+    // Only a camera still delivering frames that count holds it (not one that only answers
+    // clock pings while its source is stuck, nor one whose frames are all late).
+    const bool delivering = now_s - last_frame_arrival_s_[c] < options_.max_wait_s;
+    if (stats_[c].active && delivering && std::isfinite(last_time_[c]) &&
         time_s - last_time_[c] > options_.max_time_jump_s) {
       return true;
     }

@@ -103,7 +103,7 @@ class LiveSynchronizer {
   // max_wait_s).
   bool WaitFor(int camera, double now_s) const;
   // Whether a group at time_s lies more than max_time_jump_s past the stream of a camera that
-  // is waited for.
+  // still delivers frames that count (one taken within max_wait_s).
   bool FarAheadOfALiveCamera(double time_s, double now_s) const;
   double first_arrival_s_ = std::numeric_limits<double>::infinity();  // of any camera
   // A group's frame number: the fastest camera's (its frame, else where its frame count would
@@ -111,7 +111,8 @@ class LiveSynchronizer {
   // started at other times number their frames otherwise (the first present camera's gave 9,
   // 19, 10, 21, ... with a 30 fps camera among 60 fps ones).
   void NumberInStream(SyncedFrame& out);
-  std::vector<double> frame_step_s_;  // each camera's time per frame (smoothed)
+  std::vector<double> frame_step_s_;          // each camera's time per frame (smoothed)
+  std::vector<double> last_frame_arrival_s_;  // of each camera's last frame taken (not late)
   bool numbered_ = false;
   long long last_out_frame_ = 0;
   bool any_group_ = false;

@@ -180,6 +180,28 @@ TEST(LiveSync, OneCameraJumpingAheadDoesNotMakeTheOthersLate) {
   EXPECT_EQ(groups.back().present(), 3);
   EXPECT_EQ(glitch.stats()[0].unpaired, 0);
   EXPECT_EQ(glitch.stats()[0].implausible, 5);  // 40, 41, then 42 held; 43, 44
+
+  // What holds a camera gone ahead is another camera still delivering frames that count: not one
+  // whose source is stuck while its node answers clock pings, nor one whose clock stepped back
+  // (its frames all late). Either stopped all fusion for good.
+  for (const bool stuck : {true, false}) {
+    SCOPED_TRACE(stuck ? "camera 0 stuck, pinging" : "camera 0's clock stepped back");
+    LiveSynchronizer sync3(3, o);
+    long long decided = 0;
+    for (int k = 0; k < 30 * 60; ++k) {
+      const double t = k / 60.0, arrival = 1.0 + t;
+      if (k < 40) {
+        sync3.Add(Msg(0, k, t), arrival);
+      } else if (stuck) {
+        sync3.Admit(0, arrival);  // a clock ping
+      } else {
+        sync3.Add(Msg(0, k, t - 1000), arrival);
+      }
+      for (int c = 1; c < 3; ++c) sync3.Add(Msg(c, k, t), arrival);
+      while (sync3.Next(arrival)) ++decided;
+    }
+    EXPECT_GT(decided, 30 * 60 - 10);
+  }
 }
 
 // Nodes connect one after another: a camera not heard from yet is waited for (up to max_wait_s

@@ -138,11 +138,16 @@ TEST(Stats, FragmentsFollowedForUnderASecondAreLeftOutAndNamed) {
   add(17, 46.4, 0.0);
   for (int k = 0; k < 4; ++k) add(17, 49.7 + 0.1 * k, 7.0 + 0.2 * k);
   add(98, 12.0, 3.0);
+  // A few scattered rows are no slow sampling: two 10 s apart, five 5 s apart 100 m to and fro
+  // (they were bridged: 30 m and 200 m).
+  add(20, 2.0, 0.0);
+  add(20, 12.0, 30.0);
+  for (int k = 0; k < 5; ++k) add(21, 5.0 * k, k % 2 ? 50.0 : -50.0);
   const StatsResult r = ComputeStats(rows, StatsOptions());
   ASSERT_EQ(r.players.size(), 1u);
   EXPECT_EQ(r.players[0].id, 1);
-  EXPECT_EQ(r.left_out, (std::vector<int>{17, 98}));
-  EXPECT_NE(r.Summary().find("2 ids left out, each followed for under 1 s in all: 17, 98"),
+  EXPECT_EQ(r.left_out, (std::vector<int>{17, 20, 21, 98}));
+  EXPECT_NE(r.Summary().find("4 ids left out, each followed for under 1 s in all: 17, 20, 21, 98"),
             std::string::npos)
       << r.Summary();
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -146,6 +147,30 @@ Roster ReadRoster(const std::string& path) {
     if (team >= 0) r.team_of[id] = team;
     const std::string name = t.Has("name") ? util::Trim(t.Get(i, "name")) : std::string();
     if (!name.empty()) r.name_of[id] = name;
+  }
+  return r;
+}
+
+Roster RosterForTracks(const std::string& tracks_path) {
+  const std::string beside = RosterPathFor(tracks_path);
+  if (std::filesystem::is_regular_file(beside)) return ReadRoster(beside);
+  Roster r;
+  std::optional<util::CsvTable> read;
+  try {
+    read = util::CsvTable::Read(tracks_path);
+  } catch (const Error&) {
+    return r;  // a MOTChallenge file without a header: no team column
+  }
+  const util::CsvTable& t = *read;
+  if (!t.Has("team") || !t.Has("id")) return r;
+  for (size_t i = 0; i < t.rows(); ++i) {
+    long long team = -1;
+    try {
+      team = util::ParseInt(t.Get(i, "team"), t.Where(i));
+    } catch (const Error&) {
+      continue;  // empty or not a team number ("A"): no team
+    }
+    if (team >= 0 && team < 1000) r.team_of.emplace(static_cast<int>(t.GetInt(i, "id")), team);
   }
   return r;
 }

@@ -52,6 +52,9 @@ Roster ReadRoster(const std::string& path);
 void WriteRoster(const Roster& roster, const std::string& path);
 // TRACKS.csv's roster file name: TRACKS.csv.teams.csv.
 std::string RosterPathFor(const std::string& tracks_path);
+// The teams and names of a tracks file: its roster beside it when there is one, else the tracks'
+// own `team` column where it has one (team numbers; other values are no team).
+Roster RosterForTracks(const std::string& tracks_path);
 // The roster of the tracks just written to `tracks_path`, beside them (RosterPathFor); a roster
 // without teams or names removes an earlier run's file there instead, which stats and tracks draw
 // would otherwise apply to other people. Returns what was done ("wrote F", "removed F (...)") or

@@ -1,6 +1,7 @@
 #include "fieldvision/track/edits.h"
 
 #include <fstream>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -74,6 +75,24 @@ TEST(TrackEdits, MergeRenameNameTeamDropInOrder) {
   const Roster back = ReadRoster(dir + "/roster.csv");
   EXPECT_EQ(back.name_of, r.roster.name_of);
   EXPECT_EQ(back.team_of, r.roster.team_of);
+}
+
+// stats and the studio take the same teams: the roster beside the tracks, else their own team
+// column (numbers only: "A" is no team), and nothing for a file without a header.
+TEST(TrackEdits, RosterForTracksIsTheRosterElseTheTeamColumn) {
+  const std::string dir = fv::testing::TempDir();
+  const std::string tracks = dir + "/T.csv";
+  std::ofstream(tracks) << "frame,id,bb_left,bb_top,bb_width,bb_height,team\n"
+                           "1,3,0,0,1,1,1\n1,4,0,0,1,1,A\n1,5,0,0,1,1,\n2,3,0,0,1,1,1\n";
+  Roster r = RosterForTracks(tracks);
+  EXPECT_EQ(r.team_of, (std::map<int, int>{{3, 1}}));
+  std::ofstream(RosterPathFor(tracks)) << "id,team,name\n4,0,Ann\n";
+  r = RosterForTracks(tracks);
+  EXPECT_EQ(r.team_of, (std::map<int, int>{{4, 0}}));
+  EXPECT_EQ(r.name_of.at(4), "Ann");
+  const std::string mot = dir + "/gt.txt";
+  std::ofstream(mot) << "1,1,0,0,1,1,1,-1,-1,-1\n1,2,0,0,1,1,1,-1,-1,-1\n";
+  EXPECT_TRUE(RosterForTracks(mot).team_of.empty());
 }
 
 TEST(TrackEdits, ErrorsNameFileAndLine) {

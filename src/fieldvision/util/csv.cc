@@ -1,5 +1,6 @@
 #include "fieldvision/util/csv.h"
 
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -18,7 +19,12 @@ std::string CsvField(std::string v) {
   for (char& c : v) {
     if (c == '\n' || c == '\r') c = ' ';
   }
-  if (v.find_first_of(",\"") == std::string::npos) return v;
+  // Also quoted: a field the reader would take otherwise (a first field starting with '#' reads
+  // as a comment line, spaces at either end are trimmed).
+  const bool edge =
+      !v.empty() && (v.front() == '#' || std::isspace(static_cast<unsigned char>(v.front())) ||
+                     std::isspace(static_cast<unsigned char>(v.back())));
+  if (!edge && v.find_first_of(",\"") == std::string::npos) return v;
   std::string q = "\"";
   for (const char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";

@@ -57,6 +57,18 @@ TEST(Csv, FieldsWithCommasAndQuotesAreQuoted) {
   EXPECT_THAT([&] { CsvTable::Parse("a,b\n1,\"x\"y\n", "t.csv"); },
               ThrowsMessage<Error>(HasSubstr("t.csv:2: text after")));
   EXPECT_EQ(CsvTable::Parse("a, b\n 1 , \" x \"\n", "s.csv").Get(0, "b"), " x ");
+  // A first field starting with '#' (a zone "#1 box") is no comment line; edge spaces are kept.
+  {
+    CsvWriter w(path, {"zone", "t"});
+    w << "#1 box"
+      << " padded ";
+    w.EndRow();
+    w.Close();
+  }
+  const CsvTable hashed = CsvTable::Read(path);
+  ASSERT_EQ(hashed.rows(), 1u);
+  EXPECT_EQ(hashed.Get(0, "zone"), "#1 box");
+  EXPECT_EQ(hashed.Get(0, "t"), " padded ");
 }
 
 // A CSV saved by a spreadsheet as "CSV UTF-8" starts with a byte-order mark: the header is read

@@ -842,27 +842,11 @@ std::vector<Route> ColourRoutes() {
 
 // Endpoints of ball and player tracks, player statistics, zones.
 // The player tracks and zones a statistics request names ({tracks[, zones]}), into `o`.
-// The teams and names of a tracks file as `stats` takes them: its roster (TRACKS.csv.teams.csv)
-// when there is one, else its own `team` column where it has one.
-track::Roster RosterOf(const fs::path& tracks) {
-  const std::string roster = track::RosterPathFor(tracks.string());
-  if (fs::is_regular_file(roster)) return track::ReadRoster(roster);
-  track::Roster r;
-  const util::CsvTable t = util::CsvTable::Read(tracks.string());
-  if (!t.Has("team") || !t.Has("id")) return r;
-  for (size_t i = 0; i < t.rows(); ++i) {
-    if (t.Get(i, "team").empty()) continue;
-    const int team = static_cast<int>(t.GetInt(i, "team"));
-    if (team >= 0) r.team_of.emplace(static_cast<int>(t.GetInt(i, "id")), team);
-  }
-  return r;
-}
-
 std::vector<track::TrackRow> ReadStatsInput(const Workspace& ws, const json& body,
                                             stats::StatsOptions& o) {
   const fs::path tracks = ws.Resolve(Get<std::string>(body, "tracks"));
   auto rows = track::ReadTracksCsv(tracks.string());
-  const track::Roster roster = RosterOf(tracks);
+  const track::Roster roster = track::RosterForTracks(tracks.string());
   o.team_of = roster.team_of;
   o.name_of = roster.name_of;
   o.write_video = false;
@@ -968,7 +952,7 @@ std::vector<Route> TrackRoutes() {
          const fs::path path = ws.Resolve(Param(r, "path"));
          const util::CsvTable t = util::CsvTable::Read(path.string());
          t.Require({"frame", "id", "bb_left", "bb_top", "bb_width", "bb_height"});
-         const track::Roster roster = RosterOf(path);
+         const track::Roster roster = track::RosterForTracks(path.string());
          json rows = json::array();
          auto num = [&](size_t i, const char* col) -> json {
            if (!t.Has(col) || t.Get(i, col).empty()) return nullptr;
