@@ -239,25 +239,38 @@ void ScanGoalsAndShots(const std::vector<BallSample>& track, const TrajectoryRes
   // Scan the ball's path for goal-line crossings and made shots.
   if (!track.empty() && (!field.goals.empty() || !field.hoops.empty())) {
     const double t0 = track.front().time_s, t1 = track.back().time_s;
-    std::vector<bool> was_in(field.goals.size(), false);
     BallPathCursor path(track, result);
     Eigen::Vector3d prev = path.At(t0, nullptr);
+    // Whether the whole ball is beyond each goal's line: a goal is the ball passing from in
+    // front of it to beyond it inside the goal mouth (where it crosses: between the posts, under
+    // the bar). A ball over the bar and then behind the line, or one that never was in front of
+    // it, is none.
+    const auto beyond = [&](const field::FieldGoal& goal, const Eigen::Vector3d& p) {
+      return goal.side * (p.x() - goal.line_x_m) > 0.5 * field.line_width_m + r;
+    };
+    std::vector<bool> was_beyond;
+    for (const auto& goal : field.goals) was_beyond.push_back(beyond(goal, prev));
     for (double t = t0 + d.time_step_s; t <= t1; t += d.time_step_s) {
       int fl = -1;
       const Eigen::Vector3d p = path.At(t, &fl);
       for (size_t g = 0; g < field.goals.size(); ++g) {
         const field::FieldGoal& goal = field.goals[g];
-        const bool beyond = goal.side * (p.x() - goal.line_x_m) > 0.5 * field.line_width_m + r;
-        const bool inside = beyond && p.y() >= goal.y_min_m && p.y() <= goal.y_max_m &&
-                            p.z() <= goal.height_m && p.z() >= -r;
-        if (inside && !was_in[g]) {
-          out->goals.push_back({fl, goal.name, t, p});
-          out->timeline.push_back(
-              {t, fmt::format("GOAL: the whole ball crossed the line of {} at ({:.2f}, {:.2f}, "
-                              "{:.2f}) m",
-                              goal.name, p.x(), p.y(), p.z())});
+        const bool now_beyond = beyond(goal, p);
+        if (now_beyond && !was_beyond[g] && p.x() != prev.x()) {
+          // Where the ball's path meets the plane its whole ball is beyond from.
+          const double x_c = goal.line_x_m + goal.side * (0.5 * field.line_width_m + r);
+          const double f = std::clamp((x_c - prev.x()) / (p.x() - prev.x()), 0.0, 1.0);
+          const Eigen::Vector3d c = prev + f * (p - prev);
+          if (c.y() >= goal.y_min_m && c.y() <= goal.y_max_m && c.z() <= goal.height_m &&
+              c.z() >= -r) {
+            out->goals.push_back({fl, goal.name, t, c});
+            out->timeline.push_back(
+                {t, fmt::format("GOAL: the whole ball crossed the line of {} at ({:.2f}, {:.2f}, "
+                                "{:.2f}) m",
+                                goal.name, c.x(), c.y(), c.z())});
+          }
         }
-        was_in[g] = inside;
+        was_beyond[g] = now_beyond;
       }
       for (const auto& h : field.hoops) {
         const double hz = h.centre_m.z();

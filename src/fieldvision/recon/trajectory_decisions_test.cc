@@ -68,6 +68,46 @@ TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
   }
 }
 
+// A goal is the ball crossing the line inside the goal mouth: not a ball over the bar that
+// comes down behind the line between the posts, nor one that never was in front of the line
+// (both were called goals, 1.67 m behind the line).
+TEST(TrajectoryDecisions, OverTheBarOrBehindTheLineIsNoGoal) {
+  testing::SeededRng rng(37);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  const field::FieldGoal* right = nullptr;
+  for (const auto& g : field.goals) {
+    if (g.side > 0) right = &g;
+  }
+  ASSERT_NE(right, nullptr);
+  TrajectoryOptions to;
+  // Over the bar: from 5 m in front, 1.3 m over the bar at the line, landing 2 m behind it.
+  BallSimOptions over;
+  over.start_m = {right->line_x_m - 5.0, 0.0, 0.11};
+  const double T = 1.2, dx = 7.0;
+  over.kicks = {{0.05, Eigen::Vector3d(dx / T, 0.0, 4.905 * T)}};
+  over.duration_s = 1.6;
+  const BallSimulation sim_over(over);
+  double z_at_line = 0;
+  for (double t = 0; t < over.duration_s; t += 1e-3) {
+    if (sim_over.BallAt(t).x() >= right->line_x_m) {
+      z_at_line = sim_over.BallAt(t).z();
+      break;
+    }
+  }
+  ASSERT_GT(z_at_line, right->height_m + 0.3);
+  Scene s = RunScene(sim_over, to, rng);
+  Decisions d = MakeDecisions(s.track, s.result, &field, to, DecisionOptions());
+  EXPECT_TRUE(d.goals.empty()) << "over the bar at z " << z_at_line;
+  // Behind the line all along: thrown along y 0.5 m behind it.
+  BallSimOptions behind;
+  behind.start_m = {right->line_x_m + 0.5, -0.8, 0.11};
+  behind.kicks = {{0.05, Eigen::Vector3d(0.0, 2.0, 3.0)}};
+  behind.duration_s = 0.8;
+  s = RunScene(BallSimulation(behind), to, rng);
+  d = MakeDecisions(s.track, s.result, &field, to, DecisionOptions());
+  EXPECT_TRUE(d.goals.empty());
+}
+
 TEST(TrajectoryDecisions, InOrOutOfTheTouchLineByTheBallsFootprint) {
   testing::SeededRng rng(33);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
