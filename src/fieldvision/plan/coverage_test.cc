@@ -97,29 +97,26 @@ TEST(CoverageTest, RaisedLayerShrinksOverheadFootprint) {
   EXPECT_DOUBLE_EQ(r.layers[1].fraction_exactly[1], (54.0 * 36.0) / (72.0 * 48.0));
 }
 
-TEST(CoverageTest, BallTooSmallBeyondMaximumDistance) {
+// The ball's image is f * D / depth pixels wide at its narrowest (depth along the optical axis,
+// not the distance: a sphere off the axis images larger). From straight above every ground point
+// is 5 m deep: with a limit just under 100 D px every cell the camera sees counts, just over it
+// none (by the distance, only those within a radius of the nadir counted).
+TEST(CoverageTest, BallTooSmallBeyondMaximumDepth) {
   const field::FieldModel field = field::BuiltinField("robocup-msl");
   CoverageOptions o;
   o.grid_step_m = 0.5;
   o.height_above_m = 0;
   const double z = 0.5 * o.ball_diameter_m;
   const camera::Camera cam = OverheadCamera("top", {0, 0}, 18, 12, z, 5.0, 100);
-  // The ball is f * D / distance pixels wide; at 5 m (right below) it is 100 px, so with
-  // min_ball_px = 100 * 5 / 7 only points within sqrt(7^2 - 5^2) m of the nadir count.
-  o.min_ball_px = 100.0 * 5.0 * o.ball_diameter_m / 7.0;
-  const CoverageResult r = EvaluateCoverage({cam}, field, o);
-  const CoverageLayer& L = r.layers[0];
-  int inside = 0;
-  for (int j = 0; j < L.ny; ++j) {
-    for (int i = 0; i < L.nx; ++i) {
-      const double radius = L.CellCentre(i, j).head<2>().norm();
-      const bool expect_seen = radius <= std::sqrt(49.0 - 25.0);
-      inside += expect_seen;
-      EXPECT_EQ(L.count[j * L.nx + i], expect_seen ? 1 : 0) << "radius " << radius;
-    }
-  }
-  EXPECT_GT(inside, 10);
-  EXPECT_DOUBLE_EQ(L.fraction_exactly[1], double(inside) / L.size());
+  const double width_px = 100.0 * o.ball_diameter_m;  // f D / 5 m, f = 500 px
+  o.min_ball_px = 0.99 * width_px;
+  const CoverageLayer seen = EvaluateCoverage({cam}, field, o).layers[0];
+  o.min_ball_px = 0;
+  const CoverageLayer all = EvaluateCoverage({cam}, field, o).layers[0];
+  EXPECT_GT(all.fraction_exactly[1], 0.5);
+  EXPECT_DOUBLE_EQ(seen.fraction_exactly[1], all.fraction_exactly[1]);
+  o.min_ball_px = 1.01 * width_px;
+  EXPECT_DOUBLE_EQ(EvaluateCoverage({cam}, field, o).layers[0].fraction_exactly[1], 0.0);
 }
 
 TEST(CoverageTest, BestPairAngleIsClosestTo90) {
