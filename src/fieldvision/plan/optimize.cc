@@ -174,6 +174,10 @@ std::vector<MountPlace> MountsFromJson(const json& j, const std::string& context
       place.a = ReadPoint(m["line"][0], ctx + ".line[0]");
       place.b = ReadPoint(m["line"][1], ctx + ".line[1]");
     }
+    // The ground is opaque (z up, the field at z = 0): cameras there saw through it.
+    FV_REQUIRE(place.a.z() >= 0 && place.b.z() >= 0,
+               "{}: {:.3g} m below the ground (z points up, the field at z = 0)", ctx,
+               -std::min(place.a.z(), place.b.z()));
     mounts.push_back(place);
   }
   FV_REQUIRE(!mounts.empty(), "{}: no mounting places", context);
@@ -185,7 +189,8 @@ std::vector<MountPlace> ReadMountsJson(const std::string& path) {
 }
 
 void OptimizeOptions::Check() const {
-  FV_REQUIRE(num_cameras >= 1 && num_cameras <= 32, "num_cameras must be in [1, 32] (got {})",
+  FV_REQUIRE(num_cameras >= 2 && num_cameras <= 32,
+             "num_cameras must be in [2, 32] (got {}): the ball is placed from two cameras or more",
              num_cameras);
   CheckPositive(grid_step_m, "grid_step_m");
   FV_REQUIRE(iterations >= 0 && iterations <= 1000000, "iterations must be in [0, 1e6] (got {})",
@@ -253,6 +258,11 @@ OptimizeResult OptimizeRig(const field::FieldModel& field, const std::vector<Mou
     }
   }
   progress.Finish();
+  FV_REQUIRE(best_score > 0,
+             "optimize: no placement of {} cameras on these mounts sees any of the field from two "
+             "of them at a usable angle (check the mounts' places and heights, the lens' field of "
+             "view and the number of cameras)",
+             options.num_cameras);
   result.rig.name =
       fmt::format("optimized rig ({} cameras, seed {})", options.num_cameras, options.seed);
   result.rig.cameras = search.Cameras(best);

@@ -93,6 +93,21 @@ TEST(OptimizeTest, PointMountsAndBadOptions) {
       ThrowsMessage<Error>(HasSubstr("mounts[0].point")));
   o.num_cameras = 0;
   EXPECT_THAT([&] { o.Check(); }, ThrowsMessage<Error>(HasSubstr("num_cameras")));
+  // Budgets no rig can meet are errors, not a rig of score 0 (exit 0 and a rig.json before): a
+  // mount under the ground, one camera, a lens of 1 degree.
+  EXPECT_THAT(
+      [&] {
+        MountsFromJson({{"mounts", {{{"point", {0, 0, -4}}}}}}, "m.json");
+      },
+      ThrowsMessage<Error>(HasSubstr("mounts[0]: 4 m below the ground")));
+  o.num_cameras = 1;
+  EXPECT_THAT([&] { o.Check(); }, ThrowsMessage<Error>(HasSubstr("two cameras or more")));
+  o.num_cameras = 2;
+  EXPECT_THAT(
+      [&] {
+        OptimizeRig(field, mounts, camera::Camera::FromFov(1280, 960, 1), CoverageOptions(), o);
+      },
+      ThrowsMessage<Error>(HasSubstr("no placement of 2 cameras")));
 }
 
 }  // namespace

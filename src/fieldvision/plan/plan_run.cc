@@ -195,6 +195,33 @@ json CoverageJson(const PlanRunResult& result, const field::FieldModel& field,
   return j;
 }
 
+namespace {
+
+// What makes the table's counts mean less than they seem: one camera (no 3D), or two cameras at
+// one place looking one way (the same camera given twice: counted as two, "seen by >= 2" at 0
+// degrees).
+std::string RigWarnings(const Rig& rig) {
+  std::string w;
+  const auto& cams = rig.cameras;
+  if (cams.size() == 1) w += "warning: one camera: the ball is placed in 3D from two or more\n";
+  for (size_t a = 0; a < cams.size(); ++a) {
+    for (size_t b = a + 1; b < cams.size(); ++b) {
+      const Eigen::Vector3d axis_a = cams[a].cam_from_world.rotation.row(2).transpose();
+      const Eigen::Vector3d axis_b = cams[b].cam_from_world.rotation.row(2).transpose();
+      if ((cams[a].CentreInWorld() - cams[b].CentreInWorld()).norm() < 0.05 &&
+          axis_a.dot(axis_b) > std::cos(2.0 * M_PI / 180.0)) {
+        w += fmt::format(
+            "warning: cameras '{}' and '{}' stand at one place looking one way: they count as two "
+            "cameras but see nothing one does not\n",
+            cams[a].name, cams[b].name);
+      }
+    }
+  }
+  return w;
+}
+
+}  // namespace
+
 PlanRunResult RunPlan(const PlanRunOptions& options) {
   options.Check();
   const field::FieldModel field = field::LoadField(options.field);
@@ -232,6 +259,7 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   summary += fmt::format("rig '{}', {} cameras, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
                          result.rig.cameras.size(), field.name, field.length_m, field.width_m);
   summary += result.coverage.Summary();
+  summary += RigWarnings(result.rig);
   if (result.given_rig_score) {
     summary += fmt::format("score on this grid: optimized {:.4f}, given rig {:.4f}\n",
                            result.coverage.score(), *result.given_rig_score);

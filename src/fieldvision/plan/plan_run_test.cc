@@ -55,6 +55,14 @@ TEST(PlanRunTest, WritesCoverageJsonAndMaps) {
     EXPECT_EQ(img.cols, 400) << name;
   }
   EXPECT_NE(r.summary.find("share of the field"), std::string::npos);
+  EXPECT_EQ(r.summary.find("warning"), std::string::npos) << r.summary;
+  // The same camera twice counts as two cameras at a 0 degree angle: said.
+  json twice = json::parse(std::ifstream(o.rig_path));
+  twice["cameras"][1] = twice["cameras"][0];
+  std::ofstream(o.rig_path) << twice.dump(2);
+  o.out_dir = dir + "/twice";
+  const PlanRunResult t = RunPlan(o);
+  EXPECT_NE(t.summary.find("stand at one place looking one way"), std::string::npos) << t.summary;
 }
 
 TEST(PlanRunTest, OptimizeWritesARigThatReadsBack) {
