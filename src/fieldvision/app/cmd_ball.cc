@@ -77,6 +77,7 @@ void RunDetections(BallCliOptions& o) {
   d.tolerance_s = o.job.pipeline.sync.tolerance_s;
   d.triangulation = o.job.pipeline.triangulation;
   d.eval = o.job.eval;
+  d.bundle = o.job.bundle;  // --no-bundle (it was ignored with --detections)
   const pipeline::DetectionsJobResult r = pipeline::RunDetectionsJob(d);
   std::cout << r.Summary() << "\n";
   std::cout << "wrote " << d.out << " (" << r.positions << " rows)"
