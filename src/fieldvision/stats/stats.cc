@@ -388,6 +388,7 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
                "given time is (frame - 1) / fps",
                r.frame);
   }
+  FV_REQUIRE(!rows.empty(), "the tracks have no rows (an empty file, or every id dropped)");
   FV_REQUIRE(!by_id.empty(),
              "the tracks have no field positions (x_m, y_m): run players with a calibrated camera");
   StatsResult res;

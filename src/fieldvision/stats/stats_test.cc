@@ -322,6 +322,9 @@ TEST(Stats, BadInputs) {
   std::vector<track::TrackRow> no_positions = {{0, 1, cv::Rect2d(0, 0, 1, 1), 1, {}, {}}};
   EXPECT_THAT([&] { ComputeStats(no_positions, StatsOptions{}); },
               ThrowsMessage<fv::Error>(HasSubstr("x_m")));
+  // No rows at all is said as such (it read "run players with a calibrated camera").
+  EXPECT_THAT([&] { ComputeStats({}, StatsOptions{}); },
+              ThrowsMessage<fv::Error>(HasSubstr("no rows")));
   const std::string dir = fv::testing::TempDir();
   {
     std::ofstream f(dir + "/zones.json");
