@@ -441,15 +441,15 @@ void WriteTables(const ReportParts& rp, ReportFiles& files) {
   // The players' table as CSV (and the speed profiles, one row per player and second).
   {
     const std::string path = out_dir + "/players.csv";
-    std::vector<std::string> header = {"id",     "name",       "team",          "from_s",
-                                       "to_s",   "distance_m", "top_speed_mps", "mean_speed_mps",
-                                       "sprints"};
+    std::vector<std::string> header = {
+        "id",        "name",       "team",          "from_s",         "to_s",
+        "tracked_s", "distance_m", "top_speed_mps", "mean_speed_mps", "sprints"};
     for (const auto& b : rp.band_names) header.push_back("time_" + b + "_mps_s");
     for (const auto& z : o.zones) header.push_back("time_in_" + z.name + "_s");
     util::CsvWriter w(path, header, 2);
     for (const auto& p : r.players) {
-      w << p.id << p.name << p.team << p.first_s << p.last_s << p.distance_m << p.top_speed_mps
-        << p.mean_speed_mps << p.sprints;
+      w << p.id << p.name << p.team << p.first_s << p.last_s << p.tracked_s << p.distance_m
+        << p.top_speed_mps << p.mean_speed_mps << p.sprints;
       for (double bt : p.band_time_s) w << bt;
       for (const auto& z : o.zones) w << p.zone_time_s.at(z.name);
       w.EndRow();
@@ -485,6 +485,7 @@ nlohmann::json StatsJson(const StatsResult& r, const StatsOptions& o, const Repo
                          {"team", p.team},
                          {"first_s", p.first_s},
                          {"last_s", p.last_s},
+                         {"tracked_s", p.tracked_s},
                          {"distance_m", p.distance_m},
                          {"top_speed_mps", p.top_speed_mps},
                          {"mean_speed_mps", p.mean_speed_mps},
@@ -524,17 +525,17 @@ void WriteIndexHtml(const std::string& path, const ReportParts& rp, const Report
        "player and second), <a href=\"distances.csv\">distances.csv</a> (distances between "
        "players each second), <a href=\"stats.json\">stats.json</a>.</p>\n";
   h << "<table class=\"sortable\"><tr><th>id</th><th>name</th><th>team</th><th>from s</th>"
-       "<th>to s</th><th>distance m</th><th>top speed m/s</th><th>mean speed m/s</th>"
-       "<th>sprints</th>";
+       "<th>to s</th><th>tracked s</th><th>distance m</th><th>top speed m/s</th>"
+       "<th>mean speed m/s</th><th>sprints</th>";
   for (const auto& b : rp.band_names) h << "<th>" << b << " m/s (s)</th>";
   for (const auto& z : o.zones) h << "<th>in " << Html(z.name) << " (s)</th>";
   h << "</tr>\n";
   for (const auto& p : r.players) {
     h << fmt::format(
         "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1f}</td><td>{:.1f}</td><td>{:.1f}</td>"
-        "<td>{:.2f}</td><td>{:.2f}</td><td>{}</td>",
+        "<td>{:.1f}</td><td>{:.2f}</td><td>{:.2f}</td><td>{}</td>",
         p.id, Html(p.name), p.team >= 0 ? std::to_string(p.team) : "-", p.first_s, p.last_s,
-        p.distance_m, p.top_speed_mps, p.mean_speed_mps, p.sprints);
+        p.tracked_s, p.distance_m, p.top_speed_mps, p.mean_speed_mps, p.sprints);
     for (double bt : p.band_time_s) h << fmt::format("<td>{:.1f}</td>", bt);
     for (const auto& z : o.zones) h << fmt::format("<td>{:.1f}</td>", p.zone_time_s.at(z.name));
     h << "</tr>\n";

@@ -345,6 +345,7 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
     }
   }
   if (sprint_run >= o.sprint_min_s) ps.sprints++;
+  ps.tracked_s = speed_time;
   ps.mean_speed_mps = speed_time > 0 ? ps.distance_m / speed_time : 0.0;
   for (const auto& [sec, sc] : per_second) {
     ps.speed_profile.emplace_back(sec, sc.first / sc.second);

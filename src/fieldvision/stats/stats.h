@@ -66,6 +66,9 @@ struct PlayerStats {
   std::string name;  // roster name, empty when none
   int samples = 0;
   double first_s = 0, last_s = 0;
+  // Time followed: first to last less the gaps the track was cut at (distance, speeds, bands and
+  // zone times are over it; a gap's ground is not guessed).
+  double tracked_s = 0;
   double distance_m = 0;
   double top_speed_mps = 0, mean_speed_mps = 0;  // mean: distance over the time tracked
   double position_noise_m = 0;                   // SmoothTrack::noise_m

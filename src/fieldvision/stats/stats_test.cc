@@ -116,7 +116,15 @@ TEST(Stats, SparseOrFastNoisySamplesGiveTheSameDistanceAndSpeed) {
     double bands = 0;
     for (double b : r.players[0].band_time_s) bands += b;
     EXPECT_NEAR(bands, 60.0, 0.6);
+    EXPECT_NEAR(r.players[0].tracked_s, 60.0, 0.6);
   }
+  // A gap of 2 s is not followed: tracked_s says so (from_s..to_s still spans it).
+  std::vector<track::TrackRow> holed = Jogger(rng, 25, 1, 0.0);
+  std::erase_if(
+      holed, [](const track::TrackRow& row) { return *row.time_s > 20.0 && *row.time_s < 22.0; });
+  const StatsResult r = ComputeStats(holed, StatsOptions());
+  EXPECT_NEAR(r.players[0].tracked_s, 58.0, 0.1);
+  EXPECT_NEAR(r.players[0].last_s - r.players[0].first_s, 60.0, 1e-9);
 }
 
 // A fragment is as long as it was followed, not as the span of its rows: one row, then four
