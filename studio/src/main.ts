@@ -53,6 +53,7 @@ function connect(): void {
   };
   es.addEventListener('hello', () => {
     clearTimeout(unreachable);
+    unreachable = 0;
     live.textContent = 'live';
   });
   es.addEventListener('saved', (e) => {
@@ -70,8 +71,9 @@ function connect(): void {
   // The server ends a stream every minute and the browser reconnects at once: only a stream
   // not back within 5 s means the server is gone.
   es.onerror = () => {
-    clearTimeout(unreachable);
-    unreachable = window.setTimeout(() => (live.textContent = 'server not reachable'), 5000);
+    if (!unreachable) {
+      unreachable = window.setTimeout(() => (live.textContent = 'server not reachable'), 5000);
+    }
   };
   events = es;
 }
@@ -79,6 +81,8 @@ document.addEventListener('visibilitychange', () => {
   if (document.hidden) {
     events?.close();
     events = null;
+    clearTimeout(unreachable);
+    unreachable = 0;
   } else if (!events) {
     connect();
   }

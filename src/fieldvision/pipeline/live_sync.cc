@@ -154,6 +154,8 @@ void LiveSynchronizer::NumberInStream(SyncedFrame& out) {
 
 void LiveSynchronizer::SetFrameRate(int camera, double fps) {
   FV_REQUIRE(camera >= 0 && camera < n_, "live sync: no camera {}", camera);
+  // Until its frames tell (a source's stated rate may be off; hellos come with every ping).
+  if (frame_step_s_[camera] > 0) return;
   if (std::isfinite(fps) && fps > 0 && fps < 1e4) frame_step_s_[camera] = 1.0 / fps;
 }
 

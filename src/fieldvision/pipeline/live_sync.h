@@ -64,8 +64,8 @@ class LiveSynchronizer {
   // Nothing captured before `time_s` will come from the camera (its source skipped frames): the
   // groups before it do not wait for it.
   void SkipUntil(int camera, double time_s, double arrival_s);
-  // The camera's frame rate as its source tells it (a node's hello): the groups' frame numbers
-  // follow the fastest camera from the first group on (else from when its rate is seen).
+  // The camera's frame rate as its source tells it (a node's hello), until its frames are seen:
+  // the groups' frame numbers follow the fastest camera from the first group on.
   void SetFrameRate(int camera, double fps);
   // The camera restarted (a new session): its stream starts afresh.
   void Restart(int camera);

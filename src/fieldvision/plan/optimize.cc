@@ -258,7 +258,10 @@ OptimizeResult OptimizeRig(const field::FieldModel& field, const std::vector<Mou
     }
   }
   progress.Finish();
-  FV_REQUIRE(best_score > 0,
+  // The score can be negative for a rig that sees the field (a large error weight): what says
+  // the search found nothing is the share seen from two cameras at a good angle.
+  const CoverageResult best_coverage = EvaluateCoverage(search.Cameras(best), field, coverage);
+  FV_REQUIRE(!best_coverage.layers.empty() && best_coverage.layers[0].fraction_good > 0,
              "optimize: no placement of {} cameras on these mounts sees any of the field from two "
              "of them at a usable angle (check the mounts' places and heights, the lens' field of "
              "view and the number of cameras)",

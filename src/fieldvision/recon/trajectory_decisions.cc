@@ -249,7 +249,16 @@ void ScanGoalsAndShots(const std::vector<BallSample>& track, const TrajectoryRes
       return goal.side * (p.x() - goal.line_x_m) > 0.5 * field.line_width_m + r;
     };
     std::vector<bool> was_beyond;
-    for (const auto& goal : field.goals) was_beyond.push_back(beyond(goal, prev));
+    for (const auto& goal : field.goals) {
+      was_beyond.push_back(beyond(goal, prev));
+      if (was_beyond.back() && prev.y() >= goal.y_min_m && prev.y() <= goal.y_max_m &&
+          prev.z() <= goal.height_m) {
+        out->timeline.push_back(
+            {t0, fmt::format("the ball is already in {} when the track starts: its crossing of "
+                             "the line is not seen, no goal called",
+                             goal.name)});
+      }
+    }
     for (double t = t0 + d.time_step_s; t <= t1; t += d.time_step_s) {
       int fl = -1;
       const Eigen::Vector3d p = path.At(t, &fl);

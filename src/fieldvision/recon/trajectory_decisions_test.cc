@@ -106,6 +106,10 @@ TEST(TrajectoryDecisions, OverTheBarOrBehindTheLineIsNoGoal) {
   s = RunScene(BallSimulation(behind), to, rng);
   d = MakeDecisions(s.track, s.result, &field, to, DecisionOptions());
   EXPECT_TRUE(d.goals.empty());
+  // Already in the goal when the track starts: no goal called, and the timeline says why.
+  bool said = false;
+  for (const auto& e : d.timeline) said |= e.text.find("already in") != std::string::npos;
+  EXPECT_TRUE(said);
 }
 
 TEST(TrajectoryDecisions, InOrOutOfTheTouchLineByTheBallsFootprint) {
