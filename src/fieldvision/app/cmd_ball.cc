@@ -10,12 +10,12 @@
 #include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/detector_options.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/pipeline/ball_job.h"
 #include "fieldvision/pipeline/ball_overlay.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -23,8 +23,8 @@ namespace {
 struct BallCliOptions {
   pipeline::BallJobOptions job;
   bool rows = false;
-  pipeline::DetectionsJobOptions det;     // with --detections instead of --video
-  pipeline::BallOverlayOptions draw;      // --draw DIR
+  pipeline::DetectionsJobOptions det;       // with --detections instead of --video
+  pipeline::BallOverlayOptions draw;        // --draw DIR
   std::optional<util::NewFolder> draw_dir;  // ... a new folder, removed if the run fails empty
 };
 
@@ -114,7 +114,7 @@ void RunBall(const BallCliOptions& o) {
 // The outputs checked against the inputs and each other, then the run (videos or detections).
 void CheckOutputsAndRun(BallCliOptions& o) {
   const auto inputs = util::PathList(o.job.cameras, o.job.videos, o.job.timestamps, o.job.truth,
-                                   o.job.field, o.job.colour, o.det.detections);
+                                     o.job.field, o.job.colour, o.det.detections);
   util::CheckOutputPath(o.job.out, inputs);
   util::CheckOutputPath(o.det.flights, util::PathList(inputs, o.job.out), "--flights");
   for (size_t i = 0; i < o.job.detections_out.size(); ++i) {
@@ -122,7 +122,8 @@ void CheckOutputsAndRun(BallCliOptions& o) {
     others.insert(others.end(), o.job.detections_out.begin(),
                   o.job.detections_out.begin() + static_cast<long>(i));
     util::CheckOutputPath(o.job.detections_out[i], others, "--write-detections");
-    o.job.detections_out[i] = util::ResolveOutputPath(o.job.detections_out[i], "--write-detections");
+    o.job.detections_out[i] =
+        util::ResolveOutputPath(o.job.detections_out[i], "--write-detections");
   }
   o.job.out = util::ResolveOutputPath(o.job.out);  // refuses a device or a folder
   if (!o.det.flights.empty()) o.det.flights = util::ResolveOutputPath(o.det.flights, "--flights");
