@@ -223,6 +223,15 @@ std::string LargerChessboardSeen(const cv::Mat& image, const BoardSpec& board) {
   return "";
 }
 
+LargerBoard LargerChessboardInViews(const std::vector<BoardView>& views, const ImageSource& source,
+                                    const BoardSpec& board) {
+  const auto first = std::find_if(views.begin(), views.end(),
+                                  [](const BoardView& v) { return !v.image_points.empty(); });
+  if (first == views.end()) return {};
+  return {first->name,
+          LargerChessboardSeen(source.Read(static_cast<int>(first - views.begin())), board)};
+}
+
 std::string BoardNotFoundHint(const cv::Mat& image, const BoardSpec& board) {
   if (board.type != BoardType::kCharuco) {
     return "(check --cols and --rows: inner corners, one fewer than the squares)";

@@ -111,4 +111,14 @@ class ImageSource {
   std::vector<int> frames_;  // video frame numbers
 };
 
+// LargerChessboardSeen on the first of `views` where the board was found, its image read again
+// from `source` (the views' own, in order): that view's name and the larger size ("" when none,
+// or when the board was found in no view).
+struct LargerBoard {
+  std::string view;
+  std::string size;
+};
+LargerBoard LargerChessboardInViews(const std::vector<BoardView>& views, const ImageSource& source,
+                                    const BoardSpec& board);
+
 }  // namespace fv::calib

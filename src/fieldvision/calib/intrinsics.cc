@@ -601,15 +601,12 @@ IntrinsicsResult CalibrateIntrinsics(const std::string& images, const Intrinsics
              options.board.Describe(), views.size(),
              BoardNotFoundHint(source.Read(0), options.board));
   IntrinsicsResult result = CalibrateFromViews(views, options);
-  const auto first = std::find_if(views.begin(), views.end(),
-                                  [](const BoardView& v) { return !v.image_points.empty(); });
-  const std::string larger =
-      LargerChessboardSeen(source.Read(static_cast<int>(first - views.begin())), options.board);
-  if (!larger.empty()) {
+  const LargerBoard larger = LargerChessboardInViews(views, source, options.board);
+  if (!larger.size.empty()) {
     result.warnings.push_back(fmt::format(
         "'{}' shows a chessboard of {}, larger than the {}x{} given: a part of it was used, "
         "a different part in different views; give the board's own --cols and --rows",
-        first->name, larger, options.board.cols, options.board.rows));
+        larger.view, larger.size, options.board.cols, options.board.rows));
   }
   return result;
 }

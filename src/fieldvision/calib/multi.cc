@@ -235,30 +235,9 @@ CameraDetections DetectCameraViews(const CameraViews& camera, const MultiOptions
     progress.Update(i + 1);
   }
   progress.Finish();
+  out.larger_board = LargerChessboardInViews(out.views, source, options.board);
   return out;
 }
-
-namespace {
-
-// A rig's cameras must see the same board points: on a larger chessboard OpenCV finds a part
-// of the given size, a different part in different views (poses off by whole squares).
-void RequireWholeBoard(const CameraViews& camera, const CameraDetections& detections,
-                       const MultiOptions& options) {
-  const auto& views = detections.views;
-  const auto first = std::find_if(views.begin(), views.end(),
-                                  [](const BoardView& v) { return !v.image_points.empty(); });
-  if (first == views.end()) return;
-  const cv::Mat image =
-      ImageSource(camera.source, options.source).Read(static_cast<int>(first - views.begin()));
-  const std::string larger = LargerChessboardSeen(image, options.board);
-  FV_REQUIRE(larger.empty(),
-             "camera '{}': '{}' shows a chessboard of {}, larger than the {}x{} given: a part of "
-             "it is found, a different part in different views, and the rig's poses would be "
-             "off by whole squares; give the board's own --cols and --rows",
-             camera.name, first->name, larger, options.board.cols, options.board.rows);
-}
-
-}  // namespace
 
 std::vector<MultiFrame> PairViews(const std::vector<CameraDetections>& cameras, Pairing pairing,
                                   std::string* how) {
@@ -1102,7 +1081,14 @@ MultiResult CalibrateMulti(const std::vector<CameraViews>& cameras, const MultiO
     FV_REQUIRE(any, "camera '{}': no {} found in any of the {} images of '{}' {}", c.name,
                options.board.Describe(), detections.back().views.size(), c.source,
                BoardNotFoundHint(ImageSource(c.source, options.source).Read(0), options.board));
-    RequireWholeBoard(c, detections.back(), options);
+    // A rig's cameras must see the same board points: on a larger chessboard OpenCV finds a part
+    // of the given size, a different part in different views (poses off by whole squares).
+    const LargerBoard& larger = detections.back().larger_board;
+    FV_REQUIRE(larger.size.empty(),
+               "camera '{}': '{}' shows a chessboard of {}, larger than the {}x{} given: a part "
+               "of it is found, a different part in different views, and the rig's poses would "
+               "be off by whole squares; give the board's own --cols and --rows",
+               c.name, larger.view, larger.size, options.board.cols, options.board.rows);
   }
   std::string how;
   const auto frames = PairViews(detections, options.pairing, &how);

@@ -89,6 +89,7 @@ struct CameraDetections {
   std::string source;
   std::vector<BoardView> views;  // every image; image_points empty where the board was not found
   std::vector<long long> frame_numbers;  // last number in each name; -1 when it has none
+  LargerBoard larger_board;              // a larger chessboard in its images (board.h)
 };
 
 // Reads and detects the board in every image of one camera.
