@@ -163,6 +163,14 @@ double PositionNoise(const std::vector<double>& t, const std::vector<Eigen::Vect
 
 }  // namespace
 
+double FollowedS(const SmoothTrack& s) {
+  double followed_s = 0;
+  for (size_t i = 1; i < s.time_s.size(); ++i) {
+    if (s.segment[i] == s.segment[i - 1]) followed_s += s.time_s[i] - s.time_s[i - 1];
+  }
+  return followed_s;
+}
+
 SmoothTrack SmoothPositions(int id, const std::vector<double>& t,
                             const std::vector<Eigen::Vector2d>& p, const StatsOptions& o) {
   SmoothTrack s;
@@ -305,7 +313,7 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
   ps.position_noise_m = std::max(s.noise_m, 0.0);
   const double dead_band_m = o.distance_noise_factor * ps.position_noise_m;
   Eigen::Vector2d counted_to = s.pos_m.front();  // where the last counted move ended
-  double sprint_run = 0, speed_time = 0;
+  double sprint_run = 0;
   std::map<std::string, std::optional<double>> inside_since;
   std::map<int, std::pair<double, int>> per_second;  // second -> (sum, count)
   for (size_t i = 0; i < t.size(); ++i) {
@@ -320,7 +328,6 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
       }
     }
     const double v = std::min(s.speed_mps[i], o.max_speed_mps);
-    speed_time += dt;
     size_t band = 0;
     while (band < o.speed_bands_mps.size() && v >= o.speed_bands_mps[band]) ++band;
     ps.band_time_s[band] += dt;
@@ -345,8 +352,8 @@ PlayerStats PlayerStatsOf(const SmoothTrack& s, const StatsOptions& o,
     }
   }
   if (sprint_run >= o.sprint_min_s) ps.sprints++;
-  ps.tracked_s = speed_time;
-  ps.mean_speed_mps = speed_time > 0 ? ps.distance_m / speed_time : 0.0;
+  ps.tracked_s = FollowedS(s);
+  ps.mean_speed_mps = ps.tracked_s > 0 ? ps.distance_m / ps.tracked_s : 0.0;
   for (const auto& [sec, sc] : per_second) {
     ps.speed_profile.emplace_back(sec, sc.first / sc.second);
   }
@@ -416,11 +423,7 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
       p.emplace_back(*r->x_m, *r->y_m);
     }
     SmoothTrack s = SmoothPositions(id, t, p, o);
-    double followed_s = 0;
-    for (size_t i = 1; i < t.size(); ++i) {
-      if (s.segment[i] == s.segment[i - 1]) followed_s += t[i] - t[i - 1];
-    }
-    if (followed_s < o.min_track_s) {
+    if (FollowedS(s) < o.min_track_s) {
       res.left_out.push_back(id);
       continue;
     }

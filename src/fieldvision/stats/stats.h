@@ -133,6 +133,9 @@ PlayerStats PlayerStatsOf(const SmoothTrack& track, const StatsOptions& o,
 std::vector<std::tuple<double, int, int, double>> PairDistancesPerSecond(
     const std::vector<SmoothTrack>& tracks, double t_min, double t_max);
 
+// The time a smoothed track was followed: its steps within segments (gaps left out).
+double FollowedS(const SmoothTrack& track);
+
 // Smooths one track's positions (exposed for tests).
 SmoothTrack SmoothPositions(int id, const std::vector<double>& time_s,
                             const std::vector<Eigen::Vector2d>& pos_m, const StatsOptions& o);
