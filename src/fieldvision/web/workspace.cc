@@ -5,6 +5,8 @@
 #include <regex>
 #include <system_error>
 
+#include "fieldvision/util/strings.h"
+
 namespace fv::web {
 
 namespace fs = std::filesystem;
@@ -18,15 +20,10 @@ bool Inside(const fs::path& root, const fs::path& p) {
   return *rel.begin() != "..";
 }
 
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-
 }  // namespace
 
 std::string FileKind(const fs::path& path) {
-  const std::string ext = Lower(path.extension().string());
+  const std::string ext = util::ToLower(path.extension().string());
   if (ext == ".avi" || ext == ".mp4" || ext == ".mkv" || ext == ".mov" || ext == ".webm") {
     return "video";
   }
@@ -71,9 +68,7 @@ fs::path Workspace::Resolve(const std::string& path, bool must_exist) const {
 fs::path Workspace::ResolveOutput(const std::string& path,
                                   const std::vector<std::string>& extensions) const {
   if (!extensions.empty()) {
-    std::string ext = fs::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+    const std::string ext = util::ToLower(fs::path(path).extension().string());
     if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) {
       std::string names;
       for (const std::string& e : extensions) names += (names.empty() ? "" : " or ") + e;
