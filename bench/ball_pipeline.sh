@@ -35,6 +35,9 @@ run() {  # mode-name extra-args...
   "$FV" eval ball --truth "$SCENE/truth.csv" --est "$SCENE/ball_$name.csv" | tail -2
 }
 run whole --whole-frames
+run no-background --no-background
 run tracked
 awk -v w="$(cat "$SCENE/wall_whole.txt")" -v t="$(cat "$SCENE/wall_tracked.txt")" \
-  'BEGIN { printf "tracked vs whole frames: %.2fx faster (wall)\n", w / t }'
+  -v n="$(cat "$SCENE/wall_no-background.txt")" 'BEGIN {
+  printf "tracked vs whole frames: %.2fx faster (wall); the backgrounds cost %.0f %% (wall)\n",
+         w / t, 100 * (t / n - 1) }'

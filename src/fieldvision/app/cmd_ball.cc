@@ -88,6 +88,11 @@ void RunDetections(BallCliOptions& o) {
 void RunBall(const BallCliOptions& o) {
   const pipeline::BallJobResult r = pipeline::RunBallJob(o.job);
   std::cout << r.summary.ToString() << "\n";
+  // The backgrounds some camera's low-contrast candidates asked for (camera_background.h).
+  for (size_t c = 0; c < r.backgrounds.size(); ++c) {
+    if (r.backgrounds[c] == detect::CameraBackground::kNotNeeded) continue;
+    std::cout << o.job.videos[c] << ": " << r.backgrounds[c] << "\n";
+  }
   if (r.bundle && r.bundle->bundled_flights > 0) {
     std::cout << fmt::format(
         "{} flights refined on the cameras' candidates ({} rows, {:.2f} px RMS{}; --no-bundle: "
@@ -186,6 +191,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "With --sync time: frames this close in seconds are combined")
       ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
+  AddBackgroundOption(cmd, o->job.background);
   cmd->add_flag("--live", o->job.live,
                 "Live: play the videos at their frame rate (as cameras deliver) and keep the "
                 "newest frames when fusion falls behind (drops frames)");

@@ -7,9 +7,9 @@
 #include "fieldvision/app/detector_options.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/detect_video.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -38,6 +38,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
+  AddBackgroundOption(cmd, o->background);
   cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (-1: all)")
       ->check(CLI::Validator(
           [](const std::string& v) -> std::string {
@@ -55,7 +56,8 @@ void Setup(CLI::App& app, int& exit_code) {
     FV_REQUIRE(
         o->field.empty() || (!o->camera.empty() && camera::ReadCameraYaml(o->camera).has_pose),
         "detect: --field needs --camera with a pose (the field is found through it)");
-    util::CheckOutputPath(o->out, util::PathList(o->video, o->camera, o->field, o->detector.colour));
+    util::CheckOutputPath(o->out,
+                          util::PathList(o->video, o->camera, o->field, o->detector.colour));
     const auto inputs = util::PathList(o->video, o->camera, o->field, o->out);
     if (io::IsVideoName(o->draw)) {
       io::CheckVideoOutput(o->draw, inputs, "--draw");

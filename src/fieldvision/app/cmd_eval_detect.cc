@@ -38,6 +38,7 @@ void Setup(CLI::App& app, int& exit_code) {
   AddBallColourOption(cmd, o->detector.colour);
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
+  AddBackgroundOption(cmd, o->background);
   cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")
       ->capture_default_str();
   cmd->add_option("--list", o->list_misses, "Misses and false detections to list")

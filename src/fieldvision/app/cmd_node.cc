@@ -5,6 +5,7 @@
 
 #include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
+#include "fieldvision/app/detector_options.h"
 #include "fieldvision/app/stop_on_signal.h"
 #include "fieldvision/net/node.h"
 #include "fieldvision/util/error.h"
@@ -57,6 +58,7 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Ignore the fusion node's hints (where the cameras together saw the ball); by "
                 "default the camera looks there when its own track lost the ball or follows "
                 "something else, as the offline `ball` does");
+  AddBackgroundOption(cmd, o->background);
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
     pipeline::JobControl control;

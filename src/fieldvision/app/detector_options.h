@@ -46,6 +46,14 @@ inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
       ->capture_default_str();
 }
 
+// `--no-background`: the static camera's background is not used (detect/camera_background.h).
+inline void AddBackgroundOption(CLI::App* cmd, bool& background) {
+  cmd->add_flag(
+      "!--no-background", background,
+      "Do not compare low-contrast candidates with the camera's background (the median of "
+      "frames sampled from its video's first minute; videos of posed, static cameras)");
+}
+
 // `auto_for_stills`: the command reads still images too and offers (and defaults to) `auto`,
 // which ResolveAutoDetector settles.
 inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,

@@ -125,8 +125,10 @@ double LeastContrastFactor(const BallRegion& r, const BallDetectorOptions& o) {
 
 // Whether a measured region stands out from its surroundings: by its colour difference
 // (min_contrast), by its hue difference alone (min_hue_contrast) or, against a neutral surround,
-// by its chroma (min_chroma_contrast); less on the field.
+// by its chroma (min_chroma_contrast), less on the field; or it stands apart from the camera's
+// background.
 bool StandsOut(const BallRegion& r, const BallDetectorOptions& o) {
+  if (r.apart_from_background) return true;
   const double f = LeastContrastFactor(r, o);
   const bool neutral_ring = r.ring_chroma <= o.max_neutral_ring_chroma &&
                             r.ring_lightness >= o.min_neutral_ring_lightness;
@@ -432,6 +434,7 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
     std::optional<BallCandidate> cand = EvaluateBlob(bgr, *blob, roi, &measured, &result.refined);
     if (cand) result.candidates.push_back(std::move(*cand));
   }
+  AddApartInRejected(bgr, roi, &result.candidates);
   std::optional<FieldBoundary> boundary;
   RejectOffField(bgr, roi, &boundary, &result.candidates);
   // Every check of the blobs' candidates first: small balls are looked for when none is left.
@@ -444,7 +447,75 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   }
   RankAndDropDuplicates(&result.candidates);
   OnFieldFirst(bgr, roi, &boundary, &result.candidates);
+  ApartFirst(bgr, roi, &result.candidates);
   return result;
+}
+
+void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
+                                      std::vector<BallCandidate>* candidates) const {
+  if (!background_) return;
+  constexpr int kMaxLooks = 4;  // rejected regions looked into per frame, largest first
+  constexpr double kMergedRatio = 1.5;
+  constexpr double kMergedSigmaRadii = 0.1;  // low-sun statics 0.05 / 0.1 / 0.2 alike
+  std::vector<const BallCandidate*> rejected;
+  for (const BallCandidate& c : *candidates) {
+    if (!c.accepted && c.radius_px >= options_.min_radius_px) rejected.push_back(&c);
+  }
+  if (rejected.empty()) return;
+  std::sort(rejected.begin(), rejected.end(), [](const BallCandidate* a, const BallCandidate* b) {
+    return a->radius_px > b->radius_px;
+  });
+  rejected.resize(std::min<size_t>(rejected.size(), kMaxLooks));
+  const Background* background = background_();
+  if (background == nullptr) return;
+  std::vector<BallCandidate> found;
+  for (const BallCandidate* c : rejected) {
+    const double reach = 1.5 * c->radius_px + 2;
+    const cv::Rect box(static_cast<int>(std::floor(c->centre_px.x() - reach)),
+                       static_cast<int>(std::floor(c->centre_px.y() - reach)),
+                       static_cast<int>(std::ceil(2 * reach)) + 1,
+                       static_cast<int>(std::ceil(2 * reach)) + 1);
+    const std::optional<Background::Circle> disc = background->ChangedDisc(bgr, box, roi);
+    // What changed must be well inside the region (a ball and what it merged with): a region of
+    // the changed part's own size (a blurred or partly hidden ball) is the tracker's guided fit's
+    // to find, seeded where the ball is expected.
+    if (!disc || disc->radius_px < options_.min_radius_px ||
+        c->radius_px < kMergedRatio * disc->radius_px) {
+      continue;
+    }
+    std::optional<BallCandidate> fit = FitAt(bgr, roi, disc->centre_px, disc->radius_px);
+    if (!fit || !background->Compare(bgr, fit->centre_px, fit->radius_px, roi).apart) continue;
+    const auto same = [&](const BallCandidate& b) {
+      return (b.centre_px - fit->centre_px).norm() < std::max(b.radius_px, 2.0);
+    };
+    if (std::any_of(candidates->begin(), candidates->end(),
+                    [&](const BallCandidate& b) { return b.accepted && same(b); }) ||
+        std::any_of(found.begin(), found.end(), same)) {
+      continue;
+    }
+    fit->guided = false;
+    fit->apart_from_background = true;
+    // Fitted beside a neighbour of its colour: part of its outline is that neighbour's.
+    fit->sigma_px = std::max(fit->sigma_px, kMergedSigmaRadii * fit->radius_px);
+    found.push_back(*fit);
+  }
+  candidates->insert(candidates->end(), found.begin(), found.end());
+}
+
+void BallDetector::ApartFirst(const cv::Mat& bgr, const cv::Rect& roi,
+                              std::vector<BallCandidate>* candidates) const {
+  if (!background_) return;
+  const auto accepted_end = std::find_if(candidates->begin(), candidates->end(),
+                                         [](const BallCandidate& c) { return !c.accepted; });
+  if (accepted_end - candidates->begin() < 2) return;
+  const Background* background = background_();
+  if (background == nullptr) return;
+  for (auto it = candidates->begin(); it != accepted_end; ++it) {
+    it->apart_from_background = it->apart_from_background ||
+                                background->Compare(bgr, it->centre_px, it->radius_px, roi).apart;
+  }
+  std::stable_partition(candidates->begin(), accepted_end,
+                        [](const BallCandidate& c) { return c.apart_from_background; });
 }
 
 void BallDetector::OnFieldFirst(const cv::Mat& bgr, const cv::Rect& roi,
@@ -607,7 +678,21 @@ std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, cons
                fit.radius_px + 1.5, fit.radius_px + 3.5, &visible, &leak);
     fit_why = OutlineProblem(fit, visible, leak, o);
   }
+  BallCandidate if_apart = cand;  // as Decide finds it
   Decide(region, fit, fit_why, visible, leak, &cand);
+  if (!cand.accepted && region.ok && background_ && !StandsOut(region, o)) {
+    // Rejected, with a region that does not stand out by colour: if standing out would have
+    // accepted it, the background decides.
+    BallRegion apart = region;
+    apart.apart_from_background = true;
+    Decide(apart, fit, fit_why, visible, leak, &if_apart);
+    const Background* background = if_apart.accepted ? background_() : nullptr;
+    if (background != nullptr &&
+        background->Compare(bgr, if_apart.centre_px, if_apart.radius_px, roi).apart) {
+      if_apart.apart_from_background = true;
+      cand = std::move(if_apart);
+    }
+  }
   return cand;
 }
 

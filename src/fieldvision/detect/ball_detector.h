@@ -7,6 +7,7 @@
 // al., IROS 2000; B-Human's ball perceptor).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/camera/camera.h"
+#include "fieldvision/detect/background.h"
 #include "fieldvision/detect/ball_fit.h"
 #include "fieldvision/detect/ball_region.h"
 #include "fieldvision/detect/blobs.h"
@@ -76,6 +78,9 @@ struct BallCandidate {
   // The share of a ring just around it that is field (BallDetector::FieldShare), where "both"
   // measured it for its keep rule (DnnBallOptions::keep_field_share); -1 elsewhere.
   double field_share = -1.0;
+  // It stands apart from the camera's background (background.h); measured only where the colour
+  // contrast was low or several candidates were accepted (BallDetector::SetBackground).
+  bool apart_from_background = false;
   std::string reason;  // why rejected ("" when accepted)
 };
 
@@ -221,6 +226,10 @@ struct BallDetectionResult {
   std::string Summary() const;
 };
 
+// A static camera's background (background.h), built on the first call; null when there is none
+// or it is not usable. Must be safe to call from several threads.
+using BackgroundFn = std::function<const Background*()>;
+
 class BallDetector {
  public:
   // camera: null for an uncalibrated camera (no size check, no field mask, pixel-space fit);
@@ -249,6 +258,11 @@ class BallDetector {
   // frame); nullopt when no outline agrees.
   std::optional<BallCandidate> FitAt(const cv::Mat& bgr, const cv::Rect& region,
                                      const Eigen::Vector2d& centre_px, double radius_px) const;
+  // A region that does not stand out from its surroundings by colour (min_contrast and the
+  // others) is still taken as standing out when it stands apart from the camera's background, and
+  // among several accepted candidates those apart from it go first; `background` is called only
+  // then. Set before detecting, not during.
+  void SetBackground(BackgroundFn background) { background_ = std::move(background); }
   const BallDetectorOptions& options() const { return options_; }
   const ColourTable& table() const { return *table_; }
   // The field's far edge the off-field check uses in `region` of a frame (field_boundary.h); no
@@ -304,6 +318,18 @@ class BallDetector {
   // the field (without a posed camera).
   void OnFieldFirst(const cv::Mat& bgr, const cv::Rect& roi, std::optional<FieldBoundary>* boundary,
                     std::vector<BallCandidate>* candidates) const;
+  // With a background (SetBackground): a rejected region (the largest few) may hold a ball that
+  // came into view merged with a board of its colour. The largest round part of its box that
+  // differs from the background (Background::ChangedDisc), if under 2/3 of the region's radius,
+  // seeds FitAt there; a fit that stands apart from the background is added, accepted. A region
+  // of the changed part's size is left to the tracker's guided fit: seeded from a blurred ball's
+  // changed streak, the fit was 1-2 px off (low-sun kick, seed 3).
+  void AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
+                          std::vector<BallCandidate>* candidates) const;
+  // With a background (SetBackground) and several accepted candidates, those that stand apart
+  // from it go first (a ball in play before still things of its colour and size).
+  void ApartFirst(const cv::Mat& bgr, const cv::Rect& roi,
+                  std::vector<BallCandidate>* candidates) const;
   // Rejects the accepted candidates darker than the field (min_lit_field_ratio).
   void RejectDarkerThanField(const cv::Mat& bgr, const cv::Rect& roi,
                              std::vector<BallCandidate>* candidates) const;
@@ -327,6 +353,7 @@ class BallDetector {
   void Decide(const BallRegion& region, const BallFit& fit, const std::string& fit_why,
               double visible, double leak, BallCandidate* cand) const;
   BallDetectorOptions options_;
+  BackgroundFn background_;
   const camera::Camera* camera_;
   const field::FieldModel* field_;
   std::shared_ptr<const ColourTable> table_;

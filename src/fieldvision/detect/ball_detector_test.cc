@@ -320,6 +320,111 @@ TEST(BallDetector, FitAtFindsABallMergedWithABoardOfItsColourWhereItIsExpected) 
   EXPECT_LT(errors.back(), 2.5);
 }
 
+// A camera's background (background.h): a disc that fails only the colour contrast is accepted
+// where it stands apart from the background, not where it stood in every sampled frame; among
+// accepted discs, the one apart from the background goes first.
+TEST(BallDetector, TheBackgroundAcceptsALowContrastBallThatCameIntoViewAndRanksItFirst) {
+  const uint64_t seed = fv::testing::TestSeed(29);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const cv::Mat base = test_util::FieldImage(320, 240, rng, 0.0);
+  const Eigen::Vector2d still(250, 60);
+  const auto frame_with = [&](const std::vector<Eigen::Vector2d>& balls, double r) {
+    cv::Mat f = base.clone();
+    for (const Eigen::Vector2d& c : balls) test_util::PaintDisc(f, c, r);
+    return test_util::WithNoise(f, rng, 2.0);
+  };
+  std::vector<cv::Mat> samples;
+  for (int i = 0; i < 7; ++i) {
+    samples.push_back(Background::Reduce(frame_with({{30 + 40.0 * i, 200}, still}, 9),
+                                         BackgroundOptions{}.scale));
+  }
+  const Background background(samples, base.size(), {});
+  ASSERT_TRUE(background.usable()) << background.Summary();
+  const Eigen::Vector2d ball(rng.Uniform(120, 180), rng.Uniform(100, 150));
+  const cv::Mat img = frame_with({ball, still}, 9);
+  const auto near = [](const BallCandidate& c, const Eigen::Vector2d& p) {
+    return (c.centre_px - p).norm() < 2;
+  };
+
+  BallDetectorOptions low;
+  low.min_contrast = 300;  // every region fails the contrast check
+  low.min_hue_contrast = 300;
+  low.min_chroma_contrast = 300;
+  BallDetector det(low, nullptr, nullptr);
+  EXPECT_EQ(Accepted(det.Detect(img)), 0);
+  det.SetBackground([&] { return &background; });
+  const std::vector<BallCandidate> found = det.Detect(img);
+  ASSERT_EQ(Accepted(found), 1);
+  EXPECT_TRUE(near(found[0], ball) && found[0].apart_from_background) << found[0].reason;
+  for (const BallCandidate& c : found) {
+    if (near(c, still)) EXPECT_NE(c.reason.find("contrast"), std::string::npos) << c.reason;
+  }
+  // No usable background: as without one.
+  det.SetBackground([] { return nullptr; });
+  EXPECT_EQ(Accepted(det.Detect(img)), 0);
+
+  // Both stand out: the still disc is larger and ranks first, until the background says which
+  // one came into view.
+  BallDetector ranked(BallDetectorOptions{}, nullptr, nullptr);
+  cv::Mat two = frame_with({ball}, 7);
+  test_util::PaintDisc(two, still, 9);
+  const std::vector<BallCandidate> plain = ranked.Detect(two);
+  ASSERT_EQ(Accepted(plain), 2);
+  EXPECT_TRUE(near(plain[0], still));
+  ranked.SetBackground([&] { return &background; });
+  const std::vector<BallCandidate> apart_first = ranked.Detect(two);
+  ASSERT_EQ(Accepted(apart_first), 2);
+  EXPECT_TRUE(near(apart_first[0], ball) && apart_first[0].apart_from_background);
+  EXPECT_FALSE(apart_first[1].apart_from_background);
+}
+
+// A ball in front of a board of its colour (one region, larger than a ball there) is found by the
+// background: the board stood there in every sampled frame, the ball did not. A camera 3 m above
+// the field looking straight down, the ball on the ground (10.55 px).
+TEST(BallDetector, TheBackgroundFindsABallMergedWithABoardOfItsColour) {
+  const uint64_t seed = fv::testing::TestSeed(31);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  camera::Camera cam = camera::Camera::FromFov(320, 240, 60.0);
+  cam.has_pose = true;
+  cam.cam_from_world.rotation = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  cam.cam_from_world.translation = Eigen::Vector3d(0, 0, 3);
+  BallDetectorOptions o;
+  o.max_height_m = 0.2;  // on the ground
+  const double r = cam.fx * 0.11 / (3 - 0.11);
+  const cv::Vec3b orange = test_util::kOrange;
+  int found_plain = 0, found = 0, off = 0;
+  constexpr int kTrials = 10;
+  for (int i = 0; i < kTrials; ++i) {
+    cv::Mat base = test_util::FieldImage(320, 240, rng, 0.0);
+    const Eigen::Vector2d c(rng.Uniform(120, 200), rng.Uniform(90, 150));
+    const cv::Rect board(int(c.x() + r / 3), int(c.y() - 3 * r), int(3 * r), int(6 * r));
+    cv::rectangle(base, board, cv::Scalar(orange[0], orange[1], orange[2]), cv::FILLED);
+    const auto noisy = [&](const cv::Mat& f) { return test_util::WithNoise(f, rng, 2.0); };
+    std::vector<cv::Mat> samples;
+    for (int k = 0; k < 7; ++k) samples.push_back(Background::Reduce(noisy(base.clone()), 2));
+    const Background background(samples, base.size(), {});
+    cv::Mat img = base.clone();
+    test_util::PaintDisc(img, c, r);
+    img = noisy(img);
+    BallDetector det(o, &cam, nullptr);
+    const auto on_ball = [&](const std::vector<BallCandidate>& cands) {
+      return !cands.empty() && cands[0].accepted && (cands[0].centre_px - c).norm() < 0.5 * r;
+    };
+    found_plain += on_ball(det.Detect(img));
+    det.SetBackground([&] { return &background; });
+    const std::vector<BallCandidate> cands = det.Detect(img);
+    if (!on_ball(cands)) continue;
+    ++found;
+    EXPECT_TRUE(cands[0].apart_from_background);
+    off += (cands[0].centre_px - c).norm() > 1.0 || std::abs(cands[0].radius_px - r) > 1.0;
+  }
+  EXPECT_LE(found_plain, 2);
+  EXPECT_GE(found, kTrials - 1);
+  EXPECT_LE(off, 1);
+}
+
 TEST(BallDetector, BadInputGivesErrors) {
   BallDetectorOptions o;
   o.scan_step_px = 0;

@@ -90,6 +90,9 @@ struct BallRegion {
   double solidity = 0.0;    // region area / convex hull area
   int outline_points = 0;   // convex outline points used by the circle fit
   int inliers = 0;
+  // Set by the detector: the disc differs from the camera's background where a ring around it does
+  // not (background.h), evidence of its own where the colour contrast is low.
+  bool apart_from_background = false;
   std::string Summary() const;
 };
 

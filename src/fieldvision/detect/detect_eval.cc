@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/detect/camera_background.h"
 #include "fieldvision/detect/eval_drawing.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/io/video_source.h"
@@ -389,6 +390,7 @@ std::string DetectEvalResult::Summary(int list) const {
     s += fmt::format("\n{} images have no label file (taken as images without a ball)",
                      no_label_file);
   }
+  if (!background.empty()) s += "\n" + background;
   if (!drawn_dir.empty()) {
     s += fmt::format("\ndrew {} misses and false detections in {}", drawn, drawn_dir);
   }
@@ -480,6 +482,24 @@ std::vector<LabelledImage> ListLabelledImages(const std::string& video,
   return items;
 }
 
+namespace {
+
+// --candidates: one row per candidate with its measurements, committed at the end.
+void OpenCandidatesCsv(const std::string& path, std::unique_ptr<util::AtomicOutput>* file,
+                       std::unique_ptr<util::CsvWriter>* csv) {
+  *file = std::make_unique<util::AtomicOutput>(path, "--candidates");
+  *csv = std::make_unique<util::CsvWriter>(
+      (*file)->temp_path(),
+      std::vector<std::string>{
+          "image",        "u",       "v",           "radius_px", "score",     "accepted", "weak",
+          "on_ball",      "visible", "inliers",     "outside",   "dents",     "region",   "arc",
+          "fill",         "spill",   "leak",        "contrast",  "outside_r", "extent",   "precise",
+          "hue_contrast", "network", "field_share", "rescued",   "apart",     "reason"},
+      4);
+}
+
+}  // namespace
+
 DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   o.Check();
   std::vector<LabelledImage> items = ListLabelledImages(o.video, o.labels, "eval detect");
@@ -516,23 +536,14 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
                o.camera);
     field = field::LoadField(o.field);
   }
-  const AnyBallDetector detector(o.detector, o.dnn, camera.get(), field ? &*field : nullptr);
+  AnyBallDetector detector(o.detector, o.dnn, camera.get(), field ? &*field : nullptr);
+  const auto background =
+      UseCameraBackground(o.background && video != nullptr, o.video, camera.get(), &detector);
 
   DetectEvalResult result;
   std::unique_ptr<util::AtomicOutput> cand_file;
   std::unique_ptr<util::CsvWriter> cand_csv;
-  if (!o.candidates_out.empty()) {
-    cand_file = std::make_unique<util::AtomicOutput>(o.candidates_out, "--candidates");
-    cand_csv = std::make_unique<util::CsvWriter>(
-        cand_file->temp_path(),
-        std::vector<std::string>{
-            "image",     "u",       "v",       "radius_px",    "score",   "accepted",
-            "weak",      "on_ball", "visible", "inliers",      "outside", "dents",
-            "region",    "arc",     "fill",    "spill",        "leak",    "contrast",
-            "outside_r", "extent",  "precise", "hue_contrast", "network", "field_share",
-            "rescued",   "reason"},
-        4);
-  }
+  if (!o.candidates_out.empty()) OpenCandidatesCsv(o.candidates_out, &cand_file, &cand_csv);
   util::Progress progress("eval detect", std::ssize(items), "images", o.progress);
   io::Frame frame;
   for (size_t i = 0; i < items.size(); ++i) {
@@ -560,7 +571,8 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
                   << c.inlier_fraction << c.outside_fraction << c.dents << int(c.region_ok)
                   << c.arc_cover << c.fill << c.spill << c.leak << c.contrast << c.region_outside
                   << c.region_extent << int(c.precise) << c.hue_contrast << c.network_score
-                  << c.field_share << int(c.rescued) << ReplaceCommas(c.reason);
+                  << c.field_share << int(c.rescued) << int(c.apart_from_background)
+                  << ReplaceCommas(c.reason);
         cand_csv->EndRow();
       }
     }
@@ -576,6 +588,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   }
   progress.Finish();
   result.seconds = progress.ElapsedSeconds();
+  result.background = NeededBackgroundSummary(background);
   if (drawings != nullptr) {
     result.drawn = drawings->written();
     result.drawn_dir = drawings->dir();

@@ -69,6 +69,9 @@ struct DetectEvalOptions {
   bool progress = true;
   BallDetectorOptions detector;
   DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
+  // A video from a posed (static) camera: low-contrast candidates are compared with its
+  // background (camera_background.h).
+  bool background = true;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -102,6 +105,7 @@ struct DetectEvalResult {
   int not_judged = 0;  // frames whose ball is less visible than LabelOptions::min_visible
   int drawn = 0;       // images drawn into DetectEvalOptions::draw_misses
   std::string drawn_dir;
+  std::string background;  // CameraBackground::Summary, "" when none was set up
   double seconds = 0.0;
   double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
   double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }

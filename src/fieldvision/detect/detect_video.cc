@@ -12,6 +12,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/codecs/codecs.h"
+#include "fieldvision/detect/camera_background.h"
 #include "fieldvision/field/field_draw.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
@@ -82,8 +83,9 @@ void DetectVideoOptions::Check() const {
 }
 
 std::string DetectVideoResult::Summary() const {
-  return fmt::format("{} frames, {} candidates, ball accepted in {} frames, {:.1f} frames/s",
-                     frames, candidates, frames_with_ball, seconds > 0 ? frames / seconds : 0.0);
+  return fmt::format("{} frames, {} candidates, ball accepted in {} frames, {:.1f} frames/s{}",
+                     frames, candidates, frames_with_ball, seconds > 0 ? frames / seconds : 0.0,
+                     background.empty() ? "" : "\n" + background);
 }
 
 void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates) {
@@ -122,8 +124,10 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   if (!o.field.empty()) field = field::LoadField(o.field);
   auto source = io::VideoSource::Open(o.video);
   if (camera) source->CheckMatchesCamera(*camera, o.camera);
-  const AnyBallDetector detector(o.detector, o.dnn, camera ? &*camera : nullptr,
-                                 field ? &*field : nullptr);
+  AnyBallDetector detector(o.detector, o.dnn, camera ? &*camera : nullptr,
+                           field ? &*field : nullptr);
+  const auto background =
+      UseCameraBackground(o.background, o.video, camera ? &*camera : nullptr, &detector);
   // Written beside --out and renamed over it at the end: a failed run leaves the old file.
   util::AtomicOutput out_file(o.out);
   util::CsvWriter csv(out_file.temp_path(),
@@ -191,6 +195,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   } else if (!draw_dir.empty()) {
     result.drawn = fmt::format("{} ({} JPEGs)", draw_dir, result.frames);
   }
+  result.background = NeededBackgroundSummary(background);
   out_file.CloseAndCommit(csv);
   return result;
 }

@@ -22,6 +22,9 @@ struct DetectVideoOptions {
   bool progress = true;
   BallDetectorOptions detector;
   DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
+  // A video from a posed (static) camera: low-contrast candidates are compared with its
+  // background (camera_background.h).
+  bool background = true;
   // Throws fv::Error naming the bad field.
   void Check() const;
 };
@@ -32,6 +35,7 @@ struct DetectVideoResult {
   int frames_with_ball = 0;  // frames with an accepted candidate
   double seconds = 0.0;
   std::string drawn;  // what --draw wrote (the video's path, frames and codec), "" when nothing
+  std::string background;  // CameraBackground::Summary, "" when none was set up
   std::string Summary() const;
 };
 

@@ -177,6 +177,8 @@ class AnyBallDetector {
   std::optional<BallCandidate> FitAt(const cv::Mat& bgr, const cv::Rect& region,
                                      const Eigen::Vector2d& centre_px, double radius_px) const;
   const BallDetector& colour() const { return *colour_; }
+  // The colour detector's background (BallDetector::SetBackground).
+  void SetBackground(BackgroundFn background) { colour_->SetBackground(std::move(background)); }
 
  private:
   std::vector<BallCandidate> FilterDnn(std::vector<BallCandidate> candidates) const;

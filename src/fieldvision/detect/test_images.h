@@ -28,6 +28,16 @@ inline void FillNormal(cv::Mat& m, util::Rng& rng, double mean, double sigma) {
   cv_rng.fill(m, cv::RNG::NORMAL, cv::Scalar::all(mean), cv::Scalar::all(sigma));
 }
 
+// `img` with Gaussian noise of `sigma` added (saturating).
+inline cv::Mat WithNoise(const cv::Mat& img, util::Rng& rng, double sigma) {
+  cv::Mat noise(img.size(), CV_16SC3), tmp, out;
+  FillNormal(noise, rng, 0, sigma);
+  img.convertTo(tmp, CV_16SC3);
+  tmp += noise;
+  tmp.convertTo(out, CV_8UC3);
+  return out;
+}
+
 // A grass-green image with mowing stripes, a few white lines and Gaussian noise.
 inline cv::Mat FieldImage(int width, int height, util::Rng& rng, double noise_sigma = 2.0) {
   cv::Mat img(height, width, CV_8UC3, cv::Scalar(kGrass[0], kGrass[1], kGrass[2]));
@@ -38,15 +48,7 @@ inline cv::Mat FieldImage(int width, int height, util::Rng& rng, double noise_si
            cv::LINE_AA);
   cv::line(img, {width / 2, 0}, {width / 2 + 30, height - 1}, cv::Scalar(235, 235, 235), 4,
            cv::LINE_AA);
-  if (noise_sigma > 0) {
-    cv::Mat noise(img.size(), CV_16SC3);
-    FillNormal(noise, rng, 0, noise_sigma);
-    cv::Mat tmp;
-    img.convertTo(tmp, CV_16SC3);
-    tmp += noise;
-    tmp.convertTo(img, CV_8UC3);
-  }
-  return img;
+  return noise_sigma > 0 ? WithNoise(img, rng, noise_sigma) : img;
 }
 
 // `img` encoded as a JPEG of this quality and decoded again (4:2:0 chroma, block artefacts).

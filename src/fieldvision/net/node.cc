@@ -19,6 +19,7 @@
 
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/camera_background.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/net/clock_sync.h"
@@ -404,6 +405,12 @@ NodeSummary RunNode(const NodeOptions& o) {
   const detect::BallDetectorOptions dopt =
       pipeline::TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   auto detector = std::make_shared<detect::BallDetector>(dopt, &camera, field ? &*field : nullptr);
+  if (o.background && o.detect && !o.realtime && !source->live() && source->FrameCount() > 0) {
+    auto background =
+        std::make_shared<detect::CameraBackground>(o.video, detect::CameraBackgroundOptions{});
+    background->Start();
+    detector->SetBackground(detect::CameraBackground::FnFor(background));
+  }
   pipeline::CameraStage stage(0, camera, pipeline::BallDetectFnFor(detector), o.track, o.video,
                               pipeline::BallGuidedFnFor(detector));
   if (o.detect) {

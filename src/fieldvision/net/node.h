@@ -36,6 +36,9 @@ struct NodeOptions {
   // pipeline/ball_hints.h) puts it when its own track has lost it or follows something else, as
   // the offline `ball` does.
   bool hints = true;
+  // A file read as fast as possible (not realtime, not live): low-contrast candidates are compared
+  // with the camera's background (detect/camera_background.h), as the offline `ball` does.
+  bool background = true;
   double connect_wait_s = 5;  // wait this long for the fusion node's first clock reply
   double ping_interval_s = 0.5;
   // Added to this node's clock: simulates a machine whose clock is off (tests, benchmarks).

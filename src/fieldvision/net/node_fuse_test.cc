@@ -90,6 +90,7 @@ std::map<long long, Row> OfflineBall(const Scene& scene) {
   // and the fusion node streams each frame's position (no end-of-clip flight bundle).
   job.pipeline.hints = false;
   job.bundle = false;
+  job.background = false;  // nodes playing a file in real time cannot sample it ahead
   pipeline::RunBallJob(job);
   return ReadBall(job.out);
 }

@@ -46,6 +46,7 @@ void BallJobOptions::Check() const {
   FV_REQUIRE(sync == "frame" || sync == "time", "ball: --sync must be 'frame' or 'time' (got '{}')",
              sync);
   dnn.Check();
+  background_options.Check();
   pipeline.Check();
   eval.Check();
   FV_REQUIRE(std::isfinite(bundle_sigma_px) && bundle_sigma_px > 0,
@@ -207,9 +208,16 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   const detect::BallDetectorOptions dopt = TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   std::vector<BallRegionDetectFn> detect_fns;
   std::vector<BallGuidedFn> guided_fns;
+  std::vector<std::shared_ptr<detect::CameraBackground>> backgrounds;
   for (int c = 0; c < n; ++c) {
     auto detector = std::make_shared<detect::AnyBallDetector>(dopt, o.dnn, &cameras[c],
                                                               field ? &*field : nullptr);
+    if (o.background && !o.live) {
+      backgrounds.push_back(
+          std::make_shared<detect::CameraBackground>(o.videos[c], o.background_options));
+      detector->SetBackground(detect::CameraBackground::FnFor(backgrounds.back()));
+      backgrounds.back()->Start();  // nearly every video asks for it (boards, far balls)
+    }
     detect_fns.push_back(BallDetectFnFor(detector));
     guided_fns.push_back(BallGuidedFnFor(detector));
   }
@@ -282,6 +290,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
     csv.Close();
   });
   for (size_t c = 0; c < det_files.size(); ++c) det_files[c]->CloseAndCommit(*det_csvs[c]);
+  for (const auto& b : backgrounds) result.backgrounds.push_back(b->Summary());
   if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);
   return result;
 }

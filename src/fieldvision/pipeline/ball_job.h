@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fieldvision/detect/ball_detector.h"
+#include "fieldvision/detect/camera_background.h"
 #include "fieldvision/detect/dnn_ball.h"
 #include "fieldvision/pipeline/ball_pipeline.h"
 #include "fieldvision/pipeline/detections_job.h"
@@ -38,6 +39,10 @@ struct BallJobOptions {
   // "frame" pairs frames by index; "time" by timestamps (the CSVs, else the container's).
   std::string sync = "frame";
   bool live = false;  // keep the newest messages (drop the oldest) instead of blocking
+  // Offline (not live): a low-contrast candidate that stands apart from its camera's background
+  // is taken as standing out (camera_background.h; a static camera's view).
+  bool background = true;
+  detect::CameraBackgroundOptions background_options;
   BallPipelineOptions pipeline;
   recon::BallEvalOptions eval;
   void Check() const;  // throws fv::Error naming the bad option
@@ -47,7 +52,8 @@ struct BallJobResult {
   BallPipelineSummary summary;
   std::optional<recon::BallEvalResult> eval;  // when a truth file was given
   long long rows_written = 0;
-  std::optional<FlightBundle> bundle;  // offline with `bundle`
+  std::optional<FlightBundle> bundle;    // offline with `bundle`
+  std::vector<std::string> backgrounds;  // per camera, CameraBackground::Summary (with background)
 };
 
 BallJobResult RunBallJob(const BallJobOptions& options);

@@ -1,0 +1,97 @@
+#include "fieldvision/detect/camera_background.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv::detect {
+
+void CameraBackgroundOptions::Check() const {
+  background.Check();
+  CheckPositive(window_s, "window_s");
+}
+
+SampledFrames SampleFrames(io::FrameSource* source, int samples, double window_s, int scale) {
+  SampledFrames out;
+  const long long count = source->FrameCount();
+  if (count <= 0 || samples <= 0) return out;
+  const double fps = source->fps() > 0 ? source->fps() : 30.0;
+  const long long span = std::min(count, std::max(1LL, std::llround(window_s * fps)));
+  const int n = static_cast<int>(std::min<long long>(samples, span));
+  long long next_sample = 0;
+  cv::Mat bgr;  // decoded into the same buffer each time (fresh pages cost more than decoding)
+  for (long long f = 0; f < span && std::ssize(out.reduced) < n; ++f) {
+    // Sample k is frame round(k (span - 1) / (n - 1)).
+    if (f == next_sample) {
+      long long frame = 0;
+      double t = 0.0;
+      if (!source->Read(&bgr, &frame, &t)) break;
+      out.reduced.push_back(Background::Reduce(bgr, scale));
+      const double taken = static_cast<double>(out.reduced.size());
+      next_sample = n > 1 ? std::llround(taken * static_cast<double>(span - 1) / (n - 1)) : span;
+    } else if (!source->SkipFrame()) {
+      break;
+    }
+  }
+  return out;
+}
+
+CameraBackground::CameraBackground(std::string spec, const CameraBackgroundOptions& options)
+    : spec_(std::move(spec)), options_(options) {
+  options_.Check();
+}
+
+void CameraBackground::Start() {
+  if (!started_.valid()) started_ = std::async(std::launch::async, [this] { Build(); });
+}
+
+const Background* CameraBackground::Get() {
+  Build();
+  std::lock_guard<std::mutex> lock(mutex_);
+  used_ = true;
+  return background_ && background_->usable() ? &*background_ : nullptr;
+}
+
+void CameraBackground::Build() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!tried_) {
+    tried_ = true;
+    try {
+      io::FrameSourceOptions so;
+      so.encoded = true;  // skipped frames are not decoded
+      auto source = io::OpenFrameSource(spec_, so);
+      const SampledFrames sampled = SampleFrames(source.get(), options_.background.samples,
+                                                 options_.window_s, options_.background.scale);
+      sampled_ = static_cast<int>(sampled.reduced.size());
+      if (source->FrameCount() <= 0) {
+        why_none_ = "a live source: no frames to sample ahead";
+      } else if (sampled_ < 3) {
+        why_none_ = fmt::format("{} frames to sample", sampled_);
+      } else {
+        background_.emplace(sampled.reduced, source->FrameSize(), options_.background);
+        if (!background_->usable()) why_none_ = background_->Summary();
+      }
+    } catch (const std::exception& e) {  // fv::Error, or OpenCV's from a damaged frame
+      why_none_ = e.what();
+    }
+  }
+}
+
+BackgroundFn CameraBackground::FnFor(std::shared_ptr<CameraBackground> self) {
+  return [self = std::move(self)]() { return self->Get(); };
+}
+
+std::string CameraBackground::Summary() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!used_) return kNotNeeded;
+  if (background_ && background_->usable()) {
+    return fmt::format("{} from {} frames", background_->Summary(), sampled_);
+  }
+  return "no background: " + why_none_;
+}
+
+}  // namespace fv::detect
