@@ -1,6 +1,6 @@
 // The background of a static camera: the per-pixel median of frames sampled across its video (a
-// moving ball is in few of them) and the frame-to-background noise (the median over the image of
-// each pixel's largest channel difference). A ball hardly set apart from its surroundings by
+// moving ball is in few of them) and the frame-to-background noise (the median of the samples'
+// per-channel differences from it). A ball hardly set apart from its surroundings by
 // colour (a shaded ball before grey stands, an olive ball against the sun) still differs from
 // what lies behind it: a disc that differs from the background where a ring around it does not
 // is a thing of that size that came into view. A still ball, a moving or refocusing camera and a
@@ -28,15 +28,15 @@ struct BackgroundOptions {
   // Frames kept reduced by this factor (1 or 2): a quarter of the memory and of the median's work
   // at 2; a ball of 4 px radius is then a disc of 2.
   int scale = 2;
-  // A pixel differs from the background by at least min_difference (largest channel, 0..255) and
-  // noise_factor times the frame-to-background noise.
+  // A pixel differs from the background when one of its channels differs by at least
+  // min_difference (0..255) and noise_factor times the frame-to-background noise.
   double min_difference = 12.0;
   double noise_factor = 6.0;
-  // A camera whose sampled frames differ from their median by more than max_noise (the median
-  // over the image, largest channel) or on more than max_changed_share of the image (on average)
-  // moves or changes exposure: no usable background. A static camera's noise is its sensor's and
-  // its codec's (the renders: 2-4; a panning camera over stands: 13).
-  double max_noise = 10.0;
+  // A camera whose sampled frames differ from their median by more than max_noise (the median of
+  // their per-channel differences) or on more than max_changed_share of their values moves or
+  // changes exposure: no usable background. A static camera's noise is its sensor's and its
+  // codec's, halved by the reduction (the renders: 1-3; a camera panning over stands: 6).
+  double max_noise = 5.0;
   double max_changed_share = 0.2;
   // A disc apart from the background: at least min_disc_share of the disc (0.8 of the radius)
   // differs from it and at most max_ring_share of a ring (1.5..2.2 radii) does. A ball's shadow
@@ -62,17 +62,17 @@ class Background {
  public:
   // From at least 3 BGR frames of one size, each reduced by options.scale (Reduce) from frames
   // of `full_size`; throws fv::Error otherwise.
-  Background(const std::vector<cv::Mat>& reduced_frames, const cv::Size& full_size,
+  Background(std::vector<cv::Mat> reduced_frames, const cv::Size& full_size,
              const BackgroundOptions& options);
   // A frame as the background keeps it: reduced by `scale` (area averaging; odd edges dropped).
   static cv::Mat Reduce(const cv::Mat& bgr, int scale);
   // Whether the sampled frames agree enough for a background (a static camera, steady light).
   bool usable() const { return usable_; }
-  // Frame-to-background noise (largest channel difference, median over the image) and the
-  // difference a changed pixel shows at least.
+  // Frame-to-background noise (the median of the samples' per-channel differences) and the
+  // difference a changed pixel shows in a channel at least.
   double noise() const { return noise_; }
   double threshold() const { return threshold_; }
-  // Average share of the image that differs from the background in the sampled frames.
+  // Share of the sampled frames' values (pixels and channels) that differ from the background.
   double changed_share() const { return changed_share_; }
   const cv::Mat& image() const { return image_; }  // reduced by options.scale
   int scale() const { return options_.scale; }

@@ -64,15 +64,15 @@ void CameraBackground::Build() {
       io::FrameSourceOptions so;
       so.encoded = true;  // skipped frames are not decoded
       auto source = io::OpenFrameSource(spec_, so);
-      const SampledFrames sampled = SampleFrames(source.get(), options_.background.samples,
-                                                 options_.window_s, options_.background.scale);
+      SampledFrames sampled = SampleFrames(source.get(), options_.background.samples,
+                                           options_.window_s, options_.background.scale);
       sampled_ = static_cast<int>(sampled.reduced.size());
       if (source->FrameCount() <= 0) {
         why_none_ = "a live source: no frames to sample ahead";
       } else if (sampled_ < 3) {
         why_none_ = fmt::format("{} frames to sample", sampled_);
       } else {
-        background_.emplace(sampled.reduced, source->FrameSize(), options_.background);
+        background_.emplace(std::move(sampled.reduced), source->FrameSize(), options_.background);
         if (!background_->usable()) why_none_ = background_->Summary();
       }
     } catch (const std::exception& e) {  // fv::Error, or OpenCV's from a damaged frame
