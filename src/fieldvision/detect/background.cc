@@ -213,7 +213,7 @@ std::optional<Background::Circle> Background::ChangedDisc(const cv::Mat& bgr, co
 std::string Background::Summary() const {
   return fmt::format(
       "background {}x{} (1/{} scale): noise {:.0f}, changed at {:.0f}, {:.1f} % of "
-      "the samples changed{}",
+      "the sampled values changed{}",
       image_.cols, image_.rows, options_.scale, noise_, threshold_, 100 * changed_share_,
       usable_ ? "" : " (not usable: the camera moves or the light changes)");
 }
