@@ -62,7 +62,7 @@ cv::Mat Background::Reduce(const cv::Mat& bgr, int scale) {
   return out;
 }
 
-Background::Background(std::vector<cv::Mat> frames, const cv::Size& full_size,
+Background::Background(std::vector<cv::Mat>&& frames, const cv::Size& full_size,
                        const BackgroundOptions& options)
     : options_(options), full_size_(full_size) {
   options_.Check();
@@ -106,11 +106,11 @@ bool Background::Changed(const cv::Vec3b& a, const cv::Vec3b& b) const {
 
 BackgroundEvidence Background::Compare(const cv::Mat& bgr, const Eigen::Vector2d& centre_px,
                                        double radius_px, const cv::Rect& roi) const {
-  FV_REQUIRE(bgr.type() == CV_8UC3 && bgr.size() == full_size_,
-             "frame of {}x{} compared with a background of {}x{}", bgr.cols, bgr.rows,
-             full_size_.width, full_size_.height);
+  FV_REQUIRE(bgr.type() == CV_8UC3, "background: the frame must be 8-bit BGR");
   BackgroundEvidence out;
-  if (!usable_ || !(radius_px > 0) || !centre_px.allFinite()) return out;
+  // A frame of another size than the sampled video's says nothing against it.
+  if (bgr.size() != full_size_ || !usable_ || !(radius_px > 0) || !centre_px.allFinite())
+    return out;
   const int k = options_.scale;
   const Eigen::Vector2d c = (centre_px + Eigen::Vector2d::Constant(0.5)) / k -
                             Eigen::Vector2d::Constant(0.5);  // pixel centres
@@ -170,12 +170,11 @@ cv::Rect Background::ReducedInside(const cv::Rect& box, const cv::Rect& roi) con
 
 std::optional<Background::Circle> Background::ChangedDisc(const cv::Mat& bgr, const cv::Rect& box,
                                                           const cv::Rect& roi) const {
-  FV_REQUIRE(bgr.type() == CV_8UC3 && bgr.size() == full_size_,
-             "frame of {}x{} compared with a background of {}x{}", bgr.cols, bgr.rows,
-             full_size_.width, full_size_.height);
+  FV_REQUIRE(bgr.type() == CV_8UC3, "background: the frame must be 8-bit BGR");
   const int k = options_.scale;
   const cv::Rect reduced = ReducedInside(box, roi);
-  if (!usable_ || reduced.width < 3 || reduced.height < 3) return std::nullopt;
+  if (bgr.size() != full_size_ || !usable_ || reduced.width < 3 || reduced.height < 3)
+    return std::nullopt;
   const cv::Mat frame =
       Reduce(bgr(cv::Rect(reduced.x * k, reduced.y * k, reduced.width * k, reduced.height * k)), k);
   cv::Mat changed(reduced.size(), CV_8U);

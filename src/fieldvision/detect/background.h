@@ -62,7 +62,8 @@ class Background {
  public:
   // From at least 3 BGR frames of one size, each reduced by options.scale (Reduce) from frames
   // of `full_size`; throws fv::Error otherwise.
-  Background(std::vector<cv::Mat> reduced_frames, const cv::Size& full_size,
+  // The frames' pixels are sorted in place (moved in: a copied cv::Mat would share them).
+  Background(std::vector<cv::Mat>&& reduced_frames, const cv::Size& full_size,
              const BackgroundOptions& options);
   // A frame as the background keeps it: reduced by `scale` (area averaging; odd edges dropped).
   static cv::Mat Reduce(const cv::Mat& bgr, int scale);
@@ -78,7 +79,7 @@ class Background {
   int scale() const { return options_.scale; }
   // The disc (centre_px, 0.8 radius_px) and ring (1.5..2.2 radius_px) of `bgr` (the background's
   // size) against the background, reading only pixels inside `roi` (empty: the frame). Not apart
-  // when the background is not usable or too few pixels were read.
+  // when the background is not usable, the frame is not of its size or too few pixels were read.
   BackgroundEvidence Compare(const cv::Mat& bgr, const Eigen::Vector2d& centre_px, double radius_px,
                              const cv::Rect& roi = cv::Rect()) const;
   // The largest part of `box` (full-resolution pixels, clipped to roi) that differs from the

@@ -139,23 +139,26 @@ TEST(Background, BadInputThrows) {
   const Scene s = MakeScene(rng, 3, false);
   const auto reduced = Reduced(s.frames, 2);
   EXPECT_NE(fv::testing::ErrorOf([&] {
-              Background(std::vector<cv::Mat>(reduced.begin(), reduced.begin() + 2), s.base.size(),
-                         {});
+              Background(std::vector<cv::Mat>{reduced[0], reduced[1]}, s.base.size(), {});
             }).find("at least 3 frames"),
             std::string::npos);
-  EXPECT_NE(
-      fv::testing::ErrorOf([&] { Background(reduced, cv::Size(640, 480), {}); }).find("160x120"),
-      std::string::npos);
+  EXPECT_NE(fv::testing::ErrorOf([&] {
+              Background(Reduced(s.frames, 2), cv::Size(640, 480), {});
+            }).find("160x120"),
+            std::string::npos);
   BackgroundOptions o;
   o.scale = 3;
   EXPECT_NE(fv::testing::ErrorOf([&] { o.Check(); }).find("scale"), std::string::npos);
   o = {};
   o.samples = 2;
   EXPECT_NE(fv::testing::ErrorOf([&] { o.Check(); }).find("samples"), std::string::npos);
-  const Background bg(reduced, s.base.size(), {});
+  const Background bg(Reduced(s.frames, 2), s.base.size(), {});
+  // A frame of another size: no evidence, no error; a frame not BGR: an error.
+  EXPECT_FALSE(bg.Compare(cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(0)), {5, 5}, 2).apart);
+  EXPECT_FALSE(bg.ChangedDisc(cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(0)), {0, 0, 10, 10}));
   EXPECT_NE(fv::testing::ErrorOf([&] {
-              bg.Compare(cv::Mat(10, 10, CV_8UC3), {5, 5}, 2);
-            }).find("compared with a background of 320x240"),
+              bg.Compare(cv::Mat(240, 320, CV_8UC1), {5, 5}, 2);
+            }).find("8-bit BGR"),
             std::string::npos);
   EXPECT_FALSE(bg.Compare(s.frames[0], {std::nan(""), 5}, 4).apart);
 }

@@ -339,7 +339,7 @@ TEST(BallDetector, TheBackgroundAcceptsALowContrastBallThatCameIntoViewAndRanksI
     samples.push_back(Background::Reduce(frame_with({{30 + 40.0 * i, 200}, still}, 9),
                                          BackgroundOptions{}.scale));
   }
-  const Background background(samples, base.size(), {});
+  const Background background(std::move(samples), base.size(), {});
   ASSERT_TRUE(background.usable()) << background.Summary();
   const Eigen::Vector2d ball(rng.Uniform(120, 180), rng.Uniform(100, 150));
   const cv::Mat img = frame_with({ball, still}, 9);
@@ -347,11 +347,21 @@ TEST(BallDetector, TheBackgroundAcceptsALowContrastBallThatCameIntoViewAndRanksI
     return (c.centre_px - p).norm() < 2;
   };
 
-  BallDetectorOptions low;
-  low.min_contrast = 300;  // every region fails the contrast check
-  low.min_hue_contrast = 300;
-  low.min_chroma_contrast = 300;
-  BallDetector det(low, nullptr, nullptr);
+  // The contrasts asked just above the ball's own (it comes within 0.9 of them): every region
+  // fails the contrast check, and the ball comes near enough for the background to decide.
+  const std::vector<BallCandidate> plain_low = BallDetector({}, nullptr, nullptr).Detect(img);
+  const auto on_ball = std::find_if(plain_low.begin(), plain_low.end(),
+                                    [&](const BallCandidate& c) { return near(c, ball); });
+  ASSERT_NE(on_ball, plain_low.end());
+  const auto asking = [&](double share) {
+    BallDetectorOptions o;
+    o.field_contrast_factor = 1.0;  // the same asked on the grass
+    o.min_contrast = on_ball->contrast / share;
+    o.min_hue_contrast = on_ball->hue_contrast / share;
+    o.min_chroma_contrast = std::abs(on_ball->chroma_contrast) / share;
+    return o;
+  };
+  BallDetector det(asking(0.9), nullptr, nullptr);
   EXPECT_EQ(Accepted(det.Detect(img)), 0);
   det.SetBackground([&] { return &background; });
   const std::vector<BallCandidate> found = det.Detect(img);
@@ -360,9 +370,13 @@ TEST(BallDetector, TheBackgroundAcceptsALowContrastBallThatCameIntoViewAndRanksI
   for (const BallCandidate& c : found) {
     if (near(c, still)) EXPECT_NE(c.reason.find("contrast"), std::string::npos) << c.reason;
   }
-  // No usable background: as without one.
+  // No usable background: as without one; a ball far from the contrast asked (half of it): the
+  // background does not decide.
   det.SetBackground([] { return nullptr; });
   EXPECT_EQ(Accepted(det.Detect(img)), 0);
+  BallDetector far(asking(0.5), nullptr, nullptr);
+  far.SetBackground([&] { return &background; });
+  EXPECT_EQ(Accepted(far.Detect(img)), 0);
 
   // Both stand out: the still disc is larger and ranks first, until the background says which
   // one came into view.
@@ -404,7 +418,7 @@ TEST(BallDetector, TheBackgroundFindsABallMergedWithABoardOfItsColour) {
     const auto noisy = [&](const cv::Mat& f) { return test_util::WithNoise(f, rng, 2.0); };
     std::vector<cv::Mat> samples;
     for (int k = 0; k < 7; ++k) samples.push_back(Background::Reduce(noisy(base.clone()), 2));
-    const Background background(samples, base.size(), {});
+    const Background background(std::move(samples), base.size(), {});
     cv::Mat img = base.clone();
     test_util::PaintDisc(img, c, r);
     img = noisy(img);

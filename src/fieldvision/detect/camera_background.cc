@@ -23,16 +23,23 @@ SampledFrames SampleFrames(io::FrameSource* source, int samples, double window_s
   const long long span = std::min(count, std::max(1LL, std::llround(window_s * fps)));
   const int n = static_cast<int>(std::min<long long>(samples, span));
   long long next_sample = 0;
+  int tried = 0;
   cv::Mat bgr;  // decoded into the same buffer each time (fresh pages cost more than decoding)
-  for (long long f = 0; f < span && std::ssize(out.reduced) < n; ++f) {
+  for (long long f = 0; f < span && tried < n; ++f) {
     // Sample k is frame round(k (span - 1) / (n - 1)).
     if (f == next_sample) {
       long long frame = 0;
       double t = 0.0;
-      if (!source->Read(&bgr, &frame, &t)) break;
-      out.reduced.push_back(Background::Reduce(bgr, scale));
-      const double taken = static_cast<double>(out.reduced.size());
-      next_sample = n > 1 ? std::llround(taken * static_cast<double>(span - 1) / (n - 1)) : span;
+      try {
+        if (!source->Read(&bgr, &frame, &t)) break;
+        out.reduced.push_back(Background::Reduce(bgr, scale));
+      } catch (const Error&) {
+        ++out.unreadable;  // a damaged frame: the others still make a background
+      }
+      ++tried;
+      next_sample =
+          n > 1 ? std::llround(static_cast<double>(tried) * static_cast<double>(span - 1) / (n - 1))
+                : span;
     } else if (!source->SkipFrame()) {
       break;
     }
@@ -69,6 +76,10 @@ void CameraBackground::Build() {
       sampled_ = static_cast<int>(sampled.reduced.size());
       if (source->FrameCount() <= 0) {
         why_none_ = "a live source: no frames to sample ahead";
+      } else if (!source->encoded()) {
+        // Skipping a frame of H.264 and the like decodes it: sampling a minute would decode it
+        // all (8 s a camera at 1080p60).
+        why_none_ = "its frames are not Motion-JPEG or JPEG files (sampling would decode them all)";
       } else if (sampled_ < 3) {
         why_none_ = fmt::format("{} frames to sample", sampled_);
       } else {

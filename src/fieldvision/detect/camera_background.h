@@ -1,8 +1,9 @@
-// A file camera's background (detect/background.h) for its ball detector, built on first need:
-// BackgroundOptions::samples frames evenly across the video's first window_s seconds, read by a
-// source of its own. Only a detector's low-contrast candidates ask for it, so a video whose balls
-// stand out pays nothing. On a video longer than the window, a later change of light makes the
-// rings around balls differ too, and the colour checks alone decide there.
+// A file camera's background (detect/background.h) for its ball detector, built on first need
+// (or from Start): BackgroundOptions::samples frames evenly across the video's first window_s
+// seconds, read by a source of its own. Only videos whose frames skip without decoding
+// (Motion-JPEG, JPEG files) get one: skipping an H.264 frame decodes it. On a video longer than the
+// window, a later change of light makes the rings around balls differ too, and the colour checks
+// alone decide there.
 #pragma once
 
 #include <future>
@@ -27,6 +28,7 @@ struct CameraBackgroundOptions {
 // Frames sampled from a video, reduced for a Background.
 struct SampledFrames {
   std::vector<cv::Mat> reduced;  // Background::Reduce of each
+  int unreadable = 0;            // sampled frames that could not be decoded (left out)
 };
 // The samples of `source` (from its current position; FrameCount known) reduced by `scale`; fewer
 // than requested when the video is short, none without a frame count.

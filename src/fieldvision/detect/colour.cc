@@ -13,8 +13,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/detect/colour_cache.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::detect {
 namespace {
