@@ -377,6 +377,22 @@ TEST(BallDetector, TheBackgroundAcceptsALowContrastBallThatCameIntoViewAndRanksI
   BallDetector far(asking(0.5), nullptr, nullptr);
   far.SetBackground([&] { return &background; });
   EXPECT_EQ(Accepted(far.Detect(img)), 0);
+  // An accept by the background alone leaves the small-ball stage on: a far ball elsewhere is
+  // still found.
+  BallDetectorOptions with_small = asking(0.9);
+  with_small.small.mode = "on";
+  BallDetector small_det(with_small, nullptr, nullptr);
+  small_det.SetBackground([&] { return &background; });
+  cv::Mat with_far = img.clone();
+  const Eigen::Vector2d tiny(60, 50);
+  test_util::PaintDisc(with_far, tiny, 2.2, test_util::kOrange, 0.3);
+  const std::vector<BallCandidate> small_found = small_det.Detect(with_far);
+  EXPECT_TRUE(std::any_of(small_found.begin(), small_found.end(), [&](const BallCandidate& c) {
+    return c.accepted && c.small && (c.centre_px - tiny).norm() < 1.5;
+  }));
+  EXPECT_TRUE(std::any_of(small_found.begin(), small_found.end(), [&](const BallCandidate& c) {
+    return c.accepted && c.apart_from_background && near(c, ball);
+  }));
 
   // Both stand out: the still disc is larger and ranks first, until the background says which
   // one came into view.
