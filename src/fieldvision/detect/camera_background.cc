@@ -71,16 +71,20 @@ void CameraBackground::Build() {
       io::FrameSourceOptions so;
       so.encoded = true;  // skipped frames are not decoded
       auto source = io::OpenFrameSource(spec_, so);
-      SampledFrames sampled = SampleFrames(source.get(), options_.background.samples,
-                                           options_.window_s, options_.background.scale);
-      sampled_ = static_cast<int>(sampled.reduced.size());
       if (source->FrameCount() <= 0) {
         why_none_ = "a live source: no frames to sample ahead";
-      } else if (!source->encoded()) {
+        return;
+      }
+      if (!source->encoded()) {
         // Skipping a frame of H.264 and the like decodes it: sampling a minute would decode it
         // all (8 s a camera at 1080p60).
         why_none_ = "its frames are not Motion-JPEG or JPEG files (sampling would decode them all)";
-      } else if (sampled_ < 3) {
+        return;
+      }
+      SampledFrames sampled = SampleFrames(source.get(), options_.background.samples,
+                                           options_.window_s, options_.background.scale);
+      sampled_ = static_cast<int>(sampled.reduced.size());
+      if (sampled_ < 3) {
         why_none_ = fmt::format("{} frames to sample", sampled_);
       } else {
         background_.emplace(std::move(sampled.reduced), source->FrameSize(), options_.background);

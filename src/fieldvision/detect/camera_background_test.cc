@@ -1,8 +1,11 @@
 #include "fieldvision/detect/camera_background.h"
 
 #include <cmath>
+#include <filesystem>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/detect/test_images.h"
@@ -65,6 +68,16 @@ TEST(CameraBackground, NoBackgroundFromAMissingOrShortVideo) {
   CameraBackground two(WriteVideo(fv::testing::TempDir() + "/two.avi", rng, 2), {});
   EXPECT_EQ(two.Get(), nullptr);
   EXPECT_NE(two.Summary().find("2 frames to sample"), std::string::npos) << two.Summary();
+  // Frames that do not skip without decoding (PNG files, H.264): none, and nothing sampled.
+  const std::string pngs = fv::testing::TempDir() + "/png";
+  std::filesystem::create_directories(pngs);
+  for (int i = 0; i < 5; ++i) {
+    cv::imwrite(fmt::format("{}/{:05d}.png", pngs, i), test_util::FieldImage(64, 48, rng));
+  }
+  CameraBackground png(pngs + "/%05d.png", {});
+  EXPECT_EQ(png.Get(), nullptr);
+  EXPECT_NE(png.Summary().find("not Motion-JPEG or JPEG files"), std::string::npos)
+      << png.Summary();
   CameraBackgroundOptions bad;
   bad.window_s = 0;
   EXPECT_NE(fv::testing::ErrorOf([&] { CameraBackground("x.avi", bad); }).find("window_s"),
