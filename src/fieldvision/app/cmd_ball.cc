@@ -90,7 +90,7 @@ void RunBall(const BallCliOptions& o) {
   std::cout << r.summary.ToString() << "\n";
   // The backgrounds some camera's low-contrast candidates asked for (camera_background.h).
   for (size_t c = 0; c < r.backgrounds.size(); ++c) {
-    if (r.backgrounds[c] == detect::CameraBackground::kNotNeeded) continue;
+    if (r.backgrounds[c].empty()) continue;
     std::cout << o.job.videos[c] << ": " << r.backgrounds[c] << "\n";
   }
   if (r.bundle && r.bundle->bundled_flights > 0) {

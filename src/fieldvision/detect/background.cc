@@ -109,8 +109,9 @@ BackgroundEvidence Background::Compare(const cv::Mat& bgr, const Eigen::Vector2d
   FV_REQUIRE(bgr.type() == CV_8UC3, "background: the frame must be 8-bit BGR");
   BackgroundEvidence out;
   // A frame of another size than the sampled video's says nothing against it.
-  if (bgr.size() != full_size_ || !usable_ || !(radius_px > 0) || !centre_px.allFinite())
+  if (bgr.size() != full_size_ || !usable_ || !(radius_px > 0) || !centre_px.allFinite()) {
     return out;
+  }
   const int k = options_.scale;
   const Eigen::Vector2d c = (centre_px + Eigen::Vector2d::Constant(0.5)) / k -
                             Eigen::Vector2d::Constant(0.5);  // pixel centres
@@ -124,8 +125,7 @@ BackgroundEvidence Background::Compare(const cv::Mat& bgr, const Eigen::Vector2d
                              static_cast<int>(std::ceil(2 * full_reach)) + 2),
                     roi);
   if (box.empty()) return out;
-  const cv::Mat frame =
-      Reduce(bgr(cv::Rect(box.x * k, box.y * k, box.width * k, box.height * k)), k);
+  const cv::Mat frame = ReducedPart(bgr, box);
   const double disc2 = std::pow(kDiscRadii * r, 2);
   const double inner2 = std::pow(kRingInnerRadii * r, 2);
   const double outer2 = reach * reach;
@@ -157,6 +157,12 @@ BackgroundEvidence Background::Compare(const cv::Mat& bgr, const Eigen::Vector2d
   return out;
 }
 
+cv::Mat Background::ReducedPart(const cv::Mat& bgr, const cv::Rect& reduced) const {
+  const int k = options_.scale;
+  return Reduce(bgr(cv::Rect(reduced.x * k, reduced.y * k, reduced.width * k, reduced.height * k)),
+                k);
+}
+
 cv::Rect Background::ReducedInside(const cv::Rect& box, const cv::Rect& roi) const {
   const int k = options_.scale;
   const cv::Rect frame(0, 0, full_size_.width, full_size_.height);
@@ -173,10 +179,10 @@ std::optional<Background::Circle> Background::ChangedDisc(const cv::Mat& bgr, co
   FV_REQUIRE(bgr.type() == CV_8UC3, "background: the frame must be 8-bit BGR");
   const int k = options_.scale;
   const cv::Rect reduced = ReducedInside(box, roi);
-  if (bgr.size() != full_size_ || !usable_ || reduced.width < 3 || reduced.height < 3)
+  if (bgr.size() != full_size_ || !usable_ || reduced.width < 3 || reduced.height < 3) {
     return std::nullopt;
-  const cv::Mat frame =
-      Reduce(bgr(cv::Rect(reduced.x * k, reduced.y * k, reduced.width * k, reduced.height * k)), k);
+  }
+  const cv::Mat frame = ReducedPart(bgr, reduced);
   cv::Mat changed(reduced.size(), CV_8U);
   for (int y = 0; y < reduced.height; ++y) {
     const auto* a = frame.ptr<cv::Vec3b>(y);

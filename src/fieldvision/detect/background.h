@@ -97,6 +97,8 @@ class Background {
  private:
   // `box` (full-resolution) in reduced pixels wholly inside roi and the image; empty if none.
   cv::Rect ReducedInside(const cv::Rect& box, const cv::Rect& roi) const;
+  // The part of full-resolution `bgr` that reduces to `reduced` (reduced pixels), reduced.
+  cv::Mat ReducedPart(const cv::Mat& bgr, const cv::Rect& reduced) const;
   bool Changed(const cv::Vec3b& a, const cv::Vec3b& b) const;
   BackgroundOptions options_;
   cv::Size full_size_;

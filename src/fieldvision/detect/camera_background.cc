@@ -15,8 +15,9 @@ void CameraBackgroundOptions::Check() const {
   CheckPositive(window_s, "window_s");
 }
 
-SampledFrames SampleFrames(io::FrameSource* source, int samples, double window_s, int scale) {
-  SampledFrames out;
+std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s,
+                                  int scale) {
+  std::vector<cv::Mat> out;
   const long long count = source->FrameCount();
   if (count <= 0 || samples <= 0) return out;
   const double fps = source->fps() > 0 ? source->fps() : 30.0;
@@ -32,9 +33,9 @@ SampledFrames SampleFrames(io::FrameSource* source, int samples, double window_s
       double t = 0.0;
       try {
         if (!source->Read(&bgr, &frame, &t)) break;
-        out.reduced.push_back(Background::Reduce(bgr, scale));
+        out.push_back(Background::Reduce(bgr, scale));
       } catch (const Error&) {
-        ++out.unreadable;  // a damaged frame: the others still make a background
+        // A damaged frame: the others still make a background.
       }
       ++tried;
       next_sample =
@@ -81,13 +82,13 @@ void CameraBackground::Build() {
         why_none_ = "its frames are not Motion-JPEG or JPEG files (sampling would decode them all)";
         return;
       }
-      SampledFrames sampled = SampleFrames(source.get(), options_.background.samples,
-                                           options_.window_s, options_.background.scale);
-      sampled_ = static_cast<int>(sampled.reduced.size());
+      std::vector<cv::Mat> sampled = SampleFrames(source.get(), options_.background.samples,
+                                                  options_.window_s, options_.background.scale);
+      sampled_ = static_cast<int>(sampled.size());
       if (sampled_ < 3) {
         why_none_ = fmt::format("{} frames to sample", sampled_);
       } else {
-        background_.emplace(std::move(sampled.reduced), source->FrameSize(), options_.background);
+        background_.emplace(std::move(sampled), source->FrameSize(), options_.background);
         if (!background_->usable()) why_none_ = background_->Summary();
       }
     } catch (const std::exception& e) {  // fv::Error, or OpenCV's from a damaged frame

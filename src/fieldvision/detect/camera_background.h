@@ -25,14 +25,10 @@ struct CameraBackgroundOptions {
   void Check() const;      // throws fv::Error naming the bad field
 };
 
-// Frames sampled from a video, reduced for a Background.
-struct SampledFrames {
-  std::vector<cv::Mat> reduced;  // Background::Reduce of each
-  int unreadable = 0;            // sampled frames that could not be decoded (left out)
-};
-// The samples of `source` (from its current position; FrameCount known) reduced by `scale`; fewer
-// than requested when the video is short, none without a frame count.
-SampledFrames SampleFrames(io::FrameSource* source, int samples, double window_s, int scale);
+// The samples of `source` (from its current position; FrameCount known) reduced by `scale`
+// (Background::Reduce); fewer than requested when the video is short or a sample cannot be
+// decoded (left out), none without a frame count.
+std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s, int scale);
 
 class CameraBackground {
  public:
@@ -69,9 +65,10 @@ class CameraBackground {
 template <typename Detector>
 std::shared_ptr<CameraBackground> UseCameraBackground(bool on, const std::string& video,
                                                       const camera::Camera* camera,
-                                                      Detector* detector) {
+                                                      Detector* detector,
+                                                      const CameraBackgroundOptions& options = {}) {
   if (!on || camera == nullptr || !camera->has_pose) return nullptr;
-  auto background = std::make_shared<CameraBackground>(video, CameraBackgroundOptions{});
+  auto background = std::make_shared<CameraBackground>(video, options);
   detector->SetBackground(CameraBackground::FnFor(background));
   return background;
 }

@@ -39,11 +39,11 @@ TEST(CameraBackground, SamplesEvenlyAcrossTheWindowAndBuildsOnce) {
   for (const auto& [window_s, expected] :
        {std::pair{60.0, std::vector<int>{0, 7, 15, 22, 29}}, {0.5, {0, 4, 7, 11, 14}}}) {
     auto source = io::OpenFrameSource(video, {.encoded = true});
-    const SampledFrames sampled = SampleFrames(source.get(), 5, window_s, 2);
-    ASSERT_EQ(sampled.reduced.size(), expected.size());
+    const std::vector<cv::Mat> sampled = SampleFrames(source.get(), 5, window_s, 2);
+    ASSERT_EQ(sampled.size(), expected.size());
     for (size_t k = 0; k < expected.size(); ++k) {
-      EXPECT_EQ(sampled.reduced[k].size(), cv::Size(160, 120));
-      const double level = cv::mean(sampled.reduced[k](cv::Rect(4, 4, 8, 8)))[0];
+      EXPECT_EQ(sampled[k].size(), cv::Size(160, 120));
+      const double level = cv::mean(sampled[k](cv::Rect(4, 4, 8, 8)))[0];
       EXPECT_NEAR(level / 8, expected[k], 0.3) << "sample " << k << ", window " << window_s;
     }
   }

@@ -405,12 +405,10 @@ NodeSummary RunNode(const NodeOptions& o) {
   const detect::BallDetectorOptions dopt =
       pipeline::TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   auto detector = std::make_shared<detect::BallDetector>(dopt, &camera, field ? &*field : nullptr);
-  if (o.background && o.detect && !o.realtime && !source->live() && source->FrameCount() > 0) {
-    auto background =
-        std::make_shared<detect::CameraBackground>(o.video, detect::CameraBackgroundOptions{});
-    background->Start();
-    detector->SetBackground(detect::CameraBackground::FnFor(background));
-  }
+  const auto background = detect::UseCameraBackground(
+      o.background && o.detect && !o.realtime && !source->live() && source->FrameCount() > 0,
+      o.video, &camera, detector.get());
+  if (background) background->Start();
   pipeline::CameraStage stage(0, camera, pipeline::BallDetectFnFor(detector), o.track, o.video,
                               pipeline::BallGuidedFnFor(detector));
   if (o.detect) {

@@ -212,12 +212,10 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   for (int c = 0; c < n; ++c) {
     auto detector = std::make_shared<detect::AnyBallDetector>(dopt, o.dnn, &cameras[c],
                                                               field ? &*field : nullptr);
-    if (o.background && !o.live) {
-      backgrounds.push_back(
-          std::make_shared<detect::CameraBackground>(o.videos[c], o.background_options));
-      detector->SetBackground(detect::CameraBackground::FnFor(backgrounds.back()));
-      backgrounds.back()->Start();  // nearly every video asks for it (boards, far balls)
-    }
+    backgrounds.push_back(detect::UseCameraBackground(
+        o.background && !o.live, o.videos[c], &cameras[c], detector.get(), o.background_options));
+    // Nearly every video asks for it (boards, far balls): built while the pipeline starts.
+    if (backgrounds.back()) backgrounds.back()->Start();
     detect_fns.push_back(BallDetectFnFor(detector));
     guided_fns.push_back(BallGuidedFnFor(detector));
   }
@@ -290,7 +288,9 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
     csv.Close();
   });
   for (size_t c = 0; c < det_files.size(); ++c) det_files[c]->CloseAndCommit(*det_csvs[c]);
-  for (const auto& b : backgrounds) result.backgrounds.push_back(b->Summary());
+  for (const auto& b : backgrounds) {
+    result.backgrounds.push_back(detect::NeededBackgroundSummary(b));
+  }
   if (truth) result.eval = recon::EvaluateBall(*truth, util::CsvTable::Read(o.out), o.eval);
   return result;
 }

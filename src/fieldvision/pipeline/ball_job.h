@@ -53,7 +53,7 @@ struct BallJobResult {
   std::optional<recon::BallEvalResult> eval;  // when a truth file was given
   long long rows_written = 0;
   std::optional<FlightBundle> bundle;    // offline with `bundle`
-  std::vector<std::string> backgrounds;  // per camera, CameraBackground::Summary (with background)
+  std::vector<std::string> backgrounds;  // per camera, NeededBackgroundSummary
 };
 
 BallJobResult RunBallJob(const BallJobOptions& options);
