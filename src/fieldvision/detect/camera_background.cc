@@ -23,26 +23,19 @@ std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double w
   const double fps = source->fps() > 0 ? source->fps() : 30.0;
   const long long span = std::min(count, std::max(1LL, std::llround(window_s * fps)));
   const int n = static_cast<int>(std::min<long long>(samples, span));
-  long long next_sample = 0;
-  int tried = 0;
   cv::Mat bgr;  // decoded into the same buffer each time (fresh pages cost more than decoding)
-  for (long long f = 0; f < span && tried < n; ++f) {
+  for (int k = 0; k < n; ++k) {
     // Sample k is frame round(k (span - 1) / (n - 1)).
-    if (f == next_sample) {
-      long long frame = 0;
-      double t = 0.0;
-      try {
-        if (!source->Read(&bgr, &frame, &t)) break;
-        out.push_back(Background::Reduce(bgr, scale));
-      } catch (const Error&) {
-        // A damaged frame: the others still make a background.
-      }
-      ++tried;
-      next_sample =
-          n > 1 ? std::llround(static_cast<double>(tried) * static_cast<double>(span - 1) / (n - 1))
-                : span;
-    } else if (!source->SkipFrame()) {
-      break;
+    const long long frame =
+        n > 1 ? std::llround(static_cast<double>(k) * static_cast<double>(span - 1) / (n - 1)) : 0;
+    if (!source->SeekFrame(frame)) break;
+    long long read = 0;
+    double t = 0.0;
+    try {
+      if (!source->Read(&bgr, &read, &t)) break;
+      out.push_back(Background::Reduce(bgr, scale));
+    } catch (const Error&) {
+      // A damaged frame: the others still make a background.
     }
   }
   return out;
@@ -74,12 +67,6 @@ void CameraBackground::Build() {
       auto source = io::OpenFrameSource(spec_, so);
       if (source->FrameCount() <= 0) {
         why_none_ = "a live source: no frames to sample ahead";
-        return;
-      }
-      if (!source->encoded()) {
-        // Skipping a frame of H.264 and the like decodes it: sampling a minute would decode it
-        // all (8 s a camera at 1080p60).
-        why_none_ = "its frames are not Motion-JPEG or JPEG files (sampling would decode them all)";
         return;
       }
       std::vector<cv::Mat> sampled = SampleFrames(source.get(), options_.background.samples,

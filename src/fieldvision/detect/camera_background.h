@@ -1,9 +1,9 @@
 // A file camera's background (detect/background.h) for its ball detector, built on first need
 // (or from Start): BackgroundOptions::samples frames evenly across the video's first window_s
-// seconds, read by a source of its own. Only videos whose frames skip without decoding
-// (Motion-JPEG, JPEG files) get one: skipping an H.264 frame decodes it. On a video longer than the
-// window, a later change of light makes the rings around balls differ too, and the colour checks
-// alone decide there.
+// seconds, read by a source of its own that seeks to each (io::FrameSource::SeekFrame: Motion-JPEG
+// and image files skip without decoding; H.264 and the like decode from the key frame before each
+// sample, up to a key-frame interval each). On a video longer than the window, a later change of
+// light makes the rings around balls differ too, and the colour checks alone decide there.
 #pragma once
 
 #include <future>
@@ -25,9 +25,9 @@ struct CameraBackgroundOptions {
   void Check() const;      // throws fv::Error naming the bad field
 };
 
-// The samples of `source` (from its current position; FrameCount known) reduced by `scale`
-// (Background::Reduce); fewer than requested when the video is short or a sample cannot be
-// decoded (left out), none without a frame count.
+// The samples of a freshly opened `source` (FrameCount known), each reached by SeekFrame and
+// reduced by `scale` (Background::Reduce); fewer than requested when the video is short, a sample
+// cannot be decoded (left out) or reached (the rest too), none without a frame count.
 std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s, int scale);
 
 class CameraBackground {

@@ -31,6 +31,7 @@ class FileSource : public FrameSource {
   FileSource(const std::string& path, const FrameSourceOptions& options);
   bool ReadFrame(SourceFrame* out) override;
   bool SkipFrame() override;
+  bool SeekFrame(long long frame) override;
   bool encoded() const override { return encoded_; }
   long long FrameCount() const override { return frame_count_; }
   cv::Size FrameSize() const override { return size_; }
@@ -188,6 +189,29 @@ bool FileSource::SkipFrame() {
     }
   }
   ++next_frame_;
+  return true;
+}
+
+bool FileSource::SeekFrame(long long frame) {
+  if (frame < next_frame_ || (frame_count_ > 0 && frame >= frame_count_)) return false;
+  // Motion-JPEG packets skip without decoding; the next frame or two are as cheap to decode.
+  constexpr long long kDecodeRather = 2;
+  if (avi_ || encoded_ || frame - next_frame_ <= kDecodeRather) {
+    while (next_frame_ < frame) {
+      if (!SkipFrame()) return false;
+    }
+    return true;
+  }
+  bool ok = false;
+  try {
+    ok = capture_->set(cv::CAP_PROP_POS_FRAMES, static_cast<double>(frame));
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) return false;
+  pending_ = SourceFrame();
+  has_pending_ = false;
+  next_frame_ = frame;
   return true;
 }
 

@@ -82,6 +82,8 @@ bool FrameSource::SkipFrame() {
   return ReadFrame(&f);
 }
 
+bool FrameSource::SeekFrame(long long /*frame*/) { return false; }
+
 bool FrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
   SourceFrame f;
   if (!ReadFrame(&f)) return false;

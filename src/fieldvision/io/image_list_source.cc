@@ -83,6 +83,11 @@ class ImageListSource : public FrameSource {
     ++next_;
     return true;
   }
+  bool SeekFrame(long long frame) override {
+    if (frame < next_ || frame >= static_cast<long long>(files_.size())) return false;
+    next_ = frame;
+    return true;
+  }
   long long FrameCount() const override { return static_cast<long long>(files_.size()); }
   cv::Size FrameSize() const override { return size_; }
   std::string name() const override { return spec_; }
