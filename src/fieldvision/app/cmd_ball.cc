@@ -187,6 +187,10 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--timestamps", o->job.timestamps,
                   "CSV with frame,time_s per video (repeat, one per video); implies --sync time");
+  cmd->add_option("--fps", o->job.fps,
+                  "Frames per second of the videos (an image sequence has none of its own: give "
+                  "this or --timestamps); default: each video's own")
+      ->check(FiniteRange(1e-3, 100000.0));
   cmd->add_option("--tolerance", o->job.pipeline.sync.tolerance_s,
                   "With --sync time: frames this close in seconds are combined")
       ->check(FiniteRange(1e-6, 10.0))

@@ -6,9 +6,9 @@
 #include "fieldvision/app/ball_options.h"
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/stop_on_signal.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/net/fuse.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {
@@ -42,6 +42,11 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-wait", o->sync.max_wait_s,
                   "Longest wait (s) for a slow camera before a frame is fused without it")
       ->check(FiniteRange(0, 60))
+      ->capture_default_str();
+  cmd->add_option("--media-max-wait", o->media_max_wait_s,
+                  "The same for nodes reading files as fast as they can (not --realtime): a "
+                  "slower node is not late, only slower")
+      ->check(FiniteRange(0, 600))
       ->capture_default_str();
   cmd->add_option("--max-time-jump", o->sync.max_time_jump_s,
                   "A frame stamped further than this (s) from its camera's stream is dropped as "

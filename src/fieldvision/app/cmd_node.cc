@@ -33,6 +33,10 @@ void Setup(CLI::App& app, int& exit_code) {
                   "With --realtime: Unix time (s) of frame 0, as for cameras triggered together")
       ->check(FiniteRange(0, 1e10))
       ->needs(realtime);
+  cmd->add_option("--fps", o->fps,
+                  "Frames per second of the video (an image sequence has none of its own: give "
+                  "it); default: the video's own")
+      ->check(FiniteRange(1e-3, 100000.0));
   cmd->add_option("--live-buffer", o->live_buffer_frames,
                   "Frames a live source holds for a slow node (the oldest are dropped; 2 absorbs "
                   "one slow frame; 1: only the newest, for a node too slow on average)")

@@ -37,6 +37,7 @@ class FileSource : public FrameSource {
   cv::Size FrameSize() const override { return size_; }
   std::string name() const override { return path_; }
   double fps() const override { return fps_; }
+  bool rate_known() const override { return rate_known_; }
 
  private:
   bool Grab(SourceFrame* out);         // decoded
@@ -56,6 +57,7 @@ class FileSource : public FrameSource {
   long long next_frame_ = 0;
   long long frame_count_ = -1;
   double fps_ = 30.0;
+  bool rate_known_ = true;
   cv::Size size_;
 };
 
@@ -75,8 +77,9 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
     codecs::DecoderProblems();  // count what FFmpeg's decoders conceal (main warns)
   }
   const double container_fps = avi_ ? avi_->fps() : capture_->get(cv::CAP_PROP_FPS);
-  fps_ = options.fps > 0 ? options.fps
-                         : (std::isfinite(container_fps) && container_fps > 0 ? container_fps : 30);
+  const bool container_rate = !pattern && std::isfinite(container_fps) && container_fps > 0;
+  fps_ = options.fps > 0 ? options.fps : (container_rate ? container_fps : 30);
+  rate_known_ = options.fps > 0 || options.time == TimeSource::kCsv || container_rate;
   const double count =
       avi_ ? static_cast<double>(avi_->frame_count()) : capture_->get(cv::CAP_PROP_FRAME_COUNT);
   if (std::isfinite(count) && count > 0) frame_count_ = static_cast<long long>(count);

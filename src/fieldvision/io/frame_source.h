@@ -98,6 +98,10 @@ class FrameSource {
   virtual cv::Size FrameSize() const = 0;
   virtual std::string name() const = 0;
   virtual double fps() const = 0;
+  // False when the frames have no rate of their own (an image sequence, a video whose container
+  // gives none) and none was given (FrameSourceOptions::fps, a timestamps CSV): fps() is then a
+  // stand-in (30) that times must not be taken from.
+  virtual bool rate_known() const { return true; }
   // True for live sources (cameras, streams, played files): time_s is on the system clock.
   virtual bool live() const { return false; }
   // True when ReadFrame delivers encoded frames.

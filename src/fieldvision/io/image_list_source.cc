@@ -27,7 +27,10 @@ class ImageListSource : public FrameSource {
  public:
   ImageListSource(const std::string& spec, std::vector<std::string> files,
                   const FrameSourceOptions& o)
-      : spec_(spec), files_(std::move(files)), fps_(o.fps > 0 ? o.fps : 30.0) {
+      : spec_(spec),
+        files_(std::move(files)),
+        fps_(o.fps > 0 ? o.fps : 30.0),
+        rate_known_(o.fps > 0 || o.time == TimeSource::kCsv) {
     encoded_ = o.encoded;
     for (const std::string& f : files_) encoded_ = encoded_ && IsJpeg(f);
     if (o.time == TimeSource::kCsv) {
@@ -93,11 +96,13 @@ class ImageListSource : public FrameSource {
   std::string name() const override { return spec_; }
   double fps() const override { return fps_; }
   bool encoded() const override { return encoded_; }
+  bool rate_known() const override { return rate_known_; }
 
  private:
   std::string spec_;
   std::vector<std::string> files_;
   double fps_;
+  bool rate_known_ = false;
   bool encoded_ = false;
   TimeOrigin origin_ = TimeOrigin::kFrameRate;
   std::map<long long, double> times_;

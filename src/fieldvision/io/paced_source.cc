@@ -47,6 +47,7 @@ class PacedSource : public FrameSource {
   cv::Size FrameSize() const override { return source_->FrameSize(); }
   std::string name() const override { return source_->name(); }
   double fps() const override { return source_->fps(); }
+  bool rate_known() const override { return source_->rate_known(); }
   bool live() const override { return true; }
   bool encoded() const override { return source_->encoded(); }
   long long dropped() const override { return dropped_; }

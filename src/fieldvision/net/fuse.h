@@ -27,6 +27,11 @@ struct FuseOptions {
       0;  // exit after this many seconds without messages (after the first); 0: never
   double ball_diameter_m = 0.22;
   pipeline::LiveSyncOptions sync;
+  // Nodes reading files as fast as they can (frames on the media clock): a camera is waited for
+  // this long instead of sync.max_wait_s, as a slower node's frames are not late, only slower
+  // (one that starts later, builds its background first or decodes more); live cameras keep
+  // sync.max_wait_s. The larger of the two is used.
+  double media_max_wait_s = 5.0;
   // Flights as they close (a worker thread analyses the positions; published on topic
   // "flight"); analysis.ball_radius_m is set from ball_diameter_m.
   bool flights = true;

@@ -40,6 +40,8 @@ void NodeOptions::Check() const {
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
              "node: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
   FV_REQUIRE(std::isfinite(start_at_s) && start_at_s >= 0, "node: --start-at must be >= 0");
+  FV_REQUIRE(std::isfinite(fps) && fps >= 0 && fps <= 100000,
+             "node: --fps must be a frame rate in (0, 100000] (got {})", fps);
   FV_REQUIRE(live_buffer_frames >= 1, "node: --live-buffer must be >= 1");
   FV_REQUIRE(max_frames >= 0, "node: --max-frames must be >= 0");
   FV_REQUIRE(std::isfinite(connect_wait_s) && connect_wait_s >= 0,
@@ -397,7 +399,11 @@ NodeSummary RunNode(const NodeOptions& o) {
   so.realtime = o.realtime;
   so.start_at_s = o.start_at_s;
   so.live_buffer_frames = o.live_buffer_frames;
+  so.fps = o.fps;
   auto source = io::OpenFrameSource(o.video, so);
+  // Times are taken from the video, never assumed (the fusion node pairs cameras by them).
+  FV_REQUIRE(source->rate_known(),
+             "video '{}' has no frame rate of its own (an image sequence): give --fps", o.video);
   const cv::Size size = source->FrameSize();
   FV_REQUIRE(size.width == camera.width && size.height == camera.height,
              "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,

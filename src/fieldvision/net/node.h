@@ -20,6 +20,9 @@ struct NodeOptions {
   std::string connect;    // the fusion node, tcp://HOST:PORT
   bool realtime = false;  // play a file at its frame rate (live sources always are)
   double start_at_s = 0;  // with realtime: Unix time of frame 0 (0: now)
+  // Frames per second of the video (0: its own). An image sequence has none of its own: the node
+  // refuses it without this rather than assume one.
+  double fps = 0.0;
   // Frames a live source holds for a slow node (the oldest dropped): 2 absorbs a single slow
   // frame (a whole-frame search) without skipping one; 1 keeps only the newest (a node that is
   // too slow on average skips to the newest frame instead of working a frame behind). On the

@@ -17,6 +17,7 @@
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/io/frame_source.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/net/fuse.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/net/node.h"
@@ -261,6 +262,10 @@ TEST(NodeFuse, FilesReadAsFastAsTheyCanGoInStepWithTheHints) {
   const auto offline = OfflineBall(scene);
   FuseOptions fo = LoopbackFuse(scene, "stepped.csv");
   fo.hints = true;
+  // The live wait (0.1 s): files are waited for FuseOptions::media_max_wait_s instead, so a node
+  // that starts a second after the others loses no frame.
+  fo.sync.max_wait_s = pipeline::LiveSyncOptions().max_wait_s;
+  fo.media_max_wait_s *= fv::testing::SlowdownFactor();
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
@@ -268,6 +273,7 @@ TEST(NodeFuse, FilesReadAsFastAsTheyCanGoInStepWithTheHints) {
   std::vector<std::thread> threads;
   for (size_t c = 0; c < scene.cameras.size(); ++c) {
     threads.emplace_back([&, c] {
+      if (c == 1) std::this_thread::sleep_for(std::chrono::seconds(1));
       NodeOptions no = PlaybackNode(scene, c, endpoint, 0.0);
       no.realtime = false;
       nodes[c] = RunNode(no);
@@ -276,6 +282,7 @@ TEST(NodeFuse, FilesReadAsFastAsTheyCanGoInStepWithTheHints) {
   for (auto& t : threads) t.join();
   fuse.join();
   SCOPED_TRACE(fused.ToString());
+  for (const pipeline::LiveCameraStats& c : fused.sync) EXPECT_EQ(c.late, 0);
   for (const NodeSummary& n : nodes) {
     SCOPED_TRACE(n.ToString());
     EXPECT_EQ(n.frames, 30);
@@ -362,6 +369,7 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   FuseOptions fo;
   fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = {dir + "/cam1.yaml"};
+  fo.triangulation.single_camera_ground = true;  // one camera: positions on the ground
   fo.out = dir + "/ball.csv";
   fo.idle_exit_s = 0.5;
   fo.progress = false;
@@ -411,6 +419,30 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
 // A second node sending as a camera whose node goes on is refused (both would be fused as one
 // camera, restarting its stream at every message), and so is a node whose images are not the
 // size of the camera file's (its pixels mean nothing here).
+// Times are taken from the video, never assumed: a node refuses an image sequence (no frame rate
+// of its own) without --fps, before it connects.
+TEST(NodeFuse, ANodeNeedsAFrameRateForAnImageSequence) {
+  const std::string dir = testing::TempDir() + "/node_sequence";
+  std::filesystem::create_directories(dir);
+  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
+  cam.has_pose = true;
+  cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
+  camera::WriteCameraYaml(cam, dir + "/cam1.yaml");
+  for (int i = 0; i < 3; ++i) {
+    io::WriteImage(fmt::format("{}/{:05d}.png", dir, i),
+                   cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 90, 0)));
+  }
+  NodeOptions no;
+  no.camera = dir + "/cam1.yaml";
+  no.video = dir + "/%05d.png";
+  no.connect = "tcp://127.0.0.1:1";
+  no.connect_wait_s = 0;
+  const std::string error = testing::ErrorOf([&] { RunNode(no); });
+  EXPECT_NE(error.find("%05d.png"), std::string::npos) << error;
+  EXPECT_NE(error.find("no frame rate"), std::string::npos) << error;
+  EXPECT_NE(error.find("--fps"), std::string::npos) << error;
+}
+
 TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   const std::string dir = testing::TempDir();
   FuseOptions fo;

@@ -37,6 +37,8 @@ void BallJobOptions::Check() const {
   FV_REQUIRE(timestamps.empty() || timestamps.size() == videos.size(),
              "ball: {} --timestamps for {} videos (give one per video or none)", timestamps.size(),
              videos.size());
+  FV_REQUIRE(std::isfinite(fps) && fps >= 0 && fps <= 100000,
+             "ball: --fps must be a frame rate in (0, 100000] (got {})", fps);
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
              "ball: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
   FV_REQUIRE(!out.empty(), "ball: --out is required");
@@ -141,7 +143,13 @@ std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
       vo.time = io::TimeSource::kContainer;
     }
     vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
+    vo.fps = o.fps;
     auto src = io::OpenFrameSource(o.videos[c], vo);
+    // Times are taken from the videos, never assumed (flight speeds scale with them).
+    FV_REQUIRE(src->rate_known(),
+               "video '{}' has no frame rate of its own (an image sequence): give --fps or "
+               "--timestamps",
+               o.videos[c]);
     const cv::Size size = src->FrameSize();
     FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
                "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
@@ -154,7 +162,7 @@ std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
     const double a = sources[0]->fps(), b = sources[c]->fps();
     FV_REQUIRE(std::abs(a - b) <= 0.01 * std::max(a, b),
                "ball: --sync frame pairs frames by index, but '{}' runs at {:.4g} frames/s and "
-               "'{}' at {:.4g} (an image pattern counts as 30): give each video's --timestamps",
+               "'{}' at {:.4g}: give each video's --timestamps",
                o.videos[0], a, o.videos[c], b);
   }
   return sources;

@@ -359,19 +359,32 @@ TEST(BallPipeline, CameraFileForAnotherResolutionIsAClearError) {
   EXPECT_FALSE(std::filesystem::exists(job.out));
 }
 
-// Pairing frames by index needs one frame rate: a camera at another rate is refused naming both
-// videos (the fused times would go back where the shorter video ends), unless timestamps pair
-// them.
-TEST(BallPipeline, TheJobRefusesFrameIndexPairingAcrossFrameRates) {
-  const std::string dir = testing::TempDir() + "/job_rates";
+// A 6-frame scene in `dir` (created).
+Scene SixFrameJobScene(const std::string& dir) {
   std::filesystem::create_directories(dir);
-  const Scene s = MakeScene(dir, {6, 6, 6}, {0, 0, 0});
+  return MakeScene(dir, {6, 6, 6}, {0, 0, 0});
+}
+
+// A ball job on `s`'s videos, its camera files written to `dir`, BALL.csv there.
+BallJobOptions JobOn(const Scene& s, const std::string& dir) {
   BallJobOptions job;
   for (int c = 0; c < 3; ++c) {
     job.cameras.push_back(dir + "/cam" + std::to_string(c) + ".yaml");
     camera::WriteCameraYaml(s.cams[c], job.cameras.back());
   }
   job.videos = s.videos;
+  job.out = dir + "/ball.csv";
+  job.pipeline.progress = false;
+  return job;
+}
+
+// Pairing frames by index needs one frame rate: a camera at another rate is refused naming both
+// videos (the fused times would go back where the shorter video ends), unless timestamps pair
+// them.
+TEST(BallPipeline, TheJobRefusesFrameIndexPairingAcrossFrameRates) {
+  const std::string dir = testing::TempDir() + "/job_rates";
+  const Scene s = SixFrameJobScene(dir);
+  BallJobOptions job = JobOn(s, dir);
   // The third camera's frames again, at twice the rate.
   job.videos[2] = dir + "/cam2_60.avi";
   {
@@ -381,13 +394,42 @@ TEST(BallPipeline, TheJobRefusesFrameIndexPairingAcrossFrameRates) {
     cv::Mat f;
     while (in.read(f)) out.write(f);
   }
-  job.out = dir + "/ball.csv";
-  job.pipeline.progress = false;
   EXPECT_THAT([&] { RunBallJob(job); },
               ThrowsMessage<Error>(::testing::AllOf(HasSubstr("--sync frame"),
                                                     HasSubstr("cam0.avi"), HasSubstr("cam2_60.avi"),
                                                     ::testing::Not(HasSubstr("\n")))));
   EXPECT_FALSE(std::filesystem::exists(job.out));
+}
+
+// Times are taken from the videos, never assumed: image sequences have no frame rate, so the job
+// refuses them (naming the sequence) without --fps or --timestamps, and takes times from --fps.
+TEST(BallPipeline, TheJobNeedsAFrameRateForImageSequences) {
+  const std::string dir = testing::TempDir() + "/job_sequence_rate";
+  const Scene s = SixFrameJobScene(dir);
+  BallJobOptions job = JobOn(s, dir);
+  job.videos.clear();
+  for (int c = 0; c < 3; ++c) {
+    const std::string folder = dir + "/seq" + std::to_string(c);
+    std::filesystem::create_directories(folder);
+    cv::VideoCapture cap(s.videos[c]);
+    cv::Mat frame;
+    for (int f = 0; cap.read(frame); ++f) {
+      ASSERT_TRUE(cv::imwrite(fmt::format("{}/{:05d}.png", folder, f), frame));
+    }
+    job.videos.push_back(folder + "/%05d.png");
+  }
+  job.ball_diameter_m = 2 * kRadius;
+  EXPECT_THAT([&] { RunBallJob(job); }, ThrowsMessage<Error>(::testing::AllOf(
+                                            HasSubstr("seq0/%05d.png"), HasSubstr("no frame rate"),
+                                            HasSubstr("--fps"), ::testing::Not(HasSubstr("\n")))));
+  EXPECT_FALSE(std::filesystem::exists(job.out));
+  job.fps = 2 * kFps;
+  RunBallJob(job);
+  const util::CsvTable t = util::CsvTable::Read(job.out);
+  ASSERT_GT(t.rows(), 0u);
+  for (size_t i = 0; i < t.rows(); ++i) {
+    EXPECT_NEAR(t.GetDouble(i, "time_s"), t.GetDouble(i, "frame") / (2 * kFps), 1e-5) << i;
+  }
 }
 
 // The job on videos: each camera's accepted candidates written as DET.csv (one row a frame
