@@ -130,10 +130,19 @@ std::vector<std::string> ListImageSequence(const std::string& spec) {
     int start = 0;
     while (start <= kLastStart && !fs::is_regular_file(name_of(start))) ++start;
     if (start > kLastStart) return files;
-    for (int i = start;; ++i) {
-      const std::string name = name_of(i);
+    int end = start;
+    for (;; ++end) {
+      const std::string name = name_of(end);
       if (!fs::is_regular_file(name)) break;
       files.push_back(name);
+    }
+    // A gap would silently cut the clip short (and pair the frames after it with other cameras'
+    // wrong frames): a missing frame is an error when the sequence goes on soon after it.
+    constexpr int kGapProbe = 1000;
+    for (int i = end + 1; i <= end + kGapProbe; ++i) {
+      FV_REQUIRE(!fs::is_regular_file(name_of(i)),
+                 "image sequence '{}': frame '{}' is missing (the sequence goes on at '{}')", spec,
+                 name_of(end), name_of(i));
     }
     return files;
   }

@@ -40,6 +40,21 @@ TEST(VideoSource, ImagePatternGlobAndFolderInOrder) {
   }
 }
 
+// A numbered sequence with a frame missing is an error naming the missing frame, not a clip cut
+// short there; one that ends is just its frames.
+TEST(VideoSource, AGapInANumberedSequenceIsAnError) {
+  const std::string dir = testing::TempDir() + "/gap";
+  std::filesystem::create_directories(dir);
+  for (int i : {0, 1, 3}) cv::imwrite(fmt::format("{}/{:05d}.png", dir, i), NumberedFrame(i));
+  const std::string error =
+      testing::ErrorOf([&] { VideoSource::Open(dir + "/%05d.png", {.fps = 25.0}); });
+  EXPECT_NE(error.find("00002.png' is missing"), std::string::npos) << error;
+  EXPECT_NE(error.find("00003.png"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  std::filesystem::remove(fmt::format("{}/{:05d}.png", dir, 3));
+  EXPECT_EQ(VideoSource::Open(dir + "/%05d.png", {.fps = 25.0})->frame_count(), 2);
+}
+
 // Still photos (a folder, a glob, one image, whatever its name) against a camera's frames (a
 // numbered sequence, a video file): what `--detector auto` decides by.
 TEST(VideoSource, StillImagesAreToldFromACamerasFrames) {
