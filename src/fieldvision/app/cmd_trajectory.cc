@@ -36,11 +36,12 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   c->add_option("--ball-diameter", j.ball_diameter_m,
                 "Ball diameter in metres (default 0.22; 0.04 for a Timestamp,X,Y,Z file)")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.001, 2.0));
   c->add_option("--gravity", j.analysis.gravity_mps2, "Gravity in m/s^2 (default 9.81)")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(0.01, 1000.0));
   c->add_option("--ground-z", j.analysis.ground_z_m,
-                "Height of the bounce surface in metres (default 0)");
+                "Height of the bounce surface in metres (default 0)")
+      ->check(FiniteRange(-10000.0, 10000.0));
   c->add_option("--drag", o->drag,
                 "Quadratic air drag: auto (used when it lowers the residual by > 10 %), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
@@ -50,14 +51,14 @@ void Setup(CLI::App& app, int& exit_code) {
   c->add_option("--ball-mass", j.ball_mass_kg,
                 "Ball mass in kg, for the spin in rev/s (default 0.43; 0.0027 for a "
                 "Timestamp,X,Y,Z file)")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteRange(1e-5, 1000.0));
   c->add_option("--noise", j.analysis.noise_m,
                 "Position noise (1 sigma, metres); default: estimated from the track")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteRange(0.0, 100.0));
   c->add_option("--accel-slack", j.accel_slack_mps2,
                 "Unmodelled acceleration (drag, spin) allowed before a velocity change counts as "
                 "a bounce or hit, m/s^2 (default 10; 25 for a Timestamp,X,Y,Z file)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteRange(0.0, 100000.0));
   c->add_option("--field", j.field,
                 "Field (built-in name or JSON) for in/out, goal and basket calls");
   CLI::Option* rule =

@@ -14,6 +14,7 @@
 
 #include "fieldvision/detect/colour_cache.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/output_path.h"
 
 namespace fv::detect {
@@ -241,22 +242,8 @@ ColourSpec ColourSpecFromJson(const json& j, const std::string& context) {
 }
 
 ColourSpec ReadColourSpec(const std::string& path) {
-  std::error_code ec;
-  FV_REQUIRE(std::filesystem::is_regular_file(path, ec), "colour file '{}' does not exist", path);
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "cannot read colour file '{}'", path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
-  FV_REQUIRE(text.find_first_not_of(" \t\r\n") != std::string::npos, "colour file '{}' is empty",
-             path);
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {
-    Throw("colour file '{}' is not valid JSON: {}", path, e.what());
-  }
-  return ColourSpecFromJson(j, fmt::format("colour file '{}'", path));
+  return ColourSpecFromJson(util::ReadJsonFile(path, "colour"),
+                            fmt::format("colour file '{}'", path));
 }
 
 void WriteColourSpec(const ColourSpec& spec, const std::string& path) {

@@ -76,8 +76,8 @@ TrackEdits ParseTrackEdits(const std::string& text, const std::string& path) {
   try {
     j = json::parse(text);
   } catch (const json::parse_error& e) {
-    Throw("{}:{}: not valid JSON ({})", path, LineOfByte(text, e.byte > 0 ? e.byte - 1 : 0),
-          e.what());
+    Throw("{}:{}: not valid JSON (byte {})", path, LineOfByte(text, e.byte > 0 ? e.byte - 1 : 0),
+          e.byte);
   }
   FV_REQUIRE(j.is_array(),
              "{}:1: expected an array of edits such as [{{\"merge\": [3, 17]}}, {{\"team\": "

@@ -52,6 +52,8 @@ json ReadJsonFile(const std::string& path, const std::string& what) {
   std::stringstream text;
   text << in.rdbuf();
   FV_REQUIRE(!in.bad(), "{} file '{}' cannot be read", what, path);
+  FV_REQUIRE(text.view().find_first_not_of(" \t\r\n") != std::string_view::npos,
+             "{} file '{}' is empty", what, path);
   FV_REQUIRE(JsonNestingDepth(text.view()) <= kMaxJsonDepth,
              "{} file '{}' nests arrays or objects deeper than {} levels", what, path,
              kMaxJsonDepth);
