@@ -387,6 +387,8 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
   camera.Check("camera");
   FV_REQUIRE(camera.has_pose, "camera '{}' has no pose; run `calibrate extrinsics` first",
              camera.name);
+  FV_REQUIRE(!field.segments.empty() || !field.arcs.empty(),
+             "field '{}' has no painted lines to refine the pose against", field.name);
   RefineResult result;
   result.camera = camera;
   result.num_line_pixels = static_cast<int>(pixels.size());

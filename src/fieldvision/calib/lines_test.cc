@@ -1,4 +1,5 @@
 #include "fieldvision/calib/lines.h"
+#include "fieldvision/calib/rig_lines.h"
 
 #include <cmath>
 #include <iostream>
@@ -150,6 +151,21 @@ TEST(Refine, NoLinesIsAValueNotAnException) {
   const RefineResult r = RefineWithLines(cam, grass, field::BuiltinField("robocup-msl"));
   EXPECT_FALSE(r.accepted);
   EXPECT_NE(r.status.find("line pixels"), std::string::npos) << r.status;
+}
+
+// A field without painted lines (a custom field of dimensions only) gives nothing to refine
+// against: an error naming it, not a "perfect" line error of 0 mm over no pixels.
+TEST(Refine, AFieldWithoutLinesIsAnError) {
+  const camera::Camera cam = CornerCamera(640, 480);
+  const cv::Mat grass(480, 640, CV_8UC3, cv::Scalar(40, 130, 40));
+  field::FieldModel bare = field::BuiltinField("robocup-msl");
+  bare.name = "bare";
+  bare.segments.clear();
+  bare.arcs.clear();
+  EXPECT_THAT([&] { RefineWithLines(cam, grass, bare); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("'bare'"), HasSubstr("no painted"))));
+  EXPECT_THAT([&] { RefineRigWithLines({cam}, {grass}, bare, {}); },
+              ThrowsMessage<Error>(HasSubstr("no painted lines")));
 }
 
 TEST(Refine, RefusalSaysWhy) {

@@ -181,6 +181,8 @@ RigRefineResult RefineRigWithLines(const std::vector<camera::Camera>& rig,
                                    const field::FieldModel& field, const RefineOptions& options) {
   options.Check();
   FV_REQUIRE(images.size() == rig.size(), "{} cameras but {} frames", rig.size(), images.size());
+  FV_REQUIRE(!field.segments.empty() || !field.arcs.empty(),
+             "field '{}' has no painted lines to refine the rig against", field.name);
   std::vector<std::vector<Eigen::Vector2d>> pixels(rig.size());
   for (size_t i = 0; i < rig.size(); ++i) {
     if (images[i].empty()) continue;
