@@ -203,9 +203,10 @@ CheckResult CheckCalibration(const camera::Camera& camera, const cv::Mat& image_
                  cv::LINE_AA);
       if (p.projected_px.allFinite()) {
         cv::line(result.overlay, cv::Point2d(p.uv_px.x(), p.uv_px.y()),
-                 cv::Point2d(p.projected_px.x(), p.projected_px.y()), clicked_colour, 1, cv::LINE_AA);
-        cv::circle(result.overlay, cv::Point2d(p.projected_px.x(), p.projected_px.y()), 2, clicked_colour,
-                   cv::FILLED, cv::LINE_AA);
+                 cv::Point2d(p.projected_px.x(), p.projected_px.y()), clicked_colour, 1,
+                 cv::LINE_AA);
+        cv::circle(result.overlay, cv::Point2d(p.projected_px.x(), p.projected_px.y()), 2,
+                   clicked_colour, cv::FILLED, cv::LINE_AA);
       }
     }
   }

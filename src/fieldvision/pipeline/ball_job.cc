@@ -73,6 +73,23 @@ camera::Camera ReadRigCamera(const std::string& path) {
   return camera;
 }
 
+void CheckRigSpread(const std::vector<camera::Camera>& cameras,
+                    const std::vector<std::string>& files) {
+  constexpr double kApartM = 0.01;
+  double widest_m = 0;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      widest_m =
+          std::max(widest_m, (cameras[i].CentreInWorld() - cameras[j].CentreInWorld()).norm());
+    }
+  }
+  FV_REQUIRE(cameras.size() < 2 || widest_m >= kApartM,
+             "camera files '{}' and '{}' put the cameras at one place ({:.3f} m apart at most): "
+             "rays from one place cross nowhere; give cameras that see the field from different "
+             "places",
+             files.front(), files.back(), widest_m);
+}
+
 namespace {
 
 recon::BallObservation Observation(const detect::BallCandidate& b) {
@@ -209,6 +226,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::vector<camera::Camera> cameras;
   cameras.reserve(n);
   for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
+  if (!o.pipeline.triangulation.single_camera_ground) CheckRigSpread(cameras, o.cameras);
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) field = field::LoadField(o.field);
   // Open every video (and check its size) before starting any thread.

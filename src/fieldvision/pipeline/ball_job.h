@@ -64,6 +64,12 @@ BallJobResult RunBallJob(const BallJobOptions& options);
 // A rig camera from its file: the pose is required; `name` defaults to the file's stem.
 camera::Camera ReadRigCamera(const std::string& path);
 
+// Throws fv::Error naming two of the files when the rig has several cameras and no two of them
+// stand apart (1 cm): rays from one place cross nowhere, and every frame would go without a
+// position, silently. A rig with one pair apart is left alone.
+void CheckRigSpread(const std::vector<camera::Camera>& cameras,
+                    const std::vector<std::string>& files);
+
 // The detector options of a tracking camera (`ball`, camera nodes): posed rig cameras, no
 // small-ball stage (the tracker's guided fit finds a small ball at its expected size; spots taken
 // from the stage moved the low-sun-kick render's centres, mean 3.2 -> 4.1 mm).

@@ -378,6 +378,22 @@ BallJobOptions JobOn(const Scene& s, const std::string& dir) {
   return job;
 }
 
+// Cameras at one place (a camera file copied under another name) triangulate nothing: an error
+// naming the files instead of a BALL.csv without rows; one pair apart is enough.
+TEST(BallPipeline, ARigOfCamerasAtOnePlaceIsRefused) {
+  const Scene s;
+  camera::Camera copy = s.cams[0];
+  copy.name = "copy";
+  EXPECT_THAT(
+      [&] {
+        CheckRigSpread({s.cams[0], copy}, {"a.yaml", "b.yaml"});
+      },
+      ThrowsMessage<Error>(
+          ::testing::AllOf(HasSubstr("'a.yaml'"), HasSubstr("'b.yaml'"), HasSubstr("one place"))));
+  EXPECT_NO_THROW(CheckRigSpread({s.cams[0], copy, s.cams[1]}, {"a.yaml", "b.yaml", "c.yaml"}));
+  EXPECT_NO_THROW(CheckRigSpread({s.cams[0]}, {"a.yaml"}));
+}
+
 // Pairing frames by index needs one frame rate: a camera at another rate is refused naming both
 // videos (the fused times would go back where the shorter video ends), unless timestamps pair
 // them.

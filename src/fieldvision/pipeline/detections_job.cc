@@ -565,15 +565,8 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
              o.truth);
   const int n = static_cast<int>(o.cameras.size());
   std::vector<camera::Camera> cameras;
-  for (int c = 0; c < n; ++c) {
-    cameras.push_back(camera::ReadCameraYaml(o.cameras[c]));
-    FV_REQUIRE(cameras.back().has_pose,
-               "camera file '{}' has no pose (rvec, tvec): calibrate its extrinsics first",
-               o.cameras[c]);
-    if (cameras.back().name.empty()) {
-      cameras.back().name = std::filesystem::path(o.cameras[c]).stem().string();
-    }
-  }
+  for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
+  if (!o.triangulation.single_camera_ground) CheckRigSpread(cameras, o.cameras);
   DetectionsJobResult res;
   for (const camera::Camera& cam : cameras) res.camera_names.push_back(cam.name);
   SyncOptions so;
