@@ -575,6 +575,15 @@ IntrinsicsResult CalibrateFromViews(const std::vector<BoardView>& views,
   result.rms_focal_higher_px =
       RmsWithFocalScaled(views, fit, size, flags, options.focal_profile_factor);
   result.coverage = Coverage(views, fit, size, options.coverage_grid);
+  // Views of the board in one orientation (the same image again, a board that never tilts) leave
+  // the focal length free (Zhang 2000, sec. 3.1: each view's homography adds two constraints only
+  // when its orientation differs): an error, not a camera file with a made-up focal length.
+  constexpr double kOneOrientationDeg = 1.0;
+  FV_REQUIRE(
+      result.num_used < 2 || result.coverage.tilt_range_deg >= kOneOrientationDeg,
+      "the {} views show the board ({}) in one orientation (they differ by {:.1f} deg): the focal "
+      "length cannot be found; tilt the board by 20-45 deg between views",
+      result.num_used, options.board.Describe(), result.coverage.tilt_range_deg);
   AddWarnings(size, options, max_drop, &result);
   AddNotes(options, &result);
   return result;

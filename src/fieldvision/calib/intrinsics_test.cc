@@ -308,5 +308,22 @@ TEST(Intrinsics, TooFewViewsIsAnError) {
               ThrowsMessage<Error>(HasSubstr("only 2 of 3")));
 }
 
+// The same view again and again (one image copied, a board that never tilts): the focal length
+// is free, so an error rather than a camera file with a made-up one.
+TEST(Intrinsics, ViewsInOneOrientationAreAnError) {
+  util::Rng rng(1);
+  IntrinsicsOptions o = ChessboardOptions();
+  o.progress = false;
+  auto views = ProjectedViews(o.board, cv::Matx33d(540, 0, 330, 0, 540, 238, 0, 0, 1), {}, 1, 0.1,
+                              0.15, rng);
+  for (int i = 1; i < 6; ++i) {
+    views.push_back(views.front());
+    views.back().name = "copy " + std::to_string(i);
+  }
+  EXPECT_THAT([&] { CalibrateFromViews(views, o); },
+              ThrowsMessage<Error>(
+                  ::testing::AllOf(HasSubstr("6 views"), HasSubstr("in one orientation"))));
+}
+
 }  // namespace
 }  // namespace fv::calib
