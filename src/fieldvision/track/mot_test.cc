@@ -73,6 +73,19 @@ TEST(Mot, AnEstimateOfAClipIsNotedOrScoredOverItsFrames) {
   EXPECT_THAT(EvaluateMot(gt, late).preprocessing.Summary(), ::testing::Not(HasSubstr("NOTE")));
 }
 
+// Tracks of other frames (another video's, a wrong frame offset) share no frame with the ground
+// truth: an error saying so, not scores of 0 that read as a tracker that found nobody.
+TEST(Mot, EstimatesInNoFrameOfTheGroundTruthAreAnError) {
+  fv::testing::SeededRng rng(5);
+  const auto gt = Walkers(rng, 3, 20);
+  auto est = gt;
+  for (auto& r : est) r.frame += 1000;
+  EXPECT_THAT([&] { EvaluateMot(gt, est); },
+              ThrowsMessage<Error>(
+                  ::testing::AllOf(HasSubstr("frames 0..19"), HasSubstr("frames 1000..1019"))));
+  EXPECT_EQ(EvaluateMot(gt, {}).tp, 0);  // no estimate at all: scored, all misses
+}
+
 TEST(Mot, CountsMissesFalsePositivesAndSwitches) {
   fv::testing::SeededRng rng(4);
   const int frames = 40;
