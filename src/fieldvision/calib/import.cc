@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -243,8 +244,11 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
     c.distortion = table.count("distortions")
                        ? Numbers(table.at("distortions"), where + " distortions")
                        : std::vector<double>{};
-    if (!c.distortion.empty() && c.distortion.size() < 4) c.distortion.resize(4, 0.0);
-    if (c.distortion.size() > 5 && c.distortion.size() < 8) c.distortion.resize(8, 0.0);
+    const size_t nd = c.distortion.size();
+    FV_REQUIRE(nd == 0 || nd == 4 || nd == 5 || nd == 8 || nd == 12 || nd == 14,
+               "{}: distortions has {} numbers; OpenCV's model takes 4, 5, 8, 12 or 14 (k1 k2 p1 "
+               "p2 [k3 ...])",
+               where, nd);
     if (table.count("rotation") && table.count("translation")) {
       const auto r = Numbers(table.at("rotation"), where + " rotation");
       const auto t = Numbers(table.at("translation"), where + " translation");
@@ -270,6 +274,16 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
 
 void WriteCalibrationToml(const std::vector<camera::Camera>& cameras, const std::string& path) {
   FV_REQUIRE(!cameras.empty(), "no cameras to write to '{}'", path);
+  std::set<std::string> names;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    const std::string name =
+        cameras[i].name.empty() ? fmt::format("cam_{}", i + 1) : cameras[i].name;
+    // A TOML file holds each table once: the second would make the file unreadable.
+    FV_REQUIRE(names.insert(name).second,
+               "two cameras are named '{}': calibration.toml holds each name once (set `name` in "
+               "the camera files)",
+               name);
+  }
   util::AtomicWrite(
       path,
       [&](const std::string& tmp) {

@@ -1,5 +1,6 @@
 #include "fieldvision/calib/import.h"
 
+#include <filesystem>
 #include <fstream>
 
 #include <gmock/gmock.h>
@@ -81,6 +82,23 @@ TEST(Import, BadTomlNamesFileAndKey) {
   EXPECT_THAT([&] { ReadCalibrationToml(path); },
               ThrowsMessage<Error>(
                   ::testing::AllOf(HasSubstr("matrix"), HasSubstr("not a finite number"))));
+  // Three distortion numbers fit no OpenCV model (k1 k2 k3? k1 k2 p1?): not padded, refused.
+  std::ofstream(path)
+      << "[cam_1]\nname = \"x\"\nsize = [10, 10]\n"
+         "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\ndistortions = [0.1, 0.2, 0.3]\n";
+  EXPECT_THAT([&] { ReadCalibrationToml(path); },
+              ThrowsMessage<Error>(
+                  ::testing::AllOf(HasSubstr("[cam_1]"), HasSubstr("distortions has 3 numbers"))));
+  // A camera given twice would be written as two tables of one name (not TOML).
+  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
+  cam.name = "same";
+  cam.has_pose = true;
+  EXPECT_THAT(
+      [&] {
+        WriteCalibrationToml({cam, cam}, path + ".out");
+      },
+      ThrowsMessage<Error>(HasSubstr("two cameras are named 'same'")));
+  EXPECT_FALSE(std::filesystem::exists(path + ".out"));
   int w = 0, h = 0;
   ParseImageSize("1920x1080", "size", &w, &h);
   EXPECT_EQ(w, 1920);
