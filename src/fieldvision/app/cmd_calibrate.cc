@@ -60,6 +60,8 @@ using calib::WriteHomographyYaml;
 using calib::WritePointErrorTable;
 
 cv::Mat ReadImage(const std::string& path) {
+  FV_REQUIRE(!std::filesystem::is_directory(path), "image '{}' is a folder, not an image file",
+             path);
   FV_REQUIRE(std::filesystem::is_regular_file(path), "image '{}' does not exist", path);
   cv::Mat image = io::TryReadImage(path);
   FV_REQUIRE(!image.empty(), "image '{}' cannot be read (corrupt or not an image)", path);

@@ -145,6 +145,8 @@ void CheckOpenCvYamlText(const std::string& path, const std::string& what) {
 }
 
 Camera ReadCameraYaml(const std::string& path) {
+  FV_REQUIRE(!std::filesystem::is_directory(path),
+             "camera file '{}' is a folder (give one of its .yaml files)", path);
   FV_REQUIRE(std::filesystem::is_regular_file(path), "camera file '{}' does not exist", path);
   CheckOpenCvYamlText(path, "camera file");
   // Read as text, without a UTF-8 byte-order mark (Windows Notepad writes one; OpenCV's parser

@@ -307,6 +307,9 @@ TEST(CameraIo, AFailedWriteLeavesNothingBehind) {
 TEST(CameraIo, MissingFile) {
   EXPECT_THAT([&] { ReadCameraYaml("/nonexistent/cam.yaml"); },
               ThrowsMessage<Error>(HasSubstr("/nonexistent/cam.yaml")));
+  const std::string folder = fv::testing::TempDir() + "/rig.yaml";
+  std::filesystem::create_directories(folder);
+  EXPECT_THAT([&] { ReadCameraYaml(folder); }, ThrowsMessage<Error>(HasSubstr("is a folder")));
 }
 
 }  // namespace
