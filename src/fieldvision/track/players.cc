@@ -140,6 +140,16 @@ class FileDetector : public PersonDetector {
     return FilterDetections(file_.frames[f], o_, filter_);
   }
   std::string name() const override { return "file " + path_; }
+  // Throws naming the file when it has boxes beyond the `frames` of `video` that were read to
+  // its end: they were dropped (a file of another video, or of a longer cut of it).
+  void CheckAllUsed(int frames, const std::string& video) const {
+    for (size_t f = frames; f < file_.frames.size(); ++f) {
+      FV_REQUIRE(file_.frames[f].empty(),
+                 "detections file '{}' has boxes in frame {} but video '{}' has {} frames "
+                 "(detections of another video?)",
+                 path_, f + 1, video, frames);
+    }
+  }
 
  private:
   DetectionsFile file_;
@@ -595,9 +605,12 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
   }
   std::unique_ptr<PersonDetector> detector;
+  const FileDetector* from_file = nullptr;
   if (!options.detections_in.empty()) {
     options.detector.Check();
-    detector = std::make_unique<FileDetector>(options.detections_in, options.detector, filter);
+    auto file = std::make_unique<FileDetector>(options.detections_in, options.detector, filter);
+    from_file = file.get();
+    detector = std::move(file);
   } else {
     detector = MakeDetector(options.detector, calibrated ? camera : nullptr, filter);
   }
@@ -640,6 +653,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   progress.Finish();
   result.frames = index;
   FV_REQUIRE(index > 0, "video '{}' has no readable frame", video);
+  if (from_file != nullptr && options.max_frames <= 0) from_file->CheckAllUsed(index, video);
   if (!options.detections_out.empty()) WriteDetectionsCsv(pass.saved, options.detections_out);
   const auto t_map = Clock::now();
   FinishTracks(options, camera, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),

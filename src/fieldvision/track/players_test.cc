@@ -320,6 +320,14 @@ TEST(Players, SynthScenePositionsAndStableIds) {
       EXPECT_EQ(r2.rows[i].id, r.rows[i].id);
       EXPECT_EQ(r2.rows[i].box, r.rows[i].box);
     }
+    // Boxes past the video's last frame (another video's file) would be dropped: an error.
+    std::filesystem::copy_file(again.detections_in, dir + "/det_beyond.txt");
+    std::ofstream(dir + "/det_beyond.txt", std::ios::app) << "99,-1,10,10,20,40,0.9,-1,-1,-1\n";
+    again.detections_in = dir + "/det_beyond.txt";
+    EXPECT_THAT(
+        [&] { RunPlayers(video, &cam, &field, again); },
+        ThrowsMessage<fv::Error>(::testing::AllOf(
+            HasSubstr("det_beyond.txt"), HasSubstr("frame 99"), HasSubstr("has 50 frames"))));
   }
   WriteTracksCsv(r.rows, dir + "/tracks.csv");
   // Per frame, rows and the truth people in the image are matched one to one by overlap
