@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -162,6 +163,19 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
     item.judged = !item.boxes.empty() ||
                   std::none_of(keys.begin(), keys.end(),
                                [&](const std::string& k) { return hidden.count(k) > 0; });
+  }
+  // A video's labels past its last frame: the labels of another video (or cut), which would be
+  // scored against frames they do not describe.
+  const bool video_frames = !out.empty() && out.front().frame >= 0;
+  for (const auto& [key, boxes] : by_key) {
+    if (!video_frames || t.Has("image")) break;
+    long long frame = 0;
+    const auto [end, ec] = std::from_chars(key.data(), key.data() + key.size(), frame);
+    FV_REQUIRE(ec == std::errc() && end == key.data() + key.size(),
+               "{}: frame '{}' is not a frame number", path, key);
+    FV_REQUIRE(frame < static_cast<long long>(out.size()),
+               "{}: labels for frame {} but video '{}' has {} frames (labels of another video?)",
+               path, frame, video, out.size());
   }
   return out;
 }

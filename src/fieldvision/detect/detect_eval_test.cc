@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/eval_drawing.h"
@@ -145,6 +146,28 @@ TEST(DetectEval, SynthTruthCirclesLabelOneCamera) {
   o.labels.camera = "cam2";
   o.labels.labels = dir + "/cam2";
   EXPECT_THROW(EvaluateDetector(o), Error);
+}
+
+// Labels past a video's last frame are another video's (or cut's): an error naming the labels,
+// the frame and the video, not scores of frames they do not describe.
+TEST(DetectEval, LabelsPastTheVideosEndAreAnError) {
+  util::Rng rng(3);
+  const std::string dir = fv::testing::TempDir() + "/detect_eval_past_end";
+  fs::create_directories(dir);
+  {
+    cv::VideoWriter w(dir + "/three.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 30,
+                      cv::Size(160, 120));
+    for (int f = 0; f < 3; ++f) w.write(test_util::FieldImage(160, 120, rng));
+  }
+  WriteText(dir + "/labels.csv", "frame,x,y,w,h\n1,10,10,8,8\n5,20,20,8,8\n");
+  DetectEvalOptions o;
+  o.video = dir + "/three.avi";
+  o.labels.labels = dir + "/labels.csv";
+  o.progress = false;
+  EXPECT_THAT([&] { EvaluateDetector(o); },
+              ::testing::ThrowsMessage<Error>(::testing::AllOf(
+                  ::testing::HasSubstr("labels.csv"), ::testing::HasSubstr("frame 5"),
+                  ::testing::HasSubstr("three.avi' has 3 frames"))));
 }
 
 // Each image's ball size is its hit box's half longer side (else its largest box's), and the
