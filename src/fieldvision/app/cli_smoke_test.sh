@@ -398,6 +398,8 @@ check "tracks draw: tracks on part of the video" 0 $FV tracks draw --tracks "$TM
   --video "$TMP/bv/cam1.avi" --out "$TMP/trp.avi"
 grep -q "the tracks cover frames 1-1 of the 6 drawn" "$TMP/out" ||
   { echo "FAIL tracks draw: the covered frames not said"; fail=1; }
+check "tracks draw: --field without a camera" nonzero $FV tracks draw --tracks "$TMP/tr.csv" \
+  --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/trf.avi"
 # Progress: a line redrawn on a terminal; nothing in a log unless asked for (the studio's jobs).
 "$FV" synth --preset kick --frames 3 --width 160 --height 120 --out "$TMP/prog" >/dev/null \
   2>"$TMP/prog.err"

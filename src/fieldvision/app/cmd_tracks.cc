@@ -115,6 +115,10 @@ void RunTracksDraw(const TracksDrawCli& c) {
                camera->width, camera->height, c.video, video->width(), video->height());
   }
   std::optional<field::FieldModel> field;
+  // Lines are drawn through a posed camera only: a field without one would be left out silently.
+  FV_REQUIRE(c.field.empty() || (camera && camera->has_pose),
+             "--field draws the field's lines through a posed camera: give --camera CAM.yaml "
+             "with a pose");
   if (!c.field.empty()) field = field::LoadField(c.field);
   const track::TrackOverlay overlay(rows, roster.team_of, roster.name_of,
                                     camera ? &*camera : nullptr, field ? &*field : nullptr,
