@@ -442,7 +442,9 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   result.runs = blobs.runs;
   result.samples = blobs.samples;
   MeasuredRegions measured;
-  for (const Blob* blob : DiscLikeFirst(blobs, o.max_aspect_ratio)) {
+  std::vector<const Blob*> order = DiscLikeFirst(blobs, o.max_aspect_ratio);
+  if (static_cast<int>(order.size()) > o.max_refine) ChangedFirst(bgr, roi, &order);
+  for (const Blob* blob : order) {
     if (!FitsInRegion(*blob, roi, bgr.size())) continue;
     std::optional<BallCandidate> cand = EvaluateBlob(bgr, *blob, roi, &measured, &result.refined);
     if (cand) result.candidates.push_back(std::move(*cand));
@@ -518,6 +520,18 @@ void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
     found.push_back(*fit);
   }
   candidates->insert(candidates->end(), found.begin(), found.end());
+}
+
+void BallDetector::ChangedFirst(const cv::Mat& bgr, const cv::Rect& roi,
+                                std::vector<const Blob*>* order) const {
+  if (!background_) return;
+  const Background* background = background_();
+  if (background == nullptr) return;
+  constexpr double kChangedShare = 0.5;
+  std::stable_partition(order->begin(), order->end(), [&](const Blob* b) {
+    const double radius = std::max(0.5 * std::max(b->width_px(), b->height_px()), 1.5);
+    return background->Compare(bgr, b->centroid_px(), radius, roi).disc_share >= kChangedShare;
+  });
 }
 
 void BallDetector::ApartFirst(const cv::Mat& bgr, const cv::Rect& roi,

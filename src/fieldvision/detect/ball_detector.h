@@ -326,6 +326,11 @@ class BallDetector {
   // changed streak, the fit was 1-2 px off (low-sun kick, seed 3).
   void AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
                           std::vector<BallCandidate>* candidates) const;
+  // With a background (SetBackground) and more blobs than max_refine: those whose disc differs
+  // from the background (half of it at least: a thing that came into view, a ball merged with a
+  // board of its colour too) are refined first, ahead of the still things of the ball's colour
+  // (boards, the stands, blocks of an H.264 video's artefacts) that would use up max_refine.
+  void ChangedFirst(const cv::Mat& bgr, const cv::Rect& roi, std::vector<const Blob*>* order) const;
   // With a background (SetBackground) and several accepted candidates, those that stand apart
   // from it go first (a ball in play before still things of its colour and size).
   void ApartFirst(const cv::Mat& bgr, const cv::Rect& roi,

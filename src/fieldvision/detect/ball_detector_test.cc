@@ -455,6 +455,40 @@ TEST(BallDetector, TheBackgroundFindsABallMergedWithABoardOfItsColour) {
   EXPECT_LE(off, 1);
 }
 
+// More blobs than max_refine: still things of the ball's colour (here 24 larger discs that stood in
+// every sampled frame) used up the refinements before the ball (blobs go largest first); with
+// the background the blobs that came into view are refined first.
+TEST(BallDetector, TheBackgroundRefinesWhatCameIntoViewFirst) {
+  const uint64_t seed = fv::testing::TestSeed(33);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  cv::Mat base = test_util::FieldImage(320, 240, rng, 0.0);
+  for (int k = 0; k < 24; ++k) {
+    test_util::PaintDisc(base, Eigen::Vector2d(20 + 40.0 * (k % 8), 20 + 40.0 * (k / 8)), 9);
+  }
+  std::vector<cv::Mat> samples;
+  for (int k = 0; k < 7; ++k) {
+    samples.push_back(Background::Reduce(test_util::WithNoise(base, rng, 2.0), 2));
+  }
+  const Background background(std::move(samples), base.size(), {});
+  ASSERT_TRUE(background.usable()) << background.Summary();
+  const Eigen::Vector2d ball(rng.Uniform(60, 260), rng.Uniform(190, 215));
+  cv::Mat img = base.clone();
+  test_util::PaintDisc(img, ball, 6);
+  img = test_util::WithNoise(img, rng, 2.0);
+  BallDetectorOptions o;
+  o.max_refine = 8;
+  BallDetector det(o, nullptr, nullptr);
+  const auto ball_accepted = [&](const std::vector<BallCandidate>& cands) {
+    return std::any_of(cands.begin(), cands.end(), [&](const BallCandidate& c) {
+      return c.accepted && (c.centre_px - ball).norm() < 1.0;
+    });
+  };
+  EXPECT_FALSE(ball_accepted(det.Detect(img)));
+  det.SetBackground([&] { return &background; });
+  EXPECT_TRUE(ball_accepted(det.Detect(img)));
+}
+
 TEST(BallDetector, BadInputGivesErrors) {
   BallDetectorOptions o;
   o.scan_step_px = 0;
