@@ -1,9 +1,11 @@
 // A file camera's background (detect/background.h) for its ball detector, built on first need
 // (or from Start): BackgroundOptions::samples frames evenly across the video's first window_s
-// seconds, read by a source of its own that seeks to each (io::FrameSource::SeekFrame: Motion-JPEG
-// and image files skip without decoding; H.264 and the like decode from the key frame before each
-// sample, up to a key-frame interval each). On a video longer than the window, a later change of
-// light makes the rings around balls differ too, and the colour checks alone decide there.
+// seconds, read by a source of its own that seeks to each (io::FrameSource::SeekFrame). Only
+// Motion-JPEG videos and image files (JPEG, PNG, ...) get one: they skip without decoding, where
+// H.264 and the like decode from the key frame before each sample (with most encoders' key-frame
+// intervals, nearly the whole window per sample). On a video longer than the window, a later
+// change of light makes the rings around balls differ too, and the colour checks alone decide
+// there.
 #pragma once
 
 #include <future>
