@@ -188,8 +188,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--timestamps", o->job.timestamps,
                   "CSV with frame,time_s per video (repeat, one per video); implies --sync time");
   cmd->add_option("--fps", o->job.fps,
-                  "Frames per second of the videos (an image sequence has none of its own: give "
-                  "this or --timestamps); default: each video's own")
+                  "Frames per second of image sequences, which have no rate of their own (give "
+                  "this or --timestamps); a video's own rate must agree with it")
       ->check(FiniteRange(1e-3, 100000.0));
   cmd->add_option("--tolerance", o->job.pipeline.sync.tolerance_s,
                   "With --sync time: frames this close in seconds are combined")

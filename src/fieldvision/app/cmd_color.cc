@@ -11,8 +11,8 @@
 #include "fieldvision/detect/colour_learn.h"
 #include "fieldvision/detect/detect_eval.h"
 #include "fieldvision/io/image_file.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 namespace {

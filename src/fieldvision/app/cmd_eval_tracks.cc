@@ -5,10 +5,10 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/input_checks.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::app {

@@ -46,7 +46,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--media-max-wait", o->media_max_wait_s,
                   "The same for nodes reading files as fast as they can (not --realtime): a "
                   "slower node is not late, only slower")
-      ->check(FiniteRange(0, 600))
+      ->check(FiniteRange(0, 9))
       ->capture_default_str();
   cmd->add_option("--max-time-jump", o->sync.max_time_jump_s,
                   "A frame stamped further than this (s) from its camera's stream is dropped as "

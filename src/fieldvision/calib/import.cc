@@ -244,10 +244,13 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
     c.distortion = table.count("distortions")
                        ? Numbers(table.at("distortions"), where + " distortions")
                        : std::vector<double>{};
+    // k1 or k1 k2 alone: the radial terms, the rest 0 (three numbers could be k1 k2 k3 or k1 k2
+    // p1: refused).
+    if (c.distortion.size() == 1 || c.distortion.size() == 2) c.distortion.resize(4, 0.0);
     const size_t nd = c.distortion.size();
     FV_REQUIRE(nd == 0 || nd == 4 || nd == 5 || nd == 8 || nd == 12 || nd == 14,
                "{}: distortions has {} numbers; OpenCV's model takes 4, 5, 8, 12 or 14 (k1 k2 p1 "
-               "p2 [k3 ...])",
+               "p2 [k3 ...]), or k1 [k2] alone",
                where, nd);
     if (table.count("rotation") && table.count("translation")) {
       const auto r = Numbers(table.at("rotation"), where + " rotation");

@@ -89,6 +89,10 @@ TEST(Import, BadTomlNamesFileAndKey) {
   EXPECT_THAT([&] { ReadCalibrationToml(path); },
               ThrowsMessage<Error>(
                   ::testing::AllOf(HasSubstr("[cam_1]"), HasSubstr("distortions has 3 numbers"))));
+  // k1 k2 alone: the radial terms, the rest 0.
+  std::ofstream(path) << "[cam_1]\nname = \"x\"\nsize = [10, 10]\n"
+                         "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\ndistortions = [0.1, 0.2]\n";
+  EXPECT_EQ(ReadCalibrationToml(path).front().distortion, (std::vector<double>{0.1, 0.2, 0, 0}));
   // A camera given twice would be written as two tables of one name (not TOML).
   camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
   cam.name = "same";

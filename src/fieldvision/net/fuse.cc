@@ -36,10 +36,11 @@ void FuseOptions::Check() const {
   FV_REQUIRE(
       publish.empty() || util::StartsWith(publish, "tcp://") || util::StartsWith(publish, "ipc://"),
       "fuse: --publish must be tcp://HOST:PORT (got '{}')", publish);
+  FV_REQUIRE(!cameras.empty(), "fuse: give at least one --camera");
   FV_REQUIRE(cameras.size() >= 2 || triangulation.single_camera_ground,
              "fuse: one camera gives no 3D position: give 2 or more --camera");
-  FV_REQUIRE(std::isfinite(media_max_wait_s) && media_max_wait_s >= 0 && media_max_wait_s <= 600,
-             "fuse: --media-max-wait must be in [0, 600] s (got {})", media_max_wait_s);
+  FV_REQUIRE(std::isfinite(media_max_wait_s) && media_max_wait_s >= 0 && media_max_wait_s <= 9,
+             "fuse: --media-max-wait must be in [0, 9] s (got {})", media_max_wait_s);
   FV_REQUIRE(!out.empty(), "fuse: --out is required");
   FV_REQUIRE(std::isfinite(idle_exit_s) && idle_exit_s >= 0, "fuse: --idle-exit must be >= 0");
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
@@ -279,6 +280,7 @@ FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
                "fuse: two cameras are named '{}' (set `name` in the camera files)",
                cameras_.back().name);
   }
+  if (!o.triangulation.single_camera_ground) pipeline::CheckRigSpread(cameras_, o.cameras);
   n_ = static_cast<int>(cameras_.size());
   recon::TriangulationOptions topt = o.triangulation;
   topt.ball_radius_m = 0.5 * o.ball_diameter_m;
@@ -523,10 +525,7 @@ void FuseServer::AddFrame(int c, const FrameMessage& f, double t1, double arriva
   if (clock_kind_.empty()) {
     clock_kind_ = f.clock;
     if (clock_kind_ == "media" && o_.media_max_wait_s > o_.sync.max_wait_s) {
-      // Files: the first frame of all, so nothing is lost with the synchronizer made anew.
-      pipeline::LiveSyncOptions media = o_.sync;
-      media.max_wait_s = o_.media_max_wait_s;
-      sync_ = std::make_unique<pipeline::LiveSynchronizer>(n_, media);
+      sync_->SetMaxWait(o_.media_max_wait_s);
     }
   }
   if (f.clock != clock_kind_) {

@@ -30,7 +30,8 @@ struct FuseOptions {
   // Nodes reading files as fast as they can (frames on the media clock): a camera is waited for
   // this long instead of sync.max_wait_s, as a slower node's frames are not late, only slower
   // (one that starts later, builds its background first or decodes more); live cameras keep
-  // sync.max_wait_s. The larger of the two is used.
+  // sync.max_wait_s. The larger of the two is used. At most 9 s: a node in step with the hints
+  // goes on without them after 10 s (node.h).
   double media_max_wait_s = 5.0;
   // Flights as they close (a worker thread analyses the positions; published on topic
   // "flight"); analysis.ball_radius_m is set from ball_diameter_m.

@@ -99,7 +99,7 @@ namespace {
 constexpr char kFrameTag = 'f', kOtherTag = 'o';
 
 // In step with the fusion node (a file read as fast as it can be): the longest wait for its
-// decision of a frame before going on alone (longer than `fuse --max-wait 5`).
+// decision of a frame before going on alone (longer than fuse's longest media wait, 9 s).
 constexpr double kStepWaitS = 10.0;
 
 std::string NewSession() {
@@ -403,7 +403,9 @@ NodeSummary RunNode(const NodeOptions& o) {
   auto source = io::OpenFrameSource(o.video, so);
   // Times are taken from the video, never assumed (the fusion node pairs cameras by them).
   FV_REQUIRE(source->rate_known(),
-             "video '{}' has no frame rate of its own (an image sequence): give --fps", o.video);
+             "video '{}' has no frame rate of its own (an image sequence, or a container without "
+             "one): give --fps",
+             o.video);
   const cv::Size size = source->FrameSize();
   FV_REQUIRE(size.width == camera.width && size.height == camera.height,
              "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,

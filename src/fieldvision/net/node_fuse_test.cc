@@ -48,14 +48,20 @@ std::map<long long, Row> ReadBall(const std::string& path) {
 
 // Starts RunFuse(o) in `thread` on a free loopback port; returns the address it listens on.
 std::string StartFuse(FuseOptions& o, FuseSummary* summary, std::thread* thread) {
-  std::promise<std::string> bound;
-  auto endpoint = bound.get_future();
-  o.on_listening = [&bound](const std::string& e) { bound.set_value(e); };
-  *thread = std::thread([o, summary] {
+  auto bound = std::make_shared<std::promise<std::string>>();
+  auto endpoint = bound->get_future();
+  auto listening = std::make_shared<bool>(false);
+  o.on_listening = [bound, listening](const std::string& e) {
+    *listening = true;
+    bound->set_value(e);
+  };
+  *thread = std::thread([o, summary, bound, listening] {
     try {
       *summary = RunFuse(o);
     } catch (const std::exception& e) {
       ADD_FAILURE() << e.what();
+      // Refused before listening: the caller gets the error instead of waiting forever.
+      if (!*listening) bound->set_exception(std::current_exception());
     }
   });
   return endpoint.get();
@@ -416,9 +422,6 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   EXPECT_EQ(line, "an earlier run's rows");
 }
 
-// A second node sending as a camera whose node goes on is refused (both would be fused as one
-// camera, restarting its stream at every message), and so is a node whose images are not the
-// size of the camera file's (its pixels mean nothing here).
 // Times are taken from the video, never assumed: a node refuses an image sequence (no frame rate
 // of its own) without --fps, before it connects.
 TEST(NodeFuse, ANodeNeedsAFrameRateForAnImageSequence) {
@@ -443,6 +446,33 @@ TEST(NodeFuse, ANodeNeedsAFrameRateForAnImageSequence) {
   EXPECT_NE(error.find("--fps"), std::string::npos) << error;
 }
 
+// A fusion node of one camera gives no 3D position (unless on the ground), nor does one whose
+// cameras stand at one place: errors before it listens, naming the files.
+TEST(NodeFuse, AFusionNodeNeedsCamerasApart) {
+  const std::string dir = testing::TempDir() + "/fuse_apart";
+  std::filesystem::create_directories(dir);
+  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
+  cam.has_pose = true;
+  cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
+  for (const std::string name : {"a", "b"}) {
+    cam.name = name;
+    camera::WriteCameraYaml(cam, dir + "/" + name + ".yaml");
+  }
+  FuseOptions fo;
+  fo.listen = "tcp://127.0.0.1:*";
+  fo.out = dir + "/ball.csv";
+  fo.progress = false;
+  fo.cameras = {dir + "/a.yaml"};
+  EXPECT_NE(testing::ErrorOf([&] { RunFuse(fo); }).find("2 or more --camera"), std::string::npos);
+  fo.cameras.push_back(dir + "/b.yaml");
+  const std::string error = testing::ErrorOf([&] { RunFuse(fo); });
+  EXPECT_NE(error.find("one place"), std::string::npos) << error;
+  EXPECT_NE(error.find("b.yaml"), std::string::npos) << error;
+}
+
+// A second node sending as a camera whose node goes on is refused (both would be fused as one
+// camera, restarting its stream at every message), and so is a node whose images are not the
+// size of the camera file's (its pixels mean nothing here).
 TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   const std::string dir = testing::TempDir();
   FuseOptions fo;
@@ -450,7 +480,7 @@ TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
     camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
     cam.name = name;
     cam.has_pose = true;
-    cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
+    cam.cam_from_world = geometry::Rigid3d::LookAt({name == "cam1" ? -5.0 : 5.0, -5, 3}, {0, 0, 0});
     camera::WriteCameraYaml(cam, dir + "/" + name + ".yaml");
     fo.cameras.push_back(dir + "/" + name + ".yaml");
   }

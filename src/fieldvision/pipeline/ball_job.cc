@@ -160,13 +160,21 @@ std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
       vo.time = io::TimeSource::kContainer;
     }
     vo.encoded = true;  // MJPG: libjpeg-turbo, and only around the tracked ball
-    vo.fps = o.fps;
     auto src = io::OpenFrameSource(o.videos[c], vo);
-    // Times are taken from the videos, never assumed (flight speeds scale with them).
+    // Times are taken from the videos, never assumed (flight speeds scale with them): --fps
+    // gives a rate to those without one and must agree with the others'.
+    if (!src->rate_known() && o.fps > 0) {
+      vo.fps = o.fps;
+      src = io::OpenFrameSource(o.videos[c], vo);
+    }
     FV_REQUIRE(src->rate_known(),
-               "video '{}' has no frame rate of its own (an image sequence): give --fps or "
-               "--timestamps",
+               "video '{}' has no frame rate of its own (an image sequence, or a container "
+               "without one): give --fps or --timestamps",
                o.videos[c]);
+    FV_REQUIRE(o.fps <= 0 || std::abs(src->fps() - o.fps) <= 0.01 * o.fps,
+               "--fps {:g} but video '{}' runs at {:.4g} frames/s (--fps is for image sequences; "
+               "--timestamps gives any video's times)",
+               o.fps, o.videos[c], src->fps());
     const cv::Size size = src->FrameSize();
     FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
                "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],

@@ -22,8 +22,9 @@ struct BallJobOptions {
   std::vector<std::string> cameras;     // camera files, paired with `videos` in order
   std::vector<std::string> videos;      // files OpenCV reads or patterns such as dir/%05d.jpg
   std::vector<std::string> timestamps;  // optional: one frame,time_s CSV per video
-  // Frames per second of every video (0: each video's own). An image sequence has none of its
-  // own: without this or `timestamps` the job refuses it rather than assume one.
+  // Frames per second of image sequences, which have none of their own: without this or
+  // `timestamps` the job refuses them rather than assume one. A video's own rate must agree with
+  // it (within 1 %). 0: none given.
   double fps = 0.0;
   double ball_diameter_m = 0.22;
   std::string colour = "orange";  // colour preset or colour file (detect/colour.h)

@@ -441,6 +441,11 @@ TEST(BallPipeline, TheJobNeedsAFrameRateForImageSequences) {
   EXPECT_FALSE(std::filesystem::exists(job.out));
   job.fps = 2 * kFps;
   RunBallJob(job);
+  // A video's own rate must agree with --fps (it is for image sequences).
+  BallJobOptions videos = JobOn(s, dir);
+  videos.fps = 2 * kFps;
+  EXPECT_THAT([&] { RunBallJob(videos); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("--fps"), HasSubstr("cam0.avi"))));
   const util::CsvTable t = util::CsvTable::Read(job.out);
   ASSERT_GT(t.rows(), 0u);
   for (size_t i = 0; i < t.rows(); ++i) {

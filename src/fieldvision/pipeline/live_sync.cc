@@ -25,6 +25,12 @@ namespace {
 constexpr int kConfirmJumpMessages = 3;
 }  // namespace
 
+void LiveSynchronizer::SetMaxWait(double max_wait_s) {
+  FV_REQUIRE(std::isfinite(max_wait_s) && max_wait_s > 0,
+             "LiveSynchronizer: max_wait_s must be > 0 (got {})", max_wait_s);
+  options_.max_wait_s = max_wait_s;
+}
+
 LiveSynchronizer::LiveSynchronizer(int num_cameras, const LiveSyncOptions& options)
     : n_(num_cameras),
       options_(options),

@@ -56,6 +56,8 @@ struct LiveCameraStats {
 class LiveSynchronizer {
  public:
   LiveSynchronizer(int num_cameras, const LiveSyncOptions& options);
+  // Changes LiveSyncOptions::max_wait_s from now on (> 0; throws otherwise).
+  void SetMaxWait(double max_wait_s);
   // Adds camera `m.camera`'s message, which arrived at `arrival_s` (any steady clock in
   // seconds, the same for Next). Returns false when it was dropped (counted).
   bool Add(CameraMessage m, double arrival_s);

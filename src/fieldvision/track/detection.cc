@@ -11,8 +11,8 @@
 #include <opencv2/video/background_segm.hpp>
 
 #include "fieldvision/geometry/rigid.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::track {

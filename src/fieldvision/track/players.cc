@@ -653,7 +653,10 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   progress.Finish();
   result.frames = index;
   FV_REQUIRE(index > 0, "video '{}' has no readable frame", video);
-  if (from_file != nullptr && options.max_frames <= 0) from_file->CheckAllUsed(index, video);
+  // Read to the video's end (not cut by --max-frames): the file's boxes after it were dropped.
+  if (from_file != nullptr && (options.max_frames <= 0 || index < options.max_frames)) {
+    from_file->CheckAllUsed(index, video);
+  }
   if (!options.detections_out.empty()) WriteDetectionsCsv(pass.saved, options.detections_out);
   const auto t_map = Clock::now();
   FinishTracks(options, camera, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
