@@ -387,13 +387,10 @@ void AddLinkSummary(const NodeLink& link, NodeSummary& summary) {
   summary.hints = link.hints_used;
 }
 
-}  // namespace
-
-NodeSummary RunNode(const NodeOptions& o) {
-  o.Check();
-  const camera::Camera camera = pipeline::ReadRigCamera(o.camera);
-  std::optional<field::FieldModel> field;
-  if (!o.field.empty()) field = field::LoadField(o.field);
+// The node's video, checked against its camera: times from the video, never assumed (the fusion
+// node pairs cameras by them).
+std::unique_ptr<io::FrameSource> OpenNodeSource(const NodeOptions& o,
+                                                const camera::Camera& camera) {
   io::FrameSourceOptions so;
   so.encoded = true;  // MJPG / JPEG: decoded only around the tracked ball
   so.realtime = o.realtime;
@@ -401,7 +398,6 @@ NodeSummary RunNode(const NodeOptions& o) {
   so.live_buffer_frames = o.live_buffer_frames;
   so.fps = o.fps;
   auto source = io::OpenFrameSource(o.video, so);
-  // Times are taken from the video, never assumed (the fusion node pairs cameras by them).
   FV_REQUIRE(source->rate_known(),
              "video '{}' has no frame rate of its own (an image sequence, or a container without "
              "one): give --fps",
@@ -410,6 +406,18 @@ NodeSummary RunNode(const NodeOptions& o) {
   FV_REQUIRE(size.width == camera.width && size.height == camera.height,
              "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,
              camera.height, o.video, size.width, size.height);
+  return source;
+}
+
+}  // namespace
+
+NodeSummary RunNode(const NodeOptions& o) {
+  o.Check();
+  const camera::Camera camera = pipeline::ReadRigCamera(o.camera);
+  std::optional<field::FieldModel> field;
+  if (!o.field.empty()) field = field::LoadField(o.field);
+  const std::unique_ptr<io::FrameSource> source = OpenNodeSource(o, camera);
+  const cv::Size size = source->FrameSize();
   const detect::BallDetectorOptions dopt =
       pipeline::TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   auto detector = std::make_shared<detect::BallDetector>(dopt, &camera, field ? &*field : nullptr);
