@@ -124,6 +124,41 @@ TEST(FrameSource, ImageGlobAndFolderEncodedOrNot) {
   EXPECT_THROW(OpenFrameSource(dir + "/none*.png"), Error);
 }
 
+// An image sequence has no frame rate of its own: none is known (fps() a stand-in) unless given,
+// or declared by a synth scene.json beside the images or one folder up; a video knows its own.
+TEST(FrameSource, AnImageSequenceKnowsARateOnlyWhenGivenOne) {
+  const std::string dir = testing::TempDir() + "/rate";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/cam1");
+  for (int i = 0; i < 3; ++i) {
+    cv::imwrite(fmt::format("{}/cam1/{:05d}.png", dir, i), cv::Mat(48, 64, CV_8UC3, cv::Scalar(i)));
+  }
+  const std::string spec = dir + "/cam1/%05d.png";
+  EXPECT_FALSE(OpenFrameSource(spec)->rate_known());
+  FrameSourceOptions given;
+  given.fps = 25;
+  EXPECT_TRUE(OpenFrameSource(spec, given)->rate_known());
+  EXPECT_DOUBLE_EQ(OpenFrameSource(spec, given)->fps(), 25.0);
+  std::ofstream(dir + "/scene.json") << R"({"fps": 60.0, "num_frames": 3})";
+  auto src = OpenFrameSource(spec);
+  EXPECT_TRUE(src->rate_known());
+  EXPECT_DOUBLE_EQ(src->fps(), 60.0);
+  cv::Mat bgr;
+  long long frame = 0;
+  double t = 0;
+  ASSERT_TRUE(src->Read(&bgr, &frame, &t) && src->Read(&bgr, &frame, &t));
+  EXPECT_DOUBLE_EQ(t, 1 / 60.0);
+  std::ofstream(dir + "/scene.json") << R"({"fps": "fast"})";
+  EXPECT_FALSE(OpenFrameSource(spec)->rate_known());
+  const std::string video = dir + "/v.avi";
+  {
+    cv::VideoWriter w(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 50, cv::Size(64, 48));
+    for (int i = 0; i < 3; ++i) w.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(i)));
+  }
+  EXPECT_TRUE(OpenFrameSource(video)->rate_known());
+  EXPECT_DOUBLE_EQ(OpenFrameSource(video)->fps(), 50.0);
+}
+
 TEST(FrameSource, TruncatedFileFailsAtItsEndEncodedOrNot) {
   const std::string video = test_util::WriteTruncatedMjpg(testing::TempDir() + "/cut.avi", 0.5);
   for (const bool encoded : {false, true}) {

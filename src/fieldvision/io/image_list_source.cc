@@ -1,10 +1,14 @@
 // Frame-source backend: an image sequence given as a glob (dir/*.png) or a folder of images, in
-// name order (ListImageSequence, video_source.h); times from the frame rate (options.fps, else
-// 30) or a frame,time_s CSV. JPEG files are delivered encoded on request (the files' bytes).
+// name order (ListImageSequence, video_source.h); times from the frame rate (options.fps, else the
+// `fps` of a synth scene.json in the images' folder or the one above it) or a frame,time_s CSV;
+// without any, no rate is known (rate_known(): fps() is a stand-in 30). JPEG files are delivered
+// encoded on request (the files' bytes).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -13,10 +17,31 @@
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::io::backend {
 namespace {
+
+// The frame rate a scene.json (synth's scene file) beside the images or one folder up declares;
+// nullopt without one (or one that cannot be read: the caller then asks for --fps).
+std::optional<double> SceneFileRate(const std::string& first_image) {
+  const std::filesystem::path dir = std::filesystem::path(first_image).parent_path();
+  for (const std::filesystem::path& d : {dir, dir.parent_path()}) {
+    const std::filesystem::path scene = d / "scene.json";
+    if (!std::filesystem::is_regular_file(scene)) continue;
+    try {
+      const nlohmann::json j = util::ReadJsonFile(scene.string(), "scene");
+      const auto it = j.find("fps");
+      if (it == j.end() || !it->is_number()) return std::nullopt;
+      const double fps = it->get<double>();
+      if (std::isfinite(fps) && fps > 0 && fps <= 100000) return fps;
+    } catch (const Error&) {
+    }
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
 
 bool IsJpeg(const std::string& path) {
   const std::string ext = util::ToLower(std::filesystem::path(path).extension().string());
@@ -44,6 +69,12 @@ class ImageListSource : public FrameSource {
     FV_REQUIRE(!first.empty(), "image sequence '{}': cannot read its first image '{}'", spec,
                files_.front());
     size_ = first.size();
+    if (!rate_known_) {
+      if (const std::optional<double> fps = SceneFileRate(files_.front())) {
+        fps_ = *fps;
+        rate_known_ = true;
+      }
+    }
   }
   bool ReadFrame(SourceFrame* out) override {
     if (next_ >= static_cast<long long>(files_.size())) return false;
