@@ -99,6 +99,8 @@ TrackEdits ParseTrackEdits(const std::string& text, const std::string& path) {
       e.kind = op == "merge" ? TrackEdit::Kind::kMerge : TrackEdit::Kind::kDrop;
       e.ids = IdList(arg, fmt::format("{}: {}", where, op));
       FV_REQUIRE(op != "merge" || e.ids.size() >= 2, "{}: merge needs two or more ids", where);
+      FV_REQUIRE(std::set<int>(e.ids.begin(), e.ids.end()).size() == e.ids.size(),
+                 "{}: {} names an id twice", where, op);
       FV_REQUIRE(!e.ids.empty(), "{}: {} needs one or more ids", where, op);
     } else if (op == "rename" || op == "team") {
       e.kind = op == "rename" ? TrackEdit::Kind::kRename : TrackEdit::Kind::kTeam;

@@ -112,6 +112,10 @@ TEST(TrackEdits, ErrorsNameFileAndLine) {
     ApplyTrackEdits(rows, {}, ParseTrackEdits("[{\"merge\": [1, 2]},\n{\"drop\": [2]}]", "e"));
   });
   EXPECT_NE(gone.find("e:2: drop: id 2 is not in the tracks"), std::string::npos) << gone;
+  EXPECT_NE(ErrorOf([&] {
+              ParseTrackEdits("[{\"merge\": [1, 1]}]", "e");
+            }).find("e:1: merge names an id twice"),
+            std::string::npos);
   const std::string used = ErrorOf(
       [&] { ApplyTrackEdits(rows, {}, ParseTrackEdits("[{\"rename\": {\"1\": 2}}]", "e")); });
   EXPECT_NE(used.find("e:1: rename: id 2 is already in use"), std::string::npos) << used;
