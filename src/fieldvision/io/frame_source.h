@@ -89,7 +89,8 @@ class FrameSource {
   // Positions a file or image sequence so that the next ReadFrame returns `frame` (at or after
   // the next frame), decoding as little as the format allows: Motion-JPEG and image files skip
   // without decoding, other codecs seek to the key frame before it (OpenCV's FFmpeg backend) and
-  // decode from there. False when the source cannot (live) or `frame` lies beyond its end.
+  // decode from there (where a container's index is approximate, an MPEG-TS, a few frames early).
+  // False when the source cannot (live) or `frame` lies beyond its end.
   virtual bool SeekFrame(long long frame);
   // The next frame decoded to BGR, its number and capture time; false at the end.
   bool Read(cv::Mat* bgr, long long* frame, double* time_s);
