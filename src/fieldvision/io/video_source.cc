@@ -1,6 +1,7 @@
 #include "fieldvision/io/video_source.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <regex>
@@ -74,7 +75,9 @@ class FrameSourceVideo : public VideoSource {
 
 }  // namespace
 
-void VideoSourceOptions::Check() const { CheckPositive(fps, "VideoSourceOptions.fps"); }
+void VideoSourceOptions::Check() const {
+  FV_REQUIRE(std::isfinite(fps) && fps >= 0, "VideoSourceOptions.fps must be >= 0 (got {})", fps);
+}
 
 void CheckEndOfStream(const std::string& path, long long frames_read, long long frames_announced) {
   // Containers without a frame index give an estimate (duration x rate): a frame or two of slack.
@@ -162,7 +165,8 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
                                                const VideoSourceOptions& options) {
   options.Check();
   FV_REQUIRE(!spec.empty(), "empty video name");
-  // Image sequences at options.fps; video files at their container's rate and times.
+  // Image sequences at options.fps (0: a scene.json's, else 30); video files at their container's
+  // rate and times.
   const bool sequence = !fs::is_regular_file(spec) &&
                         (spec.find_first_of("%*?") != std::string::npos || fs::is_directory(spec));
   FrameSourceOptions so;

@@ -18,8 +18,9 @@
 namespace fv::io {
 
 struct VideoSourceOptions {
-  // Frame rate assumed for image sequences (and for files whose container has none).
-  double fps = 30.0;
+  // Frame rate of image sequences, which have none of their own; 0: the `fps` of a synth
+  // scene.json beside them (or one folder up), else 30 stands in (FrameSource::rate_known).
+  double fps = 0.0;
   void Check() const;
 };
 
