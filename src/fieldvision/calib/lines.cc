@@ -291,6 +291,11 @@ std::string LineErrorStats::Summary() const {
       mean_mm, median_mm, p95_mm, num_inliers, num_pixels, gate_m * 1000);
 }
 
+void RequirePaintedLines(const field::FieldModel& field) {
+  FV_REQUIRE(!field.segments.empty() || !field.arcs.empty(),
+             "field '{}' has no painted lines to refine the pose against", field.name);
+}
+
 LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
                          const field::FieldModel& field, double gate_m) {
   CheckPositive(gate_m, "gate_m");
@@ -387,8 +392,7 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
   camera.Check("camera");
   FV_REQUIRE(camera.has_pose, "camera '{}' has no pose; run `calibrate extrinsics` first",
              camera.name);
-  FV_REQUIRE(!field.segments.empty() || !field.arcs.empty(),
-             "field '{}' has no painted lines to refine the pose against", field.name);
+  RequirePaintedLines(field);
   RefineResult result;
   result.camera = camera;
   result.num_line_pixels = static_cast<int>(pixels.size());

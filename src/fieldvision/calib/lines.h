@@ -127,6 +127,10 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
                                   const field::FieldModel& field,
                                   const RefineOptions& options = {});
 
+// Throws fv::Error naming `field` when it has no painted lines (segments or arcs): both line
+// refinements would report a line error of 0 mm over no pixels.
+void RequirePaintedLines(const field::FieldModel& field);
+
 // The pose solve of both line refinements (RefineWithLinePixels, RefineRigWithLines): `build`
 // adds the residuals (on *rvec, *tvec) with a Cauchy loss of the given scale; the problem is
 // solved at each of `scales` in turn, then its robust cost at the last scale is evaluated at the

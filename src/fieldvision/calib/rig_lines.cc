@@ -86,6 +86,7 @@ RigRefineResult RefineRigWithLinePixels(const std::vector<camera::Camera>& rig,
                                         const RefineOptions& options) {
   options.Check();
   FV_REQUIRE(!rig.empty(), "the rig has no cameras");
+  RequirePaintedLines(field);
   FV_REQUIRE(pixels.size() == rig.size(), "{} cameras but {} line pixel lists", rig.size(),
              pixels.size());
   RigRefineResult result;
@@ -181,8 +182,6 @@ RigRefineResult RefineRigWithLines(const std::vector<camera::Camera>& rig,
                                    const field::FieldModel& field, const RefineOptions& options) {
   options.Check();
   FV_REQUIRE(images.size() == rig.size(), "{} cameras but {} frames", rig.size(), images.size());
-  FV_REQUIRE(!field.segments.empty() || !field.arcs.empty(),
-             "field '{}' has no painted lines to refine the rig against", field.name);
   std::vector<std::vector<Eigen::Vector2d>> pixels(rig.size());
   for (size_t i = 0; i < rig.size(); ++i) {
     if (images[i].empty()) continue;

@@ -6,7 +6,6 @@
 
 #include <fmt/format.h>
 
-#include "fieldvision/io/video_source.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
@@ -70,7 +69,7 @@ void CameraBackground::Build() {
         why_none_ = "a live source: no frames to sample ahead";
         return;
       }
-      if (!source->encoded() && io::ListImageSequence(spec_).empty()) {
+      if (!source->SkipsWithoutDecoding()) {
         // Seeking in H.264 and the like decodes from the key frame before each sample: with the
         // long key-frame intervals of most encoders nearly all of the window, for each sample
         // (the kick render as H.264: the job 1.8-2.6x slower).

@@ -166,15 +166,15 @@ std::vector<LabelledImage> ReadCsvLabels(const std::vector<LabelledImage>& items
   }
   // A video's labels past its last frame: the labels of another video (or cut), which would be
   // scored against frames they do not describe.
-  const bool video_frames = !out.empty() && out.front().frame >= 0;
-  for (const auto& [key, boxes] : by_key) {
-    if (!video_frames || t.Has("image")) break;
+  const bool video_frames = !out.empty() && out.front().frame >= 0 && !t.Has("image");
+  // A container without a frame index gives FFmpeg's estimate of the count: a little slack.
+  const long long count = static_cast<long long>(out.size());
+  for (auto it = by_key.begin(); video_frames && it != by_key.end(); ++it) {
+    const std::string& key = it->first;
     long long frame = 0;
     const auto [end, ec] = std::from_chars(key.data(), key.data() + key.size(), frame);
     FV_REQUIRE(ec == std::errc() && end == key.data() + key.size(),
                "{}: frame '{}' is not a frame number", path, key);
-    // A container without a frame index gives FFmpeg's estimate of the count: a little slack.
-    const long long count = static_cast<long long>(out.size());
     FV_REQUIRE(frame < count + std::max(2LL, count / 100),
                "{}: labels for frame {} but video '{}' has {} frames (labels of another video?)",
                path, frame, video, out.size());

@@ -32,6 +32,7 @@ class FileSource : public FrameSource {
   bool ReadFrame(SourceFrame* out) override;
   bool SkipFrame() override;
   bool SeekFrame(long long frame) override;
+  bool SkipsWithoutDecoding() const override { return avi_ != nullptr || encoded_; }
   bool encoded() const override { return encoded_; }
   long long FrameCount() const override { return frame_count_; }
   cv::Size FrameSize() const override { return size_; }
@@ -199,7 +200,7 @@ bool FileSource::SeekFrame(long long frame) {
   if (frame < next_frame_ || (frame_count_ > 0 && frame >= frame_count_)) return false;
   // Motion-JPEG packets skip without decoding; the next frame or two are as cheap to decode.
   constexpr long long kDecodeRather = 2;
-  if (avi_ || encoded_ || frame - next_frame_ <= kDecodeRather) {
+  if (SkipsWithoutDecoding() || frame - next_frame_ <= kDecodeRather) {
     while (next_frame_ < frame) {
       if (!SkipFrame()) return false;
     }

@@ -92,6 +92,8 @@ class FrameSource {
   // decode from there (where a container's index is approximate, an MPEG-TS, a few frames early).
   // False when the source cannot (live) or `frame` lies beyond its end.
   virtual bool SeekFrame(long long frame);
+  // Whether skipping and seeking go without decoding (Motion-JPEG packets, image files).
+  virtual bool SkipsWithoutDecoding() const { return false; }
   // The next frame decoded to BGR, its number and capture time; false at the end.
   bool Read(cv::Mat* bgr, long long* frame, double* time_s);
   // Frames in the stream, or -1 when unknown (live).

@@ -128,6 +128,7 @@ class ImageListSource : public FrameSource {
   double fps() const override { return fps_; }
   bool encoded() const override { return encoded_; }
   bool rate_known() const override { return rate_known_; }
+  bool SkipsWithoutDecoding() const override { return true; }
 
  private:
   std::string spec_;

@@ -48,6 +48,7 @@ class PacedSource : public FrameSource {
   std::string name() const override { return source_->name(); }
   double fps() const override { return source_->fps(); }
   bool rate_known() const override { return source_->rate_known(); }
+  bool SkipsWithoutDecoding() const override { return source_->SkipsWithoutDecoding(); }
   bool live() const override { return true; }
   bool encoded() const override { return source_->encoded(); }
   long long dropped() const override { return dropped_; }

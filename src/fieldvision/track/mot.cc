@@ -4,7 +4,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <map>
 #include <set>
 
@@ -301,19 +300,20 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
   }
   if (o.clip_to_gt_frames && !gt_frames.empty()) {
     const int first = gt_frames.begin()->first, last = gt_frames.rbegin()->first;
-    const size_t before = est.size();
-    int est_lo = std::numeric_limits<int>::max(), est_hi = std::numeric_limits<int>::min();
-    for (const TrackRow& r : est) {
-      est_lo = std::min(est_lo, r.frame);
-      est_hi = std::max(est_hi, r.frame);
-    }
-    std::erase_if(est, [&](const TrackRow& r) { return r.frame < first || r.frame > last; });
-    p.est_outside_gt_frames = static_cast<int>(before - est.size());
+    const auto outside_gt = [&](const TrackRow& r) { return r.frame < first || r.frame > last; };
     // Scores of 0 from tracks of other frames would read as a tracker that found nobody.
-    FV_REQUIRE(before == 0 || !est.empty(),
-               "no estimated box lies in the ground truth's frames {}..{} (the estimates are in "
-               "frames {}..{}): another video's tracks, or a wrong --frame-offset?",
-               first, last, est_lo, est_hi);
+    if (!est.empty() && std::all_of(est.begin(), est.end(), outside_gt)) {
+      const auto [lo, hi] = std::minmax_element(
+          est.begin(), est.end(),
+          [](const TrackRow& a, const TrackRow& b) { return a.frame < b.frame; });
+      Throw(
+          "no estimated box lies in the ground truth's frames {}..{} (the estimates are in "
+          "frames {}..{}): another video's tracks, or a wrong --frame-offset?",
+          first, last, lo->frame, hi->frame);
+    }
+    const size_t before = est.size();
+    std::erase_if(est, outside_gt);
+    p.est_outside_gt_frames = static_cast<int>(before - est.size());
   }
   if (!est.empty()) {
     const auto [lo, hi] =
