@@ -67,6 +67,17 @@ std::string StartFuse(FuseOptions& o, FuseSummary* summary, std::thread* thread)
   return endpoint.get();
 }
 
+// A 64x48 camera file `name`.yaml in `dir`, 5 m off the centre at (eye_x, -5, 3) looking at it.
+std::string WriteTinyCamera(const std::string& dir, const std::string& name, double eye_x = -5) {
+  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
+  cam.name = name;
+  cam.has_pose = true;
+  cam.cam_from_world = geometry::Rigid3d::LookAt({eye_x, -5, 3}, {0, 0, 0});
+  const std::string path = dir + "/" + name + ".yaml";
+  camera::WriteCameraYaml(cam, path);
+  return path;
+}
+
 struct Scene {
   std::string dir;
   std::vector<std::string> cameras, videos;
@@ -367,11 +378,7 @@ TEST(NodeFuse, ANodeRestartedMidSceneIsReadmittedWithTheOfflinePositions) {
 
 TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   const std::string dir = testing::TempDir();
-  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
-  cam.name = "cam1";
-  cam.has_pose = true;
-  cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
-  camera::WriteCameraYaml(cam, dir + "/cam1.yaml");
+  WriteTinyCamera(dir, "cam1");
   FuseOptions fo;
   fo.listen = "tcp://127.0.0.1:*";
   fo.cameras = {dir + "/cam1.yaml"};
@@ -427,10 +434,7 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
 TEST(NodeFuse, ANodeNeedsAFrameRateForAnImageSequence) {
   const std::string dir = testing::TempDir() + "/node_sequence";
   std::filesystem::create_directories(dir);
-  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
-  cam.has_pose = true;
-  cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
-  camera::WriteCameraYaml(cam, dir + "/cam1.yaml");
+  WriteTinyCamera(dir, "cam1");
   for (int i = 0; i < 3; ++i) {
     io::WriteImage(fmt::format("{}/{:05d}.png", dir, i),
                    cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 90, 0)));
@@ -451,13 +455,8 @@ TEST(NodeFuse, ANodeNeedsAFrameRateForAnImageSequence) {
 TEST(NodeFuse, AFusionNodeNeedsCamerasApart) {
   const std::string dir = testing::TempDir() + "/fuse_apart";
   std::filesystem::create_directories(dir);
-  camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
-  cam.has_pose = true;
-  cam.cam_from_world = geometry::Rigid3d::LookAt({-5, -5, 3}, {0, 0, 0});
-  for (const std::string name : {"a", "b"}) {
-    cam.name = name;
-    camera::WriteCameraYaml(cam, dir + "/" + name + ".yaml");
-  }
+  WriteTinyCamera(dir, "a");
+  WriteTinyCamera(dir, "b");  // where a stands
   FuseOptions fo;
   fo.listen = "tcp://127.0.0.1:*";
   fo.out = dir + "/ball.csv";
@@ -476,14 +475,7 @@ TEST(NodeFuse, AFusionNodeNeedsCamerasApart) {
 TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   const std::string dir = testing::TempDir();
   FuseOptions fo;
-  for (const std::string name : {"cam1", "cam2"}) {
-    camera::Camera cam = camera::Camera::FromFov(64, 48, 60);
-    cam.name = name;
-    cam.has_pose = true;
-    cam.cam_from_world = geometry::Rigid3d::LookAt({name == "cam1" ? -5.0 : 5.0, -5, 3}, {0, 0, 0});
-    camera::WriteCameraYaml(cam, dir + "/" + name + ".yaml");
-    fo.cameras.push_back(dir + "/" + name + ".yaml");
-  }
+  fo.cameras = {WriteTinyCamera(dir, "cam1"), WriteTinyCamera(dir, "cam2", 5)};
   fo.listen = "tcp://127.0.0.1:*";
   fo.out = dir + "/ball.csv";
   fo.idle_exit_s = 0.5;

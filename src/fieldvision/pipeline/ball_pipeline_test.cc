@@ -105,6 +105,19 @@ Scene MakeScene(const std::string& dir, const std::vector<int>& lengths,
   return s;
 }
 
+// `video`'s frames as numbered images folder/NNNNN.ext from `first`; the printf pattern of them.
+std::string WriteSequence(const std::string& video, const std::string& folder,
+                          const std::string& ext, int first) {
+  std::filesystem::create_directories(folder);
+  cv::VideoCapture cap(video);
+  cv::Mat frame;
+  for (int f = first; cap.read(frame); ++f) {
+    FV_REQUIRE(cv::imwrite(fmt::format("{}/{:05d}.{}", folder, f, ext), frame),
+               "cannot write frame {} of '{}'", f, video);
+  }
+  return folder + "/%05d." + ext;
+}
+
 std::vector<std::unique_ptr<io::FrameSource>> Open(const Scene& s,
                                                    const std::vector<io::FrameSourceOptions>& vo) {
   std::vector<std::unique_ptr<io::FrameSource>> src;
@@ -201,14 +214,7 @@ TEST(BallPipeline, JpegSequencesAreDecodedInWindows) {
   const Scene s = MakeScene(dir, {24, 24, 24}, {0, 0, 0});
   std::vector<std::string> patterns;
   for (int c = 0; c < 3; ++c) {
-    const std::string folder = dir + "/seq" + std::to_string(c);
-    std::filesystem::create_directories(folder);
-    cv::VideoCapture cap(s.videos[c]);
-    cv::Mat frame;
-    for (int f = 1; cap.read(frame); ++f) {
-      ASSERT_TRUE(cv::imwrite(fmt::format("{}/{:05d}.jpg", folder, f), frame));
-    }
-    patterns.push_back(folder + "/%05d.jpg");
+    patterns.push_back(WriteSequence(s.videos[c], dir + "/seq" + std::to_string(c), "jpg", 1));
   }
   io::FrameSourceOptions enc;
   enc.encoded = true;
@@ -423,16 +429,8 @@ TEST(BallPipeline, TheJobNeedsAFrameRateForImageSequences) {
   const std::string dir = testing::TempDir() + "/job_sequence_rate";
   const Scene s = SixFrameJobScene(dir);
   BallJobOptions job = JobOn(s, dir);
-  job.videos.clear();
   for (int c = 0; c < 3; ++c) {
-    const std::string folder = dir + "/seq" + std::to_string(c);
-    std::filesystem::create_directories(folder);
-    cv::VideoCapture cap(s.videos[c]);
-    cv::Mat frame;
-    for (int f = 0; cap.read(frame); ++f) {
-      ASSERT_TRUE(cv::imwrite(fmt::format("{}/{:05d}.png", folder, f), frame));
-    }
-    job.videos.push_back(folder + "/%05d.png");
+    job.videos[c] = WriteSequence(s.videos[c], dir + "/seq" + std::to_string(c), "png", 0);
   }
   job.ball_diameter_m = 2 * kRadius;
   EXPECT_THAT([&] { RunBallJob(job); }, ThrowsMessage<Error>(::testing::AllOf(
