@@ -1,22 +1,31 @@
 #include "fieldvision/detect/lab.h"
 
-#include <mutex>
-
-#include <opencv2/imgproc.hpp>
+#include <algorithm>
+#include <array>
+#include <cmath>
 
 #include "fieldvision/util/error.h"
 
 namespace fv::detect {
 namespace {
 
-void BuildTablesOnce() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    const cv::Mat pixel(1, 1, CV_8UC3, cv::Scalar::all(0));
-    cv::Mat lab;
-    cv::cvtColor(pixel, lab, cv::COLOR_BGR2Lab);
-  });
+// sRGB 8-bit value -> linear light in [0, 1] (IEC 61966-2-1).
+const std::array<double, 256>& LinearTable() {
+  static const std::array<double, 256> kTable = [] {
+    std::array<double, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const double c = i / 255.0;
+      t[i] = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    }
+    return t;
+  }();
+  return kTable;
 }
+
+// CIE 1976 f(t): the cube root above (6/29)^3, its tangent line below.
+double LabF(double t) { return t > 0.008856 ? std::cbrt(t) : 7.787 * t + 16.0 / 116.0; }
+
+uint8_t Level(double v) { return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L)); }
 
 }  // namespace
 
@@ -27,10 +36,23 @@ void BgrToLab(const cv::Mat& bgr, cv::Mat* lab) {
     return;
   }
   FV_REQUIRE(bgr.type() == CV_8UC3, "BgrToLab: the image must be 8-bit BGR");
-  BuildTablesOnce();
-  cv::cvtColor(bgr, *lab, cv::COLOR_BGR2Lab);
+  FV_REQUIRE(lab->data == nullptr || lab->data != bgr.data, "BgrToLab: converting in place");
+  const std::array<double, 256>& lin = LinearTable();
+  lab->create(bgr.size(), CV_8UC3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const uint8_t* in = bgr.ptr<uint8_t>(y);
+    uint8_t* out = lab->ptr<uint8_t>(y);
+    for (int x = 0; x < bgr.cols; ++x, in += 3, out += 3) {
+      const double b = lin[in[0]], g = lin[in[1]], r = lin[in[2]];
+      // sRGB primaries to XYZ, divided by the D65 white point (OpenCV's matrix and white).
+      const double fx = LabF((0.412453 * r + 0.357580 * g + 0.180423 * b) / 0.950456);
+      const double fy = LabF(0.212671 * r + 0.715160 * g + 0.072169 * b);
+      const double fz = LabF((0.019334 * r + 0.119193 * g + 0.950227 * b) / 1.088754);
+      out[0] = Level((116.0 * fy - 16.0) * 255.0 / 100.0);
+      out[1] = Level(500.0 * (fx - fy) + 128.0);
+      out[2] = Level(200.0 * (fy - fz) + 128.0);
+    }
+  }
 }
-
-std::future<void> PrepareBgrToLab() { return std::async(std::launch::async, BuildTablesOnce); }
 
 }  // namespace fv::detect

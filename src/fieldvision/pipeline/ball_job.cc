@@ -3,13 +3,11 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <future>
 #include <memory>
 #include <optional>
 
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/detect/ball_detector.h"
-#include "fieldvision/detect/lab.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/pipeline/detections_job.h"
 #include "fieldvision/pipeline/flight_refiner.h"
@@ -217,8 +215,6 @@ BallGuidedFn BallGuidedFnFor(std::shared_ptr<detect::AnyBallDetector> detector) 
 
 BallJobResult RunBallJob(const BallJobOptions& o) {
   o.Check();
-  // OpenCV's CIELAB tables build while the inputs open and the first frames decode (detect/lab.h).
-  const std::future<void> lab_tables = detect::PrepareBgrToLab();
   FV_REQUIRE(o.truth.empty() || std::filesystem::exists(o.truth), "truth file '{}' does not exist",
              o.truth);
   // A bad truth file fails before anything is written (read as both truth and estimate, it is
