@@ -127,6 +127,25 @@ check "detect: --ball-diameter nan" nonzero $FV detect --video "$TMP/v.avi" --ou
 grep -q -- "--ball-diameter" "$TMP/err" || { echo "FAIL detect: nan diameter not named"; fail=1; }
 check "detect: --ball-diameter 1e300" nonzero $FV detect --video "$TMP/v.avi" --out "$TMP/d.csv" \
   --ball-diameter 1e300
+# Options checked together or by their own rules are named as options, not as internal fields.
+named() {  # named NAME OPTION CMD...: one-line error naming OPTION
+  local name="$1" option="$2"
+  shift 2
+  check "$name" nonzero "$@"
+  grep -q -- "$option" "$TMP/err" || { echo "FAIL $name: $option not named"; fail=1; }
+}
+named "detect: --min-radius above --max-radius" --max-radius $FV detect --video "$TMP/v.avi" \
+  --out "$TMP/d.csv" --min-radius 100 --max-radius 5
+named "eval detect: --min-radius above --max-radius" --min-radius $FV eval detect \
+  --video "$TMP/v.avi" --labels "$TMP/none" --min-radius 100 --max-radius 5
+named "detect: --dnn-width 33" --dnn-width $FV detect --video "$TMP/v.avi" --out "$TMP/d.csv" \
+  --dnn-width 33
+named "detect: --dnn-accept 2" --dnn-accept $FV detect --video "$TMP/v.avi" --out "$TMP/d.csv" \
+  --dnn-accept 2
+named "eval detect: --grow 9" --grow $FV eval detect --video "$TMP/v.avi" --labels "$TMP/none" \
+  --grow 9
+named "plan: --good-angle 120 40" --good-angle $FV plan --rig "$TMP/none.json" --out "$TMP/plan" \
+  --good-angle 120 40
 check "eval ball: NaN truth" nonzero $FV eval ball --truth "$TMP/nan.csv" --est "$TMP/nan.csv"
 # An output that is one of the inputs (by name or through a link) is refused; the input stays.
 printf 'not a video\n' > "$TMP/v.avi"

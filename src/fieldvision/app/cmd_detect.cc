@@ -52,6 +52,7 @@ void Setup(CLI::App& app, int& exit_code) {
           "-1 or > 0"));
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
+    CheckBallSizeOptions(o->detector);
     // The field mask is the field seen through a posed camera; without one --field did nothing.
     FV_REQUIRE(
         o->field.empty() || (!o->camera.empty() && camera::ReadCameraYaml(o->camera).has_pose),

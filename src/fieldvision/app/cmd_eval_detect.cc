@@ -40,8 +40,10 @@ void Setup(CLI::App& app, int& exit_code) {
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
   AddBackgroundOption(cmd, o->background);
   cmd->add_option("--grow", o->grow, "Box growth for a hit, each side (share of the box)")
+      ->check(FiniteRange(0.0, 5.0))
       ->capture_default_str();
   cmd->add_option("--list", o->list_misses, "Misses and false detections to list")
+      ->check(CLI::Range(0, 1000000))
       ->capture_default_str();
   cmd->add_option("--out", o->out, "CSV with one row per image");
   cmd->add_option("--candidates", o->candidates_out,
@@ -51,6 +53,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "labelled box, every candidate, the reason)");
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
+    CheckBallSizeOptions(o->detector);
     ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
     std::cout << r.Summary(o->list_misses) << "\n";

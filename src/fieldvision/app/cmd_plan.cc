@@ -7,6 +7,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/plan/optimize.h"
 #include "fieldvision/plan/plan_run.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 namespace {
@@ -88,6 +89,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->needs(optimize);
   cmd->callback([o, good, &exit_code] {
     if (good->size() == 2) {
+      FV_REQUIRE((*good)[0] <= (*good)[1], "--good-angle MIN MAX: MIN ({}) is above MAX ({})",
+                 (*good)[0], (*good)[1]);
       o->coverage.good_angle_min_deg = (*good)[0];
       o->coverage.good_angle_max_deg = (*good)[1];
     }

@@ -46,6 +46,13 @@ inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
       ->capture_default_str();
 }
 
+// The radius limits together (each option checks its own range): in the options' names.
+inline void CheckBallSizeOptions(const detect::BallDetectorOptions& o) {
+  FV_REQUIRE(o.max_radius_px > o.min_radius_px,
+             "--max-radius ({}) must be larger than --min-radius ({})", o.max_radius_px,
+             o.min_radius_px);
+}
+
 // `--no-background`: the static camera's background is not used (detect/camera_background.h).
 inline void AddBackgroundOption(CLI::App* cmd, bool& background) {
   cmd->add_flag(
@@ -74,17 +81,29 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,
   cmd->add_option("--dnn-width", o.input_width,
                   "With dnn/both: network input width for the whole-frame search (multiple of "
                   "32; 0: the frame's width, at least 416)")
+      ->check(CLI::Validator(
+          [](const std::string& v) -> std::string {
+            int w = -1;
+            const bool ok = CLI::detail::lexical_cast(v, w) &&
+                            (w == 0 || (w >= 64 && w <= 4096 && w % 32 == 0));
+            return ok ? ""
+                      : "'" + v + "': give 0 (the frame's width) or a multiple of 32 in 64..4096";
+          },
+          "0 or 64..4096 by 32"))
       ->capture_default_str();
   cmd->add_option("--dnn-accept", o.accept_score,
                   "With dnn: a network ball is accepted from this score")
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--dnn-confirm", o.confirm_score,
                   "With both: a colour candidate is confirmed (accepted) from this network score "
                   "(in a crop around it or the whole frame)")
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--dnn-complete", o.complete_score,
                   "With both: a network ball where colour found nothing is accepted from this "
                   "score (1: never)")
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
   cmd->add_flag("!--dnn-crops-only", o.whole_frame,
                 "With both: check colour candidates in crops only, no whole-frame search (about "
