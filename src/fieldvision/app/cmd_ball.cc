@@ -46,6 +46,7 @@ void PrepareDraw(BallCliOptions& o) {
   }
   o.draw.ball_diameter_m = o.job.ball_diameter_m;
   o.draw.max_frames = o.job.pipeline.max_frames;
+  o.draw.fps = o.job.fps;  // image sequences' rate (videos keep their own, checked by the job)
   o.draw.progress = o.job.pipeline.progress;
   o.draw.Check();
   std::vector<std::string> stems;

@@ -112,6 +112,7 @@ void BallOverlayOptions::Check() const {
   FV_REQUIRE(!dir.empty(), "--draw needs a folder");
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0,
              "ball_diameter_m must be > 0 (got {})", ball_diameter_m);
+  FV_REQUIRE(std::isfinite(fps) && fps >= 0, "--fps must be >= 0 (got {})", fps);
 }
 
 std::string BallOverlayResult::Summary() const {
@@ -150,7 +151,9 @@ BallOverlayResult DrawBallOverlays(const std::vector<camera::Camera>& cameras,
     const camera::Camera& cam = cameras[i];
     const auto candidates =
         CandidatesByFrame(detections.empty() ? "" : detections[i], static_cast<int>(i));
-    auto source = io::VideoSource::Open(videos[i]);
+    io::VideoSourceOptions vo;
+    vo.fps = o.fps;
+    auto source = io::VideoSource::Open(videos[i], vo);
     FV_REQUIRE(!source->live(), "--draw: '{}' is a live source (its frames now are not the run's)",
                videos[i]);
     const cv::Mat band = detect::TextBand({legend}, source->width());

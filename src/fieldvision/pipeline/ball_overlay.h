@@ -21,9 +21,12 @@ struct BallOverlayOptions {
   // DrawNames of the cameras' names.
   std::vector<std::string> names;
   double ball_diameter_m = 0.22;  // the drawn circle's size
-  long long max_frames = 0;       // frames drawn per camera (<= 0: all)
-  bool progress = true;           // on a terminal
-  void Check() const;             // throws fv::Error naming the bad option
+  // Frame rate of image sequences (`ball --fps`; io::VideoSourceOptions::fps): 0 takes a synth
+  // scene.json's, else 30 stands in. Videos keep their own.
+  double fps = 0.0;
+  long long max_frames = 0;  // frames drawn per camera (<= 0: all)
+  bool progress = true;      // on a terminal
+  void Check() const;        // throws fv::Error naming the bad option
 };
 
 struct BallOverlayResult {

@@ -116,6 +116,15 @@ TEST(BallOverlay, DrawsTheBallWhereEachCameraSeesIt) {
   EXPECT_EQ(colour_near(frame_of(r.videos[1], 2), *cams[1].Project(ball) + Eigen::Vector2d(20, 0),
                         5, green),
             0);
+  // The sequences' rate: 30 stands in; `ball --fps` gives theirs.
+  EXPECT_NEAR(cv::VideoCapture(r.videos[0]).get(cv::CAP_PROP_FPS), 30.0, 0.01);
+  BallOverlayOptions at60 = o;
+  at60.dir = dir + "/drawn60";
+  at60.fps = 60;
+  fs::create_directories(at60.dir);
+  const BallOverlayResult r60 = DrawBallOverlays(cams, videos, dir + "/ball.csv", {}, at60);
+  ASSERT_EQ(r60.videos.size(), 2u);
+  EXPECT_NEAR(cv::VideoCapture(r60.videos[1]).get(cv::CAP_PROP_FPS), 60.0, 0.01);
   // A camera without its video, or BALL.csv missing: one error naming it.
   EXPECT_THROW(DrawBallOverlays(cams, {videos[0]}, dir + "/ball.csv", {}, o), Error);
   try {
