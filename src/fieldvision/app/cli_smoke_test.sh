@@ -291,6 +291,15 @@ grep -q -- "--smooth" "$TMP/err" || { echo "FAIL stats: option not named"; fail=
 check "fuse: --tolerance 1e300 (hung)" nonzero timeout 20 $FV fuse --listen tcp://127.0.0.1:0 \
   --camera "$TMP/sc/cam1.yaml" --camera "$TMP/sc/cam2.yaml" --out "$TMP/f.csv" --tolerance 1e300 \
   --no-progress
+# A fusion node's log (stderr not a terminal) gets no progress redraws.
+timeout -s INT 2 $FV fuse --listen tcp://127.0.0.1:0 --camera "$TMP/sc/cam1.yaml" \
+  --camera "$TMP/sc/cam2.yaml" --out "$TMP/f.csv" >/dev/null 2>"$TMP/fuse_log"
+if grep -q $'\r' "$TMP/fuse_log"; then echo "FAIL fuse: progress in a log"; fail=1; else
+  echo "ok   fuse: quiet in a log"; fi
+check "fuse: --listen not this machine's" nonzero timeout 20 $FV fuse \
+  --listen tcp://192.0.2.1:5555 --camera "$TMP/sc/cam1.yaml" --camera "$TMP/sc/cam2.yaml" \
+  --out "$TMP/f.csv" --no-progress
+grep -q "tcp://\*:PORT" "$TMP/err" || { echo "FAIL fuse: no advice for a foreign address"; fail=1; }
 check "studio: --assets a missing folder" nonzero timeout 20 $FV studio --assets "$TMP/none" \
   --port 0
 check "node: --start-at 1e300" nonzero $FV node --camera "$TMP/sc/cam1.yaml" \

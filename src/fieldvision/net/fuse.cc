@@ -25,6 +25,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
+#include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
@@ -271,6 +272,8 @@ class FuseServer {
   std::unique_ptr<FlightWorker> flight_worker_;
   util::CsvWriter* csv_ = nullptr;  // BALL.csv, while Run runs
   double last_report_ = 0;
+  // On a terminal, frames fused so far; quiet in a log (a fusion node runs for hours).
+  std::optional<util::Progress> progress_;
 };
 
 FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
@@ -298,6 +301,25 @@ FuseServer::FuseServer(const FuseOptions& o) : o_(o) {
   timings_.resize(n_);
 }
 
+namespace {
+
+// What to do about a failed bind, for the errors a user's address causes.
+std::string BindAdvice(int error) {
+  switch (error) {
+    case ENODEV:
+    case EADDRNOTAVAIL:
+      return " (give an address of this machine: tcp://*:PORT listens on all its networks)";
+    case EADDRINUSE:
+      return " (another program, or another fuse, listens there: give another PORT)";
+    case EACCES:
+      return " (ports below 1024 need administrator rights: give a PORT from 1024)";
+    default:
+      return "";
+  }
+}
+
+}  // namespace
+
 void FuseServer::Bind() {
   router_ = zmq::socket_t(ctx_, zmq::socket_type::router);
   router_.set(zmq::sockopt::linger, 0);
@@ -307,7 +329,7 @@ void FuseServer::Bind() {
   try {
     router_.bind(o_.listen);
   } catch (const zmq::error_t& e) {
-    Throw("fuse: cannot listen on '{}': {}", o_.listen, e.what());
+    Throw("fuse: cannot listen on '{}': {}{}", o_.listen, e.what(), BindAdvice(e.num()));
   }
   if (o_.on_listening) o_.on_listening(router_.get(zmq::sockopt::last_endpoint));
   if (o_.publish.empty()) return;
@@ -317,7 +339,7 @@ void FuseServer::Bind() {
   try {
     pub_.bind(o_.publish);
   } catch (const zmq::error_t& e) {
-    Throw("fuse: cannot publish on '{}': {}", o_.publish, e.what());
+    Throw("fuse: cannot publish on '{}': {}{}", o_.publish, e.what(), BindAdvice(e.num()));
   }
 }
 
@@ -560,15 +582,12 @@ void FuseServer::ReportProgress(double now) {
   if (o_.control != nullptr) {
     o_.control->Report({"fuse", fusion_->stats().frames, -1, "frames", ""});
   }
-  if (o_.progress) {
-    std::cerr << fmt::format("\rfuse: {} frames, {} positions", fusion_->stats().frames,
-                             summary_.rows_written)
-              << std::flush;
-  }
+  if (progress_) progress_->Update(fusion_->stats().frames);
 }
 
 FuseSummary FuseServer::Run() {
   Bind();
+  if (o_.progress) progress_.emplace("fuse", -1, "frames fused");
   if (o_.flights) {
     pipeline::LiveFlightsOptions fopt = o_.flight_options;
     fopt.analysis.ball_radius_m = 0.5 * o_.ball_diameter_m;
@@ -614,7 +633,7 @@ FuseSummary FuseServer::Run() {
     if (o_.idle_exit_s > 0 && summary_.messages > 0 && now - last_message > o_.idle_exit_s) break;
     ReportProgress(now);
   }
-  if (o_.progress) std::cerr << "\n";
+  if (progress_) progress_->Finish();
   while (auto group = sync_->Next(SteadyNow(), /*flush=*/true)) Emit(*group);
   if (flight_worker_) {
     flight_worker_->Finish();
