@@ -144,6 +144,8 @@ named "detect: --dnn-accept 2" --dnn-accept $FV detect --video "$TMP/v.avi" --ou
   --dnn-accept 2
 named "eval detect: --grow 9" --grow $FV eval detect --video "$TMP/v.avi" --labels "$TMP/none" \
   --grow 9
+named "synth: --seed -1" --seed $FV synth --preset kick --seed -1 --out "$TMP/syn_m1"
+[ -e "$TMP/syn_m1" ] && { echo "FAIL synth: a refused run made --out"; fail=1; }
 named "plan: --good-angle 120 40" --good-angle $FV plan --rig "$TMP/none.json" --out "$TMP/plan" \
   --good-angle 120 40
 check "eval ball: NaN truth" nonzero $FV eval ball --truth "$TMP/nan.csv" --est "$TMP/nan.csv"

@@ -85,6 +85,7 @@ void Setup(CLI::App& app, int& exit_code) {
   search_option("--restarts", o->search.restarts, "Restarts (the first from an even spread)", 1,
                 100);
   cmd->add_option("--seed", o->search.seed, "Random seed of the search")
+      ->check(Seed())
       ->capture_default_str()
       ->needs(optimize);
   cmd->callback([o, good, &exit_code] {

@@ -63,7 +63,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "balls near cam1's border) | held (a ball in a robot's handler)");
   cmd->add_option("--scene", o->scene, "Scene JSON (see scene.json written by a preset)");
   cmd->add_option("--out", o->out, "Output folder (created)")->required();
-  cmd->add_option("--seed", o->seed, "Random seed (placements, paths, noise)");
+  cmd->add_option("--seed", o->seed, "Random seed (placements, paths, noise)")->check(Seed());
   cmd->add_option("--frames", o->frames, "Number of frames")->check(CLI::Range(1, 1000000));
   cmd->add_option("--width", o->width, "Image width of every camera (at most 8192)")
       ->check(CLI::Range(16, 8192));

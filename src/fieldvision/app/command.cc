@@ -65,6 +65,17 @@ CLI::Validator FiniteRange(double lo, double hi) {
       fmt::format("NUMBER in [{}, {}]", lo, hi));
 }
 
+CLI::Validator Seed() {
+  return CLI::Validator(
+      [](std::string& text) {
+        const bool digits = !text.empty() && text.size() <= 19 &&
+                            text.find_first_not_of("0123456789") == std::string::npos;
+        return digits ? std::string()
+                      : fmt::format("'{}' is not a seed (a whole number from 0)", text);
+      },
+      "0..10^19");
+}
+
 CLI::Validator Endpoint(bool bind) {
   return CLI::Validator(
       [bind](std::string& text) {

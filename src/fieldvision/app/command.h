@@ -28,6 +28,9 @@ CLI::App* CommandGroup(CLI::App& app, const std::string& name);
 // option's name before the message ("--step: value nan is not a number in [0.001, 100]").
 CLI::Validator FiniteRange(double lo, double hi);
 
+// An option check for a seed: digits only (CLI11 reads "-1" into an unsigned as 2^64 - 1).
+CLI::Validator Seed();
+
 // An option check for a ZeroMQ address: tcp://HOST:PORT (HOST not empty, PORT in 1..65535, or
 // also * and 0 where `bind`) or ipc://PATH. ZeroMQ aborts the process on some malformed ones.
 CLI::Validator Endpoint(bool bind);
