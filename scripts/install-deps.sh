@@ -7,7 +7,7 @@ PKGS=(
   build-essential cmake ninja-build pkg-config
   libopencv-dev libopencv-contrib-dev libjpeg62-turbo-dev libavutil-dev
   libeigen3-dev libceres-dev
-  nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev
+  nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-onnx python3-numpy darknet
   libcpp-httplib-dev chromium

@@ -1,14 +1,15 @@
 #include "fieldvision/calib/import.h"
 
-#include <cctype>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
 #include <fmt/format.h>
+#include <toml++/toml.h>
 #include <opencv2/core.hpp>
 
 #include "fieldvision/camera/camera_io.h"
@@ -19,167 +20,44 @@
 namespace fv::calib {
 namespace {
 
-struct TomlValue {
-  enum class Type { kString, kNumber, kBool, kArray } type = Type::kNumber;
-  std::string text;
-  double number = 0.0;
-  bool boolean = false;
-  std::vector<TomlValue> items;
-};
-
-class TomlParser {
- public:
-  TomlParser(const std::string& s, const std::string& where) : s_(s), where_(where) {}
-  TomlValue Value() {
-    Skip();
-    FV_REQUIRE(pos_ < s_.size(), "{}: a value is missing", where_);
-    const char c = s_[pos_];
-    TomlValue v;
-    if (c == '[') {
-      v.type = TomlValue::Type::kArray;
-      ++pos_;
-      while (true) {
-        Skip();
-        FV_REQUIRE(pos_ < s_.size(), "{}: an array is not closed", where_);
-        if (s_[pos_] == ']') {
-          ++pos_;
-          break;
-        }
-        v.items.push_back(Value());
-        Skip();
-        if (pos_ < s_.size() && s_[pos_] == ',') ++pos_;
-      }
-      return v;
-    }
-    if (c == '"' || c == '\'') {
-      v.type = TomlValue::Type::kString;
-      const size_t end = s_.find(c, pos_ + 1);
-      FV_REQUIRE(end != std::string::npos, "{}: a string is not closed", where_);
-      v.text = s_.substr(pos_ + 1, end - pos_ - 1);
-      pos_ = end + 1;
-      return v;
-    }
-    size_t end = pos_;
-    while (end < s_.size() && s_[end] != ',' && s_[end] != ']' &&
-           !std::isspace(static_cast<unsigned char>(s_[end]))) {
-      ++end;
-    }
-    const std::string tok = s_.substr(pos_, end - pos_);
-    pos_ = end;
-    if (tok == "true" || tok == "false") {
-      v.type = TomlValue::Type::kBool;
-      v.boolean = tok == "true";
-      return v;
-    }
-    try {
-      size_t used = 0;
-      v.number = std::stod(tok, &used);
-      FV_REQUIRE(used == tok.size(), "{}: '{}' is not a number", where_, tok);
-    } catch (const std::logic_error&) {
-      Throw("{}: '{}' is not a number, string, boolean or array", where_, tok);
-    }
-    return v;
+// The camera tables of a calibration.toml in file order (toml::table orders its keys by name).
+std::vector<std::pair<std::string, const toml::table*>> CameraSections(const toml::table& root) {
+  std::vector<std::pair<std::string, const toml::table*>> out;
+  for (const auto& [key, node] : root) {
+    const toml::table* t = node.as_table();
+    if (t != nullptr && t->contains("matrix")) out.emplace_back(std::string(key.str()), t);
   }
-
- private:
-  void Skip() {
-    while (pos_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[pos_]))) ++pos_;
-  }
-  const std::string& s_;
-  std::string where_;
-  size_t pos_ = 0;
-};
-
-// Removes a # comment outside strings.
-std::string StripComment(const std::string& line) {
-  char quote = 0;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quote) {
-      if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '#') {
-      return line.substr(0, i);
-    }
-  }
-  return line;
-}
-
-std::string Trim(const std::string& s) {
-  const size_t b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const size_t e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
-
-using TomlTable = std::map<std::string, TomlValue>;
-
-// Sections in file order, each a table of key -> value.
-std::vector<std::pair<std::string, TomlTable>> ParseToml(const std::string& path) {
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "calibration file '{}' cannot be read", path);
-  util::SkipUtf8Bom(in);
-  std::vector<std::pair<std::string, TomlTable>> out;
-  out.emplace_back("", TomlTable{});
-  std::string line, pending_key, pending;
-  int depth = 0, line_no = 0, key_line = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    line = StripComment(line);
-    if (!pending_key.empty()) {
-      pending += "\n" + line;
-    } else {
-      const std::string t = Trim(line);
-      if (t.empty()) continue;
-      if (t.front() == '[' && t.find('=') == std::string::npos) {
-        FV_REQUIRE(t.back() == ']', "{}:{}: a section header is not closed", path, line_no);
-        out.emplace_back(Trim(t.substr(1, t.size() - 2)), TomlTable{});
-        continue;
-      }
-      const size_t eq = t.find('=');
-      FV_REQUIRE(eq != std::string::npos, "{}:{}: expected key = value", path, line_no);
-      pending_key = Trim(t.substr(0, eq));
-      pending = t.substr(eq + 1);
-      key_line = line_no;
-    }
-    depth = 0;
-    char quote = 0;
-    for (char c : pending) {
-      if (quote) {
-        if (c == quote) quote = 0;
-      } else if (c == '"' || c == '\'') {
-        quote = c;
-      } else if (c == '[') {
-        ++depth;
-      } else if (c == ']') {
-        --depth;
-      }
-    }
-    if (depth > 0) continue;
-    const std::string where = fmt::format("{}:{}: key '{}'", path, key_line, pending_key);
-    TomlParser p(pending, where);
-    out.back().second[pending_key] = p.Value();
-    pending_key.clear();
-    pending.clear();
-  }
-  FV_REQUIRE(pending_key.empty(), "{}:{}: the value of '{}' is not closed", path, key_line,
-             pending_key);
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    return a.second->source().begin.line < b.second->source().begin.line;
+  });
   return out;
 }
 
-std::vector<double> Numbers(const TomlValue& v, const std::string& where) {
-  FV_REQUIRE(v.type == TomlValue::Type::kArray, "{}: expected an array of numbers", where);
+toml::table ParseToml(const std::string& path) {
+  FV_REQUIRE(std::ifstream(path).good() && !std::filesystem::is_directory(path),
+             "calibration file '{}' cannot be read", path);
+  try {
+    return toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    Throw("{}:{}: {}", path, e.source().begin.line, e.description());
+  }
+}
+
+// The numbers of an array, nested arrays flattened (a matrix as rows).
+std::vector<double> Numbers(const toml::node* node, const std::string& where) {
+  FV_REQUIRE(node != nullptr && node->is_array(), "{}: expected an array of numbers", where);
   std::vector<double> out;
-  for (const auto& item : v.items) {
-    if (item.type == TomlValue::Type::kArray) {
-      const auto inner = Numbers(item, where);
+  for (const toml::node& item : *node->as_array()) {
+    if (item.is_array()) {
+      const auto inner = Numbers(&item, where);
       out.insert(out.end(), inner.begin(), inner.end());
-    } else {
-      FV_REQUIRE(item.type == TomlValue::Type::kNumber, "{}: expected numbers", where);
-      FV_REQUIRE(std::isfinite(item.number), "{}: {} is not a finite number", where, item.number);
-      out.push_back(item.number);
+      continue;
     }
+    const std::optional<double> v = item.value<double>();
+    FV_REQUIRE(v.has_value() && (item.is_floating_point() || item.is_integer()),
+               "{}: expected numbers", where);
+    FV_REQUIRE(std::isfinite(*v), "{}: {} is not a finite number", where, *v);
+    out.push_back(*v);
   }
   return out;
 }
@@ -208,23 +86,18 @@ void ParseImageSize(const std::string& text, const std::string& what, int* width
 
 std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double metres_per_unit) {
   CheckPositive(metres_per_unit, "metres_per_unit");
-  const auto sections = ParseToml(path);
+  const toml::table root = ParseToml(path);
   std::vector<camera::Camera> cams;
-  for (const auto& entry : sections) {
-    const auto& section = entry.first;
-    const auto& table = entry.second;  // a plain reference: lambdas below capture it
-    if (!table.count("matrix")) continue;
+  for (const auto& [section, table_ptr] : CameraSections(root)) {
+    const toml::table& table = *table_ptr;  // a plain reference: lambdas below capture it
     const std::string where = fmt::format("calibration file '{}' [{}]", path, section);
-    auto get = [&](const char* key) -> const TomlValue& {
-      const auto it = table.find(key);
-      FV_REQUIRE(it != table.end(), "{}: key '{}' is missing", where, key);
-      return it->second;
+    auto get = [&](const char* key) {
+      const toml::node* n = table.get(key);
+      FV_REQUIRE(n != nullptr, "{}: key '{}' is missing", where, key);
+      return n;
     };
     camera::Camera c;
-    c.name = section;
-    if (table.count("name") && table.at("name").type == TomlValue::Type::kString) {
-      c.name = table.at("name").text;
-    }
+    c.name = table["name"].value_or(section);
     const auto size = Numbers(get("size"), where + " size");
     FV_REQUIRE(size.size() == 2, "{}: size must be [width, height]", where);
     c.width = static_cast<int>(std::lround(size[0]));
@@ -237,12 +110,10 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
     c.cy = k[5];
     FV_REQUIRE(std::abs(k[1]) < 1e-9 * std::abs(k[0]) + 1e-12,
                "{}: the matrix has a skew term {}; the OpenCV model has none", where, k[1]);
-    if (table.count("fisheye")) {
-      FV_REQUIRE(!table.at("fisheye").boolean,
-                 "{}: fisheye cameras are not supported (OpenCV's pinhole model only)", where);
-    }
-    c.distortion = table.count("distortions")
-                       ? Numbers(table.at("distortions"), where + " distortions")
+    FV_REQUIRE(!table["fisheye"].value_or(false),
+               "{}: fisheye cameras are not supported (OpenCV's pinhole model only)", where);
+    c.distortion = table.contains("distortions")
+                       ? Numbers(table.get("distortions"), where + " distortions")
                        : std::vector<double>{};
     // k1 or k1 k2 alone: the radial terms, the rest 0 (three numbers could be k1 k2 k3 or k1 k2
     // p1: refused).
@@ -252,9 +123,9 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
                "{}: distortions has {} numbers; OpenCV's model takes 4, 5, 8, 12 or 14 (k1 k2 p1 "
                "p2 [k3 ...]), or k1 [k2] alone",
                where, nd);
-    if (table.count("rotation") && table.count("translation")) {
-      const auto r = Numbers(table.at("rotation"), where + " rotation");
-      const auto t = Numbers(table.at("translation"), where + " translation");
+    if (table.contains("rotation") && table.contains("translation")) {
+      const auto r = Numbers(table.get("rotation"), where + " rotation");
+      const auto t = Numbers(table.get("translation"), where + " translation");
       FV_REQUIRE(r.size() == 3 || r.size() == 9,
                  "{}: rotation must be a Rodrigues vector or a 3x3 matrix", where);
       FV_REQUIRE(t.size() == 3, "{}: translation must have 3 numbers", where);

@@ -3,8 +3,8 @@
 // 3x3, distortions [k1 k2 p1 p2 (k3)], rotation (Rodrigues rvec) and translation, world to camera
 // as OpenCV), and OpenCV's stereo calibration files (stereo_calib.cpp's intrinsics.yml M1 D1 M2 D2
 // and extrinsics.yml R T, camera 2 from camera 1). Qualisys `.qca.txt` is read by pose2sim.h.
-// The TOML reader covers the subset these files use (tables, strings, numbers, booleans, nested
-// arrays; comments), written by hand as no TOML library is packaged for C++ in Debian 12.
+// TOML is read with toml++ (Debian's libtomlplusplus-dev); the writer prints the subset these
+// tools read, in their layout.
 #pragma once
 
 #include <string>

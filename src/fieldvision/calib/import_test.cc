@@ -89,6 +89,19 @@ TEST(Import, BadTomlNamesFileAndKey) {
   EXPECT_THAT([&] { ReadCalibrationToml(path); },
               ThrowsMessage<Error>(
                   ::testing::AllOf(HasSubstr("[cam_1]"), HasSubstr("distortions has 3 numbers"))));
+  // A key given twice is not TOML (the last one used to win): file and line named.
+  std::ofstream(path) << "[cam_1]\nname = \"x\"\nsize = [10, 10]\n"
+                         "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\nname = \"y\"\n";
+  EXPECT_THAT([&] { ReadCalibrationToml(path); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("bad.toml:5"), HasSubstr("name"))));
+  // Cameras come in file order, whatever their sections' names.
+  std::ofstream(path) << "[cam_2]\nname = \"first\"\nsize = [10, 10]\n"
+                         "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\n"
+                         "[cam_1]\nsize = [10, 10]\nmatrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\n";
+  const auto ordered = ReadCalibrationToml(path);
+  ASSERT_EQ(ordered.size(), 2u);
+  EXPECT_EQ(ordered[0].name, "first");
+  EXPECT_EQ(ordered[1].name, "cam_1");
   // k1 k2 alone: the radial terms, the rest 0.
   std::ofstream(path) << "[cam_1]\nname = \"x\"\nsize = [10, 10]\n"
                          "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\ndistortions = [0.1, 0.2]\n";
