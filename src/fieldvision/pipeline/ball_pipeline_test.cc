@@ -400,6 +400,23 @@ TEST(BallPipeline, ARigOfCamerasAtOnePlaceIsRefused) {
   EXPECT_NO_THROW(CheckRigSpread({s.cams[0]}, {"a.yaml"}));
 }
 
+// A run without one position (here the wrong colour) is an error saying why, and an earlier
+// BALL.csv stays as it was instead of becoming a header.
+TEST(BallPipeline, AJobWithoutAPositionKeepsTheEarlierOutput) {
+  const std::string dir = testing::TempDir() + "/job_no_position";
+  const Scene s = SixFrameJobScene(dir);
+  BallJobOptions job = JobOn(s, dir);
+  job.ball_diameter_m = 2 * kRadius;
+  const BallJobResult first = RunBallJob(job);
+  ASSERT_GT(first.rows_written, 0);
+  job.colour = "blue";
+  EXPECT_THAT([&] { RunBallJob(job); },
+              ThrowsMessage<Error>(::testing::AllOf(
+                  HasSubstr("no ball position in 6 frames"), HasSubstr("cam0 0"),
+                  HasSubstr("ball.csv' not written"), ::testing::Not(HasSubstr("\n")))));
+  EXPECT_EQ(util::CsvTable::Read(job.out).rows(), static_cast<size_t>(first.rows_written));
+}
+
 // Pairing frames by index needs one frame rate: a camera at another rate is refused naming both
 // videos (the fused times would go back where the shorter video ends), unless timestamps pair
 // them.
