@@ -14,12 +14,13 @@
 #include "fieldvision/detect/colour.h"
 #include "fieldvision/pipeline/camera_stage.h"
 #include "fieldvision/recon/triangulation.h"
+#include "fieldvision/util/error.h"
 
 namespace fv::app {
 
 inline void AddBallDiameterOption(CLI::App* cmd, double& diameter_m) {
   cmd->add_option("--ball-diameter", diameter_m, "Ball diameter in metres")
-      ->check(FiniteRange(0.01, 2.0))
+      ->check(FiniteRange(0.01, 1.5))
       ->capture_default_str();
 }
 
@@ -56,6 +57,13 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
   cmd->add_flag("!--no-weak", t.use_weak,
                 "Never use candidates that failed a shape check to complete a position");
+}
+
+// The tracking options together (each checks its own range): in the options' names.
+inline void CheckTrackOptions(const pipeline::BallTrackOptions& t) {
+  FV_REQUIRE(t.scan_bands <= t.full_scan_every,
+             "--scan-bands ({}) must not exceed --full-scan-every ({})", t.scan_bands,
+             t.full_scan_every);
 }
 
 inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {

@@ -144,6 +144,17 @@ named "detect: --dnn-accept 2" --dnn-accept $FV detect --video "$TMP/v.avi" --ou
   --dnn-accept 2
 named "eval detect: --grow 9" --grow $FV eval detect --video "$TMP/v.avi" --labels "$TMP/none" \
   --grow 9
+named "ball: --scan-bands above --full-scan-every" --scan-bands $FV ball --camera "$TMP/c1.yaml" \
+  --video "$TMP/v.avi" --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" \
+  --scan-bands 50
+named "fuse: --max-wait 0" --max-wait $FV fuse --listen tcp://127.0.0.1:0 --camera "$TMP/c1.yaml" \
+  --camera "$TMP/c2.yaml" --out "$TMP/f.csv" --max-wait 0
+named "eval detect: --min-visible 2" --min-visible $FV eval detect --video "$TMP/v.avi" \
+  --labels "$TMP/none" --min-visible 2
+named "players: --input-width 33" --input-width $FV players --video "$TMP/v.avi" \
+  --out "$TMP/t.csv" --input-width 33
+named "trajectory: --predict-fraction nan" --predict-fraction $FV trajectory --in "$TMP/none.csv" \
+  --out "$TMP/f.json" --predict-fraction nan
 named "synth: --seed -1" --seed $FV synth --preset kick --seed -1 --out "$TMP/syn_m1"
 [ -e "$TMP/syn_m1" ] && { echo "FAIL synth: a refused run made --out"; fail=1; }
 named "plan: --good-angle 120 40" --good-angle $FV plan --rig "$TMP/none.json" --out "$TMP/plan" \
@@ -188,7 +199,7 @@ check "synth: over 16 Mpx" nonzero $FV synth --preset static --width 8192 --heig
   --out "$TMP/synth"
 check "players: --input-width 32000" nonzero $FV players --video "$TMP/v.avi" \
   --input-width 32000 --out "$TMP/tracks.csv"
-grep -q input_width "$TMP/err" || { echo "FAIL players: error does not name input_width"; fail=1; }
+grep -q -- --input-width "$TMP/err" || { echo "FAIL players: error does not name --input-width"; fail=1; }
 check "plan: --step 1e-4" nonzero $FV plan --field fifa --optimize --step 1e-4 --out "$TMP/plan"
 grep -q "grid step" "$TMP/err" || { echo "FAIL plan: error does not name the step"; fail=1; }
 printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n' > "$TMP/tracks.csv"

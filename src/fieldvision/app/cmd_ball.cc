@@ -206,6 +206,7 @@ void Setup(CLI::App& app, int& exit_code) {
   AddTrackOptions(cmd, o->job.pipeline.track);
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
   cmd->callback([o, cmd] {
+    CheckTrackOptions(o->job.pipeline.track);
     FV_REQUIRE(!o->det.detections.empty() ||
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");

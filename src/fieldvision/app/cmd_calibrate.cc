@@ -643,7 +643,7 @@ void SetupRefine(CLI::App* group) {
   re->add_option("--out", rc->out, "Camera file to write (with --rig: a folder)")->required();
   re->add_option("--lut-resolution", rc->o.lut_resolution_m,
                  "Cell of the distance lookup table in metres")
-      ->check(FiniteRange(1e-3, 1))
+      ->check(FiniteRange(1e-3, 0.5))
       ->capture_default_str();
   re->add_option("--overlay", rc->overlay,
                  "Also write the check image of the refined pose (with --rig: of the first "

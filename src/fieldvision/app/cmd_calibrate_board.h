@@ -12,8 +12,8 @@
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/calib/board.h"
-#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/output_path.h"
 
 namespace fv::app {
 

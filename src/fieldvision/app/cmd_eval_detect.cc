@@ -30,6 +30,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "name, cam1.avi -> cam1, else its folder's, cam1/%05d.png -> cam1)");
   cmd->add_option("--min-visible", o->labels.min_visible,
                   "truth_2d.csv: frames whose ball is less visible than this share are not judged")
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--camera", o->camera, "Camera file (size checks)");
   cmd->add_option("--field", o->field,

@@ -41,7 +41,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--max-wait", o->sync.max_wait_s,
                   "Longest wait (s) for a slow camera before a frame is fused without it")
-      ->check(FiniteRange(0, 60))
+      ->check(FiniteRange(0.001, 60))
       ->capture_default_str();
   cmd->add_option("--media-max-wait", o->media_max_wait_s,
                   "The same for nodes reading files as fast as they can (not --realtime): a "

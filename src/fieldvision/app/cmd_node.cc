@@ -65,6 +65,7 @@ void Setup(CLI::App& app, int& exit_code) {
   AddBackgroundOption(cmd, o->background);
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o, &exit_code] {
+    CheckTrackOptions(o->track);
     pipeline::JobControl control;
     const StopOnSignal stop_on_signal(control);
     o->control = &control;

@@ -111,7 +111,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--model", c->o.detector.model_path,
                   "NanoDet model (default: BUILD/models/nanodet.onnx from make build)");
   cmd->add_option("--input-width", c->o.detector.input_width,
-                  "Network input width in pixels (multiple of 32; smaller is faster)");
+                  "Network input width in pixels (multiple of 32; smaller is faster)")
+      ->check(NetworkWidth());
   cmd->add_option("--score", c->o.detector.score_threshold, "Lowest detection score kept")
       ->check(FiniteRange(0, 1));
   cmd->add_option("--min-height", c->o.detector.min_height_px,

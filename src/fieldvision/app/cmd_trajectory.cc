@@ -51,14 +51,14 @@ void Setup(CLI::App& app, int& exit_code) {
   c->add_option("--ball-mass", j.ball_mass_kg,
                 "Ball mass in kg, for the spin in rev/s (default 0.43; 0.0027 for a "
                 "Timestamp,X,Y,Z file)")
-      ->check(FiniteRange(1e-5, 1000.0));
+      ->check(FiniteRange(1e-5, 100.0));
   c->add_option("--noise", j.analysis.noise_m,
                 "Position noise (1 sigma, metres); default: estimated from the track")
       ->check(FiniteRange(0.0, 100.0));
   c->add_option("--accel-slack", j.accel_slack_mps2,
                 "Unmodelled acceleration (drag, spin) allowed before a velocity change counts as "
                 "a bounce or hit, m/s^2 (default 10; 25 for a Timestamp,X,Y,Z file)")
-      ->check(FiniteRange(0.0, 100000.0));
+      ->check(FiniteRange(0.0, 1000.0));
   c->add_option("--field", j.field,
                 "Field (built-in name or JSON) for in/out, goal and basket calls");
   CLI::Option* rule =
@@ -72,7 +72,7 @@ void Setup(CLI::App& app, int& exit_code) {
   c->add_option("--report", j.report_path, "Write a report JSON (flights, calls, timeline)");
   c->add_option("--predict-fraction", j.predict_fraction,
                 "Part of each flight used to predict its landing (default 0.5)")
-      ->check(CLI::Range(0.05, 1.0));
+      ->check(FiniteRange(0.05, 1.0));
   c->add_flag("!--no-progress", o->progress,
               "Do not show progress (shown on a terminal only, while the arcs are fitted)");
   c->callback([o, rule, line, &exit_code] {

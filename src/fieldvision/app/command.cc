@@ -65,6 +65,19 @@ CLI::Validator FiniteRange(double lo, double hi) {
       fmt::format("NUMBER in [{}, {}]", lo, hi));
 }
 
+CLI::Validator NetworkWidth() {
+  return CLI::Validator(
+      [](std::string& text) {
+        int w = -1;
+        const bool ok =
+            CLI::detail::lexical_cast(text, w) && (w == 0 || (w >= 64 && w <= 4096 && w % 32 == 0));
+        return ok ? std::string()
+                  : fmt::format("'{}': give 0 (the frame's width) or a multiple of 32 in 64..4096",
+                                text);
+      },
+      "0 or 64..4096 by 32");
+}
+
 CLI::Validator Seed() {
   return CLI::Validator(
       [](std::string& text) {

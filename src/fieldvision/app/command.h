@@ -28,6 +28,10 @@ CLI::App* CommandGroup(CLI::App& app, const std::string& name);
 // option's name before the message ("--step: value nan is not a number in [0.001, 100]").
 CLI::Validator FiniteRange(double lo, double hi);
 
+// An option check for a network's input width: 0 (from the frame) or a multiple of 32 in
+// 64..4096 (dnn/nanodet.h).
+CLI::Validator NetworkWidth();
+
 // An option check for a seed: digits only (CLI11 reads "-1" into an unsigned as 2^64 - 1).
 CLI::Validator Seed();
 

@@ -81,15 +81,7 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,
   cmd->add_option("--dnn-width", o.input_width,
                   "With dnn/both: network input width for the whole-frame search (multiple of "
                   "32; 0: the frame's width, at least 416)")
-      ->check(CLI::Validator(
-          [](const std::string& v) -> std::string {
-            int w = -1;
-            const bool ok = CLI::detail::lexical_cast(v, w) &&
-                            (w == 0 || (w >= 64 && w <= 4096 && w % 32 == 0));
-            return ok ? ""
-                      : "'" + v + "': give 0 (the frame's width) or a multiple of 32 in 64..4096";
-          },
-          "0 or 64..4096 by 32"))
+      ->check(NetworkWidth())
       ->capture_default_str();
   cmd->add_option("--dnn-accept", o.accept_score,
                   "With dnn: a network ball is accepted from this score")

@@ -52,6 +52,16 @@ int CalibFlags(const IntrinsicsOptions& o, bool k3_free) {
   return flags;
 }
 
+// The distortion vector calibrateCamera fills for `flags`: OpenCV refuses a longer start (a
+// 14-number start with the thin-prism model of 12).
+cv::Mat ZeroDistortionFor(int flags) {
+  const int n = (flags & cv::CALIB_TILTED_MODEL)       ? 14
+                : (flags & cv::CALIB_THIN_PRISM_MODEL) ? 12
+                : (flags & cv::CALIB_RATIONAL_MODEL)   ? 8
+                                                       : 5;
+  return cv::Mat::zeros(1, n, CV_64F);
+}
+
 std::string Today() {
   const std::time_t t = std::time(nullptr);
   char buf[32];
@@ -205,7 +215,7 @@ CvFit FitDroppingOutliers(const std::vector<BoardView>& views, const std::vector
       img.push_back(views[i].image_points);
     }
     k = cv::Mat::eye(3, 3, CV_64F);
-    d = cv::Mat::zeros(1, 14, CV_64F);
+    d = ZeroDistortionFor(flags);
     rvecs.clear();
     tvecs.clear();
     try {
@@ -339,7 +349,7 @@ double OuterPredictionRmsPx(const std::vector<BoardView>& views, const std::vect
   }
   constexpr double kNone = std::numeric_limits<double>::infinity();
   if (obj.size() < 3) return kNone;
-  cv::Mat k = cv::Mat::eye(3, 3, CV_64F), d = cv::Mat::zeros(1, 14, CV_64F);
+  cv::Mat k = cv::Mat::eye(3, 3, CV_64F), d = ZeroDistortionFor(flags);
   std::vector<cv::Mat> rvecs, tvecs;
   try {
     cv::calibrateCamera(obj, img, size, k, d, rvecs, tvecs, flags, FitCriteria());

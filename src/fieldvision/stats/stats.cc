@@ -431,9 +431,8 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
     t_min = std::min(t_min, t.front());
     t_max = std::max(t_max, t.back());
   }
-  FV_REQUIRE(!res.tracks.empty(),
-             "no player is followed for min_track_s = {} s ({} ids, each shorter)", o.min_track_s,
-             res.left_out.size());
+  FV_REQUIRE(!res.tracks.empty(), "no player is followed for {} s or more ({} ids, each shorter)",
+             o.min_track_s, res.left_out.size());
   // A track too short to tell its noise takes the others' median (one camera, one tracker).
   std::vector<double> known;
   for (const SmoothTrack& s : res.tracks) {
