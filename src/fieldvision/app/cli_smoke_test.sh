@@ -155,6 +155,22 @@ named "players: --input-width 33" --input-width $FV players --video "$TMP/v.avi"
   --out "$TMP/t.csv" --input-width 33
 named "trajectory: --predict-fraction nan" --predict-fraction $FV trajectory --in "$TMP/none.csv" \
   --out "$TMP/f.json" --predict-fraction nan
+named "ball: --max-frames with --detections" --max-frames $FV ball --camera "$TMP/c1.yaml" \
+  --detections "$TMP/d1.csv" --camera "$TMP/c2.yaml" --detections "$TMP/d2.csv" \
+  --out "$TMP/b.csv" --max-frames 2
+named "ball: --color with --detections" --color $FV ball --camera "$TMP/c1.yaml" \
+  --detections "$TMP/d1.csv" --camera "$TMP/c2.yaml" --detections "$TMP/d2.csv" \
+  --out "$TMP/b.csv" --colour yellow
+named "calibrate import: --image-size with --toml" --image-size $FV calibrate import \
+  --toml "$TMP/none.toml" --image-size 640x480 --out "$TMP/imp_size"
+named "studio: --live port 99999" --live $FV studio --port 0 --live tcp://127.0.0.1:99999
+named "calibrate intrinsics: --k3 free with --model 4" --k3 $FV calibrate intrinsics \
+  --images "$TMP/none" --cols 9 --rows 6 --square 0.025 --out "$TMP/ci.yaml" --model 4 --k3 free
+named "calibrate multi: --tangential free --zero-tangent" --zero-tangent $FV calibrate multi \
+  --board chessboard --cols 9 --rows 6 --square 0.025 --views a="$TMP/none" \
+  --views b="$TMP/none2" --out "$TMP/multi_tz" --tangential free --zero-tangent
+named "calibrate extrinsics: --image-size with --camera" --image-size $FV calibrate extrinsics \
+  --camera "$TMP/c1.yaml" --image-size 640x480 --points "$TMP/none.csv" --out "$TMP/ce.yaml"
 named "synth: --seed -1" --seed $FV synth --preset kick --seed -1 --out "$TMP/syn_m1"
 [ -e "$TMP/syn_m1" ] && { echo "FAIL synth: a refused run made --out"; fail=1; }
 named "plan: --good-angle 120 40" --good-angle $FV plan --rig "$TMP/none.json" --out "$TMP/plan" \

@@ -113,6 +113,9 @@ void RunBall(const BallCliOptions& o) {
         r.bundle->kept_flights);
   }
   std::cout << "wrote " << o.job.out << " (" << r.rows_written << " rows)\n";
+  if (const std::string w = r.NoPositionWarning(); !w.empty()) {
+    std::cerr << "fieldvision: warning: " << w << "\n";
+  }
   if (r.eval) std::cout << r.eval->Table(o.rows || r.eval->rows.size() <= 40) << "\n";
   if (!o.draw.dir.empty()) Draw(o);
 }
@@ -157,6 +160,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "[,radius_px,score] (repeat; pairs with --camera in order; paired by time)");
   cmd->add_option("--det-sigma", o->det.sigma_px,
                   "With --detections: 1-sigma of a detection's centre in pixels")
+      ->check(FiniteRange(0.01, 100))
       ->capture_default_str();
   cmd->add_option("--flights", o->det.flights,
                   "With --detections: also fit the flights and write FLIGHTS.json");
@@ -200,7 +204,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("--live", o->job.live,
                 "Live: play the videos at their frame rate (as cameras deliver) and keep the "
                 "newest frames when fusion falls behind (drops frames)");
-  cmd->add_option("--max-frames", o->job.pipeline.max_frames, "Stop after this many frames")
+  cmd->add_option("--max-frames", o->job.pipeline.max_frames,
+                  "Stop after this many frames (0: all)")
       ->check(CLI::Range(0LL, 1000000000LL));
   AddFusionOptions(cmd, o->job.pipeline.triangulation);
   AddTrackOptions(cmd, o->job.pipeline.track);
@@ -210,6 +215,36 @@ void Setup(CLI::App& app, int& exit_code) {
     FV_REQUIRE(!o->det.detections.empty() ||
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");
+    if (!o->det.detections.empty()) {
+      // With detections the 2D positions are given: what reads and searches frames cannot apply.
+      for (const char* name : {"--color",
+                               "--detector",
+                               "--dnn-width",
+                               "--dnn-accept",
+                               "--dnn-confirm",
+                               "--dnn-complete",
+                               "--dnn-crops-only",
+                               "--dnn-keep-score",
+                               "--dnn-keep-field",
+                               "--dnn-keep",
+                               "--sync",
+                               "--timestamps",
+                               "--fps",
+                               "--no-background",
+                               "--live",
+                               "--max-frames",
+                               "--whole-frames",
+                               "--full-scan-every",
+                               "--scan-bands",
+                               "--guided-frames",
+                               "--unconfirmed-scan-every",
+                               "--field"}) {
+        FV_REQUIRE(cmd->count(name) == 0,
+                   "ball: {} applies to --video only (with --detections the 2D positions are "
+                   "given)",
+                   name);
+      }
+    }
     if (o->det.detections.empty()) PrepareDraw(*o);
     o->det.own_scores = cmd->count("--min-two-view-score") > 0;
     try {

@@ -202,6 +202,9 @@ void RunIntrinsics(IntrinsicsCli& c) {
   c.o.board = c.board.Spec();
   c.o.camera_name = c.name;
   c.o.progress = !c.quiet;
+  FV_REQUIRE(c.k3 == "auto" || c.o.num_distortion == 5,
+             "--k3 {} goes with --model 5 (the model of {} numbers decides k3 itself)", c.k3,
+             c.o.num_distortion);
   c.o.k3 = calib::ParseK3Model(c.k3);
   const IntrinsicsResult r = CalibrateIntrinsics(c.images, c.o);
   std::cout << fmt::format("{:<48s} {:>7s} {:>8s}  {}\n", "view", "corners", "rms_px", "status");
@@ -298,6 +301,7 @@ void RunFocal(const ExtrinsicsCli& c, const field::FieldModel* field) {
   ParseImageSize(c.image_size, "--image-size", &w, &h);
   const auto pts = ReadPointsCsv(c.points.front(), field, w, h);
   if (c.homography_only) {
+    FV_REQUIRE(!c.k1, "--k1 goes with the focal length's fit, not with --homography-only");
     const HomographyResult r = EstimateGroundHomography(w, h, pts, c.o.ransac_threshold_px);
     PrintPointTable(r.points);
     std::cout << r.Summary() << "\n";
@@ -349,6 +353,9 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
     RunFocal(c, field.get());
     return;
   }
+  FV_REQUIRE(c.image_size.empty() && !c.k1,
+             "--image-size and --k1 estimate the focal length from the points; with --camera its "
+             "intrinsics are used: give one or the other");
   FV_REQUIRE(!c.homography_only, "--homography-only goes with --image-size, not --camera");
   const camera::Camera cam = camera::ReadCameraYaml(c.camera);
   const auto pts = ReadPointsCsv(c.points.front(), field.get(), cam.width, cam.height);

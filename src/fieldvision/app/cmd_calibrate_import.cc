@@ -77,6 +77,8 @@ void RunImport(const ImportCli& c) {
       !c.tsai.empty() + !c.qualisys.empty() + !c.toml.empty() + !c.opencv_stereo.empty();
   FV_REQUIRE(sources == 1, "give one of --tsai, --qualisys, --toml or --opencv-stereo (got {})",
              sources);
+  FV_REQUIRE(c.image_size.empty() || !c.opencv_stereo.empty(),
+             "--image-size goes with --opencv-stereo (the other files hold each camera's size)");
   if (!c.tsai.empty()) {
     const track::TsaiParameters p = track::ReadTsaiXml(c.tsai);
     std::string name = c.name;

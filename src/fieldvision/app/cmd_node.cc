@@ -45,7 +45,7 @@ void Setup(CLI::App& app, int& exit_code) {
   AddBallDiameterOption(cmd, o->ball_diameter_m);
   AddBallColourOption(cmd, o->colour);
   cmd->add_option("--field", o->field, "Field (name or JSON): look for the ball only over it");
-  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames")
+  cmd->add_option("--max-frames", o->max_frames, "Stop after this many frames (0: all)")
       ->check(FiniteRange(0, 1e12));
   AddTrackOptions(cmd, o->track);
   cmd->add_option("--connect-wait", o->connect_wait_s,

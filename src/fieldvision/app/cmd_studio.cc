@@ -25,7 +25,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--token", o->token, "Token for a non-loopback --host (default: random)");
   cmd->add_option("--live", o->live,
                   "Subscribe the 3D view's live mode to a fusion node's positions from the start "
-                  "(its --publish address, tcp://HOST:PORT)");
+                  "(its --publish address, tcp://HOST:PORT)")
+      ->check(Endpoint(/*bind=*/false));
   cmd->add_option("--assets", o->assets,
                   "Folder of the built front end (default: studio/dist of the source tree, else "
                   "share/fieldvision/studio of the install)");

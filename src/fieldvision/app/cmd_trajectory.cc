@@ -53,7 +53,7 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Timestamp,X,Y,Z file)")
       ->check(FiniteRange(1e-5, 100.0));
   c->add_option("--noise", j.analysis.noise_m,
-                "Position noise (1 sigma, metres); default: estimated from the track")
+                "Position noise (1 sigma, metres); default or 0: estimated from the track")
       ->check(FiniteRange(0.0, 100.0));
   c->add_option("--accel-slack", j.accel_slack_mps2,
                 "Unmodelled acceleration (drag, spin) allowed before a velocity change counts as "

@@ -191,8 +191,11 @@ std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
   return sources;
 }
 
-// One line: why no frame got a position, and that `out` was not written.
-std::string NoPositionError(const BallPipelineSummary& s, const std::string& out) {
+}  // namespace
+
+std::string BallJobResult::NoPositionWarning() const {
+  if (rows_written > 0) return "";
+  const BallPipelineSummary& s = summary;
   std::string per_camera;
   for (size_t c = 0; c < s.candidates_per_camera.size(); ++c) {
     per_camera += fmt::format("{}{} {}", c > 0 ? ", " : "",
@@ -200,13 +203,11 @@ std::string NoPositionError(const BallPipelineSummary& s, const std::string& out
                               s.candidates_per_camera[c]);
   }
   return fmt::format(
-      "ball: no ball position in {} frames ({} with candidates in fewer than 2 cameras, {} whose "
-      "candidates disagree; candidates per camera: {}): '{}' not written, an earlier file is "
-      "kept (check --color and the cameras' poses)",
-      s.frames, s.frames_few_blobs, s.frames_inconsistent, per_camera, out);
+      "no ball position in {} frames ({} with candidates in fewer than 2 cameras, {} whose "
+      "candidates disagree; candidates per camera: {}): the output has its header only (check "
+      "--color and the cameras' poses)",
+      s.frames, s.frames_few_blobs, s.frames_inconsistent, per_camera);
 }
-
-}  // namespace
 
 BallRegionDetectFn BallDetectFnFor(std::shared_ptr<detect::BallDetector> detector) {
   return [det = std::move(detector)](const cv::Mat& bgr, const cv::Rect& roi) {
@@ -330,9 +331,6 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
       refiner->Finish();
       result.bundle = refiner->totals();
     }
-    // Not one position (a wrong colour, unposed cameras): an earlier BALL.csv is worth more than
-    // a header, and the run did not do its job.
-    if (result.rows_written == 0) Throw("{}", NoPositionError(result.summary, o.out));
     csv.Close();
   });
   for (size_t c = 0; c < det_files.size(); ++c) det_files[c]->CloseAndCommit(*det_csvs[c]);

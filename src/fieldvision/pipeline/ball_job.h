@@ -58,6 +58,9 @@ struct BallJobResult {
   long long rows_written = 0;
   std::optional<FlightBundle> bundle;    // offline with `bundle`
   std::vector<std::string> backgrounds;  // per camera, NeededBackgroundSummary
+  // One line when not one frame got a position (a wrong colour, unposed cameras): why, from the
+  // summary; "" otherwise. BALL.csv then holds its header only (a video without the ball).
+  std::string NoPositionWarning() const;
 };
 
 BallJobResult RunBallJob(const BallJobOptions& options);
