@@ -163,7 +163,8 @@ named "ball: --color with --detections" --color $FV ball --camera "$TMP/c1.yaml"
   --out "$TMP/b.csv" --colour yellow
 named "calibrate import: --image-size with --toml" --image-size $FV calibrate import \
   --toml "$TMP/none.toml" --image-size 640x480 --out "$TMP/imp_size"
-named "studio: --live port 99999" --live $FV studio --port 0 --live tcp://127.0.0.1:99999
+named "studio: --live port 99999" --live timeout 20 $FV studio --port 0 \
+  --live tcp://127.0.0.1:99999
 named "calibrate intrinsics: --k3 free with --model 4" --k3 $FV calibrate intrinsics \
   --images "$TMP/none" --cols 9 --rows 6 --square 0.025 --out "$TMP/ci.yaml" --model 4 --k3 free
 named "calibrate multi: --tangential free --zero-tangent" --zero-tangent $FV calibrate multi \

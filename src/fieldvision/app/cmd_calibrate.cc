@@ -337,8 +337,8 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
   std::unique_ptr<field::FieldModel> field;
   if (!c.field.empty()) field = std::make_unique<field::FieldModel>(field::LoadField(c.field));
   if (!c.rig.empty()) {
-    FV_REQUIRE(c.image_size.empty() && !c.homography_only,
-               "--rig places calibrated cameras; it does not go with --image-size or "
+    FV_REQUIRE(c.image_size.empty() && !c.homography_only && !c.k1,
+               "--rig places calibrated cameras; it does not go with --image-size, --k1 or "
                "--homography-only");
     PlaceRigOnField(c, field.get());
     return;

@@ -171,7 +171,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--pairing", c->pairing,
                   "auto (frame number when every file name has one, else sorted order), order or "
                   "frame")
-      ->check(CLI::IsMember({"auto", "order", "frame", "frame-number"}))
+      ->check(CLI::IsMember({"auto", "order", "frame", "frame-number"}, CLI::ignore_case))
       ->capture_default_str();
   cmd->add_option("--intrinsics", c->intrinsics,
                   "NAME=CAM.yaml: known intrinsics of a camera, kept fixed (repeat)");
@@ -181,7 +181,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--tangential", c->tangential,
                   "Tangential distortion p1 p2: auto (per camera, kept only where it lowers the "
                   "reprojection error by more than its 2 parameters cost: BIC), free or zero")
-      ->check(CLI::IsMember({"auto", "free", "zero"}))
+      ->check(CLI::IsMember({"auto", "free", "zero"}, CLI::ignore_case))
       ->capture_default_str();
   cmd->add_flag("--zero-tangent", c->zero_tangent, "The same as --tangential zero");
   cmd->add_option("--k3", c->k3,

@@ -36,7 +36,7 @@ void Setup(CLI::App& app, int& exit_code) {
       ->required();
   c->add_option("--ball-diameter", j.ball_diameter_m,
                 "Ball diameter in metres (default 0.22; 0.04 for a Timestamp,X,Y,Z file)")
-      ->check(FiniteRange(0.001, 2.0));
+      ->check(FiniteRange(0.001, 1.5));
   c->add_option("--gravity", j.analysis.gravity_mps2, "Gravity in m/s^2 (default 9.81)")
       ->check(FiniteRange(0.01, 1000.0));
   c->add_option("--ground-z", j.analysis.ground_z_m,

@@ -1,6 +1,7 @@
 #include "fieldvision/calib/import.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -20,13 +21,26 @@
 namespace fv::calib {
 namespace {
 
+// The tables with a `matrix` under `table`, at any depth ([cam.1] is table 1 in table cam), named
+// by their dotted path.
+void CollectCameraTables(const toml::table& table, const std::string& prefix,
+                         std::vector<std::pair<std::string, const toml::table*>>* out) {
+  for (const auto& [key, node] : table) {
+    const toml::table* t = node.as_table();
+    if (t == nullptr) continue;
+    const std::string name = prefix + std::string(key.str());
+    if (t->contains("matrix")) {
+      out->emplace_back(name, t);
+    } else {
+      CollectCameraTables(*t, name + ".", out);
+    }
+  }
+}
+
 // The camera tables of a calibration.toml in file order (toml::table orders its keys by name).
 std::vector<std::pair<std::string, const toml::table*>> CameraSections(const toml::table& root) {
   std::vector<std::pair<std::string, const toml::table*>> out;
-  for (const auto& [key, node] : root) {
-    const toml::table* t = node.as_table();
-    if (t != nullptr && t->contains("matrix")) out.emplace_back(std::string(key.str()), t);
-  }
+  CollectCameraTables(root, "", &out);
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
     return a.second->source().begin.line < b.second->source().begin.line;
   });
@@ -63,6 +77,31 @@ std::vector<double> Numbers(const toml::node* node, const std::string& where) {
 }
 
 std::string Num(double v) { return fmt::format("{:.17g}", v); }
+
+// A TOML basic string: quoted, with quotes, backslashes and control characters escaped.
+std::string TomlString(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (u < 0x20 || u == 0x7f) {
+      out += fmt::format("\\u{:04X}", u);
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+// A table name: bare when it is letters, digits, _ and - only, else quoted (a dot would nest it).
+std::string TomlKey(const std::string& s) {
+  const bool bare = !s.empty() && std::all_of(s.begin(), s.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+  });
+  return bare ? s : TomlString(s);
+}
 
 cv::Mat ReadMat(const cv::FileStorage& fs, const std::string& key) {
   cv::Mat m;
@@ -171,8 +210,8 @@ void WriteCalibrationToml(const std::vector<camera::Camera>& cameras, const std:
           d.resize(std::max<size_t>(d.size(), 4), 0.0);
           const Eigen::Vector3d r = c.cam_from_world.Rvec();
           const Eigen::Vector3d& t = c.cam_from_world.translation;
-          out << "[" << name << "]\n";
-          out << "name = \"" << name << "\"\n";
+          out << "[" << TomlKey(name) << "]\n";
+          out << "name = " << TomlString(name) << "\n";
           out << "size = [ " << c.width << ".0, " << c.height << ".0,]\n";
           out << "matrix = [ [ " << Num(c.fx) << ", 0.0, " << Num(c.cx) << ",], [ 0.0, "
               << Num(c.fy) << ", " << Num(c.cy) << ",], [ 0.0, 0.0, 1.0,],]\n";

@@ -67,6 +67,21 @@ error = 0.42
                                              cams[i].cam_from_world.rotation),
               1e-12);
   }
+  // Names that are no bare TOML keys (a dot would nest the table, a space or quote end it) come
+  // back as they were; a dotted header written by hand ([cam.1]) is still a camera.
+  std::vector<camera::Camera> odd = cams;
+  odd[0].name = "cam.1";
+  odd[1].name = "cam 2 \"left\"";
+  WriteCalibrationToml(odd, out);
+  const auto odd_back = ReadCalibrationToml(out);
+  ASSERT_EQ(odd_back.size(), 2u);
+  EXPECT_EQ(odd_back[0].name, "cam.1");
+  EXPECT_EQ(odd_back[1].name, "cam 2 \"left\"");
+  std::ofstream(out)
+      << "[rig.cam_1]\nsize = [10, 10]\nmatrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\n";
+  const auto nested = ReadCalibrationToml(out);
+  ASSERT_EQ(nested.size(), 1u);
+  EXPECT_EQ(nested[0].name, "rig.cam_1");
 }
 
 TEST(Import, BadTomlNamesFileAndKey) {
