@@ -28,11 +28,14 @@ const examples: Record<string, string> = {
 export async function jobsPage(root: HTMLElement): Promise<void> {
   const command = optionsSelect('jb-command', Object.keys(examples), 'ball');
   const args = el('input', { id: 'jb-args', value: examples.ball, size: '90' });
+  // An existing output (an earlier run's ball.csv) is written over only when asked.
+  const replace = el('input', { id: 'jb-replace', type: 'checkbox' }) as HTMLInputElement;
   const start = el('button', { id: 'jb-start', text: 'Start' });
   const msg = el('div', { id: 'jb-status', class: 'status' });
   const table = el('table', { id: 'jb-list' });
   root.replaceChildren(
-    el('section', { class: 'controls' }, labelled('Command', command), labelled('Arguments (paths inside the folder)', args), start),
+    el('section', { class: 'controls' }, labelled('Command', command), labelled('Arguments (paths inside the folder)', args),
+      el('label', {}, replace, 'Replace existing outputs'), start),
     msg, table,
   );
   command.onchange = () => (args.value = examples[command.value]);
@@ -68,7 +71,9 @@ export async function jobsPage(root: HTMLElement): Promise<void> {
   window.addEventListener('studio-event', onEvent);
   start.onclick = async () => {
     try {
-      const j = await api.post<Job>('/api/jobs', { command: command.value, args: args.value.split(/\s+/).filter(Boolean) });
+      const j = await api.post<Job>('/api/jobs', {
+        command: command.value, args: args.value.split(/\s+/).filter(Boolean), replace: replace.checked,
+      });
       jobs.set(j.id, j);
       draw();
       status(msg, `started job ${j.id}`);

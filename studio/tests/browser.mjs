@@ -66,9 +66,11 @@ const consoleErrors = [];
 page.on('pageerror', (e) => consoleErrors.push(String(e)));
 page.on('console', (m) => m.type() === 'error' && !/Failed to load resource/.test(m.text()) && consoleErrors.push(m.text()));
 // Replies with 4xx/5xx that the pages did not ask for on purpose.
-// (A pose request with too few or collinear points is answered 422 and shown on the page.)
-page.on('response', (r) => r.status() >= 400 && !(r.status() === 422 && r.url().includes('/api/calibrate/pose')) &&
-  consoleErrors.push(`${r.status()} ${r.url()}`));
+// (A pose request with too few or collinear points is answered 422 and shown on the page; a job
+// whose output exists, 409, in the jobs check below.)
+const asked = (r) => (r.status() === 422 && r.url().includes('/api/calibrate/pose')) ||
+  (r.status() === 409 && r.url().endsWith('/api/jobs'));
+page.on('response', (r) => r.status() >= 400 && !asked(r) && consoleErrors.push(`${r.status()} ${r.url()}`));
 page.setDefaultTimeout(20000);
 
 // Clicks image pixel (u, v) (OpenCV convention) on a canvas showing the image scaled.
@@ -360,6 +362,15 @@ try {
   await page.click('#jb-start');
   await page.waitForSelector('#jb-list tr[data-state="done"]', { timeout: 30000 });
   check(fs.existsSync(path.join(work, 'flights_job.json')), 'a trajectory job ran to the end (flights_job.json written)');
+  // The same job again would write over its output: refused until "Replace existing outputs".
+  await page.click('#jb-start');
+  await page.waitForFunction(() => /exists/.test(document.querySelector('#jb-status').textContent));
+  check(await page.$$eval('#jb-list tr[data-job]', (rows) => rows.length) === 1,
+    'a job whose output exists is refused (no second job)');
+  await page.check('#jb-replace');
+  await page.click('#jb-start');
+  await page.waitForFunction(() => document.querySelectorAll('#jb-list tr[data-state="done"]').length === 2, null, { timeout: 30000 });
+  check(true, 'with "Replace existing outputs" it runs again');
   await page.selectOption('#jb-command', 'synth');
   await page.fill('#jb-args', '--preset kick --frames 100000 --out long_scene');
   await page.click('#jb-start');

@@ -45,7 +45,7 @@ bool LooksLikePath(const std::string& v) {
 }  // namespace
 
 std::vector<std::string> CheckJobArguments(const Workspace& ws, const std::string& command,
-                                           const std::vector<std::string>& args) {
+                                           const std::vector<std::string>& args, bool replace) {
   if (!kCommands.count(command)) {
     std::string names;
     for (const auto& c : kCommands) names += (names.empty() ? "" : ", ") + c;
@@ -64,7 +64,15 @@ std::vector<std::string> CheckJobArguments(const Workspace& ws, const std::strin
     }
     const bool input = kInputs.count(option) || (kNameOrFile.count(option) && LooksLikePath(a));
     if (input || kOutputs.count(option)) {
-      argv.push_back(ws.Resolve(a, input).string());
+      const fs::path resolved = ws.Resolve(a, input);
+      std::error_code ec;
+      const bool taken =
+          fs::is_directory(resolved, ec) ? !fs::is_empty(resolved, ec) : fs::exists(resolved, ec);
+      if (!input && taken && !replace) {
+        throw HttpError(409, "'" + a + "' (" + option +
+                                 ") exists: choose another name, or replace it (replace: true)");
+      }
+      argv.push_back(resolved.string());
     } else if (LooksLikePath(a) || a.find('/') != std::string::npos) {
       throw HttpError(400, "job argument '" + a + "' looks like a path, but " +
                                (option.empty() ? "no option" : "option " + option) +
@@ -128,9 +136,10 @@ JobRunner::~JobRunner() {
   }
 }
 
-int JobRunner::Start(const std::string& command, const std::vector<std::string>& args) {
+int JobRunner::Start(const std::string& command, const std::vector<std::string>& args,
+                     bool replace) {
   const std::vector<std::string> argv_strings = [&] {
-    std::vector<std::string> a = CheckJobArguments(workspace_, command, args);
+    std::vector<std::string> a = CheckJobArguments(workspace_, command, args, replace);
     a.insert(a.begin(), program_);
     return a;
   }();

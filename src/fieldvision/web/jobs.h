@@ -19,9 +19,12 @@ namespace fv::web {
 
 // The command line of a job after checking: the subcommand must be one of the allowed ones; the
 // values of options that name files are resolved inside the folder (inputs must exist); any
-// other value that looks like a path is refused. Throws HttpError 400/403/404.
+// other value that looks like a path is refused; an output that exists (a file, a folder with
+// files) is refused unless `replace` (the page's prefilled arguments would write over an earlier
+// run's results). Throws HttpError 400/403/404/409.
 std::vector<std::string> CheckJobArguments(const Workspace& workspace, const std::string& command,
-                                           const std::vector<std::string>& args);
+                                           const std::vector<std::string>& args,
+                                           bool replace = false);
 
 class JobRunner {
  public:
@@ -34,7 +37,7 @@ class JobRunner {
 
   // Starts a job; returns its id. Throws HttpError for refused arguments, fv::Error when the
   // process cannot be started.
-  int Start(const std::string& command, const std::vector<std::string>& args);
+  int Start(const std::string& command, const std::vector<std::string>& args, bool replace = false);
   // Ends a running job (SIGTERM to its process group); false when it is not running.
   bool Cancel(int id);
   // {id, command, args, state (running|done|failed|cancelled), exit_code, progress, output,

@@ -1049,12 +1049,14 @@ std::vector<Route> JobRoutes() {
          return Json(jobs->List());
        }},
       {{"POST", "/api/jobs",
-        "{command: ball|trajectory|players|stats|plan|detect|synth, args: [...]}: start a job"},
+        "{command: ball|trajectory|players|stats|plan|detect|synth, args: [...], replace: false}: "
+        "start a job (an existing output is refused unless replace)"},
        [](const Workspace&, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          if (!jobs) throw HttpError(404, "this server runs no jobs");
          const json body = Body(r);
          const int id = jobs->Start(Get<std::string>(body, "command"),
-                                    GetOr<std::vector<std::string>>(body, "args", {}));
+                                    GetOr<std::vector<std::string>>(body, "args", {}),
+                                    GetOr<bool>(body, "replace", false));
          return Json(jobs->Get(id));
        }},
       {{"POST", "/api/jobs/cancel", "{id}: end a running job"},

@@ -896,10 +896,18 @@ TEST_F(StudioApiTest, JobsRunAndCancel) {
   const Reply trajectory = Post("/api/jobs", json{{"command", "trajectory"}, {"args", fit}});
   ASSERT_EQ(trajectory.status, 200) << trajectory.body;
   WaitForJob(*client_, trajectory.j()["id"], 120);
+  // Run again, it would write over its outputs: refused unless asked to replace them.
+  ExpectError(Post("/api/jobs", json{{"command", "trajectory"}, {"args", fit}}), 409,
+              "'jobs/t.json' (--out) exists");
+  const Reply again =
+      Post("/api/jobs", json{{"command", "trajectory"}, {"args", fit}, {"replace", true}});
+  ASSERT_EQ(again.status, 200) << again.body;
+  EXPECT_EQ(WaitForJob(*client_, again.j()["id"], 120)["state"], "done");
   std::vector<std::string> outside = fit;
   outside[5] = "../r.json";
-  ExpectError(Post("/api/jobs", json{{"command", "trajectory"}, {"args", outside}}), 403,
-              "outside");
+  ExpectError(
+      Post("/api/jobs", json{{"command", "trajectory"}, {"args", outside}, {"replace", true}}), 403,
+      "outside");
 
   const Reply long_job = Post(
       "/api/jobs", json{{"command", "synth"},
