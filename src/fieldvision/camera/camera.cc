@@ -1,8 +1,10 @@
 #include "fieldvision/camera/camera.h"
 
 #include <cmath>
+#include <limits>
 
 #include <ceres/jet.h>
+#include <Eigen/SVD>
 
 #include "fieldvision/util/error.h"
 
@@ -149,6 +151,19 @@ std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) cons
     x = *next;
   }
   return x;
+}
+
+double Camera::DistortionMinScale(const Eigen::Vector2d& xn) const {
+  const auto intr = IntrinsicsBlock();
+  using Jet = ceres::Jet<double, 2>;
+  std::array<Jet, kNumDistortion> dj;
+  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(intr[4 + i]);
+  Jet xd, yd;
+  DistortNormalized(dj.data(), Jet(xn.x(), 0), Jet(xn.y(), 1), &xd, &yd);
+  Eigen::Matrix2d j;
+  j << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
+  if (!j.allFinite() || j.determinant() <= 0) return std::numeric_limits<double>::quiet_NaN();
+  return Eigen::JacobiSVD<Eigen::Matrix2d>(j).singularValues().minCoeff();
 }
 
 std::optional<geometry::Ray3d> Camera::RayFromPixel(const Eigen::Vector2d& uv) const {

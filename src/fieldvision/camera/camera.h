@@ -50,6 +50,10 @@ struct Camera {
   std::optional<geometry::Ray3d> RayFromPixel(const Eigen::Vector2d& uv) const;
   // Metres on a plane facing the camera covered by one pixel at the depth of `p_world`.
   double PixelFootprintM(const Eigen::Vector3d& p_world) const;
+  // The lens distortion's smallest local magnification at normalized point `xn` (x/z, y/z): the
+  // smaller singular value of its Jacobian, 1 without distortion (a barrel lens shrinks things
+  // near the border, most along the radius). Not finite where the model folds.
+  double DistortionMinScale(const Eigen::Vector2d& xn) const;
   // Inside the image, OpenCV pixel centres: [-0.5, w - 0.5) x [-0.5, h - 0.5), shrunk by margin.
   bool InImage(const Eigen::Vector2d& uv, double margin_px = 0.0) const;
 };

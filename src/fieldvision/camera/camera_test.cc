@@ -135,6 +135,23 @@ TEST(Camera, UndistortStaysOnTheBranchThroughTheCentre) {
   }
 }
 
+// k1 alone: at radius r the image is stretched 1 + k1 r^2 across the radius and 1 + 3 k1 r^2
+// along it (d/dr of r (1 + k1 r^2)); a barrel lens (k1 < 0) shrinks most along the radius.
+TEST(Camera, DistortionMinScale) {
+  Camera cam = Camera::FromFov(1000, 800, 90);
+  EXPECT_DOUBLE_EQ(cam.DistortionMinScale({0.6, -0.3}), 1.0);
+  cam.distortion = {-0.2, 0, 0, 0, 0};
+  const Eigen::Vector2d xn(0.6, -0.3);
+  const double r2 = xn.squaredNorm();
+  EXPECT_NEAR(cam.DistortionMinScale(xn), 1 - 3 * 0.2 * r2, 1e-12);
+  EXPECT_NEAR(cam.DistortionMinScale({0, 0}), 1.0, 1e-12);
+  cam.distortion = {0.2, 0, 0, 0, 0};  // pincushion: the tangential stretch is the smaller one
+  EXPECT_NEAR(cam.DistortionMinScale(xn), 1 + 0.2 * r2, 1e-12);
+  // Beyond the fold of a strong barrel lens (1 + 3 k1 r^2 < 0): no scale.
+  cam.distortion = {-0.5, 0, 0, 0, 0};
+  EXPECT_FALSE(std::isfinite(cam.DistortionMinScale({1.0, 0.5})));
+}
+
 TEST(Camera, BehindAndFootprint) {
   Camera cam = Camera::FromFov(1000, 800, 90);
   cam.has_pose = true;  // identity pose: looking along +z

@@ -96,10 +96,13 @@ bool SeesPoint(const camera::Camera& camera, const Eigen::Vector3d& p_world,
     // Its image's narrowest width: the focal length times the diameter over the depth along the
     // optical axis (over the distance it was 1 / cos(off-axis angle) too small: 8.2 px for the
     // render's 9.6-10.1 px 32 degrees off the axis, and corners the cameras see were counted
-    // unseen).
-    const double diameter_px =
-        std::sqrt(camera.fx * camera.fy) * options.ball_diameter_m / p_cam.z();
-    if (diameter_px < options.min_ball_px) return false;
+    // unseen), times the lens distortion's smallest magnification there (a wide barrel lens
+    // shrinks a ball near its border).
+    double diameter_px = std::sqrt(camera.fx * camera.fy) * options.ball_diameter_m / p_cam.z();
+    if (HasDistortion(camera)) {
+      diameter_px *= camera.DistortionMinScale(p_cam.head<2>() / p_cam.z());
+    }
+    if (!(diameter_px >= options.min_ball_px)) return false;
   }
   if (HasDistortion(camera)) {
     // Strong distortion folds points far outside the view back into the image: keep a point only

@@ -119,6 +119,24 @@ TEST(CoverageTest, BallTooSmallBeyondMaximumDepth) {
   EXPECT_DOUBLE_EQ(EvaluateCoverage({cam}, field, o).layers[0].fraction_exactly[1], 0.0);
 }
 
+// A barrel lens shrinks the ball near the image border (most along the radius): with the
+// pinhole width just above the limit, the centre still sees it and the border does not.
+TEST(CoverageTest, BarrelDistortionShrinksTheBallNearTheBorder) {
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  CoverageOptions o;
+  const double z = 0.5 * o.ball_diameter_m;
+  camera::Camera cam = OverheadCamera("top", {0, 0}, 18, 12, z, 5.0, 100);
+  const double width_px = 100.0 * o.ball_diameter_m;  // f D / 5 m, f = 500 px
+  o.min_ball_px = 0.95 * width_px;
+  const Eigen::Vector3d centre(0, 0, z), border(8.0, 0, z);  // x/z 1.6 at the border
+  EXPECT_TRUE(SeesPoint(cam, centre, o));
+  EXPECT_TRUE(SeesPoint(cam, border, o));
+  cam.distortion = {-0.02, 0, 0, 0, 0};  // 1 + 3 k1 r^2 = 0.85 at r = 1.6
+  ASSERT_TRUE(cam.InImage(*cam.Project(border)));
+  EXPECT_TRUE(SeesPoint(cam, centre, o));
+  EXPECT_FALSE(SeesPoint(cam, border, o));
+}
+
 TEST(CoverageTest, BestPairAngleIsClosestTo90) {
   fv::testing::SeededRng rng(11);
   const Eigen::Vector3d p(rng.Uniform(-5, 5), rng.Uniform(-3, 3), 0.11);
