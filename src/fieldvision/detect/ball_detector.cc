@@ -528,8 +528,11 @@ void BallDetector::ChangedFirst(const cv::Mat& bgr, const cv::Rect& roi,
   const Background* background = background_();
   if (background == nullptr) return;
   constexpr double kChangedShare = 0.5;
+  // A disc of 2 reduced pixels at least: a smaller one reads too few of them to say anything (a
+  // 1.5 px yellow patch of a printed, shaded 5 px ball never counted as changed).
+  const double min_radius_px = 2.0 * background->scale();
   std::stable_partition(order->begin(), order->end(), [&](const Blob* b) {
-    const double radius = std::max(0.5 * std::max(b->width_px(), b->height_px()), 1.5);
+    const double radius = std::max(0.5 * std::max(b->width_px(), b->height_px()), min_radius_px);
     return background->Compare(bgr, b->centroid_px(), radius, roi).disc_share >= kChangedShare;
   });
 }

@@ -472,21 +472,26 @@ TEST(BallDetector, TheBackgroundRefinesWhatCameIntoViewFirst) {
   }
   const Background background(std::move(samples), base.size(), {});
   ASSERT_TRUE(background.usable()) << background.Summary();
-  const Eigen::Vector2d ball(rng.Uniform(60, 260), rng.Uniform(190, 215));
-  cv::Mat img = base.clone();
-  test_util::PaintDisc(img, ball, 6);
-  img = test_util::WithNoise(img, rng, 2.0);
-  BallDetectorOptions o;
-  o.max_refine = 8;
-  BallDetector det(o, nullptr, nullptr);
-  const auto ball_accepted = [&](const std::vector<BallCandidate>& cands) {
-    return std::any_of(cands.begin(), cands.end(), [&](const BallCandidate& c) {
-      return c.accepted && (c.centre_px - ball).norm() < 1.0;
-    });
-  };
-  EXPECT_FALSE(ball_accepted(det.Detect(img)));
-  det.SetBackground([&] { return &background; });
-  EXPECT_TRUE(ball_accepted(det.Detect(img)));
+  // A ball of 6 px, and one of 2.5 px (a disc too small to compare at the background's half
+  // scale was never counted as changed).
+  for (const double radius_px : {6.0, 2.5}) {
+    SCOPED_TRACE(::testing::Message() << "ball radius " << radius_px << " px");
+    const Eigen::Vector2d ball(rng.Uniform(60, 260), rng.Uniform(190, 215));
+    cv::Mat img = base.clone();
+    test_util::PaintDisc(img, ball, radius_px);
+    img = test_util::WithNoise(img, rng, 2.0);
+    BallDetectorOptions o;
+    o.max_refine = 8;
+    BallDetector det(o, nullptr, nullptr);
+    const auto ball_accepted = [&](const std::vector<BallCandidate>& cands) {
+      return std::any_of(cands.begin(), cands.end(), [&](const BallCandidate& c) {
+        return c.accepted && (c.centre_px - ball).norm() < 1.0;
+      });
+    };
+    EXPECT_FALSE(ball_accepted(det.Detect(img)));
+    det.SetBackground([&] { return &background; });
+    EXPECT_TRUE(ball_accepted(det.Detect(img)));
+  }
 }
 
 TEST(BallDetector, BadInputGivesErrors) {
