@@ -172,6 +172,8 @@ named "calibrate multi: --tangential free --zero-tangent" --zero-tangent $FV cal
   --views b="$TMP/none2" --out "$TMP/multi_tz" --tangential free --zero-tangent
 named "calibrate extrinsics: --image-size with --camera" --image-size $FV calibrate extrinsics \
   --camera "$TMP/c1.yaml" --image-size 640x480 --points "$TMP/none.csv" --out "$TMP/ce.yaml"
+named "plan: --search-step too fine" --search-step $FV plan --camera "$TMP/sc/cam1.yaml" \
+  --camera "$TMP/sc/cam2.yaml" --out "$TMP/plan_fine" --optimize --search-step 1e-6 --no-progress
 named "synth: --seed -1" --seed $FV synth --preset kick --seed -1 --out "$TMP/syn_m1"
 [ -e "$TMP/syn_m1" ] && { echo "FAIL synth: a refused run made --out"; fail=1; }
 named "plan: --good-angle 120 40" --good-angle $FV plan --rig "$TMP/none.json" --out "$TMP/plan" \
@@ -218,7 +220,7 @@ check "players: --input-width 32000" nonzero $FV players --video "$TMP/v.avi" \
   --input-width 32000 --out "$TMP/tracks.csv"
 grep -q -- --input-width "$TMP/err" || { echo "FAIL players: error does not name --input-width"; fail=1; }
 check "plan: --step 1e-4" nonzero $FV plan --field fifa --optimize --step 1e-4 --out "$TMP/plan"
-grep -q "grid step" "$TMP/err" || { echo "FAIL plan: error does not name the step"; fail=1; }
+grep -q -- "--step 0.0001" "$TMP/err" || { echo "FAIL plan: error does not name the step"; fail=1; }
 printf 'frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n' > "$TMP/tracks.csv"
 for f in 1 2 3; do echo "$f,1,0,0,10,20,1,$f,0," >> "$TMP/tracks.csv"; done
 echo "2000000000,1,0,0,10,20,1,5,0," >> "$TMP/tracks.csv"

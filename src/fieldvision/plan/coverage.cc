@@ -74,16 +74,18 @@ void CoverageOptions::Check() const {
   CheckNonNegative(error_weight_per_m, "error_weight_per_m");
 }
 
-void CheckCoverageGrid(const field::FieldModel& field, const CoverageOptions& options) {
+void CheckCoverageGrid(const field::FieldModel& field, const CoverageOptions& options,
+                       std::string_view what) {
   const double half_x =
       options.include_surround ? field.HalfLengthWithSurround() : 0.5 * field.length_m;
   const double half_y =
       options.include_surround ? field.HalfWidthWithSurround() : 0.5 * field.width_m;
   constexpr double kMaxCells = 4e6;  // a 2 km x 2 km area at 1 m, a football pitch at 6 cm
-  FV_REQUIRE((2 * half_x / options.grid_step_m) * (2 * half_y / options.grid_step_m) <= kMaxCells,
-             "coverage: grid step {} m gives more than {:.0f} cells on field '{}' ({:.0f} x {:.0f} "
-             "m): use a larger step",
-             options.grid_step_m, kMaxCells, field.name, 2 * half_x, 2 * half_y);
+  FV_REQUIRE(
+      (2 * half_x / options.grid_step_m) * (2 * half_y / options.grid_step_m) <= kMaxCells,
+      "coverage: {} {} m gives more than {:.0f} cells on field '{}' ({:.0f} x {:.0f} m): use "
+      "a larger step",
+      what, options.grid_step_m, kMaxCells, field.name, 2 * half_x, 2 * half_y);
 }
 
 bool SeesPoint(const camera::Camera& camera, const Eigen::Vector3d& p_world,

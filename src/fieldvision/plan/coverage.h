@@ -9,6 +9,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -89,7 +90,9 @@ std::optional<Eigen::Matrix3d> TriangulationCovariance(
     double sigma_px);
 
 // Throws fv::Error (naming the step and the field) when the grid would have over 4 million cells.
-void CheckCoverageGrid(const field::FieldModel& field, const CoverageOptions& options);
+// `what` names the step in the error (a job names its option).
+void CheckCoverageGrid(const field::FieldModel& field, const CoverageOptions& options,
+                       std::string_view what = "grid step");
 
 CoverageResult EvaluateCoverage(const std::vector<camera::Camera>& cameras,
                                 const field::FieldModel& field, const CoverageOptions& options);

@@ -225,11 +225,11 @@ std::string RigWarnings(const Rig& rig) {
 PlanRunResult RunPlan(const PlanRunOptions& options) {
   options.Check();
   const field::FieldModel field = field::LoadField(options.field);
-  CheckCoverageGrid(field, options.coverage);
+  CheckCoverageGrid(field, options.coverage, "--step");
   if (options.optimize) {
     CoverageOptions search_grid = options.coverage;
     search_grid.grid_step_m = options.search.grid_step_m;
-    CheckCoverageGrid(field, search_grid);
+    CheckCoverageGrid(field, search_grid, "--search-step");
   }
   PlanRunResult result;
   const std::optional<Rig> given = LoadGivenRig(options);
