@@ -202,9 +202,7 @@ void RunIntrinsics(IntrinsicsCli& c) {
   c.o.board = c.board.Spec();
   c.o.camera_name = c.name;
   c.o.progress = !c.quiet;
-  FV_REQUIRE(c.k3 == "auto" || c.o.num_distortion == 5,
-             "--k3 {} goes with --model 5 (the model of {} numbers decides k3 itself)", c.k3,
-             c.o.num_distortion);
+  CheckK3Model(c.k3, c.o.num_distortion);
   c.o.k3 = calib::ParseK3Model(c.k3);
   const IntrinsicsResult r = CalibrateIntrinsics(c.images, c.o);
   std::cout << fmt::format("{:<48s} {:>7s} {:>8s}  {}\n", "view", "corners", "rms_px", "status");

@@ -52,6 +52,14 @@ inline void AddBoardOptions(CLI::App* cmd, BoardCli& b) {
   cmd->add_option("--dictionary", b.dictionary, "ChArUco ArUco dictionary")->capture_default_str();
 }
 
+// `--k3` (auto, free or zero) is chosen for the 5-number model only: the others decide k3 with
+// their own coefficients.
+inline void CheckK3Model(const std::string& k3, int num_distortion) {
+  FV_REQUIRE(k3 == "auto" || num_distortion == 5,
+             "--k3 {} goes with --model 5 (the model of {} numbers decides k3 itself)", k3,
+             num_distortion);
+}
+
 // The board fit's options that `calibrate intrinsics` and `calibrate multi` share (--model,
 // --outlier-factor, --outlier-min-px, --max-frames); `Options` is calib::IntrinsicsOptions or
 // calib::MultiOptions.

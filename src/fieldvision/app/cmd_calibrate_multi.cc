@@ -48,9 +48,7 @@ void RunMulti(MultiCli& c) {
              "--zero-tangent is --tangential zero: it does not go with --tangential {}",
              c.tangential);
   c.o.tangential = c.zero_tangent ? TangentialModel::kZero : ParseTangentialModel(c.tangential);
-  FV_REQUIRE(c.k3 == "auto" || c.o.num_distortion == 5,
-             "--k3 {} goes with --model 5 (the model of {} numbers decides k3 itself)", c.k3,
-             c.o.num_distortion);
+  CheckK3Model(c.k3, c.o.num_distortion);
   c.o.k3 = fv::calib::ParseK3Model(c.k3);
   std::vector<CameraViews> cams;
   std::vector<std::string> inputs;  // views and known intrinsics: no output may replace one

@@ -1,10 +1,10 @@
 #include "fieldvision/camera/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include <ceres/jet.h>
-#include <Eigen/SVD>
 
 #include "fieldvision/util/error.h"
 
@@ -97,21 +97,34 @@ std::optional<Eigen::Vector2d> Camera::Project(const Eigen::Vector3d& p_world) c
 
 namespace {
 
-// Newton's method on distort(x) = target from `x` (exact Jacobians from dual numbers); the
-// solution, or nullopt when it does not converge or lies where the model folds (the Jacobian's
-// determinant not positive: a second, unphysical preimage beyond the radius where a barrel
-// distortion turns back).
+using Jet2 = ceres::Jet<double, 2>;
+using DistortionJets = std::array<Jet2, kNumDistortion>;
+
+// The distortion coefficients `d` (kNumDistortion of them) as constants for dual numbers.
+DistortionJets JetsOf(const double* d) {
+  DistortionJets dj;
+  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet2(d[i]);
+  return dj;
+}
+
+// distort(x) of a normalized point, and its Jacobian in *j (exact, from dual numbers).
+Eigen::Vector2d DistortWithJacobian(const DistortionJets& dj, const Eigen::Vector2d& x,
+                                    Eigen::Matrix2d* j) {
+  Jet2 xd, yd;
+  DistortNormalized(dj.data(), Jet2(x.x(), 0), Jet2(x.y(), 1), &xd, &yd);
+  *j << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
+  return {xd.a, yd.a};
+}
+
+// Newton's method on distort(x) = target from `x`; the solution, or nullopt when it does not
+// converge or lies where the model folds (the Jacobian's determinant not positive: a second,
+// unphysical preimage beyond the radius where a barrel distortion turns back).
 std::optional<Eigen::Vector2d> SolveDistortion(const double* d, const Eigen::Vector2d& target,
                                                Eigen::Vector2d x, double fx, double fy) {
-  using Jet = ceres::Jet<double, 2>;
-  std::array<Jet, kNumDistortion> dj;
-  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(d[i]);
+  const DistortionJets dj = JetsOf(d);
+  Eigen::Matrix2d j;
   for (int iter = 0; iter < 50; ++iter) {
-    Jet xd, yd;
-    DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
-    const Eigen::Vector2d r(xd.a - target.x(), yd.a - target.y());
-    Eigen::Matrix2d j;
-    j << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
+    const Eigen::Vector2d r = DistortWithJacobian(dj, x, &j) - target;
     const double det = j.determinant();
     if (!std::isfinite(det) || det < 1e-12) return std::nullopt;
     if (r.norm() < 1e-14) return x;
@@ -122,11 +135,9 @@ std::optional<Eigen::Vector2d> SolveDistortion(const double* d, const Eigen::Vec
     x -= step;
     if (!x.allFinite()) return std::nullopt;
   }
-  Jet xd, yd;
-  DistortNormalized(dj.data(), Jet(x.x(), 0), Jet(x.y(), 1), &xd, &yd);
-  const double err_px = std::hypot((xd.a - target.x()) * fx, (yd.a - target.y()) * fy);
-  const double det = xd.v[0] * yd.v[1] - xd.v[1] * yd.v[0];
-  if (err_px < 1e-6 && det > 1e-12) return x;
+  const Eigen::Vector2d r = DistortWithJacobian(dj, x, &j) - target;
+  const double err_px = std::hypot(r.x() * fx, r.y() * fy);
+  if (err_px < 1e-6 && j.determinant() > 1e-12) return x;
   return std::nullopt;
 }
 
@@ -155,15 +166,14 @@ std::optional<Eigen::Vector2d> Camera::Undistort(const Eigen::Vector2d& uv) cons
 
 double Camera::DistortionMinScale(const Eigen::Vector2d& xn) const {
   const auto intr = IntrinsicsBlock();
-  using Jet = ceres::Jet<double, 2>;
-  std::array<Jet, kNumDistortion> dj;
-  for (int i = 0; i < kNumDistortion; ++i) dj[i] = Jet(intr[4 + i]);
-  Jet xd, yd;
-  DistortNormalized(dj.data(), Jet(xn.x(), 0), Jet(xn.y(), 1), &xd, &yd);
   Eigen::Matrix2d j;
-  j << xd.v[0], xd.v[1], yd.v[0], yd.v[1];
+  DistortWithJacobian(JetsOf(intr.data() + 4), xn, &j);
   if (!j.allFinite() || j.determinant() <= 0) return std::numeric_limits<double>::quiet_NaN();
-  return Eigen::JacobiSVD<Eigen::Matrix2d>(j).singularValues().minCoeff();
+  // A 2x2 matrix's singular values: s_max^2 = (a + sqrt(a^2 - 4 det^2)) / 2 with a its squared
+  // Frobenius norm, and s_min = det / s_max (no cancellation).
+  const double a = j.squaredNorm(), det = j.determinant();
+  const double s_max = std::sqrt(0.5 * (a + std::sqrt(std::max(a * a - 4 * det * det, 0.0))));
+  return det / s_max;
 }
 
 std::optional<geometry::Ray3d> Camera::RayFromPixel(const Eigen::Vector2d& uv) const {
