@@ -53,6 +53,12 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                   "scores made elsewhere have no known scale)")
       ->check(FiniteRange(0.0, 100.0))
       ->capture_default_str();
+  cmd->add_option("--still-max-change", t.still_max_change,
+                  "Two cameras alone, one seeing a thing that came into view and the other a "
+                  "thing that was there all along (its disc differs from the camera's "
+                  "background on at most this share), are no ball (0: off)")
+      ->check(FiniteRange(0.0, 0.69))
+      ->capture_default_str();
   cmd->add_flag("--ground", t.single_camera_ground,
                 "Seen by one camera only: place the ball on the ground (a 2D position, n_cams 1)");
   cmd->add_flag("!--no-weak", t.use_weak,

@@ -150,6 +150,7 @@ BackgroundEvidence Background::Compare(const cv::Mat& bgr, const Eigen::Vector2d
   const double disc_area = M_PI * disc2;
   const double ring_area = M_PI * (outer2 - inner2);
   if (disc < std::max(3.0, 0.5 * disc_area) || ring < std::max(8.0, 0.5 * ring_area)) return out;
+  out.measured = true;
   out.disc_share = static_cast<double>(disc_changed) / disc;
   out.ring_share = static_cast<double>(ring_changed) / ring;
   out.apart =

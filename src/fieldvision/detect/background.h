@@ -56,6 +56,7 @@ struct BackgroundEvidence {
   double disc_share = 0.0;  // share of the disc's pixels that differ
   double ring_share = 1.0;  // share of the ring's pixels that differ
   bool apart = false;       // both shares as BackgroundOptions asks (enough pixels read)
+  bool measured = false;    // the shares were read (a usable background, enough pixels)
 };
 
 class Background {

@@ -504,7 +504,11 @@ void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
       continue;
     }
     std::optional<BallCandidate> fit = FitAt(bgr, roi, disc->centre_px, disc->radius_px);
-    if (!fit || !background->Compare(bgr, fit->centre_px, fit->radius_px, roi).apart) continue;
+    if (!fit) continue;
+    const BackgroundEvidence evidence =
+        background->Compare(bgr, fit->centre_px, fit->radius_px, roi);
+    if (!evidence.apart) continue;
+    fit->background_change = evidence.disc_share;
     const auto same = [&](const BallCandidate& b) {
       return (b.centre_px - fit->centre_px).norm() < std::max(b.radius_px, 2.0);
     };
@@ -546,8 +550,9 @@ void BallDetector::ApartFirst(const cv::Mat& bgr, const cv::Rect& roi,
   const Background* background = background_();
   if (background == nullptr) return;
   for (auto it = candidates->begin(); it != accepted_end; ++it) {
-    it->apart_from_background = it->apart_from_background ||
-                                background->Compare(bgr, it->centre_px, it->radius_px, roi).apart;
+    const BackgroundEvidence evidence = background->Compare(bgr, it->centre_px, it->radius_px, roi);
+    it->apart_from_background = it->apart_from_background || evidence.apart;
+    if (evidence.measured) it->background_change = evidence.disc_share;
   }
   // Apart from the background counts as a quarter more score: it reorders near equals, it does
   // not put a faint candidate before a clear one (a passer-by's head before a still ball: PETS
@@ -730,9 +735,13 @@ std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, cons
     apart.apart_from_background = true;
     Decide(apart, fit, fit_why, visible, leak, &if_apart);
     const Background* background = if_apart.accepted ? background_() : nullptr;
-    if (background != nullptr &&
-        background->Compare(bgr, if_apart.centre_px, if_apart.radius_px, roi).apart) {
+    const BackgroundEvidence evidence =
+        background != nullptr
+            ? background->Compare(bgr, if_apart.centre_px, if_apart.radius_px, roi)
+            : BackgroundEvidence{};
+    if (evidence.apart) {
       if_apart.apart_from_background = true;
+      if_apart.background_change = evidence.disc_share;
       cand = std::move(if_apart);
     }
   }

@@ -81,6 +81,10 @@ struct BallCandidate {
   // It stands apart from the camera's background (background.h); measured only where the colour
   // contrast was low or several candidates were accepted (BallDetector::SetBackground).
   bool apart_from_background = false;
+  // The share of its disc that differs from the camera's background (Background::Compare): near
+  // 1 for a thing that came into view, near 0 for one that was always there; -1 where it was not
+  // compared.
+  double background_change = -1.0;
   std::string reason;  // why rejected ("" when accepted)
 };
 

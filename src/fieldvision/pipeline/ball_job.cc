@@ -100,6 +100,7 @@ recon::BallObservation Observation(const detect::BallCandidate& b) {
   obs.radius_px = b.radius_px;
   obs.sigma_px = std::max(b.sigma_px, 0.05);
   obs.score = b.score;
+  obs.background_change = b.background_change;
   return obs;
 }
 

@@ -29,7 +29,8 @@ json CandidatesToJson(const std::vector<recon::BallObservation>& candidates) {
                {"r", o.radius_px},
                {"sigma", o.sigma_px},
                {"score", o.score}};
-    if (o.weak) cj["weak"] = true;  // absent means false
+    if (o.weak) cj["weak"] = true;                                 // absent means false
+    if (o.background_change >= 0) cj["bg"] = o.background_change;  // absent: not compared
     c.push_back(std::move(cj));
   }
   return c;
@@ -51,6 +52,11 @@ std::vector<recon::BallObservation> CandidatesFromJson(const json& j, const std:
     if (c.contains("weak")) {
       FV_REQUIRE(c["weak"].is_boolean(), "{}: 'weak' is not true or false", ctx);
       o.weak = c["weak"].get<bool>();
+    }
+    if (c.contains("bg")) {
+      o.background_change = Number(c, "bg", ctx);
+      FV_REQUIRE(o.background_change >= 0 && o.background_change <= 1,
+                 "{}: 'bg' must be in [0, 1] (got {})", ctx, o.background_change);
     }
     out.push_back(o);
   }

@@ -23,6 +23,7 @@ TEST(CameraMessage, JsonLineRoundTripsExactly) {
       o.sigma_px = rng.Uniform(0.01, 3);
       o.score = rng.Uniform(0, 1);
       o.weak = rng.UniformInt(0, 1) == 1;
+      if (rng.UniformInt(0, 1) == 1) o.background_change = rng.Uniform(0, 1);
       m.candidates.push_back(o);
     }
     const std::string line = m.ToJsonLine();
@@ -38,6 +39,7 @@ TEST(CameraMessage, JsonLineRoundTripsExactly) {
       EXPECT_EQ(back.candidates[k].sigma_px, m.candidates[k].sigma_px);
       EXPECT_EQ(back.candidates[k].score, m.candidates[k].score);
       EXPECT_EQ(back.candidates[k].weak, m.candidates[k].weak);
+      EXPECT_EQ(back.candidates[k].background_change, m.candidates[k].background_change);
     }
   }
 }
@@ -64,6 +66,11 @@ TEST(CameraMessage, BadLinesNameTheProblem) {
       message_of(
           R"({"camera":0,"frame":1,"time_s":0,"candidates":[{"u":1,"v":2,"r":1,"sigma":1,"score":1,"weak":1}]})")
           .find("'weak'"),
+      std::string::npos);
+  EXPECT_NE(
+      message_of(
+          R"({"camera":0,"frame":1,"time_s":0,"candidates":[{"u":1,"v":2,"r":1,"sigma":1,"score":1,"bg":1.5}]})")
+          .find("'bg' must be in [0, 1]"),
       std::string::npos);
 }
 

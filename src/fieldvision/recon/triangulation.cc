@@ -89,6 +89,11 @@ void TriangulationOptions::Check() const {
              "TriangulationOptions.weak_max_radius_ratio must be 0 (off) or > 1 (got {})",
              weak_max_radius_ratio);
   CheckNonNegative(min_two_view_score, "TriangulationOptions.min_two_view_score");
+  FV_REQUIRE(
+      still_max_change >= 0.0 && still_max_change < new_min_change && new_min_change <= 1.0,
+      "TriangulationOptions: still_max_change ({}) and new_min_change ({}) must satisfy 0 <= "
+      "still_max_change < new_min_change <= 1",
+      still_max_change, new_min_change);
   CheckNonNegative(radius_sigma_factor, "TriangulationOptions.radius_sigma_factor");
   CheckNonNegative(radius_tolerance, "TriangulationOptions.radius_tolerance");
   CheckNonNegative(radius_tolerance_px, "TriangulationOptions.radius_tolerance_px");

@@ -27,6 +27,9 @@ struct BallObservation {
   // uses it only to complete a set that an accepted candidate of another camera starts, and only
   // when the accepted candidates alone give no 3D position.
   bool weak = false;
+  // The share of its disc that differs from its camera's background (detect/background.h): near
+  // 1 for a thing that came into view, near 0 for one that was always there; -1: not compared.
+  double background_change = -1.0;
 };
 
 // ---- Two rays -----------------------------------------------------------------------------
@@ -112,6 +115,15 @@ struct TriangulationOptions {
   // same ghosts; 0.3 loses a frame of the ball on seed 1), `--detector both` unchanged. 0: off
   // (`ball --detections`: scores made elsewhere have no known scale).
   double min_two_view_score = 0.2;
+  // Two cameras alone, one seeing a thing that came into view (its disc differs from that
+  // camera's background on at least new_min_change of it) and the other a thing that was there
+  // all along (at most still_max_change), are no ball: one ball is new, or still, in every camera
+  // at once. A ball-coloured board in the stands of one camera met the ray of a flying ball that
+  // the other camera saw (the low-sun static render, seed 10: a position 1.9 m off). Only views
+  // whose detector compared them with a background (BallObservation::background_change) count.
+  // still_max_change 0: off.
+  double still_max_change = 0.1;
+  double new_min_change = 0.7;
   // Robust mode: with only one camera seeing anything, place the ball on the ground.
   bool single_camera_ground = false;
   // Robust mode: use weak candidates (BallObservation::weak) when the others give no position.

@@ -130,6 +130,20 @@ double PairSigma(const camera::Camera& cam_a, const BallObservation& a, const ca
 
 namespace {
 
+// One view of a thing that came into view and one of a thing that was always there
+// (TriangulationOptions::still_max_change).
+bool NewAndStill(const BallObservation& a, const BallObservation& b,
+                 const TriangulationOptions& o) {
+  if (o.still_max_change <= 0 || a.background_change < 0 || b.background_change < 0) return false;
+  const auto still = [&](const BallObservation& v) {
+    return v.background_change <= o.still_max_change;
+  };
+  const auto fresh = [&](const BallObservation& v) {
+    return v.background_change >= o.new_min_change;
+  };
+  return (still(a) && fresh(b)) || (fresh(a) && still(b));
+}
+
 // Keeps the set (n cameras, cost, total detector score) in `best` when it is better: more cameras
 // first, then a higher total score, then a smaller error.
 void KeepBetter(int n, double cost, double score, const std::vector<int>& pick,
@@ -193,6 +207,7 @@ BestHypothesis SearchHypotheses(const std::vector<camera::Camera>& cameras,
           }
           // Two faint things far from where the ball is expected: no ball.
           if (n == 2 && score < o.min_two_view_score && far_from_prior) continue;
+          if (n == 2 && NewAndStill(candidates[ca][ka], candidates[cb][kb], o)) continue;
           KeepBetter(n, cost, score, pick, gated ? &far : &best);
         }
       }

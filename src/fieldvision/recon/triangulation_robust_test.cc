@@ -143,6 +143,38 @@ TEST(RobustStages, TwoFaintViewsFarFromThePriorAreNoBall) {
   EXPECT_THROW(o.Check(), Error);
 }
 
+// Two cameras alone: a thing that came into view in one (its disc differs from the camera's
+// background) and one that was always there in the other are no ball, wherever their rays meet
+// (still_max_change); both new, both still, or either not compared with a background: a ball.
+TEST(RobustStages, ANewThingAndAStillThingAreNoBall) {
+  const auto cams = RingCameras();
+  const Eigen::Vector3d p(-2.0, 2.5, 1.5);
+  const auto pair = [&](double change_a, double change_b) {
+    std::vector<std::vector<BallObservation>> cand = {
+        {Seen(cams[0], p, 0.5)}, {Seen(cams[1], p, 0.5)}, {}};
+    cand[0][0].background_change = change_a;
+    cand[1][0].background_change = change_b;
+    return cand;
+  };
+  TriangulationOptions o;
+  EXPECT_FALSE(TriangulateRobust(cams, pair(0.95, 0.02), o).ok());
+  EXPECT_FALSE(TriangulateRobust(cams, pair(0.0, 0.8), o).ok());
+  for (const auto& [a, b] :
+       {std::pair{0.95, 0.9}, {0.02, 0.0}, {-1.0, 0.0}, {0.95, -1.0}, {0.5, 0.0}, {0.95, 0.3}}) {
+    const TriangulationResult r = TriangulateRobust(cams, pair(a, b), o);
+    ASSERT_TRUE(r.ok()) << a << " " << b;
+    EXPECT_LT((r.point_world - p).norm(), 1e-3);
+  }
+  // A third camera that agrees outvotes the disagreement.
+  std::vector<std::vector<BallObservation>> three = pair(0.95, 0.02);
+  three[2] = {Seen(cams[2], p, 0.5)};
+  EXPECT_TRUE(TriangulateRobust(cams, three, o).ok());
+  o.still_max_change = 0.0;
+  EXPECT_TRUE(TriangulateRobust(cams, pair(0.95, 0.02), o).ok());
+  o.still_max_change = 0.8;
+  EXPECT_THROW(o.Check(), Error);
+}
+
 // One camera's ball paired with another camera's still ball-coloured thing on that camera's ray,
 // 30 % farther: as many cameras as the ball's own pair and a higher total score, but the first
 // camera's radius does not fit the farther point (score_radius_sigma), so the ball is taken;
