@@ -41,6 +41,12 @@ inline void AddFusionOptions(CLI::App* cmd, recon::TriangulationOptions& t) {
                   "expected at the point (0: any radius)")
       ->check(FiniteRange(0.0, 0.0) | FiniteRange(1.01, 100.0))
       ->capture_default_str();
+  cmd->add_option("--max-larger-radius-ratio", t.max_larger_radius_ratio,
+                  "A camera whose ball's radius is more than this factor larger than the one "
+                  "expected at the point does not agree (a circle that took in something beside "
+                  "the ball; 0: --max-radius-ratio alone)")
+      ->check(FiniteRange(0.0, 0.0) | FiniteRange(1.01, 100.0))
+      ->capture_default_str();
   cmd->add_option("--score-radius-sigma", t.score_radius_sigma,
                   "Between sets of equally many cameras, each camera's score counts weighted by "
                   "how well its ball's radius fits the point (this spread of the log ratio; 0: "

@@ -82,6 +82,9 @@ void TriangulationOptions::Check() const {
   FV_REQUIRE(max_radius_ratio == 0.0 || max_radius_ratio > 1.0,
              "TriangulationOptions.max_radius_ratio must be 0 (off) or > 1 (got {})",
              max_radius_ratio);
+  FV_REQUIRE(max_larger_radius_ratio == 0.0 || max_larger_radius_ratio > 1.0,
+             "TriangulationOptions.max_larger_radius_ratio must be 0 (off) or > 1 (got {})",
+             max_larger_radius_ratio);
   FV_REQUIRE(score_radius_sigma >= 0.0 && std::isfinite(score_radius_sigma),
              "TriangulationOptions.score_radius_sigma must be finite and >= 0 (got {})",
              score_radius_sigma);

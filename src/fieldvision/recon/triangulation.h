@@ -91,6 +91,16 @@ struct TriangulationOptions {
   // 4.3 m off; low-sun-kick mean 4.1 -> 3.2 mm; kick, held, fisheye unchanged (1.3: fisheye 15 ->
   // 12 of 16 frames).
   double max_radius_ratio = 1.5;
+  // A view whose radius is more than this factor larger than the one predicted from the depth is
+  // inconsistent too; 0: max_radius_ratio alone. Shading, occlusion and a print's fragments make
+  // a fitted circle smaller, never larger: a larger one took in something beside the ball, and
+  // its centre moved with it. Measured with `detect` on 13 renders (kick, low-sun kick and static
+  // seeds 1-3, static seeds 1-3, three lighting variants): of 3302 accepted candidates on the
+  // ball, fitted radius / true radius p99 1.14; 27 of the 31 above 1.15 had centres 0.5-6.5 px
+  // off. `ball --truth` (1.25): low-sun static seed 3 7.42 -> 5.17 mm (a fragment 2.3 px off
+  // with a radius 1.36x too large no longer pairs), seed 6 3.80 -> 3.66 mm, seed 5 one frame of
+  // 16 less; 32 other renders unchanged (kicks, statics, fisheye, held, lighting variants).
+  double max_larger_radius_ratio = 1.25;
   // Between sets of equally many cameras the higher total detector score wins; each view's
   // score counts weighted by how well its radius fits the set's point, exp(-0.5 (ln(radius /
   // radius predicted from the depth) / score_radius_sigma)^2), when the detector reports

@@ -95,7 +95,8 @@ RankedCandidates RankCandidates(const std::vector<camera::Camera>& cameras,
 // The reported radius against the one that the depth of p predicts, within max_ratio either way
 // (true when max_ratio is 0 or a radius is unknown).
 bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
-                      const Eigen::Vector3d& p, double ball_radius_m, double max_ratio);
+                      const Eigen::Vector3d& p, double ball_radius_m, double max_ratio,
+                      double max_larger_ratio = 0.0);
 // The candidate's score weighted by how well its radius fits the depth of p
 // (TriangulationOptions::score_radius_sigma; the score itself when off or a radius is unknown).
 double RadiusWeightedScore(const camera::Camera& camera, const BallObservation& obs,

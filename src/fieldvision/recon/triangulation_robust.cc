@@ -44,12 +44,16 @@ RankedCandidates RankCandidates(const std::vector<camera::Camera>& cameras,
 }
 
 bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
-                      const Eigen::Vector3d& p, double ball_radius_m, double max_ratio) {
-  if (max_ratio <= 0 || obs.radius_px <= 0 || ball_radius_m <= 0) return true;
+                      const Eigen::Vector3d& p, double ball_radius_m, double max_ratio,
+                      double max_larger_ratio) {
+  if ((max_ratio <= 0 && max_larger_ratio <= 0) || obs.radius_px <= 0 || ball_radius_m <= 0) {
+    return true;
+  }
   const auto expected = ExpectedRadiusPx(camera, p, ball_radius_m);
   if (!expected || !(*expected > 0)) return false;  // not in front of the camera
   const double ratio = obs.radius_px / *expected;
-  return ratio <= max_ratio && ratio >= 1.0 / max_ratio;
+  if (max_larger_ratio > 0 && ratio > max_larger_ratio) return false;
+  return max_ratio <= 0 || (ratio <= max_ratio && ratio >= 1.0 / max_ratio);
 }
 
 double RadiusWeightedScore(const camera::Camera& camera, const BallObservation& obs,
@@ -69,8 +73,12 @@ double ConsistentError(const camera::Camera& camera, const BallObservation& obs,
   if (!uv) return -1;
   const double err = (*uv - obs.centre_px).norm();
   if (err > Threshold(o, obs.sigma_px)) return -1;
-  if (!RadiusConsistent(camera, obs, p, o.ball_radius_m, o.max_radius_ratio)) return -1;
-  if (obs.weak && !RadiusConsistent(camera, obs, p, o.ball_radius_m, o.weak_max_radius_ratio)) {
+  if (!RadiusConsistent(camera, obs, p, o.ball_radius_m, o.max_radius_ratio,
+                        o.max_larger_radius_ratio)) {
+    return -1;
+  }
+  if (obs.weak && !RadiusConsistent(camera, obs, p, o.ball_radius_m, o.weak_max_radius_ratio,
+                                    o.max_larger_radius_ratio)) {
     return -1;
   }
   return err;

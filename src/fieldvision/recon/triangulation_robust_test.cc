@@ -83,6 +83,22 @@ TEST(RobustStages, ConsistencyChecksThresholdDepthAndRadius) {
   EXPECT_FALSE(RadiusConsistent(cams[0], sized, p, 0.11, 1.5));
   sized.weak = true;  // weak candidates also meet weak_max_radius_ratio (1.5)
   EXPECT_EQ(ConsistentError(cams[0], sized, p, o), -1);
+  // Larger than expected by a third: within 1.5 either way, beyond max_larger_radius_ratio (1.25);
+  // smaller by as much passes.
+  BallObservation larger = Seen(cams[0], p);
+  larger.radius_px = sized.radius_px / 2 * 4.0 / 3.0;
+  EXPECT_TRUE(RadiusConsistent(cams[0], larger, p, 0.11, 1.5));
+  EXPECT_FALSE(RadiusConsistent(cams[0], larger, p, 0.11, 1.5, 1.25));
+  EXPECT_FALSE(RadiusConsistent(cams[0], larger, p, 0.11, 0.0, 1.25));
+  EXPECT_EQ(ConsistentError(cams[0], larger, p, o), -1);
+  BallObservation smaller = larger;
+  smaller.radius_px = sized.radius_px / 2 * 3.0 / 4.0;
+  EXPECT_TRUE(RadiusConsistent(cams[0], smaller, p, 0.11, 1.5, 1.25));
+  EXPECT_GE(ConsistentError(cams[0], smaller, p, o), 0.0);
+  o.max_larger_radius_ratio = 0.0;
+  EXPECT_GE(ConsistentError(cams[0], larger, p, o), 0.0);
+  o.max_larger_radius_ratio = 1.0;
+  EXPECT_THROW(o.Check(), Error);
 }
 
 // Two cameras' still objects of the ball's colour that meet at a point by chance, scored above
@@ -111,6 +127,7 @@ TEST(RobustStages, AGhostWhoseSizesDoNotFitItIsNoBall) {
   // Any radius allowed: the scores weighted by the sizes' fit still take the ball; the scores
   // alone, the better scored ghost.
   o.max_radius_ratio = 0.0;
+  o.max_larger_radius_ratio = 0.0;
   const TriangulationResult weighted = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(weighted.ok());
   EXPECT_LT((weighted.point_world - ball).norm(), 1e-3);
@@ -200,7 +217,13 @@ TEST(RobustStages, APairAlongOneCamerasRayGivesWayWhereItsRadiusDoesNotFit) {
   EXPECT_NEAR(RadiusWeightedScore(cams[0], cand[0][0], ball, o), 0.3, 1e-9);
   EXPECT_LT(RadiusWeightedScore(cams[0], cand[0][0], thing, o),
             0.5 * RadiusWeightedScore(cams[0], cand[0][0], ball, o));
+  // The scores alone: cam0's radius 1.3 times larger than the thing's depth predicts still rules
+  // the pair along the ray out (max_larger_radius_ratio); without that rule too, the thing.
   o.score_radius_sigma = 0.0;
+  const TriangulationResult larger_rule = TriangulateRobust(cams, cand, o);
+  ASSERT_TRUE(larger_rule.ok());
+  EXPECT_LT((larger_rule.point_world - ball).norm(), 1e-3);
+  o.max_larger_radius_ratio = 0.0;
   const TriangulationResult scores_only = TriangulateRobust(cams, cand, o);
   ASSERT_TRUE(scores_only.ok());
   EXPECT_LT((scores_only.point_world - thing).norm(), 1e-3);
