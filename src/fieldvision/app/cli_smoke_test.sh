@@ -106,6 +106,14 @@ check "detect: auto on a still image" 0 $FV detect --video "$TMP/limgs/a.png" --
   --no-progress
 head -1 "$TMP/out" | grep -q "^detector: both (auto: still images\|^detector: colour (auto: still images, but no NanoDet model" || {
   echo "FAIL detect: the auto detector not said"; fail=1; }
+# A missing input: its error alone, no "detector:" line before it.
+for c in "detect" "eval detect --labels $TMP/limgs"; do
+  # shellcheck disable=SC2086  # the command's words
+  check "$c: auto on a missing image" nonzero $FV $c --video "$TMP/limgs/none.png" \
+    --out "$TMP/dm.csv" --no-progress
+  grep -q "none.png" "$TMP/err" || { echo "FAIL $c: the missing image not named"; fail=1; }
+  [ ! -s "$TMP/out" ] || { echo "FAIL $c: printed before its error: $(head -1 "$TMP/out")"; fail=1; }
+done
 check "ball: --detector auto" nonzero $FV ball --camera "$TMP/c1.yaml" --video "$TMP/v.avi" \
   --camera "$TMP/c2.yaml" --video "$TMP/v2.avi" --out "$TMP/b.csv" --detector auto
 grep -q -- "--detector" "$TMP/err" || { echo "FAIL ball: --detector auto not named"; fail=1; }

@@ -65,7 +65,7 @@ void Setup(CLI::App& app, int& exit_code) {
     } else {
       util::CheckOutputPath(o->draw, inputs, "--draw");  // a folder of JPEGs
     }
-    ChooseAutoDetector(o->dnn, o->video);
+    o->on_start = ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);
     std::cout << r.Summary() << "\nwrote " << o->out << "\n";
     if (!r.drawn.empty()) std::cout << "drew " << r.drawn << "\n";

@@ -55,7 +55,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_flag("!--no-progress", o->progress, "Do not show progress");
   cmd->callback([o] {
     CheckBallSizeOptions(o->detector);
-    ChooseAutoDetector(o->dnn, o->video);
+    o->on_start = ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectEvalResult r = detect::EvaluateDetector(*o);
     std::cout << r.Summary(o->list_misses) << "\n";
   });

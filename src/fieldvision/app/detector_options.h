@@ -2,6 +2,7 @@
 // `eval detect` and `ball`.
 #pragma once
 
+#include <functional>
 #include <iostream>
 #include <string>
 
@@ -135,13 +136,17 @@ inline std::string ResolveAutoDetector(detect::DnnBallOptions& o, bool still_ima
   }
 }
 
-// ResolveAutoDetector for the frames `input` names, its warning on stderr and its choice on
-// stdout, flushed before a run that may take minutes.
-inline void ChooseAutoDetector(detect::DnnBallOptions& o, const std::string& input) {
+// ResolveAutoDetector for the frames `input` names, its warning on stderr; returns what prints
+// the choice on stdout (flushed: a run may take minutes), for the run to call once its inputs
+// are open (a missing input's error is then the only line).
+inline std::function<void()> ChooseAutoDetector(detect::DnnBallOptions& o,
+                                                const std::string& input) {
   std::string notice;
-  const std::string chosen = ResolveAutoDetector(o, io::IsStillImageInput(input), &notice);
+  std::string chosen = ResolveAutoDetector(o, io::IsStillImageInput(input), &notice);
   if (!notice.empty()) std::cerr << "fieldvision: warning: " << notice << "\n";
-  if (!chosen.empty()) std::cout << chosen << std::endl;
+  return [chosen = std::move(chosen)] {
+    if (!chosen.empty()) std::cout << chosen << std::endl;
+  };
 }
 
 }  // namespace fv::app

@@ -560,6 +560,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   std::unique_ptr<util::AtomicOutput> cand_file;
   std::unique_ptr<util::CsvWriter> cand_csv;
   if (!o.candidates_out.empty()) OpenCandidatesCsv(o.candidates_out, &cand_file, &cand_csv);
+  if (o.on_start) o.on_start();
   util::Progress progress("eval detect", std::ssize(items), "images", o.progress);
   io::Frame frame;
   for (size_t i = 0; i < items.size(); ++i) {

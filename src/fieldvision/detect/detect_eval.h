@@ -8,6 +8,7 @@
 // RoboCup photo sets, shared/data/robocup-ball-photos/README).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,8 @@ struct DetectEvalOptions {
   // Optional new (or empty) folder: each miss and false detection drawn (eval_drawing.h).
   std::string draw_misses;
   bool progress = true;
+  // Called once the labels are read and the outputs checked, before the first image ("": none).
+  std::function<void()> on_start;
   BallDetectorOptions detector;
   DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
   // A video from a posed (static) camera: low-contrast candidates are compared with its

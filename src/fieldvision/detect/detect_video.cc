@@ -154,6 +154,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   const long long total = o.max_frames > 0 && source->frame_count() > 0
                               ? std::min(o.max_frames, source->frame_count())
                               : (o.max_frames > 0 ? o.max_frames : source->frame_count());
+  if (o.on_start) o.on_start();
   util::Progress progress("detect", total, "frames", o.progress);
   const auto t0 = std::chrono::steady_clock::now();
   io::Frame frame;

@@ -3,6 +3,7 @@
 // and optionally draws them on the frames (an annotated video or a folder of images).
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "fieldvision/detect/ball_detector.h"
@@ -20,6 +21,8 @@ struct DetectVideoOptions {
   std::string draw;
   int max_frames = -1;  // -1: all
   bool progress = true;
+  // Called once the inputs are open and the outputs checked, before the first frame ("": none).
+  std::function<void()> on_start;
   BallDetectorOptions detector;
   DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
   // A video from a posed (static) camera: low-contrast candidates are compared with its
