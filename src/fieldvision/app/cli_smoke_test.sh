@@ -180,6 +180,11 @@ named "calibrate multi: --tangential free --zero-tangent" --zero-tangent $FV cal
   --views b="$TMP/none2" --out "$TMP/multi_tz" --tangential free --zero-tangent
 named "calibrate extrinsics: --image-size with --camera" --image-size $FV calibrate extrinsics \
   --camera "$TMP/c1.yaml" --image-size 640x480 --points "$TMP/none.csv" --out "$TMP/ce.yaml"
+named "calibrate extrinsics: --image-size over the limit" --image-size $FV calibrate \
+  extrinsics --image-size 100000x100000 --points "$TMP/none.csv" --out "$TMP/ce.yaml"
+named "calibrate intrinsics: --marker over --square" --marker $FV calibrate intrinsics \
+  --images "$TMP/none" --board charuco --cols 5 --rows 7 --square 0.04 --marker 0.05 \
+  --out "$TMP/ci.yaml"
 named "plan: --search-step too fine" --search-step $FV plan --camera "$TMP/sc/cam1.yaml" \
   --camera "$TMP/sc/cam2.yaml" --out "$TMP/plan_fine" --optimize --search-step 1e-6 --no-progress
 named "synth: --seed -1" --seed $FV synth --preset kick --seed -1 --out "$TMP/syn_m1"

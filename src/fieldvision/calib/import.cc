@@ -119,6 +119,8 @@ void ParseImageSize(const std::string& text, const std::string& what, int* width
   std::istringstream is(text);
   FV_REQUIRE((is >> w >> x >> h) && (x == 'x' || x == 'X') && is.peek() == EOF && w > 0 && h > 0,
              "{} '{}' is not an image size like 1920x1080", what, text);
+  FV_REQUIRE(w <= camera::Camera::kMaxSide && h <= camera::Camera::kMaxSide,
+             "{} '{}' is over the limit of {} pixels a side", what, text, camera::Camera::kMaxSide);
   *width = w;
   *height = h;
 }

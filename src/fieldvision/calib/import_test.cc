@@ -137,6 +137,10 @@ TEST(Import, BadTomlNamesFileAndKey) {
   EXPECT_EQ(h, 1080);
   EXPECT_THROW(ParseImageSize("1920", "size", &w, &h), Error);
   EXPECT_THROW(ParseImageSize("1920x1080x3", "size", &w, &h), Error);
+  ParseImageSize("65536x10", "size", &w, &h);
+  EXPECT_THAT(
+      [&] { ParseImageSize("100000x10", "--image-size", &w, &h); },
+      ThrowsMessage<Error>(HasSubstr("--image-size '100000x10' is over the limit of 65536")));
 }
 
 TEST(Import, OpenCvStereoFiles) {

@@ -29,7 +29,6 @@ Camera Camera::FromFov(int width, int height, double hfov_deg) {
 
 void Camera::Check(const std::string& context) const {
   // Limits far beyond any real camera, so that sizes and products of them stay in range.
-  constexpr int kMaxSide = 65536;
   constexpr double kMaxPixels = 1e7, kMaxMetres = 1e7, kMaxDistortion = 1e6;
   FV_REQUIRE(width > 0 && height > 0, "{}: image size must be positive (got {}x{})", context, width,
              height);

@@ -33,6 +33,9 @@ struct Camera {
 
   // Throws fv::Error naming `context` and the bad member (size, focal, NaN, distortion size).
   void Check(const std::string& context = "camera") const;
+  // The largest image side Check accepts: far beyond any real camera, so that sizes and products
+  // of them stay in range.
+  static constexpr int kMaxSide = 65536;
 
   // fx, fy, cx, cy, d[14]: the parameter block of projection.h.
   std::array<double, kNumIntrinsics> IntrinsicsBlock() const;

@@ -296,7 +296,7 @@ Hit IntersectBody(const Body& body, const Eigen::Vector3d& ro, const Eigen::Vect
     }
   }
   for (const Cylinder& cy : body.cylinders) {
-    Eigen::Vector3d n;
+    Eigen::Vector3d n = Eigen::Vector3d::UnitZ();  // set by CylinderHit on a hit
     bool top = false;
     const double t = CylinderHit(cy, ro, rd, &n, &top);
     if (t > t_min && (hit.t < 0 || t < hit.t)) {
