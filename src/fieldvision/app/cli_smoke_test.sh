@@ -480,4 +480,13 @@ grep -q "elapsed" "$TMP/prog.err" && { echo "FAIL synth: progress lines in a log
 FV_PROGRESS=lines "$FV" synth --preset kick --frames 3 --width 160 --height 120 \
   --out "$TMP/prog2" >/dev/null 2>"$TMP/prog.err"
 grep -q "elapsed" "$TMP/prog.err" || { echo "FAIL synth: FV_PROGRESS=lines gave no line"; fail=1; }
+# A stop asked by a signal says so, on a line of its own (no blank line before it in a log).
+"$FV" fuse --listen "tcp://127.0.0.1:*" --camera "$TMP/sc/cam1.yaml" \
+  --camera "$TMP/sc/cam2.yaml" --out "$TMP/fuse_sig.csv" >/dev/null 2>"$TMP/fuse_sig.err" &
+fuse_pid=$!
+for _ in $(seq 100); do grep -q "listening" "$TMP/fuse_sig.err" 2>/dev/null && break; sleep 0.1; done
+kill -TERM "$fuse_pid"
+wait "$fuse_pid"
+head -1 "$TMP/fuse_sig.err" | grep -q "^stopping (again to quit at once" || {
+  echo "FAIL fuse: the stop's message is not the first line:"; cat "$TMP/fuse_sig.err"; fail=1; }
 exit $fail

@@ -17,6 +17,7 @@ class StopOnSignal {
  public:
   explicit StopOnSignal(pipeline::JobControl& control) {
     target_ = &control;
+    terminal_ = isatty(STDERR_FILENO) == 1;  // decided here: isatty is not async-signal-safe
     std::signal(SIGINT, &Handle);
     std::signal(SIGTERM, &Handle);
   }
@@ -34,11 +35,14 @@ class StopOnSignal {
       return;
     }
     control->Stop();
+    // On a terminal the progress line may be half written: the message starts a line of its own.
     constexpr char kSaid[] = "\nstopping (again to quit at once, outputs unwritten)\n";
-    [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, kSaid, sizeof(kSaid) - 1);
+    const int skip = terminal_ ? 0 : 1;
+    [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, kSaid + skip, sizeof(kSaid) - 1 - skip);
   }
   static inline std::atomic<pipeline::JobControl*> target_{nullptr};
   static inline std::atomic<bool> stopping_{false};
+  static inline std::atomic<bool> terminal_{false};
 };
 
 }  // namespace fv::app
