@@ -165,8 +165,11 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--flights", o->det.flights,
                   "With --detections: also fit the flights and write FLIGHTS.json");
   AddBallDiameterOption(cmd, o->job.ball_diameter_m);
-  AddBallColourOption(cmd, o->job.colour);
-  AddDetectorOptions(cmd, o->job.dnn);
+  // What reads and searches frames, refused with --detections (the 2D positions are given).
+  CLI::Option_group* frames =
+      cmd->add_option_group("Reading frames", "With --video only (not with --detections)");
+  AddBallColourOption(frames, o->job.colour);
+  AddDetectorOptions(frames, o->job.dnn);
   cmd->add_option("--out", o->job.out, "BALL.csv: frame,time_s,x_m,y_m,z_m,n_cams,err_px")
       ->required();
   cmd->add_option("--write-detections", o->job.detections_out,
@@ -184,65 +187,47 @@ void Setup(CLI::App& app, int& exit_code) {
                 "cameras' candidates at the end");
   cmd->add_option("--truth", o->job.truth, "truth.csv: also print the error table");
   cmd->add_flag("--rows", o->rows, "With --truth: print every frame's error, not only summary");
-  cmd->add_option("--field", o->job.field,
-                  "Field (built-in name or JSON): look for the ball only over it");
-  cmd->add_option("--sync", o->job.sync,
-                  "Pair frames by 'frame' index or by 'time' (the --timestamps CSVs, else the "
-                  "container's timestamps)")
+  frames->add_option("--field", o->job.field,
+                     "Field (built-in name or JSON): look for the ball only over it");
+  frames
+      ->add_option("--sync", o->job.sync,
+                   "Pair frames by 'frame' index or by 'time' (the --timestamps CSVs, else the "
+                   "container's timestamps)")
       ->capture_default_str();
-  cmd->add_option("--timestamps", o->job.timestamps,
-                  "CSV with frame,time_s per video (repeat, one per video); implies --sync time");
-  cmd->add_option("--fps", o->job.fps,
-                  "Frames per second of image sequences, which have no rate of their own (give "
-                  "this or --timestamps); a video's own rate must agree with it")
+  frames->add_option(
+      "--timestamps", o->job.timestamps,
+      "CSV with frame,time_s per video (repeat, one per video); implies --sync time");
+  frames
+      ->add_option("--fps", o->job.fps,
+                   "Frames per second of image sequences, which have no rate of their own (give "
+                   "this or --timestamps); a video's own rate must agree with it")
       ->check(FiniteRange(1e-3, 100000.0));
   cmd->add_option("--tolerance", o->job.pipeline.sync.tolerance_s,
                   "With --sync time: frames this close in seconds are combined")
       ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
-  AddBackgroundOption(cmd, o->job.background);
-  cmd->add_flag("--live", o->job.live,
-                "Live: play the videos at their frame rate (as cameras deliver) and keep the "
-                "newest frames when fusion falls behind (drops frames)");
-  cmd->add_option("--max-frames", o->job.pipeline.max_frames,
-                  "Stop after this many frames (0: all)")
+  AddBackgroundOption(frames, o->job.background);
+  frames->add_flag("--live", o->job.live,
+                   "Live: play the videos at their frame rate (as cameras deliver) and keep the "
+                   "newest frames when fusion falls behind (drops frames)");
+  frames
+      ->add_option("--max-frames", o->job.pipeline.max_frames,
+                   "Stop after this many frames (0: all)")
       ->check(CLI::Range(0LL, 1000000000LL));
   AddFusionOptions(cmd, o->job.pipeline.triangulation);
-  AddTrackOptions(cmd, o->job.pipeline.track);
+  AddTrackOptions(frames, o->job.pipeline.track);
   cmd->add_flag("!--no-progress", o->job.pipeline.progress, "Do not show progress");
-  cmd->callback([o, cmd] {
+  cmd->callback([o, cmd, frames] {
     CheckTrackOptions(o->job.pipeline.track);
     FV_REQUIRE(!o->det.detections.empty() ||
                    (cmd->count("--det-sigma") == 0 && cmd->count("--flights") == 0),
                "ball: --det-sigma and --flights apply only with --detections");
     if (!o->det.detections.empty()) {
-      // With detections the 2D positions are given: what reads and searches frames cannot apply.
-      for (const char* name : {"--color",
-                               "--detector",
-                               "--dnn-width",
-                               "--dnn-accept",
-                               "--dnn-confirm",
-                               "--dnn-complete",
-                               "--dnn-crops-only",
-                               "--dnn-keep-score",
-                               "--dnn-keep-field",
-                               "--dnn-keep",
-                               "--sync",
-                               "--timestamps",
-                               "--fps",
-                               "--no-background",
-                               "--live",
-                               "--max-frames",
-                               "--whole-frames",
-                               "--full-scan-every",
-                               "--scan-bands",
-                               "--guided-frames",
-                               "--unconfirmed-scan-every",
-                               "--field"}) {
-        FV_REQUIRE(cmd->count(name) == 0,
+      for (const CLI::Option* option : frames->get_options()) {
+        FV_REQUIRE(option->count() == 0,
                    "ball: {} applies to --video only (with --detections the 2D positions are "
                    "given)",
-                   name);
+                   option->get_name());
       }
     }
     if (o->det.detections.empty()) PrepareDraw(*o);
