@@ -42,6 +42,8 @@ struct Camera {
   void SetIntrinsicsBlock(const std::array<double, kNumIntrinsics>& block, int num_distortion);
 
   Eigen::Vector3d CentreInWorld() const;
+  // The optical axis (the camera's z) as a unit direction in the world.
+  Eigen::Vector3d AxisInWorld() const { return cam_from_world.rotation.row(2).transpose(); }
   geometry::Rigid3d world_from_cam() const { return cam_from_world.Inverse(); }
 
   // World point -> pixel; nullopt when the point is behind the camera. Not clipped to the image.

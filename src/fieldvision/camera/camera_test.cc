@@ -160,6 +160,11 @@ TEST(Camera, BehindAndFootprint) {
   EXPECT_NEAR(cam.PixelFootprintM({0, 0, 10}), 10.0 / 500.0, 1e-12);
   EXPECT_TRUE(cam.InImage({-0.4, 0}));
   EXPECT_FALSE(cam.InImage({999.6, 0}));
+  // The optical axis points from the camera at what it looks at.
+  EXPECT_TRUE(cam.AxisInWorld().isApprox(Eigen::Vector3d::UnitZ()));
+  const Eigen::Vector3d eye(3, -4, 5), target(0, 1, 0);
+  cam.cam_from_world = geometry::Rigid3d::LookAt(eye, target);
+  EXPECT_TRUE(cam.AxisInWorld().isApprox((target - eye).normalized(), 1e-12));
 }
 
 TEST(CameraIo, YamlRoundTrip) {

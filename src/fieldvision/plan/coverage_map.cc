@@ -142,7 +142,7 @@ void DrawCameras(cv::Mat& img, const std::vector<camera::Camera>& cameras, doubl
     }
     const Eigen::Vector3d eye = cam.CentreInWorld();
     const cv::Point2d p = view.ToPixel(eye.head<2>());
-    const Eigen::Vector3d axis = cam.cam_from_world.rotation.row(2).transpose();
+    const Eigen::Vector3d axis = cam.AxisInWorld();
     Eigen::Vector3d aim = eye + 5.0 * axis;
     if (axis.z() < -1e-6) aim = eye + std::min(range_m, (height_m - eye.z()) / axis.z()) * axis;
     cv::arrowedLine(img, p, view.ToPixel(aim.head<2>()), colour, std::max(1, int(2 * scale)),

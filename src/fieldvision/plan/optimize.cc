@@ -283,7 +283,7 @@ std::string OptimizeResult::Summary() const {
       rig.cameras.size(), score, start_score, evaluations, seconds);
   for (const camera::Camera& c : rig.cameras) {
     const Eigen::Vector3d p = c.CentreInWorld();
-    const Eigen::Vector3d axis = c.cam_from_world.rotation.row(2).transpose();
+    const Eigen::Vector3d axis = c.AxisInWorld();
     Eigen::Vector3d aim = p + 10 * axis;
     if (axis.z() < -1e-6) aim = p + (-p.z() / axis.z()) * axis;
     s += fmt::format("  {:<6s} at ({:6.2f}, {:6.2f}, {:5.2f}) m aimed at ({:6.2f}, {:6.2f}) m\n",

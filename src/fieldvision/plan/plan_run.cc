@@ -206,8 +206,8 @@ std::string RigWarnings(const Rig& rig) {
   if (cams.size() == 1) w += "warning: one camera: the ball is placed in 3D from two or more\n";
   for (size_t a = 0; a < cams.size(); ++a) {
     for (size_t b = a + 1; b < cams.size(); ++b) {
-      const Eigen::Vector3d axis_a = cams[a].cam_from_world.rotation.row(2).transpose();
-      const Eigen::Vector3d axis_b = cams[b].cam_from_world.rotation.row(2).transpose();
+      const Eigen::Vector3d axis_a = cams[a].AxisInWorld();
+      const Eigen::Vector3d axis_b = cams[b].AxisInWorld();
       if ((cams[a].CentreInWorld() - cams[b].CentreInWorld()).norm() < 0.05 &&
           axis_a.dot(axis_b) > std::cos(2.0 * M_PI / 180.0)) {
         w += fmt::format(

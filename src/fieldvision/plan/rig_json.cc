@@ -213,7 +213,7 @@ json RigToJson(const Rig& rig) {
     cj["name"] = c.name;
     const Eigen::Vector3d eye = c.CentreInWorld();
     cj["position"] = util::JsonFromVector(eye);
-    const Eigen::Vector3d axis = c.cam_from_world.rotation.row(2).transpose();
+    const Eigen::Vector3d axis = c.AxisInWorld();
     const geometry::Rigid3d look = geometry::Rigid3d::LookAt(eye, eye + axis);
     if (geometry::RotationAngleBetween(look.rotation, c.cam_from_world.rotation) < 1e-9) {
       Eigen::Vector3d target = eye + 10.0 * axis;
