@@ -26,11 +26,6 @@ struct BoardCli {
   calib::BoardSpec Spec() const {
     calib::BoardSpec b;
     b.type = calib::ParseBoardType(board);
-    // In the options' names (BoardSpec::Check says the same in its fields').
-    FV_REQUIRE(b.type != calib::BoardType::kCharuco || marker_m < square_m,
-               "--marker ({} m) must be smaller than --square ({} m): the marker sits inside a "
-               "square",
-               marker_m, square_m);
     b.cols = cols;
     b.rows = rows;
     b.square_m = square_m;

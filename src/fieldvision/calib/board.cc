@@ -93,8 +93,9 @@ void BoardSpec::Check() const {
              marker_m, marker_m / 1000);
   if (type == BoardType::kCharuco) {
     FV_REQUIRE(std::isfinite(marker_m) && marker_m >= 0 && marker_m < square_m,
-               "board marker size must be in [0, square) (got {} m, square {} m)", marker_m,
-               square_m);
+               "board marker (--marker {} m) must be smaller than its square (--square {} m): the "
+               "marker sits inside a square",
+               marker_m, square_m);
     FV_REQUIRE(DictionaryNames().count(dictionary) > 0,
                "board dictionary '{}' is not an OpenCV ArUco dictionary (e.g. DICT_4X4_50)",
                dictionary);
