@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/camera/sphere_image.h"
 #include "fieldvision/detect/edge_circle.h"
 #include "fieldvision/detect/search_area.h"
 #include "fieldvision/util/error.h"
@@ -347,16 +348,11 @@ bool BallDetector::ExpectedRadius(const Vector2d& uv, double* min_px, double* ma
                       &s_hi)) {
     return false;
   }
-  // Image radius of the ball at distance s along the ray: project a point r_m off the ray.
-  const Vector3d side = ray->direction.cross(Vector3d::UnitZ()).squaredNorm() > 1e-12
-                            ? ray->direction.cross(Vector3d::UnitZ()).normalized()
-                            : ray->direction.cross(Vector3d::UnitX()).normalized();
+  // Image radius of the ball at distance s along the ray.
   auto radius_at = [&](double s) {
     const Vector3d p = ray->At(s);
-    const auto a = camera_->Project(p);
-    const auto b = camera_->Project(p + r_m * side);
-    if (!a || !b) return r_m / camera_->PixelFootprintM(p);
-    return (*a - *b).norm();
+    const std::optional<double> r_px = camera::SphereRadiusPx(*camera_, p, r_m);
+    return r_px ? *r_px : r_m / camera_->PixelFootprintM(p);
   };
   *max_px = radius_at(s_lo);
   *min_px = s_hi >= 1e5 ? 0.0 : radius_at(s_hi);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fieldvision/camera/sphere_image.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::pipeline {
@@ -120,7 +121,9 @@ std::optional<ExpectedBall> ExpectBall(const BallHint& hint, const camera::Camer
   if (in_cam.z() <= hint.radius_m) return std::nullopt;
   ExpectedBall e;
   e.centre_px = *uv;
-  e.radius_px = hint.radius_m / camera.PixelFootprintM(at);
+  const std::optional<double> radius_px = camera::SphereRadiusPx(camera, at, hint.radius_m);
+  if (!radius_px) return std::nullopt;
+  e.radius_px = *radius_px;
   const std::optional<Eigen::Vector2d> before =
       camera.Project(BallAfter(hint, age_s - std::max(frame_dt_s, 0.0)));
   if (before && before->allFinite()) e.step_px = *uv - *before;

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/camera/sphere_image.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::pipeline {
@@ -146,6 +147,24 @@ TEST(ExpectBall, ProjectsTheBallAheadWithItsVelocityAndSize) {
   EXPECT_FALSE(ExpectBall(h, cam, 1.0, 0.05, o));
   h.ball_in_world = Vector3d(50, 0, 10);  // outside the image
   EXPECT_FALSE(ExpectBall(h, cam, 1.0, 0.05, o));
+}
+
+// Through a barrel lens the ball near the border is smaller than without it: the hint's radius is
+// the one the detector will see there.
+TEST(ExpectBall, TheRadiusIncludesTheLens) {
+  camera::Camera cam = camera::Camera::FromFov(1000, 800, 90.0);
+  cam.has_pose = true;
+  cam.distortion = {-0.2, 0, 0, 0, 0};
+  BallHint h;
+  h.time_s = 1.0;
+  h.ball_in_world = Vector3d(6, 0, 10);  // normalised image radius 0.6
+  h.radius_m = 0.11;
+  const std::optional<ExpectedBall> e = ExpectBall(h, cam, 1.0, 0.05, BallHintOptions());
+  ASSERT_TRUE(e);
+  camera::Camera no_lens = cam;
+  no_lens.distortion.clear();
+  EXPECT_LT(e->radius_px, 0.9 * *camera::SphereRadiusPx(no_lens, h.ball_in_world, h.radius_m));
+  EXPECT_NEAR(e->radius_px, *camera::SphereRadiusPx(cam, h.ball_in_world, h.radius_m), 1e-9);
 }
 
 }  // namespace

@@ -48,11 +48,6 @@ bool PredictCentre(const CameraBlock& cam, double radius_m, const T* p_world, T*
 }
 
 double Depth(const camera::Camera& cam, const Eigen::Vector3d& p_world);
-// The ball's image radius at `p` in `cam`: the mean distance from its centre's projection to
-// those of two points a ball radius away across the viewing ray (lens distortion included);
-// nullopt when a point does not project.
-std::optional<double> ExpectedRadiusPx(const camera::Camera& cam, const Eigen::Vector3d& p,
-                                       double radius_m);
 // Radius for the outline-centre model (0: observations are projections of the centre).
 double ModelRadius(const TriangulationOptions& o);
 // The reprojection error below which a view is consistent.

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "fieldvision/camera/sphere_image.h"
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
@@ -120,21 +121,6 @@ void Refine(const std::vector<camera::Camera>& cameras, const std::vector<View>&
   result->point_world = *p;
 }
 
-std::optional<double> ExpectedRadiusPx(const camera::Camera& cam, const Eigen::Vector3d& p,
-                                       double radius_m) {
-  const auto centre = cam.Project(p);
-  if (!centre) return std::nullopt;
-  const Eigen::Vector3d ray = (p - cam.CentreInWorld()).normalized();
-  const Eigen::Vector3d across = ray.unitOrthogonal();
-  double sum = 0;
-  for (const Eigen::Vector3d& d : {across, ray.cross(across)}) {
-    const auto edge = cam.Project(p + radius_m * d);
-    if (!edge) return std::nullopt;
-    sum += (*edge - *centre).norm();
-  }
-  return 0.5 * sum;
-}
-
 // The views with each centre's sigma grown by its radius' unexplained difference from the one
 // expected at `p` (TriangulationOptions::radius_sigma_factor); nullopt when none differs.
 std::optional<std::vector<View>> SizeWeightedViews(const std::vector<camera::Camera>& cameras,
@@ -146,7 +132,7 @@ std::optional<std::vector<View>> SizeWeightedViews(const std::vector<camera::Cam
   bool changed = false;
   for (View& v : out) {
     if (v.observation.radius_px <= 0) continue;
-    const auto expected = ExpectedRadiusPx(cameras[v.camera], p, o.ball_radius_m);
+    const auto expected = camera::SphereRadiusPx(cameras[v.camera], p, o.ball_radius_m);
     if (!expected) continue;
     const double excess = std::abs(v.observation.radius_px - *expected) -
                           o.radius_tolerance * *expected - o.radius_tolerance_px;

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/camera/sphere_image.h"
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
 
@@ -49,7 +50,7 @@ bool RadiusConsistent(const camera::Camera& camera, const BallObservation& obs,
   if ((max_ratio <= 0 && max_larger_ratio <= 0) || obs.radius_px <= 0 || ball_radius_m <= 0) {
     return true;
   }
-  const auto expected = ExpectedRadiusPx(camera, p, ball_radius_m);
+  const auto expected = camera::SphereRadiusPx(camera, p, ball_radius_m);
   if (!expected || !(*expected > 0)) return false;  // not in front of the camera
   const double ratio = obs.radius_px / *expected;
   if (max_larger_ratio > 0 && ratio > max_larger_ratio) return false;
@@ -60,7 +61,7 @@ double RadiusWeightedScore(const camera::Camera& camera, const BallObservation& 
                            const Eigen::Vector3d& p, const TriangulationOptions& o) {
   if (o.score_radius_sigma <= 0 || obs.radius_px <= 0 || o.ball_radius_m <= 0) return obs.score;
   // Not in front of the camera (no projection): the score alone.
-  const auto expected = ExpectedRadiusPx(camera, p, o.ball_radius_m);
+  const auto expected = camera::SphereRadiusPx(camera, p, o.ball_radius_m);
   if (!expected || !(*expected > 0) || !std::isfinite(*expected)) return obs.score;
   const double z = std::log(obs.radius_px / *expected) / o.score_radius_sigma;
   return obs.score * std::exp(-0.5 * z * z);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/camera/sphere_image.h"
 #include "fieldvision/recon/triangulation.h"
 #include "fieldvision/recon/triangulation_internal.h"
 #include "fieldvision/util/error.h"
@@ -203,7 +204,7 @@ TEST(RobustStages, APairAlongOneCamerasRayGivesWayWhereItsRadiusDoesNotFit) {
   const Eigen::Vector3d thing = eye + 1.3 * (ball - eye);
   const auto sized = [](const camera::Camera& cam, const Eigen::Vector3d& p, double score) {
     BallObservation o = Seen(cam, p, score);
-    o.radius_px = *ExpectedRadiusPx(cam, p, 0.11);
+    o.radius_px = *camera::SphereRadiusPx(cam, p, 0.11);
     return o;
   };
   const std::vector<std::vector<BallObservation>> cand = {
