@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -58,85 +59,92 @@ void WriteMotChallenge(const std::vector<TrackRow>& rows, const std::string& pat
   });
 }
 
-std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
-  // Ranges of the numbers read (NaN fails them too).
+namespace {
+
+// A header-less file's columns by position: MOTChallenge's first seven, then (with 9 columns)
+// MOT17's class and visibility, or (with 10) the unused world position.
+const std::vector<std::string> kMotColumns = {"frame",     "id",   "bb_left", "bb_top", "bb_width",
+                                              "bb_height", "conf", "mot_7",   "mot_8",  "mot_9"};
+
+// The file's text; whether its first line is a header (not a number: a MOTChallenge file has
+// none).
+std::string ReadTracksText(const std::string& path, bool* has_header) {
+  std::ifstream in(path, std::ios::binary);
+  FV_REQUIRE(in.good(), "cannot open tracks file '{}'", path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  if (util::StartsWith(text, "\xEF\xBB\xBF")) text.erase(0, 3);
+  const size_t first = text.find_first_not_of(" \t\r\n");
+  *has_header = first != std::string::npos &&
+                !std::isdigit(static_cast<unsigned char>(text[first])) && text[first] != '-';
+  return text;
+}
+
+// Row `i` of `t` as a TrackRow, its numbers checked (NaN fails them too).
+TrackRow TrackRowAt(const util::CsvTable& t, size_t i, bool has_header) {
   constexpr double kMaxPixel = 1e6;
   constexpr double kMaxFieldM = 1e4;
   constexpr long long kMaxFrame = 100000000;  // 46 days at 25 frames/s; 2e9 is a damaged file
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "cannot open tracks file '{}'", path);
-  util::SkipUtf8Bom(in);
-  std::vector<TrackRow> rows;
-  std::string line;
-  int line_no = 0;
-  // Column of each field; without a header, MOTChallenge's order.
-  std::map<std::string, int> col = {{"frame", 0},  {"id", 1},       {"bb_left", 2},
-                                    {"bb_top", 3}, {"bb_width", 4}, {"bb_height", 5},
-                                    {"conf", 6}};
-  bool header = false;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string t = util::Trim(line);
-    if (t.empty()) continue;
-    if (line_no == 1 && !std::isdigit(static_cast<unsigned char>(t[0])) && t[0] != '-') {
-      FV_REQUIRE(util::StartsWith(t, "frame,id,bb_left"),
-                 "{}: header must start with frame,id,bb_left,bb_top,bb_width,bb_height", path);
-      const std::vector<std::string> names = util::Split(t, ',');
-      col.clear();
-      for (size_t i = 0; i < names.size(); ++i) col[util::Trim(names[i])] = static_cast<int>(i);
-      for (const char* need : {"bb_top", "bb_width", "bb_height"}) {
-        FV_REQUIRE(col.count(need), "{}: header has no column '{}'", path, need);
-      }
-      header = true;
-      continue;
+  const std::string where = t.Where(i);
+  auto present = [&](const char* column) { return t.Has(column) && !t.Get(i, column).empty(); };
+  TrackRow r;
+  const long long frame = t.GetInt(i, "frame");
+  FV_REQUIRE(frame >= 0 && frame <= kMaxFrame, "{}: frame {} is not in [0, {}]", where, frame,
+             kMaxFrame);
+  r.frame = static_cast<int>(frame);
+  r.id = static_cast<int>(t.GetInt(i, "id"));
+  r.box = cv::Rect2d(t.GetDouble(i, "bb_left"), t.GetDouble(i, "bb_top"),
+                     t.GetDouble(i, "bb_width"), t.GetDouble(i, "bb_height"));
+  FV_REQUIRE(std::abs(r.box.x) <= kMaxPixel && std::abs(r.box.y) <= kMaxPixel &&
+                 r.box.width <= kMaxPixel && r.box.height <= kMaxPixel,
+             "{}: box {},{},{},{} is not a box in an image (finite, within +-{:.0f} px)", where,
+             r.box.x, r.box.y, r.box.width, r.box.height, kMaxPixel);
+  FV_REQUIRE(r.box.width >= 0 && r.box.height >= 0, "{}: negative box size", where);
+  if (present("conf")) r.conf = t.GetDouble(i, "conf");
+  FV_REQUIRE(std::isfinite(r.conf), "{}: conf is not a finite number", where);
+  if (has_header) {
+    if (present("x_m") && present("y_m")) {
+      r.x_m = t.GetDouble(i, "x_m");
+      r.y_m = t.GetDouble(i, "y_m");
+      FV_REQUIRE(std::abs(*r.x_m) <= kMaxFieldM && std::abs(*r.y_m) <= kMaxFieldM,
+                 "{}: field position {}, {} m is not finite or beyond +-{:.0f} m (leave x_m,y_m "
+                 "empty when unknown)",
+                 where, *r.x_m, *r.y_m, kMaxFieldM);
     }
-    const std::vector<std::string> f = util::Split(t, ',');
-    FV_REQUIRE(f.size() >= 6, "{}:{}: expected at least 6 columns, got {}", path, line_no,
-               f.size());
-    const std::string where = fmt::format("{}:{}", path, line_no);
-    auto field = [&](const char* name) -> std::string {
-      const auto it = col.find(name);
-      if (it == col.end() || it->second >= static_cast<int>(f.size())) return {};
-      return util::Trim(f[it->second]);
-    };
-    auto number = [&](const char* name) {
-      return util::ParseDouble(field(name), where + " " + name);
-    };
-    TrackRow r;
-    const long long frame = util::ParseInt(field("frame"), where + " frame");
-    FV_REQUIRE(frame >= 0 && frame <= kMaxFrame, "{}: frame {} is not in [0, {}]", where, frame,
-               kMaxFrame);
-    r.frame = static_cast<int>(frame);
-    r.id = static_cast<int>(util::ParseInt(field("id"), where + " id"));
-    r.box =
-        cv::Rect2d(number("bb_left"), number("bb_top"), number("bb_width"), number("bb_height"));
-    FV_REQUIRE(std::abs(r.box.x) <= kMaxPixel && std::abs(r.box.y) <= kMaxPixel &&
-                   r.box.width <= kMaxPixel && r.box.height <= kMaxPixel,
-               "{}: box {},{},{},{} is not a box in an image (finite, within +-{:.0f} px)", where,
-               r.box.x, r.box.y, r.box.width, r.box.height, kMaxPixel);
-    FV_REQUIRE(r.box.width >= 0 && r.box.height >= 0, "{}: negative box size", where);
-    if (!field("conf").empty()) r.conf = number("conf");
-    FV_REQUIRE(std::isfinite(r.conf), "{}: conf is not a finite number", where);
-    if (header) {
-      if (!field("x_m").empty() && !field("y_m").empty()) {
-        r.x_m = number("x_m");
-        r.y_m = number("y_m");
-        FV_REQUIRE(std::abs(*r.x_m) <= kMaxFieldM && std::abs(*r.y_m) <= kMaxFieldM,
-                   "{}: field position {}, {} m is not finite or beyond +-{:.0f} m (leave x_m,y_m "
-                   "empty when unknown)",
-                   where, *r.x_m, *r.y_m, kMaxFieldM);
-      }
-      if (!field("time_s").empty()) {
-        r.time_s = number("time_s");
-        FV_REQUIRE(std::isfinite(*r.time_s), "{}: time_s is not a finite number", where);
-      }
-    } else if (f.size() == 9) {
-      // MOT16/17/20 ground truth: class and visibility.
-      r.mot_class = static_cast<int>(util::ParseDouble(util::Trim(f[7]), where + " class"));
-      r.visibility = util::ParseDouble(util::Trim(f[8]), where + " visibility");
+    if (present("time_s")) {
+      r.time_s = t.GetDouble(i, "time_s");
+      FV_REQUIRE(std::isfinite(*r.time_s), "{}: time_s is not a finite number", where);
     }
-    rows.push_back(r);
+  } else if (t.header().size() == 9) {
+    // MOT16/17/20 ground truth: class and visibility.
+    r.mot_class = static_cast<int>(t.GetDouble(i, "mot_7"));
+    r.visibility = t.GetDouble(i, "mot_8");
   }
+  return r;
+}
+
+}  // namespace
+
+std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
+  bool has_header = false;
+  const std::string text = ReadTracksText(path, &has_header);
+  const util::CsvTable t = has_header ? util::CsvTable::Parse(text, path)
+                                      : util::CsvTable::ParseHeaderless(text, path, kMotColumns);
+  if (has_header) {
+    FV_REQUIRE(t.header().size() >= 3 && t.header()[0] == "frame" && t.header()[1] == "id" &&
+                   t.header()[2] == "bb_left",
+               "{}: header must start with frame,id,bb_left,bb_top,bb_width,bb_height", path);
+    for (const char* need : {"bb_top", "bb_width", "bb_height"}) {
+      FV_REQUIRE(t.Has(need), "{}: header has no column '{}'", path, need);
+    }
+  } else {
+    FV_REQUIRE(t.rows() == 0 || t.header().size() >= 6, "{}: expected at least 6 columns, got {}",
+               t.Where(0), t.header().size());
+  }
+  std::vector<TrackRow> rows;
+  rows.reserve(t.rows());
+  for (size_t i = 0; i < t.rows(); ++i) rows.push_back(TrackRowAt(t, i, has_header));
   return rows;
 }
 

@@ -142,6 +142,19 @@ TEST(Mot, CsvRoundTripAndBadFile) {
   }
   EXPECT_THAT([&] { ReadTracksCsv(dir + "/bad.csv"); },
               ThrowsMessage<fv::Error>(HasSubstr("bad.csv:2")));
+  // A row cut short (a write that stopped) is an error, not a row without a field position; so is
+  // a MOTChallenge row with fewer columns than the first.
+  {
+    std::ofstream cut(dir + "/cut.csv");
+    cut << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n"
+        << "1,2,3,4,5,6,0.9,1.5,2.5,0.04\n1,3,3,4,5,6,0.9\n";
+    std::ofstream mot(dir + "/cut.txt");
+    mot << "1,2,3,4,5,6,0.9,-1,-1,-1\n2,2,3,4,5,6,0.9,-1,-1\n";
+  }
+  EXPECT_THAT([&] { ReadTracksCsv(dir + "/cut.csv"); },
+              ThrowsMessage<fv::Error>(HasSubstr("cut.csv:3: 7 fields, the header has 10")));
+  EXPECT_THAT([&] { ReadTracksCsv(dir + "/cut.txt"); },
+              ThrowsMessage<fv::Error>(HasSubstr("cut.txt:2: 9 fields, the first row has 10")));
 }
 
 TEST(Mot, NumbersOutOfRangeNameTheLine) {

@@ -78,6 +78,18 @@ CsvTable CsvTable::Read(const std::string& path) {
 }
 
 CsvTable CsvTable::Parse(const std::string& text, const std::string& name) {
+  return ParseRows(text, name, nullptr);
+}
+
+CsvTable CsvTable::ParseHeaderless(const std::string& text, const std::string& name,
+                                   const std::vector<std::string>& names) {
+  return ParseRows(text, name, &names);
+}
+
+// The rows of `text`: its first line is the header, or with `names` (no header) the first row
+// takes as many of them as it has fields.
+CsvTable CsvTable::ParseRows(const std::string& text, const std::string& name,
+                             const std::vector<std::string>* names) {
   CsvTable t;
   t.name_ = name;
   std::istringstream in(text);
@@ -90,20 +102,28 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& name) {
     if (Trim(line).empty() || StartsWith(Trim(line), "#")) continue;
     std::vector<std::string> fields = SplitCsvLine(line, fmt::format("{}:{}", name, line_no));
     if (t.header_.empty()) {
-      t.header_ = fields;
-      for (size_t i = 0; i < fields.size(); ++i) {
-        FV_REQUIRE(!fields[i].empty(), "{}:{}: empty column name in header", name, line_no);
-        FV_REQUIRE(t.index_.emplace(fields[i], static_cast<int>(i)).second,
-                   "{}:{}: duplicate column '{}'", name, line_no, fields[i]);
+      if (names == nullptr) {
+        t.header_ = fields;
+      } else {
+        FV_REQUIRE(fields.size() <= names->size(), "{}:{}: {} fields, at most {} expected", name,
+                   line_no, fields.size(), names->size());
+        t.header_.assign(names->begin(), names->begin() + static_cast<long>(fields.size()));
       }
-      continue;
+      for (size_t i = 0; i < t.header_.size(); ++i) {
+        FV_REQUIRE(!t.header_[i].empty(), "{}:{}: empty column name in header", name, line_no);
+        FV_REQUIRE(t.index_.emplace(t.header_[i], static_cast<int>(i)).second,
+                   "{}:{}: duplicate column '{}'", name, line_no, t.header_[i]);
+      }
+      if (names == nullptr) continue;
     }
-    FV_REQUIRE(fields.size() == t.header_.size(), "{}:{}: {} fields, the header has {}", name,
-               line_no, fields.size(), t.header_.size());
+    FV_REQUIRE(fields.size() == t.header_.size(), "{}:{}: {} fields, {} {}", name, line_no,
+               fields.size(), names == nullptr ? "the header has" : "the first row has",
+               t.header_.size());
     t.rows_.push_back(std::move(fields));
     t.line_numbers_.push_back(line_no);
   }
-  FV_REQUIRE(!t.header_.empty(), "CSV file '{}' is empty (no header)", name);
+  FV_REQUIRE(!t.header_.empty(), "CSV file '{}' is empty ({})", name,
+             names == nullptr ? "no header" : "no rows");
   return t;
 }
 

@@ -15,6 +15,10 @@ class CsvTable {
   // Reads `path`; throws fv::Error if it cannot be opened, is empty or has ragged rows.
   static CsvTable Read(const std::string& path);
   static CsvTable Parse(const std::string& text, const std::string& name);
+  // A file without a header row (MOTChallenge's det.txt, gt.txt): every line is a data row, the
+  // first one's fields named by the first of `names` (it may have no more), the others as many.
+  static CsvTable ParseHeaderless(const std::string& text, const std::string& name,
+                                  const std::vector<std::string>& names);
 
   const std::string& name() const { return name_; }
   const std::vector<std::string>& header() const { return header_; }
@@ -30,6 +34,8 @@ class CsvTable {
   std::string Where(size_t row) const;
 
  private:
+  static CsvTable ParseRows(const std::string& text, const std::string& name,
+                            const std::vector<std::string>* names);
   std::string name_;
   std::vector<std::string> header_;
   std::map<std::string, int> index_;

@@ -92,6 +92,23 @@ TEST(Csv, ErrorsNameTheInput) {
   EXPECT_THROW(CsvTable::Parse("", "empty.csv"), Error);
 }
 
+// A file without header (MOTChallenge's det.txt): the first row takes as many names as it has
+// fields, and every other row must have as many.
+TEST(Csv, HeaderlessRowsTakeTheirNamesFromTheFirstRow) {
+  const std::vector<std::string> names = {"frame", "id", "x", "y"};
+  CsvTable t = CsvTable::ParseHeaderless("1,7,0.5\n\n2,8,1.5\n", "det.txt", names);
+  ASSERT_EQ(t.rows(), 2u);
+  EXPECT_EQ(t.header().size(), 3u);
+  EXPECT_FALSE(t.Has("y"));
+  EXPECT_EQ(t.GetInt(1, "id"), 8);
+  EXPECT_EQ(t.Where(1), "det.txt:3");
+  EXPECT_THAT([&] { CsvTable::ParseHeaderless("1,7,0.5\n2,8\n", "r.txt", names); },
+              ThrowsMessage<Error>(HasSubstr("r.txt:2: 2 fields, the first row has 3")));
+  EXPECT_THAT([&] { CsvTable::ParseHeaderless("1,2,3,4,5\n", "w.txt", names); },
+              ThrowsMessage<Error>(HasSubstr("w.txt:1: 5 fields, at most 4 expected")));
+  EXPECT_THROW(CsvTable::ParseHeaderless("", "e.txt", names), Error);
+}
+
 TEST(Csv, WriterRejectsRaggedRows) {
   CsvWriter w(testing::TempDir() + "/b.csv", {"a", "b"});
   w << 1;
