@@ -11,6 +11,7 @@
 #include <opencv2/video/background_segm.hpp>
 
 #include "fieldvision/geometry/rigid.h"
+#include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
@@ -98,34 +99,32 @@ void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& pat
   util::WriteTextFile(path, out, "detections file");
 }
 
+const std::vector<std::string>& MotColumns() {
+  static const std::vector<std::string> kColumns = {
+      "frame",     "id",   "bb_left",   "bb_top",         "bb_width",
+      "bb_height", "conf", "mot_class", "mot_visibility", "mot_9"};
+  return kColumns;
+}
+
 DetectionsFile ReadDetectionsCsv(const std::string& path) {
-  std::ifstream in(path);
-  FV_REQUIRE(in.good(), "cannot open detections file '{}'", path);
-  util::SkipUtf8Bom(in);
+  const util::CsvTable t = util::CsvTable::ParseHeaderless(
+      util::ReadCsvText(path, "detections file"), "detections file " + path, MotColumns());
+  FV_REQUIRE(t.rows() == 0 || t.header().size() >= 7,
+             "{}: expected at least 7 columns (frame,-1,bb_left,bb_top,bb_width,bb_height,"
+             "score), got {}",
+             t.Where(0), t.header().size());
   DetectionsFile out;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string t = util::Trim(line);
-    if (t.empty() || t[0] == '#') continue;
-    const std::vector<std::string> f = util::Split(t, ',');
-    const std::string where = fmt::format("detections file {}:{}", path, line_no);
-    FV_REQUIRE(f.size() >= 7,
-               "{}: expected at least 7 columns (frame,-1,bb_left,bb_top,bb_width,bb_height,"
-               "score), got {}",
-               where, f.size());
-    const long long frame = util::ParseInt(util::Trim(f[0]), where + " frame");
+  for (size_t i = 0; i < t.rows(); ++i) {
+    const std::string where = t.Where(i);
+    const long long frame = t.GetInt(i, "frame");
     FV_REQUIRE(frame >= 1 && frame <= 10000000, "{}: frame {} (frames are 1-based)", where, frame);
     Detection d;
-    d.box = cv::Rect2d(util::ParseDouble(util::Trim(f[2]), where + " bb_left"),
-                       util::ParseDouble(util::Trim(f[3]), where + " bb_top"),
-                       util::ParseDouble(util::Trim(f[4]), where + " bb_width"),
-                       util::ParseDouble(util::Trim(f[5]), where + " bb_height"));
+    d.box = cv::Rect2d(t.GetDouble(i, "bb_left"), t.GetDouble(i, "bb_top"),
+                       t.GetDouble(i, "bb_width"), t.GetDouble(i, "bb_height"));
     FV_REQUIRE(std::isfinite(d.box.x) && std::isfinite(d.box.y) && d.box.width >= 0 &&
                    d.box.height >= 0 && std::isfinite(d.box.width) && std::isfinite(d.box.height),
                "{}: box must be finite with a non-negative size", where);
-    d.score = util::ParseDouble(util::Trim(f[6]), where + " score");
+    d.score = t.GetDouble(i, "conf");
     FV_REQUIRE(std::isfinite(d.score), "{}: score is not finite", where);
     if (out.frames.size() < size_t(frame)) out.frames.resize(frame);
     out.frames[frame - 1].push_back(d);

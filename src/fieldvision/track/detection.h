@@ -96,6 +96,10 @@ std::vector<Detection> FilterDetections(std::vector<Detection> detections,
 struct DetectionsFile {
   std::vector<std::vector<Detection>> frames;
 };
+// The columns of a MOTChallenge file (no header) by position: frame, id, the box, conf, then
+// MOT17 ground truth's class and visibility, and a tenth (det.txt's world position is x, y, z
+// from the eighth on; unused).
+const std::vector<std::string>& MotColumns();
 // Writes with full precision (reading gives back the same numbers). Throws fv::Error naming the
 // path when it cannot be written.
 void WriteDetectionsCsv(const DetectionsFile& detections, const std::string& path);

@@ -6,7 +6,6 @@
 #include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -61,19 +60,10 @@ void WriteMotChallenge(const std::vector<TrackRow>& rows, const std::string& pat
 
 namespace {
 
-// A header-less file's columns by position: MOTChallenge's first seven, then (with 9 columns)
-// MOT17's class and visibility, or (with 10) the unused world position.
-const std::vector<std::string> kMotColumns = {"frame",     "id",   "bb_left", "bb_top", "bb_width",
-                                              "bb_height", "conf", "mot_7",   "mot_8",  "mot_9"};
-
 // The file's text; whether its first line is a header (not a number: a MOTChallenge file has
 // none).
 std::string ReadTracksText(const std::string& path, bool* has_header) {
-  std::ifstream in(path, std::ios::binary);
-  FV_REQUIRE(in.good(), "cannot open tracks file '{}'", path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::string text = util::ReadCsvText(path, "tracks file");
   if (util::StartsWith(text, "\xEF\xBB\xBF")) text.erase(0, 3);
   const size_t first = text.find_first_not_of(" \t\r\n");
   *has_header = first != std::string::npos &&
@@ -118,8 +108,8 @@ TrackRow TrackRowAt(const util::CsvTable& t, size_t i, bool has_header) {
     }
   } else if (t.header().size() == 9) {
     // MOT16/17/20 ground truth: class and visibility.
-    r.mot_class = static_cast<int>(t.GetDouble(i, "mot_7"));
-    r.visibility = t.GetDouble(i, "mot_8");
+    r.mot_class = static_cast<int>(t.GetDouble(i, "mot_class"));
+    r.visibility = t.GetDouble(i, "mot_visibility");
   }
   return r;
 }
@@ -130,7 +120,7 @@ std::vector<TrackRow> ReadTracksCsv(const std::string& path) {
   bool has_header = false;
   const std::string text = ReadTracksText(path, &has_header);
   const util::CsvTable t = has_header ? util::CsvTable::Parse(text, path)
-                                      : util::CsvTable::ParseHeaderless(text, path, kMotColumns);
+                                      : util::CsvTable::ParseHeaderless(text, path, MotColumns());
   if (has_header) {
     FV_REQUIRE(t.header().size() >= 3 && t.header()[0] == "frame" && t.header()[1] == "id" &&
                    t.header()[2] == "bb_left",

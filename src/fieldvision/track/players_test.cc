@@ -322,7 +322,7 @@ TEST(Players, SynthScenePositionsAndStableIds) {
     }
     // Boxes past the video's last frame (another video's file) would be dropped: an error.
     std::filesystem::copy_file(again.detections_in, dir + "/det_beyond.txt");
-    std::ofstream(dir + "/det_beyond.txt", std::ios::app) << "99,-1,10,10,20,40,0.9,-1,-1,-1\n";
+    std::ofstream(dir + "/det_beyond.txt", std::ios::app) << "99,-1,10,10,20,40,0.9\n";
     again.detections_in = dir + "/det_beyond.txt";
     EXPECT_THAT(
         [&] { RunPlayers(video, &cam, &field, again); },

@@ -69,13 +69,15 @@ std::vector<std::string> SplitCsvLine(const std::string& line, const std::string
 
 }  // namespace
 
-CsvTable CsvTable::Read(const std::string& path) {
+std::string ReadCsvText(const std::string& path, const std::string& what) {
   std::ifstream in(path, std::ios::binary);
-  FV_REQUIRE(in.good(), "cannot open CSV file '{}'", path);
+  FV_REQUIRE(in.good(), "cannot open {} '{}'", what, path);
   std::stringstream ss;
   ss << in.rdbuf();
-  return Parse(ss.str(), path);
+  return ss.str();
 }
+
+CsvTable CsvTable::Read(const std::string& path) { return Parse(ReadCsvText(path), path); }
 
 CsvTable CsvTable::Parse(const std::string& text, const std::string& name) {
   return ParseRows(text, name, nullptr);
@@ -122,8 +124,7 @@ CsvTable CsvTable::ParseRows(const std::string& text, const std::string& name,
     t.rows_.push_back(std::move(fields));
     t.line_numbers_.push_back(line_no);
   }
-  FV_REQUIRE(!t.header_.empty(), "CSV file '{}' is empty ({})", name,
-             names == nullptr ? "no header" : "no rows");
+  FV_REQUIRE(!t.header_.empty() || names != nullptr, "CSV file '{}' is empty (no header)", name);
   return t;
 }
 

@@ -10,6 +10,10 @@
 
 namespace fv::util {
 
+// The whole text of `path` for CsvTable::Parse or ParseHeaderless; throws fv::Error "cannot open
+// {what} '{path}'".
+std::string ReadCsvText(const std::string& path, const std::string& what = "CSV file");
+
 class CsvTable {
  public:
   // Reads `path`; throws fv::Error if it cannot be opened, is empty or has ragged rows.
@@ -17,6 +21,7 @@ class CsvTable {
   static CsvTable Parse(const std::string& text, const std::string& name);
   // A file without a header row (MOTChallenge's det.txt, gt.txt): every line is a data row, the
   // first one's fields named by the first of `names` (it may have no more), the others as many.
+  // Without rows the table has no columns either.
   static CsvTable ParseHeaderless(const std::string& text, const std::string& name,
                                   const std::vector<std::string>& names);
 
