@@ -365,6 +365,13 @@ std::vector<BallCandidate> BallDetector::Detect(const cv::Mat& bgr, const cv::Re
 
 namespace {
 
+// What a comparison with the background tells of a candidate: apart from it when it says so, and
+// the disc's changed share whenever it was read (the fusion's still-vs-new rule).
+void TakeEvidence(const BackgroundEvidence& evidence, BallCandidate* c) {
+  c->apart_from_background = c->apart_from_background || evidence.apart;
+  if (evidence.measured) c->background_change = evidence.disc_share;
+}
+
 // Disc-like blobs first (a printed or partly hidden ball may be a few of them), then larger.
 std::vector<const Blob*> DiscLikeFirst(const BlobScanResult& blobs, double max_aspect_ratio) {
   std::vector<const Blob*> order;
@@ -504,7 +511,7 @@ void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
     const BackgroundEvidence evidence =
         background->Compare(bgr, fit->centre_px, fit->radius_px, roi);
     if (!evidence.apart) continue;
-    fit->background_change = evidence.disc_share;
+    TakeEvidence(evidence, &*fit);
     const auto same = [&](const BallCandidate& b) {
       return (b.centre_px - fit->centre_px).norm() < std::max(b.radius_px, 2.0);
     };
@@ -514,7 +521,6 @@ void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
       continue;
     }
     fit->guided = false;
-    fit->apart_from_background = true;
     // Fitted beside a neighbour of its colour: part of its outline is that neighbour's.
     fit->sigma_px = std::max(fit->sigma_px, kMergedSigmaRadii * fit->radius_px);
     found.push_back(*fit);
@@ -547,8 +553,7 @@ void BallDetector::ApartFirst(const cv::Mat& bgr, const cv::Rect& roi,
   if (background == nullptr) return;
   for (auto it = candidates->begin(); it != accepted_end; ++it) {
     const BackgroundEvidence evidence = background->Compare(bgr, it->centre_px, it->radius_px, roi);
-    it->apart_from_background = it->apart_from_background || evidence.apart;
-    if (evidence.measured) it->background_change = evidence.disc_share;
+    TakeEvidence(evidence, &*it);
   }
   // Apart from the background counts as a quarter more score: it reorders near equals, it does
   // not put a faint candidate before a clear one (a passer-by's head before a still ball: PETS
@@ -736,8 +741,7 @@ std::optional<BallCandidate> BallDetector::EvaluateBlob(const cv::Mat& bgr, cons
             ? background->Compare(bgr, if_apart.centre_px, if_apart.radius_px, roi)
             : BackgroundEvidence{};
     if (evidence.apart) {
-      if_apart.apart_from_background = true;
-      if_apart.background_change = evidence.disc_share;
+      TakeEvidence(evidence, &if_apart);
       cand = std::move(if_apart);
     }
   }
