@@ -55,6 +55,7 @@ class FrameSourceVideo : public VideoSource {
     width_ = size.width;
     height_ = size.height;
     fps_ = source_->fps();
+    rate_known_ = source_->rate_known();
     const long long n = source_->FrameCount();
     frame_count_ = n > 0 ? static_cast<int>(n) : -1;
     live_ = source_->live();

@@ -41,6 +41,9 @@ class VideoSource {
   int width() const { return width_; }
   int height() const { return height_; }
   double fps() const { return fps_; }
+  // False for an image sequence without a frame rate: fps() is a stand-in
+  // (FrameSource::rate_known).
+  bool rate_known() const { return rate_known_; }
   // Frames announced by the container or found on disk; -1 when unknown (live camera).
   int frame_count() const { return frame_count_; }
   bool live() const { return live_; }
@@ -59,6 +62,7 @@ class VideoSource {
   int width_ = 0;
   int height_ = 0;
   double fps_ = 0.0;
+  bool rate_known_ = true;
   int frame_count_ = -1;
   bool live_ = false;
   int next_index_ = 0;

@@ -208,6 +208,11 @@ DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out
   r.path = writer.path();
   r.codec = writer.codec();
   r.note = writer.note();
+  if (fps <= 0 && !source->rate_known()) {
+    r.note +=
+        fmt::format("{}played at {:g} frames/s: the images carry no frame rate (--fps sets it)",
+                    r.note.empty() ? "" : "; ", rate);
+  }
   return r;
 }
 

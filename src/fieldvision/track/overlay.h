@@ -71,8 +71,8 @@ struct DrawVideoResult {
 };
 
 // Reads `video` (any file or image pattern fv::io::VideoSource opens) and writes each frame with
-// the overlay drawn (one output frame per input frame, at the video's rate; `fps` > 0 overrides),
-// up to `max_frames` (0: all).
+// the overlay drawn (one output frame per input frame, at the video's rate; `fps` > 0 overrides;
+// images without a rate play at the stand-in and the note says so), up to `max_frames` (0: all).
 DrawVideoResult DrawTracksVideo(const std::string& video, const std::string& out,
                                 const TrackOverlay& overlay, double fps = 0, int max_frames = 0);
 

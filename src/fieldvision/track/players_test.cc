@@ -472,5 +472,21 @@ TEST(PlayersStages, DropShortTracksAndTeams) {
   EXPECT_NE(teams.at(1), teams.at(3));
 }
 
+// Images carry no frame rate: the drawn video plays at the stand-in rate and says so, unless the
+// rate is given.
+TEST(DrawTracksVideo, ImagesWithoutAFrameRateSaySo) {
+  const std::string dir = fv::testing::TempDir();
+  for (int i = 0; i < 3; ++i) {
+    cv::imwrite(fmt::format("{}/{:03d}.png", dir, i), cv::Mat(48, 64, CV_8UC3, cv::Scalar(40 * i)));
+  }
+  const std::vector<TrackRow> rows = {{1, 1, cv::Rect2d(4, 4, 10, 20), 0.9, {}, {}}};
+  const TrackOverlay overlay(rows, {}, {}, nullptr, nullptr);
+  const DrawVideoResult stand_in = DrawTracksVideo(dir + "/%03d.png", dir + "/a.mp4", overlay);
+  EXPECT_EQ(stand_in.frames, 3);
+  EXPECT_THAT(stand_in.Summary(), HasSubstr("the images carry no frame rate (--fps sets it)"));
+  const DrawVideoResult given = DrawTracksVideo(dir + "/%03d.png", dir + "/b.mp4", overlay, 12.0);
+  EXPECT_THAT(given.Summary(), ::testing::Not(HasSubstr("frame rate")));
+}
+
 }  // namespace
 }  // namespace fv::track
