@@ -474,23 +474,48 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
   return result;
 }
 
+namespace {
+
+// Up to `most` rejected candidates of at least `min_radius_px` whose disc differs from the
+// background, the largest changed area (disc share x radius^2) first: a ball merged with a board
+// or block of its colour, not the stands' still blocks, which are larger.
+std::vector<const BallCandidate*> MostChangedRejected(const cv::Mat& bgr, const cv::Rect& roi,
+                                                      const Background& background,
+                                                      const std::vector<BallCandidate>& candidates,
+                                                      double min_radius_px, int most) {
+  std::vector<std::pair<double, const BallCandidate*>> changed;
+  for (const BallCandidate& c : candidates) {
+    if (c.accepted || c.radius_px < min_radius_px) continue;
+    const BackgroundEvidence e = background.Compare(bgr, c.centre_px, c.radius_px, roi);
+    const double area = e.measured ? e.disc_share * c.radius_px * c.radius_px : 0.0;
+    if (area > 0) changed.emplace_back(area, &c);
+  }
+  std::stable_sort(changed.begin(), changed.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<const BallCandidate*> out;
+  for (size_t i = 0; i < changed.size() && static_cast<int>(i) < most; ++i) {
+    out.push_back(changed[i].second);
+  }
+  return out;
+}
+
+}  // namespace
+
 void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
                                       std::vector<BallCandidate>* candidates) const {
   if (!background_) return;
-  constexpr int kMaxLooks = 4;  // rejected regions looked into per frame, largest first
+  constexpr int kMaxLooks = 4;  // rejected regions looked into per frame
   constexpr double kMergedRatio = 1.5;
   constexpr double kMergedSigmaRadii = 0.1;  // low-sun statics 0.05 / 0.1 / 0.2 alike
-  std::vector<const BallCandidate*> rejected;
-  for (const BallCandidate& c : *candidates) {
-    if (!c.accepted && c.radius_px >= options_.min_radius_px) rejected.push_back(&c);
+  if (std::none_of(candidates->begin(), candidates->end(), [&](const BallCandidate& c) {
+        return !c.accepted && c.radius_px >= options_.min_radius_px;
+      })) {
+    return;
   }
-  if (rejected.empty()) return;
-  std::sort(rejected.begin(), rejected.end(), [](const BallCandidate* a, const BallCandidate* b) {
-    return a->radius_px > b->radius_px;
-  });
-  rejected.resize(std::min<size_t>(rejected.size(), kMaxLooks));
   const Background* background = background_();
   if (background == nullptr) return;
+  const std::vector<const BallCandidate*> rejected =
+      MostChangedRejected(bgr, roi, *background, *candidates, options_.min_radius_px, kMaxLooks);
   std::vector<BallCandidate> found;
   for (const BallCandidate* c : rejected) {
     const double reach = 1.5 * c->radius_px + 2;
