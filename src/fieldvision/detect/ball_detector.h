@@ -323,11 +323,10 @@ class BallDetector {
   void OnFieldFirst(const cv::Mat& bgr, const cv::Rect& roi, std::optional<FieldBoundary>* boundary,
                     std::vector<BallCandidate>* candidates) const;
   // With a background (SetBackground): a rejected region (the few whose disc changed most, by
-  // area) may hold a ball that came into view merged with a board of its colour. The largest round
-  // part of its box that differs from the background (Background::ChangedDisc), if under 2/3 of the
-  // region's radius, seeds FitAt there; a fit that stands apart from the background is added,
-  // accepted. A region of the changed part's size is left to the tracker's guided fit: seeded from
-  // a blurred ball's changed streak, the fit was 1-2 px off (low-sun kick, seed 3).
+  // area) may hold a ball that came into view merged with a board of its colour, or a ball whose
+  // region failed its shape checks. The largest round part of its box that differs from the
+  // background (Background::ChangedDisc), if not larger than the region, seeds FitAt there; a fit
+  // that stands apart from the background is added, accepted.
   void AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
                           std::vector<BallCandidate>* candidates) const;
   // With a background (SetBackground) and more blobs than max_refine: those whose disc differs

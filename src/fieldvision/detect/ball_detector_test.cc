@@ -413,7 +413,8 @@ TEST(BallDetector, TheBackgroundAcceptsALowContrastBallThatCameIntoViewAndRanksI
 // background: the board stood there in every sampled frame, the ball did not. A camera 3 m above
 // the field looking straight down, the ball on the ground (10.55 px). With four larger still
 // blocks of its colour in the corners (stands), the rejected regions looked into are those that
-// changed, not the largest.
+// changed, not the largest; with a small block instead of the board, a region not much larger
+// than the ball is looked into too.
 TEST(BallDetector, TheBackgroundFindsABallMergedWithABoardOfItsColour) {
   const uint64_t seed = fv::testing::TestSeed(31);
   FV_SEED_TRACE(seed);
@@ -427,14 +428,20 @@ TEST(BallDetector, TheBackgroundFindsABallMergedWithABoardOfItsColour) {
   const double r = cam.fx * 0.11 / (3 - 0.11);
   const cv::Vec3b orange = test_util::kOrange;
   const cv::Scalar orange_bgr(orange[0], orange[1], orange[2]);
-  for (const bool blocks : {false, true}) {
-    SCOPED_TRACE(blocks ? "with still blocks" : "the board alone");
+  enum Scene { kBoard, kBoardAndBlocks, kPatch };
+  for (const Scene scene : {kBoard, kBoardAndBlocks, kPatch}) {
+    SCOPED_TRACE(scene == kBoard ? "the board" : scene == kPatch ? "a patch" : "still blocks");
+    const bool blocks = scene == kBoardAndBlocks;
     int found_plain = 0, found = 0, off = 0;
     constexpr int kTrials = 10;
     for (int i = 0; i < kTrials; ++i) {
       cv::Mat base = test_util::FieldImage(320, 240, rng, 0.0);
       const Eigen::Vector2d c(rng.Uniform(120, 200), rng.Uniform(90, 150));
-      const cv::Rect board(int(c.x() + r / 3), int(c.y() - 3 * r), int(3 * r), int(6 * r));
+      // The patch: a block half behind the ball, a region hardly larger than the ball.
+      const cv::Rect board =
+          scene == kPatch
+              ? cv::Rect(int(c.x() + 0.8 * r), int(c.y() - 0.6 * r), int(1.4 * r), int(1.2 * r))
+              : cv::Rect(int(c.x() + r / 3), int(c.y() - 3 * r), int(3 * r), int(6 * r));
       cv::rectangle(base, board, orange_bgr, cv::FILLED);
       if (blocks) {
         for (const cv::Point& corner :
