@@ -476,19 +476,18 @@ BallDetectionResult BallDetector::DetectWithSummary(const cv::Mat& bgr,
 
 namespace {
 
-// Up to `most` rejected candidates of at least `min_radius_px` whose disc differs from the
-// background, the largest changed area (disc share x radius^2) first: a ball merged with a board
-// or block of its colour, not the stands' still blocks, which are larger.
-std::vector<const BallCandidate*> MostChangedRejected(const cv::Mat& bgr, const cv::Rect& roi,
-                                                      const Background& background,
-                                                      const std::vector<BallCandidate>& candidates,
-                                                      double min_radius_px, int most) {
+// Up to `most` of `rejected` whose disc differs from the background, the largest changed area
+// (disc share x radius^2) first: a ball merged with a board or block of its colour, not the
+// stands' still blocks, which are larger.
+std::vector<const BallCandidate*> MostChanged(const cv::Mat& bgr, const cv::Rect& roi,
+                                              const Background& background,
+                                              const std::vector<const BallCandidate*>& rejected,
+                                              int most) {
   std::vector<std::pair<double, const BallCandidate*>> changed;
-  for (const BallCandidate& c : candidates) {
-    if (c.accepted || c.radius_px < min_radius_px) continue;
-    const BackgroundEvidence e = background.Compare(bgr, c.centre_px, c.radius_px, roi);
-    const double area = e.measured ? e.disc_share * c.radius_px * c.radius_px : 0.0;
-    if (area > 0) changed.emplace_back(area, &c);
+  for (const BallCandidate* c : rejected) {
+    const BackgroundEvidence e = background.Compare(bgr, c->centre_px, c->radius_px, roi);
+    const double area = e.measured ? e.disc_share * c->radius_px * c->radius_px : 0.0;
+    if (area > 0) changed.emplace_back(area, c);
   }
   std::stable_sort(changed.begin(), changed.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -510,15 +509,14 @@ void BallDetector::AddApartInRejected(const cv::Mat& bgr, const cv::Rect& roi,
   // views of the low-sun statics, seeds 1-3, with the same 3D errors.
   constexpr double kMergedRatio = 1.0;
   constexpr double kMergedSigmaRadii = 0.1;  // low-sun statics 0.05 / 0.1 / 0.2 alike
-  if (std::none_of(candidates->begin(), candidates->end(), [&](const BallCandidate& c) {
-        return !c.accepted && c.radius_px >= options_.min_radius_px;
-      })) {
-    return;
+  std::vector<const BallCandidate*> rejected;
+  for (const BallCandidate& c : *candidates) {
+    if (!c.accepted && c.radius_px >= options_.min_radius_px) rejected.push_back(&c);
   }
+  if (rejected.empty()) return;
   const Background* background = background_();
   if (background == nullptr) return;
-  const std::vector<const BallCandidate*> rejected =
-      MostChangedRejected(bgr, roi, *background, *candidates, options_.min_radius_px, kMaxLooks);
+  rejected = MostChanged(bgr, roi, *background, rejected, kMaxLooks);
   std::vector<BallCandidate> found;
   for (const BallCandidate* c : rejected) {
     const double reach = 1.5 * c->radius_px + 2;

@@ -78,8 +78,8 @@ double ConsistentError(const camera::Camera& camera, const BallObservation& obs,
                         o.max_larger_radius_ratio)) {
     return -1;
   }
-  if (obs.weak && !RadiusConsistent(camera, obs, p, o.ball_radius_m, o.weak_max_radius_ratio,
-                                    o.max_larger_radius_ratio)) {
+  // The larger-radius bound was applied above.
+  if (obs.weak && !RadiusConsistent(camera, obs, p, o.ball_radius_m, o.weak_max_radius_ratio)) {
     return -1;
   }
   return err;

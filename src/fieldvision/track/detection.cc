@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <opencv2/dnn.hpp>
@@ -14,7 +13,6 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
-#include "fieldvision/util/strings.h"
 
 namespace fv::track {
 
