@@ -1,8 +1,8 @@
 // The ball options that several subcommands declare alike: --ball-diameter (ball, node, fuse,
 // detect, plan), --color (ball, node, detect, eval detect) and the fusion's --inlier-px, --ground
 // and --no-weak (ball, fuse; recon/triangulation.h), the tracking window's --whole-frames,
-// --full-scan-every, --scan-bands, --guided-frames and --unconfirmed-scan-every (ball, node;
-// pipeline/camera_stage.h).
+// --full-scan-every, --scan-bands, --guided-frames, --unconfirmed-scan-every and
+// --hidden-scan-every (ball, node; pipeline/camera_stage.h).
 #pragma once
 
 #include <string>
@@ -99,6 +99,12 @@ inline void AddTrackOptions(CLI::App* cmd, pipeline::BallTrackOptions& t) {
                   "camera searches the whole frame every N frames (0: only every "
                   "--full-scan-every), so that a track on a still thing gives way to the ball "
                   "(a camera node: once the fusion node tells of frames without one)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd->add_option("--hidden-scan-every", t.hidden_scan_every,
+                  "While the cameras together see the ball and this camera finds none where "
+                  "they expect it (hidden from it), search its whole frame only every N frames "
+                  "after the first (0 or 1: every frame)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
 }

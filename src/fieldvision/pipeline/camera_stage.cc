@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 
 #include <fmt/format.h>
 
@@ -20,6 +21,8 @@ void BallTrackOptions::Check() const {
   FV_REQUIRE(unconfirmed_scan_every >= 0,
              "BallTrackOptions.unconfirmed_scan_every must be >= 0 (got {})",
              unconfirmed_scan_every);
+  FV_REQUIRE(hidden_scan_every >= 0, "BallTrackOptions.hidden_scan_every must be >= 0 (got {})",
+             hidden_scan_every);
   FV_REQUIRE(std::isfinite(window_radii) && window_radii >= 2,
              "BallTrackOptions.window_radii must be >= 2 (got {})", window_radii);
   FV_REQUIRE(max_guided_frames >= 0, "BallTrackOptions.max_guided_frames must be >= 0 (got {})",
@@ -32,6 +35,16 @@ bool HasAccepted(const std::vector<recon::BallObservation>& obs) {
   return std::any_of(obs.begin(), obs.end(),
                      [](const recon::BallObservation& o) { return !o.weak; });
 }
+
+namespace {
+// A ball in this camera's image at a time.
+struct Sighting {
+  double time_s = 0.0;
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  double tolerance_s = 0.0;  // times this close are the same frame
+};
+}  // namespace
 
 // Where a camera stage looks next: the window around the ball's predicted image position.
 class CameraStage::Track {
@@ -71,18 +84,22 @@ class CameraStage::Track {
   // whole.
   bool Confirms(const std::vector<recon::BallObservation>& obs) const {
     const recon::BallObservation* best = Best(obs);
-    return best != nullptr && (best->centre_px - ExpectedCentre()).norm() <= 2.0 * radius_ + 2.0;
+    return best != nullptr && Near(best->centre_px, ExpectedCentre(), 0.0);
+  }
+  // Whether the window is where `e` expects the ball.
+  bool Expects(const ExpectedBall& e) const {
+    return active_ && Near(ExpectedCentre(), e.centre_px, e.radius_px);
   }
   // Whether a guided fit may look for the ball at its expected place (Expected).
   bool MayGuide() const { return o_.enabled && active_ && guided_run_ < o_.max_guided_frames; }
   Eigen::Vector2d ExpectedCentre() const { return centre_ + velocity_; }
-  // Where the fusion expects the ball: taken unless the track expects it there too.
-  void Steer(const ExpectedBall& e) {
+  // Where the fusion expects the ball: taken unless the track expects it there too, or the track
+  // was on the ball when the cameras together last saw it (`fused_then`: the fused position in
+  // this camera at its time, within half a frame of a tracked one): the track has seen the frames
+  // since and knows of a bounce or a kick that the fusion's prediction does not.
+  void Steer(const ExpectedBall& e, const std::optional<Sighting>& fused_then) {
     if (!o_.enabled) return;
-    if (active_ &&
-        (ExpectedCentre() - e.centre_px).norm() <= 2.0 * std::max(radius_, e.radius_px) + 2.0) {
-      return;
-    }
+    if (Expects(e) || (active_ && fused_then && Saw(*fused_then))) return;
     centre_ = e.centre_px - e.step_px;
     velocity_ = e.step_px;
     radius_ = std::max(e.radius_px, 2.0);
@@ -90,16 +107,27 @@ class CameraStage::Track {
   }
   double radius() const { return radius_; }
   int unconfirmed_scan_every() const { return o_.unconfirmed_scan_every; }
+  int hidden_scan_every() const { return o_.hidden_scan_every; }
   // `guided`: the candidate of obs that a guided fit gave, or null.
-  void Update(const std::vector<recon::BallObservation>& obs,
-              const recon::BallObservation* guided) {
+  void Update(const std::vector<recon::BallObservation>& obs, const recon::BallObservation* guided,
+              double time_s) {
     ++frames_;
+    frames_seen_.push_back({time_s, {}});
+    for (const recon::BallObservation& o : obs) {
+      if (!o.weak) frames_seen_.back().balls.push_back({time_s, o.centre_px, o.radius_px});
+    }
+    if (frames_seen_.size() > kSeenKept) frames_seen_.pop_front();
     const recon::BallObservation* best = Best(obs);
     if (best == nullptr) {
       active_ = false;
       guided_run_ = 0;
       return;
     }
+    // A ball away from the expected place: another object, or the ball after a jump of the
+    // track; its sightings start anew.
+    if (!active_ || !Near(best->centre_px, ExpectedCentre(), best->radius_px)) seen_.clear();
+    seen_.push_back({time_s, best->centre_px, best->radius_px});
+    if (seen_.size() > kSeenKept) seen_.pop_front();
     guided_run_ = best == guided ? guided_run_ + 1 : 0;
     velocity_ = active_ ? Eigen::Vector2d(best->centre_px - centre_) : Eigen::Vector2d::Zero();
     centre_ = best->centre_px;
@@ -107,6 +135,16 @@ class CameraStage::Track {
     active_ = true;
   }
 
+  // Whether the frame at `f`'s time was seen, without an accepted candidate on `f`'s ball.
+  bool MissedAt(const Sighting& f) const {
+    for (const FrameSeen& seen : frames_seen_) {
+      if (std::abs(seen.time_s - f.time_s) > f.tolerance_s) continue;
+      return std::none_of(seen.balls.begin(), seen.balls.end(), [&](const Sighting& s) {
+        return (s.centre_px - f.centre_px).norm() <= 2.0 * std::max(s.radius_px, f.radius_px) + 2.0;
+      });
+    }
+    return false;
+  }
  private:
   static const recon::BallObservation* Best(const std::vector<recon::BallObservation>& obs) {
     const recon::BallObservation* best = nullptr;
@@ -115,8 +153,26 @@ class CameraStage::Track {
     }
     return best;
   }
+  // Within two radii (the larger of the track's and `radius_px`) and 2 px.
+  bool Near(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius_px) const {
+    return (a - b).norm() <= 2.0 * std::max(radius_, radius_px) + 2.0;
+  }
+  // Whether the track's ball in the frame at `f`'s time lay on `f`'s.
+  bool Saw(const Sighting& f) const {
+    return std::any_of(seen_.begin(), seen_.end(), [&](const Sighting& s) {
+      return std::abs(s.time_s - f.time_s) <= f.tolerance_s &&
+             (s.centre_px - f.centre_px).norm() <= 2.0 * std::max(s.radius_px, f.radius_px) + 2.0;
+    });
+  }
+  static constexpr size_t kSeenKept = 16;  // frames: more than the hints' lag
+  struct FrameSeen {
+    double time_s;
+    std::vector<Sighting> balls;  // the accepted candidates
+  };
+  std::deque<FrameSeen> frames_seen_;  // the last frames
   BallTrackOptions o_;
   bool active_ = false;
+  std::deque<Sighting> seen_;  // the track's balls in its last frames (no tolerance)
   int Slot() const { return static_cast<int>((frames_ + phase_) % o_.full_scan_every); }
   int phase_;
   long long frames_ = 0;  // frames seen
@@ -241,8 +297,28 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
   last_time_s_ = in.time_s;
   const bool recent = hint && in.time_s - hint->time_s <= hints_->options().max_age_s;
   unconfirmed_ = recent ? 0 : unconfirmed_ + 1;
+  hidden_ = false;
   if (!hint) return;
-  if (auto e = ExpectBall(*hint, camera_, in.time_s, dt_s, hints_->options())) track_->Steer(*e);
+  const std::optional<ExpectedBall> e =
+      ExpectBall(*hint, camera_, in.time_s, dt_s, hints_->options());
+  if (!e) return;
+  std::optional<Sighting> then;
+  if (const auto at = ExpectBall(*hint, camera_, hint->time_s, 0.0, hints_->options())) {
+    then = Sighting{hint->time_s, at->centre_px, at->radius_px, 0.5 * dt_s};
+  }
+  track_->Steer(*e, then);
+  const double fresh_s = (hints_->options().lag_messages + 1.5) * dt_s;
+  hidden_ =
+      in.time_s - hint->time_s <= fresh_s && track_->Expects(*e) && then && track_->MissedAt(*then);
+}
+
+bool CameraStage::HiddenHere(bool found) {
+  if (found || !hidden_) {
+    hidden_run_ = 0;
+    return false;
+  }
+  const int every = track_->hidden_scan_every();
+  return every > 1 && hidden_run_++ % every != 0;
 }
 
 bool CameraStage::UnconfirmedScan(long long frame) {
@@ -280,12 +356,14 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       m.candidates = detector_(*frame, window);
       ++stats_.window_scans;
       full = !track_->Confirms(m.candidates);
+      if (!full) HiddenHere(true);
       // Nothing accepted where the ball is expected: a guided fit there before the whole frame
       // (a camera that sees the ball only that way would otherwise search every frame whole).
       if (full) {
         guided = AddGuided(*frame, &m.candidates);
         guided_tried = true;
-        full = guided < 0;
+        const bool hidden = HiddenHere(guided >= 0);
+        full = guided < 0 && !hidden;
       } else {
         SearchBand(in, &m.candidates);
       }
@@ -299,7 +377,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
     }
   }
   if (!guided_tried && frame != nullptr) guided = AddGuided(*frame, &m.candidates);
-  track_->Update(m.candidates, guided >= 0 ? &m.candidates[guided] : nullptr);
+  track_->Update(m.candidates, guided >= 0 ? &m.candidates[guided] : nullptr, in.time_s);
   ++stats_.frames;
   for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
   return m;

@@ -11,8 +11,10 @@
 // live node) at some more work on average (the bands overlap); after a whole-frame search without a
 // ball at the expected place the guided fit is tried there too. With the fusion's hints
 // (ball_hints.h) the expected place is where the cameras together last saw the ball, when the image
-// track disagrees. The same stage serves the in-process pipeline (ball_pipeline.h) and the camera
-// node (net/node.h).
+// track disagrees and was not on the ball in the frame they saw it in; a ball they see and this
+// camera does not is hidden from it, and its whole frame is searched less often
+// (hidden_scan_every). The same stage serves the in-process pipeline (ball_pipeline.h) and the
+// camera node (net/node.h).
 #pragma once
 
 #include <functional>
@@ -63,6 +65,13 @@ struct BallTrackOptions {
   // comes into view (the kick render, cam1 and cam2: the ball hidden from cam1 until frame 19,
   // tracked from frame 33, the next whole-frame search, before).
   int unconfirmed_scan_every = 5;
+  // With hints: while the cameras together see the ball (a fused position at most
+  // BallHintOptions::lag_messages + 1 frames old) where this camera had no candidate in that
+  // frame, and finds none where they expect it now, the ball is hidden from this camera: it
+  // searches the whole frame only in the first of every this many such frames in a row (0 or 1:
+  // in each), and its window where the others see the ball in each (the kick render: cam1
+  // searched 17 frames whole while the ball was behind a robot, now 5).
+  int hidden_scan_every = 5;
   void Check() const;  // throws fv::Error naming the bad field
 };
 
@@ -115,6 +124,9 @@ class CameraStage {
   void FollowHint(const io::SourceFrame& in);
   // Whether this frame is searched whole because no fused position confirmed the track lately.
   bool UnconfirmedScan(long long frame);
+  // Whether a window without the ball at its expected place leaves the whole frame unsearched in
+  // this frame (hidden_scan_every); counts such frames.
+  bool HiddenHere(bool found);
   int camera_index_;
   camera::Camera camera_;
   cv::Size size_;
@@ -122,7 +134,11 @@ class CameraStage {
   BallGuidedFn guided_;
   BallHintBoard* hints_ = nullptr;
   double last_time_s_ = 0.0;
-  int unconfirmed_ = 0;        // frames in a row without a recent fused position (with hints)
+  int unconfirmed_ = 0;  // frames in a row without a recent fused position (with hints)
+  // This frame's window is where a fresh fused position expects the ball, and this camera had no
+  // candidate on the ball in the frame of that position (hidden_scan_every).
+  bool hidden_ = false;
+  int hidden_run_ = 0;         // frames in a row without the ball in such a window
   long long last_block_ = -1;  // frame / unconfirmed_scan_every of the last frame processed
   bool no_hint_means_unconfirmed_ = true;
   std::string source_name_;

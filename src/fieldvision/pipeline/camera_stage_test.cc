@@ -1,8 +1,10 @@
 // The camera stage's tracking window: a ball that leaves the window where another accepted object
 // lies is found again by a whole-frame search in that frame, not after full_scan_every frames;
 // while tracking, bands of rows cover the whole frame every full_scan_every frames; the fusion's
-// hints move the window off a better-scored static thing onto the ball, and guided fits go on
-// where the search finds no ball, for at most max_guided_frames frames.
+// hints move the window off a better-scored static thing onto the ball (not off a track that
+// follows the ball through a bounce they do not know of yet), a ball hidden from this camera alone
+// is searched for in the whole frame every hidden_scan_every frames, and guided fits go on where
+// the search finds no ball, for at most max_guided_frames frames.
 #include "fieldvision/pipeline/camera_stage.h"
 
 #include <gtest/gtest.h>
@@ -311,6 +313,118 @@ TEST(CameraStage, ANodeSearchesWholeOnAlignedFramesOnceTheFusionTellsOfLoss) {
     // Told: the first whole search from frame 10 on falls on frame 10 (a multiple of 5).
     EXPECT_EQ(first_ball, tells ? 10 : -1) << (tells ? "told of loss" : "never told");
   }
+}
+
+// What a stage did with the fusion's hints: the fusion publishes the ball of frame f - 2 (the
+// offline hints' lag; seen by the other cameras) before this camera's frame f.
+struct HintedRun {
+  std::vector<long long> whole;      // frames searched whole
+  std::vector<long long> with_ball;  // frames whose message has the ball
+};
+HintedRun RunHinted(const std::vector<std::vector<Thing>>& frames,
+                    const std::vector<Vector2d>& ball, const BallTrackOptions& track) {
+  const camera::Camera cam = PosedCamera();
+  HintedRun run;
+  long long f = 0;
+  auto scripted = Scripted(&frames, &f);
+  auto recording = [&](const cv::Mat& bgr, const cv::Rect& roi) {
+    if (roi.empty()) run.whole.push_back(f);
+    return scripted(bgr, roi);
+  };
+  CameraStage stage(0, cam, recording, track, "scripted");
+  BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+  stage.SetHints(&board);
+  for (f = 0; f < static_cast<long long>(frames.size()); ++f) {
+    if (f >= 2) board.Publish((f - 2) / 60.0, PointAt(cam, ball[f - 2]), 0.11);
+    io::SourceFrame in;
+    in.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(0));
+    in.frame = f;
+    in.time_s = f / 60.0;
+    const CameraMessage m = stage.Process(in);
+    if (std::any_of(m.candidates.begin(), m.candidates.end(),
+                    [&](const auto& o) { return (o.centre_px - ball[f]).norm() < 1; })) {
+      run.with_ball.push_back(f);
+    }
+  }
+  return run;
+}
+
+std::vector<long long> Frames(long long from, long long to, long long except = -1) {
+  std::vector<long long> out;
+  for (long long f = from; f < to; ++f) {
+    if (f != except) out.push_back(f);
+  }
+  return out;
+}
+
+TEST(CameraStage, ATrackOnTheBallWhenTheCamerasLastSawItKeepsItsWindowThroughABounce) {
+  // The ball rolls right, then from frame 10 also up the image (a bounce). The fusion's hints,
+  // two frames late, expect it to go on straight for two frames; the camera's own track, which
+  // was on the ball at the hints' times, follows it: no window moved off the ball, no frame
+  // searched whole but the first.
+  std::vector<std::vector<Thing>> frames;
+  std::vector<Vector2d> ball;
+  for (int f = 0; f < 20; ++f) {
+    ball.push_back(f == 0 ? Vector2d(100, 300)
+                          : Vector2d(ball.back() + (f <= 9 ? Vector2d(6, 0) : Vector2d(6, -10))));
+    frames.push_back({{ball.back(), 0.8}});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  const HintedRun run = RunHinted(frames, ball, track);
+  EXPECT_EQ(run.with_ball, Frames(0, 20));
+  EXPECT_EQ(run.whole, std::vector<long long>{0});
+}
+
+TEST(CameraStage, ATrackThatJumpedToAnotherThingIsSteeredBackToTheBall) {
+  // The ball, hidden from this camera in frame 10 only, is seen by the others throughout; the
+  // whole-frame search of frame 10 takes a better-scored seat that came into view. The track was
+  // on the ball at the hints' time (frame 9), but then jumped: the hint moves its window back to
+  // the ball in frame 11.
+  std::vector<std::vector<Thing>> frames;
+  std::vector<Vector2d> ball;
+  for (int f = 0; f < 20; ++f) {
+    ball.emplace_back(100 + 5 * f, 300);
+    frames.emplace_back();
+    if (f != 10) frames.back().push_back({ball.back(), 0.5});
+    if (f >= 10) frames.back().push_back({Vector2d(500, 100), 0.9});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  const HintedRun run = RunHinted(frames, ball, track);
+  EXPECT_EQ(run.with_ball, Frames(0, 20, /*except=*/10));
+  EXPECT_EQ(run.whole, (std::vector<long long>{0, 10}));  // not 11: the window went to the ball
+}
+
+TEST(CameraStage, ABallHiddenFromThisCameraOnlyIsSearchedWholeEveryHiddenScanEveryFrames) {
+  // The ball rolls; the other cameras see it throughout, this one not in frames 5-24 (behind a
+  // robot), while a still thing of its colour is in view. A whole-frame search finds only the
+  // thing: after the first hidden frame, the whole frame is searched every hidden_scan_every
+  // frames; the window stays where the others see the ball and finds it in frame 25.
+  std::vector<std::vector<Thing>> frames;
+  std::vector<Vector2d> ball;
+  for (int f = 0; f < 35; ++f) {
+    ball.emplace_back(100 + 5 * f, 300);
+    frames.push_back({{Vector2d(500, 100), 0.2}});
+    if (f < 5 || f >= 25) frames.back().push_back({ball.back(), 0.8});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  for (const int every : {0, 5}) {
+    track.hidden_scan_every = every;
+    const HintedRun run = RunHinted(frames, ball, track);
+    std::vector<long long> visible = Frames(0, 5);
+    for (long long f : Frames(25, 35)) visible.push_back(f);
+    EXPECT_EQ(run.with_ball, visible) << "hidden_scan_every " << every;
+    // Frames 5 and 6 whole: the hints are of frames 3 and 4, where this camera saw the ball.
+    std::vector<long long> whole{0, 5, 6};
+    for (long long f : Frames(7, 25)) {
+      if (every == 0 || (f - 7) % every == 0) whole.push_back(f);
+    }
+    EXPECT_EQ(run.whole, whole) << "hidden_scan_every " << every;
+  }
+  track.hidden_scan_every = -1;
+  EXPECT_THROW(track.Check(), Error);
 }
 
 TEST(CameraStage, GuidedFitsGoOnWhereTheSearchLosesTheBallForMaxGuidedFrames) {
