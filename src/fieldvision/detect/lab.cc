@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "fieldvision/util/error.h"
 
@@ -22,10 +24,27 @@ const std::array<double, 256>& LinearTable() {
   return kTable;
 }
 
-// CIE 1976 f(t): the cube root above (6/29)^3, its tangent line below.
-double LabF(double t) { return t > 0.008856 ? std::cbrt(t) : 7.787 * t + 16.0 / 116.0; }
+// The cube root of t in f(t)'s range below to a few ulps: a first guess within 4 % from the
+// bits divided by three (exponent and mantissa alike), then three of Halley's steps, each cubing
+// the relative error. std::cbrt, for any double, was a fifth of the detector's time.
+double CubeRoot(double t) {
+  uint64_t bits = 0;
+  std::memcpy(&bits, &t, sizeof bits);
+  bits = bits / 3 + 0x2A9F7893782DA1CEULL;
+  double y = 0.0;
+  std::memcpy(&y, &bits, sizeof y);
+  for (int i = 0; i < 3; ++i) {
+    const double y3 = y * y * y;
+    y *= (y3 + 2.0 * t) / (2.0 * y3 + t);
+  }
+  return y;
+}
 
-uint8_t Level(double v) { return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L)); }
+// CIE 1976 f(t): the cube root above (6/29)^3, its tangent line below.
+double LabF(double t) { return t > 0.008856 ? CubeRoot(t) : 7.787 * t + 16.0 / 116.0; }
+
+// Rounded to the nearest level (halves up) and clamped to 0..255.
+uint8_t Level(double v) { return static_cast<uint8_t>(std::clamp(v, 0.0, 255.0) + 0.5); }
 
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "fieldvision/detect/lab.h"
 
+#include <algorithm>
+#include <cmath>
 #include <thread>
 #include <vector>
 
@@ -64,6 +66,51 @@ TEST(BgrToLab, WithinThreeLevelsOfOpenCvAndTheSameOnEveryThread) {
   cv::Mat part;
   BgrToLab(images[0](cv::Rect(5, 7, 20, 9)), &part);
   EXPECT_EQ(cv::norm(part, labs[0](cv::Rect(5, 7, 20, 9)), cv::NORM_INF), 0.0);
+}
+
+// The CIE 1976 definition in 8 bits, straight from the standards' formulas (std::pow, std::cbrt).
+cv::Vec3b DefinitionLab(const cv::Vec3b& bgr) {
+  auto linear = [](int v) {
+    const double c = v / 255.0;
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  };
+  auto f = [](double t) { return t > 0.008856 ? std::cbrt(t) : 7.787 * t + 16.0 / 116.0; };
+  auto level = [](double v) { return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L)); };
+  const double b = linear(bgr[0]), g = linear(bgr[1]), r = linear(bgr[2]);
+  const double fx = f((0.412453 * r + 0.357580 * g + 0.180423 * b) / 0.950456);
+  const double fy = f(0.212671 * r + 0.715160 * g + 0.072169 * b);
+  const double fz = f((0.019334 * r + 0.119193 * g + 0.950227 * b) / 1.088754);
+  return {level((116.0 * fy - 16.0) * 255.0 / 100.0), level(500.0 * (fx - fy) + 128.0),
+          level(200.0 * (fy - fz) + 128.0)};
+}
+
+TEST(BgrToLab, TheDefinitionOnEveryThirdLevelOfEachChannel) {
+  std::vector<int> levels;
+  for (int v = 0; v < 255; v += 3) levels.push_back(v);
+  levels.push_back(255);
+  cv::Mat bgr(static_cast<int>(levels.size() * levels.size()), static_cast<int>(levels.size()),
+              CV_8UC3);
+  for (size_t i = 0; i < levels.size(); ++i) {
+    for (size_t j = 0; j < levels.size(); ++j) {
+      for (size_t k = 0; k < levels.size(); ++k) {
+        bgr.at<cv::Vec3b>(static_cast<int>(i * levels.size() + j), static_cast<int>(k)) =
+            cv::Vec3b(levels[i], levels[j], levels[k]);
+      }
+    }
+  }
+  cv::Mat lab;
+  BgrToLab(bgr, &lab);
+  int differ = 0;
+  for (int y = 0; y < bgr.rows; ++y) {
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3b want = DefinitionLab(bgr.at<cv::Vec3b>(y, x));
+      if (lab.at<cv::Vec3b>(y, x) != want && ++differ <= 3) {
+        ADD_FAILURE() << "BGR " << bgr.at<cv::Vec3b>(y, x) << ": " << lab.at<cv::Vec3b>(y, x)
+                      << ", the definition " << want;
+      }
+    }
+  }
+  EXPECT_EQ(differ, 0);
 }
 
 TEST(BgrToLab, EmptyInEmptyOutAndOtherTypesThrow) {
