@@ -46,6 +46,7 @@ TEST(BgrToLab, WithinThreeLevelsOfOpenCvAndTheSameOnEveryThread) {
   FV_SEED_TRACE(seed);
   testing::SeededRng rng(seed);
   std::vector<cv::Mat> images;
+  images.reserve(4);
   for (int t = 0; t < 4; ++t) images.push_back(RandomImage(rng, 64, 64));
   std::vector<cv::Mat> labs(images.size());
   std::vector<std::thread> threads;  // the first conversions at once: the table is built once
@@ -86,6 +87,7 @@ cv::Vec3b DefinitionLab(const cv::Vec3b& bgr) {
 
 TEST(BgrToLab, TheDefinitionOnEveryThirdLevelOfEachChannel) {
   std::vector<int> levels;
+  levels.reserve(87);
   for (int v = 0; v < 255; v += 3) levels.push_back(v);
   levels.push_back(255);
   cv::Mat bgr(static_cast<int>(levels.size() * levels.size()), static_cast<int>(levels.size()),
