@@ -42,8 +42,11 @@ struct Sighting {
   double time_s = 0.0;
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
   double radius_px = 0.0;
-  double tolerance_s = 0.0;  // times this close are the same frame
 };
+// Within two radii (the larger) and 2 px: the same ball as the tracking window takes it.
+bool SameBall(const Sighting& a, const Sighting& b) {
+  return (a.centre_px - b.centre_px).norm() <= 2.0 * std::max(a.radius_px, b.radius_px) + 2.0;
+}
 }  // namespace
 
 // Where a camera stage looks next: the window around the ball's predicted image position.
@@ -95,11 +98,12 @@ class CameraStage::Track {
   Eigen::Vector2d ExpectedCentre() const { return centre_ + velocity_; }
   // Where the fusion expects the ball: taken unless the track expects it there too, or the track
   // was on the ball when the cameras together last saw it (`fused_then`: the fused position in
-  // this camera at its time, within half a frame of a tracked one): the track has seen the frames
+  // this camera at its time; a frame within `same_frame_s` of it): the track has seen the frames
   // since and knows of a bounce or a kick that the fusion's prediction does not.
-  void Steer(const ExpectedBall& e, const std::optional<Sighting>& fused_then) {
+  void Steer(const ExpectedBall& e, const std::optional<Sighting>& fused_then,
+             double same_frame_s) {
     if (!o_.enabled) return;
-    if (Expects(e) || (active_ && fused_then && Saw(*fused_then))) return;
+    if (Expects(e) || (active_ && fused_then && Saw(*fused_then, same_frame_s))) return;
     centre_ = e.centre_px - e.step_px;
     velocity_ = e.step_px;
     radius_ = std::max(e.radius_px, 2.0);
@@ -135,16 +139,17 @@ class CameraStage::Track {
     active_ = true;
   }
 
-  // Whether the frame at `f`'s time was seen, without an accepted candidate on `f`'s ball.
-  bool MissedAt(const Sighting& f) const {
+  // Whether the frame at `f`'s time (within `same_frame_s`) was seen, without an accepted
+  // candidate on `f`'s ball.
+  bool MissedAt(const Sighting& f, double same_frame_s) const {
     for (const FrameSeen& seen : frames_seen_) {
-      if (std::abs(seen.time_s - f.time_s) > f.tolerance_s) continue;
-      return std::none_of(seen.balls.begin(), seen.balls.end(), [&](const Sighting& s) {
-        return (s.centre_px - f.centre_px).norm() <= 2.0 * std::max(s.radius_px, f.radius_px) + 2.0;
-      });
+      if (std::abs(seen.time_s - f.time_s) > same_frame_s) continue;
+      return std::none_of(seen.balls.begin(), seen.balls.end(),
+                          [&](const Sighting& s) { return SameBall(s, f); });
     }
     return false;
   }
+
  private:
   static const recon::BallObservation* Best(const std::vector<recon::BallObservation>& obs) {
     const recon::BallObservation* best = nullptr;
@@ -157,11 +162,10 @@ class CameraStage::Track {
   bool Near(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius_px) const {
     return (a - b).norm() <= 2.0 * std::max(radius_, radius_px) + 2.0;
   }
-  // Whether the track's ball in the frame at `f`'s time lay on `f`'s.
-  bool Saw(const Sighting& f) const {
+  // Whether the track's ball in the frame at `f`'s time (within `same_frame_s`) lay on `f`'s.
+  bool Saw(const Sighting& f, double same_frame_s) const {
     return std::any_of(seen_.begin(), seen_.end(), [&](const Sighting& s) {
-      return std::abs(s.time_s - f.time_s) <= f.tolerance_s &&
-             (s.centre_px - f.centre_px).norm() <= 2.0 * std::max(s.radius_px, f.radius_px) + 2.0;
+      return std::abs(s.time_s - f.time_s) <= same_frame_s && SameBall(s, f);
     });
   }
   static constexpr size_t kSeenKept = 16;  // frames: more than the hints' lag
@@ -172,7 +176,7 @@ class CameraStage::Track {
   std::deque<FrameSeen> frames_seen_;  // the last frames
   BallTrackOptions o_;
   bool active_ = false;
-  std::deque<Sighting> seen_;  // the track's balls in its last frames (no tolerance)
+  std::deque<Sighting> seen_;  // the track's balls in its last frames
   int Slot() const { return static_cast<int>((frames_ + phase_) % o_.full_scan_every); }
   int phase_;
   long long frames_ = 0;  // frames seen
@@ -304,12 +308,13 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
   if (!e) return;
   std::optional<Sighting> then;
   if (const auto at = ExpectBall(*hint, camera_, hint->time_s, 0.0, hints_->options())) {
-    then = Sighting{hint->time_s, at->centre_px, at->radius_px, 0.5 * dt_s};
+    then = Sighting{hint->time_s, at->centre_px, at->radius_px};
   }
-  track_->Steer(*e, then);
+  const double same_frame_s = 0.5 * dt_s;
+  track_->Steer(*e, then, same_frame_s);
   const double fresh_s = (hints_->options().lag_messages + 1.5) * dt_s;
-  hidden_ =
-      in.time_s - hint->time_s <= fresh_s && track_->Expects(*e) && then && track_->MissedAt(*then);
+  hidden_ = in.time_s - hint->time_s <= fresh_s && track_->Expects(*e) && then &&
+            track_->MissedAt(*then, same_frame_s);
 }
 
 bool CameraStage::HiddenHere(bool found) {
