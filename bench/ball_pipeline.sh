@@ -32,6 +32,9 @@ run() {  # mode-name extra-args...
     printf "ball pipeline (%s): %d cameras x %d frames (%.2f s of 60 fps video) in %.2f s wall, %.2f s CPU = %.1f frames/s, %.2fx real time\n",
            name, cams, n, video, wall, cpu, n / wall, video / wall }'
   awk -v s="$start" -v e="$end" 'BEGIN { print e - s }' >"$SCENE/wall_$name.txt"
+  # The tracked modes' decoding work: camera frames searched in a window, and whole.
+  grep -oE '[0-9]+ camera frames searched in a window around the ball, [0-9]+ whole' \
+    "$SCENE/ball_$name.log" | sed 's/^/  /' || true
   "$FV" eval ball --truth "$SCENE/truth.csv" --est "$SCENE/ball_$name.csv" | tail -2
 }
 run whole --whole-frames
