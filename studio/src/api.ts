@@ -86,6 +86,8 @@ export interface CameraJson {
   position_m?: number[];
   cam_from_world_rotation?: number[];
   tvec?: number[];
+  // The image's border through the lens model, normalized (x/z, y/z), round from the top-left.
+  image_outline_normalized?: number[][];
 }
 
 export async function files(): Promise<FileEntry[]> {

@@ -1,7 +1,8 @@
 // 3D view: the field, each camera as a frustum at its pose, the ball track (BALL.csv) coloured by
-// time, flights (FLIGHTS.json: origin, apex, landing), the rays from the cameras to the ball at
-// the time of the slider, and the ball's height over time (uPlot). Live mode: the server
-// subscribes to a fusion node's positions (`fuse --publish`) and forwards them as 'ball' events.
+// time, flights (FLIGHTS.json: origin, apex, landing), the rays to the ball at the time of the
+// slider from the cameras whose image holds it, and the ball's height over time (uPlot). Live
+// mode: the server subscribes to a fusion node's positions (`fuse --publish`) and forwards them
+// as 'ball' events.
 // Drawing is cheap and on demand: a track is one set of buffers drawn as points and as the line
 // segments the markers do not cover, the markers one Points object, the rays one preallocated
 // buffer; a frame is rendered only when the view, the time or the data changed (at most once per
@@ -168,21 +169,49 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   rays.frustumCulled = false;
   scene.add(ballMarker, rays);
 
-  function setBall(p: number[] | null) {
+  // Whether camera c's image holds world point p: in front of it, and its normalized point inside
+  // the image's outline through the lens (the server's), else inside the pinhole's frame.
+  function holds(c: api.CameraJson, p: number[]): boolean {
+    const r = c.cam_from_world_rotation!;
+    const t = c.tvec!;
+    const z = r[6] * p[0] + r[7] * p[1] + r[8] * p[2] + t[2];
+    if (!(z > 0)) return false;
+    const x = (r[0] * p[0] + r[1] * p[1] + r[2] * p[2] + t[0]) / z;
+    const y = (r[3] * p[0] + r[4] * p[1] + r[5] * p[2] + t[1]) / z;
+    const outline = c.image_outline_normalized ?? [];
+    if (outline.length < 3) {
+      const u = c.fx * x + c.cx;
+      const v = c.fy * y + c.cy;
+      return u >= -0.5 && u < c.width - 0.5 && v >= -0.5 && v < c.height - 0.5;
+    }
+    let inside = false;  // even-odd rule
+    for (let i = 0, j = outline.length - 1; i < outline.length; j = i++) {
+      const [xi, yi] = outline[i];
+      const [xj, yj] = outline[j];
+      if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
+    }
+    return inside;
+  }
+
+  // Rays from the cameras whose image holds the ball (BALL.csv does not say which cameras found
+  // it); returns those cameras.
+  function setBall(p: number[] | null): api.CameraJson[] {
     ballMarker.visible = !!p;
     if (!p) {
       rayGeometry.setDrawRange(0, 0);
-      return;
+      return [];
     }
     ballMarker.position.set(p[0], p[1], p[2]);
-    const n = Math.min(cams.length, maxRays);
-    for (let i = 0; i < n; ++i) {
-      rayPositions.set(cams[i].position_m!, 6 * i);
+    const from = cams.filter((c) => holds(c, p)).slice(0, maxRays);
+    const n = from.length;
+    from.forEach((c, i) => {
+      rayPositions.set(c.position_m!, 6 * i);
       rayPositions.set([p[0], p[1], p[2]], 6 * i + 3);
-    }
+    });
     rayGeometry.setDrawRange(0, 2 * n);
     (rayGeometry.attributes.position as THREE.BufferAttribute).needsUpdate = true;
     rayGeometry.computeBoundingSphere();
+    return from;
   }
 
   function fieldGroup(f: api.FieldModel): THREE.Group {
@@ -360,8 +389,10 @@ export async function view3dPage(root: HTMLElement, options: { bench?: boolean }
   function setTime(i: number) {
     if (!samples.length) return;
     const s = samples[Math.min(i, samples.length - 1)];
-    timeLabel.textContent = ` t = ${s[1].toFixed(3)} s (frame ${s[0]}), ball at (${s[2].toFixed(2)}, ${s[3].toFixed(2)}, ${s[4].toFixed(2)}) m from ${s[5]} cameras (rays drawn from every camera shown)`;
-    setBall([s[2], s[3], s[4]]);
+    const from = setBall([s[2], s[3], s[4]]);
+    timeLabel.textContent = ` t = ${s[1].toFixed(3)} s (frame ${s[0]}), ball at (${s[2].toFixed(2)}, ${s[3].toFixed(2)}, ${s[4].toFixed(2)}) m from ${s[5]} cameras; rays from the ${from.length} of ${cams.length} cameras shown whose image holds it`;
+    timeLabel.dataset.frame = String(s[0]);
+    timeLabel.dataset.rays = JSON.stringify(from.map((c) => c.name));
     plot?.setCursor({ left: plot.valToPos(s[1], 'x'), top: 10 });
     requestRender();
   }

@@ -225,6 +225,16 @@ try {
 
   lap('ball colour');
   // ---- 3D view
+  // A camera 10 m above the field's centre looking up (cam1's lens, identity rotation): the ball
+  // is behind it, so no ray from it.
+  const cam1Yaml = fs.readFileSync(path.join(work, 'scene/cam1.yaml'), 'utf8');
+  const matrix = (key, values) => (text) => text.replace(new RegExp(`(${key}: !!opencv-matrix[\\s\\S]*?data: )\\[[^\\]]*\\]`), `$1[ ${values.join(', ')} ]`);
+  let awayYaml = cam1Yaml.replace(/^name: .*$/m, 'name: away');
+  awayYaml = matrix('rvec', [0, 0, 0])(awayYaml);
+  awayYaml = matrix('tvec', [0, 0, -10])(awayYaml);
+  awayYaml = matrix('camera_position_m', [0, 0, 10])(awayYaml);
+  fs.mkdirSync(path.join(work, 'extra'), { recursive: true });  // not beside ball.csv: all cameras ticked
+  fs.writeFileSync(path.join(work, 'extra/away.yaml'), awayYaml);
   await page.goto(url + '#view3d');
   await page.waitForSelector('#page[data-ready="1"]');
   await page.selectOption('#v3-ball', 'ball.csv');
@@ -255,6 +265,20 @@ try {
   });
   check(stats.changed > 0.05 && stats.colours > 20, `3D canvas rendered (${(100 * stats.changed).toFixed(1)} % of pixels off the background, ${stats.colours} colours)`);
   await page.locator('#v3-time').fill('20');
+  // Rays from the cameras whose image holds the ball: of the scene's cameras (by name; the
+  // camera files made earlier in this test are poses of them, and one of a phone), those that hold
+  // the true ball in that frame.
+  const shownFrame = await page.locator('#v3-time-label').getAttribute('data-frame');
+  const rayNames = JSON.parse((await page.locator('#v3-time-label').getAttribute('data-rays')) ?? '[]');
+  const truthNow = readCsv(path.join(work, 'scene/truth_2d.csv')).filter((t) => t.frame === shownFrame);
+  const judged = withPose.filter((c) => c.has_pose && truthNow.some((t) => t.cam === c.name));
+  const wrong = judged.filter((c) => {
+    const t = truthNow.find((r) => r.cam === c.name);
+    const inImage = t.u_px >= -0.5 && t.u_px < c.width - 0.5 && t.v_px >= -0.5 && t.v_px < c.height - 0.5;
+    return inImage !== rayNames.includes(c.name);
+  });
+  const away = withPose.find((c) => c.name === 'away');
+  check(shownFrame !== null && judged.length >= 4 && wrong.length === 0 && away && !rayNames.includes('away'), `3D view at frame ${shownFrame}: rays from ${rayNames.join(' ')}; of ${judged.length} scene cameras ${wrong.length} drawn against the truth; none from the camera looking up (${away ? 'listed' : 'not listed'})`);
   await page.screenshot({ path: path.join(out, 'view3d.jpg'), quality: 70 });
   lap('3D view');
   // The benchmark page: a 10,000-point track over the field and the cameras, turned for 2 s.

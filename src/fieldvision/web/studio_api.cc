@@ -1,5 +1,6 @@
 #include "fieldvision/web/studio_api.h"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -143,6 +144,29 @@ field::FieldModel LoadFieldIn(const Workspace& ws, const std::string& name_or_pa
   return field::LoadField(ws.Resolve(name_or_path).string());
 }
 
+// The image's border through the lens model, in normalized coordinates (x/z, y/z): 8 points a side
+// from the top-left corner round, so that a client tells whether the camera's image holds a point
+// (a pinhole's frame would leave out what a barrel or fisheye lens bends into it). Points whose
+// undistortion does not converge are left out.
+json ImageOutlineNormalized(const camera::Camera& c) {
+  constexpr int kPerSide = 8;
+  const double x0 = -0.5, y0 = -0.5, x1 = c.width - 0.5, y1 = c.height - 0.5;
+  const std::array<Eigen::Vector2d, 5> corners = {Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0),
+                                                  Eigen::Vector2d(x1, y1), Eigen::Vector2d(x0, y1),
+                                                  Eigen::Vector2d(x0, y0)};
+  json outline = json::array();
+  for (int side = 0; side < 4; ++side) {
+    for (int k = 0; k < kPerSide; ++k) {
+      const double f = static_cast<double>(k) / kPerSide;
+      const Eigen::Vector2d uv = (1.0 - f) * corners[side] + f * corners[side + 1];
+      if (const auto xn = c.Undistort(uv); xn && xn->allFinite()) {
+        outline.push_back({xn->x(), xn->y()});
+      }
+    }
+  }
+  return outline;
+}
+
 json CameraToJson(const camera::Camera& c) {
   json j = {{"name", c.name},
             {"width", c.width},
@@ -162,6 +186,7 @@ json CameraToJson(const camera::Camera& c) {
     j["cam_from_world_rotation"] = {r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1),
                                     r(1, 2), r(2, 0), r(2, 1), r(2, 2)};
   }
+  j["image_outline_normalized"] = ImageOutlineNormalized(c);
   return j;
 }
 

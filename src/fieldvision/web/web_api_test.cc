@@ -209,6 +209,20 @@ TEST_F(StudioApiTest, FieldVideoFrameAndCamera) {
   const camera::Camera truth = camera::ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
   EXPECT_TRUE(cam.j()["has_pose"].get<bool>());
   EXPECT_NEAR(cam.j()["position_m"][0].get<double>(), truth.CentreInWorld().x(), 1e-9);
+  // The image's border in normalized coordinates: 8 points a side, each back on the border
+  // through the lens.
+  const json outline = cam.j()["image_outline_normalized"];
+  ASSERT_EQ(outline.size(), 32u);
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const auto uv = truth.ProjectFromCamera(
+        Eigen::Vector3d(outline[i][0].get<double>(), outline[i][1].get<double>(), 1.0));
+    ASSERT_TRUE(uv.has_value());
+    const double to_border =
+        std::min({std::abs(uv->x() + 0.5), std::abs(uv->x() - truth.width + 0.5),
+                  std::abs(uv->y() + 0.5), std::abs(uv->y() - truth.height + 0.5)});
+    EXPECT_LT(to_border, 1e-6) << "outline point " << i << " at " << uv->transpose();
+  }
+  EXPECT_NEAR(outline[0][0].get<double>(), (-0.5 - truth.cx) / truth.fx, 0.05);
   ExpectError(Get("/api/camera?path=scene/truth.csv"), 422, "truth.csv");
 }
 
