@@ -74,7 +74,10 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
       use[last] = 0;
     }
   }
-  // Then the worst one dropped while it is off the line and more than two remain.
+  // Then the worst one dropped while it is off the line and more than two remain. When that leaves
+  // two, which were off is a guess (of three positions, the middle one on another object, or the
+  // ball at three places far apart): the newest position alone, without velocity.
+  int dropped = 0;
   for (auto left = std::count(use.begin(), use.end(), 1);; --left) {
     FitLine(tau, x, use, &at0, &v);
     if (left <= 2) break;
@@ -89,6 +92,11 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
     }
     if (worst_m <= o.outlier_m) break;
     use[worst] = 0;
+    ++dropped;
+  }
+  if (dropped > 0 && std::count(use.begin(), use.end(), 1) <= 2) {
+    h.airborne = false;
+    return h;
   }
   if (v.norm() > o.max_speed_mps) {
     h.airborne = false;
@@ -96,6 +104,7 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
   }
   h.ball_in_world = at0;
   h.velocity_mps = v;
+  h.positions = static_cast<int>(std::count(use.begin(), use.end(), 1));
   return h;
 }
 

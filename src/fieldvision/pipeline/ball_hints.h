@@ -30,6 +30,9 @@ struct BallHint {
   Eigen::Vector3d velocity_mps = Eigen::Vector3d::Zero();
   double radius_m = 0.11;
   bool airborne = false;  // both positions it came from were above a resting ball
+  // The positions its line was fitted to; 1: the newest alone, without velocity (a single one, a
+  // jump, positions that disagree).
+  int positions = 1;
 };
 
 // Where a camera expects the ball at a time: its image centre and radius, and its image motion
@@ -48,8 +51,9 @@ struct BallHintOptions {
   double airborne_m = 0.05;     // above a resting ball's centre by this much: in flight
   // The state is a line (a parabola in flight) fitted to the positions of the last fit_span_s
   // (each within max_gap_s of the next), dropping the worst one while it is farther than
-  // outlier_m from the fit (a position on another object) and more than two remain; when the two
-  // newest are both dropped the ball was kicked, and the line is theirs.
+  // outlier_m from the fit (a position on another object) and more than two remain (when two are
+  // left so, the newest alone); when the two newest are both dropped the ball was kicked, and the
+  // line is theirs.
   double fit_span_s = 0.1;
   double outlier_m = 0.15;
   void Check() const;  // throws fv::Error naming the bad field

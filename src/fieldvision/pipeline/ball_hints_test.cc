@@ -79,6 +79,25 @@ TEST(BallHintBoard, AJumpOrAGapGivesNoVelocity) {
   EXPECT_THROW(bad.Check(), Error);
 }
 
+TEST(BallHintBoard, ThreePositionsOneOffTheLineGiveTheNewestAloneAndALineCountsItsPositions) {
+  // Three positions 1 m apart at 60 fps, the middle one off the others' line: which one is off is
+  // a guess (a position on another object, or a ball seen at three places), so no velocity.
+  BallHintBoard board(1, BallHintOptions{}, /*wait=*/false);
+  board.Publish(0.0, Vector3d(0, 0, 0.11), 0.11);
+  board.Publish(1.0 / 60, Vector3d(0.5, 1.0, 0.11), 0.11);
+  board.Publish(2.0 / 60, Vector3d(0.6, 0, 0.11), 0.11);
+  const std::optional<BallHint> h = board.Get(0, 0);
+  ASSERT_TRUE(h);
+  EXPECT_EQ(h->ball_in_world, Vector3d(0.6, 0, 0.11));
+  EXPECT_EQ(h->velocity_mps, Vector3d::Zero());
+  EXPECT_EQ(h->positions, 1);
+  // Four on a line: the line through them.
+  BallHintBoard line(1, BallHintOptions{}, /*wait=*/false);
+  for (int f = 0; f < 4; ++f) line.Publish(f / 60.0, Vector3d(0.1 * f, 0, 0.11), 0.11);
+  EXPECT_EQ(line.Get(0, 0)->positions, 4);
+  EXPECT_LT((line.Get(0, 0)->velocity_mps - Vector3d(6, 0, 0)).norm(), 1e-9);
+}
+
 TEST(BallHintBoard, AFlyingBallFallsAlongItsParabola) {
   // A ball thrown up at 5 m/s from 2 m: positions at 60 fps; the hint at the third predicts the
   // tenth within a millimetre (constant velocity alone: 9 cm off).

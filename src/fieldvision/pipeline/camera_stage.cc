@@ -313,8 +313,10 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
   const double same_frame_s = 0.5 * dt_s;
   track_->Steer(*e, then, same_frame_s);
   const double fresh_s = (hints_->options().lag_messages + 1.5) * dt_s;
-  hidden_ = in.time_s - hint->time_s <= fresh_s && track_->Expects(*e) && then &&
-            track_->MissedAt(*then, same_frame_s);
+  // Hidden: the cameras together follow the ball (a line through three positions at least, not a
+  // jump) and saw it lately where this camera did not.
+  hidden_ = hint->positions >= 3 && in.time_s - hint->time_s <= fresh_s && track_->Expects(*e) &&
+            then && track_->MissedAt(*then, same_frame_s);
 }
 
 bool CameraStage::HiddenHere(bool found) {

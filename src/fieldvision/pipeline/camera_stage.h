@@ -65,12 +65,12 @@ struct BallTrackOptions {
   // comes into view (the kick render, cam1 and cam2: the ball hidden from cam1 until frame 19,
   // tracked from frame 33, the next whole-frame search, before).
   int unconfirmed_scan_every = 5;
-  // With hints: while the cameras together see the ball (a fused position at most
-  // BallHintOptions::lag_messages + 1 frames old) where this camera had no candidate in that
-  // frame, and finds none where they expect it now, the ball is hidden from this camera: it
-  // searches the whole frame only in the first of every this many such frames in a row (0 or 1:
-  // in each), and its window where the others see the ball in each (the kick render: cam1
-  // searched 17 frames whole while the ball was behind a robot, now 5).
+  // With hints: while the cameras together follow the ball (a fused position at most
+  // BallHintOptions::lag_messages + 1 frames old, on a line through three at least) where this
+  // camera had no candidate in that frame, and it finds none where they expect it now, the ball
+  // is hidden from this camera: it searches the whole frame only in the first of every this many
+  // such frames in a row (0 or 1: in each), and its window where the others see the ball in each
+  // (the kick render: cam1 searched 17 frames whole while the ball was behind a robot, now 5).
   int hidden_scan_every = 5;
   void Check() const;  // throws fv::Error naming the bad field
 };

@@ -427,6 +427,25 @@ TEST(CameraStage, ABallHiddenFromThisCameraOnlyIsSearchedWholeEveryHiddenScanEve
   EXPECT_THROW(track.Check(), Error);
 }
 
+TEST(CameraStage, ABallAtANewPlaceEachFrameIsNotHiddenAndIsSearchedForWhole) {
+  // The fused positions jump between far places every frame (no line through them: the hints
+  // have no track), and this camera misses the ball until frame 10: not hidden from it, so each
+  // frame whose window misses is searched whole, and the ball is found from frame 10 on.
+  std::vector<std::vector<Thing>> frames;
+  std::vector<Vector2d> ball;
+  for (int f = 0; f < 20; ++f) {
+    ball.emplace_back(100 + 200 * (f % 3), 100 + 150 * ((f / 3) % 2));
+    frames.push_back({{Vector2d(600, 450), 0.2}});
+    if (f >= 10) frames.back().push_back({ball.back(), 0.8});
+  }
+  BallTrackOptions track;
+  track.full_scan_every = 100;
+  const HintedRun run = RunHinted(frames, ball, track);
+  EXPECT_EQ(run.with_ball, Frames(10, 20));
+  // Frame 1: no hint yet, the window on the still thing the first search took.
+  EXPECT_EQ(run.whole, Frames(0, 20, /*except=*/1));
+}
+
 TEST(CameraStage, GuidedFitsGoOnWhereTheSearchLosesTheBallForMaxGuidedFrames) {
   // The ball rolls right; from frame 5 the search no longer finds it (merged with a board).
   // A guided fit at the expected place finds it there for max_guided_frames frames in a row.
