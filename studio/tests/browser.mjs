@@ -225,16 +225,16 @@ try {
 
   lap('ball colour');
   // ---- 3D view
-  // A camera 10 m above the field's centre looking up (cam1's lens, identity rotation): the ball
-  // is behind it, so no ray from it.
+  // Two cameras with cam1's lens that do not hold the ball: 10 m above the field's centre looking
+  // up (the ball behind it), and 10 m up 100 m beside the field looking down (the ball in front
+  // of it, 10 image widths off its image). No ray from either.
   const cam1Yaml = fs.readFileSync(path.join(work, 'scene/cam1.yaml'), 'utf8');
   const matrix = (key, values) => (text) => text.replace(new RegExp(`(${key}: !!opencv-matrix[\\s\\S]*?data: )\\[[^\\]]*\\]`), `$1[ ${values.join(', ')} ]`);
-  let awayYaml = cam1Yaml.replace(/^name: .*$/m, 'name: away');
-  awayYaml = matrix('rvec', [0, 0, 0])(awayYaml);
-  awayYaml = matrix('tvec', [0, 0, -10])(awayYaml);
-  awayYaml = matrix('camera_position_m', [0, 0, 10])(awayYaml);
+  const posed = (name, rvec, tvec, position) => [matrix('rvec', rvec), matrix('tvec', tvec), matrix('camera_position_m', position)]
+    .reduce((text, f) => f(text), cam1Yaml.replace(/^name: .*$/m, `name: ${name}`));
   fs.mkdirSync(path.join(work, 'extra'), { recursive: true });  // not beside ball.csv: all cameras ticked
-  fs.writeFileSync(path.join(work, 'extra/away.yaml'), awayYaml);
+  fs.writeFileSync(path.join(work, 'extra/away.yaml'), posed('away', [0, 0, 0], [0, 0, -10], [0, 0, 10]));
+  fs.writeFileSync(path.join(work, 'extra/aside.yaml'), posed('aside', [Math.PI, 0, 0], [-100, 0, 10], [100, 0, 10]));
   await page.goto(url + '#view3d');
   await page.waitForSelector('#page[data-ready="1"]');
   await page.selectOption('#v3-ball', 'ball.csv');
@@ -277,8 +277,8 @@ try {
     const inImage = t.u_px >= -0.5 && t.u_px < c.width - 0.5 && t.v_px >= -0.5 && t.v_px < c.height - 0.5;
     return inImage !== rayNames.includes(c.name);
   });
-  const away = withPose.find((c) => c.name === 'away');
-  check(shownFrame !== null && judged.length >= 4 && wrong.length === 0 && away && !rayNames.includes('away'), `3D view at frame ${shownFrame}: rays from ${rayNames.join(' ')}; of ${judged.length} scene cameras ${wrong.length} drawn against the truth; none from the camera looking up (${away ? 'listed' : 'not listed'})`);
+  const apart = ['away', 'aside'].filter((n) => withPose.some((c) => c.name === n) && !rayNames.includes(n));
+  check(shownFrame !== null && judged.length >= 4 && wrong.length === 0 && apart.length === 2, `3D view at frame ${shownFrame}: rays from ${rayNames.join(' ')}; of ${judged.length} scene cameras ${wrong.length} drawn against the truth; listed without a ray: ${apart.join(', ')} (away, aside)`);
   await page.screenshot({ path: path.join(out, 'view3d.jpg'), quality: 70 });
   lap('3D view');
   // The benchmark page: a 10,000-point track over the field and the cameras, turned for 2 s.

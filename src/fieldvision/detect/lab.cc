@@ -43,8 +43,8 @@ double CubeRoot(double t) {
 // CIE 1976 f(t): the cube root above (6/29)^3, its tangent line below.
 double LabF(double t) { return t > 0.008856 ? CubeRoot(t) : 7.787 * t + 16.0 / 116.0; }
 
-// Rounded to the nearest level (halves up) and clamped to 0..255 (as std::lround, a call, but for
-// the largest double below 0.5).
+// A finite v rounded to the nearest level (halves up) and clamped to 0..255 (as std::lround, a
+// call, but for the largest double below 0.5).
 uint8_t Level(double v) {
   const double up = std::clamp(v, 0.0, 255.0) + 0.5;
   return static_cast<uint8_t>(up);  // NOLINT(bugprone-incorrect-roundings): see above

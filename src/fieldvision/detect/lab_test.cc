@@ -87,7 +87,7 @@ cv::Vec3b DefinitionLab(const cv::Vec3b& bgr) {
 
 TEST(BgrToLab, TheDefinitionOnEveryThirdLevelOfEachChannel) {
   std::vector<int> levels;
-  levels.reserve(87);
+  levels.reserve(86);  // 0, 3, ..., 252 and 255
   for (int v = 0; v < 255; v += 3) levels.push_back(v);
   levels.push_back(255);
   cv::Mat bgr(static_cast<int>(levels.size() * levels.size()), static_cast<int>(levels.size()),

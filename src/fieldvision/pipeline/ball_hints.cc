@@ -75,8 +75,9 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
     }
   }
   // Then the worst one dropped while it is off the line and more than two remain. When that leaves
-  // two, which were off is a guess (of three positions, the middle one on another object, or the
-  // ball at three places far apart): the newest position alone, without velocity.
+  // two, which were off is a guess (of three evenly spaced positions the middle one is always the
+  // one dropped: on another object, or the ball at three places far apart): the newest position
+  // kept, alone, without velocity.
   int dropped = 0;
   for (auto left = std::count(use.begin(), use.end(), 1);; --left) {
     FitLine(tau, x, use, &at0, &v);
@@ -95,6 +96,11 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
     ++dropped;
   }
   if (dropped > 0 && std::count(use.begin(), use.end(), 1) <= 2) {
+    const size_t from_end =
+        static_cast<size_t>(std::find(use.rbegin(), use.rend(), 1) - use.rbegin());
+    const auto& [t_s, p] = recent[recent.size() - 1 - from_end];
+    h.time_s = t_s;
+    h.ball_in_world = p;
     h.airborne = false;
     return h;
   }

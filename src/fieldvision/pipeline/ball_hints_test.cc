@@ -91,6 +91,19 @@ TEST(BallHintBoard, ThreePositionsOneOffTheLineGiveTheNewestAloneAndALineCountsI
   EXPECT_EQ(h->ball_in_world, Vector3d(0.6, 0, 0.11));
   EXPECT_EQ(h->velocity_mps, Vector3d::Zero());
   EXPECT_EQ(h->positions, 1);
+  // Five: the newest far off the older ones' line (on another object), and of the four left two
+  // more off: the newest of the two kept, at its own time (not the one judged off).
+  BallHintBoard five(1, BallHintOptions{}, /*wait=*/false);
+  const std::vector<Vector3d> at = {Vector3d(0, 0, 0.11), Vector3d(0, 3, 0.11),
+                                    Vector3d(0, 0, 0.11), Vector3d(0, 1, 0.11),
+                                    Vector3d(5, 5, 0.11)};
+  for (size_t f = 0; f < at.size(); ++f) five.Publish(f / 60.0, at[f], 0.11);
+  const std::optional<BallHint> k = five.Get(0, 0);
+  ASSERT_TRUE(k);
+  EXPECT_EQ(k->ball_in_world, at[3]);
+  EXPECT_NEAR(k->time_s, 3 / 60.0, 1e-12);
+  EXPECT_EQ(k->velocity_mps, Vector3d::Zero());
+  EXPECT_EQ(k->positions, 1);
   // Four on a line: the line through them.
   BallHintBoard line(1, BallHintOptions{}, /*wait=*/false);
   for (int f = 0; f < 4; ++f) line.Publish(f / 60.0, Vector3d(0.1 * f, 0, 0.11), 0.11);

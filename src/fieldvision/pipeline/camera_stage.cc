@@ -142,12 +142,12 @@ class CameraStage::Track {
   // Whether the frame at `f`'s time (within `same_frame_s`) was seen, without an accepted
   // candidate on `f`'s ball.
   bool MissedAt(const Sighting& f, double same_frame_s) const {
-    for (const FrameSeen& seen : frames_seen_) {
-      if (std::abs(seen.time_s - f.time_s) > same_frame_s) continue;
-      return std::none_of(seen.balls.begin(), seen.balls.end(),
-                          [&](const Sighting& s) { return SameBall(s, f); });
+    const auto seen = Nearest(frames_seen_, f.time_s);
+    if (seen == frames_seen_.end() || std::abs(seen->time_s - f.time_s) > same_frame_s) {
+      return false;
     }
-    return false;
+    return std::none_of(seen->balls.begin(), seen->balls.end(),
+                        [&](const Sighting& s) { return SameBall(s, f); });
   }
 
  private:
@@ -164,8 +164,14 @@ class CameraStage::Track {
   }
   // Whether the track's ball in the frame at `f`'s time (within `same_frame_s`) lay on `f`'s.
   bool Saw(const Sighting& f, double same_frame_s) const {
-    return std::any_of(seen_.begin(), seen_.end(), [&](const Sighting& s) {
-      return std::abs(s.time_s - f.time_s) <= same_frame_s && SameBall(s, f);
+    const auto s = Nearest(seen_, f.time_s);
+    return s != seen_.end() && std::abs(s->time_s - f.time_s) <= same_frame_s && SameBall(*s, f);
+  }
+  // The entry of `frames` (each with a time_s) nearest `time_s`; end() when empty.
+  template <typename Deque>
+  static typename Deque::const_iterator Nearest(const Deque& frames, double time_s) {
+    return std::min_element(frames.begin(), frames.end(), [&](const auto& a, const auto& b) {
+      return std::abs(a.time_s - time_s) < std::abs(b.time_s - time_s);
     });
   }
   static constexpr size_t kSeenKept = 16;  // frames: more than the hints' lag
@@ -319,11 +325,8 @@ void CameraStage::FollowHint(const io::SourceFrame& in) {
             then && track_->MissedAt(*then, same_frame_s);
 }
 
-bool CameraStage::HiddenHere(bool found) {
-  if (found || !hidden_) {
-    hidden_run_ = 0;
-    return false;
-  }
+bool CameraStage::SkipWholeWhileHidden() {
+  if (!hidden_) return false;
   const int every = track_->hidden_scan_every();
   return every > 1 && hidden_run_++ % every != 0;
 }
@@ -356,6 +359,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   bool full = window.empty();
   long guided = -1;
   bool guided_tried = false;  // the same fit on the whole frame would read the same pixels
+  bool hidden_miss = false;   // the ball is hidden here and the window missed it (hidden_run_)
   const cv::Mat* frame = Image(in, window);
   if (frame != nullptr) {
     CheckSize(frame->size(), in.frame);
@@ -363,14 +367,13 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
       m.candidates = detector_(*frame, window);
       ++stats_.window_scans;
       full = !track_->Confirms(m.candidates);
-      if (!full) HiddenHere(true);
       // Nothing accepted where the ball is expected: a guided fit there before the whole frame
       // (a camera that sees the ball only that way would otherwise search every frame whole).
       if (full) {
         guided = AddGuided(*frame, &m.candidates);
         guided_tried = true;
-        const bool hidden = HiddenHere(guided >= 0);
-        full = guided < 0 && !hidden;
+        hidden_miss = guided < 0 && hidden_;
+        full = guided < 0 && !SkipWholeWhileHidden();
       } else {
         SearchBand(in, &m.candidates);
       }
@@ -385,6 +388,7 @@ CameraMessage CameraStage::Process(const io::SourceFrame& in) {
   }
   if (!guided_tried && frame != nullptr) guided = AddGuided(*frame, &m.candidates);
   track_->Update(m.candidates, guided >= 0 ? &m.candidates[guided] : nullptr, in.time_s);
+  if (!hidden_miss) hidden_run_ = 0;
   ++stats_.frames;
   for (const recon::BallObservation& o : m.candidates) stats_.candidates += !o.weak;
   return m;

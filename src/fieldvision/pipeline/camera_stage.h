@@ -124,9 +124,9 @@ class CameraStage {
   void FollowHint(const io::SourceFrame& in);
   // Whether this frame is searched whole because no fused position confirmed the track lately.
   bool UnconfirmedScan(long long frame);
-  // Whether a window without the ball at its expected place leaves the whole frame unsearched in
-  // this frame (hidden_scan_every); counts such frames.
-  bool HiddenHere(bool found);
+  // Whether this frame, whose window (where the fusion expects the ball) missed the ball hidden
+  // from this camera, leaves the whole frame unsearched (hidden_scan_every); counts such frames.
+  [[nodiscard]] bool SkipWholeWhileHidden();
   int camera_index_;
   camera::Camera camera_;
   cv::Size size_;
@@ -135,10 +135,11 @@ class CameraStage {
   BallHintBoard* hints_ = nullptr;
   double last_time_s_ = 0.0;
   int unconfirmed_ = 0;  // frames in a row without a recent fused position (with hints)
-  // This frame's window is where a fresh fused position expects the ball, and this camera had no
-  // candidate on the ball in the frame of that position (hidden_scan_every).
+  // The ball is hidden from this camera in this frame (hidden_scan_every): the fused state is a
+  // fresh line through three positions at least, this camera's window is where it expects the
+  // ball, and this camera had no candidate on the ball in the frame of its newest position.
   bool hidden_ = false;
-  int hidden_run_ = 0;         // frames in a row without the ball in such a window
+  int hidden_run_ = 0;         // frames in a row whose window missed the ball while it was hidden
   long long last_block_ = -1;  // frame / unconfirmed_scan_every of the last frame processed
   bool no_hint_means_unconfirmed_ = true;
   std::string source_name_;

@@ -153,8 +153,9 @@ TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
   EXPECT_EQ(endpoints.j().size(), StudioApi::Endpoints().size());
   // A lone numbered photo is an image (it was left out), a folder named build... is the user's
   // (only a CMake build tree is not listed).
-  for (const char* folder : {"one", "buildings", "cmake-out"})
+  for (const char* folder : {"one", "buildings", "cmake-out"}) {
     fs::create_directories(dir_ / folder);
+  }
   cv::imwrite((dir_ / "one/00017.jpg").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 200, 255)));
   cv::imwrite((dir_ / "buildings/a.png").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(9)));
   cv::imwrite((dir_ / "cmake-out/b.png").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(9)));
@@ -209,20 +210,21 @@ TEST_F(StudioApiTest, FieldVideoFrameAndCamera) {
   const camera::Camera truth = camera::ReadCameraYaml((dir_ / "scene/cam1.yaml").string());
   EXPECT_TRUE(cam.j()["has_pose"].get<bool>());
   EXPECT_NEAR(cam.j()["position_m"][0].get<double>(), truth.CentreInWorld().x(), 1e-9);
-  // The image's border in normalized coordinates: 8 points a side, each back on the border
-  // through the lens.
+  // The image's border in normalized coordinates: 8 points a side from the top-left corner round,
+  // each back at its place on the border through the lens.
   const json outline = cam.j()["image_outline_normalized"];
   ASSERT_EQ(outline.size(), 32u);
+  const double w = truth.width - 0.5, h = truth.height - 0.5;
+  const std::vector<Eigen::Vector2d> corners = {
+      {-0.5, -0.5}, {w, -0.5}, {w, h}, {-0.5, h}, {-0.5, -0.5}};
   for (size_t i = 0; i < outline.size(); ++i) {
     const auto uv = truth.ProjectFromCamera(
         Eigen::Vector3d(outline[i][0].get<double>(), outline[i][1].get<double>(), 1.0));
     ASSERT_TRUE(uv.has_value());
-    const double to_border =
-        std::min({std::abs(uv->x() + 0.5), std::abs(uv->x() - truth.width + 0.5),
-                  std::abs(uv->y() + 0.5), std::abs(uv->y() - truth.height + 0.5)});
-    EXPECT_LT(to_border, 1e-6) << "outline point " << i << " at " << uv->transpose();
+    const double f = static_cast<double>(i % 8) / 8;
+    const Eigen::Vector2d want = (1 - f) * corners[i / 8] + f * corners[i / 8 + 1];
+    EXPECT_LT((*uv - want).norm(), 1e-6) << "outline point " << i << " at " << uv->transpose();
   }
-  EXPECT_NEAR(outline[0][0].get<double>(), (-0.5 - truth.cx) / truth.fx, 0.05);
   ExpectError(Get("/api/camera?path=scene/truth.csv"), 422, "truth.csv");
 }
 
