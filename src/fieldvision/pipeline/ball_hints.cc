@@ -95,7 +95,8 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
     use[worst] = 0;
     ++dropped;
   }
-  if (dropped > 0 && std::count(use.begin(), use.end(), 1) <= 2) {
+  const int kept = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  if (dropped > 0 && kept <= 2) {
     const size_t from_end =
         static_cast<size_t>(std::find(use.rbegin(), use.rend(), 1) - use.rbegin());
     const auto& [t_s, p] = recent[recent.size() - 1 - from_end];
@@ -110,7 +111,7 @@ BallHint FitHint(const std::deque<std::pair<double, Eigen::Vector3d>>& recent, d
   }
   h.ball_in_world = at0;
   h.velocity_mps = v;
-  h.positions = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  h.positions = kept;
   return h;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <deque>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -43,9 +44,12 @@ struct Sighting {
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
   double radius_px = 0.0;
 };
-// Within two radii (the larger) and 2 px: the same ball as the tracking window takes it.
+// Within two radii and 2 px: the same ball, as the tracking window takes it.
+bool WithinTwoRadii(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius_px) {
+  return (a - b).norm() <= 2.0 * radius_px + 2.0;
+}
 bool SameBall(const Sighting& a, const Sighting& b) {
-  return (a.centre_px - b.centre_px).norm() <= 2.0 * std::max(a.radius_px, b.radius_px) + 2.0;
+  return WithinTwoRadii(a.centre_px, b.centre_px, std::max(a.radius_px, b.radius_px));
 }
 }  // namespace
 
@@ -116,22 +120,26 @@ class CameraStage::Track {
   void Update(const std::vector<recon::BallObservation>& obs, const recon::BallObservation* guided,
               double time_s) {
     ++frames_;
-    frames_seen_.push_back({time_s, {}});
+    FrameSeen seen{time_s, {}, std::nullopt};
     for (const recon::BallObservation& o : obs) {
-      if (!o.weak) frames_seen_.back().balls.push_back({time_s, o.centre_px, o.radius_px});
+      if (!o.weak) seen.balls.push_back({time_s, o.centre_px, o.radius_px});
     }
-    if (frames_seen_.size() > kSeenKept) frames_seen_.pop_front();
     const recon::BallObservation* best = Best(obs);
+    if (best != nullptr) {
+      // A ball away from the expected place: another object, or the ball after a jump of the
+      // track; the track starts anew.
+      if (!active_ || !Near(best->centre_px, ExpectedCentre(), best->radius_px)) {
+        track_since_s_ = time_s;
+      }
+      seen.track = Sighting{time_s, best->centre_px, best->radius_px};
+    }
+    frames_seen_.push_back(std::move(seen));
+    if (frames_seen_.size() > kSeenKept) frames_seen_.pop_front();
     if (best == nullptr) {
       active_ = false;
       guided_run_ = 0;
       return;
     }
-    // A ball away from the expected place: another object, or the ball after a jump of the
-    // track; its sightings start anew.
-    if (!active_ || !Near(best->centre_px, ExpectedCentre(), best->radius_px)) seen_.clear();
-    seen_.push_back({time_s, best->centre_px, best->radius_px});
-    if (seen_.size() > kSeenKept) seen_.pop_front();
     guided_run_ = best == guided ? guided_run_ + 1 : 0;
     velocity_ = active_ ? Eigen::Vector2d(best->centre_px - centre_) : Eigen::Vector2d::Zero();
     centre_ = best->centre_px;
@@ -142,12 +150,9 @@ class CameraStage::Track {
   // Whether the frame at `f`'s time (within `same_frame_s`) was seen, without an accepted
   // candidate on `f`'s ball.
   bool MissedAt(const Sighting& f, double same_frame_s) const {
-    const auto seen = Nearest(frames_seen_, f.time_s);
-    if (seen == frames_seen_.end() || std::abs(seen->time_s - f.time_s) > same_frame_s) {
-      return false;
-    }
-    return std::none_of(seen->balls.begin(), seen->balls.end(),
-                        [&](const Sighting& s) { return SameBall(s, f); });
+    const FrameSeen* seen = FrameAt(f.time_s, same_frame_s);
+    return seen != nullptr && std::none_of(seen->balls.begin(), seen->balls.end(),
+                                           [&](const Sighting& s) { return SameBall(s, f); });
   }
 
  private:
@@ -160,29 +165,35 @@ class CameraStage::Track {
   }
   // Within two radii (the larger of the track's and `radius_px`) and 2 px.
   bool Near(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double radius_px) const {
-    return (a - b).norm() <= 2.0 * std::max(radius_, radius_px) + 2.0;
+    return WithinTwoRadii(a, b, std::max(radius_, radius_px));
   }
-  // Whether the track's ball in the frame at `f`'s time (within `same_frame_s`) lay on `f`'s.
+  // Whether the track, on its present object, had its ball on `f`'s in the frame at `f`'s time
+  // (within `same_frame_s`).
   bool Saw(const Sighting& f, double same_frame_s) const {
-    const auto s = Nearest(seen_, f.time_s);
-    return s != seen_.end() && std::abs(s->time_s - f.time_s) <= same_frame_s && SameBall(*s, f);
+    const FrameSeen* seen = FrameAt(f.time_s, same_frame_s);
+    return seen != nullptr && seen->time_s >= track_since_s_ && seen->track &&
+           SameBall(*seen->track, f);
   }
-  // The entry of `frames` (each with a time_s) nearest `time_s`; end() when empty.
-  template <typename Deque>
-  static typename Deque::const_iterator Nearest(const Deque& frames, double time_s) {
-    return std::min_element(frames.begin(), frames.end(), [&](const auto& a, const auto& b) {
-      return std::abs(a.time_s - time_s) < std::abs(b.time_s - time_s);
-    });
-  }
-  static constexpr size_t kSeenKept = 16;  // frames: more than the hints' lag
   struct FrameSeen {
     double time_s;
-    std::vector<Sighting> balls;  // the accepted candidates
+    std::vector<Sighting> balls;    // the accepted candidates
+    std::optional<Sighting> track;  // the one the track took
   };
-  std::deque<FrameSeen> frames_seen_;  // the last frames
+  // The kept frame nearest `time_s` if within `same_frame_s` of it, else null.
+  const FrameSeen* FrameAt(double time_s, double same_frame_s) const {
+    const auto it = std::min_element(
+        frames_seen_.begin(), frames_seen_.end(), [&](const FrameSeen& a, const FrameSeen& b) {
+          return std::abs(a.time_s - time_s) < std::abs(b.time_s - time_s);
+        });
+    return it != frames_seen_.end() && std::abs(it->time_s - time_s) <= same_frame_s ? &*it
+                                                                                     : nullptr;
+  }
+  static constexpr size_t kSeenKept = 16;  // frames: more than the hints' lag
+  std::deque<FrameSeen> frames_seen_;      // the last frames
+  // The time of the frame from which the track has followed its present object.
+  double track_since_s_ = -std::numeric_limits<double>::infinity();
   BallTrackOptions o_;
   bool active_ = false;
-  std::deque<Sighting> seen_;  // the track's balls in its last frames
   int Slot() const { return static_cast<int>((frames_ + phase_) % o_.full_scan_every); }
   int phase_;
   long long frames_ = 0;  // frames seen
