@@ -64,10 +64,10 @@ namespace {
 // none).
 std::string ReadTracksText(const std::string& path, bool* has_header) {
   std::string text = util::ReadCsvText(path, "tracks file");
-  if (util::StartsWith(text, "\xEF\xBB\xBF")) text.erase(0, 3);
-  const size_t first = text.find_first_not_of(" \t\r\n");
-  *has_header = first != std::string::npos &&
-                !std::isdigit(static_cast<unsigned char>(text[first])) && text[first] != '-';
+  const std::string_view body = util::WithoutUtf8Bom(text);  // the parser skips the mark too
+  const size_t first = body.find_first_not_of(" \t\r\n");
+  *has_header = first != std::string_view::npos &&
+                !std::isdigit(static_cast<unsigned char>(body[first])) && body[first] != '-';
   return text;
 }
 

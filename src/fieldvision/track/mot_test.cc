@@ -137,6 +137,17 @@ TEST(Mot, CsvRoundTripAndBadFile) {
   EXPECT_FALSE(back[1].x_m.has_value());
   EXPECT_THROW(ReadTracksCsv(dir + "/missing.csv"), fv::Error);
   {
+    // Saved by a spreadsheet ("CSV UTF-8"): a byte-order mark before the header.
+    std::ofstream marked(dir + "/marked.csv", std::ios::binary);
+    marked << "\xEF\xBB\xBF"
+           << "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s\n"
+           << "1,2,3,4,5,6,0.9,1.5,2.5,0.04\n";
+  }
+  const auto marked = ReadTracksCsv(dir + "/marked.csv");
+  ASSERT_EQ(marked.size(), 1u);
+  ASSERT_TRUE(marked[0].x_m.has_value());
+  EXPECT_NEAR(*marked[0].x_m, 1.5, 1e-12);
+  {
     std::ofstream bad(dir + "/bad.csv");
     bad << "frame,id,bb_left,bb_top,bb_width,bb_height\n1,2,abc,4,5,6\n";
   }

@@ -59,14 +59,22 @@ std::string FileNamePart(std::string_view s) {
   return out;
 }
 
+namespace {
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+}  // namespace
+
 void SkipUtf8Bom(std::istream& in) {
   if (in.peek() != 0xEF) return;
   const std::istream::pos_type start = in.tellg();
   char bytes[3] = {};
   in.read(bytes, 3);
-  if (in.gcount() == 3 && std::string_view(bytes, 3) == "\xEF\xBB\xBF") return;
+  if (in.gcount() == 3 && std::string_view(bytes, 3) == kUtf8Bom) return;
   in.clear();
   in.seekg(start);  // not a mark: read from the start as it is
+}
+
+std::string_view WithoutUtf8Bom(std::string_view text) {
+  return text.substr(0, kUtf8Bom.size()) == kUtf8Bom ? text.substr(kUtf8Bom.size()) : text;
 }
 
 std::string Shown(std::string_view t) {

@@ -21,6 +21,8 @@ std::string FileNamePart(std::string_view s);
 // Skips a UTF-8 byte-order mark at the stream's start (spreadsheets write one before a CSV's
 // header: "CSV UTF-8" in Excel); other bytes are left unread.
 void SkipUtf8Bom(std::istream& in);
+// `text` without a UTF-8 byte-order mark at its start (the same text when it has none).
+std::string_view WithoutUtf8Bom(std::string_view text);
 
 // A value as an error message shows it: one line (control characters as '?'), at most 40
 // characters and "...", so that a file's bytes never make a message several lines.

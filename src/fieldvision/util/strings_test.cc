@@ -25,6 +25,15 @@ TEST(FileNamePart, KeepsSafeCharactersOnly) {
 
 // A spreadsheet's UTF-8 byte-order mark before a CSV's header is skipped; other text is read as
 // it is, a lone 0xEF byte included.
+TEST(WithoutUtf8Bom, DropsAWholeMarkOnly) {
+  EXPECT_EQ(WithoutUtf8Bom("\xEF\xBB\xBF"
+                           "frame,u"),
+            "frame,u");
+  EXPECT_EQ(WithoutUtf8Bom("frame,u"), "frame,u");
+  EXPECT_EQ(WithoutUtf8Bom("\xEF\xBBx"), "\xEF\xBBx");
+  EXPECT_EQ(WithoutUtf8Bom(""), "");
+}
+
 TEST(SkipUtf8Bom, SkipsAWholeMarkOnly) {
   std::istringstream with(
       "\xEF\xBB\xBF"
