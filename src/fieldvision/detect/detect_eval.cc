@@ -257,6 +257,8 @@ void DetectEvalOptions::Check() const {
   FV_REQUIRE(list_misses >= 0, "list_misses must be >= 0");
   FV_REQUIRE(field.empty() || !camera.empty(),
              "eval detect: --field needs --camera with a pose (the field is found through it)");
+  FV_REQUIRE(!transform || (camera.empty() && draw_misses.empty()),
+             "eval detect: an image transform goes with neither a camera nor drawings");
   detector.Check();
   dnn.Check();
 }
@@ -516,6 +518,21 @@ void OpenCandidatesCsv(const std::string& path, std::unique_ptr<util::AtomicOutp
 
 }  // namespace
 
+namespace {
+
+// The image changed by `transform` and its boxes scaled as its size changed.
+void TransformImage(const std::function<cv::Mat(const cv::Mat&)>& transform, cv::Mat* bgr,
+                    std::vector<cv::Rect2d>* boxes) {
+  cv::Mat changed = transform(*bgr);
+  FV_REQUIRE(!changed.empty() && changed.type() == CV_8UC3,
+             "eval detect: the image transform must give an 8-bit BGR image");
+  const double sx = double(changed.cols) / bgr->cols, sy = double(changed.rows) / bgr->rows;
+  for (cv::Rect2d& b : *boxes) b = cv::Rect2d(b.x * sx, b.y * sy, b.width * sx, b.height * sy);
+  *bgr = std::move(changed);
+}
+
+}  // namespace
+
 DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   o.Check();
   std::vector<LabelledImage> items = ListLabelledImages(o.video, o.labels, "eval detect");
@@ -577,12 +594,13 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
       progress.Update(static_cast<long long>(i) + 1);
       continue;
     }
+    std::vector<cv::Rect2d> boxes = item.boxes;
+    if (o.transform) TransformImage(o.transform, &bgr, &boxes);
     const auto candidates = detector.Detect(bgr);
-    DetectEvalImage r = ScoreImage(candidates, item.boxes, o.grow);
+    DetectEvalImage r = ScoreImage(candidates, boxes, o.grow);
     if (cand_csv != nullptr) {
       for (const auto& c : candidates) {
-        const bool on_ball =
-            BoxHolding(item.boxes, o.grow, c.centre_px.x(), c.centre_px.y()) != nullptr;
+        const bool on_ball = BoxHolding(boxes, o.grow, c.centre_px.x(), c.centre_px.y()) != nullptr;
         *cand_csv << item.image << c.centre_px.x() << c.centre_px.y() << c.radius_px << c.score
                   << int(c.accepted) << int(c.weak) << int(on_ball) << c.visible_fraction
                   << c.inlier_fraction << c.outside_fraction << c.dents << int(c.region_ok)

@@ -70,6 +70,11 @@ struct DetectEvalOptions {
   bool progress = true;
   // Called once the labels are read and the outputs checked, before the first image ("": none).
   std::function<void()> on_start;
+  // Optional change made to each image before it is searched (bench/photo_robustness_bench.cc:
+  // the photos re-encoded, scaled, darker, another white balance); its boxes are scaled by the
+  // changed image's size over the original's. Neither with a camera (its frames have a fixed
+  // size) nor with draw_misses.
+  std::function<cv::Mat(const cv::Mat&)> transform;
   BallDetectorOptions detector;
   DnnBallOptions dnn;  // --detector colour|dnn|both (dnn_ball.h)
   // A video from a posed (static) camera: low-contrast candidates are compared with its

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/camera/camera_io.h"
@@ -74,6 +75,51 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   for (const auto& im : r.images) {
     if (im.hit) EXPECT_LT(im.centre_err_rel, 0.2) << im.image;
   }
+}
+
+// A transform changes each image before the search and its boxes scale with it: the balls of an
+// image doubled in size are hits where their boxes doubled; the balls' pixels moved without the
+// size changing (a shift) are misses, as the boxes stay; a transform with a camera is refused.
+TEST(DetectEval, ATransformChangesTheImagesAndScalesTheirBoxes) {
+  const uint64_t seed = fv::testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  const std::string dir = fv::testing::TempDir() + "/detect_eval_transform";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const Eigen::Vector2d c(rng.Uniform(80, 240), rng.Uniform(70, 170));
+    const double r = rng.Uniform(7, 12);
+    test_util::PaintDisc(img, c, r);
+    const std::string stem = "im" + std::to_string(i);
+    WriteText(fmt::format("{}/{}.txt", dir, stem),
+              fmt::format("0 {} {} {} {}\n", c.x() / 320, c.y() / 240, 2 * r / 320, 2 * r / 240));
+    cv::imwrite(fmt::format("{}/{}.png", dir, stem), img);
+  }
+  DetectEvalOptions o;
+  o.video = dir;
+  o.progress = false;
+  o.transform = [](const cv::Mat& m) {
+    cv::Mat out;
+    cv::resize(m, out, cv::Size(), 2.0, 2.0, cv::INTER_LINEAR);
+    return out;
+  };
+  const DetectEvalResult doubled = EvaluateDetector(o);
+  EXPECT_EQ(doubled.with_ball, 3);
+  EXPECT_EQ(doubled.hits, 3) << doubled.Summary();
+  for (const auto& im : doubled.images) EXPECT_GT(im.ball_radius_px, 13.0) << im.image;
+  o.transform = [](const cv::Mat& m) {
+    cv::Mat out;
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 60, 0, 1, 0);
+    cv::warpAffine(m, out, shift, m.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+    return out;
+  };
+  const DetectEvalResult shifted = EvaluateDetector(o);
+  EXPECT_EQ(shifted.hits, 0) << shifted.Summary();
+  o.camera = dir + "/cam.yaml";
+  EXPECT_THAT([&] { o.Check(); },
+              ::testing::ThrowsMessage<Error>(::testing::HasSubstr("image transform")));
 }
 
 // synth's truth_2d.csv labels a camera's frames (the camera named by the images' folder, frames
