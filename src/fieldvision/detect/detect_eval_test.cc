@@ -26,6 +26,22 @@ namespace fs = std::filesystem;
 
 void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 
+// A 320x240 field image DIR/STEM.png with a ball drawn in `area` (its centre), radius r0..r1 px,
+// and its YOLO label LABEL_DIR/STEM.txt: `other_rows`, then class 0.
+void WriteBallImage(const std::string& dir, const std::string& label_dir, const std::string& stem,
+                    const cv::Rect2d& area, double r0, double r1, const std::string& other_rows,
+                    util::Rng& rng) {
+  cv::Mat img = test_util::FieldImage(320, 240, rng);
+  const Eigen::Vector2d c(rng.Uniform(area.x, area.x + area.width),
+                          rng.Uniform(area.y, area.y + area.height));
+  const double r = rng.Uniform(r0, r1);
+  test_util::PaintDisc(img, c, r);
+  WriteText(fmt::format("{}/{}.txt", label_dir, stem),
+            fmt::format("{}0 {} {} {} {}\n", other_rows, c.x() / 320, c.y() / 240, 2 * r / 320,
+                        2 * r / 240));
+  cv::imwrite(fmt::format("{}/{}.png", dir, stem), img);
+}
+
 TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   const uint64_t seed = fv::testing::TestSeed(3);
   FV_SEED_TRACE(seed);
@@ -33,20 +49,13 @@ TEST(DetectEval, ScoresDrawnBallsAgainstYoloLabels) {
   const std::string dir = fv::testing::TempDir() + "/detect_eval_yolo";
   fs::remove_all(dir);
   fs::create_directories(dir + "/labels");
-  // Three images with a ball (labelled), one without (no label file).
-  for (int i = 0; i < 4; ++i) {
-    cv::Mat img = test_util::FieldImage(320, 240, rng);
-    const std::string stem = "im" + std::to_string(i);
-    if (i < 3) {
-      const Eigen::Vector2d c(rng.Uniform(60, 260), rng.Uniform(60, 180));
-      const double r = rng.Uniform(6, 14);
-      test_util::PaintDisc(img, c, r);
-      WriteText(fmt::format("{}/labels/{}.txt", dir, stem),
-                fmt::format("2 0.5 0.5 0.1 0.1\n0 {} {} {} {}\n", c.x() / 320, c.y() / 240,
-                            2 * r / 320, 2 * r / 240));
-    }
-    cv::imwrite(fmt::format("{}/{}.png", dir, stem), img);
+  // Three images with a ball (labelled, after a row of another class), one without (no label
+  // file).
+  for (int i = 0; i < 3; ++i) {
+    WriteBallImage(dir, dir + "/labels", "im" + std::to_string(i), cv::Rect2d(60, 60, 200, 120), 6,
+                   14, "2 0.5 0.5 0.1 0.1\n", rng);
   }
+  cv::imwrite(dir + "/im3.png", test_util::FieldImage(320, 240, rng));
   DetectEvalOptions o;
   o.video = dir;
   o.labels.labels = dir + "/labels";
@@ -88,14 +97,8 @@ TEST(DetectEval, ATransformChangesTheImagesAndScalesTheirBoxes) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   for (int i = 0; i < 3; ++i) {
-    cv::Mat img = test_util::FieldImage(320, 240, rng);
-    const Eigen::Vector2d c(rng.Uniform(80, 240), rng.Uniform(70, 170));
-    const double r = rng.Uniform(7, 12);
-    test_util::PaintDisc(img, c, r);
-    const std::string stem = "im" + std::to_string(i);
-    WriteText(fmt::format("{}/{}.txt", dir, stem),
-              fmt::format("0 {} {} {} {}\n", c.x() / 320, c.y() / 240, 2 * r / 320, 2 * r / 240));
-    cv::imwrite(fmt::format("{}/{}.png", dir, stem), img);
+    WriteBallImage(dir, dir, "im" + std::to_string(i), cv::Rect2d(80, 70, 160, 100), 7, 12, "",
+                   rng);
   }
   DetectEvalOptions o;
   o.video = dir;
