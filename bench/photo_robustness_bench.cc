@@ -6,8 +6,9 @@
 // 0.7 px). Each variant reports recall, precision and their ratios to the photos as they are,
 // measured in the same process; the last lines give the mean over the changed copies. A decision
 // that sits on a threshold flips under such changes: a score that holds on the originals alone
-// will not hold on other photos. Still images, so `--detector auto` (both, colour without the
-// model). One benchmark runs a whole set once (MSL about 25 s, SSL about 45 s a variant).
+// will not hold on other photos. `--detector=colour|both` (default both, as `eval detect` on
+// still images; colour without the model). One benchmark runs a whole set once (MSL about 25 s,
+// SSL about 40 s a variant with both).
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -96,7 +97,14 @@ std::map<std::string, std::vector<Score>>& Changed() {
   return scores;
 }
 
-std::string DetectorChoice() {
+// --detector=colour|both (before the benchmark's own flags); without it both, or colour when
+// the NanoDet model is missing.
+std::string& DetectorChoice() {
+  static std::string choice;
+  return choice;
+}
+
+std::string DefaultDetector() {
   try {
     fv::dnn::FindModel("nanodet.onnx");
     return "both";
@@ -172,9 +180,25 @@ void PrintMeans() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  DetectorChoice() = DefaultDetector();
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--detector=", 0) != 0) {
+      args.push_back(argv[i]);
+      continue;
+    }
+    DetectorChoice() = arg.substr(11);
+    if (DetectorChoice() != "colour" && DetectorChoice() != "both") {
+      std::fprintf(stderr, "bench_photo_robustness: --detector must be colour or both (got %s)\n",
+                   DetectorChoice().c_str());
+      return 1;
+    }
+  }
+  int n = static_cast<int>(args.size());
   RegisterAll();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::Initialize(&n, args.data());
+  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
   std::printf("detector: %s\n", DetectorChoice().c_str());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
