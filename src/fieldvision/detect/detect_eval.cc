@@ -516,10 +516,6 @@ void OpenCandidatesCsv(const std::string& path, std::unique_ptr<util::AtomicOutp
       4);
 }
 
-}  // namespace
-
-namespace {
-
 // The image changed by `transform` and its boxes scaled as its size changed.
 void TransformImage(const std::function<cv::Mat(const cv::Mat&)>& transform, cv::Mat* bgr,
                     std::vector<cv::Rect2d>* boxes) {
