@@ -33,9 +33,7 @@ void Setup(CLI::App& app, int& exit_code) {
       "--draw", o->draw,
       "Draw the candidates: an annotated video (.mp4: H.264 where OpenCV's FFmpeg has it, else "
       "Motion-JPEG as .avi; .avi, .mkv: Motion-JPEG) or a folder of JPEGs");
-  cmd->add_option("--step", o->detector.scan_step_px, "Scanline step in pixels")
-      ->check(CLI::Range(1, 16))
-      ->capture_default_str();
+  AddScanStepOption(cmd, o->detector);
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
   AddBackgroundOption(cmd, o->background);

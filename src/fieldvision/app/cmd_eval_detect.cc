@@ -37,6 +37,7 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Field (built-in name or JSON): ignore everything outside the field of play, as "
                   "`detect --field` (needs --camera with a pose)");
   AddBallColourOption(cmd, o->detector.colour);
+  AddScanStepOption(cmd, o->detector);
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
   AddBackgroundOption(cmd, o->background);

@@ -18,6 +18,15 @@
 
 namespace fv::app {
 
+// The colour detector's scanline step (`detect`, `eval detect`).
+inline void AddScanStepOption(CLI::App* cmd, detect::BallDetectorOptions& o) {
+  cmd->add_option("--step", o.scan_step_px,
+                  "Scanline step in pixels (1: every pixel, finds balls with only a few pixels "
+                  "of their colour, and more fragments)")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+}
+
 // The colour detector's radius limits, small-ball stage, off-field score and lit-part check
 // (`detect`, `eval detect`).
 inline void AddBallSizeOptions(CLI::App* cmd, detect::BallDetectorOptions& o) {
