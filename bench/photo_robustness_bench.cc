@@ -23,6 +23,7 @@
 #include "fieldvision/detect/detect_eval.h"
 #include "fieldvision/dnn/nanodet.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace {
 
@@ -81,10 +82,9 @@ const std::vector<Variant>& Variants() {
   return kVariants;
 }
 
+// A run's recall and precision (DetectEvalResult::recall, precision).
 struct Score {
-  int hits = 0, with_ball = 0, detected = 0;
-  double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
-  double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }
+  double recall = 0.0, precision = 0.0;
 };
 
 std::map<std::string, Score>& Originals() {
@@ -132,9 +132,9 @@ void BM_PhotoVariant(benchmark::State& state, const PhotoSet& set, const Variant
       return;
     }
   }
-  const Score s{r.hits, r.with_ball, r.detected};
-  state.counters["recall"] = s.recall();
-  state.counters["precision"] = s.precision();
+  const Score s{r.recall(), r.precision()};
+  state.counters["recall"] = s.recall;
+  state.counters["precision"] = s.precision;
   state.counters["images_per_s"] = r.seconds > 0 ? r.images.size() / r.seconds : 0.0;
   if (!variant.transform) {
     Originals()[set.name] = s;
@@ -142,9 +142,9 @@ void BM_PhotoVariant(benchmark::State& state, const PhotoSet& set, const Variant
   }
   Changed()[set.name].push_back(s);
   const auto orig = Originals().find(set.name);
-  if (orig != Originals().end() && orig->second.recall() > 0 && orig->second.precision() > 0) {
-    state.counters["recall_x_orig"] = s.recall() / orig->second.recall();
-    state.counters["precision_x_orig"] = s.precision() / orig->second.precision();
+  if (orig != Originals().end() && orig->second.recall > 0 && orig->second.precision > 0) {
+    state.counters["recall_x_orig"] = s.recall / orig->second.recall;
+    state.counters["precision_x_orig"] = s.precision / orig->second.precision;
   }
 }
 
@@ -162,16 +162,16 @@ void RegisterAll() {
 // The mean recall and precision over the changed copies run, against the originals.
 void PrintMeans() {
   for (const auto& [name, scores] : Changed()) {
-    double recall = 0, precision = 0;
+    std::vector<double> recalls, precisions;
     for (const Score& s : scores) {
-      recall += s.recall() / scores.size();
-      precision += s.precision() / scores.size();
+      recalls.push_back(s.recall);
+      precisions.push_back(s.precision);
     }
     const auto orig = Originals().find(name);
     std::printf("%s: %zu changed copies, mean recall %.3f, mean precision %.3f", name.c_str(),
-                scores.size(), recall, precision);
+                scores.size(), fv::util::Mean(recalls), fv::util::Mean(precisions));
     if (orig != Originals().end()) {
-      std::printf(" (originals %.3f / %.3f)", orig->second.recall(), orig->second.precision());
+      std::printf(" (originals %.3f / %.3f)", orig->second.recall, orig->second.precision);
     }
     std::printf("\n");
   }
