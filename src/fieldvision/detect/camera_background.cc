@@ -13,7 +13,26 @@ namespace fv::detect {
 void CameraBackgroundOptions::Check() const {
   background.Check();
   CheckPositive(window_s, "window_s");
+  CheckNonNegative(decoded_window_s, "decoded_window_s");
 }
+
+namespace {
+
+// Moves `source`, whose next frame is *next, on to `frame` (not before it): a seek where frames
+// skip without decoding, else frame by frame (each decoded, none converted).
+bool MoveTo(io::FrameSource* source, long long frame, long long* next) {
+  if (source->SkipsWithoutDecoding()) {
+    if (!source->SeekFrame(frame)) return false;
+  } else {
+    for (; *next < frame; ++*next) {
+      if (!source->SkipFrame()) return false;
+    }
+  }
+  *next = frame;
+  return true;
+}
+
+}  // namespace
 
 std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s,
                                   int scale) {
@@ -24,14 +43,16 @@ std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double w
   const long long span = std::min(count, std::max(1LL, std::llround(window_s * fps)));
   const int n = static_cast<int>(std::min<long long>(samples, span));
   cv::Mat bgr;  // decoded into the same buffer each time (fresh pages cost more than decoding)
+  long long next = 0;
   for (int k = 0; k < n; ++k) {
     // Sample k is frame round(k (span - 1) / (n - 1)).
     const long long frame =
         n > 1 ? std::llround(static_cast<double>(k) * static_cast<double>(span - 1) / (n - 1)) : 0;
-    if (!source->SeekFrame(frame)) break;
+    if (!MoveTo(source, frame, &next)) break;
     long long read = 0;
     double t = 0.0;
     try {
+      ++next;
       if (!source->Read(&bgr, &read, &t)) break;
       out.push_back(Background::Reduce(bgr, scale));
     } catch (const Error&) {
@@ -69,15 +90,17 @@ void CameraBackground::Build() {
         why_none_ = "a live source: no frames to sample ahead";
         return;
       }
+      double window_s = options_.window_s;
       if (!source->SkipsWithoutDecoding()) {
-        // Seeking in H.264 and the like decodes from the key frame before each sample: with the
-        // long key-frame intervals of most encoders nearly all of the window, for each sample
-        // (the kick render as H.264: the job 1.8-2.6x slower).
-        why_none_ = "its frames are not Motion-JPEG or image files (seeking would decode them)";
-        return;
+        if (options_.decoded_window_s <= 0) {
+          why_none_ = "its frames are not Motion-JPEG or image files (sampling would decode them)";
+          return;
+        }
+        window_s = std::min(window_s, options_.decoded_window_s);
+        decoded_ = true;
       }
       std::vector<cv::Mat> sampled = SampleFrames(source.get(), options_.background.samples,
-                                                  options_.window_s, options_.background.scale);
+                                                  window_s, options_.background.scale);
       sampled_ = static_cast<int>(sampled.size());
       if (sampled_ < 3) {
         why_none_ = fmt::format("{} frames to sample", sampled_);
@@ -99,7 +122,8 @@ std::string CameraBackground::Summary() const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!used_) return kNotNeeded;
   if (background_ && background_->usable()) {
-    return fmt::format("{} from {} frames", background_->Summary(), sampled_);
+    return fmt::format("{} from {} frames{}", background_->Summary(), sampled_,
+                       decoded_ ? " (read in order, each decoded)" : "");
   }
   return "no background: " + why_none_;
 }

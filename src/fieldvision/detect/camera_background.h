@@ -1,11 +1,12 @@
 // A file camera's background (detect/background.h) for its ball detector, built on first need
 // (or from Start): BackgroundOptions::samples frames evenly across the video's first window_s
-// seconds, read by a source of its own that seeks to each (io::FrameSource::SeekFrame). Only
-// Motion-JPEG videos and image files (JPEG, PNG, ...) get one: they skip without decoding, where
-// H.264 and the like decode from the key frame before each sample (with most encoders' key-frame
-// intervals, nearly the whole window per sample). On a video longer than the window, a later
-// change of light makes the rings around balls differ too, and the colour checks alone decide
-// there.
+// seconds, read by a source of its own. Motion-JPEG videos and image files skip to each sample
+// without decoding (io::FrameSource::SeekFrame); H.264 and the like are read in order from the
+// start instead, each frame up to the last sample decoded once (a seek would decode from the key
+// frame before each sample: nearly the whole window per sample with most encoders' key-frame
+// intervals), over a shorter window (decoded_window_s). On a video longer than the window, a
+// later change of light makes the rings around balls differ too, and the colour checks alone
+// decide there.
 #pragma once
 
 #include <future>
@@ -24,12 +25,17 @@ namespace fv::detect {
 struct CameraBackgroundOptions {
   BackgroundOptions background;
   double window_s = 60.0;  // frames sampled from the video's first this many seconds
-  void Check() const;      // throws fv::Error naming the bad field
+  // Videos that decode every frame they pass (H.264 and the like): sampled from the first this
+  // many seconds at most (each decoded once more than the job itself does; the kick render as
+  // H.264, 3.2 s of 4 cameras: see README); 0: no background for them.
+  double decoded_window_s = 10.0;
+  void Check() const;  // throws fv::Error naming the bad field
 };
 
-// The samples of a freshly opened `source` (FrameCount known), each reached by SeekFrame and
-// reduced by `scale` (Background::Reduce); fewer than requested when the video is short, a sample
-// cannot be decoded (left out) or reached (the rest too), none without a frame count.
+// The samples of a freshly opened `source` (FrameCount known), each reduced by `scale`
+// (Background::Reduce) and reached by SeekFrame where the source skips without decoding, else by
+// reading on in order (SkipFrame); fewer than requested when the video is short, a sample cannot
+// be decoded (left out) or reached (the rest too), none without a frame count.
 std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s, int scale);
 
 class CameraBackground {
@@ -58,6 +64,7 @@ class CameraBackground {
   bool used_ = false;  // Get was called
   std::optional<Background> background_;
   int sampled_ = 0;
+  bool decoded_ = false;  // sampled in order, every frame up to the last sample decoded
   std::string why_none_;
   std::future<void> started_;  // last: a running build ends before the members go
 };

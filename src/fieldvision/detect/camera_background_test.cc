@@ -62,10 +62,10 @@ TEST(CameraBackground, SamplesEvenlyAcrossTheWindowAndBuildsOnce) {
   EXPECT_NE(cb->Summary().find("from 5 frames"), std::string::npos) << cb->Summary();
 }
 
-// Videos whose frames do not skip without decoding (MPEG-4 part 2 here, as H.264) and PNG files
-// are sampled by seeking: the same frames as a Motion-JPEG video's. The image files get a
-// background; the video none (each seek decodes from the key frame before it).
-TEST(CameraBackground, SeeksToTheSamplesOfOtherCodecsAndImageFiles) {
+// Videos whose frames do not skip without decoding (MPEG-4 part 2 here, as H.264) are read in
+// order, PNG files sampled by seeking: the same frames as a Motion-JPEG video's. Both get a
+// background; the video's over decoded_window_s at most, none when that is 0.
+TEST(CameraBackground, ReadsOtherCodecsInOrderAndSeeksInImageFiles) {
   const uint64_t seed = fv::testing::TestSeed(72);
   FV_SEED_TRACE(seed);
   util::Rng rng(seed);
@@ -78,6 +78,7 @@ TEST(CameraBackground, SeeksToTheSamplesOfOtherCodecsAndImageFiles) {
   {
     auto source = io::OpenFrameSource(mp4, {.encoded = true});
     ASSERT_FALSE(source->encoded());
+    ASSERT_FALSE(source->SkipsWithoutDecoding());
     cv::Mat bgr;
     long long frame = 0;
     double t = 0;
@@ -86,28 +87,33 @@ TEST(CameraBackground, SeeksToTheSamplesOfOtherCodecsAndImageFiles) {
     }
   }
   for (const std::string& video : {mp4, pngs + "/%05d.png"}) {
-    auto source = io::OpenFrameSource(video, {.encoded = true});
-    const std::vector<cv::Mat> sampled = SampleFrames(source.get(), 5, 60.0, 2);
-    ASSERT_EQ(sampled.size(), 5u) << video;
-    const std::vector<int> expected{0, 7, 15, 22, 29};
-    for (size_t k = 0; k < expected.size(); ++k) {
-      const double level = cv::mean(sampled[k](cv::Rect(4, 4, 8, 8)))[0];
-      EXPECT_NEAR(level / 8, expected[k], 0.5) << "sample " << k << " of " << video;
+    for (const auto& [window_s, expected] :
+         {std::pair{60.0, std::vector<int>{0, 7, 15, 22, 29}}, {0.5, {0, 4, 7, 11, 14}}}) {
+      auto source = io::OpenFrameSource(video, {.encoded = true});
+      const std::vector<cv::Mat> sampled = SampleFrames(source.get(), 5, window_s, 2);
+      ASSERT_EQ(sampled.size(), 5u) << video;
+      for (size_t k = 0; k < expected.size(); ++k) {
+        const double level = cv::mean(sampled[k](cv::Rect(4, 4, 8, 8)))[0];
+        EXPECT_NEAR(level / 8, expected[k], 0.5)
+            << "sample " << k << " of " << video << ", window " << window_s;
+      }
+      // Not backwards, not beyond the end.
+      EXPECT_FALSE(source->SeekFrame(3)) << video;
+      EXPECT_FALSE(source->SeekFrame(30)) << video;
     }
-    // Not backwards, not beyond the end.
-    EXPECT_FALSE(source->SeekFrame(3)) << video;
-    EXPECT_FALSE(source->SeekFrame(30)) << video;
     CameraBackgroundOptions o;
     o.background.samples = 5;
     CameraBackground cb(video, o);
-    if (video == mp4) {
-      EXPECT_EQ(cb.Get(), nullptr);
-      EXPECT_NE(cb.Summary().find("not Motion-JPEG or image files"), std::string::npos)
-          << cb.Summary();
-    } else {
-      EXPECT_NE(cb.Get(), nullptr) << video << ": " << cb.Summary();
-    }
+    EXPECT_NE(cb.Get(), nullptr) << video << ": " << cb.Summary();
+    EXPECT_EQ(cb.Summary().find("read in order") != std::string::npos, video == mp4)
+        << cb.Summary();
   }
+  CameraBackgroundOptions off;
+  off.decoded_window_s = 0;
+  CameraBackground none(mp4, off);
+  EXPECT_EQ(none.Get(), nullptr);
+  EXPECT_NE(none.Summary().find("not Motion-JPEG or image files"), std::string::npos)
+      << none.Summary();
 }
 
 TEST(CameraBackground, NoBackgroundFromAMissingOrShortVideo) {
@@ -122,6 +128,10 @@ TEST(CameraBackground, NoBackgroundFromAMissingOrShortVideo) {
   CameraBackgroundOptions bad;
   bad.window_s = 0;
   EXPECT_NE(fv::testing::ErrorOf([&] { CameraBackground("x.avi", bad); }).find("window_s"),
+            std::string::npos);
+  bad.window_s = 60;
+  bad.decoded_window_s = -1;
+  EXPECT_NE(fv::testing::ErrorOf([&] { CameraBackground("x.avi", bad); }).find("decoded_window_s"),
             std::string::npos);
 }
 
