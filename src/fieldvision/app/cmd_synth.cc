@@ -69,8 +69,10 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(16, 8192));
   cmd->add_option("--height", o->height, "Image height of every camera (at most 8192)")
       ->check(CLI::Range(16, 8192));
-  cmd->add_option("--format", o->format, "avi (MJPG) | png | jpg (image sequences)")
-      ->check(CLI::IsMember({"avi", "png", "jpg"}));
+  cmd->add_option("--format", o->format,
+                  "avi (MJPG) | mp4 (H.264 at the encoder's default quality, as most cameras' "
+                  "footage: what compression costs) | png | jpg (image sequences)")
+      ->check(CLI::IsMember({"avi", "mp4", "png", "jpg"}));
   cmd->add_flag("--quiet", o->quiet, "No progress line");
   cmd->callback([o] { RunSynth(*o); });
   (void)exit_code;

@@ -652,8 +652,8 @@ void SceneSpec::Check() const {
   FV_REQUIRE(std::isfinite(noise_sigma) && noise_sigma >= 0 && noise_sigma <= 50,
              "noise_sigma: must be in [0, 50]");
   FV_REQUIRE(jpeg_quality >= 1 && jpeg_quality <= 100, "jpeg_quality: must be in 1..100");
-  FV_REQUIRE(format == "avi" || format == "png" || format == "jpg",
-             "format: must be avi, png or jpg (got '{}')", format);
+  FV_REQUIRE(format == "avi" || format == "mp4" || format == "png" || format == "jpg",
+             "format: must be avi, mp4, png or jpg (got '{}')", format);
   FV_REQUIRE(format != "avi" || (jpeg_quality >= 50 && jpeg_quality <= 95),
              "jpeg_quality: must be in 50..95 for \"avi\" (the MJPG writer's range; got {}); "
              "format \"jpg\" takes 1..100",

@@ -165,9 +165,11 @@ struct SceneSpec {
       TeamSpec{}, TeamSpec{"blue", Eigen::Vector3d(180, 90, 20), Eigen::Vector3d(40, 30, 30)}};
   std::vector<ConeSpec> cones;
   LightingSpec lighting;
-  double noise_sigma = 2.0;    // Gaussian sensor noise, 8-bit levels
-  int jpeg_quality = 90;       // libjpeg's scale (cv::imwrite's), also for the MJPG frames of "avi"
-  std::string format = "avi";  // "avi" (MJPG), "png" or "jpg" (image sequence <cam>/%05d.ext)
+  double noise_sigma = 2.0;  // Gaussian sensor noise, 8-bit levels
+  int jpeg_quality = 90;     // libjpeg's scale (cv::imwrite's), also for the MJPG frames of "avi"
+  // "avi" (MJPG), "mp4" (H.264 as OpenCV's FFmpeg writes it, its encoder's default quality: what
+  // compression costs), "png" or "jpg" (image sequence <cam>/%05d.ext).
+  std::string format = "avi";
 
   double duration_s() const { return num_frames / fps; }
   // Throws fv::Error naming the bad key (e.g. "cameras[1].width must be > 0").

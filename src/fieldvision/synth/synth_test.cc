@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -499,6 +500,36 @@ TEST(Writer, ImageSequencesAndBadOutput) {
   cv::VideoCapture cap(dir + "/seq/a/%05d.png");
   ASSERT_TRUE(cap.isOpened());
   EXPECT_THROW(WriteScene(s, "/proc/nonexistent/x"), Error);
+}
+
+// "mp4": H.264 as OpenCV's FFmpeg writes it (where it has the encoder): every frame, each close to
+// the scene's picture (the lossless PNG of the same frame), compressed.
+TEST(Writer, Mp4IsH264OfEveryFrame) {
+  const std::string dir = fv::testing::TempDir();
+  {
+    cv::VideoWriter probe(dir + "/probe.mp4", cv::CAP_FFMPEG,
+                          cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 30, cv::Size(64, 64));
+    if (!probe.isOpened()) GTEST_SKIP() << "OpenCV's FFmpeg has no H.264 encoder here";
+  }
+  SceneSpec s = CleanScene(
+      {Eigen::Vector3d(-2, -1, 0.5), Eigen::Vector3d(-1, 0, 1.0), Eigen::Vector3d(0, 1, 0.3)}, 1);
+  s.format = "mp4";
+  WriteScene(s, dir + "/mp4");
+  s.format = "png";
+  WriteScene(s, dir + "/png");
+  cv::VideoCapture cap(dir + "/mp4/a.mp4");
+  ASSERT_TRUE(cap.isOpened());
+  cv::Mat frame;
+  int n = 0;
+  for (; cap.read(frame); ++n) {
+    const cv::Mat png = cv::imread(fmt::format("{}/png/a/{:05d}.png", dir, n));
+    ASSERT_EQ(frame.size(), png.size()) << n;
+    const double mean_abs = cv::norm(frame, png, cv::NORM_L1) / (3.0 * png.total());
+    EXPECT_LT(mean_abs, 8.0) << "frame " << n;  // the same picture
+    EXPECT_GT(mean_abs, 0.0) << "frame " << n;  // compressed
+  }
+  EXPECT_EQ(n, s.num_frames);
+  EXPECT_FALSE(fs::exists(dir + "/mp4/a.avi"));
 }
 
 TEST(Figures, PathsGoBackAndForth) {

@@ -107,7 +107,7 @@ void WriteSpecAndCameras(const SceneSpec& spec, const SceneRenderer& scene,
   }
 }
 
-// Per camera: the video file or image pattern, created folders and an open MJPG writer.
+// Per camera: the video file or image pattern, created folders and an open video writer.
 struct CameraOut {
   std::string file;
   std::mutex mutex;
@@ -123,6 +123,17 @@ std::vector<std::unique_ptr<CameraOut>> OpenOutputs(const SceneSpec& spec,
   for (const camera::Camera& cam : scene.cameras()) {
     outs.push_back(std::make_unique<CameraOut>());
     CameraOut& out = *outs.back();
+    if (spec.format == "mp4") {
+      out.file = folder.Path(cam.name + ".mp4");
+      out.writer = codecs::NewVideoWriter();
+      FV_REQUIRE(codecs::OpenVideoWriter(out.writer.get(), out.file, cv::CAP_FFMPEG,
+                                         codecs::FourCc('a', 'v', 'c', '1'), spec.fps,
+                                         cv::Size(cam.width, cam.height)),
+                 "cannot open H.264 video '{}' for writing (OpenCV's FFmpeg has no H.264 encoder "
+                 "here? format \"avi\" writes Motion-JPEG)",
+                 out.file);
+      continue;
+    }
     if (spec.format != "avi") {
       std::error_code ec;
       fs::create_directories(folder.Path(cam.name), ec);
@@ -158,7 +169,7 @@ void RenderAndWrite(const SceneSpec& spec, const SceneRenderer& scene, const Sce
   std::string error;
   auto write_ready = [&](CameraOut& out, int c) {
     while (!out.pending.empty() && out.pending.begin()->first == out.next_write) {
-      if (spec.format == "avi") {
+      if (out.writer) {
         out.writer->write(out.pending.begin()->second);
       } else {
         const std::string p = fmt::format("{}/{}/{:05d}.{}", folder.dir, scene.cameras()[c].name,
