@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # What a camera's compression costs `fieldvision ball`: the same renders written as Motion-JPEG
 # (libjpeg quality 90, every frame a JPEG: the baseline) and as H.264 (`synth --format mp4`, the
-# encoder's default quality, as most cameras and phones record), each camera's background read
-# as the codec allows (camera_background.h). Prints, per scene and codec, the frames placed, the
+# x264 encoder's default quality: about 1 Mbit/s for these renders), each camera's background
+# read as the codec allows (camera_background.h). Prints, per scene and codec, the frames placed, the
 # 3D error against the truth and the wall time, the H.264 run's ratios to the baseline, and H.264
 # without the background (what reading it in order buys).
 # Usage: bench/codecs.sh [BUILD_DIR]   (scenes cached in BUILD_DIR/bench-data)
