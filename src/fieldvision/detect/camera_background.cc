@@ -16,24 +16,6 @@ void CameraBackgroundOptions::Check() const {
   CheckNonNegative(decoded_window_s, "decoded_window_s");
 }
 
-namespace {
-
-// Moves `source`, whose next frame is *next, on to `frame` (not before it): a seek where frames
-// skip without decoding, else frame by frame (each decoded, none converted).
-bool MoveTo(io::FrameSource* source, long long frame, long long* next) {
-  if (source->SkipsWithoutDecoding()) {
-    if (!source->SeekFrame(frame)) return false;
-  } else {
-    for (; *next < frame; ++*next) {
-      if (!source->SkipFrame()) return false;
-    }
-  }
-  *next = frame;
-  return true;
-}
-
-}  // namespace
-
 std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s,
                                   int scale) {
   std::vector<cv::Mat> out;
@@ -43,12 +25,17 @@ std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double w
   const long long span = std::min(count, std::max(1LL, std::llround(window_s * fps)));
   const int n = static_cast<int>(std::min<long long>(samples, span));
   cv::Mat bgr;  // decoded into the same buffer each time (fresh pages cost more than decoding)
-  long long next = 0;
+  long long next = 0;  // the source's next frame
   for (int k = 0; k < n; ++k) {
     // Sample k is frame round(k (span - 1) / (n - 1)).
     const long long frame =
         n > 1 ? std::llround(static_cast<double>(k) * static_cast<double>(span - 1) / (n - 1)) : 0;
-    if (!MoveTo(source, frame, &next)) break;
+    // Frame by frame: Motion-JPEG packets and image files skip without decoding, H.264 and the
+    // like decode each frame without converting it (a seek would decode from the key frame
+    // before each sample).
+    bool reached = true;
+    for (; reached && next < frame; ++next) reached = source->SkipFrame();
+    if (!reached) break;
     long long read = 0;
     double t = 0.0;
     try {

@@ -1,10 +1,10 @@
 // A file camera's background (detect/background.h) for its ball detector, built on first need
 // (or from Start): BackgroundOptions::samples frames evenly across the video's first window_s
-// seconds, read by a source of its own. Motion-JPEG videos and image files skip to each sample
-// without decoding (io::FrameSource::SeekFrame); H.264 and the like are read in order from the
-// start instead, each frame up to the last sample decoded once (a seek would decode from the key
-// frame before each sample: nearly the whole window per sample with most encoders' key-frame
-// intervals), over a shorter window (decoded_window_s). On a video longer than the window, a
+// seconds, read in order by a source of its own. Motion-JPEG videos and image files skip the
+// frames between samples without decoding (io::FrameSource::SkipFrame); H.264 and the like decode
+// each frame up to the last sample once (a seek would decode from the key frame before each
+// sample: nearly the whole window per sample with most encoders' key-frame intervals), so they
+// are sampled over a shorter window (decoded_window_s). On a video longer than the window, a
 // later change of light makes the rings around balls differ too, and the colour checks alone
 // decide there.
 #pragma once
@@ -32,10 +32,10 @@ struct CameraBackgroundOptions {
   void Check() const;  // throws fv::Error naming the bad field
 };
 
-// The samples of a freshly opened `source` (FrameCount known), each reduced by `scale`
-// (Background::Reduce) and reached by SeekFrame where the source skips without decoding, else by
-// reading on in order (SkipFrame); fewer than requested when the video is short, a sample cannot
-// be decoded (left out) or reached (the rest too), none without a frame count.
+// The samples of a freshly opened `source` (FrameCount known), each reached by reading on in order
+// (SkipFrame: without decoding where the source can) and reduced by `scale` (Background::Reduce);
+// fewer than requested when the video is short, a sample cannot be decoded (left out) or reached
+// (the rest too), none without a frame count.
 std::vector<cv::Mat> SampleFrames(io::FrameSource* source, int samples, double window_s, int scale);
 
 class CameraBackground {

@@ -62,10 +62,10 @@ TEST(CameraBackground, SamplesEvenlyAcrossTheWindowAndBuildsOnce) {
   EXPECT_NE(cb->Summary().find("from 5 frames"), std::string::npos) << cb->Summary();
 }
 
-// Videos whose frames do not skip without decoding (MPEG-4 part 2 here, as H.264) are read in
-// order, PNG files sampled by seeking: the same frames as a Motion-JPEG video's. Both get a
-// background; the video's over decoded_window_s at most, none when that is 0.
-TEST(CameraBackground, ReadsOtherCodecsInOrderAndSeeksInImageFiles) {
+// Videos whose frames do not skip without decoding (MPEG-4 part 2 here, as H.264) and PNG files
+// are sampled as a Motion-JPEG video is: the same frames. Both get a background; the video's
+// over decoded_window_s at most, none when that is 0.
+TEST(CameraBackground, SamplesOtherCodecsAndImageFilesAlike) {
   const uint64_t seed = fv::testing::TestSeed(72);
   FV_SEED_TRACE(seed);
   util::Rng rng(seed);
