@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "fieldvision/synth/synth.h"
+#include "times_reporter.h"
 
 namespace {
 
@@ -57,19 +58,8 @@ BENCHMARK(BM_JpegEncode)->Unit(benchmark::kMillisecond);
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   Scene();  // set-up outside the timings
-  struct Reporter : benchmark::ConsoleReporter {
-    std::map<std::string, double> ms;
-    void ReportRuns(const std::vector<Run>& runs) override {
-      for (const auto& r : runs) ms[r.benchmark_name()] = r.GetAdjustedRealTime();
-      ConsoleReporter::ReportRuns(runs);
-    }
-  } reporter;
+  fv::bench::TimesReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  const double base = reporter.ms["BM_BackgroundCopy"];
-  if (base > 0) {
-    for (const auto& [name, t] : reporter.ms) {
-      printf("ratio %-24s %8.1fx the background copy\n", name.c_str(), t / base);
-    }
-  }
+  reporter.PrintRatios("BM_BackgroundCopy", "the background copy");
   return 0;
 }

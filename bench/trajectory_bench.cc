@@ -30,6 +30,7 @@
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/random.h"
+#include "times_reporter.h"
 
 namespace {
 
@@ -302,18 +303,12 @@ int main(int argc, char** argv) {
     std::cout << fv::recon::Summarize(scores).Table() << "\n";
   }
   benchmark::Initialize(&argc, argv);
-  struct Reporter : benchmark::ConsoleReporter {
-    std::map<std::string, double> s;  // real time per iteration, seconds
-    void ReportRuns(const std::vector<Run>& runs) override {
-      for (const auto& r : runs) s[r.benchmark_name()] = r.GetAdjustedRealTime();
-      ConsoleReporter::ReportRuns(runs);
-    }
-  } reporter;
+  fv::bench::TimesReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
-  const auto base = reporter.s.find("BM_TrajectoryJob/20000/iterations:3/real_time");
-  const auto big = reporter.s.find("BM_TrajectoryJob/2000000/iterations:1/real_time");
-  if (base != reporter.s.end() && big != reporter.s.end() && base->second > 0) {
+  const auto base = reporter.times.find("BM_TrajectoryJob/20000/iterations:3/real_time");
+  const auto big = reporter.times.find("BM_TrajectoryJob/2000000/iterations:1/real_time");
+  if (base != reporter.times.end() && big != reporter.times.end() && base->second > 0) {
     printf("ratio trajectory 2,000,000 rows: %.1f s, %.2fx the time per row of 20,000 rows\n",
            big->second, big->second / 2e6 / (base->second / 2e4));
   }

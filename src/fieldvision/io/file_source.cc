@@ -51,6 +51,7 @@ class FileSource : public FrameSource {
   JpegRegionDecoder decoder_;            // decoded: its frames (the encoded path's pixels)
   std::vector<uint8_t> packet_;
   std::unique_ptr<cv::VideoCapture> capture_;  // else OpenCV's
+  RepeatedChromaRepair chroma_;                // its frames' chroma (repeated_chroma.h)
   std::map<long long, double> times_;          // kCsv
   bool encoded_ = false;
   SourceFrame pending_;  // the first frame, read when opening
@@ -152,6 +153,7 @@ bool FileSource::Grab(SourceFrame* out) {
   }
   if (!ok || out->bgr.empty()) return false;
   if (out->bgr.channels() == 1) cv::cvtColor(out->bgr, out->bgr, cv::COLOR_GRAY2BGR);
+  if (!avi_) chroma_.Apply(&out->bgr);
   out->time_s = TimeOf(next_frame_);
   return true;
 }

@@ -27,7 +27,7 @@ class GStreamerSource : public LiveSource {
  private:
   bool Grab(SourceFrame* out) override {
     double arrival_s = 0, ms = 0;  // ms: the buffer's PTS
-    if (!ReadCapture(*capture_, out, &arrival_s, &ms)) return false;
+    if (!ReadCapture(*capture_, &chroma_, out, &arrival_s, &ms)) return false;
     if (std::isfinite(ms) && ms >= 0 && (anchor_s_ == 0 || ms > last_ms_)) {
       if (anchor_s_ == 0) anchor_s_ = arrival_s - ms / 1000.0;
       last_ms_ = ms;
@@ -41,6 +41,7 @@ class GStreamerSource : public LiveSource {
   }
 
   std::unique_ptr<cv::VideoCapture> capture_ = codecs::NewVideoCapture();
+  RepeatedChromaRepair chroma_;
   double anchor_s_ = 0;  // system time of PTS 0
   double last_ms_ = -1;
 };

@@ -1,5 +1,6 @@
-// Helpers shared by the io tests (header only, not part of the library): a video file cut short,
-// a JPEG header that announces another size.
+// Helpers shared by the io tests and those above them (header only, not part of the library): a
+// video file cut short, a JPEG header that announces another size, chroma as FFmpeg's reader
+// repeats it.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 namespace fv::io::test_util {
@@ -46,6 +48,22 @@ inline std::string WriteTruncatedMjpg(const std::string& path, double keep) {
   std::ofstream(path, std::ios::binary | std::ios::trunc)
       << bytes.substr(0, static_cast<size_t>(keep * bytes.size()));
   return path;
+}
+
+// What OpenCV's FFmpeg reader makes of 4:2:0 video: each 2x2 block takes its mean chroma (the
+// encoder's decimation) and every pixel of the block gets it (the decoder's, swscale's unscaled
+// conversion).
+inline cv::Mat RepeatChroma2x2(const cv::Mat& bgr) {
+  cv::Mat ycc;
+  cv::cvtColor(bgr, ycc, cv::COLOR_BGR2YCrCb);
+  cv::Mat half, full;
+  cv::resize(ycc, half, cv::Size(ycc.cols / 2, ycc.rows / 2), 0, 0, cv::INTER_AREA);
+  cv::resize(half, full, ycc.size(), 0, 0, cv::INTER_NEAREST);
+  const int from_to[] = {1, 1, 2, 2};
+  cv::mixChannels(&full, 1, &ycc, 1, from_to, 2);
+  cv::Mat out;
+  cv::cvtColor(ycc, out, cv::COLOR_YCrCb2BGR);
+  return out;
 }
 
 }  // namespace fv::io::test_util

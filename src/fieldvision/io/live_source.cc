@@ -38,7 +38,8 @@ bool OpenCapture(cv::VideoCapture& capture, const std::string& target, int api) 
   }
 }
 
-bool ReadCapture(cv::VideoCapture& capture, SourceFrame* out, double* arrival_s, double* pos_ms) {
+bool ReadCapture(cv::VideoCapture& capture, RepeatedChromaRepair* chroma, SourceFrame* out,
+                 double* arrival_s, double* pos_ms) {
   bool ok = false;
   try {
     ok = capture.read(out->bgr);
@@ -48,6 +49,7 @@ bool ReadCapture(cv::VideoCapture& capture, SourceFrame* out, double* arrival_s,
   *arrival_s = SystemClockNow();
   if (!ok || out->bgr.empty()) return false;
   if (out->bgr.channels() == 1) cv::cvtColor(out->bgr, out->bgr, cv::COLOR_GRAY2BGR);
+  chroma->Apply(&out->bgr);
   out->jpeg.clear();
   *pos_ms = capture.get(cv::CAP_PROP_POS_MSEC);
   return true;

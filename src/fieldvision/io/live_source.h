@@ -9,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "fieldvision/io/frame_source.h"
+#include "fieldvision/io/repeated_chroma.h"
 
 namespace fv::io::backend {
 
@@ -48,9 +49,11 @@ bool OpenVideoFile(cv::VideoCapture& capture, const std::string& path);
 // Opens `target` with the OpenCV backend `api` (cv::CAP_V4L2, cv::CAP_GSTREAMER); false, never
 // an exception, when it cannot.
 bool OpenCapture(cv::VideoCapture& capture, const std::string& target, int api);
-// The next frame of `capture` as BGR (grey converted), its arrival on the system clock and the
+// The next frame of `capture` as BGR (grey converted; chroma the decoder repeated over 2x2
+// pixels re-upsampled by `chroma`, repeated_chroma.h), its arrival on the system clock and the
 // capture's position in milliseconds (CAP_PROP_POS_MSEC: the buffer's timestamp); false at the
 // end or on a read error.
-bool ReadCapture(cv::VideoCapture& capture, SourceFrame* out, double* arrival_s, double* pos_ms);
+bool ReadCapture(cv::VideoCapture& capture, RepeatedChromaRepair* chroma, SourceFrame* out,
+                 double* arrival_s, double* pos_ms);
 
 }  // namespace fv::io::backend

@@ -37,7 +37,7 @@ class V4l2Source : public LiveSource {
   bool Grab(SourceFrame* out) override {
     // OpenCV's V4L2 backend reports the buffer's timestamp (ms on CLOCK_MONOTONIC).
     double arrival_s = 0, ms = 0;
-    if (!ReadCapture(*capture_, out, &arrival_s, &ms)) return false;
+    if (!ReadCapture(*capture_, &chroma_, out, &arrival_s, &ms)) return false;
     const double device_s = std::isfinite(ms) && ms > 0 ? SystemFromMonotonic(ms / 1000.0) : 0;
     if (device_s > 0 && std::abs(device_s - arrival_s) < 1.0) {
       out->time_s = device_s;
@@ -50,6 +50,7 @@ class V4l2Source : public LiveSource {
   }
 
   std::unique_ptr<cv::VideoCapture> capture_ = codecs::NewVideoCapture();
+  RepeatedChromaRepair chroma_;
 };
 
 }  // namespace
