@@ -13,7 +13,9 @@
 // camera would be: frames wait in a small buffer and the oldest are dropped when the reader is
 // slower. Each frame carries its capture time and says where that time came from (TimeOrigin);
 // times of live sources are seconds on this machine's system clock (Unix time), times of files
-// read as fast as possible are the video's own (from 0).
+// read as fast as possible are the video's own (from 0). Frames OpenCV decodes with their chroma
+// repeated over 2x2 pixels (FFmpeg's 4:2:0 video, as H.264 and MPEG-4) come re-upsampled
+// (repeated_chroma.h).
 #pragma once
 
 #include <cstdint>
