@@ -165,7 +165,12 @@ RepeatedChromaRepair::RepeatedChromaRepair(const RepeatedChromaOptions& options)
 
 void RepeatedChromaRepair::Apply(cv::Mat* bgr) {
   if (bgr == nullptr || bgr->empty() || bgr->type() != CV_8UC3) return;
-  if (layout_ == ChromaLayout::kUnknown) layout_ = MeasureChromaLayout(*bgr, options_);
+  if (layout_ == ChromaLayout::kUnknown) {
+    layout_ = MeasureChromaLayout(*bgr, options_);
+    if (layout_ == ChromaLayout::kUnknown && ++measured_ >= kMeasuredFrames) {
+      layout_ = ChromaLayout::kOther;
+    }
+  }
   if (layout_ == ChromaLayout::kRepeated2x2) UpsampleRepeatedChroma(bgr, options_, &workspace_);
 }
 

@@ -50,18 +50,21 @@ void UpsampleRepeatedChroma(cv::Mat* bgr, const RepeatedChromaOptions& options =
 void UpsampleRepeatedChroma(cv::Mat* bgr, const RepeatedChromaOptions& options,
                             ChromaWorkspace* workspace);
 
-// A stream's frames: the layout is measured on each frame until one decides it, then every frame
-// of a stream with repeated chroma is re-upsampled.
+// A stream's frames: the layout is measured on each frame until one decides it (at most
+// kMeasuredFrames: a stream without colour in them, grey video, is left as it is), then every
+// frame of a stream with repeated chroma is re-upsampled.
 class RepeatedChromaRepair {
  public:
   explicit RepeatedChromaRepair(const RepeatedChromaOptions& options = {});
   void Apply(cv::Mat* bgr);
   ChromaLayout layout() const { return layout_; }
+  static constexpr int kMeasuredFrames = 30;
 
  private:
   RepeatedChromaOptions options_;
   ChromaWorkspace workspace_;
   ChromaLayout layout_ = ChromaLayout::kUnknown;
+  int measured_ = 0;
 };
 
 }  // namespace fv::io

@@ -117,6 +117,13 @@ TEST(RepeatedChroma, AStreamIsRepairedOnlyWhenItsChromaIsRepeated) {
   repeated.Apply(&b);
   EXPECT_EQ(repeated.layout(), ChromaLayout::kRepeated2x2);
   EXPECT_GT(cv::norm(b, before, cv::NORM_INF), 0.0);
+  RepeatedChromaRepair grey;  // never any colour: measured no longer after a while
+  for (int i = 0; i < RepeatedChromaRepair::kMeasuredFrames; ++i) {
+    cv::Mat g(64, 96, CV_8UC3, cv::Scalar(70, 70, 70));
+    grey.Apply(&g);
+    EXPECT_EQ(grey.layout(), i + 1 < RepeatedChromaRepair::kMeasuredFrames ? ChromaLayout::kUnknown
+                                                                           : ChromaLayout::kOther);
+  }
 }
 
 TEST(RepeatedChroma, OptionsAreChecked) {
