@@ -21,9 +21,10 @@ struct RepeatedChromaOptions {
   // 1.83, 8 1.51, 16 1.56 mm; per-view 2D median on it and the low-sun kick, as decoded 0.309 /
   // 0.532 px, sigma 8 0.222 / 0.474, 16 0.209 / 0.439 px.
   double luma_sigma = 12.0;
-  // Pixels of blocks whose chroma is within skip_levels (summed over B, G, R minus luma) of all
-  // eight neighbours' are kept: there every weight falls on about one chroma (the change would
-  // be under half of it). Most of a frame (grass, sky, walls) is such blocks.
+  // Pixels of blocks whose chroma ranges over at most skip_levels (the ranges of B, G and R minus
+  // luma summed) across the block and its eight neighbours are kept: there every weight falls on
+  // about one chroma. Most of a frame (grass, sky, walls) is such blocks: 78-84 % of a decoded
+  // 1280x960 kick frame.
   double skip_levels = 8.0;
   // A frame's chroma is repeated when its mean change between a block's pixels is at most
   // max_within_share of its mean change between neighbouring blocks, and the latter at least
