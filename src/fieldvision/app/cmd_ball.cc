@@ -94,6 +94,11 @@ void RunBall(const BallCliOptions& o) {
     if (r.backgrounds[c].empty()) continue;
     std::cout << o.job.videos[c] << ": " << r.backgrounds[c] << "\n";
   }
+  for (size_t c = 0; c < r.frames_notes.size(); ++c) {
+    if (!r.frames_notes[c].empty()) {
+      std::cout << o.job.videos[c] << ": " << r.frames_notes[c] << "\n";
+    }
+  }
   if (r.bundle && r.bundle->bundled_flights > 0) {
     std::cout << fmt::format(
         "{} flights refined on the cameras' candidates ({} rows, {:.2f} px RMS{}; --no-bundle: "

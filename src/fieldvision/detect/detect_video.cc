@@ -83,9 +83,10 @@ void DetectVideoOptions::Check() const {
 }
 
 std::string DetectVideoResult::Summary() const {
-  return fmt::format("{} frames, {} candidates, ball accepted in {} frames, {:.1f} frames/s{}",
+  return fmt::format("{} frames, {} candidates, ball accepted in {} frames, {:.1f} frames/s{}{}",
                      frames, candidates, frames_with_ball, seconds > 0 ? frames / seconds : 0.0,
-                     background.empty() ? "" : "\n" + background);
+                     background.empty() ? "" : "\n" + background,
+                     frames_note.empty() ? "" : "\n" + frames_note);
 }
 
 void DrawCandidates(cv::Mat& bgr, const std::vector<BallCandidate>& candidates) {
@@ -197,6 +198,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     result.drawn = fmt::format("{} ({} JPEGs)", draw_dir, result.frames);
   }
   result.background = NeededBackgroundSummary(background);
+  result.frames_note = source->frames_note();
   out_file.CloseAndCommit(csv);
   return result;
 }

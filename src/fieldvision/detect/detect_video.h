@@ -38,7 +38,8 @@ struct DetectVideoResult {
   int frames_with_ball = 0;  // frames with an accepted candidate
   double seconds = 0.0;
   std::string drawn;  // what --draw wrote (the video's path, frames and codec), "" when nothing
-  std::string background;  // CameraBackground::Summary, "" when none was set up
+  std::string background;   // CameraBackground::Summary, "" when none was set up
+  std::string frames_note;  // what the frame source did to the frames (FramesNote), or ""
   std::string Summary() const;
 };
 

@@ -39,6 +39,7 @@ class FileSource : public FrameSource {
   std::string name() const override { return path_; }
   double fps() const override { return fps_; }
   bool rate_known() const override { return rate_known_; }
+  std::string FramesNote() const override { return chroma_.Note(); }
 
  private:
   bool Grab(SourceFrame* out);         // decoded

@@ -113,6 +113,9 @@ class FrameSource {
   virtual bool encoded() const { return false; }
   // Frames the source skipped because the reader was slower than the camera.
   virtual long long dropped() const { return 0; }
+  // What the source does to its frames beyond decoding, for a job's summary ("" for nothing):
+  // chroma the decoder repeated, re-upsampled (repeated_chroma.h).
+  virtual std::string FramesNote() const { return ""; }
 
  private:
   JpegRegionDecoder decoder_;  // Read() of encoded frames

@@ -24,6 +24,8 @@ class GStreamerSource : public LiveSource {
     ReadFirstFrame();
   }
 
+  std::string FramesNote() const override { return chroma_.Note(); }
+
  private:
   bool Grab(SourceFrame* out) override {
     double arrival_s = 0, ms = 0;  // ms: the buffer's PTS

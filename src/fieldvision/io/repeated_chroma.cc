@@ -162,6 +162,13 @@ RepeatedChromaRepair::RepeatedChromaRepair(const RepeatedChromaOptions& options)
   options_.Check();
 }
 
+std::string RepeatedChromaRepair::Note() const {
+  return layout_ == ChromaLayout::kRepeated2x2
+             ? "colour repeated over 2x2 pixels by the video reader (4:2:0), re-upsampled along "
+               "the luma's edges"
+             : "";
+}
+
 void RepeatedChromaRepair::Apply(cv::Mat* bgr) {
   if (bgr == nullptr || bgr->empty() || bgr->type() != CV_8UC3) return;
   if (layout_ == ChromaLayout::kUnknown) {

@@ -10,6 +10,8 @@
 // luma (a decoder's YCbCr -> RGB adds luma to every channel alike).
 #pragma once
 
+#include <string>
+
 #include <opencv2/core.hpp>
 
 namespace fv::io {
@@ -59,6 +61,8 @@ class RepeatedChromaRepair {
   explicit RepeatedChromaRepair(const RepeatedChromaOptions& options = {});
   void Apply(cv::Mat* bgr);
   ChromaLayout layout() const { return layout_; }
+  // A line for a summary when the stream's chroma is re-upsampled, else "".
+  std::string Note() const;
   static constexpr int kMeasuredFrames = 30;
 
  private:

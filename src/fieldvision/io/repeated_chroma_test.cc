@@ -158,6 +158,7 @@ TEST(RepeatedChroma, VideoFramesComeWithoutRepeatedChroma) {
   ASSERT_EQ(MeasureChromaLayout(raw), ChromaLayout::kRepeated2x2)
       << "OpenCV's reader no longer repeats chroma: the repair is never used";
   auto source = OpenFrameSource(path);
+  EXPECT_NE(source->FramesNote().find("re-upsampled"), std::string::npos) << source->FramesNote();
   cv::Mat bgr;
   long long frame = 0;
   double t = 0;
@@ -167,6 +168,15 @@ TEST(RepeatedChroma, VideoFramesComeWithoutRepeatedChroma) {
     ++frames;
   }
   EXPECT_EQ(frames, 5);
+  // Motion-JPEG (libjpeg interpolates its chroma): nothing to say.
+  const std::string avi = testing::TempDir() + "/disc.avi";
+  {
+    cv::VideoWriter w(avi, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25,
+                      cv::Size(160, 120));
+    ASSERT_TRUE(w.isOpened());
+    for (int i = 0; i < 3; ++i) w.write(Disc({160, 120}, {70.0 + 3 * i, 60.5}, 20, rng));
+  }
+  EXPECT_EQ(OpenFrameSource(avi)->FramesNote(), "");
 }
 
 }  // namespace

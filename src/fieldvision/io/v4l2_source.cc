@@ -33,6 +33,8 @@ class V4l2Source : public LiveSource {
     ReadFirstFrame();
   }
 
+  std::string FramesNote() const override { return chroma_.Note(); }
+
  private:
   bool Grab(SourceFrame* out) override {
     // OpenCV's V4L2 backend reports the buffer's timestamp (ms on CLOCK_MONOTONIC).

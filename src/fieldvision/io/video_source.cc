@@ -60,6 +60,7 @@ class FrameSourceVideo : public VideoSource {
     frame_count_ = n > 0 ? static_cast<int>(n) : -1;
     live_ = source_->live();
   }
+  std::string frames_note() const override { return source_->FramesNote(); }
   bool Read(Frame& frame) override {
     long long index = 0;
     if (!source_->Read(&frame.bgr, &index, &frame.time_s)) return false;

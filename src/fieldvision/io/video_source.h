@@ -47,6 +47,8 @@ class VideoSource {
   // Frames announced by the container or found on disk; -1 when unknown (live camera).
   int frame_count() const { return frame_count_; }
   bool live() const { return live_; }
+  // FrameSource::FramesNote of the source behind it ("" for none).
+  virtual std::string frames_note() const { return ""; }
 
   // Reads the next frame into `frame`; false at the end. A frame that cannot be decoded in an
   // image sequence, or a frame of another size, throws fv::Error naming the source and frame.

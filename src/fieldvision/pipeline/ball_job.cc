@@ -252,6 +252,8 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   if (!o.field.empty()) field = field::LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
   std::vector<std::unique_ptr<io::FrameSource>> sources = OpenBallVideos(o, cameras);
+  std::vector<std::string> frames_notes(sources.size());  // decided on each video's first frame
+  for (size_t c = 0; c < sources.size(); ++c) frames_notes[c] = sources[c]->FramesNote();
   const detect::BallDetectorOptions dopt = TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   std::vector<BallRegionDetectFn> detect_fns;
   std::vector<BallGuidedFn> guided_fns;
@@ -335,6 +337,7 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
     csv.Close();
   });
   for (size_t c = 0; c < det_files.size(); ++c) det_files[c]->CloseAndCommit(*det_csvs[c]);
+  result.frames_notes = std::move(frames_notes);
   for (const auto& b : backgrounds) {
     result.backgrounds.push_back(detect::NeededBackgroundSummary(b));
   }

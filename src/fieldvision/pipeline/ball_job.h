@@ -56,8 +56,9 @@ struct BallJobResult {
   BallPipelineSummary summary;
   std::optional<recon::BallEvalResult> eval;  // when a truth file was given
   long long rows_written = 0;
-  std::optional<FlightBundle> bundle;    // offline with `bundle`
-  std::vector<std::string> backgrounds;  // per camera, NeededBackgroundSummary
+  std::optional<FlightBundle> bundle;     // offline with `bundle`
+  std::vector<std::string> backgrounds;   // per camera, NeededBackgroundSummary
+  std::vector<std::string> frames_notes;  // per camera, FrameSource::FramesNote after opening
   // One line when not one frame got a position (a wrong colour, unposed cameras): why, from the
   // summary; "" otherwise. BALL.csv then holds its header only (a video without the ball).
   std::string NoPositionWarning() const;
