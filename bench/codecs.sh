@@ -14,7 +14,9 @@ DATA="$BUILD/bench-data/codecs"
 mkdir -p "$DATA"
 
 # scene-name preset seed colour
-scenes=("kick kick 1 orange" "low-sun-kick low-sun-kick 1 yellow" "low-sun low-sun 1 yellow")
+# (three low-sun statics: 16 frames each, one seed alone swings by a frame or a few mm)
+scenes=("kick kick 1 orange" "low-sun-kick low-sun-kick 1 yellow" "low-sun low-sun 1 yellow"
+  "low-sun-2 low-sun 2 yellow" "low-sun-3 low-sun 3 yellow")
 
 run() {  # dir ext colour tag [ball options] -> prints "found mean p95 wall"
   local dir="$1" ext="$2" colour="$3" tag="$4" args=() start end
