@@ -51,6 +51,7 @@ class FrameReader {
     fps_ = source_->fps();
     total_ = static_cast<int>(std::max(0LL, source_->FrameCount()));
     size_ = source_->FrameSize();
+    frames_note_ = source_->FramesNote();  // decided on the first frame, read when opening
     thread_ = std::thread([this] { Run(); });
   }
   ~FrameReader() {
@@ -81,6 +82,9 @@ class FrameReader {
   int total() const { return total_; }
   cv::Size size() const { return size_; }
   double read_seconds() const { return read_s_; }
+
+  // FrameSource::FramesNote, taken when opening (the reading thread owns the source after).
+  const std::string& frames_note() const { return frames_note_; }
 
  private:
   void Run() {
@@ -120,6 +124,7 @@ class FrameReader {
   double fps_ = 0;
   int total_ = 0;
   cv::Size size_;
+  std::string frames_note_;
   double read_s_ = 0;
   std::deque<cv::Mat> queue_;
   std::deque<double> times_ms_;
@@ -367,7 +372,7 @@ std::string PlayersResult::Summary() const {
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
-      "{:.1f}, map {:.1f}); tracker: {}{}",
+      "{:.1f}, map {:.1f}); tracker: {}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -376,7 +381,8 @@ std::string PlayersResult::Summary() const {
       rows.size(), interpolated, off_ground, times.total_s, frames / std::max(1e-9, times.total_s),
       1000 * times.read_s / f, 1000 * times.detect_s / f, 1000 * times.track_s / f,
       1000 * times.map_s / f, tracker.Summary(),
-      smoothing.tracks > 0 ? "; " + smoothing.Summary() : "");
+      smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
+      frames_note.empty() ? "" : "; " + frames_note);
 }
 
 void CheckCameraMatchesVideo(const camera::Camera& camera, int width, int height,
@@ -663,6 +669,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
                result);
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();
+  result.frames_note = reader.frames_note();
   result.tracker = tracker.stats();
   result.times.total_s = Seconds(t_start, Clock::now());
   return result;

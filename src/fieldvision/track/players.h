@@ -111,6 +111,7 @@ struct PlayersResult {
   int tracks = 0;            // ids in the output
   int interpolated = 0;      // rows added by gap filling
   int stitched = 0;          // tracklets joined to an earlier one
+  std::string frames_note;   // what the frame source did to the frames (FramesNote), or ""
   int off_ground = 0;        // rows whose foot point does not meet the ground
   GroundSmoothResult smoothing;
   TrackerStats tracker;
