@@ -13,12 +13,8 @@
 namespace fv::io {
 namespace {
 
-// BT.601 luma in 8-bit fixed point.
-inline int Luma(const cv::Vec3b& p) { return (29 * p[0] + 150 * p[1] + 77 * p[2] + 128) >> 8; }
-
-// Sum over the channels of |chroma(a) - chroma(b)|, chroma = BGR - luma.
-inline int ChromaStep(const cv::Vec3b& a, const cv::Vec3b& b) {
-  const int la = Luma(a), lb = Luma(b);
+// Sum over the channels of |chroma(a) - chroma(b)|, chroma = BGR - luma (la, lb).
+inline int ChromaStep(const cv::Vec3b& a, int la, const cv::Vec3b& b, int lb) {
   return std::abs((a[0] - la) - (b[0] - lb)) + std::abs((a[1] - la) - (b[1] - lb)) +
          std::abs((a[2] - la) - (b[2] - lb));
 }
@@ -72,15 +68,22 @@ ChromaLayout MeasureChromaLayout(const cv::Mat& bgr, const RepeatedChromaOptions
   o.Check();
   FV_REQUIRE(bgr.type() == CV_8UC3, "repeated chroma: the frame must be 8-bit BGR (got type {})",
              bgr.type());
+  cv::Mat luma;  // the luma UpsampleRepeatedChroma keeps (OpenCV's BT.601)
+  cv::cvtColor(bgr, luma, cv::COLOR_BGR2GRAY);
   double within = 0, across = 0;
   long long pairs = 0;
   for (int y = 0; y + 2 < bgr.rows; y += 8) {  // every fourth block row
     const cv::Vec3b* r0 = bgr.ptr<cv::Vec3b>(y);
     const cv::Vec3b* r1 = bgr.ptr<cv::Vec3b>(y + 1);
     const cv::Vec3b* r2 = bgr.ptr<cv::Vec3b>(y + 2);
+    const uint8_t* l0 = luma.ptr<uint8_t>(y);
+    const uint8_t* l1 = luma.ptr<uint8_t>(y + 1);
+    const uint8_t* l2 = luma.ptr<uint8_t>(y + 2);
     for (int x = 0; x + 2 < bgr.cols; x += 2) {
-      within += ChromaStep(r0[x], r0[x + 1]) + ChromaStep(r0[x], r1[x]);
-      across += ChromaStep(r0[x + 1], r0[x + 2]) + ChromaStep(r1[x], r2[x]);
+      within +=
+          ChromaStep(r0[x], l0[x], r0[x + 1], l0[x + 1]) + ChromaStep(r0[x], l0[x], r1[x], l1[x]);
+      across += ChromaStep(r0[x + 1], l0[x + 1], r0[x + 2], l0[x + 2]) +
+                ChromaStep(r1[x], l1[x], r2[x], l2[x]);
       pairs += 2;
     }
   }
