@@ -211,23 +211,36 @@ void StitchOptions::Check() const {
   CheckNonNegative(speed_slack_mps, "stitch speed_slack_mps");
   CheckNonNegative(max_speed_mps, "stitch max_speed_mps");
   CheckPositive(velocity_window_s, "stitch velocity_window_s");
+  CheckNonNegative(height_window_s, "stitch height_window_s");
   CheckInRange(max_appearance_distance, 0.0, 1.0, "stitch max_appearance_distance");
+  CheckPositive(appearance_end_samples, "stitch appearance_end_samples");
   CheckNonNegative(border_px, "stitch border_px");
   CheckInRange(full_height_ratio, 0.0, 1.0, "stitch full_height_ratio");
   CheckPositive(person_height_m, "stitch person_height_m");
 }
 
 std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const StitchOptions& o,
-                                       double fps, cv::Size image) {
+                                       double fps, cv::Size image, const StitchCamera& cam) {
   std::map<int, Tracklet> tl;
   for (const auto& r : rows) tl[r.id].rows.push_back(&r);
   bool field = true;
   for (const auto& r : rows) field = field && r.x_m && r.y_m;
-  // Ground position in metres: the field position, else the foot pixel scaled by the box height.
-  auto pos = [&](const TrackRow& r) -> Eigen::Vector2d {
+  const bool posed = cam.camera != nullptr && cam.camera->has_pose;
+  // A box taller than it was measured (`height`, its top kept): the person's head is in view, the
+  // legs hidden. Foot points of such boxes are mapped again when they can be: with a posed camera,
+  // or in pixels without field positions; with field positions alone they cannot.
+  const bool can_lengthen = posed || !field;
+  // Ground position in metres of `r`'s box with `height` (at least its own): the field position,
+  // else the foot pixel scaled by the box height.
+  auto pos = [&](const TrackRow& r, double height) -> Eigen::Vector2d {
+    cv::Rect2d box = r.box;
+    box.height = std::max(box.height, height);
+    if (posed && box.height > r.box.height) {
+      if (const auto g = FootOnGround(*cam.camera, box, cam.foot_offset_m)) return *g;
+    }
     if (field) return {*r.x_m, *r.y_m};
-    const double s = o.person_height_m / std::max(1.0, r.box.height);
-    return {(r.box.x + 0.5 * r.box.width) * s, (r.box.y + r.box.height) * s};
+    const double s = o.person_height_m / std::max(1.0, box.height);
+    return {(box.x + 0.5 * box.width) * s, (box.y + box.height) * s};
   };
   auto at_border = [&](const cv::Rect2d& b) {
     if (image.empty()) return false;
@@ -239,6 +252,8 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
     return n > o.max_speed_mps ? Eigen::Vector2d(v * (o.max_speed_mps / n)) : v;
   };
   const int window = std::max(1, static_cast<int>(std::lround(o.velocity_window_s * fps)));
+  const int height_window =
+      std::max(window, static_cast<int>(std::lround(o.height_window_s * fps)));
   for (auto& entry : tl) {
     // Not a structured binding: clang 14 (make fuzz, make sanitize) cannot capture one.
     Tracklet& t = entry.second;
@@ -247,39 +262,50 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
               [](const TrackRow* a, const TrackRow* b) { return a->frame < b->frame; });
     const TrackRow& f = *t.rows.front();
     const TrackRow& l = *t.rows.back();
-    // Ends: the rows within the velocity window of the first/last row; positions come from
-    // those whose box is not much shorter than the window's median (a shorter box is partly
-    // hidden and its foot point is wrong).
+    // Ends: the rows within the velocity window of the first/last row. A box much shorter than
+    // the person's height near that end (the median over height_window_s) is partly hidden and
+    // its foot point is wrong: it is lengthened to that height where it can be, else left out.
     auto ends = [&](bool at_end) {
-      std::vector<const TrackRow*> w;
+      const int end_frame = at_end ? l.frame : f.frame;
+      std::vector<const TrackRow*> wide;  // from the end inwards, within height_window
+      std::vector<double> hs;
       for (size_t k = 0; k < t.rows.size(); ++k) {
         const TrackRow* r = at_end ? t.rows[t.rows.size() - 1 - k] : t.rows[k];
-        if (std::abs(r->frame - (at_end ? l.frame : f.frame)) > window) break;
-        w.push_back(r);  // from the end inwards
+        if (std::abs(r->frame - end_frame) > height_window) break;
+        hs.push_back(r->box.height);
+        wide.push_back(r);
       }
-      std::vector<double> hs;
-      hs.reserve(w.size());
-      for (const TrackRow* r : w) hs.push_back(r->box.height);
-      const double full = o.full_height_ratio * util::NearestRankPercentile(hs, 0.5);
+      const double height = util::NearestRankPercentile(hs, 0.5);
+      // The rows used: those within `window` of the end when short boxes can be lengthened; else
+      // the full boxes over `window` from the nearest one (all within it when there is none).
       std::vector<const TrackRow*> good;
-      for (const TrackRow* r : w) {
-        if (r->box.height >= full) good.push_back(r);
-      }
-      if (good.empty()) good = w;
+      auto take_window = [&](bool full_only) {
+        for (const TrackRow* r : wide) {
+          if (full_only && r->box.height < o.full_height_ratio * height) continue;
+          const int from = !full_only ? end_frame : good.empty() ? r->frame : good.front()->frame;
+          if (std::abs(r->frame - from) > window) break;
+          good.push_back(r);
+        }
+      };
+      take_window(!can_lengthen);
+      if (good.empty()) take_window(false);
       const TrackRow* anchor = good.front();
       const TrackRow* other = good.back();
+      auto at = [&](const TrackRow* r) {
+        return pos(*r, r->box.height < o.full_height_ratio * height ? height : 0.0);
+      };
       Eigen::Vector2d v = Eigen::Vector2d::Zero();
       if (anchor->frame != other->frame) {
-        v = clamp_speed((pos(*anchor) - pos(*other)) * fps / (anchor->frame - other->frame));
+        v = clamp_speed((at(anchor) - at(other)) * fps / (anchor->frame - other->frame));
       }
-      return std::make_pair(anchor, v);
+      return std::make_tuple(anchor, at(anchor), v);
     };
-    const auto [fa, vf] = ends(false);
-    const auto [la, vl] = ends(true);
-    t.first = pos(*fa);
+    const auto [fa, pf, vf] = ends(false);
+    const auto [la, pl, vl] = ends(true);
+    t.first = pf;
     t.first_frame = fa->frame;
     t.v_first = vf;
-    t.last = pos(*la);
+    t.last = pl;
     t.last_frame = la->frame;
     t.v_last = vl;
     t.starts_at_border = at_border(f.box);
@@ -309,8 +335,13 @@ std::vector<TrackletLink> TrackletLinks(const std::map<int, Tracklet>& tl,
       const auto ha = appearance.find(ia), hb = appearance.find(ib);
       if (ha != appearance.end() && hb != appearance.end() && ha->second.count > 0 &&
           hb->second.count > 0) {
-        app = cv::compareHist(ha->second.sum / ha->second.count, hb->second.sum / hb->second.count,
-                              cv::HISTCMP_BHATTACHARYYA);
+        // A's latest look against B's first: what the person looked like on either side of the
+        // gap (the whole track's mean when an end has none).
+        const cv::Mat a_end = ha->second.LastMean(), b_start = hb->second.FirstMean();
+        app =
+            !a_end.empty() && !b_start.empty()
+                ? cv::compareHist(a_end, b_start, cv::HISTCMP_BHATTACHARYYA)
+                : cv::compareHist(ha->second.Mean(), hb->second.Mean(), cv::HISTCMP_BHATTACHARYYA);
       }
       if (app > o.max_appearance_distance) continue;
       const double cost =
@@ -345,11 +376,11 @@ int JoinTracklets(const std::vector<TrackletLink>& links, std::vector<TrackRow>&
 }
 
 int StitchTracklets(std::vector<TrackRow>& rows, const std::map<int, TrackAppearance>& appearance,
-                    const StitchOptions& o, double fps, cv::Size image) {
+                    const StitchOptions& o, double fps, cv::Size image, const StitchCamera& cam) {
   o.Check();
   if (o.max_gap_s <= 0 || rows.empty()) return 0;
   fps = fps > 0 ? fps : 25.0;
-  const std::map<int, Tracklet> tl = BuildTracklets(rows, o, fps, image);
+  const std::map<int, Tracklet> tl = BuildTracklets(rows, o, fps, image, cam);
   const std::vector<TrackletLink> links = TrackletLinks(tl, appearance, o, fps);
   return JoinTracklets(links, rows);
 }
@@ -452,7 +483,8 @@ FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel
 }
 
 void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& frame,
-                        double high_score, std::map<int, TrackAppearance>& appearance) {
+                        double high_score, int end_samples,
+                        std::map<int, TrackAppearance>& appearance) {
   for (const auto& s : states) {
     if (s.predicted || s.score < high_score) continue;
     bool clear = true;
@@ -462,10 +494,31 @@ void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& fr
     if (!clear) continue;
     const cv::Mat h = TorsoHistogram(frame, s.box);
     if (h.empty()) continue;
-    TrackAppearance& a = appearance[s.id];
-    a.sum = a.sum.empty() ? h.clone() : a.sum + h;
-    a.count++;
+    appearance[s.id].Add(h, end_samples);
   }
+}
+
+void TrackAppearance::Add(const cv::Mat& histogram, int end_samples) {
+  sum = sum.empty() ? histogram.clone() : sum + histogram;
+  ++count;
+  if (first_count < end_samples) {
+    first_sum = first_sum.empty() ? histogram.clone() : first_sum + histogram;
+    ++first_count;
+  }
+  last.push_back(histogram.clone());
+  last_sum = last_sum.empty() ? histogram.clone() : last_sum + histogram;
+  while (static_cast<int>(last.size()) > std::max(1, end_samples)) {
+    last_sum -= last.front();
+    last.pop_front();
+  }
+}
+
+cv::Mat TrackAppearance::Mean() const { return count > 0 ? cv::Mat(sum / count) : cv::Mat(); }
+cv::Mat TrackAppearance::FirstMean() const {
+  return first_count > 0 ? cv::Mat(first_sum / first_count) : cv::Mat();
+}
+cv::Mat TrackAppearance::LastMean() const {
+  return last.empty() ? cv::Mat() : cv::Mat(last_sum / static_cast<double>(last.size()));
 }
 
 std::optional<cv::Vec3f> TorsoColour(const cv::Mat& frame, const cv::Rect2d& box) {
@@ -559,8 +612,8 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
   if (options.min_track_frames > 0) {
     result.dropped_tracks = DropShortTracks(result.rows, result.min_track_frames);
   }
-  result.stitched =
-      StitchTracklets(result.rows, pass.appearance, options.stitch, result.fps, image);
+  result.stitched = StitchTracklets(result.rows, pass.appearance, options.stitch, result.fps, image,
+                                    {calibrated ? camera : nullptr, options.tracker.foot_offset_m});
   result.interpolated =
       InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
                       options.tracker.foot_offset_m);
@@ -647,7 +700,8 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     result.detections += static_cast<int>(dets.size());
     // Appearance of each track for stitching: confident boxes that no other box overlaps.
     if (options.stitch.max_gap_s > 0) {
-      AddTrackAppearance(states, frame, options.tracker.high_score, pass.appearance);
+      AddTrackAppearance(states, frame, options.tracker.high_score,
+                         options.stitch.appearance_end_samples, pass.appearance);
     }
     if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);
     RecordTracks(states, frame, index + 1, calibrated, options, result, pass);

@@ -23,11 +23,12 @@ struct Tracklet {
   bool starts_at_border = false, ends_at_border = false;
 };
 
-// The rows of each id with their ends: within velocity_window_s of the first and last row, from
-// boxes not much shorter than the window's median (a shorter box is partly hidden). Positions are
-// the field positions when every row has one (`field`), else foot pixels scaled by box height.
+// The rows of each id with their ends: within velocity_window_s of the first and last row; a box
+// much shorter than the person there is partly hidden (its foot taken at the person's height below
+// its top, or the box left out). Positions are the field positions when every row has one, else
+// foot pixels scaled by box height; lengthened boxes are mapped through `camera` when posed.
 std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const StitchOptions& o,
-                                       double fps, cv::Size image);
+                                       double fps, cv::Size image, const StitchCamera& camera = {});
 
 struct TrackletLink {
   double cost;
@@ -49,7 +50,8 @@ FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel
 
 // Adds the torso histograms of confident, unpredicted tracks that no other track overlaps.
 void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& frame,
-                        double high_score, std::map<int, TrackAppearance>& appearance);
+                        double high_score, int end_samples,
+                        std::map<int, TrackAppearance>& appearance);
 
 // Mean CIELAB colour of the torso (lightness weighted 0.3: chroma first); nullopt when tiny.
 std::optional<cv::Vec3f> TorsoColour(const cv::Mat& frame, const cv::Rect2d& box);

@@ -85,6 +85,13 @@ TEST(Players, InterpolationFillsShortGapsOnly) {
   EXPECT_NEAR(rows[2].box.x, 4.0, 1e-9);
 }
 
+// A histogram with all its weight in one hue bin (TorsoHistogram's 16 x 8 layout).
+cv::Mat OneBinHistogram(int hue_bin) {
+  cv::Mat h = cv::Mat::zeros(16, 8, CV_32F);
+  h.at<float>(hue_bin, 3) = 1.0f;
+  return h;
+}
+
 // One person walking in a straight line, tracked as two tracklets with a gap of 10 frames, and
 // a second person in another colour: the tracklets are joined, the other person is not, and gap
 // interpolation then fills the gap exactly.
@@ -97,13 +104,9 @@ TEST(Players, StitchJoinsTrackletsOfOnePersonAndInterpolationFillsTheGap) {
     // Someone else starts right after the gap near the first person but looks different.
     if (f >= 32) rows.push_back({f, 3, box_at(f, 150), 0.9, {}, {}});
   }
-  auto hist = [](int bin) {
-    cv::Mat h = cv::Mat::zeros(16, 8, CV_32F);
-    h.at<float>(bin, 3) = 1.0f;
-    return h;
-  };
-  std::map<int, TrackAppearance> app = {
-      {1, {hist(2), 1}}, {2, {2 * hist(2), 2}}, {3, {hist(10), 1}}};
+  std::map<int, TrackAppearance> app = {{1, {OneBinHistogram(2), 1}},
+                                        {2, {2 * OneBinHistogram(2), 2}},
+                                        {3, {OneBinHistogram(10), 1}}};
   StitchOptions o;
   const cv::Size image(640, 480);
   std::vector<TrackRow> stitched = rows;
@@ -440,6 +443,92 @@ TEST(PlayersStages, TrackletEndsLinksAndJoins) {
   std::set<int> ids;
   for (const auto& r : rows) ids.insert(r.id);
   EXPECT_EQ(ids, (std::set<int>{1, 3}));
+}
+
+// A person whose torso looks different at the two ends of a track (light, pose): the join compares
+// the looks on either side of the gap, not the whole tracks' means.
+TEST(PlayersStages, StitchComparesTheLooksOnEitherSideOfTheGap) {
+  const double fps = 10;
+  StitchOptions o;
+  std::vector<TrackRow> rows = WalkerRows(1, 1, 40, 0.0, 1.0, fps);              // ends at x = 3.9
+  for (const auto& r : WalkerRows(2, 45, 60, 4.4, 1.0, fps)) rows.push_back(r);  // on its way
+  for (const auto& r : WalkerRows(3, 45, 60, 4.6, 1.0, fps)) rows.push_back(r);  // as near
+  std::map<int, TrackAppearance> look;
+  const int n = o.appearance_end_samples;
+  for (int i = 0; i < 40; ++i) look[1].Add(OneBinHistogram(i < 30 ? 2 : 6), n);
+  for (int i = 0; i < 16; ++i) look[2].Add(OneBinHistogram(i < 10 ? 6 : 9), n);
+  for (int i = 0; i < 16; ++i) look[3].Add(OneBinHistogram(2), n);
+  EXPECT_EQ(look[1].count, 40);
+  EXPECT_EQ(look[1].first_count, o.appearance_end_samples);
+  EXPECT_EQ(cv::norm(look[1].FirstMean() - OneBinHistogram(2)), 0.0);
+  EXPECT_EQ(cv::norm(look[1].LastMean() - OneBinHistogram(6)), 0.0);
+  // The whole tracks' means: 1 is mostly bin 2, as 3 is; 2 mostly bin 6.
+  EXPECT_GT(cv::compareHist(look[1].Mean(), look[2].Mean(), cv::HISTCMP_BHATTACHARYYA),
+            o.max_appearance_distance);
+  const auto tl = BuildTracklets(rows, o, fps, cv::Size());
+  const auto links = TrackletLinks(tl, look, o, fps);
+  ASSERT_EQ(links.size(), 1u);
+  EXPECT_EQ(links[0].a, 1);
+  EXPECT_EQ(links[0].b, 2);
+  // Tracks without end looks (built by hand) are compared by their means.
+  std::map<int, TrackAppearance> means = {
+      {1, {OneBinHistogram(2), 1}}, {2, {OneBinHistogram(6), 1}}, {3, {OneBinHistogram(2), 1}}};
+  const auto by_means = TrackletLinks(tl, means, o, fps);
+  ASSERT_EQ(by_means.size(), 1u);
+  EXPECT_EQ(by_means[0].b, 3);
+  o.appearance_end_samples = 0;
+  EXPECT_THROW(o.Check(), fv::Error);
+}
+
+// A person whose legs go behind someone nearer the camera before the track ends: the short boxes'
+// foot points are taken below their tops at the person's height, in pixels and through a posed
+// camera, so the track that follows the person is joined.
+TEST(PlayersStages, PartlyHiddenEndsAreLengthenedToThePersonsHeight) {
+  const double fps = 10;
+  StitchOptions o;
+  auto walker = [](int id, int first, int last, int hidden_from) {
+    std::vector<TrackRow> rows;
+    for (int f = first; f <= last; ++f) {
+      TrackRow r;
+      r.frame = f;
+      r.id = id;
+      r.box = cv::Rect2d(200 + 2.0 * f, 150, 30, f >= hidden_from ? 50 : 80);
+      r.conf = 0.9;
+      rows.push_back(r);
+    }
+    return rows;
+  };
+  std::vector<TrackRow> rows = walker(1, 1, 40, 28);  // the last 13 boxes show the top 50 px
+  for (const auto& r : walker(2, 43, 60, 1000)) rows.push_back(r);
+  std::map<int, TrackAppearance> look;
+  for (int id : {1, 2}) look[id].Add(OneBinHistogram(4), o.appearance_end_samples);
+  // In pixels scaled by the box height (no camera, no field positions).
+  auto tl = BuildTracklets(rows, o, fps, cv::Size());
+  const double s = o.person_height_m / 80;
+  EXPECT_NEAR(tl.at(1).last.x(), (200 + 2.0 * 40 + 15) * s, 1e-9);
+  EXPECT_NEAR(tl.at(1).last.y(), 230 * s, 1e-9);
+  EXPECT_NEAR(tl.at(1).v_last.x(), 2.0 * fps * s, 1e-9);
+  ASSERT_EQ(TrackletLinks(tl, look, o, fps).size(), 1u);
+  // Field positions from a camera 6 m up, 15 m back: the hidden boxes' feet map 30 px nearer.
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
+  cam.has_pose = true;
+  cam.cam_from_world =
+      geometry::Rigid3d::LookAt(Eigen::Vector3d(0, -15, 6), Eigen::Vector3d(0, 0, 0));
+  for (auto& r : rows) {
+    const auto g = FootOnGround(cam, r.box);
+    ASSERT_TRUE(g.has_value());
+    r.x_m = g->x();
+    r.y_m = g->y();
+  }
+  const auto full_foot = FootOnGround(cam, cv::Rect2d(200 + 2.0 * 40, 150, 30, 80));
+  ASSERT_TRUE(full_foot.has_value());
+  tl = BuildTracklets(rows, o, fps, cv::Size(), {&cam, 0.0});
+  EXPECT_NEAR((tl.at(1).last - *full_foot).norm(), 0.0, 1e-6);
+  EXPECT_EQ(TrackletLinks(tl, look, o, fps).size(), 1u);
+  // Without the camera the field positions of the short boxes cannot be mended: they are left
+  // out, and the end is the last full box.
+  tl = BuildTracklets(rows, o, fps, cv::Size());
+  EXPECT_EQ(tl.at(1).last_frame, 27);
 }
 
 TEST(PlayersStages, JoinTakesOneSuccessorEachAndFollowsChains) {
