@@ -8,14 +8,16 @@
 // that sits on a threshold flips under such changes: a score that holds on the originals alone
 // will not hold on other photos. `--detector=colour|both` (default both, as `eval detect` on
 // still images; colour without the model). One benchmark runs a whole set once (MSL about 25 s,
-// SSL about 40 s a variant with both).
+// SSL about 40 s a variant with both). `--step=N` sets the scanline step (default: eval detect's).
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <string>
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -104,6 +106,12 @@ std::string& DetectorChoice() {
   return choice;
 }
 
+// --step=N: the scanline step (BallDetectorOptions::scan_step_px; default that of `eval detect`).
+int& StepChoice() {
+  static int step = 0;
+  return step;
+}
+
 std::string DefaultDetector() {
   try {
     fv::dnn::FindModel("nanodet.onnx");
@@ -121,6 +129,7 @@ void BM_PhotoVariant(benchmark::State& state, const PhotoSet& set, const Variant
   o.labels.class_id = set.class_id;
   o.detector.colour = set.colour;
   o.dnn.detector = DetectorChoice();
+  if (StepChoice() > 0) o.detector.scan_step_px = StepChoice();
   o.progress = false;
   o.transform = variant.transform;
   fv::detect::DetectEvalResult r;
@@ -184,6 +193,15 @@ int main(int argc, char** argv) {
   std::vector<char*> args;
   for (int i = 0; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg.rfind("--step=", 0) == 0) {
+      StepChoice() = std::atoi(arg.c_str() + 7);
+      if (StepChoice() < 1 || StepChoice() > 16) {
+        std::fprintf(stderr, "bench_photo_robustness: --step must be 1..16 (got %s)\n",
+                     arg.c_str() + 7);
+        return 1;
+      }
+      continue;
+    }
     if (arg.rfind("--detector=", 0) != 0) {
       args.push_back(argv[i]);
       continue;
@@ -199,7 +217,8 @@ int main(int argc, char** argv) {
   RegisterAll();
   benchmark::Initialize(&n, args.data());
   if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
-  std::printf("detector: %s\n", DetectorChoice().c_str());
+  std::printf("detector: %s%s\n", DetectorChoice().c_str(),
+              StepChoice() > 0 ? fmt::format(", scanline step {} px", StepChoice()).c_str() : "");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   PrintMeans();

@@ -121,6 +121,11 @@ inline void AddDetectorOptions(CLI::App* cmd, detect::DnnBallOptions& o,
                   "vouches for a ball on the carpet; 0: off)")
       ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
+  cmd->add_option("--dnn-rescan-step", o.rescan_step_px,
+                  "With both: in a frame where nothing is accepted, the colour stage scans "
+                  "again at this scanline step and the network judges what it adds (0: off)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   cmd->add_flag("!--dnn-keep", o.demote_unconfirmed,
                 "With both: keep every colour-accepted candidate the network does not confirm "
                 "(default: those below --dnn-keep-score and off the field, --dnn-keep-field, are "

@@ -70,6 +70,8 @@ void DnnBallOptions::Check() const {
              max_crops);
   CheckInRange(box_size_ratio, 1.0, 10.0, "dnn box_size_ratio");
   CheckInRange(hold_min_radius_px, 0.0, 1000.0, "dnn hold_min_radius_px");
+  FV_REQUIRE(rescan_step_px >= 0 && rescan_step_px <= 16,
+             "dnn rescan_step_px must be in 0..16 (got {})", rescan_step_px);
 }
 
 BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score) {
@@ -280,6 +282,11 @@ AnyBallDetector::AnyBallDetector(const BallDetectorOptions& colour, const DnnBal
     colour_options.small.min_contrast = dnn_options_.spot_min_contrast;
   }
   colour_ = std::make_unique<BallDetector>(colour_options, camera, field);
+  if (dnn_options_.detector == "both" && dnn_options_.rescan_step_px > 0 &&
+      dnn_options_.rescan_step_px < colour_options.scan_step_px) {
+    colour_options.scan_step_px = dnn_options_.rescan_step_px;
+    fine_colour_ = std::make_unique<BallDetector>(colour_options, camera, field);
+  }
   if (dnn_options_.uses_dnn()) dnn_ = std::make_unique<DnnBallDetector>(dnn_options_);
 }
 
@@ -308,8 +315,8 @@ void AnyBallDetector::DemoteFaintSpots(std::vector<BallCandidate>* candidates) c
 
 void AnyBallDetector::MeasureFieldShares(const cv::Mat& bgr, const cv::Rect& region,
                                          const std::vector<double>& confirm,
+                                         const DnnBallOptions& o,
                                          std::vector<BallCandidate>* candidates) const {
-  const DnnBallOptions& o = dnn_options_;
   if (o.keep_field_share <= 0 || !o.demote_unconfirmed) return;
   BallDetector::ImageFieldCache image_field;
   for (size_t i = 0; i < candidates->size(); ++i) {
@@ -324,22 +331,45 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
                                                    const cv::Rect& region) const {
   if (dnn_ == nullptr) return colour_->Detect(bgr, region);
   if (!dnn_options_.uses_colour()) return FilterDnn(dnn_->Detect(bgr, region));
-  std::vector<BallCandidate> colour = colour_->Detect(bgr, region);
-  // Here, not in the colour detector: only the network's confirmation reads the mark, and the
-  // edge costs a pass over the frame's columns.
-  MarkOffField(colour_->OffFieldBoundary(bgr, region), &colour);
-  DemoteFaintSpots(&colour);
-  std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
   std::vector<BallCandidate> whole;
+  double input_scale = 1.0;
   if (dnn_options_.whole_frame) {
     whole = FilterDnn(dnn_->Detect(bgr, region));
     // Network balls come only from a searchable region, whose input scale is then defined.
-    const double input_scale = whole.empty() ? 1.0 : dnn_->InputScale(bgr.size(), region);
-    const std::vector<double> held = HoldingScores(colour, whole, dnn_options_, input_scale);
+    if (!whole.empty()) input_scale = dnn_->InputScale(bgr.size(), region);
+  }
+  std::vector<BallCandidate> out =
+      ConfirmColour(bgr, region, *colour_, whole, input_scale, dnn_options_, /*rescue=*/true);
+  const bool none =
+      std::none_of(out.begin(), out.end(), [](const BallCandidate& c) { return c.accepted; });
+  if (none && fine_colour_ != nullptr) {
+    out = ConfirmColour(bgr, region, *fine_colour_, whole, input_scale, dnn_options_,
+                        /*rescue=*/false);
+  }
+  return out;
+}
+
+std::vector<BallCandidate> AnyBallDetector::ConfirmColour(
+    const cv::Mat& bgr, const cv::Rect& region, const BallDetector& colour_detector,
+    const std::vector<BallCandidate>& whole, double input_scale, const DnnBallOptions& o,
+    bool rescue) const {
+  std::vector<BallCandidate> colour = colour_detector.Detect(bgr, region);
+  // Here, not in the colour detector: only the network's confirmation reads the mark, and the
+  // edge costs a pass over the frame's columns.
+  MarkOffField(colour_detector.OffFieldBoundary(bgr, region), &colour);
+  DemoteFaintSpots(&colour);
+  std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
+  if (!whole.empty()) {
+    const std::vector<double> held = HoldingScores(colour, whole, o, input_scale);
     for (size_t i = 0; i < confirm.size(); ++i) confirm[i] = std::max(confirm[i], held[i]);
   }
-  MeasureFieldShares(bgr, region, confirm, &colour);
-  return CombineBallCandidates(colour, confirm, whole, dnn_options_);
+  if (!rescue) {
+    for (size_t i = 0; i < confirm.size(); ++i) {
+      if (!colour[i].accepted) confirm[i] = 0.0;
+    }
+  }
+  MeasureFieldShares(bgr, region, confirm, o, &colour);
+  return CombineBallCandidates(colour, confirm, whole, o);
 }
 
 std::optional<BallCandidate> AnyBallDetector::FitAt(const cv::Mat& bgr, const cv::Rect& region,

@@ -41,6 +41,9 @@ TEST(DnnBallOptions, CheckNamesTheBadField) {
   o = DnnBallOptions();
   o.hold_min_radius_px = std::nan("");
   EXPECT_NE(fv::testing::ErrorOf([&] { o.Check(); }).find("hold_min_radius_px"), std::string::npos);
+  o = DnnBallOptions();
+  o.rescan_step_px = 17;
+  EXPECT_NE(fv::testing::ErrorOf([&] { o.Check(); }).find("rescan_step_px"), std::string::npos);
   EXPECT_EQ(fv::testing::ErrorOf([] { DnnBallOptions().Check(); }), "");
 }
 
@@ -202,6 +205,18 @@ class DnnBallOnPhotos : public ::testing::Test {
     o.dnn.detector = detector;
     return o;
   }
+  // `eval detect` in "both" of the SSL photo NAME.jpg with the orange preset.
+  std::string SslDir() const { return dir_ + "/../../ssl-orange"; }
+  DetectEvalOptions OrangeEval(const std::string& name) const {
+    DetectEvalOptions o;
+    o.video = SslDir() + "/images/" + name + ".jpg";
+    o.labels.labels = SslDir() + "/labels";
+    o.labels.class_id = 1;
+    o.progress = false;
+    o.detector.colour = "orange";
+    o.dnn.detector = "both";
+    return o;
+  }
   std::string dir_;
 };
 
@@ -329,6 +344,20 @@ TEST_F(DnnBallOnPhotos, ColourHitsOnTheCarpetAreKept) {
   EXPECT_EQ(off.hits, 2) << off.Summary(10);
 }
 
+// An SSL golf ball of a few pixels (00370.jpg, 3.5 px radius) that falls between the fast
+// scan's rows: in a frame where nothing is accepted, "both" scans again at every pixel
+// (DnnBallOptions::rescan_step_px) and finds it; without the rescan nothing is found.
+TEST_F(DnnBallOnPhotos, RescanFindsABallBetweenTheScanRows) {
+  DetectEvalOptions o = OrangeEval("00370");
+  const DetectEvalResult on = EvaluateDetector(o);
+  ASSERT_EQ(on.with_ball, 1);
+  EXPECT_EQ(on.hits, 1) << on.Summary(5);
+  o.dnn.rescan_step_px = 0;
+  const DetectEvalResult off = EvaluateDetector(o);
+  EXPECT_EQ(off.hits, 0) << off.Summary(5);
+  EXPECT_EQ(off.false_detections, 0) << off.Summary(5);
+}
+
 // The whole-frame search's input scale, which hold_min_radius_px is measured in.
 TEST_F(DnnBallOnPhotos, InputScaleOfTheWholeFrameSearch) {
   DnnBallOptions o;
@@ -347,15 +376,8 @@ TEST_F(DnnBallOnPhotos, InputScaleOfTheWholeFrameSearch) {
 // whole-frame network box around a far robot (2.3-2.8 px orange spots) does not confirm the spot,
 // as it did before hold_min_radius_px.
 TEST_F(DnnBallOnPhotos, WholeFrameBoxesDoNotConfirmFarSpots) {
-  const std::string ssl = dir_ + "/../../ssl-orange";
   for (const char* name : {"00109", "00208"}) {
-    DetectEvalOptions o;
-    o.video = ssl + "/images/" + name + ".jpg";
-    o.labels.labels = ssl + "/labels";
-    o.labels.class_id = 1;
-    o.progress = false;
-    o.detector.colour = "orange";
-    o.dnn.detector = "both";
+    DetectEvalOptions o = OrangeEval(name);
     const DetectEvalResult now = EvaluateDetector(o);
     EXPECT_EQ(now.false_detections, 0) << name << ": " << now.Summary(10);
     o.dnn.hold_min_radius_px = 0;
