@@ -315,8 +315,8 @@ void AnyBallDetector::DemoteFaintSpots(std::vector<BallCandidate>* candidates) c
 
 void AnyBallDetector::MeasureFieldShares(const cv::Mat& bgr, const cv::Rect& region,
                                          const std::vector<double>& confirm,
-                                         const DnnBallOptions& o,
                                          std::vector<BallCandidate>* candidates) const {
+  const DnnBallOptions& o = dnn_options_;
   if (o.keep_field_share <= 0 || !o.demote_unconfirmed) return;
   BallDetector::ImageFieldCache image_field;
   for (size_t i = 0; i < candidates->size(); ++i) {
@@ -339,20 +339,20 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
     if (!whole.empty()) input_scale = dnn_->InputScale(bgr.size(), region);
   }
   std::vector<BallCandidate> out =
-      ConfirmColour(bgr, region, *colour_, whole, input_scale, dnn_options_, /*rescue=*/true);
+      ConfirmColour(bgr, region, *colour_, whole, input_scale, /*rescue=*/true);
   const bool none =
       std::none_of(out.begin(), out.end(), [](const BallCandidate& c) { return c.accepted; });
   if (none && fine_colour_ != nullptr) {
-    out = ConfirmColour(bgr, region, *fine_colour_, whole, input_scale, dnn_options_,
-                        /*rescue=*/false);
+    out = ConfirmColour(bgr, region, *fine_colour_, whole, input_scale, /*rescue=*/false);
   }
   return out;
 }
 
-std::vector<BallCandidate> AnyBallDetector::ConfirmColour(
-    const cv::Mat& bgr, const cv::Rect& region, const BallDetector& colour_detector,
-    const std::vector<BallCandidate>& whole, double input_scale, const DnnBallOptions& o,
-    bool rescue) const {
+std::vector<BallCandidate> AnyBallDetector::ConfirmColour(const cv::Mat& bgr,
+                                                          const cv::Rect& region,
+                                                          const BallDetector& colour_detector,
+                                                          const std::vector<BallCandidate>& whole,
+                                                          double input_scale, bool rescue) const {
   std::vector<BallCandidate> colour = colour_detector.Detect(bgr, region);
   // Here, not in the colour detector: only the network's confirmation reads the mark, and the
   // edge costs a pass over the frame's columns.
@@ -360,7 +360,7 @@ std::vector<BallCandidate> AnyBallDetector::ConfirmColour(
   DemoteFaintSpots(&colour);
   std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
   if (!whole.empty()) {
-    const std::vector<double> held = HoldingScores(colour, whole, o, input_scale);
+    const std::vector<double> held = HoldingScores(colour, whole, dnn_options_, input_scale);
     for (size_t i = 0; i < confirm.size(); ++i) confirm[i] = std::max(confirm[i], held[i]);
   }
   if (!rescue) {
@@ -368,8 +368,8 @@ std::vector<BallCandidate> AnyBallDetector::ConfirmColour(
       if (!colour[i].accepted) confirm[i] = 0.0;
     }
   }
-  MeasureFieldShares(bgr, region, confirm, o, &colour);
-  return CombineBallCandidates(colour, confirm, whole, o);
+  MeasureFieldShares(bgr, region, confirm, &colour);
+  return CombineBallCandidates(colour, confirm, whole, dnn_options_);
 }
 
 std::optional<BallCandidate> AnyBallDetector::FitAt(const cv::Mat& bgr, const cv::Rect& region,

@@ -201,19 +201,19 @@ class AnyBallDetector {
  private:
   std::vector<BallCandidate> FilterDnn(std::vector<BallCandidate> candidates) const;
   // "both" with one colour detector: its candidates confirmed by crops and by the whole-frame
-  // network balls `whole` (found at `input_scale`), then combined.
+  // network balls `whole` (found at `input_scale`), then combined; without `rescue` a candidate
+  // colour rejected is not accepted on the network's word (the rescan's extra places).
   std::vector<BallCandidate> ConfirmColour(const cv::Mat& bgr, const cv::Rect& region,
                                            const BallDetector& colour,
                                            const std::vector<BallCandidate>& whole,
-                                           double input_scale, const DnnBallOptions& o,
-                                           bool rescue) const;
+                                           double input_scale, bool rescue) const;
   // "both": small spots fainter than the colour detector alone takes (its own
   // SmallBallOptions::min_contrast) are not colour-accepted, only worth the network's look.
   void DemoteFaintSpots(std::vector<BallCandidate>* candidates) const;
   // "both": the field share of each colour-accepted candidate that only its field share can
   // keep (not confirmed by `confirm`, below keep_score; DnnBallOptions::keep_field_share).
   void MeasureFieldShares(const cv::Mat& bgr, const cv::Rect& region,
-                          const std::vector<double>& confirm, const DnnBallOptions& o,
+                          const std::vector<double>& confirm,
                           std::vector<BallCandidate>* candidates) const;
   DnnBallOptions dnn_options_;
   double colour_spot_contrast_ = 0.0;
