@@ -115,7 +115,7 @@ std::vector<double> HoldingScores(const std::vector<BallCandidate>& colour,
 std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate>& colour,
                                                  const std::vector<double>& confirm,
                                                  const std::vector<BallCandidate>& dnn,
-                                                 const DnnBallOptions& o) {
+                                                 const DnnBallOptions& o, bool rescue) {
   FV_REQUIRE(confirm.size() == colour.size(), "CombineBallCandidates: {} scores for {} candidates",
              confirm.size(), colour.size());
   // Tiers: 0 confirmed, 1 colour-accepted unconfirmed, 2 completing network ball, 3 the rest.
@@ -128,7 +128,7 @@ std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate
   for (size_t i = 0; i < colour.size(); ++i) {
     BallCandidate c = colour[i];
     c.network_score = confirm[i];
-    if (confirm[i] >= ConfirmScore(c, o)) {
+    if ((c.accepted || rescue) && confirm[i] >= ConfirmScore(c, o)) {
       c.rescued = !c.accepted && confirm[i] < o.accept_score;
       c.accepted = true;
       c.reason.clear();
@@ -338,12 +338,16 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
     // Network balls come only from a searchable region, whose input scale is then defined.
     if (!whole.empty()) input_scale = dnn_->InputScale(bgr.size(), region);
   }
+  // Here, not in the colour detector: only the network's confirmation reads the mark, and the
+  // edge costs a pass over the frame's columns (once: both scans share it).
+  const FieldBoundary boundary = colour_->OffFieldBoundary(bgr, region);
   std::vector<BallCandidate> out =
-      ConfirmColour(bgr, region, *colour_, whole, input_scale, /*rescue=*/true);
+      ConfirmColour(bgr, region, *colour_, boundary, whole, input_scale, /*rescue=*/true);
   const bool none =
       std::none_of(out.begin(), out.end(), [](const BallCandidate& c) { return c.accepted; });
   if (none && fine_colour_ != nullptr) {
-    out = ConfirmColour(bgr, region, *fine_colour_, whole, input_scale, /*rescue=*/false);
+    out = ConfirmColour(bgr, region, *fine_colour_, boundary, whole, input_scale,
+                        /*rescue=*/false);
   }
   return out;
 }
@@ -351,25 +355,19 @@ std::vector<BallCandidate> AnyBallDetector::Detect(const cv::Mat& bgr,
 std::vector<BallCandidate> AnyBallDetector::ConfirmColour(const cv::Mat& bgr,
                                                           const cv::Rect& region,
                                                           const BallDetector& colour_detector,
+                                                          const FieldBoundary& boundary,
                                                           const std::vector<BallCandidate>& whole,
                                                           double input_scale, bool rescue) const {
   std::vector<BallCandidate> colour = colour_detector.Detect(bgr, region);
-  // Here, not in the colour detector: only the network's confirmation reads the mark, and the
-  // edge costs a pass over the frame's columns.
-  MarkOffField(colour_detector.OffFieldBoundary(bgr, region), &colour);
+  MarkOffField(boundary, &colour);
   DemoteFaintSpots(&colour);
   std::vector<double> confirm = dnn_->CropScores(bgr, colour, region);
   if (!whole.empty()) {
     const std::vector<double> held = HoldingScores(colour, whole, dnn_options_, input_scale);
     for (size_t i = 0; i < confirm.size(); ++i) confirm[i] = std::max(confirm[i], held[i]);
   }
-  if (!rescue) {
-    for (size_t i = 0; i < confirm.size(); ++i) {
-      if (!colour[i].accepted) confirm[i] = 0.0;
-    }
-  }
   MeasureFieldShares(bgr, region, confirm, &colour);
-  return CombineBallCandidates(colour, confirm, whole, dnn_options_);
+  return CombineBallCandidates(colour, confirm, whole, dnn_options_, rescue);
 }
 
 std::optional<BallCandidate> AnyBallDetector::FitAt(const cv::Mat& bgr, const cv::Rect& region,

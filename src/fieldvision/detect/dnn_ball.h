@@ -137,11 +137,13 @@ void MarkOffField(const FieldBoundary& boundary, std::vector<BallCandidate>* can
 // whole-frame network balls `dnn` (candidates, best first). Returns the candidates best first:
 // confirmed ones (accepted, by network score), then colour-accepted unconfirmed ones (with
 // demote_unconfirmed those below keep_score whose field_share is below keep_field_share are
-// rejected), then completing network balls from complete_score, then the rest.
+// rejected), then completing network balls from complete_score, then the rest. Without `rescue`
+// the network confirms only what colour accepted (a colour-rejected candidate stays rejected,
+// with its network score).
 std::vector<BallCandidate> CombineBallCandidates(const std::vector<BallCandidate>& colour,
                                                  const std::vector<double>& confirm,
                                                  const std::vector<BallCandidate>& dnn,
-                                                 const DnnBallOptions& options);
+                                                 const DnnBallOptions& options, bool rescue = true);
 
 // The network part: NanoDet loaded once. Detect and CropScores lock a mutex (one network).
 class DnnBallDetector {
@@ -200,11 +202,12 @@ class AnyBallDetector {
 
  private:
   std::vector<BallCandidate> FilterDnn(std::vector<BallCandidate> candidates) const;
-  // "both" with one colour detector: its candidates confirmed by crops and by the whole-frame
-  // network balls `whole` (found at `input_scale`), then combined; without `rescue` a candidate
-  // colour rejected is not accepted on the network's word (the rescan's extra places).
+  // "both" with one colour detector: its candidates, marked off the field by `boundary`,
+  // confirmed by crops and by the whole-frame network balls `whole` (found at `input_scale`),
+  // then combined (CombineBallCandidates; `rescue` off for the rescan's extra places).
   std::vector<BallCandidate> ConfirmColour(const cv::Mat& bgr, const cv::Rect& region,
                                            const BallDetector& colour,
+                                           const FieldBoundary& boundary,
                                            const std::vector<BallCandidate>& whole,
                                            double input_scale, bool rescue) const;
   // "both": small spots fainter than the colour detector alone takes (its own

@@ -158,6 +158,14 @@ TEST(CombineBallCandidates, ALowConfirmationOfARejectedCandidateIsARescue) {
   out = CombineBallCandidates({rejected}, {0.05}, {}, o);  // below the confirm score
   EXPECT_FALSE(out[0].accepted);
   EXPECT_FALSE(out[0].rescued);
+  // Without rescues (the rescan's extra places) only what colour accepted is confirmed; the
+  // network's score is still reported.
+  out = CombineBallCandidates({rejected, accepted}, {o.accept_score, 0.2}, {}, o, false);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_TRUE(out[0].accepted);
+  EXPECT_DOUBLE_EQ(out[0].network_score, 0.2);
+  EXPECT_FALSE(out[1].accepted);
+  EXPECT_DOUBLE_EQ(out[1].network_score, o.accept_score);
 }
 
 TEST(HoldingScores, ABoxConfirmsTheCandidatesItHoldsOfASimilarSize) {
