@@ -213,7 +213,6 @@ void StitchOptions::Check() const {
   CheckPositive(velocity_window_s, "stitch velocity_window_s");
   CheckNonNegative(height_window_s, "stitch height_window_s");
   CheckInRange(max_appearance_distance, 0.0, 1.0, "stitch max_appearance_distance");
-  CheckPositive(appearance_end_samples, "stitch appearance_end_samples");
   CheckNonNegative(border_px, "stitch border_px");
   CheckInRange(full_height_ratio, 0.0, 1.0, "stitch full_height_ratio");
   CheckPositive(person_height_m, "stitch person_height_m");
@@ -294,11 +293,12 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
       auto at = [&](const TrackRow* r) {
         return pos(*r, r->box.height < o.full_height_ratio * height ? height : 0.0);
       };
+      const Eigen::Vector2d p = at(anchor);
       Eigen::Vector2d v = Eigen::Vector2d::Zero();
       if (anchor->frame != other->frame) {
-        v = clamp_speed((at(anchor) - at(other)) * fps / (anchor->frame - other->frame));
+        v = clamp_speed((p - at(other)) * fps / (anchor->frame - other->frame));
       }
-      return std::make_tuple(anchor, at(anchor), v);
+      return std::make_tuple(anchor, p, v);
     };
     const auto [fa, pf, vf] = ends(false);
     const auto [la, pl, vl] = ends(true);
@@ -335,13 +335,8 @@ std::vector<TrackletLink> TrackletLinks(const std::map<int, Tracklet>& tl,
       const auto ha = appearance.find(ia), hb = appearance.find(ib);
       if (ha != appearance.end() && hb != appearance.end() && ha->second.count > 0 &&
           hb->second.count > 0) {
-        // A's latest look against B's first: what the person looked like on either side of the
-        // gap (the whole track's mean when an end has none).
-        const cv::Mat a_end = ha->second.LastMean(), b_start = hb->second.FirstMean();
-        app =
-            !a_end.empty() && !b_start.empty()
-                ? cv::compareHist(a_end, b_start, cv::HISTCMP_BHATTACHARYYA)
-                : cv::compareHist(ha->second.Mean(), hb->second.Mean(), cv::HISTCMP_BHATTACHARYYA);
+        app = cv::compareHist(ha->second.sum / ha->second.count, hb->second.sum / hb->second.count,
+                              cv::HISTCMP_BHATTACHARYYA);
       }
       if (app > o.max_appearance_distance) continue;
       const double cost =
@@ -483,8 +478,7 @@ FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel
 }
 
 void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& frame,
-                        double high_score, int end_samples,
-                        std::map<int, TrackAppearance>& appearance) {
+                        double high_score, std::map<int, TrackAppearance>& appearance) {
   for (const auto& s : states) {
     if (s.predicted || s.score < high_score) continue;
     bool clear = true;
@@ -494,31 +488,10 @@ void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& fr
     if (!clear) continue;
     const cv::Mat h = TorsoHistogram(frame, s.box);
     if (h.empty()) continue;
-    appearance[s.id].Add(h, end_samples);
+    TrackAppearance& a = appearance[s.id];
+    a.sum = a.sum.empty() ? h.clone() : a.sum + h;
+    a.count++;
   }
-}
-
-void TrackAppearance::Add(const cv::Mat& histogram, int end_samples) {
-  sum = sum.empty() ? histogram.clone() : sum + histogram;
-  ++count;
-  if (first_count < end_samples) {
-    first_sum = first_sum.empty() ? histogram.clone() : first_sum + histogram;
-    ++first_count;
-  }
-  last.push_back(histogram.clone());
-  last_sum = last_sum.empty() ? histogram.clone() : last_sum + histogram;
-  while (static_cast<int>(last.size()) > std::max(1, end_samples)) {
-    last_sum -= last.front();
-    last.pop_front();
-  }
-}
-
-cv::Mat TrackAppearance::Mean() const { return count > 0 ? cv::Mat(sum / count) : cv::Mat(); }
-cv::Mat TrackAppearance::FirstMean() const {
-  return first_count > 0 ? cv::Mat(first_sum / first_count) : cv::Mat();
-}
-cv::Mat TrackAppearance::LastMean() const {
-  return last.empty() ? cv::Mat() : cv::Mat(last_sum / static_cast<double>(last.size()));
 }
 
 std::optional<cv::Vec3f> TorsoColour(const cv::Mat& frame, const cv::Rect2d& box) {
@@ -700,8 +673,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     result.detections += static_cast<int>(dets.size());
     // Appearance of each track for stitching: confident boxes that no other box overlaps.
     if (options.stitch.max_gap_s > 0) {
-      AddTrackAppearance(states, frame, options.tracker.high_score,
-                         options.stitch.appearance_end_samples, pass.appearance);
+      AddTrackAppearance(states, frame, options.tracker.high_score, pass.appearance);
     }
     if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);
     RecordTracks(states, frame, index + 1, calibrated, options, result, pass);

@@ -7,7 +7,6 @@
 // stage.
 #pragma once
 
-#include <deque>
 #include <map>
 #include <optional>
 #include <string>
@@ -26,8 +25,7 @@ namespace fv::track {
 // and a tracklet B that starts at most max_gap_s later are joined (B takes A's id) when B's start
 // is where A's motion leads across the gap (A extrapolated forward and B backward by half the gap
 // each, at their end/start velocities, meet within reach_m + speed_slack_mps * gap) and their
-// torso colours on either side of the gap are alike (Bhattacharyya distance <=
-// max_appearance_distance). Pairs are
+// mean torso colours are alike (Bhattacharyya distance <= max_appearance_distance). Pairs are
 // joined greedily by increasing cost (sum of both distances relative to their limits), each
 // tracklet once on each side. A tracklet that ends at the image border and one that starts at the
 // border are not joined (the person left and someone came in; MOTChallenge gives a new id).
@@ -40,12 +38,6 @@ struct StitchOptions {
   double max_speed_mps = 3.0;      // end/start velocities are clamped to this speed
   double velocity_window_s = 1.0;  // velocity from the tracklet's last/first this many seconds
   double max_appearance_distance = 0.3;  // torso histograms (0: same, 1: disjoint)
-  // The torso histograms compared: the mean of A's latest and B's first this many (clear frames,
-  // TrackAppearance), not the whole tracks' means, which light and pose change along the way.
-  // Measured on PETS 2009 S2.L1 (bench/players.sh, tracker alone, 10 draws of the boxes moved by
-  // 0.5 px, with the lengthened boxes below): IDF1 mean 0.869 -> 0.884 with 10 (5 / 20 / 40:
-  // 0.885 / 0.881 / 0.887), MOTA unchanged.
-  int appearance_end_samples = 10;
   // Near its ends, a box shorter than this share of the person's height there (the median box
   // height within height_window_s of the end) is taken as partly hidden, its legs behind someone
   // nearer the camera: its foot point is taken below the box's top at that height (with a posed
@@ -59,22 +51,10 @@ struct StitchOptions {
   void Check() const;
 };
 
-// Appearance of one track: the sum of its torso histograms (TorsoHistogram) and how many, and of
-// its first and latest `end_samples` ones (what a join compares: light and pose change along a
-// track).
+// Mean appearance of one track: the sum of its torso histograms (TorsoHistogram) and how many.
 struct TrackAppearance {
   cv::Mat sum;
   int count = 0;
-  cv::Mat first_sum;
-  int first_count = 0;
-  std::deque<cv::Mat> last;
-  cv::Mat last_sum;
-  // Adds one histogram (the same size as those before).
-  void Add(const cv::Mat& histogram, int end_samples);
-  // Mean histograms: of all, of the first ones and of the latest ones; empty without any.
-  cv::Mat Mean() const;
-  cv::Mat FirstMean() const;
-  cv::Mat LastMean() const;
 };
 
 struct PlayersOptions {

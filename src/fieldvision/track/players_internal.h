@@ -50,8 +50,7 @@ FootFilter FieldFootFilter(const camera::Camera& camera, const field::FieldModel
 
 // Adds the torso histograms of confident, unpredicted tracks that no other track overlaps.
 void AddTrackAppearance(const std::vector<TrackState>& states, const cv::Mat& frame,
-                        double high_score, int end_samples,
-                        std::map<int, TrackAppearance>& appearance);
+                        double high_score, std::map<int, TrackAppearance>& appearance);
 
 // Mean CIELAB colour of the torso (lightness weighted 0.3: chroma first); nullopt when tiny.
 std::optional<cv::Vec3f> TorsoColour(const cv::Mat& frame, const cv::Rect2d& box);

@@ -445,41 +445,6 @@ TEST(PlayersStages, TrackletEndsLinksAndJoins) {
   EXPECT_EQ(ids, (std::set<int>{1, 3}));
 }
 
-// A person whose torso looks different at the two ends of a track (light, pose): the join compares
-// the looks on either side of the gap, not the whole tracks' means.
-TEST(PlayersStages, StitchComparesTheLooksOnEitherSideOfTheGap) {
-  const double fps = 10;
-  StitchOptions o;
-  std::vector<TrackRow> rows = WalkerRows(1, 1, 40, 0.0, 1.0, fps);              // ends at x = 3.9
-  for (const auto& r : WalkerRows(2, 45, 60, 4.4, 1.0, fps)) rows.push_back(r);  // on its way
-  for (const auto& r : WalkerRows(3, 45, 60, 4.6, 1.0, fps)) rows.push_back(r);  // as near
-  std::map<int, TrackAppearance> look;
-  const int n = o.appearance_end_samples;
-  for (int i = 0; i < 40; ++i) look[1].Add(OneBinHistogram(i < 30 ? 2 : 6), n);
-  for (int i = 0; i < 16; ++i) look[2].Add(OneBinHistogram(i < 10 ? 6 : 9), n);
-  for (int i = 0; i < 16; ++i) look[3].Add(OneBinHistogram(2), n);
-  EXPECT_EQ(look[1].count, 40);
-  EXPECT_EQ(look[1].first_count, o.appearance_end_samples);
-  EXPECT_EQ(cv::norm(look[1].FirstMean() - OneBinHistogram(2)), 0.0);
-  EXPECT_EQ(cv::norm(look[1].LastMean() - OneBinHistogram(6)), 0.0);
-  // The whole tracks' means: 1 is mostly bin 2, as 3 is; 2 mostly bin 6.
-  EXPECT_GT(cv::compareHist(look[1].Mean(), look[2].Mean(), cv::HISTCMP_BHATTACHARYYA),
-            o.max_appearance_distance);
-  const auto tl = BuildTracklets(rows, o, fps, cv::Size());
-  const auto links = TrackletLinks(tl, look, o, fps);
-  ASSERT_EQ(links.size(), 1u);
-  EXPECT_EQ(links[0].a, 1);
-  EXPECT_EQ(links[0].b, 2);
-  // Tracks without end looks (built by hand) are compared by their means.
-  std::map<int, TrackAppearance> means = {
-      {1, {OneBinHistogram(2), 1}}, {2, {OneBinHistogram(6), 1}}, {3, {OneBinHistogram(2), 1}}};
-  const auto by_means = TrackletLinks(tl, means, o, fps);
-  ASSERT_EQ(by_means.size(), 1u);
-  EXPECT_EQ(by_means[0].b, 3);
-  o.appearance_end_samples = 0;
-  EXPECT_THROW(o.Check(), fv::Error);
-}
-
 // A person whose legs go behind someone nearer the camera before the track ends: the short boxes'
 // foot points are taken below their tops at the person's height, in pixels and through a posed
 // camera, so the track that follows the person is joined.
@@ -501,7 +466,7 @@ TEST(PlayersStages, PartlyHiddenEndsAreLengthenedToThePersonsHeight) {
   std::vector<TrackRow> rows = walker(1, 1, 40, 28);  // the last 13 boxes show the top 50 px
   for (const auto& r : walker(2, 43, 60, 1000)) rows.push_back(r);
   std::map<int, TrackAppearance> look;
-  for (int id : {1, 2}) look[id].Add(OneBinHistogram(4), o.appearance_end_samples);
+  for (int id : {1, 2}) look[id] = {OneBinHistogram(4), 1};
   // In pixels scaled by the box height (no camera, no field positions).
   auto tl = BuildTracklets(rows, o, fps, cv::Size());
   const double s = o.person_height_m / 80;
