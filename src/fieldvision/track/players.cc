@@ -330,7 +330,7 @@ std::vector<TrackletLink> TrackletLinks(const std::map<int, Tracklet>& tl,
       const Eigen::Vector2d pb = b.first - 0.5 * gap_s * b.v_first;
       const double limit = o.reach_m + o.speed_slack_mps * gap_s;
       const double d = (pa - pb).norm();
-      if (d > limit) continue;
+      if (!(d <= limit)) continue;  // NaN-safe: an undefined distance never links
       double app = 1.0;
       const auto ha = appearance.find(ia), hb = appearance.find(ib);
       if (ha != appearance.end() && hb != appearance.end() && ha->second.count > 0 &&
@@ -338,7 +338,7 @@ std::vector<TrackletLink> TrackletLinks(const std::map<int, Tracklet>& tl,
         app = cv::compareHist(ha->second.sum / ha->second.count, hb->second.sum / hb->second.count,
                               cv::HISTCMP_BHATTACHARYYA);
       }
-      if (app > o.max_appearance_distance) continue;
+      if (!(app <= o.max_appearance_distance)) continue;  // NaN (a broken histogram) never links
       const double cost =
           d / std::max(1e-9, limit) + app / std::max(1e-9, o.max_appearance_distance);
       links.push_back({cost, ia, ib});

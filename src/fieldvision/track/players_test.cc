@@ -1,7 +1,9 @@
 #include "fieldvision/track/players.h"
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -443,6 +445,25 @@ TEST(PlayersStages, TrackletEndsLinksAndJoins) {
   std::set<int> ids;
   for (const auto& r : rows) ids.insert(r.id);
   EXPECT_EQ(ids, (std::set<int>{1, 3}));
+}
+
+// A torso histogram with negative bins (or a NaN field position) makes the distance NaN; NaN fails
+// every comparison, so it must not pass the limits as 'not greater'.
+TEST(PlayersStages, UndefinedDistancesNeverLink) {
+  const double fps = 10;
+  StitchOptions o;
+  std::vector<TrackRow> rows = WalkerRows(1, 1, 20, 0.0, 1.0, fps);
+  for (const auto& r : WalkerRows(2, 25, 40, 2.4, 1.0, fps)) rows.push_back(r);
+  auto tl = BuildTracklets(rows, o, fps, cv::Size());
+  std::map<int, TrackAppearance> look;
+  look[1] = {cv::Mat(16, 8, CV_32F, cv::Scalar(1.0 / 128)), 1};
+  look[2] = {cv::Mat(16, 8, CV_32F, cv::Scalar(-1.0 / 128)), 1};
+  ASSERT_TRUE(std::isnan(cv::compareHist(look[1].sum, look[2].sum, cv::HISTCMP_BHATTACHARYYA)));
+  EXPECT_TRUE(TrackletLinks(tl, look, o, fps).empty());
+  look[2] = look[1];
+  ASSERT_EQ(TrackletLinks(tl, look, o, fps).size(), 1u);
+  tl.at(2).first.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(TrackletLinks(tl, look, o, fps).empty());
 }
 
 // A person whose legs go behind someone nearer the camera before the track ends: the short boxes'
