@@ -301,6 +301,8 @@ void BallRegionOptions::Check() const {
              "BallRegionOptions.inside_share must be in (0, 1] (got {})", inside_share);
   CheckInRange(hidden_value, 0, 255, "BallRegionOptions.hidden_value");
   CheckInRange(min_seen, 0.1, 1.0, "BallRegionOptions.min_seen");
+  CheckInRange(well_seen, min_seen, 1.0, "BallRegionOptions.well_seen");
+  CheckInRange(min_partly_seen_rise, -1.0, 1.0, "BallRegionOptions.min_partly_seen_rise");
   CheckInRange(own_reach, 0.0, 2.0, "BallRegionOptions.own_reach");
   CheckInRange(own_share, 0.0, 1.0, "BallRegionOptions.own_share");
   CheckNonNegative(own_max_delta_e, "BallRegionOptions.own_max_delta_e");
@@ -314,9 +316,9 @@ std::string BallRegion::Summary() const {
   return fmt::format(
       "centre ({:.2f}, {:.2f}) px, radius {:.2f} px, arc {:.0f} %, fill {:.0f} %, spill {:.0f} %, "
       "leak {:.0f} %, purity {:.0f} %, contrast {:.0f}, solidity {:.2f}, {}/{} outline points, "
-      "rms {:.2f} px",
+      "rms {:.2f} px, seen {:.0f} % (rise {:.2f})",
       centre_px.x(), centre_px.y(), radius_px, 100 * arc_cover, 100 * fill, 100 * spill, 100 * leak,
-      100 * purity, contrast, solidity, inliers, outline_points, rms_px);
+      100 * purity, contrast, solidity, inliers, outline_points, rms_px, 100 * seen, seen_rise);
 }
 
 namespace {
@@ -671,13 +673,15 @@ bool IsDark(const cv::Mat& bgr, int x, int y, int hidden_value) {
 }
 
 // Angle bins of the circle that are seen (`known`: not outside `lim`, not hidden: every pixel
-// just beyond it, 1.1..1.3 r, dark) and those of them with outline (`hit`).
+// just beyond it, 1.1..1.3 r, dark), those of them with outline (`hit`) and how far up the seen
+// part lies (`rise`: the mean of -sin over the seen bins, image rows down; 1: only the top).
 void CountSeenBins(const cv::Mat& bgr, const Vector2d& c, double r,
                    const std::vector<char>& bin_hit, const cv::Rect& lim, int hidden_value,
-                   int* known, int* hit) {
+                   int* known, int* hit, double* rise) {
   const int bins = static_cast<int>(bin_hit.size());
   *known = 0;
   *hit = 0;
+  double rise_sum = 0.0;
   for (int b = 0; b < bins; ++b) {
     const double th = 2 * M_PI * (b + 0.5) / bins;
     const double x = c.x() + r * std::cos(th), y = c.y() + r * std::sin(th);
@@ -696,7 +700,25 @@ void CountSeenBins(const cv::Mat& bgr, const Vector2d& c, double r,
     }
     *known += visible || bin_hit[b];
     *hit += bin_hit[b];
+    if (visible || bin_hit[b]) rise_sum -= std::sin(th);
   }
+  *rise = *known > 0 ? rise_sum / *known : 0.0;
+}
+
+// Why a circle seen as `region` says (seen, partly_seen, seen_rise) cannot be judged ("" when it
+// can): too little of it seen, or under half of it and not its top or not its centre.
+std::string SeenProblem(const BallRegion& region, const Vector2d& c, const cv::Rect& lim,
+                        const BallRegionOptions& o) {
+  if (region.seen < o.min_seen) return "most of the outline is outside the image or hidden";
+  if (!region.partly_seen) return "";
+  if (region.seen_rise < o.min_partly_seen_rise) {
+    return fmt::format("under half the outline seen, and not its top (rise {:.2f} < {:.2f})",
+                       region.seen_rise, o.min_partly_seen_rise);
+  }
+  if (!cv::Rect2d(lim).contains(cv::Point2d(c.x(), c.y()))) {
+    return "under half the outline seen, its centre outside the image";
+  }
+  return "";
 }
 
 // The convex outline's second largest distance from the centre, in radii (one stray pixel does
@@ -853,12 +875,11 @@ BallRegion AnalyseBallRegion(const cv::Mat& bgr, const ColourTable& table, uint8
   const int bins = std::clamp(static_cast<int>(std::lround(M_PI * r)), 8, 36);
   const OutlineOnCircle on = MeasureOutlineOnCircle(pts, inl, c, r, thr, bins);
   int known = 0, hit = 0;
-  CountSeenBins(bgr, c, r, on.bin_hit, lim, o.hidden_value, &known, &hit);
+  CountSeenBins(bgr, c, r, on.bin_hit, lim, o.hidden_value, &known, &hit, &out.seen_rise);
   out.seen = double(known) / bins;
-  if (out.seen < o.min_seen) {
-    out.failure = "most of the outline is outside the image or hidden";
-    return out;
-  }
+  out.partly_seen = out.seen < o.well_seen;
+  out.failure = SeenProblem(out, c, lim, o);
+  if (!out.failure.empty()) return out;
   out.inliers = on.inliers;
   out.outside = double(on.outside) / pts.size();
   // Corners are measured against the circle of the same band both ways: the outer outline's

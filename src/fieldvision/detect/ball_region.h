@@ -37,7 +37,19 @@ struct BallRegionOptions {
   // it, and the disc's dark pixels, count neither for nor against the outline and the fill.
   // 0 turns this off.
   int hidden_value = 40;
-  double min_seen = 0.5;  // least share of the circle's angles seen (not outside, not hidden)
+  double min_seen = 0.4;  // least share of the circle's angles seen (not outside, not hidden)
+  // A region seen less than this is partly seen (`BallRegion::partly_seen`): a ball held in a
+  // robot's handler or behind its bumper, whose visible cap is under half its outline. What
+  // hides a ball stands on the ground in front of it, so the part seen must be the top
+  // (min_partly_seen_rise), and its centre must lie in the image (a circle extrapolated from a
+  // short arc beyond the image's edge is too loosely fixed to report). A lamp cut by the image's
+  // top edge is neither.
+  double well_seen = 0.5;
+  // ... and its seen part must be the circle's top: the mean of -sin over the seen angles (image
+  // rows down) at least this. A cap seen from straight above gives sin(pi s) / (pi s) (0.64 at
+  // half the circle, s the share seen), an occluder's edge tilted by 50 deg about 0.4; a lamp cut
+  // by the image's top edge shows its lower part (below 0). -1: any part.
+  double min_partly_seen_rise = 0.4;
   // Growth by the ball's own colour (seeded region growing): pixels within own_reach radii of
   // the region join, when connected to it, if their CIELAB colour is nearer the region's median
   // colour than the surroundings' and within own_share of the distance between the two (and at
@@ -55,14 +67,16 @@ struct BallRegion {
   std::string failure;  // why not ok
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();
   double radius_px = 0.0;
-  double sigma_px = 0.0;   // standard deviation of the centre (each axis), from the residuals
-  double rms_px = 0.0;     // RMS distance of the inlier outline points from the circle
-  double area_px = 0.0;    // the closed, filled region
-  double arc_cover = 0.0;  // share of the seen angle bins around the circle with an inlier point
-  double fill = 0.0;       // share of the seen disc (inside the image, not hidden) in the region
-  double seen = 0.0;       // share of the circle's angle bins not outside the image or hidden
-  double spill = 0.0;      // region area beyond 1.25 r + 1 px, as a share of the disc area
-  double leak = 0.0;       // ball-coloured share of the ring ring_inner..ring_outer radii
+  double sigma_px = 0.0;     // standard deviation of the centre (each axis), from the residuals
+  double rms_px = 0.0;       // RMS distance of the inlier outline points from the circle
+  double area_px = 0.0;      // the closed, filled region
+  double arc_cover = 0.0;    // share of the seen angle bins around the circle with an inlier point
+  double fill = 0.0;         // share of the seen disc (inside the image, not hidden) in the region
+  double seen = 0.0;         // share of the circle's angle bins not outside the image or hidden
+  bool partly_seen = false;  // seen < well_seen
+  double seen_rise = 0.0;    // how far up the seen part lies: mean -sin of its angles (1: top)
+  double spill = 0.0;        // region area beyond 1.25 r + 1 px, as a share of the disc area
+  double leak = 0.0;         // ball-coloured share of the ring ring_inner..ring_outer radii
   // Share of the convex outline points farther out than the circle (beyond the inlier band): a
   // corner or an apex (a cone, a robot's part) sticks out; an occluder's edge lies inside.
   double outside = 0.0;

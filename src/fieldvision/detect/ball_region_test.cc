@@ -15,6 +15,7 @@
 #include "fieldvision/detect/test_images.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
+#include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::detect {
@@ -154,6 +155,58 @@ TEST(BallRegion, ShadedBallHeldByADarkRobot) {
     EXPECT_GE(seen.arc_cover, 0.5);
     EXPECT_GE(seen.fill, 0.8);
     EXPECT_LT((seen.centre_px - c).norm(), 0.15 * r + 0.5);
+  }
+}
+
+// A ball in another robot's handler: the handler's dark bars hide all but a cap of it (under half
+// its outline). A cap seen from above is a ball hidden by what stands in front of it and is
+// taken, its circle from the cap's arc; the same shape seen from below (a lamp cut by the
+// image's top edge or a fisheye's dark border) is not, nor is the cap when half the outline is
+// required (well_seen as min_seen), nor a cap whose circle's centre lies beyond the image.
+TEST(BallRegion, CapAboveAHandlerIsABallACapBelowIsNot) {
+  fv::testing::SeededRng rng(11);
+  const ColourTable table(PresetColourSpec("orange"));
+  BallRegionOptions half;
+  half.min_seen = half.well_seen;
+  const BallDetector det(BallDetectorOptions{}, nullptr, nullptr);
+  for (int trial = 0; trial < 5; ++trial) {
+    cv::Mat img = test_util::FieldImage(320, 240, rng);
+    const double r = rng.Uniform(8, 24);
+    const Vector2d c(rng.Uniform(80, 240), rng.Uniform(70, 170));
+    test_util::PaintDisc(img, c, r);
+    const int bar_top = static_cast<int>(std::lround(c.y() - rng.Uniform(0.15, 0.25) * r));
+    cv::rectangle(img, cv::Point(static_cast<int>(c.x() - 2.5 * r), bar_top),
+                  cv::Point(static_cast<int>(c.x() + 2.5 * r), 239), cv::Scalar(20, 22, 24),
+                  cv::FILLED);
+    const cv::Rect cap(static_cast<int>(c.x() - r), static_cast<int>(c.y() - r),
+                       static_cast<int>(2 * r), bar_top - static_cast<int>(c.y() - r));
+    const BallRegion held = AnalyseBallRegion(img, table, table.BallBit(), cap, {});
+    SCOPED_TRACE("r " + std::to_string(r) + ": " + held.Summary());
+    ASSERT_TRUE(held.ok) << held.failure;
+    EXPECT_TRUE(held.partly_seen);
+    EXPECT_GT(held.seen_rise, 0.5);
+    EXPECT_LT((held.centre_px - c).norm(), 0.15 * r + 0.5);
+    EXPECT_NEAR(held.radius_px, r, 0.15 * r + 0.5);
+    EXPECT_FALSE(AnalyseBallRegion(img, table, table.BallBit(), cap, {}, half).ok);
+    const auto cands = det.Detect(img);
+    const BallCandidate* best = Best(cands);
+    ASSERT_NE(best, nullptr) << (cands.empty() ? "no candidate" : cands.front().reason);
+    EXPECT_LT((best->centre_px - c).norm(), 0.15 * r + 0.5) << Describe(*best);
+    // Upside down: the cap's lower part seen, the rest hidden above it.
+    cv::Mat flipped;
+    cv::flip(img, flipped, 0);
+    const cv::Rect cap_below(cap.x, img.rows - cap.y - cap.height, cap.width, cap.height);
+    const BallRegion below = AnalyseBallRegion(flipped, table, table.BallBit(), cap_below, {});
+    EXPECT_FALSE(below.ok);
+    EXPECT_LT(below.seen_rise, -0.5) << below.failure;
+    // A ball whose centre lies just below the image's bottom edge: its top seen, its centre not.
+    cv::Mat edge = test_util::FieldImage(320, 240, rng);
+    test_util::PaintDisc(edge, Vector2d(c.x(), 240 + 0.1 * r), r);
+    const cv::Rect cap_edge(static_cast<int>(c.x() - r), static_cast<int>(240 - 0.9 * r),
+                            static_cast<int>(2 * r), static_cast<int>(0.9 * r));
+    const BallRegion cut = AnalyseBallRegion(edge, table, table.BallBit(), cap_edge, {});
+    EXPECT_FALSE(cut.ok) << cut.Summary();
+    EXPECT_NE(cut.failure.find("centre outside the image"), std::string::npos) << cut.failure;
   }
 }
 
