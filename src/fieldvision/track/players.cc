@@ -384,6 +384,7 @@ void PlayersOptions::Check() const {
   detector.Check();
   tracker.Check();
   stitch.Check();
+  hidden_feet.Check();
   smooth.Check();
   CheckNonNegative(field_margin_m, "field_margin_m");
   CheckNonNegative(max_frames, "max_frames");
@@ -396,7 +397,7 @@ std::string PlayersResult::Summary() const {
   const double f = std::max(1, frames);
   return fmt::format(
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
-      "({} interpolated, {} off the ground); "
+      "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
       "{:.1f}, map {:.1f}); tracker: {}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
@@ -404,9 +405,9 @@ std::string PlayersResult::Summary() const {
                                        "--min-track-frames",
                                        dropped_tracks, min_track_frames)
                          : "",
-      rows.size(), interpolated, off_ground, times.total_s, frames / std::max(1e-9, times.total_s),
-      1000 * times.read_s / f, 1000 * times.detect_s / f, 1000 * times.track_s / f,
-      1000 * times.map_s / f, tracker.Summary(),
+      rows.size(), interpolated, off_ground, mended_feet, times.total_s,
+      frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f, 1000 * times.detect_s / f,
+      1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary(),
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
       frames_note.empty() ? "" : "; " + frames_note);
 }
@@ -594,6 +595,9 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
     // Rows with a detection are measurements; carried and interpolated ones (conf 0) are not.
     std::vector<bool> measured(result.rows.size());
     for (size_t i = 0; i < result.rows.size(); ++i) measured[i] = result.rows[i].conf > 0;
+    result.mended_feet =
+        MendHiddenFeet(result.rows, measured, *camera, options.tracker.foot_offset_m, result.fps,
+                       options.hidden_feet);
     result.smoothing =
         SmoothGroundTracks(result.rows, measured, *camera, result.fps, options.smooth);
   }

@@ -17,6 +17,7 @@
 #include "fieldvision/track/bytetrack.h"
 #include "fieldvision/track/detection.h"
 #include "fieldvision/track/ground_smoother.h"
+#include "fieldvision/track/hidden_feet.h"
 #include "fieldvision/track/mot.h"
 
 namespace fv::track {
@@ -68,10 +69,11 @@ struct PlayersOptions {
   // than twice this, the minimum is half the clip's frames (a 3-frame clip keeps 2-frame tracks).
   // The summary says how many were dropped.
   int min_track_frames = 5;
-  StitchOptions stitch;        // offline joining of tracklets (before gap interpolation)
-  GroundSmoothOptions smooth;  // offline smoothing of field positions (calibrated camera)
-  bool teams = false;          // assign teams (k-means, k = 2, on torso colour)
-  bool progress = true;        // fv::util::Progress on stderr
+  StitchOptions stitch;           // offline joining of tracklets (before gap interpolation)
+  HiddenFeetOptions hidden_feet;  // feet of partly hidden people (calibrated camera)
+  GroundSmoothOptions smooth;     // offline smoothing of field positions (calibrated camera)
+  bool teams = false;             // assign teams (k-means, k = 2, on torso colour)
+  bool progress = true;           // fv::util::Progress on stderr
   // Overrides the video's time: frame i (0-based) is at i / fps seconds. 0: the video's
   // timestamps, else its frame rate (TimesOfFrames).
   double fps = 0;
@@ -114,6 +116,7 @@ struct PlayersResult {
   int detections = 0;        // after filtering and NMS, all frames
   int tracks = 0;            // ids in the output
   int interpolated = 0;      // rows added by gap filling
+  int mended_feet = 0;       // rows of partly hidden people whose foot was moved (hidden_feet.h)
   int stitched = 0;          // tracklets joined to an earlier one
   std::string frames_note;   // what the frame source did to the frames (FramesNote), or ""
   int off_ground = 0;        // rows whose foot point does not meet the ground

@@ -1,0 +1,107 @@
+#include "fieldvision/track/hidden_feet.h"
+
+#include <functional>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "fieldvision/track/bytetrack.h"
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/seeded_rng.h"
+
+namespace fv::track {
+namespace {
+
+camera::Camera SideCamera() {
+  camera::Camera c = camera::Camera::FromFov(1280, 720, 70);
+  c.cam_from_world = geometry::Rigid3d::LookAt({0, -14, 6}, {0, 0, 0});
+  c.has_pose = true;
+  return c;
+}
+
+// The image box of a 1.8 m person standing at (x, y) with the lowest `hidden_m` of them hidden.
+cv::Rect2d BoxAt(const camera::Camera& cam, double x, double y, double hidden_m = 0.0) {
+  const auto foot = cam.Project({x, y, hidden_m});
+  const auto head = cam.Project({x, y, 1.8});
+  const double h = foot->y() - head->y();
+  return {foot->x() - 0.2 * h, head->y(), 0.4 * h, h};
+}
+
+// A walker whose legs go behind someone nearer the camera for a second, with boxes a few
+// percent off in height: the hidden rows' feet come back to the path (before: metres beyond it),
+// the others keep theirs; boxes wider than the person (two people in one box) are left alone.
+TEST(HiddenFeet, HiddenLegsAreGivenBackTheirFeet) {
+  testing::SeededRng rng(43);
+  const camera::Camera cam = SideCamera();
+  const double fps = 25;
+  const double foot_offset_m = 0.2;
+  std::vector<TrackRow> rows;
+  std::vector<double> true_x;
+  for (int f = 1; f <= 100; ++f) {
+    const double x = -3.0 + 1.5 * (f - 1) / fps;
+    const bool hidden = f >= 40 && f < 65;
+    cv::Rect2d box = BoxAt(cam, x, 0.0, hidden ? 0.8 : 0.0);
+    box.height *= 1.0 + rng.Uniform(-0.03, 0.03);
+    if (f == 70) box.width *= 2.0;  // two people in one box
+    if (f == 70) box.height *= 0.7;
+    TrackRow r;
+    r.frame = f;
+    r.id = 3;
+    r.box = box;
+    const auto g = FootOnGround(cam, box, foot_offset_m);
+    ASSERT_TRUE(g.has_value());
+    r.x_m = g->x();
+    r.y_m = g->y();
+    rows.push_back(r);
+    true_x.push_back(x);
+  }
+  const std::vector<TrackRow> before = rows;
+  const int moved = MendHiddenFeet(rows, {}, cam, foot_offset_m, fps);
+  EXPECT_EQ(moved, 25);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const bool hidden = rows[i].frame >= 40 && rows[i].frame < 65;
+    SCOPED_TRACE("frame " + std::to_string(rows[i].frame));
+    if (hidden) {
+      EXPECT_GT(*before[i].y_m, 2.0);  // a foot 0.8 m up, mapped to the ground beyond the walker
+      EXPECT_NEAR(*rows[i].y_m, foot_offset_m, 0.45);  // the box heights are 3 % off
+      EXPECT_NEAR(*rows[i].x_m, true_x[i], 0.1);
+    } else {
+      EXPECT_EQ(*rows[i].x_m, *before[i].x_m);
+      EXPECT_EQ(*rows[i].y_m, *before[i].y_m);
+    }
+  }
+  // Off: nothing moves; without a pose nothing can.
+  std::vector<TrackRow> again = before;
+  HiddenFeetOptions off;
+  off.enabled = false;
+  EXPECT_EQ(MendHiddenFeet(again, {}, cam, foot_offset_m, fps, off), 0);
+  camera::Camera unposed = cam;
+  unposed.has_pose = false;
+  EXPECT_EQ(MendHiddenFeet(again, {}, unposed, foot_offset_m, fps), 0);
+  // Rows that are not measurements neither count for the height nor move.
+  std::vector<bool> measured(again.size(), true);
+  for (size_t i = 0; i < again.size(); ++i) measured[i] = again[i].frame < 45;
+  EXPECT_EQ(MendHiddenFeet(again, measured, cam, foot_offset_m, fps), 5);
+}
+
+TEST(HiddenFeet, BadInputIsRefused) {
+  std::vector<TrackRow> rows(2);
+  const camera::Camera cam = SideCamera();
+  EXPECT_THROW(MendHiddenFeet(rows, {true}, cam, 0.2, 25), Error);
+  EXPECT_THROW(MendHiddenFeet(rows, {}, cam, 0.2, 0), Error);
+  const std::vector<std::function<void(HiddenFeetOptions&)>> bad = {
+      [](HiddenFeetOptions& o) { o.full_height_ratio = 1.5; },
+      [](HiddenFeetOptions& o) { o.window_s = 0.0; },
+      [](HiddenFeetOptions& o) { o.max_width_ratio = 0.5; }};
+  for (const auto& make_bad : bad) {
+    HiddenFeetOptions o;
+    make_bad(o);
+    EXPECT_THROW(o.Check(), Error);
+    std::vector<TrackRow> none;
+    EXPECT_THROW(MendHiddenFeet(none, {}, cam, 0.2, 25, o), Error);
+  }
+}
+
+}  // namespace
+}  // namespace fv::track
