@@ -9,6 +9,12 @@
 #include "fieldvision/util/stats.h"
 
 namespace fv::track {
+namespace {
+
+// A box whose top is this near the image's top edge may have lost the head above it.
+constexpr double kTopEdgePx = 2.0;
+
+}  // namespace
 
 void HiddenFeetOptions::Check() const {
   CheckInRange(full_height_ratio, 0.0, 1.0, "hidden feet full_height_ratio");
@@ -49,6 +55,7 @@ int MendHiddenFeet(std::vector<TrackRow>& rows, const std::vector<bool>& measure
       const double h = util::Median(heights), w = util::Median(widths);
       const cv::Rect2d& box = rows[i].box;
       if (box.height >= o.full_height_ratio * h || box.width > o.max_width_ratio * w) continue;
+      if (box.y <= kTopEdgePx) continue;  // the head above the image: its top is not the head
       mend.emplace_back(i, cv::Rect2d(box.x, box.y, box.width, h));
     }
   }

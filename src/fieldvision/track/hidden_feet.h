@@ -1,6 +1,7 @@
 // Foot points of partly hidden people: a box much shorter than the person's height around it (the
 // median box height of the track within window_s) shows the head and body while the legs are
-// behind someone nearer the camera or below the image's edge, so its bottom is not the foot. The
+// behind someone nearer the camera or below the image's edge, so its bottom is not the foot (a box
+// at the image's top edge is left: its top may not be the head). The
 // foot is taken at the person's height below the box's top (the head stays in view) and mapped to
 // the ground again. The same model as the stitcher's ends (players.h, StitchOptions), applied to
 // every row before the ground smoothing; the speeds and distances of `stats` come from them.
