@@ -716,7 +716,7 @@ std::string SeenProblem(const BallRegion& region, const Vector2d& c, const cv::R
                        region.seen_rise, o.min_partly_seen_rise);
   }
   if (!cv::Rect2d(lim).contains(cv::Point2d(c.x(), c.y()))) {
-    return "under half the outline seen, its centre outside the image";
+    return "under half the outline seen, its centre outside the image (or the area searched)";
   }
   return "";
 }
