@@ -157,8 +157,9 @@ void Setup(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_flag("!--no-smooth", c->o.smooth.enabled, "Do not smooth the field positions");
   cmd->add_flag("!--no-hidden-feet", c->o.hidden_feet.enabled,
-                "Keep the foot point of every box: do not take the feet of a person whose legs "
-                "are hidden (a box under 0.85 of their height) at their height below the head");
+                "Keep the foot point of every box: do not move the feet of a person whose legs "
+                "are hidden (a box whose top lies under 0.85 of their height above its foot) to "
+                "below the head at their height");
   cmd->add_flag("--teams", c->o.teams,
                 "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
   cmd->add_flag("!--no-progress", c->o.progress, "No progress line");

@@ -300,6 +300,12 @@ TEST(BallRegion, OptionsAreChecked) {
   o.min_seen = 0.0;
   EXPECT_THROW(o.Check(), Error);
   o = BallRegionOptions{};
+  o.min_seen = 0.6;  // above well_seen
+  EXPECT_THROW(o.Check(), Error);
+  o = BallRegionOptions{};
+  o.min_partly_seen_rise = 1.5;
+  EXPECT_THROW(o.Check(), Error);
+  o = BallRegionOptions{};
   o.inside_share = 0.0;
   EXPECT_THROW(o.Check(), Error);
   BallDetectorOptions d;
