@@ -70,8 +70,7 @@ void DnnBallOptions::Check() const {
              max_crops);
   CheckInRange(box_size_ratio, 1.0, 10.0, "dnn box_size_ratio");
   CheckInRange(hold_min_radius_px, 0.0, 1000.0, "dnn hold_min_radius_px");
-  FV_REQUIRE(rescan_step_px >= 0 && rescan_step_px <= 16,
-             "dnn rescan_step_px must be in 0..16 (got {})", rescan_step_px);
+  CheckInRange(rescan_step_px, 0, 16, "dnn rescan_step_px");
 }
 
 BallCandidate CandidateFromBox(const dnn::DnnBox& box, double accept_score) {

@@ -40,16 +40,22 @@ std::string TrackerStats::Summary() const {
                      frames, tracks_started, refound, first_stage_matches, second_stage_matches);
 }
 
-std::optional<Eigen::Vector2d> FootOnGround(const camera::Camera& camera, const cv::Rect2d& box,
-                                            double offset_m) {
-  const auto ray = camera.RayFromPixel({box.x + 0.5 * box.width, box.y + box.height});
+std::optional<Eigen::Vector2d> GroundBelowPixel(const camera::Camera& camera,
+                                                const Eigen::Vector2d& uv, double height_m,
+                                                double offset_m) {
+  const auto ray = camera.RayFromPixel(uv);
   if (!ray) return std::nullopt;
-  const auto p = geometry::IntersectHorizontalPlane(*ray, 0.0);
+  const auto p = geometry::IntersectHorizontalPlane(*ray, height_m);
   if (!p) return std::nullopt;
   Eigen::Vector2d g = p->head<2>();
   const Eigen::Vector2d away = g - camera.CentreInWorld().head<2>();
   if (offset_m != 0.0 && away.norm() > 1e-6) g += offset_m * away.normalized();
   return g;
+}
+
+std::optional<Eigen::Vector2d> FootOnGround(const camera::Camera& camera, const cv::Rect2d& box,
+                                            double offset_m) {
+  return GroundBelowPixel(camera, {box.x + 0.5 * box.width, box.y + box.height}, 0.0, offset_m);
 }
 
 cv::Mat TorsoHistogram(const cv::Mat& bgr, const cv::Rect2d& box) {

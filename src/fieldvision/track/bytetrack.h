@@ -100,6 +100,13 @@ class ByteTracker {
   TrackerStats stats_;
 };
 
+// Where the ray through pixel `uv` is at height `height_m` (the ground position below that
+// point), moved `offset_m` horizontally away from the camera; nullopt when the ray does not reach
+// that height in front of the camera.
+std::optional<Eigen::Vector2d> GroundBelowPixel(const camera::Camera& camera,
+                                                const Eigen::Vector2d& uv, double height_m,
+                                                double offset_m = 0.0);
+
 // Ground position of a person's box: the bottom centre on the plane z = 0, moved `offset_m`
 // horizontally away from the camera; nullopt when the ray misses the ground.
 std::optional<Eigen::Vector2d> FootOnGround(const camera::Camera& camera, const cv::Rect2d& box,

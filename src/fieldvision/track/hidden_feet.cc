@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <optional>
 
-#include "fieldvision/geometry/rigid.h"
 #include "fieldvision/track/bytetrack.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
@@ -22,31 +20,16 @@ void HiddenFeetOptions::Check() const {
 namespace {
 
 // The height above the ground (metres) at which the ray through the top centre of `box` passes
-// over its foot point (the bottom centre on the ground): the person's height when the box is
-// whole, less when the legs are hidden. Not finite when either ray misses.
+// over its foot point (FootOnGround without offset): the person's height when the box is whole,
+// less when the legs are hidden. Not finite when either ray misses.
 double HeightOverFoot(const camera::Camera& camera, const cv::Rect2d& box) {
-  const auto foot = camera.RayFromPixel({box.x + 0.5 * box.width, box.y + box.height});
+  const auto foot = FootOnGround(camera, box);
   const auto top = camera.RayFromPixel({box.x + 0.5 * box.width, box.y});
   if (!foot || !top) return std::nan("");
-  const auto g = geometry::IntersectHorizontalPlane(*foot, 0.0);
   const Eigen::Vector2d d = top->direction.head<2>();
-  if (!g || d.squaredNorm() < 1e-12) return std::nan("");
-  const double s = (g->head<2>() - top->origin.head<2>()).dot(d) / d.squaredNorm();
+  if (d.squaredNorm() < 1e-12) return std::nan("");
+  const double s = (*foot - top->origin.head<2>()).dot(d) / d.squaredNorm();
   return s > 0 ? top->At(s).z() : std::nan("");
-}
-
-// The foot below the top centre of `box` for a person `height_m` tall: where the top's ray is at
-// that height, moved `offset_m` away from the camera (as FootOnGround).
-std::optional<Eigen::Vector2d> FootBelowTop(const camera::Camera& camera, const cv::Rect2d& box,
-                                            double height_m, double offset_m) {
-  const auto top = camera.RayFromPixel({box.x + 0.5 * box.width, box.y});
-  if (!top) return std::nullopt;
-  const auto p = geometry::IntersectHorizontalPlane(*top, height_m);
-  if (!p) return std::nullopt;
-  Eigen::Vector2d g = p->head<2>();
-  const Eigen::Vector2d away = g - camera.CentreInWorld().head<2>();
-  if (offset_m != 0.0 && away.norm() > 1e-6) g += offset_m * away.normalized();
-  return g;
 }
 
 }  // namespace
@@ -61,20 +44,20 @@ int MendHiddenFeet(std::vector<TrackRow>& rows, const std::vector<bool>& measure
   if (!o.enabled || !camera.has_pose) return 0;
   // Per id: every row, and the measured ones (whose boxes give the person's height) by frame.
   std::map<int, std::vector<size_t>> all, by_id;
+  std::vector<double> implied_m(rows.size());  // HeightOverFoot of each row
   for (size_t i = 0; i < rows.size(); ++i) {
     all[rows[i].id].push_back(i);
     if (measured.empty() || measured[i]) by_id[rows[i].id].push_back(i);
+    implied_m[i] = HeightOverFoot(camera, rows[i].box);
   }
   const int half = std::max(1, static_cast<int>(std::lround(0.5 * o.window_s * fps)));
-  std::vector<std::pair<size_t, double>> mend;  // row, person's height: decided before moving
   std::vector<double> window, widths;
+  int moved = 0;
   for (auto& [id, idx] : by_id) {
     std::sort(idx.begin(), idx.end(),
               [&](size_t a, size_t b) { return rows[a].frame < rows[b].frame; });
     std::vector<int> frames;
     for (const size_t k : idx) frames.push_back(rows[k].frame);
-    std::vector<double> heights_m(idx.size());  // HeightOverFoot of the measured rows
-    for (size_t k = 0; k < idx.size(); ++k) heights_m[k] = HeightOverFoot(camera, rows[idx[k]].box);
     for (const size_t i : all[id]) {
       const int f = rows[i].frame;
       const auto lo = std::lower_bound(frames.begin(), frames.end(), f - half) - frames.begin();
@@ -82,26 +65,26 @@ int MendHiddenFeet(std::vector<TrackRow>& rows, const std::vector<bool>& measure
       window.clear();
       widths.clear();
       for (auto k = lo; k < hi; ++k) {
-        if (std::isfinite(heights_m[k])) window.push_back(heights_m[k]);
+        if (std::isfinite(implied_m[idx[k]])) window.push_back(implied_m[idx[k]]);
         widths.push_back(rows[idx[k]].box.width);
       }
       if (window.size() < 3) continue;
       // The person's height is the same near or far: a window that reaches to one side only (a
-      // track's end) serves as well as a centred one.
+      // track's end) serves as well as a centred one. Decisions read the boxes only, so a row
+      // moved here changes none of the others.
       const double h_m = util::Median(window), w = util::Median(widths);
       const cv::Rect2d& box = rows[i].box;
-      const double own = HeightOverFoot(camera, box);
-      if (!(own < o.full_height_ratio * h_m) || box.width > o.max_width_ratio * w) continue;
+      if (!(implied_m[i] < o.full_height_ratio * h_m) || box.width > o.max_width_ratio * w) {
+        continue;
+      }
       if (box.y <= o.top_edge_px) continue;  // the head may be above the image
-      mend.emplace_back(i, h_m);
-    }
-  }
-  int moved = 0;
-  for (const auto& [i, height_m] : mend) {
-    if (const auto g = FootBelowTop(camera, rows[i].box, height_m, foot_offset_m)) {
-      rows[i].x_m = g->x();
-      rows[i].y_m = g->y();
-      ++moved;
+      // The foot below the box's top for a person h_m tall.
+      if (const auto g =
+              GroundBelowPixel(camera, {box.x + 0.5 * box.width, box.y}, h_m, foot_offset_m)) {
+        rows[i].x_m = g->x();
+        rows[i].y_m = g->y();
+        ++moved;
+      }
     }
   }
   return moved;
