@@ -72,6 +72,8 @@ for det in "${DETECTORS[@]}"; do
     awk -F, -v n="$FRAMES" 'NR == 1 || $1 <= n' "$OUT/gt.csv" > "$OUT/gt_$FRAMES.csv"
     GT="$OUT/gt_$FRAMES.csv"
   fi
-  "$FV" eval tracks --gt "$GT" --est "$OUT/tracks_$det.csv" --json "$OUT/metrics_$det.json"
+  # --camera: the tracks' field positions against the annotated boxes' feet through the same camera.
+  "$FV" eval tracks --gt "$GT" --est "$OUT/tracks_$det.csv" --camera "$OUT/pets.yaml" \
+    --json "$OUT/metrics_$det.json"
   stability "$det" "$GT"
 done

@@ -253,6 +253,10 @@ for f in 1 2 3; do echo "$f,1,0,0,10,20,1,,," >> "$TMP/gt.csv"; done
 cp "$TMP/gt.csv" "$TMP/dup.csv" && echo "2,1,0,0,10,20,1,,," >> "$TMP/dup.csv"
 check "eval tracks: a duplicated row" nonzero $FV eval tracks --gt "$TMP/gt.csv" --est "$TMP/dup.csv"
 grep -q "two boxes in frame 2" "$TMP/err" || { echo "FAIL eval tracks: not the duplicate"; fail=1; }
+printf '%%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\ndistortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]\n' > "$TMP/intr.yaml"
+check "eval tracks: --camera without a pose" nonzero $FV eval tracks --gt "$TMP/gt.csv" \
+  --est "$TMP/gt.csv" --camera "$TMP/intr.yaml"
+grep -q "intr.yaml: the camera has no pose" "$TMP/err" || { echo "FAIL eval tracks: pose"; fail=1; }
 echo "4,2,0,0,10,20,1,nan,0," >> "$TMP/gt.csv"
 check "stats: NaN position" nonzero $FV stats --tracks "$TMP/gt.csv" --field fifa --out "$TMP/st"
 grep -q "gt.csv:5" "$TMP/err" || { echo "FAIL stats: NaN row not named"; fail=1; }

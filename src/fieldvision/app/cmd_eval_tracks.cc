@@ -2,11 +2,17 @@
 // `fieldvision eval import-pets`: PETS CVML annotations -> MOT CSV.
 #include <fstream>
 #include <iostream>
+#include <optional>
+
+#include <nlohmann/json.hpp>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/input_checks.h"
+#include "fieldvision/camera/camera_io.h"
+#include "fieldvision/track/bytetrack.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/pets.h"
+#include "fieldvision/track/position_eval.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
@@ -15,13 +21,46 @@ namespace fv::app {
 namespace {
 
 struct EvalTracksCli {
-  std::string gt, est, json;
+  std::string gt, est, json, camera;
+  double foot_offset_m = track::TrackerOptions{}.foot_offset_m;
   track::MotOptions o;
 };
+
+bool AnyPosition(const std::vector<track::TrackRow>& rows) {
+  for (const auto& r : rows) {
+    if (r.x_m && r.y_m) return true;
+  }
+  return false;
+}
 
 std::vector<track::TrackRow> ReadGt(const std::string& path) {
   if (util::EndsWith(util::ToLower(path), ".xml")) return track::ReadPetsCvml(path);
   return track::ReadTracksCsv(path);
+}
+
+// The posed camera of --camera, checked before any scoring; none without the option.
+std::optional<camera::Camera> ReadPositionCamera(const EvalTracksCli& c,
+                                                 const std::vector<track::TrackRow>& est) {
+  if (c.camera.empty()) return std::nullopt;
+  camera::Camera cam = camera::ReadCameraYaml(c.camera);
+  FV_REQUIRE(cam.has_pose, "{}: the camera has no pose (field positions need one)", c.camera);
+  FV_REQUIRE(AnyPosition(est),
+             "--camera given but the estimate '{}' has no field positions (x_m, y_m)", c.est);
+  return cam;
+}
+
+// Field-position errors when the estimate has positions and the ground truth has them or the
+// camera places its boxes' feet.
+std::optional<track::PositionErrors> ScorePositions(const EvalTracksCli& c,
+                                                    const std::optional<camera::Camera>& cam,
+                                                    std::vector<track::TrackRow> gt,
+                                                    const std::vector<track::TrackRow>& est) {
+  if (cam) track::PlaceFeet(*cam, c.foot_offset_m, &gt);
+  if (!AnyPosition(est) || !AnyPosition(gt)) return std::nullopt;
+  track::PositionEvalOptions po;
+  po.iou_threshold = c.o.iou_threshold;
+  po.frame_offset = c.o.frame_offset;
+  return track::EvaluatePositions(gt, est, po);
 }
 
 void RunEvalTracks(const EvalTracksCli& c) {
@@ -30,6 +69,7 @@ void RunEvalTracks(const EvalTracksCli& c) {
   // Nothing to score is an error, not a table of zeros.
   FV_REQUIRE(!gt.empty(), "ground truth '{}' has no boxes", c.gt);
   FV_REQUIRE(!est.empty(), "estimate '{}' has no boxes", c.est);
+  const std::optional<camera::Camera> cam = ReadPositionCamera(c, est);
   const track::MotMetrics m = [&] {
     try {
       return track::EvaluateMot(gt, est, c.o);
@@ -42,13 +82,17 @@ void RunEvalTracks(const EvalTracksCli& c) {
     }
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
+  const auto positions = ScorePositions(c, cam, gt, est);
+  if (positions) std::cout << positions->Summary() << "\n";
   if (!c.json.empty()) {
+    nlohmann::json j = nlohmann::json::parse(m.ToJson());
+    if (positions) j["positions"] = nlohmann::json::parse(positions->ToJson());
     util::AtomicWrite(
         c.json,
         [&](const std::string& tmp) {
           std::ofstream out(tmp);
           FV_REQUIRE(out.good(), "cannot write '{}'", c.json);
-          out << m.ToJson() << "\n";
+          out << j.dump(2) << "\n";
           out.close();
           FV_REQUIRE(!out.fail(), "cannot write '{}'", c.json);
         },
@@ -86,8 +130,17 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Score only the frames from the estimate's first to its last (an estimate of a "
                 "clip; default: ground truth outside them counts as misses, and a note says so)");
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
+  cmd->add_option("--camera", c->camera,
+                  "Posed camera of the video: the ground truth's boxes get field positions (their "
+                  "foot points, as `players` maps its boxes), and the estimate's x_m, y_m are "
+                  "scored against them (without it: when both files have positions)");
+  cmd->add_option("--foot-offset", c->foot_offset_m,
+                  "With --camera: the foot point moved this far from the camera (metres, as "
+                  "`players`)")
+      ->capture_default_str()
+      ->check(FiniteRange(0, 2));
   cmd->callback([c] {
-    util::CheckOutputPath(c->json, {c->gt, c->est}, "--json");
+    util::CheckOutputPath(c->json, util::PathList(c->gt, c->est, c->camera), "--json");
     if (!c->json.empty()) util::ResolveOutputPath(c->json, "--json");
     RunEvalTracks(*c);
   });

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/track/bytetrack.h"
+#include "fieldvision/track/track_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -13,23 +14,10 @@
 namespace fv::track {
 namespace {
 
+using test_util::PersonBox;
+using test_util::SideCamera;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
-
-camera::Camera SideCamera() {
-  camera::Camera c = camera::Camera::FromFov(1280, 720, 70);
-  c.cam_from_world = geometry::Rigid3d::LookAt({0, -14, 6}, {0, 0, 0});
-  c.has_pose = true;
-  return c;
-}
-
-// The image box of a 1.8 m person standing at (x, y), its bottom moved by noise_px.
-cv::Rect2d BoxAt(const camera::Camera& cam, double x, double y, double noise_px) {
-  const auto foot = cam.Project({x, y, 0});
-  const auto head = cam.Project({x, y, 1.8});
-  const double h = foot->y() - head->y();
-  return {foot->x() - 0.2 * h, head->y(), 0.4 * h, h + noise_px};
-}
 
 // A person walking a curve at 1.5-3 m/s, seen with foot points that jitter by 5 % of the box
 // height: the smoothed positions are much closer to the path, and gaps get positions.
@@ -43,11 +31,11 @@ TEST(GroundSmoother, NoisyFootPointsOfAWalkAreSmoothed) {
   for (int f = 0; f < 200; ++f) {
     const double t = f / fps;
     const Eigen::Vector2d p(-6 + 1.5 * t + 0.3 * t * t / 8, 3 * std::sin(0.4 * t));
-    const cv::Rect2d clean = BoxAt(cam, p.x(), p.y(), 0);
+    const cv::Rect2d clean = PersonBox(cam, p.x(), p.y());
     TrackRow r;
     r.frame = f;
     r.id = 7;
-    r.box = BoxAt(cam, p.x(), p.y(), rng.Normal(0, 0.05 * clean.height));
+    r.box = PersonBox(cam, p.x(), p.y(), 0.0, rng.Normal(0, 0.05 * clean.height));
     r.conf = 0.9;
     const bool gap = f >= 100 && f < 110;  // interpolated rows: no measurement
     if (const auto g = FootOnGround(cam, gap ? clean : r.box, 0.0)) {

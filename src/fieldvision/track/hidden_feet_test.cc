@@ -7,26 +7,15 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/track/bytetrack.h"
+#include "fieldvision/track/track_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
 
 namespace fv::track {
 namespace {
 
-camera::Camera SideCamera() {
-  camera::Camera c = camera::Camera::FromFov(1280, 720, 70);
-  c.cam_from_world = geometry::Rigid3d::LookAt({0, -14, 6}, {0, 0, 0});
-  c.has_pose = true;
-  return c;
-}
-
-// The image box of a 1.8 m person standing at (x, y) with the lowest `hidden_m` of them hidden.
-cv::Rect2d BoxAt(const camera::Camera& cam, double x, double y, double hidden_m = 0.0) {
-  const auto foot = cam.Project({x, y, hidden_m});
-  const auto head = cam.Project({x, y, 1.8});
-  const double h = foot->y() - head->y();
-  return {foot->x() - 0.2 * h, head->y(), 0.4 * h, h};
-}
+using test_util::PersonBox;
+using test_util::SideCamera;
 
 // A walker whose legs go behind someone nearer the camera for a second, with boxes a few
 // percent off in height: the hidden rows' feet come back to the path (before: metres beyond it),
@@ -42,7 +31,7 @@ TEST(HiddenFeet, HiddenLegsAreGivenBackTheirFeet) {
   for (int f = 1; f <= 100; ++f) {
     const double x = -3.0 + 1.5 * (f - 1) / fps;
     const bool hidden = f >= 40 && f < 65;
-    cv::Rect2d box = BoxAt(cam, x, 0.0, hidden ? 0.8 : 0.0);
+    cv::Rect2d box = PersonBox(cam, x, 0.0, hidden ? 0.8 : 0.0);
     box.height *= 1.0 + rng.Uniform(-0.03, 0.03);
     if (f == 70) box.width *= 2.0;  // two people in one box
     if (f == 70) box.height *= 0.7;
@@ -105,7 +94,7 @@ TEST(HiddenFeet, ASprinterTowardsTheCameraIsNotHidden) {
     TrackRow r;
     r.frame = f;
     r.id = 1;
-    r.box = BoxAt(cam, 1.0, 10.0 - 8.0 * (f - 1) / fps);
+    r.box = PersonBox(cam, 1.0, 10.0 - 8.0 * (f - 1) / fps);
     const auto g = FootOnGround(cam, r.box, 0.2);
     ASSERT_TRUE(g.has_value());
     r.x_m = g->x();

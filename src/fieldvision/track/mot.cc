@@ -212,9 +212,6 @@ std::string MotMetrics::ToJson() const {
   return j.dump(2);
 }
 
-namespace {
-
-// One-to-one matching of boxes at IoU >= thr maximising the IoU sum (Hungarian): pairs (i, j).
 std::vector<std::pair<int, int>> MatchBoxes(const std::vector<const TrackRow*>& a,
                                             const std::vector<const TrackRow*>& b, double thr) {
   std::vector<std::pair<int, int>> out;
@@ -232,6 +229,8 @@ std::vector<std::pair<int, int>> MatchBoxes(const std::vector<const TrackRow*>& 
   }
   return out;
 }
+
+namespace {
 
 std::map<int, std::vector<const TrackRow*>> ByFrame(const std::vector<TrackRow>& rows,
                                                     int offset = 0) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "fieldvision/track/mot.h"
@@ -12,6 +13,10 @@ namespace fv::track {
 struct MotFrame {
   std::vector<const TrackRow*> gt, est;
 };
+
+// One-to-one matching of boxes at IoU >= thr maximising the IoU sum (Hungarian): pairs (i, j).
+std::vector<std::pair<int, int>> MatchBoxes(const std::vector<const TrackRow*>& a,
+                                            const std::vector<const TrackRow*>& b, double thr);
 
 // The rows by frame and every id as a dense index (in order of first appearance).
 struct MotIndex {
