@@ -264,6 +264,9 @@ check "trajectory: --line without --field" nonzero $FV trajectory --in "$TMP/tru
   --out "$TMP/f.json" --line touch_top
 check "players: --margin without --field" nonzero $FV players --video "$TMP/v.avi" \
   --out "$TMP/tracks.csv" --margin 2
+check "players: --moving-camera with the motion detector" nonzero $FV players \
+  --video "$TMP/v.avi" --out "$TMP/tracks.csv" --moving-camera --detector motion
+grep -q "needs a still camera" "$TMP/err" || { echo "FAIL players: moving motion"; fail=1; }
 check "detect: --field without a camera" nonzero $FV detect --video "$TMP/v.avi" --field fifa \
   --out "$TMP/det.csv"
 grep -q "needs --camera" "$TMP/err" || { echo "FAIL detect: not the --field error"; fail=1; }

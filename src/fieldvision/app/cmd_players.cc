@@ -63,7 +63,9 @@ void RunPlayersCommand(const PlayersCli& c) {
   }
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
-    const track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
+    // A moving camera's field lines move with each frame: not drawn.
+    const bool lines = camera && !c.o.moving_camera;
+    const track::TrackOverlay overlay(r.rows, r.team_of, {}, lines ? &*camera : nullptr,
                                       field ? &*field : nullptr, c.overlay);
     const track::DrawVideoResult d =
         track::DrawTracksVideo(c.video, c.draw, overlay, c.o.fps, c.o.max_frames);
@@ -80,6 +82,35 @@ void AddDrawOptions(CLI::App* cmd, PlayersCli& c) {
   cmd->add_flag("!--no-legend", c.overlay.legend,
                 "With --draw: leave out the legend in the bottom-left corner (teams, boxes, "
                 "trails, lines)");
+}
+
+// The offline passes after the tracker (gaps, tracklets, smoothing, hidden feet) and a moving
+// camera.
+void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
+  cmd->add_option("--interpolate", c.o.interpolate_max_gap,
+                  "Fill track gaps up to this many frames (0: off)")
+      ->check(FiniteRange(0, 100000));
+  cmd->add_option("--stitch-gap", c.o.stitch.max_gap_s,
+                  "Join tracklets of one person across gaps up to this many seconds (0: off)")
+      ->check(FiniteRange(0, 3600));
+  cmd->add_option("--stitch-appearance", c.o.stitch.max_appearance_distance,
+                  "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets")
+      ->check(FiniteRange(0, 1));
+  cmd->add_option("--smooth-accel", c.o.smooth.accel_sigma_mps2,
+                  "Field-position smoothing (Kalman + RTS): players' acceleration sigma in m/s^2 "
+                  "(smaller: smoother)")
+      ->check(FiniteRange(0.01, 1000))
+      ->capture_default_str();
+  cmd->add_flag("!--no-smooth", c.o.smooth.enabled, "Do not smooth the field positions");
+  cmd->add_flag("!--no-hidden-feet", c.o.hidden_feet.enabled,
+                "Keep the foot point of every box: do not move the feet of a person whose legs "
+                "are hidden (a box whose top lies under 0.85 of their height above its foot) to "
+                "below the head at their height");
+  cmd->add_flag("--moving-camera", c.o.moving_camera,
+                "The camera sways, turns or drifts (a phone held by hand, a hovering drone): each "
+                "frame is registered to the first (ORB features off the people, a homography), "
+                "where the camera file's pose holds, and field positions are taken there; people "
+                "outside the first frame's view are not tracked; --draw draws no field lines");
 }
 
 void Setup(CLI::App& app, int& exit_code) {
@@ -141,25 +172,7 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--mot-out", c->mot_out,
                   "Also write the tracks as a MOTChallenge results file (no header, "
                   "frame,id,left,top,w,h,conf,-1,-1,-1) for TrackEval / py-motmetrics");
-  cmd->add_option("--interpolate", c->o.interpolate_max_gap,
-                  "Fill track gaps up to this many frames (0: off)")
-      ->check(FiniteRange(0, 100000));
-  cmd->add_option("--stitch-gap", c->o.stitch.max_gap_s,
-                  "Join tracklets of one person across gaps up to this many seconds (0: off)")
-      ->check(FiniteRange(0, 3600));
-  cmd->add_option("--stitch-appearance", c->o.stitch.max_appearance_distance,
-                  "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets")
-      ->check(FiniteRange(0, 1));
-  cmd->add_option("--smooth-accel", c->o.smooth.accel_sigma_mps2,
-                  "Field-position smoothing (Kalman + RTS): players' acceleration sigma in m/s^2 "
-                  "(smaller: smoother)")
-      ->check(FiniteRange(0.01, 1000))
-      ->capture_default_str();
-  cmd->add_flag("!--no-smooth", c->o.smooth.enabled, "Do not smooth the field positions");
-  cmd->add_flag("!--no-hidden-feet", c->o.hidden_feet.enabled,
-                "Keep the foot point of every box: do not move the feet of a person whose legs "
-                "are hidden (a box whose top lies under 0.85 of their height above its foot) to "
-                "below the head at their height");
+  AddTrackingPassOptions(cmd, *c);
   cmd->add_flag("--teams", c->o.teams,
                 "Split tracks into two teams by shirt colour (writes TRACKS.csv.teams.csv)");
   cmd->add_flag("!--no-progress", c->o.progress, "No progress line");

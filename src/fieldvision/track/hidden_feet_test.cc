@@ -76,8 +76,9 @@ TEST(HiddenFeet, HiddenLegsAreGivenBackTheirFeet) {
   // Rows that are not measurements (filled across a gap) do not count for the height but are
   // moved too; so are the hidden rows at a track's end (the earlier heights' line reaches them).
   std::vector<bool> measured(again.size(), true);
-  for (size_t i = 0; i < again.size(); ++i)
+  for (size_t i = 0; i < again.size(); ++i) {
     measured[i] = again[i].frame < 50 || again[i].frame > 53;
+  }
   EXPECT_EQ(MendHiddenFeet(again, measured, cam, foot_offset_m, fps), 25);
   std::vector<TrackRow> end(before.begin(), before.begin() + 44);  // the track ends hidden
   EXPECT_EQ(MendHiddenFeet(end, {}, cam, foot_offset_m, fps), 5);

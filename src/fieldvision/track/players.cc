@@ -391,6 +391,11 @@ void PlayersOptions::Check() const {
   CheckNonNegative(interpolate_max_gap, "interpolate_max_gap");
   CheckNonNegative(min_track_frames, "min_track_frames");
   CheckNonNegative(fps, "fps");
+  if (moving_camera) {
+    camera_motion.Check();
+    FV_REQUIRE(detector.kind != "motion",
+               "the motion detector needs a still camera, not a moving one (--moving-camera)");
+  }
 }
 
 std::string PlayersResult::Summary() const {
@@ -399,7 +404,7 @@ std::string PlayersResult::Summary() const {
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
-      "{:.1f}, map {:.1f}); tracker: {}{}{}",
+      "{:.1f}, map {:.1f}); tracker: {}{}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -409,6 +414,7 @@ std::string PlayersResult::Summary() const {
       frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f, 1000 * times.detect_s / f,
       1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary(),
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
+      camera_motion ? "; " + camera_motion->Summary() : "",
       frames_note.empty() ? "" : "; " + frames_note);
 }
 
@@ -548,7 +554,31 @@ struct PlayersPass {
   std::map<int, TrackAppearance> appearance;
   std::vector<double> times_ms;
   DetectionsFile saved;
+  std::vector<cv::Matx33d> first_from_frame;  // with a moving camera, per frame (0-based)
 };
+
+// A moving camera's frame: registered to the first one, its detections moved into the first
+// frame's pixels (those whose foot point then fails `filter` dropped) and the frame warped there,
+// where the tracker's appearance model reads it at the moved boxes.
+cv::Mat ToFirstView(CameraMotion& motion, const FootFilter& filter, const cv::Mat& frame,
+                    std::vector<Detection>& dets, PlayersPass& pass) {
+  std::vector<cv::Rect2d> boxes;
+  boxes.reserve(dets.size());
+  for (const Detection& d : dets) boxes.push_back(d.box);
+  const cv::Matx33d h = motion.Register(frame, boxes);
+  pass.first_from_frame.push_back(h);
+  std::vector<Detection> kept;
+  for (Detection d : dets) {
+    d.box = MapBox(h, d.box);
+    if (!filter || filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height})) {
+      kept.push_back(d);
+    }
+  }
+  dets = std::move(kept);
+  cv::Mat view;
+  cv::warpPerspective(frame, view, h, frame.size());
+  return view;
+}
 
 // One frame's tracks as rows (1-based frame `frame_number`), with their torso colours for teams.
 void RecordTracks(const std::vector<TrackState>& states, const cv::Mat& frame, int frame_number,
@@ -644,11 +674,14 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   const FileDetector* from_file = nullptr;
   if (!options.detections_in.empty()) {
     options.detector.Check();
-    auto file = std::make_unique<FileDetector>(options.detections_in, options.detector, filter);
+    // A moving camera's feet are judged in the first frame's pixels (ToFirstView).
+    auto file = std::make_unique<FileDetector>(options.detections_in, options.detector,
+                                               options.moving_camera ? FootFilter() : filter);
     from_file = file.get();
     detector = std::move(file);
   } else {
-    detector = MakeDetector(options.detector, calibrated ? camera : nullptr, filter);
+    detector = MakeDetector(options.detector, calibrated ? camera : nullptr,
+                            options.moving_camera ? FootFilter() : filter);
   }
   PlayersResult result;
   result.detector = detector->name();
@@ -664,23 +697,26 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   }
   util::Progress progress("players", total, "frames", options.progress);
   PlayersPass pass;
+  std::optional<CameraMotion> motion;
+  if (options.moving_camera) motion.emplace(options.camera_motion);
   cv::Mat frame;
   int index = 0;
   double time_ms = 0;
   while (reader.Next(frame, time_ms)) {
     pass.times_ms.push_back(time_ms);
     const auto t0 = Clock::now();
-    const std::vector<Detection> dets = detector->Detect(frame);
+    std::vector<Detection> dets = detector->Detect(frame);
+    if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);  // the frame's pixels
+    const cv::Mat view = motion ? ToFirstView(*motion, filter, frame, dets, pass) : frame;
     const auto t1 = Clock::now();
-    const std::vector<TrackState> states = tracker.Update(dets, frame);
+    const std::vector<TrackState> states = tracker.Update(dets, view);
     const auto t2 = Clock::now();
     result.detections += static_cast<int>(dets.size());
     // Appearance of each track for stitching: confident boxes that no other box overlaps.
     if (options.stitch.max_gap_s > 0) {
-      AddTrackAppearance(states, frame, options.tracker.high_score, pass.appearance);
+      AddTrackAppearance(states, view, options.tracker.high_score, pass.appearance);
     }
-    if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);
-    RecordTracks(states, frame, index + 1, calibrated, options, result, pass);
+    RecordTracks(states, view, index + 1, calibrated, options, result, pass);
     result.times.detect_s += std::chrono::duration<double>(t1 - t0).count();
     result.times.track_s += std::chrono::duration<double>(t2 - t1).count();
     ++index;
@@ -697,6 +733,10 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   const auto t_map = Clock::now();
   FinishTracks(options, camera, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
                result);
+  if (motion) {  // the boxes back in each frame's own pixels
+    for (TrackRow& r : result.rows) r.box = MapBox(pass.first_from_frame[r.frame - 1].inv(), r.box);
+    result.camera_motion = motion->stats();
+  }
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();
   result.frames_note = reader.frames_note();

@@ -15,6 +15,7 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/track/bytetrack.h"
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/detection.h"
 #include "fieldvision/track/ground_smoother.h"
 #include "fieldvision/track/hidden_feet.h"
@@ -84,6 +85,12 @@ struct PlayersOptions {
   // Write the detections of every frame (after filtering) to this file; reading it back with
   // detections_in gives the same tracks.
   std::string detections_out;
+  // A camera that sways, turns or drifts (camera_motion.h): every frame is registered to the
+  // first, the view the camera file's pose holds for, and tracked in that frame's pixels; the
+  // rows' boxes are given back in each frame's own pixels. Not with the "motion" detector
+  // (background subtraction needs a still camera).
+  bool moving_camera = false;
+  CameraMotionOptions camera_motion;
 
   void Check() const;
 };
@@ -121,6 +128,7 @@ struct PlayersResult {
   std::string frames_note;   // what the frame source did to the frames (FramesNote), or ""
   int off_ground = 0;        // rows whose foot point does not meet the ground
   GroundSmoothResult smoothing;
+  std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
   TrackerStats tracker;
   StageTimes times;
   std::string detector;
