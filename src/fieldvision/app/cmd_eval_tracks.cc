@@ -132,13 +132,15 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option("--json", c->json, "Also write the metrics as JSON");
   cmd->add_option("--camera", c->camera,
                   "Posed camera of the video: the ground truth's boxes get field positions (their "
-                  "foot points, as `players` maps its boxes), and the estimate's x_m, y_m are "
-                  "scored against them (without it: when both files have positions)");
+                  "foot points, as `players` maps its boxes; rows with positions keep them), and "
+                  "the estimate's x_m, y_m are scored against them (without it: when both files "
+                  "have positions)");
   cmd->add_option("--foot-offset", c->foot_offset_m,
                   "With --camera: the foot point moved this far from the camera (metres, as "
                   "`players`)")
       ->capture_default_str()
-      ->check(FiniteRange(0, 2));
+      ->check(FiniteRange(0, 2))
+      ->needs("--camera");
   cmd->callback([c] {
     util::CheckOutputPath(c->json, util::PathList(c->gt, c->est, c->camera), "--json");
     if (!c->json.empty()) util::ResolveOutputPath(c->json, "--json");

@@ -30,9 +30,10 @@ void CameraMotionOptions::Check() const {
 
 std::string CameraMotionStats::Summary() const {
   return fmt::format(
-      "camera motion: {} frames registered to the first ({} directly, {} through the previous "
-      "frame, {} not matched: the last view kept); the image centre moved up to {:.0f} px",
-      frames, direct, chained, lost, max_shift_px);
+      "camera motion: of {} frames after the first, {} matched to it directly, {} through the "
+      "last frame matched, {} not at all (the last view kept); the image centre moved up to "
+      "{:.0f} px",
+      std::max(0, frames - 1), direct, chained, lost, max_shift_px);
 }
 
 namespace {
@@ -40,6 +41,21 @@ namespace {
 cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
   const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
   return {q[0] / q[2], q[1] / q[2]};
+}
+
+// A homography a camera's turn or drift can give: finite, the frame's corners stay in front
+// (no horizon inside the frame) and its area changes by less than 4x.
+bool Plausible(const cv::Matx33d& h, const cv::Size& size) {
+  const std::vector<cv::Point2d> corners = {
+      {0, 0}, {size.width - 1.0, 0}, {size.width - 1.0, size.height - 1.0}, {0, size.height - 1.0}};
+  std::vector<cv::Point2f> mapped;
+  for (const cv::Point2d& p : corners) {
+    const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
+    if (!(q[2] > 1e-9) || !std::isfinite(q[0]) || !std::isfinite(q[1])) return false;
+    mapped.emplace_back(static_cast<float>(q[0] / q[2]), static_cast<float>(q[1] / q[2]));
+  }
+  const double ratio = std::abs(cv::contourArea(mapped)) / (static_cast<double>(size.area()));
+  return ratio > 0.25 && ratio < 4.0;
 }
 
 }  // namespace
@@ -76,7 +92,7 @@ CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
   Features f;
   orb_->detectAndCompute(gray, mask, f.keypoints, f.descriptors);
   // ORB's corners from its coarser pyramid levels are pixels off: each is moved to the corner's
-  // sub-pixel place in the full-resolution image.
+  // sub-pixel place in the image registered (at work_width_px).
   if (!f.keypoints.empty()) {
     std::vector<cv::Point2f> corners;
     cv::KeyPoint::convert(f.keypoints, corners);
@@ -114,7 +130,7 @@ bool CameraMotion::Match(const Features& a, const Features& b, cv::Matx33d* a_fr
   cv::convexHull(kept, hull);
   if (cv::contourArea(hull) < options_.min_inlier_cover * size_.area()) return false;
   *a_from_b = cv::Matx33d(h);
-  return std::isfinite((*a_from_b)(2, 2)) && std::abs(cv::determinant(*a_from_b)) > 1e-9;
+  return Plausible(*a_from_b, size_);
 }
 
 cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people) {
@@ -126,7 +142,6 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     first_ = f;
     previous_ = std::move(f);
     first_from_previous_ = cv::Matx33d::eye();
-    ++stats_.direct;
     return first_from_previous_;
   }
   FV_REQUIRE(bgr.size() == size_, "camera motion: frame {} is {}x{}, the first was {}x{}",
@@ -139,8 +154,10 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     h = first_from_previous_ * previous_from_this;
     ++stats_.chained;
   } else {
-    h = first_from_previous_;
+    // Neither: the last view is kept, and the last registered frame stays the one to chain from
+    // (a blank or blurred frame must not become the base of the next).
     ++stats_.lost;
+    return first_from_previous_;
   }
   h *= 1.0 / h(2, 2);
   const cv::Point2d centre(0.5 * (size_.width - 1), 0.5 * (size_.height - 1));

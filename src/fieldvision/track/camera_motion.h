@@ -30,10 +30,10 @@ struct CameraMotionOptions {
 };
 
 struct CameraMotionStats {
-  int frames = 0;
-  int direct = 0;             // matched to the first frame
-  int chained = 0;            // through the previous frame
-  int lost = 0;               // neither: the previous frame's homography kept
+  int frames = 0;             // frames registered, the first included
+  int direct = 0;             // matched to the first frame (the first itself not counted)
+  int chained = 0;            // through the last registered frame
+  int lost = 0;               // neither: the last registered frame's homography kept
   double max_shift_px = 0.0;  // largest move of the image centre from the first frame's view
   std::string Summary() const;
 };

@@ -403,8 +403,8 @@ std::string PlayersResult::Summary() const {
   return fmt::format(
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
-      "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}, track "
-      "{:.1f}, map {:.1f}); tracker: {}{}{}{}",
+      "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}{}, "
+      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -412,6 +412,7 @@ std::string PlayersResult::Summary() const {
                          : "",
       rows.size(), interpolated, off_ground, mended_feet, times.total_s,
       frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f, 1000 * times.detect_s / f,
+      camera_motion ? fmt::format(", register {:.1f}", 1000 * times.register_s / f) : "",
       1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary(),
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
       camera_motion ? "; " + camera_motion->Summary() : "",
@@ -558,7 +559,8 @@ struct PlayersPass {
 };
 
 // A moving camera's frame: registered to the first one, its detections moved into the first
-// frame's pixels (those whose foot point then fails `filter` dropped) and the frame warped there,
+// frame's pixels (those whose foot point then lies outside the first frame's view or fails
+// `filter` dropped) and the frame warped there,
 // where the tracker's appearance model reads it at the moved boxes.
 cv::Mat ToFirstView(CameraMotion& motion, const FootFilter& filter, const cv::Mat& frame,
                     std::vector<Detection>& dets, PlayersPass& pass) {
@@ -570,9 +572,11 @@ cv::Mat ToFirstView(CameraMotion& motion, const FootFilter& filter, const cv::Ma
   std::vector<Detection> kept;
   for (Detection d : dets) {
     d.box = MapBox(h, d.box);
-    if (!filter || filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height})) {
-      kept.push_back(d);
-    }
+    const cv::Point2d foot(d.box.x + 0.5 * d.box.width, d.box.y + d.box.height);
+    // Outside the first frame's view the warped frame is black: no appearance to track by.
+    const bool in_view = std::isfinite(d.box.area()) && foot.x >= 0 && foot.y >= 0 &&
+                         foot.x < frame.cols && foot.y < frame.rows;
+    if (in_view && (!filter || filter(foot))) kept.push_back(d);
   }
   dets = std::move(kept);
   cv::Mat view;
@@ -707,8 +711,10 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     const auto t0 = Clock::now();
     std::vector<Detection> dets = detector->Detect(frame);
     if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);  // the frame's pixels
+    const auto t_register = Clock::now();
     const cv::Mat view = motion ? ToFirstView(*motion, filter, frame, dets, pass) : frame;
     const auto t1 = Clock::now();
+    result.times.register_s += Seconds(t_register, t1);
     const std::vector<TrackState> states = tracker.Update(dets, view);
     const auto t2 = Clock::now();
     result.detections += static_cast<int>(dets.size());
@@ -717,7 +723,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
       AddTrackAppearance(states, view, options.tracker.high_score, pass.appearance);
     }
     RecordTracks(states, view, index + 1, calibrated, options, result, pass);
-    result.times.detect_s += std::chrono::duration<double>(t1 - t0).count();
+    result.times.detect_s += Seconds(t0, t_register);
     result.times.track_s += std::chrono::duration<double>(t2 - t1).count();
     ++index;
     progress.Update(index);

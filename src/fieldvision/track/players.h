@@ -82,8 +82,9 @@ struct PlayersOptions {
   // running the detector; the video is still read (the tracker's appearance model uses the
   // frames). The same filtering (min height, field area, NMS, score threshold) is applied.
   std::string detections_in;
-  // Write the detections of every frame (after filtering) to this file; reading it back with
-  // detections_in gives the same tracks.
+  // Write the detections of every frame (after filtering; with a moving camera before the field
+  // filter, which is applied in the first frame's pixels) to this file; reading it back with
+  // detections_in and the same options gives the same tracks.
   std::string detections_out;
   // A camera that sways, turns or drifts (camera_motion.h): every frame is registered to the
   // first, the view the camera file's pose holds for, and tracked in that frame's pixels; the
@@ -110,6 +111,7 @@ FrameTimes TimesOfFrames(const std::vector<double>& container_ms, double contain
 
 struct StageTimes {
   double read_s = 0, detect_s = 0, track_s = 0, map_s = 0, total_s = 0;
+  double register_s = 0;  // a moving camera's frames registered to the first
 };
 
 struct PlayersResult {

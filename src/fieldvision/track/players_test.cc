@@ -412,7 +412,7 @@ TEST(Players, SynthScenePositionsAndStableIds) {
 #ifdef FV_HAVE_SYNTH
 // A camera swaying by up to 4 degrees (yaw), 3 (pitch) and 1 (roll) around the calibrated view:
 // the players scene's frames warped by K R K^-1, with the people's true boxes moved alike as the
-// detections. With --moving-camera the median field error is within 5 cm of the same detections'
+// detections. With --moving-camera the median field error is within 3 cm of the same detections'
 // in the calibrated view (the boxes come back in each frame's own pixels); without it the median
 // is over 0.2 m worse. Seeds 1-10 pass (within 0.007 m of the calibrated view's).
 TEST(Players, SwayingCameraKeepsTheFieldPositions) {

@@ -22,7 +22,8 @@ void PositionEvalOptions::Check() const {
 
 namespace {
 
-bool Scored(const TrackRow& gt) { return gt.conf > 0 && (gt.mot_class < 0 || gt.mot_class == 1); }
+// As EvaluateMot: MOT17 rules (conf 0 or not a pedestrian left out) where the file has classes.
+bool Scored(const TrackRow& gt) { return gt.mot_class < 0 || (gt.conf > 0 && gt.mot_class == 1); }
 
 bool HasPosition(const TrackRow& r) {
   return r.x_m && r.y_m && std::isfinite(*r.x_m) && std::isfinite(*r.y_m);
@@ -36,6 +37,7 @@ std::string Stats(const std::vector<double>& v) {
 }
 
 nlohmann::json StatsJson(const std::vector<double>& v) {
+  if (v.empty()) return {{"rows", 0}};  // no numbers rather than zeros that read as perfect
   return {{"rows", v.size()},
           {"median_m", util::Median(v)},
           {"mean_m", util::Mean(v)},

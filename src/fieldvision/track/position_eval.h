@@ -25,7 +25,7 @@ struct PositionEvalOptions {
 };
 
 struct PositionErrors {
-  int gt_boxes = 0;          // ground-truth rows scored (conf > 0, a pedestrian or no class)
+  int gt_boxes = 0;          // ground truth scored: no class, or conf > 0 and a pedestrian
   int matched = 0;           // estimated rows matched to one of them
   int without_position = 0;  // matched, but either side has no field position
   // Horizontal distance between the matched positions (metres), all rows and the short ones.
