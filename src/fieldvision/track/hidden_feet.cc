@@ -36,7 +36,7 @@ double HeightOverFoot(const camera::Camera& camera, const cv::Rect2d& box) {
 
 int MendHiddenFeet(std::vector<TrackRow>& rows, const std::vector<bool>& measured,
                    const camera::Camera& camera, double foot_offset_m, double fps,
-                   const HiddenFeetOptions& o) {
+                   const HiddenFeetOptions& o, const FrameBoxOf& frame_box) {
   o.Check();
   FV_REQUIRE(measured.empty() || measured.size() == rows.size(),
              "MendHiddenFeet: {} measured flags for {} rows", measured.size(), rows.size());
@@ -77,7 +77,8 @@ int MendHiddenFeet(std::vector<TrackRow>& rows, const std::vector<bool>& measure
       if (!(implied_m[i] < o.full_height_ratio * h_m) || box.width > o.max_width_ratio * w) {
         continue;
       }
-      if (box.y <= o.top_edge_px) continue;  // the head may be above the image
+      // The head may be above the image.
+      if ((frame_box ? frame_box(rows[i]).y : box.y) <= o.top_edge_px) continue;
       // The foot below the box's top for a person h_m tall.
       if (const auto g =
               GroundBelowPixel(camera, {box.x + 0.5 * box.width, box.y}, h_m, foot_offset_m)) {

@@ -29,9 +29,10 @@ struct HiddenFeetOptions {
 
 // Moves x_m, y_m of the partly hidden rows to the foot below the box's top at the person's height,
 // through `camera` (posed) with its foot offset (as FootOnGround); the person's height comes from
-// the rows flagged in `measured` (empty: every row). Returns how many rows were moved.
+// the rows flagged in `measured` (empty: every row); `frame_box` gives a row's box in its frame's
+// pixels for the top-edge check (a moving camera). Returns how many rows were moved.
 int MendHiddenFeet(std::vector<TrackRow>& rows, const std::vector<bool>& measured,
                    const camera::Camera& camera, double foot_offset_m, double fps,
-                   const HiddenFeetOptions& options = {});
+                   const HiddenFeetOptions& options = {}, const FrameBoxOf& frame_box = {});
 
 }  // namespace fv::track

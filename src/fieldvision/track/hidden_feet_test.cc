@@ -73,6 +73,12 @@ TEST(HiddenFeet, HiddenLegsAreGivenBackTheirFeet) {
   camera::Camera unposed = cam;
   unposed.has_pose = false;
   EXPECT_EQ(MendHiddenFeet(again, {}, unposed, foot_offset_m, fps), 0);
+  // A moving camera's rows (in the first frame's pixels) whose boxes reach their own frame's top
+  // (frame_box) are left: the top edge is judged in the frame's pixels.
+  const FrameBoxOf at_top = [](const TrackRow& r) { return cv::Rect2d(r.box.x, 0, 10, 10); };
+  std::vector<TrackRow> moving = before;
+  EXPECT_EQ(MendHiddenFeet(moving, {}, cam, foot_offset_m, fps, {}, at_top), 0);
+  EXPECT_GT(MendHiddenFeet(moving, {}, cam, foot_offset_m, fps, {}, {}), 0);
   // Rows that are not measurements (filled across a gap) do not count for the height but are
   // moved too; so are the hidden rows at a track's end (the earlier heights' line reaches them).
   std::vector<bool> measured(again.size(), true);

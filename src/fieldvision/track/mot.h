@@ -9,6 +9,7 @@
 // (Luiten et al. 2021, as TrackEval computes it: alpha from 0.05 to 0.95, DetA x AssA).
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,6 +30,11 @@ struct TrackRow {
   int mot_class = -1;
   double visibility = -1;
 };
+
+// A row's box in its own frame's pixels, for the checks at the image's edges (a tracklet ending at
+// the border, a box whose top is the image's): with a moving camera the rows are in the first
+// frame's pixels (camera_motion.h). Empty: the box as it is.
+using FrameBoxOf = std::function<cv::Rect2d(const TrackRow&)>;
 
 // Writes TRACKS.csv with the contract header (rows in the order given), through a temporary file
 // renamed at the end (a failed write leaves an existing file as it was).

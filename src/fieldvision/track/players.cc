@@ -308,8 +308,8 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
     t.last = pl;
     t.last_frame = la->frame;
     t.v_last = vl;
-    t.starts_at_border = at_border(f.box);
-    t.ends_at_border = at_border(l.box);
+    t.starts_at_border = at_border(cam.frame_box ? cam.frame_box(f) : f.box);
+    t.ends_at_border = at_border(cam.frame_box ? cam.frame_box(l) : l.box);
   }
   return tl;
 }
@@ -620,8 +620,19 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
   if (options.min_track_frames > 0) {
     result.dropped_tracks = DropShortTracks(result.rows, result.min_track_frames);
   }
-  result.stitched = StitchTracklets(result.rows, pass.appearance, options.stitch, result.fps, image,
-                                    {calibrated ? camera : nullptr, options.tracker.foot_offset_m});
+  // A moving camera's rows are in the first frame's pixels; the checks at the image's edges take
+  // each box back to its own frame's.
+  std::vector<cv::Matx33d> frame_from_first;
+  for (const cv::Matx33d& h : pass.first_from_frame) frame_from_first.push_back(h.inv());
+  FrameBoxOf frame_box;
+  if (!frame_from_first.empty()) {
+    frame_box = [&frame_from_first](const TrackRow& r) {
+      return MapBox(frame_from_first[r.frame - 1], r.box);
+    };
+  }
+  result.stitched =
+      StitchTracklets(result.rows, pass.appearance, options.stitch, result.fps, image,
+                      {calibrated ? camera : nullptr, options.tracker.foot_offset_m, frame_box});
   result.interpolated =
       InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
                       options.tracker.foot_offset_m);
@@ -631,7 +642,7 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
     for (size_t i = 0; i < result.rows.size(); ++i) measured[i] = result.rows[i].conf > 0;
     result.mended_feet =
         MendHiddenFeet(result.rows, measured, *camera, options.tracker.foot_offset_m, result.fps,
-                       options.hidden_feet);
+                       options.hidden_feet, frame_box);
     result.smoothing =
         SmoothGroundTracks(result.rows, measured, *camera, result.fps, options.smooth);
   }

@@ -153,6 +153,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
 struct StitchCamera {
   const camera::Camera* camera = nullptr;
   double foot_offset_m = 0.0;  // as TrackerOptions::foot_offset_m
+  FrameBoxOf frame_box;        // rows in the first frame's pixels (a moving camera)
 };
 
 // Joins tracklets in `rows` (StitchOptions); `appearance` by id (ids without one are joined on
