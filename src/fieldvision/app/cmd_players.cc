@@ -63,10 +63,13 @@ void RunPlayersCommand(const PlayersCli& c) {
   }
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
-    // A moving camera's field lines move with each frame: not drawn.
-    const bool lines = camera && !c.o.moving_camera;
-    const track::TrackOverlay overlay(r.rows, r.team_of, {}, lines ? &*camera : nullptr,
-                                      field ? &*field : nullptr, c.overlay);
+    track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
+                                field ? &*field : nullptr, c.overlay);
+    if (!r.first_from_frame.empty()) {  // a moving camera's lines move with each frame
+      std::vector<cv::Matx33d> frame_from_first;
+      for (const cv::Matx33d& h : r.first_from_frame) frame_from_first.push_back(h.inv());
+      overlay.SetCameraMotion(std::move(frame_from_first));
+    }
     const track::DrawVideoResult d =
         track::DrawTracksVideo(c.video, c.draw, overlay, c.o.fps, c.o.max_frames);
     std::cout << d.Summary() << "\n";
@@ -110,7 +113,7 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
                 "The camera sways, turns or drifts (a phone held by hand, a hovering drone): each "
                 "frame is registered to the first (ORB features off the people, a homography), "
                 "where the camera file's pose holds, and field positions are taken there; people "
-                "outside the first frame's view are not tracked; --draw draws no field lines");
+                "outside the first frame's view are not tracked");
 }
 
 void Setup(CLI::App& app, int& exit_code) {

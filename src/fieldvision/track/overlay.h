@@ -8,6 +8,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,10 @@ class TrackOverlay {
   TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int> team_of,
                std::map<int, std::string> name_of, const camera::Camera* camera,
                const field::FieldModel* field, const OverlayOptions& options = {});
+  // A moving camera (players --moving-camera): per frame (0-based), the homography from the
+  // first frame's pixels, where the camera's pose holds, to that frame's; the field lines are
+  // drawn in the first frame's view and moved with it. Frames beyond the list get none.
+  void SetCameraMotion(std::vector<cv::Matx33d> frame_from_first);
   // Draws TRACKS.csv frame `frame` (1-based) onto `bgr`.
   void Draw(cv::Mat& bgr, int frame) const;
 
@@ -51,6 +56,8 @@ class TrackOverlay {
     std::string text;
   };
   std::vector<LegendLine> LegendLines() const;
+  // With a camera motion: pixels of frame `from_frame` to those of `to_frame` (1-based).
+  std::optional<cv::Matx33d> TrailHomography(int from_frame, int to_frame) const;
   void DrawLegend(cv::Mat& bgr) const;
 
   std::map<int, std::vector<TrackRow>> by_frame_;
@@ -58,6 +65,8 @@ class TrackOverlay {
   std::map<int, std::string> name_of_;
   std::unique_ptr<camera::Camera> camera_;
   std::unique_ptr<field::FieldModel> field_;
+  std::vector<cv::Matx33d> frame_from_first_;
+  cv::Mat first_lines_;  // the field lines in the first frame's view (CV_8U, 255 on a line)
   cv::Mat field_layer_, field_mask_;  // projected lines, drawn once
   OverlayOptions o_;
   std::vector<LegendLine> legend_;  // made once

@@ -753,6 +753,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   if (motion) {  // the boxes back in each frame's own pixels
     for (TrackRow& r : result.rows) r.box = MapBox(pass.first_from_frame[r.frame - 1].inv(), r.box);
     result.camera_motion = motion->stats();
+    result.first_from_frame = pass.first_from_frame;
   }
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();

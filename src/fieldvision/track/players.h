@@ -131,6 +131,7 @@ struct PlayersResult {
   int off_ground = 0;        // rows whose foot point does not meet the ground
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
+  std::vector<cv::Matx33d> first_from_frame;       // its homographies, per frame (0-based)
   TrackerStats tracker;
   StageTimes times;
   std::string detector;

@@ -247,6 +247,56 @@ TEST(Players, ShortClipTimeFromTheVideoAndOverlay) {
   EXPECT_GT(cv::norm(first, raw, cv::NORM_L1) / raw.total(), 1.0);  // something was drawn
 }
 
+// A moving camera's field lines move with its frames: the lines drawn for a frame whose view is
+// 40 px right of the first are the first frame's lines moved 40 px (white pixels compared), and a
+// frame beyond the homographies given gets none; trails are drawn in the frame's view.
+TEST(Overlay, MovingCameraLinesFollowTheFrame) {
+  camera::Camera cam = camera::Camera::FromFov(640, 480, 70);
+  cam.cam_from_world = geometry::Rigid3d::LookAt({0, -14, 8}, {0, 0, 0});
+  cam.has_pose = true;
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  OverlayOptions o;
+  o.legend = false;
+  o.time_label = false;
+  TrackOverlay overlay({}, {}, {}, &cam, &field, o);
+  const cv::Matx33d moved(1, 0, 40, 0, 1, 0, 0, 0, 1);
+  overlay.SetCameraMotion({cv::Matx33d::eye(), moved});
+  const cv::Mat black(480, 640, CV_8UC3, cv::Scalar::all(0));
+  std::vector<cv::Mat> drawn;
+  for (int frame = 1; frame <= 3; ++frame) {
+    cv::Mat f = black.clone();
+    overlay.Draw(f, frame);
+    cv::Mat grey;
+    cv::cvtColor(f, grey, cv::COLOR_BGR2GRAY);
+    drawn.push_back(grey > 60);
+  }
+  ASSERT_GT(cv::countNonZero(drawn[0]), 500);
+  cv::Mat shifted;
+  cv::warpAffine(drawn[0], shifted, cv::Matx23d(1, 0, 40, 0, 1, 0), drawn[0].size());
+  const double agree = cv::countNonZero(shifted & drawn[1]);
+  EXPECT_GT(agree, 0.8 * cv::countNonZero(drawn[1]));
+  EXPECT_LT(cv::countNonZero(drawn[0] & drawn[1]), 0.5 * cv::countNonZero(drawn[1]));
+  EXPECT_EQ(cv::countNonZero(drawn[2]), 0);
+
+  // A still person's trail in a moving view: frame 1's foot moved into frame 2's view is where
+  // frame 2's foot is (no trail drawn between them; unmoved, 40 px of trail).
+  std::vector<TrackRow> rows(2);
+  rows[0].frame = 1;
+  rows[1].frame = 2;
+  rows[0].id = rows[1].id = 4;
+  rows[0].box = cv::Rect2d(100, 100, 20, 60);
+  rows[1].box = cv::Rect2d(140, 100, 20, 60);
+  for (const bool with_motion : {true, false}) {
+    TrackOverlay trail(rows, {}, {}, nullptr, nullptr, o);
+    if (with_motion) trail.SetCameraMotion({cv::Matx33d::eye(), moved});
+    cv::Mat f = black.clone();
+    trail.Draw(f, 2);
+    cv::Mat grey;
+    cv::cvtColor(f(cv::Rect(112, 155, 24, 10)), grey, cv::COLOR_BGR2GRAY);
+    EXPECT_EQ(cv::countNonZero(grey) > 0, !with_motion) << "with motion " << with_motion;
+  }
+}
+
 // The overlay's legend names the teams of the tracks drawn by their colours (a roster team
 // without a track is left out), adds the colours by id when a track has no team of the four,
 // and says what dashed boxes and trails are, in the bottom-left corner; without it, or on a
