@@ -257,6 +257,14 @@ printf '%%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!o
 check "eval tracks: --camera without a pose" nonzero $FV eval tracks --gt "$TMP/gt.csv" \
   --est "$TMP/gt.csv" --camera "$TMP/intr.yaml"
 grep -q "intr.yaml: the camera has no pose" "$TMP/err" || { echo "FAIL eval tracks: pose"; fail=1; }
+# A walker at 1.5 m/s for 4 s scored against itself: positions exact, the coach's numbers equal.
+awk 'BEGIN { print "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x_m,y_m,time_s";
+  for (f = 1; f <= 41; f++) printf "%d,1,%d,100,20,50,1,%.3f,2,%.1f\n", f, 100 + f, 0.15 * (f - 1), (f - 1) / 10 }' \
+  > "$TMP/walker.csv"
+check "eval tracks: positions and coach's numbers" 0 $FV eval tracks --gt "$TMP/walker.csv" \
+  --est "$TMP/walker.csv"
+grep -q "median 0.000 m" "$TMP/out" && grep -q "distance over everyone 6 m against the ground truth's 6 m (+0.0 %)" "$TMP/out" ||
+  { echo "FAIL eval tracks: positions or coach's numbers"; cat "$TMP/out"; fail=1; }
 echo "4,2,0,0,10,20,1,nan,0," >> "$TMP/gt.csv"
 check "stats: NaN position" nonzero $FV stats --tracks "$TMP/gt.csv" --field fifa --out "$TMP/st"
 grep -q "gt.csv:5" "$TMP/err" || { echo "FAIL stats: NaN row not named"; fail=1; }

@@ -1,14 +1,17 @@
 // `fieldvision eval tracks`: MOTA, MOTP, IDF1, HOTA of TRACKS.csv against ground truth; and
 // `fieldvision eval import-pets`: PETS CVML annotations -> MOT CSV.
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <optional>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "fieldvision/app/command.h"
 #include "fieldvision/app/input_checks.h"
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/stats/stats.h"
 #include "fieldvision/track/bytetrack.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/pets.h"
@@ -49,18 +52,66 @@ std::optional<camera::Camera> ReadPositionCamera(const EvalTracksCli& c,
   return cam;
 }
 
-// Field-position errors when the estimate has positions and the ground truth has them or the
-// camera places its boxes' feet.
+// Field-position errors when the estimate has positions and the ground truth has them (placed by
+// the camera where given).
 std::optional<track::PositionErrors> ScorePositions(const EvalTracksCli& c,
-                                                    const std::optional<camera::Camera>& cam,
-                                                    std::vector<track::TrackRow> gt,
+                                                    const std::vector<track::TrackRow>& gt,
                                                     const std::vector<track::TrackRow>& est) {
-  if (cam) track::PlaceFeet(*cam, c.foot_offset_m, &gt);
   if (!AnyPosition(est) || !AnyPosition(gt)) return std::nullopt;
   track::PositionEvalOptions po;
   po.iou_threshold = c.o.iou_threshold;
   po.frame_offset = c.o.frame_offset;
   return track::EvaluatePositions(gt, est, po);
+}
+
+// The coach's numbers (`stats`: distance covered, top speed) of the estimate and of the ground
+// truth's positions, both timed at the estimate's frame rate (the ground truth often has no time).
+struct CoachNumbers {
+  double fps = 0;
+  double est_distance_m = 0, gt_distance_m = 0;
+  double est_top_speed_mps = 0, gt_top_speed_mps = 0;
+  std::string Summary() const {
+    return fmt::format(
+        "coach's numbers (stats, {:.2f} frames/s): distance over everyone {:.0f} m against the "
+        "ground truth's {:.0f} m ({:+.1f} %), top speed {:.2f} m/s against {:.2f} m/s",
+        fps, est_distance_m, gt_distance_m,
+        gt_distance_m > 0 ? 100.0 * (est_distance_m / gt_distance_m - 1.0) : 0.0, est_top_speed_mps,
+        gt_top_speed_mps);
+  }
+  nlohmann::json ToJson() const {
+    return {{"fps", fps},
+            {"distance_m", est_distance_m},
+            {"gt_distance_m", gt_distance_m},
+            {"top_speed_mps", est_top_speed_mps},
+            {"gt_top_speed_mps", gt_top_speed_mps}};
+  }
+};
+
+std::optional<CoachNumbers> CompareCoachNumbers(const std::vector<track::TrackRow>& gt,
+                                                const std::vector<track::TrackRow>& est) {
+  for (const auto& r : est) {
+    if (!r.time_s) return std::nullopt;  // a MOTChallenge file: no time to give speeds
+  }
+  CoachNumbers n;
+  n.fps = stats::FrameRateOfRows(est);
+  if (!(n.fps > 0)) return std::nullopt;
+  stats::StatsOptions so;
+  so.fps = n.fps;
+  so.write_video = false;
+  std::vector<track::TrackRow> gt_placed;
+  for (const auto& r : gt) {
+    if (r.x_m && r.y_m) gt_placed.push_back(r);
+  }
+  const stats::StatsResult e = stats::ComputeStats(est, so), g = stats::ComputeStats(gt_placed, so);
+  for (const auto& p : e.players) {
+    n.est_distance_m += p.distance_m;
+    n.est_top_speed_mps = std::max(n.est_top_speed_mps, p.top_speed_mps);
+  }
+  for (const auto& p : g.players) {
+    n.gt_distance_m += p.distance_m;
+    n.gt_top_speed_mps = std::max(n.gt_top_speed_mps, p.top_speed_mps);
+  }
+  return n;
 }
 
 void RunEvalTracks(const EvalTracksCli& c) {
@@ -82,11 +133,16 @@ void RunEvalTracks(const EvalTracksCli& c) {
     }
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
-  const auto positions = ScorePositions(c, cam, gt, est);
+  std::vector<track::TrackRow> placed = gt;
+  if (cam) track::PlaceFeet(*cam, c.foot_offset_m, &placed);
+  const auto positions = ScorePositions(c, placed, est);
   if (positions) std::cout << positions->Summary() << "\n";
+  const auto coach = positions ? CompareCoachNumbers(placed, est) : std::nullopt;
+  if (coach) std::cout << coach->Summary() << "\n";
   if (!c.json.empty()) {
     nlohmann::json j = nlohmann::json::parse(m.ToJson());
     if (positions) j["positions"] = nlohmann::json::parse(positions->ToJson());
+    if (coach) j["coach"] = coach->ToJson();
     util::AtomicWrite(
         c.json,
         [&](const std::string& tmp) {
