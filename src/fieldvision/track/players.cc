@@ -308,8 +308,10 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
     t.last = pl;
     t.last_frame = la->frame;
     t.v_last = vl;
-    t.starts_at_border = at_border(cam.frame_box ? cam.frame_box(f) : f.box);
-    t.ends_at_border = at_border(cam.frame_box ? cam.frame_box(l) : l.box);
+    // A moving camera's rows: at the border of their own frame or of the first frame's view
+    // (people whose foot leaves it are not followed).
+    t.starts_at_border = at_border(f.box) || (cam.frame_box && at_border(cam.frame_box(f)));
+    t.ends_at_border = at_border(l.box) || (cam.frame_box && at_border(cam.frame_box(l)));
   }
   return tl;
 }
