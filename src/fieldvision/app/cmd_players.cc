@@ -61,6 +61,12 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (r.time.time_s.empty()) {
     std::cerr << "fieldvision: warning: time_s left empty: " << r.time.source << "\n";
   }
+  // Frames not registered keep the last view: their positions are as good as that guess.
+  if (r.camera_motion && r.camera_motion->lost > 0.1 * r.frames) {
+    std::cerr << "fieldvision: warning: " << r.camera_motion->lost << " of " << r.frames
+              << " frames could not be matched to the first or the last registered one (too "
+                 "little texture off the people?): their positions assume the last view matched\n";
+  }
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
     track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
