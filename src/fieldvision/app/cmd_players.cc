@@ -71,11 +71,8 @@ void RunPlayersCommand(const PlayersCli& c) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
     track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
                                 field ? &*field : nullptr, c.overlay);
-    if (!r.first_from_frame.empty()) {  // a moving camera's lines move with each frame
-      std::vector<cv::Matx33d> frame_from_first;
-      for (const cv::Matx33d& h : r.first_from_frame) frame_from_first.push_back(h.inv());
-      overlay.SetCameraMotion(std::move(frame_from_first));
-    }
+    // A moving camera's lines move with each frame.
+    if (!r.frame_from_first.empty()) overlay.SetCameraMotion(r.frame_from_first);
     const track::DrawVideoResult d =
         track::DrawTracksVideo(c.video, c.draw, overlay, c.o.fps, c.o.max_frames);
     std::cout << d.Summary() << "\n";

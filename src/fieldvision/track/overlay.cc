@@ -64,19 +64,20 @@ std::optional<cv::Matx33d> TrackOverlay::TrailHomography(int from_frame, int to_
 
 void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "overlay: expected a BGR frame");
+  // The field lines, drawn half-transparent so the players stay visible; a moving camera's are
+  // the first frame's moved into this frame's view.
+  cv::Mat lines;
   if (camera_ && frame_from_first_.empty()) {
-    // The field lines, drawn half-transparent so the players stay visible.
-    cv::Mat lines = bgr.clone();
+    lines = bgr.clone();
     calib::DrawFieldOverlay(lines, *camera_, *field_, o_.field_colour, 1, 0.1);
-    cv::addWeighted(lines, 0.6, bgr, 0.4, 0.0, bgr);
   } else if (!first_lines_.empty() && frame >= 1 &&
              frame <= static_cast<int>(frame_from_first_.size())) {
     cv::Mat moved;
     cv::warpPerspective(first_lines_, moved, frame_from_first_[frame - 1], bgr.size());
-    cv::Mat lines = bgr.clone();
+    lines = bgr.clone();
     lines.setTo(o_.field_colour, moved > 64);
-    cv::addWeighted(lines, 0.6, bgr, 0.4, 0.0, bgr);
   }
+  if (!lines.empty()) cv::addWeighted(lines, 0.6, bgr, 0.4, 0.0, bgr);
   // Under the tracks: players in its corner stay in full colour.
   if (o_.legend) DrawLegend(bgr);
   const double scale = std::max(0.4, bgr.rows / 1000.0);

@@ -67,7 +67,6 @@ class TrackOverlay {
   std::unique_ptr<field::FieldModel> field_;
   std::vector<cv::Matx33d> frame_from_first_;
   cv::Mat first_lines_;  // the field lines in the first frame's view (CV_8U, 255 on a line)
-  cv::Mat field_layer_, field_mask_;  // projected lines, drawn once
   OverlayOptions o_;
   std::vector<LegendLine> legend_;  // made once
 };

@@ -557,20 +557,22 @@ struct PlayersPass {
   std::map<int, TrackAppearance> appearance;
   std::vector<double> times_ms;
   DetectionsFile saved;
-  std::vector<cv::Matx33d> first_from_frame;  // with a moving camera, per frame (0-based)
+  // With a moving camera, per frame (0-based): the homography from the first frame's pixels to
+  // that frame's, which takes the rows back (their edge checks, TRACKS.csv, the overlay).
+  std::vector<cv::Matx33d> frame_from_first;
 };
 
 // A moving camera's frame: registered to the first one, its detections moved into the first
 // frame's pixels (those whose foot point then lies outside the first frame's view or fails
-// `filter` dropped) and the frame warped there,
-// where the tracker's appearance model reads it at the moved boxes.
+// `filter` dropped) and the frame warped there, where the tracker's appearance model reads it at
+// the moved boxes.
 cv::Mat ToFirstView(CameraMotion& motion, const FootFilter& filter, const cv::Mat& frame,
                     std::vector<Detection>& dets, PlayersPass& pass) {
   std::vector<cv::Rect2d> boxes;
   boxes.reserve(dets.size());
   for (const Detection& d : dets) boxes.push_back(d.box);
   const cv::Matx33d h = motion.Register(frame, boxes);
-  pass.first_from_frame.push_back(h);
+  pass.frame_from_first.push_back(h.inv());
   std::vector<Detection> kept;
   for (Detection d : dets) {
     d.box = MapBox(h, d.box);
@@ -624,12 +626,10 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
   }
   // A moving camera's rows are in the first frame's pixels; the checks at the image's edges take
   // each box back to its own frame's.
-  std::vector<cv::Matx33d> frame_from_first;
-  for (const cv::Matx33d& h : pass.first_from_frame) frame_from_first.push_back(h.inv());
   FrameBoxOf frame_box;
-  if (!frame_from_first.empty()) {
-    frame_box = [&frame_from_first](const TrackRow& r) {
-      return MapBox(frame_from_first[r.frame - 1], r.box);
+  if (!pass.frame_from_first.empty()) {
+    frame_box = [&pass](const TrackRow& r) {
+      return MapBox(pass.frame_from_first[r.frame - 1], r.box);
     };
   }
   result.stitched =
@@ -753,9 +753,9 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   FinishTracks(options, camera, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
                result);
   if (motion) {  // the boxes back in each frame's own pixels
-    for (TrackRow& r : result.rows) r.box = MapBox(pass.first_from_frame[r.frame - 1].inv(), r.box);
+    for (TrackRow& r : result.rows) r.box = MapBox(pass.frame_from_first[r.frame - 1], r.box);
     result.camera_motion = motion->stats();
-    result.first_from_frame = pass.first_from_frame;
+    result.frame_from_first = std::move(pass.frame_from_first);
   }
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();

@@ -131,7 +131,9 @@ struct PlayersResult {
   int off_ground = 0;        // rows whose foot point does not meet the ground
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
-  std::vector<cv::Matx33d> first_from_frame;       // its homographies, per frame (0-based)
+  // Its homographies from the first frame's pixels to each frame's (0-based), as
+  // TrackOverlay::SetCameraMotion takes them.
+  std::vector<cv::Matx33d> frame_from_first;
   TrackerStats tracker;
   StageTimes times;
   std::string detector;

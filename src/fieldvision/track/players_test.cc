@@ -549,7 +549,7 @@ TEST(Players, SwayingCameraKeepsTheFieldPositions) {
   o.moving_camera = true;
   const PlayersResult moving = RunPlayers(dir + "/sway/%05d.png", &cam, &field, o);
   ASSERT_TRUE(moving.camera_motion.has_value());
-  EXPECT_EQ(moving.first_from_frame.size(), static_cast<size_t>(spec.num_frames));
+  EXPECT_EQ(moving.frame_from_first.size(), static_cast<size_t>(spec.num_frames));
   EXPECT_EQ(moving.camera_motion->lost, 0) << moving.Summary();
   const double error = median_error(moving);
   std::cout << "swaying camera: field error median " << error << " m, in the calibrated view "
