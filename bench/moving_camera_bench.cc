@@ -66,12 +66,6 @@ cv::Matx33d Sway(const fv::camera::Camera& cam, int t) {
   return k * r * k.inv();
 }
 
-// Whether a box's foot point lies in the frame (768x576).
-bool InView(const cv::Rect2d& box) {
-  const double u = box.x + 0.5 * box.width, v = box.y + box.height;
-  return u >= 0 && v >= 0 && u < Work().camera.width && v < Work().camera.height;
-}
-
 void Prepare() {
   Workspace& w = Work();
   if (!w.dir.empty()) return;
@@ -94,7 +88,8 @@ void Prepare() {
   // Every run is scored on the people the swayed video shows (a detector there sees no others).
   for (const TrackRow& r : w.gt) {
     if (r.frame >= 1 && r.frame <= static_cast<int>(w.sway.size()) &&
-        InView(fv::track::MapBox(w.sway[r.frame - 1], r.box))) {
+        fv::track::FootInView(fv::track::MapBox(w.sway[r.frame - 1], r.box),
+                              cv::Size(w.camera.width, w.camera.height))) {
       w.gt_in_view.push_back(r);
     }
   }
@@ -136,7 +131,9 @@ void BM_Players(benchmark::State& state, Run run) {
       std::vector<fv::track::Detection> kept;
       for (auto d : det.frames[f]) {
         d.box = fv::track::MapBox(w.sway[f], d.box);
-        if (InView(d.box)) kept.push_back(d);
+        if (fv::track::FootInView(d.box, cv::Size(w.camera.width, w.camera.height))) {
+          kept.push_back(d);
+        }
       }
       det.frames[f] = std::move(kept);
     }

@@ -69,6 +69,11 @@ cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box) {
   return {foot.x - 0.5 * width, foot.y - height, width, height};
 }
 
+bool FootInView(const cv::Rect2d& box, const cv::Size& size) {
+  const double u = box.x + 0.5 * box.width, v = box.y + box.height;
+  return std::isfinite(box.area()) && u >= 0 && v >= 0 && u < size.width && v < size.height;
+}
+
 CameraMotion::CameraMotion(const CameraMotionOptions& options) : options_(options) {
   options_.Check();
   orb_ = cv::ORB::create(options_.max_features);

@@ -68,4 +68,7 @@ class CameraMotion {
 // points; the width scales with the height.
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box);
 
+// Whether a (moved) box is finite and its foot point (bottom centre) lies in a view of `size`.
+bool FootInView(const cv::Rect2d& box, const cv::Size& size);
+
 }  // namespace fv::track

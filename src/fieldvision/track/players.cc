@@ -576,11 +576,11 @@ cv::Mat ToFirstView(CameraMotion& motion, const FootFilter& filter, const cv::Ma
   std::vector<Detection> kept;
   for (Detection d : dets) {
     d.box = MapBox(h, d.box);
-    const cv::Point2d foot(d.box.x + 0.5 * d.box.width, d.box.y + d.box.height);
     // Outside the first frame's view the warped frame is black: no appearance to track by.
-    const bool in_view = std::isfinite(d.box.area()) && foot.x >= 0 && foot.y >= 0 &&
-                         foot.x < frame.cols && foot.y < frame.rows;
-    if (in_view && (!filter || filter(foot))) kept.push_back(d);
+    if (!FootInView(d.box, frame.size())) continue;
+    if (!filter || filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height})) {
+      kept.push_back(d);
+    }
   }
   dets = std::move(kept);
   cv::Mat view;
