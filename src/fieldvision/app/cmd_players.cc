@@ -61,18 +61,19 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (r.time.time_s.empty()) {
     std::cerr << "fieldvision: warning: time_s left empty: " << r.time.source << "\n";
   }
-  // Frames not registered keep the last view: their positions are as good as that guess.
+  // Frames not registered take the view the camera's motion predicts: as good as that guess.
   if (r.camera_motion && r.camera_motion->lost > 0.1 * r.frames) {
     std::cerr << "fieldvision: warning: " << r.camera_motion->lost << " of " << r.frames
               << " frames could not be matched to the first or the last registered one (too "
-                 "little texture off the people?): their positions assume the last view matched\n";
+                 "little texture off the people?): their positions assume the camera kept moving "
+                 "as before\n";
   }
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
     track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,
                                 field ? &*field : nullptr, c.overlay);
     // A moving camera's lines move with each frame.
-    if (!r.frame_from_first.empty()) overlay.SetCameraMotion(r.frame_from_first);
+    if (r.canvas) overlay.SetCameraMotion(*r.canvas);
     const track::DrawVideoResult d =
         track::DrawTracksVideo(c.video, c.draw, overlay, c.o.fps, c.o.max_frames);
     std::cout << d.Summary() << "\n";
@@ -113,10 +114,15 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
                 "are hidden (a box whose top lies under 0.85 of their height above its foot) to "
                 "below the head at their height");
   cmd->add_flag("--moving-camera", c.o.moving_camera,
-                "The camera sways, turns or drifts (a phone held by hand, a hovering drone): each "
-                "frame is registered to the first (ORB features off the people, a homography), "
-                "where the camera file's pose holds, and field positions are taken there; people "
-                "outside the first frame's view are not tracked");
+                "The camera sways, turns, pans or drifts (a phone held by hand or following "
+                "play, a drone): each frame is registered to the first (ORB features off the "
+                "people, a homography), where the camera file's pose holds, and people are "
+                "tracked and placed on that view widened by --canvas-margin");
+  cmd->add_option("--canvas-margin", c.o.camera_motion.canvas_margin,
+                  "With --moving-camera: how many image widths (heights) beyond the first view "
+                  "people are tracked on each side")
+      ->check(FiniteRange(0, 10))
+      ->capture_default_str();
 }
 
 void Setup(CLI::App& app, int& exit_code) {

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include "fieldvision/util/error.h"
 
@@ -26,14 +28,18 @@ void CameraMotionOptions::Check() const {
              "CameraMotionOptions.min_inlier_cover must be in [0, 1] (got {})", min_inlier_cover);
   FV_REQUIRE(std::isfinite(min_inlier_share) && min_inlier_share >= 0 && min_inlier_share <= 1,
              "CameraMotionOptions.min_inlier_share must be in [0, 1] (got {})", min_inlier_share);
+  FV_REQUIRE(std::isfinite(keyframe_overlap) && keyframe_overlap >= 0 && keyframe_overlap <= 1,
+             "CameraMotionOptions.keyframe_overlap must be in [0, 1] (got {})", keyframe_overlap);
+  FV_REQUIRE(std::isfinite(canvas_margin) && canvas_margin >= 0 && canvas_margin <= 10,
+             "CameraMotionOptions.canvas_margin must be in [0, 10] (got {})", canvas_margin);
 }
 
 std::string CameraMotionStats::Summary() const {
   return fmt::format(
-      "camera motion: of {} frames after the first, {} matched to it directly, {} through the "
-      "last frame matched, {} not at all (the last view kept); the image centre moved up to "
-      "{:.0f} px",
-      std::max(0, frames - 1), direct, chained, lost, max_shift_px);
+      "camera motion: of {} frames after the first, {} matched to it directly, {} through a "
+      "keyframe ({} keyframes), {} through the frame before, {} not at all (the camera's "
+      "motion carried on); the image centre moved up to {:.0f} px",
+      std::max(0, frames - 1), direct, keyed, keyframes, chained, lost, max_shift_px);
 }
 
 namespace {
@@ -61,9 +67,19 @@ bool Plausible(const cv::Matx33d& h, const cv::Size& size) {
 }  // namespace
 
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box) {
+  return MapBoxBy([&h](const cv::Point2d& p) { return std::optional(Apply(h, p)); }, box);
+}
+
+cv::Rect2d MapBoxBy(const std::function<std::optional<cv::Point2d>(const cv::Point2d&)>& to,
+                    const cv::Rect2d& box) {
   const double cx = box.x + 0.5 * box.width;
-  const cv::Point2d foot = Apply(h, {cx, box.y + box.height});
-  const cv::Point2d top = Apply(h, {cx, box.y});
+  const std::optional<cv::Point2d> mapped_foot = to({cx, box.y + box.height});
+  const std::optional<cv::Point2d> mapped_top = to({cx, box.y});
+  if (!mapped_foot || !mapped_top) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {nan, nan, nan, nan};
+  }
+  const cv::Point2d foot = *mapped_foot, top = *mapped_top;
   const double height = std::hypot(foot.x - top.x, foot.y - top.y);
   const double width = box.height > 0 ? box.width * height / box.height : box.width;
   return {foot.x - 0.5 * width, foot.y - height, width, height};
@@ -74,8 +90,13 @@ bool FootInView(const cv::Rect2d& box, const cv::Size& size) {
   return std::isfinite(box.area()) && u >= 0 && v >= 0 && u < size.width && v < size.height;
 }
 
-CameraMotion::CameraMotion(const CameraMotionOptions& options) : options_(options) {
+CameraMotion::CameraMotion(const CameraMotionOptions& options, const camera::Camera* lens)
+    : options_(options) {
   options_.Check();
+  if (lens != nullptr) {
+    lens->Check("moving camera's lens");
+    lens_ = *lens;
+  }
   orb_ = cv::ORB::create(options_.max_features);
 }
 
@@ -86,27 +107,43 @@ CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
   cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
   if (scale < 1.0) cv::resize(gray, gray, cv::Size(), scale, scale, cv::INTER_AREA);
   cv::Mat mask(gray.size(), CV_8U, cv::Scalar(255));
+  // Each person's box widened, and lengthened below the feet for the shadow: a group of people
+  // moving together would otherwise outvote sparse background (grass) in the fit.
   for (const cv::Rect2d& b : people) {
-    const cv::Rect r(cv::Point(static_cast<int>(std::floor(b.x * scale)) - 2,
-                               static_cast<int>(std::floor(b.y * scale)) - 2),
-                     cv::Point(static_cast<int>(std::ceil((b.x + b.width) * scale)) + 2,
-                               static_cast<int>(std::ceil((b.y + b.height) * scale)) + 2));
+    const double x0 = b.x - 0.25 * b.width, x1 = b.x + 1.25 * b.width;
+    const double y0 = b.y - 0.1 * b.height, y1 = b.y + 1.4 * b.height;
+    const cv::Rect r(cv::Point(static_cast<int>(std::floor(x0 * scale)) - 2,
+                               static_cast<int>(std::floor(y0 * scale)) - 2),
+                     cv::Point(static_cast<int>(std::ceil(x1 * scale)) + 2,
+                               static_cast<int>(std::ceil(y1 * scale)) + 2));
     const cv::Rect clipped = r & cv::Rect(0, 0, mask.cols, mask.rows);
     if (!clipped.empty()) mask(clipped).setTo(0);
   }
   Features f;
-  orb_->detectAndCompute(gray, mask, f.keypoints, f.descriptors);
+  f.gray = gray;
+  f.scale = scale;
+  cv::goodFeaturesToTrack(gray, f.corners, options_.max_features / 3, 0.01, 8, mask);
+  std::vector<cv::KeyPoint> keypoints;
+  orb_->detectAndCompute(gray, mask, keypoints, f.descriptors);
+  if (keypoints.empty()) return f;
   // ORB's corners from its coarser pyramid levels are pixels off: each is moved to the corner's
   // sub-pixel place in the image registered (at work_width_px).
-  if (!f.keypoints.empty()) {
-    std::vector<cv::Point2f> corners;
-    cv::KeyPoint::convert(f.keypoints, corners);
-    cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1),
-                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.03));
-    for (size_t i = 0; i < corners.size(); ++i) f.keypoints[i].pt = corners[i];
-  }
-  for (cv::KeyPoint& k : f.keypoints) k.pt *= 1.0 / scale;
+  cv::KeyPoint::convert(keypoints, f.points);
+  cv::cornerSubPix(gray, f.points, cv::Size(3, 3), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.03));
+  f.points = ToUndistorted(f.points, scale);
   return f;
+}
+
+std::vector<cv::Point2f> CameraMotion::ToUndistorted(std::vector<cv::Point2f> work_px,
+                                                     double scale) const {
+  for (cv::Point2f& p : work_px) p *= 1.0 / scale;
+  if (lens_ && !work_px.empty()) {
+    const cv::Matx33d k(lens_->fx, 0, lens_->cx, 0, lens_->fy, lens_->cy, 0, 0, 1);
+    cv::undistortPoints(std::vector<cv::Point2f>(work_px), work_px, k, lens_->distortion,
+                        cv::noArray(), k);
+  }
+  return work_px;
 }
 
 bool CameraMotion::Match(const Features& a, const Features& b, cv::Matx33d* a_from_b) const {
@@ -118,9 +155,60 @@ bool CameraMotion::Match(const Features& a, const Features& b, cv::Matx33d* a_fr
   std::vector<cv::Point2f> from, to;
   for (const auto& m : knn) {
     if (m.size() < 2 || m[0].distance >= options_.ratio_test * m[1].distance) continue;
-    from.push_back(b.keypoints[m[0].queryIdx].pt);
-    to.push_back(a.keypoints[m[0].trainIdx].pt);
+    from.push_back(b.points[m[0].queryIdx]);
+    to.push_back(a.points[m[0].trainIdx]);
   }
+  return Fit(from, to, a_from_b);
+}
+
+cv::Point2f CameraMotion::ToWork(const cv::Point2d& undistorted, double scale) const {
+  cv::Point2d px = undistorted;
+  if (lens_) {
+    const auto uv = lens_->ProjectFromCamera(
+        {(undistorted.x - lens_->cx) / lens_->fx, (undistorted.y - lens_->cy) / lens_->fy, 1.0});
+    if (!uv) return {-1e6f, -1e6f};
+    px = {uv->x(), uv->y()};
+  }
+  return {static_cast<float>(px.x * scale), static_cast<float>(px.y * scale)};
+}
+
+bool CameraMotion::Flow(const View& a, const Features& b, const cv::Matx33d& predicted,
+                        cv::Matx33d* a_from_b) const {
+  const Features& fa = a.features;
+  if (static_cast<int>(fa.corners.size()) < options_.min_inliers || b.gray.empty()) return false;
+  // Each corner's place in b as the prediction has it: LK corrects from there.
+  const cv::Matx33d b_from_a = predicted.inv() * a.first_from_view;
+  const std::vector<cv::Point2f> undistorted = ToUndistorted(fa.corners, fa.scale);
+  std::vector<cv::Point2f> ahead;
+  ahead.reserve(undistorted.size());
+  for (const cv::Point2f& p : undistorted) {
+    const cv::Vec3d q = b_from_a * cv::Vec3d(p.x, p.y, 1.0);
+    ahead.push_back(q[2] > 1e-9 ? ToWork({q[0] / q[2], q[1] / q[2]}, b.scale)
+                                : cv::Point2f(-1e6f, -1e6f));
+  }
+  const cv::Size window(21, 21);
+  const int levels = 3;
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 30, 0.01);
+  std::vector<cv::Point2f> back = fa.corners;
+  std::vector<uchar> found, found_back;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(fa.gray, b.gray, fa.corners, ahead, found, error, window, levels, stop,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  cv::calcOpticalFlowPyrLK(b.gray, fa.gray, ahead, back, found_back, error, window, levels, stop,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  std::vector<cv::Point2f> from, to;
+  for (size_t i = 0; i < fa.corners.size(); ++i) {
+    const cv::Point2f d = back[i] - fa.corners[i];
+    if (found[i] && found_back[i] && d.dot(d) < 0.25f) {
+      from.push_back(ahead[i]);
+      to.push_back(undistorted[i]);
+    }
+  }
+  return Fit(ToUndistorted(from, b.scale), to, a_from_b);
+}
+
+bool CameraMotion::Fit(const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                       cv::Matx33d* a_from_b) const {
   if (static_cast<int>(from.size()) < options_.min_inliers) return false;
   std::vector<uchar> inlier;
   const cv::Mat h = cv::findHomography(from, to, cv::USAC_MAGSAC, options_.ransac_px, inlier);
@@ -138,39 +226,103 @@ bool CameraMotion::Match(const Features& a, const Features& b, cv::Matx33d* a_fr
   return Plausible(*a_from_b, size_);
 }
 
+double CameraMotion::Overlap(const cv::Matx33d& a_from_b) const {
+  const double w = size_.width, h = size_.height;
+  std::vector<cv::Point2f> mapped, frame = {{0, 0},
+                                            {static_cast<float>(w), 0},
+                                            {static_cast<float>(w), static_cast<float>(h)},
+                                            {0, static_cast<float>(h)}};
+  for (const cv::Point2f& p : frame) {
+    const cv::Vec3d q = a_from_b * cv::Vec3d(p.x, p.y, 1.0);
+    if (!(q[2] > 1e-9)) return 0.0;
+    mapped.emplace_back(static_cast<float>(q[0] / q[2]), static_cast<float>(q[1] / q[2]));
+  }
+  std::vector<cv::Point2f> common;
+  const float area = cv::intersectConvexConvex(mapped, frame, common, true);
+  return std::max(0.0f, area) / (w * h);
+}
+
 cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people) {
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "camera motion: the frame must be 8-bit BGR");
+  if (lens_) {
+    FV_REQUIRE(bgr.cols == lens_->width && bgr.rows == lens_->height,
+               "camera motion: frame {} is {}x{}, the camera {}x{}", stats_.frames + 1, bgr.cols,
+               bgr.rows, lens_->width, lens_->height);
+  }
   Features f = Detect(bgr, people);
   ++stats_.frames;
   if (stats_.frames == 1) {
     size_ = bgr.size();
-    first_ = f;
-    previous_ = std::move(f);
-    first_from_previous_ = cv::Matx33d::eye();
-    return first_from_previous_;
+    first_ = {std::move(f), cv::Matx33d::eye()};
+    key_ = first_;
+    previous_ = first_;
+    velocity_ = cv::Matx33d::eye();
+    return first_.first_from_view;
   }
   FV_REQUIRE(bgr.size() == size_, "camera motion: frame {} is {}x{}, the first was {}x{}",
              stats_.frames, bgr.cols, bgr.rows, size_.width, size_.height);
-  cv::Matx33d h;
-  cv::Matx33d previous_from_this;
-  if (Match(first_, f, &h)) {
-    ++stats_.direct;
-  } else if (Match(previous_, f, &previous_from_this)) {
-    h = first_from_previous_ * previous_from_this;
-    ++stats_.chained;
-  } else {
-    // Neither: the last view is kept, and the last registered frame stays the one to chain from
-    // (a blank or blurred frame must not become the base of the next).
+  // This frame's view as the last two registered ones predict it (constant motion, carried over
+  // frames lost, for at most kMaxCarried of them).
+  constexpr int kMaxCarried = 10;
+  cv::Matx33d predicted = previous_.first_from_view;
+  for (int i = 0; i <= std::min(since_registered_, kMaxCarried - 1); ++i) {
+    predicted = predicted * velocity_;
+  }
+  predicted *= 1.0 / predicted(2, 2);
+  // Optical flow from the prediction first (the first frame where the view is back over it, the
+  // keyframe, the frame before), then descriptors (a jump, or a view found again after frames
+  // lost): descriptors on repeated texture can lock on a copy of it one period off.
+  struct Attempt {
+    const View* view;
+    bool flow;  // else descriptors
+  };
+  const Attempt attempts[] = {{&first_, true},  {&key_, true},  {&previous_, true},
+                              {&first_, false}, {&key_, false}, {&previous_, false}};
+  cv::Matx33d a_from_this;
+  const View* base = nullptr;
+  for (const Attempt& a : attempts) {
+    if (a.flow && a.view == &first_ && Overlap(predicted) <= 0.5) continue;
+    if (a.flow ? Flow(*a.view, f, predicted, &a_from_this)
+               : Match(a.view->features, f, &a_from_this)) {
+      base = a.view;
+      break;
+    }
+  }
+  if (base == nullptr) {
+    // Neither: the predicted view is taken, and the last registered frame stays the one to chain
+    // from (a blank or blurred frame must not become the base of the next).
     ++stats_.lost;
-    return first_from_previous_;
+    ++since_registered_;
+    return predicted;
+  }
+  cv::Matx33d h = base->first_from_view * a_from_this;
+  bool new_key;
+  if (base == &first_) {
+    ++stats_.direct;
+    new_key = Overlap(key_.first_from_view.inv() * h) < options_.keyframe_overlap;
+  } else if (base == &key_) {
+    ++stats_.keyed;
+    new_key = Overlap(a_from_this) < options_.keyframe_overlap;
+  } else {
+    ++stats_.chained;  // the keyframe is out of reach: this frame is the next one
+    new_key = true;
   }
   h *= 1.0 / h(2, 2);
   const cv::Point2d centre(0.5 * (size_.width - 1), 0.5 * (size_.height - 1));
   const cv::Point2d moved = Apply(h, centre);
   stats_.max_shift_px =
       std::max(stats_.max_shift_px, std::hypot(moved.x - centre.x, moved.y - centre.y));
-  previous_ = std::move(f);
-  first_from_previous_ = h;
+  // The step from the last registered frame (over frames lost, the step before is kept).
+  if (since_registered_ == 0) {
+    velocity_ = previous_.first_from_view.inv() * h;
+    velocity_ *= 1.0 / velocity_(2, 2);
+  }
+  since_registered_ = 0;
+  previous_ = {std::move(f), h};
+  if (new_key) {
+    key_ = previous_;
+    ++stats_.keyframes;
+  }
   return h;
 }
 

@@ -2,17 +2,23 @@
 // frame is registered to the first one, the view the camera file's pose holds for, by a
 // homography from ORB features matched outside the people's boxes (Rublee et al., ICCV 2011;
 // MAGSAC++ homography, Barath et al., CVPR 2020; Hartley & Zisserman ch. 4). A frame is matched to
-// the first directly where the two share enough features, else through the previous frame
-// (chained). A homography maps a turning camera's whole image exactly and a moving camera's ground
-// plane. The players pipeline then works in the first frame's pixels: boxes move there (MapBox),
-// and back for TRACKS.csv.
+// the first directly where the two share enough features, else through the last keyframe (a frame
+// that overlaps the one before it by less than keyframe_overlap, as in keyframe mosaicking and
+// visual odometry: the error adds up per keyframe, not per frame), else through the previous frame
+// (chained). With the camera's lens the homographies are between undistorted pixels, where a
+// homography maps a turning camera's whole image exactly and a moving camera's ground plane. The
+// players pipeline then works on the first view widened (view_canvas.h).
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
+
+#include "fieldvision/camera/camera.h"
 
 namespace fv::track {
 
@@ -26,40 +32,76 @@ struct CameraMotionOptions {
   // The inliers' convex hull must cover this share of the frame, else the homography is fixed
   // in a strip only (a small overlap) and not trusted.
   double min_inlier_cover = 0.25;
+  // A frame registered through the last keyframe (or the previous frame) becomes the next
+  // keyframe when it shares less than this share of its area with it.
+  double keyframe_overlap = 0.7;
+  // The canvas the frames are tracked on reaches this many image sizes beyond the first view on
+  // each side (view_canvas.h): a camera that pans further loses the people beyond.
+  double canvas_margin = 1.0;
   void Check() const;  // throws fv::Error naming the bad field
 };
 
 struct CameraMotionStats {
-  int frames = 0;             // frames registered, the first included
-  int direct = 0;             // matched to the first frame (the first itself not counted)
-  int chained = 0;            // through the last registered frame
-  int lost = 0;               // neither: the last registered frame's homography kept
+  int frames = 0;     // frames registered, the first included
+  int direct = 0;     // matched to the first frame (the first itself not counted)
+  int keyed = 0;      // through the last keyframe
+  int keyframes = 0;  // frames that became keyframes (the first not counted)
+  int chained = 0;    // through the last registered frame
+  int lost = 0;       // neither: the view predicted from the last two registered frames taken
   double max_shift_px = 0.0;  // largest move of the image centre from the first frame's view
   std::string Summary() const;
 };
 
 class CameraMotion {
  public:
-  explicit CameraMotion(const CameraMotionOptions& options = {});
-  // The homography from this frame's pixels to the first frame's (identity for the first), with
-  // the people's boxes left out of the matching.
+  // With `lens` (intrinsics and distortion; its size is the frames') the homographies are
+  // between undistorted pixels of its matrix; without, between pixels.
+  explicit CameraMotion(const CameraMotionOptions& options = {},
+                        const camera::Camera* lens = nullptr);
+  // The homography from this frame's (undistorted) pixels to the first frame's (identity for the
+  // first), with the people's boxes left out of the matching.
   cv::Matx33d Register(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people);
   const CameraMotionStats& stats() const { return stats_; }
 
  private:
   struct Features {
-    std::vector<cv::KeyPoint> keypoints;  // in frame pixels
+    std::vector<cv::Point2f> points;  // ORB's, undistorted pixels (frame pixels without a lens)
     cv::Mat descriptors;
+    cv::Mat gray;                      // the frame at work_width_px
+    double scale = 1.0;                // of gray to the frame
+    std::vector<cv::Point2f> corners;  // Shi-Tomasi corners of gray, off the people
+  };
+  // A registered frame to match later ones to.
+  struct View {
+    Features features;
+    cv::Matx33d first_from_view = cv::Matx33d::eye();
   };
   Features Detect(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people) const;
   // The homography from b's pixels to a's, or false when untrusted.
   bool Match(const Features& a, const Features& b, cv::Matx33d* a_from_b) const;
+  // The homography from b's pixels to view a's from a's corners followed into b by pyramidal
+  // Lucas-Kanade optical flow, starting where `predicted` (b's first_from_view) puts them, kept
+  // where the flow back returns within 0.5 px (Bouguet 2000; Kalal et al., ICPR 2010): for views
+  // whose texture repeats (stands, seats) or is sparse (grass, lines), where descriptors fail.
+  bool Flow(const View& a, const Features& b, const cv::Matx33d& predicted,
+            cv::Matx33d* a_from_b) const;
+  // A homography from point pairs with the trust checks (inliers, their share and cover,
+  // plausible).
+  bool Fit(const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+           cv::Matx33d* a_from_b) const;
+  // Points at work scale to undistorted frame pixels, and one back.
+  std::vector<cv::Point2f> ToUndistorted(std::vector<cv::Point2f> work_px, double scale) const;
+  cv::Point2f ToWork(const cv::Point2d& undistorted, double scale) const;
+  // The share of this frame's area that the view at a_from_b covers.
+  double Overlap(const cv::Matx33d& a_from_b) const;
 
   CameraMotionOptions options_;
   cv::Ptr<cv::ORB> orb_;
   cv::BFMatcher matcher_{cv::NORM_HAMMING};
-  Features first_, previous_;
-  cv::Matx33d first_from_previous_ = cv::Matx33d::eye();
+  std::optional<camera::Camera> lens_;
+  View first_, key_, previous_;
+  cv::Matx33d velocity_ = cv::Matx33d::eye();  // the last step: previous's view from the one before
+  int since_registered_ = 0;                   // frames lost since the last registered one
   cv::Size size_;
   CameraMotionStats stats_;
 };
@@ -67,6 +109,9 @@ class CameraMotion {
 // A person's box moved by a homography: the bottom centre (the foot) and the top centre map as
 // points; the width scales with the height.
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box);
+// The same by a point mapping; NaN coordinates where it cannot map the foot or the top.
+cv::Rect2d MapBoxBy(const std::function<std::optional<cv::Point2d>(const cv::Point2d&)>& to,
+                    const cv::Rect2d& box);
 
 // Whether a (moved) box is finite and its foot point (bottom centre) lies in a view of `size`.
 bool FootInView(const cv::Rect2d& box, const cv::Size& size);

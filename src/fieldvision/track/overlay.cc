@@ -46,36 +46,39 @@ TrackOverlay::TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int>
   if (o_.legend) legend_ = LegendLines();
 }
 
-void TrackOverlay::SetCameraMotion(std::vector<cv::Matx33d> frame_from_first) {
-  frame_from_first_ = std::move(frame_from_first);
-  if (!camera_ || frame_from_first_.empty()) return;
-  cv::Mat drawn(camera_->height, camera_->width, CV_8UC3, cv::Scalar(0, 0, 0));
-  calib::DrawFieldOverlay(drawn, *camera_, *field_, cv::Scalar(255, 255, 255), 1, 0.1);
-  cv::cvtColor(drawn, first_lines_, cv::COLOR_BGR2GRAY);
+void TrackOverlay::SetCameraMotion(const ViewCanvas& canvas) {
+  canvas_ = canvas;
+  canvas_lines_.release();
+  if (!camera_ || !canvas.camera().has_pose) return;
+  const camera::Camera& c = canvas.camera();
+  cv::Mat drawn(c.height, c.width, CV_8UC3, cv::Scalar(0, 0, 0));
+  calib::DrawFieldOverlay(drawn, c, *field_, cv::Scalar(255, 255, 255), 1, 0.1);
+  cv::cvtColor(drawn, canvas_lines_, cv::COLOR_BGR2GRAY);
 }
 
-std::optional<cv::Matx33d> TrackOverlay::TrailHomography(int from_frame, int to_frame) const {
-  const int n = static_cast<int>(frame_from_first_.size());
-  if (from_frame == to_frame || from_frame < 1 || to_frame < 1 || from_frame > n || to_frame > n) {
-    return std::nullopt;
-  }
-  return frame_from_first_[to_frame - 1] * frame_from_first_[from_frame - 1].inv();
+std::optional<cv::Point2d> TrackOverlay::TrailPoint(const cv::Point2d& foot, int from_frame,
+                                                    int to_frame) const {
+  if (!canvas_ || from_frame == to_frame) return foot;
+  const int n = canvas_->frames();
+  if (from_frame < 1 || to_frame < 1 || from_frame > n || to_frame > n) return foot;
+  const auto on_canvas = canvas_->ToCanvas(from_frame - 1, foot);
+  if (!on_canvas) return std::nullopt;
+  return canvas_->ToFrame(to_frame - 1, *on_canvas);
 }
 
 void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
   FV_REQUIRE(!bgr.empty() && bgr.type() == CV_8UC3, "overlay: expected a BGR frame");
   // The field lines, drawn half-transparent so the players stay visible; a moving camera's are
-  // the first frame's moved into this frame's view.
+  // what this frame sees of them on the canvas.
   cv::Mat lines;
-  if (camera_ && frame_from_first_.empty()) {
+  if (camera_ && !canvas_) {
     lines = bgr.clone();
     calib::DrawFieldOverlay(lines, *camera_, *field_, o_.field_colour, 1, 0.1);
-  } else if (!first_lines_.empty() && frame >= 1 &&
-             frame <= static_cast<int>(frame_from_first_.size())) {
-    cv::Mat moved;
-    cv::warpPerspective(first_lines_, moved, frame_from_first_[frame - 1], bgr.size());
+  } else if (!canvas_lines_.empty() && frame >= 1 && frame <= canvas_->frames() &&
+             bgr.cols == canvas_->lens().width && bgr.rows == canvas_->lens().height) {
+    const cv::Mat seen = canvas_->SeenByFrame(frame - 1, canvas_lines_);
     lines = bgr.clone();
-    lines.setTo(o_.field_colour, moved > 64);
+    lines.setTo(o_.field_colour, seen > 64);
   }
   if (!lines.empty()) cv::addWeighted(lines, 0.6, bgr, 0.4, 0.0, bgr);
   // Under the tracks: players in its corner stay in full colour.
@@ -87,11 +90,10 @@ void TrackOverlay::Draw(cv::Mat& bgr, int frame) const {
     for (auto it = by_frame_.lower_bound(frame - o_.trail_frames);
          it != by_frame_.end() && it->first <= frame; ++it) {
       // A moving camera's earlier feet are moved into this frame's view.
-      const std::optional<cv::Matx33d> to_now = TrailHomography(it->first, frame);
       for (const auto& r : it->second) {
-        cv::Vec3d foot(r.box.x + 0.5 * r.box.width, r.box.y + r.box.height, 1.0);
-        if (to_now) foot = *to_now * foot;
-        trail[r.id].emplace_back(cvRound(foot[0] / foot[2]), cvRound(foot[1] / foot[2]));
+        const auto foot =
+            TrailPoint({r.box.x + 0.5 * r.box.width, r.box.y + r.box.height}, it->first, frame);
+        if (foot) trail[r.id].emplace_back(cvRound(foot->x), cvRound(foot->y));
       }
     }
     for (const auto& [id, pts] : trail) {

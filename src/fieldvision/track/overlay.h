@@ -17,6 +17,7 @@
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/view_canvas.h"
 
 namespace fv::track {
 
@@ -43,10 +44,11 @@ class TrackOverlay {
   TrackOverlay(const std::vector<TrackRow>& rows, std::map<int, int> team_of,
                std::map<int, std::string> name_of, const camera::Camera* camera,
                const field::FieldModel* field, const OverlayOptions& options = {});
-  // A moving camera (players --moving-camera): per frame (0-based), the homography from the
-  // first frame's pixels, where the camera's pose holds, to that frame's; the field lines are
-  // drawn in the first frame's view and moved with it. Frames beyond the list get none.
-  void SetCameraMotion(std::vector<cv::Matx33d> frame_from_first);
+  // A moving camera (players --moving-camera): the canvas its frames were tracked on
+  // (view_canvas.h); the field lines are drawn on the canvas, through its camera, and each frame
+  // shows what it sees of them; trails move with the frames. Frames beyond the canvas's get no
+  // lines.
+  void SetCameraMotion(const ViewCanvas& canvas);
   // Draws TRACKS.csv frame `frame` (1-based) onto `bgr`.
   void Draw(cv::Mat& bgr, int frame) const;
 
@@ -56,8 +58,10 @@ class TrackOverlay {
     std::string text;
   };
   std::vector<LegendLine> LegendLines() const;
-  // With a camera motion: pixels of frame `from_frame` to those of `to_frame` (1-based).
-  std::optional<cv::Matx33d> TrailHomography(int from_frame, int to_frame) const;
+  // A foot point of frame `from_frame` in the pixels of `to_frame` (1-based; moved with a camera
+  // motion); nullopt where it cannot be moved.
+  std::optional<cv::Point2d> TrailPoint(const cv::Point2d& foot, int from_frame,
+                                        int to_frame) const;
   void DrawLegend(cv::Mat& bgr) const;
 
   std::map<int, std::vector<TrackRow>> by_frame_;
@@ -65,8 +69,8 @@ class TrackOverlay {
   std::map<int, std::string> name_of_;
   std::unique_ptr<camera::Camera> camera_;
   std::unique_ptr<field::FieldModel> field_;
-  std::vector<cv::Matx33d> frame_from_first_;
-  cv::Mat first_lines_;  // the field lines in the first frame's view (CV_8U, 255 on a line)
+  std::optional<ViewCanvas> canvas_;
+  cv::Mat canvas_lines_;  // the field lines on the canvas (CV_8U, 255 on a line)
   OverlayOptions o_;
   std::vector<LegendLine> legend_;  // made once
 };

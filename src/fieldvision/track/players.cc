@@ -241,10 +241,16 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
     const double s = o.person_height_m / std::max(1.0, box.height);
     return {(box.x + 0.5 * box.width) * s, (box.y + box.height) * s};
   };
-  auto at_border = [&](const cv::Rect2d& b) {
-    if (image.empty()) return false;
-    return b.x <= o.border_px || b.y <= o.border_px || b.x + b.width >= image.width - o.border_px ||
-           b.y + b.height >= image.height - o.border_px;
+  auto at_edge = [&](const cv::Rect2d& b, cv::Size size) {
+    if (size.empty()) return false;
+    return b.x <= o.border_px || b.y <= o.border_px || b.x + b.width >= size.width - o.border_px ||
+           b.y + b.height >= size.height - o.border_px;
+  };
+  // A moving camera's rows lie on its canvas: at the border of their own frame or of the canvas
+  // (people whose foot leaves it are not followed).
+  auto at_border = [&](const TrackRow& r) {
+    if (!cam.frame_box) return at_edge(r.box, image);
+    return at_edge(cam.frame_box(r), image) || at_edge(r.box, cam.canvas_size);
   };
   auto clamp_speed = [&](const Eigen::Vector2d& v) {
     const double n = v.norm();
@@ -308,10 +314,8 @@ std::map<int, Tracklet> BuildTracklets(const std::vector<TrackRow>& rows, const 
     t.last = pl;
     t.last_frame = la->frame;
     t.v_last = vl;
-    // A moving camera's rows: at the border of their own frame or of the first frame's view
-    // (people whose foot leaves it are not followed).
-    t.starts_at_border = at_border(f.box) || (cam.frame_box && at_border(cam.frame_box(f)));
-    t.ends_at_border = at_border(l.box) || (cam.frame_box && at_border(cam.frame_box(l)));
+    t.starts_at_border = at_border(f);
+    t.ends_at_border = at_border(l);
   }
   return tl;
 }
@@ -557,35 +561,34 @@ struct PlayersPass {
   std::map<int, TrackAppearance> appearance;
   std::vector<double> times_ms;
   DetectionsFile saved;
-  // With a moving camera, per frame (0-based): the homography from the first frame's pixels to
-  // that frame's, which takes the rows back (their edge checks, TRACKS.csv, the overlay).
-  std::vector<cv::Matx33d> frame_from_first;
+  // With a moving camera: the canvas the frames are tracked on (its homographies take the rows
+  // back: their edge checks, TRACKS.csv, the overlay) and the image of it given to the tracker.
+  std::optional<ViewCanvas> canvas;
+  cv::Mat canvas_image;
 };
 
-// A moving camera's frame: registered to the first one, its detections moved into the first
-// frame's pixels (those whose foot point then lies outside the first frame's view or fails
-// `filter` dropped) and the frame warped there, where the tracker's appearance model reads it at
-// the moved boxes.
-cv::Mat ToFirstView(CameraMotion& motion, const FootFilter& filter, const cv::Mat& frame,
-                    std::vector<Detection>& dets, PlayersPass& pass) {
+// A moving camera's frame: registered to the first one, its detections moved onto the canvas
+// (those whose foot point then lies outside it or fails `filter` dropped) and the frame drawn
+// there, where the tracker's appearance model reads it at the moved boxes.
+const cv::Mat& ToCanvas(CameraMotion& motion, const FootFilter& filter, const cv::Mat& frame,
+                        std::vector<Detection>& dets, PlayersPass& pass) {
   std::vector<cv::Rect2d> boxes;
   boxes.reserve(dets.size());
   for (const Detection& d : dets) boxes.push_back(d.box);
-  const cv::Matx33d h = motion.Register(frame, boxes);
-  pass.frame_from_first.push_back(h.inv());
+  ViewCanvas& canvas = *pass.canvas;
+  canvas.AddFrame(motion.Register(frame, boxes));
+  const int index = canvas.frames() - 1;
   std::vector<Detection> kept;
   for (Detection d : dets) {
-    d.box = MapBox(h, d.box);
-    // Outside the first frame's view the warped frame is black: no appearance to track by.
-    if (!FootInView(d.box, frame.size())) continue;
+    d.box = canvas.BoxToCanvas(index, d.box);
+    if (!FootInView(d.box, canvas.size())) continue;
     if (!filter || filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height})) {
       kept.push_back(d);
     }
   }
   dets = std::move(kept);
-  cv::Mat view;
-  cv::warpPerspective(frame, view, h, frame.size());
-  return view;
+  canvas.Draw(index, frame, pass.canvas_image);
+  return pass.canvas_image;
 }
 
 // One frame's tracks as rows (1-based frame `frame_number`), with their torso colours for teams.
@@ -624,17 +627,17 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
   if (options.min_track_frames > 0) {
     result.dropped_tracks = DropShortTracks(result.rows, result.min_track_frames);
   }
-  // A moving camera's rows are in the first frame's pixels; the checks at the image's edges take
-  // each box back to its own frame's.
+  // A moving camera's rows are on its canvas; the checks at the image's edges take each box back
+  // to its own frame's.
   FrameBoxOf frame_box;
-  if (!pass.frame_from_first.empty()) {
-    frame_box = [&pass](const TrackRow& r) {
-      return MapBox(pass.frame_from_first[r.frame - 1], r.box);
-    };
+  cv::Size canvas_size;
+  if (pass.canvas) {
+    frame_box = [&pass](const TrackRow& r) { return pass.canvas->BoxToFrame(r.frame - 1, r.box); };
+    canvas_size = pass.canvas->size();
   }
-  result.stitched =
-      StitchTracklets(result.rows, pass.appearance, options.stitch, result.fps, image,
-                      {calibrated ? camera : nullptr, options.tracker.foot_offset_m, frame_box});
+  result.stitched = StitchTracklets(
+      result.rows, pass.appearance, options.stitch, result.fps, image,
+      {calibrated ? camera : nullptr, options.tracker.foot_offset_m, frame_box, canvas_size});
   result.interpolated =
       InterpolateGaps(result.rows, options.interpolate_max_gap, calibrated ? camera : nullptr,
                       options.tracker.foot_offset_m);
@@ -673,8 +676,6 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   options.Check();
   const auto t_start = Clock::now();
   const bool calibrated = camera != nullptr && camera->has_pose;
-  FootFilter filter;
-  if (calibrated) filter = FieldFootFilter(*camera, field, options.field_margin_m);
   // Open the video first: a bad video is reported before the model is loaded.
   // An image sequence is read up to its last file (reading past it makes OpenCV warn).
   const size_t sequence_files = io::ListImageSequence(video).size();
@@ -687,11 +688,24 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   if (camera != nullptr) {
     CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
   }
+  // A moving camera's frames are tracked on its canvas, as the canvas's camera.
+  PlayersPass pass;
+  std::optional<CameraMotion> motion;
+  if (options.moving_camera) {
+    motion.emplace(options.camera_motion, camera);
+    const double margin = options.camera_motion.canvas_margin;
+    pass.canvas = camera != nullptr ? ViewCanvas(*camera, margin)
+                                    : ViewCanvas::Uncalibrated(reader.size(), margin);
+  }
+  const camera::Camera* tracked =
+      pass.canvas && camera != nullptr ? &pass.canvas->camera() : camera;
+  FootFilter filter;
+  if (calibrated) filter = FieldFootFilter(*tracked, field, options.field_margin_m);
   std::unique_ptr<PersonDetector> detector;
   const FileDetector* from_file = nullptr;
   if (!options.detections_in.empty()) {
     options.detector.Check();
-    // A moving camera's feet are judged in the first frame's pixels (ToFirstView).
+    // A moving camera's feet are judged on its canvas (ToCanvas).
     auto file = std::make_unique<FileDetector>(options.detections_in, options.detector,
                                                options.moving_camera ? FootFilter() : filter);
     from_file = file.get();
@@ -707,15 +721,12 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   result.fps = options.fps > 0 ? options.fps : (ValidFps(reader.fps()) ? reader.fps() : 25.0);
   TrackerOptions topt = options.tracker;
   topt.fps = result.fps;
-  ByteTracker tracker(topt, calibrated ? camera : nullptr);
+  ByteTracker tracker(topt, calibrated ? tracked : nullptr);
   long long total = reader.total();
   if (options.max_frames > 0 && (total <= 0 || total > options.max_frames)) {
     total = options.max_frames;
   }
   util::Progress progress("players", total, "frames", options.progress);
-  PlayersPass pass;
-  std::optional<CameraMotion> motion;
-  if (options.moving_camera) motion.emplace(options.camera_motion);
   cv::Mat frame;
   int index = 0;
   double time_ms = 0;
@@ -725,7 +736,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     std::vector<Detection> dets = detector->Detect(frame);
     if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);  // the frame's pixels
     const auto t_register = Clock::now();
-    const cv::Mat view = motion ? ToFirstView(*motion, filter, frame, dets, pass) : frame;
+    const cv::Mat view = motion ? ToCanvas(*motion, filter, frame, dets, pass) : frame;
     const auto t1 = Clock::now();
     result.times.register_s += Seconds(t_register, t1);
     const std::vector<TrackState> states = tracker.Update(dets, view);
@@ -750,12 +761,12 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   }
   if (!options.detections_out.empty()) WriteDetectionsCsv(pass.saved, options.detections_out);
   const auto t_map = Clock::now();
-  FinishTracks(options, camera, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
+  FinishTracks(options, tracked, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
                result);
   if (motion) {  // the boxes back in each frame's own pixels
-    for (TrackRow& r : result.rows) r.box = MapBox(pass.frame_from_first[r.frame - 1], r.box);
+    for (TrackRow& r : result.rows) r.box = pass.canvas->BoxToFrame(r.frame - 1, r.box);
     result.camera_motion = motion->stats();
-    result.frame_from_first = std::move(pass.frame_from_first);
+    result.canvas = std::move(pass.canvas);
   }
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();

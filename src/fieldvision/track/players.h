@@ -20,6 +20,7 @@
 #include "fieldvision/track/ground_smoother.h"
 #include "fieldvision/track/hidden_feet.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/view_canvas.h"
 
 namespace fv::track {
 
@@ -83,12 +84,13 @@ struct PlayersOptions {
   // frames). The same filtering (min height, field area, NMS, score threshold) is applied.
   std::string detections_in;
   // Write the detections of every frame (after filtering; with a moving camera before the field
-  // filter, which is applied in the first frame's pixels) to this file; reading it back with
+  // filter, which is applied on its canvas) to this file; reading it back with
   // detections_in and the same options gives the same tracks.
   std::string detections_out;
-  // A camera that sways, turns or drifts (camera_motion.h): every frame is registered to the
-  // first, the view the camera file's pose holds for, and tracked in that frame's pixels; the
-  // rows' boxes are given back in each frame's own pixels. Not with the "motion" detector
+  // A camera that sways, turns, pans or drifts (camera_motion.h): every frame is registered to
+  // the first, the view the camera file's pose holds for, and tracked on that view widened by
+  // camera_motion.canvas_margin (view_canvas.h); the rows' boxes are given back in each frame's
+  // own pixels. Not with the "motion" detector
   // (background subtraction needs a still camera).
   bool moving_camera = false;
   CameraMotionOptions camera_motion;
@@ -131,9 +133,9 @@ struct PlayersResult {
   int off_ground = 0;        // rows whose foot point does not meet the ground
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
-  // Its homographies from the first frame's pixels to each frame's (0-based), as
-  // TrackOverlay::SetCameraMotion takes them.
-  std::vector<cv::Matx33d> frame_from_first;
+  // The canvas its frames were tracked on (view_canvas.h), as TrackOverlay::SetCameraMotion
+  // takes it.
+  std::optional<ViewCanvas> canvas;
   TrackerStats tracker;
   StageTimes times;
   std::string detector;
@@ -156,7 +158,8 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
 struct StitchCamera {
   const camera::Camera* camera = nullptr;
   double foot_offset_m = 0.0;  // as TrackerOptions::foot_offset_m
-  FrameBoxOf frame_box;        // rows in the first frame's pixels (a moving camera)
+  FrameBoxOf frame_box;        // rows on a moving camera's canvas: each one's box in its frame
+  cv::Size canvas_size;        // the canvas's size (with frame_box)
 };
 
 // Joins tracklets in `rows` (StitchOptions); `appearance` by id (ids without one are joined on
