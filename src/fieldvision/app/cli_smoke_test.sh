@@ -488,6 +488,27 @@ grep -q "the tracks cover frames 1-1 of the 6 drawn" "$TMP/out" ||
   { echo "FAIL tracks draw: the covered frames not said"; fail=1; }
 check "tracks draw: --field without a camera" nonzero $FV tracks draw --tracks "$TMP/tr.csv" \
   --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/trf.avi"
+# A moving camera's motion goes beside its TRACKS.csv; tracks draw reads it; a still run removes it.
+check "players: --moving-camera writes its motion" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
+  --video "$TMP/bv/cam1.avi" --out "$TMP/mv.csv" --moving-camera --no-progress
+[ -s "$TMP/mv.csv.motion.json" ] || { echo "FAIL players: no motion file"; fail=1; }
+# (the scene has no people: its motion goes with a TRACKS.csv of one row)
+cp "$TMP/tr.csv" "$TMP/trm.csv" && cp "$TMP/mv.csv.motion.json" "$TMP/trm.csv.motion.json"
+check "tracks draw: a moving camera's motion" 0 $FV tracks draw --tracks "$TMP/trm.csv" \
+  --video "$TMP/bv/cam1.avi" --camera "$TMP/bv/cam1.yaml" --field robocup-msl --out "$TMP/mvd.avi"
+grep -q "camera motion from .*trm.csv.motion.json (6 frames)" "$TMP/out" ||
+  { echo "FAIL tracks draw: motion file not read"; fail=1; }
+check "tracks edit: the motion goes with the tracks" 0 $FV tracks edit --tracks "$TMP/trm.csv" \
+  --edits "$TMP/ren.json" --out "$TMP/trm_ed.csv"
+cmp -s "$TMP/trm.csv.motion.json" "$TMP/trm_ed.csv.motion.json" ||
+  { echo "FAIL tracks edit: motion file not carried"; fail=1; }
+echo '{"format": "fieldvision camera motion 1"' >"$TMP/trm.csv.motion.json"
+check "tracks draw: a broken motion file" nonzero $FV tracks draw --tracks "$TMP/trm.csv" \
+  --video "$TMP/bv/cam1.avi" --out "$TMP/mvd.avi"
+grep -q "trm.csv.motion.json" "$TMP/err" || { echo "FAIL tracks draw: motion file not named"; fail=1; }
+check "players: a still camera removes the motion" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
+  --video "$TMP/bv/cam1.avi" --out "$TMP/mv.csv" --no-progress
+[ -e "$TMP/mv.csv.motion.json" ] && { echo "FAIL players: an earlier motion file kept"; fail=1; }
 # Progress: a line redrawn on a terminal; nothing in a log unless asked for (the studio's jobs).
 "$FV" synth --preset kick --frames 3 --width 160 --height 120 --out "$TMP/prog" >/dev/null \
   2>"$TMP/prog.err"

@@ -11,6 +11,7 @@
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/motion_file.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/track/players.h"
 #include "fieldvision/util/csv.h"
@@ -47,6 +48,8 @@ void RunPlayersCommand(const PlayersCli& c) {
   roster.team_of = r.team_of;
   const std::string roster_done = track::SaveRosterFor(c.out, roster);
   if (!roster_done.empty()) std::cout << roster_done << "\n";
+  const std::string motion_done = track::SaveMotionFor(c.out, r.canvas ? &*r.canvas : nullptr);
+  if (!motion_done.empty()) std::cout << motion_done << "\n";
   std::cout << r.Summary() << "\nwrote " << c.out << (c.mot_out.empty() ? "" : " and " + c.mot_out)
             << "\n";
   if (r.rows.empty()) {
@@ -207,6 +210,7 @@ void Setup(CLI::App& app, int& exit_code) {
       util::CheckOutputPath(out, util::PathList(inputs, c->out), what);
     }
     util::CheckOutputPath(track::RosterPathFor(c->out), inputs, "--out's teams file");
+    util::CheckOutputPath(track::MotionPathFor(c->out), inputs, "--out's camera motion file");
     if (!c->draw.empty()) io::CheckVideoOutput(c->draw, util::PathList(inputs, c->out), "--draw");
     // A device, a folder or a missing folder as an output is refused before the run.
     for (const auto& [out, what] : {std::pair{c->out, "--out"},

@@ -17,6 +17,7 @@
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/track/edits.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/motion_file.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
@@ -48,6 +49,9 @@ void RunTracksEdit(const TracksEditCli& c) {
   const std::vector<std::string> inputs = {c.tracks, c.edits, roster_in};
   util::CheckOutputPath(c.out, inputs);
   util::CheckOutputPath(track::RosterPathFor(c.out), inputs, "--out's teams file");
+  const std::string motion_in = track::MotionPathFor(c.tracks);
+  util::CheckOutputPath(track::MotionPathFor(c.out), {c.tracks, c.edits, roster_in, motion_in},
+                        "--out's camera motion file");
   util::ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
@@ -55,6 +59,11 @@ void RunTracksEdit(const TracksEditCli& c) {
   std::cout << r.Summary() << "\nwrote " << c.out << "\n";
   const std::string roster_done = track::SaveRosterFor(c.out, r.roster);
   if (!roster_done.empty()) std::cout << roster_done << "\n";
+  // A moving camera's motion goes with its tracks (tracks draw reads it).
+  std::optional<track::ViewCanvas> motion;
+  if (std::filesystem::exists(motion_in)) motion = track::ReadMotionFile(motion_in);
+  const std::string motion_done = track::SaveMotionFor(c.out, motion ? &*motion : nullptr);
+  if (!motion_done.empty()) std::cout << motion_done << "\n";
 }
 
 struct TracksDrawCli {
@@ -120,9 +129,16 @@ void RunTracksDraw(const TracksDrawCli& c) {
              "--field draws the field's lines through a posed camera: give --camera CAM.yaml "
              "with a pose");
   if (!c.field.empty()) field = field::LoadField(c.field);
-  const track::TrackOverlay overlay(rows, roster.team_of, roster.name_of,
-                                    camera ? &*camera : nullptr, field ? &*field : nullptr,
-                                    c.overlay);
+  track::TrackOverlay overlay(rows, roster.team_of, roster.name_of, camera ? &*camera : nullptr,
+                              field ? &*field : nullptr, c.overlay);
+  // A moving camera's tracks: the lines and trails follow its frames as players --draw drew them.
+  const std::string motion_in = track::MotionPathFor(c.tracks);
+  if (std::filesystem::exists(motion_in)) {
+    const auto canvas =
+        track::ReadMotionFile(motion_in, camera && camera->has_pose ? &*camera : nullptr);
+    overlay.SetCameraMotion(canvas);
+    std::cout << "camera motion from " << motion_in << " (" << canvas.frames() << " frames)\n";
+  }
   const track::DrawVideoResult d =
       track::DrawTracksVideo(c.video, c.out, overlay, c.fps, c.max_frames);
   std::cout << d.Summary() << "\n";

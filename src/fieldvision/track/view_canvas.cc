@@ -25,6 +25,7 @@ ViewCanvas::ViewCanvas(const camera::Camera& lens, double margin) : lens_(lens) 
   FV_REQUIRE(std::isfinite(margin) && margin >= 0 && margin <= 10,
              "the canvas margin must be in [0, 10] image sizes (got {})", margin);
   k_ = Intrinsics(lens_);
+  margin_ = margin;
   const double dx = std::round(margin * lens_.width), dy = std::round(margin * lens_.height);
   canvas_from_first_ = Shift(dx, dy);
   canvas_ = lens_;
@@ -57,6 +58,11 @@ void ViewCanvas::AddFrame(const cv::Matx33d& first_from_frame) {
 const cv::Matx33d& ViewCanvas::CanvasFromFrame(int index) const {
   FV_REQUIRE(index >= 0 && index < frames(), "canvas: frame {} of {}", index, frames());
   return canvas_from_frame_[index];
+}
+
+cv::Matx33d ViewCanvas::FirstFromFrame(int index) const {
+  cv::Matx33d h = canvas_from_first_.inv() * CanvasFromFrame(index);
+  return h * (1.0 / h(2, 2));
 }
 
 std::optional<cv::Point2d> ViewCanvas::ToCanvas(int index, const cv::Point2d& frame_px) const {

@@ -34,8 +34,10 @@ class ViewCanvas {
   // (CameraMotion::Register with this lens).
   void AddFrame(const cv::Matx33d& first_from_frame);
   int frames() const { return static_cast<int>(canvas_from_frame_.size()); }
-  // From the undistorted pixels of frame `index` (0-based) to the canvas.
+  // From the undistorted pixels of frame `index` (0-based) to the canvas, and to the first view.
   const cv::Matx33d& CanvasFromFrame(int index) const;
+  cv::Matx33d FirstFromFrame(int index) const;
+  double margin() const { return margin_; }
 
   // A pixel of frame `index` on the canvas; nullopt where the lens cannot undistort it.
   std::optional<cv::Point2d> ToCanvas(int index, const cv::Point2d& frame_px) const;
@@ -61,6 +63,7 @@ class ViewCanvas {
 
   camera::Camera lens_;
   camera::Camera canvas_;
+  double margin_ = 0;
   cv::Matx33d k_;                  // the lens's intrinsics (the undistorted pixels' matrix)
   cv::Matx33d canvas_from_first_;  // the margin's shift
   std::vector<cv::Matx33d> canvas_from_frame_;
