@@ -116,11 +116,13 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
                 "Keep the foot point of every box: do not move the feet of a person whose legs "
                 "are hidden (a box whose top lies under 0.85 of their height above its foot) to "
                 "below the head at their height");
-  cmd->add_flag("--moving-camera", c.o.moving_camera,
-                "The camera sways, turns, pans or drifts (a phone held by hand or following "
-                "play, a drone): each frame is registered to the first (ORB features off the "
-                "people, a homography), where the camera file's pose holds, and people are "
-                "tracked and placed on that view widened by --canvas-margin");
+  cmd->add_flag(
+      "--moving-camera", c.o.moving_camera,
+      "The camera sways, turns, pans or drifts (a phone held by hand or following "
+      "play, a drone): each frame is registered to the first (optical flow and ORB "
+      "features off the people, a homography), where the camera file's pose holds, and people are "
+      "tracked and placed on that view widened by --canvas-margin (writes "
+      "TRACKS.csv.motion.json, read by tracks draw)");
   cmd->add_option("--canvas-margin", c.o.camera_motion.canvas_margin,
                   "With --moving-camera: how many image widths (heights) beyond the first view "
                   "people are tracked on each side")

@@ -53,16 +53,16 @@ void RunTracksEdit(const TracksEditCli& c) {
   util::CheckOutputPath(track::MotionPathFor(c.out), {c.tracks, c.edits, roster_in, motion_in},
                         "--out's camera motion file");
   util::ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
+  // A moving camera's motion goes with its tracks (tracks draw reads it); checked before writing.
+  const bool has_motion = std::filesystem::exists(motion_in);
+  if (has_motion) track::ReadMotionFile(motion_in);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);
   std::cout << r.Summary() << "\nwrote " << c.out << "\n";
   const std::string roster_done = track::SaveRosterFor(c.out, r.roster);
   if (!roster_done.empty()) std::cout << roster_done << "\n";
-  // A moving camera's motion goes with its tracks (tracks draw reads it).
-  std::optional<track::ViewCanvas> motion;
-  if (std::filesystem::exists(motion_in)) motion = track::ReadMotionFile(motion_in);
-  const std::string motion_done = track::SaveMotionFor(c.out, motion ? &*motion : nullptr);
+  const std::string motion_done = track::CarryMotionTo(c.out, has_motion ? motion_in : "");
   if (!motion_done.empty()) std::cout << motion_done << "\n";
 }
 
@@ -135,7 +135,8 @@ void RunTracksDraw(const TracksDrawCli& c) {
   const std::string motion_in = track::MotionPathFor(c.tracks);
   if (std::filesystem::exists(motion_in)) {
     const auto canvas =
-        track::ReadMotionFile(motion_in, camera && camera->has_pose ? &*camera : nullptr);
+        track::ReadMotionFile(motion_in, camera && camera->has_pose ? &*camera : nullptr,
+                              fmt::format("camera file '{}'", c.camera));
     overlay.SetCameraMotion(canvas);
     std::cout << "camera motion from " << motion_in << " (" << canvas.frames() << " frames)\n";
   }

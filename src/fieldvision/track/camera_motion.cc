@@ -66,6 +66,12 @@ bool Plausible(const cv::Matx33d& h, const cv::Size& size) {
 
 }  // namespace
 
+cv::Matx33d NormalizedHomography(const cv::Matx33d& h) {
+  const double n = cv::norm(h);
+  if (!(n > 0) || !std::isfinite(n)) return h;
+  return h * ((cv::determinant(h) < 0 ? -1.0 : 1.0) / n);
+}
+
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box) {
   return MapBoxBy([&h](const cv::Point2d& p) { return std::optional(Apply(h, p)); }, box);
 }
@@ -140,8 +146,10 @@ std::vector<cv::Point2f> CameraMotion::ToUndistorted(std::vector<cv::Point2f> wo
   for (cv::Point2f& p : work_px) p *= 1.0 / scale;
   if (lens_ && !work_px.empty()) {
     const cv::Matx33d k(lens_->fx, 0, lens_->cx, 0, lens_->fy, lens_->cy, 0, 0, 1);
-    cv::undistortPoints(std::vector<cv::Point2f>(work_px), work_px, k, lens_->distortion,
-                        cv::noArray(), k);
+    // Iterated to convergence, as Camera::Undistort (OpenCV's default stops after 5 steps).
+    cv::undistortPoints(
+        std::vector<cv::Point2f>(work_px), work_px, k, lens_->distortion, cv::noArray(), k,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50, 1e-9));
   }
   return work_px;
 }
@@ -268,7 +276,7 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
   for (int i = 0; i <= std::min(since_registered_, kMaxCarried - 1); ++i) {
     predicted = predicted * velocity_;
   }
-  predicted *= 1.0 / predicted(2, 2);
+  predicted = NormalizedHomography(predicted);
   // Optical flow from the prediction first (the first frame where the view is back over it, the
   // keyframe, the frame before), then descriptors (a jump, or a view found again after frames
   // lost): descriptors on repeated texture can lock on a copy of it one period off.
@@ -307,15 +315,15 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     ++stats_.chained;  // the keyframe is out of reach: this frame is the next one
     new_key = true;
   }
-  h *= 1.0 / h(2, 2);
-  const cv::Point2d centre(0.5 * (size_.width - 1), 0.5 * (size_.height - 1));
+  h = NormalizedHomography(h);
+  const cv::Point2d centre = Centre();
   const cv::Point2d moved = Apply(h, centre);
   stats_.max_shift_px =
       std::max(stats_.max_shift_px, std::hypot(moved.x - centre.x, moved.y - centre.y));
   // The step from the last registered frame (over frames lost, the step before is kept).
   if (since_registered_ == 0) {
     velocity_ = previous_.first_from_view.inv() * h;
-    velocity_ *= 1.0 / velocity_(2, 2);
+    velocity_ = NormalizedHomography(velocity_);
   }
   since_registered_ = 0;
   previous_ = {std::move(f), h};

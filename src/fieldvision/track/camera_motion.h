@@ -92,6 +92,7 @@ class CameraMotion {
   // Points at work scale to undistorted frame pixels, and one back.
   std::vector<cv::Point2f> ToUndistorted(std::vector<cv::Point2f> work_px, double scale) const;
   cv::Point2f ToWork(const cv::Point2d& undistorted, double scale) const;
+  cv::Point2d Centre() const { return {0.5 * (size_.width - 1), 0.5 * (size_.height - 1)}; }
   // The share of this frame's area that the view at a_from_b covers.
   double Overlap(const cv::Matx33d& a_from_b) const;
 
@@ -105,6 +106,11 @@ class CameraMotion {
   cv::Size size_;
   CameraMotionStats stats_;
 };
+
+// A homography scaled to unit norm with a positive determinant (a camera's turn or drift keeps
+// the image's orientation), not h(2,2) = 1: that is near 0 or negative once the camera has
+// turned 90 degrees from the view, where points behind it must stay behind (w < 0).
+cv::Matx33d NormalizedHomography(const cv::Matx33d& h);
 
 // A person's box moved by a homography: the bottom centre (the foot) and the top centre map as
 // points; the width scales with the height.

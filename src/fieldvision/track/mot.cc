@@ -20,6 +20,11 @@
 
 namespace fv::track {
 
+bool BoxInRange(const cv::Rect2d& box) {
+  return std::abs(box.x) <= kMaxBoxPixel && std::abs(box.y) <= kMaxBoxPixel && box.width >= 0 &&
+         box.height >= 0 && box.width <= kMaxBoxPixel && box.height <= kMaxBoxPixel;
+}
+
 void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) {
   util::AtomicWrite(path, [&](const std::string& tmp) {
     util::CsvWriter w(tmp,
@@ -73,7 +78,6 @@ std::string ReadTracksText(const std::string& path, bool* has_header) {
 
 // Row `i` of `t` as a TrackRow, its numbers checked (NaN fails them too).
 TrackRow TrackRowAt(const util::CsvTable& t, size_t i, bool has_header) {
-  constexpr double kMaxPixel = 1e6;
   constexpr double kMaxFieldM = 1e4;
   constexpr long long kMaxFrame = 100000000;  // 46 days at 25 frames/s; 2e9 is a damaged file
   const std::string where = t.Where(i);
@@ -86,10 +90,10 @@ TrackRow TrackRowAt(const util::CsvTable& t, size_t i, bool has_header) {
   r.id = static_cast<int>(t.GetInt(i, "id"));
   r.box = cv::Rect2d(t.GetDouble(i, "bb_left"), t.GetDouble(i, "bb_top"),
                      t.GetDouble(i, "bb_width"), t.GetDouble(i, "bb_height"));
-  FV_REQUIRE(std::abs(r.box.x) <= kMaxPixel && std::abs(r.box.y) <= kMaxPixel &&
-                 r.box.width <= kMaxPixel && r.box.height <= kMaxPixel,
+  FV_REQUIRE(std::abs(r.box.x) <= kMaxBoxPixel && std::abs(r.box.y) <= kMaxBoxPixel &&
+                 r.box.width <= kMaxBoxPixel && r.box.height <= kMaxBoxPixel,
              "{}: box {},{},{},{} is not a box in an image (finite, within +-{:.0f} px)", where,
-             r.box.x, r.box.y, r.box.width, r.box.height, kMaxPixel);
+             r.box.x, r.box.y, r.box.width, r.box.height, kMaxBoxPixel);
   FV_REQUIRE(r.box.width >= 0 && r.box.height >= 0, "{}: negative box size", where);
   if (present("conf")) r.conf = t.GetDouble(i, "conf");
   FV_REQUIRE(std::isfinite(r.conf), "{}: conf is not a finite number", where);

@@ -32,9 +32,14 @@ struct TrackRow {
 };
 
 // A row's box in its own frame's pixels, for the checks at the image's edges (a tracklet ending at
-// the border, a box whose top is the image's): with a moving camera the rows are in the first
-// frame's pixels (camera_motion.h). Empty: the box as it is.
+// the border, a box whose top is the image's): with a moving camera the rows are on its canvas
+// (view_canvas.h). Empty: the box as it is.
 using FrameBoxOf = std::function<cv::Rect2d(const TrackRow&)>;
+
+// The largest pixel coordinate and size of a box TRACKS.csv holds (ReadTracksCsv refuses others).
+inline constexpr double kMaxBoxPixel = 1e6;
+// Whether a box is finite, of non-negative size and within kMaxBoxPixel.
+bool BoxInRange(const cv::Rect2d& box);
 
 // Writes TRACKS.csv with the contract header (rows in the order given), through a temporary file
 // renamed at the end (a failed write leaves an existing file as it was).

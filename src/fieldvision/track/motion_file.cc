@@ -56,7 +56,8 @@ void WriteMotionFile(const ViewCanvas& canvas, const std::string& path) {
   util::WriteTextFile(path, j.dump(1) + "\n", "the camera motion file");
 }
 
-ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed) {
+ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed,
+                          const std::string& posed_what) {
   const nlohmann::json j = util::ReadJsonFile(path, "camera motion file");
   const std::string ctx = fmt::format("camera motion file '{}'", path);
   FV_REQUIRE(j.is_object(), "{}: expected a JSON object", ctx);
@@ -77,21 +78,44 @@ ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed) 
   lens.Check(ctx);
   if (posed != nullptr) {
     FV_REQUIRE(SameLens(lens, *posed),
-               "{}: the tracks were registered through another lens than camera file '{}' ({}x{}, "
-               "fx {:.6g} against {}x{}, fx {:.6g})",
-               ctx, posed->name, lens.width, lens.height, lens.fx, posed->width, posed->height,
+               "{}: the tracks were registered through another lens than {} ({}x{}, fx {:.6g} "
+               "against {}x{}, fx {:.6g})",
+               ctx, posed_what, lens.width, lens.height, lens.fx, posed->width, posed->height,
                posed->fx);
     lens = *posed;
   }
-  ViewCanvas canvas(lens, util::JsonNumber(j, "canvas_margin", ctx));
+  const double margin = util::JsonNumber(j, "canvas_margin", ctx);
   const nlohmann::json& frames = util::JsonArray(j, "first_from_frame", ctx);
   FV_REQUIRE(!frames.empty(), "{}: first_from_frame has no frame", ctx);
+  std::vector<cv::Matx33d> first_from_frame;
   for (size_t i = 0; i < frames.size(); ++i) {
     const std::vector<double> v =
         util::JsonFixedNumbers(frames[i], 9, fmt::format("{}: first_from_frame[{}]", ctx, i));
-    canvas.AddFrame(cv::Matx33d(v.data()));
+    first_from_frame.emplace_back(v.data());
   }
-  return canvas;
+  // The canvas's own checks (margin, homographies) name the file too.
+  try {
+    ViewCanvas canvas(lens, margin);
+    for (const cv::Matx33d& h : first_from_frame) canvas.AddFrame(h);
+    return canvas;
+  } catch (const Error& e) {
+    Throw("{}: {}", ctx, e.what());
+  }
+}
+
+std::string CarryMotionTo(const std::string& tracks_path, const std::string& from) {
+  if (from.empty()) return SaveMotionFor(tracks_path, nullptr);
+  const std::string path = MotionPathFor(tracks_path);
+  util::AtomicWrite(
+      path,
+      [&from](const std::string& temp) {
+        std::error_code ec;
+        std::filesystem::copy_file(from, temp, std::filesystem::copy_options::overwrite_existing,
+                                   ec);
+        FV_REQUIRE(!ec, "cannot copy the camera motion file '{}': {}", from, ec.message());
+      },
+      "the camera motion file");
+  return fmt::format("wrote {} (the camera's motion of {}, read by tracks draw)", path, from);
 }
 
 std::string SaveMotionFor(const std::string& tracks_path, const ViewCanvas* canvas) {

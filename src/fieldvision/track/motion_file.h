@@ -20,10 +20,16 @@ void WriteMotionFile(const ViewCanvas& canvas, const std::string& path);
 // Reads a motion file. With `posed` (a camera file with a pose, for the field lines) its lens must
 // be the file's (size, intrinsics, distortion) and the canvas takes its pose. Throws fv::Error
 // naming the file and the key for a malformed file, and both files for another lens.
-ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed = nullptr);
+// `posed_what` names the camera in that error.
+ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed = nullptr,
+                          const std::string& posed_what = "the camera");
 
 // After `players` wrote `tracks_path`: the motion file beside it written (a moving camera) or an
 // earlier run's removed (a still one, canvas null). Returns a line for the user, or "".
 std::string SaveMotionFor(const std::string& tracks_path, const ViewCanvas* canvas);
+
+// After `tracks edit` wrote `tracks_path`: the motion file `from` (read first: valid) copied beside
+// it byte for byte, or, with `from` empty, an earlier one there removed. Returns a line or "".
+std::string CarryMotionTo(const std::string& tracks_path, const std::string& from);
 
 }  // namespace fv::track

@@ -410,7 +410,7 @@ std::string PlayersResult::Summary() const {
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}{}, "
-      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}",
+      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -422,6 +422,9 @@ std::string PlayersResult::Summary() const {
       1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary(),
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
       camera_motion ? "; " + camera_motion->Summary() : "",
+      outside_frames > 0
+          ? fmt::format(" ({} rows left out: beyond what their frame shows)", outside_frames)
+          : "",
       frames_note.empty() ? "" : "; " + frames_note);
 }
 
@@ -765,6 +768,12 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
                result);
   if (motion) {  // the boxes back in each frame's own pixels
     for (TrackRow& r : result.rows) r.box = pass.canvas->BoxToFrame(r.frame - 1, r.box);
+    // A row carried or filled in beyond what its frame can show (behind its view) has no box
+    // there: left out.
+    const auto outside = std::remove_if(result.rows.begin(), result.rows.end(),
+                                        [](const TrackRow& r) { return !BoxInRange(r.box); });
+    result.outside_frames = static_cast<int>(result.rows.end() - outside);
+    result.rows.erase(outside, result.rows.end());
     result.camera_motion = motion->stats();
     result.canvas = std::move(pass.canvas);
   }

@@ -131,6 +131,7 @@ struct PlayersResult {
   int stitched = 0;          // tracklets joined to an earlier one
   std::string frames_note;   // what the frame source did to the frames (FramesNote), or ""
   int off_ground = 0;        // rows whose foot point does not meet the ground
+  int outside_frames = 0;    // a moving camera's rows whose box their frame cannot show (left out)
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
   // The canvas its frames were tracked on (view_canvas.h), as TrackOverlay::SetCameraMotion

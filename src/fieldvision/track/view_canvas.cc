@@ -32,9 +32,12 @@ ViewCanvas::ViewCanvas(const camera::Camera& lens, double margin) : lens_(lens) 
   canvas_.name = lens_.name + " canvas";
   canvas_.width = lens_.width + 2 * static_cast<int>(dx);
   canvas_.height = lens_.height + 2 * static_cast<int>(dy);
-  FV_REQUIRE(
-      canvas_.width <= camera::Camera::kMaxSide && canvas_.height <= camera::Camera::kMaxSide,
-      "the canvas of {}x{} frames with margin {} is too large", lens_.width, lens_.height, margin);
+  // A BGR canvas of at most 100 Mpx (300 MB), as large again for the overlay's lines.
+  constexpr double kMaxCanvasPixels = 1e8;
+  FV_REQUIRE(static_cast<double>(canvas_.width) * canvas_.height <= kMaxCanvasPixels,
+             "a canvas margin of {} makes {}x{} frames a {}x{} canvas (over 100 Mpx): use a "
+             "smaller margin",
+             margin, lens_.width, lens_.height, canvas_.width, canvas_.height);
   canvas_.cx += dx;
   canvas_.cy += dy;
   canvas_.distortion.clear();
@@ -48,11 +51,10 @@ ViewCanvas ViewCanvas::Uncalibrated(cv::Size size, double margin) {
 }
 
 void ViewCanvas::AddFrame(const cv::Matx33d& first_from_frame) {
-  cv::Matx33d h = canvas_from_first_ * first_from_frame;
-  FV_REQUIRE(std::isfinite(cv::norm(h)) && std::abs(h(2, 2)) > 1e-12,
-             "canvas: frame {} has no usable homography", frames());
-  h *= 1.0 / h(2, 2);
-  canvas_from_frame_.push_back(h);
+  const cv::Matx33d h = canvas_from_first_ * first_from_frame;
+  FV_REQUIRE(std::isfinite(cv::norm(h)) && cv::determinant(h) != 0,
+             "canvas: frame {} has no usable homography", frames() + 1);
+  canvas_from_frame_.push_back(NormalizedHomography(h));
 }
 
 const cv::Matx33d& ViewCanvas::CanvasFromFrame(int index) const {
@@ -61,8 +63,7 @@ const cv::Matx33d& ViewCanvas::CanvasFromFrame(int index) const {
 }
 
 cv::Matx33d ViewCanvas::FirstFromFrame(int index) const {
-  cv::Matx33d h = canvas_from_first_.inv() * CanvasFromFrame(index);
-  return h * (1.0 / h(2, 2));
+  return NormalizedHomography(canvas_from_first_.inv() * CanvasFromFrame(index));
 }
 
 std::optional<cv::Point2d> ViewCanvas::ToCanvas(int index, const cv::Point2d& frame_px) const {
@@ -78,8 +79,13 @@ std::optional<cv::Point2d> ViewCanvas::ToFrame(int index, const cv::Point2d& can
   const cv::Vec3d q = CanvasFromFrame(index).inv() * cv::Vec3d(canvas_px.x, canvas_px.y, 1.0);
   if (!(q[2] > 0)) return std::nullopt;
   const cv::Vec3d n = k_.inv() * q;
-  const auto uv = lens_.ProjectFromCamera({n[0] / n[2], n[1] / n[2], 1.0});
+  const Eigen::Vector2d xn(n[0] / n[2], n[1] / n[2]);
+  const auto uv = lens_.ProjectFromCamera({xn.x(), xn.y(), 1.0});
   if (!uv) return std::nullopt;
+  // Beyond the lens model's fold a far point lands back inside the image: such a point is not
+  // in the frame's view.
+  const auto back = lens_.Undistort(*uv);
+  if (!back || (*back - xn).norm() > 1e-6 * (1.0 + xn.norm())) return std::nullopt;
   return cv::Point2d(uv->x(), uv->y());
 }
 
@@ -131,7 +137,7 @@ cv::Rect ViewCanvas::Draw(int index, const cv::Mat& frame, cv::Mat& canvas) {
       Shift(-drawn_.x, -drawn_.y) * CanvasFromFrame(index) * k_;
   cv::Mat map1, map2;
   cv::initUndistortRectifyMap(k_, lens_.distortion, cv::noArray(), region_from_normalized,
-                              drawn_.size(), CV_16SC2, map1, map2);
+                              drawn_.size(), CV_32FC1, map1, map2);
   cv::Mat region = canvas(drawn_);
   cv::remap(frame, region, map1, map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
   return drawn_;

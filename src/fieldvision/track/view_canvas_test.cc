@@ -134,8 +134,29 @@ TEST(ViewCanvas, DrawnFrameAndWhatTheFrameSeesAgree) {
   EXPECT_LT(cv::mean(diff)[0] + cv::mean(diff)[1], 4.0);
 }
 
-// Bad input: a margin out of range, a homography with NaN, a frame of another size, an image of
-// another size than the canvas, a frame index beyond those added: each one error naming it.
+// A canvas point far beyond a strong barrel lens's fold (k1 -0.3 folds at 1.05 normalized) is not
+// in the frame's view, though the lens model would put it back inside the image. A camera turned
+// by 100 degrees: the ray through its centre does not meet the canvas (it points behind the first
+// view), so it is not placed there, and the canvas's centre is not taken into its view.
+TEST(ViewCanvas, PointsBeyondTheLensOrBehindTheViewAreNotInTheFrame) {
+  camera::Camera lens = Lens();
+  lens.distortion = {-0.3, 0, 0, 0, 0};
+  ViewCanvas canvas(lens, 1.0);
+  canvas.AddFrame(cv::Matx33d::eye());
+  const double cx = canvas.camera().cx, cy = canvas.camera().cy;
+  EXPECT_FALSE(canvas.ToFrame(0, {cx + 1.6 * lens.fx, cy}).has_value());
+  EXPECT_TRUE(canvas.ToFrame(0, {cx + 0.5 * lens.fx, cy}).has_value());
+  cv::Matx33d first_from;
+  Turned(Lens(), {0.0, 100.0 * M_PI / 180.0, 0.0}, &first_from);
+  ViewCanvas wide(Lens(), 1.0);
+  wide.AddFrame(first_from);
+  EXPECT_FALSE(wide.ToCanvas(0, {lens.cx, lens.cy}).has_value());
+  EXPECT_FALSE(wide.ToFrame(0, {wide.camera().cx, wide.camera().cy}).has_value());
+}
+
+// Bad input: a margin out of range or making a canvas over 100 Mpx, a homography with NaN, a frame
+// of another size, an image of another size than the canvas, a frame index beyond those added:
+// each one error naming it.
 TEST(ViewCanvas, BadInputIsRefused) {
   const camera::Camera lens = Lens();
   EXPECT_THAT([&] { ViewCanvas(lens, -1.0); },
@@ -146,7 +167,7 @@ TEST(ViewCanvas, BadInputIsRefused) {
   cv::Matx33d bad = cv::Matx33d::eye();
   bad(0, 2) = std::nan("");
   EXPECT_THAT([&] { canvas.AddFrame(bad); },
-              ThrowsMessage<Error>(HasSubstr("frame 0 has no usable homography")));
+              ThrowsMessage<Error>(HasSubstr("frame 1 has no usable homography")));
   canvas.AddFrame(cv::Matx33d::eye());
   cv::Mat image;
   EXPECT_THAT([&] { canvas.Draw(0, cv::Mat(100, 100, CV_8UC3), image); },
@@ -159,6 +180,8 @@ TEST(ViewCanvas, BadInputIsRefused) {
         ViewCanvas::Uncalibrated({0, 0}, 1.0);
       },
       ThrowsMessage<Error>(HasSubstr("the frames' size")));
+  EXPECT_THAT([&] { ViewCanvas(lens, 10.0); },
+              ThrowsMessage<Error>(HasSubstr("13440x10080 canvas (over 100 Mpx)")));
 }
 
 }  // namespace
