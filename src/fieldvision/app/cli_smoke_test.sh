@@ -498,6 +498,10 @@ check "tracks draw: a moving camera's motion" 0 $FV tracks draw --tracks "$TMP/t
   --video "$TMP/bv/cam1.avi" --camera "$TMP/bv/cam1.yaml" --field robocup-msl --out "$TMP/mvd.avi"
 grep -q "camera motion from .*trm.csv.motion.json (6 frames)" "$TMP/out" ||
   { echo "FAIL tracks draw: motion file not read"; fail=1; }
+check "eval tracks: a moving camera's ground truth" 0 $FV eval tracks --gt "$TMP/trm.csv" \
+  --est "$TMP/trm.csv" --camera "$TMP/bv/cam1.yaml"
+grep -q "ground truth placed through the camera's motion" "$TMP/out" ||
+  { echo "FAIL eval tracks: motion file not used"; fail=1; }
 check "tracks edit: the motion goes with the tracks" 0 $FV tracks edit --tracks "$TMP/trm.csv" \
   --edits "$TMP/ren.json" --out "$TMP/trm_ed.csv"
 cmp -s "$TMP/trm.csv.motion.json" "$TMP/trm_ed.csv.motion.json" ||

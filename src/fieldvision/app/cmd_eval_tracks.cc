@@ -1,6 +1,7 @@
 // `fieldvision eval tracks`: MOTA, MOTP, IDF1, HOTA of TRACKS.csv against ground truth; and
 // `fieldvision eval import-pets`: PETS CVML annotations -> MOT CSV.
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -14,6 +15,7 @@
 #include "fieldvision/stats/stats.h"
 #include "fieldvision/track/bytetrack.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/motion_file.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/track/position_eval.h"
 #include "fieldvision/util/error.h"
@@ -134,7 +136,17 @@ void RunEvalTracks(const EvalTracksCli& c) {
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
   std::vector<track::TrackRow> placed = gt;
-  if (cam) track::PlaceFeet(*cam, c.foot_offset_m, &placed);
+  // A moving camera's tracks (players --moving-camera): the ground truth's feet through the
+  // camera's motion saved beside them.
+  const std::string motion = track::MotionPathFor(c.est);
+  if (cam && std::filesystem::exists(motion)) {
+    const track::ViewCanvas canvas =
+        track::ReadMotionFile(motion, &*cam, fmt::format("camera file '{}'", c.camera));
+    track::PlaceFeet(canvas, c.foot_offset_m, &placed);
+    std::cout << "ground truth placed through the camera's motion in " << motion << "\n";
+  } else if (cam) {
+    track::PlaceFeet(*cam, c.foot_offset_m, &placed);
+  }
   const auto positions = ScorePositions(c, placed, est);
   if (positions) std::cout << positions->Summary() << "\n";
   const auto coach = positions ? CompareCoachNumbers(placed, est) : std::nullopt;

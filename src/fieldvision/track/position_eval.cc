@@ -77,6 +77,24 @@ void PlaceFeet(const camera::Camera& camera, double foot_offset_m, std::vector<T
   }
 }
 
+void PlaceFeet(const ViewCanvas& canvas, double foot_offset_m, std::vector<TrackRow>* rows) {
+  std::vector<TrackRow> on_canvas;
+  std::vector<size_t> index;
+  for (size_t i = 0; i < rows->size(); ++i) {
+    TrackRow r = (*rows)[i];
+    if (HasPosition(r) || r.frame < 1 || r.frame > canvas.frames()) continue;
+    r.box = canvas.BoxToCanvas(r.frame - 1, r.box);
+    if (!BoxInRange(r.box)) continue;
+    on_canvas.push_back(r);
+    index.push_back(i);
+  }
+  PlaceFeet(canvas.camera(), foot_offset_m, &on_canvas);
+  for (size_t k = 0; k < index.size(); ++k) {
+    (*rows)[index[k]].x_m = on_canvas[k].x_m;
+    (*rows)[index[k]].y_m = on_canvas[k].y_m;
+  }
+}
+
 PositionErrors EvaluatePositions(const std::vector<TrackRow>& gt, const std::vector<TrackRow>& est,
                                  const PositionEvalOptions& options) {
   options.Check();

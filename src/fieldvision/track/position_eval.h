@@ -12,6 +12,7 @@
 
 #include "fieldvision/camera/camera.h"
 #include "fieldvision/track/mot.h"
+#include "fieldvision/track/view_canvas.h"
 
 namespace fv::track {
 
@@ -38,6 +39,10 @@ struct PositionErrors {
 // moved foot_offset_m away from the camera as the tracker does); a box whose bottom ray misses the
 // ground keeps none. Throws when the camera has no pose.
 void PlaceFeet(const camera::Camera& camera, double foot_offset_m, std::vector<TrackRow>* rows);
+// The same for a moving camera's frames (players --moving-camera, motion_file.h): each row's box
+// is placed through the canvas where its frame lies, with the canvas's camera (posed); rows of
+// frames beyond the canvas's keep none.
+void PlaceFeet(const ViewCanvas& canvas, double foot_offset_m, std::vector<TrackRow>* rows);
 
 PositionErrors EvaluatePositions(const std::vector<TrackRow>& gt, const std::vector<TrackRow>& est,
                                  const PositionEvalOptions& options = {});

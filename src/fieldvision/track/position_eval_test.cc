@@ -106,5 +106,27 @@ TEST(PositionEval, RowsWithoutPositionsAndBadInput) {
   EXPECT_THROW(EvaluatePositions(gt, est, bad), Error);
 }
 
+// A moving camera's ground truth: a person standing still, seen 40 px further left in the second
+// frame because the view moved 40 px right, is placed at the same field point in both frames
+// through the canvas (within 1e-6 m) as the first frame's box through the camera; a row of a frame
+// beyond the canvas keeps no position.
+TEST(PositionEval, MovingCameraFeetPlacedThroughTheCanvas) {
+  const camera::Camera cam = SideCamera();
+  const cv::Rect2d box = PersonBox(cam, 3.0, 1.0);
+  std::vector<TrackRow> gt = {Row(1, 1, box), Row(2, 1, box - cv::Point2d(40, 0)), Row(3, 1, box)};
+  ViewCanvas canvas(cam, 0.5);
+  canvas.AddFrame(cv::Matx33d::eye());
+  canvas.AddFrame(cv::Matx33d(1, 0, 40, 0, 1, 0, 0, 0, 1));  // the first view's from the second's
+  PlaceFeet(canvas, 0.2, &gt);
+  std::vector<TrackRow> still = {Row(1, 1, box)};
+  PlaceFeet(cam, 0.2, &still);
+  ASSERT_TRUE(still[0].x_m && gt[0].x_m && gt[1].x_m);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(*gt[i].x_m, *still[0].x_m, 1e-6) << "frame " << i + 1;
+    EXPECT_NEAR(*gt[i].y_m, *still[0].y_m, 1e-6) << "frame " << i + 1;
+  }
+  EXPECT_FALSE(gt[2].x_m.has_value());
+}
+
 }  // namespace
 }  // namespace fv::track
