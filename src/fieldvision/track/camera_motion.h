@@ -1,13 +1,14 @@
-// A camera that sways, turns a little or drifts (a phone held by hand, a hovering drone): each
-// frame is registered to the first one, the view the camera file's pose holds for, by a
-// homography from ORB features matched outside the people's boxes (Rublee et al., ICCV 2011;
-// MAGSAC++ homography, Barath et al., CVPR 2020; Hartley & Zisserman ch. 4). A frame is matched to
-// the first directly where the two share enough features, else through the last keyframe (a frame
-// that overlaps the one before it by less than keyframe_overlap, as in keyframe mosaicking and
-// visual odometry: the error adds up per keyframe, not per frame), else through the previous frame
-// (chained). With the camera's lens the homographies are between undistorted pixels, where a
-// homography maps a turning camera's whole image exactly and a moving camera's ground plane. The
-// players pipeline then works on the first view widened (view_canvas.h).
+// A camera that sways, turns, pans or drifts (a phone held by hand or following play, a hovering
+// drone): each frame is registered to the first one, the view the camera file's pose holds for,
+// by a homography (MAGSAC++, Barath et al., CVPR 2020; Hartley & Zisserman ch. 4) from points off
+// the people's boxes: corners followed by pyramidal Lucas-Kanade flow from where the camera's last
+// step predicts them (Bouguet 2000), else ORB descriptors (Rublee et al., ICCV 2011). A frame is
+// matched to the first where its predicted view is back over it, else to the last keyframe (a frame
+// that overlapped its own keyframe by less than keyframe_overlap, as in keyframe mosaicking and
+// visual odometry: the error adds up per keyframe, not per frame), else to the frame before. With
+// the camera's lens the homographies are between undistorted pixels, where a homography maps a
+// turning camera's whole image exactly and a moving camera's ground plane. The players pipeline
+// then works on the first view widened (view_canvas.h).
 #pragma once
 
 #include <functional>
@@ -32,8 +33,9 @@ struct CameraMotionOptions {
   // The inliers' convex hull must cover this share of the frame, else the homography is fixed
   // in a strip only (a small overlap) and not trusted.
   double min_inlier_cover = 0.25;
-  // A frame registered through the last keyframe (or the previous frame) becomes the next
-  // keyframe when it shares less than this share of its area with it.
+  // A frame registered through the last keyframe or the first frame becomes the next keyframe
+  // when it shares less than this share of its area with the keyframe (through the frame before:
+  // always).
   double keyframe_overlap = 0.7;
   // The canvas the frames are tracked on reaches this many image sizes beyond the first view on
   // each side (view_canvas.h): a camera that pans further loses the people beyond.
