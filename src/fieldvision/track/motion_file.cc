@@ -58,7 +58,7 @@ void WriteMotionFile(const ViewCanvas& canvas, const std::string& path) {
 
 ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed,
                           const std::string& posed_what) {
-  const nlohmann::json j = util::ReadJsonFile(path, "camera motion file");
+  const nlohmann::json j = util::ReadJsonFile(path, "camera motion");
   const std::string ctx = fmt::format("camera motion file '{}'", path);
   FV_REQUIRE(j.is_object(), "{}: expected a JSON object", ctx);
   util::JsonKnownKeys(j, ctx,
