@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <fmt/format.h>
 #include <opencv2/calib3d.hpp>
@@ -49,18 +50,27 @@ cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
   return {q[0] / q[2], q[1] / q[2]};
 }
 
+// `points` mapped by h, or nullopt when one of them goes behind (w <= 0) or to infinity.
+std::optional<std::vector<cv::Point2f>> MapInFront(const cv::Matx33d& h,
+                                                   const std::vector<cv::Point2d>& points) {
+  std::vector<cv::Point2f> mapped;
+  for (const cv::Point2d& p : points) {
+    const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
+    if (!(q[2] > 1e-9) || !std::isfinite(q[0]) || !std::isfinite(q[1])) return std::nullopt;
+    mapped.emplace_back(static_cast<float>(q[0] / q[2]), static_cast<float>(q[1] / q[2]));
+  }
+  return mapped;
+}
+
 // A homography a camera's turn or drift can give: finite, the frame's corners stay in front
 // (no horizon inside the frame) and its area changes by less than 4x.
 bool Plausible(const cv::Matx33d& h, const cv::Size& size) {
-  const std::vector<cv::Point2d> corners = {
-      {0, 0}, {size.width - 1.0, 0}, {size.width - 1.0, size.height - 1.0}, {0, size.height - 1.0}};
-  std::vector<cv::Point2f> mapped;
-  for (const cv::Point2d& p : corners) {
-    const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
-    if (!(q[2] > 1e-9) || !std::isfinite(q[0]) || !std::isfinite(q[1])) return false;
-    mapped.emplace_back(static_cast<float>(q[0] / q[2]), static_cast<float>(q[1] / q[2]));
-  }
-  const double ratio = std::abs(cv::contourArea(mapped)) / (static_cast<double>(size.area()));
+  const auto mapped = MapInFront(h, {{0, 0},
+                                     {size.width - 1.0, 0},
+                                     {size.width - 1.0, size.height - 1.0},
+                                     {0, size.height - 1.0}});
+  if (!mapped) return false;
+  const double ratio = std::abs(cv::contourArea(*mapped)) / (static_cast<double>(size.area()));
   return ratio > 0.25 && ratio < 4.0;
 }
 
@@ -129,6 +139,7 @@ CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
   f.gray = gray;
   f.scale = scale;
   cv::goodFeaturesToTrack(gray, f.corners, options_.max_features / 3, 0.01, 8, mask);
+  f.corners_undistorted = ToUndistorted(f.corners, scale);
   std::vector<cv::KeyPoint> keypoints;
   orb_->detectAndCompute(gray, mask, keypoints, f.descriptors);
   if (keypoints.empty()) return f;
@@ -186,7 +197,7 @@ bool CameraMotion::Flow(const View& a, const Features& b, const cv::Matx33d& pre
   if (static_cast<int>(fa.corners.size()) < options_.min_inliers || b.gray.empty()) return false;
   // Each corner's place in b as the prediction has it: LK corrects from there.
   const cv::Matx33d b_from_a = predicted.inv() * a.first_from_view;
-  const std::vector<cv::Point2f> undistorted = ToUndistorted(fa.corners, fa.scale);
+  const std::vector<cv::Point2f>& undistorted = fa.corners_undistorted;
   std::vector<cv::Point2f> ahead;
   ahead.reserve(undistorted.size());
   for (const cv::Point2f& p : undistorted) {
@@ -236,17 +247,14 @@ bool CameraMotion::Fit(const std::vector<cv::Point2f>& from, const std::vector<c
 
 double CameraMotion::Overlap(const cv::Matx33d& a_from_b) const {
   const double w = size_.width, h = size_.height;
-  std::vector<cv::Point2f> mapped, frame = {{0, 0},
-                                            {static_cast<float>(w), 0},
-                                            {static_cast<float>(w), static_cast<float>(h)},
-                                            {0, static_cast<float>(h)}};
-  for (const cv::Point2f& p : frame) {
-    const cv::Vec3d q = a_from_b * cv::Vec3d(p.x, p.y, 1.0);
-    if (!(q[2] > 1e-9)) return 0.0;
-    mapped.emplace_back(static_cast<float>(q[0] / q[2]), static_cast<float>(q[1] / q[2]));
-  }
+  const auto mapped = MapInFront(a_from_b, {{0, 0}, {w, 0}, {w, h}, {0, h}});
+  if (!mapped) return 0.0;
+  const std::vector<cv::Point2f> frame = {{0, 0},
+                                          {static_cast<float>(w), 0},
+                                          {static_cast<float>(w), static_cast<float>(h)},
+                                          {0, static_cast<float>(h)}};
   std::vector<cv::Point2f> common;
-  const float area = cv::intersectConvexConvex(mapped, frame, common, true);
+  const float area = cv::intersectConvexConvex(*mapped, frame, common, true);
   return std::max(0.0f, area) / (w * h);
 }
 

@@ -69,9 +69,10 @@ class CameraMotion {
   struct Features {
     std::vector<cv::Point2f> points;  // ORB's, undistorted pixels (frame pixels without a lens)
     cv::Mat descriptors;
-    cv::Mat gray;                      // the frame at work_width_px
-    double scale = 1.0;                // of gray to the frame
-    std::vector<cv::Point2f> corners;  // Shi-Tomasi corners of gray, off the people
+    cv::Mat gray;                                  // the frame at work_width_px
+    double scale = 1.0;                            // of gray to the frame
+    std::vector<cv::Point2f> corners;              // Shi-Tomasi corners of gray, off the people
+    std::vector<cv::Point2f> corners_undistorted;  // the same in undistorted frame pixels
   };
   // A registered frame to match later ones to.
   struct View {
