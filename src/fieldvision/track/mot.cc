@@ -20,9 +20,19 @@
 
 namespace fv::track {
 
+namespace {
+
+// Coordinates and size finite and within kMaxBoxPixel (a negative size passes: ReadTracksCsv says
+// that apart).
+bool BoxWithinPixels(const cv::Rect2d& box) {
+  return std::abs(box.x) <= kMaxBoxPixel && std::abs(box.y) <= kMaxBoxPixel &&
+         box.width <= kMaxBoxPixel && box.height <= kMaxBoxPixel;
+}
+
+}  // namespace
+
 bool BoxInRange(const cv::Rect2d& box) {
-  return std::abs(box.x) <= kMaxBoxPixel && std::abs(box.y) <= kMaxBoxPixel && box.width >= 0 &&
-         box.height >= 0 && box.width <= kMaxBoxPixel && box.height <= kMaxBoxPixel;
+  return BoxWithinPixels(box) && box.width >= 0 && box.height >= 0;
 }
 
 void WriteTracksCsv(const std::vector<TrackRow>& rows, const std::string& path) {
@@ -90,8 +100,7 @@ TrackRow TrackRowAt(const util::CsvTable& t, size_t i, bool has_header) {
   r.id = static_cast<int>(t.GetInt(i, "id"));
   r.box = cv::Rect2d(t.GetDouble(i, "bb_left"), t.GetDouble(i, "bb_top"),
                      t.GetDouble(i, "bb_width"), t.GetDouble(i, "bb_height"));
-  FV_REQUIRE(std::abs(r.box.x) <= kMaxBoxPixel && std::abs(r.box.y) <= kMaxBoxPixel &&
-                 r.box.width <= kMaxBoxPixel && r.box.height <= kMaxBoxPixel,
+  FV_REQUIRE(BoxWithinPixels(r.box),
              "{}: box {},{},{},{} is not a box in an image (finite, within +-{:.0f} px)", where,
              r.box.x, r.box.y, r.box.width, r.box.height, kMaxBoxPixel);
   FV_REQUIRE(r.box.width >= 0 && r.box.height >= 0, "{}: negative box size", where);
