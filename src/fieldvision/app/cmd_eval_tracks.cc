@@ -1,7 +1,6 @@
 // `fieldvision eval tracks`: MOTA, MOTP, IDF1, HOTA of TRACKS.csv against ground truth; and
 // `fieldvision eval import-pets`: PETS CVML annotations -> MOT CSV.
 #include <algorithm>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -138,12 +137,13 @@ void RunEvalTracks(const EvalTracksCli& c) {
   std::vector<track::TrackRow> placed = gt;
   // A moving camera's tracks (players --moving-camera): the ground truth's feet through the
   // camera's motion saved beside them.
-  const std::string motion = track::MotionPathFor(c.est);
-  if (cam && std::filesystem::exists(motion)) {
-    const track::ViewCanvas canvas =
-        track::ReadMotionFile(motion, &*cam, fmt::format("camera file '{}'", c.camera));
-    track::PlaceFeet(canvas, c.foot_offset_m, &placed);
-    std::cout << "ground truth placed through the camera's motion in " << motion << "\n";
+  const auto canvas =
+      cam ? track::ReadMotionFor(c.est, &*cam, fmt::format("camera file '{}'", c.camera))
+          : std::nullopt;
+  if (canvas) {
+    track::PlaceFeet(*canvas, c.foot_offset_m, &placed);
+    std::cout << "ground truth placed through the camera's motion in "
+              << track::MotionPathFor(c.est) << "\n";
   } else if (cam) {
     track::PlaceFeet(*cam, c.foot_offset_m, &placed);
   }

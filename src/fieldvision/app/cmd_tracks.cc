@@ -54,8 +54,7 @@ void RunTracksEdit(const TracksEditCli& c) {
                         "--out's camera motion file");
   util::ResolveOutputPath(c.out);  // not a device, a folder or in a missing folder
   // A moving camera's motion goes with its tracks (tracks draw reads it); checked before writing.
-  const bool has_motion = std::filesystem::exists(motion_in);
-  if (has_motion) track::ReadMotionFile(motion_in);
+  const bool has_motion = track::ReadMotionFor(c.tracks).has_value();
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
   const track::EditResult r = track::ApplyTrackEdits(rows, roster, edits);
   track::WriteTracksCsv(r.rows, c.out);
@@ -132,13 +131,12 @@ void RunTracksDraw(const TracksDrawCli& c) {
   track::TrackOverlay overlay(rows, roster.team_of, roster.name_of, camera ? &*camera : nullptr,
                               field ? &*field : nullptr, c.overlay);
   // A moving camera's tracks: the lines and trails follow its frames as players --draw drew them.
-  const std::string motion_in = track::MotionPathFor(c.tracks);
-  if (std::filesystem::exists(motion_in)) {
-    const auto canvas =
-        track::ReadMotionFile(motion_in, camera && camera->has_pose ? &*camera : nullptr,
-                              fmt::format("camera file '{}'", c.camera));
-    overlay.SetCameraMotion(canvas);
-    std::cout << "camera motion from " << motion_in << " (" << canvas.frames() << " frames)\n";
+  if (const auto canvas =
+          track::ReadMotionFor(c.tracks, camera && camera->has_pose ? &*camera : nullptr,
+                               fmt::format("camera file '{}'", c.camera))) {
+    overlay.SetCameraMotion(*canvas);
+    std::cout << "camera motion from " << track::MotionPathFor(c.tracks) << " (" << canvas->frames()
+              << " frames)\n";
   }
   const track::DrawVideoResult d =
       track::DrawTracksVideo(c.video, c.out, overlay, c.fps, c.max_frames);

@@ -205,10 +205,7 @@ std::string SaveRosterFor(const std::string& tracks_path, const Roster& roster) 
     WriteRoster(roster, path);
     return fmt::format("wrote {} (teams and names, read by stats and tracks draw)", path);
   }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return "";
-  FV_REQUIRE(std::filesystem::remove(path, ec), "cannot remove the earlier teams file '{}': {}",
-             path, ec.message());
+  if (!util::RemoveEarlierFile(path, "teams file")) return "";
   return fmt::format("removed {} (an earlier run's teams and names: these tracks have none)", path);
 }
 

@@ -103,6 +103,13 @@ ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed,
   }
 }
 
+std::optional<ViewCanvas> ReadMotionFor(const std::string& tracks_path, const camera::Camera* posed,
+                                        const std::string& posed_what) {
+  const std::string path = MotionPathFor(tracks_path);
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  return ReadMotionFile(path, posed, posed_what);
+}
+
 std::string CarryMotionTo(const std::string& tracks_path, const std::string& from) {
   if (from.empty()) return SaveMotionFor(tracks_path, nullptr);
   const std::string path = MotionPathFor(tracks_path);
@@ -124,10 +131,7 @@ std::string SaveMotionFor(const std::string& tracks_path, const ViewCanvas* canv
     WriteMotionFile(*canvas, path);
     return fmt::format("wrote {} (the camera's motion, read by tracks draw)", path);
   }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return "";
-  FV_REQUIRE(std::filesystem::remove(path, ec), "cannot remove the earlier motion file '{}': {}",
-             path, ec.message());
+  if (!util::RemoveEarlierFile(path, "motion file")) return "";
   return fmt::format("removed {} (an earlier run's camera motion: this camera stood still)", path);
 }
 

@@ -4,6 +4,7 @@
 // canvas margin and each frame's homography to the first view (view_canvas.h).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "fieldvision/camera/camera.h"
@@ -23,6 +24,12 @@ void WriteMotionFile(const ViewCanvas& canvas, const std::string& path);
 // `posed_what` names the camera in that error.
 ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed = nullptr,
                           const std::string& posed_what = "the camera");
+
+// The motion file beside `tracks_path` (MotionPathFor) read as ReadMotionFile does, or nullopt
+// when there is none (a still camera's tracks).
+std::optional<ViewCanvas> ReadMotionFor(const std::string& tracks_path,
+                                        const camera::Camera* posed = nullptr,
+                                        const std::string& posed_what = "the camera");
 
 // After `players` wrote `tracks_path`: the motion file beside it written (a moving camera) or an
 // earlier run's removed (a still one, canvas null). Returns a line for the user, or "".

@@ -151,4 +151,12 @@ NewFolder::~NewFolder() {
   }
 }
 
+bool RemoveEarlierFile(const std::string& path, std::string_view what) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  FV_REQUIRE(std::filesystem::remove(path, ec), "cannot remove the earlier {} '{}': {}", what, path,
+             ec.message());
+  return true;
+}
+
 }  // namespace fv::util

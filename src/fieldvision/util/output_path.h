@@ -100,4 +100,9 @@ void AtomicWrite(const std::string& out, const std::function<void(const std::str
 // when it cannot be written.
 void WriteTextFile(const std::string& out, std::string_view text, std::string_view what);
 
+// Removes an earlier run's file at `path` (a sidecar a new run does not write) when there is one;
+// returns whether it did. Throws fv::Error "cannot remove the earlier <what> '<path>': ..." when
+// it cannot.
+bool RemoveEarlierFile(const std::string& path, std::string_view what);
+
 }  // namespace fv::util
