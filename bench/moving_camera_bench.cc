@@ -60,10 +60,8 @@ struct Workspace {
   std::vector<cv::Matx33d> pan;   // per frame: the pan camera's turn from the PETS camera
   fv::camera::Camera pan_camera;  // the pan camera unturned (intrinsics; no pose)
   Moved swayed, panned;
-  std::vector<TrackRow> gt_all;       // every annotated person with a place (the video's runs)
-  bool video_run = false;             // BM_Players/video ran in this process (its det.txt)
-  std::optional<double> base_median;  // the baseline's, for the ratios
-  double base_p90 = 0, base_mota = 0, base_matched = 0;
+  // BM_Players/video's tracks, once it ran in this process (its det.txt is the one moved).
+  std::optional<std::vector<TrackRow>> video_rows;
 };
 
 Workspace& Work() {
@@ -266,7 +264,7 @@ void BM_Players(benchmark::State& state, Run run) {
     o.moving_camera = true;  // NanoDet on the swayed frames themselves
     video = moved->video;
   } else {
-    if (!w.video_run) {
+    if (!w.video_rows) {
       state.SkipWithError("run BM_Players/video first (its detections are moved)");
       return;
     }
@@ -279,8 +277,6 @@ void BM_Players(benchmark::State& state, Run run) {
   for (auto _ : state) r = fv::track::RunPlayers(video, camera, nullptr, o);
   const std::vector<TrackRow> est =
       run == Run::kVideo ? r.rows : MoveRows(r.rows, moved->to_original);
-  static std::vector<TrackRow> video_rows;
-  if (run == Run::kVideo) video_rows = r.rows;
   const std::vector<TrackRow>& gt = run == Run::kVideo ? w.gt : moved->gt_in_view;
   const Score score = ScoreRows(gt, est);
   state.counters["median_m"] = score.median;
@@ -295,12 +291,13 @@ void BM_Players(benchmark::State& state, Run run) {
     state.counters["lost"] = r.camera_motion->lost;
   }
   if (run == Run::kVideo) {
-    w.video_run = true;
+    w.video_rows = r.rows;
     return;
   }
+  if (!w.video_rows) return;  // no baseline to compare with (BM_Players/video did not run)
   // The baseline: the video's own tracks of the people the moved frames show.
   std::vector<TrackRow> shown;
-  for (const TrackRow& row : video_rows) {
+  for (const TrackRow& row : *w.video_rows) {
     const cv::Rect2d box = fv::track::MapBoxBy(
         [&](const cv::Point2d& p) { return moved->from_original(row.frame - 1, p); }, row.box);
     if (fv::track::FootInView(box, cv::Size(w.camera.width, w.camera.height))) {
