@@ -492,6 +492,13 @@ check "tracks draw: --field without a camera" nonzero $FV tracks draw --tracks "
 check "players: --moving-camera writes its motion" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
   --video "$TMP/bv/cam1.avi" --out "$TMP/mv.csv" --moving-camera --no-progress
 [ -s "$TMP/mv.csv.motion.json" ] || { echo "FAIL players: no motion file"; fail=1; }
+check "players: --moving-camera on a field with lines" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
+  --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/mvl.csv" --moving-camera --no-progress
+grep -q "field lines: " "$TMP/out" || { echo "FAIL players: the field lines not used"; fail=1; }
+check "players: --no-line-anchor" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
+  --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/mvl.csv" --moving-camera \
+  --no-line-anchor --no-progress
+grep -q "field lines: " "$TMP/out" && { echo "FAIL players: --no-line-anchor ignored"; fail=1; }
 # (the scene has no people: its motion goes with a TRACKS.csv of one row)
 cp "$TMP/tr.csv" "$TMP/trm.csv" && cp "$TMP/mv.csv.motion.json" "$TMP/trm.csv.motion.json"
 check "tracks draw: a moving camera's motion" 0 $FV tracks draw --tracks "$TMP/trm.csv" \

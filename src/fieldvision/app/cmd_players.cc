@@ -123,6 +123,10 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
       "features off the people, a homography), where the camera file's pose holds, and people are "
       "tracked and placed on that view widened by --canvas-margin (writes "
       "TRACKS.csv.motion.json, read by tracks draw)");
+  cmd->add_flag("!--no-line-anchor", c.o.hold_to_lines,
+                "With --moving-camera: do not hold the views to the painted field lines (with a "
+                "posed camera file and a field with lines, each keyframe's view is fitted to the "
+                "lines it sees, which stops the registration's drift)");
   cmd->add_option("--canvas-margin", c.o.camera_motion.canvas_margin,
                   "With --moving-camera: how many image widths (heights) beyond the first view "
                   "people are tracked on each side")

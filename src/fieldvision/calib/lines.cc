@@ -127,11 +127,19 @@ struct LinePixelCost {
   template <typename T>
   bool operator()(const T* rvec, const T* tvec, T* residual) const {
     const T minus_r[3] = {-rvec[0], -rvec[1], -rvec[2]};
-    const T d_cam[3] = {T(ray_.x()), T(ray_.y()), T(1.0)};
-    T d_world[3], c_world[3];
-    ceres::AngleAxisRotatePoint(minus_r, d_cam, d_world);
+    T c_world[3];
     ceres::AngleAxisRotatePoint(minus_r, tvec, c_world);
     for (T& v : c_world) v = -v;
+    return Residual(rvec, c_world, residual);
+  }
+
+  // The same for a camera centre `c_world` in the world.
+  template <typename T>
+  bool Residual(const T* rvec, const T* c_world, T* residual) const {
+    const T minus_r[3] = {-rvec[0], -rvec[1], -rvec[2]};
+    const T d_cam[3] = {T(ray_.x()), T(ray_.y()), T(1.0)};
+    T d_world[3];
+    ceres::AngleAxisRotatePoint(minus_r, d_cam, d_world);
     if (!(d_world[2] < T(-1e-9)) || !(c_world[2] > T(0))) {
       residual[0] = T(map_->max_distance_m());
       return true;
@@ -148,6 +156,17 @@ struct LinePixelCost {
   Eigen::Vector2d ray_;
   const LineDistanceMap* map_;
   const ceres::BiCubicInterpolator<ceres::Grid2D<float, 1>>* interp_;
+};
+
+// The same with the camera's centre fixed (RefineOptions::fix_centre): the rotation free.
+struct LinePixelTurnCost {
+  template <typename T>
+  bool operator()(const T* rvec, T* residual) const {
+    const T c_world[3] = {T(centre.x()), T(centre.y()), T(centre.z())};
+    return cost.Residual(rvec, c_world, residual);
+  }
+  LinePixelCost cost;
+  Eigen::Vector3d centre;
 };
 
 }  // namespace
@@ -414,15 +433,24 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
   Eigen::Vector3d rvec = camera.cam_from_world.Rvec();
   Eigen::Vector3d tvec = camera.cam_from_world.translation;
   const Eigen::Vector3d rvec0 = rvec, tvec0 = tvec;
+  const Eigen::Vector3d centre = camera.CentreInWorld();
   auto build = [&](ceres::Problem& problem, double scale) {
     for (const auto& r : rays) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LinePixelCost, 1, 3, 3>(
-                                   new LinePixelCost(r, &map, &interp)),
-                               new ceres::CauchyLoss(scale), rvec.data(), tvec.data());
+      if (options.fix_centre) {
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<LinePixelTurnCost, 1, 3>(
+                new LinePixelTurnCost{LinePixelCost(r, &map, &interp), centre}),
+            new ceres::CauchyLoss(scale), rvec.data());
+      } else {
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LinePixelCost, 1, 3, 3>(
+                                     new LinePixelCost(r, &map, &interp)),
+                                 new ceres::CauchyLoss(scale), rvec.data(), tvec.data());
+      }
     }
   };
   const LossScaleSolve solve = SolveOverLossScales(
       build, options.loss_scales_m, options.max_iterations, &rvec, &tvec, rvec0, tvec0);
+  if (options.fix_centre) tvec = -geometry::RotationFromRvec(rvec) * centre;
   result.iterations = solve.iterations;
   result.initial_cost = solve.initial_cost;
   result.final_cost = solve.final_cost;

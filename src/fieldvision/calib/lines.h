@@ -100,6 +100,9 @@ struct RefineOptions {
   double gate_m = 0.5;       // for the reported line error
   // A refined pose that moves the camera farther than this from the start is rejected.
   double max_move_m = 3.0;
+  // Refine the rotation only, the camera's centre held where it is (a camera on a tripod that
+  // turns: three unknowns instead of six, held by fewer lines).
+  bool fix_centre = false;
   void Check() const;
 };
 

@@ -31,6 +31,8 @@ void CameraMotionOptions::Check() const {
              "CameraMotionOptions.min_inlier_share must be in [0, 1] (got {})", min_inlier_share);
   FV_REQUIRE(std::isfinite(keyframe_overlap) && keyframe_overlap >= 0 && keyframe_overlap <= 1,
              "CameraMotionOptions.keyframe_overlap must be in [0, 1] (got {})", keyframe_overlap);
+  FV_REQUIRE(std::isfinite(max_departure) && max_departure > 0,
+             "CameraMotionOptions.max_departure must be > 0 (got {})", max_departure);
   FV_REQUIRE(std::isfinite(canvas_margin) && canvas_margin >= 0 && canvas_margin <= 10,
              "CameraMotionOptions.canvas_margin must be in [0, 10] (got {})", canvas_margin);
 }
@@ -38,9 +40,16 @@ void CameraMotionOptions::Check() const {
 std::string CameraMotionStats::Summary() const {
   return fmt::format(
       "camera motion: of {} frames after the first, {} matched to it directly, {} through a "
-      "keyframe ({} keyframes), {} through the frame before, {} not at all (the camera's "
-      "motion carried on); the image centre moved up to {:.0f} px",
-      std::max(0, frames - 1), direct, keyed, keyframes, chained, lost, max_shift_px);
+      "keyframe ({} keyframes{}), {} through the frame before, {} not at all (the camera's "
+      "motion carried on){}{}; the image centre moved up to {:.0f} px",
+      std::max(0, frames - 1), direct, keyed, keyframes,
+      anchored > 0 ? fmt::format(", {} held to the field lines", anchored) : "", chained, lost,
+      found_by_anchor > 0 ? fmt::format(", {} found by the field lines alone", found_by_anchor)
+                          : "",
+      departed > 0
+          ? fmt::format(", {} registered far from the predicted view by every base", departed)
+          : "",
+      max_shift_px);
 }
 
 namespace {
@@ -245,6 +254,18 @@ bool CameraMotion::Fit(const std::vector<cv::Point2f>& from, const std::vector<c
   return Plausible(*a_from_b, size_);
 }
 
+double CameraMotion::Departure(const cv::Matx33d& a, const cv::Matx33d& b) const {
+  const double w = size_.width - 1.0, h = size_.height - 1.0;
+  const std::vector<cv::Point2d> corners = {{0, 0}, {w, 0}, {w, h}, {0, h}};
+  const auto in_a = MapInFront(a, corners), in_b = MapInFront(b, corners);
+  if (!in_a || !in_b) return std::numeric_limits<double>::infinity();
+  double worst = 0.0;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    worst = std::max(worst, static_cast<double>(cv::norm((*in_a)[i] - (*in_b)[i])));
+  }
+  return worst;
+}
+
 double CameraMotion::Overlap(const cv::Matx33d& a_from_b) const {
   const double w = size_.width, h = size_.height;
   const auto mapped = MapInFront(a_from_b, {{0, 0}, {w, 0}, {w, h}, {0, h}});
@@ -294,26 +315,44 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
   };
   const Attempt attempts[] = {{&first_, true},  {&key_, true},  {&previous_, true},
                               {&first_, false}, {&key_, false}, {&previous_, false}};
+  // A registration that puts the frame's corners farther from the prediction than
+  // max_departure (a fit whose inliers lie on one side, extrapolated) gives way to the next
+  // attempt; when all do, the one nearest the prediction is taken.
   cv::Matx33d a_from_this;
   const View* base = nullptr;
+  double nearest = std::numeric_limits<double>::infinity();
+  const double limit = options_.max_departure * size_.width;
   for (const Attempt& a : attempts) {
     if (a.flow && a.view == &first_ && Overlap(predicted) <= 0.5) continue;
-    if (a.flow ? Flow(*a.view, f, predicted, &a_from_this)
-               : Match(a.view->features, f, &a_from_this)) {
-      base = a.view;
-      break;
+    cv::Matx33d fitted;
+    if (a.flow ? Flow(*a.view, f, predicted, &fitted) : Match(a.view->features, f, &fitted)) {
+      const double departure = Departure(a.view->first_from_view * fitted, predicted);
+      if (departure < nearest) {
+        nearest = departure;
+        a_from_this = fitted;
+        base = a.view;
+      }
+      if (departure <= limit) break;
     }
   }
-  if (base == nullptr) {
-    // Neither: the predicted view is taken, and the last registered frame stays the one to chain
-    // from (a blank or blurred frame must not become the base of the next).
-    ++stats_.lost;
+  if (base != nullptr && nearest > limit) ++stats_.departed;
+  // Neither: the anchor may still hold the predicted view (the field lines), and it becomes the
+  // next keyframe; else the predicted view is taken, and the last registered frame stays the one
+  // to chain from (a blank or blurred frame must not become the base of the next).
+  std::optional<cv::Matx33d> held;
+  if (base == nullptr && anchor_) held = anchor_(bgr, people, predicted);
+  if (base == nullptr && (!held || static_cast<int>(f.corners.size()) < options_.min_inliers)) {
+    // A frame without texture to match later ones to keeps the frame before as the base.
+    ++(held ? stats_.found_by_anchor : stats_.lost);
     ++since_registered_;
-    return predicted;
+    return held ? NormalizedHomography(*held) : predicted;
   }
-  cv::Matx33d h = base->first_from_view * a_from_this;
+  cv::Matx33d h = held ? *held : base->first_from_view * a_from_this;
   bool new_key;
-  if (base == &first_) {
+  if (held) {
+    ++stats_.found_by_anchor;
+    new_key = true;
+  } else if (base == &first_) {
     ++stats_.direct;
     new_key = Overlap(key_.first_from_view.inv() * h) < options_.keyframe_overlap;
   } else if (base == &key_) {
@@ -324,16 +363,22 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     new_key = true;
   }
   h = NormalizedHomography(h);
-  const cv::Point2d centre = Centre();
-  const cv::Point2d moved = Apply(h, centre);
-  stats_.max_shift_px =
-      std::max(stats_.max_shift_px, std::hypot(moved.x - centre.x, moved.y - centre.y));
   // The step from the last registered frame (over frames lost, the step before is kept).
   if (since_registered_ == 0) {
     velocity_ = previous_.first_from_view.inv() * h;
     velocity_ = NormalizedHomography(velocity_);
   }
   since_registered_ = 0;
+  if (new_key && anchor_ && !held) {
+    if (const std::optional<cv::Matx33d> held = anchor_(bgr, people, h)) {
+      h = NormalizedHomography(*held);
+      ++stats_.anchored;
+    }
+  }
+  const cv::Point2d centre = Centre();
+  const cv::Point2d moved = Apply(h, centre);
+  stats_.max_shift_px =
+      std::max(stats_.max_shift_px, std::hypot(moved.x - centre.x, moved.y - centre.y));
   previous_ = {std::move(f), h};
   if (new_key) {
     key_ = previous_;

@@ -5,10 +5,12 @@
 // step predicts them (Bouguet 2000), else ORB descriptors (Rublee et al., ICCV 2011). A frame is
 // matched to the first where its predicted view is back over it, else to the last keyframe (a frame
 // that overlapped its own keyframe by less than keyframe_overlap, as in keyframe mosaicking and
-// visual odometry: the error adds up per keyframe, not per frame), else to the frame before. With
-// the camera's lens the homographies are between undistorted pixels, where a homography maps a
-// turning camera's whole image exactly and a moving camera's ground plane. The players pipeline
-// then works on the first view widened (view_canvas.h).
+// visual odometry: the error adds up per keyframe, not per frame), else to the frame before; a
+// fit far from the predicted view gives way to the next. With the camera's lens the homographies
+// are between undistorted pixels, where a homography maps a turning camera's whole image exactly
+// and a moving camera's ground plane. An anchor may correct keyframes and find lost frames
+// (line_anchor.h: the field lines). The players pipeline then works on the first view widened
+// (view_canvas.h).
 #pragma once
 
 #include <functional>
@@ -37,6 +39,10 @@ struct CameraMotionOptions {
   // when it shares less than this share of its area with the keyframe (through the frame before:
   // always).
   double keyframe_overlap = 0.7;
+  // A registration that moves a corner of the frame farther than this share of the image width
+  // from where the camera's last step predicts it is tried against the next base (a fit on
+  // points along one side, wild on the other: 48 px off there in a synthetic pan).
+  double max_departure = 0.05;
   // The canvas the frames are tracked on reaches this many image sizes beyond the first view on
   // each side (view_canvas.h): a camera that pans further loses the people beyond.
   double canvas_margin = 1.0;
@@ -44,12 +50,15 @@ struct CameraMotionOptions {
 };
 
 struct CameraMotionStats {
-  int frames = 0;     // frames registered, the first included
-  int direct = 0;     // matched to the first frame (the first itself not counted)
-  int keyed = 0;      // through the last keyframe
-  int keyframes = 0;  // frames that became keyframes (the first not counted)
-  int chained = 0;    // through the last registered frame
-  int lost = 0;       // neither: the view predicted from the last two registered frames taken
+  int frames = 0;           // frames registered, the first included
+  int direct = 0;           // matched to the first frame (the first itself not counted)
+  int keyed = 0;            // through the last keyframe
+  int keyframes = 0;        // frames that became keyframes (the first not counted)
+  int chained = 0;          // through the last registered frame
+  int lost = 0;             // neither: the view predicted from the last two registered frames taken
+  int departed = 0;         // registered off the prediction by over max_departure by every base
+  int anchored = 0;         // keyframes whose view the anchor corrected (SetAnchor)
+  int found_by_anchor = 0;  // frames matched to none, whose predicted view the anchor corrected
   double max_shift_px = 0.0;  // largest move of the image centre from the first frame's view
   std::string Summary() const;
 };
@@ -64,6 +73,14 @@ class CameraMotion {
   // first), with the people's boxes left out of the matching.
   cv::Matx33d Register(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people);
   const CameraMotionStats& stats() const { return stats_; }
+  // Called with each new keyframe (the frame, the people's boxes, its registered homography): a
+  // homography it gives replaces the registered one (line_anchor.h: held to the field lines), so
+  // that the frames registered through the keyframe start from it; nullopt keeps the registered.
+  // Also with a frame matched to no other, at its predicted view: a homography it gives is the
+  // frame's (a keyframe), else the frame is lost.
+  using Anchor = std::function<std::optional<cv::Matx33d>(
+      const cv::Mat& bgr, const std::vector<cv::Rect2d>& people, const cv::Matx33d& registered)>;
+  void SetAnchor(Anchor anchor) { anchor_ = std::move(anchor); }
 
  private:
   struct Features {
@@ -96,6 +113,9 @@ class CameraMotion {
   std::vector<cv::Point2f> ToUndistorted(std::vector<cv::Point2f> work_px, double scale) const;
   cv::Point2f ToWork(const cv::Point2d& undistorted, double scale) const;
   cv::Point2d Centre() const { return {0.5 * (size_.width - 1), 0.5 * (size_.height - 1)}; }
+  // The largest distance between where a and b put this frame's corners (infinite when one
+  // puts a corner behind).
+  double Departure(const cv::Matx33d& a, const cv::Matx33d& b) const;
   // The share of this frame's area that the view at a_from_b covers.
   double Overlap(const cv::Matx33d& a_from_b) const;
 
@@ -108,6 +128,7 @@ class CameraMotion {
   int since_registered_ = 0;                   // frames lost since the last registered one
   cv::Size size_;
   CameraMotionStats stats_;
+  Anchor anchor_;
 };
 
 // A homography scaled to unit norm with a positive determinant (a camera's turn or drift keeps

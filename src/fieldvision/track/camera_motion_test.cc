@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/track/track_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
 
@@ -42,15 +43,7 @@ cv::Matx33d Turned(double yaw, double pitch, double roll) {
 // The largest distance between where a and b take a grid of points over the image's inner 80 %
 // (corners outside the other frame's view are extrapolations).
 double ViewError(const cv::Matx33d& a, const cv::Matx33d& b) {
-  double worst = 0;
-  for (double x = 64; x <= 576; x += 128) {
-    for (double y = 48; y <= 432; y += 96) {
-      const cv::Vec3d qa = a * cv::Vec3d(x, y, 1), qb = b * cv::Vec3d(x, y, 1);
-      worst =
-          std::max(worst, std::hypot(qa[0] / qa[2] - qb[0] / qb[2], qa[1] / qa[2] - qb[1] / qb[2]));
-    }
-  }
-  return worst;
+  return test_util::ViewError(a, b, 64, 576, 48, 432, 4);
 }
 
 // A camera turning by up to 4 degrees over 30 frames, a person (a block moving on its own) in
@@ -140,6 +133,49 @@ TEST(CameraMotion, FarTurnsAreChainedThroughKeyframes) {
   std::cout << "1100 px pan: centre error at the end " << last_error[0] << " px through keyframes, "
             << last_error[1] << " px through every frame\n";
   EXPECT_LE(last_error[0], last_error[1] + 0.5);
+}
+
+// An anchor (line_anchor.h holds views to the field lines) is asked about keyframes and frames
+// matched to nothing, never others: the views it gives replace the registered ones, so the pan's
+// chained drift is gone at the end (here it knows the truth), and a blank frame it holds is found
+// instead of lost (not a keyframe: it has nothing to match later frames to). An anchor that
+// declines changes nothing.
+TEST(CameraMotion, AnAnchorHoldsKeyframesAndFindsLostFrames) {
+  testing::SeededRng rng(6);
+  cv::Mat world;
+  cv::hconcat(std::vector<cv::Mat>{Blocks(rng), Blocks(rng), Blocks(rng)}, world);
+  for (const bool declines : {false, true}) {
+    CameraMotion motion;
+    cv::Matx33d truth;
+    int asked = 0;
+    motion.SetAnchor([&](const cv::Mat&, const std::vector<cv::Rect2d>& people,
+                         const cv::Matx33d&) -> std::optional<cv::Matx33d> {
+      ++asked;
+      EXPECT_EQ(people.size(), 1u);
+      if (declines) return std::nullopt;
+      return truth;
+    });
+    double centre_error = 0;
+    for (int t = 0; t < 12; ++t) {
+      const double shift = 100.0 * t;
+      truth = cv::Matx33d(1, 0, shift, 0, 1, 0, 0, 0, 1);
+      cv::Mat frame;
+      cv::warpPerspective(world, frame, cv::Matx33d(1, 0, -shift, 0, 1, 0, 0, 0, 1),
+                          cv::Size(640, 480));
+      if (t == 7) frame.setTo(cv::Scalar(80, 80, 80));  // blank: no match to any view
+      const cv::Matx33d h = motion.Register(frame, {cv::Rect2d(600, 10, 20, 40)});
+      const cv::Vec3d c = h * cv::Vec3d(319.5, 239.5, 1);
+      centre_error = std::hypot(c[0] / c[2] - 319.5 - shift, c[1] / c[2] - 239.5);
+    }
+    const CameraMotionStats& s = motion.stats();
+    std::cout << (declines ? "declining" : "holding") << " anchor: centre error at the end "
+              << centre_error << " px; " << s.Summary() << "\n";
+    EXPECT_EQ(s.anchored, declines ? 0 : s.keyframes);
+    EXPECT_EQ(s.found_by_anchor, declines ? 0 : 1);
+    EXPECT_EQ(s.lost, declines ? 1 : 0);
+    EXPECT_EQ(asked, s.keyframes + 1);
+    if (!declines) EXPECT_LT(centre_error, 1.0);
+  }
 }
 
 TEST(CameraMotion, BoxesMoveByTheirFootAndTop) {

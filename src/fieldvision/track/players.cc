@@ -399,6 +399,7 @@ void PlayersOptions::Check() const {
   CheckNonNegative(fps, "fps");
   if (moving_camera) {
     camera_motion.Check();
+    if (hold_to_lines) line_anchor.Check();
     FV_REQUIRE(detector.kind != "motion",
                "the motion detector needs a still camera, not a moving one (--moving-camera)");
   }
@@ -410,7 +411,7 @@ std::string PlayersResult::Summary() const {
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}{}, "
-      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}",
+      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -422,6 +423,7 @@ std::string PlayersResult::Summary() const {
       1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary(),
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
       camera_motion ? "; " + camera_motion->Summary() : "",
+      line_anchor ? "; " + line_anchor->Summary() : "",
       outside_frames > 0
           ? fmt::format(" ({} rows left out: beyond what their frame shows)", outside_frames)
           : "",
@@ -694,8 +696,17 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   // A moving camera's frames are tracked on its canvas, as the canvas's camera.
   PlayersPass pass;
   std::optional<CameraMotion> motion;
+  std::optional<LineAnchor> anchor;
   if (options.moving_camera) {
     motion.emplace(options.camera_motion, camera);
+    if (options.hold_to_lines && calibrated && field != nullptr &&
+        (!field->segments.empty() || !field->arcs.empty())) {
+      anchor.emplace(*camera, *field, options.line_anchor);
+      motion->SetAnchor([&anchor](const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
+                                  const cv::Matx33d& registered) {
+        return anchor->Correct(bgr, people, registered);
+      });
+    }
     const double margin = options.camera_motion.canvas_margin;
     pass.canvas = camera != nullptr ? ViewCanvas(*camera, margin)
                                     : ViewCanvas::Uncalibrated(reader.size(), margin);
@@ -775,6 +786,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     result.outside_frames = static_cast<int>(result.rows.end() - outside);
     result.rows.erase(outside, result.rows.end());
     result.camera_motion = motion->stats();
+    if (anchor) result.line_anchor = anchor->stats();
     result.canvas = std::move(pass.canvas);
   }
   result.times.map_s = Seconds(t_map, Clock::now());

@@ -19,6 +19,7 @@
 #include "fieldvision/track/detection.h"
 #include "fieldvision/track/ground_smoother.h"
 #include "fieldvision/track/hidden_feet.h"
+#include "fieldvision/track/line_anchor.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/view_canvas.h"
 
@@ -94,6 +95,10 @@ struct PlayersOptions {
   // (background subtraction needs a still camera).
   bool moving_camera = false;
   CameraMotionOptions camera_motion;
+  // With a moving camera, a posed camera file and a field with painted lines: each keyframe's
+  // view is held to the lines it sees (line_anchor.h), which stops the registration's drift.
+  bool hold_to_lines = true;
+  LineAnchorOptions line_anchor;
 
   void Check() const;
 };
@@ -134,6 +139,7 @@ struct PlayersResult {
   int outside_frames = 0;    // a moving camera's rows whose box their frame cannot show (left out)
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
+  std::optional<LineAnchorStats> line_anchor;      // with PlayersOptions::hold_to_lines in use
   // The canvas its frames were tracked on (view_canvas.h), as TrackOverlay::SetCameraMotion
   // takes it.
   std::optional<ViewCanvas> canvas;

@@ -1,6 +1,9 @@
 // Helpers shared by the track tests (header only, not part of the library): a posed camera beside
-// a field and the image box of a person standing on it.
+// a field, the image box of a person standing on it and the distance between two views.
 #pragma once
+
+#include <algorithm>
+#include <cmath>
 
 #include <opencv2/core.hpp>
 
@@ -24,6 +27,22 @@ inline cv::Rect2d PersonBox(const camera::Camera& cam, double x, double y, doubl
   const auto head = cam.Project({x, y, 1.8});
   const double h = foot->y() - head->y();
   return {foot->x() - 0.2 * h, head->y(), 0.4 * h, h + noise_px};
+}
+
+// The largest distance between where homographies a and b take a grid of points: x from x0 to
+// x1 and y from y0 to y1 in `steps` steps each.
+inline double ViewError(const cv::Matx33d& a, const cv::Matx33d& b, double x0, double x1, double y0,
+                        double y1, int steps) {
+  double worst = 0;
+  for (int i = 0; i <= steps; ++i) {
+    for (int j = 0; j <= steps; ++j) {
+      const double x = x0 + (x1 - x0) * i / steps, y = y0 + (y1 - y0) * j / steps;
+      const cv::Vec3d qa = a * cv::Vec3d(x, y, 1), qb = b * cv::Vec3d(x, y, 1);
+      worst =
+          std::max(worst, std::hypot(qa[0] / qa[2] - qb[0] / qb[2], qa[1] / qa[2] - qb[1] / qb[2]));
+    }
+  }
+  return worst;
 }
 
 }  // namespace fv::track::test_util

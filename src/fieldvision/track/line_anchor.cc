@@ -1,0 +1,211 @@
+#include "fieldvision/track/line_anchor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
+
+#include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
+
+namespace fv::track {
+
+namespace {
+
+cv::Matx33d ToCv(const Eigen::Matrix3d& m) {
+  cv::Matx33d out;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out(r, c) = m(r, c);
+  }
+  return out;
+}
+
+Eigen::Matrix3d ToEigen(const cv::Matx33d& m) {
+  Eigen::Matrix3d out;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out(r, c) = m(r, c);
+  }
+  return out;
+}
+
+// The rotation nearest to `m` (Frobenius norm) with a positive determinant.
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+  d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixU() * d * svd.matrixV().transpose();
+}
+
+cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
+  const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
+  return {q[0] / q[2], q[1] / q[2]};
+}
+
+bool InAnyBox(const Eigen::Vector2d& p, const std::vector<cv::Rect2d>& people) {
+  return std::any_of(people.begin(), people.end(), [&p](const cv::Rect2d& b) {
+    return p.x() >= b.x - 0.1 * b.width && p.x() <= b.x + 1.1 * b.width && p.y() >= b.y &&
+           p.y() <= b.y + 1.1 * b.height;
+  });
+}
+
+// How a pose fits its line pixels, over those within gate_m of a line: how well they fix it
+// both ways on the ground (the smaller over the larger eigenvalue of the scatter of their
+// nearest lines' normals, the distance field's gradient) and their median distance in pixels
+// from the nearest line's point projected back into the image.
+struct LineFit {
+  double crossing = 0.0;
+  double median_px = std::numeric_limits<double>::infinity();
+};
+
+LineFit CheckLineFit(const camera::Camera& camera, const std::vector<Eigen::Vector2d>& pixels,
+                     const field::FieldModel& field, double gate_m) {
+  constexpr double kStepM = 0.02;
+  constexpr size_t kMaxPixels = 800;
+  const size_t stride = std::max<size_t>(1, pixels.size() / kMaxPixels);
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  std::vector<double> residuals_px;
+  for (size_t i = 0; i < pixels.size(); i += stride) {
+    const auto ray = camera.RayFromPixel(pixels[i]);
+    if (!ray || !(ray->direction.z() < 0)) continue;
+    const Eigen::Vector3d g = ray->origin - ray->origin.z() / ray->direction.z() * ray->direction;
+    const Eigen::Vector2d p = g.head<2>();
+    const double d = field.DistanceToLineCentres(p);
+    if (d > gate_m) continue;
+    const Eigen::Vector2d dx(kStepM, 0), dy(0, kStepM);
+    Eigen::Vector2d normal(
+        field.DistanceToLineCentres(p + dx) - field.DistanceToLineCentres(p - dx),
+        field.DistanceToLineCentres(p + dy) - field.DistanceToLineCentres(p - dy));
+    if (!(normal.norm() > 1e-9)) continue;
+    normal.normalize();
+    scatter += normal * normal.transpose();
+    const Eigen::Vector2d on_line = p - d * normal;
+    if (const auto uv = camera.Project({on_line.x(), on_line.y(), 0.0})) {
+      residuals_px.push_back((*uv - pixels[i]).norm());
+    }
+  }
+  LineFit fit;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
+  const double largest = eig.eigenvalues()(1);
+  if (largest > 0) fit.crossing = eig.eigenvalues()(0) / largest;
+  if (!residuals_px.empty()) fit.median_px = util::Median(residuals_px);
+  return fit;
+}
+
+}  // namespace
+
+calib::RefineOptions LineAnchorOptions::DefaultRefine() {
+  calib::RefineOptions o;
+  o.lut_resolution_m = 0.02;
+  o.max_move_m = 1.0;
+  o.max_iterations = 50;
+  o.fix_centre = true;
+  return o;
+}
+
+void LineAnchorOptions::Check() const {
+  refine.Check();
+  FV_REQUIRE(min_inliers >= 50, "LineAnchorOptions.min_inliers must be >= 50 (got {})",
+             min_inliers);
+  FV_REQUIRE(std::isfinite(min_crossing) && min_crossing >= 0 && min_crossing <= 1,
+             "LineAnchorOptions.min_crossing must be in [0, 1] (got {})", min_crossing);
+  FV_REQUIRE(std::isfinite(max_median_px) && max_median_px > 0,
+             "LineAnchorOptions.max_median_px must be > 0 (got {})", max_median_px);
+  FV_REQUIRE(std::isfinite(max_correction_share) && max_correction_share > 0,
+             "LineAnchorOptions.max_correction_share must be > 0 (got {})", max_correction_share);
+}
+
+std::string LineAnchorStats::Summary() const {
+  if (tried == 0) return "field lines: no keyframe to fit";
+  return fmt::format(
+      "field lines: {} of {} views fitted held to them (correction median {:.1f} px, largest "
+      "{:.1f} px)",
+      anchored, tried, corrections_px.empty() ? 0.0 : util::Median(corrections_px),
+      corrections_px.empty() ? 0.0
+                             : *std::max_element(corrections_px.begin(), corrections_px.end()));
+}
+
+LineAnchor::LineAnchor(const camera::Camera& first, const field::FieldModel& field,
+                       const LineAnchorOptions& options)
+    : first_(first), field_(field), options_(options) {
+  options_.Check();
+  first_.Check("moving camera");
+  FV_REQUIRE(first_.has_pose, "camera '{}' has no pose: the field lines need one", first_.name);
+  calib::RequirePaintedLines(field_);
+  k_ = cv::Matx33d(first_.fx, 0, first_.cx, 0, first_.fy, first_.cy, 0, 0, 1);
+}
+
+camera::Camera LineAnchor::FramePose(const cv::Matx33d& first_from_frame) const {
+  // x_first ~ K R0 Rf^T K^-1 x_frame for a camera turning about its centre.
+  const Eigen::Matrix3d a = ToEigen(k_.inv() * first_from_frame * k_);
+  const Eigen::Matrix3d r0 = first_.cam_from_world.rotation;
+  const Eigen::Matrix3d rf = NearestRotation(a).transpose() * r0;
+  camera::Camera frame = first_;
+  frame.cam_from_world.rotation = rf;
+  frame.cam_from_world.translation = -rf * first_.CentreInWorld();
+  return frame;
+}
+
+cv::Matx33d LineAnchor::GroundHomography(const camera::Camera& frame) const {
+  auto ground_to_pixels = [this](const camera::Camera& c) {
+    Eigen::Matrix3d g;
+    g.col(0) = c.cam_from_world.rotation.col(0);
+    g.col(1) = c.cam_from_world.rotation.col(1);
+    g.col(2) = c.cam_from_world.translation;
+    return k_ * ToCv(g);
+  };
+  return ground_to_pixels(first_) * ground_to_pixels(frame).inv();
+}
+
+double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& registered,
+                              const cv::Matx33d& held) const {
+  // Over a 3x3 grid of the frame, where it sees the ground within kReachM (near the horizon a
+  // moved centre's ground homography parts from any other).
+  constexpr double kReachM = 60.0;
+  double correction = 0.0;
+  const Eigen::Matrix3d world_from_pixels =
+      frame.cam_from_world.rotation.transpose() * ToEigen(k_.inv());
+  const Eigen::Vector3d centre = frame.CentreInWorld();
+  for (const double fy : {0.0, 0.5, 1.0}) {
+    for (const double fx : {0.0, 0.5, 1.0}) {
+      const cv::Point2d p(fx * (first_.width - 1.0), fy * (first_.height - 1.0));
+      const Eigen::Vector3d d = world_from_pixels * Eigen::Vector3d(p.x, p.y, 1.0);
+      if (!(d.z() < 0) || -centre.z() / d.z() * d.norm() > kReachM) continue;
+      const cv::Point2d a = Apply(registered, p), b = Apply(held, p);
+      correction = std::max(correction, std::hypot(a.x - b.x, a.y - b.y));
+    }
+  }
+  return correction;
+}
+
+std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,
+                                               const std::vector<cv::Rect2d>& people,
+                                               const cv::Matx33d& first_from_frame) {
+  ++stats_.tried;
+  const camera::Camera start = FramePose(first_from_frame);
+  std::vector<Eigen::Vector2d> pixels =
+      calib::DetectLinePixels(bgr, start, field_, options_.refine.detect);
+  pixels.erase(std::remove_if(pixels.begin(), pixels.end(),
+                              [&people](const Eigen::Vector2d& p) { return InAnyBox(p, people); }),
+               pixels.end());
+  if (static_cast<int>(pixels.size()) < options_.min_inliers) return std::nullopt;
+  const calib::RefineResult fit =
+      calib::RefineWithLinePixels(start, pixels, field_, options_.refine);
+  if (!fit.accepted || fit.after.num_inliers < options_.min_inliers) return std::nullopt;
+  const LineFit check = CheckLineFit(fit.camera, pixels, field_, options_.refine.gate_m);
+  if (check.crossing < options_.min_crossing || check.median_px > options_.max_median_px) {
+    return std::nullopt;
+  }
+  const cv::Matx33d held = GroundHomography(fit.camera);
+  const double correction = Correction(start, first_from_frame, held);
+  if (!std::isfinite(correction) || correction > options_.max_correction_share * first_.width) {
+    return std::nullopt;
+  }
+  ++stats_.anchored;
+  stats_.corrections_px.push_back(correction);
+  return held;
+}
+
+}  // namespace fv::track
