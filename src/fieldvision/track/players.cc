@@ -785,6 +785,9 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
                                         [](const TrackRow& r) { return !BoxInRange(r.box); });
     result.outside_frames = static_cast<int>(result.rows.end() - outside);
     result.rows.erase(outside, result.rows.end());
+    std::set<int> ids;  // a track whose every row was beyond its frames is gone
+    for (const TrackRow& r : result.rows) ids.insert(r.id);
+    result.tracks = static_cast<int>(ids.size());
     result.camera_motion = motion->stats();
     if (anchor) result.line_anchor = anchor->stats();
     result.canvas = std::move(pass.canvas);

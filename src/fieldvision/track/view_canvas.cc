@@ -55,6 +55,7 @@ void ViewCanvas::AddFrame(const cv::Matx33d& first_from_frame) {
   FV_REQUIRE(std::isfinite(cv::norm(h)) && cv::determinant(h) != 0,
              "canvas: frame {} has no usable homography", frames() + 1);
   canvas_from_frame_.push_back(NormalizedHomography(h));
+  undistorted_from_canvas_.push_back(k_.inv() * canvas_from_frame_.back().inv());
 }
 
 const cv::Matx33d& ViewCanvas::CanvasFromFrame(int index) const {
@@ -76,9 +77,9 @@ std::optional<cv::Point2d> ViewCanvas::ToCanvas(int index, const cv::Point2d& fr
 }
 
 std::optional<cv::Point2d> ViewCanvas::ToFrame(int index, const cv::Point2d& canvas_px) const {
-  const cv::Vec3d q = CanvasFromFrame(index).inv() * cv::Vec3d(canvas_px.x, canvas_px.y, 1.0);
-  if (!(q[2] > 0)) return std::nullopt;
-  const cv::Vec3d n = k_.inv() * q;
+  FV_REQUIRE(index >= 0 && index < frames(), "canvas: frame {} of {}", index, frames());
+  const cv::Vec3d n = undistorted_from_canvas_[index] * cv::Vec3d(canvas_px.x, canvas_px.y, 1.0);
+  if (!(n[2] > 0)) return std::nullopt;  // behind the view (K's last row keeps w)
   const Eigen::Vector2d xn(n[0] / n[2], n[1] / n[2]);
   const auto uv = lens_.ProjectFromCamera({xn.x(), xn.y(), 1.0});
   if (!uv) return std::nullopt;

@@ -67,8 +67,9 @@ class ViewCanvas {
   cv::Matx33d k_;                  // the lens's intrinsics (the undistorted pixels' matrix)
   cv::Matx33d canvas_from_first_;  // the margin's shift
   std::vector<cv::Matx33d> canvas_from_frame_;
-  cv::Rect drawn_;                    // the region Draw filled last
-  mutable cv::Mat undistorted_grid_;  // CV_32FC2, frame-sized
+  std::vector<cv::Matx33d> undistorted_from_canvas_;  // K^-1 (canvas_from_frame)^-1, per frame
+  cv::Rect drawn_;                                    // the region Draw filled last
+  mutable cv::Mat undistorted_grid_;                  // CV_32FC2, frame-sized
 };
 
 }  // namespace fv::track
