@@ -499,6 +499,11 @@ check "players: --no-line-anchor" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
   --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/mvl.csv" --moving-camera \
   --no-line-anchor --no-progress
 grep -q "field lines: " "$TMP/out" && { echo "FAIL players: --no-line-anchor ignored"; fail=1; }
+check "players: --canvas-margin without --moving-camera" nonzero $FV players \
+  --camera "$TMP/bv/cam1.yaml" --video "$TMP/bv/cam1.avi" --out "$TMP/mvl.csv" --canvas-margin 2
+grep -q "requires --moving-camera" "$TMP/err" || { echo "FAIL players: margin alone"; fail=1; }
+check "players: --no-line-anchor without --moving-camera" nonzero $FV players \
+  --camera "$TMP/bv/cam1.yaml" --video "$TMP/bv/cam1.avi" --out "$TMP/mvl.csv" --no-line-anchor
 # (the scene has no people: its motion goes with a TRACKS.csv of one row)
 cp "$TMP/tr.csv" "$TMP/trm.csv" && cp "$TMP/mv.csv.motion.json" "$TMP/trm.csv.motion.json"
 check "tracks draw: a moving camera's motion" 0 $FV tracks draw --tracks "$TMP/trm.csv" \

@@ -116,7 +116,7 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
                 "Keep the foot point of every box: do not move the feet of a person whose legs "
                 "are hidden (a box whose top lies under 0.85 of their height above its foot) to "
                 "below the head at their height");
-  cmd->add_flag(
+  CLI::Option* moving = cmd->add_flag(
       "--moving-camera", c.o.moving_camera,
       "The camera sways, turns, pans or drifts (a phone held by hand or following "
       "play, a drone): each frame is registered to the first (optical flow and ORB "
@@ -126,12 +126,14 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
   cmd->add_flag("!--no-line-anchor", c.o.hold_to_lines,
                 "With --moving-camera: do not hold the views to the painted field lines (with a "
                 "posed camera file and a field with lines, each keyframe's view is fitted to the "
-                "lines it sees, which stops the registration's drift)");
+                "lines it sees, which stops the registration's drift)")
+      ->needs(moving);
   cmd->add_option("--canvas-margin", c.o.camera_motion.canvas_margin,
                   "With --moving-camera: how many image widths (heights) beyond the first view "
                   "people are tracked on each side")
       ->check(FiniteRange(0, 10))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(moving);
 }
 
 void Setup(CLI::App& app, int& exit_code) {
