@@ -408,6 +408,17 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
                                   const std::vector<Eigen::Vector2d>& pixels,
                                   const field::FieldModel& field, const RefineOptions& options) {
   options.Check();
+  RequirePaintedLines(field);
+  return RefineWithLinePixels(
+      camera, pixels, field,
+      LineDistanceMap(field, options.lut_resolution_m, options.lut_max_distance_m), options);
+}
+
+RefineResult RefineWithLinePixels(const camera::Camera& camera,
+                                  const std::vector<Eigen::Vector2d>& pixels,
+                                  const field::FieldModel& field, const LineDistanceMap& map,
+                                  const RefineOptions& options) {
+  options.Check();
   camera.Check("camera");
   FV_REQUIRE(camera.has_pose, "camera '{}' has no pose; run `calibrate extrinsics` first",
              camera.name);
@@ -426,7 +437,6 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
     result.status = fmt::format("only {} line pixels; need 50", rays.size());
     return result;
   }
-  const LineDistanceMap map(field, options.lut_resolution_m, options.lut_max_distance_m);
   const ceres::Grid2D<float, 1> grid(map.values().data(), 0, map.rows(), 0, map.cols());
   const ceres::BiCubicInterpolator<ceres::Grid2D<float, 1>> interp(grid);
 

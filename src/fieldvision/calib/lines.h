@@ -129,6 +129,12 @@ RefineResult RefineWithLinePixels(const camera::Camera& camera,
                                   const std::vector<Eigen::Vector2d>& pixels,
                                   const field::FieldModel& field,
                                   const RefineOptions& options = {});
+// The same with the field's distance table built once (a video's frames); the table's resolution
+// and reach replace options.lut_resolution_m and lut_max_distance_m.
+RefineResult RefineWithLinePixels(const camera::Camera& camera,
+                                  const std::vector<Eigen::Vector2d>& pixels,
+                                  const field::FieldModel& field, const LineDistanceMap& map,
+                                  const RefineOptions& options = {});
 
 // Throws fv::Error naming `field` when it has no painted lines (segments or arcs): both line
 // refinements would report a line error of 0 mm over no pixels.

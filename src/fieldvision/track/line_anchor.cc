@@ -94,6 +94,16 @@ LineFit CheckLineFit(const camera::Camera& camera, const std::vector<Eigen::Vect
   return fit;
 }
 
+// The field's distance table for the options, after checking both (a field without lines has
+// none).
+calib::LineDistanceMap DistanceMap(const field::FieldModel& field,
+                                   const LineAnchorOptions& options) {
+  options.Check();
+  calib::RequirePaintedLines(field);
+  return calib::LineDistanceMap(field, options.refine.lut_resolution_m,
+                                options.refine.lut_max_distance_m);
+}
+
 }  // namespace
 
 calib::RefineOptions LineAnchorOptions::DefaultRefine() {
@@ -129,11 +139,9 @@ std::string LineAnchorStats::Summary() const {
 
 LineAnchor::LineAnchor(const camera::Camera& first, const field::FieldModel& field,
                        const LineAnchorOptions& options)
-    : first_(first), field_(field), options_(options) {
-  options_.Check();
+    : first_(first), field_(field), options_(options), map_(DistanceMap(field, options)) {
   first_.Check("moving camera");
   FV_REQUIRE(first_.has_pose, "camera '{}' has no pose: the field lines need one", first_.name);
-  calib::RequirePaintedLines(field_);
   k_ = cv::Matx33d(first_.fx, 0, first_.cx, 0, first_.fy, first_.cy, 0, 0, 1);
 }
 
@@ -192,7 +200,7 @@ std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,
                pixels.end());
   if (static_cast<int>(pixels.size()) < options_.min_inliers) return std::nullopt;
   const calib::RefineResult fit =
-      calib::RefineWithLinePixels(start, pixels, field_, options_.refine);
+      calib::RefineWithLinePixels(start, pixels, field_, map_, options_.refine);
   if (!fit.accepted || fit.after.num_inliers < options_.min_inliers) return std::nullopt;
   const LineFit check = CheckLineFit(fit.camera, pixels, field_, options_.refine.gate_m);
   if (check.crossing < options_.min_crossing || check.median_px > options_.max_median_px) {

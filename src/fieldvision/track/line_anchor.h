@@ -79,6 +79,7 @@ class LineAnchor {
   camera::Camera first_;
   field::FieldModel field_;
   LineAnchorOptions options_;
+  calib::LineDistanceMap map_;  // built once for all the frames
   cv::Matx33d k_;
   LineAnchorStats stats_;
 };
