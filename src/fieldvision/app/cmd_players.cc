@@ -126,7 +126,8 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
   cmd->add_flag("!--no-line-anchor", c.o.hold_to_lines,
                 "With --moving-camera: do not hold the views to the painted field lines (with a "
                 "posed camera file and a field with lines, each keyframe's view is fitted to the "
-                "lines it sees, which stops the registration's drift)")
+                "lines it sees, which stops the registration's drift; the fit turns the camera "
+                "about the camera file's centre: use this for a drone that drifts)")
       ->needs(moving);
   cmd->add_option("--canvas-margin", c.o.camera_motion.canvas_margin,
                   "With --moving-camera: how many image widths (heights) beyond the first view "

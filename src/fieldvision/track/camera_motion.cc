@@ -327,7 +327,7 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     cv::Matx33d fitted;
     if (a.flow ? Flow(*a.view, f, predicted, &fitted) : Match(a.view->features, f, &fitted)) {
       const double departure = Departure(a.view->first_from_view * fitted, predicted);
-      if (departure < nearest) {
+      if (base == nullptr || departure < nearest) {  // infinite: a corner behind either view
         nearest = departure;
         a_from_this = fitted;
         base = a.view;
@@ -363,15 +363,16 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     new_key = true;
   }
   h = NormalizedHomography(h);
-  // The step from the last registered frame (over frames lost, the step before is kept).
-  if (since_registered_ == 0) {
+  // The step from the last registered frame (over frames lost, the step before is kept; a frame
+  // found by the anchor alone is no measurement of the step: its correction is drift).
+  if (since_registered_ == 0 && !held) {
     velocity_ = previous_.first_from_view.inv() * h;
     velocity_ = NormalizedHomography(velocity_);
   }
   since_registered_ = 0;
   if (new_key && anchor_ && !held) {
-    if (const std::optional<cv::Matx33d> held = anchor_(bgr, people, h)) {
-      h = NormalizedHomography(*held);
+    if (const std::optional<cv::Matx33d> corrected = anchor_(bgr, people, h)) {
+      h = NormalizedHomography(*corrected);
       ++stats_.anchored;
     }
   }

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"
 
@@ -147,7 +148,7 @@ LineAnchor::LineAnchor(const camera::Camera& first, const field::FieldModel& fie
 
 camera::Camera LineAnchor::FramePose(const cv::Matx33d& first_from_frame) const {
   // x_first ~ K R0 Rf^T K^-1 x_frame for a camera turning about its centre.
-  const Eigen::Matrix3d a = ToEigen(k_.inv() * first_from_frame * k_);
+  const Eigen::Matrix3d a = ToEigen(k_.inv() * NormalizedHomography(first_from_frame) * k_);
   const Eigen::Matrix3d r0 = first_.cam_from_world.rotation;
   const Eigen::Matrix3d rf = NearestRotation(a).transpose() * r0;
   camera::Camera frame = first_;
@@ -173,6 +174,7 @@ double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& re
   // moved centre's ground homography parts from any other).
   constexpr double kReachM = 60.0;
   double correction = 0.0;
+  int measured = 0;
   const Eigen::Matrix3d world_from_pixels =
       frame.cam_from_world.rotation.transpose() * ToEigen(k_.inv());
   const Eigen::Vector3d centre = frame.CentreInWorld();
@@ -183,9 +185,11 @@ double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& re
       if (!(d.z() < 0) || -centre.z() / d.z() * d.norm() > kReachM) continue;
       const cv::Point2d a = Apply(registered, p), b = Apply(held, p);
       correction = std::max(correction, std::hypot(a.x - b.x, a.y - b.y));
+      ++measured;
     }
   }
-  return correction;
+  // No ground in reach: the correction cannot be judged (and is not taken).
+  return measured > 0 ? correction : std::numeric_limits<double>::infinity();
 }
 
 std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,

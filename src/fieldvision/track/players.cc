@@ -676,6 +676,21 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
 
 }  // namespace
 
+// A moving camera's rows back in each frame's own pixels; a row carried or filled in beyond what
+// its frame can show (behind its view) has no box there: left out, with a track left without
+// rows and its team.
+void BoxesBackToFrames(const ViewCanvas& canvas, PlayersResult& result) {
+  for (TrackRow& r : result.rows) r.box = canvas.BoxToFrame(r.frame - 1, r.box);
+  const auto outside = std::remove_if(result.rows.begin(), result.rows.end(),
+                                      [](const TrackRow& r) { return !BoxInRange(r.box); });
+  result.outside_frames = static_cast<int>(result.rows.end() - outside);
+  result.rows.erase(outside, result.rows.end());
+  std::set<int> ids;
+  for (const TrackRow& r : result.rows) ids.insert(r.id);
+  result.tracks = static_cast<int>(ids.size());
+  std::erase_if(result.team_of, [&ids](const auto& entry) { return !ids.contains(entry.first); });
+}
+
 PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
                          const field::FieldModel* field, const PlayersOptions& options) {
   options.Check();
@@ -777,17 +792,8 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   const auto t_map = Clock::now();
   FinishTracks(options, tracked, calibrated, reader.size(), pass, sequence_files > 0, reader.fps(),
                result);
-  if (motion) {  // the boxes back in each frame's own pixels
-    for (TrackRow& r : result.rows) r.box = pass.canvas->BoxToFrame(r.frame - 1, r.box);
-    // A row carried or filled in beyond what its frame can show (behind its view) has no box
-    // there: left out.
-    const auto outside = std::remove_if(result.rows.begin(), result.rows.end(),
-                                        [](const TrackRow& r) { return !BoxInRange(r.box); });
-    result.outside_frames = static_cast<int>(result.rows.end() - outside);
-    result.rows.erase(outside, result.rows.end());
-    std::set<int> ids;  // a track whose every row was beyond its frames is gone
-    for (const TrackRow& r : result.rows) ids.insert(r.id);
-    result.tracks = static_cast<int>(ids.size());
+  if (motion) {
+    BoxesBackToFrames(*pass.canvas, result);
     result.camera_motion = motion->stats();
     if (anchor) result.line_anchor = anchor->stats();
     result.canvas = std::move(pass.canvas);

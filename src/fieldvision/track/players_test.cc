@@ -711,6 +711,7 @@ TEST(Players, PanningCameraTracksPeopleBeyondTheFirstView) {
   EXPECT_LT(p90, held_p90 + 0.5) << r.Summary();
   EXPECT_LT(worst_px, 12.0) << r.Summary();
   EXPECT_LT(worst_px, free_px + 1.0) << r.Summary();
+  EXPECT_LT(free_px, 30.0) << free_run.Summary();
   o.camera_motion.canvas_margin = 0;
   const PanScore first_view_only =
       ScorePan(pan.first, pan.panned, RunPlayers(video, &pan.first, &field, o));
