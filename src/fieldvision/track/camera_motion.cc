@@ -40,10 +40,10 @@ void CameraMotionOptions::Check() const {
 std::string CameraMotionStats::Summary() const {
   return fmt::format(
       "camera motion: of {} frames after the first, {} matched to it directly, {} through a "
-      "keyframe ({} keyframes{}), {} through the frame before, {} not at all (the camera's "
-      "motion carried on){}{}; the image centre moved up to {:.0f} px",
-      std::max(0, frames - 1), direct, keyed, keyframes,
-      anchored > 0 ? fmt::format(", {} held to the field lines", anchored) : "", chained, lost,
+      "keyframe ({} keyframes), {} through the frame before, {} not at all (the camera's "
+      "motion carried on){}{}{}; the image centre moved up to {:.0f} px",
+      std::max(0, frames - 1), direct, keyed, keyframes, chained, lost,
+      anchored > 0 ? fmt::format(", {} held to the field lines", anchored) : "",
       found_by_anchor > 0 ? fmt::format(", {} found by the field lines alone", found_by_anchor)
                           : "",
       departed > 0
@@ -340,7 +340,7 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
   // next keyframe; else the predicted view is taken, and the last registered frame stays the one
   // to chain from (a blank or blurred frame must not become the base of the next).
   std::optional<cv::Matx33d> held;
-  if (base == nullptr && anchor_) held = anchor_(bgr, people, predicted);
+  if (base == nullptr && anchor_) held = anchor_(bgr, people, predicted, true);
   if (base == nullptr && (!held || static_cast<int>(f.corners.size()) < options_.min_inliers)) {
     // A frame without texture to match later ones to keeps the frame before as the base.
     ++(held ? stats_.found_by_anchor : stats_.lost);
@@ -370,8 +370,8 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     velocity_ = NormalizedHomography(velocity_);
   }
   since_registered_ = 0;
-  if (new_key && anchor_ && !held) {
-    if (const std::optional<cv::Matx33d> corrected = anchor_(bgr, people, h)) {
+  if (anchor_ && !held) {
+    if (const std::optional<cv::Matx33d> corrected = anchor_(bgr, people, h, new_key)) {
       h = NormalizedHomography(*corrected);
       ++stats_.anchored;
     }

@@ -57,7 +57,7 @@ struct CameraMotionStats {
   int chained = 0;          // through the last registered frame
   int lost = 0;             // neither: the view predicted from the last two registered frames taken
   int departed = 0;         // registered off the prediction by over max_departure by every base
-  int anchored = 0;         // keyframes whose view the anchor corrected (SetAnchor)
+  int anchored = 0;         // registered frames whose view the anchor corrected (SetAnchor)
   int found_by_anchor = 0;  // frames matched to none, whose predicted view the anchor corrected
   double max_shift_px = 0.0;  // largest move of the image centre from the first frame's view
   std::string Summary() const;
@@ -73,13 +73,14 @@ class CameraMotion {
   // first), with the people's boxes left out of the matching.
   cv::Matx33d Register(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people);
   const CameraMotionStats& stats() const { return stats_; }
-  // Called with each new keyframe (the frame, the people's boxes, its registered homography): a
-  // homography it gives replaces the registered one (line_anchor.h: held to the field lines), so
-  // that the frames registered through the keyframe start from it; nullopt keeps the registered.
-  // Also with a frame matched to no other, at its predicted view: a homography it gives is the
-  // frame's (a keyframe), else the frame is lost.
+  // Called with each registered frame (the frame, the people's boxes, its registered homography,
+  // whether it is a new keyframe): a homography it gives replaces the registered one
+  // (line_anchor.h: held to the field lines), so that the frames registered through it start
+  // from it; nullopt keeps the registered. Also with a frame matched to no other, at its
+  // predicted view, as a keyframe: a homography it gives is the frame's, else the frame is lost.
   using Anchor = std::function<std::optional<cv::Matx33d>(
-      const cv::Mat& bgr, const std::vector<cv::Rect2d>& people, const cv::Matx33d& registered)>;
+      const cv::Mat& bgr, const std::vector<cv::Rect2d>& people, const cv::Matx33d& registered,
+      bool keyframe)>;
   void SetAnchor(Anchor anchor) { anchor_ = std::move(anchor); }
 
  private:

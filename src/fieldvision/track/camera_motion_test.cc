@@ -135,8 +135,9 @@ TEST(CameraMotion, FarTurnsAreChainedThroughKeyframes) {
   EXPECT_LE(last_error[0], last_error[1] + 0.5);
 }
 
-// An anchor (line_anchor.h holds views to the field lines) is asked about keyframes and frames
-// matched to nothing, never others: the views it gives replace the registered ones, so the pan's
+// An anchor (line_anchor.h holds views to the field lines) is told which frames are keyframes
+// (and frames matched to nothing are asked as keyframes); here it holds keyframes only: the views
+// it gives replace the registered ones, so the pan's
 // chained drift is gone at the end (here it knows the truth), and a blank frame it holds is found
 // instead of lost (not a keyframe: it has nothing to match later frames to). An anchor that
 // declines changes nothing.
@@ -148,8 +149,9 @@ TEST(CameraMotion, AnAnchorHoldsKeyframesAndFindsLostFrames) {
     CameraMotion motion;
     cv::Matx33d truth;
     int asked = 0;
-    motion.SetAnchor([&](const cv::Mat&, const std::vector<cv::Rect2d>& people,
-                         const cv::Matx33d&) -> std::optional<cv::Matx33d> {
+    motion.SetAnchor([&](const cv::Mat&, const std::vector<cv::Rect2d>& people, const cv::Matx33d&,
+                         bool keyframe) -> std::optional<cv::Matx33d> {
+      if (!keyframe) return std::nullopt;
       ++asked;
       EXPECT_EQ(people.size(), 1u);
       if (declines) return std::nullopt;

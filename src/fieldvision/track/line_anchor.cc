@@ -129,11 +129,12 @@ void LineAnchorOptions::Check() const {
 }
 
 std::string LineAnchorStats::Summary() const {
-  if (tried == 0) return "field lines: no keyframe to fit";
+  if (tried == 0 && checked == 0) return "field lines: no view to fit";
   return fmt::format(
-      "field lines: {} of {} views fitted held to them (correction median {:.1f} px, largest "
-      "{:.1f} px)",
-      anchored, tried, corrections_px.empty() ? 0.0 : util::Median(corrections_px),
+      "field lines: {} frames between keyframes checked; of {} views to fit (keyframes, frames off "
+      "the lines or matched to none) {} held to them (correction median {:.1f} px, largest {:.1f} "
+      "px)",
+      checked, tried, anchored, corrections_px.empty() ? 0.0 : util::Median(corrections_px),
       corrections_px.empty() ? 0.0
                              : *std::max_element(corrections_px.begin(), corrections_px.end()));
 }
@@ -194,8 +195,9 @@ double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& re
 
 std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,
                                                const std::vector<cv::Rect2d>& people,
-                                               const cv::Matx33d& first_from_frame) {
-  ++stats_.tried;
+                                               const cv::Matx33d& first_from_frame, bool keyframe) {
+  if (!keyframe && !options_.every_frame) return std::nullopt;
+  if (keyframe) ++stats_.tried;
   const camera::Camera start = FramePose(first_from_frame);
   std::vector<Eigen::Vector2d> pixels =
       calib::DetectLinePixels(bgr, start, field_, options_.refine.detect);
@@ -203,6 +205,15 @@ std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,
                               [&people](const Eigen::Vector2d& p) { return InAnyBox(p, people); }),
                pixels.end());
   if (static_cast<int>(pixels.size()) < options_.min_inliers) return std::nullopt;
+  if (!keyframe) {
+    // Another frame is fitted only when its registered view puts its lines off the field's.
+    ++stats_.checked;
+    if (!(CheckLineFit(start, pixels, field_, options_.refine.gate_m).median_px >
+          options_.refit_above_px)) {
+      return std::nullopt;
+    }
+    ++stats_.tried;
+  }
   const calib::RefineResult fit =
       calib::RefineWithLinePixels(start, pixels, field_, map_, options_.refine);
   if (!fit.accepted || fit.after.num_inliers < options_.min_inliers) return std::nullopt;

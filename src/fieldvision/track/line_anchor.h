@@ -1,11 +1,13 @@
 // A moving camera's view held to the painted field lines: a frame's homography to the first view
-// (CameraMotion: each new keyframe's, and a frame matched to no other at its predicted view)
-// gives its pose, the first camera turned about its centre; the frame's line pixels refine that
+// (CameraMotion: each new keyframe's, a frame matched to no other at its predicted view, and any
+// other frame whose line pixels lie off the field's lines under its registered view) gives its
+// pose, the first camera turned about its centre; the frame's line pixels refine that
 // rotation (calib::RefineWithLinePixels, chamfer matching on the ground plane) and the ground
 // plane's homography between the refined pose and the first pose replaces the registered one
 // (Hartley & Zisserman 13.1). Taken only when the lines hold it: lines across each other, the
 // pixels on them after the fit, a correction of a drift's size (lines matched to the wrong ones
-// fail these). The chained registration's drift stops at every keyframe that sees enough lines.
+// fail these). The registration's drift and its single frames off (a fit over grass) stop
+// wherever enough lines are seen.
 #pragma once
 
 #include <optional>
@@ -28,6 +30,10 @@ struct LineAnchorOptions {
   // scatter of the fitted line pixels' line normals over the larger (0: all lines parallel, the
   // view free to slide along them; 1: as much across as along) at least this.
   double min_crossing = 0.1;
+  // Frames between keyframes are checked too: when their line pixels lie over refit_above_px
+  // (median) from the field's lines under the registered view, they are fitted as keyframes.
+  bool every_frame = true;
+  double refit_above_px = 1.0;
   // The fitted line pixels' median distance from their lines, in pixels, at most this (a pose
   // matching lines to the wrong ones leaves many far off).
   double max_median_px = 2.0;
@@ -45,8 +51,9 @@ struct LineAnchorOptions {
 };
 
 struct LineAnchorStats {
-  int tried = 0;                       // views asked about (keyframes, frames matched to no other)
-  int anchored = 0;                    // of those, views the lines corrected
+  int checked = 0;   // frames between keyframes whose line pixels were checked (every_frame)
+  int tried = 0;     // views fitted (keyframes, frames matched to no other, frames off the lines)
+  int anchored = 0;  // of those, views the lines corrected
   std::vector<double> corrections_px;  // anchored frames' largest correction on the first view
   std::string Summary() const;
 };
@@ -61,7 +68,7 @@ class LineAnchor {
   // line pixels (those inside the people's boxes left out), or nullopt when the lines do not
   // hold it (too few, the fit refused, a correction too large).
   std::optional<cv::Matx33d> Correct(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
-                                     const cv::Matx33d& first_from_frame);
+                                     const cv::Matx33d& first_from_frame, bool keyframe = true);
   const LineAnchorStats& stats() const { return stats_; }
 
   // The pose of a frame whose undistorted pixels map to the first view's by `first_from_frame`,

@@ -99,6 +99,15 @@ TEST(LineAnchor, DriftedViewIsHeldToTheLines) {
             << " px held to the lines; " << anchor.stats().Summary() << "\n";
   EXPECT_GT(before, 4.0);
   EXPECT_LT(after, 1.0);
+  // Between keyframes a view on the lines is only checked; one off them is fitted.
+  LineAnchor between(first, field);
+  EXPECT_FALSE(between.Correct(frame, {}, truth, /*keyframe=*/false).has_value());
+  EXPECT_EQ(between.stats().checked, 1);
+  EXPECT_EQ(between.stats().tried, 0);
+  const auto refitted = between.Correct(frame, {}, drifted, /*keyframe=*/false);
+  ASSERT_TRUE(refitted.has_value()) << between.stats().Summary();
+  EXPECT_LT(ViewError(*refitted, truth), 1.0);
+  EXPECT_EQ(between.stats().tried, 1);
   // People's boxes over the whole frame leave no line pixels: the registered view is kept.
   EXPECT_FALSE(anchor.Correct(frame, {cv::Rect2d(0, 0, 640, 480)}, drifted).has_value());
 }

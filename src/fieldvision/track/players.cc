@@ -718,8 +718,8 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
         (!field->segments.empty() || !field->arcs.empty())) {
       anchor.emplace(*camera, *field, options.line_anchor);
       motion->SetAnchor([&anchor](const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
-                                  const cv::Matx33d& registered) {
-        return anchor->Correct(bgr, people, registered);
+                                  const cv::Matx33d& registered, bool keyframe) {
+        return anchor->Correct(bgr, people, registered, keyframe);
       });
     }
     const double margin = options.camera_motion.canvas_margin;
