@@ -122,6 +122,8 @@ void LineAnchorOptions::Check() const {
              min_inliers);
   FV_REQUIRE(std::isfinite(min_crossing) && min_crossing >= 0 && min_crossing <= 1,
              "LineAnchorOptions.min_crossing must be in [0, 1] (got {})", min_crossing);
+  FV_REQUIRE(std::isfinite(refit_above_px) && refit_above_px > 0,
+             "LineAnchorOptions.refit_above_px must be > 0 (got {})", refit_above_px);
   FV_REQUIRE(std::isfinite(max_median_px) && max_median_px > 0,
              "LineAnchorOptions.max_median_px must be > 0 (got {})", max_median_px);
   FV_REQUIRE(std::isfinite(max_correction_share) && max_correction_share > 0,

@@ -132,6 +132,10 @@ TEST(LineAnchor, WithoutLinesTheViewIsKept) {
   camera::Camera unposed = first;
   unposed.has_pose = false;
   EXPECT_THAT([&] { LineAnchor(unposed, field); }, ThrowsMessage<Error>(HasSubstr("no pose")));
+  LineAnchorOptions bad;
+  bad.refit_above_px = std::nan("");
+  EXPECT_THAT([&] { LineAnchor(first, field, bad); },
+              ThrowsMessage<Error>(HasSubstr("refit_above_px")));
 }
 
 }  // namespace
