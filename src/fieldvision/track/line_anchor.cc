@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <opencv2/imgproc.hpp>
 
 #include "fieldvision/track/camera_motion.h"
 #include "fieldvision/util/error.h"
@@ -122,6 +123,8 @@ void LineAnchorOptions::Check() const {
              min_inliers);
   FV_REQUIRE(std::isfinite(min_crossing) && min_crossing >= 0 && min_crossing <= 1,
              "LineAnchorOptions.min_crossing must be in [0, 1] (got {})", min_crossing);
+  FV_REQUIRE(work_width_px >= 160, "LineAnchorOptions.work_width_px must be >= 160 (got {})",
+             work_width_px);
   FV_REQUIRE(std::isfinite(refit_above_px) && refit_above_px > 0,
              "LineAnchorOptions.refit_above_px must be > 0 (got {})", refit_above_px);
   FV_REQUIRE(std::isfinite(max_median_px) && max_median_px > 0,
@@ -195,14 +198,36 @@ double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& re
   return measured > 0 ? correction : std::numeric_limits<double>::infinity();
 }
 
+std::vector<Eigen::Vector2d> LineAnchor::LinePixels(const cv::Mat& bgr,
+                                                    const camera::Camera& frame) const {
+  const double scale = std::min(1.0, static_cast<double>(options_.work_width_px) / bgr.cols);
+  if (scale >= 1.0) return calib::DetectLinePixels(bgr, frame, field_, options_.refine.detect);
+  // The frame and its camera scaled (pixel centres kept), the pixels found there scaled back.
+  cv::Mat small;
+  cv::resize(bgr, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  camera::Camera scaled = frame;
+  scaled.width = small.cols;
+  scaled.height = small.rows;
+  scaled.fx *= static_cast<double>(small.cols) / bgr.cols;
+  scaled.fy *= static_cast<double>(small.rows) / bgr.rows;
+  scaled.cx = (frame.cx + 0.5) * small.cols / bgr.cols - 0.5;
+  scaled.cy = (frame.cy + 0.5) * small.rows / bgr.rows - 0.5;
+  std::vector<Eigen::Vector2d> pixels =
+      calib::DetectLinePixels(small, scaled, field_, options_.refine.detect);
+  for (Eigen::Vector2d& p : pixels) {
+    p.x() = (p.x() + 0.5) * bgr.cols / small.cols - 0.5;
+    p.y() = (p.y() + 0.5) * bgr.rows / small.rows - 0.5;
+  }
+  return pixels;
+}
+
 std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,
                                                const std::vector<cv::Rect2d>& people,
                                                const cv::Matx33d& first_from_frame, bool keyframe) {
   if (!keyframe && !options_.every_frame) return std::nullopt;
   if (keyframe) ++stats_.tried;
   const camera::Camera start = FramePose(first_from_frame);
-  std::vector<Eigen::Vector2d> pixels =
-      calib::DetectLinePixels(bgr, start, field_, options_.refine.detect);
+  std::vector<Eigen::Vector2d> pixels = LinePixels(bgr, start);
   pixels.erase(std::remove_if(pixels.begin(), pixels.end(),
                               [&people](const Eigen::Vector2d& p) { return InAnyBox(p, people); }),
                pixels.end());

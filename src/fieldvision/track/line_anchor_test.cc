@@ -112,6 +112,34 @@ TEST(LineAnchor, DriftedViewIsHeldToTheLines) {
   EXPECT_FALSE(anchor.Correct(frame, {cv::Rect2d(0, 0, 640, 480)}, drifted).has_value());
 }
 
+// A frame wider than the work width (1280x960, searched at 960) is held as well as at full
+// width: within 2 px over the ground it sees (1 px at 640x480).
+TEST(LineAnchor, WideFramesAreSearchedAtTheWorkWidth) {
+  testing::SeededRng rng(4);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  synth::SceneSpec spec = SideCamera(rng.seed());
+  synth::ResizeCameras(spec, 1280, 960);
+  const camera::Camera first = synth::SceneRenderer(spec).cameras()[0];
+  spec.cameras[0].look_at_m.x() += rng.Uniform(-5, 5);
+  const synth::SceneRenderer scene(spec);
+  const cv::Mat frame = scene.Render(0)[0];
+  const cv::Matx33d truth = RotationHomography(first, scene.cameras()[0]);
+  const cv::Matx33d to_half(0.5, 0, -0.25, 0, 0.5, -0.25, 0, 0, 1);  // 1280x960 px to 640x480
+  const cv::Matx33d drifted = to_half.inv() * Drift(4, -3, 0.5) * to_half * truth;
+  for (const int width : {960, 1280}) {
+    LineAnchorOptions o;
+    o.work_width_px = width;
+    LineAnchor anchor(first, field, o);
+    const auto held = anchor.Correct(frame, {}, drifted);
+    ASSERT_TRUE(held.has_value()) << anchor.stats().Summary();
+    const double after =
+        ViewError(to_half * *held * to_half.inv(), to_half * truth * to_half.inv());
+    std::cout << "line anchor at 1280x960, lines found at " << width << " px wide: " << 2 * after
+              << " px off\n";
+    EXPECT_LT(2 * after, 2.0);
+  }
+}
+
 // A frame without lines (grass only), a view too far off for the lines to hold it, a field
 // without lines and a camera without a pose.
 TEST(LineAnchor, WithoutLinesTheViewIsKept) {
