@@ -69,15 +69,6 @@ Workspace& Work() {
   return w;
 }
 
-cv::Matx33d Intrinsics(const fv::camera::Camera& c) {
-  return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
-}
-
-cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
-  const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
-  return {q[0] / q[2], q[1] / q[2]};
-}
-
 // The camera turned by (yaw, pitch, roll) at frame t; none at frame 0 (the calibrated view).
 cv::Matx33d Sway(const fv::camera::Camera& cam, int t) {
   const double a = t == 0 ? 0.0 : 1.0;
@@ -87,7 +78,7 @@ cv::Matx33d Sway(const fv::camera::Camera& cam, int t) {
                           a * 3 * deg * std::sin(2 * M_PI * t / 200.0),
                           a * 1 * deg * std::sin(2 * M_PI * t / 90.0 + 1.3)),
                 r);
-  return Intrinsics(cam) * r * Intrinsics(cam).inv();
+  return fv::track::IntrinsicMatrix(cam) * r * fv::track::IntrinsicMatrix(cam).inv();
 }
 
 constexpr double kPanZoom = 1.6;
@@ -134,10 +125,10 @@ void PrepareSway() {
   Moved& m = w.swayed;
   m.camera = w.camera;
   m.from_original = [&w](int t, const cv::Point2d& p) {
-    return std::optional(Apply(w.sway[t], p));
+    return std::optional(fv::track::MapPoint(w.sway[t], p));
   };
   m.to_original = [&w](int t, const cv::Point2d& p) {
-    return std::optional(Apply(w.sway[t].inv(), p));
+    return std::optional(fv::track::MapPoint(w.sway[t].inv(), p));
   };
   WriteMoved(
       "swayed",
@@ -160,12 +151,14 @@ void PreparePan() {
   m.from_original = [&w](int t, const cv::Point2d& p) -> std::optional<cv::Point2d> {
     const auto n = w.camera.Undistort({p.x, p.y});
     if (!n) return std::nullopt;
-    const cv::Vec3d v = Intrinsics(w.pan_camera) * (w.pan[t] * cv::Vec3d(n->x(), n->y(), 1.0));
+    const cv::Vec3d v =
+        fv::track::IntrinsicMatrix(w.pan_camera) * (w.pan[t] * cv::Vec3d(n->x(), n->y(), 1.0));
     if (!(v[2] > 0)) return std::nullopt;
     return cv::Point2d(v[0] / v[2], v[1] / v[2]);
   };
   m.to_original = [&w](int t, const cv::Point2d& p) -> std::optional<cv::Point2d> {
-    const cv::Vec3d v = w.pan[t].t() * (Intrinsics(w.pan_camera).inv() * cv::Vec3d(p.x, p.y, 1));
+    const cv::Vec3d v =
+        w.pan[t].t() * (fv::track::IntrinsicMatrix(w.pan_camera).inv() * cv::Vec3d(p.x, p.y, 1));
     const auto uv = w.camera.ProjectFromCamera({v[0], v[1], v[2]});
     if (!uv) return std::nullopt;
     return cv::Point2d(uv->x(), uv->y());
@@ -174,8 +167,9 @@ void PreparePan() {
       "panned",
       [&w](int t, const cv::Mat& f, cv::Mat& v) {
         cv::Mat map1, map2;
-        cv::initUndistortRectifyMap(Intrinsics(w.camera), w.camera.distortion, w.pan.at(t),
-                                    Intrinsics(w.pan_camera), f.size(), CV_16SC2, map1, map2);
+        cv::initUndistortRectifyMap(fv::track::IntrinsicMatrix(w.camera), w.camera.distortion,
+                                    w.pan.at(t), fv::track::IntrinsicMatrix(w.pan_camera), f.size(),
+                                    CV_16SC2, map1, map2);
         cv::remap(f, v, map1, map2, cv::INTER_LINEAR);
       },
       m);

@@ -21,20 +21,14 @@ void CameraMotionOptions::Check() const {
              work_width_px);
   FV_REQUIRE(std::isfinite(ratio_test) && ratio_test > 0 && ratio_test <= 1,
              "CameraMotionOptions.ratio_test must be in (0, 1] (got {})", ratio_test);
-  FV_REQUIRE(std::isfinite(ransac_px) && ransac_px > 0,
-             "CameraMotionOptions.ransac_px must be > 0 (got {})", ransac_px);
+  CheckPositive(ransac_px, "CameraMotionOptions.ransac_px");
   FV_REQUIRE(min_inliers >= 8, "CameraMotionOptions.min_inliers must be >= 8 (got {})",
              min_inliers);
-  FV_REQUIRE(std::isfinite(min_inlier_cover) && min_inlier_cover >= 0 && min_inlier_cover <= 1,
-             "CameraMotionOptions.min_inlier_cover must be in [0, 1] (got {})", min_inlier_cover);
-  FV_REQUIRE(std::isfinite(min_inlier_share) && min_inlier_share >= 0 && min_inlier_share <= 1,
-             "CameraMotionOptions.min_inlier_share must be in [0, 1] (got {})", min_inlier_share);
-  FV_REQUIRE(std::isfinite(keyframe_overlap) && keyframe_overlap >= 0 && keyframe_overlap <= 1,
-             "CameraMotionOptions.keyframe_overlap must be in [0, 1] (got {})", keyframe_overlap);
-  FV_REQUIRE(std::isfinite(max_departure) && max_departure > 0,
-             "CameraMotionOptions.max_departure must be > 0 (got {})", max_departure);
-  FV_REQUIRE(std::isfinite(canvas_margin) && canvas_margin >= 0 && canvas_margin <= 10,
-             "CameraMotionOptions.canvas_margin must be in [0, 10] (got {})", canvas_margin);
+  CheckInRange(min_inlier_cover, 0, 1, "CameraMotionOptions.min_inlier_cover");
+  CheckInRange(min_inlier_share, 0, 1, "CameraMotionOptions.min_inlier_share");
+  CheckInRange(keyframe_overlap, 0, 1, "CameraMotionOptions.keyframe_overlap");
+  CheckPositive(max_departure, "CameraMotionOptions.max_departure");
+  CheckInRange(canvas_margin, 0, 10, "CameraMotionOptions.canvas_margin");
 }
 
 std::string CameraMotionStats::Summary() const {
@@ -53,11 +47,6 @@ std::string CameraMotionStats::Summary() const {
 }
 
 namespace {
-
-cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
-  const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
-  return {q[0] / q[2], q[1] / q[2]};
-}
 
 // `points` mapped by h, or nullopt when one of them goes behind (w <= 0) or to infinity.
 std::optional<std::vector<cv::Point2f>> MapInFront(const cv::Matx33d& h,
@@ -91,8 +80,17 @@ cv::Matx33d NormalizedHomography(const cv::Matx33d& h) {
   return h * ((cv::determinant(h) < 0 ? -1.0 : 1.0) / n);
 }
 
+cv::Point2d MapPoint(const cv::Matx33d& h, const cv::Point2d& p) {
+  const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
+  return {q[0] / q[2], q[1] / q[2]};
+}
+
+cv::Matx33d IntrinsicMatrix(const camera::Camera& c) {
+  return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
+}
+
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box) {
-  return MapBoxBy([&h](const cv::Point2d& p) { return std::optional(Apply(h, p)); }, box);
+  return MapBoxBy([&h](const cv::Point2d& p) { return std::optional(MapPoint(h, p)); }, box);
 }
 
 cv::Rect2d MapBoxBy(const std::function<std::optional<cv::Point2d>(const cv::Point2d&)>& to,
@@ -165,7 +163,7 @@ std::vector<cv::Point2f> CameraMotion::ToUndistorted(std::vector<cv::Point2f> wo
                                                      double scale) const {
   for (cv::Point2f& p : work_px) p *= 1.0 / scale;
   if (lens_ && !work_px.empty()) {
-    const cv::Matx33d k(lens_->fx, 0, lens_->cx, 0, lens_->fy, lens_->cy, 0, 0, 1);
+    const cv::Matx33d k = IntrinsicMatrix(*lens_);
     // Iterated to convergence, as Camera::Undistort (OpenCV's default stops after 5 steps).
     cv::undistortPoints(
         std::vector<cv::Point2f>(work_px), work_px, k, lens_->distortion, cv::noArray(), k,
@@ -377,7 +375,7 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     }
   }
   const cv::Point2d centre = Centre();
-  const cv::Point2d moved = Apply(h, centre);
+  const cv::Point2d moved = MapPoint(h, centre);
   stats_.max_shift_px =
       std::max(stats_.max_shift_px, std::hypot(moved.x - centre.x, moved.y - centre.y));
   previous_ = {std::move(f), h};

@@ -137,6 +137,11 @@ class CameraMotion {
 // turned 90 degrees from the view, where points behind it must stay behind (w < 0).
 cv::Matx33d NormalizedHomography(const cv::Matx33d& h);
 
+// A point moved by a homography (no check of w: the caller's points are in front).
+cv::Point2d MapPoint(const cv::Matx33d& h, const cv::Point2d& p);
+// The intrinsic matrix K of a camera: its undistorted pixels, between which the homographies are.
+cv::Matx33d IntrinsicMatrix(const camera::Camera& c);
+
 // A person's box moved by a homography: the bottom centre (the foot) and the top centre map as
 // points; the width scales with the height.
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box);

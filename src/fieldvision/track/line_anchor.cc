@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/track/camera_motion.h"
@@ -19,17 +20,13 @@ namespace {
 
 cv::Matx33d ToCv(const Eigen::Matrix3d& m) {
   cv::Matx33d out;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) out(r, c) = m(r, c);
-  }
+  cv::eigen2cv(m, out);
   return out;
 }
 
 Eigen::Matrix3d ToEigen(const cv::Matx33d& m) {
   Eigen::Matrix3d out;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) out(r, c) = m(r, c);
-  }
+  cv::cv2eigen(m, out);
   return out;
 }
 
@@ -39,11 +36,6 @@ Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& m) {
   Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
   d(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0 ? -1.0 : 1.0;
   return svd.matrixU() * d * svd.matrixV().transpose();
-}
-
-cv::Point2d Apply(const cv::Matx33d& h, const cv::Point2d& p) {
-  const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
-  return {q[0] / q[2], q[1] / q[2]};
 }
 
 bool InAnyBox(const Eigen::Vector2d& p, const std::vector<cv::Rect2d>& people) {
@@ -71,9 +63,9 @@ LineFit CheckLineFit(const camera::Camera& camera, const std::vector<Eigen::Vect
   std::vector<double> residuals_px;
   for (size_t i = 0; i < pixels.size(); i += stride) {
     const auto ray = camera.RayFromPixel(pixels[i]);
-    if (!ray || !(ray->direction.z() < 0)) continue;
-    const Eigen::Vector3d g = ray->origin - ray->origin.z() / ray->direction.z() * ray->direction;
-    const Eigen::Vector2d p = g.head<2>();
+    const auto g = ray ? geometry::IntersectHorizontalPlane(*ray, 0.0) : std::nullopt;
+    if (!g) continue;
+    const Eigen::Vector2d p = g->head<2>();
     const double d = field.DistanceToLineCentres(p);
     if (d > gate_m) continue;
     const Eigen::Vector2d dx(kStepM, 0), dy(0, kStepM);
@@ -121,16 +113,12 @@ void LineAnchorOptions::Check() const {
   refine.Check();
   FV_REQUIRE(min_inliers >= 50, "LineAnchorOptions.min_inliers must be >= 50 (got {})",
              min_inliers);
-  FV_REQUIRE(std::isfinite(min_crossing) && min_crossing >= 0 && min_crossing <= 1,
-             "LineAnchorOptions.min_crossing must be in [0, 1] (got {})", min_crossing);
+  CheckInRange(min_crossing, 0, 1, "LineAnchorOptions.min_crossing");
   FV_REQUIRE(work_width_px >= 160, "LineAnchorOptions.work_width_px must be >= 160 (got {})",
              work_width_px);
-  FV_REQUIRE(std::isfinite(refit_above_px) && refit_above_px > 0,
-             "LineAnchorOptions.refit_above_px must be > 0 (got {})", refit_above_px);
-  FV_REQUIRE(std::isfinite(max_median_px) && max_median_px > 0,
-             "LineAnchorOptions.max_median_px must be > 0 (got {})", max_median_px);
-  FV_REQUIRE(std::isfinite(max_correction_share) && max_correction_share > 0,
-             "LineAnchorOptions.max_correction_share must be > 0 (got {})", max_correction_share);
+  CheckPositive(refit_above_px, "LineAnchorOptions.refit_above_px");
+  CheckPositive(max_median_px, "LineAnchorOptions.max_median_px");
+  CheckPositive(max_correction_share, "LineAnchorOptions.max_correction_share");
 }
 
 std::string LineAnchorStats::Summary() const {
@@ -149,7 +137,7 @@ LineAnchor::LineAnchor(const camera::Camera& first, const field::FieldModel& fie
     : first_(first), field_(field), options_(options), map_(DistanceMap(field, options)) {
   first_.Check("moving camera");
   FV_REQUIRE(first_.has_pose, "camera '{}' has no pose: the field lines need one", first_.name);
-  k_ = cv::Matx33d(first_.fx, 0, first_.cx, 0, first_.fy, first_.cy, 0, 0, 1);
+  k_ = IntrinsicMatrix(first_);
 }
 
 camera::Camera LineAnchor::FramePose(const cv::Matx33d& first_from_frame) const {
@@ -188,8 +176,9 @@ double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& re
     for (const double fx : {0.0, 0.5, 1.0}) {
       const cv::Point2d p(fx * (first_.width - 1.0), fy * (first_.height - 1.0));
       const Eigen::Vector3d d = world_from_pixels * Eigen::Vector3d(p.x, p.y, 1.0);
-      if (!(d.z() < 0) || -centre.z() / d.z() * d.norm() > kReachM) continue;
-      const cv::Point2d a = Apply(registered, p), b = Apply(held, p);
+      const auto ground = geometry::IntersectHorizontalPlane({centre, d.normalized()}, 0.0);
+      if (!ground || (*ground - centre).norm() > kReachM) continue;
+      const cv::Point2d a = MapPoint(registered, p), b = MapPoint(held, p);
       correction = std::max(correction, std::hypot(a.x - b.x, a.y - b.y));
       ++measured;
     }

@@ -8,6 +8,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "fieldvision/synth/synth.h"
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/track_testing.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -28,14 +29,12 @@ synth::SceneSpec SideCamera(uint64_t seed) {
   return spec;
 }
 
-cv::Matx33d Intrinsics(const camera::Camera& c) { return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1}; }
-
 // A turned camera's view on the first one's undistorted pixels: K R0 Rf^T K^-1.
 cv::Matx33d RotationHomography(const camera::Camera& first, const camera::Camera& frame) {
   cv::Matx33d r0, rf;
   cv::eigen2cv(Eigen::Matrix3d(first.cam_from_world.rotation), r0);
   cv::eigen2cv(Eigen::Matrix3d(frame.cam_from_world.rotation), rf);
-  const cv::Matx33d k = Intrinsics(first);
+  const cv::Matx33d k = IntrinsicMatrix(first);
   return k * r0 * rf.t() * k.inv();
 }
 

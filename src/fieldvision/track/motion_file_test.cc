@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
 #include "fieldvision/util/testing.h"
@@ -36,7 +37,7 @@ TEST(MotionFile, RoundTripAndLens) {
   for (int t = 0; t < 5; ++t) {
     cv::Matx33d q;
     cv::Rodrigues(cv::Vec3d(rng.Uniform(-0.05, 0.05), rng.Uniform(-0.3, 0.3), 0), q);
-    const cv::Matx33d k(lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
+    const cv::Matx33d k = IntrinsicMatrix(lens);
     canvas.AddFrame(k * q * k.inv());
   }
   const std::string dir = fv::testing::TempDir();

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/track/players_internal.h"
 #include "fieldvision/util/error.h"
@@ -478,7 +479,7 @@ TEST(Players, SwayingCameraKeepsTheFieldPositions) {
   synth::SceneRenderer scene(spec);
   const camera::Camera cam = scene.cameras()[0];
   const field::FieldModel& field = scene.field();
-  const cv::Matx33d k(cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+  const cv::Matx33d k = IntrinsicMatrix(cam);
   std::filesystem::create_directories(dir + "/sway");
   std::vector<cv::Matx33d> sway;  // frame_from_first of each frame
   for (int t = 0; t < spec.num_frames; ++t) {

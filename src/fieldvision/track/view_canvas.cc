@@ -14,8 +14,6 @@ namespace fv::track {
 
 namespace {
 
-cv::Matx33d Intrinsics(const camera::Camera& c) { return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1}; }
-
 cv::Matx33d Shift(double x, double y) { return {1, 0, x, 0, 1, y, 0, 0, 1}; }
 
 }  // namespace
@@ -24,7 +22,7 @@ ViewCanvas::ViewCanvas(const camera::Camera& lens, double margin) : lens_(lens) 
   lens_.Check("moving camera's lens");
   FV_REQUIRE(std::isfinite(margin) && margin >= 0 && margin <= 10,
              "the canvas margin must be in [0, 10] image sizes (got {})", margin);
-  k_ = Intrinsics(lens_);
+  k_ = IntrinsicMatrix(lens_);
   margin_ = margin;
   const double dx = std::round(margin * lens_.width), dy = std::round(margin * lens_.height);
   canvas_from_first_ = Shift(dx, dy);

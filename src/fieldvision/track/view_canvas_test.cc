@@ -7,6 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
 
@@ -30,7 +31,7 @@ camera::Camera Lens() {
 camera::Camera Turned(const camera::Camera& lens, const cv::Vec3d& rvec, cv::Matx33d* first_from) {
   cv::Matx33d q;
   cv::Rodrigues(rvec, q);
-  const cv::Matx33d k(lens.fx, 0, lens.cx, 0, lens.fy, lens.cy, 0, 0, 1);
+  const cv::Matx33d k = IntrinsicMatrix(lens);
   *first_from = k * q.t() * k.inv();
   camera::Camera turned = lens;
   Eigen::Matrix3d qe;
