@@ -311,8 +311,8 @@ std::string LineErrorStats::Summary() const {
 }
 
 void RequirePaintedLines(const field::FieldModel& field) {
-  FV_REQUIRE(!field.segments.empty() || !field.arcs.empty(),
-             "field '{}' has no painted lines to refine the pose against", field.name);
+  FV_REQUIRE(field.HasPaintedLines(), "field '{}' has no painted lines to refine the pose against",
+             field.name);
 }
 
 LineErrorStats LineError(const camera::Camera& camera, const std::vector<Eigen::Vector2d>& pixels,

@@ -75,6 +75,8 @@ struct FieldModel {
   const FieldKeypoint* FindKeypoint(const std::string& name) const;
   // Distance from p to the nearest line centreline (segments and arcs).
   double DistanceToLineCentres(const Eigen::Vector2d& p) const;
+  // Whether the field has painted lines (segments or arcs) to fit a camera's pose to.
+  bool HasPaintedLines() const { return !segments.empty() || !arcs.empty(); }
   // Signed distance to the nearest painted area: < 0 inside the paint.
   double DistanceToPaint(const Eigen::Vector2d& p) const;
   // Points along every line centreline, about step_m apart (ends included).

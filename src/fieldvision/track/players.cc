@@ -621,6 +621,13 @@ void RecordTracks(const std::vector<TrackState>& states, const cv::Mat& frame, i
   }
 }
 
+// The ids that have rows.
+std::set<int> TrackIds(const std::vector<TrackRow>& rows) {
+  std::set<int> ids;
+  for (const TrackRow& r : rows) ids.insert(r.id);
+  return ids;
+}
+
 // After the pass: short tracks dropped, tracklets joined, gaps filled, ground tracks smoothed,
 // teams and the rows' times.
 void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, bool calibrated,
@@ -656,8 +663,7 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
     result.smoothing =
         SmoothGroundTracks(result.rows, measured, *camera, result.fps, options.smooth);
   }
-  std::set<int> ids;
-  for (const auto& r : result.rows) ids.insert(r.id);
+  const std::set<int> ids = TrackIds(result.rows);
   result.tracks = static_cast<int>(ids.size());
   if (options.teams) result.team_of = AssignTeams(pass.torso_colours, ids);
   // An image sequence has no time of its own (OpenCV reports 25 frames/s for any pattern).
@@ -674,8 +680,6 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
   }
 }
 
-}  // namespace
-
 // A moving camera's rows back in each frame's own pixels; a row carried or filled in beyond what
 // its frame can show (behind its view) has no box there: left out, with a track left without
 // rows and its team.
@@ -685,11 +689,12 @@ void BoxesBackToFrames(const ViewCanvas& canvas, PlayersResult& result) {
                                       [](const TrackRow& r) { return !BoxInRange(r.box); });
   result.outside_frames = static_cast<int>(result.rows.end() - outside);
   result.rows.erase(outside, result.rows.end());
-  std::set<int> ids;
-  for (const TrackRow& r : result.rows) ids.insert(r.id);
+  const std::set<int> ids = TrackIds(result.rows);
   result.tracks = static_cast<int>(ids.size());
   std::erase_if(result.team_of, [&ids](const auto& entry) { return !ids.contains(entry.first); });
 }
+
+}  // namespace
 
 PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
                          const field::FieldModel* field, const PlayersOptions& options) {
@@ -714,8 +719,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   std::optional<LineAnchor> anchor;
   if (options.moving_camera) {
     motion.emplace(options.camera_motion, camera);
-    if (options.hold_to_lines && calibrated && field != nullptr &&
-        (!field->segments.empty() || !field->arcs.empty())) {
+    if (options.hold_to_lines && calibrated && field != nullptr && field->HasPaintedLines()) {
       anchor.emplace(*camera, *field, options.line_anchor);
       motion->SetAnchor([&anchor](const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
                                   const cv::Matx33d& registered, bool keyframe) {
