@@ -499,6 +499,15 @@ check "players: --no-line-anchor" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
   --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/mvl.csv" --moving-camera \
   --no-line-anchor --no-progress
 grep -q "field lines: " "$TMP/out" && { echo "FAIL players: --no-line-anchor ignored"; fail=1; }
+check "players: --moving-centre" 0 $FV players --camera "$TMP/bv/cam1.yaml" \
+  --video "$TMP/bv/cam1.avi" --field robocup-msl --out "$TMP/mvl.csv" --moving-camera \
+  --moving-centre --no-progress
+grep -q "field lines: " "$TMP/out" || { echo "FAIL players: --moving-centre without lines"; fail=1; }
+check "players: --moving-centre without a field" nonzero $FV players \
+  --camera "$TMP/bv/cam1.yaml" --video "$TMP/bv/cam1.avi" --out "$TMP/mvl.csv" --moving-camera \
+  --moving-centre
+grep -q "needs a posed camera file and a field" "$TMP/err" ||
+  { echo "FAIL players: --moving-centre without a field"; fail=1; }
 check "players: --canvas-margin without --moving-camera" nonzero $FV players \
   --camera "$TMP/bv/cam1.yaml" --video "$TMP/bv/cam1.avi" --out "$TMP/mvl.csv" --canvas-margin 2
 grep -q "requires --moving-camera" "$TMP/err" || { echo "FAIL players: margin alone"; fail=1; }

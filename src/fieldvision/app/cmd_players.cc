@@ -127,7 +127,13 @@ void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
                 "With --moving-camera: do not hold the views to the painted field lines (with a "
                 "posed camera file and a field with lines, each keyframe's view is fitted to the "
                 "lines it sees, which stops the registration's drift; the fit turns the camera "
-                "about the camera file's centre: use this for a drone that drifts)")
+                "about the camera file's centre, or with --moving-centre refits its whole pose)")
+      ->needs(moving);
+  cmd->add_flag("--moving-centre", c.o.moving_centre,
+                "With --moving-camera: the camera moves as well as turns (a drone, a camera "
+                "carried along the side line): frames are registered on the ground alone (the "
+                "field and its surround, not the stands) and the field lines refit each frame's "
+                "whole pose; needs --field and a posed camera file")
       ->needs(moving);
   cmd->add_option("--canvas-margin", c.o.camera_motion.canvas_margin,
                   "With --moving-camera: how many image widths (heights) beyond the first view "

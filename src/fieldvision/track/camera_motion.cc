@@ -89,6 +89,13 @@ cv::Matx33d IntrinsicMatrix(const camera::Camera& c) {
   return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
 }
 
+cv::Matx33d PixelsFromGround(const camera::Camera& c) {
+  const Eigen::Matrix3d& r = c.cam_from_world.rotation;
+  const Eigen::Vector3d& t = c.cam_from_world.translation;
+  const cv::Matx33d rt(r(0, 0), r(0, 1), t.x(), r(1, 0), r(1, 1), t.y(), r(2, 0), r(2, 1), t.z());
+  return IntrinsicMatrix(c) * rt;
+}
+
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box) {
   return MapBoxBy([&h](const cv::Point2d& p) { return std::optional(MapPoint(h, p)); }, box);
 }
@@ -124,7 +131,8 @@ CameraMotion::CameraMotion(const CameraMotionOptions& options, const camera::Cam
 }
 
 CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
-                                            const std::vector<cv::Rect2d>& people) const {
+                                            const std::vector<cv::Rect2d>& people,
+                                            const cv::Matx33d& predicted) const {
   const double scale = std::min(1.0, static_cast<double>(options_.work_width_px) / bgr.cols);
   cv::Mat gray;
   cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
@@ -142,6 +150,7 @@ CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
     const cv::Rect clipped = r & cv::Rect(0, 0, mask.cols, mask.rows);
     if (!clipped.empty()) mask(clipped).setTo(0);
   }
+  MaskFiltered(predicted, scale, &mask);
   Features f;
   f.gray = gray;
   f.scale = scale;
@@ -157,6 +166,39 @@ CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
                    cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 10, 0.03));
   f.points = ToUndistorted(f.points, scale);
   return f;
+}
+
+void CameraMotion::MaskFiltered(const cv::Matx33d& predicted, double scale, cv::Mat* mask) const {
+  if (!keep_) return;
+  // The filter at the centres of kCellPx cells: corners are then chosen among the kept ones
+  // (goodFeaturesToTrack's quality is relative to the strongest corner in the mask).
+  constexpr int kCellPx = 8;
+  std::vector<cv::Point2f> centres;
+  for (int y = 0; y < mask->rows; y += kCellPx) {
+    for (int x = 0; x < mask->cols; x += kCellPx) {
+      centres.emplace_back(std::min(x + 0.5f * kCellPx, mask->cols - 1.0f),
+                           std::min(y + 0.5f * kCellPx, mask->rows - 1.0f));
+    }
+  }
+  const std::vector<cv::Point2f> undistorted = ToUndistorted(centres, scale);
+  size_t i = 0;
+  for (int y = 0; y < mask->rows; y += kCellPx) {
+    for (int x = 0; x < mask->cols; x += kCellPx, ++i) {
+      const cv::Point2f& p = undistorted[i];
+      if (keep_(predicted * cv::Vec3d(p.x, p.y, 1.0))) continue;
+      (*mask)(cv::Rect(x, y, kCellPx, kCellPx) & cv::Rect(0, 0, mask->cols, mask->rows)).setTo(0);
+    }
+  }
+}
+
+void CameraMotion::Known(const cv::Matx33d& view, bool by_anchor, bool step_known) {
+  // Two views the anchor held in a row measure the step (its corrections are not drift there).
+  if (!step_known && by_anchor && previous_held_ && since_known_ == 0) {
+    velocity_ = NormalizedHomography(last_view_.inv() * view);
+  }
+  last_view_ = view;
+  since_known_ = 0;
+  previous_held_ = by_anchor;
 }
 
 std::vector<cv::Point2f> CameraMotion::ToUndistorted(std::vector<cv::Point2f> work_px,
@@ -284,26 +326,28 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
                "camera motion: frame {} is {}x{}, the camera {}x{}", stats_.frames + 1, bgr.cols,
                bgr.rows, lens_->width, lens_->height);
   }
-  Features f = Detect(bgr, people);
   ++stats_.frames;
   if (stats_.frames == 1) {
     size_ = bgr.size();
-    first_ = {std::move(f), cv::Matx33d::eye()};
+    first_ = {Detect(bgr, people, cv::Matx33d::eye()), cv::Matx33d::eye()};
     key_ = first_;
     previous_ = first_;
     velocity_ = cv::Matx33d::eye();
+    Known(cv::Matx33d::eye(), false, true);
     return first_.first_from_view;
   }
   FV_REQUIRE(bgr.size() == size_, "camera motion: frame {} is {}x{}, the first was {}x{}",
              stats_.frames, bgr.cols, bgr.rows, size_.width, size_.height);
-  // This frame's view as the last two registered ones predict it (constant motion, carried over
-  // frames lost, for at most kMaxCarried of them).
+  // This frame's view as the camera's last step predicts it from the last frame whose view is
+  // known (registered or found by the anchor; constant motion, carried over frames lost, for at
+  // most kMaxCarried of them).
   constexpr int kMaxCarried = 10;
-  cv::Matx33d predicted = previous_.first_from_view;
-  for (int i = 0; i <= std::min(since_registered_, kMaxCarried - 1); ++i) {
+  cv::Matx33d predicted = last_view_;
+  for (int i = 0; i <= std::min(since_known_, kMaxCarried - 1); ++i) {
     predicted = predicted * velocity_;
   }
   predicted = NormalizedHomography(predicted);
+  Features f = Detect(bgr, people, predicted);
   // Optical flow from the prediction first (the first frame where the view is back over it, the
   // keyframe, the frame before), then descriptors (a jump, or a view found again after frames
   // lost): descriptors on repeated texture can lock on a copy of it one period off.
@@ -341,9 +385,16 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
   if (base == nullptr && anchor_) held = anchor_(bgr, people, predicted, true);
   if (base == nullptr && (!held || static_cast<int>(f.corners.size()) < options_.min_inliers)) {
     // A frame without texture to match later ones to keeps the frame before as the base.
-    ++(held ? stats_.found_by_anchor : stats_.lost);
     ++since_registered_;
-    return held ? NormalizedHomography(*held) : predicted;
+    if (!held) {
+      ++stats_.lost;
+      ++since_known_;
+      previous_held_ = false;
+      return predicted;
+    }
+    ++stats_.found_by_anchor;
+    Known(NormalizedHomography(*held), true);
+    return last_view_;
   }
   cv::Matx33d h = held ? *held : base->first_from_view * a_from_this;
   bool new_key;
@@ -362,18 +413,21 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
   }
   h = NormalizedHomography(h);
   // The step from the last registered frame (over frames lost, the step before is kept; a frame
-  // found by the anchor alone is no measurement of the step: its correction is drift).
-  if (since_registered_ == 0 && !held) {
-    velocity_ = previous_.first_from_view.inv() * h;
-    velocity_ = NormalizedHomography(velocity_);
+  // found by the anchor alone measures it only from a frame the anchor held too: from a
+  // registered one its correction is drift).
+  if (!held && since_registered_ == 0) {
+    velocity_ = NormalizedHomography(previous_.first_from_view.inv() * h);
   }
   since_registered_ = 0;
+  bool by_anchor = held.has_value();
   if (anchor_ && !held) {
     if (const std::optional<cv::Matx33d> corrected = anchor_(bgr, people, h, new_key)) {
       h = NormalizedHomography(*corrected);
       ++stats_.anchored;
+      by_anchor = true;
     }
   }
+  Known(h, by_anchor, /*step_known=*/!held);
   const cv::Point2d centre = Centre();
   const cv::Point2d moved = MapPoint(h, centre);
   stats_.max_shift_px =

@@ -8,8 +8,9 @@
 // visual odometry: the error adds up per keyframe, not per frame), else to the frame before; a
 // fit far from the predicted view gives way to the next. With the camera's lens the homographies
 // are between undistorted pixels, where a homography maps a turning camera's whole image exactly
-// and a moving camera's ground plane. An anchor may correct keyframes and find lost frames
-// (line_anchor.h: the field lines). The players pipeline then works on the first view widened
+// and a moving camera's ground plane (matched there alone: a feature filter). An anchor may
+// correct keyframes and find lost frames (line_anchor.h: the field lines), and the camera's step
+// is then also taken from two frames in a row it held. The players pipeline then works on the first view widened
 // (view_canvas.h).
 #pragma once
 
@@ -82,6 +83,12 @@ class CameraMotion {
       const cv::Mat& bgr, const std::vector<cv::Rect2d>& people, const cv::Matx33d& registered,
       bool keyframe)>;
   void SetAnchor(Anchor anchor) { anchor_ = std::move(anchor); }
+  // Features are searched only where the frame's place on the first view (homogeneous, through
+  // its predicted view, the sign kept) passes `keep` (tried at the centres of 8 px cells): a
+  // camera that moves maps from frame to frame by one homography only over one plane, the ground
+  // (OnTheGround in players.cc), not over the stands and boards beside it.
+  using FeatureFilter = std::function<bool(const cv::Vec3d& first_px)>;
+  void SetFeatureFilter(FeatureFilter keep) { keep_ = std::move(keep); }
 
  private:
   struct Features {
@@ -97,7 +104,16 @@ class CameraMotion {
     Features features;
     cv::Matx33d first_from_view = cv::Matx33d::eye();
   };
-  Features Detect(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people) const;
+  // The frame's features off the people's boxes and where the filter keeps them at the frame's
+  // `predicted` view.
+  Features Detect(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
+                  const cv::Matx33d& predicted) const;
+  // A frame's view is known (registered, corrected or found by the anchor): the next frames are
+  // predicted from it; a step not measured by the registration (`step_known` false) is taken
+  // from two views in a row the anchor held.
+  void Known(const cv::Matx33d& view, bool by_anchor, bool step_known = false);
+  // Clears the cells of a work-scale mask whose centre keep_ refuses at `predicted`.
+  void MaskFiltered(const cv::Matx33d& predicted, double scale, cv::Mat* mask) const;
   // The homography from b's pixels to a's, or false when untrusted.
   bool Match(const Features& a, const Features& b, cv::Matx33d* a_from_b) const;
   // The homography from b's pixels to view a's from a's corners followed into b by pyramidal
@@ -126,10 +142,14 @@ class CameraMotion {
   std::optional<camera::Camera> lens_;
   View first_, key_, previous_;
   cv::Matx33d velocity_ = cv::Matx33d::eye();  // the last step: previous's view from the one before
-  int since_registered_ = 0;                   // frames lost since the last registered one
+  int since_registered_ = 0;                   // frames since the last registered one
+  cv::Matx33d last_view_ = cv::Matx33d::eye();  // the last frame's whose view is known
+  int since_known_ = 0;                         // frames lost since then
+  bool previous_held_ = false;                  // that view is the anchor's
   cv::Size size_;
   CameraMotionStats stats_;
   Anchor anchor_;
+  FeatureFilter keep_;
 };
 
 // A homography scaled to unit norm with a positive determinant (a camera's turn or drift keeps
@@ -141,6 +161,9 @@ cv::Matx33d NormalizedHomography(const cv::Matx33d& h);
 cv::Point2d MapPoint(const cv::Matx33d& h, const cv::Point2d& p);
 // The intrinsic matrix K of a camera: its undistorted pixels, between which the homographies are.
 cv::Matx33d IntrinsicMatrix(const camera::Camera& c);
+// K [r1 r2 t] of a posed camera: the ground plane (z = 0) to its undistorted pixels, scaled so
+// that a ground point's image has the point's depth as its w (positive in front).
+cv::Matx33d PixelsFromGround(const camera::Camera& c);
 
 // A person's box moved by a homography: the bottom centre (the foot) and the top centre map as
 // points; the width scales with the height.

@@ -18,12 +18,6 @@ namespace fv::track {
 
 namespace {
 
-cv::Matx33d ToCv(const Eigen::Matrix3d& m) {
-  cv::Matx33d out;
-  cv::eigen2cv(m, out);
-  return out;
-}
-
 Eigen::Matrix3d ToEigen(const cv::Matx33d& m) {
   Eigen::Matrix3d out;
   cv::cv2eigen(m, out);
@@ -141,6 +135,7 @@ LineAnchor::LineAnchor(const camera::Camera& first, const field::FieldModel& fie
 }
 
 camera::Camera LineAnchor::FramePose(const cv::Matx33d& first_from_frame) const {
+  if (!options_.refine.fix_centre) return PlanePose(first_from_frame);
   // x_first ~ K R0 Rf^T K^-1 x_frame for a camera turning about its centre.
   const Eigen::Matrix3d a = ToEigen(k_.inv() * NormalizedHomography(first_from_frame) * k_);
   const Eigen::Matrix3d r0 = first_.cam_from_world.rotation;
@@ -151,15 +146,32 @@ camera::Camera LineAnchor::FramePose(const cv::Matx33d& first_from_frame) const 
   return frame;
 }
 
+camera::Camera LineAnchor::PlanePose(const cv::Matx33d& first_from_frame) const {
+  // K^-1 H ~ [r1 r2 t] for the frame's homography from the ground (Hartley & Zisserman 8.8.1;
+  // Zhang 2000): scaled so that r1 and r2 are unit on average, the sign putting the camera above
+  // the ground, the rotation the nearest to [r1 r2 r1 x r2].
+  const Eigen::Matrix3d m = ToEigen(k_.inv() * first_from_frame.inv() * PixelsFromGround(first_));
+  const double scale = 2.0 / (m.col(0).norm() + m.col(1).norm());
+  Eigen::Matrix3d r;
+  r.col(0) = scale * m.col(0);
+  r.col(1) = scale * m.col(1);
+  r.col(2) = r.col(0).cross(r.col(1));
+  Eigen::Matrix3d rotation = NearestRotation(r);
+  Eigen::Vector3d translation = scale * m.col(2);
+  if ((-rotation.transpose() * translation).z() < 0) {
+    // The other sign: r1, r2 and t flip, r3 = r1 x r2 stays.
+    r.leftCols<2>() *= -1.0;
+    rotation = NearestRotation(r);
+    translation = -translation;
+  }
+  camera::Camera frame = first_;
+  frame.cam_from_world.rotation = rotation;
+  frame.cam_from_world.translation = translation;
+  return frame;
+}
+
 cv::Matx33d LineAnchor::GroundHomography(const camera::Camera& frame) const {
-  auto ground_to_pixels = [this](const camera::Camera& c) {
-    Eigen::Matrix3d g;
-    g.col(0) = c.cam_from_world.rotation.col(0);
-    g.col(1) = c.cam_from_world.rotation.col(1);
-    g.col(2) = c.cam_from_world.translation;
-    return k_ * ToCv(g);
-  };
-  return ground_to_pixels(first_) * ground_to_pixels(frame).inv();
+  return PixelsFromGround(first_) * PixelsFromGround(frame).inv();
 }
 
 double LineAnchor::Correction(const camera::Camera& frame, const cv::Matx33d& registered,

@@ -1,8 +1,9 @@
 // A moving camera's view held to the painted field lines: a frame's homography to the first view
 // (CameraMotion: each new keyframe's, a frame matched to no other at its predicted view, and any
 // other frame whose line pixels lie off the field's lines under its registered view) gives its
-// pose, the first camera turned about its centre; the frame's line pixels refine that
-// rotation (calib::RefineWithLinePixels, chamfer matching on the ground plane) and the ground
+// pose, the first camera turned about its centre (a camera that moves: the pose that sees the
+// ground through it, Zhang 2000); the frame's line pixels refine that rotation (or the whole
+// pose; calib::RefineWithLinePixels, chamfer matching on the ground plane) and the ground
 // plane's homography between the refined pose and the first pose replaces the registered one
 // (Hartley & Zisserman 13.1). Taken only when the lines hold it: lines across each other, the
 // pixels on them after the fit, a correction of a drift's size (lines matched to the wrong ones
@@ -48,8 +49,9 @@ struct LineAnchorOptions {
   // Line refinement for a frame already registered: a coarse 20 mm table and the rotation only,
   // the camera's centre held where the camera file puts it (fix_centre: a camera on a tripod or
   // held still turns about a point near it; over a turning camera's lines a free centre left the
-  // views 0.6-0.8 px off on the ground against 0.03-0.26 px). A drone that drifts: fix_centre
-  // false, the centre moving at most max_move_m (1 m).
+  // views 0.6-0.8 px off on the ground against 0.03-0.26 px). A camera that moves (a drone):
+  // fix_centre false, each frame's pose taken from its ground homography (PlanePose) and refined
+  // whole, its centre moving at most max_move_m (1 m) from there.
   static calib::RefineOptions DefaultRefine();
 };
 
@@ -74,9 +76,13 @@ class LineAnchor {
                                      const cv::Matx33d& first_from_frame, bool keyframe = true);
   const LineAnchorStats& stats() const { return stats_; }
 
-  // The pose of a frame whose undistorted pixels map to the first view's by `first_from_frame`,
-  // taken as the first camera turned about its centre.
+  // The pose of a frame whose undistorted pixels map to the first view's by `first_from_frame`:
+  // the first camera turned about its centre (refine.fix_centre), or else the pose that sees the
+  // ground through that homography (PlanePose).
   camera::Camera FramePose(const cv::Matx33d& first_from_frame) const;
+  // The pose, centre and rotation, under which the ground maps to the frame's undistorted pixels
+  // as it does through `first_from_frame` and the first view (a camera that moves).
+  camera::Camera PlanePose(const cv::Matx33d& first_from_frame) const;
   // The homography of the ground plane from `frame`'s undistorted pixels to the first view's.
   cv::Matx33d GroundHomography(const camera::Camera& frame) const;
 

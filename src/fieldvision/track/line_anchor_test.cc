@@ -74,6 +74,29 @@ TEST(LineAnchor, TurnedCameraPoseFromItsHomography) {
   }
 }
 
+// A camera moved and turned (a drone): the pose from its ground plane's homography to the first
+// view is its own (1e-9), at any scale of the homography.
+TEST(LineAnchor, MovedCameraPoseFromItsGroundHomography) {
+  testing::SeededRng rng(2);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  const camera::Camera first = synth::SceneRenderer(SideCamera(rng.seed())).cameras()[0];
+  LineAnchorOptions moving;
+  moving.refine.fix_centre = false;
+  const LineAnchor anchor(first, field, moving);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d centre =
+        first.CentreInWorld() +
+        Eigen::Vector3d(rng.Uniform(-5, 5), rng.Uniform(-2, 2), rng.Uniform(-1, 3));
+    camera::Camera moved = first;
+    moved.cam_from_world = geometry::Rigid3d::LookAt(
+        centre, Eigen::Vector3d(rng.Uniform(-5, 5), rng.Uniform(-2, 2), 0.0));
+    const cv::Matx33d h = anchor.GroundHomography(moved);
+    const camera::Camera pose = anchor.FramePose(h * (trial % 2 == 0 ? 2.5 : -0.3));
+    EXPECT_LT((pose.cam_from_world.rotation - moved.cam_from_world.rotation).norm(), 1e-9);
+    EXPECT_LT((pose.CentreInWorld() - moved.CentreInWorld()).norm(), 1e-9);
+  }
+}
+
 // A turned camera's view registered with drift (moved 4-8 px and turned 0.5 degree on the first
 // view, as a chain of flows drifts over grass) is pulled back onto the painted lines it sees:
 // within 1 px over the ground it sees (seeds 1-20: drifted 6.0-13.0 px, held 0.03-0.26 px).

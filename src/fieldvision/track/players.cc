@@ -683,6 +683,53 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
 // A moving camera's rows back in each frame's own pixels; a row carried or filled in beyond what
 // its frame can show (behind its view) has no box there: left out, with a track left without
 // rows and its team.
+}  // namespace
+
+// The first view's undistorted pixels to the ground by its pose: w > 0 where the frame's ray meets
+// the ground ahead of it (PixelsFromGround's scale); kInsetM off the surround's edge, where boards
+// and goals stand.
+CameraMotion::FeatureFilter OnTheGround(const camera::Camera& first,
+                                        const field::FieldModel& field) {
+  constexpr double kInsetM = 0.3;
+  const cv::Matx33d ground_from_first = PixelsFromGround(first).inv();
+  const double hx = field.HalfLengthWithSurround() - kInsetM;
+  const double hy = field.HalfWidthWithSurround() - kInsetM;
+  return [ground_from_first, hx, hy](const cv::Vec3d& first_px) {
+    const cv::Vec3d g = ground_from_first * first_px;
+    return g[2] > 0 && std::abs(g[0]) <= hx * g[2] && std::abs(g[1]) <= hy * g[2];
+  };
+}
+
+namespace {
+
+// A moving camera's registration (held to the field's lines when it has them and the camera a
+// pose; on the ground alone for a camera that moves as well as turns) and its canvas.
+void SetUpMovingCamera(const camera::Camera* camera, const field::FieldModel* field,
+                       const PlayersOptions& options, cv::Size size,
+                       std::optional<CameraMotion>& motion, std::optional<LineAnchor>& anchor,
+                       PlayersPass& pass) {
+  const bool calibrated = camera != nullptr && camera->has_pose;
+  motion.emplace(options.camera_motion, camera);
+  LineAnchorOptions anchor_options = options.line_anchor;
+  if (options.moving_centre) {
+    FV_REQUIRE(calibrated && field != nullptr,
+               "players: a camera that moves as well as turns (--moving-centre) needs a posed "
+               "camera file and a field (--field)");
+    motion->SetFeatureFilter(OnTheGround(*camera, *field));
+    anchor_options.refine.fix_centre = false;
+  }
+  if (options.hold_to_lines && calibrated && field != nullptr && field->HasPaintedLines()) {
+    anchor.emplace(*camera, *field, anchor_options);
+    motion->SetAnchor([&anchor](const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
+                                const cv::Matx33d& registered, bool keyframe) {
+      return anchor->Correct(bgr, people, registered, keyframe);
+    });
+  }
+  const double margin = options.camera_motion.canvas_margin;
+  pass.canvas =
+      camera != nullptr ? ViewCanvas(*camera, margin) : ViewCanvas::Uncalibrated(size, margin);
+}
+
 void BoxesBackToFrames(const ViewCanvas& canvas, PlayersResult& result) {
   for (TrackRow& r : result.rows) r.box = canvas.BoxToFrame(r.frame - 1, r.box);
   const auto outside = std::remove_if(result.rows.begin(), result.rows.end(),
@@ -718,17 +765,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   std::optional<CameraMotion> motion;
   std::optional<LineAnchor> anchor;
   if (options.moving_camera) {
-    motion.emplace(options.camera_motion, camera);
-    if (options.hold_to_lines && calibrated && field != nullptr && field->HasPaintedLines()) {
-      anchor.emplace(*camera, *field, options.line_anchor);
-      motion->SetAnchor([&anchor](const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
-                                  const cv::Matx33d& registered, bool keyframe) {
-        return anchor->Correct(bgr, people, registered, keyframe);
-      });
-    }
-    const double margin = options.camera_motion.canvas_margin;
-    pass.canvas = camera != nullptr ? ViewCanvas(*camera, margin)
-                                    : ViewCanvas::Uncalibrated(reader.size(), margin);
+    SetUpMovingCamera(camera, field, options, reader.size(), motion, anchor, pass);
   }
   const camera::Camera* tracked =
       pass.canvas && camera != nullptr ? &pass.canvas->camera() : camera;

@@ -99,6 +99,11 @@ struct PlayersOptions {
   // view is held to the lines it sees (line_anchor.h), which stops the registration's drift.
   bool hold_to_lines = true;
   LineAnchorOptions line_anchor;
+  // A moving camera that moves as well as turns (a drone, a camera carried along the side line):
+  // its frames are registered on the ground alone (one homography maps frame to frame there, not
+  // over the stands) and the lines refit each frame's whole pose (line_anchor.refine.fix_centre
+  // false). Needs a posed camera and a field.
+  bool moving_centre = false;
 
   void Check() const;
 };

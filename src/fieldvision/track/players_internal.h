@@ -10,9 +10,16 @@
 #include <opencv2/core.hpp>
 
 #include "fieldvision/track/bytetrack.h"
+#include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/players.h"
 
 namespace fv::track {
+
+// The feature filter of a camera that moves (CameraMotion::SetFeatureFilter): a place on the
+// first view (undistorted pixels, homogeneous through a frame's view) is kept where the frame's
+// ray meets the ground ahead of it within the field and its surround, less 0.3 m.
+CameraMotion::FeatureFilter OnTheGround(const camera::Camera& first,
+                                        const field::FieldModel& field);
 
 // One track's ends as the stitcher sees them: ground positions (metres) and velocities (m/s).
 struct Tracklet {
