@@ -64,6 +64,13 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (r.time.time_s.empty()) {
     std::cerr << "fieldvision: warning: time_s left empty: " << r.time.source << "\n";
   }
+  if (r.view_drift && r.view_drift->moved) {
+    std::cerr << fmt::format(
+        "fieldvision: warning: the view moved by up to {:.0f} px from the first frame's (frame "
+        "{}): the positions assume a still camera; for a camera that sways, pans or was knocked, "
+        "run with --moving-camera\n",
+        r.view_drift->max_shift_px, r.view_drift->max_frame + 1);
+  }
   // Frames not registered take the view the camera's motion predicts: as good as that guess.
   if (r.camera_motion && r.camera_motion->lost > 0.1 * r.frames) {
     std::cerr << "fieldvision: warning: " << r.camera_motion->lost << " of " << r.frames

@@ -397,11 +397,16 @@ void PlayersOptions::Check() const {
   CheckNonNegative(interpolate_max_gap, "interpolate_max_gap");
   CheckNonNegative(min_track_frames, "min_track_frames");
   CheckNonNegative(fps, "fps");
+  FV_REQUIRE(!moving_centre || moving_camera,
+             "players: a camera that moves as well as turns (--moving-centre) needs "
+             "--moving-camera");
   if (moving_camera) {
     camera_motion.Check();
     if (hold_to_lines) line_anchor.Check();
     FV_REQUIRE(detector.kind != "motion",
                "the motion detector needs a still camera, not a moving one (--moving-camera)");
+  } else {
+    view_drift.Check();
   }
 }
 
@@ -411,7 +416,7 @@ std::string PlayersResult::Summary() const {
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}{}, "
-      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}{}",
+      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -419,11 +424,13 @@ std::string PlayersResult::Summary() const {
                          : "",
       rows.size(), interpolated, off_ground, mended_feet, times.total_s,
       frames / std::max(1e-9, times.total_s), 1000 * times.read_s / f, 1000 * times.detect_s / f,
-      camera_motion ? fmt::format(", register {:.1f}", 1000 * times.register_s / f) : "",
+      camera_motion || view_drift ? fmt::format(", register {:.1f}", 1000 * times.register_s / f)
+                                  : "",
       1000 * times.track_s / f, 1000 * times.map_s / f, tracker.Summary(),
       smoothing.tracks > 0 ? "; " + smoothing.Summary() : "",
       camera_motion ? "; " + camera_motion->Summary() : "",
       line_anchor ? "; " + line_anchor->Summary() : "",
+      view_drift ? "; " + view_drift->Summary() : "",
       outside_frames > 0
           ? fmt::format(" ({} rows left out: beyond what their frame shows)", outside_frames)
           : "",
@@ -572,16 +579,21 @@ struct PlayersPass {
   cv::Mat canvas_image;
 };
 
+// The detections' boxes.
+std::vector<cv::Rect2d> Boxes(const std::vector<Detection>& dets) {
+  std::vector<cv::Rect2d> boxes;
+  boxes.reserve(dets.size());
+  for (const Detection& d : dets) boxes.push_back(d.box);
+  return boxes;
+}
+
 // A moving camera's frame: registered to the first one, its detections moved onto the canvas
 // (those whose foot point then lies outside it or fails `filter` dropped) and the frame drawn
 // there, where the tracker's appearance model reads it at the moved boxes.
 const cv::Mat& ToCanvas(CameraMotion& motion, const FootFilter& filter, const cv::Mat& frame,
                         std::vector<Detection>& dets, PlayersPass& pass) {
-  std::vector<cv::Rect2d> boxes;
-  boxes.reserve(dets.size());
-  for (const Detection& d : dets) boxes.push_back(d.box);
   ViewCanvas& canvas = *pass.canvas;
-  canvas.AddFrame(motion.Register(frame, boxes));
+  canvas.AddFrame(motion.Register(frame, Boxes(dets)));
   const int index = canvas.frames() - 1;
   std::vector<Detection> kept;
   for (Detection d : dets) {
@@ -797,6 +809,9 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     total = options.max_frames;
   }
   util::Progress progress("players", total, "frames", options.progress);
+  // A still run's view is checked for moves (a camera knocked, swaying or panning).
+  std::optional<ViewDrift> drift;
+  if (!motion) drift.emplace(options.view_drift);
   cv::Mat frame;
   int index = 0;
   double time_ms = 0;
@@ -807,6 +822,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     if (!options.detections_out.empty()) pass.saved.frames.push_back(dets);  // the frame's pixels
     const auto t_register = Clock::now();
     const cv::Mat view = motion ? ToCanvas(*motion, filter, frame, dets, pass) : frame;
+    if (drift) drift->Add(index, frame, Boxes(dets));
     const auto t1 = Clock::now();
     result.times.register_s += Seconds(t_register, t1);
     const std::vector<TrackState> states = tracker.Update(dets, view);
@@ -839,6 +855,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     if (anchor) result.line_anchor = anchor->stats();
     result.canvas = std::move(pass.canvas);
   }
+  if (drift) result.view_drift = drift->stats();
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();
   result.frames_note = reader.frames_note();

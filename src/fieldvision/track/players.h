@@ -22,6 +22,7 @@
 #include "fieldvision/track/line_anchor.h"
 #include "fieldvision/track/mot.h"
 #include "fieldvision/track/view_canvas.h"
+#include "fieldvision/track/view_drift.h"
 
 namespace fv::track {
 
@@ -104,6 +105,9 @@ struct PlayersOptions {
   // over the stands) and the lines refit each frame's whole pose (line_anchor.refine.fix_centre
   // false). Needs a posed camera and a field.
   bool moving_centre = false;
+  // Without moving_camera: the view is checked for moves (view_drift.h), which the still run's
+  // positions do not follow (PlayersResult::view_drift).
+  ViewDriftOptions view_drift;
 
   void Check() const;
 };
@@ -123,7 +127,8 @@ FrameTimes TimesOfFrames(const std::vector<double>& container_ms, double contain
 
 struct StageTimes {
   double read_s = 0, detect_s = 0, track_s = 0, map_s = 0, total_s = 0;
-  double register_s = 0;  // a moving camera's frames registered to the first
+  double register_s = 0;  // a moving camera's frames registered to the first (a still one's
+                          // checked: view_drift.h)
 };
 
 struct PlayersResult {
@@ -145,6 +150,7 @@ struct PlayersResult {
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
   std::optional<LineAnchorStats> line_anchor;      // with PlayersOptions::hold_to_lines in use
+  std::optional<ViewDriftStats> view_drift;        // without PlayersOptions::moving_camera
   // The canvas its frames were tracked on (view_canvas.h), as TrackOverlay::SetCameraMotion
   // takes it.
   std::optional<ViewCanvas> canvas;

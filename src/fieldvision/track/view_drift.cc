@@ -1,0 +1,50 @@
+#include "fieldvision/track/view_drift.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "fieldvision/util/error.h"
+
+namespace fv::track {
+
+void ViewDriftOptions::Check() const {
+  FV_REQUIRE(every_frames >= 1, "ViewDriftOptions.every_frames must be >= 1 (got {})",
+             every_frames);
+  CheckPositive(moved_share, "ViewDriftOptions.moved_share");
+}
+
+std::string ViewDriftStats::Summary() const {
+  if (checked == 0) return "view: not checked";
+  return fmt::format(
+      "view: {} frames registered to the first ({} matched to none), its centre moved up to "
+      "{:.1f} px (frame {})",
+      checked, unmatched, max_shift_px, max_frame + 1);
+}
+
+ViewDrift::ViewDrift(const ViewDriftOptions& options) : options_(options) { options_.Check(); }
+
+void ViewDrift::Add(int index, const cv::Mat& bgr, const std::vector<cv::Rect2d>& people) {
+  if (index > 0 && index % options_.every_frames != 0) return;
+  const int lost_before = motion_.stats().lost;
+  const cv::Matx33d first_from_frame = motion_.Register(bgr, people);
+  if (index == 0) {
+    width_ = bgr.cols;
+    return;
+  }
+  ++stats_.checked;
+  if (motion_.stats().lost > lost_before) {
+    ++stats_.unmatched;
+    return;
+  }
+  const cv::Point2d centre(0.5 * (bgr.cols - 1), 0.5 * (bgr.rows - 1));
+  const cv::Point2d moved = MapPoint(first_from_frame, centre);
+  const double shift_px = std::hypot(moved.x - centre.x, moved.y - centre.y);
+  if (shift_px > stats_.max_shift_px) {
+    stats_.max_shift_px = shift_px;
+    stats_.max_frame = index;
+  }
+  stats_.moved = stats_.max_shift_px > options_.moved_share * width_;
+}
+
+}  // namespace fv::track
