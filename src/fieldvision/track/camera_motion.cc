@@ -33,10 +33,11 @@ void CameraMotionOptions::Check() const {
 
 std::string CameraMotionStats::Summary() const {
   return fmt::format(
-      "camera motion: of {} frames after the first, {} matched to it directly, {} through a "
+      "camera motion{}: of {} frames after the first, {} matched to it directly, {} through a "
       "keyframe ({} keyframes), {} through the frame before, {} not at all (the camera's "
       "motion carried on){}{}{}; the image centre moved up to {:.0f} px",
-      std::max(0, frames - 1), direct, keyed, keyframes, chained, lost,
+      ground_only ? " (features on the ground alone)" : "", std::max(0, frames - 1), direct, keyed,
+      keyframes, chained, lost,
       anchored > 0 ? fmt::format(", {} held to the field lines", anchored) : "",
       found_by_anchor > 0 ? fmt::format(", {} found by the field lines alone", found_by_anchor)
                           : "",
@@ -132,7 +133,7 @@ CameraMotion::CameraMotion(const CameraMotionOptions& options, const camera::Cam
 
 CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
                                             const std::vector<cv::Rect2d>& people,
-                                            const cv::Matx33d& predicted) const {
+                                            const cv::Matx33d& predicted) {
   const double scale = std::min(1.0, static_cast<double>(options_.work_width_px) / bgr.cols);
   cv::Mat gray;
   cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
@@ -168,32 +169,54 @@ CameraMotion::Features CameraMotion::Detect(const cv::Mat& bgr,
   return f;
 }
 
-void CameraMotion::MaskFiltered(const cv::Matx33d& predicted, double scale, cv::Mat* mask) const {
+void CameraMotion::MaskFiltered(const cv::Matx33d& predicted, double scale, cv::Mat* mask) {
   if (!keep_) return;
-  // The filter at the centres of kCellPx cells: corners are then chosen among the kept ones
-  // (goodFeaturesToTrack's quality is relative to the strongest corner in the mask).
+  // The filter at the centres of kCellPx cells (of the image registered): corners are then chosen
+  // among the kept ones (goodFeaturesToTrack's quality is relative to the strongest corner in the
+  // mask). The centres are undistorted once for the frames' size.
   constexpr int kCellPx = 8;
-  std::vector<cv::Point2f> centres;
-  for (int y = 0; y < mask->rows; y += kCellPx) {
-    for (int x = 0; x < mask->cols; x += kCellPx) {
-      centres.emplace_back(std::min(x + 0.5f * kCellPx, mask->cols - 1.0f),
-                           std::min(y + 0.5f * kCellPx, mask->rows - 1.0f));
+  if (cells_of_ != mask->size()) {
+    std::vector<cv::Point2f> centres;
+    for (int y = 0; y < mask->rows; y += kCellPx) {
+      for (int x = 0; x < mask->cols; x += kCellPx) {
+        centres.emplace_back(std::min(x + 0.5f * kCellPx, mask->cols - 1.0f),
+                             std::min(y + 0.5f * kCellPx, mask->rows - 1.0f));
+      }
     }
+    cells_ = ToUndistorted(centres, scale);
+    cells_of_ = mask->size();
   }
-  const std::vector<cv::Point2f> undistorted = ToUndistorted(centres, scale);
   size_t i = 0;
   for (int y = 0; y < mask->rows; y += kCellPx) {
     for (int x = 0; x < mask->cols; x += kCellPx, ++i) {
-      const cv::Point2f& p = undistorted[i];
+      const cv::Point2f& p = cells_[i];
       if (keep_(predicted * cv::Vec3d(p.x, p.y, 1.0))) continue;
       (*mask)(cv::Rect(x, y, kCellPx, kCellPx) & cv::Rect(0, 0, mask->cols, mask->rows)).setTo(0);
     }
   }
 }
 
+bool CameraMotion::NewKeyframe(const View* base, const cv::Matx33d& h,
+                               const cv::Matx33d& base_from_this) {
+  if (base == nullptr) {
+    ++stats_.found_by_anchor;
+    return true;
+  }
+  if (base == &first_) {
+    ++stats_.direct;
+    return Overlap(key_.first_from_view.inv() * h) < options_.keyframe_overlap;
+  }
+  if (base == &key_) {
+    ++stats_.keyed;
+    return Overlap(base_from_this) < options_.keyframe_overlap;
+  }
+  ++stats_.chained;  // the keyframe is out of reach: this frame is the next one
+  return true;
+}
+
 void CameraMotion::Known(const cv::Matx33d& view, bool by_anchor, bool step_known) {
   // Two views the anchor held in a row measure the step (its corrections are not drift there).
-  if (!step_known && by_anchor && previous_held_ && since_known_ == 0) {
+  if (!step_known && by_anchor && previous_held_) {
     velocity_ = NormalizedHomography(last_view_.inv() * view);
   }
   last_view_ = view;
@@ -397,20 +420,7 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
     return last_view_;
   }
   cv::Matx33d h = held ? *held : base->first_from_view * a_from_this;
-  bool new_key;
-  if (held) {
-    ++stats_.found_by_anchor;
-    new_key = true;
-  } else if (base == &first_) {
-    ++stats_.direct;
-    new_key = Overlap(key_.first_from_view.inv() * h) < options_.keyframe_overlap;
-  } else if (base == &key_) {
-    ++stats_.keyed;
-    new_key = Overlap(a_from_this) < options_.keyframe_overlap;
-  } else {
-    ++stats_.chained;  // the keyframe is out of reach: this frame is the next one
-    new_key = true;
-  }
+  const bool new_key = NewKeyframe(held ? nullptr : base, h, a_from_this);
   h = NormalizedHomography(h);
   // The step from the last registered frame (over frames lost, the step before is kept; a frame
   // found by the anchor alone measures it only from a frame the anchor held too: from a
@@ -432,6 +442,9 @@ cv::Matx33d CameraMotion::Register(const cv::Mat& bgr, const std::vector<cv::Rec
   const cv::Point2d moved = MapPoint(h, centre);
   stats_.max_shift_px =
       std::max(stats_.max_shift_px, std::hypot(moved.x - centre.x, moved.y - centre.y));
+  // Corners were chosen where the filter keeps them at the predicted view: at a view found or
+  // corrected far from it, chosen again there (this frame may be the base of the next).
+  if (keep_ && !(Departure(h, predicted) <= 0.01 * size_.width)) f = Detect(bgr, people, h);
   previous_ = {std::move(f), h};
   if (new_key) {
     key_ = previous_;

@@ -10,8 +10,8 @@
 // are between undistorted pixels, where a homography maps a turning camera's whole image exactly
 // and a moving camera's ground plane (matched there alone: a feature filter). An anchor may
 // correct keyframes and find lost frames (line_anchor.h: the field lines), and the camera's step
-// is then also taken from two frames in a row it held. The players pipeline then works on the first view widened
-// (view_canvas.h).
+// is then also taken from two frames in a row it held. The players pipeline then works on the first
+// view widened (view_canvas.h).
 #pragma once
 
 #include <functional>
@@ -51,15 +51,16 @@ struct CameraMotionOptions {
 };
 
 struct CameraMotionStats {
-  int frames = 0;           // frames registered, the first included
-  int direct = 0;           // matched to the first frame (the first itself not counted)
-  int keyed = 0;            // through the last keyframe
-  int keyframes = 0;        // frames that became keyframes (the first not counted)
-  int chained = 0;          // through the last registered frame
-  int lost = 0;             // neither: the view predicted from the last two registered frames taken
-  int departed = 0;         // registered off the prediction by over max_departure by every base
-  int anchored = 0;         // registered frames whose view the anchor corrected (SetAnchor)
-  int found_by_anchor = 0;  // frames matched to none, whose predicted view the anchor corrected
+  int frames = 0;             // frames registered, the first included
+  int direct = 0;             // matched to the first frame (the first itself not counted)
+  int keyed = 0;              // through the last keyframe
+  int keyframes = 0;          // frames that became keyframes (the first not counted)
+  int chained = 0;            // through the last registered frame
+  int lost = 0;               // neither: the view predicted from the last known one taken
+  int departed = 0;           // registered off the prediction by over max_departure by every base
+  bool ground_only = false;   // features matched on the ground alone (SetFeatureFilter)
+  int anchored = 0;           // registered frames whose view the anchor corrected (SetAnchor)
+  int found_by_anchor = 0;    // frames matched to none, whose predicted view the anchor corrected
   double max_shift_px = 0.0;  // largest move of the image centre from the first frame's view
   std::string Summary() const;
 };
@@ -88,7 +89,10 @@ class CameraMotion {
   // camera that moves maps from frame to frame by one homography only over one plane, the ground
   // (OnTheGround in players.cc), not over the stands and boards beside it.
   using FeatureFilter = std::function<bool(const cv::Vec3d& first_px)>;
-  void SetFeatureFilter(FeatureFilter keep) { keep_ = std::move(keep); }
+  void SetFeatureFilter(FeatureFilter keep) {
+    keep_ = std::move(keep);
+    stats_.ground_only = static_cast<bool>(keep_);
+  }
 
  private:
   struct Features {
@@ -107,13 +111,16 @@ class CameraMotion {
   // The frame's features off the people's boxes and where the filter keeps them at the frame's
   // `predicted` view.
   Features Detect(const cv::Mat& bgr, const std::vector<cv::Rect2d>& people,
-                  const cv::Matx33d& predicted) const;
+                  const cv::Matx33d& predicted);
+  // Whether a frame registered through `base` (nullptr: found by the anchor) at view `h` is the
+  // next keyframe (counted in the stats by how it was matched).
+  bool NewKeyframe(const View* base, const cv::Matx33d& h, const cv::Matx33d& base_from_this);
   // A frame's view is known (registered, corrected or found by the anchor): the next frames are
   // predicted from it; a step not measured by the registration (`step_known` false) is taken
   // from two views in a row the anchor held.
   void Known(const cv::Matx33d& view, bool by_anchor, bool step_known = false);
   // Clears the cells of a work-scale mask whose centre keep_ refuses at `predicted`.
-  void MaskFiltered(const cv::Matx33d& predicted, double scale, cv::Mat* mask) const;
+  void MaskFiltered(const cv::Matx33d& predicted, double scale, cv::Mat* mask);
   // The homography from b's pixels to a's, or false when untrusted.
   bool Match(const Features& a, const Features& b, cv::Matx33d* a_from_b) const;
   // The homography from b's pixels to view a's from a's corners followed into b by pyramidal
@@ -141,15 +148,19 @@ class CameraMotion {
   cv::BFMatcher matcher_{cv::NORM_HAMMING};
   std::optional<camera::Camera> lens_;
   View first_, key_, previous_;
-  cv::Matx33d velocity_ = cv::Matx33d::eye();  // the last step: previous's view from the one before
-  int since_registered_ = 0;                   // frames since the last registered one
-  cv::Matx33d last_view_ = cv::Matx33d::eye();  // the last frame's whose view is known
+  // The last step: a registered frame's view from the frame before, or between two frames the
+  // anchor held in a row.
+  cv::Matx33d velocity_ = cv::Matx33d::eye();
+  int since_registered_ = 0;                    // frames since the last registered one
+  cv::Matx33d last_view_ = cv::Matx33d::eye();  // the view of the last frame whose view is known
   int since_known_ = 0;                         // frames lost since then
   bool previous_held_ = false;                  // that view is the anchor's
   cv::Size size_;
   CameraMotionStats stats_;
   Anchor anchor_;
   FeatureFilter keep_;
+  std::vector<cv::Point2f> cells_;  // MaskFiltered's cell centres, undistorted (per frame size)
+  cv::Size cells_of_;
 };
 
 // A homography scaled to unit norm with a positive determinant (a camera's turn or drift keeps

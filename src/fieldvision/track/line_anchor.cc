@@ -228,6 +228,12 @@ std::optional<cv::Matx33d> LineAnchor::Correct(const cv::Mat& bgr,
   if (!keyframe && !options_.every_frame) return std::nullopt;
   if (keyframe) ++stats_.tried;
   const camera::Camera start = FramePose(first_from_frame);
+  // A degenerate homography (a plane pose from a near-singular one) gives no pose to start from.
+  const geometry::Rigid3d& pose = start.cam_from_world;
+  if (!pose.rotation.allFinite() || !pose.translation.allFinite() ||
+      pose.translation.norm() > 1e6) {
+    return std::nullopt;
+  }
   std::vector<Eigen::Vector2d> pixels = LinePixels(bgr, start);
   pixels.erase(std::remove_if(pixels.begin(), pixels.end(),
                               [&people](const Eigen::Vector2d& p) { return InAnyBox(p, people); }),

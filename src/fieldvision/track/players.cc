@@ -692,14 +692,12 @@ void FinishTracks(const PlayersOptions& options, const camera::Camera* camera, b
   }
 }
 
-// A moving camera's rows back in each frame's own pixels; a row carried or filled in beyond what
-// its frame can show (behind its view) has no box there: left out, with a track left without
-// rows and its team.
 }  // namespace
 
 // The first view's undistorted pixels to the ground by its pose: w > 0 where the frame's ray meets
-// the ground ahead of it (PixelsFromGround's scale); kInsetM off the surround's edge, where boards
-// and goals stand.
+// the ground ahead of it (PixelsFromGround's scale); kInsetM inside the surround's edge, where the
+// far side's boards stand. Goals (on the goal lines) and boards between the camera and the field
+// are not left out: rays through them meet the ground inside the area.
 CameraMotion::FeatureFilter OnTheGround(const camera::Camera& first,
                                         const field::FieldModel& field) {
   constexpr double kInsetM = 0.3;
@@ -742,6 +740,9 @@ void SetUpMovingCamera(const camera::Camera* camera, const field::FieldModel* fi
       camera != nullptr ? ViewCanvas(*camera, margin) : ViewCanvas::Uncalibrated(size, margin);
 }
 
+// A moving camera's rows back in each frame's own pixels; a row carried or filled in beyond what
+// its frame can show (behind its view) has no box there: left out, with a track left without
+// rows and its team.
 void BoxesBackToFrames(const ViewCanvas& canvas, PlayersResult& result) {
   for (TrackRow& r : result.rows) r.box = canvas.BoxToFrame(r.frame - 1, r.box);
   const auto outside = std::remove_if(result.rows.begin(), result.rows.end(),
