@@ -65,11 +65,17 @@ void RunPlayersCommand(const PlayersCli& c) {
     std::cerr << "fieldvision: warning: time_s left empty: " << r.time.source << "\n";
   }
   if (r.view_drift && r.view_drift->moved) {
-    std::cerr << fmt::format(
-        "fieldvision: warning: the view moved by up to {:.0f} px from the first frame's (frame "
-        "{}): the positions assume a still camera; for a camera that sways, pans or was knocked, "
-        "run with --moving-camera\n",
-        r.view_drift->max_shift_px, r.view_drift->max_frame + 1);
+    const track::ViewDriftStats& v = *r.view_drift;
+    std::cerr << "fieldvision: warning: "
+              << (2 * v.unmatched > v.checked
+                      ? fmt::format("{} of {} frames checked could not be matched to the first "
+                                    "(the view left it?)",
+                                    v.unmatched, v.checked)
+                      : fmt::format("the view moved by up to {:.0f} px from the first frame's "
+                                    "(frame {})",
+                                    v.max_shift_px, v.max_frame + 1))
+              << ": the positions assume a still camera; for a camera that sways, pans or was "
+                 "knocked, run with --moving-camera\n";
   }
   // Frames not registered take the view the camera's motion predicts: as good as that guess.
   if (r.camera_motion && r.camera_motion->lost > 0.1 * r.frames) {

@@ -35,6 +35,9 @@ void ViewDrift::Add(int index, const cv::Mat& bgr, const std::vector<cv::Rect2d>
   ++stats_.checked;
   if (motion_.stats().lost > lost_before) {
     ++stats_.unmatched;
+    // Most checks matched to nothing: the view left the first one (or has too little texture
+    // to tell).
+    stats_.moved = stats_.moved || (stats_.checked >= 4 && 2 * stats_.unmatched > stats_.checked);
     return;
   }
   const cv::Point2d centre(0.5 * (bgr.cols - 1), 0.5 * (bgr.rows - 1));
@@ -44,7 +47,7 @@ void ViewDrift::Add(int index, const cv::Mat& bgr, const std::vector<cv::Rect2d>
     stats_.max_shift_px = shift_px;
     stats_.max_frame = index;
   }
-  stats_.moved = stats_.max_shift_px > options_.moved_share * width_;
+  stats_.moved = stats_.moved || stats_.max_shift_px > options_.moved_share * width_;
 }
 
 }  // namespace fv::track

@@ -27,7 +27,9 @@ struct ViewDriftStats {
   int unmatched = 0;          // of those, matched to none (no measurement)
   double max_shift_px = 0.0;  // the farthest the image centre moved, pixels of the frame
   int max_frame = 0;          // the frame (0-based) where it did
-  bool moved = false;         // max_shift_px over moved_share of the width
+  // max_shift_px over moved_share of the width, or over half the checks (from the fourth)
+  // matched to none.
+  bool moved = false;
   std::string Summary() const;
 };
 
