@@ -67,7 +67,7 @@ void RunPlayersCommand(const PlayersCli& c) {
   if (r.view_drift && r.view_drift->moved) {
     const track::ViewDriftStats& v = *r.view_drift;
     std::cerr << "fieldvision: warning: "
-              << (2 * v.unmatched > v.checked
+              << (v.mostly_unmatched
                       ? fmt::format("{} of {} frames checked could not be matched to the first "
                                     "(the view left it?)",
                                     v.unmatched, v.checked)

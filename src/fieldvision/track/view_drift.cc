@@ -1,7 +1,5 @@
 #include "fieldvision/track/view_drift.h"
 
-#include <cmath>
-
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
@@ -26,28 +24,25 @@ ViewDrift::ViewDrift(const ViewDriftOptions& options) : options_(options) { opti
 
 void ViewDrift::Add(int index, const cv::Mat& bgr, const std::vector<cv::Rect2d>& people) {
   if (index > 0 && index % options_.every_frames != 0) return;
-  const int lost_before = motion_.stats().lost;
-  const cv::Matx33d first_from_frame = motion_.Register(bgr, people);
+  const CameraMotionStats before = motion_.stats();
+  motion_.Register(bgr, people);
   if (index == 0) {
     width_ = bgr.cols;
     return;
   }
   ++stats_.checked;
-  if (motion_.stats().lost > lost_before) {
+  const CameraMotionStats& after = motion_.stats();
+  if (after.lost > before.lost) {
     ++stats_.unmatched;
     // Most checks matched to nothing: the view left the first one (or has too little texture
     // to tell).
-    stats_.moved = stats_.moved || (stats_.checked >= 4 && 2 * stats_.unmatched > stats_.checked);
-    return;
-  }
-  const cv::Point2d centre(0.5 * (bgr.cols - 1), 0.5 * (bgr.rows - 1));
-  const cv::Point2d moved = MapPoint(first_from_frame, centre);
-  const double shift_px = std::hypot(moved.x - centre.x, moved.y - centre.y);
-  if (shift_px > stats_.max_shift_px) {
-    stats_.max_shift_px = shift_px;
+    stats_.mostly_unmatched =
+        stats_.mostly_unmatched || (stats_.checked >= 4 && 2 * stats_.unmatched > stats_.checked);
+  } else if (after.max_shift_px > stats_.max_shift_px) {  // the registration's centre shift
+    stats_.max_shift_px = after.max_shift_px;
     stats_.max_frame = index;
   }
-  stats_.moved = stats_.moved || stats_.max_shift_px > options_.moved_share * width_;
+  stats_.moved = stats_.mostly_unmatched || stats_.max_shift_px > options_.moved_share * width_;
 }
 
 }  // namespace fv::track

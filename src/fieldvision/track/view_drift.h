@@ -23,13 +23,12 @@ struct ViewDriftOptions {
 };
 
 struct ViewDriftStats {
-  int checked = 0;            // frames registered to the first
-  int unmatched = 0;          // of those, matched to none (no measurement)
-  double max_shift_px = 0.0;  // the farthest the image centre moved, pixels of the frame
-  int max_frame = 0;          // the frame (0-based) where it did
-  // max_shift_px over moved_share of the width, or over half the checks (from the fourth)
-  // matched to none.
-  bool moved = false;
+  int checked = 0;                // frames registered to the first
+  int unmatched = 0;              // of those, matched to none (no measurement)
+  double max_shift_px = 0.0;      // the farthest the image centre moved, pixels of the frame
+  int max_frame = 0;              // the frame (0-based) where it did
+  bool mostly_unmatched = false;  // over half the checks (from the fourth) matched to none
+  bool moved = false;             // that, or max_shift_px over moved_share of the width
   std::string Summary() const;
 };
 
