@@ -587,11 +587,11 @@ TEST(Players, OnTheGroundKeepsTheFieldAndItsSurroundOnly) {
     }
     return keep(sign * (first_from_moved * cv::Vec3d(px->x(), px->y(), 1.0)));
   };
-  const double edge_x = 0.5 * field.length_m + field.surround_m;
+  const double edge_x = field.HalfLengthWithSurround();
   EXPECT_TRUE(kept({4, 2, 0}));
   EXPECT_TRUE(kept({-edge_x + 0.4, 0, 0}));
   EXPECT_FALSE(kept({-edge_x + 0.2, 0, 0}));
-  EXPECT_FALSE(kept({4, 0.5 * field.width_m + field.surround_m, 0}));
+  EXPECT_FALSE(kept({4, field.HalfWidthWithSurround(), 0}));
   EXPECT_FALSE(kept({4, 2, 0}, -1.0));
 }
 
