@@ -84,6 +84,15 @@ void RunPlayersCommand(const PlayersCli& c) {
                  "little texture off the people?): their positions assume the camera kept moving "
                  "as before\n";
   }
+  // People the view turned or moved to beyond the canvas have no canvas pixels to be tracked on.
+  if (r.beyond_canvas > 0) {
+    std::cerr << "fieldvision: warning: " << r.beyond_canvas << " detections in "
+              << r.beyond_canvas_frames << " frames (the first in frame " << r.first_beyond_canvas
+              << ") lay beyond the canvas (the first frame's view widened by --canvas-margin "
+              << c.o.camera_motion.canvas_margin
+              << " image widths each side) and were left out: raise --canvas-margin, or cut the "
+                 "video where the view has turned 90 degrees or more from its first frame\n";
+  }
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.
     track::TrackOverlay overlay(r.rows, r.team_of, {}, camera ? &*camera : nullptr,

@@ -416,7 +416,7 @@ std::string PlayersResult::Summary() const {
       "{} frames, time from {}; {} detections ({}), {} tracks ({} tracklets joined{}), {} rows "
       "({} interpolated, {} off the ground, {} partly hidden with their feet moved); "
       "{:.1f} s = {:.1f} frames/s (read {:.1f} ms/frame in its own thread, detect {:.1f}{}, "
-      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}{}{}",
+      "track {:.1f}, map {:.1f}); tracker: {}{}{}{}{}{}{}{}",
       frames, time.source, detections, detector, tracks, stitched,
       dropped_tracks > 0 ? fmt::format(", {} dropped: seen in fewer than {} frames, "
                                        "--min-track-frames",
@@ -434,6 +434,9 @@ std::string PlayersResult::Summary() const {
       outside_frames > 0
           ? fmt::format(" ({} rows left out: beyond what their frame shows)", outside_frames)
           : "",
+      beyond_canvas > 0 ? fmt::format("; {} detections in {} frames left out: beyond the canvas",
+                                      beyond_canvas, beyond_canvas_frames)
+                        : "",
       frames_note.empty() ? "" : "; " + frames_note);
 }
 
@@ -577,6 +580,10 @@ struct PlayersPass {
   // back: their edge checks, TRACKS.csv, the overlay) and the image of it given to the tracker.
   std::optional<ViewCanvas> canvas;
   cv::Mat canvas_image;
+  // Detections left out as their foot fell beyond the canvas, frames with such, the first one.
+  int beyond_canvas = 0;
+  int beyond_canvas_frames = 0;
+  int first_beyond_canvas = 0;
 };
 
 // The detections' boxes.
@@ -596,14 +603,22 @@ const cv::Mat& ToCanvas(CameraMotion& motion, const FootFilter& filter, const cv
   canvas.AddFrame(motion.Register(frame, Boxes(dets)));
   const int index = canvas.frames() - 1;
   std::vector<Detection> kept;
+  int beyond = 0;
   for (Detection d : dets) {
     d.box = canvas.BoxToCanvas(index, d.box);
-    if (!FootInView(d.box, canvas.size())) continue;
+    if (!FootInView(d.box, canvas.size())) {
+      ++beyond;
+      continue;
+    }
     if (!filter || filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height})) {
       kept.push_back(d);
     }
   }
   dets = std::move(kept);
+  if (beyond > 0) {
+    pass.beyond_canvas += beyond;
+    if (pass.beyond_canvas_frames++ == 0) pass.first_beyond_canvas = index + 1;
+  }
   canvas.Draw(index, frame, pass.canvas_image);
   return pass.canvas_image;
 }
@@ -852,6 +867,9 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
                result);
   if (motion) {
     BoxesBackToFrames(*pass.canvas, result);
+    result.beyond_canvas = pass.beyond_canvas;
+    result.beyond_canvas_frames = pass.beyond_canvas_frames;
+    result.first_beyond_canvas = pass.first_beyond_canvas;
     result.camera_motion = motion->stats();
     if (anchor) result.line_anchor = anchor->stats();
     result.canvas = std::move(pass.canvas);

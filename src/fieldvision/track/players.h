@@ -147,6 +147,11 @@ struct PlayersResult {
   std::string frames_note;   // what the frame source did to the frames (FramesNote), or ""
   int off_ground = 0;        // rows whose foot point does not meet the ground
   int outside_frames = 0;    // a moving camera's rows whose box their frame cannot show (left out)
+  // A moving camera's detections whose foot point fell beyond its canvas (left out), in how many
+  // frames, and the first such frame (1-based; 0: none).
+  int beyond_canvas = 0;
+  int beyond_canvas_frames = 0;
+  int first_beyond_canvas = 0;
   GroundSmoothResult smoothing;
   std::optional<CameraMotionStats> camera_motion;  // with PlayersOptions::moving_camera
   std::optional<LineAnchorStats> line_anchor;      // with PlayersOptions::hold_to_lines in use

@@ -763,11 +763,18 @@ TEST(Players, PanningCameraTracksPeopleBeyondTheFirstView) {
   EXPECT_LT(worst_px, 3.0) << r.Summary();
   EXPECT_LT(free_px, 30.0) << free_run.Summary();
   o.camera_motion.canvas_margin = 0;
-  const PanScore first_view_only =
-      ScorePan(pan.first, pan.panned, RunPlayers(video, &pan.first, &field, o));
+  const PlayersResult first_only = RunPlayers(video, &pan.first, &field, o);
+  const PanScore first_view_only = ScorePan(pan.first, pan.panned, first_only);
   std::cout << "panning camera, first view only: " << first_view_only.beyond_matched
-            << " person-frames beyond it matched\n";
+            << " person-frames beyond it matched; " << first_only.beyond_canvas
+            << " detections beyond the canvas (with the margin: " << r.beyond_canvas << ")\n";
   EXPECT_LT(first_view_only.beyond_matched, 0.6 * score.beyond_matched);
+  // The people left out for lack of canvas are counted (players warns of them).
+  EXPECT_GT(first_only.beyond_canvas,
+            0.5 * (score.beyond_matched - first_view_only.beyond_matched));
+  EXPECT_GT(first_only.first_beyond_canvas, 1);
+  EXPECT_LT(r.beyond_canvas, 0.1 * first_only.beyond_canvas) << r.Summary();
+  EXPECT_NE(first_only.Summary().find("left out: beyond the canvas"), std::string::npos);
 }
 
 // A drone following play: the players scene's camera raised to 9 m and carried 4 m each way
