@@ -27,6 +27,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/detection.h"
 #include "fieldvision/track/mot.h"
@@ -78,7 +79,7 @@ cv::Matx33d Sway(const fv::camera::Camera& cam, int t) {
                           a * 3 * deg * std::sin(2 * M_PI * t / 200.0),
                           a * 1 * deg * std::sin(2 * M_PI * t / 90.0 + 1.3)),
                 r);
-  return fv::track::IntrinsicMatrix(cam) * r * fv::track::IntrinsicMatrix(cam).inv();
+  return fv::camera::IntrinsicMatrix(cam) * r * fv::camera::IntrinsicMatrix(cam).inv();
 }
 
 constexpr double kPanZoom = 1.6;
@@ -152,13 +153,13 @@ void PreparePan() {
     const auto n = w.camera.Undistort({p.x, p.y});
     if (!n) return std::nullopt;
     const cv::Vec3d v =
-        fv::track::IntrinsicMatrix(w.pan_camera) * (w.pan[t] * cv::Vec3d(n->x(), n->y(), 1.0));
+        fv::camera::IntrinsicMatrix(w.pan_camera) * (w.pan[t] * cv::Vec3d(n->x(), n->y(), 1.0));
     if (!(v[2] > 0)) return std::nullopt;
     return cv::Point2d(v[0] / v[2], v[1] / v[2]);
   };
   m.to_original = [&w](int t, const cv::Point2d& p) -> std::optional<cv::Point2d> {
     const cv::Vec3d v =
-        w.pan[t].t() * (fv::track::IntrinsicMatrix(w.pan_camera).inv() * cv::Vec3d(p.x, p.y, 1));
+        w.pan[t].t() * (fv::camera::IntrinsicMatrix(w.pan_camera).inv() * cv::Vec3d(p.x, p.y, 1));
     const auto uv = w.camera.ProjectFromCamera({v[0], v[1], v[2]});
     if (!uv) return std::nullopt;
     return cv::Point2d(uv->x(), uv->y());
@@ -167,9 +168,9 @@ void PreparePan() {
       "panned",
       [&w](int t, const cv::Mat& f, cv::Mat& v) {
         cv::Mat map1, map2;
-        cv::initUndistortRectifyMap(fv::track::IntrinsicMatrix(w.camera), w.camera.distortion,
-                                    w.pan.at(t), fv::track::IntrinsicMatrix(w.pan_camera), f.size(),
-                                    CV_16SC2, map1, map2);
+        cv::initUndistortRectifyMap(fv::camera::IntrinsicMatrix(w.camera), w.camera.distortion,
+                                    w.pan.at(t), fv::camera::IntrinsicMatrix(w.pan_camera),
+                                    f.size(), CV_16SC2, map1, map2);
         cv::remap(f, v, map1, map2, cv::INTER_LINEAR);
       },
       m);

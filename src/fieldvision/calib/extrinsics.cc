@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "fieldvision/calib/costs.h"
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 
@@ -187,10 +188,8 @@ ExtrinsicsResult EstimatePose(const camera::Camera& intrinsics,
              "edge-on",
              n, spread_px);
 
-  const cv::Mat k = (cv::Mat_<double>(3, 3) << intrinsics.fx, 0, intrinsics.cx, 0, intrinsics.fy,
-                     intrinsics.cy, 0, 0, 1);
-  cv::Mat d = intrinsics.distortion.empty() ? cv::Mat::zeros(1, 5, CV_64F)
-                                            : cv::Mat(intrinsics.distortion, true).reshape(1, 1);
+  const cv::Mat k(camera::IntrinsicMatrix(intrinsics));
+  cv::Mat d = camera::DistortionRow(intrinsics);
   std::vector<cv::Point3d> obj;
   std::vector<cv::Point2d> img;
   for (const auto& p : points) {

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fieldvision/calib/intrinsics.h"
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/camera/projection.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
@@ -101,9 +102,8 @@ double RmsBetween(const std::vector<cv::Point2f>& a, const std::vector<cv::Point
 ViewPose BoardPose(const camera::Camera& cam, const BoardView& view) {
   ViewPose out;
   if (view.image_points.size() < 4) return out;
-  const cv::Mat k = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
-  const cv::Mat d = cam.distortion.empty() ? cv::Mat::zeros(1, 5, CV_64F)
-                                           : cv::Mat(cam.distortion, true).reshape(1, 1);
+  const cv::Mat k(camera::IntrinsicMatrix(cam));
+  const cv::Mat d = camera::DistortionRow(cam);
   cv::Mat rvec, tvec;
   try {
     if (!cv::solvePnP(view.object_points, view.image_points, k, d, rvec, tvec, false,
@@ -952,12 +952,9 @@ void CompareWithOpenCv(const std::vector<MultiFrame>& frames,
   if (obj.size() < 3) return;
   const bool zero_tangent = !s.tangential[i] && !s.tangential[j];
   const bool zero_k3 = !s.k3[i] && !s.k3[j];
-  auto k_of = [](const camera::Camera& c) {
-    return cv::Mat(cv::Matx33d(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1));
-  };
+  auto k_of = [](const camera::Camera& c) { return cv::Mat(camera::IntrinsicMatrix(c)); };
   auto d_of = [&](const camera::Camera& c) {
-    cv::Mat d = c.distortion.empty() ? cv::Mat(cv::Mat::zeros(1, 5, CV_64F))
-                                     : cv::Mat(c.distortion, true).reshape(1, 1);
+    cv::Mat d = camera::DistortionRow(c);
     if (zero_tangent) d.at<double>(2) = d.at<double>(3) = 0.0;
     if (zero_k3 && d.cols >= 5) d.at<double>(4) = 0.0;
     return d;

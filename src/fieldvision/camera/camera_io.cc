@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
@@ -194,12 +195,8 @@ void WriteCameraYaml(const Camera& camera, const std::string& path) {
         // cv::write, not <<: << takes strings that start with [ ] { } for structure marks.
         if (!camera.name.empty()) cv::write(fs, "name", camera.name);
         fs << "image_width" << camera.width << "image_height" << camera.height;
-        const cv::Mat k =
-            (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
-        fs << "camera_matrix" << k;
-        std::vector<double> d = camera.distortion;
-        if (d.empty()) d.assign(5, 0.0);
-        fs << "distortion_coefficients" << cv::Mat(d, true).reshape(1, 1);
+        fs << "camera_matrix" << cv::Mat(IntrinsicMatrix(camera));
+        fs << "distortion_coefficients" << DistortionRow(camera);
         if (camera.has_pose) {
           const Eigen::Vector3d r = camera.cam_from_world.Rvec();
           const Eigen::Vector3d& t = camera.cam_from_world.translation;

@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -60,12 +61,13 @@ TEST_P(CameraModel, AgreesWithOpenCvProjectPoints) {
       const Eigen::Vector3d p(rng.Uniform(-9, 9), rng.Uniform(-6, 6), rng.Uniform(0, 3));
       if ((cam.cam_from_world * p).z() > 0.5) pts.emplace_back(p.x(), p.y(), p.z());
     }
-    const cv::Mat k = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+    // K and the distortion row as opencv_camera.h gives them to OpenCV.
+    const cv::Mat k(IntrinsicMatrix(cam));
     const Eigen::Vector3d r = cam.cam_from_world.Rvec();
     const Eigen::Vector3d& t = cam.cam_from_world.translation;
     std::vector<cv::Point2d> uv_cv;
     cv::projectPoints(pts, cv::Vec3d(r.x(), r.y(), r.z()), cv::Vec3d(t.x(), t.y(), t.z()), k,
-                      cam.distortion, uv_cv);
+                      DistortionRow(cam), uv_cv);
     for (size_t i = 0; i < pts.size(); ++i) {
       // Far outside the image the high-order terms blow up; compare where pixels exist.
       if (!cam.InImage({uv_cv[i].x, uv_cv[i].y}, -0.5 * cam.width)) continue;

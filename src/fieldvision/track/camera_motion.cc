@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::track {
@@ -84,10 +85,6 @@ cv::Matx33d NormalizedHomography(const cv::Matx33d& h) {
 cv::Point2d MapPoint(const cv::Matx33d& h, const cv::Point2d& p) {
   const cv::Vec3d q = h * cv::Vec3d(p.x, p.y, 1.0);
   return {q[0] / q[2], q[1] / q[2]};
-}
-
-cv::Matx33d IntrinsicMatrix(const camera::Camera& c) {
-  return {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
 }
 
 cv::Matx33d PixelsFromGround(const camera::Camera& c) {

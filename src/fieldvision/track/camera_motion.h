@@ -170,8 +170,6 @@ cv::Matx33d NormalizedHomography(const cv::Matx33d& h);
 
 // A point moved by a homography (no check of w: the caller's points are in front).
 cv::Point2d MapPoint(const cv::Matx33d& h, const cv::Point2d& p);
-// The intrinsic matrix K of a camera: its undistorted pixels, between which the homographies are.
-cv::Matx33d IntrinsicMatrix(const camera::Camera& c);
 // K [r1 r2 t] of a posed camera: the ground plane (z = 0) to its undistorted pixels, scaled so
 // that a ground point's image has the point's depth as its w (positive in front).
 cv::Matx33d PixelsFromGround(const camera::Camera& c);

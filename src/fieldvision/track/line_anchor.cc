@@ -10,6 +10,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/track/camera_motion.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/stats.h"

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core/eigen.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/synth/synth.h"
 #include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/track_testing.h"

@@ -18,6 +18,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/geometry/rigid.h"
 #include "fieldvision/track/camera_motion.h"
 #include "fieldvision/track/overlay.h"

@@ -7,6 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/camera/opencv_camera.h"
 #include "fieldvision/track/camera_motion.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/seeded_rng.h"
