@@ -134,7 +134,9 @@ void RunEvalTracks(const EvalTracksCli& c) {
     }
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
+  // Field positions and the coach's numbers over the frames the metrics scored (--est-frames).
   std::vector<track::TrackRow> placed = gt;
+  m.preprocessing.ClipAsScored(placed);
   // A moving camera's tracks (players --moving-camera): the ground truth's feet through the
   // camera's motion saved beside them.
   const auto canvas =

@@ -344,7 +344,7 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
     p.gt_frames = static_cast<int>(frames.size());
     p.gt_frames_outside_est = static_cast<int>(frames_outside.size());
     p.gt_clipped = o.clip_to_est_frames;
-    if (o.clip_to_est_frames) std::erase_if(gt, outside);
+    p.ClipAsScored(gt);
   }
 }
 
@@ -576,6 +576,11 @@ void ScoreHota(const MotIndex& index, const MotIdCounts& c, MotMetrics& m) {
   m.hota = hota / kAlphas;
   m.deta = deta / kAlphas;
   m.assa = assa / kAlphas;
+}
+
+void MotPreprocessing::ClipAsScored(std::vector<TrackRow>& gt) const {
+  if (!gt_clipped) return;
+  std::erase_if(gt, [&](const TrackRow& r) { return r.frame < est_first || r.frame > est_last; });
 }
 
 MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,

@@ -88,6 +88,10 @@ struct MotPreprocessing {
   int best_offset = 0;
   double iou_at_zero = 0, iou_at_best = 0;
   std::string Summary() const;
+  // Drops from `gt` the rows left out as outside the estimate's frames (with gt_clipped), so
+  // that what else is scored on the ground truth (field positions, the coach's numbers) covers
+  // the frames the metrics do.
+  void ClipAsScored(std::vector<TrackRow>& gt) const;
 };
 
 struct MotMetrics {

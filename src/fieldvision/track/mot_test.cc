@@ -64,6 +64,15 @@ TEST(Mot, AnEstimateOfAClipIsNotedOrScoredOverItsFrames) {
   EXPECT_DOUBLE_EQ(scored.mota, 1.0);
   EXPECT_EQ(scored.frames, 15);
   EXPECT_THAT(scored.preprocessing.Summary(), ::testing::Not(HasSubstr("NOTE")));
+  // What else is scored on the ground truth (eval tracks: positions, the coach's numbers) takes
+  // the same frames; without the option all of them.
+  std::vector<TrackRow> as_scored = gt;
+  scored.preprocessing.ClipAsScored(as_scored);
+  EXPECT_EQ(as_scored.size(), 5u * 15);
+  for (const auto& r : as_scored) EXPECT_TRUE(r.frame >= 5 && r.frame < 20) << r.frame;
+  as_scored = gt;
+  whole.preprocessing.ClipAsScored(as_scored);
+  EXPECT_EQ(as_scored.size(), gt.size());
   EXPECT_EQ(EvaluateMot(gt, gt, o).preprocessing.gt_outside_est_frames, 0);
   // A tracker's warm-up (nothing in the first 3 of 50 frames) is no clip: no note.
   std::vector<TrackRow> late;
