@@ -1515,6 +1515,11 @@ void PlaceEndpoints(const TrajectoryOptions& options, double lo_s, double hi_s, 
     }
   }
   f->landing_m = mdl.PositionAt(f->t_landing_s);
+  // At a ground contact the ball's centre is a radius above the ground (CONTRACT.md): an arc
+  // started at a rolling ball's last sample, or ended at the first one after it, is there within
+  // the ground band, not on it (the kick render's origin 0.8 mm up).
+  if (f->start_event == FlightEvent::kGround) f->origin_m.z() = zr;
+  if (f->end_event == FlightEvent::kGround) f->landing_m.z() = zr;
   if (f->end_event != FlightEvent::kHit) f->t_end_s = f->t_landing_s;
   f->origin_extrapolated = f->start_event == FlightEvent::kTrackStart;
   f->landing_extrapolated =

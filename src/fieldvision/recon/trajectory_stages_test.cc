@@ -48,6 +48,16 @@ TEST(TrajectoryStages, EndpointsAreWhereTheArcMeetsTheGround) {
   PlaceEndpoints(o, -kInf, 0.995, &bounded);
   EXPECT_DOUBLE_EQ(bounded.t_landing_s, 0.995);
   EXPECT_EQ(bounded.end_event, FlightEvent::kGround);
+  // Still a ground contact there: the centre a radius up (CONTRACT.md), not the arc's 1.4 cm
+  // above; likewise an arc started from a rolling ball's last sample 1.4 cm up.
+  EXPECT_DOUBLE_EQ(bounded.landing_m.z(), zr);
+  Flight rolled = Arc(0.0, {0, 0, 1}, {5, 0, 4}, 0.0, 0.5);
+  rolled.start_event = rolled.end_event = FlightEvent::kGround;
+  const double t_rise = (4 - std::sqrt(16 + 2 * g * (1 - zr))) / g;  // the arc leaves the ground
+  PlaceEndpoints(o, t_rise + 0.002, kInf, &rolled);                  // 1.2 cm up there
+  EXPECT_EQ(rolled.start_event, FlightEvent::kGround);
+  EXPECT_DOUBLE_EQ(rolled.t_start_s, t_rise + 0.002);
+  EXPECT_DOUBLE_EQ(rolled.origin_m.z(), zr);
   // A bound while the arc is still 0.8 m up (a sample off it, then too few to fit): the flight
   // ended in the air there, and where it would have landed is extrapolated.
   Flight cut = Arc(0.0, {0, 0, 1}, {5, 0, 4}, 0.0, 0.5);
