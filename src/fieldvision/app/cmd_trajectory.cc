@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
+#include "fieldvision/recon/standard_balls.h"
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
@@ -49,8 +50,9 @@ void Setup(CLI::App& app, int& exit_code) {
                 "Spin (Magnus lift with drag): auto (used when it lowers the BIC by > 10), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   c->add_option("--ball-mass", j.ball_mass_kg,
-                "Ball mass in kg, for the spin in rev/s (default 0.43; 0.0027 for a "
-                "Timestamp,X,Y,Z file)")
+                "Ball mass in kg, for the spin in rev/s (default: the standard ball nearest "
+                "the diameter: 0.0027 table tennis, 0.0459 golf, 0.0577 tennis, 0.42 futsal, "
+                "0.43 football, 0.62 basketball)")
       ->check(FiniteRange(1e-5, 100.0));
   c->add_option("--noise", j.analysis.noise_m,
                 "Position noise (1 sigma, metres); default or 0: estimated from the track")
@@ -80,6 +82,10 @@ void Setup(CLI::App& app, int& exit_code) {
       FV_REQUIRE(opt->count() == 0 || !o->job.field.empty(),
                  "trajectory: {} needs --field (the calls are made on a field's lines)",
                  opt->get_name());
+    }
+    if (o->job.ball_mass_kg > 0 && o->job.ball_diameter_m > 0) {
+      const std::string odd = recon::BallMassWarning(o->job.ball_diameter_m, o->job.ball_mass_kg);
+      if (!odd.empty()) std::cerr << "fieldvision: warning: " << odd << "\n";
     }
     o->job.analysis.drag = recon::ParseDragMode(o->drag, "--drag");
     o->job.analysis.spin = recon::ParseDragMode(o->spin, "--spin");

@@ -19,6 +19,7 @@
 #include "fieldvision/pipeline/fusion_stage.h"
 #include "fieldvision/pipeline/rest_bundle.h"
 #include "fieldvision/recon/ball_csv.h"
+#include "fieldvision/recon/standard_balls.h"
 #include "fieldvision/recon/trajectory_io.h"
 #include "fieldvision/recon/trajectory_path.h"
 #include "fieldvision/recon/trajectory_physics.h"
@@ -422,12 +423,13 @@ Bundled BundleFlight(const std::vector<camera::Camera>& cameras,
   return out;
 }
 
-// The flight model's options for a ball of this size (mass 0: a table-tennis ball below 5 cm,
-// else a football).
+// The flight model's options for a ball of this size (mass 0: the standard ball's nearest in
+// diameter).
 recon::TrajectoryOptions FlightOptions(double ball_diameter_m, double ball_mass_kg) {
   recon::TrajectoryOptions to;
   to.ball_radius_m = 0.5 * ball_diameter_m;
-  to.ball_mass_kg = ball_mass_kg > 0 ? ball_mass_kg : (ball_diameter_m < 0.05 ? 0.0027 : 0.43);
+  to.ball_mass_kg =
+      ball_mass_kg > 0 ? ball_mass_kg : recon::NearestStandardBall(ball_diameter_m).mass_kg;
   return to;
 }
 
@@ -565,6 +567,7 @@ DetectionsJobResult RunDetectionsJob(const DetectionsJobOptions& o) {
              o.truth);
   const int n = static_cast<int>(o.cameras.size());
   std::vector<camera::Camera> cameras;
+  cameras.reserve(n);
   for (int c = 0; c < n; ++c) cameras.push_back(ReadRigCamera(o.cameras[c]));
   if (!o.triangulation.single_camera_ground) CheckRigSpread(cameras, o.cameras);
   DetectionsJobResult res;

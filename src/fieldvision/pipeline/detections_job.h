@@ -33,7 +33,7 @@ struct DetectionsJobOptions {
   std::string truth;           // optional truth.csv for the error table
   std::string flights;         // optional FLIGHTS.json: the trajectory fit of the result
   bool bundle = true;          // refine flights on the 2D detections (else per-frame points)
-  double ball_mass_kg = 0.0;   // for the spin model; 0: 2.7 g below 5 cm diameter, else 0.43 kg
+  double ball_mass_kg = 0.0;   // for the spin model; 0: recon::NearestStandardBall's
   recon::TriangulationOptions triangulation;  // ball_radius_m is set from the diameter
   // Whether the detections' scores are fieldvision's own (`ball --write-detections`),
   // so that triangulation.min_two_view_score applies; scores made elsewhere have no known scale

@@ -7,13 +7,14 @@
 
 #include <fmt/format.h>
 
-#include "fieldvision/util/output_path.h"
+#include "fieldvision/recon/standard_balls.h"
 #include "fieldvision/recon/trajectory_draw.h"
 #include "fieldvision/recon/trajectory_eval.h"
 #include "fieldvision/recon/trajectory_run_internal.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
+#include "fieldvision/util/output_path.h"
 #include "fieldvision/util/parallel.h"
 
 namespace fv::recon {
@@ -123,7 +124,17 @@ TrajectoryOptions TrajectoryOptionsFor(const TrajectoryJob& job, const std::stri
                        tt3d ? "table tennis, TT3D layout" : "football");
   }
   o.ball_radius_m = 0.5 * diameter;
-  o.ball_mass_kg = job.ball_mass_kg > 0 ? job.ball_mass_kg : (tt3d ? 0.0027 : 0.43);
+  o.ball_mass_kg = job.ball_mass_kg;
+  if (o.ball_mass_kg <= 0) {
+    // The mass turns the fitted lift into rev/s: a 4 cm ball fitted as a football's 0.43 kg
+    // gave a table-tennis track 2657 rev/s.
+    const StandardBall& ball = NearestStandardBall(diameter);
+    o.ball_mass_kg = ball.mass_kg;
+    log << fmt::format(
+        "ball mass {:.4g} kg (the standard ball nearest {:.3f} m across: {}, {:.3f} m; "
+        "--ball-mass to change)\n",
+        ball.mass_kg, diameter, ball.name, ball.diameter_m);
+  }
   o.unmodelled_accel_mps2 = job.accel_slack_mps2 > 0 ? job.accel_slack_mps2 : (tt3d ? 25.0 : 10.0);
   o.Check();
   return o;

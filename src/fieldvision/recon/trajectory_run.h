@@ -19,7 +19,7 @@ struct TrajectoryJob {
   std::string in_path;           // BALL.csv or Timestamp,X,Y,Z
   std::string out_path;          // FLIGHTS.json
   double ball_diameter_m = 0.0;  // 0: 0.22 m (football), 0.04 m for the TT3D layout
-  double ball_mass_kg = 0.0;     // 0: 0.43 kg (football), 0.0027 kg for the TT3D layout
+  double ball_mass_kg = 0.0;     // 0: the standard ball's nearest the diameter (standard_balls.h)
   TrajectoryOptions analysis;    // ball_radius_m is set from the diameter
   // Unmodelled acceleration allowed at breaks; 0: 10 m/s^2 (football), 25 for the TT3D layout
   // (a 2.7 g ball with strong drag and spin).

@@ -1,4 +1,5 @@
 #include "fieldvision/recon/trajectory_run.h"
+#include "fieldvision/recon/standard_balls.h"
 
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldvision/recon/standard_balls.h"
 #include "fieldvision/recon/trajectory_run_internal.h"
 #include "fieldvision/recon/trajectory_sim.h"
 #include "fieldvision/util/error.h"
@@ -144,6 +146,32 @@ TEST(TrajectoryRunStages, OptionsFollowTheLayoutUnlessGiven) {
   EXPECT_DOUBLE_EQ(given.ball_mass_kg, 1.0);
   EXPECT_DOUBLE_EQ(given.unmodelled_accel_mps2, 5.0);
   EXPECT_TRUE(quiet.str().empty()) << quiet.str();
+  // A diameter without a mass takes the standard ball's of that size: a table-tennis track given
+  // as BALL.csv with --ball-diameter 0.04 had a football's 0.43 kg (its spin 2657 rev/s).
+  TrajectoryJob small;
+  small.ball_diameter_m = 0.04;
+  std::ostringstream said;
+  EXPECT_DOUBLE_EQ(TrajectoryOptionsFor(small, "ball_csv", said).ball_mass_kg, 0.0027);
+  EXPECT_NE(said.str().find("table-tennis"), std::string::npos) << said.str();
+  small.ball_diameter_m = 0.0427;  // the SSL's golf ball
+  EXPECT_NEAR(TrajectoryOptionsFor(small, "ball_csv", said).ball_mass_kg, 0.0459, 1e-4);
+}
+
+TEST(StandardBalls, NearestByDiameterAndOddMassesWarned) {
+  EXPECT_STREQ(NearestStandardBall(0.040).name, "table-tennis");
+  EXPECT_STREQ(NearestStandardBall(0.043).name, "golf (RoboCup SSL)");
+  EXPECT_STREQ(NearestStandardBall(0.065).name, "tennis");
+  EXPECT_STREQ(NearestStandardBall(0.22).name, "football (size 5)");
+  EXPECT_STREQ(NearestStandardBall(0.24).name, "basketball (size 7)");
+  EXPECT_STREQ(NearestStandardBall(5.0).name, "basketball (size 7)");
+  EXPECT_THROW(NearestStandardBall(0.0), Error);
+  EXPECT_THROW(NearestStandardBall(std::nan("")), Error);
+  for (const double d : {0.040, 0.04267, 0.067, 0.2, 0.22, 0.239}) {
+    EXPECT_EQ(BallMassWarning(d, NearestStandardBall(d).mass_kg), "") << d;
+  }
+  EXPECT_NE(BallMassWarning(0.04, 0.43).find("density of 12832 kg/m^3"), std::string::npos)
+      << BallMassWarning(0.04, 0.43);
+  EXPECT_NE(BallMassWarning(0.22, 0.0027), "");
 }
 
 }  // namespace

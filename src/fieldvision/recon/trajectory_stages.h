@@ -16,8 +16,8 @@ namespace fv::recon::detail {
 // it does not meet it, two ground contacts (origin and landing from each arc's own crossing of
 // the ground level), as next to a hop too short to fit.
 void ResolveContacts(const std::vector<BallSample>& track, const std::vector<int>& piece_of_flight,
-                     const TrajectoryOptions& options, double noise_m,
-                     std::vector<Flight>* flights, std::vector<TrackBreak>* breaks);
+                     const TrajectoryOptions& options, double noise_m, std::vector<Flight>* flights,
+                     std::vector<TrackBreak>* breaks);
 // Origin, landing, apex and launch velocity of a flight from its model and events; a ground
 // contact lies within the contact-time bounds [lo_s, hi_s] of its piece, and an arc still in the
 // air at its bound began or ended in the air there (a hit; the landing then extrapolated).
