@@ -159,7 +159,10 @@ void RunCompare(const CompareCli& c) {
   for (const auto& ca : a_all) {
     for (const auto& cb : b_all) {
       if (cb.name != ca.name) continue;
-      FV_REQUIRE(ca.has_pose && cb.has_pose, "camera '{}' has no pose in both rigs", ca.name);
+      for (const auto& [cam, rig] : {std::pair{&ca, &c.rigs[0]}, {&cb, &c.rigs[1]}}) {
+        FV_REQUIRE(cam->has_pose, "camera '{}' has no pose in rig '{}' (comparing needs poses)",
+                   cam->name, *rig);
+      }
       a.push_back(ca);
       b.push_back(cb);
     }

@@ -11,19 +11,39 @@
 #include <Eigen/Geometry>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::calib {
 namespace {
 
-std::map<std::string, double> Attributes(const std::string& tag) {
-  std::map<std::string, double> out;
-  static const std::regex kAttr(R"((\w+)=\"([-+0-9.eE]+)\")");
-  for (auto it = std::sregex_iterator(tag.begin(), tag.end(), kAttr); it != std::sregex_iterator();
-       ++it) {
-    out[(*it)[1]] = std::stod((*it)[2]);
+// A tag's attributes (name="value"), read as numbers on lookup: a missing one or one that is not
+// a finite number ("nan", "1,5") throws naming the file, the camera, the element and the value.
+class Attributes {
+ public:
+  Attributes(const std::string& tag, std::string context) : context_(std::move(context)) {
+    static const std::regex kAttr(R"((\w+)=\"([^\"]*)\")");
+    for (auto it = std::sregex_iterator(tag.begin(), tag.end(), kAttr);
+         it != std::sregex_iterator(); ++it) {
+      values_[(*it)[1]] = (*it)[2];
+    }
   }
-  return out;
-}
+  bool Has(const std::string& key) const { return values_.count(key) > 0; }
+  double Number(const std::string& key) const {
+    const auto it = values_.find(key);
+    FV_REQUIRE(it != values_.end(), "{} has no {}", context_, key);
+    const std::string where = fmt::format("{} {}", context_, key);
+    const double v = util::ParseDouble(it->second, where);
+    FV_REQUIRE(std::isfinite(v), "{}: '{}' is not a finite number", where, it->second);
+    return v;
+  }
+  double NumberOr(const std::string& key, double fallback) const {
+    return Has(key) ? Number(key) : fallback;
+  }
+
+ private:
+  std::map<std::string, std::string> values_;
+  std::string context_;
+};
 
 }  // namespace
 
@@ -43,37 +63,35 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
   std::vector<camera::Camera> cams;
   for (auto it = std::sregex_iterator(text.begin(), text.end(), kCamera);
        it != std::sregex_iterator(); ++it) {
-    const auto fov = Attributes((*it)[2]);
-    for (const char* key : {"left", "right", "top", "bottom"}) {
-      FV_REQUIRE(fov.count(key), "Qualisys calibration '{}': camera {} has no fov_video {}", path,
-                 (*it)[1].str(), key);
-    }
-    const auto t = Attributes((*it)[3]);
-    const auto k = Attributes((*it)[4]);
-    for (const char* key :
-         {"r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33", "x", "y", "z"}) {
-      FV_REQUIRE(t.count(key), "Qualisys calibration '{}': camera {} has no transform {}", path,
-                 (*it)[1].str(), key);
-    }
-    for (const char* key : {"focalLengthU", "focalLengthV", "centerPointU", "centerPointV"}) {
-      FV_REQUIRE(k.count(key), "Qualisys calibration '{}': camera {} has no intrinsic {}", path,
-                 (*it)[1].str(), key);
-    }
+    const std::string serial = (*it)[1].str();
+    const auto element = [&](int group, const char* name) {
+      return Attributes((*it)[group], fmt::format("Qualisys calibration '{}': camera {}'s {}", path,
+                                                  serial, name));
+    };
+    const Attributes fov = element(2, "fov_video");
+    const Attributes t = element(3, "transform");
+    const Attributes k = element(4, "intrinsic");
     camera::Camera c;
-    c.name = (*it)[1];
-    c.width = static_cast<int>(fov.at("right") - fov.at("left") + 1);
-    c.height = static_cast<int>(fov.at("bottom") - fov.at("top") + 1);
-    c.fx = k.at("focalLengthU") / 64.0;
-    c.fy = k.at("focalLengthV") / 64.0;
-    c.cx = k.at("centerPointU") / 64.0;
-    c.cy = k.at("centerPointV") / 64.0;
-    c.distortion = {k.count("radialDistortion1") ? k.at("radialDistortion1") : 0.0,
-                    k.count("radialDistortion2") ? k.at("radialDistortion2") : 0.0,
-                    k.count("tangentalDistortion1") ? k.at("tangentalDistortion1") : 0.0,
-                    k.count("tangentalDistortion2") ? k.at("tangentalDistortion2") : 0.0};
+    c.name = serial;
+    const double width = fov.Number("right") - fov.Number("left") + 1;
+    const double height = fov.Number("bottom") - fov.Number("top") + 1;
+    FV_REQUIRE(width >= 1 && height >= 1 && width <= camera::Camera::kMaxSide &&
+                   height <= camera::Camera::kMaxSide,
+               "Qualisys calibration '{}': camera {}'s fov_video makes a {}x{} image", path, serial,
+               width, height);
+    c.width = static_cast<int>(width);
+    c.height = static_cast<int>(height);
+    c.fx = k.Number("focalLengthU") / 64.0;
+    c.fy = k.Number("focalLengthV") / 64.0;
+    c.cx = k.Number("centerPointU") / 64.0;
+    c.cy = k.Number("centerPointV") / 64.0;
+    c.distortion = {k.NumberOr("radialDistortion1", 0.0), k.NumberOr("radialDistortion2", 0.0),
+                    k.NumberOr("tangentalDistortion1", 0.0),
+                    k.NumberOr("tangentalDistortion2", 0.0)};
     Eigen::Matrix3d r;
-    r << t.at("r11"), t.at("r12"), t.at("r13"), t.at("r21"), t.at("r22"), t.at("r23"), t.at("r31"),
-        t.at("r32"), t.at("r33");
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) r(i, j) = t.Number(fmt::format("r{}{}", i + 1, j + 1));
+    }
     // A rotation: orthonormal, determinant +1 (a mistyped entry makes the camera's centre, R^T
     // times the position, land metres off).
     const double off_identity =
@@ -81,12 +99,13 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
     FV_REQUIRE(off_identity < 1e-3,
                "Qualisys calibration '{}': camera {}'s transform r11..r33 is not a rotation "
                "(R R^T differs from the identity by {:.3g})",
-               path, (*it)[1].str(), off_identity);
+               path, serial, off_identity);
     FV_REQUIRE(r.determinant() > 0,
                "Qualisys calibration '{}': camera {}'s transform r11..r33 mirrors (determinant "
                "{:.3g}): not a rotation",
-               path, (*it)[1].str(), r.determinant());
-    const Eigen::Vector3d position_m(t.at("x") / 1000, t.at("y") / 1000, t.at("z") / 1000);
+               path, serial, r.determinant());
+    const Eigen::Vector3d position_m(t.Number("x") / 1000, t.Number("y") / 1000,
+                                     t.Number("z") / 1000);
     const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();
     c.has_pose = true;
     c.cam_from_world.rotation = flip * r;

@@ -84,7 +84,15 @@ TEST(Pose2Sim, DamagedQualisysFilesAreRefused) {
   std::string no_fov = text;
   const size_t fov = no_fov.find("<fov_video ");
   no_fov.replace(fov, no_fov.find("/>", fov) + 2 - fov, "<fov_video />");
-  EXPECT_NE(error_of("fov.qca.txt", no_fov).find("fov_video"), std::string::npos);
+  EXPECT_NE(error_of("fov.qca.txt", no_fov).find("fov_video has no "), std::string::npos);
+  // A value that is not a number is named as such, not as missing.
+  std::string nan = text;
+  nan.replace(r11, nan.find('"', r11) - r11, "nan");
+  EXPECT_NE(error_of("nan.qca.txt", nan).find("transform r11: 'nan' is not a finite number"),
+            std::string::npos);
+  std::string comma = text;
+  comma.replace(r11, comma.find('"', r11) - r11, "0,5");
+  EXPECT_NE(error_of("comma.qca.txt", comma).find("'0,5' is not a number"), std::string::npos);
 }
 
 TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {

@@ -190,7 +190,10 @@ std::string BallDetector::SizeProblem(const Vector2d& centre, double radius,
   const BallDetectorOptions& o = options_;
   *size_factor = 1.0;
   if (radius < o.min_radius_px || radius > o.max_radius_px) {
-    return fmt::format("radius {:.1f} px outside {}..{}", radius, o.min_radius_px, o.max_radius_px);
+    return fmt::format(
+        "radius outside the allowed range ({:.1f} px; --min-radius {}, "
+        "--max-radius {})",
+        radius, o.min_radius_px, o.max_radius_px);
   }
   double exp_min = 0, exp_max = 0;
   if (!ExpectedRadius(centre, &exp_min, &exp_max)) return "";

@@ -86,8 +86,8 @@ void CheckEndOfStream(const std::string& path, long long frames_read, long long 
   const long long slack = std::max(1LL, frames_announced / 1000);
   FV_REQUIRE(frames_announced <= 0 || frames_read + slack >= frames_announced,
              "video '{}' ends after {} of the {} frames its header announces (truncated or "
-             "damaged from frame {})",
-             path, frames_read, frames_announced, frames_read);
+             "damaged from frame {}; --max-frames {} uses the frames before it)",
+             path, frames_read, frames_announced, frames_read, frames_read);
 }
 
 bool IsImageFile(const std::string& path) {
