@@ -67,7 +67,8 @@ void Cross(cv::Mat& img, cv::Point2d p, const cv::Scalar& c, int r = 5) {
 }
 
 cv::Scalar FlightColour(int i) {
-  static const cv::Scalar kColours[] = {kBlue, kOrange, kPurple, cv::Scalar(30, 130, 30),
+  // No green or red: those mark the samples, in / out calls and outliers.
+  static const cv::Scalar kColours[] = {kBlue, kOrange, kPurple, cv::Scalar(40, 90, 150),
                                         cv::Scalar(160, 120, 0)};
   return kColours[i % 5];
 }
@@ -205,7 +206,7 @@ cv::Mat DrawTrackHeight(const std::vector<BallSample>& track, const TrajectoryRe
   const double t0 = track.front().time_s, t1 = track.back().time_s;
   const double mt = 0.02 * (t1 - t0) + 1e-3, mz = 0.08 * (zmax - zmin) + 0.02;
   Axes a{t0 - mt, t1 + mt, zmin - mz, zmax + mz,
-         cv::Rect(70, 50, size.width - 100, size.height - 110)};
+         cv::Rect(70, 64, size.width - 100, size.height - 124)};  // the title, then the y label
   DrawGrid(img, a, "time (s)", "height z (m)");
   cv::line(img, a.P(a.x0, o.ground_z_m), a.P(a.x1, o.ground_z_m), kDark, 2);
   for (const auto& f : result.flights) {
