@@ -305,8 +305,8 @@ double LineDistanceMap::Distance(double x_m, double y_m) const {
 
 std::string LineErrorStats::Summary() const {
   return fmt::format(
-      "line error mean {:.1f} mm, median {:.1f} mm, p95 {:.1f} mm over {} of {} "
-      "line pixels (within {:.0f} mm of a line)",
+      "line error mean {:.1f} mm, median {:.1f} mm, p95 {:.1f} mm over {} of the {} "
+      "line pixels that land on the field (within {:.0f} mm of a line)",
       mean_mm, median_mm, p95_mm, num_inliers, num_pixels, gate_m * 1000);
 }
 

@@ -256,8 +256,9 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
     one_layer.height_above_m = 0;
     result.given_rig_score = EvaluateCoverage(given->cameras, field, one_layer).score();
   }
-  summary += fmt::format("rig '{}', {} cameras, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
-                         result.rig.cameras.size(), field.name, field.length_m, field.width_m);
+  summary += fmt::format("rig '{}', {} camera{}, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
+                         result.rig.cameras.size(), result.rig.cameras.size() == 1 ? "" : "s",
+                         field.name, field.length_m, field.width_m);
   summary += result.coverage.Summary();
   summary += RigWarnings(result.rig);
   if (result.given_rig_score) {

@@ -17,6 +17,7 @@
 #include "fieldvision/track/overlay.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/json.h"
 #include "fieldvision/util/output_path.h"
 #include "fieldvision/util/stats.h"
 
@@ -474,7 +475,7 @@ void WriteTables(const ReportParts& rp, ReportFiles& files) {
 nlohmann::json StatsJson(const StatsResult& r, const StatsOptions& o, const ReportFiles& files) {
   nlohmann::json j;
   j["duration_s"] = r.duration_s;
-  j["fps"] = r.fps;
+  j["fps"] = util::JsonRound(r.fps, 6);  // from time_s steps (10.000000000000036)
   j["time_source"] = r.time_source;
   j["summary"] = r.Summary();
   j["speed_bands_mps"] = o.speed_bands_mps;
