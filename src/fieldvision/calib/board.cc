@@ -213,15 +213,32 @@ std::string LargerChessboardSeen(const cv::Mat& image, const BoardSpec& board) {
   }
   const int flags =
       cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK;
-  // A board one row and one column larger holds both of these.
-  for (const cv::Size larger :
-       {cv::Size(board.cols + 1, board.rows), cv::Size(board.cols, board.rows + 1)}) {
+  const auto found_at = [&](const cv::Size& size) {
     std::vector<cv::Point2f> corners;
-    if (cv::findChessboardCorners(grey, larger, corners, flags)) {
-      return fmt::format("{}x{} inner corners", larger.width, larger.height);
+    return cv::findChessboardCorners(grey, size, corners, flags);
+  };
+  // A board one row and one column larger holds both of these (a whole board not found with
+  // either is rare; each try that fails costs a full search).
+  cv::Size larger(board.cols + 1, board.rows);
+  if (!found_at(larger)) {
+    larger = {board.cols, board.rows + 1};
+    if (!found_at(larger)) return "";
+  }
+  // Then the largest up to kMaxGrowth corners wider and taller that is found: OpenCV finds a
+  // whole board reliably and its parts only at times (7x5 given on the 9x6 sample: 7x6 found, 8x6
+  // not; the first step alone named 7x6).
+  constexpr int kMaxGrowth = 4;
+  std::vector<cv::Size> sizes;
+  for (int dc = 0; dc <= kMaxGrowth; ++dc) {
+    for (int dr = 0; dr <= kMaxGrowth; ++dr) {
+      if (dc + dr > 0) sizes.emplace_back(board.cols + dc, board.rows + dr);
     }
   }
-  return "";
+  std::stable_sort(sizes.begin(), sizes.end(),
+                   [](const cv::Size& a, const cv::Size& b) { return a.area() > b.area(); });
+  const auto found = std::find_if(sizes.begin(), sizes.end(), found_at);
+  if (found != sizes.end()) larger = *found;
+  return fmt::format("{}x{} inner corners", larger.width, larger.height);
 }
 
 LargerBoard LargerChessboardInViews(const std::vector<BoardView>& views, const ImageSource& source,

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/calib/board.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/random.h"
 #include "fieldvision/util/seeded_rng.h"
@@ -100,6 +101,10 @@ TEST(Intrinsics, APartOfALargerChessboardIsWarnedAbout) {
   EXPECT_NE(all.find("shows a chessboard of 9x6 inner corners, larger than the 8x6 given"),
             std::string::npos)
       << all;
+  // Smaller in both directions: the board's own size is named, not the first step (7x6).
+  const cv::Mat view = cv::imread(data + "/opencv-chessboard/left01.jpg");
+  EXPECT_EQ(LargerChessboardSeen(view, {BoardType::kChessboard, 7, 5, 0.025}), "9x6 inner corners");
+  EXPECT_EQ(LargerChessboardSeen(view, {BoardType::kChessboard, 9, 6, 0.025}), "");
 }
 
 // p plus Gaussian noise (sigma_px per axis). The draws are sequenced, y first: the arguments of
