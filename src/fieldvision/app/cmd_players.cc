@@ -258,7 +258,7 @@ void Setup(CLI::App& app, int& exit_code) {
     try {
       RunPlayersCommand(*c);
     } catch (const Error& e) {
-      // track::CheckCameraMatchesVideo names the camera by its name: add its file.
+      // RunPlayers names the camera by its name (camera::FitCameraToFrames): add its file.
       const std::string what = e.what();
       if (!c->camera.empty() && what.rfind("camera '", 0) == 0 &&
           what.find(" images but video ") != std::string::npos) {

@@ -117,10 +117,8 @@ void RunTracksDraw(const TracksDrawCli& c) {
   if (!c.camera.empty()) {
     camera = camera::ReadCameraYaml(c.camera);
     // Field lines drawn with a camera of another size would be wrong everywhere.
-    const auto video = io::VideoSource::Open(c.video);
-    FV_REQUIRE(video->width() == camera->width && video->height() == camera->height,
-               "camera file '{}' is for {}x{} images but video '{}' is {}x{}", c.camera,
-               camera->width, camera->height, c.video, video->width(), video->height());
+    const std::string note = io::VideoSource::Open(c.video)->FitCamera(*camera, c.camera);
+    if (!note.empty()) std::cout << note << "\n";
   }
   std::optional<field::FieldModel> field;
   // Lines are drawn through a posed camera only: a field without one would be left out silently.

@@ -124,7 +124,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) field = field::LoadField(o.field);
   auto source = io::VideoSource::Open(o.video);
-  if (camera) source->CheckMatchesCamera(*camera, o.camera);
+  const std::string camera_note = camera ? source->FitCamera(*camera, o.camera) : "";
   AnyBallDetector detector(o.detector, o.dnn, camera ? &*camera : nullptr,
                            field ? &*field : nullptr);
   const auto background =
@@ -198,7 +198,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     result.drawn = fmt::format("{} ({} JPEGs)", draw_dir, result.frames);
   }
   result.background = NeededBackgroundSummary(background);
-  result.frames_note = source->frames_note();
+  result.frames_note = util::JoinNonEmpty({camera_note, source->frames_note()}, "; ");
   out_file.CloseAndCommit(csv);
   return result;
 }

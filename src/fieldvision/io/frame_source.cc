@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/io/source_backends.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
@@ -98,12 +99,11 @@ bool FrameSource::Read(cv::Mat* bgr, long long* frame, double* time_s) {
   return true;
 }
 
-void CheckFrameSize(const FrameSource& source, const camera::Camera& camera,
-                    const std::string& camera_file) {
+std::string FitCameraToSource(const FrameSource& source, camera::Camera& camera,
+                              const std::string& camera_file) {
   const cv::Size size = source.FrameSize();
-  FV_REQUIRE(size.width == camera.width && size.height == camera.height,
-             "video '{}' is {}x{} but camera file '{}' is for {}x{} images", source.name(),
-             size.width, size.height, camera_file, camera.width, camera.height);
+  return camera::FitCameraToFrames(camera, fmt::format("camera file '{}'", camera_file), size.width,
+                                   size.height, source.name());
 }
 
 double SystemClockNow() {

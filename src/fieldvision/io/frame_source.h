@@ -126,9 +126,10 @@ class FrameSource {
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& spec,
                                              const FrameSourceOptions& options = {});
 
-// Throws fv::Error naming both when the source's frames are not the camera's image size.
-void CheckFrameSize(const FrameSource& source, const camera::Camera& camera,
-                    const std::string& camera_file);
+// The camera fitted to the source's frames (camera::FitCameraToFrames: a note when an encoder's
+// block padding was taken off, "" when the sizes match); throws naming both otherwise.
+std::string FitCameraToSource(const FrameSource& source, camera::Camera& camera,
+                              const std::string& camera_file);
 
 // Seconds on the system clock (Unix time): the clock of live sources' time_s.
 double SystemClockNow();

@@ -113,7 +113,7 @@ TEST(FrameSource, ImageGlobAndFolderEncodedOrNot) {
       EXPECT_EQ(n, 4);
       camera::Camera cam = camera::Camera::FromFov(640, 480, 60);
       try {
-        CheckFrameSize(*src, cam, "cam.yaml");
+        FitCameraToSource(*src, cam, "cam.yaml");
         ADD_FAILURE() << "no size error";
       } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("cam.yaml"), std::string::npos) << e.what();

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/strings.h"
@@ -185,11 +186,9 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
   return std::make_unique<FrameSourceVideo>(spec, OpenFrameSource(spec, so));
 }
 
-void VideoSource::CheckMatchesCamera(const camera::Camera& camera,
-                                     const std::string& camera_name) const {
-  FV_REQUIRE(camera.width == width_ && camera.height == height_,
-             "video '{}' is {}x{} but camera file '{}' is for {}x{} images", spec_, width_, height_,
-             camera_name, camera.width, camera.height);
+std::string VideoSource::FitCamera(camera::Camera& camera, const std::string& camera_file) const {
+  return camera::FitCameraToFrames(camera, fmt::format("camera file '{}'", camera_file), width_,
+                                   height_, spec_);
 }
 
 }  // namespace fv::io

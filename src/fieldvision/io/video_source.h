@@ -56,8 +56,9 @@ class VideoSource {
   // Frames read so far.
   int frames_read() const { return next_index_; }
 
-  // Throws fv::Error naming both files when the frames are not the camera's image size.
-  void CheckMatchesCamera(const camera::Camera& camera, const std::string& camera_name) const;
+  // The camera fitted to the frames (camera::FitCameraToFrames: a note when an encoder's block
+  // padding was taken off, "" when the sizes match); throws naming both files otherwise.
+  std::string FitCamera(camera::Camera& camera, const std::string& camera_file) const;
 
  protected:
   std::string spec_;

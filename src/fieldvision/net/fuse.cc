@@ -18,6 +18,7 @@
 #include <fmt/format.h>
 #include <zmq.hpp>
 
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/pipeline/ball_job.h"
@@ -528,6 +529,8 @@ bool FuseServer::AcceptSession(int c, const std::string& session, double arrival
 void FuseServer::CheckHello(int c, const HelloMessage& h) {
   const camera::Camera& cam = cameras_[c];
   if (h.width <= 0 || h.height <= 0 || (h.width == cam.width && h.height == cam.height)) return;
+  // The node fitted the same camera file to its video (camera::FitCameraToFrames).
+  if (camera::IsCroppedPadding(cam, h.width, h.height)) return;
   if (!warned_size_.insert(c).second) return;
   std::cerr << fmt::format(
       "fuse: warning: the node of camera '{}' sends {}x{} images but its camera file here is for "

@@ -59,6 +59,7 @@ std::string NodeSummary::ToString() const {
       "{} skipped by the source (node slower than the camera)",
       camera, frames, source_origin.empty() ? "no" : source_origin, sent, send_dropped,
       source_dropped);
+  if (!camera_note.empty()) s += "\n" + camera_note;
   if (has_offset) {
     s += fmt::format(
         "\nclock: fusion node - this node = {:+.4f} s (round trip {:.2f} ms, {} samples)", offset_s,
@@ -387,10 +388,10 @@ void AddLinkSummary(const NodeLink& link, NodeSummary& summary) {
   summary.hints = link.hints_used;
 }
 
-// The node's video, checked against its camera: times from the video, never assumed (the fusion
-// node pairs cameras by them).
-std::unique_ptr<io::FrameSource> OpenNodeSource(const NodeOptions& o,
-                                                const camera::Camera& camera) {
+// The node's video, its camera fitted to it (camera_note): times from the video, never assumed (the
+// fusion node pairs cameras by them).
+std::unique_ptr<io::FrameSource> OpenNodeSource(const NodeOptions& o, camera::Camera& camera,
+                                                std::string& camera_note) {
   io::FrameSourceOptions so;
   so.encoded = true;  // MJPG / JPEG: decoded only around the tracked ball
   so.realtime = o.realtime;
@@ -402,10 +403,7 @@ std::unique_ptr<io::FrameSource> OpenNodeSource(const NodeOptions& o,
              "video '{}' has no frame rate of its own (an image sequence, or a container without "
              "one): give --fps",
              o.video);
-  const cv::Size size = source->FrameSize();
-  FV_REQUIRE(size.width == camera.width && size.height == camera.height,
-             "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.camera, camera.width,
-             camera.height, o.video, size.width, size.height);
+  camera_note = io::FitCameraToSource(*source, camera, o.camera);
   return source;
 }
 
@@ -413,10 +411,11 @@ std::unique_ptr<io::FrameSource> OpenNodeSource(const NodeOptions& o,
 
 NodeSummary RunNode(const NodeOptions& o) {
   o.Check();
-  const camera::Camera camera = pipeline::ReadRigCamera(o.camera);
+  camera::Camera camera = pipeline::ReadRigCamera(o.camera);
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) field = field::LoadField(o.field);
-  const std::unique_ptr<io::FrameSource> source = OpenNodeSource(o, camera);
+  std::string camera_note;
+  const std::unique_ptr<io::FrameSource> source = OpenNodeSource(o, camera, camera_note);
   const cv::Size size = source->FrameSize();
   const detect::BallDetectorOptions dopt =
       pipeline::TrackingDetectorOptions(o.ball_diameter_m, o.colour);
@@ -445,6 +444,7 @@ NodeSummary RunNode(const NodeOptions& o) {
 
   NodeSummary summary;
   summary.camera = camera.name;
+  summary.camera_note = camera_note;
   const auto start = std::chrono::steady_clock::now();
   zmq::context_t ctx(1);
   const std::string session = NewSession();

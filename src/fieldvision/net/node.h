@@ -54,6 +54,7 @@ struct NodeOptions {
 struct NodeSummary {
   std::string camera;
   std::string source_origin;     // where frame times come from (TimeOrigin)
+  std::string camera_note;       // the camera fitted to an encoder's cropped padding, or ""
   long long frames = 0;          // frames read and processed
   long long sent = 0;            // frame messages handed to the socket
   long long send_dropped = 0;    // frame messages the socket could not take

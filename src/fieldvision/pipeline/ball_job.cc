@@ -15,6 +15,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::pipeline {
 
@@ -139,11 +140,13 @@ BallGuidedFn GuidedFnFor(std::shared_ptr<Detector> detector) {
   };
 }
 
-// The job's videos, each checked against its camera's size. --live on files: a file is not
-// live; each is played at its own frame rate from one common start (as cameras would deliver
-// it), so frames drop only when fusion is slower than that.
+// The job's videos, each checked against its camera's size (a camera fitted to an encoder's
+// cropped padding, its note in `camera_notes`). --live on files: a file is not live; each is
+// played at its own frame rate from one common start (as cameras would deliver it), so frames
+// drop only when fusion is slower than that.
 std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
-    const BallJobOptions& o, const std::vector<camera::Camera>& cameras) {
+    const BallJobOptions& o, std::vector<camera::Camera>& cameras,
+    std::vector<std::string>& camera_notes) {
   std::vector<std::unique_ptr<io::FrameSource>> sources;
   const double live_start_s =
       std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() +
@@ -174,10 +177,7 @@ std::vector<std::unique_ptr<io::FrameSource>> OpenBallVideos(
                "--fps {:g} but video '{}' runs at {:.4g} frames/s (--fps is for image sequences; "
                "--timestamps gives any video's times)",
                o.fps, o.videos[c], src->fps());
-    const cv::Size size = src->FrameSize();
-    FV_REQUIRE(size.width == cameras[c].width && size.height == cameras[c].height,
-               "camera file '{}' is for {}x{} images but video '{}' is {}x{}", o.cameras[c],
-               cameras[c].width, cameras[c].height, o.videos[c], size.width, size.height);
+    camera_notes.push_back(io::FitCameraToSource(*src, cameras[c], o.cameras[c]));
     sources.push_back(std::move(src));
   }
   // Frames paired by index are of one time only at one frame rate (else the fused times go back
@@ -251,9 +251,11 @@ BallJobResult RunBallJob(const BallJobOptions& o) {
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) field = field::LoadField(o.field);
   // Open every video (and check its size) before starting any thread.
-  std::vector<std::unique_ptr<io::FrameSource>> sources = OpenBallVideos(o, cameras);
-  std::vector<std::string> frames_notes(sources.size());  // decided on each video's first frame
-  for (size_t c = 0; c < sources.size(); ++c) frames_notes[c] = sources[c]->FramesNote();
+  std::vector<std::string> frames_notes;  // the cameras' fits and each video's first frame's
+  std::vector<std::unique_ptr<io::FrameSource>> sources = OpenBallVideos(o, cameras, frames_notes);
+  for (size_t c = 0; c < sources.size(); ++c) {
+    frames_notes[c] = util::JoinNonEmpty({frames_notes[c], sources[c]->FramesNote()}, "; ");
+  }
   const detect::BallDetectorOptions dopt = TrackingDetectorOptions(o.ball_diameter_m, o.colour);
   std::vector<BallRegionDetectFn> detect_fns;
   std::vector<BallGuidedFn> guided_fns;

@@ -14,6 +14,7 @@
 #include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/detect/lab.h"
 #include "fieldvision/io/frame_source.h"
 #include "fieldvision/io/video_source.h"
@@ -21,6 +22,7 @@
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/progress.h"
 #include "fieldvision/util/stats.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::track {
 namespace {
@@ -440,15 +442,6 @@ std::string PlayersResult::Summary() const {
       frames_note.empty() ? "" : "; " + frames_note);
 }
 
-void CheckCameraMatchesVideo(const camera::Camera& camera, int width, int height,
-                             const std::string& video) {
-  FV_REQUIRE(camera.width == width && camera.height == height,
-             "camera '{}' is for {}x{} images but video '{}' is {}x{}: use the camera file made "
-             "for this video",
-             camera.name.empty() ? "(unnamed)" : camera.name, camera.width, camera.height, video,
-             width, height);
-}
-
 int InterpolateGaps(std::vector<TrackRow>& rows, int max_gap, const camera::Camera* camera,
                     double foot_offset_m) {
   if (max_gap <= 0) return 0;
@@ -785,8 +778,15 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     frame_limit = frame_limit > 0 ? std::min(frame_limit, n) : n;
   }
   FrameReader reader(video, frame_limit, sequence_files > 0);
+  // The camera fitted to the frames (an encoder's cropped padding; else an error).
+  std::optional<camera::Camera> fitted;
+  std::string camera_note;
   if (camera != nullptr) {
-    CheckCameraMatchesVideo(*camera, reader.size().width, reader.size().height, video);
+    fitted = *camera;
+    camera_note = camera::FitCameraToFrames(
+        *fitted, fmt::format("camera '{}'", camera->name.empty() ? "(unnamed)" : camera->name),
+        reader.size().width, reader.size().height, video);
+    camera = &*fitted;
   }
   // A moving camera's frames are tracked on its canvas, as the canvas's camera.
   PlayersPass pass;
@@ -877,7 +877,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
   if (drift) result.view_drift = drift->stats();
   result.times.map_s = Seconds(t_map, Clock::now());
   result.times.read_s = reader.read_seconds();
-  result.frames_note = reader.frames_note();
+  result.frames_note = util::JoinNonEmpty({camera_note, reader.frames_note()}, "; ");
   result.tracker = tracker.stats();
   result.times.total_s = Seconds(t_start, Clock::now());
   return result;

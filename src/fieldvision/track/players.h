@@ -165,10 +165,6 @@ struct PlayersResult {
   std::string Summary() const;
 };
 
-// Throws fv::Error when the camera's image size differs from the video's (names both).
-void CheckCameraMatchesVideo(const camera::Camera& camera, int width, int height,
-                             const std::string& video);
-
 // Runs the pipeline on a video (any file OpenCV reads or an image pattern). `camera` may be
 // null or uncalibrated (no pose): then boxes only, no field positions. `field` (optional) limits
 // detections. Rows number frames from 1 and carry the frame's time (TimesOfFrames; an image

@@ -85,6 +85,16 @@ std::string Shown(std::string_view t) {
   return t.size() > 40 ? out + "..." : out;
 }
 
+std::string JoinNonEmpty(const std::vector<std::string>& parts, std::string_view sep) {
+  std::string out;
+  for (const std::string& p : parts) {
+    if (p.empty()) continue;
+    if (!out.empty()) out += sep;
+    out += p;
+  }
+  return out;
+}
+
 double ParseDouble(std::string_view s, std::string_view context) {
   const std::string t = Trim(s);
   FV_REQUIRE(!t.empty(), "{}: empty value where a number is expected", context);

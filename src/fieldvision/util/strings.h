@@ -15,6 +15,8 @@ std::string Trim(std::string_view s);
 bool StartsWith(std::string_view s, std::string_view prefix);
 bool EndsWith(std::string_view s, std::string_view suffix);
 std::string ToLower(std::string_view s);
+// The non-empty ones of `parts` joined by `sep` ("" when all are empty).
+std::string JoinNonEmpty(const std::vector<std::string>& parts, std::string_view sep);
 // `s` as part of a file name: ASCII letters, digits, '-', '_', '.' and non-ASCII (UTF-8) bytes
 // kept, every other byte and leading dots '_' (so never a path, nor a hidden file).
 std::string FileNamePart(std::string_view s);
