@@ -32,7 +32,8 @@ void Setup(CLI::App& app, int& exit_code) {
   cmd->add_option(
       "--draw", o->draw,
       "Draw the candidates: an annotated video (.mp4: H.264 where OpenCV's FFmpeg has it, else "
-      "Motion-JPEG as .avi; .avi, .mkv: Motion-JPEG) or a folder of JPEGs");
+      "Motion-JPEG as .avi; .avi, .mkv: Motion-JPEG), an image (.jpg, .png: one frame only) or "
+      "a folder of JPEGs");
   AddScanStepOption(cmd, o->detector);
   AddBallSizeOptions(cmd, o->detector);
   AddDetectorOptions(cmd, o->dnn, /*auto_for_stills=*/true);
@@ -61,7 +62,7 @@ void Setup(CLI::App& app, int& exit_code) {
     if (io::IsVideoName(o->draw)) {
       io::CheckVideoOutput(o->draw, inputs, "--draw");
     } else {
-      util::CheckOutputPath(o->draw, inputs, "--draw");  // a folder of JPEGs
+      util::CheckOutputPath(o->draw, inputs, "--draw");  // an image or a folder of JPEGs
     }
     o->on_start = ChooseAutoDetector(o->dnn, o->video);
     const detect::DetectVideoResult r = detect::DetectVideo(*o);

@@ -14,6 +14,7 @@
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/detect/camera_background.h"
 #include "fieldvision/field/field_draw.h"
+#include "fieldvision/io/image_file.h"
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/io/video_writer.h"
 #include "fieldvision/util/csv.h"
@@ -135,7 +136,8 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
                       {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
   std::optional<io::PlayableVideoWriter> writer;  // renamed over --draw at the end
   std::string draw_dir;
-  cv::Mat legend;  // below each drawn frame, made again only for a frame of another width
+  std::string draw_image;  // one image drawn (a still's --draw x.jpg)
+  cv::Mat legend;          // below each drawn frame, made again only for a frame of another width
   if (!o.draw.empty()) {
     legend = CandidateLegend(source->width());
     if (io::IsVideoName(o.draw)) {
@@ -143,6 +145,14 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
       // The frame and, below it, the legend.
       writer.emplace(o.draw, fps, cv::Size(source->width(), source->height() + legend.rows),
                      "--draw");
+    } else if (io::IsImageFile(o.draw)) {
+      // A name such as x.jpg made a folder of that name: one image is written for one frame.
+      FV_REQUIRE(source->frame_count() == 1,
+                 "--draw '{}' names one image but '{}' has {} frames: give a video (.mp4, .avi, "
+                 ".mkv) or a folder for a JPEG a frame",
+                 o.draw, o.video,
+                 source->frame_count() > 0 ? std::to_string(source->frame_count()) : "more");
+      draw_image = o.draw;
     } else {
       std::error_code ec;
       std::filesystem::create_directories(o.draw, ec);
@@ -171,7 +181,7 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     result.candidates += static_cast<long long>(cands.size());
     result.frames_with_ball += any;
     ++result.frames;
-    if (writer || !draw_dir.empty()) {
+    if (writer || !draw_dir.empty() || !draw_image.empty()) {
       cv::Mat canvas = frame.bgr.clone();
       DrawFieldBoundary(canvas, detector.colour().OffFieldBoundary(frame.bgr));
       DrawCandidates(canvas, cands);
@@ -179,6 +189,8 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
       cv::vconcat(canvas, legend, canvas);
       if (writer) {
         writer->Write(canvas);
+      } else if (!draw_image.empty()) {
+        io::WriteImage(draw_image, canvas);
       } else {
         const std::string path = fmt::format("{}/{:05d}.jpg", draw_dir, frame.index);
         FV_REQUIRE(codecs::ImWrite(path, canvas), "cannot write '{}'", path);
@@ -196,6 +208,8 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
                     writer->note().empty() ? "" : "; " + writer->note());
   } else if (!draw_dir.empty()) {
     result.drawn = fmt::format("{} ({} JPEGs)", draw_dir, result.frames);
+  } else if (!draw_image.empty()) {
+    result.drawn = draw_image;
   }
   result.background = NeededBackgroundSummary(background);
   result.frames_note = util::JoinNonEmpty({camera_note, source->frames_note()}, "; ");

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -101,6 +102,17 @@ TEST(DetectVideo, WritesEveryCandidateAndDrawsThem) {
   cv::minMaxLoc(first.rowRange(frame.rows, first.rows).reshape(1), &lo, &hi);
   EXPECT_LT(lo, 30);
   EXPECT_GT(hi, 200);
+  // An image name draws a still (one frame) into that image, not a folder of that name; for
+  // several frames it is an error naming both.
+  DetectVideoOptions still = ClipOptions(clip, clip.dir + "/still.png");
+  still.video = clip.dir + "/frames/00002.png";
+  EXPECT_EQ(DetectVideo(still).drawn, still.draw);
+  const cv::Mat drawn = cv::imread(still.draw);
+  EXPECT_EQ(drawn.size(), first.size());
+  DetectVideoOptions several = ClipOptions(clip, clip.dir + "/several.png");
+  EXPECT_THAT(fv::testing::ErrorOf([&] { DetectVideo(several); }),
+              ::testing::HasSubstr("names one image but"));
+  EXPECT_FALSE(std::filesystem::exists(several.draw));
 }
 
 // An annotated video goes to a temporary file renamed over --draw at the end: a run that fails
