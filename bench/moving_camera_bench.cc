@@ -168,9 +168,9 @@ void PreparePan() {
       "panned",
       [&w](int t, const cv::Mat& f, cv::Mat& v) {
         cv::Mat map1, map2;
-        cv::initUndistortRectifyMap(fv::camera::IntrinsicMatrix(w.camera), w.camera.distortion,
-                                    w.pan.at(t), fv::camera::IntrinsicMatrix(w.pan_camera),
-                                    f.size(), CV_16SC2, map1, map2);
+        cv::initUndistortRectifyMap(
+            fv::camera::IntrinsicMatrix(w.camera), fv::camera::DistortionRow(w.camera), w.pan.at(t),
+            fv::camera::IntrinsicMatrix(w.pan_camera), f.size(), CV_16SC2, map1, map2);
         cv::remap(f, v, map1, map2, cv::INTER_LINEAR);
       },
       m);

@@ -23,6 +23,7 @@
 #include "fieldvision/calib/rig_lines.h"
 #include "fieldvision/calib/rig_place.h"
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
@@ -31,8 +32,16 @@
 namespace fv::app {
 namespace {
 
+// `camera` fitted to `image` (camera::FitCameraToFrames: an encoder's cropped padding), the note
+// printed; another size is an error naming both.
+void FitToImage(const cv::Mat& image, const std::string& image_path, camera::Camera& camera,
+                const std::string& camera_what) {
+  const std::string note = camera::FitCameraToFrames(camera, camera_what, image.cols, image.rows,
+                                                     fmt::format("image '{}'", image_path));
+  if (!note.empty()) std::cout << note << "\n";
+}
+
 using calib::CheckCalibration;
-using calib::CheckImageSize;
 using calib::CheckOptions;
 using calib::CheckResult;
 using calib::ExtrinsicsOptions;
@@ -86,8 +95,9 @@ int FindRigCamera(const std::vector<camera::Camera>& rig, const std::string& whi
 }
 
 // Frames of a rig's cameras from --image NAME=FRAME (or FRAME for the --camera NAME); empty for
-// cameras without a frame; names[i] the file of camera i's frame.
-std::vector<cv::Mat> ReadRigFrames(const std::vector<camera::Camera>& rig,
+// cameras without a frame; names[i] the file of camera i's frame. A camera is fitted to its frame
+// (camera::FitCameraToFrames: an encoder's cropped padding, noted; else an error).
+std::vector<cv::Mat> ReadRigFrames(std::vector<camera::Camera>& rig,
                                    const std::vector<std::string>& images,
                                    const std::string& camera, const std::string& dir,
                                    std::vector<std::string>* names) {
@@ -111,7 +121,7 @@ std::vector<cv::Mat> ReadRigFrames(const std::vector<camera::Camera>& rig,
     FV_REQUIRE(frames[k].empty(), "--image: two frames for rig camera '{}' ('{}' and '{}')",
                rig[k].name, (*names)[k], file);
     frames[k] = ReadImage(file);
-    CheckImageSize(frames[k], rig[k], file, rig[k].name);
+    FitToImage(frames[k], file, rig[k], fmt::format("camera '{}'", rig[k].name));
     (*names)[k] = file;
   }
   return frames;
@@ -395,7 +405,7 @@ void WriteOverlay(const std::string& path, const camera::Camera& cam, const cv::
 // A rig on the field refined with the lines in frames of any of its cameras: one rigid
 // correction for the whole rig (calib/rig_lines.h).
 void RunRefineRig(const RefineCli& c) {
-  const std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
+  std::vector<camera::Camera> rig = ReadCameraFolder(c.rig, /*require_pose=*/true);
   const std::vector<std::string> paths = RigOutputPaths(
       CameraFilesIn(c.rig), c.out, util::PathList(FilesOf(c.images), c.field), "--out");
   std::vector<std::string> names;
@@ -422,10 +432,10 @@ void RunRefine(const RefineCli& c) {
   FV_REQUIRE(!c.camera.empty(), "give --camera CAM.yaml (or --rig DIR with --image NAME=FRAME)");
   FV_REQUIRE(c.images.size() == 1,
              "give one --image for --camera (several only with --rig DIR, as NAME=FRAME)");
-  const camera::Camera cam = camera::ReadCameraYaml(c.camera);
+  camera::Camera cam = camera::ReadCameraYaml(c.camera);
   const std::string& image_path = c.images.front();
   const cv::Mat image = ReadImage(image_path);
-  CheckImageSize(image, cam, image_path, c.camera);
+  FitToImage(image, image_path, cam, fmt::format("camera file '{}'", c.camera));
   const field::FieldModel field = field::LoadField(c.field);
   const RefineResult r = RefineWithLines(cam, image, field, c.o);
   // One report: the library's summary, then the contract's line error.
@@ -460,9 +470,9 @@ struct CheckCli {
 };
 
 void RunCheck(const CheckCli& c) {
-  const camera::Camera cam = camera::ReadCameraYaml(c.camera);
+  camera::Camera cam = camera::ReadCameraYaml(c.camera);
   const cv::Mat image = ReadImage(c.image);
-  CheckImageSize(image, cam, c.image, c.camera);
+  FitToImage(image, c.image, cam, fmt::format("camera file '{}'", c.camera));
   const field::FieldModel field = field::LoadField(c.field);
   std::vector<PointCorrespondence> pts;
   if (!c.points.empty()) pts = ReadPointsCsv(c.points, &field, cam.width, cam.height);

@@ -134,9 +134,11 @@ void RunEvalTracks(const EvalTracksCli& c) {
     }
   }();
   std::cout << m.Summary() << "\n" << m.preprocessing.Summary() << "\n";
-  // Field positions and the coach's numbers over the frames the metrics scored (--est-frames).
+  // Field positions and the coach's numbers over the frames the metrics scored (--est-frames,
+  // --all-frames).
   std::vector<track::TrackRow> placed = gt;
-  m.preprocessing.ClipAsScored(placed);
+  std::vector<track::TrackRow> scored = est;
+  m.preprocessing.ClipAsScored(placed, scored, c.o.frame_offset);
   // A moving camera's tracks (players --moving-camera): the ground truth's feet through the
   // camera's motion saved beside them.
   const auto canvas =
@@ -149,9 +151,9 @@ void RunEvalTracks(const EvalTracksCli& c) {
   } else if (cam) {
     track::PlaceFeet(*cam, c.foot_offset_m, &placed);
   }
-  const auto positions = ScorePositions(c, placed, est);
+  const auto positions = ScorePositions(c, placed, scored);
   if (positions) std::cout << positions->Summary() << "\n";
-  const auto coach = positions ? CompareCoachNumbers(placed, est) : std::nullopt;
+  const auto coach = positions ? CompareCoachNumbers(placed, scored) : std::nullopt;
   if (coach) std::cout << coach->Summary() << "\n";
   if (!c.json.empty()) {
     nlohmann::json j = nlohmann::json::parse(m.ToJson());

@@ -90,8 +90,9 @@ void RunPlayersCommand(const PlayersCli& c) {
               << r.beyond_canvas_frames << " frames (the first in frame " << r.first_beyond_canvas
               << ") lay beyond the canvas (the first frame's view widened by --canvas-margin "
               << c.o.camera_motion.canvas_margin
-              << " image widths each side) and were left out: raise --canvas-margin, or cut the "
-                 "video where the view has turned 90 degrees or more from its first frame\n";
+              << " image widths each side) and were left out: raise --canvas-margin, or start the "
+                 "video aimed at the middle of what it pans over (a flat canvas never reaches 90 "
+                 "degrees from the first view)\n";
   }
   if (!c.draw.empty()) {
     // Field lines need a posed camera; without a field file the camera's own field is unknown.

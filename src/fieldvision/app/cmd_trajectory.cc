@@ -6,7 +6,6 @@
 #include <memory>
 
 #include "fieldvision/app/command.h"
-#include "fieldvision/recon/standard_balls.h"
 #include "fieldvision/recon/trajectory_run.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
@@ -82,10 +81,6 @@ void Setup(CLI::App& app, int& exit_code) {
       FV_REQUIRE(opt->count() == 0 || !o->job.field.empty(),
                  "trajectory: {} needs --field (the calls are made on a field's lines)",
                  opt->get_name());
-    }
-    if (o->job.ball_mass_kg > 0 && o->job.ball_diameter_m > 0) {
-      const std::string odd = recon::BallMassWarning(o->job.ball_diameter_m, o->job.ball_mass_kg);
-      if (!odd.empty()) std::cerr << "fieldvision: warning: " << odd << "\n";
     }
     o->job.analysis.drag = recon::ParseDragMode(o->drag, "--drag");
     o->job.analysis.spin = recon::ParseDragMode(o->spin, "--spin");

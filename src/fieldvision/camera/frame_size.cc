@@ -17,22 +17,22 @@ bool PaddedSide(int camera_px, int frames_px) {
 }  // namespace
 
 bool IsCroppedPadding(const Camera& camera, int width, int height) {
-  return (camera.height == height && PaddedSide(camera.width, width)) ||
-         (camera.width == width && PaddedSide(camera.height, height));
+  const bool same_width = camera.width == width, same_height = camera.height == height;
+  return !(same_width && same_height) && (same_width || PaddedSide(camera.width, width)) &&
+         (same_height || PaddedSide(camera.height, height));
 }
 
 std::string FitCameraToFrames(Camera& camera, const std::string& camera_what, int width, int height,
-                              const std::string& video) {
+                              const std::string& frames_what) {
   if (camera.width == width && camera.height == height) return "";
   FV_REQUIRE(IsCroppedPadding(camera, width, height),
-             "{} is for {}x{} images but video '{}' is {}x{}: use the camera file made for this "
-             "video",
-             camera_what, camera.width, camera.height, video, width, height);
+             "{} is for {}x{} images but {} is {}x{}: use the camera file made for it", camera_what,
+             camera.width, camera.height, frames_what, width, height);
   std::string note = fmt::format(
-      "{} is for {}x{} images, video '{}' is {}x{}: taken as the encoder's padding to {}-pixel "
-      "blocks cropped off at the {} (the intrinsics kept)",
-      camera_what, camera.width, camera.height, video, width, height, kBlockPx,
-      camera.width != width ? "right" : "bottom");
+      "{} is for {}x{} images, {} is {}x{}: taken as the encoder's padding to {}-pixel blocks "
+      "cropped off at the {} (the intrinsics kept)",
+      camera_what, camera.width, camera.height, frames_what, width, height, kBlockPx,
+      camera.width == width ? "bottom" : (camera.height == height ? "right" : "right and bottom"));
   camera.width = width;
   camera.height = height;
   return note;

@@ -12,12 +12,11 @@
 namespace fv::camera {
 
 // Whether frames of width x height are the camera's image with an encoder's padding to whole
-// 16-pixel blocks cropped off (1..15 pixels fewer on one side, the camera's side a multiple of 16,
-// the other side equal).
+// 16-pixel blocks cropped off (each side equal, or 1..15 pixels fewer with the camera's side a
+// multiple of 16; not both equal).
 bool IsCroppedPadding(const Camera& camera, int width, int height);
 
-// The same size: "". A camera 1..15 pixels wider or taller than the frames (the other side equal)
-// whose larger side is a multiple of 16: the camera takes the frames' size and the returned note
+// The same size: "". IsCroppedPadding: the camera takes the frames' size and the returned note
 // says so. Any other size throws fv::Error naming the camera (`camera_what`: "camera file
 // 'cam.yaml'") and `video` with both sizes.
 std::string FitCameraToFrames(Camera& camera, const std::string& camera_what, int width, int height,

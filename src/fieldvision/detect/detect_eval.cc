@@ -380,6 +380,7 @@ std::string DetectEvalResult::Summary(int list) const {
       "{} false detections",
       images.size(), with_ball, detected, ratio(recall(), with_ball), hits, with_ball,
       ratio(precision(), detected), hits, detected, false_detections);
+  if (!camera_note.empty()) s += "\n" + camera_note;
   const std::string by_size = RecallBySize(images);
   if (!by_size.empty()) s += "\nrecall by ball radius (half the box's longer side): " + by_size;
   if (!err_px.empty()) {
@@ -556,8 +557,11 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     drawings = std::make_unique<MissDrawings>(o.draw_misses, o.video, image_files);
   }
   std::unique_ptr<camera::Camera> camera;
+  std::string camera_note;
   if (!o.camera.empty()) {
     camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
+    // Fitted to a video's frames before the detector takes it (an encoder's cropped padding).
+    if (video != nullptr) camera_note = video->FitCamera(*camera, o.camera);
   }
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) {
@@ -620,6 +624,7 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   progress.Finish();
   result.seconds = progress.ElapsedSeconds();
   result.background = NeededBackgroundSummary(background);
+  result.camera_note = camera_note;
   if (drawings != nullptr) {
     result.drawn = drawings->written();
     result.drawn_dir = drawings->dir();

@@ -113,7 +113,8 @@ struct DetectEvalResult {
   int not_judged = 0;  // frames whose ball is less visible than LabelOptions::min_visible
   int drawn = 0;       // images drawn into DetectEvalOptions::draw_misses
   std::string drawn_dir;
-  std::string background;  // CameraBackground::Summary, "" when none was set up
+  std::string background;   // CameraBackground::Summary, "" when none was set up
+  std::string camera_note;  // the camera fitted to the video (camera/frame_size.h), or ""
   double seconds = 0.0;
   double recall() const { return with_ball > 0 ? double(hits) / with_ball : 0.0; }
   double precision() const { return detected > 0 ? double(hits) / detected : 0.0; }

@@ -134,6 +134,9 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
   util::AtomicOutput out_file(o.out);
   util::CsvWriter csv(out_file.temp_path(),
                       {"frame", "u", "v", "radius_px", "score", "accepted", "sigma_px"});
+  const long long total = o.max_frames > 0 && source->frame_count() > 0
+                              ? std::min(o.max_frames, source->frame_count())
+                              : (o.max_frames > 0 ? o.max_frames : source->frame_count());
   std::optional<io::PlayableVideoWriter> writer;  // renamed over --draw at the end
   std::string draw_dir;
   std::string draw_image;  // one image drawn (a still's --draw x.jpg)
@@ -147,11 +150,10 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
                      "--draw");
     } else if (io::IsImageFile(o.draw)) {
       // A name such as x.jpg made a folder of that name: one image is written for one frame.
-      FV_REQUIRE(source->frame_count() == 1,
-                 "--draw '{}' names one image but '{}' has {} frames: give a video (.mp4, .avi, "
-                 ".mkv) or a folder for a JPEG a frame",
-                 o.draw, o.video,
-                 source->frame_count() > 0 ? std::to_string(source->frame_count()) : "more");
+      FV_REQUIRE(total == 1,
+                 "--draw '{}' names one image but {} frames of '{}' are read: give a video (.mp4, "
+                 ".avi, .mkv), a folder for a JPEG a frame, or --max-frames 1",
+                 o.draw, total > 0 ? std::to_string(total) : "several", o.video);
       draw_image = o.draw;
     } else {
       std::error_code ec;
@@ -162,9 +164,6 @@ DetectVideoResult DetectVideo(const DetectVideoOptions& o) {
     }
   }
   DetectVideoResult result;
-  const long long total = o.max_frames > 0 && source->frame_count() > 0
-                              ? std::min(o.max_frames, source->frame_count())
-                              : (o.max_frames > 0 ? o.max_frames : source->frame_count());
   if (o.on_start) o.on_start();
   util::Progress progress("detect", total, "frames", o.progress);
   const auto t0 = std::chrono::steady_clock::now();

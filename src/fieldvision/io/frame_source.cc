@@ -103,7 +103,7 @@ std::string FitCameraToSource(const FrameSource& source, camera::Camera& camera,
                               const std::string& camera_file) {
   const cv::Size size = source.FrameSize();
   return camera::FitCameraToFrames(camera, fmt::format("camera file '{}'", camera_file), size.width,
-                                   size.height, source.name());
+                                   size.height, fmt::format("video '{}'", source.name()));
 }
 
 double SystemClockNow() {

@@ -188,7 +188,7 @@ std::unique_ptr<VideoSource> VideoSource::Open(const std::string& spec,
 
 std::string VideoSource::FitCamera(camera::Camera& camera, const std::string& camera_file) const {
   return camera::FitCameraToFrames(camera, fmt::format("camera file '{}'", camera_file), width_,
-                                   height_, spec_);
+                                   height_, fmt::format("video '{}'", spec_));
 }
 
 }  // namespace fv::io

@@ -125,7 +125,10 @@ TrajectoryOptions TrajectoryOptionsFor(const TrajectoryJob& job, const std::stri
   }
   o.ball_radius_m = 0.5 * diameter;
   o.ball_mass_kg = job.ball_mass_kg;
-  if (o.ball_mass_kg <= 0) {
+  if (o.ball_mass_kg > 0) {
+    const std::string odd = BallMassWarning(diameter, o.ball_mass_kg);
+    if (!odd.empty()) log << "warning: " << odd << "\n";
+  } else {
     // The mass turns the fitted lift into rev/s: a 4 cm ball fitted as a football's 0.43 kg
     // gave a table-tennis track 2657 rev/s.
     const StandardBall& ball = NearestStandardBall(diameter);

@@ -1,5 +1,4 @@
 #include "fieldvision/recon/trajectory_run.h"
-#include "fieldvision/recon/standard_balls.h"
 
 #include <filesystem>
 #include <fstream>
@@ -155,6 +154,13 @@ TEST(TrajectoryRunStages, OptionsFollowTheLayoutUnlessGiven) {
   EXPECT_NE(said.str().find("table-tennis"), std::string::npos) << said.str();
   small.ball_diameter_m = 0.0427;  // the SSL's golf ball
   EXPECT_NEAR(TrajectoryOptionsFor(small, "ball_csv", said).ball_mass_kg, 0.0459, 1e-4);
+  // A football's mass on a TT3D file (its 4 cm by default) is warned of.
+  TrajectoryJob heavy;
+  heavy.ball_mass_kg = 0.43;
+  std::ostringstream warned;
+  TrajectoryOptionsFor(heavy, "tt3d", warned);
+  EXPECT_NE(warned.str().find("warning: a ball of 0.040 m and 0.43 kg"), std::string::npos)
+      << warned.str();
 }
 
 TEST(StandardBalls, NearestByDiameterAndOddMassesWarned) {

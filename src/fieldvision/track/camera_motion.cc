@@ -91,7 +91,7 @@ cv::Matx33d PixelsFromGround(const camera::Camera& c) {
   const Eigen::Matrix3d& r = c.cam_from_world.rotation;
   const Eigen::Vector3d& t = c.cam_from_world.translation;
   const cv::Matx33d rt(r(0, 0), r(0, 1), t.x(), r(1, 0), r(1, 1), t.y(), r(2, 0), r(2, 1), t.z());
-  return IntrinsicMatrix(c) * rt;
+  return camera::IntrinsicMatrix(c) * rt;
 }
 
 cv::Rect2d MapBox(const cv::Matx33d& h, const cv::Rect2d& box) {
@@ -225,11 +225,11 @@ std::vector<cv::Point2f> CameraMotion::ToUndistorted(std::vector<cv::Point2f> wo
                                                      double scale) const {
   for (cv::Point2f& p : work_px) p *= 1.0 / scale;
   if (lens_ && !work_px.empty()) {
-    const cv::Matx33d k = IntrinsicMatrix(*lens_);
+    const cv::Matx33d k = camera::IntrinsicMatrix(*lens_);
     // Iterated to convergence, as Camera::Undistort (OpenCV's default stops after 5 steps).
     cv::undistortPoints(
-        std::vector<cv::Point2f>(work_px), work_px, k, lens_->distortion, cv::noArray(), k,
-        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50, 1e-9));
+        std::vector<cv::Point2f>(work_px), work_px, k, camera::DistortionRow(*lens_), cv::noArray(),
+        k, cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 50, 1e-9));
   }
   return work_px;
 }

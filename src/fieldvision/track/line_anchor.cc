@@ -132,7 +132,7 @@ LineAnchor::LineAnchor(const camera::Camera& first, const field::FieldModel& fie
     : first_(first), field_(field), options_(options), map_(DistanceMap(field, options)) {
   first_.Check("moving camera");
   FV_REQUIRE(first_.has_pose, "camera '{}' has no pose: the field lines need one", first_.name);
-  k_ = IntrinsicMatrix(first_);
+  k_ = camera::IntrinsicMatrix(first_);
 }
 
 camera::Camera LineAnchor::FramePose(const cv::Matx33d& first_from_frame) const {

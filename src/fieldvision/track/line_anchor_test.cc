@@ -35,7 +35,7 @@ cv::Matx33d RotationHomography(const camera::Camera& first, const camera::Camera
   cv::Matx33d r0, rf;
   cv::eigen2cv(Eigen::Matrix3d(first.cam_from_world.rotation), r0);
   cv::eigen2cv(Eigen::Matrix3d(frame.cam_from_world.rotation), rf);
-  const cv::Matx33d k = IntrinsicMatrix(first);
+  const cv::Matx33d k = camera::IntrinsicMatrix(first);
   return k * r0 * rf.t() * k.inv();
 }
 

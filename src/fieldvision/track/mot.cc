@@ -324,6 +324,9 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
     const size_t before = est.size();
     std::erase_if(est, outside_gt);
     p.est_outside_gt_frames = static_cast<int>(before - est.size());
+    p.gt_first = first;
+    p.gt_last = last;
+    p.est_clipped = true;
   }
   if (!est.empty()) {
     const auto [lo, hi] =
@@ -344,7 +347,9 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
     p.gt_frames = static_cast<int>(frames.size());
     p.gt_frames_outside_est = static_cast<int>(frames_outside.size());
     p.gt_clipped = o.clip_to_est_frames;
-    p.ClipAsScored(gt);
+    if (p.gt_clipped) {
+      std::erase_if(gt, [&](const TrackRow& r) { return outside(r); });
+    }
   }
 }
 
@@ -578,9 +583,16 @@ void ScoreHota(const MotIndex& index, const MotIdCounts& c, MotMetrics& m) {
   m.assa = assa / kAlphas;
 }
 
-void MotPreprocessing::ClipAsScored(std::vector<TrackRow>& gt) const {
-  if (!gt_clipped) return;
-  std::erase_if(gt, [&](const TrackRow& r) { return r.frame < est_first || r.frame > est_last; });
+void MotPreprocessing::ClipAsScored(std::vector<TrackRow>& gt, std::vector<TrackRow>& est,
+                                    int frame_offset) const {
+  if (gt_clipped) {
+    std::erase_if(gt, [&](const TrackRow& r) { return r.frame < est_first || r.frame > est_last; });
+  }
+  if (est_clipped) {
+    std::erase_if(est, [&](const TrackRow& r) {
+      return r.frame + frame_offset < gt_first || r.frame + frame_offset > gt_last;
+    });
+  }
 }
 
 MotMetrics EvaluateMot(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>& est_in,

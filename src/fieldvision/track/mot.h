@@ -75,6 +75,8 @@ struct MotPreprocessing {
   int gt_ignored = 0;          // conf 0 or not a pedestrian (MOT17 rules)
   int est_on_distractors = 0;  // estimated boxes matched to a distractor (MOT17 rules)
   int est_outside_gt_frames = 0;
+  int gt_first = 0, gt_last = 0;  // the ground truth's frames when estimates outside were left out
+  bool est_clipped = false;
   // Ground-truth boxes in frames outside the estimate's first..last frame (est_first..est_last,
   // after frame_offset): left out with clip_to_est_frames, else counted as misses (Summary notes
   // it when over a tenth of the ground truth's frames lie outside: a clip of the video).
@@ -88,10 +90,11 @@ struct MotPreprocessing {
   int best_offset = 0;
   double iou_at_zero = 0, iou_at_best = 0;
   std::string Summary() const;
-  // Drops from `gt` the rows left out as outside the estimate's frames (with gt_clipped), so
-  // that what else is scored on the ground truth (field positions, the coach's numbers) covers
-  // the frames the metrics do.
-  void ClipAsScored(std::vector<TrackRow>& gt) const;
+  // Drops from `gt` the rows left out as outside the estimate's frames (with gt_clipped) and
+  // from `est` (its frames as in its file, `frame_offset` not yet added) those left out as outside
+  // the ground truth's (est_clipped), so that what else is scored on both (field positions, the
+  // coach's numbers) covers the frames the metrics do.
+  void ClipAsScored(std::vector<TrackRow>& gt, std::vector<TrackRow>& est, int frame_offset) const;
 };
 
 struct MotMetrics {

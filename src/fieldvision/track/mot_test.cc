@@ -66,13 +66,28 @@ TEST(Mot, AnEstimateOfAClipIsNotedOrScoredOverItsFrames) {
   EXPECT_THAT(scored.preprocessing.Summary(), ::testing::Not(HasSubstr("NOTE")));
   // What else is scored on the ground truth (eval tracks: positions, the coach's numbers) takes
   // the same frames; without the option all of them.
-  std::vector<TrackRow> as_scored = gt;
-  scored.preprocessing.ClipAsScored(as_scored);
+  std::vector<TrackRow> as_scored = gt, est_scored = clip;
+  scored.preprocessing.ClipAsScored(as_scored, est_scored, 0);
   EXPECT_EQ(as_scored.size(), 5u * 15);
   for (const auto& r : as_scored) EXPECT_TRUE(r.frame >= 5 && r.frame < 20) << r.frame;
+  EXPECT_EQ(est_scored.size(), clip.size());
   as_scored = gt;
-  whole.preprocessing.ClipAsScored(as_scored);
+  whole.preprocessing.ClipAsScored(as_scored, est_scored, 0);
   EXPECT_EQ(as_scored.size(), gt.size());
+  // And the estimate's rows outside the ground truth's frames (a ground truth of part of the
+  // video): the ground truth of frames 5..19 against tracks of all 50 frames, 1-based tracks
+  // scored with an offset of -1.
+  std::vector<TrackRow> shifted = gt;
+  for (auto& r : shifted) r.frame += 1;
+  MotOptions offset;
+  offset.frame_offset = -1;
+  const MotMetrics part = EvaluateMot(clip, shifted, offset);
+  EXPECT_DOUBLE_EQ(part.mota, 1.0);
+  std::vector<TrackRow> part_gt = clip, part_est = shifted;
+  part.preprocessing.ClipAsScored(part_gt, part_est, offset.frame_offset);
+  EXPECT_EQ(part_gt.size(), clip.size());
+  EXPECT_EQ(part_est.size(), 5u * 15);
+  for (const auto& r : part_est) EXPECT_TRUE(r.frame >= 6 && r.frame < 21) << r.frame;
   EXPECT_EQ(EvaluateMot(gt, gt, o).preprocessing.gt_outside_est_frames, 0);
   // A tracker's warm-up (nothing in the first 3 of 50 frames) is no clip: no note.
   std::vector<TrackRow> late;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
 #include "fieldvision/util/output_path.h"
@@ -77,12 +78,18 @@ ViewCanvas ReadMotionFile(const std::string& path, const camera::Camera* posed,
   lens.distortion = util::JsonNumbers(j, "distortion", ctx, false);
   lens.Check(ctx);
   if (posed != nullptr) {
-    FV_REQUIRE(SameLens(lens, *posed),
+    // players fitted the camera file to its video (an encoder's cropped padding): so is it here.
+    camera::Camera fitted = *posed;
+    if (camera::IsCroppedPadding(fitted, lens.width, lens.height)) {
+      fitted.width = lens.width;
+      fitted.height = lens.height;
+    }
+    FV_REQUIRE(SameLens(lens, fitted),
                "{}: the tracks were registered through another lens than {} ({}x{}, fx {:.6g} "
                "against {}x{}, fx {:.6g})",
                ctx, posed_what, lens.width, lens.height, lens.fx, posed->width, posed->height,
                posed->fx);
-    lens = *posed;
+    lens = fitted;
   }
   const double margin = util::JsonNumber(j, "canvas_margin", ctx);
   const nlohmann::json& frames = util::JsonArray(j, "first_from_frame", ctx);

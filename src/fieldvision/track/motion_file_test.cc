@@ -38,7 +38,7 @@ TEST(MotionFile, RoundTripAndLens) {
   for (int t = 0; t < 5; ++t) {
     cv::Matx33d q;
     cv::Rodrigues(cv::Vec3d(rng.Uniform(-0.05, 0.05), rng.Uniform(-0.3, 0.3), 0), q);
-    const cv::Matx33d k = IntrinsicMatrix(lens);
+    const cv::Matx33d k = camera::IntrinsicMatrix(lens);
     canvas.AddFrame(k * q * k.inv());
   }
   const std::string dir = fv::testing::TempDir();
@@ -59,6 +59,20 @@ TEST(MotionFile, RoundTripAndLens) {
   other.fx *= 1.01;
   EXPECT_THAT([&] { ReadMotionFile(MotionPathFor(tracks), &other); },
               ThrowsMessage<Error>(HasSubstr("registered through another lens")));
+  // Tracks of a 632 px wide video through a 640 px camera file (an encoder's padding, which
+  // players fitted away) are read with that camera file; 16 px more is another camera.
+  camera::Camera narrow = lens;
+  narrow.width = 632;
+  ViewCanvas narrow_canvas(narrow, 0.5);
+  narrow_canvas.AddFrame(cv::Matx33d::eye());
+  const std::string narrow_tracks = dir + "/NARROW.csv";
+  SaveMotionFor(narrow_tracks, &narrow_canvas);
+  const ViewCanvas fitted = ReadMotionFile(MotionPathFor(narrow_tracks), &lens);
+  EXPECT_EQ(fitted.lens().width, 632);
+  EXPECT_TRUE(fitted.camera().has_pose);
+  camera::Camera wider = lens;
+  wider.width = 656;
+  EXPECT_THROW(ReadMotionFile(MotionPathFor(narrow_tracks), &wider), Error);
   EXPECT_THAT(SaveMotionFor(tracks, nullptr), HasSubstr("removed"));
   EXPECT_FALSE(std::filesystem::exists(MotionPathFor(tracks)));
   EXPECT_EQ(SaveMotionFor(tracks, nullptr), "");

@@ -599,13 +599,14 @@ const cv::Mat& ToCanvas(CameraMotion& motion, const FootFilter& filter, const cv
   int beyond = 0;
   for (Detection d : dets) {
     d.box = canvas.BoxToCanvas(index, d.box);
+    const cv::Point2d foot(d.box.x + 0.5 * d.box.width, d.box.y + d.box.height);
+    const bool on_field = !filter || filter(foot);
     if (!FootInView(d.box, canvas.size())) {
-      ++beyond;
+      // Counted where the field filter keeps it, or where no canvas pixel holds it at all.
+      if (on_field || !std::isfinite(foot.x) || !std::isfinite(foot.y)) ++beyond;
       continue;
     }
-    if (!filter || filter({d.box.x + 0.5 * d.box.width, d.box.y + d.box.height})) {
-      kept.push_back(d);
-    }
+    if (on_field) kept.push_back(d);
   }
   dets = std::move(kept);
   if (beyond > 0) {
@@ -785,7 +786,7 @@ PlayersResult RunPlayers(const std::string& video, const camera::Camera* camera,
     fitted = *camera;
     camera_note = camera::FitCameraToFrames(
         *fitted, fmt::format("camera '{}'", camera->name.empty() ? "(unnamed)" : camera->name),
-        reader.size().width, reader.size().height, video);
+        reader.size().width, reader.size().height, fmt::format("video '{}'", video));
     camera = &*fitted;
   }
   // A moving camera's frames are tracked on its canvas, as the canvas's camera.

@@ -483,7 +483,7 @@ TEST(Players, SwayingCameraKeepsTheFieldPositions) {
   synth::SceneRenderer scene(spec);
   const camera::Camera cam = scene.cameras()[0];
   const field::FieldModel& field = scene.field();
-  const cv::Matx33d k = IntrinsicMatrix(cam);
+  const cv::Matx33d k = camera::IntrinsicMatrix(cam);
   std::filesystem::create_directories(dir + "/sway");
   std::vector<cv::Matx33d> sway;  // frame_from_first of each frame
   for (int t = 0; t < spec.num_frames; ++t) {

@@ -23,7 +23,7 @@ ViewCanvas::ViewCanvas(const camera::Camera& lens, double margin) : lens_(lens) 
   lens_.Check("moving camera's lens");
   FV_REQUIRE(std::isfinite(margin) && margin >= 0 && margin <= 10,
              "the canvas margin must be in [0, 10] image sizes (got {})", margin);
-  k_ = IntrinsicMatrix(lens_);
+  k_ = camera::IntrinsicMatrix(lens_);
   margin_ = margin;
   const double dx = std::round(margin * lens_.width), dy = std::round(margin * lens_.height);
   canvas_from_first_ = Shift(dx, dy);
@@ -136,8 +136,8 @@ cv::Rect ViewCanvas::Draw(int index, const cv::Mat& frame, cv::Mat& canvas) {
   const cv::Matx33d region_from_normalized =
       Shift(-drawn_.x, -drawn_.y) * CanvasFromFrame(index) * k_;
   cv::Mat map1, map2;
-  cv::initUndistortRectifyMap(k_, lens_.distortion, cv::noArray(), region_from_normalized,
-                              drawn_.size(), CV_32FC1, map1, map2);
+  cv::initUndistortRectifyMap(k_, camera::DistortionRow(lens_), cv::noArray(),
+                              region_from_normalized, drawn_.size(), CV_32FC1, map1, map2);
   cv::Mat region = canvas(drawn_);
   cv::remap(frame, region, map1, map2, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
   return drawn_;
@@ -146,7 +146,7 @@ cv::Rect ViewCanvas::Draw(int index, const cv::Mat& frame, cv::Mat& canvas) {
 const cv::Mat& ViewCanvas::UndistortedGrid() const {
   if (undistorted_grid_.empty()) {
     cv::Mat mx, my;
-    cv::initInverseRectificationMap(k_, lens_.distortion, cv::noArray(), k_,
+    cv::initInverseRectificationMap(k_, camera::DistortionRow(lens_), cv::noArray(), k_,
                                     cv::Size(lens_.width, lens_.height), CV_32FC1, mx, my);
     cv::merge(std::vector<cv::Mat>{mx, my}, undistorted_grid_);
   }

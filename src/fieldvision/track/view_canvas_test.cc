@@ -32,7 +32,7 @@ camera::Camera Lens() {
 camera::Camera Turned(const camera::Camera& lens, const cv::Vec3d& rvec, cv::Matx33d* first_from) {
   cv::Matx33d q;
   cv::Rodrigues(rvec, q);
-  const cv::Matx33d k = IntrinsicMatrix(lens);
+  const cv::Matx33d k = camera::IntrinsicMatrix(lens);
   *first_from = k * q.t() * k.inv();
   camera::Camera turned = lens;
   Eigen::Matrix3d qe;

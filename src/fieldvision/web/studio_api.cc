@@ -18,6 +18,7 @@
 #include "fieldvision/calib/intrinsics.h"
 #include "fieldvision/calib/lines.h"
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/detect/colour.h"
@@ -656,7 +657,10 @@ std::vector<Route> CalibrationRoutes() {
          const int frame = GetOr<int>(body, "frame", 0);
          if (frame < 0) throw HttpError(400, "frame must be >= 0");
          const cv::Mat bgr = detect::ReadVideoFrame(video.string(), frame);
-         calib::CheckImageSize(bgr, cam, video_path, camera_path);
+         // An encoder's cropped padding (camera/frame_size.h) is fitted and noted.
+         const std::string size_note =
+             camera::FitCameraToFrames(cam, fmt::format("camera file '{}'", camera_path), bgr.cols,
+                                       bgr.rows, fmt::format("video '{}'", video_path));
          const calib::RefineOptions options;
          const auto pixels = calib::DetectLinePixels(bgr, cam, field, options.detect);
          const calib::RefineResult res = calib::RefineWithLinePixels(cam, pixels, field, options);
@@ -679,6 +683,7 @@ std::vector<Route> CalibrationRoutes() {
                    {"summary", OneLine(res.Summary())},
                    {"wrote", json::array()}};
          j.update(ProjectField(res.camera, field));
+         if (!size_note.empty()) j["note"] = size_note;
          if (!out.empty() && res.accepted) {
            camera::WriteCameraYaml(res.camera, out.string());
            j["wrote"].push_back(ws.Relative(out));
