@@ -24,7 +24,7 @@ for y in "$SCENE"/cam*.yaml; do
 done
 
 echo
-echo "== 2. ball in 3D from ${#CAMS[@]} / 4 camera+video pairs: $FV ball ... --out $OUT/ball.csv"
+echo "== 2. ball in 3D from $(( ${#CAMS[@]} / 4 )) camera+video pairs: $FV ball ... --out $OUT/ball.csv"
 "$FV" ball "${CAMS[@]}" --field robocup-msl --out "$OUT/ball.csv" --truth "$SCENE/truth.csv"
 
 echo

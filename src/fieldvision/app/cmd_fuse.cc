@@ -77,9 +77,9 @@ void Setup(CLI::App& app, int& exit_code) {
                "reach --listen {}?)",
                o->out, o->listen);
     FV_REQUIRE(s.written,
-               "fuse: {} messages arrived but no frame could be fused (see the counts above), {} "
-               "not written",
-               s.messages, o->out);
+               "fuse: {} messages arrived but no frame could be fused (see the counts above: "
+               "{} frames, none with two cameras or a position), {} not written",
+               s.messages, s.groups, o->out);
     std::cout << "wrote " << o->out << " (" << s.rows_written << " rows)\n";
   });
 }

@@ -365,6 +365,7 @@ FuseSummary::LatencyParts FuseServer::LatencyPartsOf(const pipeline::SyncedFrame
 void FuseServer::Emit(const pipeline::SyncedFrame& group) {
   const pipeline::BallFrame f = fusion_->Fuse(group);
   ++summary_.groups;
+  summary_.paired_groups += group.present() >= 2;
   // Capture to decision, for every frame fused (with a position or not).
   const double decided_s = io::SystemClockNow();
   const double latency_s = clock_kind_ == "system" ? decided_s - group.time_s : 0.0;
@@ -643,9 +644,9 @@ FuseSummary FuseServer::Run() {
     PublishFlights();
   }
   csv_ = nullptr;
-  // Without a single frame (nodes pointed elsewhere, stopped before any came) an earlier file
-  // stays as it was.
-  summary_.written = summary_.groups > 0;
+  // Without a single frame fused (nodes pointed elsewhere, stopped before any came, or only one
+  // camera delivered and gave no position) an earlier file stays as it was.
+  summary_.written = summary_.rows_written > 0 || summary_.paired_groups > 0;
   if (summary_.written) out_file.CloseAndCommit(csv);
   summary_.fusion = fusion_->stats();
   summary_.sync = sync_->stats();

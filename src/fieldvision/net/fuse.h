@@ -70,6 +70,7 @@ struct FuseSummary {
   std::vector<pipeline::LiveCameraStats> sync;
   std::vector<std::string> sync_problems;
   long long groups = 0;
+  long long paired_groups = 0;  // of those, frames that two or more cameras delivered
   pipeline::FusionStats fusion;
   long long rows_written = 0;
   bool written = false;  // --out was written: false when no frame arrived (it is left as it was)

@@ -489,6 +489,7 @@ TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   fo.cameras = {WriteTinyCamera(dir, "cam1"), WriteTinyCamera(dir, "cam2", 5)};
   fo.listen = "tcp://127.0.0.1:*";
   fo.out = dir + "/ball.csv";
+  std::ofstream(fo.out) << "an earlier run's BALL.csv\n";
   fo.idle_exit_s = 0;  // stopped after the pongs below: no wall-clock limit on a loaded machine
   pipeline::JobControl control;
   fo.control = &control;
@@ -540,6 +541,14 @@ TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   EXPECT_EQ(fused.sync[0].restarts, 0);
   EXPECT_EQ(fused.cameras[1].frames, 0);
   EXPECT_EQ(fused.cameras[1].refused, 6);  // its hello and frames
+  // cam1's frames alone, no position: nothing fused, the earlier BALL.csv kept (fuse fails).
+  EXPECT_GT(fused.groups, 0);
+  EXPECT_EQ(fused.paired_groups, 0);
+  EXPECT_FALSE(fused.written);
+  std::ifstream kept(fo.out);
+  std::string line;
+  std::getline(kept, line);
+  EXPECT_EQ(line, "an earlier run's BALL.csv");
 }
 
 // Synth cameras on the world's clock: node 2 is stopped and started again (a new session) and

@@ -156,6 +156,9 @@ camera::Camera MakeAimedCamera(const std::string& name, int width, int height, d
 
 Rig RigFromJson(const json& j, const std::string& context, const std::string& base_dir) {
   FV_REQUIRE(j.is_object(), "{}: the rig must be a JSON object with key 'cameras'", context);
+  FV_REQUIRE(!j.contains("mounts"),
+             "{}: a file of mounting places, not a rig: give it to plan --optimize --mounts",
+             context);
   for (auto it = j.begin(); it != j.end(); ++it) {
     FV_REQUIRE(it.key() == "name" || it.key() == "cameras" || it.key() == "defaults" ||
                    it.key() == "field" || it.key() == "description" || it.key() == "score",

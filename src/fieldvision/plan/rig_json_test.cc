@@ -125,6 +125,11 @@ TEST(RigTest, BadInputGivesOneLineErrors) {
                         RigFromJson({{"cameras", json::array()}}, "r.json", "");
                       }),
                       {"r.json", "no cameras"});
+  // A mounts file (plan --optimize --mounts) given as a rig says where it goes.
+  ExpectOneLineNaming(ErrorOf([&] {
+                        RigFromJson({{"mounts", json::array()}}, "m.json", "");
+                      }),
+                      {"m.json", "--optimize --mounts"});
   // Missing key, named with the camera's index.
   ExpectOneLineNaming(ErrorOf([&] {
                         RigFromJson(
