@@ -191,6 +191,14 @@ std::vector<NodeSummary> RunLoopback(const Scene& scene, FuseOptions& fo, double
   return nodes;
 }
 
+// The first line of a file ("" when it cannot be read).
+std::string FirstLine(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
 TEST(NodeFuse, LoopbackMatchesOfflineBallWithAClockOff) {
   const uint64_t seed = testing::TestSeed(3);
   FV_SEED_TRACE(seed);
@@ -434,10 +442,7 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   EXPECT_EQ(fused.unsynced, 1);
   // Not one frame was fused: an earlier file is left as it was.
   EXPECT_FALSE(fused.written);
-  std::ifstream kept(fo.out);
-  std::string line;
-  std::getline(kept, line);
-  EXPECT_EQ(line, "an earlier run's rows");
+  EXPECT_EQ(FirstLine(fo.out), "an earlier run's rows");
 }
 
 // Times are taken from the video, never assumed: a node refuses an image sequence (no frame rate
@@ -545,10 +550,7 @@ TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   EXPECT_GT(fused.groups, 0);
   EXPECT_EQ(fused.paired_groups, 0);
   EXPECT_FALSE(fused.written);
-  std::ifstream kept(fo.out);
-  std::string line;
-  std::getline(kept, line);
-  EXPECT_EQ(line, "an earlier run's BALL.csv");
+  EXPECT_EQ(FirstLine(fo.out), "an earlier run's BALL.csv");
 }
 
 // Synth cameras on the world's clock: node 2 is stopped and started again (a new session) and
