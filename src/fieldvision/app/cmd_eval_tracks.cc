@@ -17,6 +17,7 @@
 #include "fieldvision/track/motion_file.h"
 #include "fieldvision/track/pets.h"
 #include "fieldvision/track/position_eval.h"
+#include "fieldvision/track/synth_truth.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/output_path.h"
 #include "fieldvision/util/strings.h"
@@ -25,7 +26,7 @@ namespace fv::app {
 namespace {
 
 struct EvalTracksCli {
-  std::string gt, est, json, camera;
+  std::string gt, est, json, camera, gt_cam;
   double foot_offset_m = track::TrackerOptions{}.foot_offset_m;
   track::MotOptions o;
 };
@@ -37,8 +38,10 @@ bool AnyPosition(const std::vector<track::TrackRow>& rows) {
   return false;
 }
 
-std::vector<track::TrackRow> ReadGt(const std::string& path) {
+std::vector<track::TrackRow> ReadGt(const std::string& path, const std::string& cam) {
   if (util::EndsWith(util::ToLower(path), ".xml")) return track::ReadPetsCvml(path);
+  if (track::IsSynthPeopleTruth(path)) return track::ReadSynthPeopleTruth(path, cam);
+  FV_REQUIRE(cam.empty(), "--gt-cam is for synth's players_2d.csv; '{}' is not one", path);
   return track::ReadTracksCsv(path);
 }
 
@@ -116,7 +119,7 @@ std::optional<CoachNumbers> CompareCoachNumbers(const std::vector<track::TrackRo
 }
 
 void RunEvalTracks(const EvalTracksCli& c) {
-  const auto gt = ReadGt(c.gt);
+  const auto gt = ReadGt(c.gt, c.gt_cam);
   const auto est = track::ReadTracksCsv(c.est);
   // Nothing to score is an error, not a table of zeros.
   FV_REQUIRE(!gt.empty(), "ground truth '{}' has no boxes", c.gt);
@@ -182,9 +185,13 @@ void Setup(CLI::App& app, int& exit_code) {
   CLI::App* cmd = group->add_subcommand(
       "tracks", "MOTA, MOTP, IDF1 and HOTA of player tracks against ground truth (MOTChallenge)");
   cmd->add_option("--gt", c->gt,
-                  "Ground truth: MOT gt.txt (MOT17 rules applied), TRACKS.csv, or a PETS CVML .xml "
-                  "(frames numbered from 1)")
+                  "Ground truth: MOT gt.txt (MOT17 rules applied), TRACKS.csv, a PETS CVML .xml "
+                  "(frames numbered from 1), or synth's players_2d.csv (people at least 20 % "
+                  "visible, positions from players.csv beside it)")
       ->required();
+  cmd->add_option("--gt-cam", c->gt_cam,
+                  "With synth's players_2d.csv of several cameras: the camera whose truth is "
+                  "scored");
   cmd->add_option("--est", c->est, "Estimated TRACKS.csv or MOTChallenge results file")->required();
   cmd->add_option("--iou", c->o.iou_threshold, "IoU needed for a match (MOTChallenge: 0.5)")
       ->check(FiniteRange(1e-6, 1));

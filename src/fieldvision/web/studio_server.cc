@@ -6,6 +6,7 @@
 #include <atomic>
 #include <csignal>
 #include <filesystem>
+#include <memory>
 #include <ostream>
 #include <random>
 #include <thread>
@@ -47,6 +48,10 @@ namespace {
 
 // Longest life of one event stream, seconds (see /api/events).
 constexpr int kStreamS = 60;
+// Server threads, and how many of them event streams may hold at once: the rest answer requests
+// (16 streams held every thread, and the pages' requests waited until a stream ended).
+constexpr int kThreads = 16;
+constexpr int kMaxStreams = 8;
 
 // The front end as built in the source tree, else as installed (share/fieldvision/studio).
 fs::path DefaultAssetsDir() {
@@ -96,6 +101,7 @@ struct StudioServer::Impl {
   httplib::Server server;
   std::thread thread;
   std::atomic<bool> loop_ended{false};
+  std::shared_ptr<std::atomic<int>> streams = std::make_shared<std::atomic<int>>(0);
   int port = -1;
   bool token_required = false;
   bool assets_built = false;
@@ -133,6 +139,16 @@ struct StudioServer::Impl {
   void AddEventStream() {
     server.Get("/api/events", [this](const httplib::Request& req, httplib::Response& res) {
       if (Refused(req, res)) return;
+      if (streams->fetch_add(1) >= kMaxStreams) {
+        streams->fetch_sub(1);
+        return Send(res,
+                    {503, "application/json",
+                     fmt::format(R"j({{"error":"{} event streams are open (studio tabs): close )j"
+                                 R"j(one and reload"}})j",
+                                 kMaxStreams)});
+      }
+      // Held until the response (and its provider) is destroyed: the stream's end.
+      auto slot = std::shared_ptr<void>(nullptr, [count = streams](void*) { count->fetch_sub(1); });
       auto cursor = std::make_shared<uint64_t>(events.Last());
       // Resume after the last event the client had (EventSource's reconnect, or ?since=).
       const std::string since = req.has_header("Last-Event-ID")
@@ -146,7 +162,7 @@ struct StudioServer::Impl {
       const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(kStreamS);
       res.set_header("Cache-Control", "no-store");
       res.set_chunked_content_provider(
-          "text/event-stream", [this, cursor, first, end](size_t, httplib::DataSink& sink) {
+          "text/event-stream", [this, cursor, first, end, slot](size_t, httplib::DataSink& sink) {
             std::string out;
             if (*first) {
               *first = false;
@@ -207,7 +223,7 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   if (m.token_required && m.options.token.empty()) m.options.token = RandomToken();
 
   httplib::Server& s = m.server;
-  s.new_task_queue = [] { return new httplib::ThreadPool(16); };
+  s.new_task_queue = [] { return new httplib::ThreadPool(kThreads); };
   s.set_payload_max_length(32 << 20);
   s.set_read_timeout(10);
   // SO_REUSEADDR only: httplib's default SO_REUSEPORT would let a second studio share the port.

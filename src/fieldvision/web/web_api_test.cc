@@ -1016,6 +1016,57 @@ TEST_F(StudioApiTest, EventsStreamResumesAfterTheLastEventAndRefusesForeignHosts
   }
 }
 
+// Event streams (one per studio tab) may hold half the server's threads: with eight open a ninth
+// is refused with a one-line 503 and requests are still answered (sixteen held every thread and
+// the pages' requests waited); a stream that ends gives its place back.
+TEST_F(StudioApiTest, EventStreamsLeaveThreadsForRequests) {
+  FV_SEED_TRACE(seed_);
+  constexpr int kStreams = 8;
+  std::atomic<bool> stop{false};
+  std::atomic<int> opened{0};
+  std::vector<std::thread> tabs;
+  for (int i = 0; i < kStreams; ++i) {
+    tabs.emplace_back([&] {
+      httplib::Client stream("127.0.0.1", port_);
+      stream.set_read_timeout(30);
+      bool counted = false;
+      stream.Get("/api/events", [&](const char*, size_t) {
+        if (!counted) ++opened, counted = true;
+        return !stop.load();
+      });
+    });
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (opened.load() < kStreams && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(opened.load(), kStreams);
+  ExpectError(Get("/api/events"), 503, "event streams are open");
+  EXPECT_EQ(Get("/api/info").status, 200);
+  // The streams end at their next event; their places come back.
+  stop = true;
+  const Reply saved =
+      Post("/api/colour/save",
+           json{{"range", {{"min", {0, 50, 50}}, {"max", {30, 255, 255}}}}, {"out", "c.json"}});
+  ASSERT_EQ(saved.status, 200) << saved.body;
+  for (std::thread& t : tabs) t.join();
+  int status = 0;
+  while (status != 200 && std::chrono::steady_clock::now() < deadline + std::chrono::seconds(15)) {
+    httplib::Client again("127.0.0.1", port_);
+    again.set_read_timeout(5);
+    // The status from the response's head; the stream itself is not read.
+    again.Get(
+        "/api/events",
+        [&](const httplib::Response& res) {
+          status = res.status;
+          return false;
+        },
+        [](const char*, size_t) { return false; });
+    if (status != 200) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  EXPECT_EQ(status, 200);
+}
+
 TEST_F(StudioApiTest, TokenRequiredOffLoopback) {
   FV_SEED_TRACE(seed_);
   EXPECT_TRUE(IsLoopback("127.0.0.1"));
