@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/net/endpoint.h"
 #include "fieldvision/util/error.h"
 
 namespace fv::app {
@@ -90,25 +91,8 @@ CLI::Validator Seed() {
 }
 
 CLI::Validator Endpoint(bool bind) {
-  return CLI::Validator(
-      [bind](std::string& text) {
-        std::string bad = fmt::format("'{}' is not tcp://HOST:PORT (PORT 1..65535{}) or ipc://PATH",
-                                      text, bind ? ", or * or 0 for a free one" : "");
-        if (text.rfind("ipc://", 0) == 0) return text.size() > 6 ? std::string() : bad;
-        if (text.rfind("tcp://", 0) != 0) return bad;
-        const std::string rest = text.substr(6);
-        const size_t colon = rest.rfind(':');
-        if (colon == std::string::npos || colon == 0) return bad;
-        const std::string port = rest.substr(colon + 1);
-        if (bind && port == "*") return std::string();
-        if (port.empty() || port.size() > 5 ||
-            port.find_first_not_of("0123456789") != std::string::npos) {
-          return bad;
-        }
-        const int p = std::stoi(port);
-        return (p >= 1 || (bind && p == 0)) && p <= 65535 ? std::string() : bad;
-      },
-      "tcp://HOST:PORT");
+  return CLI::Validator([bind](std::string& text) { return net::EndpointProblem(text, bind); },
+                        "tcp://HOST:PORT");
 }
 
 }  // namespace fv::app

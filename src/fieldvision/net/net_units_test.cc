@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/net/clock_sync.h"
+#include "fieldvision/net/endpoint.h"
 #include "fieldvision/net/fuse.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/util/random.h"
@@ -18,6 +19,19 @@ MessageError::Reason ReasonOf(const std::string& bytes) {
   }
   ADD_FAILURE() << "accepted: " << bytes;
   return MessageError::Reason::kMalformed;
+}
+
+TEST(Endpoint, AddressesAsTheCommandsTakeThem) {
+  EXPECT_EQ(EndpointProblem("tcp://127.0.0.1:8480", false), "");
+  EXPECT_EQ(EndpointProblem("tcp://[::1]:8480", false), "");
+  EXPECT_EQ(EndpointProblem("ipc:///tmp/fuse", false), "");
+  EXPECT_EQ(EndpointProblem("tcp://127.0.0.1:*", true), "");
+  EXPECT_EQ(EndpointProblem("tcp://127.0.0.1:0", true), "");
+  for (const char* bad : {"tcp://127.0.0.1:*", "tcp://127.0.0.1:0", "tcp://h:65536",
+                          "tcp://h:99999", "tcp://:80", "tcp://h", "udp://h:80", "ipc://", ""}) {
+    EXPECT_NE(EndpointProblem(bad, false), "") << bad;
+  }
+  EXPECT_NE(EndpointProblem("tcp://h:99999", false).find("'tcp://h:99999'"), std::string::npos);
 }
 
 TEST(Messages, FrameRoundTripsExactly) {

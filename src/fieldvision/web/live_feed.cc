@@ -5,6 +5,7 @@
 
 #include <zmq.hpp>
 
+#include "fieldvision/net/endpoint.h"
 #include "fieldvision/net/messages.h"
 #include "fieldvision/web/workspace.h"
 
@@ -19,12 +20,15 @@ LiveFeed::LiveFeed(EventHub* events)
 LiveFeed::~LiveFeed() { Stop(); }
 
 void LiveFeed::Start(const std::string& endpoint) {
-  static const std::regex kEndpoint(
+  // The host as a name or address only (the page's text reaches ZeroMQ's connect).
+  static const std::regex kTcp(
       R"(tcp://[A-Za-z0-9.\-]+:[0-9]{1,5}|tcp://\[[0-9A-Fa-f:]+\]:[0-9]{1,5})");
-  if (endpoint.size() > 200 || !std::regex_match(endpoint, kEndpoint)) {
-    throw HttpError(400,
-                    "live endpoint must be tcp://HOST:PORT (the fusion node's --publish), got '" +
-                        endpoint.substr(0, 200) + "'");
+  const std::string problem = net::EndpointProblem(endpoint, /*bind=*/false);
+  if (endpoint.size() > 200 || !problem.empty() || !std::regex_match(endpoint, kTcp)) {
+    throw HttpError(
+        400, "live endpoint (the fusion node's --publish): " +
+                 (problem.empty() ? "'" + endpoint.substr(0, 200) + "' is not tcp://HOST:PORT"
+                                  : problem));
   }
   std::lock_guard<std::mutex> control(control_);
   StopLocked();

@@ -527,6 +527,9 @@ TEST_F(StudioApiTest, LivePositionsFromAFusionNodeArriveAsEvents) {
 
   ExpectError(Post("/api/live/start", json{{"endpoint", "ipc:///etc/passwd"}}), 400, "tcp://");
   ExpectError(Post("/api/live/start", json{{"endpoint", "tcp://127.0.0.1"}}), 400, "tcp://");
+  // As the commands' --connect: a port past 65535 is no address (it was accepted, "running").
+  ExpectError(Post("/api/live/start", json{{"endpoint", "tcp://256.1.1.1:99999"}}), 400,
+              "PORT 1..65535");
   ExpectError(Post("/api/live/start", json::object()), 400, "endpoint");
   EXPECT_EQ(Get("/api/live").j()["state"], "idle");
 
