@@ -5,9 +5,8 @@
 namespace fv::net {
 
 std::string EndpointProblem(const std::string& text, bool bind) {
-  const std::string bad =
-      fmt::format("'{}' is not tcp://HOST:PORT (PORT 1..65535{}) or ipc://PATH",
-                  text.substr(0, 200), bind ? ", or * or 0 for a free one" : "");
+  std::string bad = fmt::format("'{}' is not tcp://HOST:PORT (PORT 1..65535{}) or ipc://PATH",
+                                text.substr(0, 200), bind ? ", or * or 0 for a free one" : "");
   if (text.rfind("ipc://", 0) == 0) return text.size() > 6 ? std::string() : bad;
   if (text.rfind("tcp://", 0) != 0) return bad;
   const std::string rest = text.substr(6);
