@@ -14,10 +14,12 @@ void ViewDriftOptions::Check() const {
 
 std::string ViewDriftStats::Summary() const {
   if (checked == 0) return "view: not checked";
+  // The frame of the largest move only where there was one (0.0 px at "frame 151" read oddly).
   return fmt::format(
       "view: {} frames registered to the first ({} matched to none), its centre moved up to "
-      "{:.1f} px (frame {})",
-      checked, unmatched, max_shift_px, max_frame + 1);
+      "{:.1f} px{}",
+      checked, unmatched, max_shift_px,
+      max_shift_px >= 0.05 ? fmt::format(" (frame {})", max_frame + 1) : "");
 }
 
 ViewDrift::ViewDrift(const ViewDriftOptions& options) : options_(options) { options_.Check(); }

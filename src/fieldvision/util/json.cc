@@ -62,10 +62,17 @@ json ReadJsonFile(const std::string& path, const std::string& what) {
   } catch (const json::parse_error& e) {
     Throw("{} file '{}' is not valid JSON (byte {})", what, path, e.byte);
   } catch (const json::exception& e) {
-    // e.g. a number too large for a double; drop nlohmann's "[json.exception...] " prefix.
-    const std::string message = e.what();
-    Throw("{} file '{}' is not valid JSON: {}", what, path, message.substr(message.find("] ") + 2));
+    // e.g. a number too large for a double.
+    Throw("{} file '{}' is not valid JSON: {}", what, path, JsonErrorText(e));
   }
+}
+
+std::string JsonErrorText(const json::exception& e) {
+  const std::string message = e.what();
+  const size_t end = message.find("] ");
+  return message.rfind("[json.exception.", 0) == 0 && end != std::string::npos
+             ? message.substr(end + 2)
+             : message;
 }
 
 std::string JsonPath(const std::string& ctx, const std::string& key) {

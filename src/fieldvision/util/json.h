@@ -17,6 +17,8 @@ namespace fv::util {
 // The JSON in the file at `path`; `what` names the file in errors ("rig file 'x' does not exist",
 // "... cannot be read", "... is not valid JSON (byte n)", "... nests deeper than ...").
 nlohmann::json ReadJsonFile(const std::string& path, const std::string& what);
+// nlohmann's message without its "[json.exception.NAME.ID] " prefix.
+std::string JsonErrorText(const nlohmann::json::exception& e);
 
 // nlohmann's parser is iterative, but copying and dumping a value recurse: a value nested a
 // million levels deep overflows the stack there. Readers of untrusted JSON (HTTP bodies, files)

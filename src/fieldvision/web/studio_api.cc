@@ -79,8 +79,8 @@ json Body(const ApiRequest& r) {
     json j = json::parse(r.body);
     if (!j.is_object()) throw HttpError(400, "request body is not a JSON object");
     return j;
-  } catch (const json::parse_error& e) {
-    throw HttpError(400, "malformed JSON: " + std::string(e.what()));
+  } catch (const json::exception& e) {  // a syntax error, a number too large for a double
+    throw HttpError(400, "malformed JSON: " + util::JsonErrorText(e));
   }
 }
 

@@ -13,9 +13,11 @@
 
 #include <fmt/format.h>
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/program_paths.h"
+#include "fieldvision/util/strings.h"
 #include "fieldvision/web/studio_api.h"
 
 #ifndef FV_STUDIO_DIST
@@ -233,6 +235,16 @@ StudioServer::StudioServer(const StudioOptions& options) : impl_(std::make_uniqu
   });
   m.AddEventStream();
   m.AddApi();
+  // Errors httplib answers itself (a page or file that is not there, a bad request line) get
+  // one line saying what, as the API's do, instead of an empty body.
+  s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return;
+    const std::string path = util::Shown(req.path);
+    const nlohmann::json error = {{"error", res.status == 404
+                                                ? fmt::format("not found: {}", path)
+                                                : fmt::format("HTTP {} for {}", res.status, path)}};
+    res.set_content(error.dump(), "application/json");
+  });
   if (m.assets_built) {
     s.set_mount_point("/", m.options.assets);
   } else {

@@ -171,6 +171,7 @@ TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
   EXPECT_EQ(kinds["buildings/a.png"], "image");
   EXPECT_EQ(kinds.count("cmake-out/b.png"), 0u);
   ExpectError(Get("/api/nothing"), 404, "unknown endpoint");
+  ExpectError(Get("/nothing.html"), 404, "not found: /nothing.html");
   ExpectError(Post("/api/info", json::object()), 405, "not allowed");
   for (const auto& r :
        {client_->Put("/api/zones/save", "{}", "application/json"),
@@ -290,6 +291,10 @@ TEST_F(StudioApiTest, EveryEndpointRefusesBadFilesAndMalformedJson) {
     if (e.method != "POST") continue;
     SCOPED_TRACE(e.path);
     ExpectError(Post(e.path, std::string("{\"out\": ")), 400, "malformed JSON");
+    // A number too large for a double: the same, without nlohmann's "[json.exception..." tag.
+    const Reply huge = Post(e.path, std::string("{\"frame\": 1e400}"));
+    ExpectError(huge, 400, "malformed JSON");
+    EXPECT_EQ(huge.body.find("json.exception"), std::string::npos) << huge.body;
     // Nested a million levels deep: copying or dumping it would overflow the server's stack.
     const std::string deep =
         "{\"zones\": " + std::string(1000000, '[') + std::string(1000000, ']') + "}";
