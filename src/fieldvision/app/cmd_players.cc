@@ -122,13 +122,16 @@ void AddDrawOptions(CLI::App* cmd, PlayersCli& c) {
 void AddTrackingPassOptions(CLI::App* cmd, PlayersCli& c) {
   cmd->add_option("--interpolate", c.o.interpolate_max_gap,
                   "Fill track gaps up to this many frames (0: off)")
-      ->check(FiniteRange(0, 100000));
+      ->check(FiniteRange(0, 100000))
+      ->capture_default_str();
   cmd->add_option("--stitch-gap", c.o.stitch.max_gap_s,
                   "Join tracklets of one person across gaps up to this many seconds (0: off)")
-      ->check(FiniteRange(0, 3600));
+      ->check(FiniteRange(0, 3600))
+      ->capture_default_str();
   cmd->add_option("--stitch-appearance", c.o.stitch.max_appearance_distance,
                   "Largest torso-colour distance (Bhattacharyya, 0..1) for joining tracklets")
-      ->check(FiniteRange(0, 1));
+      ->check(FiniteRange(0, 1))
+      ->capture_default_str();
   cmd->add_option("--smooth-accel", c.o.smooth.accel_sigma_mps2,
                   "Field-position smoothing (Kalman + RTS): players' acceleration sigma in m/s^2 "
                   "(smaller: smoother)")
@@ -183,7 +186,8 @@ void Setup(CLI::App& app, int& exit_code) {
                   "Field (built-in name or JSON): keep only people on it plus --margin");
   CLI::Option* margin =
       cmd->add_option("--margin", c->o.field_margin_m, "Metres around the field still accepted")
-          ->check(FiniteRange(0, 100));
+          ->check(FiniteRange(0, 100))
+          ->capture_default_str();
   cmd->add_option("--detector", c->o.detector.kind, "nanodet (default), hog, motion or onnx")
       ->check(CLI::IsMember({"nanodet", "hog", "motion", "onnx"}));
   cmd->add_option("--onnx", c->onnx, "A YOLO-style ONNX model of your own (sets --detector onnx)");
@@ -196,12 +200,15 @@ void Setup(CLI::App& app, int& exit_code) {
                   "NanoDet model (default: BUILD/models/nanodet.onnx from make build)");
   cmd->add_option("--input-width", c->o.detector.input_width,
                   "Network input width in pixels (multiple of 32; smaller is faster)")
-      ->check(NetworkWidth());
+      ->check(NetworkWidth())
+      ->capture_default_str();
   cmd->add_option("--score", c->o.detector.score_threshold, "Lowest detection score kept")
-      ->check(FiniteRange(0, 1));
+      ->check(FiniteRange(0, 1))
+      ->capture_default_str();
   cmd->add_option("--min-height", c->o.detector.min_height_px,
                   "Ignore people shorter than this in pixels (far outside the area of interest)")
-      ->check(FiniteRange(0, 100000));
+      ->check(FiniteRange(0, 100000))
+      ->capture_default_str();
   cmd->add_option("--threads", c->o.detector.threads, "OpenCV threads (0: all cores)")
       ->check(FiniteRange(0, 256));
   cmd->add_option("--sot", c->o.tracker.sot,
@@ -209,7 +216,8 @@ void Setup(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"none", "csrt", "kcf", "mosse"}));
   cmd->add_option("--max-lost", c->o.tracker.max_lost_frames,
                   "Frames a lost track is kept to be re-found")
-      ->check(FiniteRange(0, 100000));
+      ->check(FiniteRange(0, 100000))
+      ->capture_default_str();
   cmd->add_option("--max-frames", c->o.max_frames, "Process at most this many frames (0: all)")
       ->check(FiniteRange(0, 1e9));
   cmd->add_option("--fps", c->o.fps,

@@ -32,7 +32,7 @@ void TrajectoryJob::Check() const {
 
 std::string FlightTable(const TrajectoryResult& r) {
   std::string s = fmt::format(
-      "{:>3} {:>14} {:>8} {:>8} {:>23} {:>23} {:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>20}\n", "#",
+      "{:>3} {:>21} {:>8} {:>8} {:>23} {:>23} {:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>20}\n", "#",
       "events", "t0_s", "t1_s", "origin_m", "landing_m", "apex_m", "v0_mps", "model", "grav_mm",
       "drag_mm", "spin_mm", "spin rev/s (axis)");
   auto mm = [](const BallisticFit& b) {
@@ -46,7 +46,7 @@ std::string FlightTable(const TrajectoryResult& r) {
                          w.z());
     }
     s += fmt::format(
-        "{:>3} {:>14} {:8.3f} {:8.3f} {:>23} {:>23} {:7.2f} {:7.2f} {:>7} {:>8} {:>8} {:>8} "
+        "{:>3} {:>21} {:8.3f} {:8.3f} {:>23} {:>23} {:7.2f} {:7.2f} {:>7} {:>8} {:>8} {:>8} "
         "{:>20}\n",
         f.index, fmt::format("{}>{}", FlightEventName(f.start_event), FlightEventName(f.end_event)),
         f.t_start_s, f.t_end_s,
@@ -57,7 +57,9 @@ std::string FlightTable(const TrajectoryResult& r) {
         f.apex_m.z(), f.speed_mps, FlightModelName(f.model_kind()), mm(f.no_drag), mm(f.with_drag),
         mm(f.with_spin), spin);
   }
-  s += "* extrapolated: the model's value beyond the samples seen (not measured)\n";
+  s += "* extrapolated: the model's value beyond the samples seen (not measured); grav_mm, "
+       "drag_mm, spin_mm: RMS residual of the fit with gravity alone, with drag, with drag and "
+       "spin ('model' is the one kept)\n";
   return s;
 }
 

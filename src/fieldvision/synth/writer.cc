@@ -40,11 +40,16 @@ double MjpegWriterQuality(int jpeg_quality) {
 }  // namespace
 
 std::string WriteSceneResult::Summary() const {
+  // One camera (the players scene) triangulates nothing: no count of the ball's 3D frames.
   return fmt::format(
-      "{} cameras x {} frames in {:.1f} s ({:.1f} frames/s over all cameras; set-up {:.1f} s); "
-      "ball seen by >= 2 cameras in {} frames; {} files in {}",
-      num_cameras, num_frames, seconds, seconds > 0 ? num_cameras * num_frames / seconds : 0.0,
-      setup_seconds, frames_with_ball_in_2plus_cams, files.size(), out_dir);
+      "{} camera{} x {} frames in {:.1f} s ({:.1f} frames/s over all cameras; set-up {:.1f} s); "
+      "{}{} files in {}",
+      num_cameras, num_cameras == 1 ? "" : "s", num_frames, seconds,
+      seconds > 0 ? num_cameras * num_frames / seconds : 0.0, setup_seconds,
+      num_cameras >= 2
+          ? fmt::format("ball seen by >= 2 cameras in {} frames; ", frames_with_ball_in_2plus_cams)
+          : "",
+      files.size(), out_dir);
 }
 
 cv::Mat ContactSheet(const std::vector<cv::Mat>& images, const std::vector<std::string>& names,
