@@ -167,19 +167,23 @@ void AddFlightEvents(const TrajectoryResult& result, std::vector<TimelineEvent>*
                        f.index, what, p.x(), p.y(), p.z(),
                        f.model().VelocityAt(f.t_first_seen_s).norm(), f.apex_m.z(),
                        f.t_first_seen_s - f.t_start_s, f.origin_m.x(), f.origin_m.y(),
-                       f.origin_m.z())});
+                       f.origin_m.z()),
+           f.index});
     } else {
-      timeline->push_back(
-          {f.t_start_s, fmt::format("flight {}: {} at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, "
-                                    "apex {:.2f} m, flight time {:.2f} s",
-                                    f.index, what, f.origin_m.x(), f.origin_m.y(), f.origin_m.z(),
-                                    f.speed_mps, f.apex_m.z(), f.FlightTime())});
+      timeline->push_back({f.t_start_s,
+                           fmt::format("flight {}: {} at ({:.2f}, {:.2f}, {:.2f}) m, {:.1f} m/s, "
+                                       "apex {:.2f} m, flight time {:.2f} s",
+                                       f.index, what, f.origin_m.x(), f.origin_m.y(),
+                                       f.origin_m.z(), f.speed_mps, f.apex_m.z(), f.FlightTime()),
+                           f.index});
     }
     if (f.end_event == FlightEvent::kHit) {
-      timeline->push_back({f.t_end_s, fmt::format("flight {}: hit at ({:.2f}, {:.2f}, {:.2f}) m",
-                                                  f.index, f.model().PositionAt(f.t_end_s).x(),
-                                                  f.model().PositionAt(f.t_end_s).y(),
-                                                  f.model().PositionAt(f.t_end_s).z())});
+      timeline->push_back(
+          {f.t_end_s,
+           fmt::format("flight {}: hit at ({:.2f}, {:.2f}, {:.2f}) m", f.index,
+                       f.model().PositionAt(f.t_end_s).x(), f.model().PositionAt(f.t_end_s).y(),
+                       f.model().PositionAt(f.t_end_s).z()),
+           f.index});
     }
   }
 }
@@ -326,13 +330,15 @@ Decisions MakeDecisions(const std::vector<BallSample>& track, const TrajectoryRe
                        c.extrapolated ? "would land" : "lands", c.point_m.x(), c.point_m.y(),
                        c.against == "playing area" ? (c.in ? "IN" : "OUT")
                                                    : (c.in ? "TOUCHES" : "CLEAR OF"),
-                       c.against, std::abs(c.margin_m))});
+                       c.against, std::abs(c.margin_m)),
+           c.flight});
     }
     ScanGoalsAndShots(track, result, *field, r, d, &out);
   }
-  std::stable_sort(
-      out.timeline.begin(), out.timeline.end(),
-      [](const TimelineEvent& a, const TimelineEvent& b) { return a.time_s < b.time_s; });
+  std::stable_sort(out.timeline.begin(), out.timeline.end(),
+                   [](const TimelineEvent& a, const TimelineEvent& b) {
+                     return a.time_s != b.time_s ? a.time_s < b.time_s : a.flight < b.flight;
+                   });
   return out;
 }
 

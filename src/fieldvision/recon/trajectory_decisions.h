@@ -6,6 +6,7 @@
 // through the ring). The ball path is the fitted arc inside flights and the samples between them.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,9 @@ struct MadeShot {
 struct TimelineEvent {
   double time_s = 0.0;
   std::string text;
+  // The flight it is about, for the order of events at one time (a landing before the bounce's
+  // next flight); events of no one flight after those of flights.
+  int flight = std::numeric_limits<int>::max();
 };
 
 struct Decisions {

@@ -24,6 +24,29 @@ Scene RunScene(const BallSimulation& sim, const TrajectoryOptions& to, util::Rng
   return s;
 }
 
+// A flight's landing is told before the next flight's bounce at the same moment (the timeline
+// said "flight 1: bounce" before "flight 0: lands").
+TEST(TrajectoryDecisions, TheTimelineTellsALandingBeforeTheBounceAfterIt) {
+  testing::SeededRng rng(32);
+  const field::FieldModel field = field::BuiltinField("robocup-msl");
+  TrajectoryOptions to;
+  BallSimOptions o;
+  o.start_m = {-4.0, 0.0, 0.11};
+  o.kicks = {{0.1, Eigen::Vector3d(5.0, 1.0, 6.0)}};
+  o.duration_s = 2.5;
+  const Scene s = RunScene(BallSimulation(o), to, rng);
+  ASSERT_GE(s.result.flights.size(), 2u);
+  const Decisions d = MakeDecisions(s.track, s.result, &field, to, DecisionOptions());
+  int pairs = 0;
+  for (size_t i = 1; i < d.timeline.size(); ++i) {
+    const TimelineEvent &a = d.timeline[i - 1], &b = d.timeline[i];
+    if (a.time_s != b.time_s) continue;
+    ++pairs;
+    EXPECT_LE(a.flight, b.flight) << a.text << " / " << b.text;
+  }
+  EXPECT_GE(pairs, 1);
+}
+
 TEST(TrajectoryDecisions, GoalLineCrossingBetweenThePostsWithItsTime) {
   testing::SeededRng rng(31);
   const field::FieldModel field = field::BuiltinField("robocup-msl");
