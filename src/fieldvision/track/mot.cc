@@ -347,9 +347,7 @@ void Preprocess(const std::vector<TrackRow>& gt_in, const std::vector<TrackRow>&
     p.gt_frames = static_cast<int>(frames.size());
     p.gt_frames_outside_est = static_cast<int>(frames_outside.size());
     p.gt_clipped = o.clip_to_est_frames;
-    if (p.gt_clipped) {
-      std::erase_if(gt, [&](const TrackRow& r) { return outside(r); });
-    }
+    if (p.gt_clipped) std::erase_if(gt, outside);
   }
 }
 
