@@ -56,6 +56,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
   const alerts = el('canvas', { id: 'pl-alerts', width: '1400', height: '60' });
   const msg = el('div', { id: 'pl-status', class: 'status' });
   const exportOut = el('input', { id: 'pl-export-out', value: 'players_export', size: '22', title: 'a folder of the working folder (made when absent)' });
+  const exportReplace = el('input', { id: 'pl-export-replace', type: 'checkbox' }) as HTMLInputElement;
   const exportButton = el('button', { id: 'pl-export', text: 'Export' });
   const exportMsg = el('div', { id: 'pl-export-status', class: 'status' });
   root.replaceChildren(
@@ -71,7 +72,8 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       el('div', { class: 'half' }, el('h3', { text: 'Heat map: time spent per 1 m cell' }), labelled('Player', heatWho), heat, legend),
       el('div', { class: 'half' }, el('h3', { text: 'Per player (fieldvision stats)' }), table)),
     el('h3', { text: 'Export' }),
-    el('section', { class: 'controls' }, labelled('Folder', exportOut), exportButton),
+    el('section', { class: 'controls' }, labelled('Folder', exportOut),
+      el('label', { title: 'a folder that is not empty is refused unless this is ticked; its files are then all replaced' }, exportReplace, 'Replace the folder'), exportButton),
     el('p', { class: 'hint', text: 'Writes the statistics (players.csv, speed_profiles.csv, distances.csv, zone_alerts.csv, stats.json, index.html), the heat maps with their scales and the radar view as `fieldvision stats` makes them, and this page\'s heat map (with its scale), board, speed chart and zone alerts as page_*.png.' }),
     exportMsg,
   );
@@ -429,7 +431,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       const speed = chart.querySelector('canvas');
       if (speed) images.speed = speed.toDataURL('image/png');
       const r = await api.post<{ wrote: string[]; notes: string[] }>('/api/players/export', {
-        tracks: tracks.value, field: field.value, out: exportOut.value, images, ...(zonesFile.value ? { zones: zonesFile.value } : {}),
+        tracks: tracks.value, field: field.value, out: exportOut.value, replace: exportReplace.checked, images, ...(zonesFile.value ? { zones: zonesFile.value } : {}),
       });
       exportMsg.dataset.wrote = JSON.stringify(r.wrote);
       status(exportMsg, `wrote ${r.wrote.length} files: ${r.wrote.join(', ')}${r.notes.length ? ` (${r.notes.join('; ')})` : ''}`);

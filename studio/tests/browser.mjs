@@ -67,9 +67,9 @@ page.on('pageerror', (e) => consoleErrors.push(String(e)));
 page.on('console', (m) => m.type() === 'error' && !/Failed to load resource/.test(m.text()) && consoleErrors.push(m.text()));
 // Replies with 4xx/5xx that the pages did not ask for on purpose.
 // (A pose request with too few or collinear points is answered 422 and shown on the page; a job
-// whose output exists, 409, in the jobs check below.)
+// whose output exists, or an export into a folder that is not empty, 409, in the checks below.)
 const asked = (r) => (r.status() === 422 && r.url().includes('/api/calibrate/pose')) ||
-  (r.status() === 409 && r.url().endsWith('/api/jobs'));
+  (r.status() === 409 && (r.url().endsWith('/api/jobs') || r.url().endsWith('/api/players/export')));
 page.on('response', (r) => r.status() >= 400 && !asked(r) && consoleErrors.push(`${r.status()} ${r.url()}`));
 page.setDefaultTimeout(20000);
 
@@ -478,6 +478,18 @@ try {
   check(pageHeat && pageHeat[0] === heatW && pageHeat[1] > heatH, `export: the page's heat map with its scale (page_heatmap.png ${pageHeat})`);
   check(['heatmap_all.png', 'page_board.png', 'page_speed.png', 'index.html', 'stats.json'].every((f) => fs.existsSync(path.join(exported, f))),
     'export: stats heat maps, board, speed chart, report');
+  // Again into that folder: refused (the earlier export is kept) until the folder is replaced.
+  const statsBefore = fs.readFileSync(path.join(exported, 'stats.json'));
+  await page.click('#pl-export');
+  await page.waitForSelector('#pl-export-status.error');
+  const refusedText = await page.textContent('#pl-export-status');
+  check(/not empty/.test(refusedText) && fs.readFileSync(path.join(exported, 'stats.json')).equals(statsBefore),
+    `export: a folder that is not empty is refused, kept as it was (${refusedText})`);
+  await page.check('#pl-export-replace');
+  await page.click('#pl-export');
+  await page.waitForFunction(() => /^wrote \d+ files/.test(document.querySelector('#pl-export-status').textContent));
+  check(fs.existsSync(path.join(exported, 'players.csv')) && fs.readdirSync(work).every((f) => !f.startsWith('.players_export')),
+    'export: with "Replace the folder" ticked it is written again');
   lap('players');
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
 } catch (e) {

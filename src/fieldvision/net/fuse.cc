@@ -239,6 +239,11 @@ class FuseServer {
   // goes on is refused (warned once), a new session after the old one ended or went quiet is
   // the camera restarted.
   bool AcceptSession(int c, const std::string& session, double arrival);
+  // Why the node of `camera` is not heard (told in its pongs), "" when it is: an unknown camera,
+  // another image size than the camera file's, or (`for_now`) a second node of one camera. Sets
+  // `c` to the camera's index when it is known.
+  std::string Admit(const Message& m, const std::string& camera, const std::string& session,
+                    const std::string& id, double arrival, int* c, bool* for_now);
   // A hello whose image size is not the camera file's: warned once, the camera's frames refused.
   void CheckHello(int c, const HelloMessage& h);
   // One warning per kind of dropped message while running (all are counted in the summary).
@@ -262,8 +267,9 @@ class FuseServer {
   std::vector<double> session_heard_s_;  // the current session's last message (steady clock)
   std::vector<bool> session_ended_;      // it said bye
   std::vector<std::string> identities_;  // each camera's node (its ROUTER routing id), for hints
-  std::set<int> warned_second_node_, warned_size_;
-  std::set<std::string> warned_dropped_;  // kinds of dropped messages warned about
+  std::set<int> warned_second_node_;
+  std::map<int, std::string> size_refused_;  // cameras whose node sends another image size: why
+  std::set<std::string> warned_dropped_;     // kinds of dropped messages warned about
   std::set<std::string> warned_unknown_;
   std::string clock_kind_;  // "system" or "media", from the first frame
   zmq::context_t ctx_{1};
@@ -455,33 +461,19 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     ++summary_.malformed;  // a pong or a ball message sent to us
     return;
   }
+  const auto& [camera, session] = *sender;
+  const std::string id = identity.to_string();
+  int c = -1;
+  bool for_now = false;
+  const std::string refused = Admit(m, camera, session, id, arrival, &c, &for_now);
   if (const auto* ping = std::get_if<PingMessage>(&m)) {
-    PongMessage pong{ping->t0_s, t1, 0, o_.hints};
+    PongMessage pong{ping->t0_s, t1, 0, o_.hints, refused, for_now};
     pong.t2_s = io::SystemClockNow();
-    // A copy of the routing id: sending a zmq message empties it, and the node's id is kept
-    // below for its hints (every hint to a node whose last message was a ping was lost).
-    const std::string id = identity.to_string();
+    // A copy of the routing id: sending a zmq message empties it.
     router_.send(zmq::buffer(id), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
     router_.send(zmq::buffer(Encode(pong)), zmq::send_flags::dontwait);
   }
-  const auto& [camera, session] = *sender;
-  const auto it = index_.find(camera);
-  if (it == index_.end()) {
-    ++summary_.unknown_camera;
-    if (warned_unknown_.insert(camera).second && warned_unknown_.size() <= 10) {
-      std::cerr << fmt::format("fuse: warning: messages from unknown camera '{}' ignored\n",
-                               camera);
-    }
-    return;
-  }
-  const int c = it->second;
-  if (!AcceptSession(c, session, arrival)) return;
-  identities_[c] = identity.to_string();
-  if (const auto* hello = std::get_if<HelloMessage>(&m)) CheckHello(c, *hello);
-  if (warned_size_.count(c) > 0) {
-    ++summary_.cameras[c].refused;  // frames of another image size than its camera file's
-    return;
-  }
+  if (!refused.empty()) return;
   if (const auto* hello = std::get_if<HelloMessage>(&m)) sync_->SetFrameRate(c, hello->fps);
   if (std::holds_alternative<PingMessage>(m) || std::holds_alternative<HelloMessage>(m)) {
     sync_->Admit(c, arrival);  // connected: its frames are waited for
@@ -499,6 +491,38 @@ void FuseServer::Receive(zmq::message_t& identity, const zmq::message_t& payload
     return;
   }
   AddFrame(c, std::get<FrameMessage>(m), t1, arrival);
+}
+
+std::string FuseServer::Admit(const Message& m, const std::string& camera,
+                              const std::string& session, const std::string& id, double arrival,
+                              int* c, bool* for_now) {
+  const auto it = index_.find(camera);
+  if (it == index_.end()) {
+    ++summary_.unknown_camera;
+    if (warned_unknown_.insert(camera).second && warned_unknown_.size() <= 10) {
+      std::cerr << fmt::format("fuse: warning: messages from unknown camera '{}' ignored\n",
+                               camera);
+    }
+    std::string names;
+    for (size_t k = 0; k < names_.size() && names.size() < 200; ++k) {
+      names += (k > 0 ? ", " : "") + names_[k];
+    }
+    return fmt::format("it has no camera '{}' (its cameras: {})", camera.substr(0, 100), names);
+  }
+  *c = it->second;
+  if (!AcceptSession(*c, session, arrival)) {
+    *for_now = true;
+    return fmt::format(
+        "another node sends as camera '{}' and goes on (give each node its own camera file)",
+        camera);
+  }
+  identities_[*c] = id;
+  if (const auto* hello = std::get_if<HelloMessage>(&m)) CheckHello(*c, *hello);
+  if (const auto size = size_refused_.find(*c); size != size_refused_.end()) {
+    ++summary_.cameras[*c].refused;  // frames of another image size than its camera file's
+    return size->second;
+  }
+  return "";
 }
 
 bool FuseServer::AcceptSession(int c, const std::string& session, double arrival) {
@@ -520,7 +544,7 @@ bool FuseServer::AcceptSession(int c, const std::string& session, double arrival
     if (!sessions_[c].empty()) sync_->Restart(c);
     sessions_[c] = session;
     session_ended_[c] = false;
-    warned_size_.erase(c);
+    size_refused_.erase(c);
     ++summary_.cameras[c].sessions;
   }
   session_heard_s_[c] = arrival;
@@ -532,7 +556,11 @@ void FuseServer::CheckHello(int c, const HelloMessage& h) {
   if (h.width <= 0 || h.height <= 0 || (h.width == cam.width && h.height == cam.height)) return;
   // The node fitted the same camera file to its video (camera::FitCameraToFrames).
   if (camera::IsCroppedPadding(cam, h.width, h.height)) return;
-  if (!warned_size_.insert(c).second) return;
+  if (size_refused_.count(c) > 0) return;
+  size_refused_[c] = fmt::format(
+      "it sends {}x{} images but the camera file of '{}' there is for {}x{} (give fuse and the "
+      "node the same camera file)",
+      h.width, h.height, names_[c], cam.width, cam.height);
   std::cerr << fmt::format(
       "fuse: warning: the node of camera '{}' sends {}x{} images but its camera file here is for "
       "{}x{}: its frames are ignored (give fuse and the node the same camera file)\n",

@@ -58,8 +58,13 @@ struct Encoder {
     return {{"type", "ping"}, {"camera", m.camera}, {"session", m.session}, {"t0_s", m.t0_s}};
   }
   json operator()(const PongMessage& m) const {
-    return {
+    json j = {
         {"type", "pong"}, {"t0_s", m.t0_s}, {"t1_s", m.t1_s}, {"t2_s", m.t2_s}, {"hints", m.hints}};
+    if (!m.refused.empty()) {
+      j["refused"] = m.refused;
+      j["refused_for_now"] = m.refused_for_now;
+    }
+    return j;
   }
   json operator()(const ByeMessage& m) const {
     return {{"type", "bye"}, {"camera", m.camera}, {"session", m.session}, {"frames", m.frames}};
@@ -167,10 +172,18 @@ Message DecodeChecked(const void* data, size_t size) {
     return PingMessage{Str(j, "camera"), Str(j, "session"), Num(j, "t0_s")};
   }
   if (type == "pong") {
-    PongMessage m{Num(j, "t0_s"), Num(j, "t1_s"), Num(j, "t2_s")};
+    PongMessage m;
+    m.t0_s = Num(j, "t0_s");
+    m.t1_s = Num(j, "t1_s");
+    m.t2_s = Num(j, "t2_s");
     if (j.contains("hints")) {
       FV_REQUIRE(j["hints"].is_boolean(), "message: 'hints' must be true or false");
       m.hints = j["hints"].get<bool>();
+    }
+    if (j.contains("refused")) {
+      m.refused = Str(j, "refused", 1000);
+      FV_REQUIRE(!m.refused.empty(), "message: 'refused' must say why");
+      m.refused_for_now = j.value("refused_for_now", false);
     }
     return m;
   }

@@ -87,6 +87,10 @@ struct PongMessage {
   double t0_s = 0, t1_s = 0, t2_s = 0;  // the ping's t0; fuse clock at receipt and at reply
   // The fusion node sends a hint for every frame it decides (optional field; absent: false).
   bool hints = false;
+  // Why the fusion node ignores the pinging node's messages (optional; absent: accepted), and
+  // whether only for now (another node sends as its camera and has not yet been quiet 1.5 s).
+  std::string refused;
+  bool refused_for_now = false;
 };
 
 struct ByeMessage {

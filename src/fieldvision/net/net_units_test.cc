@@ -1,5 +1,6 @@
 // Messages (round trip, refusals by reason) and the NTP-style clock estimate.
 #include <gtest/gtest.h>
+#include <cstring>
 
 #include "fieldvision/net/clock_sync.h"
 #include "fieldvision/net/endpoint.h"
@@ -132,6 +133,22 @@ TEST(Messages, PongTellsWhetherHintsAreSent) {
   EXPECT_FALSE(std::get<PongMessage>(Decode(old.data(), old.size())).hints);
   const std::string bad = R"({"v":1,"type":"pong","t0_s":1,"t1_s":2,"t2_s":3,"hints":1})";
   EXPECT_THROW(Decode(bad.data(), bad.size()), MessageError);
+}
+
+// A clock reply tells a node it is refused and why (absent: accepted; an older node ignores it).
+TEST(Messages, PongTellsARefusedNodeWhy) {
+  const PongMessage pong{1.0, 2.0, 3.0, true, "it has no camera 'c9'", false};
+  const std::string bytes = Encode(pong);
+  const PongMessage back = std::get<PongMessage>(Decode(bytes.data(), bytes.size()));
+  EXPECT_EQ(back.refused, "it has no camera 'c9'");
+  EXPECT_FALSE(back.refused_for_now);
+  EXPECT_EQ(Encode(PongMessage{1.0, 2.0, 3.0}).find("refused"), std::string::npos);
+  for (const char* bad : {R"({"v":1,"type":"pong","t0_s":1,"t1_s":2,"t2_s":3,"refused":""})",
+                          R"({"v":1,"type":"pong","t0_s":1,"t1_s":2,"t2_s":3,"refused":3})",
+                          R"({"v":1,"type":"pong","t0_s":1,"t1_s":2,"t2_s":3,"refused":"x",)"
+                          R"("refused_for_now":"yes"})"}) {
+    EXPECT_THROW(Decode(bad, std::strlen(bad)), MessageError) << bad;
+  }
 }
 
 TEST(Messages, HintRoundTripsAndABadRadiusIsRefused) {

@@ -103,6 +103,10 @@ constexpr char kFrameTag = 'f', kOtherTag = 'o';
 // decision of a frame before going on alone (longer than fuse's longest media wait, 9 s).
 constexpr double kStepWaitS = 10.0;
 
+// How long a fusion node may ignore a node for now (a second node of its camera, while the
+// first goes on; it gives way after 1.5 s of quiet) before the node stops.
+constexpr double kRefusedForNowS = 3.0;
+
 std::string NewSession() {
   std::random_device rd;
   return fmt::format("{:08x}{:08x}", rd(), rd());
@@ -165,6 +169,23 @@ class NodeLink {
   std::atomic<long long> hints_used{0};
 
  private:
+  void SetRefusal(const PongMessage& pong) {
+    std::lock_guard<std::mutex> lock(refusal_mutex_);
+    if (pong.refused.empty()) {
+      refusal_.clear();
+      return;
+    }
+    if (refusal_.empty()) {
+      refused_since_ = std::chrono::steady_clock::now();
+      if (pong.refused_for_now) {
+        std::cerr << fmt::format("node {}: the fusion node ignores this node for now: {}\n",
+                                 camera_, pong.refused);
+      }
+    }
+    refusal_ = pong.refused;
+    refusal_for_now_ = pong.refused_for_now;
+  }
+
   // A fusion node's hint, on this node's frame clock, to the camera stage's board.
   void TakeHint(const HintMessage& h) {
     if (hints_ == nullptr) return;
@@ -189,6 +210,18 @@ class NodeLink {
  public:
   // Whether the fusion node said (in its clock replies) that it sends a hint for every frame.
   bool fuse_sends_hints() const { return fuse_hints_; }
+  // Why the fusion node ignores this node, "" while it does not: at once when it never will
+  // hear it (an unknown camera, another image size), else once its latest replies have said so
+  // for longer than `for_now_s` (a second node of one camera; the first may end).
+  std::string Refusal(double for_now_s) const {
+    std::lock_guard<std::mutex> lock(refusal_mutex_);
+    if (refusal_.empty()) return "";
+    if (refusal_for_now_ && std::chrono::steady_clock::now() - refused_since_ <
+                                std::chrono::duration<double>(for_now_s)) {
+      return "";
+    }
+    return refusal_;
+  }
   // Waits until the fusion node has decided the frame at `time_s` (on this node's frame clock:
   // a hint of that time or later came), at most `timeout_s`; false when it did not.
   bool WaitForDecision(double time_s, double timeout_s, const pipeline::JobControl* control) {
@@ -229,6 +262,7 @@ class NodeLink {
             const Message m = Decode(reply.data(), reply.size());
             if (const auto* pong = std::get_if<PongMessage>(&m)) {
               fuse_hints_ = pong->hints;
+              SetRefusal(*pong);
               if (clock.Add(pong->t0_s, pong->t1_s, pong->t2_s, t3)) {
                 const ClockSample e = *clock.Estimate();
                 offset_s_ = e.offset_s;
@@ -295,6 +329,10 @@ class NodeLink {
   cv::Size image_size_;
   double fps_;
   std::atomic<bool> fuse_hints_{false};
+  mutable std::mutex refusal_mutex_;
+  std::string refusal_;  // from the latest clock reply
+  bool refusal_for_now_ = false;
+  std::chrono::steady_clock::time_point refused_since_;
   std::mutex decided_mutex_;
   std::condition_variable decided_changed_;
   double decided_s_ = -std::numeric_limits<double>::infinity();  // the latest hint's time
@@ -464,8 +502,9 @@ NodeSummary RunNode(const NodeOptions& o) {
     std::vector<double> process_s;
     long long last_dropped = 0;
     InStep step(hints && !system_clock, camera.name);
+    std::string refusal;
     while (!StopRequested(o.control) && (o.max_frames == 0 || summary.frames < o.max_frames) &&
-           source->ReadFrame(&in)) {
+           (refusal = link.Refusal(kRefusedForNowS)).empty() && source->ReadFrame(&in)) {
       const double read_s = io::SystemClockNow();
       if (const long long dropped = source->dropped(); dropped > last_dropped) {
         // Tell the fusion node now, before the work on this frame, that the skipped frames will
@@ -511,8 +550,11 @@ NodeSummary RunNode(const NodeOptions& o) {
     summary.in_step_to_end = step.on() && summary.in_step_frames > 0;
     SetProcessTimes(process_s, summary);
     link.frames_for_bye = summary.frames;
+    if (refusal.empty()) refusal = link.Refusal(0);  // a file read before the reply came
     link.Finish();
     AddLinkSummary(link, summary);
+    FV_REQUIRE(refusal.empty(), "node {}: the fusion node at {} refuses its frames: {}",
+               camera.name, o.connect, refusal);
   }
   summary.source_dropped = source->dropped();
   summary.stage = stage.stats();

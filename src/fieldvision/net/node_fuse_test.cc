@@ -70,13 +70,16 @@ std::string StartFuse(FuseOptions& o, FuseSummary* summary, std::thread* thread)
 
 // Sends a ping as `camera`/`session` on `node` and waits for the fusion node's pong: every
 // message sent earlier on that connection has been handled (one connection keeps its order).
-bool PongAfter(zmq::socket_t& node, const std::string& camera, const std::string& session) {
+std::optional<PongMessage> PongAfter(zmq::socket_t& node, const std::string& camera,
+                                     const std::string& session) {
   node.set(zmq::sockopt::rcvtimeo, static_cast<int>(10000 * fv::testing::SlowdownFactor()));
   node.send(zmq::buffer(Encode(PingMessage{camera, session, io::SystemClockNow()})),
             zmq::send_flags::none);
   zmq::message_t reply;
-  return node.recv(reply) &&
-         std::holds_alternative<PongMessage>(Decode(reply.data(), reply.size()));
+  if (!node.recv(reply)) return std::nullopt;
+  const Message m = Decode(reply.data(), reply.size());
+  if (const auto* pong = std::get_if<PongMessage>(&m)) return *pong;
+  return std::nullopt;
 }
 
 // A 64x48 camera file `name`.yaml in `dir`, 5 m off the centre at (eye_x, -5, 3) looking at it.
@@ -88,6 +91,19 @@ std::string WriteTinyCamera(const std::string& dir, const std::string& name, dou
   const std::string path = dir + "/" + name + ".yaml";
   camera::WriteCameraYaml(cam, path);
   return path;
+}
+
+// A fusion node of the tiny cameras cam1 and cam2 in `dir` writing dir/ball.csv, run until
+// `control` stops it (no idle limit: no wall-clock limit on a loaded machine).
+FuseOptions TinyFuseOptions(const std::string& dir, pipeline::JobControl* control) {
+  FuseOptions fo;
+  fo.cameras = {WriteTinyCamera(dir, "cam1"), WriteTinyCamera(dir, "cam2", 5)};
+  fo.listen = "tcp://127.0.0.1:*";
+  fo.out = dir + "/ball.csv";
+  fo.idle_exit_s = 0;
+  fo.control = control;
+  fo.progress = false;
+  return fo;
 }
 
 struct Scene {
@@ -431,8 +447,8 @@ TEST(NodeFuse, BadMessagesAreCountedAndTheFusionNodeGoesOn) {
   send(Encode(f));  // an unknown camera
   f.camera = "cam1";
   f.clock = "system";
-  send(Encode(f));                         // a live frame without a clock estimate
-  EXPECT_TRUE(PongAfter(s, "cam1", "s"));  // the fusion node still answers
+  send(Encode(f));                                     // a live frame without a clock estimate
+  EXPECT_TRUE(PongAfter(s, "cam1", "s").has_value());  // the fusion node still answers
   control.Stop();
   fuse.join();
   EXPECT_EQ(fused.malformed, 2);
@@ -490,15 +506,9 @@ TEST(NodeFuse, AFusionNodeNeedsCamerasApart) {
 // size of the camera file's (its pixels mean nothing here).
 TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   const std::string dir = testing::TempDir();
-  FuseOptions fo;
-  fo.cameras = {WriteTinyCamera(dir, "cam1"), WriteTinyCamera(dir, "cam2", 5)};
-  fo.listen = "tcp://127.0.0.1:*";
-  fo.out = dir + "/ball.csv";
-  std::ofstream(fo.out) << "an earlier run's BALL.csv\n";
-  fo.idle_exit_s = 0;  // stopped after the pongs below: no wall-clock limit on a loaded machine
   pipeline::JobControl control;
-  fo.control = &control;
-  fo.progress = false;
+  FuseOptions fo = TinyFuseOptions(dir, &control);
+  std::ofstream(fo.out) << "an earlier run's BALL.csv\n";
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
@@ -524,7 +534,7 @@ TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
   send(0, Encode(HelloMessage{"cam1", "first", 64, 48, 30, "a.avi", "media"}));
   // The first node's hello is read before the second node's first frame (three connections
   // deliver in any order, and a loaded machine made the second node the first).
-  EXPECT_TRUE(PongAfter(nodes[0], "cam1", "first"));
+  EXPECT_TRUE(PongAfter(nodes[0], "cam1", "first").has_value());
   send(2, Encode(HelloMessage{"cam2", "big", 128, 96, 30, "c.avi", "media"}));
   for (int k = 0; k < 5; ++k) {
     send(0, frame("cam1", "first", k));
@@ -532,25 +542,72 @@ TEST(NodeFuse, ASecondNodeAsOneCameraAndAnotherImageSizeAreRefused) {
     send(2, frame("cam2", "big", k));
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  // Every message handled; the other two connections ping as a camera fuse does not know (a
-  // ping as cam1 or cam2 would be refused and counted).
-  EXPECT_TRUE(PongAfter(nodes[0], "cam1", "first"));
-  EXPECT_TRUE(PongAfter(nodes[1], "probe", "p"));
-  EXPECT_TRUE(PongAfter(nodes[2], "probe", "p"));
+  // Every message handled; each node's clock replies tell it why it is refused (the pings as
+  // cam1 and cam2 are counted as refused, one more each).
+  const auto first = PongAfter(nodes[0], "cam1", "first");
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->refused, "");
+  const auto second = PongAfter(nodes[1], "cam1", "second");
+  ASSERT_TRUE(second.has_value());
+  EXPECT_NE(second->refused.find("another node sends as camera 'cam1'"), std::string::npos)
+      << second->refused;
+  EXPECT_TRUE(second->refused_for_now);
+  const auto big = PongAfter(nodes[2], "cam2", "big");
+  ASSERT_TRUE(big.has_value());
+  EXPECT_NE(big->refused.find("128x96 images but the camera file of 'cam2' there is for 64x48"),
+            std::string::npos)
+      << big->refused;
+  EXPECT_FALSE(big->refused_for_now);
+  const auto unknown = PongAfter(nodes[2], "probe", "p");
+  ASSERT_TRUE(unknown.has_value());
+  EXPECT_EQ(unknown->refused, "it has no camera 'probe' (its cameras: cam1, cam2)");
+  EXPECT_FALSE(unknown->refused_for_now);
   control.Stop();
   fuse.join();
   SCOPED_TRACE(fused.ToString());
   EXPECT_EQ(fused.cameras[0].sessions, 1);
   EXPECT_EQ(fused.cameras[0].frames, 5);
-  EXPECT_EQ(fused.cameras[0].refused, 5);
+  EXPECT_EQ(fused.cameras[0].refused, 6);
   EXPECT_EQ(fused.sync[0].restarts, 0);
   EXPECT_EQ(fused.cameras[1].frames, 0);
-  EXPECT_EQ(fused.cameras[1].refused, 6);  // its hello and frames
+  EXPECT_EQ(fused.cameras[1].refused, 7);  // its hello, frames and ping
   // cam1's frames alone, no position: nothing fused, the earlier BALL.csv kept (fuse fails).
   EXPECT_GT(fused.groups, 0);
   EXPECT_EQ(fused.paired_groups, 0);
   EXPECT_FALSE(fused.written);
   EXPECT_EQ(FirstLine(fo.out), "an earlier run's BALL.csv");
+}
+
+// A node whose camera the fusion node does not know is told so by its clock replies and stops
+// with an error naming the reason (it went on to the end of its file before, rc 0).
+TEST(NodeFuse, ANodeOfAnUnknownCameraStopsWithTheReason) {
+  const std::string dir = testing::TempDir() + "/node_unknown";
+  std::filesystem::create_directories(dir);
+  pipeline::JobControl control;
+  FuseOptions fo = TinyFuseOptions(dir, &control);
+  FuseSummary fused;
+  std::thread fuse;
+  const std::string endpoint = StartFuse(fo, &fused, &fuse);
+  for (int i = 0; i < 3; ++i) {
+    io::WriteImage(fmt::format("{}/{:05d}.png", dir, i),
+                   cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 90, 0)));
+  }
+  NodeOptions no;
+  no.camera = WriteTinyCamera(dir, "cam3");
+  no.video = dir + "/%05d.png";
+  no.fps = 30;
+  no.connect = endpoint;
+  no.connect_wait_s = 10 * fv::testing::SlowdownFactor();
+  no.progress = false;
+  const std::string error = testing::ErrorOf([&] { RunNode(no); });
+  control.Stop();
+  fuse.join();
+  EXPECT_NE(error.find("node cam3: the fusion node at " + endpoint +
+                       " refuses its frames: it "
+                       "has no camera 'cam3' (its cameras: cam1, cam2)"),
+            std::string::npos)
+      << error;
+  EXPECT_GT(fused.unknown_camera, 0);
 }
 
 // Synth cameras on the world's clock: node 2 is stopped and started again (a new session) and

@@ -428,9 +428,13 @@ void SaveZones(const json& zones, const fs::path& out) {
   } catch (const HttpError&) {
     throw;
   } catch (const fv::Error& e) {
+    // The reader names the file it read; the zones came in the request.
     std::string m = e.what();
-    const auto at = m.find(out.string());
-    if (at != std::string::npos) m.replace(at, out.string().size(), "request");
+    for (const std::string& named : {"zones file '" + out.string() + "'", out.string()}) {
+      for (size_t at = m.find(named); at != std::string::npos; at = m.find(named, at)) {
+        m.replace(at, named.size(), "the zones sent");
+      }
+    }
     throw HttpError(400, m);
   }
 }
@@ -524,6 +528,19 @@ struct Route {
   Endpoint endpoint;
   Handler handler;
 };
+
+// A new folder beside `path` (".NAME.WHAT-XXXXXXXX", never one that was there before); empty
+// when none could be made.
+fs::path NewFolderBeside(const fs::path& path, const std::string& what) {
+  std::error_code ec;
+  std::random_device random;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    fs::path p =
+        path.parent_path() / fmt::format(".{}.{}-{:08x}", path.filename().string(), what, random());
+    if (fs::create_directory(p, ec)) return p;
+  }
+  return {};
+}
 
 void Saved(EventHub* events, const Workspace& ws, const fs::path& path, const std::string& what) {
   if (events) events->Publish("saved", {{"path", ws.Relative(path)}, {"what", what}});
@@ -887,11 +904,18 @@ std::vector<track::TrackRow> ReadStatsInput(const Workspace& ws, const json& bod
 }
 
 // POST /api/players/export. Everything is checked before anything is written; the files are
-// written into a new folder beside OUT and then renamed into OUT, so that a link already in OUT
-// is replaced, never written through.
+// written into a new folder beside OUT, which then takes OUT's place whole: an earlier export's
+// files never mix with these, a link in OUT is never written through, and an OUT that is not
+// empty is refused (409) unless the request says replace.
 ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiRequest& r) {
   const json body = Body(r);
   const fs::path out = ResolveOutputFolder(ws, Get<std::string>(body, "out"));
+  std::error_code ec;
+  if (fs::is_directory(out, ec) && !fs::is_empty(out, ec) && !GetOr<bool>(body, "replace", false)) {
+    throw HttpError(409,
+                    "folder '" + ws.Relative(out) +
+                        "' is not empty: choose another folder, or replace it (replace: true)");
+  }
   const field::FieldModel field = LoadFieldIn(ws, GetOr<std::string>(body, "field", "robocup-msl"));
   std::vector<std::pair<std::string, cv::Mat>> images;
   const json sent = GetOr<json>(body, "images", json::object());
@@ -911,15 +935,7 @@ ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiReques
   const auto rows = ReadStatsInput(ws, body, o);
   const stats::StatsResult res = stats::ComputeStats(rows, o);
 
-  // A new folder (never one that was there before), removed at the end.
-  std::error_code ec;
-  fs::path tmp;
-  std::random_device random;
-  for (int attempt = 0; tmp.empty() && attempt < 100; ++attempt) {
-    const fs::path p =
-        out.parent_path() / fmt::format(".{}.export-{:08x}", out.filename().string(), random());
-    if (fs::create_directory(p, ec)) tmp = p;
-  }
+  const fs::path tmp = NewFolderBeside(out, "export");
   FV_REQUIRE(!tmp.empty(), "cannot create a folder beside '{}'", ws.Relative(out));
   json wrote = json::array();
   stats::ReportFiles files;
@@ -938,18 +954,25 @@ ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiReques
       f.write(png.data(), static_cast<std::streamsize>(png.size()));
       FV_REQUIRE(f.good(), "cannot write '{}'", name);
     }
-    fs::create_directory(out);
     std::vector<fs::path> made;
-    for (const auto& e : fs::directory_iterator(tmp)) made.push_back(e.path());
+    for (const auto& e : fs::directory_iterator(tmp)) made.push_back(e.path().filename());
     std::sort(made.begin(), made.end());
-    for (const auto& p : made) {
-      const fs::path target = out / p.filename();
-      if (fs::is_directory(fs::symlink_status(target))) {
-        throw HttpError(409, "'" + ws.Relative(target) + "' is a folder; not replaced");
+    if (fs::exists(fs::symlink_status(out))) {
+      const fs::path old = NewFolderBeside(out, "replaced");
+      FV_REQUIRE(!old.empty(), "cannot create a folder beside '{}'", ws.Relative(out));
+      fs::rename(out, old / "folder");
+      try {
+        fs::rename(tmp, out);
+      } catch (...) {
+        fs::rename(old / "folder", out, ec);
+        fs::remove_all(old, ec);
+        throw;
       }
-      fs::rename(p, target);
-      wrote.push_back(ws.Relative(target));
+      fs::remove_all(old, ec);
+    } else {
+      fs::rename(tmp, out);
     }
+    for (const auto& f : made) wrote.push_back(ws.Relative(out / f));
   } catch (...) {
     fs::remove_all(tmp, ec);
     throw;
@@ -1040,7 +1063,8 @@ std::vector<Route> TrackRoutes() {
                       {"summary", OneLine(res.Summary())}});
        }},
       {{"POST", "/api/players/export",
-        "{tracks[, zones, field, images: {name: PNG base64}], out: FOLDER}: the Players page's "
+        "{tracks[, zones, field, images: {name: PNG base64}], out: FOLDER[, replace]}: the "
+        "Players page's "
         "export: `stats` report (players.csv, speed_profiles.csv, distances.csv, heat maps with "
         "scales, radar.png, stats.json, index.html), zone_alerts.csv, the page's images as "
         "page_NAME.png"},

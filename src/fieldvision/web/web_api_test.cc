@@ -783,8 +783,14 @@ TEST_F(StudioApiTest, PlayersExport) {
   fs::create_directory(dir_ / "exports/walk");
   std::ofstream(dir_.parent_path() / "victim.csv") << "untouched\n";
   fs::create_symlink(dir_.parent_path() / "victim.csv", dir_ / "exports/walk/players.csv");
+  // A folder that is not empty is refused unless replaced, and then replaced whole.
+  std::ofstream(dir_ / "exports/walk/heatmap_9.png") << "an earlier export's player 9\n";
+  ExpectError(Post("/api/players/export", request), 409, "replace: true");
+  EXPECT_TRUE(fs::exists(dir_ / "exports/walk/heatmap_9.png"));
+  request["replace"] = true;
   const Reply r = Post("/api/players/export", request);
   ASSERT_EQ(r.status, 200) << r.body;
+  EXPECT_FALSE(fs::exists(dir_ / "exports/walk/heatmap_9.png"));
   std::set<std::string> wrote;
   const json reply = r.j();
   for (const auto& w : reply["wrote"]) wrote.insert(w.get<std::string>());
@@ -863,7 +869,7 @@ TEST_F(StudioApiTest, ZonesSaveAndRead) {
   EXPECT_EQ(read.j(), zones);
   const json bad = {{{"name", "line"}, {"polygon", {{0, 0}, {1, 1}}}}};
   ExpectError(Post("/api/zones/save", json{{"zones", bad}, {"out", "zones.json"}}), 400,
-              "3 or more vertices");
+              "the zones sent: zone 'line' needs 3 or more vertices");
   EXPECT_EQ(Get("/api/zones?path=zones.json").j(), zones);  // the old file is kept
   EXPECT_FALSE(fs::exists(dir_ / "zones.json.check"));
   ExpectError(Get("/api/zones?path=scene/truth.csv"), 422, "not valid JSON");
