@@ -22,7 +22,9 @@ void Setup(CLI::App& app, int& exit_code) {
       "searches the best rig over allowed mounting places and writes rig.json.");
   cmd->add_option("--rig", o->rig_path, "Rig JSON (cameras by position, aim, size, field of view)");
   cmd->add_option("--camera", o->camera_paths, "Camera YAML with a pose (repeat for each)");
-  cmd->add_option("--field", o->field, "Built-in field name or field JSON")->capture_default_str();
+  cmd->add_option("--field", o->field,
+                  "Built-in field name or field JSON [default: the rig file's field, else "
+                  "robocup-msl]");
   cmd->add_option("--out", o->out_dir, "Output folder")->required();
   auto& c = o->coverage;
   cmd->add_option("--step", c.grid_step_m, "Grid cell size in metres")

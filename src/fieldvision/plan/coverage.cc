@@ -285,7 +285,7 @@ std::string CoverageResult::Summary() const {
                      L.step_y_m);
     s += "  cameras seeing a point ";
     for (size_t k = 0; k < L.fraction_exactly.size(); ++k) s += fmt::format("{:>8d}", k);
-    s += "\n  share of the field     ";
+    s += options.include_surround ? "\n  share of field+run-off " : "\n  share of the field     ";
     for (double f : L.fraction_exactly) s += fmt::format("{:>8s}", pct(f));
     s += fmt::format(
         "\n  seen by >= 2: {}   with a good pair angle: {}   median best angle {}\n",
@@ -298,7 +298,15 @@ std::string CoverageResult::Summary() const {
         mm(L.err_median_m), mm(L.err_p95_m), mm(L.err_max_m), mm(L.err_max_axis_max_m));
     s += fmt::format("  score (good share - weight x worst error): {:.4f}\n", L.score);
   }
+  if (layers.size() > 1) s += fmt::format("score (mean of the layers): {:.4f}\n", score());
   return s;
+}
+
+double CoverageResult::score() const {
+  if (layers.empty()) return 0.0;
+  double sum = 0;
+  for (const CoverageLayer& L : layers) sum += L.score;
+  return sum / static_cast<double>(layers.size());
 }
 
 }  // namespace fv::plan

@@ -69,7 +69,9 @@ struct CoverageResult {
   int num_cameras = 0;
   std::vector<CoverageLayer> layers;  // layer 0 at the ball's height
   double seconds = 0;
-  double score() const { return layers.empty() ? 0.0 : layers[0].score; }
+  // The rig's score: the mean of its layers' (the ball on the ground and in the air), so that
+  // a search never trades the air for the ground.
+  double score() const;
   // A table: per layer the fractions by camera count, angles and errors.
   std::string Summary() const;
 };

@@ -44,7 +44,6 @@ class Search {
          const OptimizeOptions& options)
       : field_(field), mounts_(mounts), model_(model), coverage_(coverage), options_(options) {
     coverage_.grid_step_m = options.grid_step_m;
-    coverage_.height_above_m = 0;
     coverage_.progress = false;
   }
 
@@ -206,7 +205,6 @@ double RigScore(const std::vector<camera::Camera>& cameras, const field::FieldMo
                 const CoverageOptions& coverage, double grid_step_m) {
   CoverageOptions o = coverage;
   o.grid_step_m = grid_step_m;
-  o.height_above_m = 0;
   o.progress = false;
   return EvaluateCoverage(cameras, field, o).score();
 }

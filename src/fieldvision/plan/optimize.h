@@ -1,10 +1,11 @@
 // Search for a camera rig: N cameras, each mounted somewhere on a set of allowed places (points
 // or straight segments with heights) and aimed at a point on the ground inside the field, that
 // maximises the coverage score (coverage.h: the share of the field seen by >= 2 cameras with a
-// good pair angle, minus a weight times the worst expected error there), evaluated on a coarse
-// grid. Method: simulated annealing (Kirkpatrick et al., Science 220, 1983) with geometric
-// cooling and shrinking moves, seeded restarts (the first from cameras spread evenly along the
-// places and aimed at the centre), keeping the best rig seen.
+// good pair angle, minus a weight times the worst expected error there, averaged over the ball's
+// layers on the ground and in the air), evaluated on a coarse grid. Method: simulated annealing
+// (Kirkpatrick et al., Science 220, 1983) with geometric cooling and shrinking moves, seeded
+// restarts (the first from cameras spread evenly along the places and aimed at the centre), keeping
+// the best rig seen.
 #pragma once
 
 #include <cstdint>
@@ -66,7 +67,7 @@ OptimizeResult OptimizeRig(const field::FieldModel& field, const std::vector<Mou
                            const camera::Camera& model, const CoverageOptions& coverage,
                            const OptimizeOptions& options);
 
-// The score of `cameras` with the coverage options on a grid of `grid_step_m`, one layer.
+// The score of `cameras` with the coverage options on a grid of `grid_step_m` (its layers').
 double RigScore(const std::vector<camera::Camera>& cameras, const field::FieldModel& field,
                 const CoverageOptions& coverage, double grid_step_m);
 

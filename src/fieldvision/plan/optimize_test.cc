@@ -54,6 +54,13 @@ TEST(OptimizeTest, FindsARigAtLeastAsGoodAsTheCornerRig) {
   EXPECT_GE(r.score, r.start_score);
   // The reported score is the rig's score, and the cameras stay on the perimeter at 4 m.
   EXPECT_NEAR(RigScore(r.rig.cameras, field, coverage, o.grid_step_m), r.score, 1e-12);
+  // It is the mean of the ball's layers on the ground and in the air: a rig is never searched
+  // for the ground alone (one that saw the air worse was reported as better).
+  CoverageOptions search_grid = coverage;
+  search_grid.grid_step_m = o.grid_step_m;
+  const CoverageResult layers = EvaluateCoverage(r.rig.cameras, field, search_grid);
+  ASSERT_EQ(layers.layers.size(), 2u);
+  EXPECT_NEAR(r.score, 0.5 * (layers.layers[0].score + layers.layers[1].score), 1e-12);
   ASSERT_EQ(r.rig.cameras.size(), 4u);
   for (const camera::Camera& c : r.rig.cameras) {
     const Eigen::Vector3d p = c.CentreInWorld();

@@ -41,7 +41,6 @@ json LayerJson(const CoverageLayer& L) {
 
 void PlanRunOptions::Check() const {
   FV_REQUIRE(!out_dir.empty(), "plan: --out is required");
-  FV_REQUIRE(!field.empty(), "plan: --field is required");
   if (!optimize) {
     FV_REQUIRE(rig_path.empty() != camera_paths.empty(),
                "plan: give either --rig RIG.json or --camera CAM.yaml (one or more)");
@@ -108,7 +107,8 @@ std::vector<std::string> OutputNames(const PlanRunOptions& options) {
 // --optimize: searches a rig over the mounting places, scores a given rig the same way and
 // writes rig.json; returns the summary lines.
 std::string OptimizeStage(const PlanRunOptions& options, const field::FieldModel& field,
-                          const std::optional<Rig>& given, PlanRunResult& result) {
+                          const std::string& field_spec, const std::optional<Rig>& given,
+                          PlanRunResult& result) {
   std::string summary;
   const std::vector<MountPlace> mounts =
       options.mounts_path.empty()
@@ -126,6 +126,8 @@ std::string OptimizeStage(const PlanRunOptions& options, const field::FieldModel
                            *result.given_rig_search_score);
   }
   result.rig = opt.rig;
+  // The field by name (a field file's path would not hold beside the written rig).
+  if (!std::filesystem::exists(field_spec)) result.rig.field = field_spec;
   result.optimized = std::move(opt);
   WriteRigJson(result.rig, OutPath(options, "rig.json"));
   result.files.push_back(OutPath(options, "rig.json"));
@@ -180,6 +182,8 @@ json CoverageJson(const PlanRunResult& result, const field::FieldModel& field,
   for (auto it = g.begin(); it != g.end(); ++it) j[it.key()] = it.value();
   j["layers"] = json::array();
   for (const auto& L : result.coverage.layers) j["layers"].push_back(LayerJson(L));
+  j["rig_score"] =
+      result.coverage.score();  // the mean of the layers' scores (what --optimize raises)
   if (result.optimized) {
     j["optimize"] = {{"search_grid_step_m", options.search.grid_step_m},
                      {"search_score", result.optimized->score},
@@ -220,19 +224,36 @@ std::string RigWarnings(const Rig& rig) {
   return w;
 }
 
+// The field of --field, else the rig file's, else robocup-msl.
+std::string FieldOfRun(const PlanRunOptions& options, const std::optional<Rig>& given) {
+  if (!options.field.empty()) return options.field;
+  return given && !given->field.empty() ? given->field : "robocup-msl";
+}
+
 }  // namespace
 
 PlanRunResult RunPlan(const PlanRunOptions& options) {
   options.Check();
-  const field::FieldModel field = field::LoadField(options.field);
+  // The options' own checks before the cameras are read, unless the rig file names the field.
+  std::optional<Rig> given;
+  if (options.field.empty() && !options.rig_path.empty()) given = LoadGivenRig(options);
+  const std::string field_spec = FieldOfRun(options, given);
+  const field::FieldModel field = field::LoadField(field_spec);
   CheckCoverageGrid(field, options.coverage, "--step");
   if (options.optimize) {
     CoverageOptions search_grid = options.coverage;
     search_grid.grid_step_m = options.search.grid_step_m;
     CheckCoverageGrid(field, search_grid, "--search-step");
   }
+  std::string summary;
+  if (!given) {
+    given = LoadGivenRig(options);
+    if (given && !given->field.empty() && given->field != options.field) {
+      summary += fmt::format("note: --field {} used; the rig file names field {}\n", options.field,
+                             given->field);
+    }
+  }
   PlanRunResult result;
-  const std::optional<Rig> given = LoadGivenRig(options);
   // No file this run may write replaces one of its inputs (--optimize --rig DIR/rig.json --out
   // DIR replaced the user's rig).
   const std::vector<std::string> inputs =
@@ -244,17 +265,14 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   std::filesystem::create_directories(options.out_dir, ec);
   FV_REQUIRE(std::filesystem::is_directory(options.out_dir), "cannot create output folder '{}'",
              options.out_dir);
-  std::string summary;
   if (options.optimize) {
-    summary += OptimizeStage(options, field, given, result);
+    summary += OptimizeStage(options, field, field_spec, given, result);
   } else {
     result.rig = *given;
   }
   result.coverage = EvaluateCoverage(result.rig.cameras, field, options.coverage);
   if (options.optimize && given) {
-    CoverageOptions one_layer = options.coverage;
-    one_layer.height_above_m = 0;
-    result.given_rig_score = EvaluateCoverage(given->cameras, field, one_layer).score();
+    result.given_rig_score = EvaluateCoverage(given->cameras, field, options.coverage).score();
   }
   summary += fmt::format("rig '{}', {} camera{}, field {} ({:.2f} x {:.2f} m)\n", result.rig.name,
                          result.rig.cameras.size(), result.rig.cameras.size() == 1 ? "" : "s",

@@ -21,8 +21,9 @@ namespace fv::plan {
 struct PlanRunOptions {
   std::string rig_path;                   // a rig JSON file, or
   std::vector<std::string> camera_paths;  // camera YAML files (with poses)
-  std::string field = "robocup-msl";      // built-in name or field JSON
-  std::string out_dir;                    // created if missing
+  // Built-in name or field JSON; empty: the rig file's `field`, else robocup-msl.
+  std::string field;
+  std::string out_dir;  // created if missing
   CoverageOptions coverage;
   CoverageMapOptions map;
 

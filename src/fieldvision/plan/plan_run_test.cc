@@ -28,13 +28,19 @@ std::string WriteCornerRig(const std::string& dir) {
   return path;
 }
 
-TEST(PlanRunTest, WritesCoverageJsonAndMaps) {
-  const std::string dir = fv::testing::TempDir();
+// A run over the corner rig in `dir` into dir/out.
+PlanRunOptions CornerRigRun(const std::string& dir, double grid_step_m, int map_width_px) {
   PlanRunOptions o;
   o.rig_path = WriteCornerRig(dir);
   o.out_dir = dir + "/out";
-  o.coverage.grid_step_m = 0.5;
-  o.map.width_px = 400;
+  o.coverage.grid_step_m = grid_step_m;
+  o.map.width_px = map_width_px;
+  return o;
+}
+
+TEST(PlanRunTest, WritesCoverageJsonAndMaps) {
+  const std::string dir = fv::testing::TempDir();
+  PlanRunOptions o = CornerRigRun(dir, 0.5, 400);
   const PlanRunResult r = RunPlan(o);
   ASSERT_EQ(r.coverage.layers.size(), 2u);
   std::ifstream in(o.out_dir + "/coverage.json");
@@ -84,6 +90,35 @@ TEST(PlanRunTest, OptimizeWritesARigThatReadsBack) {
   CoverageOptions c = o.coverage;
   EXPECT_NEAR(EvaluateCoverage(back.cameras, field::LoadField("robocup-msl"), c).score(),
               r.coverage.score(), 1e-9);
+  EXPECT_EQ(back.field, "robocup-msl");  // the field it was searched on, by name
+}
+
+// A rig file's field is the run's unless --field names another (said); one that is not a field
+// is an error naming it (it was ignored: robocup-msl, silently).
+TEST(PlanRunTest, TheRigFilesFieldIsUsed) {
+  const std::string dir = fv::testing::TempDir();
+  PlanRunOptions o = CornerRigRun(dir, 2.0, 200);
+  o.coverage.height_above_m = 0;
+  json rig = json::parse(std::ifstream(o.rig_path));
+  rig["field"] = "fifa";
+  std::ofstream(o.rig_path) << rig.dump(2);
+  EXPECT_NE(RunPlan(o).summary.find("field fifa (105.00 x 68.00 m)"), std::string::npos);
+  o.field = "robocup-msl";
+  const std::string replaced = RunPlan(o).summary;
+  EXPECT_NE(replaced.find("note: --field robocup-msl used; the rig file names field fifa"),
+            std::string::npos)
+      << replaced;
+  EXPECT_NE(replaced.find("field robocup-msl (18.00 x 12.00 m)"), std::string::npos) << replaced;
+  o.field.clear();
+  rig["field"] = "no-such-field";
+  std::ofstream(o.rig_path) << rig.dump(2);
+  std::string error;
+  try {
+    RunPlan(o);
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("no-such-field"), std::string::npos) << error;
 }
 
 TEST(PlanRunTest, BadInputGivesOneLineErrors) {

@@ -167,6 +167,12 @@ Rig RigFromJson(const json& j, const std::string& context, const std::string& ba
   }
   Rig rig;
   rig.name = util::JsonString(j, "name", context, rig.name);
+  rig.field = util::JsonString(j, "field", context, "");
+  if (!rig.field.empty() && !base_dir.empty()) {
+    const std::filesystem::path beside = std::filesystem::path(base_dir) / rig.field;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(beside, ec)) rig.field = beside.string();
+  }
   json defaults = json::object();
   if (j.contains("defaults")) {
     FV_REQUIRE(j["defaults"].is_object(), "{}: key 'defaults' must be an object", context);
@@ -210,6 +216,7 @@ Rig ReadRigJson(const std::string& path) {
 json RigToJson(const Rig& rig) {
   json j;
   j["name"] = rig.name;
+  if (!rig.field.empty()) j["field"] = rig.field;
   j["cameras"] = json::array();
   for (const camera::Camera& c : rig.cameras) {
     json cj;

@@ -23,6 +23,9 @@ namespace fv::plan {
 struct Rig {
   std::string name;
   std::vector<camera::Camera> cameras;  // all with poses
+  // The field the rig file names (a built-in name, or a field JSON resolved beside the file);
+  // empty when it names none.
+  std::string field;
 
   // Throws fv::Error naming `context` and the bad camera: no cameras, no pose, NaN, bad intrinsics.
   void Check(const std::string& context = "rig") const;
