@@ -24,6 +24,7 @@
 #include "fieldvision/calib/rig_place.h"
 #include "fieldvision/camera/camera_io.h"
 #include "fieldvision/camera/frame_size.h"
+#include "fieldvision/camera/pose_range.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
@@ -78,6 +79,17 @@ cv::Mat ReadImage(const std::string& path) {
 }
 
 void Warn(const std::string& message) { std::cerr << "warning: " << message << "\n"; }
+
+// Many clicked points that fit no pose are more often the wrong field or misnamed points than
+// bad clicks: said when 30 % or more were left out.
+void WarnManyOutliers(size_t points, size_t inliers, const field::FieldModel* field) {
+  if (points == 0 || inliers >= points || (points - inliers) * 10 < points * 3) return;
+  Warn(fmt::format(
+      "{} of the {} points fit no pose together with the others: are the points' names those "
+      "of {} (`fieldvision field show --field NAME` lists them), and their x, y, z metres?",
+      points - inliers, points,
+      field != nullptr ? "field '" + field->name + "'" : "the field they were clicked on"));
+}
 
 // A refined pose whose line error is above this (mean, mm) likely has the wrong frame or field.
 constexpr double kLooseLinesMm = 50.0;
@@ -288,7 +300,9 @@ void PlaceRigOnField(const ExtrinsicsCli& c, const field::FieldModel* field) {
     Warn(fmt::format("{} points did not fit and were left out (marked 'outlier')",
                      r.num_points - r.num_inliers));
   }
+  WarnManyOutliers(r.num_points, r.num_inliers, field);
   std::vector<camera::Camera> out = r.cameras;
+  for (const camera::Camera& cam : out) camera::CheckCameraNearOrigin(cam, "--rig " + c.rig);
   for (size_t i = 0; i < out.size(); ++i) {
     out[i].notes["placed_with_rig"] = c.rig;
     out[i].notes["rig_placement_rms_px"] = fmt::format("{:.3f}", r.rms_px_all);
@@ -332,7 +346,9 @@ void RunFocal(const ExtrinsicsCli& c, const field::FieldModel* field) {
       r.camera_position_m.y(), r.camera_position_m.z(), r.std_position_m.x(), r.std_position_m.y(),
       r.std_position_m.z());
   for (const auto& w2 : r.warnings) Warn(w2);
+  WarnManyOutliers(pts.size(), r.num_inliers, field);
   camera::Camera out = r.camera;
+  camera::CheckCameraNearOrigin(out, "--points " + c.points.front());
   out.rms_px = r.rms_px;
   out.notes["extrinsics_points"] = c.points.front();
   out.notes["focal_std_px"] = fmt::format("{:.2f}", r.std_focal_px);
@@ -378,7 +394,9 @@ void RunExtrinsics(const ExtrinsicsCli& c) {
     Warn(fmt::format("{} points did not fit and were left out (marked 'outlier')",
                      pts.size() - r.num_inliers));
   }
+  WarnManyOutliers(pts.size(), r.num_inliers, field.get());
   camera::Camera out = r.camera;
+  camera::CheckCameraNearOrigin(out, "--points " + c.points.front());
   out.rms_px = r.rms_px;
   out.notes["extrinsics_points"] = c.points.front();
   out.notes["extrinsics_rms_px"] = fmt::format("{:.3f}", r.rms_px);
@@ -438,6 +456,11 @@ void RunRefine(const RefineCli& c) {
   FitToImage(image, image_path, cam, fmt::format("camera file '{}'", c.camera));
   const field::FieldModel field = field::LoadField(c.field);
   const RefineResult r = RefineWithLines(cam, image, field, c.o);
+  // No line pixel near a line: nothing to refine with, and no line error (0.0 mm read as perfect).
+  FV_REQUIRE(r.before.num_inliers > 0,
+             "calibrate refine: camera '{}' sees no line of field '{}' in '{}' ({} line pixels, "
+             "none near a line): the pose or the field is wrong; nothing written",
+             c.camera, field.name, image_path, r.before.num_pixels);
   // One report: the library's summary, then the contract's line error.
   std::cout << r.Summary() << "\n";
   std::cout << fmt::format(

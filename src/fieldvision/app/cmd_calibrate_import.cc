@@ -86,10 +86,22 @@ void RunImport(const ImportCli& c) {
     if (name.empty()) name = std::filesystem::path(c.tsai).stem().string();
     const track::TsaiConversion conv = track::CameraFromTsai(p, name);
     util::CheckOutputPath(c.out, {c.tsai});
+    // Tsai's one-coefficient radial model is fitted exactly by OpenCV's for real lenses (PETS
+    // View_001: 0.000 px); a large difference is a distortion no lens has (a mistyped kappa1):
+    // tens of pixels are not written.
+    FV_REQUIRE(conv.max_fit_error_px <= 10.0,
+               "'{}': OpenCV's lens model cannot follow Tsai's (up to {:.0f} px apart over the "
+               "image): check kappa1 ({}) and the sensor sizes in the file; nothing written",
+               c.tsai, conv.max_fit_error_px, p.kappa1);
     camera::WriteCameraYaml(conv.camera, c.out);
     std::cout << conv.Summary() << "\ncamera " << name << "\nwrote " << c.out << "\n";
-    // Tsai's one-coefficient radial model is fitted exactly by OpenCV's for real lenses (PETS
-    // View_001: 0.000 px); a large difference is a distortion no lens has (a mistyped kappa1).
+    // Tx, Ty, Tz are millimetres: a camera within a metre of the world's origin had metres.
+    if (const double from_origin_m = conv.camera.CentreInWorld().norm(); from_origin_m < 1.0) {
+      std::cerr << fmt::format(
+          "warning: '{}': the camera stands {:.3f} m from the world origin: Tsai files give Tx, "
+          "Ty, Tz in millimetres (were they metres?)\n",
+          c.tsai, from_origin_m);
+    }
     if (conv.max_fit_error_px > 1.0) {
       std::cerr << fmt::format(
           "warning: '{}': OpenCV's lens model differs from Tsai's by up to {:.1f} px over the "

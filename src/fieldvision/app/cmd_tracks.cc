@@ -104,6 +104,19 @@ void ReportTracksOnVideo(const std::vector<track::TrackRow>& rows, const track::
   }
 }
 
+// Tracks of which most boxes lie beside the video's frames were made on another video: an error
+// before anything is written (a few beside them are warned of after drawing).
+void CheckTracksFitVideo(const std::vector<track::TrackRow>& rows, const io::VideoSource& video,
+                         const std::string& tracks) {
+  const cv::Rect2d frame(0, 0, video.width(), video.height());
+  size_t outside = 0;
+  for (const auto& r : rows) outside += (r.box & frame).area() <= 0;
+  FV_REQUIRE(outside * 2 <= rows.size(),
+             "tracks draw: {} of the {} boxes of '{}' lie outside the {}x{} frames of video '{}' "
+             "(tracks of another video?); nothing written",
+             outside, rows.size(), tracks, video.width(), video.height(), video.spec());
+}
+
 // The video with the (edited) tracks drawn: names from the roster, team colours.
 void RunTracksDraw(const TracksDrawCli& c) {
   std::string roster_in = c.roster_in;
@@ -113,11 +126,13 @@ void RunTracksDraw(const TracksDrawCli& c) {
   io::CheckVideoOutput(c.out, {c.tracks, c.video, c.camera, c.field, roster_in}, "--out");
   const auto rows = ReadTracks(c.tracks);
   const track::Roster roster = roster_in.empty() ? track::Roster{} : track::ReadRoster(roster_in);
+  const std::unique_ptr<io::VideoSource> probe = io::VideoSource::Open(c.video);
+  CheckTracksFitVideo(rows, *probe, c.tracks);
   std::optional<camera::Camera> camera;
   if (!c.camera.empty()) {
     camera = camera::ReadCameraYaml(c.camera);
     // Field lines drawn with a camera of another size would be wrong everywhere.
-    const std::string note = io::VideoSource::Open(c.video)->FitCamera(*camera, c.camera);
+    const std::string note = probe->FitCamera(*camera, c.camera);
     if (!note.empty()) std::cout << note << "\n";
   }
   std::optional<field::FieldModel> field;

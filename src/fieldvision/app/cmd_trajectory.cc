@@ -115,7 +115,11 @@ void Setup(CLI::App& app, int& exit_code) {
       o->job.analysis.progress = nullptr;
       if (bar) bar->Finish();
     } else {
-      recon::RunTrajectoryBatch(o->job, files, std::cout);
+      const recon::TrajectoryBatchResult batch =
+          recon::RunTrajectoryBatch(o->job, files, std::cout);
+      // The others are written; the run still fails, so that a script notices.
+      FV_REQUIRE(batch.failed.empty(), "trajectory: {} of {} tracks failed (listed above)",
+                 batch.failed.size(), files.size());
     }
     exit_code = 0;
   });

@@ -21,15 +21,17 @@
 namespace fv::calib {
 namespace {
 
-// The tables with a `matrix` under `table`, at any depth ([cam.1] is table 1 in table cam), named
-// by their dotted path.
+// The camera tables under `table`, at any depth ([cam.1] is table 1 in table cam), named by their
+// dotted path: those with a camera's key (a section without `matrix` is then an error naming
+// the key, not a camera left out).
 void CollectCameraTables(const toml::table& table, const std::string& prefix,
                          std::vector<std::pair<std::string, const toml::table*>>* out) {
   for (const auto& [key, node] : table) {
     const toml::table* t = node.as_table();
     if (t == nullptr) continue;
     const std::string name = prefix + std::string(key.str());
-    if (t->contains("matrix")) {
+    if (t->contains("matrix") || t->contains("distortions") || t->contains("rotation") ||
+        t->contains("translation")) {
       out->emplace_back(name, t);
     } else {
       CollectCameraTables(*t, name + ".", out);
@@ -182,7 +184,9 @@ std::vector<camera::Camera> ReadCalibrationToml(const std::string& path, double 
     c.Check(where);
     cams.push_back(c);
   }
-  FV_REQUIRE(!cams.empty(), "calibration file '{}' has no camera sections (with a 'matrix' key)",
+  FV_REQUIRE(!cams.empty(),
+             "calibration file '{}' has no camera sections (with 'matrix', 'distortions', "
+             "'rotation', 'translation')",
              path);
   return cams;
 }

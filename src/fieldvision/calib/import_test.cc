@@ -117,6 +117,15 @@ TEST(Import, BadTomlNamesFileAndKey) {
   ASSERT_EQ(ordered.size(), 2u);
   EXPECT_EQ(ordered[0].name, "first");
   EXPECT_EQ(ordered[1].name, "cam_1");
+  // A camera's section without its matrix is named, not left out (the others were imported).
+  std::ofstream(path) << "[cam_2]\nname = \"first\"\nsize = [10, 10]\n"
+                         "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\n"
+                         "[cam_1]\nsize = [10, 10]\ndistortions = [0.1, 0.2]\n"
+                         "rotation = [0, 0, 0]\ntranslation = [0, 0, 1]\n"
+                         "[metadata]\nadjusted = false\n";
+  EXPECT_THAT([&] { ReadCalibrationToml(path); },
+              ThrowsMessage<Error>(::testing::AllOf(HasSubstr("[cam_1]"),
+                                                    HasSubstr("key 'matrix' is missing"))));
   // k1 k2 alone: the radial terms, the rest 0.
   std::ofstream(path) << "[cam_1]\nname = \"x\"\nsize = [10, 10]\n"
                          "matrix = [[1, 0, 2], [0, 1, 3], [0, 0, 1]]\ndistortions = [0.1, 0.2]\n";

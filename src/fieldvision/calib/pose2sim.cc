@@ -75,7 +75,8 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
     c.name = serial;
     const double width = fov.Number("right") - fov.Number("left") + 1;
     const double height = fov.Number("bottom") - fov.Number("top") + 1;
-    FV_REQUIRE(width >= 1 && height >= 1 && width <= camera::Camera::kMaxSide &&
+    // 16 px a side at least: an all-zero fov_video (a camera left out of the capture) is 1x1.
+    FV_REQUIRE(width >= 16 && height >= 16 && width <= camera::Camera::kMaxSide &&
                    height <= camera::Camera::kMaxSide,
                "Qualisys calibration '{}': camera {}'s fov_video makes a {}x{} image", path, serial,
                width, height);

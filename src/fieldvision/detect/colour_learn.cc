@@ -351,6 +351,12 @@ ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
   }
   FV_REQUIRE(px.positive.size() >= 5,
              "only {} positive pixels; give more points or a larger region", px.positive.size());
+  // Without background the purity check cannot fail: a box over the whole frame learned a class
+  // of every colour, written as good.
+  FV_REQUIRE(px.negative.size() >= 50,
+             "colour learn: {} background pixels outside the ball's boxes (a box over the whole "
+             "frame?): a class cannot be checked against the background; box the ball tightly",
+             px.negative.size());
   ColourLearnResult result;
   result.range = ShrinkAgainstNegatives(InitialColourRange(px.positive, o), px, o.min_recall);
   result.positives = static_cast<int>(px.positive.size());

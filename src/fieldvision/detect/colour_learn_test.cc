@@ -1,5 +1,6 @@
 #include "fieldvision/detect/colour_learn.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -12,6 +13,9 @@
 
 namespace fv::detect {
 namespace {
+
+using ::testing::HasSubstr;
+using ::testing::ThrowsMessage;
 
 // Share of the pixels of `mask` (CV_8U) that the class selects.
 double Selected(const ColourTable& t, const cv::Mat& bgr, const cv::Mat& mask) {
@@ -82,6 +86,11 @@ TEST(LearnColour, AClassThatSelectsTheBackgroundIsBad) {
   test_util::PaintDisc(clean, c, 14, cv::Vec3b(180, 105, 255));
   o.roi = cv::Rect(140, 50, 40, 40);
   EXPECT_FALSE(LearnColour(clean, o).bad);
+  // A box over the whole frame leaves no background to check the class against: refused (it
+  // learned every colour and called the class good).
+  o.roi = cv::Rect(0, 0, 320, 240);
+  EXPECT_THAT([&] { LearnColour(clean, o); },
+              ThrowsMessage<Error>(HasSubstr("a class cannot be checked against the background")));
 }
 
 TEST(LearnColourStages, HueIntervalIsCircularAndTrimmed) {

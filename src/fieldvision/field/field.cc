@@ -48,9 +48,14 @@ void FieldModel::Check() const {
   FV_REQUIRE(std::max(length_m, width_m) <= kMaxAspect * std::min(length_m, width_m),
              "{}: {} x {} m: one side is more than {:.0f} times the other", ctx, length_m, width_m,
              kMaxAspect);
+  // Everything painted or named lies within the largest field's reach of its centre.
+  auto within = [&](double metres) { return std::abs(metres) <= kMaxSideM; };
   for (const auto& s : segments) {
     FV_REQUIRE(s.a.allFinite() && s.b.allFinite() && std::isfinite(s.width_m) && s.width_m > 0,
                "{}: line '{}' has a non-finite end or a bad width", ctx, s.name);
+    FV_REQUIRE(s.a.cwiseAbs().maxCoeff() <= kMaxSideM && s.b.cwiseAbs().maxCoeff() <= kMaxSideM &&
+                   s.width_m <= kMaxSideM,
+               "{}: line '{}' reaches more than {:.0f} m from the centre", ctx, s.name, kMaxSideM);
   }
   for (const auto& a : arcs) {
     FV_REQUIRE(a.centre.allFinite() && std::isfinite(a.radius_m) && a.radius_m > 0 &&
@@ -60,16 +65,29 @@ void FieldModel::Check() const {
                "{}: arc '{}' needs a finite centre, radius > 0 and start_rad < end_rad <= "
                "start_rad + 2 pi",
                ctx, a.name);
+    FV_REQUIRE(a.centre.cwiseAbs().maxCoeff() + a.radius_m <= kMaxSideM && a.width_m <= kMaxSideM,
+               "{}: arc '{}' reaches more than {:.0f} m from the centre", ctx, a.name, kMaxSideM);
   }
   std::set<std::string> names;
   for (const auto& k : keypoints) {
     FV_REQUIRE(!k.name.empty(), "{}: a keypoint has no name", ctx);
     FV_REQUIRE(k.position_m.allFinite(), "{}: keypoint '{}' is not finite", ctx, k.name);
+    FV_REQUIRE(k.position_m.cwiseAbs().maxCoeff() <= kMaxSideM,
+               "{}: keypoint '{}' lies more than {:.0f} m from the centre", ctx, k.name, kMaxSideM);
     FV_REQUIRE(names.insert(k.name).second, "{}: keypoint '{}' is listed twice", ctx, k.name);
   }
   for (const auto& g : goals) {
     FV_REQUIRE(g.y_max_m > g.y_min_m && g.height_m > 0 && (g.side == -1 || g.side == 1),
                "{}: goal '{}' needs y_max_m > y_min_m, height_m > 0 and side -1 or 1", ctx, g.name);
+    FV_REQUIRE(within(g.line_x_m) && within(g.y_min_m) && within(g.y_max_m) && within(g.height_m) &&
+                   within(g.depth_m),
+               "{}: goal '{}' reaches more than {:.0f} m from the centre", ctx, g.name, kMaxSideM);
+  }
+  for (const auto& h : hoops) {
+    FV_REQUIRE(h.centre_m.allFinite() && h.centre_m.cwiseAbs().maxCoeff() <= kMaxSideM &&
+                   std::isfinite(h.radius_m) && h.radius_m > 0 && h.radius_m <= kMaxSideM,
+               "{}: hoop '{}' needs a centre within {:.0f} m of the field's and a radius > 0", ctx,
+               h.name, kMaxSideM);
   }
 }
 

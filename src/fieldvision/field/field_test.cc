@@ -146,6 +146,16 @@ TEST(Fields, BadNamesAndFiles) {
     std::ofstream(dir + "/huge.json", std::ios::trunc) << "{\"name\": \"huge\", " << size << "}";
     EXPECT_THAT([&] { LoadField(dir + "/huge.json"); }, ThrowsMessage<Error>(HasSubstr("huge")));
   }
+  // So is anything painted or named beyond that reach (a keypoint at 1e308 was printed whole).
+  for (const auto& [part, what] : std::vector<std::pair<std::string, std::string>>{
+           {R"("keypoints": [{"name": "far", "position_m": [1e308, 0, 0]}])", "keypoint 'far'"},
+           {R"("arcs": [{"name": "wide", "centre": [0, 0], "radius_m": 1e9}])", "arc 'wide'"},
+           {R"("segments": [{"name": "long", "a": [0, 0], "b": [5e3, 0]}])", "line 'long'"}}) {
+    std::ofstream(dir + "/far.json", std::ios::trunc)
+        << R"({"name": "far", "length_m": 100, "width_m": 50, )" << part << "}";
+    EXPECT_THAT([&] { LoadField(dir + "/far.json"); }, ThrowsMessage<Error>(HasSubstr(what + " ")))
+        << part;
+  }
   std::ofstream(dir + "/polo.json", std::ios::trunc) << R"({"length_m": 275, "width_m": 146})";
   EXPECT_NO_THROW(LoadField(dir + "/polo.json"));
 }

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/camera/pose_range.h"
 #include "fieldvision/detect/ball_detector.h"
 #include "fieldvision/field/field.h"
 #include "fieldvision/pipeline/detections_job.h"
@@ -69,6 +70,7 @@ camera::Camera ReadRigCamera(const std::string& path) {
   if (camera.name.empty()) camera.name = path;
   FV_REQUIRE(camera.has_pose,
              "camera file '{}' has no pose (rvec, tvec): calibrate its extrinsics first", path);
+  camera::CheckCameraNearOrigin(camera, "camera file '" + path + "'");
   return camera;
 }
 

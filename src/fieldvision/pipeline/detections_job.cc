@@ -32,6 +32,9 @@ namespace fv::pipeline {
 
 void DetectionsJobOptions::Check() const {
   FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --detections pair");
+  FV_REQUIRE(cameras.size() >= 2 || triangulation.single_camera_ground,
+             "ball: one camera gives no 3D position: give 2 or more --camera/--detections pairs "
+             "(or --ground for positions on the ground)");
   FV_REQUIRE(cameras.size() == detections.size(),
              "ball: {} --camera but {} --detections (they pair up)", cameras.size(),
              detections.size());

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldvision/camera/pose_range.h"
 #include "fieldvision/io/image_file.h"
 #include "fieldvision/util/error.h"
 #include "fieldvision/util/json.h"
@@ -66,13 +67,9 @@ std::optional<Rig> LoadGivenRig(const PlanRunOptions& options) {
   if (!options.camera_paths.empty()) given = RigFromCameraFiles(options.camera_paths);
   if (!given) return given;
   // A camera kilometres away sees nothing and would only stretch the maps.
-  constexpr double kMaxDistanceM = 1e4;
   for (const camera::Camera& c : given->cameras) {
-    const double d = c.CentreInWorld().norm();
-    FV_REQUIRE(d <= kMaxDistanceM,
-               "plan: camera '{}' of '{}' stands {:.3g} m from the field centre (at most {:.0f} "
-               "m)",
-               c.name, options.rig_path.empty() ? "--camera" : options.rig_path, d, kMaxDistanceM);
+    camera::CheckCameraNearOrigin(
+        c, "plan: " + (options.rig_path.empty() ? std::string("--camera") : options.rig_path));
   }
   return given;
 }

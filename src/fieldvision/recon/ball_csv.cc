@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 
 namespace fv::recon {
 
@@ -49,8 +50,12 @@ BallSample ReadBallCsvRow(const util::CsvTable& t, size_t r) {
   return s;
 }
 
+namespace {
+constexpr double kMaxPositionM = 1e4;
+}  // namespace
+
 void CheckBallTrackRanges(const util::CsvTable& table) {
-  constexpr double kMaxFrame = 1e8, kMaxPositionM = 1e4, kMaxTimeS = 1e11;
+  constexpr double kMaxFrame = 1e8, kMaxTimeS = 1e11;
   for (size_t r = 0; r < table.rows(); ++r) {
     const BallSample s = ReadBallCsvRow(table, r);
     if (table.Has("frame")) {
@@ -108,6 +113,13 @@ BallTrackFile ParseBallTrack(const util::CsvTable& t) {
           fmt::format("{}: NaN or infinite time or position; row skipped", t.Where(r)));
       continue;
     }
+    if (s.ball_in_world.cwiseAbs().maxCoeff() > kMaxPositionM) {
+      out.skipped.push_back(
+          fmt::format("{}: position more than {:.0f} m from the origin; row "
+                      "skipped",
+                      t.Where(r), kMaxPositionM));
+      continue;
+    }
     if (!out.samples.empty() && s.time_s <= out.samples.back().time_s) {
       const bool dup = s.time_s == out.samples.back().time_s;
       out_of_order += !dup;
@@ -124,7 +136,31 @@ BallTrackFile ParseBallTrack(const util::CsvTable& t) {
              "ball track '{}': times are not increasing ({} rows out of order); sort the file "
              "by time",
              t.name(), out_of_order);
+  CheckBallTrackUnits(out.samples, t.name());
   return out;
+}
+
+void CheckBallTrackUnits(const std::vector<BallSample>& samples, const std::string& name) {
+  // Rows 1 s apart or more, or a ball that moves faster than any ball is hit (the fastest
+  // shuttlecock smash is about 140 m/s) from one row to the next, half the time: not seconds and
+  // metres.
+  constexpr double kMaxMedianStepS = 1.0, kMaxMedianSpeedMps = 150.0;
+  if (samples.size() < 3) return;
+  std::vector<double> steps_s, speeds_mps;
+  for (size_t i = 1; i < samples.size(); ++i) {
+    const double dt = samples[i].time_s - samples[i - 1].time_s;
+    steps_s.push_back(dt);
+    speeds_mps.push_back((samples[i].ball_in_world - samples[i - 1].ball_in_world).norm() / dt);
+  }
+  const double step_s = util::Median(steps_s), speed_mps = util::Median(speeds_mps);
+  FV_REQUIRE(step_s < kMaxMedianStepS,
+             "ball track '{}': rows are {:.4g} s apart (the median): are its times in seconds "
+             "(not milliseconds or frames)?",
+             name, step_s);
+  FV_REQUIRE(speed_mps < kMaxMedianSpeedMps,
+             "ball track '{}': the ball moves {:.4g} m/s between rows (the median), faster than "
+             "any ball: are its positions in metres (not millimetres)?",
+             name, speed_mps);
 }
 
 BallTrackFile ReadBallTrack(const std::string& path) {

@@ -32,8 +32,12 @@ struct BallTrackFile {
 
 // A ball track for fitting flights: throws fv::Error naming the file when columns are missing, no
 // row is valid or most rows are out of time order; skips (and names) single bad rows (not
-// numbers, NaN, times not increasing, duplicates).
+// numbers, NaN, positions beyond 10 km, times not increasing, duplicates) and checks the units
+// (CheckBallTrackUnits).
 BallTrackFile ParseBallTrack(const util::CsvTable& table);
+// Throws fv::Error naming `name` when the samples are not in seconds and metres: the median step
+// 1 s or more (milliseconds), or the median speed between rows 150 m/s or more (millimetres).
+void CheckBallTrackUnits(const std::vector<BallSample>& samples, const std::string& name);
 BallTrackFile ReadBallTrack(const std::string& path);
 // Writes BALL.csv (BallCsvColumns()).
 void WriteBallTrack(const std::string& path, const std::vector<BallSample>& samples);

@@ -366,6 +366,10 @@ TrajectoryBatchResult RunTrajectoryBatch(const TrajectoryJob& job,
       for (const auto& b : r.result.breaks) bounce |= b.kind == FlightEvent::kBounce;
       if (bounce) scores.push_back(ScoreBounceTrack(file, r.input.samples, r.options));
     }
+    // Nothing fitted: no summary of nothing (an earlier one is kept).
+    FV_REQUIRE(res.failed.size() < files.size(),
+               "trajectory: none of the {} tracks could be read or fitted (the first: {})",
+               files.size(), res.failed.empty() ? "" : res.failed.front());
     summary.CloseAndCommit(csv);
   }
   if (!scores.empty()) log << Summarize(scores).Table();

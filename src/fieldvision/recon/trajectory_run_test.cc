@@ -81,6 +81,42 @@ TEST(TrajectoryRun, WritesTheContractJsonPicturesAndSmoothedTrack) {
   EXPECT_THROW(RunTrajectory(job, log), Error);
 }
 
+// Batch mode: a summary row per flight of the tracks that read; the failed ones are listed, and a
+// batch of which none reads fails without a summary (it wrote one of nothing, exit 0).
+TEST(TrajectoryRun, ABatchListsItsFailuresAndFailsWhenNothingFits) {
+  testing::SeededRng rng(47);
+  BallSimOptions o;
+  o.start_m = {-6, -1, 0.11};
+  o.kicks = {{0.2, {8, 1.5, 6}}};
+  o.duration_s = 2.0;
+  const BallSimulation sim(o);
+  const std::string dir = testing::TempDir() + "/batch";
+  std::filesystem::create_directories(dir);
+  WriteBallTrack(dir + "/good.csv", sim.Sample(50.0, 0.005, 0.05, 0.02, 0.5, rng));
+  std::ofstream(dir + "/junk.csv") << "not,a,ball,track\n1,2\n";
+  TrajectoryJob job;
+  job.out_path = dir + "/out";
+  std::ostringstream log;
+  const TrajectoryBatchResult r =
+      RunTrajectoryBatch(job, {dir + "/good.csv", dir + "/junk.csv"}, log);
+  ASSERT_EQ(r.failed.size(), 1u);
+  EXPECT_NE(r.failed[0].find("junk.csv"), std::string::npos) << r.failed[0];
+  EXPECT_TRUE(std::filesystem::exists(r.summary_csv));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/out/good.json"));
+  std::ifstream summary(r.summary_csv);
+  const std::string before((std::istreambuf_iterator<char>(summary)),
+                           std::istreambuf_iterator<char>());
+  try {
+    RunTrajectoryBatch(job, {dir + "/junk.csv"}, log);
+    ADD_FAILURE() << "a batch of which nothing reads passed";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("none of the 1 tracks"), std::string::npos) << e.what();
+  }
+  std::ifstream again(r.summary_csv);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>()),
+            before);
+}
+
 // A ball that never rests (60 hops in one airborne block): every bounce is found. Finding the
 // breaks took O(samples x breaks^2) (a 40,000-row track of such hops did not finish).
 TEST(TrajectoryRun, LongBlockWithManyBounces) {

@@ -386,6 +386,36 @@ std::vector<std::tuple<double, int, int, double>> PairDistancesPerSecond(
   return out;
 }
 
+namespace {
+
+// Players that move faster than anyone runs (12.5 m/s) over a second or more, half the time:
+// positions not in metres. (From one row to the next, 20 cm of position noise at 100 frames/s
+// is 28 m/s.)
+void CheckPlayerSpeedUnits(std::map<int, std::vector<const track::TrackRow*>>& by_id, double fps) {
+  constexpr double kMaxMedianSpeedMps = 20.0, kBaselineS = 1.0;
+  std::vector<double> speeds_mps;
+  for (auto& [id, rs] : by_id) {
+    std::sort(rs.begin(), rs.end(), [](auto* a, auto* b) { return a->frame < b->frame; });
+    size_t j = 0;
+    for (size_t i = 0; i < rs.size(); ++i) {
+      const double t = TimeOf(*rs[i], fps);
+      j = std::max(j, i + 1);
+      while (j < rs.size() && TimeOf(*rs[j], fps) - t < kBaselineS) ++j;
+      if (j >= rs.size()) break;
+      speeds_mps.push_back(std::hypot(*rs[j]->x_m - *rs[i]->x_m, *rs[j]->y_m - *rs[i]->y_m) /
+                           (TimeOf(*rs[j], fps) - t));
+    }
+  }
+  if (speeds_mps.empty()) return;
+  const double median = util::Median(speeds_mps);
+  FV_REQUIRE(median < kMaxMedianSpeedMps,
+             "the players move {:.4g} m/s over a second (the median), faster than anyone runs: "
+             "are x_m, y_m metres (not millimetres or pixels)?",
+             median);
+}
+
+}  // namespace
+
 StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOptions& options) {
   options.Check();
   std::map<int, std::vector<const track::TrackRow*>> by_id;
@@ -408,9 +438,14 @@ StatsResult ComputeStats(const std::vector<track::TrackRow>& rows, const StatsOp
   } else {
     // The rate of the rows' own times: the median step between consecutive frames.
     res.fps = FrameRateOfRows(rows);
+    FV_REQUIRE(res.fps == 0 || res.fps >= 0.2,
+               "the tracks' time_s steps {:.4g} s a frame (the median; {:.3g} frames/s): are "
+               "they seconds, not milliseconds? (--fps gives the video's rate instead)",
+               1 / res.fps, res.fps);
     res.time_source = "TRACKS.csv time_s";
     o.fps = res.fps > 0 ? res.fps : 25.0;  // only for the gap rule of SmoothPositions
   }
+  CheckPlayerSpeedUnits(by_id, options.fps);
   double t_min = 1e300, t_max = -1e300;
   for (auto& [id, rs] : by_id) {
     std::sort(rs.begin(), rs.end(), [](auto* a, auto* b) { return a->frame < b->frame; });

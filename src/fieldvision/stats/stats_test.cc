@@ -257,7 +257,7 @@ TEST(Stats, PositionsBeyondThePictureAreNotedAndSparseSamplesCount) {
     a.box = cv::Rect2d(0, 0, 10, 20);
     a.x_m = -5.0 + 0.01 * i;
     a.y_m = 2.0;
-    a.time_s = 10.0 * i;  // one position every 10 s
+    a.time_s = 4.0 * i;  // one position every 4 s
     rows.push_back(a);
     track::TrackRow b = a;
     b.id = 2;
@@ -275,7 +275,7 @@ TEST(Stats, PositionsBeyondThePictureAreNotedAndSparseSamplesCount) {
   // Player 2's map says it is empty instead of drawing a scale from 0 to 0.
   const cv::Mat empty = cv::imread(dir + "/heatmap_player2.png");
   ASSERT_FALSE(empty.empty());
-  // Player 1's 30 positions 10 s apart stand for 300 s on its map (a fixed 0.5 s cap: 15 s).
+  // Player 1's 30 positions 4 s apart stand for 120 s on its map (a fixed 0.5 s cap: 15 s).
   const SmoothTrack* one = nullptr;
   for (const auto& t : r.tracks) {
     if (t.id == 1) one = &t;
@@ -283,7 +283,7 @@ TEST(Stats, PositionsBeyondThePictureAreNotedAndSparseSamplesCount) {
   ASSERT_NE(one, nullptr);
   const field::TopView view = field::TopView::ForField(field::BuiltinField("futsal"), 800, 2.0);
   const cv::Mat density = TimeSpentPerSquareMetre({one}, view, o);
-  EXPECT_NEAR(cv::sum(density)[0] / (view.px_per_m * view.px_per_m), 300.0, 3.0);
+  EXPECT_NEAR(cv::sum(density)[0] / (view.px_per_m * view.px_per_m), 120.0, 1.2);
 }
 
 // The time comes from TRACKS.csv's time_s (here 10 frames/s, the rate of the video), --fps
@@ -317,6 +317,17 @@ TEST(Stats, TimeFromTracksAndRateOverride) {
   const StatsResult fast = ComputeStats(rows, o);
   EXPECT_NEAR(fast.players[0].top_speed_mps, v * 2.5, 0.6);
   EXPECT_NE(fast.Summary().find("--fps 25"), std::string::npos) << fast.Summary();
+  // Times in milliseconds, positions in millimetres: named, not 0.01 frames/s and no speed.
+  std::vector<track::TrackRow> ms = rows, mm = rows;
+  for (auto& row : ms) *row.time_s *= 1000;
+  EXPECT_THAT([&] { ComputeStats(ms, StatsOptions{}); },
+              ThrowsMessage<fv::Error>(HasSubstr("are they seconds, not milliseconds?")));
+  for (auto& row : mm) {
+    *row.x_m *= 1000;
+    *row.y_m *= 1000;
+  }
+  EXPECT_THAT([&] { ComputeStats(mm, StatsOptions{}); },
+              ThrowsMessage<fv::Error>(HasSubstr("are x_m, y_m metres")));
   for (auto& row : rows) row.time_s.reset();
   EXPECT_THAT([&] { ComputeStats(rows, StatsOptions{}); },
               ThrowsMessage<fv::Error>(HasSubstr("--fps")));

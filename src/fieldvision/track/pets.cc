@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -60,6 +61,7 @@ std::vector<TrackRow> ReadPetsCvml(const std::string& path) {
   FV_REQUIRE(text.find("<dataset") != std::string::npos,
              "'{}' is not a CVML annotation file (no <dataset>)", path);
   std::vector<TrackRow> rows;
+  std::set<std::pair<int, int>> boxed;  // (frame, id): one box each, as MOTChallenge allows
   int frame = -1, id = -1;
   size_t pos = 0;
   while ((pos = text.find('<', pos)) != std::string::npos) {
@@ -80,6 +82,10 @@ std::vector<TrackRow> ReadPetsCvml(const std::string& path) {
           std::abs(xc) <= 1e6 && std::abs(yc) <= 1e6 && w >= 0 && w <= 1e6 && h >= 0 && h <= 1e6,
           "{}: box xc={} yc={} w={} h={} is not a box in an image (within +-1e6 px)", where, xc, yc,
           w, h);
+      FV_REQUIRE(boxed.emplace(frame, id).second,
+                 "{}: object {} has a second box in frame {} (an id, or a frame number, given "
+                 "twice)",
+                 where, id, frame);
       TrackRow r;
       r.frame = frame + 1;  // CVML numbers frames from 0, MOTChallenge from 1
       r.id = id;

@@ -95,6 +95,15 @@ TEST(Pets, BadFilesGiveErrorsNamingThem) {
   }
   EXPECT_THAT([&] { ReadTsaiXml(dir + "/bad.xml"); },
               ThrowsMessage<fv::Error>(HasSubstr("bad.xml")));
+  // An id given twice in a frame (or a frame number twice) is named, not written as ground truth
+  // that eval tracks then refuses.
+  std::ofstream(dir + "/twice.xml")
+      << "<dataset><frame number=\"0\"><objectlist>"
+         "<object id=\"9\"><box xc=\"10\" yc=\"10\" w=\"4\" h=\"8\"/></object>"
+         "<object id=\"9\"><box xc=\"30\" yc=\"10\" w=\"4\" h=\"8\"/></object>"
+         "</objectlist></frame></dataset>";
+  EXPECT_THAT([&] { ReadPetsCvml(dir + "/twice.xml"); },
+              ThrowsMessage<fv::Error>(HasSubstr("object 9 has a second box in frame 0")));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/input_file.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::util {
@@ -70,6 +71,7 @@ std::vector<std::string> SplitCsvLine(const std::string& line, const std::string
 }  // namespace
 
 std::string ReadCsvText(const std::string& path, const std::string& what) {
+  RequireInputFile(path, what);
   std::ifstream in(path, std::ios::binary);
   FV_REQUIRE(in.good(), "cannot open {} '{}'", what, path);
   std::stringstream ss;

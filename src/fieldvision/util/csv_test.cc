@@ -83,7 +83,14 @@ TEST(Csv, AByteOrderMarkBeforeTheHeaderIsSkipped) {
 }
 
 TEST(Csv, ErrorsNameTheInput) {
-  EXPECT_THROW(CsvTable::Read("/nonexistent/x.csv"), Error);
+  EXPECT_THAT([&] { CsvTable::Read("/nonexistent/x.csv"); },
+              ThrowsMessage<Error>(HasSubstr("CSV file '/nonexistent/x.csv' does not exist")));
+  // A folder reads as an empty file: "no header" said nothing of what was wrong.
+  const std::string folder = testing::TempDir();
+  EXPECT_THAT([&] { CsvTable::Read(folder); },
+              ThrowsMessage<Error>(HasSubstr("CSV file '" + folder + "' is a folder, not a file")));
+  EXPECT_THAT([&] { ReadCsvText(folder, "detections file"); },
+              ThrowsMessage<Error>(HasSubstr("detections file '" + folder + "' is a folder")));
   EXPECT_THAT([&] { CsvTable::Parse("a,b\n1,2\n3\n", "f.csv"); },
               ThrowsMessage<Error>(HasSubstr("f.csv:3")));
   CsvTable t = CsvTable::Parse("a,b\n1,x\n", "g.csv");

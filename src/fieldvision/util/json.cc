@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/input_file.h"
 
 namespace fv::util {
 namespace {
@@ -46,7 +47,7 @@ int JsonNestingDepth(std::string_view text, int stop_above) {
 }
 
 json ReadJsonFile(const std::string& path, const std::string& what) {
-  FV_REQUIRE(std::filesystem::is_regular_file(path), "{} file '{}' does not exist", what, path);
+  RequireInputFile(path, what + " file");
   std::ifstream in(path, std::ios::binary);
   FV_REQUIRE(in.good(), "{} file '{}' cannot be read", what, path);
   std::stringstream text;
