@@ -73,7 +73,7 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       el('div', { class: 'half' }, el('h3', { text: 'Per player (fieldvision stats)' }), table)),
     el('h3', { text: 'Export' }),
     el('section', { class: 'controls' }, labelled('Folder', exportOut),
-      el('label', { title: 'a folder that is not empty is refused unless this is ticked; its files are then all replaced' }, exportReplace, 'Replace the folder'), exportButton),
+      el('label', { title: 'a folder that is not empty is refused unless this is ticked; then an earlier export there is replaced and other files are kept' }, exportReplace, 'Replace an earlier export'), exportButton),
     el('p', { class: 'hint', text: 'Writes the statistics (players.csv, speed_profiles.csv, distances.csv, zone_alerts.csv, stats.json, index.html), the heat maps with their scales and the radar view as `fieldvision stats` makes them, and this page\'s heat map (with its scale), board, speed chart and zone alerts as page_*.png.' }),
     exportMsg,
   );

@@ -489,7 +489,7 @@ try {
   await page.click('#pl-export');
   await page.waitForFunction(() => /^wrote \d+ files/.test(document.querySelector('#pl-export-status').textContent));
   check(fs.existsSync(path.join(exported, 'players.csv')) && fs.readdirSync(work).every((f) => !f.startsWith('.players_export')),
-    'export: with "Replace the folder" ticked it is written again');
+    'export: with "Replace an earlier export" ticked it is written again');
   lap('players');
   check(consoleErrors.length === 0, `no errors in the page's console${consoleErrors.length ? ': ' + consoleErrors.join(' | ') : ''}`);
 } catch (e) {

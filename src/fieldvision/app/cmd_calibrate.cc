@@ -457,7 +457,7 @@ void RunRefine(const RefineCli& c) {
   const field::FieldModel field = field::LoadField(c.field);
   const RefineResult r = RefineWithLines(cam, image, field, c.o);
   // No line pixel near a line: nothing to refine with, and no line error (0.0 mm read as perfect).
-  FV_REQUIRE(r.before.num_inliers > 0,
+  FV_REQUIRE(r.accepted || r.before.num_inliers > 0,
              "calibrate refine: camera '{}' sees no line of field '{}' in '{}' ({} line pixels, "
              "none near a line): the pose or the field is wrong; nothing written",
              c.camera, field.name, image_path, r.before.num_pixels);

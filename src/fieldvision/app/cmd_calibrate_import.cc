@@ -88,8 +88,8 @@ void RunImport(const ImportCli& c) {
     util::CheckOutputPath(c.out, {c.tsai});
     // Tsai's one-coefficient radial model is fitted exactly by OpenCV's for real lenses (PETS
     // View_001: 0.000 px); a large difference is a distortion no lens has (a mistyped kappa1):
-    // tens of pixels are not written.
-    FV_REQUIRE(conv.max_fit_error_px <= 10.0,
+    // 50 pixels and more are not written (20 times PETS' kappa1, a very wide lens: 12 px).
+    FV_REQUIRE(conv.max_fit_error_px <= 50.0,
                "'{}': OpenCV's lens model cannot follow Tsai's (up to {:.0f} px apart over the "
                "image): check kappa1 ({}) and the sensor sizes in the file; nothing written",
                c.tsai, conv.max_fit_error_px, p.kappa1);
@@ -112,7 +112,10 @@ void RunImport(const ImportCli& c) {
   }
   std::vector<camera::Camera> cams;
   if (!c.qualisys.empty()) {
-    cams = calib::ReadQualisysCalibration(c.qualisys);
+    std::vector<std::string> skipped;
+    cams = calib::ReadQualisysCalibration(c.qualisys, &skipped);
+    for (const std::string& s : skipped)
+      std::cerr << "warning: '" << c.qualisys << "': " << s << "\n";
   } else if (!c.toml.empty()) {
     cams = calib::ReadCalibrationToml(c.toml, MetresPerUnit(c.units));
   } else {
@@ -147,6 +150,7 @@ void RunExport(const ExportCli& c) {
     files.insert(files.end(), in_rig.begin(), in_rig.end());
     std::sort(files.begin(), files.end());
   }
+  FV_REQUIRE(c.rig.empty() || !files.empty(), "--rig '{}' holds no camera file (*.yaml)", c.rig);
   FV_REQUIRE(!files.empty(), "give --camera CAM.yaml (repeat) or --rig DIR");
   std::vector<camera::Camera> cams;
   cams.reserve(files.size());

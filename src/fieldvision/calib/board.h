@@ -98,6 +98,8 @@ class ImageSource {
   explicit ImageSource(const std::string& spec, const ImageSourceOptions& options = {});
   int size() const { return static_cast<int>(names_.size()); }
   const std::string& spec() const { return spec_; }
+  // "images", or for a video "frames sampled from the video" (for messages).
+  std::string what() const { return video_ ? "frames sampled from the video" : "images"; }
   const std::string& name(int i) const { return names_[i]; }
   // Reads image i (BGR or grey as stored); throws naming the file when it cannot be read. A
   // video is read forward through io's frame source (reopened when i goes back).

@@ -555,8 +555,11 @@ void AddNotes(const IntrinsicsOptions& options, IntrinsicsResult* out) {
   cam.notes["distortion_model"] = std::to_string(options.num_distortion) + " coefficients";
   if (result.k3_tested) {
     cam.notes["distortion_model"] +=
-        fmt::format(", k3 {} (BIC gain of fitting it {:.1f}; kept by auto over {:.0f})",
-                    result.k3_kept ? "fitted" : "zero", result.k3_bic_gain, kK3MinBicGain);
+        options.k3 == K3Model::kFree
+            ? fmt::format(", k3 fitted (asked for; BIC gain of fitting it {:.1f})",
+                          result.k3_bic_gain)
+            : fmt::format(", k3 {} (BIC gain of fitting it {:.1f}; kept by auto over {:.0f})",
+                          result.k3_kept ? "fitted" : "zero", result.k3_bic_gain, kK3MinBicGain);
   } else if (options.num_distortion == 5 && options.k3 == K3Model::kZero) {
     cam.notes["distortion_model"] += ", k3 zero";
   }
@@ -616,8 +619,8 @@ IntrinsicsResult CalibrateIntrinsics(const std::string& images, const Intrinsics
   progress.Finish();
   const bool any = std::any_of(views.begin(), views.end(),
                                [](const BoardView& v) { return !v.image_points.empty(); });
-  FV_REQUIRE(any, "images '{}': no {} found in any of the {} images {}", images,
-             options.board.Describe(), views.size(),
+  FV_REQUIRE(any, "images '{}': no {} found in any of the {} {} {}", images,
+             options.board.Describe(), views.size(), source.what(),
              BoardNotFoundHint(source.Read(0), options.board));
   IntrinsicsResult result = CalibrateFromViews(views, options);
   const LargerBoard larger = LargerChessboardInViews(views, source, options.board);

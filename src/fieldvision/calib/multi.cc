@@ -1001,6 +1001,11 @@ void CollectPairs(const std::vector<MultiFrame>& frames, const std::vector<camer
                            Eigen::Matrix3d::Identity()) *
                        kRadToDeg;
       p.baseline_m = (a.CentreInWorld() - b.CentreInWorld()).norm();
+      // Two cameras at one place see nothing in depth (ball and fuse refuse such a rig).
+      FV_REQUIRE(p.baseline_m >= 1e-3,
+                 "cameras '{}' and '{}' come out at one place ({:.2f} mm apart, turned {:.3f} "
+                 "deg): were the same views given for both?",
+                 a.name, b.name, 1000 * p.baseline_m, p.rotation_deg);
       if (options.compare_opencv && p.shared_views >= 3) {
         CompareWithOpenCv(frames, cams, s, *result, &p);
       }

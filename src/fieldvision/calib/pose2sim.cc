@@ -47,7 +47,8 @@ class Attributes {
 
 }  // namespace
 
-std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
+std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path,
+                                                    std::vector<std::string>* skipped) {
   std::ifstream in(path);
   FV_REQUIRE(in.good(), "Qualisys calibration '{}' cannot be read", path);
   std::stringstream ss;
@@ -61,6 +62,7 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
              "file)",
              path);
   std::vector<camera::Camera> cams;
+  size_t left_out = 0;
   for (auto it = std::sregex_iterator(text.begin(), text.end(), kCamera);
        it != std::sregex_iterator(); ++it) {
     const std::string serial = (*it)[1].str();
@@ -73,9 +75,18 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
     const Attributes k = element(4, "intrinsic");
     camera::Camera c;
     c.name = serial;
+    if (fov.Number("right") == 0 && fov.Number("left") == 0 && fov.Number("bottom") == 0 &&
+        fov.Number("top") == 0) {
+      ++left_out;
+      if (skipped != nullptr) {
+        skipped->push_back(fmt::format(
+            "camera {}: its fov_video is all zeros (not in the capture); left out", serial));
+      }
+      continue;
+    }
     const double width = fov.Number("right") - fov.Number("left") + 1;
     const double height = fov.Number("bottom") - fov.Number("top") + 1;
-    // 16 px a side at least: an all-zero fov_video (a camera left out of the capture) is 1x1.
+    // 16 px a side at least (another size is a damaged element).
     FV_REQUIRE(width >= 16 && height >= 16 && width <= camera::Camera::kMaxSide &&
                    height <= camera::Camera::kMaxSide,
                "Qualisys calibration '{}': camera {}'s fov_video makes a {}x{} image", path, serial,
@@ -114,16 +125,17 @@ std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path) {
     c.Check("Qualisys calibration '" + path + "' camera " + c.name);
     cams.push_back(c);
   }
-  FV_REQUIRE(!cams.empty(), "Qualisys calibration '{}' has no cameras", path);
+  FV_REQUIRE(!cams.empty(), "Qualisys calibration '{}' has no cameras{}", path,
+             left_out > 0 ? " in the capture (every fov_video is all zeros)" : "");
   size_t tags = 0;
   for (size_t at = text.find("<camera "); at != std::string::npos;
        at = text.find("<camera ", at + 1)) {
     ++tags;
   }
-  FV_REQUIRE(tags == cams.size(),
+  FV_REQUIRE(tags == cams.size() + left_out,
              "Qualisys calibration '{}': {} <camera> elements, {} of them whole (fov_video, "
              "transform and intrinsic each)",
-             path, tags, cams.size());
+             path, tags, cams.size() + left_out);
   return cams;
 }
 

@@ -17,7 +17,10 @@ namespace fv::calib {
 // Pose2Sim does (the transform's rows are Qualisys' camera axes, looking along -z with y up: x_cam
 // = Rx(pi) R (x - position)). Throws fv::Error naming the file when it cannot be read or has no
 // cameras.
-std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path);
+// A camera whose fov_video is all zeros (not in the capture) is left out and named in `skipped`
+// (when given).
+std::vector<camera::Camera> ReadQualisysCalibration(const std::string& path,
+                                                    std::vector<std::string>* skipped = nullptr);
 
 struct RigComparison {
   // Per pair (i < j): |C_i - C_j| of a minus that of b (mm), and the angle of

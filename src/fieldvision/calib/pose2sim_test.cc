@@ -93,6 +93,17 @@ TEST(Pose2Sim, DamagedQualisysFilesAreRefused) {
   std::string comma = text;
   comma.replace(r11, comma.find('"', r11) - r11, "0,5");
   EXPECT_NE(error_of("comma.qca.txt", comma).find("'0,5' is not a number"), std::string::npos);
+  // A camera left out of the capture (fov_video all zeros) is left out and named; the others
+  // are read (it was a 1x1 camera).
+  std::string unused = text;
+  const size_t first_fov = unused.find("<fov_video ");
+  unused.replace(first_fov, unused.find("/>", first_fov) + 2 - first_fov,
+                 R"(<fov_video left="0" top="0" right="0" bottom="0"/>)");
+  std::ofstream(dir + "/unused.qca.txt") << unused;
+  std::vector<std::string> skipped;
+  EXPECT_EQ(ReadQualisysCalibration(dir + "/unused.qca.txt", &skipped).size(), 3u);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].find("all zeros"), std::string::npos) << skipped[0];
 }
 
 TEST(Pose2Sim, IntrinsicsAndScenePosesAgreeWithQualisys) {

@@ -355,7 +355,8 @@ ColourLearnResult LearnColour(const std::vector<ColourLearnSample>& samples,
   // of every colour, written as good.
   FV_REQUIRE(px.negative.size() >= 50,
              "colour learn: {} background pixels outside the ball's boxes (a box over the whole "
-             "frame?): a class cannot be checked against the background; box the ball tightly",
+             "frame?): a class cannot be checked against the background; box the ball tightly, or "
+             "mark background with --negative",
              px.negative.size());
   ColourLearnResult result;
   result.range = ShrinkAgainstNegatives(InitialColourRange(px.positive, o), px, o.min_recall);

@@ -80,7 +80,9 @@ FileSource::FileSource(const std::string& path, const FrameSourceOptions& option
     codecs::DecoderProblems();  // count what FFmpeg's decoders conceal (main warns)
   }
   const double container_fps = avi_ ? avi_->fps() : capture_->get(cv::CAP_PROP_FPS);
-  const bool container_rate = !pattern && std::isfinite(container_fps) && container_fps > 0;
+  // A rate above any camera's (--fps allows 100000) is a damaged header's: no rate of its own.
+  const bool container_rate =
+      !pattern && std::isfinite(container_fps) && container_fps > 0 && container_fps <= 1e5;
   fps_ = options.fps > 0 ? options.fps : (container_rate ? container_fps : 30);
   rate_known_ = options.fps > 0 || options.time == TimeSource::kCsv || container_rate;
   const double count =

@@ -12,6 +12,7 @@
 #include "fieldvision/io/video_source.h"
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/stats.h"
 #include "fieldvision/util/strings.h"
 
 namespace fv::io {
@@ -74,6 +75,20 @@ std::map<long long, double> ReadTimestampsCsv(const std::string& path) {
     }
     times.emplace_hint(times.end(), row.first, row.second.first);
     previous = &row;
+  }
+  // A camera's frames come more than once a second: a median step of a second or more is
+  // milliseconds (or frame numbers) in time_s.
+  std::vector<double> steps_s;
+  for (auto it = times.begin(); std::next(it) != times.end(); ++it) {
+    steps_s.push_back((std::next(it)->second - it->second) /
+                      static_cast<double>(std::next(it)->first - it->first));
+  }
+  if (!steps_s.empty()) {
+    const double step_s = util::Median(steps_s);
+    FV_REQUIRE(step_s < 1.0,
+               "timestamps '{}': frames are {:.4g} s apart (the median): is time_s in seconds "
+               "(not milliseconds)?",
+               path, step_s);
   }
   return times;
 }

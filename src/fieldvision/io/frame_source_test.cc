@@ -225,6 +225,10 @@ TEST(FrameSource, TimestampsCsvRangesNameFileAndLine) {
   }
   std::ofstream(bad, std::ios::trunc) << "frame,time_s\n";
   EXPECT_THROW(ReadTimestampsCsv(bad), Error);
+  // Milliseconds (40 "s" a frame at 25 frames/s) are said, not taken as a 0.025 frames/s video.
+  std::ofstream(bad, std::ios::trunc) << "frame,time_s\n0,0\n1,40\n2,80\n3,120\n";
+  EXPECT_NE(testing::ErrorOf([&] { ReadTimestampsCsv(bad); }).find("frames are 40 s apart"),
+            std::string::npos);
 }
 
 TEST(FrameSource, RealtimeFileIsStampedOnTheSystemClockAndSkipsWhatIsGone) {

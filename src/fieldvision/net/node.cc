@@ -104,8 +104,9 @@ constexpr char kFrameTag = 'f', kOtherTag = 'o';
 constexpr double kStepWaitS = 10.0;
 
 // How long a fusion node may ignore a node for now (a second node of its camera, while the
-// first goes on; it gives way after 1.5 s of quiet) before the node stops.
-constexpr double kRefusedForNowS = 3.0;
+// first goes on; it gives way after 1.5 s of quiet, or once it has read the first one's bye
+// behind its queued frames) before the node stops.
+constexpr double kRefusedForNowS = 10.0;
 
 std::string NewSession() {
   std::random_device rd;

@@ -32,12 +32,12 @@ namespace fv::pipeline {
 
 void DetectionsJobOptions::Check() const {
   FV_REQUIRE(!cameras.empty(), "ball: give at least one --camera and --detections pair");
-  FV_REQUIRE(cameras.size() >= 2 || triangulation.single_camera_ground,
-             "ball: one camera gives no 3D position: give 2 or more --camera/--detections pairs "
-             "(or --ground for positions on the ground)");
   FV_REQUIRE(cameras.size() == detections.size(),
              "ball: {} --camera but {} --detections (they pair up)", cameras.size(),
              detections.size());
+  FV_REQUIRE(cameras.size() >= 2 || triangulation.single_camera_ground,
+             "ball: one camera gives no 3D position: give 2 or more --camera/--detections pairs "
+             "(or --ground for positions on the ground)");
   FV_REQUIRE(std::isfinite(ball_diameter_m) && ball_diameter_m > 0 && ball_diameter_m < 2,
              "ball: --ball-diameter must be in (0, 2) metres (got {})", ball_diameter_m);
   FV_REQUIRE(std::isfinite(sigma_px) && sigma_px > 0, "ball: --det-sigma must be > 0 (got {})",

@@ -123,8 +123,16 @@ std::string OptimizeStage(const PlanRunOptions& options, const field::FieldModel
                            *result.given_rig_search_score);
   }
   result.rig = opt.rig;
-  // The field by name (a field file's path would not hold beside the written rig).
-  if (!std::filesystem::exists(field_spec)) result.rig.field = field_spec;
+  // The field by name, or a field file by its path from the rig file's folder (where the rig
+  // reader looks for it).
+  result.rig.field = field_spec;
+  if (std::filesystem::is_regular_file(field_spec)) {
+    std::error_code ec;
+    const std::filesystem::path from_rig = std::filesystem::relative(
+        std::filesystem::absolute(field_spec), std::filesystem::absolute(options.out_dir), ec);
+    result.rig.field =
+        ec || from_rig.empty() ? std::filesystem::absolute(field_spec).string() : from_rig.string();
+  }
   result.optimized = std::move(opt);
   WriteRigJson(result.rig, OutPath(options, "rig.json"));
   result.files.push_back(OutPath(options, "rig.json"));
@@ -245,7 +253,8 @@ PlanRunResult RunPlan(const PlanRunOptions& options) {
   std::string summary;
   if (!given) {
     given = LoadGivenRig(options);
-    if (given && !given->field.empty() && given->field != options.field) {
+    if (given && !given->field.empty() && given->field != options.field &&
+        !util::SameFile(given->field, options.field)) {
       summary += fmt::format("note: --field {} used; the rig file names field {}\n", options.field,
                              given->field);
     }

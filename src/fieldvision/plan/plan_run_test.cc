@@ -119,6 +119,23 @@ TEST(PlanRunTest, TheRigFilesFieldIsUsed) {
     error = e.what();
   }
   EXPECT_NE(error.find("no-such-field"), std::string::npos) << error;
+  // A rig searched on a field file names it by its path from the rig's folder: read back, the
+  // rig is on that field (it fell back to robocup-msl).
+  std::ofstream(dir + "/pitch40.json") << R"({"name": "pitch40", "length_m": 40, "width_m": 20})";
+  PlanRunOptions search = o;
+  search.rig_path.clear();
+  search.optimize = true;
+  search.field = dir + "/pitch40.json";
+  search.out_dir = dir + "/searched";
+  search.search.grid_step_m = 4.0;
+  search.search.iterations = 20;
+  search.search.restarts = 1;
+  search.search.num_cameras = 2;
+  RunPlan(search);
+  PlanRunOptions again = o;
+  again.rig_path = search.out_dir + "/rig.json";
+  again.out_dir = dir + "/again";
+  EXPECT_NE(RunPlan(again).summary.find("field pitch40 (40.00 x 20.00 m)"), std::string::npos);
 }
 
 TEST(PlanRunTest, BadInputGivesOneLineErrors) {

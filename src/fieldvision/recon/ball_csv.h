@@ -36,7 +36,7 @@ struct BallTrackFile {
 // (CheckBallTrackUnits).
 BallTrackFile ParseBallTrack(const util::CsvTable& table);
 // Throws fv::Error naming `name` when the samples are not in seconds and metres: the median step
-// 1 s or more (milliseconds), or the median speed between rows 150 m/s or more (millimetres).
+// 1 s or more (milliseconds), or the median speed over 0.2 s 150 m/s or more (millimetres).
 void CheckBallTrackUnits(const std::vector<BallSample>& samples, const std::string& name);
 BallTrackFile ReadBallTrack(const std::string& path);
 // Writes BALL.csv (BallCsvColumns()).

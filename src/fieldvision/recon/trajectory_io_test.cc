@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/random.h"
 #include "fieldvision/util/testing.h"
 
 namespace fv::recon {
@@ -20,6 +21,27 @@ std::string ErrorOf(const std::string& text) {
     return e.what();
   }
   return "";
+}
+
+// Seconds and metres: a noisy 240 Hz kick (30 cm of noise, 150 m/s from one row to the next)
+// reads; the same track in millimetres, or its times in milliseconds, is named.
+TEST(TrajectoryIo, TracksInOtherUnitsAreNamedNotFitted) {
+  const uint64_t seed = testing::TestSeed(5);
+  FV_SEED_TRACE(seed);
+  util::Rng rng(seed);
+  std::string metres = kHeader, millimetres = kHeader, milliseconds = kHeader;
+  for (int i = 0; i < 240; ++i) {
+    const double t = i / 240.0;
+    const Eigen::Vector3d p(-5 + 12 * t + rng.Normal(0, 0.3), 2 * t + rng.Normal(0, 0.3),
+                            0.11 + 6 * t - 4.9 * t * t + rng.Normal(0, 0.3));
+    metres += fmt::format("{},{},{},{},{},2,0.5\n", i, t, p.x(), p.y(), p.z());
+    millimetres +=
+        fmt::format("{},{},{},{},{},2,0.5\n", i, t, 1e3 * p.x(), 1e3 * p.y(), 1e3 * p.z());
+    milliseconds += fmt::format("{},{},{},{},{},2,0.5\n", i, 1e3 * t, p.x(), p.y(), p.z());
+  }
+  EXPECT_EQ(ErrorOf(metres), "");
+  EXPECT_NE(ErrorOf(millimetres).find("are its positions in metres"), std::string::npos);
+  EXPECT_NE(ErrorOf(milliseconds).find("are its times in seconds"), std::string::npos);
 }
 
 TEST(TrajectoryIo, MissingColumnsAreNamed) {

@@ -115,7 +115,10 @@ DetectionsFile ReadDetectionsCsv(const std::string& path) {
   for (size_t i = 0; i < t.rows(); ++i) {
     const std::string where = t.Where(i);
     const long long frame = t.GetInt(i, "frame");
-    FV_REQUIRE(frame >= 1 && frame <= 10000000, "{}: frame {} (frames are 1-based)", where, frame);
+    FV_REQUIRE(frame >= 1 && frame <= 10000000,
+               "{}: frame {} is not in 1..10000000 (frames count "
+               "from 1)",
+               where, frame);
     Detection d;
     d.box = cv::Rect2d(t.GetDouble(i, "bb_left"), t.GetDouble(i, "bb_top"),
                        t.GetDouble(i, "bb_width"), t.GetDouble(i, "bb_height"));

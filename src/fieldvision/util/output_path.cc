@@ -69,6 +69,15 @@ AtomicOutput::AtomicOutput(const std::string& out, std::string_view what)
   temp_ = (t.parent_path() / (t.stem().string() + "." + std::to_string(::getpid()) + "-" +
                               std::to_string(count++) + ".part" + t.extension().string()))
               .string();
+  // Made and removed at once: a folder that takes no file is named now, with the output's name
+  // (a writer's error names the temporary file, which the user never gave).
+  {
+    std::ofstream probe(temp_, std::ios::binary);
+    FV_REQUIRE(probe.good(), "{} '{}': cannot write a file in folder '{}'", what, out,
+               t.parent_path().empty() ? std::string(".") : t.parent_path().string());
+  }
+  std::error_code ec;
+  fs::remove(temp_, ec);
 }
 
 AtomicOutput::~AtomicOutput() {

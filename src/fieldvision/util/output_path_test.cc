@@ -137,6 +137,14 @@ TEST(AtomicWrite, WritesThroughASymlinkAndRefusesDevicesAndFolders) {
   // A missing folder is named with the output, not with the temporary file's name.
   const std::string lost = dir + "/no/such/out.csv";
   EXPECT_NE(testing::ErrorOf([&] { ResolveOutputPath(lost); }).find(lost), std::string::npos);
+  // So is a folder that takes no file (/proc, even for root), and nothing is left there.
+  const std::string error = testing::ErrorOf([] { AtomicOutput out("/proc/fv_out.csv"); });
+  EXPECT_NE(error.find("--out '/proc/fv_out.csv': cannot write a file in folder '/proc'"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(error.find(".part"), std::string::npos) << error;
+  AtomicOutput fine(dir + "/fine.csv");
+  EXPECT_FALSE(fs::exists(fine.temp_path()));  // the probe file is gone until a writer writes
 }
 
 // A run's new output folder: made with its parents, refused when it holds files or is a file;

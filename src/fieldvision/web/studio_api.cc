@@ -903,18 +903,69 @@ std::vector<track::TrackRow> ReadStatsInput(const Workspace& ws, const json& bod
   return rows;
 }
 
+// Whether `name` is a file a players export writes (the stats report's, zone_alerts.csv, the
+// page's images): the files an earlier export left, which a replacing one removes.
+bool IsExportFile(const std::string& name) {
+  static const std::regex kExport(
+      "(players|distances|speed_profiles|zone_alerts)\\.csv|stats\\.json|index\\.html|"
+      "radar\\.(png|mp4|avi)|heatmap_[A-Za-z0-9_]+\\.png|page_[A-Za-z0-9_-]+\\.png");
+  return std::regex_match(name, kExport);
+}
+
+// The files written in `made` (a new folder) moved into `out`, replacing files of their names
+// (a link is replaced, never written through); with `replace`, an earlier export's other files
+// in `out` go first. A file of the user's, or one this export read, is never removed.
+json MoveExportInto(const Workspace& ws, const fs::path& made, const fs::path& out, bool replace,
+                    const std::vector<fs::path>& inputs) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(made)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  for (const std::string& name : names) {
+    const fs::path target = out / name;
+    for (const fs::path& input : inputs) {
+      if (util::SameFile(target.string(), input.string())) {
+        throw HttpError(
+            409, "'" + ws.Relative(target) + "' is read by this export: choose another folder");
+      }
+    }
+    if (fs::is_directory(fs::symlink_status(target))) {
+      throw HttpError(409, "'" + ws.Relative(target) + "' is a folder; not replaced");
+    }
+  }
+  fs::create_directory(out);
+  if (replace) {
+    std::vector<fs::path> earlier;
+    for (const auto& e : fs::directory_iterator(out)) {
+      const bool read = std::any_of(inputs.begin(), inputs.end(), [&](const fs::path& input) {
+        return util::SameFile(e.path().string(), input.string());
+      });
+      if (!e.is_directory() && !read && IsExportFile(e.path().filename().string())) {
+        earlier.push_back(e.path());
+      }
+    }
+    for (const fs::path& p : earlier) fs::remove(p);
+  }
+  json wrote = json::array();
+  for (const std::string& name : names) {
+    fs::rename(made / name, out / name);
+    wrote.push_back(ws.Relative(out / name));
+  }
+  return wrote;
+}
+
 // POST /api/players/export. Everything is checked before anything is written; the files are
-// written into a new folder beside OUT, which then takes OUT's place whole: an earlier export's
-// files never mix with these, a link in OUT is never written through, and an OUT that is not
-// empty is refused (409) unless the request says replace.
+// written into a new folder beside OUT and then moved into it. An OUT that is not empty is
+// refused (409) unless the request says replace: then an earlier export's files there are
+// replaced (those of players that are gone removed too) and any other file is kept.
 ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiRequest& r) {
   const json body = Body(r);
   const fs::path out = ResolveOutputFolder(ws, Get<std::string>(body, "out"));
   std::error_code ec;
-  if (fs::is_directory(out, ec) && !fs::is_empty(out, ec) && !GetOr<bool>(body, "replace", false)) {
-    throw HttpError(409,
-                    "folder '" + ws.Relative(out) +
-                        "' is not empty: choose another folder, or replace it (replace: true)");
+  const bool replace = GetOr<bool>(body, "replace", false);
+  if (fs::is_directory(out, ec) && !fs::is_empty(out, ec) && !replace) {
+    throw HttpError(409, "folder '" + ws.Relative(out) +
+                             "' is not empty: choose another folder, or replace the export "
+                             "there (replace: true; other files are kept)");
   }
   const field::FieldModel field = LoadFieldIn(ws, GetOr<std::string>(body, "field", "robocup-msl"));
   std::vector<std::pair<std::string, cv::Mat>> images;
@@ -954,25 +1005,11 @@ ApiResponse ExportPlayers(const Workspace& ws, EventHub* events, const ApiReques
       f.write(png.data(), static_cast<std::streamsize>(png.size()));
       FV_REQUIRE(f.good(), "cannot write '{}'", name);
     }
-    std::vector<fs::path> made;
-    for (const auto& e : fs::directory_iterator(tmp)) made.push_back(e.path().filename());
-    std::sort(made.begin(), made.end());
-    if (fs::exists(fs::symlink_status(out))) {
-      const fs::path old = NewFolderBeside(out, "replaced");
-      FV_REQUIRE(!old.empty(), "cannot create a folder beside '{}'", ws.Relative(out));
-      fs::rename(out, old / "folder");
-      try {
-        fs::rename(tmp, out);
-      } catch (...) {
-        fs::rename(old / "folder", out, ec);
-        fs::remove_all(old, ec);
-        throw;
-      }
-      fs::remove_all(old, ec);
-    } else {
-      fs::rename(tmp, out);
+    std::vector<fs::path> inputs = {ws.Resolve(Get<std::string>(body, "tracks"))};
+    if (body.contains("zones") && !body["zones"].is_null()) {
+      inputs.push_back(ws.Resolve(Get<std::string>(body, "zones")));
     }
-    for (const auto& f : made) wrote.push_back(ws.Relative(out / f));
+    wrote = MoveExportInto(ws, tmp, out, replace, inputs);
   } catch (...) {
     fs::remove_all(tmp, ec);
     throw;

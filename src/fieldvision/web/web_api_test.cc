@@ -783,14 +783,17 @@ TEST_F(StudioApiTest, PlayersExport) {
   fs::create_directory(dir_ / "exports/walk");
   std::ofstream(dir_.parent_path() / "victim.csv") << "untouched\n";
   fs::create_symlink(dir_.parent_path() / "victim.csv", dir_ / "exports/walk/players.csv");
-  // A folder that is not empty is refused unless replaced, and then replaced whole.
-  std::ofstream(dir_ / "exports/walk/heatmap_9.png") << "an earlier export's player 9\n";
+  // A folder that is not empty is refused unless replaced; then an earlier export's files go
+  // (a player's map of the last export among them), the user's own stay.
+  std::ofstream(dir_ / "exports/walk/heatmap_player9.png") << "an earlier export's player 9\n";
+  std::ofstream(dir_ / "exports/walk/notes.txt") << "the user's\n";
   ExpectError(Post("/api/players/export", request), 409, "replace: true");
-  EXPECT_TRUE(fs::exists(dir_ / "exports/walk/heatmap_9.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "exports/walk/heatmap_player9.png"));
   request["replace"] = true;
   const Reply r = Post("/api/players/export", request);
   ASSERT_EQ(r.status, 200) << r.body;
-  EXPECT_FALSE(fs::exists(dir_ / "exports/walk/heatmap_9.png"));
+  EXPECT_FALSE(fs::exists(dir_ / "exports/walk/heatmap_player9.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "exports/walk/notes.txt"));
   std::set<std::string> wrote;
   const json reply = r.j();
   for (const auto& w : reply["wrote"]) wrote.insert(w.get<std::string>());
@@ -857,6 +860,14 @@ TEST_F(StudioApiTest, PlayersExport) {
     EXPECT_FALSE(fs::exists(dir_ / "exports/bad")) << words;
   }
   ExpectError(Post("/api/players/export", std::string("{\"out\": ")), 400, "malformed JSON");
+  // An export into the folder of its own tracks, named as one of its files, is refused.
+  fs::copy_file(dir_ / "WALK.csv", dir_ / "exports/walk/players.csv",
+                fs::copy_options::overwrite_existing);
+  json own = request;
+  own["out"] = "exports/walk";
+  own["tracks"] = "exports/walk/players.csv";
+  ExpectError(Post("/api/players/export", own), 409, "is read by this export");
+  EXPECT_TRUE(fs::exists(dir_ / "exports/walk/notes.txt"));
 }
 
 TEST_F(StudioApiTest, ZonesSaveAndRead) {
