@@ -44,6 +44,19 @@ export async function post<T>(path: string, body: unknown): Promise<T> {
   return (await check(res)).json();
 }
 
+// A save that asks before replacing a file: the server refuses an existing output (409); the
+// user is asked, and only a yes sends the save again with replace.
+export async function postSave<T>(path: string, body: Record<string, unknown>): Promise<T> {
+  try {
+    return await post<T>(path, body);
+  } catch (e) {
+    if (!(e instanceof ApiError) || e.status !== 409) throw e;
+    const name = String(body.out ?? body.points_out ?? 'the file');
+    if (!confirm(`${name} exists. Replace it?`)) throw new ApiError(409, `${name} exists: not replaced (choose another name)`);
+    return post<T>(path, { ...body, replace: true });
+  }
+}
+
 // A frame of a video as an image element (PNG from /api/frame).
 export function loadFrame(video: string, frame: number): Promise<HTMLImageElement> {
   return new Promise((resolve, reject) => {

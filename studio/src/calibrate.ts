@@ -278,6 +278,17 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
       return;
     }
     try {
+      // A camera file of another size than the frame (another camera's) gives no pose: said as
+      // such (an encoder's padding, under 16 px, is fitted by the server).
+      const cam = await api.get<api.CameraJson>('/api/camera', { path: camera.value });
+      if (id !== requestId) return;
+      if (img && (Math.abs(cam.width - img.naturalWidth) >= 16 || Math.abs(cam.height - img.naturalHeight) >= 16)) {
+        pose = null;
+        status(msg, `camera file ${camera.value} is for ${cam.width}x${cam.height} images but the frame is ${img.naturalWidth}x${img.naturalHeight}: choose this video's camera file`, true);
+        showPose();
+        draw();
+        return;
+      }
       const r = await api.post<PoseResult>('/api/calibrate/pose', { camera: camera.value, field: field.value, points: clicks });
       if (id !== requestId) return;
       pose = r;
@@ -372,14 +383,14 @@ export async function calibratePage(root: HTMLElement): Promise<void> {
   save.onclick = async () => {
     try {
       if (refined?.accepted) {
-        const r = await api.post<RefineResult>('/api/calibrate/refine', { ...refineBody(), out: out.value });
+        const r = await api.postSave<RefineResult>('/api/calibrate/refine', { ...refineBody(), out: out.value });
         refined = r;
         showRefined();
         draw();
         status(msg, r.wrote.length ? `wrote ${r.wrote.join(', ')} (refined against the lines)` : `not written: ${r.status}`, !r.wrote.length);
         return;
       }
-      const r = await api.post<PoseResult>('/api/calibrate/save', {
+      const r = await api.postSave<PoseResult>('/api/calibrate/save', {
         camera: camera.value, field: field.value, points: clicks, out: out.value,
         points_out: out.value.replace(/(\.ya?ml)?$/i, '_points.csv'),
       });
@@ -411,7 +422,7 @@ function intrinsicsSection(list: api.FileEntry[]): HTMLElement {
     try {
       status(msg, 'finding the board in every image and calibrating…');
       table.replaceChildren();
-      const r = await api.post<IntrinsicsResult>('/api/calibrate/intrinsics', {
+      const r = await api.postSave<IntrinsicsResult>('/api/calibrate/intrinsics', {
         images: images.value, num_distortion: Number(dist.value), out: out.value || undefined,
         board: { type: type.value, cols: Number(cols.value), rows: Number(rows.value), square_m: Number(square.value) / 1000 },
       });

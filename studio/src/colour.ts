@@ -193,6 +193,12 @@ export async function colourPage(root: HTMLElement): Promise<void> {
   });
   image.addEventListener('pointerup', (e) => {
     if (!drag || !img) return;
+    if (shownFrame < 0) {  // the frame shown is another video's
+      drag = null;
+      dragNow = null;
+      status(msg, `open a frame of ${video.value} first (Open frame)`, true);
+      return;
+    }
     const end = toImage(e);
     const start = drag;
     drag = null;
@@ -254,11 +260,12 @@ export async function colourPage(root: HTMLElement): Promise<void> {
     found = [];
     shownFrame = -1;
     drawOverlay();
+    status(msg, `open a frame of ${video.value} (Open frame): clicks go on its frames`);
   });
   save.onclick = async () => {
     if (!range) return status(msg, 'nothing to save: click on the ball or set the sliders first', true);
     try {
-      const r = await api.post<{ wrote: string[] }>('/api/colour/save', { range: rangeFromSliders(), out: out.value });
+      const r = await api.postSave<{ wrote: string[] }>('/api/colour/save', { range: rangeFromSliders(), out: out.value });
       saved = r.wrote[0];
       savedRange = JSON.stringify(rangeFromSliders());
       status(msg, `wrote ${saved}`);

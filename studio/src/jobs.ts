@@ -25,6 +25,14 @@ const examples: Record<string, string> = {
   synth: '--preset kick --frames 60 --out scene2',
 };
 
+// The arguments as a shell splits them: "a b" or 'a b' is one argument (a path with spaces).
+export function splitArgs(text: string): string[] {
+  const out: string[] = [];
+  const re = /"([^"]*)"|'([^']*)'|(\S+)/g;
+  for (let m = re.exec(text); m; m = re.exec(text)) out.push(m[1] ?? m[2] ?? m[3]);
+  return out;
+}
+
 export async function jobsPage(root: HTMLElement): Promise<void> {
   const command = optionsSelect('jb-command', Object.keys(examples), 'ball');
   const args = el('input', { id: 'jb-args', value: examples.ball, size: '90' });
@@ -34,13 +42,20 @@ export async function jobsPage(root: HTMLElement): Promise<void> {
   const msg = el('div', { id: 'jb-status', class: 'status' });
   const table = el('table', { id: 'jb-list' });
   root.replaceChildren(
-    el('section', { class: 'controls' }, labelled('Command', command), labelled('Arguments (paths inside the folder)', args),
+    el('section', { class: 'controls' }, labelled('Command', command), labelled('Arguments (paths inside the folder; quote a path with spaces)', args),
       el('label', {}, replace, 'Replace existing outputs'), start),
     msg, table,
   );
   command.onchange = () => (args.value = examples[command.value]);
 
   const jobs = new Map<number, Job>();
+  // A job's news in any order (the start's reply can come after the event of its end): an ended
+  // job never goes back to running.
+  function update(j: Job) {
+    const known = jobs.get(j.id);
+    if (known && known.state !== 'running' && j.state === 'running') return;
+    jobs.set(j.id, j);
+  }
   function draw() {
     table.replaceChildren(
       el('tr', {}, ...['id', 'command', 'state', 'time', 'progress / output', ''].map((h) => el('th', { text: h }))),
@@ -65,22 +80,22 @@ export async function jobsPage(root: HTMLElement): Promise<void> {
   const onEvent = (e: Event) => {
     const d = (e as CustomEvent).detail;
     if (d.type !== 'job' || !root.isConnected) return;
-    jobs.set(d.data.id, d.data);
+    update(d.data);
     draw();
   };
   window.addEventListener('studio-event', onEvent);
   start.onclick = async () => {
     try {
       const j = await api.post<Job>('/api/jobs', {
-        command: command.value, args: args.value.split(/\s+/).filter(Boolean), replace: replace.checked,
+        command: command.value, args: splitArgs(args.value), replace: replace.checked,
       });
-      jobs.set(j.id, j);
+      update(j);
       draw();
       status(msg, `started job ${j.id}`);
     } catch (e) {
       status(msg, (e as Error).message, true);
     }
   };
-  for (const j of await api.get<Job[]>('/api/jobs')) jobs.set(j.id, j);
+  for (const j of await api.get<Job[]>('/api/jobs')) update(j);
   draw();
 }

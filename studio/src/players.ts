@@ -399,7 +399,16 @@ export async function playersPage(root: HTMLElement): Promise<void> {
       time.max = String(Math.max(0, frames.length - 1));
       time.value = '0';
       draw(0);
-      status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions, ${players.size} players${statsNote}` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
+      // Positions beyond the map (the field and its surround) are not drawn: said, with the field.
+      let off = 0, placed = 0;
+      for (const ps of byFrame.values()) {
+        for (const p of ps) {
+          placed++;
+          if (Math.abs(p.x) > f.length_m / 2 + f.surround_m || Math.abs(p.y) > f.width_m / 2 + f.surround_m) off++;
+        }
+      }
+      const offNote = off ? `; ${off} of ${placed} positions lie beyond the ${f.name} map (not drawn): is it the field they were tracked on?` : '';
+      status(msg, frames.length ? `${tr.rows.length} rows, ${frames.length} frames with field positions, ${players.size} players${statsNote}${offNote}` : 'no field positions (x_m, y_m) in this file: track with a calibrated camera', !frames.length);
     } catch (e) {
       status(msg, (e as Error).message, true);
     }

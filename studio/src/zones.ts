@@ -117,7 +117,7 @@ export async function zonesPage(root: HTMLElement): Promise<void> {
   };
   save.onclick = async () => {
     try {
-      const r = await api.post<{ wrote: string[] }>('/api/zones/save', { zones, out: out.value });
+      const r = await api.postSave<{ wrote: string[] }>('/api/zones/save', { zones, out: out.value });
       status(msg, `wrote ${r.wrote.join(', ')}`);
     } catch (e) {
       status(msg, (e as Error).message, true);

@@ -27,6 +27,8 @@ for c in synth ball trajectory plan players stats detect "calibrate intrinsics" 
          "eval import-pets" "calibrate multi" "calibrate import" "calibrate export" \
          "calibrate compare" node fuse studio tracks; do
   check "$c --help" 0 $FV $c --help
+  # A negated flag reads as its name (CLI11 wrote "--no-progress{false}").
+  grep -q "{false}\|{true}" "$TMP/out" && { echo "FAIL $c --help: a flag's {value}"; fail=1; }
 done
 check "field show" 0 $FV field show robocup-msl
 # OpenCV's codecs (a plugin, codecs.h) load only for a command that reads or writes images.

@@ -44,10 +44,26 @@ void WarnOfDamagedVideo() {
                "wrong\n";
 }
 
+// Help without CLI11's flag values: "--no-legend{false}" (the value a negated flag gives) reads
+// as a syntax to type; the option's name alone is what a user types.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  std::string make_option_name(const CLI::Option* opt, bool is_positional) const override {
+    std::string name = CLI::Formatter::make_option_name(opt, is_positional);
+    for (const char* value : {"{false}", "{true}"}) {
+      for (size_t at = name.find(value); at != std::string::npos; at = name.find(value, at)) {
+        name.erase(at, std::char_traits<char>::length(value));
+      }
+    }
+    return name;
+  }
+};
+
 int Run(int argc, char** argv) {
   CLI::App app{
       "fieldvision: calibrate cameras against a sports field, find the ball, place it in 3D, fit "
       "its flight, plan camera rigs and track players."};
+  app.formatter(std::make_shared<HelpFormatter>());
   app.require_subcommand(1);
   app.set_version_flag("--version", "fieldvision 0.1.0");
   QuietLibraries(false);

@@ -69,8 +69,9 @@ std::vector<std::string> CheckJobArguments(const Workspace& ws, const std::strin
       const bool taken =
           fs::is_directory(resolved, ec) ? !fs::is_empty(resolved, ec) : fs::exists(resolved, ec);
       if (!input && taken && !replace) {
-        throw HttpError(409, "'" + a + "' (" + option +
-                                 ") exists: choose another name, or replace it (replace: true)");
+        throw HttpError(
+            409, fmt::format("'{}' ({}) exists: choose another name, or replace it (replace: true)",
+                             a, option));
       }
       argv.push_back(resolved.string());
     } else if (LooksLikePath(a) || a.find('/') != std::string::npos) {
@@ -181,6 +182,10 @@ int JobRunner::Start(const std::string& command, const std::vector<std::string>&
     if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
     if (chdir(root.c_str()) != 0) _exit(126);
     execve(argv[0], argv.data(), envp.data());
+    // Said in the job's output (it showed "failed (exit 127)" and nothing else).
+    static constexpr char kNotStarted[] =
+        "studio: the job's program could not be started (moved, removed or being rebuilt?)\n";
+    [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, kNotStarted, sizeof(kNotStarted) - 1);
     _exit(127);
   }
   setpgid(pid, pid);

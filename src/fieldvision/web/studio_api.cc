@@ -145,6 +145,21 @@ field::FieldModel LoadFieldIn(const Workspace& ws, const std::string& name_or_pa
   return field::LoadField(ws.Resolve(name_or_path).string());
 }
 
+// The built-in fields' names, then the folder's field files (JSON files of at most 1 MB that read
+// as a field; others, flights or zones, are left out).
+json FieldsIn(const Workspace& ws) {
+  json names = field::BuiltinFieldNames();
+  for (const auto& f : ws.ListFiles()) {
+    if (f["kind"] != "json" || f["size"].get<uint64_t>() > (1u << 20)) continue;
+    try {
+      field::LoadField(ws.Resolve(f["path"].get<std::string>()).string());
+      names.push_back(f["path"]);
+    } catch (const std::exception&) {  // not a field file
+    }
+  }
+  return names;
+}
+
 // The image's border through the lens model, in normalized coordinates (x/z, y/z): 8 points a side
 // from the top-left corner round, so that a client tells whether the camera's image holds a point
 // (a pinhole's frame would leave out what a barrel or fisheye lens bends into it). Points whose
@@ -529,6 +544,20 @@ struct Route {
   Handler handler;
 };
 
+// The file a save writes (body[key]): refused (409) when it exists, unless the request says
+// replace (the page asks first): a click never replaces a user's camera or colour file.
+fs::path SaveTarget(const Workspace& ws, const json& body, const char* key,
+                    const std::vector<std::string>& extensions) {
+  const std::string name = Get<std::string>(body, key);
+  fs::path out = ws.ResolveOutput(name, extensions);
+  std::error_code ec;
+  if (fs::exists(fs::symlink_status(out, ec)) && !GetOr<bool>(body, "replace", false)) {
+    throw HttpError(409,
+                    "'" + name + "' exists: choose another name, or replace it (replace: true)");
+  }
+  return out;
+}
+
 // A new folder beside `path` (".NAME.WHAT-XXXXXXXX", never one that was there before); empty
 // when none could be made.
 fs::path NewFolderBeside(const fs::path& path, const std::string& what) {
@@ -557,10 +586,12 @@ std::vector<Route> FolderRoutes() {
          }
          return Json(j);
        }},
-      {{"GET", "/api/info", "working folder, built-in fields and colour presets"},
+      {{"GET", "/api/info",
+        "working folder, fields (built in, then the folder's field files) and "
+        "colour presets"},
        [](const Workspace& ws, EventHub*, JobRunner* jobs, LiveFeed*, const ApiRequest&) {
          return Json({{"root", ws.root().string()},
-                      {"fields", field::BuiltinFieldNames()},
+                      {"fields", FieldsIn(ws)},
                       {"colour_presets", detect::ColourPresetNames()}});
        }},
       {{"GET", "/api/files", "files of the working folder: [{path, size, kind}]"},
@@ -626,10 +657,10 @@ std::vector<Route> CalibrationRoutes() {
              camera::ReadCameraYaml(ws.Resolve(Get<std::string>(body, "camera")).string());
          const field::FieldModel field = LoadFieldIn(ws, Get<std::string>(body, "field"));
          const auto points = ParseClicks(body, field);
-         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"), {".yaml", ".yml"});
+         const fs::path out = SaveTarget(ws, body, "out", {".yaml", ".yml"});
          fs::path points_out;
          if (body.contains("points_out")) {
-           points_out = ws.ResolveOutput(Get<std::string>(body, "points_out"), {".csv"});
+           points_out = SaveTarget(ws, body, "points_out", {".csv"});
          }
          const calib::ExtrinsicsResult result = calib::EstimatePose(cam, points);
          camera::WriteCameraYaml(result.camera, out.string());
@@ -661,7 +692,7 @@ std::vector<Route> CalibrationRoutes() {
          const fs::path video = ws.Resolve(video_path);
          fs::path out;
          if (body.contains("out")) {
-           out = ws.ResolveOutput(Get<std::string>(body, "out"), {".yaml", ".yml"});
+           out = SaveTarget(ws, body, "out", {".yaml", ".yml"});
          }
          if (body.contains("points")) {
            cam = calib::EstimatePose(cam, ParseClicks(body, field)).camera;
@@ -743,7 +774,7 @@ std::vector<Route> IntrinsicsAndLiveRoutes() {
          }
          fs::path out;
          if (body.contains("out")) {
-           out = ws.ResolveOutput(Get<std::string>(body, "out"), {".yaml", ".yml"});
+           out = SaveTarget(ws, body, "out", {".yaml", ".yml"});
          }
          const calib::IntrinsicsResult res = calib::CalibrateIntrinsics(spec, o);
          json j = IntrinsicsToJson(ws, res);
@@ -837,7 +868,7 @@ std::vector<Route> ColourRoutes() {
        [](const Workspace& ws, EventHub* events, JobRunner* jobs, LiveFeed*, const ApiRequest& r) {
          const json body = Body(r);
          const detect::ColourSpec spec = SpecWithBallRange(RangeFromJson(Get<json>(body, "range")));
-         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"), {".json"});
+         const fs::path out = SaveTarget(ws, body, "out", {".json"});
          detect::WriteColourSpec(spec, out.string());
          Saved(events, ws, out, "colour");
          return Json({{"wrote", {ws.Relative(out)}}, {"spec", detect::ColourSpecToJson(spec)}});
@@ -1123,7 +1154,7 @@ std::vector<Route> TrackRoutes() {
          const json body = Body(r);
          const json zones = Get<json>(body, "zones");
          if (!zones.is_array()) throw HttpError(400, "'zones' must be an array");
-         const fs::path out = ws.ResolveOutput(Get<std::string>(body, "out"), {".json"});
+         const fs::path out = SaveTarget(ws, body, "out", {".json"});
          SaveZones(zones, out);
          Saved(events, ws, out, "zones");
          return Json({{"wrote", {ws.Relative(out)}}, {"zones", zones.size()}});

@@ -144,17 +144,29 @@ class StudioApiTest : public ::testing::Test {
 
 TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
   FV_SEED_TRACE(seed_);
+  // The folder's field files are offered after the built-in fields; other JSON files are not.
+  std::ofstream(dir_ / "pitch40.json") << R"({"name": "pitch40", "length_m": 40, "width_m": 20})";
+  std::ofstream(dir_ / "other.json") << R"({"cameras": []})";
   const Reply info = Get("/api/info");
   ASSERT_EQ(info.status, 200);
   EXPECT_EQ(info.j()["root"], fs::canonical(dir_).string());
-  EXPECT_NE(info.body.find("robocup-msl"), std::string::npos);
+  const json fields = info.j()["fields"];
+  EXPECT_EQ(fields.front(), "robocup-msl");
+  EXPECT_EQ(fields.back(), "pitch40.json");
+  EXPECT_EQ(info.body.find("other.json"), std::string::npos);
   const Reply endpoints = Get("/api/endpoints");
   ASSERT_EQ(endpoints.status, 200);
   EXPECT_EQ(endpoints.j().size(), StudioApi::Endpoints().size());
   // A lone numbered photo is an image (it was left out), a folder named build... is the user's
   // (only a CMake build tree is not listed).
-  for (const char* folder : {"one", "buildings", "cmake-out"}) {
+  for (const char* folder : {"one", "buildings", "cmake-out", "seq", "photos"}) {
     fs::create_directories(dir_ / folder);
+  }
+  // Numbered frames in a row are a sequence; numbered photos with gaps are photos (a pattern over
+  // the gaps opened none of them).
+  for (const char* name : {"seq/00001.png", "seq/00002.png", "seq/00003.png", "photos/00005.jpg",
+                           "photos/00006.jpg", "photos/00021.jpg"}) {
+    cv::imwrite((dir_ / name).string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(9)));
   }
   cv::imwrite((dir_ / "one/00017.jpg").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 200, 255)));
   cv::imwrite((dir_ / "buildings/a.png").string(), cv::Mat(8, 8, CV_8UC3, cv::Scalar(9)));
@@ -170,6 +182,9 @@ TEST_F(StudioApiTest, InfoEndpointsAndFiles) {
   EXPECT_EQ(kinds["one/00017.jpg"], "image");
   EXPECT_EQ(kinds["buildings/a.png"], "image");
   EXPECT_EQ(kinds.count("cmake-out/b.png"), 0u);
+  EXPECT_EQ(kinds["seq/%05d.png"], "images");
+  EXPECT_EQ(kinds["photos/00021.jpg"], "image");
+  EXPECT_EQ(kinds.count("photos/%05d.jpg"), 0u);
   ExpectError(Get("/api/nothing"), 404, "unknown endpoint");
   ExpectError(Get("/nothing.html"), 404, "not found: /nothing.html");
   ExpectError(Post("/api/info", json::object()), 405, "not allowed");
@@ -377,6 +392,14 @@ TEST_F(StudioApiTest, PoseFromClickedKeypoints) {
   const camera::Camera written = camera::ReadCameraYaml((dir_ / "scene/cam1_studio.yaml").string());
   EXPECT_LT((written.CentreInWorld() - truth.CentreInWorld()).norm(), 0.005);
   EXPECT_EQ(util::CsvTable::Read((dir_ / "scene/cam1_points.csv").string()).rows(), points.size());
+  // Saving over the camera calibrated from (or any file there) waits for replace: the page asks.
+  const auto size_before = fs::file_size(dir_ / "scene/cam1.yaml");
+  body["out"] = "scene/cam1.yaml";
+  body.erase("points_out");
+  ExpectError(Post("/api/calibrate/save", body), 409, "'scene/cam1.yaml' exists");
+  EXPECT_EQ(fs::file_size(dir_ / "scene/cam1.yaml"), size_before);
+  body["replace"] = true;
+  EXPECT_EQ(Post("/api/calibrate/save", body).status, 200);
 }
 
 TEST_F(StudioApiTest, PoseRefinedAgainstThePaintedLines) {
@@ -878,9 +901,13 @@ TEST_F(StudioApiTest, ZonesSaveAndRead) {
   const Reply read = Get("/api/zones?path=zones.json");
   ASSERT_EQ(read.status, 200) << read.body;
   EXPECT_EQ(read.j(), zones);
+  // A file that is there is replaced only when the request says so (the page asks first).
+  ExpectError(Post("/api/zones/save", json{{"zones", zones}, {"out", "zones.json"}}), 409,
+              "'zones.json' exists");
   const json bad = {{{"name", "line"}, {"polygon", {{0, 0}, {1, 1}}}}};
-  ExpectError(Post("/api/zones/save", json{{"zones", bad}, {"out", "zones.json"}}), 400,
-              "the zones sent: zone 'line' needs 3 or more vertices");
+  ExpectError(
+      Post("/api/zones/save", json{{"zones", bad}, {"out", "zones.json"}, {"replace", true}}), 400,
+      "the zones sent: zone 'line' needs 3 or more vertices");
   EXPECT_EQ(Get("/api/zones?path=zones.json").j(), zones);  // the old file is kept
   EXPECT_FALSE(fs::exists(dir_ / "zones.json.check"));
   ExpectError(Get("/api/zones?path=scene/truth.csv"), 422, "not valid JSON");
@@ -891,8 +918,9 @@ TEST_F(StudioApiTest, ZonesSaveAndRead) {
               "must end in .json");
   EXPECT_EQ(fs::file_size(dir_ / "scene/truth.csv"), truth_before);
   const json twice = {zones[0], zones[0]};
-  ExpectError(Post("/api/zones/save", json{{"zones", twice}, {"out", "zones.json"}}), 400,
-              "two zones are named 'box'");
+  ExpectError(
+      Post("/api/zones/save", json{{"zones", twice}, {"out", "zones.json"}, {"replace", true}}),
+      400, "two zones are named 'box'");
   ExpectError(
       Post("/api/colour/save", json{{"range", {{"min", {0, 50, 50}}, {"max", {30, 255, 255}}}},
                                     {"out", "scene/cam1.avi"}}),

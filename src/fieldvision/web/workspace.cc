@@ -1,6 +1,8 @@
 #include "fieldvision/web/workspace.h"
 
 #include <algorithm>
+#include <charconv>
+#include <limits>
 #include <map>
 #include <regex>
 #include <system_error>
@@ -122,7 +124,19 @@ nlohmann::json Workspace::ListFiles(size_t max_files) const {
     if (paths.size() >= max_files) break;
   }
   for (const auto& [folder, s] : sequences) {
-    if (s.second.size() < 2) {  // one numbered image is an image
+    // One numbered image is an image; numbers with gaps are photos (a video's frames are
+    // numbered without gaps, and a pattern over gaps opens none of them).
+    long long lo = std::numeric_limits<long long>::max(), hi = -1;
+    for (const fs::path& p : s.second) {
+      const std::string stem = p.stem().string();
+      long long n = 0;
+      if (std::from_chars(stem.data(), stem.data() + stem.size(), n).ec != std::errc()) {
+        n = std::numeric_limits<long long>::max() / 2;  // too long a number: no sequence
+      }
+      lo = std::min(lo, n);
+      hi = std::max(hi, n);
+    }
+    if (s.second.size() < 2 || hi - lo + 1 != static_cast<long long>(s.second.size())) {
       paths.insert(paths.end(), s.second.begin(), s.second.end());
       continue;
     }
