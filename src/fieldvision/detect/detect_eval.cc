@@ -18,6 +18,7 @@
 #include <fmt/format.h>
 
 #include "fieldvision/camera/camera_io.h"
+#include "fieldvision/camera/frame_size.h"
 #include "fieldvision/detect/camera_background.h"
 #include "fieldvision/detect/eval_drawing.h"
 #include "fieldvision/io/image_file.h"
@@ -560,8 +561,16 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   std::string camera_note;
   if (!o.camera.empty()) {
     camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
-    // Fitted to a video's frames before the detector takes it (an encoder's cropped padding).
-    if (video != nullptr) camera_note = video->FitCamera(*camera, o.camera);
+    // Fitted to a video's frames, or to the first image, before the detector takes it (an
+    // encoder's cropped padding).
+    if (video != nullptr) {
+      camera_note = video->FitCamera(*camera, o.camera);
+    } else if (!items.empty()) {
+      const cv::Mat first = io::ReadImage(items.front().image);
+      camera_note =
+          camera::FitCameraToFrames(*camera, fmt::format("camera file '{}'", o.camera), first.cols,
+                                    first.rows, fmt::format("image '{}'", items.front().image));
+    }
   }
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) {

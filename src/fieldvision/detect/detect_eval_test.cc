@@ -439,6 +439,29 @@ TEST(DetectEval, FieldNeedsACamera) {
   }
 }
 
+// Photos of a camera whose file is for the encoder's padded size (camera/frame_size.h: 300x200
+// frames of a 304x208 camera) are scored; another size is an error naming both.
+TEST(DetectEval, AnEncodersPaddedCameraFitsItsPhotos) {
+  const std::string dir = fv::testing::TempDir() + "/detect_eval_padded";
+  fs::create_directories(dir);
+  util::Rng rng(4);
+  cv::Mat img = test_util::FieldImage(300, 200, rng);
+  test_util::PaintDisc(img, Eigen::Vector2d(150, 100), 10);
+  cv::imwrite(dir + "/a.png", img);
+  WriteText(dir + "/a.txt", fmt::format("0 0.5 0.5 {} {}\n", 20.0 / 300, 20.0 / 200));
+  camera::WriteCameraYaml(camera::Camera::FromFov(304, 208, 60), dir + "/padded.yaml");
+  camera::WriteCameraYaml(camera::Camera::FromFov(320, 240, 60), dir + "/other.yaml");
+  DetectEvalOptions o;
+  o.video = dir;
+  o.progress = false;
+  o.camera = dir + "/padded.yaml";
+  EXPECT_EQ(EvaluateDetector(o).hits, 1);
+  o.camera = dir + "/other.yaml";
+  const std::string error = fv::testing::ErrorOf([&] { EvaluateDetector(o); });
+  EXPECT_NE(error.find("300x200"), std::string::npos) << error;
+  EXPECT_NE(error.find("other.yaml"), std::string::npos) << error;
+}
+
 // The real RoboCup photos (shared/data/robocup-ball-photos): a floor under today's measured
 // recall and precision so that a change that loses real balls shows up here.
 TEST(DetectEval, RealRobocupPhotos) {

@@ -109,7 +109,7 @@ TEST(DetectionsFile, MotChallengeColumnsReadAndBadRowsNameFileAndLine) {
   const std::vector<std::pair<std::string, std::string>> bad = {
       {"1,-1,10,20,30,80\n", "7 columns"},
       {"1,-1,10,20,30,80,0.5\n2,-1,10,x,30,80,0.5\n", "bb_top"},
-      {"0,-1,10,20,30,80,0.5\n", "1-based"},
+      {"0,-1,10,20,30,80,0.5\n", "frames count from 1"},
       {"1,-1,10,20,-30,80,0.5\n", "non-negative"},
       {"1,-1,10,20,30,80,0.5\n2,-1,10,20,30,80\n", "6 fields, the first row has 7"},
   };
