@@ -531,6 +531,27 @@ void TransformImage(const std::function<cv::Mat(const cv::Mat&)>& transform, cv:
 
 }  // namespace
 
+namespace {
+
+// The camera file (null when none), fitted to a video's frames or to the first image before the
+// detector takes it (an encoder's cropped padding: *note says so).
+std::unique_ptr<camera::Camera> LoadEvalCamera(const std::string& path, io::VideoSource* video,
+                                               const std::vector<LabelledImage>& items,
+                                               std::string* note) {
+  if (path.empty()) return nullptr;
+  auto camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(path));
+  if (video != nullptr) {
+    *note = video->FitCamera(*camera, path);
+  } else if (!items.empty()) {
+    const cv::Mat first = io::ReadImage(items.front().image);
+    *note = camera::FitCameraToFrames(*camera, fmt::format("camera file '{}'", path), first.cols,
+                                      first.rows, fmt::format("image '{}'", items.front().image));
+  }
+  return camera;
+}
+
+}  // namespace
+
 DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
   o.Check();
   std::vector<LabelledImage> items = ListLabelledImages(o.video, o.labels, "eval detect");
@@ -557,21 +578,9 @@ DetectEvalResult EvaluateDetector(const DetectEvalOptions& o) {
     }
     drawings = std::make_unique<MissDrawings>(o.draw_misses, o.video, image_files);
   }
-  std::unique_ptr<camera::Camera> camera;
   std::string camera_note;
-  if (!o.camera.empty()) {
-    camera = std::make_unique<camera::Camera>(camera::ReadCameraYaml(o.camera));
-    // Fitted to a video's frames, or to the first image, before the detector takes it (an
-    // encoder's cropped padding).
-    if (video != nullptr) {
-      camera_note = video->FitCamera(*camera, o.camera);
-    } else if (!items.empty()) {
-      const cv::Mat first = io::ReadImage(items.front().image);
-      camera_note =
-          camera::FitCameraToFrames(*camera, fmt::format("camera file '{}'", o.camera), first.cols,
-                                    first.rows, fmt::format("image '{}'", items.front().image));
-    }
-  }
+  const std::unique_ptr<camera::Camera> camera =
+      LoadEvalCamera(o.camera, video.get(), items, &camera_note);
   std::optional<field::FieldModel> field;
   if (!o.field.empty()) {
     FV_REQUIRE(camera->has_pose, "eval detect: --field needs a camera with a pose ('{}' has none)",
