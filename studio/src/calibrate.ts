@@ -430,6 +430,8 @@ function intrinsicsSection(list: api.FileEntry[]): HTMLElement {
       status(msg, `fx ${c.fx.toFixed(1)} fy ${c.fy.toFixed(1)} cx ${c.cx.toFixed(1)} cy ${c.cy.toFixed(1)} px (± ${r.std_px.map((v) => v.toFixed(1)).join(', ')}), ` +
         `RMS ${r.rms_px.toFixed(3)} px over ${r.num_used} of ${r.num_images} views (${r.num_found} with the board)` +
         `${r.warnings.length ? '; ' + r.warnings.join('; ') : ''}${r.wrote.length ? '; wrote ' + r.wrote.join(', ') : ''}`);
+      // Done, but with warnings (few views, a board only in the middle): not in the success colour.
+      if (r.warnings.length) msg.classList.add('warn');
       msg.dataset.fx = String(c.fx);
       table.replaceChildren(
         el('tr', {}, ...['view', 'board', 'corners', 'error px', ''].map((h) => el('th', { text: h }))),
