@@ -72,18 +72,23 @@ struct TracksDrawCli {
   int max_frames = 0;
 };
 
+// The boxes that lie wholly outside frames of `size`.
+size_t BoxesOutside(const std::vector<track::TrackRow>& rows, cv::Size size) {
+  const cv::Rect2d frame(0, 0, size.width, size.height);
+  return static_cast<size_t>(std::count_if(
+      rows.begin(), rows.end(), [&](const auto& r) { return (r.box & frame).area() <= 0; }));
+}
+
 // Which of the drawn frames the tracks cover; warnings where tracks drawn on a video they were not
 // made from run past its end or lie beside its frames.
 void ReportTracksOnVideo(const std::vector<track::TrackRow>& rows, const track::DrawVideoResult& d,
                          const std::string& video, int max_frames) {
   int first_frame = std::numeric_limits<int>::max(), last_frame = 0;
-  long outside = 0;
-  const cv::Rect2d frame(0, 0, d.frame_size.width, d.frame_size.height);
   for (const auto& r : rows) {
     first_frame = std::min(first_frame, r.frame);
     last_frame = std::max(last_frame, r.frame);
-    outside += (r.box & frame).area() <= 0;
   }
+  const size_t outside = BoxesOutside(rows, d.frame_size);
   if (last_frame <= d.frames && (first_frame > 1 || last_frame < d.frames)) {
     std::cout << fmt::format(
         "the tracks cover frames {}-{} of the {} drawn; the others have no "
@@ -108,9 +113,7 @@ void ReportTracksOnVideo(const std::vector<track::TrackRow>& rows, const track::
 // before anything is written (a few beside them are warned of after drawing).
 void CheckTracksFitVideo(const std::vector<track::TrackRow>& rows, const io::VideoSource& video,
                          const std::string& tracks) {
-  const cv::Rect2d frame(0, 0, video.width(), video.height());
-  size_t outside = 0;
-  for (const auto& r : rows) outside += (r.box & frame).area() <= 0;
+  const size_t outside = BoxesOutside(rows, cv::Size(video.width(), video.height()));
   FV_REQUIRE(outside * 2 <= rows.size(),
              "tracks draw: {} of the {} boxes of '{}' lie outside the {}x{} frames of video '{}' "
              "(tracks of another video?); nothing written",

@@ -12,6 +12,7 @@
 #include "fieldvision/app/command.h"
 #include "fieldvision/codecs/codecs.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace {
 
@@ -49,13 +50,8 @@ void WarnOfDamagedVideo() {
 class HelpFormatter : public CLI::Formatter {
  public:
   std::string make_option_name(const CLI::Option* opt, bool is_positional) const override {
-    std::string name = CLI::Formatter::make_option_name(opt, is_positional);
-    for (const char* value : {"{false}", "{true}"}) {
-      for (size_t at = name.find(value); at != std::string::npos; at = name.find(value, at)) {
-        name.erase(at, std::char_traits<char>::length(value));
-      }
-    }
-    return name;
+    const std::string name = CLI::Formatter::make_option_name(opt, is_positional);
+    return fv::util::ReplaceAll(fv::util::ReplaceAll(name, "{false}", ""), "{true}", "");
   }
 };
 

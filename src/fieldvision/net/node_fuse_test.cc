@@ -93,6 +93,15 @@ std::string WriteTinyCamera(const std::string& dir, const std::string& name, dou
   return path;
 }
 
+// Three 64x48 frames of a tiny camera in `dir` (no frame rate of their own): their pattern.
+std::string WriteTinySequence(const std::string& dir) {
+  for (int i = 0; i < 3; ++i) {
+    io::WriteImage(fmt::format("{}/{:05d}.png", dir, i),
+                   cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 90, 0)));
+  }
+  return dir + "/%05d.png";
+}
+
 // A fusion node of the tiny cameras cam1 and cam2 in `dir` writing dir/ball.csv, run until
 // `control` stops it (no idle limit: no wall-clock limit on a loaded machine).
 FuseOptions TinyFuseOptions(const std::string& dir, pipeline::JobControl* control) {
@@ -467,13 +476,9 @@ TEST(NodeFuse, ANodeNeedsAFrameRateForAnImageSequence) {
   const std::string dir = testing::TempDir() + "/node_sequence";
   std::filesystem::create_directories(dir);
   WriteTinyCamera(dir, "cam1");
-  for (int i = 0; i < 3; ++i) {
-    io::WriteImage(fmt::format("{}/{:05d}.png", dir, i),
-                   cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 90, 0)));
-  }
   NodeOptions no;
   no.camera = dir + "/cam1.yaml";
-  no.video = dir + "/%05d.png";
+  no.video = WriteTinySequence(dir);
   no.connect = "tcp://127.0.0.1:1";
   no.connect_wait_s = 0;
   const std::string error = testing::ErrorOf([&] { RunNode(no); });
@@ -588,13 +593,9 @@ TEST(NodeFuse, ANodeOfAnUnknownCameraStopsWithTheReason) {
   FuseSummary fused;
   std::thread fuse;
   const std::string endpoint = StartFuse(fo, &fused, &fuse);
-  for (int i = 0; i < 3; ++i) {
-    io::WriteImage(fmt::format("{}/{:05d}.png", dir, i),
-                   cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 90, 0)));
-  }
   NodeOptions no;
   no.camera = WriteTinyCamera(dir, "cam3");
-  no.video = dir + "/%05d.png";
+  no.video = WriteTinySequence(dir);
   no.fps = 30;
   no.connect = endpoint;
   no.connect_wait_s = 10 * fv::testing::SlowdownFactor();

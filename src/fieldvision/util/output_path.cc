@@ -9,6 +9,7 @@
 
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/error.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::util {
 namespace fs = std::filesystem;
@@ -95,12 +96,7 @@ void AtomicOutput::Commit() {
 }
 
 void AtomicOutput::Rethrow(const std::exception& error) const {
-  std::string message = error.what();
-  for (size_t at = message.find(temp_); at != std::string::npos;
-       at = message.find(temp_, at + out_.size())) {
-    message.replace(at, temp_.size(), out_);
-  }
-  throw Error(message);
+  throw Error(ReplaceAll(error.what(), temp_, out_));
 }
 
 void AtomicOutput::CloseAndCommit(CsvWriter& csv) {

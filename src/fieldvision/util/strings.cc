@@ -46,6 +46,14 @@ std::string ToLower(std::string_view s) {
   return out;
 }
 
+std::string ReplaceAll(std::string text, std::string_view from, std::string_view to) {
+  if (from.empty()) return text;
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
 std::string FileNamePart(std::string_view s) {
   std::string out(s);
   for (char& c : out) {

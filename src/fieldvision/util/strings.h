@@ -15,6 +15,9 @@ std::string Trim(std::string_view s);
 bool StartsWith(std::string_view s, std::string_view prefix);
 bool EndsWith(std::string_view s, std::string_view suffix);
 std::string ToLower(std::string_view s);
+// `text` with every occurrence of `from` (not empty) replaced by `to`, left to right; what `to`
+// brings in is not searched again.
+std::string ReplaceAll(std::string text, std::string_view from, std::string_view to);
 // The non-empty ones of `parts` joined by `sep` ("" when all are empty).
 std::string JoinNonEmpty(const std::vector<std::string>& parts, std::string_view sep);
 // `s` as part of a file name: ASCII letters, digits, '-', '_', '.' and non-ASCII (UTF-8) bytes

@@ -9,6 +9,13 @@
 namespace fv::util {
 namespace {
 
+TEST(Strings, ReplaceAllReplacesEveryOccurrenceOnce) {
+  EXPECT_EQ(ReplaceAll("a.part a.part", "a.part", "a"), "a a");
+  EXPECT_EQ(ReplaceAll("--x{false} --y{true}", "{false}", ""), "--x --y{true}");
+  EXPECT_EQ(ReplaceAll("aaa", "a", "aa"), "aaaaaa");  // what comes in is not searched again
+  EXPECT_EQ(ReplaceAll("abc", "", "x"), "abc");
+}
+
 TEST(Fnv1a64, PublishedVectors) {
   EXPECT_EQ(Fnv1a64(""), 0xcbf29ce484222325ull);
   EXPECT_EQ(Fnv1a64("a"), 0xaf63dc4c8601ec8cull);

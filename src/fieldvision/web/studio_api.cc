@@ -33,6 +33,7 @@
 #include "fieldvision/util/csv.h"
 #include "fieldvision/util/json.h"
 #include "fieldvision/util/output_path.h"
+#include "fieldvision/util/strings.h"
 
 namespace fv::web {
 
@@ -444,13 +445,9 @@ void SaveZones(const json& zones, const fs::path& out) {
     throw;
   } catch (const fv::Error& e) {
     // The reader names the file it read; the zones came in the request.
-    std::string m = e.what();
-    for (const std::string& named : {"zones file '" + out.string() + "'", out.string()}) {
-      for (size_t at = m.find(named); at != std::string::npos; at = m.find(named, at)) {
-        m.replace(at, named.size(), "the zones sent");
-      }
-    }
-    throw HttpError(400, m);
+    const std::string named =
+        util::ReplaceAll(e.what(), "zones file '" + out.string() + "'", "the zones sent");
+    throw HttpError(400, util::ReplaceAll(named, out.string(), "the zones sent"));
   }
 }
 
@@ -948,16 +945,19 @@ bool IsExportFile(const std::string& name) {
 // in `out` go first. A file of the user's, or one this export read, is never removed.
 json MoveExportInto(const Workspace& ws, const fs::path& made, const fs::path& out, bool replace,
                     const std::vector<fs::path>& inputs) {
+  const auto read_here = [&](const fs::path& p) {
+    return std::any_of(inputs.begin(), inputs.end(), [&](const fs::path& input) {
+      return util::SameFile(p.string(), input.string());
+    });
+  };
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(made)) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   for (const std::string& name : names) {
     const fs::path target = out / name;
-    for (const fs::path& input : inputs) {
-      if (util::SameFile(target.string(), input.string())) {
-        throw HttpError(
-            409, "'" + ws.Relative(target) + "' is read by this export: choose another folder");
-      }
+    if (read_here(target)) {
+      throw HttpError(
+          409, "'" + ws.Relative(target) + "' is read by this export: choose another folder");
     }
     if (fs::is_directory(fs::symlink_status(target))) {
       throw HttpError(409, "'" + ws.Relative(target) + "' is a folder; not replaced");
@@ -967,10 +967,7 @@ json MoveExportInto(const Workspace& ws, const fs::path& made, const fs::path& o
   if (replace) {
     std::vector<fs::path> earlier;
     for (const auto& e : fs::directory_iterator(out)) {
-      const bool read = std::any_of(inputs.begin(), inputs.end(), [&](const fs::path& input) {
-        return util::SameFile(e.path().string(), input.string());
-      });
-      if (!e.is_directory() && !read && IsExportFile(e.path().filename().string())) {
+      if (!e.is_directory() && !read_here(e.path()) && IsExportFile(e.path().filename().string())) {
         earlier.push_back(e.path());
       }
     }
